@@ -1,0 +1,62 @@
+"""The ``rocksweep`` group, shared options, and the one error path to the user.
+
+Each command lives in its own module and is thin: it turns options into arguments and
+calls the library. Errors the user can fix (a bad scene, a foreign file, an existing
+output) reach the terminal as one line through ``click.ClickException``: no traceback, a
+non-zero exit.
+"""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+
+import click
+
+from rocksweep.model import BodyError
+from rocksweep.scene import SceneError, load_scene
+
+# errors that are the user's to fix; other modules register theirs with ``user_errors``
+USER_ERRORS: list[type[Exception]] = [SceneError, BodyError]
+
+
+def user_errors(fn):
+    """Turn the library's user-facing errors into one-line click errors."""
+
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        try:
+            return fn(*args, **kwargs)
+        except tuple(USER_ERRORS) as err:
+            raise click.ClickException(str(err)) from None
+
+    return wrapper
+
+
+scene_argument = click.argument(
+    "scene_path", metavar="SCENE.yaml", type=click.Path(dir_okay=False, path_type=Path))
+set_option = click.option(
+    "--set", "overrides", multiple=True, metavar="KEY=VALUE",
+    help="Override a scene value, e.g. --set pulse.A_ratio=4.5 (repeatable).")
+
+
+def load(scene_path: Path, overrides: tuple[str, ...] = ()):
+    if not scene_path.exists():
+        raise click.ClickException(f"{scene_path}: no such scene file")
+    return load_scene(scene_path, list(overrides))
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="rocksweep")
+def main() -> None:
+    """Stability diagrams of flexible rocking oscillators (Zhu, Chatzis & Acikgoz).
+
+    Times are p*t, rotations theta/alpha_cg, energies E/E_ref.
+    """
+
+
+def _register() -> None:
+    from rocksweep.cli import commands  # noqa: F401  (imports attach the commands)
+
+
+_register()

@@ -1,0 +1,199 @@
+"""Equations of motion, uplift and impact of the flexible rocking oscillator (jitted).
+
+Everything here is a pure function of scalars and the parameter row ``prm`` (see
+``layout``). Conventions (``rocksweep.model``): theta > 0 clockwise = rocking on the +b
+corner (s = +1), u along the body's x axis, SI units with m = 1, g = 9.81, p = 1.
+
+Derivation (section 2 of the paper; Lagrange's equations in the frame of the ground,
+ground acceleration xg'' as d'Alembert loads -m_i xg'' on each mass, damper as the
+generalised force -c u'). Rocking on corner s, with a = u - s b the top mass's lever arm:
+
+    T = 1/2 m [(u' + h theta')^2 + a^2 theta'^2] + 1/2 (I_A + m_A R_A^2) theta'^2
+    V = m g (h cos theta - a sin theta) + m_A g (h_A cos theta + s b sin theta) + 1/2 k u^2
+
+which gives   [ I_O(u)  m h ] [theta'']   [F_theta]
+              [  m h     m  ] [  u''  ] = [  F_u  ]     with I_O(u) = I_A + m_A R_A^2 + m (h^2 + a^2),
+
+    F_theta = -2 m a u' theta' + m g (a cos + h sin) - m_A g (s b cos - h_A sin)
+              - xg'' [m (h cos - a sin) + m_A (h_A cos + s b sin)]
+    F_u     = m a theta'^2 + m g sin - k u - c u' - m xg'' cos
+
+solved as theta'' = (F_theta - h F_u) / (I_A + m_A R_A^2 + m a^2), u'' = F_u/m - h theta''.
+Full contact (theta = 0):  m u'' + c u' + k u = -m xg''.
+"""
+
+import math
+
+from numba import njit
+
+from rocksweep.kernel.layout import (
+    PAR_AMP, PAR_B, PAR_C, PAR_G, PAR_H, PAR_HA, PAR_HCG, PAR_IA0, PAR_IAH, PAR_IO, PAR_K,
+    PAR_LAM, PAR_M, PAR_MA, PAR_MTOT, PAR_OMEGA, PAR_SHAPE, SHAPE_COSINE,
+)
+
+# ----------------------------------------------------------------------------------------
+# Eq. (2): the single-cycle pulse. ``on`` is decided per step by the loop (the step that
+# ends exactly at 2 pi/omega still sees the pulse, the next one does not), so the cosine
+# pulse's jump is never smeared across a step.
+# ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def ground_acc(t, on, prm):
+    """xg''(t) [m/s^2] of eq. (2); 0 when ``on`` is False."""
+    if not on:
+        return 0.0
+    if prm[PAR_SHAPE] == SHAPE_COSINE:
+        return prm[PAR_AMP] * math.cos(prm[PAR_OMEGA] * t)
+    return prm[PAR_AMP] * math.sin(prm[PAR_OMEGA] * t)
+
+
+@njit(cache=True)
+def ground_jerk(t, on, prm):
+    """d xg''/dt [m/s^3], for locating an uplift inside a step."""
+    if not on:
+        return 0.0
+    w = prm[PAR_OMEGA]
+    if prm[PAR_SHAPE] == SHAPE_COSINE:
+        return -prm[PAR_AMP] * w * math.sin(w * t)
+    return prm[PAR_AMP] * w * math.cos(w * t)
+
+
+# ----------------------------------------------------------------------------------------
+# Rocking phases
+# ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def rocking_rhs(theta, theta_dot, u, u_dot, s, xg, prm, DAMPED):
+    """Accelerations while rocking on corner s (+1 / -1), and the input and damper powers.
+
+    Returns (theta'' [rad/s^2], u'' [m/s^2], ground power [W], damper power [W]).
+    """
+    m, m_A, h, h_A = prm[PAR_M], prm[PAR_MA], prm[PAR_H], prm[PAR_HA]
+    g, k, sb = prm[PAR_G], prm[PAR_K], s * prm[PAR_B]
+    cth, sth = math.cos(theta), math.sin(theta)
+    a = u - sb
+    f_damp = prm[PAR_C] * u_dot if DAMPED else 0.0
+    lever = m * (h * cth - a * sth) + m_A * (h_A * cth + sb * sth)  # d(X_i)/d theta, summed
+    f_theta = (-2.0 * m * a * u_dot * theta_dot + m * g * (a * cth + h * sth)
+               - m_A * g * (sb * cth - h_A * sth) - xg * lever)
+    f_u = m * a * theta_dot * theta_dot + m * g * sth - k * u - f_damp - m * xg * cth
+    theta_dd = (f_theta - h * f_u) / (prm[PAR_IA0] + m * a * a)
+    u_dd = f_u / m - h * theta_dd
+    power_in = -xg * (lever * theta_dot + m * cth * u_dot)
+    return theta_dd, u_dd, power_in, f_damp * u_dot
+
+
+@njit(cache=True)
+def rigid_rhs(theta, theta_dot, s, xg, prm):
+    """Rigid body (top mass welded, or a block): I_O theta'' = moment about corner s.
+
+    I_O theta'' = -M g (s b cos - h_cg sin) - M xg'' (h_cg cos + s b sin); this is
+    ``rocking_rhs`` with u = u' = 0 and no u equation. Returns (theta'', ground power).
+    """
+    M, sb, hcg = prm[PAR_MTOT], s * prm[PAR_B], prm[PAR_HCG]
+    cth, sth = math.cos(theta), math.sin(theta)
+    lever = M * (hcg * cth + sb * sth)
+    theta_dd = (-M * prm[PAR_G] * (sb * cth - hcg * sth) - xg * lever) / prm[PAR_IO]
+    return theta_dd, -xg * lever * theta_dot
+
+
+# ----------------------------------------------------------------------------------------
+# Full contact and uplift
+# ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def contact_rhs(u, u_dot, xg, prm, DAMPED):
+    """Full contact: m u'' + c u' + k u = -m xg''. Returns (u'', ground power, damper power)."""
+    f_damp = prm[PAR_C] * u_dot if DAMPED else 0.0
+    u_dd = -(prm[PAR_K] * u + f_damp) / prm[PAR_M] - xg
+    return u_dd, -prm[PAR_M] * xg * u_dot, f_damp * u_dot
+
+
+@njit(cache=True)
+def uplift_moment(u, u_dot, xg, prm, FLEX, DAMPED):
+    """Q [N m]: the moment that tips the body in full contact.
+
+    In full contact the ground reaction N = M g acts at x_R in [-b, b]; holding theta'' = 0
+    in the theta equation about corner s (theta = theta' = 0, u'' from full contact) gives
+    N (b - s x_R) = M g b - s Q with
+
+        Q = h (k u + c u') + m g u - m_A h_A xg''.
+
+    The reaction reaches corner s, and the body uplifts on it, when s Q >= M g b.
+    (The top mass's d'Alembert load cancels against m h u''; only the spring force reaches
+    the frame.) Rigid body: Q = -M h_cg xg'', i.e. uplift at |xg''| = g tan(alpha_cg).
+    """
+    if not FLEX:
+        return -prm[PAR_MTOT] * prm[PAR_HCG] * xg
+    f = prm[PAR_K] * u + (prm[PAR_C] * u_dot if DAMPED else 0.0)
+    return prm[PAR_H] * f + prm[PAR_M] * prm[PAR_G] * u - prm[PAR_MA] * prm[PAR_HA] * xg
+
+
+@njit(cache=True)
+def uplift_moment_rate(u, u_dot, xg, jerk, prm, FLEX, DAMPED):
+    """dQ/dt [N m/s] in full contact."""
+    if not FLEX:
+        return -prm[PAR_MTOT] * prm[PAR_HCG] * jerk
+    u_dd = contact_rhs(u, u_dot, xg, prm, DAMPED)[0]
+    df = prm[PAR_K] * u_dot + (prm[PAR_C] * u_dd if DAMPED else 0.0)
+    return prm[PAR_H] * df + prm[PAR_M] * prm[PAR_G] * u_dot - prm[PAR_MA] * prm[PAR_HA] * jerk
+
+
+# ----------------------------------------------------------------------------------------
+# Impact (eq. 1)
+# ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def restitution(s, u, prm, FLEX):
+    """e = theta'^+ / theta'^- for an impact that ends rocking on corner s.
+
+    The vertical impulse acts at x_Q = s' b (1 - lam), lam*b from the future corner
+    s' = -s. Angular momentum of the whole body about x_Q is conserved (a horizontal
+    impulse at the ground has no moment about it) and, since the spring and damper carry no
+    impulse, so is the top mass's horizontal momentum m (u' + h theta'). Eliminating u'^+:
+
+        e = [I_A + m_A (h_A^2 + x_Q s b)  + m (u - x_Q)(u - s b)]
+          / [I_A + m_A (h_A^2 + x_Q s' b) + m (u - x_Q)(u - s' b)],
+
+    which is eq. (1) (upper sign: s = +1). Rigid body: (I_O - M b^2 (2 - lam)) / (I_O - lam M b^2).
+    """
+    b, lam = prm[PAR_B], prm[PAR_LAM]
+    if not FLEX:
+        mb2 = prm[PAR_MTOT] * b * b
+        return (prm[PAR_IO] - mb2 * (2.0 - lam)) / (prm[PAR_IO] - lam * mb2)
+    m, m_A = prm[PAR_M], prm[PAR_MA]
+    x_q = -s * b * (1.0 - lam)
+    num = prm[PAR_IAH] + m_A * x_q * s * b + m * (u - x_q) * (u - s * b)
+    den = prm[PAR_IAH] - m_A * x_q * s * b + m * (u - x_q) * (u + s * b)
+    return num / den
+
+
+# ----------------------------------------------------------------------------------------
+# Energy (relative to rest, in the frame of the ground)
+# ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def mechanical_energy(theta, theta_dot, u, u_dot, s, prm, FLEX):
+    """T + V - V_rest [J] in phase s (0: full contact)."""
+    if not FLEX:
+        if s == 0:
+            return 0.0
+        sth, cth = math.sin(theta), math.cos(theta)
+        pot = prm[PAR_MTOT] * prm[PAR_G] * (s * prm[PAR_B] * sth + prm[PAR_HCG] * (cth - 1.0))
+        return 0.5 * prm[PAR_IO] * theta_dot * theta_dot + pot
+    m, k = prm[PAR_M], prm[PAR_K]
+    if s == 0:
+        return 0.5 * m * u_dot * u_dot + 0.5 * k * u * u
+    h, h_A, sb, g = prm[PAR_H], prm[PAR_HA], s * prm[PAR_B], prm[PAR_G]
+    sth, cth = math.sin(theta), math.cos(theta)
+    a = u - sb
+    v_x = u_dot + h * theta_dot
+    kin = 0.5 * m * (v_x * v_x + a * a * theta_dot * theta_dot) + 0.5 * prm[PAR_IA0] * theta_dot**2
+    pot = (m * g * (h * (cth - 1.0) - a * sth) + prm[PAR_MA] * g * (h_A * (cth - 1.0) + sb * sth)
+           + 0.5 * k * u * u)
+    return kin + pot

@@ -1,0 +1,587 @@
+"""Fixed-step RK4 with event location: the loop that runs one point (jitted).
+
+Design (scipy's ``_ivp`` split): ``rk4_step`` knows nothing of events; ``_crossing``
+decides whether an event function crossed zero inside a step (including a dip through zero
+and back that leaves both ends on the same side, found from the step's cubic Hermite
+interpolant); ``_locate`` brackets and shrinks the root by re-integrating from the step's
+start; ``simulate_point`` owns the phases and the actions.
+
+Compile-time specialisation: the functions take the flags FLEX, DAMPED, ENERGY and HISTORY
+and call ``numba.literally`` on them, so numba compiles one specialisation per flag value
+(a ``Literal[bool]`` type) and the branches a variant does not need are removed at compile
+time. One small jitted entry point per variant (bottom of this module) fixes the flags;
+every variant is assembled from the same functions.
+
+Event functions g (the event fires when g crosses from > 0 to <= 0):
+  impact     g = s theta              (rocking on corner s)
+  overturn   g = pi/2 - s theta
+  uplift     g = M g b - s Q          (full contact, each corner s; Q from ``uplift_moment``)
+The pulse end is not searched for: the step is shortened to land on it exactly.
+"""
+
+import math
+
+import numpy as np
+from numba import literally, njit
+
+from rocksweep.kernel.equations import (
+    contact_rhs, ground_acc, ground_jerk, mechanical_energy, restitution, rigid_rhs,
+    rocking_rhs, uplift_moment, uplift_moment_rate,
+)
+from rocksweep.kernel.layout import (
+    HIST_D_DAMP, HIST_E, HIST_E_IMPACT, HIST_PHASE, HIST_T, HIST_THETA, HIST_THETA_DOT,
+    HIST_U, HIST_U_DOT, HIST_W_IN, HIST_XG, OUT_CONTACTS, OUT_D_DAMP, OUT_E_END,
+    OUT_E_GAINED, OUT_E_IMPACT, OUT_E_MAX, OUT_EVENT_STEPS, OUT_HIST_ROWS, OUT_IMPACTS,
+    OUT_N_GAINING, OUT_OUTCOME, OUT_STATUS, OUT_STEPS, OUT_T_END, OUT_T_FIRST_IMPACT,
+    OUT_T_OVERTURN, OUT_THETA_MAX, OUT_UPLIFTS, OUT_W_IN, OUTCOME_MODE1, OUTCOME_MODE2,
+    OUTCOME_SAFE, PAR_B, PAR_C, PAR_DT, PAR_G, PAR_H, PAR_K, PAR_M, PAR_MAXEVENTS,
+    PAR_MAXSTEPS, PAR_MTOT, PAR_RESTRATE, PAR_ROOT, PAR_TEND, PAR_THETA_OVER, PAR_TOL,
+    PAR_TPULSE, ROOT_ILLINOIS, STATUS_E_ABOVE_1, STATUS_ENERGY_GAIN, STATUS_EVENT_CAP,
+    STATUS_HIST_FULL, STATUS_HORIZON, STATUS_NONFINITE, STATUS_OVERTURNED, STATUS_REST,
+    STATUS_SETTLED, STATUS_STEP_CAP,
+)
+
+EV_NONE = 0
+EV_IMPACT = 1
+EV_OVERTURN = 2
+EV_UPLIFT_POS = 3
+EV_UPLIFT_NEG = 4
+
+
+# ----------------------------------------------------------------------------------------
+# The right-hand side on the state (theta, theta', u, u', W_in, D_damp)
+# ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def derivatives(t, y, s, on, prm, FLEX, DAMPED, ENERGY):
+    """dy/dt for phase s (0 full contact, +-1 rocking corner); y is a 6-tuple."""
+    theta, theta_dot, u, u_dot = y[0], y[1], y[2], y[3]
+    xg = ground_acc(t, on, prm)
+    if s == 0:
+        if not FLEX:
+            return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        u_dd, p_in, p_damp = contact_rhs(u, u_dot, xg, prm, DAMPED)
+        if ENERGY:
+            return (0.0, 0.0, u_dot, u_dd, p_in, p_damp)
+        return (0.0, 0.0, u_dot, u_dd, 0.0, 0.0)
+    if not FLEX:
+        theta_dd, p_in = rigid_rhs(theta, theta_dot, s, xg, prm)
+        if ENERGY:
+            return (theta_dot, theta_dd, 0.0, 0.0, p_in, 0.0)
+        return (theta_dot, theta_dd, 0.0, 0.0, 0.0, 0.0)
+    theta_dd, u_dd, p_in, p_damp = rocking_rhs(theta, theta_dot, u, u_dot, s, xg, prm, DAMPED)
+    if ENERGY:
+        return (theta_dot, theta_dd, u_dot, u_dd, p_in, p_damp)
+    return (theta_dot, theta_dd, u_dot, u_dd, 0.0, 0.0)
+
+
+@njit(cache=True)
+def _axpy(y, a, k):
+    return (y[0] + a * k[0], y[1] + a * k[1], y[2] + a * k[2],
+            y[3] + a * k[3], y[4] + a * k[4], y[5] + a * k[5])
+
+
+@njit(cache=True)
+def rk4_step(t, y, h, s, on, prm, FLEX, DAMPED, ENERGY):
+    """One classical RK4 step of size h from (t, y). Returns the new 6-tuple."""
+    literally(FLEX)
+    literally(DAMPED)
+    literally(ENERGY)
+    k1 = derivatives(t, y, s, on, prm, FLEX, DAMPED, ENERGY)
+    k2 = derivatives(t + 0.5 * h, _axpy(y, 0.5 * h, k1), s, on, prm, FLEX, DAMPED, ENERGY)
+    k3 = derivatives(t + 0.5 * h, _axpy(y, 0.5 * h, k2), s, on, prm, FLEX, DAMPED, ENERGY)
+    k4 = derivatives(t + h, _axpy(y, h, k3), s, on, prm, FLEX, DAMPED, ENERGY)
+    w = h / 6.0
+    return (y[0] + w * (k1[0] + 2.0 * (k2[0] + k3[0]) + k4[0]),
+            y[1] + w * (k1[1] + 2.0 * (k2[1] + k3[1]) + k4[1]),
+            y[2] + w * (k1[2] + 2.0 * (k2[2] + k3[2]) + k4[2]),
+            y[3] + w * (k1[3] + 2.0 * (k2[3] + k3[3]) + k4[3]),
+            y[4] + w * (k1[4] + 2.0 * (k2[4] + k3[4]) + k4[4]),
+            y[5] + w * (k1[5] + 2.0 * (k2[5] + k3[5]) + k4[5]))
+
+
+# ----------------------------------------------------------------------------------------
+# Events
+# ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def event_value(ev, t, y, s, on, prm, FLEX, DAMPED):
+    """Value of event function ``ev`` at (t, y) in phase s."""
+    if ev == EV_IMPACT:
+        return s * y[0]
+    if ev == EV_OVERTURN:
+        return prm[PAR_THETA_OVER] - s * y[0]
+    q = uplift_moment(y[2], y[3], ground_acc(t, on, prm), prm, FLEX, DAMPED)
+    mgb = prm[PAR_MTOT] * prm[PAR_G] * prm[PAR_B]
+    return mgb - q if ev == EV_UPLIFT_POS else mgb + q
+
+
+@njit(cache=True)
+def event_rate(ev, t, y, s, on, prm, FLEX, DAMPED):
+    """d/dt of event function ``ev`` at (t, y) (for the Hermite check)."""
+    if ev == EV_IMPACT:
+        return s * y[1]
+    if ev == EV_OVERTURN:
+        return -s * y[1]
+    dq = uplift_moment_rate(y[2], y[3], ground_acc(t, on, prm), ground_jerk(t, on, prm), prm,
+                            FLEX, DAMPED)
+    return -dq if ev == EV_UPLIFT_POS else dq
+
+
+@njit(cache=True)
+def hermite_min(g0, d0, g1, d1, h):
+    """Minimum of the cubic Hermite interpolant of g on [0, h] when g dips inside the step.
+
+    Called when g0 > 0, g1 > 0, d0 < 0 < d1 (g falls, then rises). Returns
+    (tau, g_min) at the interior minimum of the cubic.
+    """
+    # cubic c(x) = g0 + d0 h x + c2 x^2 + c3 x^3 on x in [0, 1]
+    c2 = 3.0 * (g1 - g0) - h * (2.0 * d0 + d1)
+    c3 = 2.0 * (g0 - g1) + h * (d0 + d1)
+    # c'(x) = h d0 + 2 c2 x + 3 c3 x^2 = 0, root with c'' > 0
+    qa, qb, qc = 3.0 * c3, 2.0 * c2, h * d0
+    if abs(qa) < 1e-300:
+        x = -qc / qb
+    else:
+        disc = qb * qb - 4.0 * qa * qc
+        if disc < 0.0:
+            disc = 0.0
+        sq = math.sqrt(disc)
+        # the minimum has c''(x) = 2 c2 + 6 c3 x > 0  <=>  x = (-qb + sq) / (2 qa)
+        x = (-qb + sq) / (2.0 * qa)
+    if x < 0.0:
+        x = 0.0
+    elif x > 1.0:
+        x = 1.0
+    return x * h, g0 + x * (h * d0 + x * (c2 + x * c3))
+
+
+@njit(cache=True)
+def _locate(ev, t0, y0, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, ENERGY):
+    """Shrink a bracket [lo, hi] (g(lo) > 0 >= g(hi)) of event ``ev`` to PAR_TOL.
+
+    Every trial point is a fresh RK4 step of that length from (t0, y0), so the located
+    state is the integrator's own solution, not an interpolant. Root finder: bisection
+    (default, the design's guaranteed method), or Illinois regula falsi, which keeps the
+    bracket and converges superlinearly. Returns (tau, y(tau), re-integrations), with tau on
+    the far side of the root (the event has happened at tau).
+    """
+    literally(FLEX)
+    literally(DAMPED)
+    literally(ENERGY)
+    tol = prm[PAR_TOL]
+    illinois = prm[PAR_ROOT] == ROOT_ILLINOIS
+    n = 0
+    side = 0
+    while hi - lo > tol:
+        if illinois:
+            mid = hi - g_hi * (hi - lo) / (g_hi - g_lo)
+            # stay strictly inside and shrink by at least tol/2 from either end
+            if mid <= lo + 0.5 * tol or mid >= hi - 0.5 * tol or not (mid == mid):
+                mid = 0.5 * (lo + hi)
+        else:
+            mid = 0.5 * (lo + hi)
+        y_mid = rk4_step(t0, y0, mid, s, on, prm, FLEX, DAMPED, ENERGY)
+        g_mid = event_value(ev, t0 + mid, y_mid, s, on, prm, FLEX, DAMPED)
+        n += 1
+        if g_mid <= 0.0:
+            hi, g_hi, y_hi = mid, g_mid, y_mid
+            if side == -1:
+                g_lo *= 0.5
+            side = -1
+        else:
+            lo, g_lo = mid, g_mid
+            if side == 1:
+                g_hi *= 0.5
+            side = 1
+    return hi, y_hi, n
+
+
+@njit(cache=True)
+def _crossing(ev, t0, y0, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
+    """Did event ``ev`` fire in the step (t0, y0) -> (t0 + h, y1)?
+
+    Returns (tau, y_event, re-integrations); tau < 0 if it did not. A sign change at the
+    ends is bracketed at once. Same sign at both ends but falling then rising (a dip
+    through zero and back, e.g. a grazing impact inside a coarse step) is checked with the
+    step's cubic Hermite interpolant; a predicted dip is confirmed by integrating to the
+    interpolant's minimum, which then closes the bracket.
+    """
+    literally(FLEX)
+    literally(DAMPED)
+    literally(ENERGY)
+    g0 = event_value(ev, t0, y0, s, on, prm, FLEX, DAMPED)
+    g1 = event_value(ev, t0 + h, y1, s, on, prm, FLEX, DAMPED)
+    if g1 <= 0.0:
+        # g0 = 0 happens right after an action put the state on g = 0 (uplift leaves
+        # theta = 0): if the motion turns straight back, that is an event just after t0.
+        return _locate(ev, t0, y0, 0.0, g0, h, g1, y1, s, on, prm, FLEX, DAMPED, ENERGY)
+    if g0 <= 0.0:
+        return -1.0, y1, 0  # leaving g = 0 after an action: not an event
+    d0 = event_rate(ev, t0, y0, s, on, prm, FLEX, DAMPED)
+    if d0 >= 0.0:
+        return -1.0, y1, 0
+    d1 = event_rate(ev, t0 + h, y1, s, on, prm, FLEX, DAMPED)
+    if d1 <= 0.0:
+        return -1.0, y1, 0
+    tau, g_min = hermite_min(g0, d0, g1, d1, h)
+    if g_min > 0.0:
+        return -1.0, y1, 0
+    y_m = rk4_step(t0, y0, tau, s, on, prm, FLEX, DAMPED, ENERGY)
+    g_m = event_value(ev, t0 + tau, y_m, s, on, prm, FLEX, DAMPED)
+    if g_m > 0.0:
+        return -1.0, y1, 1
+    tau, y_e, n = _locate(ev, t0, y0, 0.0, g0, tau, g_m, y_m, s, on, prm, FLEX, DAMPED, ENERGY)
+    return tau, y_e, n + 1
+
+
+@njit(cache=True)
+def uplift_side(t, y, on, prm, FLEX, DAMPED):
+    """Corner (+1 / -1) the body uplifts on from full contact at (t, y), or 0."""
+    q = uplift_moment(y[2], y[3], ground_acc(t, on, prm), prm, FLEX, DAMPED)
+    mgb = prm[PAR_MTOT] * prm[PAR_G] * prm[PAR_B]
+    if q >= mgb:
+        return 1
+    if q <= -mgb:
+        return -1
+    return 0
+
+
+@njit(cache=True)
+def rest_proven(y, prm, FLEX):
+    """After the pulse, in full contact: can the oscillator ever uplift the body again?
+
+    Q = (h k + m g) u + h c u' is linear in (u, u'); over the energy ellipse
+    1/2 m u'^2 + 1/2 k u^2 <= E (which c >= 0 never lets grow) its largest value is
+    sqrt(2 E (L_u^2/k + L_v^2/m)). Below M g b the body stays in contact for good.
+    """
+    if not FLEX:
+        return True
+    m, k, h = prm[PAR_M], prm[PAR_K], prm[PAR_H]
+    l_u = h * k + m * prm[PAR_G]
+    l_v = h * prm[PAR_C]
+    e2 = m * y[3] * y[3] + k * y[2] * y[2]  # 2 E
+    q_max2 = e2 * (l_u * l_u / k + l_v * l_v / m)
+    mgb = prm[PAR_MTOT] * prm[PAR_G] * prm[PAR_B]
+    return q_max2 < mgb * mgb
+
+
+# ----------------------------------------------------------------------------------------
+# The loop
+# ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def _record(hist, row, t, y, s, on, prm, e_imp, FLEX):
+    literally(FLEX)
+    if row >= hist.shape[0]:
+        return False
+    hist[row, HIST_T] = t
+    hist[row, HIST_THETA] = y[0]
+    hist[row, HIST_THETA_DOT] = y[1]
+    hist[row, HIST_U] = y[2]
+    hist[row, HIST_U_DOT] = y[3]
+    hist[row, HIST_PHASE] = s
+    hist[row, HIST_E] = mechanical_energy(y[0], y[1], y[2], y[3], s, prm, FLEX)
+    hist[row, HIST_W_IN] = y[4]
+    hist[row, HIST_D_DAMP] = y[5]
+    hist[row, HIST_E_IMPACT] = e_imp
+    hist[row, HIST_XG] = ground_acc(t, on, prm)
+    return True
+
+
+@njit(cache=True)
+def _first_event(t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
+    """The first event in the step (t, y) -> (t + h, y1) of phase s.
+
+    Returns (event code, tau, state at the event, re-integrations); EV_NONE and y1 if none.
+    """
+    literally(FLEX)
+    literally(DAMPED)
+    literally(ENERGY)
+    if s != 0:
+        tau, y_ev, n = _crossing(EV_IMPACT, t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
+        if tau >= 0.0:
+            return EV_IMPACT, tau, y_ev, n
+        tau, y_ev, n2 = _crossing(EV_OVERTURN, t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
+        if tau >= 0.0:
+            return EV_OVERTURN, tau, y_ev, n + n2
+        return EV_NONE, h, y1, n + n2
+    tau, y_ev, n = _crossing(EV_UPLIFT_POS, t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
+    tau2, y_ev2, n2 = _crossing(EV_UPLIFT_NEG, t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
+    if tau2 >= 0.0 and (tau < 0.0 or tau2 < tau):
+        return EV_UPLIFT_NEG, tau2, y_ev2, n + n2
+    if tau >= 0.0:
+        return EV_UPLIFT_POS, tau, y_ev, n + n2
+    return EV_NONE, h, y1, n + n2
+
+
+@njit(cache=True)
+def _impact(y, s, prm, FLEX, ENERGY):
+    """Impact map at theta = 0 ending rocking on corner s (eq. 1 and the settling rule).
+
+    Returns (state after, new phase, e, energy lost E_d [J] (0 unless ENERGY)).
+    e > 0 with |e theta'^-| >= PAR_RESTRATE: rocking continues on -s, theta'^+ = e theta'^-.
+    Otherwise full contact: e <= 0 is inadmissible as rocking, and a post-impact rate
+    below the rest rate ends a chattering (Zeno) sequence after finitely many impacts.
+    Either way the top mass keeps its horizontal momentum m (u' + h theta').
+    """
+    literally(FLEX)
+    literally(ENERGY)
+    e = restitution(s, y[2], prm, FLEX)
+    w_minus = y[1]
+    if e > 0.0 and abs(e * w_minus) >= prm[PAR_RESTRATE]:
+        s_new = -s
+        w_plus = e * w_minus
+    else:
+        s_new = 0
+        w_plus = 0.0
+    u_dot_plus = y[3] + prm[PAR_H] * (w_minus - w_plus) if FLEX else 0.0
+    y_new = (0.0, w_plus, y[2], u_dot_plus, y[4], y[5])
+    e_d = 0.0
+    if ENERGY:
+        e_d = (mechanical_energy(y[0], y[1], y[2], y[3], s, prm, FLEX)
+               - mechanical_energy(0.0, w_plus, y[2], u_dot_plus, s_new, prm, FLEX))
+    return y_new, s_new, e, e_d
+
+
+
+@njit(cache=True)
+def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, HISTORY):
+    """Run one point from rest to a decided outcome, a cap or the horizon.
+
+    prm: float64[N_PAR] parameter row; out: float64[N_OUT] result row (filled);
+    hist: float64[n, N_HIST] history buffer (used when HISTORY; may be empty otherwise).
+    """
+    literally(FLEX)
+    literally(DAMPED)
+    literally(ENERGY)
+    literally(HISTORY)
+    dt, t_end, t_pulse = prm[PAR_DT], prm[PAR_TEND], prm[PAR_TPULSE]
+    max_steps, max_events = prm[PAR_MAXSTEPS], prm[PAR_MAXEVENTS]
+
+    t = 0.0
+    y = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    s = 0
+    status = 0
+    outcome = OUTCOME_SAFE
+    impacts = 0
+    uplifts = 0
+    contacts = 0
+    steps = 0
+    event_steps = 0
+    theta_max = 0.0
+    t_over = np.nan
+    t_first_impact = np.nan
+    e_imp = 0.0  # net energy lost in impacts
+    e_gained = 0.0
+    n_gaining = 0
+    e_max = 0.0
+    row = 0
+
+    on = t_pulse > 0.0
+    # Uplift is possible at t = 0 (a cosine pulse starts at its peak).
+    s = uplift_side(t, y, on, prm, FLEX, DAMPED)
+    if s != 0:
+        uplifts += 1
+    if HISTORY:
+        if _record(hist, row, t, y, s, on, prm, e_imp, FLEX):
+            row += 1
+
+    while True:
+        on = t < t_pulse
+        if s == 0 and not on and rest_proven(y, prm, FLEX):
+            status |= STATUS_REST
+            break
+        if t >= t_end:
+            status |= STATUS_HORIZON
+            break
+        if steps + event_steps >= max_steps:
+            status |= STATUS_STEP_CAP
+            break
+        if impacts + uplifts >= max_events:
+            status |= STATUS_EVENT_CAP
+            break
+
+        h = dt
+        lands = False
+        if on and t + h >= t_pulse:
+            h = t_pulse - t
+            lands = True
+        elif t + h > t_end:
+            h = t_end - t
+        y1 = rk4_step(t, y, h, s, on, prm, FLEX, DAMPED, ENERGY)
+        steps += 1
+        if not (math.isfinite(y1[0]) and math.isfinite(y1[1]) and math.isfinite(y1[2])
+                and math.isfinite(y1[3])):
+            status |= STATUS_NONFINITE
+            break
+
+        ev, tau, y_ev, n = _first_event(t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
+        event_steps += n
+
+        # --- largest |theta|, including a turning point inside the step ---
+        y_end = y_ev if ev != EV_NONE else y1
+        h_end = tau if ev != EV_NONE else h
+        if s != 0:
+            a_end = abs(y_end[0])
+            if a_end > theta_max:
+                theta_max = a_end
+            if s * y[1] > 0.0 and s * y_end[1] < 0.0:
+                # turning point inside the step: Hermite maximum of s*theta = -min(-s*theta)
+                _, gm = hermite_min(-s * y[0], -s * y[1], -s * y_end[0], -s * y_end[1], h_end)
+                if -gm > theta_max:
+                    theta_max = -gm
+
+        if ev == EV_NONE:
+            t = t_pulse if lands else t + h
+            y = y1
+            if HISTORY:
+                if _record(hist, row, t, y, s, t < t_pulse, prm, e_imp, FLEX):
+                    row += 1
+                else:
+                    status |= STATUS_HIST_FULL
+            continue
+
+        t = t + tau
+        y = y_ev
+        if HISTORY:
+            if _record(hist, row, t, y, s, on, prm, e_imp, FLEX):
+                row += 1
+            else:
+                status |= STATUS_HIST_FULL
+
+        if ev == EV_OVERTURN:
+            outcome = OUTCOME_MODE1 if impacts > 0 else OUTCOME_MODE2
+            t_over = t
+            status |= STATUS_OVERTURNED
+            break
+
+        if ev == EV_IMPACT:
+            impacts += 1
+            if impacts == 1:
+                t_first_impact = t
+            y, s_new, e, e_d = _impact(y, s, prm, FLEX, ENERGY)
+            s = s_new
+            if e > e_max:
+                e_max = e
+            if e > 1.0:
+                status |= STATUS_E_ABOVE_1
+            if s == 0:
+                contacts += 1
+                if e > 0.0:
+                    status |= STATUS_SETTLED
+            if ENERGY:
+                e_imp += e_d
+                if e_d < 0.0:
+                    e_gained -= e_d
+                    n_gaining += 1
+                    status |= STATUS_ENERGY_GAIN
+            if s == 0:
+                # back in full contact: uplift is checked again at once
+                s = uplift_side(t, y, on, prm, FLEX, DAMPED)
+                if s != 0:
+                    uplifts += 1
+        else:
+            # uplift: theta = theta' = 0 exactly, now rocking on the located corner
+            s = 1 if ev == EV_UPLIFT_POS else -1
+            y = (0.0, 0.0, y[2], y[3], y[4], y[5])
+            uplifts += 1
+        if HISTORY:
+            if _record(hist, row, t, y, s, on, prm, e_imp, FLEX):
+                row += 1
+            else:
+                status |= STATUS_HIST_FULL
+
+    out[OUT_OUTCOME] = outcome
+    out[OUT_STATUS] = status
+    out[OUT_IMPACTS] = impacts
+    out[OUT_UPLIFTS] = uplifts
+    out[OUT_THETA_MAX] = theta_max
+    out[OUT_T_OVERTURN] = t_over
+    out[OUT_T_END] = t
+    out[OUT_STEPS] = steps
+    out[OUT_EVENT_STEPS] = event_steps
+    out[OUT_T_FIRST_IMPACT] = t_first_impact
+    out[OUT_E_MAX] = e_max
+    out[OUT_CONTACTS] = contacts
+    out[OUT_HIST_ROWS] = row
+    if ENERGY:
+        out[OUT_W_IN] = y[4]
+        out[OUT_D_DAMP] = y[5]
+        out[OUT_E_IMPACT] = e_imp
+        out[OUT_E_GAINED] = e_gained
+        out[OUT_N_GAINING] = n_gaining
+        out[OUT_E_END] = mechanical_energy(y[0], y[1], y[2], y[3], s, prm, FLEX)
+    else:
+        out[OUT_W_IN] = np.nan
+        out[OUT_D_DAMP] = np.nan
+        out[OUT_E_IMPACT] = np.nan
+        out[OUT_E_GAINED] = np.nan
+        out[OUT_N_GAINING] = np.nan
+        out[OUT_E_END] = np.nan
+
+
+@njit(cache=True)
+def _chunk(prms, outs, FLEX, DAMPED, ENERGY):
+    literally(FLEX)
+    literally(DAMPED)
+    literally(ENERGY)
+    empty = np.empty((0, 1))
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], empty, FLEX, DAMPED, ENERGY, False)
+
+
+# ----------------------------------------------------------------------------------------
+# Variants. One entry point per effect set; the flags are literals here.
+#   chunk_*: prms float64[n, N_PAR] -> outs float64[n, N_OUT] (filled in place)
+#   point_*: one point with energy accounting and a history buffer float64[n, N_HIST]
+# ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def chunk_flexible(prms, outs):
+    _chunk(prms, outs, True, True, False)
+
+
+@njit(cache=True)
+def chunk_flexible_undamped(prms, outs):
+    _chunk(prms, outs, True, False, False)
+
+
+@njit(cache=True)
+def chunk_rigid(prms, outs):
+    _chunk(prms, outs, False, False, False)
+
+
+@njit(cache=True)
+def chunk_flexible_energy(prms, outs):
+    _chunk(prms, outs, True, True, True)
+
+
+@njit(cache=True)
+def chunk_flexible_undamped_energy(prms, outs):
+    _chunk(prms, outs, True, False, True)
+
+
+@njit(cache=True)
+def chunk_rigid_energy(prms, outs):
+    _chunk(prms, outs, False, False, True)
+
+
+@njit(cache=True)
+def point_flexible_history(prm, out, hist):
+    simulate_point(prm, out, hist, True, True, True, True)
+
+
+@njit(cache=True)
+def point_flexible_undamped_history(prm, out, hist):
+    simulate_point(prm, out, hist, True, False, True, True)
+
+
+@njit(cache=True)
+def point_rigid_history(prm, out, hist):
+    simulate_point(prm, out, hist, False, False, True, True)
+

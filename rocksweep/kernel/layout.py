@@ -1,0 +1,105 @@
+"""What crosses into the jitted kernel: index constants of the plain float64 arrays.
+
+Numba reads module-level ints as compile-time constants, so these cost nothing in the loop.
+The kernel takes one parameter row per point (``PAR_*``) and fills one result row
+(``OUT_*``); single runs also fill a history buffer (``HIST_*`` columns). All quantities
+are SI with m = 1 kg, g = 9.81 m/s^2 and p = 1 rad/s (see ``rocksweep.model``), so times
+are p*t.
+"""
+
+# --- parameter row ---------------------------------------------------------------------
+PAR_M = 0  # top mass m [kg]
+PAR_MA = 1  # base mass m_A [kg]
+PAR_IA0 = 2  # I_A + m_A R_A^2: base inertia about a corner [kg m^2]
+PAR_IAH = 3  # I_A + m_A h_A^2: base inertia about the base's mid point (eq. 1) [kg m^2]
+PAR_H = 4  # h [m]
+PAR_HA = 5  # h_A [m]
+PAR_B = 6  # b [m]
+PAR_G = 7  # g [m/s^2]
+PAR_K = 8  # k [N/m] (unused by the rigid kernel)
+PAR_C = 9  # c [N s/m]
+PAR_MTOT = 10  # M = m + m_A [kg]
+PAR_HCG = 11  # h_cg [m]
+PAR_IO = 12  # I_O about a corner with u = 0 [kg m^2]
+PAR_AMP = 13  # pulse amplitude A [m/s^2] (signed)
+PAR_OMEGA = 14  # pulse frequency omega [rad/s]
+PAR_SHAPE = 15  # SHAPE_SINE or SHAPE_COSINE
+PAR_TPULSE = 16  # pulse end 2 pi / omega [s]
+PAR_LAM = 17  # lam (Pi10)
+PAR_DT = 18  # RK4 step [s]
+PAR_TOL = 19  # event bisection tolerance on time [s]
+PAR_TEND = 20  # horizon: absolute end time [s]
+PAR_MAXSTEPS = 21  # cap on RK4 evaluations (regular + event) per run
+PAR_MAXEVENTS = 22  # cap on impacts + uplifts per run
+PAR_RESTRATE = 23  # post-impact |theta'| below which the body settles [rad/s]
+PAR_THETA_OVER = 24  # |theta| at which the body lies on its side: pi/2 [rad]
+PAR_ROOT = 25  # event root finder: ROOT_BISECT or ROOT_ILLINOIS
+N_PAR = 26
+
+SHAPE_SINE = 0.0
+SHAPE_COSINE = 1.0
+ROOT_BISECT = 0.0
+ROOT_ILLINOIS = 1.0
+
+# --- result row ------------------------------------------------------------------------
+OUT_OUTCOME = 0  # OUTCOME_* code
+OUT_STATUS = 1  # bit set of STATUS_*
+OUT_IMPACTS = 2
+OUT_UPLIFTS = 3
+OUT_THETA_MAX = 4  # max |theta| [rad]
+OUT_T_OVERTURN = 5  # [s] = p*t, NaN if none
+OUT_T_END = 6  # time the run stopped [s]
+OUT_STEPS = 7  # regular RK4 steps
+OUT_EVENT_STEPS = 8  # RK4 re-integrations spent locating events
+OUT_T_FIRST_IMPACT = 9  # [s], NaN if none
+OUT_W_IN = 10  # work of the ground motion [J] (energy variants only, else NaN)
+OUT_D_DAMP = 11  # energy dissipated by the damper [J] (energy variants only)
+OUT_E_IMPACT = 12  # energy lost in impacts, net [J] (energy variants only)
+OUT_E_GAINED = 13  # energy gained in impacts with E_d < 0 [J] (energy variants only)
+OUT_N_GAINING = 14  # impacts that gained energy (energy variants only)
+OUT_E_END = 15  # mechanical energy at the end, relative to rest [J] (energy variants)
+OUT_E_MAX = 16  # largest restitution seen
+OUT_CONTACTS = 17  # returns to full contact (e <= 0 or settling below the rest rate)
+OUT_HIST_ROWS = 18  # rows written to the history buffer
+N_OUT = 19
+
+# --- history columns ---------------------------------------------------------------------
+HIST_T = 0
+HIST_THETA = 1
+HIST_THETA_DOT = 2
+HIST_U = 3
+HIST_U_DOT = 4
+HIST_PHASE = 5  # -1 / +1 rocking corner, 0 full contact
+HIST_E = 6  # mechanical energy relative to rest [J]
+HIST_W_IN = 7
+HIST_D_DAMP = 8
+HIST_E_IMPACT = 9
+HIST_XG = 10  # ground acceleration [m/s^2]
+N_HIST = 11
+
+# --- outcome and status codes ----------------------------------------------------------
+OUTCOME_NOT_RUN = -1
+OUTCOME_SAFE = 0
+OUTCOME_MODE1 = 1  # overturned after one or more impacts
+OUTCOME_MODE2 = 2  # overturned without impact
+
+STATUS_REST = 1  # rest proven after the pulse (early exit)
+STATUS_HORIZON = 2  # horizon reached before the outcome was decided
+STATUS_STEP_CAP = 4
+STATUS_EVENT_CAP = 8
+STATUS_NONFINITE = 16
+STATUS_HIST_FULL = 32  # history buffer full; integration went on unrecorded
+STATUS_ENERGY_GAIN = 64  # at least one impact gained energy (energy variants)
+STATUS_SETTLED = 128  # chattering ended in full contact through the rest-rate rule
+STATUS_OVERTURNED = 256
+STATUS_E_ABOVE_1 = 512  # at least one impact had e > 1
+# A run with any of these is not a reliable classification: "flagged".
+STATUS_FLAGGED = STATUS_HORIZON | STATUS_STEP_CAP | STATUS_EVENT_CAP | STATUS_NONFINITE
+
+# --- kernel variants (compile-time flags) -----------------------------------------------
+KIND_FLEXIBLE = 0
+KIND_FLEXIBLE_UNDAMPED = 1
+KIND_RIGID = 2
+LEVEL_OUTCOME = 0  # outcome and summary metrics only
+LEVEL_ENERGY = 1  # + energy accounting
+LEVEL_HISTORY = 2  # + energy accounting + time history

@@ -1,0 +1,330 @@
+"""The flexible rocking oscillator of Zhu, Chatzis & Acikgoz: Pi groups -> dimensional body.
+
+Sketch (body frame, upright; the body is symmetric about its vertical axis)::
+
+              P (m, at x = u, y = h)        top mass on a lateral spring k, damper c
+          ----o----
+          |       |
+          |   A   |    U-shaped base: mass m_A at (0, h_A), inertia I_A about A
+          |       |
+     o'---+-------+---o     base corners at x = -b (o') and x = +b (o)
+
+Glossary and sign conventions (used everywhere in rocksweep):
+
+- ``theta`` [rad]: rotation of the body, positive clockwise. ``theta > 0`` is rocking on
+  the corner at x = +b ("the +b corner"), ``theta < 0`` on the corner at x = -b.
+- ``u`` [m]: lateral displacement of the top mass along the body's x axis (it rotates
+  with the body), positive toward +b.
+- ``s`` = +1 / -1: the corner the body rocks on (sign of theta); 0 is full contact.
+- Eq. (1) of the paper: its *upper* sign is, in rocksweep, the impact that ends rocking
+  on the +b corner (theta > 0 -> theta < 0, future corner at x = -b), with u positive
+  toward +b. Eq. (6) uses the same correspondence.
+
+Non-dimensionalisation (stated once, here). The response depends only on the Pi groups of
+Table 1. rocksweep picks the three repeating quantities as
+
+    m = 1 kg,   g = 9.81 m/s^2,   p = 1 rad/s,
+
+so that kernel time t [s] *is* the paper's p*t. All lengths follow from the base half
+width b, which is fixed by p = 1:
+
+    h_cg = b / tan(alpha_cg),  h_A = b / tan(alpha_A),  h = ((m + m_A) h_cg - m_A h_A) / m,
+    R_x  = sqrt(b^2 + h_x^2)   (x = cg, A, top),
+    I_A  = IA_ratio * m_A * R_A^2,
+    I_O  = I_A + m_A R_A^2 + m R^2           (inertia about a corner, u = 0),
+    p^2  = (m + m_A) g R_cg / I_O   =>   b = (m + m_A) g (R_cg/b) / (I_O/b^2).
+
+Then omega_n = wn_over_p * p, k = m omega_n^2, c = 2 zeta m omega_n,
+A = A_ratio * g tan(alpha_cg), omega = w_over_p * p,
+u_cr = (m_A/m + 1) g b / (omega_n^2 h)   (as printed; omits the top mass's own P-delta),
+E_ref = (m + m_A) g R_cg (1 - cos alpha_cg).
+
+``wn_over_p = inf`` is a rigid body: the top mass is welded to the frame (k = inf, u = 0).
+The uniform rectangular block (``BlockBody``) is a rigid body too, with M = 1 kg and
+p^2 = M g R / I_O.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+G = 9.81  # m/s^2
+M_TOP = 1.0  # kg, the top mass m (a repeating quantity)
+P = 1.0  # rad/s, the rocking frequency p (a repeating quantity)
+
+
+class BodyError(ValueError):
+    """A body that is not physical; the message names the offending key and value."""
+
+
+@dataclass(frozen=True)
+class FlexibleBody:
+    """The paper's body from its Pi groups (Table 1).
+
+    Attributes are the Pi groups; derived dimensional quantities are properties (SI).
+    """
+
+    wn_over_p: float  # Pi1; inf = rigid (top mass welded)
+    zeta: float  # Pi2
+    alpha_cg: float  # Pi3 [rad]
+    alpha_A: float  # Pi4 [rad]
+    mA_over_m: float  # Pi8
+    IA_ratio: float  # Pi9 = I_A / (m_A R_A^2)
+
+    kind = "flexible"
+
+    def __post_init__(self) -> None:
+        def bad(key: str, value: float, allowed: str) -> BodyError:
+            return BodyError(f"body.{key} = {value!r}: {allowed}")
+
+        for key in ("zeta", "alpha_cg", "alpha_A", "mA_over_m", "IA_ratio"):
+            if not math.isfinite(getattr(self, key)):
+                raise bad(key, getattr(self, key), "must be a finite number")
+        if not (self.wn_over_p > 0):  # also rejects NaN
+            raise bad("wn_over_p", self.wn_over_p, "must be > 0 (.inf for a rigid body)")
+        if self.zeta < 0:
+            raise bad("zeta", self.zeta, "must be >= 0")
+        for key in ("alpha_cg", "alpha_A"):
+            if not (0 < getattr(self, key) < math.pi / 2):
+                raise bad(key, getattr(self, key), "must be in (0, pi/2) rad")
+        if not (self.mA_over_m > 0):
+            raise bad("mA_over_m", self.mA_over_m, "must be > 0")
+        if self.IA_ratio < 0:
+            raise bad("IA_ratio", self.IA_ratio, "must be >= 0")
+        if self.h_over_b <= 0:
+            raise BodyError(
+                f"body: alpha_cg = {self.alpha_cg!r}, alpha_A = {self.alpha_A!r}, "
+                f"mA_over_m = {self.mA_over_m!r} put the top mass at h/b = {self.h_over_b:.4g} "
+                "(must be > 0: the top mass cannot sit below the base); raise alpha_cg, "
+                "lower alpha_A or mA_over_m"
+            )
+
+    # -- geometry in units of b --------------------------------------------------------
+    @property
+    def h_over_b(self) -> float:
+        mu = self.mA_over_m
+        return (1 + mu) / math.tan(self.alpha_cg) - mu / math.tan(self.alpha_A)
+
+    @property
+    def rigid(self) -> bool:
+        return math.isinf(self.wn_over_p)
+
+    # -- dimensional quantities (SI) ---------------------------------------------------
+    @property
+    def m(self) -> float:
+        return M_TOP
+
+    @property
+    def m_A(self) -> float:
+        return self.mA_over_m * M_TOP
+
+    @property
+    def M(self) -> float:
+        return self.m + self.m_A
+
+    @property
+    def b(self) -> float:
+        tan_cg, tan_A, hb = math.tan(self.alpha_cg), math.tan(self.alpha_A), self.h_over_b
+        rA2 = 1 + 1 / tan_A**2
+        j = (self.IA_ratio + 1) * self.mA_over_m * rA2 + (1 + hb**2)  # I_O / (m b^2)
+        r_cg = math.hypot(1.0, 1 / tan_cg)
+        return (1 + self.mA_over_m) * G * r_cg / (j * P**2)
+
+    @property
+    def h(self) -> float:
+        return self.h_over_b * self.b
+
+    @property
+    def h_A(self) -> float:
+        return self.b / math.tan(self.alpha_A)
+
+    @property
+    def h_cg(self) -> float:
+        return self.b / math.tan(self.alpha_cg)
+
+    @property
+    def R(self) -> float:
+        return math.hypot(self.b, self.h)
+
+    @property
+    def R_A(self) -> float:
+        return math.hypot(self.b, self.h_A)
+
+    @property
+    def R_cg(self) -> float:
+        return math.hypot(self.b, self.h_cg)
+
+    @property
+    def I_A(self) -> float:
+        return self.IA_ratio * self.m_A * self.R_A**2
+
+    @property
+    def I_O(self) -> float:
+        """Inertia of the whole body about a base corner with u = 0 [kg m^2]."""
+        return self.I_A + self.m_A * self.R_A**2 + self.m * self.R**2
+
+    @property
+    def p(self) -> float:
+        return math.sqrt(self.M * G * self.R_cg / self.I_O)
+
+    @property
+    def omega_n(self) -> float:
+        return self.wn_over_p * self.p
+
+    @property
+    def k(self) -> float:
+        return self.m * self.omega_n**2
+
+    @property
+    def c(self) -> float:
+        return 0.0 if self.rigid else 2 * self.zeta * self.m * self.omega_n
+
+    @property
+    def u_cr(self) -> float:
+        """Eq. (4)'s normaliser (m_A/m + 1) g b / (omega_n^2 h) [m]; 0 for a rigid body."""
+        return self.M / self.m * G * self.b / (self.omega_n**2 * self.h)
+
+    @property
+    def E_ref(self) -> float:
+        """(m + m_A) g R_cg (1 - cos alpha_cg) [J]: the energy that tips the rigid body."""
+        return self.M * G * self.R_cg * (1 - math.cos(self.alpha_cg))
+
+    @property
+    def alpha_ref(self) -> float:
+        """The slenderness theta is normalised by (alpha_cg)."""
+        return self.alpha_cg
+
+    @property
+    def omega_rock(self) -> float:
+        """Frequency of the top mass on its spring while the base rocks (u = 0) [rad/s].
+
+        The rocking base is a light, rotating support: the spring sees a smaller mass and
+        oscillates faster than omega_n, by sqrt(I_O / (I_A + m_A R_A^2 + m b^2)) (about 2.7
+        for the paper's bodies). The step size must resolve this, not omega_n.
+        """
+        i_a0 = self.I_A + self.m_A * self.R_A**2
+        return self.omega_n * math.sqrt(self.I_O / (i_a0 + self.m * self.b**2))
+
+
+@dataclass(frozen=True)
+class BlockBody:
+    """The uniform rectangular block of the classic rocking literature (rigid).
+
+    ``alpha`` is its slenderness [rad]; ``inertia`` = I_O / (M R^2) (4/3 for a uniform block).
+    M = 1 kg, g = 9.81, p^2 = M g R / I_O = 1 rad^2/s^2 fixes R = g / (inertia p^2).
+    """
+
+    alpha: float
+    inertia: float = 4.0 / 3.0
+
+    kind = "block"
+    rigid = True
+    zeta = 0.0
+    m = 0.0
+    m_A = 0.0
+    M = 1.0
+    c = 0.0
+    I_A = 0.0
+    h_A = 0.0
+    h = 0.0
+    k = math.inf
+    wn_over_p = math.inf
+    u_cr = 0.0
+
+    def __post_init__(self) -> None:
+        if not (0 < self.alpha < math.pi / 2):
+            raise BodyError(f"body.alpha = {self.alpha!r}: must be in (0, pi/2) rad")
+        # A body's inertia about a corner is at least M R^2 (all mass at distance R from O
+        # would give exactly that only if concentrated at the centre of gravity).
+        if not (math.isfinite(self.inertia) and self.inertia >= 1.0):
+            raise BodyError(f"body.inertia = {self.inertia!r}: must be >= 1 (I_O >= M R^2)")
+
+    @property
+    def R(self) -> float:
+        return G / (self.inertia * P**2)
+
+    R_cg = R
+
+    @property
+    def b(self) -> float:
+        return self.R * math.sin(self.alpha)
+
+    @property
+    def h_cg(self) -> float:
+        return self.R * math.cos(self.alpha)
+
+    @property
+    def I_O(self) -> float:
+        return self.inertia * self.M * self.R**2
+
+    @property
+    def p(self) -> float:
+        return math.sqrt(self.M * G * self.R / self.I_O)
+
+    @property
+    def E_ref(self) -> float:
+        return self.M * G * self.R * (1 - math.cos(self.alpha))
+
+    @property
+    def alpha_ref(self) -> float:
+        return self.alpha
+
+    alpha_cg = alpha_ref
+
+
+Body = FlexibleBody | BlockBody
+
+
+def restitution(
+    body: FlexibleBody, lam: float | np.ndarray, u: float | np.ndarray, upper: bool
+) -> np.ndarray:
+    """Eq. (1): e = theta'^+ / theta'^- for a rocking-to-rocking impact.
+
+    Parameters: lam (Pi10, impulse at lam*b from the future corner), u [m] at impact,
+    ``upper`` selects the paper's upper sign (in rocksweep: rocking on the +b corner ends,
+    future corner -b; see the module docstring). Arrays broadcast. Returns e (may be <= 0,
+    meaning full contact follows, or > 1).
+    """
+    sg = 1.0 if upper else -1.0
+    m, m_A, b = body.m, body.m_A, body.b
+    i0 = body.I_A + m_A * body.h_A**2
+    lam = np.asarray(lam, dtype=float)
+    u = np.asarray(u, dtype=float)
+    num = i0 + m * u * (-sg * b + u) + b * (1 - lam) * (-m_A * b - m * b + sg * m * u)
+    den = i0 + m * u * (sg * b + u) + b * (1 - lam) * (m_A * b + m * b + sg * m * u)
+    return num / den
+
+
+def restitution_rigid(body: Body, lam: float | np.ndarray) -> np.ndarray:
+    """Restitution of a rigid body for an impulse at lam*b from the future corner.
+
+    Angular momentum about the impulse point is conserved:
+    e = (I_O - M b^2 (2 - lam)) / (I_O - lam M b^2); lam = 0 is Housner's 1 - 2 M b^2/I_O.
+    """
+    lam = np.asarray(lam, dtype=float)
+    mb2 = body.M * body.b**2
+    return (body.I_O - mb2 * (2 - lam)) / (body.I_O - lam * mb2)
+
+
+def impact_energy_loss(
+    body: FlexibleBody, e: float | np.ndarray, u: float | np.ndarray,
+    theta_dot_minus: float | np.ndarray, upper: bool,
+) -> np.ndarray:
+    """Eq. (6): energy E_d [J] dissipated by an impact with restitution e at lateral u [m]."""
+    sg = 1.0 if upper else -1.0
+    e = np.asarray(e, dtype=float)
+    i = body.I_A + body.m_A * body.R_A**2 + body.m * body.b**2 + body.m * np.asarray(u) ** 2
+    w2 = np.asarray(theta_dot_minus, dtype=float) ** 2
+    return -0.5 * i * (e**2 - 1) * w2 - sg * body.m * body.b * u * (e**2 + 1) * w2
+
+
+def lam_0(body: FlexibleBody, u: float, upper: bool) -> float:
+    """The lam at which eq. (1) gives e = 0 (full contact follows) for lateral u [m]."""
+    sg = 1.0 if upper else -1.0
+    m, m_A, b = body.m, body.m_A, body.b
+    i0 = body.I_A + m_A * body.h_A**2
+    # numerator of eq. (1) is linear in lam: i0 + m u (u - sg b) - b (1 - lam) (M b - sg m u)
+    return 1 - (i0 + m * u * (u - sg * b)) / (b * (body.M * b - sg * m * u))

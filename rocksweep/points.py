@@ -1,0 +1,120 @@
+"""One point of a study (body, impact, pulse) -> the kernel's parameter row.
+
+This is the only place where the model's dimensional quantities are packed for the kernel.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from rocksweep.kernel import layout as L
+from rocksweep.model import G, Body, FlexibleBody
+from rocksweep.numerics import Numerics, step_size
+
+SHAPES = ("sine", "cosine")
+_SHAPE_CODE = {"sine": L.SHAPE_SINE, "cosine": L.SHAPE_COSINE}
+_ROOT_CODE = {"bisection": L.ROOT_BISECT, "illinois": L.ROOT_ILLINOIS}
+
+
+@dataclass(frozen=True)
+class Point:
+    """One simulation: a body, the impulse position lam, and a pulse (eq. 2)."""
+
+    body: Body
+    lam: float
+    shape: str
+    w_over_p: float
+    A_ratio: float
+
+    @property
+    def omega(self) -> float:
+        return self.w_over_p * self.body.p
+
+    @property
+    def A(self) -> float:
+        """Pulse amplitude [m/s^2]: A_ratio * g tan(alpha_cg) (alpha for a block)."""
+        return self.A_ratio * G * math.tan(self.body.alpha_ref)
+
+    @property
+    def t_pulse(self) -> float:
+        return 2 * math.pi / self.omega
+
+
+def kernel_kind(body: Body) -> int:
+    """The specialised kernel a body needs (only the effects it calls for)."""
+    if body.rigid:
+        return L.KIND_RIGID
+    return L.KIND_FLEXIBLE if body.zeta > 0 else L.KIND_FLEXIBLE_UNDAMPED
+
+
+def body_row(body: Body) -> np.ndarray:
+    """The body's part of a parameter row (float64[N_PAR], other entries zero)."""
+    row = np.zeros(L.N_PAR)
+    row[L.PAR_MTOT] = body.M
+    row[L.PAR_B] = body.b
+    row[L.PAR_G] = G
+    row[L.PAR_HCG] = body.h_cg
+    row[L.PAR_IO] = body.I_O
+    row[L.PAR_THETA_OVER] = math.pi / 2
+    if isinstance(body, FlexibleBody):
+        row[L.PAR_M] = body.m
+        row[L.PAR_MA] = body.m_A
+        row[L.PAR_IA0] = body.I_A + body.m_A * body.R_A**2
+        row[L.PAR_IAH] = body.I_A + body.m_A * body.h_A**2
+        row[L.PAR_H] = body.h
+        row[L.PAR_HA] = body.h_A
+        row[L.PAR_K] = body.k if not body.rigid else 0.0
+        row[L.PAR_C] = body.c
+    return row
+
+
+def body_omega_rock(body: Body) -> float:
+    """Fastest spring frequency of the body [rad/s] (0 for a rigid body: no spring)."""
+    return 0.0 if body.rigid else body.omega_rock
+
+
+def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
+              alpha_ref: np.ndarray, lam: np.ndarray, shape_code: np.ndarray,
+              w_over_p: np.ndarray, A_ratio: np.ndarray, numerics: Numerics) -> None:
+    """Fill parameter rows in place, vectorised over points.
+
+    rows: float64[n, N_PAR] (out); body_rows: float64[n, N_PAR] from ``body_row``;
+    omega_rock, alpha_ref, lam, shape_code, w_over_p, A_ratio: float64[n] (p = 1).
+    """
+    rows[:] = body_rows
+    omega = np.asarray(w_over_p, float)  # p = 1 rad/s
+    with np.errstate(divide="ignore"):
+        dt = step_size(omega_rock, omega, numerics.steps_per_period)
+    t_pulse = 2 * np.pi / omega
+    rows[:, L.PAR_AMP] = A_ratio * G * np.tan(alpha_ref)
+    rows[:, L.PAR_OMEGA] = omega
+    rows[:, L.PAR_SHAPE] = shape_code
+    rows[:, L.PAR_TPULSE] = t_pulse
+    rows[:, L.PAR_LAM] = lam
+    rows[:, L.PAR_DT] = dt
+    rows[:, L.PAR_TOL] = numerics.event_tol
+    t_end = t_pulse + numerics.horizon
+    rows[:, L.PAR_TEND] = t_end
+    rows[:, L.PAR_MAXSTEPS] = numerics.max_steps_factor * np.ceil(t_end / dt) + 200.0 * (
+        numerics.max_events)
+    rows[:, L.PAR_MAXEVENTS] = numerics.max_events
+    rows[:, L.PAR_RESTRATE] = numerics.rest_rate * alpha_ref  # p = 1
+    rows[:, L.PAR_ROOT] = _ROOT_CODE[numerics.root]
+
+
+def point_row(point: Point, numerics: Numerics) -> np.ndarray:
+    """The kernel's parameter row float64[N_PAR] for one point."""
+    body = point.body
+    rows = np.empty((1, L.N_PAR))
+    fill_rows(rows, body_row(body)[None, :], np.array([body_omega_rock(body)]),
+              np.array([body.alpha_ref]), np.array([point.lam]),
+              np.array([_SHAPE_CODE[point.shape]]), np.array([point.w_over_p]),
+              np.array([point.A_ratio]), numerics)
+    return rows[0]
+
+
+def shape_code(shape: str) -> float:
+    return _SHAPE_CODE[shape]
