@@ -4,6 +4,7 @@
 effect set; see ``integrate`` for how the variants are built and ``layout`` for the arrays.
 """
 
+from rocksweep.kernel import _cache  # noqa: F401  (must precede every @njit(cache=True))
 from rocksweep.kernel import integrate as _k
 from rocksweep.kernel.layout import (
     KIND_FLEXIBLE,

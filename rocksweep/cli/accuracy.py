@@ -1,0 +1,1 @@
+"""``rocksweep accuracy`` (to be written)."""

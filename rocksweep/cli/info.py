@@ -1,0 +1,1 @@
+"""``rocksweep info`` (to be written)."""

@@ -1,0 +1,1 @@
+"""``rocksweep plot`` (to be written)."""

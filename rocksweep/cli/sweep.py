@@ -1,0 +1,1 @@
+"""``rocksweep sweep`` (to be written)."""
