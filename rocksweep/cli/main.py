@@ -13,11 +13,14 @@ from pathlib import Path
 
 import click
 
+from rocksweep.diagrams import DiagramError
 from rocksweep.model import BodyError
 from rocksweep.scene import SceneError, load_scene
+from rocksweep.store import StoreError
 
 # errors that are the user's to fix; other modules register theirs with ``user_errors``
 USER_ERRORS: list[type[Exception]] = [SceneError, BodyError]
+USER_ERRORS += [StoreError, DiagramError]  # sweep results, stability diagrams (issue 3)
 
 
 def user_errors(fn):

@@ -1,0 +1,124 @@
+"""A scene's grid: axes -> flat point index -> kernel parameter rows, one chunk at a time.
+
+The grid is the Cartesian product of the scene's axes in ``Scene.axes`` order (shape, body
+keys, lam, A_ratio, w_over_p; w_over_p varies fastest). A point is named by its flat
+(C-order) index ``0 <= i < size``. Nothing here materialises all points: a chunk of flat
+indices is unravelled on its own, and the body-dependent part of the rows (``body_row``,
+the spring frequency, alpha_ref, E_ref, the kernel kind) is computed once per distinct
+body in the chunk. Result arrays have the shape of the *swept* axes (``Grid.shape``); an
+unswept axis is a length-1 dimension of the full grid and vanishes from the result shape,
+which leaves the flat index unchanged.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.points import body_omega_rock, body_row, fill_rows, kernel_kind, shape_code
+from rocksweep.scene import Scene
+
+
+@dataclass
+class ChunkRows:
+    """Parameter rows of one chunk of points (n points).
+
+    rows: float64[n, N_PAR] (``points.fill_rows``); kinds: int64[n] (``KIND_*``);
+    alpha_ref [rad] and E_ref [J]: float64[n], per point, to normalise results
+    (theta/alpha_ref, E/E_ref).
+    """
+
+    rows: np.ndarray
+    kinds: np.ndarray
+    alpha_ref: np.ndarray
+    E_ref: np.ndarray
+
+
+class Grid:
+    """The points of a scene, addressed by flat index.
+
+    dims: names of the swept axes (result dimensions); shape: their lengths; size: number
+    of points.
+    """
+
+    def __init__(self, scene: Scene) -> None:
+        self.scene = scene
+        self.full_shape = tuple(len(a.values) for a in scene.axes)
+        self.dims = tuple(a.name for a in scene.swept)
+        self.shape = scene.shape
+        self.size = scene.size
+        names = [a.name for a in scene.axes]
+        self._body_pos = [i for i, a in enumerate(scene.axes) if a.key.startswith("body.")]
+        self._body_shape = tuple(self.full_shape[i] for i in self._body_pos)
+        self._i_shape = names.index("shape")
+        self._i_lam = names.index("lam")
+        self._i_w = names.index("w_over_p")
+        self._i_A = names.index("A_ratio")
+        self._shape_codes = np.array([shape_code(s) for s in scene.axes[self._i_shape].values])
+        self._values = [np.asarray(a.values, float) if i != self._i_shape else None
+                        for i, a in enumerate(scene.axes)]
+
+    def coords(self) -> dict[str, np.ndarray]:
+        """Coordinate values of each swept dimension (strings for ``shape``)."""
+        return {a.name: np.asarray(a.values) for a in self.scene.swept}
+
+    def index_values(self, flat: np.ndarray) -> dict[str, np.ndarray]:
+        """Value of every axis (by name) at the given flat indices (int64[n])."""
+        multi = np.unravel_index(np.asarray(flat, np.int64), self.full_shape)
+        out = {}
+        for i, a in enumerate(self.scene.axes):
+            vals = np.asarray(a.values) if self._values[i] is None else self._values[i]
+            out[a.name] = vals[multi[i]]
+        return out
+
+    def _bodies(self, body_index: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Per distinct body index: body rows, omega_rock, alpha_ref, E_ref, kind."""
+        multi = np.unravel_index(body_index, self._body_shape)
+        axes = [self.scene.axes[i] for i in self._body_pos]
+        n = len(body_index)
+        rows = np.empty((n, L.N_PAR))
+        omega_rock, alpha_ref, E_ref = np.empty(n), np.empty(n), np.empty(n)
+        kinds = np.empty(n, np.int64)
+        for j in range(n):
+            body = self.scene.make_body(**{a.name: a.values[int(m[j])]
+                                           for a, m in zip(axes, multi, strict=True)})
+            rows[j] = body_row(body)
+            omega_rock[j] = body_omega_rock(body)
+            alpha_ref[j] = body.alpha_ref
+            E_ref[j] = body.E_ref
+            kinds[j] = kernel_kind(body)
+        return rows, omega_rock, alpha_ref, E_ref, kinds
+
+    def rows(self, start: int, stop: int) -> ChunkRows:
+        """Rows of the points with flat indices ``start <= i < stop``."""
+        return self.rows_at(np.arange(start, stop, dtype=np.int64))
+
+    def rows_at(self, flat: np.ndarray) -> ChunkRows:
+        """Rows of the points with the given flat indices (int64[n])."""
+        flat = np.asarray(flat, np.int64)
+        if flat.size and (flat.min() < 0 or flat.max() >= self.size):
+            raise IndexError(f"flat index out of range [0, {self.size})")
+        multi = np.unravel_index(flat, self.full_shape)
+        body_index = np.ravel_multi_index([multi[i] for i in self._body_pos], self._body_shape)
+        distinct, inverse = np.unique(body_index, return_inverse=True)
+        b_rows, b_omega, b_alpha, b_E, b_kind = self._bodies(distinct)
+        n = flat.size
+        rows = np.empty((n, L.N_PAR))
+        alpha_ref = b_alpha[inverse]
+        fill_rows(rows, b_rows[inverse], b_omega[inverse], alpha_ref,
+                  self._values[self._i_lam][multi[self._i_lam]],
+                  self._shape_codes[multi[self._i_shape]],
+                  self._values[self._i_w][multi[self._i_w]],
+                  self._values[self._i_A][multi[self._i_A]], self.scene.numerics)
+        return ChunkRows(rows, b_kind[inverse], alpha_ref, b_E[inverse])
+
+    def kinds(self) -> list[int]:
+        """The kernel kinds the grid's bodies need (each distinct body visited once)."""
+        n_bodies = int(np.prod(self._body_shape, dtype=np.int64))
+        found: set[int] = set()
+        step = 4096
+        for a in range(0, n_bodies, step):
+            found.update(int(k) for k in self._bodies(np.arange(a, min(a + step, n_bodies)))[4])
+        return sorted(found)
