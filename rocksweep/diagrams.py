@@ -134,7 +134,9 @@ def stability_figure(result: SweepResult, path: str | Path) -> list[str]:
     x = np.asarray(result.coords["w_over_p"], float)
     y = np.asarray(result.coords["A_ratio"], float)
 
-    ncols = min(len(panels), 3)
+    per_first = len(panels) // len(result.coords[panel_dims[0]]) if panel_dims else 1
+    # a row per value of the first panel key (the pulse shape) when that fits, else 3 across
+    ncols = per_first if len(panel_dims) >= 2 and per_first <= 4 else min(len(panels), 3)
     nrows = math.ceil(len(panels) / ncols)
     fig, axes = plt.subplots(nrows, ncols, figsize=(4.8 * ncols, 4.2 * nrows + 0.9),
                              squeeze=False, layout="constrained")
@@ -161,7 +163,8 @@ def stability_figure(result: SweepResult, path: str | Path) -> list[str]:
             ax.plot(x[xx], y[yy], "x", color="k", ms=3.5, mew=0.7)
         done = (po != L.OUTCOME_NOT_RUN)
         area = [f"${SYMBOLS['lam']}$ = {_fmt(lv)}: "
-                f"{100 * (po[k] == L.OUTCOME_MODE1).sum() / max(1, done[k].sum()):.1f}%"
+                + (f"{100 * (po[k] == L.OUTCOME_MODE1).sum() / done[k].sum():.1f}%"
+                   if done[k].any() else "-")
                 for k, lv in enumerate(lam)]
         ax.text(0.98, 0.02, "mode 1 area\n" + "\n".join(area), transform=ax.transAxes,
                 ha="right", va="bottom", fontsize=7,

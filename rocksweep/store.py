@@ -108,7 +108,7 @@ def _short(v) -> str:
 def scene_differences(stored: dict, new: dict) -> list[str]:
     """One phrase per difference between two ``resolved_scene`` dicts."""
     diffs = []
-    for section in ("name", "kind", "energy", "overrides"):
+    for section in ("name", "kind", "energy"):  # --set overrides show in the axes
         if stored.get(section) != new.get(section):
             key = "outputs.energy" if section == "energy" else section
             diffs.append(f"{key}: file {_short(stored.get(section))}, "
@@ -209,14 +209,18 @@ def _open(path: Path, mode: str) -> h5py.File:
     if path.is_dir():
         raise StoreError(f"{path}: is a directory, not a sweep result")
     try:
-        return h5py.File(path, mode)
+        # readers do not lock: `info` and `plot` work while a sweep writes (datasets are
+        # allocated up front, so a running sweep changes raw data only)
+        return h5py.File(path, mode, locking=(mode != "r"))
     except OSError as err:
         if not h5py.is_hdf5(path):
             raise StoreError(f"{path}: not an HDF5 file (expected a rocksweep sweep "
                              "result)") from None
-        text = str(err).split("(")[0].strip() or "unreadable"
-        raise StoreError(f"{path}: cannot open the HDF5 file ({text}; damaged, or "
-                         "written by a sweep still running?)") from None
+        if "unable to lock" in str(err).lower():
+            raise StoreError(f"{path}: open for writing by another process (a sweep still "
+                             "running?)") from None
+        raise StoreError(f"{path}: damaged or truncated HDF5 file, cannot be opened "
+                         "(rerun the sweep with --overwrite)") from None
 
 
 class SweepFile:

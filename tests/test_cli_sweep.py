@@ -1,0 +1,261 @@
+"""`rocksweep sweep`, `plot` and `info` end to end, kill-and-resume, bad input."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from rocksweep.cli import main
+from rocksweep.store import SweepFile, read_result
+from rocksweep.sweep import ChunkResult, variables
+
+ROOT = Path(__file__).resolve().parents[1]
+CI_SMALL = ROOT / "configs" / "ci-small.yaml"
+
+BODY3 = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, "
+         "mA_over_m: 0.47, IA_ratio: 0.56}\n")
+
+
+def one_line_error(result) -> str:
+    assert result.exit_code != 0
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1, result.output
+    assert "Traceback" not in result.output
+    return lines[0]
+
+
+def assert_same_results(a: Path, b: Path) -> None:
+    ra, rb = read_result(a), read_result(b)
+    assert ra.dims == rb.dims
+    for name in ra.arrays:
+        assert ra.arrays[name].dtype == rb.arrays[name].dtype
+        np.testing.assert_array_equal(ra.arrays[name], rb.arrays[name], err_msg=name)
+
+
+@pytest.fixture(scope="module")
+def ci_result(tmp_path_factory):
+    """configs/ci-small.yaml swept once through the CLI (in process)."""
+    from click.testing import CliRunner
+
+    out = tmp_path_factory.mktemp("ci") / "ci.h5"
+    res = CliRunner().invoke(main, ["sweep", str(CI_SMALL), "-o", str(out), "--jobs", "1"])
+    assert res.exit_code == 0, res.output
+    return out, res.output
+
+
+def test_sweep_summary(ci_result):
+    out, text = ci_result
+    assert "mode1" in text and "mode2" in text and "safe" in text and "flagged" in text
+    assert "points/s" in text and "accuracy: default (steps_per_period=20" in text
+    assert "RK4 steps:" in text
+    # one summary row per (shape, lam)
+    rows = [ln.split() for ln in text.splitlines() if ln.startswith(("sine", "cosine"))]
+    assert [(r[0], float(r[1])) for r in rows] == [("sine", 0.0), ("sine", 0.4),
+                                                  ("cosine", 0.0), ("cosine", 0.4)]
+    assert all(int(r[2]) + int(r[3]) + int(r[4]) == 64 for r in rows)
+
+
+def test_file_opens_in_xarray(ci_result):
+    xr = pytest.importorskip("xarray")  # in the test extra: never skipped in CI
+    out, _ = ci_result
+    with xr.open_dataset(out, engine="h5netcdf") as ds:
+        assert ds["outcome"].dims == ("shape", "lam", "A_ratio", "w_over_p")
+        assert list(ds["shape"].values) == ["sine", "cosine"]
+        np.testing.assert_array_equal(ds["lam"].values, [0.0, 0.4])
+        np.testing.assert_allclose(ds["w_over_p"].values, np.linspace(0.5, 6, 8))
+        assert int((ds["outcome"] < 0).sum()) == 0
+        assert float(ds["alpha_cg"]) == 0.15
+
+
+def test_info_text_and_json(ci_result, cli):
+    out, _ = ci_result
+    res = cli.invoke(main, ["info", str(out)])
+    assert res.exit_code == 0, res.output
+    assert "256 of 256 done" in res.output and "complete" in res.output
+    assert "numba" in res.output and "accuracy: default" in res.output
+    res = cli.invoke(main, ["info", str(out), "--json"])
+    assert res.exit_code == 0, res.output
+    d = json.loads(res.output)
+    assert d["dims"]["lam"]["values"] == [0.0, 0.4]
+    assert d["dims"]["shape"]["scene_key"] == "pulse.shape"
+    assert d["points_done"] == d["points_total"] == 256
+    assert sum(c["safe"] + c["mode1"] + c["mode2"] for c in d["counts"]) == 256
+    assert d["numerics"]["steps_per_period"] == 20
+    assert d["provenance"]["numba_version"]
+    assert d["scene"] == CI_SMALL.read_text()
+
+
+@pytest.mark.parametrize("suffix, magic", [(".png", b"\x89PNG"), (".pdf", b"%PDF"),
+                                           (".svg", b"<?xml")])
+def test_plot_formats(ci_result, cli, tmp_path, suffix, magic):
+    out, _ = ci_result
+    fig = tmp_path / f"fig{suffix}"
+    res = cli.invoke(main, ["plot", str(out), "-o", str(fig)])
+    assert res.exit_code == 0, res.output
+    assert fig.read_bytes().startswith(magic)
+    assert [p.name for p in tmp_path.iterdir()] == [fig.name]  # no temporary left
+
+
+def test_existing_output_refused_then_overwritten_and_resumed(ci_result, cli, tmp_path):
+    out = tmp_path / "o.h5"
+    out.write_bytes(Path(ci_result[0]).read_bytes())
+    before = out.read_bytes()
+    msg = one_line_error(cli.invoke(main, ["sweep", str(CI_SMALL), "-o", str(out)]))
+    assert "already exists" in msg and "--overwrite" in msg
+    assert out.read_bytes() == before
+    res = cli.invoke(main, ["sweep", str(CI_SMALL), "-o", str(out), "--resume", "-j", "1"])
+    assert res.exit_code == 0, res.output
+    assert "computed 0 points (256 were done before)" in res.output
+    msg = one_line_error(cli.invoke(main, ["sweep", str(CI_SMALL), "-o", str(out), "--resume",
+                                           "--set", "impact.lam=[0.0, 0.2]"]))
+    assert "cannot resume" in msg and "impact.lam: file [0.0, 0.4], scene [0.0, 0.2]" in msg
+    res = cli.invoke(main, ["sweep", str(CI_SMALL), "-o", str(out), "--overwrite", "-q",
+                            "-j", "1", "--set", "pulse.shape=sine"])
+    assert res.exit_code == 0 and res.output == ""
+    assert read_result(out).dims == ("lam", "A_ratio", "w_over_p")
+
+
+@pytest.mark.parametrize("edit, needle", [
+    (("w_over_p: {start: 0.5, stop: 6, num: 8}", "w_over_p: {start: 0.0, stop: 6, num: 8}"),
+     "pulse.w_over_p = 0.0"),
+    (("num: 8}   # Pi5", "num: 0}   # Pi5"), "pulse.w_over_p.num = 0"),
+    (("lam: [0.0, 0.4]", "lam: [0.0, .nan]"), "impact.lam = nan"),
+    (("lam: [0.0, 0.4]", "lam: []"), "impact.lam = []"),
+    (("A_ratio: {start: 0.5, stop: 8, num: 8}", "A_ratio: .inf"), "pulse.A_ratio = inf"),
+    (("zeta: 0.05", "zeta: 0.05\n  zeta_typo: 1"), "body.zeta_typo"),
+])
+def test_bad_scenes_leave_no_file(cli, tmp_path, edit, needle):
+    scene = tmp_path / "bad.yaml"
+    scene.write_text(CI_SMALL.read_text().replace(*edit))
+    assert scene.read_text() != CI_SMALL.read_text()
+    msg = one_line_error(cli.invoke(main, ["sweep", str(scene), "-o",
+                                           str(tmp_path / "out.h5")]))
+    assert needle in msg
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.yaml"]
+
+
+def test_bad_files_for_plot_and_info(cli, tmp_path):
+    text = tmp_path / "a.h5"
+    text.write_text("hello")
+    foreign = tmp_path / "b.h5"
+    with h5py.File(foreign, "w") as f:
+        f["x"] = np.arange(3)
+    for cmd in ("plot", "info"):
+        assert "not an HDF5 file" in one_line_error(cli.invoke(main, [cmd, str(text)]))
+        assert "not a rocksweep sweep result" in one_line_error(
+            cli.invoke(main, [cmd, str(foreign)]))
+        assert "no such file" in one_line_error(cli.invoke(main, [cmd, str(tmp_path / "c")]))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.h5", "b.h5"]
+
+
+def test_bad_options(cli, tmp_path, ci_result):
+    out = tmp_path / "o.h5"
+    for args, needle in [(["--resume", "--overwrite"], "exclude each other"),
+                         (["--backend", "dask"], "--scheduler"),
+                         (["--scheduler", "tcp://x:1"], "--backend dask"),
+                         (["--jobs", "0"], "--jobs 0")]:
+        msg = one_line_error(cli.invoke(main, ["sweep", str(CI_SMALL), "-o", str(out), *args]))
+        assert needle in msg
+    assert not out.exists()
+    msg = one_line_error(cli.invoke(main, ["plot", str(ci_result[0]), "-o",
+                                           str(tmp_path / "f.gif")]))
+    assert "'.gif'" in msg
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_plot_of_a_line_sweep_is_refused(cli, tmp_path):
+    scene = tmp_path / "line.yaml"
+    scene.write_text(BODY3 + "impact: {lam: 0.2}\n"
+                     "pulse: {shape: sine, w_over_p: [1.0, 2.0, 3.0], A_ratio: 2.0}\n")
+    out = tmp_path / "line.h5"
+    res = cli.invoke(main, ["sweep", str(scene), "-o", str(out), "-q", "-j", "1"])
+    assert res.exit_code == 0, res.output
+    msg = one_line_error(cli.invoke(main, ["plot", str(out), "-o", str(tmp_path / "f.png")]))
+    assert "pulse.A_ratio has one value" in msg
+    assert not (tmp_path / "f.png").exists()
+
+
+def test_plot_block_scene_with_panels_and_partial_file(cli, tmp_path):
+    """A block-body scene (issue 6) with a swept body key: one panel per alpha; points
+    not computed yet are drawn grey with a warning. Results are synthetic (no kernel)."""
+    from rocksweep.scene import parse_scene
+
+    sc = parse_scene("body: {kind: block, alpha: [0.15, 0.25]}\n"
+                     "pulse: {shape: [sine, cosine], w_over_p: {start: 0.5, stop: 6, num: 6},"
+                     " A_ratio: {start: 0.5, stop: 6, num: 5}}\n")
+    out = tmp_path / "block.h5"
+    sf = SweepFile.create(out, sc)
+    n = sf.grid.size // 2
+    arrays = {k: np.full(n, 0, dtype) for k, (dtype, _, _) in variables(sc).items()}
+    arrays["outcome"][:] = np.arange(n) % 3
+    sf.write(ChunkResult(0, n, arrays, 0.0))
+    sf.close()
+    fig = tmp_path / "block.png"
+    res = cli.invoke(main, ["plot", str(out), "-o", str(fig)])
+    assert res.exit_code == 0, res.output
+    assert f"{sf.grid.size - n} of {sf.grid.size} points not computed" in res.output
+    assert fig.read_bytes().startswith(b"\x89PNG")
+    from rocksweep.diagrams import y_label
+
+    assert y_label("block") == r"$A/(g\,\tan\alpha)$"
+    assert y_label("flexible") == r"$A/(g\,\tan\alpha_{cg})$"
+
+
+def _done_points(path: Path) -> int:
+    try:
+        with h5py.File(path, "r", locking=False) as f:
+            return int((f["outcome"][()] >= 0).sum())
+    except (OSError, KeyError):
+        return 0
+
+
+def test_kill_and_resume_equals_uninterrupted_run(cli, tmp_path):
+    """SIGKILL a real `rocksweep sweep` mid-run; --resume finishes the file without
+    recomputing finished points, and the result equals an uninterrupted run."""
+    scene = tmp_path / "kill.yaml"
+    scene.write_text(BODY3 + "impact: {lam: [0.0, 0.4]}\n"
+                     "pulse: {shape: sine, w_over_p: {start: 0.3, stop: 6, num: 40},"
+                     " A_ratio: {start: 0.3, stop: 8, num: 40}}\n")
+    killed = tmp_path / "killed.h5"
+    total = 3200
+    proc = subprocess.Popen(
+        [sys.executable, "-c", "from rocksweep.cli import main; main()", "sweep", str(scene),
+         "-o", str(killed),
+         "--jobs", "1", "--chunk-size", "40", "--quiet"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=tmp_path)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and proc.poll() is None:
+            if _done_points(killed) >= 400:
+                break
+            time.sleep(0.01)
+        assert proc.poll() is None, "the sweep ended before it could be killed"
+        os.kill(proc.pid, signal.SIGKILL)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        proc.communicate(timeout=30)
+    assert proc.returncode == -signal.SIGKILL
+    partial = read_result(killed)  # a well-formed file, part done
+    n_before = int(partial.done.sum())
+    assert 400 <= n_before < total
+    assert not partial.attrs["finished"]
+
+    res = cli.invoke(main, ["sweep", str(scene), "-o", str(killed), "--resume", "-j", "1"])
+    assert res.exit_code == 0, res.output
+    assert f"computed {total - n_before} points ({n_before} were done before)" in res.output
+
+    whole = tmp_path / "whole.h5"
+    res = cli.invoke(main, ["sweep", str(scene), "-o", str(whole), "-j", "2", "-q",
+                            "--chunk-size", "37"])
+    assert res.exit_code == 0, res.output
+    assert_same_results(killed, whole)
+    r = read_result(killed)
+    assert r.attrs["complete"] and r.attrs["finished"] and r.attrs["sessions"] == 2
