@@ -1,0 +1,655 @@
+"""What accuracy costs in time: the kernel's settings against the reference path.
+
+``accuracy_study(scene, n_points, ladder)``:
+
+1. Classify every point of the scene with the kernel at the scene's own numerics (the
+   sweep machinery, ``rocksweep.sweep.compute``) and mark the points on an outcome
+   boundary of the stability diagram (a neighbour along A_ratio or w_over_p has another
+   outcome).
+2. Draw a stratified sample of ``n_points``: strata are (outcome, boundary or interior);
+   half the sample goes to boundary strata, half to interior strata, equally over the
+   outcomes present (capped by each stratum's size). Every sampled point carries the
+   weight N_h / n_h of its stratum, so weighted means estimate the whole scene (outcome
+   flips gather at boundaries; sampling them more sharpens the estimate, the weights undo
+   the bias).
+3. Run the sample with the reference (``rocksweep.reference``, DOP853 at rtol 1e-10) and
+   with the kernel at each setting of the ladder. Kernel times exclude compilation
+   (``kernel.warm_up``). Per-point times come from timing each point as its own 1-row
+   chunk (one call into the jitted chunk kernel per point; the call overhead is ~1 us);
+   the total is one call on the whole sample (best of ``repeat``).
+4. For each setting: time per point (median of the 1-row timings, and the weighted mean:
+   the scene's estimate), RK4 evaluations per point, and errors against the reference:
+   |d theta_max|/alpha_cg (points both call safe), |d t_first_impact| (both impact),
+   |d t_overturn| (both overturn), |d impacts| (same outcome), and the outcome flips
+   (weighted share, and a matrix of counts: reference outcome -> kernel outcome).
+5. The observed order of convergence of the step ladder (settings with a common event
+   tolerance, steps_per_period doubling): log2 of the ratio of median errors per halving
+   of the step, on the first impact time (the smooth stretch uplift -> first impact) and
+   on theta_max of points that never impact (a smooth stretch from uplift to rest).
+
+Times are p*t (p = 1 rad/s); theta_max errors are in units of alpha_cg (alpha_ref).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from rocksweep.kernel import chunk_kernel, warm_up
+from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.numerics import PRESETS, Numerics
+from rocksweep.scene import Scene
+
+OUTCOMES = ("safe", "mode1", "mode2")  # codes 0, 1, 2
+MEASURES = ("theta_max", "t_first_impact", "t_overturn", "impacts")
+MEASURE_LABELS = {
+    "theta_max": "|d theta_max|/alpha_cg",
+    "t_first_impact": "|d t_first_impact| (p*t)",
+    "t_overturn": "|d t_overturn| (p*t)",
+    "impacts": "mean |d impacts|",
+}
+
+
+@dataclass(frozen=True)
+class Setting:
+    """One rung of a ladder: kernel steps per period and event tolerance [p*t].
+
+    group: the curve the rung belongs to. "steps ..." groups share one event tolerance
+    with the steps per period doubling (observed order), "tol ..." groups share one step
+    with the tolerance shrinking, "preset" holds the named presets.
+    """
+
+    name: str
+    steps_per_period: int
+    event_tol: float
+    group: str
+
+
+def _steps(steps: tuple[int, ...], tol: float, tag: bool = False) -> list[Setting]:
+    return [Setting(f"{s}/{tol:.0e}" if tag else f"spp={s}", s, tol, f"steps tol={tol:.0e}")
+            for s in steps]
+
+
+def _tols(spp: int, tols: tuple[float, ...]) -> list[Setting]:
+    return [Setting(f"tol={t:.0e}", spp, t, f"tol spp={spp}") for t in tols]
+
+
+def _presets() -> list[Setting]:
+    return [Setting(name, spp, tol, "preset") for name, (spp, tol) in PRESETS.items()]
+
+
+LADDERS: dict[str, Callable[[], list[Setting]]] = {
+    # the step ladder at a tolerance far below the step's error (its order), the event
+    # tolerance at a fine step, and the presets
+    "full": lambda: (_steps((5, 10, 20, 40, 80, 160), 1e-12)
+                     + _tols(80, (1e-2, 1e-4, 1e-6, 1e-8)) + _presets()),
+    "short": lambda: _steps((10, 20), 1e-12) + _presets(),
+    # the cheap settings the default preset is chosen from (README, "Accuracy and its price")
+    "candidates": lambda: (_steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-6, tag=True)
+                           + _steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-8, tag=True)
+                           + _presets()),
+}
+
+
+def ladder(name: str) -> list[Setting]:
+    """The settings of a named ladder ("full" or "short")."""
+    return LADDERS[name]()
+
+
+# ----------------------------------------------------------------------------------------
+# Sampling
+# ----------------------------------------------------------------------------------------
+
+
+def boundary_mask(outcome: np.ndarray, dims: tuple[str, ...]) -> np.ndarray:
+    """Points of a stability diagram next to another outcome (bool, outcome's shape).
+
+    outcome: int[grid shape] over the swept dims ``dims``; neighbours are taken along the
+    diagram's axes A_ratio and w_over_p (where swept).
+    """
+    mask = np.zeros(outcome.shape, bool)
+    for ax, name in enumerate(dims):
+        if name not in ("A_ratio", "w_over_p"):
+            continue
+        diff = np.diff(outcome, axis=ax) != 0
+        lo = [slice(None)] * outcome.ndim
+        hi = [slice(None)] * outcome.ndim
+        lo[ax] = slice(0, -1)
+        hi[ax] = slice(1, None)
+        mask[tuple(lo)] |= diff
+        mask[tuple(hi)] |= diff
+    return mask
+
+
+def _allocate(sizes: list[int], n: int) -> list[int]:
+    """Split n as equally as possible over strata of the given sizes (water filling)."""
+    take = [0] * len(sizes)
+    left = min(n, sum(sizes))
+    open_ = [i for i, s in enumerate(sizes) if s > 0]
+    while left > 0 and open_:
+        share = max(1, left // len(open_))
+        for i in list(open_):
+            k = min(share, sizes[i] - take[i], left)
+            take[i] += k
+            left -= k
+            if take[i] == sizes[i]:
+                open_.remove(i)
+            if left == 0:
+                break
+    return take
+
+
+@dataclass
+class Sample:
+    """A stratified sample of a scene's points.
+
+    flat: int64[n] flat point indices (``Grid``); stratum: int64[n] index into ``strata``;
+    weight: float64[n] = N_h / n_h; strata: names "outcome/boundary|interior";
+    stratum_size: int64[H] points of each stratum in the scene; classified: int8[size]
+    outcome of every point at the scene's numerics; classify_seconds: time of that pass.
+    """
+
+    flat: np.ndarray
+    stratum: np.ndarray
+    weight: np.ndarray
+    strata: list[str]
+    stratum_size: np.ndarray
+    size: int
+    classified: np.ndarray
+    classify_seconds: float
+
+
+def stratified_sample(outcome: np.ndarray, boundary: np.ndarray, n: int | None,
+                      seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str],
+                                              np.ndarray]:
+    """Draw the sample (see the module docstring). outcome, boundary: flat arrays [size].
+
+    Returns (flat indices sorted, stratum per point, weight per point, strata names,
+    stratum sizes). ``n`` None or >= size takes every point (weights 1).
+    """
+    size = outcome.size
+    codes = np.asarray(outcome).ravel()
+    bnd = np.asarray(boundary, bool).ravel()
+    names, members = [], []
+    for part, sel in (("boundary", bnd), ("interior", ~bnd)):
+        for code in sorted(set(codes[sel].tolist())):
+            word = OUTCOMES[code] if 0 <= code < len(OUTCOMES) else f"code{code}"
+            names.append(f"{word}/{part}")
+            members.append(np.flatnonzero(sel & (codes == code)))
+    sizes = [len(m) for m in members]
+    if n is None or n >= size:
+        take = sizes
+    else:
+        is_b = [nm.endswith("/boundary") for nm in names]
+        n_b = n // 2 if any(is_b) and not all(is_b) else (n if any(is_b) else 0)
+        b_idx = [i for i in range(len(names)) if is_b[i]]
+        i_idx = [i for i in range(len(names)) if not is_b[i]]
+        take = [0] * len(names)
+        tb = _allocate([sizes[i] for i in b_idx], n_b)
+        for i, k in zip(b_idx, tb, strict=True):
+            take[i] = k
+        ti = _allocate([sizes[i] for i in i_idx], n - sum(tb))
+        for i, k in zip(i_idx, ti, strict=True):
+            take[i] = k
+        short = n - sum(take)  # a half could not absorb its share: give it to the other
+        if short > 0:
+            extra = _allocate([s - t for s, t in zip(sizes, take, strict=True)], short)
+            take = [t + e for t, e in zip(take, extra, strict=True)]
+    rng = np.random.default_rng(seed)
+    flat, stratum, weight = [], [], []
+    for h, (m, k) in enumerate(zip(members, take, strict=True)):
+        if k == 0:
+            continue
+        pick = m if k == len(m) else rng.choice(m, size=k, replace=False)
+        flat.append(pick)
+        stratum.append(np.full(k, h))
+        weight.append(np.full(k, len(m) / k))
+    flat_a = np.concatenate(flat).astype(np.int64)
+    order = np.argsort(flat_a)
+    return (flat_a[order], np.concatenate(stratum)[order].astype(np.int64),
+            np.concatenate(weight)[order], names, np.asarray(sizes, np.int64))
+
+
+def sample_scene(scene: Scene, n: int | None, seed: int = 0) -> Sample:
+    """Classify every point at the scene's numerics, then draw the stratified sample.
+
+    ``n`` None or >= the scene's size takes every point (one stratum "all", weights 1,
+    no classification pass).
+    """
+    from rocksweep.grid import Grid
+    from rocksweep.sweep import compute
+
+    grid = Grid(scene)
+    if n is None or n >= grid.size:
+        return Sample(np.arange(grid.size, dtype=np.int64), np.zeros(grid.size, np.int64),
+                      np.ones(grid.size), ["all"], np.array([grid.size], np.int64),
+                      grid.size, np.full(grid.size, L.OUTCOME_NOT_RUN, np.int8), 0.0)
+    t0 = time.perf_counter()
+    outcome = compute(scene)["outcome"]
+    secs = time.perf_counter() - t0
+    bnd = boundary_mask(outcome, grid.dims)
+    flat, stratum, weight, names, sizes = stratified_sample(outcome.ravel(), bnd.ravel(), n,
+                                                            seed)
+    return Sample(flat, stratum, weight, names, sizes, grid.size, outcome.ravel(), secs)
+
+
+# ----------------------------------------------------------------------------------------
+# Running
+# ----------------------------------------------------------------------------------------
+
+
+def _with_numerics(scene: Scene, numerics: Numerics) -> Scene:
+    return dataclasses.replace(scene, numerics=numerics)
+
+
+def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int = 3
+               ) -> tuple[np.ndarray, np.ndarray, float]:
+    """The outcome-only kernel on the given points.
+
+    Returns (outs float64[n, N_OUT], seconds per point float64[n], seconds for the whole
+    sample). Each point is timed as its own 1-row chunk (one call of the jitted chunk
+    kernel); the sample is also timed as one call per kernel kind. Both are the best of
+    ``repeat`` rounds (the machine's noise only ever adds time). Compilation is excluded.
+    """
+    from rocksweep.grid import Grid
+
+    cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
+    n = len(flat)
+    outs = np.empty((n, L.N_OUT))
+    kinds = np.unique(cr.kinds)
+    for kind in kinds:
+        warm_up(int(kind), L.LEVEL_OUTCOME)
+    fns = [chunk_kernel(int(k), L.LEVEL_OUTCOME) for k in cr.kinds]
+    per_point = np.full(n, np.inf)
+    batch = math.inf
+    part = np.empty_like(outs)
+    groups = [(chunk_kernel(int(k), L.LEVEL_OUTCOME),
+               np.ascontiguousarray(cr.rows[cr.kinds == k])) for k in kinds]
+    clock = time.perf_counter
+    for _ in range(max(1, repeat)):
+        for i in range(n):
+            row, out = cr.rows[i:i + 1], outs[i:i + 1]
+            t0 = clock()
+            fns[i](row, out)
+            dt = clock() - t0
+            if dt < per_point[i]:
+                per_point[i] = dt
+        t0 = clock()
+        for fn, rows in groups:
+            fn(rows, part[:len(rows)])
+        batch = min(batch, clock() - t0)
+    return outs, per_point, batch
+
+
+def run_reference(scene: Scene, flat: np.ndarray,
+                  progress: Callable[[int, int], None] | None = None
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The reference path on the given points.
+
+    Returns (outs float64[n, N_OUT], seconds float64[n], anomalies int64[n]: the
+    reference's self-check, see ``reference_run``)."""
+    from rocksweep.grid import Grid
+    from rocksweep.reference import reference_run, result_row
+
+    grid = Grid(scene)
+    values = grid.index_values(flat)
+    n = len(flat)
+    outs = np.empty((n, L.N_OUT))
+    secs = np.empty(n)
+    anomalies = np.zeros(n, np.int64)
+    for i in range(n):
+        point = scene.point({k: v[i] for k, v in values.items()})
+        r = reference_run(point, scene.numerics)
+        outs[i] = result_row(r)
+        secs[i] = r["wall_time"]
+        anomalies[i] = r["anomalies"]
+        if progress is not None:
+            progress(i + 1, n)
+    return outs, secs, anomalies
+
+
+# ----------------------------------------------------------------------------------------
+# Comparing
+# ----------------------------------------------------------------------------------------
+
+
+def point_errors(k: np.ndarray, r: np.ndarray, alpha_ref: np.ndarray) -> dict[str, np.ndarray]:
+    """Per-point absolute errors of kernel rows k against reference rows r (NaN where a
+    measure does not apply: theta_max where both are safe, t_first_impact where both
+    impact, t_overturn where both overturn, impacts where the outcomes agree)."""
+    ko, ro = k[:, L.OUT_OUTCOME], r[:, L.OUT_OUTCOME]
+    nan = np.full(len(k), np.nan)
+    both_safe = (ko == L.OUTCOME_SAFE) & (ro == L.OUTCOME_SAFE)
+    d_theta = np.where(both_safe, np.abs(k[:, L.OUT_THETA_MAX] - r[:, L.OUT_THETA_MAX])
+                       / alpha_ref, nan)
+    d_imp = np.abs(k[:, L.OUT_T_FIRST_IMPACT] - r[:, L.OUT_T_FIRST_IMPACT])
+    d_over = np.abs(k[:, L.OUT_T_OVERTURN] - r[:, L.OUT_T_OVERTURN])
+    d_n = np.where(ko == ro, np.abs(k[:, L.OUT_IMPACTS] - r[:, L.OUT_IMPACTS]), nan)
+    return {"theta_max": d_theta, "t_first_impact": d_imp, "t_overturn": d_over,
+            "impacts": d_n}
+
+
+@dataclass
+class SettingResult:
+    """One setting's measurements on the sample (see ``accuracy_study``)."""
+
+    setting: Setting
+    outs: np.ndarray  # float64[n, N_OUT]
+    seconds: np.ndarray  # float64[n], each point as a 1-row chunk
+    batch_seconds: float  # the whole sample in one call per kind (best of repeat)
+    errors: dict[str, np.ndarray]  # per point, see ``point_errors``
+    agreement: float  # weighted share of points with the reference's outcome
+    agreement_se: float  # its standard error (stratified, finite population)
+    flips: np.ndarray  # int64[3, 3]: [reference outcome, kernel outcome] counts
+    flagged: int  # sampled points with a flagged status (horizon, caps, nonfinite)
+
+    @property
+    def median_us(self) -> float:
+        return float(np.median(self.seconds) * 1e6)
+
+    def mean_us(self, weight: np.ndarray) -> float:
+        return float(np.sum(self.seconds * weight) / np.sum(weight) * 1e6)
+
+    @property
+    def evals(self) -> np.ndarray:
+        """RK4 step evaluations per point (regular + event re-integrations)."""
+        return self.outs[:, L.OUT_STEPS] + self.outs[:, L.OUT_EVENT_STEPS]
+
+    def median_error(self, measure: str) -> float:
+        e = self.errors[measure]
+        e = e[np.isfinite(e)]
+        if measure == "impacts":
+            return float(np.mean(e)) if e.size else math.nan
+        return float(np.median(e)) if e.size else math.nan
+
+    def max_error(self, measure: str) -> float:
+        e = self.errors[measure]
+        e = e[np.isfinite(e)]
+        return float(np.max(e)) if e.size else math.nan
+
+
+def _agreement(agree: np.ndarray, sample: Sample) -> tuple[float, float]:
+    """Stratified estimate of the scene's share of agreeing points and its standard error."""
+    total, var = 0.0, 0.0
+    size = sample.size
+    for h in range(len(sample.strata)):
+        sel = sample.stratum == h
+        n_h = int(sel.sum())
+        if n_h == 0:
+            continue
+        big_n = int(sample.stratum_size[h])
+        w = big_n / size
+        p = float(np.mean(agree[sel]))
+        total += w * p
+        if n_h > 1:
+            var += w * w * p * (1 - p) / (n_h - 1) * (1 - n_h / big_n)
+    return total, math.sqrt(var)
+
+
+def flip_matrix(k_outcome: np.ndarray, r_outcome: np.ndarray) -> np.ndarray:
+    """Counts [reference outcome, kernel outcome] over codes 0..2."""
+    m = np.zeros((3, 3), np.int64)
+    for a, b in zip(r_outcome.astype(int), k_outcome.astype(int), strict=True):
+        if 0 <= a < 3 and 0 <= b < 3:
+            m[a, b] += 1
+    return m
+
+
+def observed_order(results: list[SettingResult], measure: str) -> list[tuple[int, int, float]]:
+    """Observed order between consecutive rungs of the step ladder.
+
+    Returns [(spp, 2 spp, log2(median error at spp / median error at 2 spp))] for every
+    pair of rungs of a "steps" group; errors are taken on the points where both rungs'
+    errors are finite and nonzero.
+    """
+    out = []
+    groups = sorted({r.setting.group for r in results if r.setting.group.startswith("steps")})
+    pairs = []
+    for g in groups:
+        steps = sorted((r for r in results if r.setting.group == g),
+                       key=lambda r: r.setting.steps_per_period)
+        pairs += [(a, b) for a in steps for b in steps
+                  if b.setting.steps_per_period == 2 * a.setting.steps_per_period]
+    for a, b in pairs:
+        ea, eb = a.errors[measure], b.errors[measure]
+        ok = np.isfinite(ea) & np.isfinite(eb) & (ea > 0) & (eb > 0)
+        if not ok.any():
+            continue
+        out.append((a.setting.steps_per_period, b.setting.steps_per_period,
+                    float(np.log2(np.median(ea[ok]) / np.median(eb[ok])))))
+    return out
+
+
+@dataclass
+class Study:
+    """Everything ``rocksweep accuracy`` measured (see the module docstring)."""
+
+    scene: Scene
+    sample: Sample
+    alpha_ref: np.ndarray  # float64[n]
+    values: dict[str, np.ndarray]  # axis name -> value per sampled point
+    reference: np.ndarray  # float64[n, N_OUT]
+    reference_seconds: np.ndarray  # float64[n]
+    results: list[SettingResult]
+    orders: dict[str, list[tuple[int, int, float]]] = field(default_factory=dict)
+    wall_seconds: float = 0.0
+    reference_anomalies: np.ndarray | None = None  # int64[n], see ``run_reference``
+
+    def row(self, r: SettingResult) -> dict:
+        """One line of the table (plain numbers)."""
+        w = self.sample.weight
+        d = {
+            "setting": r.setting.name, "group": r.setting.group,
+            "steps_per_period": r.setting.steps_per_period, "event_tol": r.setting.event_tol,
+            "median_us": r.median_us, "mean_us": r.mean_us(w),
+            "total_s": r.batch_seconds,
+            "evals_per_point": float(np.sum(r.evals * w) / np.sum(w)),
+            "agreement": r.agreement, "agreement_se": r.agreement_se,
+            "flips": int(r.flips.sum() - np.trace(r.flips)), "flagged": r.flagged,
+        }
+        for m in MEASURES:
+            d[f"err_{m}"] = r.median_error(m)
+            d[f"max_err_{m}"] = r.max_error(m)
+        return d
+
+    def table(self) -> list[dict]:
+        return [self.row(r) for r in self.results]
+
+
+def accuracy_study(scene: Scene, n_points: int | None = 200,
+                   settings: list[Setting] | None = None, seed: int = 0, repeat: int = 3,
+                   progress: Callable[[str, int, int], None] | None = None) -> Study:
+    """Measure time and error of each kernel setting against the reference on a sample.
+
+    n_points: sample size (None: every point); settings: the ladder (default "full");
+    progress(stage, done, total) is called as the reference and the settings run.
+    """
+    from rocksweep.grid import Grid
+
+    t_wall = time.perf_counter()
+    settings = settings if settings is not None else ladder("full")
+    if progress:
+        progress("classify", 0, 1)
+    sample = sample_scene(scene, n_points, seed)
+    if progress:
+        progress("classify", 1, 1)
+    grid = Grid(scene)
+    cr = grid.rows_at(sample.flat)
+    values = grid.index_values(sample.flat)
+    ref, ref_secs, anomalies = run_reference(
+        scene, sample.flat, (lambda i, n: progress("reference", i, n)) if progress else None)
+    results = []
+    for j, s in enumerate(settings):
+        numerics = dataclasses.replace(scene.numerics, accuracy=s.name,
+                                       steps_per_period=s.steps_per_period,
+                                       event_tol=s.event_tol)
+        outs, secs, batch = run_kernel(scene, sample.flat, numerics, repeat)
+        agree = outs[:, L.OUT_OUTCOME] == ref[:, L.OUT_OUTCOME]
+        share, se = _agreement(agree, sample)
+        flagged = int(np.sum((outs[:, L.OUT_STATUS].astype(np.int64) & L.STATUS_FLAGGED) != 0))
+        results.append(SettingResult(
+            s, outs, secs, batch, point_errors(outs, ref, cr.alpha_ref), share, se,
+            flip_matrix(outs[:, L.OUT_OUTCOME], ref[:, L.OUT_OUTCOME]), flagged))
+        if progress:
+            progress("kernel", j + 1, len(settings))
+    study = Study(scene, sample, cr.alpha_ref, values, ref, ref_secs, results,
+                  reference_anomalies=anomalies)
+    study.orders = {m: observed_order(results, m) for m in ("t_first_impact", "theta_max")}
+    study.wall_seconds = time.perf_counter() - t_wall
+    return study
+
+
+# ----------------------------------------------------------------------------------------
+# Output
+# ----------------------------------------------------------------------------------------
+
+
+def _e(x: float) -> str:
+    return "-" if not math.isfinite(x) else f"{x:.1e}"
+
+
+def format_table(study: Study) -> str:
+    """The table ``rocksweep accuracy`` prints."""
+    s = study.sample
+    n = len(s.flat)
+    lines = []
+    ref_ms = np.median(study.reference_seconds) * 1e3
+    mean_w = float(np.sum(study.reference_seconds * s.weight) / np.sum(s.weight)) * 1e3
+    how = ("every point" if n == s.size else
+           f"stratified sample of {n} of {s.size} points (strata: outcome x boundary/interior "
+           f"at the scene's numerics; weighted to estimate the whole scene)")
+    lines.append(f"{study.scene.name}: {how}")
+    counts = ", ".join(f"{nm} {int((s.stratum == h).sum())}/{int(s.stratum_size[h])}"
+                       for h, nm in enumerate(s.strata))
+    lines.append(f"  strata (sampled/in scene): {counts}")
+    lines.append(f"  reference (DOP853, rtol 1e-10, atol 1e-12): {ref_ms:.1f} ms/point median, "
+                 f"{mean_w:.1f} ms/point scene mean, {study.reference_seconds.sum():.1f} s total")
+    lines.append("  kernel time per point: median of 1-row chunk calls; mean = weighted scene "
+                 "estimate; total = one call on the sample")
+    lines.append("  errors against the reference: median |d| (max in brackets); "
+                 "d impacts: mean |d| where outcomes agree")
+    head = (f"{'setting':>11} {'spp':>4} {'tol':>6} {'med us':>8} {'mean us':>8} "
+            f"{'total s':>7} {'evals':>7} {'agree %':>13} {'flips':>5} "
+            f"{'theta_max':>17} {'t_1st_impact':>17} {'t_overturn':>17} {'d impacts':>9}")
+    lines.append(head)
+    lines.append("-" * len(head))
+    for d in study.table():
+        agree = f"{100 * d['agreement']:.2f}+-{100 * d['agreement_se']:.2f}"
+        cells = [f"{_e(d['err_' + m])} ({_e(d['max_err_' + m])})"
+                 for m in ("theta_max", "t_first_impact", "t_overturn")]
+        imp = "-" if not math.isfinite(d["err_impacts"]) else f"{d['err_impacts']:.2f}"
+        lines.append(
+            f"{d['setting']:>11} {d['steps_per_period']:>4} {d['event_tol']:>6.0e} "
+            f"{d['median_us']:>8.1f} {d['mean_us']:>8.1f} {d['total_s']:>7.3f} "
+            f"{d['evals_per_point']:>7.0f} {agree:>13} {d['flips']:>5} "
+            f"{cells[0]:>17} {cells[1]:>17} {cells[2]:>17} {imp:>9}")
+    for m, orders in study.orders.items():
+        if orders:
+            txt = ", ".join(f"{a}->{b}: {p:.2f}" for a, b, p in orders)
+            lines.append(f"  observed order on {m} (step ladder, per halving of the step; "
+                         f"RK4: 4): {txt}")
+    for r in study.results:
+        flips = [(OUTCOMES[a], OUTCOMES[b], int(r.flips[a, b]))
+                 for a in range(3) for b in range(3) if a != b and r.flips[a, b]]
+        if flips:
+            txt = ", ".join(f"{a} -> {b}: {c}" for a, b, c in flips)
+            lines.append(f"  flips at {r.setting.name} (reference -> kernel): {txt}")
+    flagged = [(r.setting.name, r.flagged) for r in study.results if r.flagged]
+    if flagged:
+        lines.append("  flagged runs (horizon, caps, nonfinite): "
+                     + ", ".join(f"{nm} {c}" for nm, c in flagged))
+    ref_flagged = int(np.sum((study.reference[:, L.OUT_STATUS].astype(np.int64)
+                              & L.STATUS_FLAGGED) != 0))
+    if ref_flagged:
+        lines.append(f"  reference flagged runs: {ref_flagged}")
+    if study.reference_anomalies is not None and study.reference_anomalies.any():
+        bad = int(np.count_nonzero(study.reference_anomalies))
+        lines.append(f"  WARNING: the reference's self-check failed on {bad} points "
+                     "(an impact with theta' pointing away from theta = 0)")
+    return "\n".join(lines)
+
+
+def write_report(study: Study, path: str | Path, command: str = "") -> None:
+    """Write the study to HDF5, atomically (a temporary file renamed at the end).
+
+    Layout: attrs (scene name and YAML, sample description, reference tolerances, command,
+    observed orders); /table: one dataset per column, one entry per setting; /flips:
+    int64[settings, 3, 3] (reference outcome, kernel outcome); /sample: flat index, stratum,
+    weight and axis values per point, stratum names and sizes; /reference and
+    /kernel/<setting>: per-point outcome, impacts, uplifts, theta_max_over_alpha,
+    t_first_impact, t_overturn, status, steps, seconds.
+    """
+    import h5py
+
+    from rocksweep.reference import ATOL, RTOL
+
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.partial")
+    try:
+        with h5py.File(tmp, "w") as f:
+            f.attrs["format"] = "rocksweep-accuracy-1"
+            f.attrs["scene_name"] = study.scene.name
+            f.attrs["scene_yaml"] = study.scene.text
+            f.attrs["numerics"] = study.scene.numerics.describe()
+            f.attrs["command"] = command
+            f.attrs["reference"] = f"scipy solve_ivp DOP853, rtol {RTOL:g}, atol {ATOL:g}"
+            f.attrs["points_in_scene"] = study.sample.size
+            f.attrs["points_sampled"] = len(study.sample.flat)
+            f.attrs["classify_seconds"] = study.sample.classify_seconds
+            f.attrs["wall_seconds"] = study.wall_seconds
+            f.attrs["time_per_point"] = ("median: each point timed as a 1-row chunk; mean: "
+                                         "weighted by stratum (scene estimate); total_s: one "
+                                         "call on the sample, best of repeats")
+            for m, orders in study.orders.items():
+                f.attrs[f"observed_order_{m}"] = np.array(
+                    [(a, b, p) for a, b, p in orders], float).reshape(-1, 3)
+            table = study.table()
+            g = f.create_group("table")
+            for key in table[0]:
+                col = [d[key] for d in table]
+                if isinstance(col[0], str):
+                    g.create_dataset(key, data=np.array(col, dtype=h5py.string_dtype()))
+                else:
+                    g.create_dataset(key, data=np.asarray(col))
+            f.create_dataset("flips", data=np.stack([r.flips for r in study.results]))
+            f["flips"].attrs["axes"] = "setting, reference outcome, kernel outcome"
+            f["flips"].attrs["outcomes"] = ", ".join(OUTCOMES)
+            s = f.create_group("sample")
+            s.create_dataset("flat_index", data=study.sample.flat)
+            s.create_dataset("stratum", data=study.sample.stratum)
+            s.create_dataset("weight", data=study.sample.weight)
+            s.create_dataset("strata", data=np.array(study.sample.strata,
+                                                     dtype=h5py.string_dtype()))
+            s.create_dataset("stratum_size", data=study.sample.stratum_size)
+            for k, v in study.values.items():
+                v = np.asarray(v)
+                s.create_dataset(k, data=v.astype(h5py.string_dtype()) if v.dtype.kind in "US"
+                                 else v)
+            g = f.create_group("reference")
+            _write_runs(g, study.reference, study.reference_seconds, study.alpha_ref)
+            if study.reference_anomalies is not None:
+                g.create_dataset("anomalies", data=study.reference_anomalies)
+            k = f.create_group("kernel")
+            for r in study.results:
+                _write_runs(k.create_group(r.setting.name), r.outs, r.seconds, study.alpha_ref)
+        tmp.replace(path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def _write_runs(g, outs: np.ndarray, seconds: np.ndarray, alpha_ref: np.ndarray) -> None:
+    g.create_dataset("outcome", data=outs[:, L.OUT_OUTCOME].astype(np.int8))
+    g.create_dataset("impacts", data=outs[:, L.OUT_IMPACTS].astype(np.int32))
+    g.create_dataset("uplifts", data=outs[:, L.OUT_UPLIFTS].astype(np.int32))
+    g.create_dataset("theta_max_over_alpha", data=outs[:, L.OUT_THETA_MAX] / alpha_ref)
+    g.create_dataset("t_first_impact", data=outs[:, L.OUT_T_FIRST_IMPACT])
+    g.create_dataset("t_overturn", data=outs[:, L.OUT_T_OVERTURN])
+    g.create_dataset("status", data=outs[:, L.OUT_STATUS].astype(np.int32))
+    g.create_dataset("steps", data=outs[:, L.OUT_STEPS] + outs[:, L.OUT_EVENT_STEPS])
+    g.create_dataset("seconds", data=seconds)
