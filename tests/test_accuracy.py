@@ -1,0 +1,126 @@
+"""``rocksweep accuracy``: sampling, bookkeeping, and the command end to end."""
+
+import h5py
+import numpy as np
+import pytest
+
+from rocksweep.accuracy import (
+    Sample,
+    _agreement,
+    _allocate,
+    boundary_mask,
+    flip_matrix,
+    ladder,
+    stratified_sample,
+)
+from rocksweep.cli.main import main
+
+SCENE = """\
+name: tiny accuracy scene
+body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47,
+       IA_ratio: 0.56}
+impact: {lam: 0.2}
+pulse: {shape: sine, w_over_p: [2.0, 5.3], A_ratio: [1.5, 3.0, 5.0]}
+"""
+
+
+def test_boundary_mask_marks_both_sides_of_a_change_along_the_diagram_axes():
+    outcome = np.array([[0, 0, 1],
+                        [0, 0, 0],
+                        [2, 0, 0]])
+    mask = boundary_mask(outcome, ("A_ratio", "w_over_p"))
+    assert mask.tolist() == [[False, True, True],
+                             [True, False, True],
+                             [True, True, False]]
+    # lam is not a diagram axis: a change along it alone marks nothing
+    assert not boundary_mask(np.array([[0], [1]]), ("lam", "w_over_p")).any()
+
+
+def test_allocate_is_equal_up_to_the_stratum_sizes():
+    assert _allocate([100, 100, 100], 9) == [3, 3, 3]
+    assert _allocate([1, 100, 100], 9) == [1, 4, 4]
+    assert _allocate([2, 3], 10) == [2, 3]
+    assert sum(_allocate([5, 7, 50, 0], 30)) == 30
+
+
+def test_stratified_sample_covers_every_outcome_and_its_weights_count_the_scene():
+    rng = np.random.default_rng(1)
+    outcome = rng.choice([0, 0, 0, 0, 1, 2], size=(40, 50))
+    outcome[:3, :3] = 2  # a small island
+    bnd = boundary_mask(outcome, ("A_ratio", "w_over_p"))
+    flat, stratum, weight, names, sizes = stratified_sample(outcome.ravel(), bnd.ravel(), 60)
+    assert len(flat) == 60 and len(np.unique(flat)) == 60
+    assert sizes.sum() == outcome.size
+    assert set(outcome.ravel()[flat]) == {0, 1, 2}
+    assert len(set(stratum)) == len(names)  # every stratum is sampled
+    assert weight.sum() == pytest.approx(outcome.size)
+    for h, name in enumerate(names):  # each point sits in the stratum it is named after
+        word, part = name.split("/")
+        sel = flat[stratum == h]
+        assert np.all(bnd.ravel()[sel] == (part == "boundary"))
+        assert np.all(outcome.ravel()[sel] == ("safe", "mode1", "mode2").index(word))
+    again = stratified_sample(outcome.ravel(), bnd.ravel(), 60)
+    assert np.array_equal(again[0], flat)  # the seed fixes the sample
+
+
+def test_agreement_is_the_stratum_weighted_share():
+    # stratum 0: 10 points in the scene, 2 sampled, 1 agrees; stratum 1: 90 points, all agree
+    sample = Sample(np.arange(4), np.array([0, 0, 1, 1]), np.array([5, 5, 45, 45.0]),
+                    ["a", "b"], np.array([10, 90]), 100, np.zeros(100, np.int8), 0.0)
+    share, se = _agreement(np.array([True, False, True, True]), sample)
+    assert share == pytest.approx(0.1 * 0.5 + 0.9 * 1.0)
+    assert se == pytest.approx(0.1 * np.sqrt(0.25 / 1 * (1 - 2 / 10)))
+
+
+def test_flip_matrix_counts_reference_to_kernel():
+    m = flip_matrix(np.array([0, 1, 1, 2, 0]), np.array([0, 0, 1, 2, 2]))
+    assert m[0, 1] == 1 and m[2, 0] == 1 and np.trace(m) == 3 and m.sum() == 5
+
+
+@pytest.fixture()
+def tiny_scene(tmp_path):
+    path = tmp_path / "tiny.yaml"
+    path.write_text(SCENE)
+    return path
+
+
+def test_accuracy_runs_end_to_end_and_writes_its_table_and_plot(cli, tiny_scene, tmp_path):
+    report, fig = tmp_path / "report.h5", tmp_path / "wp.png"
+    res = cli.invoke(main, ["accuracy", str(tiny_scene), "-o", str(report), "--plot", str(fig),
+                            "--points", "4", "--ladder", "short", "--repeat", "1", "-q"])
+    assert res.exit_code == 0, res.output
+    settings = ladder("short")
+    for s in settings:
+        assert f" {s.name} " in res.output
+    assert "stratified sample of 4 of 6 points" in res.output
+    with h5py.File(report) as f:
+        names = [n.decode() if isinstance(n, bytes) else n for n in f["table/setting"][:]]
+        assert names == [s.name for s in settings]
+        agree = dict(zip(names, f["table/agreement"][:], strict=True))
+        assert all(0.0 <= a <= 1.0 for a in agree.values())
+        assert agree["fine"] == 1.0  # the fine preset classifies like the reference
+        assert f["flips"].shape == (len(settings), 3, 3)
+        assert f["sample/flat_index"].shape == (4,)
+        assert f["reference/anomalies"][:].sum() == 0
+        assert np.all(np.isfinite(f["table/median_us"][:]))
+        assert f.attrs["command"].startswith("rocksweep accuracy")
+    assert fig.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and fig.stat().st_size > 20_000
+
+
+def test_accuracy_takes_every_point_of_a_small_scene(cli, tiny_scene):
+    res = cli.invoke(main, ["accuracy", str(tiny_scene), "--points", "50", "--ladder", "short",
+                            "--repeat", "1", "-q"])
+    assert res.exit_code == 0, res.output
+    assert "every point" in res.output and "all 6/6" in res.output
+
+
+def test_accuracy_rejects_bad_input_in_one_line_without_output(cli, tiny_scene, tmp_path):
+    res = cli.invoke(main, ["accuracy", str(tiny_scene), "--points", "0"])
+    assert res.exit_code != 0 and "--points" in res.output and "Traceback" not in res.output
+    missing = tmp_path / "nowhere" / "r.h5"
+    res = cli.invoke(main, ["accuracy", str(tiny_scene), "-o", str(missing)])
+    assert res.exit_code != 0
+    assert res.output.strip().count("\n") == 0 and "does not exist" in res.output
+    assert not missing.exists()
+    res = cli.invoke(main, ["accuracy", str(tmp_path / "none.yaml")])
+    assert res.exit_code != 0 and "no such scene file" in res.output
