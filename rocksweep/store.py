@@ -299,15 +299,16 @@ class SweepFile:
                 ds[index] = arr[a - res.start:b - res.start].reshape(box)
         self.f.flush()
 
-    def finish(self, wall_time: float, kernel_time: float) -> dict:
-        """Record this session's times and the totals; returns the attributes set."""
+    def finish(self, wall_time: float, cpu_time: float) -> dict:
+        """Record this session's wall time [s], the workers' CPU time on its points [s]
+        and the file's totals; returns the attributes set."""
         f = self.f
         done = self.done()
         steps = int(f["steps"][()].sum())
         event_steps = int(f["event_steps"][()].sum())
         attrs = {
             "wall_time": float(f.attrs.get("wall_time", 0.0)) + wall_time,
-            "kernel_time": float(f.attrs.get("kernel_time", 0.0)) + kernel_time,
+            "cpu_time": float(f.attrs.get("cpu_time", 0.0)) + cpu_time,
             "points_done": int(done.sum()),
             "complete": bool(done.all()),
             "steps_total": steps,
@@ -354,7 +355,7 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...]) -> None:
     a["started"] = _now()
     a["finished"] = ""
     a["wall_time"] = 0.0
-    a["kernel_time"] = 0.0
+    a["cpu_time"] = 0.0
     a["sessions"] = 0
     a["points_total"] = grid.size
     a["points_done"] = 0

@@ -64,18 +64,20 @@ def level(scene: Scene) -> int:
 class ChunkResult:
     """Results of the points ``start <= i < stop`` (flat indices).
 
-    arrays: name -> array[stop - start] (see ``VARIABLES``); seconds: time in the kernel.
+    arrays: name -> array[stop - start] (see ``VARIABLES``); seconds: wall time of the
+    chunk in its worker; cpu_seconds: CPU time the worker spent on it.
     """
 
     start: int
     stop: int
     arrays: dict[str, np.ndarray]
     seconds: float
+    cpu_seconds: float = 0.0
 
 
 def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
     """Compute one chunk (what a worker runs): rows, one kernel call per kind, results."""
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     cr = grid.rows(start, stop)
     outs = np.empty((stop - start, L.N_OUT))
     for kind in np.unique(cr.kinds):
@@ -100,7 +102,8 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
         arrays["work_in_over_Eref"] = outs[:, L.OUT_W_IN] / cr.E_ref
         arrays["damper_loss_over_Eref"] = outs[:, L.OUT_D_DAMP] / cr.E_ref
         arrays["impact_loss_over_Eref"] = outs[:, L.OUT_E_IMPACT] / cr.E_ref
-    return ChunkResult(start, stop, arrays, time.perf_counter() - t0)
+    return ChunkResult(start, stop, arrays, time.perf_counter() - t0,
+                       time.process_time() - c0)
 
 
 def effective_jobs(jobs: int) -> int:

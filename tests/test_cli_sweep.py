@@ -259,3 +259,15 @@ def test_kill_and_resume_equals_uninterrupted_run(cli, tmp_path):
     assert_same_results(killed, whole)
     r = read_result(killed)
     assert r.attrs["complete"] and r.attrs["finished"] and r.attrs["sessions"] == 2
+
+
+def test_sweep_on_a_dask_cluster_equals_local(ci_result, cli, tmp_path):
+    distributed = pytest.importorskip("distributed")  # in the test extra: never skipped in CI
+    out = tmp_path / "dask.h5"
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                  dashboard_address=None) as cluster:
+        res = cli.invoke(main, ["sweep", str(CI_SMALL), "-o", str(out), "-q", "--backend",
+                                "dask", "--scheduler", cluster.scheduler_address,
+                                "--chunk-size", "20"])
+    assert res.exit_code == 0, res.output
+    assert_same_results(out, ci_result[0])

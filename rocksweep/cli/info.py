@@ -61,7 +61,7 @@ def info_dict(result) -> dict:
                                      "h5py_version", "hdf5_version", "python_version",
                                      "started", "finished", "sessions")},
             "wall_time_s": a.get("wall_time"),
-            "kernel_time_s": a.get("kernel_time"),
+            "cpu_time_s": a.get("cpu_time"),
             "overrides": json.loads(a.get("overrides", "[]")),
         },
         "scene": a.get("scene"),
@@ -102,7 +102,7 @@ def info(result_path: Path, as_json: bool) -> None:
     wall = p["wall_time_s"] or 0.0
     click.echo(f"run: started {p['started']}, finished {p['finished'] or '-'}, "
                f"{p['sessions']} session(s), {wall:.2f} s wall time, "
-               f"{p['kernel_time_s'] or 0.0:.2f} s in the kernel")
+               f"{p['cpu_time_s'] or 0.0:.2f} s CPU time on the points")
     click.echo(f"versions: rocksweep {p['rocksweep_version']}, numba {p['numba_version']}, "
                f"numpy {p['numpy_version']}, h5py {p['h5py_version']} "
                f"(HDF5 {p['hdf5_version']}), Python {p['python_version']}")

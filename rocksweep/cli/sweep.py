@@ -65,7 +65,7 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
         sf = SweepFile.resume(out, scene, overrides)
     else:
         sf = SweepFile.create(out, scene, overrides, overwrite=overwrite)
-    kernel_time = t_prep = 0.0
+    cpu_time = t_prep = 0.0
     n_done_before = 0
     n_new = 0
     try:
@@ -96,19 +96,19 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
             for res in sw.run_chunks(sf.grid, chunks, sw.level(scene), jobs, backend,
                                      scheduler):
                 sf.write(res)
-                kernel_time += res.seconds
+                cpu_time += res.cpu_seconds
                 n_new += res.stop - res.start
                 bar.update(res.stop - res.start)
     except KeyboardInterrupt:
         wall = time.perf_counter() - t0
-        sf.finish(wall, kernel_time)
+        sf.finish(wall, cpu_time)
         sf.close()
         click.echo(f"\ninterrupted: {n_done_before + n_new} of {sf.grid.size} points saved "
                    f"in {out}; finish with: rocksweep sweep {scene_path} -o {out} --resume",
                    err=True)
         sys.exit(130)
     wall = time.perf_counter() - t0
-    attrs = sf.finish(wall, kernel_time)
+    attrs = sf.finish(wall, cpu_time)
     sf.close()
     if quiet:
         return
@@ -120,7 +120,8 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     rate = n_new / wall if wall > 0 else float("nan")
     resumed = f" ({n_done_before} were done before)" if n_done_before else ""
     click.echo(f"computed {n_new} points{resumed} in {wall:.2f} s wall time: "
-               f"{rate:.0f} points/s (kernel compile/cache load: {t_prep:.2f} s)")
+               f"{rate:.0f} points/s (kernel compile/cache load: {t_prep:.2f} s; workers' "
+               f"CPU time {cpu_time:.2f} s)")
     click.echo(f"accuracy: {scene.numerics.describe()}")
     click.echo(f"RK4 steps: {attrs['steps_total']} + {attrs['event_steps_total']} event "
                f"re-integrations (all points in the file)")
