@@ -33,6 +33,7 @@ import numpy as np
 
 from rocksweep.grid import Grid
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
 from rocksweep.scene import Scene
 from rocksweep.sweep import ChunkResult, variables
 
@@ -389,6 +390,13 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...]) -> None:
         ds = f.create_dataset(name, shape=grid.shape, dtype=dtype, fillvalue=fill,
                               dcpl=dcpl, fill_time="alloc")
         ds.attrs["description"] = text
+        if name == "outcome":  # CF-style flag attributes, for xarray users
+            ds.attrs["flag_values"] = np.array(list(OUTCOME_WORDS), np.int8)
+            ds.attrs["flag_meanings"] = " ".join(OUTCOME_WORDS.values())
+        elif name == "status":
+            ds.attrs["flag_masks"] = np.array(list(STATUS_WORDS), np.int32)
+            ds.attrs["flag_meanings"] = " ".join(STATUS_WORDS.values())
+            ds.attrs["flagged_mask"] = np.int32(L.STATUS_FLAGGED)
         if scalars:
             ds.attrs["coordinates"] = " ".join(scalars)
         for i, sc in enumerate(scales):

@@ -160,7 +160,9 @@ def test_bad_options(cli, tmp_path, ci_result):
     for args, needle in [(["--resume", "--overwrite"], "exclude each other"),
                          (["--backend", "dask"], "--scheduler"),
                          (["--scheduler", "tcp://x:1"], "--backend dask"),
-                         (["--jobs", "0"], "--jobs 0")]:
+                         (["--jobs", "0"], "--jobs 0"),
+                         (["--backend", "dask", "--scheduler", "bogus://x"],
+                          "cannot reach a dask scheduler")]:
         msg = one_line_error(cli.invoke(main, ["sweep", str(CI_SMALL), "-o", str(out), *args]))
         assert needle in msg
     assert not out.exists()

@@ -56,6 +56,14 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
         raise click.ClickException(f"--jobs {jobs}: give a number >= 1, or -1 for all cores")
     scene = load(scene_path, overrides)
     out = out_path if out_path is not None else Path(scene_path.stem + ".h5")
+    if backend == "dask":  # before any file is made
+        from distributed import Client
+
+        try:
+            Client(scheduler, timeout="10s").close()
+        except (OSError, TimeoutError, ValueError) as err:
+            raise click.ClickException(f"--scheduler {scheduler}: cannot reach a dask "
+                                       f"scheduler there ({type(err).__name__})") from None
 
     from rocksweep import sweep as sw
     from rocksweep.store import SweepFile, read_result
