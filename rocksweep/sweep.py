@@ -65,7 +65,7 @@ class ChunkResult:
     """Results of the points ``start <= i < stop`` (flat indices).
 
     arrays: name -> array[stop - start] (see ``VARIABLES``); seconds: wall time of the
-    chunk in its worker; cpu_seconds: CPU time the worker spent on it.
+    chunk in its worker; cpu_seconds: CPU time of the worker thread that ran it.
     """
 
     start: int
@@ -77,7 +77,7 @@ class ChunkResult:
 
 def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
     """Compute one chunk (what a worker runs): rows, one kernel call per kind, results."""
-    t0, c0 = time.perf_counter(), time.process_time()
+    t0, c0 = time.perf_counter(), time.thread_time()
     cr = grid.rows(start, stop)
     outs = np.empty((stop - start, L.N_OUT))
     for kind in np.unique(cr.kinds):
@@ -103,7 +103,7 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
         arrays["damper_loss_over_Eref"] = outs[:, L.OUT_D_DAMP] / cr.E_ref
         arrays["impact_loss_over_Eref"] = outs[:, L.OUT_E_IMPACT] / cr.E_ref
     return ChunkResult(start, stop, arrays, time.perf_counter() - t0,
-                       time.process_time() - c0)
+                       time.thread_time() - c0)
 
 
 def effective_jobs(jobs: int) -> int:
