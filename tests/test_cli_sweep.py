@@ -227,13 +227,20 @@ def test_kill_and_resume_equals_uninterrupted_run(cli, tmp_path):
                      " A_ratio: {start: 0.3, stop: 8, num: 40}}\n")
     killed = tmp_path / "killed.h5"
     total = 3200
+    # compile here if need be, so the subprocess loads numba's cache and starts at once
+    from rocksweep.grid import Grid
+    from rocksweep.scene import load_scene
+    from rocksweep.sweep import level, prepare
+
+    sc = load_scene(scene)
+    prepare(Grid(sc), level(sc))
     proc = subprocess.Popen(
         [sys.executable, "-c", "from rocksweep.cli import main; main()", "sweep", str(scene),
          "-o", str(killed),
          "--jobs", "1", "--chunk-size", "40", "--quiet"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=tmp_path)
     try:
-        deadline = time.monotonic() + 120
+        deadline = time.monotonic() + 300
         while time.monotonic() < deadline and proc.poll() is None:
             if _done_points(killed) >= 400:
                 break
