@@ -1,0 +1,293 @@
+"""Every kernel variant with an effect switched off equals the general kernel with that
+effect at zero; the welded limit; early exits.
+
+Variants (``rocksweep.kernel``): kinds flexible / flexible_undamped / rigid, each at the
+bookkeeping levels outcome-only and energy (sweeps) and with energy + history (single
+runs). All are compiled from the same functions with compile-time flags, so the state they
+integrate must agree to round-off whenever the physics agrees.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from rocksweep.kernel import chunk_kernel, point_kernel
+from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.model import BlockBody, FlexibleBody, G, restitution, restitution_rigid
+from rocksweep.numerics import Numerics
+from rocksweep.points import Point, kernel_kind, point_row
+from rocksweep.run import history_capacity, simulate
+
+TABLE3 = dict(zeta=0.05, alpha_cg=0.15, alpha_A=0.28, mA_over_m=0.47, IA_ratio=0.56)
+# A short horizon keeps undamped runs (which may never come to rest) cheap.
+NUM = Numerics.preset("draft", horizon=20.0)
+ENERGY_COLS = [L.OUT_W_IN, L.OUT_D_DAMP, L.OUT_E_IMPACT, L.OUT_E_GAINED, L.OUT_N_GAINING,
+               L.OUT_E_END]
+OUTCOME_COLS = [c for c in range(L.N_OUT) if c not in ENERGY_COLS and c != L.OUT_HIST_ROWS]
+# A small grid that crosses safe, mode 1 and mode 2 (sine and cosine, lam 0 and 0.4).
+GRID = [(shape, lam, w, a) for shape in ("sine", "cosine") for lam in (0.0, 0.4)
+        for w in (0.8, 3.0, 8.0) for a in (0.8, 2.5, 6.0)]
+
+
+def rows_for(body) -> np.ndarray:
+    """Parameter rows float64[len(GRID), N_PAR] of the test grid for ``body``."""
+    return np.array([point_row(Point(body, lam, shape, w, a), NUM) for shape, lam, w, a in GRID])
+
+
+def run_chunk(kind: int, level: int, rows: np.ndarray) -> np.ndarray:
+    outs = np.empty((rows.shape[0], L.N_OUT))
+    chunk_kernel(kind, level)(rows, outs)
+    return outs
+
+
+def run_points(kind: int, rows: np.ndarray) -> tuple[np.ndarray, list[np.ndarray]]:
+    """The single-run (energy + history) kernel on every row: results and histories."""
+    outs = np.empty((rows.shape[0], L.N_OUT))
+    hists = []
+    for i, row in enumerate(rows):
+        hist = np.empty((history_capacity(row), L.N_HIST))
+        point_kernel(kind)(row, outs[i], hist)
+        hists.append(hist[: int(outs[i, L.OUT_HIST_ROWS])])
+    return outs, hists
+
+
+def assert_same_outcomes(a: np.ndarray, b: np.ndarray, cols=OUTCOME_COLS) -> None:
+    np.testing.assert_array_equal(a[:, L.OUT_OUTCOME], b[:, L.OUT_OUTCOME])
+    np.testing.assert_array_equal(a[:, L.OUT_STATUS], b[:, L.OUT_STATUS])
+    np.testing.assert_allclose(a[:, cols], b[:, cols], rtol=1e-12, atol=1e-14)
+
+
+def assert_covers_all_outcomes(outs: np.ndarray) -> None:
+    """The comparison means something only if the grid rocks, impacts and overturns."""
+    codes = set(outs[:, L.OUT_OUTCOME].astype(int))
+    assert {L.OUTCOME_SAFE, L.OUTCOME_MODE1, L.OUTCOME_MODE2} <= codes
+    assert np.any((outs[:, L.OUT_OUTCOME] == L.OUTCOME_SAFE) & (outs[:, L.OUT_IMPACTS] > 0))
+
+
+@pytest.fixture(scope="module")
+def bodies() -> dict:
+    return {
+        "flexible": FlexibleBody(wn_over_p=2.43, **TABLE3),
+        "undamped": FlexibleBody(wn_over_p=2.43, **{**TABLE3, "zeta": 0.0}),
+        "rigid": FlexibleBody(wn_over_p=math.inf, **TABLE3),
+        "block": BlockBody(alpha=0.15),
+    }
+
+
+def test_kernel_kind_picks_the_effects_a_body_calls_for(bodies):
+    assert kernel_kind(bodies["flexible"]) == L.KIND_FLEXIBLE
+    assert kernel_kind(bodies["undamped"]) == L.KIND_FLEXIBLE_UNDAMPED
+    assert kernel_kind(bodies["rigid"]) == L.KIND_RIGID
+    assert kernel_kind(bodies["block"]) == L.KIND_RIGID
+
+
+# ---------------------------------------------------------------------------------------
+# Damping switched off == damped kernel at zeta = 0
+# ---------------------------------------------------------------------------------------
+
+
+def test_undamped_kernel_equals_damped_kernel_at_zero_zeta(bodies):
+    rows = rows_for(bodies["undamped"])
+    assert np.all(rows[:, L.PAR_C] == 0.0)
+    for level in (L.LEVEL_OUTCOME, L.LEVEL_ENERGY):
+        general = run_chunk(L.KIND_FLEXIBLE, level, rows)
+        special = run_chunk(L.KIND_FLEXIBLE_UNDAMPED, level, rows)
+        cols = OUTCOME_COLS + (ENERGY_COLS if level == L.LEVEL_ENERGY else [])
+        assert_same_outcomes(general, special, cols)
+    assert_covers_all_outcomes(general)
+    # histories too, row by row
+    out_g, hist_g = run_points(L.KIND_FLEXIBLE, rows)
+    out_s, hist_s = run_points(L.KIND_FLEXIBLE_UNDAMPED, rows)
+    assert_same_outcomes(out_g, out_s, OUTCOME_COLS + ENERGY_COLS)
+    for hg, hs in zip(hist_g, hist_s, strict=True):
+        np.testing.assert_allclose(hg, hs, rtol=1e-12, atol=1e-14)
+    np.testing.assert_array_equal(out_s[:, L.OUT_D_DAMP], 0.0)  # no damper, no damper loss
+
+
+def test_damping_is_not_ignored(bodies):
+    """The converse: with zeta > 0 the damped kernel differs from the undamped physics."""
+    damped = run_chunk(L.KIND_FLEXIBLE, L.LEVEL_ENERGY, rows_for(bodies["flexible"]))
+    undamped = run_chunk(L.KIND_FLEXIBLE, L.LEVEL_ENERGY, rows_for(bodies["undamped"]))
+    assert np.all(damped[:, L.OUT_D_DAMP] > 0)
+    assert not np.allclose(damped[:, L.OUT_THETA_MAX], undamped[:, L.OUT_THETA_MAX])
+
+
+# ---------------------------------------------------------------------------------------
+# Bookkeeping: outcome-only == energy == history, for every kind
+# ---------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", ["flexible", "undamped", "rigid"])
+def test_bookkeeping_levels_give_identical_outcomes(bodies, name):
+    body = bodies[name]
+    kind = kernel_kind(body)
+    rows = rows_for(body)
+    outcome_only = run_chunk(kind, L.LEVEL_OUTCOME, rows)
+    energy = run_chunk(kind, L.LEVEL_ENERGY, rows)
+    history, hists = run_points(kind, rows)
+    assert_covers_all_outcomes(outcome_only)
+    assert_same_outcomes(outcome_only, energy)
+    assert_same_outcomes(outcome_only, history)
+    np.testing.assert_allclose(energy[:, ENERGY_COLS], history[:, ENERGY_COLS], rtol=1e-12,
+                               atol=1e-14)
+    # the outcome-only kernel keeps no energy account and no history ...
+    assert np.all(np.isnan(outcome_only[:, ENERGY_COLS]))
+    assert np.all(outcome_only[:, L.OUT_HIST_ROWS] == 0)
+    assert np.all(energy[:, L.OUT_HIST_ROWS] == 0)
+    # ... the history kernel records the run to its end
+    for out, hist in zip(history, hists, strict=True):
+        assert hist[-1, L.HIST_T] == out[L.OUT_T_END]
+        assert hist[-1, L.HIST_E] == pytest.approx(out[L.OUT_E_END], rel=1e-12, abs=1e-12)
+
+
+@pytest.mark.parametrize("name", ["rigid", "block"])
+def test_rigid_energy_balance(bodies, name):
+    """Rigid kernel with energy accounting: work of the ground = energy left + lost in
+    impacts (no damper), up to the integration error."""
+    body = bodies[name]
+    rows = np.array([point_row(Point(body, lam, shape, w, a), Numerics.preset("default"))
+                     for shape, lam, w, a in GRID])
+    out = run_chunk(L.KIND_RIGID, L.LEVEL_ENERGY, rows)
+    assert np.all(out[:, L.OUT_D_DAMP] == 0.0)
+    balance = out[:, L.OUT_W_IN] - out[:, L.OUT_E_IMPACT] - out[:, L.OUT_E_END]
+    alive = out[:, L.OUT_OUTCOME] == L.OUTCOME_SAFE  # overturned runs gain unbounded energy
+    assert np.all(np.abs(balance[alive]) < 1e-4 * body.E_ref)
+    assert np.any(out[alive, L.OUT_E_IMPACT] > 0.01 * body.E_ref)
+
+
+def test_simulate_runs_bookkeeping_only_when_asked(bodies):
+    point = Point(bodies["flexible"], 0.2, "sine", 3.0, 2.5)
+    lean = simulate(point, NUM, history=False)
+    full = simulate(point, NUM, history=True)
+    assert lean.history is None and "work_in_over_Eref" not in lean.summary()
+    assert full.history is not None and "work_in_over_Eref" in full.summary()
+    np.testing.assert_array_equal(lean.out[OUTCOME_COLS], full.out[OUTCOME_COLS])
+
+
+# ---------------------------------------------------------------------------------------
+# Rigid variants among themselves
+# ---------------------------------------------------------------------------------------
+
+
+def test_block_equals_welded_body_of_the_same_geometry(bodies):
+    """The rigid kernel sees M, b, h_cg, I_O only: a uniform-block description with the
+    same slenderness and I_O/(M R^2) as the welded two-mass body is the same body."""
+    welded = bodies["rigid"]
+    block = BlockBody(alpha=welded.alpha_cg, inertia=welded.I_O / (welded.M * welded.R_cg**2))
+    assert block.p == pytest.approx(1.0) and welded.p == pytest.approx(1.0)
+    assert float(restitution_rigid(block, 0.3)) == pytest.approx(
+        float(restitution_rigid(welded, 0.3)), rel=1e-12)
+    a = run_chunk(L.KIND_RIGID, L.LEVEL_OUTCOME, rows_for(welded))
+    b = run_chunk(L.KIND_RIGID, L.LEVEL_OUTCOME, rows_for(block))
+    assert_covers_all_outcomes(a)
+    np.testing.assert_array_equal(a[:, L.OUT_OUTCOME], b[:, L.OUT_OUTCOME])
+    np.testing.assert_array_equal(a[:, L.OUT_IMPACTS], b[:, L.OUT_IMPACTS])
+    for col in (L.OUT_THETA_MAX, L.OUT_T_END, L.OUT_T_FIRST_IMPACT, L.OUT_T_OVERTURN):
+        np.testing.assert_allclose(a[:, col], b[:, col], rtol=1e-8)
+
+
+def test_rigid_body_is_not_the_stiff_flexible_body_after_an_impact(bodies):
+    """Why the welded limit below stops at the first impact: eq. (1) lets no impulse through
+    the spring, so even a stiff flexible body loses more at impact than the welded one
+    (paper, section 3: e(lam = 0, u = 0) is much smaller than Housner's)."""
+    stiff = FlexibleBody(wn_over_p=1e4, **TABLE3)
+    e_flex = float(restitution(stiff, 0.0, 0.0, upper=True))
+    e_rigid = float(restitution_rigid(bodies["rigid"], 0.0))
+    assert e_flex < e_rigid - 0.1
+
+
+def test_flexible_body_tends_to_the_welded_body_before_impact(bodies):
+    """Uplift time and (impact-free) overturning time converge to the rigid kernel's as
+    wn_over_p grows; the spring's transient makes the approach oscillate, so only the
+    overall decrease is checked."""
+    fine = Numerics.preset("fine", steps_per_period=400, event_tol=1e-12)
+
+    def times(body, numerics):
+        out = np.empty(L.N_OUT)
+        row = point_row(Point(body, 0.0, "sine", 1.0, 3.0), numerics)
+        hist = np.empty((history_capacity(row), L.N_HIST))
+        point_kernel(kernel_kind(body))(row, out, hist)
+        hist = hist[: int(out[L.OUT_HIST_ROWS])]
+        assert out[L.OUT_OUTCOME] == L.OUTCOME_MODE2
+        return hist[np.nonzero(hist[:, L.HIST_PHASE] != 0)[0][0], L.HIST_T], out[
+            L.OUT_T_OVERTURN]
+
+    t_up_rigid, t_over_rigid = times(bodies["rigid"], fine)
+    d_up, d_over = [], []
+    for wn in (40.0, 160.0, 640.0):
+        t_up, t_over = times(FlexibleBody(wn_over_p=wn, **TABLE3), NUM)
+        d_up.append(abs(t_up - t_up_rigid))
+        d_over.append(abs(t_over - t_over_rigid))
+    assert d_up[-1] < 1e-4 and d_up[-1] < d_up[0] / 100
+    assert d_over[-1] < 1e-4 and d_over[-1] < d_over[0] / 10
+
+
+# ---------------------------------------------------------------------------------------
+# Early exits
+# ---------------------------------------------------------------------------------------
+
+
+def _stopped_early(out: np.ndarray, row: np.ndarray) -> None:
+    horizon_end = row[L.PAR_TEND]
+    assert not int(out[L.OUT_STATUS]) & L.STATUS_FLAGGED
+    assert out[L.OUT_T_END] < row[L.PAR_TPULSE] + 0.05 * (horizon_end - row[L.PAR_TPULSE])
+    # the loop really stopped: the regular steps cover [0, t_end], not the horizon
+    assert out[L.OUT_STEPS] <= out[L.OUT_T_END] / row[L.PAR_DT] + 3
+
+
+@pytest.mark.parametrize("name", ["flexible", "rigid", "block"])
+def test_overturning_stops_the_run(bodies, name):
+    body = bodies[name]
+    row = point_row(Point(body, 0.0, "sine", 1.0, 6.0), Numerics.preset("default"))
+    out = run_chunk(kernel_kind(body), L.LEVEL_OUTCOME, row[None])[0]
+    assert out[L.OUT_OUTCOME] == L.OUTCOME_MODE2
+    assert out[L.OUT_T_END] == out[L.OUT_T_OVERTURN]
+    assert int(out[L.OUT_STATUS]) & L.STATUS_OVERTURNED
+    _stopped_early(out, row)
+
+
+def test_rest_stops_the_flexible_run(bodies):
+    """No uplift (A < g tan alpha_cg); the damped spring cannot uplift the body after the
+    pulse: rest is proven at the pulse's end."""
+    body = bodies["flexible"]
+    row = point_row(Point(body, 0.0, "sine", 1.0, 0.3), Numerics.preset("default"))
+    out = run_chunk(kernel_kind(body), L.LEVEL_OUTCOME, row[None])[0]
+    assert out[L.OUT_UPLIFTS] == 0
+    assert int(out[L.OUT_STATUS]) & L.STATUS_REST
+    assert out[L.OUT_T_END] == pytest.approx(row[L.PAR_TPULSE])
+    _stopped_early(out, row)
+
+
+@pytest.mark.parametrize("lam, a_ratio", [(0.0, 4.0), (1.0, 2.0)])
+def test_rigid_run_below_the_overturning_energy_stops_after_the_pulse(lam, a_ratio):
+    """A rigid body rocking after the pulse with energy below M g (R - h_cg) and |e| <= 1
+    cannot overturn: the run stops (status 'bounded'). At lam = 1 (e = 1, no loss) it
+    would otherwise rock to the horizon. The energy at the stop is below the barrier and
+    theta_max is the peak of the excursion then under way (energy conservation)."""
+    body = BlockBody(alpha=0.2618)
+    row = point_row(Point(body, lam, "sine", 6.0, a_ratio), Numerics.preset("default"))
+    out = run_chunk(L.KIND_RIGID, L.LEVEL_ENERGY, row[None])[0]
+    assert out[L.OUT_OUTCOME] == L.OUTCOME_SAFE and out[L.OUT_IMPACTS] >= 1
+    assert int(out[L.OUT_STATUS]) & L.STATUS_BOUNDED
+    _stopped_early(out, row)
+    barrier = body.M * G * (body.R - body.h_cg)
+    assert 0 < out[L.OUT_E_END] < barrier
+    e = float(restitution_rigid(body, lam))
+    # the peaks still to come: at E (moving away from theta = 0) or e^2 E (after the impact)
+    peaks = [body.alpha - math.acos(math.cos(body.alpha) + x * out[L.OUT_E_END] / (body.M * G
+                                                                                 * body.R))
+             for x in (1.0, e * e)]
+    assert out[L.OUT_THETA_MAX] >= min(peaks) * (1 - 1e-12)
+    assert out[L.OUT_THETA_MAX] < body.alpha
+
+
+def test_rigid_energy_exit_needs_e_at_most_1():
+    """lam > 1 gives e > 1 (impacts feed energy in): no early exit then."""
+    body = BlockBody(alpha=0.2618)
+    assert float(restitution_rigid(body, 1.5)) > 1
+    row = point_row(Point(body, 1.5, "sine", 6.0, 2.0), NUM)
+    out = run_chunk(L.KIND_RIGID, L.LEVEL_OUTCOME, row[None])[0]
+    assert not int(out[L.OUT_STATUS]) & L.STATUS_BOUNDED
