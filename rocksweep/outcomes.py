@@ -22,6 +22,7 @@ STATUS_WORDS = {
     L.STATUS_SETTLED: "settled",
     L.STATUS_OVERTURNED: "overturned",
     L.STATUS_E_ABOVE_1: "e_above_1",
+    L.STATUS_BOUNDED: "bounded",
 }
 
 STATUS_MEANING = {
@@ -35,6 +36,8 @@ STATUS_MEANING = {
     "settled": "a chattering sequence ended in full contact (rest-rate rule)",
     "overturned": "the body reached |theta| = pi/2",
     "e_above_1": "at least one impact had e > 1",
+    "bounded": "rigid body below its overturning energy after the pulse, |e| <= 1: "
+               "safe proven (early exit)",
 }
 
 

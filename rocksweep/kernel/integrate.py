@@ -34,11 +34,12 @@ from rocksweep.kernel.layout import (
     OUT_E_GAINED, OUT_E_IMPACT, OUT_E_MAX, OUT_EVENT_STEPS, OUT_HIST_ROWS, OUT_IMPACTS,
     OUT_N_GAINING, OUT_OUTCOME, OUT_STATUS, OUT_STEPS, OUT_T_END, OUT_T_FIRST_IMPACT,
     OUT_T_OVERTURN, OUT_THETA_MAX, OUT_UPLIFTS, OUT_W_IN, OUTCOME_MODE1, OUTCOME_MODE2,
-    OUTCOME_SAFE, PAR_B, PAR_C, PAR_DT, PAR_G, PAR_H, PAR_K, PAR_M, PAR_MAXEVENTS,
+    OUTCOME_SAFE, PAR_B, PAR_C, PAR_DT, PAR_G, PAR_H, PAR_HCG, PAR_K, PAR_M, PAR_MAXEVENTS,
     PAR_MAXSTEPS, PAR_MTOT, PAR_RESTRATE, PAR_ROOT, PAR_TEND, PAR_THETA_OVER, PAR_TOL,
-    PAR_TPULSE, ROOT_ILLINOIS, STATUS_E_ABOVE_1, STATUS_ENERGY_GAIN, STATUS_EVENT_CAP,
+    PAR_THETA0, PAR_THETA_DOT0, PAR_TPULSE, ROOT_ILLINOIS, STATUS_E_ABOVE_1,
+    STATUS_ENERGY_GAIN, STATUS_EVENT_CAP,
     STATUS_HIST_FULL, STATUS_HORIZON, STATUS_NONFINITE, STATUS_OVERTURNED, STATUS_REST,
-    STATUS_SETTLED, STATUS_STEP_CAP,
+    STATUS_BOUNDED, STATUS_SETTLED, STATUS_STEP_CAP,
 )
 
 EV_NONE = 0
@@ -268,6 +269,32 @@ def rest_proven(y, prm, FLEX):
     return q_max2 < mgb * mgb
 
 
+@njit(cache=True)
+def rigid_bounded(y, s, prm):
+    """After the pulse, a rigid body rocking on corner s: is its outcome decided (safe)?
+
+    With no ground motion its energy E is constant while it rocks and is multiplied by
+    e^2 <= 1 at every impact when |e| <= 1 (lam <= 1; e is the same at every impact).
+    The potential V = M g (R cos(a - s theta) - h_cg), a = atan(b/h_cg), peaks at
+    s theta = a; a body inside the barrier (s theta < a) with E below that peak (with a
+    1e-6 relative margin for the integrator's energy error) never overturns. Returns the
+    largest |theta| still to come (V = E if moving away from theta = 0, else V = e^2 E
+    after the next impact), or -1 when not proven.
+    """
+    e = restitution(s, 0.0, prm, False)
+    if abs(e) > 1.0:
+        return -1.0
+    mg, b, hcg = prm[PAR_MTOT] * prm[PAR_G], prm[PAR_B], prm[PAR_HCG]
+    r = math.hypot(b, hcg)
+    a = math.atan2(b, hcg)
+    e_now = mechanical_energy(y[0], y[1], 0.0, 0.0, s, prm, False)
+    if not (s * y[0] < a and e_now < (1.0 - 1e-6) * mg * (r - hcg)):
+        return -1.0
+    if s * y[1] < 0.0:
+        e_now *= e * e
+    return a - math.acos(min((e_now / mg + hcg) / r, 1.0))
+
+
 # ----------------------------------------------------------------------------------------
 # The loop
 # ----------------------------------------------------------------------------------------
@@ -363,7 +390,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, HISTORY):
     max_steps, max_events = prm[PAR_MAXSTEPS], prm[PAR_MAXEVENTS]
 
     t = 0.0
-    y = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    theta0, theta_dot0 = prm[PAR_THETA0], prm[PAR_THETA_DOT0]
+    y = (theta0, theta_dot0, 0.0, 0.0, 0.0, 0.0)
     s = 0
     status = 0
     outcome = OUTCOME_SAFE
@@ -372,7 +400,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, HISTORY):
     contacts = 0
     steps = 0
     event_steps = 0
-    theta_max = 0.0
+    theta_max = abs(theta0)
     t_over = np.nan
     t_first_impact = np.nan
     e_imp = 0.0  # net energy lost in impacts
@@ -380,12 +408,17 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, HISTORY):
     n_gaining = 0
     e_max = 0.0
     row = 0
+    free_check = True  # rigid: test rigid_bounded at the next loop top after the pulse
 
     on = t_pulse > 0.0
-    # Uplift is possible at t = 0 (a cosine pulse starts at its peak).
-    s = uplift_side(t, y, on, prm, FLEX, DAMPED)
-    if s != 0:
-        uplifts += 1
+    if theta0 != 0.0 or theta_dot0 != 0.0:
+        # a given initial state: rocking on the corner theta (else theta') points to
+        s = 1 if theta0 > 0.0 or (theta0 == 0.0 and theta_dot0 > 0.0) else -1
+    else:
+        # Uplift is possible at t = 0 (a cosine pulse starts at its peak).
+        s = uplift_side(t, y, on, prm, FLEX, DAMPED)
+        if s != 0:
+            uplifts += 1
     if HISTORY:
         if _record(hist, row, t, y, s, on, prm, e_imp, FLEX):
             row += 1
@@ -398,6 +431,15 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, HISTORY):
         if t >= t_end:
             status |= STATUS_HORIZON
             break
+        if not FLEX and s != 0 and not on and free_check:
+            # E is constant between impacts after the pulse: test once per excursion
+            free_check = False
+            peak = rigid_bounded(y, s, prm)
+            if peak >= 0.0:
+                if peak > theta_max:
+                    theta_max = peak
+                status |= STATUS_BOUNDED
+                break
         if steps + event_steps >= max_steps:
             status |= STATUS_STEP_CAP
             break
@@ -461,6 +503,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, HISTORY):
 
         if ev == EV_IMPACT:
             impacts += 1
+            free_check = True
             if impacts == 1:
                 t_first_impact = t
             y, s_new, e, e_d = _impact(y, s, prm, FLEX, ENERGY)

@@ -34,7 +34,9 @@ PAR_MAXEVENTS = 22  # cap on impacts + uplifts per run
 PAR_RESTRATE = 23  # post-impact |theta'| below which the body settles [rad/s]
 PAR_THETA_OVER = 24  # |theta| at which the body lies on its side: pi/2 [rad]
 PAR_ROOT = 25  # event root finder: ROOT_BISECT or ROOT_ILLINOIS
-N_PAR = 26
+PAR_THETA0 = 26  # initial theta [rad] (0: start at rest; != 0 starts rocking on its corner)
+PAR_THETA_DOT0 = 27  # initial theta' [rad/s] (from theta = 0: rocking on its sign's corner)
+N_PAR = 28
 
 SHAPE_SINE = 0.0
 SHAPE_COSINE = 1.0
@@ -93,6 +95,8 @@ STATUS_ENERGY_GAIN = 64  # at least one impact gained energy (energy variants)
 STATUS_SETTLED = 128  # chattering ended in full contact through the rest-rate rule
 STATUS_OVERTURNED = 256
 STATUS_E_ABOVE_1 = 512  # at least one impact had e > 1
+STATUS_BOUNDED = 1024  # rigid body after the pulse below its overturning energy, |e| <= 1:
+#                        safe proven (early exit; impacts counted up to there)
 # A run with any of these is not a reliable classification: "flagged".
 STATUS_FLAGGED = STATUS_HORIZON | STATUS_STEP_CAP | STATUS_EVENT_CAP | STATUS_NONFINITE
 
