@@ -28,6 +28,12 @@ def _positive(v: float) -> float:
     return v if math.isfinite(v) and v > 0 else math.nan
 
 
+def _rungs(table: list[dict], group: str) -> list[int]:
+    """Indices of a group's settings in ladder order (finer step, then tighter tolerance)."""
+    idx = [i for i, d in enumerate(table) if d["group"] == group]
+    return sorted(idx, key=lambda i: (table[i]["steps_per_period"], -table[i]["event_tol"]))
+
+
 def work_precision_figure(study: Study, path: str | Path) -> None:
     """Draw the work-precision diagram of a study to ``path`` (PNG, PDF, SVG...)."""
     table = study.table()
@@ -35,7 +41,7 @@ def work_precision_figure(study: Study, path: str | Path) -> None:
     x = np.array([d["mean_us"] for d in table])
     groups = [d["group"] for d in table]
     names = [d["setting"] for d in table]
-    fig, (ax_a, ax_b) = plt.subplots(1, 2, figsize=(13, 5.2))
+    fig, (ax_a, ax_b) = plt.subplots(1, 2, figsize=(13, 6.2), layout="constrained")
 
     curves = sorted({g for g in groups if g != "preset"})
     styles = dict(zip(curves, ["-o", "--s", ":^", "-.v", "-D", "--x"] * 4, strict=False))
@@ -43,7 +49,7 @@ def work_precision_figure(study: Study, path: str | Path) -> None:
         y = np.array([_positive(d[f"err_{m}"]) for d in table])
         color = _COLORS[m]
         for k, group in enumerate(curves):
-            idx = sorted((i for i, g in enumerate(groups) if g == group), key=lambda i: x[i])
+            idx = _rungs(table, group)
             ax_a.plot(x[idx], y[idx], styles[group], color=color, ms=4, lw=1.2,
                       label=label if k == 0 else None)
         idx = [i for i, g in enumerate(groups) if g == "preset"]
@@ -72,20 +78,23 @@ def work_precision_figure(study: Study, path: str | Path) -> None:
     ax_a.set_ylabel("median error against the reference")
     ax_a.set_title("(a) error vs cost (labels: steps per period, event_tol; "
                    "stars: presets)", fontsize=9)
-    ax_a.legend(fontsize=8, loc="lower left")
+    ax_a.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=3,
+                frameon=False)
 
     agree = np.array([100 * d["agreement"] for d in table])
     se = np.array([100 * d["agreement_se"] for d in table])
     for group in [*curves, "preset"]:
         style = styles.get(group, "*")
-        idx = sorted((i for i, g in enumerate(groups) if g == group), key=lambda i: x[i])
+        idx = _rungs(table, group)
         lab = group
         ax_b.errorbar(x[idx], agree[idx], yerr=se[idx], fmt=style, ms=11 if group == "preset"
                       else 4, capsize=2, lw=1.2, label=lab,
                       mec="k" if group == "preset" else None)
-        for i in idx:
-            ax_b.annotate(names[i], (x[i], agree[i]), textcoords="offset points",
-                          xytext=(3, 4), fontsize=7, color="0.3")
+        for j, i in enumerate(idx):
+            txt = (f"{table[i]['steps_per_period']}" if group.startswith("steps") else
+                   f"{table[i]['event_tol']:.0e}" if group.startswith("tol") else names[i])
+            ax_b.annotate(txt, (x[i], agree[i]), textcoords="offset points",
+                          xytext=(3, 5 if j % 2 == 0 else -11), fontsize=7, color="0.3")
     ax_b.axhline(AGREEMENT_TARGET, color="C3", ls="--", lw=1,
                  label=f"{AGREEMENT_TARGET}% (picks the default)")
     lo = min(float(np.nanmin(agree - se)) if agree.size else 99.0, 99.0)
@@ -94,11 +103,11 @@ def work_precision_figure(study: Study, path: str | Path) -> None:
               color="0.3")
     ax_b.set_ylabel("outcome agreement with the reference [%] (+- standard error)")
     ax_b.set_title("(b) outcome (safe / mode 1 / mode 2) agreement vs cost", fontsize=9)
-    ax_b.legend(fontsize=8, loc="lower right")
+    ax_b.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=3,
+                frameon=False)
 
     n, size = len(study.sample.flat), study.sample.size
     fig.suptitle(f"{study.scene.name}: work-precision, {n} of {size} points", fontsize=11)
-    fig.tight_layout()
     _save(fig, path)
 
 

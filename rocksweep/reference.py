@@ -16,6 +16,8 @@ rules documented in ``rocksweep.kernel.integrate`` and the paper:
   momentum m (u' + h theta'); full contact is checked for uplift at once;
 - after the pulse, in full contact, rest is proven when the largest Q on the oscillator's
   energy ellipse is below M g b (the energy never grows: c >= 0);
+- a rigid body after the pulse whose energy cannot carry it over the barrier stops early
+  (safe, STATUS_BOUNDED), as in the kernel;
 - the run stops at the horizon t_pulse + horizon (flagged), or after max_events events.
 
 Each phase is one ``solve_ivp`` call from the transition to the next one or to the next
@@ -302,12 +304,40 @@ def _rocking(pb: _Problem, t0: float, y0, s: int, t1: float, on: bool):
     return kind, t_stop, (y[0], y[1], 0.0, 0.0), theta_max
 
 
+def _rigid_bounded_peak(y, s: int, prm: np.ndarray) -> float:
+    """Rigid body after the pulse, rocking on corner s: the largest |theta| still to come if
+    it can never overturn, else -1 (the kernel's documented early-exit rule, STATUS_BOUNDED).
+
+    With no ground motion E = 1/2 I_O theta'^2 + M g (R cos(a - s theta) - h_cg) is constant
+    while rocking and shrinks by e^2 <= 1 at each impact (|e| <= 1); below the barrier
+    M g (R - h_cg) (relative margin 1e-6) and on the near side of it (s theta < a,
+    a = atan(b/h_cg)) the body only rocks back. The next peak has V = E when moving away
+    from theta = 0, else V = e^2 E (after the impact).
+    """
+    e = float(restitution(s, 0.0, prm, False))
+    if abs(e) > 1.0:
+        return -1.0
+    mg, b, hcg = prm[L.PAR_MTOT] * prm[L.PAR_G], prm[L.PAR_B], prm[L.PAR_HCG]
+    r, a = math.hypot(b, hcg), math.atan2(b, hcg)
+    energy = 0.5 * prm[L.PAR_IO] * y[1] ** 2 + mg * (r * math.cos(a - s * y[0]) - hcg)
+    if not (s * y[0] < a and energy < (1.0 - 1e-6) * mg * (r - hcg)):
+        return -1.0
+    if s * y[1] < 0.0:
+        energy *= e * e
+    return a - math.acos(min((energy / mg + hcg) / r, 1.0))
+
+
 def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = RTOL,
-                  atol: float = ATOL, events: bool = False) -> dict:
+                  atol: float = ATOL, events: bool = False, early_exit: bool = True,
+                  theta0: float | None = None, theta_dot0: float | None = None) -> dict:
     """Run one point with the reference integrator.
 
     numerics supplies horizon, rest_rate and max_events (steps_per_period and event_tol
-    are the kernel's and are ignored). Returns a dict with the kernel's summary quantities:
+    are the kernel's and are ignored). The run starts at rest, or rocking from
+    (theta0 [rad], theta_dot0 [rad/s]) if either is given and nonzero (default: the
+    parameter row's PAR_THETA0, PAR_THETA_DOT0), like the kernel. ``early_exit`` False
+    turns off the rigid body's bounded-energy exit (to follow every impact, e.g. to check
+    free rocking against closed forms). Returns a dict with the kernel's summary quantities:
     outcome (OUTCOME_* code), status (STATUS_* bits), impacts, uplifts, contacts,
     theta_max [rad], t_overturn, t_first_impact, t_end [p*t] (NaN when not applicable),
     e_max, plus steps (DOP853 steps), nfev (right-hand-side calls), anomalies (impacts
@@ -326,12 +356,15 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
     log: list[dict] | None = [] if events else None
     t0_wall = time.perf_counter()
 
+    th0 = float(prm[L.PAR_THETA0]) if theta0 is None else float(theta0)
+    thd0 = float(prm[L.PAR_THETA_DOT0]) if theta_dot0 is None else float(theta_dot0)
     t = 0.0
-    y = (0.0, 0.0, 0.0, 0.0)  # theta, theta', u, u'
+    y = (th0, thd0, 0.0, 0.0)  # theta, theta', u, u'
     status, outcome = 0, L.OUTCOME_SAFE
     impacts = uplifts = contacts = anomalies = 0
-    theta_max, e_max = 0.0, 0.0
+    theta_max, e_max = abs(th0), 0.0
     t_over = t_first = math.nan
+    free_check = True  # rigid: test the bounded-energy exit once per excursion
 
     def energy(y, s):
         return mechanical_energy(y[0], y[1], y[2], y[3], s, prm, flex)
@@ -343,10 +376,13 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
                         "u_dot_before": y0[3], "u_dot_after": y1[3], "e": e,
                         "energy_before": energy(y0, s0), "energy_after": energy(y1, s1)})
 
-    s = pb.uplift_corner(t, (0.0, 0.0), pb.t_pulse > 0.0)
-    if s != 0:
-        uplifts += 1
-        note("uplift", t, 0, s, y, y)
+    if th0 != 0.0 or thd0 != 0.0:  # rocking from the given state, on the corner it points to
+        s = 1 if th0 > 0.0 or (th0 == 0.0 and thd0 > 0.0) else -1
+    else:
+        s = pb.uplift_corner(t, (0.0, 0.0), pb.t_pulse > 0.0)
+        if s != 0:
+            uplifts += 1
+            note("uplift", t, 0, s, y, y)
     while True:
         on = t < pb.t_pulse
         if s == 0 and not on and pb.rest_margin((y[2], y[3])) < 0.0:
@@ -355,6 +391,13 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
         if t >= t_end:
             status |= L.STATUS_HORIZON
             break
+        if early_exit and not flex and s != 0 and not on and free_check:
+            free_check = False
+            peak = _rigid_bounded_peak(y, s, prm)
+            if peak >= 0.0:
+                theta_max = max(theta_max, peak)
+                status |= L.STATUS_BOUNDED
+                break
         if impacts + uplifts >= max_events:
             status |= L.STATUS_EVENT_CAP
             break
@@ -398,6 +441,7 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
             continue
         # impact at theta = 0 ending rocking on corner s (eq. 1)
         impacts += 1
+        free_check = True
         if impacts == 1:
             t_first = t
         if s * y[1] > 0.0:  # moving away from theta = 0: not a crossing (a bug if seen)

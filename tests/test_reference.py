@@ -63,7 +63,7 @@ def test_rigid_block_free_rocking_matches_the_elliptic_half_cycles(lam):
     """After the pulse: every interval between impacts is the exact free half cycle, and
     every impact multiplies theta' by Housner's / Chatzis' rigid restitution."""
     p = Point(BLOCK, lam, "sine", 6.0, 2.0)
-    run = reference_run(p, events=True)
+    run = reference_run(p, events=True, early_exit=False)
     imp = _impacts(run)
     e_rigid = float(restitution_rigid(BLOCK, lam))
     checked = 0
@@ -75,6 +75,35 @@ def test_rigid_block_free_rocking_matches_the_elliptic_half_cycles(lam):
                                                 abs=1e-9)
         checked += 1
     assert checked == 8
+
+
+def test_rigid_block_released_from_rest_hits_the_ground_at_the_closed_form_time():
+    """Free rocking from (theta0, 0): the first impact comes after half a half cycle, and
+    the kernel, started from the same state, agrees."""
+    theta0 = 0.6 * BLOCK.alpha
+    a, p2 = BLOCK.alpha, BLOCK.p**2
+    w0 = math.sqrt(2 * p2 * (math.cos(a - theta0) - math.cos(a)))  # |theta'| at theta = 0
+    p = Point(BLOCK, 0.0, "sine", 100.0, 0.0)  # no ground motion
+    run = reference_run(p, theta0=theta0, theta_dot0=0.0, early_exit=False, events=True)
+    first = _impacts(run)[0]
+    assert first["t"] == pytest.approx(0.5 * _half_cycle(BLOCK, w0), abs=1e-9)
+    assert abs(first["theta_dot_before"]) == pytest.approx(w0, rel=1e-9)
+    assert run["theta_max"] == pytest.approx(theta0, abs=1e-15)
+
+
+def test_rigid_block_bounded_exit_matches_the_kernel():
+    """After the pulse a rigid body below its overturning energy stops early (safe); both
+    paths stop at the same impact and predict the same largest rotation."""
+    p = Point(BLOCK, 0.0, "sine", 6.0, 2.0)
+    ref = reference_run(p)
+    run = simulate(p, Numerics(steps_per_period=40, event_tol=1e-12), history=False)
+    assert ref["status"] & L.STATUS_BOUNDED and int(run.out[L.OUT_STATUS]) & L.STATUS_BOUNDED
+    assert ref["outcome"] == run.out[L.OUT_OUTCOME] == L.OUTCOME_SAFE
+    assert ref["impacts"] == run.out[L.OUT_IMPACTS]
+    assert run.out[L.OUT_THETA_MAX] == pytest.approx(ref["theta_max"], abs=1e-6)
+    full = reference_run(p, early_exit=False)  # following every impact: the same maximum
+    assert full["outcome"] == L.OUTCOME_SAFE and full["impacts"] > 100
+    assert full["theta_max"] == pytest.approx(ref["theta_max"], abs=1e-9)
 
 
 # ----------------------------------------------------------------------------------------

@@ -1,0 +1,95 @@
+"""Tables for the README from ``rocksweep accuracy`` reports: the presets' price, and the
+setting the default preset is chosen by.
+
+Run the study on each shipped figure scene first, e.g.
+
+    for f in fig3a fig3b fig4a fig4b; do
+        rocksweep accuracy configs/$f.yaml --points 1000 --ladder candidates -o acc_$f.h5
+    done
+    python scripts/accuracy_tables.py acc_fig3a.h5 acc_fig3b.h5 acc_fig4a.h5 acc_fig4b.h5
+
+Prints (1) a markdown table of each preset's time per point (weighted mean over the
+stratified sample: an estimate for the whole scene, one core) and outcome agreement with
+the reference (+- its standard error) per scene, and (2) every setting measured on all
+the scenes, cheapest first (time summed over the scenes), marking those whose agreement
+is at least 99.5% on every scene: the first of them is the rule's choice for `default`.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+TARGET = 0.995
+
+
+def _text(v) -> str:
+    return v.decode() if isinstance(v, bytes) else str(v)
+
+
+def read(path: Path) -> dict:
+    with h5py.File(path) as f:
+        t = f["table"]
+        names = [_text(n) for n in t["setting"][:]]
+        rows = {n: {k: (t[k][i] if t[k].dtype.kind != "O" else _text(t[k][i]))
+                    for k in t} for i, n in enumerate(names)}
+        return {"scene": _text(f.attrs["scene_name"]), "command": _text(f.attrs["command"]),
+                "n": int(f.attrs["points_sampled"]), "size": int(f.attrs["points_in_scene"]),
+                "rows": rows}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("reports", nargs="+", type=Path)
+    args = ap.parse_args()
+    reports = [read(p) for p in args.reports]
+    short = [r["scene"].split(":")[0] for r in reports]
+
+    print("Commands:")
+    for r in reports:
+        print(f"    {r['command']}   # {r['n']} of {r['size']} points")
+    print()
+    head = "| preset | steps/period, event_tol | " + " | ".join(
+        f"{s}: us/pt, agreement" for s in short) + " |"
+    print(head)
+    print("|" + "---|" * (2 + len(reports)))
+    for name in ("draft", "default", "fine"):
+        cells = []
+        for r in reports:
+            d = r["rows"].get(name)
+            cells.append("-" if d is None else
+                         f"{d['mean_us']:.0f}, {100 * d['agreement']:.2f}% "
+                         f"(+-{100 * d['agreement_se']:.2f})")
+        d0 = reports[0]["rows"][name]
+        print(f"| {name} | {int(d0['steps_per_period'])}, {d0['event_tol']:.0e} | "
+              + " | ".join(cells) + " |")
+    print()
+
+    common = set.intersection(*(set(r["rows"]) for r in reports))
+    ranked = []
+    for name in common:
+        ds = [r["rows"][name] for r in reports]
+        cost = float(np.sum([d["mean_us"] for d in ds]))
+        worst = min(float(d["agreement"]) for d in ds)
+        ranked.append((cost, name, worst, ds))
+    ranked.sort()
+    print(f"Settings measured on every scene, cheapest first (ok: agreement >= "
+          f"{100 * TARGET:.1f}% on every scene):")
+    print(f"{'setting':>12} {'spp':>4} {'tol':>6} {'sum us/pt':>10} {'worst agree %':>14}  "
+          + "  ".join(f"{s:>12}" for s in short))
+    choice = None
+    for cost, name, worst, ds in ranked:
+        ok = worst >= TARGET
+        if ok and choice is None:
+            choice = name
+        per = "  ".join(f"{100 * d['agreement']:>11.2f}%" for d in ds)
+        print(f"{name:>12} {int(ds[0]['steps_per_period']):>4} {ds[0]['event_tol']:>6.0e} "
+              f"{cost:>10.0f} {100 * worst:>14.2f}  {per}  {'ok' if ok else ''}"
+              f"{'  <- cheapest ok' if name == choice and ok else ''}")
+
+
+if __name__ == "__main__":
+    main()
