@@ -1,0 +1,3 @@
+from rocksweep.cli import main
+
+main()

@@ -1,0 +1,117 @@
+"""`simulate`, `restitution` and scene errors through the command line (CliRunner)."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from rocksweep.cli import main
+
+CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+
+GOOD = """
+body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47, IA_ratio: 0.56}
+impact: {lam: 0.4}
+pulse: {shape: sine, w_over_p: 5.3, A_ratio: 5.0}
+"""
+
+
+def test_simulate_json_keys(cli):
+    res = cli.invoke(main, ["simulate", str(CONFIGS / "fig5.yaml"), "--set", "impact.lam=0.4",
+                            "--json"])
+    assert res.exit_code == 0, res.output
+    d = json.loads(res.output)
+    for k in ("outcome", "impacts", "uplifts", "theta_max_over_alpha", "t_overturn", "t_end",
+              "status"):
+        assert k in d
+    assert d["outcome"] == "mode1" and d["t_overturn"] > 0 and d["impacts"] >= 1
+
+
+def test_simulate_plot_and_csv(cli, tmp_path):
+    png, csv = tmp_path / "fig5.png", tmp_path / "h.csv"
+    res = cli.invoke(main, ["simulate", str(CONFIGS / "fig5.yaml"), "--plot", str(png),
+                            "--csv", str(csv)])
+    assert res.exit_code == 0, res.output
+    assert png.stat().st_size > 10_000 and png.read_bytes()[:4] == b"\x89PNG"
+    lines = csv.read_text().splitlines()
+    assert lines[0].startswith("run,lam,p_t,theta_over_alpha")
+    assert {ln.split(",")[0] for ln in lines[1:]} == {"0", "1", "2"}  # three lam runs
+
+
+def test_restitution_json(cli):
+    res = cli.invoke(main, ["restitution", str(CONFIGS / "fig2.yaml"), "--json"])
+    assert res.exit_code == 0, res.output
+    d = json.loads(res.output)
+    assert d["lam"][0] == 0 and d["lam"][-1] == 1
+    assert d["u_over_ucr"][0] == -2 and d["u_over_ucr"][-1] == 2
+    up = d["e"]["upper"]
+    assert len(up) == len(d["lam"]) and len(up[0]) == len(d["u_over_ucr"])
+    # mirror: lower(lam, u) = upper(lam, -u)
+    assert d["e"]["lower"][10][0] == pytest.approx(up[10][-1], rel=1e-12)
+
+
+def test_restitution_plot(cli, tmp_path):
+    png = tmp_path / "fig2.png"
+    res = cli.invoke(main, ["restitution", str(CONFIGS / "fig2.yaml"), "--plot", str(png)])
+    assert res.exit_code == 0 and png.read_bytes()[:4] == b"\x89PNG"
+
+
+BAD = [
+    ("zeta: 0.05", "zeta: -0.1", "body.zeta = -0.1: must be >= 0"),
+    ("zeta: 0.05", "zeta: 0.05, zta: 1", "body.zta: unknown key"),
+    ("lam: 0.4", "lam: 2.5", "impact.lam = 2.5: must be in [0, 2]"),
+    ("w_over_p: 5.3", "w_over_p: 0", "pulse.w_over_p = 0.0: must be > 0"),
+    ("A_ratio: 5.0", "A_ratio: .nan", "pulse.A_ratio = nan"),
+    ("A_ratio: 5.0", "A_ratio: .inf", "pulse.A_ratio = inf"),
+    ("shape: sine", "shape: square", "pulse.shape = 'square'"),
+    ("mA_over_m: 0.47", "mA_over_m: -1", "body.mA_over_m = -1.0: must be > 0"),
+    ("alpha_cg: 0.15", "alpha_cg: 1.6", "body.alpha_cg = 1.6: must be in (0, pi/2)"),
+    ("alpha_cg: 0.15, alpha_A: 0.28", "alpha_cg: 0.6, alpha_A: 0.1",
+     "the top mass cannot sit below the base"),
+    ("wn_over_p: 2.43", "wn_over_p: 0", "body.wn_over_p = 0.0: must be > 0"),
+    ("impact: {lam: 0.4}", "impact: {lam: 0.4}\nfoo: 1", "foo: unknown key"),
+    ("{shape: sine,", "{shape: sine", "YAML syntax error"),
+]
+
+
+@pytest.mark.parametrize("old, new, message", BAD)
+def test_bad_scene_one_line_error(cli, tmp_path, old, new, message):
+    scene = tmp_path / "bad.yaml"
+    assert old in GOOD
+    scene.write_text(GOOD.replace(old, new, 1))
+    out = tmp_path / "out.png"
+    res = cli.invoke(main, ["simulate", str(scene), "--plot", str(out)])
+    assert res.exit_code != 0
+    assert message in res.output, res.output
+    assert len(res.output.strip().splitlines()) == 1
+    assert "Traceback" not in res.output
+    assert not out.exists()
+
+
+def test_simulate_rejects_grid_and_missing_file(cli, tmp_path):
+    res = cli.invoke(main, ["simulate", str(CONFIGS / "fig3a.yaml")])
+    assert res.exit_code != 0 and "--set" in res.output
+    res = cli.invoke(main, ["simulate", str(tmp_path / "nope.yaml")])
+    assert res.exit_code != 0 and "no such scene file" in res.output
+
+
+def test_console_script_error_has_no_traceback(tmp_path):
+    scene = tmp_path / "bad.yaml"
+    scene.write_text(GOOD.replace("zeta: 0.05", "zeta: -1"))
+    proc = subprocess.run([sys.executable, "-m", "rocksweep", "simulate", str(scene)],
+                          capture_output=True, text=True)
+    assert proc.returncode != 0
+    assert "Traceback" not in proc.stderr
+    assert proc.stderr.strip().splitlines() == ["Error: " + f"{scene}: body.zeta = -1.0: must be >= 0"]
+
+
+def test_kernel_import_pulls_no_io_libraries():
+    """The layers point one way: the kernel knows nothing of files, CLI or plots.
+    (yaml is not checked: numba itself imports it to read its config file.)"""
+    code = ("import sys, rocksweep.kernel, rocksweep.model, rocksweep.points;"
+            "bad = [m for m in ('h5py', 'click', 'matplotlib', 'pydantic') if m in sys.modules];"
+            "print(','.join(bad))")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0 and proc.stdout.strip() == ""
