@@ -48,6 +48,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -125,7 +126,7 @@ class FlexibleBody:
     def M(self) -> float:
         return self.m + self.m_A
 
-    @property
+    @cached_property  # every length derives from b; computed once per body
     def b(self) -> float:
         tan_cg, tan_A, hb = math.tan(self.alpha_cg), math.tan(self.alpha_A), self.h_over_b
         rA2 = 1 + 1 / tan_A**2

@@ -26,7 +26,10 @@ def counts_lines(result) -> list[str]:
 
 
 def _json_value(v):
-    if isinstance(v, float) and not math.isfinite(v):
+    """JSON has no inf: write it as the string "inf" (wn_over_p: .inf, a rigid body)."""
+    if isinstance(v, float) and math.isinf(v):
+        return "inf" if v > 0 else "-inf"
+    if isinstance(v, float) and math.isnan(v):
         return None
     return v
 
