@@ -88,7 +88,7 @@ LADDERS: dict[str, Callable[[], list[Setting]]] = {
     # the step ladder at a tolerance far below the step's error (its order), the event
     # tolerance at a fine step, and the presets
     "full": lambda: (_steps((5, 10, 20, 40, 80, 160), 1e-12)
-                     + _tols(80, (1e-2, 1e-4, 1e-6, 1e-8)) + _presets()),
+                     + _tols(80, (1e-4, 1e-5, 1e-6, 1e-8)) + _presets()),
     "short": lambda: _steps((10, 20), 1e-12) + _presets(),
     # the cheap settings the default preset is chosen from (README, "Accuracy and its price")
     "candidates": lambda: (_steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-6, tag=True)
@@ -463,7 +463,7 @@ class Study:
 
 
 def accuracy_study(scene: Scene, n_points: int | None = 200,
-                   settings: list[Setting] | None = None, seed: int = 0, repeat: int = 3,
+                   settings: list[Setting] | None = None, seed: int = 0, repeat: int = 5,
                    progress: Callable[[str, int, int], None] | None = None) -> Study:
     """Measure time and error of each kernel setting against the reference on a sample.
 
