@@ -63,14 +63,32 @@ class Numerics:
 
 
 def step_size(omega_rock: np.ndarray | float, omega: np.ndarray | float,
-              steps_per_period: int) -> np.ndarray:
+              steps_per_period: int, omega_amp: np.ndarray | float = 0.0) -> np.ndarray:
     """RK4 step [p*t]: the shortest period of the point over ``steps_per_period``.
 
     The periods are the top mass's spring period while the base rocks (2 pi/omega_rock,
-    the stiffest the kernel meets; inf for a rigid body), the pulse period 2 pi/omega and
-    the rocking period scale 2 pi/p (= 2 pi). A stiff spring thus gets a smaller step.
+    the stiffest the kernel meets; inf for a rigid body), the pulse period 2 pi/omega,
+    the rocking period scale 2 pi/p (= 2 pi) and the pulse's own rocking time scale
+    2 pi/omega_amp (``amplitude_frequency``; 0 leaves it out). A stiff spring or a pulse
+    far above the uplift threshold thus gets a smaller step.
     """
     two_pi = 2 * math.pi
-    periods = np.minimum(np.minimum(two_pi / np.asarray(omega_rock, float),
-                                    two_pi / np.asarray(omega, float)), two_pi)
+    with np.errstate(divide="ignore"):
+        periods = np.minimum(np.minimum(two_pi / np.asarray(omega_rock, float),
+                                        two_pi / np.asarray(omega, float)), two_pi)
+        periods = np.minimum(periods, two_pi / np.asarray(omega_amp, float))
     return periods / steps_per_period
+
+
+def amplitude_frequency(A_ratio: np.ndarray | float, alpha_ref: np.ndarray | float
+                        ) -> np.ndarray:
+    """p sqrt(A/g) [rad/s] (p = 1): the rate at which the pulse alone turns the body.
+
+    A = A_ratio g tan(alpha_ref). The pulse's moment about a corner gives the body an
+    angular acceleration of about M h_cg A / I_O <= p^2 A/g (p^2 = M g R_cg / I_O), so it
+    turns the body through a radian in about 1/(p sqrt(A/g)). Below A = g (the paper's
+    ranges) this is slower than the rocking scale p and changes nothing; far above it
+    (A_ratio = 1e3 overturns the body in a few hundredths of 2 pi/p) a step following only
+    2 pi/p would jump over the whole motion (issue 5, "A_ratio huge").
+    """
+    return np.sqrt(np.abs(np.asarray(A_ratio, float)) * np.tan(np.asarray(alpha_ref, float)))

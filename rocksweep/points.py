@@ -12,7 +12,7 @@ import numpy as np
 
 from rocksweep.kernel import layout as L
 from rocksweep.model import G, Body, FlexibleBody
-from rocksweep.numerics import Numerics, step_size
+from rocksweep.numerics import Numerics, amplitude_frequency, step_size
 
 SHAPES = ("sine", "cosine")
 _SHAPE_CODE = {"sine": L.SHAPE_SINE, "cosine": L.SHAPE_COSINE}
@@ -72,8 +72,27 @@ def body_row(body: Body) -> np.ndarray:
 
 
 def body_omega_rock(body: Body) -> float:
-    """Fastest spring frequency of the body [rad/s] (0 for a rigid body: no spring)."""
-    return 0.0 if body.rigid else body.omega_rock
+    """Fastest rate of the top mass's motion [rad/s], which the step must follow (0 for a
+    rigid body: no spring).
+
+    While the base rocks, the spring and the damper reach the top mass also through the
+    base's rotation. Linearising the rocking equations (``rocksweep.kernel.equations``):
+    u'' = -Gamma (k u + c u') / m + ..., Gamma = 1 + m h^2 / (I_A + m_A R_A^2 + m a^2), with
+    a = u - s b the top mass's lever arm: a spring of frequency omega_n sqrt(Gamma) and
+    damping ratio zeta sqrt(Gamma). ``body.omega_rock`` takes a = b (u = 0); Gamma is
+    largest at a = 0 (the top mass above the corner), which rocking reaches whenever
+    |u| ~ b. Above a damping ratio of 1 the mode is overdamped and its fast root,
+    omega (zeta' + sqrt(zeta'^2 - 1)), is what an explicit RK4 step must resolve (it is
+    unstable beyond |lambda dt| ~ 2.8): a slender, tall body with a light base (m h^2 >>
+    I_A + m_A R_A^2) and zeta ~ 0.2 has zeta' ~ 5 (issue 5, found by the property test).
+    """
+    if body.rigid:
+        return 0.0
+    gamma = 1.0 + body.m * body.h**2 / (body.I_A + body.m_A * body.R_A**2)
+    omega, zeta = body.omega_n * math.sqrt(gamma), body.zeta * math.sqrt(gamma)
+    if zeta > 1.0:
+        omega *= zeta + math.sqrt(zeta * zeta - 1.0)
+    return max(omega, body.omega_rock)
 
 
 def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
@@ -87,7 +106,8 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     rows[:] = body_rows
     omega = np.asarray(w_over_p, float)  # p = 1 rad/s
     with np.errstate(divide="ignore"):
-        dt = step_size(omega_rock, omega, numerics.steps_per_period)
+        dt = step_size(omega_rock, omega, numerics.steps_per_period,
+                       amplitude_frequency(A_ratio, alpha_ref))
     t_pulse = 2 * np.pi / omega
     rows[:, L.PAR_AMP] = A_ratio * G * np.tan(alpha_ref)
     rows[:, L.PAR_OMEGA] = omega

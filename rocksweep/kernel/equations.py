@@ -197,3 +197,29 @@ def mechanical_energy(theta, theta_dot, u, u_dot, s, prm, FLEX):
     pot = (m * g * (h * (cth - 1.0) - a * sth) + prm[PAR_MA] * g * (h_A * (cth - 1.0) + sb * sth)
            + 0.5 * k * u * u)
     return kin + pot
+
+
+@njit(cache=True)
+def impact_loss(s, s_new, u, w_minus, w_plus, prm, FLEX):
+    """Energy [J] the impact itself dissipates (eq. 6; < 0: the impact gains energy).
+
+    At theta = 0 the potential energy is the same before and after, and the top mass keeps
+    its horizontal velocity u' + h theta' (no impulse reaches it), so only the rest of the
+    kinetic energy changes: with a = u - s b the top mass's lever arm about corner s,
+
+        E_d = 1/2 (I_A + m_A R_A^2 + m a^2) w^-^2 - 1/2 (I_A + m_A R_A^2 + m a'^2) w^+^2,
+
+    a' = u - s_new b (w^+ = 0 when s_new = 0, full contact). With s_new = -s and
+    w^+ = e w^- this is eq. (6). Rigid body: 1/2 I_O (w^-^2 - w^+^2). Written as this
+    difference, not as a difference of total energies, so that round-off in the spring's
+    energy cannot make a dissipating impact look like one that gains energy.
+    """
+    if not FLEX:
+        return 0.5 * prm[PAR_IO] * (w_minus * w_minus - w_plus * w_plus)
+    m, b = prm[PAR_M], prm[PAR_B]
+    a_minus = u - s * b
+    loss = 0.5 * (prm[PAR_IA0] + m * a_minus * a_minus) * w_minus * w_minus
+    if s_new != 0:
+        a_plus = u - s_new * b
+        loss -= 0.5 * (prm[PAR_IA0] + m * a_plus * a_plus) * w_plus * w_plus
+    return loss

@@ -25,8 +25,8 @@ import numpy as np
 from numba import literally, njit
 
 from rocksweep.kernel.equations import (
-    contact_rhs, ground_acc, ground_jerk, mechanical_energy, restitution, rigid_rhs,
-    rocking_rhs, uplift_moment, uplift_moment_rate,
+    contact_rhs, ground_acc, ground_jerk, impact_loss, mechanical_energy, restitution,
+    rigid_rhs, rocking_rhs, uplift_moment, uplift_moment_rate,
 )
 from rocksweep.kernel.layout import (
     HIST_D_DAMP, HIST_E, HIST_E_IMPACT, HIST_PHASE, HIST_T, HIST_THETA, HIST_THETA_DOT,
@@ -207,8 +207,11 @@ def _crossing(ev, t0, y0, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
     Returns (tau, y_event, re-integrations); tau < 0 if it did not. A sign change at the
     ends is bracketed at once. Same sign at both ends but falling then rising (a dip
     through zero and back, e.g. a grazing impact inside a coarse step) is checked with the
-    step's cubic Hermite interpolant; a predicted dip is confirmed by integrating to the
-    interpolant's minimum, which then closes the bracket.
+    step's cubic Hermite interpolant. The cubic is only an estimate: when its minimum is
+    nearer zero than the dip is deep, the minimum of the integrator's own solution (fresh
+    RK4 steps from t0, as in ``_locate``) is searched for (Illinois on g' = 0, bracketed by
+    d0 < 0 < d1) until g <= 0 is found, which closes the bracket, or the bracket proves
+    that the dip stays above zero (g convex there: g_min >= g - max|g'| * width).
     """
     literally(FLEX)
     literally(DAMPED)
@@ -228,14 +231,37 @@ def _crossing(ev, t0, y0, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
     if d1 <= 0.0:
         return -1.0, y1, 0
     tau, g_min = hermite_min(g0, d0, g1, d1, h)
-    if g_min > 0.0:
-        return -1.0, y1, 0
-    y_m = rk4_step(t0, y0, tau, s, on, prm, FLEX, DAMPED, ENERGY)
-    g_m = event_value(ev, t0 + tau, y_m, s, on, prm, FLEX, DAMPED)
-    if g_m > 0.0:
-        return -1.0, y1, 1
-    tau, y_e, n = _locate(ev, t0, y0, 0.0, g0, tau, g_m, y_m, s, on, prm, FLEX, DAMPED, ENERGY)
-    return tau, y_e, n + 1
+    if g_min > min(g0, g1) - g_min:
+        return -1.0, y1, 0  # far from zero compared with the dip: the cubic is good enough
+    if not (0.0 < tau < h):
+        tau = 0.5 * h
+    lo, r_lo, f_lo, hi, r_hi, f_hi = 0.0, d0, d0, h, d1, d1
+    side = 0
+    n = 0
+    while True:
+        y_m = rk4_step(t0, y0, tau, s, on, prm, FLEX, DAMPED, ENERGY)
+        g_m = event_value(ev, t0 + tau, y_m, s, on, prm, FLEX, DAMPED)
+        n += 1
+        if g_m <= 0.0:
+            tau, y_e, k = _locate(ev, t0, y0, 0.0, g0, tau, g_m, y_m, s, on, prm, FLEX,
+                                  DAMPED, ENERGY)
+            return tau, y_e, n + k
+        d_m = event_rate(ev, t0 + tau, y_m, s, on, prm, FLEX, DAMPED)
+        if d_m < 0.0:
+            lo, r_lo, f_lo = tau, d_m, d_m
+            if side == -1:
+                f_hi *= 0.5
+            side = -1
+        else:
+            hi, r_hi, f_hi = tau, d_m, d_m
+            if side == 1:
+                f_lo *= 0.5
+            side = 1
+        if g_m > max(-r_lo, r_hi) * (hi - lo) or hi - lo <= prm[PAR_TOL] or n >= 50:
+            return -1.0, y1, n
+        tau = lo - f_lo * (hi - lo) / (f_hi - f_lo)
+        if not (lo < tau < hi):
+            tau = 0.5 * (lo + hi)
 
 
 @njit(cache=True)
@@ -349,7 +375,11 @@ def _first_event(t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
 def _impact(y, s, prm, FLEX, ENERGY):
     """Impact map at theta = 0 ending rocking on corner s (eq. 1 and the settling rule).
 
-    Returns (state after, new phase, e, energy lost E_d [J] (0 unless ENERGY)).
+    Returns (state after, new phase, e, energy lost E_d [J], impact loss [J]) (energies 0
+    unless ENERGY). E_d = E(before) - E(after) closes the energy balance; it includes the
+    potential energy of the located state's overshoot of theta = 0 (within the event
+    tolerance). The impact loss (``impact_loss``, eq. 6) is the impact's own share; only it
+    decides whether an impact gained energy, so the overshoot cannot flag a spurious gain.
     e > 0 with |e theta'^-| >= PAR_RESTRATE: rocking continues on -s, theta'^+ = e theta'^-.
     Otherwise full contact: e <= 0 is inadmissible as rocking, and a post-impact rate
     below the rest rate ends a chattering (Zeno) sequence after finitely many impacts.
@@ -368,10 +398,12 @@ def _impact(y, s, prm, FLEX, ENERGY):
     u_dot_plus = y[3] + prm[PAR_H] * (w_minus - w_plus) if FLEX else 0.0
     y_new = (0.0, w_plus, y[2], u_dot_plus, y[4], y[5])
     e_d = 0.0
+    loss = 0.0
     if ENERGY:
         e_d = (mechanical_energy(y[0], y[1], y[2], y[3], s, prm, FLEX)
                - mechanical_energy(0.0, w_plus, y[2], u_dot_plus, s_new, prm, FLEX))
-    return y_new, s_new, e, e_d
+        loss = impact_loss(s, s_new, y[2], w_minus, w_plus, prm, FLEX)
+    return y_new, s_new, e, e_d, loss
 
 
 
@@ -485,6 +517,19 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, HISTORY):
                     row += 1
                 else:
                     status |= STATUS_HIST_FULL
+            if lands and s == 0:
+                # The pulse ends with a jump of xg'' (a cosine pulse ends at its peak), and
+                # Q jumps with it by m_A h_A xg'': the state may now be past the uplift
+                # threshold, which no crossing inside the next step would show. Checked at
+                # once, as at t = 0 and after an impact.
+                s = uplift_side(t, y, False, prm, FLEX, DAMPED)
+                if s != 0:
+                    uplifts += 1
+                    if HISTORY:
+                        if _record(hist, row, t, y, s, False, prm, e_imp, FLEX):
+                            row += 1
+                        else:
+                            status |= STATUS_HIST_FULL
             continue
 
         t = t + tau
@@ -506,7 +551,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, HISTORY):
             free_check = True
             if impacts == 1:
                 t_first_impact = t
-            y, s_new, e, e_d = _impact(y, s, prm, FLEX, ENERGY)
+            y, s_new, e, e_d, loss = _impact(y, s, prm, FLEX, ENERGY)
             s = s_new
             if e > e_max:
                 e_max = e
@@ -518,8 +563,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, HISTORY):
                     status |= STATUS_SETTLED
             if ENERGY:
                 e_imp += e_d
-                if e_d < 0.0:
-                    e_gained -= e_d
+                if loss < 0.0:
+                    e_gained -= loss
                     n_gaining += 1
                     status |= STATUS_ENERGY_GAIN
             if s == 0:
