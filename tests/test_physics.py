@@ -4,6 +4,7 @@ import math
 
 import numpy as np
 import pytest
+from numba import njit
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
@@ -97,12 +98,19 @@ def test_flexible_uplift_time_matches_independent_integration(body_fig3):
 # ------------------------------------------------------------------------------------
 
 
-def _integrate_rocking(row, y0, t_total, n, s=1):
+@njit
+def _rk4_loop(row, y0, t_total, n, s):
+    # jitted: a `literally`-specialised kernel function called from Python re-enters the
+    # dispatcher on every call; from jitted code the flags are literals at compile time
     y, t, h = y0, 0.0, t_total / n
     for _ in range(n):
         y = ki.rk4_step(t, y, h, s, True, row, True, True, True)
         t += h
-    return np.array(y[:4])
+    return y
+
+
+def _integrate_rocking(row, y0, t_total, n, s=1):
+    return np.array(_rk4_loop(row, y0, t_total, n, s)[:4])
 
 
 def test_rk4_error_falls_16_fold_per_halving(body_fig3):
