@@ -546,7 +546,7 @@ def format_table(study: Study) -> str:
         imp = "-" if not math.isfinite(d["err_impacts"]) else f"{d['err_impacts']:.2f}"
         lines.append(
             f"{d['setting']:>11} {d['steps_per_period']:>4} {d['event_tol']:>6.0e} "
-            f"{d['median_us']:>8.1f} {d['mean_us']:>8.1f} {d['total_s']:>7.3f} "
+            f"{d['median_us']:>8.1f} {d['mean_us']:>8.1f} {d['total_s']:>7.3g} "
             f"{d['evals_per_point']:>7.0f} {agree:>13} {d['flips']:>5} "
             f"{cells[0]:>17} {cells[1]:>17} {cells[2]:>17} {imp:>9}")
     for m, orders in study.orders.items():
