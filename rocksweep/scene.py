@@ -76,7 +76,7 @@ class PulseSpec(BaseModel):
 
 class NumericsSpec(BaseModel):
     model_config = _STRICT
-    accuracy: Literal["draft", "default", "fine"] = "default"
+    accuracy: Literal["draft", "default", "fine"] | None = None
     steps_per_period: int | None = None
     event_tol: float | None = None
     horizon: float | int | None = None
@@ -177,7 +177,8 @@ class Scene:
     name: str
     kind: str  # "flexible" | "block"
     axes: tuple[Axis, ...]
-    numerics: Numerics
+    numerics: Numerics  # sweeps: the `default` preset unless the scene names one
+    single_numerics: Numerics  # single runs (simulate): `fine` unless the scene names one
     energy: bool
     text: str = field(repr=False)
 
@@ -376,9 +377,12 @@ def _parse(text: str, overrides: list[str]) -> Scene:
             raise SceneError(f"numerics.{k} = {_fmt(v)}: {checks[k][1]}")
     if "horizon" in overrides_n:
         overrides_n["horizon"] = float(overrides_n["horizon"])
-    assert n.accuracy in PRESETS
-    numerics = Numerics.preset(n.accuracy, **overrides_n)
+    assert n.accuracy is None or n.accuracy in PRESETS
+    numerics = Numerics.preset(n.accuracy or "default", **overrides_n)
+    # A single run exists for its time history and energy balance, which the outcome-tuned
+    # `default` (5 steps per period) resolves only roughly; it costs milliseconds at `fine`.
+    single_numerics = Numerics.preset(n.accuracy or "fine", **overrides_n)
 
     name = spec.name or "rocksweep scene"
     return Scene(name=name, kind=kind, axes=tuple(axes), numerics=numerics,
-                 energy=spec.outputs.energy, text=text)
+                 single_numerics=single_numerics, energy=spec.outputs.energy, text=text)

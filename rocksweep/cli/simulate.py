@@ -44,7 +44,8 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     names = [a.name for a in scene.axes]
     runs = []
     for combo in product(*(a.values for a in scene.axes)):
-        runs.append(run_point(scene.point(dict(zip(names, combo))), scene.numerics))
+        runs.append(run_point(scene.point(dict(zip(names, combo, strict=True))),
+                              scene.single_numerics))
     swept = [a.name for a in scene.swept]
 
     if as_json:
