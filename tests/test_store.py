@@ -155,7 +155,11 @@ def test_resume_with_a_different_scene_says_what_differs(tmp_path, scene):
     assert "\n" not in msg
     assert "impact.lam" in msg and "[0.0, 0.2, 0.4]" in msg and "[0.0, 0.2]" in msg
     finer = parse_scene(TEXT + "numerics: {accuracy: fine}\n")
-    with pytest.raises(StoreError, match="numerics.steps_per_period: file 20, scene 40"):
+    from rocksweep.numerics import PRESETS
+
+    want = (f"numerics.steps_per_period: file {PRESETS['default'][0]}, "
+            f"scene {PRESETS['fine'][0]}")
+    with pytest.raises(StoreError, match=want):
         SweepFile.resume(path, finer)
     # a comment is not a different scene
     SweepFile.resume(path, parse_scene("# another comment\n" + TEXT)).close()
