@@ -20,7 +20,7 @@ from pydantic import BaseModel, ConfigDict, ValidationError
 
 from rocksweep.model import BlockBody, Body, BodyError, FlexibleBody
 from rocksweep.numerics import PRESETS, Numerics
-from rocksweep.points import SHAPES, Point
+from rocksweep.points import Point
 
 
 class SceneError(ValueError):
@@ -360,7 +360,7 @@ def _parse(text: str, overrides: list[str]) -> Scene:
     for combo in product(*(a.values for a in body_axes)):
         try:
             (BlockBody if kind == "block" else FlexibleBody)(
-                **{a.name: v for a, v in zip(body_axes, combo)})
+                **{a.name: v for a, v in zip(body_axes, combo, strict=True)})
         except BodyError as err:
             raise SceneError(str(err)) from None
 

@@ -104,7 +104,8 @@ def test_console_script_error_has_no_traceback(tmp_path):
                           capture_output=True, text=True)
     assert proc.returncode != 0
     assert "Traceback" not in proc.stderr
-    assert proc.stderr.strip().splitlines() == ["Error: " + f"{scene}: body.zeta = -1.0: must be >= 0"]
+    want = f"Error: {scene}: body.zeta = -1.0: must be >= 0"
+    assert proc.stderr.strip().splitlines() == [want]
 
 
 def test_kernel_import_pulls_no_io_libraries():

@@ -12,8 +12,8 @@ import sympy as sp
 from rocksweep.kernel import equations as eq
 from rocksweep.kernel.layout import PAR_LAM
 from rocksweep.model import impact_energy_loss, restitution
-from rocksweep.points import Point, point_row
 from rocksweep.numerics import Numerics
+from rocksweep.points import Point, point_row
 
 t = sp.symbols("t")
 m, mA, IA, h, hA, b, g, k, c, lam = sp.symbols("m m_A I_A h h_A b g k c lambda", positive=True)
@@ -123,7 +123,9 @@ def impact_solution():
 
     def h_about_q(w, v, corner):
         vP, vA = velocities(w, v, corner)
-        cross = (lambda r, vv: r[0] * vv[1] - r[1] * vv[0])
+        def cross(r, vv):
+            return r[0] * vv[1] - r[1] * vv[0]
+
         return (m * cross((uu - x_q, h), vP) + mA * cross((0 - x_q, hA), vA) - IA * w)
 
     eqs = [h_about_q(w_p, v_p, -s_old * b) - h_about_q(w_m, v_m, s_old * b),
@@ -162,7 +164,8 @@ def test_eq5_is_the_derivative_of_eq1(impact_solution):
     for upper, s_val in ((True, 1), (False, -1)):
         pm = 1 if upper else -1
         d = sp.diff(impact_solution["e"].subs(s_old, s_val), lam)
-        den = IA + mA * hA**2 + m * uu * (pm * b + uu) + b * (1 - lam) * (mA * b + m * b + pm * m * uu)
+        den = (IA + mA * hA**2 + m * uu * (pm * b + uu)
+               + b * (1 - lam) * (mA * b + m * b + pm * m * uu))
         paper5 = (2 * (m + mA) * b**2 * (IA + mA * hA**2) + 2 * m * mA * b**2 * uu**2) / den**2
         assert sp.simplify(d - paper5) == 0
 

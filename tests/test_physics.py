@@ -10,7 +10,7 @@ from scipy.optimize import brentq
 
 from rocksweep.kernel import equations as eq
 from rocksweep.kernel import integrate as ki
-from rocksweep.model import G, FlexibleBody, restitution, restitution_rigid
+from rocksweep.model import FlexibleBody, G, restitution, restitution_rigid
 from rocksweep.numerics import Numerics
 from rocksweep.points import Point, point_row
 from rocksweep.run import simulate
