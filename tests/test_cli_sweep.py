@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from rocksweep.cli import main
+from rocksweep.numerics import PRESETS
 from rocksweep.store import SweepFile, read_result
 from rocksweep.sweep import ChunkResult, variables
 
@@ -53,7 +54,8 @@ def ci_result(tmp_path_factory):
 def test_sweep_summary(ci_result):
     out, text = ci_result
     assert "mode1" in text and "mode2" in text and "safe" in text and "flagged" in text
-    assert "points/s" in text and "accuracy: default (steps_per_period=20" in text
+    spp = PRESETS["default"][0]
+    assert "points/s" in text and f"accuracy: default (steps_per_period={spp}" in text
     assert "RK4 steps:" in text
     # one summary row per (shape, lam)
     rows = [ln.split() for ln in text.splitlines() if ln.startswith(("sine", "cosine"))]
@@ -87,7 +89,7 @@ def test_info_text_and_json(ci_result, cli):
     assert d["dims"]["shape"]["scene_key"] == "pulse.shape"
     assert d["points_done"] == d["points_total"] == 256
     assert sum(c["safe"] + c["mode1"] + c["mode2"] for c in d["counts"]) == 256
-    assert d["numerics"]["steps_per_period"] == 20
+    assert d["numerics"]["steps_per_period"] == PRESETS["default"][0]
     assert d["provenance"]["numba_version"]
     assert d["scene"] == CI_SMALL.read_text()
 
