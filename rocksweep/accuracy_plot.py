@@ -19,6 +19,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from rocksweep.accuracy import MEASURE_LABELS, Study  # noqa: E402
+from rocksweep.plots import save_figure  # noqa: E402
 
 _COLORS = {"theta_max": "C0", "t_first_impact": "C1", "t_overturn": "C2", "impacts": "C3"}
 AGREEMENT_TARGET = 99.5  # % (the rule that picks the default preset)
@@ -108,16 +109,4 @@ def work_precision_figure(study: Study, path: str | Path) -> None:
 
     n, size = len(study.sample.flat), study.sample.size
     fig.suptitle(f"{study.scene.name}: work-precision, {n} of {size} points", fontsize=11)
-    _save(fig, path)
-
-
-def _save(fig, path: str | Path) -> None:
-    """Save atomically: a figure is either complete or absent."""
-    path = Path(path)
-    tmp = path.with_name(f".{path.stem}.partial{path.suffix}")
-    try:
-        fig.savefig(tmp, dpi=130)
-        tmp.replace(path)
-    finally:
-        plt.close(fig)
-        tmp.unlink(missing_ok=True)
+    save_figure(fig, path)

@@ -125,7 +125,7 @@ def stability_figure(result: SweepResult, path: str | Path) -> list[str]:
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
-    from rocksweep.plots import _save
+    from rocksweep.plots import save_figure
 
     n_lam = len(lam)
     m1 = mode1_colours(n_lam)
@@ -208,7 +208,7 @@ def stability_figure(result: SweepResult, path: str | Path) -> list[str]:
     fig.legend(handles=handles, loc="outside lower center", fontsize=8, frameon=False,
                ncol=max(1, min(len(handles), 2 * ncols)))
     fig.suptitle(result.name, fontsize=11)
-    _save(fig, path)
+    save_figure(fig, path)
     warnings = []
     n_missing = int((outcome == L.OUTCOME_NOT_RUN).sum())
     if n_missing:

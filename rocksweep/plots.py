@@ -55,7 +55,7 @@ def time_history_figure(runs: list[Run], swept: list[str], title: str, path: str
     for ax in axes:
         ax.grid(alpha=0.3)
     fig.tight_layout()
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 def restitution_figure(lam: np.ndarray, u_over_ucr: np.ndarray, e_upper: np.ndarray,
@@ -90,10 +90,10 @@ def restitution_figure(lam: np.ndarray, u_over_ucr: np.ndarray, e_upper: np.ndar
         ax.grid(alpha=0.3)
     fig.suptitle(title, fontsize=11)
     fig.tight_layout()
-    _save(fig, path)
+    save_figure(fig, path)
 
 
-def _save(fig, path: str | Path) -> None:
+def save_figure(fig, path: str | Path) -> None:
     """Save atomically: a figure is either complete or absent."""
     path = Path(path)
     tmp = path.with_name(f".{path.stem}.partial{path.suffix}")
