@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rocksweep.kernel import layout as L
-from rocksweep.model import G, Body, FlexibleBody
+from rocksweep.model import Body, FlexibleBody, G
 from rocksweep.numerics import Numerics, amplitude_frequency, step_size
 
 SHAPES = ("sine", "cosine")
