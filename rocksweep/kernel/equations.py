@@ -12,7 +12,9 @@ generalised force -c u'). Rocking on corner s, with a = u - s b the top mass's l
     V = m g (h cos theta - a sin theta) + m_A g (h_A cos theta + s b sin theta) + 1/2 k u^2
 
 which gives   [ I_O(u)  m h ] [theta'']   [F_theta]
-              [  m h     m  ] [  u''  ] = [  F_u  ]     with I_O(u) = I_A + m_A R_A^2 + m (h^2 + a^2),
+              [  m h     m  ] [  u''  ] = [  F_u  ]
+
+with I_O(u) = I_A + m_A R_A^2 + m (h^2 + a^2),
 
     F_theta = -2 m a u' theta' + m g (a cos + h sin) - m_A g (s b cos - h_A sin)
               - xg'' [m (h cos - a sin) + m_A (h_A cos + s b sin)]
@@ -25,10 +27,25 @@ Full contact (theta = 0):  m u'' + c u' + k u = -m xg''.
 import math
 
 from numba import njit
-
 from rocksweep.kernel.layout import (
-    PAR_AMP, PAR_B, PAR_C, PAR_G, PAR_H, PAR_HA, PAR_HCG, PAR_IA0, PAR_IAH, PAR_IO, PAR_K,
-    PAR_LAM, PAR_M, PAR_MA, PAR_MTOT, PAR_OMEGA, PAR_SHAPE, SHAPE_COSINE,
+    PAR_AMP,
+    PAR_B,
+    PAR_C,
+    PAR_G,
+    PAR_H,
+    PAR_HA,
+    PAR_HCG,
+    PAR_IA0,
+    PAR_IAH,
+    PAR_IO,
+    PAR_K,
+    PAR_LAM,
+    PAR_M,
+    PAR_MA,
+    PAR_MTOT,
+    PAR_OMEGA,
+    PAR_SHAPE,
+    SHAPE_COSINE,
 )
 
 # ----------------------------------------------------------------------------------------
