@@ -27,6 +27,7 @@ Full contact (theta = 0):  m u'' + c u' + k u = -m xg''.
 import math
 
 from numba import njit
+
 from rocksweep.kernel.layout import (
     PAR_AMP,
     PAR_B,
@@ -55,7 +56,7 @@ from rocksweep.kernel.layout import (
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def ground_acc(t, on, prm):
     """xg''(t) [m/s^2] of eq. (2); 0 when ``on`` is False."""
     if not on:
@@ -65,7 +66,7 @@ def ground_acc(t, on, prm):
     return prm[PAR_AMP] * math.sin(prm[PAR_OMEGA] * t)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def ground_jerk(t, on, prm):
     """d xg''/dt [m/s^3], for locating an uplift inside a step."""
     if not on:
@@ -81,7 +82,7 @@ def ground_jerk(t, on, prm):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def rocking_rhs(theta, theta_dot, u, u_dot, s, xg, prm, DAMPED):
     """Accelerations while rocking on corner s (+1 / -1), and the input and damper powers.
 
@@ -102,7 +103,7 @@ def rocking_rhs(theta, theta_dot, u, u_dot, s, xg, prm, DAMPED):
     return theta_dd, u_dd, power_in, f_damp * u_dot
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def rigid_rhs(theta, theta_dot, s, xg, prm):
     """Rigid body (top mass welded, or a block): I_O theta'' = moment about corner s.
 
@@ -121,7 +122,7 @@ def rigid_rhs(theta, theta_dot, s, xg, prm):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def contact_rhs(u, u_dot, xg, prm, DAMPED):
     """Full contact: m u'' + c u' + k u = -m xg''. Returns (u'', ground power, damper power)."""
     f_damp = prm[PAR_C] * u_dot if DAMPED else 0.0
@@ -129,7 +130,7 @@ def contact_rhs(u, u_dot, xg, prm, DAMPED):
     return u_dd, -prm[PAR_M] * xg * u_dot, f_damp * u_dot
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def uplift_moment(u, u_dot, xg, prm, FLEX, DAMPED):
     """Q [N m]: the moment that tips the body in full contact.
 
@@ -149,7 +150,7 @@ def uplift_moment(u, u_dot, xg, prm, FLEX, DAMPED):
     return prm[PAR_H] * f + prm[PAR_M] * prm[PAR_G] * u - prm[PAR_MA] * prm[PAR_HA] * xg
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def uplift_moment_rate(u, u_dot, xg, jerk, prm, FLEX, DAMPED):
     """dQ/dt [N m/s] in full contact."""
     if not FLEX:
