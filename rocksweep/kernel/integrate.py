@@ -6,11 +6,20 @@ and back that leaves both ends on the same side, found from the step's cubic Her
 interpolant); ``_locate`` brackets and shrinks the root by re-integrating from the step's
 start; ``simulate_point`` owns the phases and the actions.
 
-Compile-time specialisation: the functions take the flags FLEX, DAMPED, ENERGY and HISTORY
-and call ``numba.literally`` on them, so numba compiles one specialisation per flag value
-(a ``Literal[bool]`` type) and the branches a variant does not need are removed at compile
-time. One small jitted entry point per variant (bottom of this module) fixes the flags;
-every variant is assembled from the same functions.
+Compile-time specialisation: the functions take the flags FLEX, DAMPED and ENERGY and call
+``numba.literally`` on them, so numba compiles one specialisation per flag value (a
+``Literal[bool]`` type) and the branches a variant does not need are removed at compile
+time (by LLVM: numba still types and lowers them, its own dead-branch pruning does not
+read literal arguments, so they cost compile time but no run time). The time history is
+the exception: ``simulate_point`` gets ``hist=None`` when there is none, and numba prunes
+the ``if hist is not None`` branches before typing. One small jitted entry point per
+variant (bottom of this module) fixes the flags; every variant is assembled from the same
+functions.
+
+Speed: the right-hand sides (``derivatives`` and the equations) and the event functions
+are inlined where they are called (numba ``inline="always"``), so an RK4 step makes no
+function call: a call costs about as much as a right-hand side, most of it the reference
+count of ``prm`` taken and dropped on every call (scripts/bench_kernel.py, roofline).
 
 Event functions g (the event fires when g crosses from > 0 to <= 0):
   impact     g = s theta              (rocking on corner s)
@@ -23,6 +32,19 @@ import math
 
 import numpy as np
 from numba import literally, njit
+
+from rocksweep.kernel.equations import (
+    contact_rhs,
+    ground_acc,
+    ground_jerk,
+    impact_loss,
+    mechanical_energy,
+    restitution,
+    rigid_rhs,
+    rocking_rhs,
+    uplift_moment,
+    uplift_moment_rate,
+)
 from rocksweep.kernel.layout import (
     HIST_D_DAMP,
     HIST_E,
@@ -90,18 +112,8 @@ from rocksweep.kernel.layout import (
     STATUS_STEP_CAP,
 )
 
-from rocksweep.kernel.equations import (
-    contact_rhs,
-    ground_acc,
-    ground_jerk,
-    impact_loss,
-    mechanical_energy,
-    restitution,
-    rigid_rhs,
-    rocking_rhs,
-    uplift_moment,
-    uplift_moment_rate,
-)
+# Functions only ever called from jitted code: no Python or C entry point to build.
+_INTERNAL = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True}
 
 EV_NONE = 0
 EV_IMPACT = 1
@@ -115,7 +127,7 @@ EV_UPLIFT_NEG = 4
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def derivatives(t, y, s, on, prm, FLEX, DAMPED, ENERGY):
     """dy/dt for phase s (0 full contact, +-1 rocking corner); y is a 6-tuple."""
     theta, theta_dot, u, u_dot = y[0], y[1], y[2], y[3]
@@ -138,7 +150,7 @@ def derivatives(t, y, s, on, prm, FLEX, DAMPED, ENERGY):
     return (theta_dot, theta_dd, u_dot, u_dd, 0.0, 0.0)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _axpy(y, a, k):
     return (y[0] + a * k[0], y[1] + a * k[1], y[2] + a * k[2],
             y[3] + a * k[3], y[4] + a * k[4], y[5] + a * k[5])
@@ -150,17 +162,26 @@ def rk4_step(t, y, h, s, on, prm, FLEX, DAMPED, ENERGY):
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
-    k1 = derivatives(t, y, s, on, prm, FLEX, DAMPED, ENERGY)
-    k2 = derivatives(t + 0.5 * h, _axpy(y, 0.5 * h, k1), s, on, prm, FLEX, DAMPED, ENERGY)
-    k3 = derivatives(t + 0.5 * h, _axpy(y, 0.5 * h, k2), s, on, prm, FLEX, DAMPED, ENERGY)
-    k4 = derivatives(t + h, _axpy(y, h, k3), s, on, prm, FLEX, DAMPED, ENERGY)
-    w = h / 6.0
-    return (y[0] + w * (k1[0] + 2.0 * (k2[0] + k3[0]) + k4[0]),
-            y[1] + w * (k1[1] + 2.0 * (k2[1] + k3[1]) + k4[1]),
-            y[2] + w * (k1[2] + 2.0 * (k2[2] + k3[2]) + k4[2]),
-            y[3] + w * (k1[3] + 2.0 * (k2[3] + k3[3]) + k4[3]),
-            y[4] + w * (k1[4] + 2.0 * (k2[4] + k3[4]) + k4[4]),
-            y[5] + w * (k1[5] + 2.0 * (k2[5] + k3[5]) + k4[5]))
+    # The four stages share one call site of the inlined right-hand side (numba types and
+    # lowers it once, LLVM unrolls the loop): 1/4 of the compile time of four call sites.
+    zero = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    k = k1 = k23 = zero
+    for stage in range(4):
+        c = 0.0 if stage == 0 else (h if stage == 3 else 0.5 * h)
+        k = derivatives(t + c, _axpy(y, c, k), s, on, prm, FLEX, DAMPED, ENERGY)
+        if stage == 0:
+            k1 = k
+        elif stage == 1:
+            k23 = k
+        elif stage == 2:
+            k23 = _axpy(k23, 1.0, k)  # k2 + k3
+    w = h / 6.0  # k is k4 now
+    return (y[0] + w * (k1[0] + 2.0 * k23[0] + k[0]),
+            y[1] + w * (k1[1] + 2.0 * k23[1] + k[1]),
+            y[2] + w * (k1[2] + 2.0 * k23[2] + k[2]),
+            y[3] + w * (k1[3] + 2.0 * k23[3] + k[3]),
+            y[4] + w * (k1[4] + 2.0 * k23[4] + k[4]),
+            y[5] + w * (k1[5] + 2.0 * k23[5] + k[5]))
 
 
 # ----------------------------------------------------------------------------------------
@@ -168,7 +189,7 @@ def rk4_step(t, y, h, s, on, prm, FLEX, DAMPED, ENERGY):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def event_value(ev, t, y, s, on, prm, FLEX, DAMPED):
     """Value of event function ``ev`` at (t, y) in phase s."""
     if ev == EV_IMPACT:
@@ -180,7 +201,7 @@ def event_value(ev, t, y, s, on, prm, FLEX, DAMPED):
     return mgb - q if ev == EV_UPLIFT_POS else mgb + q
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def event_rate(ev, t, y, s, on, prm, FLEX, DAMPED):
     """d/dt of event function ``ev`` at (t, y) (for the Hermite check)."""
     if ev == EV_IMPACT:
@@ -192,7 +213,7 @@ def event_rate(ev, t, y, s, on, prm, FLEX, DAMPED):
     return -dq if ev == EV_UPLIFT_POS else dq
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def hermite_min(g0, d0, g1, d1, h):
     """Minimum of the cubic Hermite interpolant of g on [0, h] when g dips inside the step.
 
@@ -220,7 +241,7 @@ def hermite_min(g0, d0, g1, d1, h):
     return x * h, g0 + x * (h * d0 + x * (c2 + x * c3))
 
 
-@njit(cache=True)
+@njit(cache=True, **_INTERNAL)
 def _locate(ev, t0, y0, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, ENERGY):
     """Shrink a bracket [lo, hi] (g(lo) > 0 >= g(hi)) of event ``ev`` to PAR_TOL.
 
@@ -261,7 +282,7 @@ def _locate(ev, t0, y0, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, ENER
     return hi, y_hi, n
 
 
-@njit(cache=True)
+@njit(cache=True, **_INTERNAL)
 def _crossing(ev, t0, y0, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
     """Did event ``ev`` fire in the step (t0, y0) -> (t0 + h, y1)?
 
@@ -325,7 +346,7 @@ def _crossing(ev, t0, y0, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
             tau = 0.5 * (lo + hi)
 
 
-@njit(cache=True)
+@njit(cache=True, **_INTERNAL)
 def uplift_side(t, y, on, prm, FLEX, DAMPED):
     """Corner (+1 / -1) the body uplifts on from full contact at (t, y), or 0."""
     q = uplift_moment(y[2], y[3], ground_acc(t, on, prm), prm, FLEX, DAMPED)
@@ -337,7 +358,7 @@ def uplift_side(t, y, on, prm, FLEX, DAMPED):
     return 0
 
 
-@njit(cache=True)
+@njit(cache=True, **_INTERNAL)
 def rest_proven(y, prm, FLEX):
     """After the pulse, in full contact: can the oscillator ever uplift the body again?
 
@@ -356,7 +377,7 @@ def rest_proven(y, prm, FLEX):
     return q_max2 < mgb * mgb
 
 
-@njit(cache=True)
+@njit(cache=True, **_INTERNAL)
 def rigid_bounded(y, s, prm):
     """After the pulse, a rigid body rocking on corner s: is its outcome decided (safe)?
 
@@ -387,7 +408,7 @@ def rigid_bounded(y, s, prm):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, **_INTERNAL)
 def _record(hist, row, t, y, s, on, prm, e_imp, FLEX):
     literally(FLEX)
     if row >= hist.shape[0]:
@@ -406,7 +427,7 @@ def _record(hist, row, t, y, s, on, prm, e_imp, FLEX):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, **_INTERNAL)
 def _first_event(t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
     """The first event in the step (t, y) -> (t + h, y1) of phase s.
 
@@ -415,24 +436,25 @@ def _first_event(t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
+    # The two event codes of a phase go through variables (type int64, not a literal), so
+    # that numba compiles _crossing, _locate, event_value and event_rate once, not once per
+    # code (a literal argument is a specialisation of its own: 4x the compile time).
     if s != 0:
-        tau, y_ev, n = _crossing(EV_IMPACT, t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
-        if tau >= 0.0:
-            return EV_IMPACT, tau, y_ev, n
-        tau, y_ev, n2 = _crossing(EV_OVERTURN, t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
-        if tau >= 0.0:
-            return EV_OVERTURN, tau, y_ev, n + n2
-        return EV_NONE, h, y1, n + n2
-    tau, y_ev, n = _crossing(EV_UPLIFT_POS, t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
-    tau2, y_ev2, n2 = _crossing(EV_UPLIFT_NEG, t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
+        ev_a, ev_b = EV_IMPACT, EV_OVERTURN
+    else:
+        ev_a, ev_b = EV_UPLIFT_POS, EV_UPLIFT_NEG
+    tau, y_ev, n = _crossing(ev_a, t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
+    if s != 0 and tau >= 0.0:
+        return ev_a, tau, y_ev, n  # the impact ends the phase before any overturning
+    tau2, y_ev2, n2 = _crossing(ev_b, t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
     if tau2 >= 0.0 and (tau < 0.0 or tau2 < tau):
-        return EV_UPLIFT_NEG, tau2, y_ev2, n + n2
+        return ev_b, tau2, y_ev2, n + n2
     if tau >= 0.0:
-        return EV_UPLIFT_POS, tau, y_ev, n + n2
+        return ev_a, tau, y_ev, n + n2
     return EV_NONE, h, y1, n + n2
 
 
-@njit(cache=True)
+@njit(cache=True, **_INTERNAL)
 def _impact(y, s, prm, FLEX, ENERGY):
     """Impact map at theta = 0 ending rocking on corner s (eq. 1 and the settling rule).
 
@@ -468,17 +490,17 @@ def _impact(y, s, prm, FLEX, ENERGY):
 
 
 
-@njit(cache=True)
-def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, HISTORY):
+@njit(cache=True, **_INTERNAL)
+def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY):
     """Run one point from rest to a decided outcome, a cap or the horizon.
 
     prm: float64[N_PAR] parameter row; out: float64[N_OUT] result row (filled);
-    hist: float64[n, N_HIST] history buffer (used when HISTORY; may be empty otherwise).
+    hist: float64[n, N_HIST] history buffer, or None: no history (the recording code is
+    then not compiled at all).
     """
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
-    literally(HISTORY)
     dt, t_end, t_pulse = prm[PAR_DT], prm[PAR_TEND], prm[PAR_TPULSE]
     max_steps, max_events = prm[PAR_MAXSTEPS], prm[PAR_MAXEVENTS]
 
@@ -512,7 +534,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, HISTORY):
         s = uplift_side(t, y, on, prm, FLEX, DAMPED)
         if s != 0:
             uplifts += 1
-    if HISTORY:
+    if hist is not None:
         if _record(hist, row, t, y, s, on, prm, e_imp, FLEX):
             row += 1
 
@@ -573,7 +595,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, HISTORY):
         if ev == EV_NONE:
             t = t_pulse if lands else t + h
             y = y1
-            if HISTORY:
+            if hist is not None:
                 if _record(hist, row, t, y, s, t < t_pulse, prm, e_imp, FLEX):
                     row += 1
                 else:
@@ -586,7 +608,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, HISTORY):
                 s = uplift_side(t, y, False, prm, FLEX, DAMPED)
                 if s != 0:
                     uplifts += 1
-                    if HISTORY:
+                    if hist is not None:
                         if _record(hist, row, t, y, s, False, prm, e_imp, FLEX):
                             row += 1
                         else:
@@ -595,7 +617,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, HISTORY):
 
         t = t + tau
         y = y_ev
-        if HISTORY:
+        if hist is not None:
             if _record(hist, row, t, y, s, on, prm, e_imp, FLEX):
                 row += 1
             else:
@@ -638,7 +660,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, HISTORY):
             s = 1 if ev == EV_UPLIFT_POS else -1
             y = (0.0, 0.0, y[2], y[3], y[4], y[5])
             uplifts += 1
-        if HISTORY:
+        if hist is not None:
             if _record(hist, row, t, y, s, on, prm, e_imp, FLEX):
                 row += 1
             else:
@@ -673,14 +695,13 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, HISTORY):
         out[OUT_E_END] = np.nan
 
 
-@njit(cache=True)
+@njit(cache=True, **_INTERNAL)
 def _chunk(prms, outs, FLEX, DAMPED, ENERGY):
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
-    empty = np.empty((0, 1))
     for i in range(prms.shape[0]):
-        simulate_point(prms[i], outs[i], empty, FLEX, DAMPED, ENERGY, False)
+        simulate_point(prms[i], outs[i], None, FLEX, DAMPED, ENERGY)
 
 
 # ----------------------------------------------------------------------------------------
@@ -722,15 +743,15 @@ def chunk_rigid_energy(prms, outs):
 
 @njit(cache=True)
 def point_flexible_history(prm, out, hist):
-    simulate_point(prm, out, hist, True, True, True, True)
+    simulate_point(prm, out, hist, True, True, True)
 
 
 @njit(cache=True)
 def point_flexible_undamped_history(prm, out, hist):
-    simulate_point(prm, out, hist, True, False, True, True)
+    simulate_point(prm, out, hist, True, False, True)
 
 
 @njit(cache=True)
 def point_rigid_history(prm, out, hist):
-    simulate_point(prm, out, hist, False, False, True, True)
+    simulate_point(prm, out, hist, False, False, True)
 
