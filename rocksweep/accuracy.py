@@ -43,7 +43,7 @@ import numpy as np
 
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.numerics import PRESETS, Numerics
+from rocksweep.numerics import PRESETS, ROOTS, Numerics
 from rocksweep.scene import Scene
 
 OUTCOMES = ("safe", "mode1", "mode2")  # codes 0, 1, 2
@@ -58,17 +58,19 @@ MEASURE_LABELS = {
 
 @dataclass(frozen=True)
 class Setting:
-    """One rung of a ladder: kernel steps per period and event tolerance [p*t].
+    """One rung of a ladder: kernel steps per period, event tolerance [p*t], root finder.
 
     group: the curve the rung belongs to. "steps ..." groups share one event tolerance
     with the steps per period doubling (observed order), "tol ..." groups share one step
-    with the tolerance shrinking, "preset" holds the named presets.
+    with the tolerance shrinking, "preset" holds the named presets, "root ..." the presets
+    with one event root finder. root: None runs the scene's own (``numerics.root``).
     """
 
     name: str
     steps_per_period: int
     event_tol: float
     group: str
+    root: str | None = None
 
 
 def _steps(steps: tuple[int, ...], tol: float, tag: bool = False) -> list[Setting]:
@@ -84,6 +86,11 @@ def _presets() -> list[Setting]:
     return [Setting(name, spp, tol, "preset") for name, (spp, tol) in PRESETS.items()]
 
 
+def _roots() -> list[Setting]:
+    return [Setting(f"{name}-{root}", spp, tol, f"root {root}", root)
+            for root in ROOTS for name, (spp, tol) in PRESETS.items()]
+
+
 LADDERS: dict[str, Callable[[], list[Setting]]] = {
     # the step ladder at a tolerance far below the step's error (its order), the event
     # tolerance at a fine step, and the presets
@@ -94,6 +101,9 @@ LADDERS: dict[str, Callable[[], list[Setting]]] = {
     "candidates": lambda: (_steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-6, tag=True)
                            + _steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-8, tag=True)
                            + _presets()),
+    # every preset with every event root finder: what each costs, and whether the outcomes
+    # stay the same
+    "roots": _roots,
 }
 
 
@@ -447,6 +457,7 @@ class Study:
         d = {
             "setting": r.setting.name, "group": r.setting.group,
             "steps_per_period": r.setting.steps_per_period, "event_tol": r.setting.event_tol,
+            "root": r.setting.root or self.scene.numerics.root,
             "median_us": r.median_us, "mean_us": r.mean_us(w),
             "total_s": r.batch_seconds,
             "evals_per_point": float(np.sum(r.evals * w) / np.sum(w)),
@@ -488,7 +499,8 @@ def accuracy_study(scene: Scene, n_points: int | None = 200,
     for j, s in enumerate(settings):
         numerics = dataclasses.replace(scene.numerics, accuracy=s.name,
                                        steps_per_period=s.steps_per_period,
-                                       event_tol=s.event_tol)
+                                       event_tol=s.event_tol,
+                                       root=s.root or scene.numerics.root)
         outs, secs, batch = run_kernel(scene, sample.flat, numerics, repeat)
         agree = outs[:, L.OUT_OUTCOME] == ref[:, L.OUT_OUTCOME]
         share, se = _agreement(agree, sample)
@@ -534,7 +546,8 @@ def format_table(study: Study) -> str:
                  "estimate; total = one call on the sample")
     lines.append("  errors against the reference: median |d| (max in brackets); "
                  "d impacts: mean |d| where outcomes agree")
-    head = (f"{'setting':>11} {'spp':>4} {'tol':>6} {'med us':>8} {'mean us':>8} "
+    w = max(11, *(len(r.setting.name) for r in study.results))
+    head = (f"{'setting':>{w}} {'spp':>4} {'tol':>6} {'med us':>8} {'mean us':>8} "
             f"{'total s':>7} {'evals':>7} {'agree %':>13} {'flips':>5} "
             f"{'theta_max':>17} {'t_1st_impact':>17} {'t_overturn':>17} {'d impacts':>9}")
     lines.append(head)
@@ -545,7 +558,7 @@ def format_table(study: Study) -> str:
                  for m in ("theta_max", "t_first_impact", "t_overturn")]
         imp = "-" if not math.isfinite(d["err_impacts"]) else f"{d['err_impacts']:.2f}"
         lines.append(
-            f"{d['setting']:>11} {d['steps_per_period']:>4} {d['event_tol']:>6.0e} "
+            f"{d['setting']:>{w}} {d['steps_per_period']:>4} {d['event_tol']:>6.0e} "
             f"{d['median_us']:>8.1f} {d['mean_us']:>8.1f} {d['total_s']:>7.3g} "
             f"{d['evals_per_point']:>7.0f} {agree:>13} {d['flips']:>5} "
             f"{cells[0]:>17} {cells[1]:>17} {cells[2]:>17} {imp:>9}")

@@ -12,11 +12,11 @@ import numpy as np
 
 from rocksweep.kernel import layout as L
 from rocksweep.model import Body, FlexibleBody, G
-from rocksweep.numerics import Numerics, amplitude_frequency, step_size
+from rocksweep.numerics import ROOTS, Numerics, amplitude_frequency, step_size
 
 SHAPES = ("sine", "cosine")
 _SHAPE_CODE = {"sine": L.SHAPE_SINE, "cosine": L.SHAPE_COSINE}
-_ROOT_CODE = {"bisection": L.ROOT_BISECT, "illinois": L.ROOT_ILLINOIS}
+_ROOT_CODE = dict(zip(ROOTS, (L.ROOT_BISECT, L.ROOT_ILLINOIS, L.ROOT_HERMITE), strict=True))
 
 
 @dataclass(frozen=True)

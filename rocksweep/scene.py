@@ -19,7 +19,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError
 
 from rocksweep.model import BlockBody, Body, BodyError, FlexibleBody
-from rocksweep.numerics import PRESETS, Numerics
+from rocksweep.numerics import PRESETS, ROOTS, Numerics
 from rocksweep.points import Point
 
 
@@ -82,7 +82,7 @@ class NumericsSpec(BaseModel):
     horizon: float | int | None = None
     rest_rate: float | None = None
     max_events: int | None = None
-    root: Literal["bisection", "illinois"] | None = None
+    root: Literal[ROOTS] | None = None  # type: ignore[valid-type]
 
 
 class OutputsSpec(BaseModel):

@@ -124,3 +124,26 @@ def test_accuracy_rejects_bad_input_in_one_line_without_output(cli, tiny_scene, 
     assert not missing.exists()
     res = cli.invoke(main, ["accuracy", str(tmp_path / "none.yaml")])
     assert res.exit_code != 0 and "no such scene file" in res.output
+
+
+def test_roots_ladder_prices_every_root_finder_on_the_same_points(cli, tiny_scene, tmp_path):
+    """Every preset with every event root finder: same outcomes, and the Hermite-seeded
+    finder needs fewer RK4 re-integrations than bisection (2-4 trials per event, not
+    log2(step/event_tol) ~ 20)."""
+    report = tmp_path / "roots.h5"
+    res = cli.invoke(main, ["accuracy", str(tiny_scene), "-o", str(report), "--points", "6",
+                            "--ladder", "roots", "--repeat", "1", "-q"])
+    assert res.exit_code == 0, res.output
+    with h5py.File(report) as f:
+        names = [n.decode() for n in f["table/setting"][:]]
+        roots = [r.decode() for r in f["table/root"][:]]
+        evals = f["table/evals_per_point"][:]
+        assert sorted(set(roots)) == ["bisection", "hermite", "illinois"]
+        by = {(n.split("-")[0], r): i for i, (n, r) in enumerate(zip(names, roots, strict=True))}
+        for preset in ("draft", "default", "fine"):
+            b, h = by[preset, "bisection"], by[preset, "hermite"]
+            assert evals[h] < 0.7 * evals[b], (preset, evals[h], evals[b])
+            for r in ("illinois", "hermite"):
+                np.testing.assert_array_equal(
+                    f[f"kernel/{names[by[preset, r]]}/outcome"][:],
+                    f[f"kernel/{names[b]}/outcome"][:])

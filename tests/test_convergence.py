@@ -44,7 +44,7 @@ def _event_times(run) -> list[float]:
     return [float(t[i]) for i in range(len(t) - 1) if t[i] == t[i + 1] and ph[i] != ph[i + 1]]
 
 
-@pytest.mark.parametrize("root", ["bisection", "illinois"])
+@pytest.mark.parametrize("root", ["bisection", "illinois", "hermite"])
 def test_event_times_converge_to_the_reference_as_the_tolerance_shrinks(root):
     """At a fine step (error ~1e-9) the event times are off by at most about event_tol.
 

@@ -31,11 +31,13 @@ def _check_output(path: Path | None, option: str) -> None:
 @click.option("--points", "n_points", type=click.IntRange(min=1), default=200,
               show_default=True,
               help="Stratified sample size (every point if the scene has no more).")
-@click.option("--ladder", "ladder_name", type=click.Choice(["full", "short", "candidates"]),
+@click.option("--ladder", "ladder_name",
+              type=click.Choice(["full", "short", "candidates", "roots"]),  # accuracy.LADDERS
               default="full", show_default=True,
               help="Kernel settings to measure: full (steps per period 5..160, event_tol "
                    "1e-4..1e-8, presets), short (a quick check), candidates (the cheap "
-                   "settings the default preset is chosen from).")
+                   "settings the default preset is chosen from), roots (every preset with "
+                   "every event root finder).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Sampling seed.")
 @click.option("--repeat", type=click.IntRange(min=1), default=5, show_default=True,
               help="Kernel timings are the best of this many rounds.")

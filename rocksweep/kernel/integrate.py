@@ -98,6 +98,7 @@ from rocksweep.kernel.layout import (
     PAR_THETA_OVER,
     PAR_TOL,
     PAR_TPULSE,
+    ROOT_HERMITE,
     ROOT_ILLINOIS,
     STATUS_BOUNDED,
     STATUS_E_ABOVE_1,
@@ -241,25 +242,78 @@ def hermite_min(g0, d0, g1, d1, h):
     return x * h, g0 + x * (h * d0 + x * (c2 + x * c3))
 
 
+@njit(cache=True, inline="always")
+def hermite_root(g0, d0, g1, d1, h, xtol):
+    """Root in [0, h] of the cubic Hermite interpolant of g when g0 >= 0 >= g1.
+
+    Safeguarded Newton on c(x) = g0 + d0 h x + c2 x^2 + c3 x^3, x in [0, 1], keeping a
+    bracket (c > 0 on its left end; g0 = 0 with the curve rising counts as > 0, so the root
+    found is the crossing after it, not x = 0); a Newton step that leaves the bracket is
+    replaced by a bisection. Stops when a step is below xtol (in units of h). Returns tau.
+    """
+    c2 = 3.0 * (g1 - g0) - h * (2.0 * d0 + d1)
+    c3 = 2.0 * (g0 - g1) + h * (d0 + d1)
+    a, b = 0.0, 1.0
+    x = g0 / (g0 - g1) if g0 > 0.0 else 0.5
+    for _ in range(16):
+        c = g0 + x * (h * d0 + x * (c2 + x * c3))
+        if c > 0.0:
+            a = x
+        else:
+            b = x
+        dc = h * d0 + x * (2.0 * c2 + 3.0 * x * c3)
+        x_new = x - c / dc if dc != 0.0 else 0.5 * (a + b)
+        if not (a < x_new < b):
+            x_new = 0.5 * (a + b)
+        done = abs(x_new - x) < xtol
+        x = x_new
+        if done:
+            break
+    return x * h
+
+
 @njit(cache=True, **_INTERNAL)
 def _locate(ev, t0, y0, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, ENERGY):
-    """Shrink a bracket [lo, hi] (g(lo) > 0 >= g(hi)) of event ``ev`` to PAR_TOL.
+    """Shrink a bracket [lo, hi] (g(lo) >= 0 >= g(hi); lo = 0, y(lo) = y0) of event ``ev``
+    to PAR_TOL.
 
     Every trial point is a fresh RK4 step of that length from (t0, y0), so the located
-    state is the integrator's own solution, not an interpolant. Root finder: bisection
-    (default, the design's guaranteed method), or Illinois regula falsi, which keeps the
-    bracket and converges superlinearly. Returns (tau, y(tau), re-integrations), with tau on
-    the far side of the root (the event has happened at tau).
+    state is the integrator's own solution, not an interpolant. Root finder (PAR_ROOT):
+
+    - bisection: the design's guaranteed method, log2(h/tol) trials (18-25 at the presets);
+    - Illinois regula falsi: keeps the bracket, converges superlinearly;
+    - Hermite: each trial is the root of the cubic Hermite interpolant of g over the
+      bracket (g and its rate at both ends: the rate comes with the state, theta' or
+      dQ/dt), put at least tol/2 inside the bracket, so that a trial next to the root
+      closes it; two trials running that fail to halve the bracket are followed by a
+      bisection step, which bounds the worst case. 2-4 trials per event.
+
+    Returns (tau, y(tau), re-integrations), with tau on the far side of the root (the event
+    has happened at tau).
     """
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
     tol = prm[PAR_TOL]
     illinois = prm[PAR_ROOT] == ROOT_ILLINOIS
+    hermite = prm[PAR_ROOT] == ROOT_HERMITE
     n = 0
     side = 0
+    slow = 0  # trials running that did not halve the bracket (Hermite)
+    d_lo = d_hi = 0.0
+    if hermite:
+        d_lo = event_rate(ev, t0 + lo, y0, s, on, prm, FLEX, DAMPED)
+        d_hi = event_rate(ev, t0 + hi, y_hi, s, on, prm, FLEX, DAMPED)
     while hi - lo > tol:
-        if illinois:
+        width = hi - lo
+        if hermite:
+            mid = 0.5 * (lo + hi)
+            if slow < 2:
+                mid = lo + hermite_root(g_lo, d_lo, g_hi, d_hi, width, 0.05 * tol / width)
+                if not (mid == mid):
+                    mid = 0.5 * (lo + hi)
+                mid = min(max(mid, lo + 0.5 * tol), hi - 0.5 * tol)
+        elif illinois:
             mid = hi - g_hi * (hi - lo) / (g_hi - g_lo)
             # stay strictly inside and shrink by at least tol/2 from either end
             if mid <= lo + 0.5 * tol or mid >= hi - 0.5 * tol or not (mid == mid):
@@ -268,36 +322,33 @@ def _locate(ev, t0, y0, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, ENER
             mid = 0.5 * (lo + hi)
         y_mid = rk4_step(t0, y0, mid, s, on, prm, FLEX, DAMPED, ENERGY)
         g_mid = event_value(ev, t0 + mid, y_mid, s, on, prm, FLEX, DAMPED)
+        d_mid = event_rate(ev, t0 + mid, y_mid, s, on, prm, FLEX, DAMPED) if hermite else 0.0
         n += 1
         if g_mid <= 0.0:
-            hi, g_hi, y_hi = mid, g_mid, y_mid
-            if side == -1:
+            hi, g_hi, d_hi, y_hi = mid, g_mid, d_mid, y_mid
+            if side == -1 and illinois:
                 g_lo *= 0.5
             side = -1
         else:
-            lo, g_lo = mid, g_mid
-            if side == 1:
+            lo, g_lo, d_lo = mid, g_mid, d_mid
+            if side == 1 and illinois:
                 g_hi *= 0.5
             side = 1
+        slow = slow + 1 if hi - lo > 0.5 * width else 0
     return hi, y_hi, n
 
 
-@njit(cache=True, **_INTERNAL)
+@njit(cache=True, inline="always")
 def _crossing(ev, t0, y0, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
     """Did event ``ev`` fire in the step (t0, y0) -> (t0 + h, y1)?
 
     Returns (tau, y_event, re-integrations); tau < 0 if it did not. A sign change at the
     ends is bracketed at once. Same sign at both ends but falling then rising (a dip
     through zero and back, e.g. a grazing impact inside a coarse step) is checked with the
-    step's cubic Hermite interpolant. The cubic is only an estimate: when its minimum is
-    nearer zero than the dip is deep, the minimum of the integrator's own solution (fresh
-    RK4 steps from t0, as in ``_locate``) is searched for (Illinois on g' = 0, bracketed by
-    d0 < 0 < d1) until g <= 0 is found, which closes the bracket, or the bracket proves
-    that the dip stays above zero (g convex there: g_min >= g - max|g'| * width).
+    step's cubic Hermite interpolant; when its minimum is nearer zero than the dip is deep,
+    ``_dip`` searches the integrator's own solution. This screening runs for every event
+    function at every step and is inlined into the loop; the searches are calls.
     """
-    literally(FLEX)
-    literally(DAMPED)
-    literally(ENERGY)
     g0 = event_value(ev, t0, y0, s, on, prm, FLEX, DAMPED)
     g1 = event_value(ev, t0 + h, y1, s, on, prm, FLEX, DAMPED)
     if g1 <= 0.0:
@@ -315,6 +366,22 @@ def _crossing(ev, t0, y0, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
     tau, g_min = hermite_min(g0, d0, g1, d1, h)
     if g_min > min(g0, g1) - g_min:
         return -1.0, y1, 0  # far from zero compared with the dip: the cubic is good enough
+    return _dip(ev, t0, y0, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERGY)
+
+
+@njit(cache=True, **_INTERNAL)
+def _dip(ev, t0, y0, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERGY):
+    """A dip of g (g0 > 0, g(h) > 0, d0 < 0 < d1) whose cubic minimum (at tau) is near zero.
+
+    The cubic is only an estimate: the minimum of the integrator's own solution (fresh RK4
+    steps from t0, as in ``_locate``) is searched for (Illinois on g' = 0, bracketed by
+    d0 < 0 < d1) until g <= 0 is found, which closes the bracket, or the bracket proves
+    that the dip stays above zero (g convex there: g_min >= g - max|g'| * width).
+    Returns as ``_crossing``.
+    """
+    literally(FLEX)
+    literally(DAMPED)
+    literally(ENERGY)
     if not (0.0 < tau < h):
         tau = 0.5 * h
     lo, r_lo, f_lo, hi, r_hi, f_hi = 0.0, d0, d0, h, d1, d1

@@ -33,7 +33,7 @@ PAR_MAXSTEPS = 21  # cap on RK4 evaluations (regular + event) per run
 PAR_MAXEVENTS = 22  # cap on impacts + uplifts per run
 PAR_RESTRATE = 23  # post-impact |theta'| below which the body settles [rad/s]
 PAR_THETA_OVER = 24  # |theta| at which the body lies on its side: pi/2 [rad]
-PAR_ROOT = 25  # event root finder: ROOT_BISECT or ROOT_ILLINOIS
+PAR_ROOT = 25  # event root finder: ROOT_BISECT, ROOT_ILLINOIS or ROOT_HERMITE
 PAR_THETA0 = 26  # initial theta [rad] (0: start at rest; != 0 starts rocking on its corner)
 PAR_THETA_DOT0 = 27  # initial theta' [rad/s] (from theta = 0: rocking on its sign's corner)
 N_PAR = 28
@@ -42,6 +42,7 @@ SHAPE_SINE = 0.0
 SHAPE_COSINE = 1.0
 ROOT_BISECT = 0.0
 ROOT_ILLINOIS = 1.0
+ROOT_HERMITE = 2.0
 
 # --- result row ------------------------------------------------------------------------
 OUT_OUTCOME = 0  # OUTCOME_* code
