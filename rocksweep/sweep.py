@@ -1,9 +1,14 @@
-"""Run a scene's grid in chunks across joblib workers (loky, or dask.distributed).
+"""Run a scene's grid in chunks across joblib workers (threads, or dask.distributed).
 
 No I/O here: ``run_chunks`` yields each chunk's result arrays as it finishes and the
 parent process (``rocksweep sweep``) writes them (``rocksweep.store``). A chunk is a
 contiguous range of flat point indices (``rocksweep.grid``) and costs one call into the
 jitted kernel per kernel kind present in the chunk; there is no Python per point.
+
+Local workers are threads of this process (joblib's threading backend): the chunk kernels
+release the GIL, so threads compute in parallel with no process start-up, no second load
+of the compiled kernel and no copies of the grid; only the few Python lines per chunk
+(building its rows, converting its results) take turns.
 
 Every point is independent of the others, so the results are identical, bit for bit,
 whatever the number of workers and the chunking. Chunks are small (by default about 32
@@ -140,11 +145,11 @@ def prepare(grid: Grid, level: int) -> None:
 
 
 def run_chunks(grid: Grid, chunks: Iterable[tuple[int, int]], level: int, jobs: int = 1,
-               backend: str = "loky", scheduler: str | None = None
+               backend: str = "threads", scheduler: str | None = None
                ) -> Iterator[ChunkResult]:
     """Yield the result of every chunk, in the order they finish.
 
-    backend "loky": ``jobs`` local worker processes (1: in this process). backend "dask":
+    backend "threads": ``jobs`` worker threads of this process (1: this thread). "dask":
     the chunks run on the dask.distributed cluster at ``scheduler`` through joblib's dask
     backend.
     """
@@ -152,15 +157,15 @@ def run_chunks(grid: Grid, chunks: Iterable[tuple[int, int]], level: int, jobs: 
     if not chunks:
         return
     prepare(grid, level)
-    if backend == "loky" and effective_jobs(jobs) == 1:
+    if backend == "threads" and effective_jobs(jobs) == 1:
         for a, b in chunks:
             yield run_chunk(grid, a, b, level)
         return
     from joblib import Parallel, delayed, parallel_config
 
     tasks = (delayed(run_chunk)(grid, a, b, level) for a, b in chunks)
-    if backend == "loky":
-        with parallel_config(backend="loky", n_jobs=effective_jobs(jobs)):
+    if backend == "threads":
+        with parallel_config(backend="threading", n_jobs=effective_jobs(jobs)):
             yield from Parallel(return_as="generator_unordered", batch_size=1)(tasks)
     elif backend == "dask":
         if not scheduler:
@@ -172,11 +177,11 @@ def run_chunks(grid: Grid, chunks: Iterable[tuple[int, int]], level: int, jobs: 
             yield from Parallel(n_jobs=n, return_as="generator_unordered", batch_size=1,
                                 pre_dispatch=f"{2 * n}")(tasks)
     else:
-        raise ValueError(f"backend = {backend!r}: must be loky or dask")
+        raise ValueError(f"backend = {backend!r}: must be threads or dask")
 
 
 def compute(scene: Scene, jobs: int = 1, chunk_size: int | None = None,
-            backend: str = "loky", scheduler: str | None = None,
+            backend: str = "threads", scheduler: str | None = None,
             on_chunk: Callable[[ChunkResult], None] | None = None) -> dict[str, np.ndarray]:
     """Sweep a whole scene in memory: name -> array with the grid's shape (``Grid.shape``).
 
@@ -186,7 +191,7 @@ def compute(scene: Scene, jobs: int = 1, chunk_size: int | None = None,
     lvl = level(scene)
     specs = variables(scene)
     flat = {k: np.full(grid.size, fill, dtype) for k, (dtype, fill, _) in specs.items()}
-    n_workers = effective_jobs(jobs) if backend == "loky" else 1
+    n_workers = effective_jobs(jobs) if backend == "threads" else 1
     size = chunk_size or auto_chunk_size(grid.size, n_workers)
     for res in run_chunks(grid, plan_chunks(np.ones(grid.size, bool), size), lvl, jobs,
                           backend, scheduler):

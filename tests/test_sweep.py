@@ -95,6 +95,16 @@ def test_bit_for_bit_whatever_jobs_and_chunks(reference):
     assert_same(ref, sw.compute(sc, jobs=2, chunk_size=64))
 
 
+def test_chunk_kernels_release_the_gil():
+    """Local workers are threads: a chunk kernel that held the GIL would run them one at a
+    time (the sweep would still be right, only as slow as one worker)."""
+    from rocksweep.kernel import chunk_kernel
+
+    for kind in (L.KIND_FLEXIBLE, L.KIND_FLEXIBLE_UNDAMPED, L.KIND_RIGID):
+        for lvl in (L.LEVEL_OUTCOME, L.LEVEL_ENERGY):
+            assert chunk_kernel(kind, lvl).targetoptions.get("nogil") is True, (kind, lvl)
+
+
 def test_dask_backend_on_a_local_cluster(reference):
     distributed = pytest.importorskip("distributed")  # in the test extra: never skipped in CI
     sc, ref = reference

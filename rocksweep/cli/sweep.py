@@ -23,8 +23,10 @@ from rocksweep.cli.main import load, main, scene_argument, set_option, user_erro
                    "missing points).")
 @click.option("--overwrite", is_flag=True, help="Replace an existing result file.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar and no summary.")
-@click.option("--backend", type=click.Choice(["loky", "dask"]), default="loky",
-              show_default=True, help="Local processes (loky) or a dask.distributed cluster.")
+@click.option("--backend", type=click.Choice(["threads", "dask"]), default="threads",
+              show_default=True,
+              help="Local worker threads (the kernel runs outside the GIL) or a "
+                   "dask.distributed cluster.")
 @click.option("--scheduler", metavar="ADDRESS",
               help="dask scheduler address (with --backend dask), e.g. tcp://host:8786.")
 @click.option("--chunk-size", type=click.IntRange(1, None), default=None,
@@ -80,11 +82,11 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
         done = sf.done()
         n_done_before = int(done.sum())
         todo = int((~done).sum())
-        n_workers = sw.effective_jobs(jobs) if backend == "loky" else 1
+        n_workers = sw.effective_jobs(jobs) if backend == "threads" else 1
         size = chunk_size or sw.auto_chunk_size(todo, n_workers)
         chunks = sw.plan_chunks(~done, size)
         if not quiet:
-            where = (f"{n_workers} worker{'s' * (n_workers > 1)}" if backend == "loky"
+            where = (f"{n_workers} worker{'s' * (n_workers > 1)}" if backend == "threads"
                      else f"dask cluster {scheduler}")
             dims = " x ".join(f"{len(a.values)} {a.name}" for a in scene.swept) or "1 point"
             click.echo(f"{scene.name}: {sf.grid.size} points ({dims}); "

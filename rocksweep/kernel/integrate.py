@@ -773,37 +773,38 @@ def _chunk(prms, outs, FLEX, DAMPED, ENERGY):
 
 # ----------------------------------------------------------------------------------------
 # Variants. One entry point per effect set; the flags are literals here.
-#   chunk_*: prms float64[n, N_PAR] -> outs float64[n, N_OUT] (filled in place)
+#   chunk_*: prms float64[n, N_PAR] -> outs float64[n, N_OUT] (filled in place); they
+#       release the GIL, so threads of one process run chunks in parallel
 #   point_*: one point with energy accounting and a history buffer float64[n, N_HIST]
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def chunk_flexible(prms, outs):
     _chunk(prms, outs, True, True, False)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def chunk_flexible_undamped(prms, outs):
     _chunk(prms, outs, True, False, False)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def chunk_rigid(prms, outs):
     _chunk(prms, outs, False, False, False)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def chunk_flexible_energy(prms, outs):
     _chunk(prms, outs, True, True, True)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def chunk_flexible_undamped_energy(prms, outs):
     _chunk(prms, outs, True, False, True)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def chunk_rigid_energy(prms, outs):
     _chunk(prms, outs, False, False, True)
 

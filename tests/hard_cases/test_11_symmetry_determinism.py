@@ -71,8 +71,8 @@ def test_same_point_gives_bit_identical_results_alone_in_a_chunk_and_elsewhere()
     perm = np.random.default_rng(5).permutation(len(rows))
     shuffled = np.empty_like(in_chunk)
     shuffled[perm] = _chunk(rows[perm])
-    # other worker processes (joblib's loky), two chunks at once
-    halves = Parallel(n_jobs=2, backend="loky")(
+    # two worker threads at once, outside the GIL (the sweep's local workers)
+    halves = Parallel(n_jobs=2, backend="threading")(
         delayed(_chunk)(part) for part in np.array_split(rows, 2))
     workers = np.concatenate(halves)
     # and a fresh interpreter, fed the rows through a file
