@@ -14,14 +14,18 @@ Prints, measured side by side in one run (issue 7's benchmark):
    uniform sample (``--mix-points``), event re-integrations split in proportion to the
    events of each phase. Then microseconds per point: kernel calls on one core, and the
    real ``rocksweep sweep`` (process start, chunking, HDF5 writing included) on 1 and 2
-   workers.
+   workers. The regular share is the regular steps' cost at the roofline over the kernel
+   time: the integration no event handling could remove.
+2b. the event root finders (bisection, Illinois, Hermite) on every point of each scene at
+   the scene's steps and event_tol: RK4 evaluations and microseconds per point, the
+   speed-up over bisection, and how many outcomes differ from bisection's.
 3. reference: scipy DOP853 (``rocksweep.reference``) on the accuracy study's stratified
    sample (``--ref-points``; strata outcome x boundary, weights make scene estimates):
    weighted mean and median time per point, the kernel's on the same points (each a 1-row
    chunk call), the speed-up, and the outcome agreement with its standard error.
 4. parallel efficiency: points/s of ``rocksweep sweep --jobs 1`` and ``--jobs 2`` on the
-   same grid, efficiency = rate(2) / (2 rate(1)); peak memory (summed RSS of the process
-   tree, sampled).
+   same grid (the shipped one, and ``--eff-n``: 200 x 200 x 3 lam by default), efficiency
+   = rate(2) / (2 rate(1)); peak memory (summed RSS of the process tree, sampled).
 5. the four paper figures (3a, 3b, 4a, 4b) at N x N x 3 lam through ``rocksweep sweep
    --jobs 2``: N = ``--four-n`` (small by default); ``--paper`` runs 200 x 200 x 3 lam
    (480,000 points) once.
@@ -41,6 +45,7 @@ times (items 1-2) are less sensitive to load than wall times (items 2-6).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import os
 import shutil
@@ -67,6 +72,7 @@ from rocksweep.kernel import chunk_kernel, point_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel.equations import contact_rhs, ground_acc, rocking_rhs
 from rocksweep.kernel.integrate import rk4_step
+from rocksweep.numerics import ROOTS
 from rocksweep.run import history_capacity
 from rocksweep.scene import Scene, load_scene
 from rocksweep.sweep import auto_chunk_size, level, plan_chunks, prepare
@@ -385,6 +391,9 @@ def main() -> None:
                     help="bare-loop steps per roofline figure (default 2e6)")
     ap.add_argument("--repeat", type=int, default=3,
                     help="best of this many (roofline, kernel sample timings)")
+    ap.add_argument("--eff-n", type=int, default=200,
+                    help="item 4 also at n x n x 3 lam (default 200: the paper's resolution, "
+                         "where start-up costs are amortised as in a real sweep)")
     ap.add_argument("--four-n", type=int, default=40,
                     help="the four figures at n x n x 3 lam for item 5 (default 40)")
     ap.add_argument("--paper", action="store_true",
@@ -398,7 +407,7 @@ def main() -> None:
     args = ap.parse_args()
     if args.tiny:
         args.n, args.ref_points, args.mix_points = 6, 4, 8
-        args.roof_steps, args.repeat, args.four_n = 20_000, 1, 4
+        args.roof_steps, args.repeat, args.four_n, args.eff_n = 20_000, 1, 4, 8
     four_n = 200 if args.paper else args.four_n
     seed = 0
 
@@ -433,12 +442,13 @@ def main() -> None:
         mixes[name] = step_mix(grid, flat)
 
     # --- CLI sweeps (items 2 and 4) ------------------------------------------------------
-    cli = {}
+    cli = {}  # (scene, grid size n or None, jobs) -> cli_sweep result
     with tempfile.TemporaryDirectory() as tmp:
         for name in scenes:
-            for jobs in (1, 2):
-                cli[name, jobs] = cli_sweep(CONFIGS / f"{name}.yaml", grid_overrides(args.n),
-                                            jobs, Path(tmp) / f"{name}-{jobs}.h5")
+            for n in dict.fromkeys((args.n, args.eff_n)):
+                for jobs in (1, 2):
+                    cli[name, n, jobs] = cli_sweep(CONFIGS / f"{name}.yaml", grid_overrides(n),
+                                                   jobs, Path(tmp) / f"{name}-{jobs}.h5")
 
     print(f"\n[2] kernel at the scene's numerics ({scenes[args.scenes[0]].numerics.describe()})"
           ", outcome-only")
@@ -457,11 +467,40 @@ def main() -> None:
         roof = float(np.sum(mix * roofs[name]["inlined"]))
         print(f"{name:<8}{n:>8}{reg / n:>9.0f}{evs / n:>8.0f}{100 * evs / (reg + evs):>8.1f}"
               f"{ns_eval:>9.1f}{roof:>9.1f}{roof / ns_eval:>10.2f}{p['wall'] / n * 1e6:>11.1f}"
-              f"{cli[name, 1]['wall'] / n * 1e6:>9.1f}{cli[name, 2]['wall'] / n * 1e6:>9.1f}")
+              f"{cli[name, args.n, 1]['wall'] / n * 1e6:>9.1f}"
+              f"{cli[name, args.n, 2]['wall'] / n * 1e6:>9.1f}")
+    print("    regular share: regular steps at the roofline's cost / kernel time (the part "
+          "no event handling could remove)")
+    for name in scenes:
+        p = passes[name]
+        o = p["outs"]
+        mix = mixes[name] / mixes[name].sum()
+        roof = float(np.sum(mix * roofs[name]["inlined"]))
+        print(f"    {name}: regular share {o[:, L.OUT_STEPS].sum() * roof * 1e-9 / p['cpu']:.2f}")
     print("    phase mix of RK4 evaluations (uniform sample): "
           + "; ".join(f"{name}: " + ", ".join(
               f"{PHASES[i]} {PULSE[j]} {100 * mixes[name][i, j] / mixes[name].sum():.0f}%"
               for i in range(2) for j in range(2)) for name in scenes))
+
+    # --- 2b: the event root finders, same points, same run ------------------------------
+    print("\n[2b] event root finders at the scene's steps and event_tol: kernel calls only "
+          "(CPU), every point of the scene; outcome differences against bisection")
+    print(f"{'scene':<8}{'root':<11}{'evals/pt':>9}{'event/pt':>9}{'us/pt':>8}"
+          f"{'vs bisection':>13}{'outcomes differ':>16}")
+    for name, scene in scenes.items():
+        by_root = {}
+        for root in ROOTS:
+            sc = dataclasses.replace(scene, numerics=dataclasses.replace(scene.numerics,
+                                                                         root=root))
+            by_root[root] = kernel_pass(sc)
+        base = by_root["bisection"]
+        for root, p in by_root.items():
+            o = p["outs"]
+            n = o.shape[0]
+            ev = o[:, L.OUT_EVENT_STEPS].sum() / n
+            diff = int(np.sum(o[:, L.OUT_OUTCOME] != base["outs"][:, L.OUT_OUTCOME]))
+            print(f"{name:<8}{root:<11}{o[:, L.OUT_STEPS].sum() / n + ev:>9.0f}{ev:>9.0f}"
+                  f"{p['cpu'] / n * 1e6:>8.1f}{base['cpu'] / p['cpu']:>12.2f}x{diff:>16}")
 
     # --- 3 -------------------------------------------------------------------------------
     print("\n[3] reference (scipy DOP853, rtol 1e-10) vs kernel on the accuracy study's "
@@ -487,19 +526,18 @@ def main() -> None:
               f"{f'{100 * share:.2f}+-{100 * se:.2f}':>14}{int((~agree).sum()):>6}")
 
     # --- 4 -------------------------------------------------------------------------------
-    print("\n[4] parallel efficiency through `rocksweep sweep` (process start, chunking, HDF5 "
-          "included); eff = rate(2) / (2 rate(1))")
+    print("\n[4] parallel efficiency through `rocksweep sweep` (start-up, kernel cache load, "
+          "chunking, HDF5 included); eff = rate(2) / (2 rate(1)); the shipped grid and "
+          f"{args.eff_n} x {args.eff_n} x 3 lam")
     print(f"{'scene':<8}{'points':>8}{'jobs':>5}{'process s':>10}{'sweep s':>9}{'pts/s':>9}"
           f"{'CPU s':>8}{'eff':>6}{'peak MB':>9}")
-    for name in scenes:
-        r1 = cli[name, 1]
-        for jobs in (1, 2):
-            r = cli[name, jobs]
-            rate = r["points"] / r["wall"]
-            eff = rate / (jobs * r1["points"] / r1["wall"])
-            print(f"{name:<8}{r['points']:>8}{jobs:>5}{r['process_wall']:>10.2f}"
-                  f"{r['wall']:>9.2f}{rate:>9.0f}{r['cpu']:>8.2f}{eff:>6.2f}"
-                  f"{r['rss'] / 2**20:>9.0f}")
+    for (name, n, jobs), r in cli.items():
+        r1 = cli[name, n, 1]
+        rate = r["points"] / r["wall"]
+        eff = rate / (jobs * r1["points"] / r1["wall"])
+        print(f"{name:<8}{r['points']:>8}{jobs:>5}{r['process_wall']:>10.2f}"
+              f"{r['wall']:>9.2f}{rate:>9.0f}{r['cpu']:>8.2f}{eff:>6.2f}"
+              f"{r['rss'] / 2**20:>9.0f}")
 
     # --- 5 -------------------------------------------------------------------------------
     print(f"\n[5] the four figures at {four_n} x {four_n} x 3 lam, `rocksweep sweep --jobs 2`"
