@@ -111,6 +111,22 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
                        time.thread_time() - c0)
 
 
+def merge_contiguous(results: Iterable[ChunkResult]) -> list[ChunkResult]:
+    """The results sorted by start, with neighbours (one's stop is the next one's start)
+    joined into one result: fewer, larger writes. Times add up."""
+    merged: list[ChunkResult] = []
+    for r in sorted(results, key=lambda r: r.start):
+        last = merged[-1] if merged else None
+        if last is not None and last.stop == r.start:
+            merged[-1] = ChunkResult(
+                last.start, r.stop,
+                {k: np.concatenate((v, r.arrays[k])) for k, v in last.arrays.items()},
+                last.seconds + r.seconds, last.cpu_seconds + r.cpu_seconds)
+        else:
+            merged.append(r)
+    return merged
+
+
 def effective_jobs(jobs: int) -> int:
     """Number of local workers for ``--jobs`` (-1 or 0: all cores)."""
     import os

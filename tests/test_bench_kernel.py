@@ -37,8 +37,8 @@ def test_tiny_run_prints_every_section():
                          text=True, timeout=600)
     assert res.returncode == 0, res.stderr
     out = res.stdout
-    for head in ("[1] roofline", "[2] kernel", "[3] reference", "[4] parallel efficiency",
-                 "[5] the four figures", "[6] warm start"):
+    for head in ("[1] roofline", "[2] kernel", "[2b] event root finders", "[3] reference",
+                 "[4] parallel efficiency", "[5] the four figures", "[6] warm start"):
         assert head in out, f"missing section {head!r}:\n{out}"
     lines = out.splitlines()
     # [1]: two loops per scene, four positive ns/step figures each
@@ -49,12 +49,17 @@ def test_tiny_run_prints_every_section():
         assert len(ns) == 4 and all(v > 0 for v in ns), ln
     # [2] .. [4]: one table row per scene (and per jobs value in [4]), all cells finite
     start = {h: next(i for i, ln in enumerate(lines) if ln.startswith(h))
-             for h in ("[2]", "[3]", "[4]", "[5]")}
-    rows2 = [ln for ln in lines[start["[2]"]:start["[3]"]] if re.match(r"fig\w+\s+\d", ln)]
+             for h in ("[2]", "[2b]", "[3]", "[4]", "[5]")}
+    rows2 = [ln for ln in lines[start["[2]"]:start["[2b]"]] if re.match(r"fig\w+\s+\d", ln)]
+    rows2b = [ln for ln in lines[start["[2b]"]:start["[3]"]] if re.match(r"fig\w+\s+[a-z]", ln)]
     rows3 = [ln for ln in lines[start["[3]"]:start["[4]"]] if re.match(r"fig\w+\s+\d", ln)]
     rows4 = [ln for ln in lines[start["[4]"]:start["[5]"]] if re.match(r"fig\w+\s+\d", ln)]
-    assert len(rows2) == 2 and len(rows3) == 2 and len(rows4) == 4
-    for ln in rows2 + rows3 + rows4:
+    # [4]: two grid sizes (the scene's and --eff-n) x jobs 1, 2 per scene
+    assert len(rows2) == 2 and len(rows3) == 2 and len(rows4) == 8
+    # [2b]: three root finders per scene, bisection's speed-up over itself is 1
+    assert [ln.split()[1] for ln in rows2b] == ["bisection", "illinois", "hermite"] * 2
+    assert all(_numbers(ln)[-2] == 1.0 for ln in rows2b if " bisection " in ln)
+    for ln in rows2 + rows2b + rows3 + rows4:
         nums = _numbers(ln.split(maxsplit=1)[1])
         assert nums and all(math.isfinite(v) for v in nums), ln
     # [2]: 6 x 6 x 3 lam = 108 points per scene; [5]: four figures, 4 x 4 x 3 lam each

@@ -239,7 +239,7 @@ def test_kill_and_resume_equals_uninterrupted_run(cli, tmp_path):
     proc = subprocess.Popen(
         [sys.executable, "-c", "from rocksweep.cli import main; main()", "sweep", str(scene),
          "-o", str(killed),
-         "--jobs", "1", "--chunk-size", "40", "--quiet"],
+         "--jobs", "1", "--chunk-size", "40", "--write-every", "0", "--quiet"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=tmp_path)
     try:
         deadline = time.monotonic() + 300
@@ -270,6 +270,44 @@ def test_kill_and_resume_equals_uninterrupted_run(cli, tmp_path):
     assert_same_results(killed, whole)
     r = read_result(killed)
     assert r.attrs["complete"] and r.attrs["finished"] and r.attrs["sessions"] == 2
+
+
+def test_ctrl_c_writes_every_finished_chunk_before_it_exits(tmp_path):
+    """Chunks are written in batches (--write-every); an interrupt writes the pending ones
+    first, so Ctrl-C loses nothing, and the message counts what the file holds."""
+    scene = tmp_path / "int.yaml"
+    scene.write_text(BODY3 + "impact: {lam: 0.2}\n"
+                     "pulse: {shape: sine, w_over_p: {start: 0.3, stop: 6, num: 300},"
+                     " A_ratio: {start: 0.3, stop: 8, num: 300}}\n")
+    out = tmp_path / "int.h5"
+    from rocksweep.grid import Grid
+    from rocksweep.scene import load_scene
+    from rocksweep.sweep import level, prepare
+
+    sc = load_scene(scene)
+    prepare(Grid(sc), level(sc))
+    proc = subprocess.Popen(
+        [sys.executable, "-c", "from rocksweep.cli import main; main()", "sweep", str(scene),
+         "-o", str(out), "--jobs", "1", "--chunk-size", "50", "--write-every", "1000"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and proc.poll() is None and not out.exists():
+            time.sleep(0.01)
+        time.sleep(1.5)
+        assert proc.poll() is None, "the sweep ended before it could be interrupted"
+        assert _done_points(out) == 0  # nothing written yet: all of it is pending
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130, err
+    line = [ln for ln in err.splitlines() if ln.startswith("interrupted: ")]
+    assert len(line) == 1 and "Traceback" not in err, err
+    saved = int(line[0].split()[1])
+    assert 0 < saved < 90_000
+    assert _done_points(out) == saved
 
 
 def test_sweep_on_a_dask_cluster_equals_local(ci_result, cli, tmp_path):

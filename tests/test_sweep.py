@@ -95,6 +95,21 @@ def test_bit_for_bit_whatever_jobs_and_chunks(reference):
     assert_same(ref, sw.compute(sc, jobs=2, chunk_size=64))
 
 
+def test_merge_contiguous_joins_neighbours_in_any_order():
+    rng = np.random.default_rng(3)
+    bounds = [(0, 5), (5, 9), (9, 20), (30, 33), (33, 40), (50, 51)]
+    full = {"x": rng.random(51), "n": np.arange(51)}
+    results = [sw.ChunkResult(a, b, {k: v[a:b] for k, v in full.items()}, 1.0, 0.5)
+               for a, b in bounds]
+    merged = sw.merge_contiguous([results[i] for i in rng.permutation(len(results))])
+    assert [(m.start, m.stop) for m in merged] == [(0, 20), (30, 40), (50, 51)]
+    for m in merged:
+        for k, v in full.items():
+            np.testing.assert_array_equal(m.arrays[k], v[m.start:m.stop])
+    assert [m.seconds for m in merged] == [3.0, 2.0, 1.0]
+    assert [m.cpu_seconds for m in merged] == [1.5, 1.0, 0.5]
+
+
 def test_chunk_kernels_release_the_gil():
     """Local workers are threads: a chunk kernel that held the GIL would run them one at a
     time (the sweep would still be right, only as slow as one worker)."""
