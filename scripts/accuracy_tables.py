@@ -8,6 +8,9 @@ Run the study on each shipped figure scene first, e.g.
     done
     python scripts/accuracy_tables.py acc_fig3a.h5 acc_fig3b.h5 acc_fig4a.h5 acc_fig4b.h5
 
+(``--ladder roots`` reports give the presets at the default root finder and a table of
+every root finder.)
+
 Prints (1) a markdown table of each preset's time per point (weighted mean over the
 stratified sample: an estimate for the whole scene, one core) and outcome agreement with
 the reference (+- its standard error) per scene, and (2) every setting measured on all
@@ -26,6 +29,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from rocksweep.numerics import ROOTS, Numerics
+
 TARGET = 0.995
 
 
@@ -39,9 +44,16 @@ def read(path: Path) -> dict:
         names = [_text(n) for n in t["setting"][:]]
         rows = {n: {k: (t[k][i] if t[k].dtype.kind != "O" else _text(t[k][i]))
                     for k in t} for i, n in enumerate(names)}
+        # per preset and root finder: sampled points whose outcome equals bisection's
+        same = {}
+        for n in names:
+            preset, _, root = n.partition("-")
+            if root and f"{preset}-bisection" in names:
+                same[preset, root] = int(np.sum(f[f"kernel/{n}/outcome"][:]
+                                                == f[f"kernel/{preset}-bisection/outcome"][:]))
         return {"scene": _text(f.attrs["scene_name"]), "command": _text(f.attrs["command"]),
                 "n": int(f.attrs["points_sampled"]), "size": int(f.attrs["points_in_scene"]),
-                "rows": rows}
+                "rows": rows, "same": same}
 
 
 def main() -> None:
@@ -62,14 +74,31 @@ def main() -> None:
     for name in ("draft", "default", "fine"):
         cells = []
         for r in reports:
-            d = r["rows"].get(name)
+            # a candidates report names the presets, a roots report "<preset>-<root>"
+            d = r["rows"].get(name, r["rows"].get(f"{name}-{Numerics().root}"))
             cells.append("-" if d is None else
                          f"{d['mean_us']:.0f}, {100 * d['agreement']:.2f}% "
                          f"(+-{100 * d['agreement_se']:.2f})")
-        d0 = reports[0]["rows"][name]
+        d0 = reports[0]["rows"].get(name, reports[0]["rows"].get(f"{name}-{Numerics().root}"))
         print(f"| {name} | {int(d0['steps_per_period'])}, {d0['event_tol']:.0e} | "
               + " | ".join(cells) + " |")
     print()
+
+    if all(f"default-{root}" in r["rows"] for r in reports for root in ROOTS):
+        print("Event root finders (--ladder roots): us/pt (RK4 evaluations per point), "
+              "agreement; the same outcomes as bisection on how many sampled points")
+        print("| preset | root | " + " | ".join(short) + " |")
+        print("|" + "---|" * (2 + len(reports)))
+        for name in ("draft", "default", "fine"):
+            for root in ROOTS:
+                cells = []
+                for r in reports:
+                    d = r["rows"][f"{name}-{root}"]
+                    cells.append(f"{d['mean_us']:.0f} ({d['evals_per_point']:.0f}), "
+                                 f"{100 * d['agreement']:.2f}%, "
+                                 f"{r['same'][name, root]}/{r['n']}")
+                print(f"| {name} | {root} | " + " | ".join(cells) + " |")
+        print()
 
     common = set.intersection(*(set(r["rows"]) for r in reports))
     ranked = []
