@@ -17,8 +17,9 @@ Prints, measured side by side in one run (issue 7's benchmark):
    workers. The regular share is the regular steps' cost at the roofline over the kernel
    time: the integration no event handling could remove.
 2b. the event root finders (bisection, Illinois, Hermite) on every point of each scene at
-   the scene's steps and event_tol: RK4 evaluations and microseconds per point, the
-   speed-up over bisection, and how many outcomes differ from bisection's.
+   the scene's steps and event_tol: RK4 evaluations and microseconds per point, ns per
+   evaluation and the roofline's share of it, the speed-up over bisection, and how many
+   outcomes differ from bisection's.
 3. reference: scipy DOP853 (``rocksweep.reference``) on the accuracy study's stratified
    sample (``--ref-points``; strata outcome x boundary, weights make scene estimates):
    weighted mean and median time per point, the kernel's on the same points (each a 1-row
@@ -485,8 +486,9 @@ def main() -> None:
     # --- 2b: the event root finders, same points, same run ------------------------------
     print("\n[2b] event root finders at the scene's steps and event_tol: kernel calls only "
           "(CPU), every point of the scene; outcome differences against bisection")
-    print(f"{'scene':<8}{'root':<11}{'evals/pt':>9}{'event/pt':>9}{'us/pt':>8}"
-          f"{'vs bisection':>13}{'outcomes differ':>16}")
+    print("    roof/kern: the roofline at the scene's phase mix (item 2) / ns per evaluation")
+    print(f"{'scene':<8}{'root':<11}{'evals/pt':>9}{'event/pt':>9}{'us/pt':>8}{'ns/eval':>9}"
+          f"{'roof/kern':>10}{'vs bisection':>13}{'outcomes differ':>16}")
     for name, scene in scenes.items():
         by_root = {}
         for root in ROOTS:
@@ -494,13 +496,17 @@ def main() -> None:
                                                                          root=root))
             by_root[root] = kernel_pass(sc)
         base = by_root["bisection"]
+        roof = float(np.sum(mixes[name] / mixes[name].sum() * roofs[name]["inlined"]))
         for root, p in by_root.items():
             o = p["outs"]
             n = o.shape[0]
             ev = o[:, L.OUT_EVENT_STEPS].sum() / n
+            evals = o[:, L.OUT_STEPS].sum() / n + ev
+            ns_eval = p["cpu"] / (evals * n) * 1e9
             diff = int(np.sum(o[:, L.OUT_OUTCOME] != base["outs"][:, L.OUT_OUTCOME]))
-            print(f"{name:<8}{root:<11}{o[:, L.OUT_STEPS].sum() / n + ev:>9.0f}{ev:>9.0f}"
-                  f"{p['cpu'] / n * 1e6:>8.1f}{base['cpu'] / p['cpu']:>12.2f}x{diff:>16}")
+            print(f"{name:<8}{root:<11}{evals:>9.0f}{ev:>9.0f}{p['cpu'] / n * 1e6:>8.1f}"
+                  f"{ns_eval:>9.1f}{roof / ns_eval:>10.2f}{base['cpu'] / p['cpu']:>12.2f}x"
+                  f"{diff:>16}")
 
     # --- 3 -------------------------------------------------------------------------------
     print("\n[3] reference (scipy DOP853, rtol 1e-10) vs kernel on the accuracy study's "
