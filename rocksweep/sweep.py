@@ -154,8 +154,9 @@ def plan_chunks(todo: np.ndarray, chunk_size: int) -> list[tuple[int, int]]:
 
 
 def prepare(grid: Grid, level: int) -> None:
-    """Compile (or load from numba's cache) every kernel variant the grid needs, in the
-    parent, so that workers load the cache instead of compiling concurrently."""
+    """Compile (or load from numba's cache) every kernel variant the grid needs, before
+    any worker starts: worker threads share the compiled code, and dask workers load
+    numba's cache instead of compiling concurrently."""
     for kind in grid.kinds():
         warm_up(kind, level)
 
