@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rocksweep.errors import RocksweepError
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.store import SweepResult
 
@@ -42,7 +43,7 @@ ALPHA_REF = {"flexible": r"\alpha_{cg}", "block": r"\alpha"}
 _SAFE, _MODE2, _NOT_RUN = "#ffffff", "#4c72b0", "#bdbdbd"
 
 
-class DiagramError(ValueError):
+class DiagramError(RocksweepError, ValueError):
     """A result that cannot be drawn as a stability diagram; ``str()`` is one line."""
 
 

@@ -52,12 +52,14 @@ from functools import cached_property
 
 import numpy as np
 
+from rocksweep.errors import RocksweepError
+
 G = 9.81  # m/s^2
 M_TOP = 1.0  # kg, the top mass m (a repeating quantity)
 P = 1.0  # rad/s, the rocking frequency p (a repeating quantity)
 
 
-class BodyError(ValueError):
+class BodyError(RocksweepError, ValueError):
     """A body that is not physical; the message names the offending key and value."""
 
 

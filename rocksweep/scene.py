@@ -18,12 +18,13 @@ import numpy as np
 import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError
 
+from rocksweep.errors import RocksweepError
 from rocksweep.model import BlockBody, Body, BodyError, FlexibleBody
 from rocksweep.numerics import PRESETS, ROOTS, Numerics
 from rocksweep.points import Point
 
 
-class SceneError(ValueError):
+class SceneError(RocksweepError, ValueError):
     """A scene that cannot be run; ``str()`` is one line for the user."""
 
 

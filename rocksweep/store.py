@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from rocksweep.errors import RocksweepError
 from rocksweep.grid import Grid
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
@@ -60,7 +61,7 @@ COORD_LONG_NAMES = {
 }
 
 
-class StoreError(Exception):
+class StoreError(RocksweepError):
     """A result file that cannot be made, read or resumed; ``str()`` is one line."""
 
 

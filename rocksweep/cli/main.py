@@ -13,24 +13,19 @@ from pathlib import Path
 
 import click
 
-from rocksweep.diagrams import DiagramError
-from rocksweep.model import BodyError
-from rocksweep.scene import SceneError, load_scene
-from rocksweep.store import StoreError
-
-# errors that are the user's to fix; other modules register theirs with ``user_errors``
-USER_ERRORS: list[type[Exception]] = [SceneError, BodyError]
-USER_ERRORS += [StoreError, DiagramError]  # sweep results, stability diagrams (issue 3)
+from rocksweep.errors import RocksweepError
+from rocksweep.scene import load_scene
 
 
 def user_errors(fn):
-    """Turn the library's user-facing errors into one-line click errors."""
+    """Turn the library's user-facing errors (``RocksweepError``) into one-line click
+    errors."""
 
     @functools.wraps(fn)
     def wrapper(*args, **kwargs):
         try:
             return fn(*args, **kwargs)
-        except tuple(USER_ERRORS) as err:
+        except RocksweepError as err:
             raise click.ClickException(str(err)) from None
 
     return wrapper

@@ -1,0 +1,131 @@
+"""Output files: one policy for every command that writes one (no I/O libraries here).
+
+- An existing path is refused unless the user said ``overwrite`` (``--overwrite``).
+- A path that is a command's own input (the scene, the result being plotted) is refused
+  even with ``overwrite``.
+- Only regular files are written: a directory, a device (``/dev/null``, ``/dev/full``), a
+  FIFO or a socket is refused even with ``overwrite``.
+- The directory must exist and be writable, and the name must fit the file system.
+- Files appear atomically: they are written under a temporary name unique to the process
+  (``tempfile.mkstemp`` in the target's directory) and renamed over the target when
+  complete, so an output is either complete or absent, and two processes writing the same
+  path never share a temporary file.
+
+Every refusal is an ``OutputError`` (a ``RocksweepError``) with one line naming the path
+and the reason.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import os
+import stat
+import tempfile
+from collections.abc import Callable, Iterable, Iterator
+from pathlib import Path
+
+from rocksweep.errors import OutputError
+
+
+def _reason(err: OSError) -> str:
+    if err.errno == errno.ENOSPC:
+        return "no space left on the device"
+    if err.errno == errno.ENAMETOOLONG:
+        return "file name too long"
+    if err.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
+        return "permission denied (read-only location?)"
+    return err.strerror or type(err).__name__
+
+
+def _same(a: str | Path, b: str | Path) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+def shown(path: str | Path) -> str:
+    """A path as error messages show it: long names shortened to one readable line."""
+    text = str(path)
+    return text if len(text) <= 120 else f"{text[:60]}...{text[-40:]}"
+
+
+def check_output(path: str | Path, *, overwrite: bool = False,
+                 inputs: Iterable[str | Path] = (), suffixes: Iterable[str] = ()) -> Path:
+    """Check that ``path`` may be written; return it as a Path, or raise OutputError.
+
+    inputs: the command's input files (never written over); suffixes: allowed file
+    suffixes (e.g. (".png", ".pdf", ".svg")), empty for any.
+    """
+    path = Path(path)
+    suffixes = tuple(suffixes)
+    if suffixes and path.suffix.lower() not in suffixes:
+        raise OutputError(f"{path}: unsupported file type {path.suffix or '(none)'!r}; "
+                          f"use one of {', '.join(suffixes)}")
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        st = None
+    except OSError as err:
+        raise OutputError(f"{shown(path)}: cannot be written ({_reason(err)})") from None
+    if st is not None:
+        if stat.S_ISDIR(st.st_mode):
+            raise OutputError(f"{path}: is a directory; give a file name")
+        if not stat.S_ISREG(st.st_mode):
+            raise OutputError(f"{path}: not a regular file (a device, FIFO or socket); "
+                              "outputs are written to regular files only")
+        if any(_same(path, inp) for inp in inputs):
+            raise OutputError(f"{path}: is this command's input; choose another output path")
+        if not overwrite:
+            raise OutputError(f"{path}: already exists; use --overwrite to replace it")
+    parent = path.parent if str(path.parent) else Path(".")
+    if not parent.is_dir():
+        raise OutputError(f"{path}: directory {parent} does not exist")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise OutputError(f"{path}: directory {parent} is not writable")
+    try:
+        name_max = os.pathconf(parent, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        name_max = 255
+    # the temporary name adds a few characters; refuse what cannot be made at all
+    if len(os.fsencode(path.name)) > name_max:
+        raise OutputError(f"{shown(path)}: file name too long "
+                          f"({len(os.fsencode(path.name))} bytes, at most {name_max})")
+    return path
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | Path) -> Iterator[Path]:
+    """A temporary path next to ``path``, unique to this process, renamed to ``path`` when
+    the block ends without an exception (removed otherwise). OSErrors become OutputError.
+
+        with atomic_path(out) as tmp:
+            fig.savefig(tmp)
+    """
+    path = Path(path)
+    parent = path.parent if str(path.parent) else Path(".")
+    try:
+        fd, name = tempfile.mkstemp(prefix=f".{path.stem[:40]}.", suffix=f".partial{path.suffix}",
+                                    dir=parent)
+        os.close(fd)
+    except OSError as err:
+        raise OutputError(f"{shown(path)}: cannot be written ({_reason(err)})") from None
+    tmp = Path(name)
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    except OutputError:
+        raise
+    except OSError as err:
+        raise OutputError(f"{shown(path)}: cannot be written ({_reason(err)})") from None
+    finally:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+
+
+def write_atomic(path: str | Path, write: Callable[[Path], None]) -> None:
+    """``write(tmp)`` to a unique temporary file, then rename it to ``path`` (see
+    ``atomic_path``)."""
+    with atomic_path(path) as tmp:
+        write(tmp)
