@@ -1,25 +1,31 @@
-"""The work-precision diagram of ``rocksweep accuracy`` (matplotlib, Agg backend).
+"""The work-precision diagram of ``rocksweep accuracy`` (a pyplot-free matplotlib Figure).
 
 (a) error against the reference versus kernel time per point, log-log, one colour per
 measure: the step ladder as a solid line (steps per period labelled), the tolerance ladder
-as a dashed line (event_tol labelled), the presets as stars. (b) outcome agreement with the
-reference versus time per point, with its standard error, the 99.5% line that picks the
-default preset, and the reference's own time per point.
+as a dashed line (event_tol labelled), the presets as stars. What is plotted is what
+``rocksweep.accuracy`` measures: the median over the sampled points of |d theta_max|/alpha
+(points both call safe), |d t_first_impact| (both impact), |d t_overturn| (both overturn),
+and the *mean* |d impacts| (same outcome); time is the weighted mean of one-point kernel
+calls (the scene estimate), at the event root finder each setting ran with. (b) outcome
+agreement with the reference versus time per point, with its standard error, the 99.5% line
+that picks the default preset, and the reference's own time per point.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from rocksweep.accuracy import MEASURE_LABELS, Study
+from rocksweep.plots import DEFAULT_DPI, given_axes, new_axes, save_figure
 
-from rocksweep.accuracy import MEASURE_LABELS, Study  # noqa: E402
-from rocksweep.plots import save_figure  # noqa: E402
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
 
 _COLORS = {"theta_max": "C0", "t_first_impact": "C1", "t_overturn": "C2", "impacts": "C3"}
 AGREEMENT_TARGET = 99.5  # % (the rule that picks the default preset)
@@ -35,14 +41,19 @@ def _rungs(table: list[dict], group: str) -> list[int]:
     return sorted(idx, key=lambda i: (table[i]["steps_per_period"], -table[i]["event_tol"]))
 
 
-def work_precision_figure(study: Study, path: str | Path) -> None:
-    """Draw the work-precision diagram of a study to ``path`` (PNG, PDF, SVG...)."""
+def work_precision(study: Study, axes: Sequence[Axes] | None = None) -> Figure:
+    """The work-precision diagram of a study (see the module docstring); axes: 2 axes to
+    draw into (else a new figure). Returns the figure."""
+    if axes is None:
+        fig, grid = new_axes(1, 2, (13, 6.4))
+        ax_a, ax_b = grid[0]
+    else:
+        fig, (ax_a, ax_b) = given_axes(axes, 2, "the work-precision diagram")
     table = study.table()
     w = study.sample.weight
     x = np.array([d["mean_us"] for d in table])
     groups = [d["group"] for d in table]
     names = [d["setting"] for d in table]
-    fig, (ax_a, ax_b) = plt.subplots(1, 2, figsize=(13, 6.2), layout="constrained")
 
     curves = sorted({g for g in groups if g != "preset"})
     styles = dict(zip(curves, ["-o", "--s", ":^", "-.v", "-D", "--x"] * 4, strict=False))
@@ -54,7 +65,9 @@ def work_precision_figure(study: Study, path: str | Path) -> None:
             ax_a.plot(x[idx], y[idx], styles[group], color=color, ms=4, lw=1.2,
                       label=label if k == 0 else None)
         idx = [i for i, g in enumerate(groups) if g == "preset"]
-        ax_a.plot(x[idx], y[idx], "*", color=color, ms=11, mec="k", mew=0.5)
+        if idx:
+            ax_a.plot(x[idx], y[idx], "*", color=color, ms=11, mec="k", mew=0.5,
+                      label=None if curves else label)
     for group in curves:  # line styles name the curves
         ax_a.plot([], [], styles[group], color="0.4", ms=4, label=group)
     # label the rungs once, on the lowest curve that has a value there
@@ -71,12 +84,13 @@ def work_precision_figure(study: Study, path: str | Path) -> None:
     for ax in (ax_a, ax_b):
         ax.axvline(ref_us, color="0.4", ls=":", lw=1)
         ax.set_xscale("log")
-        ax.set_xlabel("kernel time per point [us] (one core; weighted mean, scene estimate)")
+        ax.set_xlabel("kernel time per point [us] (one-point calls, one core; "
+                      "weighted mean = scene estimate)")
         ax.grid(alpha=0.3, which="both")
-    ax_a.text(ref_us, 0.98, " reference\n (DOP853)",
+    ax_a.text(ref_us, 0.98, f" reference\n (DOP853)\n {ref_us / 1e3:.0f} ms",
               transform=ax_a.get_xaxis_transform(), va="top", fontsize=8, color="0.3")
     ax_a.set_yscale("log")
-    ax_a.set_ylabel("median error against the reference")
+    ax_a.set_ylabel("error against the reference\n(median over points; impacts: mean)")
     ax_a.set_title("(a) error vs cost (labels: steps per period, event_tol; "
                    "stars: presets)", fontsize=9)
     ax_a.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=3,
@@ -84,16 +98,19 @@ def work_precision_figure(study: Study, path: str | Path) -> None:
 
     agree = np.array([100 * d["agreement"] for d in table])
     se = np.array([100 * d["agreement_se"] for d in table])
+    evals = np.array([d["evals_per_point"] for d in table])
     for group in [*curves, "preset"]:
-        style = styles.get(group, "*")
         idx = _rungs(table, group)
-        lab = group
-        ax_b.errorbar(x[idx], agree[idx], yerr=se[idx], fmt=style, ms=11 if group == "preset"
-                      else 4, capsize=2, lw=1.2, label=lab,
+        if not idx:
+            continue
+        style = styles.get(group, "*")
+        ax_b.errorbar(x[idx], agree[idx], yerr=se[idx], fmt=style,
+                      ms=11 if group == "preset" else 4, capsize=2, lw=1.2, label=group,
                       mec="k" if group == "preset" else None)
         for j, i in enumerate(idx):
             txt = (f"{table[i]['steps_per_period']}" if group.startswith("steps") else
-                   f"{table[i]['event_tol']:.0e}" if group.startswith("tol") else names[i])
+                   f"{table[i]['event_tol']:.0e}" if group.startswith("tol") else
+                   f"{names[i]} ({evals[i]:.0f} RK4/pt)")
             ax_b.annotate(txt, (x[i], agree[i]), textcoords="offset points",
                           xytext=(3, 5 if j % 2 == 0 else -11), fontsize=7, color="0.3")
     ax_b.axhline(AGREEMENT_TARGET, color="C3", ls="--", lw=1,
@@ -103,10 +120,20 @@ def work_precision_figure(study: Study, path: str | Path) -> None:
     ax_b.text(ref_us, 0.02, " reference", transform=ax_b.get_xaxis_transform(), fontsize=8,
               color="0.3")
     ax_b.set_ylabel("outcome agreement with the reference [%] (+- standard error)")
-    ax_b.set_title("(b) outcome (safe / mode 1 / mode 2) agreement vs cost", fontsize=9)
+    ax_b.set_title("(b) outcome (safe / mode 1 / mode 2) agreement vs cost "
+                   "(weighted: scene estimate)", fontsize=9)
     ax_b.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=3,
                 frameon=False)
 
-    n, size = len(study.sample.flat), study.sample.size
-    fig.suptitle(f"{study.scene.name}: work-precision, {n} of {size} points", fontsize=11)
-    save_figure(fig, path)
+    if axes is None:
+        n, size = len(study.sample.flat), study.sample.size
+        roots = sorted({d["root"] for d in table})
+        fig.suptitle(f"{study.scene.name}: work-precision, {n} of {size} points; "
+                     f"event root finder: {', '.join(roots)}", fontsize=11)
+    return fig
+
+
+def work_precision_figure(study: Study, path: str | Path, *, dpi: int = DEFAULT_DPI,
+                          overwrite: bool = True) -> None:
+    """``work_precision`` saved to ``path`` (the call of ``rocksweep accuracy --plot``)."""
+    save_figure(work_precision(study), path, dpi, overwrite=overwrite)

@@ -1,34 +1,51 @@
-"""Stability diagrams (Figures 3 and 4 of the paper) from a sweep result.
+"""Stability diagrams (Figures 3 and 4 of the paper) from a sweep result, over any two
+swept axes, and line plots of 1-D sweeps.
 
-x = omega/p, y = A/(g tan alpha_ref) (alpha_ref = alpha_cg for the paper's flexible body,
-alpha for a block). Each cell is coloured by what the pulse does:
+By default x = omega/p and y = A/(g tan alpha_ref) (alpha_ref = alpha_cg for the paper's
+flexible body, alpha for a block) when both are swept; ``x``/``y`` pick any other swept
+axis (e.g. ``alpha_cg`` against ``A_ratio``). Each cell is coloured by what the pulse does:
 
 - mode 2 (overturned without impact): blue. It does not depend on lam, which acts only
   at impacts;
 - mode 1 (overturned after one or more impacts): red at the smallest lam, and lighter
   shades where a point first overturns in mode 1 at a larger lam, so the growth of the
-  mode 1 area with lam is visible at a glance (the paper's claim);
+  mode 1 area with lam is visible at a glance (the paper's claim). This layering is used
+  when lam is swept and on neither axis;
 - safe at every lam: white; not computed yet: grey.
 
 Points that are mode 1 at some lam but safe again at a larger one get a black dot;
 flagged points (horizon, step or event cap, non-finite: ``STATUS_FLAGGED``) an ``x``.
 Each panel also lists the mode 1 area (fraction of its points) for every lam. One panel
 per pulse shape and per value of any other swept key.
+
+A sweep with one swept numeric axis (besides lam) is drawn as max|theta|/alpha_ref against
+that axis, one line per lam, the markers coloured by outcome.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from itertools import product
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+from matplotlib.colors import BoundaryNorm, ListedColormap
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
 
-from rocksweep.errors import RocksweepError
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.plots import DEFAULT_DPI, FORMATS, FigureError, given_axes, new_axes, save_figure
 from rocksweep.store import SweepResult
 
-FORMATS = (".png", ".pdf", ".svg")
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+__all__ = ["FORMATS", "DiagramError", "choose_axes", "stability_diagram", "line_diagram",
+           "sweep_figure", "stability_figure", "missing_warnings", "categories", "y_label"]
+
 MAX_PANELS = 36
 
 SYMBOLS = {
@@ -37,14 +54,16 @@ SYMBOLS = {
     "IA_ratio": r"I_A/(m_A R_A^2)", "alpha": r"\alpha", "inertia": r"I_O/(M R^2)",
     "w_over_p": r"\omega/p", "A_ratio": r"A/(g\tan\alpha)",
 }
+UNITS = {"alpha_cg": " [rad]", "alpha_A": " [rad]", "alpha": " [rad]"}
 # the slenderness that normalises the amplitude, per body kind (body.alpha_ref)
 ALPHA_REF = {"flexible": r"\alpha_{cg}", "block": r"\alpha"}
+DEFAULT_X, DEFAULT_Y = "w_over_p", "A_ratio"
 
 _SAFE, _MODE2, _NOT_RUN = "#ffffff", "#4c72b0", "#bdbdbd"
 
 
-class DiagramError(RocksweepError, ValueError):
-    """A result that cannot be drawn as a stability diagram; ``str()`` is one line."""
+class DiagramError(FigureError):
+    """A result that cannot be drawn as asked; ``str()`` is one line."""
 
 
 def _fmt(v) -> str:
@@ -52,8 +71,16 @@ def _fmt(v) -> str:
 
 
 def y_label(kind: str) -> str:
+    """Label of the amplitude axis A/(g tan alpha_ref) for a body kind."""
     alpha = ALPHA_REF.get(kind, ALPHA_REF["block"])
     return rf"$A/(g\,\tan{alpha})$"
+
+
+def axis_label(dim: str, kind: str) -> str:
+    """Axis label of a swept dimension (the paper's symbol, units where they are not 1)."""
+    if dim == "A_ratio":
+        return y_label(kind)
+    return rf"${SYMBOLS.get(dim, dim)}${UNITS.get(dim, '')}"
 
 
 def categories(outcome: np.ndarray) -> np.ndarray:
@@ -83,71 +110,186 @@ def mode1_colours(n_lam: int) -> list:
     return [cmap(0.85 - 0.6 * k / (n_lam - 1)) for k in range(n_lam)]
 
 
-def stability_figure(result: SweepResult, path: str | Path) -> list[str]:
-    """Draw the stability diagram of ``result`` to ``path`` (.png, .pdf or .svg).
+# ---------------------------------------------------------------------------------------
+# Which axes to draw
+# ---------------------------------------------------------------------------------------
 
-    Returns warnings for the user (e.g. points not computed yet).
+def plottable(result: SweepResult) -> list[str]:
+    """Swept numeric dimensions with two or more values (what x and y may be)."""
+    return [d for d in result.dims if d != "shape" and len(result.coords[d]) >= 2]
+
+
+def _check_key(result: SweepResult, key: str, option: str) -> str:
+    name = key.split(".", 1)[1] if key.startswith(("body.", "pulse.", "impact.")) else key
+    ok = plottable(result)
+    if name not in ok:
+        why = ("pulse shapes are drawn as panels, not along an axis" if name == "shape"
+               else "has one value" if name in result.dims
+               else "not swept" if name in result.scalars
+               else "no such axis")
+        raise DiagramError(f"{result.path}: {option} {key}: {why}; swept axes: "
+                           f"{', '.join(ok) or '(none with two or more values)'}")
+    return name
+
+
+def choose_axes(result: SweepResult, x: str | None = None, y: str | None = None,
+                option_names: tuple[str, str] = ("x", "y")) -> tuple[str, str | None]:
+    """The (x, y) dimensions to draw; y None: a 1-D line plot over x.
+
+    Defaults: x = w_over_p and y = A_ratio when swept, else other swept axes (lam last:
+    it is layered in the colours when on neither axis). With fewer than two swept axes
+    besides lam, a line plot over the one left (one line per lam). Keys may be given as
+    names (``alpha_cg``) or scene keys (``body.alpha_cg``). option_names: how errors call
+    x and y (the CLI passes ("--x", "--y")).
     """
-    path = Path(path)
-    if path.suffix.lower() not in FORMATS:
-        raise DiagramError(f"{path}: unknown figure format {path.suffix or '(none)'!r}; "
-                           f"use {', '.join(FORMATS)}")
-    for d, key in (("w_over_p", "pulse.w_over_p"), ("A_ratio", "pulse.A_ratio")):
-        if d not in result.dims or len(result.coords[d]) < 2:
-            raise DiagramError(f"{result.path}: {key} has one value; a stability diagram "
-                               "needs pulse.w_over_p and pulse.A_ratio swept (lists or ranges)")
-    outcome = result.arrays["outcome"]
-    flagged = result.flagged & result.done
+    if x is not None:
+        x = _check_key(result, x, option_names[0])
+    if y is not None:
+        y = _check_key(result, y, option_names[1])
+    if x is not None and x == y:
+        raise DiagramError(f"{result.path}: {option_names[0]} and {option_names[1]} are both "
+                           f"{x}; choose two different swept axes: "
+                           f"{', '.join(plottable(result))}")
+    axes = plottable(result)
+    if not axes:
+        raise DiagramError(f"{result.path}: no swept axis with two or more values to draw; "
+                           "sweep at least one key (a list or a range)")
+    rest = [d for d in axes if d != "lam" and d not in (x, y)]
+    if x is None:
+        if y is None and len(rest) < 2:
+            return (rest[0] if rest else "lam"), None  # a line plot
+        if DEFAULT_X in rest:
+            x = DEFAULT_X
+        else:
+            pool = ([d for d in rest if d != DEFAULT_Y] or rest
+                    or (["lam"] if "lam" in axes and y != "lam" else []))
+            x = pool[0] if pool else None
+            if x is None:
+                raise DiagramError(f"{result.path}: {option_names[1]} {y}: no other swept "
+                                   f"axis for x; swept axes: {', '.join(axes)}")
+        rest = [d for d in rest if d != x]
+    if y is None and rest:
+        y = DEFAULT_Y if DEFAULT_Y in rest else DEFAULT_X if DEFAULT_X in rest else rest[0]
+    return x, y
+
+
+# ---------------------------------------------------------------------------------------
+# Drawing
+# ---------------------------------------------------------------------------------------
+
+def _arrays(result: SweepResult, order: list[str], names: Sequence[str]) -> list[np.ndarray]:
+    """result arrays transposed to ``order``; numeric axes sorted ascending."""
     dims = list(result.dims)
-    panel_dims = [d for d in dims if d not in ("lam", "A_ratio", "w_over_p")]
-    order = [*panel_dims, *(["lam"] if "lam" in dims else []), "A_ratio", "w_over_p"]
     perm = [dims.index(d) for d in order]
-    o = np.transpose(outcome, perm)
-    fl = np.transpose(flagged, perm)
-    if "lam" not in dims:
-        o, fl = o[..., None, :, :], fl[..., None, :, :]
-        lam = np.array([result.scalars.get("lam", 0.0)], float)
-    else:
-        lam = np.asarray(result.coords["lam"], float)
-    lam_order = np.argsort(lam, kind="stable")
-    lam = lam[lam_order]
-    o = np.take(o, lam_order, axis=len(panel_dims))
-    fl = np.take(fl, lam_order, axis=len(panel_dims))
+    out = []
+    for a in names:
+        v = np.transpose(a if isinstance(a, np.ndarray) else result.arrays[a], perm)
+        for axis, d in enumerate(order):
+            if d != "shape":
+                v = np.take(v, np.argsort(np.asarray(result.coords[d], float), kind="stable"),
+                            axis=axis)
+        out.append(v)
+    return out
+
+
+def _coord(result: SweepResult, d: str) -> np.ndarray:
+    vals = result.coords[d]
+    return vals if d == "shape" else np.sort(np.asarray(vals, float), kind="stable")
+
+
+def _panels(result: SweepResult, panel_dims: list[str]) -> list[tuple[int, ...]]:
     panels = list(product(*(range(len(result.coords[d])) for d in panel_dims)))
     if len(panels) > MAX_PANELS:
         raise DiagramError(f"{result.path}: {len(panels)} panels "
-                           f"({' x '.join(panel_dims)}); at most {MAX_PANELS} fit a figure")
+                           f"({' x '.join(panel_dims)}); at most {MAX_PANELS} fit a figure; "
+                           "choose other --x/--y or sweep fewer values")
+    return panels
 
-    import matplotlib
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.colors import BoundaryNorm, ListedColormap
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
+def _layout(result: SweepResult, panel_dims: list[str], n: int) -> tuple[int, int]:
+    per_first = n // len(result.coords[panel_dims[0]]) if panel_dims else 1
+    # a row per value of the first panel key (the pulse shape) when that fits, else 3 across
+    ncols = per_first if len(panel_dims) >= 2 and per_first <= 4 else min(n, 3)
+    return math.ceil(n / ncols), ncols
 
-    from rocksweep.plots import save_figure
 
-    n_lam = len(lam)
+def _panel_title(result: SweepResult, panel_dims: list[str], idx: tuple[int, ...]) -> str:
+    parts = []
+    for d, i in zip(panel_dims, idx, strict=True):
+        v = _coord(result, d)[i]
+        parts.append(f"{v} pulse" if d == "shape" else f"${SYMBOLS.get(d, d)}$ = {_fmt(v)}")
+    return ", ".join(parts)
+
+
+def _title(result: SweepResult, on_axes: Sequence[str]) -> str:
+    """The scene's name, plus the unswept pulse values it does not already state (said
+    once: panels name only what varies between them)."""
+    name = result.name
+    extra = []
+    shape = result.scalars.get("shape")
+    if shape is not None and f"{shape} pulse" not in name.lower():
+        extra.append(f"{shape} pulse")
+    for d in ("w_over_p", "A_ratio"):
+        if d in result.scalars and d not in on_axes:
+            sym = SYMBOLS[d] if d != "A_ratio" else rf"A/(g\tan{ALPHA_REF.get(result.kind)})"
+            extra.append(f"${sym}$ = {_fmt(float(result.scalars[d]))}")
+    return ", ".join([name, *extra])
+
+
+def _place_axes(axes, n: int, rows_cols: tuple[int, int], size: tuple[float, float],
+                what: str) -> tuple[Figure, list, bool]:
+    if axes is None:
+        nrows, ncols = rows_cols
+        fig, grid = new_axes(nrows, ncols, (size[0] * ncols, size[1] * nrows + 0.9))
+        flat = list(grid.flat)
+        for ax in flat[n:]:
+            ax.set_visible(False)
+        return fig, flat[:n], True
+    fig, flat = given_axes(axes, n, what)
+    return fig, flat, False
+
+
+def stability_diagram(result: SweepResult, x: str | None = None, y: str | None = None, *,
+                      axes: Axes | Sequence[Axes] | None = None,
+                      option_names: tuple[str, str] = ("x", "y")) -> Figure:
+    """The stability diagram of ``result`` over swept axes x and y (see the module
+    docstring; defaults from ``choose_axes``). Needs the ``outcome`` and ``status``
+    arrays. axes: one Axes per panel to draw into (else a new figure). Returns the figure.
+    """
+    x, y = choose_axes(result, x, y, option_names)
+    if y is None:
+        raise DiagramError(f"{result.path}: one swept axis besides lam ({x}); a stability "
+                           "diagram needs two: draw it with line_diagram (rocksweep plot "
+                           "does) or sweep another key")
+    dims = list(result.dims)
+    layered = "lam" in dims and "lam" not in (x, y)
+    panel_dims = [d for d in dims if d not in (x, y) and not (layered and d == "lam")]
+    order = [*panel_dims, *(["lam"] if layered else []), y, x]
+    flagged = result.flagged & result.done
+    o, fl = _arrays(result, order, ["outcome", flagged])
+    if layered:
+        lam = _coord(result, "lam")
+    else:  # one layer: the fixed lam, or none when lam is on an axis
+        o, fl = o[..., None, :, :], fl[..., None, :, :]
+        lam = np.array([float(result.scalars["lam"])]) if "lam" in result.scalars else None
+    panels = _panels(result, panel_dims)
+
+    n_lam = o.shape[len(panel_dims)]
     m1 = mode1_colours(n_lam)
     cmap = ListedColormap([_NOT_RUN, _SAFE, _MODE2, *m1])
     norm = BoundaryNorm(np.arange(-0.5, 3 + n_lam), cmap.N)
-    x = np.asarray(result.coords["w_over_p"], float)
-    y = np.asarray(result.coords["A_ratio"], float)
+    xs, ys = _coord(result, x), _coord(result, y)
 
-    per_first = len(panels) // len(result.coords[panel_dims[0]]) if panel_dims else 1
-    # a row per value of the first panel key (the pulse shape) when that fits, else 3 across
-    ncols = per_first if len(panel_dims) >= 2 and per_first <= 4 else min(len(panels), 3)
-    nrows = math.ceil(len(panels) / ncols)
-    fig, axes = plt.subplots(nrows, ncols, figsize=(4.8 * ncols, 4.2 * nrows + 0.9),
-                             squeeze=False, layout="constrained")
+    fig, flat, own = _place_axes(axes, len(panels), _layout(result, panel_dims, len(panels)),
+                                 (4.8, 4.2), "this stability diagram")
     used = np.zeros(3 + n_lam, bool)
     any_flag = any_back = False
-    for ax, idx in zip(axes.flat, panels, strict=False):
-        po, pf = o[idx], fl[idx]  # [n_lam, n_A, n_w]
+    lam_sym = SYMBOLS["lam"]
+    for ax, idx in zip(flat, panels, strict=False):
+        po, pf = o[idx], fl[idx]  # [n_lam, n_y, n_x]
         cat = categories(po)
         used[np.unique(cat)] = True
-        ax.pcolormesh(x, y, cat, cmap=cmap, norm=norm, shading="nearest", rasterized=True)
+        ax.pcolormesh(xs, ys, cat, cmap=cmap, norm=norm, shading="nearest", rasterized=True)
         m1_any = po == L.OUTCOME_MODE1
         # mode 1 at some lam, safe at a larger one: against the paper's trend
         later_safe = np.zeros(cat.shape, bool)
@@ -156,36 +298,30 @@ def stability_figure(result: SweepResult, path: str | Path) -> list[str]:
         if later_safe.any():
             any_back = True
             yy, xx = np.nonzero(later_safe)
-            ax.plot(x[xx], y[yy], ".", color="k", ms=2.5)
+            ax.plot(xs[xx], ys[yy], ".", color="k", ms=2.5)
         f_any = pf.any(axis=0)
         if f_any.any():
             any_flag = True
             yy, xx = np.nonzero(f_any)
-            ax.plot(x[xx], y[yy], "x", color="k", ms=3.5, mew=0.7)
-        done = (po != L.OUTCOME_NOT_RUN)
-        area = [f"${SYMBOLS['lam']}$ = {_fmt(lv)}: "
-                + (f"{100 * (po[k] == L.OUTCOME_MODE1).sum() / done[k].sum():.1f}%"
-                   if done[k].any() else "-")
-                for k, lv in enumerate(lam)]
+            ax.plot(xs[xx], ys[yy], "x", color="k", ms=3.5, mew=0.7)
+        done = po != L.OUTCOME_NOT_RUN
+
+        def share(k: int, po=po, done=done) -> str:
+            return (f"{100 * (po[k] == L.OUTCOME_MODE1).sum() / done[k].sum():.1f}%"
+                    if done[k].any() else "-")
+
+        area = ([f"${lam_sym}$ = {_fmt(lv)}: {share(k)}" for k, lv in enumerate(lam)]
+                if lam is not None else [f"all: {share(0)}"])
         ax.text(0.98, 0.02, "mode 1 area\n" + "\n".join(area), transform=ax.transAxes,
                 ha="right", va="bottom", fontsize=7,
                 bbox={"boxstyle": "round", "fc": "white", "ec": "0.6", "alpha": 0.85})
-        parts = []
-        for d, i in zip(panel_dims, idx, strict=True):
-            v = result.coords[d][i]
-            parts.append(f"{v} pulse" if d == "shape" else f"${SYMBOLS.get(d, d)}$ = {_fmt(v)}")
-        if "shape" not in panel_dims and "shape" in result.scalars:
-            parts.insert(0, f"{result.scalars['shape']} pulse")
-        ax.set_title(", ".join(parts), fontsize=10)
-        ax.set_xlabel(rf"${SYMBOLS['w_over_p']}$")
-        ax.set_ylabel(y_label(result.kind))
-    for ax in list(axes.flat)[len(panels):]:
-        ax.set_visible(False)
+        ax.set_title(_panel_title(result, panel_dims, idx), fontsize=10)
+        ax.set_xlabel(axis_label(x, result.kind))
+        ax.set_ylabel(axis_label(y, result.kind))
 
-    lam_sym = SYMBOLS["lam"]
     handles = []
     if used[1]:
-        handles.append(Patch(fc=_SAFE, ec="0.5", label="safe" + (" at every $\\lambda$"
+        handles.append(Patch(fc=_SAFE, ec="0.5", label="safe" + (f" at every ${lam_sym}$"
                                                                    if n_lam > 1 else "")))
     for k in range(n_lam):
         if n_lam == 1:
@@ -206,13 +342,117 @@ def stability_figure(result: SweepResult, path: str | Path) -> list[str]:
     if any_flag:
         handles.append(Line2D([], [], ls="", marker="x", color="k",
                               label="flagged (horizon/step/event cap, non-finite)"))
-    fig.legend(handles=handles, loc="outside lower center", fontsize=8, frameon=False,
-               ncol=max(1, min(len(handles), 2 * ncols)))
-    fig.suptitle(result.name, fontsize=11)
-    save_figure(fig, path)
-    warnings = []
+    if own:
+        ncols = _layout(result, panel_dims, len(panels))[1]
+        fig.legend(handles=handles, loc="outside lower center", fontsize=8, frameon=False,
+                   ncol=max(1, min(len(handles), 2 * ncols)))
+        fig.suptitle(_title(result, (x, y)), fontsize=11)
+    else:
+        flat[0].legend(handles=handles, fontsize=7, loc="upper left")
+    return fig
+
+
+_OUTCOME_STYLE = {  # outcome code -> (marker, face colour, legend label)
+    L.OUTCOME_SAFE: ("o", _SAFE, "safe"),
+    L.OUTCOME_MODE1: ("^", mode1_colours(1)[0], "mode 1 (overturned after impacts)"),
+    L.OUTCOME_MODE2: ("s", _MODE2, "mode 2 (overturned, no impact)"),
+    L.OUTCOME_NOT_RUN: ("o", _NOT_RUN, "not computed"),
+}
+
+
+def line_diagram(result: SweepResult, x: str | None = None, *,
+                 axes: Axes | Sequence[Axes] | None = None,
+                 option_names: tuple[str, str] = ("x", "y")) -> Figure:
+    """A 1-D sweep: max|theta|/alpha_ref against x, one line per lam (when lam is swept
+    and not x), markers by outcome (safe, mode 1, mode 2, not computed); one panel per
+    value of any other swept key. Without ``theta_max_over_alpha`` in the result's arrays
+    the outcome itself is drawn. axes: one Axes per panel (else a new figure).
+    """
+    if x is None:
+        x, _ = choose_axes(result, None, None, option_names)
+    else:
+        x = _check_key(result, x, option_names[0])
+    dims = list(result.dims)
+    series = "lam" in dims and x != "lam"
+    panel_dims = [d for d in dims if d != x and not (series and d == "lam")]
+    order = [*panel_dims, *(["lam"] if series else []), x]
+    has_theta = "theta_max_over_alpha" in result.arrays
+    names = ["outcome", "theta_max_over_alpha" if has_theta else "outcome"]
+    o, v = _arrays(result, order, names)
+    if not series:
+        o, v = o[..., None, :], v[..., None, :]
+        lam = [float(result.scalars["lam"])] if "lam" in result.scalars else [None]
+    else:
+        lam = list(_coord(result, "lam"))
+    panels = _panels(result, panel_dims)
+    xs = _coord(result, x)
+    fig, flat, own = _place_axes(axes, len(panels), _layout(result, panel_dims, len(panels)),
+                                 (5.6, 3.8), "this line plot")
+    import matplotlib
+
+    cmap = matplotlib.colormaps["viridis"]
+    alpha = ALPHA_REF.get(result.kind, ALPHA_REF["block"])
+    used: set[int] = set()
+    for ax, idx in zip(flat, panels, strict=False):
+        po, pv = o[idx], v[idx]  # [n_lam, n_x]
+        for k, lv in enumerate(lam):
+            colour = cmap(0.85 * k / max(1, len(lam) - 1)) if len(lam) > 1 else "0.3"
+            label = f"${SYMBOLS['lam']}$ = {_fmt(lv)}" if lv is not None else None
+            yv = pv[k].astype(float)
+            yv[po[k] == L.OUTCOME_NOT_RUN] = np.nan
+            ax.plot(xs, yv, "-", color=colour, lw=1.1, label=label, zorder=1)
+            for code, (marker, face, _) in _OUTCOME_STYLE.items():
+                sel = po[k] == code
+                if sel.any():
+                    used.add(code)
+                    ax.scatter(xs[sel], np.where(np.isfinite(yv[sel]), yv[sel], 0.0),
+                               marker=marker, s=22, c=[face], edgecolors=colour,
+                               linewidths=0.8, zorder=2)
+        ax.set_title(_panel_title(result, panel_dims, idx), fontsize=10)
+        ax.set_xlabel(axis_label(x, result.kind))
+        if has_theta:
+            ax.set_ylabel(rf"max$|\theta|/{alpha}$")
+        else:
+            ax.set_yticks([0, 1, 2], ["safe", "mode 1", "mode 2"])
+        ax.grid(alpha=0.3)
+    handles = [Line2D([], [], ls="", marker=m, mfc=f, mec="0.3", label=lab)
+               for code, (m, f, lab) in _OUTCOME_STYLE.items() if code in used]
+    handles += [h for h in flat[0].get_legend_handles_labels()[0]]
+    if own:
+        fig.legend(handles=handles, loc="outside lower center", fontsize=8, frameon=False,
+                   ncol=max(1, min(len(handles), 4)))
+        fig.suptitle(_title(result, (x,)), fontsize=11)
+    else:
+        flat[0].legend(handles=handles, fontsize=7)
+    return fig
+
+
+def sweep_figure(result: SweepResult, x: str | None = None, y: str | None = None, *,
+                 axes: Axes | Sequence[Axes] | None = None,
+                 option_names: tuple[str, str] = ("x", "y")) -> Figure:
+    """The figure ``rocksweep plot`` draws: a stability diagram over (x, y), or a line
+    plot when the result has one swept axis besides lam (see ``choose_axes``)."""
+    x, y = choose_axes(result, x, y, option_names)
+    if y is None:
+        return line_diagram(result, x, axes=axes, option_names=option_names)
+    return stability_diagram(result, x, y, axes=axes, option_names=option_names)
+
+
+def missing_warnings(result: SweepResult) -> list[str]:
+    """Warnings for the user about a result (e.g. points not computed yet)."""
+    outcome = result.arrays["outcome"]
     n_missing = int((outcome == L.OUTCOME_NOT_RUN).sum())
     if n_missing:
-        warnings.append(f"{n_missing} of {outcome.size} points not computed yet (grey); "
-                        "finish the sweep with --resume")
-    return warnings
+        return [f"{n_missing} of {outcome.size} points not computed yet (grey); "
+                "finish the sweep with --resume"]
+    return []
+
+
+def stability_figure(result: SweepResult, path: str | Path, *, x: str | None = None,
+                     y: str | None = None, dpi: int = DEFAULT_DPI,
+                     overwrite: bool = True) -> list[str]:
+    """``sweep_figure`` saved to ``path`` (.png, .pdf or .svg); returns the warnings of
+    ``missing_warnings``."""
+    save_figure(sweep_figure(result, x, y), path, dpi, overwrite=overwrite,
+                inputs=[result.path])
+    return missing_warnings(result)

@@ -1,26 +1,86 @@
-"""Figures (the only module that imports matplotlib): Figures 2 and 5 of the paper.
+"""Figures 2 and 5 of the paper, and the one way figures are saved.
 
-Stability diagrams (Figures 3 and 4) live in ``rocksweep.diagrams``.
+Every figure function builds and returns a ``matplotlib.figure.Figure`` (no pyplot, so no
+global figure registry and no backend switch: a notebook keeps its own backend and shows
+the returned figure); an optional ``axes`` argument draws into axes the caller made.
+Saving is separate: ``save_figure(fig, path)`` follows the output policy of
+``rocksweep.outputs`` (refuses an existing file without ``overwrite``, a device, a missing
+or read-only directory, an unknown suffix; writes under a temporary name, then renames).
+
+Stability diagrams (Figures 3 and 4) live in ``rocksweep.diagrams``, the work-precision
+diagram in ``rocksweep.accuracy_plot``.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from rocksweep.errors import RocksweepError
+from rocksweep.outputs import atomic_path, check_output
 
-from rocksweep.run import Run  # noqa: E402
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from rocksweep.run import Run
+
+FORMATS = (".png", ".pdf", ".svg")
+DEFAULT_DPI = 200
 
 
-def _label(run: Run, swept: list[str]) -> str:
+class FigureError(RocksweepError, ValueError):
+    """Something that cannot be drawn as asked; ``str()`` is one line."""
+
+
+def new_axes(nrows: int, ncols: int, figsize: tuple[float, float],
+             **subplots) -> tuple[Figure, np.ndarray]:
+    """A pyplot-free figure with constrained layout and its axes[nrows, ncols]."""
+    fig = Figure(figsize=figsize, layout="constrained")
+    axes = fig.subplots(nrows, ncols, squeeze=False, **subplots)
+    return fig, axes
+
+
+def given_axes(axes: Axes | Sequence[Axes], n: int, what: str) -> tuple[Figure, list[Axes]]:
+    """The caller's axes for a figure that needs ``n`` of them (one Axes if n == 1)."""
+    seq = [axes] if hasattr(axes, "plot") else list(np.ravel(np.asarray(axes, dtype=object)))
+    if len(seq) < n:
+        raise FigureError(f"axes: {what} needs {n} axes, {len(seq)} given")
+    return seq[0].figure, seq[:n]
+
+
+def save_figure(fig: Figure, path: str | Path, dpi: int = DEFAULT_DPI, *,
+                overwrite: bool = False, inputs: Iterable[str | Path] = ()) -> Path:
+    """Save ``fig`` to ``path`` (.png, .pdf or .svg) atomically: complete or absent.
+
+    Refuses (``OutputError``, one line) an existing file unless ``overwrite``, any of the
+    command's ``inputs``, a device, directory, missing or read-only directory, and other
+    suffixes. dpi: dots per inch of raster output (PNG; the raster parts of PDF/SVG).
+    """
+    path = check_output(path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=dpi, format=path.suffix[1:].lower())
+    return path
+
+
+# ---------------------------------------------------------------------------------------
+# Figure 5: time histories
+# ---------------------------------------------------------------------------------------
+
+def _alpha_symbol(run: Run) -> str:
+    """The slenderness that normalises theta and A: alpha_cg (flexible body), alpha (block)."""
+    return r"\alpha" if getattr(run.point.body, "kind", "flexible") == "block" else r"\alpha_{cg}"
+
+
+def _label(run: Run, swept: Sequence[str]) -> str:
     p = run.point
     values = {"lam": p.lam, "shape": p.shape, "w_over_p": p.w_over_p, "A_ratio": p.A_ratio}
     symbols = {"lam": r"$\lambda$", "w_over_p": r"$\omega/p$",
-               "A_ratio": r"$A/(g\tan\alpha_{cg})$", "shape": "pulse"}
+               "A_ratio": rf"$A/(g\tan{_alpha_symbol(run)})$", "shape": "pulse"}
     parts = []
     for k in swept:
         v = values.get(k, getattr(p.body, k, None))
@@ -29,48 +89,115 @@ def _label(run: Run, swept: list[str]) -> str:
     return f"{text} ({run.outcome})"
 
 
-def time_history_figure(runs: list[Run], swept: list[str], title: str, path: str | Path) -> None:
-    """Figure 5: theta/alpha_cg, E/E_ref and the energy dissipated against p*t, one line
-    per run. Runs are Runs with a history."""
-    fig, axes = plt.subplots(3, 1, figsize=(7.5, 8.5), sharex=True)
+def time_history(runs: Sequence[Run], swept: Sequence[str] = (), title: str = "",
+                 axes: Sequence[Axes] | None = None) -> Figure:
+    """Figure 5: against p*t, (a) the input pulse xg''/A (eq. 2, the history's ``xg``
+    column over the point's amplitude A), (b) theta/alpha_cg, (c) E/E_ref, (d) the energy
+    dissipated in impacts and the damper / E_ref; one colour per run.
+
+    runs: Runs with a history (``rocksweep.run.simulate(..., history=True)``); swept: the
+    scene's swept axis names, which label the runs; axes: 4 axes to draw into (else a new
+    figure). Returns the figure.
+    """
+    if axes is None:
+        fig, grid = new_axes(4, 1, (7.5, 10.0), sharex=True,
+                             gridspec_kw={"height_ratios": [1.0, 2.0, 1.4, 1.4]})
+        ax_in, ax_th, ax_e, ax_d = grid[:, 0]
+    else:
+        fig, (ax_in, ax_th, ax_e, ax_d) = given_axes(axes, 4, "a time history figure")
+    if not runs:
+        raise FigureError("time history: no runs to draw")
+    for run in runs:
+        if run.history is None:
+            raise FigureError("time history: a run without a history (simulate with "
+                              "history=True)")
+    alpha = _alpha_symbol(runs[0])
+    # one input line when every run has the same pulse shape and frequency (xg''/A is then
+    # the same curve), else one per run in the run's colour
+    pulses = {(r.point.shape, r.point.w_over_p) for r in runs}
     for run in runs:
         h = run.history
         body = run.point.body
-        label = _label(run, swept)
-        line, = axes[0].plot(h["t"], h["theta"] / body.alpha_ref, lw=1.2, label=label)
-        axes[1].plot(h["t"], h["E"] / body.E_ref, lw=1.2, color=line.get_color())
-        axes[2].plot(h["t"], (h["D_damp"] + h["E_impact"]) / body.E_ref, lw=1.2,
-                     color=line.get_color())
+        line, = ax_th.plot(h["t"], h["theta"] / body.alpha_ref, lw=1.2,
+                           label=_label(run, swept))
+        c = line.get_color()
+        ax_e.plot(h["t"], h["E"] / body.E_ref, lw=1.2, color=c)
+        ax_d.plot(h["t"], (h["D_damp"] + h["E_impact"]) / body.E_ref, lw=1.2, color=c)
         if run.t_overturn is not None:
-            axes[0].axvline(run.t_overturn, color=line.get_color(), ls=":", lw=0.8)
-    axes[0].axhline(1.0, color="0.6", lw=0.6, ls="--")
-    axes[0].axhline(-1.0, color="0.6", lw=0.6, ls="--")
-    axes[0].set_ylabel(r"$\theta/\alpha_{cg}$")
-    axes[0].set_ylim(-3, 3)
-    axes[0].legend(fontsize=8, loc="upper left")
-    axes[0].set_title(title, fontsize=10)
-    axes[1].set_ylabel(r"$E/E_{ref}$")
-    axes[2].set_ylabel(r"dissipated $(E_d + E_{damper})/E_{ref}$")
-    axes[2].set_xlabel(r"$pt$")
-    for ax in axes:
+            for ax in (ax_th, ax_e, ax_d):
+                ax.axvline(run.t_overturn, color=c, ls=":", lw=0.9)
+        if len(pulses) > 1 or run is runs[0]:
+            a = run.point.A
+            pc = c if len(pulses) > 1 else "k"
+            ax_in.plot(h["t"], h["xg"] / a if a else h["xg"], lw=1.1, color=pc,
+                       label=f"{run.point.shape}, $\\omega/p$ = {run.point.w_over_p:g}")
+    ax_in.axhline(0.0, color="0.6", lw=0.6)
+    ax_in.set_ylabel(r"$\ddot{x}_g/A$")
+    ax_in.set_ylim(-1.25, 1.25)
+    ax_in.legend(fontsize=8, loc="upper right", title="input pulse (eq. 2)",
+                 title_fontsize=8)
+    for v in (1.0, -1.0):
+        ax_th.axhline(v, color="0.45", lw=0.7, ls="--")
+    guides = [Line2D([], [], color="0.45", lw=0.7, ls="--",
+                     label=rf"$|\theta| = {alpha}$ (reference slenderness)")]
+    if any(r.t_overturn is not None for r in runs):
+        guides.append(Line2D([], [], color="0.3", lw=0.9, ls=":",
+                             label="overturning (run's colour)"))
+    handles = [*ax_th.get_legend_handles_labels()[0], *guides]
+    ax_th.legend(handles=handles, fontsize=8, loc="upper left")
+    ax_th.set_ylabel(rf"$\theta/{alpha}$")
+    ax_th.set_ylim(-3, 3)
+    ax_e.set_ylabel(r"$E/E_{ref}$")
+    ax_d.set_ylabel("dissipated\n" + r"$(E_d + E_{damper})/E_{ref}$")
+    ax_d.set_xlabel(r"$pt$")
+    for ax in (ax_in, ax_th, ax_e, ax_d):
         ax.grid(alpha=0.3)
-    fig.tight_layout()
-    save_figure(fig, path)
+    if title and axes is None:
+        fig.suptitle(title, fontsize=10)
+    return fig
 
 
-def restitution_figure(lam: np.ndarray, u_over_ucr: np.ndarray, e_upper: np.ndarray,
-                       e_housner: float, title: str, path: str | Path) -> None:
-    """Figure 2: (a) e against lam for several u/u_cr; (b) e against u/u_cr at lam = 0.
+def time_history_figure(runs: Sequence[Run], swept: Sequence[str], title: str,
+                        path: str | Path, *, dpi: int = DEFAULT_DPI,
+                        overwrite: bool = True) -> None:
+    """``time_history`` saved to ``path`` (the call of ``rocksweep simulate --plot``)."""
+    save_figure(time_history(runs, swept, title), path, dpi, overwrite=overwrite)
 
-    e_upper: float[len(lam), len(u_over_ucr)] under the paper's upper sign (the lower sign
-    is its mirror, e_lower(lam, u) = e_upper(lam, -u)).
+
+# ---------------------------------------------------------------------------------------
+# Figure 2: restitution
+# ---------------------------------------------------------------------------------------
+
+# u/u_cr -> colour: blues below 0, reds above, black at 0 (the rigid-like case must stand
+# out on white, so no light middle colour of a diverging map)
+_U_COLOURS = {-2.0: "#2166ac", -1.0: "#67a9cf", 0.0: "#000000", 1.0: "#ef8a62",
+              2.0: "#b2182b"}
+
+
+def restitution_map(lam: np.ndarray, u_over_ucr: np.ndarray, e_upper: np.ndarray,
+                    e_housner: float, title: str = "",
+                    axes: Sequence[Axes] | None = None) -> Figure:
+    """Figure 2: (a) e against lam for u/u_cr = -2, -1, 0, 1, 2; (b) e against u/u_cr at
+    lam = 0 with Housner's e of the same body welded rigid.
+
+    lam: float[n_lam]; u_over_ucr: float[n_u]; e_upper: float[n_lam, n_u], eq. (1) under
+    the paper's upper sign (the lower sign is its mirror, e_lower(lam, u) =
+    e_upper(lam, -u)); axes: 2 axes to draw into (else a new figure).
     """
-    fig, (ax_a, ax_b) = plt.subplots(1, 2, figsize=(11, 4.5))
-    picks = [v for v in (-2.0, -1.0, 0.0, 1.0, 2.0) if u_over_ucr.min() <= v <= u_over_ucr.max()]
-    cmap = plt.get_cmap("coolwarm")
-    for v in picks:
+    if axes is None:
+        fig, grid = new_axes(1, 2, (11, 4.6))
+        ax_a, ax_b = grid[0]
+    else:
+        fig, (ax_a, ax_b) = given_axes(axes, 2, "the restitution figure")
+    lam = np.asarray(lam, float)
+    u_over_ucr = np.asarray(u_over_ucr, float)
+    e_upper = np.asarray(e_upper, float)
+    for v, colour in _U_COLOURS.items():
+        if not u_over_ucr.min() <= v <= u_over_ucr.max():
+            continue
         j = int(np.argmin(abs(u_over_ucr - v)))
-        ax_a.plot(lam, e_upper[:, j], color=cmap((v + 2) / 4), label=f"$u/u_{{cr}}$ = {v:g}")
+        ax_a.plot(lam, e_upper[:, j], color=colour, lw=2.0 if v == 0 else 1.4,
+                  label=f"$u/u_{{cr}}$ = {v:g}")
     ax_a.axhline(1.0, color="0.5", lw=0.6, ls="--")
     ax_a.axhline(0.0, color="0.5", lw=0.6)
     ax_a.set_xlabel(r"$\lambda$")
@@ -78,28 +205,26 @@ def restitution_figure(lam: np.ndarray, u_over_ucr: np.ndarray, e_upper: np.ndar
     ax_a.set_title(r"(a) $e$ against $\lambda$ (upper sign of eq. 1)", fontsize=10)
     ax_a.legend(fontsize=8)
     i0 = int(np.argmin(abs(lam)))
-    ax_b.plot(u_over_ucr, e_upper[i0], label=r"eq. (1), $\lambda = 0$, upper sign")
-    ax_b.plot(u_over_ucr, e_upper[i0, ::-1], ls="--", label="lower sign (mirror)")
+    ax_b.plot(u_over_ucr, e_upper[i0], color="C0",
+              label=rf"eq. (1), $\lambda$ = {lam[i0]:g}, upper sign")
+    ax_b.plot(u_over_ucr, e_upper[i0, ::-1], color="C1", ls="--",
+              label="lower sign (mirror)")
     ax_b.axhline(e_housner, color="k", lw=0.8, ls=":",
                  label=f"Housner, rigid body: {e_housner:.3f}")
     ax_b.set_xlabel(r"$u/u_{cr}$")
     ax_b.set_ylabel("$e$")
-    ax_b.set_title(r"(b) $e$ against $u/u_{cr}$ at $\lambda = 0$", fontsize=10)
+    ax_b.set_title(rf"(b) $e$ against $u/u_{{cr}}$ at $\lambda$ = {lam[i0]:g}", fontsize=10)
     ax_b.legend(fontsize=8)
     for ax in (ax_a, ax_b):
         ax.grid(alpha=0.3)
-    fig.suptitle(title, fontsize=11)
-    fig.tight_layout()
-    save_figure(fig, path)
+    if title and axes is None:
+        fig.suptitle(title, fontsize=11)
+    return fig
 
 
-def save_figure(fig, path: str | Path) -> None:
-    """Save atomically: a figure is either complete or absent."""
-    path = Path(path)
-    tmp = path.with_name(f".{path.stem}.partial{path.suffix}")
-    try:
-        fig.savefig(tmp, dpi=130)
-        tmp.replace(path)
-    finally:
-        plt.close(fig)
-        tmp.unlink(missing_ok=True)
+def restitution_figure(lam: np.ndarray, u_over_ucr: np.ndarray, e_upper: np.ndarray,
+                       e_housner: float, title: str, path: str | Path, *,
+                       dpi: int = DEFAULT_DPI, overwrite: bool = True) -> None:
+    """``restitution_map`` saved to ``path`` (the call of ``rocksweep restitution --plot``)."""
+    save_figure(restitution_map(lam, u_over_ucr, e_upper, e_housner, title), path, dpi,
+                overwrite=overwrite)

@@ -1,4 +1,5 @@
-"""``rocksweep plot``: the stability diagram of a sweep result (Figures 3 and 4)."""
+"""``rocksweep plot``: the stability diagram of a sweep result (Figures 3 and 4), over any
+two swept axes, or a line plot of a 1-D sweep."""
 
 from __future__ import annotations
 
@@ -13,21 +14,33 @@ from rocksweep.cli.main import main, user_errors
 @click.argument("result_path", metavar="OUT.h5", type=click.Path(path_type=Path))
 @click.option("-o", "--output", "fig_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Figure file, .png, .pdf or .svg [default: OUT.png].")
+@click.option("--x", "x_key", metavar="KEY",
+              help="Swept axis along x, e.g. w_over_p or body.alpha_cg [default: w_over_p "
+                   "when swept].")
+@click.option("--y", "y_key", metavar="KEY",
+              help="Swept axis along y [default: A_ratio when swept].")
+@click.option("--dpi", type=click.IntRange(20, 2400), default=200, show_default=True,
+              help="Resolution of raster output (PNG).")
+@click.option("--overwrite", is_flag=True, help="Replace an existing figure file.")
 @user_errors
-def plot(result_path: Path, fig_path: Path | None) -> None:
-    """Draw the stability diagram of a sweep: x = omega/p, y = A/(g tan alpha_cg), mode 1 /
-    mode 2 / safe regions, one panel per pulse shape (and per other swept body key), the
-    growth of the mode 1 area with lam in shades of red."""
-    from rocksweep.diagrams import FORMATS, stability_figure
+def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str | None,
+         dpi: int, overwrite: bool) -> None:
+    """Draw the stability diagram of a sweep: by default x = omega/p, y = A/(g tan
+    alpha_cg); --x/--y pick any two swept axes. Mode 1 / mode 2 / safe regions, one panel
+    per pulse shape and per other swept key, the growth of the mode 1 area with lam in
+    shades of red. A sweep with one swept axis besides lam is drawn as max|theta|/alpha
+    against it, markers by outcome."""
+    from rocksweep.diagrams import missing_warnings, sweep_figure
+    from rocksweep.outputs import check_output
+    from rocksweep.plots import FORMATS, save_figure
     from rocksweep.store import read_result
 
-    fig = fig_path if fig_path is not None else result_path.with_suffix(".png")
-    if fig.suffix.lower() not in FORMATS:
-        raise click.ClickException(f"{fig}: unknown figure format {fig.suffix or '(none)'!r}; "
-                                   f"use {', '.join(FORMATS)}")
-    if not fig.parent.is_dir():
-        raise click.ClickException(f"{fig}: directory {fig.parent} does not exist")
-    result = read_result(result_path, ["outcome", "status"])
-    for w in stability_figure(result, fig):
+    fig_out = fig_path if fig_path is not None else result_path.with_suffix(".png")
+    # refuse a bad output before reading the result and drawing
+    check_output(fig_out, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
+    result = read_result(result_path, ["outcome", "status", "theta_max_over_alpha"])
+    fig = sweep_figure(result, x_key, y_key, option_names=("--x", "--y"))
+    save_figure(fig, fig_out, dpi, overwrite=overwrite, inputs=[result_path])
+    for w in missing_warnings(result):
         click.echo(f"warning: {w}", err=True)
-    click.echo(f"wrote {fig}")
+    click.echo(f"wrote {fig_out}")
