@@ -387,7 +387,7 @@ def line_diagram(result: SweepResult, x: str | None = None, *,
     panels = _panels(result, panel_dims)
     xs = _coord(result, x)
     fig, flat, own = _place_axes(axes, len(panels), _layout(result, panel_dims, len(panels)),
-                                 (5.6, 3.8), "this line plot")
+                                 (6.4, 4.0), "this line plot")
     import matplotlib
 
     cmap = matplotlib.colormaps["viridis"]
@@ -419,8 +419,9 @@ def line_diagram(result: SweepResult, x: str | None = None, *,
                for code, (m, f, lab) in _OUTCOME_STYLE.items() if code in used]
     handles += [h for h in flat[0].get_legend_handles_labels()[0]]
     if own:
+        ncols = _layout(result, panel_dims, len(panels))[1]
         fig.legend(handles=handles, loc="outside lower center", fontsize=8, frameon=False,
-                   ncol=max(1, min(len(handles), 4)))
+                   ncol=max(1, min(len(handles), 2 * ncols)))
         fig.suptitle(_title(result, (x,)), fontsize=11)
     else:
         flat[0].legend(handles=handles, fontsize=7)

@@ -115,6 +115,7 @@ def time_history(runs: Sequence[Run], swept: Sequence[str] = (), title: str = ""
     # one input line when every run has the same pulse shape and frequency (xg''/A is then
     # the same curve), else one per run in the run's colour
     pulses = {(r.point.shape, r.point.w_over_p) for r in runs}
+    longest = max(runs, key=lambda r: r.history["t"][-1] if len(r.history["t"]) else 0.0)
     for run in runs:
         h = run.history
         body = run.point.body
@@ -126,7 +127,7 @@ def time_history(runs: Sequence[Run], swept: Sequence[str] = (), title: str = ""
         if run.t_overturn is not None:
             for ax in (ax_th, ax_e, ax_d):
                 ax.axvline(run.t_overturn, color=c, ls=":", lw=0.9)
-        if len(pulses) > 1 or run is runs[0]:
+        if len(pulses) > 1 or run is longest:
             a = run.point.A
             pc = c if len(pulses) > 1 else "k"
             ax_in.plot(h["t"], h["xg"] / a if a else h["xg"], lw=1.1, color=pc,
@@ -139,7 +140,8 @@ def time_history(runs: Sequence[Run], swept: Sequence[str] = (), title: str = ""
     for v in (1.0, -1.0):
         ax_th.axhline(v, color="0.45", lw=0.7, ls="--")
     guides = [Line2D([], [], color="0.45", lw=0.7, ls="--",
-                     label=rf"$|\theta| = {alpha}$ (reference slenderness)")]
+                     label=rf"$|\theta| = {alpha}$: centre of gravity over the corner"
+                     + (r" at $u = 0$" if alpha == r"\alpha_{cg}" else ""))]
     if any(r.t_overturn is not None for r in runs):
         guides.append(Line2D([], [], color="0.3", lw=0.9, ls=":",
                              label="overturning (run's colour)"))
