@@ -84,8 +84,7 @@ def work_precision(study: Study, axes: Sequence[Axes] | None = None) -> Figure:
     for ax in (ax_a, ax_b):
         ax.axvline(ref_us, color="0.4", ls=":", lw=1)
         ax.set_xscale("log")
-        ax.set_xlabel("kernel time per point [us] (one-point calls, one core; "
-                      "weighted mean = scene estimate)")
+        ax.set_xlabel("kernel time per point [us] (one core; weighted mean: scene estimate)")
         ax.grid(alpha=0.3, which="both")
     ax_a.text(ref_us, 0.98, f" reference\n (DOP853)\n {ref_us / 1e3:.0f} ms",
               transform=ax_a.get_xaxis_transform(), va="top", fontsize=8, color="0.3")
@@ -104,13 +103,14 @@ def work_precision(study: Study, axes: Sequence[Axes] | None = None) -> Figure:
         if not idx:
             continue
         style = styles.get(group, "*")
+        label = group if group != "preset" else "presets (RK4 evaluations per point: " + \
+            ", ".join(f"{names[i]} {evals[i]:.0f}" for i in idx) + ")"
         ax_b.errorbar(x[idx], agree[idx], yerr=se[idx], fmt=style,
-                      ms=11 if group == "preset" else 4, capsize=2, lw=1.2, label=group,
+                      ms=11 if group == "preset" else 4, capsize=2, lw=1.2, label=label,
                       mec="k" if group == "preset" else None)
         for j, i in enumerate(idx):
             txt = (f"{table[i]['steps_per_period']}" if group.startswith("steps") else
-                   f"{table[i]['event_tol']:.0e}" if group.startswith("tol") else
-                   f"{names[i]} ({evals[i]:.0f} RK4/pt)")
+                   f"{table[i]['event_tol']:.0e}" if group.startswith("tol") else names[i])
             ax_b.annotate(txt, (x[i], agree[i]), textcoords="offset points",
                           xytext=(3, 5 if j % 2 == 0 else -11), fontsize=7, color="0.3")
     ax_b.axhline(AGREEMENT_TARGET, color="C3", ls="--", lw=1,
@@ -122,7 +122,7 @@ def work_precision(study: Study, axes: Sequence[Axes] | None = None) -> Figure:
     ax_b.set_ylabel("outcome agreement with the reference [%] (+- standard error)")
     ax_b.set_title("(b) outcome (safe / mode 1 / mode 2) agreement vs cost "
                    "(weighted: scene estimate)", fontsize=9)
-    ax_b.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=3,
+    ax_b.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
                 frameon=False)
 
     if axes is None:

@@ -1,0 +1,101 @@
+"""Regenerate every figure in docs/ from the current code, by one command.
+
+    python scripts/make_docs_figures.py              # ~1 min on 2 cores
+    python scripts/make_docs_figures.py --accuracy   # also docs/accuracy_fig3a.png (+~1 min)
+
+Runs the shipped commands, exactly as the README shows them:
+
+- ``rocksweep sweep configs/NAME.yaml --jobs 2`` and ``rocksweep plot`` for the stability
+  diagrams fig3a, fig3b, fig4a, fig4b and block, at the configs' own resolution;
+- ``rocksweep simulate configs/fig5.yaml --plot`` (Figure 5) and ``rocksweep restitution
+  configs/fig2.yaml --plot`` (Figure 2);
+- with ``--accuracy``: ``rocksweep accuracy configs/fig3a.yaml --points 200 --plot``.
+
+Everything is written to a temporary directory first and moved into docs/ when the
+command succeeded, so a failure leaves the old figure in place. Sweep results are
+deleted unless ``--keep DIR`` is given.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+DIAGRAMS = ("fig3a", "fig3b", "fig4a", "fig4b", "block")
+
+
+def rocksweep(*args: str) -> None:
+    """Run ``rocksweep ARGS`` (this interpreter's package); stop on failure."""
+    cmd = [sys.executable, "-m", "rocksweep", *args]
+    print("$ rocksweep " + " ".join(args), flush=True)
+    proc = subprocess.run(cmd, cwd=ROOT)
+    if proc.returncode != 0:
+        sys.exit(f"failed ({proc.returncode}): {' '.join(cmd)}")
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--accuracy", action="store_true",
+                    help="also the work-precision diagram (rocksweep accuracy, ~1 min)")
+    ap.add_argument("--jobs", type=int, default=2, help="sweep worker threads [2]")
+    ap.add_argument("--dpi", type=int, default=200, help="resolution of the PNGs [200]")
+    ap.add_argument("--only", nargs="+", metavar="NAME",
+                    choices=[*DIAGRAMS, "fig5", "fig2", "accuracy_fig3a"],
+                    help="regenerate only these figures")
+    ap.add_argument("--docs", type=Path, default=ROOT / "docs", help="output directory")
+    ap.add_argument("--keep", type=Path, metavar="DIR", help="keep the sweep results here")
+    args = ap.parse_args(argv)
+    wanted = set(args.only or [*DIAGRAMS, "fig5", "fig2"]
+                 + (["accuracy_fig3a"] if args.accuracy else []))
+    args.docs.mkdir(parents=True, exist_ok=True)
+    if args.keep:
+        args.keep.mkdir(parents=True, exist_ok=True)
+    cfg = ROOT / "configs"
+    made, t_all = [], time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="rocksweep-docs-") as tmp_dir:
+        tmp = Path(tmp_dir)
+
+        def publish(name: str) -> None:
+            """Copy tmp/NAME.png into docs/ atomically (a partial file, then a rename)."""
+            dest = args.docs / f"{name}.png"
+            part = dest.with_name(f".{name}.png.partial")
+            shutil.copyfile(tmp / f"{name}.png", part)
+            os.replace(part, dest)
+            made.append(dest)
+
+        for name in DIAGRAMS:
+            if name not in wanted:
+                continue
+            t0 = time.perf_counter()
+            h5 = (args.keep or tmp) / f"{name}.h5"
+            rocksweep("sweep", str(cfg / f"{name}.yaml"), "-o", str(h5), "--jobs",
+                      str(args.jobs), "--quiet", "--overwrite")
+            rocksweep("plot", str(h5), "-o", str(tmp / f"{name}.png"), "--dpi", str(args.dpi))
+            publish(name)
+            print(f"  {name}: {time.perf_counter() - t0:.1f} s", flush=True)
+        if "fig5" in wanted:
+            rocksweep("simulate", str(cfg / "fig5.yaml"), "--plot", str(tmp / "fig5.png"))
+            publish("fig5")
+        if "fig2" in wanted:
+            rocksweep("restitution", str(cfg / "fig2.yaml"), "--plot", str(tmp / "fig2.png"))
+            publish("fig2")
+        if "accuracy_fig3a" in wanted:
+            t0 = time.perf_counter()
+            rocksweep("accuracy", str(cfg / "fig3a.yaml"), "--points", "200", "--quiet",
+                      "--plot", str(tmp / "accuracy_fig3a.png"))
+            publish("accuracy_fig3a")
+            print(f"  accuracy_fig3a: {time.perf_counter() - t0:.1f} s", flush=True)
+    print(f"wrote {len(made)} figures in {time.perf_counter() - t_all:.1f} s:")
+    for p in made:
+        print(f"  {p.relative_to(ROOT) if p.is_relative_to(ROOT) else p}")
+
+
+if __name__ == "__main__":
+    main()
