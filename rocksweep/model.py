@@ -53,6 +53,7 @@ from functools import cached_property
 import numpy as np
 
 from rocksweep.errors import RocksweepError
+from rocksweep.schema import BODY_KEYS, check_value, fmt, is_number
 
 G = 9.81  # m/s^2
 M_TOP = 1.0  # kg, the top mass m (a repeating quantity)
@@ -61,6 +62,18 @@ P = 1.0  # rad/s, the rocking frequency p (a repeating quantity)
 
 class BodyError(RocksweepError, ValueError):
     """A body that is not physical; the message names the offending key and value."""
+
+
+def _check_keys(body: object, keys: tuple[str, ...]) -> None:
+    """Each Pi group against the scene's table (``rocksweep.schema.KEYS``): the same
+    message as in a scene file, ``body.KEY = VALUE: allowed``."""
+    for key in keys:
+        value = getattr(body, key)
+        if not is_number(value):
+            raise BodyError(f"body.{key} = {fmt(value)}: must be a number")
+        msg = check_value(f"body.{key}", value)
+        if msg is not None:
+            raise BodyError(msg)
 
 
 @dataclass(frozen=True)
@@ -80,29 +93,13 @@ class FlexibleBody:
     kind = "flexible"
 
     def __post_init__(self) -> None:
-        def bad(key: str, value: float, allowed: str) -> BodyError:
-            return BodyError(f"body.{key} = {value!r}: {allowed}")
-
-        for key in ("zeta", "alpha_cg", "alpha_A", "mA_over_m", "IA_ratio"):
-            if not math.isfinite(getattr(self, key)):
-                raise bad(key, getattr(self, key), "must be a finite number")
-        if not (self.wn_over_p > 0):  # also rejects NaN
-            raise bad("wn_over_p", self.wn_over_p, "must be > 0 (.inf for a rigid body)")
-        if self.zeta < 0:
-            raise bad("zeta", self.zeta, "must be >= 0")
-        for key in ("alpha_cg", "alpha_A"):
-            if not (0 < getattr(self, key) < math.pi / 2):
-                raise bad(key, getattr(self, key), "must be in (0, pi/2) rad")
-        if not (self.mA_over_m > 0):
-            raise bad("mA_over_m", self.mA_over_m, "must be > 0")
-        if self.IA_ratio < 0:
-            raise bad("IA_ratio", self.IA_ratio, "must be >= 0")
+        _check_keys(self, BODY_KEYS["flexible"])
         if self.h_over_b <= 0:
             raise BodyError(
                 f"body: alpha_cg = {self.alpha_cg!r}, alpha_A = {self.alpha_A!r}, "
                 f"mA_over_m = {self.mA_over_m!r} put the top mass at h/b = {self.h_over_b:.4g} "
-                "(must be > 0: the top mass cannot sit below the base); raise alpha_cg, "
-                "lower alpha_A or mA_over_m"
+                "(must be > 0: the top mass cannot sit below the base); lower alpha_cg, "
+                "raise alpha_A or lower mA_over_m"
             )
 
     # -- geometry in units of b --------------------------------------------------------
@@ -238,12 +235,7 @@ class BlockBody:
     u_cr = 0.0
 
     def __post_init__(self) -> None:
-        if not (0 < self.alpha < math.pi / 2):
-            raise BodyError(f"body.alpha = {self.alpha!r}: must be in (0, pi/2) rad")
-        # A body's inertia about a corner is at least M R^2 (all mass at distance R from O
-        # would give exactly that only if concentrated at the centre of gravity).
-        if not (math.isfinite(self.inertia) and self.inertia >= 1.0):
-            raise BodyError(f"body.inertia = {self.inertia!r}: must be >= 1 (I_O >= M R^2)")
+        _check_keys(self, BODY_KEYS["block"])
 
     @property
     def R(self) -> float:

@@ -34,6 +34,25 @@ PRESETS: dict[str, tuple[int, float]] = {
     "fine": (20, 1e-8),
 }
 
+# Smallest event_tol [p*t] a scene may ask for. An event's time is t0 + tau in float64; at
+# t ~ 1e2 (a run lasts the pulse plus the 200-long horizon) its spacing is 1.4e-14, and
+# 2.8e-14 to 5.7e-14 up to t = 512: below ~1e-12 the tolerance asks for digits t does not
+# have. (The root finders bracket tau inside one step, <= pi/2 long, spacing 2.2e-16, so
+# they end for any tolerance above ~1e-15; 1e-12 leaves a margin of ~4000 spacings.)
+MIN_EVENT_TOL = 1e-12
+
+# RK4 evaluations the kernel may spend locating one event before a run is capped
+# (``step_budget``): bisection takes log2(step/event_tol) ~ 20-40, Hermite 2-4.
+EVENT_STEP_ALLOWANCE = 200.0
+
+# Cap on one point's step budget (``step_budget``, PAR_MAXSTEPS) that a scene may imply.
+# At the kernel's measured ~160-180 ns per RK4 evaluation (README, bench [2]) a point that
+# runs to 1e8 takes ~17 s of one core: the longest a single point may take before the
+# values are taken for a mistake (w_over_p = 1e-9, a pulse of 6e9 p*t; wn_over_p = 1e5 at
+# steps of 1e-5). The shipped scenes need at most 1.5e6 (fig4b at `fine`), of which the
+# default allowance for 5000 events is 1e6.
+MAX_POINT_STEPS = 1e8
+
 
 @dataclass(frozen=True)
 class Numerics:
@@ -91,6 +110,17 @@ def step_size(omega_rock: np.ndarray | float, omega: np.ndarray | float,
                                         two_pi / np.asarray(omega, float)), two_pi)
         periods = np.minimum(periods, two_pi / np.asarray(omega_amp, float))
     return periods / steps_per_period
+
+
+def step_budget(t_end: np.ndarray | float, dt: np.ndarray | float,
+                numerics: Numerics) -> np.ndarray:
+    """Cap on the RK4 evaluations of one run (the kernel's PAR_MAXSTEPS).
+
+    max_steps_factor x the regular steps of a run to t_end [p*t] at step dt [p*t], plus
+    EVENT_STEP_ALLOWANCE re-integrations for each of max_events events.
+    """
+    return numerics.max_steps_factor * np.ceil(np.asarray(t_end) / dt) + EVENT_STEP_ALLOWANCE * (
+        numerics.max_events)
 
 
 def amplitude_frequency(A_ratio: np.ndarray | float, alpha_ref: np.ndarray | float

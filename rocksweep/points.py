@@ -12,7 +12,7 @@ import numpy as np
 
 from rocksweep.kernel import layout as L
 from rocksweep.model import Body, FlexibleBody, G
-from rocksweep.numerics import ROOTS, Numerics, amplitude_frequency, step_size
+from rocksweep.numerics import ROOTS, Numerics, amplitude_frequency, step_budget, step_size
 
 SHAPES = ("sine", "cosine")
 _SHAPE_CODE = {"sine": L.SHAPE_SINE, "cosine": L.SHAPE_COSINE}
@@ -95,6 +95,24 @@ def body_omega_rock(body: Body) -> float:
     return max(omega, body.omega_rock)
 
 
+def run_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, w_over_p: np.ndarray,
+             A_ratio: np.ndarray, numerics: Numerics) -> tuple[np.ndarray, ...]:
+    """A run's step, length and step cap, vectorised over points (all float64[n], p = 1).
+
+    Returns dt [p*t] (``step_size``), t_pulse = 2 pi/omega, t_end = t_pulse + horizon
+    [p*t] and the cap on RK4 evaluations (``step_budget``): the kernel's PAR_DT,
+    PAR_TPULSE, PAR_TEND and PAR_MAXSTEPS. The scene bounds the last (MAX_POINT_STEPS).
+    """
+    omega = np.asarray(w_over_p, float)  # p = 1 rad/s
+    with np.errstate(divide="ignore", over="ignore"):
+        dt = step_size(omega_rock, omega, numerics.steps_per_period,
+                       amplitude_frequency(A_ratio, alpha_ref))
+        t_pulse = 2 * np.pi / omega
+        t_end = t_pulse + numerics.horizon
+        max_steps = step_budget(t_end, dt, numerics)
+    return dt, t_pulse, t_end, max_steps
+
+
 def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
               alpha_ref: np.ndarray, lam: np.ndarray, shape_code: np.ndarray,
               w_over_p: np.ndarray, A_ratio: np.ndarray, numerics: Numerics) -> None:
@@ -105,10 +123,7 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     """
     rows[:] = body_rows
     omega = np.asarray(w_over_p, float)  # p = 1 rad/s
-    with np.errstate(divide="ignore"):
-        dt = step_size(omega_rock, omega, numerics.steps_per_period,
-                       amplitude_frequency(A_ratio, alpha_ref))
-    t_pulse = 2 * np.pi / omega
+    dt, t_pulse, t_end, max_steps = run_cost(omega_rock, alpha_ref, omega, A_ratio, numerics)
     rows[:, L.PAR_AMP] = A_ratio * G * np.tan(alpha_ref)
     rows[:, L.PAR_OMEGA] = omega
     rows[:, L.PAR_SHAPE] = shape_code
@@ -116,10 +131,8 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     rows[:, L.PAR_LAM] = lam
     rows[:, L.PAR_DT] = dt
     rows[:, L.PAR_TOL] = numerics.event_tol
-    t_end = t_pulse + numerics.horizon
     rows[:, L.PAR_TEND] = t_end
-    rows[:, L.PAR_MAXSTEPS] = numerics.max_steps_factor * np.ceil(t_end / dt) + 200.0 * (
-        numerics.max_events)
+    rows[:, L.PAR_MAXSTEPS] = max_steps
     rows[:, L.PAR_MAXEVENTS] = numerics.max_events
     rows[:, L.PAR_RESTRATE] = numerics.rest_rate * alpha_ref  # p = 1
     rows[:, L.PAR_ROOT] = _ROOT_CODE[numerics.root]

@@ -3,130 +3,149 @@
 Any Pi-group value may be a scalar, a list, or a range ``{start, stop, num}`` (inclusive,
 like ``numpy.linspace``); ``pulse.shape`` may be a list. Lists and ranges are swept axes.
 Every problem is a ``SceneError`` with one line naming the key, the value and what is
-allowed.
+allowed; the keys, their types, ranges and messages are one table, ``rocksweep.schema``.
+
+Every valid scene runs in bounded time and space:
+
+- YAML: numbers follow YAML 1.2 (``1e-6`` is a number), a key given twice in a mapping is
+  refused, nesting is limited to MAX_DEPTH levels;
+- at most MAX_AXIS_VALUES values per axis and MAX_POINTS points per grid;
+- every point's cap on RK4 evaluations (the kernel's PAR_MAXSTEPS, ``points.run_cost``)
+  is at most ``numerics.MAX_POINT_STEPS``, at the sweep's and at the single runs' accuracy.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+import re
+from dataclasses import dataclass, field, replace
 from itertools import product
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 import yaml
-from pydantic import BaseModel, ConfigDict, ValidationError
 
 from rocksweep.errors import RocksweepError
 from rocksweep.model import BlockBody, Body, BodyError, FlexibleBody
-from rocksweep.numerics import PRESETS, ROOTS, Numerics
-from rocksweep.points import Point
+from rocksweep.numerics import (
+    EVENT_STEP_ALLOWANCE,
+    MAX_POINT_STEPS,
+    PRESETS,
+    Numerics,
+)
+from rocksweep.points import Point, body_omega_rock, run_cost
+from rocksweep.schema import (
+    BODY_KEYS,
+    KEYS,
+    SECTIONS,
+    check_values,
+    fmt,
+    is_number,
+    section_keys,
+)
 
 
 class SceneError(RocksweepError, ValueError):
     """A scene that cannot be run; ``str()`` is one line for the user."""
 
 
-# ---------------------------------------------------------------------------------------
-# Schema (structure and types; pydantic). Values are checked per key below.
-# ---------------------------------------------------------------------------------------
-
-_STRICT = ConfigDict(extra="forbid", strict=True)
-
-
-class RangeSpec(BaseModel):
-    model_config = _STRICT
-    start: float | int
-    stop: float | int
-    num: int
-
-
-AxisSpec = float | int | list[float | int] | RangeSpec
-
-
-class FlexibleSpec(BaseModel):
-    model_config = _STRICT
-    kind: Literal["flexible"] = "flexible"
-    wn_over_p: AxisSpec
-    zeta: AxisSpec
-    alpha_cg: AxisSpec
-    alpha_A: AxisSpec
-    mA_over_m: AxisSpec
-    IA_ratio: AxisSpec
-
-
-class BlockSpec(BaseModel):
-    model_config = _STRICT
-    kind: Literal["block"]
-    alpha: AxisSpec
-    inertia: AxisSpec = 4.0 / 3.0
-
-
-class ImpactSpec(BaseModel):
-    model_config = _STRICT
-    lam: AxisSpec
-
-
-class PulseSpec(BaseModel):
-    model_config = _STRICT
-    shape: Literal["sine", "cosine"] | list[Literal["sine", "cosine"]]
-    w_over_p: AxisSpec
-    A_ratio: AxisSpec
-
-
-class NumericsSpec(BaseModel):
-    model_config = _STRICT
-    accuracy: Literal["draft", "default", "fine"] | None = None
-    steps_per_period: int | None = None
-    event_tol: float | None = None
-    horizon: float | int | None = None
-    rest_rate: float | None = None
-    max_events: int | None = None
-    root: Literal[ROOTS] | None = None  # type: ignore[valid-type]
-
-
-class OutputsSpec(BaseModel):
-    model_config = _STRICT
-    energy: bool = False  # sweeps: store energy metrics (runs the energy-accounting kernel)
-
-
-class SceneSpec(BaseModel):
-    model_config = _STRICT
-    name: str | None = None
-    body: FlexibleSpec | BlockSpec
-    impact: ImpactSpec | None = None
-    pulse: PulseSpec
-    numerics: NumericsSpec = NumericsSpec()
-    outputs: OutputsSpec = OutputsSpec()
-
-
-# ---------------------------------------------------------------------------------------
-# Per-key admissible values: (low, high, low inclusive, high inclusive, inf allowed, text)
-# ---------------------------------------------------------------------------------------
-
-_HALF_PI = math.pi / 2
-_LIMITS: dict[str, tuple[float, float, bool, bool, bool, str]] = {
-    "body.wn_over_p": (0, math.inf, False, True, True, "must be > 0 (.inf for a rigid body)"),
-    "body.zeta": (0, math.inf, True, False, False, "must be >= 0"),
-    "body.alpha_cg": (0, _HALF_PI, False, False, False, "must be in (0, pi/2) rad"),
-    "body.alpha_A": (0, _HALF_PI, False, False, False, "must be in (0, pi/2) rad"),
-    "body.mA_over_m": (0, math.inf, False, False, False, "must be > 0"),
-    "body.IA_ratio": (0, math.inf, True, False, False, "must be >= 0"),
-    "body.alpha": (0, _HALF_PI, False, False, False, "must be in (0, pi/2) rad"),
-    "body.inertia": (1, math.inf, True, False, False, "must be >= 1 (I_O >= M R^2)"),
-    "impact.lam": (0, 2, True, True, False, "must be in [0, 2]"),
-    "pulse.w_over_p": (0, math.inf, False, False, False,
-                       "must be > 0 and finite (the pulse lasts 2 pi/omega)"),
-    "pulse.A_ratio": (-math.inf, math.inf, False, False, False,
-                      "must be a finite number (negative: a pulse in the other direction)"),
-}
-
-BODY_KEYS = {"flexible": ("wn_over_p", "zeta", "alpha_cg", "alpha_A", "mA_over_m", "IA_ratio"),
-             "block": ("alpha", "inertia")}
-# Order of the grid's dimensions: shape, body keys, lam, A_ratio, w_over_p (x last).
+# Largest grid a scene may describe [points]. A sweep file stores ~34 bytes a point (58
+# with energy metrics, rocksweep.sweep.VARIABLES): 2e8 points are a 7-12 GB file, one
+# float64 variable read back for a figure or xarray is 1.6 GB of memory, and at the
+# kernel's 27-54 us a point (README, bench) the sweep takes 1.5-3 hours of one core.
+MAX_POINTS = 200_000_000
+# Values per axis: an axis is kept as a tuple of Python floats (~32 bytes a value; 1e6
+# values are 32 MB and 0.1 s to build); a figure's axis needs a few thousand at most.
+MAX_AXIS_VALUES = 1_000_000
+# Nesting of the scene's YAML (a scene needs 3 levels: section, key, range or list).
+# PyYAML composes nodes recursively; 3000 levels would end in a RecursionError.
+MAX_DEPTH = 20
+# Body grids up to this many distinct bodies are checked body by body; larger ones at the
+# combinations of each key's extreme values (``_candidate_bodies``).
+MAX_BODIES_CHECKED = 4096
 PULSE_AXES = ("A_ratio", "w_over_p")
+# Typical values (Table 3; the `default` numerics) that the cost check puts in place of a
+# value, one at a time, to find which value makes a point too costly.
+_TAME = {"body.wn_over_p": 2.43, "body.zeta": 0.05, "body.alpha_cg": 0.15,
+         "body.alpha_A": 0.28, "body.mA_over_m": 0.47, "body.IA_ratio": 0.56,
+         "body.alpha": 0.2618, "body.inertia": 4.0 / 3.0,
+         "pulse.w_over_p": 1.0, "pulse.A_ratio": 1.0,
+         "numerics.steps_per_period": PRESETS["default"][0], "numerics.horizon": 200.0,
+         "numerics.max_events": Numerics().max_events}
 
+
+# ---------------------------------------------------------------------------------------
+# YAML
+# ---------------------------------------------------------------------------------------
+
+class _YamlError(Exception):
+    """A YAML text the scene refuses; ``str()`` says where (1-based line) and why."""
+
+
+class SceneLoader(yaml.SafeLoader):
+    """PyYAML's safe loader with YAML 1.2 numbers, no duplicate keys and a depth limit.
+
+    PyYAML follows YAML 1.1, where a float needs a dot and a signed exponent: ``1e-6`` and
+    ``1E+3`` would be strings. The resolver added below reads them as numbers (YAML 1.2's
+    core schema).
+    """
+
+    def __init__(self, stream: str) -> None:
+        super().__init__(stream)
+        self._depth = 0
+
+    def compose_node(self, parent: Any, index: Any) -> Any:
+        self._depth += 1
+        try:
+            if self._depth > MAX_DEPTH:
+                mark = self.peek_event().start_mark
+                raise _YamlError(f"error at line {mark.line + 1}: nested more than "
+                                 f"{MAX_DEPTH} levels deep")
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict:
+        seen: set = set()
+        for key_node, _ in node.value:
+            if key_node.tag == "tag:yaml.org,2002:merge":
+                continue
+            key = self.construct_object(key_node, deep=True)
+            try:
+                dup = key in seen
+                seen.add(key)
+            except TypeError:  # an unhashable key: PyYAML reports it below
+                continue
+            if dup:
+                raise _YamlError(f"error at line {key_node.start_mark.line + 1}: key "
+                                 f"{fmt(key)} given twice in one mapping")
+        return super().construct_mapping(node, deep=deep)
+
+
+SceneLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
+    list("-+0123456789."))
+
+
+def _load_yaml(text: str) -> Any:
+    """Parse YAML text with ``SceneLoader``; problems raise ``_YamlError``."""
+    loader = SceneLoader(text)
+    try:
+        return loader.get_single_data()
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        problem = getattr(err, "problem", None) or "invalid YAML"
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        raise _YamlError(f"syntax error{where}: {problem}") from None
+    finally:
+        loader.dispose()
+
+
+# ---------------------------------------------------------------------------------------
+# Scene
+# ---------------------------------------------------------------------------------------
 
 @dataclass(frozen=True)
 class Axis:
@@ -136,39 +155,6 @@ class Axis:
     key: str  # dotted scene key, e.g. "pulse.A_ratio"
     values: tuple
     swept: bool
-
-
-def _fmt(v: Any) -> str:
-    if isinstance(v, float):
-        return repr(v) if math.isfinite(v) else str(v)
-    return repr(v)
-
-
-def _axis_values(key: str, spec: Any) -> tuple[tuple, bool]:
-    if isinstance(spec, RangeSpec):
-        if spec.num < 1:
-            raise SceneError(f"{key}.num = {spec.num}: must be an integer >= 1")
-        for part in ("start", "stop"):
-            v = float(getattr(spec, part))
-            if not math.isfinite(v):
-                raise SceneError(f"{key}.{part} = {_fmt(v)}: must be finite")
-        values = tuple(float(x) for x in np.linspace(spec.start, spec.stop, spec.num))
-        swept = True
-    elif isinstance(spec, list):
-        if not spec:
-            raise SceneError(f"{key} = []: an empty list; give at least one value")
-        values, swept = tuple(float(x) for x in spec), True
-    else:
-        values, swept = (float(spec),), False
-    lo, hi, lo_in, hi_in, inf_ok, text = _LIMITS[key]
-    for v in values:
-        ok = not math.isnan(v)
-        ok = ok and (v > lo or (lo_in and v == lo)) and (v < hi or (hi_in and v == hi))
-        if ok and math.isinf(v) and not inf_ok:
-            ok = False
-        if not ok:
-            raise SceneError(f"{key} = {_fmt(v)}: {text}")
-    return values, swept
 
 
 @dataclass(frozen=True)
@@ -200,7 +186,18 @@ class Scene:
 
     @property
     def size(self) -> int:
-        return int(np.prod(self.shape, dtype=np.int64))
+        """Number of points of the grid (<= MAX_POINTS)."""
+        return math.prod(self.shape)
+
+    def sweep_nbytes(self) -> int:
+        """Bytes a sweep file of this scene needs for its per-point variables (the stored
+        variables of ``rocksweep.sweep.variables``, ~34 a point, 58 with energy metrics)
+        and its coordinates; HDF5's own overhead (a few kB) is not counted."""
+        from rocksweep.sweep import variables  # the sweep knows what it stores
+
+        per_point = sum(np.dtype(dtype).itemsize for dtype, _, _ in variables(self).values())
+        coords = sum(8 * len(a.values) for a in self.swept)
+        return self.size * per_point + coords
 
     def body_axes(self) -> tuple[Axis, ...]:
         return tuple(a for a in self.axes if a.key.startswith("body."))
@@ -227,68 +224,26 @@ class Scene:
         return self.point({a.name: a.values[0] for a in self.axes})
 
 
-def _format_validation_error(err: ValidationError) -> str:
-    e = err.errors()[0]
-    loc = [str(p) for p in e["loc"] if not str(p).startswith(("FlexibleSpec", "BlockSpec"))]
-    # pydantic reports union members; keep the path of keys the user wrote
-    loc = [p for p in loc if p not in ("RangeSpec", "float", "int", "list[union[float,int]]",
-                                       "constrained-str", "str", "bool", "literal['sine','cosine']",
-                                       "list[literal['sine','cosine']]",
-                                       "function-after[model_validator()]")
-           and not p.startswith(("list[", "literal[", "union[", "function-"))]
-    key = ".".join(loc) if loc else "(top level)"
-    kind = e["type"]
-    if kind == "extra_forbidden":
-        return f"{key}: unknown key"
-    if kind == "missing":
-        return f"{key}: missing required key"
-    value = e.get("input")
-    return f"{key} = {_fmt(value)}: {e['msg']}"
-
-
-def _allowed_keys(model: type[BaseModel]) -> str:
-    return ", ".join(model.model_fields)
-
-
-def _check_unknown(raw: dict) -> None:
-    """Unknown keys with the list of allowed ones (clearer than pydantic's union report)."""
-    sections = {"body": None, "impact": ImpactSpec, "pulse": PulseSpec,
-                "numerics": NumericsSpec, "outputs": OutputsSpec}
-    for k in raw:
-        if k not in (*sections, "name"):
-            raise SceneError(f"{k}: unknown key (allowed: name, {', '.join(sections)})")
-    body = raw.get("body")
-    if isinstance(body, dict):
-        kind = body.get("kind", "flexible")
-        if kind not in BODY_KEYS:
-            raise SceneError(f"body.kind = {kind!r}: must be one of flexible, block")
-        allowed = ("kind", *BODY_KEYS[kind])
-        for k in body:
-            if k not in allowed:
-                raise SceneError(f"body.{k}: unknown key for a {kind} body "
-                                 f"(allowed: {', '.join(allowed)})")
-    for name, model in sections.items():
-        sec = raw.get(name)
-        if model is not None and isinstance(sec, dict):
-            for k in sec:
-                if k not in model.model_fields:
-                    raise SceneError(f"{name}.{k}: unknown key (allowed: {_allowed_keys(model)})")
-
-
 def apply_overrides(raw: dict, overrides: list[str]) -> dict:
     """Apply ``--set section.key=VALUE`` overrides (VALUE parsed as YAML) to a raw scene."""
     for item in overrides:
         if "=" not in item:
             raise SceneError(f"--set {item!r}: expected KEY=VALUE, e.g. pulse.A_ratio=4.5")
         key, text = item.split("=", 1)
-        parts = key.strip().split(".")
+        key = key.strip()
+        parts = key.split(".")
+        if not all(parts):
+            raise SceneError(f"--set {item!r}: expected KEY=VALUE, e.g. pulse.A_ratio=4.5")
         try:
-            value = yaml.safe_load(text)
-        except yaml.YAMLError:
-            raise SceneError(f"--set {key}: value {text!r} is not valid YAML") from None
+            value = _load_yaml(text)
+        except _YamlError as err:
+            raise SceneError(f"--set {key}: value {fmt(text)} is not valid YAML "
+                             f"({err})") from None
         node = raw
         for p in parts[:-1]:
-            node = node.setdefault(p, {})
+            if node.get(p) is None:
+                node[p] = {}
+            node = node[p]
             if not isinstance(node, dict):
                 raise SceneError(f"--set {key}: {p} is not a section")
         node[parts[-1]] = value
@@ -314,76 +269,372 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
     return parse_scene(text, str(path), overrides)
 
 
+# -- structure ---------------------------------------------------------------------------
+
+def _section(raw: dict, name: str, kind: str, required: bool) -> dict:
+    """The mapping of a section, with its keys checked against the table."""
+    sec = raw.get(name)
+    if name == "body" and isinstance(sec, dict):
+        kind = sec.get("kind", "flexible")
+        if not (isinstance(kind, str) and kind in BODY_KEYS):
+            raise SceneError(f"body.kind = {fmt(kind)}: {KEYS['body.kind'].allowed}")
+    allowed = section_keys(name, kind)
+    if sec is None:
+        if required:
+            needed = ", ".join(k for k in allowed if KEYS[f"{name}.{k}"].required)
+            raise SceneError(f"{name}: missing required section ({name}: {{{needed}}})")
+        return {}
+    if not isinstance(sec, dict):
+        if name == "body":
+            what = (f"keys {', '.join(BODY_KEYS['flexible'])} (a flexible body), "
+                    f"or kind: block, {', '.join(BODY_KEYS['block'])}")
+        else:
+            what = f"keys {', '.join(allowed)}"
+        raise SceneError(f"{name} = {fmt(sec)}: must be a mapping with {what}")
+    for k in sec:
+        if k not in allowed:
+            what = f" for a {kind} body" if name == "body" else ""
+            raise SceneError(f"{name}.{k}: unknown key{what} (allowed: {', '.join(allowed)})")
+    for k in allowed:
+        spec = KEYS[f"{name}.{k}"]
+        if spec.required and sec.get(k) is None:
+            hint = {"axis": "a number, a list of numbers or a range {start, stop, num}",
+                    "choices": spec.allowed.removeprefix("must be ")}.get(spec.kind, "")
+            raise SceneError(f"{name}.{k}: missing required key ({hint})")
+    return sec
+
+
+def _axis_spec(key: str, spec: Any) -> tuple[str, Any, int]:
+    """Check an axis's form, without building its values: (form, spec, length)."""
+    if is_number(spec):
+        return "scalar", float(spec), 1
+    if isinstance(spec, list):
+        if not spec:
+            raise SceneError(f"{key} = []: an empty list; give at least one value")
+        for v in spec:
+            if not is_number(v):
+                raise SceneError(f"{key} = {fmt(v)}: each value must be a number")
+        if len(spec) > MAX_AXIS_VALUES:
+            raise SceneError(f"{key}: {len(spec):,} values; at most {MAX_AXIS_VALUES:,} "
+                             "per axis")
+        return "list", spec, len(spec)
+    if isinstance(spec, dict):
+        for k in spec:
+            if k not in ("start", "stop", "num"):
+                raise SceneError(f"{key}.{k}: unknown key in a range (allowed: start, stop, "
+                                 "num)")
+        for k in ("start", "stop", "num"):
+            if k not in spec:
+                raise SceneError(f"{key}.{k}: missing (a range is {{start, stop, num}}, "
+                                 "num values from start to stop inclusive)")
+        num = spec["num"]
+        if not (isinstance(num, int) and not isinstance(num, bool) and num >= 1):
+            raise SceneError(f"{key}.num = {fmt(num)}: must be an integer >= 1")
+        if num > MAX_AXIS_VALUES:
+            raise SceneError(f"{key}.num = {num}: at most {MAX_AXIS_VALUES:,} values per axis")
+        for k in ("start", "stop"):
+            v = spec[k]
+            if not (is_number(v) and math.isfinite(v)):
+                raise SceneError(f"{key}.{k} = {fmt(v)}: must be a finite number")
+        return "range", spec, num
+    raise SceneError(f"{key} = {fmt(spec)}: must be a number, a list of numbers or a range "
+                     "{start, stop, num}")
+
+
+def _axis_values(key: str, form: str, spec: Any) -> np.ndarray:
+    """The values of a checked axis spec (float64[n]), each admissible and distinct."""
+    if form == "range":
+        values = np.linspace(float(spec["start"]), float(spec["stop"]), spec["num"])
+    else:
+        values = np.array(spec if form == "list" else [spec], dtype=float)
+    msg = check_values(key, values)
+    if msg is not None:
+        raise SceneError(msg)
+    if values.size > 1:
+        ordered = np.sort(values)
+        same = ordered[1:] == ordered[:-1]
+        if same.any():
+            dup = float(ordered[1:][same][0])
+            if form == "range":
+                why = ("start = stop" if spec["start"] == spec["stop"]
+                       else "its step is below float64's resolution")
+                raise SceneError(
+                    f"{key} = {{start: {fmt(spec['start'])}, stop: {fmt(spec['stop'])}, "
+                    f"num: {spec['num']}}}: {why}, so the value {fmt(dup)} repeats; the "
+                    "values of an axis must differ (they label the result's coordinates)")
+            raise SceneError(f"{key}: the value {fmt(dup)} is given twice; the values of an "
+                             "axis must differ (they label the result's coordinates)")
+    return values
+
+
+def _shapes(spec: Any) -> tuple[tuple[str, ...], bool]:
+    allowed = KEYS["pulse.shape"]
+    if isinstance(spec, list):
+        if not spec:
+            raise SceneError("pulse.shape = []: an empty list; use sine, cosine or both")
+        for v in spec:
+            if v not in allowed.choices:
+                raise SceneError(f"pulse.shape = {fmt(v)}: {allowed.allowed}")
+        if len(set(spec)) < len(spec):
+            raise SceneError(f"pulse.shape = {fmt(spec)}: a shape is given twice; the values "
+                             "of an axis must differ")
+        return tuple(spec), True
+    if not (isinstance(spec, str) and spec in allowed.choices):
+        raise SceneError(f"pulse.shape = {fmt(spec)}: {allowed.allowed}")
+    return (spec,), False
+
+
+def _numerics(sec: dict) -> tuple[Numerics, Numerics]:
+    """The sweeps' and the single runs' numerics of a checked ``numerics`` section."""
+    given: dict[str, Any] = {}
+    for k, v in sec.items():
+        if v is None:
+            continue
+        key = f"numerics.{k}"
+        spec = KEYS[key]
+        if spec.kind == "choice":
+            if not (isinstance(v, str) and v in spec.choices):
+                raise SceneError(f"{key} = {fmt(v)}: {spec.allowed}")
+        elif spec.kind == "integer":
+            if not (isinstance(v, int) and not isinstance(v, bool)):
+                raise SceneError(f"{key} = {fmt(v)}: {spec.allowed}")
+        elif not is_number(v):
+            raise SceneError(f"{key} = {fmt(v)}: {spec.allowed}")
+        if spec.kind in ("integer", "number"):
+            msg = check_values(key, np.array([float(v)]))
+            if msg is not None:
+                raise SceneError(f"{key} = {fmt(v)}: {spec.allowed}")
+            v = float(v) if spec.kind == "number" else v
+        given[k] = v
+    accuracy = given.pop("accuracy", None)
+    numerics = Numerics.preset(accuracy or "default", **given)
+    # A single run exists for its time history and energy balance, which the outcome-tuned
+    # `default` (5 steps per period) resolves only roughly; it costs milliseconds at `fine`.
+    single = Numerics.preset(accuracy or "fine", **given)
+    return numerics, single
+
+
 def _parse(text: str, overrides: list[str]) -> Scene:
     try:
-        raw = yaml.safe_load(text)
-    except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(err, "problem", None) or "invalid YAML"
-        raise SceneError(f"YAML syntax error{where}: {problem}") from None
+        raw = _load_yaml(text)
+    except _YamlError as err:
+        raise SceneError(f"YAML {err}") from None
     if raw is None:
         raw = {}
     if not isinstance(raw, dict):
-        raise SceneError("a scene is a YAML mapping with sections body, impact, pulse")
+        raise SceneError(f"a scene is a YAML mapping with sections {', '.join(SECTIONS)} "
+                         f"(got {fmt(raw)})")
     raw = apply_overrides(raw, overrides)
-    _check_unknown(raw)
-    if isinstance(raw.get("body"), dict):
-        raw["body"].setdefault("kind", "flexible")
-    try:
-        spec = SceneSpec.model_validate(raw)
-    except ValidationError as err:
-        raise SceneError(_format_validation_error(err)) from None
+    for k in raw:
+        if k not in ("name", *SECTIONS):
+            raise SceneError(f"{k}: unknown key (allowed: name, {', '.join(SECTIONS)})")
+    name = raw.get("name")
+    if name is not None and not isinstance(name, str):
+        raise SceneError(f"name = {fmt(name)}: {KEYS['name'].allowed}")
 
-    kind = spec.body.kind
-    axes: list[Axis] = []
-    shapes = spec.pulse.shape if isinstance(spec.pulse.shape, list) else [spec.pulse.shape]
-    if not shapes:
-        raise SceneError("pulse.shape = []: an empty list; use sine, cosine or both")
-    axes.append(Axis("shape", "pulse.shape", tuple(shapes), isinstance(spec.pulse.shape, list)))
+    body = _section(raw, "body", "flexible", required=True)
+    kind = body.get("kind", "flexible")
+    impact = _section(raw, "impact", kind, required=kind == "flexible")
+    pulse = _section(raw, "pulse", kind, required=True)
+    numerics_sec = _section(raw, "numerics", kind, required=False)
+    outputs = _section(raw, "outputs", kind, required=False)
+    energy = outputs.get("energy", KEYS["outputs.energy"].default)
+    if not isinstance(energy, bool):
+        raise SceneError(f"outputs.energy = {fmt(energy)}: {KEYS['outputs.energy'].allowed}")
+
+    # forms and lengths first: the grid's size is known before any value is built
+    shapes, shape_swept = _shapes(pulse["shape"])
+    specs: list[tuple[str, str, str, Any]] = []  # (name, key, form, spec)
     for k in BODY_KEYS[kind]:
-        values, swept = _axis_values(f"body.{k}", getattr(spec.body, k))
-        axes.append(Axis(k, f"body.{k}", values, swept))
-    if spec.impact is None:
-        if kind == "flexible":
-            raise SceneError("impact: missing required section (impact: {lam: ...})")
-        lam_axis = Axis("lam", "impact.lam", (0.0,), False)  # Housner's impulse at the corner
-    else:
-        values, swept = _axis_values("impact.lam", spec.impact.lam)
-        lam_axis = Axis("lam", "impact.lam", values, swept)
-    axes.append(lam_axis)
+        spec = body.get(k, KEYS[f"body.{k}"].default)
+        specs.append((k, f"body.{k}", *_axis_spec(f"body.{k}", spec)[:2]))
+    lam = impact.get("lam", 0.0)  # a block without an impact section: Housner's corner
+    specs.append(("lam", "impact.lam", *_axis_spec("impact.lam", lam)[:2]))
     for k in PULSE_AXES:
-        values, swept = _axis_values(f"pulse.{k}", getattr(spec.pulse, k))
-        axes.append(Axis(k, f"pulse.{k}", values, swept))
+        specs.append((k, f"pulse.{k}", *_axis_spec(f"pulse.{k}", pulse[k])[:2]))
+    lengths = [len(shapes)] + [1 if form == "scalar" else
+                               (spec["num"] if form == "range" else len(spec))
+                               for _, _, form, spec in specs]
+    size = math.prod(lengths)
+    if size > MAX_POINTS:
+        dims = " x ".join(f"{n:,} {key}" for n, (_, key, form, _) in
+                          zip(lengths[1:], specs, strict=True) if form != "scalar")
+        raise SceneError(f"the grid has {size:,} points ({dims}): at most {MAX_POINTS:,} "
+                         "points per scene (a sweep file of ~34 bytes a point); split it "
+                         "into several scenes or use fewer values")
 
-    # every body of the grid must be physical (e.g. the top mass above the base)
-    body_axes = [a for a in axes if a.key.startswith("body.")]
-    for combo in product(*(a.values for a in body_axes)):
+    axes = [Axis("shape", "pulse.shape", shapes, shape_swept)]
+    for name_, key, form, spec in specs:
+        values = _axis_values(key, form, spec)
+        axes.append(Axis(name_, key, tuple(values.tolist()), form != "scalar"))
+
+    numerics, single = _numerics(numerics_sec)
+    scene = Scene(name=name or "rocksweep scene", kind=kind, axes=tuple(axes),
+                  numerics=numerics, single_numerics=single, energy=energy, text=text)
+    bodies = _candidate_bodies(scene)
+    _check_cost(scene, bodies)
+    return scene
+
+
+# -- bodies and cost ---------------------------------------------------------------------
+
+def _candidate_bodies(scene: Scene) -> list[dict[str, float]]:
+    """Body values (by key name) that stand for the grid's bodies; each is built, so a body
+    that is not physical raises its ``BodyError`` (as a SceneError).
+
+    Up to MAX_BODIES_CHECKED distinct bodies: all of them. Beyond: the combinations of
+    each key's extreme values (its least and largest, and wn_over_p's largest finite
+    one), at most 3 x 2^5 = 96 bodies. The body's conditions and costs reach their worst
+    there: with each key's range checked value by value, what is left is h/b > 0, and h/b
+    is monotonic in alpha_cg and alpha_A and linear in mA_over_m; the step's rate
+    ``body_omega_rock`` grows with wn_over_p and zeta, falls with IA_ratio and alpha_cg,
+    rises with alpha_A and is convex in mA_over_m (m h^2 / (I_A + m_A R_A^2) ~ (c + d
+    mu)^2 / mu); the pulse's rate grows with tan(alpha_cg). A function that is monotonic
+    or convex in each key alone takes its largest value over a grid at such a corner.
+    """
+    axes = scene.body_axes()
+    n_bodies = math.prod(len(a.values) for a in axes)
+    if n_bodies <= MAX_BODIES_CHECKED:
+        choices = [a.values for a in axes]
+    else:
+        choices = []
+        for a in axes:
+            v = np.asarray(a.values)
+            pick = {float(v.min()), float(v.max())}
+            finite = v[np.isfinite(v)]
+            if finite.size:
+                pick.add(float(finite.max()))
+            choices.append(sorted(pick))
+    out = []
+    for combo in product(*choices):
+        values = {a.name: float(v) for a, v in zip(axes, combo, strict=True)}
         try:
-            (BlockBody if kind == "block" else FlexibleBody)(
-                **{a.name: v for a, v in zip(body_axes, combo, strict=True)})
+            scene.make_body(**values)
         except BodyError as err:
             raise SceneError(str(err)) from None
+        out.append(values)
+    return out
 
-    n = spec.numerics
-    overrides_n = {k: v for k, v in n.model_dump().items()
-                   if k != "accuracy" and v is not None}
-    checks = {"steps_per_period": (lambda v: v >= 4, "must be an integer >= 4"),
-              "event_tol": (lambda v: 0 < v < 1, "must be in (0, 1) (p*t)"),
-              "horizon": (lambda v: 0 < v < math.inf, "must be > 0 and finite (p*t)"),
-              "rest_rate": (lambda v: 0 < v < 1, "must be in (0, 1) (x p alpha_cg)"),
-              "max_events": (lambda v: v >= 1, "must be an integer >= 1")}
-    for k, v in overrides_n.items():
-        if k in checks and not (isinstance(v, int | float) and v == v and checks[k][0](v)):
-            raise SceneError(f"numerics.{k} = {_fmt(v)}: {checks[k][1]}")
-    if "horizon" in overrides_n:
-        overrides_n["horizon"] = float(overrides_n["horizon"])
-    assert n.accuracy is None or n.accuracy in PRESETS
-    numerics = Numerics.preset(n.accuracy or "default", **overrides_n)
-    # A single run exists for its time history and energy balance, which the outcome-tuned
-    # `default` (5 steps per period) resolves only roughly; it costs milliseconds at `fine`.
-    single_numerics = Numerics.preset(n.accuracy or "fine", **overrides_n)
 
-    name = spec.name or "rocksweep scene"
-    return Scene(name=name, kind=kind, axes=tuple(axes), numerics=numerics,
-                 single_numerics=single_numerics, energy=spec.outputs.energy, text=text)
+def _budgets(scene: Scene, bodies: list[dict[str, float]], w: np.ndarray, A: np.ndarray,
+             numerics: Numerics) -> np.ndarray:
+    """Step cap (PAR_MAXSTEPS) of every combination of the bodies, w and A: float64[b, w, A]
+    (NaN, from an overflow, counts as inf)."""
+    built = [scene.make_body(**b) for b in bodies]
+    omega_rock = np.array([body_omega_rock(b) for b in built])[:, None, None]
+    alpha_ref = np.array([b.alpha_ref for b in built])[:, None, None]
+    shape = (len(built), w.size, A.size)
+    _, _, _, cap = run_cost(np.broadcast_to(omega_rock, shape),
+                            np.broadcast_to(alpha_ref, shape),
+                            np.broadcast_to(w[None, :, None], shape),
+                            np.broadcast_to(A[None, None, :], shape), numerics)
+    return np.where(np.isnan(cap), math.inf, cap)
+
+
+def _check_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
+    """Refuse a scene with a point whose step cap exceeds MAX_POINT_STEPS.
+
+    The cap grows with the run's length t_pulse + horizon and with 1/step; over the pulse
+    axes it is largest at an end of each (the step follows max(omega, rates of the body and
+    of |A|), the length 2 pi/omega: (2 pi/w + H) max(X, w) falls then rises in w).
+    """
+    w = np.asarray(scene.axis("w_over_p").values)
+    A = np.asarray(scene.axis("A_ratio").values)
+    w, A = np.array([w.min(), w.max()]), np.array([A.min(), A.max()])
+    for numerics, label in ((scene.numerics, ""),
+                            (scene.single_numerics, " (at the single runs' accuracy, "
+                             f"{scene.single_numerics.accuracy})")):
+        caps = _budgets(scene, bodies, w, A, numerics)
+        worst = int(np.argmax(caps))
+        if caps.flat[worst] <= MAX_POINT_STEPS:
+            continue
+        i, j, k = np.unravel_index(worst, caps.shape)
+        point = {**{f"body.{n}": v for n, v in bodies[i].items()},
+                 "pulse.w_over_p": float(w[j]), "pulse.A_ratio": float(A[k])}
+        raise SceneError(_cost_message(scene, point, numerics, label))
+
+
+def _point_cost(scene: Scene, point: dict[str, float], numerics: Numerics
+                ) -> tuple[float, float, float] | None:
+    """(step cap, t_end, dt) of one point given by key; None for a body that is not
+    physical."""
+    try:
+        body = scene.make_body(**{k[5:]: v for k, v in point.items() if k.startswith("body.")})
+    except BodyError:
+        return None
+    dt, _, t_end, cap = run_cost(np.array([body_omega_rock(body)]), np.array([body.alpha_ref]),
+                                 np.array([point["pulse.w_over_p"]]),
+                                 np.array([point["pulse.A_ratio"]]), numerics)
+    c = float(cap[0])
+    return (math.inf if math.isnan(c) else c), float(t_end[0]), float(dt[0])
+
+
+def _with(scene: Scene, point: dict, numerics: Numerics, key: str, value: float
+          ) -> float | None:
+    """The step cap of ``point`` with one key (of the point or the numerics) changed."""
+    if key.startswith("numerics."):
+        name = key.split(".", 1)[1]
+        value = int(value) if name != "horizon" else float(value)
+        got = _point_cost(scene, point, replace(numerics, **{name: value}))
+    else:
+        got = _point_cost(scene, {**point, key: value}, numerics)
+    return None if got is None else got[0]
+
+
+def _bound(scene: Scene, point: dict, numerics: Numerics, key: str, bad: float,
+           good: float) -> float:
+    """The value between ``good`` (within the cap) and ``bad`` (beyond) where the cap is
+    reached, rounded to 3 digits on the good side (60 bisections; log scale when both
+    have one sign)."""
+    logs = good * bad > 0
+    lo, hi = (math.log(abs(good)), math.log(abs(bad))) if logs else (good, bad)
+    sign = math.copysign(1.0, bad)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        v = sign * math.exp(mid) if logs else mid
+        cost = _with(scene, point, numerics, key, v)
+        if cost is not None and cost <= MAX_POINT_STEPS:
+            lo = mid
+        else:
+            hi = mid
+    v = sign * math.exp(lo) if logs else lo
+    if KEYS[key].kind == "integer":
+        return float(math.floor(v) if bad > good else math.ceil(v))
+    e = 10.0 ** (math.floor(math.log10(abs(v))) - 2) if v else 1.0
+    return (math.floor(v / e) if bad > good else math.ceil(v / e)) * e
+
+
+def _cost_message(scene: Scene, point: dict, numerics: Numerics, label: str) -> str:
+    cap, t_end, dt = _point_cost(scene, point, numerics)  # type: ignore[misc]
+    why = (f"{numerics.max_steps_factor:g} x a run of {t_end:.3g} p*t in steps of "
+           f"{dt:.3g} p*t, plus {EVENT_STEP_ALLOWANCE:g} per event x max_events "
+           f"{numerics.max_events}")
+    head = (f"one point could need {cap:.2g} RK4 steps ({why}){label}, more than the cap of "
+            f"{MAX_POINT_STEPS:.0e} a point (~17 s of one core)")
+    # which value of the point makes it costly: the one whose typical value cuts the most
+    current = {**point, **{f"numerics.{k}": getattr(numerics, k)
+                           for k in ("steps_per_period", "horizon", "max_events")}}
+    best, best_key = 1.0, None
+    for key, value in current.items():
+        tame = _TAME[key]
+        if key == "pulse.A_ratio":
+            tame = math.copysign(tame, value)
+        if value == tame:
+            continue
+        cost = _with(scene, point, numerics, key, tame)
+        if cost is not None and cap / max(cost, 1.0) > best:
+            best, best_key = cap / max(cost, 1.0), key
+    if best_key is None:
+        return f"{head}; use fewer steps_per_period, a shorter horizon or fewer max_events"
+    value, tame = current[best_key], _TAME[best_key]
+    if best_key == "pulse.A_ratio":
+        tame = math.copysign(tame, value)
+    if _with(scene, point, numerics, best_key, tame) > MAX_POINT_STEPS:
+        return f"{best_key} = {fmt(value)}: {head}; other values of this point are costly too"
+    bound = _bound(scene, point, numerics, best_key, value, tame)
+    shown = f"{abs(bound):.3g}" if KEYS[best_key].kind != "integer" else str(int(bound))
+    if best_key == "pulse.A_ratio":
+        rule = f"|{best_key}| must be <= {shown}"
+    else:
+        rule = f"{best_key} must be {'<=' if value > tame else '>='} {shown}"
+    return f"{best_key} = {fmt(value)}: {head}; with the scene's other values {rule}"

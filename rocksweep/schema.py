@@ -1,0 +1,167 @@
+"""The scene's keys: one table of types, admissible values and messages.
+
+``KEYS`` maps every dotted scene key to a ``Key``: the kind of value it holds, the range
+of admissible numbers (ends, inclusive or not, +inf allowed or not) and the text a user
+reads when a value is refused. The scene validator (``rocksweep.scene``) and the body
+classes (``rocksweep.model``) both check values here, so a body built from Python and a
+scene file get the same one-line message ``KEY = VALUE: what is allowed``.
+
+Bounds of the body's Pi groups. Beside the physical ranges (angles in (0, pi/2), lam in
+[0, 2], I_O >= M R^2) the body's ratios are kept within a factor 1e6 of 1: a spring a
+million times faster or slower than rocking, one mass a million times the other, a body a
+million times taller than wide are no rocking problem, and the bounds stay ~1e140 away
+from where the body's float64 arithmetic breaks (wn_over_p = 1e-300 divides by zero in
+u_cr, mA_over_m = 1e200 overflows h^2, alpha_cg = 1e-300 divides by zero in b).
+What a whole point costs (the step, the run's length) is checked by the scene, which
+knows the pulse and the numerics.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from rocksweep.numerics import MIN_EVENT_TOL, PRESETS, ROOTS
+
+RATIO_MAX = 1e6  # bound of the body's ratios (see the module docstring)
+ANGLE_MIN = 1e-6  # [rad] smallest slenderness: h/b = 1e6
+
+
+@dataclass(frozen=True)
+class Key:
+    """One scene key.
+
+    kind: "axis" (a number, a list of numbers or a range {start, stop, num}: a swept
+    parameter), "number", "integer", "choice" (one of ``choices``), "choices" (one of
+    ``choices`` or a list of them: a swept axis of words), "bool" or "string".
+    Numbers must lie between lo and hi (ends included when lo_in / hi_in), NaN never;
+    inf_ok admits +inf beyond hi (wn_over_p = .inf: a rigid body).
+    allowed: the message's right-hand side, what the user may write.
+    required: a key the scene must give; default: its value otherwise.
+    """
+
+    kind: str
+    allowed: str
+    lo: float = -math.inf
+    hi: float = math.inf
+    lo_in: bool = True
+    hi_in: bool = True
+    inf_ok: bool = False
+    choices: tuple[str, ...] = ()
+    required: bool = True
+    default: Any = None
+
+
+_AXIS = "a number, a list of numbers or a range {start, stop, num}"
+_RATIO = f"[1e-06, {RATIO_MAX:g}]"
+_ANGLE = f"must be in [{ANGLE_MIN:g}, pi/2) rad"
+
+KEYS: dict[str, Key] = {
+    "name": Key("string", "must be a string (the scene's title)", required=False),
+    "body.kind": Key("choice", "must be one of flexible, block", choices=("flexible", "block"),
+                     required=False, default="flexible"),
+    # flexible body: Table 1's Pi groups
+    "body.wn_over_p": Key("axis", f"must be in {_RATIO} (omega_n/p), or .inf for a rigid body",
+                          1e-6, RATIO_MAX, inf_ok=True),
+    "body.zeta": Key("axis", f"must be in [0, {RATIO_MAX:g}]", 0.0, RATIO_MAX),
+    "body.alpha_cg": Key("axis", _ANGLE, ANGLE_MIN, math.pi / 2, hi_in=False),
+    "body.alpha_A": Key("axis", _ANGLE, ANGLE_MIN, math.pi / 2, hi_in=False),
+    "body.mA_over_m": Key("axis", f"must be in {_RATIO}", 1e-6, RATIO_MAX),
+    "body.IA_ratio": Key("axis", f"must be in [0, {RATIO_MAX:g}] (I_A / (m_A R_A^2))",
+                         0.0, RATIO_MAX),
+    # block body
+    "body.alpha": Key("axis", _ANGLE, ANGLE_MIN, math.pi / 2, hi_in=False),
+    # A body's inertia about a corner is at least M R^2 (all its mass at distance R from O
+    # would give exactly that only if concentrated at the centre of gravity).
+    "body.inertia": Key("axis", f"must be in [1, {RATIO_MAX:g}] (I_O / (M R^2) >= 1)",
+                        1.0, RATIO_MAX, required=False, default=4.0 / 3.0),
+    "impact.lam": Key("axis", "must be in [0, 2]", 0.0, 2.0),
+    "pulse.shape": Key("choices", "must be sine, cosine or a list of them",
+                       choices=("sine", "cosine")),
+    "pulse.w_over_p": Key("axis", "must be > 0 and finite (the pulse lasts 2 pi/omega)",
+                          0.0, math.inf, lo_in=False, hi_in=False),
+    "pulse.A_ratio": Key("axis",
+                         "must be a finite number (negative: a pulse in the other direction)",
+                         -math.inf, math.inf, lo_in=False, hi_in=False),
+    "numerics.accuracy": Key("choice", f"must be one of {', '.join(PRESETS)}",
+                             choices=tuple(PRESETS), required=False),
+    "numerics.steps_per_period": Key("integer", "must be an integer >= 4", 4, required=False),
+    "numerics.event_tol": Key(
+        "number", f"must be in [{MIN_EVENT_TOL:g}, 1) (p*t; below {MIN_EVENT_TOL:g} an event "
+        "time t ~ 1e2 is at float64's resolution)", MIN_EVENT_TOL, 1.0, hi_in=False,
+        required=False),
+    "numerics.horizon": Key("number", "must be > 0 and finite (p*t)", 0.0, math.inf,
+                            lo_in=False, hi_in=False, required=False),
+    "numerics.rest_rate": Key("number", "must be in (0, 1) (x p alpha_cg)", 0.0, 1.0,
+                              lo_in=False, hi_in=False, required=False),
+    "numerics.max_events": Key("integer", "must be an integer >= 1", 1, required=False),
+    "numerics.root": Key("choice", f"must be one of {', '.join(ROOTS)}", choices=ROOTS,
+                         required=False),
+    "outputs.energy": Key("bool", "must be true or false (store energy metrics)",
+                          required=False, default=False),
+}
+
+# Keys of each body kind, in the grid's dimension order.
+BODY_KEYS: dict[str, tuple[str, ...]] = {
+    "flexible": ("wn_over_p", "zeta", "alpha_cg", "alpha_A", "mA_over_m", "IA_ratio"),
+    "block": ("alpha", "inertia"),
+}
+SECTIONS = ("body", "impact", "pulse", "numerics", "outputs")
+
+
+def section_keys(section: str, kind: str = "flexible") -> tuple[str, ...]:
+    """The keys (without the section) a section may hold; body keys depend on its kind."""
+    if section == "body":
+        return ("kind", *BODY_KEYS[kind])
+    pre = section + "."
+    return tuple(k[len(pre):] for k in KEYS if k.startswith(pre))
+
+
+def fmt(v: Any) -> str:
+    """A value as the user wrote it, in one line (floats in full, inf/nan as words)."""
+    if isinstance(v, float):
+        return repr(v) if math.isfinite(v) else str(v)
+    if isinstance(v, np.floating):
+        return fmt(float(v))
+    text = repr(v)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _ok(spec: Key, v: np.ndarray) -> np.ndarray:
+    above = (v > spec.lo) | (spec.lo_in & (v == spec.lo))
+    below = (v < spec.hi) | (spec.hi_in & (v == spec.hi))
+    ok = above & below
+    if spec.inf_ok:
+        ok |= v == math.inf
+    return ok & ~np.isnan(v)
+
+
+def check_value(key: str, value: float) -> str | None:
+    """None if the number is admissible for ``key``, else ``KEY = VALUE: allowed``."""
+    spec = KEYS[key]
+    v = float(value)
+    ok = ((v > spec.lo or (spec.lo_in and v == spec.lo))
+          and (v < spec.hi or (spec.hi_in and v == spec.hi)))
+    if ok or (spec.inf_ok and v == math.inf):
+        return None
+    return f"{key} = {fmt(v)}: {spec.allowed}"
+
+
+def check_values(key: str, values: np.ndarray) -> str | None:
+    """As ``check_value``, vectorised over ``values`` (float64[n]): the message names the
+    first value that is not admissible."""
+    spec = KEYS[key]
+    v = np.atleast_1d(np.asarray(values, dtype=float))
+    bad = np.flatnonzero(~_ok(spec, v))
+    if bad.size == 0:
+        return None
+    return f"{key} = {fmt(float(v[bad[0]]))}: {spec.allowed}"
+
+
+def is_number(v: Any) -> bool:
+    """A real number (bool is not one, although Python counts it as an int)."""
+    return isinstance(v, numbers.Real) and not isinstance(v, bool | np.bool_)
