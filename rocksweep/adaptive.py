@@ -1,0 +1,544 @@
+"""Adaptive stability diagrams: compute only where the class can change (issue 11).
+
+A stability diagram is large uniform regions (safe, mode 1, mode 2) separated by thin
+boundaries. Over the two *diagram axes* (by default x = w_over_p, y = A_ratio; any two
+swept axes with at least 2 values), for every value of the other axes (a *panel*):
+
+1. coarse pass: the lattice L_s0, s0 = 2**coarse, i.e. every s0-th index of both diagram
+   axes plus each axis's last index;
+2. refinement, stride s = s0, s0/2, ..., 2: a cell of the stride-s lattice is *mixed* when
+   the computed points inside it (closed: edges and corners included, at any resolution)
+   hold more than one class. Mixed cells, dilated by ``margin`` cells across their edges
+   (so a boundary that bends between samples is not lost; ``final_margin`` at the last
+   level, s = 2, where a bend between samples is a one-point feature), get every point of
+   the stride-s/2 lattice inside them computed;
+3. audit: a fixed pseudo-random share ``audit`` of all points (seeded, independent of the
+   state) is computed once refinement has converged, i.e. a Bernoulli sample of the points
+   that would be filled. An audit point whose class differs from its fill makes its cells
+   mixed, so step 2 refines around it down to the final resolution;
+4. fill: every point not computed takes the class of the finest-to-coarsest uniform cell
+   (all four corners computed, one class inside) that contains it.
+
+The computed set is the least fixed point of step 2 above the coarse lattice (and, after
+the audit, above the audit points): adding points only adds mixed cells, so the order in
+which batches are computed does not matter. ``next_batch`` is therefore a pure function of
+(outcome, computed): a driver calls it, computes the batch it returns (any workers, any
+chunking; a point's result depends only on the point), stores the results and calls it
+again, until it returns an empty batch. An interrupted sweep resumes from the file.
+
+Per point, the state is two arrays over the grid's flat indices (``rocksweep.grid``):
+``outcome`` (int8, the kernel's class; read only where computed > 0) and ``computed``
+(int8, the flags below). Filled points keep the "not computed" fill values of every other
+variable (``rocksweep.sweep.VARIABLES``).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rocksweep.errors import RocksweepError
+from rocksweep.grid import Grid
+from rocksweep.scene import Scene
+
+# ``computed`` flags (int8 per point).
+FILLED = 0  # not computed: outcome holds the class filled from its uniform cell
+COMPUTED = 1  # computed by the coarse pass or a refinement
+AUDIT = 2  # computed as an audit point; its class equals the fill it replaced
+AUDIT_MISS = 3  # computed as an audit point; its class differs from the fill (refined)
+COMPUTED_MEANING = {
+    FILLED: "filled (not computed; outcome from the uniform cell around it)",
+    COMPUTED: "computed (coarse pass or refinement)",
+    AUDIT: "computed as an audit point, agreed with its fill",
+    AUDIT_MISS: "computed as an audit point, disagreed with its fill (region refined)",
+}
+
+DIAGRAM_AXES = ("w_over_p", "A_ratio")  # (x, y)
+# Default coarse level: the largest k whose coarse lattice keeps >= MIN_COARSE_CELLS cells
+# along both diagram axes (80: k = 2, 400: k = 4, 1000: k = 5); see ``default_coarse``.
+MIN_COARSE_CELLS = 16
+DEFAULT_MARGIN = 1
+# No margin at the last level: there it caught only one-point-wide slivers (44 of 480 000
+# points of Figure 4(b) at 400 x 400) for ~20% more points computed.
+DEFAULT_FINAL_MARGIN = 0
+DEFAULT_AUDIT = 0.02
+DEFAULT_SEED = 0
+# A run warns when more than this share of its audit points disagree with their fill.
+DEFAULT_AUDIT_THRESHOLD = 0.002
+
+_NO_CLASS = np.int8(127)  # above every class, for minima over computed points
+
+
+class AdaptiveError(RocksweepError, ValueError):
+    """Bad adaptive settings (axes, coarse level, margin, audit share)."""
+
+
+@dataclass(frozen=True)
+class Plan:
+    """Where and how a grid is refined.
+
+    full_shape: the grid's full shape (``Grid.full_shape``; flat indices are C-order in it);
+    x, y: positions in full_shape of the two diagram axes; names: their names (x, y);
+    coarse: the coarse pass takes every 2**coarse-th index; margin: cells [>= 0] refined
+    around each mixed cell (across edges) at strides >= 4; final_margin: the same at the
+    last level (stride 2); audit: share in [0, 1] of all points that are audit candidates;
+    seed: of the audit sample.
+    """
+
+    full_shape: tuple[int, ...]
+    x: int
+    y: int
+    names: tuple[str, str] = DIAGRAM_AXES
+    coarse: int | None = None  # None: default_coarse(ny, nx)
+    margin: int = DEFAULT_MARGIN
+    audit: float = DEFAULT_AUDIT
+    seed: int = DEFAULT_SEED
+    final_margin: int = DEFAULT_FINAL_MARGIN
+
+    def __post_init__(self) -> None:
+        if self.coarse is None:
+            object.__setattr__(self, "coarse", default_coarse(self.full_shape[self.y],
+                                                              self.full_shape[self.x]))
+        if not (isinstance(self.coarse, int | np.integer) and 0 <= self.coarse <= 20):
+            raise AdaptiveError(f"coarse = {self.coarse!r}: must be an integer in [0, 20]")
+        for name in ("margin", "final_margin"):
+            v = getattr(self, name)
+            if not (isinstance(v, int | np.integer) and v >= 0):
+                raise AdaptiveError(f"{name} = {v!r}: must be an integer >= 0")
+        if not (isinstance(self.audit, float | int) and 0.0 <= self.audit <= 1.0):
+            raise AdaptiveError(f"audit = {self.audit!r}: must be a share in [0, 1]")
+        if self.x == self.y:
+            raise AdaptiveError(f"diagram axes {self.names}: must be two different axes")
+        for pos, name in zip((self.x, self.y), self.names, strict=True):
+            if self.full_shape[pos] < 2:
+                raise AdaptiveError(f"diagram axis {name} has {self.full_shape[pos]} value: "
+                                    "the adaptive sweep needs >= 2 values on both axes")
+
+    @property
+    def size(self) -> int:
+        return int(np.prod(self.full_shape, dtype=np.int64))
+
+    @property
+    def panel_shape(self) -> tuple[int, int, int]:
+        """(panels, ny, nx): panels = product of the other axes' lengths."""
+        ny, nx = self.full_shape[self.y], self.full_shape[self.x]
+        return self.size // (nx * ny), ny, nx
+
+    @property
+    def strides(self) -> list[int]:
+        """Cell sizes of the refinement levels, coarse to fine: 2**coarse, ..., 2."""
+        return [2**k for k in range(self.coarse, 0, -1)]
+
+    def panels(self, a: np.ndarray) -> np.ndarray:
+        """A flat per-point array (size,) as panels (panels, ny, nx), diagram axes last."""
+        full = np.asarray(a).reshape(self.full_shape)
+        return np.moveaxis(full, (self.y, self.x), (-2, -1)).reshape(self.panel_shape)
+
+    def flat_index(self) -> np.ndarray:
+        """int64[panels, ny, nx]: the flat grid index of every panel cell."""
+        return self.panels(np.arange(self.size, dtype=np.int64))
+
+
+def make_plan(grid_or_scene: Grid | Scene, axes: Sequence[str] = DIAGRAM_AXES,
+              coarse: int | None = None, margin: int = DEFAULT_MARGIN,
+              audit: float = DEFAULT_AUDIT, seed: int = DEFAULT_SEED,
+              final_margin: int = DEFAULT_FINAL_MARGIN) -> Plan:
+    """The plan of a scene's grid. axes: (x, y) names of two swept axes; coarse: None for
+    ``default_coarse`` of the grid. Raises AdaptiveError naming a bad axis."""
+    scene = grid_or_scene.scene if isinstance(grid_or_scene, Grid) else grid_or_scene
+    names = [a.name for a in scene.axes]
+    if len(axes) != 2:
+        raise AdaptiveError(f"axes = {list(axes)}: give two axis names (x, y)")
+    pos = []
+    for name in axes:
+        if name not in names:
+            raise AdaptiveError(f"axis {name!r}: not an axis of the scene (axes: "
+                                f"{', '.join(names)})")
+        ax = scene.axis(name)
+        if name == "shape" or len(ax.values) < 2:
+            raise AdaptiveError(f"axis {name} ({ax.key}): a diagram axis must be a swept "
+                                f"numeric axis with >= 2 values (has {len(ax.values)})")
+        pos.append(names.index(name))
+    full_shape = tuple(len(a.values) for a in scene.axes)
+    return Plan(full_shape, pos[0], pos[1], (str(axes[0]), str(axes[1])),
+                None if coarse is None else int(coarse),
+                int(margin), float(audit), int(seed), int(final_margin))
+
+
+def default_coarse(ny: int, nx: int) -> int:
+    """Default coarse level of a ny x nx diagram: the largest k whose lattice (every
+    2**k-th index) keeps at least MIN_COARSE_CELLS cells along both axes.
+
+    Measured (``scripts/bench_adaptive.py --study``): on the four figures, the classic
+    block and two held-out scenes at 80 x 80 and 400 x 400, coarse lattices of 5 (80) and
+    12.5 (400) cells per axis gave the same outcomes as 16 or more; 16 keeps a factor ~3
+    (80) and ~1.3 (400) below the coarsest lattice seen to be safe, and costs 1/4**k of
+    the points (6.3% at 80, 0.4% at 400, 0.1% at 1000).
+    """
+    k = 0
+    while (min(ny, nx) - 1) / 2 ** (k + 1) >= MIN_COARSE_CELLS:
+        k += 1
+    return k
+
+
+# --- lattices and cells ------------------------------------------------------------------
+
+def plan_coarse(shape: Sequence[int], axes: tuple[int, int], level: int) -> np.ndarray:
+    """Flat indices (int64, increasing) of the coarse lattice: every 2**level-th index of
+    the axes at positions ``axes`` (x, y) of ``shape`` plus their last index, for every
+    value of the other axes."""
+    plan = Plan(tuple(shape), axes[0], axes[1], coarse=level, audit=0.0)
+    return np.sort(_lattice_points(plan, 2**level))
+
+
+def _axis_lattice(n: int, s: int) -> np.ndarray:
+    """Indices of the stride-s lattice of an axis of length n: 0, s, 2s, ... and n - 1."""
+    return np.unique(np.append(np.arange(0, n, s), n - 1))
+
+
+def _lattice_points(plan: Plan, s: int) -> np.ndarray:
+    _, ny, nx = plan.panel_shape
+    idx = plan.flat_index()
+    return idx[:, _axis_lattice(ny, s)][:, :, _axis_lattice(nx, s)].ravel()
+
+
+def _ncells(n: int, s: int) -> int:
+    return max(1, math.ceil((n - 1) / s))
+
+
+def _pad(a: np.ndarray, s: int) -> np.ndarray:
+    """Pad panels (P, ny, nx) by repeating the last row/column to (P, cy s + 1, cx s + 1):
+    the last, shorter cell then spans exactly up to index n - 1."""
+    _, ny, nx = a.shape
+    py, px = _ncells(ny, s) * s + 1 - ny, _ncells(nx, s) * s + 1 - nx
+    return np.pad(a, ((0, 0), (0, py), (0, px)), mode="edge") if py or px else a
+
+
+def _closed_reduce(a: np.ndarray, s: int, axis: int, op: Callable) -> np.ndarray:
+    """op over closed windows [j s, (j+1) s] along ``axis`` of a padded array (c s + 1)."""
+    a = np.moveaxis(a, axis, -1)
+    c = (a.shape[-1] - 1) // s
+    half = op.reduce(a[..., :c * s].reshape(*a.shape[:-1], c, s), axis=-1)
+    return np.moveaxis(op(half, a[..., s::s]), -1, axis)
+
+
+@dataclass
+class _Cells:
+    """Per stride-s cell of every panel (P, cy, cx): lo/hi class among its computed points
+    (127/-1 when none), and whether its four corners are computed."""
+
+    lo: np.ndarray
+    hi: np.ndarray
+    corners: np.ndarray
+
+    @property
+    def mixed(self) -> np.ndarray:
+        return (self.hi >= 0) & (self.lo < self.hi)
+
+    @property
+    def uniform_class(self) -> np.ndarray:
+        """Class of uniform cells with computed corners, -1 elsewhere."""
+        ok = self.corners & (self.lo == self.hi)
+        return np.where(ok, self.hi, -1).astype(np.int8)
+
+
+def _cells(known: np.ndarray, s: int) -> _Cells:
+    """known: int8 panels, class where computed, -1 elsewhere."""
+    kp = _pad(known, s)
+    hi = _closed_reduce(_closed_reduce(kp, s, 2, np.maximum), s, 1, np.maximum)
+    lo_src = np.where(kp < 0, _NO_CLASS, kp)
+    lo = _closed_reduce(_closed_reduce(lo_src, s, 2, np.minimum), s, 1, np.minimum)
+    c = kp[:, ::s, ::s] >= 0
+    corners = c[:, :-1, :-1] & c[:, 1:, :-1] & c[:, :-1, 1:] & c[:, 1:, 1:]
+    return _Cells(lo, hi, corners)
+
+
+def _dilate(mask: np.ndarray, m: int) -> np.ndarray:
+    """Cells within m steps across cell edges (4-neighbourhood, per panel) of a marked
+    cell: a boundary enters a cell through an edge, so its edge neighbours are the cells it
+    can bend into between samples (the 8-neighbourhood cost 13-18% more points at 400 x 400
+    for the same outcomes on the study scenes)."""
+    out = mask.copy()
+    for _ in range(m):
+        cur = out.copy()
+        out[:, 1:, :] |= cur[:, :-1, :]
+        out[:, :-1, :] |= cur[:, 1:, :]
+        out[:, :, 1:] |= cur[:, :, :-1]
+        out[:, :, :-1] |= cur[:, :, 1:]
+    return out
+
+
+def _points_of_cells(plan: Plan, cells: np.ndarray, s: int) -> np.ndarray:
+    """Panel coordinates' flat indices of the stride-s/2 lattice points inside the marked
+    stride-s cells (closed), each once."""
+    h = s // 2
+    P, cy, cx = cells.shape
+    _, ny, nx = plan.panel_shape
+    lat = np.zeros((P, 2 * cy + 1, 2 * cx + 1), bool)
+    for dy in range(3):
+        for dx in range(3):
+            lat[:, dy:dy + 2 * cy:2, dx:dx + 2 * cx:2] |= cells
+    p, jj, ii = np.nonzero(lat)
+    y = np.minimum(jj * h, ny - 1)
+    x = np.minimum(ii * h, nx - 1)
+    return np.unique(plan.flat_index()[p, y, x])
+
+
+def _known(plan: Plan, outcome: np.ndarray, computed: np.ndarray) -> np.ndarray:
+    c = np.asarray(computed).ravel() > FILLED
+    k = np.where(c, np.asarray(outcome).ravel(), -1).astype(np.int8)
+    return plan.panels(k)
+
+
+def audit_mask(plan: Plan) -> np.ndarray:
+    """bool[size]: the audit candidates, a fixed Bernoulli(audit) sample of all points
+    (``seed``); those still filled once refinement has converged are computed."""
+    if plan.audit <= 0:
+        return np.zeros(plan.size, bool)
+    return np.random.default_rng(plan.seed).random(plan.size) < plan.audit
+
+
+# --- the state machine --------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Batch:
+    """Points to compute next: flat: int64[n], increasing; kind: "coarse" | "refine" |
+    "audit" | "done" (flat empty); stride: the lattice the points complete (1 for audit)."""
+
+    flat: np.ndarray
+    kind: str
+    stride: int
+
+    def __len__(self) -> int:
+        return int(self.flat.size)
+
+
+def next_batch(plan: Plan, outcome: np.ndarray, computed: np.ndarray) -> Batch:
+    """The next batch of points to compute, from the state alone (see module docstring).
+
+    outcome, computed: int8[size] (or the grid's shape); outcome is read only where
+    computed > 0. Order: the coarse lattice; then, at every level at once, the points of
+    the refined cells not computed yet (all belong to the final computed set, whatever is
+    computed later, so batching them together changes nothing but the number of rounds;
+    stride: the coarsest level among them); once refinement has converged, the audit
+    points not yet computed; then "done".
+    """
+    done = np.asarray(computed).ravel() > FILLED
+    s0 = 2**plan.coarse
+    coarse = _lattice_points(plan, s0)
+    missing = coarse[~done[coarse]]
+    if missing.size:
+        return Batch(np.sort(missing), "coarse", s0)
+    known = _known(plan, outcome, computed)
+    parts, stride = [], 0
+    for s in plan.strides:
+        refine = _dilate(_cells(known, s).mixed, plan.margin if s > 2 else plan.final_margin)
+        if not refine.any():
+            continue
+        want = _points_of_cells(plan, refine, s)
+        missing = want[~done[want]]
+        if missing.size:
+            parts.append(missing)
+            stride = stride or s // 2
+    if parts:
+        return Batch(np.unique(np.concatenate(parts)), "refine", stride)
+    missing = np.flatnonzero(audit_mask(plan) & ~done)
+    if missing.size:
+        return Batch(missing.astype(np.int64), "audit", 1)
+    return Batch(np.empty(0, np.int64), "done", 0)
+
+
+def fill(plan: Plan, outcome: np.ndarray, computed: np.ndarray) -> np.ndarray:
+    """int8[size]: the computed class where computed > 0; elsewhere the class of the uniform
+    cell (four corners computed, one class inside) around the point, coarsest first; -1
+    where no such cell exists yet (never, once ``next_batch`` says "done")."""
+    known = _known(plan, outcome, computed)
+    out = known.copy()
+    _, ny, nx = plan.panel_shape
+    for s in plan.strides:
+        cls = _cells(known, s).uniform_class
+        cy = np.minimum(np.arange(ny) // s, cls.shape[1] - 1)
+        cx = np.minimum(np.arange(nx) // s, cls.shape[2] - 1)
+        cand = cls[:, cy][:, :, cx]
+        out = np.where(out < 0, cand, out)
+    flat = np.empty(plan.size, np.int8)
+    idx = plan.flat_index()
+    flat[idx.ravel()] = out.ravel()
+    return flat
+
+
+def audit_flags(filled_before: np.ndarray, outcome: np.ndarray) -> np.ndarray:
+    """int8[n]: AUDIT where the computed class equals the fill it replaces, else
+    AUDIT_MISS. filled_before: ``fill(...)`` of the state before the audit batch, at the
+    batch's points; outcome: the computed classes there."""
+    same = np.asarray(filled_before) == np.asarray(outcome)
+    return np.where(same, AUDIT, AUDIT_MISS).astype(np.int8)
+
+
+# --- driving it -------------------------------------------------------------------------
+
+@dataclass
+class AdaptiveStats:
+    """What an adaptive run did. points: grid size; computed: points computed (audit
+    included); audited / audit_misses: audit points and those that disagreed with their
+    fill; batches: (kind, stride, points) in order; threshold: warning level of the audit
+    miss share; seconds: wall time."""
+
+    points: int
+    computed: int
+    audited: int
+    audit_misses: int
+    batches: list[tuple[str, int, int]] = field(default_factory=list)
+    threshold: float = DEFAULT_AUDIT_THRESHOLD
+    seconds: float = 0.0
+
+    @property
+    def computed_share(self) -> float:
+        return self.computed / self.points if self.points else 0.0
+
+    @property
+    def audit_miss_share(self) -> float:
+        return self.audit_misses / self.audited if self.audited else 0.0
+
+    @property
+    def suspicious(self) -> bool:
+        """More audit points disagreed than the threshold allows: features smaller than
+        the coarse cell are likely missed; rerun with a lower coarse level."""
+        return self.audit_miss_share > self.threshold
+
+    def warning(self) -> str | None:
+        if not self.suspicious:
+            return None
+        return (f"{self.audit_misses} of {self.audited} audit points "
+                f"({100 * self.audit_miss_share:.2f}%) disagreed with the filled class "
+                f"(threshold {100 * self.threshold:.2f}%): the diagram has features finer "
+                "than the coarse cells; use a lower coarse level")
+
+
+def stats_of(outcome_computed: np.ndarray, threshold: float = DEFAULT_AUDIT_THRESHOLD
+             ) -> AdaptiveStats:
+    """Counts from a ``computed`` flag array alone (what ``rocksweep info`` can print)."""
+    c = np.asarray(outcome_computed).ravel()
+    n = np.bincount(c.astype(np.int64), minlength=4)
+    return AdaptiveStats(points=int(c.size), computed=int(n[1:].sum()),
+                         audited=int(n[AUDIT] + n[AUDIT_MISS]), audit_misses=int(n[AUDIT_MISS]),
+                         threshold=threshold)
+
+
+def drive(plan: Plan, evaluate: Callable[[np.ndarray, Batch], np.ndarray],
+          outcome: np.ndarray | None = None, computed: np.ndarray | None = None,
+          threshold: float = DEFAULT_AUDIT_THRESHOLD
+          ) -> tuple[np.ndarray, np.ndarray, AdaptiveStats]:
+    """Run the adaptive loop in memory: ``evaluate(flat, batch) -> int8[n] classes``.
+
+    outcome, computed: a state to resume from (flat, int8[size]); default: nothing
+    computed. Returns the filled outcome (int8[size]), the computed flags (int8[size]) and
+    the stats. The driver of ``rocksweep sweep --adaptive`` does the same with the file.
+    """
+    t0 = time.perf_counter()
+    size = plan.size
+    outcome = (np.full(size, -1, np.int8) if outcome is None
+               else np.asarray(outcome, np.int8).ravel().copy())
+    computed = (np.zeros(size, np.int8) if computed is None
+                else np.asarray(computed, np.int8).ravel().copy())
+    batches = []
+    while True:
+        b = next_batch(plan, outcome, computed)
+        if b.kind == "done":
+            break
+        before = fill(plan, outcome, computed)[b.flat] if b.kind == "audit" else None
+        cls = np.asarray(evaluate(b.flat, b), np.int8)
+        outcome[b.flat] = cls
+        computed[b.flat] = COMPUTED if before is None else audit_flags(before, cls)
+        batches.append((b.kind, b.stride, len(b)))
+    filled = fill(plan, outcome, computed)
+    st = stats_of(computed, threshold)
+    st.batches, st.seconds = batches, time.perf_counter() - t0
+    return filled, computed, st
+
+
+@dataclass
+class BatchResult:
+    """Results of some points of a batch: flat: int64[n] (increasing), arrays: name ->
+    array[n] (``rocksweep.sweep.VARIABLES``), seconds / cpu_seconds of the chunk."""
+
+    flat: np.ndarray
+    arrays: dict[str, np.ndarray]
+    seconds: float
+    cpu_seconds: float
+
+
+class _Subset:
+    """A grid seen through a list of flat indices: what ``rocksweep.sweep.run_chunk`` needs
+    (``rows(start, stop)`` over positions in the list, ``kinds()``), so a batch runs through
+    the chunk machinery (threads or dask) unchanged."""
+
+    def __init__(self, grid: Grid, flat: np.ndarray) -> None:
+        self.grid = grid
+        self.flat = np.asarray(flat, np.int64)
+
+    def rows(self, start: int, stop: int):  # noqa: ANN201 (ChunkRows)
+        return self.grid.rows_at(self.flat[start:stop])
+
+    def kinds(self) -> list[int]:
+        return self.grid.kinds()
+
+
+def run_batch(grid: Grid, flat: np.ndarray, jobs: int = 1, chunk_size: int | None = None,
+              backend: str = "threads", scheduler: str | None = None
+              ) -> Iterator[BatchResult]:
+    """Compute the points ``flat`` (int64[n]) through ``rocksweep.sweep.run_chunks``; yield
+    each chunk's results as it finishes (any order). Results depend only on the point."""
+    from rocksweep import sweep as sw
+
+    flat = np.asarray(flat, np.int64)
+    if flat.size == 0:
+        return
+    n_workers = sw.effective_jobs(jobs) if backend == "threads" else 1
+    size = chunk_size or sw.auto_chunk_size(flat.size, n_workers)
+    sub = _Subset(grid, flat)
+    chunks = sw.plan_chunks(np.ones(flat.size, bool), size)
+    for r in sw.run_chunks(sub, chunks, sw.level(grid.scene), jobs, backend,  # type: ignore[arg-type]
+                           scheduler):
+        yield BatchResult(flat[r.start:r.stop], r.arrays, r.seconds, r.cpu_seconds)
+
+
+def adaptive_compute(scene: Scene, jobs: int = 1, coarse: int | None = None,
+                     audit: float = DEFAULT_AUDIT, margin: int = DEFAULT_MARGIN,
+                     axes: Sequence[str] = DIAGRAM_AXES, seed: int = DEFAULT_SEED,
+                     chunk_size: int | None = None, backend: str = "threads",
+                     scheduler: str | None = None,
+                     threshold: float = DEFAULT_AUDIT_THRESHOLD,
+                     final_margin: int = DEFAULT_FINAL_MARGIN,
+                     on_batch: Callable[[Batch], None] | None = None
+                     ) -> tuple[dict[str, np.ndarray], AdaptiveStats]:
+    """Adaptive sweep of a whole scene in memory, like ``rocksweep.sweep.compute``.
+
+    Returns (arrays, stats): arrays maps every variable of ``rocksweep.sweep.variables``
+    plus ``computed`` (int8 flags, see COMPUTED_MEANING) to an array of the grid's shape;
+    ``outcome`` is filled everywhere, the other variables hold their "not computed" fill
+    value at filled points. Identical whatever ``jobs``, ``chunk_size`` and backend.
+    """
+    from rocksweep import sweep as sw
+
+    grid = Grid(scene)
+    plan = make_plan(grid, axes, coarse, margin, audit, seed, final_margin)
+    specs = sw.variables(scene)
+    flat = {k: np.full(grid.size, fv, dt) for k, (dt, fv, _) in specs.items()}
+
+    def evaluate(points: np.ndarray, batch: Batch) -> np.ndarray:
+        if on_batch is not None:
+            on_batch(batch)
+        for res in run_batch(grid, points, jobs, chunk_size, backend, scheduler):
+            for k, v in res.arrays.items():
+                flat[k][res.flat] = v
+        return flat["outcome"][points]
+
+    outcome, computed, stats = drive(plan, evaluate, threshold=threshold)
+    flat["outcome"] = outcome
+    flat["computed"] = computed
+    return {k: v.reshape(grid.shape) for k, v in flat.items()}, stats
