@@ -13,7 +13,7 @@ Formats read:
   that header).
 - A plain two-column file: ``t [s]  xg'' [g]`` per line, whitespace or comma separated,
   lines starting with ``#`` (a header) and blank lines ignored. Times must increase
-  uniformly (each step within 1e-3 of the mean step: printed times may be rounded); the
+  uniformly (each step within 1e-3 of the first step: printed times may be rounded); the
   first row is the record's t = 0.
 
 Why a parser of our own: the AT2 readers in the packages available here have known
@@ -156,8 +156,10 @@ def _header(lines: list[str], src: str) -> tuple[int, float]:
                           "record in units of g")
     m = _NGA_HEADER.match(lines[3]) or _OLD_HEADER.match(lines[3])
     if m is None:
-        raise RecordError(f"{_where(src, 4)}: {lines[3].strip()[:60]!r}: missing header: "
-                          "expected 'NPTS=  4000, DT= .01000 SEC' or '4000  0.0100  NPTS, DT'")
+        found = lines[3].strip()
+        found = found if len(found) <= 32 else found[:29].rstrip() + "..."
+        raise RecordError(f"{_where(src, 4)}: missing header: expected 'NPTS=  4000, DT= "
+                          f".01000 SEC' or '4000  0.0100  NPTS, DT', found {found!r}")
     npts_s, dt_s = m.groups()
     try:
         npts = int(npts_s)
@@ -211,14 +213,15 @@ def _parse_two_column(lines: list[str], src: str) -> tuple[float, np.ndarray, st
         raise RecordError(f"{_where(src, rows[-1] if rows else 1)}: {len(t)} sample(s): a "
                           f"record needs at least {_NPTS_MIN}")
     tt = np.array(t)
-    dt = (tt[-1] - tt[0]) / (tt.size - 1)
     steps = np.diff(tt)
-    bad = np.flatnonzero(np.abs(steps - dt) > 1e-3 * dt)
+    # each step against the first (printed times may be rounded: 1e-3 of a step is allowed)
+    bad = np.flatnonzero(np.abs(steps - steps[0]) > 1e-3 * steps[0])
     if bad.size:
         i = int(bad[0]) + 1
         raise RecordError(f"{_where(src, rows[i])}: time step {steps[i - 1]:.6g} s differs "
-                          f"from the record's mean step {dt:.6g} s: times must be uniformly "
-                          "spaced")
+                          f"from the first step {steps[0]:.6g} s (line {rows[1]}): times must "
+                          "be uniformly spaced")
+    dt = (tt[-1] - tt[0]) / (tt.size - 1)  # the mean step: rounding errors average out
     return float(dt), np.array(a, dtype=np.float64), ""
 
 
