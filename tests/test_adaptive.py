@@ -1,0 +1,220 @@
+"""Adaptive sweeps (rocksweep.adaptive): same outcomes as the full grid where the diagram is
+resolved, islands caught by the audit, results independent of workers, chunking and
+interruptions."""
+
+import numpy as np
+import pytest
+
+import rocksweep.adaptive as ad
+import rocksweep.sweep as sw
+from rocksweep.errors import RocksweepError
+from rocksweep.scene import load_scene, parse_scene
+
+# A rigid block under long pulses (omega/p <= 0.6): below A = g tan(alpha) (A_ratio < 1)
+# the ground cannot lift it (the inertial moment M A h_cg stays below the restoring
+# moment M g b), so it never rocks and is safe; above, the pulse lasts long enough to tip
+# it over. The diagram is two large regions and one boundary near A_ratio = 1.
+BLOCK_LONG = """body: {kind: block, alpha: 0.2, inertia: 1.3333333333333333}
+pulse: {shape: sine, w_over_p: {start: 0.05, stop: 0.6, num: 33},
+        A_ratio: {start: 0.5, stop: 2.5, num: 33}}
+"""
+
+
+def assert_same(a: dict, b: dict) -> None:
+    assert a.keys() == b.keys()
+    for k in a:
+        assert a[k].dtype == b[k].dtype, k
+        np.testing.assert_array_equal(a[k], b[k], err_msg=k)
+
+
+def synthetic(plan: ad.Plan, truth: np.ndarray):
+    """An evaluator that looks classes up in a planted map (flat int8[size])."""
+    calls = []
+
+    def evaluate(flat, batch):
+        calls.append((batch.kind, flat.copy()))
+        return truth[flat]
+
+    return evaluate, calls
+
+
+@pytest.fixture(scope="module")
+def block_long():
+    sc = parse_scene(BLOCK_LONG)
+    return sc, sw.compute(sc, jobs=1)
+
+
+# --- against the full grid, real kernel -------------------------------------------------
+
+def test_block_long_pulse_equals_full_grid(block_long):
+    sc, full = block_long
+    A = np.asarray(sc.axis("A_ratio").values)
+    assert (full["outcome"][A < 1] == 0).all()  # no uplift below g tan(alpha)
+    assert (full["outcome"][A > 1.2] > 0).all()  # a boundary to find
+    arr, st = ad.adaptive_compute(sc, jobs=1)
+    np.testing.assert_array_equal(arr["outcome"], full["outcome"])
+    assert st.computed < 0.5 * st.points
+    c = arr["computed"] > 0
+    # computed points hold the kernel's results, filled ones the "not computed" values
+    for k, (_, fv, _) in sw.variables(sc).items():
+        np.testing.assert_array_equal(arr[k][c], full[k][c], err_msg=k)
+        if k != "outcome":
+            np.testing.assert_array_equal(arr[k][~c], np.full((~c).sum(), fv), err_msg=k)
+    assert set(np.unique(arr["computed"])) <= {ad.FILLED, ad.COMPUTED, ad.AUDIT,
+                                               ad.AUDIT_MISS}
+    assert (~c).any()
+
+
+def test_figure_3a_two_lam_equals_full_grid():
+    """The paper's Figure 3(a) at its shipped 80 x 80, lam = 0 and 0.4."""
+    sc = load_scene("configs/fig3a.yaml", ["impact.lam=[0.0, 0.4]"])
+    full = sw.compute(sc, jobs=2)
+    arr, st = ad.adaptive_compute(sc, jobs=2)
+    np.testing.assert_array_equal(arr["outcome"], full["outcome"])
+    assert st.audit_misses == 0 and not st.suspicious
+    assert st.computed_share < 0.5
+
+
+def test_same_results_whatever_jobs_and_chunks(block_long):
+    sc, _ = block_long
+    a, sa = ad.adaptive_compute(sc, jobs=1, chunk_size=7)
+    b, sb = ad.adaptive_compute(sc, jobs=2, chunk_size=64)
+    c, _ = ad.adaptive_compute(sc, jobs=2)
+    assert_same(a, b)
+    assert_same(a, c)
+    assert sa.batches == sb.batches
+
+
+# --- planted maps (synthetic classifier) --------------------------------------------------
+
+def disc_map(shape, cx, cy, r):
+    """Class 2 inside a disc, class 1 above the line y = 0.3 ny + 0.2 x, else 0."""
+    P, ny, nx = shape
+    y, x = np.mgrid[0:ny, 0:nx]
+    m = np.where(y > 0.3 * ny + 0.2 * x, 1, 0)
+    m = np.where((x - cx) ** 2 + (y - cy) ** 2 < r * r, 2, m)
+    return np.broadcast_to(m, shape).astype(np.int8).copy()
+
+
+def test_smooth_planted_map_recovered_exactly_and_cheaply():
+    shape = (2, 257, 257)
+    truth = disc_map(shape, 150.3, 60.7, 30.0)
+    plan = ad.Plan(shape, 2, 1, audit=0.0)
+    evaluate, _ = synthetic(plan, truth.ravel())
+    out, comp, st = ad.drive(plan, evaluate)
+    np.testing.assert_array_equal(out, truth.ravel())
+    assert st.computed_share < 0.15
+    assert (comp[out != truth.ravel()] > 0).all()
+
+
+def test_audit_catches_planted_island():
+    shape = (1, 129, 129)
+    base = np.zeros(shape, np.int8)
+    plan = ad.Plan(shape, 2, 1, coarse=5, audit=0.05, seed=3)
+    # plant a 3 x 3 island of class 1 on an audit candidate far from every coarse sample
+    cand = ad.audit_mask(plan).reshape(shape)[0]
+    ys, xs = np.nonzero(cand)
+    far = (np.abs((ys + 16) % 32 - 16) >= 8) & (np.abs((xs + 16) % 32 - 16) >= 8)
+    y0, x0 = ys[far][0], xs[far][0]
+    truth = base.copy()
+    truth[0, y0 - 1:y0 + 2, x0 - 1:x0 + 2] = 1
+    t = truth.ravel()
+    # without an audit the island is missed: it lies inside one uniform coarse cell
+    out0, _, st0 = ad.drive(ad.Plan(shape, 2, 1, coarse=5, audit=0.0), synthetic(plan, t)[0])
+    assert (out0 == 0).all() and st0.audited == 0
+    # with it, the audit point disagrees, the region is refined and the island recovered
+    out, comp, st = ad.drive(plan, synthetic(plan, t)[0], threshold=0.0)
+    np.testing.assert_array_equal(out, t)
+    assert st.audit_misses >= 1 and comp.reshape(shape)[0, y0, x0] == ad.AUDIT_MISS
+    assert st.suspicious and "audit points" in st.warning()
+    # the audit share: about 5% of the points that would otherwise have been filled
+    filled0 = int((ad.drive(ad.Plan(shape, 2, 1, coarse=5, audit=0.0),
+                            synthetic(plan, base.ravel())[0])[1] == 0).sum())
+    _, _, st_clean = ad.drive(plan, synthetic(plan, base.ravel())[0], threshold=0.0)
+    assert 0.03 * filled0 < st_clean.audited < 0.07 * filled0
+    assert st_clean.audit_misses == 0 and not st_clean.suspicious
+
+
+def test_interrupted_run_resumes_to_the_same_result():
+    """The next batch is a function of the state: computing any part of a batch, then
+    asking again, ends with the same outcomes and computed set as an uninterrupted run."""
+    shape = (3, 97, 65)
+    truth = disc_map(shape, 40.2, 50.5, 12.0).ravel()
+    plan = ad.Plan(shape, 2, 1, coarse=3, audit=0.1, seed=1)
+    ref_out, ref_comp, _ = ad.drive(plan, synthetic(plan, truth)[0])
+    outcome = np.full(plan.size, -1, np.int8)
+    computed = np.zeros(plan.size, np.int8)
+    rng = np.random.default_rng(0)
+    for _ in range(1000):
+        b = ad.next_batch(plan, outcome, computed)
+        if b.kind == "done":
+            break
+        part = b.flat[rng.random(len(b)) < 0.4] if len(b) > 1 else b.flat  # "killed"
+        outcome[part] = truth[part]
+        computed[part] = ad.AUDIT if b.kind == "audit" else ad.COMPUTED
+    else:
+        raise AssertionError("no convergence")
+    np.testing.assert_array_equal(ad.fill(plan, outcome, computed), ref_out)
+    np.testing.assert_array_equal(computed > 0, ref_comp > 0)
+    # a finished file asks for nothing more, even with filled classes in outcome
+    filled = ad.fill(plan, outcome, computed)
+    assert ad.next_batch(plan, filled, computed).kind == "done"
+
+
+def test_other_diagram_axes_equal_transposed_default():
+    shape = (2, 65, 81)
+    truth = disc_map(shape, 30.5, 20.2, 9.0)
+    plan = ad.Plan(shape, 2, 1, audit=0.02)
+    out, comp, _ = ad.drive(plan, synthetic(plan, truth.ravel())[0])
+    # the same map with the diagram axes first and the "other" axis last, y and x swapped
+    moved = np.ascontiguousarray(np.transpose(truth, (2, 1, 0)))  # (x, y, panel)
+    plan_t = ad.Plan(moved.shape, 0, 1, audit=0.0)
+    out_t, comp_t, _ = ad.drive(plan_t, synthetic(plan_t, moved.ravel())[0])
+    np.testing.assert_array_equal(out_t.reshape(moved.shape), moved)
+    np.testing.assert_array_equal(out.reshape(shape), truth)
+
+
+# --- pieces ------------------------------------------------------------------------------
+
+def test_plan_coarse_takes_every_2k_th_index_and_the_last():
+    shape = (9, 3, 17)
+    flat = ad.plan_coarse(shape, (0, 2), 2)  # x = axis 0 (9), y = axis 2 (17), stride 4
+    i, j, k = np.unravel_index(flat, shape)
+    assert sorted(set(i.tolist())) == [0, 4, 8]
+    assert sorted(set(k.tolist())) == [0, 4, 8, 12, 16]
+    assert sorted(set(j.tolist())) == [0, 1, 2]
+    assert flat.size == 3 * 3 * 5 and np.all(np.diff(flat) > 0)
+    flat = ad.plan_coarse((1, 10, 10), (2, 1), 2)  # last index 9 is not a multiple of 4
+    _, y, x = np.unravel_index(flat, (1, 10, 10))
+    assert sorted(set(y.tolist())) == sorted(set(x.tolist())) == [0, 4, 8, 9]
+
+
+def test_default_coarse_keeps_16_cells_per_axis():
+    assert ad.default_coarse(80, 80) == 2      # 79 / 4 = 19.75 cells
+    assert ad.default_coarse(400, 400) == 4    # 399 / 16 = 24.9
+    assert ad.default_coarse(1000, 1000) == 5  # 999 / 32 = 31.2
+    assert ad.default_coarse(10, 400) == 0     # too few points for a coarse pass
+    assert ad.Plan((1, 400, 80), 2, 1).coarse == 2
+
+
+def test_stats_from_flags_alone():
+    flags = np.array([0, 0, 1, 1, 1, 2, 2, 3], np.int8)
+    st = ad.stats_of(flags, threshold=0.1)
+    assert (st.points, st.computed, st.audited, st.audit_misses) == (8, 6, 3, 1)
+    assert st.suspicious and st.warning()
+    assert not ad.stats_of(flags[:-1]).suspicious
+
+
+@pytest.mark.parametrize("kwargs, word", [
+    ({"axes": ("w_over_p", "speed")}, "speed"),
+    ({"axes": ("w_over_p", "lam")}, "lam"),
+    ({"axes": ("w_over_p",)}, "two axis names"),
+    ({"audit": 1.5}, "audit = 1.5"),
+    ({"margin": -1}, "margin = -1"),
+    ({"coarse": -2}, "coarse = -2"),
+])
+def test_bad_settings_are_one_line_errors(block_long, kwargs, word):
+    sc, _ = block_long
+    with pytest.raises(RocksweepError) as err:
+        ad.make_plan(sc, **kwargs)
+    assert word in str(err.value) and "\n" not in str(err.value)
