@@ -95,6 +95,12 @@ def check_output(path: str | Path, *, overwrite: bool = False,
     return path
 
 
+def _umask() -> int:
+    mask = os.umask(0o022)  # read it (the only way), then put it back
+    os.umask(mask)
+    return mask
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | Path) -> Iterator[Path]:
     """A temporary path next to ``path``, unique to this process, renamed to ``path`` when
@@ -109,6 +115,8 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         fd, name = tempfile.mkstemp(prefix=f".{path.stem[:40]}.", suffix=f".partial{path.suffix}",
                                     dir=parent)
         os.close(fd)
+        # mkstemp makes the file 0600; an output gets the mode any new file would get
+        os.chmod(name, 0o666 & ~_umask())
     except OSError as err:
         raise OutputError(f"{shown(path)}: cannot be written ({_reason(err)})") from None
     tmp = Path(name)
