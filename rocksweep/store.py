@@ -1,6 +1,7 @@
 """Sweep results on disk (HDF5 through h5py; the only module that writes them).
 
-Layout (netCDF-4 style, so ``xarray.open_dataset(path, engine="h5netcdf")`` opens it):
+Layout (netCDF-4 / CF-1.10, so ``xarray.open_dataset(path, engine="h5netcdf")`` and
+netCDF-4 readers open it):
 
 - one dataset per swept axis, named after it (``shape``, a body key, ``lam``, ``A_ratio``,
   ``w_over_p``), holding its values and made an HDF5 dimension scale;
@@ -8,22 +9,51 @@ Layout (netCDF-4 style, so ``xarray.open_dataset(path, engine="h5netcdf")`` open
   ``coordinates`` attribute);
 - one dataset per stored variable (``rocksweep.sweep.VARIABLES``) with the grid's
   dimensions attached; ``outcome`` is -1 where a point is not computed yet;
-- attributes: the scene YAML verbatim and its resolved form, the resolved numerics,
-  versions, times, totals and the format version.
+- every variable and coordinate has ``long_name`` and (but the pulse shape and the flag
+  variables ``outcome``, ``status``) CF ``units``: ``"rad"`` for angles, ``"1"`` for
+  everything else, which is a pure number: Pi groups, counts, theta/alpha_ref, energies
+  / E_ref, and times p*t (``t_overturn``: its ``long_name`` says p*t, its
+  ``rocksweep_units`` the scale, here ``"1/p"``);
+- global attributes: ``Conventions`` (``CF-1.10``), ``title``, ``source``, ``history``
+  (one line per session: time, host, backend, rocksweep version, points done), the scene
+  YAML verbatim and its resolved form, the resolved numerics, versions, times, totals,
+  ``host`` and ``backend`` of the latest session and the format version. ``complete``
+  and ``energy`` are int8 0/1 (netCDF has no boolean attribute; HDF5 enums are lost).
 
-Only the parent process writes. Datasets are allocated in full when the file is made
-(under a temporary name, renamed when complete), so later writes touch raw data only: a
-killed run leaves a well-formed file whose ``outcome`` marks exactly the finished points
-(each chunk's other variables are flushed before its ``outcome``). ``--resume`` reopens it
-and computes the rest.
+Only the parent process writes. Datasets are allocated in full when the file is made,
+under a temporary name unique to the process, renamed when complete, so later writes
+touch raw data only: a killed run leaves a well-formed file whose ``outcome`` marks
+exactly the finished points (each chunk's other variables are flushed before its
+``outcome``). ``--resume`` reopens it and computes the rest.
+
+Safety (issue 16):
+
+- The attributes a session changes (``SESSION_ATTRS``) have fixed-size types (numbers,
+  fixed-length strings) and are overwritten in place (``attrs.modify``): reopening,
+  writing results and finishing never need new space in the file, so a full disk cannot
+  damage what is there, and resuming on a full disk works.
+- A new file's size is known (every dataset is allocated at creation): a grid larger
+  than the free space is refused before anything is written.
+- A writer holds HDF5's exclusive lock (``flock``) on its file; ``create`` takes the same
+  lock on a file it overwrites, and holds the new file's lock before it is renamed into
+  place, so no two processes write one path, whatever ``--resume``/``--overwrite`` they
+  are given. Without ``overwrite`` the rename is a hard link, which fails if another
+  process made the path meanwhile.
+- Readers validate what they rely on (attributes, coordinates, shapes, dtypes, outcome
+  codes); every problem is a one-line ``StoreError`` naming the file.
 """
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import json
 import math
 import os
 import platform
+import re
+import shutil
+import tempfile
 from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
@@ -31,10 +61,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import OutputError, RocksweepError
 from rocksweep.grid import Grid
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
+from rocksweep.outputs import _reason, check_output, shown
 from rocksweep.scene import Scene
 from rocksweep.sweep import ChunkResult, variables
 
@@ -42,7 +73,34 @@ if TYPE_CHECKING:
     import h5py
 
 FORMAT = "rocksweep-sweep"
-FORMAT_VERSION = 1
+# 1: first release; 2: CF attributes (units, Conventions, int8 flags), fixed-size session
+# attributes, history/host/backend. This version reads both and resumes both.
+FORMAT_VERSION = 2
+CONVENTIONS = "CF-1.10"
+
+# Free space required beyond the datasets' bytes when a file is made [bytes]: HDF5
+# metadata (attributes, object headers, the scene text) is well under 100 kB.
+SPACE_MARGIN = 1 << 20
+# Size of the ``history`` attribute [bytes]: fixed, so a session rewrites it in place;
+# about 30 sessions of one line each (the oldest are dropped beyond that).
+HISTORY_BYTES = 4096
+
+# The attributes a session changes -> fixed-size dtype (written in place, never resized).
+SESSION_ATTRS: dict[str, str] = {
+    "sessions": "int64",
+    "last_started": "S32",
+    "last_finished": "S32",
+    "finished": "S32",
+    "wall_time": "float64",
+    "cpu_time": "float64",
+    "points_done": "int64",
+    "complete": "int8",
+    "steps_total": "int64",
+    "event_steps_total": "int64",
+    "host": "S256",
+    "backend": "S256",
+    "history": f"S{HISTORY_BYTES}",
+}
 
 # long names of the coordinates (the paper's symbols)
 COORD_LONG_NAMES = {
@@ -59,6 +117,19 @@ COORD_LONG_NAMES = {
     "alpha": "alpha [rad]",
     "inertia": "I_O/(M R^2)",
 }
+# CF units of the coordinates: angles in radians, the other Pi groups are pure numbers.
+COORD_UNITS = {"alpha_cg": "rad", "alpha_A": "rad", "alpha": "rad"}
+# Variables whose values are codes (CF flag_values / flag_masks): no units.
+FLAG_VARIABLES = ("outcome", "status")
+# rocksweep's own unit of a variable where it is not plainly "1" (the CF units are "1":
+# each is a ratio). TODO(fields.py): read ``rocksweep.fields.UNITS`` once fields.py is
+# committed; it holds these same strings.
+SCALED_UNITS = {"theta_max_over_alpha": "alpha_ref", "t_overturn": "1/p",
+                "work_in_over_Eref": "E_ref", "damper_loss_over_Eref": "E_ref",
+                "impact_loss_over_Eref": "E_ref"}
+
+# What h5py raises for I/O and damaged files (HDF5 errors surface as any of these).
+_H5_ERRORS = (OSError, RuntimeError, ValueError, KeyError, TypeError, IndexError)
 
 
 class StoreError(RocksweepError):
@@ -67,6 +138,22 @@ class StoreError(RocksweepError):
 
 def _now() -> str:
     return datetime.now(timezone.utc).isoformat(timespec="seconds")
+
+
+def _why(err: BaseException) -> str:
+    """One short phrase for an OS or HDF5 error (from its errno where it has one)."""
+    no = getattr(err, "errno", None)
+    if not isinstance(no, int):
+        m = re.search(r"errno = (\d+)", str(err))
+        no = int(m.group(1)) if m else None
+    if no:
+        return _reason(OSError(no, os.strerror(no)))
+    text = str(err).strip().splitlines()
+    return text[0][:160] if text else type(err).__name__
+
+
+def _mib(n: float) -> str:
+    return f"{n / 2**20:.1f} MiB"
 
 
 def versions() -> dict[str, str]:
@@ -157,38 +244,160 @@ def flat_slabs(shape: tuple[int, ...], start: int, stop: int) -> list[tuple[tupl
     return out
 
 
-def _check_format(f: h5py.File, path: Path) -> None:
-    import h5py
-    fmt = f.attrs.get("rocksweep_format")
-    if isinstance(fmt, bytes):
-        fmt = fmt.decode()
-    if fmt != FORMAT:
-        raise StoreError(f"{path}: an HDF5 file, but not a rocksweep sweep result "
-                         "(no rocksweep_format attribute)")
-    ver = int(f.attrs.get("format_version", -1))
-    if ver > FORMAT_VERSION:
-        raise StoreError(f"{path}: written in result format {ver} by a newer rocksweep; "
-                         f"this version reads format {FORMAT_VERSION}; upgrade rocksweep")
-    if ver < 1:
-        raise StoreError(f"{path}: damaged rocksweep result (format_version = {ver})")
+def file_bytes(scene: Scene) -> int:
+    """Bytes the datasets of a result file of ``scene`` take (all allocated when the
+    file is made): every variable's dtype size x grid points, plus the coordinates."""
+    grid = Grid(scene)
+    per_point = sum(np.dtype(dt).itemsize for dt, _, _ in variables(scene).values())
+    coords = sum(16 * len(a.values) for a in scene.axes)
+    return per_point * grid.size + coords
+
+
+def _check_space(path: Path, need: int, what: str) -> None:
+    """Refuse (StoreError) when the file system of ``path`` has less than ``need`` bytes
+    free."""
+    parent = path.parent if str(path.parent) else Path(".")
     try:
-        stored = json.loads(_attr_str(f, "scene_resolved"))
-    except (KeyError, ValueError):
-        raise StoreError(f"{path}: damaged rocksweep result "
-                         "(scene_resolved attribute missing or unreadable)") from None
-    dims = tuple(k.split(".", 1)[1] for k, v in stored["axes"].items() if v["swept"])
-    shape = tuple(len(v["values"]) for v in stored["axes"].values() if v["swept"])
+        free = shutil.disk_usage(parent).free
+    except OSError:
+        return  # cannot tell: the writes themselves will say
+    if free < need:
+        raise StoreError(f"{shown(path)}: not enough free space for {what}: needs about "
+                         f"{_mib(need)} ({need} bytes), {_mib(free)} free in {parent}")
+
+
+# ---------------------------------------------------------------------------------------
+# Validation (every reader and resume): what the code relies on, one line per problem
+# ---------------------------------------------------------------------------------------
+
+@dataclass
+class _Layout:
+    """What a valid file holds: its resolved scene, swept dims and their sizes."""
+
+    scene: dict
+    dims: tuple[str, ...]
+    shape: tuple[int, ...]
+    names: list[str]
+
+
+def _damaged(path: Path, what: str) -> StoreError:
+    return StoreError(f"{shown(path)}: damaged rocksweep result ({what})")
+
+
+def _cut(v, n: int = 40) -> str:
+    text = repr(v)
+    return text if len(text) <= n else text[: n - 3] + "..."
+
+
+def _attr_str(f: h5py.File, key: str) -> str:
+    v = f.attrs[key]
+    if isinstance(v, bytes | np.bytes_):
+        return bytes(v).decode("utf-8", "replace")
+    if not isinstance(v, str):
+        raise TypeError(f"attribute {key} is {_cut(_plain(v))}, not text")
+    return v
+
+
+def _check_scene(stored, path: Path) -> None:
+    """The resolved scene dict as ``resolved_scene`` makes it, or StoreError."""
+    def bad(what: str) -> StoreError:
+        return _damaged(path, f"attribute scene_resolved: {what}")
+
+    if not isinstance(stored, dict):
+        raise bad(f"{_cut(stored)} is not a JSON object")
+    for key, typ in (("name", str), ("kind", str), ("energy", bool), ("axes", dict),
+                     ("numerics", dict)):
+        if not isinstance(stored.get(key), typ):
+            raise bad(f"'{key}' is {_cut(stored.get(key))}, not a {typ.__name__}")
+    if not stored["axes"]:
+        raise bad("no axes")
+    for key, ax in stored["axes"].items():
+        if not (isinstance(key, str) and "." in key and isinstance(ax, dict)
+                and isinstance(ax.get("swept"), bool) and isinstance(ax.get("values"), list)
+                and ax["values"]):
+            raise bad(f"axis {_cut(key)} is {_cut(ax)}")
+        kinds = (str,) if key.endswith(".shape") else (int, float)
+        if not all(isinstance(v, kinds) and not isinstance(v, bool) for v in ax["values"]):
+            raise bad(f"axis {key} has values {_cut(ax['values'])}")
+        if not ax["swept"] and len(ax["values"]) != 1:
+            raise bad(f"unswept axis {key} has {len(ax['values'])} values")
+
+
+def _json_attr(f: h5py.File, key: str, path: Path, typ: type):
+    try:
+        text = _attr_str(f, key)
+    except KeyError:
+        raise _damaged(path, f"attribute {key} missing") from None
+    except TypeError as err:
+        raise _damaged(path, str(err)) from None
+    try:
+        value = json.loads(text)
+    except ValueError:
+        raise _damaged(path, f"attribute {key} is not JSON: {_cut(text)}") from None
+    if not isinstance(value, typ):
+        raise _damaged(path, f"attribute {key} is {_cut(text)}, not a JSON "
+                       f"{'object' if typ is dict else 'list'}")
+    return value
+
+
+def _layout(f: h5py.File, path: Path) -> _Layout:
+    """Validate the format, the resolved scene, the coordinates and the variables."""
+    import h5py
+
+    fmt = f.attrs.get("rocksweep_format")
+    if isinstance(fmt, bytes | np.bytes_):
+        fmt = bytes(fmt).decode("utf-8", "replace")
+    if fmt != FORMAT:
+        raise StoreError(f"{shown(path)}: an HDF5 file, but not a rocksweep sweep result "
+                         "(no rocksweep_format attribute)")
+    try:
+        ver = int(f.attrs.get("format_version", -1))
+    except (TypeError, ValueError):
+        raise _damaged(path, f"format_version = {_cut(_plain(f.attrs['format_version']))}"
+                       ) from None
+    if ver > FORMAT_VERSION:
+        raise StoreError(f"{shown(path)}: written in result format {ver} by a newer "
+                         f"rocksweep; this version reads formats 1 to {FORMAT_VERSION}; "
+                         "upgrade rocksweep")
+    if ver < 1:
+        raise _damaged(path, f"format_version = {ver}")
+    stored = _json_attr(f, "scene_resolved", path, object)
+    _check_scene(stored, path)
+    swept = {k.split(".", 1)[1]: v["values"] for k, v in stored["axes"].items() if v["swept"]}
+    dims = tuple(swept)
+    shape = tuple(len(v) for v in swept.values())
+    for d, values in swept.items():
+        ds = f.get(d)
+        if not isinstance(ds, h5py.Dataset):
+            raise _damaged(path, f"coordinate '{d}' missing")
+        if ds.shape != (len(values),):
+            raise _damaged(path, f"coordinate '{d}' has shape {ds.shape}, the scene "
+                           f"{len(values)} values")
+        data = ds[()]
+        if d == "shape":
+            ok = [_plain(v) for v in data] == values
+        else:
+            ok = data.dtype.kind == "f" and np.array_equal(data, np.asarray(values, float))
+        if not ok:
+            raise _damaged(path, f"coordinate '{d}' holds {_cut(data.tolist())}, the scene "
+                           f"{_cut(values)}")
     names = ["outcome", *(n for n in variables_for(stored) if n != "outcome")]
+    specs = variables_for(stored)
     for name in names:
         ds = f.get(name)
         if not isinstance(ds, h5py.Dataset):
-            raise StoreError(f"{path}: damaged rocksweep result (variable '{name}' missing)")
+            raise _damaged(path, f"variable '{name}' missing")
         if ds.shape != shape:
-            raise StoreError(f"{path}: damaged rocksweep result (variable '{name}' has shape "
-                             f"{ds.shape}, the grid {shape})")
-    for d in dims:
-        if not isinstance(f.get(d), h5py.Dataset):
-            raise StoreError(f"{path}: damaged rocksweep result (coordinate '{d}' missing)")
+            raise _damaged(path, f"variable '{name}' has shape {ds.shape}, the grid {shape}")
+        if ds.dtype != np.dtype(specs[name][0]):
+            raise _damaged(path, f"variable '{name}' has dtype {ds.dtype}, expected "
+                           f"{specs[name][0]}")
+    return _Layout(stored, dims, shape, names)
+
+
+def _check_format(f: h5py.File, path: Path) -> None:
+    """Raise StoreError unless ``f`` is a valid rocksweep result (see ``_layout``)."""
+    _layout(f, path)
 
 
 def variables_for(stored: dict) -> dict:
@@ -198,90 +407,299 @@ def variables_for(stored: dict) -> dict:
     return {**VARIABLES, **(ENERGY_VARIABLES if stored.get("energy") else {})}
 
 
-def _attr_str(f: h5py.File, key: str) -> str:
-    v = f.attrs[key]
-    return v.decode() if isinstance(v, bytes) else str(v)
+def _is_hdf5(path: Path) -> bool:
+    import h5py
+    try:
+        return bool(h5py.is_hdf5(path))
+    except _H5_ERRORS:
+        return False
 
 
 def _open(path: Path, mode: str) -> h5py.File:
-    """Open an existing file; foreign or damaged files give a one-line StoreError."""
+    """Open an existing file; foreign, damaged, locked or unreadable files give a one-line
+    StoreError. Writers (mode "r+") take HDF5's exclusive lock; readers take none."""
     import h5py
-    if not path.exists():
-        raise StoreError(f"{path}: no such file")
-    if path.is_dir():
-        raise StoreError(f"{path}: is a directory, not a sweep result")
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise StoreError(f"{shown(path)}: no such file") from None
+    except OSError as err:
+        raise StoreError(f"{shown(path)}: cannot be read ({_why(err)})") from None
+    if os.path.isdir(path):
+        raise StoreError(f"{shown(path)}: is a directory, not a sweep result")
+    if not os.path.isfile(path):
+        raise StoreError(f"{shown(path)}: not a regular file (expected a rocksweep sweep "
+                         "result)")
+    if st.st_size == 0:
+        raise StoreError(f"{shown(path)}: empty file (expected a rocksweep sweep result)")
     try:
         # readers do not lock: `info` and `plot` work while a sweep writes (datasets are
         # allocated up front, so a running sweep changes raw data only)
         return h5py.File(path, mode, locking=(mode != "r"))
-    except OSError as err:
-        if not h5py.is_hdf5(path):
-            raise StoreError(f"{path}: not an HDF5 file (expected a rocksweep sweep "
+    except _H5_ERRORS as err:
+        no = getattr(err, "errno", None)
+        if isinstance(err, BlockingIOError) or "unable to lock" in str(err).lower():
+            raise StoreError(f"{shown(path)}: open for writing by another process (a sweep "
+                             "still running?)") from None
+        if no in (errno.EACCES, errno.EPERM, errno.EROFS):
+            doing = "written" if mode != "r" else "read"
+            raise StoreError(f"{shown(path)}: cannot be {doing} ({_why(err)})") from None
+        if not _is_hdf5(path):
+            raise StoreError(f"{shown(path)}: not an HDF5 file (expected a rocksweep sweep "
                              "result)") from None
-        if "unable to lock" in str(err).lower():
-            raise StoreError(f"{path}: open for writing by another process (a sweep still "
-                             "running?)") from None
-        raise StoreError(f"{path}: damaged or truncated HDF5 file, cannot be opened "
+        raise StoreError(f"{shown(path)}: damaged or truncated HDF5 file, cannot be opened "
                          "(rerun the sweep with --overwrite)") from None
 
 
-class SweepFile:
-    """A result file open for writing (by the parent process only)."""
+def _close_quietly(f) -> None:
+    """Close after an error: a second error must not hide the first."""
+    with contextlib.suppress(Exception):
+        f.close()
 
-    def __init__(self, path: Path, f: h5py.File, scene: Scene) -> None:
+
+def _fixed(text: str, dtype: str) -> np.ndarray:
+    """``text`` as a fixed-length ASCII string of ``dtype`` (cut to fit)."""
+    n = np.dtype(dtype).itemsize
+    return np.array(text.encode("ascii", "replace")[:n], dtype=dtype)
+
+
+def _put(f: h5py.File, name: str, value) -> None:
+    """Overwrite a session attribute in place (its fixed type and size)."""
+    dtype = SESSION_ATTRS[name]
+    arr = _fixed(value, dtype) if dtype.startswith("S") else np.array(value, dtype=dtype)
+    f.attrs.modify(name, arr)
+
+
+def _in_place(f: h5py.File) -> bool:
+    """Whether every session attribute exists with its fixed type (format 2)."""
+    a = f.attrs
+    for name, dtype in SESSION_ATTRS.items():
+        try:
+            if name not in a or a.get_id(name).dtype != np.dtype(dtype):
+                return False
+        except _H5_ERRORS:
+            return False
+    return True
+
+
+def _upgrade_session_attrs(f: h5py.File) -> None:
+    """Give a format-1 file's session attributes their fixed types (needs a little space,
+    checked before; only the first resume of such a file does this)."""
+    a = f.attrs
+    for name, dtype in SESSION_ATTRS.items():
+        if name in a and a.get_id(name).dtype == np.dtype(dtype):
+            continue
+        old = _plain(a[name]) if name in a else None
+        if name == "complete":
+            old = int(bool(old))
+        elif old is None or (dtype.startswith("S") and not isinstance(old, str)):
+            old = "" if dtype.startswith("S") else 0
+        if name in a:
+            del a[name]
+        a.create(name, _fixed(old, dtype) if dtype.startswith("S")
+                 else np.array(old, dtype=dtype))
+
+
+def _umask_mode() -> int:
+    """Mode of a new file under this process's umask (mkstemp makes files 0600)."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return 0o666 & ~int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    return 0o644
+
+
+def _lock_existing(path: Path) -> int:
+    """Open the file at ``path`` and take the exclusive lock a writer holds (HDF5 locks
+    with flock); returns the descriptor. StoreError if a sweep is writing it."""
+    import fcntl
+
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_CLOEXEC", 0))
+    except OSError as err:
+        raise StoreError(f"{shown(path)}: cannot be replaced ({_why(err)})") from None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        os.close(fd)
+        raise StoreError(f"{shown(path)}: open for writing by another process (a sweep "
+                         "still running?); not overwritten") from None
+    except OSError:
+        pass  # no flock on this file system: HDF5 cannot lock there either
+    return fd
+
+
+def _publish(tmp: Path, path: Path, old_fd: int | None) -> None:
+    """Rename the finished temporary file to ``path``: over the file locked by ``old_fd``,
+    or, without one, only if nothing is at ``path`` (another process may have made it
+    since it was checked)."""
+    os.chmod(tmp, _umask_mode())
+    if old_fd is not None:
+        try:
+            same = os.path.samestat(os.fstat(old_fd), os.stat(path))
+        except OSError:
+            same = False
+        if not same:
+            raise StoreError(f"{shown(path)}: replaced by another process meanwhile; not "
+                             "overwritten")
+        os.replace(tmp, path)
+        return
+    try:
+        os.link(tmp, path)
+    except FileExistsError:
+        raise StoreError(f"{shown(path)}: made by another process meanwhile (a sweep "
+                         "started at the same time?); not overwritten") from None
+    except OSError as err:
+        if err.errno not in (errno.EPERM, errno.ENOTSUP, errno.EOPNOTSUPP, errno.EXDEV,
+                             errno.EMLINK):
+            raise
+        if path.exists():  # no hard links here: check, then rename
+            raise StoreError(f"{shown(path)}: made by another process meanwhile; not "
+                             "overwritten") from None
+        os.replace(tmp, path)
+        return
+    with contextlib.suppress(OSError):
+        os.unlink(tmp)
+
+
+class SweepFile:
+    """A result file open for writing (by the parent process only; it holds the file's
+    exclusive lock until ``close``)."""
+
+    def __init__(self, path: Path, f: h5py.File, scene: Scene,
+                 backend: str | None = None) -> None:
         self.path = path
         self.f = f
         self.grid = Grid(scene)
         self.names = list(variables(scene))
         self.session_start = _now()
+        self.backend = backend or "unspecified"
+        self._history = ""  # the file's history before this session
+        self._session_line = ""
 
     # -- making and reopening -------------------------------------------------------------
     @classmethod
     def create(cls, path: str | Path, scene: Scene, overrides: tuple[str, ...] = (),
-               overwrite: bool = False) -> SweepFile:
-        """Make a new result file (all points not computed), atomically."""
+               overwrite: bool = False, *, backend: str | None = None) -> SweepFile:
+        """Make a new result file (all points not computed), atomically, and open it.
+
+        Refused (StoreError) before anything is written: an existing path without
+        ``overwrite``, a directory, device or FIFO, a missing directory, a grid larger
+        than the free space, a file another process is writing. ``backend``: how the
+        points are computed (e.g. "threads x 2"), recorded with the host in the file.
+        """
         import h5py
         path = Path(path)
-        if path.exists() and not overwrite:
-            raise StoreError(f"{path}: already exists; use --resume to finish it or "
-                             "--overwrite to replace it")
-        if path.is_dir():
-            raise StoreError(f"{path}: is a directory")
-        if not path.parent.is_dir():
-            raise StoreError(f"{path}: directory {path.parent} does not exist")
-        tmp = path.with_name(f".{path.name}.partial")
         try:
-            with h5py.File(tmp, "w", track_order=True) as f:
-                _initialise(f, scene, overrides)
-            os.replace(tmp, path)
-        except OSError as err:
-            raise StoreError(f"{path}: cannot write ({err.strerror or err})") from None
+            check_output(path, overwrite=True)  # devices, directories, missing dirs
+        except OutputError as err:
+            raise StoreError(str(err)) from None
+        existed = os.path.lexists(path)
+        if existed and not overwrite:
+            raise StoreError(f"{shown(path)}: already exists; use --resume to finish it or "
+                             "--overwrite to replace it")
+        grid = Grid(scene)
+        _check_space(path, file_bytes(scene) + SPACE_MARGIN,
+                     f"a grid of {grid.size} points")
+        old_fd = _lock_existing(path) if existed else None
+        tmp: Path | None = None
+        f = None
+        try:
+            parent = path.parent if str(path.parent) else Path(".")
+            fd, name = tempfile.mkstemp(prefix=f".{path.name[:40]}.", suffix=".partial",
+                                        dir=parent)
+            os.close(fd)
+            tmp = Path(name)
+            g = h5py.File(tmp, "w", track_order=True)
+            try:
+                _initialise(g, scene, overrides)
+                g.flush()
+            except BaseException:
+                _close_quietly(g)
+                raise
+            g.close()
+            f = h5py.File(tmp, "r+", locking=True)  # locked before anyone can see it
+            self = cls(path, f, scene, backend)
+            self._start_session()
+            _publish(tmp, path, old_fd)
+            tmp = None
+            return self
+        except StoreError:
+            if f is not None:
+                _close_quietly(f)
+            raise
+        except _H5_ERRORS as err:
+            if f is not None:
+                _close_quietly(f)
+            raise StoreError(f"{shown(path)}: cannot write ({_why(err)}); nothing written"
+                             ) from None
         finally:
-            tmp.unlink(missing_ok=True)
-        return cls._reopen(path, scene)
+            if tmp is not None:
+                with contextlib.suppress(OSError):
+                    os.unlink(tmp)
+            if old_fd is not None:
+                os.close(old_fd)
 
     @classmethod
-    def resume(cls, path: str | Path, scene: Scene,
-               overrides: tuple[str, ...] = ()) -> SweepFile:
-        """Reopen a result file of the same scene to finish it."""
+    def resume(cls, path: str | Path, scene: Scene, overrides: tuple[str, ...] = (),
+               *, backend: str | None = None) -> SweepFile:
+        """Reopen a result file of the same scene to finish it (its points are kept
+        whatever happens: the session's attributes are updated in place)."""
         path = Path(path)
-        with _open(path, "r") as f:
-            _check_format(f, path)
-            stored = json.loads(_attr_str(f, "scene_resolved"))
+        f = _open(path, "r")
+        try:
+            stored = _layout(f, path).scene
+        except _H5_ERRORS as err:
+            raise _damaged(path, _why(err)) from None
+        finally:
+            _close_quietly(f)
         diffs = scene_differences(stored, resolved_scene(scene, overrides))
         if diffs:
-            raise StoreError(f"{path}: cannot resume, the scene differs from the file's: "
-                             + "; ".join(diffs) + " (use --overwrite to start again)")
-        return cls._reopen(path, scene)
-
-    @classmethod
-    def _reopen(cls, path: Path, scene: Scene) -> SweepFile:
+            raise StoreError(f"{shown(path)}: cannot resume, the scene differs from the "
+                             "file's: " + "; ".join(diffs) + " (use --overwrite to start "
+                             "again)")
         f = _open(path, "r+")
-        self = cls(path, f, scene)
-        f.attrs["sessions"] = int(f.attrs.get("sessions", 0)) + 1
-        f.attrs["last_started"] = self.session_start
-        f.flush()
+        try:
+            _layout(f, path)  # the file locked now (another may have replaced the first)
+            self = cls(path, f, scene, backend)
+            self._start_session()
+        except BaseException as err:
+            _close_quietly(f)
+            if isinstance(err, _H5_ERRORS) and not isinstance(err, RocksweepError):
+                raise StoreError(f"{shown(path)}: cannot be resumed ({_why(err)})") from None
+            raise
         return self
+
+    def _start_session(self) -> None:
+        """Count the session and record its start, host and backend (in place)."""
+        f = self.f
+        if not _in_place(f):  # a format-1 file: its attributes change type once
+            _check_space(self.path, SPACE_MARGIN, "updating its attributes")
+            try:
+                _upgrade_session_attrs(f)
+                f.flush()
+            except _H5_ERRORS as err:
+                raise StoreError(f"{shown(self.path)}: cannot update its attributes "
+                                 f"({_why(err)})") from None
+        try:
+            n = int(f.attrs["sessions"]) + 1
+            self._history = _plain(f.attrs["history"])
+            host = platform.node() or "unknown"
+            self._session_line = (f"{self.session_start} session {n}: rocksweep "
+                                  f"{versions()['rocksweep']} on host {host}, backend "
+                                  f"{self.backend}")
+            _put(f, "sessions", n)
+            _put(f, "last_started", self.session_start)
+            _put(f, "host", host)
+            _put(f, "backend", self.backend)
+            _put(f, "history", _history(self._history, self._session_line))
+            f.flush()
+        except _H5_ERRORS as err:
+            raise StoreError(f"{shown(self.path)}: cannot update its attributes "
+                             f"({_why(err)}); its points are kept") from None
 
     # -- state ------------------------------------------------------------------------
     def done(self) -> np.ndarray:
@@ -289,58 +707,103 @@ class SweepFile:
         return self.f["outcome"][()].reshape(-1) != L.OUTCOME_NOT_RUN
 
     def write(self, res: ChunkResult) -> None:
-        """Write one chunk's results; ``outcome`` last, each step flushed to the OS."""
-        boxes = flat_slabs(self.grid.shape, res.start, res.stop)
-        for name in [*(n for n in self.names if n != "outcome"), "outcome"]:
-            if name == "outcome":
-                self.f.flush()
-            ds = self.f[name]
-            arr = res.arrays[name]
-            for index, a, b in boxes:
-                box = tuple(len(range(*s.indices(n))) for s, n in zip(index, ds.shape, strict=True))
-                ds[index] = arr[a - res.start:b - res.start].reshape(box)
-        self.f.flush()
+        """Write one chunk's results; ``outcome`` last, each step flushed to the OS.
 
-    def finish(self, wall_time: float, cpu_time: float) -> dict:
+        A failed write (StoreError) leaves the chunk's points "not computed" and every
+        point written before intact; the file is closed (finish it with --resume).
+        """
+        boxes = flat_slabs(self.grid.shape, res.start, res.stop)
+        try:
+            for name in [*(n for n in self.names if n != "outcome"), "outcome"]:
+                if name == "outcome":
+                    self.f.flush()
+                ds = self.f[name]
+                arr = res.arrays[name]
+                for index, a, b in boxes:
+                    box = tuple(len(range(*s.indices(n)))
+                                for s, n in zip(index, ds.shape, strict=True))
+                    ds[index] = arr[a - res.start:b - res.start].reshape(box)
+            self.f.flush()
+        except _H5_ERRORS as err:
+            _close_quietly(self.f)
+            raise StoreError(f"{shown(self.path)}: cannot write results ({_why(err)}); "
+                             "the points written before are kept, finish with --resume"
+                             ) from None
+
+    def finish(self, wall_seconds: float, cpu_seconds: float, *,
+               backend: str | None = None) -> dict:
         """Record this session's wall time [s], the workers' CPU time on its points [s]
-        and the file's totals; returns the attributes set."""
+        and the file's totals (in place); returns the attributes set (plain Python
+        values; ``complete`` a bool)."""
         f = self.f
-        done = self.done()
-        steps = int(f["steps"][()].sum())
-        event_steps = int(f["event_steps"][()].sum())
-        attrs = {
-            "wall_time": float(f.attrs.get("wall_time", 0.0)) + wall_time,
-            "cpu_time": float(f.attrs.get("cpu_time", 0.0)) + cpu_time,
-            "points_done": int(done.sum()),
-            "complete": bool(done.all()),
-            "steps_total": steps,
-            "event_steps_total": event_steps,
-            "last_finished": _now(),
-        }
-        if done.all() and not _attr_str(f, "finished"):
-            attrs["finished"] = attrs["last_finished"]
-        for k, v in attrs.items():
-            f.attrs[k] = v
-        f.flush()
+        try:
+            done = self.done()
+            a = f.attrs
+            attrs = {
+                "wall_time": float(a.get("wall_time", 0.0)) + wall_seconds,
+                "cpu_time": float(a.get("cpu_time", 0.0)) + cpu_seconds,
+                "points_done": int(done.sum()),
+                "complete": bool(done.all()),
+                "steps_total": int(f["steps"][()].sum()),
+                "event_steps_total": int(f["event_steps"][()].sum()),
+                "last_finished": _now(),
+            }
+            if done.all() and not _plain(a["finished"]):
+                attrs["finished"] = attrs["last_finished"]
+            if backend:
+                self.backend = attrs["backend"] = backend
+                self._session_line = re.sub(r"backend .*$", f"backend {backend}",
+                                            self._session_line)
+            line = (f"{self._session_line}; finished {attrs['last_finished']}, "
+                    f"{attrs['points_done']} of {done.size} points done")
+            attrs["history"] = _history(self._history, line)
+            for k, v in attrs.items():
+                _put(f, k, int(v) if k == "complete" else v)
+            f.flush()
+        except _H5_ERRORS as err:
+            _close_quietly(f)
+            raise StoreError(f"{shown(self.path)}: cannot record the session's totals "
+                             f"({_why(err)}); its points are kept") from None
         return attrs
 
     def close(self) -> None:
-        self.f.close()
+        try:
+            self.f.close()
+        except _H5_ERRORS as err:
+            raise StoreError(f"{shown(self.path)}: cannot close ({_why(err)})") from None
 
     def __enter__(self) -> SweepFile:
         return self
 
     def __exit__(self, *exc) -> None:
-        self.close()
+        if exc[0] is None:
+            self.close()
+        else:
+            _close_quietly(self.f)
+
+
+def _history(before: str, line: str) -> str:
+    """``before`` plus ``line``, the oldest lines dropped to fit HISTORY_BYTES."""
+    lines = [ln for ln in before.splitlines() if ln] + [line]
+    while len(lines) > 1 and len("\n".join(lines).encode()) > HISTORY_BYTES:
+        lines.pop(0)
+    return "\n".join(lines)
 
 
 def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...]) -> None:
     import h5py
     grid = Grid(scene)
+    vers = versions()
     a = f.attrs
+    a["Conventions"] = CONVENTIONS
+    a["title"] = scene.name
+    a["source"] = f"rocksweep {vers['rocksweep']} (rocksweep sweep)"
+    a["comment"] = ("Stability diagram of a flexible rocking oscillator (Zhu, Chatzis & "
+                    "Acikgoz). outcome -1 marks points not computed. complete and energy "
+                    "are flags: int8 1 true, 0 false. Times are p*t and all variables "
+                    "are dimensionless (units 1; rocksweep_units names the scale).")
     a["rocksweep_format"] = FORMAT
     a["format_version"] = FORMAT_VERSION
-    a["title"] = scene.name
     a["scene"] = scene.text
     a["scene_kind"] = scene.kind
     a["scene_resolved"] = json.dumps(resolved_scene(scene, overrides))
@@ -351,19 +814,16 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...]) -> None:
     a["steps_per_period"] = n.steps_per_period
     a["event_tol"] = n.event_tol
     a["horizon"] = n.horizon
-    a["energy"] = scene.energy
-    for k, v in versions().items():
+    a["energy"] = np.int8(bool(scene.energy))
+    for k, v in vers.items():
         a[f"{k}_version"] = v
     a["started"] = _now()
-    a["finished"] = ""
-    a["wall_time"] = 0.0
-    a["cpu_time"] = 0.0
-    a["sessions"] = 0
-    a["points_total"] = grid.size
-    a["points_done"] = 0
-    a["complete"] = False
-    a["steps_total"] = 0
-    a["event_steps_total"] = 0
+    a["points_total"] = np.int64(grid.size)
+    # fixed-size attributes, updated in place by every session
+    zeros = {"S": "", "i": 0, "f": 0.0}
+    for name, dtype in SESSION_ATTRS.items():
+        kind = np.dtype(dtype).kind
+        a.create(name, _fixed("", dtype) if kind == "S" else np.array(zeros[kind], dtype))
 
     scales = []
     for axis in scene.swept:
@@ -371,8 +831,7 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...]) -> None:
                 else np.asarray(axis.values, float))
         ds = f.create_dataset(axis.name, data=data)
         ds.make_scale(axis.name)
-        ds.attrs["long_name"] = COORD_LONG_NAMES.get(axis.name, axis.name)
-        ds.attrs["scene_key"] = axis.key
+        _coord_attrs(ds, axis)
         scales.append(ds)
     scalars = []
     for axis in scene.axes:
@@ -381,8 +840,7 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...]) -> None:
         v = axis.values[0]
         ds = f.create_dataset(axis.name, data=(np.array(v, dtype=h5py.string_dtype())
                                                if axis.name == "shape" else float(v)))
-        ds.attrs["long_name"] = COORD_LONG_NAMES.get(axis.name, axis.name)
-        ds.attrs["scene_key"] = axis.key
+        _coord_attrs(ds, axis)
         scalars.append(axis.name)
 
     for name, (dtype, fill, text) in variables(scene).items():
@@ -390,7 +848,11 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...]) -> None:
         dcpl.set_alloc_time(h5py.h5d.ALLOC_TIME_EARLY)  # no metadata changes later
         ds = f.create_dataset(name, shape=grid.shape, dtype=dtype, fillvalue=fill,
                               dcpl=dcpl, fill_time="alloc")
+        ds.attrs["long_name"] = text
         ds.attrs["description"] = text
+        if name not in FLAG_VARIABLES:
+            ds.attrs["units"] = "1"
+            ds.attrs["rocksweep_units"] = SCALED_UNITS.get(name, "1")
         if name == "outcome":  # CF-style flag attributes, for xarray users
             ds.attrs["flag_values"] = np.array(list(OUTCOME_WORDS), np.int8)
             ds.attrs["flag_meanings"] = " ".join(OUTCOME_WORDS.values())
@@ -402,6 +864,13 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...]) -> None:
             ds.attrs["coordinates"] = " ".join(scalars)
         for i, sc in enumerate(scales):
             ds.dims[i].attach_scale(sc)
+
+
+def _coord_attrs(ds, axis) -> None:
+    ds.attrs["long_name"] = COORD_LONG_NAMES.get(axis.name, axis.name)
+    if axis.name != "shape":
+        ds.attrs["units"] = COORD_UNITS.get(axis.name, "1")
+    ds.attrs["scene_key"] = axis.key
 
 
 # ---------------------------------------------------------------------------------------
@@ -471,38 +940,96 @@ class SweepResult:
 
 
 def _plain(v):
-    if isinstance(v, bytes):
-        return v.decode()
+    if isinstance(v, bytes | np.bytes_):
+        return bytes(v).decode("utf-8", "replace")
     if isinstance(v, np.generic):
         return v.item()
     return v
 
 
-def read_result(path: str | Path, names: list[str] | None = None) -> SweepResult:
-    """Read a result file (``names``: variables to load; default all)."""
-    path = Path(path)
-    with _open(path, "r") as f:
-        _check_format(f, path)
+# Attributes readers use (``rocksweep info``, ``plot``) -> what they must be.
+_TEXT_ATTRS = ("scene", "accuracy", "started", "finished")
+_NUMBER_ATTRS = ("wall_time", "cpu_time")
+_COUNT_ATTRS = ("sessions",)
+_FLAG_ATTRS = ("energy", "complete")
+
+
+def _attr_ok(key: str, v) -> bool:
+    if key in _TEXT_ATTRS:
+        return isinstance(v, str)
+    if isinstance(v, bool) or not isinstance(v, int | float):
+        return key in _FLAG_ATTRS and isinstance(v, bool)
+    if key in _NUMBER_ATTRS:
+        return math.isfinite(v) and v >= 0
+    if key in _COUNT_ATTRS:
+        return isinstance(v, int) and v >= 0
+    return v in (0, 1)  # a flag: int8 (format 2) or bool (format 1)
+
+
+def _checked_attrs(f: h5py.File, path: Path) -> dict:
+    """The file's attributes as plain Python values, those readers use validated."""
+    attrs = {}
+    for k in f.attrs:
         try:
-            stored = json.loads(_attr_str(f, "scene_resolved"))
-            dims, coords, scalars = [], {}, {}
-            for key, ax in stored["axes"].items():
-                name = key.split(".", 1)[1]
-                if ax["swept"]:
-                    dims.append(name)
-                    vals = f[name][()]
-                    if name == "shape":
-                        vals = np.array([_plain(v) for v in vals])
-                    coords[name] = vals
-                else:
-                    scalars[name] = ax["values"][0]
-            wanted = names or list(variables_for(stored))
-            arrays = {n: f[n][()] for n in wanted}
-            attrs = {k: _plain(v) for k, v in f.attrs.items()}
-        except (KeyError, OSError, ValueError, TypeError) as err:
-            raise StoreError(f"{path}: damaged rocksweep result ({err})") from None
-    return SweepResult(path, tuple(dims), tuple(len(coords[d]) for d in dims), coords,
-                       scalars, arrays, attrs, stored)
+            attrs[k] = _plain(f.attrs[k])
+        except _H5_ERRORS as err:
+            raise _damaged(path, f"attribute {k} unreadable: {_why(err)}") from None
+    _json_attr(f, "numerics", path, dict)
+    overrides = _json_attr(f, "overrides", path, list)
+    if not all(isinstance(o, str) for o in overrides):
+        raise _damaged(path, f"attribute overrides is {_cut(overrides)}, not a list of text")
+    for k in (*_TEXT_ATTRS, *_NUMBER_ATTRS, *_COUNT_ATTRS, *_FLAG_ATTRS):
+        if k not in attrs:
+            raise _damaged(path, f"attribute {k} missing")
+        if not _attr_ok(k, attrs[k]):
+            raise _damaged(path, f"attribute {k} is {_cut(attrs[k])}")
+    return attrs
+
+
+def read_result(path: str | Path, names: list[str] | None = None) -> SweepResult:
+    """Read a result file (``names``: variables to load; default all).
+
+    Validates what readers rely on (format, resolved scene, coordinates, variables'
+    shapes and dtypes, outcome codes, the attributes ``info`` shows); any problem is a
+    one-line StoreError naming the file.
+    """
+    path = Path(path)
+    f = _open(path, "r")
+    try:
+        lay = _layout(f, path)
+        stored = lay.scene
+        known = variables_for(stored)
+        wanted = list(names) if names else list(known)
+        for n in wanted:
+            if n not in known:
+                raise StoreError(f"{shown(path)}: no variable '{n}' in this result (it "
+                                 f"holds {', '.join(known)})")
+        coords, scalars = {}, {}
+        for key, ax in stored["axes"].items():
+            name = key.split(".", 1)[1]
+            if ax["swept"]:
+                vals = f[name][()]
+                if name == "shape":
+                    vals = np.array([_plain(v) for v in vals])
+                coords[name] = vals
+            else:
+                scalars[name] = ax["values"][0]
+        arrays = {n: f[n][()] for n in wanted}
+        if "outcome" in arrays:
+            codes = np.array([L.OUTCOME_NOT_RUN, *OUTCOME_WORDS], np.int8)
+            bad = ~np.isin(arrays["outcome"], codes)
+            if bad.any():
+                raise _damaged(path, f"variable 'outcome' holds {int(bad.sum())} invalid "
+                               f"codes, e.g. {int(arrays['outcome'][bad][0])} (valid: -1, "
+                               "0, 1, 2)")
+        attrs = _checked_attrs(f, path)
+    except RocksweepError:
+        raise
+    except _H5_ERRORS as err:
+        raise _damaged(path, _why(err)) from None
+    finally:
+        _close_quietly(f)
+    return SweepResult(path, lay.dims, lay.shape, coords, scalars, arrays, attrs, stored)
 
 
 def peek_done(path: str | Path) -> tuple[int, int] | None:

@@ -172,8 +172,9 @@ def test_create_failure_leaves_no_file(tmp_path, scene, monkeypatch):
         raise OSError(28, "No space left on device")
 
     monkeypatch.setattr(store, "_initialise", boom)
-    with pytest.raises(StoreError, match="No space left"):
+    with pytest.raises(StoreError) as err:
         SweepFile.create(path, scene)
+    assert str(err.value) == f"{path}: cannot write (no space left on the device); nothing written"
     assert list(tmp_path.iterdir()) == []
 
 
