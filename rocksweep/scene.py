@@ -39,6 +39,7 @@ from rocksweep.schema import (
     BODY_KEYS,
     KEYS,
     SECTIONS,
+    as_float,
     check_values,
     fmt,
     is_number,
@@ -50,8 +51,8 @@ class SceneError(RocksweepError, ValueError):
     """A scene that cannot be run; ``str()`` is one line for the user."""
 
 
-# Largest grid a scene may describe [points]. A sweep file stores ~34 bytes a point (58
-# with energy metrics, rocksweep.sweep.VARIABLES): 2e8 points are a 7-12 GB file, one
+# Largest grid a scene may describe [points]. A sweep file stores 45 bytes a point (69
+# with energy metrics, rocksweep.sweep.VARIABLES): 2e8 points are a 9-14 GB file, one
 # float64 variable read back for a figure or xarray is 1.6 GB of memory, and at the
 # kernel's 27-54 us a point (README, bench) the sweep takes 1.5-3 hours of one core.
 MAX_POINTS = 200_000_000
@@ -63,7 +64,7 @@ MAX_AXIS_VALUES = 1_000_000
 MAX_DEPTH = 20
 # Body grids up to this many distinct bodies are checked body by body; larger ones at the
 # combinations of each key's extreme values (``_candidate_bodies``).
-MAX_BODIES_CHECKED = 4096
+MAX_BODIES_CHECKED = 1024
 PULSE_AXES = ("A_ratio", "w_over_p")
 # Typical values (Table 3; the `default` numerics) that the cost check puts in place of a
 # value, one at a time, to find which value makes a point too costly.
@@ -191,7 +192,7 @@ class Scene:
 
     def sweep_nbytes(self) -> int:
         """Bytes a sweep file of this scene needs for its per-point variables (the stored
-        variables of ``rocksweep.sweep.variables``, ~34 a point, 58 with energy metrics)
+        variables of ``rocksweep.sweep.variables``, 45 a point, 69 with energy metrics)
         and its coordinates; HDF5's own overhead (a few kB) is not counted."""
         from rocksweep.sweep import variables  # the sweep knows what it stores
 
@@ -307,7 +308,7 @@ def _section(raw: dict, name: str, kind: str, required: bool) -> dict:
 def _axis_spec(key: str, spec: Any) -> tuple[str, Any, int]:
     """Check an axis's form, without building its values: (form, spec, length)."""
     if is_number(spec):
-        return "scalar", float(spec), 1
+        return "scalar", as_float(spec), 1
     if isinstance(spec, list):
         if not spec:
             raise SceneError(f"{key} = []: an empty list; give at least one value")
@@ -317,7 +318,7 @@ def _axis_spec(key: str, spec: Any) -> tuple[str, Any, int]:
         if len(spec) > MAX_AXIS_VALUES:
             raise SceneError(f"{key}: {len(spec):,} values; at most {MAX_AXIS_VALUES:,} "
                              "per axis")
-        return "list", spec, len(spec)
+        return "list", [as_float(v) for v in spec], len(spec)
     if isinstance(spec, dict):
         for k in spec:
             if k not in ("start", "stop", "num"):
@@ -334,9 +335,9 @@ def _axis_spec(key: str, spec: Any) -> tuple[str, Any, int]:
             raise SceneError(f"{key}.num = {num}: at most {MAX_AXIS_VALUES:,} values per axis")
         for k in ("start", "stop"):
             v = spec[k]
-            if not (is_number(v) and math.isfinite(v)):
+            if not (is_number(v) and math.isfinite(as_float(v))):
                 raise SceneError(f"{key}.{k} = {fmt(v)}: must be a finite number")
-        return "range", spec, num
+        return "range", {**spec, "start": float(spec["start"]), "stop": float(spec["stop"])}, num
     raise SceneError(f"{key} = {fmt(spec)}: must be a number, a list of numbers or a range "
                      "{start, stop, num}")
 
@@ -401,7 +402,7 @@ def _numerics(sec: dict) -> tuple[Numerics, Numerics]:
         elif not is_number(v):
             raise SceneError(f"{key} = {fmt(v)}: {spec.allowed}")
         if spec.kind in ("integer", "number"):
-            msg = check_values(key, np.array([float(v)]))
+            msg = check_values(key, np.array([as_float(v)]))
             if msg is not None:
                 raise SceneError(f"{key} = {fmt(v)}: {spec.allowed}")
             v = float(v) if spec.kind == "number" else v
@@ -460,7 +461,7 @@ def _parse(text: str, overrides: list[str]) -> Scene:
         dims = " x ".join(f"{n:,} {key}" for n, (_, key, form, _) in
                           zip(lengths[1:], specs, strict=True) if form != "scalar")
         raise SceneError(f"the grid has {size:,} points ({dims}): at most {MAX_POINTS:,} "
-                         "points per scene (a sweep file of ~34 bytes a point); split it "
+                         "points per scene (a sweep file stores 45 bytes a point); split it "
                          "into several scenes or use fewer values")
 
     axes = [Axis("shape", "pulse.shape", shapes, shape_swept)]
@@ -531,6 +532,15 @@ def _budgets(scene: Scene, bodies: list[dict[str, float]], w: np.ndarray, A: np.
     return np.where(np.isnan(cap), math.inf, cap)
 
 
+def _runs(scene: Scene) -> tuple[tuple[Numerics, str], ...]:
+    """The numerics a scene's points run at, with the words that name them: the sweeps'
+    and the single runs' (``simulate``; `fine`, 4x the steps of `default`, unless the scene
+    names an accuracy)."""
+    single = scene.single_numerics
+    return ((scene.numerics, ""),
+            (single, f" at the single runs' accuracy ({single.accuracy})"))
+
+
 def _check_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
     """Refuse a scene with a point whose step cap exceeds MAX_POINT_STEPS.
 
@@ -541,48 +551,50 @@ def _check_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
     w = np.asarray(scene.axis("w_over_p").values)
     A = np.asarray(scene.axis("A_ratio").values)
     w, A = np.array([w.min(), w.max()]), np.array([A.min(), A.max()])
-    for numerics, label in ((scene.numerics, ""),
-                            (scene.single_numerics, " (at the single runs' accuracy, "
-                             f"{scene.single_numerics.accuracy})")):
-        caps = _budgets(scene, bodies, w, A, numerics)
-        worst = int(np.argmax(caps))
-        if caps.flat[worst] <= MAX_POINT_STEPS:
-            continue
-        i, j, k = np.unravel_index(worst, caps.shape)
-        point = {**{f"body.{n}": v for n, v in bodies[i].items()},
-                 "pulse.w_over_p": float(w[j]), "pulse.A_ratio": float(A[k])}
-        raise SceneError(_cost_message(scene, point, numerics, label))
+    caps = np.max([_budgets(scene, bodies, w, A, n) for n, _ in _runs(scene)], axis=0)
+    worst = int(np.argmax(caps))
+    if caps.flat[worst] <= MAX_POINT_STEPS:
+        return
+    i, j, k = np.unravel_index(worst, caps.shape)
+    point = {**{f"body.{n}": v for n, v in bodies[i].items()},
+             "pulse.w_over_p": float(w[j]), "pulse.A_ratio": float(A[k])}
+    raise SceneError(_cost_message(scene, point))
 
 
-def _point_cost(scene: Scene, point: dict[str, float], numerics: Numerics
-                ) -> tuple[float, float, float] | None:
-    """(step cap, t_end, dt) of one point given by key; None for a body that is not
-    physical."""
+def _point_cost(scene: Scene, point: dict[str, float], numerics: Numerics | None = None
+                ) -> tuple[float, float, float, str] | None:
+    """(step cap, t_end, dt, words naming the numerics) of one point given by key, at the
+    scene's costlier numerics (or at ``numerics``); None for a body that is not physical."""
     try:
         body = scene.make_body(**{k[5:]: v for k, v in point.items() if k.startswith("body.")})
     except BodyError:
         return None
-    dt, _, t_end, cap = run_cost(np.array([body_omega_rock(body)]), np.array([body.alpha_ref]),
-                                 np.array([point["pulse.w_over_p"]]),
-                                 np.array([point["pulse.A_ratio"]]), numerics)
-    c = float(cap[0])
-    return (math.inf if math.isnan(c) else c), float(t_end[0]), float(dt[0])
+    worst = None
+    for n, label in _runs(scene) if numerics is None else ((numerics, ""),):
+        dt, _, t_end, cap = run_cost(np.array([body_omega_rock(body)]),
+                                     np.array([body.alpha_ref]),
+                                     np.array([point["pulse.w_over_p"]]),
+                                     np.array([point["pulse.A_ratio"]]), n)
+        c = float(cap[0])
+        c = math.inf if math.isnan(c) else c
+        if worst is None or c > worst[0]:
+            worst = (c, float(t_end[0]), float(dt[0]), label)
+    return worst
 
 
-def _with(scene: Scene, point: dict, numerics: Numerics, key: str, value: float
-          ) -> float | None:
-    """The step cap of ``point`` with one key (of the point or the numerics) changed."""
+def _with(scene: Scene, point: dict, key: str, value: float) -> float | None:
+    """The step cap of ``point`` (at the costlier numerics) with one key of the point or
+    of the numerics changed."""
     if key.startswith("numerics."):
         name = key.split(".", 1)[1]
         value = int(value) if name != "horizon" else float(value)
-        got = _point_cost(scene, point, replace(numerics, **{name: value}))
-    else:
-        got = _point_cost(scene, {**point, key: value}, numerics)
+        caps = [_point_cost(scene, point, replace(n, **{name: value})) for n, _ in _runs(scene)]
+        return max(c[0] for c in caps)  # type: ignore[index]
+    got = _point_cost(scene, {**point, key: value})
     return None if got is None else got[0]
 
 
-def _bound(scene: Scene, point: dict, numerics: Numerics, key: str, bad: float,
-           good: float) -> float:
+def _bound(scene: Scene, point: dict, key: str, bad: float, good: float) -> float:
     """The value between ``good`` (within the cap) and ``bad`` (beyond) where the cap is
     reached, rounded to 3 digits on the good side (60 bisections; log scale when both
     have one sign)."""
@@ -592,7 +604,7 @@ def _bound(scene: Scene, point: dict, numerics: Numerics, key: str, bad: float,
     for _ in range(60):
         mid = 0.5 * (lo + hi)
         v = sign * math.exp(mid) if logs else mid
-        cost = _with(scene, point, numerics, key, v)
+        cost = _with(scene, point, key, v)
         if cost is not None and cost <= MAX_POINT_STEPS:
             lo = mid
         else:
@@ -604,37 +616,37 @@ def _bound(scene: Scene, point: dict, numerics: Numerics, key: str, bad: float,
     return (math.floor(v / e) if bad > good else math.ceil(v / e)) * e
 
 
-def _cost_message(scene: Scene, point: dict, numerics: Numerics, label: str) -> str:
-    cap, t_end, dt = _point_cost(scene, point, numerics)  # type: ignore[misc]
-    why = (f"{numerics.max_steps_factor:g} x a run of {t_end:.3g} p*t in steps of "
-           f"{dt:.3g} p*t, plus {EVENT_STEP_ALLOWANCE:g} per event x max_events "
-           f"{numerics.max_events}")
-    head = (f"one point could need {cap:.2g} RK4 steps ({why}){label}, more than the cap of "
+def _cost_message(scene: Scene, point: dict) -> str:
+    cap, t_end, dt, label = _point_cost(scene, point)  # type: ignore[misc]
+    n = scene.numerics
+    why = (f"{n.max_steps_factor:g} x a run of {t_end:.3g} p*t in steps of {dt:.3g} p*t, "
+           f"plus {EVENT_STEP_ALLOWANCE:g} per event x max_events {n.max_events}")
+    head = (f"one point could need {cap:.2g} RK4 steps{label} ({why}), more than the cap of "
             f"{MAX_POINT_STEPS:.0e} a point (~17 s of one core)")
     # which value of the point makes it costly: the one whose typical value cuts the most
-    current = {**point, **{f"numerics.{k}": getattr(numerics, k)
+    current = {**point, **{f"numerics.{k}": getattr(n, k)
                            for k in ("steps_per_period", "horizon", "max_events")}}
+
+    def tame(key: str) -> float:
+        t = _TAME[key]
+        return math.copysign(t, current[key]) if key == "pulse.A_ratio" else t
+
     best, best_key = 1.0, None
     for key, value in current.items():
-        tame = _TAME[key]
-        if key == "pulse.A_ratio":
-            tame = math.copysign(tame, value)
-        if value == tame:
+        if value == tame(key):
             continue
-        cost = _with(scene, point, numerics, key, tame)
+        cost = _with(scene, point, key, tame(key))
         if cost is not None and cap / max(cost, 1.0) > best:
             best, best_key = cap / max(cost, 1.0), key
     if best_key is None:
         return f"{head}; use fewer steps_per_period, a shorter horizon or fewer max_events"
-    value, tame = current[best_key], _TAME[best_key]
-    if best_key == "pulse.A_ratio":
-        tame = math.copysign(tame, value)
-    if _with(scene, point, numerics, best_key, tame) > MAX_POINT_STEPS:
+    value = current[best_key]
+    if _with(scene, point, best_key, tame(best_key)) > MAX_POINT_STEPS:  # type: ignore[operator]
         return f"{best_key} = {fmt(value)}: {head}; other values of this point are costly too"
-    bound = _bound(scene, point, numerics, best_key, value, tame)
+    bound = _bound(scene, point, best_key, value, tame(best_key))
     shown = f"{abs(bound):.3g}" if KEYS[best_key].kind != "integer" else str(int(bound))
     if best_key == "pulse.A_ratio":
         rule = f"|{best_key}| must be <= {shown}"
     else:
-        rule = f"{best_key} must be {'<=' if value > tame else '>='} {shown}"
+        rule = f"{best_key} must be {'<=' if value > tame(best_key) else '>='} {shown}"
     return f"{best_key} = {fmt(value)}: {head}; with the scene's other values {rule}"

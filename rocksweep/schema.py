@@ -89,7 +89,8 @@ KEYS: dict[str, Key] = {
                          -math.inf, math.inf, lo_in=False, hi_in=False),
     "numerics.accuracy": Key("choice", f"must be one of {', '.join(PRESETS)}",
                              choices=tuple(PRESETS), required=False),
-    "numerics.steps_per_period": Key("integer", "must be an integer >= 4", 4, required=False),
+    "numerics.steps_per_period": Key("integer", "must be an integer in [4, 1e9]", 4, 1e9,
+                                     required=False),
     "numerics.event_tol": Key(
         "number", f"must be in [{MIN_EVENT_TOL:g}, 1) (p*t; below {MIN_EVENT_TOL:g} an event "
         "time t ~ 1e2 is at float64's resolution)", MIN_EVENT_TOL, 1.0, hi_in=False,
@@ -98,7 +99,8 @@ KEYS: dict[str, Key] = {
                             lo_in=False, hi_in=False, required=False),
     "numerics.rest_rate": Key("number", "must be in (0, 1) (x p alpha_cg)", 0.0, 1.0,
                               lo_in=False, hi_in=False, required=False),
-    "numerics.max_events": Key("integer", "must be an integer >= 1", 1, required=False),
+    "numerics.max_events": Key("integer", "must be an integer in [1, 1e9]", 1, 1e9,
+                               required=False),
     "numerics.root": Key("choice", f"must be one of {', '.join(ROOTS)}", choices=ROOTS,
                          required=False),
     "outputs.energy": Key("bool", "must be true or false (store energy metrics)",
@@ -160,6 +162,15 @@ def check_values(key: str, values: np.ndarray) -> str | None:
     if bad.size == 0:
         return None
     return f"{key} = {fmt(float(v[bad[0]]))}: {spec.allowed}"
+
+
+def as_float(v: Any) -> float:
+    """A number as a float; an integer beyond float64's range becomes +-inf (float()
+    would raise OverflowError), so that the range check names it."""
+    try:
+        return float(v)
+    except OverflowError:
+        return math.inf if v > 0 else -math.inf
 
 
 def is_number(v: Any) -> bool:
