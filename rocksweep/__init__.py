@@ -1,0 +1,42 @@
+"""rocksweep: stability (overturning) diagrams of flexible rocking oscillators (Zhu,
+Chatzis & Acikgoz).
+
+The Python API (see the README's "Python API"):
+
+- ``rocksweep.run(scene, *, jobs=1, output=None, overrides=(), progress=False,
+  overwrite=False, resume=False)``: every point of a scene's grid -> xarray.Dataset
+  (the same variables, dims, coords and attributes as ``rocksweep sweep``'s HDF5 file).
+- ``rocksweep.open(path)``: a result file -> xarray.Dataset.
+- ``rocksweep.simulate(scene, overrides=(), **keys)``: one point with its time history
+  -> ``Simulation`` (``.summary`` dict, ``.history`` Dataset over p*t, ``.figure()``).
+- ``rocksweep.RocksweepError``: the base of every error a user can fix (one line).
+
+Importing the package is light: numba, h5py, xarray and matplotlib load on first use.
+"""
+
+from __future__ import annotations
+
+from rocksweep.api import open, run, simulate  # noqa: A004
+from rocksweep.errors import RocksweepError
+
+
+def _version() -> str:
+    """The installed distribution's version; from pyproject.toml in a source tree."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("rocksweep")
+    except PackageNotFoundError:
+        import re
+        from pathlib import Path
+
+        pyproject = Path(__file__).resolve().parent.parent / "pyproject.toml"
+        try:
+            m = re.search(r'^version\s*=\s*"([^"]+)"', pyproject.read_text(), re.M)
+        except OSError:
+            m = None
+        return f"{m.group(1)}+source" if m else "0+unknown"
+
+
+__version__ = _version()
+__all__ = ["RocksweepError", "__version__", "open", "run", "simulate"]

@@ -41,12 +41,15 @@ from pathlib import Path
 
 import numpy as np
 
+from rocksweep import fields
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import PRESETS, ROOTS, Numerics
 from rocksweep.scene import Scene
 
 OUTCOMES = ("safe", "mode1", "mode2")  # codes 0, 1, 2
+# Per-point fields of the report: all the outcome-level kernel fills (no energies).
+REPORT_FIELDS = tuple(f for f in fields.FIELDS if not f.energy)
 MEASURES = ("theta_max", "t_first_impact", "t_overturn", "impacts")
 MEASURE_LABELS = {
     "theta_max": "|d theta_max|/alpha_cg",
@@ -595,16 +598,18 @@ def write_report(study: Study, path: str | Path, command: str = "") -> None:
     observed orders); /table: one dataset per column, one entry per setting; /flips:
     int64[settings, 3, 3] (reference outcome, kernel outcome); /sample: flat index, stratum,
     weight and axis values per point, stratum names and sizes; /reference and
-    /kernel/<setting>: per-point outcome, impacts, uplifts, theta_max_over_alpha,
-    t_first_impact, t_overturn, status, steps, seconds.
+    /kernel/<setting>: per point, every result field of the outcome-level kernel
+    (``REPORT_FIELDS``: outcome, impacts, uplifts, theta_max_over_alpha, t_overturn,
+    status, steps (regular RK4 steps), event_steps, t_end, t_first_impact, e_max,
+    returns_to_contact, each with ``units``) and seconds. In /reference, steps are
+    DOP853's steps and event_steps 0 (``reference.result_row``).
     """
     import h5py
 
+    from rocksweep.outputs import atomic_path
     from rocksweep.reference import ATOL, RTOL
 
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.partial")
-    try:
+    with atomic_path(path) as tmp:
         with h5py.File(tmp, "w") as f:
             f.attrs["format"] = "rocksweep-accuracy-1"
             f.attrs["scene_name"] = study.scene.name
@@ -651,18 +656,11 @@ def write_report(study: Study, path: str | Path, command: str = "") -> None:
             k = f.create_group("kernel")
             for r in study.results:
                 _write_runs(k.create_group(r.setting.name), r.outs, r.seconds, study.alpha_ref)
-        tmp.replace(path)
-    finally:
-        tmp.unlink(missing_ok=True)
 
 
 def _write_runs(g, outs: np.ndarray, seconds: np.ndarray, alpha_ref: np.ndarray) -> None:
-    g.create_dataset("outcome", data=outs[:, L.OUT_OUTCOME].astype(np.int8))
-    g.create_dataset("impacts", data=outs[:, L.OUT_IMPACTS].astype(np.int32))
-    g.create_dataset("uplifts", data=outs[:, L.OUT_UPLIFTS].astype(np.int32))
-    g.create_dataset("theta_max_over_alpha", data=outs[:, L.OUT_THETA_MAX] / alpha_ref)
-    g.create_dataset("t_first_impact", data=outs[:, L.OUT_T_FIRST_IMPACT])
-    g.create_dataset("t_overturn", data=outs[:, L.OUT_T_OVERTURN])
-    g.create_dataset("status", data=outs[:, L.OUT_STATUS].astype(np.int32))
-    g.create_dataset("steps", data=outs[:, L.OUT_STEPS] + outs[:, L.OUT_EVENT_STEPS])
+    # every field the outcome-level kernel reports (rocksweep.fields), in its unit
+    for name, arr in fields.convert(outs, alpha_ref, np.nan, REPORT_FIELDS).items():
+        ds = g.create_dataset(name, data=arr)
+        ds.attrs["units"] = fields.UNITS[name]
     g.create_dataset("seconds", data=seconds)

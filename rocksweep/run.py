@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rocksweep import fields
 from rocksweep.kernel import chunk_kernel, point_kernel, warm_up
 from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
@@ -19,8 +20,10 @@ from rocksweep.points import Point, kernel_kind, point_row
 class Run:
     """Result of one point. Times in p*t, energies in units of E_ref.
 
-    history: dict of float64 arrays (t, theta, theta_dot, u, u_dot, phase, E, W_in, D_damp,
-    E_impact, xg) when a history was asked for, else None.
+    history: dict of float64 arrays in SI units with p = 1 rad/s (keys
+    ``fields.HISTORY_RAW``: t, theta, theta_dot, u, u_dot, phase, E, W_in, D_damp,
+    E_impact, xg) when a history was asked for, else None; ``history_columns()`` gives
+    them normalised.
     """
 
     point: Point
@@ -29,8 +32,11 @@ class Run:
     history: dict | None
     wall_time: float
 
-    def _get(self, index: int) -> float:
-        return float(self.out[index])
+    def get(self, name: str) -> int | float | None:
+        """One result field by name (``rocksweep.fields.FIELDS``) in its unit; None for
+        a time or energy that does not exist (no overturning, no energy accounting)."""
+        body = self.point.body
+        return fields.value(self.out, fields.BY_NAME[name], body.alpha_ref, body.E_ref)
 
     @property
     def outcome(self) -> str:
@@ -46,62 +52,47 @@ class Run:
 
     @property
     def impacts(self) -> int:
-        return int(self.out[L.OUT_IMPACTS])
+        return self.get("impacts")
 
     @property
     def uplifts(self) -> int:
-        return int(self.out[L.OUT_UPLIFTS])
+        return self.get("uplifts")
 
     @property
     def theta_max_over_alpha(self) -> float:
-        return self._get(L.OUT_THETA_MAX) / self.point.body.alpha_ref
+        return self.get("theta_max_over_alpha")
 
     @property
     def t_overturn(self) -> float | None:
-        t = self._get(L.OUT_T_OVERTURN)
-        return None if math.isnan(t) else t
+        return self.get("t_overturn")
 
     @property
     def t_end(self) -> float:
-        return self._get(L.OUT_T_END)
-
-    def energy(self, index: int) -> float:
-        return self._get(index) / self.point.body.E_ref
+        return self.get("t_end")
 
     def summary(self) -> dict:
-        """Plain-JSON summary (the keys of ``rocksweep simulate --json``)."""
-        o = self.out
-        d = {
-            "outcome": self.outcome,
-            "impacts": self.impacts,
-            "uplifts": self.uplifts,
-            "theta_max_over_alpha": self.theta_max_over_alpha,
-            "t_overturn": self.t_overturn,
-            "t_end": self.t_end,
-            "status": self.status,
-            "t_first_impact": None if math.isnan(o[L.OUT_T_FIRST_IMPACT])
-            else float(o[L.OUT_T_FIRST_IMPACT]),
-            "e_max": float(o[L.OUT_E_MAX]),
-            "returns_to_contact": int(o[L.OUT_CONTACTS]),
-            "accuracy": self.numerics.describe(),
-            "steps": int(o[L.OUT_STEPS]),
-            "event_steps": int(o[L.OUT_EVENT_STEPS]),
-            "wall_time_s": self.wall_time,
-        }
-        if not math.isnan(o[L.OUT_W_IN]):
-            d.update({
-                "work_in_over_Eref": self.energy(L.OUT_W_IN),
-                "damper_loss_over_Eref": self.energy(L.OUT_D_DAMP),
-                "impact_loss_over_Eref": self.energy(L.OUT_E_IMPACT),
-                "impact_gain_over_Eref": self.energy(L.OUT_E_GAINED),
-                "energy_gaining_impacts": int(o[L.OUT_N_GAINING]),
-                "energy_end_over_Eref": self.energy(L.OUT_E_END),
-            })
+        """Plain-JSON summary (the keys of ``rocksweep simulate --json``): every field of
+        ``rocksweep.fields.FIELDS`` (the energy fields when energy was accounted), the
+        outcome and status as words, the accuracy setting and the wall time [s].
+
+        Times are p*t, theta_max in alpha_ref, energies in E_ref; a time that did not
+        happen (no overturning, no impact) is None. "steps" are the regular RK4 steps,
+        "event_steps" the re-integrations spent locating events.
+        """
+        energy = not math.isnan(self.out[L.OUT_W_IN])
+        d = {f.name: self.get(f.name) for f in fields.FIELDS if energy or not f.energy}
+        d["outcome"] = self.outcome
+        d["status"] = self.status
+        d["accuracy"] = self.numerics.describe()
+        d["wall_time_s"] = self.wall_time
         return d
 
-
-_HIST_NAMES = ("t", "theta", "theta_dot", "u", "u_dot", "phase", "E", "W_in", "D_damp",
-               "E_impact", "xg")
+    def history_columns(self) -> dict[str, np.ndarray]:
+        """The time history normalised (``rocksweep.fields.HISTORY``: p_t,
+        theta_over_alpha, u_over_ucr, E_over_Eref, ...): name -> float64[rows]."""
+        if self.history is None:
+            raise ValueError("this run has no history (simulate with history=True)")
+        return fields.history_columns(self.history, self.point.body)
 
 
 def history_capacity(row: np.ndarray) -> int:
@@ -122,7 +113,7 @@ def simulate(point: Point, numerics: Numerics, history: bool = True) -> Run:
         hist = np.empty((history_capacity(row), L.N_HIST))
         point_kernel(kind)(row, out, hist)
         n = int(out[L.OUT_HIST_ROWS])
-        hist_d = {name: hist[:n, i].copy() for i, name in enumerate(_HIST_NAMES)}
+        hist_d = {c.raw: hist[:n, c.slot].copy() for c in fields.HISTORY}
     else:
         outs = out[None, :]
         chunk_kernel(kind, L.LEVEL_OUTCOME)(row[None, :], outs)

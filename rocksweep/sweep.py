@@ -1,7 +1,8 @@
 """Run a scene's grid in chunks across joblib workers (threads, or dask.distributed).
 
 No I/O here: ``run_chunks`` yields each chunk's result arrays as it finishes and the
-parent process (``rocksweep sweep``) writes them (``rocksweep.store``). A chunk is a
+driver (``rocksweep.api.sweep_file``, behind ``rocksweep sweep`` and ``rocksweep.run``)
+writes them (``rocksweep.store``). A chunk is a
 contiguous range of flat point indices (``rocksweep.grid``) and costs one call into the
 jitted kernel per kernel kind present in the chunk; there is no Python per point.
 
@@ -19,40 +20,45 @@ take long (long pulses at small omega/p, chattering) do not leave a worker idle 
 from __future__ import annotations
 
 import math
+import os
 import time
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
 
+from rocksweep import fields
+from rocksweep.errors import RocksweepError
 from rocksweep.grid import Grid
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.scene import Scene
 
-# Stored per point: name -> (dtype, fill value for "not computed", description).
+
+class SweepError(RocksweepError, ValueError):
+    """A sweep that cannot run as asked (workers, cluster); ``str()`` is one line."""
+
+
+# Stored per point: name -> (dtype, fill value for "not computed", description), derived
+# from the one table of result fields (``rocksweep.fields``; units: ``fields.UNITS``).
 VARIABLES: dict[str, tuple[str, float, str]] = {
-    "outcome": ("int8", L.OUTCOME_NOT_RUN,
-                "-1 not computed, 0 safe, 1 mode 1 (overturned after impacts), "
-                "2 mode 2 (overturned without impact)"),
-    "impacts": ("int32", -1, "number of impacts"),
-    "uplifts": ("int32", -1, "number of uplifts (rocking starts from full contact)"),
-    "theta_max_over_alpha": ("float64", math.nan, "max |theta| / alpha_ref"),
-    "t_overturn": ("float64", math.nan, "overturning time p*t (NaN if none)"),
-    "status": ("int32", 0, "bit flags (rocksweep.outcomes.STATUS_WORDS); flagged = "
-               "status & (horizon | step_cap | event_cap | nonfinite)"),
-    "steps": ("int64", 0, "regular RK4 steps taken"),
-    "event_steps": ("int64", 0, "RK4 re-integrations spent locating events"),
-}
+    f.name: (f.dtype, f.fill, f.meaning) for f in fields.SWEEP_FIELDS}
 # Stored when the scene asks for energy metrics (outputs.energy: true).
 ENERGY_VARIABLES: dict[str, tuple[str, float, str]] = {
-    "work_in_over_Eref": ("float64", math.nan, "work of the ground motion / E_ref"),
-    "damper_loss_over_Eref": ("float64", math.nan, "energy dissipated by the damper / E_ref"),
-    "impact_loss_over_Eref": ("float64", math.nan, "energy lost in impacts (net) / E_ref"),
-}
+    f.name: (f.dtype, f.fill, f.meaning) for f in fields.ENERGY_FIELDS}
 
 # Upper bound of the automatic chunk size [points]; see ``auto_chunk_size``.
 MAX_CHUNK = 1024
+# Local worker threads allowed per core: the chunk kernels keep a core busy, so threads
+# beyond a few per core only wait (and a typo like 99999999999999999999 must not start them).
+MAX_JOBS_PER_CORE = 4
+# A dask cluster with no worker for this long [s] ends the sweep with an error (at the
+# start: none joined; mid-sweep: all left), instead of waiting for ever.
+NO_WORKERS_TIMEOUT = 60.0
+# How often [s] the dask driver checks the cluster while no chunk finishes.
+CLUSTER_POLL = 1.0
+# Cold compile of one kernel variant [s], measured (README, Performance): 15-25 s.
+COMPILE_SECONDS = 20.0
 
 
 def variables(scene: Scene) -> dict[str, tuple[str, float, str]]:
@@ -93,20 +99,8 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
             part = np.empty((int(sel.sum()), L.N_OUT))
             chunk_kernel(int(kind), level)(np.ascontiguousarray(cr.rows[sel]), part)
             outs[sel] = part
-    arrays = {
-        "outcome": outs[:, L.OUT_OUTCOME].astype(np.int8),
-        "impacts": outs[:, L.OUT_IMPACTS].astype(np.int32),
-        "uplifts": outs[:, L.OUT_UPLIFTS].astype(np.int32),
-        "theta_max_over_alpha": outs[:, L.OUT_THETA_MAX] / cr.alpha_ref,
-        "t_overturn": outs[:, L.OUT_T_OVERTURN].copy(),
-        "status": outs[:, L.OUT_STATUS].astype(np.int32),
-        "steps": outs[:, L.OUT_STEPS].astype(np.int64),
-        "event_steps": outs[:, L.OUT_EVENT_STEPS].astype(np.int64),
-    }
-    if level == L.LEVEL_ENERGY:
-        arrays["work_in_over_Eref"] = outs[:, L.OUT_W_IN] / cr.E_ref
-        arrays["damper_loss_over_Eref"] = outs[:, L.OUT_D_DAMP] / cr.E_ref
-        arrays["impact_loss_over_Eref"] = outs[:, L.OUT_E_IMPACT] / cr.E_ref
+    arrays = fields.convert(outs, cr.alpha_ref, cr.E_ref,
+                            fields.sweep_fields(level == L.LEVEL_ENERGY))
     return ChunkResult(start, stop, arrays, time.perf_counter() - t0,
                        time.thread_time() - c0)
 
@@ -127,12 +121,26 @@ def merge_contiguous(results: Iterable[ChunkResult]) -> list[ChunkResult]:
     return merged
 
 
-def effective_jobs(jobs: int) -> int:
-    """Number of local workers for ``--jobs`` (-1 or 0: all cores)."""
-    import os
-
+def check_jobs(jobs: int, name: str = "jobs =") -> int:
+    """Number of local worker threads for ``jobs`` (-1: one per core); a one-line
+    ``SweepError`` for 0, other negatives and more than ``MAX_JOBS_PER_CORE`` threads per
+    core. name: how the message names the option ("--jobs" on the command line)."""
     n = os.cpu_count() or 1
-    return n if jobs <= 0 else jobs
+    if jobs == -1:
+        return n
+    if jobs < 1:
+        raise SweepError(f"{name} {jobs}: give a number >= 1, or -1 for all cores")
+    cap = MAX_JOBS_PER_CORE * n
+    if jobs > cap:
+        raise SweepError(f"{name} {jobs}: at most {cap} ({MAX_JOBS_PER_CORE} x the {n} "
+                         f"core{'s' * (n > 1)} of this machine: each thread keeps a core busy, "
+                         "so more threads only wait for one)")
+    return jobs
+
+
+def effective_jobs(jobs: int) -> int:
+    """Number of local workers for ``jobs`` (-1: all cores); see ``check_jobs``."""
+    return check_jobs(jobs)
 
 
 def auto_chunk_size(n_todo: int, n_workers: int) -> int:
@@ -161,40 +169,132 @@ def prepare(grid: Grid, level: int) -> None:
         warm_up(kind, level)
 
 
+def _in_cache(dispatcher) -> bool | None:
+    """Whether numba has this variant in memory or in its on-disk cache for this machine;
+    None if that cannot be told (numba's cache internals changed)."""
+    try:
+        if dispatcher.signatures:
+            return True
+        index = dispatcher._cache._cache_file._load_index()  # {(sig, machine): file}
+        machine = dispatcher.targetdescr.target_context.codegen().magic_tuple()
+        return any(key[1] == machine for key in index)
+    except Exception:  # private numba API: any change means "unknown"
+        return None
+
+
+def kernel_cache_state(grid: Grid, level: int) -> tuple[int, int]:
+    """(variants to compile, variants of unknown state) among those ``prepare`` needs:
+    what a sweep says before the kernel is compiled or loaded."""
+    states = [_in_cache(chunk_kernel(kind, level)) for kind in grid.kinds()]
+    return sum(s is False for s in states), sum(s is None for s in states)
+
+
+def check_scheduler(address: str, timeout: float = 10.0) -> None:
+    """A one-line ``SweepError`` unless a dask scheduler answers at ``address``."""
+    try:
+        from distributed import Client
+    except ImportError:
+        raise SweepError("the dask backend needs dask and distributed: "
+                         "pip install 'rocksweep[dask]'") from None
+    try:
+        Client(address, timeout=f"{timeout}s").close()
+    except (OSError, TimeoutError, ValueError) as err:
+        raise SweepError(f"scheduler {address}: cannot reach a dask scheduler there "
+                         f"({type(err).__name__})") from None
+
+
 def run_chunks(grid: Grid, chunks: Iterable[tuple[int, int]], level: int, jobs: int = 1,
                backend: str = "threads", scheduler: str | None = None
                ) -> Iterator[ChunkResult]:
     """Yield the result of every chunk, in the order they finish.
 
-    backend "threads": ``jobs`` worker threads of this process (1: this thread). "dask":
-    the chunks run on the dask.distributed cluster at ``scheduler`` through joblib's dask
-    backend.
+    backend "threads": ``jobs`` worker threads of this process (1: this thread; -1: one
+    per core). "dask": every chunk runs on the dask.distributed cluster at ``scheduler``
+    (never in this process), at most two chunks per worker thread in flight.
     """
     chunks = list(chunks)
+    if backend not in ("threads", "dask"):
+        raise ValueError(f"backend = {backend!r}: must be threads or dask")
+    n_jobs = check_jobs(jobs) if backend == "threads" else 1
     if not chunks:
         return
     prepare(grid, level)
-    if backend == "threads" and effective_jobs(jobs) == 1:
+    if backend == "dask":
+        if not scheduler:
+            raise SweepError("the dask backend needs a scheduler address")
+        yield from _run_on_cluster(grid, chunks, level, scheduler)
+    elif n_jobs == 1:
         for a, b in chunks:
             yield run_chunk(grid, a, b, level)
-        return
-    from joblib import Parallel, delayed, parallel_config
-
-    tasks = (delayed(run_chunk)(grid, a, b, level) for a, b in chunks)
-    if backend == "threads":
-        with parallel_config(backend="threading", n_jobs=effective_jobs(jobs)):
-            yield from Parallel(return_as="generator_unordered", batch_size=1)(tasks)
-    elif backend == "dask":
-        if not scheduler:
-            raise ValueError("the dask backend needs a scheduler address")
-        from distributed import Client
-
-        with Client(scheduler) as client, parallel_config(backend="dask"):
-            n = max(1, sum(client.nthreads().values()))
-            yield from Parallel(n_jobs=n, return_as="generator_unordered", batch_size=1,
-                                pre_dispatch=f"{2 * n}")(tasks)
     else:
-        raise ValueError(f"backend = {backend!r}: must be threads or dask")
+        from joblib import Parallel, delayed, parallel_config
+
+        tasks = (delayed(run_chunk)(grid, a, b, level) for a, b in chunks)
+        with parallel_config(backend="threading", n_jobs=n_jobs):
+            yield from Parallel(return_as="generator_unordered", batch_size=1)(tasks)
+
+
+def _run_on_cluster(grid: Grid, chunks: list[tuple[int, int]], level: int,
+                    scheduler: str) -> Iterator[ChunkResult]:
+    """The chunks as dask futures (``client.submit``), two per worker thread in flight.
+
+    Submitting directly, not through joblib's dask backend: with one worker thread in the
+    cluster, joblib's n_jobs = 1 ran every chunk in this process. A cluster that has no
+    worker for ``NO_WORKERS_TIMEOUT`` seconds (none joined, or all left) is a
+    ``SweepError``; the caller saves what finished.
+    """
+    from distributed import Client, wait
+    from distributed.client import FIRST_COMPLETED
+
+    with Client(scheduler, timeout="10s") as client:
+        try:
+            client.wait_for_workers(1, timeout=NO_WORKERS_TIMEOUT)
+        except TimeoutError:
+            raise SweepError(f"dask cluster {scheduler}: no worker joined in "
+                             f"{NO_WORKERS_TIMEOUT:g} s; start workers (dask worker "
+                             f"{scheduler}), then rerun with --resume") from None
+        in_flight = 2 * max(1, sum(client.nthreads().values()))
+        todo = iter(chunks)
+        running: dict = {}
+
+        def submit(n: int) -> None:
+            for a, b in (c for _, c in zip(range(n), todo, strict=False)):
+                running[client.submit(run_chunk, grid, a, b, level, pure=False)] = (a, b)
+
+        submit(in_flight)
+        idle_since = None
+        while running:
+            try:
+                wait(list(running), timeout=CLUSTER_POLL, return_when=FIRST_COMPLETED)
+            except TimeoutError:
+                pass
+            done = [f for f in running if f.done()]
+            if not done:
+                if client.nthreads():
+                    idle_since = None
+                elif idle_since is None:
+                    idle_since = time.monotonic()
+                elif time.monotonic() - idle_since >= NO_WORKERS_TIMEOUT:
+                    for f in running:
+                        f.cancel()
+                    raise SweepError(
+                        f"dask cluster {scheduler}: lost all its workers (none for "
+                        f"{NO_WORKERS_TIMEOUT:g} s) with {len(running)} chunks unfinished; "
+                        "finished points are saved: start workers, then rerun with --resume")
+                continue
+            for f in done:
+                a, b = running.pop(f)
+                try:
+                    res = f.result()
+                except Exception as err:
+                    if type(err).__name__ == "KilledWorker":
+                        raise SweepError(
+                            f"dask cluster {scheduler}: the chunk of points {a}..{b - 1} "
+                            "killed the workers that ran it (out of memory?); finished "
+                            "points are saved: rerun with --resume") from None
+                    raise
+                submit(1)
+                yield res
 
 
 def compute(scene: Scene, jobs: int = 1, chunk_size: int | None = None,
@@ -208,7 +308,7 @@ def compute(scene: Scene, jobs: int = 1, chunk_size: int | None = None,
     lvl = level(scene)
     specs = variables(scene)
     flat = {k: np.full(grid.size, fill, dtype) for k, (dtype, fill, _) in specs.items()}
-    n_workers = effective_jobs(jobs) if backend == "threads" else 1
+    n_workers = check_jobs(jobs) if backend == "threads" else 1
     size = chunk_size or auto_chunk_size(grid.size, n_workers)
     for res in run_chunks(grid, plan_chunks(np.ones(grid.size, bool), size), lvl, jobs,
                           backend, scheduler):

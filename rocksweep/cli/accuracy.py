@@ -7,18 +7,14 @@ from pathlib import Path
 
 import click
 
-from rocksweep.cli.main import load, main, scene_argument, set_option, user_errors
-
-
-def _check_output(path: Path | None, option: str) -> None:
-    """Fail before the (long) study if an output file cannot be written."""
-    if path is None:
-        return
-    if path.exists() and path.is_dir():
-        raise click.ClickException(f"{option} {path}: is a directory; give a file name")
-    parent = path.parent if str(path.parent) else Path(".")
-    if not parent.is_dir():
-        raise click.ClickException(f"{option} {path}: directory {parent} does not exist")
+from rocksweep.cli.main import (
+    load,
+    main,
+    overwrite_option,
+    scene_argument,
+    set_option,
+    user_errors,
+)
 
 
 @main.command()
@@ -42,10 +38,11 @@ def _check_output(path: Path | None, option: str) -> None:
 @click.option("--repeat", type=click.IntRange(min=1), default=5, show_default=True,
               help="Kernel timings are the best of this many rounds.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress lines (the table is printed).")
+@overwrite_option
 @user_errors
 def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | None,
              plot_path: Path | None, n_points: int, ladder_name: str, seed: int, repeat: int,
-             quiet: bool) -> None:
+             quiet: bool, overwrite: bool) -> None:
     """Measure what accuracy costs on SCENE.yaml: kernel settings against a reference.
 
     Runs a stratified sample of the scene's points (strata: outcome x on/off a boundary
@@ -59,9 +56,18 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
     rest_rate, max_events and root for every run; the ladder sets steps_per_period and
     event_tol.
     """
+    from rocksweep.outputs import check_output
+
+    # refuse a bad output before the (long) study
+    if report_path is not None and plot_path is not None and report_path == plot_path:
+        raise click.ClickException(f"-o and --plot name the same file {report_path}")
+    if report_path is not None:
+        check_output(report_path, overwrite=overwrite, inputs=[scene_path])
+    if plot_path is not None:
+        from rocksweep.plots import FORMATS
+
+        check_output(plot_path, overwrite=overwrite, inputs=[scene_path], suffixes=FORMATS)
     scene = load(scene_path, overrides)
-    _check_output(report_path, "-o")
-    _check_output(plot_path, "--plot")
 
     from rocksweep.accuracy import accuracy_study, format_table, ladder, write_report
 
@@ -82,12 +88,13 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
     if report_path is not None:
         words = ["rocksweep", "accuracy", str(scene_path), *(f"--set={o}" for o in overrides),
                  f"--points={n_points}", f"--ladder={ladder_name}", f"--seed={seed}",
-                 f"--repeat={repeat}"]
+                 f"--repeat={repeat}", *(["--overwrite"] if overwrite else [])]
         command = " ".join(shlex.quote(w) for w in words)
         write_report(study, report_path, command)
         click.echo(f"wrote {report_path}")
     if plot_path is not None:
-        from rocksweep.accuracy_plot import work_precision_figure
+        from rocksweep.accuracy_plot import work_precision
+        from rocksweep.plots import save_figure
 
-        work_precision_figure(study, plot_path)
+        save_figure(work_precision(study), plot_path, overwrite=overwrite, inputs=[scene_path])
         click.echo(f"wrote {plot_path}")

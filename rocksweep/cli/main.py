@@ -13,8 +13,8 @@ from pathlib import Path
 
 import click
 
+import rocksweep
 from rocksweep.errors import RocksweepError
-from rocksweep.scene import load_scene
 
 
 def user_errors(fn):
@@ -36,16 +36,23 @@ scene_argument = click.argument(
 set_option = click.option(
     "--set", "overrides", multiple=True, metavar="KEY=VALUE",
     help="Override a scene value, e.g. --set pulse.A_ratio=4.5 (repeatable).")
+overwrite_option = click.option("--overwrite", is_flag=True,
+                                help="Replace existing output files.")
 
 
 def load(scene_path: Path, overrides: tuple[str, ...] = ()):
+    """The validated scene at ``scene_path`` (imports the scene machinery, and with it
+    numba, only when a command runs: ``rocksweep --help`` stays fast)."""
+    from rocksweep.scene import load_scene
+
     if not scene_path.exists():
         raise click.ClickException(f"{scene_path}: no such scene file")
     return load_scene(scene_path, list(overrides))
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(package_name="rocksweep")
+@click.version_option(rocksweep.__version__, "--version", "-V", package_name="rocksweep",
+                      message="%(prog)s %(version)s")
 def main() -> None:
     """Stability diagrams of flexible rocking oscillators (Zhu, Chatzis & Acikgoz).
 

@@ -1,0 +1,486 @@
+"""The Python API: run a scene's grid, open a result, simulate one point; and the sweep
+driver behind both ``rocksweep.run`` and ``rocksweep sweep``.
+
+A scene is given as a path to a YAML file, as YAML text or as a dict with the YAML's
+structure. Overrides are ``"KEY=VALUE"`` strings (the command line's ``--set``, VALUE is
+YAML) or a mapping of dotted keys to Python values (``{"impact.lam": 0.4}``).
+
+Nothing heavy is imported here at module level (numba, h5py, xarray, matplotlib load
+inside the functions), so ``import rocksweep`` stays light.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Union
+
+from rocksweep.errors import RocksweepError
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.figure import Figure
+
+    from rocksweep.run import Run
+    from rocksweep.scene import Scene
+
+SceneLike = Union[str, Path, Mapping[str, Any]]  # noqa: UP007 (a runtime alias on 3.10)
+Overrides = Union[Sequence[str], Mapping[str, Any]]  # noqa: UP007
+
+# Finished chunks are written to the file at most this often [s] by default: a write
+# (several hyperslabs per variable, two flushes) costs ~10 ms, as much as a chunk of easy
+# points, and holds the GIL that worker threads need between kernel calls.
+WRITE_EVERY = 1.0
+# `simulate` on the command line overlays a few runs; larger grids are for sweeps.
+MAX_RUNS = 12
+
+
+class ApiError(RocksweepError, ValueError):
+    """An argument of the Python API that cannot be used; ``str()`` is one line."""
+
+
+# ---------------------------------------------------------------------------------------
+# Scenes and overrides
+# ---------------------------------------------------------------------------------------
+
+def _yaml_value(v: Any) -> str:
+    """A Python value as the YAML text of a ``KEY=VALUE`` override (inf as .inf)."""
+    import yaml
+
+    if hasattr(v, "tolist"):  # numpy scalars and arrays
+        v = v.tolist()
+    if isinstance(v, tuple):
+        v = list(v)
+    text = yaml.safe_dump(v, default_flow_style=True, width=1 << 30).strip()
+    return text[:-3].strip() if text.endswith("\n...") else text
+
+
+def override_strings(overrides: Overrides | None) -> list[str]:
+    """Overrides as ``KEY=VALUE`` strings: a sequence of such strings is kept, a mapping
+    ``{dotted key: value}`` is written as YAML (``{"impact.lam": 0.4}`` -> impact.lam=0.4;
+    ``__`` in a key stands for a dot, as in ``impact__lam``)."""
+    if overrides is None:
+        return []
+    if isinstance(overrides, str):
+        return [overrides]
+    if isinstance(overrides, Mapping):
+        return [f"{str(k).replace('__', '.')}={_yaml_value(v)}" for k, v in overrides.items()]
+    return [str(o) for o in overrides]
+
+
+def load(scene: SceneLike | Scene, overrides: Overrides | None = ()) -> tuple[Scene, Path | None]:
+    """A validated scene and the file it came from (None for text or a dict).
+
+    scene: a ``Path``; a ``str`` that names an existing file, or else holds YAML (a
+    newline or a colon), or else is taken as a missing path; a mapping (the YAML's
+    structure); or a ``Scene`` (then without overrides). Errors are one-line SceneErrors.
+    """
+    from rocksweep.scene import Scene, SceneError, load_scene, parse_scene
+
+    ov = override_strings(overrides)
+    if isinstance(scene, Scene):
+        if ov:
+            raise ApiError("overrides apply to a scene path, text or dict, not to a Scene")
+        return scene, None
+    if isinstance(scene, Mapping):
+        import yaml
+
+        text = yaml.safe_dump(_plain_tree(scene), sort_keys=False)
+        return parse_scene(text, "scene", ov), None
+    if isinstance(scene, str) and not Path(scene).is_file() and ("\n" in scene or ":" in scene):
+        return parse_scene(scene, "scene", ov), None
+    if not isinstance(scene, str | Path):
+        raise ApiError(f"scene = {scene!r}: give a path, YAML text or a dict")
+    path = Path(scene)
+    if not path.exists():
+        raise SceneError(f"{path}: no such scene file")
+    return load_scene(path, ov), path
+
+
+def _plain_tree(v: Any) -> Any:
+    """A mapping with numpy values and tuples -> plain YAML-safe Python."""
+    if isinstance(v, Mapping):
+        return {str(k): _plain_tree(x) for k, x in v.items()}
+    if hasattr(v, "tolist"):
+        return v.tolist()
+    if isinstance(v, list | tuple):
+        return [_plain_tree(x) for x in v]
+    return v
+
+
+# ---------------------------------------------------------------------------------------
+# The sweep driver
+# ---------------------------------------------------------------------------------------
+
+@dataclass
+class SweepReport:
+    """What a sweep session did. Times in seconds.
+
+    points_done: points in the file now; computed: points computed in this session;
+    done_before: points the file held when the session started; compile_s: kernel
+    compile or cache load; cpu_s: the workers' CPU time on this session's points;
+    attrs: the file's totals (``SweepFile.finish``).
+    """
+
+    path: Path
+    points_total: int
+    done_before: int
+    computed: int
+    wall_s: float
+    cpu_s: float
+    compile_s: float
+    attrs: dict = field(default_factory=dict)
+
+    @property
+    def points_done(self) -> int:
+        return self.done_before + self.computed
+
+    @property
+    def complete(self) -> bool:
+        return self.points_done == self.points_total
+
+    @property
+    def rate(self) -> float:
+        """Points computed per second of wall time."""
+        return self.computed / self.wall_s if self.wall_s > 0 else math.nan
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C during a sweep, after every finished chunk was written (``report``)."""
+
+    def __init__(self, report: SweepReport) -> None:
+        super().__init__(f"interrupted: {report.points_done} of {report.points_total} "
+                         f"points saved in {report.path}")
+        self.report = report
+
+
+def check_write_every(seconds: float, name: str = "write_every =") -> float:
+    """``seconds`` if finite and >= 0, else a one-line ApiError (``name``: how the
+    message names the option, "--write-every" on the command line)."""
+    if not (isinstance(seconds, int | float) and math.isfinite(seconds) and seconds >= 0):
+        raise ApiError(f"{name} {seconds}: give a finite number of seconds >= 0 (0: write "
+                       "every chunk as it finishes)")
+    return float(seconds)
+
+
+def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
+               jobs: int = 1, resume: bool = False, overwrite: bool = False,
+               backend: str = "threads", scheduler: str | None = None,
+               chunk_size: int | None = None, write_every: float = WRITE_EVERY,
+               progress: bool = False, log: Callable[[str], None] | None = None,
+               inputs: Iterable[str | Path] = ()) -> SweepReport:
+    """Sweep ``scene`` into the result file ``path`` (``rocksweep sweep``).
+
+    Makes the file (refusing an existing one unless ``overwrite``), or with ``resume``
+    reopens an existing file of the same scene and computes only its missing points.
+    Finished chunks are written in batches, at most every ``write_every`` seconds; on
+    Ctrl-C the pending chunks are written and ``SweepInterrupted`` (a KeyboardInterrupt)
+    is raised; on any other error they are written before the error propagates.
+
+    jobs: local worker threads (-1: one per core); backend "threads" or "dask" (with
+    ``scheduler``, an address); chunk_size: points per chunk (default about 32 chunks per
+    worker); progress: a progress bar on stderr; log: receives the header and kernel
+    lines; inputs: the command's input files, never written over; overrides: recorded in
+    the file. Returns a ``SweepReport``.
+    """
+    from rocksweep import sweep as sw
+    from rocksweep.outputs import OutputError, check_output
+
+    if resume and overwrite:
+        raise ApiError("resume and overwrite exclude each other")
+    check_write_every(write_every)
+    if chunk_size is not None and chunk_size < 1:
+        raise ApiError(f"chunk_size = {chunk_size}: must be >= 1")
+    if backend == "threads":
+        if scheduler:
+            raise ApiError("a scheduler address works with backend='dask' only")
+        n_workers = sw.check_jobs(jobs)
+    elif backend == "dask":
+        if not scheduler:
+            raise ApiError("backend 'dask' needs a scheduler address")
+        sw.check_scheduler(scheduler)  # before any file is made
+        n_workers = 1
+    else:
+        raise ApiError(f"backend = {backend!r}: must be threads or dask")
+    say = log or (lambda _line: None)
+
+    from rocksweep.store import SweepFile
+
+    path = Path(path)
+    t0 = time.perf_counter()
+    if resume and path.exists():
+        check_output(path, overwrite=True, inputs=inputs)
+        sf = SweepFile.resume(path, scene, overrides)
+    else:
+        if path.is_file() and not overwrite:
+            raise OutputError(f"{path}: already exists; use --resume to finish it or "
+                              "--overwrite to replace it")
+        check_output(path, overwrite=overwrite, inputs=inputs)
+        sf = SweepFile.create(path, scene, overrides, overwrite=overwrite)
+    report = SweepReport(path, sf.grid.size, 0, 0, 0.0, 0.0, 0.0)
+    pending: list = []  # finished chunks not yet in the file
+
+    def write_pending() -> None:
+        for merged in sw.merge_contiguous(pending):
+            sf.write(merged)
+        pending.clear()
+
+    try:
+        done = sf.done()
+        report.done_before = int(done.sum())
+        todo = int((~done).sum())
+        size = chunk_size or sw.auto_chunk_size(todo, n_workers)
+        chunks = sw.plan_chunks(~done, size)
+        where = (f"{n_workers} worker{'s' * (n_workers > 1)}" if backend == "threads"
+                 else f"dask cluster {scheduler}")
+        dims = " x ".join(f"{len(a.values)} {a.name}" for a in scene.swept) or "1 point"
+        say(f"{scene.name}: {sf.grid.size} points ({dims}); {report.done_before} done, "
+            f"{todo} to compute on {where}; accuracy {scene.numerics.describe()}")
+        lvl = sw.level(scene)
+        if todo:
+            to_compile, unknown = sw.kernel_cache_state(sf.grid, lvl)
+            if to_compile:
+                say(f"compiling the kernel (once per machine, "
+                    f"~{to_compile * sw.COMPILE_SECONDS:.0f} s)...")
+            elif unknown:
+                say("loading or compiling the kernel...")
+            t_prep = time.perf_counter()
+            sw.prepare(sf.grid, lvl)  # compile, or load numba's cache, once
+            report.compile_s = time.perf_counter() - t_prep
+            if to_compile or unknown or report.compile_s > 1.0:
+                how = "compiled" if to_compile else "compiled or loaded from numba's cache"
+                say(f"kernel {how} in {report.compile_s:.1f} s")
+        from tqdm import tqdm
+
+        with tqdm(total=todo, unit="pt", disable=not progress, file=sys.stderr,
+                  smoothing=0.1, dynamic_ncols=True) as bar:
+            t_write = time.perf_counter()
+            for res in sw.run_chunks(sf.grid, chunks, lvl, jobs, backend, scheduler):
+                pending.append(res)
+                report.cpu_s += res.cpu_seconds
+                report.computed += res.stop - res.start
+                bar.update(res.stop - res.start)
+                if time.perf_counter() - t_write >= write_every:
+                    write_pending()
+                    t_write = time.perf_counter()
+            write_pending()
+    except BaseException as err:
+        try:
+            write_pending()
+            report.wall_s = time.perf_counter() - t0
+            report.attrs = sf.finish(report.wall_s, report.cpu_s)
+        finally:
+            sf.close()
+        if isinstance(err, KeyboardInterrupt) and not isinstance(err, SweepInterrupted):
+            raise SweepInterrupted(report) from None
+        raise
+    report.wall_s = time.perf_counter() - t0
+    report.attrs = sf.finish(report.wall_s, report.cpu_s)
+    sf.close()
+    return report
+
+
+# ---------------------------------------------------------------------------------------
+# rocksweep.run and rocksweep.open
+# ---------------------------------------------------------------------------------------
+
+def _stderr(line: str) -> None:
+    print(line, file=sys.stderr, flush=True)
+
+
+def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
+        overrides: Overrides = (), progress: bool = False, overwrite: bool = False,
+        resume: bool = False) -> xr.Dataset:
+    """Compute every point of a scene's grid; return the results as an xarray Dataset.
+
+    scene: a path to a scene YAML file, YAML text, or a dict with the YAML's structure.
+    jobs: worker threads (-1: one per core). output: also keep the HDF5 result file
+    there (written exactly as ``rocksweep sweep SCENE -o OUTPUT`` writes it; an existing
+    file is refused unless ``overwrite``; ``resume`` finishes an interrupted file of the
+    same scene). overrides: ``["impact.lam=0.2"]`` or ``{"impact.lam": 0.2}``.
+    progress: print the header and a progress bar on stderr.
+
+    The Dataset has the file's variables (outcome: -1 not computed, 0 safe, 1 mode 1, 2
+    mode 2; impacts, uplifts, theta_max_over_alpha, t_overturn, status, steps,
+    event_steps, and energies with ``outputs: {energy: true}``), one dimension per swept
+    key (coordinates named after the keys: shape, lam, A_ratio, w_over_p, body keys),
+    the unswept keys as scalar coordinates and the file's attributes (see ``open``). It
+    is loaded in memory; without ``output`` no file is kept.
+
+    Raises a one-line ``RocksweepError`` for a bad scene, option or output path;
+    KeyboardInterrupt (``SweepInterrupted``) after saving the finished points to
+    ``output``.
+    """
+    sc, source = load(scene, overrides)
+    ov = override_strings(overrides)
+    log = _stderr if progress else None
+    if output is None:
+        if resume:
+            raise ApiError("resume=True needs output= (the file to finish)")
+        import tempfile
+
+        with tempfile.TemporaryDirectory(prefix="rocksweep-") as tmp:
+            path = Path(tmp) / "result.h5"
+            sweep_file(sc, path, overrides=ov, jobs=jobs, progress=progress, log=log)
+            return open(path)
+    sweep_file(sc, output, overrides=ov, jobs=jobs, resume=resume, overwrite=overwrite,
+               progress=progress, log=log, inputs=[source] if source else ())
+    return open(output)
+
+
+def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xarray's)
+    """A sweep result file as an xarray Dataset, loaded in memory (the file is closed).
+
+    Each variable carries ``units`` (``rocksweep.fields.UNITS``) and a ``description``;
+    ``outcome`` its codes and words as CF flags (``flag_values`` -1 0 1 2,
+    ``flag_meanings`` "not_run safe mode1 mode2"), ``status`` its bits (``flag_masks``,
+    ``flag_meanings``, ``flagged_mask``). The Dataset's attributes are the file's
+    provenance: the scene YAML verbatim (``scene``) and resolved (``scene_resolved``),
+    ``overrides``, the resolved ``numerics`` and ``accuracy``, library versions,
+    ``started``/``finished``, ``wall_time``/``cpu_time`` [s], ``points_done``,
+    ``complete``. Works while a sweep is still writing the file (no lock is taken).
+    A file that is not a rocksweep result is a one-line ``RocksweepError``.
+    """
+    import xarray as xr
+
+    from rocksweep import fields
+    from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
+    from rocksweep.store import read_result
+
+    path = Path(path)
+    read_result(path, ["outcome"])  # one-line errors for foreign or damaged files
+    with xr.open_dataset(path, engine="h5netcdf", driver_kwds={"locking": False}) as ds:
+        ds = ds.load()
+    for name, var in ds.data_vars.items():
+        f = fields.BY_NAME.get(str(name))
+        if f is not None:
+            var.attrs.setdefault("units", f.unit)
+            var.attrs.setdefault("description", f.meaning)
+    if "outcome" in ds:
+        ds["outcome"].attrs.setdefault("flag_values", list(OUTCOME_WORDS))
+        ds["outcome"].attrs.setdefault("flag_meanings", " ".join(OUTCOME_WORDS.values()))
+    if "status" in ds:
+        ds["status"].attrs.setdefault("flag_masks", list(STATUS_WORDS))
+        ds["status"].attrs.setdefault("flag_meanings", " ".join(STATUS_WORDS.values()))
+    ds.attrs = {k: (v.item() if hasattr(v, "item") else v) for k, v in ds.attrs.items()}
+    return ds
+
+
+# ---------------------------------------------------------------------------------------
+# rocksweep.simulate
+# ---------------------------------------------------------------------------------------
+
+@dataclass
+class Simulation:
+    """One run of one point (``rocksweep.simulate``).
+
+    summary: plain dict (``rocksweep simulate --json``: outcome, impacts, uplifts,
+    theta_max_over_alpha, t_overturn, t_first_impact, energies / E_ref, status words,
+    steps, event_steps, accuracy, wall_time_s); history: xarray Dataset over ``p_t``
+    (``rocksweep.fields.HISTORY``: theta_over_alpha, u_over_ucr, E_over_Eref, ..., each
+    with ``units``; at an event p_t repeats: the rows before and after it); run: the
+    underlying ``rocksweep.run.Run``.
+    """
+
+    summary: dict
+    history: xr.Dataset
+    run: Run
+    title: str = ""
+
+    def figure(self) -> Figure:
+        """Figure 5 for this run (pulse, theta/alpha, E/E_ref, dissipated energy against
+        p*t) as a pyplot-free matplotlib Figure: show it in a notebook or ``savefig``."""
+        from rocksweep.plots import time_history
+
+        return time_history([self.run], (), self.title)
+
+
+def history_dataset(run: Run, title: str = "") -> xr.Dataset:
+    """A run's time history as an xarray Dataset over p_t (see ``Simulation``)."""
+    import xarray as xr
+
+    from rocksweep import fields
+
+    cols = run.history_columns()
+    spec = {c.name: c for c in fields.HISTORY}
+    t = cols.pop("p_t")
+    ds = xr.Dataset(
+        {k: ("p_t", v, {"units": spec[k].unit, "long_name": spec[k].meaning})
+         for k, v in cols.items()},
+        coords={"p_t": ("p_t", t, {"units": spec["p_t"].unit,
+                                   "long_name": spec["p_t"].meaning})})
+    s = run.summary()
+    ds.attrs = {"title": title, "outcome": s["outcome"], "accuracy": s["accuracy"],
+                "lam": run.point.lam, "shape": run.point.shape,
+                "w_over_p": run.point.w_over_p, "A_ratio": run.point.A_ratio}
+    return ds
+
+
+def simulate(scene: SceneLike, overrides: Overrides = (), /, **keys: Any) -> Simulation:
+    """Run one point of a scene with its energy balance and time history.
+
+    scene: a path, YAML text or a dict (as for ``run``) that holds one point after the
+    overrides. Overrides as a mapping or ``KEY=VALUE`` strings (``{"impact.lam": 0.4}``),
+    or as keywords with ``__`` for the dot: ``simulate("fig5.yaml", impact__lam=0.4)``.
+    The accuracy is the scene's preset, ``fine`` if it names none (as ``rocksweep
+    simulate``). Returns a ``Simulation`` (summary dict, history Dataset over p*t, and
+    ``.figure()``).
+    """
+    from rocksweep.run import simulate as run_point
+
+    ov = [*override_strings(overrides), *override_strings(keys)]
+    sc, _ = load(scene, ov)
+    r = run_point(sc.single_point(), sc.single_numerics)
+    return Simulation(r.summary(), history_dataset(r, sc.name), r, sc.name)
+
+
+def simulate_runs(scene: Scene, max_runs: int = MAX_RUNS) -> list[Run]:
+    """Each point of a small scene as a single run with history (``rocksweep simulate``
+    overlays them); a SceneError naming the longest swept key if there are more than
+    ``max_runs`` points."""
+    from itertools import product
+
+    from rocksweep.run import simulate as run_point
+    from rocksweep.scene import SceneError
+
+    if scene.size > max_runs:
+        big = max(scene.swept, key=lambda a: len(a.values))
+        raise SceneError(f"{scene.size} points; simulate runs at most {max_runs} (use "
+                         f"`rocksweep sweep`, or pick a value with --set {big.key}=VALUE)")
+    names = [a.name for a in scene.axes]
+    return [run_point(scene.point(dict(zip(names, combo, strict=True))), scene.single_numerics)
+            for combo in product(*(a.values for a in scene.axes))]
+
+
+def swept_values(run: Run, swept: Sequence[str]) -> list:
+    """The run's value of each swept key, as plain Python (str for shape, else float)."""
+    p = run.point
+    out = []
+    for k in swept:
+        v = getattr(p, k) if hasattr(p, k) else getattr(p.body, k)
+        out.append(v if isinstance(v, str) else float(v))
+    return out
+
+
+def write_history_csv(runs: Sequence[Run], swept: Sequence[str], path: str | Path) -> None:
+    """The runs' time histories to one CSV file, atomically: columns run, the swept
+    keys, then ``rocksweep.fields.HISTORY`` (p_t, theta_over_alpha, u_over_ucr,
+    E_over_Eref, ...); plain numbers (``repr`` of Python floats: nan, inf as such).
+    Check the path first with ``rocksweep.outputs.check_output``."""
+    import csv
+
+    from rocksweep import fields
+    from rocksweep.outputs import atomic_path
+
+    with atomic_path(path) as tmp, tmp.open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["run", *swept, *(c.name for c in fields.HISTORY)])
+        for i, r in enumerate(runs):
+            fixed = swept_values(r, swept)
+            cols = list(r.history_columns().values())
+            for j in range(len(cols[0])):
+                w.writerow([i, *fixed, *(repr(float(c[j])) for c in cols)])

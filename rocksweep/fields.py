@@ -1,0 +1,190 @@
+"""One definition of every result: the fields of a run's result row and the columns of
+its time history.
+
+``FIELDS`` lists what the kernel reports per point (its ``OUT_*`` slots) under the names
+users see: in sweep files (``rocksweep sweep``, ``rocksweep.run``), in single runs
+(``Run.summary``, ``rocksweep simulate --json``) and in the accuracy report. Each field
+says its dtype, the fill value of a point not computed, its unit, its meaning, the kernel
+slot it comes from and the per-point scale it is divided by (theta by alpha_ref, energies
+by E_ref). ``HISTORY`` does the same for the columns of a time history (``HIST_*``).
+
+Units follow the conventions of ``rocksweep.model``: times are p*t (unit ``1/p``),
+rotations theta/alpha_ref (unit ``alpha_ref``: alpha_cg of a flexible body, alpha of a
+block), lateral displacements u/u_cr, energies E/E_ref; ``1`` is a count, a code or a
+pure number.
+
+"steps" means the regular RK4 steps everywhere; the RK4 re-integrations spent locating
+events are ``event_steps`` (their sum is the evaluations a run cost).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.model import G
+
+
+@dataclass(frozen=True)
+class Field:
+    """One quantity of the kernel's result row.
+
+    name: the user-facing name; dtype: numpy dtype in files; fill: value of a point not
+    computed; unit: see the module docstring; meaning: one line; slot: index into the
+    kernel's result row (``layout.OUT_*``); scale: per-point divisor, "" (none),
+    "alpha_ref" or "E_ref"; stored: kept in sweep files; energy: needs the
+    energy-accounting kernel (sweeps with ``outputs: {energy: true}``, single runs).
+    """
+
+    name: str
+    dtype: str
+    fill: float
+    unit: str
+    meaning: str
+    slot: int
+    scale: str = ""
+    stored: bool = True
+    energy: bool = False
+
+
+_FLAGGED = "status & (horizon | step_cap | event_cap | nonfinite)"
+
+FIELDS: tuple[Field, ...] = (
+    Field("outcome", "int8", L.OUTCOME_NOT_RUN, "1",
+          "-1 not computed, 0 safe, 1 mode 1 (overturned after impacts), "
+          "2 mode 2 (overturned without impact)", L.OUT_OUTCOME),
+    Field("impacts", "int32", -1, "1", "number of impacts", L.OUT_IMPACTS),
+    Field("uplifts", "int32", -1, "1", "number of uplifts (rocking starts from full contact)",
+          L.OUT_UPLIFTS),
+    Field("theta_max_over_alpha", "float64", math.nan, "alpha_ref", "max |theta| / alpha_ref",
+          L.OUT_THETA_MAX, "alpha_ref"),
+    Field("t_overturn", "float64", math.nan, "1/p", "overturning time p*t (NaN if none)",
+          L.OUT_T_OVERTURN),
+    Field("status", "int32", 0, "1",
+          f"bit flags (rocksweep.outcomes.STATUS_WORDS); flagged = {_FLAGGED}", L.OUT_STATUS),
+    Field("steps", "int64", 0, "1", "regular RK4 steps taken", L.OUT_STEPS),
+    Field("event_steps", "int64", 0, "1", "RK4 re-integrations spent locating events",
+          L.OUT_EVENT_STEPS),
+    Field("work_in_over_Eref", "float64", math.nan, "E_ref",
+          "work of the ground motion / E_ref", L.OUT_W_IN, "E_ref", energy=True),
+    Field("damper_loss_over_Eref", "float64", math.nan, "E_ref",
+          "energy dissipated by the damper / E_ref", L.OUT_D_DAMP, "E_ref", energy=True),
+    Field("impact_loss_over_Eref", "float64", math.nan, "E_ref",
+          "energy lost in impacts (net) / E_ref", L.OUT_E_IMPACT, "E_ref", energy=True),
+    # single runs and the accuracy report only (not stored in sweep files)
+    Field("t_end", "float64", math.nan, "1/p", "time p*t at which the run stopped",
+          L.OUT_T_END, stored=False),
+    Field("t_first_impact", "float64", math.nan, "1/p", "first impact time p*t (NaN if none)",
+          L.OUT_T_FIRST_IMPACT, stored=False),
+    Field("e_max", "float64", math.nan, "1", "largest coefficient of restitution seen (eq. 1)",
+          L.OUT_E_MAX, stored=False),
+    Field("returns_to_contact", "int64", -1, "1",
+          "returns to full contact (e <= 0, or settling below the rest rate)", L.OUT_CONTACTS,
+          stored=False),
+    Field("impact_gain_over_Eref", "float64", math.nan, "E_ref",
+          "energy gained in impacts with E_d < 0 / E_ref", L.OUT_E_GAINED, "E_ref",
+          stored=False, energy=True),
+    Field("energy_gaining_impacts", "int64", -1, "1", "impacts that gained energy",
+          L.OUT_N_GAINING, stored=False, energy=True),
+    Field("energy_end_over_Eref", "float64", math.nan, "E_ref",
+          "mechanical energy at the end, relative to rest / E_ref", L.OUT_E_END, "E_ref",
+          stored=False, energy=True),
+)
+
+BY_NAME: dict[str, Field] = {f.name: f for f in FIELDS}
+UNITS: dict[str, str] = {f.name: f.unit for f in FIELDS}
+"""name -> unit of every result field (the ``units`` attribute of a file's variable)."""
+
+SWEEP_FIELDS: tuple[Field, ...] = tuple(f for f in FIELDS if f.stored and not f.energy)
+ENERGY_FIELDS: tuple[Field, ...] = tuple(f for f in FIELDS if f.stored and f.energy)
+
+
+def sweep_fields(energy: bool) -> tuple[Field, ...]:
+    """The fields a sweep file stores (``energy``: the scene's ``outputs.energy``)."""
+    return SWEEP_FIELDS + (ENERGY_FIELDS if energy else ())
+
+
+def convert(outs: np.ndarray, alpha_ref: np.ndarray | float, E_ref: np.ndarray | float,
+            fields: tuple[Field, ...] | list[Field]) -> dict[str, np.ndarray]:
+    """Kernel result rows -> named arrays in the fields' units and dtypes.
+
+    outs: float64[n, N_OUT]; alpha_ref [rad], E_ref [J]: float64[n] or scalars (the
+    per-point scales). Returns name -> array[n] (fresh arrays, not views of ``outs``).
+    """
+    scales = {"": None, "alpha_ref": alpha_ref, "E_ref": E_ref}
+    arrays = {}
+    for f in fields:
+        col = outs[:, f.slot]
+        s = scales[f.scale]
+        arrays[f.name] = (col / s if s is not None else col).astype(f.dtype, copy=True)
+    return arrays
+
+
+def value(out: np.ndarray, f: Field, alpha_ref: float, E_ref: float) -> int | float | None:
+    """One field of one result row as a plain Python number (NaN -> None for optional
+    times and energies)."""
+    v = float(out[f.slot])
+    if math.isnan(v):
+        return None
+    v /= {"": 1.0, "alpha_ref": alpha_ref, "E_ref": E_ref}[f.scale]
+    return int(v) if np.dtype(f.dtype).kind == "i" else v
+
+
+# ---------------------------------------------------------------------------------------
+# Time history columns
+# ---------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Column:
+    """One column of a time history.
+
+    name: user-facing, normalised name; raw: key in ``Run.history`` (SI, p = 1 rad/s);
+    slot: the kernel's ``HIST_*`` column; scale: per-run divisor ("" none, "alpha_ref",
+    "u_cr", "E_ref", "g"); unit, meaning: as for ``Field``.
+    """
+
+    name: str
+    raw: str
+    slot: int
+    scale: str
+    unit: str
+    meaning: str
+
+
+HISTORY: tuple[Column, ...] = (
+    Column("p_t", "t", L.HIST_T, "", "1/p", "time p*t"),
+    Column("theta_over_alpha", "theta", L.HIST_THETA, "alpha_ref", "alpha_ref",
+           "rotation theta/alpha_ref (> 0: rocking on the corner at x = +b)"),
+    Column("u_over_ucr", "u", L.HIST_U, "u_cr", "u_cr",
+           "lateral displacement of the top mass u/u_cr (eq. 4; NaN for a rigid body)"),
+    Column("E_over_Eref", "E", L.HIST_E, "E_ref", "E_ref",
+           "mechanical energy relative to rest / E_ref"),
+    Column("theta_dot_over_alpha", "theta_dot", L.HIST_THETA_DOT, "alpha_ref", "p alpha_ref",
+           "rotation rate theta'/(p alpha_ref)"),
+    Column("u_dot_over_ucr", "u_dot", L.HIST_U_DOT, "u_cr", "p u_cr",
+           "lateral velocity u'/(p u_cr) (NaN for a rigid body)"),
+    Column("phase", "phase", L.HIST_PHASE, "", "1",
+           "-1 / +1 rocking on the corner at x = -b / +b, 0 full contact"),
+    Column("W_in_over_Eref", "W_in", L.HIST_W_IN, "E_ref", "E_ref",
+           "work of the ground motion so far / E_ref"),
+    Column("D_damp_over_Eref", "D_damp", L.HIST_D_DAMP, "E_ref", "E_ref",
+           "energy dissipated by the damper so far / E_ref"),
+    Column("E_impact_over_Eref", "E_impact", L.HIST_E_IMPACT, "E_ref", "E_ref",
+           "energy lost in impacts so far (net) / E_ref"),
+    Column("xg_over_g", "xg", L.HIST_XG, "g", "g", "ground acceleration x_g''/g (eq. 2)"),
+)
+
+HISTORY_RAW: tuple[str, ...] = tuple(c.raw for c in sorted(HISTORY, key=lambda c: c.slot))
+"""Keys of ``Run.history`` in kernel column order."""
+
+
+def history_columns(raw: dict[str, np.ndarray], body) -> dict[str, np.ndarray]:
+    """A run's raw history (``Run.history``) -> name -> normalised float64 array, in
+    ``HISTORY`` order. body: the run's body (alpha_ref, u_cr, E_ref)."""
+    u_cr = body.u_cr if body.u_cr else math.nan  # rigid bodies have no u_cr
+    scales = {"": 1.0, "alpha_ref": body.alpha_ref, "u_cr": u_cr, "E_ref": body.E_ref,
+              "g": G}
+    return {c.name: np.asarray(raw[c.raw], float) / scales[c.scale] for c in HISTORY}

@@ -1,0 +1,223 @@
+"""What a sweep result holds: class counts per swept key, completeness and provenance
+(the library side of ``rocksweep info`` and of the summary ``rocksweep sweep`` prints).
+
+Counts are per class (mode 1 / mode 2 / safe), with the points flagged (horizon, step or
+event cap, non-finite state) and not computed yet. ``class_counts`` groups them by any
+swept keys, summing over the others; long axes are shown as ranges of values
+(``in_ranges``), so a 101-value lam axis takes a few lines, not a hundred.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from rocksweep.kernel import layout as L  # noqa: N812
+
+if TYPE_CHECKING:
+    from rocksweep.store import SweepResult
+
+CLASSES = ("mode1", "mode2", "safe", "flagged", "not_computed")
+# A swept key with more values than this is printed as this many ranges of values.
+MAX_ROWS = 10
+# Variables ``info_dict`` needs from the file.
+INFO_VARIABLES = ["outcome", "status", "steps", "event_steps"]
+
+
+def _plain(v):
+    if isinstance(v, bytes):
+        return v.decode()
+    if isinstance(v, np.generic):
+        return v.item()
+    return v
+
+
+def class_counts(result: SweepResult, by: Sequence[str]) -> list[dict]:
+    """Points per class for each combination of values of the swept keys ``by`` (in the
+    grid's order, the others summed); keys in ``by`` that are not swept are labelled with
+    their one value.
+
+    Returns one dict per combination: the key values, then mode1, mode2, safe, flagged
+    (computed points with a flagged status) and not_computed.
+    """
+    out = np.asarray(result.arrays["outcome"])
+    status = np.asarray(result.arrays["status"])
+    swept = [d for d in by if d in result.dims]
+    pos = [result.dims.index(d) for d in swept]
+    rest = [i for i in range(len(result.dims)) if i not in pos]
+    shape = [result.shape[i] for i in pos]
+    o = np.transpose(out, [*pos, *rest]).reshape(*shape, -1)
+    fl = np.transpose((status & L.STATUS_FLAGGED) != 0, [*pos, *rest]).reshape(o.shape)
+    fl &= o != L.OUTCOME_NOT_RUN
+    rows = []
+    for idx in np.ndindex(*shape):
+        label = {d: (_plain(result.coords[d][idx[swept.index(d)]]) if d in swept
+                     else _plain(result.scalars.get(d))) for d in by}
+        cell = o[idx]
+        rows.append({**label,
+                     "mode1": int((cell == L.OUTCOME_MODE1).sum()),
+                     "mode2": int((cell == L.OUTCOME_MODE2).sum()),
+                     "safe": int((cell == L.OUTCOME_SAFE).sum()),
+                     "flagged": int(fl[idx].sum()),
+                     "not_computed": int((cell == L.OUTCOME_NOT_RUN).sum())})
+    return rows
+
+
+def counts_by_key(result: SweepResult) -> dict[str, list[dict]]:
+    """swept key -> ``class_counts`` over its values alone (every other key summed)."""
+    return {d: class_counts(result, [d]) for d in result.dims}
+
+
+def shape_lam_counts(result: SweepResult) -> list[dict]:
+    """Counts per pulse shape and lam (the paper's comparison of Figures 3 and 4)."""
+    return class_counts(result, ["shape", "lam"])
+
+
+def in_ranges(rows: list[dict], key: str, max_rows: int = MAX_ROWS) -> list[dict]:
+    """Consecutive rows that share every label but ``key`` merged into at most
+    ``max_rows`` ranges of ``key``'s values, counts summed; a merged row's ``key`` is
+    (first, last) and ``n_values`` says how many values it holds."""
+    labels = [k for k in rows[0] if k not in CLASSES] if rows else []
+    others = [k for k in labels if k != key]
+    out: list[dict] = []
+    start = 0
+    while start < len(rows):
+        stop = start
+        while stop < len(rows) and all(rows[stop][k] == rows[start][k] for k in others):
+            stop += 1
+        run = rows[start:stop]
+        if len(run) <= max_rows:
+            out.extend(run)
+        else:
+            for part in np.array_split(np.arange(len(run)), max_rows):
+                group = [run[i] for i in part]
+                row = {k: group[0][k] for k in others}
+                row[key] = (group[0][key], group[-1][key])
+                row["n_values"] = len(group)
+                row.update({c: sum(g[c] for g in group) for c in CLASSES})
+                out.append(row)
+        start = stop
+    return out
+
+
+def _label(v) -> str:
+    if isinstance(v, tuple):
+        return f"{_label(v[0])} .. {_label(v[1])}"
+    if isinstance(v, float):
+        return f"{v:g}"
+    return str(v)
+
+
+def format_counts(rows: list[dict], indent: str = "") -> list[str]:
+    """A text table of ``class_counts`` rows (ranges from ``in_ranges`` as "a .. b");
+    the not_computed column only when some point is missing."""
+    if not rows:
+        return []
+    labels = [k for k in rows[0] if k not in CLASSES and k != "n_values"]
+    classes = [c for c in CLASSES if c != "not_computed" or any(r[c] for r in rows)]
+    cells = [[_label(r[k]) for k in labels] for r in rows]
+    widths = [max(len(k), *(len(c[i]) for c in cells)) for i, k in enumerate(labels)]
+    head = "".join(f"{k:<{w + 2}}" for k, w in zip(labels, widths, strict=True))
+    names = {"not_computed": "missing"}
+    lines = [indent + head + "".join(f"{names.get(c, c):>9}" for c in classes)]
+    for r, c in zip(rows, cells, strict=True):
+        left = "".join(f"{v:<{w + 2}}" for v, w in zip(c, widths, strict=True))
+        lines.append(indent + left + "".join(f"{r[k]:>9}" for k in classes))
+    return lines
+
+
+def counts_lines(result: SweepResult) -> list[str]:
+    """The per shape and lam table, long lam axes in ranges (``rocksweep sweep`` prints
+    it after a sweep)."""
+    return format_counts(in_ranges(shape_lam_counts(result), "lam"))
+
+
+def _json_value(v):
+    """JSON has no inf: write it as the string "inf" (wn_over_p: .inf, a rigid body)."""
+    if isinstance(v, float) and math.isinf(v):
+        return "inf" if v > 0 else "-inf"
+    if isinstance(v, float) and math.isnan(v):
+        return None
+    return v
+
+
+def info_dict(result: SweepResult) -> dict:
+    """Everything ``rocksweep info`` reports, as plain JSON: dims (size, scene key,
+    values), fixed keys, completeness, counts per shape and lam and per swept key,
+    accuracy, RK4 step totals and provenance (versions, times, overrides, scene YAML).
+
+    result: ``store.read_result(path, INFO_VARIABLES)``.
+    """
+    a = result.attrs
+    done = result.done
+    keys = {k.split(".", 1)[1]: k for k in result.scene["axes"]}
+    dims = {d: {"size": len(result.coords[d]), "scene_key": keys[d],
+                "values": [_plain(v) for v in result.coords[d]]} for d in result.dims}
+    return {
+        "path": str(result.path),
+        "title": result.name,
+        "format_version": a.get("format_version"),
+        "body_kind": result.kind,
+        "dims": dims,
+        "fixed": {k: _json_value(v) for k, v in result.scalars.items()},
+        "points_total": int(done.size),
+        "points_done": int(done.sum()),
+        "complete": bool(done.all()),
+        "counts": shape_lam_counts(result),
+        "counts_by_key": counts_by_key(result),
+        "accuracy": a.get("accuracy"),
+        "numerics": json.loads(a.get("numerics", "{}")),
+        "energy": bool(a.get("energy", False)),
+        "steps_total": int(result.arrays["steps"].sum()),
+        "event_steps_total": int(result.arrays["event_steps"].sum()),
+        "provenance": {
+            **{k: a.get(k) for k in ("rocksweep_version", "numba_version", "numpy_version",
+                                     "h5py_version", "hdf5_version", "python_version",
+                                     "started", "finished", "sessions")},
+            "wall_time_s": a.get("wall_time"),
+            "cpu_time_s": a.get("cpu_time"),
+            "overrides": json.loads(a.get("overrides", "[]")),
+        },
+        "scene": a.get("scene"),
+    }
+
+
+def format_info(d: dict) -> list[str]:
+    """The text of ``rocksweep info`` from ``info_dict``."""
+    lines = [f"{d['path']}: {d['title']}"]
+    for name, dim in d["dims"].items():
+        v = dim["values"]
+        span = ", ".join(map(str, v)) if len(v) <= 6 else f"{v[0]:g} .. {v[-1]:g}"
+        lines.append(f"  {name:<10} {dim['size']:>6}  [{span}]   ({dim['scene_key']})")
+    if d["fixed"]:
+        lines.append("  fixed: " + ", ".join(f"{k} = {v}" for k, v in d["fixed"].items()))
+    pct = 100 * d["points_done"] / max(1, d["points_total"])
+    state = ("complete" if d["complete"] else
+             "INCOMPLETE (finish it with rocksweep sweep SCENE.yaml -o FILE --resume)")
+    lines.append(f"points: {d['points_done']} of {d['points_total']} done ({pct:.1f}%), "
+                 f"{state}")
+    lines.append("counts per pulse shape and lam:")
+    lines += format_counts(in_ranges(d["counts"], "lam"), "  ")
+    by_key = {k: rows for k, rows in d["counts_by_key"].items() if k not in ("shape", "lam")}
+    if by_key:
+        lines.append("counts per swept key (the other keys summed):")
+        for key, rows in by_key.items():
+            lines += format_counts(in_ranges(rows, key), "  ")
+    p = d["provenance"]
+    lines.append(f"accuracy: {d['accuracy']}")
+    lines.append(f"RK4 steps: {d['steps_total']} + {d['event_steps_total']} event "
+                 "re-integrations")
+    wall = p["wall_time_s"] or 0.0
+    lines.append(f"run: started {p['started']}, finished {p['finished'] or '-'}, "
+                 f"{p['sessions']} session(s), {wall:.2f} s wall time, "
+                 f"{p['cpu_time_s'] or 0.0:.2f} s CPU time on the points")
+    lines.append(f"versions: rocksweep {p['rocksweep_version']}, numba {p['numba_version']}, "
+                 f"numpy {p['numpy_version']}, h5py {p['h5py_version']} "
+                 f"(HDF5 {p['hdf5_version']}), Python {p['python_version']}")
+    if p["overrides"]:
+        lines.append("overrides: " + " ".join(f"--set {o}" for o in p["overrides"]))
+    return lines
