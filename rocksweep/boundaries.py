@@ -1,0 +1,389 @@
+"""Boundaries of a stability diagram: labelled polylines and the overturning threshold.
+
+For every panel (a value of each non-diagram axis: shape, body keys, lam) of a diagram over
+(x, y) = (w_over_p, A_ratio) by default:
+
+- ``boundary_lines``: the lines separating two classes, as polylines in axis values,
+  labelled by the pair of classes (marching squares on the class map: a line crosses each
+  edge between two differing grid points at its midpoint; in a cell with three classes
+  every crossing joins the cell's centre, a triple junction);
+- ``a_min``: A_min(w_over_p), the smallest A_ratio that overturns, with the mode it
+  overturns in: the first overturning grid value of each column, refined by bisection in
+  A_ratio between it and the grid value below (single kernel runs at the sweep's numerics)
+  to a relative tolerance, so the curve is not limited by the grid spacing.
+
+Rows for CSV (``a_min_rows``, ``csv_text``) and a figure (``a_min_figure``: a matplotlib
+Figure, no pyplot) export them. Units: those of the axes (w_over_p = omega/p, A_ratio =
+A/(g tan alpha_cg), eq. 2).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections import defaultdict
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from rocksweep.adaptive import DIAGRAM_AXES, AdaptiveError, make_plan
+from rocksweep.grid import Grid
+from rocksweep.kernel import chunk_kernel, warm_up
+from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.outcomes import outcome_word
+from rocksweep.points import Point, kernel_kind, point_row
+from rocksweep.scene import Scene
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+DEFAULT_RTOL = 1e-3
+OVERTURNED = (L.OUTCOME_MODE1, L.OUTCOME_MODE2)
+
+
+# --- panels -----------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Panel:
+    """One diagram: where: value of every swept non-diagram axis (name -> value); x, y:
+    the diagram axes' values (float64[nx], [ny]); classes: int8[ny, nx]; flat: the grid's
+    flat index of each cell, int64[ny, nx]."""
+
+    where: dict[str, Any]
+    x: np.ndarray
+    y: np.ndarray
+    classes: np.ndarray
+    flat: np.ndarray
+
+
+def panels(scene: Scene, outcome: np.ndarray, axes: Sequence[str] = DIAGRAM_AXES
+           ) -> Iterator[Panel]:
+    """The panels of a result (outcome: int8 array of the grid's shape or flat), in the
+    grid's order of the other axes."""
+    plan = make_plan(scene, axes, coarse=0, audit=0.0)
+    outcome = np.asarray(outcome)
+    if outcome.size != plan.size:
+        raise AdaptiveError(f"outcome has {outcome.size} points; the scene's grid has "
+                            f"{plan.size}")
+    cls = plan.panels(outcome.ravel())
+    idx = plan.flat_index()
+    grid = Grid(scene)
+    others = [a for i, a in enumerate(scene.axes) if i not in (plan.x, plan.y) and a.swept]
+    x = np.asarray(scene.axis(axes[0]).values, float)
+    y = np.asarray(scene.axis(axes[1]).values, float)
+    for p in range(cls.shape[0]):
+        values = grid.index_values(idx[p, :1, 0])
+        where = {a.name: _plain(values[a.name][0]) for a in others}
+        yield Panel(where, x, y, cls[p], idx[p])
+
+
+def _plain(v: Any) -> Any:
+    return v.item() if isinstance(v, np.generic) else v
+
+
+# --- boundary lines ---------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class BoundaryLine:
+    """A polyline separating two classes: classes (a, b), a < b (0 safe, 1 mode 1, 2 mode
+    2); xy: float64[n, 2], (x, y) in axis values; closed when its ends coincide."""
+
+    classes: tuple[int, int]
+    xy: np.ndarray
+
+    @property
+    def label(self) -> str:
+        return f"{outcome_word(self.classes[0])}|{outcome_word(self.classes[1])}"
+
+
+def _node_xy(node: tuple[int, int], x: np.ndarray, y: np.ndarray) -> tuple[float, float]:
+    """Position of a node in doubled index coordinates (2 row, 2 col): grid points are
+    even/even, edge midpoints odd in one coordinate, cell centres odd/odd."""
+    r, c = node
+
+    def at(v: np.ndarray, k: int) -> float:
+        return float(v[k // 2]) if k % 2 == 0 else 0.5 * float(v[k // 2] + v[k // 2 + 1])
+
+    return at(x, c), at(y, r)
+
+
+def boundary_segments(classes: np.ndarray) -> list[tuple[tuple[int, int], tuple, tuple]]:
+    """Marching squares on a class map (int[ny, nx]): segments (pair, node, node), nodes in
+    doubled index coordinates (see ``_node_xy``), pair = (a, b), a < b."""
+    C = np.asarray(classes)
+    ny, nx = C.shape
+    diff_cell = np.zeros((max(ny - 1, 0), max(nx - 1, 0)), bool)
+    if ny > 1 and nx > 1:
+        a, b, c, d = C[:-1, :-1], C[:-1, 1:], C[1:, 1:], C[1:, :-1]
+        diff_cell = (a != b) | (b != c) | (c != d) | (d != a)
+    segs = []
+    for i, j in zip(*np.nonzero(diff_cell), strict=True):
+        i, j = int(i), int(j)
+        # corners counter-clockwise from bottom-left; edge k joins corner k and k + 1
+        corner = [C[i, j], C[i, j + 1], C[i + 1, j + 1], C[i + 1, j]]
+        nodes = [(2 * i, 2 * j + 1), (2 * i + 1, 2 * j + 2), (2 * i + 2, 2 * j + 1),
+                 (2 * i + 1, 2 * j)]
+        cross = [(k, tuple(sorted((int(corner[k]), int(corner[(k + 1) % 4])))))
+                 for k in range(4) if corner[k] != corner[(k + 1) % 4]]
+        if len(cross) == 2:
+            segs.append((cross[0][1], nodes[cross[0][0]], nodes[cross[1][0]]))
+        elif len(cross) == 4 and len(set(int(v) for v in corner)) == 2:
+            # saddle: cut off the bottom-left and top-right corners (a fixed choice)
+            segs.append((cross[0][1], nodes[0], nodes[3]))
+            segs.append((cross[1][1], nodes[1], nodes[2]))
+        else:  # three or four classes meet: every crossing joins the centre
+            centre = (2 * i + 1, 2 * j + 1)
+            segs.extend((pair, nodes[k], centre) for k, pair in cross)
+    return segs
+
+
+def _chain(edges: list[tuple[tuple, tuple]]) -> list[list[tuple]]:
+    """Join segments sharing ends into polylines: paths between nodes of degree != 2
+    first, then the remaining cycles."""
+    adj: dict[tuple, list[int]] = defaultdict(list)
+    for k, (u, v) in enumerate(edges):
+        adj[u].append(k)
+        adj[v].append(k)
+    used = [False] * len(edges)
+
+    def walk(start: tuple, k: int) -> list[tuple]:
+        path = [start]
+        node = start
+        while True:
+            used[k] = True
+            u, v = edges[k]
+            node = v if u == node else u
+            path.append(node)
+            if len(adj[node]) != 2:
+                return path
+            nxt = [e for e in adj[node] if not used[e]]
+            if not nxt:
+                return path
+            k = nxt[0]
+
+    lines = []
+    for node in sorted(adj):
+        if len(adj[node]) != 2:
+            for k in adj[node]:
+                if not used[k]:
+                    lines.append(walk(node, k))
+    for k in range(len(edges)):
+        if not used[k]:
+            lines.append(walk(edges[k][0], k))
+    return lines
+
+
+def boundary_lines(classes: np.ndarray, x: np.ndarray, y: np.ndarray) -> list[BoundaryLine]:
+    """The boundary polylines of one diagram. classes: int[ny, nx] (y rows, x columns);
+    x: float64[nx], y: float64[ny] axis values. Sorted by classes, then by length (longest
+    first)."""
+    by_pair: dict[tuple[int, int], list] = defaultdict(list)
+    for pair, u, v in boundary_segments(classes):
+        by_pair[pair].append((u, v))
+    out = []
+    for pair in sorted(by_pair):
+        lines = [np.array([_node_xy(n, x, y) for n in path]) for path in _chain(by_pair[pair])]
+        lines.sort(key=lambda a: -len(a))
+        out.extend(BoundaryLine(pair, xy) for xy in lines)
+    return out
+
+
+@dataclass(frozen=True)
+class PanelBoundaries:
+    """The boundary lines of one panel (``where``: its non-diagram axis values)."""
+
+    where: dict[str, Any]
+    lines: list[BoundaryLine]
+
+
+def diagram_boundaries(scene: Scene, outcome: np.ndarray,
+                       axes: Sequence[str] = DIAGRAM_AXES) -> list[PanelBoundaries]:
+    """Boundary lines of every panel of a result (outcome: filled, no -1)."""
+    return [PanelBoundaries(p.where, boundary_lines(p.classes, p.x, p.y))
+            for p in panels(scene, outcome, axes)]
+
+
+# --- A_min ------------------------------------------------------------------------------
+
+@dataclass
+class AMinCurve:
+    """A_min along x for one panel.
+
+    where: non-diagram axis values; x: float64[nx] (w_over_p); a_min: float64[nx], the
+    smallest y (A_ratio) that overturns (NaN: no grid value of the column overturns);
+    mode: int8[nx], the class at a_min (1, 2; 0 where NaN); lo, hi: float64[nx], the final
+    bracket (lo does not overturn, hi does; lo = NaN when the column's first grid value
+    already overturns, then a_min = that value and is only an upper bound); runs: kernel
+    runs spent on the column.
+    """
+
+    where: dict[str, Any]
+    x: np.ndarray
+    a_min: np.ndarray
+    mode: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    runs: np.ndarray
+    xname: str = DIAGRAM_AXES[0]
+    yname: str = DIAGRAM_AXES[1]
+    target: tuple[int, ...] = field(default=OVERTURNED)
+
+
+Evaluator = Callable[[list[Point]], np.ndarray]
+
+
+def kernel_evaluator(scene: Scene) -> Evaluator:
+    """Classes of arbitrary points, one kernel run each (outcome-only kernel, the scene's
+    sweep numerics, as the grid was computed)."""
+
+    def evaluate(points: list[Point]) -> np.ndarray:
+        rows = np.array([point_row(p, scene.numerics) for p in points]).reshape(-1, L.N_PAR)
+        kinds = np.array([kernel_kind(p.body) for p in points], np.int64)
+        outs = np.empty((len(points), L.N_OUT))
+        for kind in np.unique(kinds):
+            sel = kinds == kind
+            warm_up(int(kind), L.LEVEL_OUTCOME)
+            part = np.empty((int(sel.sum()), L.N_OUT))
+            chunk_kernel(int(kind), L.LEVEL_OUTCOME)(np.ascontiguousarray(rows[sel]), part)
+            outs[sel] = part
+        return outs[:, L.OUT_OUTCOME].astype(np.int8)
+
+    return evaluate
+
+
+def a_min(scene: Scene, outcome: np.ndarray, rtol: float = DEFAULT_RTOL,
+          axes: Sequence[str] = DIAGRAM_AXES, mode: int | None = None,
+          evaluate: Evaluator | None = None, max_iter: int = 60) -> list[AMinCurve]:
+    """A_min(x) of every panel, bisected to ``rtol`` (relative to |A_min|).
+
+    outcome: the grid's classes (filled, grid shape or flat); y (axes[1]) must have
+    increasing values. mode: None for any overturning (mode 1 or 2; the curve's ``mode``
+    says which), 1 or 2 for the smallest y where that mode occurs. evaluate: classes of a
+    list of points (default: one kernel run each). The bisection assumes one crossing
+    between the two grid values; a feature thinner than the grid spacing between them is
+    resolved as found.
+    """
+    if not (0 < rtol < 1):
+        raise AdaptiveError(f"rtol = {rtol!r}: must be in (0, 1)")
+    if mode not in (None, L.OUTCOME_MODE1, L.OUTCOME_MODE2):
+        raise AdaptiveError(f"mode = {mode!r}: must be None (any), 1 or 2")
+    target = OVERTURNED if mode is None else (mode,)
+    yv = np.asarray(scene.axis(axes[1]).values, float)
+    if not np.all(np.diff(yv) > 0):
+        raise AdaptiveError(f"{scene.axis(axes[1]).key}: A_min needs increasing values")
+    evaluate = evaluate or kernel_evaluator(scene)
+    grid = Grid(scene)
+    ps = list(panels(scene, outcome, axes))
+    curves, todo = [], []  # todo: (curve, column, base point, lo, hi)
+    for p in ps:
+        nx = p.x.size
+        hit = np.isin(p.classes, target)
+        first = np.where(hit.any(axis=0), hit.argmax(axis=0), -1)
+        c = AMinCurve(p.where, p.x, np.full(nx, np.nan), np.zeros(nx, np.int8),
+                      np.full(nx, np.nan), np.full(nx, np.nan), np.zeros(nx, np.int64),
+                      axes[0], axes[1], target)
+        for j in range(nx):
+            i = int(first[j])
+            if i < 0:
+                continue
+            c.hi[j], c.mode[j] = yv[i], p.classes[i, j]
+            if i == 0:
+                c.a_min[j] = yv[0]
+                continue
+            c.lo[j] = yv[i - 1]
+            values = grid.index_values(p.flat[i - 1:i, j])
+            todo.append((c, j, {k: _plain(v[0]) for k, v in values.items()}))
+        curves.append(c)
+    for _ in range(max_iter):
+        active = [t for t in todo if t[0].hi[t[1]] - t[0].lo[t[1]]
+                  > rtol * abs(t[0].hi[t[1]])]
+        if not active:
+            break
+        mids = [0.5 * (c.lo[j] + c.hi[j]) for c, j, _ in active]
+        pts = [scene.point({**values, axes[1]: float(m)})
+               for (_, _, values), m in zip(active, mids, strict=True)]
+        cls = evaluate(pts)
+        for (c, j, _), m, k in zip(active, mids, cls, strict=True):
+            c.runs[j] += 1
+            if int(k) in target:
+                c.hi[j], c.mode[j] = m, k
+            else:
+                c.lo[j] = m
+    for c, j, _ in todo:
+        c.a_min[j] = c.hi[j]
+    return curves
+
+
+# --- exports ----------------------------------------------------------------------------
+
+def a_min_rows(curves: Sequence[AMinCurve]) -> list[dict[str, Any]]:
+    """One row per panel and x value with an A_min: the non-diagram axis values, x, A_min,
+    mode (word), and whether A_min is only an upper bound (first grid value)."""
+    rows = []
+    for c in curves:
+        for j in range(c.x.size):
+            if math.isnan(c.a_min[j]):
+                continue
+            rows.append({**c.where, c.xname: float(c.x[j]), "A_min": float(c.a_min[j]),
+                         "mode": outcome_word(int(c.mode[j])),
+                         "upper_bound": bool(math.isnan(c.lo[j]))})
+    return rows
+
+
+def csv_text(rows: Sequence[dict[str, Any]]) -> str:
+    """CSV text of rows (the keys of the first row as the header)."""
+    buf = io.StringIO()
+    if rows:
+        w = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in r.items()})
+    return buf.getvalue()
+
+
+def boundary_rows(bounds: Sequence[PanelBoundaries], axes: Sequence[str] = DIAGRAM_AXES
+                  ) -> list[dict[str, Any]]:
+    """One row per vertex of every boundary polyline: the non-diagram axis values, line
+    (number within the panel), classes (e.g. safe|mode1), x, y."""
+    rows = []
+    for b in bounds:
+        for n, line in enumerate(b.lines):
+            for xv, yv in line.xy:
+                rows.append({**b.where, "line": n, "classes": line.label,
+                             axes[0]: float(xv), axes[1]: float(yv)})
+    return rows
+
+
+def _where_label(where: dict[str, Any]) -> str:
+    return ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
+                     for k, v in where.items()) or "all"
+
+
+def a_min_figure(curves: Sequence[AMinCurve], bounds: Sequence[PanelBoundaries] = (),
+                 title: str = "") -> Figure:
+    """A_min(x) of every panel overlaid on one axis (one colour per panel, e.g. per lam;
+    solid where the onset is mode 1, dashed where mode 2), with the boundary lines of
+    ``bounds`` drawn thin in the same colours when given. No pyplot."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(6.4, 4.8), layout="constrained")
+    ax = fig.add_subplot()
+    colours = [f"C{k % 10}" for k in range(max(len(curves), len(bounds)))]
+    for k, b in enumerate(bounds):
+        for line in b.lines:
+            ax.plot(line.xy[:, 0], line.xy[:, 1], lw=0.5, color=colours[k], alpha=0.5)
+    for k, c in enumerate(curves):
+        for m, style in ((L.OUTCOME_MODE1, "-"), (L.OUTCOME_MODE2, "--")):
+            y = np.where(c.mode == m, c.a_min, np.nan)
+            ax.plot(c.x, y, style, color=colours[k], lw=1.5, marker=".", ms=2,
+                    label=f"{_where_label(c.where)} ({outcome_word(m)})"
+                    if np.isfinite(y).any() else None)
+    if curves:
+        ax.set_xlabel(curves[0].xname)
+        ax.set_ylabel(f"{curves[0].yname} at overturning onset (A_min)")
+    ax.legend(fontsize="small")
+    ax.set_title(title)
+    return fig
