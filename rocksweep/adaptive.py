@@ -218,14 +218,6 @@ def _pad(a: np.ndarray, s: int) -> np.ndarray:
     return np.pad(a, ((0, 0), (0, py), (0, px)), mode="edge") if py or px else a
 
 
-def _closed_reduce(a: np.ndarray, s: int, axis: int, op: Callable) -> np.ndarray:
-    """op over closed windows [j s, (j+1) s] along ``axis`` of a padded array (c s + 1)."""
-    a = np.moveaxis(a, axis, -1)
-    c = (a.shape[-1] - 1) // s
-    half = op.reduce(a[..., :c * s].reshape(*a.shape[:-1], c, s), axis=-1)
-    return np.moveaxis(op(half, a[..., s::s]), -1, axis)
-
-
 @dataclass
 class _Cells:
     """Per stride-s cell of every panel (P, cy, cx): lo/hi class among its computed points
@@ -246,15 +238,45 @@ class _Cells:
         return np.where(ok, self.hi, -1).astype(np.int8)
 
 
-def _cells(known: np.ndarray, s: int) -> _Cells:
-    """known: int8 panels, class where computed, -1 elsewhere."""
-    kp = _pad(known, s)
-    hi = _closed_reduce(_closed_reduce(kp, s, 2, np.maximum), s, 1, np.maximum)
+def _cells(known: np.ndarray, strides: Sequence[int]) -> dict[int, _Cells]:
+    """Cell statistics at every stride (powers of 2 >= 2). known: int8 panels, the class
+    where computed, -1 elsewhere.
+
+    Stride 2 is reduced from the points (closed windows of 3); each coarser stride from
+    the one below, since a closed 2s-cell is the union of its four closed s-subcells
+    (a missing last subcell beyond the padded edge repeats the last one, which holds the
+    same points of the edge).
+    """
+    out: dict[int, _Cells] = {}
+    if not strides:
+        return out
+    kp = _pad(known, 2)
     lo_src = np.where(kp < 0, _NO_CLASS, kp)
-    lo = _closed_reduce(_closed_reduce(lo_src, s, 2, np.minimum), s, 1, np.minimum)
-    c = kp[:, ::s, ::s] >= 0
-    corners = c[:, :-1, :-1] & c[:, 1:, :-1] & c[:, :-1, 1:] & c[:, 1:, 1:]
-    return _Cells(lo, hi, corners)
+
+    def closed3(a: np.ndarray, op: Callable) -> np.ndarray:
+        a = op(op(a[:, :, 0:-1:2], a[:, :, 1::2]), a[:, :, 2::2])
+        return op(op(a[:, 0:-1:2], a[:, 1::2]), a[:, 2::2])
+
+    hi, lo = closed3(kp, np.maximum), closed3(lo_src, np.minimum)
+    _, ny, nx = known.shape
+    s = 2
+    while True:
+        if s in strides:
+            c = known[:, _axis_lattice(ny, s)][:, :, _axis_lattice(nx, s)] >= 0
+            corners = c[:, :-1, :-1] & c[:, 1:, :-1] & c[:, :-1, 1:] & c[:, 1:, 1:]
+            out[s] = _Cells(lo, hi, corners)
+        if s >= max(strides):
+            return out
+        s *= 2
+        cy, cx = _ncells(ny, s), _ncells(nx, s)
+
+        def up(a: np.ndarray, op: Callable, cy: int = cy, cx: int = cx) -> np.ndarray:
+            a = np.pad(a, ((0, 0), (0, 2 * cy - a.shape[1]), (0, 2 * cx - a.shape[2])),
+                       mode="edge")
+            a = op(a[:, 0::2], a[:, 1::2])
+            return op(a[:, :, 0::2], a[:, :, 1::2])
+
+        hi, lo = up(hi, np.maximum), up(lo, np.minimum)
 
 
 def _dilate(mask: np.ndarray, m: int) -> np.ndarray:
@@ -335,8 +357,9 @@ def next_batch(plan: Plan, outcome: np.ndarray, computed: np.ndarray) -> Batch:
         return Batch(np.sort(missing), "coarse", s0)
     known = _known(plan, outcome, computed)
     parts, stride = [], 0
+    cells = _cells(known, plan.strides)
     for s in plan.strides:
-        refine = _dilate(_cells(known, s).mixed, plan.margin if s > 2 else plan.final_margin)
+        refine = _dilate(cells[s].mixed, plan.margin if s > 2 else plan.final_margin)
         if not refine.any():
             continue
         want = _points_of_cells(plan, refine, s)
@@ -359,8 +382,9 @@ def fill(plan: Plan, outcome: np.ndarray, computed: np.ndarray) -> np.ndarray:
     known = _known(plan, outcome, computed)
     out = known.copy()
     _, ny, nx = plan.panel_shape
+    cells = _cells(known, plan.strides)
     for s in plan.strides:
-        cls = _cells(known, s).uniform_class
+        cls = cells[s].uniform_class
         cy = np.minimum(np.arange(ny) // s, cls.shape[1] - 1)
         cx = np.minimum(np.arange(nx) // s, cls.shape[2] - 1)
         cand = cls[:, cy][:, :, cx]
