@@ -75,8 +75,8 @@ def override_strings(overrides: Overrides | None) -> list[str]:
 def load(scene: SceneLike | Scene, overrides: Overrides | None = ()) -> tuple[Scene, Path | None]:
     """A validated scene and the file it came from (None for text or a dict).
 
-    scene: a ``Path``; a ``str`` that names an existing file, or else holds YAML (a
-    newline or a colon), or else is taken as a missing path; a mapping (the YAML's
+    scene: a ``Path``; a ``str`` with a newline (YAML), or that names an existing file,
+    or else holds a colon (one line of YAML), or else is taken as a missing path; a mapping (the YAML's
     structure); or a ``Scene`` (then without overrides). Errors are one-line SceneErrors.
     """
     from rocksweep.scene import Scene, SceneError, load_scene, parse_scene
@@ -91,7 +91,7 @@ def load(scene: SceneLike | Scene, overrides: Overrides | None = ()) -> tuple[Sc
 
         text = yaml.safe_dump(_plain_tree(scene), sort_keys=False)
         return parse_scene(text, "scene", ov), None
-    if isinstance(scene, str) and not Path(scene).is_file() and ("\n" in scene or ":" in scene):
+    if isinstance(scene, str) and ("\n" in scene or (":" in scene and not _is_file(scene))):
         return parse_scene(scene, "scene", ov), None
     if not isinstance(scene, str | Path):
         raise ApiError(f"scene = {scene!r}: give a path, YAML text or a dict")
@@ -99,6 +99,13 @@ def load(scene: SceneLike | Scene, overrides: Overrides | None = ()) -> tuple[Sc
     if not path.exists():
         raise SceneError(f"{path}: no such scene file")
     return load_scene(path, ov), path
+
+
+def _is_file(text: str) -> bool:
+    try:
+        return Path(text).is_file()
+    except (OSError, ValueError):  # too long for a file name, NUL bytes
+        return False
 
 
 def _plain_tree(v: Any) -> Any:
@@ -212,15 +219,18 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
 
     path = Path(path)
     t0 = time.perf_counter()
+    where = (f"{n_workers} worker{'s' * (n_workers > 1)}" if backend == "threads"
+             else f"dask cluster {scheduler}")
+    how = f"threads x {n_workers}" if backend == "threads" else f"dask {scheduler}"
     if resume and path.exists():
         check_output(path, overwrite=True, inputs=inputs)
-        sf = SweepFile.resume(path, scene, overrides)
+        sf = SweepFile.resume(path, scene, overrides, backend=how)
     else:
         if path.is_file() and not overwrite:
             raise OutputError(f"{path}: already exists; use --resume to finish it or "
                               "--overwrite to replace it")
         check_output(path, overwrite=overwrite, inputs=inputs)
-        sf = SweepFile.create(path, scene, overrides, overwrite=overwrite)
+        sf = SweepFile.create(path, scene, overrides, overwrite=overwrite, backend=how)
     report = SweepReport(path, sf.grid.size, 0, 0, 0.0, 0.0, 0.0)
     pending: list = []  # finished chunks not yet in the file
 
@@ -235,8 +245,6 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
         todo = int((~done).sum())
         size = chunk_size or sw.auto_chunk_size(todo, n_workers)
         chunks = sw.plan_chunks(~done, size)
-        where = (f"{n_workers} worker{'s' * (n_workers > 1)}" if backend == "threads"
-                 else f"dask cluster {scheduler}")
         dims = " x ".join(f"{len(a.values)} {a.name}" for a in scene.swept) or "1 point"
         say(f"{scene.name}: {sf.grid.size} points ({dims}); {report.done_before} done, "
             f"{todo} to compute on {where}; accuracy {scene.numerics.describe()}")
@@ -335,7 +343,8 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
 def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xarray's)
     """A sweep result file as an xarray Dataset, loaded in memory (the file is closed).
 
-    Each variable carries ``units`` (``rocksweep.fields.UNITS``) and a ``description``;
+    Each variable carries its unit (``rocksweep_units``: ``rocksweep.fields.UNITS``, e.g.
+    alpha_ref, 1/p, E_ref; CF ``units`` "1" as written by the store) and a description;
     ``outcome`` its codes and words as CF flags (``flag_values`` -1 0 1 2,
     ``flag_meanings`` "not_run safe mode1 mode2"), ``status`` its bits (``flag_masks``,
     ``flag_meanings``, ``flagged_mask``). The Dataset's attributes are the file's
@@ -355,10 +364,10 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
     read_result(path, ["outcome"])  # one-line errors for foreign or damaged files
     with xr.open_dataset(path, engine="h5netcdf", driver_kwds={"locking": False}) as ds:
         ds = ds.load()
-    for name, var in ds.data_vars.items():
+    for name, var in ds.data_vars.items():  # files of format 1 have neither
         f = fields.BY_NAME.get(str(name))
         if f is not None:
-            var.attrs.setdefault("units", f.unit)
+            var.attrs.setdefault("rocksweep_units", f.unit)
             var.attrs.setdefault("description", f.meaning)
     if "outcome" in ds:
         ds["outcome"].attrs.setdefault("flag_values", list(OUTCOME_WORDS))

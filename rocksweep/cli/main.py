@@ -52,7 +52,7 @@ def load(scene_path: Path, overrides: tuple[str, ...] = ()):
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(rocksweep.__version__, "--version", "-V", package_name="rocksweep",
-                      message="%(prog)s %(version)s")
+                      message="rocksweep %(version)s")
 def main() -> None:
     """Stability diagrams of flexible rocking oscillators (Zhu, Chatzis & Acikgoz).
 

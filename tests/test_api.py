@@ -1,0 +1,376 @@
+"""The Python API (rocksweep.run / open / simulate), the library sweep driver, the field
+table, the dask backend, and the README's "Python API" example."""
+
+import math
+import os
+import re
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import rocksweep
+import rocksweep.sweep as sw
+from rocksweep import api, fields
+from rocksweep.cli import main
+from rocksweep.grid import Grid
+from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.model import FlexibleBody
+from rocksweep.scene import load_scene
+from rocksweep.store import read_result
+
+ROOT = Path(__file__).resolve().parents[1]
+CI_SMALL = ROOT / "configs" / "ci-small.yaml"
+FIG5 = ROOT / "configs" / "fig5.yaml"
+
+BODY3 = {"wn_over_p": 2.43, "zeta": 0.05, "alpha_cg": 0.15, "alpha_A": 0.28,
+         "mA_over_m": 0.47, "IA_ratio": 0.56}
+SMALL = {"name": "api test", "body": BODY3, "impact": {"lam": [0.0, 0.4]},
+         "pulse": {"shape": "sine", "w_over_p": {"start": 1.0, "stop": 6.0, "num": 6},
+                   "A_ratio": {"start": 1.0, "stop": 8.0, "num": 5}}}
+
+
+def _modules_after(code: str) -> list[str]:
+    probe = (f"import sys\n{code}\n"
+             "print('LOADED:' + ','.join(m for m in ('numba', 'h5py', 'matplotlib', 'xarray', "
+             "'scipy') if m in sys.modules))")
+    proc = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    last = proc.stdout.split("LOADED:")[-1].strip()  # after any --help text
+    return [m for m in last.split(",") if m]
+
+
+def test_import_and_help_are_light():
+    """`import rocksweep` and `rocksweep --help` load none of the heavy libraries."""
+    assert _modules_after("import rocksweep; rocksweep.run, rocksweep.open") == []
+    assert _modules_after("from rocksweep.cli import main\ntry:\n    main(['--help'])\n"
+                          "except SystemExit:\n    pass") == []
+    assert _modules_after("from rocksweep.cli import main\ntry:\n    main(['sweep', '--help'])"
+                          "\nexcept SystemExit:\n    pass") == []
+
+
+def test_public_names_have_docstrings_and_version(cli):
+    for obj in (rocksweep.run, rocksweep.open, rocksweep.simulate, rocksweep.RocksweepError,
+                api.Simulation, api.sweep_file):
+        assert obj.__doc__ and len(obj.__doc__) > 40, obj
+    from importlib.metadata import version
+
+    assert rocksweep.__version__ == version("rocksweep")
+    res = cli.invoke(main, ["--version"])
+    assert res.exit_code == 0 and res.output.strip() == f"rocksweep {version('rocksweep')}"
+    assert issubclass(sw.SweepError, rocksweep.RocksweepError)
+
+
+def test_importing_the_single_run_module_keeps_rocksweep_run_a_function():
+    """Regression: `from rocksweep.run import simulate` (the module rocksweep/run.py) made
+    the import system replace the function rocksweep.run with that module."""
+    code = ("import rocksweep\nfrom rocksweep.run import simulate\nimport rocksweep.run\n"
+            "print(rocksweep.run is rocksweep.api.run, rocksweep.open is rocksweep.api.open)")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.stdout.strip() == "True True", proc.stderr
+
+
+# --- run and open -------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def cli_file(tmp_path_factory):
+    from click.testing import CliRunner
+
+    out = tmp_path_factory.mktemp("cli") / "ci.h5"
+    res = CliRunner().invoke(main, ["sweep", str(CI_SMALL), "-o", str(out), "-q", "-j", "1"])
+    assert res.exit_code == 0, res.output
+    return out
+
+
+def test_run_returns_what_the_cli_writes(cli_file, tmp_path):
+    """rocksweep.run(path, output=...) writes the file the CLI writes and returns it;
+    without output the Dataset is the same, with no file kept."""
+    out = tmp_path / "api.h5"
+    ds = rocksweep.run(CI_SMALL, output=out, jobs=2)
+    xr.testing.assert_identical(ds, rocksweep.open(out))
+    cli_ds = rocksweep.open(cli_file)
+    assert ds.sizes == cli_ds.sizes and list(ds.data_vars) == list(cli_ds.data_vars)
+    assert set(ds.coords) == set(cli_ds.coords) and set(ds.attrs) == set(cli_ds.attrs)
+    raw = read_result(cli_file)  # the file through h5py, not xarray
+    for name, arr in raw.arrays.items():
+        assert ds[name].dtype == arr.dtype, name
+        np.testing.assert_array_equal(ds[name].values, arr, err_msg=name)
+    assert ds.outcome.dims == raw.dims
+    np.testing.assert_array_equal(ds.w_over_p.values, np.linspace(0.5, 6, 8))
+    assert float(ds.alpha_cg) == 0.15  # an unswept key: a scalar coordinate
+
+    before = set(tmp_path.iterdir())
+    mem = rocksweep.run(CI_SMALL.read_text())  # YAML text, in memory
+    assert set(tmp_path.iterdir()) == before
+    for name in raw.arrays:
+        np.testing.assert_array_equal(mem[name].values, raw.arrays[name], err_msg=name)
+    assert mem.attrs["scene"] == CI_SMALL.read_text()
+
+
+def test_run_from_a_dict_with_overrides(tmp_path):
+    a = rocksweep.run(SMALL, overrides={"impact.lam": 0.4})
+    b = rocksweep.run(SMALL, overrides=["impact.lam=0.4"])
+    assert "lam" not in a.outcome.dims and float(a.lam) == 0.4
+    np.testing.assert_array_equal(a.outcome.values, b.outcome.values)
+    whole = rocksweep.run(SMALL)
+    np.testing.assert_array_equal(whole.outcome.sel(lam=0.4).values, a.outcome.values)
+    assert a.attrs["overrides"] == '["impact.lam=0.4"]'
+    assert set(np.unique(whole.outcome).tolist()) <= {0, 1, 2}
+
+
+def test_open_carries_words_units_and_provenance(cli_file):
+    ds = rocksweep.open(cli_file)
+    assert ds.outcome.attrs["flag_meanings"].split() == ["not_run", "safe", "mode1", "mode2"]
+    assert list(ds.outcome.attrs["flag_values"]) == [-1, 0, 1, 2]
+    assert "horizon" in ds.status.attrs["flag_meanings"].split()
+    assert ds.theta_max_over_alpha.attrs["rocksweep_units"] == "alpha_ref"
+    assert ds.t_overturn.attrs["rocksweep_units"] == "1/p"
+    assert ds.attrs["scene"] == CI_SMALL.read_text()
+    assert ds.attrs["rocksweep_version"] == rocksweep.__version__
+    assert ds.attrs["numba_version"]
+
+
+def test_open_and_run_errors_are_one_line(tmp_path):
+    bad = tmp_path / "x.h5"
+    bad.write_text("not hdf5")
+    cases = [
+        (lambda: rocksweep.open(bad), "not an HDF5 file"),
+        (lambda: rocksweep.open(tmp_path / "none.h5"), "no such file"),
+        (lambda: rocksweep.run(SMALL, jobs=0), "jobs = 0: give a number >= 1"),
+        (lambda: rocksweep.run(SMALL, resume=True), "resume=True needs output="),
+        (lambda: rocksweep.run({**SMALL, "impact": {"lam": 3}}), "impact.lam = 3.0"),
+        (lambda: rocksweep.run(tmp_path / "none.yaml"), "no such scene file"),
+        (lambda: rocksweep.run(SMALL, output=bad), "already exists; use --resume"),
+        (lambda: rocksweep.run(SMALL, output=bad, resume=True, overwrite=True),
+         "exclude each other"),
+    ]
+    for call, needle in cases:
+        with pytest.raises(rocksweep.RocksweepError) as exc:
+            call()
+        assert needle in str(exc.value) and "\n" not in str(exc.value)
+    assert bad.read_text() == "not hdf5"
+
+
+def test_run_never_writes_over_its_scene(tmp_path):
+    scene = tmp_path / "s.yaml"
+    scene.write_text(CI_SMALL.read_text())
+    with pytest.raises(rocksweep.RocksweepError, match="this command's input"):
+        rocksweep.run(scene, output=scene, overwrite=True)
+    assert scene.read_text() == CI_SMALL.read_text()
+
+
+def test_run_resumes_a_partial_file(tmp_path):
+    """A file with some points written (as after a kill) is finished by resume=True."""
+    from rocksweep.store import SweepFile
+
+    out = tmp_path / "part.h5"
+    full = rocksweep.run(SMALL)
+    sc, _ = api.load(SMALL)  # the dict scene as the API parses it
+    sf = SweepFile.create(out, sc)
+    g = Grid(sc)
+    sf.write(sw.run_chunk(g, 0, 17, sw.level(sc)))
+    sf.close()
+    assert int((rocksweep.open(out).outcome >= 0).sum()) == 17
+    got = rocksweep.run(SMALL, output=out, resume=True)
+    for name in full.data_vars:
+        np.testing.assert_array_equal(got[name].values, full[name].values, err_msg=name)
+
+
+# --- the driver: messages -----------------------------------------------------------------
+
+def test_driver_says_compiling_before_an_uncached_kernel(tmp_path, monkeypatch):
+    """When numba's cache lacks the variant, the sweep says so before compiling (the
+    state is faked here; the real check is test_cache_state_of_a_fresh_cache)."""
+    monkeypatch.setattr(sw, "_in_cache", lambda dispatcher: False)
+    lines: list[str] = []
+    sc = load_scene(CI_SMALL)
+    rep = api.sweep_file(sc, tmp_path / "c.h5", log=lines.append)
+    assert rep.complete and rep.computed == 256
+    i = next(i for i, ln in enumerate(lines) if ln.startswith("compiling the kernel"))
+    assert re.fullmatch(r"compiling the kernel \(once per machine, ~\d+ s\)\.\.\.", lines[i])
+    assert re.fullmatch(r"kernel compiled in \d+\.\d s", lines[i + 1])
+    monkeypatch.setattr(sw, "_in_cache", lambda dispatcher: None)
+    lines.clear()
+    api.sweep_file(sc, tmp_path / "d.h5", log=lines.append)
+    assert "loading or compiling the kernel..." in lines
+
+
+def test_cache_state_of_a_fresh_cache(tmp_path):
+    """An empty numba cache directory: the variant is reported as to be compiled (no
+    compilation happens here); the shared cache holds it once prepared."""
+    sc = load_scene(CI_SMALL)
+    sw.prepare(Grid(sc), sw.level(sc))
+    assert sw.kernel_cache_state(Grid(sc), sw.level(sc)) == (0, 0)
+    code = ("from rocksweep import sweep as sw; from rocksweep.grid import Grid; "
+            "from rocksweep.scene import load_scene; "
+            f"sc = load_scene({str(CI_SMALL)!r}); "
+            "print(sw.kernel_cache_state(Grid(sc), sw.level(sc)))")
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env=env)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "(1, 0)"
+
+
+@pytest.mark.parametrize("jobs", [0, -5, 10**20])
+def test_jobs_limits(jobs):
+    n = os.cpu_count() or 1
+    with pytest.raises(sw.SweepError) as exc:
+        sw.check_jobs(jobs, "--jobs")
+    if jobs < 1:
+        assert str(exc.value) == f"--jobs {jobs}: give a number >= 1, or -1 for all cores"
+    else:
+        assert str(exc.value).startswith(f"--jobs {jobs}: at most {4 * n} (4 x the {n} core")
+    assert sw.check_jobs(-1) == n and sw.check_jobs(4 * n) == 4 * n
+
+
+# --- simulate -------------------------------------------------------------------------------
+
+def test_simulate_keywords_and_dict_agree_and_history_is_physical():
+    """Figure 5, lam = 0.4: overturns after impacts (the paper). The history ends where
+    the body lies on its side, theta = pi/2, i.e. theta/alpha_cg = (pi/2)/0.15, and
+    the energy balance E = W_in - D_damp - E_impact holds at every row."""
+    a = rocksweep.simulate(FIG5, impact__lam=0.4)
+    b = rocksweep.simulate(FIG5, {"impact.lam": 0.4})
+    assert a.summary["outcome"] == b.summary["outcome"] == "mode1"
+    assert a.summary["impacts"] >= 1
+    h = a.history
+    assert h.theta_over_alpha.dims == ("p_t",)
+    t = h.p_t.values
+    assert t[0] == 0.0 and np.all(np.diff(t) >= 0)
+    assert t[-1] == pytest.approx(a.summary["t_overturn"], abs=1e-12)
+    assert abs(h.theta_over_alpha.values[-1]) == pytest.approx(math.pi / 2 / 0.15, rel=1e-6)
+    balance = h.W_in_over_Eref - h.D_damp_over_Eref - h.E_impact_over_Eref
+    # to the integration error of the work integral at the `fine` preset (~1e-5 E_ref)
+    np.testing.assert_allclose(h.E_over_Eref.values, balance.values, atol=1e-4)
+    assert h.theta_over_alpha.attrs["units"] == "alpha_ref"
+    assert h.p_t.attrs["units"] == "1/p"
+    body = FlexibleBody(**BODY3)  # u/u_cr with u_cr from the model, eq. (4)
+    np.testing.assert_allclose(h.u_over_ucr.values * body.u_cr, a.run.history["u"])
+    # the input pulse: one cycle of A sin(w t), A = 5 g tan(0.15)
+    w, amp = 5.3, 5.0 * math.tan(0.15)
+    on = t < 2 * math.pi / w
+    np.testing.assert_allclose(h.xg_over_g.values[on], amp * np.sin(w * t[on]), atol=1e-9)
+    fig = a.figure()
+    assert len(fig.axes) >= 4
+
+
+def test_simulate_needs_one_point():
+    with pytest.raises(rocksweep.RocksweepError, match="impact.lam has 3 values"):
+        rocksweep.simulate(FIG5)
+
+
+# --- fields ---------------------------------------------------------------------------------
+
+def test_one_field_table():
+    """Sweeps, the store's variable list and single runs all read rocksweep.fields."""
+    assert list(sw.VARIABLES) == [f.name for f in fields.SWEEP_FIELDS]
+    assert list(sw.ENERGY_VARIABLES) == [f.name for f in fields.ENERGY_FIELDS]
+    assert sw.VARIABLES["outcome"][1] == L.OUTCOME_NOT_RUN
+    assert fields.UNITS["work_in_over_Eref"] == "E_ref"
+    slots = [f.slot for f in fields.FIELDS]
+    assert len(set(slots)) == len(slots)  # no kernel slot read twice
+    assert len({c.slot for c in fields.HISTORY}) == L.N_HIST == len(fields.HISTORY)
+    run = rocksweep.simulate(FIG5, impact__lam=0.0).run
+    assert set(run.summary()) == {f.name for f in fields.FIELDS} | {
+        "accuracy", "wall_time_s"}
+    # "steps" is the regular RK4 steps in a sweep and in a single run alike
+    sc = load_scene(FIG5, ["impact.lam=0.2"])
+    g = Grid(sc)
+    chunk = sw.run_chunk(g, 0, 1, sw.level(sc))
+    from rocksweep.run import simulate
+
+    one = simulate(sc.point({a.name: a.values[0] for a in sc.axes}), sc.numerics,
+                   history=False)
+    assert chunk.arrays["steps"][0] == one.summary()["steps"] == one.out[L.OUT_STEPS]
+    assert chunk.arrays["event_steps"][0] == one.summary()["event_steps"]
+
+
+# --- dask -----------------------------------------------------------------------------------
+
+RAN_IN_MAIN_THREAD: list[bool] = []
+
+
+def _spy_chunk(grid, a, b, level):
+    RAN_IN_MAIN_THREAD.append(threading.current_thread() is threading.main_thread())
+    return _REAL_RUN_CHUNK(grid, a, b, level)
+
+
+_REAL_RUN_CHUNK = sw.run_chunk
+
+
+def test_dask_one_thread_cluster_computes_every_chunk(tmp_path, cli_file, monkeypatch):
+    """A cluster of one worker thread: every chunk runs on the cluster, none in this
+    process's main thread (joblib's dask backend with n_jobs = 1 ran them all here)."""
+    distributed = pytest.importorskip("distributed")  # in the test extra: never skipped
+    monkeypatch.setattr(sw, "run_chunk", _spy_chunk)
+    RAN_IN_MAIN_THREAD.clear()
+    out = tmp_path / "d.h5"
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster:
+        api.sweep_file(load_scene(CI_SMALL), out, backend="dask",
+                       scheduler=cluster.scheduler_address, chunk_size=16)
+    assert len(RAN_IN_MAIN_THREAD) == 16 and not any(RAN_IN_MAIN_THREAD)
+    a, b = read_result(out), read_result(cli_file)
+    for name in b.arrays:
+        np.testing.assert_array_equal(a.arrays[name], b.arrays[name], err_msg=name)
+
+
+def test_dask_cluster_without_workers_is_an_error(tmp_path, monkeypatch, cli):
+    distributed = pytest.importorskip("distributed")
+    monkeypatch.setattr(sw, "NO_WORKERS_TIMEOUT", 1.0)
+    out = tmp_path / "n.h5"
+    with distributed.LocalCluster(n_workers=0, processes=False,
+                                  dashboard_address=None) as cluster:
+        res = cli.invoke(main, ["sweep", str(CI_SMALL), "-o", str(out), "-q", "--backend",
+                                "dask", "--scheduler", cluster.scheduler_address])
+    assert res.exit_code == 1
+    assert res.output.strip().splitlines() == [
+        f"Error: dask cluster {cluster.scheduler_address}: no worker joined in 1 s; start "
+        f"workers (dask worker {cluster.scheduler_address}), then rerun with --resume"]
+    assert read_result(out).done.sum() == 0  # the file is there to resume
+
+
+def test_dask_losing_every_worker_mid_sweep_saves_and_stops(tmp_path, monkeypatch):
+    distributed = pytest.importorskip("distributed")
+    monkeypatch.setattr(sw, "NO_WORKERS_TIMEOUT", 1.0)
+    out = tmp_path / "l.h5"
+    sc = load_scene(CI_SMALL)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster:
+        real = sw.run_chunks
+
+        def run_then_lose_workers(*args, **kwargs):
+            for i, res in enumerate(real(*args, **kwargs)):
+                if i == 2:
+                    cluster.scale(0)  # every worker leaves the cluster
+                yield res
+
+        monkeypatch.setattr(sw, "run_chunks", run_then_lose_workers)
+        with pytest.raises(sw.SweepError) as exc:
+            api.sweep_file(sc, out, backend="dask", scheduler=cluster.scheduler_address,
+                           chunk_size=1, write_every=1000.0)
+    msg = str(exc.value)
+    assert "lost all its workers" in msg and "--resume" in msg and "\n" not in msg
+    r = read_result(out)
+    assert 3 <= int(r.done.sum()) < 256  # what finished was written before the error
+    assert not r.attrs["complete"]
+
+
+# --- the README -----------------------------------------------------------------------------
+
+def test_readme_python_api_example_runs(tmp_path, monkeypatch):
+    text = (ROOT / "README.md").read_text()
+    section = text[text.index("## Python API"):]
+    section = section[:section.index("\n## ", 3)]
+    blocks = re.findall(r"```python\n(.*?)```", section, re.S)
+    assert blocks, "no python block under ## Python API"
+    monkeypatch.chdir(tmp_path)
+    for code in blocks:
+        exec(compile(code, "README.md", "exec"), {})  # noqa: S102
+    assert (tmp_path / "coarse.h5").exists()
+    assert (tmp_path / "fig5_lam04.png").read_bytes()[:4] == b"\x89PNG"
