@@ -1,5 +1,6 @@
 """`simulate`, `restitution` and scene errors through the command line (CliRunner)."""
 
+import csv
 import json
 import subprocess
 import sys
@@ -30,14 +31,60 @@ def test_simulate_json_keys(cli):
 
 
 def test_simulate_plot_and_csv(cli, tmp_path):
-    png, csv = tmp_path / "fig5.png", tmp_path / "h.csv"
+    png, path = tmp_path / "fig5.png", tmp_path / "h.csv"
     res = cli.invoke(main, ["simulate", str(CONFIGS / "fig5.yaml"), "--plot", str(png),
-                            "--csv", str(csv)])
+                            "--csv", str(path)])
     assert res.exit_code == 0, res.output
     assert png.stat().st_size > 10_000 and png.read_bytes()[:4] == b"\x89PNG"
-    lines = csv.read_text().splitlines()
-    assert lines[0].startswith("run,lam,p_t,theta_over_alpha")
-    assert {ln.split(",")[0] for ln in lines[1:]} == {"0", "1", "2"}  # three lam runs
+    with path.open(newline="") as f:
+        rows = list(csv.reader(f))
+    assert rows[0][:4] == ["run", "lam", "p_t", "theta_over_alpha"]
+    assert {r[0] for r in rows[1:]} == {"0", "1", "2"}  # three lam runs
+    widths = {len(r) for r in rows}
+    assert widths == {len(rows[0])}
+    for r in rows[1:]:
+        for cell in r:
+            float(cell)  # plain numbers only (numpy 2 scalars once printed np.float64(...))
+    lam = {r[0]: float(r[1]) for r in rows[1:]}
+    assert lam == {"0": 0.0, "1": 0.2, "2": 0.4}
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fig5.png", "h.csv"]  # no temp
+
+
+def test_outputs_refuse_existing_files_and_inputs(cli, tmp_path):
+    """simulate --csv/--plot, restitution --plot and accuracy -o/--plot: an existing file
+    is refused before computing unless --overwrite; the scene itself never."""
+    scene = tmp_path / "s.yaml"
+    scene.write_text(GOOD)
+    old = tmp_path / "old.csv"
+    old.write_text("keep")
+    png = tmp_path / "old.png"
+    png.write_bytes(b"keep")
+    report = tmp_path / "old.h5"
+    report.write_bytes(b"keep")
+    cases = [
+        (["simulate", str(scene), "--csv", str(old)], old),
+        (["simulate", str(scene), "--plot", str(png)], png),
+        (["restitution", str(scene), "--plot", str(png)], png),
+        (["accuracy", str(scene), "-o", str(report)], report),
+        (["accuracy", str(scene), "--plot", str(png)], png),
+    ]
+    for args, path in cases:
+        res = cli.invoke(main, args)
+        assert res.exit_code == 1, (args, res.output)
+        assert res.output.strip().splitlines() == [
+            f"Error: {path}: already exists; use --overwrite to replace it"], args
+    for args in (["simulate", str(scene), "--csv", str(scene), "--overwrite"],
+                 ["accuracy", str(scene), "-o", str(scene), "--overwrite"]):
+        res = cli.invoke(main, args)
+        assert res.output.strip().splitlines() == [
+            f"Error: {scene}: is this command's input; choose another output path"], args
+    assert old.read_text() == "keep" and png.read_bytes() == b"keep"
+    assert report.read_bytes() == b"keep" and scene.read_text() == GOOD
+    res = cli.invoke(main, ["simulate", str(scene), "--csv", str(old), "--overwrite"])
+    assert res.exit_code == 0, res.output
+    assert old.read_text().startswith("run,p_t,theta_over_alpha,")
+    res = cli.invoke(main, ["restitution", str(scene), "--plot", str(png), "--overwrite"])
+    assert res.exit_code == 0 and png.read_bytes()[:4] == b"\x89PNG"
 
 
 def test_restitution_json(cli):
@@ -70,7 +117,8 @@ BAD = [
     ("alpha_cg: 0.15", "alpha_cg: 1.6", "body.alpha_cg = 1.6: must be in [1e-06, pi/2) rad"),
     ("alpha_cg: 0.15, alpha_A: 0.28", "alpha_cg: 0.6, alpha_A: 0.1",
      "the top mass cannot sit below the base"),
-    ("wn_over_p: 2.43", "wn_over_p: 0", "body.wn_over_p = 0.0: must be in [1e-06, 1e+06] (omega_n/p), or .inf"),
+    ("wn_over_p: 2.43", "wn_over_p: 0",
+     "body.wn_over_p = 0.0: must be in [1e-06, 1e+06] (omega_n/p), or .inf"),
     ("impact: {lam: 0.4}", "impact: {lam: 0.4}\nfoo: 1", "foo: unknown key"),
     ("{shape: sine,", "{shape: sine", "YAML syntax error"),
 ]

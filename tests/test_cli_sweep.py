@@ -2,6 +2,7 @@
 
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -174,16 +175,93 @@ def test_bad_options(cli, tmp_path, ci_result):
     assert list(tmp_path.iterdir()) == []
 
 
-def test_plot_of_a_line_sweep_is_refused(cli, tmp_path):
+def test_plot_of_a_line_sweep_draws_a_line_plot(cli, tmp_path):
     scene = tmp_path / "line.yaml"
     scene.write_text(BODY3 + "impact: {lam: 0.2}\n"
                      "pulse: {shape: sine, w_over_p: [1.0, 2.0, 3.0], A_ratio: 2.0}\n")
     out = tmp_path / "line.h5"
     res = cli.invoke(main, ["sweep", str(scene), "-o", str(out), "-q", "-j", "1"])
     assert res.exit_code == 0, res.output
-    msg = one_line_error(cli.invoke(main, ["plot", str(out), "-o", str(tmp_path / "f.png")]))
-    assert "pulse.A_ratio has one value" in msg
-    assert not (tmp_path / "f.png").exists()
+    res = cli.invoke(main, ["plot", str(out), "-o", str(tmp_path / "f.png")])
+    assert res.exit_code == 0, res.output
+    assert (tmp_path / "f.png").read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--jobs", "0"], "--jobs 0: give a number >= 1, or -1 for all cores"),
+    (["--jobs", "-5"], "--jobs -5: give a number >= 1, or -1 for all cores"),
+    (["--write-every", "nan"], "--write-every nan: give a finite number of seconds >= 0 "
+                               "(0: write every chunk as it finishes)"),
+    (["--write-every", "inf"], "--write-every inf: give a finite number of seconds >= 0 "
+                               "(0: write every chunk as it finishes)"),
+    (["--write-every", "-1"], "--write-every -1.0: give a finite number of seconds >= 0 "
+                              "(0: write every chunk as it finishes)"),
+])
+def test_bad_numbers_are_one_line_errors(cli, tmp_path, args, message):
+    out = tmp_path / "o.h5"
+    msg = one_line_error(cli.invoke(main, ["sweep", str(CI_SMALL), "-o", str(out), *args]))
+    assert msg == f"Error: {message}"
+    assert not out.exists()
+
+
+def test_absurd_jobs_is_one_line_error(cli, tmp_path):
+    n = os.cpu_count() or 1
+    out = tmp_path / "o.h5"
+    msg = one_line_error(cli.invoke(main, ["sweep", str(CI_SMALL), "-o", str(out), "--jobs",
+                                           "99999999999999999999"]))
+    assert msg == (f"Error: --jobs 99999999999999999999: at most {4 * n} (4 x the {n} "
+                   f"core{'s' * (n > 1)} of this machine: each thread keeps a core busy, so "
+                   "more threads only wait for one)")
+    assert not out.exists()
+
+
+def test_sweep_refuses_to_write_over_its_scene(cli, tmp_path):
+    scene = tmp_path / "s.yaml"
+    scene.write_text(CI_SMALL.read_text())
+    msg = one_line_error(cli.invoke(main, ["sweep", str(scene), "-o", str(scene),
+                                           "--overwrite"]))
+    assert msg == f"Error: {scene}: is this command's input; choose another output path"
+    assert scene.read_text() == CI_SMALL.read_text()
+
+
+def test_info_counts_per_swept_key_in_ranges(cli, tmp_path):
+    """A 101-value lam axis: counts per key are in the JSON for every value, and the text
+    shows them as at most 10 ranges per table (synthetic results: no kernel)."""
+    from rocksweep.scene import parse_scene
+
+    sc = parse_scene(BODY3 + "impact: {lam: {start: 0, stop: 1, num: 101}}\n"
+                     "pulse: {shape: sine, w_over_p: [1.0, 2.0, 3.0], A_ratio: [2.0, 4.0]}\n")
+    out = tmp_path / "long.h5"
+    sf = SweepFile.create(out, sc)
+    n = sf.grid.size
+    assert n == 606
+    arrays = {k: np.full(n, 0, dtype) for k, (dtype, _, _) in variables(sc).items()}
+    outcome = np.arange(n) % 3  # flat order: lam, A_ratio, w_over_p (w fastest)
+    arrays["outcome"][:] = outcome
+    sf.write(ChunkResult(0, n - 6, {k: v[:n - 6] for k, v in arrays.items()}, 0.0))
+    sf.close()
+    res = cli.invoke(main, ["info", str(out), "--json"])
+    assert res.exit_code == 0, res.output
+    d = json.loads(res.output)
+    grid = outcome.reshape(101, 2, 3).astype(int)
+    grid[-1] = -1  # the last lam's 6 points are not computed
+    lam_rows = d["counts_by_key"]["lam"]
+    assert len(lam_rows) == 101 and lam_rows[0]["lam"] == 0.0 and lam_rows[-1]["lam"] == 1.0
+    for i, r in enumerate(lam_rows):
+        assert r["mode1"] == int((grid[i] == 1).sum()) and r["safe"] == int((grid[i] == 0).sum())
+        assert r["not_computed"] == int((grid[i] == -1).sum())
+    w_rows = d["counts_by_key"]["w_over_p"]
+    assert [r["w_over_p"] for r in w_rows] == [1.0, 2.0, 3.0]
+    assert [r["mode2"] for r in w_rows] == [int((grid[..., j] == 2).sum()) for j in range(3)]
+    res = cli.invoke(main, ["info", str(out)])
+    assert res.exit_code == 0, res.output
+    text = res.output.splitlines()
+    assert len(text) < 40, res.output
+    lam_lines = [ln for ln in text if re.match(r"\s+sine\s", ln)]
+    assert 1 <= len(lam_lines) <= 10
+    assert lam_lines[0].split()[1] == "0" and lam_lines[-1].split()[3] == "1"
+    assert any(re.match(r"\s+A_ratio\s", ln) for ln in text)
+    assert "missing" in res.output
 
 
 def test_plot_block_scene_with_panels_and_partial_file(cli, tmp_path):
