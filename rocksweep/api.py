@@ -76,8 +76,9 @@ def load(scene: SceneLike | Scene, overrides: Overrides | None = ()) -> tuple[Sc
     """A validated scene and the file it came from (None for text or a dict).
 
     scene: a ``Path``; a ``str`` with a newline (YAML), or that names an existing file,
-    or else holds a colon (one line of YAML), or else is taken as a missing path; a mapping (the YAML's
-    structure); or a ``Scene`` (then without overrides). Errors are one-line SceneErrors.
+    or else holds a colon (one line of YAML), or else is taken as a missing path; a
+    mapping (the YAML's structure); or a ``Scene`` (then without overrides). Errors are
+    one-line SceneErrors.
     """
     from rocksweep.scene import Scene, SceneError, load_scene, parse_scene
 
