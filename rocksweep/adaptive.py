@@ -16,8 +16,9 @@ swept axes with at least 2 values), for every value of the other axes (a *panel*
    state) is computed once refinement has converged, i.e. a Bernoulli sample of the points
    that would be filled. An audit point whose class differs from its fill makes its cells
    mixed, so step 2 refines around it down to the final resolution;
-4. fill: every point not computed takes the class of the finest-to-coarsest uniform cell
-   (all four corners computed, one class inside) that contains it.
+4. fill: every point not computed takes the class of a uniform cell (all four corners
+   computed, one class inside) that contains it (all such cells agree: nested or
+   neighbouring cells share computed points).
 
 The computed set is the least fixed point of step 2 above the coarse lattice (and, after
 the audit, above the audit points): adding points only adds mixed cells, so the order in
@@ -42,7 +43,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rocksweep.errors import RocksweepError
-from rocksweep.grid import Grid
+from rocksweep.grid import ChunkRows, Grid
 from rocksweep.scene import Scene
 
 # ``computed`` flags (int8 per point).
@@ -62,8 +63,8 @@ DIAGRAM_AXES = ("w_over_p", "A_ratio")  # (x, y)
 # along both diagram axes (80: k = 2, 400: k = 4, 1000: k = 5); see ``default_coarse``.
 MIN_COARSE_CELLS = 16
 DEFAULT_MARGIN = 1
-# No margin at the last level: there it caught only one-point-wide slivers (44 of 480 000
-# points of Figure 4(b) at 400 x 400) for ~20% more points computed.
+# No margin at the last level: there it caught only one-point-tall slivers (40 of 480 000
+# points of Figure 4(b) at 400 x 400) for 17-27% more points computed.
 DEFAULT_FINAL_MARGIN = 0
 DEFAULT_AUDIT = 0.02
 DEFAULT_SEED = 0
@@ -173,11 +174,16 @@ def default_coarse(ny: int, nx: int) -> int:
     """Default coarse level of a ny x nx diagram: the largest k whose lattice (every
     2**k-th index) keeps at least MIN_COARSE_CELLS cells along both axes.
 
-    Measured (``scripts/bench_adaptive.py --study``): on the four figures, the classic
-    block and two held-out scenes at 80 x 80 and 400 x 400, coarse lattices of 5 (80) and
-    12.5 (400) cells per axis gave the same outcomes as 16 or more; 16 keeps a factor ~3
-    (80) and ~1.3 (400) below the coarsest lattice seen to be safe, and costs 1/4**k of
-    the points (6.3% at 80, 0.4% at 400, 0.1% at 1000).
+    A class region is sure to be sampled by the coarse pass only if it holds a whole
+    coarse cell; smaller regions are found through the boundary they touch (refinement and
+    margin) or by the audit. Measured (``scripts/bench_adaptive.py --study``, replaying
+    every coarse level on the full grids): on the four figures, configs/block.yaml and two
+    held-out scenes, at 80 x 80 and 400 x 400, every level from 1 to 7 (down to 3 cells per
+    axis) gives the same outcomes: each region is either large or a speck (<= 8 points)
+    on a boundary. Beyond 16 cells per axis a coarser lattice saves < 0.2% of the points
+    (400 x 400: 7.76% computed at k = 4, 7.61% at k = 5), so 16 keeps every region with an
+    extent above 1/8 of both axes sampled at almost no cost: k = 2 at 80, 4 at 400, 5 at
+    1000.
     """
     k = 0
     while (min(ny, nx) - 1) / 2 ** (k + 1) >= MIN_COARSE_CELLS:
@@ -505,7 +511,7 @@ class _Subset:
         self.grid = grid
         self.flat = np.asarray(flat, np.int64)
 
-    def rows(self, start: int, stop: int):  # noqa: ANN201 (ChunkRows)
+    def rows(self, start: int, stop: int) -> ChunkRows:
         return self.grid.rows_at(self.flat[start:stop])
 
     def kinds(self) -> list[int]:
