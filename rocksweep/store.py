@@ -81,6 +81,10 @@ CONVENTIONS = "CF-1.10"
 # Free space required beyond the datasets' bytes when a file is made [bytes]: HDF5
 # metadata (attributes, object headers, the scene text) is well under 100 kB.
 SPACE_MARGIN = 1 << 20
+# Space reserved for HDF5's metadata when a file is made [bytes], beyond the datasets and
+# the scene text: HDF5 fails badly when a metadata write hits a full disk (a segmentation
+# fault in the next flush), so the whole file's space is reserved before it is written.
+METADATA_RESERVE = 256 << 10
 # Size of the ``history`` attribute [bytes]: fixed, so a session rewrites it in place;
 # about 30 sessions of one line each (the oldest are dropped beyond that).
 HISTORY_BYTES = 4096
@@ -142,6 +146,8 @@ def _now() -> str:
 
 def _why(err: BaseException) -> str:
     """One short phrase for an OS or HDF5 error (from its errno where it has one)."""
+    if isinstance(err, KeyError) and err.args:
+        err = RuntimeError(str(err.args[0]))  # KeyError's str() adds quotes
     no = getattr(err, "errno", None)
     if not isinstance(no, int):
         m = re.search(r"errno = (\d+)", str(err))
@@ -149,7 +155,11 @@ def _why(err: BaseException) -> str:
     if no:
         return _reason(OSError(no, os.strerror(no)))
     text = str(err).strip().splitlines()
-    return text[0][:160] if text else type(err).__name__
+    if not text:
+        return type(err).__name__
+    # HDF5: "Unable to ... (the reason)": the reason is what helps
+    m = re.search(r"\(([^()]+)\)\s*$", text[0])
+    return (m.group(1) if m else text[0])[:160]
 
 
 def _mib(n: float) -> str:
@@ -253,6 +263,20 @@ def file_bytes(scene: Scene) -> int:
     return per_point * grid.size + coords
 
 
+def _reserve(path: Path, nbytes: int) -> None:
+    """Allocate ``nbytes`` of disk space to the file at ``path`` (``posix_fallocate``):
+    writes within them cannot fail for want of space. OSError(ENOSPC) if there is no
+    room; file systems without the call are left as they are."""
+    fd = os.open(path, os.O_WRONLY | getattr(os, "O_CLOEXEC", 0))
+    try:
+        os.posix_fallocate(fd, 0, nbytes)
+    except OSError as err:
+        if err.errno not in (errno.EOPNOTSUPP, errno.EINVAL, errno.ENOSYS):
+            raise
+    finally:
+        os.close(fd)
+
+
 def _check_space(path: Path, need: int, what: str) -> None:
     """Refuse (StoreError) when the file system of ``path`` has less than ``need`` bytes
     free."""
@@ -340,14 +364,33 @@ def _json_attr(f: h5py.File, key: str, path: Path, typ: type):
     return value
 
 
+def _looks_like_ours(f: h5py.File, fmt) -> bool:
+    """Whether a file without a valid rocksweep_format attribute still shows the marks of a
+    rocksweep result (then it is damaged, not foreign)."""
+    if isinstance(fmt, str) and fmt.startswith("rocksweep"):
+        return True
+    try:
+        a = f.attrs
+        return "scene_resolved" in a or ("format_version" in a and "outcome" in f)
+    except _H5_ERRORS:
+        return False
+
+
 def _layout(f: h5py.File, path: Path) -> _Layout:
     """Validate the format, the resolved scene, the coordinates and the variables."""
     import h5py
 
-    fmt = f.attrs.get("rocksweep_format")
+    try:  # h5py's attrs.get hides damage as "missing"
+        fmt = f.attrs["rocksweep_format"] if "rocksweep_format" in f.attrs else None
+    except _H5_ERRORS as err:
+        raise StoreError(f"{shown(path)}: damaged HDF5 file, its attributes cannot be read "
+                         f"({_why(err)})") from None
     if isinstance(fmt, bytes | np.bytes_):
         fmt = bytes(fmt).decode("utf-8", "replace")
     if fmt != FORMAT:
+        if _looks_like_ours(f, fmt):  # a damaged result is not a foreign file
+            raise _damaged(path, "attribute rocksweep_format " + (
+                "missing" if fmt is None else f"is {_cut(_plain(fmt))}"))
         raise StoreError(f"{shown(path)}: an HDF5 file, but not a rocksweep sweep result "
                          "(no rocksweep_format attribute)")
     try:
@@ -579,6 +622,14 @@ class SweepFile:
         self.backend = backend or "unspecified"
         self._history = ""  # the file's history before this session
         self._session_line = ""
+        self._broken: StoreError | None = None  # the error that closed the file
+
+    def _fail(self, err: StoreError) -> StoreError:
+        """Close the file after a failed write (nothing more is written) and remember why:
+        later calls repeat this error, not a second one about a closed file."""
+        _close_quietly(self.f)
+        self._broken = err
+        return err
 
     # -- making and reopening -------------------------------------------------------------
     @classmethod
@@ -613,17 +664,23 @@ class SweepFile:
                                         dir=parent)
             os.close(fd)
             tmp = Path(name)
-            g = h5py.File(tmp, "w", track_order=True)
+            reserve = file_bytes(scene) + METADATA_RESERVE + 4 * len(scene.text.encode())
+            _reserve(tmp, reserve)  # room for all of it, or ENOSPC before HDF5 writes
+            g = h5py.File(tmp, "w", track_order=True)  # truncates: reserve again
             try:
+                _reserve(tmp, reserve)
                 _initialise(g, scene, overrides)
                 g.flush()
+                size = g.id.get_filesize()  # HDF5's end of allocation (eof is stale)
             except BaseException:
                 _close_quietly(g)
                 raise
             g.close()
+            if 0 < size < reserve:
+                os.truncate(tmp, size)  # give back what the metadata did not use
             f = h5py.File(tmp, "r+", locking=True)  # locked before anyone can see it
             self = cls(path, f, scene, backend)
-            self._start_session()
+            self._start_session()  # before the file has its name: failing leaves nothing
             _publish(tmp, path, old_fd)
             tmp = None
             return self
@@ -652,6 +709,8 @@ class SweepFile:
         f = _open(path, "r")
         try:
             stored = _layout(f, path).scene
+            _checked_attrs(f, path)  # what readers need, before any point is computed
+            _check_outcome(f["outcome"][()], path)
         except _H5_ERRORS as err:
             raise _damaged(path, _why(err)) from None
         finally:
@@ -669,37 +728,31 @@ class SweepFile:
         except BaseException as err:
             _close_quietly(f)
             if isinstance(err, _H5_ERRORS) and not isinstance(err, RocksweepError):
-                raise StoreError(f"{shown(path)}: cannot be resumed ({_why(err)})") from None
+                raise StoreError(f"{shown(path)}: cannot update its attributes "
+                                 f"({_why(err)}); its points are kept") from None
             raise
         return self
 
     def _start_session(self) -> None:
-        """Count the session and record its start, host and backend (in place)."""
+        """Count the session and record its start, host and backend (in place). Raises
+        h5py's errors (the callers say what they mean for the file)."""
         f = self.f
         if not _in_place(f):  # a format-1 file: its attributes change type once
             _check_space(self.path, SPACE_MARGIN, "updating its attributes")
-            try:
-                _upgrade_session_attrs(f)
-                f.flush()
-            except _H5_ERRORS as err:
-                raise StoreError(f"{shown(self.path)}: cannot update its attributes "
-                                 f"({_why(err)})") from None
-        try:
-            n = int(f.attrs["sessions"]) + 1
-            self._history = _plain(f.attrs["history"])
-            host = platform.node() or "unknown"
-            self._session_line = (f"{self.session_start} session {n}: rocksweep "
-                                  f"{versions()['rocksweep']} on host {host}, backend "
-                                  f"{self.backend}")
-            _put(f, "sessions", n)
-            _put(f, "last_started", self.session_start)
-            _put(f, "host", host)
-            _put(f, "backend", self.backend)
-            _put(f, "history", _history(self._history, self._session_line))
+            _upgrade_session_attrs(f)
             f.flush()
-        except _H5_ERRORS as err:
-            raise StoreError(f"{shown(self.path)}: cannot update its attributes "
-                             f"({_why(err)}); its points are kept") from None
+        n = int(f.attrs["sessions"]) + 1
+        self._history = _plain(f.attrs["history"])
+        host = platform.node() or "unknown"
+        self._session_line = (f"{self.session_start} session {n}: rocksweep "
+                              f"{versions()['rocksweep']} on host {host}, backend "
+                              f"{self.backend}")
+        _put(f, "sessions", n)
+        _put(f, "last_started", self.session_start)
+        _put(f, "host", host)
+        _put(f, "backend", self.backend)
+        _put(f, "history", _history(self._history, self._session_line))
+        f.flush()
 
     # -- state ------------------------------------------------------------------------
     def done(self) -> np.ndarray:
@@ -712,6 +765,8 @@ class SweepFile:
         A failed write (StoreError) leaves the chunk's points "not computed" and every
         point written before intact; the file is closed (finish it with --resume).
         """
+        if self._broken:
+            raise self._broken
         boxes = flat_slabs(self.grid.shape, res.start, res.stop)
         try:
             for name in [*(n for n in self.names if n != "outcome"), "outcome"]:
@@ -725,16 +780,17 @@ class SweepFile:
                     ds[index] = arr[a - res.start:b - res.start].reshape(box)
             self.f.flush()
         except _H5_ERRORS as err:
-            _close_quietly(self.f)
-            raise StoreError(f"{shown(self.path)}: cannot write results ({_why(err)}); "
-                             "the points written before are kept, finish with --resume"
-                             ) from None
+            raise self._fail(StoreError(
+                f"{shown(self.path)}: cannot write results ({_why(err)}); the points "
+                "written before are kept, finish with --resume")) from None
 
     def finish(self, wall_seconds: float, cpu_seconds: float, *,
                backend: str | None = None) -> dict:
         """Record this session's wall time [s], the workers' CPU time on its points [s]
         and the file's totals (in place); returns the attributes set (plain Python
         values; ``complete`` a bool)."""
+        if self._broken:
+            raise self._broken
         f = self.f
         try:
             done = self.done()
@@ -761,12 +817,14 @@ class SweepFile:
                 _put(f, k, int(v) if k == "complete" else v)
             f.flush()
         except _H5_ERRORS as err:
-            _close_quietly(f)
-            raise StoreError(f"{shown(self.path)}: cannot record the session's totals "
-                             f"({_why(err)}); its points are kept") from None
+            raise self._fail(StoreError(
+                f"{shown(self.path)}: cannot record the session's totals ({_why(err)}); "
+                "its points are kept")) from None
         return attrs
 
     def close(self) -> None:
+        if self._broken:
+            return  # closed when it broke
         try:
             self.f.close()
         except _H5_ERRORS as err:
@@ -966,6 +1024,14 @@ def _attr_ok(key: str, v) -> bool:
     return v in (0, 1)  # a flag: int8 (format 2) or bool (format 1)
 
 
+def _check_outcome(outcome: np.ndarray, path: Path) -> None:
+    codes = np.array([L.OUTCOME_NOT_RUN, *OUTCOME_WORDS], np.int8)
+    bad = ~np.isin(outcome, codes)
+    if bad.any():
+        raise _damaged(path, f"variable 'outcome' holds {int(bad.sum())} invalid codes, "
+                       f"e.g. {int(outcome[bad][0])} (valid: -1, 0, 1, 2)")
+
+
 def _checked_attrs(f: h5py.File, path: Path) -> dict:
     """The file's attributes as plain Python values, those readers use validated."""
     attrs = {}
@@ -1016,12 +1082,7 @@ def read_result(path: str | Path, names: list[str] | None = None) -> SweepResult
                 scalars[name] = ax["values"][0]
         arrays = {n: f[n][()] for n in wanted}
         if "outcome" in arrays:
-            codes = np.array([L.OUTCOME_NOT_RUN, *OUTCOME_WORDS], np.int8)
-            bad = ~np.isin(arrays["outcome"], codes)
-            if bad.any():
-                raise _damaged(path, f"variable 'outcome' holds {int(bad.sum())} invalid "
-                               f"codes, e.g. {int(arrays['outcome'][bad][0])} (valid: -1, "
-                               "0, 1, 2)")
+            _check_outcome(arrays["outcome"], path)
         attrs = _checked_attrs(f, path)
     except RocksweepError:
         raise
