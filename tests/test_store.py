@@ -224,3 +224,72 @@ def test_resolved_scene_is_stored(tmp_path, scene):
         assert json.loads(f.attrs["numerics"]) == scene.numerics.as_dict()
     assert stored["axes"]["impact.lam"] == {"values": [0.0, 0.2, 0.4], "swept": True}
     assert stored["overrides"] == ["pulse.A_ratio={start: 1, stop: 8, num: 4}"]
+
+
+def test_cf_attributes_survive_netcdf_readers(tmp_path, scene):
+    """Issue 13: Conventions, units, int8 flags and per-session provenance (host, backend)
+    as netCDF-4 readers (xarray + h5netcdf) see them."""
+    import platform
+
+    xr = pytest.importorskip("xarray")  # in the test extra: never skipped in CI
+    path = tmp_path / "r.h5"
+    sf = SweepFile.create(path, scene, backend="threads x 2")
+    sf.write(fake_chunk(scene, 0, 11))
+    sf.finish(1.0, 0.5)
+    sf.close()
+    sf = SweepFile.resume(path, scene, backend="dask tcp://h:8786")
+    chunks = plan_chunks(~sf.done(), 50)
+    for a, b in chunks:
+        sf.write(fake_chunk(scene, a, b))
+    attrs = sf.finish(2.0, 1.0)
+    sf.close()
+    assert attrs["complete"] is True and attrs["points_done"] == 120
+    host = platform.node()
+    with xr.open_dataset(path, engine="h5netcdf") as ds:
+        a = ds.attrs
+        assert a["Conventions"] == "CF-1.10"
+        assert a["complete"] == 1 and a["complete"].dtype == np.int8
+        assert a["energy"] == 0 and a["energy"].dtype == np.int8
+        assert a["sessions"] == 2 and a["host"] == host and a["backend"] == "dask tcp://h:8786"
+        lines = a["history"].splitlines()
+        assert len(lines) == 2
+        assert "session 1" in lines[0] and f"on host {host}, backend threads x 2" in lines[0]
+        assert lines[0].endswith("11 of 120 points done")
+        assert "session 2" in lines[1] and "backend dask tcp://h:8786" in lines[1]
+        assert lines[1].endswith("120 of 120 points done")
+        assert a["finished"] and a["wall_time"] == 3.0
+        want = {"w_over_p": "1", "A_ratio": "1", "lam": "1", "wn_over_p": "1", "zeta": "1",
+                "alpha_cg": "rad", "alpha_A": "rad", "mA_over_m": "1", "IA_ratio": "1"}
+        for name, unit in want.items():
+            assert ds[name].attrs["units"] == unit, name
+            assert ds[name].attrs["long_name"], name
+        assert "units" not in ds["shape"].attrs
+        for name in variables(scene):
+            v = ds[name].attrs
+            assert v["long_name"], name
+            if name in ("outcome", "status"):  # flag variables: codes, no units
+                assert "units" not in v and "flag_meanings" in v
+            else:
+                assert v["units"] == "1", name
+        assert ds["t_overturn"].attrs["rocksweep_units"] == "1/p"
+        assert "p*t" in ds["t_overturn"].attrs["long_name"]
+
+
+def test_session_attributes_are_rewritten_in_place(tmp_path, scene):
+    """Resuming and finishing change no attribute's type or size (so they need no new
+    space in the file): the file's size and its attributes' dtypes stay the same."""
+    path = tmp_path / "r.h5"
+    SweepFile.create(path, scene).close()
+    size = path.stat().st_size
+    with h5py.File(path, "r") as f:
+        types = {k: f.attrs.get_id(k).dtype for k in f.attrs}
+    for k in range(3):
+        sf = SweepFile.resume(path, scene, backend="x" * 300)  # cut to fit, not grown
+        sf.write(fake_chunk(scene, 10 * k, 10 * k + 10))
+        sf.finish(1.0, 1.0)
+        sf.close()
+    assert path.stat().st_size == size
+    with h5py.File(path, "r") as f:
+        assert {k: f.attrs.get_id(k).dtype for k in f.attrs} == types
+        assert f.attrs["sessions"] == 4
+        assert f.attrs["backend"] == b"x" * 256
