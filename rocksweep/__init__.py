@@ -16,31 +16,8 @@ Importing the package is light: numba, h5py, xarray and matplotlib load on first
 
 from __future__ import annotations
 
-import sys as _sys
-import types as _types
-
 from rocksweep.api import open, run, simulate  # noqa: A004
 from rocksweep.errors import RocksweepError
-
-_API = ("open", "run", "simulate")
-
-
-class _Package(_types.ModuleType):
-    """The package keeps its API functions when a submodule of the same name is imported.
-
-    Importing ``rocksweep/run.py`` (single runs: ``from rocksweep.run import simulate``)
-    makes the import system set the package attribute ``run`` to that module, which would
-    replace the function ``rocksweep.run``. The module stays in ``sys.modules`` and
-    ``from rocksweep.run import ...`` keeps working.
-    """
-
-    def __setattr__(self, name: str, value: object) -> None:
-        if name in _API and isinstance(value, _types.ModuleType):
-            return
-        super().__setattr__(name, value)
-
-
-_sys.modules[__name__].__class__ = _Package
 
 
 def _version() -> str:

@@ -25,8 +25,8 @@ if TYPE_CHECKING:
     import xarray as xr
     from matplotlib.figure import Figure
 
-    from rocksweep.run import Run
     from rocksweep.scene import Scene
+    from rocksweep.single import Run
 
 SceneLike = Union[str, Path, Mapping[str, Any]]  # noqa: UP007 (a runtime alias on 3.10)
 Overrides = Union[Sequence[str], Mapping[str, Any]]  # noqa: UP007
@@ -393,7 +393,7 @@ class Simulation:
     steps, event_steps, accuracy, wall_time_s); history: xarray Dataset over ``p_t``
     (``rocksweep.fields.HISTORY``: theta_over_alpha, u_over_ucr, E_over_Eref, ..., each
     with ``units``; at an event p_t repeats: the rows before and after it); run: the
-    underlying ``rocksweep.run.Run``.
+    underlying ``rocksweep.single.Run``.
     """
 
     summary: dict
@@ -440,7 +440,7 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /, **keys: Any) -> Sim
     simulate``). Returns a ``Simulation`` (summary dict, history Dataset over p*t, and
     ``.figure()``).
     """
-    from rocksweep.run import simulate as run_point
+    from rocksweep.single import simulate as run_point
 
     ov = [*override_strings(overrides), *override_strings(keys)]
     sc, _ = load(scene, ov)
@@ -454,8 +454,8 @@ def simulate_runs(scene: Scene, max_runs: int = MAX_RUNS) -> list[Run]:
     ``max_runs`` points."""
     from itertools import product
 
-    from rocksweep.run import simulate as run_point
     from rocksweep.scene import SceneError
+    from rocksweep.single import simulate as run_point
 
     if scene.size > max_runs:
         big = max(scene.swept, key=lambda a: len(a.values))

@@ -27,7 +27,7 @@ from rocksweep.outputs import atomic_path, check_output
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-    from rocksweep.run import Run
+    from rocksweep.single import Run
 
 FORMATS = (".png", ".pdf", ".svg")
 DEFAULT_DPI = 200
@@ -95,7 +95,7 @@ def time_history(runs: Sequence[Run], swept: Sequence[str] = (), title: str = ""
     column over the point's amplitude A), (b) theta/alpha_cg, (c) E/E_ref, (d) the energy
     dissipated in impacts and the damper / E_ref; one colour per run.
 
-    runs: Runs with a history (``rocksweep.run.simulate(..., history=True)``); swept: the
+    runs: Runs with a history (``rocksweep.single.simulate(..., history=True)``); swept: the
     scene's swept axis names, which label the runs; axes: 4 axes to draw into (else a new
     figure). Returns the figure.
     """

@@ -75,8 +75,8 @@ from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel.equations import contact_rhs, ground_acc, rocking_rhs
 from rocksweep.kernel.integrate import rk4_step
 from rocksweep.numerics import ROOTS
-from rocksweep.run import history_capacity
 from rocksweep.scene import Scene, load_scene
+from rocksweep.single import history_capacity
 from rocksweep.sweep import auto_chunk_size, level, plan_chunks, prepare
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -25,8 +25,8 @@ SINGLE = ["fig5", "fig5-rigid"]
 def collect() -> dict[str, np.ndarray]:
     from itertools import product
 
-    from rocksweep.run import simulate
     from rocksweep.scene import load_scene
+    from rocksweep.single import simulate
     from rocksweep.sweep import compute
 
     arrays: dict[str, np.ndarray] = {}

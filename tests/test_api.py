@@ -65,10 +65,11 @@ def test_public_names_have_docstrings_and_version(cli):
     assert issubclass(sw.SweepError, rocksweep.RocksweepError)
 
 
-def test_importing_the_single_run_module_keeps_rocksweep_run_a_function():
-    """Regression: `from rocksweep.run import simulate` (the module rocksweep/run.py) made
-    the import system replace the function rocksweep.run with that module."""
-    code = ("import rocksweep\nfrom rocksweep.run import simulate\nimport rocksweep.run\n"
+
+def test_importing_single_runs_keeps_the_api_functions():
+    """Importing the single-run module (rocksweep/single.py) leaves rocksweep.run and
+    rocksweep.open the API functions (a module named run.py used to replace rocksweep.run)."""
+    code = ("import rocksweep\nfrom rocksweep.single import simulate\nimport rocksweep.single\n"
             "print(rocksweep.run is rocksweep.api.run, rocksweep.open is rocksweep.api.open)")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert proc.stdout.strip() == "True True", proc.stderr
@@ -282,7 +283,7 @@ def test_one_field_table():
     sc = load_scene(FIG5, ["impact.lam=0.2"])
     g = Grid(sc)
     chunk = sw.run_chunk(g, 0, 1, sw.level(sc))
-    from rocksweep.run import simulate
+    from rocksweep.single import simulate
 
     one = simulate(sc.point({a.name: a.values[0] for a in sc.axes}), sc.numerics,
                    history=False)

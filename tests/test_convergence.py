@@ -11,7 +11,7 @@ from rocksweep.model import FlexibleBody
 from rocksweep.numerics import Numerics
 from rocksweep.points import Point
 from rocksweep.reference import reference_run
-from rocksweep.run import simulate
+from rocksweep.single import simulate
 
 BODY3 = FlexibleBody(wn_over_p=2.43, zeta=0.05, alpha_cg=0.15, alpha_A=0.28, mA_over_m=0.47,
                      IA_ratio=0.56)

@@ -19,7 +19,7 @@ from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.model import BlockBody, FlexibleBody, G, restitution, restitution_rigid
 from rocksweep.numerics import Numerics
 from rocksweep.points import Point, kernel_kind, point_row
-from rocksweep.run import history_capacity, simulate
+from rocksweep.single import history_capacity, simulate
 
 TABLE3 = dict(zeta=0.05, alpha_cg=0.15, alpha_A=0.28, mA_over_m=0.47, IA_ratio=0.56)
 # A short horizon keeps undamped runs (which may never come to rest) cheap.

@@ -13,7 +13,7 @@ from rocksweep.kernel import integrate as ki
 from rocksweep.model import FlexibleBody, G, restitution, restitution_rigid
 from rocksweep.numerics import Numerics
 from rocksweep.points import Point, point_row
-from rocksweep.run import simulate
+from rocksweep.single import simulate
 
 # Physics checks run at a pinned accuracy, independent of how the presets are tuned.
 NUM = Numerics.preset("default", steps_per_period=20, event_tol=1e-8)

@@ -225,8 +225,8 @@ def test_stability_diagram_draws_into_given_axes(acg_result):
 
 @pytest.fixture(scope="module")
 def fig5_runs():
-    from rocksweep.run import simulate
     from rocksweep.scene import load_scene
+    from rocksweep.single import simulate
 
     scene = load_scene(ROOT / "configs" / "fig5.yaml")
     fixed = {a.name: a.values[0] for a in scene.axes}

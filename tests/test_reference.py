@@ -12,7 +12,7 @@ from rocksweep.model import BlockBody, FlexibleBody, impact_energy_loss, restitu
 from rocksweep.numerics import Numerics
 from rocksweep.points import Point
 from rocksweep.reference import reference_run
-from rocksweep.run import simulate
+from rocksweep.single import simulate
 
 BLOCK = BlockBody(alpha=0.2)
 
