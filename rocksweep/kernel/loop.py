@@ -4,8 +4,9 @@
 state y (``layout.Y_*``); it takes fixed RK4 steps (``stepping``), asks ``events`` for the
 first event inside each step and applies the transition rules (``transitions``). Its
 counters live in the result row ``out`` (``OUT_*``) as it runs; the actions that update
-them are the small helpers below, inlined into the loop (numba ``inline="always"``, so the
-compiled code is the same as one long function).
+them are the small helpers below. Those on the path of every step take no arrays and are
+inlined (numba ``inline="always"``); those of events are calls (an inlined helper that
+takes ``prm`` or ``out`` adds reference counting to every step: ~15% slower, measured).
 
 Compile-time specialisation: the functions take the flags FLEX, DAMPED and ENERGY and call
 ``numba.literally`` on them, so numba compiles one specialisation per flag value (a
@@ -107,7 +108,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY):
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
-    t, t_pulse = 0.0, prm[PAR_TPULSE]
+    t, dt, t_pulse, t_end = 0.0, prm[PAR_DT], prm[PAR_TPULSE], prm[PAR_TEND]
     y = (prm[PAR_THETA0], prm[PAR_THETA_DOT0], 0.0, 0.0, 0.0, 0.0)
     _reset(out, abs(y[Y_THETA]))
     on = t_pulse > 0.0
@@ -121,10 +122,26 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY):
 
     while True:
         on = t < t_pulse
-        stop, free_check = _run_ends(t, y, s, on, free_check, prm, out, FLEX)
-        if stop:
+        # why the run ends before this step, if it does (a STATUS_* bit); written out here,
+        # not in a helper: a helper taking the arrays costs ~15% at every step
+        if s == 0 and not on and rest_proven(y, prm, FLEX):
+            _flag(out, STATUS_REST)
             break
-        h, lands = _step_length(t, on, prm)
+        if t >= t_end:
+            _flag(out, STATUS_HORIZON)
+            break
+        if not FLEX and s != 0 and not on and free_check:
+            free_check = False  # E is constant between impacts after the pulse: test once
+            if _bounded(y, s, prm, out):
+                _flag(out, STATUS_BOUNDED)
+                break
+        if out[OUT_STEPS] + out[OUT_EVENT_STEPS] >= prm[PAR_MAXSTEPS]:
+            _flag(out, STATUS_STEP_CAP)
+            break
+        if out[OUT_IMPACTS] + out[OUT_UPLIFTS] >= prm[PAR_MAXEVENTS]:
+            _flag(out, STATUS_EVENT_CAP)
+            break
+        h, lands = _step_length(t, on, dt, t_pulse, t_end)
         y1 = rk4_step(t, y, h, s, on, prm, FLEX, DAMPED, ENERGY)
         out[OUT_STEPS] += 1.0
         if not _finite(y1):
@@ -133,7 +150,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY):
         ev, tau, y_ev, n = _first_event(t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
         out[OUT_EVENT_STEPS] += n
         if s != 0:
-            _track_theta_max(y, y_ev, tau, s, out)  # (y_ev, tau) = (y1, h) without event
+            # (y_ev, tau) = (y1, h) without an event
+            out[OUT_THETA_MAX] = _theta_max(y, y_ev, tau, s, out[OUT_THETA_MAX])
 
         if ev == EV_NONE:
             t, y = (t_pulse if lands else t + h), y1
@@ -165,7 +183,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY):
 
 
 # ----------------------------------------------------------------------------------------
-# The loop's actions (inlined)
+# The loop's actions
 # ----------------------------------------------------------------------------------------
 
 
@@ -175,7 +193,7 @@ def _flag(out, bit):
     out[OUT_STATUS] = int(out[OUT_STATUS]) | bit
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INTERNAL)
 def _reset(out, theta_max):
     """The result row before the first step: counters 0, times NaN, safe so far."""
     out[OUT_OUTCOME] = OUTCOME_SAFE
@@ -196,41 +214,22 @@ def _reset(out, theta_max):
     out[OUT_HIST_ROWS] = 0.0
 
 
-@njit(cache=True, inline="always")
-def _run_ends(t, y, s, on, free_check, prm, out, FLEX):
-    """Does the run end before the next step (why: a STATUS_* bit in out)?
-
-    Returns (stop, free_check): a rigid body's bounded-energy test runs once per excursion
-    after the pulse (its energy is constant between impacts), then waits for an impact.
-    """
-    if s == 0 and not on and rest_proven(y, prm, FLEX):
-        _flag(out, STATUS_REST)
-        return True, free_check
-    if t >= prm[PAR_TEND]:
-        _flag(out, STATUS_HORIZON)
-        return True, free_check
-    if not FLEX and s != 0 and not on and free_check:
-        free_check = False
-        peak = rigid_bounded(y, s, prm)
-        if peak >= 0.0:
-            if peak > out[OUT_THETA_MAX]:
-                out[OUT_THETA_MAX] = peak
-            _flag(out, STATUS_BOUNDED)
-            return True, free_check
-    if out[OUT_STEPS] + out[OUT_EVENT_STEPS] >= prm[PAR_MAXSTEPS]:
-        _flag(out, STATUS_STEP_CAP)
-        return True, free_check
-    if out[OUT_IMPACTS] + out[OUT_UPLIFTS] >= prm[PAR_MAXEVENTS]:
-        _flag(out, STATUS_EVENT_CAP)
-        return True, free_check
-    return False, free_check
+@njit(cache=True, **INTERNAL)
+def _bounded(y, s, prm, out):
+    """Rigid body after the pulse: proven safe (``rigid_bounded``)? Then its largest |theta|
+    still to come counts in theta_max."""
+    peak = rigid_bounded(y, s, prm)
+    if peak < 0.0:
+        return False
+    if peak > out[OUT_THETA_MAX]:
+        out[OUT_THETA_MAX] = peak
+    return True
 
 
 @njit(cache=True, inline="always")
-def _step_length(t, on, prm):
-    """(h, lands): the step PAR_DT, shortened to land exactly on the pulse's end (lands) or
-    on the horizon."""
-    dt, t_pulse, t_end = prm[PAR_DT], prm[PAR_TPULSE], prm[PAR_TEND]
+def _step_length(t, on, dt, t_pulse, t_end):
+    """(h, lands): the step dt, shortened to land exactly on the pulse's end (lands) or on
+    the horizon."""
     if on and t + dt >= t_pulse:
         return t_pulse - t, True
     if t + dt > t_end:
@@ -245,21 +244,22 @@ def _finite(y):
 
 
 @njit(cache=True, inline="always")
-def _track_theta_max(y, y_end, h_end, s, out):
-    """Largest |theta| over a rocking step (t, y) -> (t + h_end, y_end), including a turning
-    point inside it."""
+def _theta_max(y, y_end, h_end, s, theta_max):
+    """theta_max updated over a rocking step (t, y) -> (t + h_end, y_end), including a
+    turning point inside it."""
     a_end = abs(y_end[Y_THETA])
-    if a_end > out[OUT_THETA_MAX]:
-        out[OUT_THETA_MAX] = a_end
+    if a_end > theta_max:
+        theta_max = a_end
     if s * y[Y_THETA_DOT] > 0.0 and s * y_end[Y_THETA_DOT] < 0.0:
         # turning point inside the step: Hermite maximum of s*theta = -min(-s*theta)
         _, gm = hermite_min(-s * y[Y_THETA], -s * y[Y_THETA_DOT], -s * y_end[Y_THETA],
                             -s * y_end[Y_THETA_DOT], h_end)
-        if -gm > out[OUT_THETA_MAX]:
-            out[OUT_THETA_MAX] = -gm
+        if -gm > theta_max:
+            theta_max = -gm
+    return theta_max
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INTERNAL)
 def _uplift(t, y, on, prm, out, FLEX, DAMPED):
     """Check uplift from full contact at (t, y) and count it. Returns the new phase."""
     s = uplift_side(t, y, on, prm, FLEX, DAMPED)
@@ -268,7 +268,7 @@ def _uplift(t, y, on, prm, out, FLEX, DAMPED):
     return s
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INTERNAL)
 def _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY):
     """Impact at (t, y) ending rocking on corner s: the impact map and its counters; back
     in full contact, uplift is checked again at once. Returns (y, new phase)."""
@@ -295,7 +295,7 @@ def _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY):
     return y, s_new
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INTERNAL)
 def _overturned(t, out):
     out[OUT_OUTCOME] = OUTCOME_MODE1 if out[OUT_IMPACTS] > 0.0 else OUTCOME_MODE2
     out[OUT_T_OVERTURN] = t
@@ -334,7 +334,7 @@ def _write_row(hist, row, t, y, s, on, prm, e_imp, FLEX):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INTERNAL)
 def _finish(t, y, s, prm, out, FLEX, ENERGY):
     """The result row's last entries: end time and the energy accounting (NaN without)."""
     out[OUT_T_END] = t
