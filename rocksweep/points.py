@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rocksweep.kernel import layout as L
+from rocksweep.kernel.equations import rocking_spring_omega
 from rocksweep.model import Body, FlexibleBody, G
 from rocksweep.numerics import ROOTS, Numerics, amplitude_frequency, step_budget, step_size
 
@@ -76,23 +77,20 @@ def body_omega_rock(body: Body) -> float:
     rigid body: no spring).
 
     While the base rocks, the spring and the damper reach the top mass also through the
-    base's rotation. Linearising the rocking equations (``rocksweep.kernel.equations``):
-    u'' = -Gamma (k u + c u') / m + ..., Gamma = 1 + m h^2 / (I_A + m_A R_A^2 + m a^2), with
-    a = u - s b the top mass's lever arm: a spring of frequency omega_n sqrt(Gamma) and
-    damping ratio zeta sqrt(Gamma). ``body.omega_rock`` takes a = b (u = 0); Gamma is
-    largest at a = 0 (the top mass above the corner), which rocking reaches whenever
-    |u| ~ b. Above a damping ratio of 1 the mode is overdamped and its fast root,
+    base's rotation: a spring of frequency omega_n sqrt(Gamma) and damping ratio
+    zeta sqrt(Gamma), Gamma = 1 + m h^2 / (I_A + m_A R_A^2 + m a^2) with a = u - s b the
+    top mass's lever arm (``rocksweep.kernel.equations.rocking_spring_omega``, the one
+    definition). ``body.omega_rock`` takes a = b (u = 0); Gamma is largest at a = 0 (the
+    top mass above the corner), which rocking reaches whenever |u| ~ b, so that is the rate
+    used. Above a damping ratio of 1 the mode is overdamped and its fast root,
     omega (zeta' + sqrt(zeta'^2 - 1)), is what an explicit RK4 step must resolve (it is
     unstable beyond |lambda dt| ~ 2.8): a slender, tall body with a light base (m h^2 >>
     I_A + m_A R_A^2) and zeta ~ 0.2 has zeta' ~ 5 (issue 5, found by the property test).
     """
     if body.rigid:
         return 0.0
-    gamma = 1.0 + body.m * body.h**2 / (body.I_A + body.m_A * body.R_A**2)
-    omega, zeta = body.omega_n * math.sqrt(gamma), body.zeta * math.sqrt(gamma)
-    if zeta > 1.0:
-        omega *= zeta + math.sqrt(zeta * zeta - 1.0)
-    return max(omega, body.omega_rock)
+    i_a0 = body.I_A + body.m_A * body.R_A**2
+    return float(rocking_spring_omega(body.omega_n, body.zeta, body.m, body.h, i_a0, 0.0))
 
 
 def run_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, w_over_p: np.ndarray,

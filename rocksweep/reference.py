@@ -2,11 +2,15 @@
 
 ``reference_run(point, numerics)`` runs one point with ``scipy.integrate.solve_ivp``
 (DOP853, rtol 1e-10, atol 1e-12) and returns the same summary quantities as the kernel's
-result row. It shares only the equations with the RK4 kernel: the right-hand sides, the
-uplift moment Q, the restitution of eq. (1) and the energy come from
-``rocksweep.kernel.equations`` (called from Python); the loop, the event location, the
-impact map, the settling and rest rules and the horizon are written again here, from the
-rules documented in ``rocksweep.kernel.integrate`` and the paper:
+result row. It shares the equations with the RK4 kernel, one copy of each, from
+``rocksweep.kernel.equations`` (called from Python): the ground motion (eq. 2) and its
+rate, the right-hand sides, the uplift moment Q, its rate and the tipping moment M g b,
+the restitution of eq. (1), the energy, the rest bound (``rest_margin``), the rigid bound
+(``rigid_peak``) and the spring's rate while rocking (its step limit). Their independent
+check is the sympy derivation (tests/test_derivations.py). The integrator, the loop, the
+event location, the impact map, the settling rule and the horizon are written again here,
+from the rules documented in ``rocksweep.kernel.loop`` and ``rocksweep.kernel.transitions``
+and the paper:
 
 - full contact: m u'' + c u' + k u = -m xg''; the body uplifts on corner s when s Q >= M g b;
 - rocking on corner s: the two-degree-of-freedom equations; impact when theta = 0,
@@ -45,11 +49,18 @@ from scipy.optimize import brentq
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel.equations import (
     contact_rhs,
+    ground_acc,
+    ground_jerk,
     mechanical_energy,
+    rest_margin,
     restitution,
+    rigid_peak,
     rigid_rhs,
     rocking_rhs,
+    rocking_spring_omega,
+    tip_moment,
     uplift_moment,
+    uplift_moment_rate,
 )
 from rocksweep.numerics import Numerics
 from rocksweep.points import Point, point_row
@@ -69,37 +80,30 @@ class _Problem:
         self.damped = damped
         self.rtol = rtol
         self.atol = atol
-        self.amp = float(prm[L.PAR_AMP])
         self.omega = float(prm[L.PAR_OMEGA])
-        self.cosine = prm[L.PAR_SHAPE] == L.SHAPE_COSINE
         self.t_pulse = float(prm[L.PAR_TPULSE])
-        self.mgb = float(prm[L.PAR_MTOT] * prm[L.PAR_G] * prm[L.PAR_B])
+        self.mgb = float(tip_moment(prm))
         self.theta_over = float(prm[L.PAR_THETA_OVER])
         self.rest_rate = float(prm[L.PAR_RESTRATE])
         self.h = float(prm[L.PAR_H])
         # largest step: a tenth of the shortest period (spring while rocking, pulse, 2 pi/p)
         periods = [2 * math.pi, 2 * math.pi / self.omega]
-        if flex:
-            w_rock = math.sqrt(prm[L.PAR_K] / prm[L.PAR_M]
-                               * (1.0 + prm[L.PAR_M] * prm[L.PAR_H] ** 2
-                                  / (prm[L.PAR_IA0] + prm[L.PAR_M] * prm[L.PAR_B] ** 2)))
+        if flex:  # the spring with the top mass at u = 0 (lever arm b); damping left to
+            # DOP853's error control
+            w_rock = rocking_spring_omega(math.sqrt(prm[L.PAR_K] / prm[L.PAR_M]), 0.0,
+                                          prm[L.PAR_M], prm[L.PAR_H], prm[L.PAR_IA0],
+                                          prm[L.PAR_B])
             periods.append(2 * math.pi / w_rock)
         self.max_step = min(periods) / 10.0
         self.nfev = 0
         self.steps = 0
 
-    # --- eq. (2), written here again ---------------------------------------------------
+    # --- eq. (2) -----------------------------------------------------------------------
     def xg(self, t: float, on: bool) -> float:
-        if not on:
-            return 0.0
-        wt = self.omega * t
-        return self.amp * (math.cos(wt) if self.cosine else math.sin(wt))
+        return ground_acc(t, on, self.prm)
 
     def jerk(self, t: float, on: bool) -> float:
-        if not on:
-            return 0.0
-        wt = self.omega * t
-        return self.amp * self.omega * (-math.sin(wt) if self.cosine else math.cos(wt))
+        return ground_jerk(t, on, self.prm)
 
     # --- full contact ------------------------------------------------------------------
     def q(self, t: float, y, on: bool) -> float:
@@ -107,16 +111,9 @@ class _Problem:
         return uplift_moment(y[0], y[1], self.xg(t, on), self.prm, self.flex, self.damped)
 
     def q_rate(self, t: float, y, on: bool) -> float:
-        """dQ/dt [N m/s] in full contact, from Q's definition (differentiated here)."""
-        prm = self.prm
-        xg, jerk = self.xg(t, on), self.jerk(t, on)
-        if not self.flex:
-            return -prm[L.PAR_MTOT] * prm[L.PAR_HCG] * jerk
-        u, v = y[0], y[1]
-        a = contact_rhs(u, v, xg, prm, self.damped)[0]
-        c = prm[L.PAR_C] if self.damped else 0.0
-        return (self.h * (prm[L.PAR_K] * v + c * a) + prm[L.PAR_M] * prm[L.PAR_G] * v
-                - prm[L.PAR_MA] * prm[L.PAR_HA] * jerk)
+        """dQ/dt [N m/s] in full contact, y = (u, u')."""
+        return uplift_moment_rate(y[0], y[1], self.xg(t, on), self.jerk(t, on), self.prm,
+                                  self.flex, self.damped)
 
     def uplift_corner(self, t: float, y, on: bool) -> int:
         """Corner the body uplifts on from full contact at (t, y): s with s Q >= M g b, or 0."""
@@ -131,12 +128,7 @@ class _Problem:
         """Largest Q^2 over the energy ellipse of (u, u') minus (M g b)^2 (< 0: rest)."""
         if not self.flex:
             return -1.0
-        prm = self.prm
-        m, k = prm[L.PAR_M], prm[L.PAR_K]
-        l_u = self.h * k + m * prm[L.PAR_G]
-        l_v = self.h * (prm[L.PAR_C] if self.damped else 0.0)
-        two_e = m * y[1] ** 2 + k * y[0] ** 2
-        return two_e * (l_u * l_u / k + l_v * l_v / m) - self.mgb**2
+        return rest_margin(y[0], y[1], self.prm)
 
     def contact_fun(self, on: bool):
         prm, damped = self.prm, self.damped
@@ -304,29 +296,6 @@ def _rocking(pb: _Problem, t0: float, y0, s: int, t1: float, on: bool):
     return kind, t_stop, (y[0], y[1], 0.0, 0.0), theta_max
 
 
-def _rigid_bounded_peak(y, s: int, prm: np.ndarray) -> float:
-    """Rigid body after the pulse, rocking on corner s: the largest |theta| still to come if
-    it can never overturn, else -1 (the kernel's documented early-exit rule, STATUS_BOUNDED).
-
-    With no ground motion E = 1/2 I_O theta'^2 + M g (R cos(a - s theta) - h_cg) is constant
-    while rocking and shrinks by e^2 <= 1 at each impact (|e| <= 1); below the barrier
-    M g (R - h_cg) (relative margin 1e-6) and on the near side of it (s theta < a,
-    a = atan(b/h_cg)) the body only rocks back. The next peak has V = E when moving away
-    from theta = 0, else V = e^2 E (after the impact).
-    """
-    e = float(restitution(s, 0.0, prm, False))
-    if abs(e) > 1.0:
-        return -1.0
-    mg, b, hcg = prm[L.PAR_MTOT] * prm[L.PAR_G], prm[L.PAR_B], prm[L.PAR_HCG]
-    r, a = math.hypot(b, hcg), math.atan2(b, hcg)
-    energy = 0.5 * prm[L.PAR_IO] * y[1] ** 2 + mg * (r * math.cos(a - s * y[0]) - hcg)
-    if not (s * y[0] < a and energy < (1.0 - 1e-6) * mg * (r - hcg)):
-        return -1.0
-    if s * y[1] < 0.0:
-        energy *= e * e
-    return a - math.acos(min((energy / mg + hcg) / r, 1.0))
-
-
 def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = RTOL,
                   atol: float = ATOL, events: bool = False, early_exit: bool = True,
                   theta0: float | None = None, theta_dot0: float | None = None) -> dict:
@@ -393,7 +362,7 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
             break
         if early_exit and not flex and s != 0 and not on and free_check:
             free_check = False
-            peak = _rigid_bounded_peak(y, s, prm)
+            peak = rigid_peak(y[0], y[1], s, prm)  # the kernel's STATUS_BOUNDED rule
             if peak >= 0.0:
                 theta_max = max(theta_max, peak)
                 status |= L.STATUS_BOUNDED

@@ -73,7 +73,7 @@ from rocksweep.grid import Grid
 from rocksweep.kernel import chunk_kernel, point_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel.equations import contact_rhs, ground_acc, rocking_rhs
-from rocksweep.kernel.integrate import rk4_step
+from rocksweep.kernel.stepping import rk4_step
 from rocksweep.numerics import ROOTS
 from rocksweep.scene import Scene, load_scene
 from rocksweep.single import history_capacity

@@ -9,7 +9,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from rocksweep.kernel import equations as eq
-from rocksweep.kernel import integrate as ki
+from rocksweep.kernel import stepping as ki
 from rocksweep.model import FlexibleBody, G, restitution, restitution_rigid
 from rocksweep.numerics import Numerics
 from rocksweep.points import Point, point_row

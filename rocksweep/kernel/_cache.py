@@ -1,9 +1,17 @@
-"""numba cache stamps that cover the whole kernel package.
+"""Where numba caches the compiled kernel, and the stamp that says it is fresh.
 
 numba's on-disk cache checks only the file that defines a function. The kernel's entry
-points are compiled together with functions from ``equations`` and ``integrate``, so an
-edit (or an upgrade) of one file must invalidate the cached code of all of them. This
-locator stamps every kernel function with a hash of all kernel sources. Imported first by
+points are compiled together with functions from every module of this package, so an edit
+(or an upgrade) of one file must invalidate the cached code of all of them: every kernel
+function is stamped with one hash of all kernel sources.
+
+numba also keys its cache directory by the source file's path, so two copies of the same
+sources (the repository run by ``python -m pytest`` and a non-editable ``pip install .`` in
+site-packages) would each compile the nine variants again. The cache is therefore one
+per-user directory per kernel hash, ``$NUMBA_CACHE_DIR/rocksweep/<hash>`` if
+NUMBA_CACHE_DIR is set, else ``$XDG_CACHE_HOME/rocksweep/numba/<hash>`` (default
+``~/.cache/rocksweep/numba/<hash>``), shared by every copy of the same sources; if it
+cannot be made or written, the kernel's own ``__pycache__`` (same stamp). Imported first by
 ``rocksweep.kernel``, before any ``@njit(cache=True)`` runs.
 """
 
@@ -17,6 +25,10 @@ from numba.core import caching, config
 
 _KERNEL_DIR = Path(__file__).resolve().parent
 
+# Options of the functions only ever called from jitted code: no Python or C entry point
+# to build (tests reach them through small @njit wrappers).
+INTERNAL = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True}
+
 
 def _kernel_hash() -> str:
     h = hashlib.sha1()
@@ -27,6 +39,16 @@ def _kernel_hash() -> str:
 
 
 _STAMP = _kernel_hash()
+
+
+def shared_cache_dir() -> Path:
+    """The per-user cache directory of these kernel sources (see the module docstring)."""
+    if config.CACHE_DIR:
+        root = Path(config.CACHE_DIR) / "rocksweep"
+    else:
+        xdg = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+        root = Path(xdg) / "rocksweep" / "numba"
+    return root / _STAMP[:20]
 
 
 class _KernelStampMixin:
@@ -40,22 +62,35 @@ class _KernelStampMixin:
         return super().from_function(py_func, py_file)
 
 
-class KernelInTreeLocator(_KernelStampMixin, caching.InTreeCacheLocator):
-    """Cache in the kernel's __pycache__, stamped by the hash of all kernel sources."""
+class KernelSharedLocator(_KernelStampMixin, caching._SourceFileBackedLocatorMixin,
+                          caching._CacheLocator):
+    """Cache in ``shared_cache_dir()``, stamped by the hash of all kernel sources.
+
+    Index and data files are named after the module, the function and its line (numba's
+    ``CacheImpl``), never the path, so every copy of the same sources finds them.
+    """
+
+    def __init__(self, py_func, py_file):
+        self._py_file = py_file
+        self._lineno = py_func.__code__.co_firstlineno
+        self._cache_path = str(shared_cache_dir())
+
+    def get_cache_path(self):
+        return self._cache_path
 
     @classmethod
     def from_function(cls, py_func, py_file):
-        if config.CACHE_DIR:  # NUMBA_CACHE_DIR set: the user's directory wins
+        try:
+            shared_cache_dir()
+        except (RuntimeError, KeyError):  # no home directory to cache in
             return None
         return super().from_function(py_func, py_file)
 
 
-class KernelUserDirLocator(_KernelStampMixin, caching.UserProvidedCacheLocator):
-    """Cache in NUMBA_CACHE_DIR, stamped by the hash of all kernel sources."""
+class KernelInTreeLocator(_KernelStampMixin, caching.InTreeCacheLocator):
+    """Fallback: the kernel's __pycache__, stamped by the hash of all kernel sources."""
 
 
-for _cls in (KernelInTreeLocator, KernelUserDirLocator):
+for _cls in (KernelInTreeLocator, KernelSharedLocator):  # inserted first: tried first
     if _cls not in caching.CacheImpl._locator_classes:
         caching.CacheImpl._locator_classes.insert(0, _cls)
-
-assert os.path.isdir(_KERNEL_DIR)

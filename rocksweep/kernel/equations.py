@@ -160,6 +160,30 @@ def uplift_moment_rate(u, u_dot, xg, jerk, prm, FLEX, DAMPED):
     return prm[PAR_H] * df + prm[PAR_M] * prm[PAR_G] * u_dot - prm[PAR_MA] * prm[PAR_HA] * jerk
 
 
+@njit(cache=True, inline="always")
+def tip_moment(prm):
+    """M g b [N m]: the moment about a corner that the body's weight resists uplift with."""
+    return prm[PAR_MTOT] * prm[PAR_G] * prm[PAR_B]
+
+
+@njit(cache=True, inline="always")
+def rest_margin(u, u_dot, prm):
+    """Q_max^2 - (M g b)^2 [N^2 m^2] after the pulse, in full contact (< 0: rest for good).
+
+    Q = (h k + m g) u + h c u' is linear in (u, u'); over the energy ellipse
+    1/2 m u'^2 + 1/2 k u^2 <= E (which c >= 0 never lets grow) its largest value Q_max
+    has Q_max^2 = 2 E (L_u^2/k + L_v^2/m). Below M g b the body stays in contact for good.
+    Flexible bodies only (a rigid body in full contact after the pulse is at rest).
+    """
+    m, k, h = prm[PAR_M], prm[PAR_K], prm[PAR_H]
+    l_u = h * k + m * prm[PAR_G]
+    l_v = h * prm[PAR_C]
+    e2 = m * u_dot * u_dot + k * u * u  # 2 E
+    q_max2 = e2 * (l_u * l_u / k + l_v * l_v / m)
+    mgb = tip_moment(prm)
+    return q_max2 - mgb * mgb
+
+
 # ----------------------------------------------------------------------------------------
 # Impact (eq. 1)
 # ----------------------------------------------------------------------------------------
@@ -241,3 +265,62 @@ def impact_loss(s, s_new, u, w_minus, w_plus, prm, FLEX):
         a_plus = u - s_new * b
         loss -= 0.5 * (prm[PAR_IA0] + m * a_plus * a_plus) * w_plus * w_plus
     return loss
+
+
+# ----------------------------------------------------------------------------------------
+# After the pulse: a rigid body that can no longer overturn
+# ----------------------------------------------------------------------------------------
+
+
+# Relative margin on the rigid body's energy below its barrier: covers the integrator's
+# energy error (RK4 at the presets drifts far less), so round-off cannot prove a body safe.
+RIGID_ENERGY_MARGIN = 1e-6
+
+
+@njit(cache=True, inline="always")
+def rigid_peak(theta, theta_dot, s, prm):
+    """After the pulse, a rigid body rocking on corner s: the largest |theta| [rad] still to
+    come if it can never overturn, else -1 (not proven).
+
+    With no ground motion its energy E is constant while it rocks and is multiplied by
+    e^2 <= 1 at every impact when |e| <= 1 (lam <= 1; e is the same at every impact).
+    The potential V = M g (R cos(a - s theta) - h_cg), a = atan(b/h_cg), peaks at
+    s theta = a; a body inside the barrier (s theta < a) with E below that peak (less
+    RIGID_ENERGY_MARGIN) never overturns. The next peak has V = E if moving away from
+    theta = 0, else V = e^2 E (after the next impact).
+    """
+    e = restitution(s, 0.0, prm, False)
+    if abs(e) > 1.0:
+        return -1.0
+    mg, b, hcg = prm[PAR_MTOT] * prm[PAR_G], prm[PAR_B], prm[PAR_HCG]
+    r = math.hypot(b, hcg)
+    a = math.atan2(b, hcg)
+    e_now = mechanical_energy(theta, theta_dot, 0.0, 0.0, s, prm, False)
+    if not (s * theta < a and e_now < (1.0 - RIGID_ENERGY_MARGIN) * mg * (r - hcg)):
+        return -1.0
+    if s * theta_dot < 0.0:
+        e_now *= e * e
+    return a - math.acos(min((e_now / mg + hcg) / r, 1.0))
+
+
+# ----------------------------------------------------------------------------------------
+# The top mass's spring while the base rocks (what the step size must resolve)
+# ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def rocking_spring_omega(omega_n, zeta, m, h, i_a0, a):
+    """Fastest rate [rad/s] of the top mass on its spring while the base rocks, with the
+    top mass's lever arm a = u - s b [m] about the corner.
+
+    Linearising ``rocking_rhs`` in u: u'' = -Gamma (k u + c u') / m + ...,
+    Gamma = 1 + m h^2 / (I_A + m_A R_A^2 + m a^2) (i_a0 = I_A + m_A R_A^2 [kg m^2]): a
+    spring of frequency omega_n sqrt(Gamma) and damping ratio zeta sqrt(Gamma). Gamma is
+    largest at a = 0. Above a damping ratio of 1 the mode is overdamped and its fast root,
+    omega (zeta' + sqrt(zeta'^2 - 1)), is what an explicit step must resolve.
+    """
+    gamma = 1.0 + m * (h * h) / (i_a0 + m * (a * a))
+    omega, zeta_r = omega_n * math.sqrt(gamma), zeta * math.sqrt(gamma)
+    if zeta_r > 1.0:
+        omega *= zeta_r + math.sqrt(zeta_r * zeta_r - 1.0)
+    return omega

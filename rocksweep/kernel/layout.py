@@ -2,9 +2,10 @@
 
 Numba reads module-level ints as compile-time constants, so these cost nothing in the loop.
 The kernel takes one parameter row per point (``PAR_*``) and fills one result row
-(``OUT_*``); single runs also fill a history buffer (``HIST_*`` columns). All quantities
-are SI with m = 1 kg, g = 9.81 m/s^2 and p = 1 rad/s (see ``rocksweep.model``), so times
-are p*t.
+(``OUT_*``; the loop keeps its counters there as it runs); single runs also fill a history
+buffer (``HIST_*`` columns). Inside the loop the state is a 6-tuple (``Y_*`` slots). All
+quantities are SI with m = 1 kg, g = 9.81 m/s^2 and p = 1 rad/s (see ``rocksweep.model``),
+so times are p*t.
 """
 
 # --- parameter row ---------------------------------------------------------------------
@@ -65,6 +66,15 @@ OUT_E_MAX = 16  # largest restitution seen
 OUT_CONTACTS = 17  # returns to full contact (e <= 0 or settling below the rest rate)
 OUT_HIST_ROWS = 18  # rows written to the history buffer
 N_OUT = 19
+
+# --- state tuple y (the loop's 6 slots, a UniTuple(float64, 6)) ----------------------------
+Y_THETA = 0  # theta [rad] (0 in full contact)
+Y_THETA_DOT = 1  # theta' [rad/s]
+Y_U = 2  # u, the top mass's lateral displacement [m] (0 for a rigid body)
+Y_U_DOT = 3  # u' [m/s]
+Y_W_IN = 4  # work of the ground motion so far [J] (energy variants; else stays 0)
+Y_D_DAMP = 5  # energy dissipated by the damper so far [J] (energy variants; else stays 0)
+N_Y = 6
 
 # --- history columns ---------------------------------------------------------------------
 HIST_T = 0

@@ -6,8 +6,8 @@ from hardkit import kernel_events, numerics, reference_events, run
 from numba import njit
 from test_02_grazing import WINDOW, point, touch
 
-from rocksweep.kernel.integrate import rk4_step
 from rocksweep.kernel.layout import PAR_DT, PAR_TPULSE
+from rocksweep.kernel.stepping import rk4_step
 from rocksweep.points import point_row
 
 pytestmark = pytest.mark.hard

@@ -1,0 +1,352 @@
+"""The loop that runs one point: steps, events, actions (jitted).
+
+``simulate_point`` owns the phase s (0 full contact, +-1 rocking on that corner) and the
+state y (``layout.Y_*``); it takes fixed RK4 steps (``stepping``), asks ``events`` for the
+first event inside each step and applies the transition rules (``transitions``). Its
+counters live in the result row ``out`` (``OUT_*``) as it runs; the actions that update
+them are the small helpers below. Those on the path of every step take no arrays and are
+inlined (numba ``inline="always"``); those of events are calls (an inlined helper that
+takes ``prm`` or ``out`` adds reference counting to every step: ~15% slower, measured).
+
+Compile-time specialisation: the functions take the flags FLEX, DAMPED and ENERGY and call
+``numba.literally`` on them, so numba compiles one specialisation per flag value (a
+``Literal[bool]`` type) and the branches a variant does not need are removed at compile
+time (by LLVM: numba still types and lowers them, its own dead-branch pruning does not
+read literal arguments, so they cost compile time but no run time). The time history is
+the exception: ``simulate_point`` gets ``hist=None`` when there is none, and numba prunes
+the ``if hist is not None`` branch of ``_record`` before typing. The variants themselves
+are in ``variants``.
+"""
+
+import math
+
+import numpy as np
+from numba import literally, njit
+
+from rocksweep.kernel._cache import INTERNAL
+from rocksweep.kernel.equations import ground_acc, mechanical_energy
+from rocksweep.kernel.events import (
+    EV_IMPACT,
+    EV_NONE,
+    EV_OVERTURN,
+    EV_UPLIFT_POS,
+    _first_event,
+    hermite_min,
+)
+from rocksweep.kernel.layout import (
+    HIST_D_DAMP,
+    HIST_E,
+    HIST_E_IMPACT,
+    HIST_PHASE,
+    HIST_T,
+    HIST_THETA,
+    HIST_THETA_DOT,
+    HIST_U,
+    HIST_U_DOT,
+    HIST_W_IN,
+    HIST_XG,
+    OUT_CONTACTS,
+    OUT_D_DAMP,
+    OUT_E_END,
+    OUT_E_GAINED,
+    OUT_E_IMPACT,
+    OUT_E_MAX,
+    OUT_EVENT_STEPS,
+    OUT_HIST_ROWS,
+    OUT_IMPACTS,
+    OUT_N_GAINING,
+    OUT_OUTCOME,
+    OUT_STATUS,
+    OUT_STEPS,
+    OUT_T_END,
+    OUT_T_FIRST_IMPACT,
+    OUT_T_OVERTURN,
+    OUT_THETA_MAX,
+    OUT_UPLIFTS,
+    OUT_W_IN,
+    OUTCOME_MODE1,
+    OUTCOME_MODE2,
+    OUTCOME_SAFE,
+    PAR_DT,
+    PAR_MAXEVENTS,
+    PAR_MAXSTEPS,
+    PAR_TEND,
+    PAR_THETA0,
+    PAR_THETA_DOT0,
+    PAR_TPULSE,
+    STATUS_BOUNDED,
+    STATUS_E_ABOVE_1,
+    STATUS_ENERGY_GAIN,
+    STATUS_EVENT_CAP,
+    STATUS_HIST_FULL,
+    STATUS_HORIZON,
+    STATUS_NONFINITE,
+    STATUS_OVERTURNED,
+    STATUS_REST,
+    STATUS_SETTLED,
+    STATUS_STEP_CAP,
+    Y_D_DAMP,
+    Y_THETA,
+    Y_THETA_DOT,
+    Y_U,
+    Y_U_DOT,
+    Y_W_IN,
+)
+from rocksweep.kernel.stepping import rk4_step
+from rocksweep.kernel.transitions import impact_map, rest_proven, rigid_bounded, uplift_side
+
+
+@njit(cache=True, **INTERNAL)
+def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY):
+    """Run one point from rest (or the given initial state) to a decided outcome, a cap or
+    the horizon.
+
+    prm: float64[N_PAR] parameter row; out: float64[N_OUT] result row (filled);
+    hist: float64[n, N_HIST] history buffer, or None: no history (the recording code is
+    then not compiled at all).
+    """
+    literally(FLEX)
+    literally(DAMPED)
+    literally(ENERGY)
+    t, dt, t_pulse, t_end = 0.0, prm[PAR_DT], prm[PAR_TPULSE], prm[PAR_TEND]
+    y = (prm[PAR_THETA0], prm[PAR_THETA_DOT0], 0.0, 0.0, 0.0, 0.0)
+    _reset(out, abs(y[Y_THETA]))
+    on = t_pulse > 0.0
+    if y[Y_THETA] != 0.0 or y[Y_THETA_DOT] != 0.0:
+        # a given initial state: rocking on the corner theta (else theta') points to
+        s = 1 if y[Y_THETA] > 0.0 or (y[Y_THETA] == 0.0 and y[Y_THETA_DOT] > 0.0) else -1
+    else:
+        s = _uplift(t, y, on, prm, out, FLEX, DAMPED)  # at t = 0: a cosine pulse's peak
+    _record(hist, t, y, s, on, prm, out, FLEX)
+    free_check = True  # rigid: test rigid_bounded at the next loop top after the pulse
+
+    while True:
+        on = t < t_pulse
+        # why the run ends before this step, if it does (a STATUS_* bit); written out here,
+        # not in a helper: a helper taking the arrays costs ~15% at every step
+        if s == 0 and not on and rest_proven(y, prm, FLEX):
+            _flag(out, STATUS_REST)
+            break
+        if t >= t_end:
+            _flag(out, STATUS_HORIZON)
+            break
+        if not FLEX and s != 0 and not on and free_check:
+            free_check = False  # E is constant between impacts after the pulse: test once
+            if _bounded(y, s, prm, out):
+                _flag(out, STATUS_BOUNDED)
+                break
+        if out[OUT_STEPS] + out[OUT_EVENT_STEPS] >= prm[PAR_MAXSTEPS]:
+            _flag(out, STATUS_STEP_CAP)
+            break
+        if out[OUT_IMPACTS] + out[OUT_UPLIFTS] >= prm[PAR_MAXEVENTS]:
+            _flag(out, STATUS_EVENT_CAP)
+            break
+        h, lands = _step_length(t, on, dt, t_pulse, t_end)
+        y1 = rk4_step(t, y, h, s, on, prm, FLEX, DAMPED, ENERGY)
+        out[OUT_STEPS] += 1.0
+        if not _finite(y1):
+            _flag(out, STATUS_NONFINITE)
+            break
+        ev, tau, y_ev, n = _first_event(t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
+        out[OUT_EVENT_STEPS] += n
+        if s != 0:
+            # (y_ev, tau) = (y1, h) without an event
+            out[OUT_THETA_MAX] = _theta_max(y, y_ev, tau, s, out[OUT_THETA_MAX])
+
+        if ev == EV_NONE:
+            t, y = (t_pulse if lands else t + h), y1
+            _record(hist, t, y, s, t < t_pulse, prm, out, FLEX)
+            if lands and s == 0:
+                # The pulse ends with a jump of xg'' (a cosine pulse ends at its peak), and
+                # Q jumps with it by m_A h_A xg'': the state may now be past the uplift
+                # threshold, which no crossing inside the next step would show. Checked at
+                # once, as at t = 0 and after an impact.
+                s = _uplift(t, y, False, prm, out, FLEX, DAMPED)
+                if s != 0:
+                    _record(hist, t, y, s, False, prm, out, FLEX)
+            continue
+
+        t, y = t + tau, y_ev
+        _record(hist, t, y, s, on, prm, out, FLEX)
+        if ev == EV_OVERTURN:
+            _overturned(t, out)
+            break
+        if ev == EV_IMPACT:
+            y, s = _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY)
+            free_check = True
+        else:  # uplift: theta = theta' = 0 exactly, now rocking on the located corner
+            s = 1 if ev == EV_UPLIFT_POS else -1
+            y = (0.0, 0.0, y[Y_U], y[Y_U_DOT], y[Y_W_IN], y[Y_D_DAMP])
+            out[OUT_UPLIFTS] += 1.0
+        _record(hist, t, y, s, on, prm, out, FLEX)
+    _finish(t, y, s, prm, out, FLEX, ENERGY)
+
+
+# ----------------------------------------------------------------------------------------
+# The loop's actions
+# ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True, inline="always")
+def _flag(out, bit):
+    """Set a STATUS_* bit in the result row."""
+    out[OUT_STATUS] = int(out[OUT_STATUS]) | bit
+
+
+@njit(cache=True, **INTERNAL)
+def _reset(out, theta_max):
+    """The result row before the first step: counters 0, times NaN, safe so far."""
+    out[OUT_OUTCOME] = OUTCOME_SAFE
+    out[OUT_STATUS] = 0.0
+    out[OUT_IMPACTS] = 0.0
+    out[OUT_UPLIFTS] = 0.0
+    out[OUT_CONTACTS] = 0.0
+    out[OUT_THETA_MAX] = theta_max
+    out[OUT_T_OVERTURN] = np.nan
+    out[OUT_T_FIRST_IMPACT] = np.nan
+    out[OUT_T_END] = 0.0
+    out[OUT_STEPS] = 0.0
+    out[OUT_EVENT_STEPS] = 0.0
+    out[OUT_E_IMPACT] = 0.0  # net energy lost in impacts
+    out[OUT_E_GAINED] = 0.0
+    out[OUT_N_GAINING] = 0.0
+    out[OUT_E_MAX] = 0.0
+    out[OUT_HIST_ROWS] = 0.0
+
+
+@njit(cache=True, **INTERNAL)
+def _bounded(y, s, prm, out):
+    """Rigid body after the pulse: proven safe (``rigid_bounded``)? Then its largest |theta|
+    still to come counts in theta_max."""
+    peak = rigid_bounded(y, s, prm)
+    if peak < 0.0:
+        return False
+    if peak > out[OUT_THETA_MAX]:
+        out[OUT_THETA_MAX] = peak
+    return True
+
+
+@njit(cache=True, inline="always")
+def _step_length(t, on, dt, t_pulse, t_end):
+    """(h, lands): the step dt, shortened to land exactly on the pulse's end (lands) or on
+    the horizon."""
+    if on and t + dt >= t_pulse:
+        return t_pulse - t, True
+    if t + dt > t_end:
+        return t_end - t, False
+    return dt, False
+
+
+@njit(cache=True, inline="always")
+def _finite(y):
+    return (math.isfinite(y[Y_THETA]) and math.isfinite(y[Y_THETA_DOT])
+            and math.isfinite(y[Y_U]) and math.isfinite(y[Y_U_DOT]))
+
+
+@njit(cache=True, inline="always")
+def _theta_max(y, y_end, h_end, s, theta_max):
+    """theta_max updated over a rocking step (t, y) -> (t + h_end, y_end), including a
+    turning point inside it."""
+    a_end = abs(y_end[Y_THETA])
+    if a_end > theta_max:
+        theta_max = a_end
+    if s * y[Y_THETA_DOT] > 0.0 and s * y_end[Y_THETA_DOT] < 0.0:
+        # turning point inside the step: Hermite maximum of s*theta = -min(-s*theta)
+        _, gm = hermite_min(-s * y[Y_THETA], -s * y[Y_THETA_DOT], -s * y_end[Y_THETA],
+                            -s * y_end[Y_THETA_DOT], h_end)
+        if -gm > theta_max:
+            theta_max = -gm
+    return theta_max
+
+
+@njit(cache=True, **INTERNAL)
+def _uplift(t, y, on, prm, out, FLEX, DAMPED):
+    """Check uplift from full contact at (t, y) and count it. Returns the new phase."""
+    s = uplift_side(t, y, on, prm, FLEX, DAMPED)
+    if s != 0:
+        out[OUT_UPLIFTS] += 1.0
+    return s
+
+
+@njit(cache=True, **INTERNAL)
+def _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY):
+    """Impact at (t, y) ending rocking on corner s: the impact map and its counters; back
+    in full contact, uplift is checked again at once. Returns (y, new phase)."""
+    out[OUT_IMPACTS] += 1.0
+    if out[OUT_IMPACTS] == 1.0:
+        out[OUT_T_FIRST_IMPACT] = t
+    y, s_new, e, e_d, loss = impact_map(y, s, prm, FLEX, ENERGY)
+    if e > out[OUT_E_MAX]:
+        out[OUT_E_MAX] = e
+    if e > 1.0:
+        _flag(out, STATUS_E_ABOVE_1)
+    if s_new == 0:
+        out[OUT_CONTACTS] += 1.0
+        if e > 0.0:
+            _flag(out, STATUS_SETTLED)
+    if ENERGY:
+        out[OUT_E_IMPACT] += e_d
+        if loss < 0.0:
+            out[OUT_E_GAINED] -= loss
+            out[OUT_N_GAINING] += 1.0
+            _flag(out, STATUS_ENERGY_GAIN)
+    if s_new == 0:
+        s_new = _uplift(t, y, on, prm, out, FLEX, DAMPED)
+    return y, s_new
+
+
+@njit(cache=True, **INTERNAL)
+def _overturned(t, out):
+    out[OUT_OUTCOME] = OUTCOME_MODE1 if out[OUT_IMPACTS] > 0.0 else OUTCOME_MODE2
+    out[OUT_T_OVERTURN] = t
+    _flag(out, STATUS_OVERTURNED)
+
+
+@njit(cache=True, inline="always")
+def _record(hist, t, y, s, on, prm, out, FLEX):
+    """Append a history row at (t, y) in phase s, or flag STATUS_HIST_FULL; nothing (not
+    even compiled) without a history."""
+    if hist is not None:
+        if _write_row(hist, int(out[OUT_HIST_ROWS]), t, y, s, on, prm,
+                      out[OUT_E_IMPACT], FLEX):
+            out[OUT_HIST_ROWS] += 1.0
+        else:
+            _flag(out, STATUS_HIST_FULL)
+
+
+@njit(cache=True, **INTERNAL)
+def _write_row(hist, row, t, y, s, on, prm, e_imp, FLEX):
+    literally(FLEX)
+    if row >= hist.shape[0]:
+        return False
+    hist[row, HIST_T] = t
+    hist[row, HIST_THETA] = y[Y_THETA]
+    hist[row, HIST_THETA_DOT] = y[Y_THETA_DOT]
+    hist[row, HIST_U] = y[Y_U]
+    hist[row, HIST_U_DOT] = y[Y_U_DOT]
+    hist[row, HIST_PHASE] = s
+    hist[row, HIST_E] = mechanical_energy(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s,
+                                          prm, FLEX)
+    hist[row, HIST_W_IN] = y[Y_W_IN]
+    hist[row, HIST_D_DAMP] = y[Y_D_DAMP]
+    hist[row, HIST_E_IMPACT] = e_imp
+    hist[row, HIST_XG] = ground_acc(t, on, prm)
+    return True
+
+
+@njit(cache=True, **INTERNAL)
+def _finish(t, y, s, prm, out, FLEX, ENERGY):
+    """The result row's last entries: end time and the energy accounting (NaN without)."""
+    out[OUT_T_END] = t
+    if ENERGY:
+        out[OUT_W_IN] = y[Y_W_IN]
+        out[OUT_D_DAMP] = y[Y_D_DAMP]
+        out[OUT_E_END] = mechanical_energy(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s,
+                                           prm, FLEX)
+    else:
+        out[OUT_W_IN] = np.nan
+        out[OUT_D_DAMP] = np.nan
+        out[OUT_E_IMPACT] = np.nan
+        out[OUT_E_GAINED] = np.nan
+        out[OUT_N_GAINING] = np.nan
+        out[OUT_E_END] = np.nan

@@ -1,0 +1,74 @@
+"""One fixed RK4 step on the state y = (theta, theta', u, u', W_in, D_damp) (jitted).
+
+``derivatives`` assembles dy/dt for a phase from the equations (``equations``);
+``rk4_step`` knows nothing of events, phases changing or the loop.
+
+Compile-time flags (see ``variants``): FLEX (the top mass moves on its spring), DAMPED (the
+spring has a damper) and ENERGY (integrate the ground's work W_in and the damper's loss
+D_damp along). Both functions are inlined where they are called (numba
+``inline="always"``), so an RK4 step makes no function call: a call costs about as much as
+a right-hand side, most of it the reference count of ``prm`` taken and dropped on every
+call (scripts/bench_kernel.py, roofline; inlining ``rk4_step`` made the sweeps 10-20%
+faster, bit for bit the same, for ~8% more compile time).
+"""
+
+from numba import njit
+
+from rocksweep.kernel.equations import contact_rhs, ground_acc, rigid_rhs, rocking_rhs
+from rocksweep.kernel.layout import Y_THETA, Y_THETA_DOT, Y_U, Y_U_DOT
+
+
+@njit(cache=True, inline="always")
+def derivatives(t, y, s, on, prm, FLEX, DAMPED, ENERGY):
+    """dy/dt (a 6-tuple in the ``Y_*`` slot order) at (t, y) in phase s (0 full contact,
+    +-1 rocking on that corner); ``on``: the pulse acts."""
+    theta, theta_dot, u, u_dot = y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT]
+    xg = ground_acc(t, on, prm)
+    if s == 0:
+        if not FLEX:
+            return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        u_dd, p_in, p_damp = contact_rhs(u, u_dot, xg, prm, DAMPED)
+        if ENERGY:
+            return (0.0, 0.0, u_dot, u_dd, p_in, p_damp)
+        return (0.0, 0.0, u_dot, u_dd, 0.0, 0.0)
+    if not FLEX:
+        theta_dd, p_in = rigid_rhs(theta, theta_dot, s, xg, prm)
+        if ENERGY:
+            return (theta_dot, theta_dd, 0.0, 0.0, p_in, 0.0)
+        return (theta_dot, theta_dd, 0.0, 0.0, 0.0, 0.0)
+    theta_dd, u_dd, p_in, p_damp = rocking_rhs(theta, theta_dot, u, u_dot, s, xg, prm, DAMPED)
+    if ENERGY:
+        return (theta_dot, theta_dd, u_dot, u_dd, p_in, p_damp)
+    return (theta_dot, theta_dd, u_dot, u_dd, 0.0, 0.0)
+
+
+@njit(cache=True, inline="always")
+def _axpy(y, a, k):
+    """y + a k, slot by slot."""
+    return (y[0] + a * k[0], y[1] + a * k[1], y[2] + a * k[2],
+            y[3] + a * k[3], y[4] + a * k[4], y[5] + a * k[5])
+
+
+@njit(cache=True, inline="always")
+def rk4_step(t, y, h, s, on, prm, FLEX, DAMPED, ENERGY):
+    """One classical RK4 step of size h [s] from (t, y) in phase s. Returns the new 6-tuple."""
+    # The four stages share one call site of the inlined right-hand side (numba types and
+    # lowers it once, LLVM unrolls the loop): 1/4 of the compile time of four call sites.
+    zero = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    k = k1 = k23 = zero
+    for stage in range(4):
+        c = 0.0 if stage == 0 else (h if stage == 3 else 0.5 * h)
+        k = derivatives(t + c, _axpy(y, c, k), s, on, prm, FLEX, DAMPED, ENERGY)
+        if stage == 0:
+            k1 = k
+        elif stage == 1:
+            k23 = k
+        elif stage == 2:
+            k23 = _axpy(k23, 1.0, k)  # k2 + k3
+    w = h / 6.0  # k is k4 now
+    return (y[0] + w * (k1[0] + 2.0 * k23[0] + k[0]),
+            y[1] + w * (k1[1] + 2.0 * k23[1] + k[1]),
+            y[2] + w * (k1[2] + 2.0 * k23[2] + k[2]),
+            y[3] + w * (k1[3] + 2.0 * k23[3] + k[3]),
+            y[4] + w * (k1[4] + 2.0 * k23[4] + k[4]),
+            y[5] + w * (k1[5] + 2.0 * k23[5] + k[5]))

@@ -1,0 +1,101 @@
+"""The rules that change the phase or end a run early (jitted).
+
+- ``uplift_side``: full contact -> rocking on a corner, when s Q >= M g b;
+- ``impact_map``: rocking -> rocking on the other corner or full contact, at theta = 0
+  (eq. 1 and the settling rule);
+- ``rest_proven``: after the pulse, full contact for good (flexible body);
+- ``rigid_bounded``: after the pulse, a rigid body that can no longer overturn.
+
+The formulas come from ``equations``; the reference path (``rocksweep.reference``) calls
+the same ones (``tip_moment``, ``rest_margin``, ``rigid_peak``).
+"""
+
+from numba import literally, njit
+
+from rocksweep.kernel._cache import INTERNAL
+from rocksweep.kernel.equations import (
+    ground_acc,
+    impact_loss,
+    mechanical_energy,
+    rest_margin,
+    restitution,
+    rigid_peak,
+    tip_moment,
+    uplift_moment,
+)
+from rocksweep.kernel.layout import (
+    PAR_H,
+    PAR_RESTRATE,
+    Y_D_DAMP,
+    Y_THETA,
+    Y_THETA_DOT,
+    Y_U,
+    Y_U_DOT,
+    Y_W_IN,
+)
+
+
+@njit(cache=True, **INTERNAL)
+def uplift_side(t, y, on, prm, FLEX, DAMPED):
+    """Corner (+1 / -1) the body uplifts on from full contact at (t, y), or 0."""
+    q = uplift_moment(y[Y_U], y[Y_U_DOT], ground_acc(t, on, prm), prm, FLEX, DAMPED)
+    mgb = tip_moment(prm)
+    if q >= mgb:
+        return 1
+    if q <= -mgb:
+        return -1
+    return 0
+
+
+@njit(cache=True, **INTERNAL)
+def rest_proven(y, prm, FLEX):
+    """After the pulse, in full contact: can the oscillator never uplift the body again?
+
+    True when the largest Q over the oscillator's energy ellipse is below M g b
+    (``rest_margin`` < 0); always for a rigid body (nothing moves in full contact).
+    """
+    if not FLEX:
+        return True
+    return rest_margin(y[Y_U], y[Y_U_DOT], prm) < 0.0
+
+
+@njit(cache=True, **INTERNAL)
+def rigid_bounded(y, s, prm):
+    """After the pulse, a rigid body rocking on corner s: the largest |theta| still to come
+    if it can never overturn (its outcome is decided: safe), else -1 (``rigid_peak``)."""
+    return rigid_peak(y[Y_THETA], y[Y_THETA_DOT], s, prm)
+
+
+@njit(cache=True, **INTERNAL)
+def impact_map(y, s, prm, FLEX, ENERGY):
+    """Impact map at theta = 0 ending rocking on corner s (eq. 1 and the settling rule).
+
+    Returns (state after, new phase, e, energy lost E_d [J], impact loss [J]) (energies 0
+    unless ENERGY). E_d = E(before) - E(after) closes the energy balance; it includes the
+    potential energy of the located state's overshoot of theta = 0 (within the event
+    tolerance). The impact loss (``impact_loss``, eq. 6) is the impact's own share; only it
+    decides whether an impact gained energy, so the overshoot cannot flag a spurious gain.
+    e > 0 with |e theta'^-| >= PAR_RESTRATE: rocking continues on -s, theta'^+ = e theta'^-.
+    Otherwise full contact: e <= 0 is inadmissible as rocking, and a post-impact rate
+    below the rest rate ends a chattering (Zeno) sequence after finitely many impacts.
+    Either way the top mass keeps its horizontal momentum m (u' + h theta').
+    """
+    literally(FLEX)
+    literally(ENERGY)
+    theta, w_minus, u, u_dot = y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT]
+    e = restitution(s, u, prm, FLEX)
+    if e > 0.0 and abs(e * w_minus) >= prm[PAR_RESTRATE]:
+        s_new = -s
+        w_plus = e * w_minus
+    else:
+        s_new = 0
+        w_plus = 0.0
+    u_dot_plus = u_dot + prm[PAR_H] * (w_minus - w_plus) if FLEX else 0.0
+    y_new = (0.0, w_plus, u, u_dot_plus, y[Y_W_IN], y[Y_D_DAMP])
+    e_d = 0.0
+    loss = 0.0
+    if ENERGY:
+        e_d = (mechanical_energy(theta, w_minus, u, u_dot, s, prm, FLEX)
+               - mechanical_energy(0.0, w_plus, u, u_dot_plus, s_new, prm, FLEX))
+        loss = impact_loss(s, s_new, u, w_minus, w_plus, prm, FLEX)
+    return y_new, s_new, e, e_d, loss

@@ -1,0 +1,124 @@
+"""The compiled variants: one small jitted entry point per effect set (jitted).
+
+Each entry point fixes the compile-time flags of ``loop.simulate_point`` as literals
+(FLEX: the top mass moves on its spring; DAMPED: the spring has a damper; ENERGY: energy
+accounting), so every variant is assembled from the same functions with the branches it
+does not need removed.
+
+  chunk_*: prms float64[n, N_PAR] -> outs float64[n, N_OUT] (filled in place); they
+      release the GIL, so threads of one process run chunks in parallel
+  point_*: one point with energy accounting and a history buffer float64[n, N_HIST]
+
+``chunk_kernel(kind, level)`` and ``point_kernel(kind)`` pick one by ``KIND_*`` and
+``LEVEL_*`` (``layout``); ``warm_up`` compiles (or loads) one now.
+"""
+
+import numpy as np
+from numba import literally, njit
+
+from rocksweep.kernel._cache import INTERNAL
+from rocksweep.kernel.layout import (
+    KIND_FLEXIBLE,
+    KIND_FLEXIBLE_UNDAMPED,
+    KIND_RIGID,
+    LEVEL_ENERGY,
+    LEVEL_OUTCOME,
+    N_HIST,
+    N_OUT,
+    N_PAR,
+    PAR_TEND,
+)
+from rocksweep.kernel.loop import simulate_point
+
+
+@njit(cache=True, **INTERNAL)
+def _chunk(prms, outs, FLEX, DAMPED, ENERGY):
+    literally(FLEX)
+    literally(DAMPED)
+    literally(ENERGY)
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, FLEX, DAMPED, ENERGY)
+
+
+@njit(cache=True, nogil=True)
+def chunk_flexible(prms, outs):
+    _chunk(prms, outs, True, True, False)
+
+
+@njit(cache=True, nogil=True)
+def chunk_flexible_undamped(prms, outs):
+    _chunk(prms, outs, True, False, False)
+
+
+@njit(cache=True, nogil=True)
+def chunk_rigid(prms, outs):
+    _chunk(prms, outs, False, False, False)
+
+
+@njit(cache=True, nogil=True)
+def chunk_flexible_energy(prms, outs):
+    _chunk(prms, outs, True, True, True)
+
+
+@njit(cache=True, nogil=True)
+def chunk_flexible_undamped_energy(prms, outs):
+    _chunk(prms, outs, True, False, True)
+
+
+@njit(cache=True, nogil=True)
+def chunk_rigid_energy(prms, outs):
+    _chunk(prms, outs, False, False, True)
+
+
+@njit(cache=True)
+def point_flexible_history(prm, out, hist):
+    simulate_point(prm, out, hist, True, True, True)
+
+
+@njit(cache=True)
+def point_flexible_undamped_history(prm, out, hist):
+    simulate_point(prm, out, hist, True, False, True)
+
+
+@njit(cache=True)
+def point_rigid_history(prm, out, hist):
+    simulate_point(prm, out, hist, False, False, True)
+
+
+_CHUNK = {
+    (KIND_FLEXIBLE, LEVEL_OUTCOME): chunk_flexible,
+    (KIND_FLEXIBLE_UNDAMPED, LEVEL_OUTCOME): chunk_flexible_undamped,
+    (KIND_RIGID, LEVEL_OUTCOME): chunk_rigid,
+    (KIND_FLEXIBLE, LEVEL_ENERGY): chunk_flexible_energy,
+    (KIND_FLEXIBLE_UNDAMPED, LEVEL_ENERGY): chunk_flexible_undamped_energy,
+    (KIND_RIGID, LEVEL_ENERGY): chunk_rigid_energy,
+}
+_POINT = {
+    KIND_FLEXIBLE: point_flexible_history,
+    KIND_FLEXIBLE_UNDAMPED: point_flexible_undamped_history,
+    KIND_RIGID: point_rigid_history,
+}
+
+
+def chunk_kernel(kind: int, level: int):
+    """Jitted ``f(prms[n, N_PAR], outs[n, N_OUT])`` for a kernel kind and bookkeeping level."""
+    return _CHUNK[(kind, level)]
+
+
+def point_kernel(kind: int):
+    """Jitted ``f(prm[N_PAR], out[N_OUT], hist[n, N_HIST])`` with energy and history."""
+    return _POINT[kind]
+
+
+def warm_up(kind: int, level: int | None = None) -> None:
+    """Compile (or load from numba's cache) a variant now, so timings exclude compilation.
+
+    ``level=None`` warms the single-run (history) variant of ``kind``.
+    """
+    prm = np.zeros((1, N_PAR))
+    prm[0, PAR_TEND] = -1.0  # the loop stops before its first step
+    out = np.empty((1, N_OUT))
+    if level is None:
+        point_kernel(kind)(prm[0], out[0], np.empty((1, N_HIST)))
+    else:
+        chunk_kernel(kind, level)(prm, out)

@@ -1,0 +1,200 @@
+"""The kernel's root finders and Hermite helpers on their own, against closed forms.
+
+The Hermite helpers are pure arithmetic with a Python entry point. ``_locate`` is compiled
+without one, so it is reached through a small @njit wrapper (one rigid specialisation, a
+few seconds to compile) on two event functions whose exact root is known in closed form
+and that the RK4 step follows exactly (so the only error left is the root finder's):
+
+- a rigid body at rest in full contact under a sine pulse: the uplift function
+  g(t) = M (g b + h_cg A sin(omega t)) (A < 0) is a function of t alone, zero at
+  sin(omega t*) = g b / (h_cg |A|);
+- a rigid body rocking with gravity off and no pulse: theta' is constant, so the impact
+  function g = theta(t) = theta0 + w t is linear, zero at t* = -theta0 / w.
+"""
+
+import math
+
+import numpy as np
+import pytest
+from numba import njit
+
+from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.kernel.equations import rocking_spring_omega
+from rocksweep.kernel.events import (
+    EV_IMPACT,
+    EV_UPLIFT_POS,
+    _locate,
+    event_value,
+    hermite_cubic,
+    hermite_min,
+    hermite_root,
+)
+from rocksweep.kernel.stepping import rk4_step
+from rocksweep.model import FlexibleBody
+from rocksweep.points import body_omega_rock
+
+# Newton's stopping step in units of the step, as _locate asks for (0.05 tol / width).
+XTOL = 1e-8
+ROOTS = {"bisect": L.ROOT_BISECT, "illinois": L.ROOT_ILLINOIS, "hermite": L.ROOT_HERMITE}
+
+
+# ------------------------------------------------------------------------------------
+# Hermite helpers: exact on cubics (the interpolant of a cubic is the cubic itself)
+# ------------------------------------------------------------------------------------
+
+
+def _ends(g, dg, h):
+    return g(0.0), dg(0.0), g(h), dg(h)
+
+
+@pytest.mark.parametrize("h", [1.0, 1e-3])
+def test_hermite_root_finds_the_root_of_a_cubic(h):
+    # g(t) = (x - 0.3)(x + 1)(x - 1.5) with x = t/h: g(0) = 0.45 > 0 > g(h) = -0.7, root
+    # 0.3 h (the other two outside [0, h])
+    def g(t):
+        x = t / h
+        return (x - 0.3) * (x + 1.0) * (x - 1.5)
+
+    def dg(t):
+        x = t / h
+        return (3 * x * x - 1.6 * x - 1.35) / h
+
+    tau = hermite_root(*_ends(g, dg, h), h, XTOL)
+    assert abs(tau - 0.3 * h) <= XTOL * h
+
+
+def test_hermite_root_after_a_start_on_zero_rising_then_falling():
+    # g(t) = t (0.6 - t)(t + 1): g(0) = 0 with g' = 0.6 > 0, then the crossing at 0.6
+    def g(t):
+        return t * (0.6 - t) * (t + 1.0)
+
+    def dg(t):
+        return -3 * t * t - 0.8 * t + 0.6
+
+    g0, d0, g1, d1 = _ends(g, dg, 1.0)
+    assert g0 == 0.0 and d0 > 0.0 and g1 < 0.0
+    assert abs(hermite_root(g0, d0, g1, d1, 1.0, XTOL) - 0.6) <= XTOL
+
+
+def test_hermite_cubic_reproduces_a_cubic():
+    # c(x) = g0 + d0 h x + c2 x^2 + c3 x^3 of g(t) = 2 - t + 3 t^2 - 0.5 t^3 on [0, h]
+    h = 0.7
+    g0, d0, g1, d1 = 2.0, -1.0, 2 - h + 3 * h * h - 0.5 * h**3, -1 + 6 * h - 1.5 * h * h
+    c2, c3 = hermite_cubic(g0, d0, g1, d1, h)
+    assert c2 == pytest.approx(3 * h * h, rel=1e-12)
+    assert c3 == pytest.approx(-0.5 * h**3, rel=1e-12)
+
+
+@pytest.mark.parametrize("h", [1.0, 0.02])
+def test_hermite_min_at_the_calculus_minimum_of_a_cubic(h):
+    # g(t) = (x - 0.4)^2 (x + 1) + 0.01, x = t/h: g'(x) = (x - 0.4)(3x + 1.6), so the
+    # minimum on [0, 1] is at x = 0.4 (g'' = 3.6 > 0), g_min = 0.01
+    def g(t):
+        x = t / h
+        return (x - 0.4) ** 2 * (x + 1.0) + 0.01
+
+    def dg(t):
+        x = t / h
+        return (x - 0.4) * (3 * x + 1.6) / h
+
+    g0, d0, g1, d1 = _ends(g, dg, h)
+    assert g0 > 0 and g1 > 0 and d0 < 0 < d1
+    tau, g_min = hermite_min(g0, d0, g1, d1, h)
+    assert tau == pytest.approx(0.4 * h, rel=1e-12)
+    assert g_min == pytest.approx(0.01, rel=1e-10)
+
+
+def test_hermite_min_of_a_quadratic_takes_the_linear_branch():
+    # g(t) = (t - 0.25)^2 + 0.1: c3 is exactly 0 (below CUBIC_TINY), c' is linear
+    g0, d0, g1, d1 = 0.1625, -0.5, 0.6625, 1.5
+    assert hermite_cubic(g0, d0, g1, d1, 1.0)[1] == 0.0
+    tau, g_min = hermite_min(g0, d0, g1, d1, 1.0)
+    assert tau == pytest.approx(0.25, rel=1e-14)
+    assert g_min == pytest.approx(0.1, rel=1e-14)
+
+
+# ------------------------------------------------------------------------------------
+# _locate with each root finder, on events with a closed-form time
+# ------------------------------------------------------------------------------------
+
+
+@njit
+def _locate_in_step(ev, t0, y0, h, s, on, prm):
+    """Take the RK4 step (t0, y0) -> t0 + h of a rigid body and locate ``ev`` in it."""
+    y1 = rk4_step(t0, y0, h, s, on, prm, False, False, False)
+    g0 = event_value(ev, t0, y0, s, on, prm, False, False)
+    g1 = event_value(ev, t0 + h, y1, s, on, prm, False, False)
+    tau, y_tau, n = _locate(ev, t0, y0, 0.0, g0, h, g1, y1, s, on, prm, False, False, False)
+    g_tau = event_value(ev, t0 + tau, y_tau, s, on, prm, False, False)
+    y_before = rk4_step(t0, y0, tau - prm[L.PAR_TOL], s, on, prm, False, False, False)
+    g_before = event_value(ev, t0 + tau - prm[L.PAR_TOL], y_before, s, on, prm, False, False)
+    return tau, n, g_tau, g_before
+
+
+def _rigid_row(root: float, tol: float) -> np.ndarray:
+    prm = np.zeros(L.N_PAR)
+    prm[L.PAR_MTOT], prm[L.PAR_G], prm[L.PAR_B], prm[L.PAR_HCG] = 1.0, 9.81, 0.2, 1.0
+    prm[L.PAR_IO] = 1.0 + 0.2**2
+    prm[L.PAR_SHAPE], prm[L.PAR_AMP], prm[L.PAR_OMEGA] = L.SHAPE_SINE, -3.0, 5.0
+    prm[L.PAR_THETA_OVER] = math.pi / 2
+    prm[L.PAR_TOL], prm[L.PAR_ROOT] = tol, root
+    return prm
+
+
+def _uplift_case(root, tol):
+    prm = _rigid_row(root, tol)
+    t_star = math.asin(9.81 * 0.2 / (1.0 * 3.0)) / 5.0  # sin(omega t*) = g b / (h_cg |A|)
+    t0, h = 0.1, 0.1
+    return prm, EV_UPLIFT_POS, t0, (0.0,) * 6, h, 0, True, t_star - t0
+
+
+def _impact_case(root, tol):
+    prm = _rigid_row(root, tol)
+    prm[L.PAR_G] = 0.0  # no gravity, no pulse: theta' constant, theta linear in t
+    theta0, w = 0.01, -0.3
+    return prm, EV_IMPACT, 0.0, (theta0, w, 0.0, 0.0, 0.0, 0.0), 0.05, 1, False, -theta0 / w
+
+
+CASES = {"uplift (sine pulse)": _uplift_case, "impact (linear theta)": _impact_case}
+
+
+@pytest.mark.parametrize("case", CASES)
+@pytest.mark.parametrize("tol", [1e-6, 1e-9])
+def test_locate_brackets_the_closed_form_root_to_the_tolerance(case, tol):
+    trials = {}
+    for name, code in ROOTS.items():
+        prm, ev, t0, y0, h, s, on, tau_star = CASES[case](code, tol)
+        tau, n, g_tau, g_before = _locate_in_step(ev, t0, y0, h, s, on, prm)
+        # the event has happened at tau and not tol before it: the root is in (tau - tol, tau]
+        assert g_tau <= 0.0 < g_before, name
+        assert -1e-15 <= tau - tau_star <= tol * (1 + 1e-6) + 1e-15, name
+        trials[name] = n
+    assert trials["bisect"] == math.ceil(math.log2(h / tol))
+    assert trials["hermite"] < trials["bisect"]
+    if case == "uplift (sine pulse)":
+        # (on the linear g the first secant lands on the root, after which every secant
+        # falls within tol/2 of that end and the safeguard bisects: no gain there)
+        assert trials["illinois"] < trials["bisect"]
+
+
+# ------------------------------------------------------------------------------------
+# The spring's rate while rocking (one definition, used by the step size and the reference)
+# ------------------------------------------------------------------------------------
+
+
+def test_rocking_spring_omega_matches_the_model_at_lever_arm_b_and_is_largest_at_zero():
+    body = FlexibleBody(wn_over_p=2.43, zeta=0.05, alpha_cg=0.15, alpha_A=0.28,
+                        mA_over_m=0.47, IA_ratio=0.56)
+    i_a0 = body.I_A + body.m_A * body.R_A**2
+    at_b = rocking_spring_omega(body.omega_n, 0.0, body.m, body.h, i_a0, body.b)
+    # model.omega_rock: omega_n sqrt(I_O / (I_A + m_A R_A^2 + m b^2)), written from I_O
+    assert at_b == pytest.approx(body.omega_rock, rel=1e-13)
+    assert body_omega_rock(body) > at_b
+    # overdamped (zeta sqrt(Gamma) > 1): the fast root omega (zeta' + sqrt(zeta'^2 - 1))
+    gamma = 1 + body.m * body.h**2 / i_a0
+    z = 0.9
+    zr = z * math.sqrt(gamma)
+    assert zr > 1
+    fast = body.omega_n * math.sqrt(gamma) * (zr + math.sqrt(zr * zr - 1))
+    assert rocking_spring_omega(body.omega_n, z, body.m, body.h, i_a0, 0.0) == pytest.approx(
+        fast, rel=1e-13)
