@@ -1,4 +1,7 @@
-"""Shared fixtures: the paper's bodies (Tables 2 and 3) and a CLI runner."""
+"""Shared fixtures: the paper's bodies (Tables 2 and 3), a CLI runner, device nodes."""
+
+import os
+import stat
 
 import pytest
 from click.testing import CliRunner
@@ -30,3 +33,18 @@ def body_fig4() -> FlexibleBody:
 @pytest.fixture()
 def cli():
     return CliRunner()
+
+
+@pytest.fixture()
+def device_node(tmp_path):
+    """make(name, minor) -> a character device in tmp_path with the numbers of /dev/null
+    (1, 3) or /dev/full (1, 7). Tests of device refusal write at these, never at the
+    machine's own /dev/null: a regression then replaces a node in tmp_path, not /dev/null
+    (it happened once during development). Needs root (CAP_MKNOD), as CI has."""
+
+    def make(name: str = "null.h5", minor: int = 3):
+        path = tmp_path / name
+        os.mknod(path, 0o666 | stat.S_IFCHR, os.makedev(1, minor))
+        return path
+
+    return make

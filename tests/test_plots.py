@@ -1,6 +1,8 @@
 """Figures: `rocksweep plot` over any swept axes, 1-D line plots, the output policy of
 figures, Figure-returning functions, and no matplotlib backend switch."""
 
+import os
+import stat
 import subprocess
 import sys
 from pathlib import Path
@@ -157,7 +159,8 @@ def test_plot_unknown_axis_is_one_line_listing_the_swept_axes(cli, acg_result, t
     assert not fig.exists()
 
 
-def test_plot_refuses_an_existing_output_and_leaves_it_untouched(cli, acg_result, tmp_path):
+def test_plot_refuses_an_existing_output_and_leaves_it_untouched(cli, acg_result, tmp_path,
+                                                                  device_node):
     fig = tmp_path / "f.png"
     fig.write_bytes(b"precious")
     msg = one_line_error(cli.invoke(main, ["plot", str(acg_result), "-o", str(fig)]))
@@ -167,9 +170,12 @@ def test_plot_refuses_an_existing_output_and_leaves_it_untouched(cli, acg_result
     assert res.exit_code == 0, res.output
     assert fig.read_bytes().startswith(b"\x89PNG")
     # a device is refused even with --overwrite
-    msg = one_line_error(cli.invoke(main, ["plot", str(acg_result), "-o", "/dev/null",
+    dev = device_node("null.png")
+    msg = one_line_error(cli.invoke(main, ["plot", str(acg_result), "-o", str(dev),
                                            "--overwrite"]))
-    assert msg.startswith("Error: /dev/null: ")
+    assert msg == (f"Error: {dev}: not a regular file (a device, FIFO or socket); outputs "
+                   "are written to regular files only")
+    assert stat.S_ISCHR(os.stat(dev).st_mode)
     msg = one_line_error(cli.invoke(main, ["plot", str(acg_result), "-o",
                                            str(tmp_path / "no" / "f.png")]))
     assert msg == f"Error: {tmp_path / 'no' / 'f.png'}: directory {tmp_path / 'no'} does not exist"
@@ -284,7 +290,7 @@ def test_work_precision_returns_two_axes(tmp_path):
     assert "root finder: hermite" in fig.get_suptitle()
 
 
-def test_save_figure_policy(tmp_path):
+def test_save_figure_policy(tmp_path, device_node):
     from rocksweep.plots import save_figure
 
     fig = Figure()
@@ -295,9 +301,11 @@ def test_save_figure_policy(tmp_path):
         save_figure(fig, out)
     with pytest.raises(RocksweepError, match=r"unsupported file type '\.gif'"):
         save_figure(fig, tmp_path / "a.gif")
-    with pytest.raises(RocksweepError, match="^/dev/null: "):
-        save_figure(fig, "/dev/null", overwrite=True)
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.svg"]
+    dev = device_node("null.png")
+    with pytest.raises(RocksweepError, match="not a regular file"):
+        save_figure(fig, dev, overwrite=True)
+    assert stat.S_ISCHR(os.stat(dev).st_mode)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.svg", "null.png"]
 
 
 def test_no_backend_switch_and_no_pyplot():
