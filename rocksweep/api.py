@@ -223,6 +223,12 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
     where = (f"{n_workers} worker{'s' * (n_workers > 1)}" if backend == "threads"
              else f"dask cluster {scheduler}")
     how = f"threads x {n_workers}" if backend == "threads" else f"dask {scheduler}"
+    try:
+        path.stat()
+    except FileNotFoundError:
+        pass
+    except OSError:  # a name too long, a path through a file...: one line, not a traceback
+        check_output(path, overwrite=overwrite, inputs=inputs)
     if resume and path.exists():
         check_output(path, overwrite=True, inputs=inputs)
         sf = SweepFile.resume(path, scene, overrides, backend=how)
