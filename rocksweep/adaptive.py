@@ -39,6 +39,7 @@ import math
 import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -106,7 +107,7 @@ class Plan:
                                                               self.full_shape[self.x]))
         if not (isinstance(self.coarse, int | np.integer) and 0 <= self.coarse <= 20):
             raise AdaptiveError(f"coarse = {self.coarse!r}: must be an integer in [0, 20]")
-        for name in ("margin", "final_margin"):
+        for name in ("margin", "final_margin", "seed"):
             v = getattr(self, name)
             if not (isinstance(v, int | np.integer) and v >= 0):
                 raise AdaptiveError(f"{name} = {v!r}: must be an integer >= 0")
@@ -152,8 +153,8 @@ def make_plan(grid_or_scene: Grid | Scene, axes: Sequence[str] = DIAGRAM_AXES,
     ``default_coarse`` of the grid. Raises AdaptiveError naming a bad axis."""
     scene = grid_or_scene.scene if isinstance(grid_or_scene, Grid) else grid_or_scene
     names = [a.name for a in scene.axes]
-    if len(axes) != 2:
-        raise AdaptiveError(f"axes = {list(axes)}: give two axis names (x, y)")
+    if isinstance(axes, str) or len(axes) != 2:
+        raise AdaptiveError(f"axes = {axes!r}: give two axis names (x, y)")
     pos = []
     for name in axes:
         if name not in names:
@@ -166,8 +167,65 @@ def make_plan(grid_or_scene: Grid | Scene, axes: Sequence[str] = DIAGRAM_AXES,
         pos.append(names.index(name))
     full_shape = tuple(len(a.values) for a in scene.axes)
     return Plan(full_shape, pos[0], pos[1], (str(axes[0]), str(axes[1])),
-                None if coarse is None else int(coarse),
-                int(margin), float(audit), int(seed), int(final_margin))
+                None if coarse is None else _integer("coarse", coarse),
+                _integer("margin", margin), _share("audit", audit), _integer("seed", seed),
+                _integer("final_margin", final_margin))
+
+
+def _integer(name: str, v: Any) -> int:
+    if isinstance(v, bool) or not isinstance(v, int | np.integer):
+        raise AdaptiveError(f"{name} = {v!r}: must be an integer")
+    return int(v)
+
+
+def _share(name: str, v: Any) -> float:
+    if (isinstance(v, bool) or not isinstance(v, int | float | np.number)
+            or not 0.0 <= float(v) <= 1.0):
+        raise AdaptiveError(f"{name} = {v!r}: must be a share in [0, 1]")
+    return float(v)
+
+
+@dataclass(frozen=True)
+class Options:
+    """Settings of an adaptive sweep as a user gives them (``rocksweep sweep --adaptive``,
+    ``rocksweep.run(..., adaptive=True)``). axes: (x, y) diagram axis names; coarse: None
+    for ``default_coarse``; audit: share of points audited, in [0, 1]; threshold: share of
+    disagreeing audit points above which a run warns, in [0, 1]; margin, final_margin,
+    seed: see ``Plan``."""
+
+    axes: tuple[str, str] = DIAGRAM_AXES
+    coarse: int | None = None
+    audit: float = DEFAULT_AUDIT
+    margin: int = DEFAULT_MARGIN
+    final_margin: int = DEFAULT_FINAL_MARGIN
+    seed: int = DEFAULT_SEED
+    threshold: float = DEFAULT_AUDIT_THRESHOLD
+
+    def __post_init__(self) -> None:
+        _share("threshold", self.threshold)
+
+    def plan(self, grid_or_scene: Grid | Scene) -> Plan:
+        """The plan of a grid (AdaptiveError for bad axes or settings)."""
+        return make_plan(grid_or_scene, self.axes, self.coarse, self.margin, self.audit,
+                         self.seed, self.final_margin)
+
+    def resolved(self, grid_or_scene: Grid | Scene) -> dict[str, Any]:
+        """The settings that decide the result, the default coarse level resolved: what a
+        result file records and a resume compares (plain JSON values)."""
+        p = self.plan(grid_or_scene)
+        return {"axes": list(p.names), "coarse": int(p.coarse), "margin": int(p.margin),
+                "final_margin": int(p.final_margin), "audit": float(p.audit),
+                "seed": int(p.seed), "threshold": float(self.threshold)}
+
+    @classmethod
+    def from_resolved(cls, d: dict[str, Any]) -> Options:
+        """Options from ``resolved`` (as read from a result file)."""
+        return cls(tuple(d["axes"]), int(d["coarse"]), float(d["audit"]),
+                   int(d["margin"]), int(d["final_margin"]), int(d["seed"]),
+                   float(d["threshold"]))
+
+
+RESOLVED_KEYS = ("axes", "coarse", "margin", "final_margin", "audit", "seed", "threshold")
 
 
 def default_coarse(ny: int, nx: int) -> int:
@@ -401,6 +459,51 @@ def fill(plan: Plan, outcome: np.ndarray, computed: np.ndarray) -> np.ndarray:
     return flat
 
 
+def audit_before(plan: Plan, outcome: np.ndarray, computed: np.ndarray) -> np.ndarray:
+    """int8[size]: the fill that audit points are compared with: ``fill`` of the state
+    before the audit batch, i.e. of the points computed with flag COMPUTED alone.
+
+    Before the audit batch every computed point has flag COMPUTED, so this is ``fill`` of
+    the state; during the batch (a resumed sweep) the audit points already computed
+    (AUDIT, AUDIT_MISS) are left out, so the flags of an interrupted and resumed audit
+    equal those of an uninterrupted one.
+    """
+    base = (np.asarray(computed).ravel() == COMPUTED).astype(np.int8)
+    return fill(plan, outcome, base)
+
+
+@dataclass(frozen=True)
+class Step:
+    """What to compute next: the batch, and for an audit batch the fill its points are
+    compared with (``audit_before``, int8[size]; None otherwise)."""
+
+    batch: Batch
+    before: np.ndarray | None = None
+
+    def flags(self, flat: np.ndarray, classes: np.ndarray) -> np.ndarray:
+        """int8[n]: the ``computed`` flags of the points ``flat`` (a subset of the batch)
+        computed with ``classes``."""
+        if self.before is None:
+            return np.full(np.shape(flat), COMPUTED, np.int8)
+        return audit_flags(self.before[flat], classes)
+
+
+def next_step(plan: Plan, outcome: np.ndarray, computed: np.ndarray) -> Step:
+    """``next_batch``, except that an audit batch, once begun (some point flagged AUDIT or
+    AUDIT_MISS while audit candidates are still filled), is finished before refinement
+    resumes: the audit is one batch whatever interrupted it, so a resumed sweep computes
+    the same points with the same flags as an uninterrupted one. Pure function of the
+    state, like ``next_batch``."""
+    c = np.asarray(computed).ravel()
+    if plan.audit > 0 and np.any(c >= AUDIT):
+        missing = np.flatnonzero(audit_mask(plan) & (c == FILLED))
+        if missing.size:
+            return Step(Batch(missing.astype(np.int64), "audit", 1),
+                        audit_before(plan, outcome, c))
+    b = next_batch(plan, outcome, c)
+    return Step(b, audit_before(plan, outcome, c) if b.kind == "audit" else None)
+
+
 def audit_flags(filled_before: np.ndarray, outcome: np.ndarray) -> np.ndarray:
     """int8[n]: AUDIT where the computed class equals the fill it replaces, else
     AUDIT_MISS. filled_before: ``fill(...)`` of the state before the audit batch, at the
@@ -477,13 +580,13 @@ def drive(plan: Plan, evaluate: Callable[[np.ndarray, Batch], np.ndarray],
                 else np.asarray(computed, np.int8).ravel().copy())
     batches = []
     while True:
-        b = next_batch(plan, outcome, computed)
+        step = next_step(plan, outcome, computed)
+        b = step.batch
         if b.kind == "done":
             break
-        before = fill(plan, outcome, computed)[b.flat] if b.kind == "audit" else None
         cls = np.asarray(evaluate(b.flat, b), np.int8)
         outcome[b.flat] = cls
-        computed[b.flat] = COMPUTED if before is None else audit_flags(before, cls)
+        computed[b.flat] = step.flags(b.flat, cls)
         batches.append((b.kind, b.stride, len(b)))
     filled = fill(plan, outcome, computed)
     st = stats_of(computed, threshold)

@@ -25,6 +25,7 @@ if TYPE_CHECKING:
     import xarray as xr
     from matplotlib.figure import Figure
 
+    from rocksweep.adaptive import AdaptiveStats, Options
     from rocksweep.scene import Scene
     from rocksweep.single import Run
 
@@ -142,6 +143,7 @@ class SweepReport:
     cpu_s: float
     compile_s: float
     attrs: dict = field(default_factory=dict)
+    adaptive: AdaptiveStats | None = None  # adaptive sweeps: the file's counts
 
     @property
     def points_done(self) -> int:
@@ -180,7 +182,8 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
                backend: str = "threads", scheduler: str | None = None,
                chunk_size: int | None = None, write_every: float = WRITE_EVERY,
                progress: bool = False, log: Callable[[str], None] | None = None,
-               inputs: Iterable[str | Path] = ()) -> SweepReport:
+               inputs: Iterable[str | Path] = (), adaptive: Options | None = None
+               ) -> SweepReport:
     """Sweep ``scene`` into the result file ``path`` (``rocksweep sweep``).
 
     Makes the file (refusing an existing one unless ``overwrite``), or with ``resume``
@@ -193,7 +196,9 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
     ``scheduler``, an address); chunk_size: points per chunk (default about 32 chunks per
     worker); progress: a progress bar on stderr; log: receives the header and kernel
     lines; inputs: the command's input files, never written over; overrides: recorded in
-    the file. Returns a ``SweepReport``.
+    the file; adaptive: compute only near the class boundaries (``rocksweep.adaptive``,
+    see ``_adaptive_loop``; the file records the settings, and a resume must give the
+    same). Returns a ``SweepReport``.
     """
     from rocksweep import sweep as sw
     from rocksweep.outputs import OutputError, check_output
@@ -215,6 +220,11 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
     else:
         raise ApiError(f"backend = {backend!r}: must be threads or dask")
     say = log or (lambda _line: None)
+    settings = None
+    if adaptive is not None:
+        from rocksweep.grid import Grid
+
+        settings = adaptive.resolved(Grid(scene))  # bad axes or settings: before any file
 
     from rocksweep.store import SweepFile
 
@@ -231,61 +241,23 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
         check_output(path, overwrite=overwrite, inputs=inputs)
     if resume and path.exists():
         check_output(path, overwrite=True, inputs=inputs)
-        sf = SweepFile.resume(path, scene, overrides, backend=how)
+        sf = SweepFile.resume(path, scene, overrides, backend=how, adaptive=settings)
     else:
         if path.is_file() and not overwrite:
             raise OutputError(f"{path}: already exists; use --resume to finish it or "
                               "--overwrite to replace it")
         check_output(path, overwrite=overwrite, inputs=inputs)
-        sf = SweepFile.create(path, scene, overrides, overwrite=overwrite, backend=how)
+        sf = SweepFile.create(path, scene, overrides, overwrite=overwrite, backend=how,
+                              adaptive=settings)
     report = SweepReport(path, sf.grid.size, 0, 0, 0.0, 0.0, 0.0)
-    pending: list = []  # finished chunks not yet in the file
-
-    def write_pending() -> None:
-        for merged in sw.merge_contiguous(pending):
-            sf.write(merged)
-        pending.clear()
-
+    pending: list = []  # finished chunks not yet in the file (each loop writes its own)
+    loop = _every_point_loop if adaptive is None else _adaptive_loop
     try:
-        done = sf.done()
-        report.done_before = int(done.sum())
-        todo = int((~done).sum())
-        size = chunk_size or sw.auto_chunk_size(todo, n_workers)
-        chunks = sw.plan_chunks(~done, size)
-        dims = " x ".join(f"{len(a.values)} {a.name}" for a in scene.swept) or "1 point"
-        say(f"{scene.name}: {sf.grid.size} points ({dims}); {report.done_before} done, "
-            f"{todo} to compute on {where}; accuracy {scene.numerics.describe()}")
-        lvl = sw.level(scene)
-        if todo:
-            to_compile, unknown = sw.kernel_cache_state(sf.grid, lvl)
-            if to_compile:
-                say(f"compiling the kernel (once per machine, "
-                    f"~{to_compile * sw.COMPILE_SECONDS:.0f} s)...")
-            elif unknown:
-                say("loading or compiling the kernel...")
-            t_prep = time.perf_counter()
-            sw.prepare(sf.grid, lvl)  # compile, or load numba's cache, once
-            report.compile_s = time.perf_counter() - t_prep
-            if to_compile or unknown or report.compile_s > 1.0:
-                how = "compiled" if to_compile else "compiled or loaded from numba's cache"
-                say(f"kernel {how} in {report.compile_s:.1f} s")
-        from tqdm import tqdm
-
-        with tqdm(total=todo, unit="pt", disable=not progress, file=sys.stderr,
-                  smoothing=0.1, dynamic_ncols=True) as bar:
-            t_write = time.perf_counter()
-            for res in sw.run_chunks(sf.grid, chunks, lvl, jobs, backend, scheduler):
-                pending.append(res)
-                report.cpu_s += res.cpu_seconds
-                report.computed += res.stop - res.start
-                bar.update(res.stop - res.start)
-                if time.perf_counter() - t_write >= write_every:
-                    write_pending()
-                    t_write = time.perf_counter()
-            write_pending()
+        loop(sf, report, adaptive, jobs=jobs, backend=backend, scheduler=scheduler,
+             chunk_size=chunk_size, where=where, write_every=write_every,
+             progress=progress, say=say, pending=pending)
     except BaseException as err:
         try:
-            write_pending()
             report.wall_s = time.perf_counter() - t0
             report.attrs = sf.finish(report.wall_s, report.cpu_s)
         finally:
@@ -299,6 +271,154 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
     return report
 
 
+def _every_point_loop(sf, report: SweepReport, _options: None, *, jobs: int, backend: str,
+                      scheduler: str | None, chunk_size: int | None, where: str,
+                      write_every: float, progress: bool, say: Callable[[str], None],
+                      pending: list) -> None:
+    """Compute every missing point of an open file, writing finished chunks every
+    ``write_every`` seconds (and the pending ones whatever ends the loop)."""
+    from tqdm import tqdm
+
+    from rocksweep import sweep as sw
+
+    scene = sf.grid.scene
+
+    def write_pending() -> None:
+        for merged in sw.merge_contiguous(pending):
+            sf.write(merged)
+        pending.clear()
+
+    try:
+        done = sf.done()
+        report.done_before = int(done.sum())
+        todo = int((~done).sum())
+        n_workers = sw.effective_jobs(jobs) if backend == "threads" else 1
+        size = chunk_size or sw.auto_chunk_size(todo, n_workers)
+        chunks = sw.plan_chunks(~done, size)
+        dims = " x ".join(f"{len(a.values)} {a.name}" for a in scene.swept) or "1 point"
+        say(f"{scene.name}: {sf.grid.size} points ({dims}); {report.done_before} done, "
+            f"{todo} to compute on {where}; accuracy {scene.numerics.describe()}")
+        lvl = sw.level(scene)
+        if todo:
+            _prepare_kernel(sf, lvl, report, say)
+        with tqdm(total=todo, unit="pt", disable=not progress, file=sys.stderr,
+                  smoothing=0.1, dynamic_ncols=True) as bar:
+            t_write = time.perf_counter()
+            for res in sw.run_chunks(sf.grid, chunks, lvl, jobs, backend, scheduler):
+                pending.append(res)
+                report.cpu_s += res.cpu_seconds
+                report.computed += res.stop - res.start
+                bar.update(res.stop - res.start)
+                if time.perf_counter() - t_write >= write_every:
+                    write_pending()
+                    t_write = time.perf_counter()
+    finally:
+        write_pending()
+
+
+def _prepare_kernel(sf, lvl: int, report: SweepReport, say: Callable[[str], None]) -> None:
+    """Compile or load the kernel variants the grid needs, saying what happens."""
+    from rocksweep import sweep as sw
+
+    to_compile, unknown = sw.kernel_cache_state(sf.grid, lvl)
+    if to_compile:
+        say(f"compiling the kernel (once per machine, "
+            f"~{to_compile * sw.COMPILE_SECONDS:.0f} s)...")
+    elif unknown:
+        say("loading or compiling the kernel...")
+    t_prep = time.perf_counter()
+    sw.prepare(sf.grid, lvl)
+    report.compile_s = time.perf_counter() - t_prep
+    if to_compile or unknown or report.compile_s > 1.0:
+        how = "compiled" if to_compile else "compiled or loaded from numba's cache"
+        say(f"kernel {how} in {report.compile_s:.1f} s")
+
+
+def _adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backend: str,
+                   scheduler: str | None, chunk_size: int | None, where: str,
+                   write_every: float, progress: bool, say: Callable[[str], None],
+                   pending: list) -> None:
+    """The adaptive sweep of an open file (``rocksweep.adaptive``).
+
+    The state (outcome, computed) is read from the file; ``adaptive.next_step`` plans a
+    batch from it; the batch runs through ``adaptive.run_batch`` (the chunk machinery:
+    threads or dask); each chunk's points are written with their ``computed`` flags
+    (batched every ``write_every`` seconds, and whatever ends the loop) and the
+    in-memory state updated; until the plan says "done". Then the
+    filled classes go into ``outcome`` and the counts into the attributes, so a resume
+    of a finished file stops at once. A file killed at any moment resumes to the same
+    result (see ``adaptive.next_step``).
+    """
+    import numpy as np
+    from tqdm import tqdm
+
+    from rocksweep import adaptive as ad
+    from rocksweep import sweep as sw
+
+    scene = sf.grid.scene
+    plan = options.plan(sf.grid)
+    outcome, computed = sf.state()
+    report.done_before = int((computed > ad.FILLED).sum())
+    dims = " x ".join(f"{len(a.values)} {a.name}" for a in scene.swept)
+    say(f"{scene.name}: {sf.grid.size} points ({dims}); adaptive over {plan.names[0]} x "
+        f"{plan.names[1]} (coarse level {plan.coarse}: stride {2 ** plan.coarse}, "
+        f"audit {100 * plan.audit:g}%); {report.done_before} computed before; on {where}; "
+        f"accuracy {scene.numerics.describe()}")
+    lvl = sw.level(scene)
+    pending_flags: list = []
+
+    def write_pending() -> None:
+        if not pending:
+            return
+        flat = np.concatenate([r.flat for r in pending])
+        order = np.argsort(flat, kind="stable")
+        arrays = {k: np.concatenate([r.arrays[k] for r in pending])[order]
+                  for k in pending[0].arrays}
+        flags = np.concatenate(pending_flags)[order]
+        sf.write_points(flat[order], arrays, flags)
+        pending.clear()
+        pending_flags.clear()
+
+    prepared = False
+    with tqdm(total=0, unit="pt", disable=not progress, file=sys.stderr, smoothing=0.1,
+              dynamic_ncols=True) as bar:
+        t_write = time.perf_counter()
+        try:
+            while True:
+                step = ad.next_step(plan, outcome, computed)
+                b = step.batch
+                if b.kind == "done":
+                    break
+                if not prepared:
+                    _prepare_kernel(sf, lvl, report, say)
+                    prepared = True
+                bar.total += len(b)  # the work grows as refinement finds boundaries
+                bar.set_description(b.kind if b.kind != "refine" else f"refine {b.stride}")
+                bar.refresh()
+                for res in ad.run_batch(sf.grid, b.flat, jobs, chunk_size, backend,
+                                        scheduler):
+                    flags = step.flags(res.flat, res.arrays["outcome"])
+                    pending.append(res)
+                    pending_flags.append(flags)
+                    outcome[res.flat] = res.arrays["outcome"]
+                    computed[res.flat] = flags
+                    report.cpu_s += res.cpu_seconds
+                    report.computed += len(res.flat)
+                    bar.update(len(res.flat))
+                    if time.perf_counter() - t_write >= write_every:
+                        write_pending()
+                        t_write = time.perf_counter()
+                write_pending()
+        finally:
+            write_pending()
+    stats = ad.stats_of(computed, options.threshold)
+    sf.write_filled(ad.fill(plan, outcome, computed),
+                    {"points_computed": stats.computed,
+                     "points_filled": stats.points - stats.computed,
+                     "points_audited": stats.audited, "audit_misses": stats.audit_misses})
+    report.adaptive = stats
+
+
 # ---------------------------------------------------------------------------------------
 # rocksweep.run and rocksweep.open
 # ---------------------------------------------------------------------------------------
@@ -309,7 +429,9 @@ def _stderr(line: str) -> None:
 
 def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
         overrides: Overrides = (), progress: bool = False, overwrite: bool = False,
-        resume: bool = False) -> xr.Dataset:
+        resume: bool = False, adaptive: bool = False, coarse: int | None = None,
+        audit: float | None = None, axes: Sequence[str] | None = None,
+        **adaptive_settings: Any) -> xr.Dataset:
     """Compute every point of a scene's grid; return the results as an xarray Dataset.
 
     scene: a path to a scene YAML file, YAML text, or a dict with the YAML's structure.
@@ -326,10 +448,21 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
     the unswept keys as scalar coordinates and the file's attributes (see ``open``). It
     is loaded in memory; without ``output`` no file is kept.
 
+    adaptive: compute only near the class boundaries (``rocksweep.adaptive``; the same
+    as ``rocksweep sweep --adaptive``): coarse: the coarse level (every 2**coarse-th
+    point of the diagram axes first; default: 16 coarse cells per axis); audit: share of
+    the filled points computed as a check (default 0.02); axes: the two diagram axes
+    (default ("w_over_p", "A_ratio")); further settings as keywords (margin,
+    final_margin, seed, threshold: see ``rocksweep.adaptive.Options``). The Dataset then
+    also has ``computed`` (0 filled, 1 computed, 2/3 audit point that agreed/disagreed)
+    and filled points hold their "not computed" values in every variable but outcome.
+
     Raises a one-line ``RocksweepError`` for a bad scene, option or output path;
     KeyboardInterrupt (``SweepInterrupted``) after saving the finished points to
     ``output``.
     """
+    opts = adaptive_options(adaptive, coarse=coarse, audit=audit, axes=axes,
+                            **adaptive_settings)
     sc, source = load(scene, overrides)
     ov = override_strings(overrides)
     log = _stderr if progress else None
@@ -340,11 +473,37 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
 
         with tempfile.TemporaryDirectory(prefix="rocksweep-") as tmp:
             path = Path(tmp) / "result.h5"
-            sweep_file(sc, path, overrides=ov, jobs=jobs, progress=progress, log=log)
+            sweep_file(sc, path, overrides=ov, jobs=jobs, progress=progress, log=log,
+                       adaptive=opts)
             return open(path)
     sweep_file(sc, output, overrides=ov, jobs=jobs, resume=resume, overwrite=overwrite,
-               progress=progress, log=log, inputs=[source] if source else ())
+               progress=progress, log=log, inputs=[source] if source else (),
+               adaptive=opts)
     return open(output)
+
+
+def adaptive_options(adaptive: bool, **settings: Any) -> Options | None:
+    """``rocksweep.adaptive.Options`` from keyword settings (None values: the defaults);
+    None when not ``adaptive``, then any setting given is an ApiError."""
+    from rocksweep.adaptive import Options
+
+    given = {k: v for k, v in settings.items() if v is not None}
+    known = {"coarse", "audit", "axes", "margin", "final_margin", "seed", "threshold"}
+    unknown = sorted(set(given) - known)
+    if unknown:
+        raise ApiError(f"{unknown[0]} = {given[unknown[0]]!r}: not a setting of an adaptive "
+                       f"sweep (settings: {', '.join(sorted(known))})")
+    if not adaptive:
+        if given:
+            k = sorted(given)[0]
+            raise ApiError(f"{k} = {given[k]!r}: an adaptive setting; add adaptive=True")
+        return None
+    if "axes" in given:
+        axes = given["axes"]
+        if isinstance(axes, str):
+            axes = [a.strip() for a in axes.split(",")]
+        given["axes"] = tuple(axes)
+    return Options(**given)
 
 
 def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xarray's)

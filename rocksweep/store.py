@@ -14,6 +14,17 @@ netCDF-4 readers open it):
   everything else, which is a pure number: Pi groups, counts, theta/alpha_ref, energies
   / E_ref, and times p*t (``t_overturn``: its ``long_name`` says p*t, its
   ``rocksweep_units`` the scale, here ``"1/p"``);
+- adaptive sweeps (``rocksweep sweep --adaptive``, ``rocksweep.adaptive``) add an int8
+  variable ``computed`` (0 filled: the point was not computed, its ``outcome`` is the class
+  of the uniform cell around it and every other variable keeps its "not computed" fill
+  value; 1 computed; 2 an audit point that agreed with its fill; 3 one that disagreed; CF
+  ``flag_values``/``flag_meanings``), the settings as attributes ``adaptive`` (int8 1),
+  ``adaptive_axes``, ``adaptive_coarse``, ``adaptive_margin``, ``adaptive_final_margin``,
+  ``adaptive_audit``, ``adaptive_seed``, ``adaptive_threshold`` (also in the resolved
+  scene, so a resume with other settings is refused), and the counts ``points_computed``,
+  ``points_filled``, ``points_audited``, ``audit_misses`` (fixed size, updated in place).
+  While an adaptive sweep runs, ``outcome`` is -1 at the points not decided yet; its
+  last session writes the filled classes;
 - global attributes: ``Conventions`` (``CF-1.10``), ``title``, ``source``, ``history``
   (one line per session: time, host, backend, rocksweep version, points done), the scene
   YAML verbatim and its resolved form, the resolved numerics, versions, times, totals,
@@ -106,6 +117,21 @@ SESSION_ATTRS: dict[str, str] = {
     "history": f"S{HISTORY_BYTES}",
 }
 
+# Counts an adaptive sweep updates at the end of every session (in place, like
+# SESSION_ATTRS): from ``rocksweep.adaptive.stats_of`` of the ``computed`` flags.
+ADAPTIVE_COUNT_ATTRS: dict[str, str] = {
+    "points_computed": "int64",
+    "points_filled": "int64",
+    "points_audited": "int64",
+    "audit_misses": "int64",
+}
+# The ``computed`` variable of adaptive sweeps: (dtype, fill, description), flag meanings.
+COMPUTED_VARIABLE = ("int8", 0, "adaptive sweep: 0 filled (not computed; outcome from the "
+                     "uniform cell around the point, other variables at their fill "
+                     "values), 1 computed, 2 audit point that agreed with its fill, 3 "
+                     "audit point that disagreed (region refined)")
+COMPUTED_FLAGS = {0: "filled", 1: "computed", 2: "audit_agreed", 3: "audit_disagreed"}
+
 # long names of the coordinates (the paper's symbols)
 COORD_LONG_NAMES = {
     "shape": "pulse shape",
@@ -124,7 +150,7 @@ COORD_LONG_NAMES = {
 # CF units of the coordinates: angles in radians, the other Pi groups are pure numbers.
 COORD_UNITS = {"alpha_cg": "rad", "alpha_A": "rad", "alpha": "rad"}
 # Variables whose values are codes (CF flag_values / flag_masks): no units.
-FLAG_VARIABLES = ("outcome", "status")
+FLAG_VARIABLES = ("outcome", "status", "computed")
 # rocksweep's own unit of a variable where it is not plainly "1" (the CF units are "1":
 # each is a ratio). TODO(fields.py): read ``rocksweep.fields.UNITS`` once fields.py is
 # committed; it holds these same strings.
@@ -182,9 +208,12 @@ def versions() -> dict[str, str]:
             "python": platform.python_version()}
 
 
-def resolved_scene(scene: Scene, overrides: tuple[str, ...] | list[str] = ()) -> dict:
-    """What decides a sweep's results (plus its name): the basis of resume checks."""
-    return {
+def resolved_scene(scene: Scene, overrides: tuple[str, ...] | list[str] = (),
+                   adaptive: dict | None = None) -> dict:
+    """What decides a sweep's results (plus its name): the basis of resume checks.
+    adaptive: the resolved settings of an adaptive sweep (``adaptive.Options.resolved``),
+    None for a sweep of every point (then no ``adaptive`` key)."""
+    d = {
         "name": scene.name,
         "kind": scene.kind,
         "axes": {a.key: {"values": list(a.values), "swept": a.swept} for a in scene.axes},
@@ -192,6 +221,17 @@ def resolved_scene(scene: Scene, overrides: tuple[str, ...] | list[str] = ()) ->
         "energy": scene.energy,
         "overrides": list(overrides),
     }
+    if adaptive is not None:
+        d["adaptive"] = dict(adaptive)
+    return d
+
+
+def _adaptive_words(a: dict) -> str:
+    """Adaptive settings as the command-line options that give them."""
+    return (f"--adaptive --axes {','.join(a.get('axes', []))} --coarse {a.get('coarse')} "
+            f"--audit {a.get('audit')!r} --margin {a.get('margin')} --final-margin "
+            f"{a.get('final_margin')} --seed {a.get('seed')} --threshold "
+            f"{a.get('threshold')!r}")
 
 
 def _short(v) -> str:
@@ -221,6 +261,16 @@ def scene_differences(stored: dict, new: dict) -> list[str]:
     for key in dict.fromkeys([*sn, *nn]):
         if sn.get(key) != nn.get(key):
             diffs.append(f"numerics.{key}: file {sn.get(key)!r}, scene {nn.get(key)!r}")
+    sa, na = stored.get("adaptive"), new.get("adaptive")
+    if sa is not None and na is None:
+        diffs.append(f"adaptive: file adaptive ({_adaptive_words(sa)}), this run not")
+    elif sa is None and na is not None:
+        diffs.append("adaptive: file of every point, this run adaptive")
+    elif sa != na:
+        for key in dict.fromkeys([*sa, *na]):
+            if sa.get(key) != na.get(key):
+                diffs.append(f"adaptive.{key}: file {sa.get(key)!r}, this run "
+                             f"{na.get(key)!r}")
     return diffs
 
 
@@ -254,11 +304,13 @@ def flat_slabs(shape: tuple[int, ...], start: int, stop: int) -> list[tuple[tupl
     return out
 
 
-def file_bytes(scene: Scene) -> int:
+def file_bytes(scene: Scene, adaptive: bool = False) -> int:
     """Bytes the datasets of a result file of ``scene`` take (all allocated when the
-    file is made): every variable's dtype size x grid points, plus the coordinates."""
+    file is made): every variable's dtype size x grid points, plus the coordinates;
+    adaptive: with the ``computed`` flags."""
     grid = Grid(scene)
     per_point = sum(np.dtype(dt).itemsize for dt, _, _ in variables(scene).values())
+    per_point += adaptive
     coords = sum(16 * len(a.values) for a in scene.axes)
     return per_point * grid.size + coords
 
@@ -345,6 +397,19 @@ def _check_scene(stored, path: Path) -> None:
             raise bad(f"axis {key} has values {_cut(ax['values'])}")
         if not ax["swept"] and len(ax["values"]) != 1:
             raise bad(f"unswept axis {key} has {len(ax['values'])} values")
+    if "adaptive" in stored:
+        a = stored["adaptive"]
+        from rocksweep.adaptive import RESOLVED_KEYS
+
+        ok = (isinstance(a, dict) and set(a) == set(RESOLVED_KEYS)
+              and isinstance(a["axes"], list) and len(a["axes"]) == 2
+              and all(isinstance(v, str) for v in a["axes"])
+              and all(isinstance(a[k], int) and not isinstance(a[k], bool) and a[k] >= 0
+                      for k in ("coarse", "margin", "final_margin", "seed"))
+              and all(isinstance(a[k], int | float) and not isinstance(a[k], bool)
+                      and 0 <= a[k] <= 1 for k in ("audit", "threshold")))
+        if not ok:
+            raise bad(f"'adaptive' is {_cut(a)}")
 
 
 def _json_attr(f: h5py.File, key: str, path: Path, typ: type):
@@ -444,10 +509,12 @@ def _check_format(f: h5py.File, path: Path) -> None:
 
 
 def variables_for(stored: dict) -> dict:
-    """The per-point variables of a file from its resolved scene."""
+    """The per-point variables of a file from its resolved scene (``computed`` in the
+    files of adaptive sweeps)."""
     from rocksweep.sweep import ENERGY_VARIABLES, VARIABLES
 
-    return {**VARIABLES, **(ENERGY_VARIABLES if stored.get("energy") else {})}
+    return {**VARIABLES, **(ENERGY_VARIABLES if stored.get("energy") else {}),
+            **({"computed": COMPUTED_VARIABLE} if stored.get("adaptive") else {})}
 
 
 def _is_hdf5(path: Path) -> bool:
@@ -508,7 +575,7 @@ def _fixed(text: str, dtype: str) -> np.ndarray:
 
 def _put(f: h5py.File, name: str, value) -> None:
     """Overwrite a session attribute in place (its fixed type and size)."""
-    dtype = SESSION_ATTRS[name]
+    dtype = SESSION_ATTRS.get(name) or ADAPTIVE_COUNT_ATTRS[name]
     arr = _fixed(value, dtype) if dtype.startswith("S") else np.array(value, dtype=dtype)
     f.attrs.modify(name, arr)
 
@@ -613,11 +680,12 @@ class SweepFile:
     exclusive lock until ``close``)."""
 
     def __init__(self, path: Path, f: h5py.File, scene: Scene,
-                 backend: str | None = None) -> None:
+                 backend: str | None = None, adaptive: dict | None = None) -> None:
         self.path = path
         self.f = f
         self.grid = Grid(scene)
         self.names = list(variables(scene))
+        self.adaptive = adaptive  # resolved adaptive settings, None: every point
         self.session_start = _now()
         self.backend = backend or "unspecified"
         self._history = ""  # the file's history before this session
@@ -634,8 +702,11 @@ class SweepFile:
     # -- making and reopening -------------------------------------------------------------
     @classmethod
     def create(cls, path: str | Path, scene: Scene, overrides: tuple[str, ...] = (),
-               overwrite: bool = False, *, backend: str | None = None) -> SweepFile:
+               overwrite: bool = False, *, backend: str | None = None,
+               adaptive: dict | None = None) -> SweepFile:
         """Make a new result file (all points not computed), atomically, and open it.
+        adaptive: resolved settings of an adaptive sweep (``adaptive.Options.resolved``):
+        the file gets the ``computed`` flags and the settings' attributes.
 
         Refused (StoreError) before anything is written: an existing path without
         ``overwrite``, a directory, device or FIFO, a missing directory, a grid larger
@@ -653,7 +724,8 @@ class SweepFile:
             raise StoreError(f"{shown(path)}: already exists; use --resume to finish it or "
                              "--overwrite to replace it")
         grid = Grid(scene)
-        _check_space(path, file_bytes(scene) + SPACE_MARGIN,
+        nbytes = file_bytes(scene, adaptive is not None)
+        _check_space(path, nbytes + SPACE_MARGIN,
                      f"a grid of {grid.size} points")
         old_fd = _lock_existing(path) if existed else None
         tmp: Path | None = None
@@ -664,12 +736,12 @@ class SweepFile:
                                         dir=parent)
             os.close(fd)
             tmp = Path(name)
-            reserve = file_bytes(scene) + METADATA_RESERVE + 4 * len(scene.text.encode())
+            reserve = nbytes + METADATA_RESERVE + 4 * len(scene.text.encode())
             _reserve(tmp, reserve)  # room for all of it, or ENOSPC before HDF5 writes
             g = h5py.File(tmp, "w", track_order=True)  # truncates: reserve again
             try:
                 _reserve(tmp, reserve)
-                _initialise(g, scene, overrides)
+                _initialise(g, scene, overrides, adaptive)
                 g.flush()
                 size = g.id.get_filesize()  # HDF5's end of allocation (eof is stale)
             except BaseException:
@@ -679,7 +751,7 @@ class SweepFile:
             if 0 < size < reserve:
                 os.truncate(tmp, size)  # give back what the metadata did not use
             f = h5py.File(tmp, "r+", locking=True)  # locked before anyone can see it
-            self = cls(path, f, scene, backend)
+            self = cls(path, f, scene, backend, adaptive)
             self._start_session()  # before the file has its name: failing leaves nothing
             _publish(tmp, path, old_fd)
             tmp = None
@@ -702,20 +774,24 @@ class SweepFile:
 
     @classmethod
     def resume(cls, path: str | Path, scene: Scene, overrides: tuple[str, ...] = (),
-               *, backend: str | None = None) -> SweepFile:
-        """Reopen a result file of the same scene to finish it (its points are kept
-        whatever happens: the session's attributes are updated in place)."""
+               *, backend: str | None = None, adaptive: dict | None = None) -> SweepFile:
+        """Reopen a result file of the same scene (and the same adaptive settings, None
+        for a sweep of every point) to finish it (its points are kept whatever happens:
+        the session's attributes are updated in place)."""
         path = Path(path)
         f = _open(path, "r")
         try:
             stored = _layout(f, path).scene
             _checked_attrs(f, path)  # what readers need, before any point is computed
-            _check_outcome(f["outcome"][()], path)
+            outcome = f["outcome"][()]
+            _check_outcome(outcome, path)
+            if stored.get("adaptive"):
+                _check_computed(f["computed"][()], outcome, path)
         except _H5_ERRORS as err:
             raise _damaged(path, _why(err)) from None
         finally:
             _close_quietly(f)
-        diffs = scene_differences(stored, resolved_scene(scene, overrides))
+        diffs = scene_differences(stored, resolved_scene(scene, overrides, adaptive))
         if diffs:
             raise StoreError(f"{shown(path)}: cannot resume, the scene differs from the "
                              "file's: " + "; ".join(diffs) + " (use --overwrite to start "
@@ -723,7 +799,7 @@ class SweepFile:
         f = _open(path, "r+")
         try:
             _layout(f, path)  # the file locked now (another may have replaced the first)
-            self = cls(path, f, scene, backend)
+            self = cls(path, f, scene, backend, adaptive)
             self._start_session()
         except BaseException as err:
             _close_quietly(f)
@@ -758,6 +834,72 @@ class SweepFile:
     def done(self) -> np.ndarray:
         """bool[size]: points already computed (flat order)."""
         return self.f["outcome"][()].reshape(-1) != L.OUTCOME_NOT_RUN
+
+    def state(self) -> tuple[np.ndarray, np.ndarray]:
+        """(outcome, computed): int8[size] each, flat order, of an adaptive file."""
+        return (self.f["outcome"][()].reshape(-1).copy(),
+                self.f["computed"][()].reshape(-1).copy())
+
+    def _write_at(self, name: str, coords: np.ndarray, values: np.ndarray) -> None:
+        """Write values[n] at the grid points coords (uint64[n, rank]): one HDF5 point
+        selection, so scattered points cost one call."""
+        import h5py
+
+        ds = self.f[name]
+        fspace = ds.id.get_space()
+        fspace.select_elements(coords)
+        mspace = h5py.h5s.create_simple((len(coords),))
+        ds.id.write(mspace, fspace, np.ascontiguousarray(values, dtype=ds.dtype))
+
+    def write_points(self, flat: np.ndarray, arrays: dict[str, np.ndarray],
+                     computed: np.ndarray) -> None:
+        """Write the results of scattered points of an adaptive sweep: flat: int64[n]
+        grid indices; arrays: variable -> array[n]; computed: int8[n] flags. Order:
+        the variables, ``outcome``, then ``computed``, each flushed: a point is computed
+        in a killed file only when all of it is there (a point with an outcome and flag
+        0 is recomputed on resume, to the same values).
+
+        A failed write is a StoreError, as for ``write``."""
+        if self._broken:
+            raise self._broken
+        flat = np.asarray(flat, np.int64)
+        if flat.size == 0:
+            return
+        coords = np.stack(np.unravel_index(flat, self.grid.shape), axis=1).astype(np.uint64)
+        try:
+            for name in self.names:
+                if name != "outcome":
+                    self._write_at(name, coords, arrays[name])
+            self.f.flush()
+            self._write_at("outcome", coords, arrays["outcome"])
+            self.f.flush()
+            self._write_at("computed", coords, computed)
+            self.f.flush()
+        except _H5_ERRORS as err:
+            raise self._fail(StoreError(
+                f"{shown(self.path)}: cannot write results ({_why(err)}); the points "
+                "written before are kept, finish with --resume")) from None
+
+    def write_filled(self, outcome: np.ndarray, counts: dict[str, int]) -> None:
+        """The end of an adaptive sweep: ``outcome`` (int8[size], flat: computed classes
+        and fills) written over the whole variable, and the ``ADAPTIVE_COUNT_ATTRS``
+        (in place)."""
+        if self._broken:
+            raise self._broken
+        try:
+            self.f["outcome"][...] = np.asarray(outcome, np.int8).reshape(self.grid.shape)
+            self.f.flush()
+            self.put_counts(counts)
+        except _H5_ERRORS as err:
+            raise self._fail(StoreError(
+                f"{shown(self.path)}: cannot write the filled outcomes ({_why(err)}); "
+                "finish with --resume")) from None
+
+    def put_counts(self, counts: dict[str, int]) -> None:
+        """Update the adaptive counts (``ADAPTIVE_COUNT_ATTRS``) in place."""
+        for k, v in counts.items():
+            _put(self.f, k, int(v))
+        self.f.flush()
 
     def write(self, res: ChunkResult) -> None:
         """Write one chunk's results; ``outcome`` last, each step flushed to the OS.
@@ -848,7 +990,8 @@ def _history(before: str, line: str) -> str:
     return "\n".join(lines)
 
 
-def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...]) -> None:
+def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
+                adaptive: dict | None = None) -> None:
     import h5py
     grid = Grid(scene)
     vers = versions()
@@ -864,7 +1007,7 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...]) -> None:
     a["format_version"] = FORMAT_VERSION
     a["scene"] = scene.text
     a["scene_kind"] = scene.kind
-    a["scene_resolved"] = json.dumps(resolved_scene(scene, overrides))
+    a["scene_resolved"] = json.dumps(resolved_scene(scene, overrides, adaptive))
     a["overrides"] = json.dumps(list(overrides))
     n = scene.numerics
     a["numerics"] = json.dumps(n.as_dict())
@@ -882,6 +1025,19 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...]) -> None:
     for name, dtype in SESSION_ATTRS.items():
         kind = np.dtype(dtype).kind
         a.create(name, _fixed("", dtype) if kind == "S" else np.array(zeros[kind], dtype))
+    if adaptive is not None:
+        a["adaptive"] = np.int8(1)
+        a["adaptive_axes"] = " ".join(adaptive["axes"])
+        for k in ("coarse", "margin", "final_margin", "seed"):
+            a[f"adaptive_{k}"] = np.int64(adaptive[k])
+        for k in ("audit", "threshold"):
+            a[f"adaptive_{k}"] = np.float64(adaptive[k])
+        for name, dtype in ADAPTIVE_COUNT_ATTRS.items():
+            a.create(name, np.array(0, dtype))
+        a["comment"] = (str(a["comment"]) + " Adaptive sweep: computed flags each point "
+                        "(0 filled: outcome from the uniform cell around it, the other "
+                        "variables at their fill values; 1 computed; 2/3 audit points that "
+                        "agreed/disagreed with their fill).")
 
     scales = []
     for axis in scene.swept:
@@ -901,7 +1057,10 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...]) -> None:
         _coord_attrs(ds, axis)
         scalars.append(axis.name)
 
-    for name, (dtype, fill, text) in variables(scene).items():
+    specs = dict(variables(scene))
+    if adaptive is not None:
+        specs["computed"] = COMPUTED_VARIABLE
+    for name, (dtype, fill, text) in specs.items():
         dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
         dcpl.set_alloc_time(h5py.h5d.ALLOC_TIME_EARLY)  # no metadata changes later
         ds = f.create_dataset(name, shape=grid.shape, dtype=dtype, fillvalue=fill,
@@ -914,6 +1073,9 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...]) -> None:
         if name == "outcome":  # CF-style flag attributes, for xarray users
             ds.attrs["flag_values"] = np.array(list(OUTCOME_WORDS), np.int8)
             ds.attrs["flag_meanings"] = " ".join(OUTCOME_WORDS.values())
+        elif name == "computed":
+            ds.attrs["flag_values"] = np.array(list(COMPUTED_FLAGS), np.int8)
+            ds.attrs["flag_meanings"] = " ".join(COMPUTED_FLAGS.values())
         elif name == "status":
             ds.attrs["flag_masks"] = np.array(list(STATUS_WORDS), np.int32)
             ds.attrs["flag_meanings"] = " ".join(STATUS_WORDS.values())
@@ -1032,6 +1194,20 @@ def _check_outcome(outcome: np.ndarray, path: Path) -> None:
                        f"e.g. {int(outcome[bad][0])} (valid: -1, 0, 1, 2)")
 
 
+def _check_computed(computed: np.ndarray, outcome: np.ndarray | None, path: Path) -> None:
+    """The ``computed`` flags of an adaptive file: codes 0..3, and no computed point
+    without an outcome (outcome is written before the flag)."""
+    bad = ~np.isin(computed, np.array(list(COMPUTED_FLAGS), np.int8))
+    if bad.any():
+        raise _damaged(path, f"variable 'computed' holds {int(bad.sum())} invalid codes, "
+                       f"e.g. {int(computed[bad][0])} (valid: 0, 1, 2, 3)")
+    if outcome is not None:
+        lost = (computed > 0) & (outcome == L.OUTCOME_NOT_RUN)
+        if lost.any():
+            raise _damaged(path, f"{int(lost.sum())} points flagged computed have no "
+                           "outcome")
+
+
 def _checked_attrs(f: h5py.File, path: Path) -> dict:
     """The file's attributes as plain Python values, those readers use validated."""
     attrs = {}
@@ -1052,8 +1228,10 @@ def _checked_attrs(f: h5py.File, path: Path) -> dict:
     return attrs
 
 
-def read_result(path: str | Path, names: list[str] | None = None) -> SweepResult:
-    """Read a result file (``names``: variables to load; default all).
+def read_result(path: str | Path, names: list[str] | None = None,
+                optional: tuple[str, ...] = ()) -> SweepResult:
+    """Read a result file (``names``: variables to load; default all; ``optional``:
+    variables loaded too when the file has them, e.g. ``computed``).
 
     Validates what readers rely on (format, resolved scene, coordinates, variables'
     shapes and dtypes, outcome codes, the attributes ``info`` shows); any problem is a
@@ -1066,6 +1244,7 @@ def read_result(path: str | Path, names: list[str] | None = None) -> SweepResult
         stored = lay.scene
         known = variables_for(stored)
         wanted = list(names) if names else list(known)
+        wanted += [n for n in optional if n in known and n not in wanted]
         for n in wanted:
             if n not in known:
                 raise StoreError(f"{shown(path)}: no variable '{n}' in this result (it "
@@ -1083,6 +1262,8 @@ def read_result(path: str | Path, names: list[str] | None = None) -> SweepResult
         arrays = {n: f[n][()] for n in wanted}
         if "outcome" in arrays:
             _check_outcome(arrays["outcome"], path)
+        if "computed" in arrays:
+            _check_computed(arrays["computed"], arrays.get("outcome"), path)
         attrs = _checked_attrs(f, path)
     except RocksweepError:
         raise

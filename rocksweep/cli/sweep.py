@@ -37,16 +37,46 @@ WRITE_EVERY = 1.0  # = rocksweep.api.WRITE_EVERY (not imported here: --help stay
               show_default=True, metavar="SECONDS",
               help="Write finished chunks to the file at most this often; a killed sweep "
                    "loses at most this much computing (Ctrl-C loses nothing).")
+@click.option("--adaptive", is_flag=True,
+              help="Compute only near the class boundaries: a coarse lattice, then "
+                   "refinement of every cell whose corners differ (and its neighbours), "
+                   "then a random audit; the other points take the class of the uniform "
+                   "cell around them (flag `computed` in the file).")
+@click.option("--coarse", type=int, default=None, metavar="K",
+              help="Adaptive: the coarse pass takes every 2^K-th point of both diagram "
+                   "axes [default: 16 coarse cells per axis]. Regions smaller than a "
+                   "coarse cell and touching no boundary can be missed: lower K to be "
+                   "safer.")
+@click.option("--audit", type=float, default=None, metavar="SHARE",
+              help="Adaptive: share of all points computed as a check of the fill "
+                   "[default: 0.02].")
+@click.option("--axes", "adaptive_axes", metavar="X,Y", default=None,
+              help="Adaptive: the two diagram axes [default: w_over_p,A_ratio].")
+@click.option("--margin", type=int, default=None, hidden=True,
+              help="Adaptive: cells refined around a mixed cell [default: 1].")
+@click.option("--final-margin", "final_margin", type=int, default=None, hidden=True,
+              help="Adaptive: the same at the last level [default: 0].")
+@click.option("--seed", type=int, default=None, hidden=True,
+              help="Adaptive: seed of the audit sample [default: 0].")
+@click.option("--threshold", type=float, default=None, hidden=True,
+              help="Adaptive: warn when more than this share of audit points disagree "
+                   "[default: 0.002].")
 @user_errors
 def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, jobs: int,
           resume: bool, overwrite: bool, quiet: bool, backend: str, scheduler: str | None,
-          chunk_size: int | None, write_every: float) -> None:
+          chunk_size: int | None, write_every: float, adaptive: bool, coarse: int | None,
+          audit: float | None, adaptive_axes: str | None, margin: int | None,
+          final_margin: int | None, seed: int | None, threshold: float | None) -> None:
     """Compute the stability diagram of SCENE.yaml: every point of its grid.
 
     Writes outcome (0 safe, 1 mode 1, 2 mode 2, -1 not computed), impacts, uplifts,
     max |theta|/alpha_cg, the overturning time and status flags per point to an HDF5 file
     (open it with xarray, `rocksweep info` or `rocksweep plot`). Results are written as
     chunks finish; if the run is interrupted, run the same command with --resume.
+
+    With --adaptive, only the points near the boundaries between classes are computed
+    (a few % at 400 x 400 and more); the others get the class of the cell around them
+    and keep the "not computed" values in every other variable.
     """
     if resume and overwrite:
         raise click.ClickException("--resume and --overwrite exclude each other")
@@ -61,6 +91,13 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     if backend == "threads":
         sw.check_jobs(jobs, "--jobs")
     api.check_write_every(write_every, "--write-every")
+    settings = {"coarse": coarse, "audit": audit, "axes": adaptive_axes, "margin": margin,
+                "final_margin": final_margin, "seed": seed, "threshold": threshold}
+    given = [k for k, v in settings.items() if v is not None]
+    if given and not adaptive:
+        raise click.ClickException(f"--{given[0].replace('_', '-')} is a setting of "
+                                   "adaptive sweeps; add --adaptive")
+    options = api.adaptive_options(adaptive, **settings)
     scene = load(scene_path, overrides)
     out = out_path if out_path is not None else Path(scene_path.stem + ".h5")
 
@@ -72,7 +109,8 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
         report = api.sweep_file(scene, out, overrides=overrides, jobs=jobs, resume=resume,
                                 overwrite=overwrite, backend=backend, scheduler=scheduler,
                                 chunk_size=chunk_size, write_every=write_every,
-                                progress=not quiet, log=say, inputs=[scene_path])
+                                progress=not quiet, log=say, inputs=[scene_path],
+                                adaptive=options)
     except api.SweepInterrupted as stop:
         r = stop.report
         click.echo(f"\ninterrupted: {r.points_done} of {r.points_total} points saved in "
@@ -91,6 +129,14 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     click.echo(f"computed {report.computed} points{resumed} in {report.wall_s:.2f} s wall "
                f"time: {report.rate:.0f} points/s (kernel compile/cache load: "
                f"{report.compile_s:.2f} s; workers' CPU time {report.cpu_s:.2f} s)")
+    st = report.adaptive
+    if st is not None:
+        click.echo(f"adaptive: {st.computed} of {st.points} points computed "
+                   f"({100 * st.computed_share:.2f}%), {st.points - st.computed} filled; "
+                   f"audit: {st.audited} points, {st.audit_misses} disagreed with their "
+                   "fill")
+        if st.warning():
+            click.echo(f"warning: {st.warning()}", err=True)
     click.echo(f"accuracy: {scene.numerics.describe()}")
     click.echo(f"RK4 steps: {a['steps_total']} + {a['event_steps_total']} event "
                f"re-integrations (all points in the file)")
