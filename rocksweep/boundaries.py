@@ -12,9 +12,10 @@ For every panel (a value of each non-diagram axis: shape, body keys, lam) of a d
   A_ratio between it and the grid value below (single kernel runs at the sweep's numerics)
   to a relative tolerance, so the curve is not limited by the grid spacing.
 
-Rows for CSV (``a_min_rows``, ``csv_text``) and a figure (``a_min_figure``: a matplotlib
-Figure, no pyplot) export them. Units: those of the axes (w_over_p = omega/p, A_ratio =
-A/(g tan alpha_cg), eq. 2).
+Rows for CSV (``a_min_rows``, ``boundary_rows``, ``csv_text``) export them; the figures
+are in ``rocksweep.diagrams`` (``a_min_figure``, and ``rocksweep plot --curves``).
+``result_curves`` does it all for a result file (``rocksweep boundaries``). Units: those
+of the axes (w_over_p = omega/p, A_ratio = A/(g tan alpha_cg), eq. 2).
 """
 
 from __future__ import annotations
@@ -38,7 +39,7 @@ from rocksweep.points import Point, kernel_kind, point_row
 from rocksweep.scene import Scene
 
 if TYPE_CHECKING:
-    from matplotlib.figure import Figure
+    from rocksweep.store import SweepResult
 
 DEFAULT_RTOL = 1e-3
 OVERTURNED = (L.OUTCOME_MODE1, L.OUTCOME_MODE2)
@@ -357,33 +358,58 @@ def boundary_rows(bounds: Sequence[PanelBoundaries], axes: Sequence[str] = DIAGR
     return rows
 
 
-def _where_label(where: dict[str, Any]) -> str:
-    return ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
-                     for k, v in where.items()) or "all"
+# --- result files -----------------------------------------------------------------------
+
+class BoundaryError(AdaptiveError):
+    """A result whose boundaries cannot be drawn (one line, naming the file)."""
 
 
-def a_min_figure(curves: Sequence[AMinCurve], bounds: Sequence[PanelBoundaries] = (),
-                 title: str = "") -> Figure:
-    """A_min(x) of every panel overlaid on one axis (one colour per panel, e.g. per lam;
-    solid where the onset is mode 1, dashed where mode 2), with the boundary lines of
-    ``bounds`` drawn thin in the same colours when given. No pyplot."""
-    from matplotlib.figure import Figure
+def scene_of(result: SweepResult) -> Scene:
+    """The scene a result was computed from, rebuilt from its YAML and overrides, checked
+    against the file's resolved scene (axes, numerics): the A_min bisection runs the
+    kernel as the sweep did."""
+    import json
 
-    fig = Figure(figsize=(6.4, 4.8), layout="constrained")
-    ax = fig.add_subplot()
-    colours = [f"C{k % 10}" for k in range(max(len(curves), len(bounds)))]
-    for k, b in enumerate(bounds):
-        for line in b.lines:
-            ax.plot(line.xy[:, 0], line.xy[:, 1], lw=0.5, color=colours[k], alpha=0.5)
-    for k, c in enumerate(curves):
-        for m, style in ((L.OUTCOME_MODE1, "-"), (L.OUTCOME_MODE2, "--")):
-            y = np.where(c.mode == m, c.a_min, np.nan)
-            ax.plot(c.x, y, style, color=colours[k], lw=1.5, marker=".", ms=2,
-                    label=f"{_where_label(c.where)} ({outcome_word(m)})"
-                    if np.isfinite(y).any() else None)
-    if curves:
-        ax.set_xlabel(curves[0].xname)
-        ax.set_ylabel(f"{curves[0].yname} at overturning onset (A_min)")
-    ax.legend(fontsize="small")
-    ax.set_title(title)
-    return fig
+    from rocksweep.scene import SceneError, parse_scene
+    from rocksweep.store import resolved_scene, scene_differences
+
+    a = result.attrs
+    overrides = json.loads(a.get("overrides", "[]"))
+    try:
+        sc = parse_scene(str(a["scene"]), str(result.path), list(overrides))
+    except SceneError as err:
+        raise BoundaryError(f"{result.path}: cannot rebuild its scene ({err})") from None
+    stored = {k: v for k, v in result.scene.items() if k != "adaptive"}
+    diffs = scene_differences(stored, resolved_scene(sc, overrides))
+    if diffs:
+        raise BoundaryError(f"{result.path}: its scene YAML no longer gives its grid "
+                            f"({'; '.join(diffs)})")
+    return sc
+
+
+def check_result(result: SweepResult, axes: Sequence[str] = DIAGRAM_AXES) -> Scene:
+    """The scene of a complete result with the diagram axes ``axes`` (x, y); one-line
+    BoundaryErrors for a result that has no such diagram or is not finished."""
+    sc = scene_of(result)
+    try:
+        make_plan(sc, axes, coarse=0, audit=0.0)
+    except AdaptiveError as err:
+        raise BoundaryError(f"{result.path}: {err}; boundaries need a diagram over two "
+                            "swept axes") from None
+    missing = int((np.asarray(result.arrays["outcome"]) < 0).sum())
+    if missing:
+        raise BoundaryError(f"{result.path}: incomplete result ({missing} of "
+                            f"{result.arrays['outcome'].size} points not computed yet); "
+                            "finish it with rocksweep sweep SCENE.yaml -o FILE --resume")
+    return sc
+
+
+def result_curves(result: SweepResult, rtol: float = DEFAULT_RTOL, mode: int | None = None,
+                  axes: Sequence[str] = DIAGRAM_AXES, evaluate: Evaluator | None = None
+                  ) -> tuple[list[AMinCurve], list[PanelBoundaries]]:
+    """A_min curves (bisected to ``rtol``; ``mode``: None any, 1 or 2) and boundary lines
+    of every panel of a result read with ``outcome`` (``store.read_result``)."""
+    sc = check_result(result, axes)
+    outcome = np.asarray(result.arrays["outcome"])
+    curves = a_min(sc, outcome, rtol, axes, mode, evaluate)
+    return curves, diagram_boundaries(sc, outcome, axes)

@@ -13,6 +13,11 @@ axis (e.g. ``alpha_cg`` against ``A_ratio``). Each cell is coloured by what the 
   when lam is swept and on neither axis;
 - safe at every lam: white; not computed yet: grey.
 
+With ``curves``, the boundary lines between classes (``rocksweep.boundaries``) of every
+lam are drawn over the cells, one colour per lam. ``a_min_figure`` draws A_min(omega/p)
+curves of several panels (e.g. lam values) on one axis, as the paper compares them.
+Filled cells of an adaptive sweep are drawn as computed ones.
+
 Points that are mode 1 at some lam but safe again at a larger one get a black dot;
 flagged points (horizon, step or event cap, non-finite: ``STATUS_FLAGGED``) an ``x``.
 Each panel also lists the mode 1 area (fraction of its points) for every lam. One panel
@@ -28,7 +33,7 @@ import math
 from collections.abc import Sequence
 from itertools import product
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap
@@ -43,8 +48,11 @@ from rocksweep.store import SweepResult
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
+    from rocksweep.boundaries import AMinCurve, PanelBoundaries
+
 __all__ = ["FORMATS", "DiagramError", "choose_axes", "stability_diagram", "line_diagram",
-           "sweep_figure", "stability_figure", "missing_warnings", "categories", "y_label"]
+           "sweep_figure", "stability_figure", "missing_warnings", "categories", "y_label",
+           "a_min_figure"]
 
 MAX_PANELS = 36
 
@@ -60,6 +68,8 @@ ALPHA_REF = {"flexible": r"\alpha_{cg}", "block": r"\alpha"}
 DEFAULT_X, DEFAULT_Y = "w_over_p", "A_ratio"
 
 _SAFE, _MODE2, _NOT_RUN = "#ffffff", "#4c72b0", "#bdbdbd"
+# boundary lines of the k-th lam (``curves``): dark colours apart from the cells' fills
+CURVE_COLOURS = ("black", "#1b9e77", "#7570b3", "#e7298a", "#66a61e", "#a6761d")
 
 
 class DiagramError(FigureError):
@@ -251,10 +261,12 @@ def _place_axes(axes, n: int, rows_cols: tuple[int, int], size: tuple[float, flo
 
 def stability_diagram(result: SweepResult, x: str | None = None, y: str | None = None, *,
                       axes: Axes | Sequence[Axes] | None = None,
-                      option_names: tuple[str, str] = ("x", "y")) -> Figure:
+                      option_names: tuple[str, str] = ("x", "y"),
+                      curves: bool = False) -> Figure:
     """The stability diagram of ``result`` over swept axes x and y (see the module
     docstring; defaults from ``choose_axes``). Needs the ``outcome`` and ``status``
-    arrays. axes: one Axes per panel to draw into (else a new figure). Returns the figure.
+    arrays. axes: one Axes per panel to draw into (else a new figure); curves: overlay
+    the boundary lines of every lam. Returns the figure.
     """
     x, y = choose_axes(result, x, y, option_names)
     if y is None:
@@ -299,6 +311,8 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
             any_back = True
             yy, xx = np.nonzero(later_safe)
             ax.plot(xs[xx], ys[yy], ".", color="k", ms=2.5)
+        if curves:
+            _draw_boundaries(ax, po, xs, ys)
         f_any = pf.any(axis=0)
         if f_any.any():
             any_flag = True
@@ -342,6 +356,12 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
     if any_flag:
         handles.append(Line2D([], [], ls="", marker="x", color="k",
                               label="flagged (horizon/step/event cap, non-finite)"))
+    if curves:
+        for k in range(n_lam):
+            label = (f"boundaries at ${lam_sym}$ = {_fmt(lam[k])}" if lam is not None
+                     and n_lam > 1 else "class boundaries")
+            handles.append(Line2D([], [], color=CURVE_COLOURS[k % len(CURVE_COLOURS)],
+                                  lw=1.0, label=label))
     if own:
         ncols = _layout(result, panel_dims, len(panels))[1]
         fig.legend(handles=handles, loc="outside lower center", fontsize=8, frameon=False,
@@ -430,13 +450,33 @@ def line_diagram(result: SweepResult, x: str | None = None, *,
 
 def sweep_figure(result: SweepResult, x: str | None = None, y: str | None = None, *,
                  axes: Axes | Sequence[Axes] | None = None,
-                 option_names: tuple[str, str] = ("x", "y")) -> Figure:
+                 option_names: tuple[str, str] = ("x", "y"), curves: bool = False) -> Figure:
     """The figure ``rocksweep plot`` draws: a stability diagram over (x, y), or a line
-    plot when the result has one swept axis besides lam (see ``choose_axes``)."""
+    plot when the result has one swept axis besides lam (see ``choose_axes``); curves:
+    the boundary lines over the diagram (``rocksweep plot --curves``)."""
     x, y = choose_axes(result, x, y, option_names)
     if y is None:
+        if curves:
+            raise DiagramError(f"{result.path}: --curves draws boundary lines on a "
+                               f"stability diagram; this result has one swept axis ({x}) "
+                               "besides lam")
         return line_diagram(result, x, axes=axes, option_names=option_names)
-    return stability_diagram(result, x, y, axes=axes, option_names=option_names)
+    return stability_diagram(result, x, y, axes=axes, option_names=option_names,
+                             curves=curves)
+
+
+def _draw_boundaries(ax: Axes, po: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> None:
+    """The boundary lines of each lam layer of a panel (po: outcome[n_lam, ny, nx], axes
+    ascending) in its colour; lines along points not computed yet are left out."""
+    from rocksweep.boundaries import boundary_lines
+
+    for k in range(po.shape[0]):
+        colour = CURVE_COLOURS[k % len(CURVE_COLOURS)]
+        for line in boundary_lines(po[k], np.asarray(xs, float), np.asarray(ys, float)):
+            if min(line.classes) < 0:
+                continue
+            ax.plot(line.xy[:, 0], line.xy[:, 1], color=colour, lw=0.8,
+                    ls=("-", "--", ":", "-.")[k // len(CURVE_COLOURS) % 4])
 
 
 def missing_warnings(result: SweepResult) -> list[str]:
@@ -457,3 +497,46 @@ def stability_figure(result: SweepResult, path: str | Path, *, x: str | None = N
     save_figure(sweep_figure(result, x, y), path, dpi, overwrite=overwrite,
                 inputs=[result.path])
     return missing_warnings(result)
+
+
+# ---------------------------------------------------------------------------------------
+# A_min curves (rocksweep boundaries --plot)
+# ---------------------------------------------------------------------------------------
+
+def _where_label(where: dict[str, Any]) -> str:
+    parts = []
+    for k, v in where.items():
+        sym = f"${SYMBOLS[k]}$" if k in SYMBOLS else k
+        parts.append(f"{sym} = {_fmt(v)}")
+    return ", ".join(parts) or "all"
+
+
+def a_min_figure(curves: Sequence[AMinCurve], bounds: Sequence[PanelBoundaries] = (),
+                 title: str = "", kind: str = "flexible") -> Figure:
+    """A_min(x) of every panel (``rocksweep.boundaries.a_min``) overlaid on one axis: one
+    colour per panel (e.g. per lam), solid where the onset is mode 1, dashed where mode 2;
+    with the boundary lines of ``bounds`` drawn thin in the same colours when given.
+    kind: the body kind (labels the amplitude axis). No pyplot."""
+    from rocksweep.outcomes import outcome_word
+
+    fig = Figure(figsize=(6.4, 4.8), layout="constrained")
+    ax = fig.add_subplot()
+    colours = [f"C{k % 10}" for k in range(max(len(curves), len(bounds)))]
+    for k, b in enumerate(bounds):
+        for line in b.lines:
+            ax.plot(line.xy[:, 0], line.xy[:, 1], lw=0.5, color=colours[k], alpha=0.5)
+    for k, c in enumerate(curves):
+        for m, style in ((L.OUTCOME_MODE1, "-"), (L.OUTCOME_MODE2, "--")):
+            y = np.where(c.mode == m, c.a_min, np.nan)
+            ax.plot(c.x, y, style, color=colours[k], lw=1.5, marker=".", ms=2,
+                    label=f"{_where_label(c.where)} ({outcome_word(m)})"
+                    if np.isfinite(y).any() else None)
+    if curves:
+        ax.set_xlabel(axis_label(curves[0].xname, kind))
+        ax.set_ylabel(f"{axis_label(curves[0].yname, kind)} at overturning onset "
+                      "($A_{min}$)")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize="small")
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    return fig

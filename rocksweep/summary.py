@@ -24,8 +24,10 @@ if TYPE_CHECKING:
 CLASSES = ("mode1", "mode2", "safe", "flagged", "not_computed")
 # A swept key with more values than this is printed as this many ranges of values.
 MAX_ROWS = 10
-# Variables ``info_dict`` needs from the file.
+# Variables ``info_dict`` needs from the file (and ``computed`` when the file has it:
+# ``read_result(path, INFO_VARIABLES, optional=INFO_OPTIONAL)``).
 INFO_VARIABLES = ["outcome", "status", "steps", "event_steps"]
+INFO_OPTIONAL = ("computed",)
 
 
 def _plain(v):
@@ -182,8 +184,28 @@ def info_dict(result: SweepResult) -> dict:
             "cpu_time_s": a.get("cpu_time"),
             "overrides": json.loads(a.get("overrides", "[]")),
         },
+        "adaptive": adaptive_info(result),
         "scene": a.get("scene"),
     }
+
+
+def adaptive_info(result: SweepResult) -> dict | None:
+    """The settings and counts of an adaptive sweep (None for a sweep of every point):
+    settings as recorded (axes, coarse, margin, final_margin, audit, seed, threshold);
+    computed, filled (outcome from the cell around the point), undecided (neither yet: an
+    unfinished sweep), audited, audit_misses, from the ``computed`` flags."""
+    settings = result.scene.get("adaptive")
+    if not settings or "computed" not in result.arrays:
+        return None
+    from rocksweep.adaptive import stats_of
+
+    c = np.asarray(result.arrays["computed"])
+    st = stats_of(c, settings.get("threshold", 0.0))
+    filled = int(((c == 0) & result.done).sum())
+    return {"settings": settings, "points": st.points, "computed": st.computed,
+            "filled": filled, "undecided": st.points - st.computed - filled,
+            "audited": st.audited, "audit_misses": st.audit_misses,
+            "warning": st.warning()}
 
 
 def format_info(d: dict) -> list[str]:
@@ -200,6 +222,17 @@ def format_info(d: dict) -> list[str]:
              "INCOMPLETE (finish it with rocksweep sweep SCENE.yaml -o FILE --resume)")
     lines.append(f"points: {d['points_done']} of {d['points_total']} done ({pct:.1f}%), "
                  f"{state}")
+    ad = d.get("adaptive")
+    if ad:
+        s = ad["settings"]
+        n = max(1, ad["points"])
+        lines.append(f"adaptive over {' x '.join(s['axes'])} (coarse {s['coarse']}, margin "
+                     f"{s['margin']}/{s['final_margin']}, audit {s['audit']:g}, seed "
+                     f"{s['seed']}): {ad['computed']} computed "
+                     f"({100 * ad['computed'] / n:.2f}%), {ad['filled']} filled"
+                     + (f", {ad['undecided']} not decided yet" if ad["undecided"] else ""))
+        lines.append(f"  audit: {ad['audited']} points, {ad['audit_misses']} disagreed with "
+                     "their fill" + (f" (warning: {ad['warning']})" if ad["warning"] else ""))
     lines.append("counts per pulse shape and lam:")
     lines += format_counts(in_ranges(d["counts"], "lam"), "  ")
     by_key = {k: rows for k, rows in d["counts_by_key"].items() if k not in ("shape", "lam")}

@@ -6,6 +6,7 @@ import pytest
 
 import rocksweep.boundaries as bd
 import rocksweep.sweep as sw
+from rocksweep.diagrams import a_min_figure
 from rocksweep.scene import parse_scene
 
 BODY3 = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, "
@@ -117,7 +118,7 @@ def test_a_min_of_a_synthetic_threshold_and_csv():
     text = bd.csv_text(rows)
     assert text.splitlines()[0] == "shape,w_over_p,A_min,mode,upper_bound"
     assert len(text.splitlines()) == 1 + 10 and "cosine,3.0," in text
-    fig = bd.a_min_figure(curves, bd.diagram_boundaries(sc, outcome), title="t")
+    fig = a_min_figure(curves, bd.diagram_boundaries(sc, outcome), title="t")
     assert type(fig).__name__ == "Figure" and len(fig.axes) == 1
     assert len(fig.axes[0].get_legend().get_texts()) == 2  # one per panel (mode 2 only)
 

@@ -1,3 +1,11 @@
 """Imports every command module so that each attaches itself to ``main``."""
 
-from rocksweep.cli import accuracy, info, plot, restitution, simulate, sweep  # noqa: F401
+from rocksweep.cli import (  # noqa: F401
+    accuracy,
+    boundaries,
+    info,
+    plot,
+    restitution,
+    simulate,
+    sweep,
+)

@@ -22,14 +22,18 @@ from rocksweep.cli.main import main, user_errors
 @click.option("--dpi", type=click.IntRange(20, 2400), default=200, show_default=True,
               help="Resolution of raster output (PNG).")
 @click.option("--overwrite", is_flag=True, help="Replace an existing figure file.")
+@click.option("--curves", is_flag=True,
+              help="Overlay the boundary lines between classes, one colour per lam "
+                   "(`rocksweep boundaries` gives them as CSV, with A_min).")
 @user_errors
 def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str | None,
-         dpi: int, overwrite: bool) -> None:
+         dpi: int, overwrite: bool, curves: bool) -> None:
     """Draw the stability diagram of a sweep: by default x = omega/p, y = A/(g tan
     alpha_cg); --x/--y pick any two swept axes. Mode 1 / mode 2 / safe regions, one panel
     per pulse shape and per other swept key, the growth of the mode 1 area with lam in
     shades of red. A sweep with one swept axis besides lam is drawn as max|theta|/alpha
-    against it, markers by outcome."""
+    against it, markers by outcome. Cells an adaptive sweep filled are drawn as computed
+    ones."""
     from rocksweep.diagrams import missing_warnings, sweep_figure
     from rocksweep.outputs import check_output
     from rocksweep.plots import FORMATS, save_figure
@@ -39,7 +43,7 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
     # refuse a bad output before reading the result and drawing
     check_output(fig_out, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
     result = read_result(result_path, ["outcome", "status", "theta_max_over_alpha"])
-    fig = sweep_figure(result, x_key, y_key, option_names=("--x", "--y"))
+    fig = sweep_figure(result, x_key, y_key, option_names=("--x", "--y"), curves=curves)
     save_figure(fig, fig_out, dpi, overwrite=overwrite, inputs=[result_path])
     for w in missing_warnings(result):
         click.echo(f"warning: {w}", err=True)

@@ -1,0 +1,77 @@
+"""``rocksweep boundaries``: the A_min curves (bisected) and the boundary lines of a sweep
+result, as CSV and as a figure (the library side is ``rocksweep.boundaries``)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from rocksweep.cli.main import main, user_errors
+
+
+@main.command()
+@click.argument("result_path", metavar="OUT.h5", type=click.Path(path_type=Path))
+@click.option("-o", "--output", "csv_path", type=click.Path(dir_okay=False, path_type=Path),
+              help="A_min curves as CSV [default: OUT-amin.csv].")
+@click.option("--lines", "lines_path", type=click.Path(dir_okay=False, path_type=Path),
+              help="Also write the boundary polylines as CSV (one row per vertex).")
+@click.option("--rtol", type=float, default=1e-3, show_default=True,
+              help="Relative tolerance of the bisection of A_min in A_ratio.")
+@click.option("--mode", type=click.Choice(["1", "2"]), default=None,
+              help="A_min of this overturning mode only [default: either].")
+@click.option("--plot", "fig_path", type=click.Path(dir_okay=False, path_type=Path),
+              help="Figure of the A_min curves of every lam (and shape) on one axis, "
+                   ".png, .pdf or .svg.")
+@click.option("--dpi", type=click.IntRange(20, 2400), default=200, show_default=True,
+              help="Resolution of raster output (PNG).")
+@click.option("--overwrite", is_flag=True, help="Replace existing output files.")
+@user_errors
+def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None,
+               rtol: float, mode: str | None, fig_path: Path | None, dpi: int,
+               overwrite: bool) -> None:
+    """The boundaries of the stability diagram of a sweep result (over omega/p and
+    A/(g tan alpha)), for each lam and pulse shape: A_min(omega/p), the smallest amplitude
+    that overturns, refined by bisection between the last safe and the first overturning
+    grid value (kernel runs at the sweep's accuracy), with the mode it overturns in; and
+    the lines between classes as polylines. Works on adaptive and regular results."""
+    from rocksweep import boundaries as bd
+    from rocksweep.outputs import check_output, write_atomic
+    from rocksweep.plots import FORMATS, save_figure
+    from rocksweep.store import read_result
+
+    if not (0 < rtol < 1):
+        raise click.ClickException(f"--rtol {rtol}: give a relative tolerance in (0, 1)")
+    out = csv_path if csv_path is not None else result_path.with_name(
+        result_path.stem + "-amin.csv")
+    # refuse bad outputs before any kernel run
+    outs = [p for p in (out, lines_path, fig_path) if p is not None]
+    if len({str(p.resolve()) for p in outs}) < len(outs):
+        raise click.ClickException("-o, --lines and --plot must name different files")
+    check_output(out, overwrite=overwrite, inputs=[result_path])
+    if lines_path is not None:
+        check_output(lines_path, overwrite=overwrite, inputs=[result_path])
+    if fig_path is not None:
+        check_output(fig_path, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
+    result = read_result(result_path, ["outcome"])
+    curves, bounds = bd.result_curves(result, rtol, None if mode is None else int(mode))
+
+    def write_text(text: str):
+        return lambda tmp: tmp.write_text(text)
+
+    rows = bd.a_min_rows(curves)
+    write_atomic(out, write_text(bd.csv_text(rows)))
+    runs = int(sum(int(c.runs.sum()) for c in curves))
+    click.echo(f"wrote {out} ({len(rows)} A_min values over {len(curves)} panel(s), "
+               f"{runs} kernel runs for the bisection to rtol {rtol:g})")
+    if lines_path is not None:
+        lrows = bd.boundary_rows(bounds)
+        write_atomic(lines_path, write_text(bd.csv_text(lrows)))
+        n = sum(len(b.lines) for b in bounds)
+        click.echo(f"wrote {lines_path} ({n} boundary lines, {len(lrows)} vertices)")
+    if fig_path is not None:
+        from rocksweep.diagrams import a_min_figure
+
+        fig = a_min_figure(curves, bounds, title=result.name, kind=result.kind)
+        save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=[result_path])
+        click.echo(f"wrote {fig_path}")
