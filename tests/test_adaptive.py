@@ -218,3 +218,40 @@ def test_bad_settings_are_one_line_errors(block_long, kwargs, word):
     with pytest.raises(RocksweepError) as err:
         ad.make_plan(sc, **kwargs)
     assert word in str(err.value) and "\n" not in str(err.value)
+
+
+def test_interrupted_audit_resumes_to_the_same_flags():
+    """``next_step`` finishes a begun audit batch before refining around its misses, and
+    compares its points with the fill of the points computed before the audit: however a
+    run is cut (any part of any batch, audit included), the flags equal an uninterrupted
+    run's, audit misses included."""
+    shape = (2, 129, 129)
+    truth = disc_map(shape, 70.3, 40.1, 14.0)
+    # specks of class 1 on audit candidates inside uniform coarse cells: audit misses
+    plan = ad.Plan(shape, 2, 1, coarse=4, audit=0.05, seed=2)
+    cand = ad.audit_mask(plan).reshape(shape)
+    for p in range(2):
+        ys, xs = np.nonzero(cand[p])
+        far = ((np.abs((ys + 8) % 16 - 8) >= 4) & (np.abs((xs + 8) % 16 - 8) >= 4)
+               & (ys > 0.3 * 129 + 0.2 * xs + 20))
+        for y0, x0 in list(zip(ys[far], xs[far], strict=True))[:3]:
+            truth[p, y0, x0] = 2
+    t = truth.ravel()
+    ref_out, ref_comp, ref_st = ad.drive(plan, synthetic(plan, t)[0])
+    assert ref_st.audit_misses >= 2  # the audit batch matters here
+    for seed in range(4):
+        rng = np.random.default_rng(seed)
+        outcome = np.full(plan.size, -1, np.int8)
+        computed = np.zeros(plan.size, np.int8)
+        for _ in range(2000):
+            step = ad.next_step(plan, outcome, computed)
+            b = step.batch
+            if b.kind == "done":
+                break
+            part = b.flat[rng.random(len(b)) < 0.3] if len(b) > 1 else b.flat  # "killed"
+            outcome[part] = t[part]
+            computed[part] = step.flags(part, t[part])
+        else:
+            raise AssertionError("no convergence")
+        np.testing.assert_array_equal(computed, ref_comp)
+        np.testing.assert_array_equal(ad.fill(plan, outcome, computed), ref_out)
