@@ -675,3 +675,40 @@ def adaptive_compute(scene: Scene, jobs: int = 1, coarse: int | None = None,
     flat["outcome"] = outcome
     flat["computed"] = computed
     return {k: v.reshape(grid.shape) for k, v in flat.items()}, stats
+
+
+@dataclass
+class Validation:
+    """A check of a finished adaptive sweep against a coarse full grid: stride: of the
+    lattice (every stride-th index of both diagram axes from stride // 2: an odd stride,
+    so the lattice is not one the refinement computes); points: lattice points;
+    checked: those that were filled (computed now; the others are kernel results
+    already); differ: flat indices (int64, increasing) of the checked points whose
+    kernel class differs from the fill, classes: those kernel classes."""
+
+    stride: int
+    points: int
+    checked: int
+    differ: np.ndarray
+    classes: np.ndarray
+
+
+def validate(grid: Grid, plan: Plan, outcome: np.ndarray, computed: np.ndarray,
+             stride: int | None = None, jobs: int = 1, chunk_size: int | None = None,
+             backend: str = "threads", scheduler: str | None = None) -> Validation:
+    """Compute the filled points of a uniform lattice (default stride: half a coarse
+    cell plus one, at least 3) and compare them with their fill (``--validate``).
+    outcome: the filled classes, computed: the flags (int8[size] each). Nothing is
+    written: the file keeps the adaptive result."""
+    s = max(3, 2 ** (plan.coarse - 1) + 1) if stride is None else int(stride)
+    if s < 1:
+        raise AdaptiveError(f"validate stride = {s}: must be >= 1")
+    _, ny, nx = plan.panel_shape
+    ys, xs = np.arange(s // 2, ny, s), np.arange(s // 2, nx, s)
+    lattice = np.sort(plan.flat_index()[:, ys][:, :, xs].ravel())
+    filled = lattice[np.asarray(computed).ravel()[lattice] == FILLED]
+    cls = np.full(filled.size, -1, np.int8)
+    for res in run_batch(grid, filled, jobs, chunk_size, backend, scheduler):
+        cls[np.searchsorted(filled, res.flat)] = res.arrays["outcome"]
+    bad = cls != np.asarray(outcome).ravel()[filled]
+    return Validation(s, int(lattice.size), int(filled.size), filled[bad], cls[bad])

@@ -11,6 +11,7 @@ inside the functions), so ``import rocksweep`` stays light.
 
 from __future__ import annotations
 
+import functools
 import math
 import sys
 import time
@@ -25,7 +26,7 @@ if TYPE_CHECKING:
     import xarray as xr
     from matplotlib.figure import Figure
 
-    from rocksweep.adaptive import AdaptiveStats, Options
+    from rocksweep.adaptive import AdaptiveStats, Options, Validation
     from rocksweep.scene import Scene
     from rocksweep.single import Run
 
@@ -144,6 +145,7 @@ class SweepReport:
     compile_s: float
     attrs: dict = field(default_factory=dict)
     adaptive: AdaptiveStats | None = None  # adaptive sweeps: the file's counts
+    validation: Validation | None = None  # adaptive sweeps with validate=True
 
     @property
     def points_done(self) -> int:
@@ -182,8 +184,8 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
                backend: str = "threads", scheduler: str | None = None,
                chunk_size: int | None = None, write_every: float = WRITE_EVERY,
                progress: bool = False, log: Callable[[str], None] | None = None,
-               inputs: Iterable[str | Path] = (), adaptive: Options | None = None
-               ) -> SweepReport:
+               inputs: Iterable[str | Path] = (), adaptive: Options | None = None,
+               validate: bool = False) -> SweepReport:
     """Sweep ``scene`` into the result file ``path`` (``rocksweep sweep``).
 
     Makes the file (refusing an existing one unless ``overwrite``), or with ``resume``
@@ -198,7 +200,9 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
     lines; inputs: the command's input files, never written over; overrides: recorded in
     the file; adaptive: compute only near the class boundaries (``rocksweep.adaptive``,
     see ``_adaptive_loop``; the file records the settings, and a resume must give the
-    same). Returns a ``SweepReport``.
+    same); validate: with adaptive, also compute the filled points of a coarse uniform
+    lattice and report those whose class differs from the fill (``report.validation``;
+    the file is not changed). Returns a ``SweepReport``.
     """
     from rocksweep import sweep as sw
     from rocksweep.outputs import OutputError, check_output
@@ -251,7 +255,10 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
                               adaptive=settings)
     report = SweepReport(path, sf.grid.size, 0, 0, 0.0, 0.0, 0.0)
     pending: list = []  # finished chunks not yet in the file (each loop writes its own)
-    loop = _every_point_loop if adaptive is None else _adaptive_loop
+    if validate and adaptive is None:
+        raise ApiError("validate=True checks an adaptive sweep; add adaptive")
+    loop = (_every_point_loop if adaptive is None
+            else functools.partial(_adaptive_loop, validate=validate))
     try:
         loop(sf, report, adaptive, jobs=jobs, backend=backend, scheduler=scheduler,
              chunk_size=chunk_size, where=where, write_every=write_every,
@@ -337,7 +344,7 @@ def _prepare_kernel(sf, lvl: int, report: SweepReport, say: Callable[[str], None
 def _adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backend: str,
                    scheduler: str | None, chunk_size: int | None, where: str,
                    write_every: float, progress: bool, say: Callable[[str], None],
-                   pending: list) -> None:
+                   pending: list, validate: bool = False) -> None:
     """The adaptive sweep of an open file (``rocksweep.adaptive``).
 
     The state (outcome, computed) is read from the file; ``adaptive.next_step`` plans a
@@ -412,11 +419,16 @@ def _adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, back
         finally:
             write_pending()
     stats = ad.stats_of(computed, options.threshold)
-    sf.write_filled(ad.fill(plan, outcome, computed),
+    filled = ad.fill(plan, outcome, computed)
+    sf.write_filled(filled,
                     {"points_computed": stats.computed,
                      "points_filled": stats.points - stats.computed,
                      "points_audited": stats.audited, "audit_misses": stats.audit_misses})
     report.adaptive = stats
+    if validate:
+        say("validating: computing the filled points of a coarse uniform lattice...")
+        report.validation = ad.validate(sf.grid, plan, filled, computed, None, jobs,
+                                        chunk_size, backend, scheduler)
 
 
 # ---------------------------------------------------------------------------------------
@@ -429,7 +441,8 @@ def _stderr(line: str) -> None:
 
 def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
         overrides: Overrides = (), progress: bool = False, overwrite: bool = False,
-        resume: bool = False, adaptive: bool = False, coarse: int | None = None,
+        resume: bool = False, adaptive: bool = False, validate: bool = False,
+        coarse: int | None = None,
         audit: float | None = None, axes: Sequence[str] | None = None,
         **adaptive_settings: Any) -> xr.Dataset:
     """Compute every point of a scene's grid; return the results as an xarray Dataset.
@@ -453,7 +466,8 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
     point of the diagram axes first; default: 16 coarse cells per axis); audit: share of
     the filled points computed as a check (default 0.02); axes: the two diagram axes
     (default ("w_over_p", "A_ratio")); further settings as keywords (margin,
-    final_margin, seed, threshold: see ``rocksweep.adaptive.Options``). The Dataset then
+    final_margin, seed, threshold: see ``rocksweep.adaptive.Options``); validate: check
+    the fill on a coarse uniform lattice (printed with ``progress``). The Dataset then
     also has ``computed`` (0 filled, 1 computed, 2/3 audit point that agreed/disagreed)
     and filled points hold their "not computed" values in every variable but outcome.
 
@@ -474,11 +488,11 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
         with tempfile.TemporaryDirectory(prefix="rocksweep-") as tmp:
             path = Path(tmp) / "result.h5"
             sweep_file(sc, path, overrides=ov, jobs=jobs, progress=progress, log=log,
-                       adaptive=opts)
+                       adaptive=opts, validate=validate)
             return open(path)
     sweep_file(sc, output, overrides=ov, jobs=jobs, resume=resume, overwrite=overwrite,
                progress=progress, log=log, inputs=[source] if source else (),
-               adaptive=opts)
+               adaptive=opts, validate=validate)
     return open(output)
 
 

@@ -246,6 +246,30 @@ def _title(result: SweepResult, on_axes: Sequence[str]) -> str:
     return ", ".join([name, *extra])
 
 
+def _fit(title: str, fig: Figure) -> str:
+    """A title wrapped to the figure's width (about 9 characters per inch at 11 pt), so
+    a long scene name is not cut at the edges: words outside mathtext ($...$) break."""
+    width = max(20, int(9 * fig.get_figwidth()))
+    if len(title) <= width:
+        return title
+    words = [w for w in title.split(" ")]
+    tokens, math = [], False  # words joined while inside $...$
+    for w in words:
+        if math:
+            tokens[-1] += " " + w
+        else:
+            tokens.append(w)
+        if w.count("$") % 2:
+            math = not math
+    lines = [""]
+    for t in tokens:
+        if lines[-1] and len(lines[-1]) + 1 + len(t) > width:
+            lines.append(t)
+        else:
+            lines[-1] = f"{lines[-1]} {t}" if lines[-1] else t
+    return "\n".join(lines)
+
+
 def _place_axes(axes, n: int, rows_cols: tuple[int, int], size: tuple[float, float],
                 what: str) -> tuple[Figure, list, bool]:
     if axes is None:
@@ -366,7 +390,7 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
         ncols = _layout(result, panel_dims, len(panels))[1]
         fig.legend(handles=handles, loc="outside lower center", fontsize=8, frameon=False,
                    ncol=max(1, min(len(handles), 2 * ncols)))
-        fig.suptitle(_title(result, (x, y)), fontsize=11)
+        fig.suptitle(_fit(_title(result, (x, y)), fig), fontsize=11)
     else:
         flat[0].legend(handles=handles, fontsize=7, loc="upper left")
     return fig
@@ -442,7 +466,7 @@ def line_diagram(result: SweepResult, x: str | None = None, *,
         ncols = _layout(result, panel_dims, len(panels))[1]
         fig.legend(handles=handles, loc="outside lower center", fontsize=8, frameon=False,
                    ncol=max(1, min(len(handles), 2 * ncols)))
-        fig.suptitle(_title(result, (x,)), fontsize=11)
+        fig.suptitle(_fit(_title(result, (x,)), fig), fontsize=11)
     else:
         flat[0].legend(handles=handles, fontsize=7)
     return fig

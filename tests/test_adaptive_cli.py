@@ -325,9 +325,9 @@ def test_plot_with_curves_and_run_api(fig3_files, cli, tmp_path):
         canvas.draw()
         return np.asarray(canvas.buffer_rgba())
 
-    flagged = read_result(full, ["status"]).flagged.any()
-    if not flagged:  # flagged points carry a mark only where computed
-        np.testing.assert_array_equal(pixels(adapt), pixels(full))
+    # (flagged points carry a mark only where computed: this scene has none)
+    assert not read_result(full, ["status"]).flagged.any()
+    np.testing.assert_array_equal(pixels(adapt), pixels(full))
     ds = rocksweep.run(FIG3_SMALL, jobs=2, adaptive=True, coarse=2)
     np.testing.assert_array_equal(ds["computed"].values, read_result(adapt).arrays["computed"])
     with pytest.raises(api.ApiError, match="coarse = 2: an adaptive setting"):
@@ -385,3 +385,31 @@ def test_boundaries_errors(cli, tmp_path, edit, message):
     line = one_line_error(res)
     assert message in line and str(out) in line
     assert not (tmp_path / "s-amin.csv").exists()
+
+
+def test_validate_reports_filled_cells_that_differ(fig3_files, cli, tmp_path):
+    scene, full, adapt, _ = fig3_files
+    out = tmp_path / "v.h5"
+    res = cli.invoke(main, ["sweep", str(scene), "-o", str(out), "--adaptive", "--coarse",
+                            "2", "--validate", "-j", "2"])
+    assert res.exit_code == 0, res.output
+    assert "validate: " in res.output and "lattice" in res.output
+    assert_same_files(out, adapt)  # the file keeps the adaptive result
+    # a fill made wrong on purpose at filled points of the lattice is reported, exactly
+    sc = parse_scene(FIG3_SMALL)
+    r = read_result(adapt)
+    outcome, computed = r.arrays["outcome"].ravel(), r.arrays["computed"].ravel()
+    from rocksweep.grid import Grid
+
+    plan = ad.make_plan(sc, coarse=2)
+    v0 = ad.validate(Grid(sc), plan, outcome, computed, stride=3)
+    assert v0.checked > 100 and v0.differ.size == 0
+    truth = read_result(full).arrays["outcome"].ravel()
+    _, ny, nx = plan.panel_shape
+    lat = plan.flat_index()[:, 1::3][:, :, 1::3].ravel()
+    wrong = np.sort(lat[computed[lat] == 0][::7])
+    bad = outcome.copy()
+    bad[wrong] = (truth[wrong] + 1) % 3
+    v = ad.validate(Grid(sc), plan, bad, computed, stride=3, jobs=2)
+    np.testing.assert_array_equal(v.differ, wrong)
+    np.testing.assert_array_equal(v.classes, truth[wrong])

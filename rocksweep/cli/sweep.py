@@ -52,6 +52,10 @@ WRITE_EVERY = 1.0  # = rocksweep.api.WRITE_EVERY (not imported here: --help stay
                    "[default: 0.02].")
 @click.option("--axes", "adaptive_axes", metavar="X,Y", default=None,
               help="Adaptive: the two diagram axes [default: w_over_p,A_ratio].")
+@click.option("--validate", is_flag=True,
+              help="Adaptive: also compute the filled points of a uniform lattice (half a "
+                   "coarse cell apart) and report those whose class differs from the "
+                   "fill; the file keeps the adaptive result.")
 @click.option("--margin", type=int, default=None, hidden=True,
               help="Adaptive: cells refined around a mixed cell [default: 1].")
 @click.option("--final-margin", "final_margin", type=int, default=None, hidden=True,
@@ -66,7 +70,8 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
           resume: bool, overwrite: bool, quiet: bool, backend: str, scheduler: str | None,
           chunk_size: int | None, write_every: float, adaptive: bool, coarse: int | None,
           audit: float | None, adaptive_axes: str | None, margin: int | None,
-          final_margin: int | None, seed: int | None, threshold: float | None) -> None:
+          final_margin: int | None, seed: int | None, threshold: float | None,
+          validate: bool) -> None:
     """Compute the stability diagram of SCENE.yaml: every point of its grid.
 
     Writes outcome (0 safe, 1 mode 1, 2 mode 2, -1 not computed), impacts, uplifts,
@@ -94,6 +99,8 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     settings = {"coarse": coarse, "audit": audit, "axes": adaptive_axes, "margin": margin,
                 "final_margin": final_margin, "seed": seed, "threshold": threshold}
     given = [k for k, v in settings.items() if v is not None]
+    if validate:
+        given.append("validate")
     if given and not adaptive:
         raise click.ClickException(f"--{given[0].replace('_', '-')} is a setting of "
                                    "adaptive sweeps; add --adaptive")
@@ -110,7 +117,7 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
                                 overwrite=overwrite, backend=backend, scheduler=scheduler,
                                 chunk_size=chunk_size, write_every=write_every,
                                 progress=not quiet, log=say, inputs=[scene_path],
-                                adaptive=options)
+                                adaptive=options, validate=validate)
     except api.SweepInterrupted as stop:
         r = stop.report
         click.echo(f"\ninterrupted: {r.points_done} of {r.points_total} points saved in "
@@ -137,8 +144,27 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
                    "fill")
         if st.warning():
             click.echo(f"warning: {st.warning()}", err=True)
+    v = report.validation
+    if v is not None:
+        click.echo(f"validate: {v.checked} filled points of the stride-{v.stride} lattice "
+                   f"({v.points} points) computed: {v.differ.size} differ from their fill"
+                   + (f" ({100 * v.differ.size / v.checked:.3f}%)" if v.checked else ""))
+        if v.differ.size:
+            vals = report_cells(scene, v.differ[:5])
+            click.echo("  e.g. " + "; ".join(vals))
     click.echo(f"accuracy: {scene.numerics.describe()}")
     click.echo(f"RK4 steps: {a['steps_total']} + {a['event_steps_total']} event "
                f"re-integrations (all points in the file)")
     state = "complete" if a["complete"] else f"{a['points_done']} points done"
     click.echo(f"wrote {out} ({state})")
+
+
+def report_cells(scene, flat) -> list[str]:
+    """The swept values of some grid points, as 'key=value, ...' texts."""
+    from rocksweep.grid import Grid
+
+    values = Grid(scene).index_values(flat)
+    swept = [a.name for a in scene.swept]
+    return [", ".join(f"{k}={values[k][i]:.4g}" if not isinstance(values[k][i], str)
+                      else f"{k}={values[k][i]}" for k in swept)
+            for i in range(len(flat))]
