@@ -205,8 +205,11 @@ class FlexibleBody:
         oscillates faster than omega_n, by sqrt(I_O / (I_A + m_A R_A^2 + m b^2)) (about 2.7
         for the paper's bodies). The step size must resolve this, not omega_n.
         """
+        from rocksweep.kernel.equations import rocking_spring_omega  # one definition
+
         i_a0 = self.I_A + self.m_A * self.R_A**2
-        return self.omega_n * math.sqrt(self.I_O / (i_a0 + self.m * self.b**2))
+        # undamped, lever arm a = u - s b = -s b at u = 0
+        return rocking_spring_omega(self.omega_n, 0.0, self.m, self.h, i_a0, self.b)
 
 
 @dataclass(frozen=True)

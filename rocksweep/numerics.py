@@ -12,7 +12,7 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
-# Event root finders (``rocksweep.kernel.integrate._locate``); each keeps the bracket and
+# Event root finders (``rocksweep.kernel.events._locate``); each keeps the bracket and
 # stops at event_tol. Hermite (the default) takes 2-4 RK4 re-integrations per event where
 # bisection takes log2(step/event_tol) ~ 20, with bisection steps as its safeguard; on the
 # four figures' accuracy samples all three give the same outcomes at every preset
@@ -65,7 +65,7 @@ class Numerics:
         contact (ends a chattering sequence after finitely many impacts).
     max_events: cap on impacts + uplifts per run (reported as a status flag).
     max_steps_factor: cap on RK4 evaluations per run, as a multiple of horizon/step.
-    root: event root finder, one of ROOTS (see ``rocksweep.kernel.integrate._locate``).
+    root: event root finder, one of ROOTS (see ``rocksweep.kernel.events._locate``).
     """
 
     accuracy: str = "default"

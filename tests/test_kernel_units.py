@@ -187,8 +187,10 @@ def test_rocking_spring_omega_matches_the_model_at_lever_arm_b_and_is_largest_at
                         mA_over_m=0.47, IA_ratio=0.56)
     i_a0 = body.I_A + body.m_A * body.R_A**2
     at_b = rocking_spring_omega(body.omega_n, 0.0, body.m, body.h, i_a0, body.b)
-    # model.omega_rock: omega_n sqrt(I_O / (I_A + m_A R_A^2 + m b^2)), written from I_O
-    assert at_b == pytest.approx(body.omega_rock, rel=1e-13)
+    # at u = 0 (a = b): omega_n sqrt(I_O / (I_A + m_A R_A^2 + m b^2)), written from I_O
+    assert at_b == pytest.approx(body.omega_n * math.sqrt(body.I_O / (i_a0 + body.m * body.b**2)),
+                                 rel=1e-13)
+    assert body.omega_rock == at_b  # the model's property is this one definition
     assert body_omega_rock(body) > at_b
     # overdamped (zeta sqrt(Gamma) > 1): the fast root omega (zeta' + sqrt(zeta'^2 - 1))
     gamma = 1 + body.m * body.h**2 / i_a0
