@@ -11,6 +11,11 @@ looked up) for every coarse level, which is how the default coarse level was cho
     python scripts/bench_adaptive.py --res 0 --study      # at the shipped resolution
     python scripts/bench_adaptive.py --fine               # Figure 3(a) 1000 x 1000 x 3 lam
     python scripts/bench_adaptive.py --fine --no-full     # ... adaptive only
+    python scripts/bench_adaptive.py --fine --file        # ... and through a result file
+
+``--file`` adds the time of the same adaptive sweep written to an HDF5 result file
+(``rocksweep.api.sweep_file``, what ``rocksweep sweep --adaptive`` runs) and checks that
+its outcome equals the in-memory one.
 
 Targets: equal outcome on >= 99.9% of cells; <= 10% of the points computed at 400 x 400,
 <= 4% at 1000 x 1000; Figure 3(a) 1000 x 1000 x 3 lam in < 20 s on 2 cores.
@@ -97,6 +102,8 @@ def main() -> None:
                     help="Figure 3(a) at 1000 x 1000 x 3 lam (configs/fig3a-fine.yaml) only")
     ap.add_argument("--no-full", action="store_true", help="skip the full sweeps")
     ap.add_argument("--study", action="store_true", help="replay every coarse level")
+    ap.add_argument("--file", action="store_true",
+                    help="also time the adaptive sweep into a result file (sweep_file)")
     args = ap.parse_args()
     jobs = sw.effective_jobs(args.jobs)
     print(f"cores: {os.cpu_count()}, jobs: {jobs}, load average at start: "
@@ -124,6 +131,20 @@ def main() -> None:
             f"{100 * np.mean(arr['outcome'] == full):.4f}% "
             f"({int(np.sum(arr['outcome'] != full))} differ)")
         plan = ad.make_plan(grid)
+        if args.file:
+            import tempfile
+
+            from rocksweep.api import sweep_file
+            from rocksweep.store import read_result
+
+            with tempfile.TemporaryDirectory() as tmp:
+                t0 = time.perf_counter()
+                sweep_file(sc, Path(tmp) / "a.h5", jobs=jobs, adaptive=ad.Options())
+                t_file = time.perf_counter() - t0
+                same = np.array_equal(read_result(Path(tmp) / "a.h5", ["outcome"])
+                                      .arrays["outcome"], arr["outcome"])
+            print(f"    {name}: through a result file {t_file:.1f} s "
+                  f"(outcome {'equal to' if same else 'DIFFERS from'} the in-memory sweep)")
         rows.append(f"| {name} | {' x '.join(map(str, sc.shape))} | "
                     f"{st.computed} / {st.points} = {100 * st.computed_share:.2f}% | "
                     f"{t_ad:.1f} | {t_full:.1f} | {t_full / t_ad:.1f}x | {eq} | "
