@@ -286,11 +286,12 @@ def _place_axes(axes, n: int, rows_cols: tuple[int, int], size: tuple[float, flo
 def stability_diagram(result: SweepResult, x: str | None = None, y: str | None = None, *,
                       axes: Axes | Sequence[Axes] | None = None,
                       option_names: tuple[str, str] = ("x", "y"),
-                      curves: bool = False) -> Figure:
+                      curves: bool = False, show_computed: bool = False) -> Figure:
     """The stability diagram of ``result`` over swept axes x and y (see the module
     docstring; defaults from ``choose_axes``). Needs the ``outcome`` and ``status``
     arrays. axes: one Axes per panel to draw into (else a new figure); curves: overlay
-    the boundary lines of every lam. Returns the figure.
+    the boundary lines of every lam; show_computed: shade the cells an adaptive sweep
+    computed at some lam (needs the ``computed`` array). Returns the figure.
     """
     x, y = choose_axes(result, x, y, option_names)
     if y is None:
@@ -302,11 +303,16 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
     panel_dims = [d for d in dims if d not in (x, y) and not (layered and d == "lam")]
     order = [*panel_dims, *(["lam"] if layered else []), y, x]
     flagged = result.flagged & result.done
-    o, fl = _arrays(result, order, ["outcome", flagged])
+    if show_computed and "computed" not in result.arrays:
+        raise DiagramError(f"{result.path}: not an adaptive sweep (no 'computed' flags): "
+                           "every cell is computed")
+    comp = (np.asarray(result.arrays["computed"]) > 0 if show_computed
+            else np.zeros(result.shape, bool))
+    o, fl, cp = _arrays(result, order, ["outcome", flagged, comp])
     if layered:
         lam = _coord(result, "lam")
     else:  # one layer: the fixed lam, or none when lam is on an axis
-        o, fl = o[..., None, :, :], fl[..., None, :, :]
+        o, fl, cp = o[..., None, :, :], fl[..., None, :, :], cp[..., None, :, :]
         lam = np.array([float(result.scalars["lam"])]) if "lam" in result.scalars else None
     panels = _panels(result, panel_dims)
 
@@ -335,6 +341,10 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
             any_back = True
             yy, xx = np.nonzero(later_safe)
             ax.plot(xs[xx], ys[yy], ".", color="k", ms=2.5)
+        if show_computed:  # grey veil over the computed cells, filled ones left clear
+            veil = np.where(cp[idx].any(axis=0), 1.0, np.nan)
+            ax.pcolormesh(xs, ys, veil, cmap=ListedColormap(["black"]), alpha=0.35,
+                          shading="nearest", rasterized=True)
         if curves:
             _draw_boundaries(ax, po, xs, ys)
         f_any = pf.any(axis=0)
@@ -380,6 +390,9 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
     if any_flag:
         handles.append(Line2D([], [], ls="", marker="x", color="k",
                               label="flagged (horizon/step/event cap, non-finite)"))
+    if show_computed:
+        handles.append(Patch(fc="black", alpha=0.35, ec="0.5",
+                             label="computed (adaptive; clear: filled)"))
     if curves:
         for k in range(n_lam):
             label = (f"boundaries at ${lam_sym}$ = {_fmt(lam[k])}" if lam is not None
@@ -474,19 +487,21 @@ def line_diagram(result: SweepResult, x: str | None = None, *,
 
 def sweep_figure(result: SweepResult, x: str | None = None, y: str | None = None, *,
                  axes: Axes | Sequence[Axes] | None = None,
-                 option_names: tuple[str, str] = ("x", "y"), curves: bool = False) -> Figure:
+                 option_names: tuple[str, str] = ("x", "y"), curves: bool = False,
+                 show_computed: bool = False) -> Figure:
     """The figure ``rocksweep plot`` draws: a stability diagram over (x, y), or a line
     plot when the result has one swept axis besides lam (see ``choose_axes``); curves:
-    the boundary lines over the diagram (``rocksweep plot --curves``)."""
+    the boundary lines over the diagram (``rocksweep plot --curves``); show_computed: the
+    cells an adaptive sweep computed shaded (``--show-computed``)."""
     x, y = choose_axes(result, x, y, option_names)
     if y is None:
-        if curves:
-            raise DiagramError(f"{result.path}: --curves draws boundary lines on a "
+        if curves or show_computed:
+            raise DiagramError(f"{result.path}: --curves and --show-computed draw on a "
                                f"stability diagram; this result has one swept axis ({x}) "
                                "besides lam")
         return line_diagram(result, x, axes=axes, option_names=option_names)
     return stability_diagram(result, x, y, axes=axes, option_names=option_names,
-                             curves=curves)
+                             curves=curves, show_computed=show_computed)
 
 
 def _draw_boundaries(ax: Axes, po: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> None:

@@ -328,6 +328,14 @@ def test_plot_with_curves_and_run_api(fig3_files, cli, tmp_path):
     # (flagged points carry a mark only where computed: this scene has none)
     assert not read_result(full, ["status"]).flagged.any()
     np.testing.assert_array_equal(pixels(adapt), pixels(full))
+    # --show-computed shades the computed cells: the figure differs, only for adaptive files
+    shaded = tmp_path / "shaded.png"
+    res = cli.invoke(main, ["plot", str(adapt), "--show-computed", "-o", str(shaded)])
+    assert res.exit_code == 0, res.output
+    assert shaded.read_bytes() != (tmp_path / f"{adapt.stem}.png").read_bytes()
+    res = cli.invoke(main, ["plot", str(full), "--show-computed", "-o", str(shaded),
+                            "--overwrite"])
+    assert "not an adaptive sweep (no 'computed' flags)" in one_line_error(res)
     ds = rocksweep.run(FIG3_SMALL, jobs=2, adaptive=True, coarse=2)
     np.testing.assert_array_equal(ds["computed"].values, read_result(adapt).arrays["computed"])
     with pytest.raises(api.ApiError, match="coarse = 2: an adaptive setting"):

@@ -25,9 +25,12 @@ from rocksweep.cli.main import main, user_errors
 @click.option("--curves", is_flag=True,
               help="Overlay the boundary lines between classes, one colour per lam "
                    "(`rocksweep boundaries` gives them as CSV, with A_min).")
+@click.option("--show-computed", "show_computed", is_flag=True,
+              help="Adaptive sweeps: shade the cells that were computed (the filled ones "
+                   "stay clear); by default both are drawn alike.")
 @user_errors
 def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str | None,
-         dpi: int, overwrite: bool, curves: bool) -> None:
+         dpi: int, overwrite: bool, curves: bool, show_computed: bool) -> None:
     """Draw the stability diagram of a sweep: by default x = omega/p, y = A/(g tan
     alpha_cg); --x/--y pick any two swept axes. Mode 1 / mode 2 / safe regions, one panel
     per pulse shape and per other swept key, the growth of the mode 1 area with lam in
@@ -42,8 +45,10 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
     fig_out = fig_path if fig_path is not None else result_path.with_suffix(".png")
     # refuse a bad output before reading the result and drawing
     check_output(fig_out, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
-    result = read_result(result_path, ["outcome", "status", "theta_max_over_alpha"])
-    fig = sweep_figure(result, x_key, y_key, option_names=("--x", "--y"), curves=curves)
+    result = read_result(result_path, ["outcome", "status", "theta_max_over_alpha"],
+                         ("computed",) if show_computed else ())
+    fig = sweep_figure(result, x_key, y_key, option_names=("--x", "--y"), curves=curves,
+                       show_computed=show_computed)
     save_figure(fig, fig_out, dpi, overwrite=overwrite, inputs=[result_path])
     for w in missing_warnings(result):
         click.echo(f"warning: {w}", err=True)
