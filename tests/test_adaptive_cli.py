@@ -329,10 +329,11 @@ def test_plot_with_curves_and_run_api(fig3_files, cli, tmp_path):
     assert not read_result(full, ["status"]).flagged.any()
     np.testing.assert_array_equal(pixels(adapt), pixels(full))
     # --show-computed shades the computed cells: the figure differs, only for adaptive files
-    shaded = tmp_path / "shaded.png"
-    res = cli.invoke(main, ["plot", str(adapt), "--show-computed", "-o", str(shaded)])
-    assert res.exit_code == 0, res.output
-    assert shaded.read_bytes() != (tmp_path / f"{adapt.stem}.png").read_bytes()
+    shaded, plain = tmp_path / "shaded.png", tmp_path / "plain.png"
+    for args, png in ((["--show-computed"], shaded), ([], plain)):
+        res = cli.invoke(main, ["plot", str(adapt), *args, "-o", str(png)])
+        assert res.exit_code == 0, res.output
+    assert shaded.read_bytes() != plain.read_bytes()
     res = cli.invoke(main, ["plot", str(full), "--show-computed", "-o", str(shaded),
                             "--overwrite"])
     assert "not an adaptive sweep (no 'computed' flags)" in one_line_error(res)
