@@ -56,13 +56,13 @@ WRITE_EVERY = 1.0  # = rocksweep.api.WRITE_EVERY (not imported here: --help stay
               help="Adaptive: also compute the filled points of a uniform lattice (half a "
                    "coarse cell apart) and report those whose class differs from the "
                    "fill; the file keeps the adaptive result.")
-@click.option("--margin", type=int, default=None, hidden=True,
+@click.option("--margin", type=int, default=None,
               help="Adaptive: cells refined around a mixed cell [default: 1].")
-@click.option("--final-margin", "final_margin", type=int, default=None, hidden=True,
+@click.option("--final-margin", "final_margin", type=int, default=None,
               help="Adaptive: the same at the last level [default: 0].")
-@click.option("--seed", type=int, default=None, hidden=True,
+@click.option("--seed", type=int, default=None,
               help="Adaptive: seed of the audit sample [default: 0].")
-@click.option("--threshold", type=float, default=None, hidden=True,
+@click.option("--threshold", type=float, default=None,
               help="Adaptive: warn when more than this share of audit points disagree "
                    "[default: 0.002].")
 @user_errors
