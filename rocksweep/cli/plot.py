@@ -21,16 +21,20 @@ from rocksweep.cli.main import main, user_errors
               help="Swept axis along y [default: A_ratio when swept].")
 @click.option("--dpi", type=click.IntRange(20, 2400), default=200, show_default=True,
               help="Resolution of raster output (PNG).")
+@click.option("--mu", "mu_map", is_flag=True,
+              help="Draw the friction demand mu_required (a result with contact outputs) as "
+                   "a contour map instead of the classes.")
 @click.option("--overwrite", is_flag=True, help="Replace an existing figure file.")
 @user_errors
 def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str | None,
-         dpi: int, overwrite: bool) -> None:
+         dpi: int, mu_map: bool, overwrite: bool) -> None:
     """Draw the stability diagram of a sweep: by default x = omega/p, y = A/(g tan
     alpha_cg); --x/--y pick any two swept axes. Mode 1 / mode 2 / safe regions, one panel
     per pulse shape and per other swept key, the growth of the mode 1 area with lam in
     shades of red. A sweep with one swept axis besides lam is drawn as max|theta|/alpha
-    against it, markers by outcome."""
-    from rocksweep.diagrams import missing_warnings, sweep_figure
+    against it, markers by outcome. With contact outputs and body.mu, the points that would
+    slide are hatched (and those that would lift off dotted); --mu draws mu_required."""
+    from rocksweep.diagrams import friction_map, missing_warnings, sweep_figure
     from rocksweep.outputs import check_output
     from rocksweep.plots import FORMATS, save_figure
     from rocksweep.store import read_result
@@ -38,8 +42,12 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
     fig_out = fig_path if fig_path is not None else result_path.with_suffix(".png")
     # refuse a bad output before reading the result and drawing
     check_output(fig_out, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
-    result = read_result(result_path, ["outcome", "status", "theta_max_over_alpha"])
-    fig = sweep_figure(result, x_key, y_key, option_names=("--x", "--y"))
+    if mu_map:
+        result = read_result(result_path, ["outcome", "status", "mu_required"])
+        fig = friction_map(result, x_key, y_key, option_names=("--x", "--y"))
+    else:
+        result = read_result(result_path, ["outcome", "status", "theta_max_over_alpha"])
+        fig = sweep_figure(result, x_key, y_key, option_names=("--x", "--y"))
     save_figure(fig, fig_out, dpi, overwrite=overwrite, inputs=[result_path])
     for w in missing_warnings(result):
         click.echo(f"warning: {w}", err=True)

@@ -37,10 +37,13 @@ WRITE_EVERY = 1.0  # = rocksweep.api.WRITE_EVERY (not imported here: --help stay
               show_default=True, metavar="SECONDS",
               help="Write finished chunks to the file at most this often; a killed sweep "
                    "loses at most this much computing (Ctrl-C loses nothing).")
+@click.option("--contact", is_flag=True,
+              help="Also store the friction demand mu_required, the smallest normal force "
+                   "and the impulse ratio per point (as outputs.contact: true).")
 @user_errors
 def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, jobs: int,
           resume: bool, overwrite: bool, quiet: bool, backend: str, scheduler: str | None,
-          chunk_size: int | None, write_every: float) -> None:
+          chunk_size: int | None, write_every: float, contact: bool) -> None:
     """Compute the stability diagram of SCENE.yaml: every point of its grid.
 
     Writes outcome (0 safe, 1 mode 1, 2 mode 2, -1 not computed), impacts, uplifts,
@@ -48,6 +51,8 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     (open it with xarray, `rocksweep info` or `rocksweep plot`). Results are written as
     chunks finish; if the run is interrupted, run the same command with --resume.
     """
+    if contact:
+        overrides = (*overrides, "outputs.contact=true")
     if resume and overwrite:
         raise click.ClickException("--resume and --overwrite exclude each other")
     if backend == "dask":
