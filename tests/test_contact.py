@@ -118,7 +118,8 @@ def test_full_contact_reactions(body_fig4, reactions_sympy):
         udd = eq.contact_rhs(uu, v, xg, row, True)[0]
         want = f_H(0.0, 0.0, uu, v, 0.0, udd, xg, 1, bd.m, bd.m_A, bd.h, bd.h_A, bd.b, 9.81)
         assert H == pytest.approx(want, rel=1e-12)
-        assert H == pytest.approx(-(bd.k * uu + bd.c * v), rel=1e-12)  # the spring's force
+        # the base follows the ground, the top mass feels the spring and damper
+        assert H == pytest.approx(bd.m_A * xg - (bd.k * uu + bd.c * v), rel=1e-10)
 
 
 @pytest.mark.parametrize("shape", ["sine", "cosine"])
@@ -204,7 +205,10 @@ def test_impulse_ratio_is_the_momentum_jump(which, body_fig3, velocities_sympy):
     """impulse_ratio_max = the largest |J_x|/J_y of the impacts of a run, J the jump of the
     two masses' momentum computed from the history's states before and after each impact."""
     body = body_fig3 if which == "flexible" else BlockBody(alpha=0.2)
-    _, out, hist = _history_run(body, A=2.0, w=3.0, lam=0.2)
+    for A, w in [(2.0, 3.0), (1.5, 2.0), (3.0, 6.0), (1.2, 1.0), (4.0, 8.0)]:
+        _, out, hist = _history_run(body, A=A, w=w, lam=0.2)
+        if out[L.OUT_IMPACTS] >= 2:
+            break
     assert out[L.OUT_IMPACTS] >= 2
     ratios = _impulses_from_history(body, hist, velocities_sympy)
     assert len(ratios) == out[L.OUT_IMPACTS]
@@ -228,12 +232,16 @@ def test_mu_required_is_located_between_steps(body_fig3):
 
 
 def test_status_bits_follow_mu(body_fig3):
-    base = _run(body_fig3, A=1.5, w=2.0)
+    for A, w in [(1.5, 2.0), (1.2, 4.0), (2.0, 8.0), (1.1, 1.0)]:  # a rocking, safe point
+        base = _run(body_fig3, A=A, w=w)
+        if (base[L.OUT_OUTCOME] == L.OUTCOME_SAFE and base[L.OUT_UPLIFTS] > 0
+                and base[L.OUT_N_MIN] > 0.0):
+            break
     mu_req = base[L.OUT_MU_REQ]
-    assert 0.0 < mu_req < 10.0 and base[L.OUT_N_MIN] > 0.0
+    assert base[L.OUT_UPLIFTS] > 0 and 0.0 < mu_req < 10.0 and base[L.OUT_N_MIN] > 0.0
     assert not int(base[L.OUT_STATUS]) & (L.STATUS_SLIDES | L.STATUS_LIFTS_OFF)  # mu NaN
-    low = _run(body_fig3, A=1.5, w=2.0, mu=0.9 * mu_req)
-    high = _run(body_fig3, A=1.5, w=2.0, mu=1.1 * mu_req)
+    low = _run(body_fig3, A=A, w=w, mu=0.9 * mu_req)
+    high = _run(body_fig3, A=A, w=w, mu=1.1 * mu_req)
     assert int(low[L.OUT_STATUS]) & L.STATUS_SLIDES
     assert not int(high[L.OUT_STATUS]) & L.STATUS_SLIDES
     over = _run(body_fig3, A=8.0, w=2.0, mu=0.6)  # overturns: N < 0 on the way down

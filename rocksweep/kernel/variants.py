@@ -35,6 +35,7 @@ from rocksweep.kernel.layout import (
     PAR_M,
     PAR_MTOT,
     PAR_TEND,
+    PAR_TPULSE,
 )
 from rocksweep.kernel.loop import simulate_point
 
@@ -147,6 +148,7 @@ def warm_up(kind: int, level: int | None = None) -> None:
     prm[0, PAR_TEND] = -1.0  # the loop stops before its first step
     # a body at rest in full contact: the contact variants evaluate the reactions at t = 0
     prm[0, PAR_M] = prm[0, PAR_MTOT] = prm[0, PAR_G] = prm[0, PAR_B] = 1.0
+    prm[0, PAR_TPULSE] = 1.0  # pulse on: no rest test (it divides by k)
     out = np.empty((1, N_OUT))
     if level is None:
         point_kernel(kind)(prm[0], out[0], np.empty((1, N_HIST)))
