@@ -37,7 +37,7 @@ def main() -> None:
     scene = load_scene(args.scene)
     grid = Grid(scene)
     rng = np.random.default_rng(args.seed)
-    worst = dict.fromkeys(n for n, _ in NAMES, 0.0)
+    worst = dict.fromkeys([n for n, _ in NAMES], 0.0)
     n_cmp = 0
     print(f"{'w/p':>6} {'A':>6} {'lam':>4} out  " + "  ".join(
         f"{n[:14]:>14} {'ref':>10} {'rel':>8}" for n, _ in NAMES))
