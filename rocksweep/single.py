@@ -120,6 +120,9 @@ def simulate(point: Point, numerics: Numerics, history: bool = True,
     if history:
         hist = np.empty((history_capacity(row), L.N_HIST))
         point_kernel(kind)(row, out, hist)
+        if not contact:  # tracked by the history variants anyway; reported when asked
+            out[L.OUT_STATUS] = int(out[L.OUT_STATUS]) & ~(L.STATUS_SLIDES | L.STATUS_LIFTS_OFF)
+            out[[L.OUT_MU_REQ, L.OUT_N_MIN, L.OUT_IMPULSE_MAX]] = np.nan
         n = int(out[L.OUT_HIST_ROWS])
         hist_d = {c.raw: hist[:n, c.slot].copy() for c in fields.HISTORY}
     else:
