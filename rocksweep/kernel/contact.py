@@ -65,6 +65,10 @@ REFINE_BAND = 0.25
 REFINE_XTOL = 1e-3
 REFINE_MAX_ITER = 12
 _GOLD = 0.3819660112501051  # 2 - golden ratio
+# contact_sample's modes
+SAMPLE_STEP = 0
+SAMPLE_START = 1
+SAMPLE_EVENT = 2
 
 
 @njit(cache=True, inline="always")
@@ -189,27 +193,42 @@ def _refine(which, t_a, y_a, f_a, t_b, y_b, f_b, t_c, f_c, s, on, prm, FLEX, DAM
     return best
 
 
-@njit(cache=True, **INTERNAL)
-def contact_sample(ct, t, y, s, on, new_segment, prm, out, FLEX, DAMPED):
-    """Take the sample (t, y) of phase s into the contact bookkeeping; returns the new
-    tracker ``ct``.
-
-    ct = (samples in the segment, t_a, y_a, r_a, n_a, t_b, y_b, r_b, n_b): the two samples
-    before this one (r = |H|/N, n = N/(M g)). ``new_segment``: the sample starts a new
-    segment (after an action, the pulse's end). Updates out[OUT_MU_REQ] (running max of r)
-    and out[OUT_N_MIN] (running min of n), refining a peak bracketed by the last three
-    samples of a segment (``_refine``).
-    """
-    literally(FLEX)
-    literally(DAMPED)
-    r, n = _values(t, y, s, on, prm, FLEX, DAMPED)
+@njit(cache=True, inline="always")
+def _take(out, r, n):
     if r > out[OUT_MU_REQ] or r != r:
         out[OUT_MU_REQ] = r
     if n < out[OUT_N_MIN]:
         out[OUT_N_MIN] = n
+
+
+@njit(cache=True, **INTERNAL)
+def contact_sample(ct, t, y, s, on, mode, prm, out, FLEX, DAMPED):
+    """Take the sample (t, y) of phase s into the contact bookkeeping; returns the new
+    tracker ``ct``.
+
+    ct = (samples in the segment, t_a, y_a, r_a, n_a, t_b, y_b, r_b, n_b): the two samples
+    before this one (r = |H|/N, n = N/(M g)). mode: SAMPLE_STEP (a step's end),
+    SAMPLE_START (the sample starts a new segment: after an action, the pulse's end) or
+    SAMPLE_EVENT (an event state, which ends the segment). Updates out[OUT_MU_REQ] (running
+    max of r) and out[OUT_N_MIN] (running min of n), refining a peak bracketed by the last
+    three samples of a segment (``_refine``). A segment that an event ends after less than
+    one step (chattering: rocking arcs shorter than a step) gets a midpoint sample (a fresh
+    RK4 half step), so that a peak inside it is bracketed too.
+    """
+    literally(FLEX)
+    literally(DAMPED)
+    r, n = _values(t, y, s, on, prm, FLEX, DAMPED)
+    _take(out, r, n)
     cnt, t_a, y_a, r_a, n_a, t_b, y_b, r_b, n_b = ct
-    if new_segment:
+    if mode == SAMPLE_START:
         return (1.0, t_b, y_b, r_b, n_b, t, y, r, n)
+    if mode == SAMPLE_EVENT and cnt == 1.0 and t_b < t:
+        t_a, y_a, r_a, n_a = t_b, y_b, r_b, n_b
+        t_b = 0.5 * (t_a + t)
+        y_b = rk4_step(t_a, y_a, t_b - t_a, s, on, prm, FLEX, DAMPED, False)
+        r_b, n_b = _values(t_b, y_b, s, on, prm, FLEX, DAMPED)
+        _take(out, r_b, n_b)
+        cnt = 2.0
     if cnt >= 2.0 and t_a < t_b < t:
         mu = out[OUT_MU_REQ]
         if (r_b >= r_a and r_b >= r and (r_b > r_a or r_b > r) and math.isfinite(mu)

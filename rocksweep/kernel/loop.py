@@ -24,7 +24,13 @@ import numpy as np
 from numba import literally, njit
 
 from rocksweep.kernel._cache import INTERNAL
-from rocksweep.kernel.contact import contact_impact, contact_sample
+from rocksweep.kernel.contact import (
+    SAMPLE_EVENT,
+    SAMPLE_START,
+    SAMPLE_STEP,
+    contact_impact,
+    contact_sample,
+)
 from rocksweep.kernel.equations import ground_acc, mechanical_energy
 from rocksweep.kernel.events import (
     EV_IMPACT,
@@ -136,7 +142,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT):
     out[OUT_N_MIN] = np.inf if CONTACT else np.nan
     out[OUT_IMPULSE_MAX] = 0.0 if CONTACT else np.nan
     if CONTACT:
-        ct = contact_sample(ct, t, y, s, on, True, prm, out, FLEX, DAMPED)
+        ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED)
 
     while True:
         on = t < t_pulse
@@ -175,7 +181,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT):
             t, y = (t_pulse if lands else t + h), y1
             _record(hist, t, y, s, t < t_pulse, prm, out, FLEX)
             if CONTACT:  # the step's end, with the step's own ground motion
-                ct = contact_sample(ct, t, y, s, on, False, prm, out, FLEX, DAMPED)
+                ct = contact_sample(ct, t, y, s, on, SAMPLE_STEP, prm, out, FLEX, DAMPED)
             if lands and s == 0:
                 # The pulse ends with a jump of xg'' (a cosine pulse ends at its peak), and
                 # Q jumps with it by m_A h_A xg'': the state may now be past the uplift
@@ -185,13 +191,13 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT):
                 if s != 0:
                     _record(hist, t, y, s, False, prm, out, FLEX)
             if CONTACT and lands:  # H jumps with xg'': a new segment without the pulse
-                ct = contact_sample(ct, t, y, s, False, True, prm, out, FLEX, DAMPED)
+                ct = contact_sample(ct, t, y, s, False, SAMPLE_START, prm, out, FLEX, DAMPED)
             continue
 
         t, y = t + tau, y_ev
         _record(hist, t, y, s, on, prm, out, FLEX)
         if CONTACT:  # the event state, last sample of its phase
-            ct = contact_sample(ct, t, y, s, on, False, prm, out, FLEX, DAMPED)
+            ct = contact_sample(ct, t, y, s, on, SAMPLE_EVENT, prm, out, FLEX, DAMPED)
         if ev == EV_OVERTURN:
             _overturned(t, out)
             break
@@ -207,7 +213,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT):
             out[OUT_UPLIFTS] += 1.0
         _record(hist, t, y, s, on, prm, out, FLEX)
         if CONTACT:  # the state after the action starts the next phase's samples
-            ct = contact_sample(ct, t, y, s, on, True, prm, out, FLEX, DAMPED)
+            ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED)
     _finish(t, y, s, prm, out, FLEX, ENERGY)
     if CONTACT:
         _contact_status(prm, out)
