@@ -134,10 +134,11 @@ def format_counts(rows: list[dict], indent: str = "") -> list[str]:
     widths = [max(len(k), *(len(c[i]) for c in cells)) for i, k in enumerate(labels)]
     head = "".join(f"{k:<{w + 2}}" for k, w in zip(labels, widths, strict=True))
     names = {"not_computed": "missing"}
-    lines = [indent + head + "".join(f"{names.get(c, c):>9}" for c in classes)]
+    cw = {c: max(9, len(names.get(c, c)) + 1) for c in classes}
+    lines = [indent + head + "".join(f"{names.get(c, c):>{cw[c]}}" for c in classes)]
     for r, c in zip(rows, cells, strict=True):
         left = "".join(f"{v:<{w + 2}}" for v, w in zip(c, widths, strict=True))
-        lines.append(indent + left + "".join(f"{r[k]:>9}" for k in classes))
+        lines.append(indent + left + "".join(f"{r[k]:>{cw[k]}}" for k in classes))
     return lines
 
 
