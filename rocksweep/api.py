@@ -623,7 +623,7 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /, **keys: Any) -> Sim
 
     ov = [*override_strings(overrides), *override_strings(keys)]
     sc, _ = load(scene, ov)
-    r = run_point(sc.single_point(), sc.single_numerics)
+    r = run_point(sc.single_point(), sc.single_numerics, contact=sc.contact)
     return Simulation(r.summary(), history_dataset(r, sc.name), r, sc.name)
 
 
@@ -641,7 +641,8 @@ def simulate_runs(scene: Scene, max_runs: int = MAX_RUNS) -> list[Run]:
         raise SceneError(f"{scene.size} points; simulate runs at most {max_runs} (use "
                          f"`rocksweep sweep`, or pick a value with --set {big.key}=VALUE)")
     names = [a.name for a in scene.axes]
-    return [run_point(scene.point(dict(zip(names, combo, strict=True))), scene.single_numerics)
+    return [run_point(scene.point(dict(zip(names, combo, strict=True))), scene.single_numerics,
+                      contact=scene.contact)
             for combo in product(*(a.values for a in scene.axes))]
 
 

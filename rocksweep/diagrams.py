@@ -308,11 +308,17 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
                            "every cell is computed")
     comp = (np.asarray(result.arrays["computed"]) > 0 if show_computed
             else np.zeros(result.shape, bool))
-    o, fl, cp = _arrays(result, order, ["outcome", flagged, comp])
+    # contact outputs (outputs.contact, body.mu): points where the model stops holding
+    status = np.asarray(result.arrays["status"])
+    contact = bool(result.scene.get("contact")) and "status" in result.arrays
+    slides = ((status & L.STATUS_SLIDES) != 0) & result.done
+    lifts = ((status & L.STATUS_LIFTS_OFF) != 0) & result.done
+    o, fl, cp, sl, lo = _arrays(result, order, ["outcome", flagged, comp, slides, lifts])
     if layered:
         lam = _coord(result, "lam")
     else:  # one layer: the fixed lam, or none when lam is on an axis
         o, fl, cp = o[..., None, :, :], fl[..., None, :, :], cp[..., None, :, :]
+        sl, lo = sl[..., None, :, :], lo[..., None, :, :]
         lam = np.array([float(result.scalars["lam"])]) if "lam" in result.scalars else None
     panels = _panels(result, panel_dims)
 
@@ -325,7 +331,7 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
     fig, flat, own = _place_axes(axes, len(panels), _layout(result, panel_dims, len(panels)),
                                  (4.8, 4.2), "this stability diagram")
     used = np.zeros(3 + n_lam, bool)
-    any_flag = any_back = False
+    any_flag = any_back = any_slide = any_lift = False
     lam_sym = SYMBOLS["lam"]
     for ax, idx in zip(flat, panels, strict=False):
         po, pf = o[idx], fl[idx]  # [n_lam, n_y, n_x]
@@ -352,6 +358,9 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
             any_flag = True
             yy, xx = np.nonzero(f_any)
             ax.plot(xs[xx], ys[yy], "x", color="k", ms=3.5, mew=0.7)
+        if contact:  # hatched where the base would slide (at some lam), outlined: lift-off
+            any_slide |= _hatch(ax, xs, ys, sl[idx].any(axis=0), "////", "k")
+            any_lift |= _hatch(ax, xs, ys, lo[idx].any(axis=0), "....", "0.25")
         done = po != L.OUTCOME_NOT_RUN
 
         def share(k: int, po=po, done=done) -> str:
@@ -399,6 +408,14 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
                      and n_lam > 1 else "class boundaries")
             handles.append(Line2D([], [], color=CURVE_COLOURS[k % len(CURVE_COLOURS)],
                                   lw=1.0, label=label))
+    mu = _mu_text(result)
+    if any_slide:
+        handles.append(Patch(fc="none", ec="k", hatch="////",
+                             label=f"slides: friction demand > $\\mu${mu}"
+                                   + (f" (at some ${lam_sym}$)" if n_lam > 1 else "")))
+    if any_lift:
+        handles.append(Patch(fc="none", ec="0.25", hatch="....",
+                             label="lifts off: normal force < 0"))
     if own:
         ncols = _layout(result, panel_dims, len(panels))[1]
         fig.legend(handles=handles, loc="outside lower center", fontsize=8, frameon=False,
@@ -406,6 +423,73 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
         fig.suptitle(_fit(_title(result, (x, y)), fig), fontsize=11)
     else:
         flat[0].legend(handles=handles, fontsize=7, loc="upper left")
+    return fig
+
+
+def _hatch(ax: Axes, xs: np.ndarray, ys: np.ndarray, mask: np.ndarray, hatch: str,
+           colour: str) -> bool:
+    """Hatch the cells of ``mask`` (bool[n_y, n_x]) of a diagram drawn with nearest
+    shading; returns whether any cell was hatched."""
+    if not mask.any():
+        return False
+    import matplotlib as mpl
+
+    with mpl.rc_context({"hatch.color": colour, "hatch.linewidth": 0.6}):
+        ax.pcolor(xs, ys, np.ma.masked_where(~mask, np.ones(mask.shape)), shading="nearest",
+                  hatch=hatch, facecolor="none", edgecolor=colour, linewidth=0.0,
+                  rasterized=False)
+    return True
+
+
+def _mu_text(result: SweepResult) -> str:
+    """' = 0.6' when the result has one fixed mu, else '' (mu swept: one panel each)."""
+    mu = result.scalars.get("mu")
+    return f" = {_fmt(float(mu))}" if mu is not None else ""
+
+
+def friction_map(result: SweepResult, x: str | None = None, y: str | None = None, *,
+                 option_names: tuple[str, str] = ("x", "y")) -> Figure:
+    """The friction demand mu_required over swept axes x and y (``rocksweep plot --mu``):
+    filled contours, one panel per value of every other swept key (lam included), labelled
+    contour lines at mu = 0.4, 0.6, 0.8; points whose normal force went below zero (infinite
+    demand, mostly on the way to overturning) in the top colour. Needs a result with
+    contact outputs (``outputs.contact``)."""
+    if "mu_required" not in result.arrays:
+        raise DiagramError(f"{result.path}: no mu_required in this result; sweep with "
+                           "--contact (outputs.contact: true) to draw the friction demand")
+    x, y = choose_axes(result, x, y, option_names)
+    if y is None:
+        raise DiagramError(f"{result.path}: one swept axis besides lam ({x}); the friction "
+                           "map needs two")
+    dims = list(result.dims)
+    panel_dims = [d for d in dims if d not in (x, y)]
+    order = [*panel_dims, y, x]
+    (mu_req,) = _arrays(result, order, ["mu_required"])
+    panels = _panels(result, panel_dims)
+    xs, ys = _coord(result, x), _coord(result, y)
+    fig, flat, _ = _place_axes(None, len(panels), _layout(result, panel_dims, len(panels)),
+                               (4.8, 4.2), "this friction map")
+    levels = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.8, 1.0, 1.5]
+    import matplotlib
+
+    cmap = matplotlib.colormaps["viridis"].with_extremes(over="#b2182b", bad="0.85")
+    norm = BoundaryNorm(levels, cmap.N, extend="max")
+    mesh = None
+    for ax, idx in zip(flat, panels, strict=False):
+        v = np.asarray(mu_req[idx], float)
+        mesh = ax.pcolormesh(xs, ys, np.ma.masked_invalid(np.where(np.isinf(v), 1e9, v)),
+                             cmap=cmap, norm=norm, shading="nearest", rasterized=True)
+        finite = np.where(np.isfinite(v), v, 1e9)
+        if len(xs) > 1 and len(ys) > 1:
+            cs = ax.contour(xs, ys, finite, levels=[0.4, 0.6, 0.8], colors="w",
+                            linewidths=0.8)
+            ax.clabel(cs, fontsize=7, fmt="%.1f")
+        ax.set_title(_panel_title(result, panel_dims, idx), fontsize=10)
+        ax.set_xlabel(axis_label(x, result.kind))
+        ax.set_ylabel(axis_label(y, result.kind))
+    cb = fig.colorbar(mesh, ax=flat, shrink=0.9, extend="max")
+    cb.set_label(r"friction demand $\max|H|/N$ (top colour: $N < 0$ or $> 1.5$)")
+    fig.suptitle(_title(result, (x, y)) + ": friction demand", fontsize=11)
     return fig
 
 

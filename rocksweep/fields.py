@@ -36,7 +36,9 @@ class Field:
     computed; unit: see the module docstring; meaning: one line; slot: index into the
     kernel's result row (``layout.OUT_*``); scale: per-point divisor, "" (none),
     "alpha_ref" or "E_ref"; stored: kept in sweep files; energy: needs the
-    energy-accounting kernel (sweeps with ``outputs: {energy: true}``, single runs).
+    energy-accounting kernel (sweeps with ``outputs: {energy: true}``, single runs);
+    contact: needs the ground-reaction kernel (``outputs: {contact: true}``, stored and
+    reported only when asked).
     """
 
     name: str
@@ -48,6 +50,7 @@ class Field:
     scale: str = ""
     stored: bool = True
     energy: bool = False
+    contact: bool = False
 
 
 _FLAGGED = "status & (horizon | step_cap | event_cap | nonfinite)"
@@ -92,19 +95,32 @@ FIELDS: tuple[Field, ...] = (
     Field("energy_end_over_Eref", "float64", math.nan, "E_ref",
           "mechanical energy at the end, relative to rest / E_ref", L.OUT_E_END, "E_ref",
           stored=False, energy=True),
+    # where the model holds (outputs.contact; rocksweep.kernel.contact)
+    Field("mu_required", "float64", math.nan, "1",
+          "friction demand max |H|/N of the ground reactions over the run (inf: N <= 0)",
+          L.OUT_MU_REQ, contact=True),
+    Field("normal_min_over_Mg", "float64", math.nan, "1",
+          "smallest normal reaction N/(M g) over the run (< 0: the body would lift off)",
+          L.OUT_N_MIN, contact=True),
+    Field("impulse_ratio_max", "float64", math.nan, "1",
+          "largest |horizontal|/vertical ground impulse of an impact (0: no impact)",
+          L.OUT_IMPULSE_MAX, contact=True),
 )
 
 BY_NAME: dict[str, Field] = {f.name: f for f in FIELDS}
 UNITS: dict[str, str] = {f.name: f.unit for f in FIELDS}
 """name -> unit of every result field (the ``units`` attribute of a file's variable)."""
 
-SWEEP_FIELDS: tuple[Field, ...] = tuple(f for f in FIELDS if f.stored and not f.energy)
+SWEEP_FIELDS: tuple[Field, ...] = tuple(f for f in FIELDS
+                                        if f.stored and not f.energy and not f.contact)
 ENERGY_FIELDS: tuple[Field, ...] = tuple(f for f in FIELDS if f.stored and f.energy)
+CONTACT_FIELDS: tuple[Field, ...] = tuple(f for f in FIELDS if f.stored and f.contact)
 
 
-def sweep_fields(energy: bool) -> tuple[Field, ...]:
-    """The fields a sweep file stores (``energy``: the scene's ``outputs.energy``)."""
-    return SWEEP_FIELDS + (ENERGY_FIELDS if energy else ())
+def sweep_fields(energy: bool, contact: bool = False) -> tuple[Field, ...]:
+    """The fields a sweep file stores (``energy``, ``contact``: the scene's
+    ``outputs.energy`` and ``outputs.contact``)."""
+    return SWEEP_FIELDS + (ENERGY_FIELDS if energy else ()) + (CONTACT_FIELDS if contact else ())
 
 
 def convert(outs: np.ndarray, alpha_ref: np.ndarray | float, E_ref: np.ndarray | float,

@@ -50,7 +50,9 @@ class Grid:
         self.shape = scene.shape
         self.size = scene.size
         names = [a.name for a in scene.axes]
-        self._body_pos = [i for i, a in enumerate(scene.axes) if a.key.startswith("body.")]
+        self._body_pos = [i for i, a in enumerate(scene.axes)
+                          if a.key.startswith("body.") and a.key != "body.mu"]
+        self._i_mu = names.index("mu") if "mu" in names else None
         self._body_shape = tuple(self.full_shape[i] for i in self._body_pos)
         self._i_shape = names.index("shape")
         self._i_lam = names.index("lam")
@@ -111,7 +113,8 @@ class Grid:
                   self._values[self._i_lam][multi[self._i_lam]],
                   self._shape_codes[multi[self._i_shape]],
                   self._values[self._i_w][multi[self._i_w]],
-                  self._values[self._i_A][multi[self._i_A]], self.scene.numerics)
+                  self._values[self._i_A][multi[self._i_A]], self.scene.numerics,
+                  np.nan if self._i_mu is None else self._values[self._i_mu][multi[self._i_mu]])
         return ChunkRows(rows, b_kind[inverse], alpha_ref, b_E[inverse])
 
     def kinds(self) -> list[int]:

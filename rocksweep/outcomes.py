@@ -23,6 +23,8 @@ STATUS_WORDS = {
     L.STATUS_OVERTURNED: "overturned",
     L.STATUS_E_ABOVE_1: "e_above_1",
     L.STATUS_BOUNDED: "bounded",
+    L.STATUS_SLIDES: "slides",
+    L.STATUS_LIFTS_OFF: "lifts_off",
 }
 
 STATUS_MEANING = {
@@ -38,6 +40,10 @@ STATUS_MEANING = {
     "e_above_1": "at least one impact had e > 1",
     "bounded": "rigid body below its overturning energy after the pulse, |e| <= 1: "
                "safe proven (early exit)",
+    "slides": "friction demand mu_required above body.mu: the base would slide "
+              "(outputs.contact)",
+    "lifts_off": "normal reaction below zero: the body would leave the ground "
+                 "(outputs.contact)",
 }
 
 

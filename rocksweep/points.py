@@ -22,13 +22,16 @@ _ROOT_CODE = dict(zip(ROOTS, (L.ROOT_BISECT, L.ROOT_ILLINOIS, L.ROOT_HERMITE), s
 
 @dataclass(frozen=True)
 class Point:
-    """One simulation: a body, the impulse position lam, and a pulse (eq. 2)."""
+    """One simulation: a body, the impulse position lam, and a pulse (eq. 2); mu: the
+    friction coefficient of the base on the ground (NaN: none given; only the contact
+    status bits read it)."""
 
     body: Body
     lam: float
     shape: str
     w_over_p: float
     A_ratio: float
+    mu: float = math.nan
 
     @property
     def omega(self) -> float:
@@ -113,11 +116,13 @@ def run_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, w_over_p: np.ndarray
 
 def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
               alpha_ref: np.ndarray, lam: np.ndarray, shape_code: np.ndarray,
-              w_over_p: np.ndarray, A_ratio: np.ndarray, numerics: Numerics) -> None:
+              w_over_p: np.ndarray, A_ratio: np.ndarray, numerics: Numerics,
+              mu: np.ndarray | float = math.nan) -> None:
     """Fill parameter rows in place, vectorised over points.
 
     rows: float64[n, N_PAR] (out); body_rows: float64[n, N_PAR] from ``body_row``;
-    omega_rock, alpha_ref, lam, shape_code, w_over_p, A_ratio: float64[n] (p = 1).
+    omega_rock, alpha_ref, lam, shape_code, w_over_p, A_ratio: float64[n] (p = 1);
+    mu: friction coefficient, float64[n] or a scalar (NaN: none).
     """
     rows[:] = body_rows
     omega = np.asarray(w_over_p, float)  # p = 1 rad/s
@@ -134,6 +139,7 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     rows[:, L.PAR_MAXEVENTS] = numerics.max_events
     rows[:, L.PAR_RESTRATE] = numerics.rest_rate * alpha_ref  # p = 1
     rows[:, L.PAR_ROOT] = _ROOT_CODE[numerics.root]
+    rows[:, L.PAR_MU] = mu
 
 
 def point_row(point: Point, numerics: Numerics) -> np.ndarray:
@@ -143,7 +149,7 @@ def point_row(point: Point, numerics: Numerics) -> np.ndarray:
     fill_rows(rows, body_row(body)[None, :], np.array([body_omega_rock(body)]),
               np.array([body.alpha_ref]), np.array([point.lam]),
               np.array([_SHAPE_CODE[point.shape]]), np.array([point.w_over_p]),
-              np.array([point.A_ratio]), numerics)
+              np.array([point.A_ratio]), numerics, point.mu)
     return rows[0]
 
 

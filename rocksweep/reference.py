@@ -44,9 +44,10 @@ import time
 
 import numpy as np
 from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
+from scipy.optimize import brentq, minimize_scalar
 
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.kernel.contact import ground_reactions, impact_impulses, impulse_ratio
 from rocksweep.kernel.equations import (
     contact_rhs,
     ground_acc,
@@ -97,6 +98,7 @@ class _Problem:
         self.max_step = min(periods) / 10.0
         self.nfev = 0
         self.steps = 0
+        self.last_sol = None  # the latest phase's solution (dense output), for contact
 
     # --- eq. (2) -----------------------------------------------------------------------
     def xg(self, t: float, on: bool) -> float:
@@ -166,6 +168,7 @@ class _Problem:
         sol = solve_ivp(fun, (t0, t1), y0, method="DOP853", rtol=self.rtol, atol=self.atol,
                         max_step=self.max_step, events=events, dense_output=True)
         self.steps += len(sol.t) - 1
+        self.last_sol = sol
         return sol
 
 
@@ -296,9 +299,76 @@ def _rocking(pb: _Problem, t0: float, y0, s: int, t1: float, on: bool):
     return kind, t_stop, (y[0], y[1], 0.0, 0.0), theta_max
 
 
+# Contact outputs on the reference path: samples per DOP853 step of a phase's dense output
+# (its steps are at most a tenth of the shortest period), then the largest sample is
+# refined by a bounded Brent search on the dense output between its neighbours.
+CONTACT_SAMPLES = 24
+
+
+class _Contact:
+    """Running friction demand max |H|/N, min N/(M g) and max impulse ratio of a reference
+    run, from each phase's dense output (``rocksweep.kernel.contact`` for H, N, J)."""
+
+    def __init__(self, pb: _Problem) -> None:
+        self.pb = pb
+        self.mu = 0.0
+        self.n_min = math.inf
+        self.impulse = 0.0
+        self.mg = float(pb.prm[L.PAR_MTOT] * pb.prm[L.PAR_G])
+
+    def _state(self, sol, t: float, s: int) -> tuple[float, float, float, float]:
+        y = sol.sol(t)
+        if s == 0:
+            return 0.0, 0.0, float(y[0]), float(y[1])
+        if self.pb.flex:
+            return float(y[0]), float(y[1]), float(y[2]), float(y[3])
+        return float(y[0]), float(y[1]), 0.0, 0.0
+
+    def _values(self, sol, t: float, s: int, on: bool) -> tuple[float, float]:
+        th, w, u, v = self._state(sol, t, s)
+        h_, n_ = ground_reactions(th, w, u, v, s, self.pb.xg(t, on), self.pb.prm,
+                                  self.pb.flex, self.pb.damped)
+        return (abs(h_) / n_ if n_ > 0.0 else math.inf), n_ / self.mg
+
+    def phase(self, t0: float, t1: float, s: int, on: bool) -> None:
+        """Take the phase just solved (``pb.last_sol``) over [t0, t1]."""
+        sol = self.pb.last_sol
+        if sol is None:
+            return
+        knots = np.unique(np.clip(np.concatenate(([t0, t1], sol.t)), t0, t1))
+        if len(knots) == 1:
+            ts = knots
+        else:
+            ts = np.unique(np.concatenate([np.linspace(a, b, CONTACT_SAMPLES + 1)
+                                           for a, b in zip(knots[:-1], knots[1:],
+                                                           strict=True)]))
+        vals = np.array([self._values(sol, t, s, on) for t in ts])
+        for col, sign in ((0, 1.0), (1, -1.0)):  # max of |H|/N, min of N/(M g)
+            f = sign * vals[:, col]
+            i = int(np.argmax(f))
+            best = f[i]
+            if math.isfinite(best) and len(ts) > 2:
+                lo, hi = ts[max(i - 1, 0)], ts[min(i + 1, len(ts) - 1)]
+                r = minimize_scalar(lambda t, col=col, sign=sign:
+                                    -sign * self._values(sol, t, s, on)[col],
+                                    bounds=(lo, hi), method="bounded",
+                                    options={"xatol": 1e-10 * max(1.0, hi)})
+                best = max(best, -float(r.fun))
+            if col == 0:
+                self.mu = max(self.mu, best)
+            else:
+                self.n_min = min(self.n_min, -best)
+
+    def impact(self, y, s: int, y_new, s_new: int) -> None:
+        j_x, j_y = impact_impulses(s, y[2], y[3], y[1], s_new, y_new[3], y_new[1],
+                                   self.pb.prm, self.pb.flex)
+        self.impulse = max(self.impulse, impulse_ratio(j_x, j_y))
+
+
 def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = RTOL,
                   atol: float = ATOL, events: bool = False, early_exit: bool = True,
-                  theta0: float | None = None, theta_dot0: float | None = None) -> dict:
+                  theta0: float | None = None, theta_dot0: float | None = None,
+                  contact: bool = False) -> dict:
     """Run one point with the reference integrator.
 
     numerics supplies horizon, rest_rate and max_events (steps_per_period and event_tol
@@ -311,7 +381,8 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
     theta_max [rad], t_overturn, t_first_impact, t_end [p*t] (NaN when not applicable),
     e_max, plus steps (DOP853 steps), nfev (right-hand-side calls), anomalies (impacts
     found with theta' pointing away from theta = 0: impossible, counted as a self-check),
-    wall_time [s], and
+    wall_time [s]; with ``contact`` mu_required, normal_min_over_Mg, impulse_ratio_max
+    (the kernel's contact outputs, from each phase's dense output: ``_Contact``); and
     with ``events`` a list of dicts, one per transition (t, kind, s before and after,
     theta', u, u' before and after, e, energy before and after).
     """
@@ -334,6 +405,7 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
     theta_max, e_max = abs(th0), 0.0
     t_over = t_first = math.nan
     free_check = True  # rigid: test the bounded-energy exit once per excursion
+    ct = _Contact(pb) if contact else None
 
     def energy(y, s):
         return mechanical_energy(y[0], y[1], y[2], y[3], s, prm, flex)
@@ -377,11 +449,15 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
                 uplifts += 1
                 note("uplift", t, 0, s, y, y)
                 continue
+            pb.last_sol = None
             kind, t_ev, yc = _contact(pb, t, (y[2], y[3]), t_stop, on)
             y_ev = (0.0, 0.0, yc[0], yc[1])
         else:
+            pb.last_sol = None
             kind, t_ev, y_ev, th = _rocking(pb, t, y, s, t_stop, on)
             theta_max = max(theta_max, th)
+        if ct is not None and kind >= 0:
+            ct.phase(t, t_ev, s, on)
         if kind < 0 or not all(math.isfinite(v) for v in y_ev):
             status |= L.STATUS_NONFINITE
             t = t_ev
@@ -430,6 +506,8 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
         # the spring and damper carry no impulse: m (u' + h theta') is conserved
         u_dot = y[3] + pb.h * (w_minus - w_plus) if flex else 0.0
         y_new = (0.0, w_plus, y[2], u_dot)
+        if ct is not None:
+            ct.impact(y, s, y_new, s_new)
         note("impact", t, s, s_new, y, y_new, e)
         s, y = s_new, y_new
         if s == 0:
@@ -444,6 +522,10 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
         "t_first_impact": t_first, "t_end": t, "e_max": e_max, "steps": pb.steps,
         "nfev": pb.nfev, "anomalies": anomalies, "wall_time": time.perf_counter() - t0_wall,
     }
+    if ct is not None:
+        res.update({"mu_required": ct.mu if math.isfinite(ct.n_min) else math.nan,
+                    "normal_min_over_Mg": ct.n_min if math.isfinite(ct.n_min) else math.nan,
+                    "impulse_ratio_max": ct.impulse})
     if log is not None:
         res["events"] = log
     return res
@@ -472,4 +554,7 @@ def result_row(r: dict) -> np.ndarray:
     out[L.OUT_E_MAX] = r["e_max"]
     out[L.OUT_CONTACTS] = r["contacts"]
     out[L.OUT_HIST_ROWS] = 0.0
+    out[L.OUT_MU_REQ] = r.get("mu_required", np.nan)
+    out[L.OUT_N_MIN] = r.get("normal_min_over_Mg", np.nan)
+    out[L.OUT_IMPULSE_MAX] = r.get("impulse_ratio_max", np.nan)
     return out

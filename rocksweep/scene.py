@@ -169,6 +169,7 @@ class Scene:
     single_numerics: Numerics  # single runs (simulate): `fine` unless the scene names one
     energy: bool
     text: str = field(repr=False)
+    contact: bool = False  # outputs.contact (on when body.mu is given)
 
     def axis(self, name: str) -> Axis:
         for a in self.axes:
@@ -201,7 +202,8 @@ class Scene:
         return self.size * per_point + coords
 
     def body_axes(self) -> tuple[Axis, ...]:
-        return tuple(a for a in self.axes if a.key.startswith("body."))
+        """The axes that make the body (body.mu is the ground's, not the body's)."""
+        return tuple(a for a in self.axes if a.key.startswith("body.") and a.key != "body.mu")
 
     def make_body(self, **values: float) -> Body:
         """A body from values of the body keys (as in ``body_axes``)."""
@@ -213,7 +215,8 @@ class Scene:
         """The point with the given value of every axis (by name)."""
         body = self.make_body(**{a.name: values[a.name] for a in self.body_axes()})
         return Point(body, float(values["lam"]), str(values["shape"]),
-                     float(values["w_over_p"]), float(values["A_ratio"]))
+                     float(values["w_over_p"]), float(values["A_ratio"]),
+                     float(values.get("mu", math.nan)))
 
     def single_point(self) -> Point:
         """The scene's only point; a SceneError names the first swept key otherwise."""
@@ -442,6 +445,15 @@ def _parse(text: str, overrides: list[str]) -> Scene:
     energy = outputs.get("energy", KEYS["outputs.energy"].default)
     if not isinstance(energy, bool):
         raise SceneError(f"outputs.energy = {fmt(energy)}: {KEYS['outputs.energy'].allowed}")
+    contact = outputs.get("contact")
+    if contact is not None and not isinstance(contact, bool):
+        raise SceneError(f"outputs.contact = {fmt(contact)}: {KEYS['outputs.contact'].allowed}")
+    mu_spec = body.get("mu")
+    if mu_spec is not None and contact is False:
+        raise SceneError(f"body.mu = {fmt(mu_spec)}: the slides/lifts_off flags need the "
+                         "contact outputs; remove outputs.contact: false (body.mu turns "
+                         "them on)")
+    contact = bool(contact) or mu_spec is not None
 
     # forms and lengths first: the grid's size is known before any value is built
     shapes, shape_swept = _shapes(pulse["shape"])
@@ -453,6 +465,8 @@ def _parse(text: str, overrides: list[str]) -> Scene:
     specs.append(("lam", "impact.lam", *_axis_spec("impact.lam", lam)[:2]))
     for k in PULSE_AXES:
         specs.append((k, f"pulse.{k}", *_axis_spec(f"pulse.{k}", pulse[k])[:2]))
+    if mu_spec is not None:  # the last axis: the same grid of runs, flagged per mu
+        specs.append(("mu", "body.mu", *_axis_spec("body.mu", mu_spec)[:2]))
     lengths = [len(shapes)] + [1 if form == "scalar" else
                                (spec["num"] if form == "range" else len(spec))
                                for _, _, form, spec in specs]
@@ -471,7 +485,8 @@ def _parse(text: str, overrides: list[str]) -> Scene:
 
     numerics, single = _numerics(numerics_sec)
     scene = Scene(name=name or "rocksweep scene", kind=kind, axes=tuple(axes),
-                  numerics=numerics, single_numerics=single, energy=energy, text=text)
+                  numerics=numerics, single_numerics=single, energy=energy, text=text,
+                  contact=contact)
     bodies = _candidate_bodies(scene)
     _check_cost(scene, bodies)
     return scene

@@ -105,6 +105,12 @@ KEYS: dict[str, Key] = {
                          required=False),
     "outputs.energy": Key("bool", "must be true or false (store energy metrics)",
                           required=False, default=False),
+    # where the model holds (rocksweep.kernel.contact); body.mu turns it on
+    "body.mu": Key("axis", "must be in (0, 10] (friction coefficient of the base on the "
+                   "ground)", 0.0, 10.0, lo_in=False, required=False),
+    "outputs.contact": Key("bool", "must be true or false (store the friction demand, the "
+                           "smallest normal force and the impulse ratio)", required=False,
+                           default=False),
 }
 
 # Keys of each body kind, in the grid's dimension order.
@@ -118,7 +124,7 @@ SECTIONS = ("body", "impact", "pulse", "numerics", "outputs")
 def section_keys(section: str, kind: str = "flexible") -> tuple[str, ...]:
     """The keys (without the section) a section may hold; body keys depend on its kind."""
     if section == "body":
-        return ("kind", *BODY_KEYS[kind])
+        return ("kind", *BODY_KEYS[kind], "mu")
     pre = section + "."
     return tuple(k[len(pre):] for k in KEYS if k.startswith(pre))
 

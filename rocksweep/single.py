@@ -31,6 +31,7 @@ class Run:
     out: np.ndarray
     history: dict | None
     wall_time: float
+    contact: bool = False  # the contact fields were asked for (outputs.contact)
 
     def get(self, name: str) -> int | float | None:
         """One result field by name (``rocksweep.fields.FIELDS``) in its unit; None for
@@ -72,7 +73,9 @@ class Run:
 
     def summary(self) -> dict:
         """Plain-JSON summary (the keys of ``rocksweep simulate --json``): every field of
-        ``rocksweep.fields.FIELDS`` (the energy fields when energy was accounted), the
+        ``rocksweep.fields.FIELDS`` (the energy fields when energy was accounted, the
+        contact fields mu_required, normal_min_over_Mg, impulse_ratio_max when asked:
+        ``outputs.contact``; an infinite mu_required, N <= 0, prints as null), the
         outcome and status as words, the accuracy setting and the wall time [s].
 
         Times are p*t, theta_max in alpha_ref, energies in E_ref; a time that did not
@@ -80,7 +83,8 @@ class Run:
         "event_steps" the re-integrations spent locating events.
         """
         energy = not math.isnan(self.out[L.OUT_W_IN])
-        d = {f.name: self.get(f.name) for f in fields.FIELDS if energy or not f.energy}
+        d = {f.name: self.get(f.name) for f in fields.FIELDS
+             if (energy or not f.energy) and (self.contact or not f.contact)}
         d["outcome"] = self.outcome
         d["status"] = self.status
         d["accuracy"] = self.numerics.describe()
@@ -101,21 +105,28 @@ def history_capacity(row: np.ndarray) -> int:
     return int(steps + 3 * row[L.PAR_MAXEVENTS] + 16)
 
 
-def simulate(point: Point, numerics: Numerics, history: bool = True) -> Run:
-    """Run one point. With ``history`` the energy-accounting kernel records every step;
-    without, the outcome-only kernel of the point's kind runs (what sweeps run)."""
+def simulate(point: Point, numerics: Numerics, history: bool = True,
+             contact: bool = False) -> Run:
+    """Run one point. With ``history`` the energy-accounting kernel records every step
+    (it tracks the ground reactions too); without, the outcome-only kernel of the point's
+    kind runs (what sweeps run), or the contact kernel with ``contact``. ``contact``: the
+    summary reports the contact fields."""
     row = point_row(point, numerics)
     out = np.empty(L.N_OUT)
     kind = kernel_kind(point.body)
-    warm_up(kind, None if history else L.LEVEL_OUTCOME)  # wall_time excludes compilation
+    lvl = L.LEVEL_CONTACT if contact else L.LEVEL_OUTCOME
+    warm_up(kind, None if history else lvl)  # wall_time excludes compilation
     t0 = time.perf_counter()
     if history:
         hist = np.empty((history_capacity(row), L.N_HIST))
         point_kernel(kind)(row, out, hist)
+        if not contact:  # tracked by the history variants anyway; reported when asked
+            out[L.OUT_STATUS] = int(out[L.OUT_STATUS]) & ~(L.STATUS_SLIDES | L.STATUS_LIFTS_OFF)
+            out[[L.OUT_MU_REQ, L.OUT_N_MIN, L.OUT_IMPULSE_MAX]] = np.nan
         n = int(out[L.OUT_HIST_ROWS])
         hist_d = {c.raw: hist[:n, c.slot].copy() for c in fields.HISTORY}
     else:
         outs = out[None, :]
-        chunk_kernel(kind, L.LEVEL_OUTCOME)(row[None, :], outs)
+        chunk_kernel(kind, lvl)(row[None, :], outs)
         hist_d = None
-    return Run(point, numerics, out, hist_d, time.perf_counter() - t0)
+    return Run(point, numerics, out, hist_d, time.perf_counter() - t0, contact)

@@ -220,6 +220,8 @@ def resolved_scene(scene: Scene, overrides: tuple[str, ...] | list[str] = (),
         "numerics": scene.numerics.as_dict(),
         "energy": scene.energy,
         "overrides": list(overrides),
+        # only when asked: files without contact outputs keep their resolved scene
+        **({"contact": True} if scene.contact else {}),
     }
     if adaptive is not None:
         d["adaptive"] = dict(adaptive)
@@ -247,9 +249,9 @@ def _short(v) -> str:
 def scene_differences(stored: dict, new: dict) -> list[str]:
     """One phrase per difference between two ``resolved_scene`` dicts."""
     diffs = []
-    for section in ("name", "kind", "energy"):  # --set overrides show in the axes
+    for section in ("name", "kind", "energy", "contact"):  # --set overrides show in the axes
         if stored.get(section) != new.get(section):
-            key = "outputs.energy" if section == "energy" else section
+            key = f"outputs.{section}" if section in ("energy", "contact") else section
             diffs.append(f"{key}: file {_short(stored.get(section))}, "
                          f"scene {_short(new.get(section))}")
     for key in dict.fromkeys([*stored.get("axes", {}), *new.get("axes", {})]):
@@ -511,9 +513,10 @@ def _check_format(f: h5py.File, path: Path) -> None:
 def variables_for(stored: dict) -> dict:
     """The per-point variables of a file from its resolved scene (``computed`` in the
     files of adaptive sweeps)."""
-    from rocksweep.sweep import ENERGY_VARIABLES, VARIABLES
+    from rocksweep.sweep import CONTACT_VARIABLES, ENERGY_VARIABLES, VARIABLES
 
     return {**VARIABLES, **(ENERGY_VARIABLES if stored.get("energy") else {}),
+            **(CONTACT_VARIABLES if stored.get("contact") else {}),
             **({"computed": COMPUTED_VARIABLE} if stored.get("adaptive") else {})}
 
 

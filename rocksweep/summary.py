@@ -22,6 +22,9 @@ if TYPE_CHECKING:
     from rocksweep.store import SweepResult
 
 CLASSES = ("mode1", "mode2", "safe", "flagged", "not_computed")
+# Counted too in results with contact outputs (outputs.contact / body.mu): computed points
+# whose status says the base would slide (mu_required > body.mu) or lift off (N < 0).
+CONTACT_COUNTS = ("slides", "lifts_off")
 # A swept key with more values than this is printed as this many ranges of values.
 MAX_ROWS = 10
 # Variables ``info_dict`` needs from the file (and ``computed`` when the file has it:
@@ -44,7 +47,8 @@ def class_counts(result: SweepResult, by: Sequence[str]) -> list[dict]:
     their one value.
 
     Returns one dict per combination: the key values, then mode1, mode2, safe, flagged
-    (computed points with a flagged status) and not_computed.
+    (computed points with a flagged status) and not_computed; with contact outputs also
+    slides and lifts_off (``CONTACT_COUNTS``).
     """
     out = np.asarray(result.arrays["outcome"])
     status = np.asarray(result.arrays["status"])
@@ -55,6 +59,10 @@ def class_counts(result: SweepResult, by: Sequence[str]) -> list[dict]:
     o = np.transpose(out, [*pos, *rest]).reshape(*shape, -1)
     fl = np.transpose((status & L.STATUS_FLAGGED) != 0, [*pos, *rest]).reshape(o.shape)
     fl &= o != L.OUTCOME_NOT_RUN
+    contact = bool(getattr(result, "scene", {}).get("contact"))
+    bits = {"slides": L.STATUS_SLIDES, "lifts_off": L.STATUS_LIFTS_OFF}
+    extra = {c: np.transpose((status & bits[c]) != 0, [*pos, *rest]).reshape(o.shape)
+             & (o != L.OUTCOME_NOT_RUN) for c in (CONTACT_COUNTS if contact else ())}
     rows = []
     for idx in np.ndindex(*shape):
         label = {d: (_plain(result.coords[d][idx[swept.index(d)]]) if d in swept
@@ -65,7 +73,8 @@ def class_counts(result: SweepResult, by: Sequence[str]) -> list[dict]:
                      "mode2": int((cell == L.OUTCOME_MODE2).sum()),
                      "safe": int((cell == L.OUTCOME_SAFE).sum()),
                      "flagged": int(fl[idx].sum()),
-                     "not_computed": int((cell == L.OUTCOME_NOT_RUN).sum())})
+                     "not_computed": int((cell == L.OUTCOME_NOT_RUN).sum()),
+                     **{c: int(v[idx].sum()) for c, v in extra.items()}})
     return rows
 
 
@@ -83,7 +92,8 @@ def in_ranges(rows: list[dict], key: str, max_rows: int = MAX_ROWS) -> list[dict
     """Consecutive rows that share every label but ``key`` merged into at most
     ``max_rows`` ranges of ``key``'s values, counts summed; a merged row's ``key`` is
     (first, last) and ``n_values`` says how many values it holds."""
-    labels = [k for k in rows[0] if k not in CLASSES] if rows else []
+    labels = [k for k in rows[0] if k not in (*CLASSES, *CONTACT_COUNTS)] if rows else []
+    counted = [c for c in (*CLASSES, *CONTACT_COUNTS) if rows and c in rows[0]]
     others = [k for k in labels if k != key]
     out: list[dict] = []
     start = 0
@@ -100,7 +110,7 @@ def in_ranges(rows: list[dict], key: str, max_rows: int = MAX_ROWS) -> list[dict
                 row = {k: group[0][k] for k in others}
                 row[key] = (group[0][key], group[-1][key])
                 row["n_values"] = len(group)
-                row.update({c: sum(g[c] for g in group) for c in CLASSES})
+                row.update({c: sum(g[c] for g in group) for c in counted})
                 out.append(row)
         start = stop
     return out
@@ -119,16 +129,18 @@ def format_counts(rows: list[dict], indent: str = "") -> list[str]:
     the not_computed column only when some point is missing."""
     if not rows:
         return []
-    labels = [k for k in rows[0] if k not in CLASSES and k != "n_values"]
+    labels = [k for k in rows[0] if k not in (*CLASSES, *CONTACT_COUNTS) and k != "n_values"]
     classes = [c for c in CLASSES if c != "not_computed" or any(r[c] for r in rows)]
+    classes += [c for c in CONTACT_COUNTS if c in rows[0]]
     cells = [[_label(r[k]) for k in labels] for r in rows]
     widths = [max(len(k), *(len(c[i]) for c in cells)) for i, k in enumerate(labels)]
     head = "".join(f"{k:<{w + 2}}" for k, w in zip(labels, widths, strict=True))
     names = {"not_computed": "missing"}
-    lines = [indent + head + "".join(f"{names.get(c, c):>9}" for c in classes)]
+    cw = {c: max(9, len(names.get(c, c)) + 1) for c in classes}
+    lines = [indent + head + "".join(f"{names.get(c, c):>{cw[c]}}" for c in classes)]
     for r, c in zip(rows, cells, strict=True):
         left = "".join(f"{v:<{w + 2}}" for v, w in zip(c, widths, strict=True))
-        lines.append(indent + left + "".join(f"{r[k]:>9}" for k in classes))
+        lines.append(indent + left + "".join(f"{r[k]:>{cw[k]}}" for k in classes))
     return lines
 
 

@@ -46,6 +46,9 @@ VARIABLES: dict[str, tuple[str, float, str]] = {
 # Stored when the scene asks for energy metrics (outputs.energy: true).
 ENERGY_VARIABLES: dict[str, tuple[str, float, str]] = {
     f.name: (f.dtype, f.fill, f.meaning) for f in fields.ENERGY_FIELDS}
+# Stored when the scene asks for the ground reactions (outputs.contact: true).
+CONTACT_VARIABLES: dict[str, tuple[str, float, str]] = {
+    f.name: (f.dtype, f.fill, f.meaning) for f in fields.CONTACT_FIELDS}
 
 # Upper bound of the automatic chunk size [points]; see ``auto_chunk_size``.
 MAX_CHUNK = 1024
@@ -63,11 +66,15 @@ COMPILE_SECONDS = 20.0
 
 def variables(scene: Scene) -> dict[str, tuple[str, float, str]]:
     """The per-point variables a sweep of this scene stores."""
-    return {**VARIABLES, **(ENERGY_VARIABLES if scene.energy else {})}
+    return {**VARIABLES, **(ENERGY_VARIABLES if scene.energy else {}),
+            **(CONTACT_VARIABLES if scene.contact else {})}
 
 
 def level(scene: Scene) -> int:
-    """Bookkeeping level of the kernel a sweep of this scene runs."""
+    """Bookkeeping level of the kernel a sweep of this scene runs (the contact variants
+    account energy too: one variant per kind serves contact with and without energy)."""
+    if scene.contact:
+        return L.LEVEL_CONTACT
     return L.LEVEL_ENERGY if scene.energy else L.LEVEL_OUTCOME
 
 
@@ -99,8 +106,13 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
             part = np.empty((int(sel.sum()), L.N_OUT))
             chunk_kernel(int(kind), level)(np.ascontiguousarray(cr.rows[sel]), part)
             outs[sel] = part
-    arrays = fields.convert(outs, cr.alpha_ref, cr.E_ref,
-                            fields.sweep_fields(level == L.LEVEL_ENERGY))
+    if level == L.LEVEL_CONTACT:
+        # a Grid, or adaptive's view of one (``adaptive._Subset``: the grid as ``.grid``)
+        scene = grid.scene if hasattr(grid, "scene") else grid.grid.scene
+        stored = fields.sweep_fields(scene.energy, True)
+    else:
+        stored = fields.sweep_fields(level == L.LEVEL_ENERGY)
+    arrays = fields.convert(outs, cr.alpha_ref, cr.E_ref, stored)
     return ChunkResult(start, stop, arrays, time.perf_counter() - t0,
                        time.thread_time() - c0)
 

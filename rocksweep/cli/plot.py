@@ -21,6 +21,9 @@ from rocksweep.cli.main import main, user_errors
               help="Swept axis along y [default: A_ratio when swept].")
 @click.option("--dpi", type=click.IntRange(20, 2400), default=200, show_default=True,
               help="Resolution of raster output (PNG).")
+@click.option("--mu", "mu_map", is_flag=True,
+              help="Draw the friction demand mu_required (a result with contact outputs) as "
+                   "a contour map instead of the classes.")
 @click.option("--overwrite", is_flag=True, help="Replace an existing figure file.")
 @click.option("--curves", is_flag=True,
               help="Overlay the boundary lines between classes, one colour per lam "
@@ -30,14 +33,16 @@ from rocksweep.cli.main import main, user_errors
                    "stay clear); by default both are drawn alike.")
 @user_errors
 def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str | None,
-         dpi: int, overwrite: bool, curves: bool, show_computed: bool) -> None:
+         dpi: int, overwrite: bool, curves: bool, show_computed: bool,
+         mu_map: bool) -> None:
     """Draw the stability diagram of a sweep: by default x = omega/p, y = A/(g tan
     alpha_cg); --x/--y pick any two swept axes. Mode 1 / mode 2 / safe regions, one panel
     per pulse shape and per other swept key, the growth of the mode 1 area with lam in
     shades of red. A sweep with one swept axis besides lam is drawn as max|theta|/alpha
     against it, markers by outcome. Cells an adaptive sweep filled are drawn as computed
-    ones."""
-    from rocksweep.diagrams import missing_warnings, sweep_figure
+    ones. With contact outputs and body.mu, the points that would slide are hatched (and
+    those that would lift off dotted); --mu draws mu_required."""
+    from rocksweep.diagrams import friction_map, missing_warnings, sweep_figure
     from rocksweep.outputs import check_output
     from rocksweep.plots import FORMATS, save_figure
     from rocksweep.store import read_result
@@ -45,10 +50,14 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
     fig_out = fig_path if fig_path is not None else result_path.with_suffix(".png")
     # refuse a bad output before reading the result and drawing
     check_output(fig_out, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
-    result = read_result(result_path, ["outcome", "status", "theta_max_over_alpha"],
-                         ("computed",) if show_computed else ())
-    fig = sweep_figure(result, x_key, y_key, option_names=("--x", "--y"), curves=curves,
-                       show_computed=show_computed)
+    if mu_map:
+        result = read_result(result_path, ["outcome", "status", "mu_required"])
+        fig = friction_map(result, x_key, y_key, option_names=("--x", "--y"))
+    else:
+        result = read_result(result_path, ["outcome", "status", "theta_max_over_alpha"],
+                             ("computed",) if show_computed else ())
+        fig = sweep_figure(result, x_key, y_key, option_names=("--x", "--y"), curves=curves,
+                           show_computed=show_computed)
     save_figure(fig, fig_out, dpi, overwrite=overwrite, inputs=[result_path])
     for w in missing_warnings(result):
         click.echo(f"warning: {w}", err=True)

@@ -32,10 +32,14 @@ MAX_POINTS = 12  # = rocksweep.api.MAX_RUNS: simulate overlays a few runs
 @click.option("--csv", "csv_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Write the time history to this CSV file (columns: run, the swept keys, "
                    "p_t, theta_over_alpha, u_over_ucr, E_over_Eref, ...).")
+@click.option("--contact", is_flag=True,
+              help="Report the friction demand, the smallest normal force and the impulse "
+                   "ratio (as outputs.contact: true).")
 @overwrite_option
 @user_errors
 def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
-             plot_path: Path | None, csv_path: Path | None, overwrite: bool) -> None:
+             plot_path: Path | None, csv_path: Path | None, contact: bool,
+             overwrite: bool) -> None:
     """Run one point of SCENE.yaml (or each of up to 12 points) and report what happened.
 
     Prints the outcome (safe, mode1: overturns after impacts, mode2: overturns without
@@ -53,6 +57,8 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
         check_output(plot_path, overwrite=overwrite, inputs=[scene_path], suffixes=FORMATS)
     if csv_path is not None:
         check_output(csv_path, overwrite=overwrite, inputs=[scene_path])
+    if contact:
+        overrides = (*overrides, "outputs.contact=true")
     scene = load(scene_path, overrides)
     from rocksweep.scene import SceneError
 
@@ -101,6 +107,10 @@ def _print_run(r, swept: list[str]) -> None:
                    f"{s['impact_loss_over_Eref']:.4f} (gained {s['impact_gain_over_Eref']:.4f}"
                    f" in {s['energy_gaining_impacts']} impacts), lost in damper "
                    f"{s['damper_loss_over_Eref']:.4f}, left {s['energy_end_over_Eref']:.4f}")
+    if "mu_required" in s:
+        mu = "inf" if s["mu_required"] is None else f"{s['mu_required']:.4f}"
+        click.echo(f"  contact: mu_required {mu}, min N/(M g) {s['normal_min_over_Mg']:.4f},"
+                   f" max impulse ratio {s['impulse_ratio_max']:.4f}")
     status = ", ".join(s["status"]) or "-"
     click.echo(f"  status: {status}   ended at p*t = {s['t_end']:.4f}")
     click.echo(f"  accuracy: {s['accuracy']}; {s['steps']} RK4 steps + {s['event_steps']} "

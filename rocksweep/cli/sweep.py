@@ -65,13 +65,16 @@ WRITE_EVERY = 1.0  # = rocksweep.api.WRITE_EVERY (not imported here: --help stay
 @click.option("--threshold", type=float, default=None,
               help="Adaptive: warn when more than this share of audit points disagree "
                    "[default: 0.002].")
+@click.option("--contact", is_flag=True,
+              help="Also store the friction demand mu_required, the smallest normal force "
+                   "and the impulse ratio per point (as outputs.contact: true).")
 @user_errors
 def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, jobs: int,
           resume: bool, overwrite: bool, quiet: bool, backend: str, scheduler: str | None,
           chunk_size: int | None, write_every: float, adaptive: bool, coarse: int | None,
           audit: float | None, adaptive_axes: str | None, margin: int | None,
           final_margin: int | None, seed: int | None, threshold: float | None,
-          validate: bool) -> None:
+          validate: bool, contact: bool) -> None:
     """Compute the stability diagram of SCENE.yaml: every point of its grid.
 
     Writes outcome (0 safe, 1 mode 1, 2 mode 2, -1 not computed), impacts, uplifts,
@@ -83,6 +86,8 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     (a few % at 400 x 400 and more); the others get the class of the cell around them
     and keep the "not computed" values in every other variable.
     """
+    if contact:
+        overrides = (*overrides, "outputs.contact=true")
     if resume and overwrite:
         raise click.ClickException("--resume and --overwrite exclude each other")
     if backend == "dask":

@@ -37,7 +37,8 @@ PAR_THETA_OVER = 24  # |theta| at which the body lies on its side: pi/2 [rad]
 PAR_ROOT = 25  # event root finder: ROOT_BISECT, ROOT_ILLINOIS or ROOT_HERMITE
 PAR_THETA0 = 26  # initial theta [rad] (0: start at rest; != 0 starts rocking on its corner)
 PAR_THETA_DOT0 = 27  # initial theta' [rad/s] (from theta = 0: rocking on its sign's corner)
-N_PAR = 28
+PAR_MU = 28  # friction coefficient of the base on the ground (NaN: none given)
+N_PAR = 29
 
 SHAPE_SINE = 0.0
 SHAPE_COSINE = 1.0
@@ -65,7 +66,10 @@ OUT_E_END = 15  # mechanical energy at the end, relative to rest [J] (energy var
 OUT_E_MAX = 16  # largest restitution seen
 OUT_CONTACTS = 17  # returns to full contact (e <= 0 or settling below the rest rate)
 OUT_HIST_ROWS = 18  # rows written to the history buffer
-N_OUT = 19
+OUT_MU_REQ = 19  # friction demand max |H|/N over the run (contact variants, else NaN)
+OUT_N_MIN = 20  # smallest normal reaction N/(M g) over the run (contact variants)
+OUT_IMPULSE_MAX = 21  # largest |horizontal|/vertical impulse of an impact (contact variants)
+N_OUT = 22
 
 # --- state tuple y (the loop's 6 slots, a UniTuple(float64, 6)) ----------------------------
 Y_THETA = 0  # theta [rad] (0 in full contact)
@@ -108,6 +112,8 @@ STATUS_OVERTURNED = 256
 STATUS_E_ABOVE_1 = 512  # at least one impact had e > 1
 STATUS_BOUNDED = 1024  # rigid body after the pulse below its overturning energy, |e| <= 1:
 #                        safe proven (early exit; impacts counted up to there)
+STATUS_SLIDES = 2048  # friction demand above PAR_MU: the base would slide (contact variants)
+STATUS_LIFTS_OFF = 4096  # normal reaction below 0: the body would leave the ground (contact)
 # A run with any of these is not a reliable classification: "flagged".
 STATUS_FLAGGED = STATUS_HORIZON | STATUS_STEP_CAP | STATUS_EVENT_CAP | STATUS_NONFINITE
 
@@ -118,3 +124,4 @@ KIND_RIGID = 2
 LEVEL_OUTCOME = 0  # outcome and summary metrics only
 LEVEL_ENERGY = 1  # + energy accounting
 LEVEL_HISTORY = 2  # + energy accounting + time history
+LEVEL_CONTACT = 3  # + energy accounting + ground reactions (outputs.contact)

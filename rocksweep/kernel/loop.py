@@ -25,6 +25,13 @@ import numpy as np
 from numba import literally, njit
 
 from rocksweep.kernel._cache import INTERNAL
+from rocksweep.kernel.contact import (
+    SAMPLE_EVENT,
+    SAMPLE_START,
+    SAMPLE_STEP,
+    contact_impact,
+    contact_sample,
+)
 from rocksweep.kernel.equations import ground_acc, mechanical_energy
 from rocksweep.kernel.events import (
     EV_IMPACT,
@@ -55,7 +62,10 @@ from rocksweep.kernel.layout import (
     OUT_EVENT_STEPS,
     OUT_HIST_ROWS,
     OUT_IMPACTS,
+    OUT_IMPULSE_MAX,
+    OUT_MU_REQ,
     OUT_N_GAINING,
+    OUT_N_MIN,
     OUT_OUTCOME,
     OUT_STATUS,
     OUT_STEPS,
@@ -71,6 +81,7 @@ from rocksweep.kernel.layout import (
     PAR_DT,
     PAR_MAXEVENTS,
     PAR_MAXSTEPS,
+    PAR_MU,
     PAR_TEND,
     PAR_THETA0,
     PAR_THETA_DOT0,
@@ -81,10 +92,12 @@ from rocksweep.kernel.layout import (
     STATUS_EVENT_CAP,
     STATUS_HIST_FULL,
     STATUS_HORIZON,
+    STATUS_LIFTS_OFF,
     STATUS_NONFINITE,
     STATUS_OVERTURNED,
     STATUS_REST,
     STATUS_SETTLED,
+    STATUS_SLIDES,
     STATUS_STEP_CAP,
     Y_D_DAMP,
     Y_THETA,
@@ -98,17 +111,21 @@ from rocksweep.kernel.transitions import impact_map, rest_proven, rigid_bounded,
 
 
 @njit(cache=True, **INTERNAL)
-def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY):
+def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT):
     """Run one point from rest (or the given initial state) to a decided outcome, a cap or
     the horizon.
 
     prm: float64[N_PAR] parameter row; out: float64[N_OUT] result row (filled);
     hist: float64[n, N_HIST] history buffer, or None: no history (the recording code is
-    then not compiled at all).
+    then not compiled at all). CONTACT: track the ground reactions (``contact``): the
+    friction demand, the lowest normal force and the impacts' impulse ratio; every sample
+    is a state the loop reaches anyway (step ends, event states before and after the
+    action), taken with ``_contact``.
     """
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
+    literally(CONTACT)
     t, dt, t_pulse, t_end = 0.0, prm[PAR_DT], prm[PAR_TPULSE], prm[PAR_TEND]
     max_steps, max_events = prm[PAR_MAXSTEPS], prm[PAR_MAXEVENTS]
     y = (prm[PAR_THETA0], prm[PAR_THETA_DOT0], 0.0, 0.0, 0.0, 0.0)
@@ -123,6 +140,13 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY):
     free_check = True  # rigid: test rigid_bounded at the next loop top after the pulse
     # the counters of every step stay in registers (in out: ~3% slower); the rest is in out
     steps, event_steps, theta_max = 0, 0, abs(y[Y_THETA])
+    # contact tracker (contact.contact_sample): unused, and removed, without CONTACT
+    ct = (0.0, 0.0, y, 0.0, 0.0, 0.0, y, 0.0, 0.0)
+    out[OUT_MU_REQ] = 0.0 if CONTACT else np.nan
+    out[OUT_N_MIN] = np.inf if CONTACT else np.nan
+    out[OUT_IMPULSE_MAX] = 0.0 if CONTACT else np.nan
+    if CONTACT:
+        ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED)
 
     while True:
         on = t < t_pulse
@@ -162,6 +186,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY):
         if ev == EV_NONE:
             t, y = (t_pulse if lands else t + h), y1
             _record(hist, t, y, s, t < t_pulse, prm, out, FLEX)
+            if CONTACT:  # the step's end, with the step's own ground motion
+                ct = contact_sample(ct, t, y, s, on, SAMPLE_STEP, prm, out, FLEX, DAMPED)
             if lands and s == 0:
                 # The pulse ends with a jump of xg'' (a cosine pulse ends at its peak), and
                 # Q jumps with it by m_A h_A xg'': the state may now be past the uplift
@@ -170,22 +196,33 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY):
                 s = _uplift(t, y, False, prm, out, FLEX, DAMPED)
                 if s != 0:
                     _record(hist, t, y, s, False, prm, out, FLEX)
+            if CONTACT and lands:  # H jumps with xg'': a new segment without the pulse
+                ct = contact_sample(ct, t, y, s, False, SAMPLE_START, prm, out, FLEX, DAMPED)
             continue
 
         t, y = t + tau, y_ev
         _record(hist, t, y, s, on, prm, out, FLEX)
+        if CONTACT:  # the event state, last sample of its phase
+            ct = contact_sample(ct, t, y, s, on, SAMPLE_EVENT, prm, out, FLEX, DAMPED)
         if ev == EV_OVERTURN:
             _overturned(t, out)
             break
         if ev == EV_IMPACT:
+            y_minus, s_minus = y, s
             y, s = _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY)
+            if CONTACT:
+                contact_impact(y_minus, s_minus, y, s, prm, out, FLEX)
             free_check = True
         else:  # uplift: theta = theta' = 0 exactly, now rocking on the located corner
             s = 1 if ev == EV_UPLIFT_POS else -1
             y = (0.0, 0.0, y[Y_U], y[Y_U_DOT], y[Y_W_IN], y[Y_D_DAMP])
             out[OUT_UPLIFTS] += 1.0
         _record(hist, t, y, s, on, prm, out, FLEX)
+        if CONTACT:  # the state after the action starts the next phase's samples
+            ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED)
     _finish(t, y, s, steps, event_steps, theta_max, prm, out, FLEX, ENERGY)
+    if CONTACT:
+        _contact_status(prm, out)
 
 
 # ----------------------------------------------------------------------------------------
@@ -284,6 +321,16 @@ def _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY):
     if s_new == 0:
         s_new = _uplift(t, y, on, prm, out, FLEX, DAMPED)
     return y, s_new
+
+
+@njit(cache=True, **INTERNAL)
+def _contact_status(prm, out):
+    """STATUS_SLIDES when the friction demand exceeds PAR_MU (never when PAR_MU is NaN),
+    STATUS_LIFTS_OFF when the normal reaction went below zero."""
+    if out[OUT_MU_REQ] > prm[PAR_MU]:
+        _flag(out, STATUS_SLIDES)
+    if out[OUT_N_MIN] < 0.0:
+        _flag(out, STATUS_LIFTS_OFF)
 
 
 @njit(cache=True, **INTERNAL)

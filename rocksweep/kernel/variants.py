@@ -2,12 +2,15 @@
 
 Each entry point fixes the compile-time flags of ``loop.simulate_point`` as literals
 (FLEX: the top mass moves on its spring; DAMPED: the spring has a damper; ENERGY: energy
-accounting), so every variant is assembled from the same functions with the branches it
-does not need removed.
+accounting; CONTACT: ground reactions, friction demand and impulses), so every variant is
+assembled from the same functions with the branches it does not need removed.
 
   chunk_*: prms float64[n, N_PAR] -> outs float64[n, N_OUT] (filled in place); they
       release the GIL, so threads of one process run chunks in parallel
-  point_*: one point with energy accounting and a history buffer float64[n, N_HIST]
+  chunk_*_contact: with energy accounting and the ground reactions (``LEVEL_CONTACT``:
+      scenes with ``outputs: {contact: true}``, with or without energy)
+  point_*: one point with energy accounting, the ground reactions and a history buffer
+      float64[n, N_HIST] (the reactions cost a single run ~nothing: no variant without)
 
 ``chunk_kernel(kind, level)`` and ``point_kernel(kind)`` pick one by ``KIND_*`` and
 ``LEVEL_*`` (``layout``); ``warm_up`` compiles (or loads) one now.
@@ -21,68 +24,90 @@ from rocksweep.kernel.layout import (
     KIND_FLEXIBLE,
     KIND_FLEXIBLE_UNDAMPED,
     KIND_RIGID,
+    LEVEL_CONTACT,
     LEVEL_ENERGY,
     LEVEL_OUTCOME,
     N_HIST,
     N_OUT,
     N_PAR,
+    PAR_B,
+    PAR_G,
+    PAR_M,
+    PAR_MTOT,
     PAR_TEND,
+    PAR_TPULSE,
 )
 from rocksweep.kernel.loop import simulate_point
 
 
 @njit(cache=True, **INTERNAL)
-def _chunk(prms, outs, FLEX, DAMPED, ENERGY):
+def _chunk(prms, outs, FLEX, DAMPED, ENERGY, CONTACT):
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
+    literally(CONTACT)
     for i in range(prms.shape[0]):
-        simulate_point(prms[i], outs[i], None, FLEX, DAMPED, ENERGY)
+        simulate_point(prms[i], outs[i], None, FLEX, DAMPED, ENERGY, CONTACT)
 
 
 @njit(cache=True, nogil=True)
 def chunk_flexible(prms, outs):
-    _chunk(prms, outs, True, True, False)
+    _chunk(prms, outs, True, True, False, False)
 
 
 @njit(cache=True, nogil=True)
 def chunk_flexible_undamped(prms, outs):
-    _chunk(prms, outs, True, False, False)
+    _chunk(prms, outs, True, False, False, False)
 
 
 @njit(cache=True, nogil=True)
 def chunk_rigid(prms, outs):
-    _chunk(prms, outs, False, False, False)
+    _chunk(prms, outs, False, False, False, False)
 
 
 @njit(cache=True, nogil=True)
 def chunk_flexible_energy(prms, outs):
-    _chunk(prms, outs, True, True, True)
+    _chunk(prms, outs, True, True, True, False)
 
 
 @njit(cache=True, nogil=True)
 def chunk_flexible_undamped_energy(prms, outs):
-    _chunk(prms, outs, True, False, True)
+    _chunk(prms, outs, True, False, True, False)
 
 
 @njit(cache=True, nogil=True)
 def chunk_rigid_energy(prms, outs):
-    _chunk(prms, outs, False, False, True)
+    _chunk(prms, outs, False, False, True, False)
+
+
+@njit(cache=True, nogil=True)
+def chunk_flexible_contact(prms, outs):
+    _chunk(prms, outs, True, True, True, True)
+
+
+@njit(cache=True, nogil=True)
+def chunk_flexible_undamped_contact(prms, outs):
+    _chunk(prms, outs, True, False, True, True)
+
+
+@njit(cache=True, nogil=True)
+def chunk_rigid_contact(prms, outs):
+    _chunk(prms, outs, False, False, True, True)
 
 
 @njit(cache=True)
 def point_flexible_history(prm, out, hist):
-    simulate_point(prm, out, hist, True, True, True)
+    simulate_point(prm, out, hist, True, True, True, True)
 
 
 @njit(cache=True)
 def point_flexible_undamped_history(prm, out, hist):
-    simulate_point(prm, out, hist, True, False, True)
+    simulate_point(prm, out, hist, True, False, True, True)
 
 
 @njit(cache=True)
 def point_rigid_history(prm, out, hist):
-    simulate_point(prm, out, hist, False, False, True)
+    simulate_point(prm, out, hist, False, False, True, True)
 
 
 _CHUNK = {
@@ -92,6 +117,9 @@ _CHUNK = {
     (KIND_FLEXIBLE, LEVEL_ENERGY): chunk_flexible_energy,
     (KIND_FLEXIBLE_UNDAMPED, LEVEL_ENERGY): chunk_flexible_undamped_energy,
     (KIND_RIGID, LEVEL_ENERGY): chunk_rigid_energy,
+    (KIND_FLEXIBLE, LEVEL_CONTACT): chunk_flexible_contact,
+    (KIND_FLEXIBLE_UNDAMPED, LEVEL_CONTACT): chunk_flexible_undamped_contact,
+    (KIND_RIGID, LEVEL_CONTACT): chunk_rigid_contact,
 }
 _POINT = {
     KIND_FLEXIBLE: point_flexible_history,
@@ -106,7 +134,8 @@ def chunk_kernel(kind: int, level: int):
 
 
 def point_kernel(kind: int):
-    """Jitted ``f(prm[N_PAR], out[N_OUT], hist[n, N_HIST])`` with energy and history."""
+    """Jitted ``f(prm[N_PAR], out[N_OUT], hist[n, N_HIST])`` with energy, ground reactions
+    and history."""
     return _POINT[kind]
 
 
@@ -117,6 +146,9 @@ def warm_up(kind: int, level: int | None = None) -> None:
     """
     prm = np.zeros((1, N_PAR))
     prm[0, PAR_TEND] = -1.0  # the loop stops before its first step
+    # a body at rest in full contact: the contact variants evaluate the reactions at t = 0
+    prm[0, PAR_M] = prm[0, PAR_MTOT] = prm[0, PAR_G] = prm[0, PAR_B] = 1.0
+    prm[0, PAR_TPULSE] = 1.0  # pulse on: no rest test (it divides by k)
     out = np.empty((1, N_OUT))
     if level is None:
         point_kernel(kind)(prm[0], out[0], np.empty((1, N_HIST)))
