@@ -100,10 +100,12 @@ class _Problem:
 
     # --- eq. (2) -----------------------------------------------------------------------
     def xg(self, t: float, on: bool) -> float:
-        return ground_acc(t, on, self.prm)
+        # on as an int: the kernel's code for every shape (a bool would compile the
+        # sine/cosine-only code, ``equations.ground_acc``)
+        return ground_acc(t, int(on), self.prm)
 
     def jerk(self, t: float, on: bool) -> float:
-        return ground_jerk(t, on, self.prm)
+        return ground_jerk(t, int(on), self.prm)
 
     # --- full contact ------------------------------------------------------------------
     def q(self, t: float, y, on: bool) -> float:

@@ -96,8 +96,11 @@ class Run:
 
 
 def history_capacity(row: np.ndarray) -> int:
-    """Rows a full history of this point can need: every step plus 3 rows per event."""
+    """Rows a full history of this point can need: every step plus 3 rows per event (a
+    record's steps on its samples counted on top)."""
     steps = math.ceil(row[L.PAR_TEND] / row[L.PAR_DT])
+    if row[L.PAR_REC_H] > 0.0:
+        steps += math.ceil(row[L.PAR_TPULSE] / row[L.PAR_REC_H]) + 1
     return int(steps + 3 * row[L.PAR_MAXEVENTS] + 16)
 
 
@@ -107,15 +110,16 @@ def simulate(point: Point, numerics: Numerics, history: bool = True) -> Run:
     row = point_row(point, numerics)
     out = np.empty(L.N_OUT)
     kind = kernel_kind(point.body)
-    warm_up(kind, None if history else L.LEVEL_OUTCOME)  # wall_time excludes compilation
+    ground = point.ground
+    warm_up(kind, None if history else L.LEVEL_OUTCOME, ground)  # wall_time: no compiling
     t0 = time.perf_counter()
     if history:
         hist = np.empty((history_capacity(row), L.N_HIST))
-        point_kernel(kind)(row, out, hist)
+        point_kernel(kind, ground)(row, out, hist)
         n = int(out[L.OUT_HIST_ROWS])
         hist_d = {c.raw: hist[:n, c.slot].copy() for c in fields.HISTORY}
     else:
         outs = out[None, :]
-        chunk_kernel(kind, L.LEVEL_OUTCOME)(row[None, :], outs)
+        chunk_kernel(kind, L.LEVEL_OUTCOME, ground)(row[None, :], outs)
         hist_d = None
     return Run(point, numerics, out, hist_d, time.perf_counter() - t0)

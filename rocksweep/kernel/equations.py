@@ -27,12 +27,17 @@ Full contact (theta = 0):  m u'' + c u' + k u = -m xg''.
 import math
 
 from numba import njit
+from numba.core import types
+from numba.extending import overload
 
+from rocksweep.kernel._cache import INTERNAL
 from rocksweep.kernel.layout import (
     PAR_AMP,
+    PAR_AMP_NORM,
     PAR_B,
     PAR_C,
     PAR_G,
+    PAR_GAMMA,
     PAR_H,
     PAR_HA,
     PAR_HCG,
@@ -44,26 +49,84 @@ from rocksweep.kernel.layout import (
     PAR_M,
     PAR_MA,
     PAR_MTOT,
+    PAR_NU,
     PAR_OMEGA,
+    PAR_REC,
+    PAR_REC_DT,
     PAR_SHAPE,
     SHAPE_COSINE,
+    SHAPE_RECORD,
+    SHAPE_RICKER,
 )
 
 # ----------------------------------------------------------------------------------------
-# Eq. (2): the single-cycle pulse. ``on`` is decided per step by the loop (the step that
-# ends exactly at 2 pi/omega still sees the pulse, the next one does not), so the cosine
-# pulse's jump is never smeared across a step.
+# Eq. (2): the pulse (n cycles of a sine or cosine), and the other ground motions. ``on``
+# is decided per step by the loop (the step that ends exactly at the pulse's end still
+# sees the pulse, the next one does not), so a jump at the end (the cosine's) is never
+# smeared across a step.
+#
+# The type of ``on`` picks the code at compile time: a bool (the loop's GROUND = False:
+# sine and cosine only, the paper's scenes, exactly the code they always ran) or an int
+# (GROUND = True: every shape, the Ricker, MP and records too, chosen by PAR_SHAPE at run
+# time). A run-time branch to the other shapes inside the pulse variants cost 5% (inlined)
+# to 60% (a call) on the paper's scenes, measured; the type costs nothing there.
 # ----------------------------------------------------------------------------------------
+
+
+def _shape_acc(t, on, prm):  # pragma: no cover (replaced by the overload below)
+    raise NotImplementedError
+
+
+def _shape_jerk(t, on, prm):  # pragma: no cover
+    raise NotImplementedError
+
+
+@overload(_shape_acc, inline="always")
+def _shape_acc_overload(t, on, prm):
+    if isinstance(on, types.Boolean):
+        def pulse(t, on, prm):
+            if prm[PAR_SHAPE] == SHAPE_COSINE:
+                return prm[PAR_AMP] * math.cos(prm[PAR_OMEGA] * t)
+            return prm[PAR_AMP] * math.sin(prm[PAR_OMEGA] * t)
+        return pulse
+
+    def any_shape(t, on, prm):
+        if prm[PAR_SHAPE] > SHAPE_COSINE:
+            return ground_acc_other(t, prm)
+        if prm[PAR_SHAPE] == SHAPE_COSINE:
+            return prm[PAR_AMP] * math.cos(prm[PAR_OMEGA] * t)
+        return prm[PAR_AMP] * math.sin(prm[PAR_OMEGA] * t)
+    return any_shape
+
+
+@overload(_shape_jerk, inline="always")
+def _shape_jerk_overload(t, on, prm):
+    if isinstance(on, types.Boolean):
+        def pulse(t, on, prm):
+            w = prm[PAR_OMEGA]
+            if prm[PAR_SHAPE] == SHAPE_COSINE:
+                return -prm[PAR_AMP] * w * math.sin(w * t)
+            return prm[PAR_AMP] * w * math.cos(w * t)
+        return pulse
+
+    def any_shape(t, on, prm):
+        if prm[PAR_SHAPE] > SHAPE_COSINE:
+            return ground_jerk_other(t, prm)
+        w = prm[PAR_OMEGA]
+        if prm[PAR_SHAPE] == SHAPE_COSINE:
+            return -prm[PAR_AMP] * w * math.sin(w * t)
+        return prm[PAR_AMP] * w * math.cos(w * t)
+    return any_shape
 
 
 @njit(cache=True, inline="always")
 def ground_acc(t, on, prm):
-    """xg''(t) [m/s^2] of eq. (2); 0 when ``on`` is False."""
+    """xg''(t) [m/s^2] of eq. (2) or of the row's other shape; 0 when ``on`` is false.
+
+    on: bool (sine and cosine only) or int (any shape; what Python callers pass)."""
     if not on:
         return 0.0
-    if prm[PAR_SHAPE] == SHAPE_COSINE:
-        return prm[PAR_AMP] * math.cos(prm[PAR_OMEGA] * t)
-    return prm[PAR_AMP] * math.sin(prm[PAR_OMEGA] * t)
+    return _shape_acc(t, on, prm)
 
 
 @njit(cache=True, inline="always")
@@ -71,10 +134,70 @@ def ground_jerk(t, on, prm):
     """d xg''/dt [m/s^3], for locating an uplift inside a step."""
     if not on:
         return 0.0
-    w = prm[PAR_OMEGA]
-    if prm[PAR_SHAPE] == SHAPE_COSINE:
-        return -prm[PAR_AMP] * w * math.sin(w * t)
-    return prm[PAR_AMP] * w * math.cos(w * t)
+    return _shape_jerk(t, on, prm)
+
+
+@njit(cache=True, inline="always")
+def _record_segment(t, prm):
+    """(a_k, x - k, a_k+1 - a_k), x = t / PAR_REC_DT: the first sample of the record's
+    linear segment [t_k, t_k+1] that holds t, the fraction of it at t, and the samples'
+    difference. At a sample time either neighbour
+    gives the same value (the interpolant is continuous), so the loop's steps, which land
+    on sample times, always see one segment's straight line."""
+    x = t / prm[PAR_REC_DT]
+    k = min(max(int(x), 0), prm.shape[0] - PAR_REC - 2)  # the last segment at the end
+    a0 = prm[PAR_REC + k]
+    return a0, x - k, prm[PAR_REC + k + 1] - a0
+
+
+@njit(cache=True, inline="always")
+def ground_acc_other(t, prm):
+    """xg''(t) [m/s^2] of the Ricker wavelet, the Mavroeidis-Papageorgiou pulse or a record
+    (while on; ``rocksweep.excitation`` defines each as a function of phi = w t).
+
+    A record: A times the samples xg''/PGA interpolated linearly, samples every
+    PAR_REC_DT (a few loads, inlined). The wavelets (``wavelet``) are one call on scalars.
+    """
+    if prm[PAR_SHAPE] == SHAPE_RECORD:
+        a0, frac, da = _record_segment(t, prm)
+        return prm[PAR_AMP] * (a0 + frac * da)
+    return wavelet(t, prm[PAR_SHAPE], prm[PAR_AMP], prm[PAR_OMEGA], prm[PAR_GAMMA],
+                   prm[PAR_NU], prm[PAR_AMP_NORM], False)
+
+
+@njit(cache=True, inline="always")
+def ground_jerk_other(t, prm):
+    """d xg''/dt [m/s^3] of ``ground_acc_other`` (a record: its segment's constant slope)."""
+    if prm[PAR_SHAPE] == SHAPE_RECORD:
+        _, _, da = _record_segment(t, prm)
+        return prm[PAR_AMP] * da / prm[PAR_REC_DT]
+    return wavelet(t, prm[PAR_SHAPE], prm[PAR_AMP], prm[PAR_OMEGA], prm[PAR_GAMMA],
+                   prm[PAR_NU], prm[PAR_AMP_NORM], True)
+
+
+@njit(cache=True, **INTERNAL)
+def wavelet(t, shape, amp, w, gamma, nu, norm, rate):
+    """xg''(t) [m/s^2] (rate: d xg''/dt [m/s^3]) of the Ricker wavelet or the
+    Mavroeidis-Papageorgiou pulse, from scalars (a call without arrays: no reference
+    counting on the paper's pulses' path).
+
+    Ricker: A (1 - 2 tau^2) exp(-tau^2), tau = phi/2 - 3 pi/2 (t0 = 1.5/f, f = w/(2 pi)),
+    phi = w t. MP: A/r_max [sin(phi/gamma) cos(psi) - gamma (1 - cos(phi/gamma)) sin(psi)],
+    psi = phi - pi gamma + nu (OpenSees' MPAcc; norm = 1/r_max).
+    """
+    phi = w * t
+    if shape == SHAPE_RICKER:
+        tau = 0.5 * phi - 1.5 * math.pi
+        e = math.exp(-tau * tau)
+        if rate:
+            return amp * w * tau * (2.0 * tau * tau - 3.0) * e
+        return amp * (1.0 - 2.0 * tau * tau) * e
+    psi = phi - math.pi * gamma + nu
+    x = phi / gamma
+    if rate:
+        return amp * norm * w * (math.cos(psi) * (math.cos(x) / gamma - gamma * (1.0 - math.cos(x)))
+                                 - 2.0 * math.sin(x) * math.sin(psi))
+    return amp * norm * (math.sin(x) * math.cos(psi) - gamma * (1.0 - math.cos(x)) * math.sin(psi))
 
 
 # ----------------------------------------------------------------------------------------
