@@ -57,6 +57,7 @@ from rocksweep.kernel.layout import (
     SHAPE_COSINE,
     SHAPE_RECORD,
     SHAPE_RICKER,
+    SHAPE_SINE,
 )
 
 # ----------------------------------------------------------------------------------------
@@ -67,9 +68,10 @@ from rocksweep.kernel.layout import (
 #
 # The type of ``on`` picks the code at compile time: a bool (the loop's GROUND = False:
 # sine and cosine only, the paper's scenes, exactly the code they always ran) or an int
-# (GROUND = True: every shape, the Ricker, MP and records too, chosen by PAR_SHAPE at run
-# time). A run-time branch to the other shapes inside the pulse variants cost 5% (inlined)
-# to 60% (a call) on the paper's scenes, measured; the type costs nothing there.
+# (GROUND = 1: every shape, the Ricker, MP and records too, chosen by PAR_SHAPE at run
+# time, ``ground_acc_any``). A run-time branch to the other shapes inside the pulse
+# variants cost 5% (inlined) to 60% (a call) on the paper's scenes, measured; the type
+# costs nothing there.
 # ----------------------------------------------------------------------------------------
 
 
@@ -91,11 +93,7 @@ def _shape_acc_overload(t, on, prm):
         return pulse
 
     def any_shape(t, on, prm):
-        if prm[PAR_SHAPE] > SHAPE_COSINE:
-            return ground_acc_other(t, prm)
-        if prm[PAR_SHAPE] == SHAPE_COSINE:
-            return prm[PAR_AMP] * math.cos(prm[PAR_OMEGA] * t)
-        return prm[PAR_AMP] * math.sin(prm[PAR_OMEGA] * t)
+        return ground_acc_any(t, prm)
     return any_shape
 
 
@@ -110,12 +108,7 @@ def _shape_jerk_overload(t, on, prm):
         return pulse
 
     def any_shape(t, on, prm):
-        if prm[PAR_SHAPE] > SHAPE_COSINE:
-            return ground_jerk_other(t, prm)
-        w = prm[PAR_OMEGA]
-        if prm[PAR_SHAPE] == SHAPE_COSINE:
-            return -prm[PAR_AMP] * w * math.sin(w * t)
-        return prm[PAR_AMP] * w * math.cos(w * t)
+        return ground_jerk_any(t, prm)
     return any_shape
 
 
@@ -150,54 +143,61 @@ def _record_segment(t, prm):
     return a0, x - k, prm[PAR_REC + k + 1] - a0
 
 
-@njit(cache=True, inline="always")
-def ground_acc_other(t, prm):
-    """xg''(t) [m/s^2] of the Ricker wavelet, the Mavroeidis-Papageorgiou pulse or a record
-    (while on; ``rocksweep.excitation`` defines each as a function of phi = w t).
+@njit(cache=True, **INTERNAL)
+def ground_acc_any(t, prm):
+    """xg''(t) [m/s^2] while on, of any shape (``rocksweep.excitation`` defines each as a
+    function of phi = w t); one call (inlining it into every right-hand side inlines
+    it again in each of the GROUND variant's call sites: numba's IR inliner warns).
 
-    A record: A times the samples xg''/PGA interpolated linearly, samples every
-    PAR_REC_DT (a few loads, inlined). The wavelets (``wavelet``) are one call on scalars.
+    Sine, cosine: A sin(phi), A cos(phi). Ricker: A (1 - 2 tau^2) exp(-tau^2), tau =
+    phi/2 - 3 pi/2 (t0 = 1.5/f, f = w/(2 pi)). MP: A/r_max [sin(phi/gamma) cos(psi) -
+    gamma (1 - cos(phi/gamma)) sin(psi)], psi = phi - pi gamma + nu (OpenSees' MPAcc;
+    PAR_AMP_NORM = 1/r_max). Record: A times the samples xg''/PGA interpolated linearly,
+    samples every PAR_REC_DT.
     """
-    if prm[PAR_SHAPE] == SHAPE_RECORD:
+    shape = prm[PAR_SHAPE]
+    amp = prm[PAR_AMP]
+    if shape == SHAPE_RECORD:
         a0, frac, da = _record_segment(t, prm)
-        return prm[PAR_AMP] * (a0 + frac * da)
-    return wavelet(t, prm[PAR_SHAPE], prm[PAR_AMP], prm[PAR_OMEGA], prm[PAR_GAMMA],
-                   prm[PAR_NU], prm[PAR_AMP_NORM], False)
-
-
-@njit(cache=True, inline="always")
-def ground_jerk_other(t, prm):
-    """d xg''/dt [m/s^3] of ``ground_acc_other`` (a record: its segment's constant slope)."""
-    if prm[PAR_SHAPE] == SHAPE_RECORD:
-        _, _, da = _record_segment(t, prm)
-        return prm[PAR_AMP] * da / prm[PAR_REC_DT]
-    return wavelet(t, prm[PAR_SHAPE], prm[PAR_AMP], prm[PAR_OMEGA], prm[PAR_GAMMA],
-                   prm[PAR_NU], prm[PAR_AMP_NORM], True)
+        return amp * (a0 + frac * da)
+    phi = prm[PAR_OMEGA] * t
+    if shape == SHAPE_SINE:
+        return amp * math.sin(phi)
+    if shape == SHAPE_COSINE:
+        return amp * math.cos(phi)
+    if shape == SHAPE_RICKER:
+        tau = 0.5 * phi - 1.5 * math.pi
+        return amp * (1.0 - 2.0 * tau * tau) * math.exp(-tau * tau)
+    gamma = prm[PAR_GAMMA]
+    psi = phi - math.pi * gamma + prm[PAR_NU]
+    x = phi / gamma
+    r = math.sin(x) * math.cos(psi) - gamma * (1.0 - math.cos(x)) * math.sin(psi)
+    return amp * prm[PAR_AMP_NORM] * r
 
 
 @njit(cache=True, **INTERNAL)
-def wavelet(t, shape, amp, w, gamma, nu, norm, rate):
-    """xg''(t) [m/s^2] (rate: d xg''/dt [m/s^3]) of the Ricker wavelet or the
-    Mavroeidis-Papageorgiou pulse, from scalars (a call without arrays: no reference
-    counting on the paper's pulses' path).
-
-    Ricker: A (1 - 2 tau^2) exp(-tau^2), tau = phi/2 - 3 pi/2 (t0 = 1.5/f, f = w/(2 pi)),
-    phi = w t. MP: A/r_max [sin(phi/gamma) cos(psi) - gamma (1 - cos(phi/gamma)) sin(psi)],
-    psi = phi - pi gamma + nu (OpenSees' MPAcc; norm = 1/r_max).
-    """
+def ground_jerk_any(t, prm):
+    """d xg''/dt [m/s^3] of ``ground_acc_any`` (a record: its segment's constant slope)."""
+    shape = prm[PAR_SHAPE]
+    amp = prm[PAR_AMP]
+    if shape == SHAPE_RECORD:
+        _, _, da = _record_segment(t, prm)
+        return amp * da / prm[PAR_REC_DT]
+    w = prm[PAR_OMEGA]
     phi = w * t
+    if shape == SHAPE_SINE:
+        return amp * w * math.cos(phi)
+    if shape == SHAPE_COSINE:
+        return -amp * w * math.sin(phi)
     if shape == SHAPE_RICKER:
         tau = 0.5 * phi - 1.5 * math.pi
-        e = math.exp(-tau * tau)
-        if rate:
-            return amp * w * tau * (2.0 * tau * tau - 3.0) * e
-        return amp * (1.0 - 2.0 * tau * tau) * e
-    psi = phi - math.pi * gamma + nu
+        return amp * w * tau * (2.0 * tau * tau - 3.0) * math.exp(-tau * tau)
+    gamma = prm[PAR_GAMMA]
+    psi = phi - math.pi * gamma + prm[PAR_NU]
     x = phi / gamma
-    if rate:
-        return amp * norm * w * (math.cos(psi) * (math.cos(x) / gamma - gamma * (1.0 - math.cos(x)))
-                                 - 2.0 * math.sin(x) * math.sin(psi))
-    return amp * norm * (math.sin(x) * math.cos(psi) - gamma * (1.0 - math.cos(x)) * math.sin(psi))
+    rate = (math.cos(psi) * (math.cos(x) / gamma - gamma * (1.0 - math.cos(x)))
+            - 2.0 * math.sin(x) * math.sin(psi))
+    return amp * prm[PAR_AMP_NORM] * w * rate
 
 
 # ----------------------------------------------------------------------------------------
