@@ -486,6 +486,7 @@ def _record(ground: dict, base: Path | None) -> GroundRecord:
     path = Path(v).expanduser()
     if not path.is_absolute() and base is not None:
         path = base / path
+    path = path.absolute()  # the file records where it was read (spectra re-read it)
     try:
         return read_record(path)
     except RecordError as err:

@@ -151,6 +151,30 @@ def test_record_sweep_end_to_end(tmp_path, cli):
     res = cli.invoke(main, ["plot", str(out), "-o", str(tmp_path / "r.png")])
     assert res.exit_code == 0, res.output
     assert (tmp_path / "r.png").stat().st_size > 10_000
+    # spectra: the bisected A_min lies in its grid bracket, overturns there (hi), and the
+    # bracket's low end does not; to rtol
+    res = cli.invoke(main, ["spectrum", str(out), "-o", str(tmp_path / "s.png"),
+                            "--rtol", "1e-2"])
+    assert res.exit_code == 0, res.output
+    assert (tmp_path / "s.png").stat().st_size > 10_000
+    from rocksweep.spectrum import kernel_evaluator, result_scene, spectra
+    from rocksweep.store import read_result
+
+    sp = spectra(out, rtol=1e-2)
+    assert sp.freq == "p" and sp.lam.tolist() == [0.0, 0.4] and sp.runs > 0
+    rebuilt = result_scene(read_result(out, ["outcome"]))
+    evaluate = kernel_evaluator(rebuilt)
+    checked = 0
+    for lam, c in zip(sp.lam, sp.a_min, strict=True):
+        for j in np.flatnonzero(np.isfinite(c.lo)):
+            assert c.hi[j] - c.lo[j] <= 1e-2 * c.hi[j]
+            pts = [rebuilt.point({**FIG3,
+                                "lam": lam, "shape": RECORD, "p": c.x[j], "A_ratio": a})
+                   for a in (c.lo[j], c.hi[j])]
+            lo_cls, hi_cls = evaluate(pts)
+            assert lo_cls == 0 and hi_cls == c.mode[j] > 0
+            checked += 1
+    assert checked > 0
     # another record under the same name: resume refuses
     data = (tmp_path / "records" / NEARFAULT.name).read_text().replace(".1", ".2", 1)
     (tmp_path / "records" / NEARFAULT.name).write_text(data)

@@ -1,3 +1,3 @@
 """Imports every command module so that each attaches itself to ``main``."""
 
-from rocksweep.cli import accuracy, info, plot, restitution, simulate, sweep  # noqa: F401
+from rocksweep.cli import accuracy, info, plot, restitution, simulate, spectrum, sweep  # noqa: F401
