@@ -124,11 +124,11 @@ def boundary_mask(outcome: np.ndarray, dims: tuple[str, ...]) -> np.ndarray:
     """Points of a stability diagram next to another outcome (bool, outcome's shape).
 
     outcome: int[grid shape] over the swept dims ``dims``; neighbours are taken along the
-    diagram's axes A_ratio and w_over_p (where swept).
+    diagram's axes A_ratio and w_over_p, or a record's p (where swept).
     """
     mask = np.zeros(outcome.shape, bool)
     for ax, name in enumerate(dims):
-        if name not in ("A_ratio", "w_over_p"):
+        if name not in ("A_ratio", "w_over_p", "p"):  # p: a record sweep's time scale
             continue
         diff = np.diff(outcome, axis=ax) != 0
         lo = [slice(None)] * outcome.ndim
@@ -271,23 +271,26 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
     ``repeat`` rounds (the machine's noise only ever adds time). Compilation is excluded.
     """
     from rocksweep.grid import Grid
+    from rocksweep.points import with_record
 
     cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
+    rows_all = with_record(cr.rows, scene.record)  # a record's samples ride on each row
+    ground = scene.ground  # the Ricker, MP and records run the GROUND variants
     n = len(flat)
     outs = np.empty((n, L.N_OUT))
     kinds = np.unique(cr.kinds)
     for kind in kinds:
-        warm_up(int(kind), L.LEVEL_OUTCOME)
-    fns = [chunk_kernel(int(k), L.LEVEL_OUTCOME) for k in cr.kinds]
+        warm_up(int(kind), L.LEVEL_OUTCOME, ground)
+    fns = [chunk_kernel(int(k), L.LEVEL_OUTCOME, ground) for k in cr.kinds]
     per_point = np.full(n, np.inf)
     batch = math.inf
     part = np.empty_like(outs)
-    groups = [(chunk_kernel(int(k), L.LEVEL_OUTCOME),
-               np.ascontiguousarray(cr.rows[cr.kinds == k])) for k in kinds]
+    groups = [(chunk_kernel(int(k), L.LEVEL_OUTCOME, ground),
+               np.ascontiguousarray(rows_all[cr.kinds == k])) for k in kinds]
     clock = time.perf_counter
     for _ in range(max(1, repeat)):
         for i in range(n):
-            row, out = cr.rows[i:i + 1], outs[i:i + 1]
+            row, out = rows_all[i:i + 1], outs[i:i + 1]
             t0 = clock()
             fns[i](row, out)
             dt = clock() - t0

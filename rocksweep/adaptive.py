@@ -612,6 +612,7 @@ class _Subset:
 
     def __init__(self, grid: Grid, flat: np.ndarray) -> None:
         self.grid = grid
+        self.scene = grid.scene
         self.flat = np.asarray(flat, np.int64)
 
     def rows(self, start: int, stop: int) -> ChunkRows:

@@ -237,20 +237,23 @@ Evaluator = Callable[[list[Point]], np.ndarray]
 
 
 def kernel_evaluator(scene: Scene) -> Evaluator:
-    """Classes of arbitrary points, one kernel run each (outcome-only kernel, the scene's
-    sweep numerics, as the grid was computed)."""
+    """Classes (int8[n]) of arbitrary points, one kernel run each (outcome-only kernel, the
+    scene's sweep numerics, as the grid was computed), for every ground motion: sine and
+    cosine pulses on the pulse variants, Ricker and MP pulses and records on the ground
+    variants (``point.ground``)."""
 
     def evaluate(points: list[Point]) -> np.ndarray:
-        rows = np.array([point_row(p, scene.numerics) for p in points]).reshape(-1, L.N_PAR)
-        kinds = np.array([kernel_kind(p.body) for p in points], np.int64)
-        outs = np.empty((len(points), L.N_OUT))
-        for kind in np.unique(kinds):
-            sel = kinds == kind
-            warm_up(int(kind), L.LEVEL_OUTCOME)
-            part = np.empty((int(sel.sum()), L.N_OUT))
-            chunk_kernel(int(kind), L.LEVEL_OUTCOME)(np.ascontiguousarray(rows[sel]), part)
-            outs[sel] = part
-        return outs[:, L.OUT_OUTCOME].astype(np.int8)
+        out = np.empty(len(points), np.int8)
+        groups: dict[tuple[int, bool], list[int]] = {}
+        for i, p in enumerate(points):
+            groups.setdefault((kernel_kind(p.body), p.ground), []).append(i)
+        for (kind, ground), idx in groups.items():
+            warm_up(kind, L.LEVEL_OUTCOME, ground)
+            rows = np.array([point_row(points[i], scene.numerics) for i in idx])
+            outs = np.empty((len(idx), L.N_OUT))
+            chunk_kernel(kind, L.LEVEL_OUTCOME, ground)(rows, outs)
+            out[idx] = outs[:, L.OUT_OUTCOME].astype(np.int8)
+        return out
 
     return evaluate
 

@@ -60,12 +60,13 @@ SYMBOLS = {
     "lam": r"\lambda", "zeta": r"\zeta", "wn_over_p": r"\omega_n/p",
     "alpha_cg": r"\alpha_{cg}", "alpha_A": r"\alpha_A", "mA_over_m": "m_A/m",
     "IA_ratio": r"I_A/(m_A R_A^2)", "alpha": r"\alpha", "inertia": r"I_O/(M R^2)",
-    "w_over_p": r"\omega/p", "A_ratio": r"A/(g\tan\alpha)",
+    "w_over_p": r"\omega/p", "A_ratio": r"A/(g\tan\alpha)", "p": r"p\ [\mathrm{rad/s}]",
 }
 UNITS = {"alpha_cg": " [rad]", "alpha_A": " [rad]", "alpha": " [rad]"}
 # the slenderness that normalises the amplitude, per body kind (body.alpha_ref)
 ALPHA_REF = {"flexible": r"\alpha_{cg}", "block": r"\alpha"}
 DEFAULT_X, DEFAULT_Y = "w_over_p", "A_ratio"
+RECORD_X = "p"  # x of a record sweep (no w_over_p): the body's frequency parameter
 
 _SAFE, _MODE2, _NOT_RUN = "#ffffff", "#4c72b0", "#bdbdbd"
 # boundary lines of the k-th lam (``curves``): dark colours apart from the cells' fills
@@ -170,6 +171,8 @@ def choose_axes(result: SweepResult, x: str | None = None, y: str | None = None,
             return (rest[0] if rest else "lam"), None  # a line plot
         if DEFAULT_X in rest:
             x = DEFAULT_X
+        elif RECORD_X in rest:  # a record sweep: the body's p sets its time scale
+            x = RECORD_X
         else:
             pool = ([d for d in rest if d != DEFAULT_Y] or rest
                     or (["lam"] if "lam" in axes and y != "lam" else []))

@@ -1,7 +1,8 @@
 """A scene's grid: axes -> flat point index -> kernel parameter rows, one chunk at a time.
 
 The grid is the Cartesian product of the scene's axes in ``Scene.axes`` order (shape, body
-keys, lam, A_ratio, w_over_p; w_over_p varies fastest). A point is named by its flat
+keys, lam, A_ratio, w_over_p or a record's p; that one varies fastest; then the pulse's
+unswept options). A point is named by its flat
 (C-order) index ``0 <= i < size``. Nothing here materialises all points: a chunk of flat
 indices is unravelled on its own, and the body-dependent part of the rows (``body_row``,
 the spring frequency, alpha_ref, E_ref, the kernel kind) is computed once per distinct
@@ -25,7 +26,9 @@ from rocksweep.scene import Scene
 class ChunkRows:
     """Parameter rows of one chunk of points (n points).
 
-    rows: float64[n, N_PAR] (``points.fill_rows``); kinds: int64[n] (``KIND_*``);
+    rows: float64[n, N_PAR] (``points.fill_rows``; a record's samples are added by
+    ``points.with_record`` just before the kernel runs, not kept here);
+    kinds: int64[n] (``KIND_*``);
     alpha_ref [rad] and E_ref [J]: float64[n], per point, to normalise results
     (theta/alpha_ref, E/E_ref).
     """
@@ -56,7 +59,7 @@ class Grid:
         self._body_shape = tuple(self.full_shape[i] for i in self._body_pos)
         self._i_shape = names.index("shape")
         self._i_lam = names.index("lam")
-        self._i_w = names.index("w_over_p")
+        self._i_w = names.index(scene.freq_axis)  # w_over_p, or p [rad/s] for a record
         self._i_A = names.index("A_ratio")
         self._shape_codes = np.array([shape_code(s) for s in scene.axes[self._i_shape].values])
         self._values = [np.asarray(a.values, float) if i != self._i_shape else None
@@ -114,6 +117,8 @@ class Grid:
                   self._shape_codes[multi[self._i_shape]],
                   self._values[self._i_w][multi[self._i_w]],
                   self._values[self._i_A][multi[self._i_A]], self.scene.numerics,
+                  self.scene.option("cycles"), self.scene.option("gamma"),
+                  self.scene.option("nu"), self.scene.record,
                   np.nan if self._i_mu is None else self._values[self._i_mu][multi[self._i_mu]])
         return ChunkRows(rows, b_kind[inverse], alpha_ref, b_E[inverse])
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -14,23 +15,42 @@ from rocksweep.kernel import layout as L
 from rocksweep.kernel.equations import rocking_spring_omega
 from rocksweep.model import Body, FlexibleBody, G
 from rocksweep.numerics import ROOTS, Numerics, amplitude_frequency, step_budget, step_size
+from rocksweep.records import GroundRecord
 
-SHAPES = ("sine", "cosine")
-_SHAPE_CODE = {"sine": L.SHAPE_SINE, "cosine": L.SHAPE_COSINE}
+if TYPE_CHECKING:
+    from rocksweep.excitation import PulseShape
+
+SHAPES = ("sine", "cosine", "ricker", "mp")
+RECORD = "record"  # the shape of a point driven by a ground-motion record
+_SHAPE_CODE = {"sine": L.SHAPE_SINE, "cosine": L.SHAPE_COSINE, "ricker": L.SHAPE_RICKER,
+               "mp": L.SHAPE_MP, RECORD: L.SHAPE_RECORD}
+# Defaults of the pulse's optional keys (scene keys pulse.cycles, pulse.gamma, pulse.nu)
+CYCLES, GAMMA, NU_DEG = 1, 2.0, 90.0
 _ROOT_CODE = dict(zip(ROOTS, (L.ROOT_BISECT, L.ROOT_ILLINOIS, L.ROOT_HERMITE), strict=True))
 
 
 @dataclass(frozen=True)
 class Point:
-    """One simulation: a body, the impulse position lam, and a pulse (eq. 2); mu: the
-    friction coefficient of the base on the ground (NaN: none given; only the contact
-    status bits read it)."""
+    """One simulation: a body, the impulse position lam, and a ground motion.
+
+    A pulse (shape one of SHAPES, ``rocksweep.excitation``): w_over_p = omega/p, cycles
+    (sine, cosine), gamma and nu [deg] (MP). A record (shape RECORD): ``record`` and the
+    body's frequency parameter p [rad/s], which fixes the body's size against the
+    record's seconds (kernel time p t); w_over_p is NaN. A is the peak |xg''| either way.
+    mu: the friction coefficient of the base on the ground (NaN: none given; only the
+    contact status bits read it).
+    """
 
     body: Body
     lam: float
     shape: str
     w_over_p: float
     A_ratio: float
+    cycles: int = CYCLES
+    gamma: float = GAMMA
+    nu: float = NU_DEG
+    record: GroundRecord | None = None
+    p: float = math.nan
     mu: float = math.nan
 
     @property
@@ -43,8 +63,26 @@ class Point:
         return self.A_ratio * G * math.tan(self.body.alpha_ref)
 
     @property
+    def ground(self) -> bool:
+        """Whether the point needs the kernel's GROUND variants (``kernel.variants``)."""
+        return self.shape in ("ricker", "mp", RECORD)
+
+    @property
+    def pulse(self) -> PulseShape | None:
+        """The pulse's reference definition (None for a record)."""
+        from rocksweep.excitation import PulseShape  # scipy: loaded when needed
+
+        if self.shape == RECORD:
+            return None
+        return PulseShape(self.shape, int(self.cycles), float(self.gamma), float(self.nu))
+
+    @property
     def t_pulse(self) -> float:
-        return 2 * math.pi / self.omega
+        """How long the ground moves [p*t]: the pulse's phase duration / omega, or the
+        record's last sample time p (npts - 1) DT."""
+        if self.shape == RECORD:
+            return self.p * self.record.duration
+        return self.pulse.duration / self.omega
 
 
 def kernel_kind(body: Body) -> int:
@@ -97,10 +135,12 @@ def body_omega_rock(body: Body) -> float:
 
 
 def run_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, w_over_p: np.ndarray,
-             A_ratio: np.ndarray, numerics: Numerics) -> tuple[np.ndarray, ...]:
+             A_ratio: np.ndarray, numerics: Numerics,
+             phase: np.ndarray | float = 2 * math.pi) -> tuple[np.ndarray, ...]:
     """A run's step, length and step cap, vectorised over points (all float64[n], p = 1).
 
-    Returns dt [p*t] (``step_size``), t_pulse = 2 pi/omega, t_end = t_pulse + horizon
+    phase: the pulse's duration in w t (2 pi n, 6 pi for the Ricker, 2 pi gamma for MP).
+    Returns dt [p*t] (``step_size``), t_pulse = phase/omega, t_end = t_pulse + horizon
     [p*t] and the cap on RK4 evaluations (``step_budget``): the kernel's PAR_DT,
     PAR_TPULSE, PAR_TEND and PAR_MAXSTEPS. The scene bounds the last (MAX_POINT_STEPS).
     """
@@ -108,28 +148,81 @@ def run_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, w_over_p: np.ndarray
     with np.errstate(divide="ignore", over="ignore"):
         dt = step_size(omega_rock, omega, numerics.steps_per_period,
                        amplitude_frequency(A_ratio, alpha_ref))
-        t_pulse = 2 * np.pi / omega
+        t_pulse = phase / omega
         t_end = t_pulse + numerics.horizon
         max_steps = step_budget(t_end, dt, numerics)
     return dt, t_pulse, t_end, max_steps
 
 
+def record_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, p: np.ndarray,
+                A_ratio: np.ndarray, record: GroundRecord, numerics: Numerics
+                ) -> tuple[np.ndarray, ...]:
+    """``run_cost`` for a record, vectorised over points (float64[n]; p [rad/s]).
+
+    The step after the record is the regular ``step_size`` without a pulse period (dt).
+    While the record acts the step is h_rec = p DT / m, m = ceil(p DT / dt): the largest
+    step of at most dt that lands on every sample time (the kernel's PAR_REC_H). Returns
+    (dt, h_rec, t_pulse = p (npts - 1) DT, t_end = t_pulse + horizon, step cap), p*t.
+    """
+    p = np.asarray(p, float)
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        dt = step_size(omega_rock, 0.0, numerics.steps_per_period,
+                       amplitude_frequency(A_ratio, alpha_ref))
+        dt_k = p * record.dt
+        h_rec = dt_k / np.ceil(dt_k / dt)
+        t_pulse = p * record.duration
+        t_end = t_pulse + numerics.horizon
+        max_steps = step_budget(t_end, np.minimum(dt, h_rec), numerics)
+    return dt, h_rec, t_pulse, t_end, max_steps
+
+
+def phase_duration(shape: str, cycles: int = CYCLES, gamma: float = GAMMA) -> float:
+    """A pulse's duration in w t (``excitation.PulseShape.duration``)."""
+    from rocksweep.excitation import PulseShape
+
+    return PulseShape(shape, int(cycles), float(gamma)).duration
+
+
 def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
               alpha_ref: np.ndarray, lam: np.ndarray, shape_code: np.ndarray,
               w_over_p: np.ndarray, A_ratio: np.ndarray, numerics: Numerics,
+              cycles: int = CYCLES, gamma: float = GAMMA, nu_deg: float = NU_DEG,
+              record: GroundRecord | None = None,
               mu: np.ndarray | float = math.nan) -> None:
     """Fill parameter rows in place, vectorised over points.
 
     rows: float64[n, N_PAR] (out); body_rows: float64[n, N_PAR] from ``body_row``;
-    omega_rock, alpha_ref, lam, shape_code, w_over_p, A_ratio: float64[n] (p = 1);
+    omega_rock, alpha_ref, lam, shape_code, w_over_p, A_ratio: float64[n] (p = 1).
+    cycles (sine, cosine), gamma and nu_deg [deg] (MP): the pulse's optional keys, one
+    value for all points. With ``record``, every point is driven by it and w_over_p holds
+    the body's p [rad/s]; the rows then still lack the samples (``with_record``).
     mu: friction coefficient, float64[n] or a scalar (NaN: none).
     """
     rows[:] = body_rows
     omega = np.asarray(w_over_p, float)  # p = 1 rad/s
-    dt, t_pulse, t_end, max_steps = run_cost(omega_rock, alpha_ref, omega, A_ratio, numerics)
+    code = np.asarray(shape_code, float)
+    if record is not None:
+        dt, h_rec, t_pulse, t_end, max_steps = record_cost(omega_rock, alpha_ref, omega,
+                                                           A_ratio, record, numerics)
+        rows[:, L.PAR_REC_DT] = omega * record.dt
+        rows[:, L.PAR_REC_H] = h_rec
+        omega = 0.0
+    else:
+        # each point's duration in w t by its shape: sine and cosine 2 pi n, the Ricker
+        # 6 pi, MP 2 pi gamma
+        phase = np.select([code == L.SHAPE_RICKER, code == L.SHAPE_MP],
+                          [6 * math.pi, 2 * math.pi * gamma], 2 * math.pi * cycles)
+        dt, t_pulse, t_end, max_steps = run_cost(omega_rock, alpha_ref, omega, A_ratio,
+                                                 numerics, phase)
+        if np.any(code == L.SHAPE_MP):
+            from rocksweep.excitation import mp_peak
+
+            rows[:, L.PAR_GAMMA] = gamma
+            rows[:, L.PAR_NU] = math.radians(nu_deg)
+            rows[:, L.PAR_AMP_NORM] = 1.0 / mp_peak(float(gamma), float(nu_deg))
     rows[:, L.PAR_AMP] = A_ratio * G * np.tan(alpha_ref)
     rows[:, L.PAR_OMEGA] = omega
-    rows[:, L.PAR_SHAPE] = shape_code
+    rows[:, L.PAR_SHAPE] = code
     rows[:, L.PAR_TPULSE] = t_pulse
     rows[:, L.PAR_LAM] = lam
     rows[:, L.PAR_DT] = dt
@@ -142,15 +235,31 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     rows[:, L.PAR_MU] = mu
 
 
+def with_record(rows: np.ndarray, record: GroundRecord | None) -> np.ndarray:
+    """Rows float64[n, N_PAR] -> float64[n, N_PAR + npts] with the record's samples
+    xg''/PGA after the parameters (``layout.PAR_REC``); ``rows`` itself without one."""
+    if record is None:
+        return rows
+    shape = record.acc / record.pga
+    out = np.empty((rows.shape[0], L.N_PAR + shape.size))
+    out[:, :L.N_PAR] = rows
+    out[:, L.N_PAR:] = shape
+    return out
+
+
 def point_row(point: Point, numerics: Numerics) -> np.ndarray:
-    """The kernel's parameter row float64[N_PAR] for one point."""
+    """The kernel's parameter row for one point: float64[N_PAR], or float64[N_PAR + npts]
+    with a record's samples."""
     body = point.body
     rows = np.empty((1, L.N_PAR))
+    rec = point.record if point.shape == RECORD else None
     fill_rows(rows, body_row(body)[None, :], np.array([body_omega_rock(body)]),
               np.array([body.alpha_ref]), np.array([point.lam]),
-              np.array([_SHAPE_CODE[point.shape]]), np.array([point.w_over_p]),
-              np.array([point.A_ratio]), numerics, point.mu)
-    return rows[0]
+              np.array([_SHAPE_CODE[point.shape]]),
+              np.array([point.p if rec is not None else point.w_over_p]),
+              np.array([point.A_ratio]), numerics, point.cycles, point.gamma, point.nu, rec,
+              point.mu)
+    return with_record(rows, rec)[0]
 
 
 def shape_code(shape: str) -> float:

@@ -88,7 +88,10 @@ class _Problem:
         self.rest_rate = float(prm[L.PAR_RESTRATE])
         self.h = float(prm[L.PAR_H])
         # largest step: a tenth of the shortest period (spring while rocking, pulse, 2 pi/p)
-        periods = [2 * math.pi, 2 * math.pi / self.omega]
+        periods = [2 * math.pi] + ([2 * math.pi / self.omega] if self.omega > 0 else [])
+        # a record: its sample interval in kernel time (0: none); phases end on every
+        # sample time while it acts, so no DOP853 step straddles a kink of the input
+        self.rec_dt = float(prm[L.PAR_REC_DT]) if prm.shape[0] > L.N_PAR else 0.0
         if flex:  # the spring with the top mass at u = 0 (lever arm b); damping left to
             # DOP853's error control
             w_rock = rocking_spring_omega(math.sqrt(prm[L.PAR_K] / prm[L.PAR_M]), 0.0,
@@ -102,10 +105,12 @@ class _Problem:
 
     # --- eq. (2) -----------------------------------------------------------------------
     def xg(self, t: float, on: bool) -> float:
-        return ground_acc(t, on, self.prm)
+        # on as an int: the kernel's code for every shape (a bool would compile the
+        # sine/cosine-only code, ``equations.ground_acc``)
+        return ground_acc(t, int(on), self.prm)
 
     def jerk(self, t: float, on: bool) -> float:
-        return ground_jerk(t, on, self.prm)
+        return ground_jerk(t, int(on), self.prm)
 
     # --- full contact ------------------------------------------------------------------
     def q(self, t: float, y, on: bool) -> float:
@@ -443,6 +448,8 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
             status |= L.STATUS_EVENT_CAP
             break
         t_stop = pb.t_pulse if on else t_end
+        if on and pb.rec_dt > 0.0:  # a record: integrate sample interval by interval
+            t_stop = min(t_stop, (math.floor(t / pb.rec_dt + 1e-9) + 1.0) * pb.rec_dt)
         if s == 0:
             s = pb.uplift_corner(t, (y[2], y[3]), on)  # e.g. the cosine pulse's end
             if s != 0:

@@ -34,7 +34,8 @@ from rocksweep.numerics import (
     PRESETS,
     Numerics,
 )
-from rocksweep.points import Point, body_omega_rock, run_cost
+from rocksweep.points import RECORD, Point, body_omega_rock, record_cost, run_cost
+from rocksweep.records import GroundRecord, RecordError, read_record
 from rocksweep.schema import (
     BODY_KEYS,
     KEYS,
@@ -170,6 +171,36 @@ class Scene:
     energy: bool
     text: str = field(repr=False)
     contact: bool = False  # outputs.contact (on when body.mu is given)
+    # a record scene (``ground`` section): the record read at load (else None); the grid's
+    # frequency axis is then p [rad/s], not w_over_p
+    record: GroundRecord | None = field(default=None, repr=False)
+
+    @property
+    def freq_axis(self) -> str:
+        """The name of the axis that sets the ground motion's time scale: ``w_over_p``
+        (a pulse) or ``p`` (a record, [rad/s])."""
+        return "p" if self.record is not None else "w_over_p"
+
+    @property
+    def ground(self) -> bool:
+        """Whether the scene needs the kernel's GROUND variants (a Ricker or MP pulse, or a
+        record); the paper's sine and cosine (n cycles too) run the pulse variants."""
+        return self.record is not None or any(
+            sh in ("ricker", "mp") for sh in self.axis("shape").values)
+
+    def option(self, name: str) -> Any:
+        """A pulse option's value (cycles, gamma, nu [deg]): the scene's or the default."""
+        for a in self.axes:
+            if a.name == name:
+                return a.values[0]
+        return KEYS[f"pulse.{name}"].default
+
+    def phase_max(self) -> float:
+        """The longest pulse of the scene's shapes in w t (2 pi n, 6 pi, 2 pi gamma)."""
+        from rocksweep.points import RECORD, phase_duration
+
+        return max(phase_duration(sh, self.option("cycles"), self.option("gamma"))
+                   for sh in self.axis("shape").values if sh != RECORD)
 
     def axis(self, name: str) -> Axis:
         for a in self.axes:
@@ -214,9 +245,15 @@ class Scene:
     def point(self, values: dict[str, Any]) -> Point:
         """The point with the given value of every axis (by name)."""
         body = self.make_body(**{a.name: values[a.name] for a in self.body_axes()})
+        if self.record is not None:
+            return Point(body, float(values["lam"]), RECORD, math.nan,
+                         float(values["A_ratio"]), record=self.record, p=float(values["p"]))
         return Point(body, float(values["lam"]), str(values["shape"]),
                      float(values["w_over_p"]), float(values["A_ratio"]),
-                     float(values.get("mu", math.nan)))
+                     int(values.get("cycles", self.option("cycles"))),
+                     float(values.get("gamma", self.option("gamma"))),
+                     float(values.get("nu", self.option("nu"))),
+                     mu=float(values.get("mu", math.nan)))
 
     def single_point(self) -> Point:
         """The scene's only point; a SceneError names the first swept key otherwise."""
@@ -254,10 +291,14 @@ def apply_overrides(raw: dict, overrides: list[str]) -> dict:
     return raw
 
 
-def parse_scene(text: str, source: str = "scene", overrides: list[str] | None = None) -> Scene:
-    """Validate scene YAML text. Raises SceneError (one line, prefixed by ``source``)."""
+def parse_scene(text: str, source: str = "scene", overrides: list[str] | None = None,
+                base: str | Path | None = None) -> Scene:
+    """Validate scene YAML text. Raises SceneError (one line, prefixed by ``source``).
+
+    base: the directory a ``ground.record`` path is relative to (the scene file's; None:
+    the working directory)."""
     try:
-        return _parse(text, overrides or [])
+        return _parse(text, overrides or [], Path(base) if base is not None else None)
     except SceneError as err:
         raise SceneError(f"{source}: {err}") from None
 
@@ -270,7 +311,7 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
         raise SceneError(f"{path}: cannot read the scene ({err.strerror})") from None
     except UnicodeDecodeError:
         raise SceneError(f"{path}: not a text (YAML) file") from None
-    return parse_scene(text, str(path), overrides)
+    return parse_scene(text, str(path), overrides, base=path.parent)
 
 
 # -- structure ---------------------------------------------------------------------------
@@ -375,7 +416,8 @@ def _shapes(spec: Any) -> tuple[tuple[str, ...], bool]:
     allowed = KEYS["pulse.shape"]
     if isinstance(spec, list):
         if not spec:
-            raise SceneError("pulse.shape = []: an empty list; use sine, cosine or both")
+            raise SceneError("pulse.shape = []: an empty list; give one or more of sine, "
+                             "cosine, ricker, mp")
         for v in spec:
             if v not in allowed.choices:
                 raise SceneError(f"pulse.shape = {fmt(v)}: {allowed.allowed}")
@@ -418,7 +460,43 @@ def _numerics(sec: dict) -> tuple[Numerics, Numerics]:
     return numerics, single
 
 
-def _parse(text: str, overrides: list[str]) -> Scene:
+def _pulse_options(pulse: dict, shapes: tuple[str, ...]) -> list[Axis]:
+    """The pulse's optional keys as unswept axes: those the scene gives, and gamma and nu
+    when a shape is mp (so the file records the values used). Each a single value."""
+    out = []
+    for k in ("cycles", "gamma", "nu"):
+        key = f"pulse.{k}"
+        spec = KEYS[key]
+        v = pulse.get(k)
+        if v is None:
+            if not (k != "cycles" and "mp" in shapes):
+                continue
+            v = spec.default
+        ok = (isinstance(v, int) and not isinstance(v, bool)) if spec.kind == "integer" \
+            else is_number(v)
+        if not ok or check_values(key, np.array([as_float(v)])) is not None:
+            raise SceneError(f"{key} = {fmt(v)}: {spec.allowed}")
+        out.append(Axis(k, key, (int(v) if spec.kind == "integer" else float(v),), False))
+    return out
+
+
+def _record(ground: dict, base: Path | None) -> GroundRecord:
+    """The record of a ``ground`` section, read (and hashed) now."""
+    spec = KEYS["ground.record"]
+    v = ground["record"]
+    if not (isinstance(v, str) and v.strip()):
+        raise SceneError(f"ground.record = {fmt(v)}: {spec.allowed}")
+    path = Path(v).expanduser()
+    if not path.is_absolute() and base is not None:
+        path = base / path
+    path = path.absolute()  # the file records where it was read (spectra re-read it)
+    try:
+        return read_record(path)
+    except RecordError as err:
+        raise SceneError(f"ground.record: {err}") from None
+
+
+def _parse(text: str, overrides: list[str], base: Path | None = None) -> Scene:
     try:
         raw = _load_yaml(text)
     except _YamlError as err:
@@ -439,7 +517,19 @@ def _parse(text: str, overrides: list[str]) -> Scene:
     body = _section(raw, "body", "flexible", required=True)
     kind = body.get("kind", "flexible")
     impact = _section(raw, "impact", kind, required=kind == "flexible")
-    pulse = _section(raw, "pulse", kind, required=True)
+    if raw.get("ground") is not None and raw.get("pulse") is not None:
+        raise SceneError("pulse, ground: give one of them (a pulse, or a recorded ground "
+                         "motion)")
+    if raw.get("ground") is None and raw.get("pulse") is None:
+        raise SceneError("pulse: missing required section (pulse: {shape, w_over_p, "
+                         "A_ratio}, or ground: {record, A_ratio, p} for a record)")
+    record = None
+    if raw.get("ground") is not None:
+        ground = _section(raw, "ground", kind, required=True)
+        record = _record(ground, base)
+        pulse = {"shape": RECORD, "A_ratio": ground["A_ratio"], "p": ground["p"]}
+    else:
+        pulse = _section(raw, "pulse", kind, required=True)
     numerics_sec = _section(raw, "numerics", kind, required=False)
     outputs = _section(raw, "outputs", kind, required=False)
     energy = outputs.get("energy", KEYS["outputs.energy"].default)
@@ -456,15 +546,22 @@ def _parse(text: str, overrides: list[str]) -> Scene:
     contact = bool(contact) or mu_spec is not None
 
     # forms and lengths first: the grid's size is known before any value is built
-    shapes, shape_swept = _shapes(pulse["shape"])
+    if record is None:
+        shapes, shape_swept = _shapes(pulse["shape"])
+        section, pulse_axes = "pulse", PULSE_AXES
+        options = _pulse_options(pulse, shapes)
+    else:
+        shapes, shape_swept = (RECORD,), False
+        section, pulse_axes = "ground", ("A_ratio", "p")
+        options = []
     specs: list[tuple[str, str, str, Any]] = []  # (name, key, form, spec)
     for k in BODY_KEYS[kind]:
         spec = body.get(k, KEYS[f"body.{k}"].default)
         specs.append((k, f"body.{k}", *_axis_spec(f"body.{k}", spec)[:2]))
     lam = impact.get("lam", 0.0)  # a block without an impact section: Housner's corner
     specs.append(("lam", "impact.lam", *_axis_spec("impact.lam", lam)[:2]))
-    for k in PULSE_AXES:
-        specs.append((k, f"pulse.{k}", *_axis_spec(f"pulse.{k}", pulse[k])[:2]))
+    for k in pulse_axes:
+        specs.append((k, f"{section}.{k}", *_axis_spec(f"{section}.{k}", pulse[k])[:2]))
     if mu_spec is not None:  # the last axis: the same grid of runs, flagged per mu
         specs.append(("mu", "body.mu", *_axis_spec("body.mu", mu_spec)[:2]))
     lengths = [len(shapes)] + [1 if form == "scalar" else
@@ -478,15 +575,22 @@ def _parse(text: str, overrides: list[str]) -> Scene:
                          "points per scene (a sweep file stores 45 bytes a point); split it "
                          "into several scenes or use fewer values")
 
-    axes = [Axis("shape", "pulse.shape", shapes, shape_swept)]
+    axes = [Axis("shape", "ground.record" if record else "pulse.shape", shapes, shape_swept)]
     for name_, key, form, spec in specs:
         values = _axis_values(key, form, spec)
         axes.append(Axis(name_, key, tuple(values.tolist()), form != "scalar"))
+    axes.extend(options)  # unswept: the flat index and the result's shape stay as they are
 
     numerics, single = _numerics(numerics_sec)
     scene = Scene(name=name or "rocksweep scene", kind=kind, axes=tuple(axes),
                   numerics=numerics, single_numerics=single, energy=energy, text=text,
-                  contact=contact)
+                  contact=contact, record=record)
+    if scene.contact and scene.ground:
+        # the contact outputs are compiled into the sine/cosine variants only (a kernel
+        # variant per combination costs compile time no scene has asked for yet)
+        what = "a recorded ground motion" if record is not None else "ricker and mp pulses"
+        raise SceneError(f"outputs.contact = true: not available with {what} yet; contact "
+                         "outputs work with sine and cosine pulses")
     bodies = _candidate_bodies(scene)
     _check_cost(scene, bodies)
     return scene
@@ -543,8 +647,33 @@ def _budgets(scene: Scene, bodies: list[dict[str, float]], w: np.ndarray, A: np.
     _, _, _, cap = run_cost(np.broadcast_to(omega_rock, shape),
                             np.broadcast_to(alpha_ref, shape),
                             np.broadcast_to(w[None, :, None], shape),
-                            np.broadcast_to(A[None, None, :], shape), numerics)
+                            np.broadcast_to(A[None, None, :], shape), numerics,
+                            scene.phase_max())
     return np.where(np.isnan(cap), math.inf, cap)
+
+
+def _check_record_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
+    """A record scene's cost check: the step cap at the ends of the p and A_ratio axes
+    (the record's length grows with p, the step shrinks with the body's rates and |A|)."""
+    p = np.asarray(scene.axis("p").values)
+    A = np.asarray(scene.axis("A_ratio").values)
+    rec = scene.record
+    for b in bodies:
+        body = scene.make_body(**b)
+        for n, label in _runs(scene):
+            for pv in (p.min(), p.max()):
+                for av in (A.min(), A.max()):
+                    dt, h_rec, _, t_end, cap = record_cost(
+                        np.array([body_omega_rock(body)]), np.array([body.alpha_ref]),
+                        np.array([pv]), np.array([av]), rec, n)
+                    c = float(cap[0])
+                    if not (c <= MAX_POINT_STEPS):
+                        raise SceneError(
+                            f"ground.p = {fmt(float(pv))}: one point could need {c:.2g} RK4 "
+                            f"steps{label} (the record's {rec.npts} samples at steps of "
+                            f"{float(h_rec[0]):.3g} p*t, then {n.horizon:g} p*t of free "
+                            f"vibration), more than the cap of {MAX_POINT_STEPS:.0e} a point;"
+                            " use a smaller p, fewer steps_per_period or a shorter horizon")
 
 
 def _runs(scene: Scene) -> tuple[tuple[Numerics, str], ...]:
@@ -563,6 +692,9 @@ def _check_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
     axes it is largest at an end of each (the step follows max(omega, rates of the body and
     of |A|), the length 2 pi/omega: (2 pi/w + H) max(X, w) falls then rises in w).
     """
+    if scene.record is not None:
+        _check_record_cost(scene, bodies)
+        return
     w = np.asarray(scene.axis("w_over_p").values)
     A = np.asarray(scene.axis("A_ratio").values)
     w, A = np.array([w.min(), w.max()]), np.array([A.min(), A.max()])
@@ -589,7 +721,7 @@ def _point_cost(scene: Scene, point: dict[str, float], numerics: Numerics | None
         dt, _, t_end, cap = run_cost(np.array([body_omega_rock(body)]),
                                      np.array([body.alpha_ref]),
                                      np.array([point["pulse.w_over_p"]]),
-                                     np.array([point["pulse.A_ratio"]]), n)
+                                     np.array([point["pulse.A_ratio"]]), n, scene.phase_max())
         c = float(cap[0])
         c = math.inf if math.isnan(c) else c
         if worst is None or c > worst[0]:

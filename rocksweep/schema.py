@@ -29,6 +29,8 @@ from rocksweep.numerics import MIN_EVENT_TOL, PRESETS, ROOTS
 
 RATIO_MAX = 1e6  # bound of the body's ratios (see the module docstring)
 ANGLE_MIN = 1e-6  # [rad] smallest slenderness: h/b = 1e6
+CYCLES_MAX = 1000  # pulse.cycles: more cycles than this are no pulse
+GAMMA_MAX = 100.0  # pulse.gamma: MP's gamma is 1-3 for near-fault records; 100 is plenty
 
 
 @dataclass(frozen=True)
@@ -80,8 +82,8 @@ KEYS: dict[str, Key] = {
     "body.inertia": Key("axis", f"must be in [1, {RATIO_MAX:g}] (I_O / (M R^2) >= 1)",
                         1.0, RATIO_MAX, required=False, default=4.0 / 3.0),
     "impact.lam": Key("axis", "must be in [0, 2]", 0.0, 2.0),
-    "pulse.shape": Key("choices", "must be sine, cosine or a list of them",
-                       choices=("sine", "cosine")),
+    "pulse.shape": Key("choices", "must be sine, cosine, ricker, mp or a list of them",
+                       choices=("sine", "cosine", "ricker", "mp")),
     "pulse.w_over_p": Key("axis", "must be > 0 and finite (the pulse lasts 2 pi/omega)",
                           0.0, math.inf, lo_in=False, hi_in=False),
     "pulse.A_ratio": Key("axis",
@@ -111,6 +113,23 @@ KEYS: dict[str, Key] = {
     "outputs.contact": Key("bool", "must be true or false (store the friction demand, the "
                            "smallest normal force and the impulse ratio)", required=False,
                            default=False),
+    # pulse families (rocksweep.excitation): full cycles of a sine or cosine, the
+    # Mavroeidis-Papageorgiou pulse's oscillation parameter and phase
+    "pulse.cycles": Key("integer", f"must be an integer in [1, {CYCLES_MAX}] (full cycles "
+                        "of the sine or cosine)", 1, CYCLES_MAX, required=False, default=1),
+    "pulse.gamma": Key("number", f"must be in [1, {GAMMA_MAX:g}] (the MP pulse's oscillation "
+                       "parameter)", 1.0, GAMMA_MAX, required=False, default=2.0),
+    "pulse.nu": Key("number", "must be a finite angle in degrees (the MP pulse's phase)",
+                    -math.inf, math.inf, lo_in=False, hi_in=False, required=False,
+                    default=90.0),
+    # a recorded ground motion instead of a pulse (rocksweep.records)
+    "ground.record": Key("string", "must be the path of a PEER .AT2 file or a two-column "
+                         "file (t [s], xg'' [g]), relative to the scene file"),
+    "ground.A_ratio": Key("axis", "must be a finite number (the record scaled to a peak of "
+                          "A_ratio g tan(alpha_cg); negative: reversed)",
+                          -math.inf, math.inf, lo_in=False, hi_in=False),
+    "ground.p": Key("axis", f"must be in [1e-3, {1e3:g}] rad/s (the body's frequency "
+                    "parameter p)", 1e-3, 1e3),
 }
 
 # Keys of each body kind, in the grid's dimension order.
@@ -118,7 +137,7 @@ BODY_KEYS: dict[str, tuple[str, ...]] = {
     "flexible": ("wn_over_p", "zeta", "alpha_cg", "alpha_A", "mA_over_m", "IA_ratio"),
     "block": ("alpha", "inertia"),
 }
-SECTIONS = ("body", "impact", "pulse", "numerics", "outputs")
+SECTIONS = ("body", "impact", "pulse", "numerics", "outputs", "ground")
 
 
 def section_keys(section: str, kind: str = "flexible") -> tuple[str, ...]:

@@ -100,8 +100,11 @@ class Run:
 
 
 def history_capacity(row: np.ndarray) -> int:
-    """Rows a full history of this point can need: every step plus 3 rows per event."""
+    """Rows a full history of this point can need: every step plus 3 rows per event (a
+    record's steps on its samples counted on top)."""
     steps = math.ceil(row[L.PAR_TEND] / row[L.PAR_DT])
+    if row[L.PAR_REC_H] > 0.0:
+        steps += math.ceil(row[L.PAR_TPULSE] / row[L.PAR_REC_H]) + 1
     return int(steps + 3 * row[L.PAR_MAXEVENTS] + 16)
 
 
@@ -114,12 +117,13 @@ def simulate(point: Point, numerics: Numerics, history: bool = True,
     row = point_row(point, numerics)
     out = np.empty(L.N_OUT)
     kind = kernel_kind(point.body)
+    ground = point.ground
     lvl = L.LEVEL_CONTACT if contact else L.LEVEL_OUTCOME
-    warm_up(kind, None if history else lvl)  # wall_time excludes compilation
+    warm_up(kind, None if history else lvl, ground)  # wall_time excludes compilation
     t0 = time.perf_counter()
     if history:
         hist = np.empty((history_capacity(row), L.N_HIST))
-        point_kernel(kind)(row, out, hist)
+        point_kernel(kind, ground)(row, out, hist)
         if not contact:  # tracked by the history variants anyway; reported when asked
             out[L.OUT_STATUS] = int(out[L.OUT_STATUS]) & ~(L.STATUS_SLIDES | L.STATUS_LIFTS_OFF)
             out[[L.OUT_MU_REQ, L.OUT_N_MIN, L.OUT_IMPULSE_MAX]] = np.nan
@@ -127,6 +131,6 @@ def simulate(point: Point, numerics: Numerics, history: bool = True,
         hist_d = {c.raw: hist[:n, c.slot].copy() for c in fields.HISTORY}
     else:
         outs = out[None, :]
-        chunk_kernel(kind, lvl)(row[None, :], outs)
+        chunk_kernel(kind, lvl, ground)(row[None, :], outs)
         hist_d = None
     return Run(point, numerics, out, hist_d, time.perf_counter() - t0, contact)

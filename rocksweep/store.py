@@ -136,6 +136,7 @@ COMPUTED_FLAGS = {0: "filled", 1: "computed", 2: "audit_agreed", 3: "audit_disag
 COORD_LONG_NAMES = {
     "shape": "pulse shape",
     "w_over_p": "omega/p (Pi5)",
+    "p": "p: the body's frequency parameter against the record [rad/s]",
     "A_ratio": "A/(g tan alpha_ref) (Pi6)",
     "lam": "lambda: impulse position / b (Pi10)",
     "wn_over_p": "omega_n/p (Pi1)",
@@ -148,7 +149,8 @@ COORD_LONG_NAMES = {
     "inertia": "I_O/(M R^2)",
 }
 # CF units of the coordinates: angles in radians, the other Pi groups are pure numbers.
-COORD_UNITS = {"alpha_cg": "rad", "alpha_A": "rad", "alpha": "rad"}
+COORD_UNITS = {"alpha_cg": "rad", "alpha_A": "rad", "alpha": "rad", "p": "rad/s",
+               "nu": "degree"}
 # Variables whose values are codes (CF flag_values / flag_masks): no units.
 FLAG_VARIABLES = ("outcome", "status", "computed")
 # rocksweep's own unit of a variable where it is not plainly "1" (the CF units are "1":
@@ -222,6 +224,7 @@ def resolved_scene(scene: Scene, overrides: tuple[str, ...] | list[str] = (),
         "overrides": list(overrides),
         # only when asked: files without contact outputs keep their resolved scene
         **({"contact": True} if scene.contact else {}),
+        **({"record": record_attrs(scene.record)} if scene.record is not None else {}),
     }
     if adaptive is not None:
         d["adaptive"] = dict(adaptive)
@@ -234,6 +237,14 @@ def _adaptive_words(a: dict) -> str:
             f"--audit {a.get('audit')!r} --margin {a.get('margin')} --final-margin "
             f"{a.get('final_margin')} --seed {a.get('seed')} --threshold "
             f"{a.get('threshold')!r}")
+
+
+def record_attrs(record) -> dict:
+    """A record scene's record as the file states it (``record_*`` attributes): name,
+    SHA-256 of the file's bytes, NPTS, DT [s], PGA [g], title and the path read."""
+    return {"name": record.name, "sha256": record.sha256, "npts": int(record.npts),
+            "dt": float(record.dt), "pga": float(record.pga), "title": record.title,
+            "source": str(record.source)}
 
 
 def _short(v) -> str:
@@ -259,6 +270,11 @@ def scene_differences(stored: dict, new: dict) -> list[str]:
         if a != b:
             diffs.append(f"{key}: file {_short(a) if a else 'absent'}, "
                          f"scene {_short(b) if b else 'absent'}")
+    rs, rn = stored.get("record") or {}, new.get("record") or {}
+    if rs.get("sha256") != rn.get("sha256"):  # the record's bytes, wherever the file is
+        diffs.append(f"ground.record: file {rs.get('name', 'absent')} (sha256 "
+                     f"{str(rs.get('sha256'))[:12]}), scene {rn.get('name', 'absent')} "
+                     f"(sha256 {str(rn.get('sha256'))[:12]})")
     sn, nn = stored.get("numerics", {}), new.get("numerics", {})
     for key in dict.fromkeys([*sn, *nn]):
         if sn.get(key) != nn.get(key):
@@ -394,7 +410,8 @@ def _check_scene(stored, path: Path) -> None:
                 and isinstance(ax.get("swept"), bool) and isinstance(ax.get("values"), list)
                 and ax["values"]):
             raise bad(f"axis {_cut(key)} is {_cut(ax)}")
-        kinds = (str,) if key.endswith(".shape") else (int, float)
+        words = key.endswith(".shape") or key == "ground.record"  # shape: "record"
+        kinds = (str,) if words else (int, float)
         if not all(isinstance(v, kinds) and not isinstance(v, bool) for v in ax["values"]):
             raise bad(f"axis {key} has values {_cut(ax['values'])}")
         if not ax["swept"] and len(ax["values"]) != 1:
@@ -1019,6 +1036,9 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
     a["event_tol"] = n.event_tol
     a["horizon"] = n.horizon
     a["energy"] = np.int8(bool(scene.energy))
+    if scene.record is not None:  # the record: name, SHA-256, NPTS, DT [s], PGA [g]
+        for k, v in record_attrs(scene.record).items():
+            a[f"record_{k}"] = v
     for k, v in vers.items():
         a[f"{k}_version"] = v
     a["started"] = _now()

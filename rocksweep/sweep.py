@@ -32,6 +32,7 @@ from rocksweep.errors import RocksweepError
 from rocksweep.grid import Grid
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.points import with_record
 from rocksweep.scene import Scene
 
 
@@ -98,13 +99,17 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
     t0, c0 = time.perf_counter(), time.thread_time()
     cr = grid.rows(start, stop)
     outs = np.empty((stop - start, L.N_OUT))
+    record, ground = grid.scene.record, grid.scene.ground
     for kind in np.unique(cr.kinds):
         sel = cr.kinds == kind
-        if sel.all():
-            chunk_kernel(int(kind), level)(cr.rows, outs)
+        kernel = chunk_kernel(int(kind), level, ground)
+        if record is not None:
+            _run_record(kernel, cr.rows, sel, outs, record)
+        elif sel.all():
+            kernel(cr.rows, outs)
         else:
             part = np.empty((int(sel.sum()), L.N_OUT))
-            chunk_kernel(int(kind), level)(np.ascontiguousarray(cr.rows[sel]), part)
+            kernel(np.ascontiguousarray(cr.rows[sel]), part)
             outs[sel] = part
     if level == L.LEVEL_CONTACT:
         # a Grid, or adaptive's view of one (``adaptive._Subset``: the grid as ``.grid``)
@@ -115,6 +120,25 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
     arrays = fields.convert(outs, cr.alpha_ref, cr.E_ref, stored)
     return ChunkResult(start, stop, arrays, time.perf_counter() - t0,
                        time.thread_time() - c0)
+
+
+# Points per kernel call of a record scene: each row carries the record's samples
+# (``points.with_record``, 8 bytes a sample: 64 rows of a 5000-sample record are 2.6 MB).
+RECORD_BATCH = 64
+
+
+def _run_record(kernel, rows: np.ndarray, sel: np.ndarray, outs: np.ndarray,
+                record) -> None:
+    """Run the selected rows of a record scene, in batches of RECORD_BATCH rows that
+    carry the record's samples (the GROUND chunk kernel reads the ground motion from the
+    row, ``kernel.equations.ground_acc``)."""
+    idx = np.flatnonzero(sel)
+    for a in range(0, idx.size, RECORD_BATCH):
+        part = idx[a:a + RECORD_BATCH]
+        wide = with_record(rows[part], record)
+        res = np.empty((part.size, L.N_OUT))
+        kernel(wide, res)
+        outs[part] = res
 
 
 def merge_contiguous(results: Iterable[ChunkResult]) -> list[ChunkResult]:
@@ -178,7 +202,7 @@ def prepare(grid: Grid, level: int) -> None:
     any worker starts: worker threads share the compiled code, and dask workers load
     numba's cache instead of compiling concurrently."""
     for kind in grid.kinds():
-        warm_up(kind, level)
+        warm_up(kind, level, grid.scene.ground)
 
 
 def _in_cache(dispatcher) -> bool | None:
@@ -197,7 +221,7 @@ def _in_cache(dispatcher) -> bool | None:
 def kernel_cache_state(grid: Grid, level: int) -> tuple[int, int]:
     """(variants to compile, variants of unknown state) among those ``prepare`` needs:
     what a sweep says before the kernel is compiled or loaded."""
-    states = [_in_cache(chunk_kernel(kind, level)) for kind in grid.kinds()]
+    states = [_in_cache(chunk_kernel(kind, level, grid.scene.ground)) for kind in grid.kinds()]
     return sum(s is False for s in states), sum(s is None for s in states)
 
 

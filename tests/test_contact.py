@@ -59,7 +59,8 @@ def velocities_sympy():
 
 
 def _row(body, A=3.0, w=2.0, shape="sine", lam=0.2, mu=math.nan, numerics=None):
-    return point_row(Point(body, lam, shape, w, A, mu), numerics or Numerics.preset("default"))
+    return point_row(Point(body, lam, shape, w, A, mu=mu),
+                     numerics or Numerics.preset("default"))
 
 
 def _run(body, level=L.LEVEL_CONTACT, **kw):

@@ -109,29 +109,30 @@ STRUCTURE_CASES = [
      "body = 3: must be a mapping with keys wn_over_p, zeta, alpha_cg, alpha_A, mA_over_m, "
      "IA_ratio (a flexible body), or kind: block, alpha, inertia"),
     (GOOD.replace("pulse: {shape: sine, w_over_p: 5.3, A_ratio: 5.0}", "pulse: [1, 2]"),
-     "pulse = [1, 2]: must be a mapping with keys shape, w_over_p, A_ratio"),
+     "pulse = [1, 2]: must be a mapping with keys shape, w_over_p, A_ratio, cycles, gamma, nu"),
     (sub("wn_over_p: 2.43", "kind: [block], wn_over_p: 2.43"),
      "body.kind = ['block']: must be one of flexible, block"),
     (sub("zeta: 0.05", "zeta: 0.05, zta: 1"),
      "body.zta: unknown key for a flexible body (allowed: kind, wn_over_p, zeta, alpha_cg, "
-     "alpha_A, mA_over_m, IA_ratio)"),
+     "alpha_A, mA_over_m, IA_ratio, mu)"),
     (GOOD + "numerics: {tol: 1}\n",
      "numerics.tol: unknown key (allowed: accuracy, steps_per_period, event_tol, horizon, "
      "rest_rate, max_events, root)"),
-    (GOOD + "foo: 1\n", "foo: unknown key (allowed: name, body, impact, pulse, numerics, outputs)"),
+    (GOOD + "foo: 1\n",
+     "foo: unknown key (allowed: name, body, impact, pulse, numerics, outputs, ground)"),
     (sub(", A_ratio: 5.0", ""),
      "pulse.A_ratio: missing required key (a number, a list of numbers or a range "
      "{start, stop, num})"),
     (sub("impact: {lam: 0.4}\n", ""), "impact: missing required section (impact: {lam})"),
     (sub("A_ratio: 5.0", "A_ratio: true"),
      "pulse.A_ratio = True: must be a number, a list of numbers or a range {start, stop, num}"),
-    (sub("shape: sine", "shape: square"), "pulse.shape = 'square': must be sine, cosine or a "
-     "list of them"),
+    (sub("shape: sine", "shape: square"),
+     "pulse.shape = 'square': must be sine, cosine, ricker, mp or a list of them"),
     (GOOD + "outputs: {energy: 'yes'}\n",
      "outputs.energy = 'yes': must be true or false (store energy metrics)"),
     (GOOD + "name: 3\n", "name = 3: must be a string (the scene's title)"),
     ("[1, 2]", "a scene is a YAML mapping with sections body, impact, pulse, numerics, "
-     "outputs (got [1, 2])"),
+     "outputs, ground (got [1, 2])"),
 ]
 
 

@@ -7,5 +7,6 @@ from rocksweep.cli import (  # noqa: F401
     plot,
     restitution,
     simulate,
+    spectrum,
     sweep,
 )

@@ -27,12 +27,17 @@ Full contact (theta = 0):  m u'' + c u' + k u = -m xg''.
 import math
 
 from numba import njit
+from numba.core import types
+from numba.extending import overload
 
+from rocksweep.kernel._cache import INTERNAL
 from rocksweep.kernel.layout import (
     PAR_AMP,
+    PAR_AMP_NORM,
     PAR_B,
     PAR_C,
     PAR_G,
+    PAR_GAMMA,
     PAR_H,
     PAR_HA,
     PAR_HCG,
@@ -44,26 +49,77 @@ from rocksweep.kernel.layout import (
     PAR_M,
     PAR_MA,
     PAR_MTOT,
+    PAR_NU,
     PAR_OMEGA,
+    PAR_REC,
+    PAR_REC_DT,
     PAR_SHAPE,
     SHAPE_COSINE,
+    SHAPE_RECORD,
+    SHAPE_RICKER,
+    SHAPE_SINE,
 )
 
 # ----------------------------------------------------------------------------------------
-# Eq. (2): the single-cycle pulse. ``on`` is decided per step by the loop (the step that
-# ends exactly at 2 pi/omega still sees the pulse, the next one does not), so the cosine
-# pulse's jump is never smeared across a step.
+# Eq. (2): the pulse (n cycles of a sine or cosine), and the other ground motions. ``on``
+# is decided per step by the loop (the step that ends exactly at the pulse's end still
+# sees the pulse, the next one does not), so a jump at the end (the cosine's) is never
+# smeared across a step.
+#
+# The type of ``on`` picks the code at compile time: a bool (the loop's GROUND = False:
+# sine and cosine only, the paper's scenes, exactly the code they always ran) or an int
+# (GROUND = 1: every shape, the Ricker, MP and records too, chosen by PAR_SHAPE at run
+# time, ``ground_acc_any``). A run-time branch to the other shapes inside the pulse
+# variants cost 5% (inlined) to 60% (a call) on the paper's scenes, measured; the type
+# costs nothing there.
 # ----------------------------------------------------------------------------------------
+
+
+def _shape_acc(t, on, prm):  # pragma: no cover (replaced by the overload below)
+    raise NotImplementedError
+
+
+def _shape_jerk(t, on, prm):  # pragma: no cover
+    raise NotImplementedError
+
+
+@overload(_shape_acc, inline="always")
+def _shape_acc_overload(t, on, prm):
+    if isinstance(on, types.Boolean):
+        def pulse(t, on, prm):
+            if prm[PAR_SHAPE] == SHAPE_COSINE:
+                return prm[PAR_AMP] * math.cos(prm[PAR_OMEGA] * t)
+            return prm[PAR_AMP] * math.sin(prm[PAR_OMEGA] * t)
+        return pulse
+
+    def any_shape(t, on, prm):
+        return ground_acc_any(t, prm)
+    return any_shape
+
+
+@overload(_shape_jerk, inline="always")
+def _shape_jerk_overload(t, on, prm):
+    if isinstance(on, types.Boolean):
+        def pulse(t, on, prm):
+            w = prm[PAR_OMEGA]
+            if prm[PAR_SHAPE] == SHAPE_COSINE:
+                return -prm[PAR_AMP] * w * math.sin(w * t)
+            return prm[PAR_AMP] * w * math.cos(w * t)
+        return pulse
+
+    def any_shape(t, on, prm):
+        return ground_jerk_any(t, prm)
+    return any_shape
 
 
 @njit(cache=True, inline="always")
 def ground_acc(t, on, prm):
-    """xg''(t) [m/s^2] of eq. (2); 0 when ``on`` is False."""
+    """xg''(t) [m/s^2] of eq. (2) or of the row's other shape; 0 when ``on`` is false.
+
+    on: bool (sine and cosine only) or int (any shape; what Python callers pass)."""
     if not on:
         return 0.0
-    if prm[PAR_SHAPE] == SHAPE_COSINE:
-        return prm[PAR_AMP] * math.cos(prm[PAR_OMEGA] * t)
-    return prm[PAR_AMP] * math.sin(prm[PAR_OMEGA] * t)
+    return _shape_acc(t, on, prm)
 
 
 @njit(cache=True, inline="always")
@@ -71,10 +127,77 @@ def ground_jerk(t, on, prm):
     """d xg''/dt [m/s^3], for locating an uplift inside a step."""
     if not on:
         return 0.0
+    return _shape_jerk(t, on, prm)
+
+
+@njit(cache=True, inline="always")
+def _record_segment(t, prm):
+    """(a_k, x - k, a_k+1 - a_k), x = t / PAR_REC_DT: the first sample of the record's
+    linear segment [t_k, t_k+1] that holds t, the fraction of it at t, and the samples'
+    difference. At a sample time either neighbour
+    gives the same value (the interpolant is continuous), so the loop's steps, which land
+    on sample times, always see one segment's straight line."""
+    x = t / prm[PAR_REC_DT]
+    k = min(max(int(x), 0), prm.shape[0] - PAR_REC - 2)  # the last segment at the end
+    a0 = prm[PAR_REC + k]
+    return a0, x - k, prm[PAR_REC + k + 1] - a0
+
+
+@njit(cache=True, **INTERNAL)
+def ground_acc_any(t, prm):
+    """xg''(t) [m/s^2] while on, of any shape (``rocksweep.excitation`` defines each as a
+    function of phi = w t); one call (inlining it into every right-hand side inlines
+    it again in each of the GROUND variant's call sites: numba's IR inliner warns).
+
+    Sine, cosine: A sin(phi), A cos(phi). Ricker: A (1 - 2 tau^2) exp(-tau^2), tau =
+    phi/2 - 3 pi/2 (t0 = 1.5/f, f = w/(2 pi)). MP: A/r_max [sin(phi/gamma) cos(psi) -
+    gamma (1 - cos(phi/gamma)) sin(psi)], psi = phi - pi gamma + nu (OpenSees' MPAcc;
+    PAR_AMP_NORM = 1/r_max). Record: A times the samples xg''/PGA interpolated linearly,
+    samples every PAR_REC_DT.
+    """
+    shape = prm[PAR_SHAPE]
+    amp = prm[PAR_AMP]
+    if shape == SHAPE_RECORD:
+        a0, frac, da = _record_segment(t, prm)
+        return amp * (a0 + frac * da)
+    phi = prm[PAR_OMEGA] * t
+    if shape == SHAPE_SINE:
+        return amp * math.sin(phi)
+    if shape == SHAPE_COSINE:
+        return amp * math.cos(phi)
+    if shape == SHAPE_RICKER:
+        tau = 0.5 * phi - 1.5 * math.pi
+        return amp * (1.0 - 2.0 * tau * tau) * math.exp(-tau * tau)
+    gamma = prm[PAR_GAMMA]
+    psi = phi - math.pi * gamma + prm[PAR_NU]
+    x = phi / gamma
+    r = math.sin(x) * math.cos(psi) - gamma * (1.0 - math.cos(x)) * math.sin(psi)
+    return amp * prm[PAR_AMP_NORM] * r
+
+
+@njit(cache=True, **INTERNAL)
+def ground_jerk_any(t, prm):
+    """d xg''/dt [m/s^3] of ``ground_acc_any`` (a record: its segment's constant slope)."""
+    shape = prm[PAR_SHAPE]
+    amp = prm[PAR_AMP]
+    if shape == SHAPE_RECORD:
+        _, _, da = _record_segment(t, prm)
+        return amp * da / prm[PAR_REC_DT]
     w = prm[PAR_OMEGA]
-    if prm[PAR_SHAPE] == SHAPE_COSINE:
-        return -prm[PAR_AMP] * w * math.sin(w * t)
-    return prm[PAR_AMP] * w * math.cos(w * t)
+    phi = w * t
+    if shape == SHAPE_SINE:
+        return amp * w * math.cos(phi)
+    if shape == SHAPE_COSINE:
+        return -amp * w * math.sin(phi)
+    if shape == SHAPE_RICKER:
+        tau = 0.5 * phi - 1.5 * math.pi
+        return amp * w * tau * (2.0 * tau * tau - 3.0) * math.exp(-tau * tau)
+    gamma = prm[PAR_GAMMA]
+    psi = phi - math.pi * gamma + prm[PAR_NU]
+    x = phi / gamma
+    rate = (math.cos(psi) * (math.cos(x) / gamma - gamma * (1.0 - math.cos(x)))
+            - 2.0 * math.sin(x) * math.sin(psi))
+    return amp * prm[PAR_AMP_NORM] * w * rate
 
 
 # ----------------------------------------------------------------------------------------

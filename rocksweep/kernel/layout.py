@@ -38,10 +38,21 @@ PAR_ROOT = 25  # event root finder: ROOT_BISECT, ROOT_ILLINOIS or ROOT_HERMITE
 PAR_THETA0 = 26  # initial theta [rad] (0: start at rest; != 0 starts rocking on its corner)
 PAR_THETA_DOT0 = 27  # initial theta' [rad/s] (from theta = 0: rocking on its sign's corner)
 PAR_MU = 28  # friction coefficient of the base on the ground (NaN: none given)
-N_PAR = 29
+PAR_GAMMA = 29  # Mavroeidis-Papageorgiou pulse: oscillation parameter gamma (>= 1)
+PAR_NU = 30  # Mavroeidis-Papageorgiou pulse: phase nu [rad]
+PAR_AMP_NORM = 31  # Mavroeidis-Papageorgiou pulse: 1/r_max, so that A is its peak |xg''|
+PAR_REC_DT = 32  # record: sample interval in kernel time, p * DT [s] (0: not a record)
+PAR_REC_H = 33  # record: RK4 step while it acts, PAR_REC_DT / m (m >= 1 an integer) [s]
+N_PAR = 34
+# A record's row is longer: its samples xg''/PGA (float64[npts], in [-1, 1]) follow the
+# N_PAR parameters, PAR_REC = N_PAR the first (``points.with_record``).
+PAR_REC = N_PAR
 
 SHAPE_SINE = 0.0
 SHAPE_COSINE = 1.0
+SHAPE_RICKER = 2.0
+SHAPE_MP = 3.0
+SHAPE_RECORD = 4.0  # linear interpolation of the samples at PAR_REC...
 ROOT_BISECT = 0.0
 ROOT_ILLINOIS = 1.0
 ROOT_HERMITE = 2.0

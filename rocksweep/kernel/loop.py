@@ -9,7 +9,9 @@ below. Those on the path of every step take no arrays and are inlined (numba
 ``inline="always"``); those of events are calls (an inlined helper that takes ``prm`` or
 ``out`` adds reference counting to every step: ~15% slower, measured).
 
-Compile-time specialisation: the functions take the flags FLEX, DAMPED and ENERGY and call
+Compile-time specialisation: the functions take the flags FLEX, DAMPED and ENERGY (and
+``simulate_point`` GROUND: every ground motion, not only the paper's sine and cosine; it
+reaches the ground motion as the type of ``on``, see ``equations.ground_acc``) and call
 ``numba.literally`` on them, so numba compiles one specialisation per flag value (a
 ``Literal[bool]`` type) and the branches a variant does not need are removed at compile
 time (by LLVM: numba still types and lowers them, its own dead-branch pruning does not
@@ -23,6 +25,8 @@ import math
 
 import numpy as np
 from numba import literally, njit
+from numba.core import types
+from numba.extending import overload
 
 from rocksweep.kernel._cache import INTERNAL
 from rocksweep.kernel.contact import (
@@ -82,6 +86,7 @@ from rocksweep.kernel.layout import (
     PAR_MAXEVENTS,
     PAR_MAXSTEPS,
     PAR_MU,
+    PAR_REC_H,
     PAR_TEND,
     PAR_THETA0,
     PAR_THETA_DOT0,
@@ -109,9 +114,33 @@ from rocksweep.kernel.layout import (
 from rocksweep.kernel.stepping import rk4_step
 from rocksweep.kernel.transitions import impact_map, rest_proven, rigid_bounded, uplift_side
 
+# _step_length: a time within this fraction of a record step of a grid time is on it (t
+# sums steps of ~1e-2..1; its round-off is ~1e-16 relative, far below).
+ALIGN_SLACK = 1e-7
+
+
+def _acting(t, t_pulse, GROUND):  # pragma: no cover (replaced by the overload below)
+    raise NotImplementedError
+
+
+@overload(_acting)
+def _acting_overload(t, t_pulse, GROUND):
+    """Does the ground move at t? A bool for the paper's pulses (GROUND = False), an int
+    for every ground motion (GROUND = 1, an int; the type of ``on`` selects the code of
+    ``equations.ground_acc``). An overload, so that GROUND's type picks one function at
+    typing time: a plain branch on it would type both returns and unify them to int."""
+    if isinstance(GROUND, types.Integer):
+        def ground(t, t_pulse, GROUND):
+            return np.int64(t < t_pulse)
+        return ground
+
+    def pulse(t, t_pulse, GROUND):
+        return t < t_pulse
+    return pulse
+
 
 @njit(cache=True, **INTERNAL)
-def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT):
+def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     """Run one point from rest (or the given initial state) to a decided outcome, a cap or
     the horizon.
 
@@ -126,11 +155,14 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT):
     literally(DAMPED)
     literally(ENERGY)
     literally(CONTACT)
+    literally(GROUND)
     t, dt, t_pulse, t_end = 0.0, prm[PAR_DT], prm[PAR_TPULSE], prm[PAR_TEND]
     max_steps, max_events = prm[PAR_MAXSTEPS], prm[PAR_MAXEVENTS]
+    # > 0: a record, whose samples the steps land on while it acts (GROUND variants only)
+    h_rec = prm[PAR_REC_H] if GROUND else 0.0
     y = (prm[PAR_THETA0], prm[PAR_THETA_DOT0], 0.0, 0.0, 0.0, 0.0)
     _reset(out)
-    on = t_pulse > 0.0
+    on = _acting(0.0, t_pulse, GROUND)
     if y[Y_THETA] != 0.0 or y[Y_THETA_DOT] != 0.0:
         # a given initial state: rocking on the corner theta (else theta') points to
         s = 1 if y[Y_THETA] > 0.0 or (y[Y_THETA] == 0.0 and y[Y_THETA_DOT] > 0.0) else -1
@@ -149,7 +181,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT):
         ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED)
 
     while True:
-        on = t < t_pulse
+        on = _acting(t, t_pulse, GROUND)
         # why the run ends before this step, if it does (a STATUS_* bit); written out here,
         # not in a helper: a helper taking the arrays costs ~15% at every step
         if s == 0 and not on and rest_proven(y, prm, FLEX):
@@ -172,7 +204,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT):
         if out[OUT_IMPACTS] + out[OUT_UPLIFTS] >= max_events:
             _flag(out, STATUS_EVENT_CAP)
             break
-        h, lands = _step_length(t, on, dt, t_pulse, t_end)
+        h, lands = _step_length(t, on, dt, t_pulse, t_end, h_rec)
         y1 = rk4_step(t, y, h, s, on, prm, FLEX, DAMPED, ENERGY)
         steps += 1
         if not _finite(y1):
@@ -185,7 +217,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT):
 
         if ev == EV_NONE:
             t, y = (t_pulse if lands else t + h), y1
-            _record(hist, t, y, s, t < t_pulse, prm, out, FLEX)
+            _record(hist, t, y, s, _acting(t, t_pulse, GROUND), prm, out, FLEX)
             if CONTACT:  # the step's end, with the step's own ground motion
                 ct = contact_sample(ct, t, y, s, on, SAMPLE_STEP, prm, out, FLEX, DAMPED)
             if lands and s == 0:
@@ -193,11 +225,13 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT):
                 # Q jumps with it by m_A h_A xg'': the state may now be past the uplift
                 # threshold, which no crossing inside the next step would show. Checked at
                 # once, as at t = 0 and after an impact.
-                s = _uplift(t, y, False, prm, out, FLEX, DAMPED)
+                off = _acting(t_pulse, t_pulse, GROUND)  # false, of the type of ``on``
+                s = _uplift(t, y, off, prm, out, FLEX, DAMPED)
                 if s != 0:
-                    _record(hist, t, y, s, False, prm, out, FLEX)
+                    _record(hist, t, y, s, off, prm, out, FLEX)
             if CONTACT and lands:  # H jumps with xg'': a new segment without the pulse
-                ct = contact_sample(ct, t, y, s, False, SAMPLE_START, prm, out, FLEX, DAMPED)
+                ct = contact_sample(ct, t, y, s, _acting(t_pulse, t_pulse, GROUND),
+                                    SAMPLE_START, prm, out, FLEX, DAMPED)
             continue
 
         t, y = t + tau, y_ev
@@ -255,9 +289,21 @@ def _reset(out):
 
 
 @njit(cache=True, inline="always")
-def _step_length(t, on, dt, t_pulse, t_end):
+def _step_length(t, on, dt, t_pulse, t_end, h_rec):
     """(h, lands): the step dt, shortened to land exactly on the pulse's end (lands) or on
-    the horizon."""
+    the horizon.
+
+    While a record acts (h_rec > 0), steps end on the grid j h_rec (h_rec = p DT / m, m an
+    integer), which holds every sample time: no step straddles a sample, so the input is
+    one straight line inside each step and RK4 keeps its order. A step starting off the
+    grid (after an event) goes to the next grid time; one starting within ALIGN_SLACK of a
+    grid time counts as on it (t is a sum of steps: round-off).
+    """
+    if on and h_rec > 0.0:
+        t_next = (math.floor(t / h_rec + ALIGN_SLACK) + 1.0) * h_rec
+        if t_next >= t_pulse - ALIGN_SLACK * h_rec:
+            return t_pulse - t, True
+        return t_next - t, False
     if on and t + dt >= t_pulse:
         return t_pulse - t, True
     if t + dt > t_end:

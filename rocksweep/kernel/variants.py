@@ -41,73 +41,121 @@ from rocksweep.kernel.loop import simulate_point
 
 
 @njit(cache=True, **INTERNAL)
-def _chunk(prms, outs, FLEX, DAMPED, ENERGY, CONTACT):
+def _chunk(prms, outs, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
     literally(CONTACT)
+    literally(GROUND)
     for i in range(prms.shape[0]):
-        simulate_point(prms[i], outs[i], None, FLEX, DAMPED, ENERGY, CONTACT)
+        simulate_point(prms[i], outs[i], None, FLEX, DAMPED, ENERGY, CONTACT, GROUND)
 
 
 @njit(cache=True, nogil=True)
 def chunk_flexible(prms, outs):
-    _chunk(prms, outs, True, True, False, False)
+    _chunk(prms, outs, True, True, False, False, False)
 
 
 @njit(cache=True, nogil=True)
 def chunk_flexible_undamped(prms, outs):
-    _chunk(prms, outs, True, False, False, False)
+    _chunk(prms, outs, True, False, False, False, False)
 
 
 @njit(cache=True, nogil=True)
 def chunk_rigid(prms, outs):
-    _chunk(prms, outs, False, False, False, False)
+    _chunk(prms, outs, False, False, False, False, False)
 
 
 @njit(cache=True, nogil=True)
 def chunk_flexible_energy(prms, outs):
-    _chunk(prms, outs, True, True, True, False)
+    _chunk(prms, outs, True, True, True, False, False)
 
 
 @njit(cache=True, nogil=True)
 def chunk_flexible_undamped_energy(prms, outs):
-    _chunk(prms, outs, True, False, True, False)
+    _chunk(prms, outs, True, False, True, False, False)
 
 
 @njit(cache=True, nogil=True)
 def chunk_rigid_energy(prms, outs):
-    _chunk(prms, outs, False, False, True, False)
+    _chunk(prms, outs, False, False, True, False, False)
 
 
 @njit(cache=True, nogil=True)
 def chunk_flexible_contact(prms, outs):
-    _chunk(prms, outs, True, True, True, True)
+    _chunk(prms, outs, True, True, True, True, False)
 
 
 @njit(cache=True, nogil=True)
 def chunk_flexible_undamped_contact(prms, outs):
-    _chunk(prms, outs, True, False, True, True)
+    _chunk(prms, outs, True, False, True, True, False)
 
 
 @njit(cache=True, nogil=True)
 def chunk_rigid_contact(prms, outs):
-    _chunk(prms, outs, False, False, True, True)
+    _chunk(prms, outs, False, False, True, True, False)
 
 
 @njit(cache=True)
 def point_flexible_history(prm, out, hist):
-    simulate_point(prm, out, hist, True, True, True, True)
+    simulate_point(prm, out, hist, True, True, True, True, False)
 
 
 @njit(cache=True)
 def point_flexible_undamped_history(prm, out, hist):
-    simulate_point(prm, out, hist, True, False, True, True)
+    simulate_point(prm, out, hist, True, False, True, True, False)
 
 
 @njit(cache=True)
 def point_rigid_history(prm, out, hist):
-    simulate_point(prm, out, hist, False, False, True, True)
+    simulate_point(prm, out, hist, False, False, True, True, False)
+
+
+# GROUND = 1 (an int, not True: its type selects the code, ``loop._acting``): the Ricker
+# and MP pulses and records (``equations.ground_acc``), compiled only when a scene asks.
+@njit(cache=True, nogil=True)
+def chunk_flexible_ground(prms, outs):
+    _chunk(prms, outs, True, True, False, False, 1)
+
+
+@njit(cache=True, nogil=True)
+def chunk_flexible_undamped_ground(prms, outs):
+    _chunk(prms, outs, True, False, False, False, 1)
+
+
+@njit(cache=True, nogil=True)
+def chunk_rigid_ground(prms, outs):
+    _chunk(prms, outs, False, False, False, False, 1)
+
+
+@njit(cache=True, nogil=True)
+def chunk_flexible_energy_ground(prms, outs):
+    _chunk(prms, outs, True, True, True, False, 1)
+
+
+@njit(cache=True, nogil=True)
+def chunk_flexible_undamped_energy_ground(prms, outs):
+    _chunk(prms, outs, True, False, True, False, 1)
+
+
+@njit(cache=True, nogil=True)
+def chunk_rigid_energy_ground(prms, outs):
+    _chunk(prms, outs, False, False, True, False, 1)
+
+
+@njit(cache=True)
+def point_flexible_history_ground(prm, out, hist):
+    simulate_point(prm, out, hist, True, True, True, True, 1)
+
+
+@njit(cache=True)
+def point_flexible_undamped_history_ground(prm, out, hist):
+    simulate_point(prm, out, hist, True, False, True, True, 1)
+
+
+@njit(cache=True)
+def point_rigid_history_ground(prm, out, hist):
+    simulate_point(prm, out, hist, False, False, True, True, 1)
 
 
 _CHUNK = {
@@ -126,20 +174,38 @@ _POINT = {
     KIND_FLEXIBLE_UNDAMPED: point_flexible_undamped_history,
     KIND_RIGID: point_rigid_history,
 }
+_CHUNK_GROUND = {
+    (KIND_FLEXIBLE, LEVEL_OUTCOME): chunk_flexible_ground,
+    (KIND_FLEXIBLE_UNDAMPED, LEVEL_OUTCOME): chunk_flexible_undamped_ground,
+    (KIND_RIGID, LEVEL_OUTCOME): chunk_rigid_ground,
+    (KIND_FLEXIBLE, LEVEL_ENERGY): chunk_flexible_energy_ground,
+    (KIND_FLEXIBLE_UNDAMPED, LEVEL_ENERGY): chunk_flexible_undamped_energy_ground,
+    (KIND_RIGID, LEVEL_ENERGY): chunk_rigid_energy_ground,
+}
+_POINT_GROUND = {
+    KIND_FLEXIBLE: point_flexible_history_ground,
+    KIND_FLEXIBLE_UNDAMPED: point_flexible_undamped_history_ground,
+    KIND_RIGID: point_rigid_history_ground,
+}
 
 
-def chunk_kernel(kind: int, level: int):
-    """Jitted ``f(prms[n, N_PAR], outs[n, N_OUT])`` for a kernel kind and bookkeeping level."""
-    return _CHUNK[(kind, level)]
+def chunk_kernel(kind: int, level: int, ground: bool = False):
+    """Jitted ``f(prms[n, N_PAR], outs[n, N_OUT])`` for a kernel kind and bookkeeping level;
+    ``ground``: the variant for every ground motion (Ricker, MP, records; rows of a record
+    carry its samples, ``points.with_record``), else sine and cosine pulses only."""
+    table = _CHUNK_GROUND if ground else _CHUNK
+    if (kind, level) not in table:  # the scene refuses this combination first
+        raise ValueError(f"no kernel variant for kind {kind}, level {level}, ground {ground}")
+    return table[(kind, level)]
 
 
-def point_kernel(kind: int):
+def point_kernel(kind: int, ground: bool = False):
     """Jitted ``f(prm[N_PAR], out[N_OUT], hist[n, N_HIST])`` with energy, ground reactions
-    and history."""
-    return _POINT[kind]
+    and history; ``ground``: the variant for every ground motion."""
+    return (_POINT_GROUND if ground else _POINT)[kind]
 
 
-def warm_up(kind: int, level: int | None = None) -> None:
+def warm_up(kind: int, level: int | None = None, ground: bool = False) -> None:
     """Compile (or load from numba's cache) a variant now, so timings exclude compilation.
 
     ``level=None`` warms the single-run (history) variant of ``kind``.
@@ -151,6 +217,6 @@ def warm_up(kind: int, level: int | None = None) -> None:
     prm[0, PAR_TPULSE] = 1.0  # pulse on: no rest test (it divides by k)
     out = np.empty((1, N_OUT))
     if level is None:
-        point_kernel(kind)(prm[0], out[0], np.empty((1, N_HIST)))
+        point_kernel(kind, ground)(prm[0], out[0], np.empty((1, N_HIST)))
     else:
-        chunk_kernel(kind, level)(prm, out)
+        chunk_kernel(kind, level, ground)(prm, out)

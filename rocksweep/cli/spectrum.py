@@ -1,0 +1,37 @@
+"""``rocksweep spectrum``: rocking and overturning spectra of a sweep over p (or w_over_p)
+and A_ratio."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from rocksweep.cli.main import main, user_errors
+
+
+@main.command()
+@click.argument("result_path", metavar="OUT.h5", type=click.Path(path_type=Path))
+@click.option("-o", "--output", "fig_path", type=click.Path(dir_okay=False, path_type=Path),
+              help="Figure file, .png, .pdf or .svg [default: OUT-spectra.png].")
+@click.option("--rtol", type=click.FloatRange(1e-9, 0.5), default=1e-3, show_default=True,
+              help="Relative tolerance of the smallest overturning A_ratio (bisection).")
+@click.option("--dpi", type=click.IntRange(20, 2400), default=200, show_default=True,
+              help="Resolution of raster output (PNG).")
+@click.option("--overwrite", is_flag=True, help="Replace an existing figure file.")
+@user_errors
+def spectrum(result_path: Path, fig_path: Path | None, rtol: float, dpi: int,
+             overwrite: bool) -> None:
+    """Rocking spectrum (max|theta|/alpha_cg against p, one curve per A_ratio and lam) and
+    overturning spectrum (smallest A_ratio that overturns against p, one curve per lam,
+    by mode, refined by bisection) of a sweep over p (a record) or w_over_p, and A_ratio."""
+    from rocksweep.outputs import check_output
+    from rocksweep.plots import FORMATS, save_figure
+    from rocksweep.spectrum import spectra
+    from rocksweep.spectrum_plot import spectra_figure
+
+    fig_out = fig_path or result_path.with_name(result_path.stem + "-spectra.png")
+    check_output(fig_out, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
+    sp = spectra(result_path, rtol)
+    save_figure(spectra_figure(sp), fig_out, dpi, overwrite=overwrite, inputs=[result_path])
+    click.echo(f"wrote {fig_out} ({sp.runs} kernel runs to bisect A_min to {rtol:g})")

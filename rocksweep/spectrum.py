@@ -1,0 +1,116 @@
+"""Rocking and overturning spectra of a sweep over the time scale and A_ratio.
+
+A sweep over ``p`` (a record scene: the body's frequency parameter [rad/s]) or
+``w_over_p`` (a pulse scene), ``A_ratio`` and, optionally, ``lam`` gives:
+
+- the rocking spectrum: max |theta| / alpha_cg against p, one curve per A_ratio and lam
+  (overturned points marked; their max |theta| is the overturning angle's pi/2);
+- the overturning spectrum: the smallest A_ratio that overturns against p, one curve per
+  lam, with the mode it overturns in. Between the first overturning grid value of each p
+  and the grid value below, A_ratio is bisected to ``rtol`` (relative) with single kernel
+  runs at the sweep's numerics: ``rocksweep.boundaries.a_min`` (shared with the stability
+  diagram's A_min curves), with an evaluator here that also runs records and the GROUND
+  pulses (``boundaries.kernel_evaluator``, which runs every ground motion's kernel).
+
+The scene is rebuilt from the file (its YAML); a record is re-read from the path the sweep
+read it at and must have the same SHA-256 as then. The figure is
+``rocksweep.spectrum_plot.spectra_figure``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from rocksweep.boundaries import DEFAULT_RTOL, AMinCurve, a_min, kernel_evaluator
+from rocksweep.errors import RocksweepError
+from rocksweep.scene import Scene, parse_scene
+
+
+class SpectrumError(RocksweepError, ValueError):
+    """A result that has no spectra (wrong axes, incomplete); ``str()`` is one line."""
+
+
+@dataclass
+class Spectra:
+    """The spectra of one sweep.
+
+    freq: "p" [rad/s] or "w_over_p"; x: float64[nx] its values; A: float64[nA] the
+    A_ratio values; lam: float64[nl] (one NaN when lam is not swept); theta_max:
+    float64[nl, nA, nx] max |theta|/alpha_ref; outcome: int8[nl, nA, nx]; a_min: one
+    ``AMinCurve`` per lam (x = freq, a_min [A_ratio], mode 1 or 2 at a_min, NaN: no grid
+    value overturns); rtol: the bisection's relative tolerance; runs: kernel runs spent.
+    """
+
+    name: str
+    freq: str
+    x: np.ndarray
+    A: np.ndarray
+    lam: np.ndarray
+    theta_max: np.ndarray
+    outcome: np.ndarray
+    a_min: list[AMinCurve]
+    rtol: float
+    runs: int
+    record: str = ""
+
+
+def result_scene(result) -> Scene:
+    """The scene of a result file, rebuilt from its YAML (a record re-read from where the
+    sweep read it, checked against its SHA-256)."""
+    text = str(result.attrs["scene"])
+    overrides = list(result.scene.get("overrides", []))
+    rec = result.scene.get("record")
+    if rec:
+        overrides.append(f"ground.record={rec['source']}")
+    try:
+        scene = parse_scene(text, str(result.path), overrides)
+    except RocksweepError as err:
+        raise SpectrumError(f"{result.path}: its scene cannot be rebuilt ({err})") from None
+    if rec and scene.record.sha256 != rec["sha256"]:
+        raise SpectrumError(f"{result.path}: the record {rec['source']} changed since the "
+                            f"sweep (sha256 {scene.record.sha256[:12]}, the file has "
+                            f"{rec['sha256'][:12]}); the spectra need the record swept")
+    return scene
+
+
+def spectra(path: str | Path, rtol: float = DEFAULT_RTOL) -> Spectra:
+    """The rocking and overturning spectra of a complete sweep result file."""
+    from rocksweep.store import read_result
+
+    result = read_result(Path(path), ["outcome", "status", "theta_max_over_alpha"])
+    freq = "p" if "p" in result.dims else "w_over_p"
+    missing = [d for d in (freq, "A_ratio") if d not in result.dims]
+    if missing:
+        raise SpectrumError(f"{result.path}: spectra need a sweep over p (a record) or "
+                            f"w_over_p, and A_ratio; not swept: {', '.join(missing)} "
+                            f"(swept: {', '.join(result.dims) or 'none'})")
+    other = [d for d in result.dims if d not in (freq, "A_ratio", "lam")]
+    if other:
+        raise SpectrumError(f"{result.path}: spectra are drawn over {freq}, A_ratio and lam; "
+                            f"also swept: {', '.join(other)} (sweep one value of each)")
+    if not result.done.all():
+        n = int((~result.done).sum())
+        raise SpectrumError(f"{result.path}: {n} points not computed; finish the sweep "
+                            "(rocksweep sweep SCENE -o OUT --resume) first")
+    A = np.asarray(result.coords["A_ratio"], float)
+    if not np.all(np.diff(A) > 0):
+        raise SpectrumError(f"{result.path}: A_ratio must increase along its axis")
+    order = [d for d in ("lam", "A_ratio", freq) if d in result.dims]
+    perm = [result.dims.index(d) for d in order]
+    theta = np.transpose(result.arrays["theta_max_over_alpha"], perm)
+    outcome = np.transpose(result.arrays["outcome"], perm)
+    if "lam" not in result.dims:
+        theta, outcome = theta[None], outcome[None]
+        lam = np.array([float(result.scalars.get("lam", np.nan))])
+    else:
+        lam = np.asarray(result.coords["lam"], float)
+    scene = result_scene(result)
+    curves = a_min(scene, result.arrays["outcome"], rtol, axes=(freq, "A_ratio"),
+                   evaluate=kernel_evaluator(scene))
+    rec = result.scene.get("record") or {}
+    return Spectra(result.name, freq, np.asarray(result.coords[freq], float), A, lam,
+                   theta, outcome, curves, rtol, int(sum(c.runs.sum() for c in curves)),
+                   rec.get("name", ""))
