@@ -34,6 +34,18 @@ PRESETS: dict[str, tuple[int, float]] = {
     "fine": (20, 1e-8),
 }
 
+# name -> rotation_step: the largest rotation one rocking step may make, as a fraction of
+# alpha_cg (the kernel's PAR_ROT_STEP = rotation_step * alpha_ref; 0: no such limit). The
+# spring, pulse and rocking time scales above set the step in the paper's region; far
+# outside it (a pulse 20x the uplift threshold, a fall to overturning, a rigid body) the body
+# turns through alpha_cg or more in one step, and the overturning time and max|theta| lose
+# their digits (issue 15; measured with scripts/wide_space.py, see the README).
+PRESET_ROTATION: dict[str, float] = {
+    "draft": 0.0,
+    "default": 0.0,
+    "fine": 0.0,
+}
+
 # Smallest event_tol [p*t] a scene may ask for. An event's time is t0 + tau in float64; at
 # t ~ 1e2 (a run lasts the pulse plus the 200-long horizon) its spacing is 1.4e-14, and
 # 2.8e-14 to 5.7e-14 up to t = 512: below ~1e-12 the tolerance asks for digits t does not
@@ -66,6 +78,9 @@ class Numerics:
     max_events: cap on impacts + uplifts per run (reported as a status flag).
     max_steps_factor: cap on RK4 evaluations per run, as a multiple of horizon/step.
     root: event root finder, one of ROOTS (see ``rocksweep.kernel.integrate._locate``).
+    rotation_step: largest rotation of one rocking step, a fraction of alpha_cg (0: none);
+        the step is shortened to it from theta' and the last step's theta'' and a step that
+        turned more than twice as far is taken again (``rocksweep.kernel.loop``).
     """
 
     accuracy: str = "default"
@@ -76,19 +91,23 @@ class Numerics:
     max_events: int = 5000
     max_steps_factor: float = 20.0
     root: str = "hermite"
+    rotation_step: float = PRESET_ROTATION["default"]
 
     @classmethod
     def preset(cls, accuracy: str = "default", **overrides) -> Numerics:
         spp, tol = PRESETS[accuracy]
-        return replace(cls(accuracy=accuracy, steps_per_period=spp, event_tol=tol), **overrides)
+        return replace(cls(accuracy=accuracy, steps_per_period=spp, event_tol=tol,
+                           rotation_step=PRESET_ROTATION[accuracy]), **overrides)
 
     def describe(self) -> str:
         label = self.accuracy
         base = PRESETS.get(self.accuracy)
-        if base is None or base != (self.steps_per_period, self.event_tol):
+        if base is None or base != (self.steps_per_period, self.event_tol) or (
+                PRESET_ROTATION[self.accuracy] != self.rotation_step):
             label = "custom"
         return (f"{label} (steps_per_period={self.steps_per_period}, "
-                f"event_tol={self.event_tol:g}, horizon={self.horizon:g}, root={self.root})")
+                f"event_tol={self.event_tol:g}, rotation_step={self.rotation_step:g}, "
+                f"horizon={self.horizon:g}, root={self.root})")
 
     def as_dict(self) -> dict:
         return asdict(self)

@@ -37,7 +37,8 @@ PAR_THETA_OVER = 24  # |theta| at which the body lies on its side: pi/2 [rad]
 PAR_ROOT = 25  # event root finder: ROOT_BISECT, ROOT_ILLINOIS or ROOT_HERMITE
 PAR_THETA0 = 26  # initial theta [rad] (0: start at rest; != 0 starts rocking on its corner)
 PAR_THETA_DOT0 = 27  # initial theta' [rad/s] (from theta = 0: rocking on its sign's corner)
-N_PAR = 28
+PAR_ROT_STEP = 28  # largest rotation of one rocking step [rad] (0: no such limit)
+N_PAR = 29
 
 SHAPE_SINE = 0.0
 SHAPE_COSINE = 1.0
@@ -96,14 +97,15 @@ OUTCOME_SAFE = 0
 OUTCOME_MODE1 = 1  # overturned after one or more impacts
 OUTCOME_MODE2 = 2  # overturned without impact
 
-STATUS_REST = 1  # rest proven after the pulse (early exit)
+STATUS_REST = 1  # rest proven after the pulse (early exit); never with STATUS_SETTLED
 STATUS_HORIZON = 2  # horizon reached before the outcome was decided
 STATUS_STEP_CAP = 4
 STATUS_EVENT_CAP = 8
 STATUS_NONFINITE = 16
 STATUS_HIST_FULL = 32  # history buffer full; integration went on unrecorded
 STATUS_ENERGY_GAIN = 64  # at least one impact gained energy (energy variants)
-STATUS_SETTLED = 128  # chattering ended in full contact through the rest-rate rule
+STATUS_SETTLED = 128  # chattering ended in full contact through the rest-rate rule (no
+#                        proof of rest: a run that then ends early is not flagged REST)
 STATUS_OVERTURNED = 256
 STATUS_E_ABOVE_1 = 512  # at least one impact had e > 1
 STATUS_BOUNDED = 1024  # rigid body after the pulse below its overturning energy, |e| <= 1:
