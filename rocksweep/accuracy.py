@@ -56,6 +56,9 @@ MEASURE_LABELS = {
     "t_first_impact": "|d t_first_impact| (p*t)",
     "t_overturn": "|d t_overturn| (p*t)",
     "impacts": "mean |d impacts|",
+}
+# measures of the tails only (not drawn in the work-precision diagram)
+TAIL_LABELS = {
     "theta_rel": "|d theta_max|/theta_max",
     "energy": "|energy balance|/E_ref",
 }
