@@ -85,9 +85,11 @@ class Setting:
     rotation_step: float = 0.0
 
 
-def _steps(steps: tuple[int, ...], tol: float, tag: bool = False) -> list[Setting]:
-    return [Setting(f"{s}/{tol:.0e}" if tag else f"spp={s}", s, tol, f"steps tol={tol:.0e}")
-            for s in steps]
+def _steps(steps: tuple[int, ...], tol: float, tag: bool = False, rot: float = 0.0
+           ) -> list[Setting]:
+    """A step ladder; rot: rotation_step of every rung (0: none, the bare RK4 order)."""
+    return [Setting(f"{s}/{tol:.0e}" if tag else f"spp={s}", s, tol, f"steps tol={tol:.0e}",
+                    rotation_step=rot) for s in steps]
 
 
 def _tols(spp: int, tols: tuple[float, ...]) -> list[Setting]:
@@ -112,8 +114,11 @@ LADDERS: dict[str, Callable[[], list[Setting]]] = {
                      + _tols(80, (1e-4, 1e-5, 1e-6, 1e-8)) + _presets()),
     "short": lambda: _steps((10, 20), 1e-12) + _presets(),
     # the cheap settings the default preset is chosen from (README, "Accuracy and its price")
-    "candidates": lambda: (_steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-6, tag=True)
-                           + _steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-8, tag=True)
+    # (with the default preset's rotation limit)
+    "candidates": lambda: (_steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-6, True,
+                                  PRESET_ROTATION["default"])
+                           + _steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-8, True,
+                                    PRESET_ROTATION["default"])
                            + _presets()),
     # every preset with every event root finder: what each costs, and whether the outcomes
     # stay the same
