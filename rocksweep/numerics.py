@@ -132,7 +132,9 @@ def step_size(omega_rock: np.ndarray | float, omega: np.ndarray | float,
     the stiffest the kernel meets; inf for a rigid body), the pulse period 2 pi/omega,
     the rocking period scale 2 pi/p (= 2 pi) and the pulse's own rocking time scale
     2 pi/omega_amp (``amplitude_frequency``; 0 leaves it out). A stiff spring or a pulse
-    far above the uplift threshold thus gets a smaller step.
+    far above the uplift threshold thus gets a smaller step. While the body rocks, the
+    kernel shortens it further so that one step turns the body by at most
+    ``Numerics.rotation_step`` x alpha_cg (PAR_ROT_STEP, ``rocksweep.kernel.loop``).
     """
     two_pi = 2 * math.pi
     with np.errstate(divide="ignore"):
