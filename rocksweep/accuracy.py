@@ -44,19 +44,27 @@ import numpy as np
 from rocksweep import fields
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.numerics import PRESETS, ROOTS, Numerics
+from rocksweep.numerics import PRESET_ROTATION, PRESETS, ROOTS, Numerics
 from rocksweep.scene import Scene
 
 OUTCOMES = ("safe", "mode1", "mode2")  # codes 0, 1, 2
 # Per-point fields of the report: all the outcome-level kernel fills (no energies).
 REPORT_FIELDS = tuple(f for f in fields.FIELDS if not f.energy)
-MEASURES = ("theta_max", "t_first_impact", "t_overturn", "impacts")
+MEASURES = ("theta_max", "t_first_impact", "t_overturn", "impacts", "theta_rel", "energy")
 MEASURE_LABELS = {
     "theta_max": "|d theta_max|/alpha_cg",
     "t_first_impact": "|d t_first_impact| (p*t)",
     "t_overturn": "|d t_overturn| (p*t)",
     "impacts": "mean |d impacts|",
 }
+# measures of the tails only (not drawn in the work-precision diagram)
+TAIL_LABELS = {
+    "theta_rel": "|d theta_max|/theta_max",
+    "energy": "|energy balance|/E_ref",
+}
+# theta_rel is taken where the reference's theta_max is at least this x alpha_cg (below it
+# the body barely leaves the ground and a relative error says nothing)
+THETA_REL_FLOOR = 1e-2
 
 
 @dataclass(frozen=True)
@@ -74,11 +82,14 @@ class Setting:
     event_tol: float
     group: str
     root: str | None = None
+    rotation_step: float = 0.0
 
 
-def _steps(steps: tuple[int, ...], tol: float, tag: bool = False) -> list[Setting]:
-    return [Setting(f"{s}/{tol:.0e}" if tag else f"spp={s}", s, tol, f"steps tol={tol:.0e}")
-            for s in steps]
+def _steps(steps: tuple[int, ...], tol: float, tag: bool = False, rot: float = 0.0
+           ) -> list[Setting]:
+    """A step ladder; rot: rotation_step of every rung (0: none, the bare RK4 order)."""
+    return [Setting(f"{s}/{tol:.0e}" if tag else f"spp={s}", s, tol, f"steps tol={tol:.0e}",
+                    rotation_step=rot) for s in steps]
 
 
 def _tols(spp: int, tols: tuple[float, ...]) -> list[Setting]:
@@ -86,11 +97,13 @@ def _tols(spp: int, tols: tuple[float, ...]) -> list[Setting]:
 
 
 def _presets() -> list[Setting]:
-    return [Setting(name, spp, tol, "preset") for name, (spp, tol) in PRESETS.items()]
+    return [Setting(name, spp, tol, "preset", rotation_step=PRESET_ROTATION[name])
+            for name, (spp, tol) in PRESETS.items()]
 
 
 def _roots() -> list[Setting]:
-    return [Setting(f"{name}-{root}", spp, tol, f"root {root}", root)
+    return [Setting(f"{name}-{root}", spp, tol, f"root {root}", root,
+                    rotation_step=PRESET_ROTATION[name])
             for root in ROOTS for name, (spp, tol) in PRESETS.items()]
 
 
@@ -101,8 +114,11 @@ LADDERS: dict[str, Callable[[], list[Setting]]] = {
                      + _tols(80, (1e-4, 1e-5, 1e-6, 1e-8)) + _presets()),
     "short": lambda: _steps((10, 20), 1e-12) + _presets(),
     # the cheap settings the default preset is chosen from (README, "Accuracy and its price")
-    "candidates": lambda: (_steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-6, tag=True)
-                           + _steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-8, tag=True)
+    # (with the default preset's rotation limit)
+    "candidates": lambda: (_steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-6, True,
+                                  PRESET_ROTATION["default"])
+                           + _steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-8, True,
+                                    PRESET_ROTATION["default"])
                            + _presets()),
     # every preset with every event root finder: what each costs, and whether the outcomes
     # stay the same
@@ -335,10 +351,18 @@ def run_reference(scene: Scene, flat: np.ndarray,
 # ----------------------------------------------------------------------------------------
 
 
-def point_errors(k: np.ndarray, r: np.ndarray, alpha_ref: np.ndarray) -> dict[str, np.ndarray]:
+def point_errors(k: np.ndarray, r: np.ndarray, alpha_ref: np.ndarray,
+                 k_energy: np.ndarray | None = None, e_ref: np.ndarray | None = None
+                 ) -> dict[str, np.ndarray]:
     """Per-point absolute errors of kernel rows k against reference rows r (NaN where a
     measure does not apply: theta_max where both are safe, t_first_impact where both
-    impact, t_overturn where both overturn, impacts where the outcomes agree)."""
+    impact, t_overturn where both overturn, impacts where the outcomes agree).
+
+    theta_rel: |d theta_max| / theta_max of the reference, where both are safe and the
+    reference's theta_max >= THETA_REL_FLOOR alpha_cg. energy: the kernel's own energy
+    balance |W_in - D_damp - E_impact - E_end| / E_ref from k_energy (rows of the
+    energy-accounting kernel at the same setting; NaN without them), e_ref [J] per point.
+    """
     ko, ro = k[:, L.OUT_OUTCOME], r[:, L.OUT_OUTCOME]
     nan = np.full(len(k), np.nan)
     both_safe = (ko == L.OUTCOME_SAFE) & (ro == L.OUTCOME_SAFE)
@@ -347,8 +371,29 @@ def point_errors(k: np.ndarray, r: np.ndarray, alpha_ref: np.ndarray) -> dict[st
     d_imp = np.abs(k[:, L.OUT_T_FIRST_IMPACT] - r[:, L.OUT_T_FIRST_IMPACT])
     d_over = np.abs(k[:, L.OUT_T_OVERTURN] - r[:, L.OUT_T_OVERTURN])
     d_n = np.where(ko == ro, np.abs(k[:, L.OUT_IMPACTS] - r[:, L.OUT_IMPACTS]), nan)
+    up = both_safe & (r[:, L.OUT_THETA_MAX] >= THETA_REL_FLOOR * alpha_ref)
+    d_rel = np.where(up, np.abs(k[:, L.OUT_THETA_MAX] - r[:, L.OUT_THETA_MAX])
+                     / np.where(up, r[:, L.OUT_THETA_MAX], 1.0), nan)
+    d_e = nan
+    if k_energy is not None and e_ref is not None:
+        d_e = np.abs(k_energy[:, L.OUT_W_IN] - k_energy[:, L.OUT_D_DAMP]
+                     - k_energy[:, L.OUT_E_IMPACT] - k_energy[:, L.OUT_E_END]) / e_ref
     return {"theta_max": d_theta, "t_first_impact": d_imp, "t_overturn": d_over,
-            "impacts": d_n}
+            "impacts": d_n, "theta_rel": d_rel, "energy": d_e}
+
+
+def run_energy(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray:
+    """The energy-accounting kernel on the given points (untimed): float64[n, N_OUT]."""
+    from rocksweep.grid import Grid
+
+    cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
+    outs = np.empty((len(flat), L.N_OUT))
+    for kind in np.unique(cr.kinds):
+        sel = np.flatnonzero(cr.kinds == kind)
+        part = np.empty((len(sel), L.N_OUT))
+        chunk_kernel(int(kind), L.LEVEL_ENERGY)(np.ascontiguousarray(cr.rows[sel]), part)
+        outs[sel] = part
+    return outs
 
 
 @dataclass
@@ -388,6 +433,13 @@ class SettingResult:
         e = self.errors[measure]
         e = e[np.isfinite(e)]
         return float(np.max(e)) if e.size else math.nan
+
+    def p95_error(self, measure: str) -> float:
+        """95th percentile over the sampled points where the measure applies (unweighted:
+        the tail of the sample, which over-samples the diagram's boundaries)."""
+        e = self.errors[measure]
+        e = e[np.isfinite(e)]
+        return float(np.percentile(e, 95)) if e.size else math.nan
 
 
 def _agreement(agree: np.ndarray, sample: Sample) -> tuple[float, float]:
@@ -464,6 +516,7 @@ class Study:
             "setting": r.setting.name, "group": r.setting.group,
             "steps_per_period": r.setting.steps_per_period, "event_tol": r.setting.event_tol,
             "root": r.setting.root or self.scene.numerics.root,
+            "rotation_step": r.setting.rotation_step,
             "median_us": r.median_us, "mean_us": r.mean_us(w),
             "total_s": r.batch_seconds,
             "evals_per_point": float(np.sum(r.evals * w) / np.sum(w)),
@@ -472,11 +525,18 @@ class Study:
         }
         for m in MEASURES:
             d[f"err_{m}"] = r.median_error(m)
+            d[f"p95_err_{m}"] = r.p95_error(m)
             d[f"max_err_{m}"] = r.max_error(m)
         return d
 
     def table(self) -> list[dict]:
         return [self.row(r) for r in self.results]
+
+
+def _e_ref(scene: Scene, values: dict[str, np.ndarray], n: int) -> np.ndarray:
+    """E_ref [J] of each sampled point (its body)."""
+    return np.array([scene.point({k: v[i] for k, v in values.items()}).body.E_ref
+                     for i in range(n)])
 
 
 def accuracy_study(scene: Scene, n_points: int | None = 200,
@@ -499,6 +559,7 @@ def accuracy_study(scene: Scene, n_points: int | None = 200,
     grid = Grid(scene)
     cr = grid.rows_at(sample.flat)
     values = grid.index_values(sample.flat)
+    e_ref = _e_ref(scene, values, len(sample.flat))
     ref, ref_secs, anomalies = run_reference(
         scene, sample.flat, (lambda i, n: progress("reference", i, n)) if progress else None)
     results = []
@@ -506,13 +567,16 @@ def accuracy_study(scene: Scene, n_points: int | None = 200,
         numerics = dataclasses.replace(scene.numerics, accuracy=s.name,
                                        steps_per_period=s.steps_per_period,
                                        event_tol=s.event_tol,
-                                       root=s.root or scene.numerics.root)
+                                       root=s.root or scene.numerics.root,
+                                       rotation_step=s.rotation_step)
         outs, secs, batch = run_kernel(scene, sample.flat, numerics, repeat)
+        outs_e = run_energy(scene, sample.flat, numerics)
         agree = outs[:, L.OUT_OUTCOME] == ref[:, L.OUT_OUTCOME]
         share, se = _agreement(agree, sample)
         flagged = int(np.sum((outs[:, L.OUT_STATUS].astype(np.int64) & L.STATUS_FLAGGED) != 0))
         results.append(SettingResult(
-            s, outs, secs, batch, point_errors(outs, ref, cr.alpha_ref), share, se,
+            s, outs, secs, batch, point_errors(outs, ref, cr.alpha_ref, outs_e, e_ref), share,
+            se,
             flip_matrix(outs[:, L.OUT_OUTCOME], ref[:, L.OUT_OUTCOME]), flagged))
         if progress:
             progress("kernel", j + 1, len(settings))
@@ -568,6 +632,18 @@ def format_table(study: Study) -> str:
             f"{d['median_us']:>8.1f} {d['mean_us']:>8.1f} {d['total_s']:>7.3g} "
             f"{d['evals_per_point']:>7.0f} {agree:>13} {d['flips']:>5} "
             f"{cells[0]:>17} {cells[1]:>17} {cells[2]:>17} {imp:>9}")
+    lines.append("  tails of the errors against the reference, median / 95th percentile / max "
+                 "over the sampled points where each applies (impacts: mean / p95 / max; "
+                 "theta_rel: |d theta_max| / theta_max, safe and uplifted; energy: the "
+                 "kernel's own balance / E_ref)")
+    tail_m = ("t_overturn", "theta_max", "theta_rel", "t_first_impact", "impacts", "energy")
+    head = f"{'setting':>{w}} " + " ".join(f"{m:>26}" for m in tail_m)
+    lines.append(head)
+    lines.append("-" * len(head))
+    for d in study.table():
+        cells = [f"{_e(d['err_' + m])}/{_e(d['p95_err_' + m])}/{_e(d['max_err_' + m])}"
+                 for m in tail_m]
+        lines.append(f"{d['setting']:>{w}} " + " ".join(f"{c:>26}" for c in cells))
     for m, orders in study.orders.items():
         if orders:
             txt = ", ".join(f"{a}->{b}: {p:.2f}" for a, b, p in orders)

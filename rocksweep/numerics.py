@@ -28,10 +28,33 @@ ROOTS = ("bisection", "illinois", "hermite")
 # agrees on every sampled point, with errors ~1e-5 (p*t, theta/alpha_cg). event_tol 1e-5
 # and above keep chattering above the rest rate (runs hit the event cap). The presets were
 # chosen with bisection; the Hermite finder gives the same outcomes at half the time.
+#
+# `accurate` (issue 15) is fit for every stored quantity far outside the paper's region:
+# on a held-out wide-space sample (scripts/wide_space.py --seed 2) the 95th percentile of
+# the overturning-time error is below 0.05 p*t and of the safe runs' max|theta| relative
+# error below 1%; `default` keeps 5 steps per period (the paper's figures may not get more
+# than ~10% slower) and meets neither there.
 PRESETS: dict[str, tuple[int, float]] = {
     "draft": (4, 1e-6),
     "default": (5, 1e-6),
     "fine": (20, 1e-8),
+    "accurate": (8, 1e-8),
+}
+
+# name -> rotation_step: the largest rotation one rocking step may make, as a fraction of
+# alpha_cg (the kernel's PAR_ROT_STEP = rotation_step * alpha_ref; 0: no such limit). The
+# spring, pulse and rocking time scales above set the step in the paper's region; far
+# outside it (a pulse 20x the uplift threshold, a fall to overturning, a rigid body) the body
+# turns through alpha_cg or more in one step, and the overturning time and max|theta| lose
+# their digits (issue 15; measured with scripts/wide_space.py, see the README).
+# A quarter of alpha_cg costs the four figures 3.5% more RK4 evaluations at `default` (0.1:
+# 15%) and halves the overturning-time tail of the wide-space sample; `accurate` and `fine`
+# take 0.1 (0.05 buys little more).
+PRESET_ROTATION: dict[str, float] = {
+    "draft": 0.25,
+    "default": 0.25,
+    "fine": 0.1,
+    "accurate": 0.1,
 }
 
 # Smallest event_tol [p*t] a scene may ask for. An event's time is t0 + tau in float64; at
@@ -66,6 +89,9 @@ class Numerics:
     max_events: cap on impacts + uplifts per run (reported as a status flag).
     max_steps_factor: cap on RK4 evaluations per run, as a multiple of horizon/step.
     root: event root finder, one of ROOTS (see ``rocksweep.kernel.events._locate``).
+    rotation_step: largest rotation of one rocking step, a fraction of alpha_cg (0: none);
+        the step is shortened to it from theta' and the last step's theta'' and a step that
+        turned more than twice as far is taken again (``rocksweep.kernel.loop``).
     """
 
     accuracy: str = "default"
@@ -76,19 +102,23 @@ class Numerics:
     max_events: int = 5000
     max_steps_factor: float = 20.0
     root: str = "hermite"
+    rotation_step: float = PRESET_ROTATION["default"]
 
     @classmethod
     def preset(cls, accuracy: str = "default", **overrides) -> Numerics:
         spp, tol = PRESETS[accuracy]
-        return replace(cls(accuracy=accuracy, steps_per_period=spp, event_tol=tol), **overrides)
+        return replace(cls(accuracy=accuracy, steps_per_period=spp, event_tol=tol,
+                           rotation_step=PRESET_ROTATION[accuracy]), **overrides)
 
     def describe(self) -> str:
         label = self.accuracy
         base = PRESETS.get(self.accuracy)
-        if base is None or base != (self.steps_per_period, self.event_tol):
+        if base is None or base != (self.steps_per_period, self.event_tol) or (
+                PRESET_ROTATION[self.accuracy] != self.rotation_step):
             label = "custom"
         return (f"{label} (steps_per_period={self.steps_per_period}, "
-                f"event_tol={self.event_tol:g}, horizon={self.horizon:g}, root={self.root})")
+                f"event_tol={self.event_tol:g}, rotation_step={self.rotation_step:g}, "
+                f"horizon={self.horizon:g}, root={self.root})")
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -102,7 +132,9 @@ def step_size(omega_rock: np.ndarray | float, omega: np.ndarray | float,
     the stiffest the kernel meets; inf for a rigid body), the pulse period 2 pi/omega,
     the rocking period scale 2 pi/p (= 2 pi) and the pulse's own rocking time scale
     2 pi/omega_amp (``amplitude_frequency``; 0 leaves it out). A stiff spring or a pulse
-    far above the uplift threshold thus gets a smaller step.
+    far above the uplift threshold thus gets a smaller step. While the body rocks, the
+    kernel shortens it further so that one step turns the body by at most
+    ``Numerics.rotation_step`` x alpha_cg (PAR_ROT_STEP, ``rocksweep.kernel.loop``).
     """
     two_pi = 2 * math.pi
     with np.errstate(divide="ignore"):

@@ -28,14 +28,16 @@ STATUS_WORDS = {
 }
 
 STATUS_MEANING = {
-    "rest": "rest proven after the pulse (early exit)",
+    "rest": "rest proven after the pulse (early exit); never after the rest-rate rule "
+            "ended a chattering sequence (then: settled)",
     "horizon": "horizon reached before the outcome was decided (flagged)",
     "step_cap": "RK4 step cap reached (flagged)",
     "event_cap": "impact/uplift cap reached (flagged)",
     "nonfinite": "state became NaN or infinite (flagged)",
     "history_full": "history buffer full; later steps not recorded",
     "energy_gain": "at least one impact gained energy",
-    "settled": "a chattering sequence ended in full contact (rest-rate rule)",
+    "settled": "a chattering sequence ended in full contact by the rest-rate rule (not a "
+               "proof: the run ends without 'rest')",
     "overturned": "the body reached |theta| = pi/2",
     "e_above_1": "at least one impact had e > 1",
     "bounded": "rigid body below its overturning energy after the pulse, |e| <= 1: "

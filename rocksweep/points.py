@@ -233,6 +233,7 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     rows[:, L.PAR_RESTRATE] = numerics.rest_rate * alpha_ref  # p = 1
     rows[:, L.PAR_ROOT] = _ROOT_CODE[numerics.root]
     rows[:, L.PAR_MU] = mu
+    rows[:, L.PAR_ROT_STEP] = numerics.rotation_step * alpha_ref
 
 
 def with_record(rows: np.ndarray, record: GroundRecord | None) -> np.ndarray:

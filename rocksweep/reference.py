@@ -432,7 +432,8 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
     while True:
         on = t < pb.t_pulse
         if s == 0 and not on and pb.rest_margin((y[2], y[3])) < 0.0:
-            status |= L.STATUS_REST
+            if not status & L.STATUS_SETTLED:  # "rest" only where no rest-rate rule acted
+                status |= L.STATUS_REST
             break
         if t >= t_end:
             status |= L.STATUS_HORIZON
@@ -475,7 +476,8 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
                 t = pb.t_pulse  # exactly, so that the pulse is off from here on
             continue
         if kind == _REST:
-            status |= L.STATUS_REST
+            if not status & L.STATUS_SETTLED:
+                status |= L.STATUS_REST
             break
         if kind == _OVERTURN:
             outcome = L.OUTCOME_MODE1 if impacts > 0 else L.OUTCOME_MODE2

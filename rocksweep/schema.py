@@ -105,6 +105,8 @@ KEYS: dict[str, Key] = {
                                required=False),
     "numerics.root": Key("choice", f"must be one of {', '.join(ROOTS)}", choices=ROOTS,
                          required=False),
+    "numerics.rotation_step": Key("number", "must be in [0, 10] (x alpha_cg per rocking step; "
+                                  "0: no limit)", 0.0, 10.0, required=False),
     "outputs.energy": Key("bool", "must be true or false (store energy metrics)",
                           required=False, default=False),
     # where the model holds (rocksweep.kernel.contact); body.mu turns it on

@@ -29,7 +29,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from rocksweep.numerics import ROOTS, Numerics
+from rocksweep.numerics import PRESET_ROTATION, PRESETS, ROOTS, Numerics
 
 TARGET = 0.995
 
@@ -56,6 +56,26 @@ def read(path: Path) -> dict:
                 "rows": rows, "same": same}
 
 
+TAILS = (("t_overturn", "t_overturn [p*t]"), ("theta_rel", "max|theta| rel."),
+         ("theta_max", "max|theta| [alpha_cg]"), ("t_first_impact", "t_1st_impact [p*t]"),
+         ("impacts", "impacts"), ("energy", "energy balance [E_ref]"))
+
+
+def _tails(reports: list[dict], short: list[str]) -> None:
+    """Per preset and scene: 95th percentile (max) of every error on the sampled points."""
+    print("Tails: 95th percentile (max) of each error over the sampled points")
+    print("| preset | scene | " + " | ".join(lab for _, lab in TAILS) + " |")
+    print("|" + "---|" * (2 + len(TAILS)))
+    for name in PRESETS:
+        for r, sc in zip(reports, short, strict=True):
+            d = r["rows"].get(name, r["rows"].get(f"{name}-{Numerics().root}"))
+            if d is None or f"p95_err_{TAILS[0][0]}" not in d:
+                continue
+            cells = [f"{d[f'p95_err_{m}']:.1e} ({d[f'max_err_{m}']:.1e})" for m, _ in TAILS]
+            print(f"| {name} | {sc} | " + " | ".join(cells) + " |")
+    print()
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("reports", nargs="+", type=Path)
@@ -67,11 +87,11 @@ def main() -> None:
     for r in reports:
         print(f"    {r['command']}   # {r['n']} of {r['size']} points")
     print()
-    head = "| preset | steps/period, event_tol | " + " | ".join(
+    head = "| preset | steps/period, event_tol, rotation_step | " + " | ".join(
         f"{s}: us/pt, agreement" for s in short) + " |"
     print(head)
     print("|" + "---|" * (2 + len(reports)))
-    for name in ("draft", "default", "fine"):
+    for name in PRESETS:
         cells = []
         for r in reports:
             # a candidates report names the presets, a roots report "<preset>-<root>"
@@ -80,16 +100,19 @@ def main() -> None:
                          f"{d['mean_us']:.0f}, {100 * d['agreement']:.2f}% "
                          f"(+-{100 * d['agreement_se']:.2f})")
         d0 = reports[0]["rows"].get(name, reports[0]["rows"].get(f"{name}-{Numerics().root}"))
-        print(f"| {name} | {int(d0['steps_per_period'])}, {d0['event_tol']:.0e} | "
-              + " | ".join(cells) + " |")
+        if d0 is None:
+            continue
+        print(f"| {name} | {int(d0['steps_per_period'])}, {d0['event_tol']:.0e}, "
+              f"{PRESET_ROTATION[name]:g} | " + " | ".join(cells) + " |")
     print()
+    _tails(reports, short)
 
     if all(f"default-{root}" in r["rows"] for r in reports for root in ROOTS):
         print("Event root finders (--ladder roots): us/pt (RK4 evaluations per point), "
               "agreement; the same outcomes as bisection on how many sampled points")
         print("| preset | root | " + " | ".join(short) + " |")
         print("|" + "---|" * (2 + len(reports)))
-        for name in ("draft", "default", "fine"):
+        for name in PRESETS:
             for root in ROOTS:
                 cells = []
                 for r in reports:

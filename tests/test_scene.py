@@ -117,7 +117,7 @@ STRUCTURE_CASES = [
      "alpha_A, mA_over_m, IA_ratio, mu)"),
     (GOOD + "numerics: {tol: 1}\n",
      "numerics.tol: unknown key (allowed: accuracy, steps_per_period, event_tol, horizon, "
-     "rest_rate, max_events, root)"),
+     "rest_rate, max_events, root, rotation_step)"),
     (GOOD + "foo: 1\n",
      "foo: unknown key (allowed: name, body, impact, pulse, numerics, outputs, ground)"),
     (sub(", A_ratio: 5.0", ""),

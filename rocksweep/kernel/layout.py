@@ -43,7 +43,8 @@ PAR_NU = 30  # Mavroeidis-Papageorgiou pulse: phase nu [rad]
 PAR_AMP_NORM = 31  # Mavroeidis-Papageorgiou pulse: 1/r_max, so that A is its peak |xg''|
 PAR_REC_DT = 32  # record: sample interval in kernel time, p * DT [s] (0: not a record)
 PAR_REC_H = 33  # record: RK4 step while it acts, PAR_REC_DT / m (m >= 1 an integer) [s]
-N_PAR = 34
+PAR_ROT_STEP = 34  # largest rotation of one rocking step [rad] (0: no such limit)
+N_PAR = 35
 # A record's row is longer: its samples xg''/PGA (float64[npts], in [-1, 1]) follow the
 # N_PAR parameters, PAR_REC = N_PAR the first (``points.with_record``).
 PAR_REC = N_PAR
@@ -111,14 +112,15 @@ OUTCOME_SAFE = 0
 OUTCOME_MODE1 = 1  # overturned after one or more impacts
 OUTCOME_MODE2 = 2  # overturned without impact
 
-STATUS_REST = 1  # rest proven after the pulse (early exit)
+STATUS_REST = 1  # rest proven after the pulse (early exit); never with STATUS_SETTLED
 STATUS_HORIZON = 2  # horizon reached before the outcome was decided
 STATUS_STEP_CAP = 4
 STATUS_EVENT_CAP = 8
 STATUS_NONFINITE = 16
 STATUS_HIST_FULL = 32  # history buffer full; integration went on unrecorded
 STATUS_ENERGY_GAIN = 64  # at least one impact gained energy (energy variants)
-STATUS_SETTLED = 128  # chattering ended in full contact through the rest-rate rule
+STATUS_SETTLED = 128  # chattering ended in full contact through the rest-rate rule (no
+#                        proof of rest: a run that then ends early is not flagged REST)
 STATUS_OVERTURNED = 256
 STATUS_E_ABOVE_1 = 512  # at least one impact had e > 1
 STATUS_BOUNDED = 1024  # rigid body after the pulse below its overturning energy, |e| <= 1:

@@ -87,6 +87,7 @@ from rocksweep.kernel.layout import (
     PAR_MAXSTEPS,
     PAR_MU,
     PAR_REC_H,
+    PAR_ROT_STEP,
     PAR_TEND,
     PAR_THETA0,
     PAR_THETA_DOT0,
@@ -179,13 +180,21 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     out[OUT_IMPULSE_MAX] = 0.0 if CONTACT else np.nan
     if CONTACT:
         ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED)
+    # The rotation limit (PAR_ROT_STEP, 0: off): a rocking step may turn the body by at most
+    # rot, predicted from theta' and the last step's |theta''| (acc), and checked after
+    # the step: a huge slow pulse or a fall is not crossed in a handful of steps.
+    rot = prm[PAR_ROT_STEP]
+    acc = 0.0
 
     while True:
         on = _acting(t, t_pulse, GROUND)
         # why the run ends before this step, if it does (a STATUS_* bit); written out here,
         # not in a helper: a helper taking the arrays costs ~15% at every step
         if s == 0 and not on and rest_proven(y, prm, FLEX):
-            _flag(out, STATUS_REST)
+            # rest is proven from this state; if the rest-rate rule made it (a chattering
+            # sequence cut short: STATUS_SETTLED), the run ends but says so, not "rest"
+            if not int(out[OUT_STATUS]) & STATUS_SETTLED:
+                _flag(out, STATUS_REST)
             break
         if t >= t_end:
             _flag(out, STATUS_HORIZON)
@@ -205,8 +214,23 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             _flag(out, STATUS_EVENT_CAP)
             break
         h, lands = _step_length(t, on, dt, t_pulse, t_end, h_rec)
+        if s != 0 and rot > 0.0:
+            h_rot = _rotation_step(y[Y_THETA_DOT], acc, rot)
+            if h_rot < h:
+                h, lands = h_rot, False
         y1 = rk4_step(t, y, h, s, on, prm, FLEX, DAMPED, ENERGY)
         steps += 1
+        if s != 0 and rot > 0.0:
+            # theta'' was not known before the step (after an uplift, or a pulse's rise):
+            # a step that turned the body by more than twice the limit is taken again,
+            # shorter (the turn grows like h to h^2); NaN ends the loop (caught below)
+            turn = abs(y1[Y_THETA] - y[Y_THETA])
+            while turn > 2.0 * rot:
+                h, lands = h * max(0.25, 0.9 * math.sqrt(rot / turn)), False
+                y1 = rk4_step(t, y, h, s, on, prm, FLEX, DAMPED, ENERGY)
+                steps += 1
+                turn = abs(y1[Y_THETA] - y[Y_THETA])
+            acc = abs(y1[Y_THETA_DOT] - y[Y_THETA_DOT]) / h
         if not _finite(y1):
             _flag(out, STATUS_NONFINITE)
             break
@@ -309,6 +333,15 @@ def _step_length(t, on, dt, t_pulse, t_end, h_rec):
     if t + dt > t_end:
         return t_end - t, False
     return dt, False
+
+
+@njit(cache=True, inline="always")
+def _rotation_step(theta_dot, acc, rot):
+    """Longest step [s] whose predicted rotation |theta'| h + acc h^2 / 2 is rot [rad]
+    (theta' [rad/s], acc: |theta''| [rad/s^2] estimated over the last step)."""
+    w = abs(theta_dot)
+    den = w + math.sqrt(w * w + 2.0 * acc * rot)
+    return 2.0 * rot / den if den > 0.0 else math.inf
 
 
 @njit(cache=True, inline="always")

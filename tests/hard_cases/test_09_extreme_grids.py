@@ -7,7 +7,7 @@ import pytest
 from hardkit import BASE, assert_sane, kernel_events, reference_events, run
 from hardkit import table3_body as body
 
-from rocksweep.kernel.layout import PAR_DT, PAR_TPULSE
+from rocksweep.kernel.layout import PAR_DT, PAR_ROT_STEP, PAR_TPULSE
 from rocksweep.model import G
 from rocksweep.points import Point, point_row
 
@@ -33,8 +33,12 @@ def test_very_long_pulse_finishes_in_bounded_work(name, shape, a_ratio):
     row = point_row(p, BASE)
     assert row[PAR_TPULSE] == pytest.approx(200 * math.pi)
     s = r.summary()
-    # one regular step per dt of simulated time, plus one cut short per event at most
-    assert s["steps"] <= r.t_end / row[PAR_DT] + 2 + r.impacts + r.uplifts
+    # one regular step per dt of simulated time, plus one cut short per event at most, plus
+    # the rotation limit's (PAR_ROT_STEP) shorter steps: about one per rot of turning, the
+    # fall's pi/2 counted twice
+    rot = row[PAR_ROT_STEP]
+    extra = 2 * (math.pi / 2) / rot if rot > 0 else 0.0
+    assert s["steps"] <= r.t_end / row[PAR_DT] + 2 + r.impacts + r.uplifts + extra
     assert s["event_steps"] <= 100 * (r.impacts + r.uplifts + 1)
     res = reference_events(p)[0]
     assert r.outcome == OUTCOME[res["outcome"]]
