@@ -475,9 +475,9 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
     KeyboardInterrupt (``SweepInterrupted``) after saving the finished points to
     ``output``.
     """
-    opts = adaptive_options(adaptive, coarse=coarse, audit=audit, axes=axes,
-                            **adaptive_settings)
     sc, source = load(scene, overrides)
+    opts = adaptive_options(adaptive, base=sc.refine, coarse=coarse, audit=audit, axes=axes,
+                            **adaptive_settings)
     ov = override_strings(overrides)
     log = _stderr if progress else None
     if output is None:
@@ -496,12 +496,18 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
     return open(output)
 
 
-def adaptive_options(adaptive: bool, **settings: Any) -> Options | None:
+def adaptive_options(adaptive: bool, base: dict | None = None,
+                     **settings: Any) -> Options | None:
     """``rocksweep.adaptive.Options`` from keyword settings (None values: the defaults);
-    None when not ``adaptive``, then any setting given is an ApiError."""
+    None when not ``adaptive``, then any setting given is an ApiError. base: a scene's
+    ``refine`` section (``Scene.refine``): it turns adaptive on, and the keyword settings
+    override its values."""
     from rocksweep.adaptive import Options
 
     given = {k: v for k, v in settings.items() if v is not None}
+    if base is not None:
+        adaptive = True
+        given = {**base, **given}
     known = {"coarse", "audit", "axes", "margin", "final_margin", "seed", "threshold"}
     unknown = sorted(set(given) - known)
     if unknown:

@@ -171,6 +171,9 @@ class Scene:
     energy: bool
     text: str = field(repr=False)
     contact: bool = False  # outputs.contact (on when body.mu is given)
+    # the `refine` section (adaptive sweep settings, rocksweep.adaptive.Options keywords),
+    # None without one
+    refine: dict | None = None
     # a record scene (``ground`` section): the record read at load (else None); the grid's
     # frequency axis is then p [rad/s], not w_over_p
     record: GroundRecord | None = field(default=None, repr=False)
@@ -430,6 +433,29 @@ def _shapes(spec: Any) -> tuple[tuple[str, ...], bool]:
     return (spec,), False
 
 
+def _refine(raw: dict, kind: str) -> dict | None:
+    """The checked ``refine`` section as ``rocksweep.adaptive.Options`` keywords, or None."""
+    if raw.get("refine") is None:
+        return None
+    sec = _section(raw, "refine", kind, required=False)
+    out: dict[str, Any] = {}
+    for k, v in sec.items():
+        key = f"refine.{k}"
+        spec = KEYS[key]
+        if k == "axes":
+            if not (isinstance(v, list) and len(v) == 2
+                    and all(isinstance(a, str) for a in v) and v[0] != v[1]):
+                raise SceneError(f"{key} = {fmt(v)}: {spec.allowed}")
+            out[k] = (v[0].split(".")[-1], v[1].split(".")[-1])
+            continue
+        if spec.kind == "integer" and not (isinstance(v, int) and not isinstance(v, bool)):
+            raise SceneError(f"{key} = {fmt(v)}: {spec.allowed}")
+        if not is_number(v) or check_values(key, np.array([as_float(v)])) is not None:
+            raise SceneError(f"{key} = {fmt(v)}: {spec.allowed}")
+        out[k] = int(v) if spec.kind == "integer" else float(v)
+    return out
+
+
 def _numerics(sec: dict, contact: bool = False) -> tuple[Numerics, Numerics]:
     """The sweeps' and the single runs' numerics of a checked ``numerics`` section.
 
@@ -589,7 +615,7 @@ def _parse(text: str, overrides: list[str], base: Path | None = None) -> Scene:
     numerics, single = _numerics(numerics_sec, contact)
     scene = Scene(name=name or "rocksweep scene", kind=kind, axes=tuple(axes),
                   numerics=numerics, single_numerics=single, energy=energy, text=text,
-                  contact=contact, record=record)
+                  contact=contact, record=record, refine=_refine(raw, kind))
     if scene.contact and scene.ground:
         # the contact outputs are compiled into the sine/cosine variants only (a kernel
         # variant per combination costs compile time no scene has asked for yet)

@@ -115,6 +115,22 @@ KEYS: dict[str, Key] = {
     "outputs.contact": Key("bool", "must be true or false (store the friction demand, the "
                            "smallest normal force and the impulse ratio)", required=False,
                            default=False),
+    # adaptive sweeps (rocksweep.adaptive, as `rocksweep sweep --adaptive`): the section's
+    # presence turns them on; CLI flags override its values
+    "refine.axes": Key("string", "must be a list of the two diagram axes, swept ranges of "
+                       "the scene, e.g. [w_over_p, A_ratio]", required=False),
+    "refine.coarse": Key("integer", "must be an integer in [0, 20] (the coarse pass takes "
+                         "every 2^coarse-th point of both axes)", 0, 20, required=False),
+    "refine.audit": Key("number", "must be in [0, 1] (share of the filled points computed "
+                        "as a check)", 0.0, 1.0, required=False),
+    "refine.margin": Key("integer", "must be an integer in [0, 8] (cells refined around a "
+                         "mixed cell)", 0, 8, required=False),
+    "refine.final_margin": Key("integer", "must be an integer in [0, 8] (the same at the "
+                               "last level)", 0, 8, required=False),
+    "refine.seed": Key("integer", "must be an integer in [0, 2^31) (seed of the audit "
+                       "sample)", 0, 2**31 - 1, required=False),
+    "refine.threshold": Key("number", "must be in [0, 1] (share of disagreeing audits "
+                            "above which a run warns)", 0.0, 1.0, required=False),
     # pulse families (rocksweep.excitation): full cycles of a sine or cosine, the
     # Mavroeidis-Papageorgiou pulse's oscillation parameter and phase
     "pulse.cycles": Key("integer", f"must be an integer in [1, {CYCLES_MAX}] (full cycles "
@@ -139,7 +155,7 @@ BODY_KEYS: dict[str, tuple[str, ...]] = {
     "flexible": ("wn_over_p", "zeta", "alpha_cg", "alpha_A", "mA_over_m", "IA_ratio"),
     "block": ("alpha", "inertia"),
 }
-SECTIONS = ("body", "impact", "pulse", "numerics", "outputs", "ground")
+SECTIONS = ("body", "impact", "pulse", "numerics", "outputs", "ground", "refine")
 
 
 def section_keys(section: str, kind: str = "flexible") -> tuple[str, ...]:

@@ -119,7 +119,8 @@ STRUCTURE_CASES = [
      "numerics.tol: unknown key (allowed: accuracy, steps_per_period, event_tol, horizon, "
      "rest_rate, max_events, root, rotation_step)"),
     (GOOD + "foo: 1\n",
-     "foo: unknown key (allowed: name, body, impact, pulse, numerics, outputs, ground)"),
+     "foo: unknown key (allowed: name, body, impact, pulse, numerics, outputs, ground, "
+     "refine)"),
     (sub(", A_ratio: 5.0", ""),
      "pulse.A_ratio: missing required key (a number, a list of numbers or a range "
      "{start, stop, num})"),
@@ -132,7 +133,7 @@ STRUCTURE_CASES = [
      "outputs.energy = 'yes': must be true or false (store energy metrics)"),
     (GOOD + "name: 3\n", "name = 3: must be a string (the scene's title)"),
     ("[1, 2]", "a scene is a YAML mapping with sections body, impact, pulse, numerics, "
-     "outputs, ground (got [1, 2])"),
+     "outputs, ground, refine (got [1, 2])"),
 ]
 
 

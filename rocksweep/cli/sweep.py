@@ -106,11 +106,11 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     given = [k for k, v in settings.items() if v is not None]
     if validate:
         given.append("validate")
-    if given and not adaptive:
+    scene = load(scene_path, overrides)
+    if given and not (adaptive or scene.refine is not None):
         raise click.ClickException(f"--{given[0].replace('_', '-')} is a setting of "
                                    "adaptive sweeps; add --adaptive")
-    options = api.adaptive_options(adaptive, **settings)
-    scene = load(scene_path, overrides)
+    options = api.adaptive_options(adaptive, base=scene.refine, **settings)
     out = out_path if out_path is not None else Path(scene_path.stem + ".h5")
 
     def say(line: str) -> None:
