@@ -100,7 +100,9 @@ def test_two_cycles_are_one_cycle_after_another():
     out = np.empty(L.N_OUT)
     point_kernel(L.KIND_RIGID, False)(row, out, np.empty((200_000, L.N_HIST)))
     assert out[L.OUT_OUTCOME] != L.OUTCOME_SAFE
-    assert out[L.OUT_T_OVERTURN] + T == pytest.approx(two.t_overturn, abs=1e-6)
+    # 1e-5: `fine`'s error; the restarted run's steps differ after T (the rotation limit
+    # predicts each step from the last one's theta'', which a restart does not carry over)
+    assert out[L.OUT_T_OVERTURN] + T == pytest.approx(two.t_overturn, abs=1e-5)
 
 
 BODY = """
