@@ -321,7 +321,12 @@ def _run_on_cluster(grid: Grid, chunks: list[tuple[int, int]], level: int,
             for f in done:
                 a, b = running.pop(f)
                 try:
-                    res = f.result()
+                    # a result held by a worker that just left goes back to pending: never
+                    # wait for it without a limit (the no-worker timer above ends the wait)
+                    res = f.result(timeout=CLUSTER_POLL)
+                except TimeoutError:
+                    running[f] = (a, b)
+                    continue
                 except Exception as err:
                     if type(err).__name__ == "KilledWorker":
                         raise SweepError(
