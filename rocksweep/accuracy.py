@@ -49,7 +49,7 @@ from rocksweep.scene import Scene
 
 OUTCOMES = ("safe", "mode1", "mode2")  # codes 0, 1, 2
 # Per-point fields of the report: all the outcome-level kernel fills (no energies).
-REPORT_FIELDS = tuple(f for f in fields.FIELDS if not f.energy)
+REPORT_FIELDS = tuple(f for f in fields.RUN_FIELDS if not f.energy)
 MEASURES = ("theta_max", "t_first_impact", "t_overturn", "impacts", "theta_rel", "energy")
 MEASURE_LABELS = {
     "theta_max": "|d theta_max|/alpha_cg",

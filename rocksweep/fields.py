@@ -38,7 +38,9 @@ class Field:
     "alpha_ref" or "E_ref"; stored: kept in sweep files; energy: needs the
     energy-accounting kernel (sweeps with ``outputs: {energy: true}``, single runs);
     contact: needs the ground-reaction kernel (``outputs: {contact: true}``, stored and
-    reported only when asked).
+    reported only when asked); check: an error estimate from the point's rerun at half the
+    step (``outputs: {check: true}``, see ``check_rows``): "value" stores the rerun's
+    ``slot``, "diff" the rerun's value minus the run's.
     """
 
     name: str
@@ -51,6 +53,7 @@ class Field:
     stored: bool = True
     energy: bool = False
     contact: bool = False
+    check: str = ""
 
 
 _FLAGGED = "status & (horizon | step_cap | event_cap | nonfinite)"
@@ -105,22 +108,54 @@ FIELDS: tuple[Field, ...] = (
     Field("impulse_ratio_max", "float64", math.nan, "1",
           "largest |horizontal|/vertical ground impulse of an impact (0: no impact)",
           L.OUT_IMPULSE_MAX, contact=True),
+    # per-point error estimates (outputs.check): the same point rerun at half the step
+    Field("check_outcome", "int8", L.OUTCOME_NOT_RUN, "1",
+          "outcome of the point rerun at half the step (differs from outcome: not resolved "
+          "at this step)", L.OUT_OUTCOME, check="value"),
+    Field("check_t_overturn_diff", "float64", math.nan, "1/p",
+          "overturning time at half the step minus t_overturn (NaN unless both overturn): "
+          "an estimate of t_overturn's error", L.OUT_T_OVERTURN, check="diff"),
+    Field("check_theta_max_diff", "float64", math.nan, "alpha_ref",
+          "max |theta| at half the step minus theta_max, / alpha_ref: an estimate of "
+          "theta_max_over_alpha's error", L.OUT_THETA_MAX, "alpha_ref", check="diff"),
 )
 
 BY_NAME: dict[str, Field] = {f.name: f for f in FIELDS}
 UNITS: dict[str, str] = {f.name: f.unit for f in FIELDS}
 """name -> unit of every result field (the ``units`` attribute of a file's variable)."""
 
-SWEEP_FIELDS: tuple[Field, ...] = tuple(f for f in FIELDS
-                                        if f.stored and not f.energy and not f.contact)
+SWEEP_FIELDS: tuple[Field, ...] = tuple(
+    f for f in FIELDS if f.stored and not f.energy and not f.contact and not f.check)
 ENERGY_FIELDS: tuple[Field, ...] = tuple(f for f in FIELDS if f.stored and f.energy)
 CONTACT_FIELDS: tuple[Field, ...] = tuple(f for f in FIELDS if f.stored and f.contact)
+CHECK_FIELDS: tuple[Field, ...] = tuple(f for f in FIELDS if f.check)
+RUN_FIELDS: tuple[Field, ...] = tuple(f for f in FIELDS if not f.check)
+"""The fields of one run's own result row (single runs, the accuracy report)."""
 
 
-def sweep_fields(energy: bool, contact: bool = False) -> tuple[Field, ...]:
-    """The fields a sweep file stores (``energy``, ``contact``: the scene's
-    ``outputs.energy`` and ``outputs.contact``)."""
-    return SWEEP_FIELDS + (ENERGY_FIELDS if energy else ()) + (CONTACT_FIELDS if contact else ())
+def sweep_fields(energy: bool, contact: bool = False, check: bool = False
+                 ) -> tuple[Field, ...]:
+    """The fields a sweep file stores (``energy``, ``contact``, ``check``: the scene's
+    ``outputs.energy``, ``outputs.contact`` and ``outputs.check``)."""
+    return (SWEEP_FIELDS + (ENERGY_FIELDS if energy else ())
+            + (CONTACT_FIELDS if contact else ()) + (CHECK_FIELDS if check else ()))
+
+
+# Row slots a half-step rerun (outputs.check) changes, and by what factor: the RK4 step
+# (PAR_REC_H, the step while a record acts, stays a whole fraction of its sample interval),
+# the rotation limit of one rocking step, and the evaluation budget, which the halved step
+# doubles. Dividing by 2 is exact in float64, so the rerun is the run at twice the
+# steps_per_period and half the rotation_step, bit for bit.
+CHECK_SCALE: dict[int, float] = {L.PAR_DT: 0.5, L.PAR_REC_H: 0.5, L.PAR_ROT_STEP: 0.5,
+                                 L.PAR_MAXSTEPS: 2.0}
+
+
+def check_rows(rows: np.ndarray) -> np.ndarray:
+    """Parameter rows (float64[n, >= N_PAR]) of the half-step rerun of the same points."""
+    half = rows.copy()
+    for slot, factor in CHECK_SCALE.items():
+        half[:, slot] *= factor
+    return half
 
 
 def convert(outs: np.ndarray, alpha_ref: np.ndarray | float, E_ref: np.ndarray | float,
@@ -133,9 +168,24 @@ def convert(outs: np.ndarray, alpha_ref: np.ndarray | float, E_ref: np.ndarray |
     scales = {"": None, "alpha_ref": alpha_ref, "E_ref": E_ref}
     arrays = {}
     for f in fields:
+        if f.check:
+            continue
         col = outs[:, f.slot]
         s = scales[f.scale]
         arrays[f.name] = (col / s if s is not None else col).astype(f.dtype, copy=True)
+    return arrays
+
+
+def convert_check(outs: np.ndarray, half: np.ndarray, alpha_ref: np.ndarray | float
+                  ) -> dict[str, np.ndarray]:
+    """The error estimates ``CHECK_FIELDS`` from the result rows of the runs (outs) and of
+    their half-step reruns (half), both float64[n, N_OUT]; alpha_ref [rad]: float64[n] or a
+    scalar. Returns name -> array[n]."""
+    scales = {"": 1.0, "alpha_ref": alpha_ref}
+    arrays = {}
+    for f in CHECK_FIELDS:
+        col = half[:, f.slot] if f.check == "value" else half[:, f.slot] - outs[:, f.slot]
+        arrays[f.name] = (col / scales[f.scale]).astype(f.dtype, copy=True)
     return arrays
 
 

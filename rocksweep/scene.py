@@ -171,6 +171,7 @@ class Scene:
     energy: bool
     text: str = field(repr=False)
     contact: bool = False  # outputs.contact (on when body.mu is given)
+    check: bool = False  # outputs.check: per-point error estimates (a half-step rerun)
     # the `refine` section (adaptive sweep settings, rocksweep.adaptive.Options keywords),
     # None without one
     refine: dict | None = None
@@ -575,6 +576,9 @@ def _parse(text: str, overrides: list[str], base: Path | None = None) -> Scene:
                          "contact outputs; remove outputs.contact: false (body.mu turns "
                          "them on)")
     contact = bool(contact) or mu_spec is not None
+    check = outputs.get("check", KEYS["outputs.check"].default)
+    if not isinstance(check, bool):
+        raise SceneError(f"outputs.check = {fmt(check)}: {KEYS['outputs.check'].allowed}")
 
     # forms and lengths first: the grid's size is known before any value is built
     if record is None:
@@ -615,7 +619,7 @@ def _parse(text: str, overrides: list[str], base: Path | None = None) -> Scene:
     numerics, single = _numerics(numerics_sec, contact)
     scene = Scene(name=name or "rocksweep scene", kind=kind, axes=tuple(axes),
                   numerics=numerics, single_numerics=single, energy=energy, text=text,
-                  contact=contact, record=record, refine=_refine(raw, kind))
+                  contact=contact, check=check, record=record, refine=_refine(raw, kind))
     if scene.contact and scene.ground:
         # the contact outputs are compiled into the sine/cosine variants only (a kernel
         # variant per combination costs compile time no scene has asked for yet)

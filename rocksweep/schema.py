@@ -115,6 +115,9 @@ KEYS: dict[str, Key] = {
     "outputs.contact": Key("bool", "must be true or false (store the friction demand, the "
                            "smallest normal force and the impulse ratio)", required=False,
                            default=False),
+    "outputs.check": Key("bool", "must be true or false (rerun every point at half the step "
+                         "and store the differences: an error estimate per point)",
+                         required=False, default=False),
     # adaptive sweeps (rocksweep.adaptive, as `rocksweep sweep --adaptive`): the section's
     # presence turns them on; CLI flags override its values
     "refine.axes": Key("string", "must be a list of the two diagram axes, swept ranges of "

@@ -83,7 +83,7 @@ class Run:
         "event_steps" the re-integrations spent locating events.
         """
         energy = not math.isnan(self.out[L.OUT_W_IN])
-        d = {f.name: self.get(f.name) for f in fields.FIELDS
+        d = {f.name: self.get(f.name) for f in fields.RUN_FIELDS
              if (energy or not f.energy) and (self.contact or not f.contact)}
         d["outcome"] = self.outcome
         d["status"] = self.status

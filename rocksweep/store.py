@@ -224,6 +224,7 @@ def resolved_scene(scene: Scene, overrides: tuple[str, ...] | list[str] = (),
         "overrides": list(overrides),
         # only when asked: files without contact outputs keep their resolved scene
         **({"contact": True} if scene.contact else {}),
+        **({"check": True} if scene.check else {}),
         **({"record": record_attrs(scene.record)} if scene.record is not None else {}),
     }
     if adaptive is not None:
@@ -260,11 +261,15 @@ def _short(v) -> str:
 def scene_differences(stored: dict, new: dict) -> list[str]:
     """One phrase per difference between two ``resolved_scene`` dicts."""
     diffs = []
-    for section in ("name", "kind", "energy", "contact"):  # --set overrides show in the axes
-        if stored.get(section) != new.get(section):
-            key = f"outputs.{section}" if section in ("energy", "contact") else section
-            diffs.append(f"{key}: file {_short(stored.get(section))}, "
-                         f"scene {_short(new.get(section))}")
+    outputs = ("energy", "contact", "check")  # absent: false
+    for section in ("name", "kind", *outputs):  # --set overrides show in the axes
+        a, b = stored.get(section), new.get(section)
+        if section in outputs:
+            a, b = str(bool(a)).lower(), str(bool(b)).lower()
+        if a != b:
+            key = f"outputs.{section}" if section in outputs else section
+            diffs.append(f"{key}: file {a if section in outputs else _short(a)}, "
+                         f"scene {b if section in outputs else _short(b)}")
     for key in dict.fromkeys([*stored.get("axes", {}), *new.get("axes", {})]):
         a, b = stored.get("axes", {}).get(key), new.get("axes", {}).get(key)
         if a != b:
@@ -530,10 +535,11 @@ def _check_format(f: h5py.File, path: Path) -> None:
 def variables_for(stored: dict) -> dict:
     """The per-point variables of a file from its resolved scene (``computed`` in the
     files of adaptive sweeps)."""
-    from rocksweep.sweep import CONTACT_VARIABLES, ENERGY_VARIABLES, VARIABLES
+    from rocksweep.sweep import CHECK_VARIABLES, CONTACT_VARIABLES, ENERGY_VARIABLES, VARIABLES
 
     return {**VARIABLES, **(ENERGY_VARIABLES if stored.get("energy") else {}),
             **(CONTACT_VARIABLES if stored.get("contact") else {}),
+            **(CHECK_VARIABLES if stored.get("check") else {}),
             **({"computed": COMPUTED_VARIABLE} if stored.get("adaptive") else {})}
 
 

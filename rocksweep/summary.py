@@ -31,6 +31,12 @@ MAX_ROWS = 10
 # ``read_result(path, INFO_VARIABLES, optional=INFO_OPTIONAL)``).
 INFO_VARIABLES = ["outcome", "status", "steps", "event_steps"]
 INFO_OPTIONAL = ("computed",)
+# ... and, in files with per-point error estimates (outputs.check), these.
+CHECK_INFO_VARIABLES = ["theta_max_over_alpha", "check_outcome", "check_t_overturn_diff",
+                        "check_theta_max_diff"]
+# Relative max|theta| errors are taken where the run uplifted this far [alpha_ref] (below,
+# it barely leaves the ground and a relative error means little; scripts/wide_space.py).
+THETA_FLOOR = 1e-2
 
 
 def _plain(v):
@@ -159,12 +165,51 @@ def _json_value(v):
     return v
 
 
+def read_info(path) -> SweepResult:
+    """The variables of a result file that ``info_dict`` reports on."""
+    from rocksweep.store import read_result
+
+    result = read_result(path, INFO_VARIABLES, INFO_OPTIONAL)
+    if result.scene.get("check"):
+        result = read_result(path, INFO_VARIABLES + CHECK_INFO_VARIABLES, INFO_OPTIONAL)
+    return result
+
+
+def _tail(x: np.ndarray) -> dict:
+    """Median, 95th percentile and maximum of the finite values of x (None if none)."""
+    x = x[np.isfinite(x)]
+    if not x.size:
+        return {"n": 0, "median": None, "p95": None, "max": None}
+    return {"n": int(x.size), "median": float(np.median(x)),
+            "p95": float(np.percentile(x, 95)), "max": float(x.max())}
+
+
+def check_info(result: SweepResult) -> dict | None:
+    """The per-point error estimates of a result with ``outputs.check`` (None without):
+    points whose outcome changes at half the step, and the tails (median, 95th
+    percentile, max) of |t_overturn change| [p*t] where both runs overturn and of the
+    relative |max|theta| change| of safe runs (both safe, theta_max >= THETA_FLOOR)."""
+    if not result.scene.get("check") or "check_outcome" not in result.arrays:
+        return None
+    a = result.arrays
+    out, chk = np.asarray(a["outcome"]), np.asarray(a["check_outcome"])
+    run = out != L.OUTCOME_NOT_RUN
+    theta = np.asarray(a["theta_max_over_alpha"])
+    safe = run & (out == L.OUTCOME_SAFE) & (chk == L.OUTCOME_SAFE) & (theta >= THETA_FLOOR)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rel = np.abs(np.asarray(a["check_theta_max_diff"])[safe]) / theta[safe]
+    return {"points": int(run.sum()),
+            "outcome_changes": int((run & (chk != out)).sum()),
+            "t_overturn_diff": _tail(np.abs(np.asarray(a["check_t_overturn_diff"])[run])),
+            "theta_max_rel_diff": _tail(rel)}
+
+
 def info_dict(result: SweepResult) -> dict:
     """Everything ``rocksweep info`` reports, as plain JSON: dims (size, scene key,
     values), fixed keys, completeness, counts per shape and lam and per swept key,
     accuracy, RK4 step totals and provenance (versions, times, overrides, scene YAML).
 
-    result: ``store.read_result(path, INFO_VARIABLES)``.
+    result: ``read_info(path)``.
     """
     a = result.attrs
     done = result.done
@@ -197,6 +242,7 @@ def info_dict(result: SweepResult) -> dict:
             "overrides": json.loads(a.get("overrides", "[]")),
         },
         "adaptive": adaptive_info(result),
+        "check": check_info(result),
         "scene": a.get("scene"),
     }
 
@@ -218,6 +264,23 @@ def adaptive_info(result: SweepResult) -> dict | None:
             "filled": filled, "undecided": st.points - st.computed - filled,
             "audited": st.audited, "audit_misses": st.audit_misses,
             "warning": st.warning()}
+
+
+def format_check(ck: dict) -> list[str]:
+    """The lines of ``rocksweep info`` on a result's error estimates (``check_info``)."""
+    def tail(t: dict, unit: str) -> str:
+        if not t["n"]:
+            return "no such points"
+        return (f"median {t['median']:.2g}, 95% {t['p95']:.2g}, max {t['max']:.2g}{unit} "
+                f"({t['n']} points)")
+
+    n = max(1, ck["points"])
+    return [f"error estimates (each point rerun at half the step, outputs.check): "
+            f"outcome changes at {ck['outcome_changes']} of {ck['points']} points "
+            f"({100 * ck['outcome_changes'] / n:.2f}%)",
+            f"  |t_overturn change|: {tail(ck['t_overturn_diff'], ' p*t')}",
+            f"  |max|theta| change| / max|theta| of safe runs: "
+            f"{tail(ck['theta_max_rel_diff'], '')}"]
 
 
 def format_info(d: dict) -> list[str]:
@@ -247,6 +310,9 @@ def format_info(d: dict) -> list[str]:
                      "their fill" + (f" (warning: {ad['warning']})" if ad["warning"] else ""))
     lines.append("counts per pulse shape and lam:")
     lines += format_counts(in_ranges(d["counts"], "lam"), "  ")
+    ck = d.get("check")
+    if ck:
+        lines += format_check(ck)
     by_key = {k: rows for k, rows in d["counts_by_key"].items() if k not in ("shape", "lam")}
     if by_key:
         lines.append("counts per swept key (the other keys summed):")

@@ -29,7 +29,7 @@ import numpy as np
 
 from rocksweep import fields
 from rocksweep.errors import RocksweepError
-from rocksweep.grid import Grid
+from rocksweep.grid import ChunkRows, Grid
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.points import with_record
@@ -50,6 +50,9 @@ ENERGY_VARIABLES: dict[str, tuple[str, float, str]] = {
 # Stored when the scene asks for the ground reactions (outputs.contact: true).
 CONTACT_VARIABLES: dict[str, tuple[str, float, str]] = {
     f.name: (f.dtype, f.fill, f.meaning) for f in fields.CONTACT_FIELDS}
+# Stored when the scene asks for per-point error estimates (outputs.check: true).
+CHECK_VARIABLES: dict[str, tuple[str, float, str]] = {
+    f.name: (f.dtype, f.fill, f.meaning) for f in fields.CHECK_FIELDS}
 
 # Upper bound of the automatic chunk size [points]; see ``auto_chunk_size``.
 MAX_CHUNK = 1024
@@ -68,7 +71,8 @@ COMPILE_SECONDS = 20.0
 def variables(scene: Scene) -> dict[str, tuple[str, float, str]]:
     """The per-point variables a sweep of this scene stores."""
     return {**VARIABLES, **(ENERGY_VARIABLES if scene.energy else {}),
-            **(CONTACT_VARIABLES if scene.contact else {})}
+            **(CONTACT_VARIABLES if scene.contact else {}),
+            **(CHECK_VARIABLES if scene.check else {})}
 
 
 def level(scene: Scene) -> int:
@@ -95,31 +99,42 @@ class ChunkResult:
 
 
 def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
-    """Compute one chunk (what a worker runs): rows, one kernel call per kind, results."""
+    """Compute one chunk (what a worker runs): rows, one kernel call per kind, results.
+    With ``outputs.check`` every point runs a second time at half the step
+    (``fields.check_rows``) through the same kernel, and the chunk's result holds the
+    differences (``fields.CHECK_FIELDS``)."""
     t0, c0 = time.perf_counter(), time.thread_time()
+    # a Grid, or adaptive's view of one (``adaptive._Subset``: the grid as ``.grid``)
+    scene = grid.scene if hasattr(grid, "scene") else grid.grid.scene
     cr = grid.rows(start, stop)
-    outs = np.empty((stop - start, L.N_OUT))
-    record, ground = grid.scene.record, grid.scene.ground
-    for kind in np.unique(cr.kinds):
-        sel = cr.kinds == kind
-        kernel = chunk_kernel(int(kind), level, ground)
-        if record is not None:
-            _run_record(kernel, cr.rows, sel, outs, record)
-        elif sel.all():
-            kernel(cr.rows, outs)
-        else:
-            part = np.empty((int(sel.sum()), L.N_OUT))
-            kernel(np.ascontiguousarray(cr.rows[sel]), part)
-            outs[sel] = part
-    if level == L.LEVEL_CONTACT:
-        # a Grid, or adaptive's view of one (``adaptive._Subset``: the grid as ``.grid``)
-        scene = grid.scene if hasattr(grid, "scene") else grid.grid.scene
-        stored = fields.sweep_fields(scene.energy, True)
-    else:
-        stored = fields.sweep_fields(level == L.LEVEL_ENERGY)
+    outs = _run_rows(cr, cr.rows, level, scene)
+    contact = level == L.LEVEL_CONTACT  # the contact variants account energy either way
+    stored = fields.sweep_fields(scene.energy if contact else level == L.LEVEL_ENERGY,
+                                 contact, scene.check)
     arrays = fields.convert(outs, cr.alpha_ref, cr.E_ref, stored)
+    if scene.check:
+        half = _run_rows(cr, fields.check_rows(cr.rows), level, scene)
+        arrays.update(fields.convert_check(outs, half, cr.alpha_ref))
     return ChunkResult(start, stop, arrays, time.perf_counter() - t0,
                        time.thread_time() - c0)
+
+
+def _run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene) -> np.ndarray:
+    """Result rows float64[n, N_OUT] of the parameter rows ``rows`` (those of ``cr`` or
+    their half-step reruns): one kernel call per kind present."""
+    outs = np.empty((rows.shape[0], L.N_OUT))
+    for kind in np.unique(cr.kinds):
+        sel = cr.kinds == kind
+        kernel = chunk_kernel(int(kind), level, scene.ground)
+        if scene.record is not None:
+            _run_record(kernel, rows, sel, outs, scene.record)
+        elif sel.all():
+            kernel(rows, outs)
+        else:
+            part = np.empty((int(sel.sum()), L.N_OUT))
+            kernel(np.ascontiguousarray(rows[sel]), part)
+            outs[sel] = part
+    return outs
 
 
 # Points per kernel call of a record scene: each row carries the record's samples

@@ -23,6 +23,11 @@ the flagged runs are counted apart.
 
     python scripts/wide_space.py --n 400 --seed 1 --cache /tmp/wide     # tuning sample
     python scripts/wide_space.py --n 400 --seed 2 --cache /tmp/wide     # held out
+    python scripts/wide_space.py --n 400 --seed 2 --cache /tmp/wide --check --presets default
+
+``--check`` measures the per-point error estimate of ``outputs.check`` (the difference
+to a rerun at half the step) against the true errors: which points above the targets
+(0.05 p*t, 1%) it catches and how many it flags.
 
 Settings: the presets (``--presets draft,default,fine``) and any ``--setting
 NAME:KEY=VALUE,KEY=VALUE`` of Numerics fields (e.g. ``x:steps_per_period=8,event_tol=1e-7``).
@@ -38,6 +43,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rocksweep.fields import check_rows
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.model import FlexibleBody
@@ -103,10 +109,13 @@ def reference(points: list[Point], numerics: Numerics, cache: Path | None, tag: 
 
 
 def kernel(points: list[Point], numerics: Numerics, level: int = L.LEVEL_OUTCOME,
-           repeat: int = 3) -> tuple[np.ndarray, float]:
+           repeat: int = 3, half: bool = False) -> tuple[np.ndarray, float]:
     """Kernel result rows float64[n, N_OUT] and us per point (one call per body kind on
-    the whole sample, best of ``repeat``; compilation excluded)."""
+    the whole sample, best of ``repeat``; compilation excluded). half: the half-step
+    reruns of ``outputs.check`` (``fields.check_rows``) instead."""
     rows = np.stack([point_row(p, numerics) for p in points])
+    if half:
+        rows = check_rows(rows)
     kinds = np.array([kernel_kind(p.body) for p in points])
     outs = np.empty((len(points), L.N_OUT))
     best = math.inf
@@ -152,6 +161,40 @@ def errors(k: np.ndarray, r: np.ndarray, ke: np.ndarray, points: list[Point]
     }
 
 
+def check_report(k: np.ndarray, half: np.ndarray, r: np.ndarray, err: dict[str, np.ndarray],
+                 points: list[Point], t_target: float, th_target: float) -> str:
+    """How well the half-step difference (``outputs.check``) tells the points whose error
+    exceeds a target: per measure, of the points above the target (true error against the
+    reference) the share the estimate also puts above it (caught), and of the points the
+    estimate puts above it the share truly above half the target (not false alarms); for
+    the outcome, of the runs whose outcome differs from the reference, the share whose
+    outcome changes at half the step."""
+    alpha = np.array([p.body.alpha_ref for p in points])
+    est_t = np.abs(half[:, L.OUT_T_OVERTURN] - k[:, L.OUT_T_OVERTURN])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        est_th = np.abs(half[:, L.OUT_THETA_MAX] - k[:, L.OUT_THETA_MAX]) / k[:, L.OUT_THETA_MAX]
+    parts = []
+    for name, e, est, tgt in (("t_overturn", err["t_overturn"], est_t, t_target),
+                              ("theta_rel", err["theta_rel"], est_th, th_target)):
+        ok = np.isfinite(e) & np.isfinite(est)
+        bad, flagged = ok & (e > tgt), ok & (est > tgt)
+        caught = np.sum(bad & flagged)
+        real = np.sum(flagged & (e > tgt / 2))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ratio = np.median(est[bad] / e[bad]) if bad.any() else math.nan
+        parts.append(f"{name} > {tgt:g}: {int(bad.sum())} points, {int(caught)} caught, "
+                     f"{int(flagged.sum())} flagged ({int(real)} truly > {tgt / 2:g}), "
+                     f"median estimate/error {ratio:.2f}")
+    st = (k[:, L.OUT_STATUS].astype(np.int64) | r[:, L.OUT_STATUS].astype(np.int64))
+    ok = (st & L.STATUS_FLAGGED) == 0
+    wrong = ok & (k[:, L.OUT_OUTCOME] != r[:, L.OUT_OUTCOME])
+    changes = half[:, L.OUT_OUTCOME] != k[:, L.OUT_OUTCOME]
+    parts.append(f"outcome: {int(wrong.sum())} differ from the reference, "
+                 f"{int(np.sum(wrong & changes))} of them change at half the step; "
+                 f"{int(changes.sum())} change in all")
+    return "; ".join(parts)
+
+
 def tails(e: np.ndarray) -> tuple[int, float, float, float]:
     """(points, median, 95th percentile, max) of the finite entries."""
     e = e[np.isfinite(e)]
@@ -186,6 +229,11 @@ def main() -> None:
     ap.add_argument("--worst", type=int, default=0,
                     help="list the N worst points of each error at each setting")
     ap.add_argument("--markdown", action="store_true", help="also print a markdown table")
+    ap.add_argument("--check", action="store_true",
+                    help="also rerun each setting at half the step (outputs.check) and "
+                         "report how well the difference tells the points above the targets")
+    ap.add_argument("--targets", default="0.05,0.01",
+                    help="t_overturn [p*t] and theta_rel targets for --check")
     args = ap.parse_args()
 
     points = draw(args.n, args.seed)
@@ -223,6 +271,11 @@ def main() -> None:
         print(f"{name:>10} {us:7.1f} {100 * agree:6.2f}% {flag:>4} {bad_rest:>4} "
               + " ".join(f"{c:>27}" for c in cells), flush=True)
         md.append((name, num, us, agree, flag, err))
+        if args.check:
+            half, us_half = kernel(points, num, half=True)
+            t_tgt, th_tgt = (float(v) for v in args.targets.split(","))
+            print(f"      check (+{us_half:.1f} us/pt): "
+                  + check_report(outs, half, ref, err, points, t_tgt, th_tgt), flush=True)
         for m in ERRORS[: 5] if args.worst else ():
             e = np.where(np.isfinite(err[m]), err[m], -1)
             for i in np.argsort(e)[::-1][: args.worst]:

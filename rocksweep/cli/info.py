@@ -18,11 +18,11 @@ from rocksweep.cli.main import main, user_errors
 def info(result_path: Path, as_json: bool) -> None:
     """Dimensions, completeness, counts per class (per pulse shape and lam, and per swept
     key; long axes in ranges) and provenance of a sweep result; for an adaptive sweep,
-    the points computed, filled and audited (and the audit points that disagreed)."""
-    from rocksweep.store import read_result
-    from rocksweep.summary import INFO_OPTIONAL, INFO_VARIABLES, format_info, info_dict
+    the points computed, filled and audited (and the audit points that disagreed); with
+    per-point error estimates (sweep --check), their tails."""
+    from rocksweep.summary import format_info, info_dict, read_info
 
-    d = info_dict(read_result(result_path, INFO_VARIABLES, INFO_OPTIONAL))
+    d = info_dict(read_info(result_path))
     if as_json:
         click.echo(json.dumps(d, indent=2))
         return

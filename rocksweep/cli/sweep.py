@@ -68,13 +68,17 @@ WRITE_EVERY = 1.0  # = rocksweep.api.WRITE_EVERY (not imported here: --help stay
 @click.option("--contact", is_flag=True,
               help="Also store the friction demand mu_required, the smallest normal force "
                    "and the impulse ratio per point (as outputs.contact: true).")
+@click.option("--check", is_flag=True,
+              help="Rerun every point at half the step and store the differences of the "
+                   "outcome, overturning time and max |theta| (an error estimate per "
+                   "point; as outputs.check: true). Costs about 3x the time.")
 @user_errors
 def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, jobs: int,
           resume: bool, overwrite: bool, quiet: bool, backend: str, scheduler: str | None,
           chunk_size: int | None, write_every: float, adaptive: bool, coarse: int | None,
           audit: float | None, adaptive_axes: str | None, margin: int | None,
           final_margin: int | None, seed: int | None, threshold: float | None,
-          validate: bool, contact: bool) -> None:
+          validate: bool, contact: bool, check: bool) -> None:
     """Compute the stability diagram of SCENE.yaml: every point of its grid.
 
     Writes outcome (0 safe, 1 mode 1, 2 mode 2, -1 not computed), impacts, uplifts,
@@ -88,6 +92,8 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     """
     if contact:
         overrides = (*overrides, "outputs.contact=true")
+    if check:
+        overrides = (*overrides, "outputs.check=true")
     if resume and overwrite:
         raise click.ClickException("--resume and --overwrite exclude each other")
     if backend == "dask":
@@ -157,6 +163,11 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
         if v.differ.size:
             vals = report_cells(scene, v.differ[:5])
             click.echo("  e.g. " + "; ".join(vals))
+    if scene.check:
+        from rocksweep.summary import check_info, format_check, read_info
+
+        for line in format_check(check_info(read_info(out))):
+            click.echo(line)
     click.echo(f"accuracy: {scene.numerics.describe()}")
     click.echo(f"RK4 steps: {a['steps_total']} + {a['event_steps_total']} event "
                f"re-integrations (all points in the file)")
