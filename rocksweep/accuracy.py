@@ -120,6 +120,8 @@ LADDERS: dict[str, Callable[[], list[Setting]]] = {
                            + _steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-8, True,
                                     PRESET_ROTATION["default"])
                            + _presets()),
+    # the presets alone: their tails on a scene far from the paper's (configs/wide-space.yaml)
+    "presets": _presets,
     # every preset with every event root finder: what each costs, and whether the outcomes
     # stay the same
     "roots": _roots,
@@ -127,7 +129,7 @@ LADDERS: dict[str, Callable[[], list[Setting]]] = {
 
 
 def ladder(name: str) -> list[Setting]:
-    """The settings of a named ladder ("full" or "short")."""
+    """The settings of a named ladder (a key of ``LADDERS``)."""
     return LADDERS[name]()
 
 

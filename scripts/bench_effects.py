@@ -11,6 +11,10 @@ Grid: the Figure 4(a) pulse ranges (sine, omega/p in [0.15, 12], A/(g tan alpha_
   outcome-only    same body, outcome and summary metrics only (what sweeps run)
   zeta=0 general  Table 3 body with zeta = 0 through the damped kernel ...
   zeta=0 undamped ... and through the undamped kernel (same physics, no damper terms)
+  + check         outcome-only plus the half-step rerun of ``outputs: {check: true}``
+                  (per-point error estimates)
+  accurate        outcome-only at the `accurate` preset (the other way to trust the
+                  overturning times and max|theta| far from the paper's region)
   rigid           Table 3 geometry with wn/p = inf (top mass welded), outcome-only
   block           uniform rigid block, alpha = 0.15 (the same slenderness), outcome-only
 
@@ -31,6 +35,7 @@ import time
 
 import numpy as np
 
+from rocksweep.fields import check_rows
 from rocksweep.kernel import chunk_kernel, point_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.model import BlockBody, FlexibleBody
@@ -65,6 +70,18 @@ def run_chunk(kind: int, level: int):
     def run(rows: np.ndarray) -> np.ndarray:
         outs = np.empty((rows.shape[0], L.N_OUT))
         f(rows, outs)
+        return outs
+    return run
+
+
+def run_check(kind: int, level: int):
+    """A chunk of a sweep with ``outputs.check``: the rows, then their half-step reruns."""
+    f = chunk_kernel(kind, level)
+
+    def run(rows: np.ndarray) -> np.ndarray:
+        outs, half = np.empty((rows.shape[0], L.N_OUT)), np.empty((rows.shape[0], L.N_OUT))
+        f(rows, outs)
+        f(check_rows(rows), half)
         return outs
     return run
 
@@ -110,6 +127,10 @@ def main() -> None:
          L.KIND_FLEXIBLE, L.LEVEL_ENERGY),
         ("flexible 9.82, outcome-only", flex, run_chunk(L.KIND_FLEXIBLE, L.LEVEL_OUTCOME),
          L.KIND_FLEXIBLE, L.LEVEL_OUTCOME),
+        ("flexible 9.82, outcome-only + check", flex,
+         run_check(L.KIND_FLEXIBLE, L.LEVEL_OUTCOME), L.KIND_FLEXIBLE, L.LEVEL_OUTCOME),
+        ("flexible 9.82, outcome-only, accurate", flex,
+         run_chunk(L.KIND_FLEXIBLE, L.LEVEL_OUTCOME), L.KIND_FLEXIBLE, L.LEVEL_OUTCOME),
         ("zeta=0, general (damped) kernel", flex0,
          run_chunk(L.KIND_FLEXIBLE, L.LEVEL_OUTCOME), L.KIND_FLEXIBLE, L.LEVEL_OUTCOME),
         ("zeta=0, undamped kernel", flex0,
@@ -125,6 +146,8 @@ def main() -> None:
         warm_up(kind, level)
     print(f"compile/load: {time.perf_counter() - t0:.1f} s")
     rows = {label: grid_rows(body, args.n, numerics) for label, body, *_ in variants}
+    rows["flexible 9.82, outcome-only, accurate"] = grid_rows(flex, args.n,
+                                                              Numerics.preset("accurate"))
     w, a = grid_values(args.n)
     rows["simulate() loop, energy + history"] = np.array(
         [Point(flex, 0.0, "sine", float(wi), float(ai)) for wi, ai in zip(w, a, strict=True)],
@@ -163,7 +186,11 @@ def main() -> None:
           "(target >= 5)")
     print(f"outcome-only vs energy + history (flexible 9.82): {best[ref] / flex_o:.2f}x "
           "cheaper (target >= 1.5)")
+    print(f"price of the per-point error estimates (outputs.check): "
+          f"{best['flexible 9.82, outcome-only + check'] / flex_o:.2f}x outcome-only; of the "
+          f"accurate preset: {best['flexible 9.82, outcome-only, accurate'] / flex_o:.2f}x")
     same = [("flexible 9.82, energy", ref), ("flexible 9.82, outcome-only", ref),
+            ("flexible 9.82, outcome-only + check", "flexible 9.82, outcome-only"),
             ("zeta=0, undamped kernel", "zeta=0, general (damped) kernel")]
     for a, b in same:
         n_diff = int(np.sum(outs[a][:, L.OUT_OUTCOME] != outs[b][:, L.OUT_OUTCOME]))

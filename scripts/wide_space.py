@@ -162,14 +162,13 @@ def errors(k: np.ndarray, r: np.ndarray, ke: np.ndarray, points: list[Point]
 
 
 def check_report(k: np.ndarray, half: np.ndarray, r: np.ndarray, err: dict[str, np.ndarray],
-                 points: list[Point], t_target: float, th_target: float) -> str:
+                 t_target: float, th_target: float) -> str:
     """How well the half-step difference (``outputs.check``) tells the points whose error
     exceeds a target: per measure, of the points above the target (true error against the
     reference) the share the estimate also puts above it (caught), and of the points the
     estimate puts above it the share truly above half the target (not false alarms); for
     the outcome, of the runs whose outcome differs from the reference, the share whose
     outcome changes at half the step."""
-    alpha = np.array([p.body.alpha_ref for p in points])
     est_t = np.abs(half[:, L.OUT_T_OVERTURN] - k[:, L.OUT_T_OVERTURN])
     with np.errstate(invalid="ignore", divide="ignore"):
         est_th = np.abs(half[:, L.OUT_THETA_MAX] - k[:, L.OUT_THETA_MAX]) / k[:, L.OUT_THETA_MAX]
@@ -275,7 +274,7 @@ def main() -> None:
             half, us_half = kernel(points, num, half=True)
             t_tgt, th_tgt = (float(v) for v in args.targets.split(","))
             print(f"      check (+{us_half:.1f} us/pt): "
-                  + check_report(outs, half, ref, err, points, t_tgt, th_tgt), flush=True)
+                  + check_report(outs, half, ref, err, t_tgt, th_tgt), flush=True)
         for m in ERRORS[: 5] if args.worst else ():
             e = np.where(np.isfinite(err[m]), err[m], -1)
             for i in np.argsort(e)[::-1][: args.worst]:

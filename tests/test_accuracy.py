@@ -147,3 +147,13 @@ def test_roots_ladder_prices_every_root_finder_on_the_same_points(cli, tiny_scen
                 np.testing.assert_array_equal(
                     f[f"kernel/{names[by[preset, r]]}/outcome"][:],
                     f[f"kernel/{names[b]}/outcome"][:])
+
+
+def test_cli_ladder_choices_are_the_ladders():
+    """The command's --ladder choices (kept literal so --help loads no numerics) name
+    exactly the ladders the study knows."""
+    from rocksweep.accuracy import LADDERS
+    from rocksweep.cli.accuracy import accuracy as command
+
+    opt = next(p for p in command.params if p.name == "ladder_name")
+    assert list(opt.type.choices) == list(LADDERS)

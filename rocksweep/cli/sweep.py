@@ -71,7 +71,7 @@ WRITE_EVERY = 1.0  # = rocksweep.api.WRITE_EVERY (not imported here: --help stay
 @click.option("--check", is_flag=True,
               help="Rerun every point at half the step and store the differences of the "
                    "outcome, overturning time and max |theta| (an error estimate per "
-                   "point; as outputs.check: true). Costs about 3x the time.")
+                   "point; as outputs.check: true). Costs about 2.5x the time.")
 @user_errors
 def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, jobs: int,
           resume: bool, overwrite: bool, quiet: bool, backend: str, scheduler: str | None,
