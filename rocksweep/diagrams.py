@@ -69,6 +69,7 @@ DEFAULT_X, DEFAULT_Y = "w_over_p", "A_ratio"
 RECORD_X = "p"  # x of a record sweep (no w_over_p): the body's frequency parameter
 
 _SAFE, _MODE2, _NOT_RUN = "#ffffff", "#4c72b0", "#bdbdbd"
+_UNSURE = "#e69f00"  # rings: the outcome changes at half the step (outputs.check)
 # boundary lines of the k-th lam (``curves``): dark colours apart from the cells' fills
 CURVE_COLOURS = ("black", "#1b9e77", "#7570b3", "#e7298a", "#66a61e", "#a6761d")
 
@@ -316,12 +317,18 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
     contact = bool(result.scene.get("contact")) and "status" in result.arrays
     slides = ((status & L.STATUS_SLIDES) != 0) & result.done
     lifts = ((status & L.STATUS_LIFTS_OFF) != 0) & result.done
-    o, fl, cp, sl, lo = _arrays(result, order, ["outcome", flagged, comp, slides, lifts])
+    # per-point error estimates (outputs.check): the outcome changes at half the step
+    unsure = np.zeros(result.shape, bool)
+    if "check_outcome" in result.arrays:
+        unsure = (np.asarray(result.arrays["check_outcome"])
+                  != np.asarray(result.arrays["outcome"])) & result.done
+    o, fl, cp, sl, lo, un = _arrays(result, order,
+                                    ["outcome", flagged, comp, slides, lifts, unsure])
     if layered:
         lam = _coord(result, "lam")
     else:  # one layer: the fixed lam, or none when lam is on an axis
         o, fl, cp = o[..., None, :, :], fl[..., None, :, :], cp[..., None, :, :]
-        sl, lo = sl[..., None, :, :], lo[..., None, :, :]
+        sl, lo, un = sl[..., None, :, :], lo[..., None, :, :], un[..., None, :, :]
         lam = np.array([float(result.scalars["lam"])]) if "lam" in result.scalars else None
     panels = _panels(result, panel_dims)
 
@@ -334,7 +341,7 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
     fig, flat, own = _place_axes(axes, len(panels), _layout(result, panel_dims, len(panels)),
                                  (4.8, 4.2), "this stability diagram")
     used = np.zeros(3 + n_lam, bool)
-    any_flag = any_back = any_slide = any_lift = False
+    any_flag = any_back = any_slide = any_lift = any_unsure = False
     lam_sym = SYMBOLS["lam"]
     for ax, idx in zip(flat, panels, strict=False):
         po, pf = o[idx], fl[idx]  # [n_lam, n_y, n_x]
@@ -361,6 +368,11 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
             any_flag = True
             yy, xx = np.nonzero(f_any)
             ax.plot(xs[xx], ys[yy], "x", color="k", ms=3.5, mew=0.7)
+        u_any = un[idx].any(axis=0)
+        if u_any.any():
+            any_unsure = True
+            yy, xx = np.nonzero(u_any)
+            ax.plot(xs[xx], ys[yy], "o", mfc="none", mec=_UNSURE, ms=4, mew=0.8)
         if contact:  # hatched where the base would slide (at some lam), outlined: lift-off
             any_slide |= _hatch(ax, xs, ys, sl[idx].any(axis=0), "////", "k")
             any_lift |= _hatch(ax, xs, ys, lo[idx].any(axis=0), "....", "0.25")
@@ -402,6 +414,9 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
     if any_flag:
         handles.append(Line2D([], [], ls="", marker="x", color="k",
                               label="flagged (horizon/step/event cap, non-finite)"))
+    if any_unsure:
+        handles.append(Line2D([], [], ls="", marker="o", mfc="none", mec=_UNSURE,
+                              label="outcome changes at half the step"))
     if show_computed:
         handles.append(Patch(fc="black", alpha=0.35, ec="0.5",
                              label="computed (adaptive; clear: filled)"))

@@ -6,7 +6,8 @@
 Runs the shipped commands, exactly as the README shows them:
 
 - ``rocksweep sweep configs/NAME.yaml --jobs 2`` and ``rocksweep plot`` for the stability
-  diagrams fig3a, fig3b, fig4a, fig4b and block, at the configs' own resolution;
+  diagrams fig3a, fig3b, fig4a, fig4b and block, at the configs' own resolution, and
+  fig3a_check (Figure 3(a) with ``--check``: rings where the outcome changes at half the step);
 - ``rocksweep simulate configs/fig5.yaml --plot`` (Figure 5) and ``rocksweep restitution
   configs/fig2.yaml --plot`` (Figure 2);
 - with ``--accuracy``: ``rocksweep accuracy configs/fig3a.yaml --points 200 --plot``.
@@ -47,12 +48,12 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--jobs", type=int, default=2, help="sweep worker threads [2]")
     ap.add_argument("--dpi", type=int, default=200, help="resolution of the PNGs [200]")
     ap.add_argument("--only", nargs="+", metavar="NAME",
-                    choices=[*DIAGRAMS, "fig5", "fig2", "accuracy_fig3a"],
+                    choices=[*DIAGRAMS, "fig3a_check", "fig5", "fig2", "accuracy_fig3a"],
                     help="regenerate only these figures")
     ap.add_argument("--docs", type=Path, default=ROOT / "docs", help="output directory")
     ap.add_argument("--keep", type=Path, metavar="DIR", help="keep the sweep results here")
     args = ap.parse_args(argv)
-    wanted = set(args.only or [*DIAGRAMS, "fig5", "fig2"]
+    wanted = set(args.only or [*DIAGRAMS, "fig3a_check", "fig5", "fig2"]
                  + (["accuracy_fig3a"] if args.accuracy else []))
     args.docs.mkdir(parents=True, exist_ok=True)
     if args.keep:
@@ -80,6 +81,13 @@ def main(argv: list[str] | None = None) -> None:
             rocksweep("plot", str(h5), "-o", str(tmp / f"{name}.png"), "--dpi", str(args.dpi))
             publish(name)
             print(f"  {name}: {time.perf_counter() - t0:.1f} s", flush=True)
+        if "fig3a_check" in wanted:  # per-point error estimates: rings where unsure
+            h5 = (args.keep or tmp) / "fig3a_check.h5"
+            rocksweep("sweep", str(cfg / "fig3a.yaml"), "--check", "-o", str(h5), "--jobs",
+                      str(args.jobs), "--quiet", "--overwrite")
+            rocksweep("plot", str(h5), "-o", str(tmp / "fig3a_check.png"), "--dpi",
+                      str(args.dpi))
+            publish("fig3a_check")
         if "fig5" in wanted:
             rocksweep("simulate", str(cfg / "fig5.yaml"), "--plot", str(tmp / "fig5.png"))
             publish("fig5")

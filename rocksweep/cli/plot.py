@@ -41,7 +41,8 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
     shades of red. A sweep with one swept axis besides lam is drawn as max|theta|/alpha
     against it, markers by outcome. Cells an adaptive sweep filled are drawn as computed
     ones. With contact outputs and body.mu, the points that would slide are hatched (and
-    those that would lift off dotted); --mu draws mu_required."""
+    those that would lift off dotted); --mu draws mu_required. A sweep with --check rings
+    the points whose outcome changes at half the step."""
     from rocksweep.diagrams import friction_map, missing_warnings, sweep_figure
     from rocksweep.outputs import check_output
     from rocksweep.plots import FORMATS, save_figure
@@ -54,8 +55,10 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
         result = read_result(result_path, ["outcome", "status", "mu_required"])
         fig = friction_map(result, x_key, y_key, option_names=("--x", "--y"))
     else:
+        # check_outcome: files with per-point error estimates (sweep --check) ring the
+        # points whose outcome changes at half the step
         result = read_result(result_path, ["outcome", "status", "theta_max_over_alpha"],
-                             ("computed",) if show_computed else ())
+                             ("check_outcome", *(("computed",) if show_computed else ())))
         fig = sweep_figure(result, x_key, y_key, option_names=("--x", "--y"), curves=curves,
                            show_computed=show_computed)
     save_figure(fig, fig_out, dpi, overwrite=overwrite, inputs=[result_path])
