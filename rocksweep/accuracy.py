@@ -65,6 +65,9 @@ TAIL_LABELS = {
 # theta_rel is taken where the reference's theta_max is at least this x alpha_cg (below it
 # the body barely leaves the ground and a relative error says nothing)
 THETA_REL_FLOOR = 1e-2
+# Error bounds against which ``--check`` scores the per-point error estimates (issue 15's
+# targets for the 95th percentiles): overturning time [p*t] and relative max|theta|.
+CHECK_TARGETS = {"t_overturn": 0.05, "theta_rel": 0.01}
 
 
 @dataclass(frozen=True)
@@ -398,6 +401,76 @@ def run_energy(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray
     return outs
 
 
+def run_half(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray:
+    """The half-step reruns of ``outputs.check`` (``fields.check_rows``) on the given
+    points, outcome-only kernel, untimed: float64[n, N_OUT]."""
+    from rocksweep.grid import Grid
+    from rocksweep.points import with_record
+
+    cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
+    rows = with_record(fields.check_rows(cr.rows), scene.record)
+    outs = np.empty((len(flat), L.N_OUT))
+    for kind in np.unique(cr.kinds):
+        sel = np.flatnonzero(cr.kinds == kind)
+        part = np.empty((len(sel), L.N_OUT))
+        chunk_kernel(int(kind), L.LEVEL_OUTCOME, scene.ground)(
+            np.ascontiguousarray(rows[sel]), part)
+        outs[sel] = part
+    return outs
+
+
+def estimate_scores(k: np.ndarray, half: np.ndarray, r: np.ndarray,
+                    errors: dict[str, np.ndarray], targets: dict[str, float] = CHECK_TARGETS
+                    ) -> dict:
+    """How well the per-point error estimates of ``outputs.check`` (|half-step rerun -
+    run|) tell the points whose true error exceeds a target.
+
+    k, half, r: the run's, the rerun's and the reference's rows float64[n, N_OUT];
+    errors: ``point_errors(k, r, ...)``; targets: measure -> bound (t_overturn [p*t],
+    theta_rel). Per measure: above (points whose true error exceeds the bound), caught
+    (those whose estimate does too), flagged (points whose estimate exceeds it), real
+    (flagged points truly above half the bound), ratio (median estimate / error over the
+    points above). outcome: wrong (unflagged runs whose outcome differs from the
+    reference), wrong_changes (those whose outcome changes at half the step), changes (all
+    runs whose outcome changes at half the step).
+    """
+    est = {"t_overturn": np.abs(half[:, L.OUT_T_OVERTURN] - k[:, L.OUT_T_OVERTURN])}
+    with np.errstate(invalid="ignore", divide="ignore"):
+        est["theta_rel"] = (np.abs(half[:, L.OUT_THETA_MAX] - k[:, L.OUT_THETA_MAX])
+                            / k[:, L.OUT_THETA_MAX])
+    out: dict = {}
+    for m, bound in targets.items():
+        e, x = errors[m], est[m]
+        ok = np.isfinite(e) & np.isfinite(x)
+        above, flagged = ok & (e > bound), ok & (x > bound)
+        out[m] = {"bound": bound, "above": int(above.sum()),
+                  "caught": int((above & flagged).sum()), "flagged": int(flagged.sum()),
+                  "real": int((flagged & (e > bound / 2)).sum()),
+                  "ratio": float(np.median(x[above] / e[above])) if above.any() else math.nan}
+    st = k[:, L.OUT_STATUS].astype(np.int64) | r[:, L.OUT_STATUS].astype(np.int64)
+    wrong = ((st & L.STATUS_FLAGGED) == 0) & (k[:, L.OUT_OUTCOME] != r[:, L.OUT_OUTCOME])
+    changes = half[:, L.OUT_OUTCOME] != k[:, L.OUT_OUTCOME]
+    out["outcome"] = {"wrong": int(wrong.sum()), "wrong_changes": int((wrong & changes).sum()),
+                      "changes": int(changes.sum())}
+    return out
+
+
+def format_scores(scores: dict) -> str:
+    """``estimate_scores`` as one line."""
+    parts = []
+    for m, d in scores.items():
+        if m == "outcome":
+            parts.append(f"outcome: {d['wrong']} differ from the reference, "
+                         f"{d['wrong_changes']} of them change at half the step; "
+                         f"{d['changes']} change in all")
+            continue
+        ratio = "-" if not math.isfinite(d["ratio"]) else f"{d['ratio']:.2f}"
+        parts.append(f"{m} > {d['bound']:g}: {d['above']} points, {d['caught']} caught, "
+                     f"{d['flagged']} flagged ({d['real']} truly > {d['bound'] / 2:g}), "
+                     f"median estimate/error {ratio}")
+    return "; ".join(parts)
+
+
 @dataclass
 class SettingResult:
     """One setting's measurements on the sample (see ``accuracy_study``)."""
@@ -411,6 +484,9 @@ class SettingResult:
     agreement_se: float  # its standard error (stratified, finite population)
     flips: np.ndarray  # int64[3, 3]: [reference outcome, kernel outcome] counts
     flagged: int  # sampled points with a flagged status (horizon, caps, nonfinite)
+    # with ``check``: the half-step reruns' rows float64[n, N_OUT] and ``estimate_scores``
+    half: np.ndarray | None = None
+    check: dict | None = None
 
     @property
     def median_us(self) -> float:
@@ -543,11 +619,14 @@ def _e_ref(scene: Scene, values: dict[str, np.ndarray], n: int) -> np.ndarray:
 
 def accuracy_study(scene: Scene, n_points: int | None = 200,
                    settings: list[Setting] | None = None, seed: int = 0, repeat: int = 5,
-                   progress: Callable[[str, int, int], None] | None = None) -> Study:
+                   progress: Callable[[str, int, int], None] | None = None,
+                   check: bool = False) -> Study:
     """Measure time and error of each kernel setting against the reference on a sample.
 
     n_points: sample size (None: every point); settings: the ladder (default "full");
-    progress(stage, done, total) is called as the reference and the settings run.
+    progress(stage, done, total) is called as the reference and the settings run;
+    check: also rerun every setting at half the step and score the per-point error
+    estimates of ``outputs.check`` against the true errors (``estimate_scores``).
     """
     from rocksweep.grid import Grid
 
@@ -576,10 +655,12 @@ def accuracy_study(scene: Scene, n_points: int | None = 200,
         agree = outs[:, L.OUT_OUTCOME] == ref[:, L.OUT_OUTCOME]
         share, se = _agreement(agree, sample)
         flagged = int(np.sum((outs[:, L.OUT_STATUS].astype(np.int64) & L.STATUS_FLAGGED) != 0))
+        errors = point_errors(outs, ref, cr.alpha_ref, outs_e, e_ref)
+        half = run_half(scene, sample.flat, numerics) if check else None
         results.append(SettingResult(
-            s, outs, secs, batch, point_errors(outs, ref, cr.alpha_ref, outs_e, e_ref), share,
-            se,
-            flip_matrix(outs[:, L.OUT_OUTCOME], ref[:, L.OUT_OUTCOME]), flagged))
+            s, outs, secs, batch, errors, share, se,
+            flip_matrix(outs[:, L.OUT_OUTCOME], ref[:, L.OUT_OUTCOME]), flagged, half,
+            estimate_scores(outs, half, ref, errors) if check else None))
         if progress:
             progress("kernel", j + 1, len(settings))
     study = Study(scene, sample, cr.alpha_ref, values, ref, ref_secs, results,
@@ -646,6 +727,13 @@ def format_table(study: Study) -> str:
         cells = [f"{_e(d['err_' + m])}/{_e(d['p95_err_' + m])}/{_e(d['max_err_' + m])}"
                  for m in tail_m]
         lines.append(f"{d['setting']:>{w}} " + " ".join(f"{c:>26}" for c in cells))
+    checked = [r for r in study.results if r.check is not None]
+    if checked:
+        lines.append("  per-point error estimates (outputs.check: |half-step rerun - run|) "
+                     "against the true errors: points above each bound, caught by an "
+                     "estimate above it, flagged by the estimate")
+        for r in checked:
+            lines.append(f"{r.setting.name:>{w}} {format_scores(r.check)}")
     for m, orders in study.orders.items():
         if orders:
             txt = ", ".join(f"{a}->{b}: {p:.2f}" for a, b, p in orders)
@@ -682,7 +770,8 @@ def write_report(study: Study, path: str | Path, command: str = "") -> None:
     /kernel/<setting>: per point, every result field of the outcome-level kernel
     (``REPORT_FIELDS``: outcome, impacts, uplifts, theta_max_over_alpha, t_overturn,
     status, steps (regular RK4 steps), event_steps, t_end, t_first_impact, e_max,
-    returns_to_contact, each with ``units``) and seconds. In /reference, steps are
+    returns_to_contact, each with ``units``) and seconds (with ``check``, also the
+    ``fields.CHECK_FIELDS`` of the half-step reruns). In /reference, steps are
     DOP853's steps and event_steps 0 (``reference.result_row``).
     """
     import h5py
@@ -736,7 +825,12 @@ def write_report(study: Study, path: str | Path, command: str = "") -> None:
                 g.create_dataset("anomalies", data=study.reference_anomalies)
             k = f.create_group("kernel")
             for r in study.results:
-                _write_runs(k.create_group(r.setting.name), r.outs, r.seconds, study.alpha_ref)
+                g = k.create_group(r.setting.name)
+                _write_runs(g, r.outs, r.seconds, study.alpha_ref)
+                if r.half is not None:  # the per-point estimates, as a sweep stores them
+                    for name, arr in fields.convert_check(r.outs, r.half,
+                                                          study.alpha_ref).items():
+                        g.create_dataset(name, data=arr).attrs["units"] = fields.UNITS[name]
 
 
 def _write_runs(g, outs: np.ndarray, seconds: np.ndarray, alpha_ref: np.ndarray) -> None:

@@ -43,6 +43,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rocksweep.accuracy import estimate_scores, format_scores
 from rocksweep.fields import check_rows
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
@@ -161,39 +162,6 @@ def errors(k: np.ndarray, r: np.ndarray, ke: np.ndarray, points: list[Point]
     }
 
 
-def check_report(k: np.ndarray, half: np.ndarray, r: np.ndarray, err: dict[str, np.ndarray],
-                 t_target: float, th_target: float) -> str:
-    """How well the half-step difference (``outputs.check``) tells the points whose error
-    exceeds a target: per measure, of the points above the target (true error against the
-    reference) the share the estimate also puts above it (caught), and of the points the
-    estimate puts above it the share truly above half the target (not false alarms); for
-    the outcome, of the runs whose outcome differs from the reference, the share whose
-    outcome changes at half the step."""
-    est_t = np.abs(half[:, L.OUT_T_OVERTURN] - k[:, L.OUT_T_OVERTURN])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        est_th = np.abs(half[:, L.OUT_THETA_MAX] - k[:, L.OUT_THETA_MAX]) / k[:, L.OUT_THETA_MAX]
-    parts = []
-    for name, e, est, tgt in (("t_overturn", err["t_overturn"], est_t, t_target),
-                              ("theta_rel", err["theta_rel"], est_th, th_target)):
-        ok = np.isfinite(e) & np.isfinite(est)
-        bad, flagged = ok & (e > tgt), ok & (est > tgt)
-        caught = np.sum(bad & flagged)
-        real = np.sum(flagged & (e > tgt / 2))
-        with np.errstate(invalid="ignore", divide="ignore"):
-            ratio = np.median(est[bad] / e[bad]) if bad.any() else math.nan
-        parts.append(f"{name} > {tgt:g}: {int(bad.sum())} points, {int(caught)} caught, "
-                     f"{int(flagged.sum())} flagged ({int(real)} truly > {tgt / 2:g}), "
-                     f"median estimate/error {ratio:.2f}")
-    st = (k[:, L.OUT_STATUS].astype(np.int64) | r[:, L.OUT_STATUS].astype(np.int64))
-    ok = (st & L.STATUS_FLAGGED) == 0
-    wrong = ok & (k[:, L.OUT_OUTCOME] != r[:, L.OUT_OUTCOME])
-    changes = half[:, L.OUT_OUTCOME] != k[:, L.OUT_OUTCOME]
-    parts.append(f"outcome: {int(wrong.sum())} differ from the reference, "
-                 f"{int(np.sum(wrong & changes))} of them change at half the step; "
-                 f"{int(changes.sum())} change in all")
-    return "; ".join(parts)
-
-
 def tails(e: np.ndarray) -> tuple[int, float, float, float]:
     """(points, median, 95th percentile, max) of the finite entries."""
     e = e[np.isfinite(e)]
@@ -273,8 +241,9 @@ def main() -> None:
         if args.check:
             half, us_half = kernel(points, num, half=True)
             t_tgt, th_tgt = (float(v) for v in args.targets.split(","))
-            print(f"      check (+{us_half:.1f} us/pt): "
-                  + check_report(outs, half, ref, err, t_tgt, th_tgt), flush=True)
+            scores = estimate_scores(outs, half, ref, err,
+                                     {"t_overturn": t_tgt, "theta_rel": th_tgt})
+            print(f"      check (+{us_half:.1f} us/pt): {format_scores(scores)}", flush=True)
         for m in ERRORS[: 5] if args.worst else ():
             e = np.where(np.isfinite(err[m]), err[m], -1)
             for i in np.argsort(e)[::-1][: args.worst]:

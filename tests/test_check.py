@@ -187,3 +187,48 @@ def test_adaptive_sweep_checks_the_computed_points_only(tmp_path):
     assert (ds.check_outcome.values[filled] == L.OUTCOME_NOT_RUN).all()
     assert (ds.check_outcome.values[~filled] >= 0).all()
     assert np.isnan(ds.check_theta_max_diff.values[filled]).all()
+
+
+def test_estimate_scores_count_what_they_say():
+    """Synthetic rows: true errors 0.1, 0.1, 0.01 and estimates 0.2, 0.01, 0.06 in the
+    overturning time (bound 0.05): 2 above, 1 caught, 2 flagged of which 1 truly above
+    0.025; one outcome wrong that changes at half the step, one change elsewhere."""
+    from rocksweep.accuracy import estimate_scores, point_errors
+
+    n = 4
+    r, k, half = (np.zeros((n, L.N_OUT)) for _ in range(3))
+    for a in (r, k, half):
+        a[:, L.OUT_OUTCOME] = L.OUTCOME_MODE2
+        a[:, L.OUT_THETA_MAX] = math.pi / 2
+    r[:, L.OUT_T_OVERTURN] = [1.0, 2.0, 3.0, 4.0]
+    k[:, L.OUT_T_OVERTURN] = [1.1, 2.1, 3.01, 4.0]
+    half[:, L.OUT_T_OVERTURN] = [1.3, 2.11, 3.07, 4.0]
+    k[3, L.OUT_OUTCOME] = half[2, L.OUT_OUTCOME] = L.OUTCOME_MODE1
+    k[3, L.OUT_T_OVERTURN] = half[3, L.OUT_T_OVERTURN] = 4.0
+    errors = point_errors(k, r, np.full(n, 0.15))
+    s = estimate_scores(k, half, r, errors)
+    t = s["t_overturn"]
+    assert (t["above"], t["caught"], t["flagged"], t["real"]) == (2, 1, 2, 1)
+    assert math.isclose(t["ratio"], np.median([0.2 / 0.1, 0.01 / 0.1]))
+    assert s["outcome"] == {"wrong": 1, "wrong_changes": 1, "changes": 2}
+    assert s["theta_rel"]["above"] == 0  # no run is safe
+
+
+def test_accuracy_check_scores_and_stores_the_estimates(cli, tmp_path):
+    import h5py
+
+    path = tmp_path / "s.yaml"
+    path.write_text(SCENE)
+    report = tmp_path / "acc.h5"
+    r = cli.invoke(main, ["accuracy", str(path), "--points", "12", "--ladder", "presets",
+                          "--repeat", "1", "--check", "-q", "-o", str(report)])
+    assert r.exit_code == 0, r.output
+    assert "per-point error estimates (outputs.check" in r.output
+    assert r.output.count("median estimate/error") == 2 * len(PRESETS)
+    with h5py.File(report) as f:
+        g = f["kernel/default"]
+        d = g["check_t_overturn_diff"][()]
+        t = g["t_overturn"][()]
+        both = np.isfinite(d)
+        assert both.any() and np.isfinite(t[both]).all()
+        assert set(CHECK_NAMES) <= set(g)

@@ -39,12 +39,16 @@ from rocksweep.cli.main import (
 @click.option("--seed", type=int, default=0, show_default=True, help="Sampling seed.")
 @click.option("--repeat", type=click.IntRange(min=1), default=5, show_default=True,
               help="Kernel timings are the best of this many rounds.")
+@click.option("--check", is_flag=True,
+              help="Also rerun each setting at half the step and score the per-point "
+                   "error estimates of `sweep --check` against the true errors (which "
+                   "points above 0.05 p*t and 1% they catch).")
 @click.option("--quiet", "-q", is_flag=True, help="No progress lines (the table is printed).")
 @overwrite_option
 @user_errors
 def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | None,
              plot_path: Path | None, n_points: int, ladder_name: str, seed: int, repeat: int,
-             quiet: bool, overwrite: bool) -> None:
+             check: bool, quiet: bool, overwrite: bool) -> None:
     """Measure what accuracy costs on SCENE.yaml: kernel settings against a reference.
 
     Runs a stratified sample of the scene's points (strata: outcome x on/off a boundary
@@ -85,12 +89,13 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
             click.echo(f"kernel: {total} settings done", err=True)
 
     study = accuracy_study(scene, n_points, ladder(ladder_name), seed=seed, repeat=repeat,
-                           progress=progress)
+                           progress=progress, check=check)
     click.echo(format_table(study))
     if report_path is not None:
         words = ["rocksweep", "accuracy", str(scene_path), *(f"--set={o}" for o in overrides),
                  f"--points={n_points}", f"--ladder={ladder_name}", f"--seed={seed}",
-                 f"--repeat={repeat}", *(["--overwrite"] if overwrite else [])]
+                 f"--repeat={repeat}", *(["--check"] if check else []),
+                 *(["--overwrite"] if overwrite else [])]
         command = " ".join(shlex.quote(w) for w in words)
         write_report(study, report_path, command)
         click.echo(f"wrote {report_path}")
