@@ -179,6 +179,12 @@ def check_write_every(seconds: float, name: str = "write_every =") -> float:
     return float(seconds)
 
 
+def _accuracy_words(scene: Scene) -> str:
+    """The numerics of a sweep as its header line says them."""
+    return (f"accuracy {scene.numerics.describe()}"
+            + ("; each point rerun at half the step (outputs.check)" if scene.check else ""))
+
+
 def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
                jobs: int = 1, resume: bool = False, overwrite: bool = False,
                backend: str = "threads", scheduler: str | None = None,
@@ -304,7 +310,7 @@ def _every_point_loop(sf, report: SweepReport, _options: None, *, jobs: int, bac
         chunks = sw.plan_chunks(~done, size)
         dims = " x ".join(f"{len(a.values)} {a.name}" for a in scene.swept) or "1 point"
         say(f"{scene.name}: {sf.grid.size} points ({dims}); {report.done_before} done, "
-            f"{todo} to compute on {where}; accuracy {scene.numerics.describe()}")
+            f"{todo} to compute on {where}; {_accuracy_words(scene)}")
         lvl = sw.level(scene)
         if todo:
             _prepare_kernel(sf, lvl, report, say)
@@ -370,7 +376,7 @@ def _adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, back
     say(f"{scene.name}: {sf.grid.size} points ({dims}); adaptive over {plan.names[0]} x "
         f"{plan.names[1]} (coarse level {plan.coarse}: stride {2 ** plan.coarse}, "
         f"audit {100 * plan.audit:g}%); {report.done_before} computed before; on {where}; "
-        f"accuracy {scene.numerics.describe()}")
+        f"{_accuracy_words(scene)}")
     lvl = sw.level(scene)
     pending_flags: list = []
 
