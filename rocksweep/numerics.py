@@ -38,7 +38,7 @@ PRESETS: dict[str, tuple[int, float]] = {
     "draft": (4, 1e-6),
     "default": (5, 1e-6),
     "fine": (20, 1e-8),
-    "accurate": (8, 1e-8),
+    "accurate": (10, 1e-8),
 }
 
 # name -> rotation_step: the largest rotation one rocking step may make, as a fraction of
