@@ -78,7 +78,8 @@ DIAGRAM_AXES = ("w_over_p", "A_ratio")  # (x, y)
 MIN_COARSE_CELLS = 16
 DEFAULT_MARGIN = 1
 # No margin at the last level: there it caught only one-point-tall slivers (40 of 480 000
-# points of Figure 4(b) at 400 x 400) for 17-27% more points computed.
+# points of Figure 4(b) at 400 x 400) for 17-27% more points computed. 0 also selects the
+# light rules of the last two levels (module docstring); >= 1 refines whole cells there.
 DEFAULT_FINAL_MARGIN = 0
 DEFAULT_AUDIT = 0.02
 DEFAULT_SEED = 0
@@ -99,9 +100,10 @@ class Plan:
     full_shape: the grid's full shape (``Grid.full_shape``; flat indices are C-order in it);
     x, y: positions in full_shape of the two diagram axes; names: their names (x, y);
     coarse: the coarse pass takes every 2**coarse-th index; margin: cells [>= 0] refined
-    around each mixed cell (across edges) at strides >= 4; final_margin: the same at the
-    last level (stride 2); audit: share in [0, 1] of all points that are audit candidates;
-    seed: of the audit sample.
+    around each mixed cell (across edges) at strides >= 4 (at stride 4, with final_margin
+    0, only probed at their centre); final_margin: the same at the last level (stride 2),
+    0 for the light last levels of the module docstring; audit: share in [0, 1] of all
+    points that are audit candidates; seed: of the audit sample.
     """
 
     full_shape: tuple[int, ...]
@@ -251,10 +253,12 @@ def default_coarse(ny: int, nx: int) -> int:
     every coarse level on the full grids): on the four figures, configs/block.yaml and two
     held-out scenes, at 80 x 80 and 400 x 400, every level from 1 to 7 (down to 3 cells per
     axis) gives the same outcomes: each region is either large or a speck (<= 8 points)
-    on a boundary. Beyond 16 cells per axis a coarser lattice saves < 0.2% of the points
-    (400 x 400: 7.76% computed at k = 4, 7.61% at k = 5), so 16 keeps every region with an
-    extent above 1/8 of both axes sampled at almost no cost: k = 2 at 80, 4 at 400, 5 at
-    1000.
+    on a boundary (the same few one-point specks and tips that the light last levels fill
+    wrong at every level: 0-70 points of a scene at 400 x 400, 0 at 80 x 80 but one point
+    of the block). Beyond 16 cells per axis a coarser lattice saves < 0.2% of the points
+    (Figure 3(a) at 400 x 400: 6.12% computed at k = 4, 5.98% at k = 5), so 16 keeps
+    every region with an extent above 1/8 of both axes sampled at almost no cost: k = 2
+    at 80, 4 at 400, 5 at 1000.
     """
     k = 0
     while (min(ny, nx) - 1) / 2 ** (k + 1) >= MIN_COARSE_CELLS:
