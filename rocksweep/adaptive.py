@@ -11,18 +11,31 @@ swept axes with at least 2 values), for every value of the other axes (a *panel*
    hold more than one class. Mixed cells, dilated by ``margin`` cells across their edges
    (so a boundary that bends between samples is not lost; ``final_margin`` at the last
    level, s = 2, where a bend between samples is a one-point feature), get every point of
-   the stride-s/2 lattice inside them computed;
+   the stride-s/2 lattice inside them computed. With ``final_margin`` = 0 (the default)
+   the last two levels are lighter, where a bend between samples is one or two points:
+   at s = 4 the margin cells get only their centre computed (a probe: if it differs, the
+   cell is mixed and refined whole); at s = 2 a mixed cell whose corners differ gets its
+   centre and the midpoints of the edges a boundary crosses (ends differ, or a one-point
+   sliver through the centre runs on across the edge; see ``_edge_points``), and the
+   other edge midpoints are filled from their two agreeing ends. Measured on Figure 3(a)
+   at 1000 x 1000 x 3 lam (``scripts/bench_adaptive.py --fine``): 3.77% of the points
+   computed instead of 4.46%, 99.9990% of the outcomes equal to the full grid instead of
+   99.9997%. What it misses are one-point specks on a boundary and one-point slivers
+   (at 400 x 400, 0-70 cells of a scene instead of 0-44, see the README's table);
 3. audit: a fixed pseudo-random share ``audit`` of all points (seeded, independent of the
    state) is computed once refinement has converged, i.e. a Bernoulli sample of the points
    that would be filled. An audit point whose class differs from its fill makes its cells
    mixed, so step 2 refines around it down to the final resolution;
 4. fill: every point not computed takes the class of a uniform cell (all four corners
    computed, one class inside) that contains it (all such cells agree: nested or
-   neighbouring cells share computed points).
+   neighbouring cells share computed points), or else, in a mixed stride-2 cell, the
+   class of the two agreeing ends of the edge it is the midpoint of.
 
 The computed set is the least fixed point of step 2 above the coarse lattice (and, after
-the audit, above the audit points): adding points only adds mixed cells, so the order in
-which batches are computed does not matter. ``next_batch`` is therefore a pure function of
+the audit, above the audit points): adding points only adds mixed cells, and every rule
+of step 2 that reads classes (edge ends, a centre) only fires once those points are
+computed and then holds for good, so the order in which batches are computed does not
+matter. ``next_batch`` is therefore a pure function of
 (outcome, computed): a driver calls it, computes the batch it returns (any workers, any
 chunking; a point's result depends only on the point), stores the results and calls it
 again, until it returns an empty batch. An interrupted sweep resumes from the file.
@@ -65,7 +78,8 @@ DIAGRAM_AXES = ("w_over_p", "A_ratio")  # (x, y)
 MIN_COARSE_CELLS = 16
 DEFAULT_MARGIN = 1
 # No margin at the last level: there it caught only one-point-tall slivers (40 of 480 000
-# points of Figure 4(b) at 400 x 400) for 17-27% more points computed.
+# points of Figure 4(b) at 400 x 400) for 17-27% more points computed. 0 also selects the
+# light rules of the last two levels (module docstring); >= 1 refines whole cells there.
 DEFAULT_FINAL_MARGIN = 0
 DEFAULT_AUDIT = 0.02
 DEFAULT_SEED = 0
@@ -86,9 +100,10 @@ class Plan:
     full_shape: the grid's full shape (``Grid.full_shape``; flat indices are C-order in it);
     x, y: positions in full_shape of the two diagram axes; names: their names (x, y);
     coarse: the coarse pass takes every 2**coarse-th index; margin: cells [>= 0] refined
-    around each mixed cell (across edges) at strides >= 4; final_margin: the same at the
-    last level (stride 2); audit: share in [0, 1] of all points that are audit candidates;
-    seed: of the audit sample.
+    around each mixed cell (across edges) at strides >= 4 (at stride 4, with final_margin
+    0, only probed at their centre); final_margin: the same at the last level (stride 2),
+    0 for the light last levels of the module docstring; audit: share in [0, 1] of all
+    points that are audit candidates; seed: of the audit sample.
     """
 
     full_shape: tuple[int, ...]
@@ -238,10 +253,12 @@ def default_coarse(ny: int, nx: int) -> int:
     every coarse level on the full grids): on the four figures, configs/block.yaml and two
     held-out scenes, at 80 x 80 and 400 x 400, every level from 1 to 7 (down to 3 cells per
     axis) gives the same outcomes: each region is either large or a speck (<= 8 points)
-    on a boundary. Beyond 16 cells per axis a coarser lattice saves < 0.2% of the points
-    (400 x 400: 7.76% computed at k = 4, 7.61% at k = 5), so 16 keeps every region with an
-    extent above 1/8 of both axes sampled at almost no cost: k = 2 at 80, 4 at 400, 5 at
-    1000.
+    on a boundary (the same few one-point specks and tips that the light last levels fill
+    wrong at every level: 0-70 points of a scene at 400 x 400, 0 at 80 x 80 but one point
+    of the block). Beyond 16 cells per axis a coarser lattice saves < 0.2% of the points
+    (Figure 3(a) at 400 x 400: 6.12% computed at k = 4, 5.98% at k = 5), so 16 keeps
+    every region with an extent above 1/8 of both axes sampled at almost no cost: k = 2
+    at 80, 4 at 400, 5 at 1000.
     """
     k = 0
     while (min(ny, nx) - 1) / 2 ** (k + 1) >= MIN_COARSE_CELLS:
@@ -374,6 +391,107 @@ def _points_of_cells(plan: Plan, cells: np.ndarray, s: int) -> np.ndarray:
     return np.unique(plan.flat_index()[p, y, x])
 
 
+def _centres(plan: Plan, cells: np.ndarray, s: int) -> np.ndarray:
+    """Flat indices of the centres of the marked stride-s cells (bool[P, cy, cx]), a
+    shorter last cell's clipped to the axis's last index (then a corner)."""
+    _, ny, nx = plan.panel_shape
+    p, j, i = np.nonzero(cells)
+    return plan.flat_index()[p, np.minimum(j * s + s // 2, ny - 1),
+                             np.minimum(i * s + s // 2, nx - 1)]
+
+
+def _corner_classes(known: np.ndarray) -> np.ndarray:
+    """int8[P, cy + 1, cx + 1]: the classes (-1: not computed) at the stride-2 lattice
+    points, i.e. the corners of the stride-2 cells."""
+    _, ny, nx = known.shape
+    return known[:, _axis_lattice(ny, 2)][:, :, _axis_lattice(nx, 2)]
+
+
+def _edge_points(plan: Plan, mixed: np.ndarray, known: np.ndarray) -> np.ndarray:
+    """Flat indices of the points the last level (stride 2 -> 1) computes in the mixed
+    stride-2 cells ``mixed`` (bool[P, cy, cx]) whose four corners are computed.
+
+    Where the corners differ: the centre, and the midpoint of each edge that a boundary
+    crosses: its two ends differ; or they agree, the computed centre differs from them and
+    the opposite edge's ends do not both side with the centre (a one-point sliver through
+    the centre that runs on across the edge, not a boundary between the centre and the
+    edge). Any edge whose ends agree and whose two computed neighbouring centres are both
+    of another class (a one-point band lying along the edge, in which a speck can hide).
+    Where the corners agree (an audit point inside made the cell mixed): all its points.
+    The other edge midpoints are filled from their two agreeing ends (``_edge_fill``).
+
+    Each rule fires only once the points it reads are computed and then holds for good
+    (classes do not change), so the wanted set only grows with the computed set: the
+    least fixed point, and so the result, does not depend on the batch order. Measured on
+    Figure 3(a) at 1000 x 1000 x 3 lam: whole mixed cells at this level are 0.91% of the
+    grid, these points 0.46%.
+    """
+    c = _corner_classes(known)
+    a, b = c[:, :-1, :-1], c[:, :-1, 1:]  # corners (y, x), (y, x + 1)
+    d, e = c[:, 1:, :-1], c[:, 1:, 1:]  # (y + 1, x), (y + 1, x + 1)
+    ok = mixed & (a >= 0) & (b >= 0) & (d >= 0) & (e >= 0)
+    same = (a == b) & (a == d) & (a == e)
+    split, whole = ok & ~same, ok & same
+    P, cy, cx = mixed.shape
+    _, ny, nx = plan.panel_shape
+    # the centres' classes (-1: not computed, or a last cell one index long: no centre)
+    m = np.full((P, cy, cx), -1, np.int8)
+    cen = known[:, 1::2, 1::2][:, :cy, :cx]
+    m[:, :cen.shape[1], :cen.shape[2]] = cen
+    if (ny - 1) % 2:
+        m[:, -1] = -1
+    if (nx - 1) % 2:
+        m[:, :, -1] = -1
+    lat = np.zeros((P, 2 * cy + 1, 2 * cx + 1), bool)  # stride-1 lattice, as _points_of_cells
+    lat[:, 1::2, 1::2] |= split  # centres
+
+    def crossed(p: np.ndarray, q: np.ndarray, r: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """Edge (p, q) of a split cell crossed; (r, t): the opposite edge's ends."""
+        return (p != q) | ((m >= 0) & (p != m) & ~((r == m) & (t == m)))
+
+    lat[:, 0:-1:2, 1::2] |= split & crossed(a, b, d, e)  # lower edges
+    lat[:, 2::2, 1::2] |= split & crossed(d, e, a, b)  # upper edges
+    lat[:, 1::2, 0:-1:2] |= split & crossed(a, d, b, e)  # left edges
+    lat[:, 1::2, 2::2] |= split & crossed(b, e, a, d)  # right edges
+
+    def band(p: np.ndarray, q: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Edge (p, q) with agreeing ends between centres u, v of another class."""
+        return (p >= 0) & (p == q) & (u >= 0) & (v >= 0) & (u != p) & (v != p)
+
+    no = np.full((P, 1, cx), -1, np.int8)  # beyond the panel: no centre
+    lat[:, 0::2, 1::2] |= band(c[:, :, :-1], c[:, :, 1:], np.concatenate([no, m], 1),
+                               np.concatenate([m, no], 1))  # edges along x
+    no = np.full((P, cy, 1), -1, np.int8)
+    lat[:, 1::2, 0::2] |= band(c[:, :-1, :], c[:, 1:, :], np.concatenate([no, m], 2),
+                               np.concatenate([m, no], 2))  # edges along y
+    for dy in range(3):
+        for dx in range(3):
+            lat[:, dy:dy + 2 * cy:2, dx:dx + 2 * cx:2] |= whole
+    p, jj, ii = np.nonzero(lat)
+    return np.unique(plan.flat_index()[p, np.minimum(jj, ny - 1), np.minimum(ii, nx - 1)])
+
+
+def _edge_fill(known: np.ndarray) -> np.ndarray:
+    """int8 panels: at the midpoints of stride-2 edges whose two ends are computed and
+    agree, their class; -1 elsewhere (what the last level leaves uncomputed, see
+    ``_edge_points``)."""
+    _, ny, nx = known.shape
+    c = _corner_classes(known)
+    lat = np.full((c.shape[0], 2 * c.shape[1] - 1, 2 * c.shape[2] - 1), -1, np.int8)
+    h = np.where(c[:, :, :-1] == c[:, :, 1:], c[:, :, :-1], -1)  # edges along x
+    v = np.where(c[:, :-1, :] == c[:, 1:, :], c[:, :-1, :], -1)  # edges along y
+    lat[:, 0::2, 1::2] = h
+    lat[:, 1::2, 0::2] = v
+    out = np.full(known.shape, -1, np.int8)
+    ys = np.minimum(np.arange(lat.shape[1]), ny - 1)
+    xs = np.minimum(np.arange(lat.shape[2]), nx - 1)
+    # the clipped last row/column maps onto the lattice's last points: keep the real ones
+    keep_y = np.r_[True, ys[1:] != ys[:-1]]
+    keep_x = np.r_[True, xs[1:] != xs[:-1]]
+    out[:, ys[keep_y][:, None], xs[keep_x][None, :]] = lat[:, keep_y][:, :, keep_x]
+    return out
+
+
 def _known(plan: Plan, outcome: np.ndarray, computed: np.ndarray) -> np.ndarray:
     c = np.asarray(computed).ravel() > FILLED
     k = np.where(c, np.asarray(outcome).ravel(), -1).astype(np.int8)
@@ -422,11 +540,19 @@ def next_batch(plan: Plan, outcome: np.ndarray, computed: np.ndarray) -> Batch:
     known = _known(plan, outcome, computed)
     parts, stride = [], 0
     cells = _cells(known, plan.strides)
+    light = plan.final_margin == 0  # the last two levels' lighter rules (module docstring)
     for s in plan.strides:
-        refine = _dilate(cells[s].mixed, plan.margin if s > 2 else plan.final_margin)
+        mixed = cells[s].mixed
+        refine = _dilate(mixed, plan.margin if s > 2 else plan.final_margin)
         if not refine.any():
             continue
-        want = _points_of_cells(plan, refine, s)
+        if s == 2 and light:
+            want = _edge_points(plan, mixed, known)
+        elif s == 4 and light:
+            want = np.concatenate([_points_of_cells(plan, mixed, s),
+                                   _centres(plan, refine, s)])
+        else:
+            want = _points_of_cells(plan, refine, s)
         missing = want[~done[want]]
         if missing.size:
             parts.append(missing)
@@ -453,6 +579,8 @@ def fill(plan: Plan, outcome: np.ndarray, computed: np.ndarray) -> np.ndarray:
         cx = np.minimum(np.arange(nx) // s, cls.shape[2] - 1)
         cand = cls[:, cy][:, :, cx]
         out = np.where(out < 0, cand, out)
+    if plan.strides and plan.final_margin == 0:
+        out = np.where(out < 0, _edge_fill(known), out)
     flat = np.empty(plan.size, np.int8)
     idx = plan.flat_index()
     flat[idx.ravel()] = out.ravel()

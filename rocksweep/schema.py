@@ -129,7 +129,7 @@ KEYS: dict[str, Key] = {
     "refine.margin": Key("integer", "must be an integer in [0, 8] (cells refined around a "
                          "mixed cell)", 0, 8, required=False),
     "refine.final_margin": Key("integer", "must be an integer in [0, 8] (the same at the "
-                               "last level)", 0, 8, required=False),
+                               "last level; 0: the light last levels)", 0, 8, required=False),
     "refine.seed": Key("integer", "must be an integer in [0, 2^31) (seed of the audit "
                        "sample)", 0, 2**31 - 1, required=False),
     "refine.threshold": Key("number", "must be in [0, 1] (share of disagreeing audits "

@@ -107,6 +107,46 @@ def test_smooth_planted_map_recovered_exactly_and_cheaply():
     assert (comp[out != truth.ravel()] > 0).all()
 
 
+def sliver_map(shape):
+    """Class 2 left of x = 41, else 0, with two one-point-tall slivers of class 1 leaving
+    the boundary: along row 61 (odd: through the centres of the stride-2 cells) and along
+    row 90 (even: on their edges), the latter with a speck of class 0 at x = 71."""
+    m = np.zeros(shape[1:], np.int8)
+    m[:, :41] = 2
+    m[61, 41:100] = 1
+    m[90, 41:120] = 1
+    m[90, 71] = 0
+    return np.broadcast_to(m, shape).copy()
+
+
+def test_one_point_slivers_and_specks_recovered_by_the_last_level():
+    """The last level computes only the edge midpoints a boundary crosses, yet follows a
+    one-point sliver through cells whose corners all agree, and looks inside a one-point
+    band lying on the cells' edges (no audit here to help)."""
+    shape = (2, 129, 129)
+    truth = sliver_map(shape).ravel()
+    plan = ad.Plan(shape, 2, 1, coarse=4, audit=0.0)
+    out, comp, st = ad.drive(plan, synthetic(plan, truth)[0])
+    np.testing.assert_array_equal(out, truth)
+    assert comp.reshape(shape)[0, 90, 71] == ad.COMPUTED  # the speck was looked at
+    assert st.computed_share < 0.35
+    # the edges along the straight boundary x = 41 that no boundary crosses (rows 2j + 1
+    # at x = 42: ends (2j, 42), (2j + 2, 42) both 0) are filled, not computed
+    c = comp.reshape(shape)[0]
+    assert (c[101:127:2, 42] == ad.FILLED).all()
+    # any order of computation ends with the same points computed
+    rng = np.random.default_rng(5)
+    outcome = np.full(plan.size, -1, np.int8)
+    computed = np.zeros(plan.size, np.int8)
+    for _ in range(2000):
+        b = ad.next_batch(plan, outcome, computed)
+        if b.kind == "done":
+            break
+        part = b.flat[rng.random(len(b)) < 0.3] if len(b) > 1 else b.flat
+        outcome[part], computed[part] = truth[part], ad.COMPUTED
+    np.testing.assert_array_equal(computed, comp)
+
+
 def test_audit_catches_planted_island():
     shape = (1, 129, 129)
     base = np.zeros(shape, np.int8)

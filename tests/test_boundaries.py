@@ -131,3 +131,99 @@ def test_a_min_first_value_overturns_is_an_upper_bound():
     (c,) = bd.a_min(sc, outcome, evaluate=lambda pts: np.zeros(len(pts), np.int8))
     assert c.a_min[0] == 1.0 and np.isnan(c.lo[0]) and np.isnan(c.a_min[1])
     assert bd.a_min_rows([c])[0]["upper_bound"] is True
+
+
+# --- rocksweep boundaries -o CURVES.h5 ----------------------------------------------------
+
+def test_boundaries_h5_holds_what_the_csv_files_hold(cli, tmp_path):
+    """-o CURVES.h5 writes the A_min curves (the -o CSV rows) and the boundary polylines
+    (the --lines CSV rows) of every panel, readable with h5py and xarray."""
+    import csv
+
+    import h5py
+    import xarray as xr
+
+    from rocksweep.cli import main
+
+    scene = tmp_path / "s.yaml"
+    scene.write_text(BODY3 + "impact: {lam: [0.0, 0.4]}\npulse: {shape: [sine, cosine], "
+                     "w_over_p: {start: 0.5, stop: 6, num: 12}, A_ratio: {start: 0.3, "
+                     "stop: 8, num: 12}}\n")
+    out = tmp_path / "s.h5"
+    res = cli.invoke(main, ["sweep", str(scene), "-o", str(out), "-q", "-j", "1"])
+    assert res.exit_code == 0, res.output
+    amin, lines, h5 = tmp_path / "a.csv", tmp_path / "l.csv", tmp_path / "c.h5"
+    res = cli.invoke(main, ["boundaries", str(out), "-o", str(amin), "--lines", str(lines)])
+    assert res.exit_code == 0, res.output
+    res = cli.invoke(main, ["boundaries", str(out), "-o", str(h5)])
+    assert res.exit_code == 0, res.output
+    assert "boundary lines" in res.output
+    assert not list(tmp_path.glob(".*partial*"))  # written atomically, nothing left over
+
+    def read_csv(path):
+        with open(path, newline="") as fh:
+            return list(csv.DictReader(fh))
+
+    def value(v):  # CSV cells back to values; h5 attributes to plain values
+        if isinstance(v, bytes):
+            v = v.decode()
+        if isinstance(v, str):
+            try:
+                return float(v)
+            except ValueError:
+                return v
+        return v.item() if isinstance(v, np.generic) else v
+
+    from rocksweep.outcomes import outcome_word
+
+    a_rows, l_rows = [], []
+    with h5py.File(h5, "r") as f:
+        assert f.attrs["x_axis"] == "w_over_p" and f.attrs["y_axis"] == "A_ratio"
+        assert f.attrs["panels"] == 4 and f.attrs["rtol"] == 1e-3
+        for i in range(int(f.attrs["panels"])):
+            g = f[f"a_min/panel_{i}"]
+            where = {k: value(g.attrs[k]) for k in str(g.attrs["where"]).split()}
+            assert set(where) == {"shape", "lam"}
+            for j, a in enumerate(g["A_min"][:]):
+                if np.isnan(a):
+                    continue
+                a_rows.append({**where, "w_over_p": float(g["w_over_p"][j]),
+                               "A_min": float(a), "mode": outcome_word(int(g["mode"][j])),
+                               "upper_bound": bool(g["upper_bound"][j])})
+            gl = f[f"lines/panel_{i}"]
+            assert {k: value(gl.attrs[k]) for k in where} == where
+            for n in range(len(gl)):
+                ds = gl[f"line_{n}"]
+                assert ds.shape[1] == 2 and ds.attrs["class_a"] < ds.attrs["class_b"]
+                for x, y in ds[:]:
+                    l_rows.append({**where, "line": n, "classes": ds.attrs["classes"],
+                                   "w_over_p": float(x), "A_ratio": float(y)})
+    want_a = [{k: value(v) for k, v in r.items()} for r in read_csv(amin)]
+    for r in want_a:
+        r["upper_bound"] = r["upper_bound"] == "True"
+    want_l = [{k: value(v) for k, v in r.items()} for r in read_csv(lines)]
+    for r in want_l:
+        r["line"] = int(r["line"])
+    assert len(want_a) > 10 and len(want_l) > 10  # curves and lines to compare
+    assert a_rows == want_a
+    assert l_rows == want_l
+    # xarray opens an A_min panel as a Dataset over w_over_p
+    ds = xr.open_dataset(h5, group="a_min/panel_1", engine="h5netcdf")
+    assert ds["A_min"].dims == ("w_over_p",) and ds.attrs["shape"] == "sine"
+    assert ds.attrs["lam"] == 0.4
+    ds.close()
+
+
+@pytest.mark.parametrize("name", ["c.txt", "c", "c.h5.bak"])
+def test_boundaries_output_suffix_is_csv_or_h5(cli, tmp_path, name):
+    from rocksweep.cli import main
+
+    res = cli.invoke(main, ["boundaries", str(tmp_path / "missing.h5"), "-o",
+                            str(tmp_path / name)])
+    assert res.exit_code != 0 and "Traceback" not in res.output
+    (line,) = res.output.strip().splitlines()
+    suffix = name.rpartition(".")[2] if "." in name else None
+    assert line.startswith(f"Error: -o {tmp_path / name}: unsupported suffix ")
+    assert (f"'.{suffix}'" if suffix else "'(none)'") in line
+    assert line.endswith("use .csv, .h5 or .hdf5")
+    assert not (tmp_path / name).exists()

@@ -1,5 +1,5 @@
 """``rocksweep boundaries``: the A_min curves (bisected) and the boundary lines of a sweep
-result, as CSV and as a figure (the library side is ``rocksweep.boundaries``)."""
+result, as CSV or HDF5 and as a figure (the library side is ``rocksweep.boundaries``)."""
 
 from __future__ import annotations
 
@@ -13,7 +13,8 @@ from rocksweep.cli.main import main, user_errors
 @main.command()
 @click.argument("result_path", metavar="OUT.h5", type=click.Path(path_type=Path))
 @click.option("-o", "--output", "csv_path", type=click.Path(dir_okay=False, path_type=Path),
-              help="A_min curves as CSV [default: OUT-amin.csv].")
+              help="A_min curves as CSV (.csv), or as HDF5 (.h5, .hdf5) with the boundary "
+                   "lines too [default: OUT-amin.csv].")
 @click.option("--lines", "lines_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Also write the boundary polylines as CSV (one row per vertex).")
 @click.option("--rtol", type=float, default=1e-3, show_default=True,
@@ -44,6 +45,11 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
         raise click.ClickException(f"--rtol {rtol}: give a relative tolerance in (0, 1)")
     out = csv_path if csv_path is not None else result_path.with_name(
         result_path.stem + "-amin.csv")
+    h5 = out.suffix.lower() in (".h5", ".hdf5")
+    if out.suffix.lower() not in bd.CURVE_SUFFIXES:
+        raise click.ClickException(
+            f"-o {out}: unsupported suffix {out.suffix or '(none)'!r}; use "
+            f"{', '.join(bd.CURVE_SUFFIXES[:-1])} or {bd.CURVE_SUFFIXES[-1]}")
     # refuse bad outputs before any kernel run
     outs = [p for p in (out, lines_path, fig_path) if p is not None]
     if len({str(p.resolve()) for p in outs}) < len(outs):
@@ -60,9 +66,17 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
         return lambda tmp: tmp.write_text(text)
 
     rows = bd.a_min_rows(curves)
-    write_atomic(out, write_text(bd.csv_text(rows)))
     runs = int(sum(int(c.runs.sum()) for c in curves))
-    click.echo(f"wrote {out} ({len(rows)} A_min values over {len(curves)} panel(s), "
+    if h5:
+        attrs = {"source": str(result_path), "rtol": rtol,
+                 "mode": "any" if mode is None else f"mode{mode}"}
+        write_atomic(out, lambda tmp: bd.write_curves_h5(tmp, curves, bounds, attrs))
+        n = sum(len(b.lines) for b in bounds)
+        also = f", {n} boundary lines"
+    else:
+        write_atomic(out, write_text(bd.csv_text(rows)))
+        also = ""
+    click.echo(f"wrote {out} ({len(rows)} A_min values over {len(curves)} panel(s){also}, "
                f"{runs} kernel runs for the bisection to rtol {rtol:g})")
     if lines_path is not None:
         lrows = bd.boundary_rows(bounds)

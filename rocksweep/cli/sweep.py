@@ -59,7 +59,9 @@ WRITE_EVERY = 1.0  # = rocksweep.api.WRITE_EVERY (not imported here: --help stay
 @click.option("--margin", type=int, default=None,
               help="Adaptive: cells refined around a mixed cell [default: 1].")
 @click.option("--final-margin", "final_margin", type=int, default=None,
-              help="Adaptive: the same at the last level [default: 0].")
+              help="Adaptive: the same at the last level [default: 0: the last level "
+                   "computes only the edges a boundary crosses, the level before probes "
+                   "its margin cells' centres; >= 1 refines whole cells at both].")
 @click.option("--seed", type=int, default=None,
               help="Adaptive: seed of the audit sample [default: 0].")
 @click.option("--threshold", type=float, default=None,
