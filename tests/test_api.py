@@ -273,12 +273,14 @@ def test_one_field_table():
     assert list(sw.ENERGY_VARIABLES) == [f.name for f in fields.ENERGY_FIELDS]
     assert sw.VARIABLES["outcome"][1] == L.OUTCOME_NOT_RUN
     assert fields.UNITS["work_in_over_Eref"] == "E_ref"
-    slots = [f.slot for f in fields.FIELDS]
-    assert len(set(slots)) == len(slots)  # no kernel slot read twice
+    slots = [f.slot for f in fields.RUN_FIELDS]
+    assert len(set(slots)) == len(slots)  # no kernel slot read twice in a run's row
+    # the error estimates (outputs.check) read run slots of the half-step rerun
+    assert {f.slot for f in fields.CHECK_FIELDS} <= set(slots)
     assert len({c.slot for c in fields.HISTORY}) == L.N_HIST == len(fields.HISTORY)
     run = rocksweep.simulate(FIG5, impact__lam=0.0).run
     contact = {f.name for f in fields.CONTACT_FIELDS}  # only when the scene asks for them
-    assert set(run.summary()) == ({f.name for f in fields.FIELDS} - contact) | {
+    assert set(run.summary()) == ({f.name for f in fields.RUN_FIELDS} - contact) | {
         "accuracy", "wall_time_s"}
     # "steps" is the regular RK4 steps in a sweep and in a single run alike
     sc = load_scene(FIG5, ["impact.lam=0.2"])
