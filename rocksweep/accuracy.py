@@ -62,9 +62,8 @@ TAIL_LABELS = {
     "theta_rel": "|d theta_max|/theta_max",
     "energy": "|energy balance|/E_ref",
 }
-# theta_rel is taken where the reference's theta_max is at least this x alpha_cg (below it
-# the body barely leaves the ground and a relative error says nothing)
-THETA_REL_FLOOR = 1e-2
+# theta_rel is taken where the reference's theta_max is at least this x alpha_cg
+THETA_REL_FLOOR = fields.THETA_REL_FLOOR
 # Error bounds against which ``--check`` scores the per-point error estimates (issue 15's
 # targets for the 95th percentiles): overturning time [p*t] and relative max|theta|.
 CHECK_TARGETS = {"t_overturn": 0.05, "theta_rel": 0.01}
@@ -434,10 +433,10 @@ def estimate_scores(k: np.ndarray, half: np.ndarray, r: np.ndarray,
     reference), wrong_changes (those whose outcome changes at half the step), changes (all
     runs whose outcome changes at half the step).
     """
-    est = {"t_overturn": np.abs(half[:, L.OUT_T_OVERTURN] - k[:, L.OUT_T_OVERTURN])}
+    d = fields.convert_check(k, half, 1.0)  # the estimates as a sweep stores them [rad]
+    est = {"t_overturn": np.abs(d["check_t_overturn_diff"])}
     with np.errstate(invalid="ignore", divide="ignore"):
-        est["theta_rel"] = (np.abs(half[:, L.OUT_THETA_MAX] - k[:, L.OUT_THETA_MAX])
-                            / k[:, L.OUT_THETA_MAX])
+        est["theta_rel"] = np.abs(d["check_theta_max_diff"]) / k[:, L.OUT_THETA_MAX]
     out: dict = {}
     for m, bound in targets.items():
         e, x = errors[m], est[m]

@@ -141,6 +141,12 @@ def sweep_fields(energy: bool, contact: bool = False, check: bool = False
             + (CONTACT_FIELDS if contact else ()) + (CHECK_FIELDS if check else ()))
 
 
+# Relative max|theta| errors (the accuracy study's theta_rel, the error estimates' tails in
+# ``rocksweep info``) are taken where max|theta| >= this x alpha_ref: below, the body barely
+# leaves the ground and a relative error says nothing.
+THETA_REL_FLOOR = 1e-2
+
+
 # Row slots a half-step rerun (outputs.check) changes, and by what factor: the RK4 step
 # (PAR_REC_H, the step while a record acts, stays a whole fraction of its sample interval),
 # the rotation limit of one rocking step, and the evaluation budget, which the halved step

@@ -1303,6 +1303,21 @@ def read_result(path: str | Path, names: list[str] | None = None,
     return SweepResult(path, lay.dims, lay.shape, coords, scalars, arrays, attrs, stored)
 
 
+def stored_scene(path: str | Path) -> dict:
+    """The resolved scene a result file records (``resolved_scene``), validated as
+    ``read_result`` validates it, without reading any variable."""
+    path = Path(path)
+    f = _open(path, "r")
+    try:
+        return _layout(f, path).scene
+    except RocksweepError:
+        raise
+    except _H5_ERRORS as err:
+        raise _damaged(path, _why(err)) from None
+    finally:
+        _close_quietly(f)
+
+
 def peek_done(path: str | Path) -> tuple[int, int] | None:
     """(points done, total) of a rocksweep result at path, None if it is not one."""
     try:

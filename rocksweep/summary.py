@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from rocksweep.fields import THETA_REL_FLOOR
 from rocksweep.kernel import layout as L  # noqa: N812
 
 if TYPE_CHECKING:
@@ -34,9 +35,6 @@ INFO_OPTIONAL = ("computed",)
 # ... and, in files with per-point error estimates (outputs.check), these.
 CHECK_INFO_VARIABLES = ["theta_max_over_alpha", "check_outcome", "check_t_overturn_diff",
                         "check_theta_max_diff"]
-# Relative max|theta| errors are taken where the run uplifted this far [alpha_ref] (below,
-# it barely leaves the ground and a relative error means little; scripts/wide_space.py).
-THETA_FLOOR = 1e-2
 
 
 def _plain(v):
@@ -167,12 +165,11 @@ def _json_value(v):
 
 def read_info(path) -> SweepResult:
     """The variables of a result file that ``info_dict`` reports on."""
-    from rocksweep.store import read_result
+    from rocksweep.store import read_result, stored_scene
 
-    result = read_result(path, INFO_VARIABLES, INFO_OPTIONAL)
-    if result.scene.get("check"):
-        result = read_result(path, INFO_VARIABLES + CHECK_INFO_VARIABLES, INFO_OPTIONAL)
-    return result
+    check = bool(stored_scene(path).get("check"))
+    return read_result(path, INFO_VARIABLES + (CHECK_INFO_VARIABLES if check else []),
+                       INFO_OPTIONAL)
 
 
 def _tail(x: np.ndarray) -> dict:
@@ -188,14 +185,14 @@ def check_info(result: SweepResult) -> dict | None:
     """The per-point error estimates of a result with ``outputs.check`` (None without):
     points whose outcome changes at half the step, and the tails (median, 95th
     percentile, max) of |t_overturn change| [p*t] where both runs overturn and of the
-    relative |max|theta| change| of safe runs (both safe, theta_max >= THETA_FLOOR)."""
+    relative |max|theta| change| of safe runs (both safe, theta_max >= THETA_REL_FLOOR)."""
     if not result.scene.get("check") or "check_outcome" not in result.arrays:
         return None
     a = result.arrays
     out, chk = np.asarray(a["outcome"]), np.asarray(a["check_outcome"])
     run = out != L.OUTCOME_NOT_RUN
     theta = np.asarray(a["theta_max_over_alpha"])
-    safe = run & (out == L.OUTCOME_SAFE) & (chk == L.OUTCOME_SAFE) & (theta >= THETA_FLOOR)
+    safe = run & (out == L.OUTCOME_SAFE) & (chk == L.OUTCOME_SAFE) & (theta >= THETA_REL_FLOOR)
     with np.errstate(invalid="ignore", divide="ignore"):
         rel = np.abs(np.asarray(a["check_theta_max_diff"])[safe]) / theta[safe]
     return {"points": int(run.sum()),

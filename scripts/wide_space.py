@@ -44,7 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from rocksweep.accuracy import estimate_scores, format_scores
-from rocksweep.fields import check_rows
+from rocksweep.fields import THETA_REL_FLOOR, check_rows
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.model import FlexibleBody
@@ -53,7 +53,6 @@ from rocksweep.points import Point, kernel_kind, point_row
 
 RIGID_SHARE = 0.15
 ZETA0_SHARE = 1 / 6
-THETA_FLOOR = 1e-2  # theta_rel only where the reference's theta_max >= this x alpha_cg
 ERRORS = ("t_overturn", "theta_rel", "theta_max", "t_first_impact", "impacts", "energy")
 
 
@@ -147,7 +146,7 @@ def errors(k: np.ndarray, r: np.ndarray, ke: np.ndarray, points: list[Point]
     nan = np.full(len(k), np.nan)
     safe = (ko == L.OUTCOME_SAFE) & (ro == L.OUTCOME_SAFE)
     d_th = np.abs(k[:, L.OUT_THETA_MAX] - r[:, L.OUT_THETA_MAX])
-    up = safe & (r[:, L.OUT_THETA_MAX] >= THETA_FLOOR * alpha)
+    up = safe & (r[:, L.OUT_THETA_MAX] >= THETA_REL_FLOOR * alpha)
     bal = (ke[:, L.OUT_W_IN] - ke[:, L.OUT_D_DAMP] - ke[:, L.OUT_E_IMPACT]
            - ke[:, L.OUT_E_END])
     return {

@@ -140,9 +140,11 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     if quiet:
         return
     from rocksweep.store import read_result
-    from rocksweep.summary import counts_lines
+    from rocksweep.summary import check_info, counts_lines, format_check, read_info
 
-    for line in counts_lines(read_result(out, ["outcome", "status"])):
+    # one read of the file: with error estimates, what info reports on them too
+    result = read_info(out) if scene.check else read_result(out, ["outcome", "status"])
+    for line in counts_lines(result):
         click.echo(line)
     a = report.attrs
     resumed = f" ({report.done_before} were done before)" if report.done_before else ""
@@ -166,9 +168,7 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
             vals = report_cells(scene, v.differ[:5])
             click.echo("  e.g. " + "; ".join(vals))
     if scene.check:
-        from rocksweep.summary import check_info, format_check, read_info
-
-        for line in format_check(check_info(read_info(out))):
+        for line in format_check(check_info(result)):
             click.echo(line)
     click.echo(f"accuracy: {scene.numerics.describe()}")
     click.echo(f"RK4 steps: {a['steps_total']} + {a['event_steps_total']} event "
