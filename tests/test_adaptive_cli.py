@@ -14,6 +14,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from helpers import one_line_error
 
 import rocksweep
 import rocksweep.adaptive as ad
@@ -34,14 +35,6 @@ FIG3_SMALL = BODY3 + ("impact: {lam: [0.0, 0.4]}\n"
 BLOCK_LONG = ("body: {kind: block, alpha: 0.2, inertia: 1.3333333333333333}\n"
               "pulse: {shape: sine, w_over_p: {start: 0.05, stop: 0.6, num: 33},\n"
               "        A_ratio: {start: 0.5, stop: 2.5, num: 33}}\n")
-
-
-def one_line_error(result) -> str:
-    assert result.exit_code != 0
-    lines = result.output.strip().splitlines()
-    assert len(lines) == 1, result.output
-    assert "Traceback" not in result.output
-    return lines[0]
 
 
 def sweep(cli, scene: Path, out: Path, *args: str):

@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 import pytest
+from helpers import one_line_error
 
 from rocksweep import sweep as sw
 from rocksweep.cli import main
@@ -169,9 +170,7 @@ def test_bad_check_value_is_one_line(cli, tmp_path):
     path = tmp_path / "s.yaml"
     path.write_text(SCENE + "outputs: {check: 3}\n")
     r = cli.invoke(main, ["sweep", str(path), "-o", str(tmp_path / "x.h5")])
-    assert r.exit_code == 1
-    lines = r.output.strip().splitlines()
-    assert len(lines) == 1 and "outputs.check = 3: must be true or false" in lines[0]
+    assert "outputs.check = 3: must be true or false" in one_line_error(r, code=1)
     assert not (tmp_path / "x.h5").exists()
 
 

@@ -12,6 +12,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from helpers import one_line_error
 
 from rocksweep.cli import main
 from rocksweep.numerics import PRESETS
@@ -23,14 +24,6 @@ CI_SMALL = ROOT / "configs" / "ci-small.yaml"
 
 BODY3 = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, "
          "mA_over_m: 0.47, IA_ratio: 0.56}\n")
-
-
-def one_line_error(result) -> str:
-    assert result.exit_code != 0
-    lines = result.output.strip().splitlines()
-    assert len(lines) == 1, result.output
-    assert "Traceback" not in result.output
-    return lines[0]
 
 
 def assert_same_results(a: Path, b: Path) -> None:

@@ -29,6 +29,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from helpers import one_line_error
 
 import rocksweep.store as store
 from rocksweep.cli import main
@@ -69,13 +70,9 @@ def partial_file(path: Path, scene, n_done: int) -> None:
     sf.close()
 
 
-def one_line(res) -> str:
-    """The single line of a failed CLI run (no traceback)."""
-    assert res.exit_code == 1, (res.exit_code, res.output)
-    assert res.exception is None or isinstance(res.exception, SystemExit), res.exception
-    lines = res.output.strip().splitlines()
-    assert len(lines) == 1 and "Traceback" not in res.output, res.output
-    return lines[0]
+def one_line(result) -> str:
+    """The single line of a failed CLI run: exit 1, no traceback (``one_line_error``)."""
+    return one_line_error(result, code=1)
 
 
 def arrays_of(path: Path) -> dict[str, np.ndarray]:

@@ -9,6 +9,7 @@ import stat
 from pathlib import Path
 
 import pytest
+from helpers import one_line_error
 
 from rocksweep.cli import main
 from rocksweep.errors import OutputError
@@ -20,11 +21,8 @@ ONE_POINT = ["--set", "pulse.shape=sine", "--set", "impact.lam=0", "--set",
 
 
 def one_line(result) -> str:
-    assert result.exit_code == 1, result.output
-    assert "Traceback" not in result.output
-    lines = [ln for ln in result.output.splitlines() if ln.strip()]
-    assert len(lines) == 1, result.output
-    return lines[0]
+    """The single line of a failed CLI run: exit 1, no traceback (``one_line_error``)."""
+    return one_line_error(result, code=1)
 
 
 @pytest.fixture()

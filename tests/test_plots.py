@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import one_line_error
 from matplotlib.colors import to_rgb
 from matplotlib.figure import Figure
 
@@ -20,14 +21,6 @@ from rocksweep.sweep import ChunkResult, variables
 ROOT = Path(__file__).resolve().parents[1]
 BODY3 = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: {start: 0.1, stop: 0.2, num: 3}, "
          "alpha_A: 0.28, mA_over_m: 0.47, IA_ratio: 0.56}\n")
-
-
-def one_line_error(result) -> str:
-    assert result.exit_code != 0
-    lines = result.output.strip().splitlines()
-    assert len(lines) == 1, result.output
-    assert "Traceback" not in result.output
-    return lines[0]
 
 
 def visible_axes(fig: Figure) -> list:
