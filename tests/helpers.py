@@ -16,3 +16,31 @@ def one_line_error(result, code: int | None = None) -> str:
     lines = result.output.strip().splitlines()
     assert len(lines) == 1, result.output
     return lines[0]
+
+
+def kill_sweep_when(args: list[str], cwd, ready, timeout: float = 300.0) -> None:
+    """Run ``rocksweep sweep ARGS`` in a subprocess and SIGKILL it as soon as ``ready()``
+    is true (polled); assert it was killed, not finished. Compile the kernel in the test
+    first, so that the subprocess loads numba's cache and starts at once."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    proc = subprocess.Popen(
+        [sys.executable, "-c", "from rocksweep.cli import main; main()", "sweep", *args],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=cwd)
+    try:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline and proc.poll() is None:
+            if ready():
+                break
+            time.sleep(0.005)
+        assert proc.poll() is None, "the sweep ended before it could be killed"
+        os.kill(proc.pid, signal.SIGKILL)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        proc.communicate(timeout=30)
+    assert proc.returncode == -signal.SIGKILL

@@ -4,17 +4,12 @@ chunking, backend and interruptions (SIGKILL included), and resumes only with it
 settings."""
 
 import json
-import os
-import signal
-import subprocess
-import sys
-import time
 from pathlib import Path
 
 import h5py
 import numpy as np
 import pytest
-from helpers import one_line_error
+from helpers import kill_sweep_when, one_line_error
 
 import rocksweep
 import rocksweep.adaptive as ad
@@ -210,24 +205,9 @@ def test_sigkill_and_resume_equals_uninterrupted_run(cli, tmp_path):
     from rocksweep.grid import Grid
 
     prepare(Grid(sc), level(sc))  # the subprocess loads numba's cache and starts at once
-    proc = subprocess.Popen(
-        [sys.executable, "-c", "from rocksweep.cli import main; main()", "sweep", str(scene),
-         "-o", str(killed), "--adaptive", "--jobs", "1", "--chunk-size", "4",
-         "--write-every", "0", "--quiet"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=tmp_path)
-    try:
-        deadline = time.monotonic() + 300
-        while time.monotonic() < deadline and proc.poll() is None:
-            if _computed_points(killed) >= 300:
-                break
-            time.sleep(0.005)
-        assert proc.poll() is None, "the sweep ended before it could be killed"
-        os.kill(proc.pid, signal.SIGKILL)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-        proc.communicate(timeout=30)
-    assert proc.returncode == -signal.SIGKILL
+    kill_sweep_when([str(scene), "-o", str(killed), "--adaptive", "--jobs", "1",
+                     "--chunk-size", "4", "--write-every", "0", "--quiet"], tmp_path,
+                    lambda: _computed_points(killed) >= 300)
     partial = read_result(killed)  # a well-formed file, part done
     n_before = int((partial.arrays["computed"] > 0).sum())
     assert n_before >= 300 and not partial.attrs["complete"]

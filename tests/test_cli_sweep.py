@@ -12,7 +12,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from helpers import one_line_error
+from helpers import kill_sweep_when, one_line_error
 
 from rocksweep.cli import main
 from rocksweep.numerics import PRESETS
@@ -307,24 +307,9 @@ def test_kill_and_resume_equals_uninterrupted_run(cli, tmp_path):
 
     sc = load_scene(scene)
     prepare(Grid(sc), level(sc))
-    proc = subprocess.Popen(
-        [sys.executable, "-c", "from rocksweep.cli import main; main()", "sweep", str(scene),
-         "-o", str(killed),
-         "--jobs", "1", "--chunk-size", "40", "--write-every", "0", "--quiet"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=tmp_path)
-    try:
-        deadline = time.monotonic() + 300
-        while time.monotonic() < deadline and proc.poll() is None:
-            if _done_points(killed) >= 400:
-                break
-            time.sleep(0.01)
-        assert proc.poll() is None, "the sweep ended before it could be killed"
-        os.kill(proc.pid, signal.SIGKILL)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-        proc.communicate(timeout=30)
-    assert proc.returncode == -signal.SIGKILL
+    kill_sweep_when([str(scene), "-o", str(killed), "--jobs", "1", "--chunk-size", "40",
+                     "--write-every", "0", "--quiet"], tmp_path,
+                    lambda: _done_points(killed) >= 400)
     partial = read_result(killed)  # a well-formed file, part done
     n_before = int(partial.done.sum())
     assert 400 <= n_before < total
