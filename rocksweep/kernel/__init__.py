@@ -4,16 +4,30 @@
 effect set; ``warm_up`` compiles one now. One idea per module:
 
 - ``layout``: the arrays' index constants (parameter row, result row, history, state);
-- ``equations``: the physics, pure formulas (also called by ``rocksweep.reference``);
+  plain Python, importable without numba;
+- ``equations``: the physics, pure formulas (also called by ``rocksweep.physics.reference``);
 - ``stepping``: the right-hand side on the state and one RK4 step;
 - ``events``: event functions, detection inside a step and location of the root;
 - ``transitions``: uplift, the impact map, the rest and rigid-bound early exits;
 - ``loop``: ``simulate_point``, one point from start to outcome;
 - ``variants``: the compiled entry points and their tables;
-- ``_cache``: where numba caches them, stamped by the hash of these sources.
+- ``_cache``: where numba caches them, stamped by the hash of these sources (imported
+  by every module that defines a jitted function, before its first ``@njit(cache=True)``).
+
+The package is lazy (PEP 562): ``from rocksweep.kernel import layout`` loads no numba;
+the entry points load the variants (and numba) on first access.
 """
 
-from rocksweep.kernel import _cache  # noqa: F401  (must precede every @njit(cache=True))
-from rocksweep.kernel.variants import chunk_kernel, point_kernel, warm_up
+from __future__ import annotations
+
+from typing import Any
 
 __all__ = ["chunk_kernel", "point_kernel", "warm_up"]
+
+
+def __getattr__(name: str) -> Any:
+    if name in __all__:
+        from rocksweep.kernel import variants
+
+        return getattr(variants, name)
+    raise AttributeError(f"module 'rocksweep.kernel' has no attribute {name!r}")
