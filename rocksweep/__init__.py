@@ -9,6 +9,10 @@ The Python API (see the README's "Python API"):
 - ``rocksweep.open(path)``: a result file -> xarray.Dataset.
 - ``rocksweep.simulate(scene, overrides=(), **keys)``: one point with its time history
   -> ``Simulation`` (``.summary`` dict, ``.history`` Dataset over p*t, ``.figure()``).
+- ``rocksweep.plot(ds, x=, y=, ax=, width=)`` -> Figure; ``rocksweep.boundaries(ds,
+  rtol=)`` -> Dataset of A_min; ``rocksweep.boundary_lines(ds)`` -> DataFrame;
+  ``rocksweep.spectra(ds)`` -> Dataset; ``rocksweep.estimate(scene)``: the cost of a run.
+  Each analysis takes what ``run`` and ``open`` return.
 - ``rocksweep.RocksweepError``: the base of every error a user can fix (one line).
 
 Importing the package is light: numba, h5py, xarray and matplotlib load on first use.
@@ -16,7 +20,16 @@ Importing the package is light: numba, h5py, xarray and matplotlib load on first
 
 from __future__ import annotations
 
-from rocksweep.api import open, run, simulate  # noqa: A004
+from rocksweep.api import (  # noqa: A004
+    boundaries,
+    boundary_lines,
+    estimate,
+    open,
+    plot,
+    run,
+    simulate,
+    spectra,
+)
 from rocksweep.errors import RocksweepError
 
 
@@ -39,4 +52,5 @@ def _version() -> str:
 
 
 __version__ = _version()
-__all__ = ["RocksweepError", "__version__", "open", "run", "simulate"]
+__all__ = ["RocksweepError", "__version__", "boundaries", "boundary_lines", "estimate", "open",
+           "plot", "run", "simulate", "spectra"]

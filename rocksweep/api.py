@@ -26,9 +26,9 @@ if TYPE_CHECKING:
     import xarray as xr
     from matplotlib.figure import Figure
 
-    from rocksweep.adaptive import AdaptiveStats, Options, Validation
-    from rocksweep.scene import Scene
-    from rocksweep.single import Run
+    from rocksweep.compute.adaptive import AdaptiveStats, Options, Validation
+    from rocksweep.compute.single import Run
+    from rocksweep.scene.scene import Scene
 
 SceneLike = Union[str, Path, Mapping[str, Any]]  # noqa: UP007 (a runtime alias on 3.10)
 Overrides = Union[Sequence[str], Mapping[str, Any]]  # noqa: UP007
@@ -82,7 +82,7 @@ def load(scene: SceneLike | Scene, overrides: Overrides | None = ()) -> tuple[Sc
     mapping (the YAML's structure); or a ``Scene`` (then without overrides). Errors are
     one-line SceneErrors.
     """
-    from rocksweep.scene import Scene, SceneError, load_scene, parse_scene
+    from rocksweep.scene.scene import Scene, SceneError, load_scene, parse_scene
 
     ov = override_strings(overrides)
     if isinstance(scene, Scene):
@@ -204,13 +204,13 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
     ``scheduler``, an address); chunk_size: points per chunk (default about 32 chunks per
     worker); progress: a progress bar on stderr; log: receives the header and kernel
     lines; inputs: the command's input files, never written over; overrides: recorded in
-    the file; adaptive: compute only near the class boundaries (``rocksweep.adaptive``,
+    the file; adaptive: compute only near the class boundaries (``rocksweep.compute.adaptive``,
     see ``_adaptive_loop``; the file records the settings, and a resume must give the
     same); validate: with adaptive, also compute the filled points of a coarse uniform
     lattice and report those whose class differs from the fill (``report.validation``;
     the file is not changed). Returns a ``SweepReport``.
     """
-    from rocksweep import sweep as sw
+    from rocksweep.compute import sweep as sw
     from rocksweep.outputs import OutputError, check_output
 
     if resume and overwrite:
@@ -232,11 +232,11 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
     say = log or (lambda _line: None)
     settings = None
     if adaptive is not None:
-        from rocksweep.grid import Grid
+        from rocksweep.compute.grid import Grid
 
         settings = adaptive.resolved(Grid(scene))  # bad axes or settings: before any file
 
-    from rocksweep.store import SweepFile
+    from rocksweep.store.sweepfile import SweepFile
 
     path = Path(path)
     t0 = time.perf_counter()
@@ -290,9 +290,9 @@ def _every_point_loop(sf, report: SweepReport, _options: None, *, jobs: int, bac
                       pending: list) -> None:
     """Compute every missing point of an open file, writing finished chunks every
     ``write_every`` seconds (and the pending ones whatever ends the loop)."""
-    from tqdm import tqdm
+    from tqdm.auto import tqdm
 
-    from rocksweep import sweep as sw
+    from rocksweep.compute import sweep as sw
 
     scene = sf.grid.scene
 
@@ -331,7 +331,7 @@ def _every_point_loop(sf, report: SweepReport, _options: None, *, jobs: int, bac
 
 def _prepare_kernel(sf, lvl: int, report: SweepReport, say: Callable[[str], None]) -> None:
     """Compile or load the kernel variants the grid needs, saying what happens."""
-    from rocksweep import sweep as sw
+    from rocksweep.compute import sweep as sw
 
     to_compile, unknown = sw.kernel_cache_state(sf.grid, lvl)
     if to_compile:
@@ -351,7 +351,7 @@ def _adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, back
                    scheduler: str | None, chunk_size: int | None, where: str,
                    write_every: float, progress: bool, say: Callable[[str], None],
                    pending: list, validate: bool = False) -> None:
-    """The adaptive sweep of an open file (``rocksweep.adaptive``).
+    """The adaptive sweep of an open file (``rocksweep.compute.adaptive``).
 
     The state (outcome, computed) is read from the file; ``adaptive.next_step`` plans a
     batch from it; the batch runs through ``adaptive.run_batch`` (the chunk machinery:
@@ -363,10 +363,10 @@ def _adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, back
     result (see ``adaptive.next_step``).
     """
     import numpy as np
-    from tqdm import tqdm
+    from tqdm.auto import tqdm
 
-    from rocksweep import adaptive as ad
-    from rocksweep import sweep as sw
+    from rocksweep.compute import adaptive as ad
+    from rocksweep.compute import sweep as sw
 
     scene = sf.grid.scene
     plan = options.plan(sf.grid)
@@ -447,10 +447,11 @@ def _stderr(line: str) -> None:
 
 def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
         overrides: Overrides = (), progress: bool = False, overwrite: bool = False,
-        resume: bool = False, adaptive: bool = False, validate: bool = False,
-        coarse: int | None = None,
-        audit: float | None = None, axes: Sequence[str] | None = None,
-        **adaptive_settings: Any) -> xr.Dataset:
+        resume: bool = False, client: Any = None, adaptive: bool = False,
+        validate: bool = False, coarse: int | None = None, audit: float | None = None,
+        axes: Sequence[str] | None = None, margin: int | None = None,
+        final_margin: int | None = None, seed: int | None = None,
+        threshold: float | None = None) -> xr.Dataset:
     """Compute every point of a scene's grid; return the results as an xarray Dataset.
 
     scene: a path to a scene YAML file, YAML text, or a dict with the YAML's structure.
@@ -458,7 +459,9 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
     there (written exactly as ``rocksweep sweep SCENE -o OUTPUT`` writes it; an existing
     file is refused unless ``overwrite``; ``resume`` finishes an interrupted file of the
     same scene). overrides: ``["impact.lam=0.2"]`` or ``{"impact.lam": 0.2}``.
-    progress: print the header and a progress bar on stderr.
+    progress: print the header and a progress bar (``tqdm.auto``: a widget in notebooks).
+    client: a ``dask.distributed.Client``: the points run on its cluster (e.g. a
+    ``LocalCluster``'s workers) instead of local threads (jobs is then not used).
 
     The Dataset has the file's variables (outcome: -1 not computed, 0 safe, 1 mode 1, 2
     mode 2; impacts, uplifts, theta_max_over_alpha, t_overturn, status, steps,
@@ -467,12 +470,12 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
     the unswept keys as scalar coordinates and the file's attributes (see ``open``). It
     is loaded in memory; without ``output`` no file is kept.
 
-    adaptive: compute only near the class boundaries (``rocksweep.adaptive``; the same
+    adaptive: compute only near the class boundaries (``rocksweep.compute.adaptive``; the same
     as ``rocksweep sweep --adaptive``): coarse: the coarse level (every 2**coarse-th
     point of the diagram axes first; default: 16 coarse cells per axis); audit: share of
     the filled points computed as a check (default 0.02); axes: the two diagram axes
-    (default ("w_over_p", "A_ratio")); further settings as keywords (margin,
-    final_margin, seed, threshold: see ``rocksweep.adaptive.Options``); validate: check
+    (default ("w_over_p", "A_ratio")); margin, final_margin, seed, threshold: see
+    ``rocksweep.compute.adaptive.Options``; validate: check
     the fill on a coarse uniform lattice (printed with ``progress``). The Dataset then
     also has ``computed`` (0 filled, 1 computed, 2/3 audit point that agreed/disagreed)
     and filled points hold their "not computed" values in every variable but outcome.
@@ -483,9 +486,16 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
     """
     sc, source = load(scene, overrides)
     opts = adaptive_options(adaptive, base=sc.refine, coarse=coarse, audit=audit, axes=axes,
-                            **adaptive_settings)
+                            margin=margin, final_margin=final_margin, seed=seed,
+                            threshold=threshold)
     ov = override_strings(overrides)
     log = _stderr if progress else None
+    where = {"backend": "threads"}
+    if client is not None:
+        address = getattr(getattr(client, "scheduler", None), "address", None)
+        if not isinstance(address, str):
+            raise TypeError(f"client = {client!r}: must be a dask.distributed.Client")
+        where = {"backend": "dask", "scheduler": address}
     if output is None:
         if resume:
             raise ApiError("resume=True needs output= (the file to finish)")
@@ -494,21 +504,21 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
         with tempfile.TemporaryDirectory(prefix="rocksweep-") as tmp:
             path = Path(tmp) / "result.h5"
             sweep_file(sc, path, overrides=ov, jobs=jobs, progress=progress, log=log,
-                       adaptive=opts, validate=validate)
+                       adaptive=opts, validate=validate, **where)
             return open(path)
     sweep_file(sc, output, overrides=ov, jobs=jobs, resume=resume, overwrite=overwrite,
                progress=progress, log=log, inputs=[source] if source else (),
-               adaptive=opts, validate=validate)
+               adaptive=opts, validate=validate, **where)
     return open(output)
 
 
 def adaptive_options(adaptive: bool, base: dict | None = None,
                      **settings: Any) -> Options | None:
-    """``rocksweep.adaptive.Options`` from keyword settings (None values: the defaults);
+    """``rocksweep.compute.adaptive.Options`` from keyword settings (None values: the defaults);
     None when not ``adaptive``, then any setting given is an ApiError. base: a scene's
     ``refine`` section (``Scene.refine``): it turns adaptive on, and the keyword settings
     override its values."""
-    from rocksweep.adaptive import Options
+    from rocksweep.compute.adaptive import Options
 
     given = {k: v for k, v in settings.items() if v is not None}
     if base is not None:
@@ -550,7 +560,7 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
 
     from rocksweep import fields
     from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
-    from rocksweep.store import read_result
+    from rocksweep.store.sweepfile import read_result
 
     path = Path(path)
     read_result(path, ["outcome"])  # one-line errors for foreign or damaged files
@@ -572,6 +582,94 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
 
 
 # ---------------------------------------------------------------------------------------
+# Analyses: a result Dataset in, a Dataset, a DataFrame or a Figure out
+# ---------------------------------------------------------------------------------------
+
+def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any = None,
+         curves: bool = False, show_computed: bool = False,
+         width: str | None = None) -> Figure:
+    """The stability diagram of a result (Figures 3 and 4) as a pyplot-free Figure.
+
+    ds: what ``run`` or ``open`` returns. x, y: the swept keys on the axes (default
+    w_over_p and A_ratio, or the two swept keys besides lam); one panel per value of the
+    other swept keys, the lam values overlaid; a result with one swept key besides lam is
+    a line plot. ax: an Axes (or one per panel) to draw into; the legend then goes outside
+    the axes, once per figure. curves: the class boundary lines; show_computed: shade
+    the points an adaptive sweep computed. width: "single" or "double" (journal column
+    widths with fonts to match), None for matplotlib's defaults.
+    """
+    import matplotlib
+
+    from rocksweep.figures.common import width_style
+    from rocksweep.figures.diagrams import sweep_figure
+    from rocksweep.store.sweepfile import as_result
+
+    result = as_result(ds)
+    with matplotlib.rc_context(width_style(width)):
+        return sweep_figure(result, x, y, axes=ax, option_names=("x", "y"), curves=curves,
+                            show_computed=show_computed)
+
+
+def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None) -> xr.Dataset:
+    """A_min: the smallest amplitude (A_ratio) that overturns, for every x (w_over_p or
+    p) of the diagram, bisected to the relative tolerance ``rtol`` between the last safe
+    and the first overturning grid value with kernel runs at the sweep's accuracy.
+
+    ds: a complete result (``run`` / ``open``) with a diagram over (w_over_p, A_ratio).
+    mode: 1 or 2 for that overturning mode only. Returns a Dataset: ``A_min`` (NaN: no
+    grid value of the column overturns), ``mode``, the final bracket ``lo``/``hi`` and
+    the kernel ``runs``, over every other swept key (e.g. shape, lam) and x. The class
+    boundary polylines: ``boundary_lines(ds)``.
+    """
+    from rocksweep.analysis import boundaries as bd
+    from rocksweep.store.sweepfile import as_result
+
+    if not (isinstance(rtol, int | float) and 0 < rtol < 1):
+        raise ApiError(f"rtol = {rtol!r}: must be a relative tolerance in (0, 1)")
+    if mode not in (None, 1, 2):
+        raise ApiError(f"mode = {mode!r}: must be None, 1 or 2")
+    result = as_result(ds, ["outcome"])
+    curves, _ = bd.result_curves(result, rtol, mode)
+    return bd.curves_dataset(curves, {"title": result.name, "rtol": rtol,
+                                      "mode": "any" if mode is None else f"mode{mode}"})
+
+
+def boundary_lines(ds: xr.Dataset) -> Any:
+    """The lines between classes of a complete result's diagrams as a tidy
+    ``pandas.DataFrame``: one row per vertex with the panel's other swept keys, ``line``,
+    ``classes`` (e.g. "safe|mode1"), ``closed``, ``vertex``, ``x``, ``y`` (axis values)."""
+    from rocksweep.analysis import boundaries as bd
+    from rocksweep.store.sweepfile import as_result
+
+    result = as_result(ds, ["outcome"])
+    sc = bd.check_result(result)
+    return bd.lines_frame(bd.diagram_boundaries(sc, result.arrays["outcome"]))
+
+
+def spectra(ds: xr.Dataset, rtol: float = 1e-3) -> xr.Dataset:
+    """Rocking and overturning spectra of a complete sweep over p (a record) or w_over_p,
+    A_ratio and optionally lam: ``theta_max_over_alpha`` and ``outcome`` over (lam,
+    A_ratio, p), ``A_min`` and ``mode`` over (lam, p), A_min bisected to ``rtol``."""
+    from rocksweep.analysis.spectrum import spectra as compute_spectra
+
+    if not (isinstance(rtol, int | float) and 0 < rtol < 1):
+        raise ApiError(f"rtol = {rtol!r}: must be a relative tolerance in (0, 1)")
+    return compute_spectra(ds, rtol).to_dataset()
+
+
+def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> Any:
+    """What ``run`` of this scene will cost on this machine, without running it: points,
+    RK4 steps and evaluations expected, seconds of compute with ``jobs`` workers, and
+    whether a kernel variant must be compiled first (and for how long). Measured on a
+    sample of 256 points when the kernel is compiled (~10 ms), else from the step bound.
+    Returns ``rocksweep.compute.sweep.Estimate`` (``str()`` is one line)."""
+    from rocksweep.compute.sweep import estimate as sweep_estimate
+
+    sc, _ = load(scene, overrides)
+    return sweep_estimate(sc, jobs=jobs)
+
+
+# ---------------------------------------------------------------------------------------
 # rocksweep.simulate
 # ---------------------------------------------------------------------------------------
 
@@ -584,7 +682,7 @@ class Simulation:
     steps, event_steps, accuracy, wall_time_s); history: xarray Dataset over ``p_t``
     (``rocksweep.fields.HISTORY``: theta_over_alpha, u_over_ucr, E_over_Eref, ..., each
     with ``units``; at an event p_t repeats: the rows before and after it); run: the
-    underlying ``rocksweep.single.Run``.
+    underlying ``rocksweep.compute.single.Run``.
     """
 
     summary: dict
@@ -595,7 +693,7 @@ class Simulation:
     def figure(self) -> Figure:
         """Figure 5 for this run (pulse, theta/alpha, E/E_ref, dissipated energy against
         p*t) as a pyplot-free matplotlib Figure: show it in a notebook or ``savefig``."""
-        from rocksweep.plots import time_history
+        from rocksweep.figures.common import time_history
 
         return time_history([self.run], (), self.title)
 
@@ -631,7 +729,7 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /, **keys: Any) -> Sim
     simulate``). Returns a ``Simulation`` (summary dict, history Dataset over p*t, and
     ``.figure()``).
     """
-    from rocksweep.single import simulate as run_point
+    from rocksweep.compute.single import simulate as run_point
 
     ov = [*override_strings(overrides), *override_strings(keys)]
     sc, _ = load(scene, ov)
@@ -645,8 +743,8 @@ def simulate_runs(scene: Scene, max_runs: int = MAX_RUNS) -> list[Run]:
     ``max_runs`` points."""
     from itertools import product
 
-    from rocksweep.scene import SceneError
-    from rocksweep.single import simulate as run_point
+    from rocksweep.compute.single import simulate as run_point
+    from rocksweep.scene.scene import SceneError
 
     if scene.size > max_runs:
         big = max(scene.swept, key=lambda a: len(a.values))

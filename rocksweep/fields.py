@@ -8,7 +8,7 @@ says its dtype, the fill value of a point not computed, its unit, its meaning, t
 slot it comes from and the per-point scale it is divided by (theta by alpha_ref, energies
 by E_ref). ``HISTORY`` does the same for the columns of a time history (``HIST_*``).
 
-Units follow the conventions of ``rocksweep.model``: times are p*t (unit ``1/p``),
+Units follow the conventions of ``rocksweep.physics.model``: times are p*t (unit ``1/p``),
 rotations theta/alpha_ref (unit ``alpha_ref``: alpha_cg of a flexible body, alpha of a
 block), lateral displacements u/u_cr, energies E/E_ref; ``1`` is a count, a code or a
 pure number.
@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.model import G
+from rocksweep.physics.model import G
 
 
 @dataclass(frozen=True)
@@ -54,6 +54,14 @@ class Field:
     energy: bool = False
     contact: bool = False
     check: str = ""
+    label: str = ""
+    symbol: str = ""
+
+    @property
+    def long_name(self) -> str:
+        """Short name without units (the ``long_name`` attribute); ``meaning`` is the
+        ``description``."""
+        return self.label or self.meaning
 
 
 _FLAGGED = "status & (horizon | step_cap | event_cap | nonfinite)"
@@ -61,25 +69,36 @@ _FLAGGED = "status & (horizon | step_cap | event_cap | nonfinite)"
 FIELDS: tuple[Field, ...] = (
     Field("outcome", "int8", L.OUTCOME_NOT_RUN, "1",
           "-1 not computed, 0 safe, 1 mode 1 (overturned after impacts), "
-          "2 mode 2 (overturned without impact)", L.OUT_OUTCOME),
-    Field("impacts", "int32", -1, "1", "number of impacts", L.OUT_IMPACTS),
+          "2 mode 2 (overturned without impact)", L.OUT_OUTCOME,
+          label="outcome class"),
+    Field("impacts", "int32", -1, "1", "number of impacts", L.OUT_IMPACTS,
+          label="impacts"),
     Field("uplifts", "int32", -1, "1", "number of uplifts (rocking starts from full contact)",
-          L.OUT_UPLIFTS),
+          L.OUT_UPLIFTS,
+          label="uplifts"),
     Field("theta_max_over_alpha", "float64", math.nan, "alpha_ref", "max |theta| / alpha_ref",
-          L.OUT_THETA_MAX, "alpha_ref"),
+          L.OUT_THETA_MAX, "alpha_ref",
+          label="largest rotation", symbol="max|theta|/alpha_ref"),
     Field("t_overturn", "float64", math.nan, "1/p", "overturning time p*t (NaN if none)",
-          L.OUT_T_OVERTURN),
+          L.OUT_T_OVERTURN,
+          label="overturning time", symbol="p t_overturn"),
     Field("status", "int32", 0, "1",
-          f"bit flags (rocksweep.outcomes.STATUS_WORDS); flagged = {_FLAGGED}", L.OUT_STATUS),
-    Field("steps", "int64", 0, "1", "regular RK4 steps taken", L.OUT_STEPS),
+          f"bit flags (rocksweep.outcomes.STATUS_WORDS); flagged = {_FLAGGED}", L.OUT_STATUS,
+          label="status flags"),
+    Field("steps", "int64", 0, "1", "regular RK4 steps taken", L.OUT_STEPS,
+          label="RK4 steps"),
     Field("event_steps", "int64", 0, "1", "RK4 re-integrations spent locating events",
-          L.OUT_EVENT_STEPS),
+          L.OUT_EVENT_STEPS,
+          label="RK4 event re-integrations"),
     Field("work_in_over_Eref", "float64", math.nan, "E_ref",
-          "work of the ground motion / E_ref", L.OUT_W_IN, "E_ref", energy=True),
+          "work of the ground motion / E_ref", L.OUT_W_IN, "E_ref", energy=True,
+          label="work of the ground motion", symbol="W_in/E_ref"),
     Field("damper_loss_over_Eref", "float64", math.nan, "E_ref",
-          "energy dissipated by the damper / E_ref", L.OUT_D_DAMP, "E_ref", energy=True),
+          "energy dissipated by the damper / E_ref", L.OUT_D_DAMP, "E_ref", energy=True,
+          label="energy dissipated by the damper", symbol="E_damp/E_ref"),
     Field("impact_loss_over_Eref", "float64", math.nan, "E_ref",
-          "energy lost in impacts (net) / E_ref", L.OUT_E_IMPACT, "E_ref", energy=True),
+          "energy lost in impacts (net) / E_ref", L.OUT_E_IMPACT, "E_ref", energy=True,
+          label="energy lost in impacts", symbol="E_d/E_ref"),
     # single runs and the accuracy report only (not stored in sweep files)
     Field("t_end", "float64", math.nan, "1/p", "time p*t at which the run stopped",
           L.OUT_T_END, stored=False),
@@ -101,23 +120,29 @@ FIELDS: tuple[Field, ...] = (
     # where the model holds (outputs.contact; rocksweep.kernel.contact)
     Field("mu_required", "float64", math.nan, "1",
           "friction demand max |H|/N of the ground reactions over the run (inf: N <= 0)",
-          L.OUT_MU_REQ, contact=True),
+          L.OUT_MU_REQ, contact=True,
+          label="friction demand", symbol="max|H|/N"),
     Field("normal_min_over_Mg", "float64", math.nan, "1",
           "smallest normal reaction N/(M g) over the run (< 0: the body would lift off)",
-          L.OUT_N_MIN, contact=True),
+          L.OUT_N_MIN, contact=True,
+          label="smallest normal reaction", symbol="N_min/(M g)"),
     Field("impulse_ratio_max", "float64", math.nan, "1",
           "largest |horizontal|/vertical ground impulse of an impact (0: no impact)",
-          L.OUT_IMPULSE_MAX, contact=True),
+          L.OUT_IMPULSE_MAX, contact=True,
+          label="largest impulse ratio", symbol="max|P_H|/P_V"),
     # per-point error estimates (outputs.check): the same point rerun at half the step
     Field("check_outcome", "int8", L.OUTCOME_NOT_RUN, "1",
           "outcome of the point rerun at half the step (differs from outcome: not resolved "
-          "at this step)", L.OUT_OUTCOME, check="value"),
+          "at this step)", L.OUT_OUTCOME, check="value",
+          label="outcome at half the step"),
     Field("check_t_overturn_diff", "float64", math.nan, "1/p",
           "overturning time at half the step minus t_overturn (NaN unless both overturn): "
-          "an estimate of t_overturn's error", L.OUT_T_OVERTURN, check="diff"),
+          "an estimate of t_overturn's error", L.OUT_T_OVERTURN, check="diff",
+          label="overturning time error estimate", symbol="p dt_overturn"),
     Field("check_theta_max_diff", "float64", math.nan, "alpha_ref",
           "max |theta| at half the step minus theta_max, / alpha_ref: an estimate of "
-          "theta_max_over_alpha's error", L.OUT_THETA_MAX, "alpha_ref", check="diff"),
+          "theta_max_over_alpha's error", L.OUT_THETA_MAX, "alpha_ref", check="diff",
+          label="largest rotation error estimate", symbol="d max|theta|/alpha_ref"),
 )
 
 BY_NAME: dict[str, Field] = {f.name: f for f in FIELDS}
@@ -139,6 +164,14 @@ def sweep_fields(energy: bool, contact: bool = False, check: bool = False
     ``outputs.energy``, ``outputs.contact`` and ``outputs.check``)."""
     return (SWEEP_FIELDS + (ENERGY_FIELDS if energy else ())
             + (CONTACT_FIELDS if contact else ()) + (CHECK_FIELDS if check else ()))
+
+
+def variables(energy: bool = False, contact: bool = False, check: bool = False
+              ) -> dict[str, tuple[str, float, str]]:
+    """The per-point variables a sweep stores: name -> (dtype, fill value of a point not
+    computed, meaning), from ``sweep_fields`` (the one table, ``FIELDS``)."""
+    return {f.name: (f.dtype, f.fill, f.meaning)
+            for f in sweep_fields(energy, contact, check)}
 
 
 # Relative max|theta| errors (the accuracy study's theta_rel, the error estimates' tails in
@@ -203,6 +236,67 @@ def value(out: np.ndarray, f: Field, alpha_ref: float, E_ref: float) -> int | fl
         return None
     v /= {"": 1.0, "alpha_ref": alpha_ref, "E_ref": E_ref}[f.scale]
     return int(v) if np.dtype(f.dtype).kind == "i" else v
+
+
+# ---------------------------------------------------------------------------------------
+# Axes: the swept keys' names, units and the paper's symbols
+# ---------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class AxisMeta:
+    """A swept key as users see it: long_name (short, no units), CF units ("1": a pure
+    number), the paper's symbol (plain text; ``alpha_ref`` is alpha_cg for a flexible
+    body and alpha for a block) and its LaTeX form for figures."""
+
+    long_name: str
+    units: str
+    symbol: str
+    latex: str
+
+
+AXES: dict[str, AxisMeta] = {
+    "shape": AxisMeta("pulse shape", "", "shape", "pulse"),
+    "w_over_p": AxisMeta("pulse frequency ratio (Pi5)", "1", "omega/p", r"\omega/p"),
+    "A_ratio": AxisMeta("pulse amplitude ratio (Pi6)", "1", "A/(g tan alpha_ref)",
+                        r"A/(g\tan\alpha_{ref})"),
+    "p": AxisMeta("frequency parameter of the body", "rad/s", "p", "p"),
+    "lam": AxisMeta("impulse position ratio (Pi10)", "1", "lambda", r"\lambda"),
+    "wn_over_p": AxisMeta("spring frequency ratio (Pi1)", "1", "omega_n/p", r"\omega_n/p"),
+    "zeta": AxisMeta("damping ratio (Pi2)", "1", "zeta", r"\zeta"),
+    "alpha_cg": AxisMeta("slenderness of the centre of gravity (Pi3)", "rad", "alpha_cg",
+                         r"\alpha_{cg}"),
+    "alpha_A": AxisMeta("slenderness of the base mass (Pi4)", "rad", "alpha_A",
+                        r"\alpha_A"),
+    "mA_over_m": AxisMeta("base to top mass ratio (Pi8)", "1", "m_A/m", "m_A/m"),
+    "IA_ratio": AxisMeta("base inertia ratio (Pi9)", "1", "I_A/(m_A R_A^2)",
+                         r"I_A/(m_A R_A^2)"),
+    "alpha": AxisMeta("slenderness of the block", "rad", "alpha", r"\alpha"),
+    "inertia": AxisMeta("inertia ratio of the block", "1", "I_O/(M R^2)", r"I_O/(M R^2)"),
+}
+
+
+def axis_attrs(name: str, kind: str = "flexible") -> dict[str, str]:
+    """The attributes of a swept key's coordinate: long_name, units (none for words) and
+    symbol, with alpha_ref written as the body kind's slenderness (alpha_cg, alpha)."""
+    meta = AXES.get(name)
+    if meta is None:
+        return {"long_name": name, "units": "1", "symbol": name}
+    alpha = "alpha" if kind == "block" else "alpha_cg"
+    out = {"long_name": meta.long_name, "symbol": meta.symbol.replace("alpha_ref", alpha)}
+    if meta.units:
+        out["units"] = meta.units
+    return out
+
+
+def field_attrs(f: Field, kind: str = "flexible") -> dict[str, str]:
+    """The attributes of a result variable: long_name (short), description, rocksweep's
+    unit (``unit``, alpha_ref written as the body kind's slenderness) and the symbol."""
+    alpha = "alpha" if kind == "block" else "alpha_cg"
+    out = {"long_name": f.long_name, "description": f.meaning,
+           "rocksweep_units": f.unit.replace("alpha_ref", alpha)}
+    if f.symbol:
+        out["symbol"] = f.symbol.replace("alpha_ref", alpha)
+    return out
 
 
 # ---------------------------------------------------------------------------------------

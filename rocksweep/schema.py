@@ -2,8 +2,8 @@
 
 ``KEYS`` maps every dotted scene key to a ``Key``: the kind of value it holds, the range
 of admissible numbers (ends, inclusive or not, +inf allowed or not) and the text a user
-reads when a value is refused. The scene validator (``rocksweep.scene``) and the body
-classes (``rocksweep.model``) both check values here, so a body built from Python and a
+reads when a value is refused. The scene validator (``rocksweep.scene.scene``) and the body
+classes (``rocksweep.physics.model``) both check values here, so a body built from Python and a
 scene file get the same one-line message ``KEY = VALUE: what is allowed``.
 
 Bounds of the body's Pi groups. Beside the physical ranges (angles in (0, pi/2), lam in
@@ -118,7 +118,7 @@ KEYS: dict[str, Key] = {
     "outputs.check": Key("bool", "must be true or false (rerun every point at half the step "
                          "and store the differences: an error estimate per point)",
                          required=False, default=False),
-    # adaptive sweeps (rocksweep.adaptive, as `rocksweep sweep --adaptive`): the section's
+    # adaptive sweeps (rocksweep.compute.adaptive, as `rocksweep sweep --adaptive`): the section's
     # presence turns them on; CLI flags override its values
     "refine.axes": Key("string", "must be a list of the two diagram axes, swept ranges of "
                        "the scene, e.g. [w_over_p, A_ratio]", required=False),
@@ -134,7 +134,7 @@ KEYS: dict[str, Key] = {
                        "sample)", 0, 2**31 - 1, required=False),
     "refine.threshold": Key("number", "must be in [0, 1] (share of disagreeing audits "
                             "above which a run warns)", 0.0, 1.0, required=False),
-    # pulse families (rocksweep.excitation): full cycles of a sine or cosine, the
+    # pulse families (rocksweep.physics.excitation): full cycles of a sine or cosine, the
     # Mavroeidis-Papageorgiou pulse's oscillation parameter and phase
     "pulse.cycles": Key("integer", f"must be an integer in [1, {CYCLES_MAX}] (full cycles "
                         "of the sine or cosine)", 1, CYCLES_MAX, required=False, default=1),
@@ -143,7 +143,7 @@ KEYS: dict[str, Key] = {
     "pulse.nu": Key("number", "must be a finite angle in degrees (the MP pulse's phase)",
                     -math.inf, math.inf, lo_in=False, hi_in=False, required=False,
                     default=90.0),
-    # a recorded ground motion instead of a pulse (rocksweep.records)
+    # a recorded ground motion instead of a pulse (rocksweep.physics.records)
     "ground.record": Key("string", "must be the path of a PEER .AT2 file or a two-column "
                          "file (t [s], xg'' [g]), relative to the scene file"),
     "ground.A_ratio": Key("axis", "must be a finite number (the record scaled to a peak of "

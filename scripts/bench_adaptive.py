@@ -1,7 +1,7 @@
 """Adaptive vs full sweeps, side by side in one run (issue 11).
 
-For each scene: the full grid (``rocksweep.sweep.compute``) and the adaptive sweep
-(``rocksweep.adaptive.adaptive_compute``, default settings) with the same workers; prints
+For each scene: the full grid (``rocksweep.compute.sweep.compute``) and the adaptive sweep
+(``rocksweep.compute.adaptive.adaptive_compute``, default settings) with the same workers; prints
 the points computed / points in the grid, both wall times, the share of cells whose
 adaptive outcome equals the full grid's, and the audit counts. ``--study`` also replays
 the adaptive algorithm on the full grid's outcomes (no kernel runs: a point's class is
@@ -21,7 +21,7 @@ Targets: equal outcome on >= 99.9% of cells; <= 10% of the points computed at 40
 <= 4% at 1000 x 1000; Figure 3(a) 1000 x 1000 x 3 lam in < 20 s on 2 cores.
 
 Measured (``python scripts/bench_adaptive.py --jobs 2``, 2 shared cores; default settings,
-light last levels, see ``rocksweep.adaptive``): at 400 x 400, 4.69-6.28% computed and
+light last levels, see ``rocksweep.compute.adaptive``): at 400 x 400, 4.69-6.28% computed and
 99.9854-100% equal (Figure 4(b) worst: 70 one-point cells of 480 000); Figure 3(a) at
 1000 x 1000 x 3 lam: 3.77% computed (1.81 refinement + 1.96 audit), 99.9990% equal,
 4.1 s through ``rocksweep sweep --adaptive`` (the README has the table).
@@ -36,10 +36,10 @@ from pathlib import Path
 
 import numpy as np
 
-from rocksweep import adaptive as ad
-from rocksweep import sweep as sw
-from rocksweep.grid import Grid
-from rocksweep.scene import Scene, load_scene, parse_scene
+from rocksweep.compute import adaptive as ad
+from rocksweep.compute import sweep as sw
+from rocksweep.compute.grid import Grid
+from rocksweep.scene.scene import Scene, load_scene, parse_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGS = ("fig3a", "fig3b", "fig4a", "fig4b", "block")
@@ -141,7 +141,7 @@ def main() -> None:
             import tempfile
 
             from rocksweep.api import sweep_file
-            from rocksweep.store import read_result
+            from rocksweep.store.sweepfile import read_result
 
             with tempfile.TemporaryDirectory() as tmp:
                 t0 = time.perf_counter()

@@ -5,7 +5,7 @@ Grid: the Figure 4(a) pulse ranges (sine, omega/p in [0.15, 12], A/(g tan alpha_
 
   everything on   flexible body wn/p = 9.82, zeta = 0.05 (Table 3), energy accounting and
                   a time history (the single-run kernel ``point_kernel``, once per point)
-  simulate() loop the same, one ``rocksweep.single.simulate`` call per point (what a script
+  simulate() loop the same, one ``rocksweep.compute.single.simulate`` call per point (what a script
                   looping over single runs pays: rows built and histories copied per point)
   energy          same body, energy accounting, no history (``outputs: {energy: true}``)
   outcome-only    same body, outcome and summary metrics only (what sweeps run)
@@ -35,13 +35,13 @@ import time
 
 import numpy as np
 
+from rocksweep.compute.single import history_capacity, simulate
 from rocksweep.fields import check_rows
 from rocksweep.kernel import chunk_kernel, point_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.model import BlockBody, FlexibleBody
 from rocksweep.numerics import Numerics
-from rocksweep.points import Point, body_omega_rock, body_row, fill_rows, shape_code
-from rocksweep.single import history_capacity, simulate
+from rocksweep.physics.model import BlockBody, FlexibleBody
+from rocksweep.physics.points import Point, body_omega_rock, body_row, fill_rows, shape_code
 
 TABLE3 = dict(wn_over_p=9.82, zeta=0.05, alpha_cg=0.15, alpha_A=0.28, mA_over_m=0.47,
               IA_ratio=0.56)
@@ -99,7 +99,7 @@ def run_history(kind: int):
 
 
 def run_simulate(numerics: Numerics):
-    """What a script looping over ``rocksweep.single.simulate`` pays (energy + history)."""
+    """What a script looping over ``rocksweep.compute.single.simulate`` pays (energy + history)."""
     def run(points: np.ndarray) -> np.ndarray:
         return np.array([simulate(p, numerics, history=True).out for p in points])
     return run

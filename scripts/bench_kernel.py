@@ -21,7 +21,7 @@ Prints, measured side by side in one run (issue 7's benchmark):
    the scene's steps and event_tol: RK4 evaluations and microseconds per point, ns per
    evaluation and the roofline's share of it, the speed-up over bisection, and how many
    outcomes differ from bisection's.
-3. reference: scipy DOP853 (``rocksweep.reference``) on the accuracy study's stratified
+3. reference: scipy DOP853 (``rocksweep.physics.reference``) on the accuracy study's stratified
    sample (``--ref-points``; strata outcome x boundary, weights make scene estimates):
    weighted mean and median time per point, the kernel's on the same points (each a 1-row
    chunk call), the speed-up, and the outcome agreement with its standard error.
@@ -61,7 +61,7 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from rocksweep.accuracy import (
+from rocksweep.analysis.accuracy import (
     Sample,
     _agreement,
     boundary_mask,
@@ -69,15 +69,15 @@ from rocksweep.accuracy import (
     run_reference,
     stratified_sample,
 )
-from rocksweep.grid import Grid
+from rocksweep.compute.grid import Grid
+from rocksweep.compute.single import history_capacity
+from rocksweep.compute.sweep import auto_chunk_size, level, plan_chunks, prepare
 from rocksweep.kernel import chunk_kernel, point_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel.equations import contact_rhs, ground_acc, rocking_rhs
 from rocksweep.kernel.stepping import rk4_step
 from rocksweep.numerics import ROOTS
-from rocksweep.scene import Scene, load_scene
-from rocksweep.single import history_capacity
-from rocksweep.sweep import auto_chunk_size, level, plan_chunks, prepare
+from rocksweep.scene.scene import Scene, load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIGS = ROOT / "configs"

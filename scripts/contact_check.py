@@ -4,7 +4,7 @@
 
 Draws random points of a scene's grid, runs each with the RK4 kernel at the scene's preset
 (contact variant) and with the reference path (DOP853, rtol 1e-10, dense output sampled and
-refined: ``rocksweep.reference._Contact``), and prints the relative difference of
+refined: ``rocksweep.physics.reference._Contact``), and prints the relative difference of
 mu_required, normal_min_over_Mg and impulse_ratio_max per point and the worst over the
 points whose outcome agrees and whose values are finite.
 """
@@ -16,12 +16,12 @@ import math
 
 import numpy as np
 
-from rocksweep.grid import Grid
+from rocksweep.compute.grid import Grid
 from rocksweep.kernel import chunk_kernel
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.points import kernel_kind, point_row
-from rocksweep.reference import reference_run
-from rocksweep.scene import load_scene
+from rocksweep.physics.points import kernel_kind, point_row
+from rocksweep.physics.reference import reference_run
+from rocksweep.scene.scene import load_scene
 
 NAMES = (("mu_required", L.OUT_MU_REQ), ("normal_min_over_Mg", L.OUT_N_MIN),
          ("impulse_ratio_max", L.OUT_IMPULSE_MAX))

@@ -4,7 +4,7 @@
     python scripts/fingerprint.py check /tmp/before.npz     # on the new code
 
 Runs the four figures, the rigid body and block scenes and the CI grid through
-``rocksweep.sweep.compute`` (outcome kernels), the same grids with energy accounting on
+``rocksweep.compute.sweep.compute`` (outcome kernels), the same grids with energy accounting on
 (``outputs.energy``), and Figure 5's single runs with their time histories (history
 kernels). ``check`` prints the number of point-runs compared and every array that differs
 in any bit (NaN equals NaN); it exits 1 if any does.
@@ -25,9 +25,9 @@ SINGLE = ["fig5", "fig5-rigid"]
 def collect() -> dict[str, np.ndarray]:
     from itertools import product
 
-    from rocksweep.scene import load_scene
-    from rocksweep.single import simulate
-    from rocksweep.sweep import compute
+    from rocksweep.compute.single import simulate
+    from rocksweep.compute.sweep import compute
+    from rocksweep.scene.scene import load_scene
 
     arrays: dict[str, np.ndarray] = {}
     for name in SWEEPS:

@@ -13,7 +13,7 @@ No recorded motion can be downloaded here, so the project makes its own:
   p = 4 pi / w_over_p is the ``sine`` pulse scene of that w_over_p.
 - ``synthetic_nearfault.AT2``: a near-fault-like record, 25 s at DT = 0.005 s (NPTS =
   5001): a Mavroeidis-Papageorgiou velocity pulse (T_p = 1.6 s, gamma = 2.2, nu = 60 deg,
-  starting at 4 s, velocity amplitude 0.80 m/s; ``rocksweep.excitation``'s ``mp`` shape)
+  starting at 4 s, velocity amplitude 0.80 m/s; ``rocksweep.physics.excitation``'s ``mp`` shape)
   plus band-limited noise: white noise (numpy PCG64, seed 20240612) through a 4th-order
   zero-phase Butterworth band-pass 0.3-12 Hz, times the envelope (t/5 s)^2 exp(2 (1 -
   t/5 s)) with 1 s cosine tapers at both ends, scaled to an RMS of 0.06 g over 3-9 s; the
@@ -62,8 +62,8 @@ def sine_record() -> tuple[np.ndarray, float, str]:
 
 def mp_pulse_acc(t: np.ndarray) -> np.ndarray:
     """The record's MP pulse, ground acceleration [g] at times t [s]."""
-    from rocksweep.excitation import PulseShape, mp_peak
-    from rocksweep.model import G
+    from rocksweep.physics.excitation import PulseShape, mp_peak
+    from rocksweep.physics.model import G
 
     p = NF_PULSE
     w = 2.0 * math.pi / p["T_p"]
@@ -106,7 +106,7 @@ FILES = {"sine_1cycle.AT2": sine_record, "synthetic_nearfault.AT2": nearfault_re
 
 def main(argv: list[str] | None = None) -> int:
     from rocksweep.errors import RocksweepError
-    from rocksweep.records import at2_text, read_record, write_at2
+    from rocksweep.physics.records import at2_text, read_record, write_at2
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=RECORDS, help="directory (default records/)")

@@ -6,7 +6,7 @@ wn/p in [1, 60] (log-uniform), zeta in [0, 0.3] (a sixth exactly 0), alpha_cg in
 lam in [0, 1.5], w/p in [0.2, 12], |A_ratio| in [0.3, 20] (random sign), sine or cosine
 (uniform unless marked log: most pulses are far above the uplift threshold); plus a share
 of rigid bodies (wn/p = inf, same ranges otherwise). Runs the reference
-(``rocksweep.reference``, DOP853 at rtol 1e-10) once per sample (cached with ``--cache``)
+(``rocksweep.physics.reference``, DOP853 at rtol 1e-10) once per sample (cached with ``--cache``)
 and the kernel at each setting, and prints per setting: outcome agreement, flagged runs,
 and the median, 95th percentile and max of every error:
 
@@ -43,13 +43,13 @@ from pathlib import Path
 
 import numpy as np
 
-from rocksweep.accuracy import estimate_scores, format_scores
+from rocksweep.analysis.accuracy import estimate_scores, format_scores
 from rocksweep.fields import THETA_REL_FLOOR, check_rows
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.model import FlexibleBody
 from rocksweep.numerics import PRESETS, Numerics
-from rocksweep.points import Point, kernel_kind, point_row
+from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.points import Point, kernel_kind, point_row
 
 RIGID_SHARE = 0.15
 ZETA0_SHARE = 1 / 6
@@ -90,7 +90,7 @@ def describe(p: Point) -> str:
 def reference(points: list[Point], numerics: Numerics, cache: Path | None, tag: str
               ) -> tuple[np.ndarray, np.ndarray]:
     """Reference result rows float64[n, N_OUT] and seconds per point (cached)."""
-    from rocksweep.reference import reference_run, result_row
+    from rocksweep.physics.reference import reference_run, result_row
 
     path = cache / f"ref_{tag}.npz" if cache else None
     if path is not None and path.exists():

@@ -6,7 +6,7 @@ import stat
 import pytest
 from click.testing import CliRunner
 
-from rocksweep.model import FlexibleBody
+from rocksweep.physics.model import FlexibleBody
 
 
 @pytest.fixture(scope="session")

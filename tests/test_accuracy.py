@@ -4,7 +4,7 @@ import h5py
 import numpy as np
 import pytest
 
-from rocksweep.accuracy import (
+from rocksweep.analysis.accuracy import (
     Sample,
     _agreement,
     _allocate,
@@ -152,7 +152,7 @@ def test_roots_ladder_prices_every_root_finder_on_the_same_points(cli, tiny_scen
 def test_cli_ladder_choices_are_the_ladders():
     """The command's --ladder choices (kept literal so --help loads no numerics) name
     exactly the ladders the study knows."""
-    from rocksweep.accuracy import LADDERS
+    from rocksweep.analysis.accuracy import LADDERS
     from rocksweep.cli.accuracy import accuracy as command
 
     opt = next(p for p in command.params if p.name == "ladder_name")

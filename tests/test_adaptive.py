@@ -1,14 +1,14 @@
-"""Adaptive sweeps (rocksweep.adaptive): same outcomes as the full grid where the diagram is
+"""Adaptive sweeps (rocksweep.compute.adaptive): same outcomes as the full grid where the diagram is
 resolved, islands caught by the audit, results independent of workers, chunking and
 interruptions."""
 
 import numpy as np
 import pytest
 
-import rocksweep.adaptive as ad
-import rocksweep.sweep as sw
+import rocksweep.compute.adaptive as ad
+import rocksweep.compute.sweep as sw
 from rocksweep.errors import RocksweepError
-from rocksweep.scene import load_scene, parse_scene
+from rocksweep.scene.scene import load_scene, parse_scene
 
 # A rigid block under long pulses (omega/p <= 0.6): below A = g tan(alpha) (A_ratio < 1)
 # the ground cannot lift it (the inertial moment M A h_cg stays below the restoring

@@ -12,12 +12,12 @@ import pytest
 from helpers import kill_sweep_when, one_line_error
 
 import rocksweep
-import rocksweep.adaptive as ad
+import rocksweep.compute.adaptive as ad
 from rocksweep import api
 from rocksweep.cli import main
-from rocksweep.scene import parse_scene
-from rocksweep.store import read_result
-from rocksweep.sweep import level, prepare, variables
+from rocksweep.compute.sweep import level, prepare, variables
+from rocksweep.scene.scene import parse_scene
+from rocksweep.store.sweepfile import read_result
 
 BODY3 = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, "
          "mA_over_m: 0.47, IA_ratio: 0.56}\n")
@@ -94,7 +94,7 @@ def test_fig3_adaptive_equals_full_and_the_library(fig3_files):
     flags = a.arrays["computed"]
     # equal but for one point: the tip of a wedge of mode 1 poking one point across an
     # edge of the last level whose ends agree (a one-point feature the last level fills
-    # from its neighbours: rocksweep.adaptive._edge_points); only filled points differ
+    # from its neighbours: rocksweep.compute.adaptive._edge_points); only filled points differ
     differ = a.arrays["outcome"] != f.arrays["outcome"]
     assert np.argwhere(differ).tolist() == [[0, 22, 29]]
     assert (flags[differ] == ad.FILLED).all()
@@ -161,7 +161,7 @@ def test_interrupted_in_any_batch_resumes_to_the_same_file(fig3_files, tmp_path,
     monkeypatch.setattr(ad, "run_batch", cut_run_batch)
     monkeypatch.setattr(ad, "next_step", spy_next_step)
     if stop_in == "torn":
-        from rocksweep.store import SweepFile
+        from rocksweep.store.sweepfile import SweepFile
 
         real_write = SweepFile._write_at
 
@@ -202,7 +202,7 @@ def test_sigkill_and_resume_equals_uninterrupted_run(cli, tmp_path):
                      " A_ratio: {start: 0.3, stop: 8, num: 100}}\n")
     killed = tmp_path / "killed.h5"
     sc = parse_scene(scene.read_text())
-    from rocksweep.grid import Grid
+    from rocksweep.compute.grid import Grid
 
     prepare(Grid(sc), level(sc))  # the subprocess loads numba's cache and starts at once
     kill_sweep_when([str(scene), "-o", str(killed), "--adaptive", "--jobs", "1",
@@ -294,7 +294,7 @@ def test_plot_with_curves_and_run_api(fig3_files, cli, tmp_path):
         assert res.exit_code == 0 and "warning" not in res.output, res.output
         assert png.read_bytes().startswith(b"\x89PNG")
     # filled cells are drawn as computed ones: the same figure as the full sweep's
-    from rocksweep.diagrams import sweep_figure
+    from rocksweep.figures.diagrams import sweep_figure
 
     # (flagged points carry a mark only where computed: this scene has none)
     assert not read_result(full, ["status"]).flagged.any()
@@ -392,7 +392,7 @@ def test_validate_reports_filled_cells_that_differ(fig3_files, cli, tmp_path):
     sc = parse_scene(FIG3_SMALL)
     r = read_result(adapt)
     outcome, computed = r.arrays["outcome"].ravel(), r.arrays["computed"].ravel()
-    from rocksweep.grid import Grid
+    from rocksweep.compute.grid import Grid
 
     plan = ad.make_plan(sc, coarse=2)
     v0 = ad.validate(Grid(sc), plan, outcome, computed, stride=3)

@@ -14,14 +14,14 @@ import pytest
 import xarray as xr
 
 import rocksweep
-import rocksweep.sweep as sw
+import rocksweep.compute.sweep as sw
 from rocksweep import api, fields
 from rocksweep.cli import main
-from rocksweep.grid import Grid
+from rocksweep.compute.grid import Grid
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.model import FlexibleBody
-from rocksweep.scene import load_scene
-from rocksweep.store import read_result
+from rocksweep.physics.model import FlexibleBody
+from rocksweep.scene.scene import load_scene
+from rocksweep.store.sweepfile import read_result
 
 ROOT = Path(__file__).resolve().parents[1]
 CI_SMALL = ROOT / "configs" / "ci-small.yaml"
@@ -69,7 +69,8 @@ def test_public_names_have_docstrings_and_version(cli):
 def test_importing_single_runs_keeps_the_api_functions():
     """Importing the single-run module (rocksweep/single.py) leaves rocksweep.run and
     rocksweep.open the API functions (a module named run.py used to replace rocksweep.run)."""
-    code = ("import rocksweep\nfrom rocksweep.single import simulate\nimport rocksweep.single\n"
+    code = ("import rocksweep\nfrom rocksweep.compute.single import simulate\n"
+            "import rocksweep.compute.single\n"
             "print(rocksweep.run is rocksweep.api.run, rocksweep.open is rocksweep.api.open)")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert proc.stdout.strip() == "True True", proc.stderr
@@ -128,7 +129,7 @@ def test_open_carries_words_units_and_provenance(cli_file):
     assert ds.outcome.attrs["flag_meanings"].split() == ["not_run", "safe", "mode1", "mode2"]
     assert list(ds.outcome.attrs["flag_values"]) == [-1, 0, 1, 2]
     assert "horizon" in ds.status.attrs["flag_meanings"].split()
-    assert ds.theta_max_over_alpha.attrs["rocksweep_units"] == "alpha_ref"
+    assert ds.theta_max_over_alpha.attrs["rocksweep_units"] == "alpha_cg"
     assert ds.t_overturn.attrs["rocksweep_units"] == "1/p"
     assert ds.attrs["scene"] == CI_SMALL.read_text()
     assert ds.attrs["rocksweep_version"] == rocksweep.__version__
@@ -166,7 +167,7 @@ def test_run_never_writes_over_its_scene(tmp_path):
 
 def test_run_resumes_a_partial_file(tmp_path):
     """A file with some points written (as after a kill) is finished by resume=True."""
-    from rocksweep.store import SweepFile
+    from rocksweep.store.sweepfile import SweepFile
 
     out = tmp_path / "part.h5"
     full = rocksweep.run(SMALL)
@@ -206,8 +207,8 @@ def test_cache_state_of_a_fresh_cache(tmp_path):
     sc = load_scene(CI_SMALL)
     sw.prepare(Grid(sc), sw.level(sc))
     assert sw.kernel_cache_state(Grid(sc), sw.level(sc)) == (0, 0)
-    code = ("from rocksweep import sweep as sw; from rocksweep.grid import Grid; "
-            "from rocksweep.scene import load_scene; "
+    code = ("from rocksweep.compute import sweep as sw; from rocksweep.compute.grid import Grid; "
+            "from rocksweep.scene.scene import load_scene; "
             f"sc = load_scene({str(CI_SMALL)!r}); "
             "print(sw.kernel_cache_state(Grid(sc), sw.level(sc)))")
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
@@ -286,7 +287,7 @@ def test_one_field_table():
     sc = load_scene(FIG5, ["impact.lam=0.2"])
     g = Grid(sc)
     chunk = sw.run_chunk(g, 0, 1, sw.level(sc))
-    from rocksweep.single import simulate
+    from rocksweep.compute.single import simulate
 
     one = simulate(sc.point({a.name: a.values[0] for a in sc.axes}), sc.numerics,
                    history=False)

@@ -1,13 +1,13 @@
-"""Boundary lines and A_min (rocksweep.boundaries): planted maps with analytic boundaries,
+"""Boundary lines and A_min (rocksweep.analysis.boundaries): planted maps with analytic boundaries,
 and the bisected threshold against a 10x finer uniform sweep of the real kernel."""
 
 import numpy as np
 import pytest
 
-import rocksweep.boundaries as bd
-import rocksweep.sweep as sw
-from rocksweep.diagrams import a_min_figure
-from rocksweep.scene import parse_scene
+import rocksweep.analysis.boundaries as bd
+import rocksweep.compute.sweep as sw
+from rocksweep.figures.diagrams import a_min_figure
+from rocksweep.scene.scene import parse_scene
 
 BODY3 = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, "
          "mA_over_m: 0.47, IA_ratio: 0.56}\n")

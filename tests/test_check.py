@@ -5,7 +5,7 @@ every point rerun at half the step, the differences stored.
   independent sweep at those settings), and the run's own fields do not change;
 - the estimate tracks the true error: on the worst cases of the wide-space sample the
   difference to the half-step rerun is within a factor 2 of the error against the scipy
-  reference (``rocksweep.reference``);
+  reference (``rocksweep.physics.reference``);
 - scenes that do not ask store nothing more; the CLI stores, reports and resumes it.
 """
 
@@ -18,16 +18,16 @@ import numpy as np
 import pytest
 from helpers import one_line_error
 
-from rocksweep import sweep as sw
 from rocksweep.cli import main
+from rocksweep.compute import sweep as sw
 from rocksweep.fields import CHECK_FIELDS, check_rows
 from rocksweep.kernel import chunk_kernel
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.model import FlexibleBody
 from rocksweep.numerics import PRESET_ROTATION, PRESETS, Numerics
-from rocksweep.points import Point, kernel_kind, point_row
-from rocksweep.reference import reference_run
-from rocksweep.scene import parse_scene
+from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.points import Point, kernel_kind, point_row
+from rocksweep.physics.reference import reference_run
+from rocksweep.scene.scene import parse_scene
 
 SCENE = """
 name: check grid
@@ -192,7 +192,7 @@ def test_estimate_scores_count_what_they_say():
     """Synthetic rows: true errors 0.1, 0.1, 0.01 and estimates 0.2, 0.01, 0.06 in the
     overturning time (bound 0.05): 2 above, 1 caught, 2 flagged of which 1 truly above
     0.025; one outcome wrong that changes at half the step, one change elsewhere."""
-    from rocksweep.accuracy import estimate_scores, point_errors
+    from rocksweep.analysis.accuracy import estimate_scores, point_errors
 
     n = 4
     r, k, half = (np.zeros((n, L.N_OUT)) for _ in range(3))

@@ -15,9 +15,9 @@ import pytest
 from helpers import kill_sweep_when, one_line_error
 
 from rocksweep.cli import main
+from rocksweep.compute.sweep import ChunkResult, variables
 from rocksweep.numerics import PRESETS
-from rocksweep.store import SweepFile, read_result
-from rocksweep.sweep import ChunkResult, variables
+from rocksweep.store.sweepfile import SweepFile, read_result
 
 ROOT = Path(__file__).resolve().parents[1]
 CI_SMALL = ROOT / "configs" / "ci-small.yaml"
@@ -220,7 +220,7 @@ def test_sweep_refuses_to_write_over_its_scene(cli, tmp_path):
 def test_info_counts_per_swept_key_in_ranges(cli, tmp_path):
     """A 101-value lam axis: counts per key are in the JSON for every value, and the text
     shows them as at most 10 ranges per table (synthetic results: no kernel)."""
-    from rocksweep.scene import parse_scene
+    from rocksweep.scene.scene import parse_scene
 
     sc = parse_scene(BODY3 + "impact: {lam: {start: 0, stop: 1, num: 101}}\n"
                      "pulse: {shape: sine, w_over_p: [1.0, 2.0, 3.0], A_ratio: [2.0, 4.0]}\n")
@@ -260,7 +260,7 @@ def test_info_counts_per_swept_key_in_ranges(cli, tmp_path):
 def test_plot_block_scene_with_panels_and_partial_file(cli, tmp_path):
     """A block-body scene (issue 6) with a swept body key: one panel per alpha; points
     not computed yet are drawn grey with a warning. Results are synthetic (no kernel)."""
-    from rocksweep.scene import parse_scene
+    from rocksweep.scene.scene import parse_scene
 
     sc = parse_scene("body: {kind: block, alpha: [0.15, 0.25]}\n"
                      "pulse: {shape: [sine, cosine], w_over_p: {start: 0.5, stop: 6, num: 6},"
@@ -277,7 +277,7 @@ def test_plot_block_scene_with_panels_and_partial_file(cli, tmp_path):
     assert res.exit_code == 0, res.output
     assert f"{sf.grid.size - n} of {sf.grid.size} points not computed" in res.output
     assert fig.read_bytes().startswith(b"\x89PNG")
-    from rocksweep.diagrams import y_label
+    from rocksweep.figures.diagrams import y_label
 
     assert y_label("block") == r"$A/(g\,\tan\alpha)$"
     assert y_label("flexible") == r"$A/(g\,\tan\alpha_{cg})$"
@@ -301,9 +301,9 @@ def test_kill_and_resume_equals_uninterrupted_run(cli, tmp_path):
     killed = tmp_path / "killed.h5"
     total = 3200
     # compile here if need be, so the subprocess loads numba's cache and starts at once
-    from rocksweep.grid import Grid
-    from rocksweep.scene import load_scene
-    from rocksweep.sweep import level, prepare
+    from rocksweep.compute.grid import Grid
+    from rocksweep.compute.sweep import level, prepare
+    from rocksweep.scene.scene import load_scene
 
     sc = load_scene(scene)
     prepare(Grid(sc), level(sc))
@@ -336,9 +336,9 @@ def test_ctrl_c_writes_every_finished_chunk_before_it_exits(tmp_path):
                      "pulse: {shape: sine, w_over_p: {start: 0.3, stop: 6, num: 300},"
                      " A_ratio: {start: 0.3, stop: 8, num: 300}}\n")
     out = tmp_path / "int.h5"
-    from rocksweep.grid import Grid
-    from rocksweep.scene import load_scene
-    from rocksweep.sweep import level, prepare
+    from rocksweep.compute.grid import Grid
+    from rocksweep.compute.sweep import level, prepare
+    from rocksweep.scene.scene import load_scene
 
     sc = load_scene(scene)
     prepare(Grid(sc), level(sc))

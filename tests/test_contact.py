@@ -17,14 +17,14 @@ import sympy as sp
 from test_derivations import _positions
 
 from rocksweep.cli.main import main
+from rocksweep.compute.single import history_capacity
 from rocksweep.kernel import chunk_kernel, contact, point_kernel
 from rocksweep.kernel import equations as eq
 from rocksweep.kernel import layout as L
-from rocksweep.model import BlockBody, FlexibleBody
 from rocksweep.numerics import Numerics
-from rocksweep.points import Point, point_row
-from rocksweep.scene import SceneError, parse_scene
-from rocksweep.single import history_capacity
+from rocksweep.physics.model import BlockBody, FlexibleBody
+from rocksweep.physics.points import Point, point_row
+from rocksweep.scene.scene import SceneError, parse_scene
 
 t = sp.symbols("t")
 m, mA, h, hA, b, g = sp.symbols("m m_A h h_A b g", positive=True)

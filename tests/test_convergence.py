@@ -6,12 +6,12 @@ import math
 import numpy as np
 import pytest
 
+from rocksweep.compute.single import simulate
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.model import FlexibleBody
 from rocksweep.numerics import Numerics
-from rocksweep.points import Point
-from rocksweep.reference import reference_run
-from rocksweep.single import simulate
+from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.points import Point
+from rocksweep.physics.reference import reference_run
 
 BODY3 = FlexibleBody(wn_over_p=2.43, zeta=0.05, alpha_cg=0.15, alpha_A=0.28, mA_over_m=0.47,
                      IA_ratio=0.56)

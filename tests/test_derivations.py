@@ -11,9 +11,9 @@ import sympy as sp
 
 from rocksweep.kernel import equations as eq
 from rocksweep.kernel.layout import PAR_LAM
-from rocksweep.model import impact_energy_loss, restitution
 from rocksweep.numerics import Numerics
-from rocksweep.points import Point, point_row
+from rocksweep.physics.model import impact_energy_loss, restitution
+from rocksweep.physics.points import Point, point_row
 
 t = sp.symbols("t")
 m, mA, IA, h, hA, b, g, k, c, lam = sp.symbols("m m_A I_A h h_A b g k c lambda", positive=True)

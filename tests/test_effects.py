@@ -14,12 +14,12 @@ import math
 import numpy as np
 import pytest
 
+from rocksweep.compute.single import history_capacity, simulate
 from rocksweep.kernel import chunk_kernel, point_kernel
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.model import BlockBody, FlexibleBody, G, restitution, restitution_rigid
 from rocksweep.numerics import Numerics
-from rocksweep.points import Point, kernel_kind, point_row
-from rocksweep.single import history_capacity, simulate
+from rocksweep.physics.model import BlockBody, FlexibleBody, G, restitution, restitution_rigid
+from rocksweep.physics.points import Point, kernel_kind, point_row
 
 TABLE3 = dict(zeta=0.05, alpha_cg=0.15, alpha_A=0.28, mA_over_m=0.47, IA_ratio=0.56)
 # A short horizon keeps undamped runs (which may never come to rest) cheap.
@@ -57,7 +57,7 @@ def run_points(kind: int, rows: np.ndarray) -> tuple[np.ndarray, list[np.ndarray
     return outs, hists
 
 
-# the history variants always track the ground reactions (rocksweep.single clears these
+# the history variants always track the ground reactions (rocksweep.compute.single clears these
 # bits when a run did not ask for contact): compare the other bits
 CONTACT_BITS = L.STATUS_SLIDES | L.STATUS_LIFTS_OFF
 

@@ -1,4 +1,4 @@
-"""The reference pulse shapes (rocksweep.excitation) against closed forms.
+"""The reference pulse shapes (rocksweep.physics.excitation) against closed forms.
 
 - sine/cosine with n cycles: on for 0 <= w t <= 2 pi n (end point included), zero net
   velocity (integral over the pulse = 0);
@@ -22,7 +22,13 @@ import pytest
 from scipy.integrate import quad
 from scipy.special import lambertw
 
-from rocksweep.excitation import SHAPES, PulseShape, mp_peak, mp_velocity_amplitude, shapes_figure
+from rocksweep.physics.excitation import (
+    SHAPES,
+    PulseShape,
+    mp_peak,
+    mp_velocity_amplitude,
+    shapes_figure,
+)
 
 ALL = [PulseShape("sine"), PulseShape("sine", cycles=3), PulseShape("cosine"),
        PulseShape("cosine", cycles=2), PulseShape("ricker"),

@@ -31,12 +31,12 @@ import numpy as np
 import pytest
 from helpers import one_line_error
 
-import rocksweep.store as store
+import rocksweep.store.sweepfile as store
 from rocksweep.cli import main
-from rocksweep.grid import Grid
-from rocksweep.scene import load_scene, parse_scene
-from rocksweep.store import SESSION_ATTRS, StoreError, SweepFile, read_result
-from rocksweep.sweep import ChunkResult, level, prepare, variables
+from rocksweep.compute.grid import Grid
+from rocksweep.compute.sweep import ChunkResult, level, prepare, variables
+from rocksweep.scene.scene import load_scene, parse_scene
+from rocksweep.store.sweepfile import SESSION_ATTRS, StoreError, SweepFile, read_result
 
 pytestmark = pytest.mark.faults
 
@@ -165,8 +165,8 @@ def test_disk_full_while_the_file_is_made_leaves_nothing_and_no_crash(tmp_path):
     fs.mkdir()
     out = in_namespace(f"mount -t tmpfs -o size=24k tmpfs {fs}", f"""
         import os, json
-        import rocksweep.store as st
-        from rocksweep.scene import load_scene
+        import rocksweep.store.sweepfile as st
+        from rocksweep.scene.scene import load_scene
         st._check_space = lambda *a: None  # as if the disk filled up after the check
         try:
             st.SweepFile.create("{fs}/a.h5", load_scene("{CI_SMALL}"))
@@ -193,9 +193,9 @@ def test_resume_on_a_full_disk_keeps_the_46_percent_and_finishes(tmp_path, cli):
     keep.mkdir()
     out = in_namespace(f"mount -t tmpfs -o size=2m tmpfs {fs}", f"""
         import os, shutil, subprocess, sys, json
-        from rocksweep.scene import load_scene
-        from rocksweep.store import SweepFile
-        from rocksweep.sweep import level, run_chunk
+        from rocksweep.scene.scene import load_scene
+        from rocksweep.store.sweepfile import SweepFile
+        from rocksweep.compute.sweep import level, run_chunk
         sc = load_scene("{CI_SMALL}")
         path = "{fs}/a.h5"
         sf = SweepFile.create(path, sc, backend="test")
@@ -257,8 +257,8 @@ def test_resume_of_a_format_1_file_on_a_full_disk_is_one_line_and_changes_nothin
     fs.mkdir()
     out = in_namespace(f"mount -t tmpfs -o size=1m tmpfs {fs}", f"""
         import os, shutil, json, hashlib
-        from rocksweep.scene import parse_scene
-        from rocksweep.store import StoreError, SweepFile
+        from rocksweep.scene.scene import parse_scene
+        from rocksweep.store.sweepfile import StoreError, SweepFile
         path = "{fs}/v1.h5"
         shutil.copy("{src}", path)
         fill("{fs}")
@@ -423,8 +423,8 @@ def test_read_only_directory_really_read_only(tmp_path):
     before = arrays_of(ro / "old.h5")
     out = in_namespace(f"mount --bind {ro} {ro} && mount -o remount,bind,ro {ro}", f"""
         import json, os, subprocess, sys
-        import rocksweep.store as st
-        from rocksweep.scene import parse_scene
+        import rocksweep.store.sweepfile as st
+        from rocksweep.scene.scene import parse_scene
         sc = parse_scene({TEXT!r})
         msgs = {{}}
         for key, call in [
@@ -466,7 +466,7 @@ def test_read_only_directory_really_read_only(tmp_path):
 # fake_chunk for the scripts of other processes (they import rocksweep only)
 FAKE_CHUNK = """
 import numpy as np
-from rocksweep.sweep import ChunkResult, variables
+from rocksweep.compute.sweep import ChunkResult, variables
 def fake_chunk(scene, a, b):
     i = np.arange(a, b)
     return ChunkResult(a, b, {n: ((i % 3) if n == "outcome" else i * 7 + len(n)).astype(d)
@@ -475,8 +475,8 @@ def fake_chunk(scene, a, b):
 
 HOLDER = FAKE_CHUNK + """
 import sys
-from rocksweep.scene import parse_scene
-from rocksweep.store import SweepFile
+from rocksweep.scene.scene import parse_scene
+from rocksweep.store.sweepfile import SweepFile
 sc = parse_scene(@TEXT@)
 sf = SweepFile.@HOW@
 print("holding", flush=True)
@@ -540,8 +540,8 @@ def test_overwrite_and_resume_refused_while_another_process_writes(tmp_path, cli
 
 RACER = FAKE_CHUNK + """
 import json, sys, time
-from rocksweep.scene import parse_scene
-from rocksweep.store import StoreError, SweepFile
+from rocksweep.scene.scene import parse_scene
+from rocksweep.store.sweepfile import StoreError, SweepFile
 sc = parse_scene(@TEXT@)
 while time.time() < @START@:
     pass

@@ -30,8 +30,8 @@ from rocksweep.kernel.events import (
     hermite_root,
 )
 from rocksweep.kernel.stepping import rk4_step
-from rocksweep.model import FlexibleBody
-from rocksweep.points import body_omega_rock
+from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.points import body_omega_rock
 
 # Newton's stopping step in units of the step, as _locate asks for (0.05 tol / width).
 XTOL = 1e-8

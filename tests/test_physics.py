@@ -8,12 +8,12 @@ from numba import njit
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
+from rocksweep.compute.single import simulate
 from rocksweep.kernel import equations as eq
 from rocksweep.kernel import stepping as ki
-from rocksweep.model import FlexibleBody, G, restitution, restitution_rigid
 from rocksweep.numerics import Numerics
-from rocksweep.points import Point, point_row
-from rocksweep.single import simulate
+from rocksweep.physics.model import FlexibleBody, G, restitution, restitution_rigid
+from rocksweep.physics.points import Point, point_row
 
 # Physics checks run at a pinned accuracy, independent of how the presets are tuned.
 NUM = Numerics.preset("default", steps_per_period=20, event_tol=1e-8)

@@ -14,9 +14,9 @@ from matplotlib.colors import to_rgb
 from matplotlib.figure import Figure
 
 from rocksweep.cli import main
+from rocksweep.compute.sweep import ChunkResult, variables
 from rocksweep.errors import RocksweepError
-from rocksweep.store import SweepFile, read_result
-from rocksweep.sweep import ChunkResult, variables
+from rocksweep.store.sweepfile import SweepFile, read_result
 
 ROOT = Path(__file__).resolve().parents[1]
 BODY3 = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: {start: 0.1, stop: 0.2, num: 3}, "
@@ -63,7 +63,7 @@ def line_result(tmp_path_factory):
 def synthetic_result(tmp_path: Path) -> Path:
     """A block scene (2 shapes x 2 alpha x 5 A x 6 w, no lam) with made-up outcomes: no
     kernel runs."""
-    from rocksweep.scene import parse_scene
+    from rocksweep.scene.scene import parse_scene
 
     sc = parse_scene("name: synthetic block\nbody: {kind: block, alpha: [0.15, 0.25]}\n"
                      "pulse: {shape: [sine, cosine], w_over_p: {start: 0.5, stop: 6, num: 6},"
@@ -90,7 +90,7 @@ def test_plot_of_alpha_cg_against_A(cli, acg_result, tmp_path):
     data = fig.read_bytes()
     assert data.startswith(b"\x89PNG") and len(data) > 10_000
     assert [p.name for p in tmp_path.iterdir()] == [fig.name]  # no temporary left
-    from rocksweep.diagrams import choose_axes, sweep_figure
+    from rocksweep.figures.diagrams import choose_axes, sweep_figure
 
     result = read_result(acg_result)
     assert choose_axes(result) == ("alpha_cg", "A_ratio")
@@ -120,7 +120,7 @@ def test_plot_of_a_1d_sweep_is_a_line_plot_of_theta_max(cli, line_result, tmp_pa
     res = cli.invoke(main, ["plot", str(line_result), "-o", str(fig)])
     assert res.exit_code == 0, res.output
     assert fig.read_bytes().startswith(b"\x89PNG") and fig.stat().st_size > 10_000
-    from rocksweep.diagrams import sweep_figure
+    from rocksweep.figures.diagrams import sweep_figure
 
     result = read_result(line_result)
     f = sweep_figure(result)
@@ -176,7 +176,7 @@ def test_plot_refuses_an_existing_output_and_leaves_it_untouched(cli, acg_result
 
 def test_one_panel_per_shape_and_swept_body_key(tmp_path):
     out = synthetic_result(tmp_path)
-    from rocksweep.diagrams import stability_diagram
+    from rocksweep.figures.diagrams import stability_diagram
 
     result = read_result(out)
     fig = stability_diagram(result)
@@ -187,8 +187,8 @@ def test_one_panel_per_shape_and_swept_body_key(tmp_path):
 
 
 def test_title_says_the_pulse_shape_once(tmp_path):
-    from rocksweep.diagrams import stability_diagram
-    from rocksweep.scene import parse_scene
+    from rocksweep.figures.diagrams import stability_diagram
+    from rocksweep.scene.scene import parse_scene
 
     sc = parse_scene("name: 'Figure X: flexible body, sine pulse'\n"
                      + BODY3.replace("{start: 0.1, stop: 0.2, num: 3}", "0.15")
@@ -209,7 +209,7 @@ def test_title_says_the_pulse_shape_once(tmp_path):
 # ---------------------------------------------------------------------------------------
 
 def test_stability_diagram_draws_into_given_axes(acg_result):
-    from rocksweep.diagrams import DiagramError, stability_diagram
+    from rocksweep.figures.diagrams import DiagramError, stability_diagram
 
     result = read_result(acg_result)
     mine = Figure()
@@ -224,8 +224,8 @@ def test_stability_diagram_draws_into_given_axes(acg_result):
 
 @pytest.fixture(scope="module")
 def fig5_runs():
-    from rocksweep.scene import load_scene
-    from rocksweep.single import simulate
+    from rocksweep.compute.single import simulate
+    from rocksweep.scene.scene import load_scene
 
     scene = load_scene(ROOT / "configs" / "fig5.yaml")
     fixed = {a.name: a.values[0] for a in scene.axes}
@@ -235,7 +235,7 @@ def fig5_runs():
 
 
 def test_time_history_has_the_input_pulse_and_guide_legend(fig5_runs):
-    from rocksweep.plots import time_history
+    from rocksweep.figures.common import time_history
 
     fig = time_history(fig5_runs, ["lam"], "Figure 5")
     assert isinstance(fig, Figure) and len(fig.axes) == 4
@@ -255,8 +255,8 @@ def test_time_history_has_the_input_pulse_and_guide_legend(fig5_runs):
 
 
 def test_restitution_map_u0_curve_is_dark(body_fig2):
-    from rocksweep.model import restitution, restitution_rigid
-    from rocksweep.plots import restitution_map
+    from rocksweep.physics.model import restitution, restitution_rigid
+    from rocksweep.figures.common import restitution_map
 
     lam = np.linspace(0, 1, 11)
     u = np.linspace(-2, 2, 9)
@@ -269,9 +269,9 @@ def test_restitution_map_u0_curve_is_dark(body_fig2):
 
 
 def test_work_precision_returns_two_axes(tmp_path):
-    from rocksweep.accuracy import accuracy_study, ladder
-    from rocksweep.accuracy_plot import work_precision
-    from rocksweep.scene import parse_scene
+    from rocksweep.analysis.accuracy import accuracy_study, ladder
+    from rocksweep.figures.accuracy import work_precision
+    from rocksweep.scene.scene import parse_scene
 
     sc = parse_scene("name: tiny\n" + BODY3.replace("{start: 0.1, stop: 0.2, num: 3}", "0.15")
                      + "impact: {lam: 0.2}\n"
@@ -284,7 +284,7 @@ def test_work_precision_returns_two_axes(tmp_path):
 
 
 def test_save_figure_policy(tmp_path, device_node):
-    from rocksweep.plots import save_figure
+    from rocksweep.figures.common import save_figure
 
     fig = Figure()
     fig.add_subplot().plot([0, 1], [0, 1])
@@ -308,8 +308,8 @@ def test_no_backend_switch_and_no_pyplot():
 import sys, tempfile, os
 import matplotlib
 matplotlib.use("svg")
-import rocksweep.plots, rocksweep.diagrams, rocksweep.accuracy_plot, rocksweep.cli.plot
-from rocksweep.plots import restitution_map, save_figure
+import rocksweep.figures.common, rocksweep.figures.diagrams, rocksweep.figures.accuracy, rocksweep.cli.plot
+from rocksweep.figures.common import restitution_map, save_figure
 import numpy as np
 fig = restitution_map(np.linspace(0, 1, 3), np.linspace(-2, 2, 5), np.ones((3, 5)), 0.8)
 save_figure(fig, os.path.join(tempfile.mkdtemp(), "r.png"))
@@ -320,7 +320,7 @@ print(matplotlib.get_backend(), "matplotlib.pyplot" in sys.modules)
     assert proc.stdout.split() == ["svg", "False"]
     # without a backend chosen, importing the modules resolves none (no Agg forced)
     code = ("import matplotlib, sys; before = matplotlib.rcParams._get_backend_or_none();"
-            "import rocksweep.plots, rocksweep.diagrams, rocksweep.accuracy_plot;"
+            "import rocksweep.figures.common, rocksweep.figures.diagrams, rocksweep.figures.accuracy;"
             "print(before == matplotlib.rcParams._get_backend_or_none(),"
             " 'matplotlib.pyplot' in sys.modules)")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
@@ -336,8 +336,8 @@ def test_check_files_ring_the_points_whose_outcome_changes(tmp_path):
     """A sweep with outputs.check: the cells whose check_outcome differs from outcome (at
     any lam) get a ring, at exactly those coordinates, and a legend entry; a file without
     check, none."""
-    from rocksweep.diagrams import stability_diagram
-    from rocksweep.scene import parse_scene
+    from rocksweep.figures.diagrams import stability_diagram
+    from rocksweep.scene.scene import parse_scene
 
     text = ("name: rings\n" + BODY3.replace("{start: 0.1, stop: 0.2, num: 3}", "0.15")
             + "impact: {lam: [0.0, 0.2]}\n"

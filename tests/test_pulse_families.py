@@ -1,5 +1,5 @@
 """Pulse families in the kernel (n cycles, Ricker, Mavroeidis-Papageorgiou) against their
-independent reference definitions (``rocksweep.excitation``, numpy) and closed forms.
+independent reference definitions (``rocksweep.physics.excitation``, numpy) and closed forms.
 
 - the jitted ground acceleration and its rate equal ``PulseShape.acc``/``rate`` (A, A w);
 - the rigid block uplifts when |xg''| first reaches g tan(alpha): the kernel's first
@@ -18,14 +18,14 @@ import math
 import numpy as np
 import pytest
 
-from rocksweep.excitation import PulseShape
+from rocksweep.compute.single import simulate
 from rocksweep.kernel import layout as L
 from rocksweep.kernel.equations import ground_acc, ground_jerk
-from rocksweep.model import BlockBody
 from rocksweep.numerics import Numerics
-from rocksweep.points import Point, point_row
-from rocksweep.scene import SceneError, parse_scene
-from rocksweep.single import simulate
+from rocksweep.physics.excitation import PulseShape
+from rocksweep.physics.model import BlockBody
+from rocksweep.physics.points import Point, point_row
+from rocksweep.scene.scene import SceneError, parse_scene
 
 BLOCK = BlockBody(alpha=0.2618, inertia=4.0 / 3.0)
 CASES = [("sine", 1, 2.0, 90.0), ("sine", 3, 2.0, 90.0), ("cosine", 2, 2.0, 90.0),

@@ -25,13 +25,13 @@ import numpy as np
 import pytest
 from scipy import signal
 
+from rocksweep.compute.single import simulate
 from rocksweep.kernel import layout as L
-from rocksweep.model import FlexibleBody
 from rocksweep.numerics import Numerics
-from rocksweep.points import RECORD, Point
-from rocksweep.records import read_record
-from rocksweep.scene import SceneError, load_scene, parse_scene
-from rocksweep.single import simulate
+from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.points import RECORD, Point
+from rocksweep.physics.records import read_record
+from rocksweep.scene.scene import SceneError, load_scene, parse_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 SINE = ROOT / "records" / "sine_1cycle.AT2"
@@ -158,9 +158,9 @@ def test_record_sweep_end_to_end(tmp_path, cli):
                             "--rtol", "1e-2"])
     assert res.exit_code == 0, res.output
     assert (tmp_path / "s.png").stat().st_size > 10_000
-    from rocksweep.boundaries import kernel_evaluator
-    from rocksweep.spectrum import result_scene, spectra
-    from rocksweep.store import read_result
+    from rocksweep.analysis.boundaries import kernel_evaluator
+    from rocksweep.analysis.spectrum import spectra
+    from rocksweep.store.sweepfile import read_result, result_scene
 
     sp = spectra(out, rtol=1e-2)
     assert sp.freq == "p" and sp.lam.tolist() == [0.0, 0.4] and sp.runs > 0
@@ -188,7 +188,7 @@ def test_record_sweep_end_to_end(tmp_path, cli):
 def test_reference_path_runs_records_sample_by_sample():
     """The scipy reference integrates a record interval by interval: the sine record and
     the sine pulse give the same overturning time (interpolation error ~1e-7)."""
-    from rocksweep.reference import reference_run
+    from rocksweep.physics.reference import reference_run
 
     body = FlexibleBody(**FIG3)
     rec = read_record(SINE)

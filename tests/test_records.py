@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from rocksweep.errors import OutputError, RocksweepError
-from rocksweep.excitation import PulseShape
-from rocksweep.records import (
+from rocksweep.physics.excitation import PulseShape
+from rocksweep.physics.records import (
     GroundRecord,
     RecordError,
     at2_text,
@@ -267,7 +267,7 @@ def test_shipped_records_have_the_documented_npts_dt_pga(name):
 
 def test_sine_record_is_the_one_cycle_sine_pulse():
     """T = 0.5 s, 1 g: linear interpolation is within (w DT)^2/8 = 2e-7 of sin(w t), plus
-    5e-8 of printing, at any time, and equals the `sine` pulse shape of rocksweep.excitation
+    5e-8 of printing, at any time, and equals the `sine` pulse shape of rocksweep.physics.excitation
     (w = 2 pi / T), including rest after the pulse."""
     rec = read_record(RECORDS / "sine_1cycle.AT2")
     w = 2 * math.pi / 0.5

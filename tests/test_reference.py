@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
+from rocksweep.compute.single import simulate
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.model import BlockBody, FlexibleBody, impact_energy_loss, restitution_rigid
 from rocksweep.numerics import Numerics
-from rocksweep.points import Point
-from rocksweep.reference import reference_run
-from rocksweep.single import simulate
+from rocksweep.physics.model import BlockBody, FlexibleBody, impact_energy_loss, restitution_rigid
+from rocksweep.physics.points import Point
+from rocksweep.physics.reference import reference_run
 
 BLOCK = BlockBody(alpha=0.2)
 

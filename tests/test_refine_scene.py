@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from rocksweep.cli import main
-from rocksweep.scene import SceneError, parse_scene
+from rocksweep.scene.scene import SceneError, parse_scene
 
 SCENE = """
 body: {kind: block, alpha: 0.2}

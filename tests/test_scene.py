@@ -15,10 +15,10 @@ import pytest
 
 from rocksweep.cli import main
 from rocksweep.errors import RocksweepError
-from rocksweep.model import BlockBody, BodyError, FlexibleBody
 from rocksweep.numerics import MAX_POINT_STEPS
-from rocksweep.points import body_omega_rock
-from rocksweep.scene import MAX_POINTS, SceneError, load_scene, parse_scene
+from rocksweep.physics.model import BlockBody, BodyError, FlexibleBody
+from rocksweep.physics.points import body_omega_rock
+from rocksweep.scene.scene import MAX_POINTS, SceneError, load_scene, parse_scene
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 
@@ -244,9 +244,14 @@ def test_scene_size_and_sweep_bytes():
     assert scene.size == 30
     # int8 outcome; int32 impacts, uplifts, status; float64 theta_max, t_overturn;
     # int64 steps, event_steps: 45 bytes a point; coordinates 8 bytes a value
-    assert scene.sweep_nbytes() == 30 * 45 + 8 * (3 + 10)
+    from rocksweep.store.sweepfile import file_bytes
+
+    # coordinates: 16 bytes a value of every axis (the stored axis and its bounds)
+    coords = sum(16 * len(a.values) for a in scene.axes)
+    assert file_bytes(scene) == 30 * 45 + coords
     energy = accepted(GOOD + "outputs: {energy: true}\n")
-    assert energy.sweep_nbytes() == 45 + 3 * 8
+    # + three float64 energy metrics
+    assert file_bytes(energy) == 45 + 3 * 8 + sum(16 * len(a.values) for a in energy.axes)
 
 
 # -- cost: every accepted point runs in bounded time ----------------------------------

@@ -9,11 +9,11 @@ import h5py
 import numpy as np
 import pytest
 
-import rocksweep.store as store
-from rocksweep.grid import Grid
-from rocksweep.scene import parse_scene
-from rocksweep.store import StoreError, SweepFile, flat_slabs, read_result
-from rocksweep.sweep import ChunkResult, plan_chunks, variables
+import rocksweep.store.sweepfile as store
+from rocksweep.compute.grid import Grid
+from rocksweep.compute.sweep import ChunkResult, plan_chunks, variables
+from rocksweep.scene.scene import parse_scene
+from rocksweep.store.sweepfile import StoreError, SweepFile, flat_slabs, read_result
 
 TEXT = """# a comment kept verbatim
 name: store test
@@ -272,7 +272,10 @@ def test_cf_attributes_survive_netcdf_readers(tmp_path, scene):
             else:
                 assert v["units"] == "1", name
         assert ds["t_overturn"].attrs["rocksweep_units"] == "1/p"
-        assert "p*t" in ds["t_overturn"].attrs["long_name"]
+        assert ds["t_overturn"].attrs["long_name"] == "overturning time"  # no units in it
+        # a flexible body's rotations are over alpha_cg (never "alpha_ref" in a file)
+        assert ds["theta_max_over_alpha"].attrs["rocksweep_units"] == "alpha_cg"
+        assert ds["A_ratio"].attrs["symbol"] == "A/(g tan alpha_cg)"
 
 
 def test_session_attributes_are_rewritten_in_place(tmp_path, scene):

@@ -19,13 +19,13 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
+from rocksweep.compute.single import simulate
 from rocksweep.kernel import chunk_kernel
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.model import FlexibleBody
 from rocksweep.numerics import Numerics
-from rocksweep.points import Point, point_row
-from rocksweep.reference import reference_run
-from rocksweep.single import simulate
+from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.points import Point, point_row
+from rocksweep.physics.reference import reference_run
 
 # The huge slow cosine pulse of issue 15 on undamped bodies (wn/p = 1.56, zeta = 0): an
 # overturning without impact (mode 2) and one after an impact (mode 1).

@@ -70,12 +70,12 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
     if report_path is not None:
         check_output(report_path, overwrite=overwrite, inputs=[scene_path])
     if plot_path is not None:
-        from rocksweep.plots import FORMATS
+        from rocksweep.figures.common import FORMATS
 
         check_output(plot_path, overwrite=overwrite, inputs=[scene_path], suffixes=FORMATS)
     scene = load(scene_path, overrides)
 
-    from rocksweep.accuracy import accuracy_study, format_table, ladder, write_report
+    from rocksweep.analysis.accuracy import accuracy_study, format_table, ladder, write_report
 
     def progress(stage: str, done: int, total: int) -> None:
         if quiet:
@@ -100,8 +100,8 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
         write_report(study, report_path, command)
         click.echo(f"wrote {report_path}")
     if plot_path is not None:
-        from rocksweep.accuracy_plot import work_precision
-        from rocksweep.plots import save_figure
+        from rocksweep.figures.accuracy import work_precision
+        from rocksweep.figures.common import save_figure
 
         save_figure(work_precision(study), plot_path, overwrite=overwrite, inputs=[scene_path])
         click.echo(f"wrote {plot_path}")

@@ -1,5 +1,5 @@
 """``rocksweep boundaries``: the A_min curves (bisected) and the boundary lines of a sweep
-result, as CSV or HDF5 and as a figure (the library side is ``rocksweep.boundaries``)."""
+result, as CSV or HDF5 and as a figure (the library side is ``rocksweep.analysis.boundaries``)."""
 
 from __future__ import annotations
 
@@ -36,10 +36,10 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
     that overturns, refined by bisection between the last safe and the first overturning
     grid value (kernel runs at the sweep's accuracy), with the mode it overturns in; and
     the lines between classes as polylines. Works on adaptive and regular results."""
-    from rocksweep import boundaries as bd
+    from rocksweep.analysis import boundaries as bd
     from rocksweep.outputs import check_output, write_atomic
-    from rocksweep.plots import FORMATS, save_figure
-    from rocksweep.store import read_result
+    from rocksweep.figures.common import FORMATS, save_figure
+    from rocksweep.store.sweepfile import read_result
 
     if not (0 < rtol < 1):
         raise click.ClickException(f"--rtol {rtol}: give a relative tolerance in (0, 1)")
@@ -84,7 +84,7 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
         n = sum(len(b.lines) for b in bounds)
         click.echo(f"wrote {lines_path} ({n} boundary lines, {len(lrows)} vertices)")
     if fig_path is not None:
-        from rocksweep.diagrams import a_min_figure
+        from rocksweep.figures.diagrams import a_min_figure
 
         fig = a_min_figure(curves, bounds, title=result.name, kind=result.kind)
         save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=[result_path])

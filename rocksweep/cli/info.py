@@ -1,5 +1,5 @@
 """``rocksweep info``: what a sweep result holds and where it came from (the summary is
-``rocksweep.summary.info_dict``; this command prints it)."""
+``rocksweep.analysis.summary.info_dict``; this command prints it)."""
 
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ def info(result_path: Path, as_json: bool) -> None:
     key; long axes in ranges) and provenance of a sweep result; for an adaptive sweep,
     the points computed, filled and audited (and the audit points that disagreed); with
     per-point error estimates (sweep --check), their tails."""
-    from rocksweep.summary import format_info, info_dict, read_info
+    from rocksweep.analysis.summary import format_info, info_dict, read_info
 
     d = info_dict(read_info(result_path))
     if as_json:

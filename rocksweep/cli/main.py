@@ -43,7 +43,7 @@ overwrite_option = click.option("--overwrite", is_flag=True,
 def load(scene_path: Path, overrides: tuple[str, ...] = ()):
     """The validated scene at ``scene_path`` (imports the scene machinery, and with it
     numba, only when a command runs: ``rocksweep --help`` stays fast)."""
-    from rocksweep.scene import load_scene
+    from rocksweep.scene.scene import load_scene
 
     if not scene_path.exists():
         raise click.ClickException(f"{scene_path}: no such scene file")

@@ -1,5 +1,5 @@
 """``rocksweep restitution``: eq. (1) over lam and u/u_cr (Figure 2); the table is
-``rocksweep.restitution.restitution_table``."""
+``rocksweep.analysis.restitution.restitution_table``."""
 
 from __future__ import annotations
 
@@ -37,11 +37,11 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     Both transition directions: "upper" is the paper's upper sign (in rocksweep: rocking on
     the +b corner ends, u positive toward +b), "lower" the other.
     """
+    from rocksweep.analysis.restitution import restitution_table
     from rocksweep.outputs import check_output
-    from rocksweep.restitution import restitution_table
 
     if plot_path is not None:
-        from rocksweep.plots import FORMATS
+        from rocksweep.figures.common import FORMATS
 
         check_output(plot_path, overwrite=overwrite, inputs=[scene_path], suffixes=FORMATS)
     table = restitution_table(load(scene_path, overrides), n_lam, n_u)
@@ -56,7 +56,7 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
                    f"max {e.max():.4f}; e > 1 at {int((e > 1).sum())} of {e.size} "
                    "points (upper sign)")
     if plot_path is not None:
-        from rocksweep.plots import save_figure
+        from rocksweep.figures.common import save_figure
 
         save_figure(table.figure(), plot_path, overwrite=overwrite, inputs=[scene_path])
         if not as_json:

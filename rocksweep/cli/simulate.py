@@ -52,7 +52,7 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     if plot_path is not None and csv_path is not None and plot_path == csv_path:
         raise click.ClickException(f"--plot and --csv name the same file {plot_path}")
     if plot_path is not None:
-        from rocksweep.plots import FORMATS
+        from rocksweep.figures.common import FORMATS
 
         check_output(plot_path, overwrite=overwrite, inputs=[scene_path], suffixes=FORMATS)
     if csv_path is not None:
@@ -60,7 +60,7 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     if contact:
         overrides = (*overrides, "outputs.contact=true")
     scene = load(scene_path, overrides)
-    from rocksweep.scene import SceneError
+    from rocksweep.scene.scene import SceneError
 
     try:
         runs = simulate_runs(scene, MAX_POINTS)
@@ -79,7 +79,7 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
         if not as_json:
             click.echo(f"wrote {csv_path}")
     if plot_path is not None:
-        from rocksweep.plots import save_figure, time_history
+        from rocksweep.figures.common import save_figure, time_history
 
         save_figure(time_history(runs, swept, scene.name), plot_path, overwrite=overwrite,
                     inputs=[scene_path])

@@ -104,7 +104,7 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     elif scheduler:
         raise click.ClickException("--scheduler works with --backend dask only")
     from rocksweep import api
-    from rocksweep import sweep as sw
+    from rocksweep.compute import sweep as sw
 
     if backend == "threads":
         sw.check_jobs(jobs, "--jobs")
@@ -139,8 +139,8 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
         sys.exit(130)
     if quiet:
         return
-    from rocksweep.store import read_result
-    from rocksweep.summary import check_info, counts_lines, format_check, read_info
+    from rocksweep.analysis.summary import check_info, counts_lines, format_check, read_info
+    from rocksweep.store.sweepfile import read_result
 
     # one read of the file: with error estimates, what info reports on them too
     result = read_info(out) if scene.check else read_result(out, ["outcome", "status"])
@@ -179,7 +179,7 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
 
 def report_cells(scene, flat) -> list[str]:
     """The swept values of some grid points, as 'key=value, ...' texts."""
-    from rocksweep.grid import Grid
+    from rocksweep.compute.grid import Grid
 
     values = Grid(scene).index_values(flat)
     swept = [a.name for a in scene.swept]

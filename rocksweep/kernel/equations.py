@@ -1,7 +1,7 @@
 """Equations of motion, uplift and impact of the flexible rocking oscillator (jitted).
 
 Everything here is a pure function of scalars and the parameter row ``prm`` (see
-``layout``). Conventions (``rocksweep.model``): theta > 0 clockwise = rocking on the +b
+``layout``). Conventions (``rocksweep.physics.model``): theta > 0 clockwise = rocking on the +b
 corner (s = +1), u along the body's x axis, SI units with m = 1, g = 9.81, p = 1.
 
 Derivation (section 2 of the paper; Lagrange's equations in the frame of the ground,
@@ -145,7 +145,7 @@ def _record_segment(t, prm):
 
 @njit(cache=True, **INTERNAL)
 def ground_acc_any(t, prm):
-    """xg''(t) [m/s^2] while on, of any shape (``rocksweep.excitation`` defines each as a
+    """xg''(t) [m/s^2] while on, of any shape (``rocksweep.physics.excitation`` defines each as a
     function of phi = w t); one call (inlining it into every right-hand side inlines
     it again in each of the GROUND variant's call sites: numba's IR inliner warns).
 

@@ -6,7 +6,7 @@
 - ``rest_proven``: after the pulse, full contact for good (flexible body);
 - ``rigid_bounded``: after the pulse, a rigid body that can no longer overturn.
 
-The formulas come from ``equations``; the reference path (``rocksweep.reference``) calls
+The formulas come from ``equations``; the reference path (``rocksweep.physics.reference``) calls
 the same ones (``tip_moment``, ``rest_margin``, ``rigid_peak``).
 """
 

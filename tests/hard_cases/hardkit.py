@@ -2,8 +2,8 @@
 
 Every check here can fail: a history with NaN or inf, a run that hit a step or event cap,
 an energy balance that does not close, events that differ from the reference path's.
-Runs use ``rocksweep.single.simulate`` (the kernel's history variant: energy accounting and
-one row per step and per action) and, for agreement, ``rocksweep.reference.reference_run``
+Runs use ``rocksweep.compute.single.simulate`` (the kernel's history variant: energy accounting and
+one row per step and per action) and, for agreement, ``rocksweep.physics.reference.reference_run``
 (scipy's DOP853 with its own event handling, sharing only the equations with the kernel).
 """
 
@@ -14,12 +14,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from rocksweep.compute.single import Run, simulate
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.model import FlexibleBody
 from rocksweep.numerics import Numerics
-from rocksweep.points import Point, point_row
-from rocksweep.reference import reference_run
-from rocksweep.single import Run, simulate
+from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.points import Point, point_row
+from rocksweep.physics.reference import reference_run
 
 # The suite's working accuracy: 20 RK4 steps per shortest period, events bracketed to
 # 1e-8 p*t. Fixed here (not taken from a preset) so that the suite does not move when the

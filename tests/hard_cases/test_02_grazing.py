@@ -13,7 +13,7 @@ from hardkit import (
 )
 from hardkit import table3_body as body
 
-from rocksweep.points import Point
+from rocksweep.physics.points import Point
 
 pytestmark = pytest.mark.hard
 

@@ -8,7 +8,7 @@ from test_02_grazing import WINDOW, point, touch
 
 from rocksweep.kernel.layout import PAR_DT, PAR_TPULSE
 from rocksweep.kernel.stepping import rk4_step
-from rocksweep.points import point_row
+from rocksweep.physics.points import point_row
 
 pytestmark = pytest.mark.hard
 

@@ -6,7 +6,7 @@ import pytest
 from hardkit import assert_sane, kernel_events, reference_events, run
 from hardkit import table3_body as body
 
-from rocksweep.points import Point
+from rocksweep.physics.points import Point
 
 pytestmark = pytest.mark.hard
 

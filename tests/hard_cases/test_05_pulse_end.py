@@ -8,7 +8,7 @@ from hardkit import assert_sane, kernel_events, numerics, reference_events, run
 from hardkit import table3_body as body
 
 from rocksweep.kernel.layout import PAR_DT, PAR_TPULSE
-from rocksweep.points import Point, body_omega_rock, point_row
+from rocksweep.physics.points import Point, body_omega_rock, point_row
 
 pytestmark = pytest.mark.hard
 

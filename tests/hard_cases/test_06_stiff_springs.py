@@ -9,8 +9,8 @@ from hardkit import table3_body as body
 from scipy.integrate import solve_ivp
 
 from rocksweep.kernel.layout import PAR_DT
-from rocksweep.model import G
-from rocksweep.points import Point, body_omega_rock, point_row
+from rocksweep.physics.model import G
+from rocksweep.physics.points import Point, body_omega_rock, point_row
 
 pytestmark = pytest.mark.hard
 

@@ -13,8 +13,8 @@ from joblib import Parallel, delayed
 
 from rocksweep.kernel import chunk_kernel
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.model import BlockBody
-from rocksweep.points import Point, point_row
+from rocksweep.physics.model import BlockBody
+from rocksweep.physics.points import Point, point_row
 
 pytestmark = pytest.mark.hard
 

@@ -10,9 +10,9 @@ from hardkit import table3_body as body
 from hypothesis import HealthCheck, assume, event, example, given, settings
 from hypothesis import strategies as st
 
-from rocksweep.model import BodyError, FlexibleBody
 from rocksweep.numerics import Numerics
-from rocksweep.points import Point
+from rocksweep.physics.model import BodyError, FlexibleBody
+from rocksweep.physics.points import Point
 
 pytestmark = pytest.mark.hard
 

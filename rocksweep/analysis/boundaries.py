@@ -13,7 +13,7 @@ For every panel (a value of each non-diagram axis: shape, body keys, lam) of a d
   to a relative tolerance, so the curve is not limited by the grid spacing.
 
 Rows for CSV (``a_min_rows``, ``boundary_rows``, ``csv_text``) export them; the figures
-are in ``rocksweep.diagrams`` (``a_min_figure``, and ``rocksweep plot --curves``).
+are in ``rocksweep.figures.diagrams`` (``a_min_figure``, and ``rocksweep plot --curves``).
 ``result_curves`` does it all for a result file (``rocksweep boundaries``). Units: those
 of the axes (w_over_p = omega/p, A_ratio = A/(g tan alpha_cg), eq. 2).
 """
@@ -31,16 +31,16 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from rocksweep.adaptive import DIAGRAM_AXES, AdaptiveError, make_plan
-from rocksweep.grid import Grid
+from rocksweep.compute.adaptive import DIAGRAM_AXES, AdaptiveError, make_plan
+from rocksweep.compute.grid import Grid
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outcomes import outcome_word
-from rocksweep.points import Point, kernel_kind, point_row
-from rocksweep.scene import Scene
+from rocksweep.physics.points import Point, kernel_kind, point_row
+from rocksweep.scene.scene import Scene
 
 if TYPE_CHECKING:
-    from rocksweep.store import SweepResult
+    from rocksweep.store.sweepfile import SweepResult
 
 DEFAULT_RTOL = 1e-3
 OVERTURNED = (L.OUTCOME_MODE1, L.OUTCOME_MODE2)
@@ -460,26 +460,10 @@ class BoundaryError(AdaptiveError):
 
 
 def scene_of(result: SweepResult) -> Scene:
-    """The scene a result was computed from, rebuilt from its YAML and overrides, checked
-    against the file's resolved scene (axes, numerics): the A_min bisection runs the
-    kernel as the sweep did."""
-    import json
+    """The scene a result was computed from (``rocksweep.store.sweepfile.result_scene``)."""
+    from rocksweep.store.sweepfile import result_scene
 
-    from rocksweep.scene import SceneError, parse_scene
-    from rocksweep.store import resolved_scene, scene_differences
-
-    a = result.attrs
-    overrides = json.loads(a.get("overrides", "[]"))
-    try:
-        sc = parse_scene(str(a["scene"]), str(result.path), list(overrides))
-    except SceneError as err:
-        raise BoundaryError(f"{result.path}: cannot rebuild its scene ({err})") from None
-    stored = {k: v for k, v in result.scene.items() if k != "adaptive"}
-    diffs = scene_differences(stored, resolved_scene(sc, overrides))
-    if diffs:
-        raise BoundaryError(f"{result.path}: its scene YAML no longer gives its grid "
-                            f"({'; '.join(diffs)})")
-    return sc
+    return result_scene(result)
 
 
 def check_result(result: SweepResult, axes: Sequence[str] = DIAGRAM_AXES) -> Scene:
@@ -508,3 +492,68 @@ def result_curves(result: SweepResult, rtol: float = DEFAULT_RTOL, mode: int | N
     outcome = np.asarray(result.arrays["outcome"])
     curves = a_min(sc, outcome, rtol, axes, mode, evaluate)
     return curves, diagram_boundaries(sc, outcome, axes)
+
+
+# ---------------------------------------------------------------------------------------
+# As xarray / pandas (rocksweep.boundaries, rocksweep.boundary_lines)
+# ---------------------------------------------------------------------------------------
+
+def _panel_index(wheres: Sequence[dict[str, Any]]) -> tuple[list[str], dict[str, list]]:
+    """The other swept axes of the panels and each one's values in order of appearance."""
+    keys = list(wheres[0]) if wheres else []
+    values: dict[str, list] = {k: [] for k in keys}
+    for w in wheres:
+        for k in keys:
+            if w[k] not in values[k]:
+                values[k].append(w[k])
+    return keys, values
+
+
+def curves_dataset(curves: Sequence[AMinCurve], attrs: dict[str, Any] | None = None):
+    """A_min curves as an ``xarray.Dataset``: ``A_min`` (NaN: no grid value of the column
+    overturns), ``mode`` (1, 2; 0 where NaN), ``lo``/``hi`` (the final bracket), ``runs``
+    (kernel runs), each over every other swept axis (e.g. shape, lam) and the diagram's x
+    axis (w_over_p or p); values in the axes' units (A_min in A_ratio)."""
+    import xarray as xr
+
+    from rocksweep import fields
+
+    if not curves:
+        return xr.Dataset(attrs=dict(attrs or {}))
+    keys, values = _panel_index([c.where for c in curves])
+    xname, yname = curves[0].xname, curves[0].yname
+    shape = (*(len(values[k]) for k in keys), len(curves[0].x))
+    data = {n: np.full(shape, fill, dtype) for n, fill, dtype in (
+        ("A_min", np.nan, float), ("mode", 0, np.int8), ("lo", np.nan, float),
+        ("hi", np.nan, float), ("runs", 0, np.int64))}
+    for c in curves:
+        idx = tuple(values[k].index(c.where[k]) for k in keys)
+        for n, v in (("A_min", c.a_min), ("mode", c.mode), ("lo", c.lo), ("hi", c.hi),
+                     ("runs", c.runs)):
+            data[n][idx] = v
+    dims = (*keys, xname)
+    ymeta = fields.axis_attrs(yname)
+    meta = {"A_min": {**ymeta, "long_name": f"smallest overturning {ymeta['long_name']}"},
+            "mode": {"long_name": "overturning mode at A_min", "flag_values": [0, 1, 2],
+                     "flag_meanings": "none mode1 mode2"},
+            "lo": {**ymeta, "long_name": "bracket: largest safe value"},
+            "hi": {**ymeta, "long_name": "bracket: smallest overturning value"},
+            "runs": {"long_name": "kernel runs of the bisection", "units": "1"}}
+    coords = {k: (k, np.asarray(values[k]), fields.axis_attrs(k)) for k in keys}
+    coords[xname] = (xname, np.asarray(curves[0].x), fields.axis_attrs(xname))
+    return xr.Dataset({n: (dims, v, meta[n]) for n, v in data.items()}, coords=coords,
+                      attrs={"x_axis": xname, "y_axis": yname, **(attrs or {})})
+
+
+def lines_frame(bounds: Sequence[PanelBoundaries]):
+    """The boundary polylines as a tidy ``pandas.DataFrame``: one row per vertex, columns:
+    every other swept axis of the panel, ``line`` (its number in the panel), ``classes``
+    (e.g. "safe|mode1"), ``vertex``, and the diagram axes' values (``x``, ``y``)."""
+    import pandas as pd
+
+    rows = [{**b.where, "line": i, "classes": line.label, "closed": line.closed
+             if hasattr(line, "closed") else bool(np.allclose(line.xy[0], line.xy[-1])),
+             "vertex": j, "x": float(x), "y": float(y)}
+            for b in bounds for i, line in enumerate(b.lines)
+            for j, (x, y) in enumerate(line.xy)]
+    return pd.DataFrame(rows)

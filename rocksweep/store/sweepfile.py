@@ -7,14 +7,14 @@ netCDF-4 readers open it):
   ``w_over_p``), holding its values and made an HDF5 dimension scale;
 - one 0-d dataset per unswept axis (a scalar coordinate, listed in each variable's
   ``coordinates`` attribute);
-- one dataset per stored variable (``rocksweep.sweep.VARIABLES``) with the grid's
+- one dataset per stored variable (``rocksweep.compute.sweep.VARIABLES``) with the grid's
   dimensions attached; ``outcome`` is -1 where a point is not computed yet;
 - every variable and coordinate has ``long_name`` and (but the pulse shape and the flag
   variables ``outcome``, ``status``) CF ``units``: ``"rad"`` for angles, ``"1"`` for
   everything else, which is a pure number: Pi groups, counts, theta/alpha_ref, energies
   / E_ref, and times p*t (``t_overturn``: its ``long_name`` says p*t, its
   ``rocksweep_units`` the scale, here ``"1/p"``);
-- adaptive sweeps (``rocksweep sweep --adaptive``, ``rocksweep.adaptive``) add an int8
+- adaptive sweeps (``rocksweep sweep --adaptive``, ``rocksweep.compute.adaptive``) add an int8
   variable ``computed`` (0 filled: the point was not computed, its ``outcome`` is the class
   of the uniform cell around it and every other variable keeps its "not computed" fill
   value; 1 computed; 2 an audit point that agreed with its fill; 3 one that disagreed; CF
@@ -72,13 +72,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from rocksweep import fields
+from rocksweep.compute.grid import Grid
+from rocksweep.compute.sweep import ChunkResult, variables
 from rocksweep.errors import OutputError, RocksweepError
-from rocksweep.grid import Grid
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
 from rocksweep.outputs import _reason, check_output, shown
-from rocksweep.scene import Scene
-from rocksweep.sweep import ChunkResult, variables
+from rocksweep.scene.scene import Scene
 
 if TYPE_CHECKING:
     import h5py
@@ -118,7 +119,7 @@ SESSION_ATTRS: dict[str, str] = {
 }
 
 # Counts an adaptive sweep updates at the end of every session (in place, like
-# SESSION_ATTRS): from ``rocksweep.adaptive.stats_of`` of the ``computed`` flags.
+# SESSION_ATTRS): from ``rocksweep.compute.adaptive.stats_of`` of the ``computed`` flags.
 ADAPTIVE_COUNT_ATTRS: dict[str, str] = {
     "points_computed": "int64",
     "points_filled": "int64",
@@ -132,34 +133,8 @@ COMPUTED_VARIABLE = ("int8", 0, "adaptive sweep: 0 filled (not computed; outcome
                      "audit point that disagreed (region refined)")
 COMPUTED_FLAGS = {0: "filled", 1: "computed", 2: "audit_agreed", 3: "audit_disagreed"}
 
-# long names of the coordinates (the paper's symbols)
-COORD_LONG_NAMES = {
-    "shape": "pulse shape",
-    "w_over_p": "omega/p (Pi5)",
-    "p": "p: the body's frequency parameter against the record [rad/s]",
-    "A_ratio": "A/(g tan alpha_ref) (Pi6)",
-    "lam": "lambda: impulse position / b (Pi10)",
-    "wn_over_p": "omega_n/p (Pi1)",
-    "zeta": "zeta (Pi2)",
-    "alpha_cg": "alpha_cg [rad] (Pi3)",
-    "alpha_A": "alpha_A [rad] (Pi4)",
-    "mA_over_m": "m_A/m (Pi8)",
-    "IA_ratio": "I_A/(m_A R_A^2) (Pi9)",
-    "alpha": "alpha [rad]",
-    "inertia": "I_O/(M R^2)",
-}
-# CF units of the coordinates: angles in radians, the other Pi groups are pure numbers.
-COORD_UNITS = {"alpha_cg": "rad", "alpha_A": "rad", "alpha": "rad", "p": "rad/s",
-               "nu": "degree"}
 # Variables whose values are codes (CF flag_values / flag_masks): no units.
 FLAG_VARIABLES = ("outcome", "status", "computed")
-# rocksweep's own unit of a variable where it is not plainly "1" (the CF units are "1":
-# each is a ratio). TODO(fields.py): read ``rocksweep.fields.UNITS`` once fields.py is
-# committed; it holds these same strings.
-SCALED_UNITS = {"theta_max_over_alpha": "alpha_ref", "t_overturn": "1/p",
-                "work_in_over_Eref": "E_ref", "damper_loss_over_Eref": "E_ref",
-                "impact_loss_over_Eref": "E_ref"}
-
 # What h5py raises for I/O and damaged files (HDF5 errors surface as any of these).
 _H5_ERRORS = (OSError, RuntimeError, ValueError, KeyError, TypeError, IndexError)
 
@@ -423,7 +398,7 @@ def _check_scene(stored, path: Path) -> None:
             raise bad(f"unswept axis {key} has {len(ax['values'])} values")
     if "adaptive" in stored:
         a = stored["adaptive"]
-        from rocksweep.adaptive import RESOLVED_KEYS
+        from rocksweep.compute.adaptive import RESOLVED_KEYS
 
         ok = (isinstance(a, dict) and set(a) == set(RESOLVED_KEYS)
               and isinstance(a["axes"], list) and len(a["axes"]) == 2
@@ -535,11 +510,9 @@ def _check_format(f: h5py.File, path: Path) -> None:
 def variables_for(stored: dict) -> dict:
     """The per-point variables of a file from its resolved scene (``computed`` in the
     files of adaptive sweeps)."""
-    from rocksweep.sweep import CHECK_VARIABLES, CONTACT_VARIABLES, ENERGY_VARIABLES, VARIABLES
 
-    return {**VARIABLES, **(ENERGY_VARIABLES if stored.get("energy") else {}),
-            **(CONTACT_VARIABLES if stored.get("contact") else {}),
-            **(CHECK_VARIABLES if stored.get("check") else {}),
+    return {**fields.variables(bool(stored.get("energy")), bool(stored.get("contact")),
+                               bool(stored.get("check"))),
             **({"computed": COMPUTED_VARIABLE} if stored.get("adaptive") else {})}
 
 
@@ -1074,7 +1047,7 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
                 else np.asarray(axis.values, float))
         ds = f.create_dataset(axis.name, data=data)
         ds.make_scale(axis.name)
-        _coord_attrs(ds, axis)
+        _coord_attrs(ds, axis, scene.kind)
         scales.append(ds)
     scalars = []
     for axis in scene.axes:
@@ -1083,7 +1056,7 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
         v = axis.values[0]
         ds = f.create_dataset(axis.name, data=(np.array(v, dtype=h5py.string_dtype())
                                                if axis.name == "shape" else float(v)))
-        _coord_attrs(ds, axis)
+        _coord_attrs(ds, axis, scene.kind)
         scalars.append(axis.name)
 
     specs = dict(variables(scene))
@@ -1094,11 +1067,15 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
         dcpl.set_alloc_time(h5py.h5d.ALLOC_TIME_EARLY)  # no metadata changes later
         ds = f.create_dataset(name, shape=grid.shape, dtype=dtype, fillvalue=fill,
                               dcpl=dcpl, fill_time="alloc")
-        ds.attrs["long_name"] = text
-        ds.attrs["description"] = text
-        if name not in FLAG_VARIABLES:
+        f_ = fields.BY_NAME.get(name)
+        meta = (fields.field_attrs(f_, scene.kind) if f_ is not None
+                else {"long_name": "computed flag", "description": text})
+        if name in FLAG_VARIABLES:
+            meta.pop("rocksweep_units", None)
+        else:
             ds.attrs["units"] = "1"
-            ds.attrs["rocksweep_units"] = SCALED_UNITS.get(name, "1")
+        for k, v in meta.items():
+            ds.attrs[k] = v
         if name == "outcome":  # CF-style flag attributes, for xarray users
             ds.attrs["flag_values"] = np.array(list(OUTCOME_WORDS), np.int8)
             ds.attrs["flag_meanings"] = " ".join(OUTCOME_WORDS.values())
@@ -1115,10 +1092,9 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
             ds.dims[i].attach_scale(sc)
 
 
-def _coord_attrs(ds, axis) -> None:
-    ds.attrs["long_name"] = COORD_LONG_NAMES.get(axis.name, axis.name)
-    if axis.name != "shape":
-        ds.attrs["units"] = COORD_UNITS.get(axis.name, "1")
+def _coord_attrs(ds, axis, kind: str = "flexible") -> None:
+    for k, v in fields.axis_attrs(axis.name, kind).items():
+        ds.attrs[k] = v
     ds.attrs["scene_key"] = axis.key
 
 
@@ -1186,6 +1162,76 @@ class SweepResult:
                          "not_computed": int((cell == L.OUTCOME_NOT_RUN).sum()),
                          "flagged": int(fl[idx].sum())})
         return rows
+
+
+def result_of(ds) -> SweepResult:
+    """A result Dataset (what ``rocksweep.run`` and ``rocksweep.open`` return) as the
+    ``SweepResult`` that ``read_result`` gives for its file: the analyses and figures take
+    either. A Dataset that is not a rocksweep sweep result is a one-line StoreError."""
+    import json
+
+    where = Path(str(ds.encoding.get("source") or ds.attrs.get("title") or "dataset"))
+    if "outcome" not in ds.data_vars or "scene_resolved" not in ds.attrs:
+        raise StoreError(f"{where}: not a rocksweep result (a Dataset from rocksweep.run or "
+                         "rocksweep.open has an outcome variable and a scene_resolved "
+                         "attribute)")
+    try:
+        stored = json.loads(str(ds.attrs["scene_resolved"]))
+    except ValueError:
+        raise StoreError(f"{where}: attribute scene_resolved is not JSON") from None
+    _check_scene(stored, where)
+    dims = tuple(str(d) for d in ds["outcome"].dims)
+    coords = {d: np.asarray(ds[d].values) for d in dims}
+    scalars = {str(k): _plain(np.asarray(v.values).reshape(()).item())
+               for k, v in ds.coords.items() if k not in dims and v.ndim == 0}
+    arrays = {str(k): np.asarray(v.transpose(*dims).values) for k, v in ds.data_vars.items()
+              if set(v.dims) == set(dims)}
+    attrs = {str(k): _plain(v) for k, v in ds.attrs.items()}
+    return SweepResult(where, dims, tuple(len(coords[d]) for d in dims), coords, scalars,
+                       arrays, attrs, stored)
+
+
+def as_result(data, names: list[str] | None = None) -> SweepResult:
+    """A ``SweepResult`` from a result Dataset, a ``SweepResult`` or a result file's path
+    (read with ``names``)."""
+    if isinstance(data, SweepResult):
+        return data
+    if isinstance(data, str | Path):
+        return read_result(data, names)
+    return result_of(data)
+
+
+def result_scene(result: SweepResult) -> Scene:
+    """The scene a result was computed from, rebuilt from its YAML and overrides and
+    checked against the result's resolved scene (axes, numerics), so that the kernel runs
+    again as the sweep did (the A_min bisection, spectra). A record is re-read from where
+    the sweep read it and checked against its SHA-256. One-line StoreErrors."""
+    import json
+
+    from rocksweep.scene.scene import parse_scene
+
+    a = result.attrs
+    try:
+        overrides = list(json.loads(str(a.get("overrides", "[]"))))
+    except ValueError:
+        raise StoreError(f"{shown(result.path)}: attribute overrides is not JSON") from None
+    rec = result.scene.get("record")
+    if rec:
+        overrides.append(f"ground.record={rec['source']}")
+    try:
+        sc = parse_scene(str(a["scene"]), str(result.path), overrides)
+    except RocksweepError as err:
+        raise StoreError(f"{shown(result.path)}: cannot rebuild its scene ({err})") from None
+    if rec and sc.record.sha256 != rec["sha256"]:
+        raise StoreError(f"{shown(result.path)}: the record {rec['source']} changed since the "
+                         f"sweep (sha256 {sc.record.sha256[:12]}, the result has "
+                         f"{rec['sha256'][:12]})")
+    stored = {k: v for k, v in result.scene.items() if k != "adaptive"}
+    diffs = scene_differences(stored, resolved_scene(sc, overrides[:len(overrides) - bool(rec)]))
+    if diffs:
+        raise StoreError(f"{shown(result.path)}: its scene YAML no longer gives its grid "
+                         f"({'; '.join(diffs)})")
+    return sc
 
 
 def _plain(v):

@@ -34,7 +34,7 @@ M g b, means a crossing was stepped over; it is then located on the dense output
 the previous extremum and that one. theta_max is the largest |theta| over the maxima of
 s*theta (located, not sampled) and the phase ends.
 
-Times are p*t (p = 1 rad/s), angles in rad, SI units with m = 1 kg (``rocksweep.model``).
+Times are p*t (p = 1 rad/s), angles in rad, SI units with m = 1 kg (``rocksweep.physics.model``).
 """
 
 from __future__ import annotations
@@ -64,7 +64,7 @@ from rocksweep.kernel.equations import (
     uplift_moment_rate,
 )
 from rocksweep.numerics import Numerics
-from rocksweep.points import Point, point_row
+from rocksweep.physics.points import Point, point_row
 
 RTOL = 1e-10
 ATOL = 1e-12

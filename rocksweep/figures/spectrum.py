@@ -1,5 +1,5 @@
 """The figure of ``rocksweep spectrum``: rocking and overturning spectra (matplotlib only;
-the computation is ``rocksweep.spectrum``)."""
+the computation is ``rocksweep.analysis.spectrum``)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 if TYPE_CHECKING:
-    from rocksweep.spectrum import Spectra
+    from rocksweep.analysis.spectrum import Spectra
 
 _XLABEL = {"p": r"$p$ [rad/s]", "w_over_p": r"$\omega/p$"}
 # at most this many A_ratio curves per lam in the rocking spectrum (evenly picked)

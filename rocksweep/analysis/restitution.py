@@ -8,12 +8,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rocksweep.model import Body, FlexibleBody, restitution, restitution_rigid
+from rocksweep.physics.model import Body, FlexibleBody, restitution, restitution_rigid
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-    from rocksweep.scene import Scene
+    from rocksweep.scene.scene import Scene
 
 
 @dataclass
@@ -48,8 +48,8 @@ class RestitutionTable:
                 "e_housner_rigid": self.e_housner}
 
     def figure(self) -> Figure:
-        """Figure 2 (``rocksweep.plots.restitution_map``), a pyplot-free Figure."""
-        from rocksweep.plots import restitution_map
+        """Figure 2 (``rocksweep.figures.common.restitution_map``), a pyplot-free Figure."""
+        from rocksweep.figures.common import restitution_map
 
         return restitution_map(self.lam, self.u_over_ucr, self.e_upper, self.e_housner,
                                self.title)
@@ -59,7 +59,7 @@ def restitution_table(scene: Scene, n_lam: int = 101, n_u: int = 81) -> Restitut
     """eq. (1) for the scene's body over lam in [0, 1] (n_lam values) and u/u_cr in
     [-2, 2] (n_u values). The scene must hold one body (a SceneError names a swept body
     key otherwise); its impact and pulse sections are not used."""
-    from rocksweep.scene import SceneError
+    from rocksweep.scene.scene import SceneError
 
     for a in scene.body_axes():
         if len(a.values) != 1:

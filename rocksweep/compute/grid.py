@@ -18,8 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.points import body_omega_rock, body_row, fill_rows, kernel_kind, shape_code
-from rocksweep.scene import Scene
+from rocksweep.physics.points import body_omega_rock, body_row, fill_rows, kernel_kind, shape_code
+from rocksweep.scene.scene import Scene
 
 
 @dataclass

@@ -7,8 +7,8 @@ Saving is separate: ``save_figure(fig, path)`` follows the output policy of
 ``rocksweep.outputs`` (refuses an existing file without ``overwrite``, a device, a missing
 or read-only directory, an unknown suffix; writes under a temporary name, then renames).
 
-Stability diagrams (Figures 3 and 4) live in ``rocksweep.diagrams``, the work-precision
-diagram in ``rocksweep.accuracy_plot``.
+Stability diagrams (Figures 3 and 4) live in ``rocksweep.figures.diagrams``, the work-precision
+diagram in ``rocksweep.figures.accuracy``.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from rocksweep.outputs import atomic_path, check_output
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-    from rocksweep.single import Run
+    from rocksweep.compute.single import Run
 
 FORMATS = (".png", ".pdf", ".svg")
 DEFAULT_DPI = 200
@@ -61,10 +61,32 @@ def save_figure(fig: Figure, path: str | Path, dpi: int = DEFAULT_DPI, *,
     command's ``inputs``, a device, directory, missing or read-only directory, and other
     suffixes. dpi: dots per inch of raster output (PNG; the raster parts of PDF/SVG).
     """
+    import matplotlib
+
     path = check_output(path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
-    with atomic_path(path) as tmp:
+    # TrueType fonts in PDF (Type 42), as journals ask, instead of matplotlib's Type 3
+    with atomic_path(path) as tmp, matplotlib.rc_context({"pdf.fonttype": 42,
+                                                          "ps.fonttype": 42}):
         fig.savefig(tmp, dpi=dpi, format=path.suffix[1:].lower())
     return path
+
+
+# Figure widths for papers [inches] and the font size [pt] that keeps text legible when the
+# figure is printed at that width: a single column (~88 mm) and a double column (~180 mm).
+WIDTHS: dict[str, tuple[float, float]] = {"single": (3.5, 7.0), "double": (7.2, 8.0)}
+
+
+def width_style(width: str | None) -> dict:
+    """matplotlib rc settings of a paper width preset (``WIDTHS``: "single" or "double"
+    column); {} for None (matplotlib's defaults)."""
+    if width is None:
+        return {}
+    if width not in WIDTHS:
+        raise FigureError(f"width = {width!r}: must be one of {', '.join(WIDTHS)} (or None)")
+    inches, pt = WIDTHS[width]
+    return {"figure.figsize": (inches, 0.8 * inches), "font.size": pt,
+            "axes.titlesize": pt, "axes.labelsize": pt, "legend.fontsize": pt - 1,
+            "xtick.labelsize": pt - 1, "ytick.labelsize": pt - 1, "lines.markersize": 3}
 
 
 # ---------------------------------------------------------------------------------------
@@ -95,7 +117,7 @@ def time_history(runs: Sequence[Run], swept: Sequence[str] = (), title: str = ""
     column over the point's amplitude A), (b) theta/alpha_cg, (c) E/E_ref, (d) the energy
     dissipated in impacts and the damper / E_ref; one colour per run.
 
-    runs: Runs with a history (``rocksweep.single.simulate(..., history=True)``); swept: the
+    runs: Runs with a history (``rocksweep.compute.single.simulate(..., history=True)``); swept: the
     scene's swept axis names, which label the runs; axes: 4 axes to draw into (else a new
     figure). Returns the figure.
     """

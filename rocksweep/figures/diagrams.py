@@ -13,7 +13,7 @@ axis (e.g. ``alpha_cg`` against ``A_ratio``). Each cell is coloured by what the 
   when lam is swept and on neither axis;
 - safe at every lam: white; not computed yet: grey.
 
-With ``curves``, the boundary lines between classes (``rocksweep.boundaries``) of every
+With ``curves``, the boundary lines between classes (``rocksweep.analysis.boundaries``) of every
 lam are drawn over the cells, one colour per lam. ``a_min_figure`` draws A_min(omega/p)
 curves of several panels (e.g. lam values) on one axis, as the paper compares them.
 Filled cells of an adaptive sweep are drawn as computed ones.
@@ -42,13 +42,20 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.plots import DEFAULT_DPI, FORMATS, FigureError, given_axes, new_axes, save_figure
-from rocksweep.store import SweepResult
+from rocksweep.figures.common import (
+    DEFAULT_DPI,
+    FORMATS,
+    FigureError,
+    given_axes,
+    new_axes,
+    save_figure,
+)
+from rocksweep.store.sweepfile import SweepResult
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-    from rocksweep.boundaries import AMinCurve, PanelBoundaries
+    from rocksweep.analysis.boundaries import AMinCurve, PanelBoundaries
 
 __all__ = ["FORMATS", "DiagramError", "choose_axes", "stability_diagram", "line_diagram",
            "sweep_figure", "stability_figure", "missing_warnings", "categories", "y_label",
@@ -609,7 +616,7 @@ def sweep_figure(result: SweepResult, x: str | None = None, y: str | None = None
 def _draw_boundaries(ax: Axes, po: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> None:
     """The boundary lines of each lam layer of a panel (po: outcome[n_lam, ny, nx], axes
     ascending) in its colour; lines along points not computed yet are left out."""
-    from rocksweep.boundaries import boundary_lines
+    from rocksweep.analysis.boundaries import boundary_lines
 
     for k in range(po.shape[0]):
         colour = CURVE_COLOURS[k % len(CURVE_COLOURS)]
@@ -654,7 +661,7 @@ def _where_label(where: dict[str, Any]) -> str:
 
 def a_min_figure(curves: Sequence[AMinCurve], bounds: Sequence[PanelBoundaries] = (),
                  title: str = "", kind: str = "flexible") -> Figure:
-    """A_min(x) of every panel (``rocksweep.boundaries.a_min``) overlaid on one axis: one
+    """A_min(x) of every panel (``rocksweep.analysis.boundaries.a_min``) overlaid on one axis: one
     colour per panel (e.g. per lam), solid where the onset is mode 1, dashed where mode 2;
     with the boundary lines of ``bounds`` drawn thin in the same colours when given.
     kind: the body kind (labels the amplitude axis). No pyplot."""

@@ -8,25 +8,23 @@ A sweep over ``p`` (a record scene: the body's frequency parameter [rad/s]) or
 - the overturning spectrum: the smallest A_ratio that overturns against p, one curve per
   lam, with the mode it overturns in. Between the first overturning grid value of each p
   and the grid value below, A_ratio is bisected to ``rtol`` (relative) with single kernel
-  runs at the sweep's numerics: ``rocksweep.boundaries.a_min`` (shared with the stability
+  runs at the sweep's numerics: ``rocksweep.analysis.boundaries.a_min`` (shared with the stability
   diagram's A_min curves), with an evaluator here that also runs records and the GROUND
   pulses (``boundaries.kernel_evaluator``, which runs every ground motion's kernel).
 
 The scene is rebuilt from the file (its YAML); a record is re-read from the path the sweep
 read it at and must have the same SHA-256 as then. The figure is
-``rocksweep.spectrum_plot.spectra_figure``.
+``rocksweep.figures.spectrum.spectra_figure``.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
-from rocksweep.boundaries import DEFAULT_RTOL, AMinCurve, a_min, kernel_evaluator
+from rocksweep.analysis.boundaries import DEFAULT_RTOL, AMinCurve, a_min, kernel_evaluator
 from rocksweep.errors import RocksweepError
-from rocksweep.scene import Scene, parse_scene
 
 
 class SpectrumError(RocksweepError, ValueError):
@@ -56,31 +54,43 @@ class Spectra:
     runs: int
     record: str = ""
 
+    def to_dataset(self):
+        """The spectra as an ``xarray.Dataset``: ``theta_max_over_alpha`` and ``outcome``
+        over (lam, A_ratio, freq) (the rocking spectrum), ``A_min`` and ``mode`` over (lam,
+        freq) (the overturning spectrum, bisected to ``rtol``; NaN: no grid value
+        overturns), freq being ``p`` [rad/s] or ``w_over_p``."""
+        import xarray as xr
 
-def result_scene(result) -> Scene:
-    """The scene of a result file, rebuilt from its YAML (a record re-read from where the
-    sweep read it, checked against its SHA-256)."""
-    text = str(result.attrs["scene"])
-    overrides = list(result.scene.get("overrides", []))
-    rec = result.scene.get("record")
-    if rec:
-        overrides.append(f"ground.record={rec['source']}")
-    try:
-        scene = parse_scene(text, str(result.path), overrides)
-    except RocksweepError as err:
-        raise SpectrumError(f"{result.path}: its scene cannot be rebuilt ({err})") from None
-    if rec and scene.record.sha256 != rec["sha256"]:
-        raise SpectrumError(f"{result.path}: the record {rec['source']} changed since the "
-                            f"sweep (sha256 {scene.record.sha256[:12]}, the file has "
-                            f"{rec['sha256'][:12]}); the spectra need the record swept")
-    return scene
+        from rocksweep import fields
+
+        a_min = np.array([c.a_min for c in self.a_min], float).reshape(len(self.lam), -1)
+        mode = np.array([c.mode for c in self.a_min], np.int8).reshape(a_min.shape)
+        f = self.freq
+        theta_attrs = fields.field_attrs(fields.BY_NAME["theta_max_over_alpha"])
+        return xr.Dataset(
+            {"theta_max_over_alpha": (("lam", "A_ratio", f), self.theta_max, theta_attrs),
+             "outcome": (("lam", "A_ratio", f), self.outcome,
+                         {"long_name": "outcome class", "flag_values": [-1, 0, 1, 2],
+                          "flag_meanings": "not_run safe mode1 mode2"}),
+             "A_min": (("lam", f), a_min,
+                       {**fields.axis_attrs("A_ratio"),
+                        "long_name": "smallest overturning amplitude ratio"}),
+             "mode": (("lam", f), mode, {"long_name": "overturning mode at A_min",
+                                         "flag_values": [0, 1, 2],
+                                         "flag_meanings": "none mode1 mode2"})},
+            coords={"lam": ("lam", self.lam, fields.axis_attrs("lam")),
+                    "A_ratio": ("A_ratio", self.A, fields.axis_attrs("A_ratio")),
+                    f: (f, self.x, fields.axis_attrs(f))},
+            attrs={"title": self.name, "rtol": self.rtol, "runs": self.runs,
+                   "record": self.record})
 
 
-def spectra(path: str | Path, rtol: float = DEFAULT_RTOL) -> Spectra:
-    """The rocking and overturning spectra of a complete sweep result file."""
-    from rocksweep.store import read_result
+def spectra(data, rtol: float = DEFAULT_RTOL) -> Spectra:
+    """The rocking and overturning spectra of a complete sweep result: a Dataset (what
+    ``rocksweep.run`` / ``rocksweep.open`` return), a ``SweepResult`` or a file's path."""
+    from rocksweep.store.sweepfile import as_result, result_scene
 
-    result = read_result(Path(path), ["outcome", "status", "theta_max_over_alpha"])
+    result = as_result(data, ["outcome", "status", "theta_max_over_alpha"])
     freq = "p" if "p" in result.dims else "w_over_p"
     missing = [d for d in (freq, "A_ratio") if d not in result.dims]
     if missing:

@@ -20,7 +20,7 @@ from rocksweep.fields import THETA_REL_FLOOR
 from rocksweep.kernel import layout as L  # noqa: N812
 
 if TYPE_CHECKING:
-    from rocksweep.store import SweepResult
+    from rocksweep.store.sweepfile import SweepResult
 
 CLASSES = ("mode1", "mode2", "safe", "flagged", "not_computed")
 # Counted too in results with contact outputs (outputs.contact / body.mu): computed points
@@ -165,7 +165,7 @@ def _json_value(v):
 
 def read_info(path) -> SweepResult:
     """The variables of a result file that ``info_dict`` reports on."""
-    from rocksweep.store import read_result, stored_scene
+    from rocksweep.store.sweepfile import read_result, stored_scene
 
     check = bool(stored_scene(path).get("check"))
     return read_result(path, INFO_VARIABLES + (CHECK_INFO_VARIABLES if check else []),
@@ -252,7 +252,7 @@ def adaptive_info(result: SweepResult) -> dict | None:
     settings = result.scene.get("adaptive")
     if not settings or "computed" not in result.arrays:
         return None
-    from rocksweep.adaptive import stats_of
+    from rocksweep.compute.adaptive import stats_of
 
     c = np.asarray(result.arrays["computed"])
     st = stats_of(c, settings.get("threshold", 0.0))

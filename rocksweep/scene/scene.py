@@ -27,15 +27,15 @@ import numpy as np
 import yaml
 
 from rocksweep.errors import RocksweepError
-from rocksweep.model import BlockBody, Body, BodyError, FlexibleBody
 from rocksweep.numerics import (
     EVENT_STEP_ALLOWANCE,
     MAX_POINT_STEPS,
     PRESETS,
     Numerics,
 )
-from rocksweep.points import RECORD, Point, body_omega_rock, record_cost, run_cost
-from rocksweep.records import GroundRecord, RecordError, read_record
+from rocksweep.physics.model import BlockBody, Body, BodyError, FlexibleBody
+from rocksweep.physics.points import RECORD, Point, body_omega_rock, record_cost, run_cost
+from rocksweep.physics.records import GroundRecord, RecordError, read_record
 from rocksweep.schema import (
     BODY_KEYS,
     KEYS,
@@ -53,7 +53,7 @@ class SceneError(RocksweepError, ValueError):
 
 
 # Largest grid a scene may describe [points]. A sweep file stores 45 bytes a point (69
-# with energy metrics, rocksweep.sweep.VARIABLES): 2e8 points are a 9-14 GB file, one
+# with energy metrics, rocksweep.compute.sweep.VARIABLES): 2e8 points are a 9-14 GB file, one
 # float64 variable read back for a figure or xarray is 1.6 GB of memory, and at the
 # kernel's 27-54 us a point (README, bench) the sweep takes 1.5-3 hours of one core.
 MAX_POINTS = 200_000_000
@@ -172,7 +172,7 @@ class Scene:
     text: str = field(repr=False)
     contact: bool = False  # outputs.contact (on when body.mu is given)
     check: bool = False  # outputs.check: per-point error estimates (a half-step rerun)
-    # the `refine` section (adaptive sweep settings, rocksweep.adaptive.Options keywords),
+    # the `refine` section (adaptive sweep settings, rocksweep.compute.adaptive.Options keywords),
     # None without one
     refine: dict | None = None
     # a record scene (``ground`` section): the record read at load (else None); the grid's
@@ -201,7 +201,7 @@ class Scene:
 
     def phase_max(self) -> float:
         """The longest pulse of the scene's shapes in w t (2 pi n, 6 pi, 2 pi gamma)."""
-        from rocksweep.points import RECORD, phase_duration
+        from rocksweep.physics.points import RECORD, phase_duration
 
         return max(phase_duration(sh, self.option("cycles"), self.option("gamma"))
                    for sh in self.axis("shape").values if sh != RECORD)
@@ -225,16 +225,6 @@ class Scene:
     def size(self) -> int:
         """Number of points of the grid (<= MAX_POINTS)."""
         return math.prod(self.shape)
-
-    def sweep_nbytes(self) -> int:
-        """Bytes a sweep file of this scene needs for its per-point variables (the stored
-        variables of ``rocksweep.sweep.variables``, 45 a point, 69 with energy metrics)
-        and its coordinates; HDF5's own overhead (a few kB) is not counted."""
-        from rocksweep.sweep import variables  # the sweep knows what it stores
-
-        per_point = sum(np.dtype(dtype).itemsize for dtype, _, _ in variables(self).values())
-        coords = sum(8 * len(a.values) for a in self.swept)
-        return self.size * per_point + coords
 
     def body_axes(self) -> tuple[Axis, ...]:
         """The axes that make the body (body.mu is the ground's, not the body's)."""
@@ -435,7 +425,8 @@ def _shapes(spec: Any) -> tuple[tuple[str, ...], bool]:
 
 
 def _refine(raw: dict, kind: str) -> dict | None:
-    """The checked ``refine`` section as ``rocksweep.adaptive.Options`` keywords, or None."""
+    """The checked ``refine`` section as ``rocksweep.compute.adaptive.Options`` keywords,
+    or None."""
     if raw.get("refine") is None:
         return None
     sec = _section(raw, "refine", kind, required=False)

@@ -2,8 +2,8 @@
 
 No I/O here: ``run_chunks`` yields each chunk's result arrays as it finishes and the
 driver (``rocksweep.api.sweep_file``, behind ``rocksweep sweep`` and ``rocksweep.run``)
-writes them (``rocksweep.store``). A chunk is a
-contiguous range of flat point indices (``rocksweep.grid``) and costs one call into the
+writes them (``rocksweep.store.sweepfile``). A chunk is a
+contiguous range of flat point indices (``rocksweep.compute.grid``) and costs one call into the
 jitted kernel per kernel kind present in the chunk; there is no Python per point.
 
 Local workers are threads of this process (joblib's threading backend): the chunk kernels
@@ -28,31 +28,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from rocksweep import fields
+from rocksweep.compute.grid import ChunkRows, Grid
 from rocksweep.errors import RocksweepError
-from rocksweep.grid import ChunkRows, Grid
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.points import with_record
-from rocksweep.scene import Scene
+from rocksweep.physics.points import with_record
+from rocksweep.scene.scene import Scene
 
 
 class SweepError(RocksweepError, ValueError):
     """A sweep that cannot run as asked (workers, cluster); ``str()`` is one line."""
 
-
-# Stored per point: name -> (dtype, fill value for "not computed", description), derived
-# from the one table of result fields (``rocksweep.fields``; units: ``fields.UNITS``).
-VARIABLES: dict[str, tuple[str, float, str]] = {
-    f.name: (f.dtype, f.fill, f.meaning) for f in fields.SWEEP_FIELDS}
-# Stored when the scene asks for energy metrics (outputs.energy: true).
-ENERGY_VARIABLES: dict[str, tuple[str, float, str]] = {
-    f.name: (f.dtype, f.fill, f.meaning) for f in fields.ENERGY_FIELDS}
-# Stored when the scene asks for the ground reactions (outputs.contact: true).
-CONTACT_VARIABLES: dict[str, tuple[str, float, str]] = {
-    f.name: (f.dtype, f.fill, f.meaning) for f in fields.CONTACT_FIELDS}
-# Stored when the scene asks for per-point error estimates (outputs.check: true).
-CHECK_VARIABLES: dict[str, tuple[str, float, str]] = {
-    f.name: (f.dtype, f.fill, f.meaning) for f in fields.CHECK_FIELDS}
 
 # Upper bound of the automatic chunk size [points]; see ``auto_chunk_size``.
 MAX_CHUNK = 1024
@@ -69,10 +55,9 @@ COMPILE_SECONDS = 20.0
 
 
 def variables(scene: Scene) -> dict[str, tuple[str, float, str]]:
-    """The per-point variables a sweep of this scene stores."""
-    return {**VARIABLES, **(ENERGY_VARIABLES if scene.energy else {}),
-            **(CONTACT_VARIABLES if scene.contact else {}),
-            **(CHECK_VARIABLES if scene.check else {})}
+    """The per-point variables a sweep of this scene stores (``fields.variables`` of the
+    scene's outputs)."""
+    return fields.variables(scene.energy, scene.contact, scene.check)
 
 
 def level(scene: Scene) -> int:
@@ -373,3 +358,83 @@ def compute(scene: Scene, jobs: int = 1, chunk_size: int | None = None,
         if on_chunk is not None:
             on_chunk(res)
     return {k: v.reshape(grid.shape) for k, v in flat.items()}
+
+
+# ---------------------------------------------------------------------------------------
+# What a sweep will cost, before it runs (rocksweep.estimate, rocksweep sweep --dry-run)
+# ---------------------------------------------------------------------------------------
+
+# Kernel time per RK4 evaluation [s] on the paper's figures at the default preset
+# (scripts/bench_kernel.py: 109-120 ns on the 2-core reference machine): the price of a
+# step when no sample can be run because the kernel is not compiled yet.
+SECONDS_PER_EVALUATION = 120e-9
+# Points run to measure the cost when the kernel variant is compiled: ~10 ms of work.
+ESTIMATE_SAMPLE = 256
+
+
+@dataclass
+class Estimate:
+    """What a sweep of a scene will cost on this machine (``estimate``).
+
+    points: grid points; steps_bound: RK4 steps if every point ran to its horizon (no
+    overturning, events not counted; the check rerun doubled in); evaluations: expected
+    RK4 evaluations (regular + event) of the whole sweep, measured on ``sampled`` random
+    points when the kernel is compiled, else steps_bound; seconds: expected compute time
+    [s] with ``jobs`` workers (compile excluded); compile_needed: a kernel variant must be
+    compiled first, ~``compile_seconds`` [s]; variants: the kernel variants the scene runs.
+    """
+
+    points: int
+    steps_bound: int
+    evaluations: float
+    seconds: float
+    compile_needed: bool
+    compile_seconds: float
+    variants: int
+    sampled: int
+    jobs: int
+
+    def __str__(self) -> str:
+        how = (f"measured on {self.sampled} sample points" if self.sampled
+               else "from the step bound (kernel not compiled: no sample run)")
+        comp = (f"; compile first, ~{self.compile_seconds:.0f} s" if self.compile_needed
+                else "; kernel compiled")
+        return (f"{self.points} points, {self.evaluations:.3g} RK4 evaluations ({how}), "
+                f"~{self.seconds:.3g} s of compute on {self.jobs} worker"
+                f"{'s' * (self.jobs > 1)}{comp}")
+
+
+def estimate(scene: Scene, jobs: int = 1, sample: int = ESTIMATE_SAMPLE,
+             seed: int = 0) -> Estimate:
+    """The cost of sweeping ``scene`` (see ``Estimate``), without compiling anything: a
+    random sample of points runs through the kernel only when its variant is in memory or
+    in numba's cache (then the estimate is measured; ~10 ms)."""
+    grid = Grid(scene)
+    lvl = level(scene)
+    n = grid.size
+    rng = np.random.default_rng(seed)
+    flat = (np.arange(n) if n <= sample
+            else np.sort(rng.choice(n, size=sample, replace=False)))
+    cr = grid.rows_at(flat)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        per = np.ceil(cr.rows[:, L.PAR_TEND] / cr.rows[:, L.PAR_DT])
+    reruns = 2 if scene.check else 1
+    steps_bound = int(round(float(np.nanmean(per)) * n * reruns))
+    to_compile, unknown = kernel_cache_state(grid, lvl)
+    workers = check_jobs(jobs)
+    sampled = 0
+    if to_compile == 0 and unknown == 0:
+        prepare(grid, lvl)  # loads the cached variant (no compile)
+        c0 = time.thread_time()
+        outs = _run_rows(cr, cr.rows, lvl, scene)
+        cpu = time.thread_time() - c0
+        evals = outs[:, L.OUT_STEPS] + outs[:, L.OUT_EVENT_STEPS]
+        evaluations = float(evals.mean()) * n * reruns
+        seconds = cpu / len(flat) * n * reruns / workers
+        sampled = len(flat)
+    else:
+        evaluations = float(steps_bound)
+        seconds = evaluations * SECONDS_PER_EVALUATION / workers
+    return Estimate(n, steps_bound, evaluations, seconds, bool(to_compile or unknown),
+                    COMPILE_SECONDS * (to_compile + unknown), len(grid.kinds()), sampled,
+                    workers)

@@ -40,10 +40,10 @@ matter. ``next_batch`` is therefore a pure function of
 chunking; a point's result depends only on the point), stores the results and calls it
 again, until it returns an empty batch. An interrupted sweep resumes from the file.
 
-Per point, the state is two arrays over the grid's flat indices (``rocksweep.grid``):
+Per point, the state is two arrays over the grid's flat indices (``rocksweep.compute.grid``):
 ``outcome`` (int8, the kernel's class; read only where computed > 0) and ``computed``
 (int8, the flags below). Filled points keep the "not computed" fill values of every other
-variable (``rocksweep.sweep.VARIABLES``).
+variable (``rocksweep.compute.sweep.VARIABLES``).
 """
 
 from __future__ import annotations
@@ -56,9 +56,9 @@ from typing import Any
 
 import numpy as np
 
+from rocksweep.compute.grid import ChunkRows, Grid
 from rocksweep.errors import RocksweepError
-from rocksweep.grid import ChunkRows, Grid
-from rocksweep.scene import Scene
+from rocksweep.scene.scene import Scene
 
 # ``computed`` flags (int8 per point).
 FILLED = 0  # not computed: outcome holds the class filled from its uniform cell
@@ -725,7 +725,7 @@ def drive(plan: Plan, evaluate: Callable[[np.ndarray, Batch], np.ndarray],
 @dataclass
 class BatchResult:
     """Results of some points of a batch: flat: int64[n] (increasing), arrays: name ->
-    array[n] (``rocksweep.sweep.VARIABLES``), seconds / cpu_seconds of the chunk."""
+    array[n] (``rocksweep.compute.sweep.VARIABLES``), seconds / cpu_seconds of the chunk."""
 
     flat: np.ndarray
     arrays: dict[str, np.ndarray]
@@ -734,7 +734,7 @@ class BatchResult:
 
 
 class _Subset:
-    """A grid seen through a list of flat indices: what ``rocksweep.sweep.run_chunk`` needs
+    """A grid seen through a list of flat indices: what ``rocksweep.compute.sweep.run_chunk`` needs
     (``rows(start, stop)`` over positions in the list, ``kinds()``), so a batch runs through
     the chunk machinery (threads or dask) unchanged."""
 
@@ -753,9 +753,9 @@ class _Subset:
 def run_batch(grid: Grid, flat: np.ndarray, jobs: int = 1, chunk_size: int | None = None,
               backend: str = "threads", scheduler: str | None = None
               ) -> Iterator[BatchResult]:
-    """Compute the points ``flat`` (int64[n]) through ``rocksweep.sweep.run_chunks``; yield
+    """Compute the points ``flat`` (int64[n]) through ``rocksweep.compute.sweep.run_chunks``; yield
     each chunk's results as it finishes (any order). Results depend only on the point."""
-    from rocksweep import sweep as sw
+    from rocksweep.compute import sweep as sw
 
     flat = np.asarray(flat, np.int64)
     if flat.size == 0:
@@ -778,14 +778,14 @@ def adaptive_compute(scene: Scene, jobs: int = 1, coarse: int | None = None,
                      final_margin: int = DEFAULT_FINAL_MARGIN,
                      on_batch: Callable[[Batch], None] | None = None
                      ) -> tuple[dict[str, np.ndarray], AdaptiveStats]:
-    """Adaptive sweep of a whole scene in memory, like ``rocksweep.sweep.compute``.
+    """Adaptive sweep of a whole scene in memory, like ``rocksweep.compute.sweep.compute``.
 
-    Returns (arrays, stats): arrays maps every variable of ``rocksweep.sweep.variables``
+    Returns (arrays, stats): arrays maps every variable of ``rocksweep.compute.sweep.variables``
     plus ``computed`` (int8 flags, see COMPUTED_MEANING) to an array of the grid's shape;
     ``outcome`` is filled everywhere, the other variables hold their "not computed" fill
     value at filled points. Identical whatever ``jobs``, ``chunk_size`` and backend.
     """
-    from rocksweep import sweep as sw
+    from rocksweep.compute import sweep as sw
 
     grid = Grid(scene)
     plan = make_plan(grid, axes, coarse, margin, audit, seed, final_margin)

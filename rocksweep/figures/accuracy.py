@@ -3,7 +3,7 @@
 (a) error against the reference versus kernel time per point, log-log, one colour per
 measure: the step ladder as a solid line (steps per period labelled), the tolerance ladder
 as a dashed line (event_tol labelled), the presets as stars. What is plotted is what
-``rocksweep.accuracy`` measures: the median over the sampled points of |d theta_max|/alpha
+``rocksweep.analysis.accuracy`` measures: the median over the sampled points of |d theta_max|/alpha
 (points both call safe), |d t_first_impact| (both impact), |d t_overturn| (both overturn),
 and the *mean* |d impacts| (same outcome); time is the weighted mean of one-point kernel
 calls (the scene estimate), at the event root finder each setting ran with. (b) outcome
@@ -21,8 +21,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from matplotlib.figure import Figure
 
-from rocksweep.accuracy import MEASURE_LABELS, Study
-from rocksweep.plots import DEFAULT_DPI, given_axes, new_axes, save_figure
+from rocksweep.analysis.accuracy import MEASURE_LABELS, Study
+from rocksweep.figures.common import DEFAULT_DPI, given_axes, new_axes, save_figure
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

@@ -3,7 +3,7 @@
 ``accuracy_study(scene, n_points, ladder)``:
 
 1. Classify every point of the scene with the kernel at the scene's own numerics (the
-   sweep machinery, ``rocksweep.sweep.compute``) and mark the points on an outcome
+   sweep machinery, ``rocksweep.compute.sweep.compute``) and mark the points on an outcome
    boundary of the stability diagram (a neighbour along A_ratio or w_over_p has another
    outcome).
 2. Draw a stratified sample of ``n_points``: strata are (outcome, boundary or interior);
@@ -12,7 +12,7 @@
    weight N_h / n_h of its stratum, so weighted means estimate the whole scene (outcome
    flips gather at boundaries; sampling them more sharpens the estimate, the weights undo
    the bias).
-3. Run the sample with the reference (``rocksweep.reference``, DOP853 at rtol 1e-10) and
+3. Run the sample with the reference (``rocksweep.physics.reference``, DOP853 at rtol 1e-10) and
    with the kernel at each setting of the ladder. Kernel times exclude compilation
    (``kernel.warm_up``). Per-point times come from timing each point as its own 1-row
    chunk (one call into the jitted chunk kernel per point; the call overhead is ~1 us);
@@ -45,7 +45,7 @@ from rocksweep import fields
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import PRESET_ROTATION, PRESETS, ROOTS, Numerics
-from rocksweep.scene import Scene
+from rocksweep.scene.scene import Scene
 
 OUTCOMES = ("safe", "mode1", "mode2")  # codes 0, 1, 2
 # Per-point fields of the report: all the outcome-level kernel fills (no energies).
@@ -255,8 +255,8 @@ def sample_scene(scene: Scene, n: int | None, seed: int = 0) -> Sample:
     ``n`` None or >= the scene's size takes every point (one stratum "all", weights 1,
     no classification pass).
     """
-    from rocksweep.grid import Grid
-    from rocksweep.sweep import compute
+    from rocksweep.compute.grid import Grid
+    from rocksweep.compute.sweep import compute
 
     grid = Grid(scene)
     if n is None or n >= grid.size:
@@ -290,8 +290,8 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
     kernel); the sample is also timed as one call per kernel kind. Both are the best of
     ``repeat`` rounds (the machine's noise only ever adds time). Compilation is excluded.
     """
-    from rocksweep.grid import Grid
-    from rocksweep.points import with_record
+    from rocksweep.compute.grid import Grid
+    from rocksweep.physics.points import with_record
 
     cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
     rows_all = with_record(cr.rows, scene.record)  # a record's samples ride on each row
@@ -330,8 +330,8 @@ def run_reference(scene: Scene, flat: np.ndarray,
 
     Returns (outs float64[n, N_OUT], seconds float64[n], anomalies int64[n]: the
     reference's self-check, see ``reference_run``)."""
-    from rocksweep.grid import Grid
-    from rocksweep.reference import reference_run, result_row
+    from rocksweep.compute.grid import Grid
+    from rocksweep.physics.reference import reference_run, result_row
 
     grid = Grid(scene)
     values = grid.index_values(flat)
@@ -388,7 +388,7 @@ def point_errors(k: np.ndarray, r: np.ndarray, alpha_ref: np.ndarray,
 
 def run_energy(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray:
     """The energy-accounting kernel on the given points (untimed): float64[n, N_OUT]."""
-    from rocksweep.grid import Grid
+    from rocksweep.compute.grid import Grid
 
     cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
     outs = np.empty((len(flat), L.N_OUT))
@@ -403,8 +403,8 @@ def run_energy(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray
 def run_half(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray:
     """The half-step reruns of ``outputs.check`` (``fields.check_rows``) on the given
     points, outcome-only kernel, untimed: float64[n, N_OUT]."""
-    from rocksweep.grid import Grid
-    from rocksweep.points import with_record
+    from rocksweep.compute.grid import Grid
+    from rocksweep.physics.points import with_record
 
     cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
     rows = with_record(fields.check_rows(cr.rows), scene.record)
@@ -627,7 +627,7 @@ def accuracy_study(scene: Scene, n_points: int | None = 200,
     check: also rerun every setting at half the step and score the per-point error
     estimates of ``outputs.check`` against the true errors (``estimate_scores``).
     """
-    from rocksweep.grid import Grid
+    from rocksweep.compute.grid import Grid
 
     t_wall = time.perf_counter()
     settings = settings if settings is not None else ladder("full")
@@ -776,7 +776,7 @@ def write_report(study: Study, path: str | Path, command: str = "") -> None:
     import h5py
 
     from rocksweep.outputs import atomic_path
-    from rocksweep.reference import ATOL, RTOL
+    from rocksweep.physics.reference import ATOL, RTOL
 
     with atomic_path(path) as tmp:
         with h5py.File(tmp, "w") as f:

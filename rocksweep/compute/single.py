@@ -13,7 +13,7 @@ from rocksweep.kernel import chunk_kernel, point_kernel, warm_up
 from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
 from rocksweep.outcomes import outcome_word, status_words
-from rocksweep.points import Point, kernel_kind, point_row
+from rocksweep.physics.points import Point, kernel_kind, point_row
 
 
 @dataclass

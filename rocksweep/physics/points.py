@@ -13,12 +13,12 @@ import numpy as np
 
 from rocksweep.kernel import layout as L
 from rocksweep.kernel.equations import rocking_spring_omega
-from rocksweep.model import Body, FlexibleBody, G
 from rocksweep.numerics import ROOTS, Numerics, amplitude_frequency, step_budget, step_size
-from rocksweep.records import GroundRecord
+from rocksweep.physics.model import Body, FlexibleBody, G
+from rocksweep.physics.records import GroundRecord
 
 if TYPE_CHECKING:
-    from rocksweep.excitation import PulseShape
+    from rocksweep.physics.excitation import PulseShape
 
 SHAPES = ("sine", "cosine", "ricker", "mp")
 RECORD = "record"  # the shape of a point driven by a ground-motion record
@@ -33,7 +33,7 @@ _ROOT_CODE = dict(zip(ROOTS, (L.ROOT_BISECT, L.ROOT_ILLINOIS, L.ROOT_HERMITE), s
 class Point:
     """One simulation: a body, the impulse position lam, and a ground motion.
 
-    A pulse (shape one of SHAPES, ``rocksweep.excitation``): w_over_p = omega/p, cycles
+    A pulse (shape one of SHAPES, ``rocksweep.physics.excitation``): w_over_p = omega/p, cycles
     (sine, cosine), gamma and nu [deg] (MP). A record (shape RECORD): ``record`` and the
     body's frequency parameter p [rad/s], which fixes the body's size against the
     record's seconds (kernel time p t); w_over_p is NaN. A is the peak |xg''| either way.
@@ -70,7 +70,7 @@ class Point:
     @property
     def pulse(self) -> PulseShape | None:
         """The pulse's reference definition (None for a record)."""
-        from rocksweep.excitation import PulseShape  # scipy: loaded when needed
+        from rocksweep.physics.excitation import PulseShape  # scipy: loaded when needed
 
         if self.shape == RECORD:
             return None
@@ -178,7 +178,7 @@ def record_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, p: np.ndarray,
 
 def phase_duration(shape: str, cycles: int = CYCLES, gamma: float = GAMMA) -> float:
     """A pulse's duration in w t (``excitation.PulseShape.duration``)."""
-    from rocksweep.excitation import PulseShape
+    from rocksweep.physics.excitation import PulseShape
 
     return PulseShape(shape, int(cycles), float(gamma)).duration
 
@@ -215,7 +215,7 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
         dt, t_pulse, t_end, max_steps = run_cost(omega_rock, alpha_ref, omega, A_ratio,
                                                  numerics, phase)
         if np.any(code == L.SHAPE_MP):
-            from rocksweep.excitation import mp_peak
+            from rocksweep.physics.excitation import mp_peak
 
             rows[:, L.PAR_GAMMA] = gamma
             rows[:, L.PAR_NU] = math.radians(nu_deg)
