@@ -255,8 +255,8 @@ def test_time_history_has_the_input_pulse_and_guide_legend(fig5_runs):
 
 
 def test_restitution_map_u0_curve_is_dark(body_fig2):
-    from rocksweep.physics.model import restitution, restitution_rigid
     from rocksweep.figures.common import restitution_map
+    from rocksweep.physics.model import restitution, restitution_rigid
 
     lam = np.linspace(0, 1, 11)
     u = np.linspace(-2, 2, 9)
@@ -308,7 +308,8 @@ def test_no_backend_switch_and_no_pyplot():
 import sys, tempfile, os
 import matplotlib
 matplotlib.use("svg")
-import rocksweep.figures.common, rocksweep.figures.diagrams, rocksweep.figures.accuracy, rocksweep.cli.plot
+import rocksweep.figures.common, rocksweep.figures.diagrams
+import rocksweep.figures.accuracy, rocksweep.cli.plot
 from rocksweep.figures.common import restitution_map, save_figure
 import numpy as np
 fig = restitution_map(np.linspace(0, 1, 3), np.linspace(-2, 2, 5), np.ones((3, 5)), 0.8)
@@ -320,7 +321,8 @@ print(matplotlib.get_backend(), "matplotlib.pyplot" in sys.modules)
     assert proc.stdout.split() == ["svg", "False"]
     # without a backend chosen, importing the modules resolves none (no Agg forced)
     code = ("import matplotlib, sys; before = matplotlib.rcParams._get_backend_or_none();"
-            "import rocksweep.figures.common, rocksweep.figures.diagrams, rocksweep.figures.accuracy;"
+            "import rocksweep.figures.common, rocksweep.figures.diagrams;"
+            "import rocksweep.figures.accuracy;"
             "print(before == matplotlib.rcParams._get_backend_or_none(),"
             " 'matplotlib.pyplot' in sys.modules)")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)

@@ -37,8 +37,8 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
     grid value (kernel runs at the sweep's accuracy), with the mode it overturns in; and
     the lines between classes as polylines. Works on adaptive and regular results."""
     from rocksweep.analysis import boundaries as bd
-    from rocksweep.outputs import check_output, write_atomic
     from rocksweep.figures.common import FORMATS, save_figure
+    from rocksweep.outputs import check_output, write_atomic
     from rocksweep.store.sweepfile import read_result
 
     if not (0 < rtol < 1):

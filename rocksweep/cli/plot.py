@@ -43,9 +43,9 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
     ones. With contact outputs and body.mu, the points that would slide are hatched (and
     those that would lift off dotted); --mu draws mu_required. A sweep with --check rings
     the points whose outcome changes at half the step."""
-    from rocksweep.outputs import check_output
     from rocksweep.figures.common import FORMATS, save_figure
     from rocksweep.figures.diagrams import friction_map, missing_warnings, sweep_figure
+    from rocksweep.outputs import check_output
     from rocksweep.store.sweepfile import read_result
 
     fig_out = fig_path if fig_path is not None else result_path.with_suffix(".png")

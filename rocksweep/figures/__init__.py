@@ -1,4 +1,5 @@
-"""Every figure (``rocksweep.plot(ds)`` is the facade): ``diagrams`` (stability diagrams, Figures 3-4, friction maps, A_min),
+"""Every figure (``rocksweep.plot(ds)`` is the facade): ``diagrams`` (stability
+diagrams, Figures 3-4, friction maps, A_min),
 ``common`` (axes, saving, time histories (Figure 5), the restitution map (Figure 2)),
 ``spectrum`` (rocking spectra), ``accuracy`` (work-precision). Figures are built without
 pyplot (``matplotlib.figure.Figure``), so nothing here needs a display.

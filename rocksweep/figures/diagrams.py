@@ -41,7 +41,6 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.figures.common import (
     DEFAULT_DPI,
     FORMATS,
@@ -50,6 +49,7 @@ from rocksweep.figures.common import (
     new_axes,
     save_figure,
 )
+from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.store.sweepfile import SweepResult
 
 if TYPE_CHECKING:
