@@ -39,6 +39,8 @@ Overrides = Union[Sequence[str], Mapping[str, Any]]  # noqa: UP007
 WRITE_EVERY = 1.0
 # `simulate` on the command line overlays a few runs; larger grids are for sweeps.
 MAX_RUNS = 12
+# `rocksweep.simulate` returns one history per point: a notebook's worth, not a grid.
+API_MAX_RUNS = 100
 
 
 class ApiError(RocksweepError, ValueError):
@@ -559,9 +561,11 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
     import xarray as xr
 
     from rocksweep import fields
+    from rocksweep.accessor import register
     from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
     from rocksweep.store.sweepfile import read_result
 
+    register()  # ds.rocksweep.plot() etc.
     path = Path(path)
     read_result(path, ["outcome"])  # one-line errors for foreign or damaged files
     with xr.open_dataset(path, engine="h5netcdf", driver_kwds={"locking": False}) as ds:
@@ -586,8 +590,8 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
 # ---------------------------------------------------------------------------------------
 
 def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any = None,
-         curves: bool = False, show_computed: bool = False,
-         width: str | None = None) -> Figure:
+         curves: bool = False, show_computed: bool = False, mu: bool = False,
+         width: str | None = None, _names: tuple[str, str] = ("x", "y")) -> Figure:
     """The stability diagram of a result (Figures 3 and 4) as a pyplot-free Figure.
 
     ds: what ``run`` or ``open`` returns. x, y: the swept keys on the axes (default
@@ -595,18 +599,23 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     other swept keys, the lam values overlaid; a result with one swept key besides lam is
     a line plot. ax: an Axes (or one per panel) to draw into; the legend then goes outside
     the axes, once per figure. curves: the class boundary lines; show_computed: shade
-    the points an adaptive sweep computed. width: "single" or "double" (journal column
-    widths with fonts to match), None for matplotlib's defaults.
+    the points an adaptive sweep computed. mu: the friction demand ``mu_required`` (a
+    result with contact outputs) as a contour map instead of the classes. width:
+    "single" or "double" (journal column widths with fonts to match), None for
+    matplotlib's defaults. A result with per-point error estimates rings the points
+    whose outcome changes at half the step.
     """
     import matplotlib
 
     from rocksweep.figures.common import width_style
-    from rocksweep.figures.diagrams import sweep_figure
+    from rocksweep.figures.diagrams import friction_map, sweep_figure
     from rocksweep.store.sweepfile import as_result
 
     result = as_result(ds)
     with matplotlib.rc_context(width_style(width)):
-        return sweep_figure(result, x, y, axes=ax, option_names=("x", "y"), curves=curves,
+        if mu:
+            return friction_map(result, x, y, option_names=_names)
+        return sweep_figure(result, x, y, axes=ax, option_names=_names, curves=curves,
                             show_computed=show_computed)
 
 
@@ -719,22 +728,37 @@ def history_dataset(run: Run, title: str = "") -> xr.Dataset:
     return ds
 
 
-def simulate(scene: SceneLike, overrides: Overrides = (), /, **keys: Any) -> Simulation:
+def simulate(scene: SceneLike, overrides: Overrides = (), /,
+             **keys: Any) -> Simulation | list[Simulation]:
     """Run one point of a scene with its energy balance and time history.
 
-    scene: a path, YAML text or a dict (as for ``run``) that holds one point after the
-    overrides. Overrides as a mapping or ``KEY=VALUE`` strings (``{"impact.lam": 0.4}``),
-    or as keywords with ``__`` for the dot: ``simulate("fig5.yaml", impact__lam=0.4)``.
-    The accuracy is the scene's preset, ``fine`` if it names none (as ``rocksweep
-    simulate``). Returns a ``Simulation`` (summary dict, history Dataset over p*t, and
-    ``.figure()``).
+    scene: a path, YAML text or a dict (as for ``run``). Overrides as a mapping or
+    ``KEY=VALUE`` strings (``{"impact.lam": 0.4}``), or as keywords with ``__`` for the
+    dot: ``simulate("fig5.yaml", impact__lam=0.4)``. The accuracy is the scene's preset,
+    ``fine`` if it names none (as ``rocksweep simulate``). Returns a ``Simulation``
+    (summary dict, history Dataset over p*t, and ``.figure()``); a scene with lists gives
+    one ``Simulation`` per combination, in grid order (at most ``API_MAX_RUNS``; sweeps
+    are for ``run``).
     """
     from rocksweep.compute.single import simulate as run_point
 
     ov = [*override_strings(overrides), *override_strings(keys)]
     sc, _ = load(scene, ov)
-    r = run_point(sc.single_point(), sc.single_numerics, contact=sc.contact)
-    return Simulation(r.summary(), history_dataset(r, sc.name), r, sc.name)
+    if sc.size == 1:
+        r = run_point(sc.single_point(), sc.single_numerics, contact=sc.contact)
+        return Simulation(r.summary(), history_dataset(r, sc.name), r, sc.name)
+    if sc.size > API_MAX_RUNS:
+        big = max(sc.swept, key=lambda a: len(a.values))
+        raise ApiError(f"the scene has {sc.size} points ({big.key} has {len(big.values)} "
+                       f"values): simulate runs at most {API_MAX_RUNS}; pass "
+                       f"overrides={{{big.key!r}: ...}}, or use rocksweep.run for a grid")
+    swept = [a.name for a in sc.swept]
+    out = []
+    for r in simulate_runs(sc, API_MAX_RUNS):
+        title = ", ".join(f"{k} = {v}" for k, v in zip(swept, swept_values(r, swept),
+                                                        strict=True))
+        out.append(Simulation(r.summary(), history_dataset(r, title), r, title))
+    return out
 
 
 def simulate_runs(scene: Scene, max_runs: int = MAX_RUNS) -> list[Run]:

@@ -270,9 +270,13 @@ def test_simulate_needs_one_point():
 
 def test_one_field_table():
     """Sweeps, the store's variable list and single runs all read rocksweep.fields."""
-    assert list(sw.VARIABLES) == [f.name for f in fields.SWEEP_FIELDS]
-    assert list(sw.ENERGY_VARIABLES) == [f.name for f in fields.ENERGY_FIELDS]
-    assert sw.VARIABLES["outcome"][1] == L.OUTCOME_NOT_RUN
+    plain, energy = fields.variables(), fields.variables(energy=True)
+    assert list(plain) == [f.name for f in fields.SWEEP_FIELDS]
+    assert list(energy)[len(plain):] == [f.name for f in fields.ENERGY_FIELDS]
+    assert plain["outcome"][1] == L.OUTCOME_NOT_RUN
+    # a stored variable's unit in the file is the field's (the error estimates included)
+    sc = load_scene(CI_SMALL, ["outputs.check=true", "pulse.shape=sine", "impact.lam=0.0"])
+    assert list(sw.variables(sc)) == list(fields.variables(check=True))
     assert fields.UNITS["work_in_over_Eref"] == "E_ref"
     slots = [f.slot for f in fields.RUN_FIELDS]
     assert len(set(slots)) == len(slots)  # no kernel slot read twice in a run's row

@@ -11,7 +11,6 @@ import numpy as np
 from rocksweep.physics.model import Body, FlexibleBody, restitution, restitution_rigid
 
 if TYPE_CHECKING:
-    from matplotlib.figure import Figure
 
     from rocksweep.scene.scene import Scene
 
@@ -46,13 +45,6 @@ class RestitutionTable:
         return {"lam": self.lam.tolist(), "u_over_ucr": self.u_over_ucr.tolist(),
                 "e": {"upper": self.e_upper.tolist(), "lower": self.e_lower.tolist()},
                 "e_housner_rigid": self.e_housner}
-
-    def figure(self) -> Figure:
-        """Figure 2 (``rocksweep.figures.common.restitution_map``), a pyplot-free Figure."""
-        from rocksweep.figures.common import restitution_map
-
-        return restitution_map(self.lam, self.u_over_ucr, self.e_upper, self.e_housner,
-                               self.title)
 
 
 def restitution_table(scene: Scene, n_lam: int = 101, n_u: int = 81) -> RestitutionTable:

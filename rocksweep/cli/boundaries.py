@@ -8,6 +8,7 @@ from pathlib import Path
 import click
 
 from rocksweep.cli.main import main, user_errors
+from rocksweep.cli.options import dpi_option, overwrite_option
 
 
 @main.command()
@@ -24,9 +25,8 @@ from rocksweep.cli.main import main, user_errors
 @click.option("--plot", "fig_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Figure of the A_min curves of every lam (and shape) on one axis, "
                    ".png, .pdf or .svg.")
-@click.option("--dpi", type=click.IntRange(20, 2400), default=200, show_default=True,
-              help="Resolution of raster output (PNG).")
-@click.option("--overwrite", is_flag=True, help="Replace existing output files.")
+@dpi_option
+@overwrite_option
 @user_errors
 def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None,
                rtol: float, mode: str | None, fig_path: Path | None, dpi: int,

@@ -14,6 +14,7 @@ from pathlib import Path
 import click
 
 import rocksweep
+from rocksweep.cli.options import overwrite_option, scene_argument, set_option  # noqa: F401
 from rocksweep.errors import RocksweepError
 
 
@@ -29,15 +30,6 @@ def user_errors(fn):
             raise click.ClickException(str(err)) from None
 
     return wrapper
-
-
-scene_argument = click.argument(
-    "scene_path", metavar="SCENE.yaml", type=click.Path(dir_okay=False, path_type=Path))
-set_option = click.option(
-    "--set", "overrides", multiple=True, metavar="KEY=VALUE",
-    help="Override a scene value, e.g. --set pulse.A_ratio=4.5 (repeatable).")
-overwrite_option = click.option("--overwrite", is_flag=True,
-                                help="Replace existing output files.")
 
 
 def load(scene_path: Path, overrides: tuple[str, ...] = ()):

@@ -8,6 +8,7 @@ from pathlib import Path
 import click
 
 from rocksweep.cli.main import main, user_errors
+from rocksweep.cli.options import dpi_option, overwrite_option
 
 
 @main.command()
@@ -19,12 +20,11 @@ from rocksweep.cli.main import main, user_errors
                    "when swept].")
 @click.option("--y", "y_key", metavar="KEY",
               help="Swept axis along y [default: A_ratio when swept].")
-@click.option("--dpi", type=click.IntRange(20, 2400), default=200, show_default=True,
-              help="Resolution of raster output (PNG).")
+@dpi_option
 @click.option("--mu", "mu_map", is_flag=True,
               help="Draw the friction demand mu_required (a result with contact outputs) as "
                    "a contour map instead of the classes.")
-@click.option("--overwrite", is_flag=True, help="Replace an existing figure file.")
+@overwrite_option
 @click.option("--curves", is_flag=True,
               help="Overlay the boundary lines between classes, one colour per lam "
                    "(`rocksweep boundaries` gives them as CSV, with A_min).")
@@ -43,25 +43,20 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
     ones. With contact outputs and body.mu, the points that would slide are hatched (and
     those that would lift off dotted); --mu draws mu_required. A sweep with --check rings
     the points whose outcome changes at half the step."""
-    from rocksweep.figures.common import FORMATS, save_figure
-    from rocksweep.figures.diagrams import friction_map, missing_warnings, sweep_figure
+    from rocksweep import api
+    from rocksweep.figures import FORMATS
+    from rocksweep.figures.common import save_figure
+    from rocksweep.figures.diagrams import missing_warnings
     from rocksweep.outputs import check_output
-    from rocksweep.store.sweepfile import read_result
+    from rocksweep.store.sweepfile import as_result
 
     fig_out = fig_path if fig_path is not None else result_path.with_suffix(".png")
     # refuse a bad output before reading the result and drawing
     check_output(fig_out, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
-    if mu_map:
-        result = read_result(result_path, ["outcome", "status", "mu_required"])
-        fig = friction_map(result, x_key, y_key, option_names=("--x", "--y"))
-    else:
-        # check_outcome: files with per-point error estimates (sweep --check) ring the
-        # points whose outcome changes at half the step
-        result = read_result(result_path, ["outcome", "status", "theta_max_over_alpha"],
-                             ("check_outcome", *(("computed",) if show_computed else ())))
-        fig = sweep_figure(result, x_key, y_key, option_names=("--x", "--y"), curves=curves,
-                           show_computed=show_computed)
+    ds = api.open(result_path)
+    fig = api.plot(ds, x_key, y_key, curves=curves, show_computed=show_computed, mu=mu_map,
+                   _names=("--x", "--y"))
     save_figure(fig, fig_out, dpi, overwrite=overwrite, inputs=[result_path])
-    for w in missing_warnings(result):
+    for w in missing_warnings(as_result(ds)):
         click.echo(f"warning: {w}", err=True)
     click.echo(f"wrote {fig_out}")

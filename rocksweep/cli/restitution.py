@@ -56,8 +56,10 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
                    f"max {e.max():.4f}; e > 1 at {int((e > 1).sum())} of {e.size} "
                    "points (upper sign)")
     if plot_path is not None:
-        from rocksweep.figures.common import save_figure
+        from rocksweep.figures.common import restitution_map, save_figure
 
-        save_figure(table.figure(), plot_path, overwrite=overwrite, inputs=[scene_path])
+        fig = restitution_map(table.lam, table.u_over_ucr, table.e_upper, table.e_housner,
+                              table.title)
+        save_figure(fig, plot_path, overwrite=overwrite, inputs=[scene_path])
         if not as_json:
             click.echo(f"wrote {plot_path}")

@@ -8,6 +8,7 @@ from pathlib import Path
 import click
 
 from rocksweep.cli.main import main, user_errors
+from rocksweep.cli.options import dpi_option, overwrite_option
 
 
 @main.command()
@@ -16,9 +17,8 @@ from rocksweep.cli.main import main, user_errors
               help="Figure file, .png, .pdf or .svg [default: OUT-spectra.png].")
 @click.option("--rtol", type=click.FloatRange(1e-9, 0.5), default=1e-3, show_default=True,
               help="Relative tolerance of the smallest overturning A_ratio (bisection).")
-@click.option("--dpi", type=click.IntRange(20, 2400), default=200, show_default=True,
-              help="Resolution of raster output (PNG).")
-@click.option("--overwrite", is_flag=True, help="Replace an existing figure file.")
+@dpi_option
+@overwrite_option
 @user_errors
 def spectrum(result_path: Path, fig_path: Path | None, rtol: float, dpi: int,
              overwrite: bool) -> None:

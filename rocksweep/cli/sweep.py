@@ -8,7 +8,8 @@ from pathlib import Path
 
 import click
 
-from rocksweep.cli.main import load, main, scene_argument, set_option, user_errors
+from rocksweep.cli.main import load, main, user_errors
+from rocksweep.cli.options import overwrite_option, scene_argument, set_option
 
 WRITE_EVERY = 1.0  # = rocksweep.api.WRITE_EVERY (not imported here: --help stays light)
 
@@ -23,7 +24,7 @@ WRITE_EVERY = 1.0  # = rocksweep.api.WRITE_EVERY (not imported here: --help stay
 @click.option("--resume", is_flag=True,
               help="Finish an interrupted sweep of the same scene (computes only the "
                    "missing points).")
-@click.option("--overwrite", is_flag=True, help="Replace an existing result file.")
+@overwrite_option
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar and no summary.")
 @click.option("--backend", type=click.Choice(["threads", "dask"]), default="threads",
               show_default=True,
@@ -74,13 +75,16 @@ WRITE_EVERY = 1.0  # = rocksweep.api.WRITE_EVERY (not imported here: --help stay
               help="Rerun every point at half the step and store the differences of the "
                    "outcome, overturning time and max |theta| (an error estimate per "
                    "point; as outputs.check: true). Costs about 2.5x the time.")
+@click.option("--dry-run", "dry_run", is_flag=True,
+              help="Say what the sweep would cost (points, RK4 evaluations, seconds on this "
+                   "machine, whether the kernel must be compiled) and stop; writes nothing.")
 @user_errors
 def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, jobs: int,
           resume: bool, overwrite: bool, quiet: bool, backend: str, scheduler: str | None,
           chunk_size: int | None, write_every: float, adaptive: bool, coarse: int | None,
           audit: float | None, adaptive_axes: str | None, margin: int | None,
           final_margin: int | None, seed: int | None, threshold: float | None,
-          validate: bool, contact: bool, check: bool) -> None:
+          validate: bool, contact: bool, check: bool, dry_run: bool) -> None:
     """Compute the stability diagram of SCENE.yaml: every point of its grid.
 
     Writes outcome (0 safe, 1 mode 1, 2 mode 2, -1 not computed), impacts, uplifts,
@@ -119,6 +123,13 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
         raise click.ClickException(f"--{given[0].replace('_', '-')} is a setting of "
                                    "adaptive sweeps; add --adaptive")
     options = api.adaptive_options(adaptive, base=scene.refine, **settings)
+    if dry_run:
+        from rocksweep.compute.sweep import estimate
+
+        est = estimate(scene, jobs=jobs if backend == "threads" else 1)
+        click.echo(str(est) + (" (every point; an adaptive sweep computes a few % of them)"
+                               if options is not None else ""))
+        return
     out = out_path if out_path is not None else Path(scene_path.stem + ".h5")
 
     def say(line: str) -> None:

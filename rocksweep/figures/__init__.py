@@ -4,3 +4,9 @@ diagrams, Figures 3-4, friction maps, A_min),
 ``spectrum`` (rocking spectra), ``accuracy`` (work-precision). Figures are built without
 pyplot (``matplotlib.figure.Figure``), so nothing here needs a display.
 """
+
+# Figure files (the suffix picks the format) and raster resolution [dots per inch]: light
+# constants, shared by the library's savers and the command line's options.
+FORMATS = (".png", ".pdf", ".svg")
+DEFAULT_DPI = 200
+DPI_RANGE = (20, 2400)

@@ -29,8 +29,7 @@ if TYPE_CHECKING:
 
     from rocksweep.compute.single import Run
 
-FORMATS = (".png", ".pdf", ".svg")
-DEFAULT_DPI = 200
+from rocksweep.figures import DEFAULT_DPI, FORMATS  # noqa: E402,F401
 
 
 class FigureError(RocksweepError, ValueError):
@@ -136,28 +135,37 @@ def time_history(runs: Sequence[Run], swept: Sequence[str] = (), title: str = ""
     alpha = _alpha_symbol(runs[0])
     # one input line when every run has the same pulse shape and frequency (xg''/A is then
     # the same curve), else one per run in the run's colour
-    pulses = {(r.point.shape, r.point.w_over_p) for r in runs}
+    pulses = {(r.point.shape, r.point.w_over_p, r.point.p) for r in runs}
     longest = max(runs, key=lambda r: r.history["t"][-1] if len(r.history["t"]) else 0.0)
+    # records run in the record's seconds: t = (p t)/p on the time axis when every run has
+    # the same p (the kernel's time is p t with p = 1 rad/s)
+    records = all(r.point.record is not None for r in runs)
+    ps = {r.point.p for r in runs}
+    seconds = records and len(ps) == 1
+    t_scale = 1.0 / next(iter(ps)) if seconds else 1.0
     for run in runs:
         h = run.history
         body = run.point.body
-        line, = ax_th.plot(h["t"], h["theta"] / body.alpha_ref, lw=1.2,
+        t = h["t"] * t_scale
+        line, = ax_th.plot(t, h["theta"] / body.alpha_ref, lw=1.2,
                            label=_label(run, swept))
         c = line.get_color()
-        ax_e.plot(h["t"], h["E"] / body.E_ref, lw=1.2, color=c)
-        ax_d.plot(h["t"], (h["D_damp"] + h["E_impact"]) / body.E_ref, lw=1.2, color=c)
+        ax_e.plot(t, h["E"] / body.E_ref, lw=1.2, color=c)
+        ax_d.plot(t, (h["D_damp"] + h["E_impact"]) / body.E_ref, lw=1.2, color=c)
         if run.t_overturn is not None:
             for ax in (ax_th, ax_e, ax_d):
-                ax.axvline(run.t_overturn, color=c, ls=":", lw=0.9)
+                ax.axvline(run.t_overturn * t_scale, color=c, ls=":", lw=0.9)
         if len(pulses) > 1 or run is longest:
             a = run.point.A
             pc = c if len(pulses) > 1 else "k"
-            ax_in.plot(h["t"], h["xg"] / a if a else h["xg"], lw=1.1, color=pc,
-                       label=f"{run.point.shape}, $\\omega/p$ = {run.point.w_over_p:g}")
+            label = (run.point.record.name if run.point.record is not None
+                     else f"{run.point.shape}, $\\omega/p$ = {run.point.w_over_p:g}")
+            ax_in.plot(t, h["xg"] / a if a else h["xg"], lw=1.1, color=pc, label=label)
     ax_in.axhline(0.0, color="0.6", lw=0.6)
     ax_in.set_ylabel(r"$\ddot{x}_g/A$")
     ax_in.set_ylim(-1.25, 1.25)
-    ax_in.legend(fontsize=8, loc="upper right", title="input pulse (eq. 2)",
+    ax_in.legend(fontsize=8, loc="upper right",
+                 title="ground record" if records else "input pulse (eq. 2)",
                  title_fontsize=8)
     for v in (1.0, -1.0):
         ax_th.axhline(v, color="0.45", lw=0.7, ls="--")
@@ -173,7 +181,7 @@ def time_history(runs: Sequence[Run], swept: Sequence[str] = (), title: str = ""
     ax_th.set_ylim(-3, 3)
     ax_e.set_ylabel(r"$E/E_{ref}$")
     ax_d.set_ylabel("dissipated\n" + r"$(E_d + E_{damper})/E_{ref}$")
-    ax_d.set_xlabel(r"$pt$")
+    ax_d.set_xlabel(f"$t$ [s] ($p$ = {next(iter(ps)):g} rad/s)" if seconds else r"$pt$")
     for ax in (ax_in, ax_th, ax_e, ax_d):
         ax.grid(alpha=0.3)
     if title and axes is None:

@@ -447,8 +447,19 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
                    ncol=max(1, min(len(handles), 2 * ncols)))
         fig.suptitle(_fit(_title(result, (x, y)), fig), fontsize=11)
     else:
-        flat[0].legend(handles=handles, fontsize=7, loc="upper left")
+        _legend_outside(flat[-1], handles)
     return fig
+
+
+def _legend_outside(ax: Axes, handles: list) -> None:
+    """The legend of a diagram drawn into the caller's axes: outside them, on the right,
+    and once per figure (a second diagram drawn into the same figure adds none)."""
+    fig = ax.figure
+    if getattr(fig, "_rocksweep_legend", False):
+        return
+    ax.legend(handles=handles, fontsize="small", loc="upper left",
+              bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0, frameon=False)
+    fig._rocksweep_legend = True
 
 
 def _hatch(ax: Axes, xs: np.ndarray, ys: np.ndarray, mask: np.ndarray, hatch: str,
@@ -590,7 +601,7 @@ def line_diagram(result: SweepResult, x: str | None = None, *,
                    ncol=max(1, min(len(handles), 2 * ncols)))
         fig.suptitle(_fit(_title(result, (x,)), fig), fontsize=11)
     else:
-        flat[0].legend(handles=handles, fontsize=7)
+        _legend_outside(flat[-1], handles)
     return fig
 
 

@@ -1,0 +1,22 @@
+"""Options and arguments shared by several commands, fed by the library's constants
+(light modules only: ``rocksweep --help`` loads no numba, h5py or matplotlib)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from rocksweep.figures import DEFAULT_DPI, DPI_RANGE
+
+scene_argument = click.argument(
+    "scene_path", metavar="SCENE.yaml", type=click.Path(dir_okay=False, path_type=Path))
+result_argument = click.argument("result_path", metavar="OUT.h5",
+                                 type=click.Path(path_type=Path))
+set_option = click.option(
+    "--set", "overrides", multiple=True, metavar="KEY=VALUE",
+    help="Override a scene value, e.g. --set pulse.A_ratio=4.5 (repeatable).")
+overwrite_option = click.option("--overwrite", is_flag=True,
+                                help="Replace existing output files.")
+dpi_option = click.option("--dpi", type=click.IntRange(*DPI_RANGE), default=DEFAULT_DPI,
+                          show_default=True, help="Resolution of raster output (PNG).")

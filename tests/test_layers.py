@@ -1,0 +1,101 @@
+"""The package's rooms and floors: an import never climbs to a higher floor.
+
+Each module belongs to a floor (``FLOORS``, lowest first); it may import its own floor
+and those below. Checked on every ``import``/``from ... import`` of rocksweep modules in
+the source, module level and inside functions alike (only ``if TYPE_CHECKING:`` blocks,
+which never run, are exempt). A new module must be placed on a floor here.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+PKG = Path(__file__).resolve().parents[1] / "rocksweep"
+
+# lowest first: vocabulary, kernel, the model, scenes, computing, files, analyses,
+# figures, the facade, the command line
+FLOORS: list[tuple[str, ...]] = [
+    ("errors", "outputs", "kernel"),
+    ("numerics", "outcomes"),
+    ("schema",),
+    ("physics",),
+    ("fields",),
+    ("scene",),
+    ("compute",),
+    ("store",),
+    ("analysis",),
+    ("figures",),
+    ("accessor", "api", "__init__"),
+    ("cli", "__main__"),
+]
+
+
+def floor_of(module: str) -> int:
+    """The floor of ``rocksweep.<room>...`` (its first component after rocksweep)."""
+    parts = module.split(".")
+    room = parts[1] if len(parts) > 1 else "__init__"
+    for i, rooms in enumerate(FLOORS):
+        if room in rooms:
+            return i
+    raise AssertionError(f"{module}: on no floor (place it in tests/test_layers.py FLOORS)")
+
+
+def module_name(path: Path) -> str:
+    rel = path.relative_to(PKG.parent).with_suffix("")
+    parts = list(rel.parts)
+    if parts[-1] == "__init__" and len(parts) > 1:
+        parts = parts[:-1] if len(parts) > 2 else [parts[0], "__init__"]
+    return ".".join(parts)
+
+
+def imports(tree: ast.AST, name: str) -> list[tuple[int, str]]:
+    """(line, imported rocksweep module) of every import outside TYPE_CHECKING blocks."""
+    out: list[tuple[int, str]] = []
+    package = name.rsplit(".", 1)[0]
+
+    def visit(node: ast.AST) -> None:
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.If) and "TYPE_CHECKING" in ast.unparse(child.test):
+                for orelse in child.orelse:
+                    visit(orelse)
+                continue
+            if isinstance(child, ast.Import):
+                out.extend((child.lineno, a.name) for a in child.names
+                           if a.name.startswith("rocksweep"))
+            elif isinstance(child, ast.ImportFrom):
+                mod = child.module or ""
+                if child.level:
+                    mod = ".".join(package.split(".")[: len(package.split(".")) - child.level + 1]
+                                   + ([mod] if mod else []))
+                if mod == "rocksweep":  # from rocksweep import fields, kernel...
+                    out.extend((child.lineno, f"rocksweep.{a.name}") for a in child.names)
+                elif mod.startswith("rocksweep"):
+                    out.append((child.lineno, mod))
+            visit(child)
+
+    visit(tree)
+    return out
+
+
+def test_no_import_climbs_a_floor():
+    climbs = []
+    for path in sorted(PKG.rglob("*.py")):
+        name = module_name(path)
+        here = floor_of(name)
+        for line, target in imports(ast.parse(path.read_text()), name):
+            if target in ("rocksweep", "rocksweep.__init__"):
+                continue  # the package itself (its __version__)
+            if floor_of(target) > here:
+                climbs.append(f"{path.relative_to(PKG.parent)}:{line} imports {target}")
+    assert not climbs, "imports that climb a floor:\n" + "\n".join(climbs)
+
+
+def test_the_checker_sees_a_climb():
+    """The check itself: a physics module importing the store is reported."""
+    src = "def f():\n    from rocksweep.store.sweepfile import read_result\n"
+    found = imports(ast.parse(src), "rocksweep.physics.model")
+    assert found == [(2, "rocksweep.store.sweepfile")]
+    assert floor_of(found[0][1]) > floor_of("rocksweep.physics.model")
+    typed = "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    import rocksweep.api\n"
+    assert imports(ast.parse(typed), "rocksweep.physics.model") == []
