@@ -612,11 +612,18 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     from rocksweep.store.sweepfile import as_result
 
     result = as_result(ds)
-    with matplotlib.rc_context(width_style(width)):
+    style = width_style(width)
+    with matplotlib.rc_context(style):
         if mu:
-            return friction_map(result, x, y, option_names=_names)
-        return sweep_figure(result, x, y, axes=ax, option_names=_names, curves=curves,
-                            show_computed=show_computed)
+            fig = friction_map(result, x, y, option_names=_names)
+        else:
+            fig = sweep_figure(result, x, y, axes=ax, option_names=_names, curves=curves,
+                               show_computed=show_computed)
+    if style and ax is None:  # the preset's width, the layout's aspect
+        w, h = fig.get_size_inches()
+        inches = style["figure.figsize"][0]
+        fig.set_size_inches(inches, h * inches / w)
+    return fig
 
 
 def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None) -> xr.Dataset:
