@@ -359,3 +359,28 @@ def test_curves_json():
     first = curves[0]
     assert (first["lam"], first["state"]) == (0.0, "overturn")
     assert first["median"] == float(fr["median"].sel(state="overturn", lam=0.0))
+
+
+def test_without_bootstrap_the_intervals_are_nan():
+    fr = F.fragility(suite_dataset(n_records=20))
+    assert np.all(np.isnan(fr["median_lo"].values)) and np.all(np.isnan(fr["band_hi"].values))
+    assert np.all(np.isfinite(fr["median"].values))
+
+
+def test_cloud_bootstrap_interval_holds_the_truth():
+    fr = F.fragility(cloud_dataset(), bootstrap=200, seed=5)
+    lo, hi = float(fr["median_lo"][0]), float(fr["median_hi"][0])
+    assert lo < float(fr["median"][0]) < hi
+    assert lo < 0.7 < hi
+    assert float(fr["beta_lo"][0]) < 0.3 < float(fr["beta_hi"][0])
+
+
+def test_bootstrap_of_nearly_degenerate_data_counts_undefined_resamples():
+    # one record of 12 overturns, at the top level only: many resamples hold no failure
+    failed = np.zeros((12, LEVELS.size), dtype=bool)
+    failed[0, -1] = True
+    b = F.bootstrap_records(LEVELS, failed, n_boot=300, seed=0)
+    # P(record 0 not drawn in 12 draws) = (11/12)^12 = 0.35
+    assert 70 < b.n_undefined < 140
+    assert np.isnan(b.medians).sum() == b.n_undefined
+    assert np.isfinite(b.median_ci[0])
