@@ -25,12 +25,14 @@ record:
   Sa(T = 0) is defined as PGA, its limit.
 - ``duration`` [s] = (n - 1) dt, ``sha256`` of a file's bytes.
 
-Why our own code and not a library: eqsig (MIT) has the same recurrence but replaces Sa by
-the PGA for every T < 6 dt, ignores the free vibration after the record (long periods come
-out low), keeps (n_periods, n) response arrays and uses 6.2831853 for 2 pi in one place and
-2 pi in another; pyrotd (MIT) works in the frequency domain (an FFT: periodic, so the
-response wraps around unless the record is padded) and imports ``pkg_resources``, which
-current setuptools no longer ship. The recurrence is ~60 lines with closed-form tests.
+Why our own code and not a library (both read at their source, both MIT): eqsig's
+``sdof.pseudo_response_spectra`` has the same recurrence but replaces Sa by the PGA for
+every T < 6 dt, stops at the record's last sample (the free vibration after it is ignored,
+so long periods can come out low), keeps (n_periods, n) response arrays and uses 6.2831853
+for 2 pi in one place and 2 pi in another; pyrotd computes the oscillator response in the
+frequency domain (FFT with frequency-domain interpolation), not the exact time-domain
+recurrence, and the versions read import ``pkg_resources``, which current setuptools no
+longer ship. The recurrence is ~60 lines here, tested against closed forms and lsim.
 """
 
 from __future__ import annotations
