@@ -1,0 +1,122 @@
+"""The fragility figure: empirical fractions, fitted lognormal curves and bootstrap bands.
+
+``fragility_figure(frag)`` draws a Dataset made by ``rocksweep.analysis.fragility.fragility``
+and returns a ``matplotlib.figure.Figure`` (no pyplot: no global figure registry, no
+backend switch). One colour per value of ``lam`` (or of the first swept dimension when there
+is no ``lam``); other swept dimensions and several states get line styles. Each curve: the
+fitted Phi(ln(x / median) / beta), its bootstrap band (pointwise percentiles of the
+resamples' curves, ``band_lo``/``band_hi``, when the fit was bootstrapped), and for stripes
+the empirical fraction at each level with the marker's area proportional to the records
+counted there. The legend gives each median and its change against the first colour's.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+import xarray as xr
+from matplotlib.figure import Figure
+
+from rocksweep.analysis.fragility import lognormal_cdf
+from rocksweep.errors import RocksweepError
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+WIDTHS = {"single": (3.5, 2.9), "double": (7.0, 4.2)}
+_STYLES = ("-", "--", ":", "-.")
+
+
+class FragilityFigureError(RocksweepError, ValueError):
+    """A fragility Dataset that cannot be drawn as asked; ``str()`` is one line."""
+
+
+def _fmt(v) -> str:
+    if isinstance(v, (float, np.floating)):
+        return f"{float(v):g}"
+    return str(v)
+
+
+def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
+                     width: str | tuple[float, float] = "single") -> Figure:
+    """Draw fragility curves; returns the Figure (``ax.figure`` when ``ax`` is given).
+
+    frag: the Dataset of ``fragility()`` (median, beta [, band_lo, band_hi over im_grid]
+    [, fraction, n_counted over the stripe dimension]); width: "single" (3.5 in), "double"
+    (7 in) or (width, height) in inches.
+    """
+    if "median" not in frag or "im_grid" not in frag.coords:
+        raise FragilityFigureError("not a fragility Dataset (no 'median' or 'im_grid')")
+    if ax is None:
+        size = WIDTHS.get(width) if isinstance(width, str) else tuple(width)
+        if size is None:
+            raise FragilityFigureError(f"width = {width!r}: 'single', 'double' or "
+                                       "(width, height) in inches")
+        fig = Figure(figsize=size, layout="constrained")
+        ax = fig.add_subplot()
+    else:
+        fig = ax.figure
+    im, unit = frag.attrs.get("im", "IM"), frag.attrs.get("im_units", "")
+    stripe = im if im in frag.dims else None
+    dims = list(frag["median"].dims)
+    colour_dim = "lam" if "lam" in dims else next((d for d in dims if d != "state"), None)
+    rest = [d for d in dims if d != colour_dim]
+    grid = frag["im_grid"].values
+    n_col = frag.sizes[colour_dim] if colour_dim else 1
+    colours = [f"C{i % 10}" for i in range(n_col)]
+    n_max = float(frag["n_counted"].max()) if "n_counted" in frag else 1.0
+    rest_pos = list(itertools.product(*(range(frag.sizes[d]) for d in rest)))
+    for ri, rpos in enumerate(rest_pos):
+        style = _STYLES[ri % len(_STYLES)]
+        base = frag.isel(dict(zip(rest, rpos, strict=True)))
+        ref_med, ref_val = math.nan, None
+        for ci in range(n_col):
+            one = base.isel({colour_dim: ci}) if colour_dim else base
+            med, beta = float(one["median"]), float(one["beta"])
+            colour = colours[ci]
+            label_bits = []
+            if colour_dim:
+                val = frag[colour_dim].values[ci] if colour_dim in frag.coords else ci
+                label_bits.append(f"{colour_dim} = {_fmt(val)}")
+            for d, i in zip(rest, rpos, strict=True):
+                v = frag[d].values[i] if d in frag.coords else i
+                label_bits.append(_fmt(v) if d == "state" else f"{d} = {_fmt(v)}")
+            if math.isfinite(med):
+                text = f"median {med:.3g} {unit}".rstrip()
+                if ci == 0:
+                    ref_med, ref_val = med, label_bits[0] if label_bits else None
+                elif math.isfinite(ref_med) and ref_val:
+                    text += f" ({100.0 * (med / ref_med - 1.0):+.0f}% vs {ref_val})"
+                ax.plot(grid, lognormal_cdf(grid, med, beta), style, color=colour,
+                        label=", ".join(label_bits + [text]))
+            else:
+                reason = str(one["reason"].values) if "reason" in one else "no fit"
+                ax.plot([], [], style, color=colour,
+                        label=", ".join(label_bits + [f"no fit ({reason})"]))
+            if "band_lo" in one:
+                lo, hi = one["band_lo"].values, one["band_hi"].values
+                if np.any(np.isfinite(lo)):
+                    ax.fill_between(grid, lo, hi, color=colour, alpha=0.18, linewidth=0)
+            if stripe and "fraction" in one:
+                n = one["n_counted"].values.astype(float)
+                ax.scatter(frag[stripe].values, one["fraction"].values,
+                           s=6.0 + 40.0 * n / max(n_max, 1.0), color=colour,
+                           edgecolor="black", linewidth=0.4, zorder=3)
+    ax.set_xscale("log")
+    ax.set_ylim(-0.02, 1.02)
+    ax.set_xlim(grid[0], grid[-1])
+    ax.set_xlabel(f"{im} [{unit}]" if unit and unit != "1" else im)
+    states = frag.attrs.get("states", ["overturn"])
+    what = states[0] if len(states) == 1 else "state"
+    ax.set_ylabel(f"P({what} | {im})")
+    method = frag.attrs.get("method", "")
+    boot = int(frag.attrs.get("bootstrap", 0))
+    title = method + (f", {frag.attrs.get('ci', 0.9):g} band of {boot} resamples"
+                      if boot else "")
+    ax.set_title(title, fontsize="small")
+    ax.legend(fontsize="x-small", loc="upper left")
+    ax.grid(True, which="both", alpha=0.25, linewidth=0.5)
+    return fig
