@@ -156,7 +156,7 @@ FILES = {f"SYN{i + 1:02d}.AT2": i for i in range(len(SCENARIOS) * REALISATIONS)}
 def main(argv: list[str] | None = None) -> int:
     from rocksweep.errors import RocksweepError
     from rocksweep.physics.intensity import pgv, sa
-    from rocksweep.records import at2_text, read_record, write_at2
+    from rocksweep.physics.records import at2_text, read_record, write_at2
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=SUITE, help="directory (default "

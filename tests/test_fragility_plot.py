@@ -1,4 +1,4 @@
-"""The fragility figure (rocksweep.plot.fragility), drawn with the Agg backend."""
+"""The fragility figure (rocksweep.figures.fragility), drawn with the Agg backend."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from matplotlib.figure import Figure  # noqa: E402
 from test_fragility import suite_dataset  # noqa: E402
 
 from rocksweep.analysis.fragility import fragility  # noqa: E402
-from rocksweep.plot.fragility import FragilityFigureError, fragility_figure  # noqa: E402
+from rocksweep.figures.fragility import FragilityFigureError, fragility_figure  # noqa: E402
 
 
 def test_one_colour_per_lam_with_band_points_and_median_differences(tmp_path):

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from rocksweep.physics.intensity import velocity
-from rocksweep.records import at2_text, read_record
+from rocksweep.physics.records import at2_text, read_record
 
 ROOT = Path(__file__).resolve().parents[1]
 SUITE = ROOT / "records" / "suite"

@@ -1,9 +1,9 @@
 """Intensity measures of a ground-acceleration record (no numba here).
 
-A record is given as its samples ``acc`` (float64[n], in g, as ``rocksweep.records`` reads
+A record is given as its samples ``acc`` (float64[n], in g, as ``rocksweep.physics.records`` reads
 them) at a constant interval ``dt`` [s]: acc[i] at t = i dt, linearly interpolated between
 samples, the ground at rest before t = 0 and after the last sample (the convention of
-``rocksweep.records.GroundRecord``). Every measure here is exact for that piecewise-linear
+``rocksweep.physics.records.GroundRecord``). Every measure here is exact for that piecewise-linear
 record:
 
 - ``pga`` [g]: max |acc| (a piecewise-linear function peaks at a sample).
@@ -44,8 +44,7 @@ from pathlib import Path
 import numpy as np
 from scipy.signal import lfilter
 
-#: gravity [m/s^2]: the project's g (``rocksweep.model.G``, the kernel's PAR_G)
-G = 9.81
+from rocksweep.physics.model import G  # gravity [m/s^2], the one definition
 
 __all__ = ["G", "duration", "pga", "pgv", "sa", "sha256", "velocity"]
 
@@ -103,7 +102,7 @@ def duration(acc, dt: float) -> float:
 
 
 def sha256(path: str | Path) -> str:
-    """Hex SHA-256 of a file's bytes (the digest ``rocksweep.records`` stores)."""
+    """Hex SHA-256 of a file's bytes (the digest ``rocksweep.physics.records`` stores)."""
     h = hashlib.sha256()
     with open(path, "rb") as f:
         for block in iter(lambda: f.read(1 << 20), b""):
