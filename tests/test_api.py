@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+from bodies import FIG3
 
 import rocksweep
 import rocksweep.compute.sweep as sw
@@ -27,8 +28,7 @@ ROOT = Path(__file__).resolve().parents[1]
 CI_SMALL = ROOT / "configs" / "ci-small.yaml"
 FIG5 = ROOT / "configs" / "fig5.yaml"
 
-BODY3 = {"wn_over_p": 2.43, "zeta": 0.05, "alpha_cg": 0.15, "alpha_A": 0.28,
-         "mA_over_m": 0.47, "IA_ratio": 0.56}
+BODY3 = dict(FIG3)
 SMALL = {"name": "api test", "body": BODY3, "impact": {"lam": [0.0, 0.4]},
          "pulse": {"shape": "sine", "w_over_p": {"start": 1.0, "stop": 6.0, "num": 6},
                    "A_ratio": {"start": 1.0, "stop": 8.0, "num": 5}}}
