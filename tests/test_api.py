@@ -261,9 +261,11 @@ def test_simulate_keywords_and_dict_agree_and_history_is_physical():
     assert len(fig.axes) >= 4
 
 
-def test_simulate_needs_one_point():
-    with pytest.raises(rocksweep.RocksweepError, match="impact.lam has 3 values"):
-        rocksweep.simulate(FIG5)
+def test_simulate_runs_each_point_of_a_small_scene():
+    sims = rocksweep.simulate(FIG5)  # lam: [0, 0.2, 0.4]
+    assert [s.run.point.lam for s in sims] == [0.0, 0.2, 0.4]
+    one = rocksweep.simulate(FIG5, impact__lam=0.4)
+    assert one.summary == {**sims[2].summary, "wall_time_s": one.summary["wall_time_s"]}
 
 
 # --- fields ---------------------------------------------------------------------------------

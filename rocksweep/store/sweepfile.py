@@ -1250,8 +1250,8 @@ _FLAG_ATTRS = ("energy", "complete")
 
 
 def _attr_ok(key: str, v) -> bool:
-    if key in _TEXT_ATTRS:
-        return isinstance(v, str)
+    if key in _TEXT_ATTRS:  # h5py decodes invalid UTF-8 to surrogates: damage
+        return isinstance(v, str) and v.encode("utf-8", "replace").decode() == v
     if isinstance(v, bool) or not isinstance(v, int | float):
         return key in _FLAG_ATTRS and isinstance(v, bool)
     if key in _NUMBER_ATTRS:
