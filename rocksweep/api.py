@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import functools
 import math
+import re
 import sys
 import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
@@ -45,6 +46,53 @@ API_MAX_RUNS = 100
 
 class ApiError(RocksweepError, ValueError):
     """An argument of the Python API that cannot be used; ``str()`` is one line."""
+
+
+# ---------------------------------------------------------------------------------------
+# Errors in Python's words
+# ---------------------------------------------------------------------------------------
+
+# The library's messages name command-line flags where the CLI is the usual way in; the
+# API says the same in its own arguments.
+_FLAG_WORDS = (
+    (re.compile(r"--set '([^']*)'"), r"overrides entry '\1'"),
+    (re.compile(r"--set ([\w.]+)=VALUE"), r"overrides={'\1': ...}"),
+    (re.compile(r"--set ([\w.]+)=(\S+)"), r"overrides={'\1': \2}"),
+    (re.compile(r"--set ([\w.]+)"), r"overrides['\1']"),
+    (re.compile(r"--resume\b"), "resume=True"),
+    (re.compile(r"--overwrite\b"), "overwrite=True"),
+    (re.compile(r"--adaptive\b"), "adaptive=True"),
+    (re.compile(r"--jobs\b"), "jobs"),
+)
+
+
+def _pythonic(message: str) -> str:
+    """A one-line message with the command line's flags said as API arguments."""
+    for pattern, words in _FLAG_WORDS:
+        message = pattern.sub(words, message)
+    return message
+
+
+def speaks_python(fn: Callable) -> Callable:
+    """Re-raise the library's one-line errors with the flags they name said as the API's
+    arguments (``--set impact.lam=VALUE`` -> ``overrides={'impact.lam': ...}``)."""
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return fn(*args, **kwargs)
+        except RocksweepError as err:
+            text = str(err)
+            said = _pythonic(text)
+            if said == text:
+                raise
+            try:
+                new = type(err)(said)
+            except TypeError:  # an error class with another constructor: as it is
+                raise err from None
+            raise new from None
+
+    return wrapper
 
 
 # ---------------------------------------------------------------------------------------
@@ -447,6 +495,7 @@ def _stderr(line: str) -> None:
     print(line, file=sys.stderr, flush=True)
 
 
+@speaks_python
 def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
         overrides: Overrides = (), progress: bool = False, overwrite: bool = False,
         resume: bool = False, client: Any = None, adaptive: bool = False,
@@ -544,6 +593,7 @@ def adaptive_options(adaptive: bool, base: dict | None = None,
     return Options(**given)
 
 
+@speaks_python
 def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xarray's)
     """A sweep result file as an xarray Dataset, loaded in memory (the file is closed).
 
@@ -589,6 +639,7 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
 # Analyses: a result Dataset in, a Dataset, a DataFrame or a Figure out
 # ---------------------------------------------------------------------------------------
 
+@speaks_python
 def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any = None,
          curves: bool = False, show_computed: bool = False, mu: bool = False,
          width: str | None = None, _names: tuple[str, str] = ("x", "y")) -> Figure:
@@ -626,6 +677,7 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     return fig
 
 
+@speaks_python
 def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None) -> xr.Dataset:
     """A_min: the smallest amplitude (A_ratio) that overturns, for every x (w_over_p or
     p) of the diagram, bisected to the relative tolerance ``rtol`` between the last safe
@@ -650,6 +702,7 @@ def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None) -> x
                                       "mode": "any" if mode is None else f"mode{mode}"})
 
 
+@speaks_python
 def boundary_lines(ds: xr.Dataset) -> Any:
     """The lines between classes of a complete result's diagrams as a tidy
     ``pandas.DataFrame``: one row per vertex with the panel's other swept keys, ``line``,
@@ -662,6 +715,7 @@ def boundary_lines(ds: xr.Dataset) -> Any:
     return bd.lines_frame(bd.diagram_boundaries(sc, result.arrays["outcome"]))
 
 
+@speaks_python
 def spectra(ds: xr.Dataset, rtol: float = 1e-3) -> xr.Dataset:
     """Rocking and overturning spectra of a complete sweep over p (a record) or w_over_p,
     A_ratio and optionally lam: ``theta_max_over_alpha`` and ``outcome`` over (lam,
@@ -673,6 +727,7 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3) -> xr.Dataset:
     return compute_spectra(ds, rtol).to_dataset()
 
 
+@speaks_python
 def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> Any:
     """What ``run`` of this scene will cost on this machine, without running it: points,
     RK4 steps and evaluations expected, seconds of compute with ``jobs`` workers, and
@@ -735,6 +790,7 @@ def history_dataset(run: Run, title: str = "") -> xr.Dataset:
     return ds
 
 
+@speaks_python
 def simulate(scene: SceneLike, overrides: Overrides = (), /,
              **keys: Any) -> Simulation | list[Simulation]:
     """Run one point of a scene with its energy balance and time history.

@@ -167,3 +167,20 @@ def test_spectra_dataset(tmp_path):
     np.testing.assert_array_equal(sp.outcome.values[0], ds.outcome.transpose(
         "A_ratio", "p").values.squeeze() if "lam" not in ds.outcome.dims else
         ds.outcome.sel(lam=0.0).transpose("A_ratio", "p").values)
+
+
+def test_python_errors_speak_python(tmp_path):
+    """The API names its own arguments where the command line names flags."""
+    with pytest.raises(rocksweep.RocksweepError) as err:
+        rocksweep.run(CI_SMALL, overrides=["pulse.A_ratio"])
+    assert "--set" not in str(err.value) and "overrides entry 'pulse.A_ratio'" in str(
+        err.value)
+    out = tmp_path / "o.h5"
+    rocksweep.run(CI_SMALL, overrides={**SINE, "impact.lam": 0.0}, output=out)
+    with pytest.raises(rocksweep.RocksweepError) as err:
+        rocksweep.run(CI_SMALL, overrides={**SINE, "impact.lam": 0.0}, output=out)
+    msg = str(err.value)
+    assert "resume=True" in msg and "overwrite=True" in msg and "--" not in msg
+    res = CliRunner().invoke(main, ["sweep", str(CI_SMALL), "-o", str(out), "--set",
+                                    "pulse.shape=sine", "--set", "impact.lam=0.0"])
+    assert res.exit_code != 0 and "--resume" in res.output  # the CLI keeps its flags
