@@ -288,11 +288,20 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
 
     from rocksweep.store.sweepfile import SweepFile
 
-    path = Path(path)
     t0 = time.perf_counter()
     where = (f"{n_workers} worker{'s' * (n_workers > 1)}" if backend == "threads"
              else f"dask cluster {scheduler}")
     how = f"threads x {n_workers}" if backend == "threads" else f"dask {scheduler}"
+    if path is None:  # in memory: nothing touches a disk (rocksweep.run without output)
+        if resume:
+            raise ApiError("resume=True needs output= (the file to finish)")
+        sf = SweepFile.in_memory(scene, overrides, backend=how, adaptive=settings)
+        return _drive(sf, None, report_of := SweepReport(Path("memory"), sf.grid.size, 0, 0,
+                                                          0.0, 0.0, 0.0),
+                      t0, adaptive, validate, jobs=jobs, backend=backend,
+                      scheduler=scheduler, chunk_size=chunk_size, where=where,
+                      write_every=write_every, progress=progress, say=say) or report_of
+    path = Path(path)
     try:
         path.stat()
     except FileNotFoundError:
@@ -310,15 +319,23 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
         sf = SweepFile.create(path, scene, overrides, overwrite=overwrite, backend=how,
                               adaptive=settings)
     report = SweepReport(path, sf.grid.size, 0, 0, 0.0, 0.0, 0.0)
-    pending: list = []  # finished chunks not yet in the file (each loop writes its own)
+    return _drive(sf, path, report, t0, adaptive, validate, jobs=jobs, backend=backend,
+                  scheduler=scheduler, chunk_size=chunk_size, where=where,
+                  write_every=write_every, progress=progress, say=say)
+
+
+def _drive(sf, path: Path | None, report: SweepReport, t0: float,
+           adaptive: Options | None, validate: bool, **loop_options: Any) -> SweepReport:
+    """Compute the missing points of an open sink (a result file, or one in memory when
+    ``path`` is None: its image lands in ``report.image``), then record the session."""
+    pending: list = []  # finished chunks not yet in the sink (each loop writes its own)
     if validate and adaptive is None:
+        sf.close()
         raise ApiError("validate=True checks an adaptive sweep; add adaptive")
     loop = (_every_point_loop if adaptive is None
             else functools.partial(_adaptive_loop, validate=validate))
     try:
-        loop(sf, report, adaptive, jobs=jobs, backend=backend, scheduler=scheduler,
-             chunk_size=chunk_size, where=where, write_every=write_every,
-             progress=progress, say=say, pending=pending)
+        loop(sf, report, adaptive, pending=pending, **loop_options)
     except BaseException as err:
         try:
             report.wall_s = time.perf_counter() - t0
@@ -330,6 +347,8 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
         raise
     report.wall_s = time.perf_counter() - t0
     report.attrs = sf.finish(report.wall_s, report.cpu_s)
+    if path is None:
+        report.image = sf.image()
     sf.close()
     return report
 
@@ -547,16 +566,13 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
         if not isinstance(address, str):
             raise TypeError(f"client = {client!r}: must be a dask.distributed.Client")
         where = {"backend": "dask", "scheduler": address}
-    if output is None:
-        if resume:
-            raise ApiError("resume=True needs output= (the file to finish)")
-        import tempfile
+    if output is None:  # in memory: nothing touches a disk
+        import io
 
-        with tempfile.TemporaryDirectory(prefix="rocksweep-") as tmp:
-            path = Path(tmp) / "result.h5"
-            sweep_file(sc, path, overrides=ov, jobs=jobs, progress=progress, log=log,
-                       adaptive=opts, validate=validate, **where)
-            return open(path)
+        report = sweep_file(sc, None, overrides=ov, jobs=jobs, resume=resume,
+                            progress=progress, log=log, adaptive=opts, validate=validate,
+                            **where)
+        return _dataset(io.BytesIO(report.image))
     sweep_file(sc, output, overrides=ov, jobs=jobs, resume=resume, overwrite=overwrite,
                progress=progress, log=log, inputs=[source] if source else (),
                adaptive=opts, validate=validate, **where)
@@ -608,17 +624,25 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
     ``complete``. Works while a sweep is still writing the file (no lock is taken).
     A file that is not a rocksweep result is a one-line ``RocksweepError``.
     """
+    from rocksweep.store.sweepfile import read_result
+
+    path = Path(path)
+    read_result(path, ["outcome"])  # one-line errors for foreign or damaged files
+    return _dataset(path)
+
+
+def _dataset(source: Path | Any) -> xr.Dataset:
+    """A result file (a path, or a file object holding the bytes of one in memory) as the
+    loaded Dataset that ``open`` and ``run`` return, with the accessor registered."""
     import xarray as xr
 
     from rocksweep import fields
     from rocksweep.accessor import register
     from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
-    from rocksweep.store.sweepfile import read_result
 
     register()  # ds.rocksweep.plot() etc.
-    path = Path(path)
-    read_result(path, ["outcome"])  # one-line errors for foreign or damaged files
-    with xr.open_dataset(path, engine="h5netcdf", driver_kwds={"locking": False}) as ds:
+    kwds = {"driver_kwds": {"locking": False}} if isinstance(source, Path) else {}
+    with xr.open_dataset(source, engine="h5netcdf", **kwds) as ds:
         ds = ds.load()
     for name, var in ds.data_vars.items():  # files of format 1 have neither
         f = fields.BY_NAME.get(str(name))

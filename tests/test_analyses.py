@@ -184,3 +184,23 @@ def test_python_errors_speak_python(tmp_path):
     res = CliRunner().invoke(main, ["sweep", str(CI_SMALL), "-o", str(out), "--set",
                                     "pulse.shape=sine", "--set", "impact.lam=0.0"])
     assert res.exit_code != 0 and "--resume" in res.output  # the CLI keeps its flags
+
+
+def test_run_without_output_touches_no_disk(tmp_path, monkeypatch, pair):
+    """run() without output= sweeps into memory (HDF5's core driver): no file in the
+    working directory nor in the temporary directory, and the same Dataset as the file."""
+    import tempfile
+
+    work, tmp = tmp_path / "work", tmp_path / "tmp"
+    work.mkdir()
+    tmp.mkdir()
+    monkeypatch.chdir(work)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp))
+    monkeypatch.setenv("TMPDIR", str(tmp))
+    ds = rocksweep.run(CI_SMALL, overrides=SINE)
+    assert list(work.iterdir()) == [] and list(tmp.iterdir()) == []
+    _, disk, _ = pair
+    xr.testing.assert_equal(ds, disk)  # values, dims, coords
+    for name in ds.variables:
+        assert ds[name].attrs.keys() == disk[name].attrs.keys(), name
+    assert ds.attrs.keys() == disk.attrs.keys()

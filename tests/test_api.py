@@ -146,7 +146,7 @@ def test_open_and_run_errors_are_one_line(tmp_path):
         (lambda: rocksweep.run(SMALL, resume=True), "resume=True needs output="),
         (lambda: rocksweep.run({**SMALL, "impact": {"lam": 3}}), "impact.lam = 3.0"),
         (lambda: rocksweep.run(tmp_path / "none.yaml"), "no such scene file"),
-        (lambda: rocksweep.run(SMALL, output=bad), "already exists; use --resume"),
+        (lambda: rocksweep.run(SMALL, output=bad), "already exists; use resume=True"),
         (lambda: rocksweep.run(SMALL, output=bad, resume=True, overwrite=True),
          "exclude each other"),
     ]
