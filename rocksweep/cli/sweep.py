@@ -80,8 +80,9 @@ WRITE_EVERY = 1.0  # = rocksweep.api.WRITE_EVERY (not imported here: --help stay
 @user_errors
 def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, jobs: int,
           resume: bool, overwrite: bool, quiet: bool, backend: str, scheduler: str | None,
-          connect_timeout: float, chunk_size: int | None, write_every: float, adaptive: bool, coarse: int | None,
-          audit: float | None, adaptive_axes: str | None, margin: int | None,
+          connect_timeout: float, chunk_size: int | None, write_every: float,
+          adaptive: bool, coarse: int | None, audit: float | None,
+          adaptive_axes: str | None, margin: int | None,
           final_margin: int | None, seed: int | None, threshold: float | None,
           validate: bool, contact: bool, check: bool) -> None:
     """Compute the stability diagram of SCENE.yaml: every point of its grid.
