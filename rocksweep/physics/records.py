@@ -46,7 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from rocksweep.errors import RocksweepError
-from rocksweep.outputs import check_output, shown, write_atomic
+from rocksweep.outputs import check_output, input_problem, shown, write_atomic
 
 
 class RecordError(RocksweepError, ValueError):
@@ -253,11 +253,15 @@ def parse_record(data: bytes, source: str | Path) -> GroundRecord:
 
 
 def read_record(path: str | Path) -> GroundRecord:
-    """Read a ``.AT2`` (NGA-West2 or older PEER) or two-column record file."""
+    """Read a ``.AT2`` (NGA-West2 or older PEER) or two-column record file (a regular
+    file: a FIFO, device or directory is refused before it is opened, never waited on)."""
+    problem = input_problem(path)
+    if problem == "is a directory, not a file":
+        raise RecordError(f"{_where(str(path))}: is a directory, not a record file")
+    if problem is not None and problem != "no such file":
+        raise RecordError(f"{_where(str(path))}: {problem}")
     try:
         data = Path(path).read_bytes()
-    except IsADirectoryError:
-        raise RecordError(f"{_where(str(path))}: is a directory, not a record file") from None
     except OSError as err:
         raise RecordError(f"{_where(str(path))}: cannot be read "
                           f"({err.strerror or type(err).__name__})") from None

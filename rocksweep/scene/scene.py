@@ -33,6 +33,7 @@ from rocksweep.numerics import (
     PRESETS,
     Numerics,
 )
+from rocksweep.outputs import input_problem, shown
 from rocksweep.physics.model import BlockBody, Body, BodyError, FlexibleBody
 from rocksweep.physics.points import RECORD, Point, body_omega_rock, record_cost, run_cost
 from rocksweep.physics.records import GroundRecord, RecordError, read_record
@@ -363,7 +364,13 @@ def parse_scene(text: str, source: str = "scene", overrides: list[str] | None = 
 
 
 def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
+    """The validated scene of a YAML file (a regular file: a FIFO, device or directory is
+    refused before it is opened, never waited on)."""
     path = Path(path)
+    problem = input_problem(path)
+    if problem is not None:
+        raise SceneError(f"{shown(path)}: {problem}" if problem != "no such file"
+                         else f"{shown(path)}: no such scene file")
     try:
         text = path.read_text()
     except OSError as err:
