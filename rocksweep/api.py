@@ -287,7 +287,7 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
                               "--overwrite to replace it")
         check_output(path, overwrite=overwrite, inputs=inputs)
         sf = SweepFile.create(path, scene, overrides, overwrite=overwrite, backend=how,
-                              adaptive=settings)
+                              adaptive=settings, log=say)
     report = SweepReport(path, sf.grid.size, 0, 0, 0.0, 0.0, 0.0)
     pending: list = []  # finished chunks not yet in the file (each loop writes its own)
     loop = (_every_point_loop if adaptive is None

@@ -64,7 +64,10 @@ import os
 import platform
 import re
 import shutil
+import stat
 import tempfile
+import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
@@ -90,9 +93,13 @@ FORMAT = "rocksweep-sweep"
 FORMAT_VERSION = 2
 CONVENTIONS = "CF-1.10"
 
-# Free space required beyond the datasets' bytes when a file is made [bytes]: HDF5
-# metadata (attributes, object headers, the scene text) is well under 100 kB.
-SPACE_MARGIN = 1 << 20
+# Free space required beyond the space a new file reserves (``_space_needed``): a share of
+# the file, at least this many bytes [bytes], so that a small sweep fits a small disk and
+# a large one leaves room for the file system's own blocks.
+SPACE_MARGIN = 64 << 10
+SPACE_SHARE = 1 / 64
+# Space for attribute updates of a format-1 file on resume [bytes].
+UPDATE_MARGIN = 1 << 20
 # Space reserved for HDF5's metadata when a file is made [bytes], beyond the datasets and
 # the scene text: HDF5 fails badly when a metadata write hits a full disk (a segmentation
 # fault in the next flush), so the whole file's space is reserved before it is written.
@@ -325,6 +332,84 @@ def _reserve(path: Path, nbytes: int) -> None:
             raise
     finally:
         os.close(fd)
+
+
+def _reserve_bytes(scene: Scene, nbytes: int) -> int:
+    """Bytes a new result file of ``scene`` reserves: its datasets (``nbytes``), HDF5's
+    metadata, the scene text and the record's samples (stored in the file)."""
+    rec = 16 * int(scene.record.npts) if scene.record is not None else 0
+    return nbytes + METADATA_RESERVE + 4 * len(scene.text.encode()) + rec
+
+
+def _space_needed(reserve: int) -> int:
+    """Free space required to make a file that reserves ``reserve`` bytes: those and a
+    margin that scales with them (``SPACE_SHARE``, at least ``SPACE_MARGIN``)."""
+    return reserve + max(SPACE_MARGIN, int(reserve * SPACE_SHARE))
+
+
+_PARTIAL = re.compile(r"\.(?:(\d+)-)?[a-z0-9_]{8}\.partial")
+STALE_AGE = 60.0  # [s] a partial file without a writer's pid is stale when this old
+
+
+def partial_prefix(path: Path) -> str:
+    """The prefix of the temporary names a new result file at ``path`` is made under: the
+    writer's pid is part of the name (``.out.h5.1234-abcd1234.partial``)."""
+    return f".{path.name[:40]}.{os.getpid()}-"
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # exists, another user's
+        return True
+    return True
+
+
+def clean_stale_partials(path: Path) -> list[tuple[str, int]]:
+    """Remove the temporary files of earlier attempts to make ``path`` that no live writer
+    owns (a sweep killed while the file was made leaves one of the reserved size): its
+    writer's process is gone (or, for a name without a pid, it is older than STALE_AGE)
+    and no process holds its lock. Returns (name, bytes) of each file removed."""
+    import fcntl
+
+    parent = path.parent if str(path.parent) else Path(".")
+    head = f".{path.name[:40]}"
+    removed = []
+    try:
+        names = [n for n in os.listdir(parent) if n.startswith(head) and n.endswith(".partial")]
+    except OSError:
+        return []
+    for name in names:
+        m = _PARTIAL.fullmatch(name[len(head):])
+        if m is None:
+            continue
+        full = parent / name
+        try:
+            st = os.lstat(full)
+        except OSError:
+            continue
+        if not stat.S_ISREG(st.st_mode):
+            continue
+        if m.group(1) is not None:
+            if int(m.group(1)) == os.getpid() or _alive(int(m.group(1))):
+                continue
+        elif time.time() - st.st_mtime < STALE_AGE:
+            continue
+        try:
+            fd = os.open(full, os.O_RDONLY | getattr(os, "O_CLOEXEC", 0))
+        except OSError:
+            continue
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # HDF5's writer lock
+            os.unlink(full)
+            removed.append((name, st.st_size))
+        except OSError:  # locked: a live writer (or no flock here: leave it)
+            pass
+        finally:
+            os.close(fd)
+    return removed
 
 
 def _check_space(path: Path, need: int, what: str) -> None:
@@ -702,7 +787,8 @@ class SweepFile:
     @classmethod
     def create(cls, path: str | Path, scene: Scene, overrides: tuple[str, ...] = (),
                overwrite: bool = False, *, backend: str | None = None,
-               adaptive: dict | None = None) -> SweepFile:
+               adaptive: dict | None = None,
+               log: Callable[[str], None] | None = None) -> SweepFile:
         """Make a new result file (all points not computed), atomically, and open it.
         adaptive: resolved settings of an adaptive sweep (``adaptive.Options.resolved``):
         the file gets the ``computed`` flags and the settings' attributes.
@@ -724,18 +810,23 @@ class SweepFile:
                              "--overwrite to replace it")
         grid = Grid(scene)
         nbytes = file_bytes(scene, adaptive is not None)
-        _check_space(path, nbytes + SPACE_MARGIN,
-                     f"a grid of {grid.size} points")
+        reserve = _reserve_bytes(scene, nbytes)
+        removed = clean_stale_partials(path)  # a killed attempt's reserved space back
+        if removed and log is not None:
+            log(f"removed {len(removed)} stale temporary file{'s' * (len(removed) > 1)} of "
+                f"{shown(path)} left by a sweep killed while making it ({removed[0][0]}"
+                f"{', ...' if len(removed) > 1 else ''}; "
+                f"{_mib(sum(n for _, n in removed))})")
+        _check_space(path, _space_needed(reserve), f"a grid of {grid.size} points")
         old_fd = _lock_existing(path) if existed else None
         tmp: Path | None = None
         f = None
         try:
             parent = path.parent if str(path.parent) else Path(".")
-            fd, name = tempfile.mkstemp(prefix=f".{path.name[:40]}.", suffix=".partial",
+            fd, name = tempfile.mkstemp(prefix=partial_prefix(path), suffix=".partial",
                                         dir=parent)
             os.close(fd)
             tmp = Path(name)
-            reserve = nbytes + METADATA_RESERVE + 4 * len(scene.text.encode())
             _reserve(tmp, reserve)  # room for all of it, or ENOSPC before HDF5 writes
             g = h5py.File(tmp, "w", track_order=True)  # truncates: reserve again
             try:
@@ -813,7 +904,7 @@ class SweepFile:
         h5py's errors (the callers say what they mean for the file)."""
         f = self.f
         if not _in_place(f):  # a format-1 file: its attributes change type once
-            _check_space(self.path, SPACE_MARGIN, "updating its attributes")
+            _check_space(self.path, UPDATE_MARGIN, "updating its attributes")
             _upgrade_session_attrs(f)
             f.flush()
         n = int(f.attrs["sessions"]) + 1
