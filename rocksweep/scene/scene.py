@@ -72,6 +72,9 @@ MAX_EXPANDED = 4_000_000
 # combinations of each key's extreme values (``_candidate_bodies``).
 MAX_BODIES_CHECKED = 1024
 PULSE_AXES = ("A_ratio", "w_over_p")
+# The pulse shapes each optional pulse key means something for (rocksweep.physics.excitation);
+# given for none of the scene's shapes, the key is refused (it would be silently ignored).
+PULSE_KEY_SHAPES = {"cycles": ("sine", "cosine"), "gamma": ("mp",), "nu": ("mp",)}
 # Typical values (Table 3; the `default` numerics) that the cost check puts in place of a
 # value, one at a time, to find which value makes a point too costly.
 _TAME = {"body.wn_over_p": 2.43, "body.zeta": 0.05, "body.alpha_cg": 0.15,
@@ -563,6 +566,12 @@ def _pulse_options(pulse: dict, shapes: tuple[str, ...]) -> list[Axis]:
         key = f"pulse.{k}"
         spec = KEYS[key]
         v = pulse.get(k)
+        applies = PULSE_KEY_SHAPES[k]
+        if v is not None and not set(applies) & set(shapes):
+            which = (f"the scene's shapes are {', '.join(shapes)}" if len(shapes) > 1
+                     else f"the scene's shape is {shapes[0]}")
+            raise SceneError(f"{key} = {fmt(v)}: applies to {' and '.join(applies)} pulses "
+                             f"only ({which}); remove it or sweep one of those shapes")
         if v is None:
             if not (k != "cycles" and "mp" in shapes):
                 continue
