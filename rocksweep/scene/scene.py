@@ -566,12 +566,7 @@ def _pulse_options(pulse: dict, shapes: tuple[str, ...]) -> list[Axis]:
         key = f"pulse.{k}"
         spec = KEYS[key]
         v = pulse.get(k)
-        applies = PULSE_KEY_SHAPES[k]
-        if v is not None and not set(applies) & set(shapes):
-            which = (f"the scene's shapes are {', '.join(shapes)}" if len(shapes) > 1
-                     else f"the scene's shape is {shapes[0]}")
-            raise SceneError(f"{key} = {fmt(v)}: applies to {' and '.join(applies)} pulses "
-                             f"only ({which}); remove it or sweep one of those shapes")
+        given = v is not None
         if v is None:
             if not (k != "cycles" and "mp" in shapes):
                 continue
@@ -580,6 +575,13 @@ def _pulse_options(pulse: dict, shapes: tuple[str, ...]) -> list[Axis]:
             else is_number(v)
         if not ok or check_values(key, np.array([as_float(v)])) is not None:
             raise SceneError(f"{key} = {fmt(v)}: {spec.allowed}")
+        if given:
+            applies = PULSE_KEY_SHAPES[k]
+            if not set(applies) & set(shapes):
+                which = (f"the scene's shapes are {', '.join(shapes)}" if len(shapes) > 1
+                         else f"the scene's shape is {shapes[0]}")
+                raise SceneError(f"{key} = {fmt(v)}: applies to {' and '.join(applies)} pulses "
+                                 f"only ({which}); remove it or sweep one of those shapes")
         out.append(Axis(k, key, (int(v) if spec.kind == "integer" else float(v),), False))
     return out
 
