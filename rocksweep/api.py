@@ -602,8 +602,18 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
 
     path = Path(path)
     read_result(path, ["outcome"])  # one-line errors for foreign or damaged files
-    with xr.open_dataset(path, engine="h5netcdf", driver_kwds={"locking": False}) as ds:
-        ds = ds.load()
+    try:
+        with xr.open_dataset(path, engine="h5netcdf", driver_kwds={"locking": False}) as ds:
+            ds = ds.load()
+    except (ValueError, TypeError, KeyError, OSError, OverflowError, AttributeError,
+            IndexError) as err:  # xarray's CF decoding of a damaged attribute
+        from rocksweep.outputs import shown
+        from rocksweep.store.sweepfile import StoreError
+
+        why = (str(err).strip().splitlines() or [type(err).__name__])[0]
+        why = why if len(why) <= 160 else why[:157] + "..."
+        raise StoreError(f"{shown(path)}: damaged rocksweep result (a variable's attributes "
+                         f"cannot be decoded: {why})") from None
     for name, var in ds.data_vars.items():  # files of format 1 have neither
         f = fields.BY_NAME.get(str(name))
         if f is not None:
