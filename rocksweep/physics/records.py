@@ -112,6 +112,9 @@ _TOKEN = re.compile(rf"\s*({_NUMBER}|[-+]?(?:nan|inf(?:inity)?))(?=[\s+-]|$)", r
 _NGA_HEADER = re.compile(r"^\s*NPTS\s*=\s*([^\s,]+)\s*,?\s*DT\s*=\s*([^\s,]+)", re.IGNORECASE)
 _OLD_HEADER = re.compile(r"^\s*([^\s,]+)\s*,?\s+([^\s,]+)\s+NPTS\s*,?\s*DT\b", re.IGNORECASE)
 _NPTS_MIN = 2
+# Sample spacing of a record [s]: 1 MHz to one sample every 10 s bound any ground motion
+# recorder; beyond, DT is a typo (1e300 would overflow the run's length, 1e-300 its steps).
+DT_MIN, DT_MAX = 1e-6, 10.0
 
 
 def _where(src: str, line: int | None = None) -> str:
@@ -244,6 +247,9 @@ def parse_record(data: bytes, source: str | Path) -> GroundRecord:
         dt, acc, title = _parse_at2(lines, src)
     else:
         dt, acc, title = _parse_two_column(lines, src)
+    if not DT_MIN <= dt <= DT_MAX:
+        raise RecordError(f"{_where(src)}: DT = {dt:g} s: the sample spacing must be in "
+                          f"[{DT_MIN:g}, {DT_MAX:g}] s")
     pga = float(np.max(np.abs(acc)))
     if pga == 0.0:
         raise RecordError(f"{_where(src)}: every value is 0 (PGA = 0): no motion to scale")

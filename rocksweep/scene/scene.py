@@ -781,11 +781,13 @@ def _check_record_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
                     c = float(cap[0])
                     if not (c <= MAX_POINT_STEPS):
                         raise SceneError(
-                            f"ground.p = {fmt(float(pv))}: one point could need {c:.2g} RK4 "
-                            f"steps{label} (the record's {rec.npts} samples at steps of "
-                            f"{float(h_rec[0]):.3g} p*t, then {n.horizon:g} p*t of free "
-                            f"vibration), more than the cap of {MAX_POINT_STEPS:.0e} a point;"
-                            " use a smaller p, fewer steps_per_period or a shorter horizon")
+                            f"ground.record {rec.name}: {rec.npts} samples at DT = "
+                            f"{rec.dt:g} s ({rec.duration:g} s) with ground.p = "
+                            f"{fmt(float(pv))}: one point could need {c:.2g} RK4 steps{label}"
+                            f" (the record at steps of {float(h_rec[0]):.3g} p*t, then "
+                            f"{n.horizon:g} p*t of free vibration), more than the cap of "
+                            f"{MAX_POINT_STEPS:.0e} a point; use a smaller p, fewer "
+                            "steps_per_period or a shorter horizon")
 
 
 def _runs(scene: Scene) -> tuple[tuple[Numerics, str], ...]:
