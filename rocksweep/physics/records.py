@@ -40,7 +40,7 @@ import hashlib
 import math
 import re
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -60,7 +60,8 @@ class GroundRecord:
     name: the file's stem; dt [s]: sample interval; acc [g]: (npts,) float64, read-only,
     acc[i] at t = i dt; npts: number of samples; pga [g]: max |acc| (> 0); sha256: hex
     digest of the file's bytes; source: the path read; title: the AT2 file's second
-    header line (event, station, component), '' for a two-column file.
+    header line (event, station, component), '' for a two-column file; data: the file's
+    bytes (a result file keeps them, so that it stands alone).
     """
 
     name: str
@@ -71,6 +72,7 @@ class GroundRecord:
     sha256: str
     source: str
     title: str = ""
+    data: bytes = field(default=b"", repr=False)  # the file's bytes (stored in results)
 
     @property
     def duration(self) -> float:
@@ -255,7 +257,8 @@ def parse_record(data: bytes, source: str | Path) -> GroundRecord:
         raise RecordError(f"{_where(src)}: every value is 0 (PGA = 0): no motion to scale")
     acc.setflags(write=False)
     return GroundRecord(name=path.stem, dt=float(dt), acc=acc, npts=int(acc.size), pga=pga,
-                        sha256=hashlib.sha256(data).hexdigest(), source=src, title=title)
+                        sha256=hashlib.sha256(data).hexdigest(), source=src, title=title,
+                        data=bytes(data))
 
 
 def read_record(path: str | Path) -> GroundRecord:

@@ -355,13 +355,15 @@ def apply_overrides(raw: dict, overrides: list[str]) -> dict:
 
 
 def parse_scene(text: str, source: str = "scene", overrides: list[str] | None = None,
-                base: str | Path | None = None) -> Scene:
+                base: str | Path | None = None, record: GroundRecord | None = None) -> Scene:
     """Validate scene YAML text. Raises SceneError (one line, prefixed by ``source``).
 
     base: the directory a ``ground.record`` path is relative to (the scene file's; None:
-    the working directory)."""
+    the working directory); record: the record of a ``ground`` section, already read (a
+    result file's stored copy): the ``ground.record`` path is then not read."""
     try:
-        return _parse(text, overrides or [], Path(base) if base is not None else None)
+        return _parse(text, overrides or [], Path(base) if base is not None else None,
+                      record)
     except SceneError as err:
         raise SceneError(f"{source}: {err}") from None
 
@@ -602,7 +604,8 @@ def _record(ground: dict, base: Path | None) -> GroundRecord:
         raise SceneError(f"ground.record: {err}") from None
 
 
-def _parse(text: str, overrides: list[str], base: Path | None = None) -> Scene:
+def _parse(text: str, overrides: list[str], base: Path | None = None,
+           given_record: GroundRecord | None = None) -> Scene:
     try:
         raw = _load_yaml(text)
     except _YamlError as err:
@@ -635,7 +638,7 @@ def _parse(text: str, overrides: list[str], base: Path | None = None) -> Scene:
     record = None
     if raw.get("ground") is not None:
         ground = _section(raw, "ground", kind, required=True)
-        record = _record(ground, base)
+        record = _record(ground, base) if given_record is None else given_record
         pulse = {"shape": RECORD, "A_ratio": ground["A_ratio"], "p": ground["p"]}
     else:
         pulse = _section(raw, "pulse", kind, required=True)

@@ -336,8 +336,9 @@ def _reserve(path: Path, nbytes: int) -> None:
 
 def _reserve_bytes(scene: Scene, nbytes: int) -> int:
     """Bytes a new result file of ``scene`` reserves: its datasets (``nbytes``), HDF5's
-    metadata, the scene text and the record's samples (stored in the file)."""
-    rec = 16 * int(scene.record.npts) if scene.record is not None else 0
+    metadata, the scene text and the record (its file and samples, ``_store_record``)."""
+    rec = (8 * int(scene.record.npts) + len(scene.record.data) + (16 << 10)
+           if scene.record is not None else 0)
     return nbytes + METADATA_RESERVE + 4 * len(scene.text.encode()) + rec
 
 
@@ -1109,6 +1110,7 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
     if scene.record is not None:  # the record: name, SHA-256, NPTS, DT [s], PGA [g]
         for k, v in record_attrs(scene.record).items():
             a[f"record_{k}"] = v
+        _store_record(f, scene.record)
     for k, v in vers.items():
         a[f"{k}_version"] = v
     a["started"] = _now()
@@ -1292,11 +1294,61 @@ def as_result(data, names: list[str] | None = None) -> SweepResult:
     return result_of(data)
 
 
+RECORD_GROUP = "record"  # a record sweep's copy of its record: file (bytes), acceleration
+
+
+def _store_record(f, record) -> None:
+    """Keep the record in the result file (group ``record``): the file's bytes (``file``,
+    uint8; the scene is rebuilt from them, ``result_scene``) and the samples
+    (``acceleration`` [g], at ``dt`` [s]) for readers. A result then stands alone: moved
+    to another machine, or kept after the record's folder is gone, it still plots and
+    gives boundaries and spectra."""
+    g = f.create_group(RECORD_GROUP)
+    raw = np.frombuffer(record.data, dtype=np.uint8)
+    if raw.size:
+        d = g.create_dataset("file", data=raw, chunks=(min(raw.size, 1 << 16),),
+                             compression="gzip")
+        d.attrs["sha256"] = record.sha256
+        d.attrs["source"] = str(record.source)
+    acc = g.create_dataset("acceleration", data=np.asarray(record.acc, np.float64))
+    acc.attrs["units"] = "g"
+    acc.attrs["dt"] = float(record.dt)
+
+
+def stored_record(path: Path, rec: dict):
+    """The record a result file keeps (``_store_record``) as a ``GroundRecord`` with the
+    sweep's source path, checked against the file's SHA-256; None for a file that keeps
+    no copy (made before records were stored). StoreError if the copy is damaged."""
+    from rocksweep.physics.records import RecordError, parse_record
+
+    f = _open(path, "r")
+    try:
+        g = f.get(RECORD_GROUP)
+        d = g.get("file") if g is not None else None
+        if d is None:
+            return None
+        data = bytes(np.asarray(d[()], dtype=np.uint8).tobytes())
+    except _H5_ERRORS as err:
+        raise _damaged(path, f"its copy of the record: {_why(err)}") from None
+    finally:
+        _close_quietly(f)
+    import hashlib
+
+    if hashlib.sha256(data).hexdigest() != rec.get("sha256"):
+        raise _damaged(path, "its copy of the record does not match its SHA-256")
+    try:
+        return parse_record(data, rec["source"])
+    except RecordError as err:
+        raise _damaged(path, f"its copy of the record: {err}") from None
+
+
 def result_scene(result: SweepResult) -> Scene:
     """The scene a result was computed from, rebuilt from its YAML and overrides and
     checked against the result's resolved scene (axes, numerics), so that the kernel runs
-    again as the sweep did (the A_min bisection, spectra). A record is re-read from where
-    the sweep read it and checked against its SHA-256. One-line StoreErrors."""
+    again as the sweep did (the A_min bisection, spectra). A record comes from the file's
+    own copy (``stored_record``, checked against its SHA-256); a file made before records
+    were stored re-reads it from where the sweep read it, checked against the SHA-256.
+    One-line StoreErrors."""
     import json
 
     from rocksweep.scene.scene import parse_scene
@@ -1307,18 +1359,30 @@ def result_scene(result: SweepResult) -> Scene:
     except ValueError:
         raise StoreError(f"{shown(result.path)}: attribute overrides is not JSON") from None
     rec = result.scene.get("record")
+    record = None
     if rec:
-        overrides.append(f"ground.record={rec['source']}")
+        # the file's own copy first (a result stands alone); a file without one re-reads
+        # the record from where the sweep read it, checked against its SHA-256
+        record = stored_record(result.path, rec)
+        if record is None:
+            from rocksweep.physics.records import RecordError, read_record
+
+            try:
+                record = read_record(rec["source"])
+            except RecordError as err:
+                raise StoreError(f"{shown(result.path)}: cannot rebuild its scene (the "
+                                 f"record: {err}; this file keeps no copy of it, made by an "
+                                 "older rocksweep: put the record back there)") from None
+            if record.sha256 != rec["sha256"]:
+                raise StoreError(f"{shown(result.path)}: the record {rec['source']} changed "
+                                 f"since the sweep (sha256 {record.sha256[:12]}, the result "
+                                 f"has {rec['sha256'][:12]})")
     try:
-        sc = parse_scene(str(a["scene"]), str(result.path), overrides)
+        sc = parse_scene(str(a["scene"]), str(result.path), overrides, record=record)
     except RocksweepError as err:
         raise StoreError(f"{shown(result.path)}: cannot rebuild its scene ({err})") from None
-    if rec and sc.record.sha256 != rec["sha256"]:
-        raise StoreError(f"{shown(result.path)}: the record {rec['source']} changed since the "
-                         f"sweep (sha256 {sc.record.sha256[:12]}, the result has "
-                         f"{rec['sha256'][:12]})")
     stored = {k: v for k, v in result.scene.items() if k != "adaptive"}
-    diffs = scene_differences(stored, resolved_scene(sc, overrides[:len(overrides) - bool(rec)]))
+    diffs = scene_differences(stored, resolved_scene(sc, overrides))
     if diffs:
         raise StoreError(f"{shown(result.path)}: its scene YAML no longer gives its grid "
                          f"({'; '.join(diffs)})")
