@@ -343,3 +343,17 @@ def test_a_record_result_moved_to_an_empty_folder(tmp_path):
     assert {"p.png", "b.csv", "s.png"} <= set(os.listdir(alone))
     ds = rocksweep.open(alone / "r.h5")
     assert rocksweep.boundaries(ds).sizes["p"] == 5
+
+
+def test_simulate_and_open_answer_in_one_line(work):
+    os.mkfifo(work / "f.h5")
+    cases = [(lambda: rocksweep.simulate(str(work / "one.yaml"), 5), TypeError, "overrides"),
+             (lambda: rocksweep.simulate(str(work / "one.yaml"), impact__lam=1j),
+              rocksweep.RocksweepError, "impact__lam = 1j"),
+             (lambda: rocksweep.simulate(str(work / "one.yaml"), name="a\x07b"),
+              rocksweep.RocksweepError, "name = 'a\\x07b'"),
+             (lambda: rocksweep.open(work / "f.h5"), rocksweep.RocksweepError, "f.h5")]
+    for call, error, words in cases:
+        with pytest.raises(error) as info:
+            call()
+        assert words in str(info.value) and "\n" not in str(info.value), str(info.value)
