@@ -14,7 +14,7 @@ from pathlib import Path
 import click
 
 import rocksweep
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import RocksweepError, one_line
 
 
 def user_errors(fn):
@@ -26,7 +26,7 @@ def user_errors(fn):
         try:
             return fn(*args, **kwargs)
         except RocksweepError as err:
-            raise click.ClickException(str(err)) from None
+            raise click.ClickException(one_line(str(err))) from None
 
     return wrapper
 
