@@ -303,7 +303,8 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
         jobs=jobs, resume=resume, overwrite=overwrite, validate=validate, adaptive=adaptive,
         backend=backend, scheduler=scheduler, chunk_size=chunk_size, write_every=write_every,
         connect_timeout=connect_timeout, cli=cli)
-    check_path_text(path)
+    if path is not None:  # None: in memory
+        check_path_text(path)
     if backend == "dask":
         from rocksweep.compute import sweep as sw
 
