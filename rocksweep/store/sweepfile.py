@@ -1387,7 +1387,8 @@ def result_scene(result: SweepResult) -> Scene:
     if rec:
         # the file's own copy first (a result stands alone); a file without one re-reads
         # the record from where the sweep read it, checked against its SHA-256
-        record = stored_record(result.path, rec)
+        # a Dataset made in memory (rocksweep.run without output) has no file to read
+        record = stored_record(result.path, rec) if result.path.is_file() else None
         if record is None:
             from rocksweep.physics.records import RecordError, read_record
 
