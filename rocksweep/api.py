@@ -673,6 +673,48 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3) -> xr.Dataset:
     return compute_spectra(ds, rtol).to_dataset()
 
 
+def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
+              im: str | None = None, period: float | None = None, bootstrap: int = 200,
+              seed: int = 0, ci: float = 0.9) -> xr.Dataset:
+    """Lognormal fragility curves P(state | IM = x) = Phi(ln(x / median) / beta) of a
+    record-suite sweep (a scene with ``ground.records``), fitted by maximum likelihood
+    (Baker 2015): to the counts at each stripe of a scaled suite ("stripes-mle"), or to
+    the (IM, 0/1) pairs of an unscaled one ("cloud-mle", im= "PGA" (default), "PGV" or
+    "Sa" with period= [s] from the stored periods).
+
+    ds: what ``run`` or ``open`` returns. state: "overturn" (either mode), "mode1",
+    "mode2", "uplift", "theta:X" (max|theta|/alpha_cg >= X, or overturned), or a list of
+    them (a ``state`` dimension). bootstrap: resamples over records for the intervals
+    and bands (0: none, NaN); seed: their generator's seed; ci: the interval's level.
+    Points flagged undecided (horizon, step or event caps, non-finite) are left out and
+    counted (``n_excluded``). One curve per value of every other swept key (lam, p, body
+    keys).
+
+    Returns a Dataset (``rocksweep.analysis.fragility.fragility``): ``median`` [IM
+    units], ``beta``, their bootstrap intervals ``median_lo``/``median_hi``,
+    ``beta_lo``/``beta_hi``, ``n_records``, ``n_excluded``, ``reason``, the bands
+    ``band_lo``/``band_hi`` over ``im_grid``, and for stripes the empirical ``fraction``
+    per stripe and, per record, ``first_level`` (the smallest stripe that reaches the
+    state: an IDA on the stripes) and ``resurrection`` (a higher stripe is safe again).
+    """
+    import xarray as xr
+
+    from rocksweep.analysis.fragility import fragility as fit
+
+    if isinstance(ds, str | Path):
+        ds = open(ds)
+    if not isinstance(ds, xr.Dataset):
+        raise ApiError(f"ds = {type(ds).__name__}: must be a result Dataset (rocksweep.run "
+                       "or rocksweep.open)")
+    if isinstance(bootstrap, bool) or not isinstance(bootstrap, int) or bootstrap < 0:
+        raise ApiError(f"bootstrap = {bootstrap!r}: must be an integer >= 0")
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise ApiError(f"seed = {seed!r}: must be an integer >= 0")
+    frag = fit(ds, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci)
+    frag.attrs["title"] = str(ds.attrs.get("title", ""))
+    return frag
+
+
 def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> Any:
     """What ``run`` of this scene will cost on this machine, without running it: points,
     RK4 steps and evaluations expected, seconds of compute with ``jobs`` workers, and
