@@ -255,3 +255,23 @@ def test_cloud_suite(tmp_path, suite_dir):
     assert frag.attrs["method"] == "cloud-mle"
     none = rocksweep.run(write_scene(tmp_path, scale="none"))
     np.testing.assert_array_equal(none["scale_factor"].values, [1.0, 1.0, 1.0])
+
+
+def test_suite_on_a_dask_cluster(tmp_path, suite_dir):
+    """The chunks of a suite run on a dask cluster (in-process workers) as locally; a
+    chunk's task (the grid with the suite's records) pickles, as process workers need."""
+    import pickle
+
+    distributed = pytest.importorskip("distributed")  # in the test extra: never skipped
+    from rocksweep.compute import sweep as sw
+
+    scene = write_scene(tmp_path, scale="{im: PGA, values: [0.5, 1.0]}")
+    sc = load_scene(scene)
+    back = pickle.loads(pickle.dumps(Grid(sc)))
+    np.testing.assert_array_equal(back.rows(0, back.size).rows, Grid(sc).rows(0, sc.size).rows)
+    local = sw.compute(sc, jobs=1)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                  dashboard_address=None) as cluster:
+        on = sw.compute(sc, backend="dask", scheduler=cluster.scheduler_address, chunk_size=4)
+    for name, v in local.items():
+        np.testing.assert_array_equal(on[name], v, err_msg=name)
