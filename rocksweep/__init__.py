@@ -9,7 +9,7 @@ The Python API (see the README's "Python API"):
 - ``rocksweep.open(path)``: a result file -> xarray.Dataset.
 - ``rocksweep.simulate(scene, overrides=(), **keys)``: one point with its time history
   -> ``Simulation`` (``.summary`` dict, ``.history`` Dataset over p*t, ``.figure()``).
-- ``rocksweep.plot(ds, x=, y=, ax=, width=)`` -> Figure; ``rocksweep.analysis.boundaries(ds,
+- ``rocksweep.plot(ds, x=, y=, ax=, width=)`` -> Figure; ``rocksweep.boundaries(ds,
   rtol=)`` -> Dataset of A_min; ``rocksweep.boundary_lines(ds)`` -> DataFrame;
   ``rocksweep.spectra(ds)`` -> Dataset; ``rocksweep.estimate(scene)``: the cost of a run;
   ``rocksweep.fragility(ds, state=, bootstrap=)`` -> Dataset of lognormal fragility

@@ -5,7 +5,7 @@ rocksweep stays light), so every Dataset they return has it:
 
     ds = rocksweep.run("configs/fig3a.yaml")
     ds.rocksweep.plot()             # the stability diagram, outcome as categories
-    ds.rocksweep.analysis.boundaries()       # A_min over w_over_p, lam, ...
+    ds.rocksweep.boundaries()       # A_min over w_over_p, lam, ...
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ class RocksweepAccessor:
         return plot(self._ds, *args, **kwargs)
 
     def boundaries(self, **kwargs: Any) -> Any:
-        """``rocksweep.analysis.boundaries(ds, ...)``: A_min as a Dataset."""
+        """``rocksweep.boundaries(ds, ...)``: A_min as a Dataset."""
         from rocksweep.api import boundaries
 
         return boundaries(self._ds, **kwargs)

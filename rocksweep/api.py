@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import functools
 import math
+import re
 import sys
 import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
@@ -45,6 +46,53 @@ API_MAX_RUNS = 100
 
 class ApiError(RocksweepError, ValueError):
     """An argument of the Python API that cannot be used; ``str()`` is one line."""
+
+
+# ---------------------------------------------------------------------------------------
+# Errors in Python's words
+# ---------------------------------------------------------------------------------------
+
+# The library's messages name command-line flags where the CLI is the usual way in; the
+# API says the same in its own arguments.
+_FLAG_WORDS = (
+    (re.compile(r"--set '([^']*)'"), r"overrides entry '\1'"),
+    (re.compile(r"--set ([\w.]+)=VALUE"), r"overrides={'\1': ...}"),
+    (re.compile(r"--set ([\w.]+)=(\S+)"), r"overrides={'\1': \2}"),
+    (re.compile(r"--set ([\w.]+)"), r"overrides['\1']"),
+    (re.compile(r"--resume\b"), "resume=True"),
+    (re.compile(r"--overwrite\b"), "overwrite=True"),
+    (re.compile(r"--adaptive\b"), "adaptive=True"),
+    (re.compile(r"--jobs\b"), "jobs"),
+)
+
+
+def _pythonic(message: str) -> str:
+    """A one-line message with the command line's flags said as API arguments."""
+    for pattern, words in _FLAG_WORDS:
+        message = pattern.sub(words, message)
+    return message
+
+
+def speaks_python(fn: Callable) -> Callable:
+    """Re-raise the library's one-line errors with the flags they name said as the API's
+    arguments (``--set impact.lam=VALUE`` -> ``overrides={'impact.lam': ...}``)."""
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return fn(*args, **kwargs)
+        except RocksweepError as err:
+            text = str(err)
+            said = _pythonic(text)
+            if said == text:
+                raise
+            try:
+                new = type(err)(said)
+            except TypeError:  # an error class with another constructor: as it is
+                raise err from None
+            raise new from None
+
+    return wrapper
 
 
 # ---------------------------------------------------------------------------------------
@@ -240,11 +288,20 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
 
     from rocksweep.store.sweepfile import SweepFile
 
-    path = Path(path)
     t0 = time.perf_counter()
     where = (f"{n_workers} worker{'s' * (n_workers > 1)}" if backend == "threads"
              else f"dask cluster {scheduler}")
     how = f"threads x {n_workers}" if backend == "threads" else f"dask {scheduler}"
+    if path is None:  # in memory: nothing touches a disk (rocksweep.run without output)
+        if resume:
+            raise ApiError("resume=True needs output= (the file to finish)")
+        sf = SweepFile.in_memory(scene, overrides, backend=how, adaptive=settings)
+        return _drive(sf, None, report_of := SweepReport(Path("memory"), sf.grid.size, 0, 0,
+                                                          0.0, 0.0, 0.0),
+                      t0, adaptive, validate, jobs=jobs, backend=backend,
+                      scheduler=scheduler, chunk_size=chunk_size, where=where,
+                      write_every=write_every, progress=progress, say=say) or report_of
+    path = Path(path)
     try:
         path.stat()
     except FileNotFoundError:
@@ -262,15 +319,23 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
         sf = SweepFile.create(path, scene, overrides, overwrite=overwrite, backend=how,
                               adaptive=settings)
     report = SweepReport(path, sf.grid.size, 0, 0, 0.0, 0.0, 0.0)
-    pending: list = []  # finished chunks not yet in the file (each loop writes its own)
+    return _drive(sf, path, report, t0, adaptive, validate, jobs=jobs, backend=backend,
+                  scheduler=scheduler, chunk_size=chunk_size, where=where,
+                  write_every=write_every, progress=progress, say=say)
+
+
+def _drive(sf, path: Path | None, report: SweepReport, t0: float,
+           adaptive: Options | None, validate: bool, **loop_options: Any) -> SweepReport:
+    """Compute the missing points of an open sink (a result file, or one in memory when
+    ``path`` is None: its image lands in ``report.image``), then record the session."""
+    pending: list = []  # finished chunks not yet in the sink (each loop writes its own)
     if validate and adaptive is None:
+        sf.close()
         raise ApiError("validate=True checks an adaptive sweep; add adaptive")
     loop = (_every_point_loop if adaptive is None
             else functools.partial(_adaptive_loop, validate=validate))
     try:
-        loop(sf, report, adaptive, jobs=jobs, backend=backend, scheduler=scheduler,
-             chunk_size=chunk_size, where=where, write_every=write_every,
-             progress=progress, say=say, pending=pending)
+        loop(sf, report, adaptive, pending=pending, **loop_options)
     except BaseException as err:
         try:
             report.wall_s = time.perf_counter() - t0
@@ -282,6 +347,8 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
         raise
     report.wall_s = time.perf_counter() - t0
     report.attrs = sf.finish(report.wall_s, report.cpu_s)
+    if path is None:
+        report.image = sf.image()
     sf.close()
     return report
 
@@ -447,6 +514,7 @@ def _stderr(line: str) -> None:
     print(line, file=sys.stderr, flush=True)
 
 
+@speaks_python
 def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
         overrides: Overrides = (), progress: bool = False, overwrite: bool = False,
         resume: bool = False, client: Any = None, adaptive: bool = False,
@@ -498,16 +566,13 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
         if not isinstance(address, str):
             raise TypeError(f"client = {client!r}: must be a dask.distributed.Client")
         where = {"backend": "dask", "scheduler": address}
-    if output is None:
-        if resume:
-            raise ApiError("resume=True needs output= (the file to finish)")
-        import tempfile
+    if output is None:  # in memory: nothing touches a disk
+        import io
 
-        with tempfile.TemporaryDirectory(prefix="rocksweep-") as tmp:
-            path = Path(tmp) / "result.h5"
-            sweep_file(sc, path, overrides=ov, jobs=jobs, progress=progress, log=log,
-                       adaptive=opts, validate=validate, **where)
-            return open(path)
+        report = sweep_file(sc, None, overrides=ov, jobs=jobs, resume=resume,
+                            progress=progress, log=log, adaptive=opts, validate=validate,
+                            **where)
+        return _dataset(io.BytesIO(report.image))
     sweep_file(sc, output, overrides=ov, jobs=jobs, resume=resume, overwrite=overwrite,
                progress=progress, log=log, inputs=[source] if source else (),
                adaptive=opts, validate=validate, **where)
@@ -544,6 +609,7 @@ def adaptive_options(adaptive: bool, base: dict | None = None,
     return Options(**given)
 
 
+@speaks_python
 def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xarray's)
     """A sweep result file as an xarray Dataset, loaded in memory (the file is closed).
 
@@ -558,17 +624,25 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
     ``complete``. Works while a sweep is still writing the file (no lock is taken).
     A file that is not a rocksweep result is a one-line ``RocksweepError``.
     """
+    from rocksweep.store.sweepfile import read_result
+
+    path = Path(path)
+    read_result(path, ["outcome"])  # one-line errors for foreign or damaged files
+    return _dataset(path)
+
+
+def _dataset(source: Path | Any) -> xr.Dataset:
+    """A result file (a path, or a file object holding the bytes of one in memory) as the
+    loaded Dataset that ``open`` and ``run`` return, with the accessor registered."""
     import xarray as xr
 
     from rocksweep import fields
     from rocksweep.accessor import register
     from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
-    from rocksweep.store.sweepfile import read_result
 
     register()  # ds.rocksweep.plot() etc.
-    path = Path(path)
-    read_result(path, ["outcome"])  # one-line errors for foreign or damaged files
-    with xr.open_dataset(path, engine="h5netcdf", driver_kwds={"locking": False}) as ds:
+    kwds = {"driver_kwds": {"locking": False}} if isinstance(source, Path) else {}
+    with xr.open_dataset(source, engine="h5netcdf", **kwds) as ds:
         ds = ds.load()
     for name, var in ds.data_vars.items():  # files of format 1 have neither
         f = fields.BY_NAME.get(str(name))
@@ -589,6 +663,7 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
 # Analyses: a result Dataset in, a Dataset, a DataFrame or a Figure out
 # ---------------------------------------------------------------------------------------
 
+@speaks_python
 def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any = None,
          curves: bool = False, show_computed: bool = False, mu: bool = False,
          width: str | None = None, _names: tuple[str, str] = ("x", "y")) -> Figure:
@@ -626,6 +701,7 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     return fig
 
 
+@speaks_python
 def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None) -> xr.Dataset:
     """A_min: the smallest amplitude (A_ratio) that overturns, for every x (w_over_p or
     p) of the diagram, bisected to the relative tolerance ``rtol`` between the last safe
@@ -650,6 +726,7 @@ def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None) -> x
                                       "mode": "any" if mode is None else f"mode{mode}"})
 
 
+@speaks_python
 def boundary_lines(ds: xr.Dataset) -> Any:
     """The lines between classes of a complete result's diagrams as a tidy
     ``pandas.DataFrame``: one row per vertex with the panel's other swept keys, ``line``,
@@ -662,6 +739,7 @@ def boundary_lines(ds: xr.Dataset) -> Any:
     return bd.lines_frame(bd.diagram_boundaries(sc, result.arrays["outcome"]))
 
 
+@speaks_python
 def spectra(ds: xr.Dataset, rtol: float = 1e-3) -> xr.Dataset:
     """Rocking and overturning spectra of a complete sweep over p (a record) or w_over_p,
     A_ratio and optionally lam: ``theta_max_over_alpha`` and ``outcome`` over (lam,
@@ -673,6 +751,7 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3) -> xr.Dataset:
     return compute_spectra(ds, rtol).to_dataset()
 
 
+@speaks_python
 def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
               im: str | None = None, period: float | None = None, bootstrap: int = 200,
               seed: int = 0, ci: float = 0.9) -> xr.Dataset:
@@ -715,6 +794,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     return frag
 
 
+@speaks_python
 def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> Any:
     """What ``run`` of this scene will cost on this machine, without running it: points,
     RK4 steps and evaluations expected, seconds of compute with ``jobs`` workers, and
@@ -777,6 +857,7 @@ def history_dataset(run: Run, title: str = "") -> xr.Dataset:
     return ds
 
 
+@speaks_python
 def simulate(scene: SceneLike, overrides: Overrides = (), /,
              **keys: Any) -> Simulation | list[Simulation]:
     """Run one point of a scene with its energy balance and time history.

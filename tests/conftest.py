@@ -4,6 +4,7 @@ import os
 import stat
 
 import pytest
+from bodies import FIG3
 from click.testing import CliRunner
 
 from rocksweep.physics.model import FlexibleBody
@@ -19,8 +20,7 @@ def body_fig2() -> FlexibleBody:
 @pytest.fixture(scope="session")
 def body_fig3() -> FlexibleBody:
     """Table 3, Figure 3: slender flexible body (wn/p = 2.43)."""
-    return FlexibleBody(wn_over_p=2.43, zeta=0.05, alpha_cg=0.15, alpha_A=0.28,
-                        mA_over_m=0.47, IA_ratio=0.56)
+    return FlexibleBody(**FIG3)
 
 
 @pytest.fixture(scope="session")

@@ -1,5 +1,7 @@
 """``rocksweep accuracy``: sampling, bookkeeping, and the command end to end."""
 
+from pathlib import Path
+
 import h5py
 import numpy as np
 import pytest
@@ -14,6 +16,7 @@ from rocksweep.analysis.accuracy import (
     stratified_sample,
 )
 from rocksweep.cli.main import main
+from rocksweep.kernel import layout as L  # noqa: N812
 
 SCENE = """\
 name: tiny accuracy scene
@@ -157,3 +160,42 @@ def test_cli_ladder_choices_are_the_ladders():
 
     opt = next(p for p in command.params if p.name == "ladder_name")
     assert list(opt.type.choices) == list(LADDERS)
+
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.mark.parametrize("name, sets", [
+    ("ricker.yaml", ["pulse.w_over_p={start: 1, stop: 6, num: 3}",
+                     "pulse.A_ratio={start: 1, stop: 8, num: 3}", "impact.lam=0.2"]),
+    ("record-demo.yaml", ["ground.A_ratio=[1.0, 4.0]", "ground.p=[1.0, 3.0]",
+                          "impact.lam=0.2"]),
+])
+def test_energy_and_half_step_runs_use_the_scene_ground_motion(name, sets):
+    """Review defect b: the accuracy study's energy runs (and half-step reruns) must run
+    the Ricker pulse and the record, not the sine/cosine variant: they equal the sweep's
+    own energy outputs and check reruns of the same points."""
+    import rocksweep.compute.sweep as sw
+    from rocksweep import fields
+    from rocksweep.analysis.accuracy import run_energy, run_half
+    from rocksweep.scene import load_scene
+
+    sc = load_scene(ROOT / "configs" / name, [*sets, "outputs.energy=true",
+                                              "outputs.check=true"])
+    flat = np.arange(sc.size)
+    swept = sw.compute(sc, jobs=1)
+    energy = run_energy(sc, flat, sc.numerics)
+    w_in = energy[:, L.OUT_W_IN] / np.array([sc.point(v).body.E_ref for v in _values(sc)])
+    np.testing.assert_array_equal(w_in, swept["work_in_over_Eref"].ravel())
+    assert np.all(np.abs(w_in) > 0)  # the ground did work: a ground motion was applied
+    half = run_half(sc, flat, sc.numerics)
+    np.testing.assert_array_equal(half[:, L.OUT_OUTCOME].astype(np.int8),
+                                  swept["check_outcome"].ravel())
+    assert fields.BY_NAME["check_outcome"].slot == L.OUT_OUTCOME
+
+
+def _values(sc):
+    from rocksweep.compute.grid import Grid
+
+    vals = Grid(sc).index_values(np.arange(sc.size))
+    return [{k: v[i] for k, v in vals.items()} for i in range(sc.size)]

@@ -9,6 +9,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from bodies import FIG3_YAML
 from helpers import kill_sweep_when, one_line_error
 
 import rocksweep
@@ -19,8 +20,7 @@ from rocksweep.compute.sweep import level, prepare, variables
 from rocksweep.scene.scene import parse_scene
 from rocksweep.store.sweepfile import read_result
 
-BODY3 = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, "
-         "mA_over_m: 0.47, IA_ratio: 0.56}\n")
+BODY3 = FIG3_YAML
 # Figure 3's body, two lam, 40 x 40: safe, mode 1 and mode 2 regions.
 FIG3_SMALL = BODY3 + ("impact: {lam: [0.0, 0.4]}\n"
                       "pulse: {shape: sine, w_over_p: {start: 0.3, stop: 6, num: 40},"

@@ -79,7 +79,7 @@ def test_pdf_has_truetype_fonts(pair, tmp_path):
 
 def test_boundaries_from_run_open_and_cli_agree(pair, tmp_path):
     mem, disk, out = pair
-    a, b = (rocksweep.analysis.boundaries(ds, rtol=1e-3) for ds in (mem, disk))
+    a, b = (rocksweep.boundaries(ds, rtol=1e-3) for ds in (mem, disk))
     xr.testing.assert_identical(a, b)
     assert a.A_min.dims == ("lam", "w_over_p")
     # the bracket holds A_min, to rtol
@@ -167,3 +167,40 @@ def test_spectra_dataset(tmp_path):
     np.testing.assert_array_equal(sp.outcome.values[0], ds.outcome.transpose(
         "A_ratio", "p").values.squeeze() if "lam" not in ds.outcome.dims else
         ds.outcome.sel(lam=0.0).transpose("A_ratio", "p").values)
+
+
+def test_python_errors_speak_python(tmp_path):
+    """The API names its own arguments where the command line names flags."""
+    with pytest.raises(rocksweep.RocksweepError) as err:
+        rocksweep.run(CI_SMALL, overrides=["pulse.A_ratio"])
+    assert "--set" not in str(err.value) and "overrides entry 'pulse.A_ratio'" in str(
+        err.value)
+    out = tmp_path / "o.h5"
+    rocksweep.run(CI_SMALL, overrides={**SINE, "impact.lam": 0.0}, output=out)
+    with pytest.raises(rocksweep.RocksweepError) as err:
+        rocksweep.run(CI_SMALL, overrides={**SINE, "impact.lam": 0.0}, output=out)
+    msg = str(err.value)
+    assert "resume=True" in msg and "overwrite=True" in msg and "--" not in msg
+    res = CliRunner().invoke(main, ["sweep", str(CI_SMALL), "-o", str(out), "--set",
+                                    "pulse.shape=sine", "--set", "impact.lam=0.0"])
+    assert res.exit_code != 0 and "--resume" in res.output  # the CLI keeps its flags
+
+
+def test_run_without_output_touches_no_disk(tmp_path, monkeypatch, pair):
+    """run() without output= sweeps into memory (HDF5's core driver): no file in the
+    working directory nor in the temporary directory, and the same Dataset as the file."""
+    import tempfile
+
+    work, tmp = tmp_path / "work", tmp_path / "tmp"
+    work.mkdir()
+    tmp.mkdir()
+    monkeypatch.chdir(work)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp))
+    monkeypatch.setenv("TMPDIR", str(tmp))
+    ds = rocksweep.run(CI_SMALL, overrides=SINE)
+    assert list(work.iterdir()) == [] and list(tmp.iterdir()) == []
+    _, disk, _ = pair
+    xr.testing.assert_equal(ds, disk)  # values, dims, coords
+    for name in ds.variables:
+        assert ds[name].attrs.keys() == disk[name].attrs.keys(), name
+    assert ds.attrs.keys() == disk.attrs.keys()

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+from bodies import FIG3
 
 import rocksweep
 import rocksweep.compute.sweep as sw
@@ -27,8 +28,7 @@ ROOT = Path(__file__).resolve().parents[1]
 CI_SMALL = ROOT / "configs" / "ci-small.yaml"
 FIG5 = ROOT / "configs" / "fig5.yaml"
 
-BODY3 = {"wn_over_p": 2.43, "zeta": 0.05, "alpha_cg": 0.15, "alpha_A": 0.28,
-         "mA_over_m": 0.47, "IA_ratio": 0.56}
+BODY3 = dict(FIG3)
 SMALL = {"name": "api test", "body": BODY3, "impact": {"lam": [0.0, 0.4]},
          "pulse": {"shape": "sine", "w_over_p": {"start": 1.0, "stop": 6.0, "num": 6},
                    "A_ratio": {"start": 1.0, "stop": 8.0, "num": 5}}}
@@ -146,7 +146,7 @@ def test_open_and_run_errors_are_one_line(tmp_path):
         (lambda: rocksweep.run(SMALL, resume=True), "resume=True needs output="),
         (lambda: rocksweep.run({**SMALL, "impact": {"lam": 3}}), "impact.lam = 3.0"),
         (lambda: rocksweep.run(tmp_path / "none.yaml"), "no such scene file"),
-        (lambda: rocksweep.run(SMALL, output=bad), "already exists; use --resume"),
+        (lambda: rocksweep.run(SMALL, output=bad), "already exists; use resume=True"),
         (lambda: rocksweep.run(SMALL, output=bad, resume=True, overwrite=True),
          "exclude each other"),
     ]
@@ -261,9 +261,11 @@ def test_simulate_keywords_and_dict_agree_and_history_is_physical():
     assert len(fig.axes) >= 4
 
 
-def test_simulate_needs_one_point():
-    with pytest.raises(rocksweep.RocksweepError, match="impact.lam has 3 values"):
-        rocksweep.simulate(FIG5)
+def test_simulate_runs_each_point_of_a_small_scene():
+    sims = rocksweep.simulate(FIG5)  # lam: [0, 0.2, 0.4]
+    assert [s.run.point.lam for s in sims] == [0.0, 0.2, 0.4]
+    one = rocksweep.simulate(FIG5, impact__lam=0.4)
+    assert one.summary == {**sims[2].summary, "wall_time_s": one.summary["wall_time_s"]}
 
 
 # --- fields ---------------------------------------------------------------------------------

@@ -3,14 +3,14 @@ and the bisected threshold against a 10x finer uniform sweep of the real kernel.
 
 import numpy as np
 import pytest
+from bodies import FIG3_YAML
 
 import rocksweep.analysis.boundaries as bd
 import rocksweep.compute.sweep as sw
 from rocksweep.figures.diagrams import a_min_figure
 from rocksweep.scene.scene import parse_scene
 
-BODY3 = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, "
-         "mA_over_m: 0.47, IA_ratio: 0.56}\n")
+BODY3 = FIG3_YAML
 
 
 def test_line_boundary_follows_the_analytic_line():

@@ -111,16 +111,16 @@ def test_scene_without_check_stores_and_runs_nothing_more():
     assert not set(CHECK_NAMES) & set(sw.variables(scene))
     calls = []
     grid = sw.Grid(scene)
-    orig = sw._run_rows
+    orig = sw.run_rows
     try:
-        sw._run_rows = lambda *a: calls.append(1) or orig(*a)
+        sw.run_rows = lambda *a: calls.append(1) or orig(*a)
         sw.run_chunk(grid, 0, 8, sw.level(scene))
         assert len(calls) == 1
         checked = parse_scene(SCENE, overrides=["outputs.check=true"])
         sw.run_chunk(sw.Grid(checked), 0, 8, sw.level(checked))
         assert len(calls) == 3
     finally:
-        sw._run_rows = orig
+        sw.run_rows = orig
 
 
 def test_record_scene_half_step(tmp_path):

@@ -12,6 +12,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from bodies import FIG3_YAML
 from helpers import kill_sweep_when, one_line_error
 
 from rocksweep.cli import main
@@ -22,8 +23,7 @@ from rocksweep.store.sweepfile import SweepFile, read_result
 ROOT = Path(__file__).resolve().parents[1]
 CI_SMALL = ROOT / "configs" / "ci-small.yaml"
 
-BODY3 = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, "
-         "mA_over_m: 0.47, IA_ratio: 0.56}\n")
+BODY3 = FIG3_YAML
 
 
 def assert_same_results(a: Path, b: Path) -> None:

@@ -5,18 +5,14 @@ import math
 
 import numpy as np
 import pytest
+from bodies import BODY3, BODY4
 
 from rocksweep.compute.single import simulate
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import FlexibleBody
 from rocksweep.physics.points import Point
 from rocksweep.physics.reference import reference_run
 
-BODY3 = FlexibleBody(wn_over_p=2.43, zeta=0.05, alpha_cg=0.15, alpha_A=0.28, mA_over_m=0.47,
-                     IA_ratio=0.56)
-BODY4 = FlexibleBody(wn_over_p=9.82, zeta=0.05, alpha_cg=0.15, alpha_A=0.28, mA_over_m=0.47,
-                     IA_ratio=0.56)
 # Smooth stretches: uplift -> first impact (stiff body), uplift -> overturning (mode 2).
 SMOOTH = {
     "first_impact": (Point(BODY4, 0.2, "sine", 4.0, 3.0), L.OUT_T_FIRST_IMPACT,

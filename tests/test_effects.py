@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 import pytest
+from bodies import SHARED
 
 from rocksweep.compute.single import history_capacity, simulate
 from rocksweep.kernel import chunk_kernel, point_kernel
@@ -21,7 +22,7 @@ from rocksweep.numerics import Numerics
 from rocksweep.physics.model import BlockBody, FlexibleBody, G, restitution, restitution_rigid
 from rocksweep.physics.points import Point, kernel_kind, point_row
 
-TABLE3 = dict(zeta=0.05, alpha_cg=0.15, alpha_A=0.28, mA_over_m=0.47, IA_ratio=0.56)
+TABLE3 = dict(SHARED)  # Table 3 without omega_n/p
 # A short horizon keeps undamped runs (which may never come to rest) cheap.
 NUM = Numerics.preset("draft", horizon=20.0)
 ENERGY_COLS = [L.OUT_W_IN, L.OUT_D_DAMP, L.OUT_E_IMPACT, L.OUT_E_GAINED, L.OUT_N_GAINING,

@@ -328,8 +328,8 @@ print(matplotlib.get_backend(), "matplotlib.pyplot" in sys.modules)
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.split() == ["True", "False"]
-    src = "".join((ROOT / "rocksweep" / f).read_text()
-                  for f in ("plots.py", "diagrams.py", "accuracy_plot.py", "cli/plot.py"))
+    src = "".join(f.read_text() for f in [*(ROOT / "rocksweep" / "figures").glob("*.py"),
+                                           ROOT / "rocksweep" / "cli" / "plot.py"])
     assert "matplotlib.use(" not in src
     assert "import matplotlib.pyplot" not in src and "import pyplot" not in src
 

@@ -23,6 +23,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from bodies import FIG3
 from scipy import signal
 
 from rocksweep.compute.single import simulate
@@ -36,8 +37,6 @@ from rocksweep.scene.scene import SceneError, load_scene, parse_scene
 ROOT = Path(__file__).resolve().parents[1]
 SINE = ROOT / "records" / "sine_1cycle.AT2"
 NEARFAULT = ROOT / "records" / "synthetic_nearfault.AT2"
-FIG3 = dict(wn_over_p=2.43, zeta=0.05, alpha_cg=0.15, alpha_A=0.28, mA_over_m=0.47,
-            IA_ratio=0.56)
 
 
 @pytest.mark.parametrize("lam, w_over_p, A_ratio", [

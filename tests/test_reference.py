@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 import pytest
+from bodies import BODY3
 from scipy.integrate import quad
 
 from rocksweep.compute.single import simulate
@@ -155,8 +156,6 @@ def test_impact_keeps_the_top_mass_horizontal_momentum(undamped_run):
 # Reference against the kernel
 # ----------------------------------------------------------------------------------------
 
-BODY3 = FlexibleBody(wn_over_p=2.43, zeta=0.05, alpha_cg=0.15, alpha_A=0.28, mA_over_m=0.47,
-                     IA_ratio=0.56)
 CASES = {
     # Figure 5's pulse: safe after 91 impacts (lam = 0), mode 1 after 3 impacts (lam = 0.4)
     "safe": Point(BODY3, 0.0, "sine", 5.3, 5.0),

@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 import pytest
+from bodies import FIG3
 
 from rocksweep.cli import main
 from rocksweep.errors import RocksweepError
@@ -22,8 +23,7 @@ from rocksweep.scene.scene import MAX_POINTS, SceneError, load_scene, parse_scen
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 
-TABLE3 = dict(wn_over_p=2.43, zeta=0.05, alpha_cg=0.15, alpha_A=0.28, mA_over_m=0.47,
-              IA_ratio=0.56)
+TABLE3 = dict(FIG3)
 GOOD = """
 body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47, IA_ratio: 0.56}
 impact: {lam: 0.4}

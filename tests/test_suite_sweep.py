@@ -157,9 +157,7 @@ def test_bad_suites_are_one_line_errors(tmp_path, suite_dir):
 def test_unscalable_record_is_named(tmp_path, suite_dir, monkeypatch):
     """A record with PGV 0 cannot be scaled to a PGV stripe (no file has one: a
     piecewise-linear record with PGA > 0 moves; the velocity is stubbed here)."""
-    from rocksweep.physics import suite as mod
-
-    monkeypatch.setattr(mod.intensity, "pgv", lambda acc, dt: 0.0)
+    monkeypatch.setattr(intensity, "pgv", lambda acc, dt: 0.0)
     with pytest.raises(SceneError, match=r"ground.records: .*SYN01.AT2: PGV = 0.0: cannot "
                        r"be scaled to a PGV stripe") as err:
         load_scene(write_scene(tmp_path, scale="{im: PGV, values: [0.1]}"))

@@ -4,3 +4,6 @@ provenance), ``boundaries`` (A_min curves, class boundary lines), ``spectrum`` (
 and overturning spectra), ``restitution`` (the eq. 1 map), ``accuracy`` (the
 work-precision study against the reference).
 """
+
+# the public modules
+__all__ = ["accuracy", "boundaries", "fragility", "restitution", "spectrum", "summary"]

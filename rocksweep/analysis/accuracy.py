@@ -395,36 +395,27 @@ def point_errors(k: np.ndarray, r: np.ndarray, alpha_ref: np.ndarray,
 
 
 def run_energy(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray:
-    """The energy-accounting kernel on the given points (untimed): float64[n, N_OUT]."""
+    """The energy-accounting kernel on the given points (untimed): float64[n, N_OUT].
+    Through the sweep's dispatch (``compute.sweep.run_rows``), so Ricker, MP and record
+    scenes run their ground variants with the record's samples."""
     from rocksweep.compute.grid import Grid
+    from rocksweep.compute.sweep import run_rows
 
-    cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
-    outs = np.empty((len(flat), L.N_OUT))
-    for kind in np.unique(cr.kinds):
-        sel = np.flatnonzero(cr.kinds == kind)
-        part = np.empty((len(sel), L.N_OUT))
-        chunk_kernel(int(kind), L.LEVEL_ENERGY)(np.ascontiguousarray(cr.rows[sel]), part)
-        outs[sel] = part
-    return outs
+    sc = _with_numerics(scene, numerics)
+    cr = Grid(sc).rows_at(flat)
+    return run_rows(cr, cr.rows, L.LEVEL_ENERGY, sc)
 
 
 def run_half(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray:
     """The half-step reruns of ``outputs.check`` (``fields.check_rows``) on the given
-    points, outcome-only kernel, untimed: float64[n, N_OUT]."""
+    points, outcome-only kernel, untimed: float64[n, N_OUT] (the sweep's dispatch)."""
     from rocksweep.compute.grid import Grid
-    from rocksweep.physics.points import with_record
+    from rocksweep.compute.sweep import run_rows
 
     _no_suite(scene)
-    cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
-    rows = with_record(fields.check_rows(cr.rows), scene.record)
-    outs = np.empty((len(flat), L.N_OUT))
-    for kind in np.unique(cr.kinds):
-        sel = np.flatnonzero(cr.kinds == kind)
-        part = np.empty((len(sel), L.N_OUT))
-        chunk_kernel(int(kind), L.LEVEL_OUTCOME, scene.ground)(
-            np.ascontiguousarray(rows[sel]), part)
-        outs[sel] = part
-    return outs
+    sc = _with_numerics(scene, numerics)
+    cr = Grid(sc).rows_at(flat)
+    return run_rows(cr, fields.check_rows(cr.rows), L.LEVEL_OUTCOME, sc)
 
 
 def estimate_scores(k: np.ndarray, half: np.ndarray, r: np.ndarray,

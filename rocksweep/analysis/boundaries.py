@@ -495,7 +495,7 @@ def result_curves(result: SweepResult, rtol: float = DEFAULT_RTOL, mode: int | N
 
 
 # ---------------------------------------------------------------------------------------
-# As xarray / pandas (rocksweep.analysis.boundaries, rocksweep.boundary_lines)
+# As xarray / pandas (rocksweep.boundaries, rocksweep.boundary_lines)
 # ---------------------------------------------------------------------------------------
 
 def _panel_index(wheres: Sequence[dict[str, Any]]) -> tuple[list[str], dict[str, list]]:

@@ -92,21 +92,23 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
     # a Grid, or adaptive's view of one (``adaptive._Subset``: the grid as ``.grid``)
     scene = grid.scene if hasattr(grid, "scene") else grid.grid.scene
     cr = grid.rows(start, stop)
-    outs = _run_rows(cr, cr.rows, level, scene)
+    outs = run_rows(cr, cr.rows, level, scene)
     contact = level == L.LEVEL_CONTACT  # the contact variants account energy either way
     stored = fields.sweep_fields(scene.energy if contact else level == L.LEVEL_ENERGY,
                                  contact, scene.check)
     arrays = fields.convert(outs, cr.alpha_ref, cr.E_ref, stored)
     if scene.check:
-        half = _run_rows(cr, fields.check_rows(cr.rows), level, scene)
+        half = run_rows(cr, fields.check_rows(cr.rows), level, scene)
         arrays.update(fields.convert_check(outs, half, cr.alpha_ref))
     return ChunkResult(start, stop, arrays, time.perf_counter() - t0,
                        time.thread_time() - c0)
 
 
-def _run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene) -> np.ndarray:
-    """Result rows float64[n, N_OUT] of the parameter rows ``rows`` (those of ``cr`` or
-    their half-step reruns): one kernel call per kind present."""
+def run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene) -> np.ndarray:
+    """The one dispatch of parameter rows to the compiled kernel variants: result rows
+    float64[n, N_OUT] of ``rows`` (float64[n, N_PAR], those of ``cr`` or their half-step
+    reruns) at bookkeeping ``level``: one kernel call per body kind present, the scene's
+    ground variant (Ricker, MP, records) with a record's samples riding on the rows."""
     outs = np.empty((rows.shape[0], L.N_OUT))
     for kind in np.unique(cr.kinds):
         sel = cr.kinds == kind
@@ -434,7 +436,7 @@ def estimate(scene: Scene, jobs: int = 1, sample: int = ESTIMATE_SAMPLE,
     if to_compile == 0 and unknown == 0:
         prepare(grid, lvl)  # loads the cached variant (no compile)
         c0 = time.thread_time()
-        outs = _run_rows(cr, cr.rows, lvl, scene)
+        outs = run_rows(cr, cr.rows, lvl, scene)
         cpu = time.thread_time() - c0
         evals = outs[:, L.OUT_STEPS] + outs[:, L.OUT_EVENT_STEPS]
         evaluations = float(evals.mean()) * n * reruns

@@ -1,8 +1,8 @@
 """Every figure (``rocksweep.plot(ds)`` is the facade): ``diagrams`` (stability
-diagrams, Figures 3-4, friction maps, A_min),
-``common`` (axes, saving, time histories (Figure 5), the restitution map (Figure 2)),
-``spectrum`` (rocking spectra), ``accuracy`` (work-precision). Figures are built without
-pyplot (``matplotlib.figure.Figure``), so nothing here needs a display.
+diagrams, Figures 3-4, friction maps, A_min), ``common`` (axes, saving, time histories
+(Figure 5), the restitution map (Figure 2)), ``spectrum`` (rocking spectra),
+``accuracy`` (work-precision), ``fragility`` (fragility curves). Figures are built
+without pyplot (``matplotlib.figure.Figure``), so nothing here needs a display.
 """
 
 # Figure files (the suffix picks the format) and raster resolution [dots per inch]: light
@@ -10,3 +10,6 @@ pyplot (``matplotlib.figure.Figure``), so nothing here needs a display.
 FORMATS = (".png", ".pdf", ".svg")
 DEFAULT_DPI = 200
 DPI_RANGE = (20, 2400)
+
+# the public modules
+__all__ = ["accuracy", "common", "diagrams", "fragility", "spectrum"]

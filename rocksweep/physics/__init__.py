@@ -7,3 +7,6 @@ Modules: ``model`` (bodies, restitution, eq. 6), ``excitation`` (pulse shapes),
 cost), ``reference`` (DOP853 + root finding, sharing only the equations with the kernel).
 Nothing here reads or writes result files.
 """
+
+# the public modules
+__all__ = ["excitation", "intensity", "model", "points", "records", "reference"]

@@ -51,7 +51,6 @@ from functools import lru_cache
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.optimize import brentq
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -99,6 +98,8 @@ def mp_peak(gamma: float, nu_deg: float) -> float:
     g_lo = float(_mp_raw_rate(np.float64(lo), gamma, nu_deg))
     g_hi = float(_mp_raw_rate(np.float64(hi), gamma, nu_deg))
     if g_lo * g_hi < 0.0:
+        from scipy.optimize import brentq  # only for MP pulses: not at import (~0.15 s)
+
         x = brentq(lambda p: float(_mp_raw_rate(np.float64(p), gamma, nu_deg)), lo, hi,
                    xtol=1e-15, rtol=4 * np.finfo(float).eps)
         best = max(best, abs(float(_mp_raw(np.float64(x), gamma, nu_deg))))
@@ -206,6 +207,8 @@ class PulseShape:
             return 0.0
         lo, hi = float(phi[i - 1]), float(phi[i])
         side = math.copysign(1.0, A_ratio * float(self.acc(hi)))
+        from scipy.optimize import brentq
+
         return brentq(lambda p: A_ratio * float(self.acc(p)) - side, lo, hi,
                       xtol=1e-14, rtol=4 * np.finfo(float).eps)
 

@@ -131,7 +131,9 @@ def body_omega_rock(body: Body) -> float:
     if body.rigid:
         return 0.0
     i_a0 = body.I_A + body.m_A * body.R_A**2
-    return float(rocking_spring_omega(body.omega_n, body.zeta, body.m, body.h, i_a0, 0.0))
+    # the plain-Python body of the jitted formula: scenes load no compiled code
+    return float(rocking_spring_omega.py_func(body.omega_n, body.zeta, body.m, body.h, i_a0,
+                                              0.0))
 
 
 def run_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, w_over_p: np.ndarray,

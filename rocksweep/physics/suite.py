@@ -26,7 +26,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rocksweep.errors import RocksweepError
-from rocksweep.physics import intensity
 from rocksweep.physics.model import G
 from rocksweep.physics.records import GroundRecord
 
@@ -120,6 +119,8 @@ def make_suite(records: list[GroundRecord], names: list[str], im: str | None,
                periods: list[float]) -> Suite:
     """A Suite with every record's IMs computed (once). A record whose IM to scale is not
     a finite number > 0 (PGV 0, Sa 0) is a ``SuiteError`` naming its file."""
+    from rocksweep.physics import intensity  # scipy.signal: loaded by suite scenes only
+
     n = len(records)
     pga = np.empty(n)
     pgv = np.empty(n)

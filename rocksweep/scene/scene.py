@@ -55,9 +55,9 @@ class SceneError(RocksweepError, ValueError):
 
 
 # Largest grid a scene may describe [points]. A sweep file stores 45 bytes a point (69
-# with energy metrics, rocksweep.compute.sweep.VARIABLES): 2e8 points are a 9-14 GB file, one
-# float64 variable read back for a figure or xarray is 1.6 GB of memory, and at the
-# kernel's 27-54 us a point (README, bench) the sweep takes 1.5-3 hours of one core.
+# with energy metrics, ``rocksweep.fields.variables``): 2e8 points are a 9-14 GB file, one
+# float64 variable read back for a figure or xarray is 1.6 GB of memory, and at tens of
+# microseconds a point (docs/performance.md) the sweep takes hours of one core.
 MAX_POINTS = 200_000_000
 # Values per axis: an axis is kept as a tuple of Python floats (~32 bytes a value; 1e6
 # values are 32 MB and 0.1 s to build); a figure's axis needs a few thousand at most.

@@ -818,6 +818,30 @@ class SweepFile:
                 os.close(old_fd)
 
     @classmethod
+    def in_memory(cls, scene: Scene, overrides: tuple[str, ...] = (), *,
+                  backend: str | None = None, adaptive: dict | None = None) -> SweepFile:
+        """The same result, held in memory (HDF5's core driver, no backing store): the
+        sink of ``rocksweep.run`` without ``output``. Nothing touches a disk; ``image``
+        gives the file's bytes, exactly what ``create`` would have written."""
+        import h5py
+
+        name = f"rocksweep-memory-{os.getpid()}-{id(scene)}.h5"
+        f = h5py.File(name, "w", driver="core", backing_store=False, track_order=True)
+        try:
+            _initialise(f, scene, overrides, adaptive)
+            self = cls(Path("memory"), f, scene, backend, adaptive)
+            self._start_session()
+        except BaseException:
+            _close_quietly(f)
+            raise
+        return self
+
+    def image(self) -> bytes:
+        """The result file's bytes as it stands (flushed)."""
+        self.f.flush()
+        return self.f.id.get_file_image()
+
+    @classmethod
     def resume(cls, path: str | Path, scene: Scene, overrides: tuple[str, ...] = (),
                *, backend: str | None = None, adaptive: dict | None = None) -> SweepFile:
         """Reopen a result file of the same scene (and the same adaptive settings, None
@@ -1375,8 +1399,8 @@ _FLAG_ATTRS = ("energy", "complete")
 
 
 def _attr_ok(key: str, v) -> bool:
-    if key in _TEXT_ATTRS:
-        return isinstance(v, str)
+    if key in _TEXT_ATTRS:  # h5py decodes invalid UTF-8 to surrogates: damage
+        return isinstance(v, str) and v.encode("utf-8", "replace").decode() == v
     if isinstance(v, bool) or not isinstance(v, int | float):
         return key in _FLAG_ATTRS and isinstance(v, bool)
     if key in _NUMBER_ATTRS:
