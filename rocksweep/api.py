@@ -120,8 +120,22 @@ def override_strings(overrides: Overrides | None) -> list[str]:
     if isinstance(overrides, str):
         return [overrides]
     if isinstance(overrides, Mapping):
-        return [f"{str(k).replace('__', '.')}={_yaml_value(v)}" for k, v in overrides.items()]
-    return [str(o) for o in overrides]
+        out = []
+        for k, v in overrides.items():
+            if not isinstance(k, str):
+                raise TypeError(f"overrides: key {k!r}: must be a string (a dotted scene "
+                                "key, e.g. 'impact.lam')")
+            out.append(f"{k.replace('__', '.')}={_yaml_value(_plain_tree(v, k))}")
+        return out
+    if isinstance(overrides, bytes | bytearray) or not isinstance(overrides, Iterable):
+        raise TypeError(f"overrides = {overrides!r}: give KEY=VALUE strings "
+                        "(['impact.lam=0.2']) or a mapping ({'impact.lam': 0.2})")
+    items = list(overrides)
+    for o in items:
+        if not isinstance(o, str):
+            raise TypeError(f"overrides: {o!r}: each override must be a KEY=VALUE string, "
+                            "e.g. 'impact.lam=0.2'")
+    return items
 
 
 def load(scene: SceneLike | Scene, overrides: Overrides | None = ()) -> tuple[Scene, Path | None]:
@@ -142,7 +156,7 @@ def load(scene: SceneLike | Scene, overrides: Overrides | None = ()) -> tuple[Sc
     if isinstance(scene, Mapping):
         import yaml
 
-        text = yaml.safe_dump(_plain_tree(scene), sort_keys=False)
+        text = yaml.safe_dump(_plain_tree(scene), sort_keys=False, allow_unicode=False)
         return parse_scene(text, "scene", ov), None
     if isinstance(scene, str) and ("\n" in scene or (":" in scene and not _is_file(scene))):
         return parse_scene(scene, "scene", ov), None
@@ -161,15 +175,32 @@ def _is_file(text: str) -> bool:
         return False
 
 
-def _plain_tree(v: Any) -> Any:
-    """A mapping with numpy values and tuples -> plain YAML-safe Python."""
+def _plain_tree(v: Any, where: str = "scene") -> Any:
+    """A mapping with numpy values and tuples -> plain YAML-safe Python; a value YAML
+    cannot hold (a complex number, an arbitrary object) is an ApiError naming where it
+    is (``scene['pulse']['A_ratio']``)."""
     if isinstance(v, Mapping):
-        return {str(k): _plain_tree(x) for k, x in v.items()}
-    if hasattr(v, "tolist"):
-        return v.tolist()
+        return {str(k): _plain_tree(x, f"{where}[{k!r}]") for k, x in v.items()}
+    if hasattr(v, "tolist") and not isinstance(v, str | bytes):
+        try:
+            v = v.tolist()
+        except Exception:  # noqa: BLE001 - a foreign object's tolist: refused below
+            pass
+        else:
+            return _plain_tree(v, where)
     if isinstance(v, list | tuple):
-        return [_plain_tree(x) for x in v]
-    return v
+        return [_plain_tree(x, f"{where}[{i}]") for i, x in enumerate(v)]
+    if v is None or isinstance(v, bool | str):
+        return v
+    if isinstance(v, int | float) and not isinstance(v, complex):
+        return int(v) if isinstance(v, int) else float(v)
+    raise ApiError(f"{where} = {_short_repr(v)}: not a scene value (numbers, strings, "
+                   "booleans, lists and mappings of them)")
+
+
+def _short_repr(v: Any) -> str:
+    text = repr(v).replace("\n", " ")
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 # ---------------------------------------------------------------------------------------
@@ -241,7 +272,8 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
                chunk_size: int | None = None, write_every: float = WRITE_EVERY,
                progress: bool = False, log: Callable[[str], None] | None = None,
                inputs: Iterable[str | Path] = (), adaptive: Options | None = None,
-               validate: bool = False) -> SweepReport:
+               validate: bool = False, connect_timeout: float = 20.0,
+               cli: bool = False) -> SweepReport:
     """Sweep ``scene`` into the result file ``path`` (``rocksweep sweep``).
 
     Makes the file (refusing an existing one unless ``overwrite``), or with ``resume``
@@ -258,27 +290,25 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
     see ``_adaptive_loop``; the file records the settings, and a resume must give the
     same); validate: with adaptive, also compute the filled points of a coarse uniform
     lattice and report those whose class differs from the fill (``report.validation``;
-    the file is not changed). Returns a ``SweepReport``.
+    the file is not changed); connect_timeout: seconds to wait for the dask scheduler
+    to answer; cli: name options as the command line spells them. Every argument is
+    checked (``rocksweep.compute.arguments``) before the output is touched. Returns a
+    ``SweepReport``.
     """
-    from rocksweep.compute import sweep as sw
-    from rocksweep.outputs import OutputError, check_output
+    from rocksweep.compute.arguments import check_sweep_arguments
+    from rocksweep.outputs import OutputError, check_output, check_path_text, shown
 
-    if resume and overwrite:
-        raise ApiError("resume and overwrite exclude each other")
-    check_write_every(write_every)
-    if chunk_size is not None and chunk_size < 1:
-        raise ApiError(f"chunk_size = {chunk_size}: must be >= 1")
-    if backend == "threads":
-        if scheduler:
-            raise ApiError("a scheduler address works with backend='dask' only")
-        n_workers = sw.check_jobs(jobs)
-    elif backend == "dask":
-        if not scheduler:
-            raise ApiError("backend 'dask' needs a scheduler address")
-        sw.check_scheduler(scheduler)  # before any file is made
-        n_workers = 1
-    else:
-        raise ApiError(f"backend = {backend!r}: must be threads or dask")
+    # every argument before anything touches the output (one place: the CLI's too)
+    n_workers = check_sweep_arguments(
+        jobs=jobs, resume=resume, overwrite=overwrite, validate=validate, adaptive=adaptive,
+        backend=backend, scheduler=scheduler, chunk_size=chunk_size, write_every=write_every,
+        connect_timeout=connect_timeout, cli=cli)
+    if path is not None:  # None: in memory (rocksweep.run without output=)
+        check_path_text(path)
+    if backend == "dask":
+        from rocksweep.compute import sweep as sw
+
+        sw.check_scheduler(scheduler, connect_timeout)  # before any file is made
     say = log or (lambda _line: None)
     settings = None
     if adaptive is not None:
@@ -313,11 +343,11 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
         sf = SweepFile.resume(path, scene, overrides, backend=how, adaptive=settings)
     else:
         if path.is_file() and not overwrite:
-            raise OutputError(f"{path}: already exists; use --resume to finish it or "
+            raise OutputError(f"{shown(path)}: already exists; use --resume to finish it or "
                               "--overwrite to replace it")
         check_output(path, overwrite=overwrite, inputs=inputs)
         sf = SweepFile.create(path, scene, overrides, overwrite=overwrite, backend=how,
-                              adaptive=settings)
+                              adaptive=settings, log=say)
     report = SweepReport(path, sf.grid.size, 0, 0, 0.0, 0.0, 0.0)
     return _drive(sf, path, report, t0, adaptive, validate, jobs=jobs, backend=backend,
                   scheduler=scheduler, chunk_size=chunk_size, where=where,
@@ -327,11 +357,9 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
 def _drive(sf, path: Path | None, report: SweepReport, t0: float,
            adaptive: Options | None, validate: bool, **loop_options: Any) -> SweepReport:
     """Compute the missing points of an open sink (a result file, or one in memory when
-    ``path`` is None: its image lands in ``report.image``), then record the session."""
+    ``path`` is None: its image lands in ``report.image``), then record the session.
+    The arguments were checked before the sink was made (``compute.arguments``)."""
     pending: list = []  # finished chunks not yet in the sink (each loop writes its own)
-    if validate and adaptive is None:
-        sf.close()
-        raise ApiError("validate=True checks an adaptive sweep; add adaptive")
     loop = (_every_point_loop if adaptive is None
             else functools.partial(_adaptive_loop, validate=validate))
     try:
@@ -552,8 +580,19 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
 
     Raises a one-line ``RocksweepError`` for a bad scene, option or output path;
     KeyboardInterrupt (``SweepInterrupted``) after saving the finished points to
-    ``output``.
+    ``output``. A wrong type (``jobs="2"``, ``overrides=5``) is a TypeError naming the
+    argument; every argument is checked before the output is touched.
     """
+    from rocksweep.compute.arguments import check_flag, check_sweep_arguments
+    from rocksweep.outputs import check_path_text
+
+    # types and ranges first: nothing below may touch ``output`` before all are checked
+    check_flag("progress", progress)
+    check_flag("adaptive", adaptive)
+    check_sweep_arguments(jobs=jobs if client is None else 1, resume=resume,
+                          overwrite=overwrite, validate=validate, adaptive=True)
+    if output is not None:
+        check_path_text(output, "output")
     sc, source = load(scene, overrides)
     opts = adaptive_options(adaptive, base=sc.refine, coarse=coarse, audit=audit, axes=axes,
                             margin=margin, final_margin=final_margin, seed=seed,
@@ -633,7 +672,8 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
 
 def _dataset(source: Path | Any) -> xr.Dataset:
     """A result file (a path, or a file object holding the bytes of one in memory) as the
-    loaded Dataset that ``open`` and ``run`` return, with the accessor registered."""
+    loaded Dataset that ``open`` and ``run`` return, with the accessor registered; a
+    damaged variable attribute is a one-line StoreError."""
     import xarray as xr
 
     from rocksweep import fields
@@ -642,8 +682,19 @@ def _dataset(source: Path | Any) -> xr.Dataset:
 
     register()  # ds.rocksweep.plot() etc.
     kwds = {"driver_kwds": {"locking": False}} if isinstance(source, Path) else {}
-    with xr.open_dataset(source, engine="h5netcdf", **kwds) as ds:
-        ds = ds.load()
+    try:
+        with xr.open_dataset(source, engine="h5netcdf", **kwds) as ds:
+            ds = ds.load()
+    except (ValueError, TypeError, KeyError, OSError, OverflowError, AttributeError,
+            IndexError) as err:  # xarray's CF decoding of a damaged attribute
+        from rocksweep.outputs import shown
+        from rocksweep.store.sweepfile import StoreError
+
+        where = shown(source) if isinstance(source, Path) else "result in memory"
+        why = (str(err).strip().splitlines() or [type(err).__name__])[0]
+        why = why if len(why) <= 160 else why[:157] + "..."
+        raise StoreError(f"{where}: damaged rocksweep result (a variable's attributes "
+                         f"cannot be decoded: {why})") from None
     for name, var in ds.data_vars.items():  # files of format 1 have neither
         f = fields.BY_NAME.get(str(name))
         if f is not None:

@@ -16,3 +16,11 @@ class RocksweepError(Exception):
 
 class OutputError(RocksweepError, OSError):
     """An output path that cannot be written (exists, is a device, no such directory...)."""
+
+
+def one_line(text: str) -> str:
+    """``text`` as one printable line: control characters (a newline, ESC), lone
+    surrogates (undecodable bytes of a damaged file) and other unprintable characters
+    escaped as in Python (``\\n``, ``\\udc91``); printable non-ASCII kept."""
+    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii")
+                   for c in text)

@@ -46,9 +46,63 @@ def _same(a: str | Path, b: str | Path) -> bool:
 
 
 def shown(path: str | Path) -> str:
-    """A path as error messages show it: long names shortened to one readable line."""
+    """A path as error messages show it: one readable line (control characters such as a
+    newline escaped as in Python, ``\\n``; long names shortened)."""
     text = str(path)
+    if any(ord(c) < 32 or ord(c) == 127 for c in text):
+        text = text.encode("unicode_escape", "backslashreplace").decode("ascii")
     return text if len(text) <= 120 else f"{text[:60]}...{text[-40:]}"
+
+
+def check_path_text(path: object, name: str = "output") -> Path:
+    """``path`` as a Path: a TypeError unless it is a ``str`` or ``os.PathLike``, an
+    OutputError for an empty path or one holding a NUL byte (no file can have it)."""
+    if isinstance(path, bytes) or not isinstance(path, str | os.PathLike):
+        raise TypeError(f"{name} = {path!r}: must be a path (str or pathlib.Path)")
+    text = os.fspath(path)
+    if isinstance(text, bytes) or not text:
+        raise OutputError(f"{name} = {path!r}: give a file name")
+    if "\0" in text:
+        raise OutputError(f"{shown(text)}: a NUL byte in a file name; no file can have it")
+    return Path(text)
+
+
+def input_problem(path: str | Path) -> str | None:
+    """Why ``path`` cannot be read as an input file (a scene, a record, a result): None
+    for a regular file; else the reason, without the path ("no such file", "a FIFO..."):
+    reading a FIFO with no writer, a character device or a directory would block or fail
+    (checked with ``stat``, which never blocks)."""
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        return "no such file"
+    except (OSError, ValueError) as err:  # ValueError: a NUL byte in the name
+        return _reason(err) if isinstance(err, OSError) else "not a valid file name"
+    if stat.S_ISDIR(st.st_mode):
+        return "is a directory, not a file"
+    if not stat.S_ISREG(st.st_mode):
+        kind = ("a FIFO (named pipe)" if stat.S_ISFIFO(st.st_mode) else
+                "a socket" if stat.S_ISSOCK(st.st_mode) else "a device")
+        return f"is {kind}, not a regular file; inputs are read from regular files only"
+    return None
+
+
+def check_distinct(paths: dict[str, str | Path | None]) -> None:
+    """Refuse (OutputError) one file given for two outputs of a command, whatever the
+    spellings (``a.png`` and ``$PWD/a.png``, a symbolic link): compared by resolved path,
+    before anything is written. paths: option name -> path (None: not given)."""
+    seen: dict[str, str] = {}
+    for option, p in paths.items():
+        if p is None:
+            continue
+        try:
+            key = os.path.realpath(p)
+        except (OSError, ValueError):
+            continue
+        if key in seen:
+            raise OutputError(f"{shown(p)}: given to both {seen[key]} and {option}; "
+                              "give each output its own file")
+        seen[key] = option
 
 
 def check_output(path: str | Path, *, overwrite: bool = False,
@@ -58,10 +112,10 @@ def check_output(path: str | Path, *, overwrite: bool = False,
     inputs: the command's input files (never written over); suffixes: allowed file
     suffixes (e.g. (".png", ".pdf", ".svg")), empty for any.
     """
-    path = Path(path)
+    path = check_path_text(path)
     suffixes = tuple(suffixes)
     if suffixes and path.suffix.lower() not in suffixes:
-        raise OutputError(f"{path}: unsupported file type {path.suffix or '(none)'!r}; "
+        raise OutputError(f"{shown(path)}: unsupported file type {path.suffix or '(none)'!r}; "
                           f"use one of {', '.join(suffixes)}")
     try:
         st = os.stat(path)
@@ -71,19 +125,19 @@ def check_output(path: str | Path, *, overwrite: bool = False,
         raise OutputError(f"{shown(path)}: cannot be written ({_reason(err)})") from None
     if st is not None:
         if stat.S_ISDIR(st.st_mode):
-            raise OutputError(f"{path}: is a directory; give a file name")
+            raise OutputError(f"{shown(path)}: is a directory; give a file name")
         if not stat.S_ISREG(st.st_mode):
-            raise OutputError(f"{path}: not a regular file (a device, FIFO or socket); "
+            raise OutputError(f"{shown(path)}: not a regular file (a device, FIFO or socket); "
                               "outputs are written to regular files only")
         if any(_same(path, inp) for inp in inputs):
-            raise OutputError(f"{path}: is this command's input; choose another output path")
+            raise OutputError(f"{shown(path)}: is this command's input; choose another output path")
         if not overwrite:
-            raise OutputError(f"{path}: already exists; use --overwrite to replace it")
+            raise OutputError(f"{shown(path)}: already exists; use --overwrite to replace it")
     parent = path.parent if str(path.parent) else Path(".")
     if not parent.is_dir():
-        raise OutputError(f"{path}: directory {parent} does not exist")
+        raise OutputError(f"{shown(path)}: directory {shown(parent)} does not exist")
     if not os.access(parent, os.W_OK | os.X_OK):
-        raise OutputError(f"{path}: directory {parent} is not writable")
+        raise OutputError(f"{shown(path)}: directory {shown(parent)} is not writable")
     try:
         name_max = os.pathconf(parent, "PC_NAME_MAX")
     except (OSError, ValueError):

@@ -244,3 +244,20 @@ def as_float(v: Any) -> float:
 def is_number(v: Any) -> bool:
     """A real number (bool is not one, although Python counts it as an int)."""
     return isinstance(v, numbers.Real) and not isinstance(v, bool | np.bool_)
+
+
+def check_option(key: str, value: Any, label: str) -> str | None:
+    """None if ``value`` is admissible for ``key`` (None: not given), else one line
+    ``LABEL VALUE: allowed``. The command line's options (``--margin 9``) and the Python
+    API's keywords (``margin = 9``) that set a scene key are checked here, against the
+    same table as the scene's own section."""
+    if value is None:
+        return None
+    spec = KEYS[key]
+    if spec.kind == "integer":
+        ok = isinstance(value, numbers.Integral) and not isinstance(value, bool | np.bool_)
+    else:
+        ok = is_number(value)
+    if ok:
+        ok = check_value(key, as_float(value)) is None and not math.isnan(as_float(value))
+    return None if ok else f"{label} {fmt(value)}: {spec.allowed}"

@@ -252,8 +252,9 @@ def test_resume_with_other_settings_is_refused(fig3_files, cli, tmp_path):
 
 @pytest.mark.parametrize("args, message", [
     (["--coarse", "2"], "--coarse is a setting of adaptive sweeps; add --adaptive"),
-    (["--adaptive", "--coarse", "-1"], "coarse = -1: must be an integer in [0, 20]"),
-    (["--adaptive", "--audit", "2"], "audit = 2.0: must be a share in [0, 1]"),
+    # the ranges of the scene's refine: section (one table, rocksweep.schema)
+    (["--adaptive", "--coarse", "-1"], "--coarse -1: must be an integer in [0, 20]"),
+    (["--adaptive", "--audit", "2"], "--audit 2.0: must be in [0, 1] (share of the filled"),
     (["--adaptive", "--axes", "w_over_p,zeta"], "axis zeta (body.zeta): a diagram axis must"),
     (["--adaptive", "--axes", "w_over_p"], "give two axis names"),
 ])

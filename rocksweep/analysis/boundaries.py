@@ -199,13 +199,23 @@ class PanelBoundaries:
 
     where: dict[str, Any]
     lines: list[BoundaryLine]
+    xname: str = DIAGRAM_AXES[0]
+    yname: str = DIAGRAM_AXES[1]
 
 
 def diagram_boundaries(scene: Scene, outcome: np.ndarray,
-                       axes: Sequence[str] = DIAGRAM_AXES) -> list[PanelBoundaries]:
-    """Boundary lines of every panel of a result (outcome: filled, no -1)."""
-    return [PanelBoundaries(p.where, boundary_lines(p.classes, p.x, p.y))
+                       axes: Sequence[str] | None = None) -> list[PanelBoundaries]:
+    """Boundary lines of every panel of a result (outcome: filled, no -1); axes: the
+    diagram's (None: the scene's, ``default_axes``)."""
+    axes = default_axes(scene) if axes is None else axes
+    return [PanelBoundaries(p.where, boundary_lines(p.classes, p.x, p.y), axes[0], axes[1])
             for p in panels(scene, outcome, axes)]
+
+
+def default_axes(scene: Scene) -> tuple[str, str]:
+    """The diagram axes of a scene: (w_over_p, A_ratio) for a pulse, (p, A_ratio) for a
+    record (its time scale is the body's p)."""
+    return (scene.freq_axis, DIAGRAM_AXES[1])
 
 
 # --- A_min ------------------------------------------------------------------------------
@@ -349,16 +359,18 @@ def csv_text(rows: Sequence[dict[str, Any]]) -> str:
     return buf.getvalue()
 
 
-def boundary_rows(bounds: Sequence[PanelBoundaries], axes: Sequence[str] = DIAGRAM_AXES
+def boundary_rows(bounds: Sequence[PanelBoundaries], axes: Sequence[str] | None = None
                   ) -> list[dict[str, Any]]:
     """One row per vertex of every boundary polyline: the non-diagram axis values, line
-    (number within the panel), classes (e.g. safe|mode1), x, y."""
+    (number within the panel), classes (e.g. safe|mode1), x, y (named after each panel's
+    diagram axes unless ``axes`` names them)."""
     rows = []
     for b in bounds:
+        names = axes if axes is not None else (b.xname, b.yname)
         for n, line in enumerate(b.lines):
             for xv, yv in line.xy:
                 rows.append({**b.where, "line": n, "classes": line.label,
-                             axes[0]: float(xv), axes[1]: float(yv)})
+                             names[0]: float(xv), names[1]: float(yv)})
     return rows
 
 
@@ -466,10 +478,12 @@ def scene_of(result: SweepResult) -> Scene:
     return result_scene(result)
 
 
-def check_result(result: SweepResult, axes: Sequence[str] = DIAGRAM_AXES) -> Scene:
-    """The scene of a complete result with the diagram axes ``axes`` (x, y); one-line
-    BoundaryErrors for a result that has no such diagram or is not finished."""
+def check_result(result: SweepResult, axes: Sequence[str] | None = None) -> Scene:
+    """The scene of a complete result with the diagram axes ``axes`` (x, y; None: the
+    scene's, ``default_axes``); one-line BoundaryErrors for a result that has no such
+    diagram or is not finished."""
     sc = scene_of(result)
+    axes = default_axes(sc) if axes is None else axes
     try:
         make_plan(sc, axes, coarse=0, audit=0.0)
     except AdaptiveError as err:
@@ -484,11 +498,13 @@ def check_result(result: SweepResult, axes: Sequence[str] = DIAGRAM_AXES) -> Sce
 
 
 def result_curves(result: SweepResult, rtol: float = DEFAULT_RTOL, mode: int | None = None,
-                  axes: Sequence[str] = DIAGRAM_AXES, evaluate: Evaluator | None = None
+                  axes: Sequence[str] | None = None, evaluate: Evaluator | None = None
                   ) -> tuple[list[AMinCurve], list[PanelBoundaries]]:
     """A_min curves (bisected to ``rtol``; ``mode``: None any, 1 or 2) and boundary lines
-    of every panel of a result read with ``outcome`` (``store.read_result``)."""
+    of every panel of a result read with ``outcome`` (``store.read_result``); axes: the
+    diagram's (None: the scene's, (p, A_ratio) for a record)."""
     sc = check_result(result, axes)
+    axes = default_axes(sc) if axes is None else axes
     outcome = np.asarray(result.arrays["outcome"])
     curves = a_min(sc, outcome, rtol, axes, mode, evaluate)
     return curves, diagram_boundaries(sc, outcome, axes)

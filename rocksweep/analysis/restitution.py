@@ -47,6 +47,12 @@ class RestitutionTable:
                 "e_housner_rigid": self.e_housner}
 
 
+# Values of a restitution table (n_lam x n_u) at most: ~16 float64 temporaries of the
+# table's size are alive while eq. (1) is evaluated (a few hundred MB at this bound); a
+# figure needs a few thousand.
+MAX_TABLE = 2_000_000
+
+
 def restitution_table(scene: Scene, n_lam: int = 101, n_u: int = 81) -> RestitutionTable:
     """eq. (1) for the scene's body over lam in [0, 1] (n_lam values) and u/u_cr in
     [-2, 2] (n_u values). The scene must hold one body (a SceneError names a swept body
@@ -60,6 +66,10 @@ def restitution_table(scene: Scene, n_lam: int = 101, n_u: int = 81) -> Restitut
     for name, n in (("n_lam", n_lam), ("n_u", n_u)):
         if n < 2:
             raise SceneError(f"{name} = {n}: must be >= 2")
+    if n_lam * n_u > MAX_TABLE:
+        raise SceneError(f"n_lam x n_u = {n_lam} x {n_u} = {n_lam * n_u:,} values: at most "
+                         f"{MAX_TABLE:,} (a table of that many takes ~"
+                         f"{16 * 8 * n_lam * n_u / 2**30:.1f} GiB to compute); use fewer")
     body = scene.make_body(**{a.name: a.values[0] for a in scene.body_axes()})
     lam = np.linspace(0.0, 1.0, n_lam)
     u_over_ucr = np.linspace(-2.0, 2.0, n_u)

@@ -62,11 +62,13 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
     rest_rate, max_events and root for every run; the ladder sets steps_per_period and
     event_tol.
     """
-    from rocksweep.outputs import check_output
+    from rocksweep.outputs import check_distinct, check_output
 
+    if not 0 <= seed < 2**63:
+        raise click.ClickException(f"--seed {seed}: must be an integer in [0, 2^63) (the "
+                                   "sampling seed)")
     # refuse a bad output before the (long) study
-    if report_path is not None and plot_path is not None and report_path == plot_path:
-        raise click.ClickException(f"-o and --plot name the same file {report_path}")
+    check_distinct({"-o": report_path, "--plot": plot_path})  # by resolved path
     if report_path is not None:
         check_output(report_path, overwrite=overwrite, inputs=[scene_path])
     if plot_path is not None:

@@ -38,7 +38,7 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
     the lines between classes as polylines. Works on adaptive and regular results."""
     from rocksweep.analysis import boundaries as bd
     from rocksweep.figures.common import FORMATS, save_figure
-    from rocksweep.outputs import check_output, write_atomic
+    from rocksweep.outputs import check_distinct, check_output, write_atomic
     from rocksweep.store.sweepfile import read_result
 
     if not (0 < rtol < 1):
@@ -51,9 +51,7 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
             f"-o {out}: unsupported suffix {out.suffix or '(none)'!r}; use "
             f"{', '.join(bd.CURVE_SUFFIXES[:-1])} or {bd.CURVE_SUFFIXES[-1]}")
     # refuse bad outputs before any kernel run
-    outs = [p for p in (out, lines_path, fig_path) if p is not None]
-    if len({str(p.resolve()) for p in outs}) < len(outs):
-        raise click.ClickException("-o, --lines and --plot must name different files")
+    check_distinct({"-o": out, "--lines": lines_path, "--plot": fig_path})
     check_output(out, overwrite=overwrite, inputs=[result_path])
     if lines_path is not None:
         check_output(lines_path, overwrite=overwrite, inputs=[result_path])

@@ -26,5 +26,7 @@ def info(result_path: Path, as_json: bool) -> None:
     if as_json:
         click.echo(json.dumps(d, indent=2))
         return
-    for line in format_info(d):
-        click.echo(line)
+    from rocksweep.errors import one_line
+
+    for line in format_info(d):  # a damaged file's strings may hold undecodable bytes
+        click.echo(one_line(line))

@@ -15,7 +15,7 @@ import click
 
 import rocksweep
 from rocksweep.cli.options import overwrite_option, scene_argument, set_option  # noqa: F401
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import RocksweepError, one_line
 
 
 def user_errors(fn):
@@ -27,7 +27,7 @@ def user_errors(fn):
         try:
             return fn(*args, **kwargs)
         except RocksweepError as err:
-            raise click.ClickException(str(err)) from None
+            raise click.ClickException(one_line(str(err))) from None
 
     return wrapper
 

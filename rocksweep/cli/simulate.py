@@ -47,10 +47,9 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     lost in impacts and in the damper, and the accuracy setting with its cost.
     """
     from rocksweep.api import simulate_runs, write_history_csv
-    from rocksweep.outputs import check_output
+    from rocksweep.outputs import check_distinct, check_output
 
-    if plot_path is not None and csv_path is not None and plot_path == csv_path:
-        raise click.ClickException(f"--plot and --csv name the same file {plot_path}")
+    check_distinct({"--plot": plot_path, "--csv": csv_path})  # by resolved path
     if plot_path is not None:
         from rocksweep.figures.common import FORMATS
 

@@ -32,6 +32,9 @@ WRITE_EVERY = 1.0  # = rocksweep.api.WRITE_EVERY (not imported here: --help stay
                    "dask.distributed cluster.")
 @click.option("--scheduler", metavar="ADDRESS",
               help="dask scheduler address (with --backend dask), e.g. tcp://host:8786.")
+@click.option("--connect-timeout", "connect_timeout", type=float, default=20.0,
+              show_default=True, metavar="SECONDS",
+              help="With --backend dask: wait this long for the scheduler to answer.")
 @click.option("--chunk-size", type=click.IntRange(1, None), default=None,
               help="Points per chunk [default: about 32 chunks per worker, at most 1024].")
 @click.option("--write-every", "write_every", type=float, default=WRITE_EVERY,
@@ -81,8 +84,9 @@ WRITE_EVERY = 1.0  # = rocksweep.api.WRITE_EVERY (not imported here: --help stay
 @user_errors
 def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, jobs: int,
           resume: bool, overwrite: bool, quiet: bool, backend: str, scheduler: str | None,
-          chunk_size: int | None, write_every: float, adaptive: bool, coarse: int | None,
-          audit: float | None, adaptive_axes: str | None, margin: int | None,
+          connect_timeout: float, chunk_size: int | None, write_every: float,
+          adaptive: bool, coarse: int | None, audit: float | None,
+          adaptive_axes: str | None, margin: int | None,
           final_margin: int | None, seed: int | None, threshold: float | None,
           validate: bool, contact: bool, check: bool, dry_run: bool) -> None:
     """Compute the stability diagram of SCENE.yaml: every point of its grid.
@@ -100,19 +104,20 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
         overrides = (*overrides, "outputs.contact=true")
     if check:
         overrides = (*overrides, "outputs.check=true")
-    if resume and overwrite:
-        raise click.ClickException("--resume and --overwrite exclude each other")
-    if backend == "dask":
-        if not scheduler:
-            raise click.ClickException("--backend dask needs --scheduler ADDRESS")
-    elif scheduler:
-        raise click.ClickException("--scheduler works with --backend dask only")
     from rocksweep import api
-    from rocksweep.compute import sweep as sw
+    from rocksweep.compute.arguments import check_sweep_arguments
+    from rocksweep.schema import check_option
 
-    if backend == "threads":
-        sw.check_jobs(jobs, "--jobs")
-    api.check_write_every(write_every, "--write-every")
+    # the arguments that need no scene, before it is read (all again in api.sweep_file)
+    check_sweep_arguments(jobs=jobs, resume=resume, overwrite=overwrite, backend=backend,
+                          scheduler=scheduler, chunk_size=chunk_size, write_every=write_every,
+                          connect_timeout=connect_timeout, cli=True)
+    for key, value in (("coarse", coarse), ("audit", audit), ("margin", margin),
+                       ("final_margin", final_margin), ("seed", seed),
+                       ("threshold", threshold)):
+        msg = check_option(f"refine.{key}", value, f"--{key.replace('_', '-')}")
+        if msg is not None:  # the ranges of the scene's refine: section, one table
+            raise click.ClickException(msg)
     settings = {"coarse": coarse, "audit": audit, "axes": adaptive_axes, "margin": margin,
                 "final_margin": final_margin, "seed": seed, "threshold": threshold}
     given = [k for k, v in settings.items() if v is not None]
@@ -141,7 +146,8 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
                                 overwrite=overwrite, backend=backend, scheduler=scheduler,
                                 chunk_size=chunk_size, write_every=write_every,
                                 progress=not quiet, log=say, inputs=[scene_path],
-                                adaptive=options, validate=validate)
+                                adaptive=options, validate=validate,
+                                connect_timeout=connect_timeout, cli=True)
     except api.SweepInterrupted as stop:
         r = stop.report
         click.echo(f"\ninterrupted: {r.points_done} of {r.points_total} points saved in "

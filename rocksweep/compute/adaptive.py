@@ -59,6 +59,7 @@ import numpy as np
 from rocksweep.compute.grid import ChunkRows, Grid
 from rocksweep.errors import RocksweepError
 from rocksweep.scene.scene import Scene
+from rocksweep.schema import check_option
 
 # ``computed`` flags (int8 per point).
 FILLED = 0  # not computed: outcome holds the class filled from its uniform cell
@@ -170,6 +171,9 @@ def make_plan(grid_or_scene: Grid | Scene, axes: Sequence[str] = DIAGRAM_AXES,
     names = [a.name for a in scene.axes]
     if isinstance(axes, str) or len(axes) != 2:
         raise AdaptiveError(f"axes = {axes!r}: give two axis names (x, y)")
+    by_key = {a.key: a.name for a in scene.axes}
+    # a dotted scene key (pulse.w_over_p) names its axis, as in refine.axes and plot --x
+    axes = [by_key.get(a, a) if isinstance(a, str) else a for a in axes]
     pos = []
     for name in axes:
         if name not in names:
@@ -217,7 +221,11 @@ class Options:
     threshold: float = DEFAULT_AUDIT_THRESHOLD
 
     def __post_init__(self) -> None:
-        _share("threshold", self.threshold)
+        # the ranges of the scene's refine: section (one table, rocksweep.schema)
+        for name in ("coarse", "audit", "margin", "final_margin", "seed", "threshold"):
+            msg = check_option(f"refine.{name}", getattr(self, name), f"{name} =")
+            if msg is not None:
+                raise AdaptiveError(msg)
 
     def plan(self, grid_or_scene: Grid | Scene) -> Plan:
         """The plan of a grid (AdaptiveError for bad axes or settings)."""

@@ -20,7 +20,6 @@ take long (long pulses at small omega/p, chattering) do not leave a worker idle 
 from __future__ import annotations
 
 import math
-import os
 import time
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
@@ -28,23 +27,21 @@ from dataclasses import dataclass
 import numpy as np
 
 from rocksweep import fields
+from rocksweep.compute.arguments import (  # noqa: F401 (re-exported)
+    CONNECT_TIMEOUT,
+    MAX_JOBS_PER_CORE,
+    SweepError,
+    check_jobs,
+    probe_scheduler,
+)
 from rocksweep.compute.grid import ChunkRows, Grid
-from rocksweep.errors import RocksweepError
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.points import with_record
 from rocksweep.scene.scene import Scene
 
-
-class SweepError(RocksweepError, ValueError):
-    """A sweep that cannot run as asked (workers, cluster); ``str()`` is one line."""
-
-
 # Upper bound of the automatic chunk size [points]; see ``auto_chunk_size``.
 MAX_CHUNK = 1024
-# Local worker threads allowed per core: the chunk kernels keep a core busy, so threads
-# beyond a few per core only wait (and a typo like 99999999999999999999 must not start them).
-MAX_JOBS_PER_CORE = 4
 # A dask cluster with no worker for this long [s] ends the sweep with an error (at the
 # start: none joined; mid-sweep: all left), instead of waiting for ever.
 NO_WORKERS_TIMEOUT = 60.0
@@ -167,23 +164,6 @@ def merge_contiguous(results: Iterable[ChunkResult]) -> list[ChunkResult]:
     return merged
 
 
-def check_jobs(jobs: int, name: str = "jobs =") -> int:
-    """Number of local worker threads for ``jobs`` (-1: one per core); a one-line
-    ``SweepError`` for 0, other negatives and more than ``MAX_JOBS_PER_CORE`` threads per
-    core. name: how the message names the option ("--jobs" on the command line)."""
-    n = os.cpu_count() or 1
-    if jobs == -1:
-        return n
-    if jobs < 1:
-        raise SweepError(f"{name} {jobs}: give a number >= 1, or -1 for all cores")
-    cap = MAX_JOBS_PER_CORE * n
-    if jobs > cap:
-        raise SweepError(f"{name} {jobs}: at most {cap} ({MAX_JOBS_PER_CORE} x the {n} "
-                         f"core{'s' * (n > 1)} of this machine: each thread keeps a core busy, "
-                         "so more threads only wait for one)")
-    return jobs
-
-
 def effective_jobs(jobs: int) -> int:
     """Number of local workers for ``jobs`` (-1: all cores); see ``check_jobs``."""
     return check_jobs(jobs)
@@ -235,18 +215,23 @@ def kernel_cache_state(grid: Grid, level: int) -> tuple[int, int]:
     return sum(s is False for s in states), sum(s is None for s in states)
 
 
-def check_scheduler(address: str, timeout: float = 10.0) -> None:
-    """A one-line ``SweepError`` unless a dask scheduler answers at ``address``."""
+def check_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
+    """A one-line ``SweepError`` unless a dask scheduler answers at ``address`` within
+    ``timeout`` seconds (``arguments.probe_scheduler`` first: dask's own timeout does not
+    bound a port that accepts and never answers)."""
     try:
         from distributed import Client
     except ImportError:
         raise SweepError("the dask backend needs dask and distributed: "
                          "pip install 'rocksweep[dask]'") from None
+    probe_scheduler(address, timeout)
     try:
         Client(address, timeout=f"{timeout}s").close()
     except (OSError, TimeoutError, ValueError) as err:
         raise SweepError(f"scheduler {address}: cannot reach a dask scheduler there "
-                         f"({type(err).__name__})") from None
+                         f"({type(err).__name__}); check the address, then run the same "
+                         "command again (with --resume to finish a file already started)"
+                         ) from None
 
 
 def run_chunks(grid: Grid, chunks: Iterable[tuple[int, int]], level: int, jobs: int = 1,

@@ -13,7 +13,14 @@ import numpy as np
 
 from rocksweep.kernel import layout as L
 from rocksweep.kernel.equations import rocking_spring_omega
-from rocksweep.numerics import ROOTS, Numerics, amplitude_frequency, step_budget, step_size
+from rocksweep.numerics import (
+    EVENT_STEP_ALLOWANCE,
+    ROOTS,
+    Numerics,
+    amplitude_frequency,
+    step_budget,
+    step_size,
+)
 from rocksweep.physics.model import Body, FlexibleBody, G
 from rocksweep.physics.records import GroundRecord
 
@@ -163,8 +170,11 @@ def record_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, p: np.ndarray,
 
     The step after the record is the regular ``step_size`` without a pulse period (dt).
     While the record acts the step is h_rec = p DT / m, m = ceil(p DT / dt): the largest
-    step of at most dt that lands on every sample time (the kernel's PAR_REC_H). Returns
-    (dt, h_rec, t_pulse = p (npts - 1) DT, t_end = t_pulse + horizon, step cap), p*t.
+    step of at most dt that lands on every sample time (the kernel's PAR_REC_H); after the
+    last sample the kernel steps at dt again, so the cap counts the record's time at h_rec
+    and the free vibration after it at dt (a short record sampled at 100 kHz costs what
+    its duration asks, not its horizon at the sample spacing). Returns (dt, h_rec,
+    t_pulse = p (npts - 1) DT, t_end = t_pulse + horizon, step cap), p*t.
     """
     p = np.asarray(p, float)
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
@@ -174,7 +184,9 @@ def record_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, p: np.ndarray,
         h_rec = dt_k / np.ceil(dt_k / dt)
         t_pulse = p * record.duration
         t_end = t_pulse + numerics.horizon
-        max_steps = step_budget(t_end, np.minimum(dt, h_rec), numerics)
+        steps = np.ceil(t_pulse / h_rec) + np.ceil(numerics.horizon / dt) + 1.0
+        max_steps = numerics.max_steps_factor * steps + EVENT_STEP_ALLOWANCE * (
+            numerics.max_events)
     return dt, h_rec, t_pulse, t_end, max_steps
 
 

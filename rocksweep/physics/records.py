@@ -40,13 +40,13 @@ import hashlib
 import math
 import re
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from rocksweep.errors import RocksweepError
-from rocksweep.outputs import check_output, shown, write_atomic
+from rocksweep.outputs import check_output, input_problem, shown, write_atomic
 
 
 class RecordError(RocksweepError, ValueError):
@@ -60,7 +60,8 @@ class GroundRecord:
     name: the file's stem; dt [s]: sample interval; acc [g]: (npts,) float64, read-only,
     acc[i] at t = i dt; npts: number of samples; pga [g]: max |acc| (> 0); sha256: hex
     digest of the file's bytes; source: the path read; title: the AT2 file's second
-    header line (event, station, component), '' for a two-column file.
+    header line (event, station, component), '' for a two-column file; data: the file's
+    bytes (a result file keeps them, so that it stands alone).
     """
 
     name: str
@@ -71,6 +72,7 @@ class GroundRecord:
     sha256: str
     source: str
     title: str = ""
+    data: bytes = field(default=b"", repr=False)  # the file's bytes (stored in results)
 
     @property
     def duration(self) -> float:
@@ -112,6 +114,9 @@ _TOKEN = re.compile(rf"\s*({_NUMBER}|[-+]?(?:nan|inf(?:inity)?))(?=[\s+-]|$)", r
 _NGA_HEADER = re.compile(r"^\s*NPTS\s*=\s*([^\s,]+)\s*,?\s*DT\s*=\s*([^\s,]+)", re.IGNORECASE)
 _OLD_HEADER = re.compile(r"^\s*([^\s,]+)\s*,?\s+([^\s,]+)\s+NPTS\s*,?\s*DT\b", re.IGNORECASE)
 _NPTS_MIN = 2
+# Sample spacing of a record [s]: 1 MHz to one sample every 10 s bound any ground motion
+# recorder; beyond, DT is a typo (1e300 would overflow the run's length, 1e-300 its steps).
+DT_MIN, DT_MAX = 1e-6, 10.0
 
 
 def _where(src: str, line: int | None = None) -> str:
@@ -244,20 +249,28 @@ def parse_record(data: bytes, source: str | Path) -> GroundRecord:
         dt, acc, title = _parse_at2(lines, src)
     else:
         dt, acc, title = _parse_two_column(lines, src)
+    if not DT_MIN <= dt <= DT_MAX:
+        raise RecordError(f"{_where(src)}: DT = {dt:g} s: the sample spacing must be in "
+                          f"[{DT_MIN:g}, {DT_MAX:g}] s")
     pga = float(np.max(np.abs(acc)))
     if pga == 0.0:
         raise RecordError(f"{_where(src)}: every value is 0 (PGA = 0): no motion to scale")
     acc.setflags(write=False)
     return GroundRecord(name=path.stem, dt=float(dt), acc=acc, npts=int(acc.size), pga=pga,
-                        sha256=hashlib.sha256(data).hexdigest(), source=src, title=title)
+                        sha256=hashlib.sha256(data).hexdigest(), source=src, title=title,
+                        data=bytes(data))
 
 
 def read_record(path: str | Path) -> GroundRecord:
-    """Read a ``.AT2`` (NGA-West2 or older PEER) or two-column record file."""
+    """Read a ``.AT2`` (NGA-West2 or older PEER) or two-column record file (a regular
+    file: a FIFO, device or directory is refused before it is opened, never waited on)."""
+    problem = input_problem(path)
+    if problem == "is a directory, not a file":
+        raise RecordError(f"{_where(str(path))}: is a directory, not a record file")
+    if problem is not None and problem != "no such file":
+        raise RecordError(f"{_where(str(path))}: {problem}")
     try:
         data = Path(path).read_bytes()
-    except IsADirectoryError:
-        raise RecordError(f"{_where(str(path))}: is a directory, not a record file") from None
     except OSError as err:
         raise RecordError(f"{_where(str(path))}: cannot be read "
                           f"({err.strerror or type(err).__name__})") from None

@@ -34,6 +34,7 @@ from rocksweep.numerics import (
     PRESETS,
     Numerics,
 )
+from rocksweep.outputs import input_problem, shown
 from rocksweep.physics.model import BlockBody, Body, BodyError, FlexibleBody
 from rocksweep.physics.points import RECORD, Point, body_omega_rock, record_cost, run_cost
 from rocksweep.physics.records import GroundRecord, RecordError, read_record
@@ -65,10 +66,17 @@ MAX_AXIS_VALUES = 1_000_000
 # Nesting of the scene's YAML (a scene needs 3 levels: section, key, range or list).
 # PyYAML composes nodes recursively; 3000 levels would end in a RecursionError.
 MAX_DEPTH = 20
+# Expanded size of a scene's YAML [characters of scalars + nodes], aliases counted at each
+# use, beyond the text's own length: an alias bomb (9 levels of 9 aliases in 640 bytes)
+# expands to ~4e8 nodes and took 4 GB and 35 s to build; it is refused before it is built.
+MAX_EXPANDED = 4_000_000
 # Body grids up to this many distinct bodies are checked body by body; larger ones at the
 # combinations of each key's extreme values (``_candidate_bodies``).
 MAX_BODIES_CHECKED = 1024
 PULSE_AXES = ("A_ratio", "w_over_p")
+# The pulse shapes each optional pulse key means something for (rocksweep.physics.excitation);
+# given for none of the scene's shapes, the key is refused (it would be silently ignored).
+PULSE_KEY_SHAPES = {"cycles": ("sine", "cosine"), "gamma": ("mp",), "nu": ("mp",)}
 # Typical values (Table 3; the `default` numerics) that the cost check puts in place of a
 # value, one at a time, to find which value makes a point too costly.
 _TAME = {"body.wn_over_p": 2.43, "body.zeta": 0.05, "body.alpha_cg": 0.15,
@@ -98,6 +106,45 @@ class SceneLoader(yaml.SafeLoader):
     def __init__(self, stream: str) -> None:
         super().__init__(stream)
         self._depth = 0
+        self._limit = max(MAX_EXPANDED, 2 * len(stream))
+
+    def get_single_data(self) -> Any:
+        node = self.get_single_node()
+        if node is None:
+            return None
+        self._check_expanded(node)
+        return self.construct_document(node)
+
+    def _check_expanded(self, root: yaml.Node) -> None:
+        """Refuse a document whose expansion (aliases repeated at every use) exceeds the
+        limit, counting on the composed graph (each node once, memoised): nothing of the
+        expansion is built."""
+        sizes: dict[int, int] = {}
+        active: set[int] = set()
+
+        def size(node: yaml.Node) -> int:
+            key = id(node)
+            if key in sizes:
+                return sizes[key]
+            if key in active:
+                raise _YamlError(f"error at line {node.start_mark.line + 1}: an alias "
+                                 "refers to a node that contains it (a recursive structure)")
+            active.add(key)
+            if isinstance(node, yaml.ScalarNode):
+                n = 1 + len(node.value)
+            elif isinstance(node, yaml.SequenceNode):
+                n = 1 + sum(size(x) for x in node.value)
+            else:
+                n = 1 + sum(size(k) + size(v) for k, v in node.value)
+            active.discard(key)
+            if n > self._limit:
+                raise _YamlError(f"expands to more than {self._limit:,} characters (aliases "
+                                 "repeated at every use, e.g. an alias bomb); write the "
+                                 "values out or use fewer aliases")
+            sizes[key] = n
+            return n
+
+        size(root)
 
     def compose_node(self, parent: Any, index: Any) -> Any:
         self._depth += 1
@@ -133,8 +180,28 @@ SceneLoader.add_implicit_resolver(
     list("-+0123456789."))
 
 
+_NOT_YAML = re.compile(  # PyYAML's reader refuses these (yaml.reader.Reader.NON_PRINTABLE)
+    r"[^\x09\x0a\x0d\x20-\x7e\x85\xa0-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f]")  # C0 controls but tab and newline
+
+
+def _control_character(text: str) -> str | None:
+    """Where ``text`` holds a character YAML refuses to read (NUL, BEL, ESC, other C0/C1
+    controls but tab and newlines): 'character 0x07 at line 2, column 7', or None."""
+    m = _NOT_YAML.search(text)
+    if m is None:
+        return None
+    line = text.count("\n", 0, m.start()) + 1
+    column = m.start() - (text.rfind("\n", 0, m.start()) + 1) + 1
+    return f"character {ord(m.group()):#04x} at line {line}, column {column}"
+
+
 def _load_yaml(text: str) -> Any:
     """Parse YAML text with ``SceneLoader``; problems raise ``_YamlError``."""
+    bad = _control_character(text)
+    if bad is not None:
+        raise _YamlError(f"error: {bad} is a control character (NUL, BEL, ESC...); a "
+                         "scene is plain text")
     loader = SceneLoader(text)
     try:
         return loader.get_single_data()
@@ -143,6 +210,8 @@ def _load_yaml(text: str) -> Any:
         problem = getattr(err, "problem", None) or "invalid YAML"
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         raise _YamlError(f"syntax error{where}: {problem}") from None
+    except RecursionError:
+        raise _YamlError("error: nested too deeply") from None
     finally:
         loader.dispose()
 
@@ -306,19 +375,27 @@ def apply_overrides(raw: dict, overrides: list[str]) -> dict:
 
 
 def parse_scene(text: str, source: str = "scene", overrides: list[str] | None = None,
-                base: str | Path | None = None) -> Scene:
+                base: str | Path | None = None, record: GroundRecord | None = None) -> Scene:
     """Validate scene YAML text. Raises SceneError (one line, prefixed by ``source``).
 
     base: the directory a ``ground.record`` path is relative to (the scene file's; None:
-    the working directory)."""
+    the working directory); record: the record of a ``ground`` section, already read (a
+    result file's stored copy): the ``ground.record`` path is then not read."""
     try:
-        return _parse(text, overrides or [], Path(base) if base is not None else None)
+        return _parse(text, overrides or [], Path(base) if base is not None else None,
+                      record)
     except SceneError as err:
         raise SceneError(f"{source}: {err}") from None
 
 
 def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
+    """The validated scene of a YAML file (a regular file: a FIFO, device or directory is
+    refused before it is opened, never waited on)."""
     path = Path(path)
+    problem = input_problem(path)
+    if problem is not None:
+        raise SceneError(f"{shown(path)}: {problem}" if problem != "no such file"
+                         else f"{shown(path)}: no such scene file")
     try:
         text = path.read_text()
     except OSError as err:
@@ -511,6 +588,7 @@ def _pulse_options(pulse: dict, shapes: tuple[str, ...]) -> list[Axis]:
         key = f"pulse.{k}"
         spec = KEYS[key]
         v = pulse.get(k)
+        given = v is not None
         if v is None:
             if not (k != "cycles" and "mp" in shapes):
                 continue
@@ -519,6 +597,13 @@ def _pulse_options(pulse: dict, shapes: tuple[str, ...]) -> list[Axis]:
             else is_number(v)
         if not ok or check_values(key, np.array([as_float(v)])) is not None:
             raise SceneError(f"{key} = {fmt(v)}: {spec.allowed}")
+        if given:
+            applies = PULSE_KEY_SHAPES[k]
+            if not set(applies) & set(shapes):
+                which = (f"the scene's shapes are {', '.join(shapes)}" if len(shapes) > 1
+                         else f"the scene's shape is {shapes[0]}")
+                raise SceneError(f"{key} = {fmt(v)}: applies to {' and '.join(applies)} pulses "
+                                 f"only ({which}); remove it or sweep one of those shapes")
         out.append(Axis(k, key, (int(v) if spec.kind == "integer" else float(v),), False))
     return out
 
@@ -702,7 +787,8 @@ def _suite(ground: dict, base: Path | None) -> tuple[Suite, tuple[str, str, Any]
     return suite, ((im, form, spec) if im else None)
 
 
-def _parse(text: str, overrides: list[str], base: Path | None = None) -> Scene:
+def _parse(text: str, overrides: list[str], base: Path | None = None,
+           given_record: GroundRecord | None = None) -> Scene:
     try:
         raw = _load_yaml(text)
     except _YamlError as err:
@@ -719,6 +805,9 @@ def _parse(text: str, overrides: list[str], base: Path | None = None) -> Scene:
     name = raw.get("name")
     if name is not None and not isinstance(name, str):
         raise SceneError(f"name = {fmt(name)}: {KEYS['name'].allowed}")
+    if name is not None and _CONTROL.search(name):
+        raise SceneError(f"name = {fmt(name)}: must not hold control characters (NUL, BEL, "
+                         "ESC...): it is stored in the result file and printed")
 
     body = _section(raw, "body", "flexible", required=True)
     kind = body.get("kind", "flexible")
@@ -746,7 +835,7 @@ def _parse(text: str, overrides: list[str], base: Path | None = None) -> Scene:
             if ground.get("A_ratio") is None:
                 raise SceneError("ground.A_ratio: missing required key (a number, a list of "
                                  "numbers or a range {start, stop, num})")
-            record = _record(ground, base)
+            record = _record(ground, base) if given_record is None else given_record
             pulse = {"shape": RECORD, "A_ratio": ground["A_ratio"], "p": ground["p"]}
     else:
         pulse = _section(raw, "pulse", kind, required=True)
@@ -905,11 +994,13 @@ def _check_record_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
                     c = float(cap[0])
                     if not (c <= MAX_POINT_STEPS):
                         raise SceneError(
-                            f"ground.p = {fmt(float(pv))}: one point could need {c:.2g} RK4 "
-                            f"steps{label} (the record's {rec.npts} samples at steps of "
-                            f"{float(h_rec[0]):.3g} p*t, then {n.horizon:g} p*t of free "
-                            f"vibration), more than the cap of {MAX_POINT_STEPS:.0e} a point;"
-                            " use a smaller p, fewer steps_per_period or a shorter horizon")
+                            f"ground.record {rec.name}: {rec.npts} samples at DT = "
+                            f"{rec.dt:g} s ({rec.duration:g} s) with ground.p = "
+                            f"{fmt(float(pv))}: one point could need {c:.2g} RK4 steps{label}"
+                            f" (the record at steps of {float(h_rec[0]):.3g} p*t, then "
+                            f"{n.horizon:g} p*t of free vibration), more than the cap of "
+                            f"{MAX_POINT_STEPS:.0e} a point; use a smaller p, fewer "
+                            "steps_per_period or a shorter horizon")
 
 
 def _check_suite_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:

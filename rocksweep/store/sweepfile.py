@@ -64,7 +64,10 @@ import os
 import platform
 import re
 import shutil
+import stat
 import tempfile
+import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
@@ -90,9 +93,13 @@ FORMAT = "rocksweep-sweep"
 FORMAT_VERSION = 2
 CONVENTIONS = "CF-1.10"
 
-# Free space required beyond the datasets' bytes when a file is made [bytes]: HDF5
-# metadata (attributes, object headers, the scene text) is well under 100 kB.
-SPACE_MARGIN = 1 << 20
+# Free space required beyond the space a new file reserves (``_space_needed``): a share of
+# the file, at least this many bytes [bytes], so that a small sweep fits a small disk and
+# a large one leaves room for the file system's own blocks.
+SPACE_MARGIN = 64 << 10
+SPACE_SHARE = 1 / 64
+# Space for attribute updates of a format-1 file on resume [bytes].
+UPDATE_MARGIN = 1 << 20
 # Space reserved for HDF5's metadata when a file is made [bytes], beyond the datasets and
 # the scene text: HDF5 fails badly when a metadata write hits a full disk (a segmentation
 # fault in the next flush), so the whole file's space is reserved before it is written.
@@ -371,6 +378,85 @@ def _reserve(path: Path, nbytes: int) -> None:
             raise
     finally:
         os.close(fd)
+
+
+def _reserve_bytes(scene: Scene, nbytes: int) -> int:
+    """Bytes a new result file of ``scene`` reserves: its datasets (``nbytes``), HDF5's
+    metadata, the scene text and the record (its file and samples, ``_store_record``)."""
+    rec = (8 * int(scene.record.npts) + len(scene.record.data) + (16 << 10)
+           if scene.record is not None else 0)
+    return nbytes + METADATA_RESERVE + 4 * len(scene.text.encode()) + rec
+
+
+def _space_needed(reserve: int) -> int:
+    """Free space required to make a file that reserves ``reserve`` bytes: those and a
+    margin that scales with them (``SPACE_SHARE``, at least ``SPACE_MARGIN``)."""
+    return reserve + max(SPACE_MARGIN, int(reserve * SPACE_SHARE))
+
+
+_PARTIAL = re.compile(r"\.(?:(\d+)-)?[a-z0-9_]{8}\.partial")
+STALE_AGE = 60.0  # [s] a partial file without a writer's pid is stale when this old
+
+
+def partial_prefix(path: Path) -> str:
+    """The prefix of the temporary names a new result file at ``path`` is made under: the
+    writer's pid is part of the name (``.out.h5.1234-abcd1234.partial``)."""
+    return f".{path.name[:40]}.{os.getpid()}-"
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # exists, another user's
+        return True
+    return True
+
+
+def clean_stale_partials(path: Path) -> list[tuple[str, int]]:
+    """Remove the temporary files of earlier attempts to make ``path`` that no live writer
+    owns (a sweep killed while the file was made leaves one of the reserved size): its
+    writer's process is gone (or, for a name without a pid, it is older than STALE_AGE)
+    and no process holds its lock. Returns (name, bytes) of each file removed."""
+    import fcntl
+
+    parent = path.parent if str(path.parent) else Path(".")
+    head = f".{path.name[:40]}"
+    removed = []
+    try:
+        names = [n for n in os.listdir(parent) if n.startswith(head) and n.endswith(".partial")]
+    except OSError:
+        return []
+    for name in names:
+        m = _PARTIAL.fullmatch(name[len(head):])
+        if m is None:
+            continue
+        full = parent / name
+        try:
+            st = os.lstat(full)
+        except OSError:
+            continue
+        if not stat.S_ISREG(st.st_mode):
+            continue
+        if m.group(1) is not None:
+            if int(m.group(1)) == os.getpid() or _alive(int(m.group(1))):
+                continue
+        elif time.time() - st.st_mtime < STALE_AGE:
+            continue
+        try:
+            fd = os.open(full, os.O_RDONLY | getattr(os, "O_CLOEXEC", 0))
+        except OSError:
+            continue
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # HDF5's writer lock
+            os.unlink(full)
+            removed.append((name, st.st_size))
+        except OSError:  # locked: a live writer (or no flock here: leave it)
+            pass
+        finally:
+            os.close(fd)
+    return removed
 
 
 def _check_space(path: Path, need: int, what: str) -> None:
@@ -748,7 +834,8 @@ class SweepFile:
     @classmethod
     def create(cls, path: str | Path, scene: Scene, overrides: tuple[str, ...] = (),
                overwrite: bool = False, *, backend: str | None = None,
-               adaptive: dict | None = None) -> SweepFile:
+               adaptive: dict | None = None,
+               log: Callable[[str], None] | None = None) -> SweepFile:
         """Make a new result file (all points not computed), atomically, and open it.
         adaptive: resolved settings of an adaptive sweep (``adaptive.Options.resolved``):
         the file gets the ``computed`` flags and the settings' attributes.
@@ -770,18 +857,23 @@ class SweepFile:
                              "--overwrite to replace it")
         grid = Grid(scene)
         nbytes = file_bytes(scene, adaptive is not None)
-        _check_space(path, nbytes + SPACE_MARGIN,
-                     f"a grid of {grid.size} points")
+        reserve = _reserve_bytes(scene, nbytes)
+        removed = clean_stale_partials(path)  # a killed attempt's reserved space back
+        if removed and log is not None:
+            log(f"removed {len(removed)} stale temporary file{'s' * (len(removed) > 1)} of "
+                f"{shown(path)} left by a sweep killed while making it ({removed[0][0]}"
+                f"{', ...' if len(removed) > 1 else ''}; "
+                f"{_mib(sum(n for _, n in removed))})")
+        _check_space(path, _space_needed(reserve), f"a grid of {grid.size} points")
         old_fd = _lock_existing(path) if existed else None
         tmp: Path | None = None
         f = None
         try:
             parent = path.parent if str(path.parent) else Path(".")
-            fd, name = tempfile.mkstemp(prefix=f".{path.name[:40]}.", suffix=".partial",
+            fd, name = tempfile.mkstemp(prefix=partial_prefix(path), suffix=".partial",
                                         dir=parent)
             os.close(fd)
             tmp = Path(name)
-            reserve = nbytes + METADATA_RESERVE + 4 * len(scene.text.encode())
             _reserve(tmp, reserve)  # room for all of it, or ENOSPC before HDF5 writes
             g = h5py.File(tmp, "w", track_order=True)  # truncates: reserve again
             try:
@@ -883,7 +975,7 @@ class SweepFile:
         h5py's errors (the callers say what they mean for the file)."""
         f = self.f
         if not _in_place(f):  # a format-1 file: its attributes change type once
-            _check_space(self.path, SPACE_MARGIN, "updating its attributes")
+            _check_space(self.path, UPDATE_MARGIN, "updating its attributes")
             _upgrade_session_attrs(f)
             f.flush()
         n = int(f.attrs["sessions"]) + 1
@@ -1088,6 +1180,7 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
     if scene.record is not None:  # the record: name, SHA-256, NPTS, DT [s], PGA [g]
         for k, v in record_attrs(scene.record).items():
             a[f"record_{k}"] = v
+        _store_record(f, scene.record)
     if scene.suite is not None:  # the stripes' IM ("none": a cloud) and Sa's period [s]
         a["scale_im"] = scene.suite.im or "none"
         a["scale_period"] = float(scene.suite.period)
@@ -1345,11 +1438,61 @@ def as_result(data, names: list[str] | None = None) -> SweepResult:
     return result_of(data)
 
 
+RECORD_GROUP = "record"  # a record sweep's copy of its record: file (bytes), acceleration
+
+
+def _store_record(f, record) -> None:
+    """Keep the record in the result file (group ``record``): the file's bytes (``file``,
+    uint8; the scene is rebuilt from them, ``result_scene``) and the samples
+    (``acceleration`` [g], at ``dt`` [s]) for readers. A result then stands alone: moved
+    to another machine, or kept after the record's folder is gone, it still plots and
+    gives boundaries and spectra."""
+    g = f.create_group(RECORD_GROUP)
+    raw = np.frombuffer(record.data, dtype=np.uint8)
+    if raw.size:
+        d = g.create_dataset("file", data=raw, chunks=(min(raw.size, 1 << 16),),
+                             compression="gzip")
+        d.attrs["sha256"] = record.sha256
+        d.attrs["source"] = str(record.source)
+    acc = g.create_dataset("acceleration", data=np.asarray(record.acc, np.float64))
+    acc.attrs["units"] = "g"
+    acc.attrs["dt"] = float(record.dt)
+
+
+def stored_record(path: Path, rec: dict):
+    """The record a result file keeps (``_store_record``) as a ``GroundRecord`` with the
+    sweep's source path, checked against the file's SHA-256; None for a file that keeps
+    no copy (made before records were stored). StoreError if the copy is damaged."""
+    from rocksweep.physics.records import RecordError, parse_record
+
+    f = _open(path, "r")
+    try:
+        g = f.get(RECORD_GROUP)
+        d = g.get("file") if g is not None else None
+        if d is None:
+            return None
+        data = bytes(np.asarray(d[()], dtype=np.uint8).tobytes())
+    except _H5_ERRORS as err:
+        raise _damaged(path, f"its copy of the record: {_why(err)}") from None
+    finally:
+        _close_quietly(f)
+    import hashlib
+
+    if hashlib.sha256(data).hexdigest() != rec.get("sha256"):
+        raise _damaged(path, "its copy of the record does not match its SHA-256")
+    try:
+        return parse_record(data, rec["source"])
+    except RecordError as err:
+        raise _damaged(path, f"its copy of the record: {err}") from None
+
+
 def result_scene(result: SweepResult) -> Scene:
     """The scene a result was computed from, rebuilt from its YAML and overrides and
     checked against the result's resolved scene (axes, numerics), so that the kernel runs
-    again as the sweep did (the A_min bisection, spectra). A record is re-read from where
-    the sweep read it and checked against its SHA-256. One-line StoreErrors."""
+    again as the sweep did (the A_min bisection, spectra). A record comes from the file's
+    own copy (``stored_record``, checked against its SHA-256); a file made before records
+    were stored re-reads it from where the sweep read it, checked against the SHA-256.
+    One-line StoreErrors."""
     import json
 
     from rocksweep.scene.scene import parse_scene
@@ -1361,21 +1504,33 @@ def result_scene(result: SweepResult) -> Scene:
         raise StoreError(f"{shown(result.path)}: attribute overrides is not JSON") from None
     rec = result.scene.get("record")
     suite = result.scene.get("suite")
+    record = None
     if rec:
-        overrides.append(f"ground.record={rec['source']}")
-    elif suite:  # the records where the sweep read them
+        # the file's own copy first (a result stands alone); a file without one re-reads
+        # the record from where the sweep read it, checked against its SHA-256
+        record = stored_record(result.path, rec)
+        if record is None:
+            from rocksweep.physics.records import RecordError, read_record
+
+            try:
+                record = read_record(rec["source"])
+            except RecordError as err:
+                raise StoreError(f"{shown(result.path)}: cannot rebuild its scene (the "
+                                 f"record: {err}; this file keeps no copy of it, made by an "
+                                 "older rocksweep: put the record back there)") from None
+            if record.sha256 != rec["sha256"]:
+                raise StoreError(f"{shown(result.path)}: the record {rec['source']} changed "
+                                 f"since the sweep (sha256 {record.sha256[:12]}, the result "
+                                 f"has {rec['sha256'][:12]})")
+    elif suite:  # the records where the sweep read them (their SHA-256s are compared)
         overrides.append("ground.records=" + json.dumps(
             [str(r.get("source")) for r in suite.get("records") or []]))
     try:
-        sc = parse_scene(str(a["scene"]), str(result.path), overrides)
+        sc = parse_scene(str(a["scene"]), str(result.path), overrides, record=record)
     except RocksweepError as err:
         raise StoreError(f"{shown(result.path)}: cannot rebuild its scene ({err})") from None
-    if rec and sc.record.sha256 != rec["sha256"]:
-        raise StoreError(f"{shown(result.path)}: the record {rec['source']} changed since the "
-                         f"sweep (sha256 {sc.record.sha256[:12]}, the result has "
-                         f"{rec['sha256'][:12]})")
     stored = {k: v for k, v in result.scene.items() if k != "adaptive"}
-    added = bool(rec) or bool(suite)
+    added = bool(suite) and not rec  # the override above is not the file's
     diffs = scene_differences(stored, resolved_scene(sc, overrides[:len(overrides) - added]))
     if diffs:
         raise StoreError(f"{shown(result.path)}: its scene YAML no longer gives its grid "

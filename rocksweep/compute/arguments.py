@@ -1,0 +1,177 @@
+"""The arguments of a sweep, checked in one place before anything touches an output.
+
+``rocksweep sweep`` (``rocksweep.cli.sweep``), ``rocksweep.run`` and the driver they share
+(``rocksweep.api.sweep_file``) call ``check_sweep_arguments`` first: an argument that cannot
+be used is refused with one line while the output file is still as it was (an existing
+result is neither removed nor changed, no new file appears). A wrong type is a
+``TypeError`` naming the argument (as Python users expect); a value out of range is a
+``SweepError`` (a ``RocksweepError``). The dask scheduler is probed here too, with a
+bounded wait (``probe_scheduler``): a port that accepts a connection and never answers
+is refused after ``connect_timeout`` seconds, not waited on for ever.
+
+Light: no numba, no h5py (the command line's ``--help`` imports nothing heavy).
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+import os
+import socket
+import time
+from typing import Any
+from urllib.parse import urlsplit
+
+from rocksweep.errors import RocksweepError
+
+
+class SweepError(RocksweepError, ValueError):
+    """A sweep that cannot run as asked (workers, cluster); ``str()`` is one line."""
+
+
+# Local worker threads allowed per core: the chunk kernels keep a core busy, so threads
+# beyond a few per core only wait (and a typo like 99999999999999999999 must not start them).
+MAX_JOBS_PER_CORE = 4
+# Seconds to wait for a dask scheduler to answer (``--connect-timeout``).
+CONNECT_TIMEOUT = 20.0
+MAX_CONNECT_TIMEOUT = 3600.0
+
+
+def is_integer(v: Any) -> bool:
+    """An integer (Python's or numpy's), not a bool."""
+    return isinstance(v, numbers.Integral) and not isinstance(v, bool)
+
+
+def check_flag(name: str, v: Any) -> bool:
+    """``v`` if it is a bool (numpy's too), else a TypeError naming ``name``."""
+    if isinstance(v, bool) or type(v).__name__ == "bool_":
+        return bool(v)
+    raise TypeError(f"{name} = {v!r}: must be True or False")
+
+
+def check_jobs(jobs: Any, name: str = "jobs =") -> int:
+    """Number of local worker threads for ``jobs`` (-1: one per core); a TypeError for a
+    non-integer, a one-line ``SweepError`` for 0, other negatives and more than
+    ``MAX_JOBS_PER_CORE`` threads per core. name: how the message names the option
+    ("--jobs" on the command line)."""
+    if not is_integer(jobs):
+        raise TypeError(f"{name} {jobs!r}: must be an integer (>= 1, or -1 for all cores)")
+    jobs = int(jobs)
+    n = os.cpu_count() or 1
+    if jobs == -1:
+        return n
+    if jobs < 1:
+        raise SweepError(f"{name} {jobs}: give a number >= 1, or -1 for all cores")
+    cap = MAX_JOBS_PER_CORE * n
+    if jobs > cap:
+        raise SweepError(f"{name} {jobs}: at most {cap} ({MAX_JOBS_PER_CORE} x the {n} "
+                         f"core{'s' * (n > 1)} of this machine: each thread keeps a core busy, "
+                         "so more threads only wait for one)")
+    return jobs
+
+
+def check_seconds(name: str, seconds: Any, *, lo: float = 0.0, hi: float = math.inf,
+                  what: str = "") -> float:
+    """A finite number of seconds in [lo, hi] (TypeError for a non-number)."""
+    if isinstance(seconds, bool) or not isinstance(seconds, numbers.Real):
+        raise TypeError(f"{name} {seconds!r}: must be a number of seconds")
+    s = float(seconds)
+    if not (math.isfinite(s) and lo <= s <= hi):
+        top = f" and <= {hi:g}" if math.isfinite(hi) else ""
+        raise SweepError(f"{name} {seconds!r}: give a finite number of seconds >= {lo:g}{top}"
+                         + (f" ({what})" if what else ""))
+    return s
+
+
+def check_sweep_arguments(*, jobs: Any = 1, resume: Any = False, overwrite: Any = False,
+                          validate: Any = False, adaptive: Any = None,
+                          backend: Any = "threads", scheduler: Any = None,
+                          chunk_size: Any = None, write_every: Any = 1.0,
+                          connect_timeout: Any = CONNECT_TIMEOUT,
+                          cli: bool = False) -> int:
+    """Check every argument of a sweep that decides nothing about the scene; return the
+    number of local worker threads (1 for dask). Raises before any file is touched.
+
+    cli: name the options as the command line spells them (``--jobs 0``), else as
+    keywords (``jobs = 0``)."""
+    def n(key: str) -> str:
+        return f"--{key.replace('_', '-')}" if cli else f"{key} ="
+
+    resume = check_flag("resume", resume)
+    overwrite = check_flag("overwrite", overwrite)
+    validate = check_flag("validate", validate)
+    if resume and overwrite:
+        raise SweepError("resume and overwrite exclude each other" if not cli else
+                         "--resume and --overwrite exclude each other")
+    if validate and adaptive is None:
+        raise SweepError("validate=True checks an adaptive sweep; add adaptive=True" if not cli
+                         else "--validate checks an adaptive sweep; add --adaptive")
+    check_seconds(n("write_every"), write_every,
+                  what="0: write every chunk as it finishes")
+    if chunk_size is not None:
+        if not is_integer(chunk_size):
+            raise TypeError(f"{n('chunk_size')} {chunk_size!r}: must be an integer >= 1")
+        if chunk_size < 1:
+            raise SweepError(f"{n('chunk_size')} {chunk_size}: must be >= 1")
+    check_seconds(n("connect_timeout"), connect_timeout, lo=0.1, hi=MAX_CONNECT_TIMEOUT)
+    if backend == "threads":
+        if scheduler:
+            raise SweepError("a scheduler address works with backend='dask' only" if not cli
+                             else "--scheduler works with --backend dask only")
+        return check_jobs(jobs, n("jobs"))
+    if backend == "dask":
+        if not (isinstance(scheduler, str) and scheduler.strip()):
+            if scheduler is not None and not isinstance(scheduler, str):
+                raise TypeError(f"scheduler = {scheduler!r}: must be an address string, "
+                                "e.g. tcp://host:8786")
+            raise SweepError("backend 'dask' needs a scheduler address" if not cli
+                             else "--backend dask needs --scheduler ADDRESS")
+        if any(ord(c) < 32 for c in scheduler):
+            raise SweepError(f"scheduler {scheduler!r}: control characters in the address")
+        return 1
+    raise SweepError(f"backend = {backend!r}: must be threads or dask")
+
+
+def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT,
+                    hint: str = "then run the same command again (with --resume to finish "
+                                "a file already started)") -> None:
+    """A one-line ``SweepError`` unless something at a ``tcp://`` ``address`` accepts a
+    connection and starts dask's handshake within ``timeout`` seconds (a dask scheduler
+    speaks first: it sends its handshake as soon as a connection is accepted). Other
+    protocols are left to dask. Bounded: a port that accepts and never answers costs
+    ``timeout`` seconds, no more."""
+    parts = urlsplit(address if "://" in address else f"tcp://{address}")
+    if parts.scheme != "tcp":
+        return
+    try:
+        host, port = parts.hostname, parts.port
+    except ValueError:
+        host, port = None, None
+    if not host or port is None:
+        raise SweepError(f"scheduler {address}: not an address like tcp://host:8786")
+    deadline = time.monotonic() + timeout
+    try:
+        sock = socket.create_connection((host, port), timeout=timeout)
+    except TimeoutError:
+        raise SweepError(f"scheduler {address}: no connection within {timeout:g} s "
+                         f"(--connect-timeout); check the address, {hint}") from None
+    except OSError as err:
+        raise SweepError(f"scheduler {address}: cannot connect ({err.strerror or err}); start "
+                         f"the scheduler or check the address, {hint}") from None
+    try:
+        sock.settimeout(max(0.1, deadline - time.monotonic()))
+        try:
+            data = sock.recv(1)
+        except TimeoutError:
+            data = None
+        except OSError:
+            data = b""
+    finally:
+        sock.close()
+    if data is None:
+        raise SweepError(f"scheduler {address}: accepts connections but no dask scheduler "
+                         f"answered within {timeout:g} s (--connect-timeout); check the "
+                         f"address, {hint}")
+    if not data:
+        raise SweepError(f"scheduler {address}: closed the connection without answering "
+                         f"(not a dask scheduler?); check the address, {hint}")
