@@ -11,7 +11,9 @@ The Python API (see the README's "Python API"):
   -> ``Simulation`` (``.summary`` dict, ``.history`` Dataset over p*t, ``.figure()``).
 - ``rocksweep.plot(ds, x=, y=, ax=, width=)`` -> Figure; ``rocksweep.boundaries(ds,
   rtol=)`` -> Dataset of A_min; ``rocksweep.boundary_lines(ds)`` -> DataFrame;
-  ``rocksweep.spectra(ds)`` -> Dataset; ``rocksweep.estimate(scene)``: the cost of a run.
+  ``rocksweep.spectra(ds)`` -> Dataset; ``rocksweep.estimate(scene)``: the cost of a run;
+  ``rocksweep.fragility(ds, state=, bootstrap=)`` -> Dataset of lognormal fragility
+  curves of a record-suite sweep.
   Each analysis takes what ``run`` and ``open`` return.
 - ``rocksweep.RocksweepError``: the base of every error a user can fix (one line).
 
@@ -24,6 +26,7 @@ from rocksweep.api import (  # noqa: A004
     boundaries,
     boundary_lines,
     estimate,
+    fragility,
     open,
     plot,
     run,
@@ -52,5 +55,5 @@ def _version() -> str:
 
 
 __version__ = _version()
-__all__ = ["RocksweepError", "__version__", "boundaries", "boundary_lines", "estimate", "open",
-           "plot", "run", "simulate", "spectra"]
+__all__ = ["RocksweepError", "__version__", "boundaries", "boundary_lines", "estimate",
+           "fragility", "open", "plot", "run", "simulate", "spectra"]

@@ -45,6 +45,12 @@ class RocksweepAccessor:
 
         return spectra(self._ds, **kwargs)
 
+    def fragility(self, **kwargs: Any) -> Any:
+        """``rocksweep.fragility(ds, ...)``: lognormal fragility curves of a suite."""
+        from rocksweep.api import fragility
+
+        return fragility(self._ds, **kwargs)
+
     def outcome_words(self) -> Any:
         """``outcome`` as words (not_run, safe, mode1, mode2), an object DataArray."""
         import numpy as np

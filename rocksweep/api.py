@@ -303,7 +303,7 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
         jobs=jobs, resume=resume, overwrite=overwrite, validate=validate, adaptive=adaptive,
         backend=backend, scheduler=scheduler, chunk_size=chunk_size, write_every=write_every,
         connect_timeout=connect_timeout, cli=cli)
-    if path is not None:  # None: in memory
+    if path is not None:  # None: in memory (rocksweep.run without output=)
         check_path_text(path)
     if backend == "dask":
         from rocksweep.compute import sweep as sw
@@ -800,6 +800,49 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3) -> xr.Dataset:
     if not (isinstance(rtol, int | float) and 0 < rtol < 1):
         raise ApiError(f"rtol = {rtol!r}: must be a relative tolerance in (0, 1)")
     return compute_spectra(ds, rtol).to_dataset()
+
+
+@speaks_python
+def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
+              im: str | None = None, period: float | None = None, bootstrap: int = 200,
+              seed: int = 0, ci: float = 0.9) -> xr.Dataset:
+    """Lognormal fragility curves P(state | IM = x) = Phi(ln(x / median) / beta) of a
+    record-suite sweep (a scene with ``ground.records``), fitted by maximum likelihood
+    (Baker 2015): to the counts at each stripe of a scaled suite ("stripes-mle"), or to
+    the (IM, 0/1) pairs of an unscaled one ("cloud-mle", im= "PGA" (default), "PGV" or
+    "Sa" with period= [s] from the stored periods).
+
+    ds: what ``run`` or ``open`` returns. state: "overturn" (either mode), "mode1",
+    "mode2", "uplift", "theta:X" (max|theta|/alpha_cg >= X, or overturned), or a list of
+    them (a ``state`` dimension). bootstrap: resamples over records for the intervals
+    and bands (0: none, NaN); seed: their generator's seed; ci: the interval's level.
+    Points flagged undecided (horizon, step or event caps, non-finite) are left out and
+    counted (``n_excluded``). One curve per value of every other swept key (lam, p, body
+    keys).
+
+    Returns a Dataset (``rocksweep.analysis.fragility.fragility``): ``median`` [IM
+    units], ``beta``, their bootstrap intervals ``median_lo``/``median_hi``,
+    ``beta_lo``/``beta_hi``, ``n_records``, ``n_excluded``, ``reason``, the bands
+    ``band_lo``/``band_hi`` over ``im_grid``, and for stripes the empirical ``fraction``
+    per stripe and, per record, ``first_level`` (the smallest stripe that reaches the
+    state: an IDA on the stripes) and ``resurrection`` (a higher stripe is safe again).
+    """
+    import xarray as xr
+
+    from rocksweep.analysis.fragility import fragility as fit
+
+    if isinstance(ds, str | Path):
+        ds = open(ds)
+    if not isinstance(ds, xr.Dataset):
+        raise ApiError(f"ds = {type(ds).__name__}: must be a result Dataset (rocksweep.run "
+                       "or rocksweep.open)")
+    if isinstance(bootstrap, bool) or not isinstance(bootstrap, int) or bootstrap < 0:
+        raise ApiError(f"bootstrap = {bootstrap!r}: must be an integer >= 0")
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise ApiError(f"seed = {seed!r}: must be an integer >= 0")
+    frag = fit(ds, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci)
+    frag.attrs["title"] = str(ds.attrs.get("title", ""))
+    return frag
 
 
 @speaks_python

@@ -272,6 +272,41 @@ AXES: dict[str, AxisMeta] = {
                          r"I_A/(m_A R_A^2)"),
     "alpha": AxisMeta("slenderness of the block", "rad", "alpha", r"\alpha"),
     "inertia": AxisMeta("inertia ratio of the block", "1", "I_O/(M R^2)", r"I_O/(M R^2)"),
+    # a record suite (ground.records): the records, the stripe IMs (ground.scale.im; each
+    # record scaled so that its IM equals the stripe's value) and Sa's periods
+    "record": AxisMeta("ground-motion record (file name)", "", "record", "record"),
+    "PGA": AxisMeta("peak ground acceleration of the scaled record", "g", "PGA", "PGA"),
+    "PGV": AxisMeta("peak ground velocity of the scaled record", "m/s", "PGV", "PGV"),
+    "Sa": AxisMeta("spectral acceleration of the scaled record (5% damping)", "g", "Sa(T)",
+                   r"S_a(T)"),
+    "PGA_ratio": AxisMeta("PGA of the scaled record over g tan(alpha_ref)", "1",
+                          "PGA/(g tan alpha_ref)", r"PGA/(g\tan\alpha_{ref})"),
+    "PGV_ratio": AxisMeta("PGV p of the scaled record over g tan(alpha_ref)", "1",
+                          "PGV p/(g tan alpha_ref)", r"PGV\,p/(g\tan\alpha_{ref})"),
+    "period": AxisMeta("period of the oscillator of Sa (5% damping)", "s", "T", "T"),
+}
+
+# Per-record variables of a suite's result (along ``record``; ``record_sa`` along
+# (record, period); ``scale_factor`` along (record, stripe) and what the factor depends
+# on): name -> (long_name, CF units or None for words and counts, description).
+RECORD_VARIABLES: dict[str, tuple[str, str | None, str]] = {
+    "record_pga": ("peak ground acceleration of the record as recorded", "g",
+                   "max |acc| of the samples (exact for the piecewise-linear record)"),
+    "record_pgv": ("peak ground velocity of the record as recorded", "m/s",
+                   "max |v|, v the trapezoidal integral of the record as given (no baseline "
+                   "correction, no filtering), extrema between samples included"),
+    "record_sa": ("spectral acceleration of the record as recorded", "g",
+                  "pseudo-spectral acceleration at 5% damping, exact recurrence for the "
+                  "piecewise-linear record (Nigam & Jennings 1969), free vibration after "
+                  "the record included"),
+    "record_npts": ("number of samples of the record", "1", "NPTS"),
+    "record_dt": ("sample interval of the record", "s", "DT"),
+    "record_duration": ("duration of the record", "s", "(NPTS - 1) DT"),
+    "record_sha256": ("SHA-256 of the record file's bytes", None,
+                      "a resume refuses a suite whose files changed"),
+    "scale_factor": ("factor multiplying the record", "1",
+                     "the record's accelerations times this factor make the point's ground "
+                     "motion (stripes: its IM equals the stripe's value)"),
 }
 
 

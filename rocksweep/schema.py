@@ -144,11 +144,33 @@ KEYS: dict[str, Key] = {
                     -math.inf, math.inf, lo_in=False, hi_in=False, required=False,
                     default=90.0),
     # a recorded ground motion instead of a pulse (rocksweep.physics.records)
+    # one record (ground.record, scaled by ground.A_ratio) or a suite (ground.records,
+    # scaled by ground.scale): the scene requires one of the two pairs
     "ground.record": Key("string", "must be the path of a PEER .AT2 file or a two-column "
-                         "file (t [s], xg'' [g]), relative to the scene file"),
+                         "file (t [s], xg'' [g]), relative to the scene file",
+                         required=False),
     "ground.A_ratio": Key("axis", "must be a finite number (the record scaled to a peak of "
                           "A_ratio g tan(alpha_cg); negative: reversed)",
-                          -math.inf, math.inf, lo_in=False, hi_in=False),
+                          -math.inf, math.inf, lo_in=False, hi_in=False, required=False),
+    "ground.records": Key("string", "must be a list of record files, a glob such as "
+                          "suite/*.AT2, or a text file listing one path a line (relative to "
+                          "the scene file)", required=False),
+    "ground.scale": Key("string", "must be none, {factor: F} (the records as recorded, times "
+                        "F) or {im: PGA|PGV|Sa|PGA_ratio|PGV_ratio, values: a number, a list "
+                        "or a range {start, stop, num}, period: T [s] for Sa}",
+                        required=False, default="none"),
+    "ground.scale.im": Key("choice", "must be one of PGA, PGV, Sa, PGA_ratio, PGV_ratio",
+                           choices=("PGA", "PGV", "Sa", "PGA_ratio", "PGV_ratio")),
+    "ground.scale.values": Key("axis", "must be finite numbers > 0 (the stripes' IM values: "
+                               "PGA, Sa [g], PGV [m/s], PGA_ratio, PGV_ratio [-])",
+                               0.0, math.inf, lo_in=False, hi_in=False),
+    "ground.scale.period": Key("number", "must be in (0, 100] s (the period of Sa)", 0.0,
+                               100.0, lo_in=False),
+    "ground.scale.factor": Key("number", "must be a finite number > 0 (every record times "
+                               "this factor)", 0.0, math.inf, lo_in=False, hi_in=False),
+    "ground.periods": Key("string", "must be a list of periods in [0, 100] s (Sa stored per "
+                          "record; 0 gives the PGA)", 0.0, 100.0, required=False,
+                          default=(0.2, 1.0)),
     "ground.p": Key("axis", f"must be in [1e-3, {1e3:g}] rad/s (the body's frequency "
                     "parameter p)", 1e-3, 1e3),
 }
@@ -166,7 +188,7 @@ def section_keys(section: str, kind: str = "flexible") -> tuple[str, ...]:
     if section == "body":
         return ("kind", *BODY_KEYS[kind], "mu")
     pre = section + "."
-    return tuple(k[len(pre):] for k in KEYS if k.startswith(pre))
+    return tuple(k[len(pre):] for k in KEYS if k.startswith(pre) and "." not in k[len(pre):])
 
 
 def fmt(v: Any) -> str:

@@ -10,6 +10,8 @@ Runs the shipped commands, exactly as the README shows them:
   fig3a_check (Figure 3(a) with ``--check``: rings where the outcome changes at half the step);
 - ``rocksweep simulate configs/fig5.yaml --plot`` (Figure 5) and ``rocksweep restitution
   configs/fig2.yaml --plot`` (Figure 2);
+- ``rocksweep sweep configs/fragility-demo.yaml`` and ``rocksweep fragility --plot``: the
+  overturning fragility of the Figure 3(a) body under the shipped record suite;
 - with ``--accuracy``: ``rocksweep accuracy configs/fig3a.yaml --points 200 --plot``.
 
 Everything is written to a temporary directory first and moved into docs/ when the
@@ -48,12 +50,13 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--jobs", type=int, default=2, help="sweep worker threads [2]")
     ap.add_argument("--dpi", type=int, default=200, help="resolution of the PNGs [200]")
     ap.add_argument("--only", nargs="+", metavar="NAME",
-                    choices=[*DIAGRAMS, "fig3a_check", "fig5", "fig2", "accuracy_fig3a"],
+                    choices=[*DIAGRAMS, "fig3a_check", "fig5", "fig2", "fragility",
+                             "accuracy_fig3a"],
                     help="regenerate only these figures")
     ap.add_argument("--docs", type=Path, default=ROOT / "docs", help="output directory")
     ap.add_argument("--keep", type=Path, metavar="DIR", help="keep the sweep results here")
     args = ap.parse_args(argv)
-    wanted = set(args.only or [*DIAGRAMS, "fig3a_check", "fig5", "fig2"]
+    wanted = set(args.only or [*DIAGRAMS, "fig3a_check", "fig5", "fig2", "fragility"]
                  + (["accuracy_fig3a"] if args.accuracy else []))
     args.docs.mkdir(parents=True, exist_ok=True)
     if args.keep:
@@ -94,6 +97,15 @@ def main(argv: list[str] | None = None) -> None:
         if "fig2" in wanted:
             rocksweep("restitution", str(cfg / "fig2.yaml"), "--plot", str(tmp / "fig2.png"))
             publish("fig2")
+        if "fragility" in wanted:  # the record suite: overturning fragility per lam
+            t0 = time.perf_counter()
+            h5 = (args.keep or tmp) / "fragility.h5"
+            rocksweep("sweep", str(cfg / "fragility-demo.yaml"), "-o", str(h5), "--jobs",
+                      str(args.jobs), "--quiet", "--overwrite")
+            rocksweep("fragility", str(h5), "--plot", str(tmp / "fragility.png"), "--dpi",
+                      str(args.dpi))
+            publish("fragility")
+            print(f"  fragility: {time.perf_counter() - t0:.1f} s", flush=True)
         if "accuracy_fig3a" in wanted:
             t0 = time.perf_counter()
             rocksweep("accuracy", str(cfg / "fig3a.yaml"), "--points", "200", "--quiet",

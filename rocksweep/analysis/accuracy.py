@@ -45,7 +45,7 @@ from rocksweep import fields
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import PRESET_ROTATION, PRESETS, ROOTS, Numerics
-from rocksweep.scene.scene import Scene
+from rocksweep.scene.scene import Scene, SceneError
 
 OUTCOMES = ("safe", "mode1", "mode2")  # codes 0, 1, 2
 # Per-point fields of the report: all the outcome-level kernel fills (no energies).
@@ -277,6 +277,13 @@ def sample_scene(scene: Scene, n: int | None, seed: int = 0) -> Sample:
 # ----------------------------------------------------------------------------------------
 
 
+def _no_suite(scene: Scene) -> None:
+    """The accuracy study runs one record a scene (its rows carry the record's samples)."""
+    if scene.suite is not None:
+        raise SceneError(f"ground.records: the accuracy study takes one record "
+                         f"(ground.record: one of {scene.suite.names[0]}, ...), not a suite")
+
+
 def _with_numerics(scene: Scene, numerics: Numerics) -> Scene:
     return dataclasses.replace(scene, numerics=numerics)
 
@@ -293,6 +300,7 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
     from rocksweep.compute.grid import Grid
     from rocksweep.physics.points import with_record
 
+    _no_suite(scene)
     cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
     rows_all = with_record(cr.rows, scene.record)  # a record's samples ride on each row
     ground = scene.ground  # the Ricker, MP and records run the GROUND variants
@@ -404,6 +412,7 @@ def run_half(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray:
     from rocksweep.compute.grid import Grid
     from rocksweep.compute.sweep import run_rows
 
+    _no_suite(scene)
     sc = _with_numerics(scene, numerics)
     cr = Grid(sc).rows_at(flat)
     return run_rows(cr, fields.check_rows(cr.rows), L.LEVEL_OUTCOME, sc)
@@ -620,6 +629,7 @@ def accuracy_study(scene: Scene, n_points: int | None = 200,
     """
     from rocksweep.compute.grid import Grid
 
+    _no_suite(scene)
     t_wall = time.perf_counter()
     settings = settings if settings is not None else ladder("full")
     if progress:

@@ -285,7 +285,8 @@ def format_info(d: dict) -> list[str]:
     lines = [f"{d['path']}: {d['title']}"]
     for name, dim in d["dims"].items():
         v = dim["values"]
-        span = ", ".join(map(str, v)) if len(v) <= 6 else f"{v[0]:g} .. {v[-1]:g}"
+        span = (", ".join(map(str, v)) if len(v) <= 6 else
+                f"{v[0]} .. {v[-1]}" if isinstance(v[0], str) else f"{v[0]:g} .. {v[-1]:g}")
         lines.append(f"  {name:<10} {dim['size']:>6}  [{span}]   ({dim['scene_key']})")
     if d["fixed"]:
         lines.append("  fixed: " + ", ".join(f"{k} = {v}" for k, v in d["fixed"].items()))

@@ -37,6 +37,9 @@ class ChunkRows:
     kinds: np.ndarray
     alpha_ref: np.ndarray
     E_ref: np.ndarray
+    # a suite's points: the index of each point's record (int64[n], into
+    # ``Scene.suite.records``), None otherwise
+    record_index: np.ndarray | None = None
 
 
 class Grid:
@@ -60,10 +63,13 @@ class Grid:
         self._i_shape = names.index("shape")
         self._i_lam = names.index("lam")
         self._i_w = names.index(scene.freq_axis)  # w_over_p, or p [rad/s] for a record
-        self._i_A = names.index("A_ratio")
+        suite = scene.suite
+        self._i_A = names.index("A_ratio") if suite is None else None
+        self._i_rec = names.index("record") if suite is not None else None
+        self._i_stripe = names.index(suite.im) if suite is not None and suite.im else None
         self._shape_codes = np.array([shape_code(s) for s in scene.axes[self._i_shape].values])
-        self._values = [np.asarray(a.values, float) if i != self._i_shape else None
-                        for i, a in enumerate(scene.axes)]
+        self._values = [np.asarray(a.values, float) if i not in (self._i_shape, self._i_rec)
+                        else None for i, a in enumerate(scene.axes)]
 
     def coords(self) -> dict[str, np.ndarray]:
         """Coordinate values of each swept dimension (strings for ``shape``)."""
@@ -112,6 +118,9 @@ class Grid:
         n = flat.size
         rows = np.empty((n, L.N_PAR))
         alpha_ref = b_alpha[inverse]
+        if self.scene.suite is not None:
+            return self._suite_rows(multi, rows, b_rows[inverse], b_omega[inverse], alpha_ref,
+                                    b_kind[inverse], b_E[inverse])
         fill_rows(rows, b_rows[inverse], b_omega[inverse], alpha_ref,
                   self._values[self._i_lam][multi[self._i_lam]],
                   self._shape_codes[multi[self._i_shape]],
@@ -121,6 +130,27 @@ class Grid:
                   self.scene.option("nu"), self.scene.record,
                   np.nan if self._i_mu is None else self._values[self._i_mu][multi[self._i_mu]])
         return ChunkRows(rows, b_kind[inverse], alpha_ref, b_E[inverse])
+
+    def _suite_rows(self, multi, rows, body_rows, omega_rock, alpha_ref, kinds, E_ref
+                    ) -> ChunkRows:
+        """Rows of a suite's points: each point's record scaled to its stripe (the peak
+        as A_ratio, ``Suite.peak_ratio``), filled record by record (each record has its
+        own DT and length)."""
+        su = self.scene.suite
+        rec = np.asarray(multi[self._i_rec], np.int64)
+        stripe = None if self._i_stripe is None else np.asarray(multi[self._i_stripe])
+        lam = self._values[self._i_lam][multi[self._i_lam]]
+        p = self._values[self._i_w][multi[self._i_w]]
+        a_ratio = su.peak_ratio(rec, stripe, alpha_ref, p)
+        code = self._shape_codes[multi[self._i_shape]]
+        for r in np.unique(rec):
+            sel = rec == r
+            part = np.empty((int(sel.sum()), L.N_PAR))
+            fill_rows(part, body_rows[sel], omega_rock[sel], alpha_ref[sel], lam[sel],
+                      code[sel], p[sel], a_ratio[sel], self.scene.numerics,
+                      record=su.records[int(r)])
+            rows[sel] = part
+        return ChunkRows(rows, kinds, alpha_ref, E_ref, rec)
 
     def kinds(self) -> list[int]:
         """The kernel kinds the grid's bodies need (each distinct body visited once)."""

@@ -110,7 +110,11 @@ def run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene) -> np.nd
     for kind in np.unique(cr.kinds):
         sel = cr.kinds == kind
         kernel = chunk_kernel(int(kind), level, scene.ground)
-        if scene.record is not None:
+        if scene.suite is not None:  # one record at a time, its samples shared
+            for r in np.unique(cr.record_index[sel]):
+                _run_record(kernel, rows, sel & (cr.record_index == r), outs,
+                            scene.suite.records[int(r)])
+        elif scene.record is not None:
             _run_record(kernel, rows, sel, outs, scene.record)
         elif sel.all():
             kernel(rows, outs)
@@ -121,23 +125,27 @@ def run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene) -> np.nd
     return outs
 
 
-# Points per kernel call of a record scene: each row carries the record's samples
-# (``points.with_record``, 8 bytes a sample: 64 rows of a 5000-sample record are 2.6 MB).
-RECORD_BATCH = 64
-
-
 def _run_record(kernel, rows: np.ndarray, sel: np.ndarray, outs: np.ndarray,
                 record) -> None:
-    """Run the selected rows of a record scene, in batches of RECORD_BATCH rows that
-    carry the record's samples (the GROUND chunk kernel reads the ground motion from the
-    row, ``kernel.equations.ground_acc``)."""
+    """Run the selected rows of a record scene, all driven by ``record``.
+
+    The GROUND chunk kernel reads the ground motion from the row after the parameters
+    (``kernel.equations.ground_acc``, ``points.with_record``). The runs share one wide
+    row: the record's samples are written into it once, and each point's N_PAR
+    parameters are copied in before its kernel call (one call a point, ~1 us of
+    dispatch against the milliseconds a run of a record takes), so no point copies the
+    samples. Each point's result is the one a row of its own gives (the kernel runs
+    every row alone), bit for bit."""
     idx = np.flatnonzero(sel)
-    for a in range(0, idx.size, RECORD_BATCH):
-        part = idx[a:a + RECORD_BATCH]
-        wide = with_record(rows[part], record)
-        res = np.empty((part.size, L.N_OUT))
+    if idx.size == 0:
+        return
+    wide = with_record(rows[idx[:1]], record)  # float64[1, N_PAR + npts]
+    res = np.empty((1, L.N_OUT))
+    head = wide[0, :L.N_PAR]
+    for i in idx.tolist():
+        head[:] = rows[i]
         kernel(wide, res)
-        outs[part] = res
+        outs[i] = res[0]
 
 
 def merge_contiguous(results: Iterable[ChunkResult]) -> list[ChunkResult]:

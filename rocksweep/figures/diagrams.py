@@ -483,6 +483,14 @@ def _mu_text(result: SweepResult) -> str:
     return f" = {_fmt(float(mu))}" if mu is not None else ""
 
 
+def _no_suite(result: SweepResult) -> None:
+    """A record suite's result (a ``record`` dimension of file names) is no diagram."""
+    if "record" in result.dims:
+        raise DiagramError(f"{result.path}: a record-suite result (dimension record); draw "
+                           "its fragility curves with rocksweep fragility --plot (Python: "
+                           "rocksweep.fragility)")
+
+
 def friction_map(result: SweepResult, x: str | None = None, y: str | None = None, *,
                  option_names: tuple[str, str] = ("x", "y")) -> Figure:
     """The friction demand mu_required over swept axes x and y (``rocksweep plot --mu``):
@@ -613,6 +621,7 @@ def sweep_figure(result: SweepResult, x: str | None = None, y: str | None = None
     plot when the result has one swept axis besides lam (see ``choose_axes``); curves:
     the boundary lines over the diagram (``rocksweep plot --curves``); show_computed: the
     cells an adaptive sweep computed shaded (``--show-computed``)."""
+    _no_suite(result)
     x, y = choose_axes(result, x, y, option_names)
     if y is None:
         if curves or show_computed:

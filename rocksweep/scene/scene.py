@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass, field, replace
+from glob import glob, has_magic
 from itertools import product
 from pathlib import Path
 from typing import Any
@@ -37,6 +38,7 @@ from rocksweep.outputs import input_problem, shown
 from rocksweep.physics.model import BlockBody, Body, BodyError, FlexibleBody
 from rocksweep.physics.points import RECORD, Point, body_omega_rock, record_cost, run_cost
 from rocksweep.physics.records import GroundRecord, RecordError, read_record
+from rocksweep.physics.suite import DEFAULT_PERIODS, SCALE_IMS, Suite, SuiteError, make_suite
 from rocksweep.schema import (
     BODY_KEYS,
     KEYS,
@@ -247,18 +249,26 @@ class Scene:
     # a record scene (``ground`` section): the record read at load (else None); the grid's
     # frequency axis is then p [rad/s], not w_over_p
     record: GroundRecord | None = field(default=None, repr=False)
+    # a suite scene (``ground.records``): the records, their IMs and the scaling (the
+    # grid's axes then hold ``record`` (file names), the stripe IM if scaled, and p)
+    suite: Suite | None = field(default=None, repr=False)
 
     @property
     def freq_axis(self) -> str:
         """The name of the axis that sets the ground motion's time scale: ``w_over_p``
-        (a pulse) or ``p`` (a record, [rad/s])."""
-        return "p" if self.record is not None else "w_over_p"
+        (a pulse) or ``p`` (a record or a suite, [rad/s])."""
+        return "p" if self.recorded else "w_over_p"
+
+    @property
+    def recorded(self) -> bool:
+        """Whether the ground motion is recorded (``ground.record`` or ``ground.records``)."""
+        return self.record is not None or self.suite is not None
 
     @property
     def ground(self) -> bool:
         """Whether the scene needs the kernel's GROUND variants (a Ricker or MP pulse, or a
         record); the paper's sine and cosine (n cycles too) run the pulse variants."""
-        return self.record is not None or any(
+        return self.recorded or any(
             sh in ("ricker", "mp") for sh in self.axis("shape").values)
 
     def option(self, name: str) -> Any:
@@ -308,6 +318,16 @@ class Scene:
     def point(self, values: dict[str, Any]) -> Point:
         """The point with the given value of every axis (by name)."""
         body = self.make_body(**{a.name: values[a.name] for a in self.body_axes()})
+        if self.suite is not None:
+            su = self.suite
+            r = su.names.index(str(values["record"]))
+            s = (np.array([self.axis(su.im).values.index(float(values[su.im]))])
+                 if su.im else None)
+            p = float(values["p"])
+            a_ratio = float(su.peak_ratio(np.array([r]), s, np.array([body.alpha_ref]),
+                                          np.array([p]))[0])
+            return Point(body, float(values["lam"]), RECORD, math.nan, a_ratio,
+                         record=su.records[r], p=p)
         if self.record is not None:
             return Point(body, float(values["lam"]), RECORD, math.nan,
                          float(values["A_ratio"]), record=self.record, p=float(values["p"]))
@@ -594,14 +614,177 @@ def _record(ground: dict, base: Path | None) -> GroundRecord:
     v = ground["record"]
     if not (isinstance(v, str) and v.strip()):
         raise SceneError(f"ground.record = {fmt(v)}: {spec.allowed}")
-    path = Path(v).expanduser()
-    if not path.is_absolute() and base is not None:
-        path = base / path
-    path = path.absolute()  # the file records where it was read (spectra re-read it)
+    path = _where(v, base)
     try:
         return read_record(path)
     except RecordError as err:
         raise SceneError(f"ground.record: {err}") from None
+
+
+def _where(v: str, base: Path | None) -> Path:
+    """A path of the scene, relative to ``base`` (the scene file's directory), absolute:
+    the file records where it read a record (spectra re-read it)."""
+    path = Path(v).expanduser()
+    if not path.is_absolute() and base is not None:
+        path = base / path
+    return path.absolute()
+
+
+# Most records a suite may hold (a scene's axis holds at most MAX_AXIS_VALUES values;
+# FEMA P695's sets are 44 and 28 records).
+MAX_RECORDS = 10_000
+_LIST_SUFFIXES = (".txt", ".list", ".lst")
+
+
+def _is_listing(path: Path) -> bool:
+    """A text file listing record paths (suffix .txt, .list or .lst, and its first line
+    that is not blank or a # comment is not made of numbers: a two-column record's is)."""
+    if path.suffix.lower() not in _LIST_SUFFIXES or not path.is_file():
+        return False
+    try:
+        with path.open("r", encoding="utf-8", errors="replace") as fh:
+            for line in fh:
+                text = line.strip()
+                if not text or text.startswith("#"):
+                    continue
+                try:
+                    [float(t) for t in text.replace(",", " ").split()]
+                except ValueError:
+                    return True
+                return False
+    except OSError:
+        return False
+    return True
+
+
+def _record_paths(spec: Any, base: Path | None) -> list[Path]:
+    """The files of ``ground.records`` in order: each entry a path, a glob (sorted) or a
+    listing (one path a line, relative to the listing's directory; # comments)."""
+    key = "ground.records"
+    entries = spec if isinstance(spec, list) else [spec]
+    if isinstance(spec, list) and not spec:
+        raise SceneError(f"{key} = []: an empty list; {KEYS[key].allowed}")
+    out: list[Path] = []
+    for e in entries:
+        if not (isinstance(e, str) and e.strip()):
+            raise SceneError(f"{key} = {fmt(e)}: {KEYS[key].allowed}")
+        if has_magic(e):
+            pattern = str(_where(e, base))
+            found = sorted(Path(p) for p in glob(pattern) if Path(p).is_file())
+            if not found:
+                raise SceneError(f"{key}: {e!r} matches no file (looked for {pattern})")
+            out.extend(found)
+            continue
+        path = _where(e, base)
+        if _is_listing(path):
+            lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
+            listed = [ln.strip() for ln in lines if ln.strip() and not
+                      ln.strip().startswith("#")]
+            if not listed:
+                raise SceneError(f"{key}: {e} lists no record file")
+            out.extend(_where(ln, path.parent) for ln in listed)
+        else:
+            out.append(path)
+        if len(out) > MAX_RECORDS:
+            break
+    if len(out) > MAX_RECORDS:
+        raise SceneError(f"{key}: more than {MAX_RECORDS:,} records; split the suite")
+    seen: dict[str, Path] = {}
+    for path in out:
+        real = str(path.resolve())
+        if real in seen:
+            raise SceneError(f"{key}: {path} is listed twice (each record once: the file "
+                             "names label the record dimension)")
+        seen[real] = path
+    names: dict[str, Path] = {}
+    for path in out:
+        if path.name in names:
+            raise SceneError(f"{key}: two records named {path.name} ({names[path.name]} and "
+                             f"{path}): the file names label the record dimension, rename "
+                             "one")
+        names[path.name] = path
+    return out
+
+
+def _periods(ground: dict) -> list[float]:
+    key = "ground.periods"
+    spec = ground.get("periods", list(DEFAULT_PERIODS))
+    values = spec if isinstance(spec, list) else [spec]
+    if not values or not all(is_number(v) for v in values):
+        raise SceneError(f"{key} = {fmt(spec)}: {KEYS[key].allowed}")
+    out = [as_float(v) for v in values]
+    for v in out:
+        if not (0.0 <= v <= 100.0):
+            raise SceneError(f"{key} = {fmt(v)}: {KEYS[key].allowed}")
+    if len(set(out)) != len(out):
+        raise SceneError(f"{key} = {fmt(spec)}: a period is given twice")
+    return out
+
+
+def _scale(ground: dict) -> tuple[str | None, str, Any, float, float]:
+    """(im or None, form, values spec, period [s] or NaN, cloud factor or NaN) of
+    ``ground.scale``."""
+    key = "ground.scale"
+    v = ground.get("scale", "none")
+    if v is None or v == "none":
+        return None, "", None, math.nan, 1.0
+    if not isinstance(v, dict):
+        raise SceneError(f"{key} = {fmt(v)}: {KEYS[key].allowed}")
+    if "factor" in v:
+        extra = sorted(set(v) - {"factor"})
+        if extra:
+            raise SceneError(f"{key}.{extra[0]}: not with factor ({KEYS[key].allowed})")
+        f = v["factor"]
+        if not is_number(f) or check_values(f"{key}.factor", np.array([as_float(f)])):
+            raise SceneError(f"{key}.factor = {fmt(f)}: {KEYS[key + '.factor'].allowed}")
+        return None, "", None, math.nan, as_float(f)
+    for k in v:
+        if k not in ("im", "values", "period"):
+            raise SceneError(f"{key}.{k}: unknown key (allowed: im, values, period; or "
+                             "factor alone)")
+    im = v.get("im")
+    if im not in SCALE_IMS:
+        raise SceneError(f"{key}.im = {fmt(im)}: {KEYS[key + '.im'].allowed}")
+    if v.get("values") is None:
+        raise SceneError(f"{key}.values: missing required key (the stripes' {im} values: "
+                         "a number, a list of numbers or a range {start, stop, num})")
+    form, spec, _ = _axis_spec(f"{key}.values", v["values"])
+    period = math.nan
+    if im == "Sa":
+        T = v.get("period")
+        if T is None:
+            raise SceneError(f"{key}.period: missing required key (Sa's period [s])")
+        if not is_number(T) or check_values(f"{key}.period", np.array([as_float(T)])):
+            raise SceneError(f"{key}.period = {fmt(T)}: {KEYS[key + '.period'].allowed}")
+        period = as_float(T)
+    elif v.get("period") is not None:
+        raise SceneError(f"{key}.period = {fmt(v['period'])}: only with im: Sa")
+    return im, form, spec, period, math.nan
+
+
+def _suite(ground: dict, base: Path | None) -> tuple[Suite, tuple[str, str, Any] | None]:
+    """The suite of a ``ground.records`` section (records read and hashed, IMs computed
+    now) and the stripe axis's (name, form, spec), None for a cloud."""
+    for k in ("record", "A_ratio"):
+        if ground.get(k) is not None:
+            other = ("ground.scale: {im: PGA_ratio, values: ...}" if k == "A_ratio"
+                     else "a list in ground.records")
+            raise SceneError(f"ground.{k}: not with ground.records (use {other})")
+    paths = _record_paths(ground["records"], base)
+    im, form, spec, period, factor = _scale(ground)
+    records = []
+    for path in paths:
+        try:
+            records.append(read_record(path))
+        except RecordError as err:
+            raise SceneError(f"ground.records: {err}") from None
+    values = _axis_values("ground.scale.values", form, spec).tolist() if im else []
+    try:
+        suite = make_suite(records, [p.name for p in paths], im, values, period, factor,
+                           _periods(ground))
+    except SuiteError as err:
+        raise SceneError(f"ground.records: {err}") from None
+    return suite, ((im, form, spec) if im else None)
 
 
 def _parse(text: str, overrides: list[str], base: Path | None = None,
@@ -635,11 +818,25 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     if raw.get("ground") is None and raw.get("pulse") is None:
         raise SceneError("pulse: missing required section (pulse: {shape, w_over_p, "
                          "A_ratio}, or ground: {record, A_ratio, p} for a record)")
-    record = None
+    record = suite = stripe = None
     if raw.get("ground") is not None:
         ground = _section(raw, "ground", kind, required=True)
-        record = _record(ground, base) if given_record is None else given_record
-        pulse = {"shape": RECORD, "A_ratio": ground["A_ratio"], "p": ground["p"]}
+        if ground.get("records") is not None:
+            suite, stripe = _suite(ground, base)
+            pulse = {"shape": RECORD, "p": ground["p"]}
+        else:
+            for k in ("scale", "periods"):
+                if ground.get(k) is not None:
+                    raise SceneError(f"ground.{k}: works with ground.records (a suite); one "
+                                     "ground.record is scaled by ground.A_ratio")
+            if ground.get("record") is None:
+                raise SceneError("ground.record: missing required key (a record file; or "
+                                 "ground.records and ground.scale for a suite)")
+            if ground.get("A_ratio") is None:
+                raise SceneError("ground.A_ratio: missing required key (a number, a list of "
+                                 "numbers or a range {start, stop, num})")
+            record = _record(ground, base) if given_record is None else given_record
+            pulse = {"shape": RECORD, "A_ratio": ground["A_ratio"], "p": ground["p"]}
     else:
         pulse = _section(raw, "pulse", kind, required=True)
     numerics_sec = _section(raw, "numerics", kind, required=False)
@@ -661,13 +858,13 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
         raise SceneError(f"outputs.check = {fmt(check)}: {KEYS['outputs.check'].allowed}")
 
     # forms and lengths first: the grid's size is known before any value is built
-    if record is None:
+    if record is None and suite is None:
         shapes, shape_swept = _shapes(pulse["shape"])
         section, pulse_axes = "pulse", PULSE_AXES
         options = _pulse_options(pulse, shapes)
     else:
         shapes, shape_swept = (RECORD,), False
-        section, pulse_axes = "ground", ("A_ratio", "p")
+        section, pulse_axes = "ground", ("A_ratio", "p") if suite is None else ("p",)
         options = []
     specs: list[tuple[str, str, str, Any]] = []  # (name, key, form, spec)
     for k in BODY_KEYS[kind]:
@@ -675,12 +872,17 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
         specs.append((k, f"body.{k}", *_axis_spec(f"body.{k}", spec)[:2]))
     lam = impact.get("lam", 0.0)  # a block without an impact section: Housner's corner
     specs.append(("lam", "impact.lam", *_axis_spec("impact.lam", lam)[:2]))
+    if suite is not None:  # the records (words), then the stripes, before p
+        specs.append(("record", "ground.record", "words", suite.names))
+        if stripe is not None:
+            specs.append((stripe[0], f"ground.{stripe[0]}", "stripes", stripe[1:]))
     for k in pulse_axes:
         specs.append((k, f"{section}.{k}", *_axis_spec(f"{section}.{k}", pulse[k])[:2]))
     if mu_spec is not None:  # the last axis: the same grid of runs, flagged per mu
         specs.append(("mu", "body.mu", *_axis_spec("body.mu", mu_spec)[:2]))
     lengths = [len(shapes)] + [1 if form == "scalar" else
-                               (spec["num"] if form == "range" else len(spec))
+                               (spec["num"] if form == "range" else
+                                len(suite.levels) if form == "stripes" else len(spec))
                                for _, _, form, spec in specs]
     size = math.prod(lengths)
     if size > MAX_POINTS:
@@ -690,8 +892,15 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
                          "points per scene (a sweep file stores 45 bytes a point); split it "
                          "into several scenes or use fewer values")
 
-    axes = [Axis("shape", "ground.record" if record else "pulse.shape", shapes, shape_swept)]
+    shape_key = ("ground.record" if record else "ground.shape" if suite else "pulse.shape")
+    axes = [Axis("shape", shape_key, shapes, shape_swept)]
     for name_, key, form, spec in specs:
+        if form == "words":  # a suite's records: always a dimension
+            axes.append(Axis(name_, key, tuple(spec), True))
+            continue
+        if form == "stripes":  # checked by _suite; always a dimension
+            axes.append(Axis(name_, key, suite.levels, True))
+            continue
         values = _axis_values(key, form, spec)
         axes.append(Axis(name_, key, tuple(values.tolist()), form != "scalar"))
     axes.extend(options)  # unswept: the flat index and the result's shape stay as they are
@@ -699,11 +908,12 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     numerics, single = _numerics(numerics_sec, contact)
     scene = Scene(name=name or "rocksweep scene", kind=kind, axes=tuple(axes),
                   numerics=numerics, single_numerics=single, energy=energy, text=text,
-                  contact=contact, check=check, record=record, refine=_refine(raw, kind))
+                  contact=contact, check=check, record=record, refine=_refine(raw, kind),
+                  suite=suite)
     if scene.contact and scene.ground:
         # the contact outputs are compiled into the sine/cosine variants only (a kernel
         # variant per combination costs compile time no scene has asked for yet)
-        what = "a recorded ground motion" if record is not None else "ricker and mp pulses"
+        what = "a recorded ground motion" if scene.recorded else "ricker and mp pulses"
         raise SceneError(f"outputs.contact = true: not available with {what} yet; contact "
                          "outputs work with sine and cosine pulses")
     bodies = _candidate_bodies(scene)
@@ -793,6 +1003,41 @@ def _check_record_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
                             "steps_per_period or a shorter horizon")
 
 
+def _check_suite_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
+    """A suite scene's cost check: for every record, the step cap at the ends of the p
+    axis and at the record's largest scaled peak (the step shrinks with it)."""
+    su = scene.suite
+    p = np.asarray(scene.axis("p").values)
+    p_ends = np.array([p.min(), p.max()])
+    stripes = (np.arange(len(su.levels)) if su.im else None)
+    for b in bodies:
+        body = scene.make_body(**b)
+        alpha = np.array([body.alpha_ref])
+        for r, rec in enumerate(su.records):
+            if stripes is None:
+                peak = su.peak_ratio(np.array([r]), None, alpha, p_ends[:1])
+            else:
+                rr = np.full((stripes.size, 2), r)
+                peak = su.peak_ratio(rr, np.repeat(stripes[:, None], 2, 1), alpha,
+                                     p_ends[None, :])
+            A = np.array([float(np.max(np.abs(peak)))] * 2)
+            for n, label in _runs(scene):
+                _, h_rec, _, _, cap = record_cost(np.array([body_omega_rock(body)] * 2),
+                                                  np.array([body.alpha_ref] * 2), p_ends, A,
+                                                  rec, n)
+                worst = int(np.argmax(np.where(np.isnan(cap), math.inf, cap)))
+                c = float(cap[worst])
+                if not (c <= MAX_POINT_STEPS):
+                    raise SceneError(
+                        f"ground.records: {su.names[r]} at p = {fmt(float(p_ends[worst]))}: "
+                        f"one point could need {c:.2g} RK4 steps{label} (the record's "
+                        f"{rec.npts} samples at steps of {float(h_rec[worst]):.3g} p*t, "
+                        f"scaled to a peak of {A[0]:.3g} g tan(alpha), then {n.horizon:g} "
+                        f"p*t of free vibration), more than the cap of {MAX_POINT_STEPS:.0e} "
+                        "a point; use a smaller p or scale, fewer steps_per_period or a "
+                        "shorter horizon")
+
+
 def _runs(scene: Scene) -> tuple[tuple[Numerics, str], ...]:
     """The numerics a scene's points run at, with the words that name them: the sweeps'
     and the single runs' (``simulate``; `fine`, 4x the steps of `default`, unless the scene
@@ -811,6 +1056,9 @@ def _check_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
     """
     if scene.record is not None:
         _check_record_cost(scene, bodies)
+        return
+    if scene.suite is not None:
+        _check_suite_cost(scene, bodies)
         return
     w = np.asarray(scene.axis("w_over_p").values)
     A = np.asarray(scene.axis("A_ratio").values)

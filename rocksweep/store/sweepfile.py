@@ -140,6 +140,8 @@ COMPUTED_VARIABLE = ("int8", 0, "adaptive sweep: 0 filled (not computed; outcome
                      "audit point that disagreed (region refined)")
 COMPUTED_FLAGS = {0: "filled", 1: "computed", 2: "audit_agreed", 3: "audit_disagreed"}
 
+# Dimensions whose coordinates are words (variable-length strings), not numbers.
+WORD_DIMS = ("shape", "record")
 # Variables whose values are codes (CF flag_values / flag_masks): no units.
 FLAG_VARIABLES = ("outcome", "status", "computed")
 # What h5py raises for I/O and damaged files (HDF5 errors surface as any of these).
@@ -208,6 +210,7 @@ def resolved_scene(scene: Scene, overrides: tuple[str, ...] | list[str] = (),
         **({"contact": True} if scene.contact else {}),
         **({"check": True} if scene.check else {}),
         **({"record": record_attrs(scene.record)} if scene.record is not None else {}),
+        **({"suite": suite_attrs(scene.suite)} if scene.suite is not None else {}),
     }
     if adaptive is not None:
         d["adaptive"] = dict(adaptive)
@@ -228,6 +231,38 @@ def record_attrs(record) -> dict:
     return {"name": record.name, "sha256": record.sha256, "npts": int(record.npts),
             "dt": float(record.dt), "pga": float(record.pga), "title": record.title,
             "source": str(record.source)}
+
+
+def suite_attrs(suite) -> dict:
+    """A suite scene's records and scaling as the resolved scene states them: the stripe
+    IM (None: a cloud), Sa's period [s], the cloud's factor, the stored Sa periods [s] and
+    every record's file name, SHA-256 and the path read (a resume compares names and
+    SHA-256s: the files' bytes, wherever they are)."""
+    def num(v: float):
+        return None if math.isnan(v) else float(v)
+
+    return {"im": suite.im, "period": num(suite.period), "factor": num(suite.factor),
+            "periods": list(suite.periods),
+            "records": [{"name": n, "sha256": r.sha256, "source": str(r.source)}
+                        for n, r in zip(suite.names, suite.records, strict=True)]}
+
+
+def _suite_differences(ss: dict, sn: dict) -> list[str]:
+    """One phrase per difference between two ``suite_attrs`` dicts (records by name)."""
+    diffs = []
+    for k in ("im", "period", "factor", "periods"):
+        if ss.get(k) != sn.get(k):
+            diffs.append(f"ground.scale {k}: file {ss.get(k)!r}, scene {sn.get(k)!r}"
+                         if k != "periods" else
+                         f"ground.periods: file {ss.get(k)!r}, scene {sn.get(k)!r}")
+    new = {r.get("name"): r for r in sn.get("records") or []}
+    for r in ss.get("records") or []:
+        m = new.get(r.get("name"))
+        if m is not None and m.get("sha256") != r.get("sha256"):
+            diffs.append(f"ground.records: {r.get('name')} changed since the sweep (sha256 "
+                         f"{str(r.get('sha256'))[:12]} in the file, {str(m.get('sha256'))[:12]}"
+                         f" now, read from {m.get('source')})")
+    return diffs
 
 
 def _short(v) -> str:
@@ -262,6 +297,13 @@ def scene_differences(stored: dict, new: dict) -> list[str]:
         diffs.append(f"ground.record: file {rs.get('name', 'absent')} (sha256 "
                      f"{str(rs.get('sha256'))[:12]}), scene {rn.get('name', 'absent')} "
                      f"(sha256 {str(rn.get('sha256'))[:12]})")
+    if stored.get("suite") is not None or new.get("suite") is not None:
+        if stored.get("suite") is None or new.get("suite") is None:
+            diffs.append("ground.records: file " + ("a suite" if stored.get("suite") else
+                                                    "no suite") + ", scene " +
+                         ("a suite" if new.get("suite") else "no suite"))
+        else:
+            diffs += _suite_differences(stored["suite"], new["suite"])
     sn, nn = stored.get("numerics", {}), new.get("numerics", {})
     for key in dict.fromkeys([*sn, *nn]):
         if sn.get(key) != nn.get(key):
@@ -317,6 +359,10 @@ def file_bytes(scene: Scene, adaptive: bool = False) -> int:
     per_point = sum(np.dtype(dt).itemsize for dt, _, _ in variables(scene).values())
     per_point += adaptive
     coords = sum(16 * len(a.values) for a in scene.axes)
+    su = scene.suite
+    if su is not None:  # the per-record variables (sha256: 64 characters) and factors
+        R = len(su.records)
+        coords += R * (8 * (5 + len(su.periods)) + 96) + 8 * R * max(1, len(su.levels))
     return per_point * grid.size + coords
 
 
@@ -567,7 +613,7 @@ def _layout(f: h5py.File, path: Path) -> _Layout:
             raise _damaged(path, f"coordinate '{d}' has shape {ds.shape}, the scene "
                            f"{len(values)} values")
         data = ds[()]
-        if d == "shape":
+        if d in WORD_DIMS:
             ok = [_plain(v) for v in data] == values
         else:
             ok = data.dtype.kind == "f" and np.array_equal(data, np.asarray(values, float))
@@ -1135,6 +1181,9 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
         for k, v in record_attrs(scene.record).items():
             a[f"record_{k}"] = v
         _store_record(f, scene.record)
+    if scene.suite is not None:  # the stripes' IM ("none": a cloud) and Sa's period [s]
+        a["scale_im"] = scene.suite.im or "none"
+        a["scale_period"] = float(scene.suite.period)
     for k, v in vers.items():
         a[f"{k}_version"] = v
     a["started"] = _now()
@@ -1160,7 +1209,7 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
 
     scales = []
     for axis in scene.swept:
-        data = (np.array(axis.values, dtype=h5py.string_dtype()) if axis.name == "shape"
+        data = (np.array(axis.values, dtype=h5py.string_dtype()) if axis.name in WORD_DIMS
                 else np.asarray(axis.values, float))
         ds = f.create_dataset(axis.name, data=data)
         ds.make_scale(axis.name)
@@ -1207,6 +1256,77 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
             ds.attrs["coordinates"] = " ".join(scalars)
         for i, sc in enumerate(scales):
             ds.dims[i].attach_scale(sc)
+    if scene.suite is not None:
+        _write_suite(f, scene, {s.name.lstrip("/"): s for s in scales})
+
+
+def suite_variables(scene: Scene) -> dict[str, tuple[tuple[str, ...], np.ndarray]]:
+    """The per-record variables of a suite scene's result: name -> (dims, values):
+    ``record_pga`` [g], ``record_pgv`` [m/s], ``record_sa`` (record, period) [g],
+    ``record_npts``, ``record_dt`` [s], ``record_duration`` [s], ``record_sha256``, and
+    ``scale_factor``: (record, stripe) when scaled, with the swept slenderness (PGA_ratio,
+    PGV_ratio) and p (PGV_ratio) when the factor depends on them; (record,) for a cloud."""
+    su = scene.suite
+    R = len(su.records)
+    out: dict[str, tuple[tuple[str, ...], np.ndarray]] = {
+        "record_pga": (("record",), np.asarray(su.pga, float)),
+        "record_pgv": (("record",), np.asarray(su.pgv, float)),
+        "record_sa": (("record", "period"), np.asarray(su.sa, float)),
+        "record_npts": (("record",), np.array([r.npts for r in su.records], np.int64)),
+        "record_dt": (("record",), np.array([r.dt for r in su.records], float)),
+        "record_duration": (("record",), np.array([r.duration for r in su.records], float)),
+        "record_sha256": (("record",), np.array([r.sha256 for r in su.records], object)),
+    }
+    r = np.arange(R)
+    if su.im is None:
+        out["scale_factor"] = (("record",), su.factors(r, None, np.zeros(R), np.ones(R)))
+        return out
+    dims = ["record", su.im]
+    shape = [R, len(su.levels)]
+    alpha_key = "alpha" if scene.kind == "block" else "alpha_cg"
+    alpha = np.asarray(scene.axis(alpha_key).values, float)
+    p = np.asarray(scene.axis("p").values, float)
+    dep = su.scale_dependence()
+    if "alpha_ref" in dep and scene.axis(alpha_key).swept:
+        dims.append(alpha_key)
+        shape.append(alpha.size)
+    else:
+        alpha = alpha[:1]
+    if "p" in dep and scene.axis("p").swept:
+        dims.append("p")
+        shape.append(p.size)
+    else:
+        p = p[:1]
+    grids = np.meshgrid(r, np.arange(len(su.levels)), alpha, p, indexing="ij")
+    fac = su.factors(grids[0], grids[1], grids[2], grids[3]).reshape(shape)
+    out["scale_factor"] = (tuple(dims), fac)
+    return out
+
+
+def _write_suite(f: h5py.File, scene: Scene, scales: dict) -> None:
+    """The suite's per-record variables (``suite_variables``) with their dimension scales
+    (``period`` made here) and CF attributes (``fields.RECORD_VARIABLES``)."""
+    import h5py
+
+    su = scene.suite
+    per = f.create_dataset("period", data=np.asarray(su.periods, float))
+    per.make_scale("period")
+    for k, v in fields.axis_attrs("period").items():
+        per.attrs[k] = v
+    scales = {**scales, "period": per}
+    for name, (dims, values) in suite_variables(scene).items():
+        if values.dtype == object:
+            ds = f.create_dataset(name, data=values.astype(str).astype(object),
+                                  dtype=h5py.string_dtype())
+        else:
+            ds = f.create_dataset(name, data=values)
+        long_name, units, text = fields.RECORD_VARIABLES[name]
+        ds.attrs["long_name"] = long_name
+        if units is not None:
+            ds.attrs["units"] = units
+        ds.attrs["description"] = text
+        for i, d in enumerate(dims):
+            ds.dims[i].attach_scale(scales[d])
 
 
 def _coord_attrs(ds, axis, kind: str = "flexible") -> None:
@@ -1383,6 +1503,7 @@ def result_scene(result: SweepResult) -> Scene:
     except ValueError:
         raise StoreError(f"{shown(result.path)}: attribute overrides is not JSON") from None
     rec = result.scene.get("record")
+    suite = result.scene.get("suite")
     record = None
     if rec:
         # the file's own copy first (a result stands alone); a file without one re-reads
@@ -1402,12 +1523,16 @@ def result_scene(result: SweepResult) -> Scene:
                 raise StoreError(f"{shown(result.path)}: the record {rec['source']} changed "
                                  f"since the sweep (sha256 {record.sha256[:12]}, the result "
                                  f"has {rec['sha256'][:12]})")
+    elif suite:  # the records where the sweep read them (their SHA-256s are compared)
+        overrides.append("ground.records=" + json.dumps(
+            [str(r.get("source")) for r in suite.get("records") or []]))
     try:
         sc = parse_scene(str(a["scene"]), str(result.path), overrides, record=record)
     except RocksweepError as err:
         raise StoreError(f"{shown(result.path)}: cannot rebuild its scene ({err})") from None
     stored = {k: v for k, v in result.scene.items() if k != "adaptive"}
-    diffs = scene_differences(stored, resolved_scene(sc, overrides))
+    added = bool(suite) and not rec  # the override above is not the file's
+    diffs = scene_differences(stored, resolved_scene(sc, overrides[:len(overrides) - added]))
     if diffs:
         raise StoreError(f"{shown(result.path)}: its scene YAML no longer gives its grid "
                          f"({'; '.join(diffs)})")
@@ -1509,7 +1634,7 @@ def read_result(path: str | Path, names: list[str] | None = None,
             name = key.split(".", 1)[1]
             if ax["swept"]:
                 vals = f[name][()]
-                if name == "shape":
+                if name in WORD_DIMS:
                     vals = np.array([_plain(v) for v in vals])
                 coords[name] = vals
             else:

@@ -1,0 +1,167 @@
+"""``rocksweep fragility``: lognormal fragility curves of a record-suite sweep, as a table,
+JSON, CSV or HDF5 and a figure. A thin wrapper: the file is opened as a Dataset
+(``rocksweep.open``), fitted by ``rocksweep.fragility`` and written or drawn."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import click
+
+from rocksweep.cli.main import main, user_errors
+from rocksweep.cli.options import dpi_option, overwrite_option, result_argument
+
+CURVE_SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
+WIDTHS = ("single", "double")
+
+
+def curve_rows(frag) -> list[dict]:
+    """One flat row per curve (``curves_json`` with the intervals as columns)."""
+    from rocksweep.analysis.fragility import curves_json
+
+    rows = []
+    for c in curves_json(frag)["curves"]:
+        row = {k: v for k, v in c.items() if k not in ("median_ci", "beta_ci")}
+        row["median_lo"], row["median_hi"] = c["median_ci"]
+        row["beta_lo"], row["beta_hi"] = c["beta_ci"]
+        rows.append(row)
+    return rows
+
+
+def csv_text(rows: list[dict]) -> str:
+    import csv
+    import io
+
+    buf = io.StringIO()
+    if rows:
+        w = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: "" if v is None else v for k, v in r.items()})
+    return buf.getvalue()
+
+
+def _g(v) -> str:
+    return "-" if v is None else f"{v:.4g}"
+
+
+@main.command()
+@result_argument
+@click.option("-o", "--output", "out_path", type=click.Path(dir_okay=False, path_type=Path),
+              help="The curves as CSV (.csv: one row per curve) or the whole fragility "
+                   "Dataset as netCDF-4/HDF5 (.h5, .hdf5, .nc: curves, bands, fractions, "
+                   "per-record first levels).")
+@click.option("--plot", "fig_path", type=click.Path(dir_okay=False, path_type=Path),
+              help="Figure of the curves with their bootstrap bands and the fraction at "
+                   "each stripe, .png, .pdf or .svg.")
+@click.option("--state", default="overturn", show_default=True,
+              help="What the curve gives the probability of: overturn, mode1, mode2, "
+                   "uplift or theta:X (max|theta|/alpha_cg >= X); several separated by "
+                   "commas.")
+@click.option("--im", default=None,
+              help="Unscaled suites (clouds): the IM, PGA (default), PGV or Sa; stripes use "
+                   "the IM they were scaled to.")
+@click.option("--period", type=float, default=None,
+              help="With --im Sa: the period [s] (one of the stored ground.periods).")
+@click.option("--bootstrap", type=click.IntRange(0, 100_000), default=200, show_default=True,
+              help="Bootstrap resamples over records for the intervals and bands (0: none).")
+@click.option("--seed", type=click.IntRange(0, 2**63 - 1), default=0, show_default=True,
+              help="Seed of the bootstrap's random generator.")
+@click.option("--ci", type=float, default=0.9, show_default=True,
+              help="Level of the bootstrap intervals and bands.")
+@click.option("--json", "as_json", is_flag=True,
+              help="Print the curves as JSON ({\"curves\": [...]}) instead of a table.")
+@click.option("--width", type=click.Choice(WIDTHS), default="single", show_default=True,
+              help="Figure width: a journal's single or double column.")
+@dpi_option
+@overwrite_option
+@user_errors
+def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, state: str,
+              im: str | None, period: float | None, bootstrap: int, seed: int, ci: float,
+              as_json: bool, width: str, dpi: int, overwrite: bool) -> None:
+    """Fragility curves of a record-suite sweep (a scene with ground.records): the
+    lognormal P(state | IM = x) = Phi(ln(x/median)/beta) fitted by maximum likelihood to
+    the counts at each stripe of a scaled suite, or to the (IM, 0/1) pairs of an unscaled
+    one (Baker 2015), one curve per value of every other swept key (lam first), with
+    bootstrap intervals over records. Points flagged undecided are left out and counted."""
+    import rocksweep
+    from rocksweep.figures.common import FORMATS, save_figure
+    from rocksweep.outputs import check_output, write_atomic
+
+    states = [s.strip() for s in state.split(",") if s.strip()]
+    if not states:
+        raise click.ClickException(f"--state {state!r}: give at least one state")
+    outs = [p for p in (out_path, fig_path) if p is not None]
+    if len({str(p.resolve()) for p in outs}) < len(outs):
+        raise click.ClickException("-o and --plot must name different files")
+    if out_path is not None:
+        if out_path.suffix.lower() not in CURVE_SUFFIXES:
+            raise click.ClickException(
+                f"-o {out_path}: unsupported suffix {out_path.suffix or '(none)'!r}; use "
+                f"{', '.join(CURVE_SUFFIXES[:-1])} or {CURVE_SUFFIXES[-1]}")
+        check_output(out_path, overwrite=overwrite, inputs=[result_path])
+    if fig_path is not None:
+        check_output(fig_path, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
+    ds = rocksweep.open(result_path)
+    frag = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states, im=im,
+                               period=period, bootstrap=bootstrap, seed=seed, ci=ci)
+    frag.attrs["source"] = str(result_path)
+    rows = curve_rows(frag)
+    if as_json:
+        from rocksweep.analysis.fragility import curves_json
+
+        click.echo(json.dumps(curves_json(frag), allow_nan=False))
+    else:
+        _print_table(frag, rows)
+    say = click.echo if not as_json else (lambda m: click.echo(m, err=True))
+    if out_path is not None:
+        if out_path.suffix.lower() == ".csv":
+            text = csv_text(rows)
+            write_atomic(out_path, lambda tmp: tmp.write_text(text))
+        else:
+            write_atomic(out_path, lambda tmp: _to_netcdf(frag, tmp))
+        say(f"wrote {out_path} ({len(rows)} curve{'s' * (len(rows) != 1)})")
+    if fig_path is not None:
+        from rocksweep.figures.fragility import fragility_figure
+
+        fig = fragility_figure(frag, width=width)
+        save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=[result_path])
+        say(f"wrote {fig_path}")
+
+
+def _to_netcdf(frag, path: Path) -> None:
+    """The fragility Dataset as netCDF-4 (h5netcdf): strings as fixed text, attrs plain."""
+    out = frag.copy()
+    out.attrs = {k: (json.dumps(v) if isinstance(v, list | dict) else v)
+                 for k, v in frag.attrs.items()}
+    for name in list(out.variables):
+        if out[name].dtype.kind in ("U", "O"):
+            out[name] = out[name].astype(str)
+    out.to_netcdf(path, engine="h5netcdf")
+
+
+def _print_table(frag, rows: list[dict]) -> None:
+    a = frag.attrs
+    im = a.get("im")
+    unit = a.get("im_units", "")
+    per = f" at T = {a['period']:g} s" if "period" in a else ""
+    click.echo(f"{a.get('title') or 'fragility'}: {a.get('method')} on {im}{per} [{unit}], "
+               f"bootstrap {a.get('bootstrap')} (seed {a.get('seed')}, {a.get('ci'):g} "
+               "intervals)")
+    if not rows:
+        return
+    fixed = ("state", "im", "method", "median", "beta", "median_lo", "median_hi", "beta_lo",
+             "beta_hi", "n_records", "n_excluded", "reason")
+    keys = [k for k in rows[0] if k not in fixed]
+    head = [*keys, "state", "median", "(lo, hi)", "beta", "(lo, hi)", "records",
+            "excluded", "fit"]
+    lines = [head]
+    for r in rows:
+        lines.append([*(str(r[k]) for k in keys), r["state"], _g(r["median"]),
+                      f"({_g(r['median_lo'])}, {_g(r['median_hi'])})", _g(r["beta"]),
+                      f"({_g(r['beta_lo'])}, {_g(r['beta_hi'])})", str(r["n_records"]),
+                      str(r["n_excluded"]), r["reason"]])
+    widths = [max(len(line[i]) for line in lines) for i in range(len(head))]
+    for line in lines:
+        click.echo("  ".join(c.ljust(w) for c, w in zip(line, widths, strict=True)).rstrip())
