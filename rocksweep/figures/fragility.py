@@ -117,6 +117,6 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
     title = method + (f", {frag.attrs.get('ci', 0.9):g} band of {boot} resamples"
                       if boot else "")
     ax.set_title(title, fontsize="small")
-    ax.legend(fontsize="x-small", loc="upper left")
+    ax.legend(fontsize="x-small", loc="lower right")
     ax.grid(True, which="both", alpha=0.25, linewidth=0.5)
     return fig
