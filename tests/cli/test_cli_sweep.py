@@ -20,7 +20,7 @@ from rocksweep.compute.sweep import ChunkResult, variables
 from rocksweep.numerics import PRESETS
 from rocksweep.store.sweepfile import SweepFile, read_result
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 CI_SMALL = ROOT / "configs" / "ci-small.yaml"
 
 BODY3 = FIG3_YAML

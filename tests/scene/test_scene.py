@@ -21,7 +21,7 @@ from rocksweep.physics.model import BlockBody, BodyError, FlexibleBody
 from rocksweep.physics.points import body_omega_rock
 from rocksweep.scene.scene import MAX_POINTS, SceneError, load_scene, parse_scene
 
-CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
 TABLE3 = dict(FIG3)
 GOOD = """

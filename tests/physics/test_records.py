@@ -25,7 +25,7 @@ from rocksweep.physics.records import (
     write_at2,
 )
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 RECORDS = ROOT / "records"
 
 NGA_HEAD = ("PEER NGA STRONG MOTION DATABASE RECORD\n"

@@ -15,7 +15,7 @@ from rocksweep.cli import main
 from rocksweep.errors import OutputError
 from rocksweep.outputs import check_output, write_atomic
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 ONE_POINT = ["--set", "pulse.shape=sine", "--set", "impact.lam=0", "--set",
              "pulse.w_over_p=2", "--set", "pulse.A_ratio=3"]
 

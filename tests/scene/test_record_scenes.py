@@ -34,7 +34,7 @@ from rocksweep.physics.points import RECORD, Point
 from rocksweep.physics.records import read_record
 from rocksweep.scene.scene import SceneError, load_scene, parse_scene
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SINE = ROOT / "records" / "sine_1cycle.AT2"
 NEARFAULT = ROOT / "records" / "synthetic_nearfault.AT2"
 

@@ -24,7 +24,7 @@ from rocksweep.physics.model import FlexibleBody
 from rocksweep.scene.scene import load_scene
 from rocksweep.store.sweepfile import read_result
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 CI_SMALL = ROOT / "configs" / "ci-small.yaml"
 FIG5 = ROOT / "configs" / "fig5.yaml"
 

@@ -12,7 +12,7 @@ import pytest
 from rocksweep.physics.intensity import velocity
 from rocksweep.physics.records import at2_text, read_record
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SUITE = ROOT / "records" / "suite"
 
 

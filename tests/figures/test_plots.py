@@ -18,7 +18,7 @@ from rocksweep.compute.sweep import ChunkResult, variables
 from rocksweep.errors import RocksweepError
 from rocksweep.store.sweepfile import SweepFile, read_result
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 BODY3 = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: {start: 0.1, stop: 0.2, num: 3}, "
          "alpha_A: 0.28, mA_over_m: 0.47, IA_ratio: 0.56}\n")
 

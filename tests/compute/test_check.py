@@ -129,7 +129,7 @@ def test_record_scene_half_step(tmp_path):
     a short grid of the shipped demo record."""
     from pathlib import Path
 
-    cfg = Path(__file__).resolve().parents[1] / "configs" / "record-demo.yaml"
+    cfg = Path(__file__).resolve().parents[2] / "configs" / "record-demo.yaml"
     scene = parse_scene(cfg.read_text(), source=str(cfg), base=cfg.parent,
                         overrides=["outputs.check=true", "ground.A_ratio=[0.8, 2.5]",
                                    "ground.p=[1.0, 2.0, 4.0]"])

@@ -16,7 +16,7 @@ from matplotlib.figure import Figure
 import rocksweep
 from rocksweep.cli import main
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 CI_SMALL = ROOT / "configs" / "ci-small.yaml"
 SINE = {"pulse.shape": "sine"}
 

@@ -162,7 +162,7 @@ def test_cli_ladder_choices_are_the_ladders():
     assert list(opt.type.choices) == list(LADDERS)
 
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.mark.parametrize("name, sets", [

@@ -30,7 +30,7 @@ from rocksweep.physics.model import G
 from rocksweep.physics.records import read_record, write_at2
 from rocksweep.scene.scene import SceneError, load_scene, parse_scene
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SUITE = ROOT / "records" / "suite"
 NAMES = ["SYN01.AT2", "SYN05.AT2", "SYN12.AT2"]
 

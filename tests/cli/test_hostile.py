@@ -27,7 +27,7 @@ from rocksweep.physics.records import at2_text
 
 pytestmark = pytest.mark.faults
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 RECORD = ROOT / "records" / "synthetic_nearfault.AT2"
 BODY = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47, "
         "IA_ratio: 0.56}\nimpact: {lam: 0.0}\n")

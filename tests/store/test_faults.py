@@ -40,7 +40,7 @@ from rocksweep.store.sweepfile import SESSION_ATTRS, StoreError, SweepFile, read
 
 pytestmark = pytest.mark.faults
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 CI_SMALL = ROOT / "configs" / "ci-small.yaml"
 
 # 2 x 3 x 4 x 5 = 120 points, synthetic results (no kernel)
