@@ -1,8 +1,8 @@
 """A scene's grid: axes -> flat point index -> kernel parameter rows, one chunk at a time.
 
 The grid is the Cartesian product of the scene's axes in ``Scene.axes`` order (shape, body
-keys, lam, A_ratio, w_over_p or a record's p; that one varies fastest; then the pulse's
-unswept options). A point is named by its flat
+keys, lam, the impact law's keys given (law, e, e_factor), A_ratio, w_over_p or a record's
+p; that one varies fastest; then the pulse's unswept options). A point is named by its flat
 (C-order) index ``0 <= i < size``. Nothing here materialises all points: a chunk of flat
 indices is unravelled on its own, and the body-dependent part of the rows (``body_row``,
 the spring frequency, alpha_ref, E_ref, the kernel kind) is computed once per distinct
@@ -18,7 +18,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.physics.points import body_omega_rock, body_row, fill_rows, kernel_kind, shape_code
+from rocksweep.physics.points import (
+    body_omega_rock,
+    body_row,
+    fill_rows,
+    kernel_kind,
+    law_code,
+    shape_code,
+)
 from rocksweep.scene.scene import Scene
 
 
@@ -62,8 +69,14 @@ class Grid:
         self._i_w = names.index(scene.freq_axis)  # w_over_p, or p [rad/s] for a record
         self._i_A = names.index("A_ratio")
         self._shape_codes = np.array([shape_code(s) for s in scene.axes[self._i_shape].values])
-        self._values = [np.asarray(a.values, float) if i != self._i_shape else None
-                        for i, a in enumerate(scene.axes)]
+        # the impact law's axes, when the scene gives them (else eq. 1's defaults)
+        self._i_law = names.index("law") if "law" in names else None
+        self._i_e = names.index("e") if "e" in names else None
+        self._i_ef = names.index("e_factor") if "e_factor" in names else None
+        self._law_codes = (None if self._i_law is None else
+                           np.array([law_code(w) for w in scene.axes[self._i_law].values]))
+        self._values = [np.asarray(a.values, float) if a.name not in ("shape", "law")
+                        else None for a in scene.axes]
 
     def coords(self) -> dict[str, np.ndarray]:
         """Coordinate values of each swept dimension (strings for ``shape``)."""
@@ -112,6 +125,11 @@ class Grid:
         n = flat.size
         rows = np.empty((n, L.N_PAR))
         alpha_ref = b_alpha[inverse]
+        law = (L.LAW_VERTICAL if self._i_law is None
+               else self._law_codes[multi[self._i_law]])
+        e = np.nan if self._i_e is None else self._values[self._i_e][multi[self._i_e]]
+        e = np.where(law == L.LAW_CONSTANT, e, np.nan)  # e is law constant's alone
+        e_factor = 1.0 if self._i_ef is None else self._values[self._i_ef][multi[self._i_ef]]
         fill_rows(rows, b_rows[inverse], b_omega[inverse], alpha_ref,
                   self._values[self._i_lam][multi[self._i_lam]],
                   self._shape_codes[multi[self._i_shape]],
@@ -119,7 +137,8 @@ class Grid:
                   self._values[self._i_A][multi[self._i_A]], self.scene.numerics,
                   self.scene.option("cycles"), self.scene.option("gamma"),
                   self.scene.option("nu"), self.scene.record,
-                  np.nan if self._i_mu is None else self._values[self._i_mu][multi[self._i_mu]])
+                  np.nan if self._i_mu is None else self._values[self._i_mu][multi[self._i_mu]],
+                  law, e, e_factor)
         return ChunkRows(rows, b_kind[inverse], alpha_ref, b_E[inverse])
 
     def kinds(self) -> list[int]:
