@@ -587,7 +587,7 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
 
 def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any = None,
          curves: bool = False, show_computed: bool = False,
-         width: str | None = None) -> Figure:
+         width: str | None = None, compare: str | None = None) -> Figure:
     """The stability diagram of a result (Figures 3 and 4) as a pyplot-free Figure.
 
     ds: what ``run`` or ``open`` returns. x, y: the swept keys on the axes (default
@@ -596,7 +596,9 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     a line plot. ax: an Axes (or one per panel) to draw into; the legend then goes outside
     the axes, once per figure. curves: the class boundary lines; show_computed: shade
     the points an adaptive sweep computed. width: "single" or "double" (journal column
-    widths with fonts to match), None for matplotlib's defaults.
+    widths with fonts to match), None for matplotlib's defaults. compare: a swept key
+    (e.g. "impact.law" or "lam") whose values are compared on one diagram, coloured by
+    which of them overturn each cell (``rocksweep plot --compare``).
     """
     import matplotlib
 
@@ -607,7 +609,7 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     result = as_result(ds)
     with matplotlib.rc_context(width_style(width)):
         return sweep_figure(result, x, y, axes=ax, option_names=("x", "y"), curves=curves,
-                            show_computed=show_computed)
+                            show_computed=show_computed, compare=compare)
 
 
 def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None) -> xr.Dataset:
