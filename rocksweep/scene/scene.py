@@ -450,7 +450,7 @@ def _impact_law(impact: dict) -> tuple[Axis | None, list[tuple[str, str, Any]]]:
     e_spec = impact.get("e")
     if e_spec is None and "constant" in laws:
         raise SceneError("impact.e: missing; law constant needs its coefficient of "
-                         f"restitution ({KEYS['impact.e'].allowed.removeprefix('must be ')})")
+                         "restitution e: a number in (0, 1], a list or a range")
     if e_spec is not None:
         if "constant" not in laws:
             raise SceneError(f"impact.e = {fmt(e_spec)}: only law constant uses e (the law "
