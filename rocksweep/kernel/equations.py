@@ -32,6 +32,8 @@ from numba.extending import overload
 
 from rocksweep.kernel._cache import INTERNAL
 from rocksweep.kernel.layout import (
+    LAW_CONSTANT,
+    LAW_LOCKED,
     PAR_AMP,
     PAR_AMP_NORM,
     PAR_B,
@@ -57,8 +59,6 @@ from rocksweep.kernel.layout import (
     PAR_REC,
     PAR_REC_DT,
     PAR_SHAPE,
-    LAW_CONSTANT,
-    LAW_LOCKED,
     SHAPE_COSINE,
     SHAPE_RECORD,
     SHAPE_RICKER,

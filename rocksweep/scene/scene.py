@@ -425,7 +425,8 @@ def _words(key: str, spec: Any) -> tuple[tuple[str, ...], bool]:
             if not (isinstance(v, str) and v in allowed.choices):
                 raise SceneError(f"{key} = {fmt(v)}: {allowed.allowed}")
         if len(set(spec)) < len(spec):
-            raise SceneError(f"{key} = {fmt(spec)}: a value is given twice; the values "
+            noun = key.split(".")[1]  # shape, law
+            raise SceneError(f"{key} = {fmt(spec)}: a {noun} is given twice; the values "
                              "of an axis must differ")
         return tuple(spec), True
     if not (isinstance(spec, str) and spec in allowed.choices):
