@@ -717,7 +717,8 @@ def _dataset(source: Path | Any) -> xr.Dataset:
 @speaks_python
 def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any = None,
          curves: bool = False, show_computed: bool = False, mu: bool = False,
-         width: str | None = None, _names: tuple[str, str] = ("x", "y")) -> Figure:
+         width: str | None = None, compare: str | None = None,
+         _names: tuple[str, ...] = ("x", "y", "compare")) -> Figure:
     """The stability diagram of a result (Figures 3 and 4) as a pyplot-free Figure.
 
     ds: what ``run`` or ``open`` returns. x, y: the swept keys on the axes (default
@@ -728,8 +729,10 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     the points an adaptive sweep computed. mu: the friction demand ``mu_required`` (a
     result with contact outputs) as a contour map instead of the classes. width:
     "single" or "double" (journal column widths with fonts to match), None for
-    matplotlib's defaults. A result with per-point error estimates rings the points
-    whose outcome changes at half the step.
+    matplotlib's defaults. compare: a swept key (e.g. "impact.law" or "lam") whose values
+    are compared on one diagram, coloured by which of them overturn each cell (``rocksweep
+    plot --compare``). A result with per-point error estimates rings the points whose
+    outcome changes at half the step.
     """
     import matplotlib
 
@@ -741,10 +744,11 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     style = width_style(width)
     with matplotlib.rc_context(style):
         if mu:
-            fig = friction_map(result, x, y, option_names=_names)
+            fig = friction_map(result, x, y, option_names=_names[:2])
         else:
-            fig = sweep_figure(result, x, y, axes=ax, option_names=_names, curves=curves,
-                               show_computed=show_computed)
+            fig = sweep_figure(result, x, y, axes=ax, option_names=_names[:2], curves=curves,
+                               show_computed=show_computed, compare=compare,
+                               compare_option=_names[2])
     if style and ax is None:  # the preset's width, the layout's aspect
         w, h = fig.get_size_inches()
         inches = style["figure.figsize"][0]

@@ -261,6 +261,9 @@ AXES: dict[str, AxisMeta] = {
                         r"A/(g\tan\alpha_{ref})"),
     "p": AxisMeta("frequency parameter of the body", "rad/s", "p", "p"),
     "lam": AxisMeta("impulse position ratio (Pi10)", "1", "lambda", r"\lambda"),
+    "law": AxisMeta("impact law", "", "law", "impact law"),
+    "e": AxisMeta("coefficient of restitution of law constant", "1", "e", "e"),
+    "e_factor": AxisMeta("factor on the impact law's e", "1", "e_factor", r"e\ factor"),
     "wn_over_p": AxisMeta("spring frequency ratio (Pi1)", "1", "omega_n/p", r"\omega_n/p"),
     "zeta": AxisMeta("damping ratio (Pi2)", "1", "zeta", r"\zeta"),
     "alpha_cg": AxisMeta("slenderness of the centre of gravity (Pi3)", "rad", "alpha_cg",
@@ -308,6 +311,12 @@ RECORD_VARIABLES: dict[str, tuple[str, str | None, str]] = {
                      "the record's accelerations times this factor make the point's ground "
                      "motion (stripes: its IM equals the stripe's value)"),
 }
+
+
+# Swept axes whose values are words (stored as strings), and their scene keys (a record
+# scene's shape is "record", under ground.record or, for a suite, ground.shape)
+WORD_AXES = ("shape", "law", "record")
+WORD_KEYS = ("pulse.shape", "ground.shape", "ground.record", "impact.law")
 
 
 def axis_attrs(name: str, kind: str = "flexible") -> dict[str, str]:

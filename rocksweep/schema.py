@@ -31,6 +31,7 @@ RATIO_MAX = 1e6  # bound of the body's ratios (see the module docstring)
 ANGLE_MIN = 1e-6  # [rad] smallest slenderness: h/b = 1e6
 CYCLES_MAX = 1000  # pulse.cycles: more cycles than this are no pulse
 GAMMA_MAX = 100.0  # pulse.gamma: MP's gamma is 1-3 for near-fault records; 100 is plenty
+E_FACTOR_MAX = 10.0  # impact.e_factor: experiments scale e by a few tens of per cent
 
 
 @dataclass(frozen=True)
@@ -82,6 +83,14 @@ KEYS: dict[str, Key] = {
     "body.inertia": Key("axis", f"must be in [1, {RATIO_MAX:g}] (I_O / (M R^2) >= 1)",
                         1.0, RATIO_MAX, required=False, default=4.0 / 3.0),
     "impact.lam": Key("axis", "must be in [0, 2]", 0.0, 2.0),
+    # impact laws (rocksweep.physics.impact): the law is a swept word axis like pulse.shape
+    "impact.law": Key("choices", "must be vertical, locked, constant or a list of them",
+                      choices=("vertical", "locked", "constant"), required=False,
+                      default="vertical"),
+    "impact.e": Key("axis", "must be in (0, 1] (the coefficient of restitution of law "
+                    "constant)", 0.0, 1.0, lo_in=False, required=False),
+    "impact.e_factor": Key("axis", f"must be in (0, {E_FACTOR_MAX:g}] (multiplies the law's "
+                           "e)", 0.0, E_FACTOR_MAX, lo_in=False, required=False, default=1.0),
     "pulse.shape": Key("choices", "must be sine, cosine, ricker, mp or a list of them",
                        choices=("sine", "cosine", "ricker", "mp")),
     "pulse.w_over_p": Key("axis", "must be > 0 and finite (the pulse lasts 2 pi/omega)",

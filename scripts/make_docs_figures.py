@@ -51,12 +51,13 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--dpi", type=int, default=200, help="resolution of the PNGs [200]")
     ap.add_argument("--only", nargs="+", metavar="NAME",
                     choices=[*DIAGRAMS, "fig3a_check", "fig5", "fig2", "fragility",
-                             "accuracy_fig3a"],
+                             "accuracy_fig3a", "impact_laws", "fig2_locked"],
                     help="regenerate only these figures")
     ap.add_argument("--docs", type=Path, default=ROOT / "docs", help="output directory")
     ap.add_argument("--keep", type=Path, metavar="DIR", help="keep the sweep results here")
     args = ap.parse_args(argv)
-    wanted = set(args.only or [*DIAGRAMS, "fig3a_check", "fig5", "fig2", "fragility"]
+    wanted = set(args.only or [*DIAGRAMS, "fig3a_check", "fig5", "fig2", "fragility",
+                               "impact_laws", "fig2_locked"]
                  + (["accuracy_fig3a"] if args.accuracy else []))
     args.docs.mkdir(parents=True, exist_ok=True)
     if args.keep:
@@ -106,6 +107,17 @@ def main(argv: list[str] | None = None) -> None:
                       str(args.dpi))
             publish("fragility")
             print(f"  fragility: {time.perf_counter() - t0:.1f} s", flush=True)
+        if "impact_laws" in wanted:  # issue 21: which laws overturn each cell
+            h5 = (args.keep or tmp) / "impact_laws.h5"
+            rocksweep("sweep", str(cfg / "impact-laws.yaml"), "-o", str(h5), "--jobs",
+                      str(args.jobs), "--quiet", "--overwrite")
+            rocksweep("plot", str(h5), "--compare", "impact.law", "-o",
+                      str(tmp / "impact_laws.png"), "--dpi", str(args.dpi))
+            publish("impact_laws")
+        if "fig2_locked" in wanted:
+            rocksweep("restitution", str(cfg / "fig2.yaml"), "--law", "locked", "--plot",
+                      str(tmp / "fig2_locked.png"))
+            publish("fig2_locked")
         if "accuracy_fig3a" in wanted:
             t0 = time.perf_counter()
             rocksweep("accuracy", str(cfg / "fig3a.yaml"), "--points", "200", "--quiet",

@@ -88,8 +88,9 @@ def counts_by_key(result: SweepResult) -> dict[str, list[dict]]:
 
 
 def shape_lam_counts(result: SweepResult) -> list[dict]:
-    """Counts per pulse shape and lam (the paper's comparison of Figures 3 and 4)."""
-    return class_counts(result, ["shape", "lam"])
+    """Counts per pulse shape and lam (the paper's comparison of Figures 3 and 4), and per
+    impact law when the law is swept (``impact.law``)."""
+    return class_counts(result, ["shape", *(["law"] if "law" in result.dims else []), "lam"])
 
 
 def in_ranges(rows: list[dict], key: str, max_rows: int = MAX_ROWS) -> list[dict]:
@@ -306,12 +307,14 @@ def format_info(d: dict) -> list[str]:
                      + (f", {ad['undecided']} not decided yet" if ad["undecided"] else ""))
         lines.append(f"  audit: {ad['audited']} points, {ad['audit_misses']} disagreed with "
                      "their fill" + (f" (warning: {ad['warning']})" if ad["warning"] else ""))
-    lines.append("counts per pulse shape and lam:")
+    law = bool(d["counts"]) and "law" in d["counts"][0]
+    lines.append(f"counts per pulse shape{', impact law' if law else ''} and lam:")
     lines += format_counts(in_ranges(d["counts"], "lam"), "  ")
     ck = d.get("check")
     if ck:
         lines += format_check(ck)
-    by_key = {k: rows for k, rows in d["counts_by_key"].items() if k not in ("shape", "lam")}
+    by_key = {k: rows for k, rows in d["counts_by_key"].items()
+              if k not in ("shape", "lam", "law")}
     if by_key:
         lines.append("counts per swept key (the other keys summed):")
         for key, rows in by_key.items():

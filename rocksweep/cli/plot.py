@@ -28,13 +28,17 @@ from rocksweep.cli.options import dpi_option, overwrite_option
 @click.option("--curves", is_flag=True,
               help="Overlay the boundary lines between classes, one colour per lam "
                    "(`rocksweep boundaries` gives them as CSV, with A_min).")
+@click.option("--compare", "compare_key", metavar="KEY",
+              help="Compare the values of a swept key on one diagram, e.g. impact.law: the "
+                   "colour says which values overturn a cell, the mode 1 area per value in "
+                   "each panel; with --curves each value's boundaries.")
 @click.option("--show-computed", "show_computed", is_flag=True,
               help="Adaptive sweeps: shade the cells that were computed (the filled ones "
                    "stay clear); by default both are drawn alike.")
 @user_errors
 def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str | None,
          dpi: int, overwrite: bool, curves: bool, show_computed: bool,
-         mu_map: bool) -> None:
+         mu_map: bool, compare_key: str | None) -> None:
     """Draw the stability diagram of a sweep: by default x = omega/p, y = A/(g tan
     alpha_cg); --x/--y pick any two swept axes. Mode 1 / mode 2 / safe regions, one panel
     per pulse shape and per other swept key, the growth of the mode 1 area with lam in
@@ -42,7 +46,8 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
     against it, markers by outcome. Cells an adaptive sweep filled are drawn as computed
     ones. With contact outputs and body.mu, the points that would slide are hatched (and
     those that would lift off dotted); --mu draws mu_required. A sweep with --check rings
-    the points whose outcome changes at half the step."""
+    the points whose outcome changes at half the step. --compare KEY (e.g. impact.law)
+    draws one diagram coloured by which of KEY's values overturn each cell."""
     from rocksweep import api
     from rocksweep.figures import FORMATS
     from rocksweep.figures.common import save_figure
@@ -53,9 +58,11 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
     fig_out = fig_path if fig_path is not None else result_path.with_suffix(".png")
     # refuse a bad output before reading the result and drawing
     check_output(fig_out, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
+    if mu_map and compare_key is not None:
+        raise click.ClickException("--mu and --compare draw different figures; give one")
     ds = api.open(result_path)
     fig = api.plot(ds, x_key, y_key, curves=curves, show_computed=show_computed, mu=mu_map,
-                   _names=("--x", "--y"))
+                   compare=compare_key, _names=("--x", "--y", "--compare"))
     save_figure(fig, fig_out, dpi, overwrite=overwrite, inputs=[result_path])
     for w in missing_warnings(as_result(ds)):
         click.echo(f"warning: {w}", err=True)

@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 import click
+import numpy as np
 
 from rocksweep.cli.main import (
     load,
@@ -29,10 +30,16 @@ from rocksweep.cli.main import (
               help="Number of lam values in [0, 1].")
 @click.option("--n-u", default=81, show_default=True, type=click.IntRange(2, 100001),
               help="Number of u/u_cr values in [-2, 2].")
+@click.option("--law", type=click.Choice(["vertical", "locked", "constant"]),
+              help="Impact law (as --set impact.law=LAW) [default: the scene's, else "
+                   "vertical: eq. (1)]; constant takes its e from impact.e.")
 @user_errors
 def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
-                    plot_path: Path | None, overwrite: bool, n_lam: int, n_u: int) -> None:
-    """Coefficient of restitution e(lam, u/u_cr) of eq. (1) for the scene's body.
+                    plot_path: Path | None, overwrite: bool, n_lam: int, n_u: int,
+                    law: str | None) -> None:
+    """Coefficient of restitution e(lam, u/u_cr) of eq. (1), or of the impact law, for the
+    scene's body, and for each u/u_cr the largest lam at which an impact cannot gain
+    energy (the paper: such lam "need to be avoided").
 
     Both transition directions: "upper" is the paper's upper sign (in rocksweep: rocking on
     the +b corner ends, u positive toward +b), "lower" the other.
@@ -44,22 +51,45 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
         from rocksweep.figures.common import FORMATS
 
         check_output(plot_path, overwrite=overwrite, inputs=[scene_path], suffixes=FORMATS)
+    if law is not None:  # e belongs to law constant alone
+        overrides = (*overrides, f"impact.law={law}",
+                     *(("impact.e=null",) if law != "constant" else ()))
     table = restitution_table(load(scene_path, overrides), n_lam, n_u)
     if as_json:
         click.echo(json.dumps(table.as_dict()))
     else:
         e = table.e_upper
         click.echo(table.title)
+        what = {"vertical": "eq. (1)", "locked": "top mass locked to the base",
+                "constant": f"e = {table.e:g}"}[table.law]
+        factor = f", e_factor {table.e_factor:g}" if table.e_factor != 1.0 else ""
+        click.echo(f"impact law: {table.law} ({what}{factor})")
         click.echo(f"e at lam = 0, u = 0: {table.e_at_rest:.4f}  (Housner, same body rigid: "
                    f"{table.e_housner:.4f})")
         click.echo(f"e over lam in [0, 1], u/u_cr in [-2, 2]: min {e.min():.4f}, "
                    f"max {e.max():.4f}; e > 1 at {int((e > 1).sum())} of {e.size} "
                    "points (upper sign)")
+        click.echo("largest lam at which an impact cannot gain energy (upper sign"
+                   + (", u' = 0" if table.law == "locked" else "") + "):")
+        u = table.u_over_ucr
+        picks = [int(i) for i in dict.fromkeys(
+            int(abs(u - v).argmin()) for v in (-2.0, -1.0, 0.0, 1.0, 2.0))]
+        click.echo("  " + "   ".join(f"u/u_cr {u[i]:g}: {_lam_text(table.lam_limit[i])}"
+                                     for i in picks))
+        lim = table.lam_limit
+        worst = "every lam gains" if bool(np.isnan(lim).any()) else _lam_text(lim.min())
+        click.echo(f"  over u/u_cr in [-2, 2]: {worst}")
     if plot_path is not None:
         from rocksweep.figures.common import restitution_map, save_figure
 
         fig = restitution_map(table.lam, table.u_over_ucr, table.e_upper, table.e_housner,
-                              table.title)
+                              table.title, lam_limit=table.lam_limit, law=table.law)
         save_figure(fig, plot_path, overwrite=overwrite, inputs=[scene_path])
         if not as_json:
             click.echo(f"wrote {plot_path}")
+
+
+def _lam_text(v: float) -> str:
+    if np.isnan(v):
+        return "none (every lam gains)"
+    return "none up to 2" if v >= 2.0 else f"{v:.4f}"

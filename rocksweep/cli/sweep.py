@@ -163,6 +163,11 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     result = read_info(out) if scene.check else read_result(out, ["outcome", "status"])
     for line in counts_lines(result):
         click.echo(line)
+    from rocksweep.analysis.restitution import energy_note
+
+    note = energy_note(scene)
+    if note:
+        click.echo(note)
     a = report.attrs
     resumed = f" ({report.done_before} were done before)" if report.done_before else ""
     click.echo(f"computed {report.computed} points{resumed} in {report.wall_s:.2f} s wall "

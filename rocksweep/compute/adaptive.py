@@ -180,7 +180,7 @@ def make_plan(grid_or_scene: Grid | Scene, axes: Sequence[str] = DIAGRAM_AXES,
             raise AdaptiveError(f"axis {name!r}: not an axis of the scene (axes: "
                                 f"{', '.join(names)})")
         ax = scene.axis(name)
-        if name == "shape" or len(ax.values) < 2:
+        if name in ("shape", "law") or len(ax.values) < 2:  # word axes: no order
             raise AdaptiveError(f"axis {name} ({ax.key}): a diagram axis must be a swept "
                                 f"numeric axis with >= 2 values (has {len(ax.values)})")
         pos.append(names.index(name))

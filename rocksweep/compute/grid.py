@@ -1,8 +1,8 @@
 """A scene's grid: axes -> flat point index -> kernel parameter rows, one chunk at a time.
 
 The grid is the Cartesian product of the scene's axes in ``Scene.axes`` order (shape, body
-keys, lam, A_ratio, w_over_p or a record's p; that one varies fastest; then the pulse's
-unswept options). A point is named by its flat
+keys, lam, the impact law's keys given (law, e, e_factor), A_ratio, w_over_p or a record's
+p; that one varies fastest; then the pulse's unswept options). A point is named by its flat
 (C-order) index ``0 <= i < size``. Nothing here materialises all points: a chunk of flat
 indices is unravelled on its own, and the body-dependent part of the rows (``body_row``,
 the spring frequency, alpha_ref, E_ref, the kernel kind) is computed once per distinct
@@ -18,7 +18,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.physics.points import body_omega_rock, body_row, fill_rows, kernel_kind, shape_code
+from rocksweep.physics.points import (
+    body_omega_rock,
+    body_row,
+    fill_rows,
+    kernel_kind,
+    law_code,
+    shape_code,
+)
 from rocksweep.scene.scene import Scene
 
 
@@ -68,8 +75,15 @@ class Grid:
         self._i_rec = names.index("record") if suite is not None else None
         self._i_stripe = names.index(suite.im) if suite is not None and suite.im else None
         self._shape_codes = np.array([shape_code(s) for s in scene.axes[self._i_shape].values])
-        self._values = [np.asarray(a.values, float) if i not in (self._i_shape, self._i_rec)
-                        else None for i, a in enumerate(scene.axes)]
+        # the impact law's axes, when the scene gives them (else eq. 1's defaults)
+        self._i_law = names.index("law") if "law" in names else None
+        self._i_e = names.index("e") if "e" in names else None
+        self._i_ef = names.index("e_factor") if "e_factor" in names else None
+        self._law_codes = (None if self._i_law is None else
+                           np.array([law_code(w) for w in scene.axes[self._i_law].values]))
+        self._values = [np.asarray(a.values, float)
+                        if i not in (self._i_shape, self._i_rec, self._i_law) else None
+                        for i, a in enumerate(scene.axes)]
 
     def coords(self) -> dict[str, np.ndarray]:
         """Coordinate values of each swept dimension (strings for ``shape``)."""
@@ -118,9 +132,14 @@ class Grid:
         n = flat.size
         rows = np.empty((n, L.N_PAR))
         alpha_ref = b_alpha[inverse]
+        law = (L.LAW_VERTICAL if self._i_law is None
+               else self._law_codes[multi[self._i_law]])
+        e = np.nan if self._i_e is None else self._values[self._i_e][multi[self._i_e]]
+        e = np.where(law == L.LAW_CONSTANT, e, np.nan)  # e is law constant's alone
+        e_factor = 1.0 if self._i_ef is None else self._values[self._i_ef][multi[self._i_ef]]
         if self.scene.suite is not None:
             return self._suite_rows(multi, rows, b_rows[inverse], b_omega[inverse], alpha_ref,
-                                    b_kind[inverse], b_E[inverse])
+                                    b_kind[inverse], b_E[inverse], (law, e, e_factor))
         fill_rows(rows, b_rows[inverse], b_omega[inverse], alpha_ref,
                   self._values[self._i_lam][multi[self._i_lam]],
                   self._shape_codes[multi[self._i_shape]],
@@ -128,11 +147,12 @@ class Grid:
                   self._values[self._i_A][multi[self._i_A]], self.scene.numerics,
                   self.scene.option("cycles"), self.scene.option("gamma"),
                   self.scene.option("nu"), self.scene.record,
-                  np.nan if self._i_mu is None else self._values[self._i_mu][multi[self._i_mu]])
+                  np.nan if self._i_mu is None else self._values[self._i_mu][multi[self._i_mu]],
+                  law, e, e_factor)
         return ChunkRows(rows, b_kind[inverse], alpha_ref, b_E[inverse])
 
-    def _suite_rows(self, multi, rows, body_rows, omega_rock, alpha_ref, kinds, E_ref
-                    ) -> ChunkRows:
+    def _suite_rows(self, multi, rows, body_rows, omega_rock, alpha_ref, kinds, E_ref,
+                    impact: tuple) -> ChunkRows:
         """Rows of a suite's points: each point's record scaled to its stripe (the peak
         as A_ratio, ``Suite.peak_ratio``), filled record by record (each record has its
         own DT and length)."""
@@ -143,12 +163,14 @@ class Grid:
         p = self._values[self._i_w][multi[self._i_w]]
         a_ratio = su.peak_ratio(rec, stripe, alpha_ref, p)
         code = self._shape_codes[multi[self._i_shape]]
+        law, e, e_factor = (np.broadcast_to(np.asarray(v, float), lam.shape) for v in impact)
         for r in np.unique(rec):
             sel = rec == r
             part = np.empty((int(sel.sum()), L.N_PAR))
             fill_rows(part, body_rows[sel], omega_rock[sel], alpha_ref[sel], lam[sel],
                       code[sel], p[sel], a_ratio[sel], self.scene.numerics,
-                      record=su.records[int(r)])
+                      record=su.records[int(r)], law=law[sel], e=e[sel],
+                      e_factor=e_factor[sel])
             rows[sel] = part
         return ChunkRows(rows, kinds, alpha_ref, E_ref, rec)
 

@@ -41,6 +41,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
+from rocksweep.fields import WORD_AXES
 from rocksweep.figures.common import (
     DEFAULT_DPI,
     FORMATS,
@@ -58,6 +59,7 @@ if TYPE_CHECKING:
     from rocksweep.analysis.boundaries import AMinCurve, PanelBoundaries
 
 __all__ = ["FORMATS", "DiagramError", "choose_axes", "stability_diagram", "line_diagram",
+           "compare_diagram", "compare_categories",
            "sweep_figure", "stability_figure", "missing_warnings", "categories", "y_label",
            "a_min_figure"]
 
@@ -68,6 +70,7 @@ SYMBOLS = {
     "alpha_cg": r"\alpha_{cg}", "alpha_A": r"\alpha_A", "mA_over_m": "m_A/m",
     "IA_ratio": r"I_A/(m_A R_A^2)", "alpha": r"\alpha", "inertia": r"I_O/(M R^2)",
     "w_over_p": r"\omega/p", "A_ratio": r"A/(g\tan\alpha)", "p": r"p\ [\mathrm{rad/s}]",
+    "e": "e", "e_factor": r"e_{\mathrm{factor}}",
 }
 UNITS = {"alpha_cg": " [rad]", "alpha_A": " [rad]", "alpha": " [rad]"}
 # the slenderness that normalises the amplitude, per body kind (body.alpha_ref)
@@ -135,7 +138,7 @@ def mode1_colours(n_lam: int) -> list:
 
 def plottable(result: SweepResult) -> list[str]:
     """Swept numeric dimensions with two or more values (what x and y may be)."""
-    return [d for d in result.dims if d != "shape" and len(result.coords[d]) >= 2]
+    return [d for d in result.dims if d not in WORD_AXES and len(result.coords[d]) >= 2]
 
 
 def _check_key(result: SweepResult, key: str, option: str) -> str:
@@ -143,6 +146,8 @@ def _check_key(result: SweepResult, key: str, option: str) -> str:
     ok = plottable(result)
     if name not in ok:
         why = ("pulse shapes are drawn as panels, not along an axis" if name == "shape"
+               else "impact laws are drawn as panels (or --compare impact.law), not along "
+               "an axis" if name == "law"
                else "has one value" if name in result.dims
                else "not swept" if name in result.scalars
                else "no such axis")
@@ -206,7 +211,7 @@ def _arrays(result: SweepResult, order: list[str], names: Sequence[str]) -> list
     for a in names:
         v = np.transpose(a if isinstance(a, np.ndarray) else result.arrays[a], perm)
         for axis, d in enumerate(order):
-            if d != "shape":
+            if d not in WORD_AXES:
                 v = np.take(v, np.argsort(np.asarray(result.coords[d], float), kind="stable"),
                             axis=axis)
         out.append(v)
@@ -215,7 +220,7 @@ def _arrays(result: SweepResult, order: list[str], names: Sequence[str]) -> list
 
 def _coord(result: SweepResult, d: str) -> np.ndarray:
     vals = result.coords[d]
-    return vals if d == "shape" else np.sort(np.asarray(vals, float), kind="stable")
+    return vals if d in WORD_AXES else np.sort(np.asarray(vals, float), kind="stable")
 
 
 def _panels(result: SweepResult, panel_dims: list[str]) -> list[tuple[int, ...]]:
@@ -238,7 +243,8 @@ def _panel_title(result: SweepResult, panel_dims: list[str], idx: tuple[int, ...
     parts = []
     for d, i in zip(panel_dims, idx, strict=True):
         v = _coord(result, d)[i]
-        parts.append(f"{v} pulse" if d == "shape" else f"${SYMBOLS.get(d, d)}$ = {_fmt(v)}")
+        parts.append(f"{v} pulse" if d == "shape" else f"law {v}" if d == "law"
+                     else f"${SYMBOLS.get(d, d)}$ = {_fmt(v)}")
     return ", ".join(parts)
 
 
@@ -462,6 +468,155 @@ def _legend_outside(ax: Axes, handles: list) -> None:
     fig._rocksweep_legend = True
 
 
+# ---------------------------------------------------------------------------------------
+# Comparing the values of one swept key (rocksweep plot --compare impact.law)
+# ---------------------------------------------------------------------------------------
+
+MAX_COMPARED = 4  # values of the compared key: 2^4 - 1 overturning sets at most
+_ALL = "#b2182b"  # overturns under every value
+_ONLY = ("#ff7f00", "#33a02c", "#6a3d9a", "#b15928")  # overturns under one value only
+_SOME = ("#fdbf6f", "#b2df8a", "#cab2d6", "#ffff99", "#a6cee3", "#fb9a99", "#e0e0e0",
+         "#dfc27d", "#80cdc1", "#c2a5cf", "#f6e8c3")  # under some values (not one, not all)
+
+
+def compare_categories(outcome: np.ndarray) -> np.ndarray:
+    """Colour category per cell from outcome[n, ...] (axis 0: the compared key's values).
+
+    0 not computed (under some value), 1 safe under every value, 2 mode 2 under every
+    value, 2 + mask otherwise: mask (1 .. 2^n - 1) has bit k set where the k-th value
+    overturns the cell (mode 1 or mode 2).
+    """
+    n = outcome.shape[0]
+    over = (outcome == L.OUTCOME_MODE1) | (outcome == L.OUTCOME_MODE2)
+    mask = np.zeros(outcome.shape[1:], np.int64)
+    for k in range(n):
+        mask |= over[k].astype(np.int64) << k
+    cat = np.where(mask > 0, 2 + mask, 1)
+    cat[(outcome == L.OUTCOME_MODE2).all(axis=0)] = 2
+    cat[(outcome == L.OUTCOME_NOT_RUN).any(axis=0)] = 0
+    return cat
+
+
+def _compare_colour(mask: int, n: int) -> str:
+    if mask == (1 << n) - 1:
+        return _ALL
+    if mask & (mask - 1) == 0:
+        return _ONLY[mask.bit_length() - 1]
+    others = [m for m in range(1, (1 << n) - 1) if m & (m - 1)]
+    return _SOME[others.index(mask) % len(_SOME)]
+
+
+def _value_label(name: str, v) -> str:
+    if name in WORD_AXES:
+        return str(v)
+    return f"${SYMBOLS.get(name, name)}$ = {_fmt(v)}"
+
+
+def _set_label(mask: int, labels: list[str], what: str) -> str:
+    n = len(labels)
+    names = [labels[k] for k in range(n) if mask >> k & 1]
+    if mask == (1 << n) - 1:
+        return "overturns under " + ("both " + what + "s" if n == 2 else f"every {what}")
+    if len(names) == 1:
+        return f"overturns only under {names[0]}"
+    return f"overturns only under {', '.join(names[:-1])} and {names[-1]}"
+
+
+def compare_diagram(result: SweepResult, key: str, x: str | None = None,
+                    y: str | None = None, *, axes: Axes | Sequence[Axes] | None = None,
+                    option_names: tuple[str, str] = ("x", "y"), curves: bool = False,
+                    option: str = "compare") -> Figure:
+    """One diagram per panel comparing the values of the swept key ``key`` (e.g.
+    ``impact.law`` or ``lam``): each cell is coloured by which values overturn it (under
+    both, only under ``locked``, only under ``vertical``, ...; blue: mode 2 under every
+    value, white: safe under every value), each panel lists the mode 1 area per value;
+    curves: every value's boundary lines overlaid, one colour each. One panel per value of
+    the other swept keys. Needs ``outcome`` and ``status``."""
+    name = key.split(".", 1)[1] if key.startswith(("body.", "pulse.", "impact.")) else key
+    if name not in result.dims or len(result.coords[name]) < 2:
+        swept = [d for d in result.dims if len(result.coords[d]) >= 2]
+        why = "has one value" if name in result.dims else (
+            "not swept" if name in result.scalars else "no such key")
+        raise DiagramError(f"{result.path}: {option} {key}: {why}; keys with two or more "
+                           f"values: {', '.join(swept) or '(none)'}")
+    n = len(result.coords[name])
+    if n > MAX_COMPARED:
+        raise DiagramError(f"{result.path}: {option} {key}: {n} values; at most "
+                           f"{MAX_COMPARED} can be compared in one diagram")
+    x, y = choose_axes(result, x, y, option_names)
+    if y is None or name in (x, y):
+        raise DiagramError(f"{result.path}: {option} {key}: needs two other swept axes for "
+                           f"the diagram (x {x}, y {y}); choose them with {option_names[0]}"
+                           f" and {option_names[1]}")
+    dims = list(result.dims)
+    panel_dims = [d for d in dims if d not in (x, y, name)]
+    order = [*panel_dims, name, y, x]
+    flagged = result.flagged & result.done
+    o, fl = _arrays(result, order, ["outcome", flagged])
+    values = list(_coord(result, name))
+    labels = [_value_label(name, v) for v in values]
+    what = "law" if name == "law" else "value"
+    panels = _panels(result, panel_dims)
+    n_cat = 3 + (1 << n) - 1
+    colours = [_NOT_RUN, _SAFE, _MODE2, *(_compare_colour(m, n) for m in range(1, 1 << n))]
+    cmap = ListedColormap(colours)
+    norm = BoundaryNorm(np.arange(-0.5, n_cat), cmap.N)
+    xs, ys = _coord(result, x), _coord(result, y)
+    fig, flat, own = _place_axes(axes, len(panels), _layout(result, panel_dims, len(panels)),
+                                 (4.8, 4.2), "this comparison")
+    used = np.zeros(n_cat, bool)
+    any_flag = False
+    for ax, idx in zip(flat, panels, strict=False):
+        po, pf = o[idx], fl[idx]  # [n, n_y, n_x]
+        cat = compare_categories(po)
+        used[np.unique(cat)] = True
+        ax.pcolormesh(xs, ys, cat, cmap=cmap, norm=norm, shading="nearest", rasterized=True)
+        if curves:
+            _draw_boundaries(ax, po, xs, ys)
+        f_any = pf.any(axis=0)
+        if f_any.any():
+            any_flag = True
+            yy, xx = np.nonzero(f_any)
+            ax.plot(xs[xx], ys[yy], "x", color="k", ms=3.5, mew=0.7)
+        done = po != L.OUTCOME_NOT_RUN
+        area = [f"{lab}: {100 * (po[k] == L.OUTCOME_MODE1).sum() / done[k].sum():.1f}%"
+                if done[k].any() else f"{lab}: -" for k, lab in enumerate(labels)]
+        ax.text(0.98, 0.02, "mode 1 area\n" + "\n".join(area), transform=ax.transAxes,
+                ha="right", va="bottom", fontsize=7,
+                bbox={"boxstyle": "round", "fc": "white", "ec": "0.6", "alpha": 0.85})
+        ax.set_title(_panel_title(result, panel_dims, idx), fontsize=10)
+        ax.set_xlabel(axis_label(x, result.kind))
+        ax.set_ylabel(axis_label(y, result.kind))
+
+    handles = []
+    if used[1]:
+        handles.append(Patch(fc=_SAFE, ec="0.5", label=f"safe under every {what}"))
+    full = (1 << n) - 1
+    for m in [full, *(1 << k for k in range(n)),
+              *(m for m in range(1, full) if m & (m - 1))]:
+        if used[2 + m]:
+            handles.append(Patch(fc=colours[2 + m], ec="0.5", label=_set_label(m, labels, what)))
+    if used[2]:
+        handles.append(Patch(fc=_MODE2, ec="0.5", label=f"mode 2 under every {what}"))
+    if used[0]:
+        handles.append(Patch(fc=_NOT_RUN, ec="0.5", label="not computed"))
+    if any_flag:
+        handles.append(Line2D([], [], ls="", marker="x", color="k",
+                              label="flagged (horizon/step/event cap, non-finite)"))
+    if curves:
+        for k, lab in enumerate(labels):
+            handles.append(Line2D([], [], color=CURVE_COLOURS[k % len(CURVE_COLOURS)], lw=1.0,
+                                  label=f"boundaries under {lab}"))
+    if own:
+        ncols = _layout(result, panel_dims, len(panels))[1]
+        fig.legend(handles=handles, loc="outside lower center", fontsize=8, frameon=False,
+                   ncol=max(1, min(len(handles), ncols + 1)))
+        fig.suptitle(_fit(_title(result, (x, y)) + f": {what}s compared", fig), fontsize=11)
+    else:
+        _legend_outside(flat[-1], handles)
+    return fig
+
+
 def _hatch(ax: Axes, xs: np.ndarray, ys: np.ndarray, mask: np.ndarray, hatch: str,
            colour: str) -> bool:
     """Hatch the cells of ``mask`` (bool[n_y, n_x]) of a diagram drawn with nearest
@@ -616,12 +771,20 @@ def line_diagram(result: SweepResult, x: str | None = None, *,
 def sweep_figure(result: SweepResult, x: str | None = None, y: str | None = None, *,
                  axes: Axes | Sequence[Axes] | None = None,
                  option_names: tuple[str, str] = ("x", "y"), curves: bool = False,
-                 show_computed: bool = False) -> Figure:
+                 show_computed: bool = False, compare: str | None = None,
+                 compare_option: str = "compare") -> Figure:
     """The figure ``rocksweep plot`` draws: a stability diagram over (x, y), or a line
     plot when the result has one swept axis besides lam (see ``choose_axes``); curves:
     the boundary lines over the diagram (``rocksweep plot --curves``); show_computed: the
-    cells an adaptive sweep computed shaded (``--show-computed``)."""
+    cells an adaptive sweep computed shaded (``--show-computed``); compare: a swept key
+    whose values are compared on one diagram (``compare_diagram``, ``--compare``)."""
     _no_suite(result)
+    if compare is not None:
+        if show_computed:
+            raise DiagramError(f"{result.path}: --show-computed draws on the stability "
+                               f"diagram, not with {compare_option}")
+        return compare_diagram(result, compare, x, y, axes=axes, option_names=option_names,
+                               curves=curves, option=compare_option)
     x, y = choose_axes(result, x, y, option_names)
     if y is None:
         if curves or show_computed:

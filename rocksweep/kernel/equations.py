@@ -32,10 +32,14 @@ from numba.extending import overload
 
 from rocksweep.kernel._cache import INTERNAL
 from rocksweep.kernel.layout import (
+    LAW_CONSTANT,
+    LAW_LOCKED,
     PAR_AMP,
     PAR_AMP_NORM,
     PAR_B,
     PAR_C,
+    PAR_E,
+    PAR_E_FACTOR,
     PAR_G,
     PAR_GAMMA,
     PAR_H,
@@ -46,6 +50,7 @@ from rocksweep.kernel.layout import (
     PAR_IO,
     PAR_K,
     PAR_LAM,
+    PAR_LAW,
     PAR_M,
     PAR_MA,
     PAR_MTOT,
@@ -308,33 +313,55 @@ def rest_margin(u, u_dot, prm):
 
 
 # ----------------------------------------------------------------------------------------
-# Impact (eq. 1)
+# Impact (eq. 1 and the other impact laws)
 # ----------------------------------------------------------------------------------------
 
 
 @njit(cache=True)
 def restitution(s, u, prm, FLEX):
-    """e = theta'^+ / theta'^- for an impact that ends rocking on corner s.
+    """e = theta'^+ / theta'^- for an impact that ends rocking on corner s, under the row's
+    impact law (PAR_LAW, ``rocksweep.physics.impact``), times PAR_E_FACTOR.
 
     The vertical impulse acts at x_Q = s' b (1 - lam), lam*b from the future corner
     s' = -s. Angular momentum of the whole body about x_Q is conserved (a horizontal
-    impulse at the ground has no moment about it) and, since the spring and damper carry no
-    impulse, so is the top mass's horizontal momentum m (u' + h theta'). Eliminating u'^+:
+    impulse at the ground has no moment about it). LAW_VERTICAL: the spring and damper
+    carry no impulse, so the top mass's horizontal momentum m (u' + h theta') is conserved
+    too; eliminating u'^+:
 
         e = [I_A + m_A (h_A^2 + x_Q s b)  + m (u - x_Q)(u - s b)]
           / [I_A + m_A (h_A^2 + x_Q s' b) + m (u - x_Q)(u - s' b)],
 
-    which is eq. (1) (upper sign: s = +1). Rigid body: (I_O - M b^2 (2 - lam)) / (I_O - lam M b^2).
+    which is eq. (1) (upper sign: s = +1). LAW_LOCKED: u' is kept instead (the top mass
+    moves with the base), which adds m h^2 to both. LAW_CONSTANT: e = PAR_E. Rigid body
+    (vertical and locked are one law: the top mass is welded):
+    (I_O - M b^2 (2 - lam)) / (I_O - lam M b^2).
     """
+    law = prm[PAR_LAW]
+    if law == LAW_CONSTANT:
+        return prm[PAR_E] * prm[PAR_E_FACTOR]
     b, lam = prm[PAR_B], prm[PAR_LAM]
     if not FLEX:
         mb2 = prm[PAR_MTOT] * b * b
-        return (prm[PAR_IO] - mb2 * (2.0 - lam)) / (prm[PAR_IO] - lam * mb2)
+        return (prm[PAR_IO] - mb2 * (2.0 - lam)) / (prm[PAR_IO] - lam * mb2) * prm[PAR_E_FACTOR]
     m, m_A = prm[PAR_M], prm[PAR_MA]
     x_q = -s * b * (1.0 - lam)
     num = prm[PAR_IAH] + m_A * x_q * s * b + m * (u - x_q) * (u - s * b)
     den = prm[PAR_IAH] - m_A * x_q * s * b + m * (u - x_q) * (u + s * b)
-    return num / den
+    if law == LAW_LOCKED:
+        mh2 = m * prm[PAR_H] * prm[PAR_H]
+        num += mh2
+        den += mh2
+    return num / den * prm[PAR_E_FACTOR]
+
+
+@njit(cache=True, inline="always")
+def top_mass_rate(u_dot, w_minus, w_plus, prm):
+    """u'^+ [m/s] after an impact (any phase after): LAW_LOCKED keeps u' (the top mass
+    moves with the base); the other laws keep the top mass's horizontal momentum
+    m (u' + h theta') (no impulse reaches it through the spring)."""
+    if prm[PAR_LAW] == LAW_LOCKED:
+        return u_dot
+    return u_dot + prm[PAR_H] * (w_minus - w_plus)
 
 
 # ----------------------------------------------------------------------------------------
@@ -365,19 +392,23 @@ def mechanical_energy(theta, theta_dot, u, u_dot, s, prm, FLEX):
 
 
 @njit(cache=True)
-def impact_loss(s, s_new, u, w_minus, w_plus, prm, FLEX):
-    """Energy [J] the impact itself dissipates (eq. 6; < 0: the impact gains energy).
+def impact_loss(s, s_new, u, u_dot, w_minus, w_plus, prm, FLEX):
+    """Energy [J] the impact itself dissipates (eq. 6 under the row's law; < 0: the
+    impact gains energy). u_dot: u' before the impact.
 
-    At theta = 0 the potential energy is the same before and after, and the top mass keeps
-    its horizontal velocity u' + h theta' (no impulse reaches it), so only the rest of the
-    kinetic energy changes: with a = u - s b the top mass's lever arm about corner s,
+    At theta = 0 the potential energy is the same before and after. With a = u - s b the
+    top mass's lever arm about corner s, the kinetic energy at theta = 0 is
+    1/2 m (u' + h w)^2 + 1/2 (I_A + m_A R_A^2 + m a^2) w^2. Under LAW_VERTICAL and
+    LAW_CONSTANT the top mass keeps its horizontal velocity u' + h w (no impulse reaches
+    it), so only the rest changes:
 
         E_d = 1/2 (I_A + m_A R_A^2 + m a^2) w^-^2 - 1/2 (I_A + m_A R_A^2 + m a'^2) w^+^2,
 
     a' = u - s_new b (w^+ = 0 when s_new = 0, full contact). With s_new = -s and
-    w^+ = e w^- this is eq. (6). Rigid body: 1/2 I_O (w^-^2 - w^+^2). Written as this
-    difference, not as a difference of total energies, so that round-off in the spring's
-    energy cannot make a dissipating impact look like one that gains energy.
+    w^+ = e w^- this is eq. (6). LAW_LOCKED keeps u' instead, which adds
+    1/2 m [(u' + h w^-)^2 - (u' + h w^+)^2]. Rigid body: 1/2 I_O (w^-^2 - w^+^2). Written
+    as this difference, not as a difference of total energies, so that round-off in the
+    spring's energy cannot make a dissipating impact look like one that gains energy.
     """
     if not FLEX:
         return 0.5 * prm[PAR_IO] * (w_minus * w_minus - w_plus * w_plus)
@@ -387,6 +418,10 @@ def impact_loss(s, s_new, u, w_minus, w_plus, prm, FLEX):
     if s_new != 0:
         a_plus = u - s_new * b
         loss -= 0.5 * (prm[PAR_IA0] + m * a_plus * a_plus) * w_plus * w_plus
+    if prm[PAR_LAW] == LAW_LOCKED:
+        v_minus = u_dot + prm[PAR_H] * w_minus
+        v_plus = u_dot + prm[PAR_H] * w_plus
+        loss += 0.5 * m * (v_minus * v_minus - v_plus * v_plus)
     return loss
 
 

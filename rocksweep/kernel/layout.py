@@ -44,7 +44,10 @@ PAR_AMP_NORM = 31  # Mavroeidis-Papageorgiou pulse: 1/r_max, so that A is its pe
 PAR_REC_DT = 32  # record: sample interval in kernel time, p * DT [s] (0: not a record)
 PAR_REC_H = 33  # record: RK4 step while it acts, PAR_REC_DT / m (m >= 1 an integer) [s]
 PAR_ROT_STEP = 34  # largest rotation of one rocking step [rad] (0: no such limit)
-N_PAR = 35
+PAR_LAW = 35  # impact law, read at impacts: LAW_VERTICAL (eq. 1), LAW_LOCKED, LAW_CONSTANT
+PAR_E = 36  # LAW_CONSTANT's coefficient of restitution (unused by the other laws)
+PAR_E_FACTOR = 37  # multiplies the law's e (1: the law's own e)
+N_PAR = 38
 # A record's row is longer: its samples xg''/PGA (float64[npts], in [-1, 1]) follow the
 # N_PAR parameters, PAR_REC = N_PAR the first (``points.with_record``).
 PAR_REC = N_PAR
@@ -54,6 +57,9 @@ SHAPE_COSINE = 1.0
 SHAPE_RICKER = 2.0
 SHAPE_MP = 3.0
 SHAPE_RECORD = 4.0  # linear interpolation of the samples at PAR_REC...
+LAW_VERTICAL = 0.0  # eq. (1): no impulse reaches the top mass (its momentum is kept)
+LAW_LOCKED = 1.0  # the top mass moves with the base through the impact (u' is kept)
+LAW_CONSTANT = 2.0  # e = PAR_E; the top mass keeps its momentum, as in LAW_VERTICAL
 ROOT_BISECT = 0.0
 ROOT_ILLINOIS = 1.0
 ROOT_HERMITE = 2.0

@@ -2,7 +2,7 @@
 
 - ``uplift_side``: full contact -> rocking on a corner, when s Q >= M g b;
 - ``impact_map``: rocking -> rocking on the other corner or full contact, at theta = 0
-  (eq. 1 and the settling rule);
+  (eq. 1 or the row's impact law, and the settling rule);
 - ``rest_proven``: after the pulse, full contact for good (flexible body);
 - ``rigid_bounded``: after the pulse, a rigid body that can no longer overturn.
 
@@ -21,10 +21,10 @@ from rocksweep.kernel.equations import (
     restitution,
     rigid_peak,
     tip_moment,
+    top_mass_rate,
     uplift_moment,
 )
 from rocksweep.kernel.layout import (
-    PAR_H,
     PAR_RESTRATE,
     Y_D_DAMP,
     Y_THETA,
@@ -78,7 +78,9 @@ def impact_map(y, s, prm, FLEX, ENERGY):
     e > 0 with |e theta'^-| >= PAR_RESTRATE: rocking continues on -s, theta'^+ = e theta'^-.
     Otherwise full contact: e <= 0 is inadmissible as rocking, and a post-impact rate
     below the rest rate ends a chattering (Zeno) sequence after finitely many impacts.
-    Either way the top mass keeps its horizontal momentum m (u' + h theta').
+    Either way the top mass follows the law's rule (``top_mass_rate``): it keeps its
+    horizontal momentum m (u' + h theta') (vertical, constant) or its rate u' (locked).
+    e is the law's (``restitution``, PAR_LAW and PAR_E_FACTOR read here, at run time).
     """
     literally(FLEX)
     literally(ENERGY)
@@ -90,12 +92,12 @@ def impact_map(y, s, prm, FLEX, ENERGY):
     else:
         s_new = 0
         w_plus = 0.0
-    u_dot_plus = u_dot + prm[PAR_H] * (w_minus - w_plus) if FLEX else 0.0
+    u_dot_plus = top_mass_rate(u_dot, w_minus, w_plus, prm) if FLEX else 0.0
     y_new = (0.0, w_plus, u, u_dot_plus, y[Y_W_IN], y[Y_D_DAMP])
     e_d = 0.0
     loss = 0.0
     if ENERGY:
         e_d = (mechanical_energy(theta, w_minus, u, u_dot, s, prm, FLEX)
                - mechanical_energy(0.0, w_plus, u, u_dot_plus, s_new, prm, FLEX))
-        loss = impact_loss(s, s_new, u, w_minus, w_plus, prm, FLEX)
+        loss = impact_loss(s, s_new, u, u_dot, w_minus, w_plus, prm, FLEX)
     return y_new, s_new, e, e_d, loss

@@ -33,6 +33,8 @@ _SHAPE_CODE = {"sine": L.SHAPE_SINE, "cosine": L.SHAPE_COSINE, "ricker": L.SHAPE
                "mp": L.SHAPE_MP, RECORD: L.SHAPE_RECORD}
 # Defaults of the pulse's optional keys (scene keys pulse.cycles, pulse.gamma, pulse.nu)
 CYCLES, GAMMA, NU_DEG = 1, 2.0, 90.0
+LAWS = ("vertical", "locked", "constant")  # impact laws (``rocksweep.physics.impact``)
+_LAW_CODE = {"vertical": L.LAW_VERTICAL, "locked": L.LAW_LOCKED, "constant": L.LAW_CONSTANT}
 _ROOT_CODE = dict(zip(ROOTS, (L.ROOT_BISECT, L.ROOT_ILLINOIS, L.ROOT_HERMITE), strict=True))
 
 
@@ -45,7 +47,9 @@ class Point:
     body's frequency parameter p [rad/s], which fixes the body's size against the
     record's seconds (kernel time p t); w_over_p is NaN. A is the peak |xg''| either way.
     mu: the friction coefficient of the base on the ground (NaN: none given; only the
-    contact status bits read it).
+    contact status bits read it). law, e, e_factor: the impact law (one of LAWS), the
+    coefficient of restitution of law ``constant`` (NaN for the others) and the factor on
+    the law's e (``rocksweep.physics.impact``).
     """
 
     body: Body
@@ -59,6 +63,9 @@ class Point:
     record: GroundRecord | None = None
     p: float = math.nan
     mu: float = math.nan
+    law: str = "vertical"
+    e: float = math.nan
+    e_factor: float = 1.0
 
     @property
     def omega(self) -> float:
@@ -108,6 +115,9 @@ def body_row(body: Body) -> np.ndarray:
     row[L.PAR_HCG] = body.h_cg
     row[L.PAR_IO] = body.I_O
     row[L.PAR_THETA_OVER] = math.pi / 2
+    row[L.PAR_LAW] = L.LAW_VERTICAL  # eq. (1), unless fill_rows is told otherwise
+    row[L.PAR_E] = math.nan
+    row[L.PAR_E_FACTOR] = 1.0
     if isinstance(body, FlexibleBody):
         row[L.PAR_M] = body.m
         row[L.PAR_MA] = body.m_A
@@ -202,7 +212,8 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
               w_over_p: np.ndarray, A_ratio: np.ndarray, numerics: Numerics,
               cycles: int = CYCLES, gamma: float = GAMMA, nu_deg: float = NU_DEG,
               record: GroundRecord | None = None,
-              mu: np.ndarray | float = math.nan) -> None:
+              mu: np.ndarray | float = math.nan, law: np.ndarray | float = L.LAW_VERTICAL,
+              e: np.ndarray | float = math.nan, e_factor: np.ndarray | float = 1.0) -> None:
     """Fill parameter rows in place, vectorised over points.
 
     rows: float64[n, N_PAR] (out); body_rows: float64[n, N_PAR] from ``body_row``;
@@ -210,7 +221,8 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     cycles (sine, cosine), gamma and nu_deg [deg] (MP): the pulse's optional keys, one
     value for all points. With ``record``, every point is driven by it and w_over_p holds
     the body's p [rad/s]; the rows then still lack the samples (``with_record``).
-    mu: friction coefficient, float64[n] or a scalar (NaN: none).
+    mu: friction coefficient, float64[n] or a scalar (NaN: none). law (a LAW_* code), e
+    (law constant's, else NaN) and e_factor: the impact law, float64[n] or scalars.
     """
     rows[:] = body_rows
     omega = np.asarray(w_over_p, float)  # p = 1 rad/s
@@ -248,6 +260,9 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     rows[:, L.PAR_ROOT] = _ROOT_CODE[numerics.root]
     rows[:, L.PAR_MU] = mu
     rows[:, L.PAR_ROT_STEP] = numerics.rotation_step * alpha_ref
+    rows[:, L.PAR_LAW] = law
+    rows[:, L.PAR_E] = e
+    rows[:, L.PAR_E_FACTOR] = e_factor
 
 
 def with_record(rows: np.ndarray, record: GroundRecord | None) -> np.ndarray:
@@ -273,9 +288,14 @@ def point_row(point: Point, numerics: Numerics) -> np.ndarray:
               np.array([_SHAPE_CODE[point.shape]]),
               np.array([point.p if rec is not None else point.w_over_p]),
               np.array([point.A_ratio]), numerics, point.cycles, point.gamma, point.nu, rec,
-              point.mu)
+              point.mu, law_code(point.law), point.e, point.e_factor)
     return with_record(rows, rec)[0]
 
 
 def shape_code(shape: str) -> float:
     return _SHAPE_CODE[shape]
+
+
+def law_code(law: str) -> float:
+    """The kernel's code (PAR_LAW) of an impact law."""
+    return _LAW_CODE[law]

@@ -15,9 +15,11 @@ and the paper:
 - full contact: m u'' + c u' + k u = -m xg''; the body uplifts on corner s when s Q >= M g b;
 - rocking on corner s: the two-degree-of-freedom equations; impact when theta = 0,
   overturning when |theta| = pi/2;
-- impact (eq. 1): theta'^+ = e theta'^- and rocking goes on on the other corner if e > 0
-  and |e theta'^-| >= rest rate, else full contact; the top mass keeps its horizontal
-  momentum m (u' + h theta'); full contact is checked for uplift at once;
+- impact (eq. 1, or the point's impact law, ``rocksweep.physics.impact``): theta'^+ =
+  e theta'^- and rocking goes on on the other corner if e > 0 and |e theta'^-| >= rest
+  rate, else full contact; the top mass keeps its horizontal momentum m (u' + h theta')
+  (laws vertical and constant) or its rate u' (law locked); full contact is checked for
+  uplift at once;
 - after the pulse, in full contact, rest is proven when the largest Q on the oscillator's
   energy ellipse is below M g b (the energy never grows: c >= 0);
 - a rigid body after the pulse whose energy cannot carry it over the barrier stops early
@@ -87,6 +89,7 @@ class _Problem:
         self.theta_over = float(prm[L.PAR_THETA_OVER])
         self.rest_rate = float(prm[L.PAR_RESTRATE])
         self.h = float(prm[L.PAR_H])
+        self.law = float(prm[L.PAR_LAW])  # the impact law (e itself: ``restitution``)
         # largest step: a tenth of the shortest period (spring while rocking, pulse, 2 pi/p)
         periods = [2 * math.pi] + ([2 * math.pi / self.omega] if self.omega > 0 else [])
         # a record: its sample interval in kernel time (0: none); phases end on every
@@ -512,8 +515,12 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
             contacts += 1
             if e > 0.0:
                 status |= L.STATUS_SETTLED
-        # the spring and damper carry no impulse: m (u' + h theta') is conserved
-        u_dot = y[3] + pb.h * (w_minus - w_plus) if flex else 0.0
+        if not flex:
+            u_dot = 0.0
+        elif pb.law == L.LAW_LOCKED:  # the top mass moves with the base: u' is kept
+            u_dot = y[3]
+        else:  # the spring and damper carry no impulse: m (u' + h theta') is conserved
+            u_dot = y[3] + pb.h * (w_minus - w_plus)
         y_new = (0.0, w_plus, y[2], u_dot)
         if ct is not None:
             ct.impact(y, s, y_new, s_new)

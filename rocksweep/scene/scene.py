@@ -327,16 +327,23 @@ class Scene:
             a_ratio = float(su.peak_ratio(np.array([r]), s, np.array([body.alpha_ref]),
                                           np.array([p]))[0])
             return Point(body, float(values["lam"]), RECORD, math.nan, a_ratio,
-                         record=su.records[r], p=p)
+                         record=su.records[r], p=p, **self._law(values))
         if self.record is not None:
             return Point(body, float(values["lam"]), RECORD, math.nan,
-                         float(values["A_ratio"]), record=self.record, p=float(values["p"]))
+                         float(values["A_ratio"]), record=self.record, p=float(values["p"]),
+                         **self._law(values))
         return Point(body, float(values["lam"]), str(values["shape"]),
                      float(values["w_over_p"]), float(values["A_ratio"]),
                      int(values.get("cycles", self.option("cycles"))),
                      float(values.get("gamma", self.option("gamma"))),
                      float(values.get("nu", self.option("nu"))),
-                     mu=float(values.get("mu", math.nan)))
+                     mu=float(values.get("mu", math.nan)), **self._law(values))
+
+    def _law(self, values: dict[str, Any]) -> dict[str, Any]:
+        """A point's impact law (Point keywords law, e, e_factor) from axis values."""
+        law = str(values.get("law", "vertical"))
+        return {"law": law, "e": float(values["e"]) if law == "constant" else math.nan,
+                "e_factor": float(values.get("e_factor", 1.0))}
 
     def single_point(self) -> Point:
         """The scene's only point; a SceneError names the first swept key otherwise."""
@@ -503,22 +510,55 @@ def _axis_values(key: str, form: str, spec: Any) -> np.ndarray:
     return values
 
 
-def _shapes(spec: Any) -> tuple[tuple[str, ...], bool]:
-    allowed = KEYS["pulse.shape"]
+def _words(key: str, spec: Any) -> tuple[tuple[str, ...], bool]:
+    """A word axis (``pulse.shape``, ``impact.law``): one of the key's choices or a list of
+    them (a swept axis). Returns (values, swept)."""
+    allowed = KEYS[key]
+    words = ", ".join(allowed.choices)
     if isinstance(spec, list):
         if not spec:
-            raise SceneError("pulse.shape = []: an empty list; give one or more of sine, "
-                             "cosine, ricker, mp")
+            raise SceneError(f"{key} = []: an empty list; give one or more of {words}")
         for v in spec:
-            if v not in allowed.choices:
-                raise SceneError(f"pulse.shape = {fmt(v)}: {allowed.allowed}")
+            if not (isinstance(v, str) and v in allowed.choices):
+                raise SceneError(f"{key} = {fmt(v)}: {allowed.allowed}")
         if len(set(spec)) < len(spec):
-            raise SceneError(f"pulse.shape = {fmt(spec)}: a shape is given twice; the values "
+            noun = key.split(".")[1]  # shape, law
+            raise SceneError(f"{key} = {fmt(spec)}: a {noun} is given twice; the values "
                              "of an axis must differ")
         return tuple(spec), True
     if not (isinstance(spec, str) and spec in allowed.choices):
-        raise SceneError(f"pulse.shape = {fmt(spec)}: {allowed.allowed}")
+        raise SceneError(f"{key} = {fmt(spec)}: {allowed.allowed}")
     return (spec,), False
+
+
+def _shapes(spec: Any) -> tuple[tuple[str, ...], bool]:
+    return _words("pulse.shape", spec)
+
+
+def _impact_law(impact: dict) -> tuple[Axis | None, list[tuple[str, str, Any]]]:
+    """The impact law's axes: the law (a word axis; None when the scene does not name
+    one: eq. 1, ``vertical``) and the specs of ``impact.e`` and ``impact.e_factor`` given.
+    ``e`` is required by law ``constant`` and refused without it."""
+    law_axis = None
+    laws: tuple[str, ...] = ("vertical",)
+    if impact.get("law") is not None:
+        laws, swept = _words("impact.law", impact["law"])
+        law_axis = Axis("law", "impact.law", laws, swept)
+    specs = []
+    e_spec = impact.get("e")
+    if e_spec is None and "constant" in laws:
+        raise SceneError("impact.e: missing; law constant needs its coefficient of "
+                         "restitution e: a number in (0, 1], a list or a range")
+    if e_spec is not None:
+        if "constant" not in laws:
+            raise SceneError(f"impact.e = {fmt(e_spec)}: only law constant uses e (the law "
+                             f"here is {', '.join(laws)}); remove impact.e or add law: "
+                             "constant")
+        specs.append(("e", "impact.e", *_axis_spec("impact.e", e_spec)[:2]))
+    if impact.get("e_factor") is not None:
+        specs.append(("e_factor", "impact.e_factor",
+                      *_axis_spec("impact.e_factor", impact["e_factor"])[:2]))
+    return law_axis, specs
 
 
 def _refine(raw: dict, kind: str) -> dict | None:
@@ -872,6 +912,9 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
         specs.append((k, f"body.{k}", *_axis_spec(f"body.{k}", spec)[:2]))
     lam = impact.get("lam", 0.0)  # a block without an impact section: Housner's corner
     specs.append(("lam", "impact.lam", *_axis_spec("impact.lam", lam)[:2]))
+    law_axis, law_specs = _impact_law(impact)
+    n_laws = 1 if law_axis is None else len(law_axis.values)
+    specs.extend(law_specs)  # after lam (and the law's axis, added below)
     if suite is not None:  # the records (words), then the stripes, before p
         specs.append(("record", "ground.record", "words", suite.names))
         if stripe is not None:
@@ -884,7 +927,7 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
                                (spec["num"] if form == "range" else
                                 len(suite.levels) if form == "stripes" else len(spec))
                                for _, _, form, spec in specs]
-    size = math.prod(lengths)
+    size = math.prod(lengths) * n_laws
     if size > MAX_POINTS:
         dims = " x ".join(f"{n:,} {key}" for n, (_, key, form, _) in
                           zip(lengths[1:], specs, strict=True) if form != "scalar")
@@ -903,6 +946,8 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
             continue
         values = _axis_values(key, form, spec)
         axes.append(Axis(name_, key, tuple(values.tolist()), form != "scalar"))
+        if name_ == "lam" and law_axis is not None:
+            axes.append(law_axis)
     axes.extend(options)  # unswept: the flat index and the result's shape stay as they are
 
     numerics, single = _numerics(numerics_sec, contact)

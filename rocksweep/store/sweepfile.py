@@ -140,8 +140,6 @@ COMPUTED_VARIABLE = ("int8", 0, "adaptive sweep: 0 filled (not computed; outcome
                      "audit point that disagreed (region refined)")
 COMPUTED_FLAGS = {0: "filled", 1: "computed", 2: "audit_agreed", 3: "audit_disagreed"}
 
-# Dimensions whose coordinates are words (variable-length strings), not numbers.
-WORD_DIMS = ("shape", "record")
 # Variables whose values are codes (CF flag_values / flag_masks): no units.
 FLAG_VARIABLES = ("outcome", "status", "computed")
 # What h5py raises for I/O and damaged files (HDF5 errors surface as any of these).
@@ -275,6 +273,10 @@ def _short(v) -> str:
     return repr(v)
 
 
+# Axes a scene need not give, with the value they then have: the impact law's (eq. 1)
+AXIS_DEFAULTS = {"impact.law": "vertical", "impact.e_factor": 1.0}
+
+
 def scene_differences(stored: dict, new: dict) -> list[str]:
     """One phrase per difference between two ``resolved_scene`` dicts."""
     diffs = []
@@ -289,6 +291,9 @@ def scene_differences(stored: dict, new: dict) -> list[str]:
                          f"scene {b if section in outputs else _short(b)}")
     for key in dict.fromkeys([*stored.get("axes", {}), *new.get("axes", {})]):
         a, b = stored.get("axes", {}).get(key), new.get("axes", {}).get(key)
+        if key in AXIS_DEFAULTS:  # a key not given is its default (files before it existed)
+            a = a or {"values": [AXIS_DEFAULTS[key]], "swept": False}
+            b = b or {"values": [AXIS_DEFAULTS[key]], "swept": False}
         if a != b:
             diffs.append(f"{key}: file {_short(a) if a else 'absent'}, "
                          f"scene {_short(b) if b else 'absent'}")
@@ -522,7 +527,7 @@ def _check_scene(stored, path: Path) -> None:
                 and isinstance(ax.get("swept"), bool) and isinstance(ax.get("values"), list)
                 and ax["values"]):
             raise bad(f"axis {_cut(key)} is {_cut(ax)}")
-        words = key.endswith(".shape") or key == "ground.record"  # shape: "record"
+        words = key in fields.WORD_KEYS
         kinds = (str,) if words else (int, float)
         if not all(isinstance(v, kinds) and not isinstance(v, bool) for v in ax["values"]):
             raise bad(f"axis {key} has values {_cut(ax['values'])}")
@@ -613,7 +618,7 @@ def _layout(f: h5py.File, path: Path) -> _Layout:
             raise _damaged(path, f"coordinate '{d}' has shape {ds.shape}, the scene "
                            f"{len(values)} values")
         data = ds[()]
-        if d in WORD_DIMS:
+        if d in fields.WORD_AXES:
             ok = [_plain(v) for v in data] == values
         else:
             ok = data.dtype.kind == "f" and np.array_equal(data, np.asarray(values, float))
@@ -1209,8 +1214,8 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
 
     scales = []
     for axis in scene.swept:
-        data = (np.array(axis.values, dtype=h5py.string_dtype()) if axis.name in WORD_DIMS
-                else np.asarray(axis.values, float))
+        data = (np.array(axis.values, dtype=h5py.string_dtype())
+                if axis.name in fields.WORD_AXES else np.asarray(axis.values, float))
         ds = f.create_dataset(axis.name, data=data)
         ds.make_scale(axis.name)
         _coord_attrs(ds, axis, scene.kind)
@@ -1221,7 +1226,8 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
             continue
         v = axis.values[0]
         ds = f.create_dataset(axis.name, data=(np.array(v, dtype=h5py.string_dtype())
-                                               if axis.name == "shape" else float(v)))
+                                               if axis.name in fields.WORD_AXES
+                                               else float(v)))
         _coord_attrs(ds, axis, scene.kind)
         scalars.append(axis.name)
 
@@ -1634,7 +1640,7 @@ def read_result(path: str | Path, names: list[str] | None = None,
             name = key.split(".", 1)[1]
             if ax["swept"]:
                 vals = f[name][()]
-                if name in WORD_DIMS:
+                if name in fields.WORD_AXES:
                     vals = np.array([_plain(v) for v in vals])
                 coords[name] = vals
             else:
