@@ -140,7 +140,7 @@ def _acting_overload(t, t_pulse, GROUND):
     return pulse
 
 
-@njit(cache=True, **INTERNAL)
+@njit(cache=True, _nrt=False, **INTERNAL)
 def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     """Run one point from rest (or the given initial state) to a decided outcome, a cap or
     the horizon.
@@ -288,13 +288,13 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _flag(out, bit):
     """Set a STATUS_* bit in the result row."""
     out[OUT_STATUS] = int(out[OUT_STATUS]) | bit
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _reset(out):
     """The result row before the first step: counters 0, times NaN, safe so far."""
     out[OUT_OUTCOME] = OUTCOME_SAFE
@@ -312,7 +312,7 @@ def _reset(out):
     out[OUT_HIST_ROWS] = 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _step_length(t, on, dt, t_pulse, t_end, h_rec):
     """(h, lands): the step dt, shortened to land exactly on the pulse's end (lands) or on
     the horizon.
@@ -335,7 +335,7 @@ def _step_length(t, on, dt, t_pulse, t_end, h_rec):
     return dt, False
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _rotation_step(theta_dot, acc, rot):
     """Longest step [s] whose predicted rotation |theta'| h + acc h^2 / 2 is rot [rad]
     (theta' [rad/s], acc: |theta''| [rad/s^2] estimated over the last step)."""
@@ -344,13 +344,13 @@ def _rotation_step(theta_dot, acc, rot):
     return 2.0 * rot / den if den > 0.0 else math.inf
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _finite(y):
     return (math.isfinite(y[Y_THETA]) and math.isfinite(y[Y_THETA_DOT])
             and math.isfinite(y[Y_U]) and math.isfinite(y[Y_U_DOT]))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _theta_max(y, y_end, h_end, s, theta_max):
     """theta_max updated over a rocking step (t, y) -> (t + h_end, y_end), including a
     turning point inside it."""
@@ -451,7 +451,7 @@ def _write_row(hist, row, t, y, s, on, prm, e_imp, FLEX):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _finish(t, y, s, steps, event_steps, theta_max, prm, out, FLEX, ENERGY):
     """The result row's last entries: end time, step counts, theta_max and the energy
     accounting (NaN without)."""
