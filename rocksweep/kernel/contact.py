@@ -34,7 +34,7 @@ import math
 
 from numba import literally, njit
 
-from rocksweep.kernel._cache import INTERNAL
+from rocksweep.kernel._cache import INLINE, INTERNAL
 from rocksweep.kernel.equations import contact_rhs, ground_acc, rigid_rhs, rocking_rhs
 from rocksweep.kernel.layout import (
     OUT_IMPULSE_MAX,
@@ -71,7 +71,7 @@ SAMPLE_START = 1
 SAMPLE_EVENT = 2
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def ground_reactions(theta, theta_dot, u, u_dot, s, xg, prm, FLEX, DAMPED):
     """(H [N], N [N]): the ground's horizontal and vertical reaction on the body in phase
     s (0 full contact) at the state (theta, theta', u, u') and ground acceleration xg."""
@@ -102,7 +102,7 @@ def ground_reactions(theta, theta_dot, u, u_dot, s, xg, prm, FLEX, DAMPED):
     return m * xp + m_A * xa, m * (yp + g) + m_A * (ya + g)
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def impact_impulses(s, u, u_dot_minus, w_minus, s_new, u_dot_plus, w_plus, prm, FLEX):
     """(J_x, J_y) [N s]: the ground's impulse on the body at an impact at theta = 0 that
     ends rocking on corner s (rate w_minus, top mass rate u_dot_minus) and leaves it in
@@ -120,7 +120,7 @@ def impact_impulses(s, u, u_dot_minus, w_minus, s_new, u_dot_plus, w_plus, prm, 
     return j_x, j_y
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def impulse_ratio(j_x, j_y):
     """|J_x| / J_y (+inf when the ground would have to pull: J_y <= 0)."""
     if j_y <= 0.0:
@@ -128,7 +128,7 @@ def impulse_ratio(j_x, j_y):
     return abs(j_x) / j_y
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def _values(t, y, s, on, prm, FLEX, DAMPED):
     """(|H|/N or +inf when N <= 0, N/(M g)) at (t, y) in phase s."""
     h_, n_ = ground_reactions(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s,
@@ -137,7 +137,7 @@ def _values(t, y, s, on, prm, FLEX, DAMPED):
     return ratio, n_ / (prm[PAR_MTOT] * prm[PAR_G])
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def _vertex(x0, f0, x1, f1, x2, f2):
     """Vertex of the parabola through three points (x0 < x1 < x2); NaN if it has none
     (collinear)."""
@@ -193,7 +193,7 @@ def _refine(which, t_a, y_a, f_a, t_b, y_b, f_b, t_c, f_c, s, on, prm, FLEX, DAM
     return best
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def _take(out, r, n):
     if r > out[OUT_MU_REQ] or r != r:
         out[OUT_MU_REQ] = r

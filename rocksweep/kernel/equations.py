@@ -30,7 +30,7 @@ from numba import njit
 from numba.core import types
 from numba.extending import overload
 
-from rocksweep.kernel._cache import INTERNAL
+from rocksweep.kernel._cache import INLINE, INTERNAL, PUBLIC
 from rocksweep.kernel.layout import (
     PAR_AMP,
     PAR_AMP_NORM,
@@ -112,7 +112,7 @@ def _shape_jerk_overload(t, on, prm):
     return any_shape
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def ground_acc(t, on, prm):
     """xg''(t) [m/s^2] of eq. (2) or of the row's other shape; 0 when ``on`` is false.
 
@@ -122,7 +122,7 @@ def ground_acc(t, on, prm):
     return _shape_acc(t, on, prm)
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def ground_jerk(t, on, prm):
     """d xg''/dt [m/s^3], for locating an uplift inside a step."""
     if not on:
@@ -130,7 +130,7 @@ def ground_jerk(t, on, prm):
     return _shape_jerk(t, on, prm)
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def _record_segment(t, prm):
     """(a_k, x - k, a_k+1 - a_k), x = t / PAR_REC_DT: the first sample of the record's
     linear segment [t_k, t_k+1] that holds t, the fraction of it at t, and the samples'
@@ -205,7 +205,7 @@ def ground_jerk_any(t, prm):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def rocking_rhs(theta, theta_dot, u, u_dot, s, xg, prm, DAMPED):
     """Accelerations while rocking on corner s (+1 / -1), and the input and damper powers.
 
@@ -226,7 +226,7 @@ def rocking_rhs(theta, theta_dot, u, u_dot, s, xg, prm, DAMPED):
     return theta_dd, u_dd, power_in, f_damp * u_dot
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def rigid_rhs(theta, theta_dot, s, xg, prm):
     """Rigid body (top mass welded, or a block): I_O theta'' = moment about corner s.
 
@@ -245,7 +245,7 @@ def rigid_rhs(theta, theta_dot, s, xg, prm):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def contact_rhs(u, u_dot, xg, prm, DAMPED):
     """Full contact: m u'' + c u' + k u = -m xg''. Returns (u'', ground power, damper power)."""
     f_damp = prm[PAR_C] * u_dot if DAMPED else 0.0
@@ -253,7 +253,7 @@ def contact_rhs(u, u_dot, xg, prm, DAMPED):
     return u_dd, -prm[PAR_M] * xg * u_dot, f_damp * u_dot
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def uplift_moment(u, u_dot, xg, prm, FLEX, DAMPED):
     """Q [N m]: the moment that tips the body in full contact.
 
@@ -273,7 +273,7 @@ def uplift_moment(u, u_dot, xg, prm, FLEX, DAMPED):
     return prm[PAR_H] * f + prm[PAR_M] * prm[PAR_G] * u - prm[PAR_MA] * prm[PAR_HA] * xg
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def uplift_moment_rate(u, u_dot, xg, jerk, prm, FLEX, DAMPED):
     """dQ/dt [N m/s] in full contact."""
     if not FLEX:
@@ -283,13 +283,13 @@ def uplift_moment_rate(u, u_dot, xg, jerk, prm, FLEX, DAMPED):
     return prm[PAR_H] * df + prm[PAR_M] * prm[PAR_G] * u_dot - prm[PAR_MA] * prm[PAR_HA] * jerk
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def tip_moment(prm):
     """M g b [N m]: the moment about a corner that the body's weight resists uplift with."""
     return prm[PAR_MTOT] * prm[PAR_G] * prm[PAR_B]
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def rest_margin(u, u_dot, prm):
     """Q_max^2 - (M g b)^2 [N^2 m^2] after the pulse, in full contact (< 0: rest for good).
 
@@ -312,7 +312,7 @@ def rest_margin(u, u_dot, prm):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, **PUBLIC)
 def restitution(s, u, prm, FLEX):
     """e = theta'^+ / theta'^- for an impact that ends rocking on corner s.
 
@@ -342,7 +342,7 @@ def restitution(s, u, prm, FLEX):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, **PUBLIC)
 def mechanical_energy(theta, theta_dot, u, u_dot, s, prm, FLEX):
     """T + V - V_rest [J] in phase s (0: full contact)."""
     if not FLEX:
@@ -364,7 +364,7 @@ def mechanical_energy(theta, theta_dot, u, u_dot, s, prm, FLEX):
     return kin + pot
 
 
-@njit(cache=True)
+@njit(cache=True, **PUBLIC)
 def impact_loss(s, s_new, u, w_minus, w_plus, prm, FLEX):
     """Energy [J] the impact itself dissipates (eq. 6; < 0: the impact gains energy).
 
@@ -400,7 +400,7 @@ def impact_loss(s, s_new, u, w_minus, w_plus, prm, FLEX):
 RIGID_ENERGY_MARGIN = 1e-6
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def rigid_peak(theta, theta_dot, s, prm):
     """After the pulse, a rigid body rocking on corner s: the largest |theta| [rad] still to
     come if it can never overturn, else -1 (not proven).
@@ -431,7 +431,7 @@ def rigid_peak(theta, theta_dot, s, prm):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, **PUBLIC)
 def rocking_spring_omega(omega_n, zeta, m, h, i_a0, a):
     """Fastest rate [rad/s] of the top mass on its spring while the base rocks, with the
     top mass's lever arm a = u - s b [m] about the corner.

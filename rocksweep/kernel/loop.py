@@ -28,7 +28,7 @@ from numba import literally, njit
 from numba.core import types
 from numba.extending import overload
 
-from rocksweep.kernel._cache import INTERNAL
+from rocksweep.kernel._cache import INLINE, INTERNAL
 from rocksweep.kernel.contact import (
     SAMPLE_EVENT,
     SAMPLE_START,
@@ -140,7 +140,7 @@ def _acting_overload(t, t_pulse, GROUND):
     return pulse
 
 
-@njit(cache=True, _nrt=False, **INTERNAL)
+@njit(cache=True, **INTERNAL)
 def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     """Run one point from rest (or the given initial state) to a decided outcome, a cap or
     the horizon.
@@ -155,7 +155,6 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
-    literally(CONTACT)
     literally(GROUND)
     t, dt, t_pulse, t_end = 0.0, prm[PAR_DT], prm[PAR_TPULSE], prm[PAR_TEND]
     max_steps, max_events = prm[PAR_MAXSTEPS], prm[PAR_MAXEVENTS]
@@ -175,10 +174,10 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     steps, event_steps, theta_max = 0, 0, abs(y[Y_THETA])
     # contact tracker (contact.contact_sample): unused, and removed, without CONTACT
     ct = (0.0, 0.0, y, 0.0, 0.0, 0.0, y, 0.0, 0.0)
-    out[OUT_MU_REQ] = 0.0 if CONTACT else np.nan
-    out[OUT_N_MIN] = np.inf if CONTACT else np.nan
-    out[OUT_IMPULSE_MAX] = 0.0 if CONTACT else np.nan
-    if CONTACT:
+    out[OUT_MU_REQ] = 0.0 if CONTACT is not None else np.nan
+    out[OUT_N_MIN] = np.inf if CONTACT is not None else np.nan
+    out[OUT_IMPULSE_MAX] = 0.0 if CONTACT is not None else np.nan
+    if CONTACT is not None:
         ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED)
     # The rotation limit (PAR_ROT_STEP, 0: off): a rocking step may turn the body by at most
     # rot, predicted from theta' and the last step's |theta''| (acc), and checked after
@@ -242,7 +241,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
         if ev == EV_NONE:
             t, y = (t_pulse if lands else t + h), y1
             _record(hist, t, y, s, _acting(t, t_pulse, GROUND), prm, out, FLEX)
-            if CONTACT:  # the step's end, with the step's own ground motion
+            if CONTACT is not None:  # the step's end, with the step's own ground motion
                 ct = contact_sample(ct, t, y, s, on, SAMPLE_STEP, prm, out, FLEX, DAMPED)
             if lands and s == 0:
                 # The pulse ends with a jump of xg'' (a cosine pulse ends at its peak), and
@@ -253,14 +252,14 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
                 s = _uplift(t, y, off, prm, out, FLEX, DAMPED)
                 if s != 0:
                     _record(hist, t, y, s, off, prm, out, FLEX)
-            if CONTACT and lands:  # H jumps with xg'': a new segment without the pulse
+            if CONTACT is not None and lands:  # H jumps with xg'': a new segment without the pulse
                 ct = contact_sample(ct, t, y, s, _acting(t_pulse, t_pulse, GROUND),
                                     SAMPLE_START, prm, out, FLEX, DAMPED)
             continue
 
         t, y = t + tau, y_ev
         _record(hist, t, y, s, on, prm, out, FLEX)
-        if CONTACT:  # the event state, last sample of its phase
+        if CONTACT is not None:  # the event state, last sample of its phase
             ct = contact_sample(ct, t, y, s, on, SAMPLE_EVENT, prm, out, FLEX, DAMPED)
         if ev == EV_OVERTURN:
             _overturned(t, out)
@@ -268,7 +267,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
         if ev == EV_IMPACT:
             y_minus, s_minus = y, s
             y, s = _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY)
-            if CONTACT:
+            if CONTACT is not None:
                 contact_impact(y_minus, s_minus, y, s, prm, out, FLEX)
             free_check = True
         else:  # uplift: theta = theta' = 0 exactly, now rocking on the located corner
@@ -276,10 +275,10 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             y = (0.0, 0.0, y[Y_U], y[Y_U_DOT], y[Y_W_IN], y[Y_D_DAMP])
             out[OUT_UPLIFTS] += 1.0
         _record(hist, t, y, s, on, prm, out, FLEX)
-        if CONTACT:  # the state after the action starts the next phase's samples
+        if CONTACT is not None:  # the state after the action starts the next phase's samples
             ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED)
     _finish(t, y, s, steps, event_steps, theta_max, prm, out, FLEX, ENERGY)
-    if CONTACT:
+    if CONTACT is not None:
         _contact_status(prm, out)
 
 
@@ -288,13 +287,13 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, inline="always")
 def _flag(out, bit):
     """Set a STATUS_* bit in the result row."""
     out[OUT_STATUS] = int(out[OUT_STATUS]) | bit
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def _reset(out):
     """The result row before the first step: counters 0, times NaN, safe so far."""
     out[OUT_OUTCOME] = OUTCOME_SAFE
@@ -312,7 +311,7 @@ def _reset(out):
     out[OUT_HIST_ROWS] = 0.0
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def _step_length(t, on, dt, t_pulse, t_end, h_rec):
     """(h, lands): the step dt, shortened to land exactly on the pulse's end (lands) or on
     the horizon.
@@ -335,7 +334,7 @@ def _step_length(t, on, dt, t_pulse, t_end, h_rec):
     return dt, False
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def _rotation_step(theta_dot, acc, rot):
     """Longest step [s] whose predicted rotation |theta'| h + acc h^2 / 2 is rot [rad]
     (theta' [rad/s], acc: |theta''| [rad/s^2] estimated over the last step)."""
@@ -344,13 +343,13 @@ def _rotation_step(theta_dot, acc, rot):
     return 2.0 * rot / den if den > 0.0 else math.inf
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def _finite(y):
     return (math.isfinite(y[Y_THETA]) and math.isfinite(y[Y_THETA_DOT])
             and math.isfinite(y[Y_U]) and math.isfinite(y[Y_U_DOT]))
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def _theta_max(y, y_end, h_end, s, theta_max):
     """theta_max updated over a rocking step (t, y) -> (t + h_end, y_end), including a
     turning point inside it."""
@@ -451,7 +450,7 @@ def _write_row(hist, row, t, y, s, on, prm, e_imp, FLEX):
     return True
 
 
-@njit(cache=True, forceinline=True)
+@njit(cache=True, **INLINE)
 def _finish(t, y, s, steps, event_steps, theta_max, prm, out, FLEX, ENERGY):
     """The result row's last entries: end time, step counts, theta_max and the energy
     accounting (NaN without)."""
