@@ -31,8 +31,12 @@ _KERNEL_DIR = Path(__file__).resolve().parent
 # run time even once inlined: numba's refcount pruning cannot pair them across branches).
 #
 # Options of the functions only ever called from jitted code: no Python or C entry point
-# to build (tests reach them through small @njit wrappers).
-INTERNAL = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True, "_nrt": False}
+# to build (tests reach them through small @njit wrappers). They are calls (the work of
+# events, once per event): ``forceinline`` set False, else numba would pass on the flag of
+# the function whose compilation compiles them (an event search inlined into every copy
+# of the screening doubles the code and the compile time, for nothing measurable).
+INTERNAL = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True, "_nrt": False,
+            "forceinline": False}
 # Options of the small functions on the path of every step: compiled once per signature
 # and inlined by LLVM (``forceinline``: LLVM's alwaysinline), not by numba (``inline=
 # "always"`` copies and retypes the callee's IR at every call site: 2/3 of the compile

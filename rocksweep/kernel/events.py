@@ -236,7 +236,8 @@ def _crossing(ev, t0, y0, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
     through zero and back, e.g. a grazing impact inside a coarse step) is checked with the
     step's cubic Hermite interpolant; when its minimum is nearer zero than the dip is deep,
     ``_dip`` searches the integrator's own solution. This screening runs for every event
-    function at every step and is inlined into the loop; the searches are calls.
+    function at every step and is inlined into the loop (with ``_first_event``); the
+    searches are calls.
     """
     g0 = event_value(ev, t0, y0, s, on, prm, FLEX, DAMPED)
     g1 = event_value(ev, t0 + h, y1, s, on, prm, FLEX, DAMPED)
@@ -303,7 +304,7 @@ def _dip(ev, t0, y0, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERGY):
             tau = 0.5 * (lo + hi)
 
 
-@njit(cache=True, **INTERNAL)
+@njit(cache=True, **INLINE)
 def _first_event(t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
     """The first event in the step (t, y) -> (t + h, y1) of phase s.
 

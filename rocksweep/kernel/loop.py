@@ -5,9 +5,9 @@ state y (``layout.Y_*``); it takes fixed RK4 steps (``stepping``), asks ``events
 first event inside each step and applies the transition rules (``transitions``). The
 counters of events live in the result row ``out`` (``OUT_*``) as it runs, those of every
 step (steps, theta_max) in locals; the actions that update them are the small helpers
-below. Those on the path of every step take no arrays and are inlined (numba
-``inline="always"``); those of events are calls (an inlined helper that takes ``prm`` or
-``out`` adds reference counting to every step: ~15% slower, measured).
+below. Those on the path of every step are inlined by LLVM (``_cache.INLINE``); those of
+events are calls (``_cache.INTERNAL``). No kernel function counts references
+(``_nrt=False``), so passing ``prm`` or ``out`` costs nothing beyond the call.
 
 Compile-time specialisation: the functions take the flags FLEX, DAMPED and ENERGY (and
 ``simulate_point`` GROUND: every ground motion, not only the paper's sine and cosine; it
@@ -15,10 +15,11 @@ reaches the ground motion as the type of ``on``, see ``equations.ground_acc``) a
 ``numba.literally`` on them, so numba compiles one specialisation per flag value (a
 ``Literal[bool]`` type) and the branches a variant does not need are removed at compile
 time (by LLVM: numba still types and lowers them, its own dead-branch pruning does not
-read literal arguments, so they cost compile time but no run time). The time history is
-the exception: ``simulate_point`` gets ``hist=None`` when there is none, and numba prunes
-the ``if hist is not None`` branch of ``_record`` before typing. The variants themselves
-are in ``variants``.
+read literal arguments, so they cost compile time but no run time). The time history and
+the ground reactions are the exceptions: ``simulate_point`` gets ``hist=None`` and
+``CONTACT=None`` when there are none, and numba prunes the ``if hist is not None`` /
+``if CONTACT is not None`` branches before typing (the contact bookkeeping was half the
+compile time of a variant without it). The variants themselves are in ``variants``.
 """
 
 import math
@@ -147,10 +148,10 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
 
     prm: float64[N_PAR] parameter row; out: float64[N_OUT] result row (filled);
     hist: float64[n, N_HIST] history buffer, or None: no history (the recording code is
-    then not compiled at all). CONTACT: track the ground reactions (``contact``): the
-    friction demand, the lowest normal force and the impacts' impulse ratio; every sample
-    is a state the loop reaches anyway (step ends, event states before and after the
-    action), taken with ``_contact``.
+    then not compiled at all). CONTACT: True to track the ground reactions (``contact``):
+    the friction demand, the lowest normal force and the impacts' impulse ratio; every
+    sample is a state the loop reaches anyway (step ends, event states before and after the
+    action), taken with ``contact_sample``. None: no tracking (the code is not compiled).
     """
     literally(FLEX)
     literally(DAMPED)

@@ -5,11 +5,9 @@
 
 Compile-time flags (see ``variants``): FLEX (the top mass moves on its spring), DAMPED (the
 spring has a damper) and ENERGY (integrate the ground's work W_in and the damper's loss
-D_damp along). Both functions are inlined where they are called (numba
-``inline="always"``), so an RK4 step makes no function call: a call costs about as much as
-a right-hand side, most of it the reference count of ``prm`` taken and dropped on every
-call (scripts/bench_kernel.py, roofline; inlining ``rk4_step`` made the sweeps 10-20%
-faster, bit for bit the same, for ~8% more compile time).
+D_damp along). Both functions are inlined where they are called, by LLVM
+(``_cache.INLINE``: compiled once, then inlined; numba's own ``inline="always"`` retyped
+them at every call site), so an RK4 step makes no function call.
 """
 
 from numba import njit
