@@ -73,14 +73,24 @@ QUICK_VARIANTS = [(L.KIND_FLEXIBLE, L.LEVEL_OUTCOME, False)]
 _COMPILE_SNIPPET = """
 import json, sys, time
 c0, w0 = time.process_time(), time.perf_counter()
+import rocksweep
 from rocksweep.kernel import warm_up
 c1, w1 = time.process_time(), time.perf_counter()
 kind, level, ground = json.loads(sys.argv[1])
 warm_up(kind, level, ground)
 c2, w2 = time.process_time(), time.perf_counter()
 print(json.dumps({"import_cpu": c1 - c0, "import_wall": w1 - w0,
-                  "cpu": c2 - c1, "wall": w2 - w1}))
+                  "cpu": c2 - c1, "wall": w2 - w1, "package": rocksweep.__file__}))
 """
+
+
+def child_env(**extra: str) -> dict[str, str]:
+    """The environment of the subprocesses: they import the same rocksweep as this process
+    (its parent directory first on PYTHONPATH; they run in a temporary directory, so that
+    ``python -c`` / ``-m`` does not put the current directory first instead)."""
+    pkg_parent = str(Path(rocksweep.__file__).resolve().parents[1])
+    path = os.pathsep.join(p for p in (pkg_parent, os.environ.get("PYTHONPATH")) if p)
+    return {**os.environ, "PYTHONPATH": path, **extra}
 
 
 def variant_name(kind: int, level: int | None, ground: bool) -> str:
@@ -90,9 +100,9 @@ def variant_name(kind: int, level: int | None, ground: bool) -> str:
 def cold_compile(variant: tuple[int, int | None, bool]) -> dict:
     """Compile one variant in a fresh process with an empty NUMBA_CACHE_DIR."""
     with tempfile.TemporaryDirectory() as cache:
-        env = {**os.environ, "NUMBA_CACHE_DIR": cache}
         res = subprocess.run([sys.executable, "-c", _COMPILE_SNIPPET, json.dumps(variant)],
-                             env=env, capture_output=True, text=True, check=True)
+                             env=child_env(NUMBA_CACHE_DIR=cache), cwd=cache,
+                             capture_output=True, text=True, check=True)
     return json.loads(res.stdout.splitlines()[-1])
 
 
@@ -103,7 +113,8 @@ def timed(cmd: list[str], repeat: int) -> tuple[float, float]:
     for _ in range(repeat):
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         t0 = time.perf_counter()
-        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                       env=child_env(), cwd=tempfile.gettempdir())
         wall = time.perf_counter() - t0
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
         cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -121,7 +132,8 @@ def startup(repeat: int, quick: bool) -> dict[str, tuple[float, float]]:
         h5 = str(Path(tmp) / "small.h5")
         sweep = [*rs, "sweep", str(CONFIGS / "fig3a.yaml"), *small, "-o", h5, "--overwrite",
                  "-q", "-j", "1"]
-        subprocess.run(sweep, check=True, capture_output=True)  # fills the cache, writes h5
+        # fills the cache, writes the small result
+        subprocess.run(sweep, check=True, capture_output=True, env=child_env(), cwd=tmp)
         res["python -c pass"] = timed([py, "-c", "pass"], repeat)
         res["rocksweep --help"] = timed([*rs, "--help"], repeat)
         res["kernel: import + warm_up (cache)"] = timed(
@@ -185,6 +197,8 @@ def main() -> None:
         print(f"    {'variant':<36}{'CPU s':>8}{'wall s':>8}{'import CPU s':>14}")
         for v in variants:
             r = cold_compile(v)
+            if Path(r["package"]).resolve() != Path(rocksweep.__file__).resolve():
+                raise SystemExit(f"the subprocess imported {r['package']}")
             print(f"    {variant_name(*v):<36}{r['cpu']:>8.2f}{r['wall']:>8.2f}"
                   f"{r['import_cpu']:>14.2f}", flush=True)
 

@@ -6,6 +6,8 @@ effect set; ``warm_up`` compiles one now. One idea per module:
 - ``layout``: the arrays' index constants (parameter row, result row, history, state);
   plain Python, importable without numba;
 - ``equations``: the physics, pure formulas (also called by ``rocksweep.physics.reference``);
+- ``spring``: the top mass's spring rate while rocking (the step-size rule's input); plain
+  Python, importable without numba;
 - ``stepping``: the right-hand side on the state and one RK4 step;
 - ``events``: event functions, detection inside a step and location of the root;
 - ``transitions``: uplift, the impact map, the rest and rigid-bound early exits;

@@ -30,6 +30,7 @@ from numba import njit
 from numba.core import types
 from numba.extending import overload
 
+from rocksweep.kernel import spring
 from rocksweep.kernel._cache import INLINE, INTERNAL, PUBLIC
 from rocksweep.kernel.layout import (
     PAR_AMP,
@@ -427,23 +428,8 @@ def rigid_peak(theta, theta_dot, s, prm):
 
 
 # ----------------------------------------------------------------------------------------
-# The top mass's spring while the base rocks (what the step size must resolve)
+# The top mass's spring while the base rocks (what the step size must resolve): plain
+# Python, in ``spring`` (called from Python only; importable without numba)
 # ----------------------------------------------------------------------------------------
 
-
-@njit(cache=True, **PUBLIC)
-def rocking_spring_omega(omega_n, zeta, m, h, i_a0, a):
-    """Fastest rate [rad/s] of the top mass on its spring while the base rocks, with the
-    top mass's lever arm a = u - s b [m] about the corner.
-
-    Linearising ``rocking_rhs`` in u: u'' = -Gamma (k u + c u') / m + ...,
-    Gamma = 1 + m h^2 / (I_A + m_A R_A^2 + m a^2) (i_a0 = I_A + m_A R_A^2 [kg m^2]): a
-    spring of frequency omega_n sqrt(Gamma) and damping ratio zeta sqrt(Gamma). Gamma is
-    largest at a = 0. Above a damping ratio of 1 the mode is overdamped and its fast root,
-    omega (zeta' + sqrt(zeta'^2 - 1)), is what an explicit step must resolve.
-    """
-    gamma = 1.0 + m * (h * h) / (i_a0 + m * (a * a))
-    omega, zeta_r = omega_n * math.sqrt(gamma), zeta * math.sqrt(gamma)
-    if zeta_r > 1.0:
-        omega *= zeta_r + math.sqrt(zeta_r * zeta_r - 1.0)
-    return omega
+rocking_spring_omega = spring.rocking_spring_omega
