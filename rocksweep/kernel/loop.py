@@ -179,7 +179,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     out[OUT_N_MIN] = np.inf if CONTACT is not None else np.nan
     out[OUT_IMPULSE_MAX] = 0.0 if CONTACT is not None else np.nan
     if CONTACT is not None:
-        ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED)
+        ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED, ENERGY)
     # The rotation limit (PAR_ROT_STEP, 0: off): a rocking step may turn the body by at most
     # rot, predicted from theta' and the last step's |theta''| (acc), and checked after
     # the step: a huge slow pulse or a fall is not crossed in a handful of steps.
@@ -243,7 +243,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             t, y = (t_pulse if lands else t + h), y1
             _record(hist, t, y, s, _acting(t, t_pulse, GROUND), prm, out, FLEX)
             if CONTACT is not None:  # the step's end, with the step's own ground motion
-                ct = contact_sample(ct, t, y, s, on, SAMPLE_STEP, prm, out, FLEX, DAMPED)
+                ct = contact_sample(ct, t, y, s, on, SAMPLE_STEP, prm, out, FLEX, DAMPED, ENERGY)
             if lands and s == 0:
                 # The pulse ends with a jump of xg'' (a cosine pulse ends at its peak), and
                 # Q jumps with it by m_A h_A xg'': the state may now be past the uplift
@@ -255,13 +255,13 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
                     _record(hist, t, y, s, off, prm, out, FLEX)
             if CONTACT is not None and lands:  # H jumps with xg'': a new segment without the pulse
                 ct = contact_sample(ct, t, y, s, _acting(t_pulse, t_pulse, GROUND),
-                                    SAMPLE_START, prm, out, FLEX, DAMPED)
+                                    SAMPLE_START, prm, out, FLEX, DAMPED, ENERGY)
             continue
 
         t, y = t + tau, y_ev
         _record(hist, t, y, s, on, prm, out, FLEX)
         if CONTACT is not None:  # the event state, last sample of its phase
-            ct = contact_sample(ct, t, y, s, on, SAMPLE_EVENT, prm, out, FLEX, DAMPED)
+            ct = contact_sample(ct, t, y, s, on, SAMPLE_EVENT, prm, out, FLEX, DAMPED, ENERGY)
         if ev == EV_OVERTURN:
             _overturned(t, out)
             break
@@ -277,7 +277,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             out[OUT_UPLIFTS] += 1.0
         _record(hist, t, y, s, on, prm, out, FLEX)
         if CONTACT is not None:  # the state after the action starts the next phase's samples
-            ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED)
+            ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED, ENERGY)
     _finish(t, y, s, steps, event_steps, theta_max, prm, out, FLEX, ENERGY)
     if CONTACT is not None:
         _contact_status(prm, out)
