@@ -13,6 +13,7 @@ effect set; ``warm_up`` compiles one now. One idea per module:
 - ``transitions``: uplift, the impact map, the rest and rigid-bound early exits;
 - ``loop``: ``simulate_point``, one point from start to outcome;
 - ``variants``: the compiled entry points and their tables;
+- ``_static``: calls that a variant's flags make dead, left out while typing;
 - ``_cache``: where numba caches them, stamped by the hash of these sources (imported
   by every module that defines a jitted function, before its first ``@njit(cache=True)``).
 

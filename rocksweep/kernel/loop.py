@@ -30,6 +30,7 @@ from numba.core import types
 from numba.extending import overload
 
 from rocksweep.kernel._cache import INLINE, INTERNAL
+from rocksweep.kernel._static import skipped_when
 from rocksweep.kernel.contact import (
     SAMPLE_EVENT,
     SAMPLE_START,
@@ -116,6 +117,9 @@ from rocksweep.kernel.layout import (
 from rocksweep.kernel.stepping import rk4_step
 from rocksweep.kernel.transitions import impact_map, rest_proven, rigid_bounded, uplift_side
 
+# the outcome-only variants do not compile the energy (``_static``)
+_energy = skipped_when(False, mechanical_energy, 0.0)
+
 # _step_length: a time within this fraction of a record step of a grid time is on it (t
 # sums steps of ~1e-2..1; its round-off is ~1e-16 relative, far below).
 ALIGN_SLACK = 1e-7
@@ -201,7 +205,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             break
         if not FLEX and s != 0 and not on and free_check:
             free_check = False  # E is constant between impacts after the pulse: test once
-            peak = rigid_bounded(y, s, prm)
+            peak = rigid_bounded(y, s, prm, FLEX)
             if peak >= 0.0:
                 if peak > theta_max:
                     theta_max = peak
@@ -462,8 +466,8 @@ def _finish(t, y, s, steps, event_steps, theta_max, prm, out, FLEX, ENERGY):
     if ENERGY:
         out[OUT_W_IN] = y[Y_W_IN]
         out[OUT_D_DAMP] = y[Y_D_DAMP]
-        out[OUT_E_END] = mechanical_energy(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s,
-                                           prm, FLEX)
+        out[OUT_E_END] = _energy(ENERGY, y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s,
+                                 prm, FLEX)
     else:
         out[OUT_W_IN] = np.nan
         out[OUT_D_DAMP] = np.nan
