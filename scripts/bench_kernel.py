@@ -33,8 +33,10 @@ Prints, measured side by side in one run (issue 7's benchmark):
    (480,000 points) once.
 6. warm start: ``rocksweep simulate configs/fig2.yaml`` with numba's cache filled (best of 3).
 Optional: ``--compile`` times a cold compile of every kernel variant (a fresh
-NUMBA_CACHE_DIR, one subprocess); ``--million`` sweeps a 10^6-point grid (the rigid block
-scene) with ``--jobs 2`` and reports its peak memory.
+NUMBA_CACHE_DIR, one subprocess; ``scripts/bench_compile.py`` compiles each variant in a
+fresh process of its own, next to the start-up and the per-point costs); ``--million``
+sweeps a 10^6-point grid (the rigid block scene) with ``--jobs 2`` and reports its peak
+memory.
 
 The machine may be shared: the load average is printed at the start and the end; CPU
 times (items 1-2) are less sensitive to load than wall times (items 2-6).

@@ -6,11 +6,14 @@ effect set; ``warm_up`` compiles one now. One idea per module:
 - ``layout``: the arrays' index constants (parameter row, result row, history, state);
   plain Python, importable without numba;
 - ``equations``: the physics, pure formulas (also called by ``rocksweep.physics.reference``);
+- ``spring``: the top mass's spring rate while rocking (the step-size rule's input); plain
+  Python, importable without numba;
 - ``stepping``: the right-hand side on the state and one RK4 step;
 - ``events``: event functions, detection inside a step and location of the root;
 - ``transitions``: uplift, the impact map, the rest and rigid-bound early exits;
 - ``loop``: ``simulate_point``, one point from start to outcome;
 - ``variants``: the compiled entry points and their tables;
+- ``_static``: calls that a variant's flags make dead, left out while typing;
 - ``_cache``: where numba caches them, stamped by the hash of these sources (imported
   by every module that defines a jitted function, before its first ``@njit(cache=True)``).
 

@@ -25,9 +25,27 @@ from numba.core import caching, config
 
 _KERNEL_DIR = Path(__file__).resolve().parent
 
+# No kernel function allocates: every one is compiled without numba's reference counting
+# (``_nrt=False``), so passing the parameter row or the result row to a function costs no
+# atomic increment and decrement (with them, a call inside the step loop cost ~40% of the
+# run time even once inlined: numba's refcount pruning cannot pair them across branches).
+#
 # Options of the functions only ever called from jitted code: no Python or C entry point
-# to build (tests reach them through small @njit wrappers).
-INTERNAL = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True}
+# to build (tests reach them through small @njit wrappers). They are calls (the work of
+# events, once per event): ``forceinline`` set False, else numba would pass on the flag of
+# the function whose compilation compiles them (an event search inlined into every copy
+# of the screening doubles the code and the compile time, for nothing measurable).
+INTERNAL = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True, "_nrt": False,
+            "forceinline": False}
+# Options of the small functions on the path of every step: compiled once per signature
+# and inlined by LLVM (``forceinline``: LLVM's alwaysinline), not by numba (``inline=
+# "always"`` copies and retypes the callee's IR at every call site: 2/3 of the compile
+# time). Still callable from Python (the reference path and the tests use some).
+INLINE = {"forceinline": True, "_nrt": False}
+# Options of the other functions called from jitted code and from Python.
+PUBLIC = {"_nrt": False}
+# Options of the entry points (``variants``): called from Python.
+ENTRY = {"_nrt": False}
 
 
 def _kernel_hash() -> str:

@@ -32,9 +32,10 @@ safeguarded successive parabolic interpolation.
 
 import math
 
+import numpy as np
 from numba import literally, njit
 
-from rocksweep.kernel._cache import INTERNAL
+from rocksweep.kernel._cache import INLINE, INTERNAL
 from rocksweep.kernel.equations import contact_rhs, ground_acc, rigid_rhs, rocking_rhs
 from rocksweep.kernel.layout import (
     OUT_IMPULSE_MAX,
@@ -65,13 +66,17 @@ REFINE_BAND = 0.25
 REFINE_XTOL = 1e-3
 REFINE_MAX_ITER = 12
 _GOLD = 0.3819660112501051  # 2 - golden ratio
-# contact_sample's modes
-SAMPLE_STEP = 0
-SAMPLE_START = 1
-SAMPLE_EVENT = 2
+# contact_sample's modes and _refine's two curves: numpy ints, not Python ints, so that
+# numba types them int64, not as literals (a literal argument is a specialisation of its
+# own: contact_sample compiled three times, _refine twice)
+SAMPLE_STEP = np.int64(0)
+SAMPLE_START = np.int64(1)
+SAMPLE_EVENT = np.int64(2)
+PEAK_RATIO = np.int64(0)  # |H|/N
+PEAK_NORMAL = np.int64(1)  # -N/(M g)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def ground_reactions(theta, theta_dot, u, u_dot, s, xg, prm, FLEX, DAMPED):
     """(H [N], N [N]): the ground's horizontal and vertical reaction on the body in phase
     s (0 full contact) at the state (theta, theta', u, u') and ground acceleration xg."""
@@ -102,7 +107,7 @@ def ground_reactions(theta, theta_dot, u, u_dot, s, xg, prm, FLEX, DAMPED):
     return m * xp + m_A * xa, m * (yp + g) + m_A * (ya + g)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def impact_impulses(s, u, u_dot_minus, w_minus, s_new, u_dot_plus, w_plus, prm, FLEX):
     """(J_x, J_y) [N s]: the ground's impulse on the body at an impact at theta = 0 that
     ends rocking on corner s (rate w_minus, top mass rate u_dot_minus) and leaves it in
@@ -120,7 +125,7 @@ def impact_impulses(s, u, u_dot_minus, w_minus, s_new, u_dot_plus, w_plus, prm, 
     return j_x, j_y
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def impulse_ratio(j_x, j_y):
     """|J_x| / J_y (+inf when the ground would have to pull: J_y <= 0)."""
     if j_y <= 0.0:
@@ -128,7 +133,7 @@ def impulse_ratio(j_x, j_y):
     return abs(j_x) / j_y
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def _values(t, y, s, on, prm, FLEX, DAMPED):
     """(|H|/N or +inf when N <= 0, N/(M g)) at (t, y) in phase s."""
     h_, n_ = ground_reactions(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s,
@@ -137,7 +142,7 @@ def _values(t, y, s, on, prm, FLEX, DAMPED):
     return ratio, n_ / (prm[PAR_MTOT] * prm[PAR_G])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def _vertex(x0, f0, x1, f1, x2, f2):
     """Vertex of the parabola through three points (x0 < x1 < x2); NaN if it has none
     (collinear)."""
@@ -150,13 +155,17 @@ def _vertex(x0, f0, x1, f1, x2, f2):
 
 
 @njit(cache=True, **INTERNAL)
-def _refine(which, t_a, y_a, f_a, t_b, y_b, f_b, t_c, f_c, s, on, prm, FLEX, DAMPED):
-    """Largest value of f (which 0: |H|/N; 1: -N/(M g)) on [t_a, t_c] around the sampled
-    peak at t_b, on the integrator's own solution: a trial at tau in [t_a, t_b] is a fresh
-    RK4 step from (t_a, y_a), one in [t_b, t_c] from (t_b, y_b). Safeguarded successive
-    parabolic interpolation on the bracket (x0, x1, x2), f(x1) >= f(x0), f(x2)."""
+def _refine(which, t_a, y_a, f_a, t_b, y_b, f_b, t_c, f_c, s, on, prm, FLEX, DAMPED,
+            ENERGY):
+    """Largest value of f (which PEAK_RATIO: |H|/N; PEAK_NORMAL: -N/(M g)) on [t_a, t_c]
+    around the sampled peak at t_b, on the integrator's own solution: a trial at tau in
+    [t_a, t_b] is a fresh RK4 step from (t_a, y_a), one in [t_b, t_c] from (t_b, y_b).
+    Safeguarded successive parabolic interpolation on the bracket (x0, x1, x2),
+    f(x1) >= f(x0), f(x2). ENERGY: the variant's (the energy slots ride along unused: one
+    compiled RK4 step for both)."""
     literally(FLEX)
     literally(DAMPED)
+    literally(ENERGY)
     x0, f0, x1, f1, x2, f2 = t_a, f_a, t_b, f_b, t_c, f_c
     best = f_b
     xtol = REFINE_XTOL * (t_c - t_a)
@@ -171,11 +180,11 @@ def _refine(which, t_a, y_a, f_a, t_b, y_b, f_b, t_c, f_c, s, on, prm, FLEX, DAM
         if abs(x - x1) < eps:
             x = x1 + eps if x2 - x1 > x1 - x0 else x1 - eps
         if x <= t_b:
-            y_x = rk4_step(t_a, y_a, x - t_a, s, on, prm, FLEX, DAMPED, False)
+            y_x = rk4_step(t_a, y_a, x - t_a, s, on, prm, FLEX, DAMPED, ENERGY)
         else:
-            y_x = rk4_step(t_b, y_b, x - t_b, s, on, prm, FLEX, DAMPED, False)
+            y_x = rk4_step(t_b, y_b, x - t_b, s, on, prm, FLEX, DAMPED, ENERGY)
         r, n = _values(x, y_x, s, on, prm, FLEX, DAMPED)
-        f = r if which == 0 else -n
+        f = r if which == PEAK_RATIO else -n
         if not math.isfinite(f):
             return f
         if f > best:
@@ -193,7 +202,7 @@ def _refine(which, t_a, y_a, f_a, t_b, y_b, f_b, t_c, f_c, s, on, prm, FLEX, DAM
     return best
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def _take(out, r, n):
     if r > out[OUT_MU_REQ] or r != r:
         out[OUT_MU_REQ] = r
@@ -202,7 +211,7 @@ def _take(out, r, n):
 
 
 @njit(cache=True, **INTERNAL)
-def contact_sample(ct, t, y, s, on, mode, prm, out, FLEX, DAMPED):
+def contact_sample(ct, t, y, s, on, mode, prm, out, FLEX, DAMPED, ENERGY):
     """Take the sample (t, y) of phase s into the contact bookkeeping; returns the new
     tracker ``ct``.
 
@@ -213,10 +222,12 @@ def contact_sample(ct, t, y, s, on, mode, prm, out, FLEX, DAMPED):
     max of r) and out[OUT_N_MIN] (running min of n), refining a peak bracketed by the last
     three samples of a segment (``_refine``). A segment that an event ends after less than
     one step (chattering: rocking arcs shorter than a step) gets a midpoint sample (a fresh
-    RK4 half step), so that a peak inside it is bracketed too.
+    RK4 half step), so that a peak inside it is bracketed too. ENERGY: the variant's flag,
+    for its RK4 steps (the energy slots are not used here; the other slots are the same).
     """
     literally(FLEX)
     literally(DAMPED)
+    literally(ENERGY)
     r, n = _values(t, y, s, on, prm, FLEX, DAMPED)
     _take(out, r, n)
     cnt, t_a, y_a, r_a, n_a, t_b, y_b, r_b, n_b = ct
@@ -225,7 +236,7 @@ def contact_sample(ct, t, y, s, on, mode, prm, out, FLEX, DAMPED):
     if mode == SAMPLE_EVENT and cnt == 1.0 and t_b < t:
         t_a, y_a, r_a, n_a = t_b, y_b, r_b, n_b
         t_b = 0.5 * (t_a + t)
-        y_b = rk4_step(t_a, y_a, t_b - t_a, s, on, prm, FLEX, DAMPED, False)
+        y_b = rk4_step(t_a, y_a, t_b - t_a, s, on, prm, FLEX, DAMPED, ENERGY)
         r_b, n_b = _values(t_b, y_b, s, on, prm, FLEX, DAMPED)
         _take(out, r_b, n_b)
         cnt = 2.0
@@ -233,12 +244,14 @@ def contact_sample(ct, t, y, s, on, mode, prm, out, FLEX, DAMPED):
         mu = out[OUT_MU_REQ]
         if (r_b >= r_a and r_b >= r and (r_b > r_a or r_b > r) and math.isfinite(mu)
                 and r_b >= (1.0 - REFINE_BAND) * mu):
-            f = _refine(0, t_a, y_a, r_a, t_b, y_b, r_b, t, r, s, on, prm, FLEX, DAMPED)
+            f = _refine(PEAK_RATIO, t_a, y_a, r_a, t_b, y_b, r_b, t, r, s, on, prm, FLEX,
+                        DAMPED, ENERGY)
             if f > out[OUT_MU_REQ]:
                 out[OUT_MU_REQ] = f
         if (n_b <= n_a and n_b <= n and (n_b < n_a or n_b < n)
                 and n_b <= out[OUT_N_MIN] + REFINE_BAND):
-            f = _refine(1, t_a, y_a, -n_a, t_b, y_b, -n_b, t, -n, s, on, prm, FLEX, DAMPED)
+            f = _refine(PEAK_NORMAL, t_a, y_a, -n_a, t_b, y_b, -n_b, t, -n, s, on, prm, FLEX,
+                        DAMPED, ENERGY)
             if -f < out[OUT_N_MIN]:
                 out[OUT_N_MIN] = -f
     return (cnt + 1.0, t_b, y_b, r_b, n_b, t, y, r, n)

@@ -30,7 +30,8 @@ from numba import njit
 from numba.core import types
 from numba.extending import overload
 
-from rocksweep.kernel._cache import INTERNAL
+from rocksweep.kernel import spring
+from rocksweep.kernel._cache import INLINE, INTERNAL, PUBLIC
 from rocksweep.kernel.layout import (
     LAW_CONSTANT,
     LAW_LOCKED,
@@ -117,7 +118,7 @@ def _shape_jerk_overload(t, on, prm):
     return any_shape
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def ground_acc(t, on, prm):
     """xg''(t) [m/s^2] of eq. (2) or of the row's other shape; 0 when ``on`` is false.
 
@@ -127,7 +128,7 @@ def ground_acc(t, on, prm):
     return _shape_acc(t, on, prm)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def ground_jerk(t, on, prm):
     """d xg''/dt [m/s^3], for locating an uplift inside a step."""
     if not on:
@@ -135,7 +136,7 @@ def ground_jerk(t, on, prm):
     return _shape_jerk(t, on, prm)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def _record_segment(t, prm):
     """(a_k, x - k, a_k+1 - a_k), x = t / PAR_REC_DT: the first sample of the record's
     linear segment [t_k, t_k+1] that holds t, the fraction of it at t, and the samples'
@@ -210,7 +211,7 @@ def ground_jerk_any(t, prm):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def rocking_rhs(theta, theta_dot, u, u_dot, s, xg, prm, DAMPED):
     """Accelerations while rocking on corner s (+1 / -1), and the input and damper powers.
 
@@ -231,7 +232,7 @@ def rocking_rhs(theta, theta_dot, u, u_dot, s, xg, prm, DAMPED):
     return theta_dd, u_dd, power_in, f_damp * u_dot
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def rigid_rhs(theta, theta_dot, s, xg, prm):
     """Rigid body (top mass welded, or a block): I_O theta'' = moment about corner s.
 
@@ -250,7 +251,7 @@ def rigid_rhs(theta, theta_dot, s, xg, prm):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def contact_rhs(u, u_dot, xg, prm, DAMPED):
     """Full contact: m u'' + c u' + k u = -m xg''. Returns (u'', ground power, damper power)."""
     f_damp = prm[PAR_C] * u_dot if DAMPED else 0.0
@@ -258,7 +259,7 @@ def contact_rhs(u, u_dot, xg, prm, DAMPED):
     return u_dd, -prm[PAR_M] * xg * u_dot, f_damp * u_dot
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def uplift_moment(u, u_dot, xg, prm, FLEX, DAMPED):
     """Q [N m]: the moment that tips the body in full contact.
 
@@ -278,7 +279,7 @@ def uplift_moment(u, u_dot, xg, prm, FLEX, DAMPED):
     return prm[PAR_H] * f + prm[PAR_M] * prm[PAR_G] * u - prm[PAR_MA] * prm[PAR_HA] * xg
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def uplift_moment_rate(u, u_dot, xg, jerk, prm, FLEX, DAMPED):
     """dQ/dt [N m/s] in full contact."""
     if not FLEX:
@@ -288,13 +289,13 @@ def uplift_moment_rate(u, u_dot, xg, jerk, prm, FLEX, DAMPED):
     return prm[PAR_H] * df + prm[PAR_M] * prm[PAR_G] * u_dot - prm[PAR_MA] * prm[PAR_HA] * jerk
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def tip_moment(prm):
     """M g b [N m]: the moment about a corner that the body's weight resists uplift with."""
     return prm[PAR_MTOT] * prm[PAR_G] * prm[PAR_B]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def rest_margin(u, u_dot, prm):
     """Q_max^2 - (M g b)^2 [N^2 m^2] after the pulse, in full contact (< 0: rest for good).
 
@@ -317,7 +318,7 @@ def rest_margin(u, u_dot, prm):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, **PUBLIC)
 def restitution(s, u, prm, FLEX):
     """e = theta'^+ / theta'^- for an impact that ends rocking on corner s, under the row's
     impact law (PAR_LAW, ``rocksweep.physics.impact``), times PAR_E_FACTOR.
@@ -354,7 +355,7 @@ def restitution(s, u, prm, FLEX):
     return num / den * prm[PAR_E_FACTOR]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def top_mass_rate(u_dot, w_minus, w_plus, prm):
     """u'^+ [m/s] after an impact (any phase after): LAW_LOCKED keeps u' (the top mass
     moves with the base); the other laws keep the top mass's horizontal momentum
@@ -369,7 +370,7 @@ def top_mass_rate(u_dot, w_minus, w_plus, prm):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, **PUBLIC)
 def mechanical_energy(theta, theta_dot, u, u_dot, s, prm, FLEX):
     """T + V - V_rest [J] in phase s (0: full contact)."""
     if not FLEX:
@@ -391,7 +392,7 @@ def mechanical_energy(theta, theta_dot, u, u_dot, s, prm, FLEX):
     return kin + pot
 
 
-@njit(cache=True)
+@njit(cache=True, **PUBLIC)
 def impact_loss(s, s_new, u, u_dot, w_minus, w_plus, prm, FLEX):
     """Energy [J] the impact itself dissipates (eq. 6 under the row's law; < 0: the
     impact gains energy). u_dot: u' before the impact.
@@ -435,7 +436,7 @@ def impact_loss(s, s_new, u, u_dot, w_minus, w_plus, prm, FLEX):
 RIGID_ENERGY_MARGIN = 1e-6
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def rigid_peak(theta, theta_dot, s, prm):
     """After the pulse, a rigid body rocking on corner s: the largest |theta| [rad] still to
     come if it can never overturn, else -1 (not proven).
@@ -462,23 +463,8 @@ def rigid_peak(theta, theta_dot, s, prm):
 
 
 # ----------------------------------------------------------------------------------------
-# The top mass's spring while the base rocks (what the step size must resolve)
+# The top mass's spring while the base rocks (what the step size must resolve): plain
+# Python, in ``spring`` (called from Python only; importable without numba)
 # ----------------------------------------------------------------------------------------
 
-
-@njit(cache=True)
-def rocking_spring_omega(omega_n, zeta, m, h, i_a0, a):
-    """Fastest rate [rad/s] of the top mass on its spring while the base rocks, with the
-    top mass's lever arm a = u - s b [m] about the corner.
-
-    Linearising ``rocking_rhs`` in u: u'' = -Gamma (k u + c u') / m + ...,
-    Gamma = 1 + m h^2 / (I_A + m_A R_A^2 + m a^2) (i_a0 = I_A + m_A R_A^2 [kg m^2]): a
-    spring of frequency omega_n sqrt(Gamma) and damping ratio zeta sqrt(Gamma). Gamma is
-    largest at a = 0. Above a damping ratio of 1 the mode is overdamped and its fast root,
-    omega (zeta' + sqrt(zeta'^2 - 1)), is what an explicit step must resolve.
-    """
-    gamma = 1.0 + m * (h * h) / (i_a0 + m * (a * a))
-    omega, zeta_r = omega_n * math.sqrt(gamma), zeta * math.sqrt(gamma)
-    if zeta_r > 1.0:
-        omega *= zeta_r + math.sqrt(zeta_r * zeta_r - 1.0)
-    return omega
+rocking_spring_omega = spring.rocking_spring_omega

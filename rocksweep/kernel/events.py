@@ -20,7 +20,7 @@ import math
 
 from numba import literally, njit
 
-from rocksweep.kernel._cache import INTERNAL
+from rocksweep.kernel._cache import INLINE, INTERNAL
 from rocksweep.kernel.equations import (
     ground_acc,
     ground_jerk,
@@ -65,7 +65,7 @@ DIP_MAX_TRIALS = 50
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def event_value(ev, t, y, s, on, prm, FLEX, DAMPED):
     """Value of event function ``ev`` at (t, y) in phase s."""
     if ev == EV_IMPACT:
@@ -77,7 +77,7 @@ def event_value(ev, t, y, s, on, prm, FLEX, DAMPED):
     return mgb - q if ev == EV_UPLIFT_POS else mgb + q
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def event_rate(ev, t, y, s, on, prm, FLEX, DAMPED):
     """d/dt of event function ``ev`` at (t, y) (for the Hermite interpolant)."""
     if ev == EV_IMPACT:
@@ -94,14 +94,14 @@ def event_rate(ev, t, y, s, on, prm, FLEX, DAMPED):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def hermite_cubic(g0, d0, g1, d1, h):
     """(c2, c3) of the cubic Hermite interpolant c(x) = g0 + d0 h x + c2 x^2 + c3 x^3 of g
     on a step of length h (x in [0, 1]) from g and its rate at both ends."""
     return 3.0 * (g1 - g0) - h * (2.0 * d0 + d1), 2.0 * (g0 - g1) + h * (d0 + d1)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def hermite_min(g0, d0, g1, d1, h):
     """Minimum of the cubic Hermite interpolant of g on [0, h] when g dips inside the step.
 
@@ -127,7 +127,7 @@ def hermite_min(g0, d0, g1, d1, h):
     return x * h, g0 + x * (h * d0 + x * (c2 + x * c3))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def hermite_root(g0, d0, g1, d1, h, xtol):
     """Root in [0, h] of the cubic Hermite interpolant of g when g0 >= 0 >= g1.
 
@@ -227,7 +227,7 @@ def _locate(ev, t0, y0, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, ENER
     return hi, y_hi, n
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def _crossing(ev, t0, y0, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
     """Did event ``ev`` fire in the step (t0, y0) -> (t0 + h, y1)?
 
@@ -236,7 +236,8 @@ def _crossing(ev, t0, y0, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
     through zero and back, e.g. a grazing impact inside a coarse step) is checked with the
     step's cubic Hermite interpolant; when its minimum is nearer zero than the dip is deep,
     ``_dip`` searches the integrator's own solution. This screening runs for every event
-    function at every step and is inlined into the loop; the searches are calls.
+    function at every step and is inlined into the loop (with ``_first_event``); the
+    searches are calls.
     """
     g0 = event_value(ev, t0, y0, s, on, prm, FLEX, DAMPED)
     g1 = event_value(ev, t0 + h, y1, s, on, prm, FLEX, DAMPED)
@@ -303,7 +304,7 @@ def _dip(ev, t0, y0, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERGY):
             tau = 0.5 * (lo + hi)
 
 
-@njit(cache=True, **INTERNAL)
+@njit(cache=True, **INLINE)
 def _first_event(t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
     """The first event in the step (t, y) -> (t + h, y1) of phase s.
 

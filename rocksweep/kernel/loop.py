@@ -5,9 +5,9 @@ state y (``layout.Y_*``); it takes fixed RK4 steps (``stepping``), asks ``events
 first event inside each step and applies the transition rules (``transitions``). The
 counters of events live in the result row ``out`` (``OUT_*``) as it runs, those of every
 step (steps, theta_max) in locals; the actions that update them are the small helpers
-below. Those on the path of every step take no arrays and are inlined (numba
-``inline="always"``); those of events are calls (an inlined helper that takes ``prm`` or
-``out`` adds reference counting to every step: ~15% slower, measured).
+below. Those on the path of every step are inlined by LLVM (``_cache.INLINE``); those of
+events are calls (``_cache.INTERNAL``). No kernel function counts references
+(``_nrt=False``), so passing ``prm`` or ``out`` costs nothing beyond the call.
 
 Compile-time specialisation: the functions take the flags FLEX, DAMPED and ENERGY (and
 ``simulate_point`` GROUND: every ground motion, not only the paper's sine and cosine; it
@@ -15,10 +15,11 @@ reaches the ground motion as the type of ``on``, see ``equations.ground_acc``) a
 ``numba.literally`` on them, so numba compiles one specialisation per flag value (a
 ``Literal[bool]`` type) and the branches a variant does not need are removed at compile
 time (by LLVM: numba still types and lowers them, its own dead-branch pruning does not
-read literal arguments, so they cost compile time but no run time). The time history is
-the exception: ``simulate_point`` gets ``hist=None`` when there is none, and numba prunes
-the ``if hist is not None`` branch of ``_record`` before typing. The variants themselves
-are in ``variants``.
+read literal arguments, so they cost compile time but no run time). The time history and
+the ground reactions are the exceptions: ``simulate_point`` gets ``hist=None`` and
+``CONTACT=None`` when there are none, and numba prunes the ``if hist is not None`` /
+``if CONTACT is not None`` branches before typing (the contact bookkeeping was half the
+compile time of a variant without it). The variants themselves are in ``variants``.
 """
 
 import math
@@ -28,7 +29,8 @@ from numba import literally, njit
 from numba.core import types
 from numba.extending import overload
 
-from rocksweep.kernel._cache import INTERNAL
+from rocksweep.kernel._cache import INLINE, INTERNAL
+from rocksweep.kernel._static import skipped_when
 from rocksweep.kernel.contact import (
     SAMPLE_EVENT,
     SAMPLE_START,
@@ -115,6 +117,9 @@ from rocksweep.kernel.layout import (
 from rocksweep.kernel.stepping import rk4_step
 from rocksweep.kernel.transitions import impact_map, rest_proven, rigid_bounded, uplift_side
 
+# the outcome-only variants do not compile the energy (``_static``)
+_energy = skipped_when(False, mechanical_energy, 0.0)
+
 # _step_length: a time within this fraction of a record step of a grid time is on it (t
 # sums steps of ~1e-2..1; its round-off is ~1e-16 relative, far below).
 ALIGN_SLACK = 1e-7
@@ -147,15 +152,14 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
 
     prm: float64[N_PAR] parameter row; out: float64[N_OUT] result row (filled);
     hist: float64[n, N_HIST] history buffer, or None: no history (the recording code is
-    then not compiled at all). CONTACT: track the ground reactions (``contact``): the
-    friction demand, the lowest normal force and the impacts' impulse ratio; every sample
-    is a state the loop reaches anyway (step ends, event states before and after the
-    action), taken with ``_contact``.
+    then not compiled at all). CONTACT: True to track the ground reactions (``contact``):
+    the friction demand, the lowest normal force and the impacts' impulse ratio; every
+    sample is a state the loop reaches anyway (step ends, event states before and after the
+    action), taken with ``contact_sample``. None: no tracking (the code is not compiled).
     """
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
-    literally(CONTACT)
     literally(GROUND)
     t, dt, t_pulse, t_end = 0.0, prm[PAR_DT], prm[PAR_TPULSE], prm[PAR_TEND]
     max_steps, max_events = prm[PAR_MAXSTEPS], prm[PAR_MAXEVENTS]
@@ -175,11 +179,11 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     steps, event_steps, theta_max = 0, 0, abs(y[Y_THETA])
     # contact tracker (contact.contact_sample): unused, and removed, without CONTACT
     ct = (0.0, 0.0, y, 0.0, 0.0, 0.0, y, 0.0, 0.0)
-    out[OUT_MU_REQ] = 0.0 if CONTACT else np.nan
-    out[OUT_N_MIN] = np.inf if CONTACT else np.nan
-    out[OUT_IMPULSE_MAX] = 0.0 if CONTACT else np.nan
-    if CONTACT:
-        ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED)
+    out[OUT_MU_REQ] = 0.0 if CONTACT is not None else np.nan
+    out[OUT_N_MIN] = np.inf if CONTACT is not None else np.nan
+    out[OUT_IMPULSE_MAX] = 0.0 if CONTACT is not None else np.nan
+    if CONTACT is not None:
+        ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED, ENERGY)
     # The rotation limit (PAR_ROT_STEP, 0: off): a rocking step may turn the body by at most
     # rot, predicted from theta' and the last step's |theta''| (acc), and checked after
     # the step: a huge slow pulse or a fall is not crossed in a handful of steps.
@@ -201,7 +205,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             break
         if not FLEX and s != 0 and not on and free_check:
             free_check = False  # E is constant between impacts after the pulse: test once
-            peak = rigid_bounded(y, s, prm)
+            peak = rigid_bounded(y, s, prm, FLEX)
             if peak >= 0.0:
                 if peak > theta_max:
                     theta_max = peak
@@ -242,8 +246,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
         if ev == EV_NONE:
             t, y = (t_pulse if lands else t + h), y1
             _record(hist, t, y, s, _acting(t, t_pulse, GROUND), prm, out, FLEX)
-            if CONTACT:  # the step's end, with the step's own ground motion
-                ct = contact_sample(ct, t, y, s, on, SAMPLE_STEP, prm, out, FLEX, DAMPED)
+            if CONTACT is not None:  # the step's end, with the step's own ground motion
+                ct = contact_sample(ct, t, y, s, on, SAMPLE_STEP, prm, out, FLEX, DAMPED, ENERGY)
             if lands and s == 0:
                 # The pulse ends with a jump of xg'' (a cosine pulse ends at its peak), and
                 # Q jumps with it by m_A h_A xg'': the state may now be past the uplift
@@ -253,22 +257,22 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
                 s = _uplift(t, y, off, prm, out, FLEX, DAMPED)
                 if s != 0:
                     _record(hist, t, y, s, off, prm, out, FLEX)
-            if CONTACT and lands:  # H jumps with xg'': a new segment without the pulse
+            if CONTACT is not None and lands:  # H jumps with xg'': a new segment without the pulse
                 ct = contact_sample(ct, t, y, s, _acting(t_pulse, t_pulse, GROUND),
-                                    SAMPLE_START, prm, out, FLEX, DAMPED)
+                                    SAMPLE_START, prm, out, FLEX, DAMPED, ENERGY)
             continue
 
         t, y = t + tau, y_ev
         _record(hist, t, y, s, on, prm, out, FLEX)
-        if CONTACT:  # the event state, last sample of its phase
-            ct = contact_sample(ct, t, y, s, on, SAMPLE_EVENT, prm, out, FLEX, DAMPED)
+        if CONTACT is not None:  # the event state, last sample of its phase
+            ct = contact_sample(ct, t, y, s, on, SAMPLE_EVENT, prm, out, FLEX, DAMPED, ENERGY)
         if ev == EV_OVERTURN:
             _overturned(t, out)
             break
         if ev == EV_IMPACT:
             y_minus, s_minus = y, s
             y, s = _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY)
-            if CONTACT:
+            if CONTACT is not None:
                 contact_impact(y_minus, s_minus, y, s, prm, out, FLEX)
             free_check = True
         else:  # uplift: theta = theta' = 0 exactly, now rocking on the located corner
@@ -276,10 +280,10 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             y = (0.0, 0.0, y[Y_U], y[Y_U_DOT], y[Y_W_IN], y[Y_D_DAMP])
             out[OUT_UPLIFTS] += 1.0
         _record(hist, t, y, s, on, prm, out, FLEX)
-        if CONTACT:  # the state after the action starts the next phase's samples
-            ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED)
+        if CONTACT is not None:  # the state after the action starts the next phase's samples
+            ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED, ENERGY)
     _finish(t, y, s, steps, event_steps, theta_max, prm, out, FLEX, ENERGY)
-    if CONTACT:
+    if CONTACT is not None:
         _contact_status(prm, out)
 
 
@@ -294,7 +298,7 @@ def _flag(out, bit):
     out[OUT_STATUS] = int(out[OUT_STATUS]) | bit
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def _reset(out):
     """The result row before the first step: counters 0, times NaN, safe so far."""
     out[OUT_OUTCOME] = OUTCOME_SAFE
@@ -312,7 +316,7 @@ def _reset(out):
     out[OUT_HIST_ROWS] = 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def _step_length(t, on, dt, t_pulse, t_end, h_rec):
     """(h, lands): the step dt, shortened to land exactly on the pulse's end (lands) or on
     the horizon.
@@ -335,7 +339,7 @@ def _step_length(t, on, dt, t_pulse, t_end, h_rec):
     return dt, False
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def _rotation_step(theta_dot, acc, rot):
     """Longest step [s] whose predicted rotation |theta'| h + acc h^2 / 2 is rot [rad]
     (theta' [rad/s], acc: |theta''| [rad/s^2] estimated over the last step)."""
@@ -344,13 +348,13 @@ def _rotation_step(theta_dot, acc, rot):
     return 2.0 * rot / den if den > 0.0 else math.inf
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def _finite(y):
     return (math.isfinite(y[Y_THETA]) and math.isfinite(y[Y_THETA_DOT])
             and math.isfinite(y[Y_U]) and math.isfinite(y[Y_U_DOT]))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def _theta_max(y, y_end, h_end, s, theta_max):
     """theta_max updated over a rocking step (t, y) -> (t + h_end, y_end), including a
     turning point inside it."""
@@ -451,7 +455,7 @@ def _write_row(hist, row, t, y, s, on, prm, e_imp, FLEX):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def _finish(t, y, s, steps, event_steps, theta_max, prm, out, FLEX, ENERGY):
     """The result row's last entries: end time, step counts, theta_max and the energy
     accounting (NaN without)."""
@@ -462,8 +466,8 @@ def _finish(t, y, s, steps, event_steps, theta_max, prm, out, FLEX, ENERGY):
     if ENERGY:
         out[OUT_W_IN] = y[Y_W_IN]
         out[OUT_D_DAMP] = y[Y_D_DAMP]
-        out[OUT_E_END] = mechanical_energy(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s,
-                                           prm, FLEX)
+        out[OUT_E_END] = _energy(ENERGY, y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s,
+                                 prm, FLEX)
     else:
         out[OUT_W_IN] = np.nan
         out[OUT_D_DAMP] = np.nan

@@ -5,20 +5,19 @@
 
 Compile-time flags (see ``variants``): FLEX (the top mass moves on its spring), DAMPED (the
 spring has a damper) and ENERGY (integrate the ground's work W_in and the damper's loss
-D_damp along). Both functions are inlined where they are called (numba
-``inline="always"``), so an RK4 step makes no function call: a call costs about as much as
-a right-hand side, most of it the reference count of ``prm`` taken and dropped on every
-call (scripts/bench_kernel.py, roofline; inlining ``rk4_step`` made the sweeps 10-20%
-faster, bit for bit the same, for ~8% more compile time).
+D_damp along). Both functions are inlined where they are called, by LLVM
+(``_cache.INLINE``: compiled once, then inlined; numba's own ``inline="always"`` retyped
+them at every call site), so an RK4 step makes no function call.
 """
 
 from numba import njit
 
+from rocksweep.kernel._cache import INLINE
 from rocksweep.kernel.equations import contact_rhs, ground_acc, rigid_rhs, rocking_rhs
 from rocksweep.kernel.layout import Y_THETA, Y_THETA_DOT, Y_U, Y_U_DOT
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def derivatives(t, y, s, on, prm, FLEX, DAMPED, ENERGY):
     """dy/dt (a 6-tuple in the ``Y_*`` slot order) at (t, y) in phase s (0 full contact,
     +-1 rocking on that corner); ``on``: the pulse acts."""
@@ -42,14 +41,14 @@ def derivatives(t, y, s, on, prm, FLEX, DAMPED, ENERGY):
     return (theta_dot, theta_dd, u_dot, u_dd, 0.0, 0.0)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def _axpy(y, a, k):
     """y + a k, slot by slot."""
     return (y[0] + a * k[0], y[1] + a * k[1], y[2] + a * k[2],
             y[3] + a * k[3], y[4] + a * k[4], y[5] + a * k[5])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **INLINE)
 def rk4_step(t, y, h, s, on, prm, FLEX, DAMPED, ENERGY):
     """One classical RK4 step of size h [s] from (t, y) in phase s. Returns the new 6-tuple."""
     # The four stages share one call site of the inlined right-hand side (numba types and

@@ -13,6 +13,7 @@ the same ones (``tip_moment``, ``rest_margin``, ``rigid_peak``).
 from numba import literally, njit
 
 from rocksweep.kernel._cache import INTERNAL
+from rocksweep.kernel._static import skipped_when
 from rocksweep.kernel.equations import (
     ground_acc,
     impact_loss,
@@ -59,11 +60,20 @@ def rest_proven(y, prm, FLEX):
     return rest_margin(y[Y_U], y[Y_U_DOT], prm) < 0.0
 
 
+# the flexible variants never test the rigid bound, the outcome-only ones never account
+# energy: neither compiles them (``_static``)
+_rigid_peak = skipped_when(True, rigid_peak, -1.0)  # -1: not proven (FLEX)
+_energy = skipped_when(False, mechanical_energy, 0.0)  # (not ENERGY)
+_impact_loss = skipped_when(False, impact_loss, 0.0)  # (not ENERGY)
+
+
 @njit(cache=True, **INTERNAL)
-def rigid_bounded(y, s, prm):
+def rigid_bounded(y, s, prm, FLEX):
     """After the pulse, a rigid body rocking on corner s: the largest |theta| still to come
-    if it can never overturn (its outcome is decided: safe), else -1 (``rigid_peak``)."""
-    return rigid_peak(y[Y_THETA], y[Y_THETA_DOT], s, prm)
+    if it can never overturn (its outcome is decided: safe), else -1 (``rigid_peak``;
+    always -1 for a flexible body, FLEX)."""
+    literally(FLEX)
+    return _rigid_peak(FLEX, y[Y_THETA], y[Y_THETA_DOT], s, prm)
 
 
 @njit(cache=True, **INTERNAL)
@@ -97,7 +107,7 @@ def impact_map(y, s, prm, FLEX, ENERGY):
     e_d = 0.0
     loss = 0.0
     if ENERGY:
-        e_d = (mechanical_energy(theta, w_minus, u, u_dot, s, prm, FLEX)
-               - mechanical_energy(0.0, w_plus, u, u_dot_plus, s_new, prm, FLEX))
-        loss = impact_loss(s, s_new, u, u_dot, w_minus, w_plus, prm, FLEX)
+        e_d = (_energy(ENERGY, theta, w_minus, u, u_dot, s, prm, FLEX)
+               - _energy(ENERGY, 0.0, w_plus, u, u_dot_plus, s_new, prm, FLEX))
+        loss = _impact_loss(ENERGY, s, s_new, u, u_dot, w_minus, w_plus, prm, FLEX)
     return y_new, s_new, e, e_d, loss

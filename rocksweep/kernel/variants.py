@@ -2,8 +2,10 @@
 
 Each entry point fixes the compile-time flags of ``loop.simulate_point`` as literals
 (FLEX: the top mass moves on its spring; DAMPED: the spring has a damper; ENERGY: energy
-accounting; CONTACT: ground reactions, friction demand and impulses), so every variant is
-assembled from the same functions with the branches it does not need removed.
+accounting; CONTACT: ground reactions, friction demand and impulses, True or None), so
+every variant is assembled from the same functions with the branches it does not need
+removed. Each calls ``simulate_point`` itself (no shared chunk loop in between: every level
+of calls is one more LLVM optimisation of the whole kernel at compile time).
 
   chunk_*: prms float64[n, N_PAR] -> outs float64[n, N_OUT] (filled in place); they
       release the GIL, so threads of one process run chunks in parallel
@@ -17,9 +19,9 @@ assembled from the same functions with the branches it does not need removed.
 """
 
 import numpy as np
-from numba import literally, njit
+from numba import njit
 
-from rocksweep.kernel._cache import INTERNAL
+from rocksweep.kernel._cache import ENTRY
 from rocksweep.kernel.layout import (
     KIND_FLEXIBLE,
     KIND_FLEXIBLE_UNDAMPED,
@@ -40,120 +42,124 @@ from rocksweep.kernel.layout import (
 from rocksweep.kernel.loop import simulate_point
 
 
-@njit(cache=True, **INTERNAL)
-def _chunk(prms, outs, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
-    literally(FLEX)
-    literally(DAMPED)
-    literally(ENERGY)
-    literally(CONTACT)
-    literally(GROUND)
-    for i in range(prms.shape[0]):
-        simulate_point(prms[i], outs[i], None, FLEX, DAMPED, ENERGY, CONTACT, GROUND)
-
-
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, **ENTRY)
 def chunk_flexible(prms, outs):
-    _chunk(prms, outs, True, True, False, False, False)
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, True, True, False, None, False)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, **ENTRY)
 def chunk_flexible_undamped(prms, outs):
-    _chunk(prms, outs, True, False, False, False, False)
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, True, False, False, None, False)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, **ENTRY)
 def chunk_rigid(prms, outs):
-    _chunk(prms, outs, False, False, False, False, False)
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, False, False, False, None, False)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, **ENTRY)
 def chunk_flexible_energy(prms, outs):
-    _chunk(prms, outs, True, True, True, False, False)
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, True, True, True, None, False)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, **ENTRY)
 def chunk_flexible_undamped_energy(prms, outs):
-    _chunk(prms, outs, True, False, True, False, False)
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, True, False, True, None, False)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, **ENTRY)
 def chunk_rigid_energy(prms, outs):
-    _chunk(prms, outs, False, False, True, False, False)
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, False, False, True, None, False)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, **ENTRY)
 def chunk_flexible_contact(prms, outs):
-    _chunk(prms, outs, True, True, True, True, False)
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, True, True, True, True, False)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, **ENTRY)
 def chunk_flexible_undamped_contact(prms, outs):
-    _chunk(prms, outs, True, False, True, True, False)
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, True, False, True, True, False)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, **ENTRY)
 def chunk_rigid_contact(prms, outs):
-    _chunk(prms, outs, False, False, True, True, False)
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, False, False, True, True, False)
 
 
-@njit(cache=True)
+@njit(cache=True, **ENTRY)
 def point_flexible_history(prm, out, hist):
     simulate_point(prm, out, hist, True, True, True, True, False)
 
 
-@njit(cache=True)
+@njit(cache=True, **ENTRY)
 def point_flexible_undamped_history(prm, out, hist):
     simulate_point(prm, out, hist, True, False, True, True, False)
 
 
-@njit(cache=True)
+@njit(cache=True, **ENTRY)
 def point_rigid_history(prm, out, hist):
     simulate_point(prm, out, hist, False, False, True, True, False)
 
 
 # GROUND = 1 (an int, not True: its type selects the code, ``loop._acting``): the Ricker
 # and MP pulses and records (``equations.ground_acc``), compiled only when a scene asks.
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, **ENTRY)
 def chunk_flexible_ground(prms, outs):
-    _chunk(prms, outs, True, True, False, False, 1)
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, True, True, False, None, 1)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, **ENTRY)
 def chunk_flexible_undamped_ground(prms, outs):
-    _chunk(prms, outs, True, False, False, False, 1)
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, True, False, False, None, 1)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, **ENTRY)
 def chunk_rigid_ground(prms, outs):
-    _chunk(prms, outs, False, False, False, False, 1)
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, False, False, False, None, 1)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, **ENTRY)
 def chunk_flexible_energy_ground(prms, outs):
-    _chunk(prms, outs, True, True, True, False, 1)
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, True, True, True, None, 1)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, **ENTRY)
 def chunk_flexible_undamped_energy_ground(prms, outs):
-    _chunk(prms, outs, True, False, True, False, 1)
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, True, False, True, None, 1)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, **ENTRY)
 def chunk_rigid_energy_ground(prms, outs):
-    _chunk(prms, outs, False, False, True, False, 1)
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, False, False, True, None, 1)
 
 
-@njit(cache=True)
+@njit(cache=True, **ENTRY)
 def point_flexible_history_ground(prm, out, hist):
     simulate_point(prm, out, hist, True, True, True, True, 1)
 
 
-@njit(cache=True)
+@njit(cache=True, **ENTRY)
 def point_flexible_undamped_history_ground(prm, out, hist):
     simulate_point(prm, out, hist, True, False, True, True, 1)
 
 
-@njit(cache=True)
+@njit(cache=True, **ENTRY)
 def point_rigid_history_ground(prm, out, hist):
     simulate_point(prm, out, hist, False, False, True, True, 1)
 

@@ -205,7 +205,7 @@ class FlexibleBody:
         oscillates faster than omega_n, by sqrt(I_O / (I_A + m_A R_A^2 + m b^2)) (about 2.7
         for the paper's bodies). The step size must resolve this, not omega_n.
         """
-        from rocksweep.kernel.equations import rocking_spring_omega  # one definition
+        from rocksweep.kernel.spring import rocking_spring_omega  # one definition, no numba
 
         i_a0 = self.I_A + self.m_A * self.R_A**2
         # undamped, lever arm a = u - s b = -s b at u = 0

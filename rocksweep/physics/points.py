@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rocksweep.kernel import layout as L
-from rocksweep.kernel.equations import rocking_spring_omega
+from rocksweep.kernel.spring import rocking_spring_omega
 from rocksweep.numerics import (
     EVENT_STEP_ALLOWANCE,
     ROOTS,
@@ -137,7 +137,7 @@ def body_omega_rock(body: Body) -> float:
     While the base rocks, the spring and the damper reach the top mass also through the
     base's rotation: a spring of frequency omega_n sqrt(Gamma) and damping ratio
     zeta sqrt(Gamma), Gamma = 1 + m h^2 / (I_A + m_A R_A^2 + m a^2) with a = u - s b the
-    top mass's lever arm (``rocksweep.kernel.equations.rocking_spring_omega``, the one
+    top mass's lever arm (``rocksweep.kernel.spring.rocking_spring_omega``, the one
     definition). ``body.omega_rock`` takes a = b (u = 0); Gamma is largest at a = 0 (the
     top mass above the corner), which rocking reaches whenever |u| ~ b, so that is the rate
     used. Above a damping ratio of 1 the mode is overdamped and its fast root,
@@ -148,9 +148,7 @@ def body_omega_rock(body: Body) -> float:
     if body.rigid:
         return 0.0
     i_a0 = body.I_A + body.m_A * body.R_A**2
-    # the plain-Python body of the jitted formula: scenes load no compiled code
-    return float(rocking_spring_omega.py_func(body.omega_n, body.zeta, body.m, body.h, i_a0,
-                                              0.0))
+    return float(rocking_spring_omega(body.omega_n, body.zeta, body.m, body.h, i_a0, 0.0))
 
 
 def run_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, w_over_p: np.ndarray,

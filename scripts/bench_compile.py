@@ -1,0 +1,252 @@
+"""What a new user waits for, and what a point costs: compile, start-up, per point, vs reference.
+
+Prints, measured side by side in one run (issue 24):
+
+1. cold compile: each kernel variant compiled alone in a fresh process with an empty
+   NUMBA_CACHE_DIR (what the first sweep of a scene pays on a fresh machine, and every
+   machine again for every new kernel source): seconds of CPU and wall for ``warm_up``
+   (the import of the kernel is shown apart).
+2. warm start-up: commands in fresh processes with numba's cache filled, best of 3, wall
+   and CPU (user + sys of the child): the interpreter alone, ``rocksweep --help``, loading
+   the compiled kernel (import + ``warm_up`` from the cache), ``rocksweep info`` on a small
+   result, and a whole small ``rocksweep sweep`` (Figure 3(a) at 5 x 5 x 3 lam, --jobs 1).
+3. per point: the outcome kernel on every point of the paper's four figures (Figures 3(a),
+   3(b), 4(a), 4(b), ``configs/fig*.yaml``, the ``default`` preset as shipped), core-us per
+   point (CPU time of the calling thread, kernel calls only, chunked as a 1-worker sweep
+   does, best of ``--repeat``; ``scripts/bench_kernel.py``'s ``best_pass``).
+4. reference: scipy DOP853 (``rocksweep.physics.reference``) on the accuracy study's stratified
+   sample of each figure (``--ref-points``): weighted mean CPU ms per point (an estimate
+   for the whole scene), its ratio to item 3's kernel time, and the ratio including
+   start-up for a sweep of 120 000 points: ref / (kernel core-us per point of item 3 +
+   warm sweep start-up (wall: serial work; its CPU time also counts OpenBLAS's idle
+   threads spinning) / 120 000); the outcome agreement.
+
+The machine may be shared: the load average is printed at the start and the end; CPU
+times are less sensitive to load than wall times.
+
+    python scripts/bench_compile.py            # ~3-4 min on 2 cores
+    python scripts/bench_compile.py --quick    # ~30 s: Figure 3(a)'s variant and scene only
+
+Run it against another copy of the package (e.g. the code before a change) with
+``PYTHONPATH=/path/to/that/copy``: every subprocess inherits the environment.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import bench_kernel as bk  # noqa: E402  (scripts/bench_kernel.py: best_pass, scene_of)
+
+import rocksweep  # noqa: E402
+from rocksweep.analysis.accuracy import (  # noqa: E402
+    Sample,
+    _agreement,
+    boundary_mask,
+    stratified_sample,
+)
+from rocksweep.kernel import layout as L  # noqa: E402, N812
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIGS = ROOT / "configs"
+SWEEP_POINTS = 120_000  # the sweep size of the start-up-inclusive reference ratio
+KINDS = {L.KIND_FLEXIBLE: "flexible", L.KIND_FLEXIBLE_UNDAMPED: "flexible_undamped",
+         L.KIND_RIGID: "rigid"}
+LEVELS = {L.LEVEL_OUTCOME: "chunk", L.LEVEL_ENERGY: "chunk_energy",
+          L.LEVEL_CONTACT: "chunk_contact", None: "point_history"}
+# (kind, level, ground): Figure 3(a) needs the first (flexible, damped, outcome level)
+ALL_VARIANTS = ([(k, lv, False) for lv in LEVELS for k in KINDS]
+                + [(k, L.LEVEL_OUTCOME, True) for k in KINDS])
+QUICK_VARIANTS = [(L.KIND_FLEXIBLE, L.LEVEL_OUTCOME, False)]
+
+_COMPILE_SNIPPET = """
+import json, sys, time
+c0, w0 = time.process_time(), time.perf_counter()
+import rocksweep
+from rocksweep.kernel import warm_up
+c1, w1 = time.process_time(), time.perf_counter()
+kind, level, ground = json.loads(sys.argv[1])
+warm_up(kind, level, ground)
+c2, w2 = time.process_time(), time.perf_counter()
+print(json.dumps({"import_cpu": c1 - c0, "import_wall": w1 - w0,
+                  "cpu": c2 - c1, "wall": w2 - w1, "package": rocksweep.__file__}))
+"""
+
+
+def child_env(**extra: str) -> dict[str, str]:
+    """The environment of the subprocesses: they import the same rocksweep as this process
+    (its parent directory first on PYTHONPATH; they run in a temporary directory, so that
+    ``python -c`` / ``-m`` does not put the current directory first instead)."""
+    pkg_parent = str(Path(rocksweep.__file__).resolve().parents[1])
+    path = os.pathsep.join(p for p in (pkg_parent, os.environ.get("PYTHONPATH")) if p)
+    return {**os.environ, "PYTHONPATH": path, **extra}
+
+
+def variant_name(kind: int, level: int | None, ground: bool) -> str:
+    return f"{LEVELS[level]}_{KINDS[kind]}{'_ground' if ground else ''}"
+
+
+def cold_compile(variant: tuple[int, int | None, bool]) -> dict:
+    """Compile one variant in a fresh process with an empty NUMBA_CACHE_DIR."""
+    with tempfile.TemporaryDirectory() as cache:
+        res = subprocess.run([sys.executable, "-c", _COMPILE_SNIPPET, json.dumps(variant)],
+                             env=child_env(NUMBA_CACHE_DIR=cache), cwd=cache,
+                             capture_output=True, text=True, check=True)
+    return json.loads(res.stdout.splitlines()[-1])
+
+
+def timed(cmd: list[str], repeat: int) -> tuple[float, float]:
+    """(wall, CPU) seconds of a command in a fresh process, the best of ``repeat``; CPU is
+    the child's user + sys time."""
+    best_wall = best_cpu = float("inf")
+    for _ in range(repeat):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        t0 = time.perf_counter()
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                       env=child_env(), cwd=tempfile.gettempdir())
+        wall = time.perf_counter() - t0
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+        best_wall, best_cpu = min(best_wall, wall), min(best_cpu, cpu)
+    return best_wall, best_cpu
+
+
+def startup(repeat: int, quick: bool) -> dict[str, tuple[float, float]]:
+    """Warm start-up of commands (numba's cache filled first)."""
+    py = sys.executable
+    rs = [py, "-m", "rocksweep"]
+    small = ["--set", "pulse.w_over_p.num=5", "--set", "pulse.A_ratio.num=5"]
+    res = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        h5 = str(Path(tmp) / "small.h5")
+        sweep = [*rs, "sweep", str(CONFIGS / "fig3a.yaml"), *small, "-o", h5, "--overwrite",
+                 "-q", "-j", "1"]
+        # fills the cache, writes the small result
+        subprocess.run(sweep, check=True, capture_output=True, env=child_env(), cwd=tmp)
+        res["python -c pass"] = timed([py, "-c", "pass"], repeat)
+        res["rocksweep --help"] = timed([*rs, "--help"], repeat)
+        res["kernel: import + warm_up (cache)"] = timed(
+            [py, "-c", "from rocksweep.kernel import warm_up; warm_up(0, 0)"], repeat)
+        if not quick:
+            res["rocksweep info (75 points)"] = timed([*rs, "info", h5], repeat)
+        res["rocksweep sweep fig3a 5x5x3, -j 1"] = timed(sweep, repeat)
+    return res
+
+
+def per_point(names: list[str], repeat: int) -> dict[str, dict]:
+    """Core-us per point of the outcome kernel on every point of each scene."""
+    out = {}
+    for name in names:
+        scene = bk.scene_of(name, None)
+        bk.kernel_pass(scene)  # loads (or compiles) the variant
+        p = bk.best_pass(scene, repeat)
+        o = p["outs"]
+        n = o.shape[0]
+        out[name] = {"scene": scene, "pass": p, "n": n, "us": p["cpu"] / n * 1e6,
+                     "evals": (o[:, L.OUT_STEPS].sum() + o[:, L.OUT_EVENT_STEPS].sum()) / n}
+    return out
+
+
+def reference(name: str, pp: dict, points: int, seed: int = 0) -> dict:
+    """The reference on the accuracy study's stratified sample of a scene: its weighted
+    mean CPU time per point (an estimate for the whole scene, like item 3's kernel time;
+    CPU time of this thread: scipy's solver is single-threaded Python), and the outcome
+    agreement with the kernel."""
+    from rocksweep.physics.reference import reference_run, result_row
+
+    scene, grid = pp["scene"], pp["pass"]["grid"]
+    outs = pp["pass"]["outs"]
+    outcome = outs[:, L.OUT_OUTCOME].astype(np.int8)
+    bnd = boundary_mask(outcome.reshape(grid.shape), grid.dims).ravel()
+    flat, stratum, weight, strata, sizes = stratified_sample(outcome, bnd, points, seed)
+    sample = Sample(flat, stratum, weight, strata, sizes, grid.size, outcome, 0.0)
+    values = grid.index_values(flat)
+    cpu = np.empty(len(flat))
+    ref_outcome = np.empty(len(flat))
+    for i in range(len(flat)):
+        point = scene.point({k: v[i] for k, v in values.items()})
+        c0 = time.thread_time()
+        r = reference_run(point, scene.numerics)
+        cpu[i] = time.thread_time() - c0
+        ref_outcome[i] = result_row(r)[L.OUT_OUTCOME]
+    agree = outs[flat, L.OUT_OUTCOME] == ref_outcome
+    share, se = _agreement(agree, sample)
+    return {"n": len(flat), "ref_ms": float(np.sum(cpu * weight) / weight.sum()) * 1e3,
+            "agree": share, "se": se}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true",
+                    help="Figure 3(a) only: its variant, its scene, 20 reference points")
+    ap.add_argument("--repeat", type=int, default=3, help="best of this many (items 2-4)")
+    ap.add_argument("--ref-points", type=int, default=100,
+                    help="reference sample per figure (default 100)")
+    ap.add_argument("--no-compile", action="store_true", help="skip item 1")
+    args = ap.parse_args()
+    variants = QUICK_VARIANTS if args.quick else ALL_VARIANTS
+    figures = ["fig3a"] if args.quick else list(bk.FOUR)
+    ref_points = 20 if args.quick else args.ref_points
+
+    print(f"rocksweep compile/start-up benchmark ({Path(rocksweep.__file__).parent}): "
+          f"{os.cpu_count()} cores, load average at start {bk.load_avg()}", flush=True)
+    t_all = time.perf_counter()
+
+    if not args.no_compile:
+        print("\n[1] cold compile, one variant per fresh process, empty NUMBA_CACHE_DIR "
+              "(s; the kernel's import apart)")
+        print(f"    {'variant':<36}{'CPU s':>8}{'wall s':>8}{'import CPU s':>14}")
+        for v in variants:
+            r = cold_compile(v)
+            if Path(r["package"]).resolve() != Path(rocksweep.__file__).resolve():
+                raise SystemExit(f"the subprocess imported {r['package']}")
+            print(f"    {variant_name(*v):<36}{r['cpu']:>8.2f}{r['wall']:>8.2f}"
+                  f"{r['import_cpu']:>14.2f}", flush=True)
+
+    print(f"\n[2] warm start-up (numba's cache filled), best of {args.repeat}")
+    print(f"    {'command':<40}{'wall s':>8}{'CPU s':>8}")
+    st = startup(args.repeat, args.quick)
+    for what, (wall, cpu) in st.items():
+        print(f"    {what:<40}{wall:>8.2f}{cpu:>8.2f}", flush=True)
+    # the sweep's start-up is serial work; its CPU time also counts the idle spinning of
+    # OpenBLAS's threads (numpy's and scipy's; 0.1-0.2 s, more on an idle machine)
+    start_wall = st["rocksweep sweep fig3a 5x5x3, -j 1"][0]
+
+    print(f"\n[3] outcome kernel on every point of the figures (default preset as shipped), "
+          f"CPU of the calling thread, best of {args.repeat}")
+    print(f"    {'figure':<8}{'points':>8}{'RK4 evals/pt':>14}{'core-us/pt':>12}")
+    pp = per_point(figures, args.repeat)
+    for name, r in pp.items():
+        print(f"    {name:<8}{r['n']:>8}{r['evals']:>14.1f}{r['us']:>12.2f}", flush=True)
+
+    print(f"\n[4] reference (scipy DOP853, rtol 1e-10): CPU ms per point, weighted mean over "
+          f"the accuracy study's stratified sample ({ref_points} points per figure: an "
+          "estimate for the whole scene), against item 3's kernel time on the whole scene")
+    print(f"    incl. start-up: ref / (kernel + item 2's sweep start-up {start_wall:.2f} s (wall) "
+          f"/ {SWEEP_POINTS} points)")
+    print(f"    {'figure':<8}{'sample':>7}{'ref ms/pt':>10}{'kern us/pt':>11}{'ratio':>8}"
+          f"{'incl. start-up':>15}{'agree %':>15}")
+    for name in figures:
+        r = reference(name, pp[name], ref_points)
+        kern = pp[name]["us"]
+        incl = r["ref_ms"] * 1e3 / (kern + start_wall / SWEEP_POINTS * 1e6)
+        agree = f"{100 * r['agree']:.2f}+-{100 * r['se']:.2f}"
+        print(f"    {name:<8}{r['n']:>7}{r['ref_ms']:>10.1f}{kern:>11.1f}"
+              f"{r['ref_ms'] * 1e3 / kern:>7.0f}x{incl:>14.0f}x{agree:>15}", flush=True)
+
+    print(f"\nbenchmark wall time {time.perf_counter() - t_all:.0f} s; load average at end "
+          f"{bk.load_avg()}")
+
+
+if __name__ == "__main__":
+    main()
