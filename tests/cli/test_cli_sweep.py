@@ -333,8 +333,8 @@ def test_ctrl_c_writes_every_finished_chunk_before_it_exits(tmp_path):
     first, so Ctrl-C loses nothing, and the message counts what the file holds."""
     scene = tmp_path / "int.yaml"
     scene.write_text(BODY3 + "impact: {lam: 0.2}\n"
-                     "pulse: {shape: sine, w_over_p: {start: 0.3, stop: 6, num: 300},"
-                     " A_ratio: {start: 0.3, stop: 8, num: 300}}\n")
+                     "pulse: {shape: sine, w_over_p: {start: 0.3, stop: 6, num: 600},"
+                     " A_ratio: {start: 0.3, stop: 8, num: 600}}\n")
     out = tmp_path / "int.h5"
     from rocksweep.compute.grid import Grid
     from rocksweep.compute.sweep import level, prepare
