@@ -79,7 +79,7 @@ def test_pdf_has_truetype_fonts(pair, tmp_path):
 
 def test_boundaries_from_run_open_and_cli_agree(pair, tmp_path):
     mem, disk, out = pair
-    a, b = (rocksweep.analysis.boundaries(ds, rtol=1e-3) for ds in (mem, disk))
+    a, b = (rocksweep.boundaries(ds, rtol=1e-3) for ds in (mem, disk))
     xr.testing.assert_identical(a, b)
     assert a.A_min.dims == ("lam", "w_over_p")
     # the bracket holds A_min, to rtol

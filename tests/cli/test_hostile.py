@@ -342,7 +342,7 @@ def test_a_record_result_moved_to_an_empty_folder(tmp_path):
         assert r.returncode == 0, (args, r.stderr)
     assert {"p.png", "b.csv", "s.png"} <= set(os.listdir(alone))
     ds = rocksweep.open(alone / "r.h5")
-    assert rocksweep.analysis.boundaries(ds).sizes["p"] == 5
+    assert rocksweep.boundaries(ds).sizes["p"] == 5
 
 
 def test_simulate_and_open_answer_in_one_line(work):
