@@ -4,10 +4,10 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import click
-import numpy as np
 
 from rocksweep.cli.main import (
     load,
@@ -77,7 +77,8 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
         click.echo("  " + "   ".join(f"u/u_cr {u[i]:g}: {_lam_text(table.lam_limit[i])}"
                                      for i in picks))
         lim = table.lam_limit
-        worst = "every lam gains" if bool(np.isnan(lim).any()) else _lam_text(lim.min())
+        worst = ("every lam gains" if any(math.isnan(v) for v in lim.tolist())
+                 else _lam_text(float(lim.min())))
         click.echo(f"  over u/u_cr in [-2, 2]: {worst}")
     if plot_path is not None:
         from rocksweep.figures.common import restitution_map, save_figure
@@ -90,6 +91,6 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
 
 
 def _lam_text(v: float) -> str:
-    if np.isnan(v):
+    if math.isnan(v):
         return "none (every lam gains)"
     return "none up to 2" if v >= 2.0 else f"{v:.4f}"
