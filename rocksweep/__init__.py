@@ -27,6 +27,7 @@ from rocksweep.api import (  # noqa: A004
     boundary_lines,
     estimate,
     fragility,
+    ida,
     open,
     plot,
     run,
@@ -56,4 +57,4 @@ def _version() -> str:
 
 __version__ = _version()
 __all__ = ["RocksweepError", "__version__", "boundaries", "boundary_lines", "estimate",
-           "fragility", "open", "plot", "run", "simulate", "spectra"]
+           "fragility", "ida", "open", "plot", "run", "simulate", "spectra"]

@@ -51,6 +51,12 @@ class RocksweepAccessor:
 
         return fragility(self._ds, **kwargs)
 
+    def ida(self, **kwargs: Any) -> Any:
+        """``rocksweep.ida(ds, ...)``: the first overturning level of each record."""
+        from rocksweep.api import ida
+
+        return ida(self._ds, **kwargs)
+
     def outcome_words(self) -> Any:
         """``outcome`` as words (not_run, safe, mode1, mode2), an object DataArray."""
         import numpy as np

@@ -807,6 +807,19 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3) -> xr.Dataset:
 
 
 @speaks_python
+def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
+    """Incremental dynamic analysis per record of a scaled record-suite sweep: the
+    smallest IM (the stripe IM: PGA [g], PGV [m/s], Sa [g], ...) that overturns each
+    record, bisected to ``rtol`` between the last stripe below the first overturning one
+    and that stripe (kernel runs at the sweep's accuracy), and whether a higher stripe is
+    safe again (``resurrection``). ds: what ``run`` or ``open`` returns. Returns a Dataset
+    over the other swept keys and ``record`` (``rocksweep.analysis.ida.ida``)."""
+    from rocksweep.analysis.ida import ida as run_ida
+
+    return run_ida(ds, rtol)
+
+
+@speaks_python
 def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
               im: str | None = None, period: float | None = None, bootstrap: int = 200,
               seed: int = 0, ci: float = 0.9) -> xr.Dataset:

@@ -255,10 +255,12 @@ def kernel_evaluator(scene: Scene) -> Evaluator:
 
     def evaluate(points: list[Point]) -> np.ndarray:
         out = np.empty(len(points), np.int8)
-        groups: dict[tuple[int, bool], list[int]] = {}
+        # one kernel call per body kind, ground variant and record (a record's samples
+        # ride on its rows: rows of one call have one length)
+        groups: dict[tuple[int, bool, int], list[int]] = {}
         for i, p in enumerate(points):
-            groups.setdefault((kernel_kind(p.body), p.ground), []).append(i)
-        for (kind, ground), idx in groups.items():
+            groups.setdefault((kernel_kind(p.body), p.ground, id(p.record)), []).append(i)
+        for (kind, ground, _), idx in groups.items():
             warm_up(kind, L.LEVEL_OUTCOME, ground)
             rows = np.array([point_row(points[i], scene.numerics) for i in idx])
             outs = np.empty((len(idx), L.N_OUT))

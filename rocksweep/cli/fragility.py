@@ -8,6 +8,7 @@ import json
 from pathlib import Path
 
 import click
+import numpy as np
 
 from rocksweep.cli.main import main, user_errors
 from rocksweep.cli.options import dpi_option, overwrite_option, result_argument
@@ -74,12 +75,18 @@ def _g(v) -> str:
               help="Print the curves as JSON ({\"curves\": [...]}) instead of a table.")
 @click.option("--width", type=click.Choice(WIDTHS), default="single", show_default=True,
               help="Figure width: a journal's single or double column.")
+@click.option("--rtol", type=click.FloatRange(1e-9, 0.5), default=None,
+              help="Also refine each record's first overturning level by bisection to this "
+                   "relative tolerance (an IDA per record, kernel runs at the sweep's "
+                   "accuracy): variables ida_im, ida_lo, ida_hi along record in -o "
+                   "(.h5/.nc) and the spread in the table [default: stripes only].")
 @dpi_option
 @overwrite_option
 @user_errors
 def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, state: str,
               im: str | None, period: float | None, bootstrap: int, seed: int, ci: float,
-              as_json: bool, width: str, dpi: int, overwrite: bool) -> None:
+              as_json: bool, width: str, dpi: int, overwrite: bool,
+              rtol: float | None) -> None:
     """Fragility curves of a record-suite sweep (a scene with ground.records): the
     lognormal P(state | IM = x) = Phi(ln(x/median)/beta) fitted by maximum likelihood to
     the counts at each stripe of a scaled suite, or to the (IM, 0/1) pairs of an unscaled
@@ -107,6 +114,11 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
     frag = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states, im=im,
                                period=period, bootstrap=bootstrap, seed=seed, ci=ci)
     frag.attrs["source"] = str(result_path)
+    refined = None
+    if rtol is not None:
+        refined = rocksweep.ida(ds, rtol)
+        for name in ("ida_im", "ida_lo", "ida_hi", "runs"):
+            frag[name if name != "runs" else "ida_runs"] = refined[name]
     rows = curve_rows(frag)
     if as_json:
         from rocksweep.analysis.fragility import curves_json
@@ -114,6 +126,8 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
         click.echo(json.dumps(curves_json(frag), allow_nan=False))
     else:
         _print_table(frag, rows)
+        if refined is not None:
+            _print_ida(refined)
     say = click.echo if not as_json else (lambda m: click.echo(m, err=True))
     if out_path is not None:
         if out_path.suffix.lower() == ".csv":
@@ -128,6 +142,27 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
         fig = fragility_figure(frag, width=width)
         save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=[result_path])
         say(f"wrote {fig_path}")
+
+
+def _print_ida(refined) -> None:
+    """One line per value of the other swept keys: the records' first overturning levels
+    (bisected), their median and range, resurrections."""
+    a = refined.attrs
+    other = [d for d in refined.ida_im.dims if d != "record"]
+    stacked = refined.stack(_k=other) if other else refined.expand_dims(_k=[0])
+    click.echo(f"IDA per record (first overturning {a['im']} [{a['im_units']}], bisected to "
+               f"rtol {a['rtol']:g}, {int(refined.runs.sum())} kernel runs):")
+    for k in range(stacked.sizes["_k"]):
+        one = stacked.isel(_k=k)
+        where = ", ".join(f"{d} = {one[d].item()}" for d in other) or "all"
+        v = one.ida_im.values
+        ok = v[~np.isnan(v)]
+        if ok.size:
+            click.echo(f"  {where}: median {np.median(ok):.4g}, range {ok.min():.4g} to "
+                       f"{ok.max():.4g} ({ok.size} of {v.size} records overturn; "
+                       f"{int(one.resurrection.sum())} resurrect above it)")
+        else:
+            click.echo(f"  {where}: no record overturns at any stripe")
 
 
 def _to_netcdf(frag, path: Path) -> None:

@@ -1,0 +1,147 @@
+"""Incremental dynamic analysis (IDA) per record of a scaled record suite.
+
+A scaled suite's sweep runs every record at every stripe of its intensity measure (IM:
+PGA, PGV, Sa, PGA_ratio or PGV_ratio). Its stripes say, per record, the first level that
+overturns the body; ``ida`` refines that level: between the last stripe below it (which
+does not overturn) and it, the record's scale is bisected to a relative tolerance with
+single kernel runs at the sweep's numerics (``boundaries.kernel_evaluator``, the runs of
+the A_min bisection). The scaled record's peak, and so the kernel's amplitude, is linear
+in the IM, so a level x between stripes is the stripe's point with its amplitude times
+x / stripe. Overturning means outcome 1 or 2 (mode 1, mode 2).
+
+"Resurrection" (Vamvatsikos & Cornell 2002): a stripe above the first overturning level
+where the record does not overturn.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+
+from rocksweep.analysis.boundaries import kernel_evaluator
+from rocksweep.errors import RocksweepError
+from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.store.sweepfile import as_result, result_scene
+
+# Bisection steps at most (a relative tolerance of 1e-12 takes ~40 from a stripe gap).
+MAX_ITER = 60
+
+
+class IdaError(RocksweepError, ValueError):
+    """A result that has no IDA (not a scaled suite, not finished); one line."""
+
+
+def ida(ds: Any, rtol: float = 1e-2) -> Any:
+    """The smallest IM that overturns each record, bisected to ``rtol`` between stripes.
+
+    ds: a complete sweep of a scaled record suite (what ``rocksweep.run`` or
+    ``rocksweep.open`` returns; the stripe dimension is named by ``ds.attrs["scale_im"]``).
+    Returns an ``xarray.Dataset`` over the other swept keys (lam, p, ...) and ``record``:
+    ``ida_im`` [IM units] (the smallest overturning level: the bracket's top; NaN: no
+    stripe overturns the record; the lowest stripe when it already overturns, then only
+    an upper bound, ``upper_bound`` = 1), ``ida_lo``/``ida_hi`` (the final bracket: lo
+    does not overturn, hi does), ``mode`` (1 or 2 at ida_hi; 0 where NaN), ``runs`` (kernel
+    runs of the bisection), ``resurrection`` (1: a higher stripe is safe again).
+    Flagged points (status & STATUS_FLAGGED) count as not overturning.
+    """
+    import xarray as xr
+
+    from rocksweep import fields
+
+    if not (isinstance(rtol, int | float) and 0 < rtol < 1):
+        raise IdaError(f"rtol = {rtol!r}: must be a relative tolerance in (0, 1)")
+    result = as_result(ds, ["outcome", "status"])
+    im = result.attrs.get("scale_im")
+    if not im or im not in result.dims or "record" not in result.dims:
+        raise IdaError(f"{result.path}: IDA needs a scaled record suite (ground.records with "
+                       "ground.scale stripes)")
+    outcome = np.asarray(result.arrays["outcome"])
+    if (outcome < 0).any():
+        raise IdaError(f"{result.path}: {int((outcome < 0).sum())} points not computed; "
+                       "finish the sweep (--resume) first")
+    scene = result_scene(result)
+    evaluate = kernel_evaluator(scene)
+    dims = list(result.dims)
+    others = [d for d in dims if d not in (im, "record")]
+    order = [*others, "record", im]
+    perm = [dims.index(d) for d in order]
+    flagged = (np.asarray(result.arrays["status"]) & L.STATUS_FLAGGED) != 0
+    over = np.isin(outcome, (L.OUTCOME_MODE1, L.OUTCOME_MODE2)) & ~flagged
+    over = np.transpose(over, perm)
+    modes = np.transpose(outcome, perm)
+    levels = np.asarray(result.coords[im], float)
+    if not np.all(np.diff(levels) > 0):
+        raise IdaError(f"{result.path}: the {im} stripes must increase")
+    lead = over.shape[:-1]  # (others..., record)
+    flat_over = over.reshape(-1, levels.size)
+    flat_mode = modes.reshape(-1, levels.size)
+    n = flat_over.shape[0]
+    first = np.where(flat_over.any(-1), flat_over.argmax(-1), -1)
+    safe_above = np.array([j >= 0 and not flat_over[i, j:].all() for i, j in enumerate(first)])
+    lo = np.full(n, np.nan)
+    hi = np.full(n, np.nan)
+    mode = np.zeros(n, np.int8)
+    runs = np.zeros(n, np.int64)
+    has = first >= 0
+    hi[has] = levels[first[has]]
+    mode[has] = flat_mode[has, first[has]]
+    inner = np.flatnonzero(first > 0)
+    lo[inner] = levels[first[inner] - 1]
+    # the point at each bracket's top stripe: its amplitude scales with the level
+    base = {a.name: a.values[0] for a in scene.axes}
+    points = {}
+    for i in inner:
+        idx = np.unravel_index(i, lead)
+        values = dict(base)
+        for d, k in zip([*others, "record"], idx, strict=True):
+            values[d] = result.coords[d][k]
+        values[im] = levels[first[i]]
+        points[i] = scene.point(_plain(values))
+    active = [i for i in inner if hi[i] - lo[i] > rtol * hi[i]]
+    for _ in range(MAX_ITER):
+        if not active:
+            break
+        mids = {i: 0.5 * (lo[i] + hi[i]) for i in active}
+        batch = [dataclasses.replace(points[i],
+                                     A_ratio=points[i].A_ratio * mids[i] / levels[first[i]])
+                 for i in active]
+        got = evaluate(batch)
+        for i, g in zip(active, got, strict=True):
+            runs[i] += 1
+            if g in (L.OUTCOME_MODE1, L.OUTCOME_MODE2):
+                hi[i], mode[i] = mids[i], g
+            else:
+                lo[i] = mids[i]
+        active = [i for i in active if hi[i] - lo[i] > rtol * hi[i]]
+    shape = lead
+    unit = fields.axis_attrs(im).get("units", "1")
+    coords = {d: (d, np.asarray(result.coords[d]), fields.axis_attrs(d))
+              for d in [*others, "record"]}
+    dims_out = [*others, "record"]
+    data = {
+        "ida_im": (dims_out, hi.reshape(shape),
+                   {"long_name": f"smallest {im} that overturns the record", "units": unit}),
+        "ida_lo": (dims_out, lo.reshape(shape),
+                   {"long_name": "bracket: largest level that does not overturn",
+                    "units": unit}),
+        "ida_hi": (dims_out, hi.reshape(shape),
+                   {"long_name": "bracket: smallest level that overturns", "units": unit}),
+        "upper_bound": (dims_out, ((first == 0).astype(np.int8)).reshape(shape),
+                        {"long_name": "1: the lowest stripe already overturns (ida_im is "
+                                      "an upper bound)"}),
+        "mode": (dims_out, mode.reshape(shape),
+                 {"long_name": "overturning mode at ida_hi", "flag_values": [0, 1, 2],
+                  "flag_meanings": "none mode1 mode2"}),
+        "runs": (dims_out, runs.reshape(shape), {"long_name": "kernel runs of the bisection"}),
+        "resurrection": (dims_out, safe_above.astype(np.int8).reshape(shape),
+                         {"long_name": "1: a stripe above ida_im does not overturn"}),
+    }
+    return xr.Dataset(data, coords=coords,
+                      attrs={"im": im, "im_units": unit, "rtol": float(rtol),
+                             "title": result.name})
+
+
+def _plain(values: dict) -> dict:
+    return {k: (v.item() if hasattr(v, "item") else v) for k, v in values.items()}
