@@ -29,7 +29,7 @@ if TYPE_CHECKING:
 
     from rocksweep.compute.adaptive import AdaptiveStats, Options, Validation
     from rocksweep.compute.single import Run
-    from rocksweep.scene.scene import Scene
+    from rocksweep.scene.model import Scene
 
 SceneLike = Union[str, Path, Mapping[str, Any]]  # noqa: UP007 (a runtime alias on 3.10)
 Overrides = Union[Sequence[str], Mapping[str, Any]]  # noqa: UP007
@@ -146,7 +146,8 @@ def load(scene: SceneLike | Scene, overrides: Overrides | None = ()) -> tuple[Sc
     mapping (the YAML's structure); or a ``Scene`` (then without overrides). Errors are
     one-line SceneErrors.
     """
-    from rocksweep.scene.scene import Scene, SceneError, load_scene, parse_scene
+    from rocksweep.scene.model import Scene, SceneError
+    from rocksweep.scene.parse import load_scene, parse_scene
 
     ov = override_strings(overrides)
     if isinstance(scene, Scene):
@@ -316,7 +317,7 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
 
         settings = adaptive.resolved(Grid(scene))  # bad axes or settings: before any file
 
-    from rocksweep.store.sweepfile import SweepFile
+    from rocksweep.store.writer import SweepFile
 
     t0 = time.perf_counter()
     where = (f"{n_workers} worker{'s' * (n_workers > 1)}" if backend == "threads"
@@ -663,7 +664,7 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
     ``complete``. Works while a sweep is still writing the file (no lock is taken).
     A file that is not a rocksweep result is a one-line ``RocksweepError``.
     """
-    from rocksweep.store.sweepfile import read_result
+    from rocksweep.store.reader import read_result
 
     path = Path(path)
     read_result(path, ["outcome"])  # one-line errors for foreign or damaged files
@@ -688,7 +689,7 @@ def _dataset(source: Path | Any) -> xr.Dataset:
     except (ValueError, TypeError, KeyError, OSError, OverflowError, AttributeError,
             IndexError) as err:  # xarray's CF decoding of a damaged attribute
         from rocksweep.outputs import shown
-        from rocksweep.store.sweepfile import StoreError
+        from rocksweep.store import StoreError
 
         where = shown(source) if isinstance(source, Path) else "result in memory"
         why = (str(err).strip().splitlines() or [type(err).__name__])[0]
@@ -738,7 +739,7 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
 
     from rocksweep.figures.common import width_style
     from rocksweep.figures.diagrams import friction_map, sweep_figure
-    from rocksweep.store.sweepfile import as_result
+    from rocksweep.store.reader import as_result
 
     result = as_result(ds)
     style = width_style(width)
@@ -769,7 +770,7 @@ def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None) -> x
     boundary polylines: ``boundary_lines(ds)``.
     """
     from rocksweep.analysis import boundaries as bd
-    from rocksweep.store.sweepfile import as_result
+    from rocksweep.store.reader import as_result
 
     if not (isinstance(rtol, int | float) and 0 < rtol < 1):
         raise ApiError(f"rtol = {rtol!r}: must be a relative tolerance in (0, 1)")
@@ -787,7 +788,7 @@ def boundary_lines(ds: xr.Dataset) -> Any:
     ``pandas.DataFrame``: one row per vertex with the panel's other swept keys, ``line``,
     ``classes`` (e.g. "safe|mode1"), ``closed``, ``vertex``, ``x``, ``y`` (axis values)."""
     from rocksweep.analysis import boundaries as bd
-    from rocksweep.store.sweepfile import as_result
+    from rocksweep.store.reader import as_result
 
     result = as_result(ds, ["outcome"])
     sc = bd.check_result(result)
@@ -966,7 +967,7 @@ def simulate_runs(scene: Scene, max_runs: int = MAX_RUNS) -> list[Run]:
     from itertools import product
 
     from rocksweep.compute.single import simulate as run_point
-    from rocksweep.scene.scene import SceneError
+    from rocksweep.scene.model import SceneError
 
     if scene.size > max_runs:
         big = max(scene.swept, key=lambda a: len(a.values))

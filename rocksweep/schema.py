@@ -2,7 +2,7 @@
 
 ``KEYS`` maps every dotted scene key to a ``Key``: the kind of value it holds, the range
 of admissible numbers (ends, inclusive or not, +inf allowed or not) and the text a user
-reads when a value is refused. The scene validator (``rocksweep.scene.scene``) and the body
+reads when a value is refused. The scene validator (``rocksweep.scene.parse``) and the body
 classes (``rocksweep.physics.model``) both check values here, so a body built from Python and a
 scene file get the same one-line message ``KEY = VALUE: what is allowed``.
 

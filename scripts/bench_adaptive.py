@@ -39,7 +39,8 @@ import numpy as np
 from rocksweep.compute import adaptive as ad
 from rocksweep.compute import sweep as sw
 from rocksweep.compute.grid import Grid
-from rocksweep.scene.scene import Scene, load_scene, parse_scene
+from rocksweep.scene.model import Scene
+from rocksweep.scene.parse import load_scene, parse_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGS = ("fig3a", "fig3b", "fig4a", "fig4b", "block")
@@ -141,7 +142,7 @@ def main() -> None:
             import tempfile
 
             from rocksweep.api import sweep_file
-            from rocksweep.store.sweepfile import read_result
+            from rocksweep.store.reader import read_result
 
             with tempfile.TemporaryDirectory() as tmp:
                 t0 = time.perf_counter()

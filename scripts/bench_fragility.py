@@ -137,7 +137,7 @@ def main(argv: list[str] | None = None) -> int:
         from rocksweep.kernel import chunk_kernel
         from rocksweep.kernel import layout as L  # noqa: N812
         from rocksweep.physics.reference import reference_run
-        from rocksweep.scene.scene import load_scene
+        from rocksweep.scene.parse import load_scene
 
         sc = load_scene(scene)
         grid = Grid(sc)

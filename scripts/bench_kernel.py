@@ -79,7 +79,8 @@ from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel.equations import contact_rhs, ground_acc, rocking_rhs
 from rocksweep.kernel.stepping import rk4_step
 from rocksweep.numerics import ROOTS
-from rocksweep.scene.scene import Scene, load_scene
+from rocksweep.scene.model import Scene
+from rocksweep.scene.parse import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIGS = ROOT / "configs"

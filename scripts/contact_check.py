@@ -21,7 +21,7 @@ from rocksweep.kernel import chunk_kernel
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.points import kernel_kind, point_row
 from rocksweep.physics.reference import reference_run
-from rocksweep.scene.scene import load_scene
+from rocksweep.scene.parse import load_scene
 
 NAMES = (("mu_required", L.OUT_MU_REQ), ("normal_min_over_Mg", L.OUT_N_MIN),
          ("impulse_ratio_max", L.OUT_IMPULSE_MAX))

@@ -27,7 +27,7 @@ def collect() -> dict[str, np.ndarray]:
 
     from rocksweep.compute.single import simulate
     from rocksweep.compute.sweep import compute
-    from rocksweep.scene.scene import load_scene
+    from rocksweep.scene.parse import load_scene
 
     arrays: dict[str, np.ndarray] = {}
     for name in SWEEPS:

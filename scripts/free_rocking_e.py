@@ -30,7 +30,7 @@ def free_rocking_e(scene_path: Path, law: str = "vertical", theta0: float = 0.8,
     from rocksweep.kernel import layout as L
     from rocksweep.kernel import point_kernel
     from rocksweep.physics.points import Point, kernel_kind, point_row
-    from rocksweep.scene.scene import load_scene
+    from rocksweep.scene.parse import load_scene
 
     scene = load_scene(scene_path)
     body = scene.make_body(**{a.name: a.values[0] for a in scene.body_axes()})

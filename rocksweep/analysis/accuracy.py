@@ -45,7 +45,7 @@ from rocksweep import fields
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import PRESET_ROTATION, PRESETS, ROOTS, Numerics
-from rocksweep.scene.scene import Scene, SceneError
+from rocksweep.scene.model import Scene, SceneError
 
 OUTCOMES = ("safe", "mode1", "mode2")  # codes 0, 1, 2
 # Per-point fields of the report: all the outcome-level kernel fills (no energies).

@@ -37,10 +37,10 @@ from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outcomes import outcome_word
 from rocksweep.physics.points import Point, kernel_kind, point_row
-from rocksweep.scene.scene import Scene
+from rocksweep.scene.model import Scene
 
 if TYPE_CHECKING:
-    from rocksweep.store.sweepfile import SweepResult
+    from rocksweep.store.reader import SweepResult
 
 DEFAULT_RTOL = 1e-3
 OVERTURNED = (L.OUTCOME_MODE1, L.OUTCOME_MODE2)
@@ -474,8 +474,8 @@ class BoundaryError(AdaptiveError):
 
 
 def scene_of(result: SweepResult) -> Scene:
-    """The scene a result was computed from (``rocksweep.store.sweepfile.result_scene``)."""
-    from rocksweep.store.sweepfile import result_scene
+    """The scene a result was computed from (``rocksweep.store.reader.result_scene``)."""
+    from rocksweep.store.reader import result_scene
 
     return result_scene(result)
 

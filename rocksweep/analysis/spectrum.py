@@ -88,7 +88,7 @@ class Spectra:
 def spectra(data, rtol: float = DEFAULT_RTOL) -> Spectra:
     """The rocking and overturning spectra of a complete sweep result: a Dataset (what
     ``rocksweep.run`` / ``rocksweep.open`` return), a ``SweepResult`` or a file's path."""
-    from rocksweep.store.sweepfile import as_result, result_scene
+    from rocksweep.store.reader import as_result, result_scene
 
     result = as_result(data, ["outcome", "status", "theta_max_over_alpha"])
     freq = "p" if "p" in result.dims else "w_over_p"

@@ -20,7 +20,7 @@ from rocksweep.fields import THETA_REL_FLOOR
 from rocksweep.kernel import layout as L  # noqa: N812
 
 if TYPE_CHECKING:
-    from rocksweep.store.sweepfile import SweepResult
+    from rocksweep.store.reader import SweepResult
 
 CLASSES = ("mode1", "mode2", "safe", "flagged", "not_computed")
 # Counted too in results with contact outputs (outputs.contact / body.mu): computed points
@@ -166,7 +166,7 @@ def _json_value(v):
 
 def read_info(path) -> SweepResult:
     """The variables of a result file that ``info_dict`` reports on."""
-    from rocksweep.store.sweepfile import read_result, stored_scene
+    from rocksweep.store.reader import read_result, stored_scene
 
     check = bool(stored_scene(path).get("check"))
     return read_result(path, INFO_VARIABLES + (CHECK_INFO_VARIABLES if check else []),

@@ -39,7 +39,7 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
     from rocksweep.analysis import boundaries as bd
     from rocksweep.figures.common import FORMATS, save_figure
     from rocksweep.outputs import check_distinct, check_output, write_atomic
-    from rocksweep.store.sweepfile import read_result
+    from rocksweep.store.reader import read_result
 
     if not (0 < rtol < 1):
         raise click.ClickException(f"--rtol {rtol}: give a relative tolerance in (0, 1)")

@@ -35,7 +35,7 @@ def user_errors(fn):
 def load(scene_path: Path, overrides: tuple[str, ...] = ()):
     """The validated scene at ``scene_path`` (imports the scene machinery, and with it
     numba, only when a command runs: ``rocksweep --help`` stays fast)."""
-    from rocksweep.scene.scene import load_scene
+    from rocksweep.scene.parse import load_scene
 
     if not scene_path.exists():
         raise click.ClickException(f"{scene_path}: no such scene file")

@@ -53,7 +53,7 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
     from rocksweep.figures.common import save_figure
     from rocksweep.figures.diagrams import missing_warnings
     from rocksweep.outputs import check_output
-    from rocksweep.store.sweepfile import as_result
+    from rocksweep.store.reader import as_result
 
     fig_out = fig_path if fig_path is not None else result_path.with_suffix(".png")
     # refuse a bad output before reading the result and drawing

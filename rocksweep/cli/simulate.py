@@ -59,7 +59,7 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     if contact:
         overrides = (*overrides, "outputs.contact=true")
     scene = load(scene_path, overrides)
-    from rocksweep.scene.scene import SceneError
+    from rocksweep.scene.model import SceneError
 
     try:
         runs = simulate_runs(scene, MAX_POINTS)

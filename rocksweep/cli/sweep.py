@@ -157,7 +157,7 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     if quiet:
         return
     from rocksweep.analysis.summary import check_info, counts_lines, format_check, read_info
-    from rocksweep.store.sweepfile import read_result
+    from rocksweep.store.reader import read_result
 
     # one read of the file: with error estimates, what info reports on them too
     result = read_info(out) if scene.check else read_result(out, ["outcome", "status"])

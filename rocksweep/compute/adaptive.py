@@ -58,7 +58,7 @@ import numpy as np
 
 from rocksweep.compute.grid import ChunkRows, Grid
 from rocksweep.errors import RocksweepError
-from rocksweep.scene.scene import Scene
+from rocksweep.scene.model import Scene
 from rocksweep.schema import check_option
 
 # ``computed`` flags (int8 per point).
@@ -167,7 +167,8 @@ def make_plan(grid_or_scene: Grid | Scene, axes: Sequence[str] = DIAGRAM_AXES,
               final_margin: int = DEFAULT_FINAL_MARGIN) -> Plan:
     """The plan of a scene's grid. axes: (x, y) names of two swept axes; coarse: None for
     ``default_coarse`` of the grid. Raises AdaptiveError naming a bad axis."""
-    scene = grid_or_scene.scene if isinstance(grid_or_scene, Grid) else grid_or_scene
+    given = grid_or_scene
+    scene = given.scene if isinstance(given, Grid) else given
     names = [a.name for a in scene.axes]
     if isinstance(axes, str) or len(axes) != 2:
         raise AdaptiveError(f"axes = {axes!r}: give two axis names (x, y)")

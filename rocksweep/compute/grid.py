@@ -26,7 +26,7 @@ from rocksweep.physics.points import (
     law_code,
     shape_code,
 )
-from rocksweep.scene.scene import Scene
+from rocksweep.scene.model import Scene
 
 
 @dataclass

@@ -2,7 +2,7 @@
 
 No I/O here: ``run_chunks`` yields each chunk's result arrays as it finishes and the
 driver (``rocksweep.api.sweep_file``, behind ``rocksweep sweep`` and ``rocksweep.run``)
-writes them (``rocksweep.store.sweepfile``). A chunk is a
+writes them (``rocksweep.store.writer``). A chunk is a
 contiguous range of flat point indices (``rocksweep.compute.grid``) and costs one call into the
 jitted kernel per kernel kind present in the chunk; there is no Python per point.
 
@@ -38,7 +38,7 @@ from rocksweep.compute.grid import ChunkRows, Grid
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.points import with_record
-from rocksweep.scene.scene import Scene
+from rocksweep.scene.model import Scene
 
 # Upper bound of the automatic chunk size [points]; see ``auto_chunk_size``.
 MAX_CHUNK = 1024

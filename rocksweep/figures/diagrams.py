@@ -51,7 +51,7 @@ from rocksweep.figures.common import (
     save_figure,
 )
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.store.sweepfile import SweepResult
+from rocksweep.store.reader import SweepResult
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

@@ -1,6 +1,6 @@
 """A suite of ground-motion records and how each run scales one (no numba here).
 
-A scene's ``ground.records`` (``rocksweep.scene.scene``) becomes a ``Suite``: the records
+A scene's ``ground.records`` (``rocksweep.scene.parse``) becomes a ``Suite``: the records
 read once, their intensity measures computed once (``rocksweep.physics.intensity``: PGA
 [g], PGV [m/s], Sa(T) [g] at 5% damping) and the scaling rule ``ground.scale``:
 

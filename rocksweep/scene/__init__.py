@@ -1,16 +1,9 @@
-"""Scenes: the YAML loader, the ``Scene`` model, the validation of every section against
-the one table of keys (``rocksweep.schema``), and the cost admission (every valid scene
-finishes in bounded time)."""
+"""Scenes: the YAML loader (``loader``), the ``Scene`` model (``model``), the validation
+of every section against the one table of keys (``parse``, ``rocksweep.schema``), and the
+cost admission (``admission``: every valid scene finishes in bounded time)."""
 
-from rocksweep.scene.scene import (
-    MAX_POINTS,
-    Axis,
-    Scene,
-    SceneError,
-    apply_overrides,
-    load_scene,
-    parse_scene,
-)
+from rocksweep.scene.model import Axis, Scene, SceneError
+from rocksweep.scene.parse import MAX_POINTS, apply_overrides, load_scene, parse_scene
 
 __all__ = ["MAX_POINTS", "Axis", "Scene", "SceneError", "apply_overrides", "load_scene",
            "parse_scene"]

@@ -1,14 +1,11 @@
-"""Result files: the HDF5 sweep format (CF metadata), the writer that survives SIGKILL and
-full disks (``SweepFile``), the reader and its validation (``read_result``)."""
+"""Result files: the HDF5 sweep format (CF metadata, ``format``), the identity a resume
+checks (``identity``), file-system safety (``safety``: space, stale files, locks), the
+writer that survives SIGKILL and full disks (``writer.SweepFile``), the reader and its
+validation (``reader.read_result``)."""
 
-from rocksweep.store.sweepfile import (
-    StoreError,
-    SweepFile,
-    SweepResult,
-    peek_done,
-    read_result,
-    stored_scene,
-)
+from rocksweep.store._common import StoreError
+from rocksweep.store.reader import SweepResult, peek_done, read_result, stored_scene
+from rocksweep.store.writer import SweepFile
 
 __all__ = ["StoreError", "SweepFile", "SweepResult", "peek_done", "read_result",
            "stored_scene"]

@@ -178,7 +178,7 @@ def test_energy_and_half_step_runs_use_the_scene_ground_motion(name, sets):
     import rocksweep.compute.sweep as sw
     from rocksweep import fields
     from rocksweep.analysis.accuracy import run_energy, run_half
-    from rocksweep.scene.scene import load_scene
+    from rocksweep.scene.parse import load_scene
 
     sc = load_scene(ROOT / "configs" / name, [*sets, "outputs.energy=true",
                                               "outputs.check=true"])

@@ -8,7 +8,7 @@ from bodies import FIG3_YAML
 import rocksweep.analysis.boundaries as bd
 import rocksweep.compute.sweep as sw
 from rocksweep.figures.diagrams import a_min_figure
-from rocksweep.scene.scene import parse_scene
+from rocksweep.scene.parse import parse_scene
 
 BODY3 = FIG3_YAML
 

@@ -21,8 +21,8 @@ from rocksweep.cli import main
 from rocksweep.compute.grid import Grid
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.model import FlexibleBody
-from rocksweep.scene.scene import load_scene
-from rocksweep.store.sweepfile import read_result
+from rocksweep.scene.parse import load_scene
+from rocksweep.store.reader import read_result
 
 ROOT = Path(__file__).resolve().parents[2]
 CI_SMALL = ROOT / "configs" / "ci-small.yaml"
@@ -167,7 +167,7 @@ def test_run_never_writes_over_its_scene(tmp_path):
 
 def test_run_resumes_a_partial_file(tmp_path):
     """A file with some points written (as after a kill) is finished by resume=True."""
-    from rocksweep.store.sweepfile import SweepFile
+    from rocksweep.store.writer import SweepFile
 
     out = tmp_path / "part.h5"
     full = rocksweep.run(SMALL)
@@ -208,7 +208,7 @@ def test_cache_state_of_a_fresh_cache(tmp_path):
     sw.prepare(Grid(sc), sw.level(sc))
     assert sw.kernel_cache_state(Grid(sc), sw.level(sc)) == (0, 0)
     code = ("from rocksweep.compute import sweep as sw; from rocksweep.compute.grid import Grid; "
-            "from rocksweep.scene.scene import load_scene; "
+            "from rocksweep.scene.parse import load_scene; "
             f"sc = load_scene({str(CI_SMALL)!r}); "
             "print(sw.kernel_cache_state(Grid(sc), sw.level(sc)))")
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}

@@ -17,8 +17,8 @@ import rocksweep.compute.adaptive as ad
 from rocksweep import api
 from rocksweep.cli import main
 from rocksweep.compute.sweep import level, prepare, variables
-from rocksweep.scene.scene import parse_scene
-from rocksweep.store.sweepfile import read_result
+from rocksweep.scene.parse import parse_scene
+from rocksweep.store.reader import read_result
 
 BODY3 = FIG3_YAML
 # Figure 3's body, two lam, 40 x 40: safe, mode 1 and mode 2 regions.
@@ -161,7 +161,7 @@ def test_interrupted_in_any_batch_resumes_to_the_same_file(fig3_files, tmp_path,
     monkeypatch.setattr(ad, "run_batch", cut_run_batch)
     monkeypatch.setattr(ad, "next_step", spy_next_step)
     if stop_in == "torn":
-        from rocksweep.store.sweepfile import SweepFile
+        from rocksweep.store.writer import SweepFile
 
         real_write = SweepFile._write_at
 

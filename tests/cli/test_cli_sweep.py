@@ -18,7 +18,8 @@ from helpers import kill_sweep_when, one_line_error
 from rocksweep.cli import main
 from rocksweep.compute.sweep import ChunkResult, variables
 from rocksweep.numerics import PRESETS
-from rocksweep.store.sweepfile import SweepFile, read_result
+from rocksweep.store.reader import read_result
+from rocksweep.store.writer import SweepFile
 
 ROOT = Path(__file__).resolve().parents[2]
 CI_SMALL = ROOT / "configs" / "ci-small.yaml"
@@ -220,7 +221,7 @@ def test_sweep_refuses_to_write_over_its_scene(cli, tmp_path):
 def test_info_counts_per_swept_key_in_ranges(cli, tmp_path):
     """A 101-value lam axis: counts per key are in the JSON for every value, and the text
     shows them as at most 10 ranges per table (synthetic results: no kernel)."""
-    from rocksweep.scene.scene import parse_scene
+    from rocksweep.scene.parse import parse_scene
 
     sc = parse_scene(BODY3 + "impact: {lam: {start: 0, stop: 1, num: 101}}\n"
                      "pulse: {shape: sine, w_over_p: [1.0, 2.0, 3.0], A_ratio: [2.0, 4.0]}\n")
@@ -260,7 +261,7 @@ def test_info_counts_per_swept_key_in_ranges(cli, tmp_path):
 def test_plot_block_scene_with_panels_and_partial_file(cli, tmp_path):
     """A block-body scene (issue 6) with a swept body key: one panel per alpha; points
     not computed yet are drawn grey with a warning. Results are synthetic (no kernel)."""
-    from rocksweep.scene.scene import parse_scene
+    from rocksweep.scene.parse import parse_scene
 
     sc = parse_scene("body: {kind: block, alpha: [0.15, 0.25]}\n"
                      "pulse: {shape: [sine, cosine], w_over_p: {start: 0.5, stop: 6, num: 6},"
@@ -303,7 +304,7 @@ def test_kill_and_resume_equals_uninterrupted_run(cli, tmp_path):
     # compile here if need be, so the subprocess loads numba's cache and starts at once
     from rocksweep.compute.grid import Grid
     from rocksweep.compute.sweep import level, prepare
-    from rocksweep.scene.scene import load_scene
+    from rocksweep.scene.parse import load_scene
 
     sc = load_scene(scene)
     prepare(Grid(sc), level(sc))
@@ -338,7 +339,7 @@ def test_ctrl_c_writes_every_finished_chunk_before_it_exits(tmp_path):
     out = tmp_path / "int.h5"
     from rocksweep.compute.grid import Grid
     from rocksweep.compute.sweep import level, prepare
-    from rocksweep.scene.scene import load_scene
+    from rocksweep.scene.parse import load_scene
 
     sc = load_scene(scene)
     prepare(Grid(sc), level(sc))

@@ -8,7 +8,7 @@ import pytest
 import rocksweep.compute.adaptive as ad
 import rocksweep.compute.sweep as sw
 from rocksweep.errors import RocksweepError
-from rocksweep.scene.scene import load_scene, parse_scene
+from rocksweep.scene.parse import load_scene, parse_scene
 
 # A rigid block under long pulses (omega/p <= 0.6): below A = g tan(alpha) (A_ratio < 1)
 # the ground cannot lift it (the inertial moment M A h_cg stays below the restoring

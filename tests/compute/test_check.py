@@ -27,7 +27,7 @@ from rocksweep.numerics import PRESET_ROTATION, PRESETS, Numerics
 from rocksweep.physics.model import FlexibleBody
 from rocksweep.physics.points import Point, kernel_kind, point_row
 from rocksweep.physics.reference import reference_run
-from rocksweep.scene.scene import parse_scene
+from rocksweep.scene.parse import parse_scene
 
 SCENE = """
 name: check grid

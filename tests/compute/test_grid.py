@@ -11,7 +11,7 @@ import rocksweep.compute.grid as grid_mod
 from rocksweep.compute.grid import Grid
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.points import kernel_kind, point_row
-from rocksweep.scene.scene import parse_scene
+from rocksweep.scene.parse import parse_scene
 
 BODY = ("body: {wn_over_p: %s, zeta: %s, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47, "
         "IA_ratio: 0.56}\n")

@@ -28,7 +28,8 @@ from rocksweep.kernel import layout as L
 from rocksweep.physics import intensity
 from rocksweep.physics.model import G
 from rocksweep.physics.records import read_record, write_at2
-from rocksweep.scene.scene import SceneError, load_scene, parse_scene
+from rocksweep.scene.model import SceneError
+from rocksweep.scene.parse import load_scene, parse_scene
 
 ROOT = Path(__file__).resolve().parents[2]
 SUITE = ROOT / "records" / "suite"

@@ -8,7 +8,7 @@ from rocksweep import fields
 from rocksweep.compute.grid import Grid
 from rocksweep.compute.single import simulate
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.scene.scene import parse_scene
+from rocksweep.scene.parse import parse_scene
 
 BODY3 = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, "
          "mA_over_m: 0.47, IA_ratio: 0.56}\n")

@@ -16,7 +16,8 @@ from matplotlib.figure import Figure
 from rocksweep.cli import main
 from rocksweep.compute.sweep import ChunkResult, variables
 from rocksweep.errors import RocksweepError
-from rocksweep.store.sweepfile import SweepFile, read_result
+from rocksweep.store.reader import read_result
+from rocksweep.store.writer import SweepFile
 
 ROOT = Path(__file__).resolve().parents[2]
 BODY3 = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: {start: 0.1, stop: 0.2, num: 3}, "
@@ -63,7 +64,7 @@ def line_result(tmp_path_factory):
 def synthetic_result(tmp_path: Path) -> Path:
     """A block scene (2 shapes x 2 alpha x 5 A x 6 w, no lam) with made-up outcomes: no
     kernel runs."""
-    from rocksweep.scene.scene import parse_scene
+    from rocksweep.scene.parse import parse_scene
 
     sc = parse_scene("name: synthetic block\nbody: {kind: block, alpha: [0.15, 0.25]}\n"
                      "pulse: {shape: [sine, cosine], w_over_p: {start: 0.5, stop: 6, num: 6},"
@@ -188,7 +189,7 @@ def test_one_panel_per_shape_and_swept_body_key(tmp_path):
 
 def test_title_says_the_pulse_shape_once(tmp_path):
     from rocksweep.figures.diagrams import stability_diagram
-    from rocksweep.scene.scene import parse_scene
+    from rocksweep.scene.parse import parse_scene
 
     sc = parse_scene("name: 'Figure X: flexible body, sine pulse'\n"
                      + BODY3.replace("{start: 0.1, stop: 0.2, num: 3}", "0.15")
@@ -225,7 +226,7 @@ def test_stability_diagram_draws_into_given_axes(acg_result):
 @pytest.fixture(scope="module")
 def fig5_runs():
     from rocksweep.compute.single import simulate
-    from rocksweep.scene.scene import load_scene
+    from rocksweep.scene.parse import load_scene
 
     scene = load_scene(ROOT / "configs" / "fig5.yaml")
     fixed = {a.name: a.values[0] for a in scene.axes}
@@ -271,7 +272,7 @@ def test_restitution_map_u0_curve_is_dark(body_fig2):
 def test_work_precision_returns_two_axes(tmp_path):
     from rocksweep.analysis.accuracy import accuracy_study, ladder
     from rocksweep.figures.accuracy import work_precision
-    from rocksweep.scene.scene import parse_scene
+    from rocksweep.scene.parse import parse_scene
 
     sc = parse_scene("name: tiny\n" + BODY3.replace("{start: 0.1, stop: 0.2, num: 3}", "0.15")
                      + "impact: {lam: 0.2}\n"
@@ -339,7 +340,7 @@ def test_check_files_ring_the_points_whose_outcome_changes(tmp_path):
     any lam) get a ring, at exactly those coordinates, and a legend entry; a file without
     check, none."""
     from rocksweep.figures.diagrams import stability_diagram
-    from rocksweep.scene.scene import parse_scene
+    from rocksweep.scene.parse import parse_scene
 
     text = ("name: rings\n" + BODY3.replace("{start: 0.1, stop: 0.2, num: 3}", "0.15")
             + "impact: {lam: [0.0, 0.2]}\n"

@@ -24,7 +24,8 @@ from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
 from rocksweep.physics.model import BlockBody, FlexibleBody
 from rocksweep.physics.points import Point, point_row
-from rocksweep.scene.scene import SceneError, parse_scene
+from rocksweep.scene.model import SceneError
+from rocksweep.scene.parse import parse_scene
 
 t = sp.symbols("t")
 m, mA, h, hA, b, g = sp.symbols("m m_A h h_A b g", positive=True)

@@ -22,7 +22,8 @@ from rocksweep.numerics import Numerics
 from rocksweep.physics import impact
 from rocksweep.physics.model import FlexibleBody
 from rocksweep.physics.points import Point, point_row
-from rocksweep.scene.scene import SceneError, load_scene, parse_scene
+from rocksweep.scene.model import SceneError
+from rocksweep.scene.parse import load_scene, parse_scene
 
 m, mA, IA, h, hA, b, lam = sp.symbols("m m_A I_A h h_A b lambda", positive=True)
 uu, v_m, w_m, w_p, v_p, e_c = sp.symbols("uu v_m w_m w_p v_p e_c")
@@ -241,7 +242,8 @@ SMALL = ["--set", "pulse.w_over_p={start: 1, stop: 6, num: 6}",
 
 
 def test_law_axis_sweeps_resumes_compares_and_refuses_a_changed_law(cli, tmp_path):
-    from rocksweep.store.sweepfile import SweepFile, read_result
+    from rocksweep.store.reader import read_result
+    from rocksweep.store.writer import SweepFile
 
     scene = ROOT / "configs" / "impact-laws.yaml"
     full = tmp_path / "full.h5"

@@ -25,7 +25,8 @@ from rocksweep.numerics import Numerics
 from rocksweep.physics.excitation import PulseShape
 from rocksweep.physics.model import BlockBody
 from rocksweep.physics.points import Point, point_row
-from rocksweep.scene.scene import SceneError, parse_scene
+from rocksweep.scene.model import SceneError
+from rocksweep.scene.parse import parse_scene
 
 BLOCK = BlockBody(alpha=0.2618, inertia=4.0 / 3.0)
 CASES = [("sine", 1, 2.0, 90.0), ("sine", 3, 2.0, 90.0), ("cosine", 2, 2.0, 90.0),

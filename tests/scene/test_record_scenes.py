@@ -32,7 +32,8 @@ from rocksweep.numerics import Numerics
 from rocksweep.physics.model import FlexibleBody
 from rocksweep.physics.points import RECORD, Point
 from rocksweep.physics.records import read_record
-from rocksweep.scene.scene import SceneError, load_scene, parse_scene
+from rocksweep.scene.model import SceneError
+from rocksweep.scene.parse import load_scene, parse_scene
 
 ROOT = Path(__file__).resolve().parents[2]
 SINE = ROOT / "records" / "sine_1cycle.AT2"
@@ -159,7 +160,7 @@ def test_record_sweep_end_to_end(tmp_path, cli):
     assert (tmp_path / "s.png").stat().st_size > 10_000
     from rocksweep.analysis.boundaries import kernel_evaluator
     from rocksweep.analysis.spectrum import spectra
-    from rocksweep.store.sweepfile import read_result, result_scene
+    from rocksweep.store.reader import read_result, result_scene
 
     sp = spectra(out, rtol=1e-2)
     assert sp.freq == "p" and sp.lam.tolist() == [0.0, 0.4] and sp.runs > 0

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from rocksweep.cli import main
-from rocksweep.scene.scene import SceneError, parse_scene
+from rocksweep.scene.model import SceneError
+from rocksweep.scene.parse import parse_scene
 
 SCENE = """
 body: {kind: block, alpha: 0.2}

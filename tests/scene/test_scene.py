@@ -19,7 +19,8 @@ from rocksweep.errors import RocksweepError
 from rocksweep.numerics import MAX_POINT_STEPS
 from rocksweep.physics.model import BlockBody, BodyError, FlexibleBody
 from rocksweep.physics.points import body_omega_rock
-from rocksweep.scene.scene import MAX_POINTS, SceneError, load_scene, parse_scene
+from rocksweep.scene.model import SceneError
+from rocksweep.scene.parse import MAX_POINTS, load_scene, parse_scene
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
@@ -244,7 +245,7 @@ def test_scene_size_and_sweep_bytes():
     assert scene.size == 30
     # int8 outcome; int32 impacts, uplifts, status; float64 theta_max, t_overturn;
     # int64 steps, event_steps: 45 bytes a point; coordinates 8 bytes a value
-    from rocksweep.store.sweepfile import file_bytes
+    from rocksweep.store.format import file_bytes
 
     # coordinates: 16 bytes a value of every axis (the stored axis and its bounds)
     coords = sum(16 * len(a.values) for a in scene.axes)

@@ -31,12 +31,15 @@ import numpy as np
 import pytest
 from helpers import one_line_error
 
-import rocksweep.store.sweepfile as store
 from rocksweep.cli import main
 from rocksweep.compute.grid import Grid
 from rocksweep.compute.sweep import ChunkResult, level, prepare, variables
-from rocksweep.scene.scene import load_scene, parse_scene
-from rocksweep.store.sweepfile import SESSION_ATTRS, StoreError, SweepFile, read_result
+from rocksweep.scene.parse import load_scene, parse_scene
+from rocksweep.store import StoreError
+from rocksweep.store._common import _plain
+from rocksweep.store.format import SESSION_ATTRS
+from rocksweep.store.reader import peek_done, read_result
+from rocksweep.store.writer import SweepFile
 
 pytestmark = pytest.mark.faults
 
@@ -165,8 +168,8 @@ def test_disk_full_while_the_file_is_made_leaves_nothing_and_no_crash(tmp_path):
     fs.mkdir()
     out = in_namespace(f"mount -t tmpfs -o size=24k tmpfs {fs}", f"""
         import os, json
-        import rocksweep.store.sweepfile as st
-        from rocksweep.scene.scene import load_scene
+        import rocksweep.store.writer as st
+        from rocksweep.scene.parse import load_scene
         st._check_space = lambda *a: None  # as if the disk filled up after the check
         try:
             st.SweepFile.create("{fs}/a.h5", load_scene("{CI_SMALL}"))
@@ -193,8 +196,8 @@ def test_resume_on_a_full_disk_keeps_the_46_percent_and_finishes(tmp_path, cli):
     keep.mkdir()
     out = in_namespace(f"mount -t tmpfs -o size=2m tmpfs {fs}", f"""
         import os, shutil, subprocess, sys, json
-        from rocksweep.scene.scene import load_scene
-        from rocksweep.store.sweepfile import SweepFile
+        from rocksweep.scene.parse import load_scene
+        from rocksweep.store.writer import SweepFile
         from rocksweep.compute.sweep import level, run_chunk
         sc = load_scene("{CI_SMALL}")
         path = "{fs}/a.h5"
@@ -236,7 +239,7 @@ def _as_format_1(path: Path) -> None:
     with h5py.File(path, "r+") as f:
         a = f.attrs
         for name in SESSION_ATTRS:
-            v = store._plain(a[name])
+            v = _plain(a[name])
             del a[name]
             if name in ("history", "host", "backend"):
                 continue
@@ -257,8 +260,9 @@ def test_resume_of_a_format_1_file_on_a_full_disk_is_one_line_and_changes_nothin
     fs.mkdir()
     out = in_namespace(f"mount -t tmpfs -o size=1m tmpfs {fs}", f"""
         import os, shutil, json, hashlib
-        from rocksweep.scene.scene import parse_scene
-        from rocksweep.store.sweepfile import StoreError, SweepFile
+        from rocksweep.scene.parse import parse_scene
+        from rocksweep.store import StoreError
+        from rocksweep.store.writer import SweepFile
         path = "{fs}/v1.h5"
         shutil.copy("{src}", path)
         fill("{fs}")
@@ -423,8 +427,8 @@ def test_read_only_directory_really_read_only(tmp_path):
     before = arrays_of(ro / "old.h5")
     out = in_namespace(f"mount --bind {ro} {ro} && mount -o remount,bind,ro {ro}", f"""
         import json, os, subprocess, sys
-        import rocksweep.store.sweepfile as st
-        from rocksweep.scene.scene import parse_scene
+        import rocksweep.store.writer as st
+        from rocksweep.scene.parse import parse_scene
         sc = parse_scene({TEXT!r})
         msgs = {{}}
         for key, call in [
@@ -475,8 +479,8 @@ def fake_chunk(scene, a, b):
 
 HOLDER = FAKE_CHUNK + """
 import sys
-from rocksweep.scene.scene import parse_scene
-from rocksweep.store.sweepfile import SweepFile
+from rocksweep.scene.parse import parse_scene
+from rocksweep.store.writer import SweepFile
 sc = parse_scene(@TEXT@)
 sf = SweepFile.@HOW@
 print("holding", flush=True)
@@ -524,7 +528,7 @@ def test_overwrite_and_resume_refused_while_another_process_writes(tmp_path, cli
         with pytest.raises(StoreError, match="open for writing by another process"):
             SweepFile.create(path, sc, overwrite=True)
         assert os.stat(path).st_ino == inode
-        assert store.peek_done(path)[1] == 120  # readers do not wait for the writer
+        assert peek_done(path)[1] == 120  # readers do not wait for the writer
     finally:
         _release(proc)
     r = read_result(path)
@@ -540,8 +544,9 @@ def test_overwrite_and_resume_refused_while_another_process_writes(tmp_path, cli
 
 RACER = FAKE_CHUNK + """
 import json, sys, time
-from rocksweep.scene.scene import parse_scene
-from rocksweep.store.sweepfile import StoreError, SweepFile
+from rocksweep.scene.parse import parse_scene
+from rocksweep.store import StoreError
+from rocksweep.store.writer import SweepFile
 sc = parse_scene(@TEXT@)
 while time.time() < @START@:
     pass
@@ -700,7 +705,7 @@ def test_damaged_attributes_coordinates_variables(synthetic, tmp_path, cli, case
         (tmp_path / "s.yaml").write_text(TEXT)
         assert one_line(cli.invoke(main, cmd)) == f"Error: {path}: {what}", cmd
     with pytest.raises(StoreError) as err:
-        store.peek_done(path) or read_result(path)
+        peek_done(path) or read_result(path)
     assert str(err.value) == f"{path}: {what}"
     # reporting did not write: the points are on disk as before
     if "outcome" not in case and "impacts" not in case:

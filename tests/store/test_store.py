@@ -9,11 +9,14 @@ import h5py
 import numpy as np
 import pytest
 
-import rocksweep.store.sweepfile as store
+import rocksweep.store.writer as writer
 from rocksweep.compute.grid import Grid
 from rocksweep.compute.sweep import ChunkResult, plan_chunks, variables
-from rocksweep.scene.scene import parse_scene
-from rocksweep.store.sweepfile import StoreError, SweepFile, flat_slabs, read_result
+from rocksweep.scene.parse import parse_scene
+from rocksweep.store import StoreError
+from rocksweep.store.format import FORMAT_VERSION, flat_slabs
+from rocksweep.store.reader import read_result
+from rocksweep.store.writer import SweepFile
 
 TEXT = """# a comment kept verbatim
 name: store test
@@ -82,7 +85,7 @@ def test_roundtrip_with_chunks_in_any_order(tmp_path, scene):
     for name in variables(scene):
         np.testing.assert_array_equal(r.arrays[name], expected(scene, name), err_msg=name)
     assert r.attrs["scene"] == TEXT  # verbatim, comment included
-    assert r.attrs["format_version"] == store.FORMAT_VERSION
+    assert r.attrs["format_version"] == FORMAT_VERSION
     assert r.attrs["steps_per_period"] == scene.numerics.steps_per_period
     assert r.attrs["event_tol"] == scene.numerics.event_tol
     assert r.attrs["horizon"] == scene.numerics.horizon
@@ -171,7 +174,7 @@ def test_create_failure_leaves_no_file(tmp_path, scene, monkeypatch):
     def boom(*args):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(store, "_initialise", boom)
+    monkeypatch.setattr(writer, "_initialise", boom)
     with pytest.raises(StoreError) as err:
         SweepFile.create(path, scene)
     assert str(err.value) == f"{path}: cannot write (no space left on the device); nothing written"
@@ -210,7 +213,7 @@ def test_damaged_and_newer_files(tmp_path, scene):
     with pytest.raises(StoreError, match="variable 'impacts' missing"):
         read_result(path)
     with h5py.File(path, "r+") as f:
-        f.attrs["format_version"] = store.FORMAT_VERSION + 1
+        f.attrs["format_version"] = FORMAT_VERSION + 1
     with pytest.raises(StoreError, match="newer rocksweep"):
         read_result(path)
 

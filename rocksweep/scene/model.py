@@ -1,0 +1,157 @@
+"""The scene model: ``Scene`` (a validated study: its axes in the grid's order, numerics,
+outputs, record or suite) and ``Axis``, and ``SceneError``, the one error of scenes."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from rocksweep.errors import RocksweepError
+from rocksweep.numerics import Numerics
+from rocksweep.physics.model import BlockBody, Body, FlexibleBody
+from rocksweep.physics.points import RECORD, Point
+from rocksweep.physics.records import GroundRecord
+from rocksweep.physics.suite import Suite
+from rocksweep.schema import KEYS
+
+
+class SceneError(RocksweepError, ValueError):
+    """A scene that cannot be run; ``str()`` is one line for the user."""
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One parameter of a scene: its name (the dimension name), values and whether swept."""
+
+    name: str
+    key: str  # dotted scene key, e.g. "pulse.A_ratio"
+    values: tuple
+    swept: bool
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene. ``axes`` in the grid's dimension order; ``text`` the YAML verbatim."""
+
+    name: str
+    kind: str  # "flexible" | "block"
+    axes: tuple[Axis, ...]
+    numerics: Numerics  # sweeps: the `default` preset unless the scene names one
+    single_numerics: Numerics  # single runs (simulate): `fine` unless the scene names one
+    energy: bool
+    text: str = field(repr=False)
+    contact: bool = False  # outputs.contact (on when body.mu is given)
+    check: bool = False  # outputs.check: per-point error estimates (a half-step rerun)
+    # the `refine` section (adaptive sweep settings, rocksweep.compute.adaptive.Options keywords),
+    # None without one
+    refine: dict | None = None
+    # a record scene (``ground`` section): the record read at load (else None); the grid's
+    # frequency axis is then p [rad/s], not w_over_p
+    record: GroundRecord | None = field(default=None, repr=False)
+    # a suite scene (``ground.records``): the records, their IMs and the scaling (the
+    # grid's axes then hold ``record`` (file names), the stripe IM if scaled, and p)
+    suite: Suite | None = field(default=None, repr=False)
+
+    @property
+    def freq_axis(self) -> str:
+        """The name of the axis that sets the ground motion's time scale: ``w_over_p``
+        (a pulse) or ``p`` (a record or a suite, [rad/s])."""
+        return "p" if self.recorded else "w_over_p"
+
+    @property
+    def recorded(self) -> bool:
+        """Whether the ground motion is recorded (``ground.record`` or ``ground.records``)."""
+        return self.record is not None or self.suite is not None
+
+    @property
+    def ground(self) -> bool:
+        """Whether the scene needs the kernel's GROUND variants (a Ricker or MP pulse, or a
+        record); the paper's sine and cosine (n cycles too) run the pulse variants."""
+        return self.recorded or any(
+            sh in ("ricker", "mp") for sh in self.axis("shape").values)
+
+    def option(self, name: str) -> Any:
+        """A pulse option's value (cycles, gamma, nu [deg]): the scene's or the default."""
+        for a in self.axes:
+            if a.name == name:
+                return a.values[0]
+        return KEYS[f"pulse.{name}"].default
+
+    def phase_max(self) -> float:
+        """The longest pulse of the scene's shapes in w t (2 pi n, 6 pi, 2 pi gamma)."""
+        from rocksweep.physics.points import RECORD, phase_duration
+
+        return max(phase_duration(sh, self.option("cycles"), self.option("gamma"))
+                   for sh in self.axis("shape").values if sh != RECORD)
+
+    def axis(self, name: str) -> Axis:
+        for a in self.axes:
+            if a.name == name:
+                return a
+        raise KeyError(name)
+
+    @property
+    def swept(self) -> tuple[Axis, ...]:
+        return tuple(a for a in self.axes if a.swept)
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """Shape of the result arrays: one dimension per swept axis."""
+        return tuple(len(a.values) for a in self.swept)
+
+    @property
+    def size(self) -> int:
+        """Number of points of the grid (<= MAX_POINTS)."""
+        return math.prod(self.shape)
+
+    def body_axes(self) -> tuple[Axis, ...]:
+        """The axes that make the body (body.mu is the ground's, not the body's)."""
+        return tuple(a for a in self.axes if a.key.startswith("body.") and a.key != "body.mu")
+
+    def make_body(self, **values: float) -> Body:
+        """A body from values of the body keys (as in ``body_axes``)."""
+        if self.kind == "block":
+            return BlockBody(**values)
+        return FlexibleBody(**values)
+
+    def point(self, values: dict[str, Any]) -> Point:
+        """The point with the given value of every axis (by name)."""
+        body = self.make_body(**{a.name: values[a.name] for a in self.body_axes()})
+        if self.suite is not None:
+            su = self.suite
+            r = su.names.index(str(values["record"]))
+            s = (np.array([self.axis(su.im).values.index(float(values[su.im]))])
+                 if su.im else None)
+            p = float(values["p"])
+            a_ratio = float(su.peak_ratio(np.array([r]), s, np.array([body.alpha_ref]),
+                                          np.array([p]))[0])
+            return Point(body, float(values["lam"]), RECORD, math.nan, a_ratio,
+                         record=su.records[r], p=p, **self._law(values))
+        if self.record is not None:
+            return Point(body, float(values["lam"]), RECORD, math.nan,
+                         float(values["A_ratio"]), record=self.record, p=float(values["p"]),
+                         **self._law(values))
+        return Point(body, float(values["lam"]), str(values["shape"]),
+                     float(values["w_over_p"]), float(values["A_ratio"]),
+                     int(values.get("cycles", self.option("cycles"))),
+                     float(values.get("gamma", self.option("gamma"))),
+                     float(values.get("nu", self.option("nu"))),
+                     mu=float(values.get("mu", math.nan)), **self._law(values))
+
+    def _law(self, values: dict[str, Any]) -> dict[str, Any]:
+        """A point's impact law (Point keywords law, e, e_factor) from axis values."""
+        law = str(values.get("law", "vertical"))
+        return {"law": law, "e": float(values["e"]) if law == "constant" else math.nan,
+                "e_factor": float(values.get("e_factor", 1.0))}
+
+    def single_point(self) -> Point:
+        """The scene's only point; a SceneError names the first swept key otherwise."""
+        for a in self.axes:
+            if len(a.values) != 1:
+                raise SceneError(
+                    f"{a.key} has {len(a.values)} values: this command runs one point; "
+                    f"pick one with --set {a.key}=VALUE")
+        return self.point({a.name: a.values[0] for a in self.axes})

@@ -1,0 +1,382 @@
+"""The sweep result format (HDF5 through h5py): its constants and metadata, and the
+making of a new file's contents (``_initialise``).
+
+Layout (netCDF-4 / CF-1.10, so ``xarray.open_dataset(path, engine="h5netcdf")`` and
+netCDF-4 readers open it):
+
+- one dataset per swept axis, named after it (``shape``, a body key, ``lam``, ``A_ratio``,
+  ``w_over_p``), holding its values and made an HDF5 dimension scale;
+- one 0-d dataset per unswept axis (a scalar coordinate, listed in each variable's
+  ``coordinates`` attribute);
+- one dataset per stored variable (``rocksweep.compute.sweep.VARIABLES``) with the grid's
+  dimensions attached; ``outcome`` is -1 where a point is not computed yet;
+- every variable and coordinate has ``long_name`` and (but the pulse shape and the flag
+  variables ``outcome``, ``status``) CF ``units``: ``"rad"`` for angles, ``"1"`` for
+  everything else, which is a pure number: Pi groups, counts, theta/alpha_ref, energies
+  / E_ref, and times p*t (``t_overturn``: its ``long_name`` says p*t, its
+  ``rocksweep_units`` the scale, here ``"1/p"``);
+- adaptive sweeps (``rocksweep sweep --adaptive``, ``rocksweep.compute.adaptive``) add an int8
+  variable ``computed`` (0 filled: the point was not computed, its ``outcome`` is the class
+  of the uniform cell around it and every other variable keeps its "not computed" fill
+  value; 1 computed; 2 an audit point that agreed with its fill; 3 one that disagreed; CF
+  ``flag_values``/``flag_meanings``), the settings as attributes ``adaptive`` (int8 1),
+  ``adaptive_axes``, ``adaptive_coarse``, ``adaptive_margin``, ``adaptive_final_margin``,
+  ``adaptive_audit``, ``adaptive_seed``, ``adaptive_threshold`` (also in the resolved
+  scene, so a resume with other settings is refused), and the counts ``points_computed``,
+  ``points_filled``, ``points_audited``, ``audit_misses`` (fixed size, updated in place).
+  While an adaptive sweep runs, ``outcome`` is -1 at the points not decided yet; its
+  last session writes the filled classes;
+- global attributes: ``Conventions`` (``CF-1.10``), ``title``, ``source``, ``history``
+  (one line per session: time, host, backend, rocksweep version, points done), the scene
+  YAML verbatim and its resolved form (``rocksweep.store.identity``), the resolved
+  numerics, versions, times, totals, ``host`` and ``backend`` of the latest session and
+  the format version. ``complete`` and ``energy`` are int8 0/1 (netCDF has no boolean
+  attribute; HDF5 enums are lost);
+- a record sweep keeps its record (group ``record``: the file's bytes and the samples).
+
+The attributes a session changes (``SESSION_ATTRS``) have fixed-size types (numbers,
+fixed-length strings) and are overwritten in place (``rocksweep.store.writer``).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import platform
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from rocksweep import fields
+from rocksweep.compute.grid import Grid
+from rocksweep.compute.sweep import variables
+from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
+from rocksweep.scene.model import Scene
+from rocksweep.store._common import _fixed, _now
+from rocksweep.store.identity import record_attrs, resolved_scene
+
+if TYPE_CHECKING:
+    import h5py
+
+
+FORMAT = "rocksweep-sweep"
+# 1: first release; 2: CF attributes (units, Conventions, int8 flags), fixed-size session
+# attributes, history/host/backend. This version reads both and resumes both.
+FORMAT_VERSION = 2
+CONVENTIONS = "CF-1.10"
+
+# Size of the ``history`` attribute [bytes]: fixed, so a session rewrites it in place;
+# about 30 sessions of one line each (the oldest are dropped beyond that).
+HISTORY_BYTES = 4096
+
+# The attributes a session changes -> fixed-size dtype (written in place, never resized).
+SESSION_ATTRS: dict[str, str] = {
+    "sessions": "int64",
+    "last_started": "S32",
+    "last_finished": "S32",
+    "finished": "S32",
+    "wall_time": "float64",
+    "cpu_time": "float64",
+    "points_done": "int64",
+    "complete": "int8",
+    "steps_total": "int64",
+    "event_steps_total": "int64",
+    "host": "S256",
+    "backend": "S256",
+    "history": f"S{HISTORY_BYTES}",
+}
+
+# Counts an adaptive sweep updates at the end of every session (in place, like
+# SESSION_ATTRS): from ``rocksweep.compute.adaptive.stats_of`` of the ``computed`` flags.
+ADAPTIVE_COUNT_ATTRS: dict[str, str] = {
+    "points_computed": "int64",
+    "points_filled": "int64",
+    "points_audited": "int64",
+    "audit_misses": "int64",
+}
+# The ``computed`` variable of adaptive sweeps: (dtype, fill, description), flag meanings.
+COMPUTED_VARIABLE = ("int8", 0, "adaptive sweep: 0 filled (not computed; outcome from the "
+                     "uniform cell around the point, other variables at their fill "
+                     "values), 1 computed, 2 audit point that agreed with its fill, 3 "
+                     "audit point that disagreed (region refined)")
+COMPUTED_FLAGS = {0: "filled", 1: "computed", 2: "audit_agreed", 3: "audit_disagreed"}
+
+# Variables whose values are codes (CF flag_values / flag_masks): no units.
+FLAG_VARIABLES = ("outcome", "status", "computed")
+
+
+def versions() -> dict[str, str]:
+    """Versions of rocksweep and the libraries that shape its results."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    import h5py
+    import numba
+
+    try:
+        rs = version("rocksweep")
+    except PackageNotFoundError:  # pragma: no cover - running from a source tree
+        rs = "unknown"
+    return {"rocksweep": rs, "numba": numba.__version__, "numpy": np.__version__,
+            "h5py": h5py.__version__, "hdf5": h5py.version.hdf5_version,
+            "python": platform.python_version()}
+
+
+def variables_for(stored: dict) -> dict:
+    """The per-point variables of a file from its resolved scene (``computed`` in the
+    files of adaptive sweeps)."""
+
+    return {**fields.variables(bool(stored.get("energy")), bool(stored.get("contact")),
+                               bool(stored.get("check"))),
+            **({"computed": COMPUTED_VARIABLE} if stored.get("adaptive") else {})}
+
+
+def flat_slabs(shape: tuple[int, ...], start: int, stop: int) -> list[tuple[tuple, int, int]]:
+    """Split the flat (C-order) range [start, stop) of an array of ``shape`` into boxes.
+
+    Returns ``(index, a, b)``: ``array[index]`` holds the flat elements a..b-1 (in order).
+    At most 2 * len(shape) - 1 boxes.
+    """
+    if start >= stop:
+        return []
+    if len(shape) == 0:
+        return [((), 0, 1)]
+    if len(shape) == 1:
+        return [((slice(start, stop),), start, stop)]
+    inner = math.prod(shape[1:])
+    i0, r0 = divmod(start, inner)
+    if i0 == (stop - 1) // inner:  # within one sub-array
+        return [((slice(i0, i0 + 1), *idx), i0 * inner + a, i0 * inner + b)
+                for idx, a, b in flat_slabs(shape[1:], r0, stop - i0 * inner)]
+    out = []
+    if r0:
+        out += flat_slabs(shape, start, (i0 + 1) * inner)
+        i0 += 1
+    i1, r1 = divmod(stop, inner)
+    if i1 > i0:
+        out.append(((slice(i0, i1), *(slice(None),) * (len(shape) - 1)),
+                    i0 * inner, i1 * inner))
+    if r1:
+        out += flat_slabs(shape, i1 * inner, stop)
+    return out
+
+
+def file_bytes(scene: Scene, adaptive: bool = False) -> int:
+    """Bytes the datasets of a result file of ``scene`` take (all allocated when the
+    file is made): every variable's dtype size x grid points, plus the coordinates;
+    adaptive: with the ``computed`` flags."""
+    grid = Grid(scene)
+    per_point = sum(np.dtype(dt).itemsize for dt, _, _ in variables(scene).values())
+    per_point += adaptive
+    coords = sum(16 * len(a.values) for a in scene.axes)
+    su = scene.suite
+    if su is not None:  # the per-record variables (sha256: 64 characters) and factors
+        R = len(su.records)
+        coords += R * (8 * (5 + len(su.periods)) + 96) + 8 * R * max(1, len(su.levels))
+    return per_point * grid.size + coords
+
+
+def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
+                adaptive: dict | None = None) -> None:
+    import h5py
+    grid = Grid(scene)
+    vers = versions()
+    a = f.attrs
+    a["Conventions"] = CONVENTIONS
+    a["title"] = scene.name
+    a["source"] = f"rocksweep {vers['rocksweep']} (rocksweep sweep)"
+    a["comment"] = ("Stability diagram of a flexible rocking oscillator (Zhu, Chatzis & "
+                    "Acikgoz). outcome -1 marks points not computed. complete and energy "
+                    "are flags: int8 1 true, 0 false. Times are p*t and all variables "
+                    "are dimensionless (units 1; rocksweep_units names the scale).")
+    a["rocksweep_format"] = FORMAT
+    a["format_version"] = FORMAT_VERSION
+    a["scene"] = scene.text
+    a["scene_kind"] = scene.kind
+    a["scene_resolved"] = json.dumps(resolved_scene(scene, overrides, adaptive))
+    a["overrides"] = json.dumps(list(overrides))
+    n = scene.numerics
+    a["numerics"] = json.dumps(n.as_dict())
+    a["accuracy"] = n.describe()
+    a["steps_per_period"] = n.steps_per_period
+    a["event_tol"] = n.event_tol
+    a["horizon"] = n.horizon
+    a["energy"] = np.int8(bool(scene.energy))
+    if scene.record is not None:  # the record: name, SHA-256, NPTS, DT [s], PGA [g]
+        for k, v in record_attrs(scene.record).items():
+            a[f"record_{k}"] = v
+        _store_record(f, scene.record)
+    if scene.suite is not None:  # the stripes' IM ("none": a cloud) and Sa's period [s]
+        a["scale_im"] = scene.suite.im or "none"
+        a["scale_period"] = float(scene.suite.period)
+    for k, v in vers.items():
+        a[f"{k}_version"] = v
+    a["started"] = _now()
+    a["points_total"] = np.int64(grid.size)
+    # fixed-size attributes, updated in place by every session
+    zeros = {"S": "", "i": 0, "f": 0.0}
+    for name, dtype in SESSION_ATTRS.items():
+        kind = np.dtype(dtype).kind
+        a.create(name, _fixed("", dtype) if kind == "S" else np.array(zeros[kind], dtype))
+    if adaptive is not None:
+        a["adaptive"] = np.int8(1)
+        a["adaptive_axes"] = " ".join(adaptive["axes"])
+        for k in ("coarse", "margin", "final_margin", "seed"):
+            a[f"adaptive_{k}"] = np.int64(adaptive[k])
+        for k in ("audit", "threshold"):
+            a[f"adaptive_{k}"] = np.float64(adaptive[k])
+        for name, dtype in ADAPTIVE_COUNT_ATTRS.items():
+            a.create(name, np.array(0, dtype))
+        a["comment"] = (str(a["comment"]) + " Adaptive sweep: computed flags each point "
+                        "(0 filled: outcome from the uniform cell around it, the other "
+                        "variables at their fill values; 1 computed; 2/3 audit points that "
+                        "agreed/disagreed with their fill).")
+
+    scales = []
+    for axis in scene.swept:
+        data = (np.array(axis.values, dtype=h5py.string_dtype())
+                if axis.name in fields.WORD_AXES else np.asarray(axis.values, float))
+        ds = f.create_dataset(axis.name, data=data)
+        ds.make_scale(axis.name)
+        _coord_attrs(ds, axis, scene.kind)
+        scales.append(ds)
+    scalars = []
+    for axis in scene.axes:
+        if axis.swept:
+            continue
+        v = axis.values[0]
+        ds = f.create_dataset(axis.name, data=(np.array(v, dtype=h5py.string_dtype())
+                                               if axis.name in fields.WORD_AXES
+                                               else float(v)))
+        _coord_attrs(ds, axis, scene.kind)
+        scalars.append(axis.name)
+
+    specs = dict(variables(scene))
+    if adaptive is not None:
+        specs["computed"] = COMPUTED_VARIABLE
+    for name, (dtype, fill, text) in specs.items():
+        dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
+        dcpl.set_alloc_time(h5py.h5d.ALLOC_TIME_EARLY)  # no metadata changes later
+        ds = f.create_dataset(name, shape=grid.shape, dtype=dtype, fillvalue=fill,
+                              dcpl=dcpl, fill_time="alloc")
+        f_ = fields.BY_NAME.get(name)
+        meta = (fields.field_attrs(f_, scene.kind) if f_ is not None
+                else {"long_name": "computed flag", "description": text})
+        if name in FLAG_VARIABLES:
+            meta.pop("rocksweep_units", None)
+        else:
+            ds.attrs["units"] = "1"
+        for k, v in meta.items():
+            ds.attrs[k] = v
+        if name == "outcome":  # CF-style flag attributes, for xarray users
+            ds.attrs["flag_values"] = np.array(list(OUTCOME_WORDS), np.int8)
+            ds.attrs["flag_meanings"] = " ".join(OUTCOME_WORDS.values())
+        elif name == "computed":
+            ds.attrs["flag_values"] = np.array(list(COMPUTED_FLAGS), np.int8)
+            ds.attrs["flag_meanings"] = " ".join(COMPUTED_FLAGS.values())
+        elif name == "status":
+            ds.attrs["flag_masks"] = np.array(list(STATUS_WORDS), np.int32)
+            ds.attrs["flag_meanings"] = " ".join(STATUS_WORDS.values())
+            ds.attrs["flagged_mask"] = np.int32(L.STATUS_FLAGGED)
+        if scalars:
+            ds.attrs["coordinates"] = " ".join(scalars)
+        for i, sc in enumerate(scales):
+            ds.dims[i].attach_scale(sc)
+    if scene.suite is not None:
+        _write_suite(f, scene, {s.name.lstrip("/"): s for s in scales})
+
+
+def suite_variables(scene: Scene) -> dict[str, tuple[tuple[str, ...], np.ndarray]]:
+    """The per-record variables of a suite scene's result: name -> (dims, values):
+    ``record_pga`` [g], ``record_pgv`` [m/s], ``record_sa`` (record, period) [g],
+    ``record_npts``, ``record_dt`` [s], ``record_duration`` [s], ``record_sha256``, and
+    ``scale_factor``: (record, stripe) when scaled, with the swept slenderness (PGA_ratio,
+    PGV_ratio) and p (PGV_ratio) when the factor depends on them; (record,) for a cloud."""
+    su = scene.suite
+    R = len(su.records)
+    out: dict[str, tuple[tuple[str, ...], np.ndarray]] = {
+        "record_pga": (("record",), np.asarray(su.pga, float)),
+        "record_pgv": (("record",), np.asarray(su.pgv, float)),
+        "record_sa": (("record", "period"), np.asarray(su.sa, float)),
+        "record_npts": (("record",), np.array([r.npts for r in su.records], np.int64)),
+        "record_dt": (("record",), np.array([r.dt for r in su.records], float)),
+        "record_duration": (("record",), np.array([r.duration for r in su.records], float)),
+        "record_sha256": (("record",), np.array([r.sha256 for r in su.records], object)),
+    }
+    r = np.arange(R)
+    if su.im is None:
+        out["scale_factor"] = (("record",), su.factors(r, None, np.zeros(R), np.ones(R)))
+        return out
+    dims = ["record", su.im]
+    shape = [R, len(su.levels)]
+    alpha_key = "alpha" if scene.kind == "block" else "alpha_cg"
+    alpha = np.asarray(scene.axis(alpha_key).values, float)
+    p = np.asarray(scene.axis("p").values, float)
+    dep = su.scale_dependence()
+    if "alpha_ref" in dep and scene.axis(alpha_key).swept:
+        dims.append(alpha_key)
+        shape.append(alpha.size)
+    else:
+        alpha = alpha[:1]
+    if "p" in dep and scene.axis("p").swept:
+        dims.append("p")
+        shape.append(p.size)
+    else:
+        p = p[:1]
+    grids = np.meshgrid(r, np.arange(len(su.levels)), alpha, p, indexing="ij")
+    fac = su.factors(grids[0], grids[1], grids[2], grids[3]).reshape(shape)
+    out["scale_factor"] = (tuple(dims), fac)
+    return out
+
+
+def _write_suite(f: h5py.File, scene: Scene, scales: dict) -> None:
+    """The suite's per-record variables (``suite_variables``) with their dimension scales
+    (``period`` made here) and CF attributes (``fields.RECORD_VARIABLES``)."""
+    import h5py
+
+    su = scene.suite
+    per = f.create_dataset("period", data=np.asarray(su.periods, float))
+    per.make_scale("period")
+    for k, v in fields.axis_attrs("period").items():
+        per.attrs[k] = v
+    scales = {**scales, "period": per}
+    for name, (dims, values) in suite_variables(scene).items():
+        if values.dtype == object:
+            ds = f.create_dataset(name, data=values.astype(str).astype(object),
+                                  dtype=h5py.string_dtype())
+        else:
+            ds = f.create_dataset(name, data=values)
+        long_name, units, text = fields.RECORD_VARIABLES[name]
+        ds.attrs["long_name"] = long_name
+        if units is not None:
+            ds.attrs["units"] = units
+        ds.attrs["description"] = text
+        for i, d in enumerate(dims):
+            ds.dims[i].attach_scale(scales[d])
+
+
+def _coord_attrs(ds, axis, kind: str = "flexible") -> None:
+    for k, v in fields.axis_attrs(axis.name, kind).items():
+        ds.attrs[k] = v
+    ds.attrs["scene_key"] = axis.key
+
+
+RECORD_GROUP = "record"  # a record sweep's copy of its record: file (bytes), acceleration
+
+
+def _store_record(f, record) -> None:
+    """Keep the record in the result file (group ``record``): the file's bytes (``file``,
+    uint8; the scene is rebuilt from them, ``result_scene``) and the samples
+    (``acceleration`` [g], at ``dt`` [s]) for readers. A result then stands alone: moved
+    to another machine, or kept after the record's folder is gone, it still plots and
+    gives boundaries and spectra."""
+    g = f.create_group(RECORD_GROUP)
+    raw = np.frombuffer(record.data, dtype=np.uint8)
+    if raw.size:
+        d = g.create_dataset("file", data=raw, chunks=(min(raw.size, 1 << 16),),
+                             compression="gzip")
+        d.attrs["sha256"] = record.sha256
+        d.attrs["source"] = str(record.source)
+    acc = g.create_dataset("acceleration", data=np.asarray(record.acc, np.float64))
+    acc.attrs["units"] = "g"
+    acc.attrs["dt"] = float(record.dt)

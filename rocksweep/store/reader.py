@@ -1,0 +1,550 @@
+"""Reading result files (plot, info, analyses) and validating them (every reader and
+resume): readers rely only on what is checked here (attributes, coordinates, shapes,
+dtypes, outcome codes); every problem is a one-line ``StoreError`` naming the file."""
+
+from __future__ import annotations
+
+import errno
+import json
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from rocksweep import fields
+from rocksweep.errors import RocksweepError
+from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.outcomes import OUTCOME_WORDS
+from rocksweep.outputs import shown
+from rocksweep.scene.model import Scene
+from rocksweep.store._common import (
+    _H5_ERRORS,
+    StoreError,
+    _close_quietly,
+    _cut,
+    _damaged,
+    _plain,
+    _why,
+)
+from rocksweep.store.format import (
+    COMPUTED_FLAGS,
+    FORMAT,
+    FORMAT_VERSION,
+    RECORD_GROUP,
+    variables_for,
+)
+from rocksweep.store.identity import resolved_scene, scene_differences
+
+if TYPE_CHECKING:
+    import h5py
+
+
+@dataclass
+class _Layout:
+    """What a valid file holds: its resolved scene, swept dims and their sizes."""
+
+    scene: dict
+    dims: tuple[str, ...]
+    shape: tuple[int, ...]
+    names: list[str]
+
+
+def _attr_str(f: h5py.File, key: str) -> str:
+    v = f.attrs[key]
+    if isinstance(v, bytes | np.bytes_):
+        return bytes(v).decode("utf-8", "replace")
+    if not isinstance(v, str):
+        raise TypeError(f"attribute {key} is {_cut(_plain(v))}, not text")
+    return v
+
+
+def _check_scene(stored, path: Path) -> None:
+    """The resolved scene dict as ``resolved_scene`` makes it, or StoreError."""
+    def bad(what: str) -> StoreError:
+        return _damaged(path, f"attribute scene_resolved: {what}")
+
+    if not isinstance(stored, dict):
+        raise bad(f"{_cut(stored)} is not a JSON object")
+    for key, typ in (("name", str), ("kind", str), ("energy", bool), ("axes", dict),
+                     ("numerics", dict)):
+        if not isinstance(stored.get(key), typ):
+            raise bad(f"'{key}' is {_cut(stored.get(key))}, not a {typ.__name__}")
+    if not stored["axes"]:
+        raise bad("no axes")
+    for key, ax in stored["axes"].items():
+        if not (isinstance(key, str) and "." in key and isinstance(ax, dict)
+                and isinstance(ax.get("swept"), bool) and isinstance(ax.get("values"), list)
+                and ax["values"]):
+            raise bad(f"axis {_cut(key)} is {_cut(ax)}")
+        words = key in fields.WORD_KEYS
+        kinds = (str,) if words else (int, float)
+        if not all(isinstance(v, kinds) and not isinstance(v, bool) for v in ax["values"]):
+            raise bad(f"axis {key} has values {_cut(ax['values'])}")
+        if not ax["swept"] and len(ax["values"]) != 1:
+            raise bad(f"unswept axis {key} has {len(ax['values'])} values")
+    if "adaptive" in stored:
+        a = stored["adaptive"]
+        from rocksweep.compute.adaptive import RESOLVED_KEYS
+
+        ok = (isinstance(a, dict) and set(a) == set(RESOLVED_KEYS)
+              and isinstance(a["axes"], list) and len(a["axes"]) == 2
+              and all(isinstance(v, str) for v in a["axes"])
+              and all(isinstance(a[k], int) and not isinstance(a[k], bool) and a[k] >= 0
+                      for k in ("coarse", "margin", "final_margin", "seed"))
+              and all(isinstance(a[k], int | float) and not isinstance(a[k], bool)
+                      and 0 <= a[k] <= 1 for k in ("audit", "threshold")))
+        if not ok:
+            raise bad(f"'adaptive' is {_cut(a)}")
+
+
+def _json_attr(f: h5py.File, key: str, path: Path, typ: type):
+    try:
+        text = _attr_str(f, key)
+    except KeyError:
+        raise _damaged(path, f"attribute {key} missing") from None
+    except TypeError as err:
+        raise _damaged(path, str(err)) from None
+    try:
+        value = json.loads(text)
+    except ValueError:
+        raise _damaged(path, f"attribute {key} is not JSON: {_cut(text)}") from None
+    if not isinstance(value, typ):
+        raise _damaged(path, f"attribute {key} is {_cut(text)}, not a JSON "
+                       f"{'object' if typ is dict else 'list'}")
+    return value
+
+
+def _looks_like_ours(f: h5py.File, fmt) -> bool:
+    """Whether a file without a valid rocksweep_format attribute still shows the marks of a
+    rocksweep result (then it is damaged, not foreign)."""
+    if isinstance(fmt, str) and fmt.startswith("rocksweep"):
+        return True
+    try:
+        a = f.attrs
+        return "scene_resolved" in a or ("format_version" in a and "outcome" in f)
+    except _H5_ERRORS:
+        return False
+
+
+def _layout(f: h5py.File, path: Path) -> _Layout:
+    """Validate the format, the resolved scene, the coordinates and the variables."""
+    import h5py
+
+    try:  # h5py's attrs.get hides damage as "missing"
+        fmt = f.attrs["rocksweep_format"] if "rocksweep_format" in f.attrs else None
+    except _H5_ERRORS as err:
+        raise StoreError(f"{shown(path)}: damaged HDF5 file, its attributes cannot be read "
+                         f"({_why(err)})") from None
+    if isinstance(fmt, bytes | np.bytes_):
+        fmt = bytes(fmt).decode("utf-8", "replace")
+    if fmt != FORMAT:
+        if _looks_like_ours(f, fmt):  # a damaged result is not a foreign file
+            raise _damaged(path, "attribute rocksweep_format " + (
+                "missing" if fmt is None else f"is {_cut(_plain(fmt))}"))
+        raise StoreError(f"{shown(path)}: an HDF5 file, but not a rocksweep sweep result "
+                         "(no rocksweep_format attribute)")
+    try:
+        ver = int(f.attrs.get("format_version", -1))
+    except (TypeError, ValueError):
+        raise _damaged(path, f"format_version = {_cut(_plain(f.attrs['format_version']))}"
+                       ) from None
+    if ver > FORMAT_VERSION:
+        raise StoreError(f"{shown(path)}: written in result format {ver} by a newer "
+                         f"rocksweep; this version reads formats 1 to {FORMAT_VERSION}; "
+                         "upgrade rocksweep")
+    if ver < 1:
+        raise _damaged(path, f"format_version = {ver}")
+    stored = _json_attr(f, "scene_resolved", path, object)
+    _check_scene(stored, path)
+    swept = {k.split(".", 1)[1]: v["values"] for k, v in stored["axes"].items() if v["swept"]}
+    dims = tuple(swept)
+    shape = tuple(len(v) for v in swept.values())
+    for d, values in swept.items():
+        ds = f.get(d)
+        if not isinstance(ds, h5py.Dataset):
+            raise _damaged(path, f"coordinate '{d}' missing")
+        if ds.shape != (len(values),):
+            raise _damaged(path, f"coordinate '{d}' has shape {ds.shape}, the scene "
+                           f"{len(values)} values")
+        data = ds[()]
+        if d in fields.WORD_AXES:
+            ok = [_plain(v) for v in data] == values
+        else:
+            ok = data.dtype.kind == "f" and np.array_equal(data, np.asarray(values, float))
+        if not ok:
+            raise _damaged(path, f"coordinate '{d}' holds {_cut(data.tolist())}, the scene "
+                           f"{_cut(values)}")
+    names = ["outcome", *(n for n in variables_for(stored) if n != "outcome")]
+    specs = variables_for(stored)
+    for name in names:
+        ds = f.get(name)
+        if not isinstance(ds, h5py.Dataset):
+            raise _damaged(path, f"variable '{name}' missing")
+        if ds.shape != shape:
+            raise _damaged(path, f"variable '{name}' has shape {ds.shape}, the grid {shape}")
+        if ds.dtype != np.dtype(specs[name][0]):
+            raise _damaged(path, f"variable '{name}' has dtype {ds.dtype}, expected "
+                           f"{specs[name][0]}")
+    return _Layout(stored, dims, shape, names)
+
+
+def _check_format(f: h5py.File, path: Path) -> None:
+    """Raise StoreError unless ``f`` is a valid rocksweep result (see ``_layout``)."""
+    _layout(f, path)
+
+
+def _is_hdf5(path: Path) -> bool:
+    import h5py
+    try:
+        return bool(h5py.is_hdf5(path))
+    except _H5_ERRORS:
+        return False
+
+
+def _open(path: Path, mode: str) -> h5py.File:
+    """Open an existing file; foreign, damaged, locked or unreadable files give a one-line
+    StoreError. Writers (mode "r+") take HDF5's exclusive lock; readers take none."""
+    import h5py
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise StoreError(f"{shown(path)}: no such file") from None
+    except OSError as err:
+        raise StoreError(f"{shown(path)}: cannot be read ({_why(err)})") from None
+    if os.path.isdir(path):
+        raise StoreError(f"{shown(path)}: is a directory, not a sweep result")
+    if not os.path.isfile(path):
+        raise StoreError(f"{shown(path)}: not a regular file (expected a rocksweep sweep "
+                         "result)")
+    if st.st_size == 0:
+        raise StoreError(f"{shown(path)}: empty file (expected a rocksweep sweep result)")
+    try:
+        # readers do not lock: `info` and `plot` work while a sweep writes (datasets are
+        # allocated up front, so a running sweep changes raw data only)
+        return h5py.File(path, mode, locking=(mode != "r"))
+    except _H5_ERRORS as err:
+        no = getattr(err, "errno", None)
+        if isinstance(err, BlockingIOError) or "unable to lock" in str(err).lower():
+            raise StoreError(f"{shown(path)}: open for writing by another process (a sweep "
+                             "still running?)") from None
+        if no in (errno.EACCES, errno.EPERM, errno.EROFS):
+            doing = "written" if mode != "r" else "read"
+            raise StoreError(f"{shown(path)}: cannot be {doing} ({_why(err)})") from None
+        if not _is_hdf5(path):
+            raise StoreError(f"{shown(path)}: not an HDF5 file (expected a rocksweep sweep "
+                             "result)") from None
+        raise StoreError(f"{shown(path)}: damaged or truncated HDF5 file, cannot be opened "
+                         "(rerun the sweep with --overwrite)") from None
+
+
+# Attributes readers use (``rocksweep info``, ``plot``) -> what they must be.
+_TEXT_ATTRS = ("scene", "accuracy", "started", "finished")
+_NUMBER_ATTRS = ("wall_time", "cpu_time")
+_COUNT_ATTRS = ("sessions",)
+_FLAG_ATTRS = ("energy", "complete")
+
+
+def _attr_ok(key: str, v) -> bool:
+    if key in _TEXT_ATTRS:  # h5py decodes invalid UTF-8 to surrogates: damage
+        return isinstance(v, str) and v.encode("utf-8", "replace").decode() == v
+    if isinstance(v, bool) or not isinstance(v, int | float):
+        return key in _FLAG_ATTRS and isinstance(v, bool)
+    if key in _NUMBER_ATTRS:
+        return math.isfinite(v) and v >= 0
+    if key in _COUNT_ATTRS:
+        return isinstance(v, int) and v >= 0
+    return v in (0, 1)  # a flag: int8 (format 2) or bool (format 1)
+
+
+def _check_outcome(outcome: np.ndarray, path: Path) -> None:
+    codes = np.array([L.OUTCOME_NOT_RUN, *OUTCOME_WORDS], np.int8)
+    bad = ~np.isin(outcome, codes)
+    if bad.any():
+        raise _damaged(path, f"variable 'outcome' holds {int(bad.sum())} invalid codes, "
+                       f"e.g. {int(outcome[bad][0])} (valid: -1, 0, 1, 2)")
+
+
+def _check_computed(computed: np.ndarray, outcome: np.ndarray | None, path: Path) -> None:
+    """The ``computed`` flags of an adaptive file: codes 0..3, and no computed point
+    without an outcome (outcome is written before the flag)."""
+    bad = ~np.isin(computed, np.array(list(COMPUTED_FLAGS), np.int8))
+    if bad.any():
+        raise _damaged(path, f"variable 'computed' holds {int(bad.sum())} invalid codes, "
+                       f"e.g. {int(computed[bad][0])} (valid: 0, 1, 2, 3)")
+    if outcome is not None:
+        lost = (computed > 0) & (outcome == L.OUTCOME_NOT_RUN)
+        if lost.any():
+            raise _damaged(path, f"{int(lost.sum())} points flagged computed have no "
+                           "outcome")
+
+
+def _checked_attrs(f: h5py.File, path: Path) -> dict:
+    """The file's attributes as plain Python values, those readers use validated."""
+    attrs = {}
+    for k in f.attrs:
+        try:
+            attrs[k] = _plain(f.attrs[k])
+        except _H5_ERRORS as err:
+            raise _damaged(path, f"attribute {k} unreadable: {_why(err)}") from None
+    _json_attr(f, "numerics", path, dict)
+    overrides = _json_attr(f, "overrides", path, list)
+    if not all(isinstance(o, str) for o in overrides):
+        raise _damaged(path, f"attribute overrides is {_cut(overrides)}, not a list of text")
+    for k in (*_TEXT_ATTRS, *_NUMBER_ATTRS, *_COUNT_ATTRS, *_FLAG_ATTRS):
+        if k not in attrs:
+            raise _damaged(path, f"attribute {k} missing")
+        if not _attr_ok(k, attrs[k]):
+            raise _damaged(path, f"attribute {k} is {_cut(attrs[k])}")
+    return attrs
+
+
+@dataclass
+class SweepResult:
+    """A result file read into memory.
+
+    dims/shape: swept dimensions; coords: dim -> values; scalars: unswept axis -> value;
+    arrays: variable -> array[shape]; attrs: file attributes; scene: resolved scene dict.
+    """
+
+    path: Path
+    dims: tuple[str, ...]
+    shape: tuple[int, ...]
+    coords: dict[str, np.ndarray]
+    scalars: dict[str, object]
+    arrays: dict[str, np.ndarray]
+    attrs: dict[str, object]
+    scene: dict
+
+    @property
+    def kind(self) -> str:
+        return self.scene["kind"]
+
+    @property
+    def name(self) -> str:
+        return self.scene["name"]
+
+    @property
+    def done(self) -> np.ndarray:
+        return self.arrays["outcome"] != L.OUTCOME_NOT_RUN
+
+    @property
+    def flagged(self) -> np.ndarray:
+        return (self.arrays["status"] & L.STATUS_FLAGGED) != 0
+
+    def counts(self) -> list[dict]:
+        """Points per class for each pulse shape and lam (needs ``outcome`` and ``status``).
+
+        One dict per (shape, lam): shape, lam, safe, mode1, mode2, not_computed, flagged.
+        """
+        out = self.arrays["outcome"]
+        flagged = self.flagged & self.done
+        groups = [d for d in ("shape", "lam") if d in self.dims]
+        rest = tuple(i for i, d in enumerate(self.dims) if d not in groups)
+        pos = [self.dims.index(d) for d in groups]
+        order = [*pos, *rest]
+        o = np.transpose(out, order).reshape(*(self.shape[i] for i in pos), -1)
+        fl = np.transpose(flagged, order).reshape(o.shape)
+        rows = []
+        for idx in np.ndindex(*o.shape[:-1]):
+            label = {}
+            for d in ("shape", "lam"):
+                label[d] = (_plain(self.coords[d][idx[groups.index(d)]]) if d in groups
+                            else self.scalars.get(d))
+            cell = o[idx]
+            rows.append({**label,
+                         "safe": int((cell == L.OUTCOME_SAFE).sum()),
+                         "mode1": int((cell == L.OUTCOME_MODE1).sum()),
+                         "mode2": int((cell == L.OUTCOME_MODE2).sum()),
+                         "not_computed": int((cell == L.OUTCOME_NOT_RUN).sum()),
+                         "flagged": int(fl[idx].sum())})
+        return rows
+
+
+def read_result(path: str | Path, names: list[str] | None = None,
+                optional: tuple[str, ...] = ()) -> SweepResult:
+    """Read a result file (``names``: variables to load; default all; ``optional``:
+    variables loaded too when the file has them, e.g. ``computed``).
+
+    Validates what readers rely on (format, resolved scene, coordinates, variables'
+    shapes and dtypes, outcome codes, the attributes ``info`` shows); any problem is a
+    one-line StoreError naming the file.
+    """
+    path = Path(path)
+    f = _open(path, "r")
+    try:
+        lay = _layout(f, path)
+        stored = lay.scene
+        known = variables_for(stored)
+        wanted = list(names) if names else list(known)
+        wanted += [n for n in optional if n in known and n not in wanted]
+        for n in wanted:
+            if n not in known:
+                raise StoreError(f"{shown(path)}: no variable '{n}' in this result (it "
+                                 f"holds {', '.join(known)})")
+        coords, scalars = {}, {}
+        for key, ax in stored["axes"].items():
+            name = key.split(".", 1)[1]
+            if ax["swept"]:
+                vals = f[name][()]
+                if name in fields.WORD_AXES:
+                    vals = np.array([_plain(v) for v in vals])
+                coords[name] = vals
+            else:
+                scalars[name] = ax["values"][0]
+        arrays = {n: f[n][()] for n in wanted}
+        if "outcome" in arrays:
+            _check_outcome(arrays["outcome"], path)
+        if "computed" in arrays:
+            _check_computed(arrays["computed"], arrays.get("outcome"), path)
+        attrs = _checked_attrs(f, path)
+    except RocksweepError:
+        raise
+    except _H5_ERRORS as err:
+        raise _damaged(path, _why(err)) from None
+    finally:
+        _close_quietly(f)
+    return SweepResult(path, lay.dims, lay.shape, coords, scalars, arrays, attrs, stored)
+
+
+def stored_scene(path: str | Path) -> dict:
+    """The resolved scene a result file records (``resolved_scene``), validated as
+    ``read_result`` validates it, without reading any variable."""
+    path = Path(path)
+    f = _open(path, "r")
+    try:
+        return _layout(f, path).scene
+    except RocksweepError:
+        raise
+    except _H5_ERRORS as err:
+        raise _damaged(path, _why(err)) from None
+    finally:
+        _close_quietly(f)
+
+
+def peek_done(path: str | Path) -> tuple[int, int] | None:
+    """(points done, total) of a rocksweep result at path, None if it is not one."""
+    try:
+        r = read_result(path, ["outcome"])
+    except StoreError:
+        return None
+    return int(r.done.sum()), int(r.done.size)
+
+
+def result_of(ds) -> SweepResult:
+    """A result Dataset (what ``rocksweep.run`` and ``rocksweep.open`` return) as the
+    ``SweepResult`` that ``read_result`` gives for its file: the analyses and figures take
+    either. A Dataset that is not a rocksweep sweep result is a one-line StoreError."""
+    import json
+
+    where = Path(str(ds.encoding.get("source") or ds.attrs.get("title") or "dataset"))
+    if "outcome" not in ds.data_vars or "scene_resolved" not in ds.attrs:
+        raise StoreError(f"{where}: not a rocksweep result (a Dataset from rocksweep.run or "
+                         "rocksweep.open has an outcome variable and a scene_resolved "
+                         "attribute)")
+    try:
+        stored = json.loads(str(ds.attrs["scene_resolved"]))
+    except ValueError:
+        raise StoreError(f"{where}: attribute scene_resolved is not JSON") from None
+    _check_scene(stored, where)
+    dims = tuple(str(d) for d in ds["outcome"].dims)
+    coords = {d: np.asarray(ds[d].values) for d in dims}
+    scalars = {str(k): _plain(np.asarray(v.values).reshape(()).item())
+               for k, v in ds.coords.items() if k not in dims and v.ndim == 0}
+    arrays = {str(k): np.asarray(v.transpose(*dims).values) for k, v in ds.data_vars.items()
+              if set(v.dims) == set(dims)}
+    attrs = {str(k): _plain(v) for k, v in ds.attrs.items()}
+    return SweepResult(where, dims, tuple(len(coords[d]) for d in dims), coords, scalars,
+                       arrays, attrs, stored)
+
+
+def as_result(data, names: list[str] | None = None) -> SweepResult:
+    """A ``SweepResult`` from a result Dataset, a ``SweepResult`` or a result file's path
+    (read with ``names``)."""
+    if isinstance(data, SweepResult):
+        return data
+    if isinstance(data, str | Path):
+        return read_result(data, names)
+    return result_of(data)
+
+
+def stored_record(path: Path, rec: dict):
+    """The record a result file keeps (``_store_record``) as a ``GroundRecord`` with the
+    sweep's source path, checked against the file's SHA-256; None for a file that keeps
+    no copy (made before records were stored). StoreError if the copy is damaged."""
+    from rocksweep.physics.records import RecordError, parse_record
+
+    f = _open(path, "r")
+    try:
+        g = f.get(RECORD_GROUP)
+        d = g.get("file") if g is not None else None
+        if d is None:
+            return None
+        data = bytes(np.asarray(d[()], dtype=np.uint8).tobytes())
+    except _H5_ERRORS as err:
+        raise _damaged(path, f"its copy of the record: {_why(err)}") from None
+    finally:
+        _close_quietly(f)
+    import hashlib
+
+    if hashlib.sha256(data).hexdigest() != rec.get("sha256"):
+        raise _damaged(path, "its copy of the record does not match its SHA-256")
+    try:
+        return parse_record(data, rec["source"])
+    except RecordError as err:
+        raise _damaged(path, f"its copy of the record: {err}") from None
+
+
+def result_scene(result: SweepResult) -> Scene:
+    """The scene a result was computed from, rebuilt from its YAML and overrides and
+    checked against the result's resolved scene (axes, numerics), so that the kernel runs
+    again as the sweep did (the A_min bisection, spectra). A record comes from the file's
+    own copy (``stored_record``, checked against its SHA-256); a file made before records
+    were stored re-reads it from where the sweep read it, checked against the SHA-256.
+    One-line StoreErrors."""
+    import json
+
+    from rocksweep.scene.parse import parse_scene
+
+    a = result.attrs
+    try:
+        overrides = list(json.loads(str(a.get("overrides", "[]"))))
+    except ValueError:
+        raise StoreError(f"{shown(result.path)}: attribute overrides is not JSON") from None
+    rec = result.scene.get("record")
+    suite = result.scene.get("suite")
+    record = None
+    if rec:
+        # the file's own copy first (a result stands alone); a file without one re-reads
+        # the record from where the sweep read it, checked against its SHA-256
+        # a Dataset made in memory (rocksweep.run without output) has no file to read
+        record = stored_record(result.path, rec) if result.path.is_file() else None
+        if record is None:
+            from rocksweep.physics.records import RecordError, read_record
+
+            try:
+                record = read_record(rec["source"])
+            except RecordError as err:
+                raise StoreError(f"{shown(result.path)}: cannot rebuild its scene (the "
+                                 f"record: {err}; this file keeps no copy of it, made by an "
+                                 "older rocksweep: put the record back there)") from None
+            if record.sha256 != rec["sha256"]:
+                raise StoreError(f"{shown(result.path)}: the record {rec['source']} changed "
+                                 f"since the sweep (sha256 {record.sha256[:12]}, the result "
+                                 f"has {rec['sha256'][:12]})")
+    elif suite:  # the records where the sweep read them (their SHA-256s are compared)
+        overrides.append("ground.records=" + json.dumps(
+            [str(r.get("source")) for r in suite.get("records") or []]))
+    try:
+        sc = parse_scene(str(a["scene"]), str(result.path), overrides, record=record)
+    except RocksweepError as err:
+        raise StoreError(f"{shown(result.path)}: cannot rebuild its scene ({err})") from None
+    stored = {k: v for k, v in result.scene.items() if k != "adaptive"}
+    added = bool(suite) and not rec  # the override above is not the file's
+    diffs = scene_differences(stored, resolved_scene(sc, overrides[:len(overrides) - added]))
+    if diffs:
+        raise StoreError(f"{shown(result.path)}: its scene YAML no longer gives its grid "
+                         f"({'; '.join(diffs)})")
+    return sc

@@ -1,0 +1,212 @@
+"""File-system safety of the writer (issue 16): space, stale temporary files, locks and
+the atomic rename.
+
+- A new file's size is known (every dataset is allocated at creation): a grid larger
+  than the free space is refused before anything is written (``_check_space``), and the
+  whole file's space is reserved before HDF5 writes (``_reserve``).
+- A new file is made under a temporary name unique to the process
+  (``partial_prefix``); those of killed attempts are removed (``clean_stale_partials``).
+- A writer holds HDF5's exclusive lock (``flock``) on its file; ``create`` takes the same
+  lock on a file it overwrites (``_lock_existing``), and holds the new file's lock before
+  it is renamed into place (``_publish``), so no two processes write one path, whatever
+  ``--resume``/``--overwrite`` they are given. Without ``overwrite`` the rename is a hard
+  link, which fails if another process made the path meanwhile.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import os
+import re
+import shutil
+import stat
+import time
+from pathlib import Path
+
+from rocksweep.outputs import shown
+from rocksweep.scene.model import Scene
+from rocksweep.store._common import StoreError, _mib, _why
+
+# Free space required beyond the space a new file reserves (``_space_needed``): a share of
+# the file, at least this many bytes [bytes], so that a small sweep fits a small disk and
+# a large one leaves room for the file system's own blocks.
+SPACE_MARGIN = 64 << 10
+SPACE_SHARE = 1 / 64
+# Space for attribute updates of a format-1 file on resume [bytes].
+UPDATE_MARGIN = 1 << 20
+# Space reserved for HDF5's metadata when a file is made [bytes], beyond the datasets and
+# the scene text: HDF5 fails badly when a metadata write hits a full disk (a segmentation
+# fault in the next flush), so the whole file's space is reserved before it is written.
+METADATA_RESERVE = 256 << 10
+
+
+def _reserve(path: Path, nbytes: int) -> None:
+    """Allocate ``nbytes`` of disk space to the file at ``path`` (``posix_fallocate``):
+    writes within them cannot fail for want of space. OSError(ENOSPC) if there is no
+    room; file systems without the call are left as they are."""
+    fd = os.open(path, os.O_WRONLY | getattr(os, "O_CLOEXEC", 0))
+    try:
+        os.posix_fallocate(fd, 0, nbytes)
+    except OSError as err:
+        if err.errno not in (errno.EOPNOTSUPP, errno.EINVAL, errno.ENOSYS):
+            raise
+    finally:
+        os.close(fd)
+
+
+def _reserve_bytes(scene: Scene, nbytes: int) -> int:
+    """Bytes a new result file of ``scene`` reserves: its datasets (``nbytes``), HDF5's
+    metadata, the scene text and the record (its file and samples, ``_store_record``)."""
+    rec = (8 * int(scene.record.npts) + len(scene.record.data) + (16 << 10)
+           if scene.record is not None else 0)
+    return nbytes + METADATA_RESERVE + 4 * len(scene.text.encode()) + rec
+
+
+def _space_needed(reserve: int) -> int:
+    """Free space required to make a file that reserves ``reserve`` bytes: those and a
+    margin that scales with them (``SPACE_SHARE``, at least ``SPACE_MARGIN``)."""
+    return reserve + max(SPACE_MARGIN, int(reserve * SPACE_SHARE))
+
+
+def _check_space(path: Path, need: int, what: str) -> None:
+    """Refuse (StoreError) when the file system of ``path`` has less than ``need`` bytes
+    free."""
+    parent = path.parent if str(path.parent) else Path(".")
+    try:
+        free = shutil.disk_usage(parent).free
+    except OSError:
+        return  # cannot tell: the writes themselves will say
+    if free < need:
+        raise StoreError(f"{shown(path)}: not enough free space for {what}: needs about "
+                         f"{_mib(need)} ({need} bytes), {_mib(free)} free in {parent}")
+
+
+_PARTIAL = re.compile(r"\.(?:(\d+)-)?[a-z0-9_]{8}\.partial")
+STALE_AGE = 60.0  # [s] a partial file without a writer's pid is stale when this old
+
+
+def partial_prefix(path: Path) -> str:
+    """The prefix of the temporary names a new result file at ``path`` is made under: the
+    writer's pid is part of the name (``.out.h5.1234-abcd1234.partial``)."""
+    return f".{path.name[:40]}.{os.getpid()}-"
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # exists, another user's
+        return True
+    return True
+
+
+def clean_stale_partials(path: Path) -> list[tuple[str, int]]:
+    """Remove the temporary files of earlier attempts to make ``path`` that no live writer
+    owns (a sweep killed while the file was made leaves one of the reserved size): its
+    writer's process is gone (or, for a name without a pid, it is older than STALE_AGE)
+    and no process holds its lock. Returns (name, bytes) of each file removed."""
+    import fcntl
+
+    parent = path.parent if str(path.parent) else Path(".")
+    head = f".{path.name[:40]}"
+    removed = []
+    try:
+        names = [n for n in os.listdir(parent) if n.startswith(head) and n.endswith(".partial")]
+    except OSError:
+        return []
+    for name in names:
+        m = _PARTIAL.fullmatch(name[len(head):])
+        if m is None:
+            continue
+        full = parent / name
+        try:
+            st = os.lstat(full)
+        except OSError:
+            continue
+        if not stat.S_ISREG(st.st_mode):
+            continue
+        if m.group(1) is not None:
+            if int(m.group(1)) == os.getpid() or _alive(int(m.group(1))):
+                continue
+        elif time.time() - st.st_mtime < STALE_AGE:
+            continue
+        try:
+            fd = os.open(full, os.O_RDONLY | getattr(os, "O_CLOEXEC", 0))
+        except OSError:
+            continue
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # HDF5's writer lock
+            os.unlink(full)
+            removed.append((name, st.st_size))
+        except OSError:  # locked: a live writer (or no flock here: leave it)
+            pass
+        finally:
+            os.close(fd)
+    return removed
+
+
+def _umask_mode() -> int:
+    """Mode of a new file under this process's umask (mkstemp makes files 0600)."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return 0o666 & ~int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    return 0o644
+
+
+def _lock_existing(path: Path) -> int:
+    """Open the file at ``path`` and take the exclusive lock a writer holds (HDF5 locks
+    with flock); returns the descriptor. StoreError if a sweep is writing it."""
+    import fcntl
+
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_CLOEXEC", 0))
+    except OSError as err:
+        raise StoreError(f"{shown(path)}: cannot be replaced ({_why(err)})") from None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        os.close(fd)
+        raise StoreError(f"{shown(path)}: open for writing by another process (a sweep "
+                         "still running?); not overwritten") from None
+    except OSError:
+        pass  # no flock on this file system: HDF5 cannot lock there either
+    return fd
+
+
+def _publish(tmp: Path, path: Path, old_fd: int | None) -> None:
+    """Rename the finished temporary file to ``path``: over the file locked by ``old_fd``,
+    or, without one, only if nothing is at ``path`` (another process may have made it
+    since it was checked)."""
+    os.chmod(tmp, _umask_mode())
+    if old_fd is not None:
+        try:
+            same = os.path.samestat(os.fstat(old_fd), os.stat(path))
+        except OSError:
+            same = False
+        if not same:
+            raise StoreError(f"{shown(path)}: replaced by another process meanwhile; not "
+                             "overwritten")
+        os.replace(tmp, path)
+        return
+    try:
+        os.link(tmp, path)
+    except FileExistsError:
+        raise StoreError(f"{shown(path)}: made by another process meanwhile (a sweep "
+                         "started at the same time?); not overwritten") from None
+    except OSError as err:
+        if err.errno not in (errno.EPERM, errno.ENOTSUP, errno.EOPNOTSUPP, errno.EXDEV,
+                             errno.EMLINK):
+            raise
+        if path.exists():  # no hard links here: check, then rename
+            raise StoreError(f"{shown(path)}: made by another process meanwhile; not "
+                             "overwritten") from None
+        os.replace(tmp, path)
+        return
+    with contextlib.suppress(OSError):
+        os.unlink(tmp)
