@@ -23,7 +23,7 @@ import numpy as np
 from rocksweep.analysis.boundaries import kernel_evaluator
 from rocksweep.errors import RocksweepError
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.store.sweepfile import as_result, result_scene
+from rocksweep.store.reader import as_result, result_scene
 
 # Bisection steps at most (a relative tolerance of 1e-12 takes ~40 from a stripe gap).
 MAX_ITER = 60
