@@ -397,12 +397,7 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
 
         area = ([f"${lam_sym}$ = {_fmt(lv)}: {share(k)}" for k, lv in enumerate(lam)]
                 if lam is not None else [f"all: {share(0)}"])
-        ax.text(0.98, 0.02, "mode 1 area\n" + "\n".join(area), transform=ax.transAxes,
-                ha="right", va="bottom", fontsize=7,
-                bbox={"boxstyle": "round", "fc": "white", "ec": "0.6", "alpha": 0.85})
-        ax.set_title(_panel_title(result, panel_dims, idx), fontsize=10)
-        ax.set_xlabel(axis_label(x, result.kind))
-        ax.set_ylabel(axis_label(y, result.kind))
+        _label_panel(ax, result, panel_dims, idx, x, y, area)
 
     handles = []
     if used[1]:
@@ -455,6 +450,18 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
     else:
         _legend_outside(flat[-1], handles)
     return fig
+
+
+def _label_panel(ax: Axes, result: SweepResult, panel_dims, idx, x: str, y: str,
+                 area: list[str]) -> None:
+    """A diagram panel's mode 1 area box (one line per lam or compared value), title and
+    axis labels."""
+    ax.text(0.98, 0.02, "mode 1 area\n" + "\n".join(area), transform=ax.transAxes,
+            ha="right", va="bottom", fontsize=7,
+            bbox={"boxstyle": "round", "fc": "white", "ec": "0.6", "alpha": 0.85})
+    ax.set_title(_panel_title(result, panel_dims, idx), fontsize=10)
+    ax.set_xlabel(axis_label(x, result.kind))
+    ax.set_ylabel(axis_label(y, result.kind))
 
 
 def _legend_outside(ax: Axes, handles: list) -> None:
@@ -581,12 +588,7 @@ def compare_diagram(result: SweepResult, key: str, x: str | None = None,
         done = po != L.OUTCOME_NOT_RUN
         area = [f"{lab}: {100 * (po[k] == L.OUTCOME_MODE1).sum() / done[k].sum():.1f}%"
                 if done[k].any() else f"{lab}: -" for k, lab in enumerate(labels)]
-        ax.text(0.98, 0.02, "mode 1 area\n" + "\n".join(area), transform=ax.transAxes,
-                ha="right", va="bottom", fontsize=7,
-                bbox={"boxstyle": "round", "fc": "white", "ec": "0.6", "alpha": 0.85})
-        ax.set_title(_panel_title(result, panel_dims, idx), fontsize=10)
-        ax.set_xlabel(axis_label(x, result.kind))
-        ax.set_ylabel(axis_label(y, result.kind))
+        _label_panel(ax, result, panel_dims, idx, x, y, area)
 
     handles = []
     if used[1]:
