@@ -678,10 +678,9 @@ def _dataset(source: Path | Any) -> xr.Dataset:
     import xarray as xr
 
     from rocksweep import fields
-    from rocksweep.accessor import register
     from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
 
-    register()  # ds.rocksweep.plot() etc.
+    register_accessor()  # ds.rocksweep.plot() etc.
     kwds = {"driver_kwds": {"locking": False}} if isinstance(source, Path) else {}
     try:
         with xr.open_dataset(source, engine="h5netcdf", **kwds) as ds:
@@ -1007,3 +1006,62 @@ def write_history_csv(runs: Sequence[Run], swept: Sequence[str], path: str | Pat
             cols = list(r.history_columns().values())
             for j in range(len(cols[0])):
                 w.writerow([i, *fixed, *(repr(float(c[j])) for c in cols)])
+
+
+# ---------------------------------------------------------------------------------------
+# ds.rocksweep: the analyses as methods of a result Dataset (as rioxarray's ``.rio``),
+# registered when ``run`` or ``open`` first imports xarray (``import rocksweep`` stays light)
+# ---------------------------------------------------------------------------------------
+
+_REGISTERED = False
+
+
+class RocksweepAccessor:
+    """``ds.rocksweep.<analysis>(...)`` is ``rocksweep.<analysis>(ds, ...)``."""
+
+    def __init__(self, ds: Any) -> None:
+        self._ds = ds
+
+    def plot(self, *args: Any, **kwargs: Any) -> Any:
+        """``rocksweep.plot(ds, ...)``: the stability diagram (categorical outcome)."""
+        return plot(self._ds, *args, **kwargs)
+
+    def boundaries(self, **kwargs: Any) -> Any:
+        """``rocksweep.boundaries(ds, ...)``: A_min as a Dataset."""
+        return boundaries(self._ds, **kwargs)
+
+    def boundary_lines(self) -> Any:
+        """``rocksweep.boundary_lines(ds)``: the class boundary polylines (DataFrame)."""
+        return boundary_lines(self._ds)
+
+    def spectra(self, **kwargs: Any) -> Any:
+        """``rocksweep.spectra(ds, ...)``: rocking and overturning spectra."""
+        return spectra(self._ds, **kwargs)
+
+    def fragility(self, **kwargs: Any) -> Any:
+        """``rocksweep.fragility(ds, ...)``: lognormal fragility curves of a suite."""
+        return fragility(self._ds, **kwargs)
+
+    def ida(self, **kwargs: Any) -> Any:
+        """``rocksweep.ida(ds, ...)``: the first overturning level of each record."""
+        return ida(self._ds, **kwargs)
+
+    def outcome_words(self) -> Any:
+        """``outcome`` as words (not_run, safe, mode1, mode2), an object DataArray."""
+        import numpy as np
+
+        from rocksweep.outcomes import OUTCOME_WORDS
+
+        o = self._ds["outcome"]
+        return o.copy(data=np.vectorize(OUTCOME_WORDS.get, otypes=[object])(o.values))
+
+
+def register_accessor() -> None:
+    """Register ``ds.rocksweep`` with xarray (once)."""
+    global _REGISTERED
+    if _REGISTERED:
+        return
+    import xarray as xr
+
+    xr.register_dataset_accessor("rocksweep")(RocksweepAccessor)
+    _REGISTERED = True

@@ -26,7 +26,7 @@ FLOORS: list[tuple[str, ...]] = [
     ("store",),
     ("analysis",),
     ("figures",),
-    ("accessor", "api", "__init__"),
+    ("api", "__init__"),
     ("cli", "__main__"),
 ]
 
