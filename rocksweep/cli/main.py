@@ -50,10 +50,3 @@ def main() -> None:
 
     Times are p*t, rotations theta/alpha_cg, energies E/E_ref.
     """
-
-
-def _register() -> None:
-    from rocksweep.cli import commands  # noqa: F401  (imports attach the commands)
-
-
-_register()
