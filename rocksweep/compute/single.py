@@ -87,9 +87,25 @@ class Run:
              if (energy or not f.energy) and (self.contact or not f.contact)}
         d["outcome"] = self.outcome
         d["status"] = self.status
+        if energy and self.history is not None:
+            E_ref = self.point.body.E_ref
+            d["impact_losses_over_Eref"] = [float(v) / E_ref for v in self.impact_losses()]
         d["accuracy"] = self.numerics.describe()
         d["wall_time_s"] = self.wall_time
         return d
+
+    def impact_losses(self) -> np.ndarray:
+        """The energy [J] each impact dissipated (eq. 6 under the run's impact law; < 0:
+        that impact gained energy), in order: float64[impacts]. From the history, where an
+        impact is the pair of rows at one time whose first rocks (phase != 0): the jump of
+        the impacts' cumulative loss across it."""
+        if self.history is None:
+            raise ValueError("this run has no history (simulate with history=True)")
+        t = np.asarray(self.history["t"])
+        phase = np.asarray(self.history["phase"])
+        lost = np.asarray(self.history["E_impact"])
+        at = np.flatnonzero((t[1:] == t[:-1]) & (phase[:-1] != 0))
+        return lost[at + 1] - lost[at]
 
     def history_columns(self) -> dict[str, np.ndarray]:
         """The time history normalised (``rocksweep.fields.HISTORY``: p_t,

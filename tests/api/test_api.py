@@ -288,7 +288,7 @@ def test_one_field_table():
     run = rocksweep.simulate(FIG5, impact__lam=0.0).run
     contact = {f.name for f in fields.CONTACT_FIELDS}  # only when the scene asks for them
     assert set(run.summary()) == ({f.name for f in fields.RUN_FIELDS} - contact) | {
-        "accuracy", "wall_time_s"}
+        "accuracy", "wall_time_s", "impact_losses_over_Eref"}  # per impact: single runs
     # "steps" is the regular RK4 steps in a sweep and in a single run alike
     sc = load_scene(FIG5, ["impact.lam=0.2"])
     g = Grid(sc)
