@@ -42,7 +42,35 @@ def load(scene_path: Path, overrides: tuple[str, ...] = ()):
     return load_scene(scene_path, list(overrides))
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+class OneLineUsageError(click.UsageError):
+    """A bad option value or a missing argument, said in one line (click's usage errors
+    print the usage and a hint first): "Error: ..." and exit code 2."""
+
+    def show(self, file=None) -> None:
+        click.echo(f"Error: {one_line(self.format_message())}", err=True, file=file)
+
+
+class OneLineCommand(click.Command):
+    def parse_args(self, ctx: click.Context, args: list[str]) -> list[str]:
+        try:
+            return super().parse_args(ctx, args)
+        except click.UsageError as err:
+            raise OneLineUsageError(err.format_message(), err.ctx) from None
+
+
+class OneLineGroup(click.Group):
+    """The group whose commands answer bad usage in one line."""
+
+    command_class = OneLineCommand
+
+    def resolve_command(self, ctx: click.Context, args: list[str]):
+        try:
+            return super().resolve_command(ctx, args)
+        except click.UsageError as err:
+            raise OneLineUsageError(err.format_message(), err.ctx) from None
+
+
+@click.group(cls=OneLineGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(rocksweep.__version__, "--version", "-V", package_name="rocksweep",
                       message="rocksweep %(version)s")
 def main() -> None:

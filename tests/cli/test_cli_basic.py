@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from click.testing import CliRunner
 
 from rocksweep.cli import main
 
@@ -164,3 +165,20 @@ def test_kernel_import_pulls_no_io_libraries():
             "print(','.join(bad))")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert proc.returncode == 0 and proc.stdout.strip() == ""
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["sweep"], "Missing argument 'SCENE.yaml'"),
+    (["sweep", "x.yaml", "--adaptive", "--margin", "1e12"], "Invalid value for '--margin'"),
+    (["plot", "x.h5", "--dpi", "5"], "Invalid value for '--dpi'"),
+    (["sweep", "x.yaml", "--bogus"], "No such option '--bogus'"),
+    (["bogus"], "No such command 'bogus'"),
+])
+def test_bad_usage_is_one_line(args, needle):
+    """Click's usage errors (a bad option value, a missing argument, an unknown option or
+    command) are one line too, exit code 2, like every other error."""
+    from helpers import one_line_error
+
+    res = CliRunner().invoke(main, args)
+    line = one_line_error(res, code=2)
+    assert line.startswith("Error: ") and needle in line
