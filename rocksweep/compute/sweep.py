@@ -47,8 +47,9 @@ MAX_CHUNK = 1024
 NO_WORKERS_TIMEOUT = 60.0
 # How often [s] the dask driver checks the cluster while no chunk finishes.
 CLUSTER_POLL = 1.0
-# Cold compile of one kernel variant [s], measured (README, Performance): 15-25 s.
-COMPILE_SECONDS = 20.0
+# Cold compile of one kernel variant [s], measured: 4.3-6.5 s CPU a variant
+# (scripts/bench_compile.py, docs/performance.md).
+COMPILE_SECONDS = 6.0
 
 
 def variables(scene: Scene) -> dict[str, tuple[str, float, str]]:
