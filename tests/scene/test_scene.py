@@ -347,3 +347,19 @@ def test_cli_reports_one_line_without_traceback(cli, tmp_path):
     lines = res.output.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in res.output
     assert lines[0].startswith(f"Error: {bad}: pulse.w_over_p = 1e-09: one point could need ")
+
+
+def test_the_key_reference_in_the_docs_is_the_schema():
+    """docs/scenes.md's table of keys is written from rocksweep.schema.KEYS (one
+    definition): a key added, removed or reworded without regenerating it fails here."""
+    import subprocess
+    import sys
+
+    root = CONFIGS.parent
+    proc = subprocess.run([sys.executable, str(root / "scripts" / "make_docs_keys.py"),
+                           "--check"], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    text = (root / "docs" / "scenes.md").read_text()
+    from rocksweep.schema import KEYS
+
+    assert all(f"| `{k}` |" in text for k in KEYS)
