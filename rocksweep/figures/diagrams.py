@@ -376,11 +376,7 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
                           shading="nearest", rasterized=True)
         if curves:
             _draw_boundaries(ax, po, xs, ys)
-        f_any = pf.any(axis=0)
-        if f_any.any():
-            any_flag = True
-            yy, xx = np.nonzero(f_any)
-            ax.plot(xs[xx], ys[yy], "x", color="k", ms=3.5, mew=0.7)
+        any_flag |= _mark_flagged(ax, pf, xs, ys)
         u_any = un[idx].any(axis=0)
         if u_any.any():
             any_unsure = True
@@ -450,6 +446,17 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
     else:
         _legend_outside(flat[-1], handles)
     return fig
+
+
+def _mark_flagged(ax: Axes, flagged: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> bool:
+    """Cross the cells flagged (undecided) at any lam or compared value (flagged[n, ny,
+    nx]); whether there was one."""
+    f_any = flagged.any(axis=0)
+    if not f_any.any():
+        return False
+    yy, xx = np.nonzero(f_any)
+    ax.plot(xs[xx], ys[yy], "x", color="k", ms=3.5, mew=0.7)
+    return True
 
 
 def _label_panel(ax: Axes, result: SweepResult, panel_dims, idx, x: str, y: str,
@@ -580,11 +587,7 @@ def compare_diagram(result: SweepResult, key: str, x: str | None = None,
         ax.pcolormesh(xs, ys, cat, cmap=cmap, norm=norm, shading="nearest", rasterized=True)
         if curves:
             _draw_boundaries(ax, po, xs, ys)
-        f_any = pf.any(axis=0)
-        if f_any.any():
-            any_flag = True
-            yy, xx = np.nonzero(f_any)
-            ax.plot(xs[xx], ys[yy], "x", color="k", ms=3.5, mew=0.7)
+        any_flag |= _mark_flagged(ax, pf, xs, ys)
         done = po != L.OUTCOME_NOT_RUN
         area = [f"{lab}: {100 * (po[k] == L.OUTCOME_MODE1).sum() / done[k].sum():.1f}%"
                 if done[k].any() else f"{lab}: -" for k, lab in enumerate(labels)]
