@@ -8,13 +8,12 @@ import json
 from pathlib import Path
 
 import click
-import numpy as np
 
 from rocksweep.cli.main import main, user_errors
 from rocksweep.cli.options import dpi_option, overwrite_option, result_argument
+from rocksweep.figures import WIDTHS
 
 CURVE_SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
-WIDTHS = ("single", "double")
 
 
 def curve_rows(frag) -> list[dict]:
@@ -73,7 +72,7 @@ def _g(v) -> str:
               help="Level of the bootstrap intervals and bands.")
 @click.option("--json", "as_json", is_flag=True,
               help="Print the curves as JSON ({\"curves\": [...]}) instead of a table.")
-@click.option("--width", type=click.Choice(WIDTHS), default="single", show_default=True,
+@click.option("--width", type=click.Choice(list(WIDTHS)), default="single", show_default=True,
               help="Figure width: a journal's single or double column.")
 @click.option("--rtol", type=click.FloatRange(1e-9, 0.5), default=None,
               help="Also refine each record's first overturning level by bisection to this "
@@ -147,6 +146,8 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
 def _print_ida(refined) -> None:
     """One line per value of the other swept keys: the records' first overturning levels
     (bisected), their median and range, resurrections."""
+    import numpy as np
+
     a = refined.attrs
     other = [d for d in refined.ida_im.dims if d != "record"]
     stacked = refined.stack(_k=other) if other else refined.expand_dims(_k=[0])

@@ -10,6 +10,9 @@ without pyplot (``matplotlib.figure.Figure``), so nothing here needs a display.
 FORMATS = (".png", ".pdf", ".svg")
 DEFAULT_DPI = 200
 DPI_RANGE = (20, 2400)
+# Figure widths for papers [inches] and the font size [pt] that keeps text legible when the
+# figure is printed at that width: a single column (~88 mm) and a double column (~180 mm).
+WIDTHS: dict[str, tuple[float, float]] = {"single": (3.5, 7.0), "double": (7.2, 8.0)}
 
 # the public modules
 __all__ = ["accuracy", "common", "diagrams", "fragility", "spectrum"]

@@ -29,7 +29,7 @@ if TYPE_CHECKING:
 
     from rocksweep.compute.single import Run
 
-from rocksweep.figures import DEFAULT_DPI, FORMATS  # noqa: E402,F401
+from rocksweep.figures import DEFAULT_DPI, FORMATS, WIDTHS  # noqa: E402,F401
 
 
 class FigureError(RocksweepError, ValueError):
@@ -70,9 +70,6 @@ def save_figure(fig: Figure, path: str | Path, dpi: int = DEFAULT_DPI, *,
     return path
 
 
-# Figure widths for papers [inches] and the font size [pt] that keeps text legible when the
-# figure is printed at that width: a single column (~88 mm) and a double column (~180 mm).
-WIDTHS: dict[str, tuple[float, float]] = {"single": (3.5, 7.0), "double": (7.2, 8.0)}
 
 
 def width_style(width: str | None) -> dict:

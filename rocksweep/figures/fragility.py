@@ -22,11 +22,13 @@ from matplotlib.figure import Figure
 
 from rocksweep.analysis.fragility import lognormal_cdf
 from rocksweep.errors import RocksweepError
+from rocksweep.figures import WIDTHS
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-WIDTHS = {"single": (3.5, 2.9), "double": (7.0, 4.2)}
+# height / width of the figure at each paper width (``rocksweep.figures.WIDTHS``)
+ASPECT = {"single": 0.83, "double": 0.6}
 _STYLES = ("-", "--", ":", "-.")
 
 
@@ -46,12 +48,14 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
 
     frag: the Dataset of ``fragility()`` (median, beta [, band_lo, band_hi over im_grid]
     [, fraction, n_counted over the stripe dimension]); width: "single" (3.5 in), "double"
-    (7 in) or (width, height) in inches.
+    (7.2 in) (``rocksweep.figures.WIDTHS``) or (width, height) in inches.
     """
     if "median" not in frag or "im_grid" not in frag.coords:
         raise FragilityFigureError("not a fragility Dataset (no 'median' or 'im_grid')")
     if ax is None:
-        size = WIDTHS.get(width) if isinstance(width, str) else tuple(width)
+        size = ((WIDTHS[width][0], WIDTHS[width][0] * ASPECT[width])
+                if isinstance(width, str) and width in WIDTHS
+                else None if isinstance(width, str) else tuple(width))
         if size is None:
             raise FragilityFigureError(f"width = {width!r}: 'single', 'double' or "
                                        "(width, height) in inches")
