@@ -450,6 +450,9 @@ def result_of(ds) -> SweepResult:
         raise StoreError(f"{where}: attribute scene_resolved is not JSON") from None
     _check_scene(stored, where)
     dims = tuple(str(d) for d in ds["outcome"].dims)
+    grid_order = tuple(k.split(".", 1)[1] for k, ax in stored["axes"].items() if ax["swept"])
+    if set(grid_order) == set(dims):  # a transposed Dataset: back in the grid's order
+        dims = grid_order
     coords = {d: np.asarray(ds[d].values) for d in dims}
     scalars = {str(k): _plain(np.asarray(v.values).reshape(()).item())
                for k, v in ds.coords.items() if k not in dims and v.ndim == 0}
@@ -547,4 +550,11 @@ def result_scene(result: SweepResult) -> Scene:
     if diffs:
         raise StoreError(f"{shown(result.path)}: its scene YAML no longer gives its grid "
                          f"({'; '.join(diffs)})")
+    grid = {a.name: len(a.values) for a in sc.swept}
+    if dict(zip(result.dims, result.shape, strict=True)) != grid:
+        have = " x ".join(f"{n} {d}" for d, n in zip(result.dims, result.shape, strict=True))
+        full = " x ".join(f"{n} {d}" for d, n in grid.items())
+        raise StoreError(f"{shown(result.path)}: holds part of its sweep's grid ({have} of "
+                         f"{full}, e.g. after .sel or .isel); this analysis reruns points of "
+                         "the whole grid: give it the whole result and select afterwards")
     return sc

@@ -204,3 +204,14 @@ def test_run_without_output_touches_no_disk(tmp_path, monkeypatch, pair):
     for name in ds.variables:
         assert ds[name].attrs.keys() == disk[name].attrs.keys(), name
     assert ds.attrs.keys() == disk.attrs.keys()
+
+
+def test_transposed_and_partial_datasets(pair):
+    """A transposed Dataset gives the same answers; a part of the grid (after .sel) is
+    refused in one line by the analyses that rerun points of the whole grid."""
+    mem, _, _ = pair
+    xr.testing.assert_identical(rocksweep.boundaries(mem),
+                                rocksweep.boundaries(mem.transpose(*mem.outcome.dims[::-1])))
+    with pytest.raises(rocksweep.RocksweepError, match="part of its sweep's grid"):
+        rocksweep.boundaries(mem.isel(lam=[0]))
+    assert isinstance(rocksweep.plot(mem.isel(lam=[0])), Figure)  # a figure of the part
