@@ -55,6 +55,14 @@ def _version() -> str:
         return f"{m.group(1)}+source" if m else "0+unknown"
 
 
-__version__ = _version()
+def __getattr__(name: str) -> str:
+    """``__version__`` on first use (importlib.metadata costs ~20 ms of every command)."""
+    if name == "__version__":
+        global __version__
+        __version__ = _version()
+        return __version__
+    raise AttributeError(f"module 'rocksweep' has no attribute {name!r}")
+
+
 __all__ = ["RocksweepError", "__version__", "boundaries", "boundary_lines", "estimate",
            "fragility", "ida", "open", "plot", "run", "simulate", "spectra"]

@@ -42,6 +42,12 @@ def load(scene_path: Path, overrides: tuple[str, ...] = ()):
     return load_scene(scene_path, list(overrides))
 
 
+def _print_version(ctx: click.Context) -> None:
+    """``rocksweep --version``: the version, read only when asked."""
+    click.echo(f"rocksweep {rocksweep.__version__}")
+    ctx.exit()
+
+
 class OneLineUsageError(click.UsageError):
     """A bad option value or a missing argument, said in one line (click's usage errors
     print the usage and a hint first): "Error: ..." and exit code 2."""
@@ -71,8 +77,9 @@ class OneLineGroup(click.Group):
 
 
 @click.group(cls=OneLineGroup, context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(rocksweep.__version__, "--version", "-V", package_name="rocksweep",
-                      message="rocksweep %(version)s")
+@click.option("--version", "-V", is_flag=True, expose_value=False, is_eager=True,
+              callback=lambda ctx, _param, value: _print_version(ctx) if value else None,
+              help="Show the version and exit.")
 def main() -> None:
     """Stability diagrams of flexible rocking oscillators (Zhu, Chatzis & Acikgoz).
 
