@@ -1,3 +1,3 @@
-from rocksweep.cli import main
+from rocksweep.cli import entry
 
-main()
+entry()

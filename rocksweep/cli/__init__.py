@@ -11,4 +11,23 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 from rocksweep.cli import commands  # noqa: E402, F401  (attaches every command)
 from rocksweep.cli.main import main  # noqa: E402
 
-__all__ = ["main"]
+
+def entry() -> None:
+    """The ``rocksweep`` command (and ``python -m rocksweep``): ``main``, then, after a
+    command that succeeded, an exit without the interpreter's teardown. Finalising numba
+    and LLVM takes ~0.15 s, a fifth of a small sweep; every file is closed and renamed into
+    place before a command returns, so nothing is left to do then. Errors and interrupts
+    exit as usual. (``main`` itself, for tests and embedding, exits as click does.)"""
+    import sys
+
+    try:
+        main()
+    except SystemExit as stop:
+        if stop.code not in (None, 0):
+            raise
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(0)
+
+
+__all__ = ["entry", "main"]

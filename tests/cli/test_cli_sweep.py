@@ -377,3 +377,25 @@ def test_sweep_on_a_dask_cluster_equals_local(ci_result, cli, tmp_path):
                                 "--chunk-size", "20"])
     assert res.exit_code == 0, res.output
     assert_same_results(out, ci_result[0])
+
+
+def test_the_command_exits_fast_and_leaves_complete_output(tmp_path):
+    """``rocksweep`` (``cli.entry``) skips the interpreter's teardown after a command that
+    succeeded: the file it wrote is complete, its printed output whole (JSON parses); a
+    failed command exits as usual with its one line."""
+    import json
+
+    import rocksweep
+
+    out = tmp_path / "fast.h5"
+    run = [sys.executable, "-m", "rocksweep"]
+    sweep = subprocess.run([*run, "sweep", str(CI_SMALL), "-o", str(out), "-q", "--set",
+                            "pulse.shape=sine"], capture_output=True, text=True, timeout=300)
+    assert sweep.returncode == 0, sweep.stderr
+    assert rocksweep.open(out).attrs["complete"] == 1
+    info = subprocess.run([*run, "info", str(out), "--json"], capture_output=True, text=True,
+                          timeout=120)
+    assert info.returncode == 0 and json.loads(info.stdout)["points_done"] == 128
+    bad = subprocess.run([*run, "info", str(tmp_path / "none.h5")], capture_output=True,
+                         text=True, timeout=120)
+    assert bad.returncode == 1 and len(bad.stderr.strip().splitlines()) == 1
