@@ -635,8 +635,6 @@ def adaptive_options(adaptive: bool, base: dict | None = None,
     None when not ``adaptive``, then any setting given is an ApiError. base: a scene's
     ``refine`` section (``Scene.refine``): it turns adaptive on, and the keyword settings
     override its values."""
-    from rocksweep.compute.adaptive import Options
-
     given = {k: v for k, v in settings.items() if v is not None}
     if base is not None:
         adaptive = True
@@ -656,6 +654,8 @@ def adaptive_options(adaptive: bool, base: dict | None = None,
         if isinstance(axes, str):
             axes = [a.strip() for a in axes.split(",")]
         given["axes"] = tuple(axes)
+    from rocksweep.compute.adaptive import Options  # an adaptive sweep's module, only then
+
     return Options(**given)
 
 
