@@ -67,7 +67,7 @@ def test_public_names_have_docstrings_and_version(cli):
 
 
 def test_importing_single_runs_keeps_the_api_functions():
-    """Importing the single-run module (rocksweep/single.py) leaves rocksweep.run and
+    """Importing the single-run module (rocksweep/compute/single.py) leaves rocksweep.run and
     rocksweep.open the API functions (a module named run.py used to replace rocksweep.run)."""
     code = ("import rocksweep\nfrom rocksweep.compute.single import simulate\n"
             "import rocksweep.compute.single\n"
