@@ -4,6 +4,7 @@ dtypes, outcome codes); every problem is a one-line ``StoreError`` naming the fi
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import json
 import math
@@ -363,6 +364,21 @@ class SweepResult:
         return rows
 
 
+@contextlib.contextmanager
+def _reading(path: Path):
+    """The result file open for reading; h5py's errors inside become one-line StoreErrors
+    (damaged file), the library's pass as they are; closed whatever happens."""
+    f = _open(path, "r")
+    try:
+        yield f
+    except RocksweepError:
+        raise
+    except _H5_ERRORS as err:
+        raise _damaged(path, _why(err)) from None
+    finally:
+        _close_quietly(f)
+
+
 def read_result(path: str | Path, names: list[str] | None = None,
                 optional: tuple[str, ...] = ()) -> SweepResult:
     """Read a result file (``names``: variables to load; default all; ``optional``:
@@ -373,8 +389,7 @@ def read_result(path: str | Path, names: list[str] | None = None,
     one-line StoreError naming the file.
     """
     path = Path(path)
-    f = _open(path, "r")
-    try:
+    with _reading(path) as f:
         lay = _layout(f, path)
         stored = lay.scene
         known = variables_for(stored)
@@ -400,12 +415,6 @@ def read_result(path: str | Path, names: list[str] | None = None,
         if "computed" in arrays:
             _check_computed(arrays["computed"], arrays.get("outcome"), path)
         attrs = _checked_attrs(f, path)
-    except RocksweepError:
-        raise
-    except _H5_ERRORS as err:
-        raise _damaged(path, _why(err)) from None
-    finally:
-        _close_quietly(f)
     return SweepResult(path, lay.dims, lay.shape, coords, scalars, arrays, attrs, stored)
 
 
@@ -413,15 +422,8 @@ def stored_scene(path: str | Path) -> dict:
     """The resolved scene a result file records (``resolved_scene``), validated as
     ``read_result`` validates it, without reading any variable."""
     path = Path(path)
-    f = _open(path, "r")
-    try:
+    with _reading(path) as f:
         return _layout(f, path).scene
-    except RocksweepError:
-        raise
-    except _H5_ERRORS as err:
-        raise _damaged(path, _why(err)) from None
-    finally:
-        _close_quietly(f)
 
 
 def peek_done(path: str | Path) -> tuple[int, int] | None:
