@@ -105,34 +105,44 @@ FILES = {"sine_1cycle.AT2": sine_record, "synthetic_nearfault.AT2": nearfault_re
 
 
 def main(argv: list[str] | None = None) -> int:
-    from rocksweep.errors import RocksweepError
-    from rocksweep.physics.records import at2_text, read_record, write_at2
-
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=RECORDS, help="directory (default records/)")
     ap.add_argument("--overwrite", action="store_true", help="replace existing files")
     ap.add_argument("--check", action="store_true",
                     help="compare the files in --out with what this script writes")
     args = ap.parse_args(argv)
+    return write_records(args.out, ((name, *make()) for name, make in FILES.items()),
+                         check=args.check, overwrite=args.overwrite,
+                         describe=lambda path, rec: (
+                             f"{path}: NPTS = {rec.npts}, DT = {rec.dt:g} s, PGA = "
+                             f"{rec.pga:.7g} g, {path.stat().st_size} bytes, sha256 "
+                             f"{rec.sha256}"))
+
+
+def write_records(out: Path, generated, *, check: bool, overwrite: bool, describe) -> int:
+    """Write each generated record (name, acc [g], DT [s], title) to ``out`` as .AT2 and
+    print ``describe(path, record read back)``; with ``check``, only say whether each file
+    equals what would be written. Returns the exit status (1: a file differs or cannot be
+    written). Shared with ``make_suite.py``."""
+    from rocksweep.errors import RocksweepError
+    from rocksweep.physics.records import at2_text, read_record, write_at2
+
     status = 0
-    for name, make in FILES.items():
-        acc, dt, title = make()
-        path = args.out / name
+    for name, acc, dt, title in generated:
+        path = out / name
         try:
-            if args.check:
+            if check:
                 same = path.is_file() and path.read_text("ascii") == at2_text(acc, dt, title)
                 print(f"{path}: {'up to date' if same else 'DIFFERS from the generator'}")
                 status |= not same
                 continue
-            write_at2(path, acc, dt, title, overwrite=args.overwrite)
+            write_at2(path, acc, dt, title, overwrite=overwrite)
             rec = read_record(path)
         except RocksweepError as err:
             print(f"Error: {err}", file=sys.stderr)
             return 1
-        print(f"{path}: NPTS = {rec.npts}, DT = {rec.dt:g} s, PGA = {rec.pga:.7g} g, "
-              f"{path.stat().st_size} bytes, sha256 {rec.sha256}")
+        print(describe(path, rec))
     return status
-
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -154,9 +154,9 @@ FILES = {f"SYN{i + 1:02d}.AT2": i for i in range(len(SCENARIOS) * REALISATIONS)}
 
 
 def main(argv: list[str] | None = None) -> int:
-    from rocksweep.errors import RocksweepError
+    from make_records import write_records  # scripts/: the .AT2 writing and --check loop
+
     from rocksweep.physics.intensity import pgv, sa
-    from rocksweep.physics.records import at2_text, read_record, write_at2
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=SUITE, help="directory (default "
@@ -165,29 +165,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--check", action="store_true",
                     help="compare the files in --out with what this script writes")
     args = ap.parse_args(argv)
-    status = 0
     if not args.check:
         args.out.mkdir(parents=True, exist_ok=True)
-    for name, index in FILES.items():
-        acc, dt, title = suite_record(index)
-        path = args.out / name
-        try:
-            if args.check:
-                same = path.is_file() and path.read_text("ascii") == at2_text(acc, dt, title)
-                print(f"{path}: {'up to date' if same else 'DIFFERS from the generator'}")
-                status |= not same
-                continue
-            write_at2(path, acc, dt, title, overwrite=args.overwrite)
-            rec = read_record(path)
-        except RocksweepError as err:
-            print(f"Error: {err}", file=sys.stderr)
-            return 1
-        s02, s10 = sa(rec.acc, rec.dt, [0.2, 1.0])
-        print(f"{path.name}: {rec.duration:5.1f} s, PGA = {rec.pga:.3f} g, PGV = "
-              f"{pgv(rec.acc, rec.dt):.3f} m/s, Sa(0.2) = {s02:.3f} g, Sa(1.0) = "
-              f"{s10:.3f} g, {path.stat().st_size} bytes")
-    return status
 
+    def describe(path, rec) -> str:
+        s02, s10 = sa(rec.acc, rec.dt, [0.2, 1.0])
+        return (f"{path.name}: {rec.duration:5.1f} s, PGA = {rec.pga:.3f} g, PGV = "
+                f"{pgv(rec.acc, rec.dt):.3f} m/s, Sa(0.2) = {s02:.3f} g, Sa(1.0) = "
+                f"{s10:.3f} g, {path.stat().st_size} bytes")
+
+    return write_records(args.out, ((name, *suite_record(i)) for name, i in FILES.items()),
+                         check=args.check, overwrite=args.overwrite, describe=describe)
 
 if __name__ == "__main__":
     sys.exit(main())
