@@ -789,16 +789,15 @@ def adaptive_compute(scene: Scene, jobs: int = 1, coarse: int | None = None,
                      ) -> tuple[dict[str, np.ndarray], AdaptiveStats]:
     """Adaptive sweep of a whole scene in memory, like ``rocksweep.compute.sweep.compute``.
 
-    Returns (arrays, stats): arrays maps every variable of ``rocksweep.compute.sweep.variables``
+    Returns (arrays, stats): arrays maps every variable of ``Scene.variables``
     plus ``computed`` (int8 flags, see COMPUTED_MEANING) to an array of the grid's shape;
     ``outcome`` is filled everywhere, the other variables hold their "not computed" fill
     value at filled points. Identical whatever ``jobs``, ``chunk_size`` and backend.
     """
-    from rocksweep.compute import sweep as sw
 
     grid = Grid(scene)
     plan = make_plan(grid, axes, coarse, margin, audit, seed, final_margin)
-    specs = sw.variables(scene)
+    specs = scene.variables()
     flat = {k: np.full(grid.size, fv, dt) for k, (dt, fv, _) in specs.items()}
 
     def evaluate(points: np.ndarray, batch: Batch) -> np.ndarray:

@@ -26,7 +26,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rocksweep import fields
+from rocksweep import (
+    fields,
+    kernel,  # lazy: numba loads at the first kernel.chunk_kernel
+)
 from rocksweep.compute.arguments import (  # noqa: F401 (re-exported)
     CONNECT_TIMEOUT,
     MAX_JOBS_PER_CORE,
@@ -35,7 +38,6 @@ from rocksweep.compute.arguments import (  # noqa: F401 (re-exported)
     probe_scheduler,
 )
 from rocksweep.compute.grid import ChunkRows, Grid
-from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.points import with_record
 from rocksweep.scene.model import Scene
@@ -52,12 +54,6 @@ CLUSTER_POLL = 1.0
 COMPILE_SECONDS = 6.0
 
 
-def variables(scene: Scene) -> dict[str, tuple[str, float, str]]:
-    """The per-point variables a sweep of this scene stores (``fields.variables`` of the
-    scene's outputs)."""
-    return fields.variables(scene.energy, scene.contact, scene.check)
-
-
 def level(scene: Scene) -> int:
     """Bookkeeping level of the kernel a sweep of this scene runs (the contact variants
     account energy too: one variant per kind serves contact with and without energy)."""
@@ -70,7 +66,7 @@ def level(scene: Scene) -> int:
 class ChunkResult:
     """Results of the points ``start <= i < stop`` (flat indices).
 
-    arrays: name -> array[stop - start] (see ``VARIABLES``); seconds: wall time of the
+    arrays: name -> array[stop - start] (``Scene.variables``); seconds: wall time of the
     chunk in its worker; cpu_seconds: CPU time of the worker thread that ran it.
     """
 
@@ -110,18 +106,18 @@ def run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene) -> np.nd
     outs = np.empty((rows.shape[0], L.N_OUT))
     for kind in np.unique(cr.kinds):
         sel = cr.kinds == kind
-        kernel = chunk_kernel(int(kind), level, scene.ground)
+        kernel_fn = kernel.chunk_kernel(int(kind), level, scene.ground)
         if scene.suite is not None:  # one record at a time, its samples shared
             for r in np.unique(cr.record_index[sel]):
-                _run_record(kernel, rows, sel & (cr.record_index == r), outs,
+                _run_record(kernel_fn, rows, sel & (cr.record_index == r), outs,
                             scene.suite.records[int(r)])
         elif scene.record is not None:
-            _run_record(kernel, rows, sel, outs, scene.record)
+            _run_record(kernel_fn, rows, sel, outs, scene.record)
         elif sel.all():
-            kernel(rows, outs)
+            kernel_fn(rows, outs)
         else:
             part = np.empty((int(sel.sum()), L.N_OUT))
-            kernel(np.ascontiguousarray(rows[sel]), part)
+            kernel_fn(np.ascontiguousarray(rows[sel]), part)
             outs[sel] = part
     return outs
 
@@ -193,7 +189,7 @@ def prepare(grid: Grid, level: int) -> None:
     any worker starts: worker threads share the compiled code, and dask workers load
     numba's cache instead of compiling concurrently."""
     for kind in grid.kinds():
-        warm_up(kind, level, grid.scene.ground)
+        kernel.warm_up(kind, level, grid.scene.ground)
 
 
 def _in_cache(dispatcher) -> bool | None:
@@ -212,7 +208,8 @@ def _in_cache(dispatcher) -> bool | None:
 def kernel_cache_state(grid: Grid, level: int) -> tuple[int, int]:
     """(variants to compile, variants of unknown state) among those ``prepare`` needs:
     what a sweep says before the kernel is compiled or loaded."""
-    states = [_in_cache(chunk_kernel(kind, level, grid.scene.ground)) for kind in grid.kinds()]
+    states = [_in_cache(kernel.chunk_kernel(kind, level, grid.scene.ground))
+              for kind in grid.kinds()]
     return sum(s is False for s in states), sum(s is None for s in states)
 
 
@@ -343,7 +340,7 @@ def compute(scene: Scene, jobs: int = 1, chunk_size: int | None = None,
     """
     grid = Grid(scene)
     lvl = level(scene)
-    specs = variables(scene)
+    specs = scene.variables()
     flat = {k: np.full(grid.size, fill, dtype) for k, (dtype, fill, _) in specs.items()}
     n_workers = check_jobs(jobs) if backend == "threads" else 1
     size = chunk_size or auto_chunk_size(grid.size, n_workers)

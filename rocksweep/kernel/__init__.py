@@ -15,7 +15,8 @@ effect set; ``warm_up`` compiles one now. One idea per module:
 - ``variants``: the compiled entry points and their tables;
 - ``_static``: calls that a variant's flags make dead, left out while typing;
 - ``_cache``: where numba caches them, stamped by the hash of these sources (imported
-  by every module that defines a jitted function, before its first ``@njit(cache=True)``).
+  by every module that defines a jitted function, before its first ``@njit(cache=True)``),
+  and how an entry point loads from it (``EntryCache``: no refresh of numba's registries).
 
 The package is lazy (PEP 562): ``from rocksweep.kernel import layout`` loads no numba;
 the entry points load the variants (and numba) on first access.

@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from rocksweep import fields
 from rocksweep.errors import RocksweepError
 from rocksweep.numerics import Numerics
 from rocksweep.physics.model import BlockBody, Body, FlexibleBody
@@ -54,6 +55,11 @@ class Scene:
     # a suite scene (``ground.records``): the records, their IMs and the scaling (the
     # grid's axes then hold ``record`` (file names), the stripe IM if scaled, and p)
     suite: Suite | None = field(default=None, repr=False)
+
+    def variables(self) -> dict[str, tuple[str, float, str]]:
+        """The per-point variables a sweep of this scene stores, name -> (dtype, fill value
+        of a point not computed, meaning): ``fields.variables`` of its outputs."""
+        return fields.variables(self.energy, self.contact, self.check)
 
     @property
     def freq_axis(self) -> str:

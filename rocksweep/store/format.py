@@ -49,7 +49,6 @@ import numpy as np
 
 from rocksweep import fields
 from rocksweep.compute.grid import Grid
-from rocksweep.compute.sweep import variables
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
 from rocksweep.scene.model import Scene
@@ -166,7 +165,7 @@ def file_bytes(scene: Scene, adaptive: bool = False) -> int:
     file is made): every variable's dtype size x grid points, plus the coordinates;
     adaptive: with the ``computed`` flags."""
     grid = Grid(scene)
-    per_point = sum(np.dtype(dt).itemsize for dt, _, _ in variables(scene).values())
+    per_point = sum(np.dtype(dt).itemsize for dt, _, _ in scene.variables().values())
     per_point += adaptive
     coords = sum(16 * len(a.values) for a in scene.axes)
     su = scene.suite
@@ -251,7 +250,7 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
         _coord_attrs(ds, axis, scene.kind)
         scalars.append(axis.name)
 
-    specs = dict(variables(scene))
+    specs = dict(scene.variables())
     if adaptive is not None:
         specs["computed"] = COMPUTED_VARIABLE
     for name, (dtype, fill, text) in specs.items():

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rocksweep.compute.grid import Grid
-from rocksweep.compute.sweep import ChunkResult, variables
+from rocksweep.compute.sweep import ChunkResult
 from rocksweep.errors import OutputError, RocksweepError
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outputs import check_output, shown
@@ -120,7 +120,7 @@ class SweepFile:
         self.path = path
         self.f = f
         self.grid = Grid(scene)
-        self.names = list(variables(scene))
+        self.names = list(scene.variables())
         self.adaptive = adaptive  # resolved adaptive settings, None: every point
         self.session_start = _now()
         self.backend = backend or "unspecified"

@@ -278,7 +278,7 @@ def test_one_field_table():
     assert plain["outcome"][1] == L.OUTCOME_NOT_RUN
     # a stored variable's unit in the file is the field's (the error estimates included)
     sc = load_scene(CI_SMALL, ["outputs.check=true", "pulse.shape=sine", "impact.lam=0.0"])
-    assert list(sw.variables(sc)) == list(fields.variables(check=True))
+    assert list(sc.variables()) == list(fields.variables(check=True))
     assert fields.UNITS["work_in_over_Eref"] == "E_ref"
     slots = [f.slot for f in fields.RUN_FIELDS]
     assert len(set(slots)) == len(slots)  # no kernel slot read twice in a run's row

@@ -16,7 +16,7 @@ import rocksweep
 import rocksweep.compute.adaptive as ad
 from rocksweep import api
 from rocksweep.cli import main
-from rocksweep.compute.sweep import level, prepare, variables
+from rocksweep.compute.sweep import level, prepare
 from rocksweep.scene.parse import parse_scene
 from rocksweep.store.reader import read_result
 
@@ -78,7 +78,7 @@ def test_adaptive_file_equals_full_sweep_on_a_known_boundary(cli, tmp_path):
     np.testing.assert_array_equal(a.arrays["outcome"], f.arrays["outcome"])
     c = a.arrays["computed"] > 0
     assert 0 < c.sum() < 0.6 * c.size
-    for name, (_, fill, _) in variables(parse_scene(BLOCK_LONG)).items():
+    for name, (_, fill, _) in parse_scene(BLOCK_LONG).variables().items():
         np.testing.assert_array_equal(a.arrays[name][c], f.arrays[name][c], err_msg=name)
         if name != "outcome":  # filled points keep the "not computed" values
             np.testing.assert_array_equal(a.arrays[name][~c], np.full((~c).sum(), fill),

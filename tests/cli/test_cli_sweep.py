@@ -16,7 +16,7 @@ from bodies import FIG3_YAML
 from helpers import kill_sweep_when, one_line_error
 
 from rocksweep.cli import main
-from rocksweep.compute.sweep import ChunkResult, variables
+from rocksweep.compute.sweep import ChunkResult
 from rocksweep.numerics import PRESETS
 from rocksweep.store.reader import read_result
 from rocksweep.store.writer import SweepFile
@@ -229,7 +229,7 @@ def test_info_counts_per_swept_key_in_ranges(cli, tmp_path):
     sf = SweepFile.create(out, sc)
     n = sf.grid.size
     assert n == 606
-    arrays = {k: np.full(n, 0, dtype) for k, (dtype, _, _) in variables(sc).items()}
+    arrays = {k: np.full(n, 0, dtype) for k, (dtype, _, _) in sc.variables().items()}
     outcome = np.arange(n) % 3  # flat order: lam, A_ratio, w_over_p (w fastest)
     arrays["outcome"][:] = outcome
     sf.write(ChunkResult(0, n - 6, {k: v[:n - 6] for k, v in arrays.items()}, 0.0))
@@ -269,7 +269,7 @@ def test_plot_block_scene_with_panels_and_partial_file(cli, tmp_path):
     out = tmp_path / "block.h5"
     sf = SweepFile.create(out, sc)
     n = sf.grid.size // 2
-    arrays = {k: np.full(n, 0, dtype) for k, (dtype, _, _) in variables(sc).items()}
+    arrays = {k: np.full(n, 0, dtype) for k, (dtype, _, _) in sc.variables().items()}
     arrays["outcome"][:] = np.arange(n) % 3
     sf.write(ChunkResult(0, n, arrays, 0.0))
     sf.close()

@@ -56,7 +56,7 @@ def test_block_long_pulse_equals_full_grid(block_long):
     assert st.computed < 0.5 * st.points
     c = arr["computed"] > 0
     # computed points hold the kernel's results, filled ones the "not computed" values
-    for k, (_, fv, _) in sw.variables(sc).items():
+    for k, (_, fv, _) in sc.variables().items():
         np.testing.assert_array_equal(arr[k][c], full[k][c], err_msg=k)
         if k != "outcome":
             np.testing.assert_array_equal(arr[k][~c], np.full((~c).sum(), fv), err_msg=k)

@@ -108,7 +108,7 @@ def test_estimate_tracks_the_error_against_the_reference(case, preset):
 def test_scene_without_check_stores_and_runs_nothing_more():
     scene = parse_scene(SCENE)
     assert not scene.check
-    assert not set(CHECK_NAMES) & set(sw.variables(scene))
+    assert not set(CHECK_NAMES) & set(scene.variables())
     calls = []
     grid = sw.Grid(scene)
     orig = sw.run_rows

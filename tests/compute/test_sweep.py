@@ -141,7 +141,7 @@ def test_each_point_goes_to_its_kernel_variant(monkeypatch):
             outs[:, L.OUT_OUTCOME] = kind  # mark which variant computed the point
         return run
 
-    monkeypatch.setattr(sw, "chunk_kernel", fake_kernel)
+    monkeypatch.setattr(sw.kernel, "chunk_kernel", fake_kernel)
     sc = parse_scene("body: {wn_over_p: [2.43, .inf], zeta: [0.0, 0.05], alpha_cg: 0.15, "
                      "alpha_A: 0.28, mA_over_m: 0.47, IA_ratio: 0.56}\nimpact: {lam: 0.2}\n"
                      "pulse: {shape: sine, w_over_p: [1.0, 2.0], A_ratio: 3.0}\n")

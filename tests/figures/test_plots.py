@@ -14,7 +14,7 @@ from matplotlib.colors import to_rgb
 from matplotlib.figure import Figure
 
 from rocksweep.cli import main
-from rocksweep.compute.sweep import ChunkResult, variables
+from rocksweep.compute.sweep import ChunkResult
 from rocksweep.errors import RocksweepError
 from rocksweep.store.reader import read_result
 from rocksweep.store.writer import SweepFile
@@ -72,7 +72,7 @@ def synthetic_result(tmp_path: Path) -> Path:
     out = tmp_path / "block.h5"
     sf = SweepFile.create(out, sc)
     n = sf.grid.size
-    arrays = {k: np.full(n, 0, dtype) for k, (dtype, _, _) in variables(sc).items()}
+    arrays = {k: np.full(n, 0, dtype) for k, (dtype, _, _) in sc.variables().items()}
     arrays["outcome"][:] = np.arange(n) % 3
     sf.write(ChunkResult(0, n, arrays, 0.0))
     sf.close()
@@ -197,7 +197,7 @@ def test_title_says_the_pulse_shape_once(tmp_path):
                      "pulse: {shape: sine, w_over_p: [1.0, 2.0, 3.0], A_ratio: [1.0, 2.0]}\n")
     out = tmp_path / "x.h5"
     sf = SweepFile.create(out, sc)
-    arrays = {k: np.full(sf.grid.size, 0, dtype) for k, (dtype, _, _) in variables(sc).items()}
+    arrays = {k: np.full(sf.grid.size, 0, dtype) for k, (dtype, _, _) in sc.variables().items()}
     sf.write(ChunkResult(0, sf.grid.size, arrays, 0.0))
     sf.close()
     fig = stability_diagram(read_result(out))
@@ -351,7 +351,7 @@ def test_check_files_ring_the_points_whose_outcome_changes(tmp_path):
         out = tmp_path / f"c{check}.h5"
         sf = SweepFile.create(out, sc)
         arrays = {k: np.full(sf.grid.size, 0, dtype)
-                  for k, (dtype, _, _) in variables(sc).items()}
+                  for k, (dtype, _, _) in sc.variables().items()}
         if check:  # grid order (lam, A_ratio, w_over_p): flip two points
             arrays["check_outcome"][[1, 6 + 5]] = 1  # lam 0 (A 1, w 2); lam 0.2 (A 2, w 3)
         sf.write(ChunkResult(0, sf.grid.size, arrays, 0.0))

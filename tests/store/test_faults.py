@@ -33,7 +33,7 @@ from helpers import one_line_error
 
 from rocksweep.cli import main
 from rocksweep.compute.grid import Grid
-from rocksweep.compute.sweep import ChunkResult, level, prepare, variables
+from rocksweep.compute.sweep import ChunkResult, level, prepare
 from rocksweep.scene.parse import load_scene, parse_scene
 from rocksweep.store import StoreError
 from rocksweep.store._common import _plain
@@ -61,7 +61,7 @@ def fake_chunk(scene, a: int, b: int) -> ChunkResult:
     """Values that encode the flat index, so misplaced or lost writes show."""
     i = np.arange(a, b)
     arrays = {}
-    for name, (dtype, _, _) in variables(scene).items():
+    for name, (dtype, _, _) in scene.variables().items():
         arrays[name] = ((i % 3) if name == "outcome" else i * 7 + len(name)).astype(dtype)
     return ChunkResult(a, b, arrays, 0.0)
 
@@ -470,11 +470,11 @@ def test_read_only_directory_really_read_only(tmp_path):
 # fake_chunk for the scripts of other processes (they import rocksweep only)
 FAKE_CHUNK = """
 import numpy as np
-from rocksweep.compute.sweep import ChunkResult, variables
+from rocksweep.compute.sweep import ChunkResult
 def fake_chunk(scene, a, b):
     i = np.arange(a, b)
     return ChunkResult(a, b, {n: ((i % 3) if n == "outcome" else i * 7 + len(n)).astype(d)
-                              for n, (d, _, _) in variables(scene).items()}, 0.0)
+                              for n, (d, _, _) in scene.variables().items()}, 0.0)
 """
 
 HOLDER = FAKE_CHUNK + """

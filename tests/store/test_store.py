@@ -11,7 +11,7 @@ import pytest
 
 import rocksweep.store.writer as writer
 from rocksweep.compute.grid import Grid
-from rocksweep.compute.sweep import ChunkResult, plan_chunks, variables
+from rocksweep.compute.sweep import ChunkResult, plan_chunks
 from rocksweep.scene.parse import parse_scene
 from rocksweep.store import StoreError
 from rocksweep.store.format import FORMAT_VERSION, flat_slabs
@@ -32,7 +32,7 @@ def fake_chunk(scene, a: int, b: int) -> ChunkResult:
     """Values that encode the flat index, so misplaced writes show."""
     i = np.arange(a, b)
     arrays = {}
-    for name, (dtype, _, _) in variables(scene).items():
+    for name, (dtype, _, _) in scene.variables().items():
         if name == "outcome":
             arrays[name] = (i % 3).astype(dtype)
         elif name == "t_overturn":
@@ -82,7 +82,7 @@ def test_roundtrip_with_chunks_in_any_order(tmp_path, scene):
     r = read_result(path)
     assert r.dims == ("shape", "lam", "A_ratio", "w_over_p")
     assert r.shape == (2, 3, 4, 5)
-    for name in variables(scene):
+    for name in scene.variables():
         np.testing.assert_array_equal(r.arrays[name], expected(scene, name), err_msg=name)
     assert r.attrs["scene"] == TEXT  # verbatim, comment included
     assert r.attrs["format_version"] == FORMAT_VERSION
@@ -133,7 +133,7 @@ def test_unfinished_file_marks_missing_points(tmp_path, scene):
     sf.finish(0.1, 0.0)
     sf.close()
     r = read_result(path)
-    for name in variables(scene):
+    for name in scene.variables():
         np.testing.assert_array_equal(r.arrays[name], expected(scene, name), err_msg=name)
     assert r.attrs["sessions"] == 2
 
@@ -267,7 +267,7 @@ def test_cf_attributes_survive_netcdf_readers(tmp_path, scene):
             assert ds[name].attrs["units"] == unit, name
             assert ds[name].attrs["long_name"], name
         assert "units" not in ds["shape"].attrs
-        for name in variables(scene):
+        for name in scene.variables():
             v = ds[name].attrs
             assert v["long_name"], name
             if name in ("outcome", "status"):  # flag variables: codes, no units
