@@ -15,7 +15,7 @@ cannot be made or written, the kernel's own ``__pycache__`` (same stamp). Import
 ``rocksweep.kernel``, before any ``@njit(cache=True)`` runs.
 
 The entry points load from it without refreshing numba's target context first
-(``EntryCache``): a warm ``rocksweep sweep`` starts in ~0.33 s, not ~0.5 s.
+(``EntryCache``; its price in start-up is measured in docs/performance.md).
 """
 
 from __future__ import annotations
@@ -125,7 +125,7 @@ class EntryCache(caching.FunctionCache):
     numba's ``Cache.load_overload`` first refreshes the CPU target context: it imports
     and registers every implementation numba has (``numba.np.arraymath``, which imports
     ``scipy.linalg`` to look for BLAS, the typed containers, the random generators, ...),
-    0.23 s of a 0.5 s ``rocksweep sweep`` start-up, none of it used: rebuilding cached
+    about half of a warm ``rocksweep sweep``'s start-up, none of it used: rebuilding cached
     machine code (``CompileResult._rebuild``) types and lowers nothing. It needs the
     context's code generator, the C helpers and math symbols that the context installs
     when it is made, and NRT's symbols (the array arguments' unboxing), installed here.
@@ -134,9 +134,13 @@ class EntryCache(caching.FunctionCache):
     """
 
     def load_overload(self, sig, target_context):
+        try:
+            guard, load = self._guard_against_spurious_io_errors, self._load_overload
+        except AttributeError:  # a numba whose cache is built otherwise: its own load
+            return super().load_overload(sig, target_context)
         rtsys.initialize(target_context)
-        with self._guard_against_spurious_io_errors():
-            return self._load_overload(sig, target_context)
+        with guard():
+            return load(sig, target_context)
 
 
 def loads_fast(dispatcher):
