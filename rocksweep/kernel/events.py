@@ -39,7 +39,7 @@ from rocksweep.kernel.layout import (
     Y_U,
     Y_U_DOT,
 )
-from rocksweep.kernel.stepping import rk4_step
+from rocksweep.kernel.stepping import rk4_from
 
 EV_NONE = 0
 EV_IMPACT = 1
@@ -162,7 +162,7 @@ def hermite_root(g0, d0, g1, d1, h, xtol):
 
 
 @njit(cache=True, **INTERNAL)
-def _locate(ev, t0, y0, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, ENERGY):
+def _locate(ev, t0, y0, k1, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, ENERGY):
     """Shrink a bracket [lo, hi] (g(lo) >= 0 >= g(hi); lo = 0, y(lo) = y0) of event ``ev``
     to PAR_TOL.
 
@@ -209,7 +209,7 @@ def _locate(ev, t0, y0, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, ENER
                 mid = 0.5 * (lo + hi)
         else:
             mid = 0.5 * (lo + hi)
-        y_mid = rk4_step(t0, y0, mid, s, on, prm, FLEX, DAMPED, ENERGY)
+        y_mid = rk4_from(t0, y0, mid, k1, s, on, prm, FLEX, DAMPED, ENERGY)
         g_mid = event_value(ev, t0 + mid, y_mid, s, on, prm, FLEX, DAMPED)
         d_mid = event_rate(ev, t0 + mid, y_mid, s, on, prm, FLEX, DAMPED) if hermite else 0.0
         n += 1
@@ -228,7 +228,7 @@ def _locate(ev, t0, y0, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, ENER
 
 
 @njit(cache=True, **INLINE)
-def _crossing(ev, t0, y0, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
+def _crossing(ev, t0, y0, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
     """Did event ``ev`` fire in the step (t0, y0) -> (t0 + h, y1)?
 
     Returns (tau, y_event, re-integrations); tau < 0 if it did not. A sign change at the
@@ -244,7 +244,7 @@ def _crossing(ev, t0, y0, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
     if g1 <= 0.0:
         # g0 = 0 happens right after an action put the state on g = 0 (uplift leaves
         # theta = 0): if the motion turns straight back, that is an event just after t0.
-        return _locate(ev, t0, y0, 0.0, g0, h, g1, y1, s, on, prm, FLEX, DAMPED, ENERGY)
+        return _locate(ev, t0, y0, k1, 0.0, g0, h, g1, y1, s, on, prm, FLEX, DAMPED, ENERGY)
     if g0 <= 0.0:
         return -1.0, y1, 0  # leaving g = 0 after an action: not an event
     d0 = event_rate(ev, t0, y0, s, on, prm, FLEX, DAMPED)
@@ -256,11 +256,11 @@ def _crossing(ev, t0, y0, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
     tau, g_min = hermite_min(g0, d0, g1, d1, h)
     if g_min > min(g0, g1) - g_min:
         return -1.0, y1, 0  # far from zero compared with the dip: the cubic is good enough
-    return _dip(ev, t0, y0, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERGY)
+    return _dip(ev, t0, y0, k1, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERGY)
 
 
 @njit(cache=True, **INTERNAL)
-def _dip(ev, t0, y0, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERGY):
+def _dip(ev, t0, y0, k1, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERGY):
     """A dip of g (g0 > 0, g(h) > 0, d0 < 0 < d1) whose cubic minimum (at tau) is near zero.
 
     The cubic is only an estimate: the minimum of the integrator's own solution (fresh RK4
@@ -278,11 +278,11 @@ def _dip(ev, t0, y0, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERGY):
     side = 0
     n = 0
     while True:
-        y_m = rk4_step(t0, y0, tau, s, on, prm, FLEX, DAMPED, ENERGY)
+        y_m = rk4_from(t0, y0, tau, k1, s, on, prm, FLEX, DAMPED, ENERGY)
         g_m = event_value(ev, t0 + tau, y_m, s, on, prm, FLEX, DAMPED)
         n += 1
         if g_m <= 0.0:
-            tau, y_e, k = _locate(ev, t0, y0, 0.0, g0, tau, g_m, y_m, s, on, prm, FLEX,
+            tau, y_e, k = _locate(ev, t0, y0, k1, 0.0, g0, tau, g_m, y_m, s, on, prm, FLEX,
                                   DAMPED, ENERGY)
             return tau, y_e, n + k
         d_m = event_rate(ev, t0 + tau, y_m, s, on, prm, FLEX, DAMPED)
@@ -305,7 +305,7 @@ def _dip(ev, t0, y0, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERGY):
 
 
 @njit(cache=True, **INLINE)
-def _first_event(t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
+def _first_event(t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
     """The first event in the step (t, y) -> (t + h, y1) of phase s.
 
     Returns (event code, tau, state at the event, re-integrations); EV_NONE and y1 if none.
@@ -320,10 +320,10 @@ def _first_event(t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
         ev_a, ev_b = EV_IMPACT, EV_OVERTURN
     else:
         ev_a, ev_b = EV_UPLIFT_POS, EV_UPLIFT_NEG
-    tau, y_ev, n = _crossing(ev_a, t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
+    tau, y_ev, n = _crossing(ev_a, t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
     if s != 0 and tau >= 0.0:
         return ev_a, tau, y_ev, n  # the impact ends the phase before any overturning
-    tau2, y_ev2, n2 = _crossing(ev_b, t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
+    tau2, y_ev2, n2 = _crossing(ev_b, t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
     if tau2 >= 0.0 and (tau < 0.0 or tau2 < tau):
         return ev_b, tau2, y_ev2, n + n2
     if tau >= 0.0:

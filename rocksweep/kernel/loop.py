@@ -114,7 +114,7 @@ from rocksweep.kernel.layout import (
     Y_U_DOT,
     Y_W_IN,
 )
-from rocksweep.kernel.stepping import rk4_step
+from rocksweep.kernel.stepping import first_stage, rk4_from
 from rocksweep.kernel.transitions import impact_map, rest_proven, rigid_bounded, uplift_side
 
 # the outcome-only variants do not compile the energy (``_static``)
@@ -222,7 +222,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             h_rot = _rotation_step(y[Y_THETA_DOT], acc, rot)
             if h_rot < h:
                 h, lands = h_rot, False
-        y1 = rk4_step(t, y, h, s, on, prm, FLEX, DAMPED, ENERGY)
+        k1 = first_stage(t, y, s, on, prm, FLEX, DAMPED, ENERGY)  # shared by every step from y
+        y1 = rk4_from(t, y, h, k1, s, on, prm, FLEX, DAMPED, ENERGY)
         steps += 1
         if s != 0 and rot > 0.0:
             # theta'' was not known before the step (after an uplift, or a pulse's rise):
@@ -231,14 +232,14 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             turn = abs(y1[Y_THETA] - y[Y_THETA])
             while turn > 2.0 * rot:
                 h, lands = h * max(0.25, 0.9 * math.sqrt(rot / turn)), False
-                y1 = rk4_step(t, y, h, s, on, prm, FLEX, DAMPED, ENERGY)
+                y1 = rk4_from(t, y, h, k1, s, on, prm, FLEX, DAMPED, ENERGY)
                 steps += 1
                 turn = abs(y1[Y_THETA] - y[Y_THETA])
             acc = abs(y1[Y_THETA_DOT] - y[Y_THETA_DOT]) / h
         if not _finite(y1):
             _flag(out, STATUS_NONFINITE)
             break
-        ev, tau, y_ev, n = _first_event(t, y, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
+        ev, tau, y_ev, n = _first_event(t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
         event_steps += n
         if s != 0:
             theta_max = _theta_max(y, y_ev, tau, s, theta_max)  # (y_ev, tau) = (y1, h) if none

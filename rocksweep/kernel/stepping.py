@@ -49,18 +49,28 @@ def _axpy(y, a, k):
 
 
 @njit(cache=True, **INLINE)
-def rk4_step(t, y, h, s, on, prm, FLEX, DAMPED, ENERGY):
-    """One classical RK4 step of size h [s] from (t, y) in phase s. Returns the new 6-tuple."""
-    # The four stages share one call site of the inlined right-hand side (numba types and
-    # lowers it once, LLVM unrolls the loop): 1/4 of the compile time of four call sites.
+def first_stage(t, y, s, on, prm, FLEX, DAMPED, ENERGY):
+    """k1 = dy/dt at (t, y): the first stage of every RK4 step from (t, y), whatever its
+    length. A step and the trial steps that locate an event in it (``events``), or the
+    shorter retries of the rotation limit (``loop``), all start from the same (t, y):
+    they share one k1 (``rk4_from``), bit for bit what each computed (the same inputs:
+    t + 0 and y + 0 k, as the other stages form theirs)."""
     zero = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-    k = k1 = k23 = zero
-    for stage in range(4):
-        c = 0.0 if stage == 0 else (h if stage == 3 else 0.5 * h)
+    return derivatives(t + 0.0, _axpy(y, 0.0, zero), s, on, prm, FLEX, DAMPED, ENERGY)
+
+
+@njit(cache=True, **INLINE)
+def rk4_from(t, y, h, k1, s, on, prm, FLEX, DAMPED, ENERGY):
+    """One classical RK4 step of size h [s] from (t, y) in phase s whose first stage k1
+    (``first_stage``) is known. Returns the new 6-tuple."""
+    # The three stages share one call site of the inlined right-hand side (numba types and
+    # lowers it once, LLVM unrolls the loop): fewer call sites, less compile time.
+    k = k1
+    k23 = k1
+    for stage in range(1, 4):
+        c = h if stage == 3 else 0.5 * h
         k = derivatives(t + c, _axpy(y, c, k), s, on, prm, FLEX, DAMPED, ENERGY)
-        if stage == 0:
-            k1 = k
-        elif stage == 1:
+        if stage == 1:
             k23 = k
         elif stage == 2:
             k23 = _axpy(k23, 1.0, k)  # k2 + k3
@@ -71,3 +81,10 @@ def rk4_step(t, y, h, s, on, prm, FLEX, DAMPED, ENERGY):
             y[3] + w * (k1[3] + 2.0 * k23[3] + k[3]),
             y[4] + w * (k1[4] + 2.0 * k23[4] + k[4]),
             y[5] + w * (k1[5] + 2.0 * k23[5] + k[5]))
+
+
+@njit(cache=True, **INLINE)
+def rk4_step(t, y, h, s, on, prm, FLEX, DAMPED, ENERGY):
+    """One classical RK4 step of size h [s] from (t, y) in phase s. Returns the new 6-tuple."""
+    return rk4_from(t, y, h, first_stage(t, y, s, on, prm, FLEX, DAMPED, ENERGY), s, on, prm,
+                    FLEX, DAMPED, ENERGY)

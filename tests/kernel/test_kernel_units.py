@@ -29,7 +29,7 @@ from rocksweep.kernel.events import (
     hermite_min,
     hermite_root,
 )
-from rocksweep.kernel.stepping import rk4_step
+from rocksweep.kernel.stepping import first_stage, rk4_step
 from rocksweep.physics.model import FlexibleBody
 from rocksweep.physics.points import body_omega_rock
 
@@ -124,7 +124,9 @@ def _locate_in_step(ev, t0, y0, h, s, on, prm):
     y1 = rk4_step(t0, y0, h, s, on, prm, False, False, False)
     g0 = event_value(ev, t0, y0, s, on, prm, False, False)
     g1 = event_value(ev, t0 + h, y1, s, on, prm, False, False)
-    tau, y_tau, n = _locate(ev, t0, y0, 0.0, g0, h, g1, y1, s, on, prm, False, False, False)
+    k1 = first_stage(t0, y0, s, on, prm, False, False, False)
+    tau, y_tau, n = _locate(ev, t0, y0, k1, 0.0, g0, h, g1, y1, s, on, prm, False, False,
+                            False)
     g_tau = event_value(ev, t0 + tau, y_tau, s, on, prm, False, False)
     y_before = rk4_step(t0, y0, tau - prm[L.PAR_TOL], s, on, prm, False, False, False)
     g_before = event_value(ev, t0 + tau - prm[L.PAR_TOL], y_before, s, on, prm, False, False)
