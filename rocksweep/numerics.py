@@ -13,10 +13,10 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 
 # Event root finders (``rocksweep.kernel.events._locate``); each keeps the bracket and
-# stops at event_tol. Hermite (the default) takes 2-4 RK4 re-integrations per event where
-# bisection takes log2(step/event_tol) ~ 20, with bisection steps as its safeguard; on the
-# four figures' accuracy samples all three give the same outcomes at every preset
-# (`rocksweep accuracy configs/fig3a.yaml --points 1000 --ladder roots`).
+# stops at event_tol. Hermite (the default) takes 2-5 RK4 re-integrations per event (3.8
+# on Figure 3(a)) where bisection takes log2(step/event_tol) ~ 20, with bisection steps as
+# its safeguard; on the four figures' accuracy samples all three give the same outcomes at
+# every preset (`rocksweep accuracy configs/fig3a.yaml --points 1000 --ladder roots`).
 ROOTS = ("bisection", "illinois", "hermite")
 
 # name -> (steps_per_period, event_tol). Measured with `rocksweep accuracy FIG.yaml
@@ -69,7 +69,7 @@ PRESET_ROTATION: dict[str, float] = {
 MIN_EVENT_TOL = 1e-12
 
 # RK4 evaluations the kernel may spend locating one event before a run is capped
-# (``step_budget``): bisection takes log2(step/event_tol) ~ 20-40, Hermite 2-4.
+# (``step_budget``): bisection takes log2(step/event_tol) ~ 20-40, Hermite 2-5.
 EVENT_STEP_ALLOWANCE = 200.0
 
 # Cap on one point's step budget (``step_budget``, PAR_MAXSTEPS) that a scene may imply.

@@ -56,6 +56,14 @@ NEWTON_MAX_ITER = 16
 # hermite_root stops when a Newton step is below this fraction of the event tolerance:
 # _locate puts the trial at least tol/2 inside the bracket anyway, so finer buys nothing.
 NEWTON_XTOL = 0.05
+# _locate (Hermite): a trial after the first goes this fraction of the tolerance past the
+# cubic's root, away from the end the last trial moved. The root estimates converge fast
+# but approach from one side (the cubic's error keeps its sign), so the trials at the
+# estimates themselves kept landing on the same side; a trial just past the root brackets
+# it from the other side, and the next one, past it the other way, closes the bracket at
+# 2 x 0.45 < 1 tolerance. Figure 3(a): 4.24 -> 3.78 trials per event (its impacts come in
+# chattering runs); no sweep point of the shipped scenes changes outcome.
+HERMITE_PAST = 0.45
 # _dip: Illinois on g' converges superlinearly (a few trials); this bounds a pathological g.
 DIP_MAX_TRIALS = 50
 
@@ -173,9 +181,11 @@ def _locate(ev, t0, y0, k1, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, 
     - Illinois regula falsi: keeps the bracket, converges superlinearly;
     - Hermite: each trial is the root of the cubic Hermite interpolant of g over the
       bracket (g and its rate at both ends: the rate comes with the state, theta' or
-      dQ/dt), put at least tol/2 inside the bracket, so that a trial next to the root
-      closes it; two trials running that fail to halve the bracket are followed by a
-      bisection step, which bounds the worst case. 2-4 trials per event.
+      dQ/dt), after the first moved HERMITE_PAST x tol past it (away from the end the
+      last trial moved) and put at least tol/2 inside the bracket, so that two trials
+      next to the root close it; two trials running that fail to halve the bracket are
+      followed by one bisection step, which bounds the worst case. 2-5 trials per event
+      (3.8 on average on Figure 3(a)).
 
     Returns (tau, y(tau), re-integrations), with tau on the far side of the root (the event
     has happened at tau).
@@ -201,6 +211,10 @@ def _locate(ev, t0, y0, k1, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, 
                 mid = lo + hermite_root(g_lo, d_lo, g_hi, d_hi, width, NEWTON_XTOL * tol / width)
                 if not (mid == mid):
                     mid = 0.5 * (lo + hi)
+                if side == 1:
+                    mid += HERMITE_PAST * tol
+                elif side == -1:
+                    mid -= HERMITE_PAST * tol
                 mid = min(max(mid, lo + 0.5 * tol), hi - 0.5 * tol)
         elif illinois:
             mid = hi - g_hi * (hi - lo) / (g_hi - g_lo)
@@ -223,7 +237,10 @@ def _locate(ev, t0, y0, k1, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, 
             if side == 1 and illinois:
                 g_hi *= 0.5
             side = 1
-        slow = slow + 1 if hi - lo > 0.5 * width else 0
+        if slow >= 2:
+            slow = 0  # that was the bisection step: the next trial is Hermite's again
+        else:
+            slow = slow + 1 if hi - lo > 0.5 * width else 0
     return hi, y_hi, n
 
 
