@@ -27,6 +27,7 @@ from rocksweep.kernel.events import (
     event_value,
     hermite_cubic,
     hermite_min,
+    hermite_newton,
     hermite_root,
 )
 from rocksweep.kernel.stepping import first_stage, rk4_step
@@ -102,6 +103,37 @@ def test_hermite_min_at_the_calculus_minimum_of_a_cubic(h):
     tau, g_min = hermite_min(g0, d0, g1, d1, h)
     assert tau == pytest.approx(0.4 * h, rel=1e-12)
     assert g_min == pytest.approx(0.01, rel=1e-10)
+
+
+def test_hermite_newton_starts_at_the_parabola_root_from_the_surface():
+    """g = d0 t - a t^2 / 2 from g = 0 (a rocking excursion bracketed from theta = 0, as
+    every chattering impact is): its cubic Hermite interpolant is the parabola itself, the
+    start is its root, and one Newton step confirms it. (From the midpoint, the cubic's
+    root at x = 0 pulled Newton into bisections: 5 iterations here.)"""
+    d0, acc, h = 0.3, 9.0, 0.2
+    t_star = 2.0 * d0 / acc  # 0.0667, a third of the step
+    g1, d1 = d0 * h - 0.5 * acc * h * h, d0 - acc * h
+    x, iterations = hermite_newton(0.0, d0, g1, d1, h, XTOL)
+    assert iterations == 1
+    assert x * h == pytest.approx(t_star, rel=1e-12)
+
+
+@pytest.mark.parametrize("t_star", [0.01, 0.19])
+def test_hermite_newton_starts_from_the_nearer_end(t_star):
+    """g = (t_star - t)(1 + t^2) on [0, 0.2], a root near either end: the start is a
+    Newton step from that end, and two more steps reach XTOL (the secant start took 3-4)."""
+    h = 0.2
+
+    def g(t):
+        return (t_star - t) * (1.0 + t * t)
+
+    def dg(t):
+        return -(1.0 + t * t) + 2.0 * t * (t_star - t)
+
+    x, iterations = hermite_newton(g(0.0), dg(0.0), g(h), dg(h), h, XTOL)
+    assert iterations <= 2
+    # the cubic interpolant's root, to XTOL: near the true root (the cubic's own error)
+    assert x * h == pytest.approx(t_star, abs=1e-4)
 
 
 def test_hermite_min_of_a_quadratic_takes_the_linear_branch():
