@@ -49,7 +49,7 @@ MAX_CHUNK = 1024
 NO_WORKERS_TIMEOUT = 60.0
 # How often [s] the dask driver checks the cluster while no chunk finishes.
 CLUSTER_POLL = 1.0
-# Cold compile of one kernel variant [s], measured: 4.3-6.5 s CPU a variant
+# Cold compile of one kernel variant [s], measured: 5.0-7.2 s CPU a variant
 # (scripts/bench_compile.py, docs/performance.md).
 COMPILE_SECONDS = 6.0
 
@@ -358,9 +358,10 @@ def compute(scene: Scene, jobs: int = 1, chunk_size: int | None = None,
 # ---------------------------------------------------------------------------------------
 
 # Kernel time per RK4 evaluation [s] on the paper's figures at the default preset
-# (scripts/bench_kernel.py: 109-120 ns on the 2-core reference machine): the price of a
-# step when no sample can be run because the kernel is not compiled yet.
-SECONDS_PER_EVALUATION = 120e-9
+# (scripts/bench_compile.py: core-us per point over RK4 evaluations per point, 75-83 ns on
+# the four figures on the 2-core reference machine): the price of a step when no sample
+# can be run because the kernel is not compiled yet.
+SECONDS_PER_EVALUATION = 85e-9
 # Points run to measure the cost when the kernel variant is compiled: ~10 ms of work.
 ESTIMATE_SAMPLE = 256
 
