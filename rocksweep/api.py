@@ -1,5 +1,6 @@
-"""The Python API: run a scene's grid, open a result, simulate one point; and the sweep
-driver behind both ``rocksweep.run`` and ``rocksweep sweep``.
+"""The Python API: run a scene's grid, open a result, simulate one point; the analyses of
+a Dataset; and ``sweep_file``, the one way into the sweep driver
+(``rocksweep.compute.driver``) for ``rocksweep.run`` and ``rocksweep sweep``.
 
 A scene is given as a path to a YAML file, as YAML text or as a dict with the YAML's
 structure. Overrides are ``"KEY=VALUE"`` strings (the command line's ``--set``, VALUE is
@@ -12,32 +13,32 @@ inside the functions), so ``import rocksweep`` stays light.
 from __future__ import annotations
 
 import functools
-import math
 import re
 import sys
 import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Union
 
+from rocksweep.compute.driver import (  # noqa: F401 (SweepInterrupted: the API's)
+    WRITE_EVERY,
+    SweepInterrupted,
+    SweepReport,
+)
 from rocksweep.errors import RocksweepError
 
 if TYPE_CHECKING:
     import xarray as xr
     from matplotlib.figure import Figure
 
-    from rocksweep.compute.adaptive import AdaptiveStats, Options, Validation
+    from rocksweep.compute.adaptive import Options
     from rocksweep.compute.single import Run
     from rocksweep.scene.model import Scene
 
 SceneLike = Union[str, Path, Mapping[str, Any]]  # noqa: UP007 (a runtime alias on 3.10)
 Overrides = Union[Sequence[str], Mapping[str, Any]]  # noqa: UP007
 
-# Finished chunks are written to the file at most this often [s] by default: a write
-# (several hyperslabs per variable, two flushes) costs ~10 ms, as much as a chunk of easy
-# points, and holds the GIL that worker threads need between kernel calls.
-WRITE_EVERY = 1.0
 # `simulate` on the command line overlays a few runs; larger grids are for sweeps.
 MAX_RUNS = 12
 # `rocksweep.simulate` returns one history per point: a notebook's worth, not a grid.
@@ -204,69 +205,6 @@ def _short_repr(v: Any) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
-# ---------------------------------------------------------------------------------------
-# The sweep driver
-# ---------------------------------------------------------------------------------------
-
-@dataclass
-class SweepReport:
-    """What a sweep session did. Times in seconds.
-
-    points_done: points in the file now; computed: points computed in this session;
-    done_before: points the file held when the session started; compile_s: kernel
-    compile or cache load; cpu_s: the workers' CPU time on this session's points;
-    attrs: the file's totals (``SweepFile.finish``).
-    """
-
-    path: Path
-    points_total: int
-    done_before: int
-    computed: int
-    wall_s: float
-    cpu_s: float
-    compile_s: float
-    attrs: dict = field(default_factory=dict)
-    adaptive: AdaptiveStats | None = None  # adaptive sweeps: the file's counts
-    validation: Validation | None = None  # adaptive sweeps with validate=True
-
-    @property
-    def points_done(self) -> int:
-        return self.done_before + self.computed
-
-    @property
-    def complete(self) -> bool:
-        return self.points_done == self.points_total
-
-    @property
-    def rate(self) -> float:
-        """Points computed per second of wall time."""
-        return self.computed / self.wall_s if self.wall_s > 0 else math.nan
-
-
-class SweepInterrupted(KeyboardInterrupt):
-    """Ctrl-C during a sweep, after every finished chunk was written (``report``)."""
-
-    def __init__(self, report: SweepReport) -> None:
-        super().__init__(f"interrupted: {report.points_done} of {report.points_total} "
-                         f"points saved in {report.path}")
-        self.report = report
-
-
-def check_write_every(seconds: float, name: str = "write_every =") -> float:
-    """``seconds`` if finite and >= 0, else a one-line ApiError (``name``: how the
-    message names the option, "--write-every" on the command line)."""
-    if not (isinstance(seconds, int | float) and math.isfinite(seconds) and seconds >= 0):
-        raise ApiError(f"{name} {seconds}: give a finite number of seconds >= 0 (0: write "
-                       "every chunk as it finishes)")
-    return float(seconds)
-
-
-def _accuracy_words(scene: Scene) -> str:
-    """The numerics of a sweep as its header line says them."""
-    return (f"accuracy {scene.numerics.describe()}"
-            + ("; each point rerun at half the step (outputs.check)" if scene.check else ""))
-
-
 def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
                jobs: int = 1, resume: bool = False, overwrite: bool = False,
                backend: str = "threads", scheduler: str | None = None,
@@ -287,13 +225,14 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
     ``scheduler``, an address); chunk_size: points per chunk (default about 32 chunks per
     worker); progress: a progress bar on stderr; log: receives the header and kernel
     lines; inputs: the command's input files, never written over; overrides: recorded in
-    the file; adaptive: compute only near the class boundaries (``rocksweep.compute.adaptive``,
-    see ``_adaptive_loop``; the file records the settings, and a resume must give the
-    same); validate: with adaptive, also compute the filled points of a coarse uniform
-    lattice and report those whose class differs from the fill (``report.validation``;
-    the file is not changed); connect_timeout: seconds to wait for the dask scheduler
-    to answer; cli: name options as the command line spells them. Every argument is
-    checked (``rocksweep.compute.arguments``) before the output is touched. Returns a
+    the file; adaptive: compute only near the class boundaries
+    (``rocksweep.compute.adaptive``, see ``compute.driver.adaptive_loop``; the file
+    records the settings, and a resume must give the same); validate: with adaptive,
+    also compute the filled points of a coarse uniform lattice and report those whose
+    class differs from the fill (``report.validation``; the file is not changed);
+    connect_timeout: seconds to wait for the dask scheduler to answer; cli: name options
+    as the command line spells them. Every argument is checked
+    (``rocksweep.compute.arguments``) before the output is touched. Returns a
     ``SweepReport``.
     """
     from rocksweep.compute.arguments import check_sweep_arguments
@@ -317,6 +256,7 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
 
         settings = adaptive.resolved(Grid(scene))  # bad axes or settings: before any file
 
+    from rocksweep.compute.driver import drive
     from rocksweep.store.writer import SweepFile
 
     t0 = time.perf_counter()
@@ -327,7 +267,7 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
         if resume:
             raise ApiError("resume=True needs output= (the file to finish)")
         sf = SweepFile.in_memory(scene, overrides, backend=how, adaptive=settings)
-        return _drive(sf, None, report_of := SweepReport(Path("memory"), sf.grid.size, 0, 0,
+        return drive(sf, None, report_of := SweepReport(Path("memory"), sf.grid.size, 0, 0,
                                                           0.0, 0.0, 0.0),
                       t0, adaptive, validate, jobs=jobs, backend=backend,
                       scheduler=scheduler, chunk_size=chunk_size, where=where,
@@ -350,199 +290,9 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
         sf = SweepFile.create(path, scene, overrides, overwrite=overwrite, backend=how,
                               adaptive=settings, log=say)
     report = SweepReport(path, sf.grid.size, 0, 0, 0.0, 0.0, 0.0)
-    return _drive(sf, path, report, t0, adaptive, validate, jobs=jobs, backend=backend,
+    return drive(sf, path, report, t0, adaptive, validate, jobs=jobs, backend=backend,
                   scheduler=scheduler, chunk_size=chunk_size, where=where,
                   write_every=write_every, progress=progress, say=say)
-
-
-def _drive(sf, path: Path | None, report: SweepReport, t0: float,
-           adaptive: Options | None, validate: bool, **loop_options: Any) -> SweepReport:
-    """Compute the missing points of an open sink (a result file, or one in memory when
-    ``path`` is None: its image lands in ``report.image``), then record the session.
-    The arguments were checked before the sink was made (``compute.arguments``)."""
-    pending: list = []  # finished chunks not yet in the sink (each loop writes its own)
-    loop = (_every_point_loop if adaptive is None
-            else functools.partial(_adaptive_loop, validate=validate))
-    try:
-        loop(sf, report, adaptive, pending=pending, **loop_options)
-    except BaseException as err:
-        try:
-            report.wall_s = time.perf_counter() - t0
-            report.attrs = sf.finish(report.wall_s, report.cpu_s)
-        finally:
-            sf.close()
-        if isinstance(err, KeyboardInterrupt) and not isinstance(err, SweepInterrupted):
-            raise SweepInterrupted(report) from None
-        raise
-    report.wall_s = time.perf_counter() - t0
-    report.attrs = sf.finish(report.wall_s, report.cpu_s)
-    if path is None:
-        report.image = sf.image()
-    sf.close()
-    return report
-
-
-def _progress_class() -> type:
-    """The progress bar: a widget in a notebook (``tqdm.auto``'s choice), else the
-    terminal's bar (without ``tqdm.auto``'s asyncio import: ~10 ms of every command)."""
-    if "ipykernel" in sys.modules:
-        from tqdm.auto import tqdm
-    else:
-        from tqdm import tqdm
-    return tqdm
-
-
-def _every_point_loop(sf, report: SweepReport, _options: None, *, jobs: int, backend: str,
-                      scheduler: str | None, chunk_size: int | None, where: str,
-                      write_every: float, progress: bool, say: Callable[[str], None],
-                      pending: list) -> None:
-    """Compute every missing point of an open file, writing finished chunks every
-    ``write_every`` seconds (and the pending ones whatever ends the loop)."""
-    from rocksweep.compute import sweep as sw
-
-    tqdm = _progress_class()
-
-    scene = sf.grid.scene
-
-    def write_pending() -> None:
-        for merged in sw.merge_contiguous(pending):
-            sf.write(merged)
-        pending.clear()
-
-    try:
-        done = sf.done()
-        report.done_before = int(done.sum())
-        todo = int((~done).sum())
-        n_workers = sw.effective_jobs(jobs) if backend == "threads" else 1
-        size = chunk_size or sw.auto_chunk_size(todo, n_workers)
-        chunks = sw.plan_chunks(~done, size)
-        dims = " x ".join(f"{len(a.values)} {a.name}" for a in scene.swept) or "1 point"
-        say(f"{scene.name}: {sf.grid.size} points ({dims}); {report.done_before} done, "
-            f"{todo} to compute on {where}; {_accuracy_words(scene)}")
-        lvl = sw.level(scene)
-        if todo:
-            _prepare_kernel(sf, lvl, report, say)
-        with tqdm(total=todo, unit="pt", disable=not progress, file=sys.stderr,
-                  smoothing=0.1, dynamic_ncols=True) as bar:
-            t_write = time.perf_counter()
-            for res in sw.run_chunks(sf.grid, chunks, lvl, jobs, backend, scheduler):
-                pending.append(res)
-                report.cpu_s += res.cpu_seconds
-                report.computed += res.stop - res.start
-                bar.update(res.stop - res.start)
-                if time.perf_counter() - t_write >= write_every:
-                    write_pending()
-                    t_write = time.perf_counter()
-    finally:
-        write_pending()
-
-
-def _prepare_kernel(sf, lvl: int, report: SweepReport, say: Callable[[str], None]) -> None:
-    """Compile or load the kernel variants the grid needs, saying what happens."""
-    from rocksweep.compute import sweep as sw
-
-    to_compile, unknown = sw.kernel_cache_state(sf.grid, lvl)
-    if to_compile:
-        say(f"compiling the kernel (once per machine, "
-            f"~{to_compile * sw.COMPILE_SECONDS:.0f} s)...")
-    elif unknown:
-        say("loading or compiling the kernel...")
-    t_prep = time.perf_counter()
-    sw.prepare(sf.grid, lvl)
-    report.compile_s = time.perf_counter() - t_prep
-    if to_compile or unknown or report.compile_s > 1.0:
-        how = "compiled" if to_compile else "compiled or loaded from numba's cache"
-        say(f"kernel {how} in {report.compile_s:.1f} s")
-
-
-def _adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backend: str,
-                   scheduler: str | None, chunk_size: int | None, where: str,
-                   write_every: float, progress: bool, say: Callable[[str], None],
-                   pending: list, validate: bool = False) -> None:
-    """The adaptive sweep of an open file (``rocksweep.compute.adaptive``).
-
-    The state (outcome, computed) is read from the file; ``adaptive.next_step`` plans a
-    batch from it; the batch runs through ``adaptive.run_batch`` (the chunk machinery:
-    threads or dask); each chunk's points are written with their ``computed`` flags
-    (batched every ``write_every`` seconds, and whatever ends the loop) and the
-    in-memory state updated; until the plan says "done". Then the
-    filled classes go into ``outcome`` and the counts into the attributes, so a resume
-    of a finished file stops at once. A file killed at any moment resumes to the same
-    result (see ``adaptive.next_step``).
-    """
-    import numpy as np
-
-    from rocksweep.compute import adaptive as ad
-    from rocksweep.compute import sweep as sw
-
-    tqdm = _progress_class()
-    scene = sf.grid.scene
-    plan = options.plan(sf.grid)
-    outcome, computed = sf.state()
-    report.done_before = int((computed > ad.FILLED).sum())
-    dims = " x ".join(f"{len(a.values)} {a.name}" for a in scene.swept)
-    say(f"{scene.name}: {sf.grid.size} points ({dims}); adaptive over {plan.names[0]} x "
-        f"{plan.names[1]} (coarse level {plan.coarse}: stride {2 ** plan.coarse}, "
-        f"audit {100 * plan.audit:g}%); {report.done_before} computed before; on {where}; "
-        f"{_accuracy_words(scene)}")
-    lvl = sw.level(scene)
-    pending_flags: list = []
-
-    def write_pending() -> None:
-        if not pending:
-            return
-        flat = np.concatenate([r.flat for r in pending])
-        order = np.argsort(flat, kind="stable")
-        arrays = {k: np.concatenate([r.arrays[k] for r in pending])[order]
-                  for k in pending[0].arrays}
-        flags = np.concatenate(pending_flags)[order]
-        sf.write_points(flat[order], arrays, flags)
-        pending.clear()
-        pending_flags.clear()
-
-    prepared = False
-    with tqdm(total=0, unit="pt", disable=not progress, file=sys.stderr, smoothing=0.1,
-              dynamic_ncols=True) as bar:
-        t_write = time.perf_counter()
-        try:
-            while True:
-                step = ad.next_step(plan, outcome, computed)
-                b = step.batch
-                if b.kind == "done":
-                    break
-                if not prepared:
-                    _prepare_kernel(sf, lvl, report, say)
-                    prepared = True
-                bar.total += len(b)  # the work grows as refinement finds boundaries
-                bar.set_description(b.kind if b.kind != "refine" else f"refine {b.stride}")
-                bar.refresh()
-                for res in ad.run_batch(sf.grid, b.flat, jobs, chunk_size, backend,
-                                        scheduler):
-                    flags = step.flags(res.flat, res.arrays["outcome"])
-                    pending.append(res)
-                    pending_flags.append(flags)
-                    outcome[res.flat] = res.arrays["outcome"]
-                    computed[res.flat] = flags
-                    report.cpu_s += res.cpu_seconds
-                    report.computed += len(res.flat)
-                    bar.update(len(res.flat))
-                    if time.perf_counter() - t_write >= write_every:
-                        write_pending()
-                        t_write = time.perf_counter()
-                write_pending()
-        finally:
-            write_pending()
-    stats = ad.stats_of(computed, options.threshold)
-    filled = ad.fill(plan, outcome, computed)
-    sf.write_filled(filled,
-                    {"points_computed": stats.computed,
-                     "points_filled": stats.points - stats.computed,
-                     "points_audited": stats.audited, "audit_misses": stats.audit_misses})
-    report.adaptive = stats
-    if validate:
-        say("validating: computing the filled points of a coarse uniform lattice...")
-        report.validation = ad.validate(sf.grid, plan, filled, computed, None, jobs,
-                                        chunk_size, backend, scheduler)
 
 
 # ---------------------------------------------------------------------------------------

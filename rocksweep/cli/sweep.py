@@ -1,5 +1,6 @@
-"""``rocksweep sweep``: a scene's grid across workers into a resumable HDF5 file (the
-driver is ``rocksweep.api.sweep_file``; this command parses options and prints)."""
+"""``rocksweep sweep``: a scene's grid across workers into a resumable HDF5 file (through
+``rocksweep.api.sweep_file`` into ``rocksweep.compute.driver``; this command parses
+options and prints)."""
 
 from __future__ import annotations
 
@@ -10,8 +11,7 @@ import click
 
 from rocksweep.cli.main import load, main, user_errors
 from rocksweep.cli.options import overwrite_option, scene_argument, set_option
-
-WRITE_EVERY = 1.0  # = rocksweep.api.WRITE_EVERY (not imported here: --help stays light)
+from rocksweep.compute.driver import WRITE_EVERY
 
 
 @main.command()

@@ -1,7 +1,9 @@
 """Running points: the grid of a scene (``grid``), single runs with histories
 (``single``), the dispatch of parameter rows to the compiled kernel variants and the
-sweep drivers (``sweep``), and adaptive refinement near class boundaries (``adaptive``).
+in-memory array drivers (``sweep``), adaptive refinement near class boundaries
+(``adaptive``), and the driver of a sweep into a result file or its in-memory image
+(``driver``).
 """
 
 # the public modules
-__all__ = ["adaptive", "grid", "single", "sweep"]
+__all__ = ["adaptive", "driver", "grid", "single", "sweep"]
