@@ -206,7 +206,9 @@ def _locate(ev, t0, y0, k1, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, 
 
     Every trial point is a fresh RK4 step of that length from (t0, y0), so the located
     state is the integrator's own solution, not an interpolant; all of them share the
-    step's first stage k1 = dy/dt at (t0, y0) (``stepping.rk4_from``). Root finder (PAR_ROOT):
+    step's first stage k1 = dy/dt at (t0, y0) (``stepping.rk4_from``).
+
+    Root finder (PAR_ROOT):
 
     - bisection: the design's guaranteed method, log2(h/tol) trials (18-25 at the presets);
     - Illinois regula falsi: keeps the bracket, converges superlinearly;
