@@ -15,7 +15,7 @@ Prints, measured side by side in one run (issue 24):
    point (CPU time of the calling thread, kernel calls only, chunked as a 1-worker sweep
    does, best of ``--repeat``; ``scripts/bench_kernel.py``'s ``best_pass``).
 4. reference: scipy DOP853 (``rocksweep.physics.reference``) on the accuracy study's stratified
-   sample of each figure (``--ref-points``): weighted mean CPU ms per point (an estimate
+   sample of each figure (``--ref-points``): weighted mean wall ms per point (an estimate
    for the whole scene), its ratio to item 3's kernel time, and the ratio including
    start-up for a sweep of 120 000 points: ref / (kernel core-us per point of item 3 +
    warm sweep start-up (wall: serial work; its CPU time also counts OpenBLAS's idle
@@ -53,6 +53,7 @@ from rocksweep.analysis.accuracy import (  # noqa: E402
     Sample,
     _agreement,
     boundary_mask,
+    run_reference,
     stratified_sample,
 )
 from rocksweep.kernel import layout as L  # noqa: E402, N812
@@ -158,33 +159,21 @@ def per_point(names: list[str], repeat: int) -> dict[str, dict]:
 
 
 def reference(name: str, pp: dict, points: int, seed: int = 0) -> dict:
-    """The reference on the accuracy study's stratified sample of a scene: its weighted
-    mean CPU time per point (an estimate for the whole scene, like item 3's kernel time;
-    CPU time of this thread: scipy's solver is single-threaded Python), and the outcome
-    agreement with the kernel."""
-    from rocksweep.physics.reference import reference_run, result_row
-
+    """The reference on the accuracy study's stratified sample of a scene
+    (``run_reference``, as the accuracy study and ``bench_kernel.py`` time it): its
+    weighted mean wall time per point (an estimate for the whole scene, like item 3's
+    kernel time; scipy's solver is single-threaded Python), and the outcome agreement with
+    the kernel."""
     scene, grid = pp["scene"], pp["pass"]["grid"]
     outs = pp["pass"]["outs"]
     outcome = outs[:, L.OUT_OUTCOME].astype(np.int8)
     bnd = boundary_mask(outcome.reshape(grid.shape), grid.dims).ravel()
     flat, stratum, weight, strata, sizes = stratified_sample(outcome, bnd, points, seed)
     sample = Sample(flat, stratum, weight, strata, sizes, grid.size, outcome, 0.0)
-    values = grid.index_values(flat)
-    cpu = np.empty(len(flat))
-    ref_outcome = np.empty(len(flat))
-    # one untimed run first: the reference's first call loads (or compiles) the jitted
-    # equations it shares with the kernel, ~0.25 s that is no point's cost
-    reference_run(scene.point({k: v[0] for k, v in values.items()}), scene.numerics)
-    for i in range(len(flat)):
-        point = scene.point({k: v[i] for k, v in values.items()})
-        c0 = time.thread_time()
-        r = reference_run(point, scene.numerics)
-        cpu[i] = time.thread_time() - c0
-        ref_outcome[i] = result_row(r)[L.OUT_OUTCOME]
-    agree = outs[flat, L.OUT_OUTCOME] == ref_outcome
+    ref, secs, _ = run_reference(scene, flat)
+    agree = outs[flat, L.OUT_OUTCOME] == ref[:, L.OUT_OUTCOME]
     share, se = _agreement(agree, sample)
-    return {"n": len(flat), "ref_ms": float(np.sum(cpu * weight) / weight.sum()) * 1e3,
+    return {"n": len(flat), "ref_ms": float(np.sum(secs * weight) / weight.sum()) * 1e3,
             "agree": share, "se": se}
 
 
@@ -232,7 +221,7 @@ def main() -> None:
     for name, r in pp.items():
         print(f"    {name:<8}{r['n']:>8}{r['evals']:>14.1f}{r['us']:>12.2f}", flush=True)
 
-    print(f"\n[4] reference (scipy DOP853, rtol 1e-10): CPU ms per point, weighted mean over "
+    print(f"\n[4] reference (scipy DOP853, rtol 1e-10): wall ms per point, weighted mean over "
           f"the accuracy study's stratified sample ({ref_points} points per figure: an "
           "estimate for the whole scene), against item 3's kernel time on the whole scene")
     print(f"    incl. start-up: ref / (kernel + item 2's sweep start-up {start_wall:.2f} s (wall) "
