@@ -159,16 +159,17 @@ def hermite_newton(g0, d0, g1, d1, h, xtol):
     # parabola g0 + d0 h x + c2 x^2; else the secant (the midpoint from g = 0). Newton from
     # the midpoint took 5 iterations on average, up to the cap, on Figure 3(a)'s impacts
     # (the cubic's other root at x = 0 pulled it into bisections); from here ~1.4.
-    x = g0 / (g0 - g1) if g0 > 0.0 else 0.5
-    if g0 == 0.0 and 0.0 < h * d0 < -c2:
-        x = -h * d0 / c2
-    elif g0 > 0.0:
+    if g0 > 0.0:
         step_lo = -g0 / (h * d0) if d0 < 0.0 else 2.0
         step_hi = g1 / (h * d1) if d1 < 0.0 else 2.0
         if 0.0 < step_lo < 1.0 and step_lo <= step_hi:
             x = step_lo
         elif 0.0 < step_hi < 1.0:
             x = 1.0 - step_hi
+        else:
+            x = g0 / (g0 - g1)
+    else:
+        x = -h * d0 / c2 if 0.0 < h * d0 < -c2 else 0.5
     iterations = 0
     for _ in range(NEWTON_MAX_ITER):
         iterations += 1
