@@ -46,8 +46,9 @@ from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import PRESET_ROTATION, PRESETS, ROOTS, Numerics
 from rocksweep.scene.model import Scene, SceneError
+from rocksweep.vocab.outcomes import CLASSES
 
-OUTCOMES = ("safe", "mode1", "mode2")  # codes 0, 1, 2
+OUTCOMES = CLASSES  # codes 0, 1, 2
 # Per-point fields of the report: all the outcome-level kernel fills (no energies).
 REPORT_FIELDS = tuple(f for f in fields.RUN_FIELDS if not f.energy)
 MEASURES = ("theta_max", "t_first_impact", "t_overturn", "impacts", "theta_rel", "energy")

@@ -52,15 +52,17 @@ from scipy.special import log_ndtr, ndtr, ndtri
 
 from rocksweep.errors import RocksweepError
 from rocksweep.kernel import layout as L
+from rocksweep.vocab.ground import CLOUD_IMS as CLOUD_IM_VARIABLES
+from rocksweep.vocab.ground import SCALE_IMS
+from rocksweep.vocab.outcomes import STATES, THETA_STATE
 
 __all__ = ["Bootstrap", "Fit", "FragilityError", "STRIPE_IMS", "bootstrap_records",
            "curves_json", "fit_cloud", "fit_stripes", "fragility", "parse_state"]
 
 #: stripe dimension names (the sweep's ``scale_im``) and their units
-STRIPE_IMS = {"PGA": "g", "PGV": "m/s", "Sa": "g", "PGA_ratio": "1", "PGV_ratio": "1"}
+STRIPE_IMS = SCALE_IMS
 #: cloud IMs and the per-record variables they come from
-CLOUD_IMS = {"PGA": ("record_pga", "g"), "PGV": ("record_pgv", "m/s"),
-             "Sa": ("record_sa", "g")}
+CLOUD_IMS = {im: (var, SCALE_IMS[im]) for im, var in CLOUD_IM_VARIABLES.items()}
 REASONS = ("ok", "no_failures", "all_failed", "separated", "decreasing", "no_data")
 BAND_POINTS = 101
 
@@ -334,7 +336,7 @@ def parse_state(state: str) -> tuple[str, float]:
     """("overturn" | "mode1" | "mode2" | "uplift" | "theta", threshold) of a state word;
     "theta:X" is max|theta|/alpha_cg >= X (X > 0) or overturned."""
     s = str(state).strip()
-    if s in ("overturn", "mode1", "mode2", "uplift"):
+    if s in STATES:
         return s, math.nan
     if s.startswith("theta:"):
         try:
@@ -345,8 +347,7 @@ def parse_state(state: str) -> tuple[str, float]:
             return "theta", x
         raise FragilityError(f"state {state!r}: theta:X needs a number X > 0 "
                              "(max|theta|/alpha_cg)")
-    raise FragilityError(f"state {state!r}: expected overturn, mode1, mode2, uplift or "
-                         "theta:X")
+    raise FragilityError(f"state {state!r}: expected {', '.join(STATES)} or {THETA_STATE}")
 
 
 def _need(ds: xr.Dataset, name: str, why: str) -> xr.DataArray:

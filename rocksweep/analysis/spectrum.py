@@ -25,6 +25,7 @@ import numpy as np
 
 from rocksweep.analysis.boundaries import DEFAULT_RTOL, AMinCurve, a_min, kernel_evaluator
 from rocksweep.errors import RocksweepError
+from rocksweep.vocab.outcomes import OUTCOME_WORDS, flag_attrs
 
 
 class SpectrumError(RocksweepError, ValueError):
@@ -70,8 +71,7 @@ class Spectra:
         return xr.Dataset(
             {"theta_max_over_alpha": (("lam", "A_ratio", f), self.theta_max, theta_attrs),
              "outcome": (("lam", "A_ratio", f), self.outcome,
-                         {"long_name": "outcome class", "flag_values": [-1, 0, 1, 2],
-                          "flag_meanings": "not_run safe mode1 mode2"}),
+                         {"long_name": "outcome class", **flag_attrs(OUTCOME_WORDS)}),
              "A_min": (("lam", f), a_min,
                        {**fields.axis_attrs("A_ratio"),
                         "long_name": "smallest overturning amplitude ratio"}),

@@ -12,6 +12,7 @@ import click
 from rocksweep.cli.main import main, user_errors
 from rocksweep.cli.options import dpi_option, overwrite_option, result_argument
 from rocksweep.figures import WIDTHS
+from rocksweep.vocab.outcomes import STATES
 
 CURVE_SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
 
@@ -56,9 +57,8 @@ def _g(v) -> str:
               help="Figure of the curves with their bootstrap bands and the fraction at "
                    "each stripe, .png, .pdf or .svg.")
 @click.option("--state", default="overturn", show_default=True,
-              help="What the curve gives the probability of: overturn, mode1, mode2, "
-                   "uplift or theta:X (max|theta|/alpha_cg >= X); several separated by "
-                   "commas.")
+              help="What the curve gives the probability of: " + ", ".join(STATES)
+              + " or theta:X (max|theta|/alpha_cg >= X); several separated by commas.")
 @click.option("--im", default=None,
               help="Unscaled suites (clouds): the IM, PGA (default), PGV or Sa; stripes use "
                    "the IM they were scaled to.")

@@ -17,6 +17,7 @@ from rocksweep.cli.main import (
     set_option,
     user_errors,
 )
+from rocksweep.vocab.laws import CONSTANT, LAWS, LOCKED, law_origin
 
 
 @main.command(name="restitution")
@@ -30,7 +31,7 @@ from rocksweep.cli.main import (
               help="Number of lam values in [0, 1].")
 @click.option("--n-u", default=81, show_default=True, type=click.IntRange(2, 100001),
               help="Number of u/u_cr values in [-2, 2].")
-@click.option("--law", type=click.Choice(["vertical", "locked", "constant"]),
+@click.option("--law", type=click.Choice(LAWS),
               help="Impact law (as --set impact.law=LAW) [default: the scene's, else "
                    "vertical: eq. (1)]; constant takes its e from impact.e.")
 @user_errors
@@ -53,15 +54,14 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
         check_output(plot_path, overwrite=overwrite, inputs=[scene_path], suffixes=FORMATS)
     if law is not None:  # e belongs to law constant alone
         overrides = (*overrides, f"impact.law={law}",
-                     *(("impact.e=null",) if law != "constant" else ()))
+                     *(("impact.e=null",) if law != CONSTANT else ()))
     table = restitution_table(load(scene_path, overrides), n_lam, n_u)
     if as_json:
         click.echo(json.dumps(table.as_dict()))
     else:
         e = table.e_upper
         click.echo(table.title)
-        what = {"vertical": "eq. (1)", "locked": "top mass locked to the base",
-                "constant": f"e = {table.e:g}"}[table.law]
+        what = law_origin(table.law, table.e)
         factor = f", e_factor {table.e_factor:g}" if table.e_factor != 1.0 else ""
         click.echo(f"impact law: {table.law} ({what}{factor})")
         click.echo(f"e at lam = 0, u = 0: {table.e_at_rest:.4f}  (Housner, same body rigid: "
@@ -70,7 +70,7 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
                    f"max {e.max():.4f}; e > 1 at {int((e > 1).sum())} of {e.size} "
                    "points (upper sign)")
         click.echo("largest lam at which an impact cannot gain energy (upper sign"
-                   + (", u' = 0" if table.law == "locked" else "") + "):")
+                   + (", u' = 0" if table.law == LOCKED else "") + "):")
         u = table.u_over_ucr
         picks = [int(i) for i in dict.fromkeys(
             int(abs(u - v).argmin()) for v in (-2.0, -1.0, 0.0, 1.0, 2.0))]

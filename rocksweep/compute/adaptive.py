@@ -60,20 +60,17 @@ from rocksweep.compute.grid import ChunkRows, Grid
 from rocksweep.errors import RocksweepError
 from rocksweep.scene.model import Scene
 from rocksweep.schema import check_option
+from rocksweep.vocab import outcomes as _out
+from rocksweep.vocab.axes import DIAGRAM_AXES
 
 # ``computed`` flags (int8 per point).
-FILLED = 0  # not computed: outcome holds the class filled from its uniform cell
-COMPUTED = 1  # computed by the coarse pass or a refinement
-AUDIT = 2  # computed as an audit point; its class equals the fill it replaced
-AUDIT_MISS = 3  # computed as an audit point; its class differs from the fill (refined)
-COMPUTED_MEANING = {
-    FILLED: "filled (not computed; outcome from the uniform cell around it)",
-    COMPUTED: "computed (coarse pass or refinement)",
-    AUDIT: "computed as an audit point, agreed with its fill",
-    AUDIT_MISS: "computed as an audit point, disagreed with its fill (region refined)",
-}
+# (codes, words and meanings: ``rocksweep.vocab.outcomes``)
+FILLED = _out.COMPUTED_CODE[_out.FILLED]  # not computed: the class filled from its cell
+COMPUTED = _out.COMPUTED_CODE[_out.COMPUTED]  # computed by the coarse pass or a refinement
+AUDIT = _out.COMPUTED_CODE[_out.AUDIT_AGREED]  # an audit point; its class equals the fill
+AUDIT_MISS = _out.COMPUTED_CODE[_out.AUDIT_DISAGREED]  # an audit point; differs (refined)
+COMPUTED_MEANING = _out.COMPUTED_MEANING
 
-DIAGRAM_AXES = ("w_over_p", "A_ratio")  # (x, y)
 # Default coarse level: the largest k whose coarse lattice keeps >= MIN_COARSE_CELLS cells
 # along both diagram axes (80: k = 2, 400: k = 4, 1000: k = 5); see ``default_coarse``.
 MIN_COARSE_CELLS = 16

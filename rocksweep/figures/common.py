@@ -23,6 +23,7 @@ from matplotlib.lines import Line2D
 
 from rocksweep.errors import RocksweepError
 from rocksweep.outputs import atomic_path, check_output
+from rocksweep.vocab import axes as _axes
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -96,13 +97,13 @@ def _alpha_symbol(run: Run) -> str:
 
 def _label(run: Run, swept: Sequence[str]) -> str:
     p = run.point
+    kind = getattr(p.body, "kind", "flexible")
     values = {"lam": p.lam, "shape": p.shape, "w_over_p": p.w_over_p, "A_ratio": p.A_ratio}
-    symbols = {"lam": r"$\lambda$", "w_over_p": r"$\omega/p$",
-               "A_ratio": rf"$A/(g\tan{_alpha_symbol(run)})$", "shape": "pulse"}
     parts = []
     for k in swept:
         v = values.get(k, getattr(p.body, k, None))
-        parts.append(f"{symbols.get(k, k)} = {v:g}" if isinstance(v, float) else f"{k} = {v}")
+        parts.append(f"${_axes.latex(k, kind)}$ = {v:g}" if isinstance(v, float)
+                     else f"{k} = {v}")
     text = ", ".join(parts) or f"$\\lambda$ = {p.lam:g}"
     return f"{text} ({run.outcome})"
 

@@ -55,10 +55,16 @@ import numpy as np
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-SHAPES = ("sine", "cosine", "ricker", "mp")
-
-# Ricker: tau = phi/2 - RICKER_TAU0, on for 0 <= phi <= 6 pi (t0 = 1.5/f, D = 2 t0)
-RICKER_TAU0 = 1.5 * math.pi
+from rocksweep.vocab.ground import (  # noqa: F401
+    MP,
+    PAPER_SHAPES,
+    RICKER,
+    RICKER_TAU0,
+    SHAPE_TITLE,
+    SHAPES,
+    SINE,
+    pulse_duration,
+)
 
 # uplift_phase samples this many points per pulse before refining with brentq
 _UPLIFT_SAMPLES = 20_001
@@ -140,18 +146,14 @@ class PulseShape:
     @property
     def duration(self) -> float:
         """Pulse duration D in phase (w t): 2 pi n, 6 pi (Ricker) or 2 pi gamma (MP)."""
-        if self.shape in ("sine", "cosine"):
-            return 2.0 * math.pi * self.cycles
-        if self.shape == "ricker":
-            return 6.0 * math.pi
-        return 2.0 * math.pi * self.gamma
+        return pulse_duration(self.shape, self.cycles, self.gamma)
 
     @property
     def label(self) -> str:
-        if self.shape in ("sine", "cosine"):
+        if self.shape in PAPER_SHAPES:
             return self.shape if self.cycles == 1 else f"{self.shape}, {self.cycles} cycles"
-        if self.shape == "ricker":
-            return "Ricker"
+        if self.shape == RICKER:
+            return SHAPE_TITLE[RICKER]
         return f"MP, gamma = {self.gamma:g}, nu = {self.nu_deg:g} deg"
 
     def _on(self, phi: np.ndarray) -> np.ndarray:
@@ -231,8 +233,6 @@ def shapes_figure(shapes: tuple[PulseShape, ...] | None = None,
 
     shapes = default_shapes() if shapes is None else tuple(shapes)
     families = [s for s in SHAPES if any(p.shape == s for p in shapes)]
-    titles = {"sine": "sine", "cosine": "cosine", "ricker": "Ricker",
-              "mp": "Mavroeidis-Papageorgiou"}
     fig = Figure(figsize=figsize, layout="constrained")
     axes = fig.subplots(1, len(families), sharey=True, squeeze=False)[0]
     for ax, family in zip(axes, families, strict=True):
@@ -242,7 +242,7 @@ def shapes_figure(shapes: tuple[PulseShape, ...] | None = None,
             phi = np.linspace(-0.05 * d_max, 1.05 * d_max, 2000)
             ax.plot(phi, p.acc(phi), lw=1.2, ls=("-", "--", ":")[k % 3], label=p.label)
         ax.axhline(0.0, color="0.6", lw=0.5)
-        ax.set_title(titles[family], fontsize=9)
+        ax.set_title(SHAPE_TITLE[family], fontsize=9)
         ax.set_xlabel(r"$\omega t$")
         ax.set_ylim(-1.8, 1.15)  # room below the curves for the legend
         ax.legend(fontsize=6, loc="lower center", frameon=False)

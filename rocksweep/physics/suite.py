@@ -28,11 +28,21 @@ import numpy as np
 from rocksweep.errors import RocksweepError
 from rocksweep.physics.model import G
 from rocksweep.physics.records import GroundRecord
+from rocksweep.vocab.ground import (  # noqa: F401
+    DEFAULT_PERIODS,
+    PGA,
+    PGA_RATIO,
+    PGV,
+    PGV_RATIO,
+    RATIO_OF,
+    SA,
+    SA_DAMPING,
+    SCALE_IMS,
+)
 
 #: the IMs a suite can be scaled to (the stripe dimension's name) and their units
-SCALE_IMS = {"PGA": "g", "PGV": "m/s", "Sa": "g", "PGA_ratio": "1", "PGV_ratio": "1"}
-DEFAULT_PERIODS = (0.2, 1.0)  # [s] Sa stored per record
-ZETA = 0.05  # damping ratio of the spectral acceleration
+# the IMs (and their units), Sa's damping ratio and default periods: rocksweep.vocab.ground
+ZETA = SA_DAMPING
 
 
 @dataclass(frozen=True, eq=False)
@@ -66,9 +76,9 @@ class Suite:
     def record_im(self) -> np.ndarray:
         """Each record's own value of the stripe IM (PGA_ratio: its PGA, PGV_ratio: its
         PGV), float64[R]."""
-        if self.im in ("PGA", "PGA_ratio"):
+        if self.im in (PGA, PGA_RATIO):
             return self.pga
-        if self.im in ("PGV", "PGV_ratio"):
+        if self.im in (PGV, PGV_RATIO):
             return self.pgv
         if self.im == "Sa":
             return self.scale_sa
@@ -106,7 +116,7 @@ class Suite:
     def scale_dependence(self) -> tuple[str, ...]:
         """What a factor depends on beside (record, stripe): "alpha_ref" (PGA_ratio,
         PGV_ratio) and "p" (PGV_ratio)."""
-        return {"PGA_ratio": ("alpha_ref",), "PGV_ratio": ("alpha_ref", "p")}.get(
+        return {PGA_RATIO: ("alpha_ref",), PGV_RATIO: ("alpha_ref", "p")}.get(
             self.im or "", ())
 
 
@@ -142,7 +152,7 @@ def make_suite(records: list[GroundRecord], names: list[str], im: str | None,
         for i, rec in enumerate(records):
             v = float(own[i])
             if not (math.isfinite(v) and v > 0.0):
-                what = {"PGA_ratio": "PGA", "PGV_ratio": "PGV"}.get(im, im)
+                what = RATIO_OF.get(im, im)
                 per = f"({period:g} s)" if im == "Sa" else ""
                 raise SuiteError(f"{rec.source}: {what}{per} = {v!r}: cannot be scaled to "
                                  f"a {im} stripe (needs a record with {what} > 0)")

@@ -42,6 +42,10 @@ from rocksweep.schema import (
     is_number,
     section_keys,
 )
+from rocksweep.vocab.axes import DIAGRAM_AXES
+from rocksweep.vocab.ground import MP
+from rocksweep.vocab.ground import PULSE_KEY_SHAPES as _PULSE_KEY_SHAPES
+from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
 
 # Largest grid a scene may describe [points]. A sweep file stores 45 bytes a point (69
 # with energy metrics, ``rocksweep.fields.variables``): 2e8 points are a 9-14 GB file, one
@@ -51,10 +55,10 @@ MAX_POINTS = 200_000_000
 # Values per axis: an axis is kept as a tuple of Python floats (~32 bytes a value; 1e6
 # values are 32 MB and 0.1 s to build); a figure's axis needs a few thousand at most.
 MAX_AXIS_VALUES = 1_000_000
-PULSE_AXES = ("A_ratio", "w_over_p")
+PULSE_AXES = tuple(reversed(DIAGRAM_AXES))  # (A_ratio, w_over_p)
 # The pulse shapes each optional pulse key means something for (rocksweep.physics.excitation);
 # given for none of the scene's shapes, the key is refused (it would be silently ignored).
-PULSE_KEY_SHAPES = {"cycles": ("sine", "cosine"), "gamma": ("mp",), "nu": ("mp",)}
+PULSE_KEY_SHAPES = _PULSE_KEY_SHAPES
 
 
 def apply_overrides(raw: dict, overrides: list[str]) -> dict:
@@ -240,17 +244,17 @@ def _impact_law(impact: dict) -> tuple[Axis | None, list[tuple[str, str, Any]]]:
     one: eq. 1, ``vertical``) and the specs of ``impact.e`` and ``impact.e_factor`` given.
     ``e`` is required by law ``constant`` and refused without it."""
     law_axis = None
-    laws: tuple[str, ...] = ("vertical",)
+    laws: tuple[str, ...] = (DEFAULT_LAW,)
     if impact.get("law") is not None:
         laws, swept = _words("impact.law", impact["law"])
         law_axis = Axis("law", "impact.law", laws, swept)
     specs = []
     e_spec = impact.get("e")
-    if e_spec is None and "constant" in laws:
+    if e_spec is None and CONSTANT in laws:
         raise SceneError("impact.e: missing; law constant needs its coefficient of "
                          "restitution e: a number in (0, 1], a list or a range")
     if e_spec is not None:
-        if "constant" not in laws:
+        if CONSTANT not in laws:
             raise SceneError(f"impact.e = {fmt(e_spec)}: only law constant uses e (the law "
                              f"here is {', '.join(laws)}); remove impact.e or add law: "
                              "constant")
@@ -330,7 +334,7 @@ def _pulse_options(pulse: dict, shapes: tuple[str, ...]) -> list[Axis]:
         v = pulse.get(k)
         given = v is not None
         if v is None:
-            if not (k != "cycles" and "mp" in shapes):
+            if not (k != "cycles" and MP in shapes):
                 continue
             v = spec.default
         ok = (isinstance(v, int) and not isinstance(v, bool)) if spec.kind == "integer" \

@@ -54,6 +54,7 @@ from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import _fixed, _now
 from rocksweep.store.identity import record_attrs, resolved_scene
+from rocksweep.vocab.outcomes import COMPUTED_FLAGS, COMPUTED_MEANING
 
 if TYPE_CHECKING:
     import h5py
@@ -95,11 +96,9 @@ ADAPTIVE_COUNT_ATTRS: dict[str, str] = {
     "audit_misses": "int64",
 }
 # The ``computed`` variable of adaptive sweeps: (dtype, fill, description), flag meanings.
-COMPUTED_VARIABLE = ("int8", 0, "adaptive sweep: 0 filled (not computed; outcome from the "
-                     "uniform cell around the point, other variables at their fill "
-                     "values), 1 computed, 2 audit point that agreed with its fill, 3 "
-                     "audit point that disagreed (region refined)")
-COMPUTED_FLAGS = {0: "filled", 1: "computed", 2: "audit_agreed", 3: "audit_disagreed"}
+COMPUTED_VARIABLE = ("int8", 0, "adaptive sweep: " + ", ".join(
+    f"{c} {m}" for c, m in COMPUTED_MEANING.items()) + "; other variables of a filled "
+    "point at their fill values")
 
 # Variables whose values are codes (CF flag_values / flag_masks): no units.
 FLAG_VARIABLES = ("outcome", "status", "computed")
