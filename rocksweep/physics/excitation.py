@@ -1,9 +1,13 @@
 """Reference definitions of the ground-acceleration pulses (pure numpy, no numba).
 
-This module is the independent definition that the kernel's jitted pulse is tested
-against, and the source of the README's plot of the shapes. Every shape is a function of
-the phase ``phi = w t`` (w = w_over_p * p [rad/s], t [s]; in kernel time p = 1, so phi =
-w_over_p * (p t)) and is normalised so that its peak |xg''| is A:
+This module is the pulses' reference in physics units and the source of the README's plot
+of the shapes. The Ricker and MP formulas are written once, in ``rocksweep.vocab.ground``,
+and evaluated here per sample and compiled into the kernel; tests/physics/test_excitation.py
+checks them against independent closed forms (the Ricker's roots and side lobes, the
+Lambert-W uplift, OpenSees' MPAcc and its velocity, finite differences).
+
+Every shape is a function of the phase ``phi = w t`` (w = w_over_p * p [rad/s], t [s];
+in kernel time p = 1, so phi = w_over_p * (p t)) and is normalised so that its peak |xg''| is A:
 
     xg''(t) = A * shape(w t),        d xg''/dt = A * w * shape'(w t).
 
@@ -63,7 +67,11 @@ from rocksweep.vocab.ground import (  # noqa: F401
     SHAPE_TITLE,
     SHAPES,
     SINE,
+    mp_raw,
+    mp_raw_rate,
     pulse_duration,
+    ricker,
+    ricker_rate,
 )
 
 # uplift_phase samples this many points per pulse before refining with brentq
@@ -74,19 +82,22 @@ def _phase(phi) -> np.ndarray:
     return np.asarray(phi, dtype=np.float64)
 
 
+# The formulas are ``rocksweep.vocab.ground``'s (the kernel compiles the same functions),
+# evaluated here per sample: float64 arrays of any shape in and out.
+_ricker = np.vectorize(ricker, otypes=[np.float64])
+_ricker_rate = np.vectorize(ricker_rate, otypes=[np.float64])
+_mp = np.vectorize(mp_raw, otypes=[np.float64])
+_mp_rate = np.vectorize(mp_raw_rate, otypes=[np.float64])
+
+
 def _mp_raw(phi: np.ndarray, gamma: float, nu_deg: float) -> np.ndarray:
     """r(phi) of the module docstring (unnormalised MP acceleration), for all phi."""
-    psi = phi - math.pi * gamma + math.radians(nu_deg)
-    x = phi / gamma
-    return np.sin(x) * np.cos(psi) - gamma * (1.0 - np.cos(x)) * np.sin(psi)
+    return _mp(phi, gamma, math.radians(nu_deg))
 
 
 def _mp_raw_rate(phi: np.ndarray, gamma: float, nu_deg: float) -> np.ndarray:
     """dr/dphi."""
-    psi = phi - math.pi * gamma + math.radians(nu_deg)
-    x = phi / gamma
-    return (np.cos(psi) * (np.cos(x) / gamma - gamma * (1.0 - np.cos(x)))
-            - 2.0 * np.sin(x) * np.sin(psi))
+    return _mp_rate(phi, gamma, math.radians(nu_deg))
 
 
 @lru_cache(maxsize=64)
@@ -166,9 +177,8 @@ class PulseShape:
             f = np.sin(phi)
         elif self.shape == "cosine":
             f = np.cos(phi)
-        elif self.shape == "ricker":
-            tau = 0.5 * phi - RICKER_TAU0
-            f = (1.0 - 2.0 * tau * tau) * np.exp(-tau * tau)
+        elif self.shape == RICKER:
+            f = _ricker(0.5 * phi - RICKER_TAU0)
         else:
             f = _mp_raw(phi, self.gamma, self.nu_deg) / mp_peak(self.gamma, self.nu_deg)
         return np.where(self._on(phi), f, 0.0)
@@ -180,10 +190,8 @@ class PulseShape:
             f = np.cos(phi)
         elif self.shape == "cosine":
             f = -np.sin(phi)
-        elif self.shape == "ricker":
-            # d/dphi = (1/2) d/dtau of (1 - 2 tau^2) e^{-tau^2} = (1/2) 2 tau (2 tau^2 - 3) e^{..}
-            tau = 0.5 * phi - RICKER_TAU0
-            f = tau * (2.0 * tau * tau - 3.0) * np.exp(-tau * tau)
+        elif self.shape == RICKER:
+            f = _ricker_rate(0.5 * phi - RICKER_TAU0)
         else:
             f = _mp_raw_rate(phi, self.gamma, self.nu_deg) / mp_peak(self.gamma, self.nu_deg)
         return np.where(self._on(phi), f, 0.0)

@@ -47,7 +47,8 @@ def pulse_duration(shape: str, cycles: int = CYCLES, gamma: float = GAMMA) -> fl
 
 # ---------------------------------------------------------------------------------------
 # The Ricker and MP formulas, written once: plain ``math`` on floats, called per sample by
-# ``rocksweep.physics.excitation`` and compiled into the kernel (``kernel.equations``).
+# ``rocksweep.physics.excitation`` and compiled into the kernel (``kernel.equations``,
+# which passes its amplitude as ``scale``: the same operations in the same order).
 # ---------------------------------------------------------------------------------------
 
 def ricker_tau(phi: float) -> float:
@@ -55,14 +56,14 @@ def ricker_tau(phi: float) -> float:
     return 0.5 * phi - RICKER_TAU0
 
 
-def ricker_shape(tau: float) -> float:
-    """(1 - 2 tau^2) exp(-tau^2): the Ricker wavelet, peak 1 at tau = 0."""
-    return (1.0 - 2.0 * tau * tau) * math.exp(-tau * tau)
+def ricker(tau: float, scale: float = 1.0) -> float:
+    """scale (1 - 2 tau^2) exp(-tau^2): the Ricker wavelet, peak ``scale`` at tau = 0."""
+    return scale * (1.0 - 2.0 * tau * tau) * math.exp(-tau * tau)
 
 
-def ricker_rate(tau: float) -> float:
-    """d/dphi of ``ricker_shape`` (d tau/d phi = 1/2): tau (2 tau^2 - 3) exp(-tau^2)."""
-    return tau * (2.0 * tau * tau - 3.0) * math.exp(-tau * tau)
+def ricker_rate(tau: float, scale: float = 1.0) -> float:
+    """d/dphi of ``ricker`` (d tau/d phi = 1/2): scale tau (2 tau^2 - 3) exp(-tau^2)."""
+    return scale * tau * (2.0 * tau * tau - 3.0) * math.exp(-tau * tau)
 
 
 def mp_raw(phi: float, gamma: float, nu: float) -> float:
