@@ -426,6 +426,20 @@ def stored_scene(path: str | Path) -> dict:
         return _layout(f, path).scene
 
 
+def result_inputs(path: str | Path) -> tuple[str, ...]:
+    """The files a command that reads the result at ``path`` never writes over: the
+    result and the records it names where the sweep read them (a single record's or a
+    suite's; an analysis may re-read them). Only ``(path,)`` for a file that is not a
+    readable result (its own error comes when it is read)."""
+    try:
+        sc = stored_scene(path)
+    except RocksweepError:
+        return (str(path),)
+    recs = [sc.get("record") or {}, *((sc.get("suite") or {}).get("records") or [])]
+    return (str(path), *(str(r["source"]) for r in recs
+                         if isinstance(r, dict) and isinstance(r.get("source"), str)))
+
+
 def peek_done(path: str | Path) -> tuple[int, int] | None:
     """(points done, total) of a rocksweep result at path, None if it is not one."""
     try:

@@ -153,7 +153,8 @@ class SweepFile:
         import h5py
         path = Path(path)
         try:
-            check_output(path, overwrite=True)  # devices, directories, missing dirs
+            # devices, directories, missing dirs, the scene's own files
+            check_output(path, overwrite=True, inputs=scene.inputs)
         except OutputError as err:
             raise StoreError(str(err)) from None
         existed = os.path.lexists(path)
@@ -245,6 +246,10 @@ class SweepFile:
         for a sweep of every point) to finish it (its points are kept whatever happens:
         the session's attributes are updated in place)."""
         path = Path(path)
+        try:
+            check_output(path, overwrite=True, inputs=scene.inputs)  # never an input
+        except OutputError as err:
+            raise StoreError(str(err)) from None
         f = _open(path, "r")
         try:
             stored = _layout(f, path).scene
