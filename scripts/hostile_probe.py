@@ -344,8 +344,28 @@ def _(d):
     shutil.move(d / "r", d / "moved")
     return py(d, """
         ds = rocksweep.open('s.h5')
-        from rocksweep.store.reader import read_result, result_scene
-        result_scene(read_result('s.h5'))
+        rocksweep.ida(ds, rtol=0.2)
+        print('OK')""")
+
+
+@case("single-record result after the record moved: spectra", "ok")
+def _(d):
+    r = cli(d, ["sweep", "one.yaml", "-o", "o.h5", "-q"])
+    if r.returncode:
+        return r
+    shutil.move(d / "rec.AT2", d / "gone.AT2")
+    return cli(d, ["spectrum", "o.h5", "--rtol", "0.2"])
+
+
+@case("in-memory result of a scene named README.md: spectra() opens no file", "ok")
+def _(d):
+    (d / "README.md").write_text("# not a result\n")
+    return py(d, """
+        import yaml
+        sc = yaml.safe_load(open('one.yaml'))
+        sc['name'] = 'README.md'
+        ds = rocksweep.run(sc)
+        rocksweep.spectra(ds, rtol=0.2)
         print('OK')""")
 
 
