@@ -273,6 +273,7 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
                       scheduler=scheduler, chunk_size=chunk_size, where=where,
                       write_every=write_every, progress=progress, say=say) or report_of
     path = Path(path)
+    inputs = [*inputs, *scene.inputs]  # the scene's records and listings: never written over
     try:
         path.stat()
     except FileNotFoundError:

@@ -98,6 +98,9 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
     states = [s.strip() for s in state.split(",") if s.strip()]
     if not states:
         raise click.ClickException(f"--state {state!r}: give at least one state")
+    from rocksweep.store.reader import result_inputs
+
+    inputs = result_inputs(result_path)  # the result and its records: never written over
     outs = [p for p in (out_path, fig_path) if p is not None]
     if len({str(p.resolve()) for p in outs}) < len(outs):
         raise click.ClickException("-o and --plot must name different files")
@@ -106,9 +109,9 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
             raise click.ClickException(
                 f"-o {out_path}: unsupported suffix {out_path.suffix or '(none)'!r}; use "
                 f"{', '.join(CURVE_SUFFIXES[:-1])} or {CURVE_SUFFIXES[-1]}")
-        check_output(out_path, overwrite=overwrite, inputs=[result_path])
+        check_output(out_path, overwrite=overwrite, inputs=inputs)
     if fig_path is not None:
-        check_output(fig_path, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
+        check_output(fig_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
     ds = rocksweep.open(result_path)
     frag = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states, im=im,
                                period=period, bootstrap=bootstrap, seed=seed, ci=ci)
@@ -139,7 +142,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
         from rocksweep.figures.fragility import fragility_figure
 
         fig = fragility_figure(frag, width=width)
-        save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=[result_path])
+        save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=inputs)
         say(f"wrote {fig_path}")
 
 

@@ -207,6 +207,7 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
     if scene.suite is not None:  # the stripes' IM ("none": a cloud) and Sa's period [s]
         a["scale_im"] = scene.suite.im or "none"
         a["scale_period"] = float(scene.suite.period)
+        _store_suite_records(f, scene.suite)
     for k, v in vers.items():
         a[f"{k}_version"] = v
     a["started"] = _now()
@@ -360,6 +361,32 @@ def _coord_attrs(ds, axis, kind: str = "flexible") -> None:
 
 
 RECORD_GROUP = "record"  # a record sweep's copy of its record: file (bytes), acceleration
+SUITE_GROUP = "records"  # a suite sweep's copies of its records' files: 0, 1, ... (bytes)
+
+
+def _store_file(g, name: str, record):
+    """One record's file bytes (uint8, gzip) as dataset ``name`` of group ``g``, with its
+    SHA-256 and the path the sweep read it from; None for a record without bytes."""
+    raw = np.frombuffer(record.data, dtype=np.uint8)
+    if not raw.size:
+        return None
+    d = g.create_dataset(name, data=raw, chunks=(min(raw.size, 1 << 16),),
+                         compression="gzip")
+    d.attrs["sha256"] = record.sha256
+    d.attrs["source"] = str(record.source)
+    return d
+
+
+def _store_suite_records(f, suite) -> None:
+    """Keep a suite's records in the result file (group ``records``, dataset ``i`` for the
+    i-th record: its file's bytes, SHA-256, path read and file name), as a single record's
+    file keeps its record: the scene is rebuilt from them (IDA, spectra, ``--rtol``) after
+    the record folder moved or is gone."""
+    g = f.create_group(SUITE_GROUP)
+    for i, (name, rec) in enumerate(zip(suite.names, suite.records, strict=True)):
+        d = _store_file(g, str(i), rec)
+        if d is not None:
+            d.attrs["name"] = name
 
 
 def _store_record(f, record) -> None:
@@ -369,12 +396,7 @@ def _store_record(f, record) -> None:
     to another machine, or kept after the record's folder is gone, it still plots and
     gives boundaries and spectra."""
     g = f.create_group(RECORD_GROUP)
-    raw = np.frombuffer(record.data, dtype=np.uint8)
-    if raw.size:
-        d = g.create_dataset("file", data=raw, chunks=(min(raw.size, 1 << 16),),
-                             compression="gzip")
-        d.attrs["sha256"] = record.sha256
-        d.attrs["source"] = str(record.source)
+    _store_file(g, "file", record)
     acc = g.create_dataset("acceleration", data=np.asarray(record.acc, np.float64))
     acc.attrs["units"] = "g"
     acc.attrs["dt"] = float(record.dt)

@@ -35,6 +35,7 @@ from rocksweep.store.format import (
     FORMAT,
     FORMAT_VERSION,
     RECORD_GROUP,
+    SUITE_GROUP,
     variables_for,
 )
 from rocksweep.store.identity import resolved_scene, scene_differences
@@ -319,6 +320,9 @@ class SweepResult:
     arrays: dict[str, np.ndarray]
     attrs: dict[str, object]
     scene: dict
+    # read from the file at ``path`` (False: a Dataset made in memory, ``path`` only names
+    # it in messages and is never opened)
+    in_file: bool = True
 
     @property
     def kind(self) -> str:
@@ -425,6 +429,20 @@ def stored_scene(path: str | Path) -> dict:
         return _layout(f, path).scene
 
 
+def result_inputs(path: str | Path) -> tuple[str, ...]:
+    """The files a command that reads the result at ``path`` never writes over: the
+    result and the records it names where the sweep read them (a single record's or a
+    suite's; an analysis may re-read them). Only ``(path,)`` for a file that is not a
+    readable result (its own error comes when it is read)."""
+    try:
+        sc = stored_scene(path)
+    except RocksweepError:
+        return (str(path),)
+    recs = [sc.get("record") or {}, *((sc.get("suite") or {}).get("records") or [])]
+    return (str(path), *(str(r["source"]) for r in recs
+                         if isinstance(r, dict) and isinstance(r.get("source"), str)))
+
+
 def peek_done(path: str | Path) -> tuple[int, int] | None:
     """(points done, total) of a rocksweep result at path, None if it is not one."""
     try:
@@ -440,7 +458,11 @@ def result_of(ds) -> SweepResult:
     either. A Dataset that is not a rocksweep sweep result is a one-line StoreError."""
     import json
 
-    where = Path(str(ds.encoding.get("source") or ds.attrs.get("title") or "dataset"))
+    source = ds.encoding.get("source")
+    in_file = isinstance(source, str | Path) and bool(str(source))
+    # a Dataset made in memory is named by its title in messages, never opened by it
+    where = Path(str(source) if in_file else
+                 f"result in memory ({ds.attrs.get('title') or 'untitled'})")
     if "outcome" not in ds.data_vars or "scene_resolved" not in ds.attrs:
         raise StoreError(f"{where}: not a rocksweep result (a Dataset from rocksweep.run or "
                          "rocksweep.open has an outcome variable and a scene_resolved "
@@ -461,7 +483,7 @@ def result_of(ds) -> SweepResult:
               if set(v.dims) == set(dims)}
     attrs = {str(k): _plain(v) for k, v in ds.attrs.items()}
     return SweepResult(where, dims, tuple(len(coords[d]) for d in dims), coords, scalars,
-                       arrays, attrs, stored)
+                       arrays, attrs, stored, in_file)
 
 
 def as_result(data, names: list[str] | None = None) -> SweepResult:
@@ -501,6 +523,43 @@ def stored_record(path: Path, rec: dict):
         raise _damaged(path, f"its copy of the record: {err}") from None
 
 
+def stored_records(path: Path, suite: dict) -> tuple | None:
+    """The records a suite's result file keeps (``_store_suite_records``) as
+    ``GroundRecord``s in the suite's order, each checked against the SHA-256 the resolved
+    scene states; None for a file that keeps no copies (made before suites stored them).
+    StoreError if a copy is damaged."""
+    import hashlib
+
+    from rocksweep.physics.records import RecordError, parse_record
+
+    want = suite.get("records") or []
+    f = _open(path, "r")
+    try:
+        g = f.get(SUITE_GROUP)
+        if g is None:
+            return None
+        blobs = []
+        for i, r in enumerate(want):
+            d = g.get(str(i))
+            if d is None:
+                raise _damaged(path, f"its copy of record {r.get('name')!r} is missing")
+            blobs.append(bytes(np.asarray(d[()], dtype=np.uint8).tobytes()))
+    except _H5_ERRORS as err:
+        raise _damaged(path, f"its copies of the records: {_why(err)}") from None
+    finally:
+        _close_quietly(f)
+    out = []
+    for r, data in zip(want, blobs, strict=True):
+        if hashlib.sha256(data).hexdigest() != r.get("sha256"):
+            raise _damaged(path, f"its copy of record {r.get('name')!r} does not match its "
+                                 "SHA-256")
+        try:
+            out.append(parse_record(data, str(r.get("source"))))
+        except RecordError as err:
+            raise _damaged(path, f"its copy of record {r.get('name')!r}: {err}") from None
+    return tuple(out)
+
+
 def result_scene(result: SweepResult) -> Scene:
     """The scene a result was computed from, rebuilt from its YAML and overrides and
     checked against the result's resolved scene (axes, numerics), so that the kernel runs
@@ -524,7 +583,7 @@ def result_scene(result: SweepResult) -> Scene:
         # the file's own copy first (a result stands alone); a file without one re-reads
         # the record from where the sweep read it, checked against its SHA-256
         # a Dataset made in memory (rocksweep.run without output) has no file to read
-        record = stored_record(result.path, rec) if result.path.is_file() else None
+        record = stored_record(result.path, rec) if result.in_file else None
         if record is None:
             from rocksweep.physics.records import RecordError, read_record
 
@@ -538,15 +597,19 @@ def result_scene(result: SweepResult) -> Scene:
                 raise StoreError(f"{shown(result.path)}: the record {rec['source']} changed "
                                  f"since the sweep (sha256 {record.sha256[:12]}, the result "
                                  f"has {rec['sha256'][:12]})")
-    elif suite:  # the records where the sweep read them (their SHA-256s are compared)
+    records = stored_records(result.path, suite) if suite and result.in_file else None
+    if suite and records is None:
+        # a file without copies (older rocksweep) or a Dataset made in memory: the records
+        # where the sweep read them (their SHA-256s are compared below)
         overrides.append("ground.records=" + json.dumps(
             [str(r.get("source")) for r in suite.get("records") or []]))
     try:
-        sc = parse_scene(str(a["scene"]), str(result.path), overrides, record=record)
+        sc = parse_scene(str(a["scene"]), str(result.path), overrides, record=record,
+                         records=records)
     except RocksweepError as err:
         raise StoreError(f"{shown(result.path)}: cannot rebuild its scene ({err})") from None
     stored = {k: v for k, v in result.scene.items() if k != "adaptive"}
-    added = bool(suite) and not rec  # the override above is not the file's
+    added = bool(suite) and not rec and records is None  # the override is not the file's
     diffs = scene_differences(stored, resolved_scene(sc, overrides[:len(overrides) - added]))
     if diffs:
         raise StoreError(f"{shown(result.path)}: its scene YAML no longer gives its grid "
