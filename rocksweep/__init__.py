@@ -13,7 +13,8 @@ The Python API (see the README's "Python API"):
   rtol=)`` -> Dataset of A_min; ``rocksweep.boundary_lines(ds)`` -> DataFrame;
   ``rocksweep.spectra(ds)`` -> Dataset; ``rocksweep.estimate(scene)``: the cost of a run;
   ``rocksweep.fragility(ds, state=, bootstrap=)`` -> Dataset of lognormal fragility
-  curves of a record-suite sweep.
+  curves of a record-suite sweep; ``rocksweep.risk(fr, hazard, years=50)`` -> Dataset of
+  the annual rate and probability of each state over a hazard curve.
   Each analysis takes what ``run`` and ``open`` return.
 - ``rocksweep.RocksweepError``: the base of every error a user can fix (one line).
 
@@ -30,6 +31,7 @@ from rocksweep.api import (  # noqa: A004
     ida,
     open,
     plot,
+    risk,
     run,
     simulate,
     spectra,
@@ -65,4 +67,4 @@ def __getattr__(name: str) -> str:
 
 
 __all__ = ["RocksweepError", "__version__", "boundaries", "boundary_lines", "estimate",
-           "fragility", "ida", "open", "plot", "run", "simulate", "spectra"]
+           "fragility", "ida", "open", "plot", "risk", "run", "simulate", "spectra"]

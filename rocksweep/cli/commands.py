@@ -7,6 +7,7 @@ from rocksweep.cli import (  # noqa: F401
     info,
     plot,
     restitution,
+    risk,
     simulate,
     spectrum,
     sweep,
