@@ -707,6 +707,20 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = N
 
 
 @speaks_python
+def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
+    """Which IM explains ``state`` best: for every IM of a record-suite sweep's records
+    (PGA, PGV, Sa(T), AvgSa, Arias, CAV, D5-95, PGV/PGA, PGA/(g tan alpha), PGV p/(g tan
+    alpha)) the lognormal dispersion ``beta`` of the fragility in that IM (each record's
+    first overturning level, an interval between stripes, re-expressed in the IM; a
+    regression for the IMs scaling leaves unchanged) and ``beta_scale`` (comparable across
+    IMs; lower is better), per value of the other swept keys
+    (``rocksweep.analysis.efficiency``)."""
+    from rocksweep.analysis.efficiency import im_efficiency as compute
+
+    return compute(_as_dataset(ds, "ds"), state=state)
+
+
+@speaks_python
 def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> Any:
     """What ``run`` of this scene will cost on this machine, without running it: points,
     RK4 steps and evaluations expected, seconds of compute with ``jobs`` workers, and
@@ -893,6 +907,10 @@ class RocksweepAccessor:
     def risk(self, hazard: Any, years: float = 50, **kwargs: Any) -> Any:
         """``rocksweep.risk(ds, hazard, years)``: annual rate and probability per state."""
         return risk(self._ds, hazard, years, **kwargs)
+
+    def im_efficiency(self, **kwargs: Any) -> Any:
+        """``rocksweep.im_efficiency(ds, ...)``: beta of the fragility in every IM."""
+        return im_efficiency(self._ds, **kwargs)
 
     def outcome_words(self) -> Any:
         """``outcome`` as words (not_run, safe, mode1, mode2), an object DataArray."""
