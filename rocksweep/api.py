@@ -480,7 +480,11 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
          curves: bool = False, show_computed: bool = False, mu: bool = False,
          width: str | None = None, compare: str | None = None,
          _names: tuple[str, ...] = ("x", "y", "compare")) -> Figure:
-    """The stability diagram of a result (Figures 3 and 4) as a pyplot-free Figure.
+    """The figure of any rocksweep Dataset, pyplot-free: a sweep's stability diagram
+    (Figures 3 and 4; the options below), or the figure of a fragility (curves, stripe
+    fractions sized by record count, bands, beta in the legend, IM on a log axis), IDA,
+    spectra, risk (hazard, fragility, the rate's integrand) or IM-efficiency Dataset
+    (``rocksweep.figures.dispatch``; ``ax`` and ``width`` apply to all).
 
     ds: what ``run`` or ``open`` returns. x, y: the swept keys on the axes (default
     w_over_p and A_ratio, or the two swept keys besides lam); one panel per value of the
@@ -497,10 +501,17 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     """
     import matplotlib
 
+    from rocksweep.analysis.kinds import dataset_kind
     from rocksweep.figures.common import width_style
     from rocksweep.figures.diagrams import friction_map, sweep_figure
     from rocksweep.store.reader import as_result
 
+    kind = dataset_kind(ds)
+    if kind not in (None, "sweep"):  # an analysis's Dataset: the figure of its kind
+        from rocksweep.figures.dispatch import plot_analysis
+
+        with matplotlib.rc_context(width_style(width)):
+            return plot_analysis(ds, ax=ax, width=width)
     result = as_result(ds)
     style = width_style(width)
     with matplotlib.rc_context(style):
@@ -621,6 +632,93 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     frag = fit(ds, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci)
     frag.attrs["title"] = str(ds.attrs.get("title", ""))
     return frag
+
+
+def open_any(path: str | Path) -> xr.Dataset:
+    """Any rocksweep Dataset from a file: a sweep result (``open``) or what an analysis
+    wrote with ``-o .h5`` (fragility, risk, IM efficiency: netCDF-4), its JSON attributes
+    (lists) decoded. A file that is neither is a one-line ``ApiError``."""
+    import json
+
+    import xarray as xr
+
+    from rocksweep.analysis.kinds import dataset_kind
+    from rocksweep.outputs import input_problem, shown
+
+    path = Path(path)
+    problem = input_problem(path)
+    if problem:
+        raise ApiError(f"{shown(path)}: {problem}")
+    try:
+        import h5py
+
+        with h5py.File(path, "r") as f:
+            sweep = "outcome" in f and "status" in f
+    except OSError:
+        raise ApiError(f"{shown(path)}: not an HDF5 file (a rocksweep result or an "
+                       "analysis written with -o .h5)") from None
+    if sweep:
+        return open(path)
+    try:
+        with xr.open_dataset(path, engine="h5netcdf") as ds:
+            ds = ds.load()
+    except (ValueError, TypeError, KeyError, OSError) as err:
+        raise ApiError(f"{shown(path)}: cannot be read as a Dataset ({err})") from None
+    for k, v in list(ds.attrs.items()):
+        if isinstance(v, str) and v[:1] in "[{":
+            try:
+                ds.attrs[k] = json.loads(v)
+            except ValueError:
+                pass
+        elif hasattr(v, "item") and getattr(v, "size", 2) == 1:
+            ds.attrs[k] = v.item()
+    if dataset_kind(ds) is None:
+        raise ApiError(f"{shown(path)}: not a rocksweep result (neither a sweep nor a "
+                       "fragility, risk, IDA or IM-efficiency Dataset)")
+    register_accessor()
+    return ds
+
+
+def _as_dataset(ds: Any, what: str) -> xr.Dataset:
+    """A Dataset argument, or a path to one (``open_any``)."""
+    import xarray as xr
+
+    if isinstance(ds, str | Path):
+        return open_any(ds)
+    if not isinstance(ds, xr.Dataset):
+        raise ApiError(f"{what} = {type(ds).__name__}: must be an xarray Dataset "
+                       "(rocksweep.run, rocksweep.open or an analysis) or a path to one")
+    return ds
+
+
+@speaks_python
+def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = None
+         ) -> xr.Dataset:
+    """Mean annual rate and probability in ``years`` of each state of a fragility:
+    lambda = integral P(state | im) |d lambda_im| over the hazard curve, 1 - exp(-lambda N)
+    (``rocksweep.analysis.risk``). fr: what ``rocksweep.fragility`` returns (or its file);
+    hazard: a CSV path (``PGA [g],annual_rate``, or OpenQuake's hazard-curve CSV, ``site``
+    its row) or a DataFrame of those two columns. Returns a Dataset: ``annual_rate``,
+    ``probability`` per state and lam, their ``_lo``/``_hi`` from the fragility's
+    bootstrap resamples, ``annual_rate_max`` (the tail above the hazard at its largest),
+    ``reason``; beyond the hazard's range the rate is bounded, never extrapolated."""
+    from rocksweep.analysis.risk import risk as compute
+
+    return compute(_as_dataset(fr, "fr"), hazard, years, site=site)
+
+
+@speaks_python
+def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
+    """Which IM explains ``state`` best: for every IM of a record-suite sweep's records
+    (PGA, PGV, Sa(T), AvgSa, Arias, CAV, D5-95, PGV/PGA, PGA/(g tan alpha), PGV p/(g tan
+    alpha)) the lognormal dispersion ``beta`` of the fragility in that IM (each record's
+    first overturning level, an interval between stripes, re-expressed in the IM; a
+    regression for the IMs scaling leaves unchanged) and ``beta_scale`` (comparable across
+    IMs; lower is better), per value of the other swept keys
+    (``rocksweep.analysis.efficiency``)."""
+    from rocksweep.analysis.efficiency import im_efficiency as compute
+
+    return compute(_as_dataset(ds, "ds"), state=state)
 
 
 @speaks_python
@@ -806,6 +904,14 @@ class RocksweepAccessor:
     def ida(self, **kwargs: Any) -> Any:
         """``rocksweep.ida(ds, ...)``: the first overturning level of each record."""
         return ida(self._ds, **kwargs)
+
+    def risk(self, hazard: Any, years: float = 50, **kwargs: Any) -> Any:
+        """``rocksweep.risk(ds, hazard, years)``: annual rate and probability per state."""
+        return risk(self._ds, hazard, years, **kwargs)
+
+    def im_efficiency(self, **kwargs: Any) -> Any:
+        """``rocksweep.im_efficiency(ds, ...)``: beta of the fragility in every IM."""
+        return im_efficiency(self._ds, **kwargs)
 
     def outcome_words(self) -> Any:
         """``outcome`` as words (not_run, safe, mode1, mode2), an object DataArray."""

@@ -3,10 +3,12 @@
 from rocksweep.cli import (  # noqa: F401
     accuracy,
     boundaries,
+    efficiency,
     fragility,
     info,
     plot,
     restitution,
+    risk,
     simulate,
     spectrum,
     sweep,

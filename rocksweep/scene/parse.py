@@ -30,7 +30,14 @@ from rocksweep.numerics import Numerics
 from rocksweep.outputs import input_problem, is_input, shown
 from rocksweep.physics.points import RECORD
 from rocksweep.physics.records import GroundRecord, RecordError, read_record
-from rocksweep.physics.suite import DEFAULT_PERIODS, SCALE_IMS, Suite, SuiteError, make_suite
+from rocksweep.physics.suite import (
+    AVGSA_RANGE,
+    DEFAULT_PERIODS,
+    SCALE_IMS,
+    Suite,
+    SuiteError,
+    make_suite,
+)
 from rocksweep.scene.admission import _candidate_bodies, _check_cost
 from rocksweep.scene.loader import _CONTROL, _load_yaml, _YamlError
 from rocksweep.scene.model import Axis, Scene, SceneError
@@ -575,6 +582,28 @@ def _scale(ground: dict) -> tuple[str | None, str, Any, float, float]:
     return im, form, spec, period, math.nan
 
 
+def _avgsa(ground: dict, period: float) -> tuple[tuple[float, float], str]:
+    """AvgSa's period range [s] and how it was chosen (``rocksweep.physics.suite``):
+    ``ground.avgsa``, else AVGSA_RANGE x T_ref, T_ref the Sa stripes' period or 2 pi / p."""
+    key = "ground.avgsa"
+    spec = ground.get("avgsa")
+    if spec is not None:
+        ok = (isinstance(spec, list) and len(spec) == 2 and all(is_number(v) for v in spec))
+        lo, hi = (as_float(spec[0]), as_float(spec[1])) if ok else (math.nan, math.nan)
+        if not (ok and 0.0 < lo <= hi <= 100.0):
+            raise SceneError(f"{key} = {fmt(spec)}: {KEYS[key].allowed}")
+        return (lo, hi), f"ground.avgsa = [{lo:g}, {hi:g}] s"
+    if math.isfinite(period):
+        t_ref, why = period, "scale.period"
+    else:
+        form, pspec, _ = _axis_spec("ground.p", ground["p"])
+        p = _axis_values("ground.p", form, pspec)
+        t_ref = 2.0 * math.pi / float(np.exp(np.mean(np.log(p))))
+        why = "2 pi / p" if p.size == 1 else "2 pi / p (geometric mean of the swept p)"
+    a, b = AVGSA_RANGE
+    return (a * t_ref, b * t_ref), f"{a:g}-{b:g} x T_ref, T_ref = {why} = {t_ref:.4g} s"
+
+
 def _suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...] | None = None
            ) -> tuple[Suite, tuple[str, str, Any] | None, tuple[str, ...]]:
     """The suite of a ``ground.records`` section (records read and hashed, IMs computed
@@ -604,7 +633,8 @@ def _suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...] | No
         read = tuple(str(p) for p in (*paths, *listings))
     values = _axis_values("ground.scale.values", form, spec).tolist() if im else []
     try:
-        suite = make_suite(records, names, im, values, period, factor, _periods(ground))
+        suite = make_suite(records, names, im, values, period, factor,
+                           _periods(ground), *_avgsa(ground, period))
     except SuiteError as err:
         raise SceneError(f"ground.records: {err}") from None
     return suite, ((im, form, spec) if im else None), read
@@ -650,7 +680,7 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
             suite, stripe, inputs = _suite(ground, base, given_records)
             pulse = {"shape": RECORD, "p": ground["p"]}
         else:
-            for k in ("scale", "periods"):
+            for k in ("scale", "periods", "avgsa"):
                 if ground.get(k) is not None:
                     raise SceneError(f"ground.{k}: works with ground.records (a suite); one "
                                      "ground.record is scaled by ground.A_ratio")
@@ -749,4 +779,7 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
                          "outputs work with sine and cosine pulses")
     bodies = _candidate_bodies(scene)
     _check_cost(scene, bodies)
+    if suite is not None:  # drift and large factors: one-line RecordWarnings
+        suite.warn(scene.axis("alpha" if kind == "block" else "alpha_cg").values,
+                   scene.axis("p").values)
     return scene

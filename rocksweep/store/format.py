@@ -297,6 +297,9 @@ def suite_variables(scene: Scene) -> dict[str, tuple[tuple[str, ...], np.ndarray
         "record_pga": (("record",), np.asarray(su.pga, float)),
         "record_pgv": (("record",), np.asarray(su.pgv, float)),
         "record_sa": (("record", "period"), np.asarray(su.sa, float)),
+        **{k: (("record",), v) for k, v in su.record_ims().items() if k not in (
+            "record_pga", "record_pgv")},  # Arias, CAV, D5-95, PGV/PGA, AvgSa (RECORD_IMS)
+        "record_v_end": (("record",), np.asarray(su.v_end, float)),
         "record_npts": (("record",), np.array([r.npts for r in su.records], np.int64)),
         "record_dt": (("record",), np.array([r.dt for r in su.records], float)),
         "record_duration": (("record",), np.array([r.duration for r in su.records], float)),
@@ -350,6 +353,9 @@ def _write_suite(f: h5py.File, scene: Scene, scales: dict) -> None:
         if units is not None:
             ds.attrs["units"] = units
         ds.attrs["description"] = text
+        if name == "record_avgsa":  # its period range and how it was chosen
+            ds.attrs["avgsa_periods"] = np.asarray(su.avgsa_range, float)
+            ds.attrs["avgsa_rule"] = su.avgsa_rule
         for i, d in enumerate(dims):
             ds.dims[i].attach_scale(scales[d])
 
