@@ -40,12 +40,18 @@ from rocksweep.errors import RocksweepError
 from rocksweep.physics.model import G
 from rocksweep.physics.records import GroundRecord
 from rocksweep.vocab.ground import (  # noqa: F401
+    ARIAS,
+    AVGSA,
+    CAV,
+    D5_95,
     DEFAULT_PERIODS,
     PGA,
     PGA_RATIO,
     PGV,
+    PGV_OVER_PGA,
     PGV_RATIO,
     RATIO_OF,
+    RECORD_IMS,
     SA,
     SA_DAMPING,
     SCALE_IMS,
@@ -60,18 +66,6 @@ DRIFT_SHARE = 0.1
 #: warn when a record is scaled by more than this factor
 MAX_FACTOR = 5.0
 
-#: The record IMs stored per record (the one list): name -> (variable, units, exponent n:
-#: the IM of the record times F is F^n times its IM; 0: scale-invariant). Sa(T) is
-#: ``record_sa`` along ``period`` (n = 1).
-RECORD_IMS: dict[str, tuple[str, str, int]] = {
-    "PGA": ("record_pga", "g", 1),
-    "PGV": ("record_pgv", "m/s", 1),
-    "Arias": ("record_arias", "m/s", 2),
-    "CAV": ("record_cav", "m/s", 1),
-    "D5_95": ("record_d5_95", "s", 0),
-    "PGV_over_PGA": ("record_pgv_over_pga", "s", 0),
-    "AvgSa": ("record_avgsa", "g", 1),
-}
 
 
 class RecordWarning(UserWarning):
@@ -114,9 +108,8 @@ class Suite:
 
     def record_ims(self) -> dict[str, np.ndarray]:
         """Each ``RECORD_IMS`` variable (not Sa) -> float64[R], the records as recorded."""
-        own = {"PGA": self.pga, "PGV": self.pgv, "Arias": self.arias, "CAV": self.cav,
-               "D5_95": self.d5_95, "PGV_over_PGA": self.pgv / (self.pga * G),
-               "AvgSa": self.avgsa}
+        own = {PGA: self.pga, PGV: self.pgv, ARIAS: self.arias, CAV: self.cav,
+               D5_95: self.d5_95, PGV_OVER_PGA: self.pgv / (self.pga * G), AVGSA: self.avgsa}
         return {RECORD_IMS[k][0]: np.asarray(v, np.float64) for k, v in own.items()}
 
     def warn(self, alpha_ref, p) -> None:
