@@ -24,6 +24,7 @@ from matplotlib.lines import Line2D
 from rocksweep.errors import RocksweepError
 from rocksweep.outputs import atomic_path, check_output
 from rocksweep.vocab import axes as _axes
+from rocksweep.vocab.laws import DEFAULT_LAW, VERTICAL, law_origin
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -207,7 +208,7 @@ _U_COLOURS = {-2.0: "#2166ac", -1.0: "#67a9cf", 0.0: "#000000", 1.0: "#ef8a62",
 def restitution_map(lam: np.ndarray, u_over_ucr: np.ndarray, e_upper: np.ndarray,
                     e_housner: float, title: str = "",
                     axes: Sequence[Axes] | None = None, lam_limit: np.ndarray | None = None,
-                    law: str = "vertical") -> Figure:
+                    law: str = DEFAULT_LAW) -> Figure:
     """Figure 2: (a) e against lam for u/u_cr = -2, -1, 0, 1, 2; (b) e against u/u_cr at
     lam = 0 with Housner's e of the same body welded rigid.
 
@@ -250,11 +251,11 @@ def restitution_map(lam: np.ndarray, u_over_ucr: np.ndarray, e_upper: np.ndarray
     ax_a.axhline(0.0, color="0.5", lw=0.6)
     ax_a.set_xlabel(r"$\lambda$")
     ax_a.set_ylabel("$e$")
-    which = "upper sign of eq. 1" if law == "vertical" else f"law {law}, upper sign"
+    which = "upper sign of eq. 1" if law == VERTICAL else f"law {law}, upper sign"
     ax_a.set_title(rf"(a) $e$ against $\lambda$ ({which})", fontsize=10)
     ax_a.legend(fontsize=8)
     i0 = int(np.argmin(abs(lam)))
-    first = "eq. (1)" if law == "vertical" else f"law {law}"
+    first = law_origin(law) if law == VERTICAL else f"law {law}"
     ax_b.plot(u_over_ucr, e_upper[i0], color="C0",
               label=rf"{first}, $\lambda$ = {lam[i0]:g}, upper sign")
     ax_b.plot(u_over_ucr, e_upper[i0, ::-1], color="C1", ls="--",

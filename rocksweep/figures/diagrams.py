@@ -72,7 +72,7 @@ DEFAULT_X, DEFAULT_Y = DIAGRAM_AXES  # symbols, units: rocksweep.vocab.axes
 
 def _alpha(kind: str) -> str:
     """LaTeX of the body kind's alpha_ref (alpha_cg, alpha)."""
-    return _axes.ALPHA_REF.get(kind, _axes.ALPHA_REF["block"])[1]
+    return _axes.alpha_latex(kind)
 
 _SAFE, _MODE2, _NOT_RUN = "#ffffff", "#4c72b0", "#bdbdbd"
 _UNSURE = "#e69f00"  # rings: the outcome changes at half the step (outputs.check)
