@@ -6,8 +6,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.figure import Figure
 
+from rocksweep.figures.common import Figure
 from rocksweep.vocab import axes as _axes
 
 if TYPE_CHECKING:
