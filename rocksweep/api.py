@@ -502,7 +502,7 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     import matplotlib
 
     from rocksweep.analysis.kinds import dataset_kind
-    from rocksweep.figures.common import width_style
+    from rocksweep.figures.common import fit_width, width_style
     from rocksweep.figures.diagrams import friction_map, sweep_figure
     from rocksweep.store.reader import as_result
 
@@ -511,7 +511,10 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
         from rocksweep.figures.dispatch import plot_analysis
 
         with matplotlib.rc_context(width_style(width)):
-            return plot_analysis(ds, ax=ax, width=width)
+            fig = plot_analysis(ds, ax=ax, width=width)
+        if width is not None and ax is None:
+            fit_width(fig, width)
+        return fig
     result = as_result(ds)
     style = width_style(width)
     with matplotlib.rc_context(style):
@@ -521,10 +524,8 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
             fig = sweep_figure(result, x, y, axes=ax, option_names=_names[:2], curves=curves,
                                show_computed=show_computed, compare=compare,
                                compare_option=_names[2])
-    if style and ax is None:  # the preset's width, the layout's aspect
-        w, h = fig.get_size_inches()
-        inches = style["figure.figsize"][0]
-        fig.set_size_inches(inches, h * inches / w)
+    if style and ax is None:  # the preset's width, the layout's aspect, what fits in it
+        fit_width(fig, width)
     return fig
 
 

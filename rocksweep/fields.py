@@ -105,7 +105,9 @@ FIELDS: tuple[Field, ...] = (
           L.OUT_T_END, stored=False),
     Field("t_first_impact", "float64", math.nan, "1/p", "first impact time p*t (NaN if none)",
           L.OUT_T_FIRST_IMPACT, stored=False),
-    Field("e_max", "float64", math.nan, "1", "largest coefficient of restitution seen (eq. 1)",
+    Field("e_max", "float64", math.nan, "1",
+          "largest coefficient of restitution seen (of the point's impact law, impact.law: "
+          "eq. (1) for vertical; times impact.e_factor)",
           L.OUT_E_MAX, stored=False),
     Field("returns_to_contact", "int64", -1, "1",
           "returns to full contact (e <= 0, or settling below the rest rate)", L.OUT_CONTACTS,

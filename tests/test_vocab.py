@@ -141,3 +141,11 @@ def test_axis_labels_name_units_and_the_body_kind():
     assert axes.label("PGV") == "$PGV$ [m/s]"
     assert axes.symbol("A_ratio", "flexible") == "A/(g tan alpha_cg)"
     assert axes.label("unknown_axis") == "unknown_axis"
+
+
+def test_e_max_is_labelled_by_the_impact_law_not_eq_1_alone():
+    """Review 3: e_max said "(eq. 1)" under every impact law."""
+    from rocksweep import fields
+
+    meaning = fields.BY_NAME["e_max"].meaning
+    assert "impact.law" in meaning and not meaning.endswith("(eq. 1)")

@@ -116,7 +116,7 @@ LADDERS: dict[str, Callable[[], list[Setting]]] = {
     "full": lambda: (_steps((5, 10, 20, 40, 80, 160), 1e-12)
                      + _tols(80, (1e-4, 1e-5, 1e-6, 1e-8)) + _presets()),
     "short": lambda: _steps((10, 20), 1e-12) + _presets(),
-    # the cheap settings the default preset is chosen from (README, "Accuracy and its price")
+    # the cheap settings the default preset is chosen from (docs/accuracy.md)
     # (with the default preset's rotation limit)
     "candidates": lambda: (_steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-6, True,
                                   PRESET_ROTATION["default"])

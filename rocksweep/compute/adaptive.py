@@ -21,7 +21,7 @@ swept axes with at least 2 values), for every value of the other axes (a *panel*
    at 1000 x 1000 x 3 lam (``scripts/bench_adaptive.py --fine``): 3.77% of the points
    computed instead of 4.46%, 99.9990% of the outcomes equal to the full grid instead of
    99.9997%. What it misses are one-point specks on a boundary and one-point slivers
-   (at 400 x 400, 0-70 cells of a scene instead of 0-44, see the README's table);
+   (at 400 x 400, 0-70 cells of a scene instead of 0-44, docs/adaptive.md's table);
 3. audit: a fixed pseudo-random share ``audit`` of all points (seeded, independent of the
    state) is computed once refinement has converged, i.e. a Bernoulli sample of the points
    that would be filled. An audit point whose class differs from its fill makes its cells

@@ -37,7 +37,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap
-from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
@@ -45,10 +44,12 @@ from rocksweep.fields import WORD_AXES
 from rocksweep.figures.common import (
     DEFAULT_DPI,
     FORMATS,
+    Figure,
     FigureError,
     given_axes,
     new_axes,
     save_figure,
+    wrap_title,
 )
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.store.reader import SweepResult
@@ -72,7 +73,7 @@ DEFAULT_X, DEFAULT_Y = DIAGRAM_AXES  # symbols, units: rocksweep.vocab.axes
 
 def _alpha(kind: str) -> str:
     """LaTeX of the body kind's alpha_ref (alpha_cg, alpha)."""
-    return _axes.ALPHA_REF.get(kind, _axes.ALPHA_REF["block"])[1]
+    return _axes.alpha_latex(kind)
 
 _SAFE, _MODE2, _NOT_RUN = "#ffffff", "#4c72b0", "#bdbdbd"
 _UNSURE = "#e69f00"  # rings: the outcome changes at half the step (outputs.check)
@@ -257,27 +258,8 @@ def _title(result: SweepResult, on_axes: Sequence[str]) -> str:
 
 
 def _fit(title: str, fig: Figure) -> str:
-    """A title wrapped to the figure's width (about 9 characters per inch at 11 pt), so
-    a long scene name is not cut at the edges: words outside mathtext ($...$) break."""
-    width = max(20, int(9 * fig.get_figwidth()))
-    if len(title) <= width:
-        return title
-    words = [w for w in title.split(" ")]
-    tokens, math = [], False  # words joined while inside $...$
-    for w in words:
-        if math:
-            tokens[-1] += " " + w
-        else:
-            tokens.append(w)
-        if w.count("$") % 2:
-            math = not math
-    lines = [""]
-    for t in tokens:
-        if lines[-1] and len(lines[-1]) + 1 + len(t) > width:
-            lines.append(t)
-        else:
-            lines[-1] = f"{lines[-1]} {t}" if lines[-1] else t
-    return "\n".join(lines)
+    """A title wrapped to the figure's width at 11 pt (``common.wrap_title``)."""
+    return wrap_title(title, fig.get_figwidth(), 11.0)
 
 
 def _place_axes(axes, n: int, rows_cols: tuple[int, int], size: tuple[float, float],
@@ -562,7 +544,7 @@ def compare_diagram(result: SweepResult, key: str, x: str | None = None,
     o, fl = _arrays(result, order, ["outcome", flagged])
     values = list(_coord(result, name))
     labels = [_value_label(name, v) for v in values]
-    what = "law" if name == "law" else "value"
+    what = "law" if name == "law" else f"${_axes.latex(name, result.kind)}$ value"
     panels = _panels(result, panel_dims)
     n_cat = 3 + (1 << n) - 1
     colours = [_NOT_RUN, _SAFE, _MODE2, *(_compare_colour(m, n) for m in range(1, 1 << n))]

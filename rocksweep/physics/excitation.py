@@ -44,7 +44,7 @@ still "on", as in the kernel, where the step ending exactly at D still sees the 
 
 ``PulseShape`` bundles a shape with its parameters; ``uplift_phase`` is the rigid block's
 uplift under it (|A_ratio * shape(phi)| first reaches 1, the block's g tan(alpha));
-``shapes_figure`` draws every shape (matplotlib is imported only there).
+``rocksweep.figures.pulses.shapes_figure`` draws every shape.
 """
 
 from __future__ import annotations
@@ -52,12 +52,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import TYPE_CHECKING
 
 import numpy as np
-
-if TYPE_CHECKING:
-    from matplotlib.figure import Figure
 
 from rocksweep.vocab.ground import (  # noqa: F401
     MP,
@@ -228,32 +224,3 @@ def default_shapes() -> tuple[PulseShape, ...]:
     return (PulseShape("sine"), PulseShape("sine", cycles=2), PulseShape("cosine"),
             PulseShape("cosine", cycles=2), PulseShape("ricker"),
             PulseShape("mp", gamma=2.0, nu_deg=90.0), PulseShape("mp", gamma=2.0, nu_deg=0.0))
-
-
-def shapes_figure(shapes: tuple[PulseShape, ...] | None = None,
-                  figsize: tuple[float, float] = (10.0, 2.6)) -> Figure:
-    """A figure of xg''/A against w t, one panel per family (sine, cosine, Ricker, MP).
-
-    Shapes of the same family share a panel. Returns a matplotlib Figure (no pyplot);
-    matplotlib is imported here only, so the module stays numpy/scipy at import.
-    """
-    from matplotlib.figure import Figure
-
-    shapes = default_shapes() if shapes is None else tuple(shapes)
-    families = [s for s in SHAPES if any(p.shape == s for p in shapes)]
-    fig = Figure(figsize=figsize, layout="constrained")
-    axes = fig.subplots(1, len(families), sharey=True, squeeze=False)[0]
-    for ax, family in zip(axes, families, strict=True):
-        members = [p for p in shapes if p.shape == family]
-        d_max = max(p.duration for p in members)
-        for k, p in enumerate(members):
-            phi = np.linspace(-0.05 * d_max, 1.05 * d_max, 2000)
-            ax.plot(phi, p.acc(phi), lw=1.2, ls=("-", "--", ":")[k % 3], label=p.label)
-        ax.axhline(0.0, color="0.6", lw=0.5)
-        ax.set_title(SHAPE_TITLE[family], fontsize=9)
-        ax.set_xlabel(r"$\omega t$")
-        ax.set_ylim(-1.8, 1.15)  # room below the curves for the legend
-        ax.legend(fontsize=6, loc="lower center", frameon=False)
-        ax.tick_params(labelsize=7)
-    axes[0].set_ylabel(r"$\ddot x_g / A$")
-    return fig

@@ -67,6 +67,11 @@ ALPHA_REF: dict[str, tuple[str, str]] = {"flexible": ("alpha_cg", r"\alpha_{cg}"
                                          "block": ("alpha", r"\alpha")}
 
 
+def alpha_latex(kind: str = "flexible") -> str:
+    """LaTeX of the body kind's alpha_ref: alpha_cg (flexible), alpha (block)."""
+    return ALPHA_REF.get(kind, ALPHA_REF["block"])[1]
+
+
 def symbol(name: str, kind: str = "flexible") -> str:
     """The plain-text symbol of a swept key (its name if it has none), alpha_ref written as
     the body kind's slenderness."""
@@ -81,7 +86,7 @@ def latex(name: str, kind: str = "flexible") -> str:
     meta = AXES.get(name)
     if meta is None:
         return r"\mathrm{" + name.replace("_", r"\_") + "}"
-    return meta.latex.replace(r"\alpha_{ref}", ALPHA_REF.get(kind, ALPHA_REF["block"])[1])
+    return meta.latex.replace(r"\alpha_{ref}", alpha_latex(kind))
 
 
 def label(name: str, kind: str = "flexible") -> str:
