@@ -229,9 +229,16 @@ def _open(path: Path, mode: str) -> h5py.File:
         return h5py.File(path, mode, locking=(mode != "r"))
     except _H5_ERRORS as err:
         no = getattr(err, "errno", None)
-        if isinstance(err, BlockingIOError) or "unable to lock" in str(err).lower():
+        text = str(err).lower()
+        if isinstance(err, BlockingIOError) or "unable to lock" in text:
             raise StoreError(f"{shown(path)}: open for writing by another process (a sweep "
                              "still running?)") from None
+        if any(w in text for w in _OPEN_HERE):
+            raise StoreError(f"{shown(path)}: already open in this process through another "
+                             "HDF5 handle (HDF5's file lock: e.g. xr.open_dataset(..., "
+                             "engine='h5netcdf') or h5py.File); the file is not damaged: "
+                             "close that handle (ds.close()) and try again; rocksweep.open "
+                             "loads the file and closes it at once") from None
         if no in (errno.EACCES, errno.EPERM, errno.EROFS):
             doing = "written" if mode != "r" else "read"
             raise StoreError(f"{shown(path)}: cannot be {doing} ({_why(err)})") from None
@@ -239,7 +246,16 @@ def _open(path: Path, mode: str) -> h5py.File:
             raise StoreError(f"{shown(path)}: not an HDF5 file (expected a rocksweep sweep "
                              "result)") from None
         raise StoreError(f"{shown(path)}: damaged or truncated HDF5 file, cannot be opened "
-                         "(rerun the sweep with --overwrite)") from None
+                         f"({_why(err)}); its points cannot be read back: if it is a copy, "
+                         "copy it again from the original; else sweep again to a new file "
+                         "(-o NEW.h5) and remove this one after") from None
+
+
+# What HDF5 says when the file is already open in this process with other settings (a
+# lock of this process, not damage): h5py/HDF5 1.10-1.14 wordings.
+_OPEN_HERE = ("locking flag values don't match", "already open for read-only",
+              "already open for write", "file close degree doesn't match",
+              "file is already open")
 
 
 # Attributes readers use (``rocksweep info``, ``plot``) -> what they must be.
