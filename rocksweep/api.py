@@ -444,8 +444,24 @@ def _dataset(source: Path | Any) -> xr.Dataset:
     register_accessor()  # ds.rocksweep.plot() etc.
     kwds = {"driver_kwds": {"locking": False}} if isinstance(source, Path) else {}
     try:
-        with xr.open_dataset(source, engine="h5netcdf", **kwds) as ds:
-            ds = ds.load()
+        try:
+            with xr.open_dataset(source, engine="h5netcdf", **kwds) as ds:
+                ds = ds.load()
+        except OSError as err:  # open here through another handle: take its lock flags
+            from rocksweep.store.reader import READER_LOCKING, _open_here
+
+            if not (kwds and _open_here(err)):
+                raise
+            for locking in READER_LOCKING:
+                try:
+                    with xr.open_dataset(source, engine="h5netcdf",
+                                         driver_kwds={"locking": locking}) as ds:
+                        ds = ds.load()
+                    break
+                except OSError:
+                    continue
+            else:
+                raise
     except (ValueError, TypeError, KeyError, OSError, OverflowError, AttributeError,
             IndexError) as err:  # xarray's CF decoding of a damaged attribute
         from rocksweep.outputs import shown

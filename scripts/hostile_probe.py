@@ -225,7 +225,7 @@ def _(d):
 
 # --- a good file called damaged -----------------------------------------------------------
 
-@case("lock: open() while xarray holds the file open (no 'damaged', no overwrite advice)")
+@case("lock: open() while xarray holds the file open", "any")
 def _(d):
     r = cli(d, ["sweep", "pulse.yaml", "-o", "p.h5", "-q"])
     if r.returncode:
@@ -234,7 +234,23 @@ def _(d):
         import xarray as xr
         ds = xr.open_dataset('p.h5', engine='h5netcdf')
         rocksweep.open('p.h5')""")
-    if "damaged" in r.stdout or "overwrite" in r.stdout or "lock" not in r.stdout.lower():
+    if ("damaged" in r.stdout.replace("not damaged", "") or "overwrite" in r.stdout
+            or (r.returncode and "lock" not in r.stdout.lower())):
+        r.stdout = "WRONG WORDS " + r.stdout
+        r.returncode = 99
+    return r
+
+
+@case("lock: run(resume=True) while xarray holds the file open")
+def _(d):
+    r = cli(d, ["sweep", "pulse.yaml", "-o", "p.h5", "-q"])
+    if r.returncode:
+        return r
+    r = py(d, """
+        import xarray as xr
+        ds = xr.open_dataset('p.h5', engine='h5netcdf')
+        rocksweep.run('pulse.yaml', output='p.h5', resume=True)""")
+    if "damaged" in r.stdout.replace("not damaged", "") or "overwrite" in r.stdout:
         r.stdout = "WRONG WORDS " + r.stdout
         r.returncode = 99
     return r
