@@ -364,6 +364,10 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
     where = {"backend": "threads"}
     if client is not None:
         address = getattr(getattr(client, "scheduler", None), "address", None)
+        if type(client).__name__ == "Client" and getattr(client, "status", None) in (
+                "closed", "closing"):
+            raise ApiError(f"client = {client!r}: this dask Client is closed; make a new one "
+                           "(Client(cluster) or Client('tcp://host:8786')) and pass it")
         if not isinstance(address, str):
             raise TypeError(f"client = {client!r}: must be a dask.distributed.Client")
         where = {"backend": "dask", "scheduler": address}

@@ -2,7 +2,7 @@
 errors), run against the command line or the Python API in a fresh directory.
 
     python scripts/hostile_probe.py            # every case
-    python scripts/hostile_probe.py -k listing # the cases whose name holds 'listing'
+    python scripts/hostile_probe.py -k 'listing|lock'  # the cases whose name holds one
     python scripts/hostile_probe.py -v         # also print each case's answer
 
 Each case is classified:
@@ -613,13 +613,14 @@ def classify(r: subprocess.CompletedProcess, before: dict, after: dict, expect: 
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("-k", default="", help="run only the cases whose name holds this")
+    ap.add_argument("-k", default="", help="run only the cases whose name holds this "
+                    "(alternatives separated by |)")
     ap.add_argument("-v", action="store_true", help="print every case's answer")
     a = ap.parse_args()
     counts: Counter[str] = Counter()
     t0 = time.perf_counter()
     for name, expect, fn in CASES:
-        if a.k not in name:
+        if not any(k in name for k in a.k.split("|")):
             continue
         with tempfile.TemporaryDirectory(prefix="probe-") as tmp:
             d = Path(tmp)
