@@ -487,7 +487,8 @@ def _dataset(source: Path | Any) -> xr.Dataset:
     if "status" in ds:
         ds["status"].attrs.setdefault("flag_masks", list(STATUS_WORDS))
         ds["status"].attrs.setdefault("flag_meanings", " ".join(STATUS_WORDS.values()))
-    ds.attrs = {k: (v.item() if hasattr(v, "item") else v) for k, v in ds.attrs.items()}
+    ds.attrs = {k: (v.item() if hasattr(v, "item") and getattr(v, "size", 1) == 1 else v)
+                for k, v in ds.attrs.items()}
     return ds
 
 

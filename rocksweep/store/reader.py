@@ -119,6 +119,11 @@ def _json_attr(f: h5py.File, key: str, path: Path, typ: type):
     return value
 
 
+# The attribute the netCDF-4 library and h5netcdf put on every file they write (xarray's
+# to_netcdf); rocksweep's writer (h5py) never does.
+NETCDF_MARK = "_NCProperties"
+
+
 def _looks_like_ours(f: h5py.File, fmt) -> bool:
     """Whether a file without a valid rocksweep_format attribute still shows the marks of a
     rocksweep result (then it is damaged, not foreign)."""
@@ -142,6 +147,15 @@ def _layout(f: h5py.File, path: Path) -> _Layout:
                          f"({_why(err)})") from None
     if isinstance(fmt, bytes | np.bytes_):
         fmt = bytes(fmt).decode("utf-8", "replace")
+    try:
+        resaved = NETCDF_MARK in f.attrs
+    except _H5_ERRORS:
+        resaved = False
+    if resaved:  # the netCDF library's mark: rocksweep writes with h5py, never sets it
+        raise StoreError(f"{shown(path)}: not written by rocksweep: a result saved again by "
+                         "xarray (to_netcdf) or another netCDF writer, which changes its "
+                         "layout; rocksweep reads the files its sweeps write (the original "
+                         "file; this one opens with xarray.open_dataset)")
     if fmt != FORMAT:
         if _looks_like_ours(f, fmt):  # a damaged result is not a foreign file
             raise _damaged(path, "attribute rocksweep_format " + (
@@ -340,6 +354,10 @@ def _checked_attrs(f: h5py.File, path: Path) -> dict:
             raise _damaged(path, f"attribute {k} missing")
         if not _attr_ok(k, attrs[k]):
             raise _damaged(path, f"attribute {k} is {_cut(attrs[k])}")
+    for k, v in attrs.items():  # the versions the writer records are text (info shows them)
+        if k.endswith("_version") and k != "format_version" and not isinstance(v, str):
+            raise _damaged(path, f"attribute {k} is {_cut(v)}, not a version text "
+                                 "(not as rocksweep writes it)")
     return attrs
 
 
