@@ -523,17 +523,21 @@ def _(d):
     return r
 
 
-def _interrupt(d: Path, delay: float) -> subprocess.CompletedProcess:
-    """Ctrl-C ``delay`` seconds after a sweep starts: exit 130, no traceback, a file that
-    resumes."""
+def _interrupt(d: Path, delay: float, after_header: bool) -> subprocess.CompletedProcess:
+    """Ctrl-C ``delay`` seconds after a sweep starts (after_header: after it printed its
+    header line, i.e. while the kernel loads and the first chunks run; else after the
+    process started): exit 130, no traceback, a file that resumes."""
     e = {**os.environ, "PYTHONPATH": str(ROOT)}
     big = PULSE.replace("[1, 2]", "{start: 0.5, stop: 6, num: 300}").replace(
         "[2, 4]", "{start: 1, stop: 8, num: 300}")
     (d / "big.yaml").write_text(big)
     freeze(d)
     p = subprocess.Popen([sys.executable, "-m", "rocksweep", "sweep", "big.yaml", "-o",
-                          "b.h5", "-q"], cwd=d, env=e, stdout=subprocess.PIPE,
+                          "b.h5"], cwd=d, env=e, stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE, text=True)
+    head = ""
+    if after_header:
+        head = p.stderr.readline()  # "big: 90000 points (...); 0 done, ..."
     time.sleep(delay)
     p.send_signal(signal.SIGINT)
     try:
@@ -541,8 +545,9 @@ def _interrupt(d: Path, delay: float) -> subprocess.CompletedProcess:
     except subprocess.TimeoutExpired:
         p.kill()
         raise
+    err = head + err
     r = subprocess.CompletedProcess(p.args, p.returncode, out, err)
-    if p.returncode != 130 or "Traceback" in err:
+    if p.returncode != 130 or "Traceback" in err or "Exception ignored" in err:
         r.stderr = f"EXIT {p.returncode}: " + err
         r.returncode = 99 if p.returncode == 0 else p.returncode
         return r
@@ -556,8 +561,14 @@ def _interrupt(d: Path, delay: float) -> subprocess.CompletedProcess:
     return r
 
 
-for _delay in (0.05, 0.2, 0.4, 0.6, 0.8, 1.0, 1.2, 1.5):
-    case(f"Ctrl-C {_delay:.2f} s into a sweep", "ok")(lambda d, t=_delay: _interrupt(d, t))
+# Before ~0.15 s (on a loaded machine) Python itself is still starting (importing site):
+# no rocksweep code runs yet, so the start-up cases begin at 0.3 s.
+for _delay in (0.3, 0.5):
+    case(f"Ctrl-C {_delay:.2f} s after the process started", "ok")(
+        lambda d, t=_delay: _interrupt(d, t, False))
+for _delay in (0.0, 0.02, 0.05, 0.1, 0.15, 0.3, 0.6):
+    case(f"Ctrl-C {_delay:.2f} s after the sweep's header", "ok")(
+        lambda d, t=_delay: _interrupt(d, t, True))
 
 
 def _amplitude(d: Path, value: float) -> subprocess.CompletedProcess:

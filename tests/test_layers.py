@@ -16,7 +16,7 @@ PKG = Path(__file__).resolve().parents[1] / "rocksweep"
 # lowest first: vocabulary, kernel, the model, scenes, computing, files, analyses,
 # figures, the facade, the command line
 FLOORS: list[tuple[str, ...]] = [
-    ("errors", "outputs", "kernel"),
+    ("errors", "outputs", "interrupts", "kernel"),
     ("numerics", "outcomes"),
     ("schema",),
     ("physics",),

@@ -65,9 +65,25 @@ class OneLineCommand(click.Command):
 
 
 class OneLineGroup(click.Group):
-    """The group whose commands answer bad usage in one line."""
+    """The group whose commands answer bad usage in one line, and Ctrl-C with exit 130
+    and one line (click would say "Aborted!" with exit 1): also when the interrupt was
+    swallowed by a library callback and surfaced as another error
+    (``rocksweep.interrupts``)."""
 
     command_class = OneLineCommand
+
+    def invoke(self, ctx: click.Context):
+        from rocksweep import interrupts
+
+        try:
+            return super().invoke(ctx)
+        except (SystemExit, click.exceptions.Exit):
+            raise
+        except BaseException as err:
+            if isinstance(err, KeyboardInterrupt) or interrupts.pending():
+                click.echo("\ninterrupted", err=True)
+                raise SystemExit(130) from None
+            raise
 
     def resolve_command(self, ctx: click.Context, args: list[str]):
         try:
