@@ -364,6 +364,10 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
     where = {"backend": "threads"}
     if client is not None:
         address = getattr(getattr(client, "scheduler", None), "address", None)
+        if type(client).__name__ == "Client" and getattr(client, "status", None) in (
+                "closed", "closing"):
+            raise ApiError(f"client = {client!r}: this dask Client is closed; make a new one "
+                           "(Client(cluster) or Client('tcp://host:8786')) and pass it")
         if not isinstance(address, str):
             raise TypeError(f"client = {client!r}: must be a dask.distributed.Client")
         where = {"backend": "dask", "scheduler": address}
@@ -444,8 +448,24 @@ def _dataset(source: Path | Any) -> xr.Dataset:
     register_accessor()  # ds.rocksweep.plot() etc.
     kwds = {"driver_kwds": {"locking": False}} if isinstance(source, Path) else {}
     try:
-        with xr.open_dataset(source, engine="h5netcdf", **kwds) as ds:
-            ds = ds.load()
+        try:
+            with xr.open_dataset(source, engine="h5netcdf", **kwds) as ds:
+                ds = ds.load()
+        except OSError as err:  # open here through another handle: take its lock flags
+            from rocksweep.store.reader import READER_LOCKING, _open_here
+
+            if not (kwds and _open_here(err)):
+                raise
+            for locking in READER_LOCKING:
+                try:
+                    with xr.open_dataset(source, engine="h5netcdf",
+                                         driver_kwds={"locking": locking}) as ds:
+                        ds = ds.load()
+                    break
+                except OSError:
+                    continue
+            else:
+                raise
     except (ValueError, TypeError, KeyError, OSError, OverflowError, AttributeError,
             IndexError) as err:  # xarray's CF decoding of a damaged attribute
         from rocksweep.outputs import shown
@@ -467,7 +487,8 @@ def _dataset(source: Path | Any) -> xr.Dataset:
     if "status" in ds:
         ds["status"].attrs.setdefault("flag_masks", list(STATUS_WORDS))
         ds["status"].attrs.setdefault("flag_meanings", " ".join(STATUS_WORDS.values()))
-    ds.attrs = {k: (v.item() if hasattr(v, "item") else v) for k, v in ds.attrs.items()}
+    ds.attrs = {k: (v.item() if hasattr(v, "item") and getattr(v, "size", 1) == 1 else v)
+                for k, v in ds.attrs.items()}
     return ds
 
 

@@ -395,7 +395,7 @@ _LIST_SUFFIXES = (".txt", ".list", ".lst")
 
 def _is_listing(path: Path) -> bool:
     """A text file listing record paths (suffix .txt, .list or .lst, and its first line
-    that is not blank or a # comment is not made of numbers: a two-column record's is).
+    that is not blank or a # comment is not two numbers: a two-column record's is).
     A file of that suffix that is not text (UTF-16, random bytes) counts as a listing:
     ``_listing`` says why it cannot be read."""
     if path.suffix.lower() not in _LIST_SUFFIXES or input_problem(path) is not None:
@@ -415,11 +415,12 @@ def _is_listing(path: Path) -> bool:
         t = line.strip()
         if not t or t.startswith("#"):
             continue
+        fields = t.replace(",", " ").split()
         try:
-            [float(x) for x in t.replace(",", " ").split()]
+            [float(x) for x in fields]
         except ValueError:
             return True
-        return False
+        return len(fields) != 2  # a record's row is two numbers; '123' names a file
     return True
 
 

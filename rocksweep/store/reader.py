@@ -11,7 +11,7 @@ import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NoReturn
 
 import numpy as np
 
@@ -120,6 +120,11 @@ def _json_attr(f: h5py.File, key: str, path: Path, typ: type):
     return value
 
 
+# The attribute the netCDF-4 library and h5netcdf put on every file they write (xarray's
+# to_netcdf); rocksweep's writer (h5py) never does.
+NETCDF_MARK = "_NCProperties"
+
+
 def _looks_like_ours(f: h5py.File, fmt) -> bool:
     """Whether a file without a valid rocksweep_format attribute still shows the marks of a
     rocksweep result (then it is damaged, not foreign)."""
@@ -143,6 +148,15 @@ def _layout(f: h5py.File, path: Path) -> _Layout:
                          f"({_why(err)})") from None
     if isinstance(fmt, bytes | np.bytes_):
         fmt = bytes(fmt).decode("utf-8", "replace")
+    try:
+        resaved = NETCDF_MARK in f.attrs
+    except _H5_ERRORS:
+        resaved = False
+    if resaved:  # the netCDF library's mark: rocksweep writes with h5py, never sets it
+        raise StoreError(f"{shown(path)}: not written by rocksweep: a result saved again by "
+                         "xarray (to_netcdf) or another netCDF writer, which changes its "
+                         "layout; rocksweep reads the files its sweeps write (the original "
+                         "file; this one opens with xarray.open_dataset)")
     if fmt != FORMAT:
         if _looks_like_ours(f, fmt):  # a damaged result is not a foreign file
             raise _damaged(path, "attribute rocksweep_format " + (
@@ -229,18 +243,58 @@ def _open(path: Path, mode: str) -> h5py.File:
         # allocated up front, so a running sweep changes raw data only)
         return h5py.File(path, mode, locking=(mode != "r"))
     except _H5_ERRORS as err:
-        no = getattr(err, "errno", None)
-        if isinstance(err, BlockingIOError) or "unable to lock" in str(err).lower():
-            raise StoreError(f"{shown(path)}: open for writing by another process (a sweep "
-                             "still running?)") from None
-        if no in (errno.EACCES, errno.EPERM, errno.EROFS):
-            doing = "written" if mode != "r" else "read"
-            raise StoreError(f"{shown(path)}: cannot be {doing} ({_why(err)})") from None
-        if not _is_hdf5(path):
-            raise StoreError(f"{shown(path)}: not an HDF5 file (expected a rocksweep sweep "
-                             "result)") from None
-        raise StoreError(f"{shown(path)}: damaged or truncated HDF5 file, cannot be opened "
-                         "(rerun the sweep with --overwrite)") from None
+        if mode == "r" and _open_here(err):
+            # open in this process through another handle (xarray's, h5py's): HDF5 wants
+            # the same locking flags; a reader takes them
+            for locking in READER_LOCKING:
+                with contextlib.suppress(*_H5_ERRORS):
+                    return h5py.File(path, mode, locking=locking)
+        _open_error(path, mode, err)
+
+
+# The locking flags a reader tries when the file is open in this process through another
+# handle (h5py's default, then HDF5's own).
+READER_LOCKING = ("best-effort", True)
+
+
+def _open_error(path: Path, mode: str, err: BaseException) -> NoReturn:
+    """Raise the one-line StoreError for a file h5py could not open (``err``): a lock
+    (another process's, or another handle in this process), permissions, a foreign file,
+    damage."""
+    no = getattr(err, "errno", None)
+    text = str(err).lower()
+    if isinstance(err, BlockingIOError) or "unable to lock" in text:
+        raise StoreError(f"{shown(path)}: open for writing by another process (a sweep "
+                         "still running?)") from None
+    if _open_here(err):
+        raise StoreError(f"{shown(path)}: already open in this process through another "
+                         "HDF5 handle (HDF5's file lock: e.g. xr.open_dataset(..., "
+                         "engine='h5netcdf') or h5py.File); the file is not damaged: "
+                         "close that handle (ds.close()) and try again; rocksweep.open "
+                         "loads the file and closes it at once") from None
+    if no in (errno.EACCES, errno.EPERM, errno.EROFS):
+        doing = "written" if mode != "r" else "read"
+        raise StoreError(f"{shown(path)}: cannot be {doing} ({_why(err)})") from None
+    if not _is_hdf5(path):
+        raise StoreError(f"{shown(path)}: not an HDF5 file (expected a rocksweep sweep "
+                         "result)") from None
+    raise StoreError(f"{shown(path)}: damaged or truncated HDF5 file, cannot be opened "
+                     f"({_why(err)}); its points cannot be read back: if it is a copy, "
+                     "copy it again from the original; else sweep again to a new file "
+                     "(-o NEW.h5) and remove this one after") from None
+
+
+def _open_here(err: BaseException) -> bool:
+    """Whether h5py's error says the file is open in this process through another handle
+    with other settings (a lock, not damage)."""
+    return any(w in str(err).lower() for w in _OPEN_HERE)
+
+
+# What HDF5 says when the file is already open in this process with other settings (a
+# lock of this process, not damage): h5py/HDF5 1.10-1.14 wordings.
+_OPEN_HERE = ("locking flag values don't match", "already open for read-only",
+              "already open for write", "file close degree doesn't match",
+              "file is already open")
 
 
 # Attributes readers use (``rocksweep info``, ``plot``) -> what they must be.
@@ -301,6 +355,10 @@ def _checked_attrs(f: h5py.File, path: Path) -> dict:
             raise _damaged(path, f"attribute {k} missing")
         if not _attr_ok(k, attrs[k]):
             raise _damaged(path, f"attribute {k} is {_cut(attrs[k])}")
+    for k, v in attrs.items():  # the versions the writer records are text (info shows them)
+        if k.endswith("_version") and k != "format_version" and not isinstance(v, str):
+            raise _damaged(path, f"attribute {k} is {_cut(v)}, not a version text "
+                                 "(not as rocksweep writes it)")
     return attrs
 
 

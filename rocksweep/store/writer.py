@@ -263,9 +263,13 @@ class SweepFile:
             _close_quietly(f)
         diffs = scene_differences(stored, resolved_scene(scene, overrides, adaptive))
         if diffs:
+            done = int((outcome != L.OUTCOME_NOT_RUN).sum())
+            keep = (f"resume with the scene, --set values and options it was made with, or "
+                    f"sweep this scene to another -o; --overwrite would discard the {done} "
+                    "points it holds" if done else "use --overwrite to start again: it "
+                    "holds no computed point")
             raise StoreError(f"{shown(path)}: cannot resume, the scene differs from the "
-                             "file's: " + "; ".join(diffs) + " (use --overwrite to start "
-                             "again)")
+                             "file's: " + "; ".join(diffs) + f" ({keep})")
         f = _open(path, "r+")
         try:
             _layout(f, path)  # the file locked now (another may have replaced the first)
