@@ -483,7 +483,8 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     (Figures 3 and 4; the options below), or the figure of a fragility (curves, stripe
     fractions sized by record count, bands, beta in the legend, IM on a log axis), IDA,
     spectra, risk (hazard, fragility, the rate's integrand) or IM-efficiency Dataset
-    (``rocksweep.figures.dispatch``; ``ax`` and ``width`` apply to all).
+    (``rocksweep.figures.dispatch``; ``ax`` and ``width`` apply to all). A record-suite
+    sweep is drawn as its overturning fragility (stripe fractions and the fitted curve).
 
     ds: what ``run`` or ``open`` returns. x, y: the swept keys on the axes (default
     w_over_p and A_ratio, or the two swept keys besides lam); one panel per value of the
@@ -506,6 +507,12 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     from rocksweep.store.reader import as_result
 
     kind = dataset_kind(ds)
+    if kind == "sweep" and "record" in ds["outcome"].dims:
+        # a record suite has no stability diagram: its overturning fragility (no bootstrap;
+        # rocksweep.fragility for other states and bands)
+        from rocksweep.analysis.fragility import fragility as fit
+
+        ds, kind = fit(ds, state="overturn", bootstrap=0), "fragility"
     if kind not in (None, "sweep"):  # an analysis's Dataset: the figure of its kind
         from rocksweep.figures.dispatch import plot_analysis
 
@@ -721,6 +728,19 @@ def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
 
 
 @speaks_python
+def table(ds: xr.Dataset) -> Any:
+    """A tidy ``pandas.DataFrame`` of any rocksweep Dataset (or its file): one row per run
+    of a sweep with its coordinates, unswept scene values, result fields, record, the
+    record's IMs as recorded (``record_*``) and as the run saw them (times
+    scale_factor^n: ``pga``, ``pgv``, ``arias``, ...); one row per curve of an analysis.
+    No row is repeated (``ds.to_dataframe()`` repeats a suite's runs per Sa period).
+    ``.attrs["units"]`` gives each column's units (``rocksweep.analysis.table``)."""
+    from rocksweep.analysis.table import table as make
+
+    return make(_as_dataset(ds, "ds"))
+
+
+@speaks_python
 def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> Any:
     """What ``run`` of this scene will cost on this machine, without running it: points,
     RK4 steps and evaluations expected, seconds of compute with ``jobs`` workers, and
@@ -911,6 +931,10 @@ class RocksweepAccessor:
     def im_efficiency(self, **kwargs: Any) -> Any:
         """``rocksweep.im_efficiency(ds, ...)``: beta of the fragility in every IM."""
         return im_efficiency(self._ds, **kwargs)
+
+    def table(self) -> Any:
+        """``rocksweep.table(ds)``: one row per run (a DataFrame)."""
+        return table(self._ds)
 
     def outcome_words(self) -> Any:
         """``outcome`` as words (not_run, safe, mode1, mode2), an object DataArray."""
