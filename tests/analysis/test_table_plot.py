@@ -89,3 +89,27 @@ def test_plot_of_a_foreign_dataset_is_one_line():
     with pytest.raises(rocksweep.RocksweepError) as err:
         rocksweep.plot(xr.Dataset({"x": ("t", [1.0, 2.0])}))
     assert "\n" not in str(err.value)
+
+
+@pytest.mark.filterwarnings("ignore::rocksweep.physics.suite.RecordWarning")
+def test_plot_of_ida_and_spectra_datasets(ds):
+    import xarray as xr
+
+    ida = rocksweep.ida(ds, rtol=0.05)
+    assert dataset_kind(ida) == "ida"
+    fig = rocksweep.plot(ida)
+    assert fig.axes[0].get_xscale() == "log"
+    n_points = sum(len(c.get_offsets()) if hasattr(c, "get_offsets") else 0
+                   for c in fig.axes[0].collections)
+    assert fig.axes[0].lines or n_points
+    lam, A, p = [0.0, 0.4], [1.0, 2.0, 3.0], np.linspace(1, 5, 7)
+    sp = xr.Dataset(
+        {"theta_max_over_alpha": (("lam", "A_ratio", "p"), np.random.default_rng(0)
+                                  .uniform(0.1, 1.0, (2, 3, 7))),
+         "outcome": (("lam", "A_ratio", "p"), np.zeros((2, 3, 7), np.int8)),
+         "A_min": (("lam", "p"), np.full((2, 7), 2.5)),
+         "mode": (("lam", "p"), np.ones((2, 7), np.int8))},
+        coords={"lam": lam, "A_ratio": A, "p": p})
+    assert dataset_kind(sp) == "spectra"
+    fig = rocksweep.plot(sp)
+    assert len(fig.axes) == 2 and fig.axes[1].get_ylabel() == "A_min"
