@@ -46,12 +46,12 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
                      width: str | tuple[float, float] = "single") -> Figure:
     """Draw fragility curves; returns the Figure (``ax.figure`` when ``ax`` is given).
 
-    frag: the Dataset of ``fragility()`` (median, beta [, band_lo, band_hi over im_grid]
+    frag: the Dataset of ``fragility()`` (im_median, beta [, band_lo, band_hi over im_grid]
     [, fraction, n_counted over the stripe dimension]); width: "single" (3.5 in), "double"
     (7.2 in) (``rocksweep.figures.WIDTHS``) or (width, height) in inches.
     """
-    if "median" not in frag or "im_grid" not in frag.coords:
-        raise FragilityFigureError("not a fragility Dataset (no 'median' or 'im_grid')")
+    if "im_median" not in frag or "im_grid" not in frag.coords:
+        raise FragilityFigureError("not a fragility Dataset (no 'im_median' or 'im_grid')")
     if ax is None:
         size = ((WIDTHS[width][0], WIDTHS[width][0] * ASPECT[width])
                 if isinstance(width, str) and width in WIDTHS
@@ -65,7 +65,7 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
         fig = ax.figure
     im, unit = frag.attrs.get("im", "IM"), frag.attrs.get("im_units", "")
     stripe = im if im in frag.dims else None
-    dims = list(frag["median"].dims)
+    dims = list(frag["im_median"].dims)
     colour_dim = "lam" if "lam" in dims else next((d for d in dims if d != "state"), None)
     rest = [d for d in dims if d != colour_dim]
     grid = frag["im_grid"].values
@@ -79,7 +79,7 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
         ref_med, ref_val = math.nan, None
         for ci in range(n_col):
             one = base.isel({colour_dim: ci}) if colour_dim else base
-            med, beta = float(one["median"]), float(one["beta"])
+            med, beta = float(one["im_median"]), float(one["beta"])
             colour = colours[ci]
             label_bits = []
             if colour_dim:
