@@ -599,28 +599,33 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
 
 @speaks_python
 def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
-              im: str | None = None, period: float | None = None, bootstrap: int = 200,
-              seed: int = 0, ci: float = 0.9) -> xr.Dataset:
-    """Lognormal fragility curves P(state | IM = x) = Phi(ln(x / median) / beta) of a
+              im: str | None = None, period: float | None = None,
+              bootstrap: int | None = None, seed: int = 0, ci: float = 0.9) -> xr.Dataset:
+    """Lognormal fragility curves P(state | IM = x) = Phi(ln(x / im_median) / beta) of a
     record-suite sweep (a scene with ``ground.records``), fitted by maximum likelihood
     (Baker 2015): to the counts at each stripe of a scaled suite ("stripes-mle"), or to
     the (IM, 0/1) pairs of an unscaled one ("cloud-mle", im= "PGA" (default), "PGV" or
     "Sa" with period= [s] from the stored periods).
 
-    ds: what ``run`` or ``open`` returns. state: "overturn" (either mode), "mode1",
-    "mode2", "uplift", "theta:X" (max|theta|/alpha_cg >= X, or overturned), or a list of
-    them (a ``state`` dimension). bootstrap: resamples over records for the intervals
-    and bands (0: none, NaN); seed: their generator's seed; ci: the interval's level.
-    Points flagged undecided (horizon, step or event caps, non-finite) are left out and
-    counted (``n_excluded``). One curve per value of every other swept key (lam, p, body
-    keys).
+    ds: what ``run`` or ``open`` returns (or a result file's path). state: "overturn"
+    (either mode), "mode1", "mode2", "uplift", "theta:X" (max|theta|/alpha_cg >= X, or
+    overturned, 0 < X <= 1), or a list of them (a ``state`` dimension): two or more of
+    uplift/theta:X/overturn are ordered damage states fitted with one beta (the curves
+    never cross), mode1 with mode2 a competing-risk fit (their curves and "safe" sum to
+    one). bootstrap: resamples over records for the intervals and bands (0: none, NaN;
+    None: ``rocksweep.analysis.resampling.DEFAULT_BOOTSTRAP``, 200); seed: their
+    generator's seed; ci: the interval's level. Points flagged undecided (horizon, step
+    or event caps, non-finite) are left out and counted (``n_excluded``). One curve per
+    value of every other swept key (lam, p, body keys).
 
-    Returns a Dataset (``rocksweep.analysis.fragility.fragility``): ``median`` [IM
-    units], ``beta``, their bootstrap intervals ``median_lo``/``median_hi``,
-    ``beta_lo``/``beta_hi``, ``n_records``, ``n_excluded``, ``reason``, the bands
-    ``band_lo``/``band_hi`` over ``im_grid``, and for stripes the empirical ``fraction``
-    per stripe and, per record, ``first_level`` (the smallest stripe that reaches the
-    state: an IDA on the stripes) and ``resurrection`` (a higher stripe is safe again).
+    Returns a Dataset (``rocksweep.analysis.fragility.fragility``): ``im_median`` [IM
+    units], ``beta``, their bootstrap intervals ``im_median_lo``/``im_median_hi``,
+    ``beta_lo``/``beta_hi``, the resamples' fits ``im_median_samples``/``beta_samples``
+    over ``sample``, ``reason`` ("ok" or why the curve should not be trusted as it is:
+    also a ``FragilityWarning``), ``n_records``, ``n_excluded``, ``n_not_run``, the fitted
+    ``curve`` and the bands ``band_lo``/``band_hi`` over ``im_grid``, and for stripes the
+    empirical ``fraction`` per stripe and, per record, ``first_level`` and
+    ``resurrection``.
     """
     import xarray as xr
 
@@ -631,10 +636,6 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     if not isinstance(ds, xr.Dataset):
         raise ApiError(f"ds = {type(ds).__name__}: must be a result Dataset (rocksweep.run "
                        "or rocksweep.open)")
-    if isinstance(bootstrap, bool) or not isinstance(bootstrap, int) or bootstrap < 0:
-        raise ApiError(f"bootstrap = {bootstrap!r}: must be an integer >= 0")
-    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-        raise ApiError(f"seed = {seed!r}: must be an integer >= 0")
     frag = fit(ds, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci)
     frag.attrs["title"] = str(ds.attrs.get("title", ""))
     return frag
