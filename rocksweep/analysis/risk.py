@@ -11,9 +11,10 @@ and lambda_im(x) the hazard curve, the mean annual rate of IM > x. The probabili
 least one occurrence in N years (Poisson): 1 - exp(-lambda_state N).
 
 Integration. The hazard is interpolated linearly in (ln x, ln lambda) between its points
-(a power law is exact; a segment that ends at rate 0 is linear in lambda), each segment
-cut into ``SUB`` pieces evenly in ln x; on a piece the decrease of lambda is exact and P is
-taken at the piece's geometric midpoint (midpoint rule in ln x, error ~1e-6 relative).
+(a power law is exact; a segment that ends at rate 0 is linear in lambda), so |d lambda|
+= |lambda'(u)| du in u = ln x is known in closed form on each segment; each segment is
+cut into ``SUB`` pieces evenly in u and integrated by 2-point Gauss-Legendre on each
+(fourth order: ~1e-7 relative on the tests' power laws).
 
 Beyond the hazard curve's range the tool BOUNDS, it does not extrapolate the hazard:
 
@@ -52,7 +53,7 @@ from rocksweep.errors import RocksweepError
 __all__ = ["Hazard", "RiskError", "fragility_median", "hazard_frame", "read_hazard",
            "risk"]
 
-SUB = 64  # pieces per hazard segment
+SUB = 8  # pieces per hazard segment, 2 Gauss-Legendre nodes each
 TAIL_SHARE = 0.01  # above_hazard when the unknown tail exceeds this share of the rate
 LOW_P = 1e-3  # below_hazard when the fragility at the hazard's smallest IM exceeds this
 PLOT_POINTS = 200  # the figure's grid over the hazard's range
@@ -294,15 +295,36 @@ def _fragility_p(x: np.ndarray, median: np.ndarray, beta: np.ndarray) -> np.ndar
     return np.where(b > 0.0, ndtr(z), np.where(np.isfinite(med), step, np.nan))
 
 
+def _nodes(hz: Hazard) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes x_j and weights w_j (2 per piece, ``SUB`` pieces per hazard
+    segment evenly in u = ln x) with sum_j f(x_j) w_j ~ integral f |d lambda| over the
+    hazard's range: w_j = the quadrature weight times |d lambda / d u| at the node (exact
+    for the log-log interpolant: lambda' = s lambda on a segment of log-log slope s;
+    a segment that ends at rate 0 is linear in lambda: constant lambda')."""
+    g = np.array([-1.0, 1.0]) / math.sqrt(3.0)  # 2-point Gauss-Legendre on [-1, 1]
+    lx = np.log(hz.im)
+    xs, ws = [], []
+    for i in range(hz.im.size - 1):
+        r0, r1 = hz.rate[i], hz.rate[i + 1]
+        du = (lx[i + 1] - lx[i]) / SUB
+        centres = lx[i] + du * (np.arange(SUB) + 0.5)
+        u = (centres[:, None] + 0.5 * du * g[None, :]).ravel()
+        if r1 > 0.0:
+            slope = (math.log(r1) - math.log(r0)) / (lx[i + 1] - lx[i])
+            dens = -slope * r0 * np.exp(slope * (u - lx[i]))
+        else:
+            dens = np.full(u.size, (r0 - r1) / (lx[i + 1] - lx[i]))
+        xs.append(u)
+        ws.append(0.5 * du * dens)
+    return np.exp(np.concatenate(xs)), np.concatenate(ws)
+
+
 def _rates(hz: Hazard, median: np.ndarray, beta: np.ndarray
            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(annual_rate, annual_rate_max, P at x_min, P at x_max) for fragility curves
     (median, beta) of any shape (module docstring)."""
-    x, lam = _pieces(hz)
-    mid = np.sqrt(x[:-1] * x[1:])
-    dlam = lam[:-1] - lam[1:]
-    p_mid = _fragility_p(mid, median, beta)
-    inside = p_mid @ dlam
+    x, w = _nodes(hz)
+    inside = _fragility_p(x, median, beta) @ w
     p_lo = _fragility_p(hz.im[:1], median, beta)[..., 0]
     p_hi = _fragility_p(hz.im[-1:], median, beta)[..., 0]
     top = hz.rate[-1]
