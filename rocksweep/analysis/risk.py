@@ -387,7 +387,8 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50.0, *,
     bound, module docstring), ``annual_rate_max`` (the tail above at its largest),
     ``probability`` = 1 - exp(-annual_rate years), their ``_lo``/``_hi`` (the bootstrap
     percentile interval at the fragility's ``ci`` from its resamples; NaN without them),
-    ``reason`` ("ok", or "above_hazard", "below_hazard", "no_fit" joined by ","); for the
+    ``reason`` ("ok", or "above_hazard", "below_hazard", "no_fit", and the fragility's
+    own non-ok reasons as "fit_<reason>", joined by ","); for the
     figure ``hazard_rate`` over ``hazard_im`` (the curve read), and over ``im_level`` (a
     grid over the hazard's range) ``fragility`` and ``rate_density`` = P(state | x)
     |d lambda / d ln x| [1/yr], the integrand. attrs: rocksweep_kind = "risk", years, im,
@@ -417,10 +418,14 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50.0, *,
         lo, hi = _interval(r_s, ci)
     reasons = np.empty(rate.shape, dtype=object)
     unknown_top = rate_max - rate
+    fit_reason = (np.asarray(fr["reason"].transpose(*dims).values, dtype=str)
+                  if "reason" in fr.data_vars and set(fr["reason"].dims) == set(dims)
+                  else np.full(rate.shape, "ok"))
     for idx in np.ndindex(*rate.shape):
-        bits = []
+        bits = [f"fit_{r}" for r in str(fit_reason[idx]).split(",")
+                if r and r != "ok"]  # the fragility's own verdict carries over
         if not math.isfinite(rate[idx]):
-            bits.append("no_fit")
+            bits.append("no_fit" if not bits else "no_rate")
         else:
             if unknown_top[idx] > TAIL_SHARE * rate[idx]:
                 bits.append("above_hazard")
@@ -454,7 +459,8 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50.0, *,
         "probability_lo": (dims, prob(lo), {"units": "1"}),
         "probability_hi": (dims, prob(hi), {"units": "1"}),
         "reason": (dims, reasons.astype(str), {"long_name": "ok, or above_hazard, "
-                                               "below_hazard, no_fit"}),
+                                               "below_hazard, no_fit, fit_<the fit's "
+                                               "reason>"}),
         "hazard_rate": (("hazard_im",), hz.rate, {"units": "1/yr", "long_name": "hazard "
                                                   "curve: annual rate of IM > x"}),
         "fragility": ([*dims, "im_level"], p_grid, {"units": "1"}),

@@ -201,3 +201,9 @@ def test_cli_writes_csv_and_h5(tmp_path, frag_file):
     assert back.attrs["rocksweep_kind"] == "risk"
     fig = rocksweep.plot(back)
     assert len(fig.axes) == 3
+
+
+def test_the_fits_verdict_carries_over():
+    fr = fragility([0.3, 0.5], 0.4, reason=(("lam",), np.array(["ok", "extrapolated"])))
+    rk = rocksweep.risk(fr, power_law(1e-4, 2.0), 50)
+    assert rk.reason.values.tolist() == ["ok", "fit_extrapolated"]
