@@ -644,8 +644,9 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
 def open_any(path: str | Path) -> xr.Dataset:
     """Any rocksweep Dataset from a file: a sweep result (``open``) or what an analysis
     wrote with ``-o .h5`` (fragility, risk, IM efficiency: netCDF-4), its JSON attributes
-    (lists) decoded. A file that is neither is a one-line ``ApiError``."""
+    (lists) decoded. Any other file gets ``open``'s one-line errors."""
     import json
+    from types import SimpleNamespace
 
     import xarray as xr
 
@@ -653,24 +654,24 @@ def open_any(path: str | Path) -> xr.Dataset:
     from rocksweep.outputs import input_problem, shown
 
     path = Path(path)
-    problem = input_problem(path)
-    if problem:
-        raise ApiError(f"{shown(path)}: {problem}")
-    try:
-        import h5py
+    kind = None
+    if input_problem(path) is None:
+        try:
+            import h5py
 
-        with h5py.File(path, "r") as f:
-            sweep = "outcome" in f and "status" in f
-    except OSError:
-        raise ApiError(f"{shown(path)}: not an HDF5 file (a rocksweep result or an "
-                       "analysis written with -o .h5)") from None
-    if sweep:
-        return open(path)
+            with h5py.File(path, "r") as f:
+                kind = dataset_kind(SimpleNamespace(
+                    variables=list(f.keys()), attrs={k: v for k, v in f.attrs.items()
+                                                     if k == "rocksweep_kind"}))
+        except OSError:
+            kind = None
+    if kind in (None, "sweep"):
+        return open(path)  # a sweep, or open's one-line error for anything else
     try:
-        with xr.open_dataset(path, engine="h5netcdf") as ds:
+        with xr.open_dataset(path, engine="h5netcdf", phony_dims="sort") as ds:
             ds = ds.load()
     except (ValueError, TypeError, KeyError, OSError) as err:
-        raise ApiError(f"{shown(path)}: cannot be read as a Dataset ({err})") from None
+        raise ApiError(f"{shown(path)}: cannot be read as a {kind} Dataset ({err})") from None
     for k, v in list(ds.attrs.items()):
         if isinstance(v, str) and v[:1] in "[{":
             try:
@@ -679,9 +680,6 @@ def open_any(path: str | Path) -> xr.Dataset:
                 pass
         elif hasattr(v, "item") and getattr(v, "size", 2) == 1:
             ds.attrs[k] = v.item()
-    if dataset_kind(ds) is None:
-        raise ApiError(f"{shown(path)}: not a rocksweep result (neither a sweep nor a "
-                       "fragility, risk, IDA or IM-efficiency Dataset)")
     register_accessor()
     return ds
 

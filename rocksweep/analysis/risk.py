@@ -28,8 +28,8 @@ Beyond the hazard curve's range the tool BOUNDS, it does not extrapolate the haz
   verdict ``below_hazard`` says when P(x_min) > ``LOW_P`` (the rate is then a lower bound).
 
 Hazard inputs (``read_hazard``): a two-column CSV with the header ``IM [unit],annual_rate``
-(e.g. ``PGA [g],annual_rate``; ``Sa(1.0) [g]`` for Sa at 1 s), the IM and unit checked
-against the fragility's; or OpenQuake's hazard-curve CSV (``oq export hcurves``: a comment
+(e.g. ``PGA [g],annual_rate``; ``Sa(1.0) [g]`` for Sa at 1 s; lines starting with # are
+comments), the IM and unit checked against the fragility's; or OpenQuake's hazard-curve CSV (``oq export hcurves``: a comment
 line ``#,,,,,"generated_by=..., investigation_time=50.0, imt='PGA'"``, then
 ``lon,lat,depth,poe-<level>,...`` and one row per site): probabilities of exceedance in the
 investigation time T converted to rates lambda = -ln(1 - poe) / T; OpenQuake's PGA and SA
@@ -222,8 +222,12 @@ def read_hazard(source: Any, *, site: int | None = None) -> Hazard:
     lines = [ln for ln in text.splitlines() if ln.strip()]
     if not lines:
         raise RiskError(f"{path}: empty hazard file")
-    if lines[0].lstrip().startswith("#"):
+    if lines[0].lstrip().startswith("#") and any(
+            ln.replace(" ", "").startswith("lon,lat") for ln in lines[1:3]):
         return _openquake(lines, str(path), site)
+    lines = [ln for ln in lines if not ln.lstrip().startswith("#")]  # comments
+    if not lines:
+        raise RiskError(f"{path}: no header 'IM [unit],{RATE_COLUMN}'")
     import csv
 
     rows = list(csv.reader(lines))

@@ -207,3 +207,11 @@ def test_the_fits_verdict_carries_over():
     fr = fragility([0.3, 0.5], 0.4, reason=(("lam",), np.array(["ok", "extrapolated"])))
     rk = rocksweep.risk(fr, power_law(1e-4, 2.0), 50)
     assert rk.reason.values.tolist() == ["ok", "fit_extrapolated"]
+
+
+def test_shipped_example_hazard_with_comments_reads():
+    from pathlib import Path
+
+    hz = read_hazard(Path(__file__).resolve().parents[2] / "configs" / "hazard-example.csv")
+    assert hz.name == "PGA" and hz.unit == "g" and hz.im.size == 16
+    assert np.all(np.diff(hz.rate) < 0)

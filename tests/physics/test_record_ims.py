@@ -127,3 +127,16 @@ def test_drift_and_large_factors_warn_in_one_line(records):
                             math.nan, [1.0]))
     assert len(got) == 1 and "drift.AT2" in str(got[0].message)
     assert f"{v_end:+.3g} m/s" in str(got[0].message)
+
+
+def test_cli_says_the_warning_in_one_line():
+    from click.testing import CliRunner
+
+    from rocksweep.cli import main
+
+    res = CliRunner().invoke(main, ["sweep", str(ROOT / "configs" / "fragility-demo.yaml"),
+                                    "--dry-run"])
+    assert res.exit_code == 0, res.output
+    warned = [ln for ln in res.output.splitlines() if ln.startswith("Warning:")]
+    assert len(warned) == 1 and "scaled by more than 5x" in warned[0]
+    assert "RecordWarning" not in res.output and "warnings.warn" not in res.output
