@@ -30,7 +30,8 @@ Beyond the hazard curve's range the tool BOUNDS, it does not extrapolate the haz
 Hazard inputs (``read_hazard``): a two-column CSV with the header ``IM [unit],annual_rate``
 (e.g. ``PGA [g],annual_rate``; ``Sa(1.0) [g]`` for Sa at 1 s; lines starting with # are
 comments), the IM and unit checked against the fragility's; or OpenQuake's hazard-curve
-CSV (``oq export hcurves``: a comment line ``#,,,,,"generated_by=..., investigation_time=50.0, imt='PGA'"``, then
+CSV (``oq export hcurves``: a comment line
+``#,,,,,"generated_by=..., investigation_time=50.0, imt='PGA'"``, then
 ``lon,lat,depth,poe-<level>,...`` and one row per site): probabilities of exceedance in the
 investigation time T converted to rates lambda = -ln(1 - poe) / T; OpenQuake's PGA and SA
 are in g, its PGV in cm/s (converted to m/s); levels with poe = 1 (a rate without bound)
