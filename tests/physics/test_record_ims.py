@@ -173,4 +173,4 @@ def test_bad_avgsa_range_is_one_line(bad):
 
     with pytest.raises(RocksweepError) as err:
         load(suite_scene(avgsa=bad))
-    assert str(err.value).startswith("ground.avgsa = ") and "\n" not in str(err.value)
+    assert "ground.avgsa = " in str(err.value) and "\n" not in str(err.value)
