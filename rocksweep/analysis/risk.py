@@ -268,24 +268,18 @@ def fragility_median(fr: xr.Dataset) -> tuple[xr.DataArray, str]:
 # ---------------------------------------------------------------------------------------
 
 
-def _pieces(hz: Hazard) -> tuple[np.ndarray, np.ndarray]:
-    """(x [n_pieces + 1], lambda there): every hazard segment cut into SUB pieces evenly
-    in ln x, lambda log-log interpolated (linear where a segment ends at 0)."""
+def _density(hz: Hazard, x: np.ndarray) -> np.ndarray:
+    """|d lambda / d ln x| of the log-log interpolated hazard at x (inside its range)."""
     lx = np.log(hz.im)
-    s = np.linspace(0.0, 1.0, SUB + 1)[:-1]
-    xs = [], []
-    for i in range(hz.im.size - 1):
-        r0, r1 = hz.rate[i], hz.rate[i + 1]
-        u = lx[i] + s * (lx[i + 1] - lx[i])
-        if r1 > 0.0:
-            lam = np.exp(np.log(r0) + s * (np.log(r1) - np.log(r0)))
-        else:  # ends at rate 0: linear in lambda over the segment
-            lam = r0 + s * (r1 - r0)
-        xs[0].append(u)
-        xs[1].append(lam)
-    x = np.exp(np.concatenate([*xs[0], [lx[-1]]]))
-    lam = np.concatenate([*xs[1], [hz.rate[-1]]])
-    return x, lam
+    u = np.log(x)
+    i = np.clip(np.searchsorted(lx, u, side="right") - 1, 0, lx.size - 2)
+    r0, r1 = hz.rate[i], hz.rate[i + 1]
+    du = lx[i + 1] - lx[i]
+    pos = r1 > 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope = np.where(pos, (np.log(np.where(pos, r1, 1.0)) - np.log(r0)) / du, 0.0)
+        out = np.where(pos, -slope * r0 * np.exp(slope * (u - lx[i])), (r0 - r1) / du)
+    return out
 
 
 def _fragility_p(x: np.ndarray, median: np.ndarray, beta: np.ndarray) -> np.ndarray:
@@ -445,9 +439,7 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50.0, *,
     if "state" in fr.coords and "state" not in dims:
         coords["state"] = fr["state"]
     grid = np.geomspace(hz.im[0], hz.im[-1], PLOT_POINTS)
-    x, lam = _pieces(hz)
-    lam_grid = np.exp(np.interp(np.log(grid), np.log(x), np.log(np.maximum(lam, 1e-300))))
-    dens = -np.gradient(lam_grid, np.log(grid))
+    dens = _density(hz, grid)
     p_grid = _fragility_p(grid, med, beta)
     unit = hz.unit
     data: dict[str, Any] = {

@@ -215,3 +215,15 @@ def test_shipped_example_hazard_with_comments_reads():
     hz = read_hazard(Path(__file__).resolve().parents[2] / "configs" / "hazard-example.csv")
     assert hz.name == "PGA" and hz.unit == "g" and hz.im.size == 16
     assert np.all(np.diff(hz.rate) < 0)
+
+
+def test_the_integrand_integrates_to_the_rate():
+    # the figure's integrand P(x) |d lambda / d ln x| over ln x, by the trapezoid rule,
+    # is the rate over the hazard's range (the certain tail above aside)
+    x = np.geomspace(0.01, 3.0, 12)
+    rate = 0.05 * np.exp(-3.0 * np.sqrt(x / 0.01) / 10.0) + 1e-6 / x
+    rk = rocksweep.risk(fragility(0.4, 0.5), pd.DataFrame({"PGA [g]": x,
+                                                           "annual_rate": rate}), 10)
+    area = integrate.trapezoid(rk.rate_density[0].values, np.log(rk.im_level.values))
+    tail = float(rk.fragility[0, -1]) * rate[-1]
+    assert area + tail == pytest.approx(float(rk.annual_rate[0]), rel=5e-3)  # 200 points
