@@ -39,6 +39,7 @@ from rocksweep.api import (  # noqa: A004
     run,
     simulate,
     spectra,
+    table,
 )
 from rocksweep.errors import RocksweepError
 
@@ -72,4 +73,4 @@ def __getattr__(name: str) -> str:
 
 __all__ = ["RocksweepError", "__version__", "boundaries", "boundary_lines", "estimate",
            "fragility", "ida", "im_efficiency", "open", "plot", "risk", "run", "simulate",
-           "spectra"]
+           "spectra", "table"]

@@ -505,7 +505,8 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     (Figures 3 and 4; the options below), or the figure of a fragility (curves, stripe
     fractions sized by record count, bands, beta in the legend, IM on a log axis), IDA,
     spectra, risk (hazard, fragility, the rate's integrand) or IM-efficiency Dataset
-    (``rocksweep.figures.dispatch``; ``ax`` and ``width`` apply to all).
+    (``rocksweep.figures.dispatch``; ``ax`` and ``width`` apply to all). A record-suite
+    sweep is drawn as its overturning fragility (stripe fractions and the fitted curve).
 
     ds: what ``run`` or ``open`` returns. x, y: the swept keys on the axes (default
     w_over_p and A_ratio, or the two swept keys besides lam); one panel per value of the
@@ -528,6 +529,12 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     from rocksweep.store.reader import as_result
 
     kind = dataset_kind(ds)
+    if kind == "sweep" and "record" in ds["outcome"].dims:
+        # a record suite has no stability diagram: its overturning fragility (no bootstrap;
+        # rocksweep.fragility for other states and bands)
+        from rocksweep.analysis.fragility import fragility as fit
+
+        ds, kind = fit(ds, state="overturn", bootstrap=0), "fragility"
     if kind not in (None, "sweep"):  # an analysis's Dataset: the figure of its kind
         from rocksweep.figures.dispatch import plot_analysis
 
@@ -615,28 +622,33 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
 
 @speaks_python
 def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
-              im: str | None = None, period: float | None = None, bootstrap: int = 200,
-              seed: int = 0, ci: float = 0.9) -> xr.Dataset:
-    """Lognormal fragility curves P(state | IM = x) = Phi(ln(x / median) / beta) of a
+              im: str | None = None, period: float | None = None,
+              bootstrap: int | None = None, seed: int = 0, ci: float = 0.9) -> xr.Dataset:
+    """Lognormal fragility curves P(state | IM = x) = Phi(ln(x / im_median) / beta) of a
     record-suite sweep (a scene with ``ground.records``), fitted by maximum likelihood
     (Baker 2015): to the counts at each stripe of a scaled suite ("stripes-mle"), or to
     the (IM, 0/1) pairs of an unscaled one ("cloud-mle", im= "PGA" (default), "PGV" or
     "Sa" with period= [s] from the stored periods).
 
-    ds: what ``run`` or ``open`` returns. state: "overturn" (either mode), "mode1",
-    "mode2", "uplift", "theta:X" (max|theta|/alpha_cg >= X, or overturned), or a list of
-    them (a ``state`` dimension). bootstrap: resamples over records for the intervals
-    and bands (0: none, NaN); seed: their generator's seed; ci: the interval's level.
-    Points flagged undecided (horizon, step or event caps, non-finite) are left out and
-    counted (``n_excluded``). One curve per value of every other swept key (lam, p, body
-    keys).
+    ds: what ``run`` or ``open`` returns (or a result file's path). state: "overturn"
+    (either mode), "mode1", "mode2", "uplift", "theta:X" (max|theta|/alpha_cg >= X, or
+    overturned, 0 < X <= 1), or a list of them (a ``state`` dimension): two or more of
+    uplift/theta:X/overturn are ordered damage states fitted with one beta (the curves
+    never cross), mode1 with mode2 a competing-risk fit (their curves and "safe" sum to
+    one). bootstrap: resamples over records for the intervals and bands (0: none, NaN;
+    None: ``rocksweep.analysis.resampling.DEFAULT_BOOTSTRAP``, 200); seed: their
+    generator's seed; ci: the interval's level. Points flagged undecided (horizon, step
+    or event caps, non-finite) are left out and counted (``n_excluded``). One curve per
+    value of every other swept key (lam, p, body keys).
 
-    Returns a Dataset (``rocksweep.analysis.fragility.fragility``): ``median`` [IM
-    units], ``beta``, their bootstrap intervals ``median_lo``/``median_hi``,
-    ``beta_lo``/``beta_hi``, ``n_records``, ``n_excluded``, ``reason``, the bands
-    ``band_lo``/``band_hi`` over ``im_grid``, and for stripes the empirical ``fraction``
-    per stripe and, per record, ``first_level`` (the smallest stripe that reaches the
-    state: an IDA on the stripes) and ``resurrection`` (a higher stripe is safe again).
+    Returns a Dataset (``rocksweep.analysis.fragility.fragility``): ``im_median`` [IM
+    units], ``beta``, their bootstrap intervals ``im_median_lo``/``im_median_hi``,
+    ``beta_lo``/``beta_hi``, the resamples' fits ``im_median_samples``/``beta_samples``
+    over ``sample``, ``reason`` ("ok" or why the curve should not be trusted as it is:
+    also a ``FragilityWarning``), ``n_records``, ``n_excluded``, ``n_not_run``, the fitted
+    ``curve`` and the bands ``band_lo``/``band_hi`` over ``im_grid``, and for stripes the
+    empirical ``fraction`` per stripe and, per record, ``first_level`` and
+    ``resurrection``.
     """
     import xarray as xr
 
@@ -647,10 +659,6 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     if not isinstance(ds, xr.Dataset):
         raise ApiError(f"ds = {type(ds).__name__}: must be a result Dataset (rocksweep.run "
                        "or rocksweep.open)")
-    if isinstance(bootstrap, bool) or not isinstance(bootstrap, int) or bootstrap < 0:
-        raise ApiError(f"bootstrap = {bootstrap!r}: must be an integer >= 0")
-    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-        raise ApiError(f"seed = {seed!r}: must be an integer >= 0")
     frag = fit(ds, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci)
     frag.attrs["title"] = str(ds.attrs.get("title", ""))
     return frag
@@ -659,8 +667,9 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
 def open_any(path: str | Path) -> xr.Dataset:
     """Any rocksweep Dataset from a file: a sweep result (``open``) or what an analysis
     wrote with ``-o .h5`` (fragility, risk, IM efficiency: netCDF-4), its JSON attributes
-    (lists) decoded. A file that is neither is a one-line ``ApiError``."""
+    (lists) decoded. Any other file gets ``open``'s one-line errors."""
     import json
+    from types import SimpleNamespace
 
     import xarray as xr
 
@@ -668,24 +677,24 @@ def open_any(path: str | Path) -> xr.Dataset:
     from rocksweep.outputs import input_problem, shown
 
     path = Path(path)
-    problem = input_problem(path)
-    if problem:
-        raise ApiError(f"{shown(path)}: {problem}")
-    try:
-        import h5py
+    kind = None
+    if input_problem(path) is None:
+        try:
+            import h5py
 
-        with h5py.File(path, "r") as f:
-            sweep = "outcome" in f and "status" in f
-    except OSError:
-        raise ApiError(f"{shown(path)}: not an HDF5 file (a rocksweep result or an "
-                       "analysis written with -o .h5)") from None
-    if sweep:
-        return open(path)
+            with h5py.File(path, "r") as f:
+                kind = dataset_kind(SimpleNamespace(
+                    variables=list(f.keys()), attrs={k: v for k, v in f.attrs.items()
+                                                     if k == "rocksweep_kind"}))
+        except OSError:
+            kind = None
+    if kind in (None, "sweep"):
+        return open(path)  # a sweep, or open's one-line error for anything else
     try:
-        with xr.open_dataset(path, engine="h5netcdf") as ds:
+        with xr.open_dataset(path, engine="h5netcdf", phony_dims="sort") as ds:
             ds = ds.load()
     except (ValueError, TypeError, KeyError, OSError) as err:
-        raise ApiError(f"{shown(path)}: cannot be read as a Dataset ({err})") from None
+        raise ApiError(f"{shown(path)}: cannot be read as a {kind} Dataset ({err})") from None
     for k, v in list(ds.attrs.items()):
         if isinstance(v, str) and v[:1] in "[{":
             try:
@@ -694,9 +703,6 @@ def open_any(path: str | Path) -> xr.Dataset:
                 pass
         elif hasattr(v, "item") and getattr(v, "size", 2) == 1:
             ds.attrs[k] = v.item()
-    if dataset_kind(ds) is None:
-        raise ApiError(f"{shown(path)}: not a rocksweep result (neither a sweep nor a "
-                       "fragility, risk, IDA or IM-efficiency Dataset)")
     register_accessor()
     return ds
 
@@ -741,6 +747,19 @@ def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
     from rocksweep.analysis.efficiency import im_efficiency as compute
 
     return compute(_as_dataset(ds, "ds"), state=state)
+
+
+@speaks_python
+def table(ds: xr.Dataset) -> Any:
+    """A tidy ``pandas.DataFrame`` of any rocksweep Dataset (or its file): one row per run
+    of a sweep with its coordinates, unswept scene values, result fields, record, the
+    record's IMs as recorded (``record_*``) and as the run saw them (times
+    scale_factor^n: ``pga``, ``pgv``, ``arias``, ...); one row per curve of an analysis.
+    No row is repeated (``ds.to_dataframe()`` repeats a suite's runs per Sa period).
+    ``.attrs["units"]`` gives each column's units (``rocksweep.analysis.table``)."""
+    from rocksweep.analysis.table import table as make
+
+    return make(_as_dataset(ds, "ds"))
 
 
 @speaks_python
@@ -934,6 +953,10 @@ class RocksweepAccessor:
     def im_efficiency(self, **kwargs: Any) -> Any:
         """``rocksweep.im_efficiency(ds, ...)``: beta of the fragility in every IM."""
         return im_efficiency(self._ds, **kwargs)
+
+    def table(self) -> Any:
+        """``rocksweep.table(ds)``: one row per run (a DataFrame)."""
+        return table(self._ds)
 
     def outcome_words(self) -> Any:
         """``outcome`` as words (not_run, safe, mode1, mode2), an object DataArray."""

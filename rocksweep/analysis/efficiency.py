@@ -177,10 +177,10 @@ def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
                 use = cnt[o] & np.isfinite(x) & (x > 0)
                 if use.sum() < 2:
                     continue
-                fit = fit_cloud(x[use], hit[o][use])
-                res["beta"][i, o] = fit.beta
-                res["beta_scale"][i, o] = fit.beta / max(n, 1)
-                res["im_median"][i, o] = fit.median
+                med, beta = fit_cloud(x[use], hit[o][use])[:2]  # (median, beta)
+                res["beta"][i, o] = beta
+                res["beta_scale"][i, o] = beta / max(n, 1)
+                res["im_median"][i, o] = med
                 n_rec[i, o] = int(use.sum())
             continue
         levels = np.asarray(ds[stripe].values, np.float64)

@@ -12,4 +12,5 @@ from rocksweep.cli import (  # noqa: F401
     simulate,
     spectrum,
     sweep,
+    table,
 )

@@ -65,8 +65,10 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
                                        "(width, height) in inches")
         fig = Figure(figsize=size, layout="constrained")
         ax = fig.add_subplot()
+        own = True
     else:
         fig = ax.figure
+        own = False
     im, unit = frag.attrs.get("im", "IM"), frag.attrs.get("im_units", "")
     stripe = im if im in frag.dims else None
     dims = list(median_da.dims)
@@ -102,7 +104,7 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
                 reason = str(one["reason"].values) if "reason" in one else "ok"
                 text += "" if reason == "ok" else f" [{reason}]"
                 ax.plot(grid, lognormal_cdf(grid, med, beta), style, color=colour,
-                        label=", ".join(label_bits + [text]))
+                        label=(", ".join(label_bits) + "\n" + text).lstrip())
             else:
                 reason = str(one["reason"].values) if "reason" in one else "no fit"
                 ax.plot([], [], style, color=colour,
@@ -130,7 +132,11 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
     ax.set_title(title, fontsize="small")
     # below the axes: the curves and stripe markers fill the plot, a legend inside would
     # cover them
+    n_entries = len(ax.get_legend_handles_labels()[0])
     ax.legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.2),
-              ncol=1, frameon=False)
+              frameon=False)
+    if own:  # two lines per entry below the axes: the figure grows to hold them
+        w, h = fig.get_size_inches()
+        fig.set_size_inches(w, h + 0.22 * max(n_entries - 3, 0))
     ax.grid(True, which="both", alpha=0.25, linewidth=0.5)
     return fig

@@ -91,3 +91,33 @@ def test_cli_on_a_real_sweep(tmp_path, suite_result):
     assert {"PGA", "PGV", "Arias", "CAV", "D5_95", "PGV_over_PGA", "AvgSa"} <= set(
         eff.im.values.tolist())
     assert np.isfinite(eff.beta.sel(im="AvgSa")).all()
+
+
+def test_cloud_is_a_probit_per_im():
+    from scipy.optimize import minimize
+    from scipy.stats import norm
+
+    rng = np.random.default_rng(8)
+    pga = rng.lognormal(np.log(0.3), 0.5, 80)
+    pgv = pga * rng.lognormal(np.log(0.6), 0.3, 80)
+    fails = rng.random(80) < norm.cdf(np.log(pgv / 0.2) / 0.3)
+    ds = xr.Dataset({"outcome": (("record",), fails.astype(np.int8)),
+                     "status": (("record",), np.zeros(80, np.int32)),
+                     "record_pga": (("record",), pga), "record_pgv": (("record",), pgv),
+                     "scale_factor": (("record",), np.ones(80))},
+                    coords={"record": [f"r{i}" for i in range(80)]})
+    eff = im_efficiency(ds)
+    assert set(eff.method.values) == {"cloud-probit"}
+
+    def direct(x):  # an independent probit MLE over (ln median, ln beta)
+        def nll(t):
+            p = np.clip(norm.cdf((np.log(x) - t[0]) / np.exp(t[1])), 1e-15, 1 - 1e-15)
+            return -np.sum(np.where(fails, np.log(p), np.log1p(-p)))
+        return np.exp(minimize(nll, [np.log(np.median(x)), -1.0], method="Nelder-Mead",
+                               options={"xatol": 1e-10, "fatol": 1e-12}).x)
+
+    for im, x in (("PGA", pga), ("PGV", pgv)):
+        med, beta = direct(x)
+        assert eff.beta.sel(im=im).item() == pytest.approx(beta, rel=1e-4)
+        assert eff.im_median.sel(im=im).item() == pytest.approx(med, rel=1e-4)
+    assert eff.beta.sel(im="PGV").item() < eff.beta.sel(im="PGA").item()

@@ -127,3 +127,50 @@ def test_drift_and_large_factors_warn_in_one_line(records):
                             math.nan, [1.0]))
     assert len(got) == 1 and "drift.AT2" in str(got[0].message)
     assert f"{v_end:+.3g} m/s" in str(got[0].message)
+
+
+def test_cli_says_the_warning_in_one_line():
+    from click.testing import CliRunner
+
+    from rocksweep.cli import main
+
+    res = CliRunner().invoke(main, ["sweep", str(ROOT / "configs" / "fragility-demo.yaml"),
+                                    "--dry-run"])
+    assert res.exit_code == 0, res.output
+    warned = [ln for ln in res.output.splitlines() if ln.startswith("Warning:")]
+    assert len(warned) == 1 and "scaled by more than 5x" in warned[0]
+    assert "RecordWarning" not in res.output and "warnings.warn" not in res.output
+
+
+def suite_scene(**ground):
+    return {"body": {"wn_over_p": 2.43, "zeta": 0.05, "alpha_cg": 0.15, "alpha_A": 0.28,
+                     "mA_over_m": 0.47, "IA_ratio": 0.56},
+            "impact": {"lam": 0.0},
+            "ground": {"records": [str(SUITE[0]), str(SUITE[1])], "p": 2.0, **ground}}
+
+
+def test_avgsa_range_from_the_scene():
+    from rocksweep.api import load
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RecordWarning)
+        sc, _ = load(suite_scene())  # default: 0.2-3 x 2 pi / p
+        assert sc.suite.avgsa_range == pytest.approx((0.2 * math.pi, 3.0 * math.pi))
+        assert "2 pi / p" in sc.suite.avgsa_rule
+        sc, _ = load(suite_scene(scale={"im": "Sa", "period": 0.5, "values": [0.3, 0.6]}))
+        assert sc.suite.avgsa_range == pytest.approx((0.1, 1.5))  # 0.2-3 x scale.period
+        sc, _ = load(suite_scene(avgsa=[0.3, 2.0]))
+    assert sc.suite.avgsa_range == (0.3, 2.0)
+    rec = read_record(SUITE[0])
+    assert sc.suite.avgsa[0] == pytest.approx(
+        np.exp(np.mean(np.log(I.sa(rec.acc, rec.dt, np.geomspace(0.3, 2.0, 10))))))
+
+
+@pytest.mark.parametrize("bad", [[2.0, 1.0], [0.0, 1.0], [1.0], "x", [1.0, 200.0]])
+def test_bad_avgsa_range_is_one_line(bad):
+    from rocksweep.api import load
+    from rocksweep.errors import RocksweepError
+
+    with pytest.raises(RocksweepError) as err:
+        load(suite_scene(avgsa=bad))
+    assert "ground.avgsa = " in str(err.value) and "\n" not in str(err.value)
