@@ -61,6 +61,24 @@ PRESET_ROTATION: dict[str, float] = {
     "accurate": 0.1,
 }
 
+# name -> pulse_steps: RK4 steps per pulse period while the pulse acts (at least
+# steps_per_period; ``step_sizes``). PLACEHOLDER: measured below.
+PRESET_PULSE: dict[str, int] = {
+    "draft": 20,
+    "default": 20,
+    "fine": 40,
+    "accurate": 20,
+}
+
+# name -> refine: most refinements (2x, 4x, ... the steps) of a close call before its
+# outcome is called uncertified (``rocksweep.compute.certify``; 0: no certification).
+PRESET_REFINE: dict[str, int] = {
+    "draft": 0,
+    "default": 3,
+    "fine": 3,
+    "accurate": 3,
+}
+
 # Smallest event_tol [p*t] a scene may ask for. An event's time is t0 + tau in float64; at
 # t ~ 1e2 (a run lasts the pulse plus the 200-long horizon) its spacing is 1.4e-14, and
 # 2.8e-14 to 5.7e-14 up to t = 512: below ~1e-12 the tolerance asks for digits t does not
@@ -86,7 +104,12 @@ MAX_POINT_STEPS = 1e8
 class Numerics:
     """Resolved numerical settings of a run (all times in p*t).
 
-    steps_per_period: RK4 steps per shortest time scale of the point, see ``step_size``.
+    steps_per_period: RK4 steps per shortest time scale of the body (its spring while it
+        rocks, its rocking), and of the pulse's amplitude while it acts: ``step_sizes``.
+    pulse_steps: RK4 steps per pulse period while the pulse acts (the larger of this and
+        steps_per_period counts; after the pulse its period sets no step): ``step_sizes``.
+    refine: most refinements of a close call (each doubling every step), until its outcome
+        is stable (``rocksweep.compute.certify``); 0: no certification.
     event_tol: width [p*t] to which an event's time is bracketed.
     horizon: how long after the pulse's end a run may go on [p*t] before it is flagged.
     rest_rate: post-impact |theta'| / (p * alpha_cg) below which the body settles into full
@@ -108,56 +131,81 @@ class Numerics:
     max_steps_factor: float = 20.0
     root: str = "hermite"
     rotation_step: float = PRESET_ROTATION["default"]
+    pulse_steps: int = PRESET_PULSE["default"]
+    refine: int = PRESET_REFINE["default"]
 
     @classmethod
     def preset(cls, accuracy: str = "default", **overrides) -> Numerics:
         spp, tol = PRESETS[accuracy]
         return replace(cls(accuracy=accuracy, steps_per_period=spp, event_tol=tol,
-                           rotation_step=PRESET_ROTATION[accuracy]), **overrides)
+                           rotation_step=PRESET_ROTATION[accuracy],
+                           pulse_steps=PRESET_PULSE[accuracy],
+                           refine=PRESET_REFINE[accuracy]), **overrides)
 
     def describe(self) -> str:
         label = self.accuracy
         base = PRESETS.get(self.accuracy)
         if base is None or base != (self.steps_per_period, self.event_tol) or (
-                PRESET_ROTATION[self.accuracy] != self.rotation_step):
+                PRESET_ROTATION[self.accuracy] != self.rotation_step) or (
+                PRESET_PULSE[self.accuracy] != self.pulse_steps) or (
+                PRESET_REFINE[self.accuracy] != self.refine):
             label = "custom"
         return (f"{label} (steps_per_period={self.steps_per_period}, "
+                f"pulse_steps={self.pulse_steps}, "
                 f"event_tol={self.event_tol:g}, rotation_step={self.rotation_step:g}, "
-                f"horizon={self.horizon:g}, root={self.root})")
+                f"refine={self.refine}, horizon={self.horizon:g}, root={self.root})")
+
+    def refined(self, level: int) -> Numerics:
+        """These numerics at 2**level times the steps: a close call's rerun at that
+        refinement (``compute.certify.refine_rows`` scales the rows the same way)."""
+        f = 2 ** level
+        return replace(self, steps_per_period=self.steps_per_period * f,
+                       pulse_steps=self.pulse_steps * f,
+                       rotation_step=self.rotation_step / f, refine=0)
 
     def as_dict(self) -> dict:
         return asdict(self)
 
 
-def step_size(omega_rock: np.ndarray | float, omega: np.ndarray | float,
-              steps_per_period: int, omega_amp: np.ndarray | float = 0.0) -> np.ndarray:
-    """RK4 step [p*t]: the shortest period of the point over ``steps_per_period``.
+def step_sizes(omega_rock: np.ndarray | float, omega: np.ndarray | float,
+               steps_per_period: int, pulse_steps: int = 0,
+               omega_amp: np.ndarray | float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """The RK4 steps [p*t] of a run: (dt, dt_on), after and while the ground moves.
 
-    The periods are the top mass's spring period while the base rocks (2 pi/omega_rock,
-    the stiffest the kernel meets; inf for a rigid body), the pulse period 2 pi/omega,
-    the rocking period scale 2 pi/p (= 2 pi) and the pulse's own rocking time scale
-    2 pi/omega_amp (``amplitude_frequency``; 0 leaves it out). A stiff spring or a pulse
-    far above the uplift threshold thus gets a smaller step. While the body rocks, the
-    kernel shortens it further so that one step turns the body by at most
+    The step follows the time scales that act at each moment. Always: the top mass's
+    spring period while the base rocks (2 pi/omega_rock, the stiffest the kernel meets;
+    inf for a rigid body) and the rocking period scale 2 pi/p (= 2 pi), each over
+    ``steps_per_period``: that is dt. While the pulse (or record) acts, also its period
+    2 pi/omega over max(pulse_steps, steps_per_period) and the pulse's own rocking time
+    scale 2 pi/omega_amp (``amplitude_frequency``; 0 leaves it out) over steps_per_period:
+    dt_on <= dt. A short, strong pulse thus gets the steps its work on the body needs (at
+    5 steps per pulse period that work is ~2% off, enough to flip outcomes: issue 28), and
+    the free rocking after it is not stepped at the pulse's rate. While the body rocks, the
+    kernel shortens either further so that one step turns the body by at most
     ``Numerics.rotation_step`` x alpha_cg (PAR_ROT_STEP, ``rocksweep.kernel.loop``).
+    omega = 0 (a record: no period) leaves the pulse period out.
     """
     two_pi = 2 * math.pi
+    n_on = max(int(pulse_steps), int(steps_per_period))
     with np.errstate(divide="ignore"):
-        periods = np.minimum(np.minimum(two_pi / np.asarray(omega_rock, float),
-                                        two_pi / np.asarray(omega, float)), two_pi)
-        periods = np.minimum(periods, two_pi / np.asarray(omega_amp, float))
-    return periods / steps_per_period
+        free = np.minimum(two_pi / np.asarray(omega_rock, float), two_pi) / steps_per_period
+        on = np.minimum(free, two_pi / np.asarray(omega, float) / n_on)
+        on = np.minimum(on, two_pi / np.asarray(omega_amp, float) / steps_per_period)
+    return free, on
 
 
-def step_budget(t_end: np.ndarray | float, dt: np.ndarray | float,
+def step_budget(t_pulse: np.ndarray | float, t_end: np.ndarray | float,
+                dt: np.ndarray | float, dt_on: np.ndarray | float,
                 numerics: Numerics) -> np.ndarray:
     """Cap on the RK4 evaluations of one run (the kernel's PAR_MAXSTEPS).
 
-    max_steps_factor x the regular steps of a run to t_end [p*t] at step dt [p*t], plus
-    EVENT_STEP_ALLOWANCE re-integrations for each of max_events events.
+    max_steps_factor x the regular steps of a run to t_end [p*t] (the pulse's t_pulse at
+    step dt_on, the rest at dt, all [p*t]), plus EVENT_STEP_ALLOWANCE re-integrations for
+    each of max_events events.
     """
-    return numerics.max_steps_factor * np.ceil(np.asarray(t_end) / dt) + EVENT_STEP_ALLOWANCE * (
-        numerics.max_events)
+    t_pulse = np.minimum(np.asarray(t_pulse, float), np.asarray(t_end, float))
+    steps = np.ceil(t_pulse / dt_on) + np.ceil((np.asarray(t_end) - t_pulse) / dt)
+    return numerics.max_steps_factor * steps + EVENT_STEP_ALLOWANCE * numerics.max_events
 
 
 def amplitude_frequency(A_ratio: np.ndarray | float, alpha_ref: np.ndarray | float

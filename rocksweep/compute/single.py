@@ -118,7 +118,9 @@ class Run:
 def history_capacity(row: np.ndarray) -> int:
     """Rows a full history of this point can need: every step plus 3 rows per event (a
     record's steps on its samples counted on top)."""
-    steps = math.ceil(row[L.PAR_TEND] / row[L.PAR_DT])
+    t_pulse = min(row[L.PAR_TPULSE], row[L.PAR_TEND])
+    steps = math.ceil(t_pulse / row[L.PAR_DT_ON]) + math.ceil(
+        (row[L.PAR_TEND] - t_pulse) / row[L.PAR_DT])
     if row[L.PAR_REC_H] > 0.0:
         steps += math.ceil(row[L.PAR_TPULSE] / row[L.PAR_REC_H]) + 1
     return int(steps + 3 * row[L.PAR_MAXEVENTS] + 16)

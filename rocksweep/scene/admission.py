@@ -85,11 +85,11 @@ def _budgets(scene: Scene, bodies: list[dict[str, float]], w: np.ndarray, A: np.
     omega_rock = np.array([body_omega_rock(b) for b in built])[:, None, None]
     alpha_ref = np.array([b.alpha_ref for b in built])[:, None, None]
     shape = (len(built), w.size, A.size)
-    _, _, _, cap = run_cost(np.broadcast_to(omega_rock, shape),
-                            np.broadcast_to(alpha_ref, shape),
-                            np.broadcast_to(w[None, :, None], shape),
-                            np.broadcast_to(A[None, None, :], shape), numerics,
-                            scene.phase_max())
+    _, _, _, _, cap = run_cost(np.broadcast_to(omega_rock, shape),
+                               np.broadcast_to(alpha_ref, shape),
+                               np.broadcast_to(w[None, :, None], shape),
+                               np.broadcast_to(A[None, None, :], shape), numerics,
+                               scene.phase_max())
     return np.where(np.isnan(cap), math.inf, cap)
 
 
@@ -199,10 +199,11 @@ def _point_cost(scene: Scene, point: dict[str, float], numerics: Numerics | None
         return None
     worst = None
     for n, label in _runs(scene) if numerics is None else ((numerics, ""),):
-        dt, _, t_end, cap = run_cost(np.array([body_omega_rock(body)]),
-                                     np.array([body.alpha_ref]),
-                                     np.array([point["pulse.w_over_p"]]),
-                                     np.array([point["pulse.A_ratio"]]), n, scene.phase_max())
+        _, dt, _, t_end, cap = run_cost(np.array([body_omega_rock(body)]),
+                                        np.array([body.alpha_ref]),
+                                        np.array([point["pulse.w_over_p"]]),
+                                        np.array([point["pulse.A_ratio"]]), n,
+                                        scene.phase_max())
         c = float(cap[0])
         c = math.inf if math.isnan(c) else c
         if worst is None or c > worst[0]:
