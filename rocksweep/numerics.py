@@ -167,6 +167,26 @@ class Numerics:
         return asdict(self)
 
 
+# The spring's steps (``step_sizes``): steps_per_period per spring period resolve a spring
+# of OMEGA_SPRING x p (Figure 4's body, omega_rock/p = 27.5: its outcomes at 5 steps are
+# those of `fine` but for 1 and 2 cells of 19 200); a softer spring holds more of the
+# energy, ~(p/omega_rock)^2, and RK4 takes ~n^-5 of it per unit time at n steps per
+# period (its numerical damping), so it gets (OMEGA_SPRING/omega_rock)^(2/5) times the
+# steps: the same error in the energy. Figure 3(a)'s spring (6.8) gets 1.75x: 73 cells
+# that went safe where `fine` overturns (mode 1) became 2, for 0% more RK4 evaluations
+# (the rotation limit sets most of its rocking steps).
+OMEGA_SPRING = 27.5
+
+
+def spring_steps(omega_rock: np.ndarray | float, steps_per_period: int) -> np.ndarray:
+    """RK4 steps per spring period 2 pi/omega_rock: steps_per_period x
+    max(1, (OMEGA_SPRING/omega_rock)^(2/5)) (omega_rock [rad/s], p = 1; see OMEGA_SPRING)."""
+    w = np.asarray(omega_rock, float)
+    with np.errstate(divide="ignore"):
+        f = np.maximum(1.0, (OMEGA_SPRING / w) ** 0.4)
+    return steps_per_period * f
+
+
 def step_sizes(omega_rock: np.ndarray | float, omega: np.ndarray | float,
                steps_per_period: int, pulse_steps: int = 0,
                omega_amp: np.ndarray | float = 0.0) -> tuple[np.ndarray, np.ndarray]:
@@ -174,21 +194,23 @@ def step_sizes(omega_rock: np.ndarray | float, omega: np.ndarray | float,
 
     The step follows the time scales that act at each moment. Always: the top mass's
     spring period while the base rocks (2 pi/omega_rock, the stiffest the kernel meets;
-    inf for a rigid body) and the rocking period scale 2 pi/p (= 2 pi), each over
-    ``steps_per_period``: that is dt. While the pulse (or record) acts, also its period
-    2 pi/omega over max(pulse_steps, steps_per_period) and the pulse's own rocking time
-    scale 2 pi/omega_amp (``amplitude_frequency``; 0 leaves it out) over steps_per_period:
-    dt_on <= dt. A short, strong pulse thus gets the steps its work on the body needs (at
-    5 steps per pulse period that work is ~2% off, enough to flip outcomes: issue 28), and
-    the free rocking after it is not stepped at the pulse's rate. While the body rocks, the
-    kernel shortens either further so that one step turns the body by at most
-    ``Numerics.rotation_step`` x alpha_cg (PAR_ROT_STEP, ``rocksweep.kernel.loop``).
-    omega = 0 (a record: no period) leaves the pulse period out.
+    inf for a rigid body) over ``spring_steps`` and the rocking period scale 2 pi/p
+    (= 2 pi) over ``steps_per_period``: that is dt. While the pulse (or record) acts, also
+    its period 2 pi/omega over max(pulse_steps, steps_per_period) and the pulse's own
+    rocking time scale 2 pi/omega_amp (``amplitude_frequency``; 0 leaves it out) over
+    steps_per_period: dt_on <= dt. A short, strong pulse thus gets the steps its work on
+    the body needs (at 5 steps per pulse period that work is ~2% off, enough to flip
+    outcomes: issue 28), and the free rocking after it is not stepped at the pulse's rate.
+    While the body rocks, the kernel shortens either further so that one step turns the
+    body by at most ``Numerics.rotation_step`` x alpha_cg (PAR_ROT_STEP,
+    ``rocksweep.kernel.loop``). omega = 0 (a record: no period) leaves the pulse out.
     """
     two_pi = 2 * math.pi
     n_on = max(int(pulse_steps), int(steps_per_period))
-    with np.errstate(divide="ignore"):
-        free = np.minimum(two_pi / np.asarray(omega_rock, float), two_pi) / steps_per_period
+    w = np.asarray(omega_rock, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        spring = np.where(w > 0.0, two_pi / (w * spring_steps(w, steps_per_period)), np.inf)
+        free = np.minimum(spring, two_pi / steps_per_period)
         on = np.minimum(free, two_pi / np.asarray(omega, float) / n_on)
         on = np.minimum(on, two_pi / np.asarray(omega_amp, float) / steps_per_period)
     return free, on
@@ -206,6 +228,23 @@ def step_budget(t_pulse: np.ndarray | float, t_end: np.ndarray | float,
     t_pulse = np.minimum(np.asarray(t_pulse, float), np.asarray(t_end, float))
     steps = np.ceil(t_pulse / dt_on) + np.ceil((np.asarray(t_end) - t_pulse) / dt)
     return numerics.max_steps_factor * steps + EVENT_STEP_ALLOWANCE * numerics.max_events
+
+
+# The margin (OUT_MARGIN, alpha_ref) below which a run is a close call, re-run finer
+# (``close_margin``), at 5 steps per period. Measured on the four figures at `default`
+# against `fine` (scripts/bench_certify.py): the outcomes that differ before the
+# certification came within 0.005 of the saddle (Figure 3(a), with the spring's steps of
+# ``spring_steps``; 0.044 at 5 steps per spring period), 0.003 on Figures 4(a)/(b).
+CLOSE_MARGIN = 0.0125
+
+
+def close_margin(steps_per_period: int) -> float:
+    """How close [alpha_ref] the free rocking may come to the overturning saddle before a
+    run counts as a close call (the kernel's PAR_CLOSE): CLOSE_MARGIN at 5 steps per
+    period, (5/steps_per_period)^(5/2) of it at more (the energy's error falls as the
+    step^5 per unit time, the margin it can flip, ~ sqrt(|E - E_barrier|/E_ref), as its
+    square root)."""
+    return CLOSE_MARGIN * (5.0 / steps_per_period) ** 2.5
 
 
 def amplitude_frequency(A_ratio: np.ndarray | float, alpha_ref: np.ndarray | float

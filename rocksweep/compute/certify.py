@@ -6,7 +6,7 @@ spring loses ~2% of its energy to RK4 each step, and on Figure 3(a) 73 of 19 200
 went safe where the reference overturns in mode 1 (issue 28). The kernel reports how
 close the free rocking came to the overturning saddle (``OUT_MARGIN``, ``loop._saddle``:
 the vertex of the hyperbola it rocks on, in alpha_ref, ~ sqrt(|E - E_barrier|/E_ref)); a
-run below ``CLOSE_MARGIN`` is a close call. A close call is run again at half the steps
+run below the row's PAR_CLOSE (``numerics.close_margin``) is a close call. A close call is run again at half the steps
 (``refine_rows``: every step and the rotation limit halved, the step cap doubled), and
 again, until two consecutive runs give the same outcome (the finer one is kept) or
 ``Numerics.refine`` refinements were made. Only the close calls pay: ~3-7% of the paper
@@ -28,17 +28,13 @@ import numpy as np
 from rocksweep.fields import CHECK_SCALE
 from rocksweep.kernel import layout as L  # noqa: N812
 
-# OUT_MARGIN [alpha_ref] below which a run is a close call. Measured on the four figures
-# at `default` (scripts/bench_certify.py): every outcome that differs from `fine` came
-# within 0.045 of the saddle (Figure 3(a): 73 points, 0.001-0.044); 0.05 marks 3-7% of
-# their points.
-CLOSE_MARGIN = 0.05
 
 
-def close_calls(outs: np.ndarray) -> np.ndarray:
-    """bool[n]: the runs (result rows float64[n, N_OUT]) whose outcome was a close call:
-    their free rocking came within CLOSE_MARGIN x alpha_ref of the overturning saddle."""
-    return outs[:, L.OUT_MARGIN] < CLOSE_MARGIN
+def close_calls(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
+    """bool[n]: the runs (parameter rows float64[n, >= N_PAR], result rows float64[n,
+    N_OUT]) whose outcome was a close call: their free rocking came within the row's
+    PAR_CLOSE x alpha_ref of the overturning saddle (``numerics.close_margin``)."""
+    return outs[:, L.OUT_MARGIN] < rows[:, L.PAR_CLOSE]
 
 
 def refine_rows(rows: np.ndarray, level: int) -> np.ndarray:
@@ -64,7 +60,7 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[[np.ndarray, np.nd
     """
     if levels <= 0 or outs.shape[0] == 0:
         return outs
-    idx = np.flatnonzero(close_calls(outs))
+    idx = np.flatnonzero(close_calls(rows, outs))
     for level in range(1, levels + 1):
         if idx.size == 0:
             break

@@ -49,7 +49,9 @@ PAR_E = 36  # LAW_CONSTANT's coefficient of restitution (unused by the other law
 PAR_E_FACTOR = 37  # multiplies the law's e (1: the law's own e)
 PAR_DT_ON = 38  # RK4 step while the ground moves, t < PAR_TPULSE (<= PAR_DT) [s]
 PAR_ALPHA_REF = 39  # alpha_ref: alpha_cg of a flexible body, alpha of a block [rad]
-N_PAR = 40
+PAR_CLOSE = 40  # OUT_MARGIN below which the run is a close call (read after the kernel,
+#                 by ``rocksweep.compute.certify``) [alpha_ref]
+N_PAR = 41
 # A record's row is longer: its samples xg''/PGA (float64[npts], in [-1, 1]) follow the
 # N_PAR parameters, PAR_REC = N_PAR the first (``points.with_record``).
 PAR_REC = N_PAR

@@ -18,6 +18,7 @@ from rocksweep.numerics import (
     ROOTS,
     Numerics,
     amplitude_frequency,
+    close_margin,
     step_budget,
     step_sizes,
 )
@@ -262,6 +263,7 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     rows[:, L.PAR_MU] = mu
     rows[:, L.PAR_ROT_STEP] = numerics.rotation_step * alpha_ref
     rows[:, L.PAR_ALPHA_REF] = alpha_ref
+    rows[:, L.PAR_CLOSE] = close_margin(numerics.steps_per_period)
     rows[:, L.PAR_LAW] = law
     rows[:, L.PAR_E] = e
     rows[:, L.PAR_E_FACTOR] = e_factor
