@@ -6,11 +6,12 @@ spring loses ~2% of its energy to RK4 each step, and on Figure 3(a) 73 of 19 200
 went safe where the reference overturns in mode 1 (issue 28). The kernel reports how
 close the free rocking came to the overturning saddle (``OUT_MARGIN``, ``loop._saddle``:
 the vertex of the hyperbola it rocks on, in alpha_ref, ~ sqrt(|E - E_barrier|/E_ref)); a
-run below the row's PAR_CLOSE (``numerics.close_margin``) is a close call. A close call is run again at half the steps
-(``refine_rows``: every step and the rotation limit halved, the step cap doubled), and
-again, until two consecutive runs give the same outcome (the finer one is kept) or
-``Numerics.refine`` refinements were made. Only the close calls pay: ~3-7% of the paper
-figures' points, whose reruns cost about what the point did (``scripts/bench_certify.py``).
+run below the row's PAR_CLOSE (``numerics.close_margin``) is a close call. A close call
+is run again at half the steps (``refine_rows``: every step and the rotation limit
+halved, the step cap doubled), and again, until two consecutive runs give the same
+outcome (the finer one is kept) or ``Numerics.refine`` refinements were made. Only the
+close calls pay: ~1-2% of the paper figures' points, whose reruns cost 1-3x what the
+point did (``scripts/bench_certify.py``).
 
 Every refined point has STATUS_REFINED in its status; one whose outcome still changed at
 the last refinement also STATUS_UNCERTIFIED (flagged: not a reliable classification).
@@ -27,7 +28,6 @@ import numpy as np
 
 from rocksweep.fields import CHECK_SCALE
 from rocksweep.kernel import layout as L  # noqa: N812
-
 
 
 def close_calls(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:

@@ -156,11 +156,18 @@ def _check_suite_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
 
 def _runs(scene: Scene) -> tuple[tuple[Numerics, str], ...]:
     """The numerics a scene's points run at, with the words that name them: the sweeps'
-    and the single runs' (``simulate``; `fine`, 4x the steps of `default`, unless the scene
-    names an accuracy)."""
-    single = scene.single_numerics
-    return ((scene.numerics, ""),
-            (single, f" at the single runs' accuracy ({single.accuracy})"))
+    (the single runs' are the same) and, with the certification of close calls
+    (``numerics.refine``), its finest rerun (``Numerics.refined``), which must fit the
+    same cap: the refinement stays bounded."""
+    n = scene.numerics
+    runs: list[tuple[Numerics, str]] = [(n, "")]
+    if scene.single_numerics != n:
+        single = scene.single_numerics
+        runs.append((single, f" at the single runs' accuracy ({single.accuracy})"))
+    if n.refine > 0:
+        runs.append((n.refined(n.refine), f" when a close call is refined {n.refine} times "
+                                          f"(numerics.refine = {n.refine})"))
+    return tuple(runs)
 
 
 def _check_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
@@ -268,7 +275,8 @@ def _cost_message(scene: Scene, point: dict) -> str:
         if cost is not None and cap / max(cost, 1.0) > best:
             best, best_key = cap / max(cost, 1.0), key
     if best_key is None:
-        return f"{head}; use fewer steps_per_period, a shorter horizon or fewer max_events"
+        return (f"{head}; use fewer steps_per_period, a shorter horizon, fewer max_events "
+                "or a smaller numerics.refine")
     value = current[best_key]
     if _with(scene, point, best_key, tame(best_key)) > MAX_POINT_STEPS:  # type: ignore[operator]
         return f"{best_key} = {fmt(value)}: {head}; other values of this point are costly too"
