@@ -185,14 +185,15 @@ def variables(energy: bool = False, contact: bool = False, check: bool = False
 THETA_REL_FLOOR = 1e-2
 
 
-# Row slots a half-step rerun (outputs.check) changes, and by what factor: the RK4 step
+# Row slots a half-step rerun (outputs.check) changes, and by what factor: the RK4 steps
 # after and while the ground moves (PAR_DT, PAR_DT_ON; PAR_REC_H, the step while a record
-# acts, stays a whole fraction of its sample interval),
-# the rotation limit of one rocking step, and the evaluation budget, which the halved step
-# doubles. Dividing by 2 is exact in float64, so the rerun is the run at twice the
-# steps_per_period and pulse_steps and half the rotation_step, bit for bit.
+# acts, stays a whole fraction of its sample interval), the rotation limit of one rocking
+# step, the evaluation budget, which the halved step doubles, and the close-call margin
+# (``numerics.close_margin``). Powers of 2 are exact in float64, so the rerun is the run at
+# twice the steps_per_period and pulse_steps and half the rotation_step, bit for bit.
 CHECK_SCALE: dict[int, float] = {L.PAR_DT: 0.5, L.PAR_DT_ON: 0.5, L.PAR_REC_H: 0.5,
-                                 L.PAR_ROT_STEP: 0.5, L.PAR_MAXSTEPS: 2.0}
+                                 L.PAR_ROT_STEP: 0.5, L.PAR_MAXSTEPS: 2.0,
+                                 L.PAR_CLOSE: 0.5 ** 2.5}
 
 
 def check_rows(rows: np.ndarray) -> np.ndarray:
