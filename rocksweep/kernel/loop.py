@@ -89,6 +89,7 @@ from rocksweep.kernel.layout import (
     PAR_B,
     PAR_DT,
     PAR_DT_ON,
+    PAR_G,
     PAR_HCG,
     PAR_M,
     PAR_MAXEVENTS,
@@ -214,6 +215,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             break
         if not FLEX and s != 0 and not on and free_check:
             free_check = False  # E is constant between impacts after the pulse: test once
+            margin = _energy_margin(y, s, prm, margin)
             peak = rigid_bounded(y, s, prm, FLEX)
             if peak >= 0.0:
                 if peak > theta_max:
@@ -419,6 +421,20 @@ def _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY):
     if s_new == 0:
         s_new = _uplift(t, y, on, prm, out, FLEX, DAMPED)
     return y, s_new
+
+
+@njit(cache=True, **INTERNAL)
+def _energy_margin(y, s, prm, margin):
+    """A rigid body's OUT_MARGIN once the ground is still, rocking on corner s: its energy
+    is then constant to the next impact, and sqrt(|E - E_ref|/E_ref) (E_ref = M g (R -
+    h_cg), the barrier) is the vertex distance ``_saddle`` measures near the saddle; taken
+    here too because a run may end at once (STATUS_BOUNDED) or overturn without a step
+    near the saddle."""
+    hcg = prm[PAR_HCG]
+    e_ref = prm[PAR_MTOT] * prm[PAR_G] * (math.hypot(prm[PAR_B], hcg) - hcg)
+    e = mechanical_energy(y[Y_THETA], y[Y_THETA_DOT], 0.0, 0.0, s, prm, False)
+    q = math.sqrt(abs(e - e_ref) / e_ref)
+    return q if q < margin else margin
 
 
 @njit(cache=True, **INLINE)
