@@ -19,15 +19,20 @@ import numpy as np
 # every preset (`rocksweep accuracy configs/fig3a.yaml --points 1000 --ladder roots`).
 ROOTS = ("bisection", "illinois", "hermite")
 
-# name -> (steps_per_period, event_tol). Measured with `rocksweep accuracy FIG.yaml
-# --points 1000 --ladder candidates` on configs/fig3a, fig3b, fig4a, fig4b and
-# `python scripts/accuracy_tables.py` (README, "Accuracy and its price"). `default` is the
-# cheapest setting whose outcomes agree with the reference on >= 99.5% of each scene's
-# points, also with two standard errors of the sample off (99.69% or more on all four);
-# `draft` is the smallest step allowed (4), ~6% cheaper, >= 99.59% on the four; `fine`
-# agrees on every sampled point, with errors ~1e-5 (p*t, theta/alpha_cg). event_tol 1e-5
-# and above keep chattering above the rest rate (runs hit the event cap). The presets were
-# chosen with bisection; the Hermite finder gives the same outcomes at half the time.
+# name -> (steps_per_period, event_tol). A preset is these with rotation_step
+# (PRESET_ROTATION), pulse_steps (PRESET_PULSE) and refine (PRESET_REFINE).
+#
+# Issue 28 (the step follows what acts, close calls certified): `default` classifies the
+# four figures like `fine` on all but 0/0/0/1 of their 19 200 cells each (the rule before
+# it: 72/32/1/2), at 1.4-6.6% more RK4 evaluations than that rule
+# (`python scripts/bench_step_rule.py`), and the held-out-style spectra (blocks alpha
+# 0.1/0.25/0.4, three flexible bodies, sine and cosine, omega/p 1-12, A/(g tan alpha) to
+# 30 on a 1000-value grid) like `fine` on every curve's first overturning value and mode.
+# `draft` is the smallest step allowed (4) with the pulse at 10 steps and no
+# certification; `fine` 20 steps per period, the pulse at 40, event_tol 1e-8; the agreement
+# of each with the reference and its price: README, "Accuracy and its price"
+# (`rocksweep accuracy FIG.yaml --points 1000 --ladder roots`, `scripts/accuracy_tables.py`).
+# event_tol 1e-5 and above keep chattering above the rest rate (runs hit the event cap).
 #
 # `accurate` (issue 15) is fit for every stored quantity far outside the paper's region:
 # the 95th percentile of the overturning-time error is below 0.05 p*t and of the safe runs'
@@ -35,9 +40,8 @@ ROOTS = ("bisection", "illinois", "hermite")
 # wide_space.py --seed 2 and 3) and on the stratified sample of configs/wide-space.yaml
 # (`rocksweep accuracy configs/wide-space.yaml --points 300 --ladder presets`), where 8
 # steps per period left the overturning time at 0.086 p*t (lam = 1.5: energy-gaining
-# impacts). `default` keeps 5 steps per period (the paper's figures may not get more than
-# ~10% slower) and meets neither there; `sweep --check` stores a per-point estimate of
-# what it misses.
+# impacts). `default` keeps 5 steps per period and meets neither there; `sweep --check`
+# stores a per-point estimate of what it misses.
 PRESETS: dict[str, tuple[int, float]] = {
     "draft": (4, 1e-6),
     "default": (5, 1e-6),
