@@ -308,7 +308,7 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
     kernel); the sample is also timed as one call per kernel kind. Both are the best of
     ``repeat`` rounds (the machine's noise only ever adds time). Compilation is excluded.
     """
-    from rocksweep.compute.certify import certify
+    from rocksweep.compute.certify import run_certified
     from rocksweep.compute.grid import Grid
     from rocksweep.physics.points import with_record
 
@@ -332,14 +332,7 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
 
     def certified(fn, rows: np.ndarray, out: np.ndarray) -> None:
         # the close calls re-run finer, as a sweep does (``compute.certify``)
-        fn(rows, out)
-        if refine > 0:
-            def rerun(sub: np.ndarray, idx: np.ndarray) -> np.ndarray:
-                res = np.empty((sub.shape[0], L.N_OUT))
-                fn(np.ascontiguousarray(sub), res)
-                return res
-
-            certify(rows, out, rerun, refine)
+        run_certified(fn, rows, out, refine)
 
     for _ in range(max(1, repeat)):
         for i in range(n):

@@ -77,3 +77,19 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[[np.ndarray, np.nd
         outs[idx, L.OUT_STATUS] = (outs[idx, L.OUT_STATUS].astype(np.int64)
                                    | L.STATUS_UNCERTIFIED)
     return outs
+
+
+def run_certified(kernel_fn: Callable[[np.ndarray, np.ndarray], None], rows: np.ndarray,
+                  outs: np.ndarray, levels: int) -> np.ndarray:
+    """``kernel_fn(rows, outs)`` (a chunk kernel: rows float64[n, N_PAR], outs float64[n,
+    N_OUT] filled), then the close calls certified with the same kernel (``certify``, up to
+    ``levels`` refinements). For callers that hold one kernel for all their rows (the A_min
+    bisection of ``analysis.boundaries``). Returns outs."""
+    kernel_fn(rows, outs)
+
+    def rerun(sub: np.ndarray, idx: np.ndarray) -> np.ndarray:
+        res = np.empty((sub.shape[0], L.N_OUT))
+        kernel_fn(np.ascontiguousarray(sub), res)
+        return res
+
+    return certify(rows, outs, rerun, levels)
