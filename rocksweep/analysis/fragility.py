@@ -50,7 +50,7 @@ import numpy as np
 import xarray as xr
 from scipy.special import log_ndtr, ndtr, ndtri
 
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import FragilityError  # noqa: F401 (defined there; re-exported)
 from rocksweep.kernel import layout as L
 from rocksweep.vocab.ground import CLOUD_IMS as CLOUD_IM_VARIABLES
 from rocksweep.vocab.ground import SCALE_IMS
@@ -66,9 +66,6 @@ CLOUD_IMS = {im: (var, SCALE_IMS[im]) for im, var in CLOUD_IM_VARIABLES.items()}
 REASONS = ("ok", "no_failures", "all_failed", "separated", "decreasing", "no_data")
 BAND_POINTS = 101
 
-
-class FragilityError(RocksweepError, ValueError):
-    """A Dataset or a request that fragility cannot answer; ``str()`` is one line."""
 
 
 class Fit(tuple):

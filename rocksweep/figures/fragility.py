@@ -20,7 +20,7 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.analysis.fragility import lognormal_cdf
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import FragilityFigureError  # noqa: F401 (defined there; re-exported)
 from rocksweep.figures import WIDTHS
 from rocksweep.figures.common import Figure
 
@@ -31,9 +31,6 @@ if TYPE_CHECKING:
 ASPECT = {"single": 0.83, "double": 0.6}
 _STYLES = ("-", "--", ":", "-.")
 
-
-class FragilityFigureError(RocksweepError, ValueError):
-    """A fragility Dataset that cannot be drawn as asked; ``str()`` is one line."""
 
 
 def _fmt(v) -> str:
