@@ -70,6 +70,18 @@ class IdaError(RocksweepError, ValueError):
     """A result that has no IDA: not a scaled suite, not finished (analysis.ida)."""
 
 
+class EfficiencyError(RocksweepError, ValueError):
+    """A Dataset that has no IM efficiency (analysis.efficiency)."""
+
+
+class RiskError(RocksweepError, ValueError):
+    """A hazard curve or a request that risk cannot answer (analysis.risk)."""
+
+
+class TableError(RocksweepError, ValueError):
+    """A Dataset that has no table (analysis.table)."""
+
+
 class FigureError(RocksweepError, ValueError):
     """Something that cannot be drawn as asked (figures)."""
 
@@ -80,6 +92,10 @@ class DiagramError(FigureError):
 
 class FragilityFigureError(RocksweepError, ValueError):
     """A fragility Dataset that cannot be drawn as asked (figures.fragility)."""
+
+
+class PlotError(RocksweepError, ValueError):
+    """A Dataset that has no figure (figures.dispatch)."""
 
 
 class ApiError(RocksweepError, ValueError):

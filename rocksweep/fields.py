@@ -262,6 +262,22 @@ RECORD_VARIABLES: dict[str, tuple[str, str | None, str]] = {
                   "pseudo-spectral acceleration at 5% damping, exact recurrence for the "
                   "piecewise-linear record (Nigam & Jennings 1969), free vibration after "
                   "the record included"),
+    "record_arias": ("Arias intensity of the record as recorded", "m/s",
+                     "pi/(2g) integral of a^2 dt, exact for the piecewise-linear record"),
+    "record_cav": ("cumulative absolute velocity of the record as recorded", "m/s",
+                   "integral of |a| dt, exact for the piecewise-linear record"),
+    "record_d5_95": ("significant duration D5-95 of the record", "s",
+                     "time between 5% and 95% of the Arias intensity (Trifunac & Brady "
+                     "1975); unchanged by scaling"),
+    "record_pgv_over_pga": ("PGV/PGA of the record", "s",
+                            "PGV / (PGA g): a pulse-period proxy; unchanged by scaling"),
+    "record_avgsa": ("average spectral acceleration of the record as recorded", "g",
+                     "geometric mean of Sa (5% damping) at 10 periods evenly spaced in ln T "
+                     "over the attribute avgsa_periods [s] (ground.avgsa; default 0.2-3 x "
+                     "the scale period, or 0.2-3 x 2 pi/p)"),
+    "record_v_end": ("ground velocity at the end of the record", "m/s",
+                     "the trapezoidal integral of the record as given at its last sample; far "
+                     "from 0: the record drifts (not baseline-corrected)"),
     "record_npts": ("number of samples of the record", "1", "NPTS"),
     "record_dt": ("sample interval of the record", "s", "DT"),
     "record_duration": ("duration of the record", "s", "(NPTS - 1) DT"),

@@ -188,6 +188,9 @@ KEYS: dict[str, Key] = {
     "ground.periods": Key("string", "must be a list of periods in [0, 100] s (Sa stored per "
                           "record; 0 gives the PGA)", 0.0, 100.0, required=False,
                           default=(0.2, 1.0)),
+    "ground.avgsa": Key("string", "must be [T_lo, T_hi], periods in (0, 100] s with T_lo <= "
+                        "T_hi (AvgSa's range; default 0.2-3 x scale.period for Sa stripes, "
+                        "else 0.2-3 x 2 pi/p)", 0.0, 100.0, required=False),
     "ground.p": Key("axis", f"must be in [1e-3, {1e3:g}] rad/s (the body's frequency "
                     "parameter p)", 1e-3, 1e3),
 }

@@ -66,13 +66,14 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
                                    "sampling seed)")
     # refuse a bad output before the (long) study
     check_distinct({"-o": report_path, "--plot": plot_path})  # by resolved path
+    scene = load(scene_path, overrides)
+    # the scene file, its records: never written over
     if report_path is not None:
-        check_output(report_path, overwrite=overwrite, inputs=[scene_path])
+        check_output(report_path, overwrite=overwrite, inputs=scene.inputs)
     if plot_path is not None:
         from rocksweep.figures.common import FORMATS
 
-        check_output(plot_path, overwrite=overwrite, inputs=[scene_path], suffixes=FORMATS)
-    scene = load(scene_path, overrides)
+        check_output(plot_path, overwrite=overwrite, inputs=scene.inputs, suffixes=FORMATS)
 
     from rocksweep.analysis.accuracy import accuracy_study, format_table, ladder, write_report
 
@@ -102,5 +103,5 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
         from rocksweep.figures.accuracy import work_precision
         from rocksweep.figures.common import save_figure
 
-        save_figure(work_precision(study), plot_path, overwrite=overwrite, inputs=[scene_path])
+        save_figure(work_precision(study), plot_path, overwrite=overwrite, inputs=scene.inputs)
         click.echo(f"wrote {plot_path}")

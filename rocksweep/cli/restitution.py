@@ -48,14 +48,21 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     from rocksweep.analysis.restitution import restitution_table
     from rocksweep.outputs import check_output
 
-    if plot_path is not None:
-        from rocksweep.figures.common import FORMATS
-
-        check_output(plot_path, overwrite=overwrite, inputs=[scene_path], suffixes=FORMATS)
     if law is not None:  # e belongs to law constant alone
+        given_e = [o for o in overrides if o.split("=", 1)[0].strip() == "impact.e"]
+        if law != CONSTANT and given_e:
+            raise click.ClickException(
+                f"--set {given_e[-1]}: e is the constant law's coefficient; --law {law} "
+                "computes e from the body (eq. (1)) and would ignore it: remove it, or use "
+                "--law constant")
         overrides = (*overrides, f"impact.law={law}",
                      *(("impact.e=null",) if law != CONSTANT else ()))
-    table = restitution_table(load(scene_path, overrides), n_lam, n_u)
+    scene = load(scene_path, overrides)
+    if plot_path is not None:  # the scene file, its records: never written over
+        from rocksweep.figures.common import FORMATS
+
+        check_output(plot_path, overwrite=overwrite, inputs=scene.inputs, suffixes=FORMATS)
+    table = restitution_table(scene, n_lam, n_u)
     if as_json:
         click.echo(json.dumps(table.as_dict()))
     else:
@@ -85,7 +92,7 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
 
         fig = restitution_map(table.lam, table.u_over_ucr, table.e_upper, table.e_housner,
                               table.title, lam_limit=table.lam_limit, law=table.law)
-        save_figure(fig, plot_path, overwrite=overwrite, inputs=[scene_path])
+        save_figure(fig, plot_path, overwrite=overwrite, inputs=scene.inputs)
         if not as_json:
             click.echo(f"wrote {plot_path}")
 

@@ -53,6 +53,9 @@ class Scene:
     # a suite scene (``ground.records``): the records, their IMs and the scaling (the
     # grid's axes then hold ``record`` (file names), the stripe IM if scaled, and p)
     suite: Suite | None = field(default=None, repr=False)
+    # every file the scene was read from: the scene file, its record, a suite's records and
+    # listings (paths as read); an output is never one of them (``outputs.check_output``)
+    inputs: tuple[str, ...] = field(default=(), repr=False)
 
     def variables(self) -> dict[str, tuple[str, float, str]]:
         """The per-point variables a sweep of this scene stores, name -> (dtype, fill value

@@ -95,3 +95,16 @@ CLOUD_IMS: dict[str, str] = {PGA: "record_pga", PGV: "record_pgv", SA: "record_s
 RATIO_OF: dict[str, str] = {PGA_RATIO: PGA, PGV_RATIO: PGV}
 SA_DAMPING = 0.05  # damping ratio of the spectral acceleration (5%)
 DEFAULT_PERIODS = (0.2, 1.0)  # [s] Sa stored per record
+ARIAS, CAV, D5_95, PGV_OVER_PGA, AVGSA = "Arias", "CAV", "D5_95", "PGV_over_PGA", "AvgSa"
+#: The record IMs stored per record (the one list): name -> (variable, units, exponent n:
+#: the IM of the record times F is F^n times its IM; 0: scale-invariant). Sa(T) is
+#: ``record_sa`` along ``period`` (n = 1).
+RECORD_IMS: dict[str, tuple[str, str, int]] = {
+    PGA: ("record_pga", "g", 1),
+    PGV: ("record_pgv", "m/s", 1),
+    ARIAS: ("record_arias", "m/s", 2),
+    CAV: ("record_cav", "m/s", 1),
+    D5_95: ("record_d5_95", "s", 0),
+    PGV_OVER_PGA: ("record_pgv_over_pga", "s", 0),
+    AVGSA: ("record_avgsa", "g", 1),
+}
