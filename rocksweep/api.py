@@ -26,7 +26,7 @@ from rocksweep.compute.driver import (  # noqa: F401 (SweepInterrupted: the API'
     SweepInterrupted,
     SweepReport,
 )
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import ApiError, RocksweepError, check_rtol
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -44,9 +44,6 @@ MAX_RUNS = 12
 # `rocksweep.simulate` returns one history per point: a notebook's worth, not a grid.
 API_MAX_RUNS = 100
 
-
-class ApiError(RocksweepError, ValueError):
-    """An argument of the Python API that cannot be used; ``str()`` is one line."""
 
 
 # ---------------------------------------------------------------------------------------
@@ -572,8 +569,7 @@ def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None) -> x
     from rocksweep.analysis import boundaries as bd
     from rocksweep.store.reader import as_result
 
-    if not (isinstance(rtol, int | float) and 0 < rtol < 1):
-        raise ApiError(f"rtol = {rtol!r}: must be a relative tolerance in (0, 1)")
+    check_rtol(rtol)
     if mode not in (None, 1, 2):
         raise ApiError(f"mode = {mode!r}: must be None, 1 or 2")
     result = as_result(ds, ["outcome"])
@@ -602,8 +598,7 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3) -> xr.Dataset:
     A_ratio, p), ``A_min`` and ``mode`` over (lam, p), A_min bisected to ``rtol``."""
     from rocksweep.analysis.spectrum import spectra as compute_spectra
 
-    if not (isinstance(rtol, int | float) and 0 < rtol < 1):
-        raise ApiError(f"rtol = {rtol!r}: must be a relative tolerance in (0, 1)")
+    check_rtol(rtol)
     return compute_spectra(ds, rtol).to_dataset()
 
 

@@ -33,6 +33,7 @@ import numpy as np
 
 from rocksweep.compute.adaptive import DIAGRAM_AXES, AdaptiveError, make_plan
 from rocksweep.compute.grid import Grid
+from rocksweep.errors import BoundaryError, check_rtol  # noqa: F401 (BoundaryError: re-exported)
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outcomes import outcome_word
@@ -283,8 +284,7 @@ def a_min(scene: Scene, outcome: np.ndarray, rtol: float = DEFAULT_RTOL,
     between the two grid values; a feature thinner than the grid spacing between them is
     resolved as found.
     """
-    if not (0 < rtol < 1):
-        raise AdaptiveError(f"rtol = {rtol!r}: must be in (0, 1)")
+    check_rtol(rtol, AdaptiveError)
     if mode not in (None, L.OUTCOME_MODE1, L.OUTCOME_MODE2):
         raise AdaptiveError(f"mode = {mode!r}: must be None (any), 1 or 2")
     target = OVERTURNED if mode is None else (mode,)
@@ -468,9 +468,6 @@ def write_curves_h5(path: str | Path, curves: Sequence[AMinCurve],
 
 
 # --- result files -----------------------------------------------------------------------
-
-class BoundaryError(AdaptiveError):
-    """A result whose boundaries cannot be drawn (one line, naming the file)."""
 
 
 def scene_of(result: SweepResult) -> Scene:

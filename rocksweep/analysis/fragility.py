@@ -82,7 +82,7 @@ import xarray as xr
 from scipy.special import log_ndtr, ndtr, ndtri, owens_t
 
 from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP, MAX_BOOTSTRAP
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import FragilityError, RocksweepError  # noqa: F401 (re-exported)
 from rocksweep.kernel import layout as L
 from rocksweep.vocab.ground import CLOUD_IMS as CLOUD_IM_VARIABLES
 from rocksweep.vocab.ground import SCALE_IMS
@@ -111,9 +111,6 @@ CENSORED_SHARE = 0.1
 FLAGGED_SHIFT = 0.01
 _CODE = {w: i for i, w in enumerate(ENDINGS)}
 
-
-class FragilityError(RocksweepError, ValueError):
-    """A Dataset or a request that fragility cannot answer; ``str()`` is one line."""
 
 
 class FragilityWarning(UserWarning):

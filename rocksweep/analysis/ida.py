@@ -21,16 +21,13 @@ from typing import Any
 import numpy as np
 
 from rocksweep.analysis.boundaries import kernel_evaluator
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import IdaError, check_rtol
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.store.reader import as_result, result_scene
 
 # Bisection steps at most (a relative tolerance of 1e-12 takes ~40 from a stripe gap).
 MAX_ITER = 60
 
-
-class IdaError(RocksweepError, ValueError):
-    """A result that has no IDA (not a scaled suite, not finished); one line."""
 
 
 def ida(ds: Any, rtol: float = 1e-2) -> Any:
@@ -50,8 +47,7 @@ def ida(ds: Any, rtol: float = 1e-2) -> Any:
 
     from rocksweep import fields
 
-    if not (isinstance(rtol, int | float) and 0 < rtol < 1):
-        raise IdaError(f"rtol = {rtol!r}: must be a relative tolerance in (0, 1)")
+    check_rtol(rtol, IdaError)
     result = as_result(ds, ["outcome", "status"])
     im = result.attrs.get("scale_im")
     if not im or im not in result.dims or "record" not in result.dims:

@@ -24,12 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from rocksweep.analysis.boundaries import DEFAULT_RTOL, AMinCurve, a_min, kernel_evaluator
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import SpectrumError  # noqa: F401 (defined there; re-exported)
 from rocksweep.vocab.outcomes import MODE_WORDS, OUTCOME_WORDS, flag_attrs
-
-
-class SpectrumError(RocksweepError, ValueError):
-    """A result that has no spectra (wrong axes, incomplete); ``str()`` is one line."""
 
 
 @dataclass

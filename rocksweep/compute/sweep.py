@@ -210,16 +210,10 @@ def prepare(grid: Grid, level: int) -> None:
 
 
 def _in_cache(dispatcher) -> bool | None:
-    """Whether numba has this variant in memory or in its on-disk cache for this machine;
-    None if that cannot be told (numba's cache internals changed)."""
-    try:
-        if dispatcher.signatures:
-            return True
-        index = dispatcher._cache._cache_file._load_index()  # {(sig, machine): file}
-        machine = dispatcher.targetdescr.target_context.codegen().magic_tuple()
-        return any(key[1] == machine for key in index)
-    except Exception:  # private numba API: any change means "unknown"
-        return None
+    """``kernel._cache.in_cache`` (numba's private cache names stay there)."""
+    from rocksweep.kernel._cache import in_cache
+
+    return in_cache(dispatcher)
 
 
 def kernel_cache_state(grid: Grid, level: int) -> tuple[int, int]:

@@ -133,8 +133,11 @@ _energy = skipped_when(False, mechanical_energy, 0.0)
 ALIGN_SLACK = 1e-7
 
 
-def _acting(t, t_pulse, GROUND):  # pragma: no cover (replaced by the overload below)
-    raise NotImplementedError
+def _acting(t, t_pulse, GROUND):
+    """Plain Python (NUMBA_DISABLE_JIT=1): the overload's choice, by GROUND's type."""
+    if isinstance(GROUND, bool | np.bool_):
+        return t < t_pulse
+    return np.int64(t < t_pulse)
 
 
 @overload(_acting)
