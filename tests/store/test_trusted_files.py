@@ -161,3 +161,29 @@ def test_an_in_memory_result_is_never_read_through_its_title(tmp_path, monkeypat
 
     res = result_of(ds)
     assert not res.in_file and "README.md" in str(res.path) and res.path != Path("README.md")
+
+
+def test_flipped_bits_anywhere_are_a_read_or_one_error(pulse_result, tmp_path):
+    """1-4 bits flipped anywhere in a result (dimension scales included: HDF5's
+    H5DSget_num_scales raised a RuntimeError through xarray before): every reader either
+    reads the file or raises a one-line RocksweepError."""
+    import random
+
+    from rocksweep.analysis.summary import read_info
+
+    data = pulse_result.read_bytes()
+    path = tmp_path / "f.h5"
+    failures = 0
+    for seed in range(100):
+        rng = random.Random(seed)
+        b = bytearray(data)
+        for _ in range(rng.randint(1, 4)):
+            b[rng.randrange(len(b))] ^= 1 << rng.randrange(8)
+        path.write_bytes(bytes(b))
+        for read in (rocksweep.open, read_result, read_info):
+            try:
+                read(path)
+            except rocksweep.RocksweepError as err:
+                assert "\n" not in str(err)
+                failures += 1
+    assert failures > 0  # the flips did damage something
