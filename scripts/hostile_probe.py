@@ -603,7 +603,8 @@ def _(d):
 
 # --- the run -------------------------------------------------------------------------------
 
-def classify(r: subprocess.CompletedProcess, before: dict, after: dict, expect: str) -> tuple[str, str]:
+def classify(r: subprocess.CompletedProcess, before: dict, after: dict,
+             expect: str) -> tuple[str, str]:
     lost = [k for k, v in before.items() if after.get(k) != v]
     text = (r.stderr.strip() + " " + r.stdout.strip()).strip()
     if lost:

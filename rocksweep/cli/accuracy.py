@@ -15,6 +15,7 @@ from rocksweep.cli.main import (
     set_option,
     user_errors,
 )
+from rocksweep.vocab.settings import DEFAULT_LADDER, LADDER_NAMES, LADDERS
 
 
 @main.command()
@@ -28,14 +29,10 @@ from rocksweep.cli.main import (
               show_default=True,
               help="Stratified sample size (every point if the scene has no more).")
 @click.option("--ladder", "ladder_name",
-              type=click.Choice(["full", "short", "candidates", "presets", "roots"]),
-              # = accuracy.LADDERS (tests/test_accuracy.py checks; --help stays light)
-              default="full", show_default=True,
-              help="Kernel settings to measure: full (steps per period 5..160, event_tol "
-                   "1e-4..1e-8, presets), short (a quick check), candidates (the cheap "
-                   "settings the default preset is chosen from), presets (the presets alone: "
-                   "their tails on a scene of your own), roots (every preset with every "
-                   "event root finder).")
+              type=click.Choice(LADDER_NAMES),  # = accuracy.LADDERS (tests/test_vocab.py)
+              default=DEFAULT_LADDER, show_default=True,
+              help="Kernel settings to measure: " + ", ".join(
+                  f"{k} ({v})" for k, v in LADDERS.items()) + ".")
 @click.option("--seed", type=int, default=0, show_default=True, help="Sampling seed.")
 @click.option("--repeat", type=click.IntRange(min=1), default=5, show_default=True,
               help="Kernel timings are the best of this many rounds.")

@@ -111,3 +111,15 @@ def main() -> None:
 
     Times are p*t, rotations theta/alpha_cg, energies E/E_ref.
     """
+    _one_line_warnings()
+
+
+def _one_line_warnings() -> None:
+    """The library's warnings (a drifting record, a large scale factor) as one line on
+    stderr, ``Warning: ...``, instead of Python's two (file, line, source)."""
+    import warnings
+
+    def show(message, category, filename, lineno, file=None, line=None) -> None:
+        click.echo(f"Warning: {one_line(str(message))}", err=True)
+
+    warnings.showwarning = show

@@ -113,10 +113,12 @@ def drive(sf, path: Path | None, report: SweepReport, t0: float,
     return report
 
 
-def progress_class() -> type:
+def progress_class(progress: bool = True) -> type:
     """The progress bar: a widget in a notebook (``tqdm.auto``'s choice), else the
-    terminal's bar (without ``tqdm.auto``'s asyncio import: ~10 ms of every command)."""
-    if "ipykernel" in sys.modules:
+    terminal's bar (without ``tqdm.auto``'s asyncio import: ~10 ms of every command).
+    No bar shown (``progress`` false): the terminal's class, which a notebook without
+    ipywidgets does not warn about (tqdm's "IProgress not found" TqdmWarning)."""
+    if progress and "ipykernel" in sys.modules:
         from tqdm.auto import tqdm
     else:
         from tqdm import tqdm
@@ -131,7 +133,7 @@ def every_point_loop(sf, report: SweepReport, _options: None, *, jobs: int, back
     ``write_every`` seconds (and the pending ones whatever ends the loop)."""
     from rocksweep.compute import sweep as sw
 
-    tqdm = progress_class()
+    tqdm = progress_class(progress)
 
     scene = sf.grid.scene
 
@@ -208,7 +210,7 @@ def adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backe
     from rocksweep.compute import adaptive as ad
     from rocksweep.compute import sweep as sw
 
-    tqdm = progress_class()
+    tqdm = progress_class(progress)
     scene = sf.grid.scene
     plan = options.plan(sf.grid)
     outcome, computed = sf.state()

@@ -30,7 +30,14 @@ from rocksweep.numerics import Numerics
 from rocksweep.outputs import input_problem, is_input, shown
 from rocksweep.physics.points import RECORD
 from rocksweep.physics.records import GroundRecord, RecordError, read_record
-from rocksweep.physics.suite import DEFAULT_PERIODS, SCALE_IMS, Suite, SuiteError, make_suite
+from rocksweep.physics.suite import (
+    AVGSA_RANGE,
+    DEFAULT_PERIODS,
+    SCALE_IMS,
+    Suite,
+    SuiteError,
+    make_suite,
+)
 from rocksweep.scene.admission import _candidate_bodies, _check_cost
 from rocksweep.scene.loader import _CONTROL, _load_yaml, _YamlError
 from rocksweep.scene.model import Axis, Scene, SceneError
@@ -44,6 +51,10 @@ from rocksweep.schema import (
     is_number,
     section_keys,
 )
+from rocksweep.vocab.axes import DIAGRAM_AXES
+from rocksweep.vocab.ground import MP
+from rocksweep.vocab.ground import PULSE_KEY_SHAPES as _PULSE_KEY_SHAPES
+from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
 
 # Largest grid a scene may describe [points]. A sweep file stores 45 bytes a point (69
 # with energy metrics, ``rocksweep.fields.variables``): 2e8 points are a 9-14 GB file, one
@@ -53,10 +64,10 @@ MAX_POINTS = 200_000_000
 # Values per axis: an axis is kept as a tuple of Python floats (~32 bytes a value; 1e6
 # values are 32 MB and 0.1 s to build); a figure's axis needs a few thousand at most.
 MAX_AXIS_VALUES = 1_000_000
-PULSE_AXES = ("A_ratio", "w_over_p")
+PULSE_AXES = tuple(reversed(DIAGRAM_AXES))  # (A_ratio, w_over_p)
 # The pulse shapes each optional pulse key means something for (rocksweep.physics.excitation);
 # given for none of the scene's shapes, the key is refused (it would be silently ignored).
-PULSE_KEY_SHAPES = {"cycles": ("sine", "cosine"), "gamma": ("mp",), "nu": ("mp",)}
+PULSE_KEY_SHAPES = _PULSE_KEY_SHAPES
 
 
 def apply_overrides(raw: dict, overrides: list[str]) -> dict:
@@ -246,17 +257,17 @@ def _impact_law(impact: dict) -> tuple[Axis | None, list[tuple[str, str, Any]]]:
     one: eq. 1, ``vertical``) and the specs of ``impact.e`` and ``impact.e_factor`` given.
     ``e`` is required by law ``constant`` and refused without it."""
     law_axis = None
-    laws: tuple[str, ...] = ("vertical",)
+    laws: tuple[str, ...] = (DEFAULT_LAW,)
     if impact.get("law") is not None:
         laws, swept = _words("impact.law", impact["law"])
         law_axis = Axis("law", "impact.law", laws, swept)
     specs = []
     e_spec = impact.get("e")
-    if e_spec is None and "constant" in laws:
+    if e_spec is None and CONSTANT in laws:
         raise SceneError("impact.e: missing; law constant needs its coefficient of "
                          "restitution e: a number in (0, 1], a list or a range")
     if e_spec is not None:
-        if "constant" not in laws:
+        if CONSTANT not in laws:
             raise SceneError(f"impact.e = {fmt(e_spec)}: only law constant uses e (the law "
                              f"here is {', '.join(laws)}); remove impact.e or add law: "
                              "constant")
@@ -336,7 +347,7 @@ def _pulse_options(pulse: dict, shapes: tuple[str, ...]) -> list[Axis]:
         v = pulse.get(k)
         given = v is not None
         if v is None:
-            if not (k != "cycles" and "mp" in shapes):
+            if not (k != "cycles" and MP in shapes):
                 continue
             v = spec.default
         ok = (isinstance(v, int) and not isinstance(v, bool)) if spec.kind == "integer" \
@@ -577,6 +588,28 @@ def _scale(ground: dict) -> tuple[str | None, str, Any, float, float]:
     return im, form, spec, period, math.nan
 
 
+def _avgsa(ground: dict, period: float) -> tuple[tuple[float, float], str]:
+    """AvgSa's period range [s] and how it was chosen (``rocksweep.physics.suite``):
+    ``ground.avgsa``, else AVGSA_RANGE x T_ref, T_ref the Sa stripes' period or 2 pi / p."""
+    key = "ground.avgsa"
+    spec = ground.get("avgsa")
+    if spec is not None:
+        ok = (isinstance(spec, list) and len(spec) == 2 and all(is_number(v) for v in spec))
+        lo, hi = (as_float(spec[0]), as_float(spec[1])) if ok else (math.nan, math.nan)
+        if not (ok and 0.0 < lo <= hi <= 100.0):
+            raise SceneError(f"{key} = {fmt(spec)}: {KEYS[key].allowed}")
+        return (lo, hi), f"ground.avgsa = [{lo:g}, {hi:g}] s"
+    if math.isfinite(period):
+        t_ref, why = period, "scale.period"
+    else:
+        form, pspec, _ = _axis_spec("ground.p", ground["p"])
+        p = _axis_values("ground.p", form, pspec)
+        t_ref = 2.0 * math.pi / float(np.exp(np.mean(np.log(p))))
+        why = "2 pi / p" if p.size == 1 else "2 pi / p (geometric mean of the swept p)"
+    a, b = AVGSA_RANGE
+    return (a * t_ref, b * t_ref), f"{a:g}-{b:g} x T_ref, T_ref = {why} = {t_ref:.4g} s"
+
+
 def _suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...] | None = None
            ) -> tuple[Suite, tuple[str, str, Any] | None, tuple[str, ...]]:
     """The suite of a ``ground.records`` section (records read and hashed, IMs computed
@@ -606,7 +639,8 @@ def _suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...] | No
         read = tuple(str(p) for p in (*paths, *listings))
     values = _axis_values("ground.scale.values", form, spec).tolist() if im else []
     try:
-        suite = make_suite(records, names, im, values, period, factor, _periods(ground))
+        suite = make_suite(records, names, im, values, period, factor,
+                           _periods(ground), *_avgsa(ground, period))
     except SuiteError as err:
         raise SceneError(f"ground.records: {err}") from None
     return suite, ((im, form, spec) if im else None), read
@@ -652,7 +686,7 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
             suite, stripe, inputs = _suite(ground, base, given_records)
             pulse = {"shape": RECORD, "p": ground["p"]}
         else:
-            for k in ("scale", "periods"):
+            for k in ("scale", "periods", "avgsa"):
                 if ground.get(k) is not None:
                     raise SceneError(f"ground.{k}: works with ground.records (a suite); one "
                                      "ground.record is scaled by ground.A_ratio")
@@ -751,4 +785,7 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
                          "outputs work with sine and cosine pulses")
     bodies = _candidate_bodies(scene)
     _check_cost(scene, bodies)
+    if suite is not None:  # drift and large factors: one-line RecordWarnings
+        suite.warn(scene.axis("alpha" if kind == "block" else "alpha_cg").values,
+                   scene.axis("p").values)
     return scene

@@ -54,6 +54,7 @@ from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import _fixed, _now
 from rocksweep.store.identity import record_attrs, resolved_scene
+from rocksweep.vocab.outcomes import COMPUTED_FLAGS, COMPUTED_MEANING
 
 if TYPE_CHECKING:
     import h5py
@@ -95,11 +96,9 @@ ADAPTIVE_COUNT_ATTRS: dict[str, str] = {
     "audit_misses": "int64",
 }
 # The ``computed`` variable of adaptive sweeps: (dtype, fill, description), flag meanings.
-COMPUTED_VARIABLE = ("int8", 0, "adaptive sweep: 0 filled (not computed; outcome from the "
-                     "uniform cell around the point, other variables at their fill "
-                     "values), 1 computed, 2 audit point that agreed with its fill, 3 "
-                     "audit point that disagreed (region refined)")
-COMPUTED_FLAGS = {0: "filled", 1: "computed", 2: "audit_agreed", 3: "audit_disagreed"}
+COMPUTED_VARIABLE = ("int8", 0, "adaptive sweep: " + ", ".join(
+    f"{c} {m}" for c, m in COMPUTED_MEANING.items()) + "; other variables of a filled "
+    "point at their fill values")
 
 # Variables whose values are codes (CF flag_values / flag_masks): no units.
 FLAG_VARIABLES = ("outcome", "status", "computed")
@@ -298,6 +297,9 @@ def suite_variables(scene: Scene) -> dict[str, tuple[tuple[str, ...], np.ndarray
         "record_pga": (("record",), np.asarray(su.pga, float)),
         "record_pgv": (("record",), np.asarray(su.pgv, float)),
         "record_sa": (("record", "period"), np.asarray(su.sa, float)),
+        **{k: (("record",), v) for k, v in su.record_ims().items() if k not in (
+            "record_pga", "record_pgv")},  # Arias, CAV, D5-95, PGV/PGA, AvgSa (RECORD_IMS)
+        "record_v_end": (("record",), np.asarray(su.v_end, float)),
         "record_npts": (("record",), np.array([r.npts for r in su.records], np.int64)),
         "record_dt": (("record",), np.array([r.dt for r in su.records], float)),
         "record_duration": (("record",), np.array([r.duration for r in su.records], float)),
@@ -351,6 +353,9 @@ def _write_suite(f: h5py.File, scene: Scene, scales: dict) -> None:
         if units is not None:
             ds.attrs["units"] = units
         ds.attrs["description"] = text
+        if name == "record_avgsa":  # its period range and how it was chosen
+            ds.attrs["avgsa_periods"] = np.asarray(su.avgsa_range, float)
+            ds.attrs["avgsa_rule"] = su.avgsa_rule
         for i, d in enumerate(dims):
             ds.dims[i].attach_scale(scales[d])
 

@@ -39,6 +39,7 @@ from rocksweep.store.format import (
     variables_for,
 )
 from rocksweep.store.identity import resolved_scene, scene_differences
+from rocksweep.vocab.outcomes import CLASSES, OUTCOME_CODE
 
 if TYPE_CHECKING:
     import h5py
@@ -418,9 +419,7 @@ class SweepResult:
                             else self.scalars.get(d))
             cell = o[idx]
             rows.append({**label,
-                         "safe": int((cell == L.OUTCOME_SAFE).sum()),
-                         "mode1": int((cell == L.OUTCOME_MODE1).sum()),
-                         "mode2": int((cell == L.OUTCOME_MODE2).sum()),
+                         **{w: int((cell == OUTCOME_CODE[w]).sum()) for w in CLASSES},
                          "not_computed": int((cell == L.OUTCOME_NOT_RUN).sum()),
                          "flagged": int(fl[idx].sum())})
         return rows
