@@ -437,6 +437,11 @@ def _listing(path: Path, shown_as: str) -> list[tuple[int, str]]:
     if data.startswith((b"\xff\xfe", b"\xfe\xff")):
         raise SceneError(f"{key}: {shown_as}: a listing saved as UTF-16; save it as UTF-8 "
                          "text (one record path a line)")
+    if b"\0" in data:
+        line = data.count(b"\n", 0, data.index(b"\0")) + 1
+        raise SceneError(f"{key}: {shown_as}, line {line}: a NUL byte (UTF-16 without a "
+                         "byte-order mark, or a binary file?); a listing is UTF-8 text, one "
+                         "record path a line")
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as err:
