@@ -38,6 +38,10 @@ def test_one_row_per_run_with_the_runs_ims(ds):
     np.testing.assert_allclose(t["d5_95"], t["record_d5_95"], rtol=1e-12)
     np.testing.assert_allclose(t["pgv_over_pga"], t["pgv"] / (t["pga"] * G), rtol=1e-9)
     assert {"record_sa(0.2)", "record_sa(1)", "sa(0.2)", "sa(1)"} <= set(t.columns)
+    # the dimensionless IMs of each run: PGA/(g tan alpha_cg), PGV p/(g tan alpha_cg)
+    np.testing.assert_allclose(t["pga_ratio"], t["PGA"] / np.tan(0.15), rtol=1e-12)
+    np.testing.assert_allclose(t["pgv_ratio"], t["pgv"] * 2.0 / (G * np.tan(0.15)),
+                               rtol=1e-12)
     assert t.attrs["units"]["arias"] == "m/s" and t.attrs["units"]["d5_95"] == "s"
     assert "record_sha256" not in t.columns
 
