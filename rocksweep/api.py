@@ -581,7 +581,9 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3) -> xr.Dataset:
 
     if not (isinstance(rtol, int | float) and 0 < rtol < 1):
         raise ApiError(f"rtol = {rtol!r}: must be a relative tolerance in (0, 1)")
-    return compute_spectra(ds, rtol).to_dataset()
+    out = compute_spectra(ds, rtol).to_dataset()
+    out.attrs["rocksweep_kind"] = "spectra"  # rocksweep.plot's dispatch (analysis.kinds)
+    return out
 
 
 @speaks_python
@@ -594,7 +596,9 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
     over the other swept keys and ``record`` (``rocksweep.analysis.ida.ida``)."""
     from rocksweep.analysis.ida import ida as run_ida
 
-    return run_ida(ds, rtol)
+    out = run_ida(ds, rtol)
+    out.attrs["rocksweep_kind"] = "ida"  # rocksweep.plot's dispatch (analysis.kinds)
+    return out
 
 
 @speaks_python
@@ -638,6 +642,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
                        "or rocksweep.open)")
     frag = fit(ds, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci)
     frag.attrs["title"] = str(ds.attrs.get("title", ""))
+    frag.attrs["rocksweep_kind"] = "fragility"  # rocksweep.plot's dispatch (analysis.kinds)
     return frag
 
 

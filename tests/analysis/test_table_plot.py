@@ -69,6 +69,7 @@ def test_plot_draws_every_kind(ds):
     for d, kind in ((ds, "sweep"), (fr, "fragility"), (eff, "im_efficiency"),
                     (rk, "risk")):
         assert dataset_kind(d) == kind
+        assert d.attrs.get("rocksweep_kind", "sweep") == kind
         fig = rocksweep.plot(d)
         assert isinstance(fig, Figure) and fig.axes
         assert isinstance(d.rocksweep.plot(), Figure)
@@ -100,7 +101,7 @@ def test_plot_of_ida_and_spectra_datasets(ds):
     import xarray as xr
 
     ida = rocksweep.ida(ds, rtol=0.05)
-    assert dataset_kind(ida) == "ida"
+    assert dataset_kind(ida) == "ida" and ida.attrs["rocksweep_kind"] == "ida"
     fig = rocksweep.plot(ida)
     assert fig.axes[0].get_xscale() == "log"
     n_points = sum(len(c.get_offsets()) if hasattr(c, "get_offsets") else 0
