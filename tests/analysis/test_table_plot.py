@@ -103,10 +103,15 @@ def test_plot_of_ida_and_spectra_datasets(ds):
     ida = rocksweep.ida(ds, rtol=0.05)
     assert dataset_kind(ida) == "ida" and ida.attrs["rocksweep_kind"] == "ida"
     fig = rocksweep.plot(ida)
-    assert fig.axes[0].get_xscale() == "log"
-    n_points = sum(len(c.get_offsets()) if hasattr(c, "get_offsets") else 0
-                   for c in fig.axes[0].collections)
-    assert fig.axes[0].lines or n_points
+    # IDA curves: one panel per lam, max|theta|/alpha against the IM, one curve per record
+    # ending at its bisected first overturning level at the limit 1
+    assert len(fig.axes) == ds.sizes["lam"]
+    ax = fig.axes[0]
+    assert ax.get_xscale() == "log"
+    v = ida.ida_im.isel(lam=0).values
+    ends = {round(float(ln.get_xdata()[0]), 12) for ln in ax.lines
+            if len(ln.get_xdata()) == 1 and ln.get_ydata()[0] == 1.0}
+    assert ends == {round(float(x), 12) for x in v[np.isfinite(v)]}
     lam, A, p = [0.0, 0.4], [1.0, 2.0, 3.0], np.linspace(1, 5, 7)
     sp = xr.Dataset(
         {"theta_max_over_alpha": (("lam", "A_ratio", "p"), np.random.default_rng(0)
