@@ -273,6 +273,7 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
                       scheduler=scheduler, chunk_size=chunk_size, where=where,
                       write_every=write_every, progress=progress, say=say) or report_of
     path = Path(path)
+    inputs = [*inputs, *scene.inputs]  # the scene's records and listings: never written over
     try:
         path.stat()
     except FileNotFoundError:
@@ -363,6 +364,10 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
     where = {"backend": "threads"}
     if client is not None:
         address = getattr(getattr(client, "scheduler", None), "address", None)
+        if type(client).__name__ == "Client" and getattr(client, "status", None) in (
+                "closed", "closing"):
+            raise ApiError(f"client = {client!r}: this dask Client is closed; make a new one "
+                           "(Client(cluster) or Client('tcp://host:8786')) and pass it")
         if not isinstance(address, str):
             raise TypeError(f"client = {client!r}: must be a dask.distributed.Client")
         where = {"backend": "dask", "scheduler": address}
@@ -443,8 +448,24 @@ def _dataset(source: Path | Any) -> xr.Dataset:
     register_accessor()  # ds.rocksweep.plot() etc.
     kwds = {"driver_kwds": {"locking": False}} if isinstance(source, Path) else {}
     try:
-        with xr.open_dataset(source, engine="h5netcdf", **kwds) as ds:
-            ds = ds.load()
+        try:
+            with xr.open_dataset(source, engine="h5netcdf", **kwds) as ds:
+                ds = ds.load()
+        except OSError as err:  # open here through another handle: take its lock flags
+            from rocksweep.store.reader import READER_LOCKING, _open_here
+
+            if not (kwds and _open_here(err)):
+                raise
+            for locking in READER_LOCKING:
+                try:
+                    with xr.open_dataset(source, engine="h5netcdf",
+                                         driver_kwds={"locking": locking}) as ds:
+                        ds = ds.load()
+                    break
+                except OSError:
+                    continue
+            else:
+                raise
     except (ValueError, TypeError, KeyError, OSError, OverflowError, AttributeError,
             IndexError) as err:  # xarray's CF decoding of a damaged attribute
         from rocksweep.outputs import shown
@@ -466,7 +487,8 @@ def _dataset(source: Path | Any) -> xr.Dataset:
     if "status" in ds:
         ds["status"].attrs.setdefault("flag_masks", list(STATUS_WORDS))
         ds["status"].attrs.setdefault("flag_meanings", " ".join(STATUS_WORDS.values()))
-    ds.attrs = {k: (v.item() if hasattr(v, "item") else v) for k, v in ds.attrs.items()}
+    ds.attrs = {k: (v.item() if hasattr(v, "item") and getattr(v, "size", 1) == 1 else v)
+                for k, v in ds.attrs.items()}
     return ds
 
 
@@ -502,7 +524,7 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     import matplotlib
 
     from rocksweep.analysis.kinds import dataset_kind
-    from rocksweep.figures.common import width_style
+    from rocksweep.figures.common import fit_width, width_style
     from rocksweep.figures.diagrams import friction_map, sweep_figure
     from rocksweep.store.reader import as_result
 
@@ -517,7 +539,10 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
         from rocksweep.figures.dispatch import plot_analysis
 
         with matplotlib.rc_context(width_style(width)):
-            return plot_analysis(ds, ax=ax, width=width)
+            fig = plot_analysis(ds, ax=ax, width=width)
+        if width is not None and ax is None:
+            fit_width(fig, width)
+        return fig
     result = as_result(ds)
     style = width_style(width)
     with matplotlib.rc_context(style):
@@ -527,10 +552,8 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
             fig = sweep_figure(result, x, y, axes=ax, option_names=_names[:2], curves=curves,
                                show_computed=show_computed, compare=compare,
                                compare_option=_names[2])
-    if style and ax is None:  # the preset's width, the layout's aspect
-        w, h = fig.get_size_inches()
-        inches = style["figure.figsize"][0]
-        fig.set_size_inches(inches, h * inches / w)
+    if style and ax is None:  # the preset's width, the layout's aspect, what fits in it
+        fit_width(fig, width)
     return fig
 
 

@@ -50,6 +50,7 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.errors import RocksweepError
+from rocksweep.vocab.ground import PGA, PGV, SA
 
 __all__ = ["Hazard", "RiskError", "fragility_median", "hazard_frame", "read_hazard",
            "risk"]
@@ -60,7 +61,7 @@ LOW_P = 1e-3  # below_hazard when the fragility at the hazard's smallest IM exce
 PLOT_POINTS = 200  # the figure's grid over the hazard's range
 RATE_COLUMN = "annual_rate"
 #: OpenQuake's IMT units, and the factor to rocksweep's
-OQ_UNITS = {"PGA": ("g", 1.0), "SA": ("g", 1.0), "PGV": ("m/s", 0.01)}
+OQ_UNITS = {PGA: ("g", 1.0), SA.upper(): ("g", 1.0), PGV: ("m/s", 0.01)}
 _HEADER = re.compile(r"^\s*(?P<im>[A-Za-z][A-Za-z0-9_]*)\s*(?:\(\s*(?P<T>[0-9.eE+-]+)\s*\))?"
                      r"\s*\[(?P<unit>[^\]]*)\]\s*$")
 
@@ -91,9 +92,9 @@ class Hazard:
 def _im_name(text: str) -> str:
     """An IM name as rocksweep spells it (SA, sa -> Sa; PGA, PGV upper case)."""
     t = text.strip()
-    if t.lower() == "sa":
-        return "Sa"
-    if t.upper() in ("PGA", "PGV"):
+    if t.lower() == SA.lower():
+        return SA
+    if t.upper() in (PGA, PGV):
         return t.upper()
     return t
 

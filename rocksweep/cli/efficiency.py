@@ -11,6 +11,7 @@ import click
 from rocksweep.cli.main import main, user_errors
 from rocksweep.cli.options import dpi_option, overwrite_option, result_argument
 from rocksweep.figures import WIDTHS
+from rocksweep.vocab.outcomes import STATES, THETA_STATE
 
 SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
 
@@ -18,7 +19,7 @@ SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
 @main.command()
 @result_argument
 @click.option("--state", default="overturn", show_default=True,
-              help="overturn, mode1, mode2, uplift or theta:X.")
+              help=", ".join(STATES) + " or " + THETA_STATE + ".")
 @click.option("-o", "--output", "out_path", type=click.Path(dir_okay=False, path_type=Path),
               help="The table as CSV (.csv) or the Dataset (.h5, .hdf5, .nc).")
 @click.option("--plot", "fig_path", type=click.Path(dir_okay=False, path_type=Path),

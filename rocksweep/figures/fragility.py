@@ -19,12 +19,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import xarray as xr
-from matplotlib.figure import Figure
 
 from rocksweep.analysis.fragility import lognormal_cdf
 from rocksweep.analysis.risk import fragility_median
 from rocksweep.errors import RocksweepError
 from rocksweep.figures import WIDTHS
+from rocksweep.figures.common import Figure
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

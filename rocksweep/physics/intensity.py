@@ -56,6 +56,7 @@ import numpy as np
 from scipy.signal import lfilter
 
 from rocksweep.physics.model import G  # gravity [m/s^2], the one definition
+from rocksweep.vocab.ground import SA_DAMPING
 
 __all__ = ["AVGSA_POINTS", "G", "arias", "avg_sa", "avgsa_periods", "cav", "duration",
            "final_velocity", "husid", "pga", "pgv", "sa", "sha256",
@@ -227,7 +228,7 @@ def _free_peak(u: float, v: float, w: float, zeta: float) -> float:
     return max(abs(u), abs(u1))  # later extrema are smaller: u(t + pi/wd) = -decay u(t)
 
 
-def sa(acc, dt: float, periods, zeta: float = 0.05, *, points_per_period: int = 32,
+def sa(acc, dt: float, periods, zeta: float = SA_DAMPING, *, points_per_period: int = 32,
        max_refine: int = 64) -> np.ndarray:
     """Pseudo-spectral acceleration Sa(T) = (2 pi / T)^2 max_t |u(t)| [units of acc: g for
     project records], float64[n_periods] for ``periods`` [s] (any shape, flattened order

@@ -39,11 +39,26 @@ import numpy as np
 from rocksweep.errors import RocksweepError
 from rocksweep.physics.model import G
 from rocksweep.physics.records import GroundRecord
+from rocksweep.vocab.ground import (  # noqa: F401
+    ARIAS,
+    AVGSA,
+    CAV,
+    D5_95,
+    DEFAULT_PERIODS,
+    PGA,
+    PGA_RATIO,
+    PGV,
+    PGV_OVER_PGA,
+    PGV_RATIO,
+    RATIO_OF,
+    RECORD_IMS,
+    SA,
+    SA_DAMPING,
+    SCALE_IMS,
+)
 
-#: the IMs a suite can be scaled to (the stripe dimension's name) and their units
-SCALE_IMS = {"PGA": "g", "PGV": "m/s", "Sa": "g", "PGA_ratio": "1", "PGV_ratio": "1"}
-DEFAULT_PERIODS = (0.2, 1.0)  # [s] Sa stored per record
-ZETA = 0.05  # damping ratio of the spectral acceleration
+# the IMs (and their units), Sa's damping ratio and default periods: rocksweep.vocab.ground
+ZETA = SA_DAMPING
 #: AvgSa's default range: these multiples of the reference period
 AVGSA_RANGE = (0.2, 3.0)
 #: warn when a record's final ground velocity exceeds this share of its PGV
@@ -51,18 +66,6 @@ DRIFT_SHARE = 0.1
 #: warn when a record is scaled by more than this factor
 MAX_FACTOR = 5.0
 
-#: The record IMs stored per record (the one list): name -> (variable, units, exponent n:
-#: the IM of the record times F is F^n times its IM; 0: scale-invariant). Sa(T) is
-#: ``record_sa`` along ``period`` (n = 1).
-RECORD_IMS: dict[str, tuple[str, str, int]] = {
-    "PGA": ("record_pga", "g", 1),
-    "PGV": ("record_pgv", "m/s", 1),
-    "Arias": ("record_arias", "m/s", 2),
-    "CAV": ("record_cav", "m/s", 1),
-    "D5_95": ("record_d5_95", "s", 0),
-    "PGV_over_PGA": ("record_pgv_over_pga", "s", 0),
-    "AvgSa": ("record_avgsa", "g", 1),
-}
 
 
 class RecordWarning(UserWarning):
@@ -105,9 +108,8 @@ class Suite:
 
     def record_ims(self) -> dict[str, np.ndarray]:
         """Each ``RECORD_IMS`` variable (not Sa) -> float64[R], the records as recorded."""
-        own = {"PGA": self.pga, "PGV": self.pgv, "Arias": self.arias, "CAV": self.cav,
-               "D5_95": self.d5_95, "PGV_over_PGA": self.pgv / (self.pga * G),
-               "AvgSa": self.avgsa}
+        own = {PGA: self.pga, PGV: self.pgv, ARIAS: self.arias, CAV: self.cav,
+               D5_95: self.d5_95, PGV_OVER_PGA: self.pgv / (self.pga * G), AVGSA: self.avgsa}
         return {RECORD_IMS[k][0]: np.asarray(v, np.float64) for k, v in own.items()}
 
     def warn(self, alpha_ref, p) -> None:
@@ -150,9 +152,9 @@ class Suite:
     def record_im(self) -> np.ndarray:
         """Each record's own value of the stripe IM (PGA_ratio: its PGA, PGV_ratio: its
         PGV), float64[R]."""
-        if self.im in ("PGA", "PGA_ratio"):
+        if self.im in (PGA, PGA_RATIO):
             return self.pga
-        if self.im in ("PGV", "PGV_ratio"):
+        if self.im in (PGV, PGV_RATIO):
             return self.pgv
         if self.im == "Sa":
             return self.scale_sa
@@ -190,7 +192,7 @@ class Suite:
     def scale_dependence(self) -> tuple[str, ...]:
         """What a factor depends on beside (record, stripe): "alpha_ref" (PGA_ratio,
         PGV_ratio) and "p" (PGV_ratio)."""
-        return {"PGA_ratio": ("alpha_ref",), "PGV_ratio": ("alpha_ref", "p")}.get(
+        return {PGA_RATIO: ("alpha_ref",), PGV_RATIO: ("alpha_ref", "p")}.get(
             self.im or "", ())
 
 
@@ -242,7 +244,7 @@ def make_suite(records: list[GroundRecord], names: list[str], im: str | None,
         for i, rec in enumerate(records):
             v = float(own[i])
             if not (math.isfinite(v) and v > 0.0):
-                what = {"PGA_ratio": "PGA", "PGV_ratio": "PGV"}.get(im, im)
+                what = RATIO_OF.get(im, im)
                 per = f"({period:g} s)" if im == "Sa" else ""
                 raise SuiteError(f"{rec.source}: {what}{per} = {v!r}: cannot be scaled to "
                                  f"a {im} stripe (needs a record with {what} > 0)")
