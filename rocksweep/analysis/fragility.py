@@ -101,6 +101,8 @@ QUALITY = ("beta_undetermined", "non_monotone", "extrapolated", "bootstrap_undef
            "censored", "incomplete", "flagged")
 REASONS = ENDINGS + QUALITY
 BAND_POINTS = 101
+#: the pointwise band is taken over at most this many resamples (the first ones)
+BAND_SAMPLES = 20_000
 #: resamples are fitted in chunks of at most this many count entries (bounded memory)
 BOOT_ELEMENTS = 1 << 20
 NONMONOTONE_P = 0.01
@@ -154,12 +156,14 @@ def _loglik(eta: np.ndarray, k: np.ndarray, n: np.ndarray) -> np.ndarray:
     return np.sum(k * log_ndtr(eta) + (n - k) * log_ndtr(-eta), axis=-1)
 
 
-def _mle_batch(lnx: np.ndarray, k: np.ndarray, n: np.ndarray
+def _mle_batch(lnx: np.ndarray, k: np.ndarray, n: np.ndarray,
+               start: tuple[float, float] | None = None, tol: float = 1e-10
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """MLE of the lognormal fragility for a batch of data sets.
 
     lnx, k, n: float64 (B, S): ln IM, points reaching the state, points counted (n = 0: the
-    entry is absent). Returns (im_median (B,), beta (B,), ending code (B,) into ENDINGS);
+    entry is absent); start: (im_median, beta) to start the scoring from (resamples: the
+    full data's fit), tol: its relative tolerance. Returns (im_median (B,), beta (B,), ending code (B,) into ENDINGS);
     separated data give the step's IM and beta = NaN.
     """
     lnx, k, n = (np.atleast_2d(np.asarray(v, dtype=np.float64)) for v in (lnx, k, n))
@@ -183,7 +187,11 @@ def _mle_batch(lnx: np.ndarray, k: np.ndarray, n: np.ndarray
     median[sep] = np.exp(0.5 * (x_fail_min[sep] + x_safe_max[sep]))
     todo = both & ~sep
     if np.any(todo):
-        a, b = _score(lnx[todo], k[todo], n[todo])
+        st = None
+        if start is not None and np.all(np.isfinite(start)) and start[1] > 0:
+            st = np.broadcast_to([-math.log(start[0]) / start[1], 1.0 / start[1]],
+                                 (int(todo.sum()), 2))
+        a, b = _score(lnx[todo], k[todo], n[todo], tol=tol, start=st)
         med, bet, rsn = np.full(a.size, np.nan), np.full(a.size, np.nan), np.zeros(a.size, int)
         up = b > 0.0
         med[up] = np.exp(-a[up] / b[up])
@@ -193,10 +201,26 @@ def _mle_batch(lnx: np.ndarray, k: np.ndarray, n: np.ndarray
     return median, beta, reason
 
 
+def _log_cdf(e: np.ndarray) -> np.ndarray:
+    """log Phi(e): log(ndtr) (half the price of ``log_ndtr``), ``log_ndtr`` where ndtr
+    underflows."""
+    v = ndtr(e)
+    tail = v < 1e-200
+    with np.errstate(divide="ignore"):
+        out = np.log(v)
+    if np.any(tail):
+        out[tail] = log_ndtr(e[tail])
+    return out
+
+
 def _score(lnx: np.ndarray, k: np.ndarray, n: np.ndarray, iters: int = 200,
-           tol: float = 1e-10) -> tuple[np.ndarray, np.ndarray]:
+           tol: float = 1e-10, start: np.ndarray | None = None
+           ) -> tuple[np.ndarray, np.ndarray]:
     """Fisher scoring with step halving for Phi(a + b lnx), batched over rows (each row
-    has points on both sides: the maximum exists). Returns (a, b) per row."""
+    has points on both sides: the maximum exists). start: (B, 2) (a, b) to start from
+    (bootstrap resamples: the full data's fit; then Newton steps on the observed
+    information, which converge in a few steps from there); default the pooled fraction,
+    slope 0. Returns (a, b) per row."""
     # standardise ln x per row for conditioning: eta = c0 + c1 z, z = (lnx - m) / s
     w = n / n.sum(-1, keepdims=True)
     m = np.sum(w * lnx, -1, keepdims=True)
@@ -205,8 +229,15 @@ def _score(lnx: np.ndarray, k: np.ndarray, n: np.ndarray, iters: int = 200,
     z = (lnx - m) / s
     frac = np.clip(k.sum(-1) / n.sum(-1), 1e-6, 1.0 - 1e-6)
     c = np.stack([ndtri(frac), np.zeros(frac.size)], axis=-1)  # (B, 2)
+    newton = start is not None
+    if newton:  # eta = a + b lnx = (a + b m) + (b s) z
+        c0 = start[:, 0] + start[:, 1] * m[:, 0]
+        c1 = start[:, 1] * s[:, 0]
+        fine = np.isfinite(c0) & np.isfinite(c1)
+        c[fine] = np.stack([c0, c1], -1)[fine]
     eta = c[:, :1] + c[:, 1:] * z
-    ll = _loglik(eta, k, n)
+    lpos, lneg = _log_cdf(eta), _log_cdf(-eta)  # log Phi(eta), log Phi(-eta)
+    ll = np.sum(k * lpos + (n - k) * lneg, -1)
     active = np.ones(frac.size, dtype=bool)
     for _ in range(iters):
         idx = np.flatnonzero(active)
@@ -214,10 +245,13 @@ def _score(lnx: np.ndarray, k: np.ndarray, n: np.ndarray, iters: int = 200,
             break
         e, zz, kk, nn = eta[idx], z[idx], k[idx], n[idx]
         logphi = -0.5 * e * e - 0.5 * math.log(2.0 * math.pi)
-        r1 = np.exp(logphi - log_ndtr(e))  # phi / Phi(eta)
-        r2 = np.exp(logphi - log_ndtr(-e))  # phi / Phi(-eta)
+        r1 = np.exp(logphi - lpos[idx])  # phi / Phi(eta)
+        r2 = np.exp(logphi - lneg[idx])  # phi / Phi(-eta)
         g = kk * r1 - (nn - kk) * r2  # d loglik / d eta
-        wgt = nn * r1 * r2  # expected information per unit of eta
+        if newton:  # observed information: -d2 loglik / d eta2 (> 0: concave)
+            wgt = kk * r1 * (e + r1) + (nn - kk) * r2 * (r2 - e)
+        else:
+            wgt = nn * r1 * r2  # expected information per unit of eta
         U0, U1 = g.sum(-1), (g * zz).sum(-1)
         I00, I01, I11 = wgt.sum(-1), (wgt * zz).sum(-1), (wgt * zz * zz).sum(-1)
         det = I00 * I11 - I01 * I01
@@ -228,16 +262,19 @@ def _score(lnx: np.ndarray, k: np.ndarray, n: np.ndarray, iters: int = 200,
         ll0 = ll[idx]
         c_new = c[idx].copy()
         ll_new = ll0.copy()
+        lp_new, ln_new = lpos[idx].copy(), lneg[idx].copy()
         pending = np.ones(idx.size, dtype=bool)
         for _half in range(60):
             cand = c[idx][pending] + step[pending, None] * np.stack(
                 [d0[pending], d1[pending]], -1)
             ecand = cand[:, :1] + cand[:, 1:] * zz[pending]
-            lc = _loglik(ecand, kk[pending], nn[pending])
+            lp_c, ln_c = _log_cdf(ecand), _log_cdf(-ecand)
+            lc = np.sum(kk[pending] * lp_c + (nn[pending] - kk[pending]) * ln_c, -1)
             ok = lc >= ll0[pending] - 1e-12 * np.abs(ll0[pending])
             pi = np.flatnonzero(pending)
             c_new[pi[ok]] = cand[ok]
             ll_new[pi[ok]] = lc[ok]
+            lp_new[pi[ok]], ln_new[pi[ok]] = lp_c[ok], ln_c[ok]
             step[pi[~ok]] *= 0.5
             pending[pi[ok]] = False
             if not pending.any():
@@ -246,6 +283,7 @@ def _score(lnx: np.ndarray, k: np.ndarray, n: np.ndarray, iters: int = 200,
         c[idx] = c_new
         eta[idx] = c_new[:, :1] + c_new[:, 1:] * zz
         ll[idx] = ll_new
+        lpos[idx], lneg[idx] = lp_new, ln_new
         active[idx[(delta < tol * (1.0 + np.abs(c_new).max(-1))) | pending]] = False
     a = c[:, 0] - c[:, 1] * m[:, 0] / s[:, 0]
     b = c[:, 1] / s[:, 0]
@@ -621,18 +659,22 @@ def _fit_competing(lnx: np.ndarray, k1: np.ndarray, k2: np.ndarray, n: np.ndarra
 # ---------------------------------------------------------------------------------------
 
 
-def _fit_counts(kind: str, lnx: np.ndarray, m: np.ndarray, stripes: bool
+def _fit_counts(kind: str, lnx: np.ndarray, m: np.ndarray, stripes: bool,
+                start: tuple[float, float] | None = None
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Fits of one group of states from category counts m (b, C, P) at ln IM lnx (P,):
     kind "single" (C = 2: not reached, reached), "ordinal" (C = K + 1: the most severe of K
     nested states reached, in severity order) or "competing" (C = 3: safe, mode 1, mode
-    2). Returns im_median, beta, ending code, beta undetermined: (b, G) each, G the states
-    of the group (severity order for "ordinal", (mode1, mode2) for "competing")."""
+    2). start: a single state's (im_median, beta) to start from (then to 1e-7: bootstrap
+    resamples). Returns im_median, beta, ending code, beta undetermined: (b, G) each, G
+    the states of the group (severity order for "ordinal", (mode1, mode2) for
+    "competing")."""
     b, C, P = m.shape
     n = m.sum(1)
     lnxb = np.broadcast_to(lnx, n.shape)
     if kind == "single":
-        med, bet, code = _mle_batch(lnxb, m[:, 1], n)
+        med, bet, code = (_mle_batch(lnxb, m[:, 1], n) if start is None else
+                          _mle_batch(lnxb, m[:, 1], n, start, tol=1e-7))
         und = (_stripe_rules(lnxb, m[:, 1], n, med, bet, code) if stripes else
                code == _CODE["separated"])
         return med[:, None], bet[:, None], code[:, None], und[:, None]
@@ -1198,8 +1240,10 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
             for o in range(n_o):
                 for kind, idxs in groups:
                     oh = onehot_of(kind, idxs, o, counted[o])
+                    st = (res["im_median"][idxs[0], o], res["beta"][idxs[0], o])
                     med, bet, _, _ = _fit_counts(kind, lnx, _category_counts(
-                        w, oh, bool(stripe)), bool(stripe))
+                        w, oh, bool(stripe)), bool(stripe),
+                        start=st if kind == "single" else None)
                     bad = ~(np.isfinite(med) & np.isfinite(bet))
                     med[bad], bet[bad] = np.nan, np.nan
                     for q, i in enumerate(idxs):
@@ -1209,6 +1253,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
             for kind, idxs in groups:
                 med_s = samples[0, idxs, o].T  # (N, G)
                 bet_s = samples[1, idxs, o].T
+                # (the intervals use every resample; the band the first BAND_SAMPLES)
                 for q_i, i in enumerate(idxs):
                     fin = np.isfinite(med_s[:, q_i])
                     n_undef[i, o] = int((~fin).sum())
@@ -1219,9 +1264,10 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
                             res["im_median"][i, o]):
                         why[i][o]["bootstrap_undefined"] = (
                             f"{n_undef[i, o]} of {N} resamples without a finite fit")
+                med_s, bet_s = med_s[:BAND_SAMPLES], bet_s[:BAND_SAMPLES]
                 rows = (np.all(np.isfinite(med_s) & np.isfinite(bet_s), -1)
                         if kind == "competing" else None)
-                step = max(1, BOOT_ELEMENTS // max(N * len(idxs), 1))
+                step = max(1, BOOT_ELEMENTS // max(med_s.shape[0] * len(idxs), 1))
                 for g0 in range(0, grid.size, step):
                     gs = slice(g0, g0 + step)
                     cur = _curves(kind, grid[gs], med_s if rows is None else med_s[rows],
