@@ -163,8 +163,8 @@ def _mle_batch(lnx: np.ndarray, k: np.ndarray, n: np.ndarray,
 
     lnx, k, n: float64 (B, S): ln IM, points reaching the state, points counted (n = 0: the
     entry is absent); start: (im_median, beta) to start the scoring from (resamples: the
-    full data's fit), tol: its relative tolerance. Returns (im_median (B,), beta (B,), ending code (B,) into ENDINGS);
-    separated data give the step's IM and beta = NaN.
+    full data's fit), tol: its relative tolerance. Returns (im_median (B,), beta (B,),
+    ending code (B,) into ENDINGS); separated data give the step's IM and beta = NaN.
     """
     lnx, k, n = (np.atleast_2d(np.asarray(v, dtype=np.float64)) for v in (lnx, k, n))
     lnx = np.broadcast_to(lnx, k.shape)
