@@ -1075,20 +1075,26 @@ def _refuse_filled(ds: xr.Dataset, states: Sequence[str], counted: xr.DataArray)
         raise FragilityError(
             f"state {need[0]!r}: {n} points of this adaptive sweep were filled from the class "
             "around them, not computed, so their uplift and theta are unknown; only overturn, "
-            "mode1 and mode2 can be fitted (sweep without --adaptive for this state)")
+            "mode1 and mode2 can be fitted (a sweep that computes every point can give it)")
 
 
 def _missing_text(not_run: np.ndarray, levels: np.ndarray | None, unit: str,
-                  stripe: str | None, complete: Any) -> str:
-    """'N points not computed (at PGA 1.2-1.6 g)...' for one curve's not_run (R[, S])."""
+                  stripe: str | None, complete: Any, names: Sequence[str]) -> str:
+    """'N points not computed (at PGA 1.2-1.6 g, records ...) left out' for one curve's
+    not_run (R[, S])."""
     n = int(not_run.sum())
-    where = ""
+    where = []
     if levels is not None:
         miss = levels[not_run.reshape(not_run.shape[0], -1).any(0)]
-        where = f" at {stripe} {miss.min():.3g}-{miss.max():.3g} {unit}".rstrip()
+        where.append(f"{stripe} {miss.min():.3g}-{miss.max():.3g} {unit}".rstrip())
+    recs = [names[r] for r in np.flatnonzero(not_run.reshape(not_run.shape[0], -1).any(-1))]
+    if len(recs) < len(names):
+        where.append("record" + "s" * (len(recs) > 1) + " " + ", ".join(recs[:3])
+                     + (f" and {len(recs) - 3} more" if len(recs) > 3 else ""))
     state = (" (the file is not complete: a sweep still running or stopped; finish it with "
              "--resume)") if complete in (0, False) else ""
-    return f"{n} points not computed{where} left out{state}"
+    return f"{n} points not computed at {', '.join(where)} left out{state}" if where else \
+        f"{n} points not computed left out{state}"
 
 
 def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
@@ -1280,7 +1286,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     for o in range(n_o):
         if n_nrun[o].any():
             text = _missing_text(n_nrun[o], levels if stripe else None, unit, stripe,
-                                 ds.attrs.get("complete"))
+                                 ds.attrs.get("complete"), names)
             for i in range(nS):
                 why[i][o]["incomplete"] = text
     reason = np.array([[_words(why[i][o]) for o in range(n_o)] for i in range(nS)],
