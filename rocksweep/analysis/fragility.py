@@ -594,15 +594,16 @@ def _cif(z: np.ndarray, t: np.ndarray, sig: np.ndarray) -> tuple[np.ndarray, ...
     the two capacities' means and deviations. Returns (P(safe), P(mode 1), P(mode 2))
     (..., P): P(mode k) = P(U_k <= z, U_k < U_other) = Phi2(h, q; rho), h = (z - t_k) /
     sig_k, q = (t_o - t_k) / sqrt(sig_k^2 + sig_o^2), rho = sig_k / sqrt(...) (Owen's T)."""
-    out = []
-    tot = np.sqrt(sig[..., 0] ** 2 + sig[..., 1] ** 2)
-    for k, o in ((0, 1), (1, 0)):
-        h = (z - t[..., k, None]) / sig[..., k, None]
-        q = np.broadcast_to(((t[..., o] - t[..., k]) / tot)[..., None], h.shape)
-        rho = np.broadcast_to((sig[..., k] / tot)[..., None], h.shape)
-        out.append(_phi2(h, q, rho))
-    safe = ndtr(-(z - t[..., 0, None]) / sig[..., 0, None]) * ndtr(
-        -(z - t[..., 1, None]) / sig[..., 1, None])
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        out = []
+        tot = np.sqrt(sig[..., 0] ** 2 + sig[..., 1] ** 2)
+        for k, o in ((0, 1), (1, 0)):
+            h = (z - t[..., k, None]) / sig[..., k, None]
+            q = np.broadcast_to(((t[..., o] - t[..., k]) / tot)[..., None], h.shape)
+            rho = np.broadcast_to((sig[..., k] / tot)[..., None], h.shape)
+            out.append(_phi2(h, q, rho))
+        safe = ndtr(-(z - t[..., 0, None]) / sig[..., 0, None]) * ndtr(
+            -(z - t[..., 1, None]) / sig[..., 1, None])
     return safe, out[0], out[1]
 
 
@@ -1235,8 +1236,11 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
                 w = why[i][o]
                 w[ENDINGS[int(code[0, q])]] = ""
                 if und[0, q]:
-                    w["beta_undetermined"] = ("one stripe, separation, or fewer than 2 "
-                                              "distinct fractions strictly between 0 and 1")
+                    c = ENDINGS[int(code[0, q])]
+                    w["beta_undetermined"] = (
+                        "one IM level counted" if c == "one_stripe" else
+                        "separated data: the likelihood grows as beta -> 0" if c == "separated"
+                        else "fewer than 2 distinct stripe fractions strictly between 0 and 1")
             _verdicts(kind, idxs, o, lnx, m, med[0], bet[0], why, counted[o], n_flag[o],
                       hits, over_all[o], states, bool(stripe), onehot_of)
     if N:
