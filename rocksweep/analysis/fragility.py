@@ -84,16 +84,18 @@ from scipy.special import log_ndtr, ndtr, ndtri, owens_t
 from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP, MAX_BOOTSTRAP
 from rocksweep.errors import RocksweepError
 from rocksweep.kernel import layout as L
+from rocksweep.vocab.ground import CLOUD_IMS as CLOUD_IM_VARIABLES
+from rocksweep.vocab.ground import SCALE_IMS
+from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, STATES, THETA_STATE, UPLIFT
 
 __all__ = ["Bootstrap", "DEFAULT_BOOTSTRAP", "Fit", "FragilityError", "FragilityWarning",
            "REASONS", "STRIPE_IMS", "bootstrap_records", "curves_json", "fit_cloud",
            "fit_stripes", "fragility", "parse_state"]
 
 #: stripe dimension names (the sweep's ``scale_im``) and their units
-STRIPE_IMS = {"PGA": "g", "PGV": "m/s", "Sa": "g", "PGA_ratio": "1", "PGV_ratio": "1"}
+STRIPE_IMS = SCALE_IMS
 #: cloud IMs and the per-record variables they come from
-CLOUD_IMS = {"PGA": ("record_pga", "g"), "PGV": ("record_pgv", "m/s"),
-             "Sa": ("record_sa", "g")}
+CLOUD_IMS = {im: (var, SCALE_IMS[im]) for im, var in CLOUD_IM_VARIABLES.items()}
 #: how a fit ended (codes of the batched fits), then the quality words
 ENDINGS = ("ok", "no_failures", "all_failed", "separated", "decreasing", "no_data",
            "one_stripe", "not_converged")
@@ -902,7 +904,7 @@ def _check_bootstrap(n: Any, curves: int) -> int:
 # ---------------------------------------------------------------------------------------
 
 
-STATE_WORDS = ("overturn", "mode1", "mode2", "uplift", "theta:X")
+STATE_WORDS = (*STATES, THETA_STATE)
 
 
 def parse_state(state: str) -> tuple[str, float]:
@@ -912,7 +914,7 @@ def parse_state(state: str) -> tuple[str, float]:
         raise FragilityError(f"state = {state!r}: a state is a string, one of "
                              f"{', '.join(STATE_WORDS)} (or a list of them)")
     s = state.strip()
-    if s in ("overturn", "mode1", "mode2", "uplift"):
+    if s in STATES:
         return s, math.nan
     if s.startswith("theta:"):
         try:
@@ -949,7 +951,7 @@ def severity(state: str) -> float:
     """Order of the nested damage states: uplift (0) < theta:X (X) < overturn (inf); NaN
     for the modes (not nested)."""
     kind, x = parse_state(state)
-    return {"uplift": 0.0, "theta": x, "overturn": math.inf}.get(kind, math.nan)
+    return {UPLIFT: 0.0, "theta": x, OVERTURN: math.inf}.get(kind, math.nan)
 
 
 def state_groups(states: Sequence[str]) -> list[tuple[str, list[int]]]:
@@ -958,7 +960,7 @@ def state_groups(states: Sequence[str]) -> list[tuple[str, list[int]]]:
     "competing" for mode1 with mode2, "single" for every other one."""
     nested = sorted((i for i, s in enumerate(states) if not math.isnan(severity(s))),
                     key=lambda i: severity(states[i]))
-    modes = [states.index(s) for s in ("mode1", "mode2") if s in states]
+    modes = [states.index(s) for s in (MODE1, MODE2) if s in states]
     groups: list[tuple[str, list[int]]] = []
     if len(nested) >= 2:
         groups.append(("ordinal", nested))
@@ -1071,12 +1073,13 @@ def _refuse_filled(ds: xr.Dataset, states: Sequence[str], counted: xr.DataArray)
 
     filled = (ds["computed"] == FILLED) & counted
     n = int(filled.sum())
-    need = [s for s in states if parse_state(s)[0] in ("uplift", "theta")]
+    need = [s for s in states if parse_state(s)[0] in (UPLIFT, "theta")]
     if n and need:
         raise FragilityError(
             f"state {need[0]!r}: {n} points of this adaptive sweep were filled from the class "
-            "around them, not computed, so their uplift and theta are unknown; only overturn, "
-            "mode1 and mode2 can be fitted (a sweep that computes every point can give it)")
+            "around them, not computed, so their uplift and theta are unknown; only "
+            f"{OVERTURN}, {MODE1} and {MODE2} can be fitted (a sweep that computes every "
+            "point can give it)")
 
 
 def _missing_text(not_run: np.ndarray, levels: np.ndarray | None, unit: str,
@@ -1185,7 +1188,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     n_flag = flagged_da.transpose(*order).values
     n_nrun = not_run_da.transpose(*order).values
     hits = np.stack([state_reached(ds, s).transpose(*order).values for s in states])
-    over_all = state_reached(ds, "overturn").transpose(*order).values
+    over_all = state_reached(ds, OVERTURN).transpose(*order).values
     shape_o = tuple(ds.sizes[d] for d in others)
     n_o = int(np.prod(shape_o)) if shape_o else 1
     R = ds.sizes["record"]
@@ -1404,7 +1407,7 @@ def _verdicts(kind, idxs, o, lnx, m, med, bet, why, counted, flagged, hits, over
                 w["non_monotone"] = ("the stripe fractions fall with the IM beyond noise "
                                      "(a competing-risk curve cannot fall)")
         kw = states[i]
-        if kind == "single" and kw in ("mode1", "mode2"):
+        if kind == "single" and kw in (MODE1, MODE2):
             own = hits[i, o] & counted
             over = over_all & counted
             other = int(over.sum() - own.sum())

@@ -3,11 +3,14 @@
 from rocksweep.cli import (  # noqa: F401
     accuracy,
     boundaries,
+    efficiency,
     fragility,
     info,
     plot,
     restitution,
+    risk,
     simulate,
     spectrum,
     sweep,
+    table,
 )

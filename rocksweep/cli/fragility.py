@@ -13,6 +13,7 @@ from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP, MAX_BOOTSTRAP
 from rocksweep.cli.main import main, user_errors
 from rocksweep.cli.options import dpi_option, overwrite_option, result_argument
 from rocksweep.figures import WIDTHS
+from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, STATES, UPLIFT
 
 CURVE_SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
 
@@ -57,11 +58,10 @@ def _g(v) -> str:
               help="Figure of the curves with their bootstrap bands and the fraction at "
                    "each stripe, .png, .pdf or .svg.")
 @click.option("--state", default="overturn", show_default=True,
-              help="What the curve gives the probability of: overturn, mode1, mode2, "
-                   "uplift or theta:X (max|theta|/alpha_cg >= X, 0 < X <= 1); several "
-                   "separated by commas: damage states (uplift, theta:X, overturn) are "
-                   "fitted with one beta so their curves never cross, mode1,mode2 as "
-                   "competing risks.")
+              help="What the curve gives the probability of: " + ", ".join(STATES)
+              + " or theta:X (max|theta|/alpha_cg >= X, 0 < X <= 1); several separated by "
+              f"commas: damage states ({UPLIFT}, theta:X, {OVERTURN}) are fitted with one "
+              f"beta so their curves never cross, {MODE1},{MODE2} as competing risks.")
 @click.option("--im", default=None,
               help="Unscaled suites (clouds): the IM, PGA (default), PGV or Sa; stripes use "
                    "the IM they were scaled to.")
@@ -107,6 +107,9 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
     states = [s.strip() for s in state.split(",") if s.strip()]
     if not states:
         raise click.ClickException(f"--state {state!r}: give at least one state")
+    from rocksweep.store.reader import result_inputs
+
+    inputs = result_inputs(result_path)  # the result and its records: never written over
     outs = [p for p in (out_path, fig_path) if p is not None]
     if len({str(p.resolve()) for p in outs}) < len(outs):
         raise click.ClickException("-o and --plot must name different files")
@@ -115,9 +118,9 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
             raise click.ClickException(
                 f"-o {out_path}: unsupported suffix {out_path.suffix or '(none)'!r}; use "
                 f"{', '.join(CURVE_SUFFIXES[:-1])} or {CURVE_SUFFIXES[-1]}")
-        check_output(out_path, overwrite=overwrite, inputs=[result_path])
+        check_output(out_path, overwrite=overwrite, inputs=inputs)
     if fig_path is not None:
-        check_output(fig_path, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
+        check_output(fig_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
     from rocksweep.analysis.fragility import FragilityWarning
 
     ds = rocksweep.open(result_path)
@@ -158,7 +161,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
         from rocksweep.figures.fragility import fragility_figure
 
         fig = fragility_figure(frag, width=width)
-        save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=[result_path])
+        save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=inputs)
         say(f"wrote {fig_path}")
 
 

@@ -17,6 +17,8 @@ from rocksweep.physics.points import RECORD, Point
 from rocksweep.physics.records import GroundRecord
 from rocksweep.physics.suite import Suite
 from rocksweep.schema import KEYS
+from rocksweep.vocab.ground import PAPER_SHAPES, pulse_duration
+from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
 
 
 class SceneError(RocksweepError, ValueError):
@@ -55,6 +57,9 @@ class Scene:
     # a suite scene (``ground.records``): the records, their IMs and the scaling (the
     # grid's axes then hold ``record`` (file names), the stripe IM if scaled, and p)
     suite: Suite | None = field(default=None, repr=False)
+    # every file the scene was read from: the scene file, its record, a suite's records and
+    # listings (paths as read); an output is never one of them (``outputs.check_output``)
+    inputs: tuple[str, ...] = field(default=(), repr=False)
 
     def variables(self) -> dict[str, tuple[str, float, str]]:
         """The per-point variables a sweep of this scene stores, name -> (dtype, fill value
@@ -77,7 +82,7 @@ class Scene:
         """Whether the scene needs the kernel's GROUND variants (a Ricker or MP pulse, or a
         record); the paper's sine and cosine (n cycles too) run the pulse variants."""
         return self.recorded or any(
-            sh in ("ricker", "mp") for sh in self.axis("shape").values)
+            sh not in PAPER_SHAPES for sh in self.axis("shape").values)
 
     def option(self, name: str) -> Any:
         """A pulse option's value (cycles, gamma, nu [deg]): the scene's or the default."""
@@ -88,9 +93,7 @@ class Scene:
 
     def phase_max(self) -> float:
         """The longest pulse of the scene's shapes in w t (2 pi n, 6 pi, 2 pi gamma)."""
-        from rocksweep.physics.points import RECORD, phase_duration
-
-        return max(phase_duration(sh, self.option("cycles"), self.option("gamma"))
+        return max(pulse_duration(sh, self.option("cycles"), self.option("gamma"))
                    for sh in self.axis("shape").values if sh != RECORD)
 
     def axis(self, name: str) -> Axis:
@@ -149,8 +152,8 @@ class Scene:
 
     def _law(self, values: dict[str, Any]) -> dict[str, Any]:
         """A point's impact law (Point keywords law, e, e_factor) from axis values."""
-        law = str(values.get("law", "vertical"))
-        return {"law": law, "e": float(values["e"]) if law == "constant" else math.nan,
+        law = str(values.get("law", DEFAULT_LAW))
+        return {"law": law, "e": float(values["e"]) if law == CONSTANT else math.nan,
                 "e_factor": float(values.get("e_factor", 1.0))}
 
     def single_point(self) -> Point:
