@@ -90,7 +90,7 @@ from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, STATES, THETA_STATE
 
 __all__ = ["Bootstrap", "DEFAULT_BOOTSTRAP", "Fit", "FragilityError", "FragilityWarning",
            "REASONS", "STRIPE_IMS", "bootstrap_records", "curves_json", "fit_cloud",
-           "fit_stripes", "fragility", "parse_state"]
+           "fit_stripes", "fragility", "parse_state", "probability"]
 
 #: stripe dimension names (the sweep's ``scale_im``) and their units
 STRIPE_IMS = SCALE_IMS
@@ -1455,6 +1455,44 @@ def verdict_lines(frag: xr.Dataset, why=None, others=None, shape_o=None) -> list
             lines.append(f"fragility{' ' + where if where else ''}, state {st}: "
                          + "; ".join(parts))
     return lines
+
+
+def probability(frag: xr.Dataset, x: Sequence[float] | np.ndarray) -> xr.DataArray:
+    """P(state | IM = x) of every curve of a ``fragility`` Dataset at the IMs x (float[X] >
+    0, the fragility's IM units), by each state's model (``fit``): the lognormal CDF
+    Phi(ln(x / im_median) / beta) for "single" and "ordinal" fits, the competing-risk
+    probabilities P(C_k <= x, C_k < C_other) for "competing" (mode1 with mode2: not a
+    lognormal CDF of their im_median and beta). NaN where a fit has no curve. Returns a
+    DataArray over ``im_median``'s dims + ("im",)."""
+    xs = np.asarray(x, dtype=np.float64).ravel()
+    if np.any(~np.isfinite(xs) | (xs <= 0.0)):
+        raise FragilityError("x: every IM must be finite and > 0")
+    med_da = frag["im_median"]
+    lead = "state" in med_da.dims
+    dims = [d for d in med_da.dims if d != "state"]
+    med = med_da.transpose(*(["state"] if lead else []), *dims).values
+    bet = frag["beta"].transpose(*(["state"] if lead else []), *dims).values
+    med, bet = (np.asarray(a, dtype=np.float64) if lead else np.asarray(a)[None]
+                for a in (med, bet))
+    kinds = np.atleast_1d(np.asarray(frag["fit"].values)) if "fit" in frag else \
+        np.array(["single"] * med.shape[0])
+    states = list(np.atleast_1d(np.asarray(frag["state"].values)))
+    out = np.full(med.shape + (xs.size,), np.nan)
+    for i, kind in enumerate(kinds):
+        if kind == "competing":
+            j1, j2 = states.index(MODE1), states.index(MODE2)
+            m = np.stack([med[j1], med[j2]], -1)
+            b = np.stack([bet[j1], bet[j2]], -1)
+            both = _curves("competing", xs, m, b)
+            out[i] = both[..., 0 if states[i] == MODE1 else 1, :]
+        else:
+            out[i] = lognormal_cdf(xs, med[i][..., None], bet[i][..., None])
+    if not lead:
+        out = out[0]
+    return xr.DataArray(out, dims=[*(["state"] if lead else []), *dims, "im"],
+                        coords={**{d: frag[d] for d in dims if d in frag.coords},
+                                "state": frag["state"], "im": xs},
+                        attrs={"long_name": "probability of the state", "units": "1"})
 
 
 def lognormal_cdf(x, median, beta) -> np.ndarray:

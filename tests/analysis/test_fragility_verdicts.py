@@ -61,6 +61,10 @@ def test_a_good_fit_stays_ok_and_warns_nothing():
         fr = F.fragility(ds, bootstrap=200, seed=0)
     assert str(fr["reason"].values) == "ok"
     assert 0.1 < float(fr["beta"]) < 1.0 and int(fr["n_boot_undefined"]) < 10
+    med, beta = float(fr["im_median"]), float(fr["beta"])
+    x = np.array([0.2, 0.5, 1.1])
+    np.testing.assert_allclose(F.probability(fr, x).values,
+                               norm.cdf(np.log(x / med) / beta), rtol=1e-12)
 
 
 def test_one_stripe_leaves_beta_undetermined_never_zero():
@@ -226,6 +230,10 @@ def test_competing_risk_fit_equals_an_independent_multinomial_mle():
             * norm.sf(np.log(grid), math.log(got[0][1]), got[1][1]))
     np.testing.assert_allclose(c.sum(0) + safe, 1.0, atol=1e-9)
     assert np.all(np.diff(c, axis=1) >= -1e-12)  # cumulative incidences never fall
+    # probability() gives the same model at any IM (what a risk integral must use)
+    x = np.array([0.05, 0.7, 3.0])
+    ps, p1, p2 = cif_trapezoid(x, got[0][0], got[1][0], got[0][1], got[1][1], n_u=200001)
+    np.testing.assert_allclose(F.probability(fr, x).values, [p1, p2], atol=1e-6)
 
 
 DAMAGE = ["theta:0.1", "theta:0.25", "theta:0.5", "overturn"]
