@@ -463,10 +463,12 @@ def fit_cloud(im: Sequence[float] | np.ndarray, failed: Sequence[bool] | np.ndar
 
 
 def _maximise(f: Callable[[np.ndarray, np.ndarray], np.ndarray], theta0: np.ndarray,
-              iters: int = 200, tol: float = 1e-11) -> tuple[np.ndarray, np.ndarray]:
+              limit: np.ndarray, iters: int = 100, tol: float = 1e-11
+              ) -> tuple[np.ndarray, np.ndarray]:
     """Maximise f(theta (b, p), rows (b,)) -> (b,) for every row of theta0 (B, p): Newton
     steps on central-difference derivatives, damped (Levenberg-Marquardt) until the value
-    rises. Returns (theta (B, p), converged bool (B,))."""
+    rises. A row whose |theta| passes ``limit`` (p,) runs away to a boundary (separated
+    data: no maximum) and stops, not converged. Returns (theta (B, p), converged (B,))."""
     B, P = theta0.shape
     th = theta0.copy()
     rows = np.arange(B)
@@ -526,8 +528,9 @@ def _maximise(f: Callable[[np.ndarray, np.ndarray], np.ndarray], theta0: np.ndar
             stuck = rej[lam[idx[rej]] > 1e12]
             done_rows[stuck] = True
             pending[stuck] = False
-        conv[idx[done_rows]] = True
-        active[idx[done_rows | bad]] = False
+        away = np.any(np.abs(th[idx]) > limit, -1)
+        conv[idx[done_rows & ~away]] = True
+        active[idx[done_rows | bad | away]] = False
     return th, conv
 
 
@@ -585,7 +588,8 @@ def _fit_ordinal(lnx: np.ndarray, m: np.ndarray) -> tuple[np.ndarray, np.ndarray
         with np.errstate(invalid="ignore"):
             return np.sum(np.where(mm > 0, mm * lp, 0.0), (1, 2))
 
-    theta, conv = _maximise(ll, theta0)
+    limit = np.array([60.0] + [40.0] * (K - 1) + [15.0])
+    theta, conv = _maximise(ll, theta0, limit)
     t = np.cumsum(np.concatenate([theta[:, :1], np.exp(theta[:, 1:K])], 1), 1)
     s = np.exp(theta[:, K])
     return np.exp(mu[:, None] + sd[:, None] * t), sd / s, conv
@@ -648,7 +652,7 @@ def _fit_competing(lnx: np.ndarray, k1: np.ndarray, k2: np.ndarray, n: np.ndarra
         return terms.sum(-1)
 
     th0 = np.where(np.isfinite(th0), th0, 0.0)
-    theta, conv = _maximise(ll, th0)
+    theta, conv = _maximise(ll, th0, np.array([60.0, 12.0, 60.0, 12.0]))
     with np.errstate(over="ignore"):
         med = np.exp(mu[:, None] + sd[:, None] * theta[:, [0, 2]])
         beta = sd[:, None] * np.exp(theta[:, [1, 3]])
