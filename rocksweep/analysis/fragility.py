@@ -462,69 +462,72 @@ def fit_cloud(im: Sequence[float] | np.ndarray, failed: Sequence[bool] | np.ndar
 # ---------------------------------------------------------------------------------------
 
 
-def _maximise(f: Callable[[np.ndarray, np.ndarray], np.ndarray], theta0: np.ndarray,
-              limit: np.ndarray, iters: int = 100, tol: float = 1e-11
+def _multinomial_ll(p: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """sum over (C, P) of m log p (m = 0 terms are 0 even where p = 0)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.sum(np.where(m > 0, m * np.log(np.maximum(p, 1e-300)), 0.0), (1, 2))
+
+
+def _maximise(prob: Callable[[np.ndarray, np.ndarray], np.ndarray], m: np.ndarray,
+              theta0: np.ndarray, limit: np.ndarray, iters: int = 100, tol: float = 1e-10
               ) -> tuple[np.ndarray, np.ndarray]:
-    """Maximise f(theta (b, p), rows (b,)) -> (b,) for every row of theta0 (B, p): Newton
-    steps on central-difference derivatives, damped (Levenberg-Marquardt) until the value
+    """Maximum likelihood of multinomial counts m (B, C, P) (C categories at P IM levels)
+    under probabilities prob(theta (b, p), rows (b,)) -> (b, C, P), for every row of
+    theta0 (B, p): Fisher scoring (information sum over c, s of n_s J J^T / p, J = dp /
+    dtheta by central differences), damped (Levenberg-Marquardt) until the likelihood
     rises. A row whose |theta| passes ``limit`` (p,) runs away to a boundary (separated
     data: no maximum) and stops, not converged. Returns (theta (B, p), converged (B,))."""
     B, P = theta0.shape
+    n = m.sum(1)
     th = theta0.copy()
-    rows = np.arange(B)
-    ll = f(th, rows)
-    lam = np.full(B, 1e-4)
+    pr = prob(th, np.arange(B))
+    ll = _multinomial_ll(pr, m)
+    lam = np.full(B, 1e-6)
     active = np.isfinite(ll)
     conv = np.zeros(B, bool)
-    h = 1e-4
+    h = 1e-6
     eye = np.eye(P)
-    # offsets: +-h e_i for the gradient, (+-h e_i +-h e_j) for the Hessian
-    offs = [h * s * eye[i] for i in range(P) for s in (1, -1)]
-    pairs = [(i, j) for i in range(P) for j in range(i + 1, P)]
-    offs += [h * (si * eye[i] + sj * eye[j]) for i, j in pairs for si in (1, -1)
-             for sj in (1, -1)]
-    offs = np.array(offs)
     for _ in range(iters):
         idx = np.flatnonzero(active)
         if idx.size == 0:
             break
         t = th[idx]
-        vals = f((t[:, None, :] + offs[None]).reshape(-1, P),
-                 np.repeat(idx, offs.shape[0])).reshape(idx.size, -1)
+        both = np.concatenate([t[:, None, :] + h * eye, t[:, None, :] - h * eye], 1)
+        vals = prob(both.reshape(-1, P), np.repeat(idx, 2 * P)).reshape(
+            (idx.size, 2 * P) + pr.shape[1:])
+        J = (vals[:, :P] - vals[:, P:]) / (2.0 * h)  # (b, p, C, P)
+        inv = 1.0 / np.maximum(pr[idx], 1e-300)
+        g = np.einsum("bkcs,bcs->bk", J, m[idx] * inv)
+        info = np.einsum("bkcs,bjcs,bcs->bkj", J, J, n[idx][:, None, :] * inv)
         f0 = ll[idx]
-        g = (vals[:, 0:2 * P:2] - vals[:, 1:2 * P:2]) / (2 * h)
-        H = np.empty((idx.size, P, P))
-        diag = (vals[:, 0:2 * P:2] + vals[:, 1:2 * P:2] - 2 * f0[:, None]) / h ** 2
-        H[:, np.arange(P), np.arange(P)] = diag
-        for q, (i, j) in enumerate(pairs):
-            v = vals[:, 2 * P + 4 * q: 2 * P + 4 * q + 4]
-            H[:, i, j] = H[:, j, i] = (v[:, 0] - v[:, 1] - v[:, 2] + v[:, 3]) / (4 * h * h)
-        bad = ~np.all(np.isfinite(vals), -1)
+        bad = ~(np.all(np.isfinite(g), -1) & np.all(np.isfinite(info), (-1, -2)))
         pending = ~bad
         done_rows = np.zeros(idx.size, bool)
         for _try in range(40):
             pi = np.flatnonzero(pending)
             if pi.size == 0:
                 break
-            A = -H[pi] + lam[idx[pi], None, None] * (eye + np.abs(H[pi]) * eye)
+            A = info[pi] + lam[idx[pi], None, None] * (eye + info[pi] * eye)
             try:
                 d = np.linalg.solve(A, g[pi][..., None])[..., 0]
             except np.linalg.LinAlgError:
                 d = np.stack([np.linalg.lstsq(a, b, rcond=None)[0] for a, b in
                               zip(A, g[pi], strict=True)])
             cand = t[pi] + d
-            lc = f(cand, idx[pi])
+            pc = prob(cand, idx[pi])
+            lc = _multinomial_ll(pc, m[idx[pi]])
             up = np.isfinite(lc) & (lc >= f0[pi] - 1e-13 * np.abs(f0[pi]))
             acc = pi[up]
             th[idx[acc]] = cand[up]
             ll[idx[acc]] = lc[up]
-            lam[idx[acc]] = np.maximum(lam[idx[acc]] * 0.2, 1e-12)
+            pr[idx[acc]] = pc[up]
+            lam[idx[acc]] = np.maximum(lam[idx[acc]] * 0.1, 1e-9)
             small = np.abs(d[up]).max(-1) < tol * (1.0 + np.abs(cand[up]).max(-1))
             flat = np.abs(lc[up] - f0[pi][up]) <= 1e-14 * (1.0 + np.abs(f0[pi][up]))
             done_rows[acc[small | flat]] = True
             pending[acc] = False
             rej = pi[~up]
-            lam[idx[rej]] *= 10.0
+            lam[idx[rej]] = np.maximum(lam[idx[rej]] * 10.0, 1e-4)
             stuck = rej[lam[idx[rej]] > 1e12]
             done_rows[stuck] = True
             pending[stuck] = False
@@ -563,12 +566,12 @@ def _ordinal_probs(z: np.ndarray, theta: np.ndarray) -> np.ndarray:
         return np.log(np.maximum(p, 0.0))
 
 
-def _fit_ordinal(lnx: np.ndarray, m: np.ndarray) -> tuple[np.ndarray, np.ndarray,
-                                                          np.ndarray]:
+def _fit_ordinal(lnx: np.ndarray, m: np.ndarray, start: tuple | None = None
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Ordinal probit with a common beta (module docstring). lnx (b, P) ln IM; m (b, K+1,
-    P) category counts (category c: the c most severe... the points whose most severe
-    state reached is the c-th, 0: none). Returns (im_median (b, K), beta (b,), converged
-    (b,))."""
+    P) category counts (category c: the points whose most severe state reached is the
+    c-th, 0: none); start: (im_median (K,), beta) to start from (resamples: the full data's
+    fit). Returns (im_median (b, K), beta (b,), converged (b,))."""
     b, K1, P = m.shape
     K = K1 - 1
     n = m.sum(1)
@@ -581,15 +584,17 @@ def _fit_ordinal(lnx: np.ndarray, m: np.ndarray) -> tuple[np.ndarray, np.ndarray
     t0 = np.maximum.accumulate(t0 + 1e-3 * np.arange(K), 1)
     theta0 = np.concatenate([t0[:, :1], np.log(np.maximum(np.diff(t0, axis=1), 1e-3)),
                              np.zeros((b, 1))], 1)
+    if start is not None and np.all(np.isfinite(start[0])) and np.isfinite(start[1]) \
+            and start[1] > 0:
+        ts = (np.log(np.asarray(start[0]))[None, :] - mu[:, None]) / sd[:, None]
+        theta0 = np.concatenate([ts[:, :1], np.log(np.maximum(np.diff(ts, axis=1), 1e-6)),
+                                 np.log(sd / start[1])[:, None]], 1)
 
-    def ll(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
-        lp = _ordinal_probs(z[rows], theta)
-        mm = m[rows]
-        with np.errstate(invalid="ignore"):
-            return np.sum(np.where(mm > 0, mm * lp, 0.0), (1, 2))
+    def prob(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        return np.exp(_ordinal_probs(z[rows], theta))
 
     limit = np.array([60.0] + [40.0] * (K - 1) + [15.0])
-    theta, conv = _maximise(ll, theta0, limit)
+    theta, conv = _maximise(prob, m, theta0, limit)
     t = np.cumsum(np.concatenate([theta[:, :1], np.exp(theta[:, 1:K])], 1), 1)
     s = np.exp(theta[:, K])
     return np.exp(mu[:, None] + sd[:, None] * t), sd / s, conv
@@ -637,22 +642,13 @@ def _fit_competing(lnx: np.ndarray, k1: np.ndarray, k2: np.ndarray, n: np.ndarra
     z = (lnx - mu[:, None]) / sd[:, None]
     th0 = np.stack([(start[:, 0] - mu) / sd, np.log(start[:, 1] / sd),
                     (start[:, 2] - mu) / sd, np.log(start[:, 3] / sd)], -1)
-    safe_n = n - k1 - k2
+    counts = np.stack([n - k1 - k2, k1, k2], 1)  # (b, 3, P)
 
-    def ll(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
-        t = theta[:, [0, 2]]
-        sig = np.exp(theta[:, [1, 3]])
-        ps, p1, p2 = _cif(z[rows], t, sig)
-        tiny = 1e-300
-        with np.errstate(divide="ignore"):
-            terms = (np.where(safe_n[rows] > 0, safe_n[rows] * np.log(np.maximum(ps, tiny)),
-                              0.0)
-                     + np.where(k1[rows] > 0, k1[rows] * np.log(np.maximum(p1, tiny)), 0.0)
-                     + np.where(k2[rows] > 0, k2[rows] * np.log(np.maximum(p2, tiny)), 0.0))
-        return terms.sum(-1)
+    def prob(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        return np.stack(_cif(z[rows], theta[:, [0, 2]], np.exp(theta[:, [1, 3]])), 1)
 
     th0 = np.where(np.isfinite(th0), th0, 0.0)
-    theta, conv = _maximise(ll, th0, np.array([60.0, 12.0, 60.0, 12.0]))
+    theta, conv = _maximise(prob, counts, th0, np.array([60.0, 12.0, 60.0, 12.0]))
     with np.errstate(over="ignore"):
         med = np.exp(mu[:, None] + sd[:, None] * theta[:, [0, 2]])
         beta = sd[:, None] * np.exp(theta[:, [1, 3]])
@@ -667,30 +663,31 @@ def _fit_competing(lnx: np.ndarray, k1: np.ndarray, k2: np.ndarray, n: np.ndarra
 
 
 def _fit_counts(kind: str, lnx: np.ndarray, m: np.ndarray, stripes: bool,
-                start: tuple[float, float] | None = None
+                start: tuple[np.ndarray, np.ndarray] | None = None
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Fits of one group of states from category counts m (b, C, P) at ln IM lnx (P,):
     kind "single" (C = 2: not reached, reached), "ordinal" (C = K + 1: the most severe of K
     nested states reached, in severity order) or "competing" (C = 3: safe, mode 1, mode
-    2). start: a single state's (im_median, beta) to start from (then to 1e-7: bootstrap
-    resamples). Returns im_median, beta, ending code, beta undetermined: (b, G) each, G
-    the states of the group (severity order for "ordinal", (mode1, mode2) for
-    "competing")."""
+    2). start: the full data's (im_median (G,), beta (G,)) to start from (bootstrap
+    resamples; a single state's fit then stops at 1e-7). Returns im_median, beta, ending
+    code, beta undetermined: (b, G) each, G the states of the group (severity order for
+    "ordinal", (mode1, mode2) for "competing")."""
     b, C, P = m.shape
     n = m.sum(1)
     lnxb = np.broadcast_to(lnx, n.shape)
     if kind == "single":
         med, bet, code = (_mle_batch(lnxb, m[:, 1], n) if start is None else
-                          _mle_batch(lnxb, m[:, 1], n, start, tol=1e-7))
+                          _mle_batch(lnxb, m[:, 1], n, (start[0][0], start[1][0]),
+                                     tol=1e-7))
         und = (_stripe_rules(lnxb, m[:, 1], n, med, bet, code) if stripes else
                code == _CODE["separated"])
         return med[:, None], bet[:, None], code[:, None], und[:, None]
     if kind == "ordinal":
-        return _fit_ordinal_counts(lnxb, m, n, stripes)
-    return _fit_competing_counts(lnxb, m, n, stripes)
+        return _fit_ordinal_counts(lnxb, m, n, stripes, start)
+    return _fit_competing_counts(lnxb, m, n, stripes, start)
 
 
-def _fit_ordinal_counts(lnx, m, n, stripes):
+def _fit_ordinal_counts(lnx, m, n, stripes, start=None):
     b, C, P = m.shape
     K = C - 1
     reach = np.cumsum(m[:, ::-1], 1)[:, ::-1][:, 1:]  # (b, K, P): reaching state j
@@ -722,7 +719,8 @@ def _fit_ordinal_counts(lnx, m, n, stripes):
         sub = m[rows][:, a:z + 2]
         sub[:, 0] += m[rows][:, :a].sum(1)
         sub[:, -1] += m[rows][:, z + 2:].sum(1)
-        mm, bb, conv = _fit_ordinal(lnx[rows], sub)
+        st = None if start is None else (np.asarray(start[0])[js], np.asarray(start[1])[js[0]])
+        mm, bb, conv = _fit_ordinal(lnx[rows], sub, st)
         _, sdv = _standardise(lnx[rows], n[rows])
         cc = np.where(conv, _CODE["ok"], _CODE["not_converged"])
         cc = np.where(conv & (bb < 1e-6 * sdv), _CODE["separated"], cc)
@@ -745,7 +743,7 @@ def _fit_ordinal_counts(lnx, m, n, stripes):
     return med, bet, code, und
 
 
-def _fit_competing_counts(lnx, m, n, stripes):
+def _fit_competing_counts(lnx, m, n, stripes, start=None):
     b = m.shape[0]
     k1, k2 = m[:, 1], m[:, 2]
     med = np.full((b, 2), np.nan)
@@ -762,14 +760,20 @@ def _fit_competing_counts(lnx, m, n, stripes):
         code[okrow & ~own, j] = _CODE["no_failures"]
     both = np.flatnonzero(okrow & has1 & has2)
     if both.size:
-        start = np.empty((both.size, 4))
+        begin = np.empty((both.size, 4))
         for j, kk in enumerate((k1, k2)):
             mm, bb, _ = _mle_batch(lnx[both], kk[both], n[both])
             fine = np.isfinite(mm) & np.isfinite(bb)
-            start[:, 2 * j] = np.where(fine, np.log(np.where(fine, mm, 1.0)),
+            begin[:, 2 * j] = np.where(fine, np.log(np.where(fine, mm, 1.0)),
                                        np.log(mo[both]))
-            start[:, 2 * j + 1] = np.where(fine, bb, bo[both])
-        mm, bb, conv = _fit_competing(lnx[both], k1[both], k2[both], n[both], start)
+            begin[:, 2 * j + 1] = np.where(fine, bb, bo[both])
+        if start is not None and np.all(np.isfinite(start[0])) and np.all(
+                np.isfinite(start[1])) and np.all(np.asarray(start[1]) > 0):
+            full = [np.log(start[0][0]), start[1][0], np.log(start[0][1]), start[1][1]]
+            first = np.broadcast_to(full, (both.size, 4))
+        else:
+            first = begin
+        mm, bb, conv = _fit_competing(lnx[both], k1[both], k2[both], n[both], first)
         med[both], bet[both] = mm, bb
         code[both] = np.where(conv, _CODE["ok"], _CODE["not_converged"])[:, None]
         med[both[~conv]], bet[both[~conv]] = np.nan, np.nan
@@ -1257,10 +1261,9 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
             for o in range(n_o):
                 for kind, idxs in groups:
                     oh = onehot_of(kind, idxs, o, counted[o])
-                    st = (res["im_median"][idxs[0], o], res["beta"][idxs[0], o])
+                    st = (res["im_median"][idxs, o], res["beta"][idxs, o])
                     med, bet, _, _ = _fit_counts(kind, lnx, _category_counts(
-                        w, oh, bool(stripe)), bool(stripe),
-                        start=st if kind == "single" else None)
+                        w, oh, bool(stripe)), bool(stripe), start=st)
                     bad = ~(np.isfinite(med) & np.isfinite(bet))
                     med[bad], bet[bad] = np.nan, np.nan
                     for q, i in enumerate(idxs):
