@@ -112,6 +112,8 @@ NONMONOTONE_SIMS = 400
 CENSORED_SHARE = 0.1
 FLAGGED_SHIFT = 0.01
 _CODE = {w: i for i, w in enumerate(ENDINGS)}
+#: endings that say all there is (nothing reaches the state, all do, nothing counted)
+_EMPTY = [_CODE[w] for w in ("no_failures", "all_failed", "no_data")]
 
 
 class FragilityError(RocksweepError, ValueError):
@@ -316,7 +318,7 @@ def _stripe_rules(lnx, k, n, med, beta, code):
     "one_stripe"; fewer than two distinct inner fractions (or separation) -> beta NaN.
     Returns bool (B,) "beta_undetermined"."""
     levels, distinct = _distinct_inner(lnx, k, n)
-    one = (levels == 1) & (code != _CODE["no_data"])
+    one = (levels == 1) & ~np.isin(code, _EMPTY)
     med[one], beta[one] = np.nan, np.nan
     code[one] = _CODE["one_stripe"]
     few = (distinct < 2) & (code == _CODE["ok"])
@@ -782,7 +784,7 @@ def _fit_competing_counts(lnx, m, n, stripes, start=None):
         und[:, j] = sep
         if stripes:  # (the other mode's censoring informs beta: no fraction rule)
             lv, _ = _distinct_inner(lnx, kk, n)
-            one = (lv == 1) & (code[:, j] != _CODE["no_data"])
+            one = (lv == 1) & ~np.isin(code[:, j], _EMPTY)
             code[one, j] = _CODE["one_stripe"]
             med[one, j] = np.nan
             und[:, j] |= one
@@ -1385,7 +1387,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
         attrs["period"] = per
     out = xr.Dataset(data, coords=coords, attrs=attrs)
     if warn:
-        for text in verdict_lines(out, why, others, shape_o):
+        for text in verdict_lines(out, why):
             warnings.warn(text, FragilityWarning, stacklevel=2)
     return out
 
@@ -1437,8 +1439,10 @@ def _verdicts(kind, idxs, o, lnx, m, med, bet, why, counted, flagged, hits, over
                                             "could move im_median")
 
 
-def verdict_lines(frag: xr.Dataset, why=None, others=None, shape_o=None) -> list[str]:
-    """One line per curve whose ``reason`` is not "ok": where, which state, and why."""
+def verdict_lines(frag: xr.Dataset, why: list[list[dict[str, str]]] | None = None
+                  ) -> list[str]:
+    """One line per curve of a ``fragility`` Dataset whose ``reason`` is not "ok": where,
+    which state, and why (with the numbers of ``why[state][curve]`` when given)."""
     lines = []
     reason = frag["reason"]
     dims = [d for d in reason.dims if d != "state"]
