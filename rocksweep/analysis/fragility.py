@@ -1088,13 +1088,8 @@ def _refuse_filled(ds: xr.Dataset, states: Sequence[str], counted: xr.DataArray)
         raise FragilityError(
             f"state {need[0]!r}: {n} points of this adaptive sweep were filled from the class "
             "around them, not computed, so their uplift and theta are unknown; only "
-<<<<<<< HEAD
-            f"{OVERTURN}, {MODE1} and {MODE2} can be fitted (sweep without --adaptive for "
-            "this state)")
-=======
             f"{OVERTURN}, {MODE1} and {MODE2} can be fitted (a sweep that computes every "
             "point can give it)")
->>>>>>> issue-29a
 
 
 def _missing_text(not_run: np.ndarray, levels: np.ndarray | None, unit: str,
