@@ -601,7 +601,9 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3) -> xr.Dataset:
     from rocksweep.analysis.spectrum import spectra as compute_spectra
 
     check_rtol(rtol)
-    return compute_spectra(ds, rtol).to_dataset()
+    out = compute_spectra(ds, rtol).to_dataset()
+    out.attrs["rocksweep_kind"] = "spectra"  # rocksweep.plot's dispatch (analysis.kinds)
+    return out
 
 
 @speaks_python
@@ -611,10 +613,21 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
     record, bisected to ``rtol`` between the last stripe below the first overturning one
     and that stripe (kernel runs at the sweep's accuracy), and whether a higher stripe is
     safe again (``resurrection``). ds: what ``run`` or ``open`` returns. Returns a Dataset
-    over the other swept keys and ``record`` (``rocksweep.analysis.ida.ida``)."""
+    over the other swept keys and ``record`` (``rocksweep.analysis.ida.ida``), with the
+    stripes' ``theta_max_over_alpha`` of the points that did not overturn (the IDA
+    curves ``rocksweep.plot`` draws)."""
     from rocksweep.analysis.ida import ida as run_ida
 
-    return run_ida(ds, rtol)
+    out = run_ida(ds, rtol)
+    out.attrs["rocksweep_kind"] = "ida"  # rocksweep.plot's dispatch (analysis.kinds)
+    im = out.attrs.get("im")
+    if hasattr(ds, "data_vars") and "theta_max_over_alpha" in ds.data_vars and im in ds.dims:
+        # the IDA curves on the stripes (max|theta|/alpha against the IM, per record, NaN
+        # where a point overturned): what the figure draws
+        theta = ds["theta_max_over_alpha"].where(ds["outcome"] == 0)
+        out["theta_max_over_alpha"] = theta.drop_vars(
+            [c for c in theta.coords if c not in theta.dims])
+    return out
 
 
 @speaks_python
@@ -658,6 +671,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
                        "or rocksweep.open)")
     frag = fit(ds, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci)
     frag.attrs["title"] = str(ds.attrs.get("title", ""))
+    frag.attrs["rocksweep_kind"] = "fragility"  # rocksweep.plot's dispatch (analysis.kinds)
     return frag
 
 
