@@ -180,6 +180,20 @@ KEYS: dict[str, Key] = {
     "ground.periods": Key("string", "must be a list of periods in [0, 100] s (Sa stored per "
                           "record; 0 gives the PGA)", 0.0, 100.0, required=False,
                           default=(0.2, 1.0)),
+    # the state at t = 0 (rocksweep.physics.points.INITIAL; the names simulate --csv writes)
+    "initial.theta_over_alpha": Key(
+        "axis", "must be a finite number (theta/alpha_cg at t = 0, |theta| < pi/2; > 0 "
+        "rocking on one corner, < 0 on the other)", -math.inf, math.inf, lo_in=False,
+        hi_in=False, required=False, default=0.0),
+    "initial.thetadot_over_palpha": Key(
+        "axis", "must be a finite number (theta'/(p alpha_cg) at t = 0)", -math.inf,
+        math.inf, lo_in=False, hi_in=False, required=False, default=0.0),
+    "initial.u_over_ucr": Key(
+        "axis", "must be a finite number (u/u_cr of the top mass at t = 0)", -math.inf,
+        math.inf, lo_in=False, hi_in=False, required=False, default=0.0),
+    "initial.udot_over_pucr": Key(
+        "axis", "must be a finite number (u'/(p u_cr) at t = 0)", -math.inf, math.inf,
+        lo_in=False, hi_in=False, required=False, default=0.0),
     "ground.p": Key("axis", f"must be in [1e-3, {1e3:g}] rad/s (the body's frequency "
                     "parameter p)", 1e-3, 1e3),
 }
@@ -189,7 +203,7 @@ BODY_KEYS: dict[str, tuple[str, ...]] = {
     "flexible": ("wn_over_p", "zeta", "alpha_cg", "alpha_A", "mA_over_m", "IA_ratio"),
     "block": ("alpha", "inertia"),
 }
-SECTIONS = ("body", "impact", "pulse", "numerics", "outputs", "ground", "refine")
+SECTIONS = ("body", "impact", "pulse", "numerics", "outputs", "ground", "refine", "initial")
 
 
 def section_keys(section: str, kind: str = "flexible") -> tuple[str, ...]:

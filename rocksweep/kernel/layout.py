@@ -35,7 +35,7 @@ PAR_MAXEVENTS = 22  # cap on impacts + uplifts per run
 PAR_RESTRATE = 23  # post-impact |theta'| below which the body settles [rad/s]
 PAR_THETA_OVER = 24  # |theta| at which the body lies on its side: pi/2 [rad]
 PAR_ROOT = 25  # event root finder: ROOT_BISECT, ROOT_ILLINOIS or ROOT_HERMITE
-PAR_THETA0 = 26  # initial theta [rad] (0: start at rest; != 0 starts rocking on its corner)
+PAR_THETA0 = 26  # initial theta [rad] (0: full contact; > 0 rocking on corner +1, < 0 on -1)
 PAR_THETA_DOT0 = 27  # initial theta' [rad/s] (from theta = 0: rocking on its sign's corner)
 PAR_MU = 28  # friction coefficient of the base on the ground (NaN: none given)
 PAR_GAMMA = 29  # Mavroeidis-Papageorgiou pulse: oscillation parameter gamma (>= 1)
@@ -47,7 +47,9 @@ PAR_ROT_STEP = 34  # largest rotation of one rocking step [rad] (0: no such limi
 PAR_LAW = 35  # impact law, read at impacts: LAW_VERTICAL (eq. 1), LAW_LOCKED, LAW_CONSTANT
 PAR_E = 36  # LAW_CONSTANT's coefficient of restitution (unused by the other laws)
 PAR_E_FACTOR = 37  # multiplies the law's e (1: the law's own e)
-N_PAR = 38
+PAR_U0 = 38  # initial u [m] (flexible bodies; with PAR_THETA0, PAR_THETA_DOT0 the state at t = 0)
+PAR_U_DOT0 = 39  # initial u' [m/s]
+N_PAR = 40
 # A record's row is longer: its samples xg''/PGA (float64[npts], in [-1, 1]) follow the
 # N_PAR parameters, PAR_REC = N_PAR the first (``points.with_record``).
 PAR_REC = N_PAR

@@ -29,8 +29,15 @@ if TYPE_CHECKING:
 
 SHAPES = ("sine", "cosine", "ricker", "mp")
 RECORD = "record"  # the shape of a point driven by a ground-motion record
+# The shape of a point without ground motion (a scene with neither pulse: nor ground:):
+# free vibration from the initial state. Its w_over_p is 0 and A_ratio 0: the kernel's
+# pulse variant with A = 0 and a pulse that ends at t = 0 (``run_cost``).
+FREE = "free"
+# The initial state's keys (scene section ``initial``), normalised as ``simulate --csv``
+# writes them: theta/alpha_ref, theta'/(p alpha_ref), u/u_cr, u'/(p u_cr).
+INITIAL = ("theta_over_alpha", "thetadot_over_palpha", "u_over_ucr", "udot_over_pucr")
 _SHAPE_CODE = {"sine": L.SHAPE_SINE, "cosine": L.SHAPE_COSINE, "ricker": L.SHAPE_RICKER,
-               "mp": L.SHAPE_MP, RECORD: L.SHAPE_RECORD}
+               "mp": L.SHAPE_MP, RECORD: L.SHAPE_RECORD, FREE: L.SHAPE_SINE}
 # Defaults of the pulse's optional keys (scene keys pulse.cycles, pulse.gamma, pulse.nu)
 CYCLES, GAMMA, NU_DEG = 1, 2.0, 90.0
 LAWS = ("vertical", "locked", "constant")  # impact laws (``rocksweep.physics.impact``)
@@ -66,6 +73,8 @@ class Point:
     law: str = "vertical"
     e: float = math.nan
     e_factor: float = 1.0
+    # the state at t = 0 (``INITIAL``, normalised; all 0: at rest in full contact)
+    initial: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
 
     @property
     def omega(self) -> float:
@@ -86,7 +95,7 @@ class Point:
         """The pulse's reference definition (None for a record)."""
         from rocksweep.physics.excitation import PulseShape  # scipy: loaded when needed
 
-        if self.shape == RECORD:
+        if self.shape in (RECORD, FREE):
             return None
         return PulseShape(self.shape, int(self.cycles), float(self.gamma), float(self.nu))
 
@@ -96,6 +105,8 @@ class Point:
         record's last sample time p (npts - 1) DT."""
         if self.shape == RECORD:
             return self.p * self.record.duration
+        if self.shape == FREE:
+            return 0.0
         return self.pulse.duration / self.omega
 
 
@@ -160,12 +171,13 @@ def run_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, w_over_p: np.ndarray
     Returns dt [p*t] (``step_size``), t_pulse = phase/omega, t_end = t_pulse + horizon
     [p*t] and the cap on RK4 evaluations (``step_budget``): the kernel's PAR_DT,
     PAR_TPULSE, PAR_TEND and PAR_MAXSTEPS. The scene bounds the last (MAX_POINT_STEPS).
+    w_over_p = 0 is no ground motion (shape FREE): t_pulse = 0.
     """
     omega = np.asarray(w_over_p, float)  # p = 1 rad/s
-    with np.errstate(divide="ignore", over="ignore"):
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
         dt = step_size(omega_rock, omega, numerics.steps_per_period,
                        amplitude_frequency(A_ratio, alpha_ref))
-        t_pulse = phase / omega
+        t_pulse = np.where(omega == 0.0, 0.0, phase / omega)
         t_end = t_pulse + numerics.horizon
         max_steps = step_budget(t_end, dt, numerics)
     return dt, t_pulse, t_end, max_steps
@@ -199,9 +211,11 @@ def record_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, p: np.ndarray,
 
 
 def phase_duration(shape: str, cycles: int = CYCLES, gamma: float = GAMMA) -> float:
-    """A pulse's duration in w t (``excitation.PulseShape.duration``)."""
+    """A pulse's duration in w t (``excitation.PulseShape.duration``; 0 for FREE)."""
     from rocksweep.physics.excitation import PulseShape
 
+    if shape == FREE:
+        return 0.0
     return PulseShape(shape, int(cycles), float(gamma)).duration
 
 
@@ -211,7 +225,8 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
               cycles: int = CYCLES, gamma: float = GAMMA, nu_deg: float = NU_DEG,
               record: GroundRecord | None = None,
               mu: np.ndarray | float = math.nan, law: np.ndarray | float = L.LAW_VERTICAL,
-              e: np.ndarray | float = math.nan, e_factor: np.ndarray | float = 1.0) -> None:
+              e: np.ndarray | float = math.nan, e_factor: np.ndarray | float = 1.0,
+              initial: tuple | None = None, u_cr: np.ndarray | float = 0.0) -> None:
     """Fill parameter rows in place, vectorised over points.
 
     rows: float64[n, N_PAR] (out); body_rows: float64[n, N_PAR] from ``body_row``;
@@ -221,6 +236,9 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     the body's p [rad/s]; the rows then still lack the samples (``with_record``).
     mu: friction coefficient, float64[n] or a scalar (NaN: none). law (a LAW_* code), e
     (law constant's, else NaN) and e_factor: the impact law, float64[n] or scalars.
+    initial: the state at t = 0 as four float64[n] or scalars in ``INITIAL``'s order
+    (theta/alpha_ref, theta'/(p alpha_ref), u/u_cr, u'/(p u_cr)), None: at rest; u_cr [m]
+    float64[n] or a scalar (0 for a rigid body). PAR_THETA0.. PAR_U_DOT0 in SI (p = 1).
     """
     rows[:] = body_rows
     omega = np.asarray(w_over_p, float)  # p = 1 rad/s
@@ -261,6 +279,12 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     rows[:, L.PAR_LAW] = law
     rows[:, L.PAR_E] = e
     rows[:, L.PAR_E_FACTOR] = e_factor
+    if initial is not None:
+        th, thd, u, ud = initial
+        rows[:, L.PAR_THETA0] = np.asarray(th, float) * alpha_ref
+        rows[:, L.PAR_THETA_DOT0] = np.asarray(thd, float) * alpha_ref
+        rows[:, L.PAR_U0] = np.asarray(u, float) * u_cr
+        rows[:, L.PAR_U_DOT0] = np.asarray(ud, float) * u_cr
 
 
 def with_record(rows: np.ndarray, record: GroundRecord | None) -> np.ndarray:
@@ -286,7 +310,8 @@ def point_row(point: Point, numerics: Numerics) -> np.ndarray:
               np.array([_SHAPE_CODE[point.shape]]),
               np.array([point.p if rec is not None else point.w_over_p]),
               np.array([point.A_ratio]), numerics, point.cycles, point.gamma, point.nu, rec,
-              point.mu, law_code(point.law), point.e, point.e_factor)
+              point.mu, law_code(point.law), point.e, point.e_factor,
+              point.initial if any(point.initial) else None, body.u_cr)
     return with_record(rows, rec)[0]
 
 

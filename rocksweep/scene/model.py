@@ -13,7 +13,7 @@ from rocksweep import fields
 from rocksweep.errors import RocksweepError
 from rocksweep.numerics import Numerics
 from rocksweep.physics.model import BlockBody, Body, FlexibleBody
-from rocksweep.physics.points import RECORD, Point
+from rocksweep.physics.points import FREE, INITIAL, RECORD, Point
 from rocksweep.physics.records import GroundRecord
 from rocksweep.physics.suite import Suite
 from rocksweep.schema import KEYS
@@ -135,17 +135,30 @@ class Scene:
             a_ratio = float(su.peak_ratio(np.array([r]), s, np.array([body.alpha_ref]),
                                           np.array([p]))[0])
             return Point(body, float(values["lam"]), RECORD, math.nan, a_ratio,
-                         record=su.records[r], p=p, **self._law(values))
+                         record=su.records[r], p=p, **self._law(values),
+                         initial=self.initial_state(values))
         if self.record is not None:
             return Point(body, float(values["lam"]), RECORD, math.nan,
                          float(values["A_ratio"]), record=self.record, p=float(values["p"]),
-                         **self._law(values))
+                         **self._law(values), initial=self.initial_state(values))
         return Point(body, float(values["lam"]), str(values["shape"]),
                      float(values["w_over_p"]), float(values["A_ratio"]),
                      int(values.get("cycles", self.option("cycles"))),
                      float(values.get("gamma", self.option("gamma"))),
                      float(values.get("nu", self.option("nu"))),
-                     mu=float(values.get("mu", math.nan)), **self._law(values))
+                     mu=float(values.get("mu", math.nan)), **self._law(values),
+                     initial=self.initial_state(values))
+
+    @property
+    def free(self) -> bool:
+        """No ground motion (neither ``pulse`` nor ``ground``): free vibration from the
+        initial state."""
+        return self.axis("shape").values == (FREE,)
+
+    def initial_state(self, values: dict[str, Any]) -> tuple[float, float, float, float]:
+        """A point's initial state (``points.INITIAL``, normalised) from axis values; the
+        keys the scene does not give are 0."""
+        return tuple(float(values.get(k, 0.0)) for k in INITIAL)  # type: ignore[return-value]
 
     def _law(self, values: dict[str, Any]) -> dict[str, Any]:
         """A point's impact law (Point keywords law, e, e_factor) from axis values."""
