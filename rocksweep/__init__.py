@@ -15,6 +15,10 @@ The Python API (see the README's "Python API"):
   ``rocksweep.fragility(ds, state=, bootstrap=)`` -> Dataset of lognormal fragility
   curves of a record-suite sweep.
   Each analysis takes what ``run`` and ``open`` return.
+- ``rocksweep.calibrate(scene, measured, fit=["impact.lam"], bounds=)`` -> Dataset of the
+  fitted keys (estimate, lo, hi, misfit) of a measured history;
+  ``rocksweep.calibrated_overrides(fit)``: overrides that sweep the scene at the estimate
+  and the interval's ends.
 - ``rocksweep.RocksweepError``: the base of every error a user can fix (one line).
 
 Importing the package is light: numba, h5py, xarray and matplotlib load on first use.
@@ -25,6 +29,8 @@ from __future__ import annotations
 from rocksweep.api import (  # noqa: A004
     boundaries,
     boundary_lines,
+    calibrate,
+    calibrated_overrides,
     estimate,
     fragility,
     ida,
@@ -64,5 +70,6 @@ def __getattr__(name: str) -> str:
     raise AttributeError(f"module 'rocksweep' has no attribute {name!r}")
 
 
-__all__ = ["RocksweepError", "__version__", "boundaries", "boundary_lines", "estimate",
+__all__ = ["RocksweepError", "__version__", "boundaries", "boundary_lines", "calibrate",
+           "calibrated_overrides", "estimate",
            "fragility", "ida", "open", "plot", "run", "simulate", "spectra"]
