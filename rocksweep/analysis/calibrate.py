@@ -14,9 +14,9 @@ is on the sequence of excursion peaks.
 1. The excursions of a history (measured, or simulated and sampled at the measured times
    by Hermite interpolation of theta and theta'): runs of samples of one sign beyond a
    threshold h (hysteresis: an excursion ends when |theta| falls below h/2 or the sign
-   changes), each with its signed peak, refined by a least-squares parabola through the
-   2 PEAK_HALF + 1 samples around the largest (the same on both sides, so the parabola's
-   own bias cancels). h = max(H_NOISE x sigma, H_REL x max |theta|), sigma the measured
+   changes), each with its signed peak: the vertex of a least-squares parabola through
+   the samples above PEAK_TOP of the largest (the largest sample alone is biased up by
+   the noise; the same rule on both sides, so the parabola's own shape error cancels). h = max(H_NOISE x sigma, H_REL x max |theta|), sigma the measured
    noise (``measured.noise_level``): the small rebounds of a chattering body, near the
    noise, do not count.
 2. The two sequences are aligned by a sequence alignment (dynamic programming, as an edit
@@ -65,7 +65,7 @@ from rocksweep.schema import KEYS, fmt
 
 H_NOISE = 4.0  # threshold of an excursion, in noise standard deviations ...
 H_REL = 0.02  # ... and at least this share of the largest |theta|
-PEAK_HALF = 3  # a peak's parabola goes through 2 PEAK_HALF + 1 samples
+PEAK_TOP = 0.5  # a peak's parabola goes through the samples above this share of it
 CHI2_95 = 3.841458820694124  # chi-square quantile, 1 degree of freedom, 95%
 GRID = 21  # first look of a one-parameter fit: GRID values across the bounds
 GRID_2D = 9  # ... and GRID_2D^2 for two parameters
@@ -107,19 +107,25 @@ def excursions(t: np.ndarray, theta: np.ndarray, h: float) -> Peaks:
     k = big[arg]
     sg = sign[starts]
     value, when = theta[k].copy(), t[k].copy()
-    # parabola through the samples around the largest: its vertex if inside them
-    n = t.size
-    for j, i in enumerate(k):
-        a, b = max(i - PEAK_HALF, 0), min(i + PEAK_HALF + 1, n)
-        if b - a < 5:
+    # a parabola through the top of each excursion (the samples within PEAK_TOP of its
+    # largest): the largest sample alone is biased up by the noise (the largest of several
+    # noisy samples), a least-squares fit through many is not
+    first = big[starts]
+    last = big[ends - 1]
+    for j in range(k.size):
+        a, b = int(first[j]), int(last[j]) + 1
+        seg = sg[j] * theta[a:b]
+        top = np.flatnonzero(seg >= PEAK_TOP * seg.max()) + a
+        if top.size < 5:
             continue
-        tt = t[a:b] - t[i]
-        c2, c1, c0 = np.polyfit(tt, theta[a:b], 2)
-        if sg[j] * c2 < 0:
-            tv = -c1 / (2 * c2)
-            if tt[0] <= tv <= tt[-1]:
-                value[j] = c0 - c1 * c1 / (4 * c2)
-                when[j] = t[i] + tv
+        tt = t[top] - t[k[j]]
+        c2, c1, c0 = np.polyfit(tt, theta[top], 2)
+        tv = -c1 / (2 * c2) if c2 != 0 else math.inf
+        if sg[j] * c2 < 0 and tt[0] <= tv <= tt[-1]:
+            value[j] = c0 - c1 * c1 / (4 * c2)
+            when[j] = t[k[j]] + tv
+        else:  # the top at an end (a release from a tilt): the fit at the largest sample
+            value[j] = c0
     return Peaks(value, when)
 
 
