@@ -86,6 +86,7 @@ class Peaks:
 
     value: np.ndarray
     time: np.ndarray
+    area: np.ndarray | None = None  # integral of |theta| over each excursion [theta/alpha p t]
 
 
 def excursions(t: np.ndarray, theta: np.ndarray, h: float) -> Peaks:
@@ -93,11 +94,10 @@ def excursions(t: np.ndarray, theta: np.ndarray, h: float) -> Peaks:
     docstring, step 1). t: float64[n] increasing; theta: float64[n]."""
     big = np.flatnonzero(np.abs(theta) > h)
     if big.size == 0:
-        return Peaks(np.zeros(0), np.zeros(0))
+        return Peaks(np.zeros(0), np.zeros(0), np.zeros(0))
     sign = np.sign(theta[big])
-    low = np.concatenate([[0], np.cumsum(np.abs(theta) < 0.5 * h)])  # low samples before i
     new = np.ones(big.size, bool)
-    new[1:] = (sign[1:] != sign[:-1]) | (low[big[1:]] > low[big[:-1] + 1])
+    new[1:] = sign[1:] != sign[:-1]
     starts = np.flatnonzero(new)
     # the largest sample of each group of samples beyond h
     signed = sign * theta[big]
@@ -112,9 +112,17 @@ def excursions(t: np.ndarray, theta: np.ndarray, h: float) -> Peaks:
     # noisy samples), a least-squares fit through many is not
     first = big[starts]
     last = big[ends - 1]
+    n = t.size
+    area = np.empty(k.size)
     for j in range(k.size):
         a, b = int(first[j]), int(last[j]) + 1
         seg = sg[j] * theta[a:b]
+        # the area beyond the threshold, int max(|theta| - h, 0) dt from the sample before
+        # to the sample after: many samples average the noise, and a sample near the
+        # threshold (or after a gap) weighs ~0, so the area is continuous in the parameters
+        a0, b0 = max(a - 1, 0), min(b + 1, n)
+        over = np.maximum(sg[j] * theta[a0:b0] - h, 0.0)
+        area[j] = float(np.sum(0.5 * (over[1:] + over[:-1]) * np.diff(t[a0:b0])))
         top = np.flatnonzero(seg >= PEAK_TOP * seg.max()) + a
         if top.size < 5:
             continue
@@ -126,44 +134,55 @@ def excursions(t: np.ndarray, theta: np.ndarray, h: float) -> Peaks:
             when[j] = t[k[j]] + tv
         else:  # the top at an end (a release from a tilt): the fit at the largest sample
             value[j] = c0
-    return Peaks(value, when)
+    return Peaks(value, when, area)
 
 
-def alignment_cost(a: np.ndarray, b: np.ndarray, h: float, band: int = 12
-                   ) -> tuple[float, list[tuple[int, int]]]:
+def alignment_cost(a: np.ndarray, b: np.ndarray, h: float, band: int = 12,
+                   area_a: np.ndarray | None = None, area_b: np.ndarray | None = None,
+                   t_scale: float = 1.0) -> tuple[float, list[tuple[int, int]]]:
     """Least cost of aligning two signed peak sequences (module docstring, step 2) and the
     pairs (i, j) of that alignment. ``band``: pairs with |i - j| beyond it are not tried
     (the cost of the rest is exact within the band)."""
     fa = np.maximum(np.abs(a) - h, 0.0)
     fb = np.maximum(np.abs(b) - h, 0.0)
+    if area_a is not None and area_b is not None:  # the areas, as mean levels
+        ga, gb = area_a / t_scale, area_b / t_scale
+        fa = np.stack([fa, ga], axis=1)
+        fb = np.stack([fb, gb], axis=1)
+    else:
+        fa, fb = fa[:, None], fb[:, None]
+    fa2, fb2 = np.sum(fa**2, axis=1), np.sum(fb**2, axis=1)
     n, m = a.size, b.size
     inf = math.inf
     d = np.full((n + 1, m + 1), inf)
     d[0, 0] = 0.0
+    sa, sb = np.sign(a), np.sign(b)
+
+    def pair(i: int, j: int) -> float:
+        if sa[i] == sb[j]:
+            return float(np.sum((fa[i] - fb[j]) ** 2))
+        return float(fa2[i] + fb2[j])
+
     for j in range(1, m + 1):
-        d[0, j] = d[0, j - 1] + fb[j - 1] ** 2 if j <= band else inf
+        d[0, j] = d[0, j - 1] + fb2[j - 1] if j <= band else inf
     for i in range(1, n + 1):
         if i <= band:
-            d[i, 0] = d[i - 1, 0] + fa[i - 1] ** 2
+            d[i, 0] = d[i - 1, 0] + fa2[i - 1]
         lo, hi = max(1, i - band), min(m, i + band)
         for j in range(lo, hi + 1):
-            same = np.sign(a[i - 1]) == np.sign(b[j - 1])
-            pair = (fa[i - 1] - fb[j - 1]) ** 2 if same else fa[i - 1] ** 2 + fb[j - 1] ** 2
-            d[i, j] = min(d[i - 1, j - 1] + pair, d[i - 1, j] + fa[i - 1] ** 2,
-                          d[i, j - 1] + fb[j - 1] ** 2)
+            d[i, j] = min(d[i - 1, j - 1] + pair(i - 1, j - 1), d[i - 1, j] + fa2[i - 1],
+                          d[i, j - 1] + fb2[j - 1])
     if not math.isfinite(d[n, m]):  # longer than the band allows: the rest unpaired
-        return float(np.sum(fa**2) + np.sum(fb**2)), []
+        return float(np.sum(fa2) + np.sum(fb2)), []
     pairs = []
     i, j = n, m
     while i > 0 and j > 0:
-        same = np.sign(a[i - 1]) == np.sign(b[j - 1])
-        pair = (fa[i - 1] - fb[j - 1]) ** 2 if same else fa[i - 1] ** 2 + fb[j - 1] ** 2
-        if math.isclose(d[i, j], d[i - 1, j - 1] + pair, rel_tol=1e-12, abs_tol=1e-300):
-            if same:
+        if math.isclose(d[i, j], d[i - 1, j - 1] + pair(i - 1, j - 1), rel_tol=1e-12,
+                        abs_tol=1e-300):
+            if sa[i - 1] == sb[j - 1]:
                 pairs.append((i - 1, j - 1))
             i, j = i - 1, j - 1
-        elif math.isclose(d[i, j], d[i - 1, j] + fa[i - 1] ** 2, rel_tol=1e-12,
-                          abs_tol=1e-300):
+        elif math.isclose(d[i, j], d[i - 1, j] + fa2[i - 1], rel_tol=1e-12, abs_tol=1e-300):
             i -= 1
         else:
             j -= 1
@@ -234,6 +253,11 @@ class Problem:
                 f"{measured.source}: {self.peaks.value.size} half cycle(s) beyond the noise "
                 f"(|theta_over_alpha| > {self.h:.3g}); a fit of the impact law needs the "
                 "measurement to go on past at least one impact")
+        # the time scale that makes an excursion's area a level: the median duration of the
+        # measured excursions (area / duration ~ its mean |theta|)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            dur = self.peaks.area / np.maximum(np.abs(self.peaks.value) - self.h, 1e-300)
+        self.t_scale = float(np.median(dur[dur > 0])) if np.any(dur > 0) else 1.0
         self.runs = 0
 
     def point(self, x: np.ndarray) -> Any:
@@ -275,7 +299,9 @@ class Problem:
         shift = self.t_onset - (onset if math.isfinite(onset) else self.t_onset)
         theta = hermite(h["t"], h["theta"], h["theta_dot"], self.m.t - shift)
         peaks = excursions(self.m.t, theta, self.h)
-        cost, pairs = alignment_cost(self.peaks.value, peaks.value, self.h)
+        cost, pairs = alignment_cost(self.peaks.value, peaks.value, self.h,
+                                     area_a=self.peaks.area, area_b=peaks.area,
+                                     t_scale=self.t_scale)
         t, ph = h["t"], h["phase"]
         ev = np.flatnonzero((t[1:] == t[:-1]) & (ph[:-1] != 0) & (ph[1:] != ph[:-1]))
         impacts = t[ev] + shift
