@@ -3,8 +3,8 @@
     python scripts/bench_calibrate.py            # every case, ~1 min on 2 cores
     python scripts/bench_calibrate.py --quick    # a few cases
 
-Synthetic measurements: ``rocksweep.simulate`` at the true value (the scene's `fine`
-accuracy, or `--truth-steps` steps per period for a reference made at another step),
+Synthetic measurements: ``rocksweep.simulate`` at the true value at `--truth-steps` (200)
+steps per period (10x the fit's `fine`: a reference made at another step),
 sampled uniformly at dt = 0.02 p t (or unevenly, with gaps), plus Gaussian noise of
 ``noise`` x max |theta|. Each is fitted back from a different starting scene value. Prints
 per case the truth, the estimate, the error, the 95% interval (and whether it covers the
@@ -117,7 +117,8 @@ def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--truth-steps", type=int, default=200,
-                    help="steps per period of the synthetic truth (linear interpolation between its rows must not flatten the peaks)")
+                    help="steps per period of the synthetic truth (linear interpolation "
+                         "between its rows must not flatten the peaks)")
     args = ap.parse_args()
     cases = CASES[::3] if args.quick else CASES
     print(f"{'case':<20} {'key':<16} {'truth':>6} {'est':>8} {'err':>8} {'95% interval':>20} "

@@ -12,24 +12,31 @@ so its misfit flattens out and grows local minima. The peaks do not drift: the m
 is on the sequence of excursion peaks.
 
 1. The excursions of a history (measured, or simulated and sampled at the measured times
-   by Hermite interpolation of theta and theta'): runs of samples of one sign beyond a
-   threshold h (hysteresis: an excursion ends when |theta| falls below h/2 or the sign
-   changes), each with its signed peak: the vertex of a least-squares parabola through
-   the samples above PEAK_TOP of the largest (the largest sample alone is biased up by
-   the noise; the same rule on both sides, so the parabola's own shape error cancels). h = max(H_NOISE x sigma, H_REL x max |theta|), sigma the measured
-   noise (``measured.noise_level``): the small rebounds of a chattering body, near the
-   noise, do not count.
+   by Hermite interpolation of theta and theta'): the samples between two changes of
+   sign, a sign counting once |theta| exceeds a threshold h (noise near zero, or the
+   base resting in full contact between two uplifts on one corner, starts none). Each
+   has two features: its signed peak, the vertex of a least-squares parabola through the
+   samples above PEAK_TOP of its largest (the largest noisy sample alone is biased up;
+   the same rule on both sides, so the parabola's own shape error cancels), and its area
+   beyond the threshold, int max(|theta| - h, 0) dt, divided by the median duration of
+   the measured excursions (a level: many samples average the noise, and a sample near
+   the threshold or next to a gap weighs ~0, so the area is continuous in the
+   parameters). h = max(H_NOISE x sigma, H_REL x max |theta|), sigma the measured noise
+   (``measured.noise_level``): the small rebounds of a chattering body, near the noise,
+   do not count.
 2. The two sequences are aligned by a sequence alignment (dynamic programming, as an edit
-   distance): a pair of peaks of one sign costs (f(a) - f(b))^2, a peak left unpaired
-   costs f(a)^2, with f(a) = max(|a| - h, 0). An excursion just above the threshold in one
-   history and just below it in the other then costs ~0 and cannot shift the pairing of
-   the later, larger ones (which order matching would do).
+   distance): a pair of excursions of one sign costs the squared differences of their
+   features, (f(a) - f(b))^2 + (g_a - g_b)^2 with f(a) = max(|a| - h, 0) and g the area
+   level; an excursion left unpaired costs f^2 + g^2. An excursion just above the
+   threshold in one history and just below it in the other then costs ~0 and cannot shift
+   the pairing of the later, larger ones (which order matching would do).
 3. The misfit is the least cost over alignments, S (units (theta/alpha)^2); ``misfit`` in
-   the result is sqrt(S / N), the root mean square peak error over the N measured peaks.
+   the result is sqrt(S / N), N the number of measured excursions.
 
 The starts are aligned: the measured history may begin with a quiet part of any length
 (before a release, or before the pulse lifts the body); the simulated history is shifted
-so that both depart from their first value by the threshold at the same time.
+so that both depart from their first value by the threshold at the same time, refined by
+least squares on theta over the first half cycles (before any phase drift).
 
 The interval
 ------------
@@ -258,6 +265,11 @@ class Problem:
         with np.errstate(invalid="ignore", divide="ignore"):
             dur = self.peaks.area / np.maximum(np.abs(self.peaks.value) - self.h, 1e-300)
         self.t_scale = float(np.median(dur[dur > 0])) if np.any(dur > 0) else 1.0
+        # the start window of the shift (``_shift``): from the first sample to the second
+        # half-cycle peak; the shift is searched within a tenth of that window
+        t_end = self.peaks.time[1] if self.peaks.time.size > 1 else measured.t[-1]
+        self.window = np.flatnonzero(measured.t <= t_end)
+        self.dt_shift = 0.1 * max(float(t_end - self.t_onset), 1e-3)
         self.runs = 0
 
     def point(self, x: np.ndarray) -> Any:
@@ -295,8 +307,7 @@ class Problem:
         if got is None:
             return None
         out, h = got
-        onset = _onset(h["t"], h["theta"], self.h)
-        shift = self.t_onset - (onset if math.isfinite(onset) else self.t_onset)
+        shift = self._shift(h)
         theta = hermite(h["t"], h["theta"], h["theta_dot"], self.m.t - shift)
         peaks = excursions(self.m.t, theta, self.h)
         cost, pairs = alignment_cost(self.peaks.value, peaks.value, self.h,
@@ -308,6 +319,31 @@ class Problem:
         impacts = impacts[impacts <= self.m.t[-1]]
         return {"S": cost, "theta": theta, "shift": shift, "peaks": peaks, "pairs": pairs,
                 "impacts": impacts, "out": out}
+
+    def _shift(self, h: dict) -> float:
+        """The time shift that aligns a simulated history's start with the measured one:
+        first the shift that makes both depart from their first value by the threshold at
+        the same time (the simulation sampled as the measurement), then the least-squares
+        shift of theta over the measured start window (up to the second half-cycle peak,
+        before any phase drift; a slow start, as a release from a tilt, departs too
+        gently for the threshold alone)."""
+        from scipy.optimize import minimize_scalar
+
+        t_rel = self.m.t - self.m.t[0]
+        th = hermite(h["t"], h["theta"], h["theta_dot"], t_rel)
+        onset = _onset(t_rel, th, self.h)
+        if not math.isfinite(onset):
+            return self.t_onset
+        shift0 = self.t_onset - onset
+        w = self.window
+        tt, yy = self.m.t[w], self.m.theta[w]
+
+        def ss(sh: float) -> float:
+            return float(np.sum((hermite(h["t"], h["theta"], h["theta_dot"], tt - sh) - yy)
+                                ** 2))
+        r = minimize_scalar(ss, bounds=(shift0 - self.dt_shift, shift0 + self.dt_shift),
+                            method="bounded", options={"xatol": 1e-6})
+        return float(r.x) if r.fun <= ss(shift0) else shift0
 
     def misfit(self, x: np.ndarray) -> float:
         x = np.asarray(x, float)
