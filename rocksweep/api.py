@@ -804,7 +804,9 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     values = {a.name: a.values[0] for a in sc.axes}
     body = sc.point(values).body
     m = read_measured(measured, p=p_body, alpha_ref=body.alpha_ref, u_cr=body.u_cr or None)
-    return calibrate_problem(Problem(sc, m, keys, bounds), float(ci))
+    fit = calibrate_problem(Problem(sc, m, keys, bounds), float(ci))
+    register_accessor()  # fit.rocksweep.as_overrides()
+    return fit
 
 
 def _body_p(scene: Scene) -> float | None:
