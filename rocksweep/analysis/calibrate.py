@@ -43,7 +43,10 @@ The interval
 Profile likelihood: a parameter's 95% interval holds the values whose misfit, minimised
 over the other fitted parameters, exceeds the least misfit by at most chi2_1(0.95) s^2,
 with s^2 = max(S_min / (N - k), sigma^2) the variance of one peak's error (the residual
-scatter, never below the measured noise). Less noise gives a smaller s^2 and a narrower
+scatter, never below the measured noise). The misfit of a run with many impacts is rough
+on small scales, so the interval is widened to where a parabola fitted to the profile
+across it rises by the same amount plus twice the profile's scatter about the parabola
+(the union of both is kept). Less noise gives a smaller s^2 and a narrower
 interval; an interval that reaches a bound is stated (``lo_at_bound``/``hi_at_bound``).
 
 Speed: each misfit evaluation is one run of the single-run history kernel (no plot, no
@@ -72,10 +75,12 @@ from rocksweep.schema import KEYS, fmt
 
 H_NOISE = 4.0  # threshold of an excursion, in noise standard deviations ...
 H_REL = 0.02  # ... and at least this share of the largest |theta|
-PEAK_TOP = 0.5  # a peak's parabola goes through the samples above this share of it
+PEAK_TOP = 0.5  # a peak's parabola goes through the samples above this share of it ...
+PEAK_RAMP = 0.2  # ... weighted from 0 there to 1 at PEAK_TOP + PEAK_RAMP
 CHI2_95 = 3.841458820694124  # chi-square quantile, 1 degree of freedom, 95%
 GRID = 21  # first look of a one-parameter fit: GRID values across the bounds
 GRID_2D = 9  # ... and GRID_2D^2 for two parameters
+PROFILE_POINTS = 15  # values of the profile misfit a parabola is fitted to (``_smooth_profile``)
 # practical default bounds of a fitted key (inside the key's admissible range)
 DEFAULT_BOUNDS = {"impact.lam": (0.0, 2.0), "impact.e": (0.02, 1.0),
                   "impact.e_factor": (0.2, 2.0), "body.zeta": (0.0, 0.5)}
@@ -130,17 +135,19 @@ def excursions(t: np.ndarray, theta: np.ndarray, h: float) -> Peaks:
         a0, b0 = max(a - 1, 0), min(b + 1, n)
         over = np.maximum(sg[j] * theta[a0:b0] - h, 0.0)
         area[j] = float(np.sum(0.5 * (over[1:] + over[:-1]) * np.diff(t[a0:b0])))
-        top = np.flatnonzero(seg >= PEAK_TOP * seg.max()) + a
-        if top.size < 5:
+        # weights rise from 0 at PEAK_TOP of the largest to 1 at PEAK_TOP + PEAK_RAMP:
+        # a sample entering the top as the parameters change enters with weight 0, so the
+        # peak is continuous in the parameters
+        wgt = np.clip((seg / seg.max() - PEAK_TOP) / PEAK_RAMP, 0.0, 1.0)
+        top = np.flatnonzero(wgt > 0) + a
+        if top.size < 4:
             continue
         tt = t[top] - t[k[j]]
-        c2, c1, c0 = np.polyfit(tt, theta[top], 2)
-        tv = -c1 / (2 * c2) if c2 != 0 else math.inf
-        if sg[j] * c2 < 0 and tt[0] <= tv <= tt[-1]:
-            value[j] = c0 - c1 * c1 / (4 * c2)
-            when[j] = t[k[j]] + tv
-        else:  # the top at an end (a release from a tilt): the fit at the largest sample
-            value[j] = c0
+        c2, c1, c0 = np.polyfit(tt, theta[top], 2, w=np.sqrt(wgt[top - a]))
+        tv = -c1 / (2 * c2) if sg[j] * c2 < 0 else (tt[0] if sg[j] * c1 < 0 else tt[-1])
+        tv = min(max(tv, tt[0]), tt[-1])  # the top at an end (a release from a tilt)
+        value[j] = c0 + c1 * tv + c2 * tv * tv
+        when[j] = t[k[j]] + tv
     return Peaks(value, when, area)
 
 
@@ -505,6 +512,47 @@ def _profile_end(problem: Problem, i: int, x_hat: np.ndarray, s_min: float, limi
     return float(0.5 * (inside + out)), False
 
 
+def _smooth_profile(problem: Problem, i: int, x_hat: np.ndarray, lo: float, hi: float,
+                    limit: float, lo_b: bool, hi_b: bool) -> tuple[float, float, bool, bool]:
+    """The interval widened to where a parabola fitted to the profile misfit across it
+    (PROFILE_POINTS values over twice its width) rises by ``limit``: the misfit of a run
+    with many impacts is rough on small scales (an excursion near the threshold, an event
+    more or less in a chattering sequence), and a bump next to the minimum must not cut
+    the interval short. The union of both intervals is kept."""
+    others = [k for k in range(len(x_hat)) if k != i]
+    b_lo, b_hi = problem.bounds[i]
+    c = float(x_hat[i])
+    a, b = max(b_lo, c - 2 * (c - lo)), min(b_hi, c + 2 * (hi - c))
+    if not b > a:
+        return lo, hi, lo_b, hi_b
+    xs = np.linspace(a, b, PROFILE_POINTS)
+    ss = []
+    for v in xs:
+        if others:
+            ss.append(_minimise_local(problem, others, {i: v}, x_hat)[1])
+        else:
+            x = x_hat.copy()
+            x[i] = v
+            ss.append(problem.misfit(x))
+    ss = np.array(ss)
+    ok = np.isfinite(ss)
+    if ok.sum() < 5:
+        return lo, hi, lo_b, hi_b
+    c2, c1, c0 = np.polyfit(xs[ok], ss[ok], 2)
+    if c2 <= 0:
+        return lo, hi, lo_b, hi_b
+    x0 = -c1 / (2 * c2)
+    # the roughness (the profile's scatter about the parabola) is added to the rise: a
+    # difference of two misfits is uncertain by about that much
+    rough = float(np.std(ss[ok] - np.polyval([c2, c1, c0], xs[ok])))
+    d = math.sqrt((limit + 2 * rough) / c2)
+    if x0 - d < lo:
+        lo, lo_b = max(b_lo, x0 - d), x0 - d <= b_lo
+    if x0 + d > hi:
+        hi, hi_b = min(b_hi, x0 + d), x0 + d >= b_hi
+    return float(lo), float(hi), bool(lo_b), bool(hi_b)
+
+
 def _minimise_local(problem: Problem, free: list[int], fixed: dict[int, float],
                     start: np.ndarray) -> tuple[np.ndarray, float]:
     """Least misfit over ``free`` near ``start`` (no grid): Brent in a bracket of 10% of
@@ -563,6 +611,8 @@ def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
     for i in range(k):
         lo[i], lo_b[i] = _profile_end(problem, i, x_hat, s_min, limit, -1)
         hi[i], hi_b[i] = _profile_end(problem, i, x_hat, s_min, limit, +1)
+        lo[i], hi[i], lo_b[i], hi_b[i] = _smooth_profile(problem, i, x_hat, lo[i], hi[i],
+                                                         limit, lo_b[i], hi_b[i])
     wall = time.perf_counter() - t0
     m = problem.m
     pairs = best["pairs"]
@@ -570,9 +620,9 @@ def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
     for i, j in pairs:
         fitted_peak[i] = best["peaks"].value[j]
     notes = list(m.notes)
-    if problem.quiet > 0:
-        notes.append(f"leading quiet part of {problem.quiet:.4g} p*t before the motion "
-                     f"(aligned: the simulation is shifted by {best['shift']:.4g} p*t)")
+    if best["shift"] > 2 * float(np.median(np.diff(m.t))):
+        notes.append(f"a leading quiet part: the motion starts {best['shift']:.4g} p*t later "
+                     "than in the simulation (aligned by shifting the simulation)")
     ds = xr.Dataset(
         {"estimate": ("parameter", x_hat), "lo": ("parameter", lo), "hi": ("parameter", hi),
          "lo_at_bound": ("parameter", lo_b), "hi_at_bound": ("parameter", hi_b),
