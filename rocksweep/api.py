@@ -810,12 +810,14 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
 
 
 def _body_p(scene: Scene) -> float | None:
-    """The body's p [rad/s] a scene knows (a record scene's ground.p, a physical body's),
+    """The body's p [rad/s] a scene knows (a physical body's, a record scene's ground.p),
     else None."""
+    if scene.physical is not None:
+        return scene.physical["p"]
     names = {a.name: a for a in scene.axes}
     if "p" in names and len(names["p"].values) == 1:
         return float(names["p"].values[0])
-    return getattr(scene, "p_physical", None)
+    return None
 
 
 def calibrated_overrides(fit: xr.Dataset, which: str = "all") -> dict[str, Any]:

@@ -55,6 +55,19 @@ class Scene:
     # a suite scene (``ground.records``): the records, their IMs and the scaling (the
     # grid's axes then hold ``record`` (file names), the stripe IM if scaled, and p)
     suite: Suite | None = field(default=None, repr=False)
+    # a body given by the laboratory's numbers (body.kind physical): its Pi groups, p
+    # [rad/s], omega_n [rad/s] and h_cg [m] (``physics.model.body_from_geometry``), else None
+    physical: dict | None = field(default=None, repr=False)
+
+    def physical_words(self) -> str:
+        """One line stating what a physical body became ('' for a body of Pi groups)."""
+        if self.physical is None:
+            return ""
+        d = self.physical
+        return ("body (kind physical): " + ", ".join(
+            f"{k} = {d[k]:.5g}" for k in ("wn_over_p", "zeta", "alpha_cg", "alpha_A",
+                                          "mA_over_m", "IA_ratio"))
+                + f", p = {d['p']:.5g} rad/s, h_cg = {d['h_cg']:.4g} m")
 
     def variables(self) -> dict[str, tuple[str, float, str]]:
         """The per-point variables a sweep of this scene stores, name -> (dtype, fill value

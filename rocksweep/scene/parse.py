@@ -26,6 +26,7 @@ import numpy as np
 
 from rocksweep.numerics import Numerics
 from rocksweep.outputs import input_problem, shown
+from rocksweep.physics.model import BodyError, body_from_geometry
 from rocksweep.physics.points import FREE, INITIAL, RECORD
 from rocksweep.physics.records import GroundRecord, RecordError, read_record
 from rocksweep.physics.suite import DEFAULT_PERIODS, SCALE_IMS, Suite, SuiteError, make_suite
@@ -142,7 +143,8 @@ def _section(raw: dict, name: str, kind: str, required: bool) -> dict:
         spec = KEYS[f"{name}.{k}"]
         if spec.required and sec.get(k) is None:
             hint = {"axis": "a number, a list of numbers or a range {start, stop, num}",
-                    "choices": spec.allowed.removeprefix("must be ")}.get(spec.kind, "")
+                    "choices": spec.allowed.removeprefix("must be ")}.get(
+                        spec.kind, spec.allowed.removeprefix("must be "))
             raise SceneError(f"{name}.{k}: missing required key ({hint})")
     return sec
 
@@ -551,6 +553,16 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
 
     body = _section(raw, "body", "flexible", required=True)
     kind = body.get("kind", "flexible")
+    physical = None
+    if kind == "physical":  # the laboratory's numbers -> the Pi groups and p
+        try:
+            physical = body_from_geometry(**{k: body.get(k, KEYS[f"body.{k}"].default)
+                                             for k in BODY_KEYS["physical"]})
+        except BodyError as err:
+            raise SceneError(str(err)) from None
+        body = {**{k: physical[k] for k in BODY_KEYS["flexible"]},
+                **({"mu": body["mu"]} if body.get("mu") is not None else {})}
+        kind = "flexible"
     impact = _section(raw, "impact", kind, required=kind == "flexible")
     if raw.get("ground") is not None and raw.get("pulse") is not None:
         raise SceneError("pulse, ground: give one of them (a pulse, or a recorded ground "
@@ -667,7 +679,7 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     scene = Scene(name=name or "rocksweep scene", kind=kind, axes=tuple(axes),
                   numerics=numerics, single_numerics=single, energy=energy, text=text,
                   contact=contact, check=check, record=record, refine=_refine(raw, kind),
-                  suite=suite)
+                  suite=suite, physical=physical)
     if scene.contact and scene.ground:
         # the contact outputs are compiled into the sine/cosine variants only (a kernel
         # variant per combination costs compile time no scene has asked for yet)
