@@ -13,7 +13,11 @@ The Python API (see the README's "Python API"):
   rtol=)`` -> Dataset of A_min; ``rocksweep.boundary_lines(ds)`` -> DataFrame;
   ``rocksweep.spectra(ds)`` -> Dataset; ``rocksweep.estimate(scene)``: the cost of a run;
   ``rocksweep.fragility(ds, state=, bootstrap=)`` -> Dataset of lognormal fragility
-  curves of a record-suite sweep.
+  curves of a record-suite sweep; ``rocksweep.risk(fr, hazard, years=50)`` -> Dataset of
+  the annual rate and probability of each state over a hazard curve;
+  ``rocksweep.im_efficiency(ds)`` -> Dataset of the dispersion of a suite's fragility in
+  every IM (which IM explains overturning best); ``rocksweep.table(ds)`` -> DataFrame, one
+  row per run.
   Each analysis takes what ``run`` and ``open`` return.
 - ``rocksweep.calibrate(scene, measured, fit=["impact.lam"], bounds=)`` -> Dataset of the
   fitted keys (estimate, lo, hi, misfit) of a measured history;
@@ -34,11 +38,14 @@ from rocksweep.api import (  # noqa: A004
     estimate,
     fragility,
     ida,
+    im_efficiency,
     open,
     plot,
+    risk,
     run,
     simulate,
     spectra,
+    table,
 )
 from rocksweep.errors import RocksweepError
 
@@ -71,5 +78,5 @@ def __getattr__(name: str) -> str:
 
 
 __all__ = ["RocksweepError", "__version__", "boundaries", "boundary_lines", "calibrate",
-           "calibrated_overrides", "estimate",
-           "fragility", "ida", "open", "plot", "run", "simulate", "spectra"]
+           "calibrated_overrides", "estimate", "fragility", "ida", "im_efficiency", "open",
+           "plot", "risk", "run", "simulate", "spectra", "table"]

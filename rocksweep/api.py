@@ -273,6 +273,7 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
                       scheduler=scheduler, chunk_size=chunk_size, where=where,
                       write_every=write_every, progress=progress, say=say) or report_of
     path = Path(path)
+    inputs = [*inputs, *scene.inputs]  # the scene's records and listings: never written over
     try:
         path.stat()
     except FileNotFoundError:
@@ -363,6 +364,10 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
     where = {"backend": "threads"}
     if client is not None:
         address = getattr(getattr(client, "scheduler", None), "address", None)
+        if type(client).__name__ == "Client" and getattr(client, "status", None) in (
+                "closed", "closing"):
+            raise ApiError(f"client = {client!r}: this dask Client is closed; make a new one "
+                           "(Client(cluster) or Client('tcp://host:8786')) and pass it")
         if not isinstance(address, str):
             raise TypeError(f"client = {client!r}: must be a dask.distributed.Client")
         where = {"backend": "dask", "scheduler": address}
@@ -443,8 +448,24 @@ def _dataset(source: Path | Any) -> xr.Dataset:
     register_accessor()  # ds.rocksweep.plot() etc.
     kwds = {"driver_kwds": {"locking": False}} if isinstance(source, Path) else {}
     try:
-        with xr.open_dataset(source, engine="h5netcdf", **kwds) as ds:
-            ds = ds.load()
+        try:
+            with xr.open_dataset(source, engine="h5netcdf", **kwds) as ds:
+                ds = ds.load()
+        except OSError as err:  # open here through another handle: take its lock flags
+            from rocksweep.store.reader import READER_LOCKING, _open_here
+
+            if not (kwds and _open_here(err)):
+                raise
+            for locking in READER_LOCKING:
+                try:
+                    with xr.open_dataset(source, engine="h5netcdf",
+                                         driver_kwds={"locking": locking}) as ds:
+                        ds = ds.load()
+                    break
+                except OSError:
+                    continue
+            else:
+                raise
     except (ValueError, TypeError, KeyError, OSError, OverflowError, AttributeError,
             IndexError) as err:  # xarray's CF decoding of a damaged attribute
         from rocksweep.outputs import shown
@@ -466,7 +487,8 @@ def _dataset(source: Path | Any) -> xr.Dataset:
     if "status" in ds:
         ds["status"].attrs.setdefault("flag_masks", list(STATUS_WORDS))
         ds["status"].attrs.setdefault("flag_meanings", " ".join(STATUS_WORDS.values()))
-    ds.attrs = {k: (v.item() if hasattr(v, "item") else v) for k, v in ds.attrs.items()}
+    ds.attrs = {k: (v.item() if hasattr(v, "item") and getattr(v, "size", 1) == 1 else v)
+                for k, v in ds.attrs.items()}
     return ds
 
 
@@ -479,7 +501,12 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
          curves: bool = False, show_computed: bool = False, mu: bool = False,
          width: str | None = None, compare: str | None = None,
          _names: tuple[str, ...] = ("x", "y", "compare")) -> Figure:
-    """The stability diagram of a result (Figures 3 and 4) as a pyplot-free Figure.
+    """The figure of any rocksweep Dataset, pyplot-free: a sweep's stability diagram
+    (Figures 3 and 4; the options below), or the figure of a fragility (curves, stripe
+    fractions sized by record count, bands, beta in the legend, IM on a log axis), IDA,
+    spectra, risk (hazard, fragility, the rate's integrand) or IM-efficiency Dataset
+    (``rocksweep.figures.dispatch``; ``ax`` and ``width`` apply to all). A record-suite
+    sweep is drawn as its overturning fragility (stripe fractions and the fitted curve).
 
     ds: what ``run`` or ``open`` returns. x, y: the swept keys on the axes (default
     w_over_p and A_ratio, or the two swept keys besides lam); one panel per value of the
@@ -496,10 +523,26 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     """
     import matplotlib
 
-    from rocksweep.figures.common import width_style
+    from rocksweep.analysis.kinds import dataset_kind
+    from rocksweep.figures.common import fit_width, width_style
     from rocksweep.figures.diagrams import friction_map, sweep_figure
     from rocksweep.store.reader import as_result
 
+    kind = dataset_kind(ds)
+    if kind == "sweep" and "record" in ds["outcome"].dims:
+        # a record suite has no stability diagram: its overturning fragility (no bootstrap;
+        # rocksweep.fragility for other states and bands)
+        from rocksweep.analysis.fragility import fragility as fit
+
+        ds, kind = fit(ds, state="overturn", bootstrap=0), "fragility"
+    if kind not in (None, "sweep"):  # an analysis's Dataset: the figure of its kind
+        from rocksweep.figures.dispatch import plot_analysis
+
+        with matplotlib.rc_context(width_style(width)):
+            fig = plot_analysis(ds, ax=ax, width=width)
+        if width is not None and ax is None:
+            fit_width(fig, width)
+        return fig
     result = as_result(ds)
     style = width_style(width)
     with matplotlib.rc_context(style):
@@ -509,10 +552,8 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
             fig = sweep_figure(result, x, y, axes=ax, option_names=_names[:2], curves=curves,
                                show_computed=show_computed, compare=compare,
                                compare_option=_names[2])
-    if style and ax is None:  # the preset's width, the layout's aspect
-        w, h = fig.get_size_inches()
-        inches = style["figure.figsize"][0]
-        fig.set_size_inches(inches, h * inches / w)
+    if style and ax is None:  # the preset's width, the layout's aspect, what fits in it
+        fit_width(fig, width)
     return fig
 
 
@@ -581,28 +622,33 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
 
 @speaks_python
 def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
-              im: str | None = None, period: float | None = None, bootstrap: int = 200,
-              seed: int = 0, ci: float = 0.9) -> xr.Dataset:
-    """Lognormal fragility curves P(state | IM = x) = Phi(ln(x / median) / beta) of a
+              im: str | None = None, period: float | None = None,
+              bootstrap: int | None = None, seed: int = 0, ci: float = 0.9) -> xr.Dataset:
+    """Lognormal fragility curves P(state | IM = x) = Phi(ln(x / im_median) / beta) of a
     record-suite sweep (a scene with ``ground.records``), fitted by maximum likelihood
     (Baker 2015): to the counts at each stripe of a scaled suite ("stripes-mle"), or to
     the (IM, 0/1) pairs of an unscaled one ("cloud-mle", im= "PGA" (default), "PGV" or
     "Sa" with period= [s] from the stored periods).
 
-    ds: what ``run`` or ``open`` returns. state: "overturn" (either mode), "mode1",
-    "mode2", "uplift", "theta:X" (max|theta|/alpha_cg >= X, or overturned), or a list of
-    them (a ``state`` dimension). bootstrap: resamples over records for the intervals
-    and bands (0: none, NaN); seed: their generator's seed; ci: the interval's level.
-    Points flagged undecided (horizon, step or event caps, non-finite) are left out and
-    counted (``n_excluded``). One curve per value of every other swept key (lam, p, body
-    keys).
+    ds: what ``run`` or ``open`` returns (or a result file's path). state: "overturn"
+    (either mode), "mode1", "mode2", "uplift", "theta:X" (max|theta|/alpha_cg >= X, or
+    overturned, 0 < X <= 1), or a list of them (a ``state`` dimension): two or more of
+    uplift/theta:X/overturn are ordered damage states fitted with one beta (the curves
+    never cross), mode1 with mode2 a competing-risk fit (their curves and "safe" sum to
+    one). bootstrap: resamples over records for the intervals and bands (0: none, NaN;
+    None: ``rocksweep.analysis.resampling.DEFAULT_BOOTSTRAP``, 200); seed: their
+    generator's seed; ci: the interval's level. Points flagged undecided (horizon, step
+    or event caps, non-finite) are left out and counted (``n_excluded``). One curve per
+    value of every other swept key (lam, p, body keys).
 
-    Returns a Dataset (``rocksweep.analysis.fragility.fragility``): ``median`` [IM
-    units], ``beta``, their bootstrap intervals ``median_lo``/``median_hi``,
-    ``beta_lo``/``beta_hi``, ``n_records``, ``n_excluded``, ``reason``, the bands
-    ``band_lo``/``band_hi`` over ``im_grid``, and for stripes the empirical ``fraction``
-    per stripe and, per record, ``first_level`` (the smallest stripe that reaches the
-    state: an IDA on the stripes) and ``resurrection`` (a higher stripe is safe again).
+    Returns a Dataset (``rocksweep.analysis.fragility.fragility``): ``im_median`` [IM
+    units], ``beta``, their bootstrap intervals ``im_median_lo``/``im_median_hi``,
+    ``beta_lo``/``beta_hi``, the resamples' fits ``im_median_samples``/``beta_samples``
+    over ``sample``, ``reason`` ("ok" or why the curve should not be trusted as it is:
+    also a ``FragilityWarning``), ``n_records``, ``n_excluded``, ``n_not_run``, the fitted
+    ``curve`` and the bands ``band_lo``/``band_hi`` over ``im_grid``, and for stripes the
+    empirical ``fraction`` per stripe and, per record, ``first_level`` and
+    ``resurrection``.
     """
     import xarray as xr
 
@@ -613,13 +659,107 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     if not isinstance(ds, xr.Dataset):
         raise ApiError(f"ds = {type(ds).__name__}: must be a result Dataset (rocksweep.run "
                        "or rocksweep.open)")
-    if isinstance(bootstrap, bool) or not isinstance(bootstrap, int) or bootstrap < 0:
-        raise ApiError(f"bootstrap = {bootstrap!r}: must be an integer >= 0")
-    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-        raise ApiError(f"seed = {seed!r}: must be an integer >= 0")
     frag = fit(ds, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci)
     frag.attrs["title"] = str(ds.attrs.get("title", ""))
     return frag
+
+
+def open_any(path: str | Path) -> xr.Dataset:
+    """Any rocksweep Dataset from a file: a sweep result (``open``) or what an analysis
+    wrote with ``-o .h5`` (fragility, risk, IM efficiency: netCDF-4), its JSON attributes
+    (lists) decoded. Any other file gets ``open``'s one-line errors."""
+    import json
+    from types import SimpleNamespace
+
+    import xarray as xr
+
+    from rocksweep.analysis.kinds import dataset_kind
+    from rocksweep.outputs import input_problem, shown
+
+    path = Path(path)
+    kind = None
+    if input_problem(path) is None:
+        try:
+            import h5py
+
+            with h5py.File(path, "r") as f:
+                kind = dataset_kind(SimpleNamespace(
+                    variables=list(f.keys()), attrs={k: v for k, v in f.attrs.items()
+                                                     if k == "rocksweep_kind"}))
+        except OSError:
+            kind = None
+    if kind in (None, "sweep"):
+        return open(path)  # a sweep, or open's one-line error for anything else
+    try:
+        with xr.open_dataset(path, engine="h5netcdf", phony_dims="sort") as ds:
+            ds = ds.load()
+    except (ValueError, TypeError, KeyError, OSError) as err:
+        raise ApiError(f"{shown(path)}: cannot be read as a {kind} Dataset ({err})") from None
+    for k, v in list(ds.attrs.items()):
+        if isinstance(v, str) and v[:1] in "[{":
+            try:
+                ds.attrs[k] = json.loads(v)
+            except ValueError:
+                pass
+        elif hasattr(v, "item") and getattr(v, "size", 2) == 1:
+            ds.attrs[k] = v.item()
+    register_accessor()
+    return ds
+
+
+def _as_dataset(ds: Any, what: str) -> xr.Dataset:
+    """A Dataset argument, or a path to one (``open_any``)."""
+    import xarray as xr
+
+    if isinstance(ds, str | Path):
+        return open_any(ds)
+    if not isinstance(ds, xr.Dataset):
+        raise ApiError(f"{what} = {type(ds).__name__}: must be an xarray Dataset "
+                       "(rocksweep.run, rocksweep.open or an analysis) or a path to one")
+    return ds
+
+
+@speaks_python
+def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = None
+         ) -> xr.Dataset:
+    """Mean annual rate and probability in ``years`` of each state of a fragility:
+    lambda = integral P(state | im) |d lambda_im| over the hazard curve, 1 - exp(-lambda N)
+    (``rocksweep.analysis.risk``). fr: what ``rocksweep.fragility`` returns (or its file);
+    hazard: a CSV path (``PGA [g],annual_rate``, or OpenQuake's hazard-curve CSV, ``site``
+    its row) or a DataFrame of those two columns. Returns a Dataset: ``annual_rate``,
+    ``probability`` per state and lam, their ``_lo``/``_hi`` from the fragility's
+    bootstrap resamples, ``annual_rate_max`` (the tail above the hazard at its largest),
+    ``reason``; beyond the hazard's range the rate is bounded, never extrapolated."""
+    from rocksweep.analysis.risk import risk as compute
+
+    return compute(_as_dataset(fr, "fr"), hazard, years, site=site)
+
+
+@speaks_python
+def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
+    """Which IM explains ``state`` best: for every IM of a record-suite sweep's records
+    (PGA, PGV, Sa(T), AvgSa, Arias, CAV, D5-95, PGV/PGA, PGA/(g tan alpha), PGV p/(g tan
+    alpha)) the lognormal dispersion ``beta`` of the fragility in that IM (each record's
+    first overturning level, an interval between stripes, re-expressed in the IM; a
+    regression for the IMs scaling leaves unchanged) and ``beta_scale`` (comparable across
+    IMs; lower is better), per value of the other swept keys
+    (``rocksweep.analysis.efficiency``)."""
+    from rocksweep.analysis.efficiency import im_efficiency as compute
+
+    return compute(_as_dataset(ds, "ds"), state=state)
+
+
+@speaks_python
+def table(ds: xr.Dataset) -> Any:
+    """A tidy ``pandas.DataFrame`` of any rocksweep Dataset (or its file): one row per run
+    of a sweep with its coordinates, unswept scene values, result fields, record, the
+    record's IMs as recorded (``record_*``) and as the run saw them (times
+    scale_factor^n: ``pga``, ``pgv``, ``arias``, ...); one row per curve of an analysis.
+    No row is repeated (``ds.to_dataframe()`` repeats a suite's runs per Sa period).
+    ``.attrs["units"]`` gives each column's units (``rocksweep.analysis.table``)."""
+    from rocksweep.analysis.table import table as make
+
+    return make(_as_dataset(ds, "ds"))
 
 
 @speaks_python
@@ -867,6 +1007,18 @@ class RocksweepAccessor:
     def ida(self, **kwargs: Any) -> Any:
         """``rocksweep.ida(ds, ...)``: the first overturning level of each record."""
         return ida(self._ds, **kwargs)
+
+    def risk(self, hazard: Any, years: float = 50, **kwargs: Any) -> Any:
+        """``rocksweep.risk(ds, hazard, years)``: annual rate and probability per state."""
+        return risk(self._ds, hazard, years, **kwargs)
+
+    def im_efficiency(self, **kwargs: Any) -> Any:
+        """``rocksweep.im_efficiency(ds, ...)``: beta of the fragility in every IM."""
+        return im_efficiency(self._ds, **kwargs)
+
+    def table(self) -> Any:
+        """``rocksweep.table(ds)``: one row per run (a DataFrame)."""
+        return table(self._ds)
 
     def as_overrides(self, which: str = "all") -> dict[str, Any]:
         """``rocksweep.calibrated_overrides(ds, which)`` of a calibration Dataset."""

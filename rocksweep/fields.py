@@ -26,6 +26,7 @@ import numpy as np
 
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.model import G
+from rocksweep.vocab.axes import AXES, AxisMeta  # noqa: F401
 
 
 @dataclass(frozen=True)
@@ -104,7 +105,9 @@ FIELDS: tuple[Field, ...] = (
           L.OUT_T_END, stored=False),
     Field("t_first_impact", "float64", math.nan, "1/p", "first impact time p*t (NaN if none)",
           L.OUT_T_FIRST_IMPACT, stored=False),
-    Field("e_max", "float64", math.nan, "1", "largest coefficient of restitution seen (eq. 1)",
+    Field("e_max", "float64", math.nan, "1",
+          "largest coefficient of restitution seen (of the point's impact law, impact.law: "
+          "eq. (1) for vertical; times impact.e_factor)",
           L.OUT_E_MAX, stored=False),
     Field("returns_to_contact", "int64", -1, "1",
           "returns to full contact (e <= 0, or settling below the rest rate)", L.OUT_CONTACTS,
@@ -242,52 +245,9 @@ def value(out: np.ndarray, f: Field, alpha_ref: float, E_ref: float) -> int | fl
 # Axes: the swept keys' names, units and the paper's symbols
 # ---------------------------------------------------------------------------------------
 
-@dataclass(frozen=True)
-class AxisMeta:
-    """A swept key as users see it: long_name (short, no units), CF units ("1": a pure
-    number), the paper's symbol (plain text; ``alpha_ref`` is alpha_cg for a flexible
-    body and alpha for a block) and its LaTeX form for figures."""
+# (``AxisMeta`` and ``AXES``, the one table of axis names, units and symbols, live in
+# ``rocksweep.vocab.axes``; re-exported here for the readers of fields)
 
-    long_name: str
-    units: str
-    symbol: str
-    latex: str
-
-
-AXES: dict[str, AxisMeta] = {
-    "shape": AxisMeta("pulse shape", "", "shape", "pulse"),
-    "w_over_p": AxisMeta("pulse frequency ratio (Pi5)", "1", "omega/p", r"\omega/p"),
-    "A_ratio": AxisMeta("pulse amplitude ratio (Pi6)", "1", "A/(g tan alpha_ref)",
-                        r"A/(g\tan\alpha_{ref})"),
-    "p": AxisMeta("frequency parameter of the body", "rad/s", "p", "p"),
-    "lam": AxisMeta("impulse position ratio (Pi10)", "1", "lambda", r"\lambda"),
-    "law": AxisMeta("impact law", "", "law", "impact law"),
-    "e": AxisMeta("coefficient of restitution of law constant", "1", "e", "e"),
-    "e_factor": AxisMeta("factor on the impact law's e", "1", "e_factor", r"e\ factor"),
-    "wn_over_p": AxisMeta("spring frequency ratio (Pi1)", "1", "omega_n/p", r"\omega_n/p"),
-    "zeta": AxisMeta("damping ratio (Pi2)", "1", "zeta", r"\zeta"),
-    "alpha_cg": AxisMeta("slenderness of the centre of gravity (Pi3)", "rad", "alpha_cg",
-                         r"\alpha_{cg}"),
-    "alpha_A": AxisMeta("slenderness of the base mass (Pi4)", "rad", "alpha_A",
-                        r"\alpha_A"),
-    "mA_over_m": AxisMeta("base to top mass ratio (Pi8)", "1", "m_A/m", "m_A/m"),
-    "IA_ratio": AxisMeta("base inertia ratio (Pi9)", "1", "I_A/(m_A R_A^2)",
-                         r"I_A/(m_A R_A^2)"),
-    "alpha": AxisMeta("slenderness of the block", "rad", "alpha", r"\alpha"),
-    "inertia": AxisMeta("inertia ratio of the block", "1", "I_O/(M R^2)", r"I_O/(M R^2)"),
-    # a record suite (ground.records): the records, the stripe IMs (ground.scale.im; each
-    # record scaled so that its IM equals the stripe's value) and Sa's periods
-    "record": AxisMeta("ground-motion record (file name)", "", "record", "record"),
-    "PGA": AxisMeta("peak ground acceleration of the scaled record", "g", "PGA", "PGA"),
-    "PGV": AxisMeta("peak ground velocity of the scaled record", "m/s", "PGV", "PGV"),
-    "Sa": AxisMeta("spectral acceleration of the scaled record (5% damping)", "g", "Sa(T)",
-                   r"S_a(T)"),
-    "PGA_ratio": AxisMeta("PGA of the scaled record over g tan(alpha_ref)", "1",
-                          "PGA/(g tan alpha_ref)", r"PGA/(g\tan\alpha_{ref})"),
-    "PGV_ratio": AxisMeta("PGV p of the scaled record over g tan(alpha_ref)", "1",
-                          "PGV p/(g tan alpha_ref)", r"PGV\,p/(g\tan\alpha_{ref})"),
-    "period": AxisMeta("period of the oscillator of Sa (5% damping)", "s", "T", "T"),
-}
 
 # Per-record variables of a suite's result (along ``record``; ``record_sa`` along
 # (record, period); ``scale_factor`` along (record, stripe) and what the factor depends
@@ -302,6 +262,22 @@ RECORD_VARIABLES: dict[str, tuple[str, str | None, str]] = {
                   "pseudo-spectral acceleration at 5% damping, exact recurrence for the "
                   "piecewise-linear record (Nigam & Jennings 1969), free vibration after "
                   "the record included"),
+    "record_arias": ("Arias intensity of the record as recorded", "m/s",
+                     "pi/(2g) integral of a^2 dt, exact for the piecewise-linear record"),
+    "record_cav": ("cumulative absolute velocity of the record as recorded", "m/s",
+                   "integral of |a| dt, exact for the piecewise-linear record"),
+    "record_d5_95": ("significant duration D5-95 of the record", "s",
+                     "time between 5% and 95% of the Arias intensity (Trifunac & Brady "
+                     "1975); unchanged by scaling"),
+    "record_pgv_over_pga": ("PGV/PGA of the record", "s",
+                            "PGV / (PGA g): a pulse-period proxy; unchanged by scaling"),
+    "record_avgsa": ("average spectral acceleration of the record as recorded", "g",
+                     "geometric mean of Sa (5% damping) at 10 periods evenly spaced in ln T "
+                     "over the attribute avgsa_periods [s] (ground.avgsa; default 0.2-3 x "
+                     "the scale period, or 0.2-3 x 2 pi/p)"),
+    "record_v_end": ("ground velocity at the end of the record", "m/s",
+                     "the trapezoidal integral of the record as given at its last sample; far "
+                     "from 0: the record drifts (not baseline-corrected)"),
     "record_npts": ("number of samples of the record", "1", "NPTS"),
     "record_dt": ("sample interval of the record", "s", "DT"),
     "record_duration": ("duration of the record", "s", "(NPTS - 1) DT"),

@@ -73,8 +73,8 @@ MIN_EVENT_TOL = 1e-12
 EVENT_STEP_ALLOWANCE = 200.0
 
 # Cap on one point's step budget (``step_budget``, PAR_MAXSTEPS) that a scene may imply.
-# At the kernel's ~100-200 ns per RK4 evaluation (docs/performance.md, measured by
-# scripts/bench_kernel.py) a point that runs to 1e8 takes 10-20 s of one core: the
+# At the kernel's ~75-120 ns per RK4 evaluation (docs/performance.md, measured by
+# scripts/bench_kernel.py) a point that runs to 1e8 takes 8-12 s of one core: the
 # longest a single point may take before the
 # values are taken for a mistake (w_over_p = 1e-9, a pulse of 6e9 p*t; wn_over_p = 1e5 at
 # steps of 1e-5). The shipped scenes need at most 1.5e6 (fig4b at `fine`), of which the

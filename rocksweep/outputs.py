@@ -1,15 +1,19 @@
 """Output files: one policy for every command that writes one (no I/O libraries here).
 
 - An existing path is refused unless the user said ``overwrite`` (``--overwrite``).
-- A path that is a command's own input (the scene, the result being plotted) is refused
-  even with ``overwrite``.
+- A path that is a command's own input is refused even with ``overwrite``: every file the
+  command reads (the scene, its records and record listings, the result being plotted,
+  a hazard or measured CSV), compared by the file's identity (device and inode: a
+  symbolic or hard link, ``..`` or another spelling of an input is that input;
+  ``is_input``). A scene lists what it read (``Scene.inputs``).
 - Only regular files are written: a directory, a device (``/dev/null``, ``/dev/full``), a
   FIFO or a socket is refused even with ``overwrite``.
 - The directory must exist and be writable, and the name must fit the file system.
 - Files appear atomically: they are written under a temporary name unique to the process
   (``tempfile.mkstemp`` in the target's directory) and renamed over the target when
-  complete, so an output is either complete or absent, and two processes writing the same
-  path never share a temporary file.
+  complete (``publish``, the one rename of every output, result files included), so an
+  output is either complete or absent, and two processes writing the same path never
+  share a temporary file. A new file gets the mode the umask gives (``new_file_mode``).
 
 Every refusal is an ``OutputError`` (a ``RocksweepError``) with one line naming the path
 and the reason.
@@ -33,16 +37,31 @@ def _reason(err: OSError) -> str:
         return "no space left on the device"
     if err.errno == errno.ENAMETOOLONG:
         return "file name too long"
+    if err.errno == errno.ELOOP:
+        return "a loop of symbolic links"
     if err.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
         return "permission denied (read-only location?)"
     return err.strerror or type(err).__name__
 
 
-def _same(a: str | Path, b: str | Path) -> bool:
+def _identity(path: str | Path) -> tuple[int, int] | None:
+    """(device, inode) of the file ``path`` names, links followed; None when there is
+    none (missing, a dangling link or a loop of links, a name no file can have)."""
     try:
-        return os.path.samefile(a, b)
-    except OSError:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    return st.st_dev, st.st_ino
+
+
+def is_input(path: str | Path, inputs: Iterable[str | Path | None]) -> bool:
+    """Whether ``path`` is one of the files ``inputs`` (None entries skipped): the same
+    file, whatever the spelling (a symbolic or hard link, ``..``, relative or absolute),
+    by device and inode."""
+    own = _identity(path)
+    if own is None:
         return False
+    return any(inp is not None and _identity(inp) == own for inp in inputs)
 
 
 def shown(path: str | Path) -> str:
@@ -129,8 +148,9 @@ def check_output(path: str | Path, *, overwrite: bool = False,
         if not stat.S_ISREG(st.st_mode):
             raise OutputError(f"{shown(path)}: not a regular file (a device, FIFO or socket); "
                               "outputs are written to regular files only")
-        if any(_same(path, inp) for inp in inputs):
-            raise OutputError(f"{shown(path)}: is this command's input; choose another output path")
+        if is_input(path, inputs):
+            raise OutputError(f"{shown(path)}: is this command's input; choose another "
+                              "output path")
         if not overwrite:
             raise OutputError(f"{shown(path)}: already exists; use --overwrite to replace it")
     parent = path.parent if str(path.parent) else Path(".")
@@ -149,10 +169,58 @@ def check_output(path: str | Path, *, overwrite: bool = False,
     return path
 
 
-def _umask() -> int:
-    mask = os.umask(0o022)  # read it (the only way), then put it back
+def new_file_mode() -> int:
+    """The mode a new file gets under this process's umask (mkstemp makes files 0600):
+    read from /proc (threads may be running: ``os.umask`` would set it to read it)."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return 0o666 & ~int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)  # no /proc: read it the only other way, then put it back
     os.umask(mask)
-    return mask
+    return 0o666 & ~mask
+
+
+def publish(tmp: Path, path: Path, *, replace: bool = True, old_fd: int | None = None) -> None:
+    """Rename the finished temporary file ``tmp`` to ``path`` with a new file's mode: the
+    one rename of every output. replace: over whatever is at ``path`` (its checks were
+    made, ``check_output``); else over the file held open by ``old_fd`` only if it is
+    still the one at ``path``, or, without ``old_fd``, only if nothing is at ``path``
+    (another process may have made it since it was checked: a hard link, which fails
+    then). OutputError when another process got there first."""
+    os.chmod(tmp, new_file_mode())
+    if replace:
+        os.replace(tmp, path)
+        return
+    if old_fd is not None:
+        try:
+            same = os.path.samestat(os.fstat(old_fd), os.stat(path))
+        except OSError:
+            same = False
+        if not same:
+            raise OutputError(f"{shown(path)}: replaced by another process meanwhile; not "
+                              "overwritten")
+        os.replace(tmp, path)
+        return
+    try:
+        os.link(tmp, path)
+    except FileExistsError:
+        raise OutputError(f"{shown(path)}: made by another process meanwhile (a sweep "
+                          "started at the same time?); not overwritten") from None
+    except OSError as err:
+        if err.errno not in (errno.EPERM, errno.ENOTSUP, errno.EOPNOTSUPP, errno.EXDEV,
+                             errno.EMLINK):
+            raise
+        if os.path.lexists(path):  # no hard links here: check, then rename
+            raise OutputError(f"{shown(path)}: made by another process meanwhile; not "
+                              "overwritten") from None
+        os.replace(tmp, path)
+        return
+    with contextlib.suppress(OSError):
+        os.unlink(tmp)
 
 
 @contextlib.contextmanager
@@ -169,14 +237,12 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         fd, name = tempfile.mkstemp(prefix=f".{path.stem[:40]}.", suffix=f".partial{path.suffix}",
                                     dir=parent)
         os.close(fd)
-        # mkstemp makes the file 0600; an output gets the mode any new file would get
-        os.chmod(name, 0o666 & ~_umask())
     except OSError as err:
         raise OutputError(f"{shown(path)}: cannot be written ({_reason(err)})") from None
     tmp = Path(name)
     try:
         yield tmp
-        os.replace(tmp, path)
+        publish(tmp, path)
     except OutputError:
         raise
     except OSError as err:

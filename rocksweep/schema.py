@@ -26,6 +26,8 @@ from typing import Any
 import numpy as np
 
 from rocksweep.numerics import MIN_EVENT_TOL, PRESETS, ROOTS
+from rocksweep.vocab.ground import SCALE_IMS, SHAPES
+from rocksweep.vocab.laws import DEFAULT_LAW, LAWS
 
 RATIO_MAX = 1e6  # bound of the body's ratios (see the module docstring)
 ANGLE_MIN = 1e-6  # [rad] smallest slenderness: h/b = 1e6
@@ -62,6 +64,12 @@ class Key:
 _AXIS = "a number, a list of numbers or a range {start, stop, num}"
 _RATIO = f"[1e-06, {RATIO_MAX:g}]"
 _ANGLE = f"must be in [{ANGLE_MIN:g}, pi/2) rad"
+
+
+def _one_of(words: tuple[str, ...]) -> str:
+    """"a, b, c" of a word list (the choices of a key)."""
+    return ", ".join(words)
+
 
 KEYS: dict[str, Key] = {
     "name": Key("string", "must be a string (the scene's title)", required=False),
@@ -103,15 +111,14 @@ KEYS: dict[str, Key] = {
                   hi_in=False, required=False, default=0.0),
     "impact.lam": Key("axis", "must be in [0, 2]", 0.0, 2.0),
     # impact laws (rocksweep.physics.impact): the law is a swept word axis like pulse.shape
-    "impact.law": Key("choices", "must be vertical, locked, constant or a list of them",
-                      choices=("vertical", "locked", "constant"), required=False,
-                      default="vertical"),
+    "impact.law": Key("choices", f"must be {_one_of(LAWS)} or a list of them",
+                      choices=LAWS, required=False, default=DEFAULT_LAW),
     "impact.e": Key("axis", "must be in (0, 1] (the coefficient of restitution of law "
                     "constant)", 0.0, 1.0, lo_in=False, required=False),
     "impact.e_factor": Key("axis", f"must be in (0, {E_FACTOR_MAX:g}] (multiplies the law's "
                            "e)", 0.0, E_FACTOR_MAX, lo_in=False, required=False, default=1.0),
-    "pulse.shape": Key("choices", "must be sine, cosine, ricker, mp or a list of them",
-                       choices=("sine", "cosine", "ricker", "mp")),
+    "pulse.shape": Key("choices", f"must be {_one_of(SHAPES)} or a list of them",
+                       choices=SHAPES),
     "pulse.w_over_p": Key("axis", "must be > 0 and finite (the pulse lasts 2 pi/omega)",
                           0.0, math.inf, lo_in=False, hi_in=False),
     "pulse.A_ratio": Key("axis",
@@ -184,13 +191,14 @@ KEYS: dict[str, Key] = {
                           "suite/*.AT2, or a text file listing one path a line (relative to "
                           "the scene file)", required=False),
     "ground.scale": Key("string", "must be none, {factor: F} (the records as recorded, times "
-                        "F) or {im: PGA|PGV|Sa|PGA_ratio|PGV_ratio, values: a number, a list "
+                        "F) or {im: " + "|".join(SCALE_IMS) + ", values: a number, a list "
                         "or a range {start, stop, num}, period: T [s] for Sa}",
                         required=False, default="none"),
-    "ground.scale.im": Key("choice", "must be one of PGA, PGV, Sa, PGA_ratio, PGV_ratio",
-                           choices=("PGA", "PGV", "Sa", "PGA_ratio", "PGV_ratio")),
+    "ground.scale.im": Key("choice", f"must be one of {', '.join(SCALE_IMS)}",
+                           choices=tuple(SCALE_IMS)),
     "ground.scale.values": Key("axis", "must be finite numbers > 0 (the stripes' IM values: "
-                               "PGA, Sa [g], PGV [m/s], PGA_ratio, PGV_ratio [-])",
+                               + ", ".join(f"{im} [{u if u != '1' else '-'}]"
+                                           for im, u in SCALE_IMS.items()) + ")",
                                0.0, math.inf, lo_in=False, hi_in=False),
     "ground.scale.period": Key("number", "must be in (0, 100] s (the period of Sa)", 0.0,
                                100.0, lo_in=False),
@@ -199,7 +207,7 @@ KEYS: dict[str, Key] = {
     "ground.periods": Key("string", "must be a list of periods in [0, 100] s (Sa stored per "
                           "record; 0 gives the PGA)", 0.0, 100.0, required=False,
                           default=(0.2, 1.0)),
-    # the state at t = 0 (rocksweep.physics.points.INITIAL; the names simulate --csv writes)
+    # the state at t = 0 (rocksweep.vocab.axes.INITIAL; the names simulate --csv writes)
     "initial.theta_over_alpha": Key(
         "axis", "must be a finite number (theta/alpha_cg at t = 0, |theta| < pi/2; > 0 "
         "rocking on one corner, < 0 on the other)", -math.inf, math.inf, lo_in=False,
@@ -213,6 +221,9 @@ KEYS: dict[str, Key] = {
     "initial.udot_over_pucr": Key(
         "axis", "must be a finite number (u'/(p u_cr) at t = 0)", -math.inf, math.inf,
         lo_in=False, hi_in=False, required=False, default=0.0),
+    "ground.avgsa": Key("string", "must be [T_lo, T_hi], periods in (0, 100] s with T_lo <= "
+                        "T_hi (AvgSa's range; default 0.2-3 x scale.period for Sa stripes, "
+                        "else 0.2-3 x 2 pi/p)", 0.0, 100.0, required=False),
     "ground.p": Key("axis", f"must be in [1e-3, {1e3:g}] rad/s (the body's frequency "
                     "parameter p)", 1e-3, 1e3),
 }

@@ -12,6 +12,9 @@ Runs the shipped commands, exactly as the README shows them:
   configs/fig2.yaml --plot`` (Figure 2);
 - ``rocksweep sweep configs/fragility-demo.yaml`` and ``rocksweep fragility --plot``: the
   overturning fragility of the Figure 3(a) body under the shipped record suite;
+- ``rocksweep efficiency``, ``rocksweep fragility --state theta:0.25,theta:0.5,overturn -o``
+  and ``rocksweep risk --hazard configs/hazard-example.csv --plot`` on that suite (``risk``:
+  docs/efficiency.png, docs/risk.png);
 - with ``--accuracy``: ``rocksweep accuracy configs/fig3a.yaml --points 200 --plot``.
 
 Everything is written to a temporary directory first and moved into docs/ when the
@@ -51,13 +54,13 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--dpi", type=int, default=200, help="resolution of the PNGs [200]")
     ap.add_argument("--only", nargs="+", metavar="NAME",
                     choices=[*DIAGRAMS, "fig3a_check", "fig5", "fig2", "fragility",
-                             "accuracy_fig3a", "impact_laws", "fig2_locked"],
+                             "accuracy_fig3a", "impact_laws", "fig2_locked", "risk"],
                     help="regenerate only these figures")
     ap.add_argument("--docs", type=Path, default=ROOT / "docs", help="output directory")
     ap.add_argument("--keep", type=Path, metavar="DIR", help="keep the sweep results here")
     args = ap.parse_args(argv)
     wanted = set(args.only or [*DIAGRAMS, "fig3a_check", "fig5", "fig2", "fragility",
-                               "impact_laws", "fig2_locked"]
+                               "impact_laws", "fig2_locked", "risk"]
                  + (["accuracy_fig3a"] if args.accuracy else []))
     args.docs.mkdir(parents=True, exist_ok=True)
     if args.keep:
@@ -107,6 +110,20 @@ def main(argv: list[str] | None = None) -> None:
                       str(args.dpi))
             publish("fragility")
             print(f"  fragility: {time.perf_counter() - t0:.1f} s", flush=True)
+        if "risk" in wanted:  # issue 29: IM efficiency and risk on the demo suite
+            h5 = (args.keep or tmp) / "fragility.h5"
+            if not h5.exists():
+                rocksweep("sweep", str(cfg / "fragility-demo.yaml"), "-o", str(h5),
+                          "--jobs", str(args.jobs), "--quiet", "--overwrite")
+            rocksweep("efficiency", str(h5), "--plot", str(tmp / "efficiency.png"), "--dpi",
+                      str(args.dpi))
+            curves = tmp / "curves.h5"
+            rocksweep("fragility", str(h5), "--state", "theta:0.25,theta:0.5,overturn", "-o",
+                      str(curves))
+            rocksweep("risk", str(curves), "--hazard", str(cfg / "hazard-example.csv"),
+                      "--plot", str(tmp / "risk.png"), "--dpi", str(args.dpi))
+            publish("efficiency")
+            publish("risk")
         if "impact_laws" in wanted:  # issue 21: which laws overturn each cell
             h5 = (args.keep or tmp) / "impact_laws.h5"
             rocksweep("sweep", str(cfg / "impact-laws.yaml"), "-o", str(h5), "--jobs",

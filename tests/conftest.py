@@ -48,3 +48,28 @@ def device_node(tmp_path):
         return path
 
     return make
+
+
+@pytest.fixture(scope="session")
+def suite_result(tmp_path_factory):
+    """A small finished record-suite sweep (issue 29's analyses): 6 records of
+    records/suite x 6 PGA stripes x 2 lam, written to a result file."""
+    import warnings
+    from pathlib import Path
+
+    import rocksweep
+
+    root = Path(__file__).resolve().parents[1]
+    scene = {"name": "small suite",
+             "body": {**FIG3},
+             "impact": {"lam": [0.0, 0.4]},
+             "ground": {"records": [str(root / "records" / "suite" / f"SYN{i:02d}.AT2")
+                                    for i in range(1, 7)],
+                        "scale": {"im": "PGA", "values": {"start": 0.2, "stop": 1.6,
+                                                          "num": 6}},
+                        "p": 2.0, "periods": [0.2, 1.0]}}
+    path = tmp_path_factory.mktemp("suite") / "suite.h5"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # large scale factors: said elsewhere
+        rocksweep.run(scene, output=path, jobs=1)
+    return path

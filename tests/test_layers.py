@@ -13,10 +13,11 @@ from pathlib import Path
 
 PKG = Path(__file__).resolve().parents[1] / "rocksweep"
 
-# lowest first: vocabulary, kernel, the model, scenes, computing, files, analyses,
-# figures, the facade, the command line
+# lowest first: errors and the vocabulary (rocksweep.vocab), kernel, the model, scenes,
+# computing, files, analyses, figures, the facade, the command line
 FLOORS: list[tuple[str, ...]] = [
-    ("errors", "outputs", "kernel"),
+    ("errors", "vocab"),
+    ("outputs", "interrupts", "kernel"),
     ("numerics", "outcomes"),
     ("schema",),
     ("physics",),

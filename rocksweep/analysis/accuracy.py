@@ -46,8 +46,9 @@ from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import PRESET_ROTATION, PRESETS, ROOTS, Numerics
 from rocksweep.scene.model import Scene, SceneError
+from rocksweep.vocab.outcomes import CLASSES
 
-OUTCOMES = ("safe", "mode1", "mode2")  # codes 0, 1, 2
+OUTCOMES = CLASSES  # codes 0, 1, 2
 # Per-point fields of the report: all the outcome-level kernel fills (no energies).
 REPORT_FIELDS = tuple(f for f in fields.RUN_FIELDS if not f.energy)
 MEASURES = ("theta_max", "t_first_impact", "t_overturn", "impacts", "theta_rel", "energy")
@@ -115,7 +116,7 @@ LADDERS: dict[str, Callable[[], list[Setting]]] = {
     "full": lambda: (_steps((5, 10, 20, 40, 80, 160), 1e-12)
                      + _tols(80, (1e-4, 1e-5, 1e-6, 1e-8)) + _presets()),
     "short": lambda: _steps((10, 20), 1e-12) + _presets(),
-    # the cheap settings the default preset is chosen from (README, "Accuracy and its price")
+    # the cheap settings the default preset is chosen from (docs/accuracy.md)
     # (with the default preset's rotation limit)
     "candidates": lambda: (_steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-6, True,
                                   PRESET_ROTATION["default"])

@@ -25,6 +25,7 @@ import numpy as np
 
 from rocksweep.analysis.boundaries import DEFAULT_RTOL, AMinCurve, a_min, kernel_evaluator
 from rocksweep.errors import RocksweepError
+from rocksweep.vocab.outcomes import MODE_WORDS, OUTCOME_WORDS, flag_attrs
 
 
 class SpectrumError(RocksweepError, ValueError):
@@ -39,7 +40,8 @@ class Spectra:
     A_ratio values; lam: float64[nl] (one NaN when lam is not swept); theta_max:
     float64[nl, nA, nx] max |theta|/alpha_ref; outcome: int8[nl, nA, nx]; a_min: one
     ``AMinCurve`` per lam (x = freq, a_min [A_ratio], mode 1 or 2 at a_min, NaN: no grid
-    value overturns); rtol: the bisection's relative tolerance; runs: kernel runs spent.
+    value overturns); rtol: the bisection's relative tolerance; runs: kernel runs spent;
+    kind: the body kind ("flexible": alpha_ref is alpha_cg; "block": alpha).
     """
 
     name: str
@@ -53,6 +55,7 @@ class Spectra:
     rtol: float
     runs: int
     record: str = ""
+    kind: str = "flexible"
 
     def to_dataset(self):
         """The spectra as an ``xarray.Dataset``: ``theta_max_over_alpha`` and ``outcome``
@@ -66,20 +69,18 @@ class Spectra:
         a_min = np.array([c.a_min for c in self.a_min], float).reshape(len(self.lam), -1)
         mode = np.array([c.mode for c in self.a_min], np.int8).reshape(a_min.shape)
         f = self.freq
-        theta_attrs = fields.field_attrs(fields.BY_NAME["theta_max_over_alpha"])
+        theta_attrs = fields.field_attrs(fields.BY_NAME["theta_max_over_alpha"], self.kind)
         return xr.Dataset(
             {"theta_max_over_alpha": (("lam", "A_ratio", f), self.theta_max, theta_attrs),
              "outcome": (("lam", "A_ratio", f), self.outcome,
-                         {"long_name": "outcome class", "flag_values": [-1, 0, 1, 2],
-                          "flag_meanings": "not_run safe mode1 mode2"}),
+                         {"long_name": "outcome class", **flag_attrs(OUTCOME_WORDS)}),
              "A_min": (("lam", f), a_min,
-                       {**fields.axis_attrs("A_ratio"),
+                       {**fields.axis_attrs("A_ratio", self.kind),
                         "long_name": "smallest overturning amplitude ratio"}),
              "mode": (("lam", f), mode, {"long_name": "overturning mode at A_min",
-                                         "flag_values": [0, 1, 2],
-                                         "flag_meanings": "none mode1 mode2"})},
+                                         **flag_attrs(MODE_WORDS)})},
             coords={"lam": ("lam", self.lam, fields.axis_attrs("lam")),
-                    "A_ratio": ("A_ratio", self.A, fields.axis_attrs("A_ratio")),
+                    "A_ratio": ("A_ratio", self.A, fields.axis_attrs("A_ratio", self.kind)),
                     f: (f, self.x, fields.axis_attrs(f))},
             attrs={"title": self.name, "rtol": self.rtol, "runs": self.runs,
                    "record": self.record})
@@ -123,4 +124,4 @@ def spectra(data, rtol: float = DEFAULT_RTOL) -> Spectra:
     rec = result.scene.get("record") or {}
     return Spectra(result.name, freq, np.asarray(result.coords[freq], float), A, lam,
                    theta, outcome, curves, rtol, int(sum(c.runs.sum() for c in curves)),
-                   rec.get("name", ""))
+                   rec.get("name", ""), result.kind)

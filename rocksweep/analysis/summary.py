@@ -18,14 +18,25 @@ import numpy as np
 
 from rocksweep.fields import THETA_REL_FLOOR
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.vocab.outcomes import (
+    COMPUTED,
+    FILLED,
+    LIFTS_OFF,
+    MODE1,
+    MODE2,
+    OUTCOME_CODE,
+    SAFE,
+    SLIDES,
+    STATUS_BIT,
+)
 
 if TYPE_CHECKING:
     from rocksweep.store.reader import SweepResult
 
-CLASSES = ("mode1", "mode2", "safe", "flagged", "not_computed")
+CLASSES = (MODE1, MODE2, SAFE, "flagged", "not_computed")
 # Counted too in results with contact outputs (outputs.contact / body.mu): computed points
 # whose status says the base would slide (mu_required > body.mu) or lift off (N < 0).
-CONTACT_COUNTS = ("slides", "lifts_off")
+CONTACT_COUNTS = (SLIDES, LIFTS_OFF)
 # A swept key with more values than this is printed as this many ranges of values.
 MAX_ROWS = 10
 # Variables ``info_dict`` needs from the file (and ``computed`` when the file has it:
@@ -64,8 +75,7 @@ def class_counts(result: SweepResult, by: Sequence[str]) -> list[dict]:
     fl = np.transpose((status & L.STATUS_FLAGGED) != 0, [*pos, *rest]).reshape(o.shape)
     fl &= o != L.OUTCOME_NOT_RUN
     contact = bool(getattr(result, "scene", {}).get("contact"))
-    bits = {"slides": L.STATUS_SLIDES, "lifts_off": L.STATUS_LIFTS_OFF}
-    extra = {c: np.transpose((status & bits[c]) != 0, [*pos, *rest]).reshape(o.shape)
+    extra = {c: np.transpose((status & STATUS_BIT[c]) != 0, [*pos, *rest]).reshape(o.shape)
              & (o != L.OUTCOME_NOT_RUN) for c in (CONTACT_COUNTS if contact else ())}
     rows = []
     for idx in np.ndindex(*shape):
@@ -73,9 +83,7 @@ def class_counts(result: SweepResult, by: Sequence[str]) -> list[dict]:
                      else _plain(result.scalars.get(d))) for d in by}
         cell = o[idx]
         rows.append({**label,
-                     "mode1": int((cell == L.OUTCOME_MODE1).sum()),
-                     "mode2": int((cell == L.OUTCOME_MODE2).sum()),
-                     "safe": int((cell == L.OUTCOME_SAFE).sum()),
+                     **{w: int((cell == OUTCOME_CODE[w]).sum()) for w in CLASSES[:3]},
                      "flagged": int(fl[idx].sum()),
                      "not_computed": int((cell == L.OUTCOME_NOT_RUN).sum()),
                      **{c: int(v[idx].sum()) for c, v in extra.items()}})
@@ -258,8 +266,8 @@ def adaptive_info(result: SweepResult) -> dict | None:
     c = np.asarray(result.arrays["computed"])
     st = stats_of(c, settings.get("threshold", 0.0))
     filled = int(((c == 0) & result.done).sum())
-    return {"settings": settings, "points": st.points, "computed": st.computed,
-            "filled": filled, "undecided": st.points - st.computed - filled,
+    return {"settings": settings, "points": st.points, COMPUTED: st.computed,
+            FILLED: filled, "undecided": st.points - st.computed - filled,
             "audited": st.audited, "audit_misses": st.audit_misses,
             "warning": st.warning()}
 

@@ -20,10 +20,16 @@ def entry() -> None:
     exit as usual. (``main`` itself, for tests and embedding, exits as click does.)"""
     import sys
 
+    from rocksweep import interrupts
+
+    interrupts.install()  # a Ctrl-C is remembered even where a library swallows it
     try:
         main()
     except SystemExit as stop:
         if stop.code not in (None, 0):
+            if interrupts.pending():  # files are closed; a library the interrupt hit
+                sys.stderr.flush()    # may not survive its teardown
+                os._exit(stop.code if isinstance(stop.code, int) else 1)
             raise
     sys.stdout.flush()
     sys.stderr.flush()

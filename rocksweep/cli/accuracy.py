@@ -15,6 +15,7 @@ from rocksweep.cli.main import (
     set_option,
     user_errors,
 )
+from rocksweep.vocab.settings import DEFAULT_LADDER, LADDER_NAMES, LADDERS
 
 
 @main.command()
@@ -28,14 +29,10 @@ from rocksweep.cli.main import (
               show_default=True,
               help="Stratified sample size (every point if the scene has no more).")
 @click.option("--ladder", "ladder_name",
-              type=click.Choice(["full", "short", "candidates", "presets", "roots"]),
-              # = accuracy.LADDERS (tests/test_accuracy.py checks; --help stays light)
-              default="full", show_default=True,
-              help="Kernel settings to measure: full (steps per period 5..160, event_tol "
-                   "1e-4..1e-8, presets), short (a quick check), candidates (the cheap "
-                   "settings the default preset is chosen from), presets (the presets alone: "
-                   "their tails on a scene of your own), roots (every preset with every "
-                   "event root finder).")
+              type=click.Choice(LADDER_NAMES),  # = accuracy.LADDERS (tests/test_vocab.py)
+              default=DEFAULT_LADDER, show_default=True,
+              help="Kernel settings to measure: " + ", ".join(
+                  f"{k} ({v})" for k, v in LADDERS.items()) + ".")
 @click.option("--seed", type=int, default=0, show_default=True, help="Sampling seed.")
 @click.option("--repeat", type=click.IntRange(min=1), default=5, show_default=True,
               help="Kernel timings are the best of this many rounds.")
@@ -69,13 +66,14 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
                                    "sampling seed)")
     # refuse a bad output before the (long) study
     check_distinct({"-o": report_path, "--plot": plot_path})  # by resolved path
+    scene = load(scene_path, overrides)
+    # the scene file, its records: never written over
     if report_path is not None:
-        check_output(report_path, overwrite=overwrite, inputs=[scene_path])
+        check_output(report_path, overwrite=overwrite, inputs=scene.inputs)
     if plot_path is not None:
         from rocksweep.figures.common import FORMATS
 
-        check_output(plot_path, overwrite=overwrite, inputs=[scene_path], suffixes=FORMATS)
-    scene = load(scene_path, overrides)
+        check_output(plot_path, overwrite=overwrite, inputs=scene.inputs, suffixes=FORMATS)
 
     from rocksweep.analysis.accuracy import accuracy_study, format_table, ladder, write_report
 
@@ -105,5 +103,5 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
         from rocksweep.figures.accuracy import work_precision
         from rocksweep.figures.common import save_figure
 
-        save_figure(work_precision(study), plot_path, overwrite=overwrite, inputs=[scene_path])
+        save_figure(work_precision(study), plot_path, overwrite=overwrite, inputs=scene.inputs)
         click.echo(f"wrote {plot_path}")

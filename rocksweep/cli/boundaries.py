@@ -51,12 +51,15 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
             f"-o {out}: unsupported suffix {out.suffix or '(none)'!r}; use "
             f"{', '.join(bd.CURVE_SUFFIXES[:-1])} or {bd.CURVE_SUFFIXES[-1]}")
     # refuse bad outputs before any kernel run
+    from rocksweep.store.reader import result_inputs
+
+    inputs = result_inputs(result_path)  # the result and its records: never written over
     check_distinct({"-o": out, "--lines": lines_path, "--plot": fig_path})
-    check_output(out, overwrite=overwrite, inputs=[result_path])
+    check_output(out, overwrite=overwrite, inputs=inputs)
     if lines_path is not None:
-        check_output(lines_path, overwrite=overwrite, inputs=[result_path])
+        check_output(lines_path, overwrite=overwrite, inputs=inputs)
     if fig_path is not None:
-        check_output(fig_path, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
+        check_output(fig_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
     result = read_result(result_path, ["outcome"])
     curves, bounds = bd.result_curves(result, rtol, None if mode is None else int(mode))
 
@@ -85,5 +88,5 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
         from rocksweep.figures.diagrams import a_min_figure
 
         fig = a_min_figure(curves, bounds, title=result.name, kind=result.kind)
-        save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=[result_path])
+        save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=inputs)
         click.echo(f"wrote {fig_path}")

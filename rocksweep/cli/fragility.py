@@ -9,9 +9,11 @@ from pathlib import Path
 
 import click
 
+from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP, MAX_BOOTSTRAP
 from rocksweep.cli.main import main, user_errors
 from rocksweep.cli.options import dpi_option, overwrite_option, result_argument
 from rocksweep.figures import WIDTHS
+from rocksweep.vocab.outcomes import STATES
 
 CURVE_SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
 
@@ -22,8 +24,8 @@ def curve_rows(frag) -> list[dict]:
 
     rows = []
     for c in curves_json(frag)["curves"]:
-        row = {k: v for k, v in c.items() if k not in ("median_ci", "beta_ci")}
-        row["median_lo"], row["median_hi"] = c["median_ci"]
+        row = {k: v for k, v in c.items() if k not in ("im_median_ci", "beta_ci")}
+        row["im_median_lo"], row["im_median_hi"] = c["im_median_ci"]
         row["beta_lo"], row["beta_hi"] = c["beta_ci"]
         rows.append(row)
     return rows
@@ -56,15 +58,17 @@ def _g(v) -> str:
               help="Figure of the curves with their bootstrap bands and the fraction at "
                    "each stripe, .png, .pdf or .svg.")
 @click.option("--state", default="overturn", show_default=True,
-              help="What the curve gives the probability of: overturn, mode1, mode2, "
-                   "uplift or theta:X (max|theta|/alpha_cg >= X); several separated by "
-                   "commas.")
+              help="What the curve gives the probability of: " + ", ".join(STATES)
+              + " or theta:X (max|theta|/alpha_cg >= X, 0 < X <= 1); several separated by "
+              "commas: damage states (uplift, theta:X, overturn) are fitted with one beta so "
+              "their curves never cross, mode1,mode2 as competing risks.")
 @click.option("--im", default=None,
               help="Unscaled suites (clouds): the IM, PGA (default), PGV or Sa; stripes use "
                    "the IM they were scaled to.")
 @click.option("--period", type=float, default=None,
               help="With --im Sa: the period [s] (one of the stored ground.periods).")
-@click.option("--bootstrap", type=click.IntRange(0, 100_000), default=200, show_default=True,
+@click.option("--bootstrap", type=click.IntRange(0, MAX_BOOTSTRAP), default=DEFAULT_BOOTSTRAP,
+              show_default=True,
               help="Bootstrap resamples over records for the intervals and bands (0: none).")
 @click.option("--seed", type=click.IntRange(0, 2**63 - 1), default=0, show_default=True,
               help="Seed of the bootstrap's random generator.")
@@ -90,7 +94,12 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
     lognormal P(state | IM = x) = Phi(ln(x/median)/beta) fitted by maximum likelihood to
     the counts at each stripe of a scaled suite, or to the (IM, 0/1) pairs of an unscaled
     one (Baker 2015), one curve per value of every other swept key (lam first), with
-    bootstrap intervals over records. Points flagged undecided are left out and counted."""
+    bootstrap intervals over records. Points flagged undecided are left out and counted.
+    A curve that should not be trusted as it is (extrapolated, beta undetermined,
+    non-monotone fractions, censored by the other mode, points missing...) says why in
+    its "fit" column and in a warning line on stderr."""
+    import warnings
+
     import rocksweep
     from rocksweep.figures.common import FORMATS, save_figure
     from rocksweep.outputs import check_output, write_atomic
@@ -98,6 +107,9 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
     states = [s.strip() for s in state.split(",") if s.strip()]
     if not states:
         raise click.ClickException(f"--state {state!r}: give at least one state")
+    from rocksweep.store.reader import result_inputs
+
+    inputs = result_inputs(result_path)  # the result and its records: never written over
     outs = [p for p in (out_path, fig_path) if p is not None]
     if len({str(p.resolve()) for p in outs}) < len(outs):
         raise click.ClickException("-o and --plot must name different files")
@@ -106,12 +118,22 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
             raise click.ClickException(
                 f"-o {out_path}: unsupported suffix {out_path.suffix or '(none)'!r}; use "
                 f"{', '.join(CURVE_SUFFIXES[:-1])} or {CURVE_SUFFIXES[-1]}")
-        check_output(out_path, overwrite=overwrite, inputs=[result_path])
+        check_output(out_path, overwrite=overwrite, inputs=inputs)
     if fig_path is not None:
-        check_output(fig_path, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
+        check_output(fig_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
+    from rocksweep.analysis.fragility import FragilityWarning
+
     ds = rocksweep.open(result_path)
-    frag = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states, im=im,
-                               period=period, bootstrap=bootstrap, seed=seed, ci=ci)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", FragilityWarning)
+        frag = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states,
+                                   im=im, period=period, bootstrap=bootstrap, seed=seed,
+                                   ci=ci)
+    for w in caught:
+        if issubclass(w.category, FragilityWarning):
+            click.echo(f"Warning: {w.message}", err=True)
+        else:
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     frag.attrs["source"] = str(result_path)
     refined = None
     if rtol is not None:
@@ -139,7 +161,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
         from rocksweep.figures.fragility import fragility_figure
 
         fig = fragility_figure(frag, width=width)
-        save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=[result_path])
+        save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=inputs)
         say(f"wrote {fig_path}")
 
 
@@ -187,17 +209,18 @@ def _print_table(frag, rows: list[dict]) -> None:
                "intervals)")
     if not rows:
         return
-    fixed = ("state", "im", "method", "median", "beta", "median_lo", "median_hi", "beta_lo",
-             "beta_hi", "n_records", "n_excluded", "reason")
+    fixed = ("state", "im", "method", "fit", "im_median", "beta", "im_median_lo",
+             "im_median_hi", "beta_lo", "beta_hi", "n_records", "n_excluded", "n_not_run",
+             "n_boot_undefined", "reason")
     keys = [k for k in rows[0] if k not in fixed]
-    head = [*keys, "state", "median", "(lo, hi)", "beta", "(lo, hi)", "records",
-            "excluded", "fit"]
+    head = [*keys, "state", "im_median", "(lo, hi)", "beta", "(lo, hi)", "records",
+            "excluded", "not run", "fit"]
     lines = [head]
     for r in rows:
-        lines.append([*(str(r[k]) for k in keys), r["state"], _g(r["median"]),
-                      f"({_g(r['median_lo'])}, {_g(r['median_hi'])})", _g(r["beta"]),
+        lines.append([*(str(r[k]) for k in keys), r["state"], _g(r["im_median"]),
+                      f"({_g(r['im_median_lo'])}, {_g(r['im_median_hi'])})", _g(r["beta"]),
                       f"({_g(r['beta_lo'])}, {_g(r['beta_hi'])})", str(r["n_records"]),
-                      str(r["n_excluded"]), r["reason"]])
+                      str(r["n_excluded"]), str(r["n_not_run"]), r["reason"]])
     widths = [max(len(line[i]) for line in lines) for i in range(len(head))]
     for line in lines:
         click.echo("  ".join(c.ljust(w) for c, w in zip(line, widths, strict=True)).rstrip())

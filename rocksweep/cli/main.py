@@ -9,6 +9,7 @@ non-zero exit.
 from __future__ import annotations
 
 import functools
+import re
 from pathlib import Path
 
 import click
@@ -17,17 +18,26 @@ import rocksweep
 from rocksweep.cli.options import overwrite_option, scene_argument, set_option  # noqa: F401
 from rocksweep.errors import RocksweepError, one_line
 
+# The library's messages may name the Python API's flags (``resume=True``); the command
+# line says its own (``--resume``): the reverse of ``api._FLAG_WORDS``.
+_CLI_WORDS = re.compile(r"\b(resume|overwrite|adaptive|validate)=True\b")
+
+
+def cli_words(message: str) -> str:
+    """A library message with the API's flags said as the command line's options."""
+    return _CLI_WORDS.sub(lambda m: f"--{m.group(1)}", message)
+
 
 def user_errors(fn):
     """Turn the library's user-facing errors (``RocksweepError``) into one-line click
-    errors."""
+    errors, in the command line's words (``cli_words``)."""
 
     @functools.wraps(fn)
     def wrapper(*args, **kwargs):
         try:
             return fn(*args, **kwargs)
         except RocksweepError as err:
-            raise click.ClickException(one_line(str(err))) from None
+            raise click.ClickException(cli_words(one_line(str(err)))) from None
 
     return wrapper
 
@@ -65,9 +75,25 @@ class OneLineCommand(click.Command):
 
 
 class OneLineGroup(click.Group):
-    """The group whose commands answer bad usage in one line."""
+    """The group whose commands answer bad usage in one line, and Ctrl-C with exit 130
+    and one line (click would say "Aborted!" with exit 1): also when the interrupt was
+    swallowed by a library callback and surfaced as another error
+    (``rocksweep.interrupts``)."""
 
     command_class = OneLineCommand
+
+    def invoke(self, ctx: click.Context):
+        from rocksweep import interrupts
+
+        try:
+            return super().invoke(ctx)
+        except (SystemExit, click.exceptions.Exit):
+            raise
+        except BaseException as err:
+            if isinstance(err, KeyboardInterrupt) or interrupts.pending():
+                click.echo("\ninterrupted", err=True)
+                raise SystemExit(130) from None
+            raise
 
     def resolve_command(self, ctx: click.Context, args: list[str]):
         try:
@@ -85,3 +111,15 @@ def main() -> None:
 
     Times are p*t, rotations theta/alpha_cg, energies E/E_ref.
     """
+    _one_line_warnings()
+
+
+def _one_line_warnings() -> None:
+    """The library's warnings (a drifting record, a large scale factor) as one line on
+    stderr, ``Warning: ...``, instead of Python's two (file, line, source)."""
+    import warnings
+
+    def show(message, category, filename, lineno, file=None, line=None) -> None:
+        click.echo(f"Warning: {one_line(str(message))}", err=True)
+
+    warnings.showwarning = show

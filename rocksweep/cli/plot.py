@@ -1,5 +1,6 @@
 """``rocksweep plot``: the stability diagram of a sweep result (Figures 3 and 4), over any
-two swept axes, or a line plot of a 1-D sweep."""
+two swept axes, or a line plot of a 1-D sweep; the figure of an analysis's file
+(fragility, risk, efficiency ``-o .h5``)."""
 
 from __future__ import annotations
 
@@ -57,13 +58,23 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
 
     fig_out = fig_path if fig_path is not None else result_path.with_suffix(".png")
     # refuse a bad output before reading the result and drawing
-    check_output(fig_out, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
+    from rocksweep.store.reader import result_inputs
+
+    inputs = result_inputs(result_path)  # the result and its records: never written over
+    check_output(fig_out, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
     if mu_map and compare_key is not None:
         raise click.ClickException("--mu and --compare draw different figures; give one")
-    ds = api.open(result_path)
+    ds = api.open_any(result_path)  # a sweep, or an analysis's -o .h5 (its own figure)
+    from rocksweep.analysis.kinds import dataset_kind
+
+    if dataset_kind(ds) != "sweep":
+        fig = api.plot(ds)
+        save_figure(fig, fig_out, dpi, overwrite=overwrite, inputs=[result_path])
+        click.echo(f"wrote {fig_out}")
+        return
     fig = api.plot(ds, x_key, y_key, curves=curves, show_computed=show_computed, mu=mu_map,
                    compare=compare_key, _names=("--x", "--y", "--compare"))
-    save_figure(fig, fig_out, dpi, overwrite=overwrite, inputs=[result_path])
+    save_figure(fig, fig_out, dpi, overwrite=overwrite, inputs=inputs)
     for w in missing_warnings(as_result(ds)):
         click.echo(f"warning: {w}", err=True)
     click.echo(f"wrote {fig_out}")

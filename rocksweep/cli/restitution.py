@@ -17,6 +17,7 @@ from rocksweep.cli.main import (
     set_option,
     user_errors,
 )
+from rocksweep.vocab.laws import CONSTANT, LAWS, LOCKED, law_origin
 
 
 @main.command(name="restitution")
@@ -30,7 +31,7 @@ from rocksweep.cli.main import (
               help="Number of lam values in [0, 1].")
 @click.option("--n-u", default=81, show_default=True, type=click.IntRange(2, 100001),
               help="Number of u/u_cr values in [-2, 2].")
-@click.option("--law", type=click.Choice(["vertical", "locked", "constant"]),
+@click.option("--law", type=click.Choice(LAWS),
               help="Impact law (as --set impact.law=LAW) [default: the scene's, else "
                    "vertical: eq. (1)]; constant takes its e from impact.e.")
 @user_errors
@@ -47,21 +48,27 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     from rocksweep.analysis.restitution import restitution_table
     from rocksweep.outputs import check_output
 
-    if plot_path is not None:
+    if law is not None:  # e belongs to law constant alone
+        given_e = [o for o in overrides if o.split("=", 1)[0].strip() == "impact.e"]
+        if law != CONSTANT and given_e:
+            raise click.ClickException(
+                f"--set {given_e[-1]}: e is the constant law's coefficient; --law {law} "
+                "computes e from the body (eq. (1)) and would ignore it: remove it, or use "
+                "--law constant")
+        overrides = (*overrides, f"impact.law={law}",
+                     *(("impact.e=null",) if law != CONSTANT else ()))
+    scene = load(scene_path, overrides)
+    if plot_path is not None:  # the scene file, its records: never written over
         from rocksweep.figures.common import FORMATS
 
-        check_output(plot_path, overwrite=overwrite, inputs=[scene_path], suffixes=FORMATS)
-    if law is not None:  # e belongs to law constant alone
-        overrides = (*overrides, f"impact.law={law}",
-                     *(("impact.e=null",) if law != "constant" else ()))
-    table = restitution_table(load(scene_path, overrides), n_lam, n_u)
+        check_output(plot_path, overwrite=overwrite, inputs=scene.inputs, suffixes=FORMATS)
+    table = restitution_table(scene, n_lam, n_u)
     if as_json:
         click.echo(json.dumps(table.as_dict()))
     else:
         e = table.e_upper
         click.echo(table.title)
-        what = {"vertical": "eq. (1)", "locked": "top mass locked to the base",
-                "constant": f"e = {table.e:g}"}[table.law]
+        what = law_origin(table.law, table.e)
         factor = f", e_factor {table.e_factor:g}" if table.e_factor != 1.0 else ""
         click.echo(f"impact law: {table.law} ({what}{factor})")
         click.echo(f"e at lam = 0, u = 0: {table.e_at_rest:.4f}  (Housner, same body rigid: "
@@ -70,7 +77,7 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
                    f"max {e.max():.4f}; e > 1 at {int((e > 1).sum())} of {e.size} "
                    "points (upper sign)")
         click.echo("largest lam at which an impact cannot gain energy (upper sign"
-                   + (", u' = 0" if table.law == "locked" else "") + "):")
+                   + (", u' = 0" if table.law == LOCKED else "") + "):")
         u = table.u_over_ucr
         picks = [int(i) for i in dict.fromkeys(
             int(abs(u - v).argmin()) for v in (-2.0, -1.0, 0.0, 1.0, 2.0))]
@@ -85,7 +92,7 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
 
         fig = restitution_map(table.lam, table.u_over_ucr, table.e_upper, table.e_housner,
                               table.title, lam_limit=table.lam_limit, law=table.law)
-        save_figure(fig, plot_path, overwrite=overwrite, inputs=[scene_path])
+        save_figure(fig, plot_path, overwrite=overwrite, inputs=scene.inputs)
         if not as_json:
             click.echo(f"wrote {plot_path}")
 

@@ -50,15 +50,16 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     from rocksweep.outputs import check_distinct, check_output
 
     check_distinct({"--plot": plot_path, "--csv": csv_path})  # by resolved path
-    if plot_path is not None:
-        from rocksweep.figures.common import FORMATS
-
-        check_output(plot_path, overwrite=overwrite, inputs=[scene_path], suffixes=FORMATS)
-    if csv_path is not None:
-        check_output(csv_path, overwrite=overwrite, inputs=[scene_path])
     if contact:
         overrides = (*overrides, "outputs.contact=true")
     scene = load(scene_path, overrides)
+    # the scene file, its record: never written over
+    if plot_path is not None:
+        from rocksweep.figures.common import FORMATS
+
+        check_output(plot_path, overwrite=overwrite, inputs=scene.inputs, suffixes=FORMATS)
+    if csv_path is not None:
+        check_output(csv_path, overwrite=overwrite, inputs=scene.inputs)
     from rocksweep.scene.model import SceneError
 
     try:
@@ -83,7 +84,7 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
         from rocksweep.figures.common import save_figure, time_history
 
         save_figure(time_history(runs, swept, scene.name), plot_path, overwrite=overwrite,
-                    inputs=[scene_path])
+                    inputs=scene.inputs)
         if not as_json:
             click.echo(f"wrote {plot_path}")
 

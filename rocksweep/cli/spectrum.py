@@ -29,9 +29,11 @@ def spectrum(result_path: Path, fig_path: Path | None, rtol: float, dpi: int,
     from rocksweep.figures.common import FORMATS, save_figure
     from rocksweep.figures.spectrum import spectra_figure
     from rocksweep.outputs import check_output
+    from rocksweep.store.reader import result_inputs
 
     fig_out = fig_path or result_path.with_name(result_path.stem + "-spectra.png")
-    check_output(fig_out, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
+    inputs = result_inputs(result_path)  # the result and its records: never written over
+    check_output(fig_out, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
     sp = spectra(result_path, rtol)
-    save_figure(spectra_figure(sp), fig_out, dpi, overwrite=overwrite, inputs=[result_path])
+    save_figure(spectra_figure(sp), fig_out, dpi, overwrite=overwrite, inputs=inputs)
     click.echo(f"wrote {fig_out} ({sp.runs} kernel runs to bisect A_min to {rtol:g})")

@@ -21,7 +21,7 @@ swept axes with at least 2 values), for every value of the other axes (a *panel*
    at 1000 x 1000 x 3 lam (``scripts/bench_adaptive.py --fine``): 3.77% of the points
    computed instead of 4.46%, 99.9990% of the outcomes equal to the full grid instead of
    99.9997%. What it misses are one-point specks on a boundary and one-point slivers
-   (at 400 x 400, 0-70 cells of a scene instead of 0-44, see the README's table);
+   (at 400 x 400, 0-70 cells of a scene instead of 0-44, docs/adaptive.md's table);
 3. audit: a fixed pseudo-random share ``audit`` of all points (seeded, independent of the
    state) is computed once refinement has converged, i.e. a Bernoulli sample of the points
    that would be filled. An audit point whose class differs from its fill makes its cells
@@ -60,20 +60,17 @@ from rocksweep.compute.grid import ChunkRows, Grid
 from rocksweep.errors import RocksweepError
 from rocksweep.scene.model import Scene
 from rocksweep.schema import check_option
+from rocksweep.vocab import outcomes as _out
+from rocksweep.vocab.axes import DIAGRAM_AXES
 
 # ``computed`` flags (int8 per point).
-FILLED = 0  # not computed: outcome holds the class filled from its uniform cell
-COMPUTED = 1  # computed by the coarse pass or a refinement
-AUDIT = 2  # computed as an audit point; its class equals the fill it replaced
-AUDIT_MISS = 3  # computed as an audit point; its class differs from the fill (refined)
-COMPUTED_MEANING = {
-    FILLED: "filled (not computed; outcome from the uniform cell around it)",
-    COMPUTED: "computed (coarse pass or refinement)",
-    AUDIT: "computed as an audit point, agreed with its fill",
-    AUDIT_MISS: "computed as an audit point, disagreed with its fill (region refined)",
-}
+# (codes, words and meanings: ``rocksweep.vocab.outcomes``)
+FILLED = _out.COMPUTED_CODE[_out.FILLED]  # not computed: the class filled from its cell
+COMPUTED = _out.COMPUTED_CODE[_out.COMPUTED]  # computed by the coarse pass or a refinement
+AUDIT = _out.COMPUTED_CODE[_out.AUDIT_AGREED]  # an audit point; its class equals the fill
+AUDIT_MISS = _out.COMPUTED_CODE[_out.AUDIT_DISAGREED]  # an audit point; differs (refined)
+COMPUTED_MEANING = _out.COMPUTED_MEANING
 
-DIAGRAM_AXES = ("w_over_p", "A_ratio")  # (x, y)
 # Default coarse level: the largest k whose coarse lattice keeps >= MIN_COARSE_CELLS cells
 # along both diagram axes (80: k = 2, 400: k = 4, 1000: k = 5); see ``default_coarse``.
 MIN_COARSE_CELLS = 16

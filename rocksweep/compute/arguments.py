@@ -128,8 +128,22 @@ def check_sweep_arguments(*, jobs: Any = 1, resume: Any = False, overwrite: Any 
                              else "--backend dask needs --scheduler ADDRESS")
         if any(ord(c) < 32 for c in scheduler):
             raise SweepError(f"scheduler {scheduler!r}: control characters in the address")
+        _address_parts(scheduler)
         return 1
     raise SweepError(f"backend = {backend!r}: must be threads or dask")
+
+
+def _address_parts(address: str):
+    """``address`` split as a URL (``tcp://`` when it names no protocol); a one-line
+    SweepError for one that is not a URL (``tcp://[::1``: an unclosed IPv6 bracket, a
+    port that is not a number)."""
+    try:
+        parts = urlsplit(address if "://" in address else f"tcp://{address}")
+        parts.port  # noqa: B018 - parsed on access: a bad port raises here
+    except ValueError as err:
+        raise SweepError(f"scheduler {address!r}: not an address like tcp://host:8786 or "
+                         f"tcp://[::1]:8786 ({err})") from None
+    return parts
 
 
 def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT,
@@ -140,7 +154,7 @@ def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT,
     speaks first: it sends its handshake as soon as a connection is accepted). Other
     protocols are left to dask. Bounded: a port that accepts and never answers costs
     ``timeout`` seconds, no more."""
-    parts = urlsplit(address if "://" in address else f"tcp://{address}")
+    parts = _address_parts(address)
     if parts.scheme != "tcp":
         return
     try:

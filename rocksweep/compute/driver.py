@@ -21,6 +21,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from rocksweep.interrupts import pending as interrupt_pending
+from rocksweep.interrupts import raise_pending
+
 if TYPE_CHECKING:
     from rocksweep.compute.adaptive import AdaptiveStats, Options, Validation
     from rocksweep.scene.model import Scene
@@ -97,7 +100,9 @@ def drive(sf, path: Path | None, report: SweepReport, t0: float,
             report.attrs = sf.finish(report.wall_s, report.cpu_s)
         finally:
             sf.close()
-        if isinstance(err, KeyboardInterrupt) and not isinstance(err, SweepInterrupted):
+        if (isinstance(err, KeyboardInterrupt) or interrupt_pending()) and not isinstance(
+                err, SweepInterrupted | SystemExit):
+            # any error after a Ctrl-C is the Ctrl-C (a library half-loaded by it)
             raise SweepInterrupted(report) from None
         raise
     report.wall_s = time.perf_counter() - t0
@@ -108,10 +113,12 @@ def drive(sf, path: Path | None, report: SweepReport, t0: float,
     return report
 
 
-def progress_class() -> type:
+def progress_class(progress: bool = True) -> type:
     """The progress bar: a widget in a notebook (``tqdm.auto``'s choice), else the
-    terminal's bar (without ``tqdm.auto``'s asyncio import: ~10 ms of every command)."""
-    if "ipykernel" in sys.modules:
+    terminal's bar (without ``tqdm.auto``'s asyncio import: ~10 ms of every command).
+    No bar shown (``progress`` false): the terminal's class, which a notebook without
+    ipywidgets does not warn about (tqdm's "IProgress not found" TqdmWarning)."""
+    if progress and "ipykernel" in sys.modules:
         from tqdm.auto import tqdm
     else:
         from tqdm import tqdm
@@ -126,7 +133,7 @@ def every_point_loop(sf, report: SweepReport, _options: None, *, jobs: int, back
     ``write_every`` seconds (and the pending ones whatever ends the loop)."""
     from rocksweep.compute import sweep as sw
 
-    tqdm = progress_class()
+    tqdm = progress_class(progress)
 
     scene = sf.grid.scene
 
@@ -156,6 +163,7 @@ def every_point_loop(sf, report: SweepReport, _options: None, *, jobs: int, back
                 report.cpu_s += res.cpu_seconds
                 report.computed += res.stop - res.start
                 bar.update(res.stop - res.start)
+                raise_pending()  # this chunk is kept: written on the way out
                 if time.perf_counter() - t_write >= write_every:
                     write_pending()
                     t_write = time.perf_counter()
@@ -176,6 +184,7 @@ def prepare_kernel(sf, lvl: int, report: SweepReport, say: Callable[[str], None]
     t_prep = time.perf_counter()
     sw.prepare(sf.grid, lvl)
     report.compile_s = time.perf_counter() - t_prep
+    raise_pending()  # a Ctrl-C that numba's callbacks swallowed while loading
     if to_compile or unknown or report.compile_s > 1.0:
         how = "compiled" if to_compile else "compiled or loaded from numba's cache"
         say(f"kernel {how} in {report.compile_s:.1f} s")
@@ -201,7 +210,7 @@ def adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backe
     from rocksweep.compute import adaptive as ad
     from rocksweep.compute import sweep as sw
 
-    tqdm = progress_class()
+    tqdm = progress_class(progress)
     scene = sf.grid.scene
     plan = options.plan(sf.grid)
     outcome, computed = sf.state()
@@ -252,6 +261,7 @@ def adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backe
                     report.cpu_s += res.cpu_seconds
                     report.computed += len(res.flat)
                     bar.update(len(res.flat))
+                    raise_pending()  # this chunk is kept: written on the way out
                     if time.perf_counter() - t_write >= write_every:
                         write_pending()
                         t_write = time.perf_counter()

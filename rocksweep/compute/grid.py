@@ -82,7 +82,7 @@ class Grid:
         self._i_ef = names.index("e_factor") if "e_factor" in names else None
         self._law_codes = (None if self._i_law is None else
                            np.array([law_code(w) for w in scene.axes[self._i_law].values]))
-        # the initial state's axes, when the scene gives them (points.INITIAL; else at rest)
+        # the initial state's axes, when the scene gives them (vocab.axes.INITIAL; else at rest)
         self._i_init = [names.index(k) if k in names else None for k in INITIAL]
         self._values = [np.asarray(a.values, float)
                         if i not in (self._i_shape, self._i_rec, self._i_law) else None

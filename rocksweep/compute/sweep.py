@@ -371,7 +371,8 @@ class Estimate:
     """What a sweep of a scene will cost on this machine (``estimate``).
 
     points: grid points; steps_bound: RK4 steps if every point ran to its horizon (no
-    overturning, events not counted; the check rerun doubled in); evaluations: expected
+    overturning, events not counted; with ``outputs.check`` the half-step rerun's own
+    bound, twice the first run's, added: ~3x); evaluations: expected
     RK4 evaluations (regular + event) of the whole sweep, measured on ``sampled`` random
     points when the kernel is compiled, else steps_bound; seconds: expected compute time
     [s] with ``jobs`` workers (compile excluded); compile_needed: a kernel variant must be
@@ -410,21 +411,22 @@ def estimate(scene: Scene, jobs: int = 1, sample: int = ESTIMATE_SAMPLE,
     flat = (np.arange(n) if n <= sample
             else np.sort(rng.choice(n, size=sample, replace=False)))
     cr = grid.rows_at(flat)
+    # the runs of each point: the first, and with outputs.check its half-step rerun
+    runs = [cr.rows, fields.check_rows(cr.rows)] if scene.check else [cr.rows]
     with np.errstate(divide="ignore", invalid="ignore"):
-        per = np.ceil(cr.rows[:, L.PAR_TEND] / cr.rows[:, L.PAR_DT])
-    reruns = 2 if scene.check else 1
-    steps_bound = int(round(float(np.nanmean(per)) * n * reruns))
+        per = sum(np.ceil(r[:, L.PAR_TEND] / r[:, L.PAR_DT]) for r in runs)
+    steps_bound = int(round(float(np.nanmean(per)) * n))
     to_compile, unknown = kernel_cache_state(grid, lvl)
     workers = check_jobs(jobs)
     sampled = 0
     if to_compile == 0 and unknown == 0:
         prepare(grid, lvl)  # loads the cached variant (no compile)
         c0 = time.thread_time()
-        outs = run_rows(cr, cr.rows, lvl, scene)
+        outs = [run_rows(cr, r, lvl, scene) for r in runs]
         cpu = time.thread_time() - c0
-        evals = outs[:, L.OUT_STEPS] + outs[:, L.OUT_EVENT_STEPS]
-        evaluations = float(evals.mean()) * n * reruns
-        seconds = cpu / len(flat) * n * reruns / workers
+        evals = sum(o[:, L.OUT_STEPS] + o[:, L.OUT_EVENT_STEPS] for o in outs)
+        evaluations = float(evals.mean()) * n
+        seconds = cpu / len(flat) * n / workers
         sampled = len(flat)
     else:
         evaluations = float(steps_bound)

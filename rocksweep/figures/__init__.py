@@ -1,7 +1,9 @@
 """Every figure (``rocksweep.plot(ds)`` is the facade): ``diagrams`` (stability
 diagrams, Figures 3-4, friction maps, A_min), ``common`` (axes, saving, time histories
 (Figure 5), the restitution map (Figure 2)), ``spectrum`` (rocking spectra),
-``accuracy`` (work-precision), ``fragility`` (fragility curves). Figures are built
+``accuracy`` (work-precision), ``fragility`` (fragility curves), ``pulses`` (the pulse
+shapes). Every figure is a ``rocksweep.figures.common.Figure`` (TrueType fonts in any
+saved PDF, a PNG in a notebook). Figures are built
 without pyplot (``matplotlib.figure.Figure``), so nothing here needs a display.
 """
 
@@ -15,4 +17,4 @@ DPI_RANGE = (20, 2400)
 WIDTHS: dict[str, tuple[float, float]] = {"single": (3.5, 7.0), "double": (7.2, 8.0)}
 
 # the public modules
-__all__ = ["accuracy", "common", "diagrams", "fragility", "spectrum"]
+__all__ = ["accuracy", "common", "diagrams", "fragility", "pulses", "spectrum"]

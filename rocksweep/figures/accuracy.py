@@ -19,10 +19,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.figure import Figure
 
 from rocksweep.analysis.accuracy import MEASURE_LABELS, Study
-from rocksweep.figures.common import DEFAULT_DPI, given_axes, new_axes, save_figure
+from rocksweep.figures.common import DEFAULT_DPI, Figure, given_axes, new_axes, save_figure
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

@@ -17,12 +17,15 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import matplotlib
 import numpy as np
-from matplotlib.figure import Figure
+from matplotlib.figure import Figure as _MplFigure
 from matplotlib.lines import Line2D
 
 from rocksweep.errors import RocksweepError
 from rocksweep.outputs import atomic_path, check_output
+from rocksweep.vocab import axes as _axes
+from rocksweep.vocab.laws import DEFAULT_LAW, VERTICAL, law_origin
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -34,6 +37,31 @@ from rocksweep.figures import DEFAULT_DPI, FORMATS, WIDTHS  # noqa: E402,F401
 
 class FigureError(RocksweepError, ValueError):
     """Something that cannot be drawn as asked; ``str()`` is one line."""
+
+
+# What every saved figure gets, whoever saves it: TrueType fonts in PDF and PostScript
+# (Type 42), as journals ask, instead of matplotlib's Type 3.
+SAVE_RC = {"pdf.fonttype": 42, "ps.fonttype": 42}
+# Resolution of the image a notebook shows (``Figure._repr_png_``) [dots per inch].
+NOTEBOOK_DPI = 100
+
+
+class Figure(_MplFigure):
+    """The figure every rocksweep figure function returns: a pyplot-free matplotlib
+    ``Figure`` whose own ``savefig`` embeds TrueType fonts in PDF/PS (``SAVE_RC``) and
+    which a notebook shows as a PNG without ``%matplotlib inline`` (``_repr_png_``).
+    Every module builds its figures from this class (tests/figures/test_plots.py checks)."""
+
+    def savefig(self, fname, *args, **kwargs):
+        with matplotlib.rc_context(SAVE_RC):
+            return super().savefig(fname, *args, **kwargs)
+
+    def _repr_png_(self) -> bytes:
+        from io import BytesIO
+
+        buf = BytesIO()
+        self.savefig(buf, format="png", dpi=NOTEBOOK_DPI)
+        return buf.getvalue()
 
 
 def new_axes(nrows: int, ncols: int, figsize: tuple[float, float],
@@ -60,12 +88,9 @@ def save_figure(fig: Figure, path: str | Path, dpi: int = DEFAULT_DPI, *,
     command's ``inputs``, a device, directory, missing or read-only directory, and other
     suffixes. dpi: dots per inch of raster output (PNG; the raster parts of PDF/SVG).
     """
-    import matplotlib
-
     path = check_output(path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
-    # TrueType fonts in PDF (Type 42), as journals ask, instead of matplotlib's Type 3
-    with atomic_path(path) as tmp, matplotlib.rc_context({"pdf.fonttype": 42,
-                                                          "ps.fonttype": 42}):
+    # TrueType fonts also for a figure the caller made (not a rocksweep Figure)
+    with atomic_path(path) as tmp, matplotlib.rc_context(SAVE_RC):
         fig.savefig(tmp, dpi=dpi, format=path.suffix[1:].lower())
     return path
 
@@ -85,6 +110,106 @@ def width_style(width: str | None) -> dict:
             "xtick.labelsize": pt - 1, "ytick.labelsize": pt - 1, "lines.markersize": 3}
 
 
+def wrap_title(title: str, inches: float, pt: float = 11.0) -> str:
+    """``title`` wrapped to a width of ``inches`` at ``pt`` points (about 100/pt
+    characters an inch), so a long scene name is not cut at the edges; words inside
+    mathtext ($...$) stay together. A wrapped title is wrapped anew."""
+    width = max(20, int(100.0 / pt * inches))
+    title = " ".join(title.split("\n"))
+    if len(title) <= width:
+        return title
+    tokens: list[str] = []
+    in_math = False  # words joined while inside $...$
+    for w in title.split(" "):
+        if in_math:
+            tokens[-1] += " " + w
+        else:
+            tokens.append(w)
+        if w.count("$") % 2:
+            in_math = not in_math
+    lines = [""]
+    for t in tokens:
+        if lines[-1] and len(lines[-1]) + 1 + len(t) > width:
+            lines.append(t)
+        else:
+            lines[-1] = f"{lines[-1]} {t}" if lines[-1] else t
+    return "\n".join(lines)
+
+
+def _wider(fig: Figure, renderer, artist) -> bool:
+    bb = artist.get_window_extent(renderer)
+    return bb.x0 < fig.bbox.x0 or bb.x1 > fig.bbox.x1
+
+
+# Under a journal width every axes keeps at least this height per inch of its width (the
+# figure grows taller rather than squash a panel to nothing), and rounds of layout tried.
+MIN_ASPECT = 0.6
+FIT_ROUNDS = 12
+
+
+def fit_width(fig: Figure, width: str) -> Figure:
+    """Fit a finished figure to a journal width (``WIDTHS``): its width in inches, titles
+    no larger than the axis labels, the suptitle wrapped to the width, every figure legend
+    in as many columns as fit, and as much height as the panels, labels and legends need
+    (the layout's aspect at least; every axes at least ``MIN_ASPECT`` as tall as wide).
+    Nothing drawn lies outside the figure (tests/figures/test_journal.py). Returns ``fig``."""
+    import warnings
+
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    inches, pt = WIDTHS[width]
+    w, h = fig.get_size_inches()
+    fig.set_size_inches(inches, h * inches / w)
+    for ax in fig.axes:
+        for t in (ax.title, ax._left_title, ax._right_title):
+            t.set_fontsize(min(t.get_fontsize(), pt))
+    sup = fig._suptitle
+    if sup is not None:
+        sup.set_fontsize(min(sup.get_fontsize(), pt))
+        sup.set_text(wrap_title(sup.get_text(), inches, sup.get_fontsize()))
+    for leg in [*fig.legends, *(a.get_legend() for a in fig.axes if a.get_legend())]:
+        for t in leg.texts:
+            t.set_fontsize(min(t.get_fontsize(), pt - 1))
+    canvas = FigureCanvasAgg(fig)  # measures text as the saved file will
+    for _ in range(FIT_ROUNDS):
+        with warnings.catch_warnings():  # a layout too short to fit, until it grows
+            warnings.simplefilter("ignore", UserWarning)
+            canvas.draw()
+        renderer = canvas.get_renderer()
+        narrowed = False
+        for leg in list(fig.legends):
+            if leg._ncols > 1 and _wider(fig, renderer, leg):
+                handles, labels = leg.legend_handles, [t.get_text() for t in leg.texts]
+                loc = _OUTSIDE.get(getattr(leg, "_outside_loc", None) or "", "lower center")
+                size = leg.texts[0].get_fontsize() if leg.texts else pt - 1
+                ncol = leg._ncols - 1
+                leg.remove()
+                fig.legend(handles, labels, loc=loc, fontsize=size, frameon=False, ncol=ncol)
+                narrowed = True
+        if narrowed:
+            continue
+        fh = fig.get_figheight()
+        tight = fig.get_tightbbox(renderer)
+        grow = max(0.0, -tight.y0) + max(0.0, tight.y1 - fh)
+        shown = [a for a in fig.axes if a.get_visible()]
+        if shown:
+            rows = max(a.get_subplotspec().get_gridspec().nrows if a.get_subplotspec()
+                       else 1 for a in shown)
+            pos = [a.get_position() for a in shown]
+            lack = max(MIN_ASPECT * p.width * inches - p.height * fh for p in pos)
+            grow += max(0.0, lack) * rows
+        if grow < 0.01:
+            break
+        fig.set_size_inches(inches, fh + grow + 0.02)
+    canvas.draw()
+    return fig
+
+
+# a figure legend's constrained-layout place (``Legend._outside_loc``) -> its loc
+_OUTSIDE = {"lower": "outside lower center", "upper": "outside upper center",
+            "left": "outside left upper", "right": "outside right upper"}
+
+
 # ---------------------------------------------------------------------------------------
 # Figure 5: time histories
 # ---------------------------------------------------------------------------------------
@@ -96,13 +221,13 @@ def _alpha_symbol(run: Run) -> str:
 
 def _label(run: Run, swept: Sequence[str]) -> str:
     p = run.point
+    kind = getattr(p.body, "kind", "flexible")
     values = {"lam": p.lam, "shape": p.shape, "w_over_p": p.w_over_p, "A_ratio": p.A_ratio}
-    symbols = {"lam": r"$\lambda$", "w_over_p": r"$\omega/p$",
-               "A_ratio": rf"$A/(g\tan{_alpha_symbol(run)})$", "shape": "pulse"}
     parts = []
     for k in swept:
         v = values.get(k, getattr(p.body, k, None))
-        parts.append(f"{symbols.get(k, k)} = {v:g}" if isinstance(v, float) else f"{k} = {v}")
+        parts.append(f"${_axes.latex(k, kind)}$ = {v:g}" if isinstance(v, float)
+                     else f"{k} = {v}")
     text = ", ".join(parts) or f"$\\lambda$ = {p.lam:g}"
     return f"{text} ({run.outcome})"
 
@@ -206,7 +331,7 @@ _U_COLOURS = {-2.0: "#2166ac", -1.0: "#67a9cf", 0.0: "#000000", 1.0: "#ef8a62",
 def restitution_map(lam: np.ndarray, u_over_ucr: np.ndarray, e_upper: np.ndarray,
                     e_housner: float, title: str = "",
                     axes: Sequence[Axes] | None = None, lam_limit: np.ndarray | None = None,
-                    law: str = "vertical") -> Figure:
+                    law: str = DEFAULT_LAW) -> Figure:
     """Figure 2: (a) e against lam for u/u_cr = -2, -1, 0, 1, 2; (b) e against u/u_cr at
     lam = 0 with Housner's e of the same body welded rigid.
 
@@ -249,11 +374,11 @@ def restitution_map(lam: np.ndarray, u_over_ucr: np.ndarray, e_upper: np.ndarray
     ax_a.axhline(0.0, color="0.5", lw=0.6)
     ax_a.set_xlabel(r"$\lambda$")
     ax_a.set_ylabel("$e$")
-    which = "upper sign of eq. 1" if law == "vertical" else f"law {law}, upper sign"
+    which = "upper sign of eq. 1" if law == VERTICAL else f"law {law}, upper sign"
     ax_a.set_title(rf"(a) $e$ against $\lambda$ ({which})", fontsize=10)
     ax_a.legend(fontsize=8)
     i0 = int(np.argmin(abs(lam)))
-    first = "eq. (1)" if law == "vertical" else f"law {law}"
+    first = law_origin(law) if law == VERTICAL else f"law {law}"
     ax_b.plot(u_over_ucr, e_upper[i0], color="C0",
               label=rf"{first}, $\lambda$ = {lam[i0]:g}, upper sign")
     ax_b.plot(u_over_ucr, e_upper[i0, ::-1], color="C1", ls="--",

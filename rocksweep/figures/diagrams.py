@@ -37,7 +37,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap
-from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
@@ -45,13 +44,17 @@ from rocksweep.fields import WORD_AXES
 from rocksweep.figures.common import (
     DEFAULT_DPI,
     FORMATS,
+    Figure,
     FigureError,
     given_axes,
     new_axes,
     save_figure,
+    wrap_title,
 )
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.store.reader import SweepResult
+from rocksweep.vocab import axes as _axes
+from rocksweep.vocab.axes import DIAGRAM_AXES, RECORD_X
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -65,18 +68,12 @@ __all__ = ["FORMATS", "DiagramError", "choose_axes", "stability_diagram", "line_
 
 MAX_PANELS = 36
 
-SYMBOLS = {
-    "lam": r"\lambda", "zeta": r"\zeta", "wn_over_p": r"\omega_n/p",
-    "alpha_cg": r"\alpha_{cg}", "alpha_A": r"\alpha_A", "mA_over_m": "m_A/m",
-    "IA_ratio": r"I_A/(m_A R_A^2)", "alpha": r"\alpha", "inertia": r"I_O/(M R^2)",
-    "w_over_p": r"\omega/p", "A_ratio": r"A/(g\tan\alpha)", "p": r"p\ [\mathrm{rad/s}]",
-    "e": "e", "e_factor": r"e_{\mathrm{factor}}",
-}
-UNITS = {"alpha_cg": " [rad]", "alpha_A": " [rad]", "alpha": " [rad]"}
-# the slenderness that normalises the amplitude, per body kind (body.alpha_ref)
-ALPHA_REF = {"flexible": r"\alpha_{cg}", "block": r"\alpha"}
-DEFAULT_X, DEFAULT_Y = "w_over_p", "A_ratio"
-RECORD_X = "p"  # x of a record sweep (no w_over_p): the body's frequency parameter
+DEFAULT_X, DEFAULT_Y = DIAGRAM_AXES  # symbols, units: rocksweep.vocab.axes
+
+
+def _alpha(kind: str) -> str:
+    """LaTeX of the body kind's alpha_ref (alpha_cg, alpha)."""
+    return _axes.alpha_latex(kind)
 
 _SAFE, _MODE2, _NOT_RUN = "#ffffff", "#4c72b0", "#bdbdbd"
 _UNSURE = "#e69f00"  # rings: the outcome changes at half the step (outputs.check)
@@ -94,15 +91,12 @@ def _fmt(v) -> str:
 
 def y_label(kind: str) -> str:
     """Label of the amplitude axis A/(g tan alpha_ref) for a body kind."""
-    alpha = ALPHA_REF.get(kind, ALPHA_REF["block"])
-    return rf"$A/(g\,\tan{alpha})$"
+    return _axes.label("A_ratio", kind)
 
 
 def axis_label(dim: str, kind: str) -> str:
     """Axis label of a swept dimension (the paper's symbol, units where they are not 1)."""
-    if dim == "A_ratio":
-        return y_label(kind)
-    return rf"${SYMBOLS.get(dim, dim)}${UNITS.get(dim, '')}"
+    return _axes.label(dim, kind)
 
 
 def categories(outcome: np.ndarray) -> np.ndarray:
@@ -244,7 +238,7 @@ def _panel_title(result: SweepResult, panel_dims: list[str], idx: tuple[int, ...
     for d, i in zip(panel_dims, idx, strict=True):
         v = _coord(result, d)[i]
         parts.append(f"{v} pulse" if d == "shape" else f"law {v}" if d == "law"
-                     else f"${SYMBOLS.get(d, d)}$ = {_fmt(v)}")
+                     else f"${_axes.latex(d)}$ = {_fmt(v)}")
     return ", ".join(parts)
 
 
@@ -258,33 +252,14 @@ def _title(result: SweepResult, on_axes: Sequence[str]) -> str:
         extra.append(f"{shape} pulse")
     for d in ("w_over_p", "A_ratio"):
         if d in result.scalars and d not in on_axes:
-            sym = SYMBOLS[d] if d != "A_ratio" else rf"A/(g\tan{ALPHA_REF.get(result.kind)})"
+            sym = _axes.latex(d, result.kind)
             extra.append(f"${sym}$ = {_fmt(float(result.scalars[d]))}")
     return ", ".join([name, *extra])
 
 
 def _fit(title: str, fig: Figure) -> str:
-    """A title wrapped to the figure's width (about 9 characters per inch at 11 pt), so
-    a long scene name is not cut at the edges: words outside mathtext ($...$) break."""
-    width = max(20, int(9 * fig.get_figwidth()))
-    if len(title) <= width:
-        return title
-    words = [w for w in title.split(" ")]
-    tokens, math = [], False  # words joined while inside $...$
-    for w in words:
-        if math:
-            tokens[-1] += " " + w
-        else:
-            tokens.append(w)
-        if w.count("$") % 2:
-            math = not math
-    lines = [""]
-    for t in tokens:
-        if lines[-1] and len(lines[-1]) + 1 + len(t) > width:
-            lines.append(t)
-        else:
-            lines[-1] = f"{lines[-1]} {t}" if lines[-1] else t
-    return "\n".join(lines)
+    """A title wrapped to the figure's width at 11 pt (``common.wrap_title``)."""
+    return wrap_title(title, fig.get_figwidth(), 11.0)
 
 
 def _place_axes(axes, n: int, rows_cols: tuple[int, int], size: tuple[float, float],
@@ -355,7 +330,7 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
                                  (4.8, 4.2), "this stability diagram")
     used = np.zeros(3 + n_lam, bool)
     any_flag = any_back = any_slide = any_lift = any_unsure = False
-    lam_sym = SYMBOLS["lam"]
+    lam_sym = _axes.latex("lam")
     for ax, idx in zip(flat, panels, strict=False):
         po, pf = o[idx], fl[idx]  # [n_lam, n_y, n_x]
         cat = categories(po)
@@ -523,7 +498,7 @@ def _compare_colour(mask: int, n: int) -> str:
 def _value_label(name: str, v) -> str:
     if name in WORD_AXES:
         return str(v)
-    return f"${SYMBOLS.get(name, name)}$ = {_fmt(v)}"
+    return f"${_axes.latex(name)}$ = {_fmt(v)}"
 
 
 def _set_label(mask: int, labels: list[str], what: str) -> str:
@@ -569,7 +544,7 @@ def compare_diagram(result: SweepResult, key: str, x: str | None = None,
     o, fl = _arrays(result, order, ["outcome", flagged])
     values = list(_coord(result, name))
     labels = [_value_label(name, v) for v in values]
-    what = "law" if name == "law" else "value"
+    what = "law" if name == "law" else f"${_axes.latex(name, result.kind)}$ value"
     panels = _panels(result, panel_dims)
     n_cat = 3 + (1 << n) - 1
     colours = [_NOT_RUN, _SAFE, _MODE2, *(_compare_colour(m, n) for m in range(1, 1 << n))]
@@ -736,13 +711,13 @@ def line_diagram(result: SweepResult, x: str | None = None, *,
     import matplotlib
 
     cmap = matplotlib.colormaps["viridis"]
-    alpha = ALPHA_REF.get(result.kind, ALPHA_REF["block"])
+    alpha = _alpha(result.kind)
     used: set[int] = set()
     for ax, idx in zip(flat, panels, strict=False):
         po, pv = o[idx], v[idx]  # [n_lam, n_x]
         for k, lv in enumerate(lam):
             colour = cmap(0.85 * k / max(1, len(lam) - 1)) if len(lam) > 1 else "0.3"
-            label = f"${SYMBOLS['lam']}$ = {_fmt(lv)}" if lv is not None else None
+            label = f"${_axes.latex('lam')}$ = {_fmt(lv)}" if lv is not None else None
             yv = pv[k].astype(float)
             yv[po[k] == L.OUTCOME_NOT_RUN] = np.nan
             ax.plot(xs, yv, "-", color=colour, lw=1.1, label=label, zorder=1)
@@ -842,7 +817,7 @@ def stability_figure(result: SweepResult, path: str | Path, *, x: str | None = N
 def _where_label(where: dict[str, Any]) -> str:
     parts = []
     for k, v in where.items():
-        sym = f"${SYMBOLS[k]}$" if k in SYMBOLS else k
+        sym = f"${_axes.latex(k)}$" if k in _axes.AXES else k
         parts.append(f"{sym} = {_fmt(v)}")
     return ", ".join(parts) or "all"
 

@@ -7,7 +7,8 @@ is no ``lam``); other swept dimensions and several states get line styles. Each 
 fitted Phi(ln(x / median) / beta), its bootstrap band (pointwise percentiles of the
 resamples' curves, ``band_lo``/``band_hi``, when the fit was bootstrapped), and for stripes
 the empirical fraction at each level with the marker's area proportional to the records
-counted there. The legend gives each median and its change against the first colour's.
+counted there. The legend (below the axes, never over the data) gives each median, its
+change against the first colour's, and beta.
 """
 
 from __future__ import annotations
@@ -18,17 +19,18 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import xarray as xr
-from matplotlib.figure import Figure
 
 from rocksweep.analysis.fragility import lognormal_cdf
+from rocksweep.analysis.risk import fragility_median
 from rocksweep.errors import RocksweepError
 from rocksweep.figures import WIDTHS
+from rocksweep.figures.common import Figure
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
 # height / width of the figure at each paper width (``rocksweep.figures.WIDTHS``)
-ASPECT = {"single": 0.83, "double": 0.6}
+ASPECT = {"single": 1.2, "double": 0.75}  # room for the legend below
 _STYLES = ("-", "--", ":", "-.")
 
 
@@ -46,12 +48,14 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
                      width: str | tuple[float, float] = "single") -> Figure:
     """Draw fragility curves; returns the Figure (``ax.figure`` when ``ax`` is given).
 
-    frag: the Dataset of ``fragility()`` (median, beta [, band_lo, band_hi over im_grid]
+    frag: the Dataset of ``fragility()`` (im_median (or median in older Datasets), beta [,
+    band_lo, band_hi over im_grid]
     [, fraction, n_counted over the stripe dimension]); width: "single" (3.5 in), "double"
     (7.2 in) (``rocksweep.figures.WIDTHS``) or (width, height) in inches.
     """
-    if "median" not in frag or "im_grid" not in frag.coords:
-        raise FragilityFigureError("not a fragility Dataset (no 'median' or 'im_grid')")
+    if "im_grid" not in frag.coords or not ({"im_median", "median"} & set(frag.data_vars)):
+        raise FragilityFigureError("not a fragility Dataset (no 'im_median' or 'im_grid')")
+    median_da, _ = fragility_median(frag)
     if ax is None:
         size = ((WIDTHS[width][0], WIDTHS[width][0] * ASPECT[width])
                 if isinstance(width, str) and width in WIDTHS
@@ -61,11 +65,13 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
                                        "(width, height) in inches")
         fig = Figure(figsize=size, layout="constrained")
         ax = fig.add_subplot()
+        own = True
     else:
         fig = ax.figure
+        own = False
     im, unit = frag.attrs.get("im", "IM"), frag.attrs.get("im_units", "")
     stripe = im if im in frag.dims else None
-    dims = list(frag["median"].dims)
+    dims = list(median_da.dims)
     colour_dim = "lam" if "lam" in dims else next((d for d in dims if d != "state"), None)
     rest = [d for d in dims if d != colour_dim]
     grid = frag["im_grid"].values
@@ -79,7 +85,7 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
         ref_med, ref_val = math.nan, None
         for ci in range(n_col):
             one = base.isel({colour_dim: ci}) if colour_dim else base
-            med, beta = float(one["median"]), float(one["beta"])
+            med, beta = float(one[median_da.name]), float(one["beta"])
             colour = colours[ci]
             label_bits = []
             if colour_dim:
@@ -94,8 +100,11 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
                     ref_med, ref_val = med, label_bits[0] if label_bits else None
                 elif math.isfinite(ref_med) and ref_val:
                     text += f" ({100.0 * (med / ref_med - 1.0):+.0f}% vs {ref_val})"
+                text += f", beta {beta:.2f}" if math.isfinite(beta) else ""
+                reason = str(one["reason"].values) if "reason" in one else "ok"
+                text += "" if reason == "ok" else f" [{reason}]"
                 ax.plot(grid, lognormal_cdf(grid, med, beta), style, color=colour,
-                        label=", ".join(label_bits + [text]))
+                        label=(", ".join(label_bits) + "\n" + text).lstrip())
             else:
                 reason = str(one["reason"].values) if "reason" in one else "no fit"
                 ax.plot([], [], style, color=colour,
@@ -121,6 +130,13 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
     title = method + (f", {frag.attrs.get('ci', 0.9):g} band of {boot} resamples"
                       if boot else "")
     ax.set_title(title, fontsize="small")
-    ax.legend(fontsize="x-small", loc="lower right")
+    # below the axes: the curves and stripe markers fill the plot, a legend inside would
+    # cover them
+    n_entries = len(ax.get_legend_handles_labels()[0])
+    ax.legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.2),
+              frameon=False)
+    if own:  # two lines per entry below the axes: the figure grows to hold them
+        w, h = fig.get_size_inches()
+        fig.set_size_inches(w, h + 0.22 * max(n_entries - 3, 0))
     ax.grid(True, which="both", alpha=0.25, linewidth=0.5)
     return fig

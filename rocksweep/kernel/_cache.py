@@ -1,9 +1,10 @@
 """Where numba caches the compiled kernel, and the stamp that says it is fresh.
 
 numba's on-disk cache checks only the file that defines a function. The kernel's entry
-points are compiled together with functions from every module of this package, so an edit
-(or an upgrade) of one file must invalidate the cached code of all of them: every kernel
-function is stamped with one hash of all kernel sources.
+points are compiled together with functions from every module of this package and the
+codes of ``rocksweep.vocab``, so an edit (or an upgrade) of one file must invalidate the
+cached code of all of them: every kernel function is stamped with one hash of all these
+sources.
 
 numba also keys its cache directory by the source file's path, so two copies of the same
 sources (the repository run by ``python -m pytest`` and a non-editable ``pip install .`` in
@@ -54,7 +55,9 @@ ENTRY = {"_nrt": False}
 
 def _kernel_hash() -> str:
     h = hashlib.sha1()
-    for f in sorted(_KERNEL_DIR.glob("*.py")):
+    # the vocabulary's codes (rocksweep.vocab, read by ``layout``) are compiled in too
+    vocab = sorted((_KERNEL_DIR.parent / "vocab").glob("*.py"))
+    for f in [*sorted(_KERNEL_DIR.glob("*.py")), *vocab]:
         h.update(f.name.encode())
         h.update(f.read_bytes())
     return h.hexdigest()

@@ -65,6 +65,15 @@ from rocksweep.kernel.layout import (
     SHAPE_RICKER,
     SHAPE_SINE,
 )
+from rocksweep.vocab import ground as _ground
+
+# The Ricker and MP formulas, written once in ``rocksweep.vocab.ground`` (the physics
+# module evaluates the same functions per sample); compiled here, inlined by LLVM.
+_ricker_tau = njit(**INLINE)(_ground.ricker_tau)
+_ricker = njit(**INLINE)(_ground.ricker)
+_ricker_rate = njit(**INLINE)(_ground.ricker_rate)
+_mp_raw = njit(**INLINE)(_ground.mp_raw)
+_mp_raw_rate = njit(**INLINE)(_ground.mp_raw_rate)
 
 # ----------------------------------------------------------------------------------------
 # Eq. (2): the pulse (n cycles of a sine or cosine), and the other ground motions. ``on``
@@ -172,13 +181,8 @@ def ground_acc_any(t, prm):
     if shape == SHAPE_COSINE:
         return amp * math.cos(phi)
     if shape == SHAPE_RICKER:
-        tau = 0.5 * phi - 1.5 * math.pi
-        return amp * (1.0 - 2.0 * tau * tau) * math.exp(-tau * tau)
-    gamma = prm[PAR_GAMMA]
-    psi = phi - math.pi * gamma + prm[PAR_NU]
-    x = phi / gamma
-    r = math.sin(x) * math.cos(psi) - gamma * (1.0 - math.cos(x)) * math.sin(psi)
-    return amp * prm[PAR_AMP_NORM] * r
+        return _ricker(_ricker_tau(phi), amp)
+    return amp * prm[PAR_AMP_NORM] * _mp_raw(phi, prm[PAR_GAMMA], prm[PAR_NU])
 
 
 @njit(cache=True, **INTERNAL)
@@ -196,14 +200,8 @@ def ground_jerk_any(t, prm):
     if shape == SHAPE_COSINE:
         return -amp * w * math.sin(phi)
     if shape == SHAPE_RICKER:
-        tau = 0.5 * phi - 1.5 * math.pi
-        return amp * w * tau * (2.0 * tau * tau - 3.0) * math.exp(-tau * tau)
-    gamma = prm[PAR_GAMMA]
-    psi = phi - math.pi * gamma + prm[PAR_NU]
-    x = phi / gamma
-    rate = (math.cos(psi) * (math.cos(x) / gamma - gamma * (1.0 - math.cos(x)))
-            - 2.0 * math.sin(x) * math.sin(psi))
-    return amp * prm[PAR_AMP_NORM] * w * rate
+        return _ricker_rate(_ricker_tau(phi), amp * w)
+    return amp * prm[PAR_AMP_NORM] * w * _mp_raw_rate(phi, prm[PAR_GAMMA], prm[PAR_NU])
 
 
 # ----------------------------------------------------------------------------------------

@@ -8,6 +8,10 @@ quantities are SI with m = 1 kg, g = 9.81 m/s^2 and p = 1 rad/s (see ``rocksweep
 so times are p*t.
 """
 
+from rocksweep.vocab import ground as _ground
+from rocksweep.vocab import laws as _laws
+from rocksweep.vocab import outcomes as _out
+
 # --- parameter row ---------------------------------------------------------------------
 PAR_M = 0  # top mass m [kg]
 PAR_MA = 1  # base mass m_A [kg]
@@ -54,14 +58,14 @@ N_PAR = 40
 # N_PAR parameters, PAR_REC = N_PAR the first (``points.with_record``).
 PAR_REC = N_PAR
 
-SHAPE_SINE = 0.0
-SHAPE_COSINE = 1.0
-SHAPE_RICKER = 2.0
-SHAPE_MP = 3.0
-SHAPE_RECORD = 4.0  # linear interpolation of the samples at PAR_REC...
-LAW_VERTICAL = 0.0  # eq. (1): no impulse reaches the top mass (its momentum is kept)
-LAW_LOCKED = 1.0  # the top mass moves with the base through the impact (u' is kept)
-LAW_CONSTANT = 2.0  # e = PAR_E; the top mass keeps its momentum, as in LAW_VERTICAL
+SHAPE_SINE = _ground.SHAPE_CODE[_ground.SINE]
+SHAPE_COSINE = _ground.SHAPE_CODE[_ground.COSINE]
+SHAPE_RICKER = _ground.SHAPE_CODE[_ground.RICKER]
+SHAPE_MP = _ground.SHAPE_CODE[_ground.MP]
+SHAPE_RECORD = _ground.SHAPE_CODE[_ground.RECORD]
+LAW_VERTICAL = _laws.LAW_CODE[_laws.VERTICAL]
+LAW_LOCKED = _laws.LAW_CODE[_laws.LOCKED]
+LAW_CONSTANT = _laws.LAW_CODE[_laws.CONSTANT]
 ROOT_BISECT = 0.0
 ROOT_ILLINOIS = 1.0
 ROOT_HERMITE = 2.0
@@ -115,28 +119,31 @@ HIST_XG = 10  # ground acceleration [m/s^2]
 N_HIST = 11
 
 # --- outcome and status codes ----------------------------------------------------------
-OUTCOME_NOT_RUN = -1
-OUTCOME_SAFE = 0
-OUTCOME_MODE1 = 1  # overturned after one or more impacts
-OUTCOME_MODE2 = 2  # overturned without impact
+# (codes and words: ``rocksweep.vocab.outcomes``)
+OUTCOME_NOT_RUN = _out.OUTCOME_CODE[_out.NOT_RUN]
+OUTCOME_SAFE = _out.OUTCOME_CODE[_out.SAFE]
+OUTCOME_MODE1 = _out.OUTCOME_CODE[_out.MODE1]  # overturned after one or more impacts
+OUTCOME_MODE2 = _out.OUTCOME_CODE[_out.MODE2]  # overturned without impact
 
-STATUS_REST = 1  # rest proven after the pulse (early exit); never with STATUS_SETTLED
-STATUS_HORIZON = 2  # horizon reached before the outcome was decided
-STATUS_STEP_CAP = 4
-STATUS_EVENT_CAP = 8
-STATUS_NONFINITE = 16
-STATUS_HIST_FULL = 32  # history buffer full; integration went on unrecorded
-STATUS_ENERGY_GAIN = 64  # at least one impact gained energy (energy variants)
-STATUS_SETTLED = 128  # chattering ended in full contact through the rest-rate rule (no
-#                        proof of rest: a run that then ends early is not flagged REST)
-STATUS_OVERTURNED = 256
-STATUS_E_ABOVE_1 = 512  # at least one impact had e > 1
-STATUS_BOUNDED = 1024  # rigid body after the pulse below its overturning energy, |e| <= 1:
-#                        safe proven (early exit; impacts counted up to there)
-STATUS_SLIDES = 2048  # friction demand above PAR_MU: the base would slide (contact variants)
-STATUS_LIFTS_OFF = 4096  # normal reaction below 0: the body would leave the ground (contact)
+STATUS_REST = _out.STATUS_BIT["rest"]
+STATUS_HORIZON = _out.STATUS_BIT["horizon"]  # horizon reached before the outcome was decided
+STATUS_STEP_CAP = _out.STATUS_BIT["step_cap"]
+STATUS_EVENT_CAP = _out.STATUS_BIT["event_cap"]
+STATUS_NONFINITE = _out.STATUS_BIT["nonfinite"]
+STATUS_HIST_FULL = _out.STATUS_BIT["history_full"]
+STATUS_ENERGY_GAIN = _out.STATUS_BIT["energy_gain"]
+# chattering ended in full contact through the rest-rate rule (no proof of rest: a run that
+# then ends early is not flagged REST)
+STATUS_SETTLED = _out.STATUS_BIT["settled"]
+STATUS_OVERTURNED = _out.STATUS_BIT["overturned"]
+STATUS_E_ABOVE_1 = _out.STATUS_BIT["e_above_1"]  # at least one impact had e > 1
+# rigid body after the pulse below its overturning energy, |e| <= 1: safe proven (early
+# exit; impacts counted up to there)
+STATUS_BOUNDED = _out.STATUS_BIT["bounded"]
+STATUS_SLIDES = _out.STATUS_BIT["slides"]
+STATUS_LIFTS_OFF = _out.STATUS_BIT["lifts_off"]
 # A run with any of these is not a reliable classification: "flagged".
-STATUS_FLAGGED = STATUS_HORIZON | STATUS_STEP_CAP | STATUS_EVENT_CAP | STATUS_NONFINITE
+STATUS_FLAGGED = _out.FLAGGED
 
 # --- kernel variants (compile-time flags) -----------------------------------------------
 KIND_FLEXIBLE = 0

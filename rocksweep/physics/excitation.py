@@ -1,9 +1,13 @@
 """Reference definitions of the ground-acceleration pulses (pure numpy, no numba).
 
-This module is the independent definition that the kernel's jitted pulse is tested
-against, and the source of the README's plot of the shapes. Every shape is a function of
-the phase ``phi = w t`` (w = w_over_p * p [rad/s], t [s]; in kernel time p = 1, so phi =
-w_over_p * (p t)) and is normalised so that its peak |xg''| is A:
+This module is the pulses' reference in physics units and the source of the README's plot
+of the shapes. The Ricker and MP formulas are written once, in ``rocksweep.vocab.ground``,
+and evaluated here per sample and compiled into the kernel; tests/physics/test_excitation.py
+checks them against independent closed forms (the Ricker's roots and side lobes, the
+Lambert-W uplift, OpenSees' MPAcc and its velocity, finite differences).
+
+Every shape is a function of the phase ``phi = w t`` (w = w_over_p * p [rad/s], t [s];
+in kernel time p = 1, so phi = w_over_p * (p t)) and is normalised so that its peak |xg''| is A:
 
     xg''(t) = A * shape(w t),        d xg''/dt = A * w * shape'(w t).
 
@@ -40,7 +44,7 @@ still "on", as in the kernel, where the step ending exactly at D still sees the 
 
 ``PulseShape`` bundles a shape with its parameters; ``uplift_phase`` is the rigid block's
 uplift under it (|A_ratio * shape(phi)| first reaches 1, the block's g tan(alpha));
-``shapes_figure`` draws every shape (matplotlib is imported only there).
+``rocksweep.figures.pulses.shapes_figure`` draws every shape.
 """
 
 from __future__ import annotations
@@ -48,17 +52,23 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from matplotlib.figure import Figure
-
-SHAPES = ("sine", "cosine", "ricker", "mp")
-
-# Ricker: tau = phi/2 - RICKER_TAU0, on for 0 <= phi <= 6 pi (t0 = 1.5/f, D = 2 t0)
-RICKER_TAU0 = 1.5 * math.pi
+from rocksweep.vocab.ground import (  # noqa: F401
+    MP,
+    PAPER_SHAPES,
+    RICKER,
+    RICKER_TAU0,
+    SHAPE_TITLE,
+    SHAPES,
+    SINE,
+    mp_raw,
+    mp_raw_rate,
+    pulse_duration,
+    ricker,
+    ricker_rate,
+)
 
 # uplift_phase samples this many points per pulse before refining with brentq
 _UPLIFT_SAMPLES = 20_001
@@ -68,19 +78,22 @@ def _phase(phi) -> np.ndarray:
     return np.asarray(phi, dtype=np.float64)
 
 
+# The formulas are ``rocksweep.vocab.ground``'s (the kernel compiles the same functions),
+# evaluated here per sample: float64 arrays of any shape in and out.
+_ricker = np.vectorize(ricker, otypes=[np.float64])
+_ricker_rate = np.vectorize(ricker_rate, otypes=[np.float64])
+_mp = np.vectorize(mp_raw, otypes=[np.float64])
+_mp_rate = np.vectorize(mp_raw_rate, otypes=[np.float64])
+
+
 def _mp_raw(phi: np.ndarray, gamma: float, nu_deg: float) -> np.ndarray:
     """r(phi) of the module docstring (unnormalised MP acceleration), for all phi."""
-    psi = phi - math.pi * gamma + math.radians(nu_deg)
-    x = phi / gamma
-    return np.sin(x) * np.cos(psi) - gamma * (1.0 - np.cos(x)) * np.sin(psi)
+    return _mp(phi, gamma, math.radians(nu_deg))
 
 
 def _mp_raw_rate(phi: np.ndarray, gamma: float, nu_deg: float) -> np.ndarray:
     """dr/dphi."""
-    psi = phi - math.pi * gamma + math.radians(nu_deg)
-    x = phi / gamma
-    return (np.cos(psi) * (np.cos(x) / gamma - gamma * (1.0 - np.cos(x)))
-            - 2.0 * np.sin(x) * np.sin(psi))
+    return _mp_rate(phi, gamma, math.radians(nu_deg))
 
 
 @lru_cache(maxsize=64)
@@ -140,18 +153,14 @@ class PulseShape:
     @property
     def duration(self) -> float:
         """Pulse duration D in phase (w t): 2 pi n, 6 pi (Ricker) or 2 pi gamma (MP)."""
-        if self.shape in ("sine", "cosine"):
-            return 2.0 * math.pi * self.cycles
-        if self.shape == "ricker":
-            return 6.0 * math.pi
-        return 2.0 * math.pi * self.gamma
+        return pulse_duration(self.shape, self.cycles, self.gamma)
 
     @property
     def label(self) -> str:
-        if self.shape in ("sine", "cosine"):
+        if self.shape in PAPER_SHAPES:
             return self.shape if self.cycles == 1 else f"{self.shape}, {self.cycles} cycles"
-        if self.shape == "ricker":
-            return "Ricker"
+        if self.shape == RICKER:
+            return SHAPE_TITLE[RICKER]
         return f"MP, gamma = {self.gamma:g}, nu = {self.nu_deg:g} deg"
 
     def _on(self, phi: np.ndarray) -> np.ndarray:
@@ -164,9 +173,8 @@ class PulseShape:
             f = np.sin(phi)
         elif self.shape == "cosine":
             f = np.cos(phi)
-        elif self.shape == "ricker":
-            tau = 0.5 * phi - RICKER_TAU0
-            f = (1.0 - 2.0 * tau * tau) * np.exp(-tau * tau)
+        elif self.shape == RICKER:
+            f = _ricker(0.5 * phi - RICKER_TAU0)
         else:
             f = _mp_raw(phi, self.gamma, self.nu_deg) / mp_peak(self.gamma, self.nu_deg)
         return np.where(self._on(phi), f, 0.0)
@@ -178,10 +186,8 @@ class PulseShape:
             f = np.cos(phi)
         elif self.shape == "cosine":
             f = -np.sin(phi)
-        elif self.shape == "ricker":
-            # d/dphi = (1/2) d/dtau of (1 - 2 tau^2) e^{-tau^2} = (1/2) 2 tau (2 tau^2 - 3) e^{..}
-            tau = 0.5 * phi - RICKER_TAU0
-            f = tau * (2.0 * tau * tau - 3.0) * np.exp(-tau * tau)
+        elif self.shape == RICKER:
+            f = _ricker_rate(0.5 * phi - RICKER_TAU0)
         else:
             f = _mp_raw_rate(phi, self.gamma, self.nu_deg) / mp_peak(self.gamma, self.nu_deg)
         return np.where(self._on(phi), f, 0.0)
@@ -218,34 +224,3 @@ def default_shapes() -> tuple[PulseShape, ...]:
     return (PulseShape("sine"), PulseShape("sine", cycles=2), PulseShape("cosine"),
             PulseShape("cosine", cycles=2), PulseShape("ricker"),
             PulseShape("mp", gamma=2.0, nu_deg=90.0), PulseShape("mp", gamma=2.0, nu_deg=0.0))
-
-
-def shapes_figure(shapes: tuple[PulseShape, ...] | None = None,
-                  figsize: tuple[float, float] = (10.0, 2.6)) -> Figure:
-    """A figure of xg''/A against w t, one panel per family (sine, cosine, Ricker, MP).
-
-    Shapes of the same family share a panel. Returns a matplotlib Figure (no pyplot);
-    matplotlib is imported here only, so the module stays numpy/scipy at import.
-    """
-    from matplotlib.figure import Figure
-
-    shapes = default_shapes() if shapes is None else tuple(shapes)
-    families = [s for s in SHAPES if any(p.shape == s for p in shapes)]
-    titles = {"sine": "sine", "cosine": "cosine", "ricker": "Ricker",
-              "mp": "Mavroeidis-Papageorgiou"}
-    fig = Figure(figsize=figsize, layout="constrained")
-    axes = fig.subplots(1, len(families), sharey=True, squeeze=False)[0]
-    for ax, family in zip(axes, families, strict=True):
-        members = [p for p in shapes if p.shape == family]
-        d_max = max(p.duration for p in members)
-        for k, p in enumerate(members):
-            phi = np.linspace(-0.05 * d_max, 1.05 * d_max, 2000)
-            ax.plot(phi, p.acc(phi), lw=1.2, ls=("-", "--", ":")[k % 3], label=p.label)
-        ax.axhline(0.0, color="0.6", lw=0.5)
-        ax.set_title(titles[family], fontsize=9)
-        ax.set_xlabel(r"$\omega t$")
-        ax.set_ylim(-1.8, 1.15)  # room below the curves for the legend
-        ax.legend(fontsize=6, loc="lower center", frameon=False)
-        ax.tick_params(labelsize=7)
-    axes[0].set_ylabel(r"$\ddot x_g / A$")
-    return fig

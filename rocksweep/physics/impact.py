@@ -46,8 +46,8 @@ import numpy as np
 
 from rocksweep.physics.model import Body, FlexibleBody, impact_energy_loss, restitution_rigid
 from rocksweep.physics.model import restitution as restitution_eq1
+from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW, LAWS, LOCKED, VERTICAL
 
-LAWS = ("vertical", "locked", "constant")
 # The u/u_cr range over which a body's energy-admissible lam is taken (Figure 2's range)
 U_RANGE = 2.0
 
@@ -56,19 +56,19 @@ def _flexible(body: Body) -> bool:
     return isinstance(body, FlexibleBody) and not body.rigid
 
 
-def restitution(body: Body, lam, u, upper: bool = True, law: str = "vertical",
+def restitution(body: Body, lam, u, upper: bool = True, law: str = DEFAULT_LAW,
                 e: float = math.nan, e_factor: float = 1.0) -> np.ndarray:
     """e = theta'^+ / theta'^- of a rocking-to-rocking impact under ``law``, times
     ``e_factor``. lam, u [m]: arrays broadcast (u is not used by a rigid body)."""
     lam = np.asarray(lam, float)
     u = np.asarray(u, float)
-    if law == "constant":
+    if law == CONSTANT:
         return np.broadcast_to(np.float64(e * e_factor), np.broadcast(lam, u).shape).copy()
-    if law not in ("vertical", "locked"):
+    if law not in (VERTICAL, LOCKED):
         raise ValueError(f"impact law {law!r}: must be one of {', '.join(LAWS)}")
     if not _flexible(body):  # top mass welded: the rigid body's e
         return np.asarray(restitution_rigid(body, lam), float) * e_factor + 0.0 * u
-    if law == "vertical":
+    if law == VERTICAL:
         return restitution_eq1(body, lam, u, upper) * e_factor
     sg = 1.0 if upper else -1.0
     m, m_A, b = body.m, body.m_A, body.b
@@ -79,7 +79,7 @@ def restitution(body: Body, lam, u, upper: bool = True, law: str = "vertical",
 
 
 def energy_loss(body: Body, e, u, theta_dot_minus, upper: bool = True,
-                law: str = "vertical", u_dot=0.0) -> np.ndarray:
+                law: str = DEFAULT_LAW, u_dot=0.0) -> np.ndarray:
     """E_d [J], the energy a rocking-to-rocking impact with restitution e dissipates
     (eq. 6 under ``law``; < 0: the impact gains energy). u [m], theta_dot_minus [rad/s]
     and (``locked`` only) u_dot [m/s], the top mass's rate relative to the base."""
@@ -88,14 +88,14 @@ def energy_loss(body: Body, e, u, theta_dot_minus, upper: bool = True,
     if not _flexible(body):
         return 0.5 * body.I_O * (1 - e**2) * w2
     loss = impact_energy_loss(body, e, u, theta_dot_minus, upper)
-    if law == "locked":
+    if law == LOCKED:
         mh = body.m * body.h
         loss = loss + (mh * np.asarray(u_dot, float) * np.asarray(theta_dot_minus, float)
                        * (1 - e) + 0.5 * mh * body.h * (1 - e**2) * w2)
     return loss
 
 
-def lam_energy_limit(body: Body, u, upper: bool = True, law: str = "vertical",
+def lam_energy_limit(body: Body, u, upper: bool = True, law: str = DEFAULT_LAW,
                      e: float = math.nan, e_factor: float = 1.0, iters: int = 60
                      ) -> np.ndarray:
     """The largest lam in [0, 2] at which a rocking-to-rocking impact at lateral u [m]
@@ -126,7 +126,7 @@ def lam_energy_limit(body: Body, u, upper: bool = True, law: str = "vertical",
     return np.where(every & ~none, np.nan, out)
 
 
-def body_lam_limit(body: Body, law: str = "vertical", e: float = math.nan,
+def body_lam_limit(body: Body, law: str = DEFAULT_LAW, e: float = math.nan,
                    e_factor: float = 1.0, n_u: int = 161) -> float:
     """The body's energy-admissible lam: the least ``lam_energy_limit`` over u/u_cr in
     [-U_RANGE, U_RANGE] (both transition directions: the lower sign is the upper's mirror

@@ -23,6 +23,17 @@ record:
   spans at least ``points_per_period`` steps, at most ``max_refine`` sub-steps per sample;
   the peak then is low by at most 1 - cos(pi / points_per_period) = 0.5 % for 32).
   Sa(T = 0) is defined as PGA, its limit.
+- ``arias`` [m/s]: Arias intensity I_A = pi / (2 g) * integral of a(t)^2 dt (a in m/s^2),
+  exact for the piecewise-linear record (per step dt (a0^2 + a0 a1 + a1^2) / 3).
+- ``cav`` [m/s]: cumulative absolute velocity, integral of |a(t)| dt (a in m/s^2), exact for
+  the piecewise-linear record (a step where acc changes sign is split at its zero).
+- ``significant_duration`` [s]: D5-95, the time between 5% and 95% of the Arias intensity
+  (Trifunac & Brady 1975), the cumulative integral exact at the samples and linear
+  between them (an error below one sample interval).
+- ``avg_sa`` [g]: AvgSa, the geometric mean of Sa over ``AVGSA_POINTS`` periods spaced
+  evenly in ln T over [T_lo, T_hi] (Eads, Miranda & Lignos 2015; Kohrangi et al. 2016).
+- ``final_velocity`` [m/s]: v at the last sample (a record whose velocity does not return to
+  0 drifts: the ground keeps moving after it ends).
 - ``duration`` [s] = (n - 1) dt, ``sha256`` of a file's bytes.
 
 Why our own code and not a library (both read at their source, both MIT): eqsig's
@@ -45,8 +56,14 @@ import numpy as np
 from scipy.signal import lfilter
 
 from rocksweep.physics.model import G  # gravity [m/s^2], the one definition
+from rocksweep.vocab.ground import SA_DAMPING
 
-__all__ = ["G", "duration", "pga", "pgv", "sa", "sha256", "velocity"]
+__all__ = ["AVGSA_POINTS", "G", "arias", "avg_sa", "avgsa_periods", "cav", "duration",
+           "final_velocity", "husid", "pga", "pgv", "sa", "sha256",
+           "significant_duration", "velocity"]
+
+#: periods of AvgSa: this many, evenly spaced in ln T over the range
+AVGSA_POINTS = 10
 
 
 def _check(acc, dt: float) -> np.ndarray:
@@ -94,6 +111,69 @@ def pgv(acc, dt: float, *, g: float = G) -> float:
         vstar = v[:-1][cross] - g * a0c * a0c * dt / (2.0 * (a1c - a0c))
         peak = max(peak, float(np.max(np.abs(vstar))))
     return peak
+
+
+def final_velocity(acc, dt: float, *, g: float = G) -> float:
+    """Ground velocity at the record's last sample [m/s] (``velocity``): 0 for a record
+    whose baseline was corrected, the drift of one that was not."""
+    return float(velocity(acc, dt, g=g)[-1])
+
+
+def husid(acc, dt: float) -> np.ndarray:
+    """Cumulative integral of acc^2 at the samples [g^2 s], float64[n], exact for the
+    piecewise-linear record: per step dt (a0^2 + a0 a1 + a1^2) / 3."""
+    a = _check(acc, dt)
+    out = np.empty_like(a)
+    out[0] = 0.0
+    np.cumsum(dt * (a[:-1] ** 2 + a[:-1] * a[1:] + a[1:] ** 2) / 3.0, out=out[1:])
+    return out
+
+
+def arias(acc, dt: float, *, g: float = G) -> float:
+    """Arias intensity I_A = pi / (2 G) integral (g acc)^2 dt [m/s]: acc in g (``g`` the
+    m/s^2 in one unit of acc; the pi / (2 G) is always gravity's)."""
+    return float(math.pi / (2.0 * G) * g * g * husid(acc, dt)[-1])
+
+
+def cav(acc, dt: float, *, g: float = G) -> float:
+    """Cumulative absolute velocity integral |g acc| dt [m/s] (acc in g), exact for the
+    piecewise-linear record (a step where acc changes sign: dt (a0^2 + a1^2) / (2 (|a0| +
+    |a1|)))."""
+    a = _check(acc, dt)
+    a0, a1 = np.abs(a[:-1]), np.abs(a[1:])
+    same = (a[:-1] * a[1:]) >= 0.0
+    s = a0 + a1
+    with np.errstate(invalid="ignore", divide="ignore"):
+        split = np.where(s > 0.0, (a0 * a0 + a1 * a1) / (2.0 * np.where(s > 0, s, 1.0)), 0.0)
+    area = np.where(same, 0.5 * s, split) * dt
+    return float(g * np.sum(area))
+
+
+def significant_duration(acc, dt: float, lo: float = 0.05, hi: float = 0.95) -> float:
+    """D5-95 [s] (``lo``, ``hi`` the fractions): the time from ``lo`` to ``hi`` of the
+    record's Arias intensity, the cumulative integral (``husid``) linear between samples.
+    NaN for a record of zeros."""
+    h = husid(acc, dt)
+    total = h[-1]
+    if not total > 0.0:
+        return math.nan
+    t = np.arange(h.size) * float(dt)
+    t_lo, t_hi = np.interp([lo * total, hi * total], h, t)
+    return float(t_hi - t_lo)
+
+
+def avgsa_periods(t_lo: float, t_hi: float, n: int = AVGSA_POINTS) -> np.ndarray:
+    """The periods of AvgSa [s]: ``n`` evenly spaced in ln T over [t_lo, t_hi]."""
+    return np.geomspace(float(t_lo), float(t_hi), int(n))
+
+
+def avg_sa(acc, dt: float, t_lo: float, t_hi: float, zeta: float = 0.05,
+           n: int = AVGSA_POINTS) -> float:
+    """AvgSa [g]: the geometric mean of Sa(T) (``sa``, damping ``zeta``) over the periods
+    ``avgsa_periods(t_lo, t_hi, n)`` [s] (0 < t_lo <= t_hi)."""
+    if not (0.0 < t_lo <= t_hi and math.isfinite(t_hi)):
+        raise ValueError(f"AvgSa periods ({t_lo!r}, {t_hi!r}): need 0 < T_lo <= T_hi")
+    return float(np.exp(np.mean(np.log(sa(acc, dt, avgsa_periods(t_lo, t_hi, n), zeta)))))
 
 
 def duration(acc, dt: float) -> float:
@@ -148,7 +228,7 @@ def _free_peak(u: float, v: float, w: float, zeta: float) -> float:
     return max(abs(u), abs(u1))  # later extrema are smaller: u(t + pi/wd) = -decay u(t)
 
 
-def sa(acc, dt: float, periods, zeta: float = 0.05, *, points_per_period: int = 32,
+def sa(acc, dt: float, periods, zeta: float = SA_DAMPING, *, points_per_period: int = 32,
        max_refine: int = 64) -> np.ndarray:
     """Pseudo-spectral acceleration Sa(T) = (2 pi / T)^2 max_t |u(t)| [units of acc: g for
     project records], float64[n_periods] for ``periods`` [s] (any shape, flattened order

@@ -23,25 +23,31 @@ from rocksweep.numerics import (
 )
 from rocksweep.physics.model import Body, FlexibleBody, G
 from rocksweep.physics.records import GroundRecord
+from rocksweep.vocab.axes import INITIAL  # noqa: F401
+from rocksweep.vocab.ground import (  # noqa: F401
+    CYCLES,
+    FREE,
+    GAMMA,
+    MP,
+    NU_DEG,
+    PAPER_SHAPES,
+    RECORD,
+    RICKER,
+    SHAPE_CODE,
+    SHAPES,
+    SINE,
+    pulse_duration,
+)
+from rocksweep.vocab.laws import DEFAULT_LAW, LAW_CODE, LAWS  # noqa: F401
 
 if TYPE_CHECKING:
     from rocksweep.physics.excitation import PulseShape
 
-SHAPES = ("sine", "cosine", "ricker", "mp")
-RECORD = "record"  # the shape of a point driven by a ground-motion record
-# The shape of a point without ground motion (a scene with neither pulse: nor ground:):
-# free vibration from the initial state. Its w_over_p is 0 and A_ratio 0: the kernel's
-# pulse variant with A = 0 and a pulse that ends at t = 0 (``run_cost``).
-FREE = "free"
-# The initial state's keys (scene section ``initial``), normalised as ``simulate --csv``
-# writes them: theta/alpha_ref, theta'/(p alpha_ref), u/u_cr, u'/(p u_cr).
-INITIAL = ("theta_over_alpha", "thetadot_over_palpha", "u_over_ucr", "udot_over_pucr")
-_SHAPE_CODE = {"sine": L.SHAPE_SINE, "cosine": L.SHAPE_COSINE, "ricker": L.SHAPE_RICKER,
-               "mp": L.SHAPE_MP, RECORD: L.SHAPE_RECORD, FREE: L.SHAPE_SINE}
-# Defaults of the pulse's optional keys (scene keys pulse.cycles, pulse.gamma, pulse.nu)
-CYCLES, GAMMA, NU_DEG = 1, 2.0, 90.0
-LAWS = ("vertical", "locked", "constant")  # impact laws (``rocksweep.physics.impact``)
-_LAW_CODE = {"vertical": L.LAW_VERTICAL, "locked": L.LAW_LOCKED, "constant": L.LAW_CONSTANT}
+# shapes, laws and their kernel codes: rocksweep.vocab (the names re-exported here)
+# FREE runs as a sine of amplitude 0 that ends at t = 0 (its own code would be a new
+# branch of the kernel for nothing)
+_SHAPE_CODE = {**SHAPE_CODE, FREE: SHAPE_CODE[SINE]}
+_LAW_CODE = LAW_CODE
 _ROOT_CODE = dict(zip(ROOTS, (L.ROOT_BISECT, L.ROOT_ILLINOIS, L.ROOT_HERMITE), strict=True))
 
 
@@ -70,7 +76,7 @@ class Point:
     record: GroundRecord | None = None
     p: float = math.nan
     mu: float = math.nan
-    law: str = "vertical"
+    law: str = DEFAULT_LAW
     e: float = math.nan
     e_factor: float = 1.0
     # the state at t = 0 (``INITIAL``, normalised; all 0: at rest in full contact)
@@ -88,7 +94,7 @@ class Point:
     @property
     def ground(self) -> bool:
         """Whether the point needs the kernel's GROUND variants (``kernel.variants``)."""
-        return self.shape in ("ricker", "mp", RECORD)
+        return self.shape not in (*PAPER_SHAPES, FREE)
 
     @property
     def pulse(self) -> PulseShape | None:
@@ -210,15 +216,6 @@ def record_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, p: np.ndarray,
     return dt, h_rec, t_pulse, t_end, max_steps
 
 
-def phase_duration(shape: str, cycles: int = CYCLES, gamma: float = GAMMA) -> float:
-    """A pulse's duration in w t (``excitation.PulseShape.duration``; 0 for FREE)."""
-    from rocksweep.physics.excitation import PulseShape
-
-    if shape == FREE:
-        return 0.0
-    return PulseShape(shape, int(cycles), float(gamma)).duration
-
-
 def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
               alpha_ref: np.ndarray, lam: np.ndarray, shape_code: np.ndarray,
               w_over_p: np.ndarray, A_ratio: np.ndarray, numerics: Numerics,
@@ -250,10 +247,10 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
         rows[:, L.PAR_REC_H] = h_rec
         omega = 0.0
     else:
-        # each point's duration in w t by its shape: sine and cosine 2 pi n, the Ricker
-        # 6 pi, MP 2 pi gamma
+        # each point's duration in w t by its shape (``vocab.ground.pulse_duration``)
         phase = np.select([code == L.SHAPE_RICKER, code == L.SHAPE_MP],
-                          [6 * math.pi, 2 * math.pi * gamma], 2 * math.pi * cycles)
+                          [pulse_duration(RICKER), pulse_duration(MP, gamma=gamma)],
+                          pulse_duration(SINE, cycles=cycles))
         dt, t_pulse, t_end, max_steps = run_cost(omega_rock, alpha_ref, omega, A_ratio,
                                                  numerics, phase)
         if np.any(code == L.SHAPE_MP):

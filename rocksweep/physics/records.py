@@ -23,8 +23,8 @@ number in the file name). This one is ~150 lines with its own tests (both header
 partial last line, CRLF, Fortran exponents, every malformed case).
 
 Any malformed file (missing header, NPTS not matching the number of values, non-uniform or
-decreasing times, NaN/inf, no motion at all, empty) is a ``RecordError``: one line naming
-the file and the line.
+decreasing times, NaN/inf, no motion at all, a peak outside [PGA_MIN, PGA_MAX] g, empty)
+is a ``RecordError``: one line naming the file and the line.
 
 The parsed record (``GroundRecord``) holds the samples acc[i] [g] at t_i = i * dt [s].
 Between samples the ground acceleration is linearly interpolated; after the last sample
@@ -117,6 +117,11 @@ _NPTS_MIN = 2
 # Sample spacing of a record [s]: 1 MHz to one sample every 10 s bound any ground motion
 # recorder; beyond, DT is a typo (1e300 would overflow the run's length, 1e-300 its steps).
 DT_MIN, DT_MAX = 1e-6, 10.0
+# Peak of a record [g]: far beyond any ground motion either way (a record in g peaks
+# between ~1e-4 and ~10), yet every scaling, velocity and spectral value of it stays a
+# normal float: a subnormal peak (1e-310) or a huge one (1e300) would overflow the scale
+# factor or the spectra (numpy's RuntimeWarnings, inf factors).
+PGA_MIN, PGA_MAX = 1e-100, 1e100
 
 
 def _where(src: str, line: int | None = None) -> str:
@@ -255,6 +260,10 @@ def parse_record(data: bytes, source: str | Path) -> GroundRecord:
     pga = float(np.max(np.abs(acc)))
     if pga == 0.0:
         raise RecordError(f"{_where(src)}: every value is 0 (PGA = 0): no motion to scale")
+    if not PGA_MIN <= pga <= PGA_MAX:
+        raise RecordError(f"{_where(src)}: PGA = {pga:g} g: the peak must be in "
+                          f"[{PGA_MIN:g}, {PGA_MAX:g}] g (accelerations in g); is it in "
+                          "other units, or not a record?")
     acc.setflags(write=False)
     return GroundRecord(name=path.stem, dt=float(dt), acc=acc, npts=int(acc.size), pga=pga,
                         sha256=hashlib.sha256(data).hexdigest(), source=src, title=title,

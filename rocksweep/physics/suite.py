@@ -1,8 +1,9 @@
 """A suite of ground-motion records and how each run scales one (no numba here).
 
 A scene's ``ground.records`` (``rocksweep.scene.parse``) becomes a ``Suite``: the records
-read once, their intensity measures computed once (``rocksweep.physics.intensity``: PGA
-[g], PGV [m/s], Sa(T) [g] at 5% damping) and the scaling rule ``ground.scale``:
+read once, their intensity measures computed once (``rocksweep.physics.intensity``; the
+list is ``RECORD_IMS``: PGA [g], PGV [m/s], Sa(T) [g] at 5% damping, Arias intensity [m/s],
+CAV [m/s], D5-95 [s], PGV/PGA [s], AvgSa [g]) and the scaling rule ``ground.scale``:
 
 - stripes, ``{im: IM, values: [x_1, ...]}``: at stripe j every record is multiplied by the
   factor that makes its IM equal x_j: PGA, PGV, Sa (at ``scale.period``) directly;
@@ -16,11 +17,21 @@ The kernel sees a scaled record as its samples acc / PGA (shared by all runs of 
 ``rocksweep.compute.sweep``) and a peak |xg''| = factor * PGA [g]; that peak is passed
 as the point's A_ratio = factor * PGA / tan(alpha_ref) (``peak_ratio``), so the rows are
 filled by the same code as a single record's (``points.fill_rows``).
+
+AvgSa's period range is ``ground.avgsa: [T_lo, T_hi]`` [s]; by default 0.2 to 3 times the
+reference period T_ref: ``scale.period`` for Sa stripes, else 2 pi / p of the body's
+frequency parameter p (the geometric mean of p when p is swept), ``avgsa_rule`` says which.
+
+Warnings (``RecordWarning``, one line each, issued once per suite by ``warn``): a record
+whose ground velocity ends far from 0 (|v_end| > ``DRIFT_SHARE`` of its PGV: not baseline
+corrected, the ground keeps moving after the record) and scale factors above
+``MAX_FACTOR`` (heavily scaled records bias the response, Luco & Bazzurro 2007).
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -28,11 +39,38 @@ import numpy as np
 from rocksweep.errors import RocksweepError
 from rocksweep.physics.model import G
 from rocksweep.physics.records import GroundRecord
+from rocksweep.vocab.ground import (  # noqa: F401
+    ARIAS,
+    AVGSA,
+    CAV,
+    D5_95,
+    DEFAULT_PERIODS,
+    PGA,
+    PGA_RATIO,
+    PGV,
+    PGV_OVER_PGA,
+    PGV_RATIO,
+    RATIO_OF,
+    RECORD_IMS,
+    SA,
+    SA_DAMPING,
+    SCALE_IMS,
+)
 
-#: the IMs a suite can be scaled to (the stripe dimension's name) and their units
-SCALE_IMS = {"PGA": "g", "PGV": "m/s", "Sa": "g", "PGA_ratio": "1", "PGV_ratio": "1"}
-DEFAULT_PERIODS = (0.2, 1.0)  # [s] Sa stored per record
-ZETA = 0.05  # damping ratio of the spectral acceleration
+# the IMs (and their units), Sa's damping ratio and default periods: rocksweep.vocab.ground
+ZETA = SA_DAMPING
+#: AvgSa's default range: these multiples of the reference period
+AVGSA_RANGE = (0.2, 3.0)
+#: warn when a record's final ground velocity exceeds this share of its PGV
+DRIFT_SHARE = 0.1
+#: warn when a record is scaled by more than this factor
+MAX_FACTOR = 5.0
+
+
+
+class RecordWarning(UserWarning):
+    """A record that can be used but should be looked at (drift, a large scale factor);
+    ``str()`` is one line."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -44,7 +82,9 @@ class Suite:
     levels: the stripe values (empty for a cloud); period: Sa's period [s] for im = "Sa"
     (NaN otherwise); factor: the cloud's factor (NaN for stripes); periods: the periods
     [s] of the stored ``sa``; pga [g], pgv [m/s]: float64[R]; sa [g]: float64[R, P];
-    scale_sa [g]: float64[R], Sa at ``period`` (NaN unless im = "Sa").
+    scale_sa [g]: float64[R], Sa at ``period`` (NaN unless im = "Sa"); arias [m/s], cav
+    [m/s], d5_95 [s], avgsa [g], v_end [m/s] (ground velocity at the last sample):
+    float64[R]; avgsa_range: (T_lo, T_hi) [s] of AvgSa and avgsa_rule: how it was chosen.
     """
 
     records: tuple[GroundRecord, ...]
@@ -58,6 +98,52 @@ class Suite:
     pgv: np.ndarray = field(repr=False)
     sa: np.ndarray = field(repr=False)
     scale_sa: np.ndarray = field(repr=False)
+    arias: np.ndarray = field(repr=False, default=None)
+    cav: np.ndarray = field(repr=False, default=None)
+    d5_95: np.ndarray = field(repr=False, default=None)
+    avgsa: np.ndarray = field(repr=False, default=None)
+    v_end: np.ndarray = field(repr=False, default=None)
+    avgsa_range: tuple[float, float] = (math.nan, math.nan)
+    avgsa_rule: str = ""
+
+    def record_ims(self) -> dict[str, np.ndarray]:
+        """Each ``RECORD_IMS`` variable (not Sa) -> float64[R], the records as recorded."""
+        own = {PGA: self.pga, PGV: self.pgv, ARIAS: self.arias, CAV: self.cav,
+               D5_95: self.d5_95, PGV_OVER_PGA: self.pgv / (self.pga * G), AVGSA: self.avgsa}
+        return {RECORD_IMS[k][0]: np.asarray(v, np.float64) for k, v in own.items()}
+
+    def warn(self, alpha_ref, p) -> None:
+        """Issue the suite's ``RecordWarning``s (module docstring) for bodies of slenderness
+        ``alpha_ref`` [rad] and frequency parameters ``p`` [rad/s] (the swept values)."""
+        R = len(self.records)
+        drift = np.abs(self.v_end) > DRIFT_SHARE * self.pgv
+        if drift.any():
+            worst = int(np.argmax(np.where(drift, np.abs(self.v_end) / self.pgv, -1.0)))
+            warnings.warn(RecordWarning(
+                f"ground.records: {int(drift.sum())} of {R} records end with a ground "
+                f"velocity above {DRIFT_SHARE:.0%} of their PGV (not baseline-corrected: "
+                f"the ground keeps moving after the record), e.g. {self.names[worst]} ends "
+                f"at {self.v_end[worst]:+.3g} m/s (PGV {self.pgv[worst]:.3g} m/s)"),
+                stacklevel=2)
+        if self.im is None and not (self.factor > MAX_FACTOR):
+            return
+        a = np.asarray(alpha_ref, np.float64).ravel()
+        pp = np.asarray(p, np.float64).ravel()
+        r, s, aa, ppp = np.meshgrid(np.arange(R), np.arange(max(len(self.levels), 1)), a,
+                                    pp, indexing="ij")
+        f = self.factors(r.ravel(), None if self.im is None else s.ravel(), aa.ravel(),
+                         ppp.ravel()).reshape(r.shape)
+        big = f > MAX_FACTOR
+        if big.any():
+            i = np.unravel_index(int(np.argmax(f)), f.shape)
+            unit = SCALE_IMS.get(self.im or "", "1")
+            at = (f" at {self.im} = {self.levels[i[1]]:g}{'' if unit == '1' else ' ' + unit}"
+                  if self.im is not None else "")
+            n_rec = int(big.reshape(R, -1).any(-1).sum())
+            warnings.warn(RecordWarning(
+                f"ground.scale: {n_rec} of {R} records are scaled by more than "
+                f"{MAX_FACTOR:g}x (largest {f[i]:.3g}x: {self.names[i[0]]}{at}); heavily "
+                "scaled records may not represent motions of that intensity"), stacklevel=2)
 
     @property
     def scaled(self) -> bool:
@@ -66,9 +152,9 @@ class Suite:
     def record_im(self) -> np.ndarray:
         """Each record's own value of the stripe IM (PGA_ratio: its PGA, PGV_ratio: its
         PGV), float64[R]."""
-        if self.im in ("PGA", "PGA_ratio"):
+        if self.im in (PGA, PGA_RATIO):
             return self.pga
-        if self.im in ("PGV", "PGV_ratio"):
+        if self.im in (PGV, PGV_RATIO):
             return self.pgv
         if self.im == "Sa":
             return self.scale_sa
@@ -106,7 +192,7 @@ class Suite:
     def scale_dependence(self) -> tuple[str, ...]:
         """What a factor depends on beside (record, stripe): "alpha_ref" (PGA_ratio,
         PGV_ratio) and "p" (PGV_ratio)."""
-        return {"PGA_ratio": ("alpha_ref",), "PGV_ratio": ("alpha_ref", "p")}.get(
+        return {PGA_RATIO: ("alpha_ref",), PGV_RATIO: ("alpha_ref", "p")}.get(
             self.im or "", ())
 
 
@@ -116,9 +202,12 @@ class SuiteError(RocksweepError, ValueError):
 
 def make_suite(records: list[GroundRecord], names: list[str], im: str | None,
                levels: list[float], period: float, factor: float,
-               periods: list[float]) -> Suite:
-    """A Suite with every record's IMs computed (once). A record whose IM to scale is not
-    a finite number > 0 (PGV 0, Sa 0) is a ``SuiteError`` naming its file."""
+               periods: list[float], avgsa_range: tuple[float, float] | None = None,
+               avgsa_rule: str = "") -> Suite:
+    """A Suite with every record's IMs computed (once). avgsa_range: (T_lo, T_hi) [s] of
+    AvgSa (default ``AVGSA_RANGE`` times ``period``, or times 1 s without one). A record
+    whose IM to scale is not a finite number > 0 (PGV 0, Sa 0) is a ``SuiteError`` naming
+    its file."""
     from rocksweep.physics import intensity  # scipy.signal: loaded by suite scenes only
 
     n = len(records)
@@ -126,7 +215,18 @@ def make_suite(records: list[GroundRecord], names: list[str], im: str | None,
     pgv = np.empty(n)
     sa = np.empty((n, len(periods)))
     scale_sa = np.full(n, math.nan)
+    if avgsa_range is None:
+        t_ref = period if math.isfinite(period) else 1.0
+        avgsa_range = (AVGSA_RANGE[0] * t_ref, AVGSA_RANGE[1] * t_ref)
+        avgsa_rule = avgsa_rule or (f"{AVGSA_RANGE[0]:g}-{AVGSA_RANGE[1]:g} x T_ref = "
+                                    f"{t_ref:g} s")
+    more = {k: np.empty(n) for k in ("arias", "cav", "d5_95", "avgsa", "v_end")}
     for i, rec in enumerate(records):
+        more["arias"][i] = intensity.arias(rec.acc, rec.dt)
+        more["cav"][i] = intensity.cav(rec.acc, rec.dt)
+        more["d5_95"][i] = intensity.significant_duration(rec.acc, rec.dt)
+        more["avgsa"][i] = intensity.avg_sa(rec.acc, rec.dt, *avgsa_range, ZETA)
+        more["v_end"][i] = intensity.final_velocity(rec.acc, rec.dt)
         pga[i] = intensity.pga(rec.acc)
         pgv[i] = intensity.pgv(rec.acc, rec.dt)
         sa[i] = intensity.sa(rec.acc, rec.dt, list(periods), ZETA)
@@ -136,13 +236,15 @@ def make_suite(records: list[GroundRecord], names: list[str], im: str | None,
                            float(intensity.sa(rec.acc, rec.dt, [period], ZETA)[0]))
     suite = Suite(tuple(records), tuple(names), im, tuple(float(v) for v in levels),
                   float(period), float(factor), tuple(float(t) for t in periods), pga, pgv,
-                  sa, scale_sa)
+                  sa, scale_sa, **more,
+                  avgsa_range=(float(avgsa_range[0]), float(avgsa_range[1])),
+                  avgsa_rule=avgsa_rule)
     if im is not None:
         own = suite.record_im()
         for i, rec in enumerate(records):
             v = float(own[i])
             if not (math.isfinite(v) and v > 0.0):
-                what = {"PGA_ratio": "PGA", "PGV_ratio": "PGV"}.get(im, im)
+                what = RATIO_OF.get(im, im)
                 per = f"({period:g} s)" if im == "Sa" else ""
                 raise SuiteError(f"{rec.source}: {what}{per} = {v!r}: cannot be scaled to "
                                  f"a {im} stripe (needs a record with {what} > 0)")

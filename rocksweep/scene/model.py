@@ -17,6 +17,8 @@ from rocksweep.physics.points import FREE, INITIAL, RECORD, Point
 from rocksweep.physics.records import GroundRecord
 from rocksweep.physics.suite import Suite
 from rocksweep.schema import KEYS
+from rocksweep.vocab.ground import PAPER_SHAPES, pulse_duration
+from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
 
 
 class SceneError(RocksweepError, ValueError):
@@ -55,6 +57,9 @@ class Scene:
     # a suite scene (``ground.records``): the records, their IMs and the scaling (the
     # grid's axes then hold ``record`` (file names), the stripe IM if scaled, and p)
     suite: Suite | None = field(default=None, repr=False)
+    # every file the scene was read from: the scene file, its record, a suite's records and
+    # listings (paths as read); an output is never one of them (``outputs.check_output``)
+    inputs: tuple[str, ...] = field(default=(), repr=False)
     # a body given by the laboratory's numbers (body.kind physical): its Pi groups, p
     # [rad/s], omega_n [rad/s] and h_cg [m] (``physics.model.body_from_geometry``), else None
     physical: dict | None = field(default=None, repr=False)
@@ -90,7 +95,7 @@ class Scene:
         """Whether the scene needs the kernel's GROUND variants (a Ricker or MP pulse, or a
         record); the paper's sine and cosine (n cycles too) run the pulse variants."""
         return self.recorded or any(
-            sh in ("ricker", "mp") for sh in self.axis("shape").values)
+            sh not in (*PAPER_SHAPES, FREE) for sh in self.axis("shape").values)
 
     def option(self, name: str) -> Any:
         """A pulse option's value (cycles, gamma, nu [deg]): the scene's or the default."""
@@ -101,9 +106,7 @@ class Scene:
 
     def phase_max(self) -> float:
         """The longest pulse of the scene's shapes in w t (2 pi n, 6 pi, 2 pi gamma)."""
-        from rocksweep.physics.points import RECORD, phase_duration
-
-        return max(phase_duration(sh, self.option("cycles"), self.option("gamma"))
+        return max(pulse_duration(sh, self.option("cycles"), self.option("gamma"))
                    for sh in self.axis("shape").values if sh != RECORD)
 
     def axis(self, name: str) -> Axis:
@@ -169,14 +172,14 @@ class Scene:
         return self.axis("shape").values == (FREE,)
 
     def initial_state(self, values: dict[str, Any]) -> tuple[float, float, float, float]:
-        """A point's initial state (``points.INITIAL``, normalised) from axis values; the
+        """A point's initial state (``vocab.axes.INITIAL``, normalised) from axis values; the
         keys the scene does not give are 0."""
         return tuple(float(values.get(k, 0.0)) for k in INITIAL)  # type: ignore[return-value]
 
     def _law(self, values: dict[str, Any]) -> dict[str, Any]:
         """A point's impact law (Point keywords law, e, e_factor) from axis values."""
-        law = str(values.get("law", "vertical"))
-        return {"law": law, "e": float(values["e"]) if law == "constant" else math.nan,
+        law = str(values.get("law", DEFAULT_LAW))
+        return {"law": law, "e": float(values["e"]) if law == CONSTANT else math.nan,
                 "e_factor": float(values.get("e_factor", 1.0))}
 
     def single_point(self) -> Point:

@@ -17,7 +17,9 @@ Every valid scene runs in bounded time and space:
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import os
 from glob import glob, has_magic
 from pathlib import Path
 from typing import Any
@@ -25,11 +27,18 @@ from typing import Any
 import numpy as np
 
 from rocksweep.numerics import Numerics
-from rocksweep.outputs import input_problem, shown
+from rocksweep.outputs import input_problem, is_input, shown
 from rocksweep.physics.model import BodyError, body_from_geometry
 from rocksweep.physics.points import FREE, INITIAL, RECORD
 from rocksweep.physics.records import GroundRecord, RecordError, read_record
-from rocksweep.physics.suite import DEFAULT_PERIODS, SCALE_IMS, Suite, SuiteError, make_suite
+from rocksweep.physics.suite import (
+    AVGSA_RANGE,
+    DEFAULT_PERIODS,
+    SCALE_IMS,
+    Suite,
+    SuiteError,
+    make_suite,
+)
 from rocksweep.scene.admission import _candidate_bodies, _check_cost
 from rocksweep.scene.loader import _CONTROL, _load_yaml, _YamlError
 from rocksweep.scene.model import Axis, Scene, SceneError
@@ -43,6 +52,10 @@ from rocksweep.schema import (
     is_number,
     section_keys,
 )
+from rocksweep.vocab.axes import DIAGRAM_AXES
+from rocksweep.vocab.ground import MP
+from rocksweep.vocab.ground import PULSE_KEY_SHAPES as _PULSE_KEY_SHAPES
+from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
 
 # Largest grid a scene may describe [points]. A sweep file stores 45 bytes a point (69
 # with energy metrics, ``rocksweep.fields.variables``): 2e8 points are a 9-14 GB file, one
@@ -52,10 +65,10 @@ MAX_POINTS = 200_000_000
 # Values per axis: an axis is kept as a tuple of Python floats (~32 bytes a value; 1e6
 # values are 32 MB and 0.1 s to build); a figure's axis needs a few thousand at most.
 MAX_AXIS_VALUES = 1_000_000
-PULSE_AXES = ("A_ratio", "w_over_p")
+PULSE_AXES = tuple(reversed(DIAGRAM_AXES))  # (A_ratio, w_over_p)
 # The pulse shapes each optional pulse key means something for (rocksweep.physics.excitation);
 # given for none of the scene's shapes, the key is refused (it would be silently ignored).
-PULSE_KEY_SHAPES = {"cycles": ("sine", "cosine"), "gamma": ("mp",), "nu": ("mp",)}
+PULSE_KEY_SHAPES = _PULSE_KEY_SHAPES
 
 
 def apply_overrides(raw: dict, overrides: list[str]) -> dict:
@@ -85,15 +98,18 @@ def apply_overrides(raw: dict, overrides: list[str]) -> dict:
 
 
 def parse_scene(text: str, source: str = "scene", overrides: list[str] | None = None,
-                base: str | Path | None = None, record: GroundRecord | None = None) -> Scene:
+                base: str | Path | None = None, record: GroundRecord | None = None,
+                records: tuple[GroundRecord, ...] | None = None) -> Scene:
     """Validate scene YAML text. Raises SceneError (one line, prefixed by ``source``).
 
     base: the directory a ``ground.record`` path is relative to (the scene file's; None:
     the working directory); record: the record of a ``ground`` section, already read (a
-    result file's stored copy): the ``ground.record`` path is then not read."""
+    result file's stored copy): the ``ground.record`` path is then not read; records: the
+    same for a suite's ``ground.records`` (in the suite's order; their file names label
+    the record dimension)."""
     try:
         return _parse(text, overrides or [], Path(base) if base is not None else None,
-                      record)
+                      record, records)
     except SceneError as err:
         raise SceneError(f"{source}: {err}") from None
 
@@ -112,7 +128,8 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
         raise SceneError(f"{path}: cannot read the scene ({err.strerror})") from None
     except UnicodeDecodeError:
         raise SceneError(f"{path}: not a text (YAML) file") from None
-    return parse_scene(text, str(path), overrides, base=path.parent)
+    scene = parse_scene(text, str(path), overrides, base=path.parent)
+    return dataclasses.replace(scene, inputs=(str(path), *scene.inputs))
 
 
 def _section(raw: dict, name: str, kind: str, required: bool) -> dict:
@@ -242,17 +259,17 @@ def _impact_law(impact: dict) -> tuple[Axis | None, list[tuple[str, str, Any]]]:
     one: eq. 1, ``vertical``) and the specs of ``impact.e`` and ``impact.e_factor`` given.
     ``e`` is required by law ``constant`` and refused without it."""
     law_axis = None
-    laws: tuple[str, ...] = ("vertical",)
+    laws: tuple[str, ...] = (DEFAULT_LAW,)
     if impact.get("law") is not None:
         laws, swept = _words("impact.law", impact["law"])
         law_axis = Axis("law", "impact.law", laws, swept)
     specs = []
     e_spec = impact.get("e")
-    if e_spec is None and "constant" in laws:
+    if e_spec is None and CONSTANT in laws:
         raise SceneError("impact.e: missing; law constant needs its coefficient of "
                          "restitution e: a number in (0, 1], a list or a range")
     if e_spec is not None:
-        if "constant" not in laws:
+        if CONSTANT not in laws:
             raise SceneError(f"impact.e = {fmt(e_spec)}: only law constant uses e (the law "
                              f"here is {', '.join(laws)}); remove impact.e or add law: "
                              "constant")
@@ -332,7 +349,7 @@ def _pulse_options(pulse: dict, shapes: tuple[str, ...]) -> list[Axis]:
         v = pulse.get(k)
         given = v is not None
         if v is None:
-            if not (k != "cycles" and "mp" in shapes):
+            if not (k != "cycles" and MP in shapes):
                 continue
             v = spec.default
         ok = (isinstance(v, int) and not isinstance(v, bool)) if spec.kind == "integer" \
@@ -380,51 +397,111 @@ _LIST_SUFFIXES = (".txt", ".list", ".lst")
 
 def _is_listing(path: Path) -> bool:
     """A text file listing record paths (suffix .txt, .list or .lst, and its first line
-    that is not blank or a # comment is not made of numbers: a two-column record's is)."""
-    if path.suffix.lower() not in _LIST_SUFFIXES or not path.is_file():
+    that is not blank or a # comment is not two numbers: a two-column record's is).
+    A file of that suffix that is not text (UTF-16, random bytes) counts as a listing:
+    ``_listing`` says why it cannot be read."""
+    if path.suffix.lower() not in _LIST_SUFFIXES or input_problem(path) is not None:
         return False
     try:
-        with path.open("r", encoding="utf-8", errors="replace") as fh:
-            for line in fh:
-                text = line.strip()
-                if not text or text.startswith("#"):
-                    continue
-                try:
-                    [float(t) for t in text.replace(",", " ").split()]
-                except ValueError:
-                    return True
-                return False
+        with path.open("rb") as fh:
+            head = fh.read(1 << 16)
     except OSError:
         return False
+    try:
+        text = head.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        return True
+    if "\0" in text:
+        return True
+    for line in text.splitlines():
+        t = line.strip()
+        if not t or t.startswith("#"):
+            continue
+        fields = t.replace(",", " ").split()
+        try:
+            [float(x) for x in fields]
+        except ValueError:
+            return True
+        return len(fields) != 2  # a record's row is two numbers; '123' names a file
     return True
 
 
-def _record_paths(spec: Any, base: Path | None) -> list[Path]:
-    """The files of ``ground.records`` in order: each entry a path, a glob (sorted) or a
-    listing (one path a line, relative to the listing's directory; # comments)."""
+def _listing(path: Path, shown_as: str) -> list[tuple[int, str]]:
+    """(line number, entry) of a listing: UTF-8 text (a byte-order mark, as Notepad
+    saves it, is skipped), one path a line, blank lines and # comments skipped."""
+    key = "ground.records"
+    try:
+        data = path.read_bytes()
+    except OSError as err:
+        raise SceneError(f"{key}: {shown_as}: cannot be read ({err.strerror})") from None
+    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise SceneError(f"{key}: {shown_as}: a listing saved as UTF-16; save it as UTF-8 "
+                         "text (one record path a line)")
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as err:
+        raise SceneError(f"{key}: {shown_as}: not a text listing of record paths (byte "
+                         f"{err.start} is not UTF-8); a listing is UTF-8 text, one record "
+                         "path a line") from None
+    bad = _CONTROL.search(text.replace("\r", ""))
+    if bad is not None:
+        line = text.count("\n", 0, bad.start()) + 1
+        raise SceneError(f"{key}: {shown_as}, line {line}: character {ord(bad.group()):#04x} "
+                         "is a control character (NUL, BEL, ESC...); a listing is plain "
+                         "text, one record path a line")
+    return [(i + 1, ln.strip()) for i, ln in enumerate(text.splitlines())
+            if ln.strip() and not ln.strip().startswith("#")]
+
+
+def _record_paths(spec: Any, base: Path | None) -> tuple[list[Path], list[Path],
+                                                          dict[Path, str]]:
+    """The files of ``ground.records`` in order: each entry a path (a file that exists is
+    that file, even if its name holds glob characters such as ``r[1].AT2``), else a glob
+    (sorted), or a listing (one path a line, relative to the listing's directory; #
+    comments; a listed path is a path, never a glob). Returns (records, listings read,
+    where each listed record was named: 'suite.txt, line 3')."""
     key = "ground.records"
     entries = spec if isinstance(spec, list) else [spec]
     if isinstance(spec, list) and not spec:
         raise SceneError(f"{key} = []: an empty list; {KEYS[key].allowed}")
     out: list[Path] = []
+    listings: list[Path] = []
+    named: dict[Path, str] = {}
     for e in entries:
         if not (isinstance(e, str) and e.strip()):
             raise SceneError(f"{key} = {fmt(e)}: {KEYS[key].allowed}")
-        if has_magic(e):
-            pattern = str(_where(e, base))
+        if "\0" in e:
+            raise SceneError(f"{key} = {fmt(e)}: a NUL byte in a file name; no file can "
+                             "have it")
+        path = _where(e, base)
+        if has_magic(e) and not os.path.lexists(path):
+            pattern = str(path)
             found = sorted(Path(p) for p in glob(pattern) if Path(p).is_file())
             if not found:
                 raise SceneError(f"{key}: {e!r} matches no file (looked for {pattern})")
             out.extend(found)
             continue
-        path = _where(e, base)
+        problem = input_problem(path)
+        if problem is not None and problem != "no such file":
+            raise SceneError(f"{key}: {shown(path)}: {problem}")
         if _is_listing(path):
-            lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
-            listed = [ln.strip() for ln in lines if ln.strip() and not
-                      ln.strip().startswith("#")]
+            listings.append(path)
+            listed = _listing(path, shown(e))
             if not listed:
                 raise SceneError(f"{key}: {e} lists no record file")
-            out.extend(_where(ln, path.parent) for ln in listed)
+            for line, entry in listed:
+                where = f"{shown(e)}, line {line}"
+                if "\0" in entry:
+                    raise SceneError(f"{key}: {where}: a NUL byte in a file name")
+                p = _where(entry, path.parent)
+                if is_input(p, [path]) or (input_problem(p) is None and _is_listing(p)):
+                    what = "the listing itself" if is_input(p, [path]) else "a listing"
+                    raise SceneError(f"{key}: {where}: {shown(entry)} is {what}; a listing "
+                                     "names record files (.AT2 or two-column), one a line")
+                named[p] = where
+                out.append(p)
+                if len(out) > MAX_RECORDS:
+                    break
         else:
             out.append(path)
         if len(out) > MAX_RECORDS:
@@ -433,10 +510,14 @@ def _record_paths(spec: Any, base: Path | None) -> list[Path]:
         raise SceneError(f"{key}: more than {MAX_RECORDS:,} records; split the suite")
     seen: dict[str, Path] = {}
     for path in out:
-        real = str(path.resolve())
+        problem = input_problem(path)
+        if problem is not None:
+            where = f"{named[path]}: " if path in named else ""
+            raise SceneError(f"{key}: {where}{shown(path)}: {problem}")
+        real = os.path.realpath(path)
         if real in seen:
-            raise SceneError(f"{key}: {path} is listed twice (each record once: the file "
-                             "names label the record dimension)")
+            raise SceneError(f"{key}: {shown(path)} is listed twice (each record once: the "
+                             "file names label the record dimension)")
         seen[real] = path
     names: dict[str, Path] = {}
     for path in out:
@@ -445,7 +526,7 @@ def _record_paths(spec: Any, base: Path | None) -> list[Path]:
                              f"{path}): the file names label the record dimension, rename "
                              "one")
         names[path.name] = path
-    return out
+    return out, listings, named
 
 
 def _periods(ground: dict) -> list[float]:
@@ -485,7 +566,7 @@ def _scale(ground: dict) -> tuple[str | None, str, Any, float, float]:
             raise SceneError(f"{key}.{k}: unknown key (allowed: im, values, period; or "
                              "factor alone)")
     im = v.get("im")
-    if im not in SCALE_IMS:
+    if not isinstance(im, str) or im not in SCALE_IMS:
         raise SceneError(f"{key}.im = {fmt(im)}: {KEYS[key + '.im'].allowed}")
     if v.get("values") is None:
         raise SceneError(f"{key}.values: missing required key (the stripes' {im} values: "
@@ -504,33 +585,67 @@ def _scale(ground: dict) -> tuple[str | None, str, Any, float, float]:
     return im, form, spec, period, math.nan
 
 
-def _suite(ground: dict, base: Path | None) -> tuple[Suite, tuple[str, str, Any] | None]:
+def _avgsa(ground: dict, period: float) -> tuple[tuple[float, float], str]:
+    """AvgSa's period range [s] and how it was chosen (``rocksweep.physics.suite``):
+    ``ground.avgsa``, else AVGSA_RANGE x T_ref, T_ref the Sa stripes' period or 2 pi / p."""
+    key = "ground.avgsa"
+    spec = ground.get("avgsa")
+    if spec is not None:
+        ok = (isinstance(spec, list) and len(spec) == 2 and all(is_number(v) for v in spec))
+        lo, hi = (as_float(spec[0]), as_float(spec[1])) if ok else (math.nan, math.nan)
+        if not (ok and 0.0 < lo <= hi <= 100.0):
+            raise SceneError(f"{key} = {fmt(spec)}: {KEYS[key].allowed}")
+        return (lo, hi), f"ground.avgsa = [{lo:g}, {hi:g}] s"
+    if math.isfinite(period):
+        t_ref, why = period, "scale.period"
+    else:
+        form, pspec, _ = _axis_spec("ground.p", ground["p"])
+        p = _axis_values("ground.p", form, pspec)
+        t_ref = 2.0 * math.pi / float(np.exp(np.mean(np.log(p))))
+        why = "2 pi / p" if p.size == 1 else "2 pi / p (geometric mean of the swept p)"
+    a, b = AVGSA_RANGE
+    return (a * t_ref, b * t_ref), f"{a:g}-{b:g} x T_ref, T_ref = {why} = {t_ref:.4g} s"
+
+
+def _suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...] | None = None
+           ) -> tuple[Suite, tuple[str, str, Any] | None, tuple[str, ...]]:
     """The suite of a ``ground.records`` section (records read and hashed, IMs computed
-    now) and the stripe axis's (name, form, spec), None for a cloud."""
+    now), the stripe axis's (name, form, spec), None for a cloud, and the files read
+    (records and listings). given: the records already read (a result file's stored
+    copies): ``ground.records`` is then not read."""
     for k in ("record", "A_ratio"):
         if ground.get(k) is not None:
             other = ("ground.scale: {im: PGA_ratio, values: ...}" if k == "A_ratio"
                      else "a list in ground.records")
             raise SceneError(f"ground.{k}: not with ground.records (use {other})")
-    paths = _record_paths(ground["records"], base)
     im, form, spec, period, factor = _scale(ground)
-    records = []
-    for path in paths:
-        try:
-            records.append(read_record(path))
-        except RecordError as err:
-            raise SceneError(f"ground.records: {err}") from None
+    if given is not None:
+        records = list(given)
+        names = [Path(r.source).name for r in records]
+        read: tuple[str, ...] = ()
+    else:
+        paths, listings, named = _record_paths(ground["records"], base)
+        records = []
+        for path in paths:
+            try:
+                records.append(read_record(path))
+            except RecordError as err:
+                where = f"{named[path]}: " if path in named else ""
+                raise SceneError(f"ground.records: {where}{err}") from None
+        names = [p.name for p in paths]
+        read = tuple(str(p) for p in (*paths, *listings))
     values = _axis_values("ground.scale.values", form, spec).tolist() if im else []
     try:
-        suite = make_suite(records, [p.name for p in paths], im, values, period, factor,
-                           _periods(ground))
+        suite = make_suite(records, names, im, values, period, factor,
+                           _periods(ground), *_avgsa(ground, period))
     except SuiteError as err:
         raise SceneError(f"ground.records: {err}") from None
-    return suite, ((im, form, spec) if im else None)
+    return suite, ((im, form, spec) if im else None), read
 
 
 def _parse(text: str, overrides: list[str], base: Path | None = None,
-           given_record: GroundRecord | None = None) -> Scene:
+           given_record: GroundRecord | None = None,
+           given_records: tuple[GroundRecord, ...] | None = None) -> Scene:
     try:
         raw = _load_yaml(text)
     except _YamlError as err:
@@ -570,15 +685,16 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     initial = _section(raw, "initial", kind, required=False)
     free = raw.get("ground") is None and raw.get("pulse") is None
     record = suite = stripe = None
+    inputs: tuple[str, ...] = ()
     if free:  # no ground motion: free vibration from the initial state
         pulse = {"shape": FREE, "w_over_p": 0.0, "A_ratio": 0.0}
     elif raw.get("ground") is not None:
         ground = _section(raw, "ground", kind, required=True)
         if ground.get("records") is not None:
-            suite, stripe = _suite(ground, base)
+            suite, stripe, inputs = _suite(ground, base, given_records)
             pulse = {"shape": RECORD, "p": ground["p"]}
         else:
-            for k in ("scale", "periods"):
+            for k in ("scale", "periods", "avgsa"):
                 if ground.get(k) is not None:
                     raise SceneError(f"ground.{k}: works with ground.records (a suite); one "
                                      "ground.record is scaled by ground.A_ratio")
@@ -589,6 +705,7 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
                 raise SceneError("ground.A_ratio: missing required key (a number, a list of "
                                  "numbers or a range {start, stop, num})")
             record = _record(ground, base) if given_record is None else given_record
+            inputs = (str(record.source),) if given_record is None else ()
             pulse = {"shape": RECORD, "A_ratio": ground["A_ratio"], "p": ground["p"]}
     else:
         pulse = _section(raw, "pulse", kind, required=True)
@@ -679,7 +796,7 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     scene = Scene(name=name or "rocksweep scene", kind=kind, axes=tuple(axes),
                   numerics=numerics, single_numerics=single, energy=energy, text=text,
                   contact=contact, check=check, record=record, refine=_refine(raw, kind),
-                  suite=suite, physical=physical)
+                  suite=suite, inputs=inputs, physical=physical)
     if scene.contact and scene.ground:
         # the contact outputs are compiled into the sine/cosine variants only (a kernel
         # variant per combination costs compile time no scene has asked for yet)
@@ -689,6 +806,9 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     bodies = _candidate_bodies(scene)
     _check_initial(scene, bodies)
     _check_cost(scene, bodies)
+    if suite is not None:  # drift and large factors: one-line RecordWarnings
+        suite.warn(scene.axis("alpha" if kind == "block" else "alpha_cg").values,
+                   scene.axis("p").values)
     return scene
 
 

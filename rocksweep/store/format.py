@@ -54,6 +54,7 @@ from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import _fixed, _now
 from rocksweep.store.identity import record_attrs, resolved_scene
+from rocksweep.vocab.outcomes import COMPUTED_FLAGS, COMPUTED_MEANING
 
 if TYPE_CHECKING:
     import h5py
@@ -95,11 +96,9 @@ ADAPTIVE_COUNT_ATTRS: dict[str, str] = {
     "audit_misses": "int64",
 }
 # The ``computed`` variable of adaptive sweeps: (dtype, fill, description), flag meanings.
-COMPUTED_VARIABLE = ("int8", 0, "adaptive sweep: 0 filled (not computed; outcome from the "
-                     "uniform cell around the point, other variables at their fill "
-                     "values), 1 computed, 2 audit point that agreed with its fill, 3 "
-                     "audit point that disagreed (region refined)")
-COMPUTED_FLAGS = {0: "filled", 1: "computed", 2: "audit_agreed", 3: "audit_disagreed"}
+COMPUTED_VARIABLE = ("int8", 0, "adaptive sweep: " + ", ".join(
+    f"{c} {m}" for c, m in COMPUTED_MEANING.items()) + "; other variables of a filled "
+    "point at their fill values")
 
 # Variables whose values are codes (CF flag_values / flag_masks): no units.
 FLAG_VARIABLES = ("outcome", "status", "computed")
@@ -208,6 +207,7 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
     if scene.suite is not None:  # the stripes' IM ("none": a cloud) and Sa's period [s]
         a["scale_im"] = scene.suite.im or "none"
         a["scale_period"] = float(scene.suite.period)
+        _store_suite_records(f, scene.suite)
     for k, v in vers.items():
         a[f"{k}_version"] = v
     a["started"] = _now()
@@ -297,6 +297,9 @@ def suite_variables(scene: Scene) -> dict[str, tuple[tuple[str, ...], np.ndarray
         "record_pga": (("record",), np.asarray(su.pga, float)),
         "record_pgv": (("record",), np.asarray(su.pgv, float)),
         "record_sa": (("record", "period"), np.asarray(su.sa, float)),
+        **{k: (("record",), v) for k, v in su.record_ims().items() if k not in (
+            "record_pga", "record_pgv")},  # Arias, CAV, D5-95, PGV/PGA, AvgSa (RECORD_IMS)
+        "record_v_end": (("record",), np.asarray(su.v_end, float)),
         "record_npts": (("record",), np.array([r.npts for r in su.records], np.int64)),
         "record_dt": (("record",), np.array([r.dt for r in su.records], float)),
         "record_duration": (("record",), np.array([r.duration for r in su.records], float)),
@@ -350,6 +353,9 @@ def _write_suite(f: h5py.File, scene: Scene, scales: dict) -> None:
         if units is not None:
             ds.attrs["units"] = units
         ds.attrs["description"] = text
+        if name == "record_avgsa":  # its period range and how it was chosen
+            ds.attrs["avgsa_periods"] = np.asarray(su.avgsa_range, float)
+            ds.attrs["avgsa_rule"] = su.avgsa_rule
         for i, d in enumerate(dims):
             ds.dims[i].attach_scale(scales[d])
 
@@ -361,6 +367,32 @@ def _coord_attrs(ds, axis, kind: str = "flexible") -> None:
 
 
 RECORD_GROUP = "record"  # a record sweep's copy of its record: file (bytes), acceleration
+SUITE_GROUP = "records"  # a suite sweep's copies of its records' files: 0, 1, ... (bytes)
+
+
+def _store_file(g, name: str, record):
+    """One record's file bytes (uint8, gzip) as dataset ``name`` of group ``g``, with its
+    SHA-256 and the path the sweep read it from; None for a record without bytes."""
+    raw = np.frombuffer(record.data, dtype=np.uint8)
+    if not raw.size:
+        return None
+    d = g.create_dataset(name, data=raw, chunks=(min(raw.size, 1 << 16),),
+                         compression="gzip")
+    d.attrs["sha256"] = record.sha256
+    d.attrs["source"] = str(record.source)
+    return d
+
+
+def _store_suite_records(f, suite) -> None:
+    """Keep a suite's records in the result file (group ``records``, dataset ``i`` for the
+    i-th record: its file's bytes, SHA-256, path read and file name), as a single record's
+    file keeps its record: the scene is rebuilt from them (IDA, spectra, ``--rtol``) after
+    the record folder moved or is gone."""
+    g = f.create_group(SUITE_GROUP)
+    for i, (name, rec) in enumerate(zip(suite.names, suite.records, strict=True)):
+        d = _store_file(g, str(i), rec)
+        if d is not None:
+            d.attrs["name"] = name
 
 
 def _store_record(f, record) -> None:
@@ -370,12 +402,7 @@ def _store_record(f, record) -> None:
     to another machine, or kept after the record's folder is gone, it still plots and
     gives boundaries and spectra."""
     g = f.create_group(RECORD_GROUP)
-    raw = np.frombuffer(record.data, dtype=np.uint8)
-    if raw.size:
-        d = g.create_dataset("file", data=raw, chunks=(min(raw.size, 1 << 16),),
-                             compression="gzip")
-        d.attrs["sha256"] = record.sha256
-        d.attrs["source"] = str(record.source)
+    _store_file(g, "file", record)
     acc = g.create_dataset("acceleration", data=np.asarray(record.acc, np.float64))
     acc.attrs["units"] = "g"
     acc.attrs["dt"] = float(record.dt)

@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 
 from rocksweep.scene.model import Scene
+from rocksweep.vocab.laws import DEFAULT_LAW
 
 
 def resolved_scene(scene: Scene, overrides: tuple[str, ...] | list[str] = (),
@@ -91,7 +92,7 @@ def _short(v) -> str:
 
 
 # Axes a scene need not give, with the value they then have: the impact law's (eq. 1)
-AXIS_DEFAULTS = {"impact.law": "vertical", "impact.e_factor": 1.0}
+AXIS_DEFAULTS = {"impact.law": DEFAULT_LAW, "impact.e_factor": 1.0}
 
 
 def scene_differences(stored: dict, new: dict) -> list[str]:

@@ -11,7 +11,7 @@ import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NoReturn
 
 import numpy as np
 
@@ -35,9 +35,11 @@ from rocksweep.store.format import (
     FORMAT,
     FORMAT_VERSION,
     RECORD_GROUP,
+    SUITE_GROUP,
     variables_for,
 )
 from rocksweep.store.identity import resolved_scene, scene_differences
+from rocksweep.vocab.outcomes import CLASSES, OUTCOME_CODE
 
 if TYPE_CHECKING:
     import h5py
@@ -118,6 +120,11 @@ def _json_attr(f: h5py.File, key: str, path: Path, typ: type):
     return value
 
 
+# The attribute the netCDF-4 library and h5netcdf put on every file they write (xarray's
+# to_netcdf); rocksweep's writer (h5py) never does.
+NETCDF_MARK = "_NCProperties"
+
+
 def _looks_like_ours(f: h5py.File, fmt) -> bool:
     """Whether a file without a valid rocksweep_format attribute still shows the marks of a
     rocksweep result (then it is damaged, not foreign)."""
@@ -141,6 +148,15 @@ def _layout(f: h5py.File, path: Path) -> _Layout:
                          f"({_why(err)})") from None
     if isinstance(fmt, bytes | np.bytes_):
         fmt = bytes(fmt).decode("utf-8", "replace")
+    try:
+        resaved = NETCDF_MARK in f.attrs
+    except _H5_ERRORS:
+        resaved = False
+    if resaved:  # the netCDF library's mark: rocksweep writes with h5py, never sets it
+        raise StoreError(f"{shown(path)}: not written by rocksweep: a result saved again by "
+                         "xarray (to_netcdf) or another netCDF writer, which changes its "
+                         "layout; rocksweep reads the files its sweeps write (the original "
+                         "file; this one opens with xarray.open_dataset)")
     if fmt != FORMAT:
         if _looks_like_ours(f, fmt):  # a damaged result is not a foreign file
             raise _damaged(path, "attribute rocksweep_format " + (
@@ -227,18 +243,58 @@ def _open(path: Path, mode: str) -> h5py.File:
         # allocated up front, so a running sweep changes raw data only)
         return h5py.File(path, mode, locking=(mode != "r"))
     except _H5_ERRORS as err:
-        no = getattr(err, "errno", None)
-        if isinstance(err, BlockingIOError) or "unable to lock" in str(err).lower():
-            raise StoreError(f"{shown(path)}: open for writing by another process (a sweep "
-                             "still running?)") from None
-        if no in (errno.EACCES, errno.EPERM, errno.EROFS):
-            doing = "written" if mode != "r" else "read"
-            raise StoreError(f"{shown(path)}: cannot be {doing} ({_why(err)})") from None
-        if not _is_hdf5(path):
-            raise StoreError(f"{shown(path)}: not an HDF5 file (expected a rocksweep sweep "
-                             "result)") from None
-        raise StoreError(f"{shown(path)}: damaged or truncated HDF5 file, cannot be opened "
-                         "(rerun the sweep with --overwrite)") from None
+        if mode == "r" and _open_here(err):
+            # open in this process through another handle (xarray's, h5py's): HDF5 wants
+            # the same locking flags; a reader takes them
+            for locking in READER_LOCKING:
+                with contextlib.suppress(*_H5_ERRORS):
+                    return h5py.File(path, mode, locking=locking)
+        _open_error(path, mode, err)
+
+
+# The locking flags a reader tries when the file is open in this process through another
+# handle (h5py's default, then HDF5's own).
+READER_LOCKING = ("best-effort", True)
+
+
+def _open_error(path: Path, mode: str, err: BaseException) -> NoReturn:
+    """Raise the one-line StoreError for a file h5py could not open (``err``): a lock
+    (another process's, or another handle in this process), permissions, a foreign file,
+    damage."""
+    no = getattr(err, "errno", None)
+    text = str(err).lower()
+    if isinstance(err, BlockingIOError) or "unable to lock" in text:
+        raise StoreError(f"{shown(path)}: open for writing by another process (a sweep "
+                         "still running?)") from None
+    if _open_here(err):
+        raise StoreError(f"{shown(path)}: already open in this process through another "
+                         "HDF5 handle (HDF5's file lock: e.g. xr.open_dataset(..., "
+                         "engine='h5netcdf') or h5py.File); the file is not damaged: "
+                         "close that handle (ds.close()) and try again; rocksweep.open "
+                         "loads the file and closes it at once") from None
+    if no in (errno.EACCES, errno.EPERM, errno.EROFS):
+        doing = "written" if mode != "r" else "read"
+        raise StoreError(f"{shown(path)}: cannot be {doing} ({_why(err)})") from None
+    if not _is_hdf5(path):
+        raise StoreError(f"{shown(path)}: not an HDF5 file (expected a rocksweep sweep "
+                         "result)") from None
+    raise StoreError(f"{shown(path)}: damaged or truncated HDF5 file, cannot be opened "
+                     f"({_why(err)}); its points cannot be read back: if it is a copy, "
+                     "copy it again from the original; else sweep again to a new file "
+                     "(-o NEW.h5) and remove this one after") from None
+
+
+def _open_here(err: BaseException) -> bool:
+    """Whether h5py's error says the file is open in this process through another handle
+    with other settings (a lock, not damage)."""
+    return any(w in str(err).lower() for w in _OPEN_HERE)
+
+
+# What HDF5 says when the file is already open in this process with other settings (a
+# lock of this process, not damage): h5py/HDF5 1.10-1.14 wordings.
+_OPEN_HERE = ("locking flag values don't match", "already open for read-only",
+              "already open for write", "file close degree doesn't match",
+              "file is already open")
 
 
 # Attributes readers use (``rocksweep info``, ``plot``) -> what they must be.
@@ -299,6 +355,10 @@ def _checked_attrs(f: h5py.File, path: Path) -> dict:
             raise _damaged(path, f"attribute {k} missing")
         if not _attr_ok(k, attrs[k]):
             raise _damaged(path, f"attribute {k} is {_cut(attrs[k])}")
+    for k, v in attrs.items():  # the versions the writer records are text (info shows them)
+        if k.endswith("_version") and k != "format_version" and not isinstance(v, str):
+            raise _damaged(path, f"attribute {k} is {_cut(v)}, not a version text "
+                                 "(not as rocksweep writes it)")
     return attrs
 
 
@@ -318,6 +378,9 @@ class SweepResult:
     arrays: dict[str, np.ndarray]
     attrs: dict[str, object]
     scene: dict
+    # read from the file at ``path`` (False: a Dataset made in memory, ``path`` only names
+    # it in messages and is never opened)
+    in_file: bool = True
 
     @property
     def kind(self) -> str:
@@ -356,9 +419,7 @@ class SweepResult:
                             else self.scalars.get(d))
             cell = o[idx]
             rows.append({**label,
-                         "safe": int((cell == L.OUTCOME_SAFE).sum()),
-                         "mode1": int((cell == L.OUTCOME_MODE1).sum()),
-                         "mode2": int((cell == L.OUTCOME_MODE2).sum()),
+                         **{w: int((cell == OUTCOME_CODE[w]).sum()) for w in CLASSES},
                          "not_computed": int((cell == L.OUTCOME_NOT_RUN).sum()),
                          "flagged": int(fl[idx].sum())})
         return rows
@@ -426,6 +487,20 @@ def stored_scene(path: str | Path) -> dict:
         return _layout(f, path).scene
 
 
+def result_inputs(path: str | Path) -> tuple[str, ...]:
+    """The files a command that reads the result at ``path`` never writes over: the
+    result and the records it names where the sweep read them (a single record's or a
+    suite's; an analysis may re-read them). Only ``(path,)`` for a file that is not a
+    readable result (its own error comes when it is read)."""
+    try:
+        sc = stored_scene(path)
+    except RocksweepError:
+        return (str(path),)
+    recs = [sc.get("record") or {}, *((sc.get("suite") or {}).get("records") or [])]
+    return (str(path), *(str(r["source"]) for r in recs
+                         if isinstance(r, dict) and isinstance(r.get("source"), str)))
+
+
 def peek_done(path: str | Path) -> tuple[int, int] | None:
     """(points done, total) of a rocksweep result at path, None if it is not one."""
     try:
@@ -441,7 +516,11 @@ def result_of(ds) -> SweepResult:
     either. A Dataset that is not a rocksweep sweep result is a one-line StoreError."""
     import json
 
-    where = Path(str(ds.encoding.get("source") or ds.attrs.get("title") or "dataset"))
+    source = ds.encoding.get("source")
+    in_file = isinstance(source, str | Path) and bool(str(source))
+    # a Dataset made in memory is named by its title in messages, never opened by it
+    where = Path(str(source) if in_file else
+                 f"result in memory ({ds.attrs.get('title') or 'untitled'})")
     if "outcome" not in ds.data_vars or "scene_resolved" not in ds.attrs:
         raise StoreError(f"{where}: not a rocksweep result (a Dataset from rocksweep.run or "
                          "rocksweep.open has an outcome variable and a scene_resolved "
@@ -462,7 +541,7 @@ def result_of(ds) -> SweepResult:
               if set(v.dims) == set(dims)}
     attrs = {str(k): _plain(v) for k, v in ds.attrs.items()}
     return SweepResult(where, dims, tuple(len(coords[d]) for d in dims), coords, scalars,
-                       arrays, attrs, stored)
+                       arrays, attrs, stored, in_file)
 
 
 def as_result(data, names: list[str] | None = None) -> SweepResult:
@@ -502,6 +581,43 @@ def stored_record(path: Path, rec: dict):
         raise _damaged(path, f"its copy of the record: {err}") from None
 
 
+def stored_records(path: Path, suite: dict) -> tuple | None:
+    """The records a suite's result file keeps (``_store_suite_records``) as
+    ``GroundRecord``s in the suite's order, each checked against the SHA-256 the resolved
+    scene states; None for a file that keeps no copies (made before suites stored them).
+    StoreError if a copy is damaged."""
+    import hashlib
+
+    from rocksweep.physics.records import RecordError, parse_record
+
+    want = suite.get("records") or []
+    f = _open(path, "r")
+    try:
+        g = f.get(SUITE_GROUP)
+        if g is None:
+            return None
+        blobs = []
+        for i, r in enumerate(want):
+            d = g.get(str(i))
+            if d is None:
+                raise _damaged(path, f"its copy of record {r.get('name')!r} is missing")
+            blobs.append(bytes(np.asarray(d[()], dtype=np.uint8).tobytes()))
+    except _H5_ERRORS as err:
+        raise _damaged(path, f"its copies of the records: {_why(err)}") from None
+    finally:
+        _close_quietly(f)
+    out = []
+    for r, data in zip(want, blobs, strict=True):
+        if hashlib.sha256(data).hexdigest() != r.get("sha256"):
+            raise _damaged(path, f"its copy of record {r.get('name')!r} does not match its "
+                                 "SHA-256")
+        try:
+            out.append(parse_record(data, str(r.get("source"))))
+        except RecordError as err:
+            raise _damaged(path, f"its copy of record {r.get('name')!r}: {err}") from None
+    return tuple(out)
+
+
 def result_scene(result: SweepResult) -> Scene:
     """The scene a result was computed from, rebuilt from its YAML and overrides and
     checked against the result's resolved scene (axes, numerics), so that the kernel runs
@@ -525,7 +641,7 @@ def result_scene(result: SweepResult) -> Scene:
         # the file's own copy first (a result stands alone); a file without one re-reads
         # the record from where the sweep read it, checked against its SHA-256
         # a Dataset made in memory (rocksweep.run without output) has no file to read
-        record = stored_record(result.path, rec) if result.path.is_file() else None
+        record = stored_record(result.path, rec) if result.in_file else None
         if record is None:
             from rocksweep.physics.records import RecordError, read_record
 
@@ -539,15 +655,19 @@ def result_scene(result: SweepResult) -> Scene:
                 raise StoreError(f"{shown(result.path)}: the record {rec['source']} changed "
                                  f"since the sweep (sha256 {record.sha256[:12]}, the result "
                                  f"has {rec['sha256'][:12]})")
-    elif suite:  # the records where the sweep read them (their SHA-256s are compared)
+    records = stored_records(result.path, suite) if suite and result.in_file else None
+    if suite and records is None:
+        # a file without copies (older rocksweep) or a Dataset made in memory: the records
+        # where the sweep read them (their SHA-256s are compared below)
         overrides.append("ground.records=" + json.dumps(
             [str(r.get("source")) for r in suite.get("records") or []]))
     try:
-        sc = parse_scene(str(a["scene"]), str(result.path), overrides, record=record)
+        sc = parse_scene(str(a["scene"]), str(result.path), overrides, record=record,
+                         records=records)
     except RocksweepError as err:
         raise StoreError(f"{shown(result.path)}: cannot rebuild its scene ({err})") from None
     stored = {k: v for k, v in result.scene.items() if k != "adaptive"}
-    added = bool(suite) and not rec  # the override above is not the file's
+    added = bool(suite) and not rec and records is None  # the override is not the file's
     diffs = scene_differences(stored, resolved_scene(sc, overrides[:len(overrides) - added]))
     if diffs:
         raise StoreError(f"{shown(result.path)}: its scene YAML no longer gives its grid "

@@ -10,12 +10,13 @@ the atomic rename.
   lock on a file it overwrites (``_lock_existing``), and holds the new file's lock before
   it is renamed into place (``_publish``), so no two processes write one path, whatever
   ``--resume``/``--overwrite`` they are given. Without ``overwrite`` the rename is a hard
-  link, which fails if another process made the path meanwhile.
+  link, which fails if another process made the path meanwhile. The rename, the new
+  file's mode and the rule that an input is never an output are ``rocksweep.outputs``'s,
+  as for every other output.
 """
 
 from __future__ import annotations
 
-import contextlib
 import errno
 import os
 import re
@@ -24,7 +25,8 @@ import stat
 import time
 from pathlib import Path
 
-from rocksweep.outputs import shown
+from rocksweep.errors import OutputError
+from rocksweep.outputs import publish, shown
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import StoreError, _mib, _why
 
@@ -57,9 +59,12 @@ def _reserve(path: Path, nbytes: int) -> None:
 
 def _reserve_bytes(scene: Scene, nbytes: int) -> int:
     """Bytes a new result file of ``scene`` reserves: its datasets (``nbytes``), HDF5's
-    metadata, the scene text and the record (its file and samples, ``_store_record``)."""
+    metadata, the scene text and the records (a record's file and samples,
+    ``_store_record``; a suite's files, ``_store_suite_records``)."""
     rec = (8 * int(scene.record.npts) + len(scene.record.data) + (16 << 10)
            if scene.record is not None else 0)
+    if scene.suite is not None:  # each record's file (gzip: at most its size) and metadata
+        rec += sum(len(r.data) + (8 << 10) for r in scene.suite.records)
     return nbytes + METADATA_RESERVE + 4 * len(scene.text.encode()) + rec
 
 
@@ -147,18 +152,6 @@ def clean_stale_partials(path: Path) -> list[tuple[str, int]]:
     return removed
 
 
-def _umask_mode() -> int:
-    """Mode of a new file under this process's umask (mkstemp makes files 0600)."""
-    try:
-        with open("/proc/self/status") as fh:
-            for line in fh:
-                if line.startswith("Umask:"):
-                    return 0o666 & ~int(line.split()[1], 8)
-    except (OSError, ValueError):
-        pass
-    return 0o644
-
-
 def _lock_existing(path: Path) -> int:
     """Open the file at ``path`` and take the exclusive lock a writer holds (HDF5 locks
     with flock); returns the descriptor. StoreError if a sweep is writing it."""
@@ -180,33 +173,10 @@ def _lock_existing(path: Path) -> int:
 
 
 def _publish(tmp: Path, path: Path, old_fd: int | None) -> None:
-    """Rename the finished temporary file to ``path``: over the file locked by ``old_fd``,
-    or, without one, only if nothing is at ``path`` (another process may have made it
-    since it was checked)."""
-    os.chmod(tmp, _umask_mode())
-    if old_fd is not None:
-        try:
-            same = os.path.samestat(os.fstat(old_fd), os.stat(path))
-        except OSError:
-            same = False
-        if not same:
-            raise StoreError(f"{shown(path)}: replaced by another process meanwhile; not "
-                             "overwritten")
-        os.replace(tmp, path)
-        return
+    """Rename the finished temporary file to ``path`` (``outputs.publish``, the one rename
+    of every output): over the file locked by ``old_fd``, or, without one, only if
+    nothing is at ``path`` (another process may have made it since it was checked)."""
     try:
-        os.link(tmp, path)
-    except FileExistsError:
-        raise StoreError(f"{shown(path)}: made by another process meanwhile (a sweep "
-                         "started at the same time?); not overwritten") from None
-    except OSError as err:
-        if err.errno not in (errno.EPERM, errno.ENOTSUP, errno.EOPNOTSUPP, errno.EXDEV,
-                             errno.EMLINK):
-            raise
-        if path.exists():  # no hard links here: check, then rename
-            raise StoreError(f"{shown(path)}: made by another process meanwhile; not "
-                             "overwritten") from None
-        os.replace(tmp, path)
-        return
-    with contextlib.suppress(OSError):
-        os.unlink(tmp)
+        publish(tmp, path, replace=False, old_fd=old_fd)
+    except OutputError as err:
+        raise StoreError(str(err)) from None

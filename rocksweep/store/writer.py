@@ -28,7 +28,7 @@ from rocksweep.compute.grid import Grid
 from rocksweep.compute.sweep import ChunkResult
 from rocksweep.errors import OutputError, RocksweepError
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.outputs import check_output, shown
+from rocksweep.outputs import check_output, is_input, shown
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import (
     _H5_ERRORS,
@@ -153,7 +153,8 @@ class SweepFile:
         import h5py
         path = Path(path)
         try:
-            check_output(path, overwrite=True)  # devices, directories, missing dirs
+            # devices, directories, missing dirs, the scene's own files
+            check_output(path, overwrite=True, inputs=scene.inputs)
         except OutputError as err:
             raise StoreError(str(err)) from None
         existed = os.path.lexists(path)
@@ -245,6 +246,9 @@ class SweepFile:
         for a sweep of every point) to finish it (its points are kept whatever happens:
         the session's attributes are updated in place)."""
         path = Path(path)
+        if is_input(path, scene.inputs):  # written in place: only the identity rule
+            raise StoreError(f"{shown(path)}: is this command's input; choose another "
+                             "output path")
         f = _open(path, "r")
         try:
             stored = _layout(f, path).scene
@@ -259,9 +263,13 @@ class SweepFile:
             _close_quietly(f)
         diffs = scene_differences(stored, resolved_scene(scene, overrides, adaptive))
         if diffs:
+            done = int((outcome != L.OUTCOME_NOT_RUN).sum())
+            keep = (f"resume with the scene, --set values and options it was made with, or "
+                    f"sweep this scene to another -o; --overwrite would discard the {done} "
+                    "points it holds" if done else "use --overwrite to start again: it "
+                    "holds no computed point")
             raise StoreError(f"{shown(path)}: cannot resume, the scene differs from the "
-                             "file's: " + "; ".join(diffs) + " (use --overwrite to start "
-                             "again)")
+                             "file's: " + "; ".join(diffs) + f" ({keep})")
         f = _open(path, "r+")
         try:
             _layout(f, path)  # the file locked now (another may have replaced the first)

@@ -120,6 +120,20 @@ def test_estimate_measures_on_a_sample(pair):
     assert not Path("x.h5").exists()
 
 
+def test_estimate_counts_the_half_step_rerun_of_a_check_sweep(pair):
+    """Review 3: ``outputs.check`` reruns every point at half the step, which alone costs
+    about twice the first run: the sweep costs ~3x, the estimate said 2x."""
+    plain = rocksweep.estimate(CI_SMALL, overrides=SINE)
+    check = rocksweep.estimate(CI_SMALL, overrides={**SINE, "outputs.check": True})
+    # the step bound: ceil(T/(h/2)) is 2 ceil(T/h) or one less, so 1 + 2 per point
+    assert 2.95 < check.steps_bound / plain.steps_bound <= 3.0
+    # measured on the whole grid: the rerun's evaluations are run and counted (more than
+    # the first run's: half the step), not a factor on the first run's (here 2.16x)
+    assert check.sampled == plain.sampled == 128
+    assert 1.5 < check.evaluations / plain.evaluations < 3.0
+    assert check.evaluations != 2 * plain.evaluations
+
+
 def test_check_fields_carry_their_units(tmp_path):
     """Review defect a: the per-point estimates were written with rocksweep_units "1"."""
     ds = rocksweep.run(CI_SMALL, overrides={**SINE, "impact.lam": 0.0,
@@ -167,6 +181,24 @@ def test_spectra_dataset(tmp_path):
     np.testing.assert_array_equal(sp.outcome.values[0], ds.outcome.transpose(
         "A_ratio", "p").values.squeeze() if "lam" not in ds.outcome.dims else
         ds.outcome.sel(lam=0.0).transpose("A_ratio", "p").values)
+
+
+def test_spectra_of_a_block_name_its_alpha():
+    """Review 3: a block's spectra labelled its theta with the flexible body's alpha_cg."""
+    from rocksweep.figures.spectrum import spectra_figure
+
+    ds = rocksweep.run(ROOT / "configs" / "block.yaml",
+                       overrides={"pulse.shape": "sine", "pulse.w_over_p": [1.0, 2.0, 3.0],
+                                  "pulse.A_ratio": [2.0, 4.0, 8.0]})
+    sp = rocksweep.spectra(ds, rtol=1e-2)
+    assert sp.theta_max_over_alpha.attrs["symbol"] == "max|theta|/alpha"
+    assert sp.A_min.attrs["symbol"] == "A/(g tan alpha)"
+    from rocksweep.analysis.spectrum import spectra as spectra_of
+
+    fig = spectra_figure(spectra_of(ds, rtol=1e-2))
+    labels = [a.get_ylabel() for a in fig.axes]
+    assert labels[0] == r"max$|\theta|/\alpha$ (x: overturned)"
+    assert r"\alpha_{cg}" not in " ".join(labels)
 
 
 def test_python_errors_speak_python(tmp_path):

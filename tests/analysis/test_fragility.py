@@ -58,8 +58,11 @@ def test_stripe_mle_recovers_a_known_lognormal_from_binomial_counts():
     n = np.full(LEVELS.size, 30)
     p = norm.cdf(np.log(LEVELS / MEDIAN) / BETA)
     fits = [F.fit_stripes(LEVELS, rng.binomial(n, p), n) for _ in range(300)]
-    assert all(f.reason == "ok" for f in fits)
-    lnm = np.log([f.median for f in fits])
+    # the data follow the model: the only verdict is the non-monotone test's false alarm,
+    # at its level (1 %)
+    assert {f.reason for f in fits} <= {"ok", "non_monotone"}
+    assert sum(f.reason == "ok" for f in fits) >= 294
+    lnm = np.log([f.im_median for f in fits])
     betas = np.array([f.beta for f in fits])
     se = lnm.std() / math.sqrt(lnm.size)
     assert abs(lnm.mean() - math.log(MEDIAN)) < 4 * se
@@ -105,7 +108,7 @@ def test_zero_and_full_stripes_are_used_not_clipped_away():
     k = np.array([0, 0, 4, 9, 20, 20])
     fit = F.fit_stripes(x, k, n)
     assert fit.reason == "ok"
-    assert fit.median == pytest.approx(direct_mle(x, k, n)[0], rel=1e-5)
+    assert fit.im_median == pytest.approx(direct_mle(x, k, n)[0], rel=1e-5)
     assert fit.beta == pytest.approx(direct_mle(x, k, n)[1], rel=1e-5)
     partial = F.fit_stripes(x[2:4], k[2:4], n[2:4])
     assert partial.beta != pytest.approx(fit.beta, rel=1e-3)
@@ -115,18 +118,19 @@ def test_degenerate_stripes_answer_with_a_reason():
     n = np.full(4, 10)
     x = np.array([0.1, 0.2, 0.4, 0.8])
     none = F.fit_stripes(x, np.zeros(4), n)
-    assert none.reason == "no_failures" and math.isnan(none.median) and math.isnan(none.beta)
+    assert none.reason == "no_failures" and math.isnan(none.im_median) and math.isnan(none.beta)
     every = F.fit_stripes(x, n, n)
-    assert every.reason == "all_failed" and math.isnan(every.median)
-    # a step between 0.2 and 0.4: beta -> 0, median at their geometric mean
+    assert every.reason == "all_failed" and math.isnan(every.im_median)
+    # a step between 0.2 and 0.4: the likelihood grows as beta -> 0, so beta is not
+    # determined (NaN, never 0) and the median is at their geometric mean
     step = F.fit_stripes(x, [0, 0, 10, 10], n)
-    assert step.reason == "separated" and step.beta == 0.0
-    assert step.median == pytest.approx(math.sqrt(0.2 * 0.4))
+    assert step.reason == "separated,beta_undetermined" and math.isnan(step.beta)
+    assert step.im_median == pytest.approx(math.sqrt(0.2 * 0.4))
     # quasi-separated at one mixed stripe: the step sits at that stripe
     quasi = F.fit_stripes(x, [0, 3, 10, 10], n)
-    assert quasi.reason == "separated" and quasi.median == pytest.approx(0.2)
+    assert quasi.reason.startswith("separated") and quasi.im_median == pytest.approx(0.2)
     down = F.fit_stripes(x, [8, 6, 4, 2], n)
-    assert down.reason == "decreasing" and math.isnan(down.median)
+    assert down.reason == "decreasing" and math.isnan(down.im_median)
     empty = F.fit_stripes(x, np.zeros(4), np.zeros(4))
     assert empty.reason == "no_data"
 
@@ -153,10 +157,10 @@ def test_cloud_fit_recovers_a_known_probit():
     fit = F.fit_cloud(im, failed)
     assert fit.reason == "ok"
     # standard errors at n = 2000 are ~0.01 on ln median and ~0.02 on beta
-    assert fit.median == pytest.approx(0.6, rel=0.05)
+    assert fit.im_median == pytest.approx(0.6, rel=0.05)
     assert fit.beta == pytest.approx(0.35, rel=0.12)
     ref = direct_mle(im, failed.astype(float), np.ones(im.size))
-    assert fit.median == pytest.approx(ref[0], rel=1e-5)
+    assert fit.im_median == pytest.approx(ref[0], rel=1e-5)
     assert fit.beta == pytest.approx(ref[1], rel=1e-5)
 
 
@@ -199,11 +203,11 @@ def test_fragility_of_stripes_recovers_each_lam_and_counts():
     ds = suite_dataset(n_records=60)
     fr = F.fragility(ds, bootstrap=100, seed=1)
     assert fr.attrs["method"] == "stripes-mle" and fr.attrs["im"] == "PGA"
-    assert fr["median"].dims == ("lam",)
+    assert fr["im_median"].dims == ("lam",)
     for i, true in enumerate((0.4, 0.55)):
-        med = float(fr["median"][i])
+        med = float(fr["im_median"][i])
         assert med == pytest.approx(true, rel=0.2)
-        assert float(fr["median_lo"][i]) < med < float(fr["median_hi"][i])
+        assert float(fr["im_median_lo"][i]) < med < float(fr["im_median_hi"][i])
         assert float(fr["beta_lo"][i]) < float(fr["beta"][i]) < float(fr["beta_hi"][i])
     # the counts the fit used, computed here from the outcome
     over = ds["outcome"].isin([1, 2])
@@ -213,13 +217,13 @@ def test_fragility_of_stripes_recovers_each_lam_and_counts():
     assert np.all(fr["n_records"].values == 60) and np.all(fr["n_excluded"].values == 0)
     # the fit itself equals fit_stripes on those counts
     k0 = over.isel(lam=0).sum("record").values
-    assert float(fr["median"][0]) == pytest.approx(
-        F.fit_stripes(LEVELS, k0, np.full(LEVELS.size, 60)).median, rel=1e-12)
+    assert float(fr["im_median"][0]) == pytest.approx(
+        F.fit_stripes(LEVELS, k0, np.full(LEVELS.size, 60)).im_median, rel=1e-12)
     # band: inside [0, 1], lower <= upper, and it holds the fitted curve at the median
     lo, hi = fr["band_lo"].values, fr["band_hi"].values
     assert np.all((lo >= 0) & (hi <= 1) & (lo <= hi))
     g = fr["im_grid"].values
-    j = np.argmin(np.abs(np.log(g / float(fr["median"][0]))))
+    j = np.argmin(np.abs(np.log(g / float(fr["im_median"][0]))))
     assert lo[0, j] < 0.5 < hi[0, j]
 
 
@@ -234,11 +238,11 @@ def test_flagged_points_are_excluded_and_counted():
     over = ds["outcome"].isin([1, 2]) & counted
     k = over.isel(lam=1).sum("record").values
     n = counted.isel(lam=1).sum("record").values
-    assert float(fr["median"][1]) == pytest.approx(F.fit_stripes(LEVELS, k, n).median,
+    assert float(fr["im_median"][1]) == pytest.approx(F.fit_stripes(LEVELS, k, n).im_median,
                                                    rel=1e-12)
     # a flagged point counted as safe would give another answer
     n_all = np.full(LEVELS.size, ds.sizes["record"])
-    assert float(fr["median"][1]) != pytest.approx(F.fit_stripes(LEVELS, k, n_all).median,
+    assert float(fr["im_median"][1]) != pytest.approx(F.fit_stripes(LEVELS, k, n_all).im_median,
                                                    rel=1e-6)
 
 
@@ -296,7 +300,7 @@ def test_state_definitions_and_per_record_levels():
 
 def test_a_single_state_has_no_state_dimension():
     fr = F.fragility(small_dataset(), state="overturn")
-    assert "state" not in fr["median"].dims and fr["state"].item() == "overturn"
+    assert "state" not in fr["im_median"].dims and fr["state"].item() == "overturn"
 
 
 def test_bad_requests_are_one_line_errors():
@@ -329,12 +333,12 @@ def test_cloud_dataset_uses_the_scaled_record_ims():
     ds = cloud_dataset()
     fr = F.fragility(ds)
     assert fr.attrs["method"] == "cloud-mle" and fr.attrs["im"] == "PGA"
-    assert float(fr["median"][0]) == pytest.approx(0.7, rel=0.1)
+    assert float(fr["im_median"][0]) == pytest.approx(0.7, rel=0.1)
     im = ds["record_pga"].values * 2.0
-    assert float(fr["median"][0]) == pytest.approx(
-        F.fit_cloud(im, ds["outcome"].values[0] > 0).median, rel=1e-12)
+    assert float(fr["im_median"][0]) == pytest.approx(
+        F.fit_cloud(im, ds["outcome"].values[0] > 0).im_median, rel=1e-12)
     sa = F.fragility(ds, im="Sa", period=1.0)
-    assert float(sa["median"][0]) == pytest.approx(1.2 * float(fr["median"][0]), rel=1e-9)
+    assert float(sa["im_median"][0]) == pytest.approx(1.2 * float(fr["im_median"][0]), rel=1e-9)
     assert sa.attrs["period"] == 1.0
     with pytest.raises(F.FragilityError):
         F.fragility(ds, im="Sa")  # two periods: which one?
@@ -349,38 +353,45 @@ def test_curves_json():
     assert json.loads(text) == doc
     curves = doc["curves"]
     assert len(curves) == 4
-    keys = {"lam", "state", "im", "method", "median", "beta", "median_ci", "beta_ci",
-            "n_records", "n_excluded"}
+    keys = {"lam", "state", "im", "method", "im_median", "beta", "im_median_ci", "beta_ci",
+            "n_records", "n_excluded", "n_not_run", "reason"}
     for c in curves:
         assert keys <= set(c)
         assert isinstance(c["lam"], float) and isinstance(c["n_records"], int)
         assert c["im"] == "PGA" and c["method"] == "stripes-mle"
-        assert len(c["median_ci"]) == 2 and c["median_ci"][0] <= c["median"]
+        assert len(c["im_median_ci"]) == 2 and c["im_median_ci"][0] <= c["im_median"]
     first = curves[0]
     assert (first["lam"], first["state"]) == (0.0, "overturn")
-    assert first["median"] == float(fr["median"].sel(state="overturn", lam=0.0))
+    assert first["im_median"] == float(fr["im_median"].sel(state="overturn", lam=0.0))
 
 
 def test_without_bootstrap_the_intervals_are_nan():
-    fr = F.fragility(suite_dataset(n_records=20))
-    assert np.all(np.isnan(fr["median_lo"].values)) and np.all(np.isnan(fr["band_hi"].values))
-    assert np.all(np.isfinite(fr["median"].values))
+    fr = F.fragility(suite_dataset(n_records=20), bootstrap=0)
+    assert "im_median_samples" not in fr
+    assert np.all(np.isnan(fr["im_median_lo"].values)) and np.all(np.isnan(fr["band_hi"].values))
+    assert np.all(np.isfinite(fr["im_median"].values))
 
 
 def test_cloud_bootstrap_interval_holds_the_truth():
     fr = F.fragility(cloud_dataset(), bootstrap=200, seed=5)
-    lo, hi = float(fr["median_lo"][0]), float(fr["median_hi"][0])
-    assert lo < float(fr["median"][0]) < hi
+    lo, hi = float(fr["im_median_lo"][0]), float(fr["im_median_hi"][0])
+    assert lo < float(fr["im_median"][0]) < hi
     assert lo < 0.7 < hi
     assert float(fr["beta_lo"][0]) < 0.3 < float(fr["beta_hi"][0])
 
 
 def test_bootstrap_of_nearly_degenerate_data_counts_undefined_resamples():
-    # one record of 12 overturns, at the top level only: many resamples hold no failure
+    # two of 12 records overturn near the top; record 1 is safe again at the level where
+    # record 0 alone fails. A resample has a finite fit only if it draws both: without
+    # record 0 the fractions take one value strictly between 0 and 1 (beta undetermined),
+    # without record 1 the data are separated. P(both drawn) = 1 - 2 (11/12)^12 +
+    # (10/12)^12 = 0.408
     failed = np.zeros((12, LEVELS.size), dtype=bool)
-    failed[0, -1] = True
+    failed[0, -3:] = True
+    failed[1, [-3, -1]] = True
     b = F.bootstrap_records(LEVELS, failed, n_boot=300, seed=0)
-    # P(record 0 not drawn in 12 draws) = (11/12)^12 = 0.35
-    assert 70 < b.n_undefined < 140
+    p_undef = 2 * (11 / 12) ** 12 - (10 / 12) ** 12
+    sd = math.sqrt(300 * p_undef * (1 - p_undef))
+    assert abs(b.n_undefined - 300 * p_undef) < 4 * sd
     assert np.isnan(b.medians).sum() == b.n_undefined
     assert np.isfinite(b.median_ci[0])

@@ -29,14 +29,14 @@ def test_one_colour_per_lam_with_band_points_and_median_differences(tmp_path):
     # each line is the fitted curve: 0.5 at its median
     for i, ln in enumerate(lines):
         x, y = np.asarray(ln.get_xdata()), np.asarray(ln.get_ydata())
-        assert np.interp(float(fr["median"][i]), x, y) == pytest.approx(0.5, abs=0.02)
+        assert np.interp(float(fr["im_median"][i]), x, y) == pytest.approx(0.5, abs=0.02)
     assert sum(isinstance(c, PolyCollection) for c in ax.collections) == 3  # bands
     pts = [c for c in ax.collections if isinstance(c, PathCollection)]
     assert len(pts) == 3
     sizes = pts[1].get_sizes()
     assert sizes[0] < sizes[1]  # fewer records counted at the flagged point's level
     texts = [t.get_text() for t in ax.get_legend().get_texts()]
-    m0, m2 = float(fr["median"][0]), float(fr["median"][2])
+    m0, m2 = float(fr["im_median"][0]), float(fr["im_median"][2])
     assert f"{100 * (m2 / m0 - 1):+.0f}% vs lam = 0" in texts[2]
     assert "lam = 0.2" in texts[1] and "%" not in texts[0]
     fig.savefig(tmp_path / "f.png")

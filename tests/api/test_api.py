@@ -374,10 +374,15 @@ def test_dask_losing_every_worker_mid_sweep_saves_and_stops(tmp_path, monkeypatc
 
 # --- the README -----------------------------------------------------------------------------
 
-def test_readme_python_api_example_runs(tmp_path, monkeypatch):
+@pytest.mark.parametrize("dask", [True, False], ids=["with-dask", "quick-start-install"])
+def test_readme_python_api_example_runs(tmp_path, monkeypatch, dask):
     """The README's Python section, run as a notebook would run it (one namespace): it
     estimates, sweeps, plots, extracts A_min as a DataFrame, runs on a two-worker
-    LocalCluster through client= and simulates, and writes no file where it runs."""
+    LocalCluster through client= and simulates, and writes no file where it runs. On the
+    quick start's install (no ``.[dask]``: dask hidden) it runs too, without the cluster."""
+    if not dask:
+        for name in ("dask", "distributed", "dask.distributed"):
+            monkeypatch.setitem(sys.modules, name, None)  # import fails, find_spec: None
     import pandas as pd
     from matplotlib.figure import Figure
 
@@ -394,7 +399,10 @@ def test_readme_python_api_example_runs(tmp_path, monkeypatch):
     assert isinstance(ns["ds"], xr.Dataset) and isinstance(ns["fig"], Figure)
     assert isinstance(ns["table"], pd.DataFrame) and "A_min" in ns["table"]
     assert isinstance(ns["lines"], pd.DataFrame) and len(ns["lines"]) > 0
-    assert ns["on_cluster"].attrs["backend"].startswith("dask")
+    if dask:
+        assert ns["on_cluster"].attrs["backend"].startswith("dask")
+    else:
+        assert "on_cluster" not in ns
     est = ns["rocksweep"].estimate(ns["scene"])
     assert est.points == ns["ds"].outcome.size
     assert [s.summary["outcome"] for s in ns["sims"]] == ["safe", "mode1"]  # Figure 5

@@ -196,9 +196,9 @@ def test_suite_sweep_end_to_end(tmp_path, suite_dir, cli):
                                   ds["theta_max_over_alpha"].values)
     frag = rocksweep.fragility(run, bootstrap=20)
     assert frag.attrs["method"] == "stripes-mle" and frag.attrs["im"] == "PGA"
-    assert frag["median"].dims == ("lam",) and int(frag["n_records"][0]) == 3
+    assert frag["im_median"].dims == ("lam",) and int(frag["n_records"][0]) == 3
     same = ds.rocksweep.fragility(bootstrap=20)
-    np.testing.assert_array_equal(same["median"].values, frag["median"].values)
+    np.testing.assert_array_equal(same["im_median"].values, frag["im_median"].values)
 
     # the CLI: --json, -o .csv and .h5, --plot
     res = cli.invoke(main, ["fragility", str(out), "--json", "--bootstrap", "20"])
@@ -206,16 +206,16 @@ def test_suite_sweep_end_to_end(tmp_path, suite_dir, cli):
     curves = json.loads(res.stdout)["curves"]
     assert [c["lam"] for c in curves] == [0.0, 0.4]
     for c in curves:
-        assert {"lam", "state", "im", "method", "median", "beta", "median_ci", "beta_ci",
+        assert {"lam", "state", "im", "method", "im_median", "beta", "im_median_ci", "beta_ci",
                 "n_records", "n_excluded"} <= set(c)
         assert c["state"] == "overturn" and c["n_records"] == 3 and c["n_excluded"] == 0
-    assert curves[0]["median"] == pytest.approx(float(frag["median"][0]))
+    assert curves[0]["im_median"] == pytest.approx(float(frag["im_median"][0]))
     res = cli.invoke(main, ["fragility", str(out), "-o", str(tmp_path / "c.csv"),
                             "--plot", str(tmp_path / "f.png"), "--bootstrap", "20"])
     assert res.exit_code == 0, res.output
     assert "lam" in res.output and "median" in res.output
     lines = (tmp_path / "c.csv").read_text().splitlines()
-    assert lines[0].startswith("lam,state,im,method,median,beta") and len(lines) == 3
+    assert lines[0].startswith("lam,state,im,method,fit,im_median,beta") and len(lines) == 3
     assert (tmp_path / "f.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert (tmp_path / "f.png").stat().st_size > 10_000
     res = cli.invoke(main, ["fragility", str(out), "-o", str(tmp_path / "c.h5"),
@@ -224,7 +224,7 @@ def test_suite_sweep_end_to_end(tmp_path, suite_dir, cli):
     import xarray as xr
 
     with xr.open_dataset(tmp_path / "c.h5", engine="h5netcdf") as back:
-        assert back["median"].dims == ("state", "lam")
+        assert back["im_median"].dims == ("state", "lam")
         assert list(back["state"].values) == ["overturn", "uplift"]
     res = cli.invoke(main, ["info", str(out)])
     assert res.exit_code == 0 and "SYN01.AT2 .. SYN12.AT2" not in res.output  # 3: listed

@@ -14,7 +14,6 @@
 
 from __future__ import annotations
 
-import io
 import math
 
 import numpy as np
@@ -23,11 +22,9 @@ from scipy.integrate import quad
 from scipy.special import lambertw
 
 from rocksweep.physics.excitation import (
-    SHAPES,
     PulseShape,
     mp_peak,
     mp_velocity_amplitude,
-    shapes_figure,
 )
 
 ALL = [PulseShape("sine"), PulseShape("sine", cycles=3), PulseShape("cosine"),
@@ -200,14 +197,3 @@ def test_bad_parameters_are_refused(kwargs, match):
     with pytest.raises(ValueError) as err:
         PulseShape(**kwargs)
     assert str(err.value) == match
-
-
-def test_shapes_figure_has_a_panel_per_family():
-    fig = shapes_figure()
-    assert len(fig.axes) == len(SHAPES)
-    assert [ax.get_title() for ax in fig.axes] == ["sine", "cosine", "Ricker",
-                                                   "Mavroeidis-Papageorgiou"]
-    assert sum(len(ax.get_lines()) for ax in fig.axes) == 7 + 4  # 7 shapes + 4 zero lines
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=50)
-    assert buf.getvalue()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -1,0 +1,114 @@
+"""A tidy table of a rocksweep Dataset: one row per run (a sweep) or per curve (an
+analysis), never duplicated.
+
+``ds.to_dataframe()`` takes the union of every variable's dims as the index, so a suite's
+``record_sa`` (record, period) repeats every run once per Sa period. Here the rows are the
+runs: the dims of ``outcome`` (for an analysis, of its main variable, ``ROW_VARIABLE``).
+Columns, in order: the row dims' coordinates; the unswept scene values (scalar
+coordinates: wn_over_p, alpha_cg, p, ...); every variable over (a subset of) the row dims,
+broadcast (the result fields, per-record variables, ``scale_factor``); a variable with one
+more short dimension (``record_sa`` over ``period``) as one column per value,
+``record_sa(0.2)``; and for a record suite the IMs of the ground motion each run saw, the
+record's IM times scale_factor^n (``physics.suite.RECORD_IMS``): ``pga`` [g], ``pgv``
+[m/s], ``arias`` [m/s], ``cav`` [m/s], ``d5_95`` [s], ``pgv_over_pga`` [s], ``avgsa`` [g],
+``sa(T)`` [g]. The units of every column are in ``DataFrame.attrs["units"]``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from rocksweep.analysis.kinds import dataset_kind
+from rocksweep.errors import RocksweepError
+from rocksweep.physics.suite import RECORD_IMS
+
+__all__ = ["ROW_VARIABLE", "TableError", "table"]
+
+#: the variable whose dims are a kind's rows
+ROW_VARIABLE = {"sweep": "outcome", "fragility": ("im_median", "median"), "ida": "ida_im",
+                "risk": "annual_rate", "im_efficiency": "beta",
+                "spectra": "theta_max_over_alpha", "boundaries": "A_min"}
+MAX_SPREAD = 32  # an extra dimension at most this long becomes columns
+SKIP = ("record_sha256",)  # identity, not data: in the file, not in every row
+
+
+class TableError(RocksweepError, ValueError):
+    """A Dataset that has no table; ``str()`` is one line."""
+
+
+def _units(da: xr.DataArray) -> str:
+    return str(da.attrs.get("rocksweep_units") or da.attrs.get("units") or "")
+
+
+def table(ds: xr.Dataset) -> Any:
+    """The tidy ``pandas.DataFrame`` of a rocksweep Dataset (module docstring): one row
+    per run of a sweep (prod of outcome's dim sizes rows), or per entry of an analysis's
+    main variable. ``.attrs["units"]``: column -> units."""
+    import pandas as pd
+
+    kind = dataset_kind(ds)
+    if kind is None:
+        raise TableError("not a rocksweep Dataset (a sweep or an analysis's result)")
+    main = ROW_VARIABLE[kind]
+    main = next((m for m in (main if isinstance(main, tuple) else (main,)) if m in ds),
+                None)
+    if main is None:
+        raise TableError(f"a {kind} Dataset without its main variable")
+    dims = list(ds[main].dims)
+    sizes = tuple(ds.sizes[d] for d in dims)
+    n = int(np.prod(sizes)) if sizes else 1
+    grids = np.meshgrid(*(np.arange(s) for s in sizes), indexing="ij") if dims else []
+    cols: dict[str, np.ndarray] = {}
+    units: dict[str, str] = {}
+    for d, g in zip(dims, grids, strict=True):
+        vals = ds[d].values if d in ds.coords else np.arange(ds.sizes[d])
+        cols[d] = np.asarray(vals)[g.ravel()]
+        units[d] = _units(ds[d]) if d in ds.coords else ""
+    for name, c in ds.coords.items():
+        if c.ndim == 0 and name not in cols:
+            cols[str(name)] = np.repeat(c.values, n)
+            units[str(name)] = _units(c)
+    frame = xr.Dataset(coords={d: np.arange(ds.sizes[d]) for d in dims})
+
+    def flat(da: xr.DataArray) -> np.ndarray:
+        da = da.drop_vars([c for c in da.coords if c not in da.dims])
+        da = da.assign_coords({d: np.arange(da.sizes[d]) for d in da.dims})
+        return np.asarray(da.broadcast_like(frame).transpose(*dims).values).reshape(n)
+
+    for name, da in ds.data_vars.items():
+        name = str(name)
+        if name in SKIP:
+            continue
+        extra = [d for d in da.dims if d not in dims]
+        if not extra:
+            cols[name] = flat(da)
+            units[name] = _units(da)
+        elif (kind == "sweep" and len(extra) == 1 and ds.sizes[extra[0]] <= MAX_SPREAD):
+            e = extra[0]
+            for i, v in enumerate(ds[e].values if e in ds.coords else range(ds.sizes[e])):
+                label = f"{name}({v:g})" if isinstance(v, float | np.floating) else \
+                    f"{name}({v})"
+                cols[label] = flat(da.isel({e: i}))
+                units[label] = _units(da)
+    if kind == "sweep" and "scale_factor" in ds.data_vars and "record" in dims:
+        f = flat(ds["scale_factor"])
+        for im, (var, unit, k) in RECORD_IMS.items():
+            if var in ds.data_vars:
+                label = im.lower()
+                cols[label] = flat(ds[var]) * f ** k
+                units[label] = unit
+        if "record_sa" in ds.data_vars and "period" in ds["record_sa"].dims:
+            for i, T in enumerate(ds["period"].values):
+                label = f"sa({float(T):g})"
+                cols[label] = flat(ds["record_sa"].isel(period=i)) * f
+                units[label] = "g"
+    out = pd.DataFrame(cols)
+    for c in out.columns:  # words as plain strings (parquet, csv)
+        if out[c].dtype == object or out[c].dtype.kind in "US":
+            out[c] = out[c].astype(str)
+    out.attrs["units"] = units
+    out.attrs["kind"] = kind
+    return out

@@ -1,0 +1,87 @@
+"""``rocksweep efficiency``: which IM explains overturning best for this body (the fragility's
+dispersion in every IM of a record suite). A thin wrapper on ``rocksweep.im_efficiency``."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import click
+
+from rocksweep.cli.main import main, user_errors
+from rocksweep.cli.options import dpi_option, overwrite_option, result_argument
+from rocksweep.figures import WIDTHS
+from rocksweep.vocab.outcomes import STATES, THETA_STATE
+
+SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
+
+
+@main.command()
+@result_argument
+@click.option("--state", default="overturn", show_default=True,
+              help=", ".join(STATES) + " or " + THETA_STATE + ".")
+@click.option("-o", "--output", "out_path", type=click.Path(dir_okay=False, path_type=Path),
+              help="The table as CSV (.csv) or the Dataset (.h5, .hdf5, .nc).")
+@click.option("--plot", "fig_path", type=click.Path(dir_okay=False, path_type=Path),
+              help="Bar chart of beta per IM (.png, .pdf, .svg).")
+@click.option("--json", "as_json", is_flag=True, help="Print the table as JSON.")
+@click.option("--width", type=click.Choice(list(WIDTHS)), default="single",
+              show_default=True, help="Figure width: a journal's single or double column.")
+@dpi_option
+@overwrite_option
+@user_errors
+def efficiency(result_path: Path, state: str, out_path: Path | None, fig_path: Path | None,
+               as_json: bool, width: str, dpi: int, overwrite: bool) -> None:
+    """IM efficiency of a record-suite sweep: for every IM of its records (PGA, PGV, Sa(T),
+    AvgSa, Arias, CAV, D5-95, PGV/PGA, PGA/(g tan alpha), PGV p/(g tan alpha)) the
+    lognormal dispersion beta of the state's fragility in that IM, best first (lower beta
+    = the IM explains the state better)."""
+    import numpy as np
+
+    import rocksweep
+    from rocksweep.figures.common import FORMATS, save_figure
+    from rocksweep.outputs import check_distinct, check_output, write_atomic
+
+    check_distinct({"-o": out_path, "--plot": fig_path})
+    if out_path is not None:
+        if out_path.suffix.lower() not in SUFFIXES:
+            raise click.ClickException(f"-o {out_path}: unsupported suffix "
+                                       f"{out_path.suffix or '(none)'!r}; use "
+                                       f"{', '.join(SUFFIXES)}")
+        check_output(out_path, overwrite=overwrite, inputs=[result_path])
+    if fig_path is not None:
+        check_output(fig_path, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
+    eff = rocksweep.im_efficiency(rocksweep.open(result_path), state=state)
+    frame = eff[["beta", "beta_scale", "im_median", "slope", "n_records",
+                 "n_censored"]].to_dataframe().reset_index()
+    frame = frame.merge(eff[["units", "exponent", "method"]].to_dataframe().reset_index(),
+                        on="im")
+    others = [d for d in eff["beta"].dims if d != "im"]
+    frame = frame.sort_values([*others, "beta_scale"])
+    if as_json:
+        click.echo(json.dumps({"state": state, "rows": json.loads(
+            frame.to_json(orient="records"))}))
+    else:
+        click.echo(f"IM efficiency for {state} ({eff.attrs['stripe_im']} stripes; beta per "
+                   "unit of ln scale factor, best first):")
+        for key, grp in (frame.groupby(others, sort=False) if others else [((), frame)]):
+            where = ", ".join(f"{d} = {v}" for d, v in zip(others, np.atleast_1d(key),
+                                                         strict=False))
+            best = "  ".join(f"{r.im} {r.beta_scale:.3f}" for r in grp.itertuples()
+                             if r.beta_scale == r.beta_scale)
+            click.echo(f"  {where or 'all'}: {best}")
+    say = click.echo if not as_json else (lambda m: click.echo(m, err=True))
+    fig = rocksweep.plot(eff, width=width) if fig_path is not None else None
+    if out_path is not None:
+        if out_path.suffix.lower() == ".csv":
+            text = frame.to_csv(index=False)
+            write_atomic(out_path, lambda tmp: tmp.write_text(text))
+        else:
+            from rocksweep.cli.fragility import _to_netcdf
+
+            write_atomic(out_path, lambda tmp: _to_netcdf(eff, tmp))
+        say(f"wrote {out_path}")
+    if fig is not None:
+        save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=[result_path])
+        say(f"wrote {fig_path}")
+

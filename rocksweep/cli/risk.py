@@ -1,0 +1,141 @@
+"""``rocksweep risk``: the mean annual rate and the probability in N years of each state of
+a fragility over a hazard curve. A thin wrapper on ``rocksweep.risk``: the fragility file
+(or a suite sweep, fitted first) and the hazard are read, everything computed, then
+written (nothing is written when anything is wrong)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import click
+
+from rocksweep.cli.main import main, user_errors
+from rocksweep.cli.options import dpi_option, overwrite_option
+from rocksweep.figures import WIDTHS
+
+RISK_SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
+
+
+def risk_rows(rk) -> list[dict]:
+    """One flat row per curve: the fragility's dims, annual_rate (and _lo, _hi, _max),
+    probability (and _lo, _hi), reason; NaN as None."""
+    import math
+
+    dims = list(rk["annual_rate"].dims)
+    stacked = rk.stack(_k=dims) if dims else rk.expand_dims(_k=[0])
+    names = ("annual_rate", "annual_rate_lo", "annual_rate_hi", "annual_rate_max",
+             "probability", "probability_lo", "probability_hi")
+    rows = []
+    for k in range(stacked.sizes["_k"]):
+        one = stacked.isel(_k=k)
+        row = {d: one[d].item() for d in dims}
+        if "state" not in dims and "state" in rk.coords:
+            row["state"] = str(rk["state"].item())
+        for n in names:
+            v = float(one[n])
+            row[n] = v if math.isfinite(v) else None
+        row["reason"] = str(one["reason"].values)
+        rows.append(row)
+    return rows
+
+
+def _g(v) -> str:
+    return "-" if v is None else f"{v:.3g}"
+
+
+@main.command()
+@click.argument("frag_path", metavar="FRAG.h5", type=click.Path(path_type=Path))
+@click.option("--hazard", "hazard_path", required=True,
+              type=click.Path(dir_okay=False, path_type=Path),
+              help="Hazard curve: CSV with the header 'IM [unit],annual_rate' (e.g. "
+                   "'PGA [g],annual_rate'), or OpenQuake's hazard-curve CSV.")
+@click.option("--years", type=float, default=50.0, show_default=True,
+              help="N: the probability of at least one occurrence in N years.")
+@click.option("--site", type=click.IntRange(0), default=None,
+              help="OpenQuake files with several sites: the row to use (0 = first).")
+@click.option("--state", default="overturn", show_default=True,
+              help="When FRAG.h5 is a suite sweep, the states to fit first (as "
+                   "rocksweep fragility --state).")
+@click.option("-o", "--output", "out_path", type=click.Path(dir_okay=False, path_type=Path),
+              help="The rates as CSV (.csv, one row per curve) or the whole risk Dataset "
+                   "(.h5, .hdf5, .nc).")
+@click.option("--plot", "fig_path", type=click.Path(dir_okay=False, path_type=Path),
+              help="Figure: hazard curve, fragility and the rate's integrand (.png, .pdf, "
+                   ".svg).")
+@click.option("--json", "as_json", is_flag=True, help="Print the rows as JSON.")
+@click.option("--width", type=click.Choice(list(WIDTHS)), default="double",
+              show_default=True, help="Figure width: a journal's single or double column.")
+@dpi_option
+@overwrite_option
+@user_errors
+def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, state: str,
+         out_path: Path | None, fig_path: Path | None, as_json: bool, width: str, dpi: int,
+         overwrite: bool) -> None:
+    """Mean annual rate lambda = integral P(state | im) |d lambda_im| of each state of a
+    fragility (FRAG.h5 from rocksweep fragility -o, or a record-suite sweep) over a
+    hazard curve, and the probability 1 - exp(-lambda N) in N years, with the band of the
+    fragility's bootstrap. Beyond the hazard curve's range the rate is bounded (the
+    certain tail above its largest IM is added), never extrapolated."""
+    import rocksweep
+    from rocksweep.analysis.kinds import dataset_kind
+    from rocksweep.api import open_any
+    from rocksweep.figures.common import FORMATS, save_figure
+    from rocksweep.outputs import check_distinct, check_output, write_atomic
+
+    inputs = [frag_path, hazard_path]
+    check_distinct({"-o": out_path, "--plot": fig_path})
+    if out_path is not None:
+        if out_path.suffix.lower() not in RISK_SUFFIXES:
+            raise click.ClickException(
+                f"-o {out_path}: unsupported suffix {out_path.suffix or '(none)'!r}; use "
+                f"{', '.join(RISK_SUFFIXES)}")
+        check_output(out_path, overwrite=overwrite, inputs=inputs)
+    if fig_path is not None:
+        check_output(fig_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
+    ds = open_any(frag_path)
+    if dataset_kind(ds) == "sweep":
+        states = [s.strip() for s in state.split(",") if s.strip()]
+        ds = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states)
+    rk = rocksweep.risk(ds, hazard_path, years, site=site)
+    rows = risk_rows(rk)
+    if as_json:
+        click.echo(json.dumps({"years": rk.attrs["years"], "im": rk.attrs["im"],
+                               "rows": rows}, allow_nan=False))
+    else:
+        a = rk.attrs
+        click.echo(f"risk over {a['hazard_source']} ({a['im']} [{a['im_units']}]), "
+                   f"{a['years']:g} years; {a['extrapolation']}")
+        keys = [k for k in rows[0] if k not in ("annual_rate", "annual_rate_lo",
+                                                 "annual_rate_hi", "annual_rate_max",
+                                                 "probability", "probability_lo",
+                                                 "probability_hi", "reason")]
+        head = [*keys, "annual rate [1/yr]", "(lo, hi)", f"P in {a['years']:g} yr",
+                "(lo, hi)", "verdict"]
+        lines = [head] + [[*(str(r[k]) for k in keys), _g(r["annual_rate"]),
+                           f"({_g(r['annual_rate_lo'])}, {_g(r['annual_rate_hi'])})",
+                           _g(r["probability"]),
+                           f"({_g(r['probability_lo'])}, {_g(r['probability_hi'])})",
+                           r["reason"]] for r in rows]
+        widths = [max(len(line[i]) for line in lines) for i in range(len(head))]
+        for line in lines:
+            click.echo("  ".join(c.ljust(w) for c, w in zip(line, widths, strict=True))
+                       .rstrip())
+    say = click.echo if not as_json else (lambda m: click.echo(m, err=True))
+    fig = None
+    if fig_path is not None:  # drawn before anything is written
+        fig = rocksweep.plot(rk, width=width)
+    if out_path is not None:
+        if out_path.suffix.lower() == ".csv":
+            from rocksweep.cli.fragility import csv_text
+
+            text = csv_text(rows)
+            write_atomic(out_path, lambda tmp: tmp.write_text(text))
+        else:
+            from rocksweep.cli.fragility import _to_netcdf
+
+            write_atomic(out_path, lambda tmp: _to_netcdf(rk, tmp))
+        say(f"wrote {out_path}")
+    if fig is not None:
+        save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=inputs)
+        say(f"wrote {fig_path}")

@@ -1,0 +1,51 @@
+"""``rocksweep table``: a result as a tidy table, one row per run (CSV or Parquet). A thin
+wrapper on ``rocksweep.table``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from rocksweep.cli.main import main, user_errors
+from rocksweep.cli.options import overwrite_option, result_argument
+
+TABLE_SUFFIXES = (".csv", ".parquet")
+
+
+@main.command("table")
+@result_argument
+@click.option("-o", "--output", "out_path", required=True,
+              type=click.Path(dir_okay=False, path_type=Path),
+              help="runs.csv or runs.parquet (Parquet needs pyarrow).")
+@overwrite_option
+@user_errors
+def table_command(result_path: Path, out_path: Path, overwrite: bool) -> None:
+    """One row per run of a sweep (its coordinates, the unswept scene values, the result
+    fields, the record and its IMs, as recorded and as scaled for the run), or one row
+    per curve of an analysis's file (fragility, risk, efficiency -o .h5); no row
+    repeated."""
+    import rocksweep
+    from rocksweep.api import open_any
+    from rocksweep.outputs import check_output, write_atomic
+
+    suffix = out_path.suffix.lower()
+    if suffix not in TABLE_SUFFIXES:
+        raise click.ClickException(f"-o {out_path}: unsupported suffix "
+                                   f"{out_path.suffix or '(none)'!r}; use .csv or .parquet")
+    if suffix == ".parquet":
+        try:
+            import pyarrow  # noqa: F401
+        except ImportError:
+            raise click.ClickException(f"-o {out_path}: Parquet needs pyarrow (pip install "
+                                       "pyarrow); or write .csv") from None
+    check_output(out_path, overwrite=overwrite, inputs=[result_path])
+    frame = rocksweep.table(open_any(result_path))
+    if suffix == ".csv":
+        text = frame.to_csv(index=False)
+        write_atomic(out_path, lambda tmp: tmp.write_text(text))
+    else:
+        frame.attrs = {}  # pandas' attrs are not Parquet metadata
+
+        write_atomic(out_path, lambda tmp: frame.to_parquet(tmp, index=False))
+    click.echo(f"wrote {out_path} ({len(frame):,} rows x {frame.shape[1]} columns)")

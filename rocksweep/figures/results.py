@@ -1,0 +1,175 @@
+"""Figures of the analyses' Datasets that have no figure module of their own: a risk result
+(hazard curve, fragility, the rate's integrand), an IDA (the first overturning level per
+record), spectra (rocking and overturning spectra from the Dataset) and the IM efficiency
+(beta per IM). ``rocksweep.figures.dispatch`` picks one by the Dataset's kind. Each returns
+a pyplot-free ``matplotlib.figure.Figure``; the legend sits outside the data.
+"""
+
+from __future__ import annotations
+
+import itertools
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from matplotlib.figure import Figure
+
+from rocksweep.figures import WIDTHS
+
+
+def _figure(width: str | None, ncols: int = 1, aspect: float = 0.75) -> tuple[Figure, Any]:
+    w = WIDTHS[width][0] if width in WIDTHS else 6.4
+    fig = Figure(figsize=(w, w * aspect), layout="constrained")
+    return fig, fig.subplots(1, ncols, squeeze=False)[0]
+
+
+def _label(d: str, v: Any) -> str:
+    v = v.item() if hasattr(v, "item") else v
+    return f"{v:g}" if d == "state" and isinstance(v, float) else (
+        str(v) if d == "state" else f"{d} = {v:g}" if isinstance(v, float) else f"{d} = {v}")
+
+
+def _curves(da: xr.DataArray, along: str):
+    """(label, 1-D values along ``along``) for every combination of the other dims."""
+    others = [d for d in da.dims if d != along]
+    for pos in itertools.product(*(range(da.sizes[d]) for d in others)):
+        sel = dict(zip(others, pos, strict=True))
+        one = da.isel(sel)
+        label = ", ".join(_label(d, da[d].values[i]) if d in da.coords else f"{d} {i}"
+                          for d, i in sel.items())
+        yield label, sel, one.values
+
+
+def risk_figure(rk: xr.Dataset, *, ax: Any = None, width: str | None = "double") -> Figure:
+    """Three panels over the IM (log axes): the hazard curve lambda(IM > x), the
+    fragility P(state | x) of each curve, and the integrand P(state | x) |d lambda /
+    d ln x| (linear axis: its area over ln x is the state's annual rate, given in the
+    legend)."""
+    if ax is not None:
+        axes = np.atleast_1d(ax)
+        fig = axes[0].figure
+    else:
+        fig, axes = _figure(width, 3, 0.42)
+    im, unit = rk.attrs.get("im", "IM"), rk.attrs.get("im_units", "")
+    xlabel = f"{im} [{unit}]" if unit and unit != "1" else im
+    a0 = axes[0]
+    a0.loglog(rk["hazard_im"].values, rk["hazard_rate"].values, "o-", color="black", ms=3)
+    a0.set_ylabel("annual rate of exceedance [1/yr]")
+    a0.set_title("hazard", fontsize="small")
+    grid = rk["im_level"].values
+    for k, (label, sel, p) in enumerate(_curves(rk["fragility"], "im_level")):
+        c = f"C{k % 10}"
+        rate = float(rk["annual_rate"].isel(sel))
+        if len(axes) > 1:
+            axes[1].semilogx(grid, p, color=c, label=label)
+        if len(axes) > 2:
+            dens = rk["rate_density"].isel(sel).values
+            axes[2].semilogx(grid, dens, color=c,
+                           label=f"{label}: {rate:.3g}/yr" if label else f"{rate:.3g}/yr")
+    if len(axes) > 1:
+        axes[1].set_ylim(-0.02, 1.02)
+        axes[1].set_ylabel("P(state | IM)")
+        axes[1].set_title("fragility", fontsize="small")
+    if len(axes) > 2:
+        axes[2].set_ylabel(r"P(state | x) |d$\lambda$/d ln x| [1/yr]")
+        axes[2].set_title(f"rate integrand, P in {rk.attrs.get('years', 50):g} yr = "
+                          f"{float(rk['probability'].max()):.3g} (max)", fontsize="small")
+        axes[2].legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.22),
+                       frameon=False)
+    for a in axes:
+        a.set_xlabel(xlabel)
+        a.grid(True, which="both", alpha=0.25, linewidth=0.5)
+    return fig
+
+
+def ida_figure(ida: xr.Dataset, *, ax: Any = None, width: str | None = "single") -> Figure:
+    """The first overturning level of each record (``ida_im``, its bracket as an error
+    bar), sorted, one series per value of the other swept keys (lam, ...); IM on a log
+    axis."""
+    if ax is None:
+        fig, axes = _figure(width, 1, 0.9)
+        ax = axes[0]
+    else:
+        fig = ax.figure
+    im, unit = ida.attrs.get("im", "IM"), ida.attrs.get("im_units", "")
+    for k, (label, sel, v) in enumerate(_curves(ida["ida_im"], "record")):
+        order = np.argsort(np.where(np.isnan(v), np.inf, v))
+        y = np.arange(v.size)
+        lo = ida["ida_lo"].isel(sel).values[order] if "ida_lo" in ida else v[order]
+        hi = ida["ida_hi"].isel(sel).values[order] if "ida_hi" in ida else v[order]
+        ax.errorbar(v[order], y + 0.15 * k, xerr=[v[order] - np.fmin(lo, v[order]),
+                                                np.fmax(hi, v[order]) - v[order]],
+                    fmt="o", ms=3, color=f"C{k % 10}", label=label or None)
+    ax.set_xscale("log")
+    ax.set_xlabel(f"first overturning {im} [{unit}]" if unit and unit != "1" else
+                  f"first overturning {im}")
+    ax.set_ylabel("record (sorted)")
+    ax.grid(True, which="both", alpha=0.25, linewidth=0.5)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.18),
+                  frameon=False)
+    return fig
+
+
+def spectra_dataset_figure(sp: xr.Dataset, *, ax: Any = None,
+                           width: str | None = "double") -> Figure:
+    """Rocking spectrum (max|theta|/alpha against the frequency axis, one curve per
+    A_ratio and lam) and overturning spectrum (A_min per lam) of ``rocksweep.spectra``."""
+    freq = next(d for d in sp["A_min"].dims if d != "lam")
+    if ax is not None:
+        axes = np.atleast_1d(ax)
+        fig = axes[0].figure
+    else:
+        fig, axes = _figure(width, 2, 0.45)
+    th = sp["theta_max_over_alpha"]
+    x = sp[freq].values
+    pick = np.unique(np.linspace(0, sp.sizes["A_ratio"] - 1,
+                                 min(6, sp.sizes["A_ratio"])).round().astype(int))
+    for li in range(sp.sizes.get("lam", 1)):
+        one = th.isel(lam=li) if "lam" in th.dims else th
+        for j, ai in enumerate(pick):
+            axes[0].plot(x, one.isel(A_ratio=ai).values, color=f"C{j}",
+                         ls=("-", "--", ":", "-.")[li % 4],
+                         label=f"A = {sp['A_ratio'].values[ai]:g}" if li == 0 else None)
+    axes[0].set_yscale("log")
+    axes[0].set_xlabel(freq)
+    axes[0].set_ylabel(r"max|$\theta$|/$\alpha$")
+    axes[0].set_title("rocking spectrum (line style: lam)", fontsize="small")
+    for label, _sel, v in _curves(sp["A_min"], freq):
+        axes[-1].plot(x, v, "o-", ms=3, label=label)
+    axes[-1].set_xlabel(freq)
+    axes[-1].set_ylabel("A_min")
+    axes[-1].set_title("overturning spectrum", fontsize="small")
+    for a in axes:
+        a.grid(True, alpha=0.25, linewidth=0.5)
+        if a.get_legend_handles_labels()[0]:
+            a.legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.2),
+                     frameon=False, ncol=3)
+    return fig
+
+
+def efficiency_figure(eff: xr.Dataset, *, ax: Any = None,
+                      width: str | None = "single") -> Figure:
+    """beta per IM (per unit of ln scale factor, ``beta_scale``, so that IMs that scale
+    differently compare), one bar group per value of the other dims; lowest is best."""
+    if ax is None:
+        fig, axes = _figure(width, 1, 0.9)
+        ax = axes[0]
+    else:
+        fig = ax.figure
+    da = eff["beta_scale"]
+    ims = [str(v) for v in eff["im"].values]
+    series = list(_curves(da, "im"))
+    wbar = 0.8 / max(len(series), 1)
+    for k, (label, _sel, v) in enumerate(series):
+        ax.bar(np.arange(len(ims)) + (k - (len(series) - 1) / 2) * wbar, v, wbar,
+               color=f"C{k % 10}", label=label or None)
+    ax.set_xticks(np.arange(len(ims)), ims, rotation=45, ha="right")
+    ax.set_ylabel("dispersion beta (lower: more efficient)")
+    state = eff.attrs.get("state", "overturn")
+    ax.set_title(f"IM efficiency for {state}", fontsize="small")
+    ax.grid(True, axis="y", alpha=0.25, linewidth=0.5)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.35),
+                  frameon=False)
+    return fig

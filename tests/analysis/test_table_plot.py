@@ -1,0 +1,115 @@
+"""rocksweep.table (one row per run, no duplicates) and rocksweep.plot of every kind of
+rocksweep Dataset."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+from matplotlib.figure import Figure
+
+import rocksweep
+from rocksweep.analysis.kinds import dataset_kind
+from rocksweep.cli import main
+from rocksweep.physics.model import G
+
+
+@pytest.fixture(scope="module")
+def ds(suite_result):
+    return rocksweep.open(suite_result)
+
+
+def test_one_row_per_run_with_the_runs_ims(ds):
+    t = rocksweep.table(ds)
+    assert len(t) == ds.outcome.size  # to_dataframe() has one row per run and period
+    assert len(ds.to_dataframe()) == ds.outcome.size * ds.sizes["period"]
+    assert not t[["lam", "record", "PGA"]].duplicated().any()
+    # every run's outcome where the Dataset has it
+    for _, row in t.sample(20, random_state=0).iterrows():
+        one = ds.sel(lam=row["lam"], record=row["record"], PGA=row["PGA"])
+        assert row["outcome"] == int(one.outcome)
+        assert row["scale_factor"] == pytest.approx(float(one.scale_factor))
+    # the scaled IMs: PGA is the stripe; PGV, Arias, D5-95 follow F^n
+    np.testing.assert_allclose(t["pga"], t["PGA"], rtol=1e-12)
+    np.testing.assert_allclose(t["pgv"], t["record_pgv"] * t["scale_factor"], rtol=1e-12)
+    np.testing.assert_allclose(t["arias"], t["record_arias"] * t["scale_factor"] ** 2,
+                               rtol=1e-12)
+    np.testing.assert_allclose(t["d5_95"], t["record_d5_95"], rtol=1e-12)
+    np.testing.assert_allclose(t["pgv_over_pga"], t["pgv"] / (t["pga"] * G), rtol=1e-9)
+    assert {"record_sa(0.2)", "record_sa(1)", "sa(0.2)", "sa(1)"} <= set(t.columns)
+    assert t.attrs["units"]["arias"] == "m/s" and t.attrs["units"]["d5_95"] == "s"
+    assert "record_sha256" not in t.columns
+
+
+def test_cli_table_csv_and_parquet(ds, suite_result, tmp_path):
+    csv = tmp_path / "runs.csv"
+    res = CliRunner().invoke(main, ["table", str(suite_result), "-o", str(csv)])
+    assert res.exit_code == 0, res.output
+    back = pd.read_csv(csv)
+    assert len(back) == ds.outcome.size and not back.duplicated().any()
+    pq = tmp_path / "runs.parquet"
+    pytest.importorskip("pyarrow", reason="Parquet needs pyarrow (the test extra)")
+    assert CliRunner().invoke(main, ["table", str(suite_result), "-o", str(pq)]).exit_code == 0
+    pd.testing.assert_frame_equal(pd.read_parquet(pq), rocksweep.table(ds),
+                                  check_dtype=False)
+    bad = CliRunner().invoke(main, ["table", str(suite_result), "-o", str(tmp_path / "x.txt")])
+    assert bad.exit_code != 0 and bad.output.startswith("Error:") and ".parquet" in bad.output
+
+
+def test_plot_draws_every_kind(ds):
+    fr = rocksweep.fragility(ds, state=["overturn", "mode1"], bootstrap=20)
+    eff = rocksweep.im_efficiency(ds)
+    x = np.geomspace(0.01, 5.0, 20)
+    rk = rocksweep.risk(fr, pd.DataFrame({"PGA [g]": x, "annual_rate": 1e-4 * x ** -2.0}))
+    for d, kind in ((ds, "sweep"), (fr, "fragility"), (eff, "im_efficiency"),
+                    (rk, "risk")):
+        assert dataset_kind(d) == kind
+        fig = rocksweep.plot(d)
+        assert isinstance(fig, Figure) and fig.axes
+        assert isinstance(d.rocksweep.plot(), Figure)
+    # the fragility: IM on a log axis, beta in the legend, the legend outside the axes
+    fig = rocksweep.plot(fr)
+    ax = fig.axes[0]
+    assert ax.get_xscale() == "log"
+    texts = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert any("beta" in t for t in texts)
+    fig.canvas.draw()
+    leg = ax.get_legend().get_window_extent()
+    box = ax.get_window_extent()
+    assert leg.y1 <= box.y0 + 1  # below the axes: covers no data
+    # the table of an analysis: one row per curve
+    assert len(rocksweep.table(rk)) == rk.annual_rate.size
+    assert len(rocksweep.table(eff)) == eff.beta.size
+
+
+def test_plot_of_a_foreign_dataset_is_one_line():
+    import xarray as xr
+
+    with pytest.raises(rocksweep.RocksweepError) as err:
+        rocksweep.plot(xr.Dataset({"x": ("t", [1.0, 2.0])}))
+    assert "\n" not in str(err.value)
+
+
+@pytest.mark.filterwarnings("ignore::rocksweep.physics.suite.RecordWarning")
+def test_plot_of_ida_and_spectra_datasets(ds):
+    import xarray as xr
+
+    ida = rocksweep.ida(ds, rtol=0.05)
+    assert dataset_kind(ida) == "ida"
+    fig = rocksweep.plot(ida)
+    assert fig.axes[0].get_xscale() == "log"
+    n_points = sum(len(c.get_offsets()) if hasattr(c, "get_offsets") else 0
+                   for c in fig.axes[0].collections)
+    assert fig.axes[0].lines or n_points
+    lam, A, p = [0.0, 0.4], [1.0, 2.0, 3.0], np.linspace(1, 5, 7)
+    sp = xr.Dataset(
+        {"theta_max_over_alpha": (("lam", "A_ratio", "p"), np.random.default_rng(0)
+                                  .uniform(0.1, 1.0, (2, 3, 7))),
+         "outcome": (("lam", "A_ratio", "p"), np.zeros((2, 3, 7), np.int8)),
+         "A_min": (("lam", "p"), np.full((2, 7), 2.5)),
+         "mode": (("lam", "p"), np.ones((2, 7), np.int8))},
+        coords={"lam": lam, "A_ratio": A, "p": p})
+    assert dataset_kind(sp) == "spectra"
+    fig = rocksweep.plot(sp)
+    assert len(fig.axes) == 2 and fig.axes[1].get_ylabel() == "A_min"

@@ -1,0 +1,142 @@
+"""An output is never an input of its command (issue 32, "Data loss").
+
+Every file a command reads (the scene, its record, a suite's records and their listing, the
+result an analysis reads and the records that result names) is refused as any of the
+command's outputs, even with --overwrite / overwrite=True, whatever the spelling: the same
+path, ``..``, a symbolic link, a hard link (compared by device and inode). Each refusal is
+one line, and every input is left byte for byte as it was.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+from helpers import one_line_error
+
+import rocksweep
+from rocksweep.cli import main
+from rocksweep.errors import OutputError
+from rocksweep.outputs import check_output, is_input
+from rocksweep.physics.records import read_record
+
+ROOT = Path(__file__).resolve().parents[2]
+SUITE = ROOT / "records" / "suite"
+BODY = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47, "
+        "IA_ratio: 0.56}\nimpact: {lam: 0.0}\n")
+REFUSED = "is this command's input; choose another output path"
+
+
+def two_column(src: Path, n: int = 600) -> str:
+    r = read_record(src)
+    return "".join(f"{i * r.dt:.4f} {a:.7e}\n" for i, a in enumerate(r.acc[:n]))
+
+
+@pytest.fixture()
+def work(tmp_path, monkeypatch) -> Path:
+    """A folder of inputs: a suite (r/*.AT2 and a listing of it), a two-column suite
+    (c/*.csv), a single-record scene with an AT2 and one with a two-column record named
+    .png (a name an output may take)."""
+    (tmp_path / "r").mkdir()
+    (tmp_path / "c").mkdir()
+    for i in (1, 2):
+        shutil.copy(SUITE / f"SYN0{i}.AT2", tmp_path / "r" / f"SYN0{i}.AT2")
+        (tmp_path / "c" / f"c{i}.csv").write_text(two_column(SUITE / f"SYN0{i + 2}.AT2"))
+    shutil.copy(SUITE / "SYN05.AT2", tmp_path / "rec.AT2")
+    (tmp_path / "rec.csv").write_text(two_column(SUITE / "SYN06.AT2"))
+    (tmp_path / "rec.png").write_text(two_column(SUITE / "SYN07.AT2"))
+    (tmp_path / "suite.txt").write_text("r/SYN01.AT2\nr/SYN02.AT2\n")
+    suite = ("ground:\n  records: {}\n  scale: {{im: PGA, values: [0.2, 0.6]}}\n  p: 2.0\n"
+             "  periods: [0.5]\n")
+    (tmp_path / "suite.yaml").write_text("name: s\n" + BODY + suite.format("r/*.AT2"))
+    (tmp_path / "listed.yaml").write_text("name: l\n" + BODY + suite.format("suite.txt"))
+    (tmp_path / "csvsuite.yaml").write_text("name: c\n" + BODY + suite.format("c/*.csv"))
+    for name, rec in (("one", "rec.AT2"), ("csv", "rec.csv"), ("png", "rec.png")):
+        (tmp_path / f"{name}.yaml").write_text(
+            f"name: {name}\n" + BODY + f"ground: {{record: {rec}, A_ratio: [1, 3], "
+            "p: [1.0, 2.0]}\n")
+    monkeypatch.chdir(tmp_path)
+    return tmp_path
+
+
+def digests(d: Path) -> dict[str, str]:
+    return {str(p.relative_to(d)): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(d.rglob("*")) if p.is_file() and not p.is_symlink()}
+
+
+def refused(cli, args: list[str], work: Path, out: str) -> None:
+    """The command refuses ``out`` in one line; no input changed, no file added."""
+    before = digests(work)
+    line = one_line_error(cli.invoke(main, args))
+    assert line == f"Error: {out}: {REFUSED}", line
+    assert digests(work) == before
+
+
+# one case per command and kind of input: (command line, the output that is an input)
+CASES = [
+    (["sweep", "suite.yaml", "-o", "r/SYN01.AT2", "--overwrite", "-q"], "r/SYN01.AT2"),
+    (["sweep", "listed.yaml", "-o", "suite.txt", "--overwrite", "-q"], "suite.txt"),
+    (["sweep", "one.yaml", "-o", "rec.AT2", "--overwrite", "-q"], "rec.AT2"),
+    (["sweep", "one.yaml", "-o", "r/../rec.AT2", "--overwrite", "-q"], "r/../rec.AT2"),
+    (["sweep", "one.yaml", "-o", "rec.AT2", "--resume", "-q"], "rec.AT2"),
+    (["simulate", "csv.yaml", "--set", "ground.A_ratio=2", "--set", "ground.p=2", "--csv",
+      "rec.csv", "--overwrite"], "rec.csv"),
+    (["simulate", "png.yaml", "--set", "ground.A_ratio=2", "--set", "ground.p=2", "--plot",
+      "rec.png", "--overwrite"], "rec.png"),
+    (["restitution", "png.yaml", "--plot", "rec.png", "--overwrite"], "rec.png"),
+    (["accuracy", "csv.yaml", "--points", "2", "--ladder", "short", "-o", "rec.csv",
+      "--overwrite"], "rec.csv"),
+]
+
+
+@pytest.mark.parametrize("args, out", CASES, ids=[" ".join(a[:1] + a[2:4]) for a, _ in CASES])
+def test_a_command_never_writes_over_a_file_it_reads(cli, work, args, out):
+    refused(cli, args, work, out)
+
+
+def test_links_to_an_input_are_that_input(cli, work):
+    os.symlink("rec.AT2", work / "soft.h5")
+    os.link(work / "r" / "SYN02.AT2", work / "hard.h5")
+    refused(cli, ["sweep", "one.yaml", "-o", "soft.h5", "--overwrite", "-q"], work, "soft.h5")
+    refused(cli, ["sweep", "suite.yaml", "-o", "hard.h5", "--overwrite", "-q"], work,
+            "hard.h5")
+    assert is_input("soft.h5", [work / "rec.AT2"]) and is_input("hard.h5", ["r/SYN02.AT2"])
+    assert not is_input("rec.csv", ["rec.AT2", None])
+
+
+def test_analyses_never_write_over_the_result_or_its_records(cli, work):
+    """A result's readers (boundaries, fragility, plot, spectrum) protect the result and
+    the records it names."""
+    assert cli.invoke(main, ["sweep", "csv.yaml", "-o", "c.h5", "-q"]).exit_code == 0
+    assert cli.invoke(main, ["sweep", "csvsuite.yaml", "-o", "cs.h5", "-q"]).exit_code == 0
+    refused(cli, ["boundaries", "c.h5", "-o", "rec.csv", "--overwrite"], work, "rec.csv")
+    refused(cli, ["fragility", "cs.h5", "-o", "c/c1.csv", "--overwrite"], work, "c/c1.csv")
+    refused(cli, ["fragility", "cs.h5", "-o", "cs.h5", "--overwrite"], work, "cs.h5")
+    os.symlink("rec.csv", work / "rec-link.png")
+    refused(cli, ["plot", "c.h5", "-o", "rec-link.png", "--overwrite"], work, "rec-link.png")
+
+
+@pytest.mark.parametrize("scene", ["path", "dict", "text"])
+def test_run_never_writes_over_the_scenes_records(work, scene):
+    text = (work / "listed.yaml").read_text().replace("suite.txt", str(work / "suite.txt"))
+    given = {"path": "listed.yaml", "dict": __import__("yaml").safe_load(text),
+             "text": text}[scene]
+    before = digests(work)
+    for out in ("suite.txt", "r/SYN01.AT2", str(work / "r" / ".." / "r" / "SYN02.AT2")):
+        with pytest.raises(OutputError, match="is this command's input"):
+            rocksweep.run(given, output=out, overwrite=True)
+    assert digests(work) == before
+
+
+def test_the_scene_lists_every_file_it_read(work):
+    from rocksweep.scene.parse import load_scene
+
+    sc = load_scene(work / "listed.yaml")
+    assert {Path(p).resolve() for p in sc.inputs} == {
+        work / "listed.yaml", work / "suite.txt", work / "r" / "SYN01.AT2",
+        work / "r" / "SYN02.AT2"}
+    with pytest.raises(OutputError):
+        check_output(work / "suite.txt", overwrite=True, inputs=sc.inputs)

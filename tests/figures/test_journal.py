@@ -1,0 +1,143 @@
+"""Figures ready for a journal and a notebook (issue 31): every Figure rocksweep returns
+saves TrueType fonts through its own ``savefig``, fits a journal width without clipping a
+legend or a label, keeps titles no larger than its labels, and shows itself in a notebook
+as a PNG without ``%matplotlib inline``."""
+
+from __future__ import annotations
+
+import ast
+import io
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.text import Text
+
+import rocksweep
+from rocksweep.figures import WIDTHS
+from rocksweep.figures.common import Figure
+
+ROOT = Path(__file__).resolve().parents[2]
+PKG = ROOT / "rocksweep"
+SMALL = {"pulse.w_over_p": {"start": 0.5, "stop": 6, "num": 8},
+         "pulse.A_ratio": {"start": 0.5, "stop": 8, "num": 8}}
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture(scope="module")
+def laws():
+    """Three impact laws x two lam over a small diagram (384 points)."""
+    return rocksweep.run(ROOT / "configs" / "impact-laws.yaml", overrides=SMALL)
+
+
+def _figures(ds):
+    yield "diagram", rocksweep.plot(ds)
+    yield "laws compared", rocksweep.plot(ds, compare="impact.law")
+    yield "lam compared", rocksweep.plot(ds, compare="lam", curves=True)
+    yield "line", rocksweep.plot(ds.isel(A_ratio=5))
+
+
+def test_every_figure_module_builds_rocksweep_figures():
+    """One Figure class: no module makes a bare matplotlib Figure (its savefig would
+    write Type 3 fonts, a notebook would not show it); annotations may name it."""
+    bare = []
+    for path in sorted(PKG.rglob("*.py")):
+        if path == PKG / "figures" / "common.py":
+            continue
+        tree = ast.parse(path.read_text())
+        mpl = any(isinstance(n, ast.ImportFrom) and n.module == "matplotlib.figure"
+                  and any(a.name == "Figure" for a in n.names) for n in ast.walk(tree))
+        bare += [f"{path.relative_to(ROOT)}:{n.lineno}" for n in ast.walk(tree)
+                 if mpl and isinstance(n, ast.Call) and isinstance(n.func, ast.Name)
+                 and n.func.id == "Figure"]
+    assert not bare, "matplotlib's Figure imported (use rocksweep.figures.common.Figure): " \
+        + ", ".join(bare)
+
+
+def test_savefig_on_a_returned_figure_embeds_truetype(laws, tmp_path):
+    sims = rocksweep.simulate(ROOT / "configs" / "fig5.yaml")
+    from rocksweep.figures.pulses import shapes_figure
+
+    figs = [*(f for _, f in _figures(laws)), sims[-1].figure(), shapes_figure()]
+    for k, fig in enumerate(figs):
+        assert isinstance(fig, Figure)
+        out = tmp_path / f"f{k}.pdf"
+        fig.savefig(out)  # plain matplotlib savefig, as a user calls it
+        pdf = out.read_bytes()
+        assert b"/Type3" not in pdf and b"/FontFile2" in pdf, k  # TrueType embedded
+        # a notebook shows it: IPython calls _repr_png_ when no backend is set up
+        assert fig._repr_png_()[:8] == PNG
+
+
+@pytest.mark.parametrize("width", list(WIDTHS))
+def test_journal_widths_clip_nothing_and_titles_are_no_larger_than_labels(laws, width):
+    inches, _ = WIDTHS[width]
+    for name, fig in _journal(laws, width):
+        assert fig.get_figwidth() == pytest.approx(inches), name
+        canvas = FigureCanvasAgg(fig)
+        canvas.draw()
+        r = canvas.get_renderer()
+        box = fig.bbox
+        for a in [fig._suptitle, *fig.legends, *fig.axes]:
+            if a is None or not a.get_visible():
+                continue
+            bb = a.get_tightbbox(r)
+            assert (bb.x0 >= box.x0 - 1e-6 and bb.x1 <= box.x1 + 1e-6
+                    and bb.y0 >= box.y0 - 1e-6 and bb.y1 <= box.y1 + 1e-6), \
+                f"{name} at {width}: {type(a).__name__} at {bb.extents} outside {box.extents}"
+        # every axes keeps a readable height (the figure grew rather than squash it)
+        for ax in fig.axes:
+            if ax.get_visible():
+                assert ax.get_position().height * fig.get_figheight() > 0.3, name
+        labels = [t.get_fontsize() for ax in fig.axes
+                  for t in (ax.xaxis.label, ax.yaxis.label) if t.get_text()]
+        titles = [ax.title for ax in fig.axes] + [fig._suptitle]
+        for t in titles:
+            if t is not None and t.get_text():
+                assert t.get_fontsize() <= max(labels), (name, t.get_text())
+
+
+def _journal(ds, width):
+    yield "diagram", rocksweep.plot(ds, width=width)
+    yield "laws compared", rocksweep.plot(ds, compare="impact.law", width=width)
+    yield "lam compared", rocksweep.plot(ds, compare="lam", width=width)
+    yield "line", rocksweep.plot(ds.isel(A_ratio=5), width=width)
+
+
+def test_lam_is_written_as_lambda(laws):
+    for name, fig in _figures(laws):
+        texts = [t.get_text() for t in fig.findobj(Text)]
+        plain = [t for t in texts if "lam" in t.replace(r"\lambda", "")]
+        assert not plain, (name, plain)
+
+
+def test_no_progress_bar_class_from_a_notebook_without_progress(monkeypatch):
+    """tqdm.auto in a notebook without ipywidgets warns (TqdmWarning) even for a bar that
+    is never shown: with progress=False the terminal's class is used."""
+    import tqdm as tqdm_module
+
+    from rocksweep.compute.driver import progress_class
+
+    monkeypatch.setitem(sys.modules, "ipykernel", sys.modules.get("ipykernel") or
+                        type(sys)("ipykernel"))
+    assert progress_class(False) is tqdm_module.tqdm
+    import tqdm.auto
+
+    assert progress_class(True) is tqdm.auto.tqdm
+
+
+def test_shapes_figure_has_a_panel_per_family():
+    from rocksweep.figures.pulses import shapes_figure
+    from rocksweep.physics.excitation import SHAPES
+
+    fig = shapes_figure()
+    assert len(fig.axes) == len(SHAPES)
+    assert [ax.get_title() for ax in fig.axes] == ["sine", "cosine", "Ricker",
+                                                   "Mavroeidis-Papageorgiou"]
+    assert sum(len(ax.get_lines()) for ax in fig.axes) == 7 + 4  # 7 shapes + 4 zero lines
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=50)
+    assert buf.getvalue()[:8] == PNG
+    assert np.isfinite(fig.get_size_inches()).all()
