@@ -1034,8 +1034,9 @@ def _refuse_filled(ds: xr.Dataset, states: Sequence[str], counted: xr.DataArray)
     if n and need:
         raise FragilityError(
             f"state {need[0]!r}: {n} points of this adaptive sweep were filled from the class "
-            "around them, not computed, so their uplift and theta are unknown; only overturn, "
-            "mode1 and mode2 can be fitted (sweep without --adaptive for this state)")
+            "around them, not computed, so their uplift and theta are unknown; only "
+            f"{OVERTURN}, {MODE1} and {MODE2} can be fitted (sweep without --adaptive for "
+            "this state)")
 
 
 def _missing_text(not_run: np.ndarray, levels: np.ndarray | None, unit: str,
@@ -1350,7 +1351,7 @@ def _verdicts(kind, idxs, o, lnx, m, med, bet, why, counted, flagged, hits, over
                 w["non_monotone"] = ("the stripe fractions fall with the IM beyond noise "
                                      "(a competing-risk curve cannot fall)")
         kw = states[i]
-        if kind == "single" and kw in ("mode1", "mode2"):
+        if kind == "single" and kw in (MODE1, MODE2):
             own = hits[i, o] & counted
             over = over_all & counted
             other = int(over.sum() - own.sum())

@@ -61,7 +61,7 @@ def _g(v) -> str:
               help="What the curve gives the probability of: " + ", ".join(STATES)
               + " or theta:X (max|theta|/alpha_cg >= X, 0 < X <= 1); several separated by "
               "commas: damage states (uplift, theta:X, overturn) are fitted with one beta so "
-              "their curves never cross, mode1,mode2 as competing risks.")
+              "their curves never cross, the two modes together as competing risks.")
 @click.option("--im", default=None,
               help="Unscaled suites (clouds): the IM, PGA (default), PGV or Sa; stripes use "
                    "the IM they were scaled to.")

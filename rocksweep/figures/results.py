@@ -12,9 +12,9 @@ from typing import Any
 
 import numpy as np
 import xarray as xr
-from matplotlib.figure import Figure
 
 from rocksweep.figures import WIDTHS
+from rocksweep.figures.common import Figure
 
 
 def _figure(width: str | None, ncols: int = 1, aspect: float = 0.75) -> tuple[Figure, Any]:
