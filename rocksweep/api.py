@@ -920,6 +920,68 @@ def write_history_csv(runs: Sequence[Run], swept: Sequence[str], path: str | Pat
 
 
 # ---------------------------------------------------------------------------------------
+# Calibration (issue 30): scene numbers fitted to a measured history
+# ---------------------------------------------------------------------------------------
+
+@speaks_python
+def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impact.lam",),
+              *, bounds: Mapping[str, Sequence[float]] | None = None,
+              overrides: Overrides = (), ci: float = 0.95, p: float | None = None
+              ) -> xr.Dataset:
+    """Fit scene numbers (``impact.lam``, ``impact.e`` under law constant,
+    ``impact.e_factor``, ``body.zeta``, ...) to a measured rocking history.
+
+    measured: a CSV path or a pandas DataFrame with columns p_t, theta_over_alpha (as
+    ``simulate --csv`` writes), or t [s], theta [rad] (then p [rad/s]: the keyword, a
+    physical body's or a record scene's ground.p). bounds: {key: (lo, hi)} inside each
+    key's admissible range (default: ``analysis.calibrate.DEFAULT_BOUNDS`` or the range).
+    Returns a Dataset over ``parameter`` (the fitted keys): ``estimate``, ``lo``, ``hi``
+    (the ``ci`` interval by profile likelihood, ``ci`` in attrs), scalar ``misfit`` (RMS
+    error of the half-cycle peaks, theta/alpha_ref), and the measured and fitted
+    histories over p_t with the fitted impacts (``rocksweep.analysis.calibrate``).
+    """
+    from rocksweep.analysis.calibrate import CalibrationError, Problem, calibrate_problem
+    from rocksweep.physics.measured import read_measured
+
+    keys = [fit] if isinstance(fit, str) else list(fit)
+    if not keys:
+        raise CalibrationError("fit = []: give at least one key, e.g. impact.lam")
+    if len(set(keys)) < len(keys):
+        raise CalibrationError(f"fit = {keys}: a key is given twice")
+    if not (isinstance(ci, float | int) and 0.5 <= ci < 1):
+        raise CalibrationError(f"ci = {ci!r}: must be in [0.5, 1)")
+    sc, _ = load(scene, overrides)
+    p_body = _body_p(sc) if p is None else float(p)
+    values = {a.name: a.values[0] for a in sc.axes}
+    body = sc.point(values).body
+    m = read_measured(measured, p=p_body, alpha_ref=body.alpha_ref, u_cr=body.u_cr or None)
+    fit = calibrate_problem(Problem(sc, m, keys, bounds), float(ci))
+    register_accessor()  # fit.rocksweep.as_overrides()
+    return fit
+
+
+def _body_p(scene: Scene) -> float | None:
+    """The body's p [rad/s] a scene knows (a physical body's, a record scene's ground.p),
+    else None."""
+    if scene.physical is not None:
+        return scene.physical["p"]
+    names = {a.name: a for a in scene.axes}
+    if "p" in names and len(names["p"].values) == 1:
+        return float(names["p"].values[0])
+    return None
+
+
+def calibrated_overrides(fit: xr.Dataset, which: str = "all") -> dict[str, Any]:
+    """Overrides {key: value} of a calibration (``calibrate``'s Dataset) to sweep a scene
+    at the estimate and at both ends of the interval: ``which="all"`` gives [lo, estimate,
+    hi] per key (a swept dimension), "estimate", "lo" or "hi" one value.
+    ``rocksweep.run(scene, overrides=rocksweep.calibrated_overrides(fit))``."""
+    from rocksweep.analysis.calibrate import calibrated_overrides as overrides_of
+
+    return overrides_of(fit, which)
+
+
+# ---------------------------------------------------------------------------------------
 # ds.rocksweep: the analyses as methods of a result Dataset (as rioxarray's ``.rio``),
 # registered when ``run`` or ``open`` first imports xarray (``import rocksweep`` stays light)
 # ---------------------------------------------------------------------------------------
@@ -968,6 +1030,10 @@ class RocksweepAccessor:
     def table(self) -> Any:
         """``rocksweep.table(ds)``: one row per run (a DataFrame)."""
         return table(self._ds)
+
+    def as_overrides(self, which: str = "all") -> dict[str, Any]:
+        """``rocksweep.calibrated_overrides(ds, which)`` of a calibration Dataset."""
+        return calibrated_overrides(self._ds, which)
 
     def outcome_words(self) -> Any:
         """``outcome`` as words (not_run, safe, mode1, mode2), an object DataArray."""

@@ -5,8 +5,8 @@ PGA, PGV, Sa, PGA_ratio or PGV_ratio). Its stripes say, per record, the first le
 overturns the body; ``ida`` refines that level: between the last stripe below it (which
 does not overturn) and it, the record's scale is bisected to a relative tolerance with
 single kernel runs at the sweep's numerics (``compute.single.simulate``: each run
-certified as a single run is). The scaled record's peak, and so the kernel's amplitude, is linear
-in the IM, so a level x between stripes is the stripe's point with its amplitude times
+certified as a single run is). The scaled record's peak, and so the kernel's amplitude,
+is linear in the IM, so a level x between stripes is the stripe's point with its amplitude times
 x / stripe. Overturning means outcome 1 or 2 (mode 1, mode 2).
 
 "Resurrection" (Vamvatsikos & Cornell 2002): a stripe above the first overturning level

@@ -39,7 +39,7 @@ PAR_MAXEVENTS = 22  # cap on impacts + uplifts per run
 PAR_RESTRATE = 23  # post-impact |theta'| below which the body settles [rad/s]
 PAR_THETA_OVER = 24  # |theta| at which the body lies on its side: pi/2 [rad]
 PAR_ROOT = 25  # event root finder: ROOT_BISECT, ROOT_ILLINOIS or ROOT_HERMITE
-PAR_THETA0 = 26  # initial theta [rad] (0: start at rest; != 0 starts rocking on its corner)
+PAR_THETA0 = 26  # initial theta [rad] (0: full contact; > 0 rocking on corner +1, < 0 on -1)
 PAR_THETA_DOT0 = 27  # initial theta' [rad/s] (from theta = 0: rocking on its sign's corner)
 PAR_MU = 28  # friction coefficient of the base on the ground (NaN: none given)
 PAR_GAMMA = 29  # Mavroeidis-Papageorgiou pulse: oscillation parameter gamma (>= 1)
@@ -55,7 +55,9 @@ PAR_DT_ON = 38  # RK4 step while the ground moves, t < PAR_TPULSE (<= PAR_DT) [s
 PAR_ALPHA_REF = 39  # alpha_ref: alpha_cg of a flexible body, alpha of a block [rad]
 PAR_CLOSE = 40  # OUT_MARGIN below which the run is a close call (read after the kernel,
 #                 by ``rocksweep.compute.certify``) [alpha_ref]
-N_PAR = 41
+PAR_U0 = 41  # initial u [m] (flexible bodies; with PAR_THETA0, PAR_THETA_DOT0 the state at t = 0)
+PAR_U_DOT0 = 42  # initial u' [m/s]
+N_PAR = 43
 # A record's row is longer: its samples xg''/PGA (float64[npts], in [-1, 1]) follow the
 # N_PAR parameters, PAR_REC = N_PAR the first (``points.with_record``).
 PAR_REC = N_PAR

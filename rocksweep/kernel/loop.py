@@ -102,6 +102,8 @@ from rocksweep.kernel.layout import (
     PAR_THETA0,
     PAR_THETA_DOT0,
     PAR_TPULSE,
+    PAR_U0,
+    PAR_U_DOT0,
     STATUS_BOUNDED,
     STATUS_E_ABOVE_1,
     STATUS_ENERGY_GAIN,
@@ -177,7 +179,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     max_steps, max_events = prm[PAR_MAXSTEPS], prm[PAR_MAXEVENTS]
     # > 0: a record, whose samples the steps land on while it acts (GROUND variants only)
     h_rec = prm[PAR_REC_H] if GROUND else 0.0
-    y = (prm[PAR_THETA0], prm[PAR_THETA_DOT0], 0.0, 0.0, 0.0, 0.0)
+    # the initial state (runtime values of the row; 0: at rest)
+    y = (prm[PAR_THETA0], prm[PAR_THETA_DOT0], prm[PAR_U0], prm[PAR_U_DOT0], 0.0, 0.0)
     _reset(out)
     on = _acting(0.0, t_pulse, GROUND)
     if y[Y_THETA] != 0.0 or y[Y_THETA_DOT] != 0.0:
@@ -186,7 +189,9 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     else:
         s = _uplift(t, y, on, prm, out, FLEX, DAMPED)  # at t = 0: a cosine pulse's peak
     _record(hist, t, y, s, on, prm, out, FLEX)
-    free_check = True  # rigid: test rigid_bounded at the next loop top after the pulse
+    # rigid: test rigid_bounded at the next loop top after the pulse; not with a history,
+    # which then goes on to rest (free rocking from a tilt is decided at once otherwise)
+    free_check = hist is None
     # the counters of every step stay in registers (in out: ~3% slower); the rest is in out
     steps, event_steps, theta_max = 0, 0, abs(y[Y_THETA])
     # contact tracker (contact.contact_sample): unused, and removed, without CONTACT
@@ -291,7 +296,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             y, s = _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY)
             if CONTACT is not None:
                 contact_impact(y_minus, s_minus, y, s, prm, out, FLEX)
-            free_check = True
+            free_check = hist is None  # (as at the start)
         else:  # uplift: theta = theta' = 0 exactly, now rocking on the located corner
             s = 1 if ev == EV_UPLIFT_POS else -1
             y = (0.0, 0.0, y[Y_U], y[Y_U_DOT], y[Y_W_IN], y[Y_D_DAMP])
