@@ -43,6 +43,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -50,6 +51,8 @@ from typing import Any
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent
+if (ROOT.parent / "rocksweep").is_dir():  # measure the checkout this script is in
+    sys.path.insert(0, str(ROOT.parent))
 CACHE = ROOT / "data" / "bench_spectra_refs.json"
 SEARCH_VERSION = 1  # bump when the reference search changes (cached entries are then stale)
 
@@ -338,6 +341,9 @@ def main() -> None:
     refs = references(cs, args.jobs)
     if args.refs_only:
         return
+    import rocksweep
+
+    print(f"rocksweep {rocksweep.__version__} from {Path(rocksweep.__file__).parent}")
     print(f"test: sweep over A_ratio linspace({A_LO}, {A_HI}, {N_A}) x omega/p {OMEGAS}, "
           f"preset {args.preset or '(scene default)'} {sets or ''}, boundaries rtol {RTOL:g}")
     mine, times = ours(cs, lams, args.preset, sets, args.jobs)
