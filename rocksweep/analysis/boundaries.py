@@ -365,6 +365,20 @@ def _search_intervals(y: np.ndarray, first: int, theta: np.ndarray, uplifts: np.
     return kept
 
 
+def check_amplitudes(scene: Scene, name: str) -> np.ndarray:
+    """The values (float64[ny]) of the axis A_min is searched along (``name``, A_ratio),
+    or a one-line AdaptiveError naming its key and values: it needs at least two,
+    increasing."""
+    ax = scene.axis(name)
+    yv = np.asarray(ax.values, float)
+    if yv.size < 2:
+        raise AdaptiveError(f"{ax.key} = {yv.tolist()}: A_min needs a sweep over at least "
+                            "two values of it")
+    if not np.all(np.diff(yv) > 0):
+        raise AdaptiveError(f"{ax.key}: A_min needs increasing values")
+    return yv
+
+
 def _bisection_steps(lo: float, hi: float, rtol: float) -> int:
     """Iterations that bisect (lo, hi) to rtol (relative to lo), bounded by float64's."""
     return int(min(60, max(0, math.ceil(math.log2(max(hi - lo, 1e-300) / (rtol * abs(lo)
@@ -400,13 +414,7 @@ def a_min(scene: Scene, outcome: np.ndarray, rtol: float = DEFAULT_RTOL,
     if mode not in (None, L.OUTCOME_MODE1, L.OUTCOME_MODE2):
         raise AdaptiveError(f"mode = {mode!r}: must be None (any), 1 or 2")
     target = OVERTURNED if mode is None else (mode,)
-    yax = scene.axis(axes[1])
-    yv = np.asarray(yax.values, float)
-    if yv.size < 2:
-        raise AdaptiveError(f"{yax.key} = {yv.tolist()}: A_min needs a sweep over at least "
-                            "two values of it")
-    if not np.all(np.diff(yv) > 0):
-        raise AdaptiveError(f"{yax.key}: A_min needs increasing values")
+    yv = check_amplitudes(scene, axes[1])
     evaluate = evaluate or kernel_evaluator(scene)
     grid = Grid(scene)
     n_grid = np.asarray(outcome).size
@@ -690,6 +698,7 @@ def check_result(result: SweepResult, axes: Sequence[str] | None = None) -> Scen
     sc = scene_of(result)
     axes = default_axes(sc) if axes is None else axes
     try:
+        check_amplitudes(sc, axes[1])
         make_plan(sc, axes, coarse=0, audit=0.0)
     except AdaptiveError as err:
         raise BoundaryError(f"{result.path}: {err}; boundaries need a diagram over two "
