@@ -28,9 +28,10 @@ The test: one ``rocksweep.run`` per body group (blocks: alpha swept) over A_rati
 linspace(0.3, 30, 300) (step 0.0993) and the omega/p list at the preset of ``--preset``
 (none given: the scene's default), then ``rocksweep.boundaries(ds, rtol=1e-4)``. Printed:
 per curve the reference's and our A_min, relative error, modes, how ours was found
-(``A_min_method`` when the Dataset has it), then the count within 0.5% and the same mode,
-and the wall time of the sweeps and of boundaries (in-process, after one warm-up of the
-kernel variants: no start-up or compile in the figures).
+(``A_min_method``), then the count within 0.5% and the same mode, also for
+``boundaries(..., search=False)`` (the grid's bracket only, side by side), and the wall
+time of the sweeps and of boundaries (in-process, after one warm-up of the kernel
+variants: no start-up or compile in the figures).
 
     python scripts/bench_spectra.py                    # references from the cache, then the test
     python scripts/bench_spectra.py --preset fine      # the test at another preset
@@ -285,7 +286,8 @@ def ours(cs: list[dict[str, Any]], lams: list[float], preset: str | None,
     import rocksweep
 
     found: dict[str, dict] = {}
-    times = {"sweep": 0.0, "boundaries": 0.0, "points": 0, "runs": 0}
+    times = {"sweep": 0.0, "boundaries": 0.0, "points": 0, "runs": 0,
+             "grid_only": 0.0, "grid_only_runs": 0}
     # warm-up: load (or compile) the kernel variants outside the timed runs
     for g in GROUPS:
         small = scene(g, lams[:1], preset, sets)
@@ -297,6 +299,9 @@ def ours(cs: list[dict[str, Any]], lams: list[float], preset: str | None,
         t1 = time.perf_counter()
         b = rocksweep.boundaries(ds, rtol=RTOL)
         t2 = time.perf_counter()
+        b0 = rocksweep.boundaries(ds, rtol=RTOL, search=False)  # the grid's bracket only
+        times["grid_only"] += time.perf_counter() - t2
+        times["grid_only_runs"] += int(b0["runs"].sum())
         times["sweep"] += t1 - t0
         times["boundaries"] += t2 - t1
         times["points"] += int(ds["outcome"].size)
@@ -309,13 +314,26 @@ def ours(cs: list[dict[str, Any]], lams: list[float], preset: str | None,
             for k, v in GROUPS[g].items():
                 if isinstance(v, list):
                     sel[k] = c["body"][k]
-            row = b.sel(sel)
+            row, row0 = b.sel(sel), b0.sel(sel)
             method = (str(row["A_min_method"].values) if "A_min_method" in b else "")
             found[curve_key(c)] = {"a_min": float(row["A_min"]), "mode": int(row["mode"]),
-                                   "runs": int(row["runs"]), "method": method}
+                                   "runs": int(row["runs"]), "method": method,
+                                   "grid_a_min": float(row0["A_min"]),
+                                   "grid_mode": int(row0["mode"])}
         log(f"  {g}: {ds['outcome'].size} points, sweep {t1 - t0:.1f} s, boundaries "
             f"{t2 - t1:.1f} s ({int(b['runs'].sum())} kernel runs)")
     return [found[curve_key(c)] for c in cs], times
+
+
+def agree(ref: float, ref_mode: int, ours: float, our_mode: int) -> tuple[float, bool]:
+    """Relative error of our A_min and whether it counts (within TOLERANCE, same mode;
+    both NaN: agree)."""
+    if math.isnan(ref) and math.isnan(ours):
+        return 0.0, True
+    if math.isnan(ref) or math.isnan(ours):
+        return math.inf, False
+    err = (ours - ref) / ref
+    return err, abs(err) <= TOLERANCE and ref_mode == our_mode
 
 
 def main() -> None:
@@ -350,18 +368,13 @@ def main() -> None:
     print(f"numerics: {times.get('numerics')}")
     print(f"\n{'curve':<40} {'ref A_min':>10} {'m':>1} {'ours':>10} {'m':>1} "
           f"{'rel.err':>8}  ok  runs  method")
-    good = both_none = 0
+    good = both_none = good0 = 0
     bad = []
     for c, r, o in zip(cs, refs, mine, strict=True):
         ra, oa = r["a_min"], o["a_min"]
-        if math.isnan(ra) and math.isnan(oa):
-            err, ok = 0.0, True
-            both_none += 1
-        elif math.isnan(ra) or math.isnan(oa):
-            err, ok = math.inf, False
-        else:
-            err = (oa - ra) / ra
-            ok = abs(err) <= TOLERANCE and r["mode"] == o["mode"]
+        err, ok = agree(ra, r["mode"], oa, o["mode"])
+        good0 += agree(ra, r["mode"], o["grid_a_min"], o["grid_mode"])[1]
+        both_none += math.isnan(ra) and math.isnan(oa)
         good += ok
         if not ok:
             bad.append(label(c))
@@ -369,10 +382,12 @@ def main() -> None:
               f"{err:+8.2%}  {'ok' if ok else '--'} {o['runs']:5d}  {o['method']}")
     n = len(cs)
     print(f"\nwithin {TOLERANCE:.1%} and the same mode: {good}/{n} curves "
-          f"({both_none} with no overturning up to {A_HI} in both)")
+          f"({both_none} with no overturning up to {A_HI} in both); without the search "
+          f"below the grid (search=False): {good0}/{n}")
     print(f"sweeps: {times['points']} points in {times['sweep']:.1f} s "
           f"({1e6 * times['sweep'] / times['points']:.1f} us/point wall, jobs {args.jobs}); "
-          f"boundaries: {times['boundaries']:.1f} s ({times['runs']} kernel runs); "
+          f"boundaries: {times['boundaries']:.1f} s ({times['runs']} kernel runs; "
+          f"search=False {times['grid_only']:.1f} s, {times['grid_only_runs']} runs); "
           f"total {times['sweep'] + times['boundaries']:.1f} s (in-process, kernels warm)")
     ref_s = sum(r["seconds"] for r in refs)
     print(f"references (cached): {sum(r['runs'] for r in refs)} reference runs, "

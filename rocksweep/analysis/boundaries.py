@@ -25,7 +25,7 @@ import io
 import math
 from collections import defaultdict
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -36,9 +36,20 @@ from rocksweep.compute.adaptive import DIAGRAM_AXES, AdaptiveError, make_plan
 from rocksweep.compute.grid import Grid
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.numerics import MAX_POINT_STEPS
+from rocksweep.numerics import MAX_POINT_STEPS, Numerics
 from rocksweep.outcomes import outcome_word
-from rocksweep.physics.points import Point, kernel_kind, point_row
+from rocksweep.physics.points import (
+    RECORD,
+    Point,
+    body_omega_rock,
+    body_row,
+    fill_rows,
+    kernel_kind,
+    law_code,
+    point_row,
+    shape_code,
+    with_record,
+)
 from rocksweep.scene.model import Scene
 
 if TYPE_CHECKING:
@@ -232,14 +243,14 @@ A_MIN_METHODS = (
 # The search below the first overturning grid value (``_search_intervals``) scans grid
 # intervals at interior values spaced (relative to A) by: NEAR_STEP from the last value
 # without uplift up to NEAR_SPAN x the first uplifting value (the narrow first bands just
-# above the uplift threshold at omega/p ~ 1, issue 28: 0.005-0.1 wide at A ~ 1), FAR_STEP
+# above the uplift threshold at omega/p ~ 1, issue 28: 0.01-0.1 wide at A ~ 1), FAR_STEP
 # from there up to UPLIFT_SPAN x it, and FAR_STEP in the intervals with an end whose
 # max|theta|/alpha_ref >= CLOSE (it came close to overturning), closest first; at most
 # SEARCH_RUNS kernel runs a column (a grid finer than the spacing adds none).
-NEAR_SPAN, NEAR_STEP = 1.3, 0.003
-UPLIFT_SPAN, FAR_STEP = 2.0, 0.01
+NEAR_SPAN, NEAR_STEP = 1.3, 0.005
+UPLIFT_SPAN, FAR_STEP = 2.0, 0.02
 CLOSE = 0.5
-SEARCH_RUNS = 256
+SEARCH_RUNS = 128
 # Bound on the RK4 evaluations the refinement of one result may cap its runs at (the sum of
 # the runs' step caps, PAR_MAXSTEPS, over the search and the bisection's iterations): 1e4
 # points at the largest cap a point may have (``numerics.MAX_POINT_STEPS``).
@@ -295,17 +306,42 @@ def kernel_rows(scene: Scene, points: list[Point]) -> np.ndarray:
     records on the ground variants (``point.ground``)."""
     outs = np.empty((len(points), L.N_OUT))
     # one kernel call per body kind, ground variant and record (a record's samples ride
-    # on its rows: rows of one call have one length)
-    groups: dict[tuple[int, bool, int], list[int]] = {}
+    # on its rows: rows of one call have one length); the rows of the points that share a
+    # body object and the pulse's options filled at once (``fill_rows``)
+    groups: dict[tuple, list[int]] = {}
     for i, p in enumerate(points):
-        groups.setdefault((kernel_kind(p.body), p.ground, id(p.record)), []).append(i)
-    for (kind, ground, _), idx in groups.items():
+        key = (kernel_kind(p.body), p.ground, id(p.record), id(p.body), p.cycles, p.gamma,
+               p.nu)
+        groups.setdefault(key, []).append(i)
+    for (kind, ground, *_), idx in groups.items():
         warm_up(kind, L.LEVEL_OUTCOME, ground)
-        rows = np.array([point_row(points[i], scene.numerics) for i in idx])
+        rows = _rows([points[i] for i in idx], scene.numerics)
         part = np.empty((len(idx), L.N_OUT))
         chunk_kernel(kind, L.LEVEL_OUTCOME, ground)(rows, part)
         outs[idx] = part
     return outs
+
+
+def _rows(points: list[Point], numerics: Numerics) -> np.ndarray:
+    """Parameter rows float64[n, N_PAR (+ samples)] of points sharing one body object,
+    record and pulse options (``point_row`` for each, vectorised: ``fill_rows``)."""
+    p0 = points[0]
+    body = p0.body
+    rec = p0.record if p0.shape == RECORD else None
+    n = len(points)
+    rows = np.empty((n, L.N_PAR))
+
+    def column(name: str) -> np.ndarray:
+        return np.array([getattr(p, name) for p in points], float)
+
+    fill_rows(rows, np.broadcast_to(body_row(body), (n, L.N_PAR)),
+              np.full(n, body_omega_rock(body)), np.full(n, body.alpha_ref), column("lam"),
+              np.array([shape_code(p.shape) for p in points]),
+              column("p") if rec is not None else column("w_over_p"), column("A_ratio"),
+              numerics, p0.cycles, p0.gamma, p0.nu, rec, column("mu"),
+              np.array([law_code(p.law) for p in points]), column("e"),
+              column("e_factor"))
+    return with_record(rows, rec)
 
 
 def kernel_evaluator(scene: Scene) -> Evaluator:
@@ -328,6 +364,17 @@ class _Column:
     first: int
     theta: np.ndarray  # the column's max|theta|/alpha_ref at the grid values (NaN: unknown)
     uplifts: np.ndarray  # its uplift counts (-1: unknown)
+    base: Point | None = None  # the column's first grid point (its body object is shared)
+
+    def point(self, scene: Scene, name: str, value: float) -> Point:
+        """The column's point with ``name`` (the searched axis) = value: the first grid
+        point with A_ratio replaced (one body object for the column: its rows are filled
+        at once), else ``scene.point``."""
+        if name != "A_ratio" or scene.suite is not None:
+            return scene.point({**self.values, name: value})
+        if self.base is None:
+            self.base = scene.point(self.values)
+        return replace(self.base, A_ratio=float(value))
 
 
 def _search_intervals(y: np.ndarray, first: int, theta: np.ndarray, uplifts: np.ndarray
@@ -388,7 +435,7 @@ def _bisection_steps(lo: float, hi: float, rtol: float) -> int:
 def a_min(scene: Scene, outcome: np.ndarray, rtol: float = DEFAULT_RTOL,
           axes: Sequence[str] = DIAGRAM_AXES, mode: int | None = None,
           evaluate: Evaluator | None = None, theta: np.ndarray | None = None,
-          uplifts: np.ndarray | None = None) -> list[AMinCurve]:
+          uplifts: np.ndarray | None = None, search: bool = True) -> list[AMinCurve]:
     """A_min(x) of every panel: the smallest y (A_ratio) that overturns, to ``rtol``
     (relative), whatever the grid's spacing.
 
@@ -397,7 +444,9 @@ def a_min(scene: Scene, outcome: np.ndarray, rtol: float = DEFAULT_RTOL,
     uplift counts (grid shape or flat; None or NaN / -1 at a point: unknown), which say
     where to search. mode: None for any overturning (mode 1 or 2; the curve's ``mode``
     says which), 1 or 2 for the smallest y where that mode occurs. evaluate: classes of a
-    list of points (default: one kernel run each at the sweep's numerics).
+    list of points (default: one kernel run each at the sweep's numerics). search: False
+    bisects between the grid's first overturning value and the one below only (cheaper;
+    A_min then depends on the grid: every value says "grid+bisection").
 
     Per column: first a search below the first overturning grid value (or in the whole
     column when none overturns) for a band narrower than the grid step: the intervals
@@ -447,14 +496,14 @@ def a_min(scene: Scene, outcome: np.ndarray, rtol: float = DEFAULT_RTOL,
 
     # the search's points, and the step budget of the whole refinement
     plan: list[tuple[_Column, list[float]]] = []
-    for col in cols:
+    for col in cols if search else ():
         scan = []
         for k, n in _search_intervals(yv, col.first, col.theta, col.uplifts):
             scan += list(np.linspace(yv[k], yv[k + 1], n + 2)[1:-1])
         if scan:
             plan.append((col, sorted(set(scan))))
     _check_budget(scene, axes, cols, plan, yv, rtol)
-    pts = [scene.point({**col.values, axes[1]: float(a)}) for col, scan in plan
+    pts = [col.point(scene, axes[1], a) for col, scan in plan
            for a in scan]
     cls = evaluate(pts) if pts else np.zeros(0, np.int8)
     at = 0
@@ -492,7 +541,7 @@ def a_min(scene: Scene, outcome: np.ndarray, rtol: float = DEFAULT_RTOL,
                 if col.curve.lo[col.j] < m < col.curve.hi[col.j]]
         if not live:
             break
-        cls = evaluate([scene.point({**col.values, axes[1]: float(m)}) for col, m in live])
+        cls = evaluate([col.point(scene, axes[1], m) for col, m in live])
         for (col, m), k in zip(live, cls, strict=True):
             c, j = col.curve, col.j
             c.runs[j] += 1
@@ -524,7 +573,7 @@ def _check_budget(scene: Scene, axes: Sequence[str], cols: list[_Column],
         if scan:
             step = max(step, float(np.max(np.diff([yv[0], *scan]))))
         n = len(scan) + _bisection_steps(max(top - step, yv[0]), top, rtol)
-        cap = point_row(scene.point({**col.values, axes[1]: float(top)}),
+        cap = point_row(col.point(scene, axes[1], top),
                         scene.numerics)[L.PAR_MAXSTEPS]
         total += n * float(cap)
         runs += n
@@ -724,15 +773,16 @@ RESPONSE = ("outcome", "theta_max_over_alpha", "uplifts")
 
 
 def result_curves(result: SweepResult, rtol: float = DEFAULT_RTOL, mode: int | None = None,
-                  axes: Sequence[str] | None = None, evaluate: Evaluator | None = None
-                  ) -> tuple[list[AMinCurve], list[PanelBoundaries]]:
+                  axes: Sequence[str] | None = None, evaluate: Evaluator | None = None,
+                  search: bool = True) -> tuple[list[AMinCurve], list[PanelBoundaries]]:
     """A_min curves (bisected to ``rtol``; ``mode``: None any, 1 or 2) and boundary lines
     of every panel of a result read with ``outcome`` (``store.read_result``); axes: the
     diagram's (None: the scene's, (p, A_ratio) for a record)."""
     sc = check_result(result, axes)
     axes = default_axes(sc) if axes is None else axes
     outcome = np.asarray(result.arrays["outcome"])
-    curves = a_min(sc, outcome, rtol, axes, mode, evaluate, **grid_response(result))
+    curves = a_min(sc, outcome, rtol, axes, mode, evaluate, **grid_response(result),
+                   search=search)
     return curves, diagram_boundaries(sc, outcome, axes)
 
 

@@ -19,6 +19,10 @@ from rocksweep.cli.options import dpi_option, overwrite_option, rtol_option
 @click.option("--lines", "lines_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Also write the boundary polylines as CSV (one row per vertex).")
 @rtol_option
+@click.option("--search/--no-search", default=True, show_default=True,
+              help="Search below the first overturning grid value for a band narrower "
+                   "than the grid step (--no-search: bisect the grid's bracket only, "
+                   "faster, A_min then depends on the grid).")
 @click.option("--mode", type=click.Choice(["1", "2"]), default=None,
               help="A_min of this overturning mode only [default: either].")
 @click.option("--plot", "fig_path", type=click.Path(dir_okay=False, path_type=Path),
@@ -28,8 +32,8 @@ from rocksweep.cli.options import dpi_option, overwrite_option, rtol_option
 @overwrite_option
 @user_errors
 def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None,
-               rtol: float, mode: str | None, fig_path: Path | None, dpi: int,
-               overwrite: bool) -> None:
+               rtol: float, search: bool, mode: str | None, fig_path: Path | None,
+               dpi: int, overwrite: bool) -> None:
     """The boundaries of the stability diagram of a sweep result (over omega/p and
     A/(g tan alpha)), for each lam and pulse shape: A_min(omega/p), the smallest amplitude
     that overturns, to --rtol whatever the grid's spacing (a search below the first
@@ -57,7 +61,8 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
     if fig_path is not None:
         check_output(fig_path, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
     result = read_result(result_path, list(bd.RESPONSE))
-    curves, bounds = bd.result_curves(result, rtol, None if mode is None else int(mode))
+    curves, bounds = bd.result_curves(result, rtol, None if mode is None else int(mode),
+                                      search=search)
 
     def write_text(text: str):
         return lambda tmp: tmp.write_text(text)
@@ -65,7 +70,7 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
     rows = bd.a_min_rows(curves)
     runs = int(sum(int(c.runs.sum()) for c in curves))
     if h5:
-        attrs = {"source": str(result_path), "rtol": rtol,
+        attrs = {"source": str(result_path), "rtol": rtol, "search": int(search),
                  "mode": "any" if mode is None else f"mode{mode}"}
         write_atomic(out, lambda tmp: bd.write_curves_h5(tmp, curves, bounds, attrs))
         n = sum(len(b.lines) for b in bounds)
