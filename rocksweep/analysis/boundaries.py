@@ -456,8 +456,8 @@ def a_min(scene: Scene, outcome: np.ndarray, rtol: float = DEFAULT_RTOL,
     overturning value found (scanned or on the grid) is then bisected with the value
     below it to ``rtol``. ``method`` says how each A_min was found (A_MIN_METHODS). A band
     narrower than the scan's spacing in an interval the search does not visit stays
-    unseen. Raises a one-line AdaptiveError for an rtol outside (0, MAX_RTOL], AdaptiveError
-    for a y axis with fewer than two or non-increasing values, or a refinement whose
+    unseen. Raises a one-line AdaptiveError for an rtol outside (0, MAX_RTOL], a y axis
+    with fewer than two or non-increasing values, or a refinement whose
     runs' step caps would exceed MAX_REFINE_STEPS.
     """
     rtol = check_rtol(rtol, AdaptiveError)
