@@ -26,7 +26,7 @@ def _rtol(_ctx: click.Context, _param: click.Parameter, value: float) -> float:
     from rocksweep.errors import RocksweepError
 
     try:
-        return check_rtol(value, "--rtol")
+        return check_rtol(value, name="--rtol")
     except RocksweepError as err:  # a bad option value: a usage error (exit 2)
         raise click.UsageError(str(err)) from None
 
