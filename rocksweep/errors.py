@@ -102,6 +102,14 @@ class ApiError(RocksweepError, ValueError):
     """An argument of the Python API that cannot be used (api)."""
 
 
+class MeasuredError(RocksweepError, ValueError):
+    """A measured history that cannot be used (physics.measured)."""
+
+
+class CalibrationError(RocksweepError, ValueError):
+    """A calibration that cannot run as asked (analysis.calibrate)."""
+
+
 # ---------------------------------------------------------------------------------------
 # Argument checks shared by every layer, written once with one wording
 # ---------------------------------------------------------------------------------------

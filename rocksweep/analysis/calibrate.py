@@ -64,7 +64,7 @@ from typing import Any
 import numpy as np
 
 from rocksweep.compute.single import history_capacity
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import CalibrationError, RocksweepError  # noqa: F401 (CalibrationError re-exported)
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import point_kernel, warm_up
 from rocksweep.numerics import step_budget
@@ -87,10 +87,6 @@ DEFAULT_BOUNDS = {"impact.lam": (0.0, 2.0), "impact.e": (0.02, 1.0),
                   "impact.e_factor": (0.2, 2.0), "body.zeta": (0.0, 0.5)}
 # keys of a scene's point a fit may set although the scene does not give them
 OPTIONAL_NAMES = ("e_factor", *INITIAL)
-
-
-class CalibrationError(RocksweepError, ValueError):
-    """A calibration that cannot run as asked; ``str()`` is one line."""
 
 
 @dataclass(frozen=True)

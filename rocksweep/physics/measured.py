@@ -25,16 +25,12 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import MeasuredError, RocksweepError  # noqa: F401 (MeasuredError re-exported)
 from rocksweep.outputs import input_problem, shown
 
 MIN_SAMPLES = 8  # fewer samples describe no rocking history
 # largest file read [bytes]: 1e7 samples of a few columns (a test at 1 kHz for hours)
 MAX_BYTES = 2_000_000_000
-
-
-class MeasuredError(RocksweepError, ValueError):
-    """A measured history that cannot be used; ``str()`` is one line."""
 
 
 @dataclass(frozen=True)
