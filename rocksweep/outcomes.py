@@ -25,6 +25,8 @@ STATUS_WORDS = {
     L.STATUS_BOUNDED: "bounded",
     L.STATUS_SLIDES: "slides",
     L.STATUS_LIFTS_OFF: "lifts_off",
+    L.STATUS_REFINED: "refined",
+    L.STATUS_UNCERTIFIED: "uncertified",
 }
 
 STATUS_MEANING = {
@@ -46,6 +48,11 @@ STATUS_MEANING = {
               "(outputs.contact)",
     "lifts_off": "normal reaction below zero: the body would leave the ground "
                  "(outputs.contact)",
+    "refined": "a close call (the free rocking came near the overturning saddle): re-run "
+               "with 2, 4, ... times the steps until its outcome was stable; the finest "
+               "run's result is kept (rocksweep.compute.certify)",
+    "uncertified": "a close call whose outcome still changed at the last refinement "
+                   "(numerics.refine) (flagged)",
 }
 
 

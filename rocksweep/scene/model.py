@@ -41,7 +41,7 @@ class Scene:
     kind: str  # "flexible" | "block"
     axes: tuple[Axis, ...]
     numerics: Numerics  # sweeps: the `default` preset unless the scene names one
-    single_numerics: Numerics  # single runs (simulate): `fine` unless the scene names one
+    single_numerics: Numerics  # single runs (simulate): the sweeps' numerics (one default)
     energy: bool
     text: str = field(repr=False)
     contact: bool = False  # outputs.contact (on when body.mu is given)

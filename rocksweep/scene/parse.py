@@ -286,10 +286,11 @@ def _refine(raw: dict, kind: str) -> dict | None:
 
 
 def _numerics(sec: dict, contact: bool = False) -> tuple[Numerics, Numerics]:
-    """The sweeps' and the single runs' numerics of a checked ``numerics`` section.
+    """The sweeps' and the single runs' numerics of a checked ``numerics`` section: the
+    same (one point, one answer).
 
-    Without a preset named, sweeps run `default`, but a sweep that stores the contact
-    demands runs `fine`: at `default` the demands of long-rocking points differ from the
+    Without a preset named, sweeps and single runs run `default`, but a scene that stores
+    the contact demands runs `fine`: at `default` the demands of long-rocking points differ from the
     reference by up to ~20% (the trajectory after many impacts), at 20 steps per period by
     5e-4 (scripts/contact_check.py)."""
     given: dict[str, Any] = {}
@@ -314,9 +315,10 @@ def _numerics(sec: dict, contact: bool = False) -> tuple[Numerics, Numerics]:
         given[k] = v
     accuracy = given.pop("accuracy", None)
     numerics = Numerics.preset(accuracy or ("fine" if contact else "default"), **given)
-    # A single run exists for its time history and energy balance, which the outcome-tuned
-    # `default` (5 steps per period) resolves only roughly; it costs milliseconds at `fine`.
-    single = Numerics.preset(accuracy or "fine", **given)
+    # One default (issue 28): a single run (simulate) runs what a sweep of the same point
+    # runs, so one point has one answer; the certification of close calls
+    # (``compute.certify``) makes the default trustworthy for both.
+    single = numerics
     return numerics, single
 
 
