@@ -517,27 +517,36 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
 
 
 @speaks_python
-def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None) -> xr.Dataset:
+def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None,
+               search: bool = True) -> xr.Dataset:
     """A_min: the smallest amplitude (A_ratio) that overturns, for every x (w_over_p or
-    p) of the diagram, bisected to the relative tolerance ``rtol`` between the last safe
-    and the first overturning grid value with kernel runs at the sweep's accuracy.
+    p) of the diagram to the relative tolerance ``rtol`` (in (0, 0.1]), whatever the grid's
+    spacing: a search below the first overturning grid value (near the uplift threshold
+    and where the response came close) and a bisection, with kernel runs at the sweep's
+    accuracy; ``A_min_method`` says how each value was found. search=False: the bisection
+    between the grid's first overturning value and the one below only (faster, but A_min
+    then depends on the grid).
 
     ds: a complete result (``run`` / ``open``) with a diagram over (w_over_p, A_ratio).
-    mode: 1 or 2 for that overturning mode only. Returns a Dataset: ``A_min`` (NaN: no
-    grid value of the column overturns), ``mode``, the final bracket ``lo``/``hi`` and
-    the kernel ``runs``, over every other swept key (e.g. shape, lam) and x. The class
+    mode: 1 or 2 for that overturning mode only. Returns a Dataset: ``A_min`` (NaN: none
+    found), ``mode``, ``A_min_method`` ("grid+bisection", "searched below grid", "first
+    grid value" (an upper bound), "not found"), the final bracket ``lo``/``hi`` and the
+    kernel ``runs``, over every other swept key (e.g. shape, lam) and x. The class
     boundary polylines: ``boundary_lines(ds)``.
     """
     from rocksweep.analysis import boundaries as bd
+    from rocksweep.analysis.tolerance import check_rtol
     from rocksweep.store.reader import as_result
 
-    if not (isinstance(rtol, int | float) and 0 < rtol < 1):
-        raise ApiError(f"rtol = {rtol!r}: must be a relative tolerance in (0, 1)")
+    rtol = check_rtol(rtol)
     if mode not in (None, 1, 2):
         raise ApiError(f"mode = {mode!r}: must be None, 1 or 2")
-    result = as_result(ds, ["outcome"])
-    curves, _ = bd.result_curves(result, rtol, mode)
+    if not isinstance(search, bool):
+        raise ApiError(f"search = {search!r}: must be True or False")
+    result = as_result(ds, list(bd.RESPONSE))
+    curves, _ = bd.result_curves(result, rtol, mode, search=search)
     return bd.curves_dataset(curves, {"title": result.name, "rtol": rtol,
+                                      "search": int(search),
                                       "mode": "any" if mode is None else f"mode{mode}"})
 
 
@@ -560,10 +569,9 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3) -> xr.Dataset:
     A_ratio and optionally lam: ``theta_max_over_alpha`` and ``outcome`` over (lam,
     A_ratio, p), ``A_min`` and ``mode`` over (lam, p), A_min bisected to ``rtol``."""
     from rocksweep.analysis.spectrum import spectra as compute_spectra
+    from rocksweep.analysis.tolerance import check_rtol
 
-    if not (isinstance(rtol, int | float) and 0 < rtol < 1):
-        raise ApiError(f"rtol = {rtol!r}: must be a relative tolerance in (0, 1)")
-    return compute_spectra(ds, rtol).to_dataset()
+    return compute_spectra(ds, check_rtol(rtol)).to_dataset()
 
 
 @speaks_python
