@@ -409,6 +409,8 @@ def _single_verdict(lnx, k, n, stripes: bool) -> tuple[Fit, dict[str, str]]:
             np.full(lnx.size, np.nan)
         if _non_monotone(lnx, k, n, p):
             why["non_monotone"] = "the stripe fractions fall with the IM beyond noise"
+    elif code[0] == _CODE["separated"]:
+        why["beta_undetermined"] = "separated"
     counted = np.exp(lnx[n > 0])
     if counted.size:
         ext = _outside(float(counted.min()), float(counted.max()), float(med[0]),

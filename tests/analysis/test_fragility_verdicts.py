@@ -87,6 +87,9 @@ def test_too_few_distinct_fractions_and_separation_leave_beta_undetermined():
     assert math.isnan(sep.beta) and sep.im_median == pytest.approx(math.sqrt(0.2 * 0.4))
     # two distinct fractions inside: beta is determined
     assert F.fit_stripes(x, [0, 3, 7, 10], n).reason == "ok"
+    # a separated cloud: the same words
+    cloud = F.fit_cloud([0.1, 0.2, 0.3, 0.4], [0, 0, 1, 1])
+    assert cloud.reason == "separated,beta_undetermined" and math.isnan(cloud.beta)
 
 
 def test_falling_fractions_are_non_monotone_and_resurrection_noise_is_not():
