@@ -420,3 +420,20 @@ def test_cli_bad_arguments_write_nothing(suite_scene, cli, tmp_path):
         line = one_line_error(res)
         assert line.startswith("Error:"), line
         assert not (tmp_path / "c.csv").exists()
+
+
+def test_the_issues_eight_record_mode2_curve_is_not_ok():
+    """Issue 29's measurement: mode 2 counts 0 0 0 0 0 0 0 1 1 2 3 1 3 1 0 0 of 8 over PGA
+    0.1-1.6 g, mode 1 taking over at high PGA, was fitted "ok" with its median above every
+    stripe."""
+    lv = np.linspace(0.1, 1.6, 16)
+    k2 = [0, 0, 0, 0, 0, 0, 0, 1, 1, 2, 3, 1, 3, 1, 0, 0]
+    k1 = [0, 0, 0, 0, 0, 1, 2, 2, 3, 3, 3, 6, 4, 7, 8, 8]
+    out = np.zeros((8, 16), int)
+    for s in range(16):
+        out[:k1[s], s] = 1
+        out[k1[s]:k1[s] + k2[s], s] = 2
+    with pytest.warns(F.FragilityWarning):
+        fr = F.fragility(stripes_ds(out, levels=lv), state="mode2", bootstrap=200)
+    assert {"censored", "extrapolated"} <= reasons(fr)
+    assert float(fr["im_median"]) > lv.max()
