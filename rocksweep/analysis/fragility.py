@@ -1411,9 +1411,10 @@ def _verdicts(kind, idxs, o, lnx, m, med, bet, why, counted, flagged, hits, over
             p = lognormal_cdf(np.exp(lnx), med[q], bet[q])
             if _non_monotone(lnx, k, n, p):
                 w["non_monotone"] = "the stripe fractions fall with the IM beyond noise"
-        elif stripes:
+        elif stripes:  # null: the fitted competing-risk probability of this mode
             k = m[0, q + 1]
-            if _non_monotone(lnx, k, n, np.full(lnx.size, np.nan)):
+            p = _curves("competing", np.exp(lnx), np.asarray(med), np.asarray(bet))[q]
+            if _non_monotone(lnx, k, n, p):
                 w["non_monotone"] = ("the stripe fractions fall with the IM beyond noise "
                                      "(a competing-risk curve cannot fall)")
         kw = states[i]

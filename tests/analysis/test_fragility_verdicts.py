@@ -154,6 +154,16 @@ def test_a_mode_fitted_alone_is_censored_by_the_other_and_the_joint_fit_is_not()
     joint = F.fragility(ds, state=["mode1", "mode2"], bootstrap=0, warn=False)
     assert list(joint["fit"].values) == ["competing", "competing"]
     assert not any("censored" in r for r in joint["reason"].values)
+    # mode 2 rising then vanishing (20 records): no competing-risk curve can fall
+    k2 = [0, 0, 2, 8, 14, 16, 10, 4, 1, 0, 0, 0]
+    k1 = [0, 0, 0, 0, 2, 4, 10, 16, 19, 20, 20, 20]
+    out = np.zeros((20, 12), int)
+    for s in range(12):
+        out[:k1[s], s] = 1
+        out[k1[s]:k1[s] + k2[s], s] = 2
+    hump = F.fragility(stripes_ds(out), state=["mode1", "mode2"], bootstrap=0, warn=False)
+    assert "non_monotone" in str(hump["reason"].sel(state="mode2").values).split(",")
+    assert "ok" not in hump["reason"].values
 
 
 def test_partial_data_are_incomplete_with_the_missing_stripes_named():
