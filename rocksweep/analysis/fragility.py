@@ -82,7 +82,7 @@ import xarray as xr
 from scipy.special import log_ndtr, ndtr, ndtri, owens_t
 
 from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP, MAX_BOOTSTRAP
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import FragilityError, RocksweepError  # noqa: F401 (re-exported)
 from rocksweep.kernel import layout as L
 from rocksweep.vocab.ground import CLOUD_IMS as CLOUD_IM_VARIABLES
 from rocksweep.vocab.ground import SCALE_IMS
@@ -115,9 +115,6 @@ _CODE = {w: i for i, w in enumerate(ENDINGS)}
 #: endings that say all there is (nothing reaches the state, all do, nothing counted)
 _EMPTY = [_CODE[w] for w in ("no_failures", "all_failed", "no_data")]
 
-
-class FragilityError(RocksweepError, ValueError):
-    """A Dataset or a request that fragility cannot answer; ``str()`` is one line."""
 
 
 class FragilityWarning(UserWarning):

@@ -4,9 +4,9 @@ A scaled suite's sweep runs every record at every stripe of its intensity measur
 PGA, PGV, Sa, PGA_ratio or PGV_ratio). Its stripes say, per record, the first level that
 overturns the body; ``ida`` refines that level: between the last stripe below it (which
 does not overturn) and it, the record's scale is bisected to a relative tolerance with
-single kernel runs at the sweep's numerics (``boundaries.kernel_evaluator``, the runs of
-the A_min bisection). The scaled record's peak, and so the kernel's amplitude, is linear
-in the IM, so a level x between stripes is the stripe's point with its amplitude times
+single kernel runs at the sweep's numerics (``compute.single.simulate``: each run
+certified as a single run is). The scaled record's peak, and so the kernel's amplitude,
+is linear in the IM, so a level x between stripes is the stripe's point with its amplitude times
 x / stripe. Overturning means outcome 1 or 2 (mode 1, mode 2).
 
 "Resurrection" (Vamvatsikos & Cornell 2002): a stripe above the first overturning level
@@ -27,16 +27,13 @@ from typing import Any
 import numpy as np
 
 from rocksweep.compute.single import simulate
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import IdaError, check_rtol
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.store.reader import as_result, result_scene
 
 # Bisection steps at most (a relative tolerance of 1e-12 takes ~40 from a stripe gap).
 MAX_ITER = 60
 
-
-class IdaError(RocksweepError, ValueError):
-    """A result that has no IDA (not a scaled suite, not finished); one line."""
 
 
 def ida(ds: Any, rtol: float = 1e-2) -> Any:
@@ -59,8 +56,7 @@ def ida(ds: Any, rtol: float = 1e-2) -> Any:
 
     from rocksweep import fields
 
-    if not (isinstance(rtol, int | float) and 0 < rtol < 1):
-        raise IdaError(f"rtol = {rtol!r}: must be a relative tolerance in (0, 1)")
+    check_rtol(rtol, IdaError)
     result = as_result(ds, ["outcome", "status"])
     im = result.attrs.get("scale_im")
     if not im or im not in result.dims or "record" not in result.dims:

@@ -51,7 +51,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import RiskError, RocksweepError  # noqa: F401 (re-exported)
 from rocksweep.vocab.ground import PGA, PGV, SA
 
 __all__ = ["Hazard", "RiskError", "fragility_median", "hazard_frame", "read_hazard",
@@ -67,9 +67,6 @@ OQ_UNITS = {PGA: ("g", 1.0), SA.upper(): ("g", 1.0), PGV: ("m/s", 0.01)}
 _HEADER = re.compile(r"^\s*(?P<im>[A-Za-z][A-Za-z0-9_]*)\s*(?:\(\s*(?P<T>[0-9.eE+-]+)\s*\))?"
                      r"\s*\[(?P<unit>[^\]]*)\]\s*$")
 
-
-class RiskError(RocksweepError, ValueError):
-    """A hazard curve or a request that risk cannot answer; ``str()`` is one line."""
 
 
 @dataclass(frozen=True)

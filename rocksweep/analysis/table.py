@@ -23,7 +23,7 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.analysis.kinds import dataset_kind
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import RocksweepError, TableError  # noqa: F401 (re-exported)
 from rocksweep.physics.model import G
 from rocksweep.physics.suite import RECORD_IMS
 
@@ -36,9 +36,6 @@ ROW_VARIABLE = {"sweep": "outcome", "fragility": ("im_median", "median"), "ida":
 MAX_SPREAD = 32  # an extra dimension at most this long becomes columns
 SKIP = ("record_sha256",)  # identity, not data: in the file, not in every row
 
-
-class TableError(RocksweepError, ValueError):
-    """A Dataset that has no table; ``str()`` is one line."""
 
 
 def _units(da: xr.DataArray) -> str:
