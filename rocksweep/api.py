@@ -533,6 +533,15 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
         # rocksweep.fragility for other states and bands)
         from rocksweep.analysis.fragility import fragility as fit
 
+        given = [n for n, v in zip((*_names[:2], "curves", "mu", _names[2],
+                                    "show_computed"),
+                                   (x, y, curves, mu, compare, show_computed), strict=True)
+                 if v not in (None, False)]
+        if given:
+            raise ApiError(f"{given[0]}: a record-suite sweep is drawn as its fragility "
+                           "curves; the diagram's options do not apply (rocksweep.fragility "
+                           "for states and bands)")
+
         ds, kind = fit(ds, state="overturn", bootstrap=0), "fragility"
     if kind not in (None, "sweep"):  # an analysis's Dataset: the figure of its kind
         from rocksweep.figures.dispatch import plot_analysis
