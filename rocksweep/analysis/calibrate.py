@@ -280,6 +280,7 @@ class Problem:
         self.dt_shift = 0.1 * max(float(t_end - self.t_onset), 1e-3)
         self.runs = 0
         self.n_use: int | None = None  # compare the first n_use half cycles (None: all)
+        self._cache: dict[tuple, tuple | None] = {}
 
     def point(self, x: np.ndarray) -> Any:
         values = dict(self.values)
@@ -312,13 +313,16 @@ class Problem:
     def evaluate(self, x: np.ndarray) -> dict | None:
         """Everything about a candidate: misfit S, the simulated theta at the measured
         times, the time shift, its peaks and impact times (measured time)."""
-        got = self.simulate(x)
+        key = tuple(float(v) for v in x)
+        if key in self._cache:  # one run per candidate, whatever half cycles are compared
+            got = self._cache[key]
+        else:
+            got = self._run(x)
+            if len(self._cache) < 5000:
+                self._cache[key] = got
         if got is None:
             return None
-        out, h = got
-        shift = self._shift(h)
-        theta = hermite(h["t"], h["theta"], h["theta_dot"], self.m.t - shift)
-        peaks = excursions(self.m.t, theta, self.h)
+        theta, shift, peaks, impacts, out = got
         mine, sim = self.peaks, peaks
         n = self.n_use
         if n is not None and n < mine.value.size:  # the first n half cycles (``fit``)
@@ -328,12 +332,23 @@ class Problem:
             sim = Peaks(sim.value[keep], sim.time[keep], sim.area[keep])
         cost, pairs = alignment_cost(mine.value, sim.value, self.h, area_a=mine.area,
                                      area_b=sim.area, t_scale=self.t_scale)
+        return {"S": cost, "theta": theta, "shift": shift, "peaks": peaks, "pairs": pairs,
+                "impacts": impacts, "out": out}
+
+    def _run(self, x: np.ndarray) -> tuple | None:
+        """A candidate's simulated history at the measured times, its shift, excursions,
+        impacts (measured time) and result row; None for a body that is not physical."""
+        got = self.simulate(x)
+        if got is None:
+            return None
+        out, h = got
+        shift = self._shift(h)
+        theta = hermite(h["t"], h["theta"], h["theta_dot"], self.m.t - shift)
+        peaks = excursions(self.m.t, theta, self.h)
         t, ph = h["t"], h["phase"]
         ev = np.flatnonzero((t[1:] == t[:-1]) & (ph[:-1] != 0) & (ph[1:] != ph[:-1]))
         impacts = t[ev] + shift
-        impacts = impacts[impacts <= self.m.t[-1]]
-        return {"S": cost, "theta": theta, "shift": shift, "peaks": peaks, "pairs": pairs,
-                "impacts": impacts, "out": out}
+        return theta, shift, peaks, impacts[impacts <= self.m.t[-1]], out
 
     def _shift(self, h: dict) -> float:
         """The time shift that aligns a simulated history's start with the measured one:
@@ -488,7 +503,9 @@ def _fit(problem: Problem) -> tuple[np.ndarray, float]:
     costs the same whatever its e): a grid can miss it. The fit therefore starts on the
     first STAGES[0] half cycles (a wide basin: a grid over the bounds, then Brent or
     Nelder-Mead), and doubles them stage by stage up to all, each stage refining the last
-    estimate on a local grid of half the previous spacing."""
+    estimate on a local grid of half the previous spacing. The plain fit on all half cycles
+    (a grid over the bounds, then Brent or Nelder-Mead) is done too; the lower misfit
+    wins."""
     from scipy.optimize import minimize, minimize_scalar
 
     n_all = problem.peaks.value.size
@@ -523,7 +540,11 @@ def _fit(problem: Problem) -> tuple[np.ndarray, float]:
             s = problem.misfit(x)
         step = step / 2
     problem.n_use = None
-    return x, problem.misfit(x)
+    s = problem.misfit(x)
+    # the first half cycles may say little about the keys (a pulse's first excursions
+    # before any impact): the plain grid on every half cycle is tried too, the better kept
+    x2, s2 = _minimise(problem, list(range(k)), {}, b.mean(axis=1))
+    return (x2, s2) if s2 < s else (x, s)
 
 
 def _profile_end(problem: Problem, i: int, x_hat: np.ndarray, s_min: float, limit: float,
