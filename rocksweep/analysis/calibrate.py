@@ -77,7 +77,6 @@ H_NOISE = 4.0  # threshold of an excursion, in noise standard deviations ...
 H_REL = 0.02  # ... and at least this share of the largest |theta|
 PEAK_TOP = 0.5  # a peak's parabola goes through the samples above this share of it ...
 PEAK_RAMP = 0.2  # ... weighted from 0 there to 1 at PEAK_TOP + PEAK_RAMP
-CHI2_95 = 3.841458820694124  # chi-square quantile, 1 degree of freedom, 95%
 GRID = 21  # first look of a one-parameter fit: GRID values across the bounds
 GRID_2D = 9  # ... and GRID_2D^2 for two parameters
 STAGES = (3, 6, 12, 24, 48, 96, 192)  # half cycles compared at each stage of ``_fit``
@@ -100,6 +99,32 @@ class Peaks:
     value: np.ndarray
     time: np.ndarray
     area: np.ndarray | None = None  # integral of |theta| over each excursion [theta/alpha p t]
+
+
+class _Result:
+    """What a one-dimensional minimisation found (``x``, ``fun``), as scipy's result."""
+
+    def __init__(self, x: float, fun: float) -> None:
+        self.x, self.fun = x, fun
+
+
+def _golden(f: Any, bounds: tuple[float, float], xatol: float) -> _Result:
+    """Minimum of f on [lo, hi] by golden-section search to xatol (a unimodal bracket;
+    scipy.optimize's import costs ~0.2-1 s of every command, this a few lines)."""
+    lo, hi = bounds
+    r = (math.sqrt(5.0) - 1.0) / 2.0
+    a, b = lo + (1 - r) * (hi - lo), lo + r * (hi - lo)
+    fa, fb = f(a), f(b)
+    while hi - lo > xatol:
+        if fa <= fb:
+            hi, b, fb = b, a, fa
+            a = lo + (1 - r) * (hi - lo)
+            fa = f(a)
+        else:
+            lo, a, fa = a, b, fb
+            b = lo + r * (hi - lo)
+            fb = f(b)
+    return _Result(a, fa) if fa <= fb else _Result(b, fb)
 
 
 def excursions(t: np.ndarray, theta: np.ndarray, h: float) -> Peaks:
@@ -357,8 +382,6 @@ class Problem:
         shift of theta over the measured start window (up to the second half-cycle peak,
         before any phase drift; a slow start, as a release from a tilt, departs too
         gently for the threshold alone)."""
-        from scipy.optimize import minimize_scalar
-
         t_rel = self.m.t - self.m.t[0]
         th = hermite(h["t"], h["theta"], h["theta_dot"], t_rel)
         onset = _onset(t_rel, th, self.h)
@@ -371,8 +394,7 @@ class Problem:
         def ss(sh: float) -> float:
             return float(np.sum((hermite(h["t"], h["theta"], h["theta_dot"], tt - sh) - yy)
                                 ** 2))
-        r = minimize_scalar(ss, bounds=(shift0 - self.dt_shift, shift0 + self.dt_shift),
-                            method="bounded", options={"xatol": 1e-6})
+        r = _golden(ss, (shift0 - self.dt_shift, shift0 + self.dt_shift), 1e-6)
         return float(r.x) if r.fun <= ss(shift0) else shift0
 
     def misfit(self, x: np.ndarray) -> float:
@@ -454,8 +476,6 @@ def _minimise(problem: Problem, free: list[int], fixed: dict[int, float],
     """Least misfit over the parameters ``free`` with the others at ``fixed``: a grid
     (GRID values for one, GRID_2D^2 for two) then Brent's method / Nelder-Mead from its
     best point."""
-    from scipy.optimize import minimize, minimize_scalar
-
     def full(z: np.ndarray) -> np.ndarray:
         x = start.copy()
         for i, v in fixed.items():
@@ -472,9 +492,8 @@ def _minimise(problem: Problem, free: list[int], fixed: dict[int, float],
         s = np.array([problem.misfit(full(np.array([v]))) for v in g])
         k = int(np.argmin(s))
         lo, hi = g[max(k - 1, 0)], g[min(k + 1, GRID - 1)]
-        r = minimize_scalar(lambda v: problem.misfit(full(np.array([v]))), bounds=(lo, hi),
-                            method="bounded",
-                            options={"xatol": 1e-5 * (b[0, 1] - b[0, 0])})
+        r = _golden(lambda v: problem.misfit(full(np.array([v]))), (lo, hi),
+                    1e-5 * (b[0, 1] - b[0, 0]))
         best = (r.x, r.fun) if r.fun <= s[k] else (g[k], s[k])
         return full(np.array([best[0]])), float(best[1])
     if len(free) == 2:
@@ -489,6 +508,8 @@ def _minimise(problem: Problem, free: list[int], fixed: dict[int, float],
     simplex = np.vstack([z0, *(z0 + np.diag(0.1 * span)[k] * (1 if z0[k] + 0.1 * span[k]
                                                                 <= b[k, 1] else -1)
                                for k in range(len(free)))])
+    from scipy.optimize import minimize
+
     r = minimize(lambda z: problem.misfit(full(z)), z0, method="Nelder-Mead",
                  options={"initial_simplex": simplex, "xatol": 1e-5 * span.min(),
                           "fatol": 1e-12, "maxfev": 400})
@@ -506,8 +527,6 @@ def _fit(problem: Problem) -> tuple[np.ndarray, float]:
     estimate on a local grid of half the previous spacing. The plain fit on all half cycles
     (a grid over the bounds, then Brent or Nelder-Mead) is done too; the lower misfit
     wins."""
-    from scipy.optimize import minimize, minimize_scalar
-
     n_all = problem.peaks.value.size
     stages = [n for n in STAGES if n < n_all] + [n_all]
     k = len(problem.keys)
@@ -525,13 +544,14 @@ def _fit(problem: Problem) -> tuple[np.ndarray, float]:
             lo, hi = g[max(j - 1, 0)], g[min(j + 1, g.size - 1)]
             x, s = np.array([g[j]]), float(ss[j])
             if hi > lo:
-                r = minimize_scalar(lambda v: problem.misfit(np.array([v])), bounds=(lo, hi),
-                                    method="bounded", options={"xatol": 1e-5 * span[0]})
+                r = _golden(lambda v: problem.misfit(np.array([v])), (lo, hi), 1e-5 * span[0])
                 if r.fun <= s:
                     x, s = np.array([float(r.x)]), float(r.fun)
         else:
             simplex = np.vstack([x, *(np.clip(x + np.diag(step)[i], b[:, 0], b[:, 1])
                                       for i in range(k))])
+            from scipy.optimize import minimize
+
             r = minimize(problem.misfit, x, method="Nelder-Mead",
                          options={"initial_simplex": simplex, "xatol": 1e-5 * span.min(),
                                   "fatol": 1e-12, "maxfev": 200})
@@ -632,8 +652,6 @@ def _minimise_local(problem: Problem, free: list[int], fixed: dict[int, float],
                     start: np.ndarray) -> tuple[np.ndarray, float]:
     """Least misfit over ``free`` near ``start`` (no grid): Brent in a bracket of 10% of
     the bounds for one parameter, Nelder-Mead for more."""
-    from scipy.optimize import minimize, minimize_scalar
-
     x = start.copy()
     for k, v in fixed.items():
         x[k] = v
@@ -652,8 +670,7 @@ def _minimise_local(problem: Problem, free: list[int], fixed: dict[int, float],
         best = (float(start[k]), f(float(start[k])))
         for _ in range(5):
             lo, hi = max(b[0, 0], best[0] - half), min(b[0, 1], best[0] + half)
-            r = minimize_scalar(f, bounds=(lo, hi), method="bounded",
-                                options={"xatol": 1e-5 * span[0]})
+            r = _golden(f, (lo, hi), 1e-5 * span[0])
             if r.fun < best[1]:
                 best = (float(r.x), float(r.fun))
             at_edge = min(best[0] - lo, hi - best[0]) < 0.05 * half
@@ -668,6 +685,8 @@ def _minimise_local(problem: Problem, free: list[int], fixed: dict[int, float],
         y = x.copy()
         y[free] = z
         return problem.misfit(y)
+    from scipy.optimize import minimize
+
     r = minimize(g, x[free], method="Nelder-Mead",
                  options={"xatol": 1e-4 * span.min(), "fatol": 1e-12, "maxfev": 200})
     y = x.copy()
@@ -677,8 +696,9 @@ def _minimise_local(problem: Problem, free: list[int], fixed: dict[int, float],
 
 def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
     """Fit a ``Problem``: the Dataset of ``rocksweep.calibrate`` (see ``calibrate``)."""
+    from statistics import NormalDist
+
     import xarray as xr
-    from scipy.stats import chi2
 
     t0 = time.perf_counter()
     k = len(problem.keys)
@@ -691,7 +711,9 @@ def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
     best = problem.evaluate(x_hat)
     n = problem.peaks.value.size
     s2 = max(s_min / max(n - k, 1), problem.sigma**2)
-    limit = float(chi2.ppf(ci, 1)) * s2
+    # chi2 quantile of 1 degree of freedom: the square of the normal's two-sided quantile
+    # (statistics, not scipy.stats: its import costs ~0.5 s of every command)
+    limit = NormalDist().inv_cdf(0.5 + 0.5 * ci) ** 2 * s2
     lo, hi, lo_b, hi_b = (np.empty(k), np.empty(k), np.zeros(k, bool), np.zeros(k, bool))
     for i in range(k):
         lo[i], lo_b[i] = _profile_end(problem, i, x_hat, s_min, limit, -1)
