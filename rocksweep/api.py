@@ -26,7 +26,7 @@ from rocksweep.compute.driver import (  # noqa: F401 (SweepInterrupted: the API'
     SweepInterrupted,
     SweepReport,
 )
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import ApiError, RocksweepError, check_rtol
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -44,9 +44,6 @@ MAX_RUNS = 12
 # `rocksweep.simulate` returns one history per point: a notebook's worth, not a grid.
 API_MAX_RUNS = 100
 
-
-class ApiError(RocksweepError, ValueError):
-    """An argument of the Python API that cannot be used; ``str()`` is one line."""
 
 
 # ---------------------------------------------------------------------------------------
@@ -467,15 +464,17 @@ def _dataset(source: Path | Any) -> xr.Dataset:
             else:
                 raise
     except (ValueError, TypeError, KeyError, OSError, OverflowError, AttributeError,
-            IndexError) as err:  # xarray's CF decoding of a damaged attribute
+            IndexError, RuntimeError, MemoryError) as err:
+        # xarray's CF decoding of a damaged attribute; HDF5's of damaged dimension scales
+        # (H5DSget_num_scales: RuntimeError), a damaged shape's allocation
         from rocksweep.outputs import shown
         from rocksweep.store import StoreError
 
         where = shown(source) if isinstance(source, Path) else "result in memory"
         why = (str(err).strip().splitlines() or [type(err).__name__])[0]
         why = why if len(why) <= 160 else why[:157] + "..."
-        raise StoreError(f"{where}: damaged rocksweep result (a variable's attributes "
-                         f"cannot be decoded: {why})") from None
+        raise StoreError(f"{where}: damaged rocksweep result (its variables or their "
+                         f"attributes cannot be decoded: {why})") from None
     for name, var in ds.data_vars.items():  # files of format 1 have neither
         f = fields.BY_NAME.get(str(name))
         if f is not None:
@@ -558,27 +557,35 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
 
 
 @speaks_python
-def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None) -> xr.Dataset:
+def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None,
+               search: bool = True) -> xr.Dataset:
     """A_min: the smallest amplitude (A_ratio) that overturns, for every x (w_over_p or
-    p) of the diagram, bisected to the relative tolerance ``rtol`` between the last safe
-    and the first overturning grid value with kernel runs at the sweep's accuracy.
+    p) of the diagram to the relative tolerance ``rtol`` (in (0, 0.1]), whatever the grid's
+    spacing: a search below the first overturning grid value (near the uplift threshold
+    and where the response came close) and a bisection, with kernel runs at the sweep's
+    accuracy; ``A_min_method`` says how each value was found. search=False: the bisection
+    between the grid's first overturning value and the one below only (faster, but A_min
+    then depends on the grid).
 
     ds: a complete result (``run`` / ``open``) with a diagram over (w_over_p, A_ratio).
-    mode: 1 or 2 for that overturning mode only. Returns a Dataset: ``A_min`` (NaN: no
-    grid value of the column overturns), ``mode``, the final bracket ``lo``/``hi`` and
-    the kernel ``runs``, over every other swept key (e.g. shape, lam) and x. The class
+    mode: 1 or 2 for that overturning mode only. Returns a Dataset: ``A_min`` (NaN: none
+    found), ``mode``, ``A_min_method`` ("grid+bisection", "searched below grid", "first
+    grid value" (an upper bound), "not found"), the final bracket ``lo``/``hi`` and the
+    kernel ``runs``, over every other swept key (e.g. shape, lam) and x. The class
     boundary polylines: ``boundary_lines(ds)``.
     """
     from rocksweep.analysis import boundaries as bd
     from rocksweep.store.reader import as_result
 
-    if not (isinstance(rtol, int | float) and 0 < rtol < 1):
-        raise ApiError(f"rtol = {rtol!r}: must be a relative tolerance in (0, 1)")
+    rtol = check_rtol(rtol)
     if mode not in (None, 1, 2):
         raise ApiError(f"mode = {mode!r}: must be None, 1 or 2")
-    result = as_result(ds, ["outcome"])
-    curves, _ = bd.result_curves(result, rtol, mode)
+    if not isinstance(search, bool):
+        raise ApiError(f"search = {search!r}: must be True or False")
+    result = as_result(ds, list(bd.RESPONSE))
+    curves, _ = bd.result_curves(result, rtol, mode, search=search)
     return bd.curves_dataset(curves, {"title": result.name, "rtol": rtol,
+                                      "search": int(search),
                                       "mode": "any" if mode is None else f"mode{mode}"})
 
 
@@ -602,9 +609,9 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3) -> xr.Dataset:
     A_ratio, p), ``A_min`` and ``mode`` over (lam, p), A_min bisected to ``rtol``."""
     from rocksweep.analysis.spectrum import spectra as compute_spectra
 
-    if not (isinstance(rtol, int | float) and 0 < rtol < 1):
-        raise ApiError(f"rtol = {rtol!r}: must be a relative tolerance in (0, 1)")
-    return compute_spectra(ds, rtol).to_dataset()
+    out = compute_spectra(ds, check_rtol(rtol)).to_dataset()
+    out.attrs["rocksweep_kind"] = "spectra"  # rocksweep.plot's dispatch (analysis.kinds)
+    return out
 
 
 @speaks_python
@@ -614,10 +621,21 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
     record, bisected to ``rtol`` between the last stripe below the first overturning one
     and that stripe (kernel runs at the sweep's accuracy), and whether a higher stripe is
     safe again (``resurrection``). ds: what ``run`` or ``open`` returns. Returns a Dataset
-    over the other swept keys and ``record`` (``rocksweep.analysis.ida.ida``)."""
+    over the other swept keys and ``record`` (``rocksweep.analysis.ida.ida``), with the
+    stripes' ``theta_max_over_alpha`` of the points that did not overturn (the IDA
+    curves ``rocksweep.plot`` draws)."""
     from rocksweep.analysis.ida import ida as run_ida
 
-    return run_ida(ds, rtol)
+    out = run_ida(ds, rtol)
+    out.attrs["rocksweep_kind"] = "ida"  # rocksweep.plot's dispatch (analysis.kinds)
+    im = out.attrs.get("im")
+    if hasattr(ds, "data_vars") and "theta_max_over_alpha" in ds.data_vars and im in ds.dims:
+        # the IDA curves on the stripes (max|theta|/alpha against the IM, per record, NaN
+        # where a point overturned): what the figure draws
+        theta = ds["theta_max_over_alpha"].where(ds["outcome"] == 0)
+        out["theta_max_over_alpha"] = theta.drop_vars(
+            [c for c in theta.coords if c not in theta.dims])
+    return out
 
 
 @speaks_python
@@ -661,6 +679,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
                        "or rocksweep.open)")
     frag = fit(ds, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci)
     frag.attrs["title"] = str(ds.attrs.get("title", ""))
+    frag.attrs["rocksweep_kind"] = "fragility"  # rocksweep.plot's dispatch (analysis.kinds)
     return frag
 
 

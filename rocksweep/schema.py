@@ -128,6 +128,10 @@ KEYS: dict[str, Key] = {
                              choices=tuple(PRESETS), required=False),
     "numerics.steps_per_period": Key("integer", "must be an integer in [4, 1e9]", 4, 1e9,
                                      required=False),
+    "numerics.pulse_steps": Key("integer", "must be an integer in [4, 1e9] (RK4 steps per "
+                                "pulse period while the pulse acts)", 4, 1e9, required=False),
+    "numerics.refine": Key("integer", "must be an integer in [0, 6] (refinements of a close "
+                           "call, each doubling the steps; 0: none)", 0, 6, required=False),
     "numerics.event_tol": Key(
         "number", f"must be in [{MIN_EVENT_TOL:g}, 1) (p*t; below {MIN_EVENT_TOL:g} an event "
         "time t ~ 1e2 is at float64's resolution)", MIN_EVENT_TOL, 1.0, hi_in=False,

@@ -52,16 +52,13 @@ from functools import cached_property
 
 import numpy as np
 
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import BodyError  # noqa: F401 (defined there; re-exported)
 from rocksweep.schema import BODY_KEYS, check_value, fmt, is_number
 
 G = 9.81  # m/s^2
 M_TOP = 1.0  # kg, the top mass m (a repeating quantity)
 P = 1.0  # rad/s, the rocking frequency p (a repeating quantity)
 
-
-class BodyError(RocksweepError, ValueError):
-    """A body that is not physical; the message names the offending key and value."""
 
 
 def _check_keys(body: object, keys: tuple[str, ...]) -> None:

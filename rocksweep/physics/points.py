@@ -18,8 +18,9 @@ from rocksweep.numerics import (
     ROOTS,
     Numerics,
     amplitude_frequency,
+    close_margin,
     step_budget,
-    step_size,
+    step_sizes,
 )
 from rocksweep.physics.model import Body, FlexibleBody, G
 from rocksweep.physics.records import GroundRecord
@@ -171,22 +172,23 @@ def body_omega_rock(body: Body) -> float:
 def run_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, w_over_p: np.ndarray,
              A_ratio: np.ndarray, numerics: Numerics,
              phase: np.ndarray | float = 2 * math.pi) -> tuple[np.ndarray, ...]:
-    """A run's step, length and step cap, vectorised over points (all float64[n], p = 1).
+    """A run's steps, length and step cap, vectorised over points (all float64[n], p = 1).
 
     phase: the pulse's duration in w t (2 pi n, 6 pi for the Ricker, 2 pi gamma for MP).
-    Returns dt [p*t] (``step_size``), t_pulse = phase/omega, t_end = t_pulse + horizon
-    [p*t] and the cap on RK4 evaluations (``step_budget``): the kernel's PAR_DT,
-    PAR_TPULSE, PAR_TEND and PAR_MAXSTEPS. The scene bounds the last (MAX_POINT_STEPS).
-    w_over_p = 0 is no ground motion (shape FREE): t_pulse = 0.
+    Returns dt [p*t] after the pulse and dt_on while it acts (``step_sizes``), t_pulse =
+    phase/omega, t_end = t_pulse + horizon [p*t] and the cap on RK4 evaluations
+    (``step_budget``): the kernel's PAR_DT, PAR_DT_ON, PAR_TPULSE, PAR_TEND and
+    PAR_MAXSTEPS. The scene bounds the last (MAX_POINT_STEPS). w_over_p = 0 is no ground
+    motion (shape FREE): t_pulse = 0.
     """
     omega = np.asarray(w_over_p, float)  # p = 1 rad/s
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
-        dt = step_size(omega_rock, omega, numerics.steps_per_period,
-                       amplitude_frequency(A_ratio, alpha_ref))
+        dt, dt_on = step_sizes(omega_rock, omega, numerics.steps_per_period,
+                               numerics.pulse_steps, amplitude_frequency(A_ratio, alpha_ref))
         t_pulse = np.where(omega == 0.0, 0.0, phase / omega)
         t_end = t_pulse + numerics.horizon
-        max_steps = step_budget(t_end, dt, numerics)
-    return dt, t_pulse, t_end, max_steps
+        max_steps = step_budget(t_pulse, t_end, dt, dt_on, numerics)
+    return dt, dt_on, t_pulse, t_end, max_steps
 
 
 def record_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, p: np.ndarray,
@@ -194,20 +196,20 @@ def record_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, p: np.ndarray,
                 ) -> tuple[np.ndarray, ...]:
     """``run_cost`` for a record, vectorised over points (float64[n]; p [rad/s]).
 
-    The step after the record is the regular ``step_size`` without a pulse period (dt).
-    While the record acts the step is h_rec = p DT / m, m = ceil(p DT / dt): the largest
-    step of at most dt that lands on every sample time (the kernel's PAR_REC_H); after the
-    last sample the kernel steps at dt again, so the cap counts the record's time at h_rec
-    and the free vibration after it at dt (a short record sampled at 100 kHz costs what
-    its duration asks, not its horizon at the sample spacing). Returns (dt, h_rec,
-    t_pulse = p (npts - 1) DT, t_end = t_pulse + horizon, step cap), p*t.
+    The step after the record is ``step_sizes``' dt (no pulse period). While the record
+    acts the step is h_rec = p DT / m, m = ceil(p DT / dt_on): the largest step of at most
+    dt_on that lands on every sample time (the kernel's PAR_REC_H); after the last sample
+    the kernel steps at dt again, so the cap counts the record's time at h_rec and the
+    free vibration after it at dt (a short record sampled at 100 kHz costs what its
+    duration asks, not its horizon at the sample spacing). Returns (dt, h_rec, t_pulse =
+    p (npts - 1) DT, t_end = t_pulse + horizon, step cap), p*t.
     """
     p = np.asarray(p, float)
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
-        dt = step_size(omega_rock, 0.0, numerics.steps_per_period,
-                       amplitude_frequency(A_ratio, alpha_ref))
+        dt, dt_on = step_sizes(omega_rock, 0.0, numerics.steps_per_period,
+                               numerics.pulse_steps, amplitude_frequency(A_ratio, alpha_ref))
         dt_k = p * record.dt
-        h_rec = dt_k / np.ceil(dt_k / dt)
+        h_rec = dt_k / np.ceil(dt_k / dt_on)
         t_pulse = p * record.duration
         t_end = t_pulse + numerics.horizon
         steps = np.ceil(t_pulse / h_rec) + np.ceil(numerics.horizon / dt) + 1.0
@@ -245,14 +247,15 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
                                                            A_ratio, record, numerics)
         rows[:, L.PAR_REC_DT] = omega * record.dt
         rows[:, L.PAR_REC_H] = h_rec
+        dt_on = h_rec
         omega = 0.0
     else:
         # each point's duration in w t by its shape (``vocab.ground.pulse_duration``)
         phase = np.select([code == L.SHAPE_RICKER, code == L.SHAPE_MP],
                           [pulse_duration(RICKER), pulse_duration(MP, gamma=gamma)],
                           pulse_duration(SINE, cycles=cycles))
-        dt, t_pulse, t_end, max_steps = run_cost(omega_rock, alpha_ref, omega, A_ratio,
-                                                 numerics, phase)
+        dt, dt_on, t_pulse, t_end, max_steps = run_cost(omega_rock, alpha_ref, omega,
+                                                        A_ratio, numerics, phase)
         if np.any(code == L.SHAPE_MP):
             from rocksweep.physics.excitation import mp_peak
 
@@ -265,6 +268,7 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     rows[:, L.PAR_TPULSE] = t_pulse
     rows[:, L.PAR_LAM] = lam
     rows[:, L.PAR_DT] = dt
+    rows[:, L.PAR_DT_ON] = dt_on
     rows[:, L.PAR_TOL] = numerics.event_tol
     rows[:, L.PAR_TEND] = t_end
     rows[:, L.PAR_MAXSTEPS] = max_steps
@@ -273,6 +277,8 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     rows[:, L.PAR_ROOT] = _ROOT_CODE[numerics.root]
     rows[:, L.PAR_MU] = mu
     rows[:, L.PAR_ROT_STEP] = numerics.rotation_step * alpha_ref
+    rows[:, L.PAR_ALPHA_REF] = alpha_ref
+    rows[:, L.PAR_CLOSE] = close_margin(numerics.steps_per_period)
     rows[:, L.PAR_LAW] = law
     rows[:, L.PAR_E] = e
     rows[:, L.PAR_E_FACTOR] = e_factor

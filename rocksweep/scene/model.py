@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from rocksweep import fields
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import SceneError  # noqa: F401 (defined there; re-exported)
 from rocksweep.numerics import Numerics
 from rocksweep.physics.model import BlockBody, Body, FlexibleBody
 from rocksweep.physics.points import FREE, INITIAL, RECORD, Point
@@ -19,10 +19,6 @@ from rocksweep.physics.suite import Suite
 from rocksweep.schema import KEYS
 from rocksweep.vocab.ground import PAPER_SHAPES, pulse_duration
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
-
-
-class SceneError(RocksweepError, ValueError):
-    """A scene that cannot be run; ``str()`` is one line for the user."""
 
 
 @dataclass(frozen=True)
@@ -43,7 +39,7 @@ class Scene:
     kind: str  # "flexible" | "block"
     axes: tuple[Axis, ...]
     numerics: Numerics  # sweeps: the `default` preset unless the scene names one
-    single_numerics: Numerics  # single runs (simulate): `fine` unless the scene names one
+    single_numerics: Numerics  # single runs (simulate): the sweeps' numerics (one default)
     energy: bool
     text: str = field(repr=False)
     contact: bool = False  # outputs.contact (on when body.mu is given)

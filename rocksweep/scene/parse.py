@@ -305,10 +305,11 @@ def _refine(raw: dict, kind: str) -> dict | None:
 
 
 def _numerics(sec: dict, contact: bool = False) -> tuple[Numerics, Numerics]:
-    """The sweeps' and the single runs' numerics of a checked ``numerics`` section.
+    """The sweeps' and the single runs' numerics of a checked ``numerics`` section: the
+    same (one point, one answer).
 
-    Without a preset named, sweeps run `default`, but a sweep that stores the contact
-    demands runs `fine`: at `default` the demands of long-rocking points differ from the
+    Without a preset named, sweeps and single runs run `default`, but a scene that stores
+    the contact demands runs `fine`: at `default` the demands of long-rocking points differ from the
     reference by up to ~20% (the trajectory after many impacts), at 20 steps per period by
     5e-4 (scripts/contact_check.py)."""
     given: dict[str, Any] = {}
@@ -333,9 +334,10 @@ def _numerics(sec: dict, contact: bool = False) -> tuple[Numerics, Numerics]:
         given[k] = v
     accuracy = given.pop("accuracy", None)
     numerics = Numerics.preset(accuracy or ("fine" if contact else "default"), **given)
-    # A single run exists for its time history and energy balance, which the outcome-tuned
-    # `default` (5 steps per period) resolves only roughly; it costs milliseconds at `fine`.
-    single = Numerics.preset(accuracy or "fine", **given)
+    # One default (issue 28): a single run (simulate) runs what a sweep of the same point
+    # runs, so one point has one answer; the certification of close calls
+    # (``compute.certify``) makes the default trustworthy for both.
+    single = numerics
     return numerics, single
 
 
@@ -437,6 +439,11 @@ def _listing(path: Path, shown_as: str) -> list[tuple[int, str]]:
     if data.startswith((b"\xff\xfe", b"\xfe\xff")):
         raise SceneError(f"{key}: {shown_as}: a listing saved as UTF-16; save it as UTF-8 "
                          "text (one record path a line)")
+    if b"\0" in data:
+        line = data.count(b"\n", 0, data.index(b"\0")) + 1
+        raise SceneError(f"{key}: {shown_as}, line {line}: a NUL byte (UTF-16 without a "
+                         "byte-order mark, or a binary file?); a listing is UTF-8 text, one "
+                         "record path a line")
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as err:
