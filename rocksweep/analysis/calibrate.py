@@ -58,7 +58,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -67,12 +67,13 @@ from rocksweep.compute.single import history_capacity
 from rocksweep.errors import RocksweepError
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import point_kernel, warm_up
-from rocksweep.numerics import step_budget
+from rocksweep.numerics import Numerics, step_budget
 from rocksweep.physics.measured import Measured, noise_level
 from rocksweep.physics.model import BodyError
 from rocksweep.physics.points import INITIAL, kernel_kind, point_row
 from rocksweep.schema import KEYS, fmt
 
+ACCURACY = "fine"  # the least accuracy of a calibration's runs (``calibration_numerics``)
 H_NOISE = 4.0  # threshold of an excursion, in noise standard deviations ...
 H_REL = 0.02  # ... and at least this share of the largest |theta|
 PEAK_TOP = 0.5  # a peak's parabola goes through the samples above this share of it ...
@@ -86,6 +87,17 @@ DEFAULT_BOUNDS = {"impact.lam": (0.0, 2.0), "impact.e": (0.02, 1.0),
                   "impact.e_factor": (0.2, 2.0), "body.zeta": (0.0, 0.5)}
 # keys of a scene's point a fit may set although the scene does not give them
 OPTIONAL_NAMES = ("e_factor", *INITIAL)
+
+
+def calibration_numerics(n: Numerics) -> Numerics:
+    """The numerics of a calibration's runs: the scene's, but at least ACCURACY's steps and
+    event tolerance (a fitted value must not carry the step's error: at `default`, 5 steps
+    per period, a freely rocking block's e came out 0.004 high, outside its interval);
+    the scene's horizon, rest rate and event cap are kept."""
+    fine = Numerics.preset(ACCURACY)
+    if n.steps_per_period >= fine.steps_per_period and n.event_tol <= fine.event_tol:
+        return n
+    return replace(fine, horizon=n.horizon, rest_rate=n.rest_rate, max_events=n.max_events)
 
 
 class CalibrationError(RocksweepError, ValueError):
@@ -275,7 +287,7 @@ class Problem:
         self.names = [check_fit_key(scene, k) for k in self.keys]
         self.bounds = np.array([check_bounds(k, (bounds or {}).get(k)) for k in self.keys])
         self.values = _single_values(scene, self.names)
-        self.numerics = scene.single_numerics
+        self.numerics = calibration_numerics(scene.single_numerics)
         base = scene.point(self.values)
         self.alpha = base.body.alpha_ref
         self.sigma = noise_level(measured.t, measured.theta)
