@@ -57,7 +57,7 @@ from typing import Any
 import numpy as np
 
 from rocksweep.compute.grid import ChunkRows, Grid
-from rocksweep.errors import AdaptiveError  # noqa: F401 (defined there; re-exported)
+from rocksweep.errors import AdaptiveError, ApiError  # noqa: F401 (AdaptiveError: re-exported)
 from rocksweep.scene.model import Scene
 from rocksweep.schema import check_option
 from rocksweep.vocab import outcomes as _out
@@ -851,3 +851,31 @@ def validate(grid: Grid, plan: Plan, outcome: np.ndarray, computed: np.ndarray,
         cls[np.searchsorted(filled, res.flat)] = res.arrays["outcome"]
     bad = cls != np.asarray(outcome).ravel()[filled]
     return Validation(s, int(lattice.size), int(filled.size), filled[bad], cls[bad])
+
+
+def adaptive_options(adaptive: bool, base: dict | None = None,
+                     **settings: Any) -> Options | None:
+    """``Options`` from the API's keyword settings (None values: the defaults);
+    None when not ``adaptive``, then any setting given is an ApiError. base: a scene's
+    ``refine`` section (``Scene.refine``): it turns adaptive on, and the keyword settings
+    override its values."""
+    given = {k: v for k, v in settings.items() if v is not None}
+    if base is not None:
+        adaptive = True
+        given = {**base, **given}
+    known = {"coarse", "audit", "axes", "margin", "final_margin", "seed", "threshold"}
+    unknown = sorted(set(given) - known)
+    if unknown:
+        raise AdaptiveError(f"{unknown[0]} = {given[unknown[0]]!r}: not a setting of an adaptive "
+                       f"sweep (settings: {', '.join(sorted(known))})")
+    if not adaptive:
+        if given:
+            k = sorted(given)[0]
+            raise ApiError(f"{k} = {given[k]!r}: an adaptive setting; add adaptive=True")
+        return None
+    if "axes" in given:
+        axes = given["axes"]
+        if isinstance(axes, str):
+            axes = [a.strip() for a in axes.split(",")]
+        given["axes"] = tuple(axes)
+    return Options(**given)
