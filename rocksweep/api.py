@@ -46,7 +46,6 @@ _MOVED = {
     "swept_values": "rocksweep.store.history",
     "write_history_csv": "rocksweep.store.history",
     "RocksweepAccessor": "rocksweep.accessor",
-    "register_accessor": "rocksweep.accessor",
 }
 
 
@@ -176,22 +175,28 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
     return _loaded(path)
 
 
+def _register() -> None:
+    """``ds.rocksweep``: the accessor, calling this module's analyses."""
+    from rocksweep.accessor import register_accessor
+
+    register_accessor({f.__name__: f for f in (plot, boundaries, boundary_lines, spectra,
+                                               fragility, ida, risk, im_efficiency, table)})
+
+
 def _loaded(source: Path | Any) -> xr.Dataset:
     """``store.dataset.result_dataset`` with the accessor registered (``ds.rocksweep``)."""
-    from rocksweep.accessor import register_accessor
     from rocksweep.store.dataset import result_dataset
 
-    register_accessor()
+    _register()
     return result_dataset(source)
 
 
 def open_any(path: str | Path) -> xr.Dataset:
     """Any rocksweep Dataset from a file (``rocksweep.analysis.files.open_any``), with
     ``ds.rocksweep``."""
-    from rocksweep.accessor import register_accessor
     from rocksweep.analysis.files import open_any as open_file
 
-    register_accessor()
+    _register()
     return open_file(path)
 
 
@@ -202,9 +207,7 @@ def _dataset_arg(ds: Any, what: str) -> xr.Dataset:
     register = isinstance(ds, str | Path)
     out = _as_dataset(ds, what)
     if register:
-        from rocksweep.accessor import register_accessor
-
-        register_accessor()
+        _register()
     return out
 
 
