@@ -786,10 +786,11 @@ def adaptive_compute(scene: Scene, jobs: int = 1, coarse: int | None = None,
                      chunk_size: int | None = None, backend: str = "threads",
                      scheduler: str | None = None,
                      threshold: float = DEFAULT_AUDIT_THRESHOLD,
-                     final_margin: int = DEFAULT_FINAL_MARGIN,
-                     on_batch: Callable[[Batch], None] | None = None
+                     final_margin: int = DEFAULT_FINAL_MARGIN
                      ) -> tuple[dict[str, np.ndarray], AdaptiveStats]:
-    """Adaptive sweep of a whole scene in memory, like ``rocksweep.compute.sweep.compute``.
+    """Adaptive sweep of a whole scene in memory, like ``rocksweep.compute.sweep.compute``,
+    through the one sweep driver (``rocksweep.compute.driver.sweep_arrays``: the loop of
+    ``rocksweep sweep --adaptive``).
 
     Returns (arrays, stats): arrays maps every variable of ``Scene.variables``
     plus ``computed`` (int8 flags, see COMPUTED_MEANING) to an array of the grid's shape;
@@ -797,23 +798,11 @@ def adaptive_compute(scene: Scene, jobs: int = 1, coarse: int | None = None,
     value at filled points. Identical whatever ``jobs``, ``chunk_size`` and backend.
     """
 
-    grid = Grid(scene)
-    plan = make_plan(grid, axes, coarse, margin, audit, seed, final_margin)
-    specs = scene.variables()
-    flat = {k: np.full(grid.size, fv, dt) for k, (dt, fv, _) in specs.items()}
+    from rocksweep.compute.driver import sweep_arrays
 
-    def evaluate(points: np.ndarray, batch: Batch) -> np.ndarray:
-        if on_batch is not None:
-            on_batch(batch)
-        for res in run_batch(grid, points, jobs, chunk_size, backend, scheduler):
-            for k, v in res.arrays.items():
-                flat[k][res.flat] = v
-        return flat["outcome"][points]
-
-    outcome, computed, stats = drive(plan, evaluate, threshold=threshold)
-    flat["outcome"] = outcome
-    flat["computed"] = computed
-    return {k: v.reshape(grid.shape) for k, v in flat.items()}, stats
+    options = Options(tuple(axes), coarse, audit, margin, final_margin, seed, threshold)
+    arrays, report = sweep_arrays(scene, jobs, chunk_size, backend, scheduler, options)
+    return arrays, report.adaptive
 
 
 @dataclass
