@@ -13,6 +13,7 @@ inside the functions), so ``import rocksweep`` stays light.
 from __future__ import annotations
 
 import functools
+import os
 import re
 import sys
 import time
@@ -165,9 +166,9 @@ def load(scene: SceneLike | Scene, overrides: Overrides | None = ()) -> tuple[Sc
     if not isinstance(scene, str | Path):
         raise ApiError(f"scene = {scene!r}: give a path, YAML text or a dict")
     path = Path(scene)
-    if not path.exists():
+    if not os.path.lexists(path):
         raise SceneError(f"{path}: no such scene file")
-    return load_scene(path, ov), path
+    return load_scene(path, ov), path  # a loop of links, a FIFO...: its one line
 
 
 def _is_file(text: str) -> bool:
