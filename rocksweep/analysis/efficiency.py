@@ -35,15 +35,12 @@ from scipy.optimize import minimize
 from scipy.special import log_ndtr
 
 from rocksweep.analysis.fragility import counted_points, fit_cloud, state_reached
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import EfficiencyError, RocksweepError  # noqa: F401 (re-exported)
 from rocksweep.physics.model import G
 from rocksweep.physics.suite import RECORD_IMS
 
 __all__ = ["EfficiencyError", "im_efficiency", "record_im_table"]
 
-
-class EfficiencyError(RocksweepError, ValueError):
-    """A Dataset that has no IM efficiency; ``str()`` is one line."""
 
 
 def _scalar(ds: xr.Dataset, names: tuple[str, ...]) -> xr.DataArray | None:

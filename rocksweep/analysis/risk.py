@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import RiskError, RocksweepError  # noqa: F401 (re-exported)
 from rocksweep.vocab.ground import PGA, PGV, SA
 
 __all__ = ["Hazard", "RiskError", "fragility_median", "hazard_frame", "read_hazard",
@@ -65,9 +65,6 @@ OQ_UNITS = {PGA: ("g", 1.0), SA.upper(): ("g", 1.0), PGV: ("m/s", 0.01)}
 _HEADER = re.compile(r"^\s*(?P<im>[A-Za-z][A-Za-z0-9_]*)\s*(?:\(\s*(?P<T>[0-9.eE+-]+)\s*\))?"
                      r"\s*\[(?P<unit>[^\]]*)\]\s*$")
 
-
-class RiskError(RocksweepError, ValueError):
-    """A hazard curve or a request that risk cannot answer; ``str()`` is one line."""
 
 
 @dataclass(frozen=True)
@@ -161,7 +158,7 @@ def _openquake(lines: list[str], where: str, site: int | None) -> Hazard:
 
     meta = lines[0]
     t = re.search(r"investigation_time\s*=\s*'?([0-9.eE+-]+)", meta)
-    imt = re.search(r"imt\s*=\s*'([^']+)'", meta)
+    imt = re.search(r"imt\s*=\s*['\"]([^'\"]+)['\"]", meta)  # 'PGA' (3.x), "PGA" (2.x)
     if t is None or imt is None:
         raise RiskError(f"{where}: OpenQuake header without investigation_time and imt: "
                         f"{meta[:80]!r}")

@@ -105,19 +105,18 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     if check:
         overrides = (*overrides, "outputs.check=true")
     from rocksweep import api
+    from rocksweep.compute.adaptive import check_settings
     from rocksweep.compute.arguments import check_sweep_arguments
-    from rocksweep.schema import check_option
 
     # the arguments that need no scene, before it is read (all again in api.sweep_file)
     check_sweep_arguments(jobs=jobs, resume=resume, overwrite=overwrite, backend=backend,
                           scheduler=scheduler, chunk_size=chunk_size, write_every=write_every,
                           connect_timeout=connect_timeout, cli=True)
-    for key, value in (("coarse", coarse), ("audit", audit), ("margin", margin),
-                       ("final_margin", final_margin), ("seed", seed),
-                       ("threshold", threshold)):
-        msg = check_option(f"refine.{key}", value, f"--{key.replace('_', '-')}")
-        if msg is not None:  # the ranges of the scene's refine: section, one table
-            raise click.ClickException(msg)
+    msg = check_settings({"coarse": coarse, "audit": audit, "margin": margin,
+                          "final_margin": final_margin, "seed": seed, "threshold": threshold},
+                         lambda k: f"--{k.replace('_', '-')}")
+    if msg is not None:  # the ranges of the scene's refine: section, one table
+        raise click.ClickException(msg)
     settings = {"coarse": coarse, "audit": audit, "axes": adaptive_axes, "margin": margin,
                 "final_margin": final_margin, "seed": seed, "threshold": threshold}
     given = [k for k, v in settings.items() if v is not None]

@@ -57,7 +57,7 @@ from typing import Any
 import numpy as np
 
 from rocksweep.compute.grid import ChunkRows, Grid
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import AdaptiveError  # noqa: F401 (defined there; re-exported)
 from rocksweep.scene.model import Scene
 from rocksweep.schema import check_option
 from rocksweep.vocab import outcomes as _out
@@ -86,9 +86,6 @@ DEFAULT_AUDIT_THRESHOLD = 0.002
 
 _NO_CLASS = np.int8(127)  # above every class, for minima over computed points
 
-
-class AdaptiveError(RocksweepError, ValueError):
-    """Bad adaptive settings (axes, coarse level, margin, audit share)."""
 
 
 @dataclass(frozen=True)
@@ -184,22 +181,32 @@ def make_plan(grid_or_scene: Grid | Scene, axes: Sequence[str] = DIAGRAM_AXES,
         pos.append(names.index(name))
     full_shape = tuple(len(a.values) for a in scene.axes)
     return Plan(full_shape, pos[0], pos[1], (str(axes[0]), str(axes[1])),
-                None if coarse is None else _integer("coarse", coarse),
-                _integer("margin", margin), _share("audit", audit), _integer("seed", seed),
-                _integer("final_margin", final_margin))
+                None if coarse is None else _checked("coarse", coarse, int),
+                _checked("margin", margin, int), _checked("audit", audit, float),
+                _checked("seed", seed, int), _checked("final_margin", final_margin, int))
 
 
-def _integer(name: str, v: Any) -> int:
-    if isinstance(v, bool) or not isinstance(v, int | np.integer):
-        raise AdaptiveError(f"{name} = {v!r}: must be an integer")
-    return int(v)
+# the settings a user gives (the scene's refine: section, rocksweep.schema's ranges)
+SETTINGS = ("coarse", "audit", "margin", "final_margin", "seed", "threshold")
 
 
-def _share(name: str, v: Any) -> float:
-    if (isinstance(v, bool) or not isinstance(v, int | float | np.number)
-            or not 0.0 <= float(v) <= 1.0):
-        raise AdaptiveError(f"{name} = {v!r}: must be a share in [0, 1]")
-    return float(v)
+def check_settings(values: dict[str, Any], label: Callable[[str], str]) -> str | None:
+    """The first setting of ``values`` (name -> value; None: not given) outside its
+    ``refine.<name>`` range, as one line naming it by ``label(name)`` ("margin =",
+    "--margin"); None if all are admissible. The one check of the adaptive settings: the
+    command line, ``Options`` and ``make_plan`` call it."""
+    for name, v in values.items():
+        msg = check_option(f"refine.{name}", v, label(name))
+        if msg is not None:
+            return msg
+    return None
+
+
+def _checked(name: str, v: Any, kind: type) -> Any:
+    msg = check_settings({name: v}, lambda n: f"{n} =")
+    if msg is not None:
+        raise AdaptiveError(msg)
+    return kind(v)
 
 
 @dataclass(frozen=True)
@@ -219,11 +226,9 @@ class Options:
     threshold: float = DEFAULT_AUDIT_THRESHOLD
 
     def __post_init__(self) -> None:
-        # the ranges of the scene's refine: section (one table, rocksweep.schema)
-        for name in ("coarse", "audit", "margin", "final_margin", "seed", "threshold"):
-            msg = check_option(f"refine.{name}", getattr(self, name), f"{name} =")
-            if msg is not None:
-                raise AdaptiveError(msg)
+        msg = check_settings({n: getattr(self, n) for n in SETTINGS}, lambda n: f"{n} =")
+        if msg is not None:
+            raise AdaptiveError(msg)
 
     def plan(self, grid_or_scene: Grid | Scene) -> Plan:
         """The plan of a grid (AdaptiveError for bad axes or settings)."""

@@ -22,12 +22,7 @@ import time
 from typing import Any
 from urllib.parse import urlsplit
 
-from rocksweep.errors import RocksweepError
-
-
-class SweepError(RocksweepError, ValueError):
-    """A sweep that cannot run as asked (workers, cluster); ``str()`` is one line."""
-
+from rocksweep.errors import SweepError, is_integer  # noqa: F401 (defined there; re-exported)
 
 # Local worker threads allowed per core: the chunk kernels keep a core busy, so threads
 # beyond a few per core only wait (and a typo like 99999999999999999999 must not start them).
@@ -35,11 +30,6 @@ MAX_JOBS_PER_CORE = 4
 # Seconds to wait for a dask scheduler to answer (``--connect-timeout``).
 CONNECT_TIMEOUT = 20.0
 MAX_CONNECT_TIMEOUT = 3600.0
-
-
-def is_integer(v: Any) -> bool:
-    """An integer (Python's or numpy's), not a bool."""
-    return isinstance(v, numbers.Integral) and not isinstance(v, bool)
 
 
 def check_flag(name: str, v: Any) -> bool:

@@ -22,7 +22,6 @@ import numpy as np
 from matplotlib.figure import Figure as _MplFigure
 from matplotlib.lines import Line2D
 
-from rocksweep.errors import RocksweepError
 from rocksweep.outputs import atomic_path, check_output
 from rocksweep.vocab import axes as _axes
 from rocksweep.vocab.laws import DEFAULT_LAW, VERTICAL, law_origin
@@ -32,12 +31,8 @@ if TYPE_CHECKING:
 
     from rocksweep.compute.single import Run
 
+from rocksweep.errors import FigureError  # noqa: F401 (defined there; re-exported)
 from rocksweep.figures import DEFAULT_DPI, FORMATS, WIDTHS  # noqa: E402,F401
-
-
-class FigureError(RocksweepError, ValueError):
-    """Something that cannot be drawn as asked; ``str()`` is one line."""
-
 
 # What every saved figure gets, whoever saves it: TrueType fonts in PDF and PostScript
 # (Type 42), as journals ask, instead of matplotlib's Type 3.

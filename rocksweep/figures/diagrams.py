@@ -40,12 +40,12 @@ from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
+from rocksweep.errors import DiagramError  # noqa: F401 (defined there; re-exported)
 from rocksweep.fields import WORD_AXES
 from rocksweep.figures.common import (
     DEFAULT_DPI,
     FORMATS,
     Figure,
-    FigureError,
     given_axes,
     new_axes,
     save_figure,
@@ -80,9 +80,6 @@ _UNSURE = "#e69f00"  # rings: the outcome changes at half the step (outputs.chec
 # boundary lines of the k-th lam (``curves``): dark colours apart from the cells' fills
 CURVE_COLOURS = ("black", "#1b9e77", "#7570b3", "#e7298a", "#66a61e", "#a6761d")
 
-
-class DiagramError(FigureError):
-    """A result that cannot be drawn as asked; ``str()`` is one line."""
 
 
 def _fmt(v) -> str:

@@ -6,11 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 from rocksweep.analysis.kinds import dataset_kind
-from rocksweep.errors import RocksweepError
-
-
-class PlotError(RocksweepError, ValueError):
-    """A Dataset that has no figure; ``str()`` is one line."""
+from rocksweep.errors import PlotError, RocksweepError  # noqa: F401 (re-exported)
 
 
 def plot_analysis(ds: Any, *, ax: Any = None, width: str | None = None) -> Any:

@@ -22,7 +22,7 @@ import xarray as xr
 
 from rocksweep.analysis.fragility import lognormal_cdf
 from rocksweep.analysis.risk import fragility_median
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import FragilityFigureError, RocksweepError  # noqa: F401 (re-exported)
 from rocksweep.figures import WIDTHS
 from rocksweep.figures.common import Figure
 
@@ -33,9 +33,6 @@ if TYPE_CHECKING:
 ASPECT = {"single": 1.2, "double": 0.75}  # room for the legend below
 _STYLES = ("-", "--", ":", "-.")
 
-
-class FragilityFigureError(RocksweepError, ValueError):
-    """A fragility Dataset that cannot be drawn as asked; ``str()`` is one line."""
 
 
 def _fmt(v) -> str:

@@ -26,9 +26,21 @@ import os
 from pathlib import Path
 
 from numba.core import caching, config
-from numba.core.runtime import rtsys
 
 _KERNEL_DIR = Path(__file__).resolve().parent
+
+
+def _supported(options: dict) -> dict:
+    """The jit options this numba knows (``_nrt``, ``no_cpython_wrapper``,
+    ``no_cfunc_wrapper`` and ``forceinline`` are private or internal): an unknown one is
+    dropped (the kernel then compiles with numba's default for it: slower, same results)
+    instead of failing every ``@njit`` at import."""
+    try:
+        from numba.core.cpu import CPUTargetOptions
+    except ImportError:  # pragma: no cover (a numba without the class: keep them all)
+        return dict(options)
+    return {k: v for k, v in options.items() if hasattr(CPUTargetOptions, k)}
+
 
 # No kernel function allocates: every one is compiled without numba's reference counting
 # (``_nrt=False``), so passing the parameter row or the result row to a function costs no
@@ -40,17 +52,17 @@ _KERNEL_DIR = Path(__file__).resolve().parent
 # events, once per event): ``forceinline`` set False, else numba would pass on the flag of
 # the function whose compilation compiles them (an event search inlined into every copy
 # of the screening doubles the code and the compile time, for nothing measurable).
-INTERNAL = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True, "_nrt": False,
-            "forceinline": False}
+INTERNAL = _supported({"no_cpython_wrapper": True, "no_cfunc_wrapper": True, "_nrt": False,
+                       "forceinline": False})
 # Options of the small functions on the path of every step: compiled once per signature
 # and inlined by LLVM (``forceinline``: LLVM's alwaysinline), not by numba (``inline=
 # "always"`` copies and retypes the callee's IR at every call site: 2/3 of the compile
 # time). Still callable from Python (the reference path and the tests use some).
-INLINE = {"forceinline": True, "_nrt": False}
+INLINE = _supported({"forceinline": True, "_nrt": False})
 # Options of the other functions called from jitted code and from Python.
-PUBLIC = {"_nrt": False}
+PUBLIC = _supported({"_nrt": False})
 # Options of the entry points (``variants``): called from Python.
-ENTRY = {"_nrt": False}
+ENTRY = _supported({"_nrt": False})
 
 
 def _kernel_hash() -> str:
@@ -76,49 +88,69 @@ def shared_cache_dir() -> Path:
     return root / _STAMP[:20]
 
 
-class _KernelStampMixin:
-    def get_source_stamp(self):
-        return _STAMP
+def install() -> tuple[type, ...]:
+    """Put the kernel's cache locators first in numba's list; the classes installed.
 
-    @classmethod
-    def from_function(cls, py_func, py_file):
-        if Path(py_file).resolve().parent != _KERNEL_DIR:
-            return None
-        return super().from_function(py_func, py_file)
-
-
-class KernelSharedLocator(_KernelStampMixin, caching._SourceFileBackedLocatorMixin,
-                          caching._CacheLocator):
-    """Cache in ``shared_cache_dir()``, stamped by the hash of all kernel sources.
-
-    Index and data files are named after the module, the function and its line (numba's
-    ``CacheImpl``), never the path, so every copy of the same sources finds them.
+    The one place that touches numba's private caching names (``_CacheLocator``,
+    ``_SourceFileBackedLocatorMixin``, ``CacheImpl._locator_classes``): if this numba
+    lacks any of them, nothing is installed and numba caches each function its own way
+    (beside its source file, stamped by that file alone: an edit of another kernel module
+    is then not seen until ``__pycache__`` is cleared; results are the same). Called once,
+    at import, before any ``@njit(cache=True)`` of the kernel runs.
     """
+    try:
+        mixin, base = caching._SourceFileBackedLocatorMixin, caching._CacheLocator
+        registry = caching.CacheImpl._locator_classes
+        in_tree = caching.InTreeCacheLocator
+    except AttributeError:
+        return ()
 
-    def __init__(self, py_func, py_file):
-        self._py_file = py_file
-        self._lineno = py_func.__code__.co_firstlineno
-        self._cache_path = str(shared_cache_dir())
+    class _KernelStampMixin:
+        def get_source_stamp(self):
+            return _STAMP
 
-    def get_cache_path(self):
-        return self._cache_path
+        @classmethod
+        def from_function(cls, py_func, py_file):
+            if Path(py_file).resolve().parent != _KERNEL_DIR:
+                return None
+            return super().from_function(py_func, py_file)
 
-    @classmethod
-    def from_function(cls, py_func, py_file):
-        try:
-            shared_cache_dir()
-        except (RuntimeError, KeyError):  # no home directory to cache in
-            return None
-        return super().from_function(py_func, py_file)
+    class KernelSharedLocator(_KernelStampMixin, mixin, base):
+        """Cache in ``shared_cache_dir()``, stamped by the hash of all kernel sources.
+
+        Index and data files are named after the module, the function and its line
+        (numba's ``CacheImpl``), never the path, so every copy of the same sources finds
+        them.
+        """
+
+        def __init__(self, py_func, py_file):
+            self._py_file = py_file
+            self._lineno = py_func.__code__.co_firstlineno
+            self._cache_path = str(shared_cache_dir())
+
+        def get_cache_path(self):
+            return self._cache_path
+
+        @classmethod
+        def from_function(cls, py_func, py_file):
+            try:
+                shared_cache_dir()
+            except (RuntimeError, KeyError):  # no home directory to cache in
+                return None
+            return super().from_function(py_func, py_file)
+
+    class KernelInTreeLocator(_KernelStampMixin, in_tree):
+        """Fallback: the kernel's __pycache__, stamped by the hash of all kernel sources."""
+
+    installed = (KernelInTreeLocator, KernelSharedLocator)
+    for cls in installed:  # inserted first: tried first
+        if not any(c.__name__ == cls.__name__ and c.__module__ == cls.__module__
+                   for c in registry):
+            registry.insert(0, cls)
+    return installed
 
 
-class KernelInTreeLocator(_KernelStampMixin, caching.InTreeCacheLocator):
-    """Fallback: the kernel's __pycache__, stamped by the hash of all kernel sources."""
-
-
-for _cls in (KernelInTreeLocator, KernelSharedLocator):  # inserted first: tried first
-    if _cls not in caching.CacheImpl._locator_classes:
-        caching.CacheImpl._locator_classes.insert(0, _cls)
+LOCATORS = install()
 
 
 class EntryCache(caching.FunctionCache):
@@ -133,21 +165,41 @@ class EntryCache(caching.FunctionCache):
     context's code generator, the C helpers and math symbols that the context installs
     when it is made, and NRT's symbols (the array arguments' unboxing), installed here.
     A miss falls through to numba's compile, which refreshes both contexts itself
-    (``CompilerBase.__init__``), so a compile sees what it always did.
+    (``CompilerBase.__init__``), so a compile sees what it always did. Every private name
+    it reads has a fallback: numba's own ``load_overload``.
     """
 
     def load_overload(self, sig, target_context):
         try:
             guard, load = self._guard_against_spurious_io_errors, self._load_overload
-        except AttributeError:  # a numba whose cache is built otherwise: its own load
+            from numba.core.runtime import rtsys
+        except (AttributeError, ImportError):  # a numba whose cache is built otherwise
             return super().load_overload(sig, target_context)
         rtsys.initialize(target_context)
         with guard():
             return load(sig, target_context)
 
 
+def in_cache(dispatcher) -> bool | None:
+    """Whether numba has this entry point in memory or in its on-disk cache for this
+    machine (True for NUMBA_DISABLE_JIT=1's plain function: nothing to compile); None if
+    that cannot be told (numba's private cache names changed)."""
+    if not hasattr(dispatcher, "py_func"):
+        return True
+    try:
+        if dispatcher.signatures:
+            return True
+        index = dispatcher._cache._cache_file._load_index()  # {(sig, machine): file}
+        machine = dispatcher.targetdescr.target_context.codegen().magic_tuple()
+        return any(key[1] == machine for key in index)
+    except Exception:  # private numba API: any change means "unknown"
+        return None
+
+
 def loads_fast(dispatcher):
     """Give a cached entry point (a ``@njit(cache=True)`` dispatcher called from Python)
-    ``EntryCache``; returns the dispatcher."""
-    dispatcher._cache = EntryCache(dispatcher.py_func)
+    ``EntryCache``; returns the dispatcher (as is where it has no numba cache to replace:
+    NUMBA_DISABLE_JIT=1's plain function, or a numba whose dispatchers keep it otherwise)."""
+    if LOCATORS and hasattr(dispatcher, "py_func") and hasattr(dispatcher, "_cache"):
+        dispatcher._cache = EntryCache(dispatcher.py_func)
     return dispatcher

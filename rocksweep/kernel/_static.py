@@ -17,8 +17,11 @@ def skipped_when(value, fn, result):
     the literal ``value`` (``Literal[bool]``, as the variants' flags are), in which case
     ``fn`` is not typed or compiled at all. Callable from jitted code only."""
 
-    def stub(flag, *args):  # pragma: no cover (replaced by the overload below)
-        raise NotImplementedError
+    def stub(flag, *args):
+        """Plain Python (NUMBA_DISABLE_JIT=1): the overload's choice."""
+        if isinstance(flag, bool) and flag == value:
+            return result
+        return fn(*args)
 
     @overload(stub, jit_options=INLINE, prefer_literal=True)
     def _select(flag, *args):

@@ -26,6 +26,7 @@ Full contact (theta = 0):  m u'' + c u' + k u = -m xg''.
 
 import math
 
+import numpy as np
 from numba import njit
 from numba.core import types
 from numba.extending import overload
@@ -90,41 +91,48 @@ _mp_raw_rate = njit(**INLINE)(_ground.mp_raw_rate)
 # ----------------------------------------------------------------------------------------
 
 
-def _shape_acc(t, on, prm):  # pragma: no cover (replaced by the overload below)
-    raise NotImplementedError
+def _pulse_acc(t, on, prm):
+    """Eq. (2): A sin(w t) or A cos(w t) (the paper's sine and cosine, n cycles)."""
+    if prm[PAR_SHAPE] == SHAPE_COSINE:
+        return prm[PAR_AMP] * math.cos(prm[PAR_OMEGA] * t)
+    return prm[PAR_AMP] * math.sin(prm[PAR_OMEGA] * t)
 
 
-def _shape_jerk(t, on, prm):  # pragma: no cover
-    raise NotImplementedError
+def _pulse_jerk(t, on, prm):
+    """d/dt of ``_pulse_acc``."""
+    w = prm[PAR_OMEGA]
+    if prm[PAR_SHAPE] == SHAPE_COSINE:
+        return -prm[PAR_AMP] * w * math.sin(w * t)
+    return prm[PAR_AMP] * w * math.cos(w * t)
 
 
+def _any_acc(t, on, prm):
+    return ground_acc_any(t, prm)
+
+
+def _any_jerk(t, on, prm):
+    return ground_jerk_any(t, prm)
+
+
+def _shape_acc(t, on, prm):
+    """Plain Python (NUMBA_DISABLE_JIT=1): the overload's choice, by the type of ``on``."""
+    return (_pulse_acc if isinstance(on, bool | np.bool_) else _any_acc)(t, on, prm)
+
+
+def _shape_jerk(t, on, prm):
+    """Plain Python (NUMBA_DISABLE_JIT=1): the overload's choice, by the type of ``on``."""
+    return (_pulse_jerk if isinstance(on, bool | np.bool_) else _any_jerk)(t, on, prm)
+
+
+# compiled: the same functions, picked while typing (``on``: a bool or an int)
 @overload(_shape_acc, inline="always")
 def _shape_acc_overload(t, on, prm):
-    if isinstance(on, types.Boolean):
-        def pulse(t, on, prm):
-            if prm[PAR_SHAPE] == SHAPE_COSINE:
-                return prm[PAR_AMP] * math.cos(prm[PAR_OMEGA] * t)
-            return prm[PAR_AMP] * math.sin(prm[PAR_OMEGA] * t)
-        return pulse
-
-    def any_shape(t, on, prm):
-        return ground_acc_any(t, prm)
-    return any_shape
+    return _pulse_acc if isinstance(on, types.Boolean) else _any_acc
 
 
 @overload(_shape_jerk, inline="always")
 def _shape_jerk_overload(t, on, prm):
-    if isinstance(on, types.Boolean):
-        def pulse(t, on, prm):
-            w = prm[PAR_OMEGA]
-            if prm[PAR_SHAPE] == SHAPE_COSINE:
-                return -prm[PAR_AMP] * w * math.sin(w * t)
-            return prm[PAR_AMP] * w * math.cos(w * t)
-        return pulse
-
-    def any_shape(t, on, prm):
-        return ground_jerk_any(t, prm)
-    return any_shape
+    return _pulse_jerk if isinstance(on, types.Boolean) else _any_jerk
 
 
 @njit(cache=True, **INLINE)

@@ -45,12 +45,8 @@ from pathlib import Path
 
 import numpy as np
 
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import RecordError  # noqa: F401 (defined there; re-exported)
 from rocksweep.outputs import check_output, input_problem, shown, write_atomic
-
-
-class RecordError(RocksweepError, ValueError):
-    """A ground-motion record that cannot be read; ``str()`` names the file and line."""
 
 
 @dataclass(frozen=True, eq=False)

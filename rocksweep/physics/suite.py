@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import SuiteError  # noqa: F401 (defined there; re-exported)
 from rocksweep.physics.model import G
 from rocksweep.physics.records import GroundRecord
 from rocksweep.vocab.ground import (  # noqa: F401
@@ -195,9 +195,6 @@ class Suite:
         return {PGA_RATIO: ("alpha_ref",), PGV_RATIO: ("alpha_ref", "p")}.get(
             self.im or "", ())
 
-
-class SuiteError(RocksweepError, ValueError):
-    """A record that cannot be scaled; ``str()`` is one line naming the file."""
 
 
 def make_suite(records: list[GroundRecord], names: list[str], im: str | None,

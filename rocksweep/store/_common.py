@@ -12,15 +12,12 @@ from pathlib import Path
 
 import numpy as np
 
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import StoreError  # noqa: F401 (defined there; re-exported)
 from rocksweep.outputs import _reason, shown
 
 # What h5py raises for I/O and damaged files (HDF5 errors surface as any of these).
 _H5_ERRORS = (OSError, RuntimeError, ValueError, KeyError, TypeError, IndexError)
 
-
-class StoreError(RocksweepError):
-    """A result file that cannot be made, read or resumed; ``str()`` is one line."""
 
 
 def _now() -> str:
