@@ -7,7 +7,6 @@ turns them into a validated ``Scene`` (the Python API's and the command line's w
 from __future__ import annotations
 
 import os
-
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Union
