@@ -447,3 +447,20 @@ def test_the_issues_eight_record_mode2_curve_is_not_ok():
         fr = F.fragility(stripes_ds(out, levels=lv), state="mode2", bootstrap=200)
     assert {"censored", "extrapolated"} <= reasons(fr)
     assert float(fr["im_median"]) > lv.max()
+
+
+def test_the_figure_draws_a_competing_mode_by_its_own_model_not_a_lognormal():
+    from rocksweep.figures.fragility import fragility_figure
+
+    lv = np.geomspace(0.1, 2.0, 12)
+    fr = F.fragility(stripes_ds(competing_outcomes(40, seed=1, levels=lv), levels=lv),
+                     state=["mode1", "mode2"], bootstrap=0, warn=False)
+    med, beta = fr["im_median"].values, fr["beta"].values
+    lines = [ln for ln in fragility_figure(fr).axes[0].get_lines() if len(ln.get_xdata())]
+    assert len(lines) == 2
+    x = np.asarray(lines[1].get_xdata())
+    # mode 2's cumulative incidence, integrated independently (cif_trapezoid): P(C2 <= x,
+    # C2 < C1), well below the lognormal CDF of its own median and beta at high IM
+    _, _, p2 = cif_trapezoid(x, med[0], beta[0], med[1], beta[1], n_u=20001)
+    np.testing.assert_allclose(lines[1].get_ydata(), p2, atol=1e-4)
+    assert np.max(np.abs(norm.cdf(np.log(x / med[1]) / beta[1]) - p2)) > 0.05
