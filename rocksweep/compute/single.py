@@ -15,6 +15,7 @@ from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
 from rocksweep.outcomes import outcome_word, status_words
 from rocksweep.physics.points import Point, kernel_kind, point_row
+from rocksweep.vocab.ground import FREE
 
 
 @dataclass
@@ -134,6 +135,8 @@ def simulate(point: Point, numerics: Numerics, history: bool = True,
     kind runs (what sweeps run), or the contact kernel with ``contact``. ``contact``: the
     summary reports the contact fields."""
     row = point_row(point, numerics)
+    if history and point.shape == FREE:
+        row[L.PAR_TO_REST] = 1.0  # free rocking's history goes on past a rigid bound to rest
     kind = kernel_kind(point.body)
     ground = point.ground
     lvl = L.LEVEL_CONTACT if contact else L.LEVEL_OUTCOME
