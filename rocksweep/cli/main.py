@@ -28,6 +28,13 @@ def cli_words(message: str) -> str:
     return _CLI_WORDS.sub(lambda m: f"--{m.group(1)}", message)
 
 
+class InputError(click.ClickException):
+    """Bad input (a scene value, a file, an argument the library refuses): one line,
+    ``Error: ...``, exit 2 as click's usage errors; nothing was written."""
+
+    exit_code = 2
+
+
 def user_errors(fn):
     """Turn the library's user-facing errors (``RocksweepError``) into one-line click
     errors, in the command line's words (``cli_words``)."""
@@ -37,7 +44,11 @@ def user_errors(fn):
         try:
             return fn(*args, **kwargs)
         except RocksweepError as err:
-            raise click.ClickException(cli_words(one_line(str(err)))) from None
+            raise InputError(cli_words(one_line(str(err)))) from None
+        except click.ClickException as err:
+            if type(err) is click.ClickException:  # a command's own one-line refusal
+                err.exit_code = InputError.exit_code
+            raise
 
     return wrapper
 

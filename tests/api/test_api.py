@@ -344,7 +344,7 @@ def test_dask_cluster_without_workers_is_an_error(tmp_path, monkeypatch, cli):
                                   dashboard_address=None) as cluster:
         res = cli.invoke(main, ["sweep", str(CI_SMALL), "-o", str(out), "-q", "--backend",
                                 "dask", "--scheduler", cluster.scheduler_address])
-    assert res.exit_code == 1
+    assert res.exit_code == 2
     assert res.output.strip().splitlines() == [
         f"Error: dask cluster {cluster.scheduler_address}: no worker joined in 1 s; start "
         f"workers (dask worker {cluster.scheduler_address}), then rerun with --resume"]

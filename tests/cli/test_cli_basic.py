@@ -71,7 +71,7 @@ def test_outputs_refuse_existing_files_and_inputs(cli, tmp_path):
     ]
     for args, path in cases:
         res = cli.invoke(main, args)
-        assert res.exit_code == 1, (args, res.output)
+        assert res.exit_code == 2, (args, res.output)
         assert res.output.strip().splitlines() == [
             f"Error: {path}: already exists; use --overwrite to replace it"], args
     for args in (["simulate", str(scene), "--csv", str(scene), "--overwrite"],

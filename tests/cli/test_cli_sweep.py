@@ -398,4 +398,4 @@ def test_the_command_exits_fast_and_leaves_complete_output(tmp_path):
     assert info.returncode == 0 and json.loads(info.stdout)["points_done"] == 128
     bad = subprocess.run([*run, "info", str(tmp_path / "none.h5")], capture_output=True,
                          text=True, timeout=120)
-    assert bad.returncode == 1 and len(bad.stderr.strip().splitlines()) == 1
+    assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1

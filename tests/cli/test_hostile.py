@@ -48,7 +48,7 @@ def refused(args: list[str], cwd: Path, *words: str) -> str:
     nothing on stdout and no new file in ``cwd``; return the line."""
     before = set(os.listdir(cwd))
     r = run_cli(args, cwd)
-    assert r.returncode == 1, (r.returncode, r.stdout, r.stderr)
+    assert r.returncode == 2, (r.returncode, r.stdout, r.stderr)
     assert "Traceback" not in r.stderr and r.stdout == "", (r.stdout, r.stderr)
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("Error: "), r.stderr

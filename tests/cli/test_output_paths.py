@@ -1,6 +1,6 @@
 """One policy for every file a command writes (rocksweep.outputs), through every command.
 
-Each case: one line naming the path and the reason, exit code 1, no traceback, and nothing
+Each case: one line naming the path and the reason, exit code 2, no traceback, and nothing
 written (issue 16, "Output paths").
 """
 
@@ -21,8 +21,8 @@ ONE_POINT = ["--set", "pulse.shape=sine", "--set", "impact.lam=0", "--set",
 
 
 def one_line(result) -> str:
-    """The single line of a failed CLI run: exit 1, no traceback (``one_line_error``)."""
-    return one_line_error(result, code=1)
+    """The single line of a failed CLI run: exit 2, no traceback (``one_line_error``)."""
+    return one_line_error(result, code=2)
 
 
 @pytest.fixture()

@@ -163,7 +163,7 @@ def test_cli_check_sweep_info_and_resume(cli, tmp_path):
     assert math.isclose(d["t_overturn_diff"]["max"],
                         float(np.abs(ds.check_t_overturn_diff.values[both]).max()))
     r = cli.invoke(main, ["sweep", str(path), "-o", str(out), "--resume"])
-    assert r.exit_code == 1
+    assert r.exit_code == 2
     assert "outputs.check: file true, scene false" in r.output
 
 
@@ -171,7 +171,7 @@ def test_bad_check_value_is_one_line(cli, tmp_path):
     path = tmp_path / "s.yaml"
     path.write_text(SCENE + "outputs: {check: 3}\n")
     r = cli.invoke(main, ["sweep", str(path), "-o", str(tmp_path / "x.h5")])
-    assert "outputs.check = 3: must be true or false" in one_line_error(r, code=1)
+    assert "outputs.check = 3: must be true or false" in one_line_error(r, code=2)
     assert not (tmp_path / "x.h5").exists()
 
 

@@ -234,7 +234,7 @@ def test_suite_sweep_end_to_end(tmp_path, suite_dir, cli):
     assert res.exit_code == 0, res.output
     assert (tmp_path / "p.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     res = cli.invoke(main, ["fragility", str(out), "--state", "topple"])
-    assert res.exit_code == 1 and "state 'topple'" in res.output
+    assert res.exit_code == 2 and "state 'topple'" in res.output
     assert "Traceback" not in res.output
 
     # resume: points lost are computed again, to the same values
@@ -247,7 +247,7 @@ def test_suite_sweep_end_to_end(tmp_path, suite_dir, cli):
     path = suite_dir / "SYN05.AT2"
     path.write_text(path.read_text().replace("\n", "\n ", 1) + "")
     res = cli.invoke(main, ["sweep", str(scene), "-o", str(out), "--resume", "--quiet"])
-    assert res.exit_code == 1
+    assert res.exit_code == 2
     assert "ground.records: SYN05.AT2 changed since the sweep" in res.output
     assert "Traceback" not in res.output
 

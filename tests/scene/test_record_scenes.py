@@ -181,7 +181,7 @@ def test_record_sweep_end_to_end(tmp_path, cli):
     data = (tmp_path / "records" / NEARFAULT.name).read_text().replace(".1", ".2", 1)
     (tmp_path / "records" / NEARFAULT.name).write_text(data)
     res = cli.invoke(main, ["sweep", str(scene), "-o", str(out), "--resume", "--quiet"])
-    assert res.exit_code == 1
+    assert res.exit_code == 2
     assert "ground.record: file synthetic_nearfault (sha256" in res.output
 
 

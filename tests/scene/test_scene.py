@@ -359,7 +359,7 @@ def test_cli_reports_one_line_without_traceback(cli, tmp_path):
     bad = tmp_path / "bad.yaml"
     bad.write_text(sub("w_over_p: 5.3", "w_over_p: 1.0e-9"))
     res = cli.invoke(main, ["simulate", str(bad)])
-    assert res.exit_code == 1
+    assert res.exit_code == 2
     lines = res.output.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in res.output
     assert lines[0].startswith(f"Error: {bad}: pulse.w_over_p = 1e-09: one point could need ")

@@ -74,8 +74,8 @@ def partial_file(path: Path, scene, n_done: int) -> None:
 
 
 def one_line(result) -> str:
-    """The single line of a failed CLI run: exit 1, no traceback (``one_line_error``)."""
-    return one_line_error(result, code=1)
+    """The single line of a failed CLI run: exit 2, no traceback (``one_line_error``)."""
+    return one_line_error(result, code=2)
 
 
 def arrays_of(path: Path) -> dict[str, np.ndarray]:
@@ -149,7 +149,7 @@ def test_grid_larger_than_the_free_space_is_refused_before_writing(tmp_path):
         print(json.dumps({{"rc": r.returncode, "err": r.stderr, "out": r.stdout,
                           "free": free, "left": os.listdir("{fs}")}}))
     """, {})
-    assert out["rc"] == 1 and out["out"] == "" and out["left"] == []
+    assert out["rc"] == 2 and out["out"] == "" and out["left"] == []
     lines = out["err"].strip().splitlines()
     assert len(lines) == 1, out["err"]
     # 45 bytes per point (int8 + 3 int32 + 2 float64 + 2 int64) x 256 points, at least
@@ -455,7 +455,7 @@ def test_read_only_directory_really_read_only(tmp_path):
                              "(read-only location?))")
     assert out["mkstemp"] == (f"{ro}/new.h5: cannot write (permission denied (read-only "
                               "location?)); nothing written")
-    assert out["rc"] == 1 and out["cli"] == f"Error: {ro}/cli.h5: directory {ro} is not " \
+    assert out["rc"] == 2 and out["cli"] == f"Error: {ro}/cli.h5: directory {ro} is not " \
                                             "writable\n"
     assert sorted(p.name for p in ro.iterdir()) == ["old.h5"]
     after = arrays_of(ro / "old.h5")
