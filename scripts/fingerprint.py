@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # the tree this script is in, not an installed copy
 SWEEPS = ["fig3a", "fig3b", "fig4a", "fig4b", "block", "fig4a-rigid", "ci-small"]
 SINGLE = ["fig5", "fig5-rigid"]
 
