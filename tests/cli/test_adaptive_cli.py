@@ -335,20 +335,34 @@ def test_boundaries_csv_a_min_between_grid_values(fig3_files, cli, tmp_path):
         csv, lines, fig = (tmp_path / f"{src.stem}.csv", tmp_path / f"{src.stem}-l.csv",
                            tmp_path / f"{src.stem}.png")
         res = cli.invoke(main, ["boundaries", str(src), "-o", str(csv), "--lines", str(lines),
-                                "--plot", str(fig), "--rtol", "1e-4"])
+                                "--plot", str(fig), "--rtol", "1e-4", "--no-search"])
         assert res.exit_code == 0, res.output
         assert fig.read_bytes().startswith(b"\x89PNG")
         assert lines.read_text().splitlines()[0] == "lam,line,classes,w_over_p,A_ratio"
         outs[src] = csv.read_text()
-    assert outs[full] == outs[adapt]  # the same classes give the same curves
+    # the grid's bracket only: the same classes give the same curves (the search below
+    # the grid reads the response an adaptive file holds only where computed)
+    assert outs[full] == outs[adapt]
     rows = [ln.split(",") for ln in outs[full].splitlines()]
-    assert rows[0] == ["lam", "w_over_p", "A_min", "mode", "upper_bound"]
+    assert rows[0] == ["lam", "w_over_p", "A_min", "mode", "upper_bound", "method"]
+    assert {r[5] for r in rows[1:]} <= {"grid+bisection", "first grid value"}
+    # with the search (the default): never above the grid's bracket, and where nothing was
+    # found below it, the same value as the grid's bracket gives
+    searched = tmp_path / "searched.csv"
+    res = cli.invoke(main, ["boundaries", str(full), "-o", str(searched), "--rtol", "1e-4"])
+    assert res.exit_code == 0, res.output
+    grid_rows = {(r[0], r[1]): r for r in rows[1:]}
+    for r in [ln.split(",") for ln in searched.read_text().splitlines()[1:]]:
+        g = grid_rows[(r[0], r[1])]
+        assert float(r[2]) <= float(g[2]) * (1 + 1e-4), (r, g)
+        if r[5] == "grid+bisection":
+            assert abs(float(r[2]) - float(g[2])) <= 2e-4 * float(g[2]), (r, g)
     r = read_result(full)
     A, W, lam = r.coords["A_ratio"], r.coords["w_over_p"], r.coords["lam"]
     o = r.arrays["outcome"]  # (lam, A_ratio, w_over_p)
     assert len(rows) - 1 == int((o > 0).any(axis=1).sum())
     checked = 0
-    for lv, wv, amin, mode, upper in rows[1:]:
+    for lv, wv, amin, mode, upper, _method in rows[1:]:
         k, j = list(lam).index(float(lv)), list(W).index(float(wv))
         first = int(np.argmax(o[k, :, j] > 0))
         if upper == "True":
@@ -361,7 +375,7 @@ def test_boundaries_csv_a_min_between_grid_values(fig3_files, cli, tmp_path):
 
 
 @pytest.mark.parametrize("edit, message", [
-    ("1d", "a diagram axis must be a swept numeric axis with >= 2 values (has 1)"),
+    ("1d", "pulse.A_ratio = [2.0]: A_min needs a sweep over at least two values of it"),
     ("incomplete", "incomplete result"),
 ])
 def test_boundaries_errors(cli, tmp_path, edit, message):
