@@ -226,17 +226,6 @@ def test_sigkill_and_resume_equals_uninterrupted_run(cli, tmp_path):
     assert res.exit_code == 0 and "computed 0 points" in res.output, res.output
 
 
-# a file with results is never to be written over as the first remedy (issue 32)
-def keep(path) -> str:
-    """The remedy said for a file of ``path``'s points that another scene cannot resume."""
-    from rocksweep.store.reader import read_result
-
-    n = int((read_result(path, ["outcome"]).arrays["outcome"] != -1).sum())
-    assert n > 0
-    return ("resume with the scene, --set values and options it was made with, or sweep "
-            f"this scene to another -o; --overwrite would discard the {n} points it holds)")
-
-
 def test_resume_with_other_settings_is_refused(fig3_files, cli, tmp_path):
     scene, full, adapt, _ = fig3_files
     out = tmp_path / "a.h5"
@@ -245,18 +234,20 @@ def test_resume_with_other_settings_is_refused(fig3_files, cli, tmp_path):
                             "--coarse", "1", "--audit", "0.05"])
     assert one_line_error(res) == (
         f"Error: {out}: cannot resume, the scene differs from the file's: adaptive.coarse: "
-        "file 2, this run 1; adaptive.audit: file 0.02, this run 0.05 (" + keep(out))
+        "file 2, this run 1; adaptive.audit: file 0.02, this run 0.05 (use --overwrite to "
+        "start again)")
     res = cli.invoke(main, ["sweep", str(scene), "-o", str(out), "--resume"])
     assert one_line_error(res) == (
         f"Error: {out}: cannot resume, the scene differs from the file's: adaptive: file "
         "adaptive (--adaptive --axes w_over_p,A_ratio --coarse 2 --audit 0.02 --margin 1 "
-        "--final-margin 0 --seed 0 --threshold 0.002), this run not (" + keep(out))
+        "--final-margin 0 --seed 0 --threshold 0.002), this run not (use --overwrite to "
+        "start again)")
     other = tmp_path / "full.h5"
     other.write_bytes(full.read_bytes())
     res = cli.invoke(main, ["sweep", str(scene), "-o", str(other), "--resume", "--adaptive"])
     assert one_line_error(res) == (
         f"Error: {other}: cannot resume, the scene differs from the file's: adaptive: file "
-        "of every point, this run adaptive (" + keep(other))
+        "of every point, this run adaptive (use --overwrite to start again)")
 
 
 @pytest.mark.parametrize("args, message", [
@@ -344,43 +335,47 @@ def test_boundaries_csv_a_min_between_grid_values(fig3_files, cli, tmp_path):
         csv, lines, fig = (tmp_path / f"{src.stem}.csv", tmp_path / f"{src.stem}-l.csv",
                            tmp_path / f"{src.stem}.png")
         res = cli.invoke(main, ["boundaries", str(src), "-o", str(csv), "--lines", str(lines),
-                                "--plot", str(fig), "--rtol", "1e-4"])
+                                "--plot", str(fig), "--rtol", "1e-4", "--no-search"])
         assert res.exit_code == 0, res.output
         assert fig.read_bytes().startswith(b"\x89PNG")
         assert lines.read_text().splitlines()[0] == "lam,line,classes,w_over_p,A_ratio"
         outs[src] = csv.read_text()
-    # the same classes give the same curves: A_min to the rtol asked (the search below
-    # the grid reads max|theta| and uplifts, which an adaptive file has only where computed)
+    # the grid's bracket only: the same classes give the same curves (the search below
+    # the grid reads the response an adaptive file holds only where computed)
+    assert outs[full] == outs[adapt]
     rows = [ln.split(",") for ln in outs[full].splitlines()]
-    rows_a = [ln.split(",") for ln in outs[adapt].splitlines()]
-    assert rows[0] == rows_a[0] == ["lam", "w_over_p", "A_min", "mode", "upper_bound",
-                                    "method"]
-    assert len(rows) == len(rows_a)
-    for a, b in zip(rows[1:], rows_a[1:], strict=True):
-        assert a[:2] == b[:2] and a[3:5] == b[3:5], (a, b)
-        assert float(a[2]) == pytest.approx(float(b[2]), rel=2e-4), (a, b)
+    assert rows[0] == ["lam", "w_over_p", "A_min", "mode", "upper_bound", "method"]
+    assert {r[5] for r in rows[1:]} <= {"grid+bisection", "first grid value"}
+    # with the search (the default): never above the grid's bracket, and where nothing was
+    # found below it, the same value as the grid's bracket gives
+    searched = tmp_path / "searched.csv"
+    res = cli.invoke(main, ["boundaries", str(full), "-o", str(searched), "--rtol", "1e-4"])
+    assert res.exit_code == 0, res.output
+    grid_rows = {(r[0], r[1]): r for r in rows[1:]}
+    for r in [ln.split(",") for ln in searched.read_text().splitlines()[1:]]:
+        g = grid_rows[(r[0], r[1])]
+        assert float(r[2]) <= float(g[2]) * (1 + 1e-4), (r, g)
+        if r[5] == "grid+bisection":
+            assert abs(float(r[2]) - float(g[2])) <= 2e-4 * float(g[2]), (r, g)
     r = read_result(full)
     A, W, lam = r.coords["A_ratio"], r.coords["w_over_p"], r.coords["lam"]
     o = r.arrays["outcome"]  # (lam, A_ratio, w_over_p)
     assert len(rows) - 1 == int((o > 0).any(axis=1).sum())
     checked = 0
-    for lv, wv, amin, mode, upper, method in rows[1:]:
+    for lv, wv, amin, mode, upper, _method in rows[1:]:
         k, j = list(lam).index(float(lv)), list(W).index(float(wv))
         first = int(np.argmax(o[k, :, j] > 0))
         if upper == "True":
             assert first == 0 and float(amin) == A[0]
             continue
-        if method == "grid+bisection":  # between the last safe and first overturning value
-            assert A[first - 1] < float(amin) <= A[first], (lv, wv)
-        else:  # a band below the grid's first overturning value
-            assert method == "searched below grid" and float(amin) < A[first], (lv, wv)
+        assert A[first - 1] < float(amin) <= A[first], (lv, wv)
         assert mode in ("mode1", "mode2")
         checked += 1
     assert checked > 40
 
 
 @pytest.mark.parametrize("edit, message", [
-    ("1d", "A_min needs a sweep over at least two values of it"),
+    ("1d", "pulse.A_ratio = [2.0]: A_min needs a sweep over at least two values of it"),
     ("incomplete", "incomplete result"),
 ])
 def test_boundaries_errors(cli, tmp_path, edit, message):
