@@ -329,6 +329,7 @@ class Problem:
         except (BodyError, ValueError):
             return None
         row = point_row(point, self.numerics)
+        row[L.PAR_FOLLOW] = 1.0  # a rigid body's history goes on past its bound, to rest
         need = float(self.m.t[-1] - self.t_onset) + row[L.PAR_TPULSE] + 10.0
         if row[L.PAR_TEND] < need:
             row[L.PAR_TEND] = need

@@ -57,7 +57,9 @@ PAR_CLOSE = 40  # OUT_MARGIN below which the run is a close call (read after the
 #                 by ``rocksweep.compute.certify``) [alpha_ref]
 PAR_U0 = 41  # initial u [m] (flexible bodies; with PAR_THETA0, PAR_THETA_DOT0 the state at t = 0)
 PAR_U_DOT0 = 42  # initial u' [m/s]
-N_PAR = 43
+PAR_FOLLOW = 43  # 1: a rigid body proven bounded is followed on to rest (a free-rocking
+#                  history, a calibration), flagged STATUS_BOUNDED; 0: the run ends there
+N_PAR = 44
 # A record's row is longer: its samples xg''/PGA (float64[npts], in [-1, 1]) follow the
 # N_PAR parameters, PAR_REC = N_PAR the first (``points.with_record``).
 PAR_REC = N_PAR

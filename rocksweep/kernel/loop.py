@@ -89,6 +89,7 @@ from rocksweep.kernel.layout import (
     PAR_B,
     PAR_DT,
     PAR_DT_ON,
+    PAR_FOLLOW,
     PAR_G,
     PAR_HCG,
     PAR_M,
@@ -189,9 +190,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     else:
         s = _uplift(t, y, on, prm, out, FLEX, DAMPED)  # at t = 0: a cosine pulse's peak
     _record(hist, t, y, s, on, prm, out, FLEX)
-    # rigid: test rigid_bounded at the next loop top after the pulse; not with a history,
-    # which then goes on to rest (free rocking from a tilt is decided at once otherwise)
-    free_check = hist is None
+    free_check = True  # rigid: test rigid_bounded at the next loop top after the pulse
+    follow = prm[PAR_FOLLOW] != 0.0  # go on past the rigid bound (PAR_FOLLOW)
     # the counters of every step stay in registers (in out: ~3% slower); the rest is in out
     steps, event_steps, theta_max = 0, 0, abs(y[Y_THETA])
     # contact tracker (contact.contact_sample): unused, and removed, without CONTACT
@@ -219,7 +219,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
                 _flag(out, STATUS_REST)
             break
         if t >= t_end:
-            _flag(out, STATUS_HORIZON)
+            if not int(out[OUT_STATUS]) & STATUS_BOUNDED:  # (followed past the bound)
+                _flag(out, STATUS_HORIZON)
             break
         if not FLEX and s != 0 and not on and free_check:
             free_check = False  # E is constant between impacts after the pulse: test once
@@ -229,7 +230,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
                 if peak > theta_max:
                     theta_max = peak
                 _flag(out, STATUS_BOUNDED)
-                break
+                if not follow:
+                    break
         if steps + event_steps >= max_steps:
             _flag(out, STATUS_STEP_CAP)
             break
@@ -296,7 +298,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             y, s = _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY)
             if CONTACT is not None:
                 contact_impact(y_minus, s_minus, y, s, prm, out, FLEX)
-            free_check = hist is None  # (as at the start)
+            free_check = True
         else:  # uplift: theta = theta' = 0 exactly, now rocking on the located corner
             s = 1 if ev == EV_UPLIFT_POS else -1
             y = (0.0, 0.0, y[Y_U], y[Y_U_DOT], y[Y_W_IN], y[Y_D_DAMP])
