@@ -329,11 +329,12 @@ class Problem:
         except (BodyError, ValueError):
             return None
         row = point_row(point, self.numerics)
-        row[L.PAR_FOLLOW] = 1.0  # a rigid body's history goes on past its bound, to rest
+        row[L.PAR_TO_REST] = 1.0  # the whole measured span, past a rigid body's bound
         need = float(self.m.t[-1] - self.t_onset) + row[L.PAR_TPULSE] + 10.0
         if row[L.PAR_TEND] < need:
             row[L.PAR_TEND] = need
-            row[L.PAR_MAXSTEPS] = step_budget(need, row[L.PAR_DT], self.numerics)
+            row[L.PAR_MAXSTEPS] = step_budget(row[L.PAR_TPULSE], need, row[L.PAR_DT],
+                                              row[L.PAR_DT_ON], self.numerics)
         out = np.empty(L.N_OUT)
         hist = np.empty((history_capacity(row), L.N_HIST))
         point_kernel(kernel_kind(point.body), point.ground)(row, out, hist)

@@ -14,7 +14,8 @@ from rocksweep.kernel import chunk_kernel, point_kernel, warm_up
 from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
 from rocksweep.outcomes import outcome_word, status_words
-from rocksweep.physics.points import FREE, Point, kernel_kind, point_row
+from rocksweep.physics.points import Point, kernel_kind, point_row
+from rocksweep.vocab.ground import FREE
 
 
 @dataclass
@@ -134,11 +135,11 @@ def simulate(point: Point, numerics: Numerics, history: bool = True,
     kind runs (what sweeps run), or the contact kernel with ``contact``. ``contact``: the
     summary reports the contact fields."""
     row = point_row(point, numerics)
+    if history and point.shape == FREE:
+        row[L.PAR_TO_REST] = 1.0  # free rocking's history goes on past a rigid bound to rest
     kind = kernel_kind(point.body)
     ground = point.ground
     lvl = L.LEVEL_CONTACT if contact else L.LEVEL_OUTCOME
-    if history and point.shape == FREE:  # free rocking's history goes on to rest
-        row[L.PAR_FOLLOW] = 1.0
     warm_up(kind, None if history else lvl, ground)  # wall_time excludes compilation
     t0 = time.perf_counter()
     out, hist_d = _run(row, kind, lvl, ground, history, contact)

@@ -57,8 +57,10 @@ PAR_CLOSE = 40  # OUT_MARGIN below which the run is a close call (read after the
 #                 by ``rocksweep.compute.certify``) [alpha_ref]
 PAR_U0 = 41  # initial u [m] (flexible bodies; with PAR_THETA0, PAR_THETA_DOT0 the state at t = 0)
 PAR_U_DOT0 = 42  # initial u' [m/s]
-PAR_FOLLOW = 43  # 1: a rigid body proven bounded is followed on to rest (a free-rocking
-#                  history, a calibration), flagged STATUS_BOUNDED; 0: the run ends there
+# 1: a rigid body's run goes on past its analytic bound (rigid_bounded) to rest, for a
+# history to show (free rocking, a calibration); the bound still decides the class
+# (STATUS_BOUNDED, never flagged at the horizon). 0: the run ends at the bound.
+PAR_TO_REST = 43
 N_PAR = 44
 # A record's row is longer: its samples xg''/PGA (float64[npts], in [-1, 1]) follow the
 # N_PAR parameters, PAR_REC = N_PAR the first (``points.with_record``).

@@ -89,7 +89,6 @@ from rocksweep.kernel.layout import (
     PAR_B,
     PAR_DT,
     PAR_DT_ON,
-    PAR_FOLLOW,
     PAR_G,
     PAR_HCG,
     PAR_M,
@@ -102,6 +101,7 @@ from rocksweep.kernel.layout import (
     PAR_TEND,
     PAR_THETA0,
     PAR_THETA_DOT0,
+    PAR_TO_REST,
     PAR_TPULSE,
     PAR_U0,
     PAR_U_DOT0,
@@ -190,8 +190,9 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     else:
         s = _uplift(t, y, on, prm, out, FLEX, DAMPED)  # at t = 0: a cosine pulse's peak
     _record(hist, t, y, s, on, prm, out, FLEX)
-    free_check = True  # rigid: test rigid_bounded at the next loop top after the pulse
-    follow = prm[PAR_FOLLOW] != 0.0  # go on past the rigid bound (PAR_FOLLOW)
+    # rigid: test rigid_bounded at the next loop top after the pulse (PAR_TO_REST: then go
+    # on to rest; a history of free rocking from a tilt would end at once otherwise)
+    free_check = True
     # the counters of every step stay in registers (in out: ~3% slower); the rest is in out
     steps, event_steps, theta_max = 0, 0, abs(y[Y_THETA])
     # contact tracker (contact.contact_sample): unused, and removed, without CONTACT
@@ -219,7 +220,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
                 _flag(out, STATUS_REST)
             break
         if t >= t_end:
-            if not int(out[OUT_STATUS]) & STATUS_BOUNDED:  # (followed past the bound)
+            if not int(out[OUT_STATUS]) & STATUS_BOUNDED:  # else: decided, went on to show
                 _flag(out, STATUS_HORIZON)
             break
         if not FLEX and s != 0 and not on and free_check:
@@ -230,7 +231,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
                 if peak > theta_max:
                     theta_max = peak
                 _flag(out, STATUS_BOUNDED)
-                if not follow:
+                if prm[PAR_TO_REST] == 0.0:
                     break
         if steps + event_steps >= max_steps:
             _flag(out, STATUS_STEP_CAP)
