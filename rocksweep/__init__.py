@@ -19,6 +19,10 @@ The Python API (see the README's "Python API"):
   every IM (which IM explains overturning best); ``rocksweep.table(ds)`` -> DataFrame, one
   row per run.
   Each analysis takes what ``run`` and ``open`` return.
+- ``rocksweep.calibrate(scene, measured, fit=["impact.lam"], bounds=)`` -> Dataset of the
+  fitted keys (estimate, lo, hi, misfit) of a measured history;
+  ``rocksweep.calibrated_overrides(fit)``: overrides that sweep the scene at the estimate
+  and the interval's ends.
 - ``rocksweep.RocksweepError``: the base of every error a user can fix (one line).
 
 Importing the package is light: numba, h5py, xarray and matplotlib load on first use.
@@ -29,6 +33,8 @@ from __future__ import annotations
 from rocksweep.api import (  # noqa: A004
     boundaries,
     boundary_lines,
+    calibrate,
+    calibrated_overrides,
     estimate,
     fragility,
     ida,
@@ -71,6 +77,6 @@ def __getattr__(name: str) -> str:
     raise AttributeError(f"module 'rocksweep' has no attribute {name!r}")
 
 
-__all__ = ["RocksweepError", "__version__", "boundaries", "boundary_lines", "estimate",
-           "fragility", "ida", "im_efficiency", "open", "plot", "risk", "run", "simulate",
-           "spectra", "table"]
+__all__ = ["RocksweepError", "__version__", "boundaries", "boundary_lines", "calibrate",
+           "calibrated_overrides", "estimate", "fragility", "ida", "im_efficiency", "open",
+           "plot", "risk", "run", "simulate", "spectra", "table"]

@@ -56,6 +56,10 @@ class RocksweepAccessor:
         """``rocksweep.table(ds)``: one row per run (a DataFrame)."""
         return self._fn["table"](self._ds)
 
+    def as_overrides(self, which: str = "all") -> dict[str, Any]:
+        """``rocksweep.calibrated_overrides(ds, which)`` of a calibration Dataset."""
+        return self._fn["calibrated_overrides"](self._ds, which)
+
     def outcome_words(self) -> Any:
         """``outcome`` as words (not_run, safe, mode1, mode2), an object DataArray."""
         import numpy as np

@@ -14,7 +14,7 @@ still importable from here (``api.load``, ``api.sweep_file``, ...: PEP 562).
 from __future__ import annotations
 
 import sys
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -32,6 +32,7 @@ if TYPE_CHECKING:
 
     from rocksweep.compute.single import Run
     from rocksweep.scene.inputs import Overrides, SceneLike
+    from rocksweep.scene.model import Scene
 
 # Names that moved to their rooms, importable from here as before (loaded on first use).
 _MOVED = {
@@ -180,7 +181,8 @@ def _register() -> None:
     from rocksweep.accessor import register_accessor
 
     register_accessor({f.__name__: f for f in (plot, boundaries, boundary_lines, spectra,
-                                               fragility, ida, risk, im_efficiency, table)})
+                                               fragility, ida, risk, im_efficiency, table,
+                                               calibrated_overrides)})
 
 
 def _loaded(source: Path | Any) -> xr.Dataset:
@@ -277,26 +279,35 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
 
 
 @speaks_python
-def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None) -> xr.Dataset:
+def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None,
+               search: bool = True) -> xr.Dataset:
     """A_min: the smallest amplitude (A_ratio) that overturns, for every x (w_over_p or
-    p) of the diagram, bisected to the relative tolerance ``rtol`` between the last safe
-    and the first overturning grid value with kernel runs at the sweep's accuracy.
+    p) of the diagram to the relative tolerance ``rtol`` (in (0, 0.1]), whatever the grid's
+    spacing: a search below the first overturning grid value (near the uplift threshold
+    and where the response came close) and a bisection, with kernel runs at the sweep's
+    accuracy; ``A_min_method`` says how each value was found. search=False: the bisection
+    between the grid's first overturning value and the one below only (faster, but A_min
+    then depends on the grid).
 
     ds: a complete result (``run`` / ``open``) with a diagram over (w_over_p, A_ratio).
-    mode: 1 or 2 for that overturning mode only. Returns a Dataset: ``A_min`` (NaN: no
-    grid value of the column overturns), ``mode``, the final bracket ``lo``/``hi`` and
-    the kernel ``runs``, over every other swept key (e.g. shape, lam) and x. The class
+    mode: 1 or 2 for that overturning mode only. Returns a Dataset: ``A_min`` (NaN: none
+    found), ``mode``, ``A_min_method`` ("grid+bisection", "searched below grid", "first
+    grid value" (an upper bound), "not found"), the final bracket ``lo``/``hi`` and the
+    kernel ``runs``, over every other swept key (e.g. shape, lam) and x. The class
     boundary polylines: ``boundary_lines(ds)``.
     """
     from rocksweep.analysis import boundaries as bd
     from rocksweep.store.reader import as_result
 
-    check_rtol(rtol)
+    rtol = check_rtol(rtol)
     if mode not in (None, 1, 2):
         raise ApiError(f"mode = {mode!r}: must be None, 1 or 2")
-    result = as_result(ds, ["outcome"])
-    curves, _ = bd.result_curves(result, rtol, mode)
+    if not isinstance(search, bool):
+        raise ApiError(f"search = {search!r}: must be True or False")
+    result = as_result(ds, list(bd.RESPONSE))
+    curves, _ = bd.result_curves(result, rtol, mode, search=search)
     return bd.curves_dataset(curves, {"title": result.name, "rtol": rtol,
+                                      "search": int(search),
                                       "mode": "any" if mode is None else f"mode{mode}"})
 
 
@@ -320,8 +331,9 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3) -> xr.Dataset:
     A_ratio, p), ``A_min`` and ``mode`` over (lam, p), A_min bisected to ``rtol``."""
     from rocksweep.analysis.spectrum import spectra as compute_spectra
 
-    check_rtol(rtol)
-    return compute_spectra(ds, rtol).to_dataset()
+    out = compute_spectra(ds, check_rtol(rtol)).to_dataset()
+    out.attrs["rocksweep_kind"] = "spectra"  # rocksweep.plot's dispatch (analysis.kinds)
+    return out
 
 
 @speaks_python
@@ -331,10 +343,21 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
     record, bisected to ``rtol`` between the last stripe below the first overturning one
     and that stripe (kernel runs at the sweep's accuracy), and whether a higher stripe is
     safe again (``resurrection``). ds: what ``run`` or ``open`` returns. Returns a Dataset
-    over the other swept keys and ``record`` (``rocksweep.analysis.ida.ida``)."""
+    over the other swept keys and ``record`` (``rocksweep.analysis.ida.ida``), with the
+    stripes' ``theta_max_over_alpha`` of the points that did not overturn (the IDA
+    curves ``rocksweep.plot`` draws)."""
     from rocksweep.analysis.ida import ida as run_ida
 
-    return run_ida(ds, rtol)
+    out = run_ida(ds, rtol)
+    out.attrs["rocksweep_kind"] = "ida"  # rocksweep.plot's dispatch (analysis.kinds)
+    im = out.attrs.get("im")
+    if hasattr(ds, "data_vars") and "theta_max_over_alpha" in ds.data_vars and im in ds.dims:
+        # the IDA curves on the stripes (max|theta|/alpha against the IM, per record, NaN
+        # where a point overturned): what the figure draws
+        theta = ds["theta_max_over_alpha"].where(ds["outcome"] == 0)
+        out["theta_max_over_alpha"] = theta.drop_vars(
+            [c for c in theta.coords if c not in theta.dims])
+    return out
 
 
 @speaks_python
@@ -378,6 +401,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
                        "or rocksweep.open)")
     frag = fit(ds, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci)
     frag.attrs["title"] = str(ds.attrs.get("title", ""))
+    frag.attrs["rocksweep_kind"] = "fragility"  # rocksweep.plot's dispatch (analysis.kinds)
     return frag
 
 
@@ -504,8 +528,64 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
 
 
 # ---------------------------------------------------------------------------------------
-# ds.rocksweep: the analyses as methods of a result Dataset (as rioxarray's ``.rio``),
-# registered when ``run`` or ``open`` first imports xarray (``import rocksweep`` stays light)
+# Calibration (issue 30): scene numbers fitted to a measured history
 # ---------------------------------------------------------------------------------------
 
+@speaks_python
+def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impact.lam",),
+              *, bounds: Mapping[str, Sequence[float]] | None = None,
+              overrides: Overrides = (), ci: float = 0.95, p: float | None = None
+              ) -> xr.Dataset:
+    """Fit scene numbers (``impact.lam``, ``impact.e`` under law constant,
+    ``impact.e_factor``, ``body.zeta``, ...) to a measured rocking history.
 
+    measured: a CSV path or a pandas DataFrame with columns p_t, theta_over_alpha (as
+    ``simulate --csv`` writes), or t [s], theta [rad] (then p [rad/s]: the keyword, a
+    physical body's or a record scene's ground.p). bounds: {key: (lo, hi)} inside each
+    key's admissible range (default: ``analysis.calibrate.DEFAULT_BOUNDS`` or the range).
+    Returns a Dataset over ``parameter`` (the fitted keys): ``estimate``, ``lo``, ``hi``
+    (the ``ci`` interval by profile likelihood, ``ci`` in attrs), scalar ``misfit`` (RMS
+    error of the half-cycle peaks, theta/alpha_ref), and the measured and fitted
+    histories over p_t with the fitted impacts (``rocksweep.analysis.calibrate``).
+    """
+    from rocksweep.analysis.calibrate import CalibrationError, Problem, calibrate_problem
+    from rocksweep.physics.measured import read_measured
+
+    keys = [fit] if isinstance(fit, str) else list(fit)
+    if not keys:
+        raise CalibrationError("fit = []: give at least one key, e.g. impact.lam")
+    if len(set(keys)) < len(keys):
+        raise CalibrationError(f"fit = {keys}: a key is given twice")
+    if not (isinstance(ci, float | int) and 0.5 <= ci < 1):
+        raise CalibrationError(f"ci = {ci!r}: must be in [0.5, 1)")
+    from rocksweep.scene.inputs import load
+
+    sc, _ = load(scene, overrides)
+    p_body = _body_p(sc) if p is None else float(p)
+    values = {a.name: a.values[0] for a in sc.axes}
+    body = sc.point(values).body
+    m = read_measured(measured, p=p_body, alpha_ref=body.alpha_ref, u_cr=body.u_cr or None)
+    fit = calibrate_problem(Problem(sc, m, keys, bounds), float(ci))
+    _register()  # fit.rocksweep.as_overrides()
+    return fit
+
+
+def _body_p(scene: Scene) -> float | None:
+    """The body's p [rad/s] a scene knows (a physical body's, a record scene's ground.p),
+    else None."""
+    if scene.physical is not None:
+        return scene.physical["p"]
+    names = {a.name: a for a in scene.axes}
+    if "p" in names and len(names["p"].values) == 1:
+        return float(names["p"].values[0])
+    return None
+
+
+def calibrated_overrides(fit: xr.Dataset, which: str = "all") -> dict[str, Any]:
+    """Overrides {key: value} of a calibration (``calibrate``'s Dataset) to sweep a scene
+    at the estimate and at both ends of the interval: ``which="all"`` gives [lo, estimate,
+    hi] per key (a swept dimension), "estimate", "lo" or "hi" one value.
+    ``rocksweep.run(scene, overrides=rocksweep.calibrated_overrides(fit))``."""
+    from rocksweep.analysis.calibrate import calibrated_overrides as overrides_of
+
+    return overrides_of(fit, which)

@@ -105,6 +105,14 @@ class ApiError(RocksweepError, ValueError):
     """An argument of the Python API that cannot be used (api)."""
 
 
+class MeasuredError(RocksweepError, ValueError):
+    """A measured history that cannot be used (physics.measured)."""
+
+
+class CalibrationError(RocksweepError, ValueError):
+    """A calibration that cannot run as asked (analysis.calibrate)."""
+
+
 # ---------------------------------------------------------------------------------------
 # Argument checks shared by every layer, written once with one wording
 # ---------------------------------------------------------------------------------------
@@ -121,10 +129,15 @@ def check_integer(name: str, v: Any, error: type[Exception] = TypeError) -> int:
     return int(v)
 
 
-def check_rtol(rtol: Any, error: type[Exception] = ApiError) -> float:
-    """A bisection's relative tolerance as a float in (0, 1), or ``error`` (one line)."""
-    if isinstance(rtol, bool) or not isinstance(rtol, numbers.Real) or not 0 < rtol < 1:
-        raise error(f"rtol = {rtol!r}: must be a relative tolerance in (0, 1)")
+MAX_RTOL = 0.1  # rtol is in (0, MAX_RTOL]: a "minimum" looser than 10% is not one
+
+
+def check_rtol(rtol: Any, error: type[Exception] = ApiError, name: str = "rtol") -> float:
+    """A bisection's relative tolerance as a float in (0, MAX_RTOL], or ``error`` (one line
+    naming ``name``: ``rtol`` in Python, ``--rtol`` on the command line)."""
+    if (isinstance(rtol, bool) or not isinstance(rtol, numbers.Real)
+            or not 0 < rtol <= MAX_RTOL):
+        raise error(f"{name} = {rtol!r}: must be a relative tolerance in (0, {MAX_RTOL:g}]")
     return float(rtol)
 
 

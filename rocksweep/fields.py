@@ -65,7 +65,7 @@ class Field:
         return self.label or self.meaning
 
 
-_FLAGGED = "status & (horizon | step_cap | event_cap | nonfinite)"
+_FLAGGED = "status & (horizon | step_cap | event_cap | nonfinite | uncertified)"
 
 FIELDS: tuple[Field, ...] = (
     Field("outcome", "int8", L.OUTCOME_NOT_RUN, "1",
@@ -129,6 +129,11 @@ FIELDS: tuple[Field, ...] = (
           "smallest normal reaction N/(M g) over the run (< 0: the body would lift off)",
           L.OUT_N_MIN, contact=True,
           label="smallest normal reaction", symbol="N_min/(M g)"),
+    Field("saddle_margin", "float64", math.nan, "alpha_ref",
+          "closest approach of the free rocking to the overturning saddle (inf: never "
+          "within 0.5); below 0.05 the run is a close call, re-run finer "
+          "(rocksweep.compute.certify)", L.OUT_MARGIN, stored=False,
+          label="closest approach to the overturning saddle"),
     Field("impulse_ratio_max", "float64", math.nan, "1",
           "largest |horizontal|/vertical ground impulse of an impact (0: no impact)",
           L.OUT_IMPULSE_MAX, contact=True,
@@ -183,13 +188,15 @@ def variables(energy: bool = False, contact: bool = False, check: bool = False
 THETA_REL_FLOOR = 1e-2
 
 
-# Row slots a half-step rerun (outputs.check) changes, and by what factor: the RK4 step
-# (PAR_REC_H, the step while a record acts, stays a whole fraction of its sample interval),
-# the rotation limit of one rocking step, and the evaluation budget, which the halved step
-# doubles. Dividing by 2 is exact in float64, so the rerun is the run at twice the
-# steps_per_period and half the rotation_step, bit for bit.
-CHECK_SCALE: dict[int, float] = {L.PAR_DT: 0.5, L.PAR_REC_H: 0.5, L.PAR_ROT_STEP: 0.5,
-                                 L.PAR_MAXSTEPS: 2.0}
+# Row slots a half-step rerun (outputs.check) changes, and by what factor: the RK4 steps
+# after and while the ground moves (PAR_DT, PAR_DT_ON; PAR_REC_H, the step while a record
+# acts, stays a whole fraction of its sample interval), the rotation limit of one rocking
+# step, the evaluation budget, which the halved step doubles, and the close-call margin
+# (``numerics.close_margin``). Powers of 2 are exact in float64, so the rerun is the run at
+# twice the steps_per_period and pulse_steps and half the rotation_step, bit for bit.
+CHECK_SCALE: dict[int, float] = {L.PAR_DT: 0.5, L.PAR_DT_ON: 0.5, L.PAR_REC_H: 0.5,
+                                 L.PAR_ROT_STEP: 0.5, L.PAR_MAXSTEPS: 2.0,
+                                 L.PAR_CLOSE: 0.5 ** 2.5}
 
 
 def check_rows(rows: np.ndarray) -> np.ndarray:

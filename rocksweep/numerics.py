@@ -19,15 +19,20 @@ import numpy as np
 # every preset (`rocksweep accuracy configs/fig3a.yaml --points 1000 --ladder roots`).
 ROOTS = ("bisection", "illinois", "hermite")
 
-# name -> (steps_per_period, event_tol). Measured with `rocksweep accuracy FIG.yaml
-# --points 1000 --ladder candidates` on configs/fig3a, fig3b, fig4a, fig4b and
-# `python scripts/accuracy_tables.py` (README, "Accuracy and its price"). `default` is the
-# cheapest setting whose outcomes agree with the reference on >= 99.5% of each scene's
-# points, also with two standard errors of the sample off (99.69% or more on all four);
-# `draft` is the smallest step allowed (4), ~6% cheaper, >= 99.59% on the four; `fine`
-# agrees on every sampled point, with errors ~1e-5 (p*t, theta/alpha_cg). event_tol 1e-5
-# and above keep chattering above the rest rate (runs hit the event cap). The presets were
-# chosen with bisection; the Hermite finder gives the same outcomes at half the time.
+# name -> (steps_per_period, event_tol). A preset is these with rotation_step
+# (PRESET_ROTATION), pulse_steps (PRESET_PULSE) and refine (PRESET_REFINE).
+#
+# Issue 28 (the step follows what acts, close calls certified): `default` classifies the
+# four figures like `fine` on all but 0/0/0/1 of their 19 200 cells each (the rule before
+# it: 72/32/1/2), at 1.4-6.6% more RK4 evaluations than that rule
+# (`python scripts/bench_step_rule.py`), and the held-out-style spectra (blocks alpha
+# 0.1/0.25/0.4, three flexible bodies, sine and cosine, omega/p 1-12, A/(g tan alpha) to
+# 30 on a 1000-value grid) like `fine` on every curve's first overturning value and mode.
+# `draft` is the smallest step allowed (4) with the pulse at 10 steps and no
+# certification; `fine` 20 steps per period, the pulse at 40, event_tol 1e-8; the agreement
+# of each with the reference and its price: README, "Accuracy and its price"
+# (`rocksweep accuracy FIG.yaml --points 1000 --ladder roots`, `scripts/accuracy_tables.py`).
+# event_tol 1e-5 and above keep chattering above the rest rate (runs hit the event cap).
 #
 # `accurate` (issue 15) is fit for every stored quantity far outside the paper's region:
 # the 95th percentile of the overturning-time error is below 0.05 p*t and of the safe runs'
@@ -35,9 +40,8 @@ ROOTS = ("bisection", "illinois", "hermite")
 # wide_space.py --seed 2 and 3) and on the stratified sample of configs/wide-space.yaml
 # (`rocksweep accuracy configs/wide-space.yaml --points 300 --ladder presets`), where 8
 # steps per period left the overturning time at 0.086 p*t (lam = 1.5: energy-gaining
-# impacts). `default` keeps 5 steps per period (the paper's figures may not get more than
-# ~10% slower) and meets neither there; `sweep --check` stores a per-point estimate of
-# what it misses.
+# impacts). `default` keeps 5 steps per period and meets neither there; `sweep --check`
+# stores a per-point estimate of what it misses.
 PRESETS: dict[str, tuple[int, float]] = {
     "draft": (4, 1e-6),
     "default": (5, 1e-6),
@@ -59,6 +63,29 @@ PRESET_ROTATION: dict[str, float] = {
     "default": 0.25,
     "fine": 0.1,
     "accurate": 0.1,
+}
+
+# name -> pulse_steps: RK4 steps per pulse period while the pulse acts (at least
+# steps_per_period; ``step_sizes``). At 5 (the rule before issue 28) the pulse's work on a
+# uniform block (alpha 0.25, sine, omega/p = 8) was ~2% off and its mode-1 band A/(g tan
+# alpha) in [10.86, 11.41] (the reference's) vanished; 10 finds [10.87, 11.40], 12 and
+# more [10.86, 11.41] (scanned at steps of 0.01). On blocks at omega/p 3-12 (A to 30),
+# 12 differs from `fine` on 3 of 18 000 cells (5: 17), for 11% more RK4 evaluations than
+# 5; on the four figures it costs 1-3%.
+PRESET_PULSE: dict[str, int] = {
+    "draft": 10,
+    "default": 12,
+    "fine": 40,
+    "accurate": 20,
+}
+
+# name -> refine: most refinements (2x, 4x, ... the steps) of a close call before its
+# outcome is called uncertified (``rocksweep.compute.certify``; 0: no certification).
+PRESET_REFINE: dict[str, int] = {
+    "draft": 0,
+    "default": 3,
+    "fine": 3,
+    "accurate": 3,
 }
 
 # Smallest event_tol [p*t] a scene may ask for. An event's time is t0 + tau in float64; at
@@ -86,7 +113,12 @@ MAX_POINT_STEPS = 1e8
 class Numerics:
     """Resolved numerical settings of a run (all times in p*t).
 
-    steps_per_period: RK4 steps per shortest time scale of the point, see ``step_size``.
+    steps_per_period: RK4 steps per shortest time scale of the body (its spring while it
+        rocks, its rocking), and of the pulse's amplitude while it acts: ``step_sizes``.
+    pulse_steps: RK4 steps per pulse period while the pulse acts (the larger of this and
+        steps_per_period counts; after the pulse its period sets no step): ``step_sizes``.
+    refine: most refinements of a close call (each doubling every step), until its outcome
+        is stable (``rocksweep.compute.certify``); 0: no certification.
     event_tol: width [p*t] to which an event's time is bracketed.
     horizon: how long after the pulse's end a run may go on [p*t] before it is flagged.
     rest_rate: post-impact |theta'| / (p * alpha_cg) below which the body settles into full
@@ -108,56 +140,120 @@ class Numerics:
     max_steps_factor: float = 20.0
     root: str = "hermite"
     rotation_step: float = PRESET_ROTATION["default"]
+    pulse_steps: int = PRESET_PULSE["default"]
+    refine: int = PRESET_REFINE["default"]
 
     @classmethod
     def preset(cls, accuracy: str = "default", **overrides) -> Numerics:
         spp, tol = PRESETS[accuracy]
         return replace(cls(accuracy=accuracy, steps_per_period=spp, event_tol=tol,
-                           rotation_step=PRESET_ROTATION[accuracy]), **overrides)
+                           rotation_step=PRESET_ROTATION[accuracy],
+                           pulse_steps=PRESET_PULSE[accuracy],
+                           refine=PRESET_REFINE[accuracy]), **overrides)
 
     def describe(self) -> str:
         label = self.accuracy
         base = PRESETS.get(self.accuracy)
         if base is None or base != (self.steps_per_period, self.event_tol) or (
-                PRESET_ROTATION[self.accuracy] != self.rotation_step):
+                PRESET_ROTATION[self.accuracy] != self.rotation_step) or (
+                PRESET_PULSE[self.accuracy] != self.pulse_steps) or (
+                PRESET_REFINE[self.accuracy] != self.refine):
             label = "custom"
         return (f"{label} (steps_per_period={self.steps_per_period}, "
+                f"pulse_steps={self.pulse_steps}, "
                 f"event_tol={self.event_tol:g}, rotation_step={self.rotation_step:g}, "
-                f"horizon={self.horizon:g}, root={self.root})")
+                f"refine={self.refine}, horizon={self.horizon:g}, root={self.root})")
+
+    def refined(self, level: int) -> Numerics:
+        """These numerics at 2**level times the steps: a close call's rerun at that
+        refinement (``compute.certify.refine_rows`` scales the rows the same way)."""
+        f = 2 ** level
+        return replace(self, steps_per_period=self.steps_per_period * f,
+                       pulse_steps=self.pulse_steps * f,
+                       rotation_step=self.rotation_step / f, refine=0)
 
     def as_dict(self) -> dict:
         return asdict(self)
 
 
-def step_size(omega_rock: np.ndarray | float, omega: np.ndarray | float,
-              steps_per_period: int, omega_amp: np.ndarray | float = 0.0) -> np.ndarray:
-    """RK4 step [p*t]: the shortest period of the point over ``steps_per_period``.
+# The spring's steps (``step_sizes``): steps_per_period per spring period resolve a spring
+# of OMEGA_SPRING x p (Figure 4's body, omega_rock/p = 27.5: its outcomes at 5 steps are
+# those of `fine` but for 1 and 2 cells of 19 200); a softer spring holds more of the
+# energy, ~(p/omega_rock)^2, and RK4 takes ~n^-5 of it per unit time at n steps per
+# period (its numerical damping), so it gets (OMEGA_SPRING/omega_rock)^(2/5) times the
+# steps: the same error in the energy. Figure 3(a)'s spring (6.8) gets 1.75x: 73 cells
+# that went safe where `fine` overturns (mode 1) became 2, for 0% more RK4 evaluations
+# (the rotation limit sets most of its rocking steps).
+OMEGA_SPRING = 27.5
 
-    The periods are the top mass's spring period while the base rocks (2 pi/omega_rock,
-    the stiffest the kernel meets; inf for a rigid body), the pulse period 2 pi/omega,
-    the rocking period scale 2 pi/p (= 2 pi) and the pulse's own rocking time scale
-    2 pi/omega_amp (``amplitude_frequency``; 0 leaves it out). A stiff spring or a pulse
-    far above the uplift threshold thus gets a smaller step. While the body rocks, the
-    kernel shortens it further so that one step turns the body by at most
-    ``Numerics.rotation_step`` x alpha_cg (PAR_ROT_STEP, ``rocksweep.kernel.loop``).
+
+def spring_steps(omega_rock: np.ndarray | float, steps_per_period: int) -> np.ndarray:
+    """RK4 steps per spring period 2 pi/omega_rock: steps_per_period x
+    max(1, (OMEGA_SPRING/omega_rock)^(2/5)) (omega_rock [rad/s], p = 1; see OMEGA_SPRING)."""
+    w = np.asarray(omega_rock, float)
+    with np.errstate(divide="ignore"):
+        f = np.maximum(1.0, (OMEGA_SPRING / w) ** 0.4)
+    return steps_per_period * f
+
+
+def step_sizes(omega_rock: np.ndarray | float, omega: np.ndarray | float,
+               steps_per_period: int, pulse_steps: int = 0,
+               omega_amp: np.ndarray | float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """The RK4 steps [p*t] of a run: (dt, dt_on), after and while the ground moves.
+
+    The step follows the time scales that act at each moment. Always: the top mass's
+    spring period while the base rocks (2 pi/omega_rock, the stiffest the kernel meets;
+    inf for a rigid body) over ``spring_steps`` and the rocking period scale 2 pi/p
+    (= 2 pi) over ``steps_per_period``: that is dt. While the pulse (or record) acts, also
+    its period 2 pi/omega over max(pulse_steps, steps_per_period) and the pulse's own
+    rocking time scale 2 pi/omega_amp (``amplitude_frequency``; 0 leaves it out) over
+    steps_per_period: dt_on <= dt. A short, strong pulse thus gets the steps its work on
+    the body needs (at 5 steps per pulse period that work is ~2% off, enough to flip
+    outcomes: issue 28), and the free rocking after it is not stepped at the pulse's rate.
+    While the body rocks, the kernel shortens either further so that one step turns the
+    body by at most ``Numerics.rotation_step`` x alpha_cg (PAR_ROT_STEP,
+    ``rocksweep.kernel.loop``). omega = 0 (a record: no period) leaves the pulse out.
     """
     two_pi = 2 * math.pi
-    with np.errstate(divide="ignore"):
-        periods = np.minimum(np.minimum(two_pi / np.asarray(omega_rock, float),
-                                        two_pi / np.asarray(omega, float)), two_pi)
-        periods = np.minimum(periods, two_pi / np.asarray(omega_amp, float))
-    return periods / steps_per_period
+    n_on = max(int(pulse_steps), int(steps_per_period))
+    w = np.asarray(omega_rock, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        spring = np.where(w > 0.0, two_pi / (w * spring_steps(w, steps_per_period)), np.inf)
+        free = np.minimum(spring, two_pi / steps_per_period)
+        on = np.minimum(free, two_pi / np.asarray(omega, float) / n_on)
+        on = np.minimum(on, two_pi / np.asarray(omega_amp, float) / steps_per_period)
+    return free, on
 
 
-def step_budget(t_end: np.ndarray | float, dt: np.ndarray | float,
+def step_budget(t_pulse: np.ndarray | float, t_end: np.ndarray | float,
+                dt: np.ndarray | float, dt_on: np.ndarray | float,
                 numerics: Numerics) -> np.ndarray:
     """Cap on the RK4 evaluations of one run (the kernel's PAR_MAXSTEPS).
 
-    max_steps_factor x the regular steps of a run to t_end [p*t] at step dt [p*t], plus
-    EVENT_STEP_ALLOWANCE re-integrations for each of max_events events.
+    max_steps_factor x the regular steps of a run to t_end [p*t] (the pulse's t_pulse at
+    step dt_on, the rest at dt, all [p*t]), plus EVENT_STEP_ALLOWANCE re-integrations for
+    each of max_events events.
     """
-    return numerics.max_steps_factor * np.ceil(np.asarray(t_end) / dt) + EVENT_STEP_ALLOWANCE * (
-        numerics.max_events)
+    t_pulse = np.minimum(np.asarray(t_pulse, float), np.asarray(t_end, float))
+    steps = np.ceil(t_pulse / dt_on) + np.ceil((np.asarray(t_end) - t_pulse) / dt)
+    return numerics.max_steps_factor * steps + EVENT_STEP_ALLOWANCE * numerics.max_events
+
+
+# The margin (OUT_MARGIN, alpha_ref) below which a run is a close call, re-run finer
+# (``close_margin``), at 5 steps per period. Measured on the four figures at `default`
+# against `fine` (scripts/bench_certify.py): the outcomes that differ before the
+# certification came within 0.005 of the saddle (Figure 3(a), with the spring's steps of
+# ``spring_steps``; 0.044 at 5 steps per spring period), 0.003 on Figures 4(a)/(b).
+CLOSE_MARGIN = 0.0125
+
+
+def close_margin(steps_per_period: int) -> float:
+    """How close [alpha_ref] the free rocking may come to the overturning saddle before a
+    run counts as a close call (the kernel's PAR_CLOSE): CLOSE_MARGIN at 5 steps per
+    period, (5/steps_per_period)^(5/2) of it at more (the energy's error falls as the
+    step^5 per unit time, the margin it can flip, ~ sqrt(|E - E_barrier|/E_ref), as its
+    square root)."""
+    return CLOSE_MARGIN * (5.0 / steps_per_period) ** 2.5
 
 
 def amplitude_frequency(A_ratio: np.ndarray | float, alpha_ref: np.ndarray | float

@@ -73,7 +73,8 @@ def _one_of(words: tuple[str, ...]) -> str:
 
 KEYS: dict[str, Key] = {
     "name": Key("string", "must be a string (the scene's title)", required=False),
-    "body.kind": Key("choice", "must be one of flexible, block", choices=("flexible", "block"),
+    "body.kind": Key("choice", "must be one of flexible, block, physical",
+                     choices=("flexible", "block", "physical"),
                      required=False, default="flexible"),
     # flexible body: Table 1's Pi groups
     "body.wn_over_p": Key("axis", f"must be in {_RATIO} (omega_n/p), or .inf for a rigid body",
@@ -90,6 +91,24 @@ KEYS: dict[str, Key] = {
     # would give exactly that only if concentrated at the centre of gravity).
     "body.inertia": Key("axis", f"must be in [1, {RATIO_MAX:g}] (I_O / (M R^2) >= 1)",
                         1.0, RATIO_MAX, required=False, default=4.0 / 3.0),
+    # a body from the laboratory's numbers (body.kind physical): converted to the Pi groups
+    # above and p (rocksweep.physics.model.body_from_geometry)
+    "body.b": Key("number", "must be > 0 and finite (half-width of the base [m])", 0.0,
+                  math.inf, lo_in=False, hi_in=False),
+    "body.h": Key("number", "must be > 0 and finite (height of the top mass [m])", 0.0,
+                  math.inf, lo_in=False, hi_in=False),
+    "body.h_A": Key("number", "must be > 0 and finite (height of the base's centroid A [m])",
+                    0.0, math.inf, lo_in=False, hi_in=False),
+    "body.m": Key("number", "must be > 0 and finite (top mass [kg])", 0.0, math.inf,
+                  lo_in=False, hi_in=False),
+    "body.m_A": Key("number", "must be > 0 and finite (base mass [kg])", 0.0, math.inf,
+                    lo_in=False, hi_in=False),
+    "body.I_A": Key("number", "must be >= 0 and finite (base inertia about A [kg m^2])",
+                    0.0, math.inf, hi_in=False),
+    "body.k": Key("number", "must be > 0 (spring stiffness [N/m]; .inf: welded, a rigid "
+                  "body)", 0.0, math.inf, lo_in=False, hi_in=False, inf_ok=True),
+    "body.c": Key("number", "must be >= 0 and finite (damper [N s/m])", 0.0, math.inf,
+                  hi_in=False, required=False, default=0.0),
     "impact.lam": Key("axis", "must be in [0, 2]", 0.0, 2.0),
     # impact laws (rocksweep.physics.impact): the law is a swept word axis like pulse.shape
     "impact.law": Key("choices", f"must be {_one_of(LAWS)} or a list of them",
@@ -109,6 +128,10 @@ KEYS: dict[str, Key] = {
                              choices=tuple(PRESETS), required=False),
     "numerics.steps_per_period": Key("integer", "must be an integer in [4, 1e9]", 4, 1e9,
                                      required=False),
+    "numerics.pulse_steps": Key("integer", "must be an integer in [4, 1e9] (RK4 steps per "
+                                "pulse period while the pulse acts)", 4, 1e9, required=False),
+    "numerics.refine": Key("integer", "must be an integer in [0, 6] (refinements of a close "
+                           "call, each doubling the steps; 0: none)", 0, 6, required=False),
     "numerics.event_tol": Key(
         "number", f"must be in [{MIN_EVENT_TOL:g}, 1) (p*t; below {MIN_EVENT_TOL:g} an event "
         "time t ~ 1e2 is at float64's resolution)", MIN_EVENT_TOL, 1.0, hi_in=False,
@@ -188,6 +211,20 @@ KEYS: dict[str, Key] = {
     "ground.periods": Key("string", "must be a list of periods in [0, 100] s (Sa stored per "
                           "record; 0 gives the PGA)", 0.0, 100.0, required=False,
                           default=(0.2, 1.0)),
+    # the state at t = 0 (rocksweep.vocab.axes.INITIAL; the names simulate --csv writes)
+    "initial.theta_over_alpha": Key(
+        "axis", "must be a finite number (theta/alpha_cg at t = 0, |theta| < pi/2; > 0 "
+        "rocking on one corner, < 0 on the other)", -math.inf, math.inf, lo_in=False,
+        hi_in=False, required=False, default=0.0),
+    "initial.thetadot_over_palpha": Key(
+        "axis", "must be a finite number (theta'/(p alpha_cg) at t = 0)", -math.inf,
+        math.inf, lo_in=False, hi_in=False, required=False, default=0.0),
+    "initial.u_over_ucr": Key(
+        "axis", "must be a finite number (u/u_cr of the top mass at t = 0)", -math.inf,
+        math.inf, lo_in=False, hi_in=False, required=False, default=0.0),
+    "initial.udot_over_pucr": Key(
+        "axis", "must be a finite number (u'/(p u_cr) at t = 0)", -math.inf, math.inf,
+        lo_in=False, hi_in=False, required=False, default=0.0),
     "ground.avgsa": Key("string", "must be [T_lo, T_hi], periods in (0, 100] s with T_lo <= "
                         "T_hi (AvgSa's range; default 0.2-3 x scale.period for Sa stripes, "
                         "else 0.2-3 x 2 pi/p)", 0.0, 100.0, required=False),
@@ -199,8 +236,9 @@ KEYS: dict[str, Key] = {
 BODY_KEYS: dict[str, tuple[str, ...]] = {
     "flexible": ("wn_over_p", "zeta", "alpha_cg", "alpha_A", "mA_over_m", "IA_ratio"),
     "block": ("alpha", "inertia"),
+    "physical": ("b", "h", "h_A", "m", "m_A", "I_A", "k", "c"),
 }
-SECTIONS = ("body", "impact", "pulse", "numerics", "outputs", "ground", "refine")
+SECTIONS = ("body", "impact", "pulse", "numerics", "outputs", "ground", "refine", "initial")
 
 
 def section_keys(section: str, kind: str = "flexible") -> tuple[str, ...]:

@@ -29,7 +29,14 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from rocksweep.numerics import PRESET_ROTATION, PRESETS, ROOTS, Numerics
+from rocksweep.numerics import (
+    PRESET_PULSE,
+    PRESET_REFINE,
+    PRESET_ROTATION,
+    PRESETS,
+    ROOTS,
+    Numerics,
+)
 
 TARGET = 0.995
 
@@ -87,8 +94,9 @@ def main() -> None:
     for r in reports:
         print(f"    {r['command']}   # {r['n']} of {r['size']} points")
     print()
-    head = "| preset | steps/period, event_tol, rotation_step | " + " | ".join(
-        f"{s}: us/pt, agreement" for s in short) + " |"
+    head = ("| preset | steps/period, pulse_steps, event_tol, rotation_step, refine | "
+            + " | ".join(
+        f"{s}: us/pt, agreement" for s in short) + " |")
     print(head)
     print("|" + "---|" * (2 + len(reports)))
     for name in PRESETS:
@@ -102,8 +110,9 @@ def main() -> None:
         d0 = reports[0]["rows"].get(name, reports[0]["rows"].get(f"{name}-{Numerics().root}"))
         if d0 is None:
             continue
-        print(f"| {name} | {int(d0['steps_per_period'])}, {d0['event_tol']:.0e}, "
-              f"{PRESET_ROTATION[name]:g} | " + " | ".join(cells) + " |")
+        print(f"| {name} | {int(d0['steps_per_period'])}, {PRESET_PULSE[name]}, "
+              f"{d0['event_tol']:.0e}, {PRESET_ROTATION[name]:g}, {PRESET_REFINE[name]} | "
+              + " | ".join(cells) + " |")
     print()
     _tails(reports, short)
 

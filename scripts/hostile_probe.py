@@ -623,12 +623,38 @@ def classify(r: subprocess.CompletedProcess, before: dict, after: dict,
     return "clean", lines[0][:200]
 
 
+def interrupt_trials(n: int) -> int:
+    """Ctrl-C at random moments (0-0.3 s after the header: the kernel loads then) n times;
+    print how many were honoured."""
+    import random
+
+    rng = random.Random(32)
+    honoured, bad = 0, []
+    for _ in range(n):
+        delay = rng.uniform(0.0, 0.3)
+        with tempfile.TemporaryDirectory(prefix="probe-") as tmp:
+            r = _interrupt(Path(tmp), delay, True)
+        if r.returncode == 0:
+            honoured += 1
+        else:
+            bad.append(f"{delay:.3f} s: {r.stderr.strip()[-300:]}")
+    for b in bad:
+        print("not honoured at", b)
+    print(f"{honoured} of {n} interrupts honoured (exit 130, no traceback, resumable)")
+    return 0 if honoured == n else 1
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("-k", default="", help="run only the cases whose name holds this "
                     "(alternatives separated by |)")
     ap.add_argument("-v", action="store_true", help="print every case's answer")
+    ap.add_argument("--interrupts", type=int, default=0, metavar="N",
+                    help="instead: N Ctrl-Cs at random moments of the first 0.3 s after "
+                         "the sweep's header; count those honoured (exit 130, one line)")
     a = ap.parse_args()
+    if a.interrupts:
+        return interrupt_trials(a.interrupts)
     counts: Counter[str] = Counter()
     t0 = time.perf_counter()
     for name, expect, fn in CASES:

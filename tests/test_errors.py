@@ -53,9 +53,9 @@ def test_old_import_paths_keep_working():
 
 
 def test_rtol_and_integer_checks_have_one_wording():
-    for bad in (0, 1.0, -0.1, True, "0.1", np.nan):
+    for bad in (0, 1.0, 0.2, -0.1, True, "0.1", np.nan):
         with pytest.raises(errors.ApiError, match=r"^rtol = .*: must be a relative "
-                                                  r"tolerance in \(0, 1\)$"):
+                                                  r"tolerance in \(0, 0\.1\]$"):
             errors.check_rtol(bad)
     assert errors.check_rtol(np.float64(1e-3)) == 1e-3
     with pytest.raises(errors.IdaError):

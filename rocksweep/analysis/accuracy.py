@@ -44,7 +44,14 @@ import numpy as np
 from rocksweep import fields
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.numerics import PRESET_ROTATION, PRESETS, ROOTS, Numerics
+from rocksweep.numerics import (
+    PRESET_PULSE,
+    PRESET_REFINE,
+    PRESET_ROTATION,
+    PRESETS,
+    ROOTS,
+    Numerics,
+)
 from rocksweep.scene.model import Scene, SceneError
 from rocksweep.vocab.outcomes import CLASSES
 
@@ -86,6 +93,8 @@ class Setting:
     group: str
     root: str | None = None
     rotation_step: float = 0.0
+    pulse_steps: int = 0  # 0: steps_per_period (the bare step ladders)
+    refine: int = 0  # certification of close calls (0: none, the bare kernel)
 
 
 def _steps(steps: tuple[int, ...], tol: float, tag: bool = False, rot: float = 0.0
@@ -100,13 +109,15 @@ def _tols(spp: int, tols: tuple[float, ...]) -> list[Setting]:
 
 
 def _presets() -> list[Setting]:
-    return [Setting(name, spp, tol, "preset", rotation_step=PRESET_ROTATION[name])
+    return [Setting(name, spp, tol, "preset", rotation_step=PRESET_ROTATION[name],
+                    pulse_steps=PRESET_PULSE[name], refine=PRESET_REFINE[name])
             for name, (spp, tol) in PRESETS.items()]
 
 
 def _roots() -> list[Setting]:
     return [Setting(f"{name}-{root}", spp, tol, f"root {root}", root,
-                    rotation_step=PRESET_ROTATION[name])
+                    rotation_step=PRESET_ROTATION[name], pulse_steps=PRESET_PULSE[name],
+                    refine=PRESET_REFINE[name])
             for root in ROOTS for name, (spp, tol) in PRESETS.items()]
 
 
@@ -298,6 +309,7 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
     kernel); the sample is also timed as one call per kernel kind. Both are the best of
     ``repeat`` rounds (the machine's noise only ever adds time). Compilation is excluded.
     """
+    from rocksweep.compute.certify import run_certified
     from rocksweep.compute.grid import Grid
     from rocksweep.physics.points import with_record
 
@@ -317,17 +329,23 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
     groups = [(chunk_kernel(int(k), L.LEVEL_OUTCOME, ground),
                np.ascontiguousarray(rows_all[cr.kinds == k])) for k in kinds]
     clock = time.perf_counter
+    refine = numerics.refine
+
+    def certified(fn, rows: np.ndarray, out: np.ndarray) -> None:
+        # the close calls re-run finer, as a sweep does (``compute.certify``)
+        run_certified(fn, rows, out, refine)
+
     for _ in range(max(1, repeat)):
         for i in range(n):
             row, out = rows_all[i:i + 1], outs[i:i + 1]
             t0 = clock()
-            fns[i](row, out)
+            certified(fns[i], row, out)
             dt = clock() - t0
             if dt < per_point[i]:
                 per_point[i] = dt
         t0 = clock()
         for fn, rows in groups:
-            fn(rows, part[:len(rows)])
+            certified(fn, rows, part[:len(rows)])
         batch = min(batch, clock() - t0)
     return outs, per_point, batch
 
@@ -654,7 +672,8 @@ def accuracy_study(scene: Scene, n_points: int | None = 200,
                                        steps_per_period=s.steps_per_period,
                                        event_tol=s.event_tol,
                                        root=s.root or scene.numerics.root,
-                                       rotation_step=s.rotation_step)
+                                       rotation_step=s.rotation_step,
+                                       pulse_steps=s.pulse_steps, refine=s.refine)
         outs, secs, batch = run_kernel(scene, sample.flat, numerics, repeat)
         outs_e = run_energy(scene, sample.flat, numerics)
         agree = outs[:, L.OUT_OUTCOME] == ref[:, L.OUT_OUTCOME]

@@ -25,25 +25,37 @@ import io
 import math
 from collections import defaultdict
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from rocksweep.analysis.tolerance import DEFAULT_RTOL, MAX_RTOL, check_rtol
 from rocksweep.compute.adaptive import DIAGRAM_AXES, AdaptiveError, make_plan
 from rocksweep.compute.grid import Grid
-from rocksweep.errors import BoundaryError, check_rtol  # noqa: F401 (BoundaryError: re-exported)
+from rocksweep.errors import BoundaryError  # noqa: F401 (re-exported)
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.numerics import MAX_POINT_STEPS, Numerics
 from rocksweep.outcomes import outcome_word
-from rocksweep.physics.points import Point, kernel_kind, point_row
+from rocksweep.physics.points import (
+    RECORD,
+    Point,
+    body_omega_rock,
+    body_row,
+    fill_rows,
+    kernel_kind,
+    law_code,
+    point_row,
+    shape_code,
+    with_record,
+)
 from rocksweep.scene.model import Scene
 
 if TYPE_CHECKING:
     from rocksweep.store.reader import SweepResult
 
-DEFAULT_RTOL = 1e-3
 OVERTURNED = (L.OUTCOME_MODE1, L.OUTCOME_MODE2)
 
 
@@ -221,16 +233,42 @@ def default_axes(scene: Scene) -> tuple[str, str]:
 
 # --- A_min ------------------------------------------------------------------------------
 
+# How a column's A_min was found (``AMinCurve.method``, the Dataset's ``A_min_method``):
+A_MIN_METHODS = (
+    "grid+bisection",       # the first overturning grid value, bisected with the one below
+    "searched below grid",  # an overturning value found by the search below (or, in a
+                            # column where no grid value overturns, between) the grid values
+    "first grid value",     # the lowest grid value overturns: an upper bound only
+    "not found",            # nothing overturns on the grid nor in the search: NaN
+)
+# The search below the first overturning grid value (``_search_intervals``) scans grid
+# intervals at interior values spaced (relative to A) by: NEAR_STEP from the last value
+# without uplift up to NEAR_SPAN x the first uplifting value (the narrow first bands just
+# above the uplift threshold at omega/p ~ 1, issue 28: 0.01-0.1 wide at A ~ 1), FAR_STEP
+# from there up to UPLIFT_SPAN x it, and FAR_STEP in the intervals with an end whose
+# max|theta|/alpha_ref >= CLOSE (it came close to overturning), closest first; at most
+# SEARCH_RUNS kernel runs a column (a grid finer than the spacing adds none).
+NEAR_SPAN, NEAR_STEP = 1.3, 0.005
+UPLIFT_SPAN, FAR_STEP = 2.0, 0.02
+CLOSE = 0.5
+SEARCH_RUNS = 128
+# Bound on the RK4 evaluations the refinement of one result may cap its runs at (the sum of
+# the runs' step caps, PAR_MAXSTEPS, over the search and the bisection's iterations): 1e4
+# points at the largest cap a point may have (``numerics.MAX_POINT_STEPS``).
+MAX_REFINE_STEPS = 1e4 * MAX_POINT_STEPS
+
+
 @dataclass
 class AMinCurve:
     """A_min along x for one panel.
 
     where: non-diagram axis values; x: float64[nx] (w_over_p); a_min: float64[nx], the
-    smallest y (A_ratio) that overturns (NaN: no grid value of the column overturns);
-    mode: int8[nx], the class at a_min (1, 2; 0 where NaN); lo, hi: float64[nx], the final
-    bracket (lo does not overturn, hi does; lo = NaN when the column's first grid value
-    already overturns, then a_min = that value and is only an upper bound); runs: kernel
-    runs spent on the column.
+    smallest y (A_ratio) that overturns (NaN: none found); mode: int8[nx], the class at
+    a_min (1, 2; 0 where NaN); lo, hi: float64[nx], the final bracket (lo does not
+    overturn, hi does; lo = NaN when the column's first grid value already overturns, then
+    a_min = that value and is only an upper bound); runs: kernel runs spent on the column
+    (search and bisection); method: int8[nx], index into A_MIN_METHODS (how a_min was
+    found); searched: kernel runs of the search below the grid's first overturning value.
     """
 
     where: dict[str, Any]
@@ -243,102 +281,317 @@ class AMinCurve:
     xname: str = DIAGRAM_AXES[0]
     yname: str = DIAGRAM_AXES[1]
     target: tuple[int, ...] = field(default=OVERTURNED)
+    method: np.ndarray | None = None
+    searched: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        n = len(self.x)
+        if self.method is None:
+            self.method = np.full(n, A_MIN_METHODS.index("not found"), np.int8)
+        if self.searched is None:
+            self.searched = np.zeros(n, np.int64)
+
+    @property
+    def method_words(self) -> list[str]:
+        """How each a_min was found, as words of A_MIN_METHODS."""
+        return [A_MIN_METHODS[int(k)] for k in self.method]
 
 
 Evaluator = Callable[[list[Point]], np.ndarray]
 
 
+def kernel_rows(scene: Scene, points: list[Point]) -> np.ndarray:
+    """The kernel's result rows float64[n, N_OUT] of arbitrary points, one run each
+    (outcome-only kernel, the scene's sweep numerics, as the grid was computed), for every
+    ground motion: sine and cosine pulses on the pulse variants, Ricker and MP pulses and
+    records on the ground variants (``point.ground``)."""
+    outs = np.empty((len(points), L.N_OUT))
+    # one kernel call per body kind, ground variant and record (a record's samples ride
+    # on its rows: rows of one call have one length); the rows of the points that share a
+    # body object and the pulse's options filled at once (``fill_rows``)
+    groups: dict[tuple, list[int]] = {}
+    for i, p in enumerate(points):
+        key = (kernel_kind(p.body), p.ground, id(p.record), id(p.body), p.cycles, p.gamma,
+               p.nu)
+        groups.setdefault(key, []).append(i)
+    for (kind, ground, *_), idx in groups.items():
+        warm_up(kind, L.LEVEL_OUTCOME, ground)
+        rows = _rows([points[i] for i in idx], scene.numerics)
+        part = np.empty((len(idx), L.N_OUT))
+        chunk_kernel(kind, L.LEVEL_OUTCOME, ground)(rows, part)
+        outs[idx] = part
+    return outs
+
+
+def _rows(points: list[Point], numerics: Numerics) -> np.ndarray:
+    """Parameter rows float64[n, N_PAR (+ samples)] of points sharing one body object,
+    record and pulse options (``point_row`` for each, vectorised: ``fill_rows``)."""
+    p0 = points[0]
+    body = p0.body
+    rec = p0.record if p0.shape == RECORD else None
+    n = len(points)
+    rows = np.empty((n, L.N_PAR))
+
+    def column(name: str) -> np.ndarray:
+        return np.array([getattr(p, name) for p in points], float)
+
+    fill_rows(rows, np.broadcast_to(body_row(body), (n, L.N_PAR)),
+              np.full(n, body_omega_rock(body)), np.full(n, body.alpha_ref), column("lam"),
+              np.array([shape_code(p.shape) for p in points]),
+              column("p") if rec is not None else column("w_over_p"), column("A_ratio"),
+              numerics, p0.cycles, p0.gamma, p0.nu, rec, column("mu"),
+              np.array([law_code(p.law) for p in points]), column("e"),
+              column("e_factor"))
+    return with_record(rows, rec)
+
+
 def kernel_evaluator(scene: Scene) -> Evaluator:
-    """Classes (int8[n]) of arbitrary points, one kernel run each (outcome-only kernel, the
-    scene's sweep numerics, as the grid was computed), for every ground motion: sine and
-    cosine pulses on the pulse variants, Ricker and MP pulses and records on the ground
-    variants (``point.ground``)."""
+    """Classes (int8[n]) of arbitrary points, one kernel run each (``kernel_rows``)."""
 
     def evaluate(points: list[Point]) -> np.ndarray:
-        out = np.empty(len(points), np.int8)
-        # one kernel call per body kind, ground variant and record (a record's samples
-        # ride on its rows: rows of one call have one length)
-        groups: dict[tuple[int, bool, int], list[int]] = {}
-        for i, p in enumerate(points):
-            groups.setdefault((kernel_kind(p.body), p.ground, id(p.record)), []).append(i)
-        for (kind, ground, _), idx in groups.items():
-            warm_up(kind, L.LEVEL_OUTCOME, ground)
-            rows = np.array([point_row(points[i], scene.numerics) for i in idx])
-            outs = np.empty((len(idx), L.N_OUT))
-            chunk_kernel(kind, L.LEVEL_OUTCOME, ground)(rows, outs)
-            out[idx] = outs[:, L.OUT_OUTCOME].astype(np.int8)
-        return out
+        return kernel_rows(scene, points)[:, L.OUT_OUTCOME].astype(np.int8)
 
     return evaluate
 
 
+@dataclass
+class _Column:
+    """One column's A_min search: its curve and index, the grid's values of the other
+    axes, the first overturning grid index (ny: none) and what the grid says of it."""
+
+    curve: AMinCurve
+    j: int
+    values: dict[str, Any]
+    first: int
+    theta: np.ndarray  # the column's max|theta|/alpha_ref at the grid values (NaN: unknown)
+    uplifts: np.ndarray  # its uplift counts (-1: unknown)
+    base: Point | None = None  # the column's first grid point (its body object is shared)
+
+    def point(self, scene: Scene, name: str, value: float) -> Point:
+        """The column's point with ``name`` (the searched axis) = value: the first grid
+        point with A_ratio replaced (one body object for the column: its rows are filled
+        at once), else ``scene.point``."""
+        if name != "A_ratio" or scene.suite is not None:
+            return scene.point({**self.values, name: value})
+        if self.base is None:
+            self.base = scene.point(self.values)
+        return replace(self.base, A_ratio=float(value))
+
+
+def _search_intervals(y: np.ndarray, first: int, theta: np.ndarray, uplifts: np.ndarray
+                      ) -> list[tuple[int, int]]:
+    """The grid intervals (k, k + 1) of one column, k + 1 <= first, to scan below its first
+    overturning value (first = len(y): none overturns), as (k, interior values), in the
+    order they are scanned: near the uplift threshold, above it, then where the response
+    came close (NEAR_SPAN, UPLIFT_SPAN, CLOSE), at most SEARCH_RUNS values in all.
+    theta: max|theta|/alpha_ref at the grid values (NaN: unknown); uplifts (-1: unknown,
+    counted as uplifted)."""
+    last = min(first, len(y) - 1)  # intervals (k, k + 1) with k + 1 <= last
+    if last < 1:
+        return []
+
+    def values(k: int, step: float) -> int:
+        return max(0, math.ceil((y[k + 1] - y[k]) / (step * abs(y[k + 1]))) - 1)
+
+    out: list[tuple[int, int]] = []
+    lifted = np.flatnonzero(uplifts[:last + 1] != 0)
+    if lifted.size:
+        u = int(lifted[0])
+        out = [(k, values(k, NEAR_STEP if y[k] < NEAR_SPAN * y[u] else FAR_STEP))
+               for k in range(max(u - 1, 0), last) if y[k] < UPLIFT_SPAN * y[u]]
+    seen = {k for k, _ in out}
+    th = np.nan_to_num(theta[:last + 1], nan=0.0)
+    close = sorted((-max(th[k], th[k + 1]), k) for k in range(last)
+                   if k not in seen and max(th[k], th[k + 1]) >= CLOSE)
+    out += [(k, values(k, FAR_STEP)) for _, k in close]
+    kept, runs = [], 0
+    for k, n in out:
+        n = min(n, SEARCH_RUNS - runs)
+        if n > 0:
+            kept.append((k, n))
+            runs += n
+    return kept
+
+
+def check_amplitudes(scene: Scene, name: str) -> np.ndarray:
+    """The values (float64[ny]) of the axis A_min is searched along (``name``, A_ratio),
+    or a one-line AdaptiveError naming its key and values: it needs at least two,
+    increasing."""
+    ax = scene.axis(name)
+    yv = np.asarray(ax.values, float)
+    if yv.size < 2:
+        raise AdaptiveError(f"{ax.key} = {yv.tolist()}: A_min needs a sweep over at least "
+                            "two values of it")
+    if not np.all(np.diff(yv) > 0):
+        raise AdaptiveError(f"{ax.key}: A_min needs increasing values")
+    return yv
+
+
+def _bisection_steps(lo: float, hi: float, rtol: float) -> int:
+    """Iterations that bisect (lo, hi) to rtol (relative to lo), bounded by float64's."""
+    return int(min(60, max(0, math.ceil(math.log2(max(hi - lo, 1e-300) / (rtol * abs(lo)
+                                                                           or 1e-300))))))
+
+
 def a_min(scene: Scene, outcome: np.ndarray, rtol: float = DEFAULT_RTOL,
           axes: Sequence[str] = DIAGRAM_AXES, mode: int | None = None,
-          evaluate: Evaluator | None = None, max_iter: int = 60) -> list[AMinCurve]:
-    """A_min(x) of every panel, bisected to ``rtol`` (relative to |A_min|).
+          evaluate: Evaluator | None = None, theta: np.ndarray | None = None,
+          uplifts: np.ndarray | None = None, search: bool = True) -> list[AMinCurve]:
+    """A_min(x) of every panel: the smallest y (A_ratio) that overturns, to ``rtol``
+    (relative), whatever the grid's spacing.
 
     outcome: the grid's classes (filled, grid shape or flat); y (axes[1]) must have
-    increasing values. mode: None for any overturning (mode 1 or 2; the curve's ``mode``
+    increasing values, at least two. theta, uplifts: the grid's max|theta|/alpha_ref and
+    uplift counts (grid shape or flat; None or NaN / -1 at a point: unknown), which say
+    where to search. mode: None for any overturning (mode 1 or 2; the curve's ``mode``
     says which), 1 or 2 for the smallest y where that mode occurs. evaluate: classes of a
-    list of points (default: one kernel run each). The bisection assumes one crossing
-    between the two grid values; a feature thinner than the grid spacing between them is
-    resolved as found.
+    list of points (default: one kernel run each at the sweep's numerics). search: False
+    bisects between the grid's first overturning value and the one below only (cheaper;
+    A_min then depends on the grid: every value says "grid+bisection").
+
+    Per column: first a search below the first overturning grid value (or in the whole
+    column when none overturns) for a band narrower than the grid step: the intervals
+    near the uplift threshold and those whose ends came close to overturning are scanned
+    at interior values (``_search_intervals``; at most SEARCH_RUNS runs); the lowest
+    overturning value found (scanned or on the grid) is then bisected with the value
+    below it to ``rtol``. ``method`` says how each A_min was found (A_MIN_METHODS). A band
+    narrower than the scan's spacing in an interval the search does not visit stays
+    unseen. Raises a one-line AdaptiveError for an rtol outside (0, MAX_RTOL], a y axis
+    with fewer than two or non-increasing values, or a refinement whose
+    runs' step caps would exceed MAX_REFINE_STEPS.
     """
-    check_rtol(rtol, AdaptiveError)
+    rtol = check_rtol(rtol, AdaptiveError)
     if mode not in (None, L.OUTCOME_MODE1, L.OUTCOME_MODE2):
         raise AdaptiveError(f"mode = {mode!r}: must be None (any), 1 or 2")
     target = OVERTURNED if mode is None else (mode,)
-    yv = np.asarray(scene.axis(axes[1]).values, float)
-    if not np.all(np.diff(yv) > 0):
-        raise AdaptiveError(f"{scene.axis(axes[1]).key}: A_min needs increasing values")
+    yv = check_amplitudes(scene, axes[1])
     evaluate = evaluate or kernel_evaluator(scene)
     grid = Grid(scene)
-    ps = list(panels(scene, outcome, axes))
-    curves, todo = [], []  # todo: (curve, column, base point, lo, hi)
-    for p in ps:
+    n_grid = np.asarray(outcome).size
+    theta = (np.full(n_grid, np.nan) if theta is None
+             else np.asarray(theta, float).ravel())
+    uplifts = (np.full(n_grid, -1) if uplifts is None else np.asarray(uplifts).ravel())
+    searched = A_MIN_METHODS.index("searched below grid")
+
+    def values_at(flat: int) -> dict[str, Any]:
+        return {k: _plain(v[0]) for k, v in grid.index_values(np.array([flat])).items()}
+
+    curves, cols = [], []
+    for p in panels(scene, outcome, axes):
         nx = p.x.size
         hit = np.isin(p.classes, target)
-        first = np.where(hit.any(axis=0), hit.argmax(axis=0), -1)
+        first = np.where(hit.any(axis=0), hit.argmax(axis=0), yv.size)
         c = AMinCurve(p.where, p.x, np.full(nx, np.nan), np.zeros(nx, np.int8),
                       np.full(nx, np.nan), np.full(nx, np.nan), np.zeros(nx, np.int64),
                       axes[0], axes[1], target)
         for j in range(nx):
-            i = int(first[j])
-            if i < 0:
-                continue
-            c.hi[j], c.mode[j] = yv[i], p.classes[i, j]
-            if i == 0:
-                c.a_min[j] = yv[0]
-                continue
-            c.lo[j] = yv[i - 1]
-            values = grid.index_values(p.flat[i - 1:i, j])
-            todo.append((c, j, {k: _plain(v[0]) for k, v in values.items()}))
+            col = _Column(c, j, values_at(int(p.flat[0, j])), int(first[j]),
+                          theta[p.flat[:, j]], uplifts[p.flat[:, j]])
+            if col.first < yv.size:
+                c.hi[j], c.mode[j] = yv[col.first], p.classes[col.first, j]
+                c.method[j] = A_MIN_METHODS.index("grid+bisection")
+                if col.first > 0:
+                    c.lo[j] = yv[col.first - 1]
+            cols.append(col)
         curves.append(c)
-    for _ in range(max_iter):
-        active = [t for t in todo if t[0].hi[t[1]] - t[0].lo[t[1]]
-                  > rtol * abs(t[0].hi[t[1]])]
-        if not active:
+
+    # the search's points, and the step budget of the whole refinement
+    plan: list[tuple[_Column, list[float]]] = []
+    for col in cols if search else ():
+        scan = []
+        for k, n in _search_intervals(yv, col.first, col.theta, col.uplifts):
+            scan += list(np.linspace(yv[k], yv[k + 1], n + 2)[1:-1])
+        if scan:
+            plan.append((col, sorted(set(scan))))
+    _check_budget(scene, axes, cols, plan, yv, rtol)
+    pts = [col.point(scene, axes[1], a) for col, scan in plan
+           for a in scan]
+    cls = evaluate(pts) if pts else np.zeros(0, np.int8)
+    at = 0
+    for col, scan in plan:
+        c, j = col.curve, col.j
+        k = cls[at:at + len(scan)]
+        at += len(scan)
+        c.runs[j] += len(scan)
+        c.searched[j] += len(scan)
+        over = np.flatnonzero(np.isin(k, target))
+        if over.size == 0:  # all below the first overturning grid value: a tighter lo
+            if not math.isnan(c.lo[j]):
+                c.lo[j] = max([c.lo[j], *(a for a in scan if a < c.hi[j])])
+            continue
+        i = int(over[0])
+        c.hi[j], c.mode[j] = scan[i], k[i]
+        if col.first == 0 or col.first == yv.size or scan[i] < yv[col.first - 1]:
+            c.method[j] = searched  # not in the bracket the grid gives
+        # the largest value below it known not to overturn: a scan value or a grid value
+        below = [*scan[:i], *(float(v) for v in yv if v < scan[i])]
+        c.lo[j] = max(below) if below else math.nan
+    for col in cols:
+        c, j = col.curve, col.j
+        if math.isnan(c.hi[j]):
+            c.method[j] = A_MIN_METHODS.index("not found")
+        elif math.isnan(c.lo[j]):
+            c.method[j] = A_MIN_METHODS.index("first grid value")
+    todo = [col for col in cols if not math.isnan(col.curve.lo[col.j])]
+    while True:
+        active = [col for col in todo if col.curve.hi[col.j] - col.curve.lo[col.j]
+                  > rtol * abs(col.curve.hi[col.j])]
+        mids = [0.5 * (col.curve.lo[col.j] + col.curve.hi[col.j]) for col in active]
+        # float64 cannot split the bracket any further: done to its resolution
+        live = [(col, m) for col, m in zip(active, mids, strict=True)
+                if col.curve.lo[col.j] < m < col.curve.hi[col.j]]
+        if not live:
             break
-        mids = [0.5 * (c.lo[j] + c.hi[j]) for c, j, _ in active]
-        pts = [scene.point({**values, axes[1]: float(m)})
-               for (_, _, values), m in zip(active, mids, strict=True)]
-        cls = evaluate(pts)
-        for (c, j, _), m, k in zip(active, mids, cls, strict=True):
+        cls = evaluate([col.point(scene, axes[1], m) for col, m in live])
+        for (col, m), k in zip(live, cls, strict=True):
+            c, j = col.curve, col.j
             c.runs[j] += 1
             if int(k) in target:
                 c.hi[j], c.mode[j] = m, k
             else:
                 c.lo[j] = m
-    for c, j, _ in todo:
-        c.a_min[j] = c.hi[j]
+    for c in curves:
+        c.a_min[:] = c.hi
+        c.mode[np.isnan(c.hi)] = 0
     return curves
+
+
+def _check_budget(scene: Scene, axes: Sequence[str], cols: list[_Column],
+                  plan: list[tuple[_Column, list[float]]], yv: np.ndarray, rtol: float
+                  ) -> None:
+    """Refuse a refinement whose runs may take more than MAX_REFINE_STEPS RK4 evaluations
+    (each run counted at its step cap, PAR_MAXSTEPS, at the top of its column's search;
+    the bisection at its iterations' bound for rtol): one line naming rtol."""
+    scans = {id(col): scan for col, scan in plan}
+    total, runs = 0.0, 0
+    for col in cols:
+        c, j = col.curve, col.j
+        scan = scans.get(id(col), [])
+        top = c.hi[j] if not math.isnan(c.hi[j]) else (max(scan) if scan else math.nan)
+        if math.isnan(top):
+            continue
+        step = float(np.max(np.diff(yv)))
+        if scan:
+            step = max(step, float(np.max(np.diff([yv[0], *scan]))))
+        n = len(scan) + _bisection_steps(max(top - step, yv[0]), top, rtol)
+        cap = point_row(col.point(scene, axes[1], top),
+                        scene.numerics)[L.PAR_MAXSTEPS]
+        total += n * float(cap)
+        runs += n
+    if total > MAX_REFINE_STEPS:
+        raise AdaptiveError(
+            f"rtol = {rtol:g}: refining A_min of {len(cols)} columns may take {runs} kernel "
+            f"runs capped at {total:.2g} RK4 steps in all, above the budget of "
+            f"{MAX_REFINE_STEPS:.0e}; use a larger rtol (at most {MAX_RTOL:g}) or fewer "
+            "columns")
 
 
 # --- exports ----------------------------------------------------------------------------
 
 def a_min_rows(curves: Sequence[AMinCurve]) -> list[dict[str, Any]]:
     """One row per panel and x value with an A_min: the non-diagram axis values, x, A_min,
-    mode (word), and whether A_min is only an upper bound (first grid value)."""
+    mode (word), whether A_min is only an upper bound (first grid value), and how it was
+    found (``method``, a word of A_MIN_METHODS)."""
     rows = []
     for c in curves:
         for j in range(c.x.size):
@@ -346,7 +599,8 @@ def a_min_rows(curves: Sequence[AMinCurve]) -> list[dict[str, Any]]:
                 continue
             rows.append({**c.where, c.xname: float(c.x[j]), "A_min": float(c.a_min[j]),
                          "mode": outcome_word(int(c.mode[j])),
-                         "upper_bound": bool(math.isnan(c.lo[j]))})
+                         "upper_bound": bool(math.isnan(c.lo[j])),
+                         "method": A_MIN_METHODS[int(c.method[j])]})
     return rows
 
 
@@ -409,7 +663,9 @@ def write_curves_h5(path: str | Path, curves: Sequence[AMinCurve],
       overturns), ``mode`` int8[nx] (1, 2; 0 where A_min is NaN), ``lo``/``hi``
       float64[nx] (the final bisection bracket, lo = NaN when the first grid value
       already overturns), ``upper_bound`` int8[nx] (1: A_min is that first grid value,
-      only an upper bound), ``runs`` int64[nx] (kernel runs of the bisection). Units
+      only an upper bound), ``runs`` int64[nx] (kernel runs of the search and the
+      bisection), ``A_min_method`` int8[nx] (how A_min was found: an index into the
+      attribute ``flag_meanings``, the words of ``A_MIN_METHODS`` joined by ";"). Units
       those of the axes (w_over_p = omega/p, A_ratio = A/(g tan alpha_cg));
     - ``lines/panel_<i>``: the same attributes, one dataset ``line_<n>`` per boundary
       polyline (n as the ``line`` column of the CSV), float64[vertices, 2], columns
@@ -449,12 +705,17 @@ def write_curves_h5(path: str | Path, curves: Sequence[AMinCurve],
                     "hi": (c.hi, f"smallest {c.yname} known to overturn"),
                     "upper_bound": (np.isnan(c.lo) & ~np.isnan(c.a_min),
                                     "1: A_min is the first grid value, an upper bound"),
-                    "runs": (c.runs.astype(np.int64), "kernel runs of the bisection")}
+                    "runs": (c.runs.astype(np.int64),
+                             "kernel runs of the search and the bisection"),
+                    "A_min_method": (c.method.astype(np.int8), "how A_min was found")}
             for name, (v, text) in data.items():
                 arr = np.asarray(v)
                 ds = g.create_dataset(name, data=arr.astype(np.int8) if arr.dtype == bool
                                       else arr)
                 ds.attrs["long_name"] = text
+                if name == "A_min_method":
+                    ds.attrs["flag_values"] = np.arange(len(A_MIN_METHODS), dtype=np.int8)
+                    ds.attrs["flag_meanings"] = ";".join(A_MIN_METHODS)
                 ds.dims[0].attach_scale(xs)
         for i, b in enumerate(bounds):
             g = panel_group("lines", i, b.where)
@@ -484,6 +745,7 @@ def check_result(result: SweepResult, axes: Sequence[str] | None = None) -> Scen
     sc = scene_of(result)
     axes = default_axes(sc) if axes is None else axes
     try:
+        check_amplitudes(sc, axes[1])
         make_plan(sc, axes, coarse=0, audit=0.0)
     except AdaptiveError as err:
         raise BoundaryError(f"{result.path}: {err}; boundaries need a diagram over two "
@@ -496,16 +758,29 @@ def check_result(result: SweepResult, axes: Sequence[str] | None = None) -> Scen
     return sc
 
 
+def grid_response(result: SweepResult) -> dict[str, np.ndarray | None]:
+    """The grid's max|theta|/alpha_ref and uplift counts of a result (``a_min``'s
+    ``theta``, ``uplifts``; None where the result was read without them; an adaptive
+    result's filled points hold NaN and -1, unknown)."""
+    return {"theta": result.arrays.get("theta_max_over_alpha"),
+            "uplifts": result.arrays.get("uplifts")}
+
+
+# the variables of a result that A_min reads (outcome) and that say where to search
+RESPONSE = ("outcome", "theta_max_over_alpha", "uplifts")
+
+
 def result_curves(result: SweepResult, rtol: float = DEFAULT_RTOL, mode: int | None = None,
-                  axes: Sequence[str] | None = None, evaluate: Evaluator | None = None
-                  ) -> tuple[list[AMinCurve], list[PanelBoundaries]]:
+                  axes: Sequence[str] | None = None, evaluate: Evaluator | None = None,
+                  search: bool = True) -> tuple[list[AMinCurve], list[PanelBoundaries]]:
     """A_min curves (bisected to ``rtol``; ``mode``: None any, 1 or 2) and boundary lines
     of every panel of a result read with ``outcome`` (``store.read_result``); axes: the
     diagram's (None: the scene's, (p, A_ratio) for a record)."""
     sc = check_result(result, axes)
     axes = default_axes(sc) if axes is None else axes
     outcome = np.asarray(result.arrays["outcome"])
-    curves = a_min(sc, outcome, rtol, axes, mode, evaluate)
+    curves = a_min(sc, outcome, rtol, axes, mode, evaluate, **grid_response(result),
+                   search=search)
     return curves, diagram_boundaries(sc, outcome, axes)
 
 
@@ -525,9 +800,10 @@ def _panel_index(wheres: Sequence[dict[str, Any]]) -> tuple[list[str], dict[str,
 
 
 def curves_dataset(curves: Sequence[AMinCurve], attrs: dict[str, Any] | None = None):
-    """A_min curves as an ``xarray.Dataset``: ``A_min`` (NaN: no grid value of the column
-    overturns), ``mode`` (1, 2; 0 where NaN), ``lo``/``hi`` (the final bracket), ``runs``
-    (kernel runs), each over every other swept axis (e.g. shape, lam) and the diagram's x
+    """A_min curves as an ``xarray.Dataset``: ``A_min`` (NaN: none found), ``mode`` (1, 2;
+    0 where NaN), ``A_min_method`` (how A_min was found, a word of A_MIN_METHODS),
+    ``lo``/``hi`` (the final bracket), ``runs`` (kernel runs of the search and the
+    bisection), each over every other swept axis (e.g. shape, lam) and the diagram's x
     axis (w_over_p or p); values in the axes' units (A_min in A_ratio)."""
     import xarray as xr
 
@@ -540,12 +816,14 @@ def curves_dataset(curves: Sequence[AMinCurve], attrs: dict[str, Any] | None = N
     shape = (*(len(values[k]) for k in keys), len(curves[0].x))
     data = {n: np.full(shape, fill, dtype) for n, fill, dtype in (
         ("A_min", np.nan, float), ("mode", 0, np.int8), ("lo", np.nan, float),
-        ("hi", np.nan, float), ("runs", 0, np.int64))}
+        ("hi", np.nan, float), ("runs", 0, np.int64),
+        ("A_min_method", A_MIN_METHODS[-1], object))}
     for c in curves:
         idx = tuple(values[k].index(c.where[k]) for k in keys)
         for n, v in (("A_min", c.a_min), ("mode", c.mode), ("lo", c.lo), ("hi", c.hi),
-                     ("runs", c.runs)):
+                     ("runs", c.runs), ("A_min_method", c.method_words)):
             data[n][idx] = v
+    data["A_min_method"] = data["A_min_method"].astype(str)
     dims = (*keys, xname)
     ymeta = fields.axis_attrs(yname)
     meta = {"A_min": {**ymeta, "long_name": f"smallest overturning {ymeta['long_name']}"},
@@ -553,7 +831,10 @@ def curves_dataset(curves: Sequence[AMinCurve], attrs: dict[str, Any] | None = N
                      "flag_meanings": "none mode1 mode2"},
             "lo": {**ymeta, "long_name": "bracket: largest safe value"},
             "hi": {**ymeta, "long_name": "bracket: smallest overturning value"},
-            "runs": {"long_name": "kernel runs of the bisection", "units": "1"}}
+            "runs": {"long_name": "kernel runs of the search and the bisection",
+                     "units": "1"},
+            "A_min_method": {"long_name": "how A_min was found",
+                             "flag_meanings": ";".join(A_MIN_METHODS)}}
     coords = {k: (k, np.asarray(values[k]), fields.axis_attrs(k)) for k in keys}
     coords[xname] = (xname, np.asarray(curves[0].x), fields.axis_attrs(xname))
     return xr.Dataset({n: (dims, v, meta[n]) for n, v in data.items()}, coords=coords,

@@ -90,7 +90,7 @@ from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, STATES, THETA_STATE
 
 __all__ = ["Bootstrap", "DEFAULT_BOOTSTRAP", "Fit", "FragilityError", "FragilityWarning",
            "REASONS", "STRIPE_IMS", "bootstrap_records", "curves_json", "fit_cloud",
-           "fit_stripes", "fragility", "parse_state"]
+           "fit_stripes", "fragility", "parse_state", "probability"]
 
 #: stripe dimension names (the sweep's ``scale_im``) and their units
 STRIPE_IMS = SCALE_IMS
@@ -103,6 +103,8 @@ QUALITY = ("beta_undetermined", "non_monotone", "extrapolated", "bootstrap_undef
            "censored", "incomplete", "flagged")
 REASONS = ENDINGS + QUALITY
 BAND_POINTS = 101
+#: the pointwise band is taken over at most this many resamples (the first ones)
+BAND_SAMPLES = 20_000
 #: resamples are fitted in chunks of at most this many count entries (bounded memory)
 BOOT_ELEMENTS = 1 << 20
 NONMONOTONE_P = 0.01
@@ -110,6 +112,8 @@ NONMONOTONE_SIMS = 400
 CENSORED_SHARE = 0.1
 FLAGGED_SHIFT = 0.01
 _CODE = {w: i for i, w in enumerate(ENDINGS)}
+#: endings that say all there is (nothing reaches the state, all do, nothing counted)
+_EMPTY = [_CODE[w] for w in ("no_failures", "all_failed", "no_data")]
 
 
 
@@ -153,13 +157,15 @@ def _loglik(eta: np.ndarray, k: np.ndarray, n: np.ndarray) -> np.ndarray:
     return np.sum(k * log_ndtr(eta) + (n - k) * log_ndtr(-eta), axis=-1)
 
 
-def _mle_batch(lnx: np.ndarray, k: np.ndarray, n: np.ndarray
+def _mle_batch(lnx: np.ndarray, k: np.ndarray, n: np.ndarray,
+               start: tuple[float, float] | None = None, tol: float = 1e-10
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """MLE of the lognormal fragility for a batch of data sets.
 
     lnx, k, n: float64 (B, S): ln IM, points reaching the state, points counted (n = 0: the
-    entry is absent). Returns (im_median (B,), beta (B,), ending code (B,) into ENDINGS);
-    separated data give the step's IM and beta = NaN.
+    entry is absent); start: (im_median, beta) to start the scoring from (resamples: the
+    full data's fit), tol: its relative tolerance. Returns (im_median (B,), beta (B,),
+    ending code (B,) into ENDINGS); separated data give the step's IM and beta = NaN.
     """
     lnx, k, n = (np.atleast_2d(np.asarray(v, dtype=np.float64)) for v in (lnx, k, n))
     lnx = np.broadcast_to(lnx, k.shape)
@@ -182,7 +188,11 @@ def _mle_batch(lnx: np.ndarray, k: np.ndarray, n: np.ndarray
     median[sep] = np.exp(0.5 * (x_fail_min[sep] + x_safe_max[sep]))
     todo = both & ~sep
     if np.any(todo):
-        a, b = _score(lnx[todo], k[todo], n[todo])
+        st = None
+        if start is not None and np.all(np.isfinite(start)) and start[1] > 0:
+            st = np.broadcast_to([-math.log(start[0]) / start[1], 1.0 / start[1]],
+                                 (int(todo.sum()), 2))
+        a, b = _score(lnx[todo], k[todo], n[todo], tol=tol, start=st)
         med, bet, rsn = np.full(a.size, np.nan), np.full(a.size, np.nan), np.zeros(a.size, int)
         up = b > 0.0
         med[up] = np.exp(-a[up] / b[up])
@@ -192,10 +202,26 @@ def _mle_batch(lnx: np.ndarray, k: np.ndarray, n: np.ndarray
     return median, beta, reason
 
 
+def _log_cdf(e: np.ndarray) -> np.ndarray:
+    """log Phi(e): log(ndtr) (half the price of ``log_ndtr``), ``log_ndtr`` where ndtr
+    underflows."""
+    v = ndtr(e)
+    tail = v < 1e-200
+    with np.errstate(divide="ignore"):
+        out = np.log(v)
+    if np.any(tail):
+        out[tail] = log_ndtr(e[tail])
+    return out
+
+
 def _score(lnx: np.ndarray, k: np.ndarray, n: np.ndarray, iters: int = 200,
-           tol: float = 1e-10) -> tuple[np.ndarray, np.ndarray]:
+           tol: float = 1e-10, start: np.ndarray | None = None
+           ) -> tuple[np.ndarray, np.ndarray]:
     """Fisher scoring with step halving for Phi(a + b lnx), batched over rows (each row
-    has points on both sides: the maximum exists). Returns (a, b) per row."""
+    has points on both sides: the maximum exists). start: (B, 2) (a, b) to start from
+    (bootstrap resamples: the full data's fit; then Newton steps on the observed
+    information, which converge in a few steps from there); default the pooled fraction,
+    slope 0. Returns (a, b) per row."""
     # standardise ln x per row for conditioning: eta = c0 + c1 z, z = (lnx - m) / s
     w = n / n.sum(-1, keepdims=True)
     m = np.sum(w * lnx, -1, keepdims=True)
@@ -204,8 +230,15 @@ def _score(lnx: np.ndarray, k: np.ndarray, n: np.ndarray, iters: int = 200,
     z = (lnx - m) / s
     frac = np.clip(k.sum(-1) / n.sum(-1), 1e-6, 1.0 - 1e-6)
     c = np.stack([ndtri(frac), np.zeros(frac.size)], axis=-1)  # (B, 2)
+    newton = start is not None
+    if newton:  # eta = a + b lnx = (a + b m) + (b s) z
+        c0 = start[:, 0] + start[:, 1] * m[:, 0]
+        c1 = start[:, 1] * s[:, 0]
+        fine = np.isfinite(c0) & np.isfinite(c1)
+        c[fine] = np.stack([c0, c1], -1)[fine]
     eta = c[:, :1] + c[:, 1:] * z
-    ll = _loglik(eta, k, n)
+    lpos, lneg = _log_cdf(eta), _log_cdf(-eta)  # log Phi(eta), log Phi(-eta)
+    ll = np.sum(k * lpos + (n - k) * lneg, -1)
     active = np.ones(frac.size, dtype=bool)
     for _ in range(iters):
         idx = np.flatnonzero(active)
@@ -213,10 +246,13 @@ def _score(lnx: np.ndarray, k: np.ndarray, n: np.ndarray, iters: int = 200,
             break
         e, zz, kk, nn = eta[idx], z[idx], k[idx], n[idx]
         logphi = -0.5 * e * e - 0.5 * math.log(2.0 * math.pi)
-        r1 = np.exp(logphi - log_ndtr(e))  # phi / Phi(eta)
-        r2 = np.exp(logphi - log_ndtr(-e))  # phi / Phi(-eta)
+        r1 = np.exp(logphi - lpos[idx])  # phi / Phi(eta)
+        r2 = np.exp(logphi - lneg[idx])  # phi / Phi(-eta)
         g = kk * r1 - (nn - kk) * r2  # d loglik / d eta
-        wgt = nn * r1 * r2  # expected information per unit of eta
+        if newton:  # observed information: -d2 loglik / d eta2 (> 0: concave)
+            wgt = kk * r1 * (e + r1) + (nn - kk) * r2 * (r2 - e)
+        else:
+            wgt = nn * r1 * r2  # expected information per unit of eta
         U0, U1 = g.sum(-1), (g * zz).sum(-1)
         I00, I01, I11 = wgt.sum(-1), (wgt * zz).sum(-1), (wgt * zz * zz).sum(-1)
         det = I00 * I11 - I01 * I01
@@ -227,16 +263,19 @@ def _score(lnx: np.ndarray, k: np.ndarray, n: np.ndarray, iters: int = 200,
         ll0 = ll[idx]
         c_new = c[idx].copy()
         ll_new = ll0.copy()
+        lp_new, ln_new = lpos[idx].copy(), lneg[idx].copy()
         pending = np.ones(idx.size, dtype=bool)
         for _half in range(60):
             cand = c[idx][pending] + step[pending, None] * np.stack(
                 [d0[pending], d1[pending]], -1)
             ecand = cand[:, :1] + cand[:, 1:] * zz[pending]
-            lc = _loglik(ecand, kk[pending], nn[pending])
+            lp_c, ln_c = _log_cdf(ecand), _log_cdf(-ecand)
+            lc = np.sum(kk[pending] * lp_c + (nn[pending] - kk[pending]) * ln_c, -1)
             ok = lc >= ll0[pending] - 1e-12 * np.abs(ll0[pending])
             pi = np.flatnonzero(pending)
             c_new[pi[ok]] = cand[ok]
             ll_new[pi[ok]] = lc[ok]
+            lp_new[pi[ok]], ln_new[pi[ok]] = lp_c[ok], ln_c[ok]
             step[pi[~ok]] *= 0.5
             pending[pi[ok]] = False
             if not pending.any():
@@ -245,6 +284,7 @@ def _score(lnx: np.ndarray, k: np.ndarray, n: np.ndarray, iters: int = 200,
         c[idx] = c_new
         eta[idx] = c_new[:, :1] + c_new[:, 1:] * zz
         ll[idx] = ll_new
+        lpos[idx], lneg[idx] = lp_new, ln_new
         active[idx[(delta < tol * (1.0 + np.abs(c_new).max(-1))) | pending]] = False
     a = c[:, 0] - c[:, 1] * m[:, 0] / s[:, 0]
     b = c[:, 1] / s[:, 0]
@@ -275,7 +315,7 @@ def _stripe_rules(lnx, k, n, med, beta, code):
     "one_stripe"; fewer than two distinct inner fractions (or separation) -> beta NaN.
     Returns bool (B,) "beta_undetermined"."""
     levels, distinct = _distinct_inner(lnx, k, n)
-    one = (levels == 1) & (code != _CODE["no_data"])
+    one = (levels == 1) & ~np.isin(code, _EMPTY)
     med[one], beta[one] = np.nan, np.nan
     code[one] = _CODE["one_stripe"]
     few = (distinct < 2) & (code == _CODE["ok"])
@@ -421,72 +461,78 @@ def fit_cloud(im: Sequence[float] | np.ndarray, failed: Sequence[bool] | np.ndar
 # ---------------------------------------------------------------------------------------
 
 
-def _maximise(f: Callable[[np.ndarray, np.ndarray], np.ndarray], theta0: np.ndarray,
-              iters: int = 200, tol: float = 1e-11) -> tuple[np.ndarray, np.ndarray]:
-    """Maximise f(theta (b, p), rows (b,)) -> (b,) for every row of theta0 (B, p): Newton
-    steps on central-difference derivatives, damped (Levenberg-Marquardt) until the value
-    rises. Returns (theta (B, p), converged bool (B,))."""
+def _multinomial_ll(p: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """sum over (C, P) of m log p (m = 0 terms are 0 even where p = 0)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.sum(np.where(m > 0, m * np.log(np.maximum(p, 1e-300)), 0.0), (1, 2))
+
+
+def _maximise(prob: Callable[[np.ndarray, np.ndarray], np.ndarray], m: np.ndarray,
+              theta0: np.ndarray, limit: np.ndarray, iters: int = 100, tol: float = 1e-10
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """Maximum likelihood of multinomial counts m (B, C, P) (C categories at P IM levels)
+    under probabilities prob(theta (b, p), rows (b,)) -> (b, C, P), for every row of
+    theta0 (B, p): Fisher scoring (information sum over c, s of n_s J J^T / p, J = dp /
+    dtheta by central differences), damped (Levenberg-Marquardt) until the likelihood
+    rises. A row whose |theta| passes ``limit`` (p,) runs away to a boundary (separated
+    data: no maximum) and stops, not converged. Returns (theta (B, p), converged (B,))."""
     B, P = theta0.shape
+    n = m.sum(1)
     th = theta0.copy()
-    rows = np.arange(B)
-    ll = f(th, rows)
-    lam = np.full(B, 1e-4)
+    pr = prob(th, np.arange(B))
+    ll = _multinomial_ll(pr, m)
+    lam = np.full(B, 1e-6)
     active = np.isfinite(ll)
     conv = np.zeros(B, bool)
-    h = 1e-4
+    h = 1e-6
     eye = np.eye(P)
-    # offsets: +-h e_i for the gradient, (+-h e_i +-h e_j) for the Hessian
-    offs = [h * s * eye[i] for i in range(P) for s in (1, -1)]
-    pairs = [(i, j) for i in range(P) for j in range(i + 1, P)]
-    offs += [h * (si * eye[i] + sj * eye[j]) for i, j in pairs for si in (1, -1)
-             for sj in (1, -1)]
-    offs = np.array(offs)
     for _ in range(iters):
         idx = np.flatnonzero(active)
         if idx.size == 0:
             break
         t = th[idx]
-        vals = f((t[:, None, :] + offs[None]).reshape(-1, P),
-                 np.repeat(idx, offs.shape[0])).reshape(idx.size, -1)
+        both = np.concatenate([t[:, None, :] + h * eye, t[:, None, :] - h * eye], 1)
+        vals = prob(both.reshape(-1, P), np.repeat(idx, 2 * P)).reshape(
+            (idx.size, 2 * P) + pr.shape[1:])
+        J = (vals[:, :P] - vals[:, P:]) / (2.0 * h)  # (b, p, C, P)
+        inv = 1.0 / np.maximum(pr[idx], 1e-300)
+        g = np.einsum("bkcs,bcs->bk", J, m[idx] * inv)
+        info = np.einsum("bkcs,bjcs,bcs->bkj", J, J, n[idx][:, None, :] * inv)
         f0 = ll[idx]
-        g = (vals[:, 0:2 * P:2] - vals[:, 1:2 * P:2]) / (2 * h)
-        H = np.empty((idx.size, P, P))
-        diag = (vals[:, 0:2 * P:2] + vals[:, 1:2 * P:2] - 2 * f0[:, None]) / h ** 2
-        H[:, np.arange(P), np.arange(P)] = diag
-        for q, (i, j) in enumerate(pairs):
-            v = vals[:, 2 * P + 4 * q: 2 * P + 4 * q + 4]
-            H[:, i, j] = H[:, j, i] = (v[:, 0] - v[:, 1] - v[:, 2] + v[:, 3]) / (4 * h * h)
-        bad = ~np.all(np.isfinite(vals), -1)
+        bad = ~(np.all(np.isfinite(g), -1) & np.all(np.isfinite(info), (-1, -2)))
         pending = ~bad
         done_rows = np.zeros(idx.size, bool)
         for _try in range(40):
             pi = np.flatnonzero(pending)
             if pi.size == 0:
                 break
-            A = -H[pi] + lam[idx[pi], None, None] * (eye + np.abs(H[pi]) * eye)
+            A = info[pi] + lam[idx[pi], None, None] * (eye + info[pi] * eye)
             try:
                 d = np.linalg.solve(A, g[pi][..., None])[..., 0]
             except np.linalg.LinAlgError:
                 d = np.stack([np.linalg.lstsq(a, b, rcond=None)[0] for a, b in
                               zip(A, g[pi], strict=True)])
             cand = t[pi] + d
-            lc = f(cand, idx[pi])
+            pc = prob(cand, idx[pi])
+            lc = _multinomial_ll(pc, m[idx[pi]])
             up = np.isfinite(lc) & (lc >= f0[pi] - 1e-13 * np.abs(f0[pi]))
             acc = pi[up]
             th[idx[acc]] = cand[up]
             ll[idx[acc]] = lc[up]
-            lam[idx[acc]] = np.maximum(lam[idx[acc]] * 0.2, 1e-12)
+            pr[idx[acc]] = pc[up]
+            lam[idx[acc]] = np.maximum(lam[idx[acc]] * 0.1, 1e-9)
             small = np.abs(d[up]).max(-1) < tol * (1.0 + np.abs(cand[up]).max(-1))
             flat = np.abs(lc[up] - f0[pi][up]) <= 1e-14 * (1.0 + np.abs(f0[pi][up]))
             done_rows[acc[small | flat]] = True
             pending[acc] = False
             rej = pi[~up]
-            lam[idx[rej]] *= 10.0
+            lam[idx[rej]] = np.maximum(lam[idx[rej]] * 10.0, 1e-4)
             stuck = rej[lam[idx[rej]] > 1e12]
             done_rows[stuck] = True
             pending[stuck] = False
-        conv[idx[done_rows]] = True
-        active[idx[done_rows | bad]] = False
+        away = np.any(np.abs(th[idx]) > limit, -1)
+        conv[idx[done_rows & ~away]] = True
+        active[idx[done_rows | bad | away]] = False
     return th, conv
 
 
@@ -519,12 +565,12 @@ def _ordinal_probs(z: np.ndarray, theta: np.ndarray) -> np.ndarray:
         return np.log(np.maximum(p, 0.0))
 
 
-def _fit_ordinal(lnx: np.ndarray, m: np.ndarray) -> tuple[np.ndarray, np.ndarray,
-                                                          np.ndarray]:
+def _fit_ordinal(lnx: np.ndarray, m: np.ndarray, start: tuple | None = None
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Ordinal probit with a common beta (module docstring). lnx (b, P) ln IM; m (b, K+1,
-    P) category counts (category c: the c most severe... the points whose most severe
-    state reached is the c-th, 0: none). Returns (im_median (b, K), beta (b,), converged
-    (b,))."""
+    P) category counts (category c: the points whose most severe state reached is the
+    c-th, 0: none); start: (im_median (K,), beta) to start from (resamples: the full data's
+    fit). Returns (im_median (b, K), beta (b,), converged (b,))."""
     b, K1, P = m.shape
     K = K1 - 1
     n = m.sum(1)
@@ -537,14 +583,17 @@ def _fit_ordinal(lnx: np.ndarray, m: np.ndarray) -> tuple[np.ndarray, np.ndarray
     t0 = np.maximum.accumulate(t0 + 1e-3 * np.arange(K), 1)
     theta0 = np.concatenate([t0[:, :1], np.log(np.maximum(np.diff(t0, axis=1), 1e-3)),
                              np.zeros((b, 1))], 1)
+    if start is not None and np.all(np.isfinite(start[0])) and np.isfinite(start[1]) \
+            and start[1] > 0:
+        ts = (np.log(np.asarray(start[0]))[None, :] - mu[:, None]) / sd[:, None]
+        theta0 = np.concatenate([ts[:, :1], np.log(np.maximum(np.diff(ts, axis=1), 1e-6)),
+                                 np.log(sd / start[1])[:, None]], 1)
 
-    def ll(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
-        lp = _ordinal_probs(z[rows], theta)
-        mm = m[rows]
-        with np.errstate(invalid="ignore"):
-            return np.sum(np.where(mm > 0, mm * lp, 0.0), (1, 2))
+    def prob(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        return np.exp(_ordinal_probs(z[rows], theta))
 
-    theta, conv = _maximise(ll, theta0)
+    limit = np.array([60.0] + [40.0] * (K - 1) + [15.0])
+    theta, conv = _maximise(prob, m, theta0, limit)
     t = np.cumsum(np.concatenate([theta[:, :1], np.exp(theta[:, 1:K])], 1), 1)
     s = np.exp(theta[:, K])
     return np.exp(mu[:, None] + sd[:, None] * t), sd / s, conv
@@ -555,15 +604,16 @@ def _cif(z: np.ndarray, t: np.ndarray, sig: np.ndarray) -> tuple[np.ndarray, ...
     the two capacities' means and deviations. Returns (P(safe), P(mode 1), P(mode 2))
     (..., P): P(mode k) = P(U_k <= z, U_k < U_other) = Phi2(h, q; rho), h = (z - t_k) /
     sig_k, q = (t_o - t_k) / sqrt(sig_k^2 + sig_o^2), rho = sig_k / sqrt(...) (Owen's T)."""
-    out = []
-    tot = np.sqrt(sig[..., 0] ** 2 + sig[..., 1] ** 2)
-    for k, o in ((0, 1), (1, 0)):
-        h = (z - t[..., k, None]) / sig[..., k, None]
-        q = np.broadcast_to(((t[..., o] - t[..., k]) / tot)[..., None], h.shape)
-        rho = np.broadcast_to((sig[..., k] / tot)[..., None], h.shape)
-        out.append(_phi2(h, q, rho))
-    safe = ndtr(-(z - t[..., 0, None]) / sig[..., 0, None]) * ndtr(
-        -(z - t[..., 1, None]) / sig[..., 1, None])
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        out = []
+        tot = np.sqrt(sig[..., 0] ** 2 + sig[..., 1] ** 2)
+        for k, o in ((0, 1), (1, 0)):
+            h = (z - t[..., k, None]) / sig[..., k, None]
+            q = np.broadcast_to(((t[..., o] - t[..., k]) / tot)[..., None], h.shape)
+            rho = np.broadcast_to((sig[..., k] / tot)[..., None], h.shape)
+            out.append(_phi2(h, q, rho))
+        safe = ndtr(-(z - t[..., 0, None]) / sig[..., 0, None]) * ndtr(
+            -(z - t[..., 1, None]) / sig[..., 1, None])
     return safe, out[0], out[1]
 
 
@@ -591,22 +641,13 @@ def _fit_competing(lnx: np.ndarray, k1: np.ndarray, k2: np.ndarray, n: np.ndarra
     z = (lnx - mu[:, None]) / sd[:, None]
     th0 = np.stack([(start[:, 0] - mu) / sd, np.log(start[:, 1] / sd),
                     (start[:, 2] - mu) / sd, np.log(start[:, 3] / sd)], -1)
-    safe_n = n - k1 - k2
+    counts = np.stack([n - k1 - k2, k1, k2], 1)  # (b, 3, P)
 
-    def ll(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
-        t = theta[:, [0, 2]]
-        sig = np.exp(theta[:, [1, 3]])
-        ps, p1, p2 = _cif(z[rows], t, sig)
-        tiny = 1e-300
-        with np.errstate(divide="ignore"):
-            terms = (np.where(safe_n[rows] > 0, safe_n[rows] * np.log(np.maximum(ps, tiny)),
-                              0.0)
-                     + np.where(k1[rows] > 0, k1[rows] * np.log(np.maximum(p1, tiny)), 0.0)
-                     + np.where(k2[rows] > 0, k2[rows] * np.log(np.maximum(p2, tiny)), 0.0))
-        return terms.sum(-1)
+    def prob(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        return np.stack(_cif(z[rows], theta[:, [0, 2]], np.exp(theta[:, [1, 3]])), 1)
 
     th0 = np.where(np.isfinite(th0), th0, 0.0)
-    theta, conv = _maximise(ll, th0)
+    theta, conv = _maximise(prob, counts, th0, np.array([60.0, 12.0, 60.0, 12.0]))
     with np.errstate(over="ignore"):
         med = np.exp(mu[:, None] + sd[:, None] * theta[:, [0, 2]])
         beta = sd[:, None] * np.exp(theta[:, [1, 3]])
@@ -620,27 +661,32 @@ def _fit_competing(lnx: np.ndarray, k1: np.ndarray, k2: np.ndarray, n: np.ndarra
 # ---------------------------------------------------------------------------------------
 
 
-def _fit_counts(kind: str, lnx: np.ndarray, m: np.ndarray, stripes: bool
+def _fit_counts(kind: str, lnx: np.ndarray, m: np.ndarray, stripes: bool,
+                start: tuple[np.ndarray, np.ndarray] | None = None
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Fits of one group of states from category counts m (b, C, P) at ln IM lnx (P,):
     kind "single" (C = 2: not reached, reached), "ordinal" (C = K + 1: the most severe of K
     nested states reached, in severity order) or "competing" (C = 3: safe, mode 1, mode
-    2). Returns im_median, beta, ending code, beta undetermined: (b, G) each, G the states
-    of the group (severity order for "ordinal", (mode1, mode2) for "competing")."""
+    2). start: the full data's (im_median (G,), beta (G,)) to start from (bootstrap
+    resamples; a single state's fit then stops at 1e-7). Returns im_median, beta, ending
+    code, beta undetermined: (b, G) each, G the states of the group (severity order for
+    "ordinal", (mode1, mode2) for "competing")."""
     b, C, P = m.shape
     n = m.sum(1)
     lnxb = np.broadcast_to(lnx, n.shape)
     if kind == "single":
-        med, bet, code = _mle_batch(lnxb, m[:, 1], n)
+        med, bet, code = (_mle_batch(lnxb, m[:, 1], n) if start is None else
+                          _mle_batch(lnxb, m[:, 1], n, (start[0][0], start[1][0]),
+                                     tol=1e-7))
         und = (_stripe_rules(lnxb, m[:, 1], n, med, bet, code) if stripes else
                code == _CODE["separated"])
         return med[:, None], bet[:, None], code[:, None], und[:, None]
     if kind == "ordinal":
-        return _fit_ordinal_counts(lnxb, m, n, stripes)
-    return _fit_competing_counts(lnxb, m, n, stripes)
+        return _fit_ordinal_counts(lnxb, m, n, stripes, start)
+    return _fit_competing_counts(lnxb, m, n, stripes, start)
 
 
-def _fit_ordinal_counts(lnx, m, n, stripes):
+def _fit_ordinal_counts(lnx, m, n, stripes, start=None):
     b, C, P = m.shape
     K = C - 1
     reach = np.cumsum(m[:, ::-1], 1)[:, ::-1][:, 1:]  # (b, K, P): reaching state j
@@ -672,7 +718,8 @@ def _fit_ordinal_counts(lnx, m, n, stripes):
         sub = m[rows][:, a:z + 2]
         sub[:, 0] += m[rows][:, :a].sum(1)
         sub[:, -1] += m[rows][:, z + 2:].sum(1)
-        mm, bb, conv = _fit_ordinal(lnx[rows], sub)
+        st = None if start is None else (np.asarray(start[0])[js], np.asarray(start[1])[js[0]])
+        mm, bb, conv = _fit_ordinal(lnx[rows], sub, st)
         _, sdv = _standardise(lnx[rows], n[rows])
         cc = np.where(conv, _CODE["ok"], _CODE["not_converged"])
         cc = np.where(conv & (bb < 1e-6 * sdv), _CODE["separated"], cc)
@@ -695,7 +742,7 @@ def _fit_ordinal_counts(lnx, m, n, stripes):
     return med, bet, code, und
 
 
-def _fit_competing_counts(lnx, m, n, stripes):
+def _fit_competing_counts(lnx, m, n, stripes, start=None):
     b = m.shape[0]
     k1, k2 = m[:, 1], m[:, 2]
     med = np.full((b, 2), np.nan)
@@ -712,14 +759,20 @@ def _fit_competing_counts(lnx, m, n, stripes):
         code[okrow & ~own, j] = _CODE["no_failures"]
     both = np.flatnonzero(okrow & has1 & has2)
     if both.size:
-        start = np.empty((both.size, 4))
+        begin = np.empty((both.size, 4))
         for j, kk in enumerate((k1, k2)):
             mm, bb, _ = _mle_batch(lnx[both], kk[both], n[both])
             fine = np.isfinite(mm) & np.isfinite(bb)
-            start[:, 2 * j] = np.where(fine, np.log(np.where(fine, mm, 1.0)),
+            begin[:, 2 * j] = np.where(fine, np.log(np.where(fine, mm, 1.0)),
                                        np.log(mo[both]))
-            start[:, 2 * j + 1] = np.where(fine, bb, bo[both])
-        mm, bb, conv = _fit_competing(lnx[both], k1[both], k2[both], n[both], start)
+            begin[:, 2 * j + 1] = np.where(fine, bb, bo[both])
+        if start is not None and np.all(np.isfinite(start[0])) and np.all(
+                np.isfinite(start[1])) and np.all(np.asarray(start[1]) > 0):
+            full = [np.log(start[0][0]), start[1][0], np.log(start[0][1]), start[1][1]]
+            first = np.broadcast_to(full, (both.size, 4))
+        else:
+            first = begin
+        mm, bb, conv = _fit_competing(lnx[both], k1[both], k2[both], n[both], first)
         med[both], bet[both] = mm, bb
         code[both] = np.where(conv, _CODE["ok"], _CODE["not_converged"])[:, None]
         med[both[~conv]], bet[both[~conv]] = np.nan, np.nan
@@ -728,7 +781,7 @@ def _fit_competing_counts(lnx, m, n, stripes):
         und[:, j] = sep
         if stripes:  # (the other mode's censoring informs beta: no fraction rule)
             lv, _ = _distinct_inner(lnx, kk, n)
-            one = (lv == 1) & (code[:, j] != _CODE["no_data"])
+            one = (lv == 1) & ~np.isin(code[:, j], _EMPTY)
             code[one, j] = _CODE["one_stripe"]
             med[one, j] = np.nan
             und[:, j] |= one
@@ -1027,26 +1080,32 @@ def _refuse_filled(ds: xr.Dataset, states: Sequence[str], counted: xr.DataArray)
 
     filled = (ds["computed"] == FILLED) & counted
     n = int(filled.sum())
-    need = [s for s in states if parse_state(s)[0] in ("uplift", "theta")]
+    need = [s for s in states if parse_state(s)[0] in (UPLIFT, "theta")]
     if n and need:
         raise FragilityError(
             f"state {need[0]!r}: {n} points of this adaptive sweep were filled from the class "
             "around them, not computed, so their uplift and theta are unknown; only "
-            f"{OVERTURN}, {MODE1} and {MODE2} can be fitted (sweep without --adaptive for "
-            "this state)")
+            f"{OVERTURN}, {MODE1} and {MODE2} can be fitted (a sweep that computes every "
+            "point can give it)")
 
 
 def _missing_text(not_run: np.ndarray, levels: np.ndarray | None, unit: str,
-                  stripe: str | None, complete: Any) -> str:
-    """'N points not computed (at PGA 1.2-1.6 g)...' for one curve's not_run (R[, S])."""
+                  stripe: str | None, complete: Any, names: Sequence[str]) -> str:
+    """'N points not computed (at PGA 1.2-1.6 g, records ...) left out' for one curve's
+    not_run (R[, S])."""
     n = int(not_run.sum())
-    where = ""
+    where = []
     if levels is not None:
         miss = levels[not_run.reshape(not_run.shape[0], -1).any(0)]
-        where = f" at {stripe} {miss.min():.3g}-{miss.max():.3g} {unit}".rstrip()
+        where.append(f"{stripe} {miss.min():.3g}-{miss.max():.3g} {unit}".rstrip())
+    recs = [names[r] for r in np.flatnonzero(not_run.reshape(not_run.shape[0], -1).any(-1))]
+    if len(recs) < len(names):
+        where.append("record" + "s" * (len(recs) > 1) + " " + ", ".join(recs[:3])
+                     + (f" and {len(recs) - 3} more" if len(recs) > 3 else ""))
     state = (" (the file is not complete: a sweep still running or stopped; finish it with "
              "--resume)") if complete in (0, False) else ""
-    return f"{n} points not computed{where} left out{state}"
+    return f"{n} points not computed at {', '.join(where)} left out{state}" if where else \
+        f"{n} points not computed left out{state}"
 
 
 def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
@@ -1136,7 +1195,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     n_flag = flagged_da.transpose(*order).values
     n_nrun = not_run_da.transpose(*order).values
     hits = np.stack([state_reached(ds, s).transpose(*order).values for s in states])
-    over_all = state_reached(ds, "overturn").transpose(*order).values
+    over_all = state_reached(ds, OVERTURN).transpose(*order).values
     shape_o = tuple(ds.sizes[d] for d in others)
     n_o = int(np.prod(shape_o)) if shape_o else 1
     R = ds.sizes["record"]
@@ -1187,8 +1246,11 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
                 w = why[i][o]
                 w[ENDINGS[int(code[0, q])]] = ""
                 if und[0, q]:
-                    w["beta_undetermined"] = ("one stripe, separation, or fewer than 2 "
-                                              "distinct fractions strictly between 0 and 1")
+                    c = ENDINGS[int(code[0, q])]
+                    w["beta_undetermined"] = (
+                        "one IM level counted" if c == "one_stripe" else
+                        "separated data: the likelihood grows as beta -> 0" if c == "separated"
+                        else "fewer than 2 distinct stripe fractions strictly between 0 and 1")
             _verdicts(kind, idxs, o, lnx, m, med[0], bet[0], why, counted[o], n_flag[o],
                       hits, over_all[o], states, bool(stripe), onehot_of)
     if N:
@@ -1198,8 +1260,9 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
             for o in range(n_o):
                 for kind, idxs in groups:
                     oh = onehot_of(kind, idxs, o, counted[o])
+                    st = (res["im_median"][idxs, o], res["beta"][idxs, o])
                     med, bet, _, _ = _fit_counts(kind, lnx, _category_counts(
-                        w, oh, bool(stripe)), bool(stripe))
+                        w, oh, bool(stripe)), bool(stripe), start=st)
                     bad = ~(np.isfinite(med) & np.isfinite(bet))
                     med[bad], bet[bad] = np.nan, np.nan
                     for q, i in enumerate(idxs):
@@ -1209,6 +1272,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
             for kind, idxs in groups:
                 med_s = samples[0, idxs, o].T  # (N, G)
                 bet_s = samples[1, idxs, o].T
+                # (the intervals use every resample; the band the first BAND_SAMPLES)
                 for q_i, i in enumerate(idxs):
                     fin = np.isfinite(med_s[:, q_i])
                     n_undef[i, o] = int((~fin).sum())
@@ -1219,9 +1283,10 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
                             res["im_median"][i, o]):
                         why[i][o]["bootstrap_undefined"] = (
                             f"{n_undef[i, o]} of {N} resamples without a finite fit")
+                med_s, bet_s = med_s[:BAND_SAMPLES], bet_s[:BAND_SAMPLES]
                 rows = (np.all(np.isfinite(med_s) & np.isfinite(bet_s), -1)
                         if kind == "competing" else None)
-                step = max(1, BOOT_ELEMENTS // max(N * len(idxs), 1))
+                step = max(1, BOOT_ELEMENTS // max(med_s.shape[0] * len(idxs), 1))
                 for g0 in range(0, grid.size, step):
                     gs = slice(g0, g0 + step)
                     cur = _curves(kind, grid[gs], med_s if rows is None else med_s[rows],
@@ -1234,7 +1299,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     for o in range(n_o):
         if n_nrun[o].any():
             text = _missing_text(n_nrun[o], levels if stripe else None, unit, stripe,
-                                 ds.attrs.get("complete"))
+                                 ds.attrs.get("complete"), names)
             for i in range(nS):
                 why[i][o]["incomplete"] = text
     reason = np.array([[_words(why[i][o]) for o in range(n_o)] for i in range(nS)],
@@ -1319,7 +1384,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
         attrs["period"] = per
     out = xr.Dataset(data, coords=coords, attrs=attrs)
     if warn:
-        for text in verdict_lines(out, why, others, shape_o):
+        for text in verdict_lines(out, why):
             warnings.warn(text, FragilityWarning, stacklevel=2)
     return out
 
@@ -1371,8 +1436,10 @@ def _verdicts(kind, idxs, o, lnx, m, med, bet, why, counted, flagged, hits, over
                                             "could move im_median")
 
 
-def verdict_lines(frag: xr.Dataset, why=None, others=None, shape_o=None) -> list[str]:
-    """One line per curve whose ``reason`` is not "ok": where, which state, and why."""
+def verdict_lines(frag: xr.Dataset, why: list[list[dict[str, str]]] | None = None
+                  ) -> list[str]:
+    """One line per curve of a ``fragility`` Dataset whose ``reason`` is not "ok": where,
+    which state, and why (with the numbers of ``why[state][curve]`` when given)."""
     lines = []
     reason = frag["reason"]
     dims = [d for d in reason.dims if d != "state"]
@@ -1396,6 +1463,44 @@ def verdict_lines(frag: xr.Dataset, why=None, others=None, shape_o=None) -> list
             lines.append(f"fragility{' ' + where if where else ''}, state {st}: "
                          + "; ".join(parts))
     return lines
+
+
+def probability(frag: xr.Dataset, x: Sequence[float] | np.ndarray) -> xr.DataArray:
+    """P(state | IM = x) of every curve of a ``fragility`` Dataset at the IMs x (float[X] >
+    0, the fragility's IM units), by each state's model (``fit``): the lognormal CDF
+    Phi(ln(x / im_median) / beta) for "single" and "ordinal" fits, the competing-risk
+    probabilities P(C_k <= x, C_k < C_other) for "competing" (mode1 with mode2: not a
+    lognormal CDF of their im_median and beta). NaN where a fit has no curve. Returns a
+    DataArray over ``im_median``'s dims + ("im",)."""
+    xs = np.asarray(x, dtype=np.float64).ravel()
+    if np.any(~np.isfinite(xs) | (xs <= 0.0)):
+        raise FragilityError("x: every IM must be finite and > 0")
+    med_da = frag["im_median"]
+    lead = "state" in med_da.dims
+    dims = [d for d in med_da.dims if d != "state"]
+    med = med_da.transpose(*(["state"] if lead else []), *dims).values
+    bet = frag["beta"].transpose(*(["state"] if lead else []), *dims).values
+    med, bet = (np.asarray(a, dtype=np.float64) if lead else np.asarray(a)[None]
+                for a in (med, bet))
+    kinds = np.atleast_1d(np.asarray(frag["fit"].values)) if "fit" in frag else \
+        np.array(["single"] * med.shape[0])
+    states = list(np.atleast_1d(np.asarray(frag["state"].values)))
+    out = np.full(med.shape + (xs.size,), np.nan)
+    for i, kind in enumerate(kinds):
+        if kind == "competing":
+            j1, j2 = states.index(MODE1), states.index(MODE2)
+            m = np.stack([med[j1], med[j2]], -1)
+            b = np.stack([bet[j1], bet[j2]], -1)
+            both = _curves("competing", xs, m, b)
+            out[i] = both[..., 0 if states[i] == MODE1 else 1, :]
+        else:
+            out[i] = lognormal_cdf(xs, med[i][..., None], bet[i][..., None])
+    if not lead:
+        out = out[0]
+    return xr.DataArray(out, dims=[*(["state"] if lead else []), *dims, "im"],
+                        coords={**{d: frag[d] for d in dims if d in frag.coords},
+                                "state": frag["state"], "im": xs},
+                        attrs={"long_name": "probability of the state", "units": "1"})
 
 
 def lognormal_cdf(x, median, beta) -> np.ndarray:

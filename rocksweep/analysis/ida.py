@@ -4,13 +4,19 @@ A scaled suite's sweep runs every record at every stripe of its intensity measur
 PGA, PGV, Sa, PGA_ratio or PGV_ratio). Its stripes say, per record, the first level that
 overturns the body; ``ida`` refines that level: between the last stripe below it (which
 does not overturn) and it, the record's scale is bisected to a relative tolerance with
-single kernel runs at the sweep's numerics (``boundaries.kernel_evaluator``, the runs of
-the A_min bisection). The scaled record's peak, and so the kernel's amplitude, is linear
-in the IM, so a level x between stripes is the stripe's point with its amplitude times
+single kernel runs at the sweep's numerics (``compute.single.simulate``: each run
+certified as a single run is). The scaled record's peak, and so the kernel's amplitude,
+is linear in the IM, so a level x between stripes is the stripe's point with its amplitude times
 x / stripe. Overturning means outcome 1 or 2 (mode 1, mode 2).
 
 "Resurrection" (Vamvatsikos & Cornell 2002): a stripe above the first overturning level
 where the record does not overturn.
+
+Points the kernel flagged undecided (horizon, step or event cap, non-finite: status &
+STATUS_FLAGGED) are neither safe nor overturning: the bracket's bottom is the highest
+stripe below the first overturning one that is decided safe (a flagged stripe between
+them lies inside the bracket and the bisection decides it), and a bisection run that comes
+back flagged stops that record's bisection with its bracket as it is (``unresolved`` = 1).
 """
 
 from __future__ import annotations
@@ -20,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.analysis.boundaries import kernel_evaluator
+from rocksweep.compute.single import simulate
 from rocksweep.errors import IdaError, check_rtol
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.store.reader import as_result, result_scene
@@ -36,12 +42,15 @@ def ida(ds: Any, rtol: float = 1e-2) -> Any:
     ds: a complete sweep of a scaled record suite (what ``rocksweep.run`` or
     ``rocksweep.open`` returns; the stripe dimension is named by ``ds.attrs["scale_im"]``).
     Returns an ``xarray.Dataset`` over the other swept keys (lam, p, ...) and ``record``:
-    ``ida_im`` [IM units] (the smallest overturning level: the bracket's top; NaN: no
-    stripe overturns the record; the lowest stripe when it already overturns, then only
-    an upper bound, ``upper_bound`` = 1), ``ida_lo``/``ida_hi`` (the final bracket: lo
-    does not overturn, hi does), ``mode`` (1 or 2 at ida_hi; 0 where NaN), ``runs`` (kernel
-    runs of the bisection), ``resurrection`` (1: a higher stripe is safe again).
-    Flagged points (status & STATUS_FLAGGED) count as not overturning.
+    ``ida_lo``/``ida_hi`` [IM units] (the final bracket: lo is decided safe, hi
+    overturns; NaN hi: no stripe overturns the record; NaN lo: no stripe below hi is
+    decided safe, ``upper_bound`` = 1), ``ida_im`` (the estimate of the smallest
+    overturning level: the bracket's geometric middle, within rtol / 2 of both ends;
+    ida_hi where lo is NaN), ``mode`` (1 or 2 at ida_hi; 0 where NaN), ``runs`` (kernel
+    runs of the bisection), ``resurrection`` (1: a higher decided stripe is safe again),
+    ``n_flagged`` (flagged stripe points of the record: neither safe nor overturning),
+    ``unresolved`` (1: a bisection run came back flagged; the bracket is wider than
+    rtol).
     """
     import xarray as xr
 
@@ -58,33 +67,40 @@ def ida(ds: Any, rtol: float = 1e-2) -> Any:
         raise IdaError(f"{result.path}: {int((outcome < 0).sum())} points not computed; "
                        "finish the sweep (--resume) first")
     scene = result_scene(result)
-    evaluate = kernel_evaluator(scene)
     dims = list(result.dims)
     others = [d for d in dims if d not in (im, "record")]
     order = [*others, "record", im]
     perm = [dims.index(d) for d in order]
-    flagged = (np.asarray(result.arrays["status"]) & L.STATUS_FLAGGED) != 0
-    over = np.isin(outcome, (L.OUTCOME_MODE1, L.OUTCOME_MODE2)) & ~flagged
-    over = np.transpose(over, perm)
+    flagged = np.transpose((np.asarray(result.arrays["status"]) & L.STATUS_FLAGGED) != 0,
+                           perm)
     modes = np.transpose(outcome, perm)
+    over = np.isin(modes, (L.OUTCOME_MODE1, L.OUTCOME_MODE2)) & ~flagged
+    safe = ~over & ~flagged
     levels = np.asarray(result.coords[im], float)
     if not np.all(np.diff(levels) > 0):
         raise IdaError(f"{result.path}: the {im} stripes must increase")
     lead = over.shape[:-1]  # (others..., record)
     flat_over = over.reshape(-1, levels.size)
+    flat_safe = safe.reshape(-1, levels.size)
     flat_mode = modes.reshape(-1, levels.size)
     n = flat_over.shape[0]
     first = np.where(flat_over.any(-1), flat_over.argmax(-1), -1)
-    safe_above = np.array([j >= 0 and not flat_over[i, j:].all() for i, j in enumerate(first)])
+    safe_above = np.array([j >= 0 and bool(flat_safe[i, j:].any())
+                           for i, j in enumerate(first)])
+    # the bracket's bottom: the highest stripe below the first overturning one decided safe
+    below = flat_safe & (np.arange(levels.size)[None, :] < np.where(first >= 0, first, 0)[:,
+                                                                                          None])
+    bottom = np.where(below.any(-1), levels.size - 1 - below[:, ::-1].argmax(-1), -1)
     lo = np.full(n, np.nan)
     hi = np.full(n, np.nan)
     mode = np.zeros(n, np.int8)
     runs = np.zeros(n, np.int64)
+    unresolved = np.zeros(n, np.int8)
     has = first >= 0
     hi[has] = levels[first[has]]
     mode[has] = flat_mode[has, first[has]]
-    inner = np.flatnonzero(first > 0)
-    lo[inner] = levels[first[inner] - 1]
+    inner = np.flatnonzero(has & (bottom >= 0))
+    lo[inner] = levels[bottom[inner]]
     # the point at each bracket's top stripe: its amplitude scales with the level
     base = {a.name: a.values[0] for a in scene.axes}
     points = {}
@@ -99,40 +115,51 @@ def ida(ds: Any, rtol: float = 1e-2) -> Any:
     for _ in range(MAX_ITER):
         if not active:
             break
-        mids = {i: 0.5 * (lo[i] + hi[i]) for i in active}
-        batch = [dataclasses.replace(points[i],
-                                     A_ratio=points[i].A_ratio * mids[i] / levels[first[i]])
-                 for i in active]
-        got = evaluate(batch)
-        for i, g in zip(active, got, strict=True):
+        for i in active:
+            mid = 0.5 * (lo[i] + hi[i])
+            pt = dataclasses.replace(points[i],
+                                     A_ratio=points[i].A_ratio * mid / levels[first[i]])
+            out = simulate(pt, scene.numerics, history=False).out
             runs[i] += 1
-            if g in (L.OUTCOME_MODE1, L.OUTCOME_MODE2):
-                hi[i], mode[i] = mids[i], g
+            g = int(out[L.OUT_OUTCOME])
+            if int(out[L.OUT_STATUS]) & L.STATUS_FLAGGED:
+                unresolved[i] = 1
+            elif g in (L.OUTCOME_MODE1, L.OUTCOME_MODE2):
+                hi[i], mode[i] = mid, g
             else:
-                lo[i] = mids[i]
-        active = [i for i in active if hi[i] - lo[i] > rtol * hi[i]]
+                lo[i] = mid
+        active = [i for i in active if not unresolved[i] and hi[i] - lo[i] > rtol * hi[i]]
+    est = np.where(np.isfinite(lo), np.sqrt(lo * hi), hi)
+    n_flag = flagged.reshape(-1, levels.size).sum(-1)
     shape = lead
     unit = fields.axis_attrs(im).get("units", "1")
     coords = {d: (d, np.asarray(result.coords[d]), fields.axis_attrs(d))
               for d in [*others, "record"]}
     dims_out = [*others, "record"]
     data = {
-        "ida_im": (dims_out, hi.reshape(shape),
-                   {"long_name": f"smallest {im} that overturns the record", "units": unit}),
-        "ida_lo": (dims_out, lo.reshape(shape),
-                   {"long_name": "bracket: largest level that does not overturn",
+        "ida_im": (dims_out, est.reshape(shape),
+                   {"long_name": f"smallest {im} that overturns the record (the bracket's "
+                                 "geometric middle; ida_hi where ida_lo is NaN)",
                     "units": unit}),
+        "ida_lo": (dims_out, lo.reshape(shape),
+                   {"long_name": "bracket: largest level decided safe", "units": unit}),
         "ida_hi": (dims_out, hi.reshape(shape),
                    {"long_name": "bracket: smallest level that overturns", "units": unit}),
-        "upper_bound": (dims_out, ((first == 0).astype(np.int8)).reshape(shape),
-                        {"long_name": "1: the lowest stripe already overturns (ida_im is "
+        "upper_bound": (dims_out, (has & (bottom < 0)).astype(np.int8).reshape(shape),
+                        {"long_name": "1: no stripe below ida_hi is decided safe (ida_im is "
                                       "an upper bound)"}),
         "mode": (dims_out, mode.reshape(shape),
                  {"long_name": "overturning mode at ida_hi", "flag_values": [0, 1, 2],
                   "flag_meanings": "none mode1 mode2"}),
         "runs": (dims_out, runs.reshape(shape), {"long_name": "kernel runs of the bisection"}),
         "resurrection": (dims_out, safe_above.astype(np.int8).reshape(shape),
-                         {"long_name": "1: a stripe above ida_im does not overturn"}),
+                         {"long_name": "1: a stripe above ida_hi is decided safe"}),
+        "n_flagged": (dims_out, n_flag.reshape(shape),
+                      {"long_name": "flagged stripe points (status & STATUS_FLAGGED): "
+                                    "neither safe nor overturning"}),
+        "unresolved": (dims_out, unresolved.reshape(shape),
+                       {"long_name": "1: a bisection run came back flagged; the bracket "
+                                     "is wider than rtol"}),
     }
     return xr.Dataset(data, coords=coords,
                       attrs={"im": im, "im_units": unit, "rtol": float(rtol),

@@ -158,7 +158,7 @@ def _openquake(lines: list[str], where: str, site: int | None) -> Hazard:
 
     meta = lines[0]
     t = re.search(r"investigation_time\s*=\s*'?([0-9.eE+-]+)", meta)
-    imt = re.search(r"imt\s*=\s*'([^']+)'", meta)
+    imt = re.search(r"imt\s*=\s*['\"]([^'\"]+)['\"]", meta)  # 'PGA' (3.x), "PGA" (2.x)
     if t is None or imt is None:
         raise RiskError(f"{where}: OpenQuake header without investigation_time and imt: "
                         f"{meta[:80]!r}")

@@ -6,11 +6,12 @@ A sweep over ``p`` (a record scene: the body's frequency parameter [rad/s]) or
 - the rocking spectrum: max |theta| / alpha_cg against p, one curve per A_ratio and lam
   (overturned points marked; their max |theta| is the overturning angle's pi/2);
 - the overturning spectrum: the smallest A_ratio that overturns against p, one curve per
-  lam, with the mode it overturns in. Between the first overturning grid value of each p
-  and the grid value below, A_ratio is bisected to ``rtol`` (relative) with single kernel
-  runs at the sweep's numerics: ``rocksweep.analysis.boundaries.a_min`` (shared with the stability
-  diagram's A_min curves), with an evaluator here that also runs records and the GROUND
-  pulses (``boundaries.kernel_evaluator``, which runs every ground motion's kernel).
+  lam, with the mode it overturns in, to ``rtol`` (relative) whatever the grid's spacing:
+  a search below the first overturning grid value of each p and a bisection, with single
+  kernel runs at the sweep's numerics: ``rocksweep.analysis.boundaries.a_min`` (shared
+  with the stability diagram's A_min curves), with an evaluator here that also runs
+  records and the GROUND pulses (``boundaries.kernel_evaluator``, which runs every ground
+  motion's kernel).
 
 The scene is rebuilt from the file (its YAML); a record is re-read from the path the sweep
 read it at and must have the same SHA-256 as then. The figure is
@@ -23,7 +24,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rocksweep.analysis.boundaries import DEFAULT_RTOL, AMinCurve, a_min, kernel_evaluator
+from rocksweep.analysis.boundaries import (
+    A_MIN_METHODS,
+    RESPONSE,
+    AMinCurve,
+    a_min,
+    grid_response,
+    kernel_evaluator,
+)
+from rocksweep.analysis.tolerance import DEFAULT_RTOL, check_rtol
 from rocksweep.errors import SpectrumError  # noqa: F401 (defined there; re-exported)
 from rocksweep.vocab.outcomes import MODE_WORDS, OUTCOME_WORDS, flag_attrs
 
@@ -55,7 +64,8 @@ class Spectra:
 
     def to_dataset(self):
         """The spectra as an ``xarray.Dataset``: ``theta_max_over_alpha`` and ``outcome``
-        over (lam, A_ratio, freq) (the rocking spectrum), ``A_min`` and ``mode`` over (lam,
+        over (lam, A_ratio, freq) (the rocking spectrum), ``A_min``, ``mode`` and
+        ``A_min_method`` (how A_min was found, ``boundaries.A_MIN_METHODS``) over (lam,
         freq) (the overturning spectrum, bisected to ``rtol``; NaN: no grid value
         overturns), freq being ``p`` [rad/s] or ``w_over_p``."""
         import xarray as xr
@@ -64,6 +74,7 @@ class Spectra:
 
         a_min = np.array([c.a_min for c in self.a_min], float).reshape(len(self.lam), -1)
         mode = np.array([c.mode for c in self.a_min], np.int8).reshape(a_min.shape)
+        method = np.array([c.method_words for c in self.a_min], str).reshape(a_min.shape)
         f = self.freq
         theta_attrs = fields.field_attrs(fields.BY_NAME["theta_max_over_alpha"], self.kind)
         return xr.Dataset(
@@ -74,7 +85,10 @@ class Spectra:
                        {**fields.axis_attrs("A_ratio", self.kind),
                         "long_name": "smallest overturning amplitude ratio"}),
              "mode": (("lam", f), mode, {"long_name": "overturning mode at A_min",
-                                         **flag_attrs(MODE_WORDS)})},
+                                         **flag_attrs(MODE_WORDS)}),
+             "A_min_method": (("lam", f), method,
+                              {"long_name": "how A_min was found",
+                               "flag_meanings": ";".join(A_MIN_METHODS)})},
             coords={"lam": ("lam", self.lam, fields.axis_attrs("lam")),
                     "A_ratio": ("A_ratio", self.A, fields.axis_attrs("A_ratio", self.kind)),
                     f: (f, self.x, fields.axis_attrs(f))},
@@ -87,7 +101,8 @@ def spectra(data, rtol: float = DEFAULT_RTOL) -> Spectra:
     ``rocksweep.run`` / ``rocksweep.open`` return), a ``SweepResult`` or a file's path."""
     from rocksweep.store.reader import as_result, result_scene
 
-    result = as_result(data, ["outcome", "status", "theta_max_over_alpha"])
+    rtol = check_rtol(rtol)
+    result = as_result(data, [*RESPONSE, "status"])
     freq = "p" if "p" in result.dims else "w_over_p"
     missing = [d for d in (freq, "A_ratio") if d not in result.dims]
     if missing:
@@ -116,7 +131,7 @@ def spectra(data, rtol: float = DEFAULT_RTOL) -> Spectra:
         lam = np.asarray(result.coords["lam"], float)
     scene = result_scene(result)
     curves = a_min(scene, result.arrays["outcome"], rtol, axes=(freq, "A_ratio"),
-                   evaluate=kernel_evaluator(scene))
+                   evaluate=kernel_evaluator(scene), **grid_response(result))
     rec = result.scene.get("record") or {}
     return Spectra(result.name, freq, np.asarray(result.coords[freq], float), A, lam,
                    theta, outcome, curves, rtol, int(sum(c.runs.sum() for c in curves)),

@@ -11,7 +11,8 @@ more short dimension (``record_sa`` over ``period``) as one column per value,
 ``record_sa(0.2)``; and for a record suite the IMs of the ground motion each run saw, the
 record's IM times scale_factor^n (``physics.suite.RECORD_IMS``): ``pga`` [g], ``pgv``
 [m/s], ``arias`` [m/s], ``cav`` [m/s], ``d5_95`` [s], ``pgv_over_pga`` [s], ``avgsa`` [g],
-``sa(T)`` [g]. The units of every column are in ``DataFrame.attrs["units"]``.
+``sa(T)`` [g], and PGA/(g tan alpha) ``pga_ratio``, PGV p/(g tan alpha) ``pgv_ratio``. The
+units of every column are in ``DataFrame.attrs["units"]``.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import xarray as xr
 
 from rocksweep.analysis.kinds import dataset_kind
 from rocksweep.errors import RocksweepError, TableError  # noqa: F401 (re-exported)
+from rocksweep.physics.model import G
 from rocksweep.physics.suite import RECORD_IMS
 
 __all__ = ["ROW_VARIABLE", "TableError", "table"]
@@ -97,6 +99,14 @@ def table(ds: xr.Dataset) -> Any:
                 label = im.lower()
                 cols[label] = flat(ds[var]) * f ** k
                 units[label] = unit
+        alpha = next((cols[a] for a in ("alpha_cg", "alpha") if a in cols), None)
+        if alpha is not None and "pga" in cols:  # the dimensionless ones of the run
+            tan = np.tan(np.asarray(alpha, np.float64))
+            cols["pga_ratio"], units["pga_ratio"] = cols["pga"] / tan, "1"
+            if "pgv" in cols and "p" in cols:
+                cols["pgv_ratio"] = cols["pgv"] * np.asarray(cols["p"], np.float64) / (
+                    G * tan)
+                units["pgv_ratio"] = "1"
         if "record_sa" in ds.data_vars and "period" in ds["record_sa"].dims:
             for i, T in enumerate(ds["period"].values):
                 label = f"sa({float(T):g})"

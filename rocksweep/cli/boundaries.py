@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from rocksweep.cli.main import main, user_errors
-from rocksweep.cli.options import dpi_option, overwrite_option
+from rocksweep.cli.options import dpi_option, overwrite_option, rtol_option
 
 
 @main.command()
@@ -18,8 +18,11 @@ from rocksweep.cli.options import dpi_option, overwrite_option
                    "lines too [default: OUT-amin.csv].")
 @click.option("--lines", "lines_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Also write the boundary polylines as CSV (one row per vertex).")
-@click.option("--rtol", type=float, default=1e-3, show_default=True,
-              help="Relative tolerance of the bisection of A_min in A_ratio.")
+@rtol_option
+@click.option("--search/--no-search", default=True, show_default=True,
+              help="Search below the first overturning grid value for a band narrower "
+                   "than the grid step (--no-search: bisect the grid's bracket only, "
+                   "faster, A_min then depends on the grid).")
 @click.option("--mode", type=click.Choice(["1", "2"]), default=None,
               help="A_min of this overturning mode only [default: either].")
 @click.option("--plot", "fig_path", type=click.Path(dir_okay=False, path_type=Path),
@@ -29,20 +32,20 @@ from rocksweep.cli.options import dpi_option, overwrite_option
 @overwrite_option
 @user_errors
 def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None,
-               rtol: float, mode: str | None, fig_path: Path | None, dpi: int,
-               overwrite: bool) -> None:
+               rtol: float, search: bool, mode: str | None, fig_path: Path | None,
+               dpi: int, overwrite: bool) -> None:
     """The boundaries of the stability diagram of a sweep result (over omega/p and
     A/(g tan alpha)), for each lam and pulse shape: A_min(omega/p), the smallest amplitude
-    that overturns, refined by bisection between the last safe and the first overturning
-    grid value (kernel runs at the sweep's accuracy), with the mode it overturns in; and
-    the lines between classes as polylines. Works on adaptive and regular results."""
+    that overturns, to --rtol whatever the grid's spacing (a search below the first
+    overturning grid value, near the uplift threshold and where the response came close,
+    then a bisection; kernel runs at the sweep's accuracy), with the mode it overturns in
+    and how it was found (column method); and the lines between classes as polylines.
+    Works on adaptive and regular results."""
     from rocksweep.analysis import boundaries as bd
     from rocksweep.figures.common import FORMATS, save_figure
     from rocksweep.outputs import check_distinct, check_output, write_atomic
     from rocksweep.store.reader import read_result
 
-    if not (0 < rtol < 1):
-        raise click.ClickException(f"--rtol {rtol}: give a relative tolerance in (0, 1)")
     out = csv_path if csv_path is not None else result_path.with_name(
         result_path.stem + "-amin.csv")
     h5 = out.suffix.lower() in (".h5", ".hdf5")
@@ -60,8 +63,9 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
         check_output(lines_path, overwrite=overwrite, inputs=inputs)
     if fig_path is not None:
         check_output(fig_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
-    result = read_result(result_path, ["outcome"])
-    curves, bounds = bd.result_curves(result, rtol, None if mode is None else int(mode))
+    result = read_result(result_path, list(bd.RESPONSE))
+    curves, bounds = bd.result_curves(result, rtol, None if mode is None else int(mode),
+                                      search=search)
 
     def write_text(text: str):
         return lambda tmp: tmp.write_text(text)
@@ -69,7 +73,7 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
     rows = bd.a_min_rows(curves)
     runs = int(sum(int(c.runs.sum()) for c in curves))
     if h5:
-        attrs = {"source": str(result_path), "rtol": rtol,
+        attrs = {"source": str(result_path), "rtol": rtol, "search": int(search),
                  "mode": "any" if mode is None else f"mode{mode}"}
         write_atomic(out, lambda tmp: bd.write_curves_h5(tmp, curves, bounds, attrs))
         n = sum(len(b.lines) for b in bounds)
@@ -78,7 +82,8 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
         write_atomic(out, write_text(bd.csv_text(rows)))
         also = ""
     click.echo(f"wrote {out} ({len(rows)} A_min values over {len(curves)} panel(s){also}, "
-               f"{runs} kernel runs for the bisection to rtol {rtol:g})")
+               f"{runs} kernel runs for the search and the bisection to rtol {rtol:g}"
+               f"{_methods(curves)})")
     if lines_path is not None:
         lrows = bd.boundary_rows(bounds)
         write_atomic(lines_path, write_text(bd.csv_text(lrows)))
@@ -90,3 +95,12 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
         fig = a_min_figure(curves, bounds, title=result.name, kind=result.kind)
         save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=inputs)
         click.echo(f"wrote {fig_path}")
+
+
+def _methods(curves) -> str:
+    """How the A_min values were found, counted (", 3 searched below grid, ...")."""
+    from collections import Counter
+
+    n = Counter(w for c in curves for w, a in zip(c.method_words, c.a_min, strict=True)
+                if a == a and w != "grid+bisection")
+    return "".join(f", {k} {w}" for w, k in sorted(n.items()))

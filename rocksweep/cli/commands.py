@@ -3,6 +3,7 @@
 from rocksweep.cli import (  # noqa: F401
     accuracy,
     boundaries,
+    calibrate,
     efficiency,
     fragility,
     info,

@@ -41,16 +41,18 @@ def efficiency(result_path: Path, state: str, out_path: Path | None, fig_path: P
     import rocksweep
     from rocksweep.figures.common import FORMATS, save_figure
     from rocksweep.outputs import check_distinct, check_output, write_atomic
+    from rocksweep.store.reader import result_inputs
 
+    inputs = result_inputs(result_path)  # the result and its records: never written over
     check_distinct({"-o": out_path, "--plot": fig_path})
     if out_path is not None:
         if out_path.suffix.lower() not in SUFFIXES:
             raise click.ClickException(f"-o {out_path}: unsupported suffix "
                                        f"{out_path.suffix or '(none)'!r}; use "
                                        f"{', '.join(SUFFIXES)}")
-        check_output(out_path, overwrite=overwrite, inputs=[result_path])
+        check_output(out_path, overwrite=overwrite, inputs=inputs)
     if fig_path is not None:
-        check_output(fig_path, overwrite=overwrite, inputs=[result_path], suffixes=FORMATS)
+        check_output(fig_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
     eff = rocksweep.im_efficiency(rocksweep.open(result_path), state=state)
     frame = eff[["beta", "beta_scale", "im_median", "slope", "n_records",
                  "n_censored"]].to_dataframe().reset_index()
@@ -82,6 +84,6 @@ def efficiency(result_path: Path, state: str, out_path: Path | None, fig_path: P
             write_atomic(out_path, lambda tmp: _to_netcdf(eff, tmp))
         say(f"wrote {out_path}")
     if fig is not None:
-        save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=[result_path])
+        save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=inputs)
         say(f"wrote {fig_path}")
 

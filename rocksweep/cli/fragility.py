@@ -13,7 +13,7 @@ from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP, MAX_BOOTSTRAP
 from rocksweep.cli.main import main, user_errors
 from rocksweep.cli.options import dpi_option, overwrite_option, result_argument
 from rocksweep.figures import WIDTHS
-from rocksweep.vocab.outcomes import STATES
+from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, STATES, UPLIFT
 
 CURVE_SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
 
@@ -60,8 +60,8 @@ def _g(v) -> str:
 @click.option("--state", default="overturn", show_default=True,
               help="What the curve gives the probability of: " + ", ".join(STATES)
               + " or theta:X (max|theta|/alpha_cg >= X, 0 < X <= 1); several separated by "
-              "commas: damage states (uplift, theta:X, overturn) are fitted with one beta so "
-              "their curves never cross, the two modes together as competing risks.")
+              f"commas: damage states ({UPLIFT}, theta:X, {OVERTURN}) are fitted with one "
+              f"beta so their curves never cross, {MODE1},{MODE2} as competing risks.")
 @click.option("--im", default=None,
               help="Unscaled suites (clouds): the IM, PGA (default), PGV or Sa; stripes use "
                    "the IM they were scaled to.")

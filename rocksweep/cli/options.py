@@ -7,6 +7,7 @@ from pathlib import Path
 
 import click
 
+from rocksweep.analysis.tolerance import DEFAULT_RTOL, MAX_RTOL
 from rocksweep.figures import DEFAULT_DPI, DPI_RANGE
 
 scene_argument = click.argument(
@@ -18,5 +19,21 @@ set_option = click.option(
     help="Override a scene value, e.g. --set pulse.A_ratio=4.5 (repeatable).")
 overwrite_option = click.option("--overwrite", is_flag=True,
                                 help="Replace existing output files.")
+
+
+def _rtol(_ctx: click.Context, _param: click.Parameter, value: float) -> float:
+    from rocksweep.analysis.tolerance import check_rtol
+    from rocksweep.errors import RocksweepError
+
+    try:
+        return check_rtol(value, name="--rtol")
+    except RocksweepError as err:  # a bad option value: a usage error (exit 2)
+        raise click.UsageError(str(err)) from None
+
+
+rtol_option = click.option(
+    "--rtol", type=float, default=DEFAULT_RTOL, show_default=True, callback=_rtol,
+    help=f"Relative tolerance of A_min, in (0, {MAX_RTOL:g}] (search below the first "
+         "overturning grid value, then bisection).")
 dpi_option = click.option("--dpi", type=click.IntRange(*DPI_RANGE), default=DEFAULT_DPI,
                           show_default=True, help="Resolution of raster output (PNG).")

@@ -69,7 +69,7 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
 
     if dataset_kind(ds) != "sweep":
         fig = api.plot(ds)
-        save_figure(fig, fig_out, dpi, overwrite=overwrite, inputs=[result_path])
+        save_figure(fig, fig_out, dpi, overwrite=overwrite, inputs=inputs)
         click.echo(f"wrote {fig_out}")
         return
     fig = api.plot(ds, x_key, y_key, curves=curves, show_computed=show_computed, mu=mu_map,

@@ -82,8 +82,10 @@ def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, sta
     from rocksweep.api import open_any
     from rocksweep.figures.common import FORMATS, save_figure
     from rocksweep.outputs import check_distinct, check_output, write_atomic
+    from rocksweep.store.reader import result_inputs
 
-    inputs = [frag_path, hazard_path]
+    # the fragility or sweep file (and a sweep's records), the hazard curve: never written
+    inputs = [*result_inputs(frag_path), hazard_path]
     check_distinct({"-o": out_path, "--plot": fig_path})
     if out_path is not None:
         if out_path.suffix.lower() not in RISK_SUFFIXES:

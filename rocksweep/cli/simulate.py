@@ -72,6 +72,8 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
         docs = [_json_safe(r.summary()) for r in runs]
         click.echo(json.dumps(docs[0] if len(docs) == 1 else docs, indent=2))
     else:
+        if scene.physical is not None:
+            click.echo(scene.physical_words())
         for r in runs:
             _print_run(r, swept)
     if csv_path is not None:

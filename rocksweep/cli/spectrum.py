@@ -8,15 +8,14 @@ from pathlib import Path
 import click
 
 from rocksweep.cli.main import main, user_errors
-from rocksweep.cli.options import dpi_option, overwrite_option
+from rocksweep.cli.options import dpi_option, overwrite_option, rtol_option
 
 
 @main.command()
 @click.argument("result_path", metavar="OUT.h5", type=click.Path(path_type=Path))
 @click.option("-o", "--output", "fig_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Figure file, .png, .pdf or .svg [default: OUT-spectra.png].")
-@click.option("--rtol", type=click.FloatRange(1e-9, 0.5), default=1e-3, show_default=True,
-              help="Relative tolerance of the smallest overturning A_ratio (bisection).")
+@rtol_option
 @dpi_option
 @overwrite_option
 @user_errors
@@ -36,4 +35,4 @@ def spectrum(result_path: Path, fig_path: Path | None, rtol: float, dpi: int,
     check_output(fig_out, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
     sp = spectra(result_path, rtol)
     save_figure(spectra_figure(sp), fig_out, dpi, overwrite=overwrite, inputs=inputs)
-    click.echo(f"wrote {fig_out} ({sp.runs} kernel runs to bisect A_min to {rtol:g})")
+    click.echo(f"wrote {fig_out} ({sp.runs} kernel runs to find A_min to {rtol:g})")

@@ -28,6 +28,7 @@ def table_command(result_path: Path, out_path: Path, overwrite: bool) -> None:
     import rocksweep
     from rocksweep.api import open_any
     from rocksweep.outputs import check_output, write_atomic
+    from rocksweep.store.reader import result_inputs
 
     suffix = out_path.suffix.lower()
     if suffix not in TABLE_SUFFIXES:
@@ -39,7 +40,7 @@ def table_command(result_path: Path, out_path: Path, overwrite: bool) -> None:
         except ImportError:
             raise click.ClickException(f"-o {out_path}: Parquet needs pyarrow (pip install "
                                        "pyarrow); or write .csv") from None
-    check_output(out_path, overwrite=overwrite, inputs=[result_path])
+    check_output(out_path, overwrite=overwrite, inputs=result_inputs(result_path))
     frame = rocksweep.table(open_any(result_path))
     if suffix == ".csv":
         text = frame.to_csv(index=False)

@@ -19,6 +19,7 @@ import numpy as np
 
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.points import (
+    INITIAL,
     body_omega_rock,
     body_row,
     fill_rows,
@@ -81,6 +82,8 @@ class Grid:
         self._i_ef = names.index("e_factor") if "e_factor" in names else None
         self._law_codes = (None if self._i_law is None else
                            np.array([law_code(w) for w in scene.axes[self._i_law].values]))
+        # the initial state's axes, when the scene gives them (vocab.axes.INITIAL; else at rest)
+        self._i_init = [names.index(k) if k in names else None for k in INITIAL]
         self._values = [np.asarray(a.values, float)
                         if i not in (self._i_shape, self._i_rec, self._i_law) else None
                         for i, a in enumerate(scene.axes)]
@@ -99,13 +102,14 @@ class Grid:
         return out
 
     def _bodies(self, body_index: np.ndarray) -> tuple[np.ndarray, ...]:
-        """Per distinct body index: body rows, omega_rock, alpha_ref, E_ref, kind."""
+        """Per distinct body index: body rows, omega_rock, alpha_ref, E_ref, kind, u_cr."""
         multi = np.unravel_index(body_index, self._body_shape)
         axes = [self.scene.axes[i] for i in self._body_pos]
         n = len(body_index)
         rows = np.empty((n, L.N_PAR))
         omega_rock, alpha_ref, E_ref = np.empty(n), np.empty(n), np.empty(n)
         kinds = np.empty(n, np.int64)
+        u_cr = np.empty(n)
         for j in range(n):
             body = self.scene.make_body(**{a.name: a.values[int(m[j])]
                                            for a, m in zip(axes, multi, strict=True)})
@@ -114,7 +118,8 @@ class Grid:
             alpha_ref[j] = body.alpha_ref
             E_ref[j] = body.E_ref
             kinds[j] = kernel_kind(body)
-        return rows, omega_rock, alpha_ref, E_ref, kinds
+            u_cr[j] = body.u_cr
+        return rows, omega_rock, alpha_ref, E_ref, kinds, u_cr
 
     def rows(self, start: int, stop: int) -> ChunkRows:
         """Rows of the points with flat indices ``start <= i < stop``."""
@@ -128,7 +133,7 @@ class Grid:
         multi = np.unravel_index(flat, self.full_shape)
         body_index = np.ravel_multi_index([multi[i] for i in self._body_pos], self._body_shape)
         distinct, inverse = np.unique(body_index, return_inverse=True)
-        b_rows, b_omega, b_alpha, b_E, b_kind = self._bodies(distinct)
+        b_rows, b_omega, b_alpha, b_E, b_kind, b_ucr = self._bodies(distinct)
         n = flat.size
         rows = np.empty((n, L.N_PAR))
         alpha_ref = b_alpha[inverse]
@@ -137,9 +142,13 @@ class Grid:
         e = np.nan if self._i_e is None else self._values[self._i_e][multi[self._i_e]]
         e = np.where(law == L.LAW_CONSTANT, e, np.nan)  # e is law constant's alone
         e_factor = 1.0 if self._i_ef is None else self._values[self._i_ef][multi[self._i_ef]]
+        initial = (None if all(i is None for i in self._i_init) else
+                   tuple(0.0 if i is None else self._values[i][multi[i]] for i in self._i_init))
+        u_cr = b_ucr[inverse]
         if self.scene.suite is not None:
             return self._suite_rows(multi, rows, b_rows[inverse], b_omega[inverse], alpha_ref,
-                                    b_kind[inverse], b_E[inverse], (law, e, e_factor))
+                                    b_kind[inverse], b_E[inverse], (law, e, e_factor),
+                                    initial, u_cr)
         fill_rows(rows, b_rows[inverse], b_omega[inverse], alpha_ref,
                   self._values[self._i_lam][multi[self._i_lam]],
                   self._shape_codes[multi[self._i_shape]],
@@ -148,11 +157,11 @@ class Grid:
                   self.scene.option("cycles"), self.scene.option("gamma"),
                   self.scene.option("nu"), self.scene.record,
                   np.nan if self._i_mu is None else self._values[self._i_mu][multi[self._i_mu]],
-                  law, e, e_factor)
+                  law, e, e_factor, initial, u_cr)
         return ChunkRows(rows, b_kind[inverse], alpha_ref, b_E[inverse])
 
     def _suite_rows(self, multi, rows, body_rows, omega_rock, alpha_ref, kinds, E_ref,
-                    impact: tuple) -> ChunkRows:
+                    impact: tuple, initial: tuple | None = None, u_cr=0.0) -> ChunkRows:
         """Rows of a suite's points: each point's record scaled to its stripe (the peak
         as A_ratio, ``Suite.peak_ratio``), filled record by record (each record has its
         own DT and length)."""
@@ -164,13 +173,18 @@ class Grid:
         a_ratio = su.peak_ratio(rec, stripe, alpha_ref, p)
         code = self._shape_codes[multi[self._i_shape]]
         law, e, e_factor = (np.broadcast_to(np.asarray(v, float), lam.shape) for v in impact)
+        if initial is not None:
+            initial = tuple(np.broadcast_to(np.asarray(v, float), lam.shape) for v in initial)
+        u_cr = np.broadcast_to(np.asarray(u_cr, float), lam.shape)
         for r in np.unique(rec):
             sel = rec == r
             part = np.empty((int(sel.sum()), L.N_PAR))
             fill_rows(part, body_rows[sel], omega_rock[sel], alpha_ref[sel], lam[sel],
                       code[sel], p[sel], a_ratio[sel], self.scene.numerics,
                       record=su.records[int(r)], law=law[sel], e=e[sel],
-                      e_factor=e_factor[sel])
+                      e_factor=e_factor[sel],
+                      initial=None if initial is None else tuple(v[sel] for v in initial),
+                      u_cr=u_cr[sel])
             rows[sel] = part
         return ChunkRows(rows, kinds, alpha_ref, E_ref, rec)
 

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rocksweep import fields
+from rocksweep.compute.certify import certify
 from rocksweep.kernel import chunk_kernel, point_kernel, warm_up
 from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
@@ -118,7 +119,9 @@ class Run:
 def history_capacity(row: np.ndarray) -> int:
     """Rows a full history of this point can need: every step plus 3 rows per event (a
     record's steps on its samples counted on top)."""
-    steps = math.ceil(row[L.PAR_TEND] / row[L.PAR_DT])
+    t_pulse = min(row[L.PAR_TPULSE], row[L.PAR_TEND])
+    steps = math.ceil(t_pulse / row[L.PAR_DT_ON]) + math.ceil(
+        (row[L.PAR_TEND] - t_pulse) / row[L.PAR_DT])
     if row[L.PAR_REC_H] > 0.0:
         steps += math.ceil(row[L.PAR_TPULSE] / row[L.PAR_REC_H]) + 1
     return int(steps + 3 * row[L.PAR_MAXEVENTS] + 16)
@@ -131,12 +134,34 @@ def simulate(point: Point, numerics: Numerics, history: bool = True,
     kind runs (what sweeps run), or the contact kernel with ``contact``. ``contact``: the
     summary reports the contact fields."""
     row = point_row(point, numerics)
-    out = np.empty(L.N_OUT)
     kind = kernel_kind(point.body)
     ground = point.ground
     lvl = L.LEVEL_CONTACT if contact else L.LEVEL_OUTCOME
     warm_up(kind, None if history else lvl, ground)  # wall_time excludes compilation
     t0 = time.perf_counter()
+    out, hist_d = _run(row, kind, lvl, ground, history, contact)
+    if numerics.refine > 0:
+        # the certification of close calls, as in sweeps (``compute.certify``): the
+        # finest run's result and history are kept
+        kept = {}
+
+        def rerun(rows: np.ndarray, idx: np.ndarray) -> np.ndarray:
+            o, h = _run(rows[0], kind, lvl, ground, history, contact)
+            kept["history"] = h
+            return o[None, :]
+
+        outs = out[None, :].copy()
+        certify(row[None, :], outs, rerun, numerics.refine)
+        out = outs[0]
+        if "history" in kept:
+            hist_d = kept["history"]
+    return Run(point, numerics, out, hist_d, time.perf_counter() - t0, contact)
+
+
+def _run(row: np.ndarray, kind: int, lvl: int, ground: bool, history: bool,
+         contact: bool) -> tuple[np.ndarray, dict | None]:
+    """One kernel run of a parameter row: (result row float64[N_OUT], history or None)."""
+    out = np.empty(L.N_OUT)
     if history:
         hist = np.empty((history_capacity(row), L.N_HIST))
         point_kernel(kind, ground)(row, out, hist)
@@ -144,9 +169,7 @@ def simulate(point: Point, numerics: Numerics, history: bool = True,
             out[L.OUT_STATUS] = int(out[L.OUT_STATUS]) & ~(L.STATUS_SLIDES | L.STATUS_LIFTS_OFF)
             out[[L.OUT_MU_REQ, L.OUT_N_MIN, L.OUT_IMPULSE_MAX]] = np.nan
         n = int(out[L.OUT_HIST_ROWS])
-        hist_d = {c.raw: hist[:n, c.slot].copy() for c in fields.HISTORY}
-    else:
-        outs = out[None, :]
-        chunk_kernel(kind, lvl, ground)(row[None, :], outs)
-        hist_d = None
-    return Run(point, numerics, out, hist_d, time.perf_counter() - t0, contact)
+        return out, {c.raw: hist[:n, c.slot].copy() for c in fields.HISTORY}
+    outs = out[None, :]
+    chunk_kernel(kind, lvl, ground)(row[None, :], outs)
+    return out, None

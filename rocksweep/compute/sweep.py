@@ -37,6 +37,7 @@ from rocksweep.compute.arguments import (  # noqa: F401 (re-exported)
     check_jobs,
     probe_scheduler,
 )
+from rocksweep.compute.certify import certify as certify_runs
 from rocksweep.compute.grid import ChunkRows, Grid
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.points import with_record
@@ -98,11 +99,27 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
                        time.thread_time() - c0)
 
 
-def run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene) -> np.ndarray:
+def run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene,
+             certify: bool = True) -> np.ndarray:
     """The one dispatch of parameter rows to the compiled kernel variants: result rows
     float64[n, N_OUT] of ``rows`` (float64[n, N_PAR], those of ``cr`` or their half-step
     reruns) at bookkeeping ``level``: one kernel call per body kind present, the scene's
-    ground variant (Ricker, MP, records) with a record's samples riding on the rows."""
+    ground variant (Ricker, MP, records) with a record's samples riding on the rows.
+    certify: re-run the close calls finer (``compute.certify``, up to the scene's
+    ``numerics.refine`` refinements)."""
+    outs = _dispatch(cr, rows, level, scene)
+    if certify and scene.numerics.refine > 0:
+        def rerun(sub: np.ndarray, idx: np.ndarray) -> np.ndarray:
+            part = ChunkRows(sub, cr.kinds[idx], cr.alpha_ref[idx], cr.E_ref[idx],
+                             None if cr.record_index is None else cr.record_index[idx])
+            return _dispatch(part, sub, level, scene)
+
+        certify_runs(rows, outs, rerun, scene.numerics.refine)
+    return outs
+
+
+def _dispatch(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene) -> np.ndarray:
+    """``run_rows`` without the certification: the kernel on every row once."""
     outs = np.empty((rows.shape[0], L.N_OUT))
     for kind in np.unique(cr.kinds):
         sel = cr.kinds == kind
@@ -395,7 +412,11 @@ def estimate(scene: Scene, jobs: int = 1, sample: int = ESTIMATE_SAMPLE,
     # the runs of each point: the first, and with outputs.check its half-step rerun
     runs = [cr.rows, fields.check_rows(cr.rows)] if scene.check else [cr.rows]
     with np.errstate(divide="ignore", invalid="ignore"):
-        per = sum(np.ceil(r[:, L.PAR_TEND] / r[:, L.PAR_DT]) for r in runs)
+        per = 0.0
+        for r in runs:  # the pulse at its own step, the rest at the free step
+            t_pulse = np.minimum(r[:, L.PAR_TPULSE], r[:, L.PAR_TEND])
+            per = per + (np.ceil(t_pulse / r[:, L.PAR_DT_ON])
+                         + np.ceil((r[:, L.PAR_TEND] - t_pulse) / r[:, L.PAR_DT]))
     steps_bound = int(round(float(np.nanmean(per)) * n))
     to_compile, unknown = kernel_cache_state(grid, lvl)
     workers = check_jobs(jobs)

@@ -83,31 +83,61 @@ def risk_figure(rk: xr.Dataset, *, ax: Any = None, width: str | None = "double")
 
 
 def ida_figure(ida: xr.Dataset, *, ax: Any = None, width: str | None = "single") -> Figure:
-    """The first overturning level of each record (``ida_im``, its bracket as an error
-    bar), sorted, one series per value of the other swept keys (lam, ...); IM on a log
-    axis."""
-    if ax is None:
-        fig, axes = _figure(width, 1, 0.9)
-        ax = axes[0]
-    else:
-        fig = ax.figure
+    """IDA curves: max|theta|/alpha against the IM (log axis) per record, one panel per
+    value of the other swept keys (lam, ...; at most 4), the stripes' safe points joined,
+    each record ending at its bisected first overturning level ``ida_im`` (drawn at
+    max|theta|/alpha = 1, the overturning limit). Without the stripes' curves: each
+    record's ``ida_im`` and bracket, sorted."""
     im, unit = ida.attrs.get("im", "IM"), ida.attrs.get("im_units", "")
-    for k, (label, sel, v) in enumerate(_curves(ida["ida_im"], "record")):
+    xlabel = f"{im} [{unit}]" if unit and unit != "1" else im
+    curves = "theta_max_over_alpha" in ida.data_vars and im in ida["theta_max_over_alpha"].dims
+    panels = list(_curves(ida["ida_im"], "record"))[:4]
+    if ax is not None:
+        axes = np.atleast_1d(ax)
+        fig = axes[0].figure
+    else:
+        fig, axes = _figure(width, len(panels) if curves else 1,
+                            0.8 if curves and len(panels) > 1 else 0.9)
+        if curves and len(panels) > 1:
+            w = fig.get_size_inches()[0]
+            fig.set_size_inches(w, w * 0.8 / len(panels) + 0.8)
+    for k, (label, sel, v) in enumerate(panels):
+        if curves:
+            a = axes[min(k, len(axes) - 1)]
+            th = ida["theta_max_over_alpha"].isel(sel).transpose("record", im)
+            x = ida[im].values
+            for r in range(th.sizes["record"]):
+                y = th.values[r]
+                c = f"C{r % 10}"
+                xs, ys = list(x[np.isfinite(y)]), list(y[np.isfinite(y)])
+                if np.isfinite(v[r]):  # up to the bisected first overturning level
+                    keep = [i for i, xx in enumerate(xs) if xx < v[r]]
+                    xs, ys = [xs[i] for i in keep] + [v[r]], [ys[i] for i in keep] + [1.0]
+                a.plot(xs, ys, "-", color=c, lw=0.8, alpha=0.8)
+                if np.isfinite(v[r]):
+                    a.plot([v[r]], [1.0], "o", color=c, ms=2.5)
+            a.set_xscale("log")
+            a.set_ylim(0.0, 1.05)
+            a.set_xlabel(xlabel)
+            a.set_ylabel(r"max|$\theta$|/$\alpha$")
+            a.set_title(label or "IDA", fontsize="small")
+            a.grid(True, which="both", alpha=0.25, linewidth=0.5)
+            continue
+        a = axes[0]
         order = np.argsort(np.where(np.isnan(v), np.inf, v))
         y = np.arange(v.size)
         lo = ida["ida_lo"].isel(sel).values[order] if "ida_lo" in ida else v[order]
         hi = ida["ida_hi"].isel(sel).values[order] if "ida_hi" in ida else v[order]
-        ax.errorbar(v[order], y + 0.15 * k, xerr=[v[order] - np.fmin(lo, v[order]),
-                                                np.fmax(hi, v[order]) - v[order]],
-                    fmt="o", ms=3, color=f"C{k % 10}", label=label or None)
-    ax.set_xscale("log")
-    ax.set_xlabel(f"first overturning {im} [{unit}]" if unit and unit != "1" else
-                  f"first overturning {im}")
-    ax.set_ylabel("record (sorted)")
-    ax.grid(True, which="both", alpha=0.25, linewidth=0.5)
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.18),
-                  frameon=False)
+        a.errorbar(v[order], y + 0.15 * k, xerr=[v[order] - np.fmin(lo, v[order]),
+                                               np.fmax(hi, v[order]) - v[order]],
+                   fmt="o", ms=3, color=f"C{k % 10}", label=label or None)
+        a.set_xscale("log")
+        a.set_xlabel(f"first overturning {xlabel}")
+        a.set_ylabel("record (sorted)")
+        a.grid(True, which="both", alpha=0.25, linewidth=0.5)
+    if not curves and axes[0].get_legend_handles_labels()[0]:
+        axes[0].legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.18),
+                       frameon=False)
     return fig
 
 

@@ -31,7 +31,7 @@ PAR_OMEGA = 14  # pulse frequency omega [rad/s]
 PAR_SHAPE = 15  # SHAPE_SINE or SHAPE_COSINE
 PAR_TPULSE = 16  # pulse end 2 pi / omega [s]
 PAR_LAM = 17  # lam (Pi10)
-PAR_DT = 18  # RK4 step [s]
+PAR_DT = 18  # RK4 step once the ground is still (after the pulse or record) [s]
 PAR_TOL = 19  # event tolerance: width of the final bracket on time [s]
 PAR_TEND = 20  # horizon: absolute end time [s]
 PAR_MAXSTEPS = 21  # cap on RK4 evaluations (regular + event) per run
@@ -39,7 +39,7 @@ PAR_MAXEVENTS = 22  # cap on impacts + uplifts per run
 PAR_RESTRATE = 23  # post-impact |theta'| below which the body settles [rad/s]
 PAR_THETA_OVER = 24  # |theta| at which the body lies on its side: pi/2 [rad]
 PAR_ROOT = 25  # event root finder: ROOT_BISECT, ROOT_ILLINOIS or ROOT_HERMITE
-PAR_THETA0 = 26  # initial theta [rad] (0: start at rest; != 0 starts rocking on its corner)
+PAR_THETA0 = 26  # initial theta [rad] (0: full contact; > 0 rocking on corner +1, < 0 on -1)
 PAR_THETA_DOT0 = 27  # initial theta' [rad/s] (from theta = 0: rocking on its sign's corner)
 PAR_MU = 28  # friction coefficient of the base on the ground (NaN: none given)
 PAR_GAMMA = 29  # Mavroeidis-Papageorgiou pulse: oscillation parameter gamma (>= 1)
@@ -51,7 +51,13 @@ PAR_ROT_STEP = 34  # largest rotation of one rocking step [rad] (0: no such limi
 PAR_LAW = 35  # impact law, read at impacts: LAW_VERTICAL (eq. 1), LAW_LOCKED, LAW_CONSTANT
 PAR_E = 36  # LAW_CONSTANT's coefficient of restitution (unused by the other laws)
 PAR_E_FACTOR = 37  # multiplies the law's e (1: the law's own e)
-N_PAR = 38
+PAR_DT_ON = 38  # RK4 step while the ground moves, t < PAR_TPULSE (<= PAR_DT) [s]
+PAR_ALPHA_REF = 39  # alpha_ref: alpha_cg of a flexible body, alpha of a block [rad]
+PAR_CLOSE = 40  # OUT_MARGIN below which the run is a close call (read after the kernel,
+#                 by ``rocksweep.compute.certify``) [alpha_ref]
+PAR_U0 = 41  # initial u [m] (flexible bodies; with PAR_THETA0, PAR_THETA_DOT0 the state at t = 0)
+PAR_U_DOT0 = 42  # initial u' [m/s]
+N_PAR = 43
 # A record's row is longer: its samples xg''/PGA (float64[npts], in [-1, 1]) follow the
 # N_PAR parameters, PAR_REC = N_PAR the first (``points.with_record``).
 PAR_REC = N_PAR
@@ -91,7 +97,9 @@ OUT_HIST_ROWS = 18  # rows written to the history buffer
 OUT_MU_REQ = 19  # friction demand max |H|/N over the run (contact variants, else NaN)
 OUT_N_MIN = 20  # smallest normal reaction N/(M g) over the run (contact variants)
 OUT_IMPULSE_MAX = 21  # largest |horizontal|/vertical impulse of an impact (contact variants)
-N_OUT = 22
+OUT_MARGIN = 22  # closest approach of the free rocking to the overturning saddle
+#                  [alpha_ref] (inf: never near it): a small value is a close call
+N_OUT = 23
 
 # --- state tuple y (the loop's 6 slots, a UniTuple(float64, 6)) ----------------------------
 Y_THETA = 0  # theta [rad] (0 in full contact)
@@ -140,6 +148,9 @@ STATUS_E_ABOVE_1 = _out.STATUS_BIT["e_above_1"]  # at least one impact had e > 1
 STATUS_BOUNDED = _out.STATUS_BIT["bounded"]
 STATUS_SLIDES = _out.STATUS_BIT["slides"]
 STATUS_LIFTS_OFF = _out.STATUS_BIT["lifts_off"]
+# Set after the kernel, by the certification of close calls (``rocksweep.compute.certify``)
+STATUS_REFINED = _out.STATUS_BIT["refined"]  # a close call, re-run finer until stable
+STATUS_UNCERTIFIED = _out.STATUS_BIT["uncertified"]  # still changed at the last refinement
 # A run with any of these is not a reliable classification: "flagged".
 STATUS_FLAGGED = _out.FLAGGED
 

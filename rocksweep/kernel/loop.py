@@ -69,6 +69,7 @@ from rocksweep.kernel.layout import (
     OUT_HIST_ROWS,
     OUT_IMPACTS,
     OUT_IMPULSE_MAX,
+    OUT_MARGIN,
     OUT_MU_REQ,
     OUT_N_GAINING,
     OUT_N_MIN,
@@ -84,9 +85,16 @@ from rocksweep.kernel.layout import (
     OUTCOME_MODE1,
     OUTCOME_MODE2,
     OUTCOME_SAFE,
+    PAR_ALPHA_REF,
+    PAR_B,
     PAR_DT,
+    PAR_DT_ON,
+    PAR_G,
+    PAR_HCG,
+    PAR_M,
     PAR_MAXEVENTS,
     PAR_MAXSTEPS,
+    PAR_MTOT,
     PAR_MU,
     PAR_REC_H,
     PAR_ROT_STEP,
@@ -94,6 +102,8 @@ from rocksweep.kernel.layout import (
     PAR_THETA0,
     PAR_THETA_DOT0,
     PAR_TPULSE,
+    PAR_U0,
+    PAR_U_DOT0,
     STATUS_BOUNDED,
     STATUS_E_ABOVE_1,
     STATUS_ENERGY_GAIN,
@@ -165,10 +175,12 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     literally(ENERGY)
     literally(GROUND)
     t, dt, t_pulse, t_end = 0.0, prm[PAR_DT], prm[PAR_TPULSE], prm[PAR_TEND]
+    dt_on = prm[PAR_DT_ON]  # the step while the ground moves (``numerics.step_sizes``)
     max_steps, max_events = prm[PAR_MAXSTEPS], prm[PAR_MAXEVENTS]
     # > 0: a record, whose samples the steps land on while it acts (GROUND variants only)
     h_rec = prm[PAR_REC_H] if GROUND else 0.0
-    y = (prm[PAR_THETA0], prm[PAR_THETA_DOT0], 0.0, 0.0, 0.0, 0.0)
+    # the initial state (runtime values of the row; 0: at rest)
+    y = (prm[PAR_THETA0], prm[PAR_THETA_DOT0], prm[PAR_U0], prm[PAR_U_DOT0], 0.0, 0.0)
     _reset(out)
     on = _acting(0.0, t_pulse, GROUND)
     if y[Y_THETA] != 0.0 or y[Y_THETA_DOT] != 0.0:
@@ -177,7 +189,9 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     else:
         s = _uplift(t, y, on, prm, out, FLEX, DAMPED)  # at t = 0: a cosine pulse's peak
     _record(hist, t, y, s, on, prm, out, FLEX)
-    free_check = True  # rigid: test rigid_bounded at the next loop top after the pulse
+    # rigid: test rigid_bounded at the next loop top after the pulse; not with a history,
+    # which then goes on to rest (free rocking from a tilt is decided at once otherwise)
+    free_check = hist is None
     # the counters of every step stay in registers (in out: ~3% slower); the rest is in out
     steps, event_steps, theta_max = 0, 0, abs(y[Y_THETA])
     # contact tracker (contact.contact_sample): unused, and removed, without CONTACT
@@ -192,6 +206,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     # the step: a huge slow pulse or a fall is not crossed in a handful of steps.
     rot = prm[PAR_ROT_STEP]
     acc = 0.0
+    margin = np.inf  # OUT_MARGIN, in a register
 
     while True:
         on = _acting(t, t_pulse, GROUND)
@@ -208,6 +223,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             break
         if not FLEX and s != 0 and not on and free_check:
             free_check = False  # E is constant between impacts after the pulse: test once
+            margin = _energy_margin(y, s, prm, margin)
             peak = rigid_bounded(y, s, prm, FLEX)
             if peak >= 0.0:
                 if peak > theta_max:
@@ -220,7 +236,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
         if out[OUT_IMPACTS] + out[OUT_UPLIFTS] >= max_events:
             _flag(out, STATUS_EVENT_CAP)
             break
-        h, lands = _step_length(t, on, dt, t_pulse, t_end, h_rec)
+        h, lands = _step_length(t, on, dt, dt_on, t_pulse, t_end, h_rec)
         if s != 0 and rot > 0.0:
             h_rot = _rotation_step(y[Y_THETA_DOT], acc, rot)
             if h_rot < h:
@@ -249,6 +265,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
 
         if ev == EV_NONE:
             t, y = (t_pulse if lands else t + h), y1
+            if s != 0 and not on:
+                margin = _saddle(y, s, prm, margin)
             _record(hist, t, y, s, _acting(t, t_pulse, GROUND), prm, out, FLEX)
             if CONTACT is not None:  # the step's end, with the step's own ground motion
                 ct = contact_sample(ct, t, y, s, on, SAMPLE_STEP, prm, out, FLEX, DAMPED, ENERGY)
@@ -278,7 +296,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             y, s = _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY)
             if CONTACT is not None:
                 contact_impact(y_minus, s_minus, y, s, prm, out, FLEX)
-            free_check = True
+            free_check = hist is None  # (as at the start)
         else:  # uplift: theta = theta' = 0 exactly, now rocking on the located corner
             s = 1 if ev == EV_UPLIFT_POS else -1
             y = (0.0, 0.0, y[Y_U], y[Y_U_DOT], y[Y_W_IN], y[Y_D_DAMP])
@@ -286,6 +304,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
         _record(hist, t, y, s, on, prm, out, FLEX)
         if CONTACT is not None:  # the state after the action starts the next phase's samples
             ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED, ENERGY)
+    out[OUT_MARGIN] = margin
     _finish(t, y, s, steps, event_steps, theta_max, prm, out, FLEX, ENERGY)
     if CONTACT is not None:
         _contact_status(prm, out)
@@ -321,9 +340,9 @@ def _reset(out):
 
 
 @njit(cache=True, **INLINE)
-def _step_length(t, on, dt, t_pulse, t_end, h_rec):
-    """(h, lands): the step dt, shortened to land exactly on the pulse's end (lands) or on
-    the horizon.
+def _step_length(t, on, dt, dt_on, t_pulse, t_end, h_rec):
+    """(h, lands): the step, dt_on while the ground moves and dt after, shortened to land
+    exactly on the pulse's end (lands) or on the horizon.
 
     While a record acts (h_rec > 0), steps end on the grid j h_rec (h_rec = p DT / m, m an
     integer), which holds every sample time: no step straddles a sample, so the input is
@@ -331,13 +350,15 @@ def _step_length(t, on, dt, t_pulse, t_end, h_rec):
     grid (after an event) goes to the next grid time; one starting within ALIGN_SLACK of a
     grid time counts as on it (t is a sum of steps: round-off).
     """
-    if on and h_rec > 0.0:
-        t_next = (math.floor(t / h_rec + ALIGN_SLACK) + 1.0) * h_rec
-        if t_next >= t_pulse - ALIGN_SLACK * h_rec:
+    if on:
+        if h_rec > 0.0:
+            t_next = (math.floor(t / h_rec + ALIGN_SLACK) + 1.0) * h_rec
+            if t_next >= t_pulse - ALIGN_SLACK * h_rec:
+                return t_pulse - t, True
+            return t_next - t, False
+        if t + dt_on >= t_pulse:
             return t_pulse - t, True
-        return t_next - t, False
-    if on and t + dt >= t_pulse:
-        return t_pulse - t, True
+        return dt_on, False
     if t + dt > t_end:
         return t_end - t, False
     return dt, False
@@ -408,6 +429,45 @@ def _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY):
     if s_new == 0:
         s_new = _uplift(t, y, on, prm, out, FLEX, DAMPED)
     return y, s_new
+
+
+@njit(cache=True, **INTERNAL)
+def _energy_margin(y, s, prm, margin):
+    """A rigid body's OUT_MARGIN once the ground is still, rocking on corner s: its energy
+    is then constant to the next impact, and sqrt(|E - E_ref|/E_ref) (E_ref = M g (R -
+    h_cg), the barrier) is the vertex distance ``_saddle`` measures near the saddle; taken
+    here too because a run may end at once (STATUS_BOUNDED) or overturn without a step
+    near the saddle."""
+    hcg = prm[PAR_HCG]
+    e_ref = prm[PAR_MTOT] * prm[PAR_G] * (math.hypot(prm[PAR_B], hcg) - hcg)
+    e = mechanical_energy(y[Y_THETA], y[Y_THETA_DOT], 0.0, 0.0, s, prm, False)
+    q = math.sqrt(abs(e - e_ref) / e_ref)
+    return q if q < margin else margin
+
+
+@njit(cache=True, **INLINE)
+def _saddle(y, s, prm, margin):
+    """The smallest distance so far of the free rocking motion from the overturning
+    saddle, in units of alpha_ref (OUT_MARGIN; ``rocksweep.compute.certify``).
+
+    Rocking on corner s, the body's centre of gravity is above the corner at
+    theta_s = s atan((b - s m u / M) / h_cg) (the spring's u shifts it). With x = (s theta -
+    s theta_s)/alpha_ref and v = theta'/(p alpha_ref) (p = 1), the motion near the saddle is
+    x'' = x: hyperbolae on which v^2 - x^2 (~ (E - E_barrier)/E_ref) stays constant, whose
+    vertex, sqrt(|v^2 - x^2|) from the saddle, is the closest the motion comes. It is
+    taken from every step end within half an alpha_ref of the saddle (any point of the
+    hyperbola gives its vertex, so steps of any length see it): a small value means the
+    run decided between overturning and not by a small margin of energy.
+    """
+    a_ref = prm[PAR_ALPHA_REF]
+    th_s = math.atan((prm[PAR_B] - s * prm[PAR_M] * y[Y_U] / prm[PAR_MTOT]) / prm[PAR_HCG])
+    x = (s * y[Y_THETA] - th_s) / a_ref
+    v = y[Y_THETA_DOT] / a_ref
+    if abs(x) < 0.5 and abs(v) < 0.5:
+        q = math.sqrt(abs(v * v - x * x))
+        if q < margin:
+            return q
+    return margin
 
 
 @njit(cache=True, **INTERNAL)

@@ -323,3 +323,43 @@ def lam_0(body: FlexibleBody, u: float, upper: bool) -> float:
     i0 = body.I_A + m_A * body.h_A**2
     # numerator of eq. (1) is linear in lam: i0 + m u (u - sg b) - b (1 - lam) (M b - sg m u)
     return 1 - (i0 + m * u * (u - sg * b)) / (b * (body.M * b - sg * m * u))
+
+
+def body_from_geometry(b: float, h: float, h_A: float, m: float, m_A: float, I_A: float,
+                       k: float, c: float = 0.0) -> dict[str, float]:
+    """The Pi groups (Table 1) and p of a body given by the laboratory's numbers.
+
+    b: half-width of the base [m]; h, h_A: heights of the top mass and of the base's
+    centroid A [m]; m, m_A [kg]; I_A: the base's inertia about A [kg m^2]; k [N/m]
+    (inf: welded, rigid); c [N s/m]. Returns {wn_over_p, zeta, alpha_cg, alpha_A,
+    mA_over_m, IA_ratio, p [rad/s], omega_n [rad/s], h_cg [m]} with h_cg = (m h +
+    m_A h_A)/M, alpha_cg = atan(b/h_cg), alpha_A = atan(b/h_A), p = sqrt(M g R_cg /
+    (I_A + m_A R_A^2 + m R^2)) (section 3.1), omega_n = sqrt(k/m), zeta = c/(2 sqrt(k m)).
+    A BodyError (one line) for a value out of range or geometry no scene could hold.
+    """
+    vals = {"b": b, "h": h, "h_A": h_A, "m": m, "m_A": m_A, "I_A": I_A, "k": k, "c": c}
+    for key, v in vals.items():
+        if not is_number(v):
+            raise BodyError(f"body.{key} = {fmt(v)}: must be a number")
+        msg = check_value(f"body.{key}", v)
+        if msg is not None:
+            raise BodyError(msg)
+    M = m + m_A
+    h_cg = (m * h + m_A * h_A) / M
+    R_A, R, R_cg = math.hypot(b, h_A), math.hypot(b, h), math.hypot(b, h_cg)
+    p = math.sqrt(M * G * R_cg / (I_A + m_A * R_A**2 + m * R**2))
+    rigid = math.isinf(k)
+    omega_n = math.inf if rigid else math.sqrt(k / m)
+    if rigid and c > 0:
+        raise BodyError(f"body.c = {fmt(c)}: a welded top mass (body.k = .inf) has no "
+                        "damper; give c: 0 or a finite k")
+    out = {"wn_over_p": omega_n / p, "zeta": 0.0 if rigid else c / (2 * math.sqrt(k * m)),
+           "alpha_cg": math.atan2(b, h_cg), "alpha_A": math.atan2(b, h_A),
+           "mA_over_m": m_A / m, "IA_ratio": I_A / (m_A * R_A**2)}
+    for key, v in out.items():
+        msg = check_value(f"body.{key}", v)
+        if msg is not None:
+            raise BodyError(f"body (kind physical): b = {fmt(b)}, h = {fmt(h)}, h_A = "
+                            f"{fmt(h_A)}, m = {fmt(m)}, m_A = {fmt(m_A)}, I_A = {fmt(I_A)}, "
+                            f"k = {fmt(k)}, c = {fmt(c)} give {msg.removeprefix('body.')}")
+    return {**out, "p": p, "omega_n": omega_n, "h_cg": h_cg}

@@ -18,13 +18,16 @@ from rocksweep.numerics import (
     ROOTS,
     Numerics,
     amplitude_frequency,
+    close_margin,
     step_budget,
-    step_size,
+    step_sizes,
 )
 from rocksweep.physics.model import Body, FlexibleBody, G
 from rocksweep.physics.records import GroundRecord
+from rocksweep.vocab.axes import INITIAL  # noqa: F401
 from rocksweep.vocab.ground import (  # noqa: F401
     CYCLES,
+    FREE,
     GAMMA,
     MP,
     NU_DEG,
@@ -42,7 +45,9 @@ if TYPE_CHECKING:
     from rocksweep.physics.excitation import PulseShape
 
 # shapes, laws and their kernel codes: rocksweep.vocab (the names re-exported here)
-_SHAPE_CODE = SHAPE_CODE
+# FREE runs as a sine of amplitude 0 that ends at t = 0 (its own code would be a new
+# branch of the kernel for nothing)
+_SHAPE_CODE = {**SHAPE_CODE, FREE: SHAPE_CODE[SINE]}
 _LAW_CODE = LAW_CODE
 _ROOT_CODE = dict(zip(ROOTS, (L.ROOT_BISECT, L.ROOT_ILLINOIS, L.ROOT_HERMITE), strict=True))
 
@@ -75,6 +80,8 @@ class Point:
     law: str = DEFAULT_LAW
     e: float = math.nan
     e_factor: float = 1.0
+    # the state at t = 0 (``INITIAL``, normalised; all 0: at rest in full contact)
+    initial: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
 
     @property
     def omega(self) -> float:
@@ -88,14 +95,14 @@ class Point:
     @property
     def ground(self) -> bool:
         """Whether the point needs the kernel's GROUND variants (``kernel.variants``)."""
-        return self.shape not in PAPER_SHAPES
+        return self.shape not in (*PAPER_SHAPES, FREE)
 
     @property
     def pulse(self) -> PulseShape | None:
         """The pulse's reference definition (None for a record)."""
         from rocksweep.physics.excitation import PulseShape  # scipy: loaded when needed
 
-        if self.shape == RECORD:
+        if self.shape in (RECORD, FREE):
             return None
         return PulseShape(self.shape, int(self.cycles), float(self.gamma), float(self.nu))
 
@@ -105,6 +112,8 @@ class Point:
         record's last sample time p (npts - 1) DT."""
         if self.shape == RECORD:
             return self.p * self.record.duration
+        if self.shape == FREE:
+            return 0.0
         return self.pulse.duration / self.omega
 
 
@@ -163,21 +172,23 @@ def body_omega_rock(body: Body) -> float:
 def run_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, w_over_p: np.ndarray,
              A_ratio: np.ndarray, numerics: Numerics,
              phase: np.ndarray | float = 2 * math.pi) -> tuple[np.ndarray, ...]:
-    """A run's step, length and step cap, vectorised over points (all float64[n], p = 1).
+    """A run's steps, length and step cap, vectorised over points (all float64[n], p = 1).
 
     phase: the pulse's duration in w t (2 pi n, 6 pi for the Ricker, 2 pi gamma for MP).
-    Returns dt [p*t] (``step_size``), t_pulse = phase/omega, t_end = t_pulse + horizon
-    [p*t] and the cap on RK4 evaluations (``step_budget``): the kernel's PAR_DT,
-    PAR_TPULSE, PAR_TEND and PAR_MAXSTEPS. The scene bounds the last (MAX_POINT_STEPS).
+    Returns dt [p*t] after the pulse and dt_on while it acts (``step_sizes``), t_pulse =
+    phase/omega, t_end = t_pulse + horizon [p*t] and the cap on RK4 evaluations
+    (``step_budget``): the kernel's PAR_DT, PAR_DT_ON, PAR_TPULSE, PAR_TEND and
+    PAR_MAXSTEPS. The scene bounds the last (MAX_POINT_STEPS). w_over_p = 0 is no ground
+    motion (shape FREE): t_pulse = 0.
     """
     omega = np.asarray(w_over_p, float)  # p = 1 rad/s
-    with np.errstate(divide="ignore", over="ignore"):
-        dt = step_size(omega_rock, omega, numerics.steps_per_period,
-                       amplitude_frequency(A_ratio, alpha_ref))
-        t_pulse = phase / omega
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        dt, dt_on = step_sizes(omega_rock, omega, numerics.steps_per_period,
+                               numerics.pulse_steps, amplitude_frequency(A_ratio, alpha_ref))
+        t_pulse = np.where(omega == 0.0, 0.0, phase / omega)
         t_end = t_pulse + numerics.horizon
-        max_steps = step_budget(t_end, dt, numerics)
-    return dt, t_pulse, t_end, max_steps
+        max_steps = step_budget(t_pulse, t_end, dt, dt_on, numerics)
+    return dt, dt_on, t_pulse, t_end, max_steps
 
 
 def record_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, p: np.ndarray,
@@ -185,20 +196,20 @@ def record_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, p: np.ndarray,
                 ) -> tuple[np.ndarray, ...]:
     """``run_cost`` for a record, vectorised over points (float64[n]; p [rad/s]).
 
-    The step after the record is the regular ``step_size`` without a pulse period (dt).
-    While the record acts the step is h_rec = p DT / m, m = ceil(p DT / dt): the largest
-    step of at most dt that lands on every sample time (the kernel's PAR_REC_H); after the
-    last sample the kernel steps at dt again, so the cap counts the record's time at h_rec
-    and the free vibration after it at dt (a short record sampled at 100 kHz costs what
-    its duration asks, not its horizon at the sample spacing). Returns (dt, h_rec,
-    t_pulse = p (npts - 1) DT, t_end = t_pulse + horizon, step cap), p*t.
+    The step after the record is ``step_sizes``' dt (no pulse period). While the record
+    acts the step is h_rec = p DT / m, m = ceil(p DT / dt_on): the largest step of at most
+    dt_on that lands on every sample time (the kernel's PAR_REC_H); after the last sample
+    the kernel steps at dt again, so the cap counts the record's time at h_rec and the
+    free vibration after it at dt (a short record sampled at 100 kHz costs what its
+    duration asks, not its horizon at the sample spacing). Returns (dt, h_rec, t_pulse =
+    p (npts - 1) DT, t_end = t_pulse + horizon, step cap), p*t.
     """
     p = np.asarray(p, float)
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
-        dt = step_size(omega_rock, 0.0, numerics.steps_per_period,
-                       amplitude_frequency(A_ratio, alpha_ref))
+        dt, dt_on = step_sizes(omega_rock, 0.0, numerics.steps_per_period,
+                               numerics.pulse_steps, amplitude_frequency(A_ratio, alpha_ref))
         dt_k = p * record.dt
-        h_rec = dt_k / np.ceil(dt_k / dt)
+        h_rec = dt_k / np.ceil(dt_k / dt_on)
         t_pulse = p * record.duration
         t_end = t_pulse + numerics.horizon
         steps = np.ceil(t_pulse / h_rec) + np.ceil(numerics.horizon / dt) + 1.0
@@ -213,7 +224,8 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
               cycles: int = CYCLES, gamma: float = GAMMA, nu_deg: float = NU_DEG,
               record: GroundRecord | None = None,
               mu: np.ndarray | float = math.nan, law: np.ndarray | float = L.LAW_VERTICAL,
-              e: np.ndarray | float = math.nan, e_factor: np.ndarray | float = 1.0) -> None:
+              e: np.ndarray | float = math.nan, e_factor: np.ndarray | float = 1.0,
+              initial: tuple | None = None, u_cr: np.ndarray | float = 0.0) -> None:
     """Fill parameter rows in place, vectorised over points.
 
     rows: float64[n, N_PAR] (out); body_rows: float64[n, N_PAR] from ``body_row``;
@@ -223,6 +235,9 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     the body's p [rad/s]; the rows then still lack the samples (``with_record``).
     mu: friction coefficient, float64[n] or a scalar (NaN: none). law (a LAW_* code), e
     (law constant's, else NaN) and e_factor: the impact law, float64[n] or scalars.
+    initial: the state at t = 0 as four float64[n] or scalars in ``INITIAL``'s order
+    (theta/alpha_ref, theta'/(p alpha_ref), u/u_cr, u'/(p u_cr)), None: at rest; u_cr [m]
+    float64[n] or a scalar (0 for a rigid body). PAR_THETA0.. PAR_U_DOT0 in SI (p = 1).
     """
     rows[:] = body_rows
     omega = np.asarray(w_over_p, float)  # p = 1 rad/s
@@ -232,14 +247,15 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
                                                            A_ratio, record, numerics)
         rows[:, L.PAR_REC_DT] = omega * record.dt
         rows[:, L.PAR_REC_H] = h_rec
+        dt_on = h_rec
         omega = 0.0
     else:
         # each point's duration in w t by its shape (``vocab.ground.pulse_duration``)
         phase = np.select([code == L.SHAPE_RICKER, code == L.SHAPE_MP],
                           [pulse_duration(RICKER), pulse_duration(MP, gamma=gamma)],
                           pulse_duration(SINE, cycles=cycles))
-        dt, t_pulse, t_end, max_steps = run_cost(omega_rock, alpha_ref, omega, A_ratio,
-                                                 numerics, phase)
+        dt, dt_on, t_pulse, t_end, max_steps = run_cost(omega_rock, alpha_ref, omega,
+                                                        A_ratio, numerics, phase)
         if np.any(code == L.SHAPE_MP):
             from rocksweep.physics.excitation import mp_peak
 
@@ -252,6 +268,7 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     rows[:, L.PAR_TPULSE] = t_pulse
     rows[:, L.PAR_LAM] = lam
     rows[:, L.PAR_DT] = dt
+    rows[:, L.PAR_DT_ON] = dt_on
     rows[:, L.PAR_TOL] = numerics.event_tol
     rows[:, L.PAR_TEND] = t_end
     rows[:, L.PAR_MAXSTEPS] = max_steps
@@ -260,9 +277,17 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     rows[:, L.PAR_ROOT] = _ROOT_CODE[numerics.root]
     rows[:, L.PAR_MU] = mu
     rows[:, L.PAR_ROT_STEP] = numerics.rotation_step * alpha_ref
+    rows[:, L.PAR_ALPHA_REF] = alpha_ref
+    rows[:, L.PAR_CLOSE] = close_margin(numerics.steps_per_period)
     rows[:, L.PAR_LAW] = law
     rows[:, L.PAR_E] = e
     rows[:, L.PAR_E_FACTOR] = e_factor
+    if initial is not None:
+        th, thd, u, ud = initial
+        rows[:, L.PAR_THETA0] = np.asarray(th, float) * alpha_ref
+        rows[:, L.PAR_THETA_DOT0] = np.asarray(thd, float) * alpha_ref
+        rows[:, L.PAR_U0] = np.asarray(u, float) * u_cr
+        rows[:, L.PAR_U_DOT0] = np.asarray(ud, float) * u_cr
 
 
 def with_record(rows: np.ndarray, record: GroundRecord | None) -> np.ndarray:
@@ -288,7 +313,8 @@ def point_row(point: Point, numerics: Numerics) -> np.ndarray:
               np.array([_SHAPE_CODE[point.shape]]),
               np.array([point.p if rec is not None else point.w_over_p]),
               np.array([point.A_ratio]), numerics, point.cycles, point.gamma, point.nu, rec,
-              point.mu, law_code(point.law), point.e, point.e_factor)
+              point.mu, law_code(point.law), point.e, point.e_factor,
+              point.initial if any(point.initial) else None, body.u_cr)
     return with_record(rows, rec)[0]
 
 

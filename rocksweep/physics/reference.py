@@ -407,7 +407,7 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
     th0 = float(prm[L.PAR_THETA0]) if theta0 is None else float(theta0)
     thd0 = float(prm[L.PAR_THETA_DOT0]) if theta_dot0 is None else float(theta_dot0)
     t = 0.0
-    y = (th0, thd0, 0.0, 0.0)  # theta, theta', u, u'
+    y = (th0, thd0, float(prm[L.PAR_U0]), float(prm[L.PAR_U_DOT0]))  # theta, theta', u, u'
     status, outcome = 0, L.OUTCOME_SAFE
     impacts = uplifts = contacts = anomalies = 0
     theta_max, e_max = abs(th0), 0.0
@@ -428,7 +428,7 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
     if th0 != 0.0 or thd0 != 0.0:  # rocking from the given state, on the corner it points to
         s = 1 if th0 > 0.0 or (th0 == 0.0 and thd0 > 0.0) else -1
     else:
-        s = pb.uplift_corner(t, (0.0, 0.0), pb.t_pulse > 0.0)
+        s = pb.uplift_corner(t, (y[2], y[3]), pb.t_pulse > 0.0)
         if s != 0:
             uplifts += 1
             note("uplift", t, 0, s, y, y)

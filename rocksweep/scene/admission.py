@@ -85,11 +85,11 @@ def _budgets(scene: Scene, bodies: list[dict[str, float]], w: np.ndarray, A: np.
     omega_rock = np.array([body_omega_rock(b) for b in built])[:, None, None]
     alpha_ref = np.array([b.alpha_ref for b in built])[:, None, None]
     shape = (len(built), w.size, A.size)
-    _, _, _, cap = run_cost(np.broadcast_to(omega_rock, shape),
-                            np.broadcast_to(alpha_ref, shape),
-                            np.broadcast_to(w[None, :, None], shape),
-                            np.broadcast_to(A[None, None, :], shape), numerics,
-                            scene.phase_max())
+    _, _, _, _, cap = run_cost(np.broadcast_to(omega_rock, shape),
+                               np.broadcast_to(alpha_ref, shape),
+                               np.broadcast_to(w[None, :, None], shape),
+                               np.broadcast_to(A[None, None, :], shape), numerics,
+                               scene.phase_max())
     return np.where(np.isnan(cap), math.inf, cap)
 
 
@@ -156,11 +156,18 @@ def _check_suite_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
 
 def _runs(scene: Scene) -> tuple[tuple[Numerics, str], ...]:
     """The numerics a scene's points run at, with the words that name them: the sweeps'
-    and the single runs' (``simulate``; `fine`, 4x the steps of `default`, unless the scene
-    names an accuracy)."""
-    single = scene.single_numerics
-    return ((scene.numerics, ""),
-            (single, f" at the single runs' accuracy ({single.accuracy})"))
+    (the single runs' are the same) and, with the certification of close calls
+    (``numerics.refine``), its finest rerun (``Numerics.refined``), which must fit the
+    same cap: the refinement stays bounded."""
+    n = scene.numerics
+    runs: list[tuple[Numerics, str]] = [(n, "")]
+    if scene.single_numerics != n:
+        single = scene.single_numerics
+        runs.append((single, f" at the single runs' accuracy ({single.accuracy})"))
+    if n.refine > 0:
+        runs.append((n.refined(n.refine), f" when a close call is refined {n.refine} times "
+                                          f"(numerics.refine = {n.refine})"))
+    return tuple(runs)
 
 
 def _check_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
@@ -199,10 +206,11 @@ def _point_cost(scene: Scene, point: dict[str, float], numerics: Numerics | None
         return None
     worst = None
     for n, label in _runs(scene) if numerics is None else ((numerics, ""),):
-        dt, _, t_end, cap = run_cost(np.array([body_omega_rock(body)]),
-                                     np.array([body.alpha_ref]),
-                                     np.array([point["pulse.w_over_p"]]),
-                                     np.array([point["pulse.A_ratio"]]), n, scene.phase_max())
+        _, dt, _, t_end, cap = run_cost(np.array([body_omega_rock(body)]),
+                                        np.array([body.alpha_ref]),
+                                        np.array([point["pulse.w_over_p"]]),
+                                        np.array([point["pulse.A_ratio"]]), n,
+                                        scene.phase_max())
         c = float(cap[0])
         c = math.inf if math.isnan(c) else c
         if worst is None or c > worst[0]:
@@ -267,7 +275,8 @@ def _cost_message(scene: Scene, point: dict) -> str:
         if cost is not None and cap / max(cost, 1.0) > best:
             best, best_key = cap / max(cost, 1.0), key
     if best_key is None:
-        return f"{head}; use fewer steps_per_period, a shorter horizon or fewer max_events"
+        return (f"{head}; use fewer steps_per_period, a shorter horizon, fewer max_events "
+                "or a smaller numerics.refine")
     value = current[best_key]
     if _with(scene, point, best_key, tame(best_key)) > MAX_POINT_STEPS:  # type: ignore[operator]
         return f"{best_key} = {fmt(value)}: {head}; other values of this point are costly too"

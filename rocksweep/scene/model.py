@@ -13,7 +13,7 @@ from rocksweep import fields
 from rocksweep.errors import SceneError  # noqa: F401 (defined there; re-exported)
 from rocksweep.numerics import Numerics
 from rocksweep.physics.model import BlockBody, Body, FlexibleBody
-from rocksweep.physics.points import RECORD, Point
+from rocksweep.physics.points import FREE, INITIAL, RECORD, Point
 from rocksweep.physics.records import GroundRecord
 from rocksweep.physics.suite import Suite
 from rocksweep.schema import KEYS
@@ -39,7 +39,7 @@ class Scene:
     kind: str  # "flexible" | "block"
     axes: tuple[Axis, ...]
     numerics: Numerics  # sweeps: the `default` preset unless the scene names one
-    single_numerics: Numerics  # single runs (simulate): `fine` unless the scene names one
+    single_numerics: Numerics  # single runs (simulate): the sweeps' numerics (one default)
     energy: bool
     text: str = field(repr=False)
     contact: bool = False  # outputs.contact (on when body.mu is given)
@@ -56,6 +56,19 @@ class Scene:
     # every file the scene was read from: the scene file, its record, a suite's records and
     # listings (paths as read); an output is never one of them (``outputs.check_output``)
     inputs: tuple[str, ...] = field(default=(), repr=False)
+    # a body given by the laboratory's numbers (body.kind physical): its Pi groups, p
+    # [rad/s], omega_n [rad/s] and h_cg [m] (``physics.model.body_from_geometry``), else None
+    physical: dict | None = field(default=None, repr=False)
+
+    def physical_words(self) -> str:
+        """One line stating what a physical body became ('' for a body of Pi groups)."""
+        if self.physical is None:
+            return ""
+        d = self.physical
+        return ("body (kind physical): " + ", ".join(
+            f"{k} = {d[k]:.5g}" for k in ("wn_over_p", "zeta", "alpha_cg", "alpha_A",
+                                          "mA_over_m", "IA_ratio"))
+                + f", p = {d['p']:.5g} rad/s, h_cg = {d['h_cg']:.4g} m")
 
     def variables(self) -> dict[str, tuple[str, float, str]]:
         """The per-point variables a sweep of this scene stores, name -> (dtype, fill value
@@ -78,7 +91,7 @@ class Scene:
         """Whether the scene needs the kernel's GROUND variants (a Ricker or MP pulse, or a
         record); the paper's sine and cosine (n cycles too) run the pulse variants."""
         return self.recorded or any(
-            sh not in PAPER_SHAPES for sh in self.axis("shape").values)
+            sh not in (*PAPER_SHAPES, FREE) for sh in self.axis("shape").values)
 
     def option(self, name: str) -> Any:
         """A pulse option's value (cycles, gamma, nu [deg]): the scene's or the default."""
@@ -134,17 +147,30 @@ class Scene:
             a_ratio = float(su.peak_ratio(np.array([r]), s, np.array([body.alpha_ref]),
                                           np.array([p]))[0])
             return Point(body, float(values["lam"]), RECORD, math.nan, a_ratio,
-                         record=su.records[r], p=p, **self._law(values))
+                         record=su.records[r], p=p, **self._law(values),
+                         initial=self.initial_state(values))
         if self.record is not None:
             return Point(body, float(values["lam"]), RECORD, math.nan,
                          float(values["A_ratio"]), record=self.record, p=float(values["p"]),
-                         **self._law(values))
+                         **self._law(values), initial=self.initial_state(values))
         return Point(body, float(values["lam"]), str(values["shape"]),
                      float(values["w_over_p"]), float(values["A_ratio"]),
                      int(values.get("cycles", self.option("cycles"))),
                      float(values.get("gamma", self.option("gamma"))),
                      float(values.get("nu", self.option("nu"))),
-                     mu=float(values.get("mu", math.nan)), **self._law(values))
+                     mu=float(values.get("mu", math.nan)), **self._law(values),
+                     initial=self.initial_state(values))
+
+    @property
+    def free(self) -> bool:
+        """No ground motion (neither ``pulse`` nor ``ground``): free vibration from the
+        initial state."""
+        return self.axis("shape").values == (FREE,)
+
+    def initial_state(self, values: dict[str, Any]) -> tuple[float, float, float, float]:
+        """A point's initial state (``vocab.axes.INITIAL``, normalised) from axis values; the
+        keys the scene does not give are 0."""
+        return tuple(float(values.get(k, 0.0)) for k in INITIAL)  # type: ignore[return-value]
 
     def _law(self, values: dict[str, Any]) -> dict[str, Any]:
         """A point's impact law (Point keywords law, e, e_factor) from axis values."""

@@ -28,7 +28,8 @@ import numpy as np
 
 from rocksweep.numerics import Numerics
 from rocksweep.outputs import input_problem, is_input, shown
-from rocksweep.physics.points import RECORD
+from rocksweep.physics.model import BodyError, body_from_geometry
+from rocksweep.physics.points import FREE, INITIAL, RECORD
 from rocksweep.physics.records import GroundRecord, RecordError, read_record
 from rocksweep.physics.suite import (
     AVGSA_RANGE,
@@ -159,7 +160,8 @@ def _section(raw: dict, name: str, kind: str, required: bool) -> dict:
         spec = KEYS[f"{name}.{k}"]
         if spec.required and sec.get(k) is None:
             hint = {"axis": "a number, a list of numbers or a range {start, stop, num}",
-                    "choices": spec.allowed.removeprefix("must be ")}.get(spec.kind, "")
+                    "choices": spec.allowed.removeprefix("must be ")}.get(
+                        spec.kind, spec.allowed.removeprefix("must be "))
             raise SceneError(f"{name}.{k}: missing required key ({hint})")
     return sec
 
@@ -303,10 +305,11 @@ def _refine(raw: dict, kind: str) -> dict | None:
 
 
 def _numerics(sec: dict, contact: bool = False) -> tuple[Numerics, Numerics]:
-    """The sweeps' and the single runs' numerics of a checked ``numerics`` section.
+    """The sweeps' and the single runs' numerics of a checked ``numerics`` section: the
+    same (one point, one answer).
 
-    Without a preset named, sweeps run `default`, but a sweep that stores the contact
-    demands runs `fine`: at `default` the demands of long-rocking points differ from the
+    Without a preset named, sweeps and single runs run `default`, but a scene that stores
+    the contact demands runs `fine`: at `default` the demands of long-rocking points differ from the
     reference by up to ~20% (the trajectory after many impacts), at 20 steps per period by
     5e-4 (scripts/contact_check.py)."""
     given: dict[str, Any] = {}
@@ -331,9 +334,10 @@ def _numerics(sec: dict, contact: bool = False) -> tuple[Numerics, Numerics]:
         given[k] = v
     accuracy = given.pop("accuracy", None)
     numerics = Numerics.preset(accuracy or ("fine" if contact else "default"), **given)
-    # A single run exists for its time history and energy balance, which the outcome-tuned
-    # `default` (5 steps per period) resolves only roughly; it costs milliseconds at `fine`.
-    single = Numerics.preset(accuracy or "fine", **given)
+    # One default (issue 28): a single run (simulate) runs what a sweep of the same point
+    # runs, so one point has one answer; the certification of close calls
+    # (``compute.certify``) makes the default trustworthy for both.
+    single = numerics
     return numerics, single
 
 
@@ -435,6 +439,11 @@ def _listing(path: Path, shown_as: str) -> list[tuple[int, str]]:
     if data.startswith((b"\xff\xfe", b"\xfe\xff")):
         raise SceneError(f"{key}: {shown_as}: a listing saved as UTF-16; save it as UTF-8 "
                          "text (one record path a line)")
+    if b"\0" in data:
+        line = data.count(b"\n", 0, data.index(b"\0")) + 1
+        raise SceneError(f"{key}: {shown_as}, line {line}: a NUL byte (UTF-16 without a "
+                         "byte-order mark, or a binary file?); a listing is UTF-8 text, one "
+                         "record path a line")
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as err:
@@ -666,16 +675,27 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
 
     body = _section(raw, "body", "flexible", required=True)
     kind = body.get("kind", "flexible")
+    physical = None
+    if kind == "physical":  # the laboratory's numbers -> the Pi groups and p
+        try:
+            physical = body_from_geometry(**{k: body.get(k, KEYS[f"body.{k}"].default)
+                                             for k in BODY_KEYS["physical"]})
+        except BodyError as err:
+            raise SceneError(str(err)) from None
+        body = {**{k: physical[k] for k in BODY_KEYS["flexible"]},
+                **({"mu": body["mu"]} if body.get("mu") is not None else {})}
+        kind = "flexible"
     impact = _section(raw, "impact", kind, required=kind == "flexible")
     if raw.get("ground") is not None and raw.get("pulse") is not None:
         raise SceneError("pulse, ground: give one of them (a pulse, or a recorded ground "
                          "motion)")
-    if raw.get("ground") is None and raw.get("pulse") is None:
-        raise SceneError("pulse: missing required section (pulse: {shape, w_over_p, "
-                         "A_ratio}, or ground: {record, A_ratio, p} for a record)")
+    initial = _section(raw, "initial", kind, required=False)
+    free = raw.get("ground") is None and raw.get("pulse") is None
     record = suite = stripe = None
     inputs: tuple[str, ...] = ()
-    if raw.get("ground") is not None:
+    if free:  # no ground motion: free vibration from the initial state
+        pulse = {"shape": FREE, "w_over_p": 0.0, "A_ratio": 0.0}
+    elif raw.get("ground") is not None:
         ground = _section(raw, "ground", kind, required=True)
         if ground.get("records") is not None:
             suite, stripe, inputs = _suite(ground, base, given_records)
@@ -715,7 +735,10 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
         raise SceneError(f"outputs.check = {fmt(check)}: {KEYS['outputs.check'].allowed}")
 
     # forms and lengths first: the grid's size is known before any value is built
-    if record is None and suite is None:
+    if free:
+        shapes, shape_swept = (FREE,), False
+        section, pulse_axes, options = "pulse", PULSE_AXES, []
+    elif record is None and suite is None:
         shapes, shape_swept = _shapes(pulse["shape"])
         section, pulse_axes = "pulse", PULSE_AXES
         options = _pulse_options(pulse, shapes)
@@ -732,15 +755,21 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     law_axis, law_specs = _impact_law(impact)
     n_laws = 1 if law_axis is None else len(law_axis.values)
     specs.extend(law_specs)  # after lam (and the law's axis, added below)
+    for k in INITIAL:  # the initial state's keys given (none: at rest, no axis)
+        if initial.get(k) is not None:
+            specs.append((k, f"initial.{k}", *_axis_spec(f"initial.{k}", initial[k])[:2]))
     if suite is not None:  # the records (words), then the stripes, before p
         specs.append(("record", "ground.record", "words", suite.names))
         if stripe is not None:
             specs.append((stripe[0], f"ground.{stripe[0]}", "stripes", stripe[1:]))
     for k in pulse_axes:
+        if free:  # not the user's: no check (w_over_p = 0 is no ground motion)
+            specs.append((k, f"{section}.{k}", "given", pulse[k]))
+            continue
         specs.append((k, f"{section}.{k}", *_axis_spec(f"{section}.{k}", pulse[k])[:2]))
     if mu_spec is not None:  # the last axis: the same grid of runs, flagged per mu
         specs.append(("mu", "body.mu", *_axis_spec("body.mu", mu_spec)[:2]))
-    lengths = [len(shapes)] + [1 if form == "scalar" else
+    lengths = [len(shapes)] + [1 if form in ("scalar", "given") else
                                (spec["num"] if form == "range" else
                                 len(suite.levels) if form == "stripes" else len(spec))
                                for _, _, form, spec in specs]
@@ -761,6 +790,9 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
         if form == "stripes":  # checked by _suite; always a dimension
             axes.append(Axis(name_, key, suite.levels, True))
             continue
+        if form == "given":  # a free scene's pulse axes (no ground motion)
+            axes.append(Axis(name_, key, (float(spec),), False))
+            continue
         values = _axis_values(key, form, spec)
         axes.append(Axis(name_, key, tuple(values.tolist()), form != "scalar"))
         if name_ == "lam" and law_axis is not None:
@@ -771,7 +803,7 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     scene = Scene(name=name or "rocksweep scene", kind=kind, axes=tuple(axes),
                   numerics=numerics, single_numerics=single, energy=energy, text=text,
                   contact=contact, check=check, record=record, refine=_refine(raw, kind),
-                  suite=suite, inputs=inputs)
+                  suite=suite, inputs=inputs, physical=physical)
     if scene.contact and scene.ground:
         # the contact outputs are compiled into the sine/cosine variants only (a kernel
         # variant per combination costs compile time no scene has asked for yet)
@@ -779,8 +811,37 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
         raise SceneError(f"outputs.contact = true: not available with {what} yet; contact "
                          "outputs work with sine and cosine pulses")
     bodies = _candidate_bodies(scene)
+    _check_initial(scene, bodies)
     _check_cost(scene, bodies)
     if suite is not None:  # drift and large factors: one-line RecordWarnings
         suite.warn(scene.axis("alpha" if kind == "block" else "alpha_cg").values,
                    scene.axis("p").values)
     return scene
+
+
+def _check_initial(scene: Scene, bodies: list[dict[str, float]]) -> None:
+    """Refuse an initial state that is not admissible (one line): |theta| >= pi/2 (the
+    body lies on its side) for a body of the scene, and a displacement or rate of the top
+    mass given to a rigid body (it has none). The contact phase follows from the state:
+    theta > 0 rocks on corner +1, theta < 0 on -1, theta = 0 with theta' != 0 on the corner
+    theta' points to, theta = theta' = 0 full contact (uplift checked at t = 0)."""
+    names = {a.name for a in scene.axes}
+    if "theta_over_alpha" in names:
+        th = np.asarray(scene.axis("theta_over_alpha").values)
+        worst = float(th[np.argmax(np.abs(th))])
+        alpha = max(scene.make_body(**b).alpha_ref for b in bodies)
+        if abs(worst) * alpha >= math.pi / 2:
+            ref = "alpha" if scene.kind == "block" else "alpha_cg"
+            raise SceneError(f"initial.theta_over_alpha = {fmt(worst)}: |theta| = "
+                             f"{abs(worst):g} x {ref} ({alpha:.4g} rad) = "
+                             f"{abs(worst) * alpha:.4g} rad; must be < pi/2 (|theta_over_alpha|"
+                             f" < {math.pi / 2 / alpha:.4g}: beyond, the body lies on its side)")
+    for k in ("u_over_ucr", "udot_over_pucr"):
+        if k not in names:
+            continue
+        v = np.asarray(scene.axis(k).values)
+        if np.any(v != 0.0) and any(scene.make_body(**b).rigid for b in bodies):
+            bad = float(v[np.flatnonzero(v != 0.0)[0]])
+            why = ("a block" if scene.kind == "block" else "body.wn_over_p = .inf")
+            raise SceneError(f"initial.{k} = {fmt(bad)}: a rigid body ({why}) has no top-mass "
+                             "motion; must be 0 (or give a finite body.wn_over_p)")

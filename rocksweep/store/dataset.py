@@ -39,15 +39,17 @@ def result_dataset(source: Path | Any) -> xr.Dataset:
             else:
                 raise
     except (ValueError, TypeError, KeyError, OSError, OverflowError, AttributeError,
-            IndexError) as err:  # xarray's CF decoding of a damaged attribute
+            IndexError, RuntimeError, MemoryError) as err:
+        # xarray's CF decoding of a damaged attribute; HDF5's of damaged dimension scales
+        # (H5DSget_num_scales: RuntimeError), a damaged shape's allocation
         from rocksweep.outputs import shown
         from rocksweep.store import StoreError
 
         where = shown(source) if isinstance(source, Path) else "result in memory"
         why = (str(err).strip().splitlines() or [type(err).__name__])[0]
         why = why if len(why) <= 160 else why[:157] + "..."
-        raise StoreError(f"{where}: damaged rocksweep result (a variable's attributes "
-                         f"cannot be decoded: {why})") from None
+        raise StoreError(f"{where}: damaged rocksweep result (its variables or their "
+                         f"attributes cannot be decoded: {why})") from None
     for name, var in ds.data_vars.items():  # files of format 1 have neither
         f = fields.BY_NAME.get(str(name))
         if f is not None:

@@ -55,7 +55,22 @@ AXES: dict[str, AxisMeta] = {
     "PGV_ratio": AxisMeta("PGV p of the scaled record over g tan(alpha_ref)", "1",
                           "PGV p/(g tan alpha_ref)", r"PGV\,p/(g\,\tan\alpha_{ref})"),
     "period": AxisMeta("period of the oscillator of Sa (5% damping)", "s", "T", "T"),
+    # the state at t = 0 (scene section ``initial``; INITIAL below)
+    "theta_over_alpha": AxisMeta("initial rotation", "1", "theta_0/alpha_ref",
+                                 r"\theta_0/\alpha_{ref}"),
+    "thetadot_over_palpha": AxisMeta("initial rotation rate", "1",
+                                     "theta'_0/(p alpha_ref)",
+                                     r"\dot\theta_0/(p\,\alpha_{ref})"),
+    "u_over_ucr": AxisMeta("initial displacement of the top mass", "1", "u_0/u_cr",
+                           r"u_0/u_{cr}"),
+    "udot_over_pucr": AxisMeta("initial velocity of the top mass", "1", "u'_0/(p u_cr)",
+                               r"\dot u_0/(p\,u_{cr})"),
 }
+
+#: the initial state's keys (scene section ``initial``, each sweepable), normalised as
+#: ``simulate --csv`` writes them: theta/alpha_ref, theta'/(p alpha_ref), u/u_cr, u'/(p u_cr)
+INITIAL: tuple[str, ...] = ("theta_over_alpha", "thetadot_over_palpha", "u_over_ucr",
+                            "udot_over_pucr")
 
 #: the stability diagram's axes (x, y): the paper's omega/p and A/(g tan alpha_ref)
 DIAGRAM_AXES: tuple[str, str] = ("w_over_p", "A_ratio")

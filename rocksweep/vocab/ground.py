@@ -17,13 +17,17 @@ import math
 SINE, COSINE, RICKER, MP = "sine", "cosine", "ricker", "mp"
 SHAPES: tuple[str, ...] = (SINE, COSINE, RICKER, MP)
 RECORD = "record"  # the shape of a point driven by a ground-motion record
+#: the shape of a scene without ground motion (neither pulse: nor ground:): free vibration
+#: from the initial state; it runs the pulse variants with A = 0 and a pulse that ends at
+#: t = 0 (w_over_p = 0, ``physics.points.run_cost``)
+FREE = "free"
 #: shapes the kernel's pulse variants run (the paper's; every other shape and a record run
 #: the GROUND variants, ``rocksweep.kernel.variants``)
 PAPER_SHAPES: tuple[str, ...] = (SINE, COSINE)
 #: the kernel's PAR_SHAPE code of each shape (float64 parameter row entry)
 SHAPE_CODE: dict[str, float] = {SINE: 0.0, COSINE: 1.0, RICKER: 2.0, MP: 3.0, RECORD: 4.0}
 SHAPE_TITLE: dict[str, str] = {SINE: "sine", COSINE: "cosine", RICKER: "Ricker",
-                               MP: "Mavroeidis-Papageorgiou"}
+                               MP: "Mavroeidis-Papageorgiou", FREE: "free rocking"}
 #: the shapes each optional pulse key (pulse.cycles, pulse.gamma, pulse.nu) means something for
 PULSE_KEY_SHAPES: dict[str, tuple[str, ...]] = {"cycles": PAPER_SHAPES, "gamma": (MP,),
                                                 "nu": (MP,)}
@@ -37,7 +41,9 @@ RICKER_DURATION = 6.0 * math.pi
 
 def pulse_duration(shape: str, cycles: int = CYCLES, gamma: float = GAMMA) -> float:
     """The pulse's duration D in phase (w t): 2 pi n (sine, cosine), 6 pi (Ricker),
-    2 pi gamma (MP)."""
+    2 pi gamma (MP), 0 (FREE: no ground motion)."""
+    if shape == FREE:
+        return 0.0
     if shape == RICKER:
         return RICKER_DURATION
     if shape == MP:

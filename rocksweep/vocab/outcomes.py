@@ -33,10 +33,14 @@ STATUS_BIT: dict[str, int] = {
     "bounded": 1024,
     SLIDES: 2048,
     LIFTS_OFF: 4096,
+    # set after the kernel by the certification of close calls (rocksweep.compute.certify)
+    "refined": 8192,
+    "uncertified": 16384,
 }
 STATUS_WORDS: dict[int, str] = {b: w for w, b in STATUS_BIT.items()}
 #: the bits that make a run's class unreliable ("flagged")
-FLAGGED_WORDS: tuple[str, ...] = ("horizon", "step_cap", "event_cap", "nonfinite")
+FLAGGED_WORDS: tuple[str, ...] = ("horizon", "step_cap", "event_cap", "nonfinite",
+                                   "uncertified")
 FLAGGED = 0
 for _w in FLAGGED_WORDS:
     FLAGGED |= STATUS_BIT[_w]
@@ -60,6 +64,11 @@ STATUS_MEANING: dict[str, str] = {
               "(outputs.contact)",
     LIFTS_OFF: "normal reaction below zero: the body would leave the ground "
                  "(outputs.contact)",
+    "refined": "a close call (the free rocking came near the overturning saddle): re-run "
+               "with 2, 4, ... times the steps until its outcome was stable; the finest "
+               "run's result is kept (rocksweep.compute.certify)",
+    "uncertified": "a close call whose outcome still changed at the last refinement "
+                   "(numerics.refine) (flagged)",
 }
 
 #: the limit states a fragility curve can count (besides "theta:X")

@@ -73,7 +73,8 @@ def sine_scene():
 def test_a_min_equals_a_10x_finer_sweep(sine_scene):
     text, sc, full = sine_scene
     rtol = 1e-3
-    curves = bd.a_min(sc, full["outcome"], rtol=rtol)
+    curves = bd.a_min(sc, full["outcome"], rtol=rtol, theta=full["theta_max_over_alpha"],
+                      uplifts=full["uplifts"])
     assert [c.where for c in curves] == [{"lam": 0.0}, {"lam": 0.4}]
     A = np.asarray(sc.axis("A_ratio").values)
     fine_sc = parse_scene(text.replace("num: 21", "num: 201"))  # spacing / 10
@@ -90,7 +91,8 @@ def test_a_min_equals_a_10x_finer_sweep(sine_scene):
             assert c.mode[j] == fine[p, i, j]
             assert c.hi[j] - c.lo[j] <= tol  # bisected, not the grid spacing
             assert c.hi[j] - c.lo[j] < (A[1] - A[0]) / 100
-            assert 5 <= c.runs[j] <= 20
+            assert c.runs[j] - c.searched[j] <= 20  # the bisection (after the search)
+            assert c.searched[j] <= bd.SEARCH_RUNS
 
 
 def test_a_min_of_a_synthetic_threshold_and_csv():
@@ -114,9 +116,9 @@ def test_a_min_of_a_synthetic_threshold_and_csv():
         np.testing.assert_allclose(c.a_min, threshold(s, w), rtol=1e-4)
         assert (c.mode == 2).all()
     rows = bd.a_min_rows(curves)
-    assert list(rows[0]) == ["shape", "w_over_p", "A_min", "mode", "upper_bound"]
+    assert list(rows[0]) == ["shape", "w_over_p", "A_min", "mode", "upper_bound", "method"]
     text = bd.csv_text(rows)
-    assert text.splitlines()[0] == "shape,w_over_p,A_min,mode,upper_bound"
+    assert text.splitlines()[0] == "shape,w_over_p,A_min,mode,upper_bound,method"
     assert len(text.splitlines()) == 1 + 10 and "cosine,3.0," in text
     fig = a_min_figure(curves, bd.diagram_boundaries(sc, outcome), title="t")
     assert type(fig).__name__ == "Figure" and len(fig.axes) == 1
@@ -189,7 +191,9 @@ def test_boundaries_h5_holds_what_the_csv_files_hold(cli, tmp_path):
                     continue
                 a_rows.append({**where, "w_over_p": float(g["w_over_p"][j]),
                                "A_min": float(a), "mode": outcome_word(int(g["mode"][j])),
-                               "upper_bound": bool(g["upper_bound"][j])})
+                               "upper_bound": bool(g["upper_bound"][j]),
+                               "method": str(g["A_min_method"].attrs["flag_meanings"]
+                                             ).split(";")[int(g["A_min_method"][j])]})
             gl = f[f"lines/panel_{i}"]
             assert {k: value(gl.attrs[k]) for k in where} == where
             for n in range(len(gl)):

@@ -4,6 +4,7 @@ of each record of a scaled suite, bisected between stripes."""
 from __future__ import annotations
 
 import dataclasses
+import math
 import shutil
 from pathlib import Path
 
@@ -58,11 +59,13 @@ def test_bisected_level_brackets_the_first_overturning(suite):
             continue
         j = int(over[k].argmax())
         hi, lo = float(r.ida_hi.sel(record=name)), float(r.ida_lo.sel(record=name))
-        assert hi == float(r.ida_im.sel(record=name)) <= levels[j]
+        est = float(r.ida_im.sel(record=name))
+        assert hi <= levels[j]
         if j == 0:
-            assert np.isnan(lo) and int(r.upper_bound.sel(record=name)) == 1
+            assert np.isnan(lo) and int(r.upper_bound.sel(record=name)) == 1 and est == hi
             continue
-        assert levels[j - 1] <= lo < hi and hi - lo <= rtol * hi
+        assert levels[j - 1] <= lo < est < hi and hi - lo <= rtol * hi
+        assert est == pytest.approx(math.sqrt(lo * hi), rel=1e-12)  # not a copy of hi
         # independently: the scaled record's peak acceleration is the IM level (PGA [g]),
         # and single runs at the sweep's numerics overturn at hi and not at lo
         top = sc.point({"record": name, "PGA": levels[j], "lam": 0.0, "p": 2.0,

@@ -227,3 +227,14 @@ def test_the_integrand_integrates_to_the_rate():
     area = integrate.trapezoid(rk.rate_density[0].values, np.log(rk.im_level.values))
     tail = float(rk.fragility[0, -1]) * rate[-1]
     assert area + tail == pytest.approx(float(rk.annual_rate[0]), rel=5e-3)  # 200 points
+
+
+def test_older_openquake_header(tmp_path):
+    # OpenQuake 2.x: "# ..., investigation_time=1.0, imt=\"SA(1.0)\"" before the columns
+    path = tmp_path / "old.csv"
+    path.write_text("# source_model_tree_path=('b1',), gsim_tree_path=('b1',), "
+                    "investigation_time=1.0, imt=\"SA(1.0)\"\n"
+                    "lon,lat,depth,poe-0.1,poe-0.2,poe-0.4\n0,0,0,0.1,0.01,0.001\n")
+    hz = read_hazard(path)
+    assert (hz.name, hz.unit, hz.period) == ("Sa", "g", 1.0)
+    np.testing.assert_allclose(hz.rate, -np.log1p(-np.array([0.1, 0.01, 0.001])))

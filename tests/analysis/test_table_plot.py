@@ -38,6 +38,10 @@ def test_one_row_per_run_with_the_runs_ims(ds):
     np.testing.assert_allclose(t["d5_95"], t["record_d5_95"], rtol=1e-12)
     np.testing.assert_allclose(t["pgv_over_pga"], t["pgv"] / (t["pga"] * G), rtol=1e-9)
     assert {"record_sa(0.2)", "record_sa(1)", "sa(0.2)", "sa(1)"} <= set(t.columns)
+    # the dimensionless IMs of each run: PGA/(g tan alpha_cg), PGV p/(g tan alpha_cg)
+    np.testing.assert_allclose(t["pga_ratio"], t["PGA"] / np.tan(0.15), rtol=1e-12)
+    np.testing.assert_allclose(t["pgv_ratio"], t["pgv"] * 2.0 / (G * np.tan(0.15)),
+                               rtol=1e-12)
     assert t.attrs["units"]["arias"] == "m/s" and t.attrs["units"]["d5_95"] == "s"
     assert "record_sha256" not in t.columns
 
@@ -65,6 +69,7 @@ def test_plot_draws_every_kind(ds):
     for d, kind in ((ds, "sweep"), (fr, "fragility"), (eff, "im_efficiency"),
                     (rk, "risk")):
         assert dataset_kind(d) == kind
+        assert d.attrs.get("rocksweep_kind", "sweep") == kind
         fig = rocksweep.plot(d)
         assert isinstance(fig, Figure) and fig.axes
         assert isinstance(d.rocksweep.plot(), Figure)
@@ -96,12 +101,17 @@ def test_plot_of_ida_and_spectra_datasets(ds):
     import xarray as xr
 
     ida = rocksweep.ida(ds, rtol=0.05)
-    assert dataset_kind(ida) == "ida"
+    assert dataset_kind(ida) == "ida" and ida.attrs["rocksweep_kind"] == "ida"
     fig = rocksweep.plot(ida)
-    assert fig.axes[0].get_xscale() == "log"
-    n_points = sum(len(c.get_offsets()) if hasattr(c, "get_offsets") else 0
-                   for c in fig.axes[0].collections)
-    assert fig.axes[0].lines or n_points
+    # IDA curves: one panel per lam, max|theta|/alpha against the IM, one curve per record
+    # ending at its bisected first overturning level at the limit 1
+    assert len(fig.axes) == ds.sizes["lam"]
+    ax = fig.axes[0]
+    assert ax.get_xscale() == "log"
+    v = ida.ida_im.isel(lam=0).values
+    ends = {round(float(ln.get_xdata()[0]), 12) for ln in ax.lines
+            if len(ln.get_xdata()) == 1 and ln.get_ydata()[0] == 1.0}
+    assert ends == {round(float(x), 12) for x in v[np.isfinite(v)]}
     lam, A, p = [0.0, 0.4], [1.0, 2.0, 3.0], np.linspace(1, 5, 7)
     sp = xr.Dataset(
         {"theta_max_over_alpha": (("lam", "A_ratio", "p"), np.random.default_rng(0)

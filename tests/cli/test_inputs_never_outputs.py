@@ -115,6 +115,13 @@ def test_analyses_never_write_over_the_result_or_its_records(cli, work):
     refused(cli, ["boundaries", "c.h5", "-o", "rec.csv", "--overwrite"], work, "rec.csv")
     refused(cli, ["fragility", "cs.h5", "-o", "c/c1.csv", "--overwrite"], work, "c/c1.csv")
     refused(cli, ["fragility", "cs.h5", "-o", "cs.h5", "--overwrite"], work, "cs.h5")
+    refused(cli, ["table", "cs.h5", "-o", "c/c2.csv", "--overwrite"], work, "c/c2.csv")
+    refused(cli, ["efficiency", "cs.h5", "-o", "c/c2.csv", "--overwrite"], work, "c/c2.csv")
+    (work / "hazard.csv").write_text("IM,rate\n0.1,0.01\n0.5,0.001\n1.0,0.0001\n")
+    refused(cli, ["risk", "cs.h5", "--hazard", "hazard.csv", "-o", "c/c1.csv",
+                  "--overwrite"], work, "c/c1.csv")
+    refused(cli, ["risk", "cs.h5", "--hazard", "hazard.csv", "-o", "hazard.csv",
+                  "--overwrite"], work, "hazard.csv")
     os.symlink("rec.csv", work / "rec-link.png")
     refused(cli, ["plot", "c.h5", "-o", "rec-link.png", "--overwrite"], work, "rec-link.png")
 

@@ -23,7 +23,7 @@ from rocksweep.compute import sweep as sw
 from rocksweep.fields import CHECK_FIELDS, check_rows
 from rocksweep.kernel import chunk_kernel
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.numerics import PRESET_ROTATION, PRESETS, Numerics
+from rocksweep.numerics import PRESET_PULSE, PRESET_ROTATION, PRESETS, Numerics
 from rocksweep.physics.model import FlexibleBody
 from rocksweep.physics.points import Point, kernel_kind, point_row
 from rocksweep.physics.reference import reference_run
@@ -54,6 +54,7 @@ def test_rerun_is_the_sweep_at_half_the_step():
     spp, _ = PRESETS["default"]
     half = sw.compute(parse_scene(SCENE, overrides=[
         f"numerics.steps_per_period={2 * spp}",
+        f"numerics.pulse_steps={2 * PRESET_PULSE['default']}",
         f"numerics.rotation_step={PRESET_ROTATION['default'] / 2}"]))
     assert set(checked) == set(plain) | set(CHECK_NAMES)
     for k, v in plain.items():

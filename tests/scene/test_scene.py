@@ -112,7 +112,7 @@ STRUCTURE_CASES = [
     (GOOD.replace("pulse: {shape: sine, w_over_p: 5.3, A_ratio: 5.0}", "pulse: [1, 2]"),
      "pulse = [1, 2]: must be a mapping with keys shape, w_over_p, A_ratio, cycles, gamma, nu"),
     (sub("wn_over_p: 2.43", "kind: [block], wn_over_p: 2.43"),
-     "body.kind = ['block']: must be one of flexible, block"),
+     "body.kind = ['block']: must be one of flexible, block, physical"),
     (sub("zeta: 0.05", "zeta: 0.05, zta: 1"),
      "body.zta: unknown key for a flexible body (allowed: kind, wn_over_p, zeta, alpha_cg, "
      "alpha_A, mA_over_m, IA_ratio, mu)"),
@@ -121,7 +121,7 @@ STRUCTURE_CASES = [
      "rest_rate, max_events, root, rotation_step)"),
     (GOOD + "foo: 1\n",
      "foo: unknown key (allowed: name, body, impact, pulse, numerics, outputs, ground, "
-     "refine)"),
+     "refine, initial)"),
     (sub(", A_ratio: 5.0", ""),
      "pulse.A_ratio: missing required key (a number, a list of numbers or a range "
      "{start, stop, num})"),
@@ -134,7 +134,7 @@ STRUCTURE_CASES = [
      "outputs.energy = 'yes': must be true or false (store energy metrics)"),
     (GOOD + "name: 3\n", "name = 3: must be a string (the scene's title)"),
     ("[1, 2]", "a scene is a YAML mapping with sections body, impact, pulse, numerics, "
-     "outputs, ground, refine (got [1, 2])"),
+     "outputs, ground, refine, initial (got [1, 2])"),
 ]
 
 

@@ -1,0 +1,737 @@
+"""Calibration: the scene numbers (lam, e, e_factor, zeta...) that reproduce a measured
+rocking history, with a confidence interval (issue 30).
+
+The misfit: peak amplitudes per half cycle, aligned
+-----------------------------------------------------
+A rocking history is a sequence of excursions (half cycles) between impacts. What the
+impact law sets is how much of an excursion's amplitude survives the impact that ends it;
+when an impact happens is a consequence of the amplitudes. Least squares on theta(t) is
+dominated by phase: after a few impacts a tiny error in e shifts the simulated impacts by
+half a cycle, and theta(t) then differs by twice the amplitude for any parameter value,
+so its misfit flattens out and grows local minima. The peaks do not drift: the misfit here
+is on the sequence of excursion peaks.
+
+1. The excursions of a history (measured, or simulated and sampled at the measured times
+   by Hermite interpolation of theta and theta'): the samples between two changes of
+   sign, a sign counting once |theta| exceeds a threshold h (noise near zero, or the
+   base resting in full contact between two uplifts on one corner, starts none). Each
+   has two features: its signed peak, the vertex of a least-squares parabola through the
+   samples above PEAK_TOP of its largest (the largest noisy sample alone is biased up;
+   the same rule on both sides, so the parabola's own shape error cancels), and its area
+   beyond the threshold, int max(|theta| - h, 0) dt, divided by the median duration of
+   the measured excursions (a level: many samples average the noise, and a sample near
+   the threshold or next to a gap weighs ~0, so the area is continuous in the
+   parameters). h = max(H_NOISE x sigma, H_REL x max |theta|), sigma the measured noise
+   (``measured.noise_level``): the small rebounds of a chattering body, near the noise,
+   do not count.
+2. The two sequences are aligned by a sequence alignment (dynamic programming, as an edit
+   distance): a pair of excursions of one sign costs the squared differences of their
+   features, (f(a) - f(b))^2 + (g_a - g_b)^2 with f(a) = max(|a| - h, 0) and g the area
+   level; an excursion left unpaired costs f^2 + g^2. An excursion just above the
+   threshold in one history and just below it in the other then costs ~0 and cannot shift
+   the pairing of the later, larger ones (which order matching would do).
+3. The misfit is the least cost over alignments, S (units (theta/alpha)^2); ``misfit`` in
+   the result is sqrt(S / N), N the number of measured excursions.
+
+The starts are aligned: the measured history may begin with a quiet part of any length
+(before a release, or before the pulse lifts the body); the simulated history is shifted
+so that both depart from their first value by the threshold at the same time, refined by
+least squares on theta over the first half cycles (before any phase drift).
+
+The interval
+------------
+Profile likelihood: a parameter's 95% interval holds the values whose misfit, minimised
+over the other fitted parameters, exceeds the least misfit by at most chi2_1(0.95) s^2,
+with s^2 = max(S_min / (N - k), sigma^2) the variance of one peak's error (the residual
+scatter, never below the measured noise). The misfit of a run with many impacts is rough
+on small scales, so the interval is widened to where a parabola fitted to the profile
+across it rises by the same amount plus twice the profile's scatter about the parabola
+(the union of both is kept). Less noise gives a smaller s^2 and a narrower
+interval; an interval that reaches a bound is stated (``lo_at_bound``/``hi_at_bound``).
+
+Speed: each misfit evaluation is one run of the single-run history kernel (no plot, no
+Dataset): the scene's point is made once and each candidate rewrites its own row.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from rocksweep.compute.single import history_capacity
+from rocksweep.errors import CalibrationError, RocksweepError  # noqa: F401 (CalibrationError re-exported)
+from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.kernel import point_kernel, warm_up
+from rocksweep.numerics import step_budget
+from rocksweep.physics.measured import Measured, noise_level
+from rocksweep.physics.model import BodyError
+from rocksweep.physics.points import INITIAL, kernel_kind, point_row
+from rocksweep.schema import KEYS, fmt
+
+H_NOISE = 4.0  # threshold of an excursion, in noise standard deviations ...
+H_REL = 0.02  # ... and at least this share of the largest |theta|
+PEAK_TOP = 0.5  # a peak's parabola goes through the samples above this share of it ...
+PEAK_RAMP = 0.2  # ... weighted from 0 there to 1 at PEAK_TOP + PEAK_RAMP
+CHI2_95 = 3.841458820694124  # chi-square quantile, 1 degree of freedom, 95%
+GRID = 21  # first look of a one-parameter fit: GRID values across the bounds
+GRID_2D = 9  # ... and GRID_2D^2 for two parameters
+STAGES = (3, 6, 12, 24, 48, 96, 192)  # half cycles compared at each stage of ``_fit``
+PROFILE_POINTS = 15  # values of the profile misfit a parabola is fitted to (``_smooth_profile``)
+# practical default bounds of a fitted key (inside the key's admissible range)
+DEFAULT_BOUNDS = {"impact.lam": (0.0, 2.0), "impact.e": (0.02, 1.0),
+                  "impact.e_factor": (0.2, 2.0), "body.zeta": (0.0, 0.5)}
+# keys of a scene's point a fit may set although the scene does not give them
+OPTIONAL_NAMES = ("e_factor", *INITIAL)
+
+
+@dataclass(frozen=True)
+class Peaks:
+    """Excursions of a history: signed peak (theta/alpha) float64[n], peak time float64[n]."""
+
+    value: np.ndarray
+    time: np.ndarray
+    area: np.ndarray | None = None  # integral of |theta| over each excursion [theta/alpha p t]
+
+
+def excursions(t: np.ndarray, theta: np.ndarray, h: float) -> Peaks:
+    """The excursions of a sampled history beyond the threshold h (see the module
+    docstring, step 1). t: float64[n] increasing; theta: float64[n]."""
+    big = np.flatnonzero(np.abs(theta) > h)
+    if big.size == 0:
+        return Peaks(np.zeros(0), np.zeros(0), np.zeros(0))
+    sign = np.sign(theta[big])
+    new = np.ones(big.size, bool)
+    new[1:] = sign[1:] != sign[:-1]
+    starts = np.flatnonzero(new)
+    # the largest sample of each group of samples beyond h
+    signed = sign * theta[big]
+    ends = np.append(starts[1:], big.size)
+    arg = np.array([s + int(np.argmax(signed[s:e])) for s, e in zip(starts, ends,
+                                                                       strict=True)])
+    k = big[arg]
+    sg = sign[starts]
+    value, when = theta[k].copy(), t[k].copy()
+    # a parabola through the top of each excursion (the samples within PEAK_TOP of its
+    # largest): the largest sample alone is biased up by the noise (the largest of several
+    # noisy samples), a least-squares fit through many is not
+    first = big[starts]
+    last = big[ends - 1]
+    n = t.size
+    area = np.empty(k.size)
+    for j in range(k.size):
+        a, b = int(first[j]), int(last[j]) + 1
+        seg = sg[j] * theta[a:b]
+        # the area beyond the threshold, int max(|theta| - h, 0) dt from the sample before
+        # to the sample after: many samples average the noise, and a sample near the
+        # threshold (or after a gap) weighs ~0, so the area is continuous in the parameters
+        a0, b0 = max(a - 1, 0), min(b + 1, n)
+        over = np.maximum(sg[j] * theta[a0:b0] - h, 0.0)
+        area[j] = float(np.sum(0.5 * (over[1:] + over[:-1]) * np.diff(t[a0:b0])))
+        # weights rise from 0 at PEAK_TOP of the largest to 1 at PEAK_TOP + PEAK_RAMP:
+        # a sample entering the top as the parameters change enters with weight 0, so the
+        # peak is continuous in the parameters
+        wgt = np.clip((seg / seg.max() - PEAK_TOP) / PEAK_RAMP, 0.0, 1.0)
+        top = np.flatnonzero(wgt > 0) + a
+        if top.size < 4:
+            continue
+        tt = t[top] - t[k[j]]
+        c2, c1, c0 = np.polyfit(tt, theta[top], 2, w=np.sqrt(wgt[top - a]))
+        tv = -c1 / (2 * c2) if sg[j] * c2 < 0 else (tt[0] if sg[j] * c1 < 0 else tt[-1])
+        tv = min(max(tv, tt[0]), tt[-1])  # the top at an end (a release from a tilt)
+        value[j] = c0 + c1 * tv + c2 * tv * tv
+        when[j] = t[k[j]] + tv
+    return Peaks(value, when, area)
+
+
+def alignment_cost(a: np.ndarray, b: np.ndarray, h: float, band: int = 12,
+                   area_a: np.ndarray | None = None, area_b: np.ndarray | None = None,
+                   t_scale: float = 1.0) -> tuple[float, list[tuple[int, int]]]:
+    """Least cost of aligning two signed peak sequences (module docstring, step 2) and the
+    pairs (i, j) of that alignment. ``band``: pairs with |i - j| beyond it are not tried
+    (the cost of the rest is exact within the band)."""
+    fa = np.maximum(np.abs(a) - h, 0.0)
+    fb = np.maximum(np.abs(b) - h, 0.0)
+    if area_a is not None and area_b is not None:  # the areas, as mean levels
+        ga, gb = area_a / t_scale, area_b / t_scale
+        fa = np.stack([fa, ga], axis=1)
+        fb = np.stack([fb, gb], axis=1)
+    else:
+        fa, fb = fa[:, None], fb[:, None]
+    fa2, fb2 = np.sum(fa**2, axis=1), np.sum(fb**2, axis=1)
+    n, m = a.size, b.size
+    inf = math.inf
+    d = np.full((n + 1, m + 1), inf)
+    d[0, 0] = 0.0
+    sa, sb = np.sign(a), np.sign(b)
+
+    def pair(i: int, j: int) -> float:
+        if sa[i] == sb[j]:
+            return float(np.sum((fa[i] - fb[j]) ** 2))
+        return float(fa2[i] + fb2[j])
+
+    for j in range(1, m + 1):
+        d[0, j] = d[0, j - 1] + fb2[j - 1] if j <= band else inf
+    for i in range(1, n + 1):
+        if i <= band:
+            d[i, 0] = d[i - 1, 0] + fa2[i - 1]
+        lo, hi = max(1, i - band), min(m, i + band)
+        for j in range(lo, hi + 1):
+            d[i, j] = min(d[i - 1, j - 1] + pair(i - 1, j - 1), d[i - 1, j] + fa2[i - 1],
+                          d[i, j - 1] + fb2[j - 1])
+    if not math.isfinite(d[n, m]):  # longer than the band allows: the rest unpaired
+        return float(np.sum(fa2) + np.sum(fb2)), []
+    pairs = []
+    i, j = n, m
+    while i > 0 and j > 0:
+        if math.isclose(d[i, j], d[i - 1, j - 1] + pair(i - 1, j - 1), rel_tol=1e-12,
+                        abs_tol=1e-300):
+            if sa[i - 1] == sb[j - 1]:
+                pairs.append((i - 1, j - 1))
+            i, j = i - 1, j - 1
+        elif math.isclose(d[i, j], d[i - 1, j] + fa2[i - 1], rel_tol=1e-12, abs_tol=1e-300):
+            i -= 1
+        else:
+            j -= 1
+    return float(d[n, m]), pairs[::-1]
+
+
+def hermite(t_h: np.ndarray, y: np.ndarray, dy: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """A history's y at times t by cubic Hermite interpolation of (y, y') between its rows
+    (t_h non-decreasing; at a repeated time, as after an event, the later row is used);
+    beyond its ends, its first or last value."""
+    i = np.searchsorted(t_h, t, side="right") - 1
+    i = np.clip(i, 0, t_h.size - 2)
+    t0, t1 = t_h[i], t_h[i + 1]
+    h = t1 - t0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s = np.where(h > 0, (t - t0) / h, 0.0)
+    s = np.clip(s, 0.0, 1.0)
+    h00 = 2 * s**3 - 3 * s**2 + 1
+    h10 = s**3 - 2 * s**2 + s
+    h01 = -2 * s**3 + 3 * s**2
+    h11 = s**3 - s**2
+    out = h00 * y[i] + h10 * h * dy[i] + h01 * y[i + 1] + h11 * h * dy[i + 1]
+    out = np.where(t >= t_h[-1], y[-1], out)
+    return np.where(t <= t_h[0], y[0], out)
+
+
+def _onset(t: np.ndarray, theta: np.ndarray, level: float) -> float:
+    """The time a history first departs from its first value by ``level``, interpolated
+    between samples."""
+    d = np.abs(theta - theta[0])
+    k = np.flatnonzero(d > level)
+    if k.size == 0:
+        return math.nan
+    i = int(k[0])
+    if i == 0:
+        return float(t[0])
+    f = (level - d[i - 1]) / (d[i] - d[i - 1])
+    return float(t[i - 1] + f * (t[i] - t[i - 1]))
+
+
+class Problem:
+    """A scene's one point, a measured history and the keys to fit: the misfit of any
+    candidate values (``misfit``) and the histories behind it (``evaluate``)."""
+
+    def __init__(self, scene: Any, measured: Measured, fit: Sequence[str],
+                 bounds: Mapping[str, Sequence[float]] | None = None) -> None:
+        self.scene = scene
+        self.m = measured
+        self.keys = tuple(fit)
+        self.names = [check_fit_key(scene, k) for k in self.keys]
+        self.bounds = np.array([check_bounds(k, (bounds or {}).get(k)) for k in self.keys])
+        self.values = _single_values(scene, self.names)
+        self.numerics = scene.single_numerics
+        base = scene.point(self.values)
+        self.alpha = base.body.alpha_ref
+        self.sigma = noise_level(measured.t, measured.theta)
+        amp = float(np.max(np.abs(measured.theta)))
+        self.h = max(H_NOISE * self.sigma, H_REL * amp)
+        self.t_onset = _onset(measured.t, measured.theta, self.h)
+        if not math.isfinite(self.t_onset):
+            raise CalibrationError(f"{measured.source}: theta_over_alpha never departs from "
+                                   f"its first value by more than {self.h:.3g} (4 x the "
+                                   "noise): no motion to fit")
+        self.quiet = self.t_onset - float(measured.t[0])
+        self.peaks = excursions(measured.t, measured.theta, self.h)
+        if self.peaks.value.size < 2:
+            raise CalibrationError(
+                f"{measured.source}: {self.peaks.value.size} half cycle(s) beyond the noise "
+                f"(|theta_over_alpha| > {self.h:.3g}); a fit of the impact law needs the "
+                "measurement to go on past at least one impact")
+        # the time scale that makes an excursion's area a level: the median duration of the
+        # measured excursions (area / duration ~ its mean |theta|)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            dur = self.peaks.area / np.maximum(np.abs(self.peaks.value) - self.h, 1e-300)
+        self.t_scale = float(np.median(dur[dur > 0])) if np.any(dur > 0) else 1.0
+        # the start window of the shift (``_shift``): from the first sample to the second
+        # half-cycle peak; the shift is searched within a tenth of that window
+        t_end = self.peaks.time[1] if self.peaks.time.size > 1 else measured.t[-1]
+        self.window = np.flatnonzero(measured.t <= t_end)
+        self.dt_shift = 0.1 * max(float(t_end - self.t_onset), 1e-3)
+        self.runs = 0
+        self.n_use: int | None = None  # compare the first n_use half cycles (None: all)
+
+    def point(self, x: np.ndarray) -> Any:
+        values = dict(self.values)
+        for name, v in zip(self.names, x, strict=True):
+            values[name] = float(v)
+        return self.scene.point(values)
+
+    def simulate(self, x: np.ndarray) -> tuple[np.ndarray, dict] | None:
+        """(result row, raw history columns) of a candidate; None if the candidate's body
+        is not physical."""
+        try:
+            point = self.point(x)
+        except (BodyError, ValueError):
+            return None
+        row = point_row(point, self.numerics)
+        need = float(self.m.t[-1] - self.t_onset) + row[L.PAR_TPULSE] + 10.0
+        if row[L.PAR_TEND] < need:
+            row[L.PAR_TEND] = need
+            row[L.PAR_MAXSTEPS] = step_budget(need, row[L.PAR_DT], self.numerics)
+        out = np.empty(L.N_OUT)
+        hist = np.empty((history_capacity(row), L.N_HIST))
+        point_kernel(kernel_kind(point.body), point.ground)(row, out, hist)
+        self.runs += 1
+        n = int(out[L.OUT_HIST_ROWS])
+        a = point.body.alpha_ref
+        return out, {"t": hist[:n, L.HIST_T], "theta": hist[:n, L.HIST_THETA] / a,
+                     "theta_dot": hist[:n, L.HIST_THETA_DOT] / a,
+                     "phase": hist[:n, L.HIST_PHASE]}
+
+    def evaluate(self, x: np.ndarray) -> dict | None:
+        """Everything about a candidate: misfit S, the simulated theta at the measured
+        times, the time shift, its peaks and impact times (measured time)."""
+        got = self.simulate(x)
+        if got is None:
+            return None
+        out, h = got
+        shift = self._shift(h)
+        theta = hermite(h["t"], h["theta"], h["theta_dot"], self.m.t - shift)
+        peaks = excursions(self.m.t, theta, self.h)
+        mine, sim = self.peaks, peaks
+        n = self.n_use
+        if n is not None and n < mine.value.size:  # the first n half cycles (``fit``)
+            cut = 0.5 * (mine.time[n - 1] + mine.time[n])
+            keep = sim.time <= cut
+            mine = Peaks(mine.value[:n], mine.time[:n], mine.area[:n])
+            sim = Peaks(sim.value[keep], sim.time[keep], sim.area[keep])
+        cost, pairs = alignment_cost(mine.value, sim.value, self.h, area_a=mine.area,
+                                     area_b=sim.area, t_scale=self.t_scale)
+        t, ph = h["t"], h["phase"]
+        ev = np.flatnonzero((t[1:] == t[:-1]) & (ph[:-1] != 0) & (ph[1:] != ph[:-1]))
+        impacts = t[ev] + shift
+        impacts = impacts[impacts <= self.m.t[-1]]
+        return {"S": cost, "theta": theta, "shift": shift, "peaks": peaks, "pairs": pairs,
+                "impacts": impacts, "out": out}
+
+    def _shift(self, h: dict) -> float:
+        """The time shift that aligns a simulated history's start with the measured one:
+        first the shift that makes both depart from their first value by the threshold at
+        the same time (the simulation sampled as the measurement), then the least-squares
+        shift of theta over the measured start window (up to the second half-cycle peak,
+        before any phase drift; a slow start, as a release from a tilt, departs too
+        gently for the threshold alone)."""
+        from scipy.optimize import minimize_scalar
+
+        t_rel = self.m.t - self.m.t[0]
+        th = hermite(h["t"], h["theta"], h["theta_dot"], t_rel)
+        onset = _onset(t_rel, th, self.h)
+        if not math.isfinite(onset):
+            return self.t_onset
+        shift0 = self.t_onset - onset
+        w = self.window
+        tt, yy = self.m.t[w], self.m.theta[w]
+
+        def ss(sh: float) -> float:
+            return float(np.sum((hermite(h["t"], h["theta"], h["theta_dot"], tt - sh) - yy)
+                                ** 2))
+        r = minimize_scalar(ss, bounds=(shift0 - self.dt_shift, shift0 + self.dt_shift),
+                            method="bounded", options={"xatol": 1e-6})
+        return float(r.x) if r.fun <= ss(shift0) else shift0
+
+    def misfit(self, x: np.ndarray) -> float:
+        x = np.asarray(x, float)
+        if np.any(x < self.bounds[:, 0]) or np.any(x > self.bounds[:, 1]):
+            return math.inf
+        got = self.evaluate(x)
+        return math.inf if got is None or not math.isfinite(got["S"]) else got["S"]
+
+
+# ---------------------------------------------------------------------------------------
+# Checks
+# ---------------------------------------------------------------------------------------
+
+def fittable(scene: Any) -> list[str]:
+    """The keys of a scene that a fit may set: its numeric axes (body, impact, pulse,
+    ground, initial) and the optional impact.e_factor and initial state."""
+    out = [a.key for a in scene.axes if KEYS.get(a.key) is not None
+           and KEYS[a.key].kind == "axis" and a.key != "body.mu"]
+    out += [f"impact.{n}" if n == "e_factor" else f"initial.{n}" for n in OPTIONAL_NAMES]
+    return list(dict.fromkeys(k for k in out if not (scene.free and k.startswith("pulse."))))
+
+
+def check_fit_key(scene: Any, key: Any) -> str:
+    """The axis name a fit key sets, or a one-line CalibrationError."""
+    if not isinstance(key, str):
+        raise CalibrationError(f"fit key {key!r}: must be a dotted scene key such as "
+                               "impact.lam")
+    if key == "impact.e" and "e" not in {a.name for a in scene.axes}:
+        raise CalibrationError("fit impact.e: only law constant uses e; give impact: "
+                               "{law: constant, e: ...} in the scene (or fit impact.e_factor)")
+    allowed = fittable(scene)
+    if key not in allowed:
+        raise CalibrationError(f"fit {key}: not a number of this scene (fit one of "
+                               f"{', '.join(allowed)})")
+    return key.split(".", 1)[1]
+
+
+def check_bounds(key: str, given: Any) -> tuple[float, float]:
+    """(lo, hi) of a fit key: given, or DEFAULT_BOUNDS / the key's admissible range;
+    a one-line CalibrationError outside the admissible range."""
+    spec = KEYS[key]
+    lo_ok = spec.lo + (0.0 if spec.lo_in else 1e-9 * max(1.0, abs(spec.lo)))
+    hi_ok = spec.hi - (0.0 if spec.hi_in else 1e-9 * max(1.0, abs(spec.hi)))
+    if given is None:
+        lo, hi = DEFAULT_BOUNDS.get(key, (max(lo_ok, -10.0), min(hi_ok, 10.0)))
+        return float(lo), float(hi)
+    try:
+        lo, hi = (float(v) for v in given)
+    except (TypeError, ValueError):
+        raise CalibrationError(f"bounds {key} = {fmt(given)}: give two numbers (lo, hi)"
+                               ) from None
+    allowed = spec.allowed.removeprefix("must be ")
+    for v in (lo, hi):
+        if not math.isfinite(v) or (v < spec.lo or (v == spec.lo and not spec.lo_in)
+                                    or v > spec.hi or (v == spec.hi and not spec.hi_in)):
+            raise CalibrationError(f"bounds {key} = ({fmt(lo)}, {fmt(hi)}): {fmt(v)} is "
+                                   f"outside the key's admissible range ({allowed})")
+    if not lo < hi:
+        raise CalibrationError(f"bounds {key} = ({fmt(lo)}, {fmt(hi)}): lo must be below hi")
+    return lo, hi
+
+
+def _single_values(scene: Any, fitted: Sequence[str]) -> dict[str, Any]:
+    """The scene's one value of every axis; a swept axis that is not fitted is refused."""
+    for a in scene.axes:
+        if len(a.values) != 1 and a.name not in fitted:
+            raise CalibrationError(f"{a.key} has {len(a.values)} values: a calibration "
+                                   f"fits one point; pick one with --set {a.key}=VALUE")
+    return {a.name: a.values[0] for a in scene.axes}
+
+
+# ---------------------------------------------------------------------------------------
+# The fit
+# ---------------------------------------------------------------------------------------
+
+def _minimise(problem: Problem, free: list[int], fixed: dict[int, float],
+              start: np.ndarray) -> tuple[np.ndarray, float]:
+    """Least misfit over the parameters ``free`` with the others at ``fixed``: a grid
+    (GRID values for one, GRID_2D^2 for two) then Brent's method / Nelder-Mead from its
+    best point."""
+    from scipy.optimize import minimize, minimize_scalar
+
+    def full(z: np.ndarray) -> np.ndarray:
+        x = start.copy()
+        for i, v in fixed.items():
+            x[i] = v
+        x[free] = z
+        return x
+
+    b = problem.bounds[free]
+    if len(free) == 0:
+        x = full(np.zeros(0))
+        return x, problem.misfit(x)
+    if len(free) == 1:
+        g = np.linspace(b[0, 0], b[0, 1], GRID)
+        s = np.array([problem.misfit(full(np.array([v]))) for v in g])
+        k = int(np.argmin(s))
+        lo, hi = g[max(k - 1, 0)], g[min(k + 1, GRID - 1)]
+        r = minimize_scalar(lambda v: problem.misfit(full(np.array([v]))), bounds=(lo, hi),
+                            method="bounded",
+                            options={"xatol": 1e-5 * (b[0, 1] - b[0, 0])})
+        best = (r.x, r.fun) if r.fun <= s[k] else (g[k], s[k])
+        return full(np.array([best[0]])), float(best[1])
+    if len(free) == 2:
+        g0 = np.linspace(b[0, 0], b[0, 1], GRID_2D)
+        g1 = np.linspace(b[1, 0], b[1, 1], GRID_2D)
+        s = np.array([[problem.misfit(full(np.array([u, v]))) for v in g1] for u in g0])
+        i, j = np.unravel_index(int(np.argmin(s)), s.shape)
+        z0 = np.array([g0[i], g1[j]])
+    else:
+        z0 = start[free]
+    span = b[:, 1] - b[:, 0]
+    simplex = np.vstack([z0, *(z0 + np.diag(0.1 * span)[k] * (1 if z0[k] + 0.1 * span[k]
+                                                                <= b[k, 1] else -1)
+                               for k in range(len(free)))])
+    r = minimize(lambda z: problem.misfit(full(z)), z0, method="Nelder-Mead",
+                 options={"initial_simplex": simplex, "xatol": 1e-5 * span.min(),
+                          "fatol": 1e-12, "maxfev": 400})
+    return full(r.x), float(r.fun)
+
+
+def _fit(problem: Problem) -> tuple[np.ndarray, float]:
+    """The least misfit over every fitted key, by continuation over the half cycles.
+
+    An error in e grows with every impact, so the misfit of a long history has a narrow
+    basin (e within ~1% after 30 impacts) on a plateau (a history that died out early
+    costs the same whatever its e): a grid can miss it. The fit therefore starts on the
+    first STAGES[0] half cycles (a wide basin: a grid over the bounds, then Brent or
+    Nelder-Mead), and doubles them stage by stage up to all, each stage refining the last
+    estimate on a local grid of half the previous spacing."""
+    from scipy.optimize import minimize, minimize_scalar
+
+    n_all = problem.peaks.value.size
+    stages = [n for n in STAGES if n < n_all] + [n_all]
+    k = len(problem.keys)
+    b = problem.bounds
+    span = b[:, 1] - b[:, 0]
+    problem.n_use = stages[0]
+    x, s = _minimise(problem, list(range(k)), {}, b.mean(axis=1))
+    step = span / ((GRID if k == 1 else GRID_2D) - 1)
+    for n in stages[1:]:
+        problem.n_use = n
+        if k == 1:
+            g = np.unique(np.clip(x[0] + np.linspace(-2, 2, 9) * step[0], b[0, 0], b[0, 1]))
+            ss = np.array([problem.misfit(np.array([v])) for v in g])
+            j = int(np.argmin(ss))
+            lo, hi = g[max(j - 1, 0)], g[min(j + 1, g.size - 1)]
+            x, s = np.array([g[j]]), float(ss[j])
+            if hi > lo:
+                r = minimize_scalar(lambda v: problem.misfit(np.array([v])), bounds=(lo, hi),
+                                    method="bounded", options={"xatol": 1e-5 * span[0]})
+                if r.fun <= s:
+                    x, s = np.array([float(r.x)]), float(r.fun)
+        else:
+            simplex = np.vstack([x, *(np.clip(x + np.diag(step)[i], b[:, 0], b[:, 1])
+                                      for i in range(k))])
+            r = minimize(problem.misfit, x, method="Nelder-Mead",
+                         options={"initial_simplex": simplex, "xatol": 1e-5 * span.min(),
+                                  "fatol": 1e-12, "maxfev": 200})
+            if r.fun <= problem.misfit(x):
+                x = np.asarray(r.x, float)
+            s = problem.misfit(x)
+        step = step / 2
+    problem.n_use = None
+    return x, problem.misfit(x)
+
+
+def _profile_end(problem: Problem, i: int, x_hat: np.ndarray, s_min: float, limit: float,
+                 side: int) -> tuple[float, bool]:
+    """Where the profile misfit of parameter i reaches s_min + limit on one side (side -1
+    below the estimate, +1 above): (value, at_bound)."""
+    others = [k for k in range(len(x_hat)) if k != i]
+    lo, hi = problem.bounds[i]
+    edge = lo if side < 0 else hi
+
+    def prof(v: float) -> float:
+        if not others:
+            x = x_hat.copy()
+            x[i] = v
+            return problem.misfit(x)
+        _, s = _minimise_local(problem, others, {i: v}, x_hat)
+        return s
+
+    span = hi - lo
+    step = 0.005 * span
+    inside = float(x_hat[i])
+    while True:
+        v = inside + side * step
+        if (side < 0 and v <= edge) or (side > 0 and v >= edge):
+            if prof(edge) - s_min <= limit:
+                return float(edge), True
+            v = edge
+            out = v
+            break
+        if prof(v) - s_min > limit:
+            out = v
+            break
+        inside, step = v, step * 1.6
+    for _ in range(12 if not others else 7):  # bisection: inside (within), out (beyond)
+        mid = 0.5 * (inside + out)
+        if prof(mid) - s_min > limit:
+            out = mid
+        else:
+            inside = mid
+    return float(0.5 * (inside + out)), False
+
+
+def _smooth_profile(problem: Problem, i: int, x_hat: np.ndarray, lo: float, hi: float,
+                    limit: float, lo_b: bool, hi_b: bool) -> tuple[float, float, bool, bool]:
+    """The interval widened to where a parabola fitted to the profile misfit across it
+    (PROFILE_POINTS values over twice its width) rises by ``limit``: the misfit of a run
+    with many impacts is rough on small scales (an excursion near the threshold, an event
+    more or less in a chattering sequence), and a bump next to the minimum must not cut
+    the interval short. The union of both intervals is kept."""
+    others = [k for k in range(len(x_hat)) if k != i]
+    b_lo, b_hi = problem.bounds[i]
+    c = float(x_hat[i])
+    a, b = max(b_lo, c - 2 * (c - lo)), min(b_hi, c + 2 * (hi - c))
+    if not b > a:
+        return lo, hi, lo_b, hi_b
+    xs = np.linspace(a, b, PROFILE_POINTS if not others else 9)
+    ss = []
+    for v in xs:
+        if others:
+            ss.append(_minimise_local(problem, others, {i: v}, x_hat)[1])
+        else:
+            x = x_hat.copy()
+            x[i] = v
+            ss.append(problem.misfit(x))
+    ss = np.array(ss)
+    ok = np.isfinite(ss)
+    if ok.sum() < 5:
+        return lo, hi, lo_b, hi_b
+    c2, c1, c0 = np.polyfit(xs[ok], ss[ok], 2)
+    if c2 <= 0:
+        return lo, hi, lo_b, hi_b
+    x0 = -c1 / (2 * c2)
+    # the roughness (the profile's scatter about the parabola) is added to the rise: a
+    # difference of two misfits is uncertain by about that much
+    rough = float(np.std(ss[ok] - np.polyval([c2, c1, c0], xs[ok])))
+    d = math.sqrt((limit + 2 * rough) / c2)
+    if x0 - d < lo:
+        lo, lo_b = max(b_lo, x0 - d), x0 - d <= b_lo
+    if x0 + d > hi:
+        hi, hi_b = min(b_hi, x0 + d), x0 + d >= b_hi
+    return float(lo), float(hi), bool(lo_b), bool(hi_b)
+
+
+def _minimise_local(problem: Problem, free: list[int], fixed: dict[int, float],
+                    start: np.ndarray) -> tuple[np.ndarray, float]:
+    """Least misfit over ``free`` near ``start`` (no grid): Brent in a bracket of 10% of
+    the bounds for one parameter, Nelder-Mead for more."""
+    from scipy.optimize import minimize, minimize_scalar
+
+    x = start.copy()
+    for k, v in fixed.items():
+        x[k] = v
+    b = problem.bounds[free]
+    span = b[:, 1] - b[:, 0]
+    if len(free) == 1:
+        k = free[0]
+
+        def f(v: float) -> float:
+            y = x.copy()
+            y[k] = v
+            return problem.misfit(y)
+        # a small bracket first (the basin of a long history is narrow), widened while
+        # the minimum sits at its edge
+        half = 0.01 * span[0]
+        best = (float(start[k]), f(float(start[k])))
+        for _ in range(5):
+            lo, hi = max(b[0, 0], best[0] - half), min(b[0, 1], best[0] + half)
+            r = minimize_scalar(f, bounds=(lo, hi), method="bounded",
+                                options={"xatol": 1e-5 * span[0]})
+            if r.fun < best[1]:
+                best = (float(r.x), float(r.fun))
+            at_edge = min(best[0] - lo, hi - best[0]) < 0.05 * half
+            if not at_edge or (lo <= b[0, 0] and hi >= b[0, 1]):
+                break
+            half *= 4
+        y = x.copy()
+        y[k] = best[0]
+        return y, best[1]
+
+    def g(z: np.ndarray) -> float:
+        y = x.copy()
+        y[free] = z
+        return problem.misfit(y)
+    r = minimize(g, x[free], method="Nelder-Mead",
+                 options={"xatol": 1e-4 * span.min(), "fatol": 1e-12, "maxfev": 200})
+    y = x.copy()
+    y[free] = r.x
+    return y, float(r.fun)
+
+
+def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
+    """Fit a ``Problem``: the Dataset of ``rocksweep.calibrate`` (see ``calibrate``)."""
+    import xarray as xr
+    from scipy.stats import chi2
+
+    t0 = time.perf_counter()
+    k = len(problem.keys)
+    kind = kernel_kind(problem.point(problem.bounds.mean(axis=1)).body)
+    warm_up(kind, None, problem.scene.ground)
+    x_hat, s_min = _fit(problem)
+    if not math.isfinite(s_min):
+        raise CalibrationError("no candidate inside the bounds gives a physical body; "
+                               "check the bounds")
+    best = problem.evaluate(x_hat)
+    n = problem.peaks.value.size
+    s2 = max(s_min / max(n - k, 1), problem.sigma**2)
+    limit = float(chi2.ppf(ci, 1)) * s2
+    lo, hi, lo_b, hi_b = (np.empty(k), np.empty(k), np.zeros(k, bool), np.zeros(k, bool))
+    for i in range(k):
+        lo[i], lo_b[i] = _profile_end(problem, i, x_hat, s_min, limit, -1)
+        hi[i], hi_b[i] = _profile_end(problem, i, x_hat, s_min, limit, +1)
+        lo[i], hi[i], lo_b[i], hi_b[i] = _smooth_profile(problem, i, x_hat, lo[i], hi[i],
+                                                         limit, lo_b[i], hi_b[i])
+    wall = time.perf_counter() - t0
+    m = problem.m
+    pairs = best["pairs"]
+    fitted_peak = np.full(n, np.nan)
+    for i, j in pairs:
+        fitted_peak[i] = best["peaks"].value[j]
+    notes = list(m.notes)
+    if best["shift"] > 2 * float(np.median(np.diff(m.t))):
+        notes.append(f"a leading quiet part: the motion starts {best['shift']:.4g} p*t later "
+                     "than in the simulation (aligned by shifting the simulation)")
+    ds = xr.Dataset(
+        {"estimate": ("parameter", x_hat), "lo": ("parameter", lo), "hi": ("parameter", hi),
+         "lo_at_bound": ("parameter", lo_b), "hi_at_bound": ("parameter", hi_b),
+         "bound_lo": ("parameter", problem.bounds[:, 0]),
+         "bound_hi": ("parameter", problem.bounds[:, 1]),
+         "misfit": ((), math.sqrt(s_min / n)),
+         "measured_theta": ("p_t", m.theta,
+                            {"long_name": "measured theta / alpha_ref"}),
+         "fitted_theta": ("p_t", best["theta"],
+                          {"long_name": "simulated theta / alpha_ref at the estimate"}),
+         "impact_time": ("impact", best["impacts"],
+                         {"long_name": "impacts of the fitted simulation [p*t, measured "
+                                       "time]"}),
+         "peak_time": ("peak", problem.peaks.time),
+         "measured_peak": ("peak", problem.peaks.value),
+         "fitted_peak": ("peak", fitted_peak)},
+        coords={"parameter": ("parameter", list(problem.keys)), "p_t": ("p_t", m.t)})
+    ds["misfit"].attrs = {"long_name": "RMS error of the half-cycle peaks at the estimate",
+                          "units": "theta/alpha_ref"}
+    ds.attrs = {
+        "title": f"calibration of {', '.join(problem.keys)}",
+        "ci": ci,
+        "interval": "profile likelihood: misfit <= min + chi2_1(ci) s^2, s^2 = max(S_min/"
+                    "(N - k), sigma^2)",
+        "misfit_definition": "sqrt(S/N): S the least cost of aligning the measured and "
+                             "simulated half-cycle peaks (rocksweep.analysis.calibrate)",
+        "noise_sigma": problem.sigma, "threshold": problem.h, "n_peaks": n,
+        "time_shift": best["shift"], "runs": problem.runs, "wall_time_s": wall,
+        "measured": m.source, "notes": "; ".join(notes) if notes else "",
+        "scene": problem.scene.text, "accuracy": problem.numerics.describe(),
+        "outcome": int(best["out"][L.OUT_OUTCOME]),
+    }
+    return ds
+
+
+def calibrated_overrides(fit: Any, which: str = "all") -> dict[str, Any]:
+    """Overrides that sweep a scene at a calibration's values: ``which`` "estimate", "lo"
+    or "hi" gives one value per key; "all" the list [lo, estimate, hi] (distinct values,
+    ascending), so that ``rocksweep.run(scene, overrides=calibrated_overrides(fit))`` draws
+    the diagram at the estimate and at both ends of the interval (a swept dimension per
+    key)."""
+    if which not in ("all", "estimate", "lo", "hi"):
+        raise CalibrationError(f"which = {which!r}: must be all, estimate, lo or hi")
+    out: dict[str, Any] = {}
+    for key in fit["parameter"].values.tolist():
+        sel = fit.sel(parameter=key)
+        if which != "all":
+            out[key] = float(sel[which])
+            continue
+        vals = sorted({float(sel["lo"]), float(sel["estimate"]), float(sel["hi"])})
+        out[key] = vals if len(vals) > 1 else vals[0]
+    return out

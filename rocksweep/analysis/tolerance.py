@@ -1,0 +1,12 @@
+"""The relative tolerance of a bisected threshold (A_min): its default. Its range and the
+one check of it are ``rocksweep.errors.MAX_RTOL`` and ``check_rtol`` (the API, the CLI and
+the analyses call it). A light module: the command line reads it while parsing options (no
+numba, h5py or matplotlib)."""
+
+from __future__ import annotations
+
+from rocksweep.errors import MAX_RTOL, check_rtol
+
+__all__ = ["DEFAULT_RTOL", "MAX_RTOL", "check_rtol"]
+
+DEFAULT_RTOL = 1e-3

@@ -1,0 +1,183 @@
+"""Calibration (issue 30, parts 2-4): measured histories in, scene numbers out.
+
+The free-rocking measurement is made here, independently of the kernel: the classic block
+theta'' = -sign(theta) sin(alpha - |theta|) (p = 1) integrated by scipy's DOP853 with an
+event at theta = 0 where theta' -> e theta' (law constant). The flexible one is a
+``rocksweep.simulate`` run at 10x the fit's steps (what is tested is the fit, not the
+kernel). Each gets Gaussian noise of 1% of max |theta|.
+"""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.integrate import solve_ivp
+
+import rocksweep
+from rocksweep.errors import RocksweepError
+
+ROOT = Path(__file__).resolve().parents[2]
+ALPHA = 0.2
+BLOCK = {"name": "free block", "body": {"kind": "block", "alpha": ALPHA},
+         "impact": {"lam": 0.0, "law": "constant", "e": 0.8},
+         "initial": {"theta_over_alpha": 0.7}}
+FLEX = {"name": "flexible", "body": {"wn_over_p": 2.43, "zeta": 0.05, "alpha_cg": 0.15,
+                                     "alpha_A": 0.28, "mA_over_m": 0.47, "IA_ratio": 0.56},
+        "impact": {"lam": 0.0}, "pulse": {"shape": "sine", "w_over_p": 4.0, "A_ratio": 2.0}}
+
+
+def free_block_history(e: float, theta0: float = 0.7 * ALPHA, t_end: float = 25.0,
+                       dt: float = 0.02) -> tuple[np.ndarray, np.ndarray]:
+    """(p t, theta [rad]) of the rigid block released at rest from theta0, e per impact."""
+    def rhs(t, y):
+        return [y[1], -math.copysign(1.0, y[0]) * math.sin(ALPHA - abs(y[0]))]
+
+    def hit(t, y):
+        return y[0]
+    hit.terminal = True
+    t0, y0 = 0.0, [theta0, 0.0]
+    ts = np.arange(0.0, t_end, dt)
+    out = np.zeros_like(ts)
+    while t0 < t_end:
+        # leave theta = 0 first (the event is at the start of every segment after one)
+        sol = solve_ivp(rhs, (t0, t_end), y0, method="DOP853", rtol=1e-11, atol=1e-13,
+                        events=hit, dense_output=True, first_step=1e-6)
+        sel = (ts >= t0) & (ts <= sol.t[-1])
+        if sel.any():
+            out[sel] = sol.sol(ts[sel])[0]
+        if sol.status != 1:
+            break
+        w = e * sol.y_events[0][0][1]
+        if abs(w) < 1e-4:
+            break
+        t0 = sol.t_events[0][0]
+        y0 = [math.copysign(1e-13, w), w]
+    return ts, out
+
+
+def noisy(t: np.ndarray, theta_over_alpha: np.ndarray, level: float, seed: int = 0
+          ) -> pd.DataFrame:
+    rng = np.random.default_rng(seed)
+    y = theta_over_alpha + level * np.abs(theta_over_alpha).max() * rng.standard_normal(t.size)
+    return pd.DataFrame({"p_t": t, "theta_over_alpha": y})
+
+
+def flexible_measurement(lam: float, level: float, seed: int = 0) -> pd.DataFrame:
+    h = rocksweep.simulate(FLEX, {"impact.lam": lam,
+                                  "numerics.steps_per_period": 200}).history
+    t, th = h.p_t.values, h.theta_over_alpha.values
+    keep = np.r_[t[1:] != t[:-1], True]
+    ts = np.arange(0.0, t[keep][-1] + 3.0, 0.02)
+    return noisy(ts, np.interp(ts, t[keep], th[keep]), level, seed)
+
+
+def test_restitution_of_a_freely_rocking_block_from_an_independent_history():
+    t, theta = free_block_history(0.88)
+    fit = rocksweep.calibrate(BLOCK, noisy(t, theta / ALPHA, 0.01), ["impact.e"])
+    est = fit.sel(parameter="impact.e")
+    assert abs(float(est.estimate) - 0.88) < 0.02
+    assert float(est.lo) <= 0.88 <= float(est.hi)
+    assert fit.attrs["ci"] == 0.95
+    assert fit.misfit.ndim == 0 and float(fit.misfit) < 0.05
+
+
+def test_lam_of_a_flexible_body_under_a_pulse_and_an_honest_interval():
+    truth = 0.2
+    widths = []
+    for level in (0.01, 0.002):
+        fit = rocksweep.calibrate(FLEX, flexible_measurement(truth, level), "impact.lam")
+        s = fit.sel(parameter="impact.lam")
+        assert abs(float(s.estimate) - truth) < 0.03
+        assert float(s.lo) <= truth <= float(s.hi)
+        widths.append(float(s.hi - s.lo))
+    assert widths[1] < 0.6 * widths[0]  # less noise, a narrower interval
+    assert list(fit["parameter"].values) == ["impact.lam"]
+
+
+def test_calibrated_overrides_sweep_the_diagram_at_the_interval():
+    fit = rocksweep.calibrate(FLEX, flexible_measurement(0.2, 0.01), ["impact.lam"])
+    ov = rocksweep.calibrated_overrides(fit)
+    lo, est, hi = (float(fit[k].sel(parameter="impact.lam")) for k in ("lo", "estimate", "hi"))
+    assert ov == {"impact.lam": [lo, est, hi]}
+    assert fit.rocksweep.as_overrides("estimate") == {"impact.lam": est}
+    scene = {**FLEX, "pulse": {"shape": "sine", "w_over_p": [3.0, 5.0], "A_ratio": [1.0, 4.0]}}
+    ds = rocksweep.run(scene, overrides=ov)
+    assert ds.lam.values.tolist() == [lo, est, hi]
+
+
+def test_physical_columns_with_the_body_s_p():
+    t, theta = free_block_history(0.85)
+    p = 3.0  # rad/s: the record of a lab block whose p is 3 rad/s
+    df = pd.DataFrame({"t": t / p, "theta": theta})
+    fit = rocksweep.calibrate(BLOCK, df, ["impact.e"], p=p)
+    assert abs(float(fit.estimate[0]) - 0.85) < 0.02
+    with pytest.raises(RocksweepError, match="columns t .s., theta .rad. need the body's p"):
+        rocksweep.calibrate(BLOCK, df, ["impact.e"])
+
+
+GOOD_T = np.arange(0.0, 10.0, 0.05)
+
+
+@pytest.mark.parametrize("frame, fit, bounds, words", [
+    (pd.DataFrame({"p_t": GOOD_T, "theta": GOOD_T}), ["impact.e"], None,
+     "no column theta_over_alpha"),
+    (pd.DataFrame({"p_t": GOOD_T[::-1], "theta_over_alpha": GOOD_T}), ["impact.e"], None,
+     "time must not decrease"),
+    (pd.DataFrame({"p_t": GOOD_T, "theta_over_alpha": np.nan}), ["impact.e"], None,
+     "NaN in every row"),
+    (None, ["pulse.shape"], None, "fit pulse.shape: not a number of this scene"),
+    (None, ["impact.e"], {"impact.e": (0.5, 1.5)}, "bounds impact.e = (0.5, 1.5): 1.5 is "
+     "outside the key's admissible range"),
+    (pd.DataFrame({"p_t": GOOD_T, "theta_over_alpha": 0.7 - 0.001 * GOOD_T**2}),
+     ["impact.e"], None, "needs the measurement to go on past at least one impact"),
+])
+def test_bad_input_is_one_line(frame, fit, bounds, words):
+    if frame is None:
+        t, theta = free_block_history(0.85, t_end=8.0)
+        frame = noisy(t, theta / ALPHA, 0.01)
+    with pytest.raises(RocksweepError) as err:
+        rocksweep.calibrate(BLOCK, frame, fit, bounds=bounds)
+    assert words in str(err.value)
+    assert "\n" not in str(err.value)
+
+
+def test_impact_e_needs_law_constant():
+    with pytest.raises(RocksweepError, match="only law constant uses e"):
+        rocksweep.calibrate(FLEX, flexible_measurement(0.2, 0.01), ["impact.e"])
+
+
+def test_command_line_writes_the_fit_and_the_figure(tmp_path):
+    import xarray as xr
+    import yaml
+
+    t, theta = free_block_history(0.9)
+    scene, meas = tmp_path / "block.yaml", tmp_path / "measured.csv"
+    scene.write_text(yaml.safe_dump(BLOCK))
+    noisy(t, theta / ALPHA, 0.01).to_csv(meas, index=False)
+    fit_path, fig = tmp_path / "fit.h5", tmp_path / "fit.png"
+    cmd = [sys.executable, "-m", "rocksweep", "calibrate", str(scene), str(meas),
+           "--fit", "impact.e", "-o", str(fit_path), "--plot", str(fig)]
+    run = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
+    assert run.returncode == 0, run.stderr
+    first = run.stdout.splitlines()[0].split()
+    assert first[:2] == ["impact.e", "="] and abs(float(first[2]) - 0.9) < 0.02
+    assert "95% interval" in run.stdout
+    ds = xr.open_dataset(fit_path, engine="h5netcdf")
+    assert abs(float(ds.estimate[0]) - 0.9) < 0.02
+    assert fig.stat().st_size > 10_000
+    # bad input: one line, exit != 0, nothing written
+    bad = tmp_path / "bad.csv"
+    bad.write_text("time,angle\n0,1\n1,2\n")
+    out2 = tmp_path / "fit2.h5"
+    run = subprocess.run([*cmd[:5], str(bad), "--fit", "impact.e", "-o", str(out2)],
+                         capture_output=True, text=True, cwd=ROOT)
+    assert run.returncode != 0
+    assert run.stderr.strip().count("\n") == 0 and run.stderr.startswith("Error: ")
+    assert "no column p_t, theta_over_alpha" in run.stderr
+    assert not out2.exists()

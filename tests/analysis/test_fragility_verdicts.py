@@ -1,0 +1,419 @@
+"""Fits that say when not to trust them (issue 29 parts 1-2, issue 32's analyses on files
+they should not trust): one test per class of verdict, the competing-risk and ordinal
+fits against independent scipy optimisations, damage-state curves that never cross on
+the demo suite, partial and adaptive files, flagged points in IDA, bad arguments."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+from helpers import one_line_error
+from scipy.optimize import minimize
+from scipy.stats import norm
+
+import rocksweep
+from rocksweep.analysis import fragility as F
+from rocksweep.cli import main
+from rocksweep.kernel import layout as L  # noqa: N812
+
+ROOT = Path(__file__).resolve().parents[2]
+LEVELS = np.geomspace(0.1, 1.6, 12)
+
+
+def stripes_ds(outcome: np.ndarray, levels=LEVELS, status=None) -> xr.Dataset:
+    """A stripes Dataset (record, PGA) from outcome codes (R, S)."""
+    outcome = np.asarray(outcome, np.int8)
+    st = np.where(outcome > 0, L.STATUS_OVERTURNED, L.STATUS_REST).astype(np.int32)
+    if status is not None:
+        st = np.asarray(status, np.int32)
+    R = outcome.shape[0]
+    return xr.Dataset(
+        {"outcome": (("record", "PGA"), outcome), "status": (("record", "PGA"), st)},
+        coords={"record": [f"R{i:02d}.AT2" for i in range(R)], "PGA": levels},
+        attrs={"scale_im": "PGA"})
+
+
+def capacity_outcomes(n_records: int, median: float, beta: float, seed: int,
+                      levels=LEVELS) -> np.ndarray:
+    """Each record overturns (mode 1) from its lognormal capacity up: outcome (R, S)."""
+    cap = np.random.default_rng(seed).lognormal(math.log(median), beta, n_records)
+    return np.where(levels[None, :] >= cap[:, None], 1, 0)
+
+
+def reasons(fr) -> set[str]:
+    return set(str(fr["reason"].values).split(","))
+
+
+# ---------------------------------------------------------------------------------------
+# one class of verdict each; good fits stay "ok"
+# ---------------------------------------------------------------------------------------
+
+
+def test_a_good_fit_stays_ok_and_warns_nothing():
+    ds = stripes_ds(capacity_outcomes(40, 0.5, 0.4, seed=1))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # any FragilityWarning would fail here
+        fr = F.fragility(ds, bootstrap=200, seed=0)
+    assert str(fr["reason"].values) == "ok"
+    assert 0.1 < float(fr["beta"]) < 1.0 and int(fr["n_boot_undefined"]) < 10
+    med, beta = float(fr["im_median"]), float(fr["beta"])
+    x = np.array([0.2, 0.5, 1.1])
+    np.testing.assert_allclose(F.probability(fr, x).values,
+                               norm.cdf(np.log(x / med) / beta), rtol=1e-12)
+
+
+def test_one_stripe_leaves_beta_undetermined_never_zero():
+    fit = F.fit_stripes([0.5], [1], [2])  # one stripe, 1 of 2 records overturn
+    assert set(fit.reason.split(",")) == {"one_stripe", "beta_undetermined"}
+    assert math.isnan(fit.beta) and math.isnan(fit.im_median)
+    ds = stripes_ds([[0], [1]], levels=np.array([0.5]))
+    with pytest.warns(F.FragilityWarning, match="one_stripe"):
+        fr = F.fragility(ds, bootstrap=0)
+    assert {"one_stripe", "beta_undetermined"} <= reasons(fr) and np.isnan(fr["beta"])
+
+
+def test_too_few_distinct_fractions_and_separation_leave_beta_undetermined():
+    x = np.array([0.1, 0.2, 0.4, 0.8])
+    n = np.full(4, 10)
+    few = F.fit_stripes(x, [0, 0, 5, 5], n)  # one fraction strictly between 0 and 1
+    assert "beta_undetermined" in few.reason and math.isnan(few.beta)
+    sep = F.fit_stripes(x, [0, 0, 10, 10], n)
+    assert set(sep.reason.split(",")) == {"separated", "beta_undetermined"}
+    assert math.isnan(sep.beta) and sep.im_median == pytest.approx(math.sqrt(0.2 * 0.4))
+    # two distinct fractions inside: beta is determined
+    assert F.fit_stripes(x, [0, 3, 7, 10], n).reason == "ok"
+
+
+def test_falling_fractions_are_non_monotone_and_resurrection_noise_is_not():
+    # a state that rises then falls to nothing (20 records a stripe)
+    k = np.array([0, 0, 2, 8, 14, 18, 10, 4, 1, 0, 0, 0])
+    fit = F.fit_stripes(LEVELS, k, np.full(12, 20))
+    assert "non_monotone" in fit.reason.split(",")
+    # three records safe again above their first level (14 of 20, then 12): noise, ok
+    out = capacity_outcomes(20, 0.5, 0.4, seed=4)
+    out[np.flatnonzero(out[:, 7])[:3], 8] = 0  # overturned at stripe 7, safe at 8
+    fr = F.fragility(stripes_ds(out), bootstrap=0)
+    assert np.diff(fr["fraction"].values).min() < 0 and str(fr["reason"].values) == "ok"
+
+
+def test_median_or_16_84_points_outside_the_stripes_are_extrapolated():
+    # PGV-like stripes 0.05-0.8 with the capacity median above the top stripe
+    lv = np.geomspace(0.05, 0.8, 8)
+    ds = stripes_ds(capacity_outcomes(40, 0.93, 0.5, seed=2, levels=lv), levels=lv)
+    with pytest.warns(F.FragilityWarning, match=r"extrapolated \(im_median .* above"):
+        fr = F.fragility(ds, bootstrap=0)
+    assert float(fr["im_median"]) > lv.max() and "extrapolated" in reasons(fr)
+    # median inside, 84% point above the stripes: also extrapolated
+    lv2 = np.geomspace(0.1, 0.7, 8)
+    fr2 = F.fragility(stripes_ds(capacity_outcomes(60, 0.5, 0.5, seed=3, levels=lv2),
+                                 levels=lv2), bootstrap=0, warn=False)
+    med, beta = float(fr2["im_median"]), float(fr2["beta"])
+    assert med < lv2.max() < med * math.exp(beta)
+    assert "extrapolated" in reasons(fr2)
+
+
+def test_a_large_share_of_undefined_resamples_is_reported():
+    # two of 12 records overturn near the top (record 1 safe again at one stripe): the
+    # full data have a finite fit; a resample lacking either record has none (59 %)
+    out = np.zeros((12, 12), int)
+    out[0, -3:] = 1
+    out[1, [-3, -1]] = 1
+    fr = F.fragility(stripes_ds(out), bootstrap=200, seed=0, warn=False)
+    assert np.isfinite(fr["im_median"]) and np.isfinite(fr["beta"])
+    assert int(fr["n_boot_undefined"]) > 0.4 * 200
+    assert "bootstrap_undefined" in reasons(fr)
+    samples = fr["im_median_samples"].values
+    assert samples.shape == (200,) and np.isnan(samples).sum() == int(fr["n_boot_undefined"])
+
+
+def competing_outcomes(n_records=30, seed=0, levels=LEVELS):
+    """Mode 2 at moderate IM, taken over by mode 1 at high IM: each record has a mode-1
+    and a mode-2 capacity; at a level past either it overturns in the mode whose capacity
+    is the smaller (the competing-risk model)."""
+    rng = np.random.default_rng(seed)
+    c1 = rng.lognormal(math.log(0.55), 0.35, n_records)
+    c2 = rng.lognormal(math.log(0.9), 0.6, n_records)
+    first = np.minimum(c1, c2)
+    mode = np.where(c1 <= c2, 1, 2)
+    return np.where(levels[None, :] >= first[:, None], mode[:, None], 0)
+
+
+def test_a_mode_fitted_alone_is_censored_by_the_other_and_the_joint_fit_is_not():
+    ds = stripes_ds(competing_outcomes())
+    with pytest.warns(F.FragilityWarning, match="censored"):
+        alone = F.fragility(ds, state="mode2", bootstrap=0)
+    assert "censored" in reasons(alone)
+    joint = F.fragility(ds, state=["mode1", "mode2"], bootstrap=0, warn=False)
+    assert list(joint["fit"].values) == ["competing", "competing"]
+    assert not any("censored" in r for r in joint["reason"].values)
+
+
+def test_partial_data_are_incomplete_with_the_missing_stripes_named():
+    out = capacity_outcomes(20, 0.5, 0.4, seed=5)
+    out[:, -3:] = L.OUTCOME_NOT_RUN  # the top stripes not computed
+    st = np.where(out > 0, L.STATUS_OVERTURNED, L.STATUS_REST)
+    st[out < 0] = 0
+    ds = stripes_ds(out, status=st)
+    ds.attrs["complete"] = 0
+    with pytest.warns(F.FragilityWarning, match=rf"60 points not computed at PGA "
+                      rf"{LEVELS[-3]:.3g}-1.6 g left out \(the file is not complete"):
+        fr = F.fragility(ds, bootstrap=0)
+    assert "incomplete" in reasons(fr) and int(fr["n_not_run"]) == 60
+
+
+def test_flagged_points_that_could_move_the_fit_mark_it():
+    out = capacity_outcomes(20, 0.5, 0.4, seed=6)
+    st = np.where(out > 0, L.STATUS_OVERTURNED, L.STATUS_REST)
+    j = 6  # near the median: flag 4 points that overturned there
+    rows = np.flatnonzero(out[:, j] > 0)[:4]
+    st[rows, j] = L.STATUS_HORIZON
+    out[rows, j] = 0
+    with pytest.warns(F.FragilityWarning, match="4 flagged points left out"):
+        fr = F.fragility(stripes_ds(out, status=st), bootstrap=0)
+    assert "flagged" in reasons(fr) and int(fr["n_excluded"]) == 4
+    assert int(fr["n_counted"][j]) == 16
+
+
+# ---------------------------------------------------------------------------------------
+# the joint fits against independent maximisations
+# ---------------------------------------------------------------------------------------
+
+
+def cif_trapezoid(x, m1, b1, m2, b2, n_u=20001):
+    """(P(safe), P(mode 1), P(mode 2)) at x (S,) of independent lognormal capacities:
+    P(mode k) = integral over ln c < ln x of f_k(c) S_other(c), by the trapezoid rule."""
+    u = np.linspace(min(math.log(m1) - 9 * b1, math.log(m2) - 9 * b2),
+                    math.log(x.max()), n_u)
+    f1 = norm.pdf(u, math.log(m1), b1) * norm.sf(u, math.log(m2), b2)
+    f2 = norm.pdf(u, math.log(m2), b2) * norm.sf(u, math.log(m1), b1)
+    cum = [np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(u))])
+           for f in (f1, f2)]
+    p1, p2 = (np.interp(np.log(x), u, c) for c in cum)
+    ps = norm.sf(np.log(x), math.log(m1), b1) * norm.sf(np.log(x), math.log(m2), b2)
+    return ps, p1, p2
+
+
+def test_competing_risk_fit_equals_an_independent_multinomial_mle():
+    rng = np.random.default_rng(3)
+    true = (0.6, 0.4, 0.9, 0.6)
+    lv = np.geomspace(0.1, 2.0, 12)
+    p = np.stack(cif_trapezoid(lv, *true), -1)
+    cnt = np.array([rng.multinomial(40, q / q.sum()) for q in p])  # (S, 3)
+    # the same counts as a Dataset: 40 records a stripe
+    out = np.zeros((40, lv.size), int)
+    for s in range(lv.size):
+        out[:, s] = np.repeat([0, 1, 2], cnt[s])
+    fr = F.fragility(stripes_ds(out, levels=lv), state=["mode1", "mode2"], bootstrap=0,
+                     warn=False)
+
+    def nll(t):
+        ps, p1, p2 = cif_trapezoid(lv, *np.exp(t))
+        return -np.sum(cnt[:, 0] * np.log(ps) + cnt[:, 1] * np.log(p1)
+                       + cnt[:, 2] * np.log(p2))
+
+    ref = minimize(nll, np.log(true), method="Nelder-Mead",
+                   options={"xatol": 1e-9, "fatol": 1e-12, "maxiter": 20000,
+                            "maxfev": 20000})
+    m1, b1, m2, b2 = np.exp(ref.x)
+    got = fr["im_median"].values, fr["beta"].values
+    np.testing.assert_allclose(got[0], [m1, m2], rtol=2e-4)
+    np.testing.assert_allclose(got[1], [b1, b2], rtol=2e-4)
+    # the curves: P(mode 1) + P(mode 2) + P(safe) = 1, P(safe) = S_1 S_2 at every IM
+    grid = fr["im_grid"].values
+    c = fr["curve"].values
+    safe = (norm.sf(np.log(grid), math.log(got[0][0]), got[1][0])
+            * norm.sf(np.log(grid), math.log(got[0][1]), got[1][1]))
+    np.testing.assert_allclose(c.sum(0) + safe, 1.0, atol=1e-9)
+    assert np.all(np.diff(c, axis=1) >= -1e-12)  # cumulative incidences never fall
+    # probability() gives the same model at any IM (what a risk integral must use)
+    x = np.array([0.05, 0.7, 3.0])
+    ps, p1, p2 = cif_trapezoid(x, got[0][0], got[1][0], got[0][1], got[1][1], n_u=200001)
+    np.testing.assert_allclose(F.probability(fr, x).values, [p1, p2], atol=1e-6)
+
+
+DAMAGE = ["theta:0.1", "theta:0.25", "theta:0.5", "overturn"]
+
+
+@pytest.fixture(scope="module")
+def demo():
+    """The demo suite of the README (configs/fragility-demo.yaml: 20 records x 16 PGA
+    stripes x 3 lam), swept with the project's own tools."""
+    return rocksweep.run(ROOT / "configs" / "fragility-demo.yaml")
+
+
+def test_damage_states_never_cross_on_the_demo_suite(demo):
+    fr = rocksweep.fragility(demo, state=DAMAGE, bootstrap=50)
+    assert list(fr["fit"].values) == ["ordinal"] * 4
+    assert np.all(fr["reason"].values == "ok")
+    c = fr["curve"].transpose("lam", "state", "im_grid").values
+    assert np.all(np.diff(c, axis=1) <= 1e-12)  # each state at most the one before
+    med = fr["im_median"].transpose("lam", "state").values
+    assert np.all(np.diff(med, axis=1) > 0)
+    beta = fr["beta"].values
+    assert np.allclose(beta, beta[:1])  # one dispersion per lam
+    # every resample ordered too
+    s = fr["im_median_samples"].transpose("lam", "sample", "state").values
+    ok = np.all(np.isfinite(s), -1)
+    assert np.all(np.diff(s[ok], axis=-1) >= 0)
+
+
+def test_one_state_fits_equal_the_single_fit_and_the_ordinal_mle_is_the_mle(demo):
+    for st in DAMAGE:  # a one-state fit is the binomial MLE of that state
+        one = rocksweep.fragility(demo, state=st, bootstrap=0).isel(lam=0)
+        k = one["n_failed"].values
+        n = one["n_counted"].values
+        direct = F.fit_stripes(demo["PGA"].values, k, n)
+        assert float(one["im_median"]) == pytest.approx(direct.im_median, rel=1e-9)
+    # the ordinal fit of lam = 0 against Nelder-Mead on the multinomial likelihood
+    fr = rocksweep.fragility(demo, state=DAMAGE, bootstrap=0).isel(lam=0)
+    lv = demo["PGA"].values
+    reach = fr["n_failed"].values.astype(float)  # (state, S), nested
+    n = fr["n_counted"].values.astype(float)
+    cats = np.vstack([n - reach[0], reach[:-1] - reach[1:], reach[-1:]])  # (5, S)
+
+    def nll(t):
+        med = np.exp(np.cumsum(np.concatenate([[t[0]], np.exp(t[1:4])])))
+        beta = math.exp(t[4])
+        q = norm.cdf(np.log(lv[None, :] / med[:, None]) / beta)  # P(DS >= j)
+        q = np.vstack([np.ones(lv.size), q, np.zeros(lv.size)])
+        prob = np.maximum(q[:-1] - q[1:], 1e-300)
+        return -np.sum(cats * np.log(prob))
+
+    med0 = fr["im_median"].values
+    t0 = np.concatenate([[math.log(med0[0])], np.log(np.diff(np.log(med0))),
+                         [math.log(float(fr["beta"][0]))]])
+    ref = minimize(nll, t0 + 0.05, method="Nelder-Mead",
+                   options={"xatol": 1e-10, "fatol": 1e-12, "maxiter": 40000,
+                            "maxfev": 40000})
+    ref_med = np.exp(np.cumsum(np.concatenate([[ref.x[0]], np.exp(ref.x[1:4])])))
+    np.testing.assert_allclose(med0, ref_med, rtol=1e-5)
+    assert float(fr["beta"][0]) == pytest.approx(math.exp(ref.x[4]), rel=1e-5)
+
+
+# ---------------------------------------------------------------------------------------
+# files fragility and IDA should not trust as they are
+# ---------------------------------------------------------------------------------------
+
+SUITE = """
+name: trust test
+body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47,
+       IA_ratio: 0.56}
+impact: {lam: 0.0}
+ground:
+  records: [ROOT/records/suite/SYN01.AT2, ROOT/records/suite/SYN05.AT2,
+            ROOT/records/suite/SYN12.AT2, ROOT/records/suite/SYN17.AT2]
+  scale: {im: PGA, values: [0.2, 0.4, 0.6, 0.8, 1.2, 1.6]}
+  p: 2.0
+"""
+
+
+@pytest.fixture(scope="module")
+def suite_scene(tmp_path_factory):
+    d = tmp_path_factory.mktemp("trust")
+    scene = d / "s.yaml"
+    scene.write_text(SUITE.replace("ROOT", str(ROOT)))
+    return d, scene
+
+
+def test_a_partial_file_is_fitted_as_incomplete_naming_the_missing_points(suite_scene, cli):
+    """A file a sweep stopped writing (as after a kill, or while it still runs): the CLI
+    warns with the missing points and marks the fit; nothing is silently dropped."""
+    import rocksweep.compute.sweep as sw
+    from rocksweep import api
+    from rocksweep.compute.grid import Grid
+    from rocksweep.store.writer import SweepFile
+
+    d, scene = suite_scene
+    part = d / "part.h5"
+    sc, _ = api.load(scene)
+    sf = SweepFile.create(part, sc)
+    g = Grid(sc)
+    sf.write(sw.run_chunk(g, 0, 18, sw.level(sc)))  # 18 of 24 points
+    sf.close()
+    res = cli.invoke(main, ["fragility", str(part), "--bootstrap", "0"])
+    assert res.exit_code == 0, res.output
+    assert "incomplete (6 points not computed at PGA 0.2-1.6 g, record SYN17.AT2 left " \
+           "out" in res.stderr and res.stderr.startswith("Warning: fragility, state overturn")
+    assert "the file is not complete" in res.stderr
+    row = [ln for ln in res.stdout.splitlines() if ln.startswith("overturn")][0]
+    assert "incomplete" in row and " 6 " in row  # the "not run" column
+
+
+def test_an_adaptive_suite_refuses_states_its_fill_cannot_know(tmp_path, cli):
+    ds = stripes_ds(capacity_outcomes(10, 0.5, 0.4, seed=7))
+    ds["uplifts"] = ds["outcome"].astype(np.int32)
+    ds["computed"] = xr.zeros_like(ds["outcome"]) + 1
+    ds["computed"][::2, ::3] = 0  # 5 x 4 points filled from the class around them
+    with pytest.raises(F.FragilityError, match=r"state 'uplift': 20 points of this adaptive "
+                       "sweep were filled"):
+        F.fragility(ds, state="uplift", bootstrap=0)
+    with pytest.raises(F.FragilityError, match="theta:0.5"):
+        F.fragility(ds, state=["overturn", "theta:0.5"], bootstrap=0)
+    # the class is known at a filled point: overturn and the modes are fitted
+    assert str(F.fragility(ds, bootstrap=0)["reason"].values) == "ok"
+
+
+def test_ida_takes_no_flagged_stripe_as_safe_and_stops_at_a_flagged_run(suite_scene,
+                                                                         monkeypatch):
+    d, scene = suite_scene
+    ds = rocksweep.run(scene)
+    over = np.isin(ds["outcome"].transpose("record", "PGA").values, (1, 2))
+    # a record overturning from stripe j >= 1 on, and at j + 1
+    r = next(i for i in range(4) if over[i].argmax() >= 1 and over[i, over[i].argmax() + 1])
+    j = int(over[r].argmax())
+    status = ds["status"].transpose("record", "PGA").values.copy()
+    status[r, j] = L.STATUS_HORIZON  # its first overturning stripe: undecided
+    flagged = ds.assign(status=(("record", "PGA"), status))
+    name = str(ds["record"].values[r])
+    got = rocksweep.ida(flagged, rtol=0.05).sel(record=name)
+    levels = ds["PGA"].values
+    assert int(got["n_flagged"]) == 1 and int(got["unresolved"]) == 0
+    # the flagged stripe is not taken as safe: the bracket starts below it (at j - 1), and
+    # the bisection finds the crossing below levels[j] (where the record does overturn)
+    assert levels[j - 1] <= float(got["ida_lo"]) < float(got["ida_hi"]) <= levels[j]
+    # a bisection run that comes back flagged stops the record's bisection
+    import rocksweep.analysis.ida as ida_mod
+
+    real = ida_mod.simulate
+
+    def flagged_run(pt, numerics, history=False):
+        run = real(pt, numerics, history=history)
+        run.out[L.OUT_STATUS] = int(run.out[L.OUT_STATUS]) | L.STATUS_EVENT_CAP
+        return run
+
+    monkeypatch.setattr(ida_mod, "simulate", flagged_run)
+    stopped = rocksweep.ida(ds, rtol=1e-3).sel(record=name)
+    assert int(stopped["unresolved"]) == 1 and int(stopped["runs"]) == 1
+    assert float(stopped["ida_lo"]) == levels[j - 1] and float(stopped["ida_hi"]) == levels[j]
+
+
+@pytest.mark.parametrize("kw, word", [
+    ({"period": "x"}, "period = 'x'"), ({"ci": "x"}, "ci = 'x'"), ({"ci": None}, "ci = None"),
+    ({"ci": [0.9]}, "ci = [0.9]"), ({"state": None}, "state = None"),
+    ({"state": 5}, "state = 5"), ({"state": {"a": 1}}, "state = {'a': 1}"),
+    ({"state": b"overturn"}, "state = b'overturn'"),
+    ({"state": "theta:1.5"}, "0 < X <= 1"), ({"bootstrap": 10**8}, "at most 100000"),
+    ({"bootstrap": -1}, "bootstrap = -1"), ({"seed": -2}, "seed = -2")])
+def test_bad_arguments_are_one_line_errors(kw, word):
+    ds = stripes_ds(capacity_outcomes(10, 0.5, 0.4, seed=8))
+    with pytest.raises(rocksweep.RocksweepError) as err:
+        rocksweep.fragility(ds, **{"bootstrap": 0, **kw})
+    assert word in str(err.value) and "\n" not in str(err.value)
+
+
+def test_cli_bad_arguments_write_nothing(suite_scene, cli, tmp_path):
+    d, scene = suite_scene
+    out = tmp_path / "s.h5"
+    rocksweep.run(scene, output=out)
+    for args in (["--state", "theta:2"], ["--state", "topple"], ["--ci", "1.5"],
+                 ["--bootstrap", "100000000"], ["--period", "1.0"]):
+        res = cli.invoke(main, ["fragility", str(out), "-o", str(tmp_path / "c.csv"),
+                                *args])
+        line = one_line_error(res)
+        assert line.startswith("Error:"), line
+        assert not (tmp_path / "c.csv").exists()

@@ -1,0 +1,141 @@
+"""The step rule that resolves what acts, the certification of close calls and the one
+default (issue 28), against the independent reference path (``physics.reference``:
+scipy's DOP853 at rtol 1e-10 with located events).
+
+- the two cases the issue reproduced: a uniform block (alpha = 0.25, lam = 0, sine,
+  omega/p = 8) overturns in mode 1 for A/(g tan alpha) in [10.86, 11.41] (at 5 steps per
+  pulse period its work on the block was ~2% off and `default` called the band safe);
+  Figure 3(b)'s body under a cosine at omega/p = 4, A = 5.47-5.66 chatters to rest
+  (`default` overturned it after one impact);
+- a close call (the run came within PAR_CLOSE of the saddle) is re-run and says so in its
+  status; a clear one is not; an outcome that keeps changing is flagged uncertified;
+- ``simulate`` and a sweep give one point one answer.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from bodies import BODY3
+
+from rocksweep.compute import sweep as sw
+from rocksweep.compute.certify import certify
+from rocksweep.compute.single import simulate
+from rocksweep.kernel import chunk_kernel, warm_up
+from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.numerics import Numerics
+from rocksweep.physics.model import BlockBody
+from rocksweep.physics.points import Point, kernel_kind, point_row
+from rocksweep.physics.reference import reference_run
+from rocksweep.scene.parse import parse_scene
+
+BLOCK = BlockBody(alpha=0.25, inertia=4.0 / 3.0)
+CASES = [
+    # (point, what the issue found the reference does)
+    (Point(BLOCK, 0.0, "sine", 8.0, 10.9), L.OUTCOME_MODE1),
+    (Point(BLOCK, 0.0, "sine", 8.0, 11.35), L.OUTCOME_MODE1),
+    (Point(BODY3, 0.0, "cosine", 4.0, 5.47), L.OUTCOME_SAFE),
+    (Point(BODY3, 0.0, "cosine", 4.0, 5.66), L.OUTCOME_SAFE),
+]
+
+
+@pytest.mark.parametrize("point,expected", CASES,
+                         ids=["block-10.9", "block-11.35", "fig3b-5.47", "fig3b-5.66"])
+def test_default_classifies_the_reproduced_cases_like_the_reference(point, expected):
+    """The reference's outcome is the issue's; `default` (sweep kernel and simulate) gives
+    the same. Before the step rule, `default` gave safe / mode 1 here."""
+    ref = reference_run(point)
+    assert ref["outcome"] == expected
+    run = simulate(point, Numerics.preset("default"), history=False)
+    assert run.out[L.OUT_OUTCOME] == expected
+    if expected == L.OUTCOME_MODE1:  # and overturns after the same single impact
+        assert run.impacts == ref["impacts"] == 1
+
+
+def _bare(point: Point, numerics: Numerics) -> np.ndarray:
+    """One kernel run without certification: the result row."""
+    row = point_row(point, numerics)
+    kind = kernel_kind(point.body)
+    warm_up(kind, L.LEVEL_OUTCOME, False)
+    out = np.empty((1, L.N_OUT))
+    chunk_kernel(kind, L.LEVEL_OUTCOME, False)(row[None, :], out)
+    return out[0]
+
+
+def test_close_calls_are_refined_and_clear_ones_are_not():
+    """Over a scan of A across the block's mode-1 band: a run is refined exactly when its
+    bare run came within PAR_CLOSE of the saddle; the scan holds both kinds; a clear run's
+    result is the bare run's, bit for bit."""
+    n = Numerics.preset("default")
+    refined = clear = 0
+    for A in np.linspace(10.0, 12.0, 41):
+        point = Point(BLOCK, 0.0, "sine", 8.0, float(A))
+        bare = _bare(point, n)
+        close = bare[L.OUT_MARGIN] < point_row(point, n)[L.PAR_CLOSE]
+        run = simulate(point, n, history=False)
+        is_refined = bool(int(run.out[L.OUT_STATUS]) & L.STATUS_REFINED)
+        assert is_refined == close, A
+        assert ("refined" in run.status) == close
+        if close:
+            refined += 1
+            assert run.out[L.OUT_STEPS] > bare[L.OUT_STEPS]  # every run's steps counted
+        else:
+            clear += 1
+            assert np.array_equal(run.out, bare, equal_nan=True)
+    assert refined >= 2 and clear >= 10
+
+
+def test_an_outcome_that_keeps_changing_is_uncertified():
+    """certify's rule on a stand-in kernel: outcomes that flip at every refinement end
+    flagged uncertified after `levels` reruns; stable ones are refined once, unflagged;
+    runs outside the margin are not touched."""
+    rows = np.zeros((3, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = 0.01
+    rows[:, L.PAR_DT] = 1.0
+    outs = np.zeros((3, L.N_OUT))
+    outs[:, L.OUT_MARGIN] = [0.001, 0.001, 0.5]
+    outs[:, L.OUT_OUTCOME] = [0, 0, 0]
+    calls = []
+
+    def run(sub, idx):
+        calls.append((idx.tolist(), sub[:, L.PAR_DT].tolist()))
+        res = np.zeros((len(idx), L.N_OUT))
+        level = round(-np.log2(sub[0, L.PAR_DT]))
+        res[:, L.OUT_OUTCOME] = np.where(idx == 0, level % 2, 0)  # point 0 flips
+        res[:, L.OUT_STEPS] = 10
+        return res
+
+    certify(rows, outs, run, 3)
+    assert calls == [([0, 1], [0.5, 0.5]), ([0], [0.25]), ([0], [0.125])]
+    st = outs[:, L.OUT_STATUS].astype(int)
+    assert st[0] & L.STATUS_UNCERTIFIED and st[0] & L.STATUS_REFINED
+    assert st[0] & L.STATUS_FLAGGED
+    assert st[1] & L.STATUS_REFINED and not st[1] & L.STATUS_UNCERTIFIED
+    assert st[2] == 0
+    assert outs[0, L.OUT_STEPS] == 30 and outs[1, L.OUT_STEPS] == 10
+
+
+SCENE = """
+name: one point
+body: {kind: block, alpha: 0.25}
+impact: {lam: 0.0}
+pulse: {shape: sine, w_over_p: 8.0, A_ratio: [10.9, 11.1, 14.0]}
+"""
+
+
+def test_simulate_and_sweep_give_one_point_one_answer():
+    """No preset named: simulate runs what the sweep runs (one default), certification
+    included: the same outcome, status, impacts and times, bit for bit."""
+    scene = parse_scene(SCENE)
+    assert scene.single_numerics == scene.numerics
+    assert scene.numerics.accuracy == "default"
+    swept = {k: np.ravel(v) for k, v in sw.compute(scene).items()}
+    fixed = {a.name: a.values[0] for a in scene.axes}
+    for i, A in enumerate((10.9, 11.1, 14.0)):
+        run = simulate(scene.point({**fixed, "A_ratio": A}), scene.single_numerics)
+        for k in ("outcome", "status", "impacts", "t_overturn", "theta_max_over_alpha",
+                  "steps", "event_steps"):
+            assert np.array_equal(np.asarray(run.get(k) if run.get(k) is not None
+                                             else np.nan, float),
+                                  np.asarray(swept[k][i], float), equal_nan=True), (A, k)
+    assert (swept["status"] & L.STATUS_REFINED).any()
