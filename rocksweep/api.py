@@ -32,7 +32,6 @@ if TYPE_CHECKING:
 
     from rocksweep.compute.single import Run
     from rocksweep.scene.inputs import Overrides, SceneLike
-    from rocksweep.scene.model import Scene
 
 # Names that moved to their rooms, importable from here as before (loaded on first use).
 _MOVED = {
@@ -254,6 +253,15 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
         # a record suite has no stability diagram: its overturning fragility (no bootstrap;
         # rocksweep.fragility for other states and bands)
         from rocksweep.analysis.fragility import fragility as fit
+
+        given = [n for n, v in zip((*_names[:2], "curves", "mu", _names[2],
+                                    "show_computed"),
+                                   (x, y, curves, mu, compare, show_computed), strict=True)
+                 if v not in (None, False)]
+        if given:
+            raise ApiError(f"{given[0]}: a record-suite sweep is drawn as its fragility "
+                           "curves; the diagram's options do not apply (rocksweep.fragility "
+                           "for states and bands)")
 
         ds, kind = fit(ds, state="overturn", bootstrap=0), "fragility"
     if kind not in (None, "sweep"):  # an analysis's Dataset: the figure of its kind
@@ -499,7 +507,7 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     scene: a path, YAML text or a dict (as for ``run``). Overrides as a mapping or
     ``KEY=VALUE`` strings (``{"impact.lam": 0.4}``), or as keywords with ``__`` for the
     dot: ``simulate("fig5.yaml", impact__lam=0.4)``. The accuracy is the scene's preset,
-    ``fine`` if it names none (as ``rocksweep simulate``). Returns a ``Simulation``
+    ``default`` if it names none, as a sweep's (one point, one answer). Returns a ``Simulation``
     (summary dict, history Dataset over p*t, and ``.figure()``); a scene with lists gives
     one ``Simulation`` per combination, in grid order (at most ``API_MAX_RUNS``; sweeps
     are for ``run``).
@@ -550,6 +558,7 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     """
     from rocksweep.analysis.calibrate import CalibrationError, Problem, calibrate_problem
     from rocksweep.physics.measured import read_measured
+    from rocksweep.scene.inputs import load
 
     keys = [fit] if isinstance(fit, str) else list(fit)
     if not keys:
@@ -558,19 +567,17 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
         raise CalibrationError(f"fit = {keys}: a key is given twice")
     if not (isinstance(ci, float | int) and 0.5 <= ci < 1):
         raise CalibrationError(f"ci = {ci!r}: must be in [0.5, 1)")
-    from rocksweep.scene.inputs import load
-
     sc, _ = load(scene, overrides)
     p_body = _body_p(sc) if p is None else float(p)
     values = {a.name: a.values[0] for a in sc.axes}
     body = sc.point(values).body
     m = read_measured(measured, p=p_body, alpha_ref=body.alpha_ref, u_cr=body.u_cr or None)
-    fit = calibrate_problem(Problem(sc, m, keys, bounds), float(ci))
-    _register()  # fit.rocksweep.as_overrides()
-    return fit
+    out = calibrate_problem(Problem(sc, m, keys, bounds), float(ci))
+    _register()  # out.rocksweep.as_overrides()
+    return out
 
 
-def _body_p(scene: Scene) -> float | None:
+def _body_p(scene: Any) -> float | None:
     """The body's p [rad/s] a scene knows (a physical body's, a record scene's ground.p),
     else None."""
     if scene.physical is not None:

@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import hashlib
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -609,7 +610,8 @@ def classify(r: subprocess.CompletedProcess, before: dict, after: dict,
     text = (r.stderr.strip() + " " + r.stdout.strip()).strip()
     if lost:
         return "dataloss", f"changed: {', '.join(lost)} | {text[:200]}"
-    if "Traceback" in r.stderr or "Warning" in r.stderr:
+    # Python's warnings (RuntimeWarning: ...), not the library's own "Warning: ..." verdicts
+    if "Traceback" in r.stderr or re.search(r"\b[A-Z]\w*Warning\b", r.stderr):
         return "traceback", r.stderr.strip()[-400:]
     if r.returncode == 0:
         return ("ok" if expect in ("ok", "any") else "traceback",

@@ -33,8 +33,8 @@ def open_any(path: str | Path) -> xr.Dataset:
                 kind = dataset_kind(SimpleNamespace(
                     variables=list(f.keys()), attrs={k: v for k, v in f.attrs.items()
                                                      if k == "rocksweep_kind"}))
-        except OSError:
-            kind = None
+        except (OSError, RuntimeError, ValueError, KeyError, TypeError):
+            kind = None  # damaged, foreign, locked: open's one-line error says which
     if kind in (None, "sweep"):  # a sweep, or rocksweep.open's one-line error for the rest
         from rocksweep.store.dataset import result_dataset
         from rocksweep.store.reader import read_result
@@ -44,8 +44,10 @@ def open_any(path: str | Path) -> xr.Dataset:
     try:
         with xr.open_dataset(path, engine="h5netcdf", phony_dims="sort") as ds:
             ds = ds.load()
-    except (ValueError, TypeError, KeyError, OSError) as err:
-        raise ApiError(f"{shown(path)}: cannot be read as a {kind} Dataset ({err})") from None
+    except (ValueError, TypeError, KeyError, OSError, RuntimeError, MemoryError, IndexError,
+            AttributeError, OverflowError) as err:  # HDF5's errors of a damaged file too
+        why = (str(err).strip().splitlines() or [type(err).__name__])[0][:160]
+        raise ApiError(f"{shown(path)}: cannot be read as a {kind} Dataset ({why})") from None
     for k, v in list(ds.attrs.items()):
         if isinstance(v, str) and v[:1] in "[{":
             try:

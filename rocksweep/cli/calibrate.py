@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from rocksweep.cli.main import main, user_errors
+from rocksweep.cli.main import load, main, user_errors
 from rocksweep.cli.options import dpi_option, overwrite_option, scene_argument, set_option
 
 
@@ -61,7 +61,8 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
     from rocksweep.outputs import check_distinct, check_output
 
     check_distinct({"-o": out_path, "--plot": plot_path})
-    inputs = [scene_path, measured_path]
+    # the scene file and what it reads (a record), the measured CSV: never written over
+    inputs = [*load(scene_path, overrides).inputs, measured_path]
     if out_path is not None:
         check_output(out_path, overwrite=overwrite, inputs=inputs, suffixes=(".h5", ".nc"))
     if plot_path is not None:

@@ -6,6 +6,7 @@ turns them into a validated ``Scene`` (the Python API's and the command line's w
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Union
@@ -86,9 +87,9 @@ def load(scene: SceneLike | Scene, overrides: Overrides | None = ()) -> tuple[Sc
     if not isinstance(scene, str | Path):
         raise ApiError(f"scene = {scene!r}: give a path, YAML text or a dict")
     path = Path(scene)
-    if not path.exists():
+    if not os.path.lexists(path):
         raise SceneError(f"{path}: no such scene file")
-    return load_scene(path, ov), path
+    return load_scene(path, ov), path  # a loop of links, a FIFO...: its one line
 
 
 def _is_file(text: str) -> bool:
