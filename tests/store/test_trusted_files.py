@@ -155,7 +155,7 @@ def test_an_in_memory_result_is_never_read_through_its_title(tmp_path, monkeypat
     sc = {"name": "README.md", **__import__("yaml").safe_load(BODY),
           "ground": {"record": str(tmp_path / "rec.AT2"), "A_ratio": [1, 3], "p": [1.0, 2.0]}}
     ds = rocksweep.run(sc)
-    sp = rocksweep.spectra(ds, rtol=0.2)
+    sp = rocksweep.spectra(ds, rtol=0.1)
     assert sp["p"].size == 2
     from rocksweep.store.reader import result_of
 
