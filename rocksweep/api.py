@@ -1,297 +1,64 @@
-"""The Python API: run a scene's grid, open a result, simulate one point; the analyses of
-a Dataset; and ``sweep_file``, the one way into the sweep driver
-(``rocksweep.compute.driver``) for ``rocksweep.run`` and ``rocksweep sweep``.
-
-A scene is given as a path to a YAML file, as YAML text or as a dict with the YAML's
-structure. Overrides are ``"KEY=VALUE"`` strings (the command line's ``--set``, VALUE is
-YAML) or a mapping of dotted keys to Python values (``{"impact.lam": 0.4}``).
+"""The Python API, a thin facade: run a scene's grid, open a result, simulate one point,
+and the analyses of a Dataset. Each function checks its arguments and hands over to the
+room that does the work: scenes and overrides (``rocksweep.scene.inputs``), the sweep
+session (``rocksweep.store.session.sweep_file``, the one way into the driver), a result
+as a Dataset (``rocksweep.store.dataset``), a run's history (``rocksweep.store.history``),
+the analyses (``rocksweep.analysis``), the figures (``rocksweep.figures``); ``ds.rocksweep``
+is ``rocksweep.accessor``. Errors speak Python (``rocksweep.errors.speaks_python``).
 
 Nothing heavy is imported here at module level (numba, h5py, xarray, matplotlib load
-inside the functions), so ``import rocksweep`` stays light.
+inside the functions), so ``import rocksweep`` stays light; the names that moved out are
+still importable from here (``api.load``, ``api.sweep_file``, ...: PEP 562).
 """
 
 from __future__ import annotations
 
-import functools
-import os
-import re
 import sys
-import time
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Union
+from typing import TYPE_CHECKING, Any
 
 from rocksweep.compute.driver import (  # noqa: F401 (SweepInterrupted: the API's)
     WRITE_EVERY,
     SweepInterrupted,
     SweepReport,
 )
-from rocksweep.errors import ApiError, RocksweepError, check_rtol
+from rocksweep.errors import ApiError, check_rtol, speaks_python
 
 if TYPE_CHECKING:
     import xarray as xr
     from matplotlib.figure import Figure
 
-    from rocksweep.compute.adaptive import Options
     from rocksweep.compute.single import Run
-    from rocksweep.scene.model import Scene
+    from rocksweep.scene.inputs import Overrides, SceneLike
 
-SceneLike = Union[str, Path, Mapping[str, Any]]  # noqa: UP007 (a runtime alias on 3.10)
-Overrides = Union[Sequence[str], Mapping[str, Any]]  # noqa: UP007
+# Names that moved to their rooms, importable from here as before (loaded on first use).
+_MOVED = {
+    "load": "rocksweep.scene.inputs",
+    "MAX_RUNS": "rocksweep.store.history",
+    "simulate_runs": "rocksweep.store.history",
+    "adaptive_options": "rocksweep.compute.adaptive",
+    "override_strings": "rocksweep.scene.inputs",
+    "sweep_file": "rocksweep.store.session",
+    "result_dataset": "rocksweep.store.dataset",
+    "history_dataset": "rocksweep.store.history",
+    "swept_values": "rocksweep.store.history",
+    "write_history_csv": "rocksweep.store.history",
+    "RocksweepAccessor": "rocksweep.accessor",
+}
 
-# `simulate` on the command line overlays a few runs; larger grids are for sweeps.
-MAX_RUNS = 12
+
+def __getattr__(name: str) -> Any:
+    if name in _MOVED:
+        from importlib import import_module
+
+        return getattr(import_module(_MOVED[name]), name)
+    raise AttributeError(f"module 'rocksweep.api' has no attribute {name!r}")
+
+
 # `rocksweep.simulate` returns one history per point: a notebook's worth, not a grid.
 API_MAX_RUNS = 100
-
-
-
-# ---------------------------------------------------------------------------------------
-# Errors in Python's words
-# ---------------------------------------------------------------------------------------
-
-# The library's messages name command-line flags where the CLI is the usual way in; the
-# API says the same in its own arguments.
-_FLAG_WORDS = (
-    (re.compile(r"--set '([^']*)'"), r"overrides entry '\1'"),
-    (re.compile(r"--set ([\w.]+)=VALUE"), r"overrides={'\1': ...}"),
-    (re.compile(r"--set ([\w.]+)=(\S+)"), r"overrides={'\1': \2}"),
-    (re.compile(r"--set ([\w.]+)"), r"overrides['\1']"),
-    (re.compile(r"--resume\b"), "resume=True"),
-    (re.compile(r"--overwrite\b"), "overwrite=True"),
-    (re.compile(r"--adaptive\b"), "adaptive=True"),
-    (re.compile(r"--jobs\b"), "jobs"),
-)
-
-
-def _pythonic(message: str) -> str:
-    """A one-line message with the command line's flags said as API arguments."""
-    for pattern, words in _FLAG_WORDS:
-        message = pattern.sub(words, message)
-    return message
-
-
-def speaks_python(fn: Callable) -> Callable:
-    """Re-raise the library's one-line errors with the flags they name said as the API's
-    arguments (``--set impact.lam=VALUE`` -> ``overrides={'impact.lam': ...}``)."""
-
-    @functools.wraps(fn)
-    def wrapper(*args: Any, **kwargs: Any) -> Any:
-        try:
-            return fn(*args, **kwargs)
-        except RocksweepError as err:
-            text = str(err)
-            said = _pythonic(text)
-            if said == text:
-                raise
-            try:
-                new = type(err)(said)
-            except TypeError:  # an error class with another constructor: as it is
-                raise err from None
-            raise new from None
-
-    return wrapper
-
-
-# ---------------------------------------------------------------------------------------
-# Scenes and overrides
-# ---------------------------------------------------------------------------------------
-
-def _yaml_value(v: Any) -> str:
-    """A Python value as the YAML text of a ``KEY=VALUE`` override (inf as .inf)."""
-    import yaml
-
-    if hasattr(v, "tolist"):  # numpy scalars and arrays
-        v = v.tolist()
-    if isinstance(v, tuple):
-        v = list(v)
-    text = yaml.safe_dump(v, default_flow_style=True, width=1 << 30).strip()
-    return text[:-3].strip() if text.endswith("\n...") else text
-
-
-def override_strings(overrides: Overrides | None) -> list[str]:
-    """Overrides as ``KEY=VALUE`` strings: a sequence of such strings is kept, a mapping
-    ``{dotted key: value}`` is written as YAML (``{"impact.lam": 0.4}`` -> impact.lam=0.4;
-    ``__`` in a key stands for a dot, as in ``impact__lam``)."""
-    if overrides is None:
-        return []
-    if isinstance(overrides, str):
-        return [overrides]
-    if isinstance(overrides, Mapping):
-        out = []
-        for k, v in overrides.items():
-            if not isinstance(k, str):
-                raise TypeError(f"overrides: key {k!r}: must be a string (a dotted scene "
-                                "key, e.g. 'impact.lam')")
-            out.append(f"{k.replace('__', '.')}={_yaml_value(_plain_tree(v, k))}")
-        return out
-    if isinstance(overrides, bytes | bytearray) or not isinstance(overrides, Iterable):
-        raise TypeError(f"overrides = {overrides!r}: give KEY=VALUE strings "
-                        "(['impact.lam=0.2']) or a mapping ({'impact.lam': 0.2})")
-    items = list(overrides)
-    for o in items:
-        if not isinstance(o, str):
-            raise TypeError(f"overrides: {o!r}: each override must be a KEY=VALUE string, "
-                            "e.g. 'impact.lam=0.2'")
-    return items
-
-
-def load(scene: SceneLike | Scene, overrides: Overrides | None = ()) -> tuple[Scene, Path | None]:
-    """A validated scene and the file it came from (None for text or a dict).
-
-    scene: a ``Path``; a ``str`` with a newline (YAML), or that names an existing file,
-    or else holds a colon (one line of YAML), or else is taken as a missing path; a
-    mapping (the YAML's structure); or a ``Scene`` (then without overrides). Errors are
-    one-line SceneErrors.
-    """
-    from rocksweep.scene.model import Scene, SceneError
-    from rocksweep.scene.parse import load_scene, parse_scene
-
-    ov = override_strings(overrides)
-    if isinstance(scene, Scene):
-        if ov:
-            raise ApiError("overrides apply to a scene path, text or dict, not to a Scene")
-        return scene, None
-    if isinstance(scene, Mapping):
-        import yaml
-
-        text = yaml.safe_dump(_plain_tree(scene), sort_keys=False, allow_unicode=False)
-        return parse_scene(text, "scene", ov), None
-    if isinstance(scene, str) and ("\n" in scene or (":" in scene and not _is_file(scene))):
-        return parse_scene(scene, "scene", ov), None
-    if not isinstance(scene, str | Path):
-        raise ApiError(f"scene = {scene!r}: give a path, YAML text or a dict")
-    path = Path(scene)
-    if not os.path.lexists(path):
-        raise SceneError(f"{path}: no such scene file")
-    return load_scene(path, ov), path  # a loop of links, a FIFO...: its one line
-
-
-def _is_file(text: str) -> bool:
-    try:
-        return Path(text).is_file()
-    except (OSError, ValueError):  # too long for a file name, NUL bytes
-        return False
-
-
-def _plain_tree(v: Any, where: str = "scene") -> Any:
-    """A mapping with numpy values and tuples -> plain YAML-safe Python; a value YAML
-    cannot hold (a complex number, an arbitrary object) is an ApiError naming where it
-    is (``scene['pulse']['A_ratio']``)."""
-    if isinstance(v, Mapping):
-        return {str(k): _plain_tree(x, f"{where}[{k!r}]") for k, x in v.items()}
-    if hasattr(v, "tolist") and not isinstance(v, str | bytes):
-        try:
-            v = v.tolist()
-        except Exception:  # noqa: BLE001 - a foreign object's tolist: refused below
-            pass
-        else:
-            return _plain_tree(v, where)
-    if isinstance(v, list | tuple):
-        return [_plain_tree(x, f"{where}[{i}]") for i, x in enumerate(v)]
-    if v is None or isinstance(v, bool | str):
-        return v
-    if isinstance(v, int | float) and not isinstance(v, complex):
-        return int(v) if isinstance(v, int) else float(v)
-    raise ApiError(f"{where} = {_short_repr(v)}: not a scene value (numbers, strings, "
-                   "booleans, lists and mappings of them)")
-
-
-def _short_repr(v: Any) -> str:
-    text = repr(v).replace("\n", " ")
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
-def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
-               jobs: int = 1, resume: bool = False, overwrite: bool = False,
-               backend: str = "threads", scheduler: str | None = None,
-               chunk_size: int | None = None, write_every: float = WRITE_EVERY,
-               progress: bool = False, log: Callable[[str], None] | None = None,
-               inputs: Iterable[str | Path] = (), adaptive: Options | None = None,
-               validate: bool = False, connect_timeout: float = 20.0,
-               cli: bool = False) -> SweepReport:
-    """Sweep ``scene`` into the result file ``path`` (``rocksweep sweep``).
-
-    Makes the file (refusing an existing one unless ``overwrite``), or with ``resume``
-    reopens an existing file of the same scene and computes only its missing points.
-    Finished chunks are written in batches, at most every ``write_every`` seconds; on
-    Ctrl-C the pending chunks are written and ``SweepInterrupted`` (a KeyboardInterrupt)
-    is raised; on any other error they are written before the error propagates.
-
-    jobs: local worker threads (-1: one per core); backend "threads" or "dask" (with
-    ``scheduler``, an address); chunk_size: points per chunk (default about 32 chunks per
-    worker); progress: a progress bar on stderr; log: receives the header and kernel
-    lines; inputs: the command's input files, never written over; overrides: recorded in
-    the file; adaptive: compute only near the class boundaries
-    (``rocksweep.compute.adaptive``, see ``compute.driver.adaptive_loop``; the file
-    records the settings, and a resume must give the same); validate: with adaptive,
-    also compute the filled points of a coarse uniform lattice and report those whose
-    class differs from the fill (``report.validation``; the file is not changed);
-    connect_timeout: seconds to wait for the dask scheduler to answer; cli: name options
-    as the command line spells them. Every argument is checked
-    (``rocksweep.compute.arguments``) before the output is touched. Returns a
-    ``SweepReport``.
-    """
-    from rocksweep.compute.arguments import check_sweep_arguments
-    from rocksweep.outputs import OutputError, check_output, check_path_text, shown
-
-    # every argument before anything touches the output (one place: the CLI's too)
-    n_workers = check_sweep_arguments(
-        jobs=jobs, resume=resume, overwrite=overwrite, validate=validate, adaptive=adaptive,
-        backend=backend, scheduler=scheduler, chunk_size=chunk_size, write_every=write_every,
-        connect_timeout=connect_timeout, cli=cli)
-    if path is not None:  # None: in memory (rocksweep.run without output=)
-        check_path_text(path)
-    if backend == "dask":
-        from rocksweep.compute import sweep as sw
-
-        sw.check_scheduler(scheduler, connect_timeout)  # before any file is made
-    say = log or (lambda _line: None)
-    settings = None
-    if adaptive is not None:
-        from rocksweep.compute.grid import Grid
-
-        settings = adaptive.resolved(Grid(scene))  # bad axes or settings: before any file
-
-    from rocksweep.compute.driver import drive
-    from rocksweep.store.writer import SweepFile
-
-    t0 = time.perf_counter()
-    where = (f"{n_workers} worker{'s' * (n_workers > 1)}" if backend == "threads"
-             else f"dask cluster {scheduler}")
-    how = f"threads x {n_workers}" if backend == "threads" else f"dask {scheduler}"
-    if path is None:  # in memory: nothing touches a disk (rocksweep.run without output)
-        if resume:
-            raise ApiError("resume=True needs output= (the file to finish)")
-        sf = SweepFile.in_memory(scene, overrides, backend=how, adaptive=settings)
-        return drive(sf, None, report_of := SweepReport(Path("memory"), sf.grid.size, 0, 0,
-                                                          0.0, 0.0, 0.0),
-                      t0, adaptive, validate, jobs=jobs, backend=backend,
-                      scheduler=scheduler, chunk_size=chunk_size, where=where,
-                      write_every=write_every, progress=progress, say=say) or report_of
-    path = Path(path)
-    inputs = [*inputs, *scene.inputs]  # the scene's records and listings: never written over
-    try:
-        path.stat()
-    except FileNotFoundError:
-        pass
-    except OSError:  # a name too long, a path through a file...: one line, not a traceback
-        check_output(path, overwrite=overwrite, inputs=inputs)
-    if resume and path.exists():
-        check_output(path, overwrite=True, inputs=inputs)
-        sf = SweepFile.resume(path, scene, overrides, backend=how, adaptive=settings)
-    else:
-        if path.is_file() and not overwrite:
-            raise OutputError(f"{shown(path)}: already exists; use --resume to finish it or "
-                              "--overwrite to replace it")
-        check_output(path, overwrite=overwrite, inputs=inputs)
-        sf = SweepFile.create(path, scene, overrides, overwrite=overwrite, backend=how,
-                              adaptive=settings, log=say)
-    report = SweepReport(path, sf.grid.size, 0, 0, 0.0, 0.0, 0.0)
-    return drive(sf, path, report, t0, adaptive, validate, jobs=jobs, backend=backend,
-                  scheduler=scheduler, chunk_size=chunk_size, where=where,
-                  write_every=write_every, progress=progress, say=say)
 
 
 # ---------------------------------------------------------------------------------------
@@ -353,6 +120,10 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
                           overwrite=overwrite, validate=validate, adaptive=True)
     if output is not None:
         check_path_text(output, "output")
+    from rocksweep.compute.adaptive import adaptive_options
+    from rocksweep.scene.inputs import load, override_strings
+    from rocksweep.store.session import sweep_file
+
     sc, source = load(scene, overrides)
     opts = adaptive_options(adaptive, base=sc.refine, coarse=coarse, audit=audit, axes=axes,
                             margin=margin, final_margin=final_margin, seed=seed,
@@ -375,41 +146,11 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
         report = sweep_file(sc, None, overrides=ov, jobs=jobs, resume=resume,
                             progress=progress, log=log, adaptive=opts, validate=validate,
                             **where)
-        return _dataset(io.BytesIO(report.image))
+        return _loaded(io.BytesIO(report.image))
     sweep_file(sc, output, overrides=ov, jobs=jobs, resume=resume, overwrite=overwrite,
                progress=progress, log=log, inputs=[source] if source else (),
                adaptive=opts, validate=validate, **where)
     return open(output)
-
-
-def adaptive_options(adaptive: bool, base: dict | None = None,
-                     **settings: Any) -> Options | None:
-    """``rocksweep.compute.adaptive.Options`` from keyword settings (None values: the defaults);
-    None when not ``adaptive``, then any setting given is an ApiError. base: a scene's
-    ``refine`` section (``Scene.refine``): it turns adaptive on, and the keyword settings
-    override its values."""
-    given = {k: v for k, v in settings.items() if v is not None}
-    if base is not None:
-        adaptive = True
-        given = {**base, **given}
-    known = {"coarse", "audit", "axes", "margin", "final_margin", "seed", "threshold"}
-    unknown = sorted(set(given) - known)
-    if unknown:
-        raise ApiError(f"{unknown[0]} = {given[unknown[0]]!r}: not a setting of an adaptive "
-                       f"sweep (settings: {', '.join(sorted(known))})")
-    if not adaptive:
-        if given:
-            k = sorted(given)[0]
-            raise ApiError(f"{k} = {given[k]!r}: an adaptive setting; add adaptive=True")
-        return None
-    if "axes" in given:
-        axes = given["axes"]
-        if isinstance(axes, str):
-            axes = [a.strip() for a in axes.split(",")]
-        given["axes"] = tuple(axes)
-    from rocksweep.compute.adaptive import Options  # an adaptive sweep's module, only then
-
-    return Options(**given)
 
 
 @speaks_python
@@ -431,65 +172,44 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
 
     path = Path(path)
     read_result(path, ["outcome"])  # one-line errors for foreign or damaged files
-    return _dataset(path)
+    return _loaded(path)
 
 
-def _dataset(source: Path | Any) -> xr.Dataset:
-    """A result file (a path, or a file object holding the bytes of one in memory) as the
-    loaded Dataset that ``open`` and ``run`` return, with the accessor registered; a
-    damaged variable attribute is a one-line StoreError."""
-    import xarray as xr
+def _register() -> None:
+    """``ds.rocksweep``: the accessor, calling this module's analyses."""
+    from rocksweep.accessor import register_accessor
 
-    from rocksweep import fields
-    from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
+    register_accessor({f.__name__: f for f in (plot, boundaries, boundary_lines, spectra,
+                                               fragility, ida, risk, im_efficiency, table,
+                                               calibrated_overrides)})
 
-    register_accessor()  # ds.rocksweep.plot() etc.
-    kwds = {"driver_kwds": {"locking": False}} if isinstance(source, Path) else {}
-    try:
-        try:
-            with xr.open_dataset(source, engine="h5netcdf", **kwds) as ds:
-                ds = ds.load()
-        except OSError as err:  # open here through another handle: take its lock flags
-            from rocksweep.store.reader import READER_LOCKING, _open_here
 
-            if not (kwds and _open_here(err)):
-                raise
-            for locking in READER_LOCKING:
-                try:
-                    with xr.open_dataset(source, engine="h5netcdf",
-                                         driver_kwds={"locking": locking}) as ds:
-                        ds = ds.load()
-                    break
-                except OSError:
-                    continue
-            else:
-                raise
-    except (ValueError, TypeError, KeyError, OSError, OverflowError, AttributeError,
-            IndexError, RuntimeError, MemoryError) as err:
-        # xarray's CF decoding of a damaged attribute; HDF5's of damaged dimension scales
-        # (H5DSget_num_scales: RuntimeError), a damaged shape's allocation
-        from rocksweep.outputs import shown
-        from rocksweep.store import StoreError
+def _loaded(source: Path | Any) -> xr.Dataset:
+    """``store.dataset.result_dataset`` with the accessor registered (``ds.rocksweep``)."""
+    from rocksweep.store.dataset import result_dataset
 
-        where = shown(source) if isinstance(source, Path) else "result in memory"
-        why = (str(err).strip().splitlines() or [type(err).__name__])[0]
-        why = why if len(why) <= 160 else why[:157] + "..."
-        raise StoreError(f"{where}: damaged rocksweep result (its variables or their "
-                         f"attributes cannot be decoded: {why})") from None
-    for name, var in ds.data_vars.items():  # files of format 1 have neither
-        f = fields.BY_NAME.get(str(name))
-        if f is not None:
-            var.attrs.setdefault("rocksweep_units", f.unit)
-            var.attrs.setdefault("description", f.meaning)
-    if "outcome" in ds:
-        ds["outcome"].attrs.setdefault("flag_values", list(OUTCOME_WORDS))
-        ds["outcome"].attrs.setdefault("flag_meanings", " ".join(OUTCOME_WORDS.values()))
-    if "status" in ds:
-        ds["status"].attrs.setdefault("flag_masks", list(STATUS_WORDS))
-        ds["status"].attrs.setdefault("flag_meanings", " ".join(STATUS_WORDS.values()))
-    ds.attrs = {k: (v.item() if hasattr(v, "item") and getattr(v, "size", 1) == 1 else v)
-                for k, v in ds.attrs.items()}
-    return ds
+    _register()
+    return result_dataset(source)
+
+
+def open_any(path: str | Path) -> xr.Dataset:
+    """Any rocksweep Dataset from a file (``rocksweep.analysis.files.open_any``), with
+    ``ds.rocksweep``."""
+    from rocksweep.analysis.files import open_any as open_file
+
+    _register()
+    return open_file(path)
+
+
+def _dataset_arg(ds: Any, what: str) -> xr.Dataset:
+    """A Dataset argument, or a path to one (``open_any``)."""
+    from rocksweep.analysis.files import _as_dataset
+
+    register = isinstance(ds, str | Path)
+    out = _as_dataset(ds, what)
+    if register:
+        _register()
+    return out
 
 
 # ---------------------------------------------------------------------------------------
@@ -533,6 +253,15 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
         # a record suite has no stability diagram: its overturning fragility (no bootstrap;
         # rocksweep.fragility for other states and bands)
         from rocksweep.analysis.fragility import fragility as fit
+
+        given = [n for n, v in zip((*_names[:2], "curves", "mu", _names[2],
+                                    "show_computed"),
+                                   (x, y, curves, mu, compare, show_computed), strict=True)
+                 if v not in (None, False)]
+        if given:
+            raise ApiError(f"{given[0]}: a record-suite sweep is drawn as its fragility "
+                           "curves; the diagram's options do not apply (rocksweep.fragility "
+                           "for states and bands)")
 
         ds, kind = fit(ds, state="overturn", bootstrap=0), "fragility"
     if kind not in (None, "sweep"):  # an analysis's Dataset: the figure of its kind
@@ -684,63 +413,6 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     return frag
 
 
-def open_any(path: str | Path) -> xr.Dataset:
-    """Any rocksweep Dataset from a file: a sweep result (``open``) or what an analysis
-    wrote with ``-o .h5`` (fragility, risk, IM efficiency: netCDF-4), its JSON attributes
-    (lists) decoded. Any other file gets ``open``'s one-line errors."""
-    import json
-    from types import SimpleNamespace
-
-    import xarray as xr
-
-    from rocksweep.analysis.kinds import dataset_kind
-    from rocksweep.outputs import input_problem, shown
-
-    path = Path(path)
-    kind = None
-    if input_problem(path) is None:
-        try:
-            import h5py
-
-            with h5py.File(path, "r") as f:
-                kind = dataset_kind(SimpleNamespace(
-                    variables=list(f.keys()), attrs={k: v for k, v in f.attrs.items()
-                                                     if k == "rocksweep_kind"}))
-        except (OSError, RuntimeError, ValueError, KeyError, TypeError):
-            kind = None  # damaged, foreign, locked: open's one-line error says which
-    if kind in (None, "sweep"):
-        return open(path)  # a sweep, or open's one-line error for anything else
-    try:
-        with xr.open_dataset(path, engine="h5netcdf", phony_dims="sort") as ds:
-            ds = ds.load()
-    except (ValueError, TypeError, KeyError, OSError, RuntimeError, MemoryError, IndexError,
-            AttributeError, OverflowError) as err:  # HDF5's errors of a damaged file too
-        why = (str(err).strip().splitlines() or [type(err).__name__])[0][:160]
-        raise ApiError(f"{shown(path)}: cannot be read as a {kind} Dataset ({why})") from None
-    for k, v in list(ds.attrs.items()):
-        if isinstance(v, str) and v[:1] in "[{":
-            try:
-                ds.attrs[k] = json.loads(v)
-            except ValueError:
-                pass
-        elif hasattr(v, "item") and getattr(v, "size", 2) == 1:
-            ds.attrs[k] = v.item()
-    register_accessor()
-    return ds
-
-
-def _as_dataset(ds: Any, what: str) -> xr.Dataset:
-    """A Dataset argument, or a path to one (``open_any``)."""
-    import xarray as xr
-
-    if isinstance(ds, str | Path):
-        return open_any(ds)
-    if not isinstance(ds, xr.Dataset):
-        raise ApiError(f"{what} = {type(ds).__name__}: must be an xarray Dataset "
-                       "(rocksweep.run, rocksweep.open or an analysis) or a path to one")
-    return ds
-
-
 @speaks_python
 def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = None
          ) -> xr.Dataset:
@@ -754,7 +426,7 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = N
     ``reason``; beyond the hazard's range the rate is bounded, never extrapolated."""
     from rocksweep.analysis.risk import risk as compute
 
-    return compute(_as_dataset(fr, "fr"), hazard, years, site=site)
+    return compute(_dataset_arg(fr, "fr"), hazard, years, site=site)
 
 
 @speaks_python
@@ -768,7 +440,7 @@ def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
     (``rocksweep.analysis.efficiency``)."""
     from rocksweep.analysis.efficiency import im_efficiency as compute
 
-    return compute(_as_dataset(ds, "ds"), state=state)
+    return compute(_dataset_arg(ds, "ds"), state=state)
 
 
 @speaks_python
@@ -781,7 +453,7 @@ def table(ds: xr.Dataset) -> Any:
     ``.attrs["units"]`` gives each column's units (``rocksweep.analysis.table``)."""
     from rocksweep.analysis.table import table as make
 
-    return make(_as_dataset(ds, "ds"))
+    return make(_dataset_arg(ds, "ds"))
 
 
 @speaks_python
@@ -792,6 +464,7 @@ def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> A
     sample of 256 points when the kernel is compiled (~10 ms), else from the step bound.
     Returns ``rocksweep.compute.sweep.Estimate`` (``str()`` is one line)."""
     from rocksweep.compute.sweep import estimate as sweep_estimate
+    from rocksweep.scene.inputs import load
 
     sc, _ = load(scene, overrides)
     return sweep_estimate(sc, jobs=jobs)
@@ -826,27 +499,6 @@ class Simulation:
         return time_history([self.run], (), self.title)
 
 
-def history_dataset(run: Run, title: str = "") -> xr.Dataset:
-    """A run's time history as an xarray Dataset over p_t (see ``Simulation``)."""
-    import xarray as xr
-
-    from rocksweep import fields
-
-    cols = run.history_columns()
-    spec = {c.name: c for c in fields.HISTORY}
-    t = cols.pop("p_t")
-    ds = xr.Dataset(
-        {k: ("p_t", v, {"units": spec[k].unit, "long_name": spec[k].meaning})
-         for k, v in cols.items()},
-        coords={"p_t": ("p_t", t, {"units": spec["p_t"].unit,
-                                   "long_name": spec["p_t"].meaning})})
-    s = run.summary()
-    ds.attrs = {"title": title, "outcome": s["outcome"], "accuracy": s["accuracy"],
-                "lam": run.point.lam, "shape": run.point.shape,
-                "w_over_p": run.point.w_over_p, "A_ratio": run.point.A_ratio}
-    return ds
-
-
 @speaks_python
 def simulate(scene: SceneLike, overrides: Overrides = (), /,
              **keys: Any) -> Simulation | list[Simulation]:
@@ -855,12 +507,14 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     scene: a path, YAML text or a dict (as for ``run``). Overrides as a mapping or
     ``KEY=VALUE`` strings (``{"impact.lam": 0.4}``), or as keywords with ``__`` for the
     dot: ``simulate("fig5.yaml", impact__lam=0.4)``. The accuracy is the scene's preset,
-    ``fine`` if it names none (as ``rocksweep simulate``). Returns a ``Simulation``
+    ``default`` if it names none, as a sweep's (one point, one answer). Returns a ``Simulation``
     (summary dict, history Dataset over p*t, and ``.figure()``); a scene with lists gives
     one ``Simulation`` per combination, in grid order (at most ``API_MAX_RUNS``; sweeps
     are for ``run``).
     """
     from rocksweep.compute.single import simulate as run_point
+    from rocksweep.scene.inputs import load, override_strings
+    from rocksweep.store.history import history_dataset, simulate_runs, swept_values
 
     ov = [*override_strings(overrides), *override_strings(keys)]
     sc, _ = load(scene, ov)
@@ -879,55 +533,6 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
                                                         strict=True))
         out.append(Simulation(r.summary(), history_dataset(r, title), r, title))
     return out
-
-
-def simulate_runs(scene: Scene, max_runs: int = MAX_RUNS) -> list[Run]:
-    """Each point of a small scene as a single run with history (``rocksweep simulate``
-    overlays them); a SceneError naming the longest swept key if there are more than
-    ``max_runs`` points."""
-    from itertools import product
-
-    from rocksweep.compute.single import simulate as run_point
-    from rocksweep.scene.model import SceneError
-
-    if scene.size > max_runs:
-        big = max(scene.swept, key=lambda a: len(a.values))
-        raise SceneError(f"{scene.size} points; simulate runs at most {max_runs} (use "
-                         f"`rocksweep sweep`, or pick a value with --set {big.key}=VALUE)")
-    names = [a.name for a in scene.axes]
-    return [run_point(scene.point(dict(zip(names, combo, strict=True))), scene.single_numerics,
-                      contact=scene.contact)
-            for combo in product(*(a.values for a in scene.axes))]
-
-
-def swept_values(run: Run, swept: Sequence[str]) -> list:
-    """The run's value of each swept key, as plain Python (str for shape, else float)."""
-    p = run.point
-    out = []
-    for k in swept:
-        v = getattr(p, k) if hasattr(p, k) else getattr(p.body, k)
-        out.append(v if isinstance(v, str) else float(v))
-    return out
-
-
-def write_history_csv(runs: Sequence[Run], swept: Sequence[str], path: str | Path) -> None:
-    """The runs' time histories to one CSV file, atomically: columns run, the swept
-    keys, then ``rocksweep.fields.HISTORY`` (p_t, theta_over_alpha, u_over_ucr,
-    E_over_Eref, ...); plain numbers (``repr`` of Python floats: nan, inf as such).
-    Check the path first with ``rocksweep.outputs.check_output``."""
-    import csv
-
-    from rocksweep import fields
-    from rocksweep.outputs import atomic_path
-
-    with atomic_path(path) as tmp, tmp.open("w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["run", *swept, *(c.name for c in fields.HISTORY)])
-        for i, r in enumerate(runs):
-            fixed = swept_values(r, swept)
-            cols = list(r.history_columns().values())
-            for j in range(len(cols[0])):
-                w.writerow([i, *fixed, *(repr(float(c[j])) for c in cols)])
 
 
 # ---------------------------------------------------------------------------------------
@@ -953,6 +558,7 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     """
     from rocksweep.analysis.calibrate import CalibrationError, Problem, calibrate_problem
     from rocksweep.physics.measured import read_measured
+    from rocksweep.scene.inputs import load
 
     keys = [fit] if isinstance(fit, str) else list(fit)
     if not keys:
@@ -966,12 +572,12 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     values = {a.name: a.values[0] for a in sc.axes}
     body = sc.point(values).body
     m = read_measured(measured, p=p_body, alpha_ref=body.alpha_ref, u_cr=body.u_cr or None)
-    fit = calibrate_problem(Problem(sc, m, keys, bounds), float(ci))
-    register_accessor()  # fit.rocksweep.as_overrides()
-    return fit
+    out = calibrate_problem(Problem(sc, m, keys, bounds), float(ci))
+    _register()  # out.rocksweep.as_overrides()
+    return out
 
 
-def _body_p(scene: Scene) -> float | None:
+def _body_p(scene: Any) -> float | None:
     """The body's p [rad/s] a scene knows (a physical body's, a record scene's ground.p),
     else None."""
     if scene.physical is not None:
@@ -990,78 +596,3 @@ def calibrated_overrides(fit: xr.Dataset, which: str = "all") -> dict[str, Any]:
     from rocksweep.analysis.calibrate import calibrated_overrides as overrides_of
 
     return overrides_of(fit, which)
-
-
-# ---------------------------------------------------------------------------------------
-# ds.rocksweep: the analyses as methods of a result Dataset (as rioxarray's ``.rio``),
-# registered when ``run`` or ``open`` first imports xarray (``import rocksweep`` stays light)
-# ---------------------------------------------------------------------------------------
-
-_REGISTERED = False
-
-
-class RocksweepAccessor:
-    """``ds.rocksweep.<analysis>(...)`` is ``rocksweep.<analysis>(ds, ...)``."""
-
-    def __init__(self, ds: Any) -> None:
-        self._ds = ds
-
-    def plot(self, *args: Any, **kwargs: Any) -> Any:
-        """``rocksweep.plot(ds, ...)``: the stability diagram (categorical outcome)."""
-        return plot(self._ds, *args, **kwargs)
-
-    def boundaries(self, **kwargs: Any) -> Any:
-        """``rocksweep.boundaries(ds, ...)``: A_min as a Dataset."""
-        return boundaries(self._ds, **kwargs)
-
-    def boundary_lines(self) -> Any:
-        """``rocksweep.boundary_lines(ds)``: the class boundary polylines (DataFrame)."""
-        return boundary_lines(self._ds)
-
-    def spectra(self, **kwargs: Any) -> Any:
-        """``rocksweep.spectra(ds, ...)``: rocking and overturning spectra."""
-        return spectra(self._ds, **kwargs)
-
-    def fragility(self, **kwargs: Any) -> Any:
-        """``rocksweep.fragility(ds, ...)``: lognormal fragility curves of a suite."""
-        return fragility(self._ds, **kwargs)
-
-    def ida(self, **kwargs: Any) -> Any:
-        """``rocksweep.ida(ds, ...)``: the first overturning level of each record."""
-        return ida(self._ds, **kwargs)
-
-    def risk(self, hazard: Any, years: float = 50, **kwargs: Any) -> Any:
-        """``rocksweep.risk(ds, hazard, years)``: annual rate and probability per state."""
-        return risk(self._ds, hazard, years, **kwargs)
-
-    def im_efficiency(self, **kwargs: Any) -> Any:
-        """``rocksweep.im_efficiency(ds, ...)``: beta of the fragility in every IM."""
-        return im_efficiency(self._ds, **kwargs)
-
-    def table(self) -> Any:
-        """``rocksweep.table(ds)``: one row per run (a DataFrame)."""
-        return table(self._ds)
-
-    def as_overrides(self, which: str = "all") -> dict[str, Any]:
-        """``rocksweep.calibrated_overrides(ds, which)`` of a calibration Dataset."""
-        return calibrated_overrides(self._ds, which)
-
-    def outcome_words(self) -> Any:
-        """``outcome`` as words (not_run, safe, mode1, mode2), an object DataArray."""
-        import numpy as np
-
-        from rocksweep.outcomes import OUTCOME_WORDS
-
-        o = self._ds["outcome"]
-        return o.copy(data=np.vectorize(OUTCOME_WORDS.get, otypes=[object])(o.values))
-
-
-def register_accessor() -> None:
-    """Register ``ds.rocksweep`` with xarray (once)."""
-    global _REGISTERED
-    if _REGISTERED:
-        return
-    import xarray as xr
-
-    xr.register_dataset_accessor("rocksweep")(RocksweepAccessor)
-    _REGISTERED = True

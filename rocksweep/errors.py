@@ -9,7 +9,10 @@ no traceback; from Python it is an ordinary exception (``except rocksweep.Rocksw
 
 from __future__ import annotations
 
+import functools
 import numbers
+import re
+from collections.abc import Callable
 from typing import Any
 
 
@@ -144,3 +147,50 @@ def one_line(text: str) -> str:
     escaped as in Python (``\\n``, ``\\udc91``); printable non-ASCII kept."""
     return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii")
                    for c in text)
+
+
+# ---------------------------------------------------------------------------------------
+# Errors in Python's words (the API's functions)
+# ---------------------------------------------------------------------------------------
+
+# The library's messages name command-line flags where the CLI is the usual way in; the
+# API says the same in its own arguments.
+_FLAG_WORDS = (
+    (re.compile(r"--set '([^']*)'"), r"overrides entry '\1'"),
+    (re.compile(r"--set ([\w.]+)=VALUE"), r"overrides={'\1': ...}"),
+    (re.compile(r"--set ([\w.]+)=(\S+)"), r"overrides={'\1': \2}"),
+    (re.compile(r"--set ([\w.]+)"), r"overrides['\1']"),
+    (re.compile(r"--resume\b"), "resume=True"),
+    (re.compile(r"--overwrite\b"), "overwrite=True"),
+    (re.compile(r"--adaptive\b"), "adaptive=True"),
+    (re.compile(r"--jobs\b"), "jobs"),
+)
+
+
+def _pythonic(message: str) -> str:
+    """A one-line message with the command line's flags said as API arguments."""
+    for pattern, words in _FLAG_WORDS:
+        message = pattern.sub(words, message)
+    return message
+
+
+def speaks_python(fn: Callable) -> Callable:
+    """Re-raise the library's one-line errors with the flags they name said as the API's
+    arguments (``--set impact.lam=VALUE`` -> ``overrides={'impact.lam': ...}``)."""
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return fn(*args, **kwargs)
+        except RocksweepError as err:
+            text = str(err)
+            said = _pythonic(text)
+            if said == text:
+                raise
+            try:
+                new = type(err)(said)
+            except TypeError:  # an error class with another constructor: as it is
+                raise err from None
+            raise new from None
+
+    return wrapper

@@ -24,8 +24,8 @@ ROOTS = ("bisection", "illinois", "hermite")
 #
 # Issue 28 (the step follows what acts, close calls certified): `default` classifies the
 # four figures like `fine` on all but 0/0/0/1 of their 19 200 cells each (the rule before
-# it: 72/32/1/2), at 1.4-6.6% more RK4 evaluations than that rule
-# (`python scripts/bench_step_rule.py`), and the held-out-style spectra (blocks alpha
+# it: 72/32/1/2), at 0.4-4.6% more RK4 evaluations (1-11% more time) than that
+# rule (`python scripts/bench_step_rule.py`), and the held-out-style spectra (blocks alpha
 # 0.1/0.25/0.4, three flexible bodies, sine and cosine, omega/p 1-12, A/(g tan alpha) to
 # 30 on a 1000-value grid) like `fine` on every curve's first overturning value and mode.
 # `draft` is the smallest step allowed (4) with the pulse at 10 steps and no

@@ -27,10 +27,16 @@ def kill_sweep_when(args: list[str], cwd, ready, timeout: float = 300.0) -> None
     import subprocess
     import sys
     import time
+    from pathlib import Path
 
+    # the package under test (this tree), not whichever rocksweep is installed
+    root = str(Path(__file__).resolve().parents[1])
+    env = {**os.environ,
+           "PYTHONPATH": os.pathsep.join(p for p in (root, os.environ.get("PYTHONPATH"))
+                                         if p)}
     proc = subprocess.Popen(
         [sys.executable, "-c", "from rocksweep.cli import main; main()", "sweep", *args],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=cwd)
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=cwd, env=env)
     try:
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline and proc.poll() is None:

@@ -58,7 +58,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -67,17 +67,17 @@ from rocksweep.compute.single import history_capacity
 from rocksweep.errors import CalibrationError, RocksweepError  # noqa: F401 (CalibrationError re-exported)
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import point_kernel, warm_up
-from rocksweep.numerics import step_budget
+from rocksweep.numerics import Numerics, step_budget
 from rocksweep.physics.measured import Measured, noise_level
 from rocksweep.physics.model import BodyError
 from rocksweep.physics.points import INITIAL, kernel_kind, point_row
 from rocksweep.schema import KEYS, fmt
 
+ACCURACY = "fine"  # the least accuracy of a calibration's runs (``calibration_numerics``)
 H_NOISE = 4.0  # threshold of an excursion, in noise standard deviations ...
 H_REL = 0.02  # ... and at least this share of the largest |theta|
 PEAK_TOP = 0.5  # a peak's parabola goes through the samples above this share of it ...
 PEAK_RAMP = 0.2  # ... weighted from 0 there to 1 at PEAK_TOP + PEAK_RAMP
-CHI2_95 = 3.841458820694124  # chi-square quantile, 1 degree of freedom, 95%
 GRID = 21  # first look of a one-parameter fit: GRID values across the bounds
 GRID_2D = 9  # ... and GRID_2D^2 for two parameters
 STAGES = (3, 6, 12, 24, 48, 96, 192)  # half cycles compared at each stage of ``_fit``
@@ -89,6 +89,17 @@ DEFAULT_BOUNDS = {"impact.lam": (0.0, 2.0), "impact.e": (0.02, 1.0),
 OPTIONAL_NAMES = ("e_factor", *INITIAL)
 
 
+def calibration_numerics(n: Numerics) -> Numerics:
+    """The numerics of a calibration's runs: the scene's, but at least ACCURACY's steps and
+    event tolerance (a fitted value must not carry the step's error: at `default`, 5 steps
+    per period, a freely rocking block's e came out 0.004 high, outside its interval);
+    the scene's horizon, rest rate and event cap are kept."""
+    fine = Numerics.preset(ACCURACY)
+    if n.steps_per_period >= fine.steps_per_period and n.event_tol <= fine.event_tol:
+        return n
+    return replace(fine, horizon=n.horizon, rest_rate=n.rest_rate, max_events=n.max_events)
+
+
 @dataclass(frozen=True)
 class Peaks:
     """Excursions of a history: signed peak (theta/alpha) float64[n], peak time float64[n]."""
@@ -96,6 +107,32 @@ class Peaks:
     value: np.ndarray
     time: np.ndarray
     area: np.ndarray | None = None  # integral of |theta| over each excursion [theta/alpha p t]
+
+
+class _Result:
+    """What a one-dimensional minimisation found (``x``, ``fun``), as scipy's result."""
+
+    def __init__(self, x: float, fun: float) -> None:
+        self.x, self.fun = x, fun
+
+
+def _golden(f: Any, bounds: tuple[float, float], xatol: float) -> _Result:
+    """Minimum of f on [lo, hi] by golden-section search to xatol (a unimodal bracket;
+    scipy.optimize's import costs ~0.2-1 s of every command, this a few lines)."""
+    lo, hi = bounds
+    r = (math.sqrt(5.0) - 1.0) / 2.0
+    a, b = lo + (1 - r) * (hi - lo), lo + r * (hi - lo)
+    fa, fb = f(a), f(b)
+    while hi - lo > xatol:
+        if fa <= fb:
+            hi, b, fb = b, a, fa
+            a = lo + (1 - r) * (hi - lo)
+            fa = f(a)
+        else:
+            lo, a, fa = a, b, fb
+            b = lo + r * (hi - lo)
+            fb = f(b)
+    return _Result(a, fa) if fa <= fb else _Result(b, fb)
 
 
 def excursions(t: np.ndarray, theta: np.ndarray, h: float) -> Peaks:
@@ -246,7 +283,7 @@ class Problem:
         self.names = [check_fit_key(scene, k) for k in self.keys]
         self.bounds = np.array([check_bounds(k, (bounds or {}).get(k)) for k in self.keys])
         self.values = _single_values(scene, self.names)
-        self.numerics = scene.single_numerics
+        self.numerics = calibration_numerics(scene.single_numerics)
         base = scene.point(self.values)
         self.alpha = base.body.alpha_ref
         self.sigma = noise_level(measured.t, measured.theta)
@@ -276,6 +313,7 @@ class Problem:
         self.dt_shift = 0.1 * max(float(t_end - self.t_onset), 1e-3)
         self.runs = 0
         self.n_use: int | None = None  # compare the first n_use half cycles (None: all)
+        self._cache: dict[tuple, tuple | None] = {}
 
     def point(self, x: np.ndarray) -> Any:
         values = dict(self.values)
@@ -308,13 +346,16 @@ class Problem:
     def evaluate(self, x: np.ndarray) -> dict | None:
         """Everything about a candidate: misfit S, the simulated theta at the measured
         times, the time shift, its peaks and impact times (measured time)."""
-        got = self.simulate(x)
+        key = tuple(float(v) for v in x)
+        if key in self._cache:  # one run per candidate, whatever half cycles are compared
+            got = self._cache[key]
+        else:
+            got = self._run(x)
+            if len(self._cache) < 5000:
+                self._cache[key] = got
         if got is None:
             return None
-        out, h = got
-        shift = self._shift(h)
-        theta = hermite(h["t"], h["theta"], h["theta_dot"], self.m.t - shift)
-        peaks = excursions(self.m.t, theta, self.h)
+        theta, shift, peaks, impacts, out = got
         mine, sim = self.peaks, peaks
         n = self.n_use
         if n is not None and n < mine.value.size:  # the first n half cycles (``fit``)
@@ -324,12 +365,23 @@ class Problem:
             sim = Peaks(sim.value[keep], sim.time[keep], sim.area[keep])
         cost, pairs = alignment_cost(mine.value, sim.value, self.h, area_a=mine.area,
                                      area_b=sim.area, t_scale=self.t_scale)
+        return {"S": cost, "theta": theta, "shift": shift, "peaks": peaks, "pairs": pairs,
+                "impacts": impacts, "out": out}
+
+    def _run(self, x: np.ndarray) -> tuple | None:
+        """A candidate's simulated history at the measured times, its shift, excursions,
+        impacts (measured time) and result row; None for a body that is not physical."""
+        got = self.simulate(x)
+        if got is None:
+            return None
+        out, h = got
+        shift = self._shift(h)
+        theta = hermite(h["t"], h["theta"], h["theta_dot"], self.m.t - shift)
+        peaks = excursions(self.m.t, theta, self.h)
         t, ph = h["t"], h["phase"]
         ev = np.flatnonzero((t[1:] == t[:-1]) & (ph[:-1] != 0) & (ph[1:] != ph[:-1]))
         impacts = t[ev] + shift
-        impacts = impacts[impacts <= self.m.t[-1]]
-        return {"S": cost, "theta": theta, "shift": shift, "peaks": peaks, "pairs": pairs,
-                "impacts": impacts, "out": out}
+        return theta, shift, peaks, impacts[impacts <= self.m.t[-1]], out
 
     def _shift(self, h: dict) -> float:
         """The time shift that aligns a simulated history's start with the measured one:
@@ -338,8 +390,6 @@ class Problem:
         shift of theta over the measured start window (up to the second half-cycle peak,
         before any phase drift; a slow start, as a release from a tilt, departs too
         gently for the threshold alone)."""
-        from scipy.optimize import minimize_scalar
-
         t_rel = self.m.t - self.m.t[0]
         th = hermite(h["t"], h["theta"], h["theta_dot"], t_rel)
         onset = _onset(t_rel, th, self.h)
@@ -352,8 +402,7 @@ class Problem:
         def ss(sh: float) -> float:
             return float(np.sum((hermite(h["t"], h["theta"], h["theta_dot"], tt - sh) - yy)
                                 ** 2))
-        r = minimize_scalar(ss, bounds=(shift0 - self.dt_shift, shift0 + self.dt_shift),
-                            method="bounded", options={"xatol": 1e-6})
+        r = _golden(ss, (shift0 - self.dt_shift, shift0 + self.dt_shift), 1e-6)
         return float(r.x) if r.fun <= ss(shift0) else shift0
 
     def misfit(self, x: np.ndarray) -> float:
@@ -435,8 +484,6 @@ def _minimise(problem: Problem, free: list[int], fixed: dict[int, float],
     """Least misfit over the parameters ``free`` with the others at ``fixed``: a grid
     (GRID values for one, GRID_2D^2 for two) then Brent's method / Nelder-Mead from its
     best point."""
-    from scipy.optimize import minimize, minimize_scalar
-
     def full(z: np.ndarray) -> np.ndarray:
         x = start.copy()
         for i, v in fixed.items():
@@ -453,9 +500,8 @@ def _minimise(problem: Problem, free: list[int], fixed: dict[int, float],
         s = np.array([problem.misfit(full(np.array([v]))) for v in g])
         k = int(np.argmin(s))
         lo, hi = g[max(k - 1, 0)], g[min(k + 1, GRID - 1)]
-        r = minimize_scalar(lambda v: problem.misfit(full(np.array([v]))), bounds=(lo, hi),
-                            method="bounded",
-                            options={"xatol": 1e-5 * (b[0, 1] - b[0, 0])})
+        r = _golden(lambda v: problem.misfit(full(np.array([v]))), (lo, hi),
+                    1e-5 * (b[0, 1] - b[0, 0]))
         best = (r.x, r.fun) if r.fun <= s[k] else (g[k], s[k])
         return full(np.array([best[0]])), float(best[1])
     if len(free) == 2:
@@ -470,6 +516,8 @@ def _minimise(problem: Problem, free: list[int], fixed: dict[int, float],
     simplex = np.vstack([z0, *(z0 + np.diag(0.1 * span)[k] * (1 if z0[k] + 0.1 * span[k]
                                                                 <= b[k, 1] else -1)
                                for k in range(len(free)))])
+    from scipy.optimize import minimize
+
     r = minimize(lambda z: problem.misfit(full(z)), z0, method="Nelder-Mead",
                  options={"initial_simplex": simplex, "xatol": 1e-5 * span.min(),
                           "fatol": 1e-12, "maxfev": 400})
@@ -484,9 +532,9 @@ def _fit(problem: Problem) -> tuple[np.ndarray, float]:
     costs the same whatever its e): a grid can miss it. The fit therefore starts on the
     first STAGES[0] half cycles (a wide basin: a grid over the bounds, then Brent or
     Nelder-Mead), and doubles them stage by stage up to all, each stage refining the last
-    estimate on a local grid of half the previous spacing."""
-    from scipy.optimize import minimize, minimize_scalar
-
+    estimate on a local grid of half the previous spacing. The plain fit on all half cycles
+    (a grid over the bounds, then Brent or Nelder-Mead) is done too; the lower misfit
+    wins."""
     n_all = problem.peaks.value.size
     stages = [n for n in STAGES if n < n_all] + [n_all]
     k = len(problem.keys)
@@ -504,13 +552,14 @@ def _fit(problem: Problem) -> tuple[np.ndarray, float]:
             lo, hi = g[max(j - 1, 0)], g[min(j + 1, g.size - 1)]
             x, s = np.array([g[j]]), float(ss[j])
             if hi > lo:
-                r = minimize_scalar(lambda v: problem.misfit(np.array([v])), bounds=(lo, hi),
-                                    method="bounded", options={"xatol": 1e-5 * span[0]})
+                r = _golden(lambda v: problem.misfit(np.array([v])), (lo, hi), 1e-5 * span[0])
                 if r.fun <= s:
                     x, s = np.array([float(r.x)]), float(r.fun)
         else:
             simplex = np.vstack([x, *(np.clip(x + np.diag(step)[i], b[:, 0], b[:, 1])
                                       for i in range(k))])
+            from scipy.optimize import minimize
+
             r = minimize(problem.misfit, x, method="Nelder-Mead",
                          options={"initial_simplex": simplex, "xatol": 1e-5 * span.min(),
                                   "fatol": 1e-12, "maxfev": 200})
@@ -519,7 +568,11 @@ def _fit(problem: Problem) -> tuple[np.ndarray, float]:
             s = problem.misfit(x)
         step = step / 2
     problem.n_use = None
-    return x, problem.misfit(x)
+    s = problem.misfit(x)
+    # the first half cycles may say little about the keys (a pulse's first excursions
+    # before any impact): the plain grid on every half cycle is tried too, the better kept
+    x2, s2 = _minimise(problem, list(range(k)), {}, b.mean(axis=1))
+    return (x2, s2) if s2 < s else (x, s)
 
 
 def _profile_end(problem: Problem, i: int, x_hat: np.ndarray, s_min: float, limit: float,
@@ -607,8 +660,6 @@ def _minimise_local(problem: Problem, free: list[int], fixed: dict[int, float],
                     start: np.ndarray) -> tuple[np.ndarray, float]:
     """Least misfit over ``free`` near ``start`` (no grid): Brent in a bracket of 10% of
     the bounds for one parameter, Nelder-Mead for more."""
-    from scipy.optimize import minimize, minimize_scalar
-
     x = start.copy()
     for k, v in fixed.items():
         x[k] = v
@@ -627,8 +678,7 @@ def _minimise_local(problem: Problem, free: list[int], fixed: dict[int, float],
         best = (float(start[k]), f(float(start[k])))
         for _ in range(5):
             lo, hi = max(b[0, 0], best[0] - half), min(b[0, 1], best[0] + half)
-            r = minimize_scalar(f, bounds=(lo, hi), method="bounded",
-                                options={"xatol": 1e-5 * span[0]})
+            r = _golden(f, (lo, hi), 1e-5 * span[0])
             if r.fun < best[1]:
                 best = (float(r.x), float(r.fun))
             at_edge = min(best[0] - lo, hi - best[0]) < 0.05 * half
@@ -643,6 +693,8 @@ def _minimise_local(problem: Problem, free: list[int], fixed: dict[int, float],
         y = x.copy()
         y[free] = z
         return problem.misfit(y)
+    from scipy.optimize import minimize
+
     r = minimize(g, x[free], method="Nelder-Mead",
                  options={"xatol": 1e-4 * span.min(), "fatol": 1e-12, "maxfev": 200})
     y = x.copy()
@@ -652,8 +704,9 @@ def _minimise_local(problem: Problem, free: list[int], fixed: dict[int, float],
 
 def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
     """Fit a ``Problem``: the Dataset of ``rocksweep.calibrate`` (see ``calibrate``)."""
+    from statistics import NormalDist
+
     import xarray as xr
-    from scipy.stats import chi2
 
     t0 = time.perf_counter()
     k = len(problem.keys)
@@ -666,7 +719,9 @@ def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
     best = problem.evaluate(x_hat)
     n = problem.peaks.value.size
     s2 = max(s_min / max(n - k, 1), problem.sigma**2)
-    limit = float(chi2.ppf(ci, 1)) * s2
+    # chi2 quantile of 1 degree of freedom: the square of the normal's two-sided quantile
+    # (statistics, not scipy.stats: its import costs ~0.5 s of every command)
+    limit = NormalDist().inv_cdf(0.5 + 0.5 * ci) ** 2 * s2
     lo, hi, lo_b, hi_b = (np.empty(k), np.empty(k), np.zeros(k, bool), np.zeros(k, bool))
     for i in range(k):
         lo[i], lo_b[i] = _profile_end(problem, i, x_hat, s_min, limit, -1)

@@ -409,6 +409,8 @@ def _single_verdict(lnx, k, n, stripes: bool) -> tuple[Fit, dict[str, str]]:
             np.full(lnx.size, np.nan)
         if _non_monotone(lnx, k, n, p):
             why["non_monotone"] = "the stripe fractions fall with the IM beyond noise"
+    elif code[0] == _CODE["separated"]:
+        why["beta_undetermined"] = "separated"
     counted = np.exp(lnx[n > 0])
     if counted.size:
         ext = _outside(float(counted.min()), float(counted.max()), float(med[0]),
@@ -593,7 +595,7 @@ def _fit_ordinal(lnx: np.ndarray, m: np.ndarray, start: tuple | None = None
         return np.exp(_ordinal_probs(z[rows], theta))
 
     limit = np.array([60.0] + [40.0] * (K - 1) + [15.0])
-    theta, conv = _maximise(prob, m, theta0, limit)
+    theta, conv = _maximise(prob, m, theta0, limit, tol=1e-10 if start is None else 1e-7)
     t = np.cumsum(np.concatenate([theta[:, :1], np.exp(theta[:, 1:K])], 1), 1)
     s = np.exp(theta[:, K])
     return np.exp(mu[:, None] + sd[:, None] * t), sd / s, conv
@@ -632,7 +634,8 @@ def _phi2(h: np.ndarray, k: np.ndarray, rho: np.ndarray) -> np.ndarray:
 
 
 def _fit_competing(lnx: np.ndarray, k1: np.ndarray, k2: np.ndarray, n: np.ndarray,
-                   start: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                   start: np.ndarray, tol: float | None = None
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Competing lognormal capacities of mode 1 and mode 2 (module docstring), each row
     with points of both modes. lnx, k1, k2, n (b, P); start (b, 4): (ln im_median_1,
     beta_1, ln im_median_2, beta_2) to start from. Returns (im_median (b, 2), beta (b, 2),
@@ -647,7 +650,8 @@ def _fit_competing(lnx: np.ndarray, k1: np.ndarray, k2: np.ndarray, n: np.ndarra
         return np.stack(_cif(z[rows], theta[:, [0, 2]], np.exp(theta[:, [1, 3]])), 1)
 
     th0 = np.where(np.isfinite(th0), th0, 0.0)
-    theta, conv = _maximise(prob, counts, th0, np.array([60.0, 12.0, 60.0, 12.0]))
+    theta, conv = _maximise(prob, counts, th0, np.array([60.0, 12.0, 60.0, 12.0]),
+                            tol=1e-10 if tol is None else tol)
     with np.errstate(over="ignore"):
         med = np.exp(mu[:, None] + sd[:, None] * theta[:, [0, 2]])
         beta = sd[:, None] * np.exp(theta[:, [1, 3]])
@@ -769,10 +773,10 @@ def _fit_competing_counts(lnx, m, n, stripes, start=None):
         if start is not None and np.all(np.isfinite(start[0])) and np.all(
                 np.isfinite(start[1])) and np.all(np.asarray(start[1]) > 0):
             full = [np.log(start[0][0]), start[1][0], np.log(start[0][1]), start[1][1]]
-            first = np.broadcast_to(full, (both.size, 4))
+            first, tol = np.broadcast_to(full, (both.size, 4)), 1e-7
         else:
-            first = begin
-        mm, bb, conv = _fit_competing(lnx[both], k1[both], k2[both], n[both], first)
+            first, tol = begin, None
+        mm, bb, conv = _fit_competing(lnx[both], k1[both], k2[both], n[both], first, tol)
         med[both], bet[both] = mm, bb
         code[both] = np.where(conv, _CODE["ok"], _CODE["not_converged"])[:, None]
         med[both[~conv]], bet[both[~conv]] = np.nan, np.nan
@@ -1407,9 +1411,10 @@ def _verdicts(kind, idxs, o, lnx, m, med, bet, why, counted, flagged, hits, over
             p = lognormal_cdf(np.exp(lnx), med[q], bet[q])
             if _non_monotone(lnx, k, n, p):
                 w["non_monotone"] = "the stripe fractions fall with the IM beyond noise"
-        elif stripes:
+        elif stripes:  # null: the fitted competing-risk probability of this mode
             k = m[0, q + 1]
-            if _non_monotone(lnx, k, n, np.full(lnx.size, np.nan)):
+            p = _curves("competing", np.exp(lnx), np.asarray(med), np.asarray(bet))[q]
+            if _non_monotone(lnx, k, n, p):
                 w["non_monotone"] = ("the stripe fractions fall with the IM beyond noise "
                                      "(a competing-risk curve cannot fall)")
         kw = states[i]

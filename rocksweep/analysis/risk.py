@@ -6,7 +6,9 @@ Krawinkler 2000, eq. 1 of the PEER framework):
 
     lambda_state = integral P(state | im) |d lambda_im(im)|,
 
-P(state | im) = Phi(ln(im / im_median) / beta) the fragility (``rocksweep.analysis.fragility``)
+P(state | im) the fragility (``rocksweep.analysis.fragility``: Phi(ln(im / im_median) /
+beta), or for mode 1 and mode 2 fitted jointly their competing-risk probabilities,
+``fragility.probability``)
 and lambda_im(x) the hazard curve, the mean annual rate of IM > x. The probability of at
 least one occurrence in N years (Poisson): 1 - exp(-lambda_state N).
 
@@ -316,14 +318,35 @@ def _nodes(hz: Hazard) -> tuple[np.ndarray, np.ndarray]:
     return np.exp(np.concatenate(xs)), np.concatenate(ws)
 
 
-def _rates(hz: Hazard, median: np.ndarray, beta: np.ndarray
-           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """(annual_rate, annual_rate_max, P at x_min, P at x_max) for fragility curves
-    (median, beta) of any shape (module docstring)."""
+def _curve_p(fr: xr.Dataset, med: xr.DataArray, beta: xr.DataArray, dims: list[str]):
+    """x -> P(state | x) float[..., x] over ``dims`` (+ any extra dims of med, e.g.
+    ``sample``, last before x): the fragility's own model (``fragility.probability``: the
+    competing-risk probabilities for mode1 with mode2 fitted jointly, the lognormal CDF
+    otherwise) when the Dataset says which (``fit``), else the lognormal CDF."""
+    extra = [d for d in med.dims if d not in dims]
+    order = [*dims, *extra]
+    if "fit" in fr.data_vars and "state" in fr.coords:
+        from rocksweep.analysis.fragility import probability
+
+        like = xr.Dataset({"im_median": med, "beta": beta, "fit": fr["fit"]},
+                          coords={"state": fr["state"]})
+
+        def p(x: np.ndarray) -> np.ndarray:
+            return np.asarray(probability(like, x).transpose(*order, "im").values,
+                              np.float64)
+        return p
+    m = np.asarray(med.transpose(*order).values, np.float64)
+    b = np.asarray(beta.transpose(*order).values, np.float64)
+    return lambda x: _fragility_p(x, m, b)
+
+
+def _rates(hz: Hazard, p) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(annual_rate, annual_rate_max, P at x_min, P at x_max) for the fragility curves
+    x -> p(x) float[..., x] (module docstring)."""
     x, w = _nodes(hz)
-    inside = _fragility_p(x, median, beta) @ w
-    p_lo = _fragility_p(hz.im[:1], median, beta)[..., 0]
-    p_hi = _fragility_p(hz.im[-1:], median, beta)[..., 0]
+    inside = p(x) @ w
+    ends = p(hz.im[[0, -1]])
+    p_lo, p_hi = ends[..., 0], ends[..., 1]
     top = hz.rate[-1]
     return inside + p_hi * top, inside + top, p_lo, p_hi
 
@@ -401,17 +424,15 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50.0, *,
     hz = read_hazard(hazard, site=site)
     _check_match(fr, hz)
     dims = list(med_da.dims)
-    med = np.asarray(med_da.transpose(*dims).values, np.float64)
-    beta = np.asarray(fr["beta"].transpose(*dims).values, np.float64)
-    rate, rate_max, p_lo, p_hi = _rates(hz, med, beta)
+    curve = _curve_p(fr, med_da, fr["beta"], dims)
+    rate, rate_max, p_lo, p_hi = _rates(hz, curve)
     ci = float(fr.attrs.get("ci", 0.9))
     lo = hi = np.full(rate.shape, np.nan)
     samples = f"{med_name}_samples"
     if samples in fr.data_vars and "beta_samples" in fr.data_vars:
-        ms = np.asarray(fr[samples].transpose(*dims, "sample").values, np.float64)
-        bs = np.asarray(fr["beta_samples"].transpose(*dims, "sample").values, np.float64)
+        ms, bs = fr[samples], fr["beta_samples"]
         ok = np.isfinite(ms) & np.isfinite(bs)
-        r_s, _, _, _ = _rates(hz, np.where(ok, ms, np.nan), np.where(ok, bs, np.nan))
+        r_s, _, _, _ = _rates(hz, _curve_p(fr, ms.where(ok), bs.where(ok), dims))
         lo, hi = _interval(r_s, ci)
     reasons = np.empty(rate.shape, dtype=object)
     unknown_top = rate_max - rate
@@ -438,7 +459,7 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50.0, *,
         coords["state"] = fr["state"]
     grid = np.geomspace(hz.im[0], hz.im[-1], PLOT_POINTS)
     dens = _density(hz, grid)
-    p_grid = _fragility_p(grid, med, beta)
+    p_grid = curve(grid)
     unit = hz.unit
     data: dict[str, Any] = {
         "annual_rate": (dims, rate, {"units": "1/yr", "long_name": "mean annual rate of the "

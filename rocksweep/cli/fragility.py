@@ -138,8 +138,9 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
     refined = None
     if rtol is not None:
         refined = rocksweep.ida(ds, rtol)
-        for name in ("ida_im", "ida_lo", "ida_hi", "runs"):
-            frag[name if name != "runs" else "ida_runs"] = refined[name]
+        for name in ("ida_im", "ida_lo", "ida_hi", "runs", "n_flagged", "unresolved"):
+            frag[name if name in ("ida_im", "ida_lo", "ida_hi") else f"ida_{name}"] = \
+                refined[name]
     rows = curve_rows(frag)
     if as_json:
         from rocksweep.analysis.fragility import curves_json
@@ -186,6 +187,11 @@ def _print_ida(refined) -> None:
                        f"{int(one.resurrection.sum())} resurrect above it)")
         else:
             click.echo(f"  {where}: no record overturns at any stripe")
+        flagged, stopped = int(one.n_flagged.sum()), int(one.unresolved.sum())
+        if flagged or stopped:
+            click.echo(f"    {flagged} flagged stripe points (neither safe nor overturning); "
+                       f"{stopped} bisections stopped at a flagged run (bracket wider than "
+                       "rtol)")
 
 
 def _to_netcdf(frag, path: Path) -> None:

@@ -57,7 +57,7 @@ from typing import Any
 import numpy as np
 
 from rocksweep.compute.grid import ChunkRows, Grid
-from rocksweep.errors import AdaptiveError  # noqa: F401 (defined there; re-exported)
+from rocksweep.errors import AdaptiveError, ApiError  # noqa: F401 (AdaptiveError: re-exported)
 from rocksweep.scene.model import Scene
 from rocksweep.schema import check_option
 from rocksweep.vocab import outcomes as _out
@@ -786,10 +786,11 @@ def adaptive_compute(scene: Scene, jobs: int = 1, coarse: int | None = None,
                      chunk_size: int | None = None, backend: str = "threads",
                      scheduler: str | None = None,
                      threshold: float = DEFAULT_AUDIT_THRESHOLD,
-                     final_margin: int = DEFAULT_FINAL_MARGIN,
-                     on_batch: Callable[[Batch], None] | None = None
+                     final_margin: int = DEFAULT_FINAL_MARGIN
                      ) -> tuple[dict[str, np.ndarray], AdaptiveStats]:
-    """Adaptive sweep of a whole scene in memory, like ``rocksweep.compute.sweep.compute``.
+    """Adaptive sweep of a whole scene in memory, like ``rocksweep.compute.sweep.compute``,
+    through the one sweep driver (``rocksweep.compute.driver.sweep_arrays``: the loop of
+    ``rocksweep sweep --adaptive``).
 
     Returns (arrays, stats): arrays maps every variable of ``Scene.variables``
     plus ``computed`` (int8 flags, see COMPUTED_MEANING) to an array of the grid's shape;
@@ -797,23 +798,11 @@ def adaptive_compute(scene: Scene, jobs: int = 1, coarse: int | None = None,
     value at filled points. Identical whatever ``jobs``, ``chunk_size`` and backend.
     """
 
-    grid = Grid(scene)
-    plan = make_plan(grid, axes, coarse, margin, audit, seed, final_margin)
-    specs = scene.variables()
-    flat = {k: np.full(grid.size, fv, dt) for k, (dt, fv, _) in specs.items()}
+    from rocksweep.compute.driver import sweep_arrays
 
-    def evaluate(points: np.ndarray, batch: Batch) -> np.ndarray:
-        if on_batch is not None:
-            on_batch(batch)
-        for res in run_batch(grid, points, jobs, chunk_size, backend, scheduler):
-            for k, v in res.arrays.items():
-                flat[k][res.flat] = v
-        return flat["outcome"][points]
-
-    outcome, computed, stats = drive(plan, evaluate, threshold=threshold)
-    flat["outcome"] = outcome
-    flat["computed"] = computed
-    return {k: v.reshape(grid.shape) for k, v in flat.items()}, stats
+    options = Options(tuple(axes), coarse, audit, margin, final_margin, seed, threshold)
+    arrays, report = sweep_arrays(scene, jobs, chunk_size, backend, scheduler, options)
+    return arrays, report.adaptive
 
 
 @dataclass
@@ -851,3 +840,31 @@ def validate(grid: Grid, plan: Plan, outcome: np.ndarray, computed: np.ndarray,
         cls[np.searchsorted(filled, res.flat)] = res.arrays["outcome"]
     bad = cls != np.asarray(outcome).ravel()[filled]
     return Validation(s, int(lattice.size), int(filled.size), filled[bad], cls[bad])
+
+
+def adaptive_options(adaptive: bool, base: dict | None = None,
+                     **settings: Any) -> Options | None:
+    """``Options`` from the API's keyword settings (None values: the defaults);
+    None when not ``adaptive``, then any setting given is an ApiError. base: a scene's
+    ``refine`` section (``Scene.refine``): it turns adaptive on, and the keyword settings
+    override its values."""
+    given = {k: v for k, v in settings.items() if v is not None}
+    if base is not None:
+        adaptive = True
+        given = {**base, **given}
+    known = {"coarse", "audit", "axes", "margin", "final_margin", "seed", "threshold"}
+    unknown = sorted(set(given) - known)
+    if unknown:
+        raise AdaptiveError(f"{unknown[0]} = {given[unknown[0]]!r}: not a setting of an adaptive "
+                       f"sweep (settings: {', '.join(sorted(known))})")
+    if not adaptive:
+        if given:
+            k = sorted(given)[0]
+            raise ApiError(f"{k} = {given[k]!r}: an adaptive setting; add adaptive=True")
+        return None
+    if "axes" in given:
+        axes = given["axes"]
+        if isinstance(axes, str):
+            axes = [a.strip() for a in axes.split(",")]
+        given["axes"] = tuple(axes)
+    return Options(**given)

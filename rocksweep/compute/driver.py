@@ -113,6 +113,77 @@ def drive(sf, path: Path | None, report: SweepReport, t0: float,
     return report
 
 
+class ArraySink:
+    """A sink of plain arrays in memory (the grid's variables, flat, at their fill values
+    until written; ``computed`` flags of an adaptive sweep): what ``sweep_arrays`` drives
+    for the library's own in-memory sweeps, with the same loops as a result file."""
+
+    def __init__(self, grid: Any) -> None:
+        import numpy as np
+
+        self.grid = grid
+        self.flat = {k: np.full(grid.size, fill, dtype)
+                     for k, (dtype, fill, _) in grid.scene.variables().items()}
+        self._done = np.zeros(grid.size, bool)
+        self.computed = np.zeros(grid.size, np.int8)  # adaptive.FILLED
+        self.counts: dict = {}
+
+    def done(self) -> Any:
+        return self._done.copy()
+
+    def write(self, res: Any) -> None:
+        for k, v in res.arrays.items():
+            self.flat[k][res.start:res.stop] = v
+        self._done[res.start:res.stop] = True
+
+    def state(self) -> tuple[Any, Any]:
+        return self.flat["outcome"].copy(), self.computed.copy()
+
+    def write_points(self, flat: Any, arrays: dict, flags: Any) -> None:
+        for k, v in arrays.items():
+            self.flat[k][flat] = v
+        self.computed[flat] = flags
+        self._done[flat] = True
+
+    def write_filled(self, outcome: Any, counts: dict) -> None:
+        self.flat["outcome"][:] = outcome
+        self.counts = counts
+
+    def finish(self, wall_s: float, cpu_s: float) -> dict:
+        return dict(self.counts)
+
+    def image(self) -> None:
+        return None
+
+    def close(self) -> None:
+        pass
+
+    def arrays(self, adaptive: bool) -> dict:
+        """name -> array of the grid's shape (``Grid.shape``); ``computed`` too when
+        ``adaptive``."""
+        out = {k: v.reshape(self.grid.shape) for k, v in self.flat.items()}
+        if adaptive:
+            out["computed"] = self.computed.reshape(self.grid.shape)
+        return out
+
+
+def sweep_arrays(scene: Scene, jobs: int = 1, chunk_size: int | None = None,
+                 backend: str = "threads", scheduler: str | None = None,
+                 adaptive: Options | None = None) -> tuple[dict, SweepReport]:
+    """Sweep a whole scene in memory through the one driver (``drive``, the loops of
+    ``rocksweep sweep``) into plain arrays: (name -> array of the grid's shape, the
+    session's report; ``report.adaptive``: an adaptive sweep's counts). For the library's
+    own studies and tests; ``rocksweep.run`` returns the same as a Dataset."""
+    from rocksweep.compute.grid import Grid
+
+    sink = ArraySink(Grid(scene))
+    report = SweepReport(Path("memory"), sink.grid.size, 0, 0, 0.0, 0.0, 0.0)
+    drive(sink, None, report, time.perf_counter(), adaptive, False, jobs=jobs,
+          backend=backend, scheduler=scheduler, chunk_size=chunk_size, where="memory",
+          write_every=0.0, progress=False, say=lambda _line: None)
+    return sink.arrays(adaptive is not None), report
+
+
 def progress_class(progress: bool = True) -> type:
     """The progress bar: a widget in a notebook (``tqdm.auto``'s choice), else the
     terminal's bar (without ``tqdm.auto``'s asyncio import: ~10 ms of every command).

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -343,25 +343,12 @@ def _run_on_cluster(grid: Grid, chunks: list[tuple[int, int]], level: int,
 
 
 def compute(scene: Scene, jobs: int = 1, chunk_size: int | None = None,
-            backend: str = "threads", scheduler: str | None = None,
-            on_chunk: Callable[[ChunkResult], None] | None = None) -> dict[str, np.ndarray]:
-    """Sweep a whole scene in memory: name -> array with the grid's shape (``Grid.shape``).
+            backend: str = "threads", scheduler: str | None = None) -> dict[str, np.ndarray]:
+    """Sweep a whole scene in memory: name -> array with the grid's shape (``Grid.shape``),
+    through the one sweep driver (``rocksweep.compute.driver.sweep_arrays``)."""
+    from rocksweep.compute.driver import sweep_arrays
 
-    For small grids and tests; ``rocksweep sweep`` writes chunks to a file as they finish.
-    """
-    grid = Grid(scene)
-    lvl = level(scene)
-    specs = scene.variables()
-    flat = {k: np.full(grid.size, fill, dtype) for k, (dtype, fill, _) in specs.items()}
-    n_workers = check_jobs(jobs) if backend == "threads" else 1
-    size = chunk_size or auto_chunk_size(grid.size, n_workers)
-    for res in run_chunks(grid, plan_chunks(np.ones(grid.size, bool), size), lvl, jobs,
-                          backend, scheduler):
-        for k, v in res.arrays.items():
-            flat[k][res.start:res.stop] = v
-        if on_chunk is not None:
-            on_chunk(res)
-    return {k: v.reshape(grid.shape) for k, v in flat.items()}
+    return sweep_arrays(scene, jobs, chunk_size, backend, scheduler)[0]
 
 
 # ---------------------------------------------------------------------------------------

@@ -100,7 +100,10 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
                 text += f", beta {beta:.2f}" if math.isfinite(beta) else ""
                 reason = str(one["reason"].values) if "reason" in one else "ok"
                 text += "" if reason == "ok" else f" [{reason}]"
-                ax.plot(grid, lognormal_cdf(grid, med, beta), style, color=colour,
+                # the fit's own curve (a competing-risk mode's is not a lognormal CDF)
+                y = (one["curve"].values if "curve" in one
+                     else lognormal_cdf(grid, med, beta))
+                ax.plot(grid, y, style, color=colour,
                         label=(", ".join(label_bits) + "\n" + text).lstrip())
             else:
                 reason = str(one["reason"].values) if "reason" in one else "no fit"

@@ -87,6 +87,9 @@ def test_too_few_distinct_fractions_and_separation_leave_beta_undetermined():
     assert math.isnan(sep.beta) and sep.im_median == pytest.approx(math.sqrt(0.2 * 0.4))
     # two distinct fractions inside: beta is determined
     assert F.fit_stripes(x, [0, 3, 7, 10], n).reason == "ok"
+    # a separated cloud: the same words
+    cloud = F.fit_cloud([0.1, 0.2, 0.3, 0.4], [0, 0, 1, 1])
+    assert cloud.reason == "separated,beta_undetermined" and math.isnan(cloud.beta)
 
 
 def test_falling_fractions_are_non_monotone_and_resurrection_noise_is_not():
@@ -151,6 +154,16 @@ def test_a_mode_fitted_alone_is_censored_by_the_other_and_the_joint_fit_is_not()
     joint = F.fragility(ds, state=["mode1", "mode2"], bootstrap=0, warn=False)
     assert list(joint["fit"].values) == ["competing", "competing"]
     assert not any("censored" in r for r in joint["reason"].values)
+    # mode 2 rising then vanishing (20 records): no competing-risk curve can fall
+    k2 = [0, 0, 2, 8, 14, 16, 10, 4, 1, 0, 0, 0]
+    k1 = [0, 0, 0, 0, 2, 4, 10, 16, 19, 20, 20, 20]
+    out = np.zeros((20, 12), int)
+    for s in range(12):
+        out[:k1[s], s] = 1
+        out[k1[s]:k1[s] + k2[s], s] = 2
+    hump = F.fragility(stripes_ds(out), state=["mode1", "mode2"], bootstrap=0, warn=False)
+    assert "non_monotone" in str(hump["reason"].sel(state="mode2").values).split(",")
+    assert "ok" not in hump["reason"].values
 
 
 def test_partial_data_are_incomplete_with_the_missing_stripes_named():
@@ -417,3 +430,37 @@ def test_cli_bad_arguments_write_nothing(suite_scene, cli, tmp_path):
         line = one_line_error(res)
         assert line.startswith("Error:"), line
         assert not (tmp_path / "c.csv").exists()
+
+
+def test_the_issues_eight_record_mode2_curve_is_not_ok():
+    """Issue 29's measurement: mode 2 counts 0 0 0 0 0 0 0 1 1 2 3 1 3 1 0 0 of 8 over PGA
+    0.1-1.6 g, mode 1 taking over at high PGA, was fitted "ok" with its median above every
+    stripe."""
+    lv = np.linspace(0.1, 1.6, 16)
+    k2 = [0, 0, 0, 0, 0, 0, 0, 1, 1, 2, 3, 1, 3, 1, 0, 0]
+    k1 = [0, 0, 0, 0, 0, 1, 2, 2, 3, 3, 3, 6, 4, 7, 8, 8]
+    out = np.zeros((8, 16), int)
+    for s in range(16):
+        out[:k1[s], s] = 1
+        out[k1[s]:k1[s] + k2[s], s] = 2
+    with pytest.warns(F.FragilityWarning):
+        fr = F.fragility(stripes_ds(out, levels=lv), state="mode2", bootstrap=200)
+    assert {"censored", "extrapolated"} <= reasons(fr)
+    assert float(fr["im_median"]) > lv.max()
+
+
+def test_the_figure_draws_a_competing_mode_by_its_own_model_not_a_lognormal():
+    from rocksweep.figures.fragility import fragility_figure
+
+    lv = np.geomspace(0.1, 2.0, 12)
+    fr = F.fragility(stripes_ds(competing_outcomes(40, seed=1, levels=lv), levels=lv),
+                     state=["mode1", "mode2"], bootstrap=0, warn=False)
+    med, beta = fr["im_median"].values, fr["beta"].values
+    lines = [ln for ln in fragility_figure(fr).axes[0].get_lines() if len(ln.get_xdata())]
+    assert len(lines) == 2
+    x = np.asarray(lines[1].get_xdata())
+    # mode 2's cumulative incidence, integrated independently (cif_trapezoid): P(C2 <= x,
+    # C2 < C1), well below the lognormal CDF of its own median and beta at high IM
+    _, _, p2 = cif_trapezoid(x, med[0], beta[0], med[1], beta[1], n_u=20001)
+    np.testing.assert_allclose(lines[1].get_ydata(), p2, atol=1e-4)
+    assert np.max(np.abs(norm.cdf(np.log(x / med[1]) / beta[1]) - p2)) > 0.05

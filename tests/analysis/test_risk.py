@@ -238,3 +238,40 @@ def test_older_openquake_header(tmp_path):
     hz = read_hazard(path)
     assert (hz.name, hz.unit, hz.period) == ("Sa", "g", 1.0)
     np.testing.assert_allclose(hz.rate, -np.log1p(-np.array([0.1, 0.01, 0.001])))
+
+
+@pytest.mark.filterwarnings("ignore")
+def test_competing_modes_integrate_their_own_probabilities():
+    # mode1 and mode2 fitted jointly are not lognormal CDFs of their im_median and beta:
+    # the rate integrates fragility.probability (checked here with scipy.quad)
+    from rocksweep.analysis.fragility import probability
+
+    rng = np.random.default_rng(2)
+    R, levels = 60, np.geomspace(0.1, 3.0, 12)
+    c1 = rng.lognormal(np.log(0.8), 0.4, R)  # each record's capacity in mode 1, mode 2
+    c2 = rng.lognormal(np.log(1.1), 0.4, R)
+    over = levels[None, :] >= np.minimum(c1, c2)[:, None]
+    outcome = np.where(over, np.where((c1 < c2)[:, None], 1, 2), 0).astype(np.int8)
+    ds = xr.Dataset({"outcome": (("lam", "record", "PGA"), outcome[None]),
+                     "status": (("lam", "record", "PGA"), np.zeros((1, R, 12), np.int32))},
+                    coords={"lam": [0.0], "record": [f"r{i}" for i in range(R)],
+                            "PGA": levels}, attrs={"scale_im": "PGA"})
+    fr = rocksweep.fragility(ds, state=["mode1", "mode2"], bootstrap=10)
+    assert set(fr.fit.values.tolist()) == {"competing"}
+    x = np.geomspace(0.01, 5.0, 30)
+    k0, k = 1e-4, 2.0
+    rk = rocksweep.risk(fr, pd.DataFrame({"PGA [g]": x, "annual_rate": k0 * x ** -k}))
+    for s in range(2):
+        def dens(u, s=s):  # P(x) |d lambda / d ln x| of the power law
+            p = probability(fr, [math.exp(u)]).isel(state=s, lam=0).item()
+            return p * k * k0 * math.exp(-k * u)
+        inside = integrate.quad(dens, math.log(0.01), math.log(5.0), limit=200)[0]
+        top = probability(fr, [5.0]).isel(state=s, lam=0).item() * k0 * 5.0 ** -k
+        got = float(rk.annual_rate.isel(state=s, lam=0))
+        assert got == pytest.approx(inside + top, rel=1e-4)
+        lognormal = fragility(float(fr.im_median.isel(state=s, lam=0)),
+                              float(fr.beta.isel(state=s, lam=0)))
+        plain = float(rocksweep.risk(lognormal, pd.DataFrame(
+            {"PGA [g]": x, "annual_rate": k0 * x ** -k})).annual_rate[0])
+        if s == 1:  # mode 2, censored by mode 1: far from its lognormal reading
+            assert abs(got / plain - 1) > 0.05

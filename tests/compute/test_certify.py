@@ -139,3 +139,28 @@ def test_simulate_and_sweep_give_one_point_one_answer():
                                              else np.nan, float),
                                   np.asarray(swept[k][i], float), equal_nan=True), (A, k)
     assert (swept["status"] & L.STATUS_REFINED).any()
+
+
+ADAPTIVE = """
+name: the block's mode-1 band, adaptive
+body: {kind: block, alpha: 0.25}
+impact: {lam: 0.0}
+pulse: {shape: sine, w_over_p: {start: 6, stop: 10, num: 9},
+        A_ratio: {start: 9.0, stop: 13.0, num: 41}}
+"""
+
+
+def test_adaptive_sweeps_certify_as_the_full_sweep_does():
+    """An adaptive sweep computes its points through the sweep's chunks: every computed
+    point has the full sweep's result, status bits (refined) included, and some of them
+    were close calls."""
+    import rocksweep.compute.adaptive as ad
+
+    sc = parse_scene(ADAPTIVE)
+    full = sw.compute(sc)
+    arr, _ = ad.adaptive_compute(sc, jobs=1)
+    c = arr["computed"] > 0
+    for k in ("outcome", "status", "steps", "t_overturn"):
+        np.testing.assert_array_equal(arr[k][c], full[k][c], err_msg=k)
+    assert ((arr["status"][c] & L.STATUS_REFINED) != 0).any()
+    np.testing.assert_array_equal(arr["outcome"], full["outcome"])

@@ -7,7 +7,7 @@ import pytest
 from hardkit import assert_sane, kernel_events, numerics, reference_events, run
 from hardkit import table3_body as body
 
-from rocksweep.kernel.layout import PAR_DT, PAR_TPULSE
+from rocksweep.kernel.layout import PAR_DT, PAR_DT_ON, PAR_TPULSE
 from rocksweep.physics.points import Point, body_omega_rock, point_row
 
 pytestmark = pytest.mark.hard
@@ -41,7 +41,10 @@ def test_jump_at_the_pulse_end_lifts_the_body_at_once():
 @pytest.mark.parametrize("w0, a_ratio", [(4.25, 1.3), (4.5, 1.5)])
 def test_results_do_not_depend_on_where_the_step_grid_meets_the_pulse_end(w0, a_ratio):
     """Guards against results that change when a step boundary falls on or near the jump."""
-    dt = 2 * math.pi / (body_omega_rock(BODY) * 20)  # BASE's step (the spring sets it here)
+    # BASE's step (the spring sets it here: 20 steps per period, x (27.5/omega_rock)^(2/5)
+    # for a spring softer than Figure 4's), the same while the pulse acts and after it
+    w_rock = body_omega_rock(BODY)
+    dt = 2 * math.pi / (w_rock * 20 * (27.5 / w_rock) ** 0.4)
     n = round(2 * math.pi / w0 / dt)
     runs = {}
     # the pulse ends on the step grid, 1e-12 / 1e-9 after a grid point (a tiny landing
@@ -51,6 +54,7 @@ def test_results_do_not_depend_on_where_the_step_grid_meets_the_pulse_end(w0, a_
         p = Point(BODY, 0.2, "cosine", 2 * math.pi / t_pulse, a_ratio)
         row = point_row(p, numerics())
         assert row[PAR_DT] == pytest.approx(dt, rel=1e-14)
+        assert row[PAR_DT_ON] == row[PAR_DT]
         r = run(p)
         assert_sane(r)
         h = r.history

@@ -7,7 +7,7 @@ import pytest
 from hardkit import BASE, assert_sane, kernel_events, reference_events, run
 from hardkit import table3_body as body
 
-from rocksweep.kernel.layout import PAR_DT, PAR_ROT_STEP, PAR_TPULSE
+from rocksweep.kernel.layout import PAR_DT, PAR_DT_ON, PAR_ROT_STEP, PAR_TPULSE
 from rocksweep.physics.model import G
 from rocksweep.physics.points import Point, point_row
 
@@ -33,12 +33,15 @@ def test_very_long_pulse_finishes_in_bounded_work(name, shape, a_ratio):
     row = point_row(p, BASE)
     assert row[PAR_TPULSE] == pytest.approx(200 * math.pi)
     s = r.summary()
-    # one regular step per dt of simulated time, plus one cut short per event at most, plus
+    # one regular step per dt_on of the pulse's time and per dt after it, plus one cut short
+    # per event at most, plus
     # the rotation limit's (PAR_ROT_STEP) shorter steps: about one per rot of turning, the
     # fall's pi/2 counted twice
     rot = row[PAR_ROT_STEP]
     extra = 2 * (math.pi / 2) / rot if rot > 0 else 0.0
-    assert s["steps"] <= r.t_end / row[PAR_DT] + 2 + r.impacts + r.uplifts + extra
+    on = min(r.t_end, row[PAR_TPULSE])
+    regular = on / row[PAR_DT_ON] + (r.t_end - on) / row[PAR_DT]
+    assert s["steps"] <= regular + 2 + r.impacts + r.uplifts + extra
     assert s["event_steps"] <= 100 * (r.impacts + r.uplifts + 1)
     res = reference_events(p)[0]
     assert r.outcome == OUTCOME[res["outcome"]]
@@ -78,8 +81,9 @@ def test_huge_amplitude_overturns_at_once_without_impact(name, shape, a_ratio):
     else:
         t_up = ref[0].t
     assert ev[0].kind == "uplift" and ev[0].t == pytest.approx(t_up, abs=2e-8)
-    # the step follows the pulse's own time scale 1/(p sqrt(A/g)), not only 2 pi/p
-    dt = point_row(p, BASE)[PAR_DT]
+    # the step follows the pulse's own time scale 1/(p sqrt(A/g)) while it acts, not only
+    # 2 pi/p
+    dt = point_row(p, BASE)[PAR_DT_ON]
     assert dt <= 2 * math.pi / (BASE.steps_per_period * math.sqrt(abs(p.A) / G)) * (1 + 1e-12)
     assert OUTCOME[res["outcome"]] == "mode2"
     assert r.t_overturn == pytest.approx(res["t_overturn"], rel=1e-3)

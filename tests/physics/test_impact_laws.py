@@ -295,8 +295,12 @@ def test_energy_lost_at_each_impact_is_eq6_of_the_law(law):
     import rocksweep
     from rocksweep.physics.impact import energy_loss
 
+    # at `fine` (event_tol 1e-8): the located impact's overshoot of theta = 0, whose
+    # potential energy the kernel's loss includes, is then below the 1e-6 compared here
+    # (3e-5 at `default`, event_tol 1e-6)
     sim = rocksweep.simulate(ROOT / "configs" / "fig5.yaml",
-                             {"impact.lam": 0.4, "impact.law": law})
+                             {"impact.lam": 0.4, "impact.law": law,
+                              "numerics.accuracy": "fine"})
     losses = np.array(sim.summary["impact_losses_over_Eref"])
     assert losses.size == sim.summary["impacts"] > 0
     assert losses.sum() == pytest.approx(sim.summary["impact_loss_over_Eref"], rel=1e-12)

@@ -117,8 +117,8 @@ STRUCTURE_CASES = [
      "body.zta: unknown key for a flexible body (allowed: kind, wn_over_p, zeta, alpha_cg, "
      "alpha_A, mA_over_m, IA_ratio, mu)"),
     (GOOD + "numerics: {tol: 1}\n",
-     "numerics.tol: unknown key (allowed: accuracy, steps_per_period, event_tol, horizon, "
-     "rest_rate, max_events, root, rotation_step)"),
+     "numerics.tol: unknown key (allowed: accuracy, steps_per_period, pulse_steps, refine, "
+     "event_tol, horizon, rest_rate, max_events, root, rotation_step)"),
     (GOOD + "foo: 1\n",
      "foo: unknown key (allowed: name, body, impact, pulse, numerics, outputs, ground, "
      "refine, initial)"),
@@ -258,16 +258,28 @@ def test_scene_size_and_sweep_bytes():
 # -- cost: every accepted point runs in bounded time ----------------------------------
 
 def _expected_steps(w: float, A: float, wn: float = 2.43, zeta: float = 0.05,
-                    mu: float = 0.47, spp: int = 20, horizon: float = 200.0,
-                    max_events: int = 5000) -> float:
-    """PAR_MAXSTEPS as the kernel's docs define it: 20 x ceil(t_end/dt) + 200 x max_events,
-    t_end = 2 pi/w + horizon, dt = the shortest of the spring's, the pulse's, the rocking
-    (2 pi) and the amplitude's (2 pi/sqrt(|A| tan alpha_cg)) periods over spp."""
+                    mu: float = 0.47, spp: int = 5 * 8, ps: int = 12 * 8,
+                    horizon: float = 200.0, max_events: int = 5000) -> float:
+    """PAR_MAXSTEPS as the kernel's docs define it (issue 28): 20 x (ceil(t_pulse/dt_on) +
+    ceil(horizon/dt)) + 200 x max_events, t_pulse = 2 pi/w; dt = the shorter of the spring's
+    period over spp x max(1, (27.5/omega_rock)^(2/5)) and the rocking's (2 pi) over spp;
+    dt_on = dt, the pulse's period over max(ps, spp) and the amplitude's (2 pi/sqrt(|A| tan
+    alpha_cg)) over spp, the shortest. Default: `default`'s finest refinement (3 doublings
+    of 5 steps per period and 12 per pulse period), the scene's costliest run."""
     omega_rock = body_omega_rock(FlexibleBody(**{**TABLE3, "wn_over_p": wn, "zeta": zeta,
                                                  "mA_over_m": mu}))
-    rate = max(omega_rock, w, 1.0, math.sqrt(abs(A) * math.tan(0.15)))
-    dt = 2 * math.pi / rate / spp
-    return 20 * math.ceil((2 * math.pi / w + horizon) / dt) + 200 * max_events
+    n_spring = spp * max(1.0, (27.5 / omega_rock) ** 0.4)
+    dt = min(2 * math.pi / omega_rock / n_spring, 2 * math.pi / spp)
+    w_amp = math.sqrt(abs(A) * math.tan(0.15))
+    dt_on = min(dt, 2 * math.pi / w / max(ps, spp),
+                2 * math.pi / w_amp / spp if w_amp > 0 else math.inf)
+    t_pulse = 2 * math.pi / w
+    first = t_pulse / dt_on
+    first = math.ceil(first) if math.isfinite(first) else math.inf
+    return 20 * (first + math.ceil(horizon / dt)) + 200 * max_events
+
+
+REFINED = " when a close call is refined 3 times (numerics.refine = 3) ("
 
 
 COST_CASES = [  # (old, new, key, expected steps kwargs, direction of the bound)
@@ -289,8 +301,8 @@ def test_a_point_beyond_the_step_cap_is_refused_with_the_bound(old, new, key, kw
     steps = _expected_steps(**kw)
     assert steps > MAX_POINT_STEPS
     value = new.split(": ")[1]
-    lead = (f"{key.strip('|')} = {float(value)!r}: one point could need {steps:.2g} RK4 steps "
-            "at the single runs' accuracy (fine) (")
+    lead = (f"{key.strip('|')} = {float(value)!r}: one point could need {steps:.2g} RK4 steps"
+            + REFINED)
     assert msg.startswith(lead), msg
     assert ("more than the cap of 1e+08 a point (~17 s of one core); with the scene's other "
             f"values {key} must be {op} ") in msg
@@ -312,24 +324,28 @@ def test_numerics_that_would_hang_are_refused():
     assert refused(GOOD + "numerics: {steps_per_period: 1e23}\n") == (
         "numerics.steps_per_period = 1e+23: must be an integer in [4, 1e9]")
     msg = refused(GOOD + "numerics: {steps_per_period: 1000000}\n")
-    steps = _expected_steps(w=5.3, A=5.0, spp=1_000_000)  # both accuracies: same steps
+    steps = _expected_steps(w=5.3, A=5.0, spp=8_000_000, ps=96)
     assert msg.startswith(f"numerics.steps_per_period = 1000000: one point could need "
-                          f"{steps:.2g} RK4 steps (")
+                          f"{steps:.2g} RK4 steps" + REFINED)
     msg = refused(GOOD + "numerics: {horizon: 1.0e+300}\n")
     steps = _expected_steps(w=5.3, A=5.0, horizon=1e300)
     assert msg.startswith(f"numerics.horizon = 1e+300: one point could need {steps:.2g} RK4 "
-                          "steps at the single runs' accuracy (fine) (")
+                          "steps" + REFINED)
 
 
-def test_the_single_runs_accuracy_is_checked_too():
-    """simulate runs a scene's points at `fine` (4x the steps of `default`)."""
+def test_the_refinement_is_checked_too():
+    """The certification of close calls re-runs a point at up to 8x the steps (refine = 3):
+    a scene whose finest rerun would pass the step cap is refused, naming numerics.refine;
+    without certification it runs."""
     wn = 3000.0
-    assert _expected_steps(w=5.3, A=5.0, wn=wn, spp=5) < MAX_POINT_STEPS
-    assert _expected_steps(w=5.3, A=5.0, wn=wn, spp=20) > MAX_POINT_STEPS
+    assert _expected_steps(w=5.3, A=5.0, wn=wn, spp=5, ps=12) < MAX_POINT_STEPS
+    assert _expected_steps(w=5.3, A=5.0, wn=wn) > MAX_POINT_STEPS
     msg = refused(sub("wn_over_p: 2.43", f"wn_over_p: {wn}"))
-    assert msg.startswith("body.wn_over_p = 3000.0: one point could need 1.1e+08 RK4 steps at "
-                          "the single runs' accuracy (fine) (")
-    accepted(sub("wn_over_p: 2.43", "wn_over_p: 2000.0"))
+    steps = _expected_steps(w=5.3, A=5.0, wn=wn)
+    assert msg.startswith(f"body.wn_over_p = 3000.0: one point could need {steps:.2g} RK4 "
+                          "steps" + REFINED), msg
+    accepted(sub("wn_over_p: 2.43", f"wn_over_p: {wn}") + "numerics: {refine: 0}\n")
+    accepted(sub("wn_over_p: 2.43", "wn_over_p: 1000.0"))
 
 
 def test_shipped_scenes_stay_valid():

@@ -1,0 +1,86 @@
+"""A single run's time history as a Dataset over p*t and as CSV (``rocksweep simulate``,
+``rocksweep.simulate``): columns ``rocksweep.fields.HISTORY``."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+# `rocksweep simulate` overlays a few runs; larger grids are for sweeps.
+MAX_RUNS = 12
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+    from rocksweep.compute.single import Run
+    from rocksweep.scene.model import Scene
+
+def history_dataset(run: Run, title: str = "") -> xr.Dataset:
+    """A run's time history as an xarray Dataset over p_t (see ``Simulation``)."""
+    import xarray as xr
+
+    from rocksweep import fields
+
+    cols = run.history_columns()
+    spec = {c.name: c for c in fields.HISTORY}
+    t = cols.pop("p_t")
+    ds = xr.Dataset(
+        {k: ("p_t", v, {"units": spec[k].unit, "long_name": spec[k].meaning})
+         for k, v in cols.items()},
+        coords={"p_t": ("p_t", t, {"units": spec["p_t"].unit,
+                                   "long_name": spec["p_t"].meaning})})
+    s = run.summary()
+    ds.attrs = {"title": title, "outcome": s["outcome"], "accuracy": s["accuracy"],
+                "lam": run.point.lam, "shape": run.point.shape,
+                "w_over_p": run.point.w_over_p, "A_ratio": run.point.A_ratio}
+    return ds
+
+
+def swept_values(run: Run, swept: Sequence[str]) -> list:
+    """The run's value of each swept key, as plain Python (str for shape, else float)."""
+    p = run.point
+    out = []
+    for k in swept:
+        v = getattr(p, k) if hasattr(p, k) else getattr(p.body, k)
+        out.append(v if isinstance(v, str) else float(v))
+    return out
+
+
+def write_history_csv(runs: Sequence[Run], swept: Sequence[str], path: str | Path) -> None:
+    """The runs' time histories to one CSV file, atomically: columns run, the swept
+    keys, then ``rocksweep.fields.HISTORY`` (p_t, theta_over_alpha, u_over_ucr,
+    E_over_Eref, ...); plain numbers (``repr`` of Python floats: nan, inf as such).
+    Check the path first with ``rocksweep.outputs.check_output``."""
+    import csv
+
+    from rocksweep import fields
+    from rocksweep.outputs import atomic_path
+
+    with atomic_path(path) as tmp, tmp.open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["run", *swept, *(c.name for c in fields.HISTORY)])
+        for i, r in enumerate(runs):
+            fixed = swept_values(r, swept)
+            cols = list(r.history_columns().values())
+            for j in range(len(cols[0])):
+                w.writerow([i, *fixed, *(repr(float(c[j])) for c in cols)])
+
+
+def simulate_runs(scene: Scene, max_runs: int = MAX_RUNS) -> list[Run]:
+    """Each point of a small scene as a single run with history (``rocksweep simulate``
+    overlays them); a SceneError naming the longest swept key if there are more than
+    ``max_runs`` points."""
+    from itertools import product
+
+    from rocksweep.compute.single import simulate as run_point
+    from rocksweep.scene.model import SceneError
+
+    if scene.size > max_runs:
+        big = max(scene.swept, key=lambda a: len(a.values))
+        raise SceneError(f"{scene.size} points; simulate runs at most {max_runs} (use "
+                         f"`rocksweep sweep`, or pick a value with --set {big.key}=VALUE)")
+    names = [a.name for a in scene.axes]
+    return [run_point(scene.point(dict(zip(names, combo, strict=True))), scene.single_numerics,
+                      contact=scene.contact)
+            for combo in product(*(a.values for a in scene.axes))]

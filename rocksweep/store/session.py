@@ -1,0 +1,107 @@
+"""``sweep_file``: the one way into the sweep driver (``rocksweep.compute.driver``) for
+``rocksweep.run`` and ``rocksweep sweep``: every argument checked, the sink made (a result
+file, or one in memory), the driver handed it."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterable, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from rocksweep.compute.driver import WRITE_EVERY, SweepReport
+from rocksweep.errors import ApiError
+
+if TYPE_CHECKING:
+    from rocksweep.compute.adaptive import Options
+    from rocksweep.scene.model import Scene
+
+def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
+               jobs: int = 1, resume: bool = False, overwrite: bool = False,
+               backend: str = "threads", scheduler: str | None = None,
+               chunk_size: int | None = None, write_every: float = WRITE_EVERY,
+               progress: bool = False, log: Callable[[str], None] | None = None,
+               inputs: Iterable[str | Path] = (), adaptive: Options | None = None,
+               validate: bool = False, connect_timeout: float = 20.0,
+               cli: bool = False) -> SweepReport:
+    """Sweep ``scene`` into the result file ``path`` (``rocksweep sweep``).
+
+    Makes the file (refusing an existing one unless ``overwrite``), or with ``resume``
+    reopens an existing file of the same scene and computes only its missing points.
+    Finished chunks are written in batches, at most every ``write_every`` seconds; on
+    Ctrl-C the pending chunks are written and ``SweepInterrupted`` (a KeyboardInterrupt)
+    is raised; on any other error they are written before the error propagates.
+
+    jobs: local worker threads (-1: one per core); backend "threads" or "dask" (with
+    ``scheduler``, an address); chunk_size: points per chunk (default about 32 chunks per
+    worker); progress: a progress bar on stderr; log: receives the header and kernel
+    lines; inputs: the command's input files, never written over; overrides: recorded in
+    the file; adaptive: compute only near the class boundaries
+    (``rocksweep.compute.adaptive``, see ``compute.driver.adaptive_loop``; the file
+    records the settings, and a resume must give the same); validate: with adaptive,
+    also compute the filled points of a coarse uniform lattice and report those whose
+    class differs from the fill (``report.validation``; the file is not changed);
+    connect_timeout: seconds to wait for the dask scheduler to answer; cli: name options
+    as the command line spells them. Every argument is checked
+    (``rocksweep.compute.arguments``) before the output is touched. Returns a
+    ``SweepReport``.
+    """
+    from rocksweep.compute.arguments import check_sweep_arguments
+    from rocksweep.outputs import OutputError, check_output, check_path_text, shown
+
+    # every argument before anything touches the output (one place: the CLI's too)
+    n_workers = check_sweep_arguments(
+        jobs=jobs, resume=resume, overwrite=overwrite, validate=validate, adaptive=adaptive,
+        backend=backend, scheduler=scheduler, chunk_size=chunk_size, write_every=write_every,
+        connect_timeout=connect_timeout, cli=cli)
+    if path is not None:  # None: in memory (rocksweep.run without output=)
+        check_path_text(path)
+    if backend == "dask":
+        from rocksweep.compute import sweep as sw
+
+        sw.check_scheduler(scheduler, connect_timeout)  # before any file is made
+    say = log or (lambda _line: None)
+    settings = None
+    if adaptive is not None:
+        from rocksweep.compute.grid import Grid
+
+        settings = adaptive.resolved(Grid(scene))  # bad axes or settings: before any file
+
+    from rocksweep.compute.driver import drive
+    from rocksweep.store.writer import SweepFile
+
+    t0 = time.perf_counter()
+    where = (f"{n_workers} worker{'s' * (n_workers > 1)}" if backend == "threads"
+             else f"dask cluster {scheduler}")
+    how = f"threads x {n_workers}" if backend == "threads" else f"dask {scheduler}"
+    if path is None:  # in memory: nothing touches a disk (rocksweep.run without output)
+        if resume:
+            raise ApiError("resume=True needs output= (the file to finish)")
+        sf = SweepFile.in_memory(scene, overrides, backend=how, adaptive=settings)
+        return drive(sf, None, report_of := SweepReport(Path("memory"), sf.grid.size, 0, 0,
+                                                          0.0, 0.0, 0.0),
+                      t0, adaptive, validate, jobs=jobs, backend=backend,
+                      scheduler=scheduler, chunk_size=chunk_size, where=where,
+                      write_every=write_every, progress=progress, say=say) or report_of
+    path = Path(path)
+    inputs = [*inputs, *scene.inputs]  # the scene's records and listings: never written over
+    try:
+        path.stat()
+    except FileNotFoundError:
+        pass
+    except OSError:  # a name too long, a path through a file...: one line, not a traceback
+        check_output(path, overwrite=overwrite, inputs=inputs)
+    if resume and path.exists():
+        check_output(path, overwrite=True, inputs=inputs)
+        sf = SweepFile.resume(path, scene, overrides, backend=how, adaptive=settings)
+    else:
+        if path.is_file() and not overwrite:
+            raise OutputError(f"{shown(path)}: already exists; use --resume to finish it or "
+                              "--overwrite to replace it")
+        check_output(path, overwrite=overwrite, inputs=inputs)
+        sf = SweepFile.create(path, scene, overrides, overwrite=overwrite, backend=how,
+                              adaptive=settings, log=say)
+    report = SweepReport(path, sf.grid.size, 0, 0, 0.0, 0.0, 0.0)
+    return drive(sf, path, report, t0, adaptive, validate, jobs=jobs, backend=backend,
+                  scheduler=scheduler, chunk_size=chunk_size, where=where,
+                  write_every=write_every, progress=progress, say=say)
