@@ -350,7 +350,7 @@ def _(d):
     r = cli(d, ["sweep", "suite.yaml", "-o", "s.h5", "-q"])
     if r.returncode:
         return r
-    return cli(d, ["fragility", "s.h5", "--rtol", "0.2"])
+    return cli(d, ["fragility", "s.h5", "--rtol", "0.1"])
 
 
 @case("suite result after the record folder moved: spectra and IDA", "ok")
@@ -361,7 +361,7 @@ def _(d):
     shutil.move(d / "r", d / "moved")
     return py(d, """
         ds = rocksweep.open('s.h5')
-        rocksweep.ida(ds, rtol=0.2)
+        rocksweep.ida(ds, rtol=0.1)
         print('OK')""")
 
 
@@ -371,7 +371,7 @@ def _(d):
     if r.returncode:
         return r
     shutil.move(d / "rec.AT2", d / "gone.AT2")
-    return cli(d, ["spectrum", "o.h5", "--rtol", "0.2"])
+    return cli(d, ["spectrum", "o.h5", "--rtol", "0.1"])
 
 
 @case("in-memory result of a scene named README.md: spectra() opens no file", "ok")
@@ -382,7 +382,7 @@ def _(d):
         sc = yaml.safe_load(open('one.yaml'))
         sc['name'] = 'README.md'
         ds = rocksweep.run(sc)
-        rocksweep.spectra(ds, rtol=0.2)
+        rocksweep.spectra(ds, rtol=0.1)
         print('OK')""")
 
 
