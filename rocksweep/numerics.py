@@ -1,7 +1,7 @@
 """Accuracy knobs of the kernel, the presets, and the step size rule.
 
 Every knob has a measured price: ``rocksweep accuracy SCENE.yaml`` measures time per point
-and error against the reference path for each setting; the README's table gives the
+and error against the reference path for each setting; docs/accuracy.md gives the
 presets' figures on the shipped paper scenes.
 """
 
@@ -30,7 +30,7 @@ ROOTS = ("bisection", "illinois", "hermite")
 # 30 on a 1000-value grid) like `fine` on every curve's first overturning value and mode.
 # `draft` is the smallest step allowed (4) with the pulse at 10 steps and no
 # certification; `fine` 20 steps per period, the pulse at 40, event_tol 1e-8; the agreement
-# of each with the reference and its price: README, "Accuracy and its price"
+# of each with the reference and its price: docs/accuracy.md
 # (`rocksweep accuracy FIG.yaml --points 1000 --ladder roots`, `scripts/accuracy_tables.py`).
 # event_tol 1e-5 and above keep chattering above the rest rate (runs hit the event cap).
 #
@@ -54,7 +54,7 @@ PRESETS: dict[str, tuple[int, float]] = {
 # spring, pulse and rocking time scales above set the step in the paper's region; far
 # outside it (a pulse 20x the uplift threshold, a fall to overturning, a rigid body) the body
 # turns through alpha_cg or more in one step, and the overturning time and max|theta| lose
-# their digits (issue 15; measured with scripts/wide_space.py, see the README).
+# their digits (issue 15; measured with scripts/wide_space.py, see docs/accuracy.md).
 # A quarter of alpha_cg costs the four figures 3.5% more RK4 evaluations at `default` (0.1:
 # 15%) and halves the overturning-time tail of the wide-space sample; `accurate` and `fine`
 # take 0.1 (0.05 buys little more).
