@@ -226,6 +226,17 @@ def test_sigkill_and_resume_equals_uninterrupted_run(cli, tmp_path):
     assert res.exit_code == 0 and "computed 0 points" in res.output, res.output
 
 
+# a file with results is never to be written over as the first remedy (issue 32)
+def keep(path) -> str:
+    """The remedy said for a file of ``path``'s points that another scene cannot resume."""
+    from rocksweep.store.reader import read_result
+
+    n = int((read_result(path, ["outcome"]).arrays["outcome"] != -1).sum())
+    assert n > 0
+    return ("resume with the scene, --set values and options it was made with, or sweep "
+            f"this scene to another -o; --overwrite would discard the {n} points it holds)")
+
+
 def test_resume_with_other_settings_is_refused(fig3_files, cli, tmp_path):
     scene, full, adapt, _ = fig3_files
     out = tmp_path / "a.h5"
@@ -234,20 +245,18 @@ def test_resume_with_other_settings_is_refused(fig3_files, cli, tmp_path):
                             "--coarse", "1", "--audit", "0.05"])
     assert one_line_error(res) == (
         f"Error: {out}: cannot resume, the scene differs from the file's: adaptive.coarse: "
-        "file 2, this run 1; adaptive.audit: file 0.02, this run 0.05 (use --overwrite to "
-        "start again)")
+        "file 2, this run 1; adaptive.audit: file 0.02, this run 0.05 (" + keep(out))
     res = cli.invoke(main, ["sweep", str(scene), "-o", str(out), "--resume"])
     assert one_line_error(res) == (
         f"Error: {out}: cannot resume, the scene differs from the file's: adaptive: file "
         "adaptive (--adaptive --axes w_over_p,A_ratio --coarse 2 --audit 0.02 --margin 1 "
-        "--final-margin 0 --seed 0 --threshold 0.002), this run not (use --overwrite to "
-        "start again)")
+        "--final-margin 0 --seed 0 --threshold 0.002), this run not (" + keep(out))
     other = tmp_path / "full.h5"
     other.write_bytes(full.read_bytes())
     res = cli.invoke(main, ["sweep", str(scene), "-o", str(other), "--resume", "--adaptive"])
     assert one_line_error(res) == (
         f"Error: {other}: cannot resume, the scene differs from the file's: adaptive: file "
-        "of every point, this run adaptive (use --overwrite to start again)")
+        "of every point, this run adaptive (" + keep(other))
 
 
 @pytest.mark.parametrize("args, message", [
