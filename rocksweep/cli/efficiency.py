@@ -40,7 +40,7 @@ def efficiency(result_path: Path, state: str, out_path: Path | None, fig_path: P
 
     import rocksweep
     from rocksweep.figures.common import FORMATS, save_figure
-    from rocksweep.outputs import check_distinct, check_output, write_atomic
+    from rocksweep.outputs import check_distinct, check_output
     from rocksweep.store.reader import result_inputs
 
     inputs = result_inputs(result_path)  # the result and its records: never written over
@@ -75,13 +75,9 @@ def efficiency(result_path: Path, state: str, out_path: Path | None, fig_path: P
     say = click.echo if not as_json else (lambda m: click.echo(m, err=True))
     fig = rocksweep.plot(eff, width=width) if fig_path is not None else None
     if out_path is not None:
-        if out_path.suffix.lower() == ".csv":
-            text = frame.to_csv(index=False)
-            write_atomic(out_path, lambda tmp: tmp.write_text(text))
-        else:
-            from rocksweep.cli.fragility import _to_netcdf
+        from rocksweep.cli.fragility import write_table
 
-            write_atomic(out_path, lambda tmp: _to_netcdf(eff, tmp))
+        write_table(out_path, frame.to_csv(index=False), eff)
         say(f"wrote {out_path}")
     if fig is not None:
         save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=inputs)

@@ -102,7 +102,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
 
     import rocksweep
     from rocksweep.figures.common import FORMATS, save_figure
-    from rocksweep.outputs import check_output, write_atomic
+    from rocksweep.outputs import check_output
 
     states = [s.strip() for s in state.split(",") if s.strip()]
     if not states:
@@ -152,11 +152,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
             _print_ida(refined)
     say = click.echo if not as_json else (lambda m: click.echo(m, err=True))
     if out_path is not None:
-        if out_path.suffix.lower() == ".csv":
-            text = csv_text(rows)
-            write_atomic(out_path, lambda tmp: tmp.write_text(text))
-        else:
-            write_atomic(out_path, lambda tmp: _to_netcdf(frag, tmp))
+        write_table(out_path, csv_text(rows), frag)
         say(f"wrote {out_path} ({len(rows)} curve{'s' * (len(rows) != 1)})")
     if fig_path is not None:
         from rocksweep.figures.fragility import fragility_figure
@@ -203,6 +199,17 @@ def _to_netcdf(frag, path: Path) -> None:
         if out[name].dtype.kind in ("U", "O"):
             out[name] = out[name].astype(str)
     out.to_netcdf(path, engine="h5netcdf")
+
+
+def write_table(out_path: Path, csv: str | None, ds) -> None:
+    """An analysis's ``-o``: the table as CSV text (``csv``) for a .csv path, else the
+    Dataset ``ds`` as netCDF-4 (.h5, .hdf5, .nc); written under a temporary name."""
+    from rocksweep.outputs import write_atomic
+
+    if out_path.suffix.lower() == ".csv":
+        write_atomic(out_path, lambda tmp: tmp.write_text(csv))
+    else:
+        write_atomic(out_path, lambda tmp: _to_netcdf(ds, tmp))
 
 
 def _print_table(frag, rows: list[dict]) -> None:

@@ -81,7 +81,7 @@ def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, sta
     from rocksweep.analysis.kinds import dataset_kind
     from rocksweep.api import open_any
     from rocksweep.figures.common import FORMATS, save_figure
-    from rocksweep.outputs import check_distinct, check_output, write_atomic
+    from rocksweep.outputs import check_distinct, check_output
     from rocksweep.store.reader import result_inputs
 
     # the fragility or sweep file (and a sweep's records), the hazard curve: never written
@@ -128,15 +128,9 @@ def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, sta
     if fig_path is not None:  # drawn before anything is written
         fig = rocksweep.plot(rk, width=width)
     if out_path is not None:
-        if out_path.suffix.lower() == ".csv":
-            from rocksweep.cli.fragility import csv_text
+        from rocksweep.cli.fragility import csv_text, write_table
 
-            text = csv_text(rows)
-            write_atomic(out_path, lambda tmp: tmp.write_text(text))
-        else:
-            from rocksweep.cli.fragility import _to_netcdf
-
-            write_atomic(out_path, lambda tmp: _to_netcdf(rk, tmp))
+        write_table(out_path, csv_text(rows), rk)
         say(f"wrote {out_path}")
     if fig is not None:
         save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=inputs)
