@@ -854,3 +854,16 @@ def lines_frame(bounds: Sequence[PanelBoundaries]):
             for b in bounds for i, line in enumerate(b.lines)
             for j, (x, y) in enumerate(line.xy)]
     return pd.DataFrame(rows)
+
+
+def boundaries_dataset(ds: Any, rtol: float = 1e-3, mode: int | None = None,
+                       search: bool = True) -> Any:
+    """``rocksweep.boundaries`` (its arguments checked there): the A_min curves of a
+    complete result (``result_curves``) as a Dataset (``curves_dataset``)."""
+    from rocksweep.store.reader import as_result
+
+    result = as_result(ds, list(RESPONSE))
+    curves, _ = result_curves(result, rtol, mode, search=search)
+    return curves_dataset(curves, {"title": result.name, "rtol": rtol,
+                                   "search": int(search),
+                                   "mode": "any" if mode is None else f"mode{mode}"})
