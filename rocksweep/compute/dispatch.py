@@ -10,6 +10,7 @@ samples riding on the rows, and the close calls certified (``compute.certify``).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -50,21 +51,21 @@ def run_variant(rows: np.ndarray, kind: int, level: int, ground: bool, refine: i
     if histories is not None:
         fn = kernel.point_kernel(kind, ground)
 
-        def call(sub: np.ndarray, res: np.ndarray, idx: np.ndarray) -> None:
-            for j, i in enumerate(idx.tolist()):
+        def call(sub: np.ndarray, res: np.ndarray, idx: Sequence[int]) -> None:
+            for j, i in enumerate(idx):
                 hist = np.empty((history_capacity(sub[j]), L.N_HIST))
                 fn(sub[j], res[j], hist)
-                histories[i] = hist
+                histories[int(i)] = hist
     else:
         fn = kernel.chunk_kernel(kind, level, ground)
 
-        def call(sub: np.ndarray, res: np.ndarray, idx: np.ndarray) -> None:
+        def call(sub: np.ndarray, res: np.ndarray, idx: Sequence[int]) -> None:
             if record is None:
                 fn(sub, res)
             else:
                 _run_record(fn, sub, np.ones(sub.shape[0], bool), res, record)
 
-    call(rows, outs, np.arange(n))
+    call(rows, outs, range(n))  # idx: the rows' places in ``histories``
     if refine > 0:
         def rerun(sub: np.ndarray, idx: np.ndarray) -> np.ndarray:
             res = np.empty((sub.shape[0], L.N_OUT))
