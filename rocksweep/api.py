@@ -13,7 +13,6 @@ still importable from here (``api.load``, ``api.sweep_file``, ...: PEP 562).
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -64,10 +63,6 @@ API_MAX_RUNS = 100
 # ---------------------------------------------------------------------------------------
 # rocksweep.run and rocksweep.open
 # ---------------------------------------------------------------------------------------
-
-def _stderr(line: str) -> None:
-    print(line, file=sys.stderr, flush=True)
-
 
 @speaks_python
 def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
@@ -122,35 +117,16 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
         check_path_text(output, "output")
     from rocksweep.compute.adaptive import adaptive_options
     from rocksweep.scene.inputs import load, override_strings
-    from rocksweep.store.session import sweep_file
+    from rocksweep.store.session import run_session
 
     sc, source = load(scene, overrides)
     opts = adaptive_options(adaptive, base=sc.refine, coarse=coarse, audit=audit, axes=axes,
                             margin=margin, final_margin=final_margin, seed=seed,
                             threshold=threshold)
-    ov = override_strings(overrides)
-    log = _stderr if progress else None
-    where = {"backend": "threads"}
-    if client is not None:
-        address = getattr(getattr(client, "scheduler", None), "address", None)
-        if type(client).__name__ == "Client" and getattr(client, "status", None) in (
-                "closed", "closing"):
-            raise ApiError(f"client = {client!r}: this dask Client is closed; make a new one "
-                           "(Client(cluster) or Client('tcp://host:8786')) and pass it")
-        if not isinstance(address, str):
-            raise TypeError(f"client = {client!r}: must be a dask.distributed.Client")
-        where = {"backend": "dask", "scheduler": address}
-    if output is None:  # in memory: nothing touches a disk
-        import io
-
-        report = sweep_file(sc, None, overrides=ov, jobs=jobs, resume=resume,
-                            progress=progress, log=log, adaptive=opts, validate=validate,
-                            **where)
-        return _loaded(io.BytesIO(report.image))
-    sweep_file(sc, output, overrides=ov, jobs=jobs, resume=resume, overwrite=overwrite,
-               progress=progress, log=log, inputs=[source] if source else (),
-               adaptive=opts, validate=validate, **where)
-    return open(output)
+    out = run_session(sc, output, source=source, overrides=override_strings(overrides),
+                      jobs=jobs, resume=resume, overwrite=overwrite, progress=progress,
+                      client=client, adaptive=opts, validate=validate)
+    return _loaded(out) if output is None else open(out)
 
 
 @speaks_python
@@ -241,49 +217,10 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     plot --compare``). A result with per-point error estimates rings the points whose
     outcome changes at half the step.
     """
-    import matplotlib
+    from rocksweep.figures.dispatch import plot_any
 
-    from rocksweep.analysis.kinds import dataset_kind
-    from rocksweep.figures.common import fit_width, width_style
-    from rocksweep.figures.diagrams import friction_map, sweep_figure
-    from rocksweep.store.reader import as_result
-
-    kind = dataset_kind(ds)
-    if kind == "sweep" and "record" in ds["outcome"].dims:
-        # a record suite has no stability diagram: its overturning fragility (no bootstrap;
-        # rocksweep.fragility for other states and bands)
-        from rocksweep.analysis.fragility import fragility as fit
-
-        given = [n for n, v in zip((*_names[:2], "curves", "mu", _names[2],
-                                    "show_computed"),
-                                   (x, y, curves, mu, compare, show_computed), strict=True)
-                 if v not in (None, False)]
-        if given:
-            raise ApiError(f"{given[0]}: a record-suite sweep is drawn as its fragility "
-                           "curves; the diagram's options do not apply (rocksweep.fragility "
-                           "for states and bands)")
-
-        ds, kind = fit(ds, state="overturn", bootstrap=0), "fragility"
-    if kind not in (None, "sweep"):  # an analysis's Dataset: the figure of its kind
-        from rocksweep.figures.dispatch import plot_analysis
-
-        with matplotlib.rc_context(width_style(width)):
-            fig = plot_analysis(ds, ax=ax, width=width)
-        if width is not None and ax is None:
-            fit_width(fig, width)
-        return fig
-    result = as_result(ds)
-    style = width_style(width)
-    with matplotlib.rc_context(style):
-        if mu:
-            fig = friction_map(result, x, y, option_names=_names[:2])
-        else:
-            fig = sweep_figure(result, x, y, axes=ax, option_names=_names[:2], curves=curves,
-                               show_computed=show_computed, compare=compare,
-                               compare_option=_names[2])
-    if style and ax is None:  # the preset's width, the layout's aspect, what fits in it
-        fit_width(fig, width)
-    return fig
+    return plot_any(ds, x, y, ax=ax, curves=curves, show_computed=show_computed, mu=mu,
+                    width=width, compare=compare, names=_names)
 
 
 @speaks_python
@@ -305,18 +242,13 @@ def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None,
     boundary polylines: ``boundary_lines(ds)``.
     """
     from rocksweep.analysis import boundaries as bd
-    from rocksweep.store.reader import as_result
 
     rtol = check_rtol(rtol)
     if mode not in (None, 1, 2):
         raise ApiError(f"mode = {mode!r}: must be None, 1 or 2")
     if not isinstance(search, bool):
         raise ApiError(f"search = {search!r}: must be True or False")
-    result = as_result(ds, list(bd.RESPONSE))
-    curves, _ = bd.result_curves(result, rtol, mode, search=search)
-    return bd.curves_dataset(curves, {"title": result.name, "rtol": rtol,
-                                      "search": int(search),
-                                      "mode": "any" if mode is None else f"mode{mode}"})
+    return bd.boundaries_dataset(ds, rtol, mode, search)
 
 
 @speaks_python
@@ -354,18 +286,9 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
     over the other swept keys and ``record`` (``rocksweep.analysis.ida.ida``), with the
     stripes' ``theta_max_over_alpha`` of the points that did not overturn (the IDA
     curves ``rocksweep.plot`` draws)."""
-    from rocksweep.analysis.ida import ida as run_ida
+    from rocksweep.analysis.ida import ida_dataset
 
-    out = run_ida(ds, rtol)
-    out.attrs["rocksweep_kind"] = "ida"  # rocksweep.plot's dispatch (analysis.kinds)
-    im = out.attrs.get("im")
-    if hasattr(ds, "data_vars") and "theta_max_over_alpha" in ds.data_vars and im in ds.dims:
-        # the IDA curves on the stripes (max|theta|/alpha against the IM, per record, NaN
-        # where a point overturned): what the figure draws
-        theta = ds["theta_max_over_alpha"].where(ds["outcome"] == 0)
-        out["theta_max_over_alpha"] = theta.drop_vars(
-            [c for c in theta.coords if c not in theta.dims])
-    return out
+    return ida_dataset(ds, rtol)
 
 
 @speaks_python
@@ -512,27 +435,18 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     one ``Simulation`` per combination, in grid order (at most ``API_MAX_RUNS``; sweeps
     are for ``run``).
     """
-    from rocksweep.compute.single import simulate as run_point
     from rocksweep.scene.inputs import load, override_strings
-    from rocksweep.store.history import history_dataset, simulate_runs, swept_values
+    from rocksweep.store.history import titled_runs
 
-    ov = [*override_strings(overrides), *override_strings(keys)]
-    sc, _ = load(scene, ov)
-    if sc.size == 1:
-        r = run_point(sc.single_point(), sc.single_numerics, contact=sc.contact)
-        return Simulation(r.summary(), history_dataset(r, sc.name), r, sc.name)
+    sc, _ = load(scene, [*override_strings(overrides), *override_strings(keys)])
     if sc.size > API_MAX_RUNS:
         big = max(sc.swept, key=lambda a: len(a.values))
         raise ApiError(f"the scene has {sc.size} points ({big.key} has {len(big.values)} "
                        f"values): simulate runs at most {API_MAX_RUNS}; pass "
                        f"overrides={{{big.key!r}: ...}}, or use rocksweep.run for a grid")
-    swept = [a.name for a in sc.swept]
-    out = []
-    for r in simulate_runs(sc, API_MAX_RUNS):
-        title = ", ".join(f"{k} = {v}" for k, v in zip(swept, swept_values(r, swept),
-                                                        strict=True))
-        out.append(Simulation(r.summary(), history_dataset(r, title), r, title))
-    return out
+    out = [Simulation(r.summary(), hist, r, title)
+           for r, hist, title in titled_runs(sc, API_MAX_RUNS)]
+    return out[0] if sc.size == 1 else out
 
 
 # ---------------------------------------------------------------------------------------
@@ -556,8 +470,7 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     error of the half-cycle peaks, theta/alpha_ref), and the measured and fitted
     histories over p_t with the fitted impacts (``rocksweep.analysis.calibrate``).
     """
-    from rocksweep.analysis.calibrate import CalibrationError, Problem, calibrate_problem
-    from rocksweep.physics.measured import read_measured
+    from rocksweep.analysis.calibrate import CalibrationError, calibrate_scene
     from rocksweep.scene.inputs import load
 
     keys = [fit] if isinstance(fit, str) else list(fit)
@@ -568,24 +481,9 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     if not (isinstance(ci, float | int) and 0.5 <= ci < 1):
         raise CalibrationError(f"ci = {ci!r}: must be in [0.5, 1)")
     sc, _ = load(scene, overrides)
-    p_body = _body_p(sc) if p is None else float(p)
-    values = {a.name: a.values[0] for a in sc.axes}
-    body = sc.point(values).body
-    m = read_measured(measured, p=p_body, alpha_ref=body.alpha_ref, u_cr=body.u_cr or None)
-    out = calibrate_problem(Problem(sc, m, keys, bounds), float(ci))
+    out = calibrate_scene(sc, measured, keys, bounds, float(ci), p)
     _register()  # out.rocksweep.as_overrides()
     return out
-
-
-def _body_p(scene: Any) -> float | None:
-    """The body's p [rad/s] a scene knows (a physical body's, a record scene's ground.p),
-    else None."""
-    if scene.physical is not None:
-        return scene.physical["p"]
-    names = {a.name: a for a in scene.axes}
-    if "p" in names and len(names["p"].values) == 1:
-        return float(names["p"].values[0])
-    return None
 
 
 def calibrated_overrides(fit: xr.Dataset, which: str = "all") -> dict[str, Any]:

@@ -42,8 +42,8 @@ from pathlib import Path
 import numpy as np
 
 from rocksweep import fields
-from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.kernel import warm_up
 from rocksweep.numerics import (
     PRESET_PULSE,
     PRESET_REFINE,
@@ -309,7 +309,7 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
     kernel); the sample is also timed as one call per kernel kind. Both are the best of
     ``repeat`` rounds (the machine's noise only ever adds time). Compilation is excluded.
     """
-    from rocksweep.compute.certify import run_certified
+    from rocksweep.compute.dispatch import run_variant
     from rocksweep.compute.grid import Grid
     from rocksweep.physics.points import with_record
 
@@ -322,30 +322,28 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
     kinds = np.unique(cr.kinds)
     for kind in kinds:
         warm_up(int(kind), L.LEVEL_OUTCOME, ground)
-    fns = [chunk_kernel(int(k), L.LEVEL_OUTCOME, ground) for k in cr.kinds]
     per_point = np.full(n, np.inf)
     batch = math.inf
     part = np.empty_like(outs)
-    groups = [(chunk_kernel(int(k), L.LEVEL_OUTCOME, ground),
-               np.ascontiguousarray(rows_all[cr.kinds == k])) for k in kinds]
+    groups = [(int(k), np.ascontiguousarray(rows_all[cr.kinds == k])) for k in kinds]
     clock = time.perf_counter
     refine = numerics.refine
 
-    def certified(fn, rows: np.ndarray, out: np.ndarray) -> None:
-        # the close calls re-run finer, as a sweep does (``compute.certify``)
-        run_certified(fn, rows, out, refine)
+    def certified(kind: int, rows: np.ndarray, out: np.ndarray) -> None:
+        # the one dispatch; the close calls re-run finer, as a sweep does
+        run_variant(rows, kind, L.LEVEL_OUTCOME, ground, refine, out=out)
 
     for _ in range(max(1, repeat)):
         for i in range(n):
             row, out = rows_all[i:i + 1], outs[i:i + 1]
             t0 = clock()
-            certified(fns[i], row, out)
+            certified(int(cr.kinds[i]), row, out)
             dt = clock() - t0
             if dt < per_point[i]:
                 per_point[i] = dt
         t0 = clock()
-        for fn, rows in groups:
-            certified(fn, rows, part[:len(rows)])
+        for kind, rows in groups:
+            certified(kind, rows, part[:len(rows)])
         batch = min(batch, clock() - t0)
     return outs, per_point, batch
 

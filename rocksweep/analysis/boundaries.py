@@ -33,11 +33,11 @@ import numpy as np
 
 from rocksweep.analysis.tolerance import DEFAULT_RTOL, MAX_RTOL, check_rtol
 from rocksweep.compute.adaptive import DIAGRAM_AXES, AdaptiveError, make_plan
-from rocksweep.compute.certify import run_certified
+from rocksweep.compute.dispatch import run_variant
 from rocksweep.compute.grid import Grid
 from rocksweep.errors import BoundaryError  # noqa: F401 (re-exported)
-from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.kernel import warm_up
 from rocksweep.numerics import MAX_POINT_STEPS, Numerics
 from rocksweep.outcomes import outcome_word
 from rocksweep.physics.points import (
@@ -304,7 +304,7 @@ Evaluator = Callable[[list[Point]], np.ndarray]
 def kernel_rows(scene: Scene, points: list[Point]) -> np.ndarray:
     """The kernel's result rows float64[n, N_OUT] of arbitrary points, one run each
     (outcome-only kernel, the scene's sweep numerics, close calls certified as the grid's
-    were: ``compute.certify.run_certified``), for every
+    were: ``compute.dispatch.run_variant``), for every
     ground motion: sine and cosine pulses on the pulse variants, Ricker and MP pulses and
     records on the ground variants (``point.ground``)."""
     outs = np.empty((len(points), L.N_OUT))
@@ -319,11 +319,8 @@ def kernel_rows(scene: Scene, points: list[Point]) -> np.ndarray:
     for (kind, ground, *_), idx in groups.items():
         warm_up(kind, L.LEVEL_OUTCOME, ground)
         rows = _rows([points[i] for i in idx], scene.numerics)
-        part = np.empty((len(idx), L.N_OUT))
         # the close calls re-run finer, as the sweep's did (``compute.certify``)
-        run_certified(chunk_kernel(kind, L.LEVEL_OUTCOME, ground), rows, part,
-                      scene.numerics.refine)
-        outs[idx] = part
+        outs[idx] = run_variant(rows, kind, L.LEVEL_OUTCOME, ground, scene.numerics.refine)
     return outs
 
 
@@ -857,3 +854,16 @@ def lines_frame(bounds: Sequence[PanelBoundaries]):
             for b in bounds for i, line in enumerate(b.lines)
             for j, (x, y) in enumerate(line.xy)]
     return pd.DataFrame(rows)
+
+
+def boundaries_dataset(ds: Any, rtol: float = 1e-3, mode: int | None = None,
+                       search: bool = True) -> Any:
+    """``rocksweep.boundaries`` (its arguments checked there): the A_min curves of a
+    complete result (``result_curves``) as a Dataset (``curves_dataset``)."""
+    from rocksweep.store.reader import as_result
+
+    result = as_result(ds, list(RESPONSE))
+    curves, _ = result_curves(result, rtol, mode, search=search)
+    return curves_dataset(curves, {"title": result.name, "rtol": rtol,
+                                   "search": int(search),
+                                   "mode": "any" if mode is None else f"mode{mode}"})

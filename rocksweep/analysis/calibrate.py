@@ -68,7 +68,7 @@ from rocksweep.errors import CalibrationError, RocksweepError  # noqa: F401 (Cal
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import point_kernel, warm_up
 from rocksweep.numerics import Numerics, step_budget
-from rocksweep.physics.measured import Measured, noise_level
+from rocksweep.physics.measured import Measured, noise_level, read_measured
 from rocksweep.physics.model import BodyError
 from rocksweep.physics.points import INITIAL, kernel_kind, point_row
 from rocksweep.schema import KEYS, fmt
@@ -774,6 +774,30 @@ def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
     }
     return ds
 
+
+
+def calibrate_scene(scene: Any, measured: Any, keys: Sequence[str],
+                    bounds: Mapping[str, Sequence[float]] | None = None, ci: float = 0.95,
+                    p: float | None = None) -> Any:
+    """``rocksweep.calibrate`` on a loaded scene: the measured history read
+    (``physics.measured.read_measured``, in the scene's body's alpha_ref and u_cr; p [rad/s]
+    given, else the scene's ``_body_p``) and ``keys`` fitted (``calibrate_problem``)."""
+    p_body = _body_p(scene) if p is None else float(p)
+    values = {a.name: a.values[0] for a in scene.axes}
+    body = scene.point(values).body
+    m = read_measured(measured, p=p_body, alpha_ref=body.alpha_ref, u_cr=body.u_cr or None)
+    return calibrate_problem(Problem(scene, m, keys, bounds), ci)
+
+
+def _body_p(scene: Any) -> float | None:
+    """The body's p [rad/s] a scene knows (a physical body's, a record scene's ground.p),
+    else None."""
+    if scene.physical is not None:
+        return scene.physical["p"]
+    names = {a.name: a for a in scene.axes}
+    if "p" in names and len(names["p"].values) == 1:
+        return float(names["p"].values[0])
+    return None
 
 def calibrated_overrides(fit: Any, which: str = "all") -> dict[str, Any]:
     """Overrides that sweep a scene at a calibration's values: ``which`` "estimate", "lo"

@@ -168,3 +168,17 @@ def ida(ds: Any, rtol: float = 1e-2) -> Any:
 
 def _plain(values: dict) -> dict:
     return {k: (v.item() if hasattr(v, "item") else v) for k, v in values.items()}
+
+
+def ida_dataset(ds: Any, rtol: float = 1e-2) -> Any:
+    """``rocksweep.ida``: ``ida`` with the IDA curves on the stripes
+    (``theta_max_over_alpha`` against the IM, per record, NaN where a point overturned:
+    what the figure draws) and its kind for ``rocksweep.plot`` (``analysis.kinds``)."""
+    out = ida(ds, rtol)
+    out.attrs["rocksweep_kind"] = "ida"
+    im = out.attrs.get("im")
+    if hasattr(ds, "data_vars") and "theta_max_over_alpha" in ds.data_vars and im in ds.dims:
+        theta = ds["theta_max_over_alpha"].where(ds["outcome"] == 0)
+        out["theta_max_over_alpha"] = theta.drop_vars(
+            [c for c in theta.coords if c not in theta.dims])
+    return out

@@ -15,9 +15,11 @@ point did (``scripts/bench_certify.py``).
 
 Every refined point has STATUS_REFINED in its status; one whose outcome still changed at
 the last refinement also STATUS_UNCERTIFIED (flagged: not a reliable classification).
-Its steps and event_steps count every run it took. The same rule runs in sweeps
-(``compute.sweep.run_rows``), adaptive sweeps (through the sweep's chunks), single runs
-(``compute.single.simulate``) and the accuracy study (``analysis.accuracy.run_kernel``).
+Its steps and event_steps count every run it took. The same rule runs wherever rows meet
+the kernel, through the one dispatch (``compute.dispatch.run_variant``): sweeps
+(``compute.sweep.run_rows``), adaptive sweeps (through the sweep's chunks), the A_min
+searches (``analysis.boundaries.kernel_rows``), single runs (``compute.single.simulate``)
+and the accuracy study (``analysis.accuracy.run_kernel``).
 """
 
 from __future__ import annotations
@@ -78,18 +80,3 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[[np.ndarray, np.nd
                                    | L.STATUS_UNCERTIFIED)
     return outs
 
-
-def run_certified(kernel_fn: Callable[[np.ndarray, np.ndarray], None], rows: np.ndarray,
-                  outs: np.ndarray, levels: int) -> np.ndarray:
-    """``kernel_fn(rows, outs)`` (a chunk kernel: rows float64[n, N_PAR], outs float64[n,
-    N_OUT] filled), then the close calls certified with the same kernel (``certify``, up to
-    ``levels`` refinements). For callers that hold one kernel for all their rows (the A_min
-    bisection of ``analysis.boundaries``). Returns outs."""
-    kernel_fn(rows, outs)
-
-    def rerun(sub: np.ndarray, idx: np.ndarray) -> np.ndarray:
-        res = np.empty((sub.shape[0], L.N_OUT))
-        kernel_fn(np.ascontiguousarray(sub), res)
-        return res
-
-    return certify(rows, outs, rerun, levels)

@@ -9,9 +9,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from rocksweep import fields
-from rocksweep.compute.certify import certify
-from rocksweep.kernel import chunk_kernel, point_kernel, warm_up
+from rocksweep.compute.dispatch import history_capacity, run_variant  # noqa: F401 (re-exported)
 from rocksweep.kernel import layout as L
+from rocksweep.kernel import warm_up
 from rocksweep.numerics import Numerics
 from rocksweep.outcomes import outcome_word, status_words
 from rocksweep.physics.points import Point, kernel_kind, point_row
@@ -117,17 +117,6 @@ class Run:
         return fields.history_columns(self.history, self.point.body)
 
 
-def history_capacity(row: np.ndarray) -> int:
-    """Rows a full history of this point can need: every step plus 3 rows per event (a
-    record's steps on its samples counted on top)."""
-    t_pulse = min(row[L.PAR_TPULSE], row[L.PAR_TEND])
-    steps = math.ceil(t_pulse / row[L.PAR_DT_ON]) + math.ceil(
-        (row[L.PAR_TEND] - t_pulse) / row[L.PAR_DT])
-    if row[L.PAR_REC_H] > 0.0:
-        steps += math.ceil(row[L.PAR_TPULSE] / row[L.PAR_REC_H]) + 1
-    return int(steps + 3 * row[L.PAR_MAXEVENTS] + 16)
-
-
 def simulate(point: Point, numerics: Numerics, history: bool = True,
              contact: bool = False) -> Run:
     """Run one point. With ``history`` the energy-accounting kernel records every step
@@ -142,37 +131,15 @@ def simulate(point: Point, numerics: Numerics, history: bool = True,
     lvl = L.LEVEL_CONTACT if contact else L.LEVEL_OUTCOME
     warm_up(kind, None if history else lvl, ground)  # wall_time excludes compilation
     t0 = time.perf_counter()
-    out, hist_d = _run(row, kind, lvl, ground, history, contact)
-    if numerics.refine > 0:
-        # the certification of close calls, as in sweeps (``compute.certify``): the
-        # finest run's result and history are kept
-        kept = {}
-
-        def rerun(rows: np.ndarray, idx: np.ndarray) -> np.ndarray:
-            o, h = _run(rows[0], kind, lvl, ground, history, contact)
-            kept["history"] = h
-            return o[None, :]
-
-        outs = out[None, :].copy()
-        certify(row[None, :], outs, rerun, numerics.refine)
-        out = outs[0]
-        if "history" in kept:
-            hist_d = kept["history"]
-    return Run(point, numerics, out, hist_d, time.perf_counter() - t0, contact)
-
-
-def _run(row: np.ndarray, kind: int, lvl: int, ground: bool, history: bool,
-         contact: bool) -> tuple[np.ndarray, dict | None]:
-    """One kernel run of a parameter row: (result row float64[N_OUT], history or None)."""
-    out = np.empty(L.N_OUT)
+    # the close calls certified, as in sweeps (``compute.certify``): the finest run's
+    # result and history are kept
+    hists = [None] if history else None
+    out = run_variant(row[None, :], kind, lvl, ground, numerics.refine, histories=hists)[0]
+    hist_d = None
     if history:
-        hist = np.empty((history_capacity(row), L.N_HIST))
-        point_kernel(kind, ground)(row, out, hist)
         if not contact:  # tracked by the history variants anyway; reported when asked
             out[L.OUT_STATUS] = int(out[L.OUT_STATUS]) & ~(L.STATUS_SLIDES | L.STATUS_LIFTS_OFF)
             out[[L.OUT_MU_REQ, L.OUT_N_MIN, L.OUT_IMPULSE_MAX]] = np.nan
         n = int(out[L.OUT_HIST_ROWS])
-        return out, {c.raw: hist[:n, c.slot].copy() for c in fields.HISTORY}
-    outs = out[None, :]
-    chunk_kernel(kind, lvl, ground)(row[None, :], outs)
-    return out, None
+        hist_d = {c.raw: hists[0][:n, c.slot].copy() for c in fields.HISTORY}
+    return Run(point, numerics, out, hist_d, time.perf_counter() - t0, contact)

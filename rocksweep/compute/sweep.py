@@ -37,10 +37,9 @@ from rocksweep.compute.arguments import (  # noqa: F401 (re-exported)
     check_jobs,
     probe_scheduler,
 )
-from rocksweep.compute.certify import certify as certify_runs
+from rocksweep.compute.dispatch import _run_record, run_variant  # noqa: F401 (re-exported)
 from rocksweep.compute.grid import ChunkRows, Grid
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.physics.points import with_record
 from rocksweep.scene.model import Scene
 
 # Upper bound of the automatic chunk size [points]; see ``auto_chunk_size``.
@@ -101,65 +100,28 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
 
 def run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene,
              certify: bool = True) -> np.ndarray:
-    """The one dispatch of parameter rows to the compiled kernel variants: result rows
-    float64[n, N_OUT] of ``rows`` (float64[n, N_PAR], those of ``cr`` or their half-step
-    reruns) at bookkeeping ``level``: one kernel call per body kind present, the scene's
-    ground variant (Ricker, MP, records) with a record's samples riding on the rows.
-    certify: re-run the close calls finer (``compute.certify``, up to the scene's
-    ``numerics.refine`` refinements)."""
-    outs = _dispatch(cr, rows, level, scene)
-    if certify and scene.numerics.refine > 0:
-        def rerun(sub: np.ndarray, idx: np.ndarray) -> np.ndarray:
-            part = ChunkRows(sub, cr.kinds[idx], cr.alpha_ref[idx], cr.E_ref[idx],
-                             None if cr.record_index is None else cr.record_index[idx])
-            return _dispatch(part, sub, level, scene)
-
-        certify_runs(rows, outs, rerun, scene.numerics.refine)
-    return outs
-
-
-def _dispatch(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene) -> np.ndarray:
-    """``run_rows`` without the certification: the kernel on every row once."""
+    """Result rows float64[n, N_OUT] of ``rows`` (float64[n, N_PAR], those of ``cr`` or
+    their half-step reruns) at bookkeeping ``level``: one call of the one dispatch
+    (``compute.dispatch.run_variant``) per body kind present (and per record of a
+    suite), the scene's ground variant (Ricker, MP, records) with a record's samples
+    riding on the rows. certify: re-run the close calls finer (``compute.certify``, up
+    to the scene's ``numerics.refine`` refinements)."""
+    refine = scene.numerics.refine if certify else 0
     outs = np.empty((rows.shape[0], L.N_OUT))
     for kind in np.unique(cr.kinds):
         sel = cr.kinds == kind
-        kernel_fn = kernel.chunk_kernel(int(kind), level, scene.ground)
         if scene.suite is not None:  # one record at a time, its samples shared
             for r in np.unique(cr.record_index[sel]):
-                _run_record(kernel_fn, rows, sel & (cr.record_index == r), outs,
-                            scene.suite.records[int(r)])
-        elif scene.record is not None:
-            _run_record(kernel_fn, rows, sel, outs, scene.record)
+                part = sel & (cr.record_index == r)
+                outs[part] = run_variant(rows[part], int(kind), level, scene.ground, refine,
+                                         record=scene.suite.records[int(r)])
         elif sel.all():
-            kernel_fn(rows, outs)
+            run_variant(rows, int(kind), level, scene.ground, refine, record=scene.record,
+                        out=outs)
         else:
-            part = np.empty((int(sel.sum()), L.N_OUT))
-            kernel_fn(np.ascontiguousarray(rows[sel]), part)
-            outs[sel] = part
+            outs[sel] = run_variant(np.ascontiguousarray(rows[sel]), int(kind), level,
+                                    scene.ground, refine, record=scene.record)
     return outs
-
-
-def _run_record(kernel, rows: np.ndarray, sel: np.ndarray, outs: np.ndarray,
-                record) -> None:
-    """Run the selected rows of a record scene, all driven by ``record``.
-
-    The GROUND chunk kernel reads the ground motion from the row after the parameters
-    (``kernel.equations.ground_acc``, ``points.with_record``). The runs share one wide
-    row: the record's samples are written into it once, and each point's N_PAR
-    parameters are copied in before its kernel call (one call a point, ~1 us of
-    dispatch against the milliseconds a run of a record takes), so no point copies the
-    samples. Each point's result is the one a row of its own gives (the kernel runs
-    every row alone), bit for bit."""
-    idx = np.flatnonzero(sel)
-    if idx.size == 0:
-        return
-    wide = with_record(rows[idx[:1]], record)  # float64[1, N_PAR + npts]
-    res = np.empty((1, L.N_OUT))
-    head = wide[0, :L.N_PAR]
-    for i in idx.tolist():
-        head[:] = rows[i]
-        kernel(wide, res)
-        outs[i] = res[0]
 
 
 def merge_contiguous(results: Iterable[ChunkResult]) -> list[ChunkResult]:

@@ -84,3 +84,22 @@ def simulate_runs(scene: Scene, max_runs: int = MAX_RUNS) -> list[Run]:
     return [run_point(scene.point(dict(zip(names, combo, strict=True))), scene.single_numerics,
                       contact=scene.contact)
             for combo in product(*(a.values for a in scene.axes))]
+
+
+def titled_runs(scene: Scene, max_runs: int = MAX_RUNS) -> list[tuple[Run, xr.Dataset, str]]:
+    """``rocksweep.simulate``'s runs: (run, its history Dataset, its title) of every point
+    of ``scene``, in grid order. One point: the scene's own point and accuracy
+    (``Scene.single_point``, ``single_numerics``), titled with the scene's name; more:
+    ``simulate_runs``, each titled with its swept values ("lam = 0.2, A_ratio = 3")."""
+    if scene.size == 1:
+        from rocksweep.compute.single import simulate as run_point
+
+        r = run_point(scene.single_point(), scene.single_numerics, contact=scene.contact)
+        return [(r, history_dataset(r, scene.name), scene.name)]
+    swept = [a.name for a in scene.swept]
+    out = []
+    for r in simulate_runs(scene, max_runs):
+        title = ", ".join(f"{k} = {v}" for k, v in zip(swept, swept_values(r, swept),
+                                                        strict=True))
+        out.append((r, history_dataset(r, title), title))
+    return out

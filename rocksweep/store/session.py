@@ -4,6 +4,7 @@ file, or one in memory), the driver handed it."""
 
 from __future__ import annotations
 
+import sys
 import time
 from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
@@ -13,6 +14,9 @@ from rocksweep.compute.driver import WRITE_EVERY, SweepReport
 from rocksweep.errors import ApiError
 
 if TYPE_CHECKING:
+    import io
+    from typing import Any
+
     from rocksweep.compute.adaptive import Options
     from rocksweep.scene.model import Scene
 
@@ -105,3 +109,49 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
     return drive(sf, path, report, t0, adaptive, validate, jobs=jobs, backend=backend,
                   scheduler=scheduler, chunk_size=chunk_size, where=where,
                   write_every=write_every, progress=progress, say=say)
+
+
+def _stderr(line: str) -> None:
+    print(line, file=sys.stderr, flush=True)
+
+
+def client_backend(client: Any) -> dict[str, str]:
+    """``sweep_file``'s backend keywords for ``rocksweep.run(client=...)``: local threads
+    (client None) or the cluster of an open ``dask.distributed.Client`` (its scheduler's
+    address). A closed Client is an ``ApiError``, anything else a TypeError."""
+    if client is None:
+        return {"backend": "threads"}
+    address = getattr(getattr(client, "scheduler", None), "address", None)
+    if type(client).__name__ == "Client" and getattr(client, "status", None) in (
+            "closed", "closing"):
+        raise ApiError(f"client = {client!r}: this dask Client is closed; make a new one "
+                       "(Client(cluster) or Client('tcp://host:8786')) and pass it")
+    if not isinstance(address, str):
+        raise TypeError(f"client = {client!r}: must be a dask.distributed.Client")
+    return {"backend": "dask", "scheduler": address}
+
+
+def run_session(scene: Scene, output: str | Path | None, *, source: str | Path | None = None,
+                overrides: Sequence[str] = (), jobs: int = 1, resume: bool = False,
+                overwrite: bool = False, progress: bool = False, client: Any = None,
+                adaptive: Options | None = None, validate: bool = False
+                ) -> Path | io.BytesIO:
+    """``rocksweep.run``'s sweep (its arguments checked by the facade): into the result
+    file ``output`` (``source``, the scene's file, never written over), or with output
+    None in memory (nothing touches a disk). progress: the header and kernel lines on
+    stderr and a progress bar; client: see ``client_backend``. Returns the file's path,
+    or the in-memory file's image (io.BytesIO)."""
+    where = client_backend(client)
+    log = _stderr if progress else None
+    if output is None:
+        import io
+
+        report = sweep_file(scene, None, overrides=overrides, jobs=jobs, resume=resume,
+                            progress=progress, log=log, adaptive=adaptive, validate=validate,
+                            **where)
+        return io.BytesIO(report.image)
+    sweep_file(scene, output, overrides=overrides, jobs=jobs, resume=resume,
+               overwrite=overwrite, progress=progress, log=log,
+               inputs=[source] if source else (), adaptive=adaptive, validate=validate,
+               **where)
+    return Path(output)

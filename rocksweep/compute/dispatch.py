@@ -1,0 +1,99 @@
+"""Parameter rows through one compiled kernel variant: the one dispatch of every run.
+
+Sweeps (``compute.sweep.run_rows``, one call per body kind and record of a chunk), the
+A_min searches of ``analysis.boundaries``, single runs (``compute.single.simulate``) and
+the accuracy study (``analysis.accuracy.run_kernel``) all run their rows through
+``run_variant``: the kernel variant of (body kind, bookkeeping level, ground), a record's
+samples riding on the rows, and the close calls certified (``compute.certify``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from rocksweep import kernel  # its variants looked up at each call (kernel.chunk_kernel)
+from rocksweep.compute.certify import certify
+from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.physics.points import with_record
+
+
+def history_capacity(row: np.ndarray) -> int:
+    """Rows a full history of this point can need: every step plus 3 rows per event (a
+    record's steps on its samples counted on top)."""
+    t_pulse = min(row[L.PAR_TPULSE], row[L.PAR_TEND])
+    steps = math.ceil(t_pulse / row[L.PAR_DT_ON]) + math.ceil(
+        (row[L.PAR_TEND] - t_pulse) / row[L.PAR_DT])
+    if row[L.PAR_REC_H] > 0.0:
+        steps += math.ceil(row[L.PAR_TPULSE] / row[L.PAR_REC_H]) + 1
+    return int(steps + 3 * row[L.PAR_MAXEVENTS] + 16)
+
+
+def run_variant(rows: np.ndarray, kind: int, level: int, ground: bool, refine: int = 0,
+                record=None, histories: list | None = None,
+                out: np.ndarray | None = None) -> np.ndarray:
+    """Result rows float64[n, N_OUT] of parameter rows float64[n, N_PAR (+ a record's
+    samples)] run through the kernel variant of body ``kind`` (``physics.points.
+    kernel_kind``), bookkeeping ``level`` (``kernel.layout.LEVEL_*``) and ``ground`` (the
+    GROUND variants: Ricker, MP, records).
+
+    refine: close calls re-run finer, up to this many refinements (``compute.certify``,
+    ``Numerics.refine``; 0: none). record: a record all rows share (its samples written
+    once into one wide row, ``_run_record``), or None (the rows carry their samples or
+    need none). histories: a list of n entries to receive each run's history
+    (float64[capacity, N_HIST], the finest run's when certified): the energy-accounting
+    point kernel runs instead (``level`` unused). out: where to write the result rows
+    (float64[n, N_OUT]; default a new array). Returns the result rows."""
+    n = rows.shape[0]
+    outs = np.empty((n, L.N_OUT)) if out is None else out
+    if histories is not None:
+        fn = kernel.point_kernel(kind, ground)
+
+        def call(sub: np.ndarray, res: np.ndarray, idx: Sequence[int]) -> None:
+            for j, i in enumerate(idx):
+                hist = np.empty((history_capacity(sub[j]), L.N_HIST))
+                fn(sub[j], res[j], hist)
+                histories[int(i)] = hist
+    else:
+        fn = kernel.chunk_kernel(kind, level, ground)
+
+        def call(sub: np.ndarray, res: np.ndarray, idx: Sequence[int]) -> None:
+            if record is None:
+                fn(sub, res)
+            else:
+                _run_record(fn, sub, np.ones(sub.shape[0], bool), res, record)
+
+    call(rows, outs, range(n))  # idx: the rows' places in ``histories``
+    if refine > 0:
+        def rerun(sub: np.ndarray, idx: np.ndarray) -> np.ndarray:
+            res = np.empty((sub.shape[0], L.N_OUT))
+            call(np.ascontiguousarray(sub), res, idx)
+            return res
+
+        certify(rows, outs, rerun, refine)
+    return outs
+
+
+def _run_record(kernel_fn, rows: np.ndarray, sel: np.ndarray, outs: np.ndarray,
+                record) -> None:
+    """Run the selected rows of a record scene, all driven by ``record``.
+
+    The GROUND chunk kernel reads the ground motion from the row after the parameters
+    (``kernel.equations.ground_acc``, ``points.with_record``). The runs share one wide
+    row: the record's samples are written into it once, and each point's N_PAR
+    parameters are copied in before its kernel call (one call a point, ~1 us of
+    dispatch against the milliseconds a run of a record takes), so no point copies the
+    samples. Each point's result is the one a row of its own gives (the kernel runs
+    every row alone), bit for bit."""
+    idx = np.flatnonzero(sel)
+    if idx.size == 0:
+        return
+    wide = with_record(rows[idx[:1]], record)  # float64[1, N_PAR + npts]
+    res = np.empty((1, L.N_OUT))
+    head = wide[0, :L.N_PAR]
+    for i in idx.tolist():
+        head[:] = rows[i]
+        kernel_fn(wide, res)
+        outs[i] = res[0]
