@@ -39,20 +39,13 @@ def efficiency(result_path: Path, state: str, out_path: Path | None, fig_path: P
     import numpy as np
 
     import rocksweep
-    from rocksweep.figures.common import FORMATS, save_figure
-    from rocksweep.outputs import check_distinct, check_output
+    from rocksweep.figures.common import save_figure
     from rocksweep.store.reader import result_inputs
 
     inputs = result_inputs(result_path)  # the result and its records: never written over
-    check_distinct({"-o": out_path, "--plot": fig_path})
-    if out_path is not None:
-        if out_path.suffix.lower() not in SUFFIXES:
-            raise click.ClickException(f"-o {out_path}: unsupported suffix "
-                                       f"{out_path.suffix or '(none)'!r}; use "
-                                       f"{', '.join(SUFFIXES)}")
-        check_output(out_path, overwrite=overwrite, inputs=inputs)
-    if fig_path is not None:
-        check_output(fig_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
+    from rocksweep.cli.fragility import check_table_outputs
+
+    check_table_outputs(out_path, fig_path, SUFFIXES, inputs, overwrite)
     eff = rocksweep.im_efficiency(rocksweep.open(result_path), state=state)
     frame = eff[["beta", "beta_scale", "im_median", "slope", "n_records",
                  "n_censored"]].to_dataframe().reset_index()

@@ -101,8 +101,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
     import warnings
 
     import rocksweep
-    from rocksweep.figures.common import FORMATS, save_figure
-    from rocksweep.outputs import check_output
+    from rocksweep.figures.common import save_figure
 
     states = [s.strip() for s in state.split(",") if s.strip()]
     if not states:
@@ -110,17 +109,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
     from rocksweep.store.reader import result_inputs
 
     inputs = result_inputs(result_path)  # the result and its records: never written over
-    outs = [p for p in (out_path, fig_path) if p is not None]
-    if len({str(p.resolve()) for p in outs}) < len(outs):
-        raise click.ClickException("-o and --plot must name different files")
-    if out_path is not None:
-        if out_path.suffix.lower() not in CURVE_SUFFIXES:
-            raise click.ClickException(
-                f"-o {out_path}: unsupported suffix {out_path.suffix or '(none)'!r}; use "
-                f"{', '.join(CURVE_SUFFIXES[:-1])} or {CURVE_SUFFIXES[-1]}")
-        check_output(out_path, overwrite=overwrite, inputs=inputs)
-    if fig_path is not None:
-        check_output(fig_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
+    check_table_outputs(out_path, fig_path, CURVE_SUFFIXES, inputs, overwrite)
     from rocksweep.analysis.fragility import FragilityWarning
 
     ds = rocksweep.open(result_path)
@@ -199,6 +188,26 @@ def _to_netcdf(frag, path: Path) -> None:
         if out[name].dtype.kind in ("U", "O"):
             out[name] = out[name].astype(str)
     out.to_netcdf(path, engine="h5netcdf")
+
+
+def check_table_outputs(out_path: Path | None, fig_path: Path | None,
+                        suffixes: tuple[str, ...], inputs, overwrite: bool) -> None:
+    """An analysis command's ``-o`` (a table: one of ``suffixes``) and ``--plot`` (a
+    figure), refused in one line before anything is computed: the same file twice, an
+    unknown suffix, an existing file without --overwrite, or one of the command's
+    ``inputs`` (``outputs.check_output``)."""
+    from rocksweep.figures.common import FORMATS
+    from rocksweep.outputs import check_distinct, check_output
+
+    check_distinct({"-o": out_path, "--plot": fig_path})
+    if out_path is not None:
+        if out_path.suffix.lower() not in suffixes:
+            raise click.ClickException(
+                f"-o {out_path}: unsupported suffix {out_path.suffix or '(none)'!r}; use "
+                f"{', '.join(suffixes[:-1])} or {suffixes[-1]}")
+        check_output(out_path, overwrite=overwrite, inputs=inputs)
+    if fig_path is not None:
+        check_output(fig_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
 
 
 def write_table(out_path: Path, csv: str | None, ds) -> None:

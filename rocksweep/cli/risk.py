@@ -80,21 +80,14 @@ def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, sta
     import rocksweep
     from rocksweep.analysis.kinds import dataset_kind
     from rocksweep.api import open_any
-    from rocksweep.figures.common import FORMATS, save_figure
-    from rocksweep.outputs import check_distinct, check_output
+    from rocksweep.figures.common import save_figure
     from rocksweep.store.reader import result_inputs
 
     # the fragility or sweep file (and a sweep's records), the hazard curve: never written
     inputs = [*result_inputs(frag_path), hazard_path]
-    check_distinct({"-o": out_path, "--plot": fig_path})
-    if out_path is not None:
-        if out_path.suffix.lower() not in RISK_SUFFIXES:
-            raise click.ClickException(
-                f"-o {out_path}: unsupported suffix {out_path.suffix or '(none)'!r}; use "
-                f"{', '.join(RISK_SUFFIXES)}")
-        check_output(out_path, overwrite=overwrite, inputs=inputs)
-    if fig_path is not None:
-        check_output(fig_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
+    from rocksweep.cli.fragility import check_table_outputs
+
+    check_table_outputs(out_path, fig_path, RISK_SUFFIXES, inputs, overwrite)
     ds = open_any(frag_path)
     if dataset_kind(ds) == "sweep":
         states = [s.strip() for s in state.split(",") if s.strip()]
