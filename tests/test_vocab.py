@@ -80,6 +80,8 @@ def redefinitions(src: str, where: str) -> list[str]:
                 continue  # (mode1, mode2 are outcome words and fragility states: once)
             reported.append(hits)
             found.append(f"{where}:{node.lineno}: {family} {sorted(hits)}")
+        if not isinstance(node, ast.Dict) and set(axes.DIAGRAM_AXES) <= set(names):
+            found.append(f"{where}:{node.lineno}: the diagram axes (vocab.axes.DIAGRAM_AXES)")
         if isinstance(node, ast.Dict) and len(set(names) & set(axes.AXES)) >= 3:
             marks = [v for v in _strings(node.values) if "\\" in v or "[" in v]
             if len(marks) >= 2:  # LaTeX symbols or units of axes: a copy of vocab.axes
@@ -100,11 +102,14 @@ def test_no_list_of_vocabulary_names_outside_the_vocabulary():
 def test_the_checker_sees_a_copy():
     src = ('LAWS = ("vertical", "locked", "constant")\n'
            'msg = "must be sine, cosine, ricker, mp or record"\n'
+           'for d in ("w_over_p", "A_ratio"): pass\n'
+           'row = {"w_over_p": 1.0, "A_ratio": 2.0}\n'
            'ok = law == "constant"\n'
            'def f():\n    """vertical, locked, constant in a docstring is prose."""\n')
     found = redefinitions(src, "x.py")
     assert found == ["x.py:1: impact laws ['constant', 'locked', 'vertical']",
-                     "x.py:2: pulse shapes in a string"]
+                     "x.py:2: pulse shapes in a string",
+                     "x.py:3: the diagram axes (vocab.axes.DIAGRAM_AXES)"]
 
 
 def test_the_homes_hold_the_vocabulary_names():

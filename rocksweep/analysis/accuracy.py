@@ -53,6 +53,7 @@ from rocksweep.numerics import (
     Numerics,
 )
 from rocksweep.scene.model import Scene, SceneError
+from rocksweep.vocab.axes import DIAGRAM_AXES, RECORD_X
 from rocksweep.vocab.outcomes import CLASSES
 
 OUTCOMES = CLASSES  # codes 0, 1, 2
@@ -160,7 +161,7 @@ def boundary_mask(outcome: np.ndarray, dims: tuple[str, ...]) -> np.ndarray:
     """
     mask = np.zeros(outcome.shape, bool)
     for ax, name in enumerate(dims):
-        if name not in ("A_ratio", "w_over_p", "p"):  # p: a record sweep's time scale
+        if name not in (*DIAGRAM_AXES, RECORD_X):
             continue
         diff = np.diff(outcome, axis=ax) != 0
         lo = [slice(None)] * outcome.ndim

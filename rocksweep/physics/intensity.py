@@ -167,7 +167,7 @@ def avgsa_periods(t_lo: float, t_hi: float, n: int = AVGSA_POINTS) -> np.ndarray
     return np.geomspace(float(t_lo), float(t_hi), int(n))
 
 
-def avg_sa(acc, dt: float, t_lo: float, t_hi: float, zeta: float = 0.05,
+def avg_sa(acc, dt: float, t_lo: float, t_hi: float, zeta: float = SA_DAMPING,
            n: int = AVGSA_POINTS) -> float:
     """AvgSa [g]: the geometric mean of Sa(T) (``sa``, damping ``zeta``) over the periods
     ``avgsa_periods(t_lo, t_hi, n)`` [s] (0 < t_lo <= t_hi)."""
