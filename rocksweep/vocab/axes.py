@@ -82,6 +82,11 @@ ALPHA_REF: dict[str, tuple[str, str]] = {"flexible": ("alpha_cg", r"\alpha_{cg}"
                                          "block": ("alpha", r"\alpha")}
 
 
+def alpha_symbol(kind: str = "flexible") -> str:
+    """Plain text of the body kind's alpha_ref: alpha_cg (flexible), alpha (block)."""
+    return ALPHA_REF.get(kind, ALPHA_REF["block"])[0]
+
+
 def alpha_latex(kind: str = "flexible") -> str:
     """LaTeX of the body kind's alpha_ref: alpha_cg (flexible), alpha (block)."""
     return ALPHA_REF.get(kind, ALPHA_REF["block"])[1]
@@ -93,7 +98,7 @@ def symbol(name: str, kind: str = "flexible") -> str:
     meta = AXES.get(name)
     if meta is None:
         return name
-    return meta.symbol.replace("alpha_ref", ALPHA_REF.get(kind, ALPHA_REF["block"])[0])
+    return meta.symbol.replace("alpha_ref", alpha_symbol(kind))
 
 
 def latex(name: str, kind: str = "flexible") -> str:
