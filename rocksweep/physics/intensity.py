@@ -56,14 +56,11 @@ import numpy as np
 from scipy.signal import lfilter
 
 from rocksweep.physics.model import G  # gravity [m/s^2], the one definition
-from rocksweep.vocab.ground import SA_DAMPING
+from rocksweep.vocab.ground import AVGSA_POINTS, SA_DAMPING
 
 __all__ = ["AVGSA_POINTS", "G", "arias", "avg_sa", "avgsa_periods", "cav", "duration",
            "final_velocity", "husid", "pga", "pgv", "sa", "sha256",
            "significant_duration", "velocity"]
-
-#: periods of AvgSa: this many, evenly spaced in ln T over the range
-AVGSA_POINTS = 10
 
 
 def _check(acc, dt: float) -> np.ndarray:

@@ -77,13 +77,16 @@ DIAGRAM_AXES: tuple[str, str] = ("w_over_p", "A_ratio")
 RECORD_X = "p"  # x of a record sweep (no w_over_p): the body's frequency parameter
 LAM = "lam"  # the impulse position ratio, the diagrams' overlay dimension
 
-#: alpha_ref of each body kind: (plain symbol, LaTeX)
+#: alpha_ref of each body kind: (plain symbol and body key, LaTeX)
 ALPHA_REF: dict[str, tuple[str, str]] = {"flexible": ("alpha_cg", r"\alpha_{cg}"),
                                          "block": ("alpha", r"\alpha")}
+#: the body keys that hold alpha_ref, one per body kind (a Dataset has one of them)
+ALPHA_KEYS: tuple[str, ...] = tuple(sym for sym, _ in ALPHA_REF.values())
 
 
 def alpha_symbol(kind: str = "flexible") -> str:
-    """Plain text of the body kind's alpha_ref: alpha_cg (flexible), alpha (block)."""
+    """Plain text of the body kind's alpha_ref, which is also the body key holding it:
+    alpha_cg (flexible), alpha (block)."""
     return ALPHA_REF.get(kind, ALPHA_REF["block"])[0]
 
 
