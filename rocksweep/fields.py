@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -237,6 +238,19 @@ def convert_check(outs: np.ndarray, half: np.ndarray, alpha_ref: np.ndarray | fl
         col = half[:, f.slot] if f.check == "value" else half[:, f.slot] - outs[:, f.slot]
         arrays[f.name] = (col / scales[f.scale]).astype(f.dtype, copy=True)
     return arrays
+
+
+def plain(v: Any, *, nan_to_none: bool = False) -> Any:
+    """A stored value as plain Python: bytes as text (UTF-8, bad bytes replaced), a numpy
+    scalar or 0-d array as its Python number or string; with ``nan_to_none`` a non-finite
+    float as None (JSON). Anything else unchanged."""
+    if isinstance(v, bytes | np.bytes_):
+        return bytes(v).decode("utf-8", "replace")
+    if isinstance(v, np.generic) or (isinstance(v, np.ndarray) and v.ndim == 0):
+        v = v.item()
+    if nan_to_none and isinstance(v, float) and not math.isfinite(v):
+        return None
+    return v
 
 
 def value(out: np.ndarray, f: Field, alpha_ref: float, E_ref: float) -> int | float | None:

@@ -36,6 +36,7 @@ from rocksweep.compute.adaptive import DIAGRAM_AXES, AdaptiveError, make_plan
 from rocksweep.compute.dispatch import run_variant
 from rocksweep.compute.grid import Grid
 from rocksweep.errors import BoundaryError  # noqa: F401 (re-exported)
+from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import warm_up
 from rocksweep.numerics import MAX_POINT_STEPS, Numerics
@@ -92,12 +93,8 @@ def panels(scene: Scene, outcome: np.ndarray, axes: Sequence[str] = DIAGRAM_AXES
     y = np.asarray(scene.axis(axes[1]).values, float)
     for p in range(cls.shape[0]):
         values = grid.index_values(idx[p, :1, 0])
-        where = {a.name: _plain(values[a.name][0]) for a in others}
+        where = {a.name: plain(values[a.name][0]) for a in others}
         yield Panel(where, x, y, cls[p], idx[p])
-
-
-def _plain(v: Any) -> Any:
-    return v.item() if isinstance(v, np.generic) else v
 
 
 # --- boundary lines ---------------------------------------------------------------------
@@ -475,7 +472,7 @@ def a_min(scene: Scene, outcome: np.ndarray, rtol: float = DEFAULT_RTOL,
     searched = A_MIN_METHODS.index("searched below grid")
 
     def values_at(flat: int) -> dict[str, Any]:
-        return {k: _plain(v[0]) for k, v in grid.index_values(np.array([flat])).items()}
+        return {k: plain(v[0]) for k, v in grid.index_values(np.array([flat])).items()}
 
     curves, cols = [], []
     for p in panels(scene, outcome, axes):

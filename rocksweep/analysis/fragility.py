@@ -83,6 +83,7 @@ from scipy.special import log_ndtr, ndtr, ndtri, owens_t
 
 from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP, MAX_BOOTSTRAP
 from rocksweep.errors import FragilityError, RocksweepError  # noqa: F401 (re-exported)
+from rocksweep.fields import plain
 from rocksweep.kernel import layout as L
 from rocksweep.vocab.ground import CLOUD_IMS as CLOUD_IM_VARIABLES
 from rocksweep.vocab.ground import SCALE_IMS
@@ -1460,7 +1461,7 @@ def verdict_lines(frag: xr.Dataset, why: list[list[dict[str, str]]] | None = Non
             words = str(one.values)
             if words == "ok":
                 continue
-            where = ", ".join(f"{d} = {_plain(frag[d].values[i]) if d in frag.coords else i}"
+            where = ", ".join(f"{d} = {_json(frag[d].values[i]) if d in frag.coords else i}"
                               for d, i in sel.items())
             detail = why[si][o] if why is not None else {}
             parts = [f"{wd} ({detail[wd]})" if detail.get(wd) else wd
@@ -1520,13 +1521,9 @@ def lognormal_cdf(x, median, beta) -> np.ndarray:
                     np.where(np.isnan(median) | np.isnan(beta), np.nan, step))
 
 
-def _plain(v: Any) -> Any:
-    if isinstance(v, np.generic):
-        v = v.item()
-    if isinstance(v, float) and not math.isfinite(v):
-        return None
-    return v
 
+def _json(v: Any) -> Any:
+    return plain(v, nan_to_none=True)
 
 def curves_json(frag: xr.Dataset) -> dict:
     """{"curves": [{<other dims>: value, "state", "im", "method", "fit", "im_median",
@@ -1544,16 +1541,16 @@ def curves_json(frag: xr.Dataset) -> dict:
             one = frag.isel(sel)
             if "state" in frag["im_median"].dims:
                 one = one.isel(state=st_i)
-            entry: dict[str, Any] = {d: _plain(frag[d].values[i]) if d in frag.coords
+            entry: dict[str, Any] = {d: _json(frag[d].values[i]) if d in frag.coords
                                      else int(i) for d, i in sel.items()}
             entry.update({
                 "state": str(st), "im": frag.attrs["im"], "method": frag.attrs["method"],
                 "fit": str(one["fit"].values),
-                "im_median": _plain(float(one["im_median"])),
-                "beta": _plain(float(one["beta"])),
-                "im_median_ci": [_plain(float(one["im_median_lo"])),
-                                 _plain(float(one["im_median_hi"]))],
-                "beta_ci": [_plain(float(one["beta_lo"])), _plain(float(one["beta_hi"]))],
+                "im_median": _json(float(one["im_median"])),
+                "beta": _json(float(one["beta"])),
+                "im_median_ci": [_json(float(one["im_median_lo"])),
+                                 _json(float(one["im_median_hi"]))],
+                "beta_ci": [_json(float(one["beta_lo"])), _json(float(one["beta_hi"]))],
                 "n_records": int(one["n_records"]), "n_excluded": int(one["n_excluded"]),
                 "n_not_run": int(one["n_not_run"]),
                 "n_boot_undefined": int(one["n_boot_undefined"]),

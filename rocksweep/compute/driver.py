@@ -54,6 +54,7 @@ class SweepReport:
     attrs: dict = field(default_factory=dict)
     adaptive: AdaptiveStats | None = None  # adaptive sweeps: the file's counts
     validation: Validation | None = None  # adaptive sweeps with validate=True
+    image: bytes | None = None  # a sweep into an in-memory file: the file's bytes
 
     @property
     def points_done(self) -> int:

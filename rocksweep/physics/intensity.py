@@ -48,9 +48,7 @@ longer ship. The recurrence is ~60 lines here, tested against closed forms and l
 
 from __future__ import annotations
 
-import hashlib
 import math
-from pathlib import Path
 
 import numpy as np
 from scipy.signal import lfilter
@@ -59,7 +57,7 @@ from rocksweep.physics.model import G  # gravity [m/s^2], the one definition
 from rocksweep.vocab.ground import AVGSA_POINTS, SA_DAMPING
 
 __all__ = ["AVGSA_POINTS", "G", "arias", "avg_sa", "avgsa_periods", "cav", "duration",
-           "final_velocity", "husid", "pga", "pgv", "sa", "sha256",
+           "final_velocity", "husid", "pga", "pgv", "sa",
            "significant_duration", "velocity"]
 
 
@@ -176,15 +174,6 @@ def avg_sa(acc, dt: float, t_lo: float, t_hi: float, zeta: float = SA_DAMPING,
 def duration(acc, dt: float) -> float:
     """Time of the last sample (n - 1) dt [s]."""
     return (np.asarray(acc).size - 1) * float(dt)
-
-
-def sha256(path: str | Path) -> str:
-    """Hex SHA-256 of a file's bytes (the digest ``rocksweep.physics.records`` stores)."""
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def _nj_coefficients(w: float, zeta: float, h: float):

@@ -20,7 +20,7 @@ if TYPE_CHECKING:
     from rocksweep.compute.adaptive import Options
     from rocksweep.scene.model import Scene
 
-def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
+def sweep_file(scene: Scene, path: str | Path | None, *, overrides: Sequence[str] = (),
                jobs: int = 1, resume: bool = False, overwrite: bool = False,
                backend: str = "threads", scheduler: str | None = None,
                chunk_size: int | None = None, write_every: float = WRITE_EVERY,
@@ -28,7 +28,8 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
                inputs: Iterable[str | Path] = (), adaptive: Options | None = None,
                validate: bool = False, connect_timeout: float = 20.0,
                cli: bool = False) -> SweepReport:
-    """Sweep ``scene`` into the result file ``path`` (``rocksweep sweep``).
+    """Sweep ``scene`` into the result file ``path`` (``rocksweep sweep``), or with ``path``
+    None into a file in memory (its bytes: ``report.image``; ``rocksweep.run``).
 
     Makes the file (refusing an existing one unless ``overwrite``), or with ``resume``
     reopens an existing file of the same scene and computes only its missing points.
