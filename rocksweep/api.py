@@ -1,10 +1,10 @@
 """The Python API, a thin facade: run a scene's grid, open a result, simulate one point,
-and the analyses of a Dataset. Each function checks its arguments and hands over to the
-room that does the work: scenes and overrides (``rocksweep.scene.inputs``), the sweep
-session (``rocksweep.store.session.sweep_file``, the one way into the driver), a result
-as a Dataset (``rocksweep.store.dataset``), a run's history (``rocksweep.store.history``),
-the analyses (``rocksweep.analysis``), the figures (``rocksweep.figures``); ``ds.rocksweep``
-is ``rocksweep.accessor``. Errors speak Python (``rocksweep.errors.speaks_python``).
+and the analyses of a Dataset. Each function hands over to the room that does the work
+and checks its arguments: scenes (``rocksweep.scene.inputs``), the sweep session
+(``rocksweep.store.session``), a result as a Dataset (``rocksweep.store.dataset``), a
+run's history (``rocksweep.store.history``), the analyses (``rocksweep.analysis``), the
+figures (``rocksweep.figures``), ``ds.rocksweep`` (``rocksweep.accessor``). Errors speak
+Python (``rocksweep.errors.speaks_python``).
 
 Nothing heavy is imported here at module level (numba, h5py, xarray, matplotlib load
 inside the functions), so ``import rocksweep`` stays light; the names that moved out are
@@ -110,15 +110,14 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
     """A sweep result file as an xarray Dataset, loaded in memory (the file is closed).
 
     Each variable carries its unit (``rocksweep_units``: ``rocksweep.fields.UNITS``, e.g.
-    alpha_ref, 1/p, E_ref; CF ``units`` "1" as written by the store) and a description;
-    ``outcome`` its codes and words as CF flags (``flag_values`` -1 0 1 2,
-    ``flag_meanings`` "not_run safe mode1 mode2"), ``status`` its bits (``flag_masks``,
-    ``flag_meanings``, ``flagged_mask``). The Dataset's attributes are the file's
-    provenance: the scene YAML verbatim (``scene``) and resolved (``scene_resolved``),
-    ``overrides``, the resolved ``numerics`` and ``accuracy``, library versions,
-    ``started``/``finished``, ``wall_time``/``cpu_time`` [s], ``points_done``,
-    ``complete``. Works while a sweep is still writing the file (no lock is taken).
-    A file that is not a rocksweep result is a one-line ``RocksweepError``.
+    alpha_ref, 1/p, E_ref; CF ``units`` "1") and a description; ``outcome`` its codes
+    and words as CF flags (``flag_values`` -1 0 1 2, ``flag_meanings`` "not_run safe
+    mode1 mode2"), ``status`` its bits (``flag_masks``, ``flag_meanings``,
+    ``flagged_mask``). The attributes are the file's provenance (all of them:
+    ``rocksweep.store.format``): ``scene`` (the YAML verbatim), ``scene_resolved``,
+    ``overrides``, ``numerics``, ``accuracy``, versions, times, ``complete``. Works
+    while a sweep is still writing the file (no lock is taken). A file that is not a
+    rocksweep result is a one-line ``RocksweepError``.
     """
     from rocksweep.store.dataset import open_result
 
@@ -145,8 +144,7 @@ def open_any(path: str | Path) -> xr.Dataset:
 
 
 def _dataset_arg(ds: Any, what: str) -> xr.Dataset:
-    """A Dataset argument, or a path to one (``analysis.files._as_dataset``), with
-    ``ds.rocksweep``."""
+    """A Dataset, or a path to one (``analysis.files._as_dataset``), with ``ds.rocksweep``."""
     from rocksweep.analysis.files import _as_dataset
 
     _register()
@@ -199,10 +197,10 @@ def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None,
 
     ds: a complete result (``run`` / ``open``) with a diagram over (w_over_p, A_ratio).
     mode: 1 or 2 for that overturning mode only. Returns a Dataset: ``A_min`` (NaN: none
-    found), ``mode``, ``A_min_method`` ("grid+bisection", "searched below grid", "first
-    grid value" (an upper bound), "not found"), the final bracket ``lo``/``hi`` and the
-    kernel ``runs``, over every other swept key (e.g. shape, lam) and x. The class
-    boundary polylines: ``boundary_lines(ds)``.
+    found), ``mode``, ``A_min_method`` (``rocksweep.analysis.boundaries.A_MIN_METHODS``;
+    "first grid value" is an upper bound), the final bracket ``lo``/``hi`` and the kernel
+    ``runs``, over every other swept key (e.g. shape, lam) and x. The class boundary
+    polylines: ``boundary_lines(ds)``.
     """
     from rocksweep.analysis.boundaries import boundaries_dataset
 
@@ -295,13 +293,13 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = N
 
 @speaks_python
 def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
-    """Which IM explains ``state`` best: for every IM of a record-suite sweep's records
-    (PGA, PGV, Sa(T), AvgSa, Arias, CAV, D5-95, PGV/PGA, PGA/(g tan alpha), PGV p/(g tan
-    alpha)) the lognormal dispersion ``beta`` of the fragility in that IM (each record's
-    first overturning level, an interval between stripes, re-expressed in the IM; a
-    regression for the IMs scaling leaves unchanged) and ``beta_scale`` (comparable across
-    IMs; lower is better), per value of the other swept keys
-    (``rocksweep.analysis.efficiency``)."""
+    """Which IM explains ``state`` (as ``fragility``'s) best: for every IM of a
+    record-suite sweep's records (``rocksweep.physics.suite.RECORD_IMS``: PGA, PGV, Sa(T),
+    Arias, D5-95, PGA/(g tan alpha), ...) the lognormal dispersion ``beta`` of the
+    fragility in that IM and ``beta_scale`` (comparable across IMs; lower is better), per
+    value of the other swept keys; how (``rocksweep.analysis.efficiency``): each record's
+    first overturning level re-expressed in the IM, or a regression for the IMs scaling
+    leaves unchanged."""
     from rocksweep.analysis.efficiency import im_efficiency as compute
 
     return compute(_dataset_arg(ds, "ds"), state=state)
@@ -322,8 +320,9 @@ def table(ds: xr.Dataset) -> Any:
 
 @speaks_python
 def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> Any:
-    """What ``run`` of this scene will cost on this machine, without running it: points,
-    RK4 steps and evaluations expected, seconds of compute with ``jobs`` workers, and
+    """What ``run`` of this scene (with ``overrides``, as for ``run``) will cost on this
+    machine, without running it: points, RK4 steps and evaluations expected, seconds of
+    compute with ``jobs`` workers, and
     whether a kernel variant must be compiled first (and for how long). Measured on a
     sample of 256 points when the kernel is compiled (~10 ms), else from the step bound.
     Returns ``rocksweep.compute.sweep.Estimate`` (``str()`` is one line)."""
@@ -390,17 +389,19 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
               *, bounds: Mapping[str, Sequence[float]] | None = None,
               overrides: Overrides = (), ci: float = 0.95, p: float | None = None
               ) -> xr.Dataset:
-    """Fit scene numbers (``impact.lam``, ``impact.e`` under law constant,
-    ``impact.e_factor``, ``body.zeta``, ...) to a measured rocking history.
+    """Fit scene numbers to a measured rocking history.
 
-    measured: a CSV path or a pandas DataFrame with columns p_t, theta_over_alpha (as
-    ``simulate --csv`` writes), or t [s], theta [rad] (then p [rad/s]: the keyword, a
-    physical body's or a record scene's ground.p). bounds: {key: (lo, hi)} inside each
-    key's admissible range (default: ``analysis.calibrate.DEFAULT_BOUNDS`` or the range).
-    Returns a Dataset over ``parameter`` (the fitted keys): ``estimate``, ``lo``, ``hi``
-    (the ``ci`` interval by profile likelihood, ``ci`` in attrs), scalar ``misfit`` (RMS
-    error of the half-cycle peaks, theta/alpha_ref), and the measured and fitted
-    histories over p_t with the fitted impacts (``rocksweep.analysis.calibrate``).
+    scene, overrides: as for ``run``. fit: the key or distinct keys to fit (``impact.lam``,
+    ``impact.e`` under law constant, ``impact.e_factor``, ``body.zeta``, ...). measured: a
+    CSV path or a pandas DataFrame with columns p_t, theta_over_alpha (as ``simulate
+    --csv`` writes), or t [s], theta [rad] (then p [rad/s]: the keyword, a physical
+    body's or a record scene's ground.p). bounds: {key: (lo, hi)} inside each key's
+    admissible range (default: ``analysis.calibrate.DEFAULT_BOUNDS`` or the range). ci:
+    the interval's level, in [0.5, 1). Returns a Dataset over ``parameter`` (the fitted
+    keys): ``estimate``, ``lo``, ``hi`` (the ``ci`` interval by profile likelihood, ``ci``
+    in attrs), scalar ``misfit`` (RMS error of the half-cycle peaks, theta/alpha_ref),
+    and the measured and fitted histories over p_t with the fitted impacts
+    (``rocksweep.analysis.calibrate``).
     """
     from rocksweep.analysis.calibrate import calibrate_scene
 
