@@ -69,7 +69,8 @@ def test_simulate_refuses_a_grid_naming_its_longest_key():
 def test_simulation_is_the_facades_type():
     sim = rocksweep.simulate({"name": "one", "body": dict(FIG3), "impact": {"lam": 0.2},
                               "pulse": {"shape": "sine", "w_over_p": 2.0, "A_ratio": 3.0}})
-    assert isinstance(sim, api.Simulation) and sim.title == "one"
+    assert isinstance(sim, api.Simulation) and isinstance(sim, rocksweep.Simulation)
+    assert rocksweep.Simulation is api.Simulation and sim.title == "one"
     assert sim.history.attrs["title"] == "one" and sim.summary["outcome"] == sim.run.outcome
 
 
