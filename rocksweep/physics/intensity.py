@@ -56,14 +56,11 @@ import numpy as np
 from scipy.signal import lfilter
 
 from rocksweep.physics.model import G  # gravity [m/s^2], the one definition
-from rocksweep.vocab.ground import SA_DAMPING
+from rocksweep.vocab.ground import AVGSA_POINTS, SA_DAMPING
 
 __all__ = ["AVGSA_POINTS", "G", "arias", "avg_sa", "avgsa_periods", "cav", "duration",
            "final_velocity", "husid", "pga", "pgv", "sa", "sha256",
            "significant_duration", "velocity"]
-
-#: periods of AvgSa: this many, evenly spaced in ln T over the range
-AVGSA_POINTS = 10
 
 
 def _check(acc, dt: float) -> np.ndarray:
@@ -167,7 +164,7 @@ def avgsa_periods(t_lo: float, t_hi: float, n: int = AVGSA_POINTS) -> np.ndarray
     return np.geomspace(float(t_lo), float(t_hi), int(n))
 
 
-def avg_sa(acc, dt: float, t_lo: float, t_hi: float, zeta: float = 0.05,
+def avg_sa(acc, dt: float, t_lo: float, t_hi: float, zeta: float = SA_DAMPING,
            n: int = AVGSA_POINTS) -> float:
     """AvgSa [g]: the geometric mean of Sa(T) (``sa``, damping ``zeta``) over the periods
     ``avgsa_periods(t_lo, t_hi, n)`` [s] (0 < t_lo <= t_hi)."""
