@@ -49,7 +49,6 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module 'rocksweep.api' has no attribute {name!r}")
 
 
-
 # --- rocksweep.run and rocksweep.open ----------------------------------------------------
 
 @speaks_python
