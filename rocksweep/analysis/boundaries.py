@@ -853,12 +853,29 @@ def lines_frame(bounds: Sequence[PanelBoundaries]):
     return pd.DataFrame(rows)
 
 
-def boundaries_dataset(ds: Any, rtol: float = 1e-3, mode: int | None = None,
-                       search: bool = True) -> Any:
-    """``rocksweep.boundaries`` (its arguments checked there): the A_min curves of a
-    complete result (``result_curves``) as a Dataset (``curves_dataset``)."""
+def boundary_lines_frame(ds: Any):
+    """``rocksweep.boundary_lines``: the class boundary polylines of a complete result's
+    diagrams (``diagram_boundaries``) as ``lines_frame``'s DataFrame."""
     from rocksweep.store.reader import as_result
 
+    result = as_result(ds, ["outcome"])
+    return lines_frame(diagram_boundaries(check_result(result), result.arrays["outcome"]))
+
+
+def boundaries_dataset(ds: Any, rtol: float = DEFAULT_RTOL, mode: int | None = None,
+                       search: bool = True) -> Any:
+    """``rocksweep.boundaries`` (its arguments documented there): the A_min curves of a
+    complete result (``result_curves``) as a Dataset (``curves_dataset``). rtol, mode
+    (None, 1 or 2) and search (a bool) are checked before the result is read: one-line
+    ApiErrors."""
+    from rocksweep.errors import ApiError
+    from rocksweep.store.reader import as_result
+
+    rtol = check_rtol(rtol)
+    if mode not in (None, 1, 2):
+        raise ApiError(f"mode = {mode!r}: must be None, 1 or 2")
+    if not isinstance(search, bool):
+        raise ApiError(f"search = {search!r}: must be True or False")
     result = as_result(ds, list(RESPONSE))
     curves, _ = result_curves(result, rtol, mode, search=search)
     return curves_dataset(curves, {"title": result.name, "rtol": rtol,

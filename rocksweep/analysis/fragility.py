@@ -1151,8 +1151,9 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     ``n_failed`` over (state, others, stripe) and ``n_counted`` over (others, stripe), and
     per record ``first_level`` (smallest level that reaches the state; NaN if none) and
     ``resurrection`` (a higher counted level does not reach it) over (state, others,
-    record). attrs: method ("stripes-mle" | "cloud-mle"), im, im_units, period (Sa),
-    states, bootstrap, seed, ci, reference.
+    record). attrs: rocksweep_kind "fragility" (``analysis.kinds``), title (the sweep's),
+    method ("stripes-mle" | "cloud-mle"), im, im_units, period (Sa), states, bootstrap,
+    seed, ci, reference.
     """
     _check_args(ds, im, period, seed)
     bootstrap = DEFAULT_BOOTSTRAP if bootstrap is None else bootstrap
@@ -1381,7 +1382,8 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
                                 "state (NaN: none)"})
         data["resurrection"] = (dims_c + ["record"], shaped(safe_above.any(-1), (R,)),
                                 {"long_name": "a higher counted level is safe again"})
-    attrs = {"method": method, "im": im_name, "im_units": unit, "states": list(states),
+    attrs = {"rocksweep_kind": "fragility", "title": str(ds.attrs.get("title", "")),
+             "method": method, "im": im_name, "im_units": unit, "states": list(states),
              "bootstrap": int(N), "seed": int(seed), "ci": float(ci),
              "reference": "Baker (2015), Efficient analytical fragility function fitting "
                           "using dynamic structural analysis, Earthquake Spectra 31(1)"}

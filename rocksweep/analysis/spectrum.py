@@ -67,7 +67,8 @@ class Spectra:
         over (lam, A_ratio, freq) (the rocking spectrum), ``A_min``, ``mode`` and
         ``A_min_method`` (how A_min was found, ``boundaries.A_MIN_METHODS``) over (lam,
         freq) (the overturning spectrum, bisected to ``rtol``; NaN: no grid value
-        overturns), freq being ``p`` [rad/s] or ``w_over_p``."""
+        overturns), freq being ``p`` [rad/s] or ``w_over_p``; attrs: rocksweep_kind
+        "spectra" (``analysis.kinds``), title, rtol, runs, record."""
         import xarray as xr
 
         from rocksweep import fields
@@ -92,8 +93,8 @@ class Spectra:
             coords={"lam": ("lam", self.lam, fields.axis_attrs("lam")),
                     "A_ratio": ("A_ratio", self.A, fields.axis_attrs("A_ratio", self.kind)),
                     f: (f, self.x, fields.axis_attrs(f))},
-            attrs={"title": self.name, "rtol": self.rtol, "runs": self.runs,
-                   "record": self.record})
+            attrs={"rocksweep_kind": "spectra", "title": self.name, "rtol": self.rtol,
+                   "runs": self.runs, "record": self.record})
 
 
 def spectra(data, rtol: float = DEFAULT_RTOL) -> Spectra:
