@@ -14,17 +14,16 @@ still importable from here (``api.load``, ``api.sweep_file``, ...: PEP 562).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rocksweep.errors import ApiError, speaks_python  # noqa: F401 (ApiError: the API's)
+from rocksweep.simulation import Simulation  # what simulate returns
 
 if TYPE_CHECKING:
     import xarray as xr
     from matplotlib.figure import Figure
 
-    from rocksweep.compute.single import Run
     from rocksweep.scene.inputs import Overrides, SceneLike
 
 # Names that live in their rooms, importable from here as before (loaded on first use):
@@ -333,31 +332,6 @@ def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> A
 
 
 # --- rocksweep.simulate ------------------------------------------------------------------
-
-@dataclass
-class Simulation:
-    """One run of one point (``rocksweep.simulate``).
-
-    summary: plain dict (``rocksweep simulate --json``: outcome, impacts, uplifts,
-    theta_max_over_alpha, t_overturn, t_first_impact, energies / E_ref, status words,
-    steps, event_steps, accuracy, wall_time_s); history: xarray Dataset over ``p_t``
-    (``rocksweep.fields.HISTORY``: theta_over_alpha, u_over_ucr, E_over_Eref, ..., each
-    with ``units``; at an event p_t repeats: the rows before and after it); run: the
-    underlying ``rocksweep.compute.single.Run``.
-    """
-
-    summary: dict
-    history: xr.Dataset
-    run: Run
-    title: str = ""
-
-    def figure(self) -> Figure:
-        """Figure 5 for this run (pulse, theta/alpha, E/E_ref, dissipated energy against
-        p*t) as a pyplot-free matplotlib Figure: show it in a notebook or ``savefig``."""
-        from rocksweep.figures.common import time_history
-
-        return time_history([self.run], (), self.title)
-
 
 @speaks_python
 def simulate(scene: SceneLike, overrides: Overrides = (), /,
