@@ -216,13 +216,14 @@ def boundary_lines(ds: xr.Dataset) -> Any:
 
 
 @speaks_python
-def spectra(ds: xr.Dataset, rtol: float = 1e-3) -> xr.Dataset:
+def spectra(ds: xr.Dataset, rtol: float = 1e-3, search: bool = True) -> xr.Dataset:
     """Rocking and overturning spectra of a complete sweep over p (a record) or w_over_p,
     A_ratio and optionally lam: ``theta_max_over_alpha`` and ``outcome`` over (lam,
-    A_ratio, p), ``A_min`` and ``mode`` over (lam, p), A_min bisected to ``rtol``."""
+    A_ratio, p), ``A_min`` and ``mode`` over (lam, p), A_min to ``rtol`` whatever the grid
+    (search=False: the grid's bracket bisected only, as for ``boundaries``)."""
     from rocksweep.analysis.spectrum import spectra as compute_spectra
 
-    return compute_spectra(ds, rtol).to_dataset()
+    return compute_spectra(ds, rtol, search).to_dataset()
 
 
 @speaks_python

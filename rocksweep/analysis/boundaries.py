@@ -862,6 +862,15 @@ def boundary_lines_frame(ds: Any):
     return lines_frame(diagram_boundaries(check_result(result), result.arrays["outcome"]))
 
 
+def check_search(search: Any) -> bool:
+    """The ``search`` argument of ``a_min``'s callers: True or False, else an ApiError."""
+    from rocksweep.errors import ApiError
+
+    if not isinstance(search, bool):
+        raise ApiError(f"search = {search!r}: must be True or False")
+    return search
+
+
 def boundaries_dataset(ds: Any, rtol: float = DEFAULT_RTOL, mode: int | None = None,
                        search: bool = True) -> Any:
     """``rocksweep.boundaries`` (its arguments documented there): the A_min curves of a
@@ -874,8 +883,7 @@ def boundaries_dataset(ds: Any, rtol: float = DEFAULT_RTOL, mode: int | None = N
     rtol = check_rtol(rtol)
     if mode not in (None, 1, 2):
         raise ApiError(f"mode = {mode!r}: must be None, 1 or 2")
-    if not isinstance(search, bool):
-        raise ApiError(f"search = {search!r}: must be True or False")
+    check_search(search)
     result = as_result(ds, list(RESPONSE))
     curves, _ = result_curves(result, rtol, mode, search=search)
     return curves_dataset(curves, {"title": result.name, "rtol": rtol,
