@@ -202,6 +202,7 @@ def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None,
     """
     from rocksweep.analysis.boundaries import boundaries_dataset
 
+    _register()  # the result's ds.rocksweep, whatever was called first
     return boundaries_dataset(ds, rtol, mode, search)
 
 
@@ -223,6 +224,7 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3, search: bool = True) -> xr.Datas
     (search=False: the grid's bracket bisected only, as for ``boundaries``)."""
     from rocksweep.analysis.spectrum import spectra as compute_spectra
 
+    _register()  # the result's ds.rocksweep, whatever was called first
     return compute_spectra(ds, rtol, search).to_dataset()
 
 
@@ -238,6 +240,7 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
     curves ``rocksweep.plot`` draws)."""
     from rocksweep.analysis.ida import ida_dataset
 
+    _register()  # the result's ds.rocksweep, whatever was called first
     return ida_dataset(ds, rtol)
 
 

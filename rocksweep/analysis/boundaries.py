@@ -886,6 +886,7 @@ def boundaries_dataset(ds: Any, rtol: float = DEFAULT_RTOL, mode: int | None = N
     check_search(search)
     result = as_result(ds, list(RESPONSE))
     curves, _ = result_curves(result, rtol, mode, search=search)
-    return curves_dataset(curves, {"title": result.name, "rtol": rtol,
+    return curves_dataset(curves, {"rocksweep_kind": "boundaries", "kind": result.kind,
+                                   "title": result.name, "rtol": rtol,
                                    "search": int(search),
                                    "mode": "any" if mode is None else f"mode{mode}"})

@@ -96,7 +96,8 @@ class Spectra:
             coords={"lam": ("lam", self.lam, fields.axis_attrs("lam")),
                     "A_ratio": ("A_ratio", self.A, fields.axis_attrs("A_ratio", self.kind)),
                     f: (f, self.x, fields.axis_attrs(f))},
-            attrs={"rocksweep_kind": "spectra", "title": self.name, "rtol": self.rtol,
+            attrs={"rocksweep_kind": "spectra", "kind": self.kind, "title": self.name,
+                   "rtol": self.rtol,
                    "search": int(self.search),
                    "runs": self.runs, "record": self.record})
 

@@ -131,3 +131,23 @@ def test_run_checks_before_the_output_and_returns_the_file(tmp_path):
     xr.testing.assert_identical(ds, rocksweep.open(out))
     assert ds.rocksweep.outcome_words().shape == ds["outcome"].shape
 
+
+
+def test_an_analysis_called_first_on_a_path_has_the_accessor(tmp_path):
+    """A fresh interpreter whose first call is ``boundaries`` or ``spectra`` on a file gets
+    ``ds.rocksweep`` on the result (before, only run, open and some analyses set it up)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    out = tmp_path / "r.h5"
+    rocksweep.run(root / "configs" / "ci-small.yaml", output=out,
+                  overrides=["pulse.shape=sine"])
+    code = ("import sys, rocksweep\n"
+            "b = rocksweep.boundaries(sys.argv[1], search=False)\n"
+            "print(hasattr(b, 'rocksweep'), type(b.rocksweep.plot()).__name__)\n")
+    res = subprocess.run([sys.executable, "-c", code, str(out)], capture_output=True,
+                         text=True, cwd=tmp_path, timeout=300)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.split() == ["True", "Figure"]
