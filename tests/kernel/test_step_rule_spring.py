@@ -1,0 +1,77 @@
+"""The spring's steps bound RK4's numerical damping of the spring mode (``numerics.spring_steps``,
+SPRING_DECAY): checked against RK4 applied to the linear oscillator here, step by step, and
+on a point of Figure 4(b) near the uplift threshold against the scipy reference."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rocksweep.compute.driver import sweep_arrays
+from rocksweep.numerics import PRESETS, SPRING_DECAY, Numerics, spring_steps, step_sizes
+from rocksweep.physics.reference import reference_run
+from rocksweep.scene.parse import load_scene
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def rk4_decay_rate(omega: float, dt: float) -> float:
+    """Decay rate [1/(p t)] of the amplitude of x'' = -omega^2 x under classical RK4 at step
+    dt: the spectral radius of one step's matrix, from the four stages taken here."""
+    a = np.array([[0.0, 1.0], [-omega * omega, 0.0]])
+
+    def step(x: np.ndarray) -> np.ndarray:
+        k1 = a @ x
+        k2 = a @ (x + dt / 2 * k1)
+        k3 = a @ (x + dt / 2 * k2)
+        k4 = a @ (x + dt * k3)
+        return x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+
+    m = np.column_stack([step(np.array([1.0, 0.0])), step(np.array([0.0, 1.0]))])
+    return -math.log(max(abs(np.linalg.eigvals(m)))) / dt
+
+
+@pytest.mark.parametrize("spp", [4, 5, 10, 20])
+@pytest.mark.parametrize("omega_rock", [16.0, 27.46, 60.0, 167.3, 1000.0])
+def test_spring_decay_bounded(omega_rock: float, spp: int) -> None:
+    """At the rule's step (the spring setting it: omega_rock >> 2 pi) RK4 damps the spring
+    by at most SPRING_DECAY (5/spp)^5 per unit p*t; the leading-order y^6/144 the rule uses
+    bounds the exact rate from above."""
+    dt, _ = step_sizes(omega_rock, 1.0, spp, PRESETS["default"][0])
+    assert float(dt) == pytest.approx(2 * math.pi / (omega_rock * spring_steps(omega_rock, spp)))
+    rate = rk4_decay_rate(omega_rock, float(dt))
+    assert rate <= SPRING_DECAY * (5.0 / spp) ** 5 * (1 + 1e-9)
+    assert rate >= 0.5 * SPRING_DECAY * (5.0 / spp) ** 5  # and not far below: no waste
+
+
+def test_figure4_spring_at_five_steps_was_damped_as_physics() -> None:
+    """What the bound fixes: 5 steps per period of Figure 4's spring (omega_rock/p = 27.5)
+    damp it at ~0.49 p, as much as the physical zeta omega_n = 0.05 x 9.82 in full contact."""
+    rate = rk4_decay_rate(27.46, 2 * math.pi / (27.46 * 5))
+    assert rate == pytest.approx(0.49, abs=0.01)
+    assert spring_steps(27.46, 5) >= 5 * 1.4
+
+
+@pytest.mark.parametrize("omega_rock", [0.0, 2.0, 6.796, 15.0])
+def test_soft_springs_and_rigid_bodies_keep_their_steps(omega_rock: float) -> None:
+    """Below 15.2 x p (Figure 3's spring, 6.8; rigid bodies: no spring) the bound is not
+    the binding one: the steps stay steps_per_period x max(1, (27.5/omega_rock)^(2/5))."""
+    for spp in (4, 5, 20):
+        want = spp * max(1.0, (27.5 / omega_rock) ** 0.4) if omega_rock else math.inf
+        assert float(spring_steps(omega_rock, spp)) == pytest.approx(want, rel=1e-12)
+
+
+def test_threshold_point_of_figure4b_is_safe_at_default() -> None:
+    """Figure 4(b), lam 0.4, A_ratio 1.0, w_over_p 0.375: at 5 steps per spring period
+    `default` called it mode 1 (50 impacts); the reference says safe (~250 impacts)."""
+    scene = load_scene(ROOT / "configs" / "fig4b.yaml",
+                       ["impact.lam=0.4", "pulse.A_ratio=1.0", "pulse.w_over_p=0.375"])
+    assert scene.numerics == Numerics.preset("default")
+    out, _ = sweep_arrays(scene)
+    point = scene.point({ax.name: ax.values[0] for ax in scene.axes})
+    ref = reference_run(point, scene.numerics, rtol=1e-10, atol=1e-12)
+    assert int(ref["outcome"]) == 0
+    assert int(out["outcome"].ravel()[0]) == int(ref["outcome"])
