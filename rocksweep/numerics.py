@@ -215,25 +215,32 @@ SPRING_DECAY = 0.1
 OMEGA_DAMP = 144.0 * SPRING_DECAY * (5.0 / (2 * math.pi)) ** 5
 
 
-def spring_steps(omega_rock: np.ndarray | float, steps_per_period: int) -> np.ndarray:
+def spring_steps(omega_rock: np.ndarray | float, steps_per_period: int,
+                 zeta_rock: np.ndarray | float = 0.0) -> np.ndarray:
     """RK4 steps per spring period 2 pi/omega_rock: steps_per_period x
     max(1, (OMEGA_SPRING/omega_rock)^(2/5), (omega_rock/OMEGA_DAMP)^(1/5)) (omega_rock
-    [rad/s], p = 1; see OMEGA_SPRING and SPRING_DECAY)."""
+    [rad/s], p = 1; see OMEGA_SPRING and SPRING_DECAY). The last factor bounds RK4's
+    damping of an oscillation: it applies where the spring's damping ratio while rocking,
+    zeta_rock (``points.rocking_spring_zeta``; 0 if unknown), is below 1; at and above 1
+    omega_rock is the overdamped mode's fast decay rate, which RK4 follows without one."""
     w = np.asarray(omega_rock, float)
-    with np.errstate(divide="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore"):
         f = np.maximum(1.0, (OMEGA_SPRING / w) ** 0.4)
-    return steps_per_period * np.maximum(f, (w / OMEGA_DAMP) ** 0.2)
+        damp = np.where(np.asarray(zeta_rock, float) < 1.0, (w / OMEGA_DAMP) ** 0.2, 0.0)
+    return steps_per_period * np.maximum(f, damp)
 
 
 def step_sizes(omega_rock: np.ndarray | float, omega: np.ndarray | float,
                steps_per_period: int, pulse_steps: int = 0,
-               omega_amp: np.ndarray | float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+               omega_amp: np.ndarray | float = 0.0,
+               zeta_rock: np.ndarray | float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """The RK4 steps [p*t] of a run: (dt, dt_on), after and while the ground moves.
 
     The step follows the time scales that act at each moment. Always: the top mass's
     spring period while the base rocks (2 pi/omega_rock, the stiffest the kernel meets;
     inf for a rigid body) over ``spring_steps`` and the rocking period scale 2 pi/p
-    (= 2 pi) over ``steps_per_period``: that is dt. While the pulse (or record) acts, also
+    (= 2 pi) over ``steps_per_period``: that is dt (zeta_rock: the spring's damping ratio
+    while rocking, ``spring_steps``). While the pulse (or record) acts, also
     its period 2 pi/omega over max(pulse_steps, steps_per_period) and the pulse's own
     rocking time scale 2 pi/omega_amp (``amplitude_frequency``; 0 leaves it out) over
     steps_per_period: dt_on <= dt. A short, strong pulse thus gets the steps its work on
@@ -247,7 +254,8 @@ def step_sizes(omega_rock: np.ndarray | float, omega: np.ndarray | float,
     n_on = max(int(pulse_steps), int(steps_per_period))
     w = np.asarray(omega_rock, float)
     with np.errstate(divide="ignore", invalid="ignore"):
-        spring = np.where(w > 0.0, two_pi / (w * spring_steps(w, steps_per_period)), np.inf)
+        spring = np.where(w > 0.0, two_pi / (w * spring_steps(w, steps_per_period,
+                                                                zeta_rock)), np.inf)
         free = np.minimum(spring, two_pi / steps_per_period)
         on = np.minimum(free, two_pi / np.asarray(omega, float) / n_on)
         on = np.minimum(on, two_pi / np.asarray(omega_amp, float) / steps_per_period)

@@ -169,13 +169,37 @@ def body_omega_rock(body: Body) -> float:
     return float(rocking_spring_omega(body.omega_n, body.zeta, body.m, body.h, i_a0, 0.0))
 
 
+def rocking_spring_zeta(omega_rock: np.ndarray | float, k: np.ndarray | float,
+                        c: np.ndarray | float) -> np.ndarray:
+    """The spring's damping ratio while the base rocks, zeta' = zeta sqrt(Gamma) =
+    c omega_rock / (2 k) (``rocking_spring_omega``: omega_rock = omega_n sqrt(Gamma),
+    omega_n = sqrt(k/m), zeta = c / (2 sqrt(k m))), where it is below 1; where the mode is
+    overdamped, omega_rock is its fast root and this is zeta' (zeta' + sqrt(zeta'^2 - 1)),
+    above 1 too: < 1 says the mode oscillates (``numerics.spring_steps``). k [N/m], c
+    [N s/m], omega_rock [rad/s], p = 1; 0 for a rigid body (k = 0). float64 like the input."""
+    k = np.asarray(k, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(k > 0.0, np.asarray(c, float) * np.asarray(omega_rock, float)
+                        / (2.0 * k), 0.0)
+
+
+def body_zeta_rock(body: Body) -> float:
+    """``rocking_spring_zeta`` of a body (0 for a rigid one)."""
+    if body.rigid:
+        return 0.0
+    return float(rocking_spring_zeta(body_omega_rock(body), body.k, body.c))
+
+
 def run_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, w_over_p: np.ndarray,
              A_ratio: np.ndarray, numerics: Numerics,
-             phase: np.ndarray | float = 2 * math.pi) -> tuple[np.ndarray, ...]:
+             phase: np.ndarray | float = 2 * math.pi,
+             zeta_rock: np.ndarray | float = 0.0) -> tuple[np.ndarray, ...]:
     """A run's steps, length and step cap, vectorised over points (all float64[n], p = 1).
 
     phase: the pulse's duration in w t (2 pi n, 6 pi for the Ricker, 2 pi gamma for MP).
-    Returns dt [p*t] after the pulse and dt_on while it acts (``step_sizes``), t_pulse =
+    zeta_rock: the spring's damping ratio while rocking (``rocking_spring_zeta``; 0, the
+    default, takes the spring to oscillate: the most steps). Returns dt [p*t] after the
+    pulse and dt_on while it acts (``step_sizes``), t_pulse =
     phase/omega, t_end = t_pulse + horizon [p*t] and the cap on RK4 evaluations
     (``step_budget``): the kernel's PAR_DT, PAR_DT_ON, PAR_TPULSE, PAR_TEND and
     PAR_MAXSTEPS. The scene bounds the last (MAX_POINT_STEPS). w_over_p = 0 is no ground
@@ -184,7 +208,8 @@ def run_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, w_over_p: np.ndarray
     omega = np.asarray(w_over_p, float)  # p = 1 rad/s
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
         dt, dt_on = step_sizes(omega_rock, omega, numerics.steps_per_period,
-                               numerics.pulse_steps, amplitude_frequency(A_ratio, alpha_ref))
+                               numerics.pulse_steps, amplitude_frequency(A_ratio, alpha_ref),
+                               zeta_rock)
         t_pulse = np.where(omega == 0.0, 0.0, phase / omega)
         t_end = t_pulse + numerics.horizon
         max_steps = step_budget(t_pulse, t_end, dt, dt_on, numerics)
@@ -192,8 +217,8 @@ def run_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, w_over_p: np.ndarray
 
 
 def record_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, p: np.ndarray,
-                A_ratio: np.ndarray, record: GroundRecord, numerics: Numerics
-                ) -> tuple[np.ndarray, ...]:
+                A_ratio: np.ndarray, record: GroundRecord, numerics: Numerics,
+                zeta_rock: np.ndarray | float = 0.0) -> tuple[np.ndarray, ...]:
     """``run_cost`` for a record, vectorised over points (float64[n]; p [rad/s]).
 
     The step after the record is ``step_sizes``' dt (no pulse period). While the record
@@ -207,7 +232,8 @@ def record_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, p: np.ndarray,
     p = np.asarray(p, float)
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
         dt, dt_on = step_sizes(omega_rock, 0.0, numerics.steps_per_period,
-                               numerics.pulse_steps, amplitude_frequency(A_ratio, alpha_ref))
+                               numerics.pulse_steps, amplitude_frequency(A_ratio, alpha_ref),
+                               zeta_rock)
         dt_k = p * record.dt
         h_rec = dt_k / np.ceil(dt_k / dt_on)
         t_pulse = p * record.duration
@@ -242,9 +268,11 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     rows[:] = body_rows
     omega = np.asarray(w_over_p, float)  # p = 1 rad/s
     code = np.asarray(shape_code, float)
+    zeta_rock = rocking_spring_zeta(omega_rock, body_rows[:, L.PAR_K], body_rows[:, L.PAR_C])
     if record is not None:
         dt, h_rec, t_pulse, t_end, max_steps = record_cost(omega_rock, alpha_ref, omega,
-                                                           A_ratio, record, numerics)
+                                                           A_ratio, record, numerics,
+                                                           zeta_rock)
         rows[:, L.PAR_REC_DT] = omega * record.dt
         rows[:, L.PAR_REC_H] = h_rec
         dt_on = h_rec
@@ -255,7 +283,7 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
                           [pulse_duration(RICKER), pulse_duration(MP, gamma=gamma)],
                           pulse_duration(SINE, cycles=cycles))
         dt, dt_on, t_pulse, t_end, max_steps = run_cost(omega_rock, alpha_ref, omega,
-                                                        A_ratio, numerics, phase)
+                                                        A_ratio, numerics, phase, zeta_rock)
         if np.any(code == L.SHAPE_MP):
             from rocksweep.physics.excitation import mp_peak
 

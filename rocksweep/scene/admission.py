@@ -22,7 +22,12 @@ from rocksweep.numerics import (
     Numerics,
 )
 from rocksweep.physics.model import BodyError
-from rocksweep.physics.points import body_omega_rock, record_cost, run_cost
+from rocksweep.physics.points import (
+    body_omega_rock,
+    body_zeta_rock,
+    record_cost,
+    run_cost,
+)
 from rocksweep.scene.model import Scene, SceneError
 from rocksweep.schema import KEYS, fmt
 
@@ -83,13 +88,14 @@ def _budgets(scene: Scene, bodies: list[dict[str, float]], w: np.ndarray, A: np.
     (NaN, from an overflow, counts as inf)."""
     built = [scene.make_body(**b) for b in bodies]
     omega_rock = np.array([body_omega_rock(b) for b in built])[:, None, None]
+    zeta_rock = np.array([body_zeta_rock(b) for b in built])[:, None, None]
     alpha_ref = np.array([b.alpha_ref for b in built])[:, None, None]
     shape = (len(built), w.size, A.size)
     _, _, _, _, cap = run_cost(np.broadcast_to(omega_rock, shape),
                                np.broadcast_to(alpha_ref, shape),
                                np.broadcast_to(w[None, :, None], shape),
                                np.broadcast_to(A[None, None, :], shape), numerics,
-                               scene.phase_max())
+                               scene.phase_max(), np.broadcast_to(zeta_rock, shape))
     return np.where(np.isnan(cap), math.inf, cap)
 
 
@@ -106,7 +112,7 @@ def _check_record_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
                 for av in (A.min(), A.max()):
                     dt, h_rec, _, t_end, cap = record_cost(
                         np.array([body_omega_rock(body)]), np.array([body.alpha_ref]),
-                        np.array([pv]), np.array([av]), rec, n)
+                        np.array([pv]), np.array([av]), rec, n, body_zeta_rock(body))
                     c = float(cap[0])
                     if not (c <= MAX_POINT_STEPS):
                         raise SceneError(
@@ -140,7 +146,7 @@ def _check_suite_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
             for n, label in _runs(scene):
                 _, h_rec, _, _, cap = record_cost(np.array([body_omega_rock(body)] * 2),
                                                   np.array([body.alpha_ref] * 2), p_ends, A,
-                                                  rec, n)
+                                                  rec, n, body_zeta_rock(body))
                 worst = int(np.argmax(np.where(np.isnan(cap), math.inf, cap)))
                 c = float(cap[worst])
                 if not (c <= MAX_POINT_STEPS):
@@ -210,7 +216,7 @@ def _point_cost(scene: Scene, point: dict[str, float], numerics: Numerics | None
                                         np.array([body.alpha_ref]),
                                         np.array([point["pulse.w_over_p"]]),
                                         np.array([point["pulse.A_ratio"]]), n,
-                                        scene.phase_max())
+                                        scene.phase_max(), body_zeta_rock(body))
         c = float(cap[0])
         c = math.inf if math.isnan(c) else c
         if worst is None or c > worst[0]:

@@ -12,6 +12,8 @@ import pytest
 
 from rocksweep.compute.driver import sweep_arrays
 from rocksweep.numerics import PRESETS, SPRING_DECAY, Numerics, spring_steps, step_sizes
+from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.points import body_omega_rock, body_zeta_rock
 from rocksweep.physics.reference import reference_run
 from rocksweep.scene.parse import load_scene
 
@@ -75,3 +77,25 @@ def test_threshold_point_of_figure4b_is_safe_at_default() -> None:
     ref = reference_run(point, scene.numerics, rtol=1e-10, atol=1e-12)
     assert int(ref["outcome"]) == 0
     assert int(out["outcome"].ravel()[0]) == int(ref["outcome"])
+
+
+def test_an_overdamped_spring_gets_no_damping_bound() -> None:
+    """zeta' = zeta sqrt(Gamma) >= 1 while rocking: omega_rock is the overdamped mode's fast
+    decay rate, with no oscillation for RK4 to damp; the bound is for zeta' < 1 only, and
+    ``body_zeta_rock`` tells the two apart (Gamma = 1 + m h^2 / (I_A + m_A R_A^2), eq. of
+    the rocking phase linearised at the top mass over the corner)."""
+    for zeta, overdamped in ((0.05, False), (0.3, False), (3.0, True)):
+        body = FlexibleBody(9.82, zeta, 0.15, 0.28, 0.47, 0.56)  # Figure 4's, other zeta
+        gamma = 1 + body.m * body.h ** 2 / (body.I_A + body.m_A * body.R_A ** 2)
+        zr = zeta * math.sqrt(gamma)
+        assert (zr >= 1) == overdamped
+        w = body_omega_rock(body)
+        if not overdamped:
+            assert w == pytest.approx(body.omega_n * math.sqrt(gamma))
+            assert body_zeta_rock(body) == pytest.approx(zr)
+        else:
+            assert body_zeta_rock(body) > 1.0
+        want = 5 * max(1.0, (27.5 / w) ** 0.4)
+        if not overdamped:
+            want = max(want, 2 * math.pi * (w / (144 * SPRING_DECAY)) ** 0.2)
+        assert float(spring_steps(w, 5, body_zeta_rock(body))) == pytest.approx(want)

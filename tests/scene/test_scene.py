@@ -262,13 +262,18 @@ def _expected_steps(w: float, A: float, wn: float = 2.43, zeta: float = 0.05,
                     horizon: float = 200.0, max_events: int = 5000) -> float:
     """PAR_MAXSTEPS as the kernel's docs define it (issue 28): 20 x (ceil(t_pulse/dt_on) +
     ceil(horizon/dt)) + 200 x max_events, t_pulse = 2 pi/w; dt = the shorter of the spring's
-    period over spp x max(1, (27.5/omega_rock)^(2/5)) and the rocking's (2 pi) over spp;
+    period over spp x max(1, (27.5/omega_rock)^(2/5)) (or, for a spring that oscillates
+    while rocking, zeta' < 1, over the n at which RK4's leading-order damping of it,
+    omega_rock (2 pi/n)^5/144, is 0.1 (5/spp)^5, if more) and the rocking's (2 pi) over spp;
     dt_on = dt, the pulse's period over max(ps, spp) and the amplitude's (2 pi/sqrt(|A| tan
     alpha_cg)) over spp, the shortest. Default: `default`'s finest refinement (3 doublings
     of 5 steps per period and 12 per pulse period), the scene's costliest run."""
-    omega_rock = body_omega_rock(FlexibleBody(**{**TABLE3, "wn_over_p": wn, "zeta": zeta,
-                                                 "mA_over_m": mu}))
+    body = FlexibleBody(**{**TABLE3, "wn_over_p": wn, "zeta": zeta, "mA_over_m": mu})
+    omega_rock = body_omega_rock(body)
     n_spring = spp * max(1.0, (27.5 / omega_rock) ** 0.4)
+    if body.zeta * omega_rock / body.omega_n < 1.0:  # zeta sqrt(Gamma): underdamped
+        n_damp = 2 * math.pi * (omega_rock / (144 * 0.1 * (5 / spp) ** 5)) ** 0.2
+        n_spring = max(n_spring, n_damp)
     dt = min(2 * math.pi / omega_rock / n_spring, 2 * math.pi / spp)
     w_amp = math.sqrt(abs(A) * math.tan(0.15))
     dt_on = min(dt, 2 * math.pi / w / max(ps, spp),
@@ -337,15 +342,15 @@ def test_the_refinement_is_checked_too():
     """The certification of close calls re-runs a point at up to 8x the steps (refine = 3):
     a scene whose finest rerun would pass the step cap is refused, naming numerics.refine;
     without certification it runs."""
-    wn = 3000.0
+    wn = 1000.0
     assert _expected_steps(w=5.3, A=5.0, wn=wn, spp=5, ps=12) < MAX_POINT_STEPS
     assert _expected_steps(w=5.3, A=5.0, wn=wn) > MAX_POINT_STEPS
     msg = refused(sub("wn_over_p: 2.43", f"wn_over_p: {wn}"))
     steps = _expected_steps(w=5.3, A=5.0, wn=wn)
-    assert msg.startswith(f"body.wn_over_p = 3000.0: one point could need {steps:.2g} RK4 "
+    assert msg.startswith(f"body.wn_over_p = 1000.0: one point could need {steps:.2g} RK4 "
                           "steps" + REFINED), msg
     accepted(sub("wn_over_p: 2.43", f"wn_over_p: {wn}") + "numerics: {refine: 0}\n")
-    accepted(sub("wn_over_p: 2.43", "wn_over_p: 1000.0"))
+    accepted(sub("wn_over_p: 2.43", "wn_over_p: 300.0"))
 
 
 def test_shipped_scenes_stay_valid():
