@@ -196,37 +196,54 @@ OMEGA_SPRING = 27.5
 # leading order), on top of its physical zeta' omega' = zeta omega_n Gamma = 3.8 p while the
 # top mass is over the corner (``rocking_spring_omega``) and 0.49 p in full contact: near
 # the uplift threshold under long pulses (A_ratio 0.9-1.4, w_over_p 0.15-1.2, hundreds of
-# small uplifts) `default` then classed 10 and 17 of 6579 cells of Figures 4(a)/(b) unlike
-# `fine` and the scipy reference, none flagged. So the spring also gets
-# (omega_rock/OMEGA_DAMP)^(1/5) times the steps: a leading-order decay rate of at most
-# SPRING_DECAY x p at 5 steps per period, SPRING_DECAY (5/steps_per_period)^5 at others
-# (the presets keep their order; a refinement's doubling halves every step). At 0.1 the
-# band's differences from `fine` fall from 10/16 to 2/3 (the reference siding with `fine`
-# on all but one), and 6 -> 0, 9 -> 3, 36 -> 19 on stiffer bodies (wn/p = 20, 50, and 35
-# undamped), for 1.43x the steps where Figure 4's spring sets them: +25%/+14% RK4
-# evaluations on the band, +23%/+22% on Figures 4(a)/(b), +15% on the four figures
-# (scripts/bench_threshold.py). 0.05 fixed no more of the damped bodies' cells, 0.02 one;
-# an undamped spring (zeta = 0: nothing else bounds how long the error lives) wants ~0.01
-# (19 -> 5), which a bound on omega_rock alone cannot give it without charging every
-# stiff body 1.6x (docs/accuracy.md). Springs below
-# (OMEGA_DAMP OMEGA_SPRING^2)^(1/3) = 15.2 x p (Figure 3's, 6.8) and rigid bodies keep
+# small uplifts) `default` then classed 10 and 16 of 6579 cells of Figures 4(a)/(b) unlike
+# `fine` and the scipy reference, none flagged. So an oscillating spring (zeta' < 1) also
+# gets the steps that hold that numerical decay rate to ``spring_decay`` at 5 steps per
+# period, (5/steps_per_period)^5 of it at others (the presets keep their order; a
+# refinement's doubling halves every step):
+#
+#     SPRING_DECAY_FREE + SPRING_DECAY_REL x zeta' omega_rock, at most SPRING_DECAY [p].
+#
+# What the error does to the spring's amplitude depends on what else damps it: driven and
+# damped at zeta' omega', the amplitude is off by ~sigma/(zeta' omega'), 1/38 = 2.6% at
+# SPRING_DECAY_REL; an undamped spring (zeta = 0) keeps the whole error for as long as the
+# run lasts, and gets SPRING_DECAY_FREE. Measured (scripts/bench_threshold.py; cells of the
+# band unlike `fine`, the reference siding with `fine`): at 0.1 p Figure 4's body (3.8 p:
+# 0.1) 10/16 -> 2/3, stiffer damped bodies (wn/p = 20, 50) 6 -> 0 and 9 -> 3, and 0.05 or
+# 0.02 fix ~nothing more there; undamped bodies kept 49-95 wrong cells at 0.1 p, 15-26 at
+# 0.01, 15-20 at 0.005 (docs/accuracy.md). Price: docs/accuracy.md ("Stiff springs near the
+# uplift threshold"); Figure 3's body (6.8 p, zeta' omega' = 0.95 p) and rigid bodies keep
 # their steps.
 SPRING_DECAY = 0.1
-OMEGA_DAMP = 144.0 * SPRING_DECAY * (5.0 / (2 * math.pi)) ** 5
+SPRING_DECAY_FREE = 0.01
+SPRING_DECAY_REL = 1.0 / 38.0
+
+
+def spring_decay(zeta_rock: np.ndarray | float, omega_rock: np.ndarray | float
+                 ) -> np.ndarray:
+    """The largest numerical decay rate [p] RK4 may add to an oscillating spring at 5 steps
+    per period: min(SPRING_DECAY, SPRING_DECAY_FREE + SPRING_DECAY_REL zeta' omega_rock)
+    (zeta_rock = zeta', the spring's damping ratio while rocking; omega_rock [rad/s], p =
+    1)."""
+    rate = np.asarray(zeta_rock, float) * np.asarray(omega_rock, float)
+    return np.minimum(SPRING_DECAY, SPRING_DECAY_FREE + SPRING_DECAY_REL * rate)
 
 
 def spring_steps(omega_rock: np.ndarray | float, steps_per_period: int,
                  zeta_rock: np.ndarray | float = 0.0) -> np.ndarray:
-    """RK4 steps per spring period 2 pi/omega_rock: steps_per_period x
-    max(1, (OMEGA_SPRING/omega_rock)^(2/5), (omega_rock/OMEGA_DAMP)^(1/5)) (omega_rock
-    [rad/s], p = 1; see OMEGA_SPRING and SPRING_DECAY). The last factor bounds RK4's
-    damping of an oscillation: it applies where the spring's damping ratio while rocking,
-    zeta_rock (``points.rocking_spring_zeta``; 0 if unknown), is below 1; at and above 1
-    omega_rock is the overdamped mode's fast decay rate, which RK4 follows without one."""
+    """RK4 steps per spring period 2 pi/omega_rock: steps_per_period x the largest of 1,
+    (OMEGA_SPRING/omega_rock)^(2/5) and, for a spring that oscillates while the base rocks
+    (zeta_rock < 1: ``points.rocking_spring_zeta``; 0, the default, an undamped one),
+    (omega_rock/omega_d)^(1/5), omega_d = 144 ``spring_decay`` (5/2 pi)^5: RK4's
+    leading-order damping of it, omega_rock (2 pi/n)^5/144, is then spring_decay
+    (5/steps_per_period)^5. At zeta_rock >= 1 omega_rock is the overdamped mode's fast
+    decay rate, which RK4 follows without such a bound. omega_rock [rad/s], p = 1."""
     w = np.asarray(omega_rock, float)
+    zr = np.asarray(zeta_rock, float)
+    omega_d = 144.0 * spring_decay(zr, w) * (5.0 / (2 * math.pi)) ** 5
     with np.errstate(divide="ignore", invalid="ignore"):
         f = np.maximum(1.0, (OMEGA_SPRING / w) ** 0.4)
-        damp = np.where(np.asarray(zeta_rock, float) < 1.0, (w / OMEGA_DAMP) ** 0.2, 0.0)
+        damp = np.where(zr < 1.0, (w / omega_d) ** 0.2, 0.0)
     return steps_per_period * np.maximum(f, damp)
 
 

@@ -5,18 +5,21 @@ the step rule before and after its damping bound, side by side in one run.
     python scripts/bench_threshold.py --bodies fig4a s20 --no-reference --no-figures
 
 ``before`` is the rule without the bound on RK4's numerical damping of the spring mode
-(``numerics.OMEGA_DAMP`` set to inf: steps_per_period x max(1, (OMEGA_SPRING/omega_rock)^(2/5))
-per spring period); ``after`` is ``numerics.spring_steps`` as it stands. Both run at the
+(``spring_steps_before``: steps_per_period x max(1, (OMEGA_SPRING/omega_rock)^(2/5)) per
+spring period); ``after`` is ``numerics.spring_steps`` as it stands. Both run at the
 `default` preset (certification on), through ``compute.driver.sweep_arrays``.
 
 1. The threshold band: A_ratio 0.9-1.4 (51) x w_over_p 0.15-1.2 (43) x lam 0, 0.4, 0.8
-   (6579 points) on Figure 4's body (configs/fig4a.yaml, sine; fig4b.yaml, cosine), three
-   stiffer bodies of other proportions (``BODIES``: wn/p = 20 and 50; 35 undamped, zeta = 0)
-   and a block (control: no spring, its steps must not move). Printed per body and rule:
+   (6579 points) on Figure 4's body (configs/fig4a.yaml, sine; fig4b.yaml, cosine), two
+   stiffer damped bodies of other proportions (``BODIES``: wn/p = 20 and 50), three
+   undamped ones (zeta = 0: wn/p 35, Figure 4's, 12) and a block (control: no spring, its
+   steps must not move). Printed per body and rule:
    cells whose class differs from `fine`, how many of them are flagged (refined or uncertified), RK4
    evaluations per point; then (unless --no-reference) each differing cell run through
    the scipy reference (``physics.reference.reference_run``, rtol 1e-10, atol 1e-12):
-   whether it agrees with the rule's class or with `fine`'s.
+   whether it agrees with `fine`'s class or the rule's ("ref f/r": counts; at most
+   --ref-max cells, a random sample if more). w_rock is omega_rock/p, zeta_w the spring's
+   physical decay rate while rocking, zeta' omega_rock [p] (``numerics.spring_decay``).
 2. The four figures (19 200 points each) at `default`: RK4 evaluations per point
    (deterministic) and CPU time per point [core-us] (best of --rounds, the rounds
    alternating between the rules), with the ratio after/before, cells differing from
@@ -45,7 +48,7 @@ import numpy as np  # noqa: E402
 import rocksweep.numerics as numerics  # noqa: E402
 from rocksweep.compute.driver import sweep_arrays  # noqa: E402
 from rocksweep.kernel import layout as L  # noqa: E402, N812
-from rocksweep.physics.points import body_omega_rock  # noqa: E402
+from rocksweep.physics.points import body_omega_rock, body_zeta_rock  # noqa: E402
 from rocksweep.physics.reference import reference_run  # noqa: E402
 from rocksweep.scene.parse import load_scene, parse_scene  # noqa: E402
 
@@ -75,6 +78,18 @@ body: {wn_over_p: 35, zeta: 0.0, alpha_cg: 0.2, alpha_A: 0.3, mA_over_m: 1.5, IA
 impact: {lam: 0.0}
 pulse: {shape: sine, w_over_p: 1, A_ratio: 1}
 """,
+    "f4z": """
+name: Figure 4's body undamped (zeta 0), cosine
+body: {wn_over_p: 9.82, zeta: 0.0, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47, IA_ratio: 0.56}
+impact: {lam: 0.0}
+pulse: {shape: cosine, w_over_p: 1, A_ratio: 1}
+""",
+    "s12z": """
+name: undamped body wn/p 12, alpha_cg 0.3, cosine
+body: {wn_over_p: 12, zeta: 0.0, alpha_cg: 0.3, alpha_A: 0.4, mA_over_m: 0.8, IA_ratio: 0.6}
+impact: {lam: 0.0}
+pulse: {shape: cosine, w_over_p: 1, A_ratio: 1}
+""",
     "block": """
 name: block alpha 0.15 (control)
 body: {kind: block, alpha: 0.15}
@@ -86,18 +101,27 @@ RULES = ("before", "after")
 FLAGS = L.STATUS_REFINED | L.STATUS_UNCERTIFIED | L.STATUS_FLAGGED
 
 
+def spring_steps_before(omega_rock, steps_per_period, zeta_rock=0.0):
+    """The spring's steps before the damping bound: steps_per_period x
+    max(1, (OMEGA_SPRING/omega_rock)^(2/5))."""
+    with np.errstate(divide="ignore"):
+        return steps_per_period * np.maximum(
+            1.0, (numerics.OMEGA_SPRING / np.asarray(omega_rock, float)) ** 0.4)
+
+
 class rule:  # noqa: N801 (a context, used as `with rule(name):`)
-    """The spring's step rule `before` (no damping bound: OMEGA_DAMP = inf) or `after`."""
+    """The spring's step rule `before` the damping bound or `after` (as it stands):
+    ``numerics.step_sizes`` looks ``spring_steps`` up at each call."""
 
     def __init__(self, name: str) -> None:
-        self.damp = math.inf if name == "before" else numerics.OMEGA_DAMP
+        self.steps = spring_steps_before if name == "before" else numerics.spring_steps
 
     def __enter__(self) -> None:
-        self.saved = numerics.OMEGA_DAMP
-        numerics.OMEGA_DAMP = self.damp
+        self.saved = numerics.spring_steps
+        numerics.spring_steps = self.steps
 
     def __exit__(self, *exc) -> None:
-        numerics.OMEGA_DAMP = self.saved
+        numerics.spring_steps = self.saved
 
 
 def scene(name: str, overrides: list[str]):
@@ -118,24 +142,24 @@ def point_of(sc, index: tuple):
                             for ax, k in zip(sc.swept, index, strict=True)}
 
 
-def band(names: list[str], reference: bool) -> None:
+def band(names: list[str], reference: bool, ref_max: int) -> None:
     print("1. threshold band: A_ratio 0.9-1.4 x w_over_p 0.15-1.2 x lam 0/0.4/0.8 "
           "(6579 points), `default` against `fine`")
-    print(f"{'body':<7}{'omega_rock':>11}{'rule':>8}{'spring x':>9}{'differ':>7}"
-          f"{'flagged':>8}{'evals/pt':>10}{'ratio':>7}{'ref=fine':>9}{'ref=rule':>9}"
-          f"{'s':>6}")
+    print(f"{'body':<7}{'w_rock':>9}{'zeta_w':>8}{'rule':>8}{'spring x':>9}{'differ':>7}"
+          f"{'flagged':>8}{'evals/pt':>10}{'ratio':>7}{'ref f/r':>12}{'s':>6}")
     for name in names:
         sc_fine = scene(name, BAND + ["numerics.accuracy=fine"])
         fine, _ = sweep_arrays(sc_fine, jobs=2)
         sc = scene(name, BAND)
-        w = body_omega_rock(sc.point({ax.name: ax.values[0] for ax in sc.axes}).body)
+        body = sc.point({ax.name: ax.values[0] for ax in sc.axes}).body
+        w, zr = body_omega_rock(body), body_zeta_rock(body)
         e0 = None
         refs: dict[tuple, int] = {}  # the reference's class per differing cell
         for r in RULES:
             t = time.perf_counter()
             with rule(r):
                 a, _ = sweep_arrays(sc, jobs=2)
-                factor = float(numerics.spring_steps(w, 5) / 5) if w else math.nan
+                factor = float(numerics.spring_steps(w, 5, zr) / 5) if w else math.nan
             diff = a["outcome"] != fine["outcome"]
             flagged = int(np.sum((a["status"][diff].astype(np.int64) & FLAGS) != 0))
             e = evals(a)
@@ -143,7 +167,9 @@ def band(names: list[str], reference: bool) -> None:
             agree_fine = agree_rule = "-"
             if reference and diff.any():
                 agree_fine = agree_rule = 0
-                for i in np.argwhere(diff):
+                cells = np.argwhere(diff)
+                cells = cells[np.random.default_rng(0).permutation(len(cells))[:ref_max]]
+                for i in cells:
                     if tuple(i) not in refs:
                         pt, _ = point_of(sc, tuple(i))
                         refs[tuple(i)] = reference_run(pt, sc.numerics, rtol=1e-10,
@@ -151,8 +177,9 @@ def band(names: list[str], reference: bool) -> None:
                     ref = refs[tuple(i)]
                     agree_fine += int(ref == fine["outcome"][tuple(i)])
                     agree_rule += int(ref == a["outcome"][tuple(i)])
-            print(f"{name:<7}{w:>11.2f}{r:>8}{factor:>9.3f}{int(diff.sum()):>7}{flagged:>8}"
-                  f"{e:>10.1f}{e / e0:>7.3f}{agree_fine!s:>9}{agree_rule!s:>9}"
+            checked = f"{agree_fine}/{agree_rule}" if agree_fine != "-" else "-"
+            print(f"{name:<7}{w:>9.2f}{zr * w:>8.2f}{r:>8}{factor:>9.3f}{int(diff.sum()):>7}"
+                  f"{flagged:>8}{e:>10.1f}{e / e0:>7.3f}{checked:>12}"
                   f"{time.perf_counter() - t:>6.1f}", flush=True)
 
 
@@ -193,6 +220,9 @@ def main() -> None:
     ap.add_argument("--bodies", nargs="*", default=list(BODIES))
     ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--no-reference", dest="reference", action="store_false")
+    ap.add_argument("--ref-max", type=int, default=12,
+                    help="differing cells per body and rule run through the reference "
+                         "(a random sample, seed 0, if more)")
     ap.add_argument("--no-figures", dest="figures", action="store_false")
     args = ap.parse_args()
     t_import = time.perf_counter() - T0
@@ -205,9 +235,9 @@ def main() -> None:
                                 ["pulse.A_ratio=1.0", "pulse.w_over_p=1.0"]), jobs=1)
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores; start-up: "
           f"imports {t_import:.2f} s, kernel warm-up {time.perf_counter() - t:.2f} s; "
-          f"SPRING_DECAY {numerics.SPRING_DECAY} p at 5 steps per period "
-          f"(OMEGA_DAMP {numerics.OMEGA_DAMP:.3f})\n")
-    band(args.bodies, args.reference)
+          f"spring decay bound at 5 steps per period: min({numerics.SPRING_DECAY}, "
+          f"{numerics.SPRING_DECAY_FREE} + {numerics.SPRING_DECAY_REL:.4f} zeta_w) p\n")
+    band(args.bodies, args.reference, args.ref_max)
     if args.figures:
         figures(args.rounds)
 

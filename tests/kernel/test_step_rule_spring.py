@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from rocksweep.compute.driver import sweep_arrays
-from rocksweep.numerics import PRESETS, SPRING_DECAY, Numerics, spring_steps, step_sizes
+from rocksweep.numerics import PRESETS, Numerics, spring_steps, step_sizes
 from rocksweep.physics.model import FlexibleBody
 from rocksweep.physics.points import body_omega_rock, body_zeta_rock
 from rocksweep.physics.reference import reference_run
@@ -36,17 +36,27 @@ def rk4_decay_rate(omega: float, dt: float) -> float:
     return -math.log(max(abs(np.linalg.eigvals(m)))) / dt
 
 
+def bound(zeta_rock: float, omega_rock: float, spp: int) -> float:
+    """The damping [p] the rule allows (docs/accuracy.md): min(0.1, 0.01 + zeta' omega/38)
+    at 5 steps per period, (5/spp)^5 of it at spp."""
+    return min(0.1, 0.01 + zeta_rock * omega_rock / 38.0) * (5.0 / spp) ** 5
+
+
 @pytest.mark.parametrize("spp", [4, 5, 10, 20])
+@pytest.mark.parametrize("zeta_rock", [0.0, 0.02, 0.14, 0.9])
 @pytest.mark.parametrize("omega_rock", [16.0, 27.46, 60.0, 167.3, 1000.0])
-def test_spring_decay_bounded(omega_rock: float, spp: int) -> None:
-    """At the rule's step (the spring setting it: omega_rock >> 2 pi) RK4 damps the spring
-    by at most SPRING_DECAY (5/spp)^5 per unit p*t; the leading-order y^6/144 the rule uses
-    bounds the exact rate from above."""
-    dt, _ = step_sizes(omega_rock, 1.0, spp, PRESETS["default"][0])
-    assert float(dt) == pytest.approx(2 * math.pi / (omega_rock * spring_steps(omega_rock, spp)))
+def test_spring_decay_bounded(omega_rock: float, zeta_rock: float, spp: int) -> None:
+    """At the rule's step (where the spring sets it) RK4 damps an oscillating spring by at
+    most the bound per unit p*t; the leading-order y^6/144 the rule uses bounds the exact
+    rate from above, and the rule takes no more steps than that needs."""
+    dt, _ = step_sizes(omega_rock, 1.0, spp, PRESETS["default"][0], zeta_rock=zeta_rock)
+    n = float(spring_steps(omega_rock, spp, zeta_rock))
+    assert float(dt) == pytest.approx(2 * math.pi / (omega_rock * n))
     rate = rk4_decay_rate(omega_rock, float(dt))
-    assert rate <= SPRING_DECAY * (5.0 / spp) ** 5 * (1 + 1e-9)
-    assert rate >= 0.5 * SPRING_DECAY * (5.0 / spp) ** 5  # and not far below: no waste
+    assert rate <= bound(zeta_rock, omega_rock, spp) * (1 + 1e-9)
+    soft = spp * max(1.0, (27.5 / omega_rock) ** 0.4)
+    if n > soft * (1 + 1e-12):  # the bound sets the steps: not far below it (no waste)
+        assert rate >= 0.5 * bound(zeta_rock, omega_rock, spp)
 
 
 def test_figure4_spring_at_five_steps_was_damped_as_physics() -> None:
@@ -54,16 +64,20 @@ def test_figure4_spring_at_five_steps_was_damped_as_physics() -> None:
     damp it at ~0.49 p, as much as the physical zeta omega_n = 0.05 x 9.82 in full contact."""
     rate = rk4_decay_rate(27.46, 2 * math.pi / (27.46 * 5))
     assert rate == pytest.approx(0.49, abs=0.01)
-    assert spring_steps(27.46, 5) >= 5 * 1.4
+    assert spring_steps(27.46, 5, 0.14) >= 5 * 1.4
 
 
-@pytest.mark.parametrize("omega_rock", [0.0, 2.0, 6.796, 15.0])
-def test_soft_springs_and_rigid_bodies_keep_their_steps(omega_rock: float) -> None:
-    """Below 15.2 x p (Figure 3's spring, 6.8; rigid bodies: no spring) the bound is not
-    the binding one: the steps stay steps_per_period x max(1, (27.5/omega_rock)^(2/5))."""
+@pytest.mark.parametrize("omega_rock, zeta_rock", [(0.0, 0.0), (2.0, 0.14), (6.796, 0.14),
+                                                   (10.0, 0.14), (2.0, 0.0), (6.5, 0.0)])
+def test_soft_springs_and_rigid_bodies_keep_their_steps(omega_rock: float,
+                                                        zeta_rock: float) -> None:
+    """Figure 3's spring (6.8 p, zeta' = 0.14), damped ones below ~10 p, undamped ones
+    below ~7 p and rigid bodies (no spring): the bound is not the binding one, the steps
+    stay steps_per_period x max(1, (27.5/omega_rock)^(2/5))."""
     for spp in (4, 5, 20):
         want = spp * max(1.0, (27.5 / omega_rock) ** 0.4) if omega_rock else math.inf
-        assert float(spring_steps(omega_rock, spp)) == pytest.approx(want, rel=1e-12)
+        got = float(spring_steps(omega_rock, spp, zeta_rock))
+        assert got == pytest.approx(want, rel=1e-12)
 
 
 def test_threshold_point_of_figure4b_is_safe_at_default() -> None:
@@ -97,5 +111,5 @@ def test_an_overdamped_spring_gets_no_damping_bound() -> None:
             assert body_zeta_rock(body) > 1.0
         want = 5 * max(1.0, (27.5 / w) ** 0.4)
         if not overdamped:
-            want = max(want, 2 * math.pi * (w / (144 * SPRING_DECAY)) ** 0.2)
+            want = max(want, 2 * math.pi * (w / (144 * bound(zr, w, 5))) ** 0.2)
         assert float(spring_steps(w, 5, body_zeta_rock(body))) == pytest.approx(want)

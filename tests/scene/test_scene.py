@@ -264,15 +264,18 @@ def _expected_steps(w: float, A: float, wn: float = 2.43, zeta: float = 0.05,
     ceil(horizon/dt)) + 200 x max_events, t_pulse = 2 pi/w; dt = the shorter of the spring's
     period over spp x max(1, (27.5/omega_rock)^(2/5)) (or, for a spring that oscillates
     while rocking, zeta' < 1, over the n at which RK4's leading-order damping of it,
-    omega_rock (2 pi/n)^5/144, is 0.1 (5/spp)^5, if more) and the rocking's (2 pi) over spp;
+    omega_rock (2 pi/n)^5/144, is min(0.1, 0.01 + zeta' omega_rock/38) (5/spp)^5, if more)
+    and the rocking's (2 pi) over spp;
     dt_on = dt, the pulse's period over max(ps, spp) and the amplitude's (2 pi/sqrt(|A| tan
     alpha_cg)) over spp, the shortest. Default: `default`'s finest refinement (3 doublings
     of 5 steps per period and 12 per pulse period), the scene's costliest run."""
     body = FlexibleBody(**{**TABLE3, "wn_over_p": wn, "zeta": zeta, "mA_over_m": mu})
     omega_rock = body_omega_rock(body)
     n_spring = spp * max(1.0, (27.5 / omega_rock) ** 0.4)
-    if body.zeta * omega_rock / body.omega_n < 1.0:  # zeta sqrt(Gamma): underdamped
-        n_damp = 2 * math.pi * (omega_rock / (144 * 0.1 * (5 / spp) ** 5)) ** 0.2
+    zeta_rock = body.zeta * omega_rock / body.omega_n  # zeta sqrt(Gamma) if underdamped
+    if zeta_rock < 1.0:
+        tol = min(0.1, 0.01 + zeta_rock * omega_rock / 38)
+        n_damp = 2 * math.pi * (omega_rock / (144 * tol * (5 / spp) ** 5)) ** 0.2
         n_spring = max(n_spring, n_damp)
     dt = min(2 * math.pi / omega_rock / n_spring, 2 * math.pi / spp)
     w_amp = math.sqrt(abs(A) * math.tan(0.15))
