@@ -62,7 +62,8 @@ def test_stiff_spring_integrates_stably(runs, pulse, wn):
     dt = point_row(r.point, BASE)[PAR_DT]
     fastest = body_omega_rock(b)
     assert fastest >= b.omega_rock > 2.5 * b.omega_n
-    n = float(spring_steps(fastest, BASE.steps_per_period))
+    zeta_rock = b.zeta * fastest / b.omega_n  # zeta sqrt(Gamma) (underdamped: < 1)
+    n = float(spring_steps(fastest, BASE.steps_per_period, zeta_rock))
     assert n >= BASE.steps_per_period
     assert dt == pytest.approx(2 * math.pi / (fastest * n))
     assert dt * fastest < 2.0

@@ -106,27 +106,18 @@ def test_energy_gaining_impacts_resolved_at_accurate():
 
 
 def test_chattering_cut_short_by_the_rest_rate_is_not_rest():
-    """zeta = 0, stiff spring: the rest-rate rule ends a chattering sequence at `draft`
-    (p*t ~ 137), after which the rest bound holds for the rule-made state; the run ends
-    "settled", not "rest" (a proof). The reference, with the same rule, is still chattering
-    at the horizon on its own trajectory (hundreds more impacts), and so are `default`,
-    `accurate` and `fine`: `default` ended settled at p*t ~ 56 too while RK4 damped this
-    undamped spring (omega_rock/p = 117) at ~2 p (5 steps per spring period, before the
-    spring's steps bounded that damping: ``numerics.SPRING_DECAY``)."""
+    """zeta = 0, stiff spring: the rest-rate rule ends chattering sequences ("settled"),
+    and the run is never called "rest" (a proof) on the rule-made state. The reference, with
+    the same rule, is still chattering at the horizon on its own trajectory (hundreds more
+    impacts), and so is every preset: `default` (and `draft`) ended "settled" at p*t ~ 56
+    (43) while RK4 damped this undamped spring (omega_rock/p = 117) at ~2 p, before the
+    spring's steps bounded that damping (``numerics.spring_decay``)."""
     body = FlexibleBody(22.5, 0.0, 0.195, 0.644, 0.359, 0.582)
     p = Point(body, 0.334, "cosine", 4.78, 15.9)
-    for name in ("draft", "default", "accurate"):
+    for name in ("draft", "default", "accurate", "fine"):
         r = simulate(p, Numerics.preset(name), history=False)
-        if "settled" in r.status:
-            assert "rest" not in r.status, name
-        else:
-            assert "rest" in r.status or r.flagged or r.outcome != "safe", (name, r.status)
-    r = simulate(p, Numerics.preset("draft"), history=False)
-    assert r.status == ["settled"] and r.outcome == "safe"
-    assert r.t_end < 180.0  # ended before the horizon (200): by the rest bound
-    fine = simulate(p, Numerics.preset("fine"), history=False)
-    r = simulate(p, Numerics.preset("default"), history=False)
-    assert r.status == fine.status == ["horizon", "settled"]
+        assert r.status == ["horizon", "settled"] and r.outcome == "safe", (name, r.status)
+        assert r.impacts > 1000, name  # chattering on to the horizon, as the reference does
 
 
 def test_rest_still_proven_without_the_rule():
