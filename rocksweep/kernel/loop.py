@@ -134,6 +134,9 @@ _energy = skipped_when(False, mechanical_energy, 0.0)
 # _step_length: a time within this fraction of a record step of a grid time is on it (t
 # sums steps of ~1e-2..1; its round-off is ~1e-16 relative, far below).
 ALIGN_SLACK = 1e-7
+# _saddle's gate: its bound is widened by this (relative, and in rad), ~1e6 times the
+# round-off of the quantities compared (|theta|, atan(b/h_cg) <= pi/2 rad)
+SADDLE_SLACK = 1e-9
 
 
 def _acting(t, t_pulse, GROUND):
@@ -208,6 +211,12 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     rot = prm[PAR_ROT_STEP]
     acc = 0.0
     margin = np.inf  # OUT_MARGIN, in a register
+    # ``_saddle``'s gate: the saddle at u = 0 and the bound on its shift by u, once per run
+    # (NaN: no gate, every step takes the full test; a row without a body, as warm_up's)
+    saddle0, saddle_du = np.nan, 0.0
+    if prm[PAR_HCG] > 0.0 and prm[PAR_MTOT] > 0.0:
+        saddle0 = math.atan(prm[PAR_B] / prm[PAR_HCG])
+        saddle_du = prm[PAR_M] / (prm[PAR_MTOT] * prm[PAR_HCG])
 
     while True:
         on = _acting(t, t_pulse, GROUND)
@@ -225,7 +234,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             break
         if not FLEX and s != 0 and not on and free_check:
             free_check = False  # E is constant between impacts after the pulse: test once
-            margin = _energy_margin(y, s, prm, margin)
+            margin = _rigid_margin(FLEX, y, s, prm, margin)
             peak = rigid_bounded(y, s, prm, FLEX)
             if peak >= 0.0:
                 if peak > theta_max:
@@ -269,7 +278,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
         if ev == EV_NONE:
             t, y = (t_pulse if lands else t + h), y1
             if s != 0 and not on:
-                margin = _saddle(y, s, prm, margin)
+                margin = _saddle(y, s, prm, margin, saddle0, saddle_du)
             _record(hist, t, y, s, _acting(t, t_pulse, GROUND), prm, out, FLEX)
             if CONTACT is not None:  # the step's end, with the step's own ground motion
                 ct = contact_sample(ct, t, y, s, on, SAMPLE_STEP, prm, out, FLEX, DAMPED, ENERGY)
@@ -448,8 +457,13 @@ def _energy_margin(y, s, prm, margin):
     return q if q < margin else margin
 
 
+# a flexible variant compiles neither this nor the rigid mechanical_energy it calls (its
+# caller's branch is dead there; the value given instead is never used)
+_rigid_margin = skipped_when(True, _energy_margin, np.inf)
+
+
 @njit(cache=True, **INLINE)
-def _saddle(y, s, prm, margin):
+def _saddle(y, s, prm, margin, saddle0, saddle_du):
     """The smallest distance so far of the free rocking motion from the overturning
     saddle, in units of alpha_ref (OUT_MARGIN; ``rocksweep.compute.certify``).
 
@@ -461,12 +475,25 @@ def _saddle(y, s, prm, margin):
     taken from every step end within half an alpha_ref of the saddle (any point of the
     hyperbola gives its vertex, so steps of any length see it): a small value means the
     run decided between overturning and not by a small margin of energy.
+
+    The atan is taken only where the step end can be that close (most rocking steps are
+    not). Gate, from the run's constants saddle0 = atan(b/h_cg) (the saddle at u = 0) and
+    saddle_du = m/(M h_cg): atan is 1-Lipschitz, so |s theta_s - saddle0| <= saddle_du |u|,
+    and |s theta - saddle0| > alpha_ref/2 + saddle_du |u| gives |x| > 1/2. The bound is
+    widened by SADDLE_SLACK (relative and absolute), far above the round-off of either
+    side, so a skipped step is one on which the full test would also have failed: the
+    margin is the same to the bit. saddle0 = NaN: no gate (every comparison with NaN fails).
     """
     a_ref = prm[PAR_ALPHA_REF]
+    v = y[Y_THETA_DOT] / a_ref
+    if not abs(v) < 0.5:
+        return margin
+    reach = 0.5 * a_ref + saddle_du * abs(y[Y_U])
+    if abs(s * y[Y_THETA] - saddle0) > reach * (1.0 + SADDLE_SLACK) + SADDLE_SLACK:
+        return margin
     th_s = math.atan((prm[PAR_B] - s * prm[PAR_M] * y[Y_U] / prm[PAR_MTOT]) / prm[PAR_HCG])
     x = (s * y[Y_THETA] - th_s) / a_ref
-    v = y[Y_THETA_DOT] / a_ref
-    if abs(x) < 0.5 and abs(v) < 0.5:
+    if abs(x) < 0.5:
         q = math.sqrt(abs(v * v - x * x))
         if q < margin:
             return q
