@@ -130,6 +130,9 @@ from rocksweep.kernel.transitions import impact_map, rest_proven, rigid_bounded,
 
 # the outcome-only variants do not compile the energy (``_static``)
 _energy = skipped_when(False, mechanical_energy, 0.0)
+# nor does a flexible variant compile the rigid body's bound (its caller's branch is dead
+# there; the value given instead is never used)
+_rigid_bounded = skipped_when(True, rigid_bounded, -1.0)
 
 # _step_length: a time within this fraction of a record step of a grid time is on it (t
 # sums steps of ~1e-2..1; its round-off is ~1e-16 relative, far below).
@@ -232,7 +235,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
         if not FLEX and s != 0 and not on and free_check:
             free_check = False  # E is constant between impacts after the pulse: test once
             margin = _rigid_margin(FLEX, y, s, prm, margin)
-            peak = rigid_bounded(y, s, prm, FLEX)
+            peak = _rigid_bounded(FLEX, y, s, prm, FLEX)
             if peak >= 0.0:
                 if peak > theta_max:
                     theta_max = peak
@@ -454,12 +457,12 @@ def _energy_margin(y, s, prm, margin):
     return q if q < margin else margin
 
 
-# a flexible variant compiles neither this nor the rigid mechanical_energy it calls (its
-# caller's branch is dead there; the value given instead is never used)
+# a flexible variant compiles neither this nor the rigid mechanical_energy it calls (as
+# _rigid_bounded)
 _rigid_margin = skipped_when(True, _energy_margin, np.inf)
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, inline="always")
 def _saddle_bounds(prm):
     """``_near_saddle``'s constants of a run: (v_cap [rad/s], saddle0 [rad], r0 [rad],
     r_u [rad/m]); saddle0 = NaN where the row has no body (h_cg or M not > 0)."""
@@ -472,7 +475,7 @@ def _saddle_bounds(prm):
     return half, saddle0, half * (1.0 + sl) + sl, r_u
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, inline="always")
 def _near_saddle(y, s, near):
     """False where ``_saddle`` would leave the margin as it is, for sure: a cheap test on
     the path of every free rocking step (``_saddle`` takes an atan and four divisions and
