@@ -31,6 +31,7 @@ Importing the package is light: numba, h5py, xarray and matplotlib load on first
 from __future__ import annotations
 
 from rocksweep.api import (  # noqa: A004
+    Simulation,
     boundaries,
     boundary_lines,
     calibrate,
@@ -77,6 +78,6 @@ def __getattr__(name: str) -> str:
     raise AttributeError(f"module 'rocksweep' has no attribute {name!r}")
 
 
-__all__ = ["RocksweepError", "__version__", "boundaries", "boundary_lines", "calibrate",
-           "calibrated_overrides", "estimate", "fragility", "ida", "im_efficiency", "open",
-           "plot", "risk", "run", "simulate", "spectra", "table"]
+__all__ = ["RocksweepError", "Simulation", "__version__", "boundaries", "boundary_lines",
+           "calibrate", "calibrated_overrides", "estimate", "fragility", "ida",
+           "im_efficiency", "open", "plot", "risk", "run", "simulate", "spectra", "table"]

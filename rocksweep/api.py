@@ -1,10 +1,10 @@
 """The Python API, a thin facade: run a scene's grid, open a result, simulate one point,
-and the analyses of a Dataset. Each function checks its arguments and hands over to the
-room that does the work: scenes and overrides (``rocksweep.scene.inputs``), the sweep
-session (``rocksweep.store.session.sweep_file``, the one way into the driver), a result
-as a Dataset (``rocksweep.store.dataset``), a run's history (``rocksweep.store.history``),
-the analyses (``rocksweep.analysis``), the figures (``rocksweep.figures``); ``ds.rocksweep``
-is ``rocksweep.accessor``. Errors speak Python (``rocksweep.errors.speaks_python``).
+and the analyses of a Dataset. Each function hands over to the room that does the work
+and checks its arguments: scenes (``rocksweep.scene.inputs``), the sweep session
+(``rocksweep.store.session``), a result as a Dataset (``rocksweep.store.dataset``), a
+run's history (``rocksweep.store.history``), the analyses (``rocksweep.analysis``), the
+figures (``rocksweep.figures``), ``ds.rocksweep`` (``rocksweep.accessor``). Errors speak
+Python (``rocksweep.errors.speaks_python``).
 
 Nothing heavy is imported here at module level (numba, h5py, xarray, matplotlib load
 inside the functions), so ``import rocksweep`` stays light; the names that moved out are
@@ -14,38 +14,30 @@ still importable from here (``api.load``, ``api.sweep_file``, ...: PEP 562).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rocksweep.compute.driver import (  # noqa: F401 (SweepInterrupted: the API's)
-    WRITE_EVERY,
-    SweepInterrupted,
-    SweepReport,
-)
-from rocksweep.errors import ApiError, check_rtol, speaks_python
+from rocksweep.errors import ApiError, speaks_python  # noqa: F401 (ApiError: the API's)
+from rocksweep.simulation import Simulation  # what simulate returns
 
 if TYPE_CHECKING:
     import xarray as xr
     from matplotlib.figure import Figure
 
-    from rocksweep.compute.single import Run
     from rocksweep.scene.inputs import Overrides, SceneLike
 
-# Names that moved to their rooms, importable from here as before (loaded on first use).
-_MOVED = {
-    "load": "rocksweep.scene.inputs",
-    "MAX_RUNS": "rocksweep.store.history",
-    "simulate_runs": "rocksweep.store.history",
-    "adaptive_options": "rocksweep.compute.adaptive",
-    "override_strings": "rocksweep.scene.inputs",
-    "sweep_file": "rocksweep.store.session",
-    "result_dataset": "rocksweep.store.dataset",
-    "history_dataset": "rocksweep.store.history",
-    "swept_values": "rocksweep.store.history",
-    "write_history_csv": "rocksweep.store.history",
-    "RocksweepAccessor": "rocksweep.accessor",
-}
+# Names that live in their rooms, importable from here as before (loaded on first use):
+# SweepInterrupted is what ``run`` raises on Ctrl-C.
+_MOVED = {name: module for module, names in {
+    "rocksweep.compute.driver": ("WRITE_EVERY", "SweepInterrupted", "SweepReport"),
+    "rocksweep.scene.inputs": ("load", "override_strings"),
+    "rocksweep.store.history": ("MAX_RUNS", "API_MAX_RUNS", "simulate_runs",
+                                "history_dataset", "swept_values", "write_history_csv"),
+    "rocksweep.compute.adaptive": ("adaptive_options",),
+    "rocksweep.store.session": ("sweep_file",),
+    "rocksweep.store.dataset": ("result_dataset",),
+    "rocksweep.accessor": ("RocksweepAccessor",),
+}.items() for name in names}
 
 
 def __getattr__(name: str) -> Any:
@@ -56,13 +48,7 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module 'rocksweep.api' has no attribute {name!r}")
 
 
-# `rocksweep.simulate` returns one history per point: a notebook's worth, not a grid.
-API_MAX_RUNS = 100
-
-
-# ---------------------------------------------------------------------------------------
-# rocksweep.run and rocksweep.open
-# ---------------------------------------------------------------------------------------
+# --- rocksweep.run and rocksweep.open ----------------------------------------------------
 
 @speaks_python
 def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
@@ -90,43 +76,31 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
     the unswept keys as scalar coordinates and the file's attributes (see ``open``). It
     is loaded in memory; without ``output`` no file is kept.
 
-    adaptive: compute only near the class boundaries (``rocksweep.compute.adaptive``; the same
-    as ``rocksweep sweep --adaptive``): coarse: the coarse level (every 2**coarse-th
-    point of the diagram axes first; default: 16 coarse cells per axis); audit: share of
-    the filled points computed as a check (default 0.02); axes: the two diagram axes
-    (default ("w_over_p", "A_ratio")); margin, final_margin, seed, threshold: see
-    ``rocksweep.compute.adaptive.Options``; validate: check
-    the fill on a coarse uniform lattice (printed with ``progress``). The Dataset then
-    also has ``computed`` (0 filled, 1 computed, 2/3 audit point that agreed/disagreed)
-    and filled points hold their "not computed" values in every variable but outcome.
+    adaptive: compute only near the class boundaries (``rocksweep sweep --adaptive``),
+    with the settings of ``rocksweep.compute.adaptive.Options`` (None: the scene's
+    ``refine`` or the default): coarse, the coarse level; audit, the share of filled
+    points computed as a check; axes, the two diagram axes; margin and final_margin, cells
+    refined around a boundary; seed, of the audit sample; threshold, the share of
+    disagreeing audits that warns. validate: check the fill on a coarse uniform lattice
+    (printed with ``progress``). The Dataset then also has ``computed`` (0 filled, 1
+    computed, 2/3 audit point that agreed/disagreed); filled points hold "not computed"
+    values in every variable but outcome.
 
     Raises a one-line ``RocksweepError`` for a bad scene, option or output path;
     KeyboardInterrupt (``SweepInterrupted``) after saving the finished points to
     ``output``. A wrong type (``jobs="2"``, ``overrides=5``) is a TypeError naming the
     argument; every argument is checked before the output is touched.
     """
-    from rocksweep.compute.arguments import check_flag, check_sweep_arguments
-    from rocksweep.outputs import check_path_text
+    from rocksweep.store.session import run_session  # checks every argument first
 
-    # types and ranges first: nothing below may touch ``output`` before all are checked
-    check_flag("progress", progress)
-    check_flag("adaptive", adaptive)
-    check_sweep_arguments(jobs=jobs if client is None else 1, resume=resume,
-                          overwrite=overwrite, validate=validate, adaptive=True)
-    if output is not None:
-        check_path_text(output, "output")
-    from rocksweep.compute.adaptive import adaptive_options
-    from rocksweep.scene.inputs import load, override_strings
-    from rocksweep.store.session import run_session
-
-    sc, source = load(scene, overrides)
-    opts = adaptive_options(adaptive, base=sc.refine, coarse=coarse, audit=audit, axes=axes,
-                            margin=margin, final_margin=final_margin, seed=seed,
-                            threshold=threshold)
-    out = run_session(sc, output, source=source, overrides=override_strings(overrides),
-                      jobs=jobs, resume=resume, overwrite=overwrite, progress=progress,
-                      client=client, adaptive=opts, validate=validate)
-    return _loaded(out) if output is None else open(out)
+    out = run_session(scene, output, overrides=overrides, jobs=jobs, resume=resume,
+                      overwrite=overwrite, progress=progress, client=client,
+                      adaptive=adaptive, validate=validate,
+                      settings={"coarse": coarse, "audit": audit, "axes": axes,
+                                "margin": margin, "final_margin": final_margin,
+                                "seed": seed, "threshold": threshold})
+    _register()
+    return out
 
 
 @speaks_python
@@ -134,21 +108,19 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
     """A sweep result file as an xarray Dataset, loaded in memory (the file is closed).
 
     Each variable carries its unit (``rocksweep_units``: ``rocksweep.fields.UNITS``, e.g.
-    alpha_ref, 1/p, E_ref; CF ``units`` "1" as written by the store) and a description;
-    ``outcome`` its codes and words as CF flags (``flag_values`` -1 0 1 2,
-    ``flag_meanings`` "not_run safe mode1 mode2"), ``status`` its bits (``flag_masks``,
-    ``flag_meanings``, ``flagged_mask``). The Dataset's attributes are the file's
-    provenance: the scene YAML verbatim (``scene``) and resolved (``scene_resolved``),
-    ``overrides``, the resolved ``numerics`` and ``accuracy``, library versions,
-    ``started``/``finished``, ``wall_time``/``cpu_time`` [s], ``points_done``,
-    ``complete``. Works while a sweep is still writing the file (no lock is taken).
-    A file that is not a rocksweep result is a one-line ``RocksweepError``.
+    alpha_ref, 1/p, E_ref; CF ``units`` "1") and a description; ``outcome`` its codes
+    and words as CF flags (``flag_values`` -1 0 1 2, ``flag_meanings`` "not_run safe
+    mode1 mode2"), ``status`` its bits (``flag_masks``, ``flag_meanings``,
+    ``flagged_mask``). The attributes are the file's provenance (all of them:
+    ``rocksweep.store.format``): ``scene`` (the YAML verbatim), ``scene_resolved``,
+    ``overrides``, ``numerics``, ``accuracy``, versions, times, ``complete``. Works
+    while a sweep is still writing the file (no lock is taken). A file that is not a
+    rocksweep result is a one-line ``RocksweepError``.
     """
-    from rocksweep.store.reader import read_result
+    from rocksweep.store.dataset import open_result
 
-    path = Path(path)
-    read_result(path, ["outcome"])  # one-line errors for foreign or damaged files
-    return _loaded(path)
+    _register()
+    return open_result(path)
 
 
 def _register() -> None:
@@ -158,14 +130,6 @@ def _register() -> None:
     register_accessor({f.__name__: f for f in (plot, boundaries, boundary_lines, spectra,
                                                fragility, ida, risk, im_efficiency, table,
                                                calibrated_overrides)})
-
-
-def _loaded(source: Path | Any) -> xr.Dataset:
-    """``store.dataset.result_dataset`` with the accessor registered (``ds.rocksweep``)."""
-    from rocksweep.store.dataset import result_dataset
-
-    _register()
-    return result_dataset(source)
 
 
 def open_any(path: str | Path) -> xr.Dataset:
@@ -178,19 +142,14 @@ def open_any(path: str | Path) -> xr.Dataset:
 
 
 def _dataset_arg(ds: Any, what: str) -> xr.Dataset:
-    """A Dataset argument, or a path to one (``open_any``)."""
+    """A Dataset, or a path to one (``analysis.files._as_dataset``), with ``ds.rocksweep``."""
     from rocksweep.analysis.files import _as_dataset
 
-    register = isinstance(ds, str | Path)
-    out = _as_dataset(ds, what)
-    if register:
-        _register()
-    return out
+    _register()
+    return _as_dataset(ds, what)
 
 
-# ---------------------------------------------------------------------------------------
-# Analyses: a result Dataset in, a Dataset, a DataFrame or a Figure out
-# ---------------------------------------------------------------------------------------
+# --- Analyses: a result Dataset in, a Dataset, a DataFrame or a Figure out ---------------
 
 @speaks_python
 def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any = None,
@@ -236,19 +195,15 @@ def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None,
 
     ds: a complete result (``run`` / ``open``) with a diagram over (w_over_p, A_ratio).
     mode: 1 or 2 for that overturning mode only. Returns a Dataset: ``A_min`` (NaN: none
-    found), ``mode``, ``A_min_method`` ("grid+bisection", "searched below grid", "first
-    grid value" (an upper bound), "not found"), the final bracket ``lo``/``hi`` and the
-    kernel ``runs``, over every other swept key (e.g. shape, lam) and x. The class
-    boundary polylines: ``boundary_lines(ds)``.
+    found), ``mode``, ``A_min_method`` (``rocksweep.analysis.boundaries.A_MIN_METHODS``;
+    "first grid value" is an upper bound), the final bracket ``lo``/``hi`` and the kernel
+    ``runs``, over every other swept key (e.g. shape, lam) and x. The class boundary
+    polylines: ``boundary_lines(ds)``.
     """
-    from rocksweep.analysis import boundaries as bd
+    from rocksweep.analysis.boundaries import boundaries_dataset
 
-    rtol = check_rtol(rtol)
-    if mode not in (None, 1, 2):
-        raise ApiError(f"mode = {mode!r}: must be None, 1 or 2")
-    if not isinstance(search, bool):
-        raise ApiError(f"search = {search!r}: must be True or False")
-    return bd.boundaries_dataset(ds, rtol, mode, search)
+    _register()  # the result's ds.rocksweep, whatever was called first
+    return boundaries_dataset(ds, rtol, mode, search)
 
 
 @speaks_python
@@ -256,24 +211,21 @@ def boundary_lines(ds: xr.Dataset) -> Any:
     """The lines between classes of a complete result's diagrams as a tidy
     ``pandas.DataFrame``: one row per vertex with the panel's other swept keys, ``line``,
     ``classes`` (e.g. "safe|mode1"), ``closed``, ``vertex``, ``x``, ``y`` (axis values)."""
-    from rocksweep.analysis import boundaries as bd
-    from rocksweep.store.reader import as_result
+    from rocksweep.analysis.boundaries import boundary_lines_frame
 
-    result = as_result(ds, ["outcome"])
-    sc = bd.check_result(result)
-    return bd.lines_frame(bd.diagram_boundaries(sc, result.arrays["outcome"]))
+    return boundary_lines_frame(ds)
 
 
 @speaks_python
-def spectra(ds: xr.Dataset, rtol: float = 1e-3) -> xr.Dataset:
+def spectra(ds: xr.Dataset, rtol: float = 1e-3, search: bool = True) -> xr.Dataset:
     """Rocking and overturning spectra of a complete sweep over p (a record) or w_over_p,
     A_ratio and optionally lam: ``theta_max_over_alpha`` and ``outcome`` over (lam,
-    A_ratio, p), ``A_min`` and ``mode`` over (lam, p), A_min bisected to ``rtol``."""
+    A_ratio, p), ``A_min`` and ``mode`` over (lam, p), A_min to ``rtol`` whatever the grid
+    (search=False: the grid's bracket bisected only, as for ``boundaries``)."""
     from rocksweep.analysis.spectrum import spectra as compute_spectra
 
-    out = compute_spectra(ds, check_rtol(rtol)).to_dataset()
-    out.attrs["rocksweep_kind"] = "spectra"  # rocksweep.plot's dispatch (analysis.kinds)
-    return out
+    _register()  # the result's ds.rocksweep, whatever was called first
+    return compute_spectra(ds, rtol, search).to_dataset()
 
 
 @speaks_python
@@ -288,6 +240,7 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
     curves ``rocksweep.plot`` draws)."""
     from rocksweep.analysis.ida import ida_dataset
 
+    _register()  # the result's ds.rocksweep, whatever was called first
     return ida_dataset(ds, rtol)
 
 
@@ -297,43 +250,31 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
               bootstrap: int | None = None, seed: int = 0, ci: float = 0.9) -> xr.Dataset:
     """Lognormal fragility curves P(state | IM = x) = Phi(ln(x / im_median) / beta) of a
     record-suite sweep (a scene with ``ground.records``), fitted by maximum likelihood
-    (Baker 2015): to the counts at each stripe of a scaled suite ("stripes-mle"), or to
-    the (IM, 0/1) pairs of an unscaled one ("cloud-mle", im= "PGA" (default), "PGV" or
-    "Sa" with period= [s] from the stored periods).
+    (Baker 2015) to the counts at each stripe of a scaled suite ("stripes-mle") or to the
+    (IM, 0/1) pairs of an unscaled one ("cloud-mle"); one curve per value of every other
+    swept key (lam, p, body keys). The states, fits and variables in full:
+    ``rocksweep.analysis.fragility.fragility``.
 
     ds: what ``run`` or ``open`` returns (or a result file's path). state: "overturn"
     (either mode), "mode1", "mode2", "uplift", "theta:X" (max|theta|/alpha_cg >= X, or
-    overturned, 0 < X <= 1), or a list of them (a ``state`` dimension): two or more of
-    uplift/theta:X/overturn are ordered damage states fitted with one beta (the curves
-    never cross), mode1 with mode2 a competing-risk fit (their curves and "safe" sum to
-    one). bootstrap: resamples over records for the intervals and bands (0: none, NaN;
-    None: ``rocksweep.analysis.resampling.DEFAULT_BOOTSTRAP``, 200); seed: their
-    generator's seed; ci: the interval's level. Points flagged undecided (horizon, step
-    or event caps, non-finite) are left out and counted (``n_excluded``). One curve per
-    value of every other swept key (lam, p, body keys).
+    overturned, 0 < X <= 1), or a list of them (a ``state`` dimension: damage states
+    share one beta, mode1 with mode2 is a competing-risk fit). im: a cloud's IM, "PGA"
+    (default), "PGV" or "Sa" with period [s] one of the stored periods. bootstrap:
+    resamples over records for the intervals and bands (0: none; None:
+    ``rocksweep.analysis.resampling.DEFAULT_BOOTSTRAP``, 200); seed: their generator's
+    seed; ci: the interval's level. Points flagged undecided are left out, counted.
 
-    Returns a Dataset (``rocksweep.analysis.fragility.fragility``): ``im_median`` [IM
-    units], ``beta``, their bootstrap intervals ``im_median_lo``/``im_median_hi``,
-    ``beta_lo``/``beta_hi``, the resamples' fits ``im_median_samples``/``beta_samples``
-    over ``sample``, ``reason`` ("ok" or why the curve should not be trusted as it is:
-    also a ``FragilityWarning``), ``n_records``, ``n_excluded``, ``n_not_run``, the fitted
-    ``curve`` and the bands ``band_lo``/``band_hi`` over ``im_grid``, and for stripes the
-    empirical ``fraction`` per stripe and, per record, ``first_level`` and
-    ``resurrection``.
+    Returns a Dataset: ``im_median`` [IM units] and ``beta``, their bootstrap intervals
+    (``_lo``/``_hi``) and resamples' fits (``_samples``), ``reason`` ("ok" or why the curve
+    should not be trusted as it is: also a ``FragilityWarning``), the counts
+    ``n_records``, ``n_excluded``, ``n_not_run``, the fitted ``curve`` and its bands over
+    ``im_grid``; for stripes ``fraction`` per stripe and ``first_level``,
+    ``resurrection`` per record.
     """
-    import xarray as xr
-
     from rocksweep.analysis.fragility import fragility as fit
 
-    if isinstance(ds, str | Path):
-        ds = open(ds)
-    if not isinstance(ds, xr.Dataset):
-        raise ApiError(f"ds = {type(ds).__name__}: must be a result Dataset (rocksweep.run "
-                       "or rocksweep.open)")
-    frag = fit(ds, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci)
-    frag.attrs["title"] = str(ds.attrs.get("title", ""))
-    frag.attrs["rocksweep_kind"] = "fragility"  # rocksweep.plot's dispatch (analysis.kinds)
-    return frag
+    return fit(_dataset_arg(ds, "ds"), state=state, im=im, period=period,
+               bootstrap=bootstrap, seed=seed, ci=ci)
 
 
 @speaks_python
@@ -354,13 +295,13 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = N
 
 @speaks_python
 def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
-    """Which IM explains ``state`` best: for every IM of a record-suite sweep's records
-    (PGA, PGV, Sa(T), AvgSa, Arias, CAV, D5-95, PGV/PGA, PGA/(g tan alpha), PGV p/(g tan
-    alpha)) the lognormal dispersion ``beta`` of the fragility in that IM (each record's
-    first overturning level, an interval between stripes, re-expressed in the IM; a
-    regression for the IMs scaling leaves unchanged) and ``beta_scale`` (comparable across
-    IMs; lower is better), per value of the other swept keys
-    (``rocksweep.analysis.efficiency``)."""
+    """Which IM explains ``state`` (as ``fragility``'s) best: for every IM of a
+    record-suite sweep's records (``rocksweep.physics.suite.RECORD_IMS``: PGA, PGV, Sa(T),
+    Arias, D5-95, PGA/(g tan alpha), ...) the lognormal dispersion ``beta`` of the
+    fragility in that IM and ``beta_scale`` (comparable across IMs; lower is better), per
+    value of the other swept keys; how (``rocksweep.analysis.efficiency``): each record's
+    first overturning level re-expressed in the IM, or a regression for the IMs scaling
+    leaves unchanged."""
     from rocksweep.analysis.efficiency import im_efficiency as compute
 
     return compute(_dataset_arg(ds, "ds"), state=state)
@@ -381,8 +322,9 @@ def table(ds: xr.Dataset) -> Any:
 
 @speaks_python
 def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> Any:
-    """What ``run`` of this scene will cost on this machine, without running it: points,
-    RK4 steps and evaluations expected, seconds of compute with ``jobs`` workers, and
+    """What ``run`` of this scene (with ``overrides``, as for ``run``) will cost on this
+    machine, without running it: points, RK4 steps and evaluations expected, seconds of
+    compute with ``jobs`` workers, and
     whether a kernel variant must be compiled first (and for how long). Measured on a
     sample of 256 points when the kernel is compiled (~10 ms), else from the step bound.
     Returns ``rocksweep.compute.sweep.Estimate`` (``str()`` is one line)."""
@@ -393,34 +335,7 @@ def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> A
     return sweep_estimate(sc, jobs=jobs)
 
 
-# ---------------------------------------------------------------------------------------
-# rocksweep.simulate
-# ---------------------------------------------------------------------------------------
-
-@dataclass
-class Simulation:
-    """One run of one point (``rocksweep.simulate``).
-
-    summary: plain dict (``rocksweep simulate --json``: outcome, impacts, uplifts,
-    theta_max_over_alpha, t_overturn, t_first_impact, energies / E_ref, status words,
-    steps, event_steps, accuracy, wall_time_s); history: xarray Dataset over ``p_t``
-    (``rocksweep.fields.HISTORY``: theta_over_alpha, u_over_ucr, E_over_Eref, ..., each
-    with ``units``; at an event p_t repeats: the rows before and after it); run: the
-    underlying ``rocksweep.compute.single.Run``.
-    """
-
-    summary: dict
-    history: xr.Dataset
-    run: Run
-    title: str = ""
-
-    def figure(self) -> Figure:
-        """Figure 5 for this run (pulse, theta/alpha, E/E_ref, dissipated energy against
-        p*t) as a pyplot-free matplotlib Figure: show it in a notebook or ``savefig``."""
-        from rocksweep.figures.common import time_history
-
-        return time_history([self.run], (), self.title)
-
+# --- rocksweep.simulate ------------------------------------------------------------------
 
 @speaks_python
 def simulate(scene: SceneLike, overrides: Overrides = (), /,
@@ -432,56 +347,42 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     dot: ``simulate("fig5.yaml", impact__lam=0.4)``. The accuracy is the scene's preset,
     ``default`` if it names none, as a sweep's (one point, one answer). Returns a ``Simulation``
     (summary dict, history Dataset over p*t, and ``.figure()``); a scene with lists gives
-    one ``Simulation`` per combination, in grid order (at most ``API_MAX_RUNS``; sweeps
-    are for ``run``).
+    one ``Simulation`` per combination, in grid order (at most
+    ``rocksweep.store.history.API_MAX_RUNS``, 100; sweeps are for ``run``).
     """
     from rocksweep.scene.inputs import load, override_strings
-    from rocksweep.store.history import titled_runs
+    from rocksweep.store.history import API_MAX_RUNS, titled_runs
 
     sc, _ = load(scene, [*override_strings(overrides), *override_strings(keys)])
-    if sc.size > API_MAX_RUNS:
-        big = max(sc.swept, key=lambda a: len(a.values))
-        raise ApiError(f"the scene has {sc.size} points ({big.key} has {len(big.values)} "
-                       f"values): simulate runs at most {API_MAX_RUNS}; pass "
-                       f"overrides={{{big.key!r}: ...}}, or use rocksweep.run for a grid")
     out = [Simulation(r.summary(), hist, r, title)
            for r, hist, title in titled_runs(sc, API_MAX_RUNS)]
     return out[0] if sc.size == 1 else out
 
 
-# ---------------------------------------------------------------------------------------
-# Calibration (issue 30): scene numbers fitted to a measured history
-# ---------------------------------------------------------------------------------------
+# --- Calibration (issue 30): scene numbers fitted to a measured history ------------------
 
 @speaks_python
 def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impact.lam",),
               *, bounds: Mapping[str, Sequence[float]] | None = None,
               overrides: Overrides = (), ci: float = 0.95, p: float | None = None
               ) -> xr.Dataset:
-    """Fit scene numbers (``impact.lam``, ``impact.e`` under law constant,
-    ``impact.e_factor``, ``body.zeta``, ...) to a measured rocking history.
+    """Fit scene numbers to a measured rocking history.
 
-    measured: a CSV path or a pandas DataFrame with columns p_t, theta_over_alpha (as
-    ``simulate --csv`` writes), or t [s], theta [rad] (then p [rad/s]: the keyword, a
-    physical body's or a record scene's ground.p). bounds: {key: (lo, hi)} inside each
-    key's admissible range (default: ``analysis.calibrate.DEFAULT_BOUNDS`` or the range).
-    Returns a Dataset over ``parameter`` (the fitted keys): ``estimate``, ``lo``, ``hi``
-    (the ``ci`` interval by profile likelihood, ``ci`` in attrs), scalar ``misfit`` (RMS
-    error of the half-cycle peaks, theta/alpha_ref), and the measured and fitted
-    histories over p_t with the fitted impacts (``rocksweep.analysis.calibrate``).
+    scene, overrides: as for ``run``. fit: the key or distinct keys to fit (``impact.lam``,
+    ``impact.e`` under law constant, ``impact.e_factor``, ``body.zeta``, ...). measured: a
+    CSV path or a pandas DataFrame with columns p_t, theta_over_alpha (as ``simulate
+    --csv`` writes), or t [s], theta [rad] (then p [rad/s]: the keyword, a physical
+    body's or a record scene's ground.p). bounds: {key: (lo, hi)} inside each key's
+    admissible range (default: ``analysis.calibrate.DEFAULT_BOUNDS`` or the range). ci:
+    the interval's level, in [0.5, 1). Returns a Dataset over ``parameter`` (the fitted
+    keys): ``estimate``, ``lo``, ``hi`` (the ``ci`` interval by profile likelihood, ``ci``
+    in attrs), scalar ``misfit`` (RMS error of the half-cycle peaks, theta/alpha_ref),
+    and the measured and fitted histories over p_t with the fitted impacts
+    (``rocksweep.analysis.calibrate``).
     """
-    from rocksweep.analysis.calibrate import CalibrationError, calibrate_scene
-    from rocksweep.scene.inputs import load
+    from rocksweep.analysis.calibrate import calibrate_scene
 
-    keys = [fit] if isinstance(fit, str) else list(fit)
-    if not keys:
-        raise CalibrationError("fit = []: give at least one key, e.g. impact.lam")
-    if len(set(keys)) < len(keys):
-        raise CalibrationError(f"fit = {keys}: a key is given twice")
-    if not (isinstance(ci, float | int) and 0.5 <= ci < 1):
-        raise CalibrationError(f"ci = {ci!r}: must be in [0.5, 1)")
-    sc, _ = load(scene, overrides)
-    out = calibrate_scene(sc, measured, keys, bounds, float(ci), p)
+    out = calibrate_scene(scene, measured, fit, bounds, ci, p, overrides)
     _register()  # out.rocksweep.as_overrides()
     return out
 

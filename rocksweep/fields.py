@@ -21,12 +21,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.model import G
-from rocksweep.vocab.axes import AXES, AxisMeta  # noqa: F401
+from rocksweep.vocab.axes import AXES, AxisMeta, alpha_symbol  # noqa: F401
+from rocksweep.vocab.ground import AVGSA_POINTS, RECORD_IMS, SA, SA_DAMPING, SCALE_IMS
 
 
 @dataclass(frozen=True)
@@ -238,6 +240,19 @@ def convert_check(outs: np.ndarray, half: np.ndarray, alpha_ref: np.ndarray | fl
     return arrays
 
 
+def plain(v: Any, *, nan_to_none: bool = False) -> Any:
+    """A stored value as plain Python: bytes as text (UTF-8, bad bytes replaced), a numpy
+    scalar or 0-d array as its Python number or string; with ``nan_to_none`` a non-finite
+    float as None (JSON). Anything else unchanged."""
+    if isinstance(v, bytes | np.bytes_):
+        return bytes(v).decode("utf-8", "replace")
+    if isinstance(v, np.generic) or (isinstance(v, np.ndarray) and v.ndim == 0):
+        v = v.item()
+    if nan_to_none and isinstance(v, float) and not math.isfinite(v):
+        return None
+    return v
+
+
 def value(out: np.ndarray, f: Field, alpha_ref: float, E_ref: float) -> int | float | None:
     """One field of one result row as a plain Python number (NaN -> None for optional
     times and energies)."""
@@ -256,32 +271,38 @@ def value(out: np.ndarray, f: Field, alpha_ref: float, E_ref: float) -> int | fl
 # ``rocksweep.vocab.axes``; re-exported here for the readers of fields)
 
 
+# the units of the record IMs' variables (``vocab.ground.RECORD_IMS``, Sa's: ``SCALE_IMS``)
+_IM_UNIT = {var: unit for var, unit, _ in RECORD_IMS.values()} | {"record_sa": SCALE_IMS[SA]}
+
 # Per-record variables of a suite's result (along ``record``; ``record_sa`` along
 # (record, period); ``scale_factor`` along (record, stripe) and what the factor depends
 # on): name -> (long_name, CF units or None for words and counts, description).
 RECORD_VARIABLES: dict[str, tuple[str, str | None, str]] = {
-    "record_pga": ("peak ground acceleration of the record as recorded", "g",
+    "record_pga": ("peak ground acceleration of the record as recorded",
+                   _IM_UNIT["record_pga"],
                    "max |acc| of the samples (exact for the piecewise-linear record)"),
-    "record_pgv": ("peak ground velocity of the record as recorded", "m/s",
+    "record_pgv": ("peak ground velocity of the record as recorded", _IM_UNIT["record_pgv"],
                    "max |v|, v the trapezoidal integral of the record as given (no baseline "
                    "correction, no filtering), extrema between samples included"),
-    "record_sa": ("spectral acceleration of the record as recorded", "g",
-                  "pseudo-spectral acceleration at 5% damping, exact recurrence for the "
-                  "piecewise-linear record (Nigam & Jennings 1969), free vibration after "
-                  "the record included"),
-    "record_arias": ("Arias intensity of the record as recorded", "m/s",
+    "record_sa": ("spectral acceleration of the record as recorded", _IM_UNIT["record_sa"],
+                  f"pseudo-spectral acceleration at {100 * SA_DAMPING:g}% damping, exact "
+                  "recurrence for the piecewise-linear record (Nigam & Jennings 1969), free "
+                  "vibration after the record included"),
+    "record_arias": ("Arias intensity of the record as recorded", _IM_UNIT["record_arias"],
                      "pi/(2g) integral of a^2 dt, exact for the piecewise-linear record"),
-    "record_cav": ("cumulative absolute velocity of the record as recorded", "m/s",
+    "record_cav": ("cumulative absolute velocity of the record as recorded",
+                   _IM_UNIT["record_cav"],
                    "integral of |a| dt, exact for the piecewise-linear record"),
-    "record_d5_95": ("significant duration D5-95 of the record", "s",
+    "record_d5_95": ("significant duration D5-95 of the record", _IM_UNIT["record_d5_95"],
                      "time between 5% and 95% of the Arias intensity (Trifunac & Brady "
                      "1975); unchanged by scaling"),
-    "record_pgv_over_pga": ("PGV/PGA of the record", "s",
+    "record_pgv_over_pga": ("PGV/PGA of the record", _IM_UNIT["record_pgv_over_pga"],
                             "PGV / (PGA g): a pulse-period proxy; unchanged by scaling"),
-    "record_avgsa": ("average spectral acceleration of the record as recorded", "g",
-                     "geometric mean of Sa (5% damping) at 10 periods evenly spaced in ln T "
-                     "over the attribute avgsa_periods [s] (ground.avgsa; default 0.2-3 x "
-                     "the scale period, or 0.2-3 x 2 pi/p)"),
+    "record_avgsa": ("average spectral acceleration of the record as recorded",
+                     _IM_UNIT["record_avgsa"],
+                     f"geometric mean of Sa ({100 * SA_DAMPING:g}% damping) at {AVGSA_POINTS} "
+                     "periods evenly spaced in ln T over the attribute avgsa_periods [s] "
+                     "(ground.avgsa; default 0.2-3 x the scale period, or 0.2-3 x 2 pi/p)"),
     "record_v_end": ("ground velocity at the end of the record", "m/s",
                      "the trapezoidal integral of the record as given at its last sample; far "
                      "from 0: the record drifts (not baseline-corrected)"),
@@ -308,7 +329,7 @@ def axis_attrs(name: str, kind: str = "flexible") -> dict[str, str]:
     meta = AXES.get(name)
     if meta is None:
         return {"long_name": name, "units": "1", "symbol": name}
-    alpha = "alpha" if kind == "block" else "alpha_cg"
+    alpha = alpha_symbol(kind)
     out = {"long_name": meta.long_name, "symbol": meta.symbol.replace("alpha_ref", alpha)}
     if meta.units:
         out["units"] = meta.units
@@ -318,7 +339,7 @@ def axis_attrs(name: str, kind: str = "flexible") -> dict[str, str]:
 def field_attrs(f: Field, kind: str = "flexible") -> dict[str, str]:
     """The attributes of a result variable: long_name (short), description, rocksweep's
     unit (``unit``, alpha_ref written as the body kind's slenderness) and the symbol."""
-    alpha = "alpha" if kind == "block" else "alpha_cg"
+    alpha = alpha_symbol(kind)
     out = {"long_name": f.long_name, "description": f.meaning,
            "rocksweep_units": f.unit.replace("alpha_ref", alpha)}
     if f.symbol:

@@ -1,7 +1,7 @@
 """Adaptive vs full sweeps, side by side in one run (issue 11).
 
-For each scene: the full grid (``rocksweep.compute.sweep.compute``) and the adaptive sweep
-(``rocksweep.compute.adaptive.adaptive_compute``, default settings) with the same workers; prints
+For each scene: the full grid and the adaptive sweep (default settings), both in memory
+through the sweep driver (``rocksweep.compute.driver.sweep_arrays``) with the same workers; prints
 the points computed / points in the grid, both wall times, the share of cells whose
 adaptive outcome equals the full grid's, and the audit counts. ``--study`` also replays
 the adaptive algorithm on the full grid's outcomes (no kernel runs: a point's class is
@@ -38,6 +38,7 @@ import numpy as np
 
 from rocksweep.compute import adaptive as ad
 from rocksweep.compute import sweep as sw
+from rocksweep.compute.driver import sweep_arrays
 from rocksweep.compute.grid import Grid
 from rocksweep.scene.model import Scene
 from rocksweep.scene.parse import load_scene, parse_scene
@@ -90,7 +91,7 @@ def study(full: np.ndarray, sc: Scene, levels: range) -> list[str]:
         plan = ad.make_plan(grid, coarse=k)
         if 2**k > min(plan.panel_shape[1:]):
             break
-        out, _, st = ad.drive(plan, lambda flat, _b: truth[flat])
+        out, _, st = ad.run_on_function(plan, lambda flat, _b: truth[flat])
         lines.append(f"    coarse {k} (stride {2**k:3d}, "
                      f"{(min(plan.panel_shape[1:]) - 1) / 2**k:6.1f} cells/axis): "
                      f"computed {100 * st.computed_share:6.2f}%, equal "
@@ -126,13 +127,14 @@ def main() -> None:
         grid = Grid(sc)
         sw.prepare(grid, sw.level(sc))  # compile/load kernels outside the timings
         t0 = time.perf_counter()
-        arr, st = ad.adaptive_compute(sc, jobs=jobs)
+        arr, report = sweep_arrays(sc, jobs=jobs, adaptive=ad.Options())
+        st = report.adaptive
         t_ad = time.perf_counter() - t0
         if args.no_full:
             full, t_full = None, float("nan")
         else:
             t0 = time.perf_counter()
-            full = sw.compute(sc, jobs=jobs)["outcome"]
+            full = sweep_arrays(sc, jobs=jobs)[0]["outcome"]
             t_full = time.perf_counter() - t0
         eq = "n/a" if full is None else (
             f"{100 * np.mean(arr['outcome'] == full):.4f}% "

@@ -5,8 +5,8 @@
     python scripts/fingerprint.py diff  /tmp/before.npz     # how much a deliberate change moved
 
 Runs the four figures, the rigid body and block scenes and the CI grid through
-``rocksweep.compute.sweep.compute`` (outcome kernels), the same grids with energy accounting on
-(``outputs.energy``), and Figure 5's single runs with their time histories (history
+``rocksweep.compute.driver.sweep_arrays`` (outcome kernels), the same grids with energy
+accounting on (``outputs.energy``), and Figure 5's single runs with their time histories (history
 kernels). ``check`` prints the number of point-runs compared and every array that differs
 in any bit (NaN equals NaN); it exits 1 if any does. ``diff`` measures a change that is
 meant to move results (a numerical method's, argued in its commit): per sweep, the points
@@ -31,8 +31,8 @@ SINGLE = ["fig5", "fig5-rigid"]
 def collect() -> dict[str, np.ndarray]:
     from itertools import product
 
+    from rocksweep.compute.driver import sweep_arrays
     from rocksweep.compute.single import simulate
-    from rocksweep.compute.sweep import compute
     from rocksweep.scene.parse import load_scene
 
     arrays: dict[str, np.ndarray] = {}
@@ -40,7 +40,7 @@ def collect() -> dict[str, np.ndarray]:
         for energy in (False, True):
             sets = ["outputs.energy=true"] if energy else []
             scene = load_scene(ROOT / "configs" / f"{name}.yaml", sets)
-            for k, v in compute(scene, jobs=2).items():
+            for k, v in sweep_arrays(scene, jobs=2)[0].items():
                 arrays[f"{name}{'+energy' if energy else ''}/{k}"] = v
     for name in SINGLE:
         scene = load_scene(ROOT / "configs" / f"{name}.yaml")

@@ -27,7 +27,7 @@ FLOORS: list[tuple[str, ...]] = [
     ("store",),
     ("analysis",),
     ("figures",),
-    ("api", "accessor", "__init__"),
+    ("api", "accessor", "simulation", "__init__"),
     ("cli", "__main__"),
 ]
 

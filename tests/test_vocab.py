@@ -31,6 +31,7 @@ FAMILIES: dict[str, tuple[str, ...]] = {
     "computed flags": tuple(outcomes.COMPUTED_CODE),
     "accuracy presets": settings.PRESET_NAMES,
     "accuracy ladders": settings.LADDER_NAMES,
+    "alpha_ref keys": axes.ALPHA_KEYS,
 }
 # Concepts whose values (not names) live elsewhere, keyed by the vocabulary's names: the
 # one dict literal allowed, checked to hold exactly the vocabulary's names below.
@@ -60,6 +61,12 @@ def redefinitions(src: str, where: str) -> list[str]:
     docs = _docstrings(tree)
     found = []
     for node in ast.walk(tree):
+        if isinstance(node, ast.IfExp):  # "alpha" if block else "alpha_cg": a mapping
+            pair = set(_strings([node.body, node.orelse]))
+            found += [f"{where}:{node.lineno}: {family} chosen by a condition"
+                      for family, members in FAMILIES.items()
+                      if len(pair) == 2 and pair == set(members)]
+            continue
         if isinstance(node, ast.Tuple | ast.List | ast.Set):
             names = _strings(node.elts)
         elif isinstance(node, ast.Dict):
@@ -80,6 +87,8 @@ def redefinitions(src: str, where: str) -> list[str]:
                 continue  # (mode1, mode2 are outcome words and fragility states: once)
             reported.append(hits)
             found.append(f"{where}:{node.lineno}: {family} {sorted(hits)}")
+        if not isinstance(node, ast.Dict) and set(axes.DIAGRAM_AXES) <= set(names):
+            found.append(f"{where}:{node.lineno}: the diagram axes (vocab.axes.DIAGRAM_AXES)")
         if isinstance(node, ast.Dict) and len(set(names) & set(axes.AXES)) >= 3:
             marks = [v for v in _strings(node.values) if "\\" in v or "[" in v]
             if len(marks) >= 2:  # LaTeX symbols or units of axes: a copy of vocab.axes
@@ -100,11 +109,17 @@ def test_no_list_of_vocabulary_names_outside_the_vocabulary():
 def test_the_checker_sees_a_copy():
     src = ('LAWS = ("vertical", "locked", "constant")\n'
            'msg = "must be sine, cosine, ricker, mp or record"\n'
+           'for d in ("w_over_p", "A_ratio"): pass\n'
+           'row = {"w_over_p": 1.0, "A_ratio": 2.0}\n'
+           'key = "alpha" if kind == "block" else "alpha_cg"\n'
+           'word = "mode1" if m == 1 else "mode2"\n'
            'ok = law == "constant"\n'
            'def f():\n    """vertical, locked, constant in a docstring is prose."""\n')
     found = redefinitions(src, "x.py")
     assert found == ["x.py:1: impact laws ['constant', 'locked', 'vertical']",
-                     "x.py:2: pulse shapes in a string"]
+                     "x.py:2: pulse shapes in a string",
+                     "x.py:3: the diagram axes (vocab.axes.DIAGRAM_AXES)",
+                     "x.py:5: alpha_ref keys chosen by a condition"]
 
 
 def test_the_homes_hold_the_vocabulary_names():

@@ -3,7 +3,7 @@
 ``accuracy_study(scene, n_points, ladder)``:
 
 1. Classify every point of the scene with the kernel at the scene's own numerics (the
-   sweep machinery, ``rocksweep.compute.sweep.compute``) and mark the points on an outcome
+   sweep machinery, ``rocksweep.compute.driver.sweep_arrays``) and mark the points on an outcome
    boundary of the stability diagram (a neighbour along A_ratio or w_over_p has another
    outcome).
 2. Draw a stratified sample of ``n_points``: strata are (outcome, boundary or interior);
@@ -53,6 +53,7 @@ from rocksweep.numerics import (
     Numerics,
 )
 from rocksweep.scene.model import Scene, SceneError
+from rocksweep.vocab.axes import DIAGRAM_AXES, RECORD_X
 from rocksweep.vocab.outcomes import CLASSES
 
 OUTCOMES = CLASSES  # codes 0, 1, 2
@@ -160,7 +161,7 @@ def boundary_mask(outcome: np.ndarray, dims: tuple[str, ...]) -> np.ndarray:
     """
     mask = np.zeros(outcome.shape, bool)
     for ax, name in enumerate(dims):
-        if name not in ("A_ratio", "w_over_p", "p"):  # p: a record sweep's time scale
+        if name not in (*DIAGRAM_AXES, RECORD_X):
             continue
         diff = np.diff(outcome, axis=ax) != 0
         lo = [slice(None)] * outcome.ndim
@@ -267,8 +268,8 @@ def sample_scene(scene: Scene, n: int | None, seed: int = 0) -> Sample:
     ``n`` None or >= the scene's size takes every point (one stratum "all", weights 1,
     no classification pass).
     """
+    from rocksweep.compute.driver import sweep_arrays
     from rocksweep.compute.grid import Grid
-    from rocksweep.compute.sweep import compute
 
     grid = Grid(scene)
     if n is None or n >= grid.size:
@@ -276,7 +277,7 @@ def sample_scene(scene: Scene, n: int | None, seed: int = 0) -> Sample:
                       np.ones(grid.size), ["all"], np.array([grid.size], np.int64),
                       grid.size, np.full(grid.size, L.OUTCOME_NOT_RUN, np.int8), 0.0)
     t0 = time.perf_counter()
-    outcome = compute(scene)["outcome"]
+    outcome = sweep_arrays(scene)[0]["outcome"]
     secs = time.perf_counter() - t0
     bnd = boundary_mask(outcome, grid.dims)
     flat, stratum, weight, names, sizes = stratified_sample(outcome.ravel(), bnd.ravel(), n,

@@ -36,6 +36,7 @@ from rocksweep.compute.adaptive import DIAGRAM_AXES, AdaptiveError, make_plan
 from rocksweep.compute.dispatch import run_variant
 from rocksweep.compute.grid import Grid
 from rocksweep.errors import BoundaryError  # noqa: F401 (re-exported)
+from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import warm_up
 from rocksweep.numerics import MAX_POINT_STEPS, Numerics
@@ -92,12 +93,8 @@ def panels(scene: Scene, outcome: np.ndarray, axes: Sequence[str] = DIAGRAM_AXES
     y = np.asarray(scene.axis(axes[1]).values, float)
     for p in range(cls.shape[0]):
         values = grid.index_values(idx[p, :1, 0])
-        where = {a.name: _plain(values[a.name][0]) for a in others}
+        where = {a.name: plain(values[a.name][0]) for a in others}
         yield Panel(where, x, y, cls[p], idx[p])
-
-
-def _plain(v: Any) -> Any:
-    return v.item() if isinstance(v, np.generic) else v
 
 
 # --- boundary lines ---------------------------------------------------------------------
@@ -475,7 +472,7 @@ def a_min(scene: Scene, outcome: np.ndarray, rtol: float = DEFAULT_RTOL,
     searched = A_MIN_METHODS.index("searched below grid")
 
     def values_at(flat: int) -> dict[str, Any]:
-        return {k: _plain(v[0]) for k, v in grid.index_values(np.array([flat])).items()}
+        return {k: plain(v[0]) for k, v in grid.index_values(np.array([flat])).items()}
 
     curves, cols = [], []
     for p in panels(scene, outcome, axes):
@@ -856,14 +853,40 @@ def lines_frame(bounds: Sequence[PanelBoundaries]):
     return pd.DataFrame(rows)
 
 
-def boundaries_dataset(ds: Any, rtol: float = 1e-3, mode: int | None = None,
-                       search: bool = True) -> Any:
-    """``rocksweep.boundaries`` (its arguments checked there): the A_min curves of a
-    complete result (``result_curves``) as a Dataset (``curves_dataset``)."""
+def boundary_lines_frame(ds: Any):
+    """``rocksweep.boundary_lines``: the class boundary polylines of a complete result's
+    diagrams (``diagram_boundaries``) as ``lines_frame``'s DataFrame."""
     from rocksweep.store.reader import as_result
 
+    result = as_result(ds, ["outcome"])
+    return lines_frame(diagram_boundaries(check_result(result), result.arrays["outcome"]))
+
+
+def check_search(search: Any) -> bool:
+    """The ``search`` argument of ``a_min``'s callers: True or False, else an ApiError."""
+    from rocksweep.errors import ApiError
+
+    if not isinstance(search, bool):
+        raise ApiError(f"search = {search!r}: must be True or False")
+    return search
+
+
+def boundaries_dataset(ds: Any, rtol: float = DEFAULT_RTOL, mode: int | None = None,
+                       search: bool = True) -> Any:
+    """``rocksweep.boundaries`` (its arguments documented there): the A_min curves of a
+    complete result (``result_curves``) as a Dataset (``curves_dataset``). rtol, mode
+    (None, 1 or 2) and search (a bool) are checked before the result is read: one-line
+    ApiErrors."""
+    from rocksweep.errors import ApiError
+    from rocksweep.store.reader import as_result
+
+    rtol = check_rtol(rtol)
+    if mode not in (None, 1, 2):
+        raise ApiError(f"mode = {mode!r}: must be None, 1 or 2")
+    check_search(search)
     result = as_result(ds, list(RESPONSE))
     curves, _ = result_curves(result, rtol, mode, search=search)
-    return curves_dataset(curves, {"title": result.name, "rtol": rtol,
+    return curves_dataset(curves, {"rocksweep_kind": "boundaries", "kind": result.kind,
+                                   "title": result.name, "rtol": rtol,
                                    "search": int(search),
                                    "mode": "any" if mode is None else f"mode{mode}"})

@@ -776,12 +776,26 @@ def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
 
 
 
-def calibrate_scene(scene: Any, measured: Any, keys: Sequence[str],
+def calibrate_scene(scene: Any, measured: Any, fit: str | Sequence[str],
                     bounds: Mapping[str, Sequence[float]] | None = None, ci: float = 0.95,
-                    p: float | None = None) -> Any:
-    """``rocksweep.calibrate`` on a loaded scene: the measured history read
-    (``physics.measured.read_measured``, in the scene's body's alpha_ref and u_cr; p [rad/s]
-    given, else the scene's ``_body_p``) and ``keys`` fitted (``calibrate_problem``)."""
+                    p: float | None = None, overrides: Any = ()) -> Any:
+    """``rocksweep.calibrate`` (its arguments documented there): ``fit`` (a key or a
+    non-empty list of distinct keys) and ``ci`` (in [0.5, 1)) checked first, then the scene
+    loaded (``scene.inputs.load``: a Scene, a path, YAML text or a dict, with
+    ``overrides``), the measured history read (``physics.measured.read_measured``, in the
+    scene's body's alpha_ref and u_cr; p [rad/s] given, else the scene's ``_body_p``) and
+    the keys fitted (``calibrate_problem``)."""
+    from rocksweep.scene.inputs import load
+
+    keys = [fit] if isinstance(fit, str) else list(fit)
+    if not keys:
+        raise CalibrationError("fit = []: give at least one key, e.g. impact.lam")
+    if len(set(keys)) < len(keys):
+        raise CalibrationError(f"fit = {keys}: a key is given twice")
+    if not (isinstance(ci, float | int) and 0.5 <= ci < 1):
+        raise CalibrationError(f"ci = {ci!r}: must be in [0.5, 1)")
+    ci = float(ci)
+    scene, _ = load(scene, overrides)
     p_body = _body_p(scene) if p is None else float(p)
     values = {a.name: a.values[0] for a in scene.axes}
     body = scene.point(values).body

@@ -38,6 +38,8 @@ from rocksweep.analysis.fragility import counted_points, fit_cloud, state_reache
 from rocksweep.errors import EfficiencyError, RocksweepError  # noqa: F401 (re-exported)
 from rocksweep.physics.model import G
 from rocksweep.physics.suite import RECORD_IMS
+from rocksweep.vocab.axes import ALPHA_KEYS
+from rocksweep.vocab.ground import PGA_RATIO, PGV_OVER_PGA, PGV_RATIO, SA, SCALE_IMS
 
 __all__ = ["EfficiencyError", "im_efficiency", "record_im_table"]
 
@@ -57,17 +59,19 @@ def record_im_table(ds: xr.Dataset) -> dict[str, tuple[xr.DataArray, str, int]]:
     for name, (var, unit, n) in RECORD_IMS.items():
         if var in ds.variables:
             out[name] = (ds[var], unit, n)
-        elif name == "PGV_over_PGA" and {"record_pga", "record_pgv"} <= set(ds.variables):
+        elif name == PGV_OVER_PGA and {"record_pga", "record_pgv"} <= set(ds.variables):
             out[name] = (ds["record_pgv"] / (ds["record_pga"] * G), unit, n)
     if "record_sa" in ds.variables and "period" in ds["record_sa"].dims:
         for T in ds["period"].values:
-            out[f"Sa({float(T):g})"] = (ds["record_sa"].sel(period=T, drop=True), "g", 1)
-    alpha = _scalar(ds, ("alpha_cg", "alpha"))
+            out[f"{SA}({float(T):g})"] = (ds["record_sa"].sel(period=T, drop=True),
+                                          SCALE_IMS[SA], 1)
+    alpha = _scalar(ds, ALPHA_KEYS)
     p = _scalar(ds, ("p",))
     if alpha is not None and "record_pga" in ds.variables:
-        out["PGA_ratio"] = (ds["record_pga"] / np.tan(alpha), "1", 1)
+        out[PGA_RATIO] = (ds["record_pga"] / np.tan(alpha), SCALE_IMS[PGA_RATIO], 1)
         if p is not None and "record_pgv" in ds.variables:
-            out["PGV_ratio"] = (ds["record_pgv"] * p / (G * np.tan(alpha)), "1", 1)
+            out[PGV_RATIO] = (ds["record_pgv"] * p / (G * np.tan(alpha)),
+                              SCALE_IMS[PGV_RATIO], 1)
     return out
 
 

@@ -36,11 +36,9 @@ def open_any(path: str | Path) -> xr.Dataset:
         except (OSError, RuntimeError, ValueError, KeyError, TypeError):
             kind = None  # damaged, foreign, locked: open's one-line error says which
     if kind in (None, "sweep"):  # a sweep, or rocksweep.open's one-line error for the rest
-        from rocksweep.store.dataset import result_dataset
-        from rocksweep.store.reader import read_result
+        from rocksweep.store.dataset import open_result
 
-        read_result(path, ["outcome"])
-        return result_dataset(path)
+        return open_result(path)
     try:
         with xr.open_dataset(path, engine="h5netcdf", phony_dims="sort") as ds:
             ds = ds.load()

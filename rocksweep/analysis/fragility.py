@@ -83,6 +83,7 @@ from scipy.special import log_ndtr, ndtr, ndtri, owens_t
 
 from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP, MAX_BOOTSTRAP
 from rocksweep.errors import FragilityError, RocksweepError  # noqa: F401 (re-exported)
+from rocksweep.fields import plain
 from rocksweep.kernel import layout as L
 from rocksweep.vocab.ground import CLOUD_IMS as CLOUD_IM_VARIABLES
 from rocksweep.vocab.ground import SCALE_IMS
@@ -1150,8 +1151,9 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     ``n_failed`` over (state, others, stripe) and ``n_counted`` over (others, stripe), and
     per record ``first_level`` (smallest level that reaches the state; NaN if none) and
     ``resurrection`` (a higher counted level does not reach it) over (state, others,
-    record). attrs: method ("stripes-mle" | "cloud-mle"), im, im_units, period (Sa),
-    states, bootstrap, seed, ci, reference.
+    record). attrs: rocksweep_kind "fragility" (``analysis.kinds``), title (the sweep's),
+    method ("stripes-mle" | "cloud-mle"), im, im_units, period (Sa), states, bootstrap,
+    seed, ci, reference.
     """
     _check_args(ds, im, period, seed)
     bootstrap = DEFAULT_BOOTSTRAP if bootstrap is None else bootstrap
@@ -1380,7 +1382,8 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
                                 "state (NaN: none)"})
         data["resurrection"] = (dims_c + ["record"], shaped(safe_above.any(-1), (R,)),
                                 {"long_name": "a higher counted level is safe again"})
-    attrs = {"method": method, "im": im_name, "im_units": unit, "states": list(states),
+    attrs = {"rocksweep_kind": "fragility", "title": str(ds.attrs.get("title", "")),
+             "method": method, "im": im_name, "im_units": unit, "states": list(states),
              "bootstrap": int(N), "seed": int(seed), "ci": float(ci),
              "reference": "Baker (2015), Efficient analytical fragility function fitting "
                           "using dynamic structural analysis, Earthquake Spectra 31(1)"}
@@ -1460,7 +1463,7 @@ def verdict_lines(frag: xr.Dataset, why: list[list[dict[str, str]]] | None = Non
             words = str(one.values)
             if words == "ok":
                 continue
-            where = ", ".join(f"{d} = {_plain(frag[d].values[i]) if d in frag.coords else i}"
+            where = ", ".join(f"{d} = {_json(frag[d].values[i]) if d in frag.coords else i}"
                               for d, i in sel.items())
             detail = why[si][o] if why is not None else {}
             parts = [f"{wd} ({detail[wd]})" if detail.get(wd) else wd
@@ -1520,13 +1523,9 @@ def lognormal_cdf(x, median, beta) -> np.ndarray:
                     np.where(np.isnan(median) | np.isnan(beta), np.nan, step))
 
 
-def _plain(v: Any) -> Any:
-    if isinstance(v, np.generic):
-        v = v.item()
-    if isinstance(v, float) and not math.isfinite(v):
-        return None
-    return v
 
+def _json(v: Any) -> Any:
+    return plain(v, nan_to_none=True)
 
 def curves_json(frag: xr.Dataset) -> dict:
     """{"curves": [{<other dims>: value, "state", "im", "method", "fit", "im_median",
@@ -1544,16 +1543,16 @@ def curves_json(frag: xr.Dataset) -> dict:
             one = frag.isel(sel)
             if "state" in frag["im_median"].dims:
                 one = one.isel(state=st_i)
-            entry: dict[str, Any] = {d: _plain(frag[d].values[i]) if d in frag.coords
+            entry: dict[str, Any] = {d: _json(frag[d].values[i]) if d in frag.coords
                                      else int(i) for d, i in sel.items()}
             entry.update({
                 "state": str(st), "im": frag.attrs["im"], "method": frag.attrs["method"],
                 "fit": str(one["fit"].values),
-                "im_median": _plain(float(one["im_median"])),
-                "beta": _plain(float(one["beta"])),
-                "im_median_ci": [_plain(float(one["im_median_lo"])),
-                                 _plain(float(one["im_median_hi"]))],
-                "beta_ci": [_plain(float(one["beta_lo"])), _plain(float(one["beta_hi"]))],
+                "im_median": _json(float(one["im_median"])),
+                "beta": _json(float(one["beta"])),
+                "im_median_ci": [_json(float(one["im_median_lo"])),
+                                 _json(float(one["im_median_hi"]))],
+                "beta_ci": [_json(float(one["beta_lo"])), _json(float(one["beta_hi"]))],
                 "n_records": int(one["n_records"]), "n_excluded": int(one["n_excluded"]),
                 "n_not_run": int(one["n_not_run"]),
                 "n_boot_undefined": int(one["n_boot_undefined"]),

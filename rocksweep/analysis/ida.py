@@ -28,6 +28,7 @@ import numpy as np
 
 from rocksweep.compute.single import simulate
 from rocksweep.errors import IdaError, check_rtol
+from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.store.reader import as_result, result_scene
 
@@ -110,7 +111,7 @@ def ida(ds: Any, rtol: float = 1e-2) -> Any:
         for d, k in zip([*others, "record"], idx, strict=True):
             values[d] = result.coords[d][k]
         values[im] = levels[first[i]]
-        points[i] = scene.point(_plain(values))
+        points[i] = scene.point({k: plain(v) for k, v in values.items()})
     active = [i for i in inner if hi[i] - lo[i] > rtol * hi[i]]
     for _ in range(MAX_ITER):
         if not active:
@@ -164,10 +165,6 @@ def ida(ds: Any, rtol: float = 1e-2) -> Any:
     return xr.Dataset(data, coords=coords,
                       attrs={"im": im, "im_units": unit, "rtol": float(rtol),
                              "title": result.name})
-
-
-def _plain(values: dict) -> dict:
-    return {k: (v.item() if hasattr(v, "item") else v) for k, v in values.items()}
 
 
 def ida_dataset(ds: Any, rtol: float = 1e-2) -> Any:

@@ -31,7 +31,9 @@ Beyond the hazard curve's range the tool BOUNDS, it does not extrapolate the haz
 
 Hazard inputs (``read_hazard``): a two-column CSV with the header ``IM [unit],annual_rate``
 (e.g. ``PGA [g],annual_rate``; ``Sa(1.0) [g]`` for Sa at 1 s; lines starting with # are
-comments), the IM and unit checked against the fragility's; or OpenQuake's hazard-curve
+comments), the IM checked against the fragility's and the unit converted to the
+fragility's where both are known (``UNIT_SI``: g, m/s^2, cm/s^2 or gal; m/s, cm/s, mm/s;
+the factor is kept in the attribute ``hazard_unit``); or OpenQuake's hazard-curve
 CSV (``oq export hcurves``: a comment line
 ``#,,,,,"generated_by=..., investigation_time=50.0, imt='PGA'"``, then
 ``lon,lat,depth,poe-<level>,...`` and one row per site): probabilities of exceedance in the
@@ -44,7 +46,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -52,6 +54,7 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.errors import RiskError, RocksweepError  # noqa: F401 (re-exported)
+from rocksweep.physics.model import G
 from rocksweep.vocab.ground import PGA, PGV, SA
 
 __all__ = ["Hazard", "RiskError", "fragility_median", "hazard_frame", "read_hazard",
@@ -64,6 +67,14 @@ PLOT_POINTS = 200  # the figure's grid over the hazard's range
 RATE_COLUMN = "annual_rate"
 #: OpenQuake's IMT units, and the factor to rocksweep's
 OQ_UNITS = {PGA: ("g", 1.0), SA.upper(): ("g", 1.0), PGV: ("m/s", 0.01)}
+#: Units a hazard curve may give its IM in: the factor to SI (accelerations to m/s^2,
+#: velocities to m/s); a hazard in another unit of the same kind is converted. g is G,
+#: the gravity of the model and of the records' PGV (9.81 m/s^2, not g_n = 9.80665)
+UNIT_SI: dict[str, tuple[str, float]] = {
+    "g": ("acceleration", G), "m/s^2": ("acceleration", 1.0), "m/s2": ("acceleration", 1.0),
+    "cm/s^2": ("acceleration", 0.01), "cm/s2": ("acceleration", 0.01),
+    "gal": ("acceleration", 0.01), "m/s": ("velocity", 1.0), "cm/s": ("velocity", 0.01),
+    "mm/s": ("velocity", 0.001)}
 _HEADER = re.compile(r"^\s*(?P<im>[A-Za-z][A-Za-z0-9_]*)\s*(?:\(\s*(?P<T>[0-9.eE+-]+)\s*\))?"
                      r"\s*\[(?P<unit>[^\]]*)\]\s*$")
 
@@ -373,7 +384,18 @@ def _check_years(years: Any) -> float:
     return y
 
 
-def _check_match(fr: xr.Dataset, hz: Hazard) -> None:
+def _unit_factor(frm: str, to: str) -> float | None:
+    """x [frm] times this is x [to]; None when either unit is unknown or their kinds
+    differ (``UNIT_SI``)."""
+    a, b = UNIT_SI.get(frm.strip().lower()), UNIT_SI.get(to.strip().lower())
+    if a is None or b is None or a[0] != b[0]:
+        return None
+    return a[1] / b[1]
+
+
+def _check_match(fr: xr.Dataset, hz: Hazard) -> Hazard:
+    """The hazard curve in the fragility's IM units (converted where both units are known),
+    or a RiskError naming what does not match."""
     im, unit = str(fr.attrs.get("im", "")), str(fr.attrs.get("im_units", ""))
     if not im:
         raise RiskError("the fragility Dataset has no attribute im (the IM its curves are "
@@ -382,14 +404,20 @@ def _check_match(fr: xr.Dataset, hz: Hazard) -> None:
         raise RiskError(f"{hz.source}: hazard IM {hz.name} [{hz.unit}] is not the "
                         f"fragility's IM {im} [{unit}]; use a hazard curve of {im}")
     if hz.unit != unit:
-        raise RiskError(f"{hz.source}: hazard unit [{hz.unit}] for {hz.name} is not the "
-                        f"fragility's [{unit}]; convert the hazard curve to {unit}")
+        factor = _unit_factor(hz.unit, unit)
+        if factor is None:
+            known = ", ".join(UNIT_SI)
+            raise RiskError(f"{hz.source}: hazard unit [{hz.unit}] for {hz.name} is not the "
+                            f"fragility's [{unit}] and cannot be converted to it (known "
+                            f"units: {known}); convert the hazard curve to {unit}")
+        hz = replace(hz, im=hz.im * factor, unit=unit)
     if im == "Sa":
         per = float(fr.attrs.get("period", math.nan))
         if not (math.isfinite(hz.period) and math.isfinite(per)
                 and math.isclose(hz.period, per, rel_tol=1e-6)):
             raise RiskError(f"{hz.source}: hazard Sa period {hz.period:g} s is not the "
                             f"fragility's {per:g} s")
+    return hz
 
 
 def risk(fr: xr.Dataset, hazard: Any, years: float = 50.0, *,
@@ -421,8 +449,8 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50.0, *,
     if "beta" not in fr.data_vars:
         raise RiskError("not a fragility Dataset (no beta)")
     N = _check_years(years)
-    hz = read_hazard(hazard, site=site)
-    _check_match(fr, hz)
+    read = read_hazard(hazard, site=site)
+    hz = _check_match(fr, read)
     dims = list(med_da.dims)
     curve = _curve_p(fr, med_da, fr["beta"], dims)
     rate, rate_max, p_lo, p_hi = _rates(hz, curve)
@@ -495,6 +523,9 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50.0, *,
                           "seismic performance assessment, PEER Center News 3(2)"}
     if math.isfinite(hz.period):
         attrs["period"] = hz.period
+    if read.unit != hz.unit:
+        attrs["hazard_unit"] = (f"{read.unit}, converted to {hz.unit} "
+                                f"(x {_unit_factor(read.unit, hz.unit):.6g})")
     for k in ("title", "states"):
         if k in fr.attrs:
             attrs[k] = fr.attrs[k]

@@ -29,6 +29,7 @@ from rocksweep.analysis.boundaries import (
     RESPONSE,
     AMinCurve,
     a_min,
+    check_search,
     grid_response,
     kernel_evaluator,
 )
@@ -46,7 +47,8 @@ class Spectra:
     float64[nl, nA, nx] max |theta|/alpha_ref; outcome: int8[nl, nA, nx]; a_min: one
     ``AMinCurve`` per lam (x = freq, a_min [A_ratio], mode 1 or 2 at a_min, NaN: no grid
     value overturns); rtol: the bisection's relative tolerance; runs: kernel runs spent;
-    kind: the body kind ("flexible": alpha_ref is alpha_cg; "block": alpha).
+    kind: the body kind ("flexible": alpha_ref is alpha_cg; "block": alpha); search:
+    whether A_min was searched below the grid's first overturning value.
     """
 
     name: str
@@ -61,13 +63,15 @@ class Spectra:
     runs: int
     record: str = ""
     kind: str = "flexible"
+    search: bool = True
 
     def to_dataset(self):
         """The spectra as an ``xarray.Dataset``: ``theta_max_over_alpha`` and ``outcome``
         over (lam, A_ratio, freq) (the rocking spectrum), ``A_min``, ``mode`` and
         ``A_min_method`` (how A_min was found, ``boundaries.A_MIN_METHODS``) over (lam,
         freq) (the overturning spectrum, bisected to ``rtol``; NaN: no grid value
-        overturns), freq being ``p`` [rad/s] or ``w_over_p``."""
+        overturns), freq being ``p`` [rad/s] or ``w_over_p``; attrs: rocksweep_kind
+        "spectra" (``analysis.kinds``), title, rtol, runs, record."""
         import xarray as xr
 
         from rocksweep import fields
@@ -92,16 +96,21 @@ class Spectra:
             coords={"lam": ("lam", self.lam, fields.axis_attrs("lam")),
                     "A_ratio": ("A_ratio", self.A, fields.axis_attrs("A_ratio", self.kind)),
                     f: (f, self.x, fields.axis_attrs(f))},
-            attrs={"title": self.name, "rtol": self.rtol, "runs": self.runs,
-                   "record": self.record})
+            attrs={"rocksweep_kind": "spectra", "kind": self.kind, "title": self.name,
+                   "rtol": self.rtol,
+                   "search": int(self.search),
+                   "runs": self.runs, "record": self.record})
 
 
-def spectra(data, rtol: float = DEFAULT_RTOL) -> Spectra:
+def spectra(data, rtol: float = DEFAULT_RTOL, search: bool = True) -> Spectra:
     """The rocking and overturning spectra of a complete sweep result: a Dataset (what
-    ``rocksweep.run`` / ``rocksweep.open`` return), a ``SweepResult`` or a file's path."""
+    ``rocksweep.run`` / ``rocksweep.open`` return), a ``SweepResult`` or a file's path.
+    search: A_min searched below the first overturning grid value too (``a_min``); False:
+    the grid's bracket bisected only (faster; A_min then depends on the grid)."""
     from rocksweep.store.reader import as_result, result_scene
 
     rtol = check_rtol(rtol)
+    check_search(search)
     result = as_result(data, [*RESPONSE, "status"])
     freq = "p" if "p" in result.dims else "w_over_p"
     missing = [d for d in (freq, "A_ratio") if d not in result.dims]
@@ -131,8 +140,8 @@ def spectra(data, rtol: float = DEFAULT_RTOL) -> Spectra:
         lam = np.asarray(result.coords["lam"], float)
     scene = result_scene(result)
     curves = a_min(scene, result.arrays["outcome"], rtol, axes=(freq, "A_ratio"),
-                   evaluate=kernel_evaluator(scene), **grid_response(result))
+                   evaluate=kernel_evaluator(scene), **grid_response(result), search=search)
     rec = result.scene.get("record") or {}
     return Spectra(result.name, freq, np.asarray(result.coords[freq], float), A, lam,
                    theta, outcome, curves, rtol, int(sum(c.runs.sum() for c in curves)),
-                   rec.get("name", ""), result.kind)
+                   rec.get("name", ""), result.kind, search)

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rocksweep.fields import THETA_REL_FLOOR
+from rocksweep.fields import THETA_REL_FLOOR, plain
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.vocab.outcomes import (
     COMPUTED,
@@ -48,14 +48,6 @@ CHECK_INFO_VARIABLES = ["theta_max_over_alpha", "check_outcome", "check_t_overtu
                         "check_theta_max_diff"]
 
 
-def _plain(v):
-    if isinstance(v, bytes):
-        return v.decode()
-    if isinstance(v, np.generic):
-        return v.item()
-    return v
-
-
 def class_counts(result: SweepResult, by: Sequence[str]) -> list[dict]:
     """Points per class for each combination of values of the swept keys ``by`` (in the
     grid's order, the others summed); keys in ``by`` that are not swept are labelled with
@@ -79,8 +71,8 @@ def class_counts(result: SweepResult, by: Sequence[str]) -> list[dict]:
              & (o != L.OUTCOME_NOT_RUN) for c in (CONTACT_COUNTS if contact else ())}
     rows = []
     for idx in np.ndindex(*shape):
-        label = {d: (_plain(result.coords[d][idx[swept.index(d)]]) if d in swept
-                     else _plain(result.scalars.get(d))) for d in by}
+        label = {d: (plain(result.coords[d][idx[swept.index(d)]]) if d in swept
+                     else plain(result.scalars.get(d))) for d in by}
         cell = o[idx]
         rows.append({**label,
                      **{w: int((cell == OUTCOME_CODE[w]).sum()) for w in CLASSES[:3]},
@@ -221,7 +213,7 @@ def info_dict(result: SweepResult) -> dict:
     done = result.done
     keys = {k.split(".", 1)[1]: k for k in result.scene["axes"]}
     dims = {d: {"size": len(result.coords[d]), "scene_key": keys[d],
-                "values": [_plain(v) for v in result.coords[d]]} for d in result.dims}
+                "values": [plain(v) for v in result.coords[d]]} for d in result.dims}
     return {
         "path": str(result.path),
         "title": result.name,

@@ -26,6 +26,8 @@ from rocksweep.analysis.kinds import dataset_kind
 from rocksweep.errors import RocksweepError, TableError  # noqa: F401 (re-exported)
 from rocksweep.physics.model import G
 from rocksweep.physics.suite import RECORD_IMS
+from rocksweep.vocab.axes import ALPHA_KEYS
+from rocksweep.vocab.ground import SA, SCALE_IMS
 
 __all__ = ["ROW_VARIABLE", "TableError", "table"]
 
@@ -99,7 +101,7 @@ def table(ds: xr.Dataset) -> Any:
                 label = im.lower()
                 cols[label] = flat(ds[var]) * f ** k
                 units[label] = unit
-        alpha = next((cols[a] for a in ("alpha_cg", "alpha") if a in cols), None)
+        alpha = next((cols[a] for a in ALPHA_KEYS if a in cols), None)
         if alpha is not None and "pga" in cols:  # the dimensionless ones of the run
             tan = np.tan(np.asarray(alpha, np.float64))
             cols["pga_ratio"], units["pga_ratio"] = cols["pga"] / tan, "1"
@@ -111,7 +113,7 @@ def table(ds: xr.Dataset) -> Any:
             for i, T in enumerate(ds["period"].values):
                 label = f"sa({float(T):g})"
                 cols[label] = flat(ds["record_sa"].isel(period=i)) * f
-                units[label] = "g"
+                units[label] = SCALE_IMS[SA]
     out = pd.DataFrame(cols)
     for c in out.columns:  # words as plain strings (parquet, csv)
         if out[c].dtype == object or out[c].dtype.kind in "US":

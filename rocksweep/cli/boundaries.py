@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from rocksweep.cli.main import main, user_errors
-from rocksweep.cli.options import dpi_option, overwrite_option, rtol_option
+from rocksweep.cli.options import dpi_option, overwrite_option, rtol_option, search_option
 
 
 @main.command()
@@ -19,10 +19,7 @@ from rocksweep.cli.options import dpi_option, overwrite_option, rtol_option
 @click.option("--lines", "lines_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Also write the boundary polylines as CSV (one row per vertex).")
 @rtol_option
-@click.option("--search/--no-search", default=True, show_default=True,
-              help="Search below the first overturning grid value for a band narrower "
-                   "than the grid step (--no-search: bisect the grid's bracket only, "
-                   "faster, A_min then depends on the grid).")
+@search_option
 @click.option("--mode", type=click.Choice(["1", "2"]), default=None,
               help="A_min of this overturning mode only [default: either].")
 @click.option("--plot", "fig_path", type=click.Path(dir_okay=False, path_type=Path),

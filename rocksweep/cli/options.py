@@ -37,3 +37,8 @@ rtol_option = click.option(
          "overturning grid value, then bisection).")
 dpi_option = click.option("--dpi", type=click.IntRange(*DPI_RANGE), default=DEFAULT_DPI,
                           show_default=True, help="Resolution of raster output (PNG).")
+search_option = click.option(
+    "--search/--no-search", default=True, show_default=True,
+    help="Search below the first overturning grid value for a band narrower than the grid "
+         "step (--no-search: bisect the grid's bracket only, faster, A_min then depends on "
+         "the grid).")

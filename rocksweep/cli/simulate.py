@@ -17,6 +17,7 @@ from rocksweep.cli.main import (
     set_option,
     user_errors,
 )
+from rocksweep.vocab.axes import alpha_symbol
 
 MAX_POINTS = 12  # = rocksweep.api.MAX_RUNS: simulate overlays a few runs
 
@@ -101,8 +102,9 @@ def _print_run(r, swept: list[str]) -> None:
     where = ", ".join(f"{k}={v}" for k, v in zip(swept, swept_values(r, swept), strict=True))
     head = f"[{where}] " if where else ""
     t_over = "-" if s["t_overturn"] is None else f"{s['t_overturn']:.4f}"
+    alpha = alpha_symbol(getattr(r.point.body, "kind", "flexible"))
     click.echo(f"{head}outcome: {s['outcome']}   impacts: {s['impacts']}   "
-               f"uplifts: {s['uplifts']}   max|theta|/alpha_cg: "
+               f"uplifts: {s['uplifts']}   max|theta|/{alpha}: "
                f"{s['theta_max_over_alpha']:.4f}   overturns at p*t: {t_over}")
     if "impact_loss_over_Eref" in s:
         click.echo(f"  energy/E_ref: input {s['work_in_over_Eref']:.4f}, lost in impacts "

@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from rocksweep.cli.main import main, user_errors
-from rocksweep.cli.options import dpi_option, overwrite_option, rtol_option
+from rocksweep.cli.options import dpi_option, overwrite_option, rtol_option, search_option
 
 
 @main.command()
@@ -16,10 +16,11 @@ from rocksweep.cli.options import dpi_option, overwrite_option, rtol_option
 @click.option("-o", "--output", "fig_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Figure file, .png, .pdf or .svg [default: OUT-spectra.png].")
 @rtol_option
+@search_option
 @dpi_option
 @overwrite_option
 @user_errors
-def spectrum(result_path: Path, fig_path: Path | None, rtol: float, dpi: int,
+def spectrum(result_path: Path, fig_path: Path | None, rtol: float, search: bool, dpi: int,
              overwrite: bool) -> None:
     """Rocking spectrum (max|theta|/alpha_cg against p, one curve per A_ratio and lam) and
     overturning spectrum (smallest A_ratio that overturns against p, one curve per lam,
@@ -33,6 +34,6 @@ def spectrum(result_path: Path, fig_path: Path | None, rtol: float, dpi: int,
     fig_out = fig_path or result_path.with_name(result_path.stem + "-spectra.png")
     inputs = result_inputs(result_path)  # the result and its records: never written over
     check_output(fig_out, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
-    sp = spectra(result_path, rtol)
+    sp = spectra(result_path, rtol, search)
     save_figure(spectra_figure(sp), fig_out, dpi, overwrite=overwrite, inputs=inputs)
     click.echo(f"wrote {fig_out} ({sp.runs} kernel runs to find A_min to {rtol:g})")

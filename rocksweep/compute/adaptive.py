@@ -36,7 +36,8 @@ the audit, above the audit points): adding points only adds mixed cells, and eve
 of step 2 that reads classes (edge ends, a centre) only fires once those points are
 computed and then holds for good, so the order in which batches are computed does not
 matter. ``next_batch`` is therefore a pure function of
-(outcome, computed): a driver calls it, computes the batch it returns (any workers, any
+(outcome, computed): ``run_plan`` (the loop, written once, that the sweep driver
+``rocksweep.compute.driver`` runs) calls it, computes the batch it returns (any workers, any
 chunking; a point's result depends only on the point), stores the results and calls it
 again, until it returns an empty batch. An interrupted sweep resumes from the file.
 
@@ -50,7 +51,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -701,15 +702,42 @@ def stats_of(outcome_computed: np.ndarray, threshold: float = DEFAULT_AUDIT_THRE
                          threshold=threshold)
 
 
-def drive(plan: Plan, evaluate: Callable[[np.ndarray, Batch], np.ndarray],
-          outcome: np.ndarray | None = None, computed: np.ndarray | None = None,
-          threshold: float = DEFAULT_AUDIT_THRESHOLD
-          ) -> tuple[np.ndarray, np.ndarray, AdaptiveStats]:
-    """Run the adaptive loop in memory: ``evaluate(flat, batch) -> int8[n] classes``.
+def run_plan(plan: Plan, outcome: np.ndarray, computed: np.ndarray,
+             run: Callable[[Batch], Iterable[BatchResult]]
+             ) -> Iterator[tuple[Batch, BatchResult, np.ndarray]]:
+    """The adaptive loop, written once: plan a batch from the state (``next_step``), run it,
+    record its classes and flags, until the plan says "done".
+
+    outcome, computed: the state (flat, int8[size]), updated in place. run(batch): the
+    batch's points' results, in chunks of any size and order (``BatchResult``: ``flat``
+    and at least ``arrays["outcome"]``). Yields (batch, result, flags) for each result
+    once it is in the state: the sweep driver (``compute.driver.adaptive_loop``) writes
+    them to its sink; ``run_on_function`` only counts them.
+    """
+    while True:
+        step = next_step(plan, outcome, computed)
+        b = step.batch
+        if b.kind == "done":
+            return
+        for res in run(b):
+            cls = res.arrays["outcome"]
+            flags = step.flags(res.flat, cls)
+            outcome[res.flat] = cls
+            computed[res.flat] = flags
+            yield b, res, flags
+
+
+def run_on_function(plan: Plan, evaluate: Callable[[np.ndarray, Batch], np.ndarray],
+                    outcome: np.ndarray | None = None, computed: np.ndarray | None = None,
+                    threshold: float = DEFAULT_AUDIT_THRESHOLD
+                    ) -> tuple[np.ndarray, np.ndarray, AdaptiveStats]:
+    """The plan run over a class function instead of the kernel, ``evaluate(flat, batch) ->
+    int8[n]`` (``run_plan``): how the planner is tested and benchmarked on a known diagram.
+    Sweeps go through the sweep driver (``compute.driver``).
 
     outcome, computed: a state to resume from (flat, int8[size]); default: nothing
     computed. Returns the filled outcome (int8[size]), the computed flags (int8[size]) and
-    the stats. The driver of ``rocksweep sweep --adaptive`` does the same with the file.
+    the stats (with ``batches``: (kind, stride, points) per batch, and ``seconds``).
     """
     t0 = time.perf_counter()
     size = plan.size
@@ -717,16 +745,13 @@ def drive(plan: Plan, evaluate: Callable[[np.ndarray, Batch], np.ndarray],
                else np.asarray(outcome, np.int8).ravel().copy())
     computed = (np.zeros(size, np.int8) if computed is None
                 else np.asarray(computed, np.int8).ravel().copy())
-    batches = []
-    while True:
-        step = next_step(plan, outcome, computed)
-        b = step.batch
-        if b.kind == "done":
-            break
+
+    def run(b: Batch) -> list[BatchResult]:
         cls = np.asarray(evaluate(b.flat, b), np.int8)
-        outcome[b.flat] = cls
-        computed[b.flat] = step.flags(b.flat, cls)
-        batches.append((b.kind, b.stride, len(b)))
+        return [BatchResult(b.flat, {"outcome": cls}, 0.0, 0.0)]
+
+    batches = [(b.kind, b.stride, len(b))
+               for b, _res, _flags in run_plan(plan, outcome, computed, run)]
     filled = fill(plan, outcome, computed)
     st = stats_of(computed, threshold)
     st.batches, st.seconds = batches, time.perf_counter() - t0
@@ -778,31 +803,6 @@ def run_batch(grid: Grid, flat: np.ndarray, jobs: int = 1, chunk_size: int | Non
     for r in sw.run_chunks(sub, chunks, sw.level(grid.scene), jobs, backend,  # type: ignore[arg-type]
                            scheduler):
         yield BatchResult(flat[r.start:r.stop], r.arrays, r.seconds, r.cpu_seconds)
-
-
-def adaptive_compute(scene: Scene, jobs: int = 1, coarse: int | None = None,
-                     audit: float = DEFAULT_AUDIT, margin: int = DEFAULT_MARGIN,
-                     axes: Sequence[str] = DIAGRAM_AXES, seed: int = DEFAULT_SEED,
-                     chunk_size: int | None = None, backend: str = "threads",
-                     scheduler: str | None = None,
-                     threshold: float = DEFAULT_AUDIT_THRESHOLD,
-                     final_margin: int = DEFAULT_FINAL_MARGIN
-                     ) -> tuple[dict[str, np.ndarray], AdaptiveStats]:
-    """Adaptive sweep of a whole scene in memory, like ``rocksweep.compute.sweep.compute``,
-    through the one sweep driver (``rocksweep.compute.driver.sweep_arrays``: the loop of
-    ``rocksweep sweep --adaptive``).
-
-    Returns (arrays, stats): arrays maps every variable of ``Scene.variables``
-    plus ``computed`` (int8 flags, see COMPUTED_MEANING) to an array of the grid's shape;
-    ``outcome`` is filled everywhere, the other variables hold their "not computed" fill
-    value at filled points. Identical whatever ``jobs``, ``chunk_size`` and backend.
-    """
-
-    from rocksweep.compute.driver import sweep_arrays
-
-    options = Options(tuple(axes), coarse, audit, margin, final_margin, seed, threshold)
-    arrays, report = sweep_arrays(scene, jobs, chunk_size, backend, scheduler, options)
-    return arrays, report.adaptive
 
 
 @dataclass

@@ -54,6 +54,7 @@ class SweepReport:
     attrs: dict = field(default_factory=dict)
     adaptive: AdaptiveStats | None = None  # adaptive sweeps: the file's counts
     validation: Validation | None = None  # adaptive sweeps with validate=True
+    image: bytes | None = None  # a sweep into an in-memory file: the file's bytes
 
     @property
     def points_done(self) -> int:
@@ -116,7 +117,11 @@ def drive(sf, path: Path | None, report: SweepReport, t0: float,
 class ArraySink:
     """A sink of plain arrays in memory (the grid's variables, flat, at their fill values
     until written; ``computed`` flags of an adaptive sweep): what ``sweep_arrays`` drives
-    for the library's own in-memory sweeps, with the same loops as a result file."""
+    for the library's own in-memory sweeps, with the same loops as a result file. Not the
+    in-memory result file (``store.writer.SweepFile`` with no path, ``rocksweep.run``):
+    that one costs ~85 ms more a sweep (an HDF5 image written, then read into a Dataset;
+    ci-small, 256 points: 13 ms here against 98 ms), which the accuracy study and the
+    tests would pay on every call, and it would take the compute room up to the store's."""
 
     def __init__(self, grid: Any) -> None:
         import numpy as np
@@ -171,9 +176,14 @@ def sweep_arrays(scene: Scene, jobs: int = 1, chunk_size: int | None = None,
                  backend: str = "threads", scheduler: str | None = None,
                  adaptive: Options | None = None) -> tuple[dict, SweepReport]:
     """Sweep a whole scene in memory through the one driver (``drive``, the loops of
-    ``rocksweep sweep``) into plain arrays: (name -> array of the grid's shape, the
-    session's report; ``report.adaptive``: an adaptive sweep's counts). For the library's
-    own studies and tests; ``rocksweep.run`` returns the same as a Dataset."""
+    ``rocksweep sweep``) into plain arrays: (name -> array of the grid's shape
+    (``Grid.shape``), the session's report). Every variable of ``Scene.variables``; with
+    ``adaptive`` (``adaptive.Options``) also ``computed`` (int8 flags,
+    ``adaptive.COMPUTED_MEANING``), ``outcome`` filled everywhere, the other variables at
+    their "not computed" fill values at filled points, and ``report.adaptive`` the counts.
+    Identical, bit for bit, whatever ``jobs``, ``chunk_size`` and backend, and to the
+    result file of ``rocksweep sweep``. For the library's own studies and tests;
+    ``rocksweep.run`` returns the same as a Dataset."""
     from rocksweep.compute.grid import Grid
 
     sink = ArraySink(Grid(scene))
@@ -267,11 +277,11 @@ def adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backe
                    pending: list, validate: bool = False) -> None:
     """The adaptive sweep of an open file (``rocksweep.compute.adaptive``).
 
-    The state (outcome, computed) is read from the file; ``adaptive.next_step`` plans a
-    batch from it; the batch runs through ``adaptive.run_batch`` (the chunk machinery:
+    The state (outcome, computed) is read from the file; ``adaptive.run_plan`` plans
+    batches from it and runs each through ``adaptive.run_batch`` (the chunk machinery:
     threads or dask); each chunk's points are written with their ``computed`` flags
-    (batched every ``write_every`` seconds, and whatever ends the loop) and the
-    in-memory state updated; until the plan says "done". Then the
+    (batched every ``write_every`` seconds, at the end of a batch, and whatever ends the
+    loop); until the plan says "done". Then the
     filled classes go into ``outcome`` and the counts into the attributes, so a resume
     of a finished file stops at once. A file killed at any moment resumes to the same
     result (see ``adaptive.next_step``).
@@ -281,6 +291,7 @@ def adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backe
     from rocksweep.compute import adaptive as ad
     from rocksweep.compute import sweep as sw
 
+    t_start = time.perf_counter()
     tqdm = progress_class(progress)
     scene = sf.grid.scene
     plan = options.plan(sf.grid)
@@ -307,39 +318,38 @@ def adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backe
         pending_flags.clear()
 
     prepared = False
+    batches: list = []  # (kind, stride, points) per batch: AdaptiveStats.batches
     with tqdm(total=0, unit="pt", disable=not progress, file=sys.stderr, smoothing=0.1,
               dynamic_ncols=True) as bar:
+
+        def run(b: Any) -> Any:  # a batch through the chunk machinery, then written
+            nonlocal prepared
+            if not prepared:
+                prepare_kernel(sf, lvl, report, say)
+                prepared = True
+            batches.append((b.kind, b.stride, len(b)))
+            bar.total += len(b)  # the work grows as refinement finds boundaries
+            bar.set_description(b.kind if b.kind != "refine" else f"refine {b.stride}")
+            bar.refresh()
+            yield from ad.run_batch(sf.grid, b.flat, jobs, chunk_size, backend, scheduler)
+            write_pending()
+
         t_write = time.perf_counter()
         try:
-            while True:
-                step = ad.next_step(plan, outcome, computed)
-                b = step.batch
-                if b.kind == "done":
-                    break
-                if not prepared:
-                    prepare_kernel(sf, lvl, report, say)
-                    prepared = True
-                bar.total += len(b)  # the work grows as refinement finds boundaries
-                bar.set_description(b.kind if b.kind != "refine" else f"refine {b.stride}")
-                bar.refresh()
-                for res in ad.run_batch(sf.grid, b.flat, jobs, chunk_size, backend,
-                                        scheduler):
-                    flags = step.flags(res.flat, res.arrays["outcome"])
-                    pending.append(res)
-                    pending_flags.append(flags)
-                    outcome[res.flat] = res.arrays["outcome"]
-                    computed[res.flat] = flags
-                    report.cpu_s += res.cpu_seconds
-                    report.computed += len(res.flat)
-                    bar.update(len(res.flat))
-                    raise_pending()  # this chunk is kept: written on the way out
-                    if time.perf_counter() - t_write >= write_every:
-                        write_pending()
-                        t_write = time.perf_counter()
-                write_pending()
+            for _batch, res, flags in ad.run_plan(plan, outcome, computed, run):
+                pending.append(res)
+                pending_flags.append(flags)
+                report.cpu_s += res.cpu_seconds
+                report.computed += len(res.flat)
+                bar.update(len(res.flat))
+                raise_pending()  # this chunk is kept: written on the way out
+                if time.perf_counter() - t_write >= write_every:
+                    write_pending()
+                    t_write = time.perf_counter()
         finally:
             write_pending()
     stats = ad.stats_of(computed, options.threshold)
+    stats.batches, stats.seconds = batches, time.perf_counter() - t_start  # this session's
     filled = ad.fill(plan, outcome, computed)
     sf.write_filled(filled,
                     {"points_computed": stats.computed,

@@ -1,10 +1,11 @@
 """Run a scene's grid in chunks across joblib workers (threads, or dask.distributed).
 
-No I/O here: ``run_chunks`` yields each chunk's result arrays as it finishes and the
-driver (``rocksweep.api.sweep_file``, behind ``rocksweep sweep`` and ``rocksweep.run``)
-writes them (``rocksweep.store.writer``). A chunk is a
-contiguous range of flat point indices (``rocksweep.compute.grid``) and costs one call into the
-jitted kernel per kernel kind present in the chunk; there is no Python per point.
+No I/O here: ``run_chunks`` yields each chunk's result arrays as it finishes and the one
+sweep driver (``rocksweep.compute.driver``) writes them to its sink: a result file
+(``rocksweep.store.writer``, behind ``rocksweep sweep`` and ``rocksweep.run``) or plain
+arrays in memory (``driver.sweep_arrays``, the library's own studies). A chunk is a
+contiguous range of flat point indices (``rocksweep.compute.grid``) and costs one call into
+the jitted kernel per kernel kind present in the chunk; there is no Python per point.
 
 Local workers are threads of this process (joblib's threading backend): the chunk kernels
 release the GIL, so threads compute in parallel with no process start-up, no second load
@@ -302,15 +303,6 @@ def _run_on_cluster(grid: Grid, chunks: list[tuple[int, int]], level: int,
                     raise
                 submit(1)
                 yield res
-
-
-def compute(scene: Scene, jobs: int = 1, chunk_size: int | None = None,
-            backend: str = "threads", scheduler: str | None = None) -> dict[str, np.ndarray]:
-    """Sweep a whole scene in memory: name -> array with the grid's shape (``Grid.shape``),
-    through the one sweep driver (``rocksweep.compute.driver.sweep_arrays``)."""
-    from rocksweep.compute.driver import sweep_arrays
-
-    return sweep_arrays(scene, jobs, chunk_size, backend, scheduler)[0]
 
 
 # ---------------------------------------------------------------------------------------

@@ -247,7 +247,7 @@ def _title(result: SweepResult, on_axes: Sequence[str]) -> str:
     shape = result.scalars.get("shape")
     if shape is not None and f"{shape} pulse" not in name.lower():
         extra.append(f"{shape} pulse")
-    for d in ("w_over_p", "A_ratio"):
+    for d in DIAGRAM_AXES:
         if d in result.scalars and d not in on_axes:
             sym = _axes.latex(d, result.kind)
             extra.append(f"${sym}$ = {_fmt(float(result.scalars[d]))}")

@@ -7,7 +7,8 @@ is no ``lam``); other swept dimensions and several states get line styles. Each 
 fitted Phi(ln(x / median) / beta), its bootstrap band (pointwise percentiles of the
 resamples' curves, ``band_lo``/``band_hi``, when the fit was bootstrapped), and for stripes
 the empirical fraction at each level with the marker's area proportional to the records
-counted there. The legend (below the axes, never over the data) gives each median, its
+counted there (one marker shape per colour, translucent faces: markers of several colours at
+one level stay readable). The legend (below the axes, never over the data) gives each median, its
 change against the first colour's, and beta.
 """
 
@@ -17,6 +18,7 @@ import itertools
 import math
 from typing import TYPE_CHECKING
 
+import matplotlib.colors
 import numpy as np
 import xarray as xr
 
@@ -32,6 +34,10 @@ if TYPE_CHECKING:
 # height / width of the figure at each paper width (``rocksweep.figures.WIDTHS``)
 ASPECT = {"single": 1.2, "double": 0.75}  # room for the legend below
 _STYLES = ("-", "--", ":", "-.")
+# Stripe markers of different colours sit on the same IM levels and often at the same
+# fraction: one shape per colour and translucent faces keep every one of them visible.
+_MARKERS = ("o", "s", "^", "D", "v", "P")
+_MARKER_ALPHA = 0.55
 
 
 
@@ -115,9 +121,11 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
                     ax.fill_between(grid, lo, hi, color=colour, alpha=0.18, linewidth=0)
             if stripe and "fraction" in one:
                 n = one["n_counted"].values.astype(float)
+                face = matplotlib.colors.to_rgba(colour, _MARKER_ALPHA)
                 ax.scatter(frag[stripe].values, one["fraction"].values,
-                           s=6.0 + 40.0 * n / max(n_max, 1.0), color=colour,
-                           edgecolor="black", linewidth=0.4, zorder=3)
+                           s=6.0 + 40.0 * n / max(n_max, 1.0), marker=_MARKERS[ci % len(
+                               _MARKERS)], facecolor=face, edgecolor=colour,
+                           linewidth=0.8, zorder=3)
     ax.set_xscale("log")
     ax.set_ylim(-0.02, 1.02)
     ax.set_xlim(grid[0], grid[-1])

@@ -1,8 +1,9 @@
 """Figures of the analyses' Datasets that have no figure module of their own: a risk result
 (hazard curve, fragility, the rate's integrand), an IDA (the first overturning level per
-record), spectra (rocking and overturning spectra from the Dataset) and the IM efficiency
-(beta per IM). ``rocksweep.figures.dispatch`` picks one by the Dataset's kind. Each returns
-a pyplot-free ``matplotlib.figure.Figure``; the legend sits outside the data.
+record), spectra (rocking and overturning spectra from the Dataset), boundaries (A_min
+against x) and the IM efficiency (beta per IM). ``rocksweep.figures.dispatch`` picks one by
+the Dataset's kind. Each returns a pyplot-free ``matplotlib.figure.Figure``; the legend
+sits outside the data.
 """
 
 from __future__ import annotations
@@ -15,10 +16,21 @@ import xarray as xr
 
 from rocksweep.figures import WIDTHS
 from rocksweep.figures.common import Figure
+from rocksweep.vocab.axes import alpha_latex, latex
+from rocksweep.vocab.axes import label as axis_label
+
+# height / width of one panel stacked in a single column (``_figure``)
+STACKED_ASPECT = 0.62
 
 
 def _figure(width: str | None, ncols: int = 1, aspect: float = 0.75) -> tuple[Figure, Any]:
+    """A figure of ``ncols`` panels side by side (height ``aspect`` x width), or, at the
+    single column width, one above the other: side by side they would be too narrow to
+    read. Returns (figure, 1-D array of the axes in reading order)."""
     w = WIDTHS[width][0] if width in WIDTHS else 6.4
+    if width == "single" and ncols > 1:
+        fig = Figure(figsize=(w, w * STACKED_ASPECT * ncols), layout="constrained")
+        return fig, fig.subplots(ncols, 1, squeeze=False)[:, 0]
     fig = Figure(figsize=(w, w * aspect), layout="constrained")
     return fig, fig.subplots(1, ncols, squeeze=False)[0]
 
@@ -60,22 +72,27 @@ def risk_figure(rk: xr.Dataset, *, ax: Any = None, width: str | None = "double")
     for k, (label, sel, p) in enumerate(_curves(rk["fragility"], "im_level")):
         c = f"C{k % 10}"
         rate = float(rk["annual_rate"].isel(sel))
+        prob = float(rk["probability"].isel(sel))
         if len(axes) > 1:
             axes[1].semilogx(grid, p, color=c, label=label)
         if len(axes) > 2:
             dens = rk["rate_density"].isel(sel).values
+            what = f"{rate:.3g}/yr, P = {prob:.3g} in {rk.attrs.get('years', 50):g} yr"
             axes[2].semilogx(grid, dens, color=c,
-                           label=f"{label}: {rate:.3g}/yr" if label else f"{rate:.3g}/yr")
+                             label=f"{label}: {what}" if label else what)
     if len(axes) > 1:
         axes[1].set_ylim(-0.02, 1.02)
         axes[1].set_ylabel("P(state | IM)")
         axes[1].set_title("fragility", fontsize="small")
     if len(axes) > 2:
         axes[2].set_ylabel(r"P(state | x) |d$\lambda$/d ln x| [1/yr]")
-        axes[2].set_title(f"rate integrand, P in {rk.attrs.get('years', 50):g} yr = "
-                          f"{float(rk['probability'].max()):.3g} (max)", fontsize="small")
-        axes[2].legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.22),
-                       frameon=False)
+        axes[2].set_title("rate integrand", fontsize="small")
+        if ax is None:  # our figure: one legend below all panels, as wide as the figure
+            fig.legend(*axes[2].get_legend_handles_labels(), loc="outside lower center",
+                       fontsize="x-small", frameon=False, ncol=2)
+        else:
+            axes[2].legend(fontsize="x-small", loc="upper center",
+                           bbox_to_anchor=(0.5, -0.22), frameon=False)
     for a in axes:
         a.set_xlabel(xlabel)
         a.grid(True, which="both", alpha=0.25, linewidth=0.5)
@@ -98,7 +115,7 @@ def ida_figure(ida: xr.Dataset, *, ax: Any = None, width: str | None = "single")
     else:
         fig, axes = _figure(width, len(panels) if curves else 1,
                             0.8 if curves and len(panels) > 1 else 0.9)
-        if curves and len(panels) > 1:
+        if curves and len(panels) > 1 and width != "single":  # side by side
             w = fig.get_size_inches()[0]
             fig.set_size_inches(w, w * 0.8 / len(panels) + 0.8)
     for k, (label, sel, v) in enumerate(panels):
@@ -153,6 +170,7 @@ def spectra_dataset_figure(sp: xr.Dataset, *, ax: Any = None,
         fig, axes = _figure(width, 2, 0.45)
     th = sp["theta_max_over_alpha"]
     x = sp[freq].values
+    kind = str(sp.attrs.get("kind", "flexible"))
     pick = np.unique(np.linspace(0, sp.sizes["A_ratio"] - 1,
                                  min(6, sp.sizes["A_ratio"])).round().astype(int))
     for li in range(sp.sizes.get("lam", 1)):
@@ -160,21 +178,52 @@ def spectra_dataset_figure(sp: xr.Dataset, *, ax: Any = None,
         for j, ai in enumerate(pick):
             axes[0].plot(x, one.isel(A_ratio=ai).values, color=f"C{j}",
                          ls=("-", "--", ":", "-.")[li % 4],
-                         label=f"A = {sp['A_ratio'].values[ai]:g}" if li == 0 else None)
+                         label=f"${latex('A_ratio', kind)}$ = {sp['A_ratio'].values[ai]:.3g}"
+                         if li == 0 else None)
     axes[0].set_yscale("log")
-    axes[0].set_xlabel(freq)
-    axes[0].set_ylabel(r"max|$\theta$|/$\alpha$")
+    axes[0].set_xlabel(axis_label(freq, kind))
+    axes[0].set_ylabel(rf"max|$\theta$|/${alpha_latex(kind)}$")
     axes[0].set_title("rocking spectrum (line style: lam)", fontsize="small")
     for label, _sel, v in _curves(sp["A_min"], freq):
         axes[-1].plot(x, v, "o-", ms=3, label=label)
-    axes[-1].set_xlabel(freq)
-    axes[-1].set_ylabel("A_min")
+    axes[-1].set_xlabel(axis_label(freq, kind))
+    axes[-1].set_ylabel(f"{axis_label('A_ratio', kind)} at overturning onset")
     axes[-1].set_title("overturning spectrum", fontsize="small")
     for a in axes:
         a.grid(True, alpha=0.25, linewidth=0.5)
         if a.get_legend_handles_labels()[0]:
             a.legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.2),
                      frameon=False, ncol=3)
+    return fig
+
+
+def boundaries_figure(bd: xr.Dataset, *, ax: Any = None,
+                      width: str | None = "single") -> Figure:
+    """A_min against the diagram's x of ``rocksweep.boundaries``, one colour per value of
+    the other swept keys (lam, shape, ...): solid where the onset is mode 1, dashed where
+    it is mode 2 (the figure of ``rocksweep boundaries --plot``)."""
+    xname = bd.attrs.get("x_axis") or bd["A_min"].dims[-1]
+    kind = str(bd.attrs.get("kind", "flexible"))
+    if ax is not None:
+        fig = ax.figure
+    else:
+        fig, axes = _figure(width, 1, 0.8)
+        ax = axes[0]
+    x = bd[xname].values
+    modes = {lab: v for lab, _sel, v in _curves(bd["mode"], xname)}
+    for k, (lab, _sel, a_min) in enumerate(_curves(bd["A_min"], xname)):
+        for m, style, word in ((1, "-", "mode 1"), (2, "--", "mode 2")):
+            y = np.where(modes[lab] == m, a_min, np.nan)
+            if np.isfinite(y).any():
+                ax.plot(x, y, style, color=f"C{k % 10}", marker=".", ms=3,
+                        label=f"{lab} ({word})" if lab else word)
+    ax.set_xlabel(axis_label(xname, kind))
+    ax.set_ylabel(f"{axis_label(str(bd.attrs.get('y_axis', 'A_ratio')), kind)} at "
+                  "overturning onset ($A_{min}$)")
+    ax.grid(True, alpha=0.25, linewidth=0.5)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.2),
+                  frameon=False, ncol=2)
     return fig
 
 

@@ -48,22 +48,17 @@ longer ship. The recurrence is ~60 lines here, tested against closed forms and l
 
 from __future__ import annotations
 
-import hashlib
 import math
-from pathlib import Path
 
 import numpy as np
 from scipy.signal import lfilter
 
 from rocksweep.physics.model import G  # gravity [m/s^2], the one definition
-from rocksweep.vocab.ground import SA_DAMPING
+from rocksweep.vocab.ground import AVGSA_POINTS, SA_DAMPING
 
 __all__ = ["AVGSA_POINTS", "G", "arias", "avg_sa", "avgsa_periods", "cav", "duration",
-           "final_velocity", "husid", "pga", "pgv", "sa", "sha256",
+           "final_velocity", "husid", "pga", "pgv", "sa",
            "significant_duration", "velocity"]
-
-#: periods of AvgSa: this many, evenly spaced in ln T over the range
-AVGSA_POINTS = 10
 
 
 def _check(acc, dt: float) -> np.ndarray:
@@ -167,7 +162,7 @@ def avgsa_periods(t_lo: float, t_hi: float, n: int = AVGSA_POINTS) -> np.ndarray
     return np.geomspace(float(t_lo), float(t_hi), int(n))
 
 
-def avg_sa(acc, dt: float, t_lo: float, t_hi: float, zeta: float = 0.05,
+def avg_sa(acc, dt: float, t_lo: float, t_hi: float, zeta: float = SA_DAMPING,
            n: int = AVGSA_POINTS) -> float:
     """AvgSa [g]: the geometric mean of Sa(T) (``sa``, damping ``zeta``) over the periods
     ``avgsa_periods(t_lo, t_hi, n)`` [s] (0 < t_lo <= t_hi)."""
@@ -179,15 +174,6 @@ def avg_sa(acc, dt: float, t_lo: float, t_hi: float, zeta: float = 0.05,
 def duration(acc, dt: float) -> float:
     """Time of the last sample (n - 1) dt [s]."""
     return (np.asarray(acc).size - 1) * float(dt)
-
-
-def sha256(path: str | Path) -> str:
-    """Hex SHA-256 of a file's bytes (the digest ``rocksweep.physics.records`` stores)."""
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def _nj_coefficients(w: float, zeta: float, h: float):
@@ -261,14 +247,18 @@ def sa(acc, dt: float, periods, zeta: float = SA_DAMPING, *, points_per_period: 
         den = np.array([1.0, -(A[0, 0] + A[1, 1]), A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]])
         nu = np.array([B1[0], B0[0] - A[1, 1] * B1[0] + A[0, 1] * B1[1],
                        A[0, 1] * B0[1] - A[1, 1] * B0[0]])
-        nv = np.array([B1[1], A[1, 0] * B1[0] + B0[1] - A[0, 0] * B1[1],
-                       A[1, 0] * B0[0] - A[0, 0] * B0[1]])
-        # initial filter states (transposed direct form II) that start the state at rest
-        # with x_0 possibly != 0: y_0 = 0 and y_1 = e^T (B0 x_0 + B1 x_1)
+        # initial filter state (transposed direct form II) that starts the state at rest
+        # with x_0 possibly != 0: u_0 = 0 and u_1 = B0[0] x_0 + B1[0] x_1
         zu = np.array([-nu[0] * x[0], (B0[0] - nu[1]) * x[0]])
-        zv = np.array([-nv[0] * x[0], (B0[1] - nv[1]) * x[0]])
         u = lfilter(nu, den, x, zi=zu)[0]
-        v = lfilter(nv, den, x, zi=zv)[0]
-        peak = max(float(np.max(np.abs(u))), _free_peak(float(u[-1]), float(v[-1]), w, zeta))
+        # the rate at the end only (for the free vibration after the record), from the
+        # recurrence's first row over the last step, then its second row: one filter
+        # instead of two (u' over the whole record is never needed)
+        if u.size > 1:
+            v_prev = (u[-1] - A[0, 0] * u[-2] - B0[0] * x[-2] - B1[0] * x[-1]) / A[0, 1]
+            v_end = A[1, 0] * u[-2] + A[1, 1] * v_prev + B0[1] * x[-2] + B1[1] * x[-1]
+        else:
+            v_end = 0.0
+        peak = max(float(np.max(np.abs(u))), _free_peak(float(u[-1]), float(v_end), w, zeta))
         out[j] = w * w * peak
     return out

@@ -86,6 +86,12 @@ class GroundRecord:
         return np.where(inside, np.interp(t, self.times(), self.acc), 0.0)
 
 
+def digest(data: bytes) -> str:
+    """Hex SHA-256 of a record file's bytes: what a scene, a result file and a resume
+    compare (``GroundRecord.sha256``)."""
+    return hashlib.sha256(data).hexdigest()
+
+
 def kernel_series(record: GroundRecord, p: float) -> tuple[float, np.ndarray]:
     """The record as the kernel sees it for a body of rocking frequency p [rad/s].
 
@@ -262,7 +268,7 @@ def parse_record(data: bytes, source: str | Path) -> GroundRecord:
                           "other units, or not a record?")
     acc.setflags(write=False)
     return GroundRecord(name=path.stem, dt=float(dt), acc=acc, npts=int(acc.size), pga=pga,
-                        sha256=hashlib.sha256(data).hexdigest(), source=src, title=title,
+                        sha256=digest(data), source=src, title=title,
                         data=bytes(data))
 
 

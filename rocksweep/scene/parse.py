@@ -52,7 +52,7 @@ from rocksweep.schema import (
     is_number,
     section_keys,
 )
-from rocksweep.vocab.axes import DIAGRAM_AXES
+from rocksweep.vocab.axes import DIAGRAM_AXES, alpha_symbol
 from rocksweep.vocab.ground import MP
 from rocksweep.vocab.ground import PULSE_KEY_SHAPES as _PULSE_KEY_SHAPES
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
@@ -814,7 +814,7 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     _check_initial(scene, bodies)
     _check_cost(scene, bodies)
     if suite is not None:  # drift and large factors: one-line RecordWarnings
-        suite.warn(scene.axis("alpha" if kind == "block" else "alpha_cg").values,
+        suite.warn(scene.axis(alpha_symbol(kind)).values,
                    scene.axis("p").values)
     return scene
 
@@ -831,7 +831,7 @@ def _check_initial(scene: Scene, bodies: list[dict[str, float]]) -> None:
         worst = float(th[np.argmax(np.abs(th))])
         alpha = max(scene.make_body(**b).alpha_ref for b in bodies)
         if abs(worst) * alpha >= math.pi / 2:
-            ref = "alpha" if scene.kind == "block" else "alpha_cg"
+            ref = alpha_symbol(scene.kind)
             raise SceneError(f"initial.theta_over_alpha = {fmt(worst)}: |theta| = "
                              f"{abs(worst):g} x {ref} ({alpha:.4g} rad) = "
                              f"{abs(worst) * alpha:.4g} rad; must be < pi/2 (|theta_over_alpha|"

@@ -51,14 +51,6 @@ def _cut(v, n: int = 40) -> str:
     return text if len(text) <= n else text[: n - 3] + "..."
 
 
-def _plain(v):
-    if isinstance(v, bytes | np.bytes_):
-        return bytes(v).decode("utf-8", "replace")
-    if isinstance(v, np.generic):
-        return v.item()
-    return v
-
-
 def _damaged(path: Path, what: str) -> StoreError:
     return StoreError(f"{shown(path)}: damaged rocksweep result ({what})")
 

@@ -9,6 +9,17 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     import xarray as xr
 
+def open_result(path: str | Path) -> xr.Dataset:
+    """A sweep result file as the loaded Dataset (``rocksweep.open``): a file that is not
+    a rocksweep result, or is damaged, is a one-line error (``reader.read_result``) before
+    ``result_dataset`` reads it."""
+    from rocksweep.store.reader import read_result
+
+    path = Path(path)
+    read_result(path, ["outcome"])
+    return result_dataset(path)
+
+
 def result_dataset(source: Path | Any) -> xr.Dataset:
     """A result file (a path, or a file object holding the bytes of one in memory) as the
     loaded Dataset that ``open`` and ``run`` return, with the accessor registered; a

@@ -54,6 +54,7 @@ from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import _fixed, _now
 from rocksweep.store.identity import record_attrs, resolved_scene
+from rocksweep.vocab.axes import alpha_symbol
 from rocksweep.vocab.outcomes import COMPUTED_FLAGS, COMPUTED_MEANING
 
 if TYPE_CHECKING:
@@ -311,7 +312,7 @@ def suite_variables(scene: Scene) -> dict[str, tuple[tuple[str, ...], np.ndarray
         return out
     dims = ["record", su.im]
     shape = [R, len(su.levels)]
-    alpha_key = "alpha" if scene.kind == "block" else "alpha_cg"
+    alpha_key = alpha_symbol(scene.kind)
     alpha = np.asarray(scene.axis(alpha_key).values, float)
     p = np.asarray(scene.axis("p").values, float)
     dep = su.scale_dependence()

@@ -9,6 +9,8 @@ from typing import TYPE_CHECKING
 
 # `rocksweep simulate` overlays a few runs; larger grids are for sweeps.
 MAX_RUNS = 12
+# `rocksweep.simulate` returns one history per point: a notebook's worth, not a grid.
+API_MAX_RUNS = 100
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -90,7 +92,16 @@ def titled_runs(scene: Scene, max_runs: int = MAX_RUNS) -> list[tuple[Run, xr.Da
     """``rocksweep.simulate``'s runs: (run, its history Dataset, its title) of every point
     of ``scene``, in grid order. One point: the scene's own point and accuracy
     (``Scene.single_point``, ``single_numerics``), titled with the scene's name; more:
-    ``simulate_runs``, each titled with its swept values ("lam = 0.2, A_ratio = 3")."""
+    ``simulate_runs``, each titled with its swept values ("lam = 0.2, A_ratio = 3"). More
+    than ``max_runs`` points: an ApiError naming the longest swept key (in the API's
+    words: an override, or ``rocksweep.run`` for a grid)."""
+    if scene.size > max_runs:
+        from rocksweep.errors import ApiError
+
+        big = max(scene.swept, key=lambda a: len(a.values))
+        raise ApiError(f"the scene has {scene.size} points ({big.key} has {len(big.values)} "
+                       f"values): simulate runs at most {max_runs}; pass "
+                       f"overrides={{{big.key!r}: ...}}, or use rocksweep.run for a grid")
     if scene.size == 1:
         from rocksweep.compute.single import simulate as run_point
 

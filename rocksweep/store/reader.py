@@ -17,6 +17,7 @@ import numpy as np
 
 from rocksweep import fields
 from rocksweep.errors import RocksweepError
+from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outcomes import OUTCOME_WORDS
 from rocksweep.outputs import shown
@@ -27,7 +28,6 @@ from rocksweep.store._common import (
     _close_quietly,
     _cut,
     _damaged,
-    _plain,
     _why,
 )
 from rocksweep.store.format import (
@@ -60,7 +60,7 @@ def _attr_str(f: h5py.File, key: str) -> str:
     if isinstance(v, bytes | np.bytes_):
         return bytes(v).decode("utf-8", "replace")
     if not isinstance(v, str):
-        raise TypeError(f"attribute {key} is {_cut(_plain(v))}, not text")
+        raise TypeError(f"attribute {key} is {_cut(plain(v))}, not text")
     return v
 
 
@@ -160,13 +160,13 @@ def _layout(f: h5py.File, path: Path) -> _Layout:
     if fmt != FORMAT:
         if _looks_like_ours(f, fmt):  # a damaged result is not a foreign file
             raise _damaged(path, "attribute rocksweep_format " + (
-                "missing" if fmt is None else f"is {_cut(_plain(fmt))}"))
+                "missing" if fmt is None else f"is {_cut(plain(fmt))}"))
         raise StoreError(f"{shown(path)}: an HDF5 file, but not a rocksweep sweep result "
                          "(no rocksweep_format attribute)")
     try:
         ver = int(f.attrs.get("format_version", -1))
     except (TypeError, ValueError):
-        raise _damaged(path, f"format_version = {_cut(_plain(f.attrs['format_version']))}"
+        raise _damaged(path, f"format_version = {_cut(plain(f.attrs['format_version']))}"
                        ) from None
     if ver > FORMAT_VERSION:
         raise StoreError(f"{shown(path)}: written in result format {ver} by a newer "
@@ -188,7 +188,7 @@ def _layout(f: h5py.File, path: Path) -> _Layout:
                            f"{len(values)} values")
         data = ds[()]
         if d in fields.WORD_AXES:
-            ok = [_plain(v) for v in data] == values
+            ok = [plain(v) for v in data] == values
         else:
             ok = data.dtype.kind == "f" and np.array_equal(data, np.asarray(values, float))
         if not ok:
@@ -343,7 +343,7 @@ def _checked_attrs(f: h5py.File, path: Path) -> dict:
     attrs = {}
     for k in f.attrs:
         try:
-            attrs[k] = _plain(f.attrs[k])
+            attrs[k] = plain(f.attrs[k])
         except _H5_ERRORS as err:
             raise _damaged(path, f"attribute {k} unreadable: {_why(err)}") from None
     _json_attr(f, "numerics", path, dict)
@@ -415,7 +415,7 @@ class SweepResult:
         for idx in np.ndindex(*o.shape[:-1]):
             label = {}
             for d in ("shape", "lam"):
-                label[d] = (_plain(self.coords[d][idx[groups.index(d)]]) if d in groups
+                label[d] = (plain(self.coords[d][idx[groups.index(d)]]) if d in groups
                             else self.scalars.get(d))
             cell = o[idx]
             rows.append({**label,
@@ -466,7 +466,7 @@ def read_result(path: str | Path, names: list[str] | None = None,
             if ax["swept"]:
                 vals = f[name][()]
                 if name in fields.WORD_AXES:
-                    vals = np.array([_plain(v) for v in vals])
+                    vals = np.array([plain(v) for v in vals])
                 coords[name] = vals
             else:
                 scalars[name] = ax["values"][0]
@@ -535,11 +535,11 @@ def result_of(ds) -> SweepResult:
     if set(grid_order) == set(dims):  # a transposed Dataset: back in the grid's order
         dims = grid_order
     coords = {d: np.asarray(ds[d].values) for d in dims}
-    scalars = {str(k): _plain(np.asarray(v.values).reshape(()).item())
+    scalars = {str(k): plain(np.asarray(v.values).reshape(()).item())
                for k, v in ds.coords.items() if k not in dims and v.ndim == 0}
     arrays = {str(k): np.asarray(v.transpose(*dims).values) for k, v in ds.data_vars.items()
               if set(v.dims) == set(dims)}
-    attrs = {str(k): _plain(v) for k, v in ds.attrs.items()}
+    attrs = {str(k): plain(v) for k, v in ds.attrs.items()}
     return SweepResult(where, dims, tuple(len(coords[d]) for d in dims), coords, scalars,
                        arrays, attrs, stored, in_file)
 
@@ -558,8 +558,6 @@ def stored_record(path: Path, rec: dict):
     """The record a result file keeps (``_store_record``) as a ``GroundRecord`` with the
     sweep's source path, checked against the file's SHA-256; None for a file that keeps
     no copy (made before records were stored). StoreError if the copy is damaged."""
-    from rocksweep.physics.records import RecordError, parse_record
-
     f = _open(path, "r")
     try:
         g = f.get(RECORD_GROUP)
@@ -571,14 +569,20 @@ def stored_record(path: Path, rec: dict):
         raise _damaged(path, f"its copy of the record: {_why(err)}") from None
     finally:
         _close_quietly(f)
-    import hashlib
+    return _stored_copy(path, data, rec, "its copy of the record")
 
-    if hashlib.sha256(data).hexdigest() != rec.get("sha256"):
-        raise _damaged(path, "its copy of the record does not match its SHA-256")
+
+def _stored_copy(path: Path, data: bytes, rec: dict, what: str):
+    """A record's copy in a result file as a ``GroundRecord``, checked against the SHA-256
+    the file states for it (``rec``: its ``sha256`` and ``source``)."""
+    from rocksweep.physics.records import RecordError, digest, parse_record
+
+    if digest(data) != rec.get("sha256"):
+        raise _damaged(path, f"{what} does not match its SHA-256")
     try:
-        return parse_record(data, rec["source"])
+        return parse_record(data, str(rec.get("source")))
     except RecordError as err:
-        raise _damaged(path, f"its copy of the record: {err}") from None
+        raise _damaged(path, f"{what}: {err}") from None
 
 
 def stored_records(path: Path, suite: dict) -> tuple | None:
@@ -586,10 +590,6 @@ def stored_records(path: Path, suite: dict) -> tuple | None:
     ``GroundRecord``s in the suite's order, each checked against the SHA-256 the resolved
     scene states; None for a file that keeps no copies (made before suites stored them).
     StoreError if a copy is damaged."""
-    import hashlib
-
-    from rocksweep.physics.records import RecordError, parse_record
-
     want = suite.get("records") or []
     f = _open(path, "r")
     try:
@@ -606,16 +606,8 @@ def stored_records(path: Path, suite: dict) -> tuple | None:
         raise _damaged(path, f"its copies of the records: {_why(err)}") from None
     finally:
         _close_quietly(f)
-    out = []
-    for r, data in zip(want, blobs, strict=True):
-        if hashlib.sha256(data).hexdigest() != r.get("sha256"):
-            raise _damaged(path, f"its copy of record {r.get('name')!r} does not match its "
-                                 "SHA-256")
-        try:
-            out.append(parse_record(data, str(r.get("source"))))
-        except RecordError as err:
-            raise _damaged(path, f"its copy of record {r.get('name')!r}: {err}") from None
-    return tuple(out)
+    return tuple(_stored_copy(path, data, r, f"its copy of record {r.get('name')!r}")
+                 for r, data in zip(want, blobs, strict=True))
 
 
 def result_scene(result: SweepResult) -> Scene:

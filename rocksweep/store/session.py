@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import sys
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -14,13 +14,15 @@ from rocksweep.compute.driver import WRITE_EVERY, SweepReport
 from rocksweep.errors import ApiError
 
 if TYPE_CHECKING:
-    import io
     from typing import Any
 
+    import xarray as xr
+
     from rocksweep.compute.adaptive import Options
+    from rocksweep.scene.inputs import Overrides, SceneLike
     from rocksweep.scene.model import Scene
 
-def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
+def sweep_file(scene: Scene, path: str | Path | None, *, overrides: Sequence[str] = (),
                jobs: int = 1, resume: bool = False, overwrite: bool = False,
                backend: str = "threads", scheduler: str | None = None,
                chunk_size: int | None = None, write_every: float = WRITE_EVERY,
@@ -28,7 +30,8 @@ def sweep_file(scene: Scene, path: str | Path, *, overrides: Sequence[str] = (),
                inputs: Iterable[str | Path] = (), adaptive: Options | None = None,
                validate: bool = False, connect_timeout: float = 20.0,
                cli: bool = False) -> SweepReport:
-    """Sweep ``scene`` into the result file ``path`` (``rocksweep sweep``).
+    """Sweep ``scene`` into the result file ``path`` (``rocksweep sweep``), or with ``path``
+    None into a file in memory (its bytes: ``report.image``; ``rocksweep.run``).
 
     Makes the file (refusing an existing one unless ``overwrite``), or with ``resume``
     reopens an existing file of the same scene and computes only its missing points.
@@ -131,27 +134,49 @@ def client_backend(client: Any) -> dict[str, str]:
     return {"backend": "dask", "scheduler": address}
 
 
-def run_session(scene: Scene, output: str | Path | None, *, source: str | Path | None = None,
-                overrides: Sequence[str] = (), jobs: int = 1, resume: bool = False,
+def run_session(scene: SceneLike | Scene, output: str | Path | None, *,
+                overrides: Overrides = (), jobs: int = 1, resume: bool = False,
                 overwrite: bool = False, progress: bool = False, client: Any = None,
-                adaptive: Options | None = None, validate: bool = False
-                ) -> Path | io.BytesIO:
-    """``rocksweep.run``'s sweep (its arguments checked by the facade): into the result
-    file ``output`` (``source``, the scene's file, never written over), or with output
-    None in memory (nothing touches a disk). progress: the header and kernel lines on
-    stderr and a progress bar; client: see ``client_backend``. Returns the file's path,
-    or the in-memory file's image (io.BytesIO)."""
+                adaptive: bool = False, validate: bool = False,
+                settings: Mapping[str, Any] | None = None) -> xr.Dataset:
+    """``rocksweep.run``'s sweep (its arguments documented there). Every argument is
+    checked before ``output`` is touched: types and ranges first, then the scene loaded
+    with its ``overrides`` (``scene.inputs.load``) and the adaptive ``settings`` (coarse,
+    audit, axes, ...; None: the scene's ``refine`` or the default) made ``Options``
+    (``compute.adaptive.adaptive_options``). Then the sweep into the result file
+    ``output`` (the scene's own file never written over), or with output None in memory
+    (nothing touches a disk). progress: the header and kernel lines on stderr and a
+    progress bar; client: see ``client_backend``. Returns the result as the loaded Dataset
+    (``store.dataset``: ``open_result`` of the file, or ``result_dataset`` of the
+    in-memory file's image)."""
+    from rocksweep.compute.arguments import check_flag, check_sweep_arguments
+    from rocksweep.outputs import check_path_text
+
+    # types and ranges first: nothing below may touch ``output`` before all are checked
+    check_flag("progress", progress)
+    check_flag("adaptive", adaptive)
+    check_sweep_arguments(jobs=jobs if client is None else 1, resume=resume,
+                          overwrite=overwrite, validate=validate, adaptive=True)
+    if output is not None:
+        check_path_text(output, "output")
+    from rocksweep.compute.adaptive import adaptive_options
+    from rocksweep.scene.inputs import load, override_strings
+    from rocksweep.store.dataset import open_result, result_dataset
+
+    scene, source = load(scene, overrides)
+    opts = adaptive_options(adaptive, base=scene.refine, **(settings or {}))
+    overrides = override_strings(overrides)
     where = client_backend(client)
     log = _stderr if progress else None
     if output is None:
         import io
 
         report = sweep_file(scene, None, overrides=overrides, jobs=jobs, resume=resume,
-                            progress=progress, log=log, adaptive=adaptive, validate=validate,
+                            progress=progress, log=log, adaptive=opts, validate=validate,
                             **where)
-        return io.BytesIO(report.image)
+        return result_dataset(io.BytesIO(report.image))
     sweep_file(scene, output, overrides=overrides, jobs=jobs, resume=resume,
                overwrite=overwrite, progress=progress, log=log,
-               inputs=[source] if source else (), adaptive=adaptive, validate=validate,
+               inputs=[source] if source else (), adaptive=opts, validate=validate,
                **where)
-    return Path(output)
+    return open_result(output)

@@ -27,6 +27,7 @@ import numpy as np
 from rocksweep.compute.grid import Grid
 from rocksweep.compute.sweep import ChunkResult
 from rocksweep.errors import OutputError, RocksweepError
+from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outputs import check_output, is_input, shown
 from rocksweep.scene.model import Scene
@@ -38,7 +39,6 @@ from rocksweep.store._common import (
     _fixed,
     _mib,
     _now,
-    _plain,
     _why,
 )
 from rocksweep.store.format import (
@@ -100,7 +100,7 @@ def _upgrade_session_attrs(f: h5py.File) -> None:
     for name, dtype in SESSION_ATTRS.items():
         if name in a and a.get_id(name).dtype == np.dtype(dtype):
             continue
-        old = _plain(a[name]) if name in a else None
+        old = plain(a[name]) if name in a else None
         if name == "complete":
             old = int(bool(old))
         elif old is None or (dtype.startswith("S") and not isinstance(old, str)):
@@ -292,7 +292,7 @@ class SweepFile:
             _upgrade_session_attrs(f)
             f.flush()
         n = int(f.attrs["sessions"]) + 1
-        self._history = _plain(f.attrs["history"])
+        self._history = plain(f.attrs["history"])
         host = platform.node() or "unknown"
         self._session_line = (f"{self.session_start} session {n}: rocksweep "
                               f"{versions()['rocksweep']} on host {host}, backend "
@@ -420,7 +420,7 @@ class SweepFile:
                 "event_steps_total": int(f["event_steps"][()].sum()),
                 "last_finished": _now(),
             }
-            if done.all() and not _plain(a["finished"]):
+            if done.all() and not plain(a["finished"]):
                 attrs["finished"] = attrs["last_finished"]
             if backend:
                 self.backend = attrs["backend"] = backend

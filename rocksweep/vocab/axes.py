@@ -77,9 +77,17 @@ DIAGRAM_AXES: tuple[str, str] = ("w_over_p", "A_ratio")
 RECORD_X = "p"  # x of a record sweep (no w_over_p): the body's frequency parameter
 LAM = "lam"  # the impulse position ratio, the diagrams' overlay dimension
 
-#: alpha_ref of each body kind: (plain symbol, LaTeX)
+#: alpha_ref of each body kind: (plain symbol and body key, LaTeX)
 ALPHA_REF: dict[str, tuple[str, str]] = {"flexible": ("alpha_cg", r"\alpha_{cg}"),
                                          "block": ("alpha", r"\alpha")}
+#: the body keys that hold alpha_ref, one per body kind (a Dataset has one of them)
+ALPHA_KEYS: tuple[str, ...] = tuple(sym for sym, _ in ALPHA_REF.values())
+
+
+def alpha_symbol(kind: str = "flexible") -> str:
+    """Plain text of the body kind's alpha_ref, which is also the body key holding it:
+    alpha_cg (flexible), alpha (block)."""
+    return ALPHA_REF.get(kind, ALPHA_REF["block"])[0]
 
 
 def alpha_latex(kind: str = "flexible") -> str:
@@ -93,7 +101,7 @@ def symbol(name: str, kind: str = "flexible") -> str:
     meta = AXES.get(name)
     if meta is None:
         return name
-    return meta.symbol.replace("alpha_ref", ALPHA_REF.get(kind, ALPHA_REF["block"])[0])
+    return meta.symbol.replace("alpha_ref", alpha_symbol(kind))
 
 
 def latex(name: str, kind: str = "flexible") -> str:

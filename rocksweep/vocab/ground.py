@@ -100,6 +100,7 @@ CLOUD_IMS: dict[str, str] = {PGA: "record_pga", PGV: "record_pgv", SA: "record_s
 #: what each ratio IM divides (its physical IM)
 RATIO_OF: dict[str, str] = {PGA_RATIO: PGA, PGV_RATIO: PGV}
 SA_DAMPING = 0.05  # damping ratio of the spectral acceleration (5%)
+AVGSA_POINTS = 10  # periods of AvgSa, evenly spaced in ln T
 DEFAULT_PERIODS = (0.2, 1.0)  # [s] Sa stored per record
 ARIAS, CAV, D5_95, PGV_OVER_PGA, AVGSA = "Arias", "CAV", "D5_95", "PGV_over_PGA", "AvgSa"
 #: The record IMs stored per record (the one list): name -> (variable, units, exponent n:

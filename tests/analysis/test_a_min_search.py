@@ -80,6 +80,30 @@ def test_a_first_band_narrower_than_the_grid_step_is_found(narrow):
     assert float(rows[1.0]["A_min"]) == ours
 
 
+def test_spectra_without_the_search_take_the_grids_bracket_as_boundaries_do(narrow, tmp_path):
+    """spectra(search=False) (and ``rocksweep spectrum --no-search``) bisect the grid's
+    bracket only: the band below the grid is missed, A_min is that of boundaries with
+    search=False, fewer kernel runs, and the Dataset says which it was."""
+    ds, out = narrow
+    fast = rocksweep.spectra(ds, rtol=RTOL, search=False)
+    full = rocksweep.spectra(ds, rtol=RTOL)
+    b = rocksweep.boundaries(ds, rtol=RTOL, search=False)
+    a_fast = float(fast["A_min"].sel(w_over_p=1.0).squeeze())
+    assert a_fast == float(b["A_min"].sel(w_over_p=1.0))
+    assert a_fast > 1.1 > float(full["A_min"].sel(w_over_p=1.0).squeeze())
+    assert "searched below grid" not in set(fast["A_min_method"].values.ravel().tolist())
+    assert fast.attrs["search"] == 0 and full.attrs["search"] == 1
+    assert fast.attrs["runs"] < full.attrs["runs"]
+    with pytest.raises(rocksweep.RocksweepError, match="^search = 'no': must be True or "
+                                                       "False$"):
+        rocksweep.spectra(ds, search="no")
+    fig = tmp_path / "sp.png"
+    res = CliRunner().invoke(main, ["spectrum", str(out), "-o", str(fig), "--rtol", str(RTOL),
+                                    "--no-search"])
+    assert res.exit_code == 0, res.output
+    assert f"({fast.attrs['runs']} kernel runs" in res.output and fig.exists()
+
+
 def test_the_search_stays_within_its_budget(narrow):
     ds, _ = narrow
     b = rocksweep.boundaries(ds, rtol=RTOL)

@@ -175,15 +175,15 @@ def test_energy_and_half_step_runs_use_the_scene_ground_motion(name, sets):
     """Review defect b: the accuracy study's energy runs (and half-step reruns) must run
     the Ricker pulse and the record, not the sine/cosine variant: they equal the sweep's
     own energy outputs and check reruns of the same points."""
-    import rocksweep.compute.sweep as sw
     from rocksweep import fields
     from rocksweep.analysis.accuracy import run_energy, run_half
+    from rocksweep.compute.driver import sweep_arrays
     from rocksweep.scene.parse import load_scene
 
     sc = load_scene(ROOT / "configs" / name, [*sets, "outputs.energy=true",
                                               "outputs.check=true"])
     flat = np.arange(sc.size)
-    swept = sw.compute(sc, jobs=1)
+    swept = sweep_arrays(sc, jobs=1)[0]
     energy = run_energy(sc, flat, sc.numerics)
     w_in = energy[:, L.OUT_W_IN] / np.array([sc.point(v).body.E_ref for v in _values(sc)])
     np.testing.assert_array_equal(w_in, swept["work_in_over_Eref"].ravel())

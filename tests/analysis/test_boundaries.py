@@ -6,7 +6,7 @@ import pytest
 from bodies import FIG3_YAML
 
 import rocksweep.analysis.boundaries as bd
-import rocksweep.compute.sweep as sw
+from rocksweep.compute.driver import sweep_arrays
 from rocksweep.figures.diagrams import a_min_figure
 from rocksweep.scene.parse import parse_scene
 
@@ -67,7 +67,7 @@ def sine_scene():
     text = (BODY3 + "impact: {lam: [0.0, 0.4]}\npulse: {shape: sine, w_over_p: "
             "[1.0, 2.5, 3.5], A_ratio: {start: 0.1, stop: 8, num: 21}}\n")
     sc = parse_scene(text)
-    return text, sc, sw.compute(sc)
+    return text, sc, sweep_arrays(sc)[0]
 
 
 def test_a_min_equals_a_10x_finer_sweep(sine_scene):
@@ -78,7 +78,7 @@ def test_a_min_equals_a_10x_finer_sweep(sine_scene):
     assert [c.where for c in curves] == [{"lam": 0.0}, {"lam": 0.4}]
     A = np.asarray(sc.axis("A_ratio").values)
     fine_sc = parse_scene(text.replace("num: 21", "num: 201"))  # spacing / 10
-    fine = sw.compute(fine_sc)["outcome"]
+    fine = sweep_arrays(fine_sc)[0]["outcome"]
     Af = np.asarray(fine_sc.axis("A_ratio").values)
     for p, c in enumerate(curves):
         for j in range(3):

@@ -43,6 +43,24 @@ def test_one_colour_per_lam_with_band_points_and_median_differences(tmp_path):
     assert (tmp_path / "f.png").stat().st_size > 1000
 
 
+def test_stripe_markers_at_the_same_place_stay_readable():
+    """Issue 31: two lam values with the same fractions at the same stripes drew opaque
+    markers over each other; each colour has its own shape and a translucent face."""
+    ds = suite_dataset(n_records=20, lams=(0.0, 0.2, 0.4), medians=(0.5, 0.5, 0.5))
+    fr = fragility(ds, bootstrap=0)
+    fig = fragility_figure(fr)
+    pts = [c for c in fig.axes[0].collections if isinstance(c, PathCollection)]
+    assert len(pts) == 3
+    offsets = [c.get_offsets() for c in pts]
+    assert np.array_equal(offsets[0], offsets[1])  # the case: they overlap exactly
+    shapes = {tuple(map(tuple, c.get_paths()[0].vertices.round(3))) for c in pts}
+    assert len(shapes) == 3  # one marker shape per colour
+    for c in pts:
+        face, edge = c.get_facecolor()[0], c.get_edgecolor()[0]
+        assert face[3] < 0.7 and edge[3] == 1.0  # see-through face, solid outline
+        assert np.allclose(face[:3], edge[:3])  # the curve's colour
+
+
 def test_into_given_axes_and_a_curve_without_fit():
     ds = suite_dataset(n_records=10)
     ds["outcome"][1] = 0  # lam = 0.2 never overturns: no fit

@@ -16,6 +16,7 @@ from scipy.stats import norm
 import rocksweep
 from rocksweep.analysis.risk import RiskError, read_hazard
 from rocksweep.cli import main
+from rocksweep.physics.model import G
 
 
 def fragility(median, beta, **extra):
@@ -43,6 +44,35 @@ def test_power_law_hazard_meets_the_closed_form(k0, k, median, beta):
     assert float(rk.annual_rate[0]) == pytest.approx(exact, rel=1e-6)  # in fact far closer
     assert float(rk.probability[0]) == pytest.approx(1 - math.exp(-exact * 50), rel=1e-4)
     assert str(rk.reason.values[0]) == "ok"
+
+
+@pytest.mark.parametrize(("unit", "per_g"), [("m/s^2", G), ("cm/s2", 100 * G),
+                                             ("gal", 100 * G)])
+def test_a_hazard_in_other_acceleration_units_is_converted(unit, per_g):
+    """The same hazard curve given in m/s^2 or cm/s^2 (Gal) gives the rate of the curve in
+    g (the closed form above); the conversion is stated. g is rocksweep's G, the gravity
+    the records' PGV and the model use."""
+    k0, k, median, beta = 1e-4, 2.0, 0.3, 0.4
+    in_g = power_law(k0, k)
+    other = pd.DataFrame({f"PGA [{unit}]": in_g["PGA [g]"] * per_g,
+                          "annual_rate": in_g["annual_rate"]})
+    rk = rocksweep.risk(fragility(median, beta), other, years=50)
+    exact = k0 * median ** -k * math.exp(k * k * beta * beta / 2.0)
+    assert float(rk.annual_rate[0]) == pytest.approx(exact, rel=1e-6)
+    assert rk.attrs["hazard_unit"].startswith(f"{unit}, converted to g")
+    assert rk.attrs["im_units"] == "g"
+    np.testing.assert_allclose(rk["hazard_im"].values, in_g["PGA [g]"].values, rtol=1e-12)
+
+
+def test_a_pgv_hazard_in_cm_per_s_is_converted():
+    frag = fragility(0.4, 0.5)
+    frag.attrs.update(im="PGV", im_units="m/s")
+    x = np.geomspace(1e-3, 10.0, 40)  # m/s
+    rate = 1e-3 * x ** -2.0
+    in_m = rocksweep.risk(frag, pd.DataFrame({"PGV [m/s]": x, "annual_rate": rate}))
+    in_cm = rocksweep.risk(frag, pd.DataFrame({"PGV [cm/s]": 100 * x, "annual_rate": rate}))
+    assert float(in_cm.annual_rate[0]) == pytest.approx(float(in_m.annual_rate[0]), rel=1e-9)
+    assert "hazard_unit" not in in_m.attrs and "x 0.01" in in_cm.attrs["hazard_unit"]
 
 
 def test_a_general_hazard_against_scipy_quad():
@@ -138,13 +168,15 @@ BAD = {
     "non-monotone": "PGA [g],annual_rate\n0.1,1e-2\n0.2,2e-2\n0.4,1e-4\n",
     "negative": "PGA [g],annual_rate\n0.1,1e-2\n0.2,-1e-3\n",
     "other IM": "PGV [m/s],annual_rate\n0.1,1e-2\n0.2,1e-3\n",
-    "other unit": "PGA [m/s2],annual_rate\n0.1,1e-2\n0.2,1e-3\n",
+    "other unit": "PGA [ft/s2],annual_rate\n0.1,1e-2\n0.2,1e-3\n",
+    "a velocity unit": "PGA [cm/s],annual_rate\n0.1,1e-2\n0.2,1e-3\n",
     "one row": "PGA [g],annual_rate\n0.1,1e-2\n",
     "NaN": "PGA [g],annual_rate\n0.1,nan\n0.2,1e-3\n",
     "no unit": "PGA,annual_rate\n0.1,1e-2\n0.2,1e-3\n",
 }
 WORDS = {"non-monotone": "must not increase", "negative": "must be >= 0",
-         "other IM": "not the fragility's IM", "other unit": "unit", "one row": "at least 2",
+         "other IM": "not the fragility's IM", "other unit": "cannot be converted",
+         "a velocity unit": "cannot be converted", "one row": "at least 2",
          "NaN": "finite", "no unit": "unit"}
 
 

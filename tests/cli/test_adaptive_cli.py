@@ -16,6 +16,7 @@ import rocksweep
 import rocksweep.compute.adaptive as ad
 from rocksweep import api
 from rocksweep.cli import main
+from rocksweep.compute.driver import sweep_arrays
 from rocksweep.compute.sweep import level, prepare
 from rocksweep.scene.parse import parse_scene
 from rocksweep.store.reader import read_result
@@ -102,7 +103,7 @@ def test_fig3_adaptive_equals_full_and_the_library(fig3_files):
     assert f"adaptive: {st.computed} of {flags.size} points computed" in text
     assert f"audit: {st.audited} points, {st.audit_misses} disagreed" in text
     # the file holds what the in-memory adaptive sweep computes
-    arr, _ = ad.adaptive_compute(parse_scene(FIG3_SMALL), jobs=1, coarse=2)
+    arr, _ = sweep_arrays(parse_scene(FIG3_SMALL), jobs=1, adaptive=ad.Options(coarse=2))
     for name, v in arr.items():
         np.testing.assert_array_equal(a.arrays[name], v, err_msg=name)
     # xarray reads it; the flags are documented CF-style

@@ -31,6 +31,18 @@ def test_simulate_json_keys(cli):
     assert d["outcome"] == "mode1" and d["t_overturn"] > 0 and d["impacts"] >= 1
 
 
+def test_simulate_names_the_body_kinds_slenderness(cli):
+    """A block's rotation is over its alpha, a flexible body's over alpha_cg."""
+    block = cli.invoke(main, ["simulate", str(CONFIGS / "block.yaml"), "--set",
+                              "pulse.shape=sine", "--set", "pulse.w_over_p=2", "--set",
+                              "pulse.A_ratio=3"])
+    assert block.exit_code == 0, block.output
+    assert "max|theta|/alpha: " in block.output and "alpha_cg" not in block.output
+    flexible = cli.invoke(main, ["simulate", str(CONFIGS / "fig5.yaml"), "--set",
+                                 "impact.lam=0.4"])
+    assert "max|theta|/alpha_cg: " in flexible.output
+
+
 def test_simulate_plot_and_csv(cli, tmp_path):
     png, path = tmp_path / "fig5.png", tmp_path / "h.csv"
     res = cli.invoke(main, ["simulate", str(CONFIGS / "fig5.yaml"), "--plot", str(png),

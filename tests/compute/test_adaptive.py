@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import rocksweep.compute.adaptive as ad
-import rocksweep.compute.sweep as sw
+from rocksweep.compute.driver import sweep_arrays
 from rocksweep.errors import RocksweepError
 from rocksweep.scene.parse import load_scene, parse_scene
 
@@ -38,10 +38,16 @@ def synthetic(plan: ad.Plan, truth: np.ndarray):
     return evaluate, calls
 
 
+def adaptive(sc, **kw):
+    """An adaptive sweep in memory at the default settings: (arrays, stats)."""
+    arrays, report = sweep_arrays(sc, adaptive=ad.Options(), **kw)
+    return arrays, report.adaptive
+
+
 @pytest.fixture(scope="module")
 def block_long():
     sc = parse_scene(BLOCK_LONG)
-    return sc, sw.compute(sc, jobs=1)
+    return sc, sweep_arrays(sc, jobs=1)[0]
 
 
 # --- against the full grid, real kernel -------------------------------------------------
@@ -51,7 +57,7 @@ def test_block_long_pulse_equals_full_grid(block_long):
     A = np.asarray(sc.axis("A_ratio").values)
     assert (full["outcome"][A < 1] == 0).all()  # no uplift below g tan(alpha)
     assert (full["outcome"][A > 1.2] > 0).all()  # a boundary to find
-    arr, st = ad.adaptive_compute(sc, jobs=1)
+    arr, st = adaptive(sc, jobs=1)
     np.testing.assert_array_equal(arr["outcome"], full["outcome"])
     assert st.computed < 0.5 * st.points
     c = arr["computed"] > 0
@@ -68,8 +74,8 @@ def test_block_long_pulse_equals_full_grid(block_long):
 def test_figure_3a_two_lam_equals_full_grid():
     """The paper's Figure 3(a) at its shipped 80 x 80, lam = 0 and 0.4."""
     sc = load_scene("configs/fig3a.yaml", ["impact.lam=[0.0, 0.4]"])
-    full = sw.compute(sc, jobs=2)
-    arr, st = ad.adaptive_compute(sc, jobs=2)
+    full = sweep_arrays(sc, jobs=2)[0]
+    arr, st = adaptive(sc, jobs=2)
     np.testing.assert_array_equal(arr["outcome"], full["outcome"])
     assert st.audit_misses == 0 and not st.suspicious
     assert st.computed_share < 0.5
@@ -77,9 +83,9 @@ def test_figure_3a_two_lam_equals_full_grid():
 
 def test_same_results_whatever_jobs_and_chunks(block_long):
     sc, _ = block_long
-    a, sa = ad.adaptive_compute(sc, jobs=1, chunk_size=7)
-    b, sb = ad.adaptive_compute(sc, jobs=2, chunk_size=64)
-    c, _ = ad.adaptive_compute(sc, jobs=2)
+    a, sa = adaptive(sc, jobs=1, chunk_size=7)
+    b, sb = adaptive(sc, jobs=2, chunk_size=64)
+    c, _ = adaptive(sc, jobs=2)
     assert_same(a, b)
     assert_same(a, c)
     assert sa.batches == sb.batches
@@ -101,7 +107,7 @@ def test_smooth_planted_map_recovered_exactly_and_cheaply():
     truth = disc_map(shape, 150.3, 60.7, 30.0)
     plan = ad.Plan(shape, 2, 1, audit=0.0)
     evaluate, _ = synthetic(plan, truth.ravel())
-    out, comp, st = ad.drive(plan, evaluate)
+    out, comp, st = ad.run_on_function(plan, evaluate)
     np.testing.assert_array_equal(out, truth.ravel())
     assert st.computed_share < 0.15
     assert (comp[out != truth.ravel()] > 0).all()
@@ -126,7 +132,7 @@ def test_one_point_slivers_and_specks_recovered_by_the_last_level():
     shape = (2, 129, 129)
     truth = sliver_map(shape).ravel()
     plan = ad.Plan(shape, 2, 1, coarse=4, audit=0.0)
-    out, comp, st = ad.drive(plan, synthetic(plan, truth)[0])
+    out, comp, st = ad.run_on_function(plan, synthetic(plan, truth)[0])
     np.testing.assert_array_equal(out, truth)
     assert comp.reshape(shape)[0, 90, 71] == ad.COMPUTED  # the speck was looked at
     assert st.computed_share < 0.35
@@ -160,17 +166,18 @@ def test_audit_catches_planted_island():
     truth[0, y0 - 1:y0 + 2, x0 - 1:x0 + 2] = 1
     t = truth.ravel()
     # without an audit the island is missed: it lies inside one uniform coarse cell
-    out0, _, st0 = ad.drive(ad.Plan(shape, 2, 1, coarse=5, audit=0.0), synthetic(plan, t)[0])
+    out0, _, st0 = ad.run_on_function(ad.Plan(shape, 2, 1, coarse=5, audit=0.0),
+                                      synthetic(plan, t)[0])
     assert (out0 == 0).all() and st0.audited == 0
     # with it, the audit point disagrees, the region is refined and the island recovered
-    out, comp, st = ad.drive(plan, synthetic(plan, t)[0], threshold=0.0)
+    out, comp, st = ad.run_on_function(plan, synthetic(plan, t)[0], threshold=0.0)
     np.testing.assert_array_equal(out, t)
     assert st.audit_misses >= 1 and comp.reshape(shape)[0, y0, x0] == ad.AUDIT_MISS
     assert st.suspicious and "audit points" in st.warning()
     # the audit share: about 5% of the points that would otherwise have been filled
-    filled0 = int((ad.drive(ad.Plan(shape, 2, 1, coarse=5, audit=0.0),
+    filled0 = int((ad.run_on_function(ad.Plan(shape, 2, 1, coarse=5, audit=0.0),
                             synthetic(plan, base.ravel())[0])[1] == 0).sum())
-    _, _, st_clean = ad.drive(plan, synthetic(plan, base.ravel())[0], threshold=0.0)
+    _, _, st_clean = ad.run_on_function(plan, synthetic(plan, base.ravel())[0], threshold=0.0)
     assert 0.03 * filled0 < st_clean.audited < 0.07 * filled0
     assert st_clean.audit_misses == 0 and not st_clean.suspicious
 
@@ -181,7 +188,7 @@ def test_interrupted_run_resumes_to_the_same_result():
     shape = (3, 97, 65)
     truth = disc_map(shape, 40.2, 50.5, 12.0).ravel()
     plan = ad.Plan(shape, 2, 1, coarse=3, audit=0.1, seed=1)
-    ref_out, ref_comp, _ = ad.drive(plan, synthetic(plan, truth)[0])
+    ref_out, ref_comp, _ = ad.run_on_function(plan, synthetic(plan, truth)[0])
     outcome = np.full(plan.size, -1, np.int8)
     computed = np.zeros(plan.size, np.int8)
     rng = np.random.default_rng(0)
@@ -205,11 +212,11 @@ def test_other_diagram_axes_equal_transposed_default():
     shape = (2, 65, 81)
     truth = disc_map(shape, 30.5, 20.2, 9.0)
     plan = ad.Plan(shape, 2, 1, audit=0.02)
-    out, comp, _ = ad.drive(plan, synthetic(plan, truth.ravel())[0])
+    out, comp, _ = ad.run_on_function(plan, synthetic(plan, truth.ravel())[0])
     # the same map with the diagram axes first and the "other" axis last, y and x swapped
     moved = np.ascontiguousarray(np.transpose(truth, (2, 1, 0)))  # (x, y, panel)
     plan_t = ad.Plan(moved.shape, 0, 1, audit=0.0)
-    out_t, comp_t, _ = ad.drive(plan_t, synthetic(plan_t, moved.ravel())[0])
+    out_t, comp_t, _ = ad.run_on_function(plan_t, synthetic(plan_t, moved.ravel())[0])
     np.testing.assert_array_equal(out_t.reshape(moved.shape), moved)
     np.testing.assert_array_equal(out.reshape(shape), truth)
 
@@ -277,7 +284,7 @@ def test_interrupted_audit_resumes_to_the_same_flags():
         for y0, x0 in list(zip(ys[far], xs[far], strict=True))[:3]:
             truth[p, y0, x0] = 2
     t = truth.ravel()
-    ref_out, ref_comp, ref_st = ad.drive(plan, synthetic(plan, t)[0])
+    ref_out, ref_comp, ref_st = ad.run_on_function(plan, synthetic(plan, t)[0])
     assert ref_st.audit_misses >= 2  # the audit batch matters here
     for seed in range(4):
         rng = np.random.default_rng(seed)

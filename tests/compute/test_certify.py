@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 from bodies import BODY3
 
-from rocksweep.compute import sweep as sw
 from rocksweep.compute.certify import certify
+from rocksweep.compute.driver import sweep_arrays
 from rocksweep.compute.single import simulate
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
@@ -129,7 +129,7 @@ def test_simulate_and_sweep_give_one_point_one_answer():
     scene = parse_scene(SCENE)
     assert scene.single_numerics == scene.numerics
     assert scene.numerics.accuracy == "default"
-    swept = {k: np.ravel(v) for k, v in sw.compute(scene).items()}
+    swept = {k: np.ravel(v) for k, v in sweep_arrays(scene)[0].items()}
     fixed = {a.name: a.values[0] for a in scene.axes}
     for i, A in enumerate((10.9, 11.1, 14.0)):
         run = simulate(scene.point({**fixed, "A_ratio": A}), scene.single_numerics)
@@ -157,8 +157,8 @@ def test_adaptive_sweeps_certify_as_the_full_sweep_does():
     import rocksweep.compute.adaptive as ad
 
     sc = parse_scene(ADAPTIVE)
-    full = sw.compute(sc)
-    arr, _ = ad.adaptive_compute(sc, jobs=1)
+    full = sweep_arrays(sc)[0]
+    arr, _ = sweep_arrays(sc, jobs=1, adaptive=ad.Options())
     c = arr["computed"] > 0
     for k in ("outcome", "status", "steps", "t_overturn"):
         np.testing.assert_array_equal(arr[k][c], full[k][c], err_msg=k)

@@ -20,6 +20,7 @@ from helpers import one_line_error
 
 from rocksweep.cli import main
 from rocksweep.compute import sweep as sw
+from rocksweep.compute.driver import sweep_arrays
 from rocksweep.fields import CHECK_FIELDS, check_rows
 from rocksweep.kernel import chunk_kernel
 from rocksweep.kernel import layout as L  # noqa: N812
@@ -49,13 +50,13 @@ def test_rerun_is_the_sweep_at_half_the_step():
     rotation_step / 2 (the row scaling is exact in float64), over flexible and rigid
     bodies, both shapes, e < 1 and e > 1; the run's own fields equal a sweep without
     check."""
-    plain = sw.compute(parse_scene(SCENE))
-    checked = sw.compute(parse_scene(SCENE, overrides=["outputs.check=true"]))
+    plain = sweep_arrays(parse_scene(SCENE))[0]
+    checked = sweep_arrays(parse_scene(SCENE, overrides=["outputs.check=true"]))[0]
     spp, _ = PRESETS["default"]
-    half = sw.compute(parse_scene(SCENE, overrides=[
+    half = sweep_arrays(parse_scene(SCENE, overrides=[
         f"numerics.steps_per_period={2 * spp}",
         f"numerics.pulse_steps={2 * PRESET_PULSE['default']}",
-        f"numerics.rotation_step={PRESET_ROTATION['default'] / 2}"]))
+        f"numerics.rotation_step={PRESET_ROTATION['default'] / 2}"]))[0]
     assert set(checked) == set(plain) | set(CHECK_NAMES)
     for k, v in plain.items():
         assert _same(checked[k], v), k
@@ -134,7 +135,7 @@ def test_record_scene_half_step(tmp_path):
     scene = parse_scene(cfg.read_text(), source=str(cfg), base=cfg.parent,
                         overrides=["outputs.check=true", "ground.A_ratio=[0.8, 2.5]",
                                    "ground.p=[1.0, 2.0, 4.0]"])
-    res = sw.compute(scene)
+    res = sweep_arrays(scene)[0]
     rows = sw.Grid(scene).rows(0, 2).rows
     assert np.array_equal(check_rows(rows)[:, L.PAR_REC_H], rows[:, L.PAR_REC_H] / 2)
     assert (res["check_outcome"] >= 0).all()

@@ -269,15 +269,15 @@ def test_suite_on_a_dask_cluster(tmp_path, suite_dir):
     import pickle
 
     distributed = pytest.importorskip("distributed")  # in the test extra: never skipped
-    from rocksweep.compute import sweep as sw
+    from rocksweep.compute.driver import sweep_arrays
 
     scene = write_scene(tmp_path, scale="{im: PGA, values: [0.5, 1.0]}")
     sc = load_scene(scene)
     back = pickle.loads(pickle.dumps(Grid(sc)))
     np.testing.assert_array_equal(back.rows(0, back.size).rows, Grid(sc).rows(0, sc.size).rows)
-    local = sw.compute(sc, jobs=1)
+    local = sweep_arrays(sc, jobs=1)[0]
     with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
                                   dashboard_address=None) as cluster:
-        on = sw.compute(sc, backend="dask", scheduler=cluster.scheduler_address, chunk_size=4)
+        on = sweep_arrays(sc, backend="dask", scheduler=cluster.scheduler_address, chunk_size=4)[0]
     for name, v in local.items():
         np.testing.assert_array_equal(on[name], v, err_msg=name)

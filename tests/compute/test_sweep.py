@@ -5,6 +5,7 @@ import pytest
 
 import rocksweep.compute.sweep as sw
 from rocksweep import fields
+from rocksweep.compute.driver import sweep_arrays
 from rocksweep.compute.grid import Grid
 from rocksweep.compute.single import simulate
 from rocksweep.kernel import layout as L  # noqa: N812
@@ -30,7 +31,7 @@ def assert_same(a: dict, b: dict) -> None:
 @pytest.fixture(scope="module")
 def reference():
     sc = small_scene()
-    return sc, sw.compute(sc, jobs=1, chunk_size=1000)
+    return sc, sweep_arrays(sc, jobs=1, chunk_size=1000)[0]
 
 
 # --- chunk planning ---------------------------------------------------------------------
@@ -91,9 +92,9 @@ def test_outcomes_are_consistent(reference):
 
 def test_bit_for_bit_whatever_jobs_and_chunks(reference):
     sc, ref = reference
-    assert_same(ref, sw.compute(sc, jobs=1, chunk_size=7))
-    assert_same(ref, sw.compute(sc, jobs=2, chunk_size=5))
-    assert_same(ref, sw.compute(sc, jobs=2, chunk_size=64))
+    assert_same(ref, sweep_arrays(sc, jobs=1, chunk_size=7)[0])
+    assert_same(ref, sweep_arrays(sc, jobs=2, chunk_size=5)[0])
+    assert_same(ref, sweep_arrays(sc, jobs=2, chunk_size=64)[0])
 
 
 def test_merge_contiguous_joins_neighbours_in_any_order():
@@ -126,7 +127,7 @@ def test_dask_backend_on_a_local_cluster(reference):
     sc, ref = reference
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
                                   dashboard_address=None) as cluster:
-        got = sw.compute(sc, chunk_size=9, backend="dask", scheduler=cluster.scheduler_address)
+        got = sweep_arrays(sc, chunk_size=9, backend="dask", scheduler=cluster.scheduler_address)[0]
     assert_same(ref, got)
 
 
@@ -165,7 +166,7 @@ def test_each_point_goes_to_its_kernel_variant(monkeypatch):
 def test_energy_outputs_match_the_single_run_bookkeeping():
     sc = parse_scene(BODY3 + "impact: {lam: 0.2}\npulse: {shape: sine, w_over_p: [2.0, 5.3], "
                      "A_ratio: [2.0, 5.0]}\noutputs: {energy: true}\n")
-    res = sw.compute(sc, jobs=1)
+    res = sweep_arrays(sc, jobs=1)[0]
     assert {f.name for f in fields.ENERGY_FIELDS} <= res.keys()
     g = Grid(sc)
     for flat in range(g.size):
@@ -185,7 +186,7 @@ def test_raising_lam_grows_mode1_area():
     sc = parse_scene(BODY3 + "impact: {lam: [0.0, 0.2, 0.4]}\n"
                      "pulse: {shape: sine, w_over_p: {start: 3.0, stop: 5.7, num: 10},"
                      " A_ratio: {start: 1.5, stop: 6.5, num: 10}}\n")
-    res = sw.compute(sc, jobs=1)
+    res = sweep_arrays(sc, jobs=1)[0]
     o = res["outcome"]  # [lam, A, w]
     mode1 = (o == L.OUTCOME_MODE1).sum(axis=(1, 2))
     assert np.all(np.diff(mode1) >= 0), mode1

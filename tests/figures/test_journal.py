@@ -71,6 +71,57 @@ def test_savefig_on_a_returned_figure_embeds_truetype(laws, tmp_path):
         assert fig._repr_png_()[:8] == PNG
 
 
+@pytest.fixture(scope="module")
+def analyses(laws, suite_result):
+    """One Dataset of every analysis kind rocksweep.plot draws (the suite's and the
+    impact-law sweep's), and a spectra Dataset over w_over_p, A_ratio and lam."""
+    import warnings
+
+    import pandas as pd
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # verdicts on a 6-record suite: not the point here
+        suite = rocksweep.open(suite_result)
+        fr = rocksweep.fragility(suite, bootstrap=20)
+        x = np.geomspace(0.01, 5.0, 20)
+        hazard = pd.DataFrame({"PGA [g]": x, "annual_rate": 1e-4 * x ** -2.0})
+        one_shape = rocksweep.run(ROOT / "configs" / "ci-small.yaml",
+                                  overrides=["pulse.shape=sine"])
+        return {"fragility": fr, "ida": rocksweep.ida(suite),
+                "risk": rocksweep.risk(fr, hazard),
+                "im_efficiency": rocksweep.im_efficiency(suite),
+                "boundaries": rocksweep.boundaries(laws, search=False),
+                "spectra": rocksweep.spectra(one_shape, search=False)}
+
+
+@pytest.mark.parametrize("width", list(WIDTHS))
+def test_every_analysis_figure_fits_the_journal_widths(analyses, width, tmp_path):
+    """Issue 31: every figure rocksweep returns, the analyses' too, at single and double
+    column width: nothing outside the figure, TrueType in a PDF."""
+    for kind, ds in analyses.items():
+        fig = rocksweep.plot(ds, width=width)
+        assert isinstance(fig, Figure), kind
+        _fits(fig, kind, width)
+        fig.savefig(tmp_path / f"{kind}.pdf")
+        assert b"/Type3" not in (tmp_path / f"{kind}.pdf").read_bytes(), kind
+
+
+def _fits(fig, name, width):
+    inches, _ = WIDTHS[width]
+    assert fig.get_figwidth() == pytest.approx(inches), name
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    r = canvas.get_renderer()
+    box = fig.bbox
+    for a in [fig._suptitle, *fig.legends, *fig.axes]:
+        if a is None or not a.get_visible():
+            continue
+        bb = a.get_tightbbox(r)
+        assert (bb.x0 >= box.x0 - 1e-6 and bb.x1 <= box.x1 + 1e-6
+                and bb.y0 >= box.y0 - 1e-6 and bb.y1 <= box.y1 + 1e-6), \
+            f"{name} at {width}: {type(a).__name__} at {bb.extents} outside {box.extents}"
+
+
 @pytest.mark.parametrize("width", list(WIDTHS))
 def test_journal_widths_clip_nothing_and_titles_are_no_larger_than_labels(laws, width):
     inches, _ = WIDTHS[width]

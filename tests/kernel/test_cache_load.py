@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from rocksweep.compute import sweep as sw
+from rocksweep.compute.driver import sweep_arrays
 from rocksweep.compute.grid import Grid
 from rocksweep.scene.parse import load_scene
 
@@ -37,11 +38,11 @@ def _python(code: str) -> str:
 def test_a_cached_variant_loads_without_a_refresh_and_gives_the_same_outcomes():
     scene = load_scene(CI_SMALL)
     sw.prepare(Grid(scene), sw.level(scene))  # in numba's cache from here on
-    here = sw.compute(scene)
+    here = sweep_arrays(scene)[0]
     out = _python(
-        "import sys, json; from rocksweep.compute import sweep as sw; "
+        "import sys, json; from rocksweep.compute.driver import sweep_arrays; "
         "from rocksweep.scene.parse import load_scene; "
-        f"r = sw.compute(load_scene({str(CI_SMALL)!r})); "
+        f"r = sweep_arrays(load_scene({str(CI_SMALL)!r}))[0]; "
         f"print(json.dumps([{REFRESHED!r} in sys.modules, r['outcome'].ravel().tolist(), "
         "r['theta_max_over_alpha'].ravel().tolist()]))")
     refreshed, outcome, theta = json.loads(out)

@@ -219,11 +219,11 @@ def test_hermite_closes_the_chattering_impacts_of_figure_3a_in_under_4_trials():
     took 4.24 per event on this grid; now 3.78."""
     from pathlib import Path
 
-    from rocksweep.compute.sweep import compute
+    from rocksweep.compute.driver import sweep_arrays
     from rocksweep.scene.parse import load_scene
 
     fig3a = Path(__file__).resolve().parents[2] / "configs" / "fig3a.yaml"
-    r = compute(load_scene(fig3a, ["pulse.w_over_p.num=12", "pulse.A_ratio.num=12"]))
+    r = sweep_arrays(load_scene(fig3a, ["pulse.w_over_p.num=12", "pulse.A_ratio.num=12"]))[0]
     events = r["impacts"].sum() + r["uplifts"].sum() + (r["outcome"] > 0).sum()
     assert events > 5000  # chattering runs: ~22 impacts a point
     assert r["event_steps"].sum() / events < 4.0

@@ -14,8 +14,8 @@ import sympy as sp
 from helpers import one_line_error
 
 from rocksweep.cli import main
+from rocksweep.compute.driver import sweep_arrays
 from rocksweep.compute.single import simulate
-from rocksweep.compute.sweep import compute
 from rocksweep.kernel import equations as eq
 from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
@@ -167,12 +167,12 @@ def test_e_factor_1_and_law_vertical_are_bit_identical(tmp_path):
     named = load_scene(ROOT / "configs" / "ci-small.yaml",
                        ["outputs.energy=true", "impact.law=vertical", "impact.e_factor=1"])
     assert [a.name for a in named.swept] == [a.name for a in base.swept]
-    a, b_ = compute(base, jobs=1), compute(named, jobs=1)
+    a, b_ = sweep_arrays(base, jobs=1)[0], sweep_arrays(named, jobs=1)[0]
     for k in a:
         assert a[k].tobytes() == b_[k].tobytes(), k
     # and a factor that is not 1 changes the outcomes
     scaled = load_scene(ROOT / "configs" / "ci-small.yaml", ["impact.e_factor=1.3"])
-    assert (compute(scaled, jobs=1)["outcome"] != a["outcome"]).any()
+    assert (sweep_arrays(scaled, jobs=1)[0]["outcome"] != a["outcome"]).any()
 
 
 def test_energy_admissible_lam(laws, body_fig2):

@@ -34,9 +34,9 @@ from helpers import one_line_error
 from rocksweep.cli import main
 from rocksweep.compute.grid import Grid
 from rocksweep.compute.sweep import ChunkResult, level, prepare
+from rocksweep.fields import plain
 from rocksweep.scene.parse import load_scene, parse_scene
 from rocksweep.store import StoreError
-from rocksweep.store._common import _plain
 from rocksweep.store.format import SESSION_ATTRS
 from rocksweep.store.reader import peek_done, read_result
 from rocksweep.store.writer import SweepFile
@@ -239,7 +239,7 @@ def _as_format_1(path: Path) -> None:
     with h5py.File(path, "r+") as f:
         a = f.attrs
         for name in SESSION_ATTRS:
-            v = _plain(a[name])
+            v = plain(a[name])
             del a[name]
             if name in ("history", "host", "backend"):
                 continue
