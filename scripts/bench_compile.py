@@ -35,8 +35,9 @@ Run it against another copy of the package (e.g. the code before a change) with
    measurement in a fresh process: item 1's cold compile of Figure 3(a)'s variant (CPU s),
    the warm whole-process wall time of a 1-point ``rocksweep sweep`` (issue 31's start-up
    target), and item 3's core-us per point of Figure 3(a) (this copy's
-   ``bench_kernel.best_pass`` on DIR's package); the median of each and the ratio
-   this / DIR. Alone (``--against DIR --ab-only``) it takes ~1.5 min per round on 2 cores.
+   ``bench_kernel.best_pass`` on DIR's package), the order swapped every round; the
+   median of each and the ratio this / DIR. Alone (``--against DIR --ab-only``) it takes
+   ~25 s per round on 2 cores.
 
     python scripts/bench_compile.py --against /tmp/main --ab-only --rounds 3
 """
@@ -220,7 +221,8 @@ def against(other: Path, rounds: int, repeat: int) -> None:
     got: dict[str, list[dict[str, float]]] = {"this": [], "other": []}
     with tempfile.TemporaryDirectory() as tmp:
         for i in range(rounds):
-            for who, tree in (("other", other), ("this", None)):
+            pair = (("other", other), ("this", None))
+            for who, tree in pair[::-1] if i % 2 else pair:  # ABBA: no order bias
                 r = ab_round(tree, repeat, tmp)
                 got[who].append(r)
                 print(f"    round {i + 1} {who:<6} compile {r['compile']:5.2f} s CPU, 1-point "
