@@ -29,6 +29,17 @@ times are less sensitive to load than wall times.
 
 Run it against another copy of the package (e.g. the code before a change) with
 ``PYTHONPATH=/path/to/that/copy``: every subprocess inherits the environment.
+
+5. A/B (``--against DIR``, DIR holding another copy's ``rocksweep`` package, e.g. ``git
+   archive main | tar -x -C DIR``): rounds alternating between this copy and DIR, each
+   measurement in a fresh process: item 1's cold compile of Figure 3(a)'s variant (CPU s),
+   the warm whole-process wall time of a 1-point ``rocksweep sweep`` (issue 31's start-up
+   target), and item 3's core-us per point of Figure 3(a) (this copy's
+   ``bench_kernel.best_pass`` on DIR's package), the order swapped every round; the
+   median of each and the ratio this / DIR. Alone (``--against DIR --ab-only``) it takes
+   ~25 s per round on 2 cores.
+
+    python scripts/bench_compile.py --against /tmp/main --ab-only --rounds 3
 """
 
 from __future__ import annotations
@@ -45,6 +56,11 @@ from pathlib import Path
 
 import numpy as np
 
+ROOT = Path(__file__).resolve().parents[1]
+# this checkout's package, not an installed one (``pip install -e`` of another checkout is
+# found after sys.path), unless PYTHONPATH names another copy: its entries stay first
+sys.path.insert(1 + len([p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]),
+                str(ROOT))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import bench_kernel as bk  # noqa: E402  (scripts/bench_kernel.py: best_pass, scene_of)
 
@@ -58,7 +74,6 @@ from rocksweep.analysis.accuracy import (  # noqa: E402
 )
 from rocksweep.kernel import layout as L  # noqa: E402, N812
 
-ROOT = Path(__file__).resolve().parents[1]
 CONFIGS = ROOT / "configs"
 SWEEP_POINTS = 120_000  # the sweep size of the start-up-inclusive reference ratio
 KINDS = {L.KIND_FLEXIBLE: "flexible", L.KIND_FLEXIBLE_UNDAMPED: "flexible_undamped",
@@ -84,11 +99,12 @@ print(json.dumps({"import_cpu": c1 - c0, "import_wall": w1 - w0,
 """
 
 
-def child_env(**extra: str) -> dict[str, str]:
+def child_env(tree: Path | None = None, **extra: str) -> dict[str, str]:
     """The environment of the subprocesses: they import the same rocksweep as this process
     (its parent directory first on PYTHONPATH; they run in a temporary directory, so that
-    ``python -c`` / ``-m`` does not put the current directory first instead)."""
-    pkg_parent = str(Path(rocksweep.__file__).resolve().parents[1])
+    ``python -c`` / ``-m`` does not put the current directory first instead), or the one
+    in ``tree`` (item 5)."""
+    pkg_parent = str(tree or Path(rocksweep.__file__).resolve().parents[1])
     path = os.pathsep.join(p for p in (pkg_parent, os.environ.get("PYTHONPATH")) if p)
     return {**os.environ, "PYTHONPATH": path, **extra}
 
@@ -97,11 +113,11 @@ def variant_name(kind: int, level: int | None, ground: bool) -> str:
     return f"{LEVELS[level]}_{KINDS[kind]}{'_ground' if ground else ''}"
 
 
-def cold_compile(variant: tuple[int, int | None, bool]) -> dict:
+def cold_compile(variant: tuple[int, int | None, bool], tree: Path | None = None) -> dict:
     """Compile one variant in a fresh process with an empty NUMBA_CACHE_DIR."""
     with tempfile.TemporaryDirectory() as cache:
         res = subprocess.run([sys.executable, "-c", _COMPILE_SNIPPET, json.dumps(variant)],
-                             env=child_env(NUMBA_CACHE_DIR=cache), cwd=cache,
+                             env=child_env(tree, NUMBA_CACHE_DIR=cache), cwd=cache,
                              capture_output=True, text=True, check=True)
     return json.loads(res.stdout.splitlines()[-1])
 
@@ -158,6 +174,68 @@ def per_point(names: list[str], repeat: int) -> dict[str, dict]:
     return out
 
 
+_PER_POINT_SNIPPET = """
+import json, sys
+sys.path.insert(0, sys.argv[1])
+import bench_kernel as bk
+import rocksweep
+scene = bk.scene_of(sys.argv[2], None)
+bk.kernel_pass(scene)
+p = bk.best_pass(scene, int(sys.argv[3]))
+print(json.dumps({"us": p["cpu"] / p["outs"].shape[0] * 1e6, "package": rocksweep.__file__}))
+"""
+# a 1-point sweep (Figure 3(a)'s body at one pulse and lam): issue 31's start-up target
+ONE_POINT = ["--set", "pulse.w_over_p=2.0", "--set", "pulse.A_ratio=3.0",
+             "--set", "impact.lam=0.2"]
+
+
+def ab_round(tree: Path | None, repeat: int, tmp: str) -> dict[str, float]:
+    """Item 5's measurements of one copy (``tree``; None: this one), each in a fresh
+    process: cold compile CPU s, warm 1-point sweep wall s, fig3a core-us per point."""
+    package = str((tree or Path(rocksweep.__file__).resolve().parents[1]) / "rocksweep")
+    comp = cold_compile(QUICK_VARIANTS[0], tree)
+    if not comp["package"].startswith(package):
+        raise SystemExit(f"the subprocess imported {comp['package']}, not {package}")
+    h5 = str(Path(tmp) / f"one-{'this' if tree is None else 'other'}.h5")
+    sweep = [sys.executable, "-m", "rocksweep", "sweep", str(CONFIGS / "fig3a.yaml"),
+             *ONE_POINT, "-o", h5, "--overwrite", "-q"]
+    subprocess.run(sweep, check=True, capture_output=True, env=child_env(tree), cwd=tmp)
+    walls = []
+    for _ in range(repeat):  # numba's cache now filled: warm start-up
+        t0 = time.perf_counter()
+        subprocess.run(sweep, check=True, capture_output=True, env=child_env(tree), cwd=tmp)
+        walls.append(time.perf_counter() - t0)
+    res = subprocess.run([sys.executable, "-c", _PER_POINT_SNIPPET, str(Path(__file__).parent),
+                          "fig3a", str(repeat)], env=child_env(tree), cwd=tmp,
+                         capture_output=True, text=True, check=True)
+    pp = json.loads(res.stdout.splitlines()[-1])
+    return {"compile": comp["cpu"], "start": min(walls), "us": pp["us"]}
+
+
+def against(other: Path, rounds: int, repeat: int) -> None:
+    """Item 5: this copy and ``other`` alternately, ``rounds`` times; medians and ratios."""
+    if not (other / "rocksweep" / "__init__.py").is_file():
+        raise SystemExit(f"--against {other}: no rocksweep package there")
+    print(f"\n[5] A/B against {other}: {rounds} rounds alternating, each measurement a "
+          "fresh process (load average beside each round)")
+    got: dict[str, list[dict[str, float]]] = {"this": [], "other": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        for i in range(rounds):
+            pair = (("other", other), ("this", None))
+            for who, tree in pair[::-1] if i % 2 else pair:  # ABBA: no order bias
+                r = ab_round(tree, repeat, tmp)
+                got[who].append(r)
+                print(f"    round {i + 1} {who:<6} compile {r['compile']:5.2f} s CPU, 1-point "
+                      f"sweep {r['start']:5.3f} s wall, fig3a {r['us']:6.2f} core-us/pt  "
+                      f"(load {bk.load_avg()})", flush=True)
+    print(f"    {'median':<28}{'this':>10}{'other':>10}{'this/other':>12}")
+    for key, what in (("compile", "cold compile, CPU s"), ("start", "1-point sweep, wall s"),
+                      ("us", "fig3a, core-us/pt")):
+        a = float(np.median([r[key] for r in got["this"]]))
+        b = float(np.median([r[key] for r in got["other"]]))
+        print(f"    {what:<28}{a:>10.3f}{b:>10.3f}{a / b:>12.3f}")
+
+
 def reference(name: str, pp: dict, points: int, seed: int = 0) -> dict:
     """The reference on the accuracy study's stratified sample of a scene
     (``run_reference``, as the accuracy study and ``bench_kernel.py`` time it): its
@@ -185,7 +263,19 @@ def main() -> None:
     ap.add_argument("--ref-points", type=int, default=100,
                     help="reference sample per figure (default 100)")
     ap.add_argument("--no-compile", action="store_true", help="skip item 1")
+    ap.add_argument("--against", type=Path, metavar="DIR",
+                    help="item 5: A/B against the rocksweep package in DIR")
+    ap.add_argument("--rounds", type=int, default=3, help="item 5's alternating rounds")
+    ap.add_argument("--ab-only", action="store_true", help="item 5 only (with --against)")
     args = ap.parse_args()
+    if args.ab_only:
+        if args.against is None:
+            raise SystemExit("--ab-only needs --against DIR")
+        print(f"rocksweep compile/start-up A/B ({Path(rocksweep.__file__).parent}): "
+              f"{os.cpu_count()} cores, load average at start {bk.load_avg()}", flush=True)
+        against(args.against.resolve(), args.rounds, args.repeat)
+        print(f"load average at end {bk.load_avg()}")
+        return
     variants = QUICK_VARIANTS if args.quick else ALL_VARIANTS
     figures = ["fig3a"] if args.quick else list(bk.FOUR)
     ref_points = 20 if args.quick else args.ref_points
@@ -235,6 +325,9 @@ def main() -> None:
         agree = f"{100 * r['agree']:.2f}+-{100 * r['se']:.2f}"
         print(f"    {name:<8}{r['n']:>7}{r['ref_ms']:>10.1f}{kern:>11.1f}"
               f"{r['ref_ms'] * 1e3 / kern:>7.0f}x{incl:>14.0f}x{agree:>15}", flush=True)
+
+    if args.against is not None:
+        against(args.against.resolve(), args.rounds, args.repeat)
 
     print(f"\nbenchmark wall time {time.perf_counter() - t_all:.0f} s; load average at end "
           f"{bk.load_avg()}")

@@ -130,10 +130,16 @@ from rocksweep.kernel.transitions import impact_map, rest_proven, rigid_bounded,
 
 # the outcome-only variants do not compile the energy (``_static``)
 _energy = skipped_when(False, mechanical_energy, 0.0)
+# nor does a flexible variant compile the rigid body's bound (its caller's branch is dead
+# there; the value given instead is never used)
+_rigid_bounded = skipped_when(True, rigid_bounded, -1.0)
 
 # _step_length: a time within this fraction of a record step of a grid time is on it (t
 # sums steps of ~1e-2..1; its round-off is ~1e-16 relative, far below).
 ALIGN_SLACK = 1e-7
+# _near_saddle's bounds are widened by this (relative, and in rad), ~1e6 times the
+# round-off of the quantities compared (|theta|, atan(b/h_cg) <= pi/2 rad)
+SADDLE_SLACK = 1e-9
 
 
 def _acting(t, t_pulse, GROUND):
@@ -208,6 +214,9 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     rot = prm[PAR_ROT_STEP]
     acc = 0.0
     margin = np.inf  # OUT_MARGIN, in a register
+    # ``_near_saddle``'s bounds, once per run (saddle0 = NaN: no gate, every free rocking
+    # step takes ``_saddle``'s test; a row without a body, as warm_up's)
+    near = _saddle_bounds(prm)
 
     while True:
         on = _acting(t, t_pulse, GROUND)
@@ -225,8 +234,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             break
         if not FLEX and s != 0 and not on and free_check:
             free_check = False  # E is constant between impacts after the pulse: test once
-            margin = _energy_margin(y, s, prm, margin)
-            peak = rigid_bounded(y, s, prm, FLEX)
+            margin = _rigid_margin(FLEX, y, s, prm, margin)
+            peak = _rigid_bounded(FLEX, y, s, prm, FLEX)
             if peak >= 0.0:
                 if peak > theta_max:
                     theta_max = peak
@@ -268,7 +277,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
 
         if ev == EV_NONE:
             t, y = (t_pulse if lands else t + h), y1
-            if s != 0 and not on:
+            if s != 0 and not on and _near_saddle(y, s, near):
                 margin = _saddle(y, s, prm, margin)
             _record(hist, t, y, s, _acting(t, t_pulse, GROUND), prm, out, FLEX)
             if CONTACT is not None:  # the step's end, with the step's own ground motion
@@ -448,7 +457,46 @@ def _energy_margin(y, s, prm, margin):
     return q if q < margin else margin
 
 
-@njit(cache=True, **INLINE)
+# a flexible variant compiles neither this nor the rigid mechanical_energy it calls (as
+# _rigid_bounded)
+_rigid_margin = skipped_when(True, _energy_margin, np.inf)
+
+
+@njit(cache=True, inline="always")
+def _saddle_bounds(prm):
+    """``_near_saddle``'s constants of a run: (v_cap [rad/s], saddle0 [rad], r0 [rad],
+    r_u [rad/m]); saddle0 = NaN where the row has no body (h_cg or M not > 0)."""
+    sl = SADDLE_SLACK
+    half = 0.5 * prm[PAR_ALPHA_REF] * (1.0 + sl)
+    if not (prm[PAR_HCG] > 0.0 and prm[PAR_MTOT] > 0.0):
+        return half, np.nan, 0.0, 0.0
+    saddle0 = math.atan(prm[PAR_B] / prm[PAR_HCG])
+    r_u = prm[PAR_M] / (prm[PAR_MTOT] * prm[PAR_HCG]) * (1.0 + sl)
+    return half, saddle0, half * (1.0 + sl) + sl, r_u
+
+
+@njit(cache=True, inline="always")
+def _near_saddle(y, s, near):
+    """False where ``_saddle`` would leave the margin as it is, for sure: a cheap test on
+    the path of every free rocking step (``_saddle`` takes an atan and four divisions and
+    is a call; inlined it slows every step).
+
+    near = ``_saddle_bounds``: (v_cap, saddle0, r0, r_u). |theta'| > v_cap = alpha_ref/2
+    (1 + SADDLE_SLACK) gives |v| > 1/2. atan is 1-Lipschitz, so |s theta_s - saddle0| <=
+    m |u| / (M h_cg) (saddle0 = atan(b/h_cg), the saddle at u = 0), and |s theta - saddle0|
+    > alpha_ref/2 + m |u| / (M h_cg) gives |x| > 1/2; r0 + r_u |u| is that bound widened by
+    SADDLE_SLACK (relative and absolute), far above the round-off of either side, so the
+    margin is the same to the bit as if ``_saddle`` ran at every step. saddle0 = NaN:
+    always True (every comparison with NaN fails). The two tests are or-ed without a
+    branch between them (one well-predicted branch, measured faster than two).
+    """
+    v_cap, saddle0, r0, r_u = near
+    far = ((abs(y[Y_THETA_DOT]) > v_cap)
+           | (abs(s * y[Y_THETA] - saddle0) > r0 + r_u * abs(y[Y_U])))
+    return not far
+
+
+@njit(cache=True, **INTERNAL)
 def _saddle(y, s, prm, margin):
     """The smallest distance so far of the free rocking motion from the overturning
     saddle, in units of alpha_ref (OUT_MARGIN; ``rocksweep.compute.certify``).
@@ -460,7 +508,9 @@ def _saddle(y, s, prm, margin):
     vertex, sqrt(|v^2 - x^2|) from the saddle, is the closest the motion comes. It is
     taken from every step end within half an alpha_ref of the saddle (any point of the
     hyperbola gives its vertex, so steps of any length see it): a small value means the
-    run decided between overturning and not by a small margin of energy.
+    run decided between overturning and not by a small margin of energy. Called only
+    where ``_near_saddle`` says the step end may be that close (~10% of Figure 3(a)'s
+    free rocking steps): a call, not inlined.
     """
     a_ref = prm[PAR_ALPHA_REF]
     th_s = math.atan((prm[PAR_B] - s * prm[PAR_M] * y[Y_U] / prm[PAR_MTOT]) / prm[PAR_HCG])

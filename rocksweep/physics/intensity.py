@@ -247,14 +247,18 @@ def sa(acc, dt: float, periods, zeta: float = SA_DAMPING, *, points_per_period: 
         den = np.array([1.0, -(A[0, 0] + A[1, 1]), A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]])
         nu = np.array([B1[0], B0[0] - A[1, 1] * B1[0] + A[0, 1] * B1[1],
                        A[0, 1] * B0[1] - A[1, 1] * B0[0]])
-        nv = np.array([B1[1], A[1, 0] * B1[0] + B0[1] - A[0, 0] * B1[1],
-                       A[1, 0] * B0[0] - A[0, 0] * B0[1]])
-        # initial filter states (transposed direct form II) that start the state at rest
-        # with x_0 possibly != 0: y_0 = 0 and y_1 = e^T (B0 x_0 + B1 x_1)
+        # initial filter state (transposed direct form II) that starts the state at rest
+        # with x_0 possibly != 0: u_0 = 0 and u_1 = B0[0] x_0 + B1[0] x_1
         zu = np.array([-nu[0] * x[0], (B0[0] - nu[1]) * x[0]])
-        zv = np.array([-nv[0] * x[0], (B0[1] - nv[1]) * x[0]])
         u = lfilter(nu, den, x, zi=zu)[0]
-        v = lfilter(nv, den, x, zi=zv)[0]
-        peak = max(float(np.max(np.abs(u))), _free_peak(float(u[-1]), float(v[-1]), w, zeta))
+        # the rate at the end only (for the free vibration after the record), from the
+        # recurrence's first row over the last step, then its second row: one filter
+        # instead of two (u' over the whole record is never needed)
+        if u.size > 1:
+            v_prev = (u[-1] - A[0, 0] * u[-2] - B0[0] * x[-2] - B1[0] * x[-1]) / A[0, 1]
+            v_end = A[1, 0] * u[-2] + A[1, 1] * v_prev + B0[1] * x[-2] + B1[1] * x[-1]
+        else:
+            v_end = 0.0
+        peak = max(float(np.max(np.abs(u))), _free_peak(float(u[-1]), float(v_end), w, zeta))
         out[j] = w * w * peak
     return out

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import hashlib
 import math
 
 import numpy as np
@@ -136,7 +135,9 @@ def test_bad_input_is_a_value_error(bad):
         im.sa(args["acc"], args["dt"], args["periods"], args["zeta"])
 
 
-def test_sha256_of_a_file(tmp_path):
-    p = tmp_path / "x.AT2"
-    p.write_bytes(b"abc")
-    assert im.sha256(p) == hashlib.sha256(b"abc").hexdigest()
+def test_a_records_digest_is_the_sha256_of_its_bytes():
+    from rocksweep.physics.records import digest
+
+    # FIPS 180-2's test vector for "abc"
+    assert digest(b"abc") == ("ba7816bf8f01cfea414140de5dae2223"
+                              "b00361a396177a9cb410ff61f20015ad")
