@@ -218,7 +218,7 @@ OMEGA_SPRING = 27.5
 # "Stiff springs near the uplift threshold"); Figure 3's body (6.8 p, zeta' omega' = 0.95
 # p), the block and the rigid bodies keep their steps, bit for bit.
 SPRING_DECAY = 0.1
-SPRING_DECAY_FREE = 0.01
+SPRING_DECAY_FREE = 0.002
 SPRING_DECAY_REL = 1.0 / 38.0
 
 

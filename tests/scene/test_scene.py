@@ -264,7 +264,7 @@ def _expected_steps(w: float, A: float, wn: float = 2.43, zeta: float = 0.05,
     ceil(horizon/dt)) + 200 x max_events, t_pulse = 2 pi/w; dt = the shorter of the spring's
     period over spp x max(1, (27.5/omega_rock)^(2/5)) (or, for a spring that oscillates
     while rocking, zeta' < 1, over the n at which RK4's leading-order damping of it,
-    omega_rock (2 pi/n)^5/144, is min(0.1, 0.01 + zeta' omega_rock/38) (5/spp)^5, if more)
+    omega_rock (2 pi/n)^5/144, is min(0.1, 0.002 + zeta' omega_rock/38) (5/spp)^5, if more)
     and the rocking's (2 pi) over spp;
     dt_on = dt, the pulse's period over max(ps, spp) and the amplitude's (2 pi/sqrt(|A| tan
     alpha_cg)) over spp, the shortest. Default: `default`'s finest refinement (3 doublings
@@ -274,7 +274,7 @@ def _expected_steps(w: float, A: float, wn: float = 2.43, zeta: float = 0.05,
     n_spring = spp * max(1.0, (27.5 / omega_rock) ** 0.4)
     zeta_rock = body.zeta * omega_rock / body.omega_n  # zeta sqrt(Gamma) if underdamped
     if zeta_rock < 1.0:
-        tol = min(0.1, 0.01 + zeta_rock * omega_rock / 38)
+        tol = min(0.1, 0.002 + zeta_rock * omega_rock / 38)
         n_damp = 2 * math.pi * (omega_rock / (144 * tol * (5 / spp) ** 5)) ** 0.2
         n_spring = max(n_spring, n_damp)
     dt = min(2 * math.pi / omega_rock / n_spring, 2 * math.pi / spp)
