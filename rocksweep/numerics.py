@@ -212,7 +212,8 @@ OMEGA_SPRING = 27.5
 # band unlike `fine`, the reference siding with `fine`): at 0.1 p Figure 4's body (3.8 p:
 # 0.1) 10/16 -> 2/3, stiffer damped bodies (wn/p = 20, 50) 6 -> 0 and 9 -> 3, and 0.05 or
 # 0.02 fix ~nothing more there; three undamped bodies kept 36-127 wrong cells before,
-# 19-95 at a flat 0.1 p, 4-26 at a floor of 0.01 p, 5-9 at 0.002 (docs/accuracy.md). Price: +15% RK4 evaluations on the four figures at `default`
+# 19-95 at a flat 0.1 p, 4-26 at a floor of 0.01 p, 5-9 at 0.002 (docs/accuracy.md).
+# Price: +15% RK4 evaluations on the four figures at `default`
 # (Figures 4(a)/(b) +23%/+22%, their spring's steps 1.43x; `fine` there +38%/+37%), 1.4-1.6x
 # on the stiffer damped bodies' band, 3.0-4.6x on the undamped ones' (docs/accuracy.md,
 # "Stiff springs near the uplift threshold"); Figure 3's body (6.8 p, zeta' omega' = 0.95
