@@ -138,8 +138,8 @@ def evals(a: dict) -> float:
 def point_of(sc, index: tuple):
     vals = {ax.name: ax.values[0] for ax in sc.axes}
     vals.update({ax.name: ax.values[k] for ax, k in zip(sc.swept, index, strict=True)})
-    return sc.point(vals), {ax.name: round(float(ax.values[k]), 4)
-                            for ax, k in zip(sc.swept, index, strict=True)}
+    return sc.point(vals), {ax.name: ax.values[k] for ax, k in zip(sc.swept, index,
+                                                                    strict=True)}
 
 
 def band(names: list[str], reference: bool, ref_max: int) -> None:
