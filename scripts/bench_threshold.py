@@ -26,6 +26,9 @@ spring period); ``after`` is ``numerics.spring_steps`` as it stands. Both run at
    `fine` (run with the rule `after`), and `fine`'s own RK4 evaluations per point under
    each rule (the bound scales with steps_per_period: `fine` pays the same factor).
 
+3. (--wide) configs/wide-space.yaml at `default`: RK4 evaluations per point before and
+   after, by zeta, CPU time per point, and how many outcomes changed.
+
 Kernels are compiled and warm before any clock starts; start-up (imports, warm-up) is
 printed apart from compute.
 """
@@ -215,6 +218,31 @@ def figures(rounds: int) -> None:
     print(f"four figures: RK4 evaluations after/before {tot['after'] / tot['before']:.3f}")
 
 
+def wide(rounds: int) -> None:
+    """configs/wide-space.yaml (48 384 points) at `default`: RK4 evaluations per point
+    before and after, by zeta, CPU time, and the outcomes that changed."""
+    sc = load_scene(ROOT / "configs" / "wide-space.yaml")
+    zi = [ax.name for ax in sc.swept].index("zeta")
+    zetas = sc.axis("zeta").values
+    print(f"\n3. configs/wide-space.yaml at `default` ({sc.size} points), CPU time best of "
+          f"{rounds}")
+    res, best = {}, {r: math.inf for r in RULES}
+    for _ in range(rounds):
+        for r in RULES:
+            with rule(r):
+                c0 = time.process_time()
+                res[r], _ = sweep_arrays(sc, jobs=1)
+                best[r] = min(best[r], time.process_time() - c0)
+    for r in RULES:
+        e = res[r]["steps"] + res[r]["event_steps"]
+        by = ", ".join(f"zeta {z:g}: {np.take(e, [k], axis=zi).mean():.0f}"
+                       for k, z in enumerate(zetas))
+        print(f"{r:>8} evals/pt {e.mean():.0f} ({by}); core-us/pt "
+              f"{1e6 * best[r] / sc.size:.1f}")
+    changed = int(np.sum(res["before"]["outcome"] != res["after"]["outcome"]))
+    print(f"outcomes changed: {changed} of {sc.size}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--bodies", nargs="*", default=list(BODIES))
@@ -224,6 +252,8 @@ def main() -> None:
                     help="differing cells per body and rule run through the reference "
                          "(a random sample, seed 0, if more)")
     ap.add_argument("--no-figures", dest="figures", action="store_false")
+    ap.add_argument("--wide", action="store_true",
+                    help="also configs/wide-space.yaml before and after (~1 min a round)")
     args = ap.parse_args()
     t_import = time.perf_counter() - T0
     t = time.perf_counter()
@@ -240,6 +270,8 @@ def main() -> None:
     band(args.bodies, args.reference, args.ref_max)
     if args.figures:
         figures(args.rounds)
+    if args.wide:
+        wide(1)
 
 
 if __name__ == "__main__":
