@@ -186,6 +186,19 @@ def band(names: list[str], reference: bool, ref_max: int) -> None:
                   f"{time.perf_counter() - t:>6.1f}", flush=True)
 
 
+def timed_rules(sc, rounds: int) -> tuple[dict, dict]:
+    """Each rule's sweep of ``sc`` on one worker, alternating, ``rounds`` times: (arrays,
+    best CPU seconds) per rule."""
+    res, best = {}, {r: math.inf for r in RULES}
+    for _ in range(rounds):
+        for r in RULES:
+            with rule(r):
+                c0 = time.process_time()
+                res[r], _ = sweep_arrays(sc, jobs=1)
+                best[r] = min(best[r], time.process_time() - c0)
+    return res, best
+
+
 def figures(rounds: int) -> None:
     print(f"\n2. the four figures at `default` (19 200 points each), CPU time best of {rounds}")
     print(f"{'scene':<7}{'rule':>8}{'differ':>7}{'evals/pt':>10}{'ratio':>7}{'core-us/pt':>11}"
@@ -199,14 +212,7 @@ def figures(rounds: int) -> None:
                 fine, _ = sweep_arrays(sc_fine, jobs=2)  # the last: `after`, compared with
             fine_evals[r] = evals(fine)
         sc = load_scene(ROOT / "configs" / f"{fig}.yaml")
-        best = {r: math.inf for r in RULES}
-        res = {}
-        for _ in range(rounds):
-            for r in RULES:
-                with rule(r):
-                    c0 = time.process_time()
-                    res[r], _ = sweep_arrays(sc, jobs=1)
-                    best[r] = min(best[r], time.process_time() - c0)
+        res, best = timed_rules(sc, rounds)
         n = sc.size
         for r in RULES:
             e = evals(res[r])
@@ -226,13 +232,7 @@ def wide(rounds: int) -> None:
     zetas = sc.axis("zeta").values
     print(f"\n3. configs/wide-space.yaml at `default` ({sc.size} points), CPU time best of "
           f"{rounds}")
-    res, best = {}, {r: math.inf for r in RULES}
-    for _ in range(rounds):
-        for r in RULES:
-            with rule(r):
-                c0 = time.process_time()
-                res[r], _ = sweep_arrays(sc, jobs=1)
-                best[r] = min(best[r], time.process_time() - c0)
+    res, best = timed_rules(sc, rounds)
     for r in RULES:
         e = res[r]["steps"] + res[r]["event_steps"]
         by = ", ".join(f"zeta {z:g}: {np.take(e, [k], axis=zi).mean():.0f}"

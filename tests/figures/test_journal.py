@@ -107,6 +107,8 @@ def test_every_analysis_figure_fits_the_journal_widths(analyses, width, tmp_path
 
 
 def _fits(fig, name, width):
+    """At a journal width: nothing drawn outside the figure, every axes of a readable
+    height (the figure grew rather than squash it), titles no larger than the labels."""
     inches, _ = WIDTHS[width]
     assert fig.get_figwidth() == pytest.approx(inches), name
     canvas = FigureCanvasAgg(fig)
@@ -120,34 +122,21 @@ def _fits(fig, name, width):
         assert (bb.x0 >= box.x0 - 1e-6 and bb.x1 <= box.x1 + 1e-6
                 and bb.y0 >= box.y0 - 1e-6 and bb.y1 <= box.y1 + 1e-6), \
             f"{name} at {width}: {type(a).__name__} at {bb.extents} outside {box.extents}"
+    for ax in fig.axes:
+        if ax.get_visible():
+            assert ax.get_position().height * fig.get_figheight() > 0.3, name
+    labels = [t.get_fontsize() for ax in fig.axes
+              for t in (ax.xaxis.label, ax.yaxis.label) if t.get_text()]
+    titles = [ax.title for ax in fig.axes] + [fig._suptitle]
+    for t in titles:
+        if t is not None and t.get_text():
+            assert t.get_fontsize() <= max(labels), (name, t.get_text())
 
 
 @pytest.mark.parametrize("width", list(WIDTHS))
 def test_journal_widths_clip_nothing_and_titles_are_no_larger_than_labels(laws, width):
-    inches, _ = WIDTHS[width]
     for name, fig in _journal(laws, width):
-        assert fig.get_figwidth() == pytest.approx(inches), name
-        canvas = FigureCanvasAgg(fig)
-        canvas.draw()
-        r = canvas.get_renderer()
-        box = fig.bbox
-        for a in [fig._suptitle, *fig.legends, *fig.axes]:
-            if a is None or not a.get_visible():
-                continue
-            bb = a.get_tightbbox(r)
-            assert (bb.x0 >= box.x0 - 1e-6 and bb.x1 <= box.x1 + 1e-6
-                    and bb.y0 >= box.y0 - 1e-6 and bb.y1 <= box.y1 + 1e-6), \
-                f"{name} at {width}: {type(a).__name__} at {bb.extents} outside {box.extents}"
-        # every axes keeps a readable height (the figure grew rather than squash it)
-        for ax in fig.axes:
-            if ax.get_visible():
-                assert ax.get_position().height * fig.get_figheight() > 0.3, name
-        labels = [t.get_fontsize() for ax in fig.axes
-                  for t in (ax.xaxis.label, ax.yaxis.label) if t.get_text()]
-        titles = [ax.title for ax in fig.axes] + [fig._suptitle]
-        for t in titles:
-            if t is not None and t.get_text():
-                assert t.get_fontsize() <= max(labels), (name, t.get_text())
+        _fits(fig, name, width)
 
 
 def _journal(ds, width):
