@@ -209,7 +209,7 @@ def run_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, w_over_p: np.ndarray
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
         dt, dt_on = step_sizes(omega_rock, omega, numerics.steps_per_period,
                                numerics.pulse_steps, amplitude_frequency(A_ratio, alpha_ref),
-                               zeta_rock)
+                               zeta_rock, A_ratio)
         t_pulse = np.where(omega == 0.0, 0.0, phase / omega)
         t_end = t_pulse + numerics.horizon
         max_steps = step_budget(t_pulse, t_end, dt, dt_on, numerics)
