@@ -26,6 +26,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
 import h5py
 import numpy as np
 

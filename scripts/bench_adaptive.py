@@ -34,6 +34,7 @@ import os
 import time
 from pathlib import Path
 
+import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
 import numpy as np
 
 from rocksweep.compute import adaptive as ad

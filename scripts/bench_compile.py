@@ -57,11 +57,8 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-# this checkout's package, not an installed one (``pip install -e`` of another checkout is
-# found after sys.path), unless PYTHONPATH names another copy: its entries stay first
-sys.path.insert(1 + len([p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]),
-                str(ROOT))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import _here  # noqa: E402, F401 (this checkout's rocksweep, not an installed one)
 import bench_kernel as bk  # noqa: E402  (scripts/bench_kernel.py: best_pass, scene_of)
 
 import rocksweep  # noqa: E402

@@ -33,6 +33,7 @@ from __future__ import annotations
 import argparse
 import time
 
+import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
 import numpy as np
 
 from rocksweep.compute.single import history_capacity, simulate

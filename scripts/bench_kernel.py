@@ -60,6 +60,7 @@ import threading
 import time
 from pathlib import Path
 
+import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
 import numpy as np
 from numba import njit
 

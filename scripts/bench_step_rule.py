@@ -36,6 +36,7 @@ import os
 import time
 from pathlib import Path
 
+import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
 import numpy as np
 
 from rocksweep.compute.grid import Grid

@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import math
 
+import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
 import numpy as np
 
 from rocksweep.compute.grid import Grid

@@ -41,6 +41,7 @@ import math
 import time
 from pathlib import Path
 
+import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
 import numpy as np
 
 from rocksweep.analysis.accuracy import estimate_scores, format_scores
