@@ -863,12 +863,13 @@ def boundary_lines_frame(ds: Any):
 
 
 def check_search(search: Any) -> bool:
-    """The ``search`` argument of ``a_min``'s callers: True or False, else an ApiError."""
+    """The ``search`` argument of ``a_min``'s callers: True or False (numpy's too), else an
+    ApiError."""
     from rocksweep.errors import ApiError
 
-    if not isinstance(search, bool):
+    if not (isinstance(search, bool) or type(search).__name__ == "bool_"):
         raise ApiError(f"search = {search!r}: must be True or False")
-    return search
+    return bool(search)
 
 
 def boundaries_dataset(ds: Any, rtol: float = DEFAULT_RTOL, mode: int | None = None,
@@ -883,7 +884,7 @@ def boundaries_dataset(ds: Any, rtol: float = DEFAULT_RTOL, mode: int | None = N
     rtol = check_rtol(rtol)
     if mode not in (None, 1, 2):
         raise ApiError(f"mode = {mode!r}: must be None, 1 or 2")
-    check_search(search)
+    search = check_search(search)
     result = as_result(ds, list(RESPONSE))
     curves, _ = result_curves(result, rtol, mode, search=search)
     return curves_dataset(curves, {"rocksweep_kind": "boundaries", "kind": result.kind,

@@ -110,7 +110,7 @@ def spectra(data, rtol: float = DEFAULT_RTOL, search: bool = True) -> Spectra:
     from rocksweep.store.reader import as_result, result_scene
 
     rtol = check_rtol(rtol)
-    check_search(search)
+    search = check_search(search)
     result = as_result(data, [*RESPONSE, "status"])
     freq = "p" if "p" in result.dims else "w_over_p"
     missing = [d for d in (freq, "A_ratio") if d not in result.dims]
