@@ -209,11 +209,6 @@ _OUTSIDE = {"lower": "outside lower center", "upper": "outside upper center",
 # Figure 5: time histories
 # ---------------------------------------------------------------------------------------
 
-def _alpha_symbol(run: Run) -> str:
-    """The slenderness that normalises theta and A: alpha_cg (flexible body), alpha (block)."""
-    return r"\alpha" if getattr(run.point.body, "kind", "flexible") == "block" else r"\alpha_{cg}"
-
-
 def _label(run: Run, swept: Sequence[str]) -> str:
     p = run.point
     kind = getattr(p.body, "kind", "flexible")
@@ -249,7 +244,7 @@ def time_history(runs: Sequence[Run], swept: Sequence[str] = (), title: str = ""
         if run.history is None:
             raise FigureError("time history: a run without a history (simulate with "
                               "history=True)")
-    alpha = _alpha_symbol(runs[0])
+    alpha = _axes.alpha_latex(getattr(runs[0].point.body, "kind", "flexible"))
     # one input line when every run has the same pulse shape and frequency (xg''/A is then
     # the same curve), else one per run in the run's colour
     pulses = {(r.point.shape, r.point.w_over_p, r.point.p) for r in runs}

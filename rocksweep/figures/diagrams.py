@@ -71,10 +71,6 @@ MAX_PANELS = 36
 DEFAULT_X, DEFAULT_Y = DIAGRAM_AXES  # symbols, units: rocksweep.vocab.axes
 
 
-def _alpha(kind: str) -> str:
-    """LaTeX of the body kind's alpha_ref (alpha_cg, alpha)."""
-    return _axes.alpha_latex(kind)
-
 _SAFE, _MODE2, _NOT_RUN = "#ffffff", "#4c72b0", "#bdbdbd"
 _UNSURE = "#e69f00"  # rings: the outcome changes at half the step (outputs.check)
 # boundary lines of the k-th lam (``curves``): dark colours apart from the cells' fills
@@ -708,7 +704,7 @@ def line_diagram(result: SweepResult, x: str | None = None, *,
     import matplotlib
 
     cmap = matplotlib.colormaps["viridis"]
-    alpha = _alpha(result.kind)
+    alpha = _axes.alpha_latex(result.kind)
     used: set[int] = set()
     for ax, idx in zip(flat, panels, strict=False):
         po, pv = o[idx], v[idx]  # [n_lam, n_x]
