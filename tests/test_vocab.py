@@ -32,6 +32,7 @@ FAMILIES: dict[str, tuple[str, ...]] = {
     "accuracy presets": settings.PRESET_NAMES,
     "accuracy ladders": settings.LADDER_NAMES,
     "alpha_ref keys": axes.ALPHA_KEYS,
+    "alpha_ref LaTeX": tuple(tex for _, tex in axes.ALPHA_REF.values()),
 }
 # Concepts whose values (not names) live elsewhere, keyed by the vocabulary's names: the
 # one dict literal allowed, checked to hold exactly the vocabulary's names below.
