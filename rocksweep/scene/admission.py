@@ -181,7 +181,9 @@ def _check_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
 
     The cap grows with the run's length t_pulse + horizon and with 1/step; over the pulse
     axes it is largest at an end of each (the step follows max(omega, rates of the body and
-    of |A|), the length 2 pi/omega: (2 pi/w + H) max(X, w) falls then rises in w).
+    of |A|), the length 2 pi/omega: (2 pi/w + H) max(X, w) falls then rises in w); along
+    A_ratio also at the smallest |A| above 1, where a rigid body's pulse steps are most
+    (``numerics.threshold_factor``).
     """
     if scene.record is not None:
         _check_record_cost(scene, bodies)
@@ -191,7 +193,9 @@ def _check_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
         return
     w = np.asarray(scene.axis("w_over_p").values)
     A = np.asarray(scene.axis("A_ratio").values)
-    w, A = np.array([w.min(), w.max()]), np.array([A.min(), A.max()])
+    above = np.abs(A)[np.abs(A) > 1.0]
+    w = np.array([w.min(), w.max()])
+    A = np.array([A.min(), A.max(), *([above.min()] if above.size else [])])
     caps = np.max([_budgets(scene, bodies, w, A, n) for n, _ in _runs(scene)], axis=0)
     worst = int(np.argmax(caps))
     if caps.flat[worst] <= MAX_POINT_STEPS:

@@ -45,3 +45,26 @@ def test_a_block_just_above_its_threshold_is_classed_as_the_reference_classes_it
     ours = int(sweep_arrays(sc)[0]["outcome"].ravel()[0])
     point = sc.point({a.name: a.values[0] for a in sc.axes})
     assert ours == reference_run(point, sc.numerics, rtol=1e-10, atol=1e-12)["outcome"]
+
+
+def test_the_cost_check_sees_the_threshold_factor(monkeypatch):
+    """The admission's step cap (largest at the grid's corners, except along A_ratio just
+    above 1, where a rigid body's pulse takes the most steps): a cap between the corners'
+    and the near-threshold point's refuses the scene at that point."""
+    from rocksweep.numerics import Numerics
+    from rocksweep.physics.points import run_cost
+    from rocksweep.scene import admission
+    from rocksweep.scene.model import SceneError
+
+    grid = ["pulse.shape=sine", "pulse.w_over_p=6.0", "pulse.A_ratio=[0.5, 1.02, 8.0]"]
+    num = Numerics()
+
+    def cap(a):
+        return float(run_cost(np.array([0.0]), np.array([0.2618]), np.array([6.0]),
+                              np.array([a]), num)[4][0])
+
+    assert cap(1.02) > max(cap(0.5), cap(8.0))
+    monkeypatch.setattr(admission, "MAX_POINT_STEPS", 0.5 * (cap(1.02) + max(cap(0.5),
+                                                                          cap(8.0))))
+    with pytest.raises(SceneError, match="1.02"):
+        load_scene(ROOT / "configs" / "block.yaml", grid)
