@@ -1,8 +1,8 @@
 """The Python API, a thin facade: run a scene's grid, open a result, simulate one point,
 and the analyses of a Dataset. Each function hands over to the room that does the work
 and checks its arguments: scenes (``rocksweep.scene.inputs``), the sweep session
-(``rocksweep.store.session``), a result as a Dataset (``rocksweep.store.dataset``), a
-run's history (``rocksweep.store.history``), the analyses (``rocksweep.analysis``), the
+(``rocksweep.compute.session``), a result as a Dataset (``rocksweep.store.dataset``), a
+run's history (``rocksweep.compute.history``), the analyses (``rocksweep.analysis``), the
 figures (``rocksweep.figures``), ``ds.rocksweep`` (``rocksweep.accessor``). Errors speak
 Python (``rocksweep.errors.speaks_python``).
 
@@ -31,10 +31,10 @@ if TYPE_CHECKING:
 _MOVED = {name: module for module, names in {
     "rocksweep.compute.driver": ("WRITE_EVERY", "SweepInterrupted", "SweepReport"),
     "rocksweep.scene.inputs": ("load", "override_strings"),
-    "rocksweep.store.history": ("MAX_RUNS", "API_MAX_RUNS", "simulate_runs",
+    "rocksweep.compute.history": ("MAX_RUNS", "API_MAX_RUNS", "simulate_runs",
                                 "history_dataset", "swept_values", "write_history_csv"),
     "rocksweep.compute.adaptive": ("adaptive_options",),
-    "rocksweep.store.session": ("sweep_file",),
+    "rocksweep.compute.session": ("sweep_file",),
     "rocksweep.store.dataset": ("result_dataset",),
     "rocksweep.accessor": ("RocksweepAccessor",),
 }.items() for name in names}
@@ -91,7 +91,7 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
     ``output``. A wrong type (``jobs="2"``, ``overrides=5``) is a TypeError naming the
     argument; every argument is checked before the output is touched.
     """
-    from rocksweep.store.session import run_session  # checks every argument first
+    from rocksweep.compute.session import run_session  # checks every argument first
 
     out = run_session(scene, output, overrides=overrides, jobs=jobs, resume=resume,
                       overwrite=overwrite, progress=progress, client=client,
@@ -348,10 +348,10 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     ``default`` if it names none, as a sweep's (one point, one answer). Returns a ``Simulation``
     (summary dict, history Dataset over p*t, and ``.figure()``); a scene with lists gives
     one ``Simulation`` per combination, in grid order (at most
-    ``rocksweep.store.history.API_MAX_RUNS``, 100; sweeps are for ``run``).
+    ``rocksweep.compute.history.API_MAX_RUNS``, 100; sweeps are for ``run``).
     """
+    from rocksweep.compute.history import API_MAX_RUNS, titled_runs
     from rocksweep.scene.inputs import load, override_strings
-    from rocksweep.store.history import API_MAX_RUNS, titled_runs
 
     sc, _ = load(scene, [*override_strings(overrides), *override_strings(keys)])
     out = [Simulation(r.summary(), hist, r, title)
