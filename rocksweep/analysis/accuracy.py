@@ -783,7 +783,8 @@ def format_table(study: Study) -> str:
     return "\n".join(lines)
 
 
-def write_report(study: Study, path: str | Path, command: str = "") -> None:
+def write_report(study: Study, path: str | Path, command: str = "", *,
+                 overwrite: bool = False) -> None:
     """Write the study to HDF5, atomically (a temporary file renamed at the end).
 
     Layout: attrs (scene name and YAML, sample description, reference tolerances, command,
@@ -802,7 +803,7 @@ def write_report(study: Study, path: str | Path, command: str = "") -> None:
     from rocksweep.outputs import atomic_path
     from rocksweep.physics.reference import ATOL, RTOL
 
-    with atomic_path(path) as tmp:
+    with atomic_path(path, overwrite=overwrite) as tmp:
         with h5py.File(tmp, "w") as f:
             f.attrs["format"] = "rocksweep-accuracy-1"
             f.attrs["scene_name"] = study.scene.name

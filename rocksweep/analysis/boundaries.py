@@ -647,7 +647,8 @@ def write_curves_h5(path: str | Path, curves: Sequence[AMinCurve],
                     bounds: Sequence[PanelBoundaries], attrs: dict[str, Any] | None = None
                     ) -> None:
     """Write A_min curves and boundary lines to a new HDF5 file at ``path`` (meant for the
-    temporary path of ``rocksweep.outputs.write_atomic``; an existing file is replaced).
+    temporary path of ``rocksweep.outputs.write_atomic``; an existing file at ``path`` is
+    truncated).
 
     Layout (h5py; every ``a_min`` panel group also opens with
     ``xarray.open_dataset(path, group="a_min/panel_0", engine="h5netcdf")``):

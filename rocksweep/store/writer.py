@@ -29,7 +29,7 @@ from rocksweep.compute.sweep import ChunkResult
 from rocksweep.errors import OutputError, RocksweepError
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.outputs import check_output, is_input, shown
+from rocksweep.outputs import check_output, clean_stale_partials, is_input, partial_prefix, shown
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import (
     _H5_ERRORS,
@@ -66,8 +66,6 @@ from rocksweep.store.safety import (
     _reserve,
     _reserve_bytes,
     _space_needed,
-    clean_stale_partials,
-    partial_prefix,
 )
 
 if TYPE_CHECKING:

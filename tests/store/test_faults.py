@@ -586,8 +586,8 @@ def test_two_sweeps_started_at_the_same_instant(tmp_path, overwrite):
         msg = next(e for e in errors if e)
         assert msg in (
             f"{path}: already exists; use --resume to finish it or --overwrite to replace it",
-            f"{path}: made by another process meanwhile (a sweep started at the same time?);"
-            " not overwritten",
+            f"{path}: made by another process meanwhile (the same command started at the "
+            "same time?); not overwritten",
             f"{path}: open for writing by another process (a sweep still running?); not "
             "overwritten",
             f"{path}: replaced by another process meanwhile; not overwritten"), (k, msg)
