@@ -371,5 +371,6 @@ def write_at2(path: str | Path, acc: Iterable[float], dt: float, title: str, *,
     existing path without ``overwrite``; atomic)."""
     path = check_output(path, overwrite=overwrite)
     text = at2_text(acc, dt, title)
-    write_atomic(path, lambda tmp: tmp.write_bytes(text.encode("ascii")))
+    write_atomic(path, lambda tmp: tmp.write_bytes(text.encode("ascii")),
+                 overwrite=overwrite)
     return path
