@@ -54,6 +54,8 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.errors import RiskError, RocksweepError  # noqa: F401 (re-exported)
+from rocksweep.inputs import check_columns, csv_table, number, number_column, read_text
+from rocksweep.outputs import shown
 from rocksweep.physics.model import G
 from rocksweep.vocab.ground import PGA, PGV, SA
 
@@ -64,6 +66,8 @@ SUB = 8  # pieces per hazard segment, 2 Gauss-Legendre nodes each
 TAIL_SHARE = 0.01  # above_hazard when the unknown tail exceeds this share of the rate
 LOW_P = 1e-3  # below_hazard when the fragility at the hazard's smallest IM exceeds this
 PLOT_POINTS = 200  # the figure's grid over the hazard's range
+MAX_HAZARD_BYTES = 200 << 20  # [bytes] largest hazard file read (~4 million levels of CSV)
+MAX_LEVELS = 1_000_000  # hazard levels of one curve (the integral's memory: docs/faults.md)
 RATE_COLUMN = "annual_rate"
 #: OpenQuake's IMT units, and the factor to rocksweep's
 OQ_UNITS = {PGA: ("g", 1.0), SA.upper(): ("g", 1.0), PGV: ("m/s", 0.01)}
@@ -110,114 +114,150 @@ def _im_name(text: str) -> str:
 
 
 def _checked(im: np.ndarray, rate: np.ndarray, name: str, unit: str, period: float,
-             where: str) -> Hazard:
-    """The one validation of a hazard curve (bad input: one line naming it)."""
+             where: str, rows: list[str]) -> Hazard:
+    """The one validation of a hazard curve (bad input: one line naming it and the row,
+    ``rows[i]``: the file and line of level i)."""
     if im.size < 2:
         raise RiskError(f"{where}: {im.size} hazard level{'s' * (im.size != 1)}; a hazard "
                         "curve needs at least 2 (IM, annual rate) rows")
-    for what, v in (("IM", im), (RATE_COLUMN, rate)):
-        bad = ~np.isfinite(v)
-        if bad.any():
-            raise RiskError(f"{where}: row {int(np.argmax(bad)) + 1}: {what} = "
-                            f"{v[bad][0]!r}: must be a finite number")
+    if im.size > MAX_LEVELS:
+        raise RiskError(f"{where}: {im.size:,} hazard levels; at most {MAX_LEVELS:,} (a "
+                        "hazard curve is smooth: thin it)")
     if np.any(im <= 0.0):
         i = int(np.argmax(im <= 0.0))
-        raise RiskError(f"{where}: row {i + 1}: IM = {im[i]!r}: must be > 0")
+        raise RiskError(f"{rows[i]}: IM = {float(im[i])!r}: must be > 0")
     if np.any(rate < 0.0):
         i = int(np.argmax(rate < 0.0))
-        raise RiskError(f"{where}: row {i + 1}: {RATE_COLUMN} = {rate[i]!r}: must be >= 0 "
+        raise RiskError(f"{rows[i]}: {RATE_COLUMN} = {float(rate[i])!r}: must be >= 0 "
                         "(an annual rate of exceedance)")
     if np.any(np.diff(im) <= 0.0):
         i = int(np.argmax(np.diff(im) <= 0.0)) + 1
-        raise RiskError(f"{where}: row {i + 1}: IM = {im[i]!r} after {im[i - 1]!r}: the IM "
+        raise RiskError(f"{rows[i]}: IM = {float(im[i])!r} after {float(im[i - 1])!r}: the IM "
                         "levels must increase")
     if np.any(np.diff(rate) > 0.0):
         i = int(np.argmax(np.diff(rate) > 0.0)) + 1
-        raise RiskError(f"{where}: row {i + 1}: {RATE_COLUMN} = {rate[i]!r} after "
-                        f"{rate[i - 1]!r}: the rates of exceedance must not increase with "
+        raise RiskError(f"{rows[i]}: {RATE_COLUMN} = {float(rate[i])!r} after "
+                        f"{float(rate[i - 1])!r}: the rates of exceedance must not increase with "
                         "the IM")
     if not rate[0] > 0.0:
         raise RiskError(f"{where}: every {RATE_COLUMN} is 0: no hazard")
     return Hazard(im, rate, name, unit, period, where)
 
 
-def hazard_frame(df: Any, where: str = "hazard") -> Hazard:
-    """A hazard curve from a two-column pandas DataFrame: ``IM [unit]`` (e.g. ``PGA [g]``,
-    ``Sa(1.0) [g]``) and ``annual_rate`` [1/yr], one row per IM level."""
-    cols = [str(c) for c in df.columns]
+def _two_columns(cols: list[str], im_vals: Any, rate_vals: Any, rows: list[str],
+                 where: str) -> Hazard:
+    """A hazard curve from its header ``IM [unit]``, ``annual_rate`` and the two columns'
+    values (``rows[i]`` names row i in messages)."""
     if len(cols) != 2:
         raise RiskError(f"{where}: {len(cols)} columns ({', '.join(cols)}); a hazard curve "
                         f"has 2: 'IM [unit]' and '{RATE_COLUMN}' (e.g. 'PGA [g],"
                         f"{RATE_COLUMN}')")
     m = _HEADER.match(cols[0])
-    if m is None:
+    period = _positive(m["T"]) if m is not None and m["T"] else math.nan
+    if m is None or (m["T"] and math.isnan(period)):
         raise RiskError(f"{where}: first column {cols[0]!r}: must name the IM and its unit, "
                         "e.g. 'PGA [g]', 'PGV [m/s]' or 'Sa(1.0) [g]'")
-    if cols[1].strip() != RATE_COLUMN:
+    if cols[1] != RATE_COLUMN:
         raise RiskError(f"{where}: second column {cols[1]!r}: must be '{RATE_COLUMN}' (mean "
                         "annual rate of exceedance [1/yr])")
-    try:
-        im = np.asarray(df.iloc[:, 0], dtype=np.float64)
-        rate = np.asarray(df.iloc[:, 1], dtype=np.float64)
-    except (TypeError, ValueError) as err:
-        raise RiskError(f"{where}: a value is not a number ({err})") from None
-    period = float(m["T"]) if m["T"] else math.nan
-    return _checked(im, rate, _im_name(m["im"]), m["unit"].strip(), period, where)
+    im = number_column(im_vals, rows, "IM", RiskError)
+    rate = number_column(rate_vals, rows, RATE_COLUMN, RiskError)
+    return _checked(im, rate, _im_name(m["im"]), m["unit"].strip(), period, where, rows)
 
 
-def _openquake(lines: list[str], where: str, site: int | None) -> Hazard:
+def hazard_frame(df: Any, where: str = "hazard") -> Hazard:
+    """A hazard curve from a two-column pandas DataFrame: ``IM [unit]`` (e.g. ``PGA [g]``,
+    ``Sa(1.0) [g]``) and ``annual_rate`` [1/yr], one row per IM level."""
+    cols = check_columns(list(df.columns), where, RiskError)
+    if len(cols) != 2:
+        return _two_columns(cols, [], [], [], where)  # its one-line refusal
+    rows = [f"{where}: row {i + 1}" for i in range(len(df))]
+    return _two_columns(cols, df.iloc[:, 0].to_numpy(), df.iloc[:, 1].to_numpy(), rows,
+                        where)
+
+
+_NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+
+
+def _positive(text: str) -> float:
+    """A number > 0 written plainly (``50.0``, ``1e-1``), else NaN (``50.0.1``, ``e``)."""
+    t = text.strip()
+    if not re.fullmatch(_NUM, t):
+        return math.nan
+    x = float(t)
+    return x if math.isfinite(x) and x > 0.0 else math.nan
+
+
+def _openquake(text: str, where: str, site: int | None) -> Hazard:
     """OpenQuake's hazard-curve CSV (module docstring) -> Hazard in rates."""
-    import csv
-
-    meta = lines[0]
-    t = re.search(r"investigation_time\s*=\s*'?([0-9.eE+-]+)", meta)
-    imt = re.search(r"imt\s*=\s*['\"]([^'\"]+)['\"]", meta)  # 'PGA' (3.x), "PGA" (2.x)
+    head_line, _, rest = text.partition("\n")
+    meta = head_line.strip()
+    t = re.search(r"investigation_time\s*=\s*'?([^,'\"\s]*)", meta)
+    imt = re.search(r"imt\s*=\s*['\"]([^'\"]*)['\"]", meta)  # 'PGA' (3.x), "PGA" (2.x)
     if t is None or imt is None:
-        raise RiskError(f"{where}: OpenQuake header without investigation_time and imt: "
-                        f"{meta[:80]!r}")
-    T = float(t.group(1))
-    if not (math.isfinite(T) and T > 0.0):
-        raise RiskError(f"{where}: investigation_time = {t.group(1)}: must be > 0 years")
-    mi = re.match(r"^\s*([A-Za-z]+)\s*(?:\(\s*([0-9.eE+-]+)\s*\))?\s*$", imt.group(1))
-    if mi is None or mi.group(1).upper() not in OQ_UNITS:
-        raise RiskError(f"{where}: imt = {imt.group(1)!r}: rocksweep reads PGA, PGV and SA(T)")
+        raise RiskError(f"{where}, line 1: OpenQuake header without investigation_time and "
+                        f"imt: {meta[:80]!r}")
+    T = _positive(t.group(1))
+    if math.isnan(T):
+        raise RiskError(f"{where}, line 1: investigation_time = {t.group(1)!r}: must be a "
+                        "number of years > 0")
+    mi = re.fullmatch(r"\s*([A-Za-z]+)\s*(?:\(\s*([^)]*?)\s*\))?\s*", imt.group(1))
+    if mi is None or mi.group(1).upper() not in OQ_UNITS or (
+            mi.group(2) is not None and math.isnan(_positive(mi.group(2)))):
+        raise RiskError(f"{where}, line 1: imt = {imt.group(1)!r}: rocksweep reads PGA, PGV "
+                        "and SA(T), T a period > 0 [s]")
     unit, factor = OQ_UNITS[mi.group(1).upper()]
-    rows = list(csv.reader(lines[1:]))
-    head = [h.strip() for h in rows[0]]
-    levels = [h for h in head if h.startswith("poe-")]
+    # the table starts on line 2: its line numbers are the file's minus one
+    table = csv_table(rest, where, RiskError, "hazard curve")
+    lines = [ln + 1 for ln in table.lines]
+    levels = [h for h in table.columns if h.startswith("poe-")]
     if not levels:
-        raise RiskError(f"{where}: no poe-<level> columns in {','.join(head)[:80]!r}")
-    data = [r for r in rows[1:] if any(c.strip() for c in r)]
-    if not data:
+        raise RiskError(f"{where}: no poe-<level> columns in "
+                        f"{','.join(table.columns)[:80]!r}")
+    if not table.rows:
         raise RiskError(f"{where}: no site rows")
-    if site is None and len(data) > 1:
-        raise RiskError(f"{where}: {len(data)} sites; choose one with site= (0 to "
-                        f"{len(data) - 1}, the row order; --site on the command line)")
-    k = 0 if site is None else int(site)
-    if not 0 <= k < len(data):
-        raise RiskError(f"{where}: site = {site!r}: the file has sites 0 to {len(data) - 1}")
-    row = dict(zip(head, data[k], strict=False))
-    try:
-        x = np.array([float(h[4:]) for h in levels]) * factor
-        poe = np.array([float(row[h]) for h in levels])
-    except (ValueError, KeyError) as err:
-        raise RiskError(f"{where}: site {k}: a value is not a number ({err})") from None
-    if np.any(~np.isfinite(poe) | (poe < 0.0) | (poe > 1.0)):
-        bad = poe[~np.isfinite(poe) | (poe < 0.0) | (poe > 1.0)][0]
-        raise RiskError(f"{where}: site {k}: poe = {bad!r}: a probability in [0, 1]")
+    if site is None and len(table.rows) > 1:
+        raise RiskError(f"{where}: {len(table.rows)} sites; choose one with site= (0 to "
+                        f"{len(table.rows) - 1}, the row order; --site on the command line)")
+    k = 0 if site is None else site
+    if not 0 <= k < len(table.rows):
+        raise RiskError(f"{where}: site = {site!r}: the file has sites 0 to "
+                        f"{len(table.rows) - 1}")
+    row = dict(zip(table.columns, table.rows[k], strict=True))
+    at = f"{where}, line {lines[k]}"
+    x = np.array([number(h[4:], f"{where}, line 2", "level", RiskError)
+                  for h in levels]) * factor
+    poe = np.array([number(row[h], at, h, RiskError) for h in levels])
+    names = [f"{at}, {h}" for h in levels]
+    bad = (poe < 0.0) | (poe > 1.0)
+    if bad.any():
+        raise RiskError(f"{names[int(np.argmax(bad))]}: poe = {float(poe[bad][0])!r}: a "
+                        "probability in [0, 1]")
+    # every level is checked, poe = 1 too, before those are left out: a poe that rises
+    # with the IM is refused wherever it rises
+    if np.any(np.diff(x) <= 0.0):
+        i = int(np.argmax(np.diff(x) <= 0.0)) + 1
+        raise RiskError(f"{where}, line 2: level {levels[i]} after {levels[i - 1]}: the IM "
+                        "levels must increase")
+    if np.any(np.diff(poe) > 0.0):
+        i = int(np.argmax(np.diff(poe) > 0.0)) + 1
+        raise RiskError(f"{names[i]}: poe = {float(poe[i])!r} after {float(poe[i - 1])!r}: the "
+                        "probabilities of exceedance must not increase with the IM")
     keep = poe < 1.0  # poe = 1: the rate has no bound there
-    with np.errstate(divide="ignore"):
-        rate = -np.log1p(-poe[keep]) / T
+    rate = -np.log1p(-poe[keep]) / T
     name = _im_name(mi.group(1))
-    period = float(mi.group(2)) if mi.group(2) else math.nan
-    return _checked(x[keep], rate, name, unit, period, where)
+    period = _positive(mi.group(2)) if mi.group(2) else math.nan
+    return _checked(x[keep], rate, name, unit, period, where,
+                    [n for n, kept in zip(names, keep, strict=True) if kept])
 
 
 def read_hazard(source: Any, *, site: int | None = None) -> Hazard:
     """A hazard curve from a path (a two-column CSV ``IM [unit],annual_rate`` or
     OpenQuake's hazard-curve CSV, told apart by its ``#`` first line), a pandas DataFrame
     of the two columns, or a ``Hazard``. site: the row of an OpenQuake file with several
-    sites. Bad input is a one-line ``RiskError`` naming the file, the row and the value."""
+    sites. Bad input is a one-line ``RiskError`` naming the file, the line and the value
+    (the file read through ``rocksweep.inputs``: a regular UTF-8 file of at most
+    ``MAX_HAZARD_BYTES``, comma-separated)."""
     if isinstance(source, Hazard):
         return source
     if hasattr(source, "columns") and hasattr(source, "iloc"):
@@ -226,37 +266,21 @@ def read_hazard(source: Any, *, site: int | None = None) -> Hazard:
         raise RiskError(f"hazard = {type(source).__name__}: a CSV path or a pandas DataFrame "
                         f"('IM [unit]', '{RATE_COLUMN}')")
     path = Path(source)
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as err:
-        raise RiskError(f"{path}: cannot read the hazard curve "
-                        f"({getattr(err, 'strerror', None) or type(err).__name__})") from None
+    where = shown(path)
+    text = read_text(path, "hazard curve", RiskError, max_bytes=MAX_HAZARD_BYTES)
     lines = [ln for ln in text.splitlines() if ln.strip()]
     if not lines:
-        raise RiskError(f"{path}: empty hazard file")
+        raise RiskError(f"{where}: empty hazard file")
     if lines[0].lstrip().startswith("#") and any(
             ln.replace(" ", "").startswith("lon,lat") for ln in lines[1:3]):
-        return _openquake(lines, str(path), site)
-    lines = [ln for ln in lines if not ln.lstrip().startswith("#")]  # comments
-    if not lines:
-        raise RiskError(f"{path}: no header 'IM [unit],{RATE_COLUMN}'")
-    import csv
-
-    rows = list(csv.reader(lines))
-    head, body = rows[0], rows[1:]
-    if any(len(r) != len(head) for r in body):
-        i = next(i for i, r in enumerate(body) if len(r) != len(head))
-        raise RiskError(f"{path}: row {i + 1}: {len(body[i])} values, the header has "
-                        f"{len(head)}")
-    import pandas as pd
-
-    try:
-        df = pd.DataFrame([[float(c) for c in r] for r in body], columns=head)
-    except ValueError as err:
-        raise RiskError(f"{path}: a value is not a number ({err})") from None
-    if not body:
-        df = pd.DataFrame(columns=head)
-    return hazard_frame(df, str(path))
+        return _openquake(text.lstrip("\n\r \t"), where, site)
+    table = csv_table(text, where, RiskError, "hazard curve",
+                      expect=f"'IM [unit],{RATE_COLUMN}'")
+    rows = [f"{where}, line {ln}" for ln in table.lines]
+    if len(table.columns) != 2:
+        return _two_columns(table.columns, [], [], [], where)  # its one-line refusal
+    return _two_columns(table.columns, table.column(table.columns[0]),
+                        table.column(table.columns[1]), rows, where)
 
 
 # ---------------------------------------------------------------------------------------
