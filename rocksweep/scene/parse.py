@@ -141,6 +141,9 @@ def _section(raw: dict, name: str, kind: str, required: bool) -> dict:
         if not (isinstance(kind, str) and kind in BODY_KEYS):
             raise SceneError(f"body.kind = {fmt(kind)}: {KEYS['body.kind'].allowed}")
     allowed = section_keys(name, kind)
+    if sec is None and name in raw:  # ``pulse:`` or ``pulse: null`` is no absent section
+        raise SceneError(f"{name} = null: must be a mapping with keys {', '.join(allowed)}, "
+                         "or leave the section out")
     if sec is None:
         if required:
             needed = ", ".join(k for k in allowed if KEYS[f"{name}.{k}"].required)
@@ -157,6 +160,10 @@ def _section(raw: dict, name: str, kind: str, required: bool) -> dict:
         if k not in allowed:
             what = f" for a {kind} body" if name == "body" else ""
             raise SceneError(f"{name}.{k}: unknown key{what} (allowed: {', '.join(allowed)})")
+    for k, v in sec.items():  # a number left empty is not its default
+        if v is None and KEYS[f"{name}.{k}"].kind == "axis":
+            raise SceneError(f"{name}.{k} = null: {KEYS[f'{name}.{k}'].allowed}, or leave "
+                             "the key out")
     for k in allowed:
         spec = KEYS[f"{name}.{k}"]
         if spec.required and sec.get(k) is None:
@@ -747,6 +754,9 @@ def _motion(raw: dict, kind: str, base: Path | None, given_record: GroundRecord 
             given_records: tuple[GroundRecord, ...] | None) -> _Motion:
     """The ground motion: none (free vibration), a ``pulse``, or a ``ground`` section
     (one record scaled by A_ratio, or a suite of records)."""
+    for name in ("pulse", "ground"):
+        if name in raw and raw[name] is None:  # refused as every null section
+            _section(raw, name, kind, required=False)
     if raw.get("ground") is None and raw.get("pulse") is None:
         return _Motion(free=True, pulse={"shape": FREE, "w_over_p": 0.0, "A_ratio": 0.0})
     if raw.get("ground") is None:
