@@ -34,7 +34,6 @@ import numpy as np
 from rocksweep.analysis.tolerance import DEFAULT_RTOL, MAX_RTOL, check_rtol
 from rocksweep.compute.adaptive import DIAGRAM_AXES, AdaptiveError, make_plan
 from rocksweep.compute.dispatch import run_variant
-from rocksweep.compute.grid import Grid
 from rocksweep.errors import BoundaryError  # noqa: F401 (re-exported)
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
@@ -53,6 +52,7 @@ from rocksweep.physics.points import (
     shape_code,
     with_record,
 )
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.model import Scene
 
 if TYPE_CHECKING:

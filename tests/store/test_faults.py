@@ -32,9 +32,9 @@ import pytest
 from helpers import one_line_error
 
 from rocksweep.cli import main
-from rocksweep.compute.grid import Grid
-from rocksweep.compute.sweep import ChunkResult, level, prepare
+from rocksweep.compute.sweep import level, prepare
 from rocksweep.fields import plain
+from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.parse import load_scene, parse_scene
 from rocksweep.store import StoreError
 from rocksweep.store.format import SESSION_ATTRS
@@ -470,7 +470,7 @@ def test_read_only_directory_really_read_only(tmp_path):
 # fake_chunk for the scripts of other processes (they import rocksweep only)
 FAKE_CHUNK = """
 import numpy as np
-from rocksweep.compute.sweep import ChunkResult
+from rocksweep.scene.grid import ChunkResult
 def fake_chunk(scene, a, b):
     i = np.arange(a, b)
     return ChunkResult(a, b, {n: ((i % 3) if n == "outcome" else i * 7 + len(n)).astype(d)

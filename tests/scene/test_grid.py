@@ -7,10 +7,10 @@ from itertools import product
 import numpy as np
 import pytest
 
-import rocksweep.compute.grid as grid_mod
-from rocksweep.compute.grid import Grid
+import rocksweep.scene.grid as grid_mod
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.points import kernel_kind, point_row
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.parse import parse_scene
 
 BODY = ("body: {wn_over_p: %s, zeta: %s, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47, "
