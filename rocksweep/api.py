@@ -462,7 +462,6 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     _typed("bounds", bounds, bounds is None or isinstance(bounds, Mapping),
            "a mapping {key: (lo, hi)}, e.g. {'impact.lam': (0, 1)}, or None")
     _typed("p", p, p is None or _is_number(p), "a number (the body's p [rad/s]) or None")
-    _typed("ci", ci, _is_number(ci), "a number in [0.5, 1)")
     out = calibrate_scene(scene, measured, fit, bounds, ci, p, overrides)
     return out
 

@@ -89,6 +89,8 @@ DEFAULT_BOUNDS = {"impact.lam": (0.0, 2.0), "impact.e": (0.02, 1.0),
 OPTIONAL_NAMES = ("e_factor", *INITIAL)
 # Longest measured history fitted [p t]: a free-rocking block comes to rest within ~100.
 MAX_SPAN = 1e4
+# Largest |theta| [rad] of a measurement: pi/2 (the body on its side) and 5% for noise.
+THETA_LIMIT = 1.05 * math.pi / 2
 
 
 def calibration_numerics(n: Numerics) -> Numerics:
@@ -833,11 +835,12 @@ def _check_measured_span(m: Measured, alpha_ref: float) -> None:
     reaching pi/2 (the body would lie on its side: the wrong column, unit or body), or a
     span longer than MAX_SPAN (each candidate is simulated over all of it)."""
     amax = float(np.max(np.abs(m.theta)))
-    if amax * alpha_ref >= math.pi / 2:
+    if amax * alpha_ref > THETA_LIMIT:
         raise CalibrationError(f"{m.source}: |theta_over_alpha| reaches {amax:.4g}, |theta| "
                                f"= {amax * alpha_ref:.4g} rad for this body (alpha "
-                               f"{alpha_ref:.4g} rad); a rocking body stays below pi/2 (is "
-                               "it the wrong column, unit or body?)")
+                               f"{alpha_ref:.4g} rad); a rocking body's |theta| stays below "
+                               "pi/2, where it lies on its side (is it the wrong column, unit "
+                               "or body?)")
     span = m.duration
     if span > MAX_SPAN:
         raise CalibrationError(f"{m.source}: the history spans {span:.4g} p*t; at most "

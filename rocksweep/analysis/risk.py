@@ -62,12 +62,18 @@ from rocksweep.vocab.ground import PGA, PGV, SA
 __all__ = ["Hazard", "RiskError", "fragility_median", "hazard_frame", "read_hazard",
            "risk"]
 
-SUB = 8  # pieces per hazard segment, 2 Gauss-Legendre nodes each
+SUB = 8  # at most this many pieces per hazard segment, 2 Gauss-Legendre nodes each
+PIECE = 0.05  # [ln IM] widest piece (a 40-level curve over 1e-4-100 g: 8 a segment)
 TAIL_SHARE = 0.01  # above_hazard when the unknown tail exceeds this share of the rate
 LOW_P = 1e-3  # below_hazard when the fragility at the hazard's smallest IM exceeds this
 PLOT_POINTS = 200  # the figure's grid over the hazard's range
 MAX_HAZARD_BYTES = 200 << 20  # [bytes] largest hazard file read (~4 million levels of CSV)
 MAX_LEVELS = 1_000_000  # hazard levels of one curve (the integral's memory: docs/faults.md)
+#: the integral takes the quadrature nodes in chunks of at most this many (curve, node)
+#: values: memory ~ 8 x this x a few temporaries, whatever the hazard's length
+CHUNK_ELEMENTS = 1 << 21
+Z_TAIL = 8.0  # a lognormal curve's transition: median exp(+-Z_TAIL beta) (1e-15 beyond)
+Z_NODES = 64  # Gauss-Legendre nodes over it (``_narrow``)
 RATE_COLUMN = "annual_rate"
 #: OpenQuake's IMT units, and the factor to rocksweep's
 OQ_UNITS = {PGA: ("g", 1.0), SA.upper(): ("g", 1.0), PGV: ("m/s", 0.01)}
@@ -330,27 +336,30 @@ def _fragility_p(x: np.ndarray, median: np.ndarray, beta: np.ndarray) -> np.ndar
 
 
 def _nodes(hz: Hazard) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss-Legendre nodes x_j and weights w_j (2 per piece, ``SUB`` pieces per hazard
-    segment evenly in u = ln x) with sum_j f(x_j) w_j ~ integral f |d lambda| over the
-    hazard's range: w_j = the quadrature weight times |d lambda / d u| at the node (exact
-    for the log-log interpolant: lambda' = s lambda on a segment of log-log slope s;
-    a segment that ends at rate 0 is linear in lambda: constant lambda')."""
+    """Gauss-Legendre nodes x_j and weights w_j (2 per piece; a hazard segment cut evenly in
+    u = ln x into pieces of at most ``PIECE`` in u, at most ``SUB`` of them) with
+    sum_j f(x_j) w_j ~ integral f |d lambda| over the hazard's range: w_j = the quadrature
+    weight times |d lambda / d u| at the node (exact for the log-log interpolant:
+    lambda' = s lambda on a segment of log-log slope s; a segment that ends at rate 0 is
+    linear in lambda: constant lambda'). Vectorised: a dense hazard (many narrow segments)
+    gets one piece a segment, so the nodes grow as 2 x its levels."""
     g = np.array([-1.0, 1.0]) / math.sqrt(3.0)  # 2-point Gauss-Legendre on [-1, 1]
     lx = np.log(hz.im)
-    xs, ws = [], []
-    for i in range(hz.im.size - 1):
-        r0, r1 = hz.rate[i], hz.rate[i + 1]
-        du = (lx[i + 1] - lx[i]) / SUB
-        centres = lx[i] + du * (np.arange(SUB) + 0.5)
-        u = (centres[:, None] + 0.5 * du * g[None, :]).ravel()
-        if r1 > 0.0:
-            slope = (math.log(r1) - math.log(r0)) / (lx[i + 1] - lx[i])
-            dens = -slope * r0 * np.exp(slope * (u - lx[i]))
-        else:
-            dens = np.full(u.size, (r0 - r1) / (lx[i + 1] - lx[i]))
-        xs.append(u)
-        ws.append(0.5 * du * dens)
-    return np.exp(np.concatenate(xs)), np.concatenate(ws)
+    width = np.diff(lx)
+    pieces = np.clip(np.ceil(width / PIECE), 1, SUB).astype(np.int64)
+    seg = np.repeat(np.arange(width.size), pieces)  # the segment of every piece
+    k = np.arange(seg.size) - np.repeat(np.cumsum(pieces) - pieces, pieces)
+    du = width[seg] / pieces[seg]
+    centres = lx[seg] + du * (k + 0.5)
+    u = (centres[:, None] + 0.5 * du[:, None] * g[None, :]).ravel()
+    s2 = np.repeat(seg, 2)
+    r0, r1 = hz.rate[s2], hz.rate[s2 + 1]
+    pos = r1 > 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope = (np.log(np.where(pos, r1, 1.0)) - np.log(r0)) / width[s2]
+        dens = np.where(pos, -slope * r0 * np.exp(slope * (u - lx[s2])),
+                        (r0 - r1) / width[s2])
+    return np.exp(u), 0.5 * np.repeat(du, 2) * dens
 
 
 def _curve_p(fr: xr.Dataset, med: xr.DataArray, beta: xr.DataArray, dims: list[str]):
@@ -375,15 +384,106 @@ def _curve_p(fr: xr.Dataset, med: xr.DataArray, beta: xr.DataArray, dims: list[s
     return lambda x: _fragility_p(x, m, b)
 
 
-def _rates(hz: Hazard, p) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _rates(hz: Hazard, p, lognormal: tuple[np.ndarray, np.ndarray] | None = None
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(annual_rate, annual_rate_max, P at x_min, P at x_max) for the fragility curves
-    x -> p(x) float[..., x] (module docstring)."""
+    x -> p(x) float[..., x] (module docstring). The quadrature nodes are taken in chunks
+    of at most ``CHUNK_ELEMENTS`` / curves (memory: ``CHUNK_ELEMENTS`` x 8 bytes a few
+    times, whatever the hazard's length). lognormal: the curves' (median, beta) when they
+    are lognormal: a curve whose transition median exp(+-Z_TAIL beta) lies between two
+    hazard levels is integrated exactly there instead (``_narrow``)."""
     x, w = _nodes(hz)
-    inside = p(x) @ w
     ends = p(hz.im[[0, -1]])
+    n_curves = max(1, int(np.prod(ends.shape[:-1])))
+    step = max(1, CHUNK_ELEMENTS // n_curves)
+    inside = np.zeros(ends.shape[:-1])
+    for k in range(0, x.size, step):
+        inside = inside + p(x[k:k + step]) @ w[k:k + step]
     p_lo, p_hi = ends[..., 0], ends[..., 1]
     top = hz.rate[-1]
-    return inside + p_hi * top, inside + top, p_lo, p_hi
+    rate = inside + p_hi * top
+    if lognormal is not None:
+        narrow = _narrow(hz, *lognormal)
+        if narrow is not None:
+            use, value = narrow
+            rate = np.where(use, value, rate)
+            inside = np.where(use, value - p_hi * top, inside)
+    return rate, inside + top, p_lo, p_hi
+
+
+def _hazard_at(hz: Hazard, x: np.ndarray) -> np.ndarray:
+    """lambda(x) of the log-log interpolated hazard inside its range (a segment ending at
+    rate 0: linear in lambda)."""
+    lx = np.log(hz.im)
+    u = np.log(x)
+    i = np.clip(np.searchsorted(lx, u, side="right") - 1, 0, lx.size - 2)
+    r0, r1 = hz.rate[i], hz.rate[i + 1]
+    f = (u - lx[i]) / (lx[i + 1] - lx[i])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        pos = r1 > 0.0
+        loglin = np.exp(np.log(r0) + f * (np.log(np.where(pos, r1, 1.0)) - np.log(r0)))
+    return np.where(pos, loglin, r0 + f * (r1 - r0))
+
+
+def _narrow(hz: Hazard, med: np.ndarray, beta: np.ndarray
+            ) -> tuple[np.ndarray, np.ndarray] | None:
+    """The rate of lognormal curves whose transition is narrow, by parts: annual_rate =
+    P(x_min) lambda(x_min) + integral lambda dP over the hazard's range, dP the lognormal
+    density, integrated over z = ln(x / median) / beta in [-Z_TAIL, Z_TAIL] by
+    ``Z_NODES``-point Gauss-Legendre (the hazard a power law there: converges
+    exponentially), exact for beta = 0 (lambda(median)). Used where no hazard level lies
+    strictly inside median exp(+-Z_TAIL beta) (a kink there would slow it down); a steep
+    curve is exactly that case, and the shared quadrature's worst. Returns (use, rate) or
+    None when no curve qualifies."""
+    from scipy.special import ndtr
+
+    med = np.asarray(med, np.float64)
+    beta = np.asarray(beta, np.float64)
+    ok = np.isfinite(med) & (med > 0) & np.isfinite(beta) & (beta >= 0)
+    if not ok.any():
+        return None
+    m = np.where(ok, med, 1.0)
+    b = np.where(ok, beta, 0.0)
+    lx = np.log(hz.im)
+    lo_u, hi_u = np.log(m) - Z_TAIL * b, np.log(m) + Z_TAIL * b
+    # no hazard level strictly inside the transition
+    inner = np.searchsorted(lx, hi_u, side="left") - np.searchsorted(lx, lo_u, side="right")
+    use = ok & (inner <= 0) & (lo_u >= lx[0]) & (hi_u <= lx[-1])
+    if not use.any():
+        return None
+    z, wz = np.polynomial.legendre.leggauss(Z_NODES)
+    z, wz = z * Z_TAIL, wz * Z_TAIL
+    dens = np.exp(-0.5 * z * z) / math.sqrt(2.0 * math.pi)
+    mu, bu = m[use], b[use]
+    xs = mu[:, None] * np.exp(bu[:, None] * z[None, :])
+    lam = _hazard_at(hz, np.clip(xs, hz.im[0], hz.im[-1]))
+    mass = ndtr(Z_TAIL) - ndtr(-Z_TAIL)  # the tails beyond: lambda at the ends' values
+    val = lam @ (wz * dens) / (wz * dens).sum() * mass
+    val = val + ndtr(-Z_TAIL) * _hazard_at(hz, mu * math.exp(-Z_TAIL) ** bu) \
+        + ndtr(-Z_TAIL) * _hazard_at(hz, mu * math.exp(Z_TAIL) ** bu)
+    out = np.zeros(med.shape)
+    out[use] = val
+    return use, out
+
+
+def _check_curves(fr: xr.Dataset, med: xr.DataArray, dims: list[str]) -> None:
+    """Refuse (one line) a fragility whose numbers no fit gives: a median <= 0 or
+    infinite, a beta < 0 or infinite (NaN: no fit, carried as such)."""
+    beta = fr["beta"]
+    for name, da, bad in (
+            ("im_median", med, lambda v: np.isinf(v) | (v <= 0.0)),
+            ("beta", beta, lambda v: np.isinf(v) | (v < 0.0))):
+        v = np.asarray(da.values, np.float64)
+        with np.errstate(invalid="ignore"):
+            wrong = bad(v) & ~np.isnan(v)
+        if wrong.any():
+            k = np.unravel_index(int(np.argmax(wrong)), v.shape)
+            at = ", ".join(f"{d} = {da[d].values[i]}" for d, i in zip(da.dims, k, strict=True)
+                           if d in da.coords)
+            src = fr.attrs.get("source") or "the fragility Dataset"
+            raise RiskError(f"{src}: {name} = {float(v[k])!r}{f' at {at}' if at else ''}: "
+                            f"must be {'> 0' if name == 'im_median' else '>= 0'} and finite "
+                            "(a fragility from rocksweep.fragility)")
 
 
 def _interval(v: np.ndarray, ci: float) -> tuple[np.ndarray, np.ndarray]:
@@ -476,15 +576,24 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50.0, *,
     read = read_hazard(hazard, site=site)
     hz = _check_match(fr, read)
     dims = list(med_da.dims)
+    _check_curves(fr, med_da, dims)
     curve = _curve_p(fr, med_da, fr["beta"], dims)
-    rate, rate_max, p_lo, p_hi = _rates(hz, curve)
+    competing = "fit" in fr.data_vars and "competing" in np.atleast_1d(
+        np.asarray(fr["fit"].values)).astype(str)
+    logn = None if competing else (
+        np.asarray(med_da.transpose(*dims).values, np.float64),
+        np.asarray(fr["beta"].transpose(*dims).values, np.float64))
+    rate, rate_max, p_lo, p_hi = _rates(hz, curve, logn)
     ci = float(fr.attrs.get("ci", 0.9))
     lo = hi = np.full(rate.shape, np.nan)
     samples = f"{med_name}_samples"
     if samples in fr.data_vars and "beta_samples" in fr.data_vars:
         ms, bs = fr[samples], fr["beta_samples"]
         ok = np.isfinite(ms) & np.isfinite(bs)
-        r_s, _, _, _ = _rates(hz, _curve_p(fr, ms.where(ok), bs.where(ok), dims))
+        order = [*dims, *[d for d in ms.dims if d not in dims]]
+        r_s, _, _, _ = _rates(hz, _curve_p(fr, ms.where(ok), bs.where(ok), dims), None if
+                              competing else (np.asarray(ms.where(ok).transpose(*order).values),
+                                              np.asarray(bs.where(ok).transpose(*order).values)))
         lo, hi = _interval(r_s, ci)
     reasons = np.empty(rate.shape, dtype=object)
     unknown_top = rate_max - rate
