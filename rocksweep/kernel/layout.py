@@ -11,6 +11,7 @@ so times are p*t.
 from rocksweep.vocab import ground as _ground
 from rocksweep.vocab import laws as _laws
 from rocksweep.vocab import outcomes as _out
+from rocksweep.vocab import settings as _settings
 
 # --- parameter row ---------------------------------------------------------------------
 PAR_M = 0  # top mass m [kg]
@@ -74,9 +75,9 @@ SHAPE_RECORD = _ground.SHAPE_CODE[_ground.RECORD]
 LAW_VERTICAL = _laws.LAW_CODE[_laws.VERTICAL]
 LAW_LOCKED = _laws.LAW_CODE[_laws.LOCKED]
 LAW_CONSTANT = _laws.LAW_CODE[_laws.CONSTANT]
-ROOT_BISECT = 0.0
-ROOT_ILLINOIS = 1.0
-ROOT_HERMITE = 2.0
+ROOT_BISECT = _settings.ROOT_CODE[_settings.BISECTION]
+ROOT_ILLINOIS = _settings.ROOT_CODE[_settings.ILLINOIS]
+ROOT_HERMITE = _settings.ROOT_CODE[_settings.HERMITE]
 
 # --- result row ------------------------------------------------------------------------
 OUT_OUTCOME = 0  # OUTCOME_* code

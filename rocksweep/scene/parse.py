@@ -56,6 +56,7 @@ from rocksweep.vocab.axes import DIAGRAM_AXES, alpha_symbol
 from rocksweep.vocab.ground import MP
 from rocksweep.vocab.ground import PULSE_KEY_SHAPES as _PULSE_KEY_SHAPES
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
+from rocksweep.vocab.settings import DEFAULT_PRESET, FINE
 
 # Largest grid a scene may describe [points]. A sweep file stores 45 bytes a point (69
 # with energy metrics, ``rocksweep.fields.variables``): 2e8 points are a 9-14 GB file, one
@@ -333,8 +334,8 @@ def _numerics(sec: dict, contact: bool = False) -> tuple[Numerics, Numerics]:
             v = float(v) if spec.kind == "number" else v
         given[k] = v
     accuracy = given.pop("accuracy", None)
-    numerics = Numerics.preset(accuracy or ("fine" if contact else "default"), **given)
-    # One default (issue 28): a single run (simulate) runs what a sweep of the same point
+    numerics = Numerics.preset(accuracy or (FINE if contact else DEFAULT_PRESET), **given)
+    # One default: a single run (simulate) runs what a sweep of the same point
     # runs, so one point has one answer; the certification of close calls
     # (``compute.certify``) makes the default trustworthy for both.
     single = numerics
