@@ -260,7 +260,7 @@ def sample_scene(scene: Scene, n: int | None, seed: int = 0) -> Sample:
     no classification pass).
     """
     from rocksweep.compute.driver import sweep_arrays
-    from rocksweep.compute.grid import Grid
+    from rocksweep.scene.grid import Grid
 
     grid = Grid(scene)
     if n is None or n >= grid.size:
@@ -302,8 +302,8 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
     ``repeat`` rounds (the machine's noise only ever adds time). Compilation is excluded.
     """
     from rocksweep.compute.dispatch import run_variant
-    from rocksweep.compute.grid import Grid
     from rocksweep.physics.points import with_record
+    from rocksweep.scene.grid import Grid
 
     _no_suite(scene)
     cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
@@ -349,8 +349,8 @@ def run_reference(scene: Scene, flat: np.ndarray,
     int64[n]: the reference's self-check, see ``reference_run``). The first point is run
     once untimed before: the reference's first call in a process loads (or compiles) the
     jitted equations it shares with the kernel, ~0.25 s that is no point's cost."""
-    from rocksweep.compute.grid import Grid
     from rocksweep.physics.reference import reference_run, result_row
+    from rocksweep.scene.grid import Grid
 
     grid = Grid(scene)
     values = grid.index_values(flat)
@@ -411,8 +411,8 @@ def run_energy(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray
     """The energy-accounting kernel on the given points (untimed): float64[n, N_OUT].
     Through the sweep's dispatch (``compute.sweep.run_rows``), so Ricker, MP and record
     scenes run their ground variants with the record's samples."""
-    from rocksweep.compute.grid import Grid
     from rocksweep.compute.sweep import run_rows
+    from rocksweep.scene.grid import Grid
 
     sc = _with_numerics(scene, numerics)
     cr = Grid(sc).rows_at(flat)
@@ -422,8 +422,8 @@ def run_energy(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray
 def run_half(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray:
     """The half-step reruns of ``outputs.check`` (``fields.check_rows``) on the given
     points, outcome-only kernel, untimed: float64[n, N_OUT] (the sweep's dispatch)."""
-    from rocksweep.compute.grid import Grid
     from rocksweep.compute.sweep import run_rows
+    from rocksweep.scene.grid import Grid
 
     _no_suite(scene)
     sc = _with_numerics(scene, numerics)
@@ -640,7 +640,7 @@ def accuracy_study(scene: Scene, n_points: int | None = 200,
     check: also rerun every setting at half the step and score the per-point error
     estimates of ``outputs.check`` against the true errors (``estimate_scores``).
     """
-    from rocksweep.compute.grid import Grid
+    from rocksweep.scene.grid import Grid
 
     _no_suite(scene)
     t_wall = time.perf_counter()
@@ -774,7 +774,8 @@ def format_table(study: Study) -> str:
     return "\n".join(lines)
 
 
-def write_report(study: Study, path: str | Path, command: str = "") -> None:
+def write_report(study: Study, path: str | Path, command: str = "", *,
+                 overwrite: bool = False) -> None:
     """Write the study to HDF5, atomically (a temporary file renamed at the end).
 
     Layout: attrs (scene name and YAML, sample description, reference tolerances, command,
@@ -793,7 +794,7 @@ def write_report(study: Study, path: str | Path, command: str = "") -> None:
     from rocksweep.outputs import atomic_path
     from rocksweep.physics.reference import ATOL, RTOL
 
-    with atomic_path(path) as tmp:
+    with atomic_path(path, overwrite=overwrite) as tmp:
         with h5py.File(tmp, "w") as f:
             f.attrs["format"] = "rocksweep-accuracy-1"
             f.attrs["scene_name"] = study.scene.name

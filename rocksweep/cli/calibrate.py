@@ -87,7 +87,7 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
     if out_path is not None:
         from rocksweep.outputs import atomic_path
 
-        with atomic_path(out_path) as tmp:
+        with atomic_path(out_path, overwrite=overwrite) as tmp:
             ds.to_netcdf(tmp, engine="h5netcdf")
         click.echo(f"wrote {out_path}")
     if plot_path is not None:

@@ -184,7 +184,7 @@ def sweep_arrays(scene: Scene, jobs: int = 1, chunk_size: int | None = None,
     Identical, bit for bit, whatever ``jobs``, ``chunk_size`` and backend, and to the
     result file of ``rocksweep sweep``. For the library's own studies and tests;
     ``rocksweep.run`` returns the same as a Dataset."""
-    from rocksweep.compute.grid import Grid
+    from rocksweep.scene.grid import Grid
 
     sink = ArraySink(Grid(scene))
     report = SweepReport(Path("memory"), sink.grid.size, 0, 0, 0.0, 0.0, 0.0)

@@ -28,3 +28,12 @@ LADDERS: dict[str, str] = {
 }
 LADDER_NAMES: tuple[str, ...] = tuple(LADDERS)
 DEFAULT_LADDER = "full"
+
+#: the settings of an adaptive sweep a user gives (the scene's ``refine:`` section, the
+#: keywords of ``rocksweep.run``; their ranges: ``rocksweep.schema``)
+ADAPTIVE_SETTINGS: tuple[str, ...] = ("coarse", "audit", "margin", "final_margin", "seed",
+                                      "threshold")
+#: the adaptive settings that decide a result (the diagram's axes too, the default coarse
+#: level resolved): what a result file records and a resume compares
+ADAPTIVE_RESOLVED: tuple[str, ...] = ("axes", "coarse", "margin", "final_margin", "audit",
+                                      "seed", "threshold")

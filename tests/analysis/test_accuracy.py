@@ -194,7 +194,7 @@ def test_energy_and_half_step_runs_use_the_scene_ground_motion(name, sets):
 
 
 def _values(sc):
-    from rocksweep.compute.grid import Grid
+    from rocksweep.scene.grid import Grid
 
     vals = Grid(sc).index_values(np.arange(sc.size))
     return [{k: v[i] for k, v in vals.items()} for i in range(sc.size)]

@@ -337,7 +337,7 @@ def test_a_partial_file_is_fitted_as_incomplete_naming_the_missing_points(suite_
     warns with the missing points and marks the fit; nothing is silently dropped."""
     import rocksweep.compute.sweep as sw
     from rocksweep import api
-    from rocksweep.compute.grid import Grid
+    from rocksweep.scene.grid import Grid
     from rocksweep.store.writer import SweepFile
 
     d, scene = suite_scene

@@ -18,9 +18,9 @@ import rocksweep
 import rocksweep.compute.sweep as sw
 from rocksweep import api, fields
 from rocksweep.cli import main
-from rocksweep.compute.grid import Grid
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.model import FlexibleBody
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.parse import load_scene
 from rocksweep.store.reader import read_result
 
@@ -207,7 +207,7 @@ def test_cache_state_of_a_fresh_cache(tmp_path):
     sc = load_scene(CI_SMALL)
     sw.prepare(Grid(sc), sw.level(sc))
     assert sw.kernel_cache_state(Grid(sc), sw.level(sc)) == (0, 0)
-    code = ("from rocksweep.compute import sweep as sw; from rocksweep.compute.grid import Grid; "
+    code = ("from rocksweep.compute import sweep as sw; from rocksweep.scene.grid import Grid; "
             "from rocksweep.scene.parse import load_scene; "
             f"sc = load_scene({str(CI_SMALL)!r}); "
             "print(sw.kernel_cache_state(Grid(sc), sw.level(sc)))")

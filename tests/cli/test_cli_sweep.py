@@ -16,8 +16,8 @@ from bodies import FIG3_YAML
 from helpers import kill_sweep_when, one_line_error
 
 from rocksweep.cli import main
-from rocksweep.compute.sweep import ChunkResult
 from rocksweep.numerics import PRESETS
+from rocksweep.scene.grid import ChunkResult
 from rocksweep.store.reader import read_result
 from rocksweep.store.writer import SweepFile
 
@@ -302,8 +302,8 @@ def test_kill_and_resume_equals_uninterrupted_run(cli, tmp_path):
     killed = tmp_path / "killed.h5"
     total = 3200
     # compile here if need be, so the subprocess loads numba's cache and starts at once
-    from rocksweep.compute.grid import Grid
     from rocksweep.compute.sweep import level, prepare
+    from rocksweep.scene.grid import Grid
     from rocksweep.scene.parse import load_scene
 
     sc = load_scene(scene)
@@ -337,8 +337,8 @@ def test_ctrl_c_writes_every_finished_chunk_before_it_exits(tmp_path):
                      "pulse: {shape: sine, w_over_p: {start: 0.3, stop: 6, num: 600},"
                      " A_ratio: {start: 0.3, stop: 8, num: 600}}\n")
     out = tmp_path / "int.h5"
-    from rocksweep.compute.grid import Grid
     from rocksweep.compute.sweep import level, prepare
+    from rocksweep.scene.grid import Grid
     from rocksweep.scene.parse import load_scene
 
     sc = load_scene(scene)

@@ -77,7 +77,7 @@ def test_one_driver():
     assert sorted(_calls("run_chunks")) == ["rocksweep/compute/adaptive.py",  # run_batch
                                             "rocksweep/compute/driver.py"]  # every_point
     assert sorted(set(_calls("drive"))) == ["rocksweep/compute/driver.py",  # sweep_arrays
-                                            "rocksweep/store/session.py"]  # sweep_file
+                                            "rocksweep/compute/session.py"]  # sweep_file
     for retired in ("compute", "adaptive_compute"):
         assert not hasattr(__import__("rocksweep.compute.sweep", fromlist=["x"]), retired)
         assert not hasattr(ad, retired)

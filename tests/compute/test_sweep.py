@@ -7,9 +7,9 @@ from bodies import FIG3_YAML, body_yaml, table3
 import rocksweep.compute.sweep as sw
 from rocksweep import fields
 from rocksweep.compute.driver import sweep_arrays
-from rocksweep.compute.grid import Grid
 from rocksweep.compute.single import simulate
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.parse import parse_scene
 
 BODY3 = FIG3_YAML
@@ -101,7 +101,7 @@ def test_merge_contiguous_joins_neighbours_in_any_order():
     rng = np.random.default_rng(3)
     bounds = [(0, 5), (5, 9), (9, 20), (30, 33), (33, 40), (50, 51)]
     full = {"x": rng.random(51), "n": np.arange(51)}
-    results = [sw.ChunkResult(a, b, {k: v[a:b] for k, v in full.items()}, 1.0, 0.5)
+    results = [ChunkResult(a, b, {k: v[a:b] for k, v in full.items()}, 1.0, 0.5)
                for a, b in bounds]
     merged = sw.merge_contiguous([results[i] for i in rng.permutation(len(results))])
     assert [(m.start, m.stop) for m in merged] == [(0, 20), (30, 40), (50, 51)]

@@ -15,8 +15,8 @@ from matplotlib.colors import to_rgb
 from matplotlib.figure import Figure
 
 from rocksweep.cli import main
-from rocksweep.compute.sweep import ChunkResult
 from rocksweep.errors import RocksweepError
+from rocksweep.scene.grid import ChunkResult
 from rocksweep.store.reader import read_result
 from rocksweep.store.writer import SweepFile
 

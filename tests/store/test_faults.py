@@ -33,9 +33,9 @@ from bodies import FIG3_YAML
 from helpers import one_line_error
 
 from rocksweep.cli import main
-from rocksweep.compute.grid import Grid
-from rocksweep.compute.sweep import ChunkResult, level, prepare
+from rocksweep.compute.sweep import level, prepare
 from rocksweep.fields import plain
+from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.parse import load_scene, parse_scene
 from rocksweep.store import StoreError
 from rocksweep.store.format import SESSION_ATTRS
@@ -469,7 +469,7 @@ def test_read_only_directory_really_read_only(tmp_path):
 # fake_chunk for the scripts of other processes (they import rocksweep only)
 FAKE_CHUNK = """
 import numpy as np
-from rocksweep.compute.sweep import ChunkResult
+from rocksweep.scene.grid import ChunkResult
 def fake_chunk(scene, a, b):
     i = np.arange(a, b)
     return ChunkResult(a, b, {n: ((i % 3) if n == "outcome" else i * 7 + len(n)).astype(d)
@@ -585,8 +585,8 @@ def test_two_sweeps_started_at_the_same_instant(tmp_path, overwrite):
         msg = next(e for e in errors if e)
         assert msg in (
             f"{path}: already exists; use --resume to finish it or --overwrite to replace it",
-            f"{path}: made by another process meanwhile (a sweep started at the same time?);"
-            " not overwritten",
+            f"{path}: made by another process meanwhile (the same command started at the "
+            "same time?); not overwritten",
             f"{path}: open for writing by another process (a sweep still running?); not "
             "overwritten",
             f"{path}: replaced by another process meanwhile; not overwritten"), (k, msg)

@@ -11,8 +11,8 @@ import pytest
 from bodies import FIG3_YAML
 
 import rocksweep.store.writer as writer
-from rocksweep.compute.grid import Grid
-from rocksweep.compute.sweep import ChunkResult, plan_chunks
+from rocksweep.compute.sweep import plan_chunks
+from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.parse import parse_scene
 from rocksweep.store import StoreError
 from rocksweep.store.format import FORMAT_VERSION, flat_slabs

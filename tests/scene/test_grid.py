@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from bodies import body_yaml, table3
 
-import rocksweep.compute.grid as grid_mod
-from rocksweep.compute.grid import Grid
+import rocksweep.scene.grid as grid_mod
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.points import kernel_kind, point_row
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.parse import parse_scene
 
 BODY = body_yaml(table3(wn_over_p="%s", zeta="%s"))
