@@ -62,7 +62,6 @@ class Key:
     default: Any = None
 
 
-_AXIS = "a number, a list of numbers or a range {start, stop, num}"
 _RATIO = f"[1e-06, {RATIO_MAX:g}]"
 _ANGLE = f"must be in [{ANGLE_MIN:g}, pi/2) rad"
 

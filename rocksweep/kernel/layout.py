@@ -113,7 +113,6 @@ Y_U = 2  # u, the top mass's lateral displacement [m] (0 for a rigid body)
 Y_U_DOT = 3  # u' [m/s]
 Y_W_IN = 4  # work of the ground motion so far [J] (energy variants; else stays 0)
 Y_D_DAMP = 5  # energy dissipated by the damper so far [J] (energy variants; else stays 0)
-N_Y = 6
 
 # --- history columns ---------------------------------------------------------------------
 HIST_T = 0
@@ -165,5 +164,5 @@ KIND_FLEXIBLE_UNDAMPED = 1
 KIND_RIGID = 2
 LEVEL_OUTCOME = 0  # outcome and summary metrics only
 LEVEL_ENERGY = 1  # + energy accounting
-LEVEL_HISTORY = 2  # + energy accounting + time history
 LEVEL_CONTACT = 3  # + energy accounting + ground reactions (outputs.contact)
+# (a single run with its time history: ``point_kernel``, not a level of the chunk kernels)
