@@ -38,8 +38,9 @@ ground:
 
 
 def base_dataset():
-    import rocksweep
     from _here import ROOT
+
+    import rocksweep
 
     files = ", ".join(str(ROOT / "records" / "suite" / f"SYN0{i}.AT2") for i in (1, 2, 3))
     return rocksweep.run(SCENE % files)
