@@ -64,15 +64,17 @@ def widened(ds, S: int, seed: int = 1):
     return wide
 
 
-def measure(what: str, fn, points: int, nbytes: int) -> None:
+def measure(what: str, fn, points: int, nbytes: int):
+    """fn() timed and its peak traced allocation printed; returns what fn returned."""
     tracemalloc.start()
     t0 = time.perf_counter()
-    fn()
+    out = fn()
     wall = time.perf_counter() - t0
     _, peak = tracemalloc.get_traced_memory()
     tracemalloc.stop()
     print(f"{what:<28}{points:>9}{nbytes / 1e6:>12.2f}{peak / 1e6:>12.1f}{wall:>9.2f}",
           flush=True)
+    return out
 
 
 def main() -> None:
@@ -89,13 +91,11 @@ def main() -> None:
     for S in args.stripes:
         ds = widened(base, S)
         n, nb = ds.sizes["record"] * S, int(ds.nbytes)
-        fr = {}
-        measure(f"fragility overturn S={S}",
-                lambda ds=ds: fr.update(one=rocksweep.fragility(ds)), n, nb)
-        measure(f"fragility 3 states S={S}", lambda ds=ds: fr.update(three=rocksweep.fragility(
-            ds, state=["theta:0.25", "theta:0.5", "overturn"])), n, nb)
+        measure(f"fragility overturn S={S}", lambda ds=ds: rocksweep.fragility(ds), n, nb)
+        three = measure(f"fragility 3 states S={S}", lambda ds=ds: rocksweep.fragility(
+            ds, state=["theta:0.25", "theta:0.5", "overturn"]), n, nb)
         measure(f"efficiency S={S}", lambda ds=ds: rocksweep.im_efficiency(ds), n, nb)
-        measure(f"risk S={S}", lambda: rocksweep.risk(fr["three"], hazard), n, nb)
+        measure(f"risk S={S}", lambda fr=three: rocksweep.risk(fr, hazard), n, nb)
         measure(f"table S={S}", lambda ds=ds: rocksweep.table(ds), n, nb)
 
 
