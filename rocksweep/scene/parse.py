@@ -34,6 +34,7 @@ from rocksweep.physics.records import GroundRecord, RecordError, read_record
 from rocksweep.physics.suite import (
     AVGSA_RANGE,
     DEFAULT_PERIODS,
+    RECORD_IMS,
     SCALE_IMS,
     Suite,
     SuiteError,
@@ -574,6 +575,9 @@ def _scale(ground: dict) -> tuple[str | None, str, Any, float, float]:
             raise SceneError(f"{key}.{k}: unknown key (allowed: im, values, period; or "
                              "factor alone)")
     im = v.get("im")
+    if isinstance(im, str) and RECORD_IMS.get(im, ("", "", 1))[2] == 0:
+        raise SceneError(f"{key}.im = {im}: does not change when a record is scaled, so no "
+                         f"factor can reach a stripe of it; {KEYS[key + '.im'].allowed}")
     if not isinstance(im, str) or im not in SCALE_IMS:
         raise SceneError(f"{key}.im = {fmt(im)}: {KEYS[key + '.im'].allowed}")
     if v.get("values") is None:

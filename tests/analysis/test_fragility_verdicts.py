@@ -105,6 +105,23 @@ def test_falling_fractions_are_non_monotone_and_resurrection_noise_is_not():
     assert np.diff(fr["fraction"].values).min() < 0 and str(fr["reason"].values) == "ok"
 
 
+def test_pool_adjacent_violators_is_the_min_max_isotonic_fit():
+    # the isotonic fit's closed form: iso[s] = max_{i<=s} min_{j>=s} mean(i..j), the
+    # weighted means of the counts over stripes i..j, by brute force
+    from rocksweep.analysis.likelihood import isotonic_fit
+
+    rng = np.random.default_rng(3)
+    for S in (1, 2, 5, 13):
+        n = rng.integers(1, 7, S).astype(float)
+        k = rng.binomial(n.astype(int), 0.5, size=(40, S)).astype(float)
+        want = np.empty_like(k)
+        for b in range(k.shape[0]):
+            for s in range(S):
+                want[b, s] = max(min(k[b, i:j + 1].sum() / n[i:j + 1].sum()
+                                     for j in range(s, S)) for i in range(s + 1))
+        np.testing.assert_allclose(isotonic_fit(k, n), want, rtol=1e-12, atol=0.0)
+
+
 def test_median_or_16_84_points_outside_the_stripes_are_extrapolated():
     # PGV-like stripes 0.05-0.8 with the capacity median above the top stripe
     lv = np.geomspace(0.05, 0.8, 8)

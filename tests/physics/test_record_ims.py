@@ -113,6 +113,20 @@ def test_scaled_ims_follow_their_exponents(records):
     assert I.avg_sa(acc2, rec.dt, 0.5, 2.0) == pytest.approx(2.0 * base.avgsa[0], rel=1e-9)
 
 
+@pytest.mark.parametrize(("im", "level", "of"), [
+    ("AvgSa", 0.4, lambda a, dt: I.avg_sa(a, dt, 0.5, 2.0)),
+    ("CAV", 3.0, I.cav),
+    ("Arias", 0.8, I.arias)])
+def test_avgsa_cav_and_arias_stripes_scale_each_record_to_the_level(records, im, level, of):
+    # the record times its factor has the stripe's IM, computed afresh from the samples
+    # (Arias grows as the factor squared: its factor is the square root of the ratio)
+    su = make_suite(records[:3], ["a", "b", "c"], im, [level], math.nan, math.nan, [1.0],
+                    (0.5, 2.0))
+    f = su.factors(np.arange(3), np.zeros(3, np.int64), np.full(3, 0.15), np.full(3, 2.0))
+    for rec, fi in zip(records[:3], f, strict=True):
+        assert of(fi * rec.acc, rec.dt) == pytest.approx(level, rel=1e-9)
+
+
 def caught(suite):
     with warnings.catch_warnings(record=True) as got:
         warnings.simplefilter("always")
