@@ -356,7 +356,7 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     return out[0] if sc.size == 1 else out
 
 
-# --- Calibration (issue 30): scene numbers fitted to a measured history ------------------
+# --- Calibration: scene numbers fitted to a measured history ------------------
 
 @_public
 def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impact.lam",),
