@@ -243,6 +243,8 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     _check_optional_text(**{_names[0]: x, _names[1]: y, _names[2]: compare, "width": width})
     _check_flags(curves=curves, show_computed=show_computed, mu=mu)
     if isinstance(ds, str | Path):
+        from rocksweep.analysis.files import open_any
+
         ds = open_any(ds)
     return plot_any(ds, x, y, ax=ax, curves=curves, show_computed=show_computed, mu=mu,
                     width=width, compare=compare, names=_names)
