@@ -112,11 +112,12 @@ class SweepFile:
     """A result file open for writing (by the parent process only; it holds the file's
     exclusive lock until ``close``)."""
 
-    def __init__(self, path: Path, f: h5py.File, scene: Scene,
+    def __init__(self, path: Path, f: h5py.File, grid: Grid,
                  backend: str | None = None, adaptive: dict | None = None) -> None:
         self.path = path
         self.f = f
-        self.grid = Grid(scene)
+        self.grid = grid  # the scene's points (the driver runs them; shape: the file's)
+        scene = grid.scene
         self.names = list(scene.variables())
         self.adaptive = adaptive  # resolved adaptive settings, None: every point
         self.session_start = _now()
@@ -137,28 +138,42 @@ class SweepFile:
     def create(cls, path: str | Path, scene: Scene, overrides: tuple[str, ...] = (),
                overwrite: bool = False, *, backend: str | None = None,
                adaptive: dict | None = None,
-               log: Callable[[str], None] | None = None) -> SweepFile:
+               log: Callable[[str], None] | None = None,
+               grid: Grid | None = None) -> SweepFile:
         """Make a new result file (all points not computed), atomically, and open it.
         adaptive: resolved settings of an adaptive sweep (``adaptive.Options.resolved``):
-        the file gets the ``computed`` flags and the settings' attributes.
+        the file gets the ``computed`` flags and the settings' attributes; grid: the
+        scene's ``Grid`` when the caller has made it (made here otherwise).
 
         Refused (StoreError) before anything is written: an existing path without
         ``overwrite``, a directory, device or FIFO, a missing directory, a grid larger
         than the free space, a file another process is writing. ``backend``: how the
         points are computed (e.g. "threads x 2"), recorded with the host in the file.
         """
-        import h5py
         path = Path(path)
         try:
             # devices, directories, missing dirs, the scene's own files
             check_output(path, overwrite=True, inputs=scene.inputs)
         except OutputError as err:
             raise StoreError(str(err)) from None
+        return cls.make(path, scene, overrides, overwrite, backend=backend,
+                        adaptive=adaptive, log=log, grid=grid)
+
+    @classmethod
+    def make(cls, path: Path, scene: Scene, overrides: tuple[str, ...] = (),
+             overwrite: bool = False, *, backend: str | None = None,
+             adaptive: dict | None = None, log: Callable[[str], None] | None = None,
+             grid: Grid | None = None) -> SweepFile:
+        """``create`` at a path its caller has checked (``outputs.check_output``, as the
+        sweep session does, naming the command's inputs): refused (StoreError) are only
+        what may have changed since, an existing path without ``overwrite``, too little
+        free space, a file another process is writing."""
+        import h5py
+        grid = grid if grid is not None else Grid(scene)
         existed = os.path.lexists(path)
         if existed and not overwrite:
             raise StoreError(f"{shown(path)}: already exists; use --resume to finish it or "
                              "--overwrite to replace it")
-        grid = Grid(scene)
         nbytes = file_bytes(scene, adaptive is not None)
         reserve = _reserve_bytes(scene, nbytes)
         removed = clean_stale_partials(path)  # a killed attempt's reserved space back
@@ -191,7 +206,7 @@ class SweepFile:
             if 0 < size < reserve:
                 os.truncate(tmp, size)  # give back what the metadata did not use
             f = h5py.File(tmp, "r+", locking=True)  # locked before anyone can see it
-            self = cls(path, f, scene, backend, adaptive)
+            self = cls(path, f, grid, backend, adaptive)
             self._start_session()  # before the file has its name: failing leaves nothing
             _publish(tmp, path, old_fd)
             tmp = None
@@ -214,17 +229,20 @@ class SweepFile:
 
     @classmethod
     def in_memory(cls, scene: Scene, overrides: tuple[str, ...] = (), *,
-                  backend: str | None = None, adaptive: dict | None = None) -> SweepFile:
+                  backend: str | None = None, adaptive: dict | None = None,
+                  grid: Grid | None = None) -> SweepFile:
         """The same result, held in memory (HDF5's core driver, no backing store): the
         sink of ``rocksweep.run`` without ``output``. Nothing touches a disk; ``image``
-        gives the file's bytes, exactly what ``create`` would have written."""
+        gives the file's bytes, exactly what ``create`` would have written. grid: as
+        for ``create``."""
         import h5py
 
         name = f"rocksweep-memory-{os.getpid()}-{id(scene)}.h5"
         f = h5py.File(name, "w", driver="core", backing_store=False, track_order=True)
         try:
             _initialise(f, scene, overrides, adaptive)
-            self = cls(Path("memory"), f, scene, backend, adaptive)
+            self = cls(Path("memory"), f, grid if grid is not None else Grid(scene),
+                       backend, adaptive)
             self._start_session()
         except BaseException:
             _close_quietly(f)
@@ -238,10 +256,11 @@ class SweepFile:
 
     @classmethod
     def resume(cls, path: str | Path, scene: Scene, overrides: tuple[str, ...] = (),
-               *, backend: str | None = None, adaptive: dict | None = None) -> SweepFile:
+               *, backend: str | None = None, adaptive: dict | None = None,
+               grid: Grid | None = None) -> SweepFile:
         """Reopen a result file of the same scene (and the same adaptive settings, None
         for a sweep of every point) to finish it (its points are kept whatever happens:
-        the session's attributes are updated in place)."""
+        the session's attributes are updated in place). grid: as for ``create``."""
         path = Path(path)
         if is_input(path, scene.inputs):  # written in place: only the identity rule
             raise StoreError(f"{shown(path)}: is this command's input; choose another "
@@ -270,7 +289,7 @@ class SweepFile:
         f = _open(path, "r+")
         try:
             _layout(f, path)  # the file locked now (another may have replaced the first)
-            self = cls(path, f, scene, backend, adaptive)
+            self = cls(path, f, grid if grid is not None else Grid(scene), backend, adaptive)
             self._start_session()
         except BaseException as err:
             _close_quietly(f)
