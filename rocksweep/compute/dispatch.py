@@ -41,7 +41,7 @@ def run_variant(rows: np.ndarray, kind: int, level: int, ground: bool, refine: i
 
     refine: close calls re-run finer, up to this many refinements (``compute.certify``,
     ``Numerics.refine``; 0: none). record: a record all rows share (its samples written
-    once into one wide row, ``_run_record``), or None (the rows carry their samples or
+    once into one wide row, ``run_record``), or None (the rows carry their samples or
     need none). histories: a list of n entries to receive each run's history
     (float64[capacity, N_HIST], the finest run's when certified): the energy-accounting
     point kernel runs instead (``level`` unused). out: where to write the result rows
@@ -63,7 +63,7 @@ def run_variant(rows: np.ndarray, kind: int, level: int, ground: bool, refine: i
             if record is None:
                 fn(sub, res)
             else:
-                _run_record(fn, sub, np.ones(sub.shape[0], bool), res, record)
+                run_record(fn, sub, np.ones(sub.shape[0], bool), res, record)
 
     call(rows, outs, range(n))  # idx: the rows' places in ``histories``
     if refine > 0:
@@ -76,7 +76,7 @@ def run_variant(rows: np.ndarray, kind: int, level: int, ground: bool, refine: i
     return outs
 
 
-def _run_record(kernel_fn, rows: np.ndarray, sel: np.ndarray, outs: np.ndarray,
+def run_record(kernel_fn, rows: np.ndarray, sel: np.ndarray, outs: np.ndarray,
                 record) -> None:
     """Run the selected rows of a record scene, all driven by ``record``.
 

@@ -3,7 +3,7 @@
 Every point's cap on RK4 evaluations (the kernel's PAR_MAXSTEPS, ``points.run_cost``,
 ``points.record_cost``) must be at most ``numerics.MAX_POINT_STEPS``, at the sweep's and
 at the single runs' accuracy; the bodies checked stand for the grid's
-(``_candidate_bodies``), and a refused scene's message names the value that makes a point
+(``candidate_bodies``), and a refused scene's message names the value that makes a point
 costly and the bound it must keep (``_cost_message``).
 """
 
@@ -32,7 +32,7 @@ from rocksweep.scene.model import Scene, SceneError
 from rocksweep.schema import KEYS, fmt
 
 # Body grids up to this many distinct bodies are checked body by body; larger ones at the
-# combinations of each key's extreme values (``_candidate_bodies``).
+# combinations of each key's extreme values (``candidate_bodies``).
 MAX_BODIES_CHECKED = 1024
 # Typical values (Table 3; the `default` numerics) that the cost check puts in place of a
 # value, one at a time, to find which value makes a point too costly.
@@ -44,7 +44,7 @@ _TAME = {"body.wn_over_p": 2.43, "body.zeta": 0.05, "body.alpha_cg": 0.15,
          "numerics.max_events": Numerics().max_events}
 
 
-def _candidate_bodies(scene: Scene) -> list[dict[str, float]]:
+def candidate_bodies(scene: Scene) -> list[dict[str, float]]:
     """Body values (by key name) that stand for the grid's bodies; each is built, so a body
     that is not physical raises its ``BodyError`` (as a SceneError).
 
@@ -176,7 +176,7 @@ def _runs(scene: Scene) -> tuple[tuple[Numerics, str], ...]:
     return tuple(runs)
 
 
-def _check_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
+def check_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
     """Refuse a scene with a point whose step cap exceeds MAX_POINT_STEPS.
 
     The cap grows with the run's length t_pulse + horizon and with 1/step; over the pulse

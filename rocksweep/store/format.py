@@ -1,5 +1,5 @@
 """The sweep result format (HDF5 through h5py): its constants and metadata, and the
-making of a new file's contents (``_initialise``).
+making of a new file's contents (``initialise``).
 
 Layout (netCDF-4 / CF-1.10, so ``xarray.open_dataset(path, engine="h5netcdf")`` and
 netCDF-4 readers open it):
@@ -51,7 +51,7 @@ from rocksweep import fields
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
 from rocksweep.scene.model import Scene
-from rocksweep.store._common import _fixed, _now
+from rocksweep.store._common import fixed_ascii, utc_now
 from rocksweep.store.identity import record_attrs, resolved_scene
 from rocksweep.vocab.axes import alpha_symbol
 from rocksweep.vocab.outcomes import COMPUTED_FLAGS, COMPUTED_MEANING
@@ -173,7 +173,7 @@ def file_bytes(scene: Scene, adaptive: bool = False) -> int:
     return per_point * scene.size + coords
 
 
-def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
+def initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
                 adaptive: dict | None = None) -> None:
     import h5py
     vers = versions()
@@ -208,13 +208,13 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
         _store_suite_records(f, scene.suite)
     for k, v in vers.items():
         a[f"{k}_version"] = v
-    a["started"] = _now()
+    a["started"] = utc_now()
     a["points_total"] = np.int64(scene.size)
     # fixed-size attributes, updated in place by every session
     zeros = {"S": "", "i": 0, "f": 0.0}
     for name, dtype in SESSION_ATTRS.items():
         kind = np.dtype(dtype).kind
-        a.create(name, _fixed("", dtype) if kind == "S" else np.array(zeros[kind], dtype))
+        a.create(name, fixed_ascii("", dtype) if kind == "S" else np.array(zeros[kind], dtype))
     if adaptive is not None:
         a["adaptive"] = np.int8(1)
         a["adaptive_axes"] = " ".join(adaptive["axes"])

@@ -31,40 +31,40 @@ from rocksweep.outputs import check_output, clean_stale_partials, is_input, part
 from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import (
-    _H5_ERRORS,
+    H5_ERRORS,
     StoreError,
-    _close_quietly,
-    _damaged,
-    _fixed,
-    _mib,
-    _now,
-    _why,
+    close_quietly,
+    damaged,
+    error_reason,
+    fixed_ascii,
+    mib,
+    utc_now,
 )
 from rocksweep.store.format import (
     ADAPTIVE_COUNT_ATTRS,
     HISTORY_BYTES,
     SESSION_ATTRS,
-    _initialise,
     file_bytes,
     flat_slabs,
+    initialise,
     versions,
 )
 from rocksweep.store.identity import resolved_scene, scene_differences
 from rocksweep.store.reader import (
-    _check_computed,
-    _check_outcome,
-    _checked_attrs,
-    _layout,
-    _open,
+    check_computed,
+    check_outcome,
+    checked_attrs,
+    open_h5,
+    read_layout,
 )
 from rocksweep.store.safety import (
     UPDATE_MARGIN,
-    _check_space,
-    _lock_existing,
-    _publish,
-    _reserve,
-    _reserve_bytes,
-    _space_needed,
+    check_space,
+    lock_existing,
+    publish_result,
+    reserve_bytes,
+    reserve_space,
+    space_needed,
 )
 
 if TYPE_CHECKING:
@@ -74,7 +74,7 @@ if TYPE_CHECKING:
 def _put(f: h5py.File, name: str, value) -> None:
     """Overwrite a session attribute in place (its fixed type and size)."""
     dtype = SESSION_ATTRS.get(name) or ADAPTIVE_COUNT_ATTRS[name]
-    arr = _fixed(value, dtype) if dtype.startswith("S") else np.array(value, dtype=dtype)
+    arr = fixed_ascii(value, dtype) if dtype.startswith("S") else np.array(value, dtype=dtype)
     f.attrs.modify(name, arr)
 
 
@@ -85,7 +85,7 @@ def _in_place(f: h5py.File) -> bool:
         try:
             if name not in a or a.get_id(name).dtype != np.dtype(dtype):
                 return False
-        except _H5_ERRORS:
+        except H5_ERRORS:
             return False
     return True
 
@@ -104,7 +104,7 @@ def _upgrade_session_attrs(f: h5py.File) -> None:
             old = "" if dtype.startswith("S") else 0
         if name in a:
             del a[name]
-        a.create(name, _fixed(old, dtype) if dtype.startswith("S")
+        a.create(name, fixed_ascii(old, dtype) if dtype.startswith("S")
                  else np.array(old, dtype=dtype))
 
 
@@ -120,7 +120,7 @@ class SweepFile:
         scene = grid.scene
         self.names = list(scene.variables())
         self.adaptive = adaptive  # resolved adaptive settings, None: every point
-        self.session_start = _now()
+        self.session_start = utc_now()
         self.backend = backend or "unspecified"
         self._history = ""  # the file's history before this session
         self._session_line = ""
@@ -129,7 +129,7 @@ class SweepFile:
     def _fail(self, err: StoreError) -> StoreError:
         """Close the file after a failed write (nothing more is written) and remember why:
         later calls repeat this error, not a second one about a closed file."""
-        _close_quietly(self.f)
+        close_quietly(self.f)
         self._broken = err
         return err
 
@@ -175,15 +175,15 @@ class SweepFile:
             raise StoreError(f"{shown(path)}: already exists; use --resume to finish it or "
                              "--overwrite to replace it")
         nbytes = file_bytes(scene, adaptive is not None)
-        reserve = _reserve_bytes(scene, nbytes)
+        reserve = reserve_bytes(scene, nbytes)
         removed = clean_stale_partials(path)  # a killed attempt's reserved space back
         if removed and log is not None:
             log(f"removed {len(removed)} stale temporary file{'s' * (len(removed) > 1)} of "
                 f"{shown(path)} left by a sweep killed while making it ({removed[0][0]}"
                 f"{', ...' if len(removed) > 1 else ''}; "
-                f"{_mib(sum(n for _, n in removed))})")
-        _check_space(path, _space_needed(reserve), f"a grid of {grid.size} points")
-        old_fd = _lock_existing(path) if existed else None
+                f"{mib(sum(n for _, n in removed))})")
+        check_space(path, space_needed(reserve), f"a grid of {grid.size} points")
+        old_fd = lock_existing(path) if existed else None
         tmp: Path | None = None
         f = None
         try:
@@ -192,15 +192,15 @@ class SweepFile:
                                         dir=parent)
             os.close(fd)
             tmp = Path(name)
-            _reserve(tmp, reserve)  # room for all of it, or ENOSPC before HDF5 writes
+            reserve_space(tmp, reserve)  # room for all of it, or ENOSPC before HDF5 writes
             g = h5py.File(tmp, "w", track_order=True)  # truncates: reserve again
             try:
-                _reserve(tmp, reserve)
-                _initialise(g, scene, overrides, adaptive)
+                reserve_space(tmp, reserve)
+                initialise(g, scene, overrides, adaptive)
                 g.flush()
                 size = g.id.get_filesize()  # HDF5's end of allocation (eof is stale)
             except BaseException:
-                _close_quietly(g)
+                close_quietly(g)
                 raise
             g.close()
             if 0 < size < reserve:
@@ -208,17 +208,17 @@ class SweepFile:
             f = h5py.File(tmp, "r+", locking=True)  # locked before anyone can see it
             self = cls(path, f, grid, backend, adaptive)
             self._start_session()  # before the file has its name: failing leaves nothing
-            _publish(tmp, path, old_fd)
+            publish_result(tmp, path, old_fd)
             tmp = None
             return self
         except StoreError:
             if f is not None:
-                _close_quietly(f)
+                close_quietly(f)
             raise
-        except _H5_ERRORS as err:
+        except H5_ERRORS as err:
             if f is not None:
-                _close_quietly(f)
-            raise StoreError(f"{shown(path)}: cannot write ({_why(err)}); nothing written"
+                close_quietly(f)
+            raise StoreError(f"{shown(path)}: cannot write ({error_reason(err)}); nothing written"
                              ) from None
         finally:
             if tmp is not None:
@@ -240,12 +240,12 @@ class SweepFile:
         name = f"rocksweep-memory-{os.getpid()}-{id(scene)}.h5"
         f = h5py.File(name, "w", driver="core", backing_store=False, track_order=True)
         try:
-            _initialise(f, scene, overrides, adaptive)
+            initialise(f, scene, overrides, adaptive)
             self = cls(Path("memory"), f, grid if grid is not None else Grid(scene),
                        backend, adaptive)
             self._start_session()
         except BaseException:
-            _close_quietly(f)
+            close_quietly(f)
             raise
         return self
 
@@ -265,18 +265,18 @@ class SweepFile:
         if is_input(path, scene.inputs):  # written in place: only the identity rule
             raise StoreError(f"{shown(path)}: is this command's input; choose another "
                              "output path")
-        f = _open(path, "r")
+        f = open_h5(path, "r")
         try:
-            stored = _layout(f, path).scene
-            _checked_attrs(f, path)  # what readers need, before any point is computed
+            stored = read_layout(f, path).scene
+            checked_attrs(f, path)  # what readers need, before any point is computed
             outcome = f["outcome"][()]
-            _check_outcome(outcome, path)
+            check_outcome(outcome, path)
             if stored.get("adaptive"):
-                _check_computed(f["computed"][()], outcome, path)
-        except _H5_ERRORS as err:
-            raise _damaged(path, _why(err)) from None
+                check_computed(f["computed"][()], outcome, path)
+        except H5_ERRORS as err:
+            raise damaged(path, error_reason(err)) from None
         finally:
-            _close_quietly(f)
+            close_quietly(f)
         diffs = scene_differences(stored, resolved_scene(scene, overrides, adaptive))
         if diffs:
             done = int((outcome != L.OUTCOME_NOT_RUN).sum())
@@ -286,16 +286,16 @@ class SweepFile:
                     "holds no computed point")
             raise StoreError(f"{shown(path)}: cannot resume, the scene differs from the "
                              "file's: " + "; ".join(diffs) + f" ({keep})")
-        f = _open(path, "r+")
+        f = open_h5(path, "r+")
         try:
-            _layout(f, path)  # the file locked now (another may have replaced the first)
+            read_layout(f, path)  # the file locked now (another may have replaced the first)
             self = cls(path, f, grid if grid is not None else Grid(scene), backend, adaptive)
             self._start_session()
         except BaseException as err:
-            _close_quietly(f)
-            if isinstance(err, _H5_ERRORS) and not isinstance(err, RocksweepError):
+            close_quietly(f)
+            if isinstance(err, H5_ERRORS) and not isinstance(err, RocksweepError):
                 raise StoreError(f"{shown(path)}: cannot update its attributes "
-                                 f"({_why(err)}); its points are kept") from None
+                                 f"({error_reason(err)}); its points are kept") from None
             raise
         return self
 
@@ -304,7 +304,7 @@ class SweepFile:
         h5py's errors (the callers say what they mean for the file)."""
         f = self.f
         if not _in_place(f):  # a format-1 file: its attributes change type once
-            _check_space(self.path, UPDATE_MARGIN, "updating its attributes")
+            check_space(self.path, UPDATE_MARGIN, "updating its attributes")
             _upgrade_session_attrs(f)
             f.flush()
         n = int(f.attrs["sessions"]) + 1
@@ -365,9 +365,9 @@ class SweepFile:
             self.f.flush()
             self._write_at("computed", coords, computed)
             self.f.flush()
-        except _H5_ERRORS as err:
+        except H5_ERRORS as err:
             raise self._fail(StoreError(
-                f"{shown(self.path)}: cannot write results ({_why(err)}); the points "
+                f"{shown(self.path)}: cannot write results ({error_reason(err)}); the points "
                 "written before are kept, finish with --resume")) from None
 
     def write_filled(self, outcome: np.ndarray, counts: dict[str, int]) -> None:
@@ -380,9 +380,9 @@ class SweepFile:
             self.f["outcome"][...] = np.asarray(outcome, np.int8).reshape(self.grid.shape)
             self.f.flush()
             self.put_counts(counts)
-        except _H5_ERRORS as err:
+        except H5_ERRORS as err:
             raise self._fail(StoreError(
-                f"{shown(self.path)}: cannot write the filled outcomes ({_why(err)}); "
+                f"{shown(self.path)}: cannot write the filled outcomes ({error_reason(err)}); "
                 "finish with --resume")) from None
 
     def put_counts(self, counts: dict[str, int]) -> None:
@@ -411,9 +411,9 @@ class SweepFile:
                                 for s, n in zip(index, ds.shape, strict=True))
                     ds[index] = arr[a - res.start:b - res.start].reshape(box)
             self.f.flush()
-        except _H5_ERRORS as err:
+        except H5_ERRORS as err:
             raise self._fail(StoreError(
-                f"{shown(self.path)}: cannot write results ({_why(err)}); the points "
+                f"{shown(self.path)}: cannot write results ({error_reason(err)}); the points "
                 "written before are kept, finish with --resume")) from None
 
     def finish(self, wall_seconds: float, cpu_seconds: float, *,
@@ -434,7 +434,7 @@ class SweepFile:
                 "complete": bool(done.all()),
                 "steps_total": int(f["steps"][()].sum()),
                 "event_steps_total": int(f["event_steps"][()].sum()),
-                "last_finished": _now(),
+                "last_finished": utc_now(),
             }
             if done.all() and not plain(a["finished"]):
                 attrs["finished"] = attrs["last_finished"]
@@ -448,9 +448,9 @@ class SweepFile:
             for k, v in attrs.items():
                 _put(f, k, int(v) if k == "complete" else v)
             f.flush()
-        except _H5_ERRORS as err:
+        except H5_ERRORS as err:
             raise self._fail(StoreError(
-                f"{shown(self.path)}: cannot record the session's totals ({_why(err)}); "
+                f"{shown(self.path)}: cannot record the session's totals ({error_reason(err)}); "
                 "its points are kept")) from None
         return attrs
 
@@ -459,8 +459,8 @@ class SweepFile:
             return  # closed when it broke
         try:
             self.f.close()
-        except _H5_ERRORS as err:
-            raise StoreError(f"{shown(self.path)}: cannot close ({_why(err)})") from None
+        except H5_ERRORS as err:
+            raise StoreError(f"{shown(self.path)}: cannot close ({error_reason(err)})") from None
 
     def __enter__(self) -> SweepFile:
         return self
@@ -469,7 +469,7 @@ class SweepFile:
         if exc[0] is None:
             self.close()
         else:
-            _close_quietly(self.f)
+            close_quietly(self.f)
 
 
 def _history(before: str, line: str) -> str:
