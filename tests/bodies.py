@@ -7,7 +7,7 @@ Figure 4 (omega_n/p = 9.82). Each as Pi groups (a dict, keyword arguments of
 
 from __future__ import annotations
 
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 
 SHARED = {"zeta": 0.05, "alpha_cg": 0.15, "alpha_A": 0.28, "mA_over_m": 0.47,
           "IA_ratio": 0.56}

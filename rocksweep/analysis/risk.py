@@ -54,7 +54,7 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.errors import RiskError, RocksweepError  # noqa: F401 (re-exported)
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 from rocksweep.vocab.ground import PGA, PGV, SA
 
 __all__ = ["Hazard", "RiskError", "fragility_median", "hazard_frame", "read_hazard",

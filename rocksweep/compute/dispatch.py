@@ -1,7 +1,7 @@
 """Parameter rows through one compiled kernel variant: the one dispatch of every run.
 
 Sweeps (``compute.sweep.run_rows``, one call per body kind and record of a chunk), the
-A_min searches of ``analysis.boundaries``, single runs (``compute.single.simulate``) and
+A_min searches of ``analysis.boundaries``, single runs (``compute.single.run_point``) and
 the accuracy study (``analysis.accuracy.run_kernel``) all run their rows through
 ``run_variant``: the kernel variant of (body kind, bookkeeping level, ground), a record's
 samples riding on the rows, and the close calls certified (``compute.certify``).

@@ -21,7 +21,7 @@ from rocksweep.numerics import (
     PRESETS,
     Numerics,
 )
-from rocksweep.physics.model import BodyError
+from rocksweep.physics.bodies import BodyError
 from rocksweep.physics.points import (
     body_omega_rock,
     body_zeta_rock,

@@ -28,7 +28,7 @@ import numpy as np
 
 from rocksweep.numerics import Numerics
 from rocksweep.outputs import input_problem, is_input, shown
-from rocksweep.physics.model import BodyError, body_from_geometry
+from rocksweep.physics.bodies import BodyError, body_from_geometry
 from rocksweep.physics.points import FREE, INITIAL, RECORD
 from rocksweep.physics.records import GroundRecord, RecordError, read_record
 from rocksweep.physics.suite import (

@@ -31,7 +31,7 @@ from rocksweep.kernel.events import (
     hermite_root,
 )
 from rocksweep.kernel.stepping import first_stage, rk4_step
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.physics.points import body_omega_rock
 
 # Newton's stopping step in units of the step, as _locate asks for (0.05 tol / width).
