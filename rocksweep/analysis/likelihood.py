@@ -223,21 +223,43 @@ def stripe_rules(lnx: np.ndarray, k: np.ndarray, n: np.ndarray, med: np.ndarray,
     return one | few | (code == CODE["separated"])
 
 
+def isotonic_fit(k: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """The weighted isotonic (non-decreasing) fit of the fractions k / n: float64 (B, S)
+    for binomial counts k (B, S) of n (S,) > 0, stripes in increasing IM. Pool adjacent
+    violators, row by row: each stripe is pushed as a block and merged with the block
+    before it while that one's mean is larger (each stripe pushed once, merged away at
+    most once: O(S) per row, O(B S) memory). Plain Python lists: on 400 x 2000 counts
+    ~3x faster than the same stack vectorised over rows."""
+    k = np.asarray(k, np.float64)
+    n = np.asarray(n, np.float64)
+    B, S = k.shape
+    iso = np.empty((B, S))
+    weights = n.tolist()
+    for b in range(B):
+        ks: list[float] = []  # the blocks: sum of k, sum of n, first stripe
+        ns: list[float] = []
+        first: list[int] = []
+        for s, (kk, nn) in enumerate(zip(k[b].tolist(), weights, strict=True)):
+            ks.append(kk)
+            ns.append(nn)
+            first.append(s)
+            # mean(block before) > mean(last block), without dividing (sums of n > 0)
+            while len(ks) > 1 and ks[-2] * ns[-1] > ks[-1] * ns[-2]:
+                k_last, n_last = ks.pop(), ns.pop()
+                first.pop()
+                ks[-1] += k_last
+                ns[-1] += n_last
+        iso[b] = np.repeat(np.array(ks) / np.array(ns), np.diff(np.append(first, S)))
+    return iso
+
+
 def isotonic_lr(k: np.ndarray, n: np.ndarray) -> np.ndarray:
     """Likelihood-ratio statistic 2 (ll(free fractions) - ll(isotonic fractions)) of
-    binomial counts k (B, S) of n (S,) > 0, stripes in increasing IM. The isotonic
-    (non-decreasing) weighted fit is max_{i<=s} min_{j>=s} mean(i..j) (the min-max formula
-    of the pool-adjacent-violators solution)."""
-    ck = np.concatenate([np.zeros(k.shape[:-1] + (1,)), np.cumsum(k, -1)], -1)
-    cn = np.concatenate([[0.0], np.cumsum(n)])
-    S = n.size
-    i, j = np.meshgrid(np.arange(S), np.arange(S), indexing="ij")
-    valid = j >= i
-    mean = np.where(valid, (ck[..., j + 1] - ck[..., i]) / np.where(valid, cn[j + 1] - cn[i],
-                                                                    1.0), np.inf)
-    # cmin[.., i, s] = min over j >= s of mean(i..j); iso[s] = max over i <= s
-    cmin = np.flip(np.minimum.accumulate(np.flip(mean, -1), -1), -1)
-    iso = np.where(valid, cmin, -np.inf).max(-2)
+    binomial counts k (B, S) of n (S,) > 0, stripes in increasing IM (``isotonic_fit``):
+    float64 (B,)."""
+    k = np.asarray(k, np.float64)
+    n = np.asarray(n, np.float64)
+    iso = isotonic_fit(k, n)
     free = k / n
 
     def xlogy(a, b):

@@ -34,6 +34,7 @@ from rocksweep.physics.records import GroundRecord, RecordError, read_record
 from rocksweep.physics.suite import (
     AVGSA_RANGE,
     DEFAULT_PERIODS,
+    RECORD_IMS,
     SCALE_IMS,
     Suite,
     SuiteError,
@@ -56,6 +57,7 @@ from rocksweep.vocab.axes import DIAGRAM_AXES, alpha_symbol
 from rocksweep.vocab.ground import MP
 from rocksweep.vocab.ground import PULSE_KEY_SHAPES as _PULSE_KEY_SHAPES
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
+from rocksweep.vocab.settings import DEFAULT_PRESET, FINE
 
 # Largest grid a scene may describe [points]. A sweep file stores 45 bytes a point (69
 # with energy metrics, ``rocksweep.fields.variables``): 2e8 points are a 9-14 GB file, one
@@ -333,8 +335,8 @@ def _numerics(sec: dict, contact: bool = False) -> tuple[Numerics, Numerics]:
             v = float(v) if spec.kind == "number" else v
         given[k] = v
     accuracy = given.pop("accuracy", None)
-    numerics = Numerics.preset(accuracy or ("fine" if contact else "default"), **given)
-    # One default (issue 28): a single run (simulate) runs what a sweep of the same point
+    numerics = Numerics.preset(accuracy or (FINE if contact else DEFAULT_PRESET), **given)
+    # One default: a single run (simulate) runs what a sweep of the same point
     # runs, so one point has one answer; the certification of close calls
     # (``compute.certify``) makes the default trustworthy for both.
     single = numerics
@@ -573,6 +575,9 @@ def _scale(ground: dict) -> tuple[str | None, str, Any, float, float]:
             raise SceneError(f"{key}.{k}: unknown key (allowed: im, values, period; or "
                              "factor alone)")
     im = v.get("im")
+    if isinstance(im, str) and RECORD_IMS.get(im, ("", "", 1))[2] == 0:
+        raise SceneError(f"{key}.im = {im}: does not change when a record is scaled, so no "
+                         f"factor can reach a stripe of it; {KEYS[key + '.im'].allowed}")
     if not isinstance(im, str) or im not in SCALE_IMS:
         raise SceneError(f"{key}.im = {fmt(im)}: {KEYS[key + '.im'].allowed}")
     if v.get("values") is None:

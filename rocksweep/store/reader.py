@@ -207,11 +207,6 @@ def read_layout(f: h5py.File, path: Path) -> FileLayout:
     return FileLayout(stored, dims, shape, names)
 
 
-def _check_format(f: h5py.File, path: Path) -> None:
-    """Raise StoreError unless ``f`` is a valid rocksweep result (see ``read_layout``)."""
-    read_layout(f, path)
-
-
 def _is_hdf5(path: Path) -> bool:
     import h5py
     try:

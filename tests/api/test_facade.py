@@ -1,4 +1,4 @@
-"""The thin facade (issue 31): each argument check and each piece of work lives in the room
+"""The thin facade: each argument check and each piece of work lives in the room
 that does it (analysis.boundaries, analysis.calibrate, analysis.fragility,
 analysis.spectrum, compute.history, compute.session), with the words the API always used, and
 what ``rocksweep.<function>`` returns is what it returned before."""
