@@ -16,7 +16,7 @@ def _bounds(items: tuple[str, ...]) -> dict[str, tuple[str, str]]:
     for item in items:
         key, sep, rng = item.partition("=")
         parts = rng.split(",")
-        if not sep or len(parts) != 2:
+        if not sep or not key.strip() or len(parts) != 2:
             raise click.ClickException(f"--bounds {item!r}: expected KEY=LO,HI, e.g. "
                                        "impact.lam=0,1")
         try:

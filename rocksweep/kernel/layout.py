@@ -29,8 +29,9 @@ PAR_HCG = 11  # h_cg [m]
 PAR_IO = 12  # I_O about a corner with u = 0 [kg m^2]
 PAR_AMP = 13  # pulse amplitude A [m/s^2] (signed)
 PAR_OMEGA = 14  # pulse frequency omega [rad/s]
-PAR_SHAPE = 15  # SHAPE_SINE or SHAPE_COSINE
-PAR_TPULSE = 16  # pulse end 2 pi / omega [s]
+PAR_SHAPE = 15  # SHAPE_* code (``vocab.ground.SHAPE_CODE``)
+PAR_TPULSE = 16  # end of the ground motion [s]: the pulse's duration (its cycles, Ricker's and
+#                  MP's own: ``vocab.ground.pulse_duration``), a record's length; 0 for FREE
 PAR_LAM = 17  # lam (Pi10)
 PAR_DT = 18  # RK4 step once the ground is still (after the pulse or record) [s]
 PAR_TOL = 19  # event tolerance: width of the final bracket on time [s]

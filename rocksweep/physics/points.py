@@ -160,7 +160,7 @@ def body_omega_rock(body: Body) -> float:
     used. Above a damping ratio of 1 the mode is overdamped and its fast root,
     omega (zeta' + sqrt(zeta'^2 - 1)), is what an explicit RK4 step must resolve (it is
     unstable beyond |lambda dt| ~ 2.8): a slender, tall body with a light base (m h^2 >>
-    I_A + m_A R_A^2) and zeta ~ 0.2 has zeta' ~ 5 (issue 5, found by the property test).
+    I_A + m_A R_A^2) and zeta ~ 0.2 has zeta' ~ 5 (found by the hard cases' property test).
     """
     if body.rigid:
         return 0.0
