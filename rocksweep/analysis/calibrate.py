@@ -72,6 +72,7 @@ from rocksweep.physics.bodies import BodyError
 from rocksweep.physics.measured import Measured, noise_level, read_measured
 from rocksweep.physics.points import INITIAL, kernel_kind, point_row
 from rocksweep.schema import KEYS, fmt
+from rocksweep.vocab.kinds import CALIBRATION, KIND_ATTR
 
 ACCURACY = "fine"  # the least accuracy of a calibration's runs (``calibration_numerics``)
 H_NOISE = 4.0  # threshold of an excursion, in noise standard deviations ...
@@ -772,6 +773,7 @@ def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
     ds["misfit"].attrs = {"long_name": "RMS error of the half-cycle peaks at the estimate",
                           "units": "theta/alpha_ref"}
     ds.attrs = {
+        KIND_ATTR: CALIBRATION,
         "title": f"calibration of {', '.join(problem.keys)}",
         "ci": ci,
         "interval": "profile likelihood: misfit <= min + chi2_1(ci) s^2, s^2 = max(S_min/"
