@@ -22,7 +22,7 @@ from rocksweep.numerics import (
     step_sizes,
     vertical_step,
 )
-from rocksweep.physics.model import Body, FlexibleBody, G
+from rocksweep.physics.bodies import Body, FlexibleBody, G
 from rocksweep.physics.records import GroundRecord, vertical_samples
 from rocksweep.physics.vertical import VerticalHarmonic, air_time_harmonic, air_time_record
 from rocksweep.vocab.axes import INITIAL  # noqa: F401

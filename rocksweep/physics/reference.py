@@ -42,7 +42,7 @@ evaluated here from the point itself, not from the kernel's reader of its row
 the uplift events compare Q with M (g + a_v) b, and the run stops, ``airborne``, at the
 first time g + a_v <= 0, located by its own root search (``_air_time``).
 
-Times are p*t (p = 1 rad/s), angles in rad, SI units with m = 1 kg (``rocksweep.physics.model``).
+Times are p*t (p = 1 rad/s), angles in rad, SI units with m = 1 kg (``rocksweep.physics.bodies``).
 """
 
 from __future__ import annotations
@@ -72,7 +72,7 @@ from rocksweep.kernel.equations import (
     uplift_moment_rate,
 )
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 from rocksweep.physics.points import Point, point_row
 
 RTOL = 1e-10

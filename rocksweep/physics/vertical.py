@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 
 
 @dataclass(frozen=True)

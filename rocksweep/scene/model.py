@@ -13,7 +13,7 @@ from rocksweep import fields
 from rocksweep.errors import SceneError  # noqa: F401 (defined there; re-exported)
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import BlockBody, Body, FlexibleBody
+from rocksweep.physics.bodies import BlockBody, Body, FlexibleBody
 from rocksweep.physics.points import FREE, INITIAL, RECORD, Point
 from rocksweep.physics.records import GroundRecord, vertical_samples
 from rocksweep.physics.suite import Suite
@@ -59,7 +59,7 @@ class Scene:
     # listings (paths as read); an output is never one of them (``outputs.check_output``)
     inputs: tuple[str, ...] = field(default=(), repr=False)
     # a body given by the laboratory's numbers (body.kind physical): its Pi groups, p
-    # [rad/s], omega_n [rad/s] and h_cg [m] (``physics.model.body_from_geometry``), else None
+    # [rad/s], omega_n [rad/s] and h_cg [m] (``physics.bodies.body_from_geometry``), else None
     physical: dict | None = field(default=None, repr=False)
     # the record's vertical component (``ground.vertical``, read at load), else None; a
     # pulse's vertical harmonic is three axes, vertical.amplitude, .w_over_p and .phase

@@ -23,11 +23,11 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from rocksweep.compute.single import simulate
+from rocksweep.compute.single import run_point
 from rocksweep.kernel import equations as eq
 from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import BlockBody, FlexibleBody
+from rocksweep.physics.bodies import BlockBody, FlexibleBody
 from rocksweep.physics.points import RECORD, Point, point_row
 from rocksweep.physics.records import parse_record
 from rocksweep.physics.reference import reference_run
@@ -176,9 +176,9 @@ def test_constant_vertical_is_gravity_times_one_plus_c(c, lam, A_ratio):
     num = Numerics.preset("fine")
     body = FlexibleBody(**FIG4)
     scaled = FlexibleBody(**{**FIG4, "wn_over_p": FIG4["wn_over_p"] / math.sqrt(q)})
-    a = simulate(Point(body, lam, "sine", w_over_p, A_ratio, cycles=3,
+    a = run_point(Point(body, lam, "sine", w_over_p, A_ratio, cycles=3,
                        pulse_vertical=_constant(c)), num)
-    b = simulate(Point(scaled, lam, "sine", w_over_p / math.sqrt(q), A_ratio / q, cycles=3),
+    b = run_point(Point(scaled, lam, "sine", w_over_p / math.sqrt(q), A_ratio / q, cycles=3),
                  num)
     ha, hb = a.history_columns(), b.history_columns()
     t_pulse = 3 * 2 * math.pi / w_over_p
@@ -218,7 +218,7 @@ def test_kernel_outcome_equals_reference_with_vertical_records(a_v, w_v, A_ratio
     point = Point(BlockBody(alpha=0.2), 1.0, RECORD, math.nan, A_ratio, record=h, p=p,
                   vertical=v)
     num = Numerics()
-    k = simulate(point, num, history=False)
+    k = run_point(point, num, history=False)
     r = reference_run(point, num)
     assert k.outcome == {0: "safe", 1: "mode1", 2: "mode2"}[r["outcome"]]
     assert k.impacts == r["impacts"] or k.outcome != "safe"
@@ -229,8 +229,8 @@ def test_kernel_outcome_equals_reference_with_vertical_records(a_v, w_v, A_ratio
 def test_zero_vertical_changes_nothing(body_fig3):
     """The vertical variant with a_v = 0 gives the horizontal variant's run (a check that
     the vertical code adds nothing but g + a_v)."""
-    plain = simulate(Point(body_fig3, 0.4, "sine", 5.3, 5.0), Numerics(), history=False)
-    zero = simulate(Point(body_fig3, 0.4, "sine", 5.3, 5.0,
+    plain = run_point(Point(body_fig3, 0.4, "sine", 5.3, 5.0), Numerics(), history=False)
+    zero = run_point(Point(body_fig3, 0.4, "sine", 5.3, 5.0,
                           pulse_vertical=VerticalHarmonic(0.0, 3.0, 0.0)), Numerics(),
                     history=False)
     assert zero.outcome == plain.outcome == "mode1"
@@ -243,13 +243,13 @@ def test_energy_balance_with_a_vertical(body_fig3):
     constant g), over a run with impacts, to the integrator's error (converged steps);
     the vertical's share of W_in is not small."""
     num = Numerics.preset("fine", steps_per_period=80, event_tol=1e-10)
-    run = simulate(Point(body_fig3, 0.2, "sine", 2.0, 1.5,
+    run = run_point(Point(body_fig3, 0.2, "sine", 2.0, 1.5,
                          pulse_vertical=VerticalHarmonic(0.6, 5.0, 20.0)), num)
     o = run.out
     assert o[L.OUT_IMPACTS] >= 1
     balance = o[L.OUT_W_IN] - o[L.OUT_D_DAMP] - o[L.OUT_E_IMPACT]
     assert o[L.OUT_E_END] == pytest.approx(balance, abs=1e-6 * o[L.OUT_W_IN])
-    plain = simulate(Point(body_fig3, 0.2, "sine", 2.0, 1.5), num)
+    plain = run_point(Point(body_fig3, 0.2, "sine", 2.0, 1.5), num)
     assert abs(o[L.OUT_W_IN] - plain.out[L.OUT_W_IN]) > 0.05 * plain.out[L.OUT_W_IN]
 
 
@@ -280,7 +280,7 @@ def test_airborne_stops_the_run_where_g_plus_av_reaches_zero():
     airborne (a flagged run), in the kernel and the reference alike."""
     pv = VerticalHarmonic(1.5, 6.0, 10.0)
     point = Point(BlockBody(alpha=0.2), 1.0, "sine", 2.0, 1.5, pulse_vertical=pv)
-    k = simulate(point, Numerics(), history=False)
+    k = run_point(point, Numerics(), history=False)
     r = reference_run(point, Numerics())
     t_air = (math.pi + math.asin(1 / 1.5) - math.radians(10.0)) / 6.0
     assert "airborne" in k.summary()["status"]
