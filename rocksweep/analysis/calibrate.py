@@ -63,10 +63,10 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.compute.single import history_capacity
+from rocksweep.compute.dispatch import run_variant
 from rocksweep.errors import CalibrationError, RocksweepError  # noqa: F401 (CalibrationError re-exported)
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.kernel import point_kernel, warm_up
+from rocksweep.kernel import warm_up
 from rocksweep.numerics import Numerics, step_budget
 from rocksweep.physics.bodies import BodyError
 from rocksweep.physics.measured import Measured, noise_level, read_measured
@@ -340,9 +340,12 @@ class Problem:
             row[L.PAR_TEND] = need
             row[L.PAR_MAXSTEPS] = step_budget(row[L.PAR_TPULSE], need, row[L.PAR_DT],
                                               row[L.PAR_DT_ON], self.numerics)
-        out = np.empty(L.N_OUT)
-        hist = np.empty((history_capacity(row), L.N_HIST))
-        point_kernel(kernel_kind(point.body), point.ground)(row, out, hist)
+        # the one dispatch of every run: close calls certified as ``rocksweep.simulate``'s
+        # (the finest run's history kept)
+        hists: list = [None]
+        out = run_variant(row[None, :], kernel_kind(point.body), L.LEVEL_OUTCOME,
+                          point.ground, self.numerics.refine, histories=hists)[0]
+        hist = hists[0]
         self.runs += 1
         n = int(out[L.OUT_HIST_ROWS])
         a = point.body.alpha_ref
