@@ -756,7 +756,7 @@ def check_search(search: Any) -> bool:
     ApiError."""
     from rocksweep.errors import ApiError
 
-    if not (isinstance(search, bool) or type(search).__name__ == "bool_"):
+    if not isinstance(search, bool | np.bool_):
         raise ApiError(f"search = {search!r}: must be True or False")
     return bool(search)
 
