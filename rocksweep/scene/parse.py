@@ -41,7 +41,7 @@ from rocksweep.physics.suite import (
     SuiteError,
     make_suite,
 )
-from rocksweep.scene.admission import candidate_bodies, check_cost
+from rocksweep.scene.admission import candidate_bodies, check_cost, check_vertical_cost
 from rocksweep.scene.loader import CONTROL_CHARS, YamlError, load_yaml
 from rocksweep.scene.model import Axis, Scene, SceneError
 from rocksweep.schema import (
@@ -973,6 +973,7 @@ def _check_vertical_start(scene: Scene) -> None:
                              f"pulse.vertical.phase = {fmt(float(phase[j]))} deg, a_v = "
                              f"{a0[i, j]:.4g} g at t = 0, so g + a_v <= 0 (the body leaves "
                              "the ground); a sin(phase) must be > -1 at t = 0")
+        check_vertical_cost(scene)
     if scene.vertical is not None:
         first = float(scene.vertical_samples()[0]) / scene.record.pga  # per unit of A
         a_ratio = float(np.max(np.abs(scene.axis("A_ratio").values)))
