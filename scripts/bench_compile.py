@@ -26,7 +26,7 @@ times are less sensitive to load than wall times.
 
     python scripts/bench_compile.py            # ~3-4 min on 2 cores
     python scripts/bench_compile.py --quick    # ~30 s: Figure 3(a)'s variant and scene only
-    python scripts/bench_compile.py --vertical # item 1 alone: the vertical variants and the ground ones
+    python scripts/bench_compile.py --vertical # item 1 alone: vertical and ground variants
 
 Run it against another copy of the package (e.g. the code before a change) with
 ``PYTHONPATH=/path/to/that/copy``: every subprocess inherits the environment.
