@@ -300,6 +300,26 @@ def read_hazard(source: Any, *, site: int | None = None) -> Hazard:
 # ---------------------------------------------------------------------------------------
 
 
+def check_fragility(ds: Any, src: str, suites: bool = False) -> None:
+    """Refuse (one line naming ``src``, the file or argument) a Dataset that is no
+    fragility: another analysis's, or a sweep (with ``suites``, a record-suite sweep is
+    let through: the command line fits it first)."""
+    from rocksweep.analysis.kinds import dataset_kind
+
+    kind = dataset_kind(ds)
+    if kind == "fragility":
+        return
+    if kind == "sweep":
+        if suites and "record" in ds["outcome"].dims:
+            return
+        what = ("a record-suite sweep" if "record" in ds["outcome"].dims else
+                "a sweep without records (a pulse or one-record sweep)")
+    else:
+        what = f"a {kind} Dataset" if kind else "not a rocksweep Dataset"
+    raise RiskError(f"{src}: {what}, not a fragility; risk takes what rocksweep.fragility "
+                    "returns (rocksweep fragility -o FRAG.h5) of a record-suite sweep")
+
+
 def fragility_median(fr: xr.Dataset) -> tuple[xr.DataArray, str]:
     """(the fitted median DataArray, its name): ``im_median``, or ``median`` in fragility
     Datasets made before that variable was renamed."""
