@@ -4,6 +4,7 @@ file, or one in memory), the driver handed it."""
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
@@ -74,7 +75,7 @@ def sweep_file(scene: Scene, path: str | Path | None, *, overrides: Sequence[str
 
         settings = adaptive.resolved(Grid(scene))  # bad axes or settings: before any file
 
-    from rocksweep.compute.driver import drive
+    from rocksweep.compute.driver import SweepInterrupted, drive
     from rocksweep.store.writer import SweepFile
 
     t0 = time.perf_counter()
@@ -109,9 +110,19 @@ def sweep_file(scene: Scene, path: str | Path | None, *, overrides: Sequence[str
         sf = SweepFile.create(path, scene, overrides, overwrite=overwrite, backend=how,
                               adaptive=settings, log=say)
     report = SweepReport(path, sf.grid.size, 0, 0, 0.0, 0.0, 0.0)
-    return drive(sf, path, report, t0, adaptive, validate, jobs=jobs, backend=backend,
-                  scheduler=scheduler, chunk_size=chunk_size, where=where,
-                  write_every=write_every, progress=progress, say=say)
+    try:
+        return drive(sf, path, report, t0, adaptive, validate, jobs=jobs, backend=backend,
+                     scheduler=scheduler, chunk_size=chunk_size, where=where,
+                     write_every=write_every, progress=progress, say=say)
+    except KeyboardInterrupt as err:
+        if isinstance(err, SweepInterrupted):
+            raise
+        # a Ctrl-C between the file's making and the driver's own handler: the file is
+        # there (its points saved), so the answer is the interrupted sweep's, resume line
+        # and all, not a bare interrupt
+        with contextlib.suppress(Exception):
+            sf.close()
+        raise SweepInterrupted(report) from None
 
 
 def _stderr(line: str) -> None:
