@@ -714,6 +714,10 @@ def appears(d: Path, target: str, args: list[str]) -> subprocess.CompletedProces
     if not (d / target).exists() or (d / target).read_text(errors="replace") != "mine":
         LOST.append(f"{target} (made meanwhile) replaced")
     freeze(d)  # the user's file is an input now: the check above said if it was lost
+    errors = [ln for ln in r.stderr.splitlines() if ln.startswith("Error: ")]
+    if r.returncode and len(errors) == 1 and "Traceback" not in r.stderr:
+        # the command did its work and said so; its refusal to publish is the answer
+        r = subprocess.CompletedProcess(r.args, r.returncode, "", errors[0])
     return r
 
 
@@ -740,10 +744,14 @@ def _(d):
     fixture(d, "s.h5")
     freeze(d)
     e = {**os.environ, "PYTHONPATH": str(ROOT)}
-    procs = [subprocess.Popen([sys.executable, "-c", APPEARS.replace(
-        "with open(target, 'x') as f:\n        f.write('mine')", "pass"), "t.csv", "table",
-        "s.h5", "-o", "t.csv"], cwd=d, env=e, stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    slow = APPEARS.replace("    try:\n        with open(target, 'x') as f:\n"
+                           "            f.write('mine')\n    except FileExistsError:\n"
+                           "        pass\n", "    import time; time.sleep(2)\n")
+    assert "sleep" in slow
+    # both check t.csv, then both wait 2 s before writing it: they overlap
+    procs = [subprocess.Popen([sys.executable, "-c", slow, "t.csv", "table", "s.h5", "-o",
+                               "t.csv"], cwd=d, env=e, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True) for _ in range(2)]
     outs = [p.communicate(timeout=TIMEOUT) for p in procs]
     r = subprocess.CompletedProcess([], 0, outs[0][0] + outs[1][0], "")
     wrote = sum("wrote" in o for o, _ in outs)
@@ -765,6 +773,7 @@ def _(d):
     os.utime(old, (time.time() - 3600, time.time() - 3600))
     r = cli(d, ["risk", "f.h5", "--hazard", "hz.csv", "-o", "r.h5"])
     left = [p.name for p in d.iterdir() if ".partial" in p.name]
+    freeze(d)  # the killed writers' files are no inputs: their removal is the point
     return wrong(r, f"left {left}") if left else r
 
 
