@@ -38,7 +38,7 @@ from rocksweep.compute.arguments import (  # noqa: F401 (re-exported)
     check_jobs,
     probe_scheduler,
 )
-from rocksweep.compute.dispatch import _run_record, run_variant  # noqa: F401 (re-exported)
+from rocksweep.compute.dispatch import run_variant
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.scene.grid import ChunkResult, ChunkRows, Grid
 from rocksweep.scene.model import Scene
@@ -231,7 +231,7 @@ def _run_on_cluster(grid: Grid, chunks: list[tuple[int, int]], level: int,
     worker for ``NO_WORKERS_TIMEOUT`` seconds (none joined, or all left) is a
     ``SweepError``; the caller saves what finished.
     """
-    from distributed import Client, wait
+    from distributed import Client, KilledWorker, wait
     from distributed.client import FIRST_COMPLETED
 
     with Client(scheduler, timeout="10s") as client:
@@ -279,13 +279,11 @@ def _run_on_cluster(grid: Grid, chunks: list[tuple[int, int]], level: int,
                 except TimeoutError:
                     running[f] = (a, b)
                     continue
-                except Exception as err:
-                    if type(err).__name__ == "KilledWorker":
-                        raise SweepError(
-                            f"dask cluster {scheduler}: the chunk of points {a}..{b - 1} "
-                            "killed the workers that ran it (out of memory?); finished "
-                            "points are saved: rerun with --resume") from None
-                    raise
+                except KilledWorker:
+                    raise SweepError(
+                        f"dask cluster {scheduler}: the chunk of points {a}..{b - 1} "
+                        "killed the workers that ran it (out of memory?); finished "
+                        "points are saved: rerun with --resume") from None
                 submit(1)
                 yield res
 
