@@ -107,6 +107,11 @@ class AnalysisWarning(UserWarning):
     prints it as one ``Warning:`` line)."""
 
 
+class FragilityWarning(AnalysisWarning):
+    """A fitted fragility curve that should not be trusted as it is (its ``reason`` is
+    not "ok")."""
+
+
 class ApiError(RocksweepError, ValueError):
     """An argument of the Python API that cannot be used (api)."""
 
