@@ -250,7 +250,8 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
 @_public
 def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
               im: str | None = None, period: float | None = None,
-              bootstrap: int | None = None, seed: int = 0, ci: float = 0.9) -> xr.Dataset:
+              bootstrap: int | None = None, seed: int = 0, ci: float = 0.9,
+              joint: bool = False) -> xr.Dataset:
     """Lognormal fragility curves P(state | IM = x) = Phi(ln(x / im_median) / beta) of a
     record-suite sweep (a scene with ``ground.records``), fitted by maximum likelihood
     (Baker 2015) to the counts at each stripe of a scaled suite ("stripes-mle") or to the
@@ -260,8 +261,11 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
 
     ds: what ``run`` or ``open`` returns (or a result file's path). state: "overturn"
     (either mode), "mode1", "mode2", "uplift", "theta:X" (max|theta|/alpha_cg >= X, or
-    overturned, 0 < X <= 1), or a list of them (a ``state`` dimension: damage states
-    share one beta, mode1 with mode2 is a competing-risk fit). im: a cloud's IM, "PGA"
+    overturned, 0 < X <= 1), or a list of them (a ``state`` dimension; each state fitted
+    alone, its numbers the same whatever else is asked for; nested curves that cross in
+    the data say "crossing"). joint: damage states share one beta (an ordinal fit, its
+    likelihood-ratio test stored: ``parallel_rejected``), mode1 with mode2 a
+    competing-risk fit. im: a cloud's IM, "PGA"
     (default), "PGV" or "Sa" with period [s] one of the stored periods. bootstrap:
     resamples over records for the intervals and bands (0: none; None:
     ``rocksweep.analysis.resampling.DEFAULT_BOOTSTRAP``, 200); seed: their generator's
@@ -277,7 +281,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     from rocksweep.analysis.fragility import fragility as fit
 
     return fit(_dataset_arg(ds, "ds"), state=state, im=im, period=period,
-               bootstrap=bootstrap, seed=seed, ci=ci)
+               bootstrap=bootstrap, seed=seed, ci=ci, joint=joint)
 
 
 @_public

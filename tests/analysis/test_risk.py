@@ -288,7 +288,7 @@ def test_competing_modes_integrate_their_own_probabilities():
                      "status": (("lam", "record", "PGA"), np.zeros((1, R, 12), np.int32))},
                     coords={"lam": [0.0], "record": [f"r{i}" for i in range(R)],
                             "PGA": levels}, attrs={"scale_im": "PGA"})
-    fr = rocksweep.fragility(ds, state=["mode1", "mode2"], bootstrap=10)
+    fr = rocksweep.fragility(ds, state=["mode1", "mode2"], bootstrap=10, joint=True)
     assert set(fr.fit.values.tolist()) == {"competing"}
     x = np.geomspace(0.01, 5.0, 30)
     k0, k = 1e-4, 2.0
