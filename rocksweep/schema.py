@@ -25,15 +25,18 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.numerics import MIN_EVENT_TOL, PRESETS, ROOTS
+from rocksweep.numerics import MIN_EVENT_TOL
 from rocksweep.vocab.ground import SCALE_IMS, SHAPES
 from rocksweep.vocab.laws import DEFAULT_LAW, LAWS
+from rocksweep.vocab.settings import PRESET_NAMES, ROOTS
 
 RATIO_MAX = 1e6  # bound of the body's ratios (see the module docstring)
 ANGLE_MIN = 1e-6  # [rad] smallest slenderness: h/b = 1e6
 CYCLES_MAX = 1000  # pulse.cycles: more cycles than this are no pulse
 GAMMA_MAX = 100.0  # pulse.gamma: MP's gamma is 1-3 for near-fault records; 100 is plenty
 E_FACTOR_MAX = 10.0  # impact.e_factor: experiments scale e by a few tens of per cent
+# initial rate and top-mass state: 1e3 x the scales (theta' = 1e3 p alpha overturns at once)
+INITIAL_MAX = 1e3
 
 
 @dataclass(frozen=True)
@@ -61,7 +64,6 @@ class Key:
     default: Any = None
 
 
-_AXIS = "a number, a list of numbers or a range {start, stop, num}"
 _RATIO = f"[1e-06, {RATIO_MAX:g}]"
 _ANGLE = f"must be in [{ANGLE_MIN:g}, pi/2) rad"
 
@@ -124,8 +126,8 @@ KEYS: dict[str, Key] = {
     "pulse.A_ratio": Key("axis",
                          "must be a finite number (negative: a pulse in the other direction)",
                          -math.inf, math.inf, lo_in=False, hi_in=False),
-    "numerics.accuracy": Key("choice", f"must be one of {', '.join(PRESETS)}",
-                             choices=tuple(PRESETS), required=False),
+    "numerics.accuracy": Key("choice", f"must be one of {', '.join(PRESET_NAMES)}",
+                             choices=PRESET_NAMES, required=False),
     "numerics.steps_per_period": Key("integer", "must be an integer in [4, 1e9]", 4, 1e9,
                                      required=False),
     "numerics.pulse_steps": Key("integer", "must be an integer in [4, 1e9] (RK4 steps per "
@@ -217,14 +219,14 @@ KEYS: dict[str, Key] = {
         "rocking on one corner, < 0 on the other)", -math.inf, math.inf, lo_in=False,
         hi_in=False, required=False, default=0.0),
     "initial.thetadot_over_palpha": Key(
-        "axis", "must be a finite number (theta'/(p alpha_cg) at t = 0)", -math.inf,
-        math.inf, lo_in=False, hi_in=False, required=False, default=0.0),
+        "axis", f"must be in [-{INITIAL_MAX:g}, {INITIAL_MAX:g}] (theta'/(p alpha_cg) at "
+        "t = 0)", -INITIAL_MAX, INITIAL_MAX, required=False, default=0.0),
     "initial.u_over_ucr": Key(
-        "axis", "must be a finite number (u/u_cr of the top mass at t = 0)", -math.inf,
-        math.inf, lo_in=False, hi_in=False, required=False, default=0.0),
+        "axis", f"must be in [-{INITIAL_MAX:g}, {INITIAL_MAX:g}] (u/u_cr of the top mass "
+        "at t = 0)", -INITIAL_MAX, INITIAL_MAX, required=False, default=0.0),
     "initial.udot_over_pucr": Key(
-        "axis", "must be a finite number (u'/(p u_cr) at t = 0)", -math.inf, math.inf,
-        lo_in=False, hi_in=False, required=False, default=0.0),
+        "axis", f"must be in [-{INITIAL_MAX:g}, {INITIAL_MAX:g}] (u'/(p u_cr) at t = 0)",
+        -INITIAL_MAX, INITIAL_MAX, required=False, default=0.0),
     "ground.avgsa": Key("string", "must be [T_lo, T_hi], periods in (0, 100] s with T_lo <= "
                         "T_hi (AvgSa's range; default 0.2-3 x scale.period for Sa stripes, "
                         "else 0.2-3 x 2 pi/p)", 0.0, 100.0, required=False),

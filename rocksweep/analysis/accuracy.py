@@ -36,7 +36,7 @@ import dataclasses
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -44,17 +44,11 @@ import numpy as np
 from rocksweep import fields
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import warm_up
-from rocksweep.numerics import (
-    PRESET_PULSE,
-    PRESET_REFINE,
-    PRESET_ROTATION,
-    PRESETS,
-    ROOTS,
-    Numerics,
-)
+from rocksweep.numerics import PRESETS, Numerics
 from rocksweep.scene.model import Scene, SceneError
 from rocksweep.vocab.axes import DIAGRAM_AXES, RECORD_X
 from rocksweep.vocab.outcomes import CLASSES
+from rocksweep.vocab.settings import DEFAULT_PRESET, ROOTS
 
 OUTCOMES = CLASSES  # codes 0, 1, 2
 # Per-point fields of the report: all the outcome-level kernel fills (no energies).
@@ -73,8 +67,9 @@ TAIL_LABELS = {
 }
 # theta_rel is taken where the reference's theta_max is at least this x alpha_cg
 THETA_REL_FLOOR = fields.THETA_REL_FLOOR
-# Error bounds against which ``--check`` scores the per-point error estimates (issue 15's
-# targets for the 95th percentiles): overturning time [p*t] and relative max|theta|.
+# Error bounds against which ``--check`` scores the per-point error estimates (the
+# `accurate` preset's targets for the 95th percentiles, docs/accuracy.md): overturning
+# time [p*t] and relative max|theta|.
 CHECK_TARGETS = {"t_overturn": 0.05, "theta_rel": 0.01}
 
 
@@ -110,16 +105,12 @@ def _tols(spp: int, tols: tuple[float, ...]) -> list[Setting]:
 
 
 def _presets() -> list[Setting]:
-    return [Setting(name, spp, tol, "preset", rotation_step=PRESET_ROTATION[name],
-                    pulse_steps=PRESET_PULSE[name], refine=PRESET_REFINE[name])
-            for name, (spp, tol) in PRESETS.items()]
+    return [Setting(name, group="preset", **asdict(p)) for name, p in PRESETS.items()]
 
 
 def _roots() -> list[Setting]:
-    return [Setting(f"{name}-{root}", spp, tol, f"root {root}", root,
-                    rotation_step=PRESET_ROTATION[name], pulse_steps=PRESET_PULSE[name],
-                    refine=PRESET_REFINE[name])
-            for root in ROOTS for name, (spp, tol) in PRESETS.items()]
+    return [Setting(f"{name}-{root}", group=f"root {root}", root=root, **asdict(p))
+            for root in ROOTS for name, p in PRESETS.items()]
 
 
 LADDERS: dict[str, Callable[[], list[Setting]]] = {
@@ -131,9 +122,9 @@ LADDERS: dict[str, Callable[[], list[Setting]]] = {
     # the cheap settings the default preset is chosen from (docs/accuracy.md)
     # (with the default preset's rotation limit)
     "candidates": lambda: (_steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-6, True,
-                                  PRESET_ROTATION["default"])
+                                  PRESETS[DEFAULT_PRESET].rotation_step)
                            + _steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-8, True,
-                                    PRESET_ROTATION["default"])
+                                    PRESETS[DEFAULT_PRESET].rotation_step)
                            + _presets()),
     # the presets alone: their tails on a scene far from the paper's (configs/wide-space.yaml)
     "presets": _presets,

@@ -242,7 +242,7 @@ A_MIN_METHODS = (
 # The search below the first overturning grid value (``_search_intervals``) scans grid
 # intervals at interior values spaced (relative to A) by: NEAR_STEP from the last value
 # without uplift up to NEAR_SPAN x the first uplifting value (the narrow first bands just
-# above the uplift threshold at omega/p ~ 1, issue 28: 0.01-0.1 wide at A ~ 1), FAR_STEP
+# above the uplift threshold at omega/p ~ 1: 0.01-0.1 wide at A ~ 1), FAR_STEP
 # from there up to UPLIFT_SPAN x it, and FAR_STEP in the intervals with an end whose
 # max|theta|/alpha_ref >= CLOSE (it came close to overturning), closest first; at most
 # SEARCH_RUNS kernel runs a column (a grid finer than the spacing adds none).

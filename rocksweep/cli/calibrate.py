@@ -16,7 +16,7 @@ def _bounds(items: tuple[str, ...]) -> dict[str, tuple[str, str]]:
     for item in items:
         key, sep, rng = item.partition("=")
         parts = rng.split(",")
-        if not sep or len(parts) != 2:
+        if not sep or not key.strip() or len(parts) != 2:
             raise click.ClickException(f"--bounds {item!r}: expected KEY=LO,HI, e.g. "
                                        "impact.lam=0,1")
         try:
@@ -69,8 +69,6 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
         from rocksweep.figures.common import FORMATS
 
         check_output(plot_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
-    if not scene_path.exists():
-        raise click.ClickException(f"{scene_path}: no such scene file")
     ds = fit_scene(scene_path, measured_path, list(fit), bounds=_bounds(bounds) or None,
                    overrides=list(overrides), p=p)
     for key in ds["parameter"].values.tolist():

@@ -1,4 +1,4 @@
-"""Adaptive stability diagrams: compute only where the class can change (issue 11).
+"""Adaptive stability diagrams: compute only where the class can change.
 
 A stability diagram is large uniform regions (safe, mode 1, mode 2) separated by thin
 boundaries. Over the two *diagram axes* (by default x = w_over_p, y = A_ratio; any two

@@ -3,7 +3,7 @@
 A run decides between overturning and not by a margin of energy. Where that margin is
 small, the step's error can decide the class: at 5 steps per spring period the top mass's
 spring loses ~2% of its energy to RK4 each step, and on Figure 3(a) 73 of 19 200 points
-went safe where the reference overturns in mode 1 (issue 28). The kernel reports how
+went safe where the reference overturns in mode 1 (docs/accuracy.md). The kernel reports how
 close the free rocking came to the overturning saddle (``OUT_MARGIN``, ``loop._saddle``:
 the vertex of the hyperbola it rocks on, in alpha_ref, ~ sqrt(|E - E_barrier|/E_ref)); a
 run below the row's PAR_CLOSE (``numerics.close_margin``) is a close call, and so is an

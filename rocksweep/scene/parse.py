@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from rocksweep.inputs import decode_text, read_input
 from rocksweep.numerics import Numerics
 from rocksweep.outputs import input_problem, is_input, shown
 from rocksweep.physics.model import BodyError, body_from_geometry
@@ -57,6 +58,7 @@ from rocksweep.vocab.axes import DIAGRAM_AXES, alpha_symbol
 from rocksweep.vocab.ground import MP
 from rocksweep.vocab.ground import PULSE_KEY_SHAPES as _PULSE_KEY_SHAPES
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
+from rocksweep.vocab.settings import DEFAULT_PRESET, FINE
 
 # Largest grid a scene may describe [points]. A sweep file stores 45 bytes a point (69
 # with energy metrics, ``rocksweep.fields.variables``): 2e8 points are a 9-14 GB file, one
@@ -141,6 +143,9 @@ def _section(raw: dict, name: str, kind: str, required: bool) -> dict:
         if not (isinstance(kind, str) and kind in BODY_KEYS):
             raise SceneError(f"body.kind = {fmt(kind)}: {KEYS['body.kind'].allowed}")
     allowed = section_keys(name, kind)
+    if sec is None and name in raw:  # ``pulse:`` or ``pulse: null`` is no absent section
+        raise SceneError(f"{name} = null: must be a mapping with keys {', '.join(allowed)}, "
+                         "or leave the section out")
     if sec is None:
         if required:
             needed = ", ".join(k for k in allowed if KEYS[f"{name}.{k}"].required)
@@ -157,6 +162,10 @@ def _section(raw: dict, name: str, kind: str, required: bool) -> dict:
         if k not in allowed:
             what = f" for a {kind} body" if name == "body" else ""
             raise SceneError(f"{name}.{k}: unknown key{what} (allowed: {', '.join(allowed)})")
+    for k, v in sec.items():  # a number left empty is not its default
+        if v is None and KEYS[f"{name}.{k}"].kind == "axis":
+            raise SceneError(f"{name}.{k} = null: {KEYS[f'{name}.{k}'].allowed}, or leave "
+                             "the key out")
     for k in allowed:
         spec = KEYS[f"{name}.{k}"]
         if spec.required and sec.get(k) is None:
@@ -334,8 +343,8 @@ def _numerics(sec: dict, contact: bool = False) -> tuple[Numerics, Numerics]:
             v = float(v) if spec.kind == "number" else v
         given[k] = v
     accuracy = given.pop("accuracy", None)
-    numerics = Numerics.preset(accuracy or ("fine" if contact else "default"), **given)
-    # One default (issue 28): a single run (simulate) runs what a sweep of the same point
+    numerics = Numerics.preset(accuracy or (FINE if contact else DEFAULT_PRESET), **given)
+    # One default: a single run (simulate) runs what a sweep of the same point
     # runs, so one point has one answer; the certification of close calls
     # (``compute.certify``) makes the default trustworthy for both.
     single = numerics
@@ -395,6 +404,7 @@ def _where(v: str, base: Path | None) -> Path:
 # Most records a suite may hold (a scene's axis holds at most MAX_AXIS_VALUES values;
 # FEMA P695's sets are 44 and 28 records).
 MAX_RECORDS = 10_000
+MAX_LISTING_BYTES = 16 << 20  # [bytes] a listing of MAX_RECORDS paths is far less
 _LIST_SUFFIXES = (".txt", ".list", ".lst")
 
 
@@ -433,30 +443,12 @@ def _listing(path: Path, shown_as: str) -> list[tuple[int, str]]:
     """(line number, entry) of a listing: UTF-8 text (a byte-order mark, as Notepad
     saves it, is skipped), one path a line, blank lines and # comments skipped."""
     key = "ground.records"
-    try:
-        data = path.read_bytes()
-    except OSError as err:
-        raise SceneError(f"{key}: {shown_as}: cannot be read ({err.strerror})") from None
-    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
-        raise SceneError(f"{key}: {shown_as}: a listing saved as UTF-16; save it as UTF-8 "
-                         "text (one record path a line)")
-    if b"\0" in data:
-        line = data.count(b"\n", 0, data.index(b"\0")) + 1
-        raise SceneError(f"{key}: {shown_as}, line {line}: a NUL byte (UTF-16 without a "
-                         "byte-order mark, or a binary file?); a listing is UTF-8 text, one "
-                         "record path a line")
-    try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError as err:
-        raise SceneError(f"{key}: {shown_as}: not a text listing of record paths (byte "
-                         f"{err.start} is not UTF-8); a listing is UTF-8 text, one record "
-                         "path a line") from None
-    bad = _CONTROL.search(text.replace("\r", ""))
-    if bad is not None:
-        line = text.count("\n", 0, bad.start()) + 1
-        raise SceneError(f"{key}: {shown_as}, line {line}: character {ord(bad.group()):#04x} "
-                         "is a control character (NUL, BEL, ESC...); a listing is plain "
-                         "text, one record path a line")
+    try:  # the one guard of input files: regular, bounded, UTF-8 text
+        text = decode_text(read_input(path, "listing", SceneError,
+                                      max_bytes=MAX_LISTING_BYTES),
+                           shown_as, SceneError, "listing of record paths (one a line)")
+    except SceneError as err:
+        raise SceneError(f"{key}: {err}") from None
     return [(i + 1, ln.strip()) for i, ln in enumerate(text.splitlines())
             if ln.strip() and not ln.strip().startswith("#")]
 
@@ -767,6 +759,9 @@ def _motion(raw: dict, kind: str, base: Path | None, given_record: GroundRecord 
             given_records: tuple[GroundRecord, ...] | None) -> _Motion:
     """The ground motion: none (free vibration), a ``pulse``, or a ``ground`` section
     (one record scaled by A_ratio, or a suite of records)."""
+    for name in ("pulse", "ground"):
+        if name in raw and raw[name] is None:  # refused as every null section
+            _section(raw, name, kind, required=False)
     if raw.get("ground") is None and raw.get("pulse") is None:
         return _Motion(free=True, pulse={"shape": FREE, "w_over_p": 0.0, "A_ratio": 0.0})
     if raw.get("ground") is None:

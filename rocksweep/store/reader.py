@@ -207,11 +207,6 @@ def _layout(f: h5py.File, path: Path) -> _Layout:
     return _Layout(stored, dims, shape, names)
 
 
-def _check_format(f: h5py.File, path: Path) -> None:
-    """Raise StoreError unless ``f`` is a valid rocksweep result (see ``_layout``)."""
-    _layout(f, path)
-
-
 def _is_hdf5(path: Path) -> bool:
     import h5py
     try:

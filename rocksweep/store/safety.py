@@ -1,4 +1,4 @@
-"""File-system safety of the writer (issue 16): space, stale temporary files, locks and
+"""File-system safety of the writer: space, stale temporary files, locks and
 the atomic rename.
 
 - A new file's size is known (every dataset is allocated at creation): a grid larger

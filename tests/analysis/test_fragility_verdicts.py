@@ -1,5 +1,5 @@
-"""Fits that say when not to trust them (issue 29 parts 1-2, issue 32's analyses on files
-they should not trust): one test per class of verdict, the competing-risk and ordinal
+"""Fits that say when not to trust them (and analyses of files they should not
+trust): one test per class of verdict, the competing-risk and ordinal
 fits against independent scipy optimisations, damage-state curves that never cross on
 the demo suite, partial and adaptive files, flagged points in IDA, bad arguments."""
 
@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+from bodies import FIG3_YAML
 from helpers import one_line_error
 from scipy.optimize import minimize
 from scipy.stats import norm
@@ -337,9 +338,7 @@ def test_one_state_fits_equal_the_single_fit_and_the_ordinal_mle_is_the_mle(demo
 
 SUITE = """
 name: trust test
-body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47,
-       IA_ratio: 0.56}
-impact: {lam: 0.0}
+""" + FIG3_YAML + """impact: {lam: 0.0}
 ground:
   records: [ROOT/records/suite/SYN01.AT2, ROOT/records/suite/SYN05.AT2,
             ROOT/records/suite/SYN12.AT2, ROOT/records/suite/SYN17.AT2]
@@ -455,8 +454,8 @@ def test_cli_bad_arguments_write_nothing(suite_scene, cli, tmp_path):
         assert not (tmp_path / "c.csv").exists()
 
 
-def test_the_issues_eight_record_mode2_curve_is_not_ok():
-    """Issue 29's measurement: mode 2 counts 0 0 0 0 0 0 0 1 1 2 3 1 3 1 0 0 of 8 over PGA
+def test_a_mode2_curve_that_falls_again_at_high_pga_is_not_ok():
+    """An eight-record measurement: mode 2 counts 0 0 0 0 0 0 0 1 1 2 3 1 3 1 0 0 of 8 over PGA
     0.1-1.6 g, mode 1 taking over at high PGA, was fitted "ok" with its median above every
     stripe."""
     lv = np.linspace(0.1, 1.6, 16)

@@ -248,7 +248,7 @@ def test_simulate_keywords_and_dict_agree_and_history_is_physical():
     assert abs(h.theta_over_alpha.values[-1]) == pytest.approx(math.pi / 2 / 0.15, rel=1e-6)
     balance = h.W_in_over_Eref - h.D_damp_over_Eref - h.E_impact_over_Eref
     # to the integration error of the work integral: ~1e-3 E_ref at `default` (the one
-    # default of sweeps and single runs, issue 28), ~1e-5 E_ref at `fine`
+    # default of sweeps and single runs), ~1e-5 E_ref at `fine`
     np.testing.assert_allclose(h.E_over_Eref.values, balance.values, atol=2e-3)
     hf = rocksweep.simulate(FIG5, impact__lam=0.4, numerics__accuracy="fine").history
     np.testing.assert_allclose(hf.E_over_Eref.values, (hf.W_in_over_Eref - hf.D_damp_over_Eref

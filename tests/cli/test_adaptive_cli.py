@@ -227,7 +227,7 @@ def test_sigkill_and_resume_equals_uninterrupted_run(cli, tmp_path):
     assert res.exit_code == 0 and "computed 0 points" in res.output, res.output
 
 
-# a file with results is never to be written over as the first remedy (issue 32)
+# a file with results is never to be written over as the first remedy
 def keep(path) -> str:
     """The remedy said for a file of ``path``'s points that another scene cannot resume."""
     from rocksweep.store.reader import read_result

@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from bodies import FIG3_YAML
 from click.testing import CliRunner
 
 from rocksweep.cli import main
@@ -14,8 +15,7 @@ from rocksweep.cli import main
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
 GOOD = """
-body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47, IA_ratio: 0.56}
-impact: {lam: 0.4}
+""" + FIG3_YAML + """impact: {lam: 0.4}
 pulse: {shape: sine, w_over_p: 5.3, A_ratio: 5.0}
 """
 

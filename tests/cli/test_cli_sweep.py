@@ -49,7 +49,7 @@ def ci_result(tmp_path_factory):
 def test_sweep_summary(ci_result):
     out, text = ci_result
     assert "mode1" in text and "mode2" in text and "safe" in text and "flagged" in text
-    spp = PRESETS["default"][0]
+    spp = PRESETS["default"].steps_per_period
     assert "points/s" in text and f"accuracy: default (steps_per_period={spp}" in text
     assert "RK4 steps:" in text
     # one summary row per (shape, lam)
@@ -84,7 +84,7 @@ def test_info_text_and_json(ci_result, cli):
     assert d["dims"]["shape"]["scene_key"] == "pulse.shape"
     assert d["points_done"] == d["points_total"] == 256
     assert sum(c["safe"] + c["mode1"] + c["mode2"] for c in d["counts"]) == 256
-    assert d["numerics"]["steps_per_period"] == PRESETS["default"][0]
+    assert d["numerics"]["steps_per_period"] == PRESETS["default"].steps_per_period
     assert d["provenance"]["numba_version"]
     assert d["scene"] == CI_SMALL.read_text()
 
@@ -259,7 +259,7 @@ def test_info_counts_per_swept_key_in_ranges(cli, tmp_path):
 
 
 def test_plot_block_scene_with_panels_and_partial_file(cli, tmp_path):
-    """A block-body scene (issue 6) with a swept body key: one panel per alpha; points
+    """A block-body scene with a swept body key: one panel per alpha; points
     not computed yet are drawn grey with a warning. Results are synthetic (no kernel)."""
     from rocksweep.scene.parse import parse_scene
 

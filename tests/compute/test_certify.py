@@ -1,8 +1,8 @@
 """The step rule that resolves what acts, the certification of close calls and the one
-default (issue 28), against the independent reference path (``physics.reference``:
+default, against the independent reference path (``physics.reference``:
 scipy's DOP853 at rtol 1e-10 with located events).
 
-- the two cases the issue reproduced: a uniform block (alpha = 0.25, lam = 0, sine,
+- two cases the old step rule got wrong: a uniform block (alpha = 0.25, lam = 0, sine,
   omega/p = 8) overturns in mode 1 for A/(g tan alpha) in [10.86, 11.41] (at 5 steps per
   pulse period its work on the block was ~2% off and `default` called the band safe);
   Figure 3(b)'s body under a cosine at omega/p = 4, A = 5.47-5.66 chatters to rest
@@ -51,7 +51,7 @@ CASES = [
                          ids=["block-10.9", "block-11.35", "fig3b-5.47", "fig3b-5.66",
                               "flexible-overturn-side"])
 def test_default_classifies_the_reproduced_cases_like_the_reference(point, expected):
-    """The reference's outcome is the issue's; `default` (sweep kernel and simulate) gives
+    """The reference's outcome is the one written here; `default` (sweep kernel and simulate) gives
     the same. Before the step rule, `default` gave safe / mode 1 here."""
     ref = reference_run(point)
     assert ref["outcome"] == expected

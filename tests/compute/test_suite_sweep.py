@@ -21,6 +21,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from bodies import FIG3_YAML
 
 import rocksweep
 from rocksweep.kernel import layout as L
@@ -37,9 +38,7 @@ NAMES = ["SYN01.AT2", "SYN05.AT2", "SYN12.AT2"]
 
 SCENE = """
 name: suite test
-body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47,
-       IA_ratio: 0.56}
-impact: {lam: [0.0, 0.4]}
+""" + FIG3_YAML + """impact: {lam: [0.0, 0.4]}
 ground:
   records: %s
   scale: %s

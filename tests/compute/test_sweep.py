@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from bodies import FIG3_YAML, body_yaml, table3
 
 import rocksweep.compute.sweep as sw
 from rocksweep import fields
@@ -11,8 +12,7 @@ from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.parse import parse_scene
 
-BODY3 = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, "
-         "mA_over_m: 0.47, IA_ratio: 0.56}\n")
+BODY3 = FIG3_YAML
 
 
 def small_scene(extra: str = "") -> object:
@@ -144,8 +144,8 @@ def test_each_point_goes_to_its_kernel_variant(monkeypatch):
         return run
 
     monkeypatch.setattr(sw.kernel, "chunk_kernel", fake_kernel)
-    sc = parse_scene("body: {wn_over_p: [2.43, .inf], zeta: [0.0, 0.05], alpha_cg: 0.15, "
-                     "alpha_A: 0.28, mA_over_m: 0.47, IA_ratio: 0.56}\nimpact: {lam: 0.2}\n"
+    sc = parse_scene(body_yaml(table3(wn_over_p="[2.43, .inf]", zeta="[0.0, 0.05]"))
+                     + "impact: {lam: 0.2}\n"
                      "pulse: {shape: sine, w_over_p: [1.0, 2.0], A_ratio: 3.0}\n")
     g = Grid(sc)
     res = sw.run_chunk(g, 0, g.size, L.LEVEL_OUTCOME)

@@ -1,4 +1,4 @@
-"""What a command pays at start-up for the compiled kernel (issue 24): a cached variant
+"""What a command pays at start-up for the compiled kernel: a cached variant
 loads without numba's registries (``kernel._cache.EntryCache``), and reading a result
 loads no numba at all.
 

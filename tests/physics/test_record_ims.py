@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from bodies import FIG3
 from scipy import integrate, signal
 
 from rocksweep.physics import intensity as I  # noqa: E741
@@ -170,8 +171,7 @@ def test_cli_says_the_warning_in_one_line():
 
 
 def suite_scene(**ground):
-    return {"body": {"wn_over_p": 2.43, "zeta": 0.05, "alpha_cg": 0.15, "alpha_A": 0.28,
-                     "mA_over_m": 0.47, "IA_ratio": 0.56},
+    return {"body": dict(FIG3),
             "impact": {"lam": 0.0},
             "ground": {"records": [str(SUITE[0]), str(SUITE[1])], "p": 2.0, **ground}}
 

@@ -23,7 +23,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from bodies import FIG3
+from bodies import FIG3, FIG3_YAML
 from scipy import signal
 
 from rocksweep.compute.single import simulate
@@ -94,9 +94,7 @@ def test_full_contact_response_is_lsim_of_the_record():
 
 SCENE = """
 name: record test
-body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47,
-       IA_ratio: 0.56}
-impact: {lam: [0.0, 0.4]}
+""" + FIG3_YAML + """impact: {lam: [0.0, 0.4]}
 ground:
   record: %s
   A_ratio: {start: 1.0, stop: 6.0, num: 3}
@@ -108,7 +106,7 @@ def test_scene_errors_are_one_line(tmp_path):
     both = SCENE % "x.AT2" + "pulse: {shape: sine, w_over_p: 1, A_ratio: 1}\n"
     with pytest.raises(SceneError, match="pulse, ground: give one of them"):
         parse_scene(both)
-    with pytest.raises(SceneError, match=r"ground.record: .*missing.AT2.*cannot be read"):
+    with pytest.raises(SceneError, match=r"ground.record: .*missing.AT2: no such record file"):
         parse_scene(SCENE % "missing.AT2", base=tmp_path)
     bad = tmp_path / "bad.AT2"
     bad.write_text("a\nb\nc\nNPTS= 3, DT= .01 SEC\n1 2\n")

@@ -1,4 +1,4 @@
-"""Fault injection for the result file (issue 16, "Nothing lost, no traceback").
+"""Fault injection for the result file: nothing lost, no traceback.
 
 Full disks are real: a tmpfs of a few pages mounted in a private mount namespace
 (``unshare --mount``, root or user namespaces; nobody else sees it), filled to the last
@@ -29,6 +29,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from bodies import FIG3_YAML
 from helpers import one_line_error
 
 from rocksweep.cli import main
@@ -48,9 +49,7 @@ CI_SMALL = ROOT / "configs" / "ci-small.yaml"
 
 # 2 x 3 x 4 x 5 = 120 points, synthetic results (no kernel)
 TEXT = """name: fault test
-body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47,
-       IA_ratio: 0.56}
-impact: {lam: [0.0, 0.2, 0.4]}
+""" + FIG3_YAML + """impact: {lam: [0.0, 0.2, 0.4]}
 pulse: {shape: [sine, cosine], w_over_p: {start: 0.5, stop: 6, num: 5},
         A_ratio: {start: 1, stop: 8, num: 4}}
 """
