@@ -445,8 +445,8 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
 @_public
 def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impact.lam",),
               *, bounds: Mapping[str, Sequence[float]] | None = None,
-              overrides: Overrides = (), ci: float = 0.95, p: float | None = None
-              ) -> xr.Dataset:
+              overrides: Overrides = (), ci: float = 0.95, p: float | None = None,
+              noise: float | None = None) -> xr.Dataset:
     """Fit scene numbers to a measured rocking history.
 
     scene, overrides: as for ``run``. fit: the key or distinct keys to fit (``impact.lam``,
@@ -457,16 +457,20 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     admissible range (default: ``analysis.calibrate.DEFAULT_BOUNDS`` or the range). ci:
     the interval's level, in [0.5, 1). Returns a Dataset over ``parameter`` (the fitted
     keys): ``estimate``, ``lo``, ``hi`` (the ``ci`` interval by profile likelihood, ``ci``
-    in attrs), scalar ``misfit`` (RMS error of the half-cycle peaks, theta/alpha_ref),
-    and the measured and fitted histories over p_t with the fitted impacts
-    (``rocksweep.analysis.calibrate``).
+    in attrs), scalar ``misfit`` (RMS error of the half-cycle peaks, theta/alpha_ref)
+    with ``noise`` (the measurement's, estimated from the history or ``noise=``, in
+    theta/alpha_ref) and ``dof``, ``reason`` ("ok" or misfit, unidentifiable, at_bound
+    joined by ",", also a ``CalibrationWarning``), and the measured and fitted histories
+    over p_t with the fitted impacts (``rocksweep.analysis.calibrate``).
     """
     from rocksweep.analysis.calibrate import calibrate_scene
 
     _typed("bounds", bounds, bounds is None or isinstance(bounds, Mapping),
            "a mapping {key: (lo, hi)}, e.g. {'impact.lam': (0, 1)}, or None")
     _typed("p", p, p is None or _is_number(p), "a number (the body's p [rad/s]) or None")
-    out = calibrate_scene(scene, measured, fit, bounds, ci, p, overrides)
+    _typed("noise", noise, noise is None or _is_number(noise),
+           "a number (the measurement noise, theta/alpha_ref) or None")
+    out = calibrate_scene(scene, measured, fit, bounds, ci, p, overrides, noise)
     return out
 
 
