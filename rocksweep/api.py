@@ -33,7 +33,7 @@ if TYPE_CHECKING:
 _MOVED = {name: module for module, names in {
     "rocksweep.compute.driver": ("WRITE_EVERY", "SweepInterrupted", "SweepReport"),
     "rocksweep.scene.inputs": ("load", "override_strings"),
-    "rocksweep.compute.history": ("MAX_RUNS", "API_MAX_RUNS", "simulate_runs",
+    "rocksweep.compute.history": ("MAX_RUNS", "API_MAX_RUNS", "run_points",
                                 "history_dataset", "swept_values", "write_history_csv"),
     "rocksweep.compute.adaptive": ("adaptive_options",),
     "rocksweep.compute.session": ("sweep_file",),
@@ -122,38 +122,32 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
 
 @_public
 def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xarray's)
-    """A sweep result file as an xarray Dataset, loaded in memory (the file is closed).
+    """Any file rocksweep writes as an xarray Dataset, loaded in memory (the file is
+    closed): a sweep result, or what an analysis wrote (fragility, risk, IM efficiency,
+    calibration ``-o .h5``, boundaries and accuracy HDF5), whose ``attrs["rocksweep_kind"]``
+    names its kind (``rocksweep.analysis.files``).
 
-    Each variable carries its unit (``rocksweep_units``: ``rocksweep.fields.UNITS``, e.g.
-    alpha_ref, 1/p, E_ref; CF ``units`` "1") and a description; ``outcome`` its codes
-    and words as CF flags (``flag_values`` -1 0 1 2, ``flag_meanings`` "not_run safe
-    mode1 mode2"), ``status`` its bits (``flag_masks``, ``flag_meanings``,
-    ``flagged_mask``). The attributes are the file's provenance (all of them:
-    ``rocksweep.store.format``): ``scene`` (the YAML verbatim), ``scene_resolved``,
+    A sweep result: each variable carries its unit (``rocksweep_units``:
+    ``rocksweep.fields.UNITS``, e.g. alpha_ref, 1/p, E_ref; CF ``units`` "1") and a
+    description; ``outcome`` its codes and words as CF flags (``flag_values`` -1 0 1 2,
+    ``flag_meanings`` "not_run safe mode1 mode2"), ``status`` its bits (``flag_masks``,
+    ``flag_meanings``, ``flagged_mask``). The attributes are the file's provenance (all of
+    them: ``rocksweep.store.format``): ``scene`` (the YAML verbatim), ``scene_resolved``,
     ``overrides``, ``numerics``, ``accuracy``, versions, times, ``complete``. Works
     while a sweep is still writing the file (no lock is taken). A file that is not a
-    rocksweep result is a one-line ``RocksweepError``.
+    rocksweep file is a one-line ``RocksweepError``.
     """
-    from rocksweep.store.dataset import open_result
+    from rocksweep.analysis.files import open_any
 
-    return open_result(path)
-
-
-@_public
-def open_any(path: str | Path) -> xr.Dataset:
-    """Any rocksweep Dataset from a file (``rocksweep.analysis.files.open_any``), with
-    ``ds.rocksweep``."""
-    from rocksweep.analysis.files import open_any as open_file
-
-    return open_file(path)
+    return open_any(path)
 
 
 def _dataset_arg(ds: Any, what: str) -> xr.Dataset:
-    """A Dataset, or a path to one (``analysis.files._as_dataset``), with ``ds.rocksweep``."""
-    from rocksweep.analysis.files import _as_dataset
+    """A Dataset, or a path to one (``analysis.files.as_dataset``), with ``ds.rocksweep``."""
+    from rocksweep.analysis.files import as_dataset
 
     _check_dataset(what, ds)
-    return _as_dataset(ds, what)
+    return as_dataset(ds, what)
 
 
 def _typed(name: str, value: Any, ok: bool, allowed: str) -> None:
@@ -249,6 +243,8 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     _check_optional_text(**{_names[0]: x, _names[1]: y, _names[2]: compare, "width": width})
     _check_flags(curves=curves, show_computed=show_computed, mu=mu)
     if isinstance(ds, str | Path):
+        from rocksweep.analysis.files import open_any
+
         ds = open_any(ds)
     return plot_any(ds, x, y, ax=ax, curves=curves, show_computed=show_computed, mu=mu,
                     width=width, compare=compare, names=_names)

@@ -77,15 +77,16 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.compute.single import history_capacity
+from rocksweep.compute.dispatch import run_variant
 from rocksweep.errors import CalibrationError, RocksweepError  # noqa: F401 (CalibrationError re-exported)
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.kernel import point_kernel, warm_up
+from rocksweep.kernel import warm_up
 from rocksweep.numerics import Numerics, step_budget
+from rocksweep.physics.bodies import BodyError
 from rocksweep.physics.measured import Measured, noise_level, read_measured
-from rocksweep.physics.model import BodyError
 from rocksweep.physics.points import INITIAL, kernel_kind, point_row
 from rocksweep.schema import KEYS, fmt
+from rocksweep.vocab.kinds import CALIBRATION, KIND_ATTR
 from rocksweep.vocab.laws import CONSTANT
 
 ACCURACY = "fine"  # the least accuracy of a calibration's runs (``calibration_numerics``)
@@ -358,7 +359,7 @@ class Problem:
             values[name] = float(v)
         return self.scene.point(values)
 
-    def simulate(self, x: np.ndarray) -> tuple[np.ndarray, dict] | None:
+    def run_candidate(self, x: np.ndarray) -> tuple[np.ndarray, dict] | None:
         """(result row, raw history columns) of a candidate; None if the candidate's body
         is not physical."""
         try:
@@ -372,9 +373,12 @@ class Problem:
             row[L.PAR_TEND] = need
             row[L.PAR_MAXSTEPS] = step_budget(row[L.PAR_TPULSE], need, row[L.PAR_DT],
                                               row[L.PAR_DT_ON], self.numerics)
-        out = np.empty(L.N_OUT)
-        hist = np.empty((history_capacity(row), L.N_HIST))
-        point_kernel(kernel_kind(point.body), point.ground)(row, out, hist)
+        # the one dispatch of every run: close calls certified as ``rocksweep.simulate``'s
+        # (the finest run's history kept)
+        hists: list = [None]
+        out = run_variant(row[None, :], kernel_kind(point.body), L.LEVEL_OUTCOME,
+                          point.ground, self.numerics.refine, histories=hists)[0]
+        hist = hists[0]
         self.runs += 1
         n = int(out[L.OUT_HIST_ROWS])
         a = point.body.alpha_ref
@@ -410,7 +414,7 @@ class Problem:
     def _run(self, x: np.ndarray) -> tuple | None:
         """A candidate's simulated history at the measured times, its shift, excursions,
         impacts (measured time) and result row; None for a body that is not physical."""
-        got = self.simulate(x)
+        got = self.run_candidate(x)
         if got is None:
             return None
         out, h = got
@@ -819,6 +823,7 @@ def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
     ds["misfit"].attrs = {"long_name": "RMS error of the half-cycle peaks at the estimate",
                           "units": "theta/alpha_ref"}
     ds.attrs = {
+        KIND_ATTR: CALIBRATION,
         "title": f"calibration of {', '.join(problem.keys)}",
         "ci": ci,
         "interval": "profile likelihood: misfit <= min + chi2_1(ci) s^2, s^2 = max(S_min/"

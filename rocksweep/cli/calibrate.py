@@ -8,6 +8,7 @@ import click
 
 from rocksweep.cli.main import load, main, user_errors
 from rocksweep.cli.options import dpi_option, overwrite_option, scene_argument, set_option
+from rocksweep.vocab.kinds import CALIBRATION
 
 
 def _bounds(items: tuple[str, ...]) -> dict[str, tuple[str, str]]:
@@ -62,17 +63,11 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
     the interval is a 95% profile likelihood. Prints the estimate, the interval and the
     misfit; -o keeps the fit, --plot draws it."""
     from rocksweep.api import calibrate as fit_scene
-    from rocksweep.outputs import check_distinct, check_output
+    from rocksweep.cli.helpers import check_table_outputs, write_table
 
-    check_distinct({"-o": out_path, "--plot": plot_path})
     # the scene file and what it reads (a record), the measured CSV: never written over
     inputs = [*load(scene_path, overrides).inputs, measured_path]
-    if out_path is not None:
-        check_output(out_path, overwrite=overwrite, inputs=inputs, suffixes=(".h5", ".nc"))
-    if plot_path is not None:
-        from rocksweep.figures.common import FORMATS
-
-        check_output(plot_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
+    check_table_outputs(out_path, plot_path, (".h5", ".nc"), inputs, overwrite)
     import warnings
 
     from rocksweep.analysis.calibrate import CalibrationWarning
@@ -99,10 +94,7 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
     if ds.attrs["notes"]:
         click.echo(f"measured: {ds.attrs['notes']}")
     if out_path is not None:
-        from rocksweep.outputs import atomic_path
-
-        with atomic_path(out_path, overwrite=overwrite) as tmp:
-            ds.to_netcdf(tmp, engine="h5netcdf")
+        write_table(out_path, None, ds, CALIBRATION, overwrite)
         click.echo(f"wrote {out_path}")
     if plot_path is not None:
         from rocksweep.figures.calibration import calibration_figure
