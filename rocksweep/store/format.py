@@ -202,6 +202,8 @@ def initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
         for k, v in record_attrs(scene.record).items():
             a[f"record_{k}"] = v
         _store_record(f, scene.record)
+    for k, v in scene.physical_summary().items():  # a physical body's p [rad/s]
+        a[k] = v
     if scene.suite is not None:  # the stripes' IM ("none": a cloud) and Sa's period [s]
         a["scale_im"] = scene.suite.im or "none"
         a["scale_period"] = float(scene.suite.period)

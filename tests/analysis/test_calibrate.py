@@ -220,6 +220,8 @@ def test_a_flat_profile_is_unidentifiable_and_an_edge_estimate_at_bound():
         flat = rocksweep.calibrate(BLOCK, frame, ["impact.e"],
                                    bounds={"impact.e": (0.8799, 0.8801)})
     assert "unidentifiable" in flat["reason"].item().split(",")
+    fig = rocksweep.plot(flat)  # the command line's --plot figure, from Python
+    assert len(fig.axes[0].get_lines()) >= 2  # measured and fitted histories
     edge = rocksweep.calibrate(BLOCK, frame, ["impact.e"], bounds={"impact.e": (0.5, 0.8)})
     words = edge["reason"].item().split(",")
     assert "at_bound" in words and float(edge.estimate[0]) == pytest.approx(0.8, abs=1e-3)
