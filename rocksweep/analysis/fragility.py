@@ -464,7 +464,10 @@ def _request(ds: Any, state: Any, im: Any, period: Any, bootstrap: Any, seed: An
     N = check_bootstrap(bootstrap, 1)
     out_da = required(ds, "outcome", "outcome codes")
     if "record" not in out_da.dims:
-        raise FragilityError("outcome has no 'record' dimension: not a record-suite sweep")
+        where = ds.encoding.get("source")  # the file it was opened from, if any
+        raise FragilityError(f"{where + ': ' if where else ''}outcome has no 'record' "
+                             "dimension: not a record-suite sweep (a scene with ground.records: a "
+                             "list of record files, and ground.scale)")
     names = [str(r) for r in ds["record"].values]
     if len(set(names)) != len(names):
         raise FragilityError("record: the coordinate lists a record twice")

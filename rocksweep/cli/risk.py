@@ -104,6 +104,8 @@ def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, sta
         a = rk.attrs
         click.echo(f"risk over {a['hazard_source']} ({a['im']} [{a['im_units']}]), "
                    f"{a['years']:g} years; {a['extrapolation']}")
+        if a.get("hazard_notes"):
+            click.echo(f"hazard: {a['hazard_notes']}")
         keys = [k for k in rows[0] if k not in ("annual_rate", "annual_rate_lo",
                                                  "annual_rate_hi", "annual_rate_max",
                                                  "probability", "probability_lo",

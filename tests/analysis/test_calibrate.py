@@ -123,6 +123,21 @@ def test_physical_columns_with_the_body_s_p():
         rocksweep.calibrate(BLOCK, df, ["impact.e"])
 
 
+def test_the_command_line_names_p_as_its_option(tmp_path):
+    # the way out in the command line's words: --p, not the API's p=
+    import yaml
+    from click.testing import CliRunner
+
+    from rocksweep.cli import main
+
+    t, theta = free_block_history(0.85, t_end=6.0)
+    scene, meas = tmp_path / "block.yaml", tmp_path / "lab.csv"
+    scene.write_text(yaml.safe_dump(BLOCK))
+    pd.DataFrame({"t": t / 3.0, "theta": theta}).to_csv(meas, index=False)
+    run = CliRunner().invoke(main, ["calibrate", str(scene), str(meas), "--fit", "impact.e"])
+    assert run.exit_code == 2 and "give --p VALUE" in run.output and "p=" not in run.output
+
+
 GOOD_T = np.arange(0.0, 10.0, 0.05)
 
 

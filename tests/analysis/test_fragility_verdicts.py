@@ -563,3 +563,21 @@ def test_the_joint_fits_parallel_test_is_a_likelihood_ratio_and_rejects_unequal_
     ok = F.fragility(nested_ds(80, 0.4, 0.4, 0.7, 0.4, seed=5), state=["theta:0.5",
                      "overturn"], bootstrap=0, warn=False, joint=True)
     assert not bool(ok["parallel_rejected"])
+
+
+def test_a_file_without_records_is_named_with_the_way_out(tmp_path):
+    import yaml
+    from click.testing import CliRunner
+
+    scene = tmp_path / "one.yaml"
+    scene.write_text(yaml.safe_dump({"body": {"kind": "block", "alpha": 0.2},
+                                     "impact": {"lam": 0.0},
+                                     "pulse": {"shape": "sine", "w_over_p": 4.0,
+                                               "A_ratio": [2.0, 3.0]}}))
+    out = tmp_path / "one.h5"
+    assert CliRunner().invoke(main, ["sweep", str(scene), "-o", str(out), "--quiet"]
+                              ).exit_code == 0
+    run = CliRunner().invoke(main, ["fragility", str(out)])
+    assert run.exit_code != 0
+    assert str(out) in run.output and "ground.records" in run.output
+    assert run.output.count("\n") == 1
