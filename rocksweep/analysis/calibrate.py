@@ -59,7 +59,8 @@ agreement a right model reaches on a noise-free measurement): the model cannot r
 the measurement at any value inside the bounds, and the interval is not an uncertainty of
 a right model; "unidentifiable" when a key's interval spans its bounds (the profile is
 flat: the history does not say the key, or the key does not change it); "at_bound" when
-an estimate sits on a bound (within AT_BOUND of the span: the minimum may lie beyond).
+an estimate sits on a search bound (within AT_BOUND of the span: the minimum may lie
+beyond; not at the key's own limit, as lam = 0, where nothing lies beyond).
 A fitted key that cannot change the scene's runs (lam under law constant) is refused
 before any run.
 
@@ -872,9 +873,12 @@ def _verdict(problem: Problem, x_hat: np.ndarray, s_min: float, lo: np.ndarray,
                         (": it does not change the simulated history" if same else ""))
         x = float(x_hat[i])
         b_lo, b_hi = problem.bounds[i]
-        if min(x - b_lo, b_hi - x) <= AT_BOUND * span[i]:
-            edge.append(f"{key} = {x:.4g} on the bound {b_lo if x - b_lo < b_hi - x else b_hi:g}"
-                        "; the least misfit may lie beyond")
+        near = b_lo if x - b_lo < b_hi - x else b_hi
+        # a bound that is the key's own limit (lam = 0, e = 1) has nothing beyond it
+        limit = near in (KEYS[key].lo, KEYS[key].hi)
+        if min(x - b_lo, b_hi - x) <= AT_BOUND * span[i] and not limit:
+            edge.append(f"{key} = {x:.4g} on the bound {near:g}; the least misfit may lie "
+                        "beyond")
     if flat:
         why["unidentifiable"] = "; ".join(flat)
     if edge:
