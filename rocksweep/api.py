@@ -367,7 +367,12 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = N
     _typed("years", years, _is_number(years), "a number of years > 0")
     _typed("site", site, site is None or _is_int(site),
            "an integer row number (0 = the first site) or None")
-    return compute(_dataset_arg(fr, "fr"), hazard, years, site=site)
+    from rocksweep.analysis.risk import check_fragility
+    from rocksweep.outputs import shown
+
+    ds = _dataset_arg(fr, "fr")
+    check_fragility(ds, shown(fr) if isinstance(fr, str | Path) else "fr")
+    return compute(ds, hazard, years, site=site)
 
 
 @_public

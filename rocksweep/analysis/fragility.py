@@ -95,7 +95,7 @@ from rocksweep.analysis.states import (
     state_groups,
     state_reached,
 )
-from rocksweep.errors import FragilityError
+from rocksweep.errors import FragilityError, FragilityWarning
 from rocksweep.fields import plain
 from rocksweep.vocab.ground import AVGSA, SCALE_IMS
 from rocksweep.vocab.ground import CLOUD_IMS as CLOUD_IM_VARIABLES
@@ -127,10 +127,6 @@ CROSSING_TOL = 0.01
 #: "parallel_rejected": the common beta of a joint ordinal fit rejected at this level
 PARALLEL_P = 0.05
 FLAGGED_SHIFT = 0.01
-
-
-class FragilityWarning(UserWarning):
-    """A fitted curve that should not be trusted as it is (its ``reason`` is not "ok")."""
 
 
 class Fit(tuple):

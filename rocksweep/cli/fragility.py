@@ -105,6 +105,8 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
     from rocksweep.analysis.fragility import FragilityWarning
 
     ds = rocksweep.open(result_path)
+    # --rtol's IDA first: refused, it says so in one line before any word about the fit
+    refined = rocksweep.ida(ds, rtol) if rtol is not None else None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", FragilityWarning)
         frag = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states,
@@ -116,9 +118,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
         else:
             warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     frag.attrs["source"] = str(result_path)
-    refined = None
-    if rtol is not None:
-        refined = rocksweep.ida(ds, rtol)
+    if refined is not None:
         for name in ("ida_im", "ida_lo", "ida_hi", "runs", "n_flagged", "unresolved"):
             frag[name if name in ("ida_im", "ida_lo", "ida_hi") else f"ida_{name}"] = \
                 refined[name]

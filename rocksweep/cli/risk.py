@@ -90,7 +90,11 @@ def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, sta
     # the fragility or sweep file (and a sweep's records), the hazard curve: never written
     inputs = [*result_inputs(frag_path), hazard_path]
     check_table_outputs(out_path, fig_path, RISK_SUFFIXES, inputs, overwrite)
+    from rocksweep.analysis.risk import check_fragility
+    from rocksweep.outputs import shown
+
     ds = rocksweep.open(frag_path)
+    check_fragility(ds, shown(frag_path), suites=True)
     if dataset_kind(ds) == "sweep":
         states = [s.strip() for s in state.split(",") if s.strip()]
         ds = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states,
