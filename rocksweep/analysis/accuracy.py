@@ -59,11 +59,6 @@ MEASURE_LABELS = {
     "t_overturn": "|d t_overturn| (p*t)",
     "impacts": "mean |d impacts|",
 }
-# measures of the tails only (not drawn in the work-precision diagram)
-TAIL_LABELS = {
-    "theta_rel": "|d theta_max|/theta_max",
-    "energy": "|energy balance|/E_ref",
-}
 # theta_rel is taken where the reference's theta_max is at least this x alpha_cg
 THETA_REL_FLOOR = fields.THETA_REL_FLOOR
 # Error bounds against which ``--check`` scores the per-point error estimates (the
@@ -306,7 +301,8 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
 
     _no_suite(scene)
     cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
-    rows_all = with_record(cr.rows, scene.record)  # a record's samples ride on each row
+    # a record's samples (and its vertical's) ride on each row
+    rows_all = with_record(cr.rows, scene.record, scene.vertical_samples())
     ground = scene.ground  # the Ricker, MP and records run the GROUND variants
     n = len(flat)
     outs = np.empty((n, L.N_OUT))
