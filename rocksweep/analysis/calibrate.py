@@ -72,6 +72,7 @@ from rocksweep.physics.measured import Measured, noise_level, read_measured
 from rocksweep.physics.model import BodyError
 from rocksweep.physics.points import INITIAL, kernel_kind, point_row
 from rocksweep.schema import KEYS, fmt
+from rocksweep.vocab.axes import axis_name
 
 ACCURACY = "fine"  # the least accuracy of a calibration's runs (``calibration_numerics``)
 H_NOISE = 4.0  # threshold of an excursion, in noise standard deviations ...
@@ -440,7 +441,7 @@ def check_fit_key(scene: Any, key: Any) -> str:
     if key not in allowed:
         raise CalibrationError(f"fit {key}: not a number of this scene (fit one of "
                                f"{', '.join(allowed)})")
-    return key.split(".", 1)[1]
+    return axis_name(key)
 
 
 def check_bounds(key: str, given: Any) -> tuple[float, float]:

@@ -41,6 +41,7 @@ from rocksweep.compute.arguments import (  # noqa: F401 (re-exported)
 from rocksweep.compute.dispatch import _run_record, run_variant  # noqa: F401 (re-exported)
 from rocksweep.compute.grid import ChunkRows, Grid
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.physics.model import G
 from rocksweep.scene.model import Scene
 
 # Upper bound of the automatic chunk size [points]; see ``auto_chunk_size``.
@@ -92,6 +93,8 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
     stored = fields.sweep_fields(scene.energy if contact else level == L.LEVEL_ENERGY,
                                  contact, scene.check)
     arrays = fields.convert(outs, cr.alpha_ref, cr.E_ref, stored)
+    if scene.floor:  # the peak the body was driven by [g]: the kernel's amplitude / g
+        arrays[fields.FLOOR_PFA] = cr.rows[:, L.PAR_AMP] / G
     if scene.check:
         half = run_rows(cr, fields.check_rows(cr.rows), level, scene)
         arrays.update(fields.convert_check(outs, half, cr.alpha_ref))
@@ -111,11 +114,11 @@ def run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene,
     outs = np.empty((rows.shape[0], L.N_OUT))
     for kind in np.unique(cr.kinds):
         sel = cr.kinds == kind
-        if scene.suite is not None:  # one record at a time, its samples shared
+        if cr.records is not None:  # one record at a time, its samples shared
             for r in np.unique(cr.record_index[sel]):
                 part = sel & (cr.record_index == r)
                 outs[part] = run_variant(rows[part], int(kind), level, scene.ground, refine,
-                                         record=scene.suite.records[int(r)])
+                                         record=cr.records[int(r)])
         elif sel.all():
             run_variant(rows, int(kind), level, scene.ground, refine, record=scene.record,
                         out=outs)

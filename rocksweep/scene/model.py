@@ -13,12 +13,17 @@ from rocksweep import fields
 from rocksweep.errors import SceneError  # noqa: F401 (defined there; re-exported)
 from rocksweep.numerics import Numerics
 from rocksweep.physics.model import BlockBody, Body, FlexibleBody
+from rocksweep.physics.path import GroundPath
 from rocksweep.physics.points import FREE, INITIAL, RECORD, Point
 from rocksweep.physics.records import GroundRecord
 from rocksweep.physics.suite import Suite
 from rocksweep.schema import KEYS
 from rocksweep.vocab.ground import PAPER_SHAPES, pulse_duration
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
+
+#: the one-mode floor's keys, the names of their axes (``floor.period`` is a dimension of
+#: its own: a suite's ``period`` is the Sa periods')
+FLOOR_AXES = ("floor.period", "floor.damping", "floor.participation")
 
 
 @dataclass(frozen=True)
@@ -59,6 +64,29 @@ class Scene:
     # a body given by the laboratory's numbers (body.kind physical): its Pi groups, p
     # [rad/s], omega_n [rad/s] and h_cg [m] (``physics.model.body_from_geometry``), else None
     physical: dict | None = field(default=None, repr=False)
+    # the excitation path (``ground.h2``/``ground.angle``, ``floor:``): what the body
+    # feels is computed from the ground motion (``physics.path``); None without those keys
+    path: GroundPath | None = field(default=None, repr=False)
+
+    @property
+    def floor(self) -> bool:
+        """Whether the body stands on a building's floor (a ``floor:`` section)."""
+        return self.path is not None and self.path.floor
+
+    def floor_words(self) -> str:
+        """One line stating the building ('' without a floor)."""
+        if not self.floor:
+            return ""
+        if self.path.modes is not None:
+            modes = self.path.modes
+            return ("floor of a linear building, modes (period [s], damping, "
+                    "participation): " + "; ".join(
+                        f"({m.period:g}, {m.damping:g}, {m.participation:g})" for m in modes))
+        vals = ", ".join(f"{k.split('.')[1]} = " + (
+            f"{self.axis(k).values[0]:g}" if len(self.axis(k).values) == 1 else
+            f"{len(self.axis(k).values)} values {min(self.axis(k).values):g}.."
+            f"{max(self.axis(k).values):g}") for k in FLOOR_AXES)
+        return f"floor of a linear building, one mode: {vals}"
 
     def physical_words(self) -> str:
         """One line stating what a physical body became ('' for a body of Pi groups)."""
@@ -73,7 +101,7 @@ class Scene:
     def variables(self) -> dict[str, tuple[str, float, str]]:
         """The per-point variables a sweep of this scene stores, name -> (dtype, fill value
         of a point not computed, meaning): ``fields.variables`` of its outputs."""
-        return fields.variables(self.energy, self.contact, self.check)
+        return fields.variables(self.energy, self.contact, self.check, self.floor)
 
     @property
     def freq_axis(self) -> str:
@@ -90,7 +118,7 @@ class Scene:
     def ground(self) -> bool:
         """Whether the scene needs the kernel's GROUND variants (a Ricker or MP pulse, or a
         record); the paper's sine and cosine (n cycles too) run the pulse variants."""
-        return self.recorded or any(
+        return self.recorded or self.floor or any(
             sh not in (*PAPER_SHAPES, FREE) for sh in self.axis("shape").values)
 
     def option(self, name: str) -> Any:
@@ -138,6 +166,8 @@ class Scene:
     def point(self, values: dict[str, Any]) -> Point:
         """The point with the given value of every axis (by name)."""
         body = self.make_body(**{a.name: values[a.name] for a in self.body_axes()})
+        if self.path is not None:
+            return self._path_point(body, values)
         if self.suite is not None:
             su = self.suite
             r = su.names.index(str(values["record"]))
@@ -160,6 +190,43 @@ class Scene:
                      float(values.get("nu", self.option("nu"))),
                      mu=float(values.get("mu", math.nan)), **self._law(values),
                      initial=self.initial_state(values))
+
+    def path_motion(self, values: dict[str, Any]):
+        """(the motion the body feels per unit of ground motion, the ground's peak that
+        A_ratio scales, record index) at one point (``physics.path``)."""
+        pa = self.path
+        angle = float(values.get("angle", 0.0))
+        floor = (tuple(float(values[k]) for k in FLOOR_AXES)
+                 if pa.floor and pa.modes is None else None)
+        if self.suite is not None:
+            r = self.suite.names.index(str(values["record"]))
+            ground = self.suite.records[r]
+            return pa.motion(ground, r, angle, floor), ground.pga, r
+        if self.record is not None:
+            return pa.motion(self.record, 0, angle, floor), self.record.pga, 0
+        from rocksweep.physics.excitation import PulseShape
+
+        shape = PulseShape(str(values["shape"]), int(self.option("cycles")),
+                           float(self.option("gamma")), float(self.option("nu")))
+        return pa.motion(None, 0, 0.0, floor, (shape, float(values["w_over_p"]))), 1.0, 0
+
+    def _path_point(self, body: Body, values: dict[str, Any]) -> Point:
+        """A point of a scene with an excitation path: driven by its computed motion, the
+        kernel's A_ratio the ground's scaled by the motion's gain."""
+        motion, ground_peak, r = self.path_motion(values)
+        if self.suite is not None:
+            su = self.suite
+            s = (np.array([self.axis(su.im).values.index(float(values[su.im]))])
+                 if su.im else None)
+            p = float(values["p"])
+            fac = float(su.factors(np.array([r]), s, np.array([body.alpha_ref]),
+                                   np.array([p]))[0])
+            a_ratio = fac * motion.pga / math.tan(body.alpha_ref)
+        else:
+            a_ratio = float(values["A_ratio"]) * motion.pga / ground_peak
+            p = float(values["p"]) if self.recorded else self.path.p
+        return Point(body, float(values["lam"]), RECORD, math.nan, a_ratio, record=motion,
+                     p=p, **self._law(values), initial=self.initial_state(values))
 
     @property
     def free(self) -> bool:

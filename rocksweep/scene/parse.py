@@ -28,7 +28,9 @@ import numpy as np
 
 from rocksweep.numerics import Numerics
 from rocksweep.outputs import input_problem, is_input, shown
+from rocksweep.physics.floor import Mode
 from rocksweep.physics.model import BodyError, body_from_geometry
+from rocksweep.physics.path import GroundPath, check_pair
 from rocksweep.physics.points import FREE, INITIAL, RECORD
 from rocksweep.physics.records import GroundRecord, RecordError, read_record
 from rocksweep.physics.suite import (
@@ -41,7 +43,7 @@ from rocksweep.physics.suite import (
 )
 from rocksweep.scene.admission import _candidate_bodies, _check_cost
 from rocksweep.scene.loader import _CONTROL, _load_yaml, _YamlError
-from rocksweep.scene.model import Axis, Scene, SceneError
+from rocksweep.scene.model import FLOOR_AXES, Axis, Scene, SceneError
 from rocksweep.schema import (
     BODY_KEYS,
     KEYS,
@@ -52,7 +54,7 @@ from rocksweep.schema import (
     is_number,
     section_keys,
 )
-from rocksweep.vocab.axes import DIAGRAM_AXES, alpha_symbol
+from rocksweep.vocab.axes import DIAGRAM_AXES, alpha_symbol, axis_name
 from rocksweep.vocab.ground import MP
 from rocksweep.vocab.ground import PULSE_KEY_SHAPES as _PULSE_KEY_SHAPES
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
@@ -99,17 +101,18 @@ def apply_overrides(raw: dict, overrides: list[str]) -> dict:
 
 def parse_scene(text: str, source: str = "scene", overrides: list[str] | None = None,
                 base: str | Path | None = None, record: GroundRecord | None = None,
-                records: tuple[GroundRecord, ...] | None = None) -> Scene:
+                records: tuple[GroundRecord, ...] | None = None,
+                h2: GroundRecord | None = None) -> Scene:
     """Validate scene YAML text. Raises SceneError (one line, prefixed by ``source``).
 
     base: the directory a ``ground.record`` path is relative to (the scene file's; None:
     the working directory); record: the record of a ``ground`` section, already read (a
     result file's stored copy): the ``ground.record`` path is then not read; records: the
     same for a suite's ``ground.records`` (in the suite's order; their file names label
-    the record dimension)."""
+    the record dimension); h2: the same for ``ground.h2``."""
     try:
         return _parse(text, overrides or [], Path(base) if base is not None else None,
-                      record, records)
+                      record, records, h2)
     except SceneError as err:
         raise SceneError(f"{source}: {err}") from None
 
@@ -294,7 +297,7 @@ def _refine(raw: dict, kind: str) -> dict | None:
             if not (isinstance(v, list) and len(v) == 2
                     and all(isinstance(a, str) for a in v) and v[0] != v[1]):
                 raise SceneError(f"{key} = {fmt(v)}: {spec.allowed}")
-            out[k] = (v[0].split(".")[-1], v[1].split(".")[-1])
+            out[k] = tuple(axis_name(a) if "." in a else a for a in v)
             continue
         if spec.kind == "integer" and not (isinstance(v, int) and not isinstance(v, bool)):
             raise SceneError(f"{key} = {fmt(v)}: {spec.allowed}")
@@ -369,17 +372,114 @@ def _pulse_options(pulse: dict, shapes: tuple[str, ...]) -> list[Axis]:
     return out
 
 
-def _record(ground: dict, base: Path | None) -> GroundRecord:
-    """The record of a ``ground`` section, read (and hashed) now."""
-    spec = KEYS["ground.record"]
-    v = ground["record"]
+def _record(ground: dict, base: Path | None, key: str = "record") -> GroundRecord:
+    """The record of a ``ground`` section (``ground.record``, or ``ground.h2``), read
+    (and hashed) now."""
+    spec = KEYS[f"ground.{key}"]
+    v = ground[key]
     if not (isinstance(v, str) and v.strip()):
-        raise SceneError(f"ground.record = {fmt(v)}: {spec.allowed}")
+        raise SceneError(f"ground.{key} = {fmt(v)}: {spec.allowed}")
     path = _where(v, base)
     try:
         return read_record(path)
     except RecordError as err:
-        raise SceneError(f"ground.record: {err}") from None
+        raise SceneError(f"ground.{key}: {err}") from None
+
+
+def _modes(spec: Any) -> tuple[Mode, ...]:
+    """The building's modes of ``floor.modes`` (numbers, each checked as the one-mode
+    form's keys)."""
+    key = "floor.modes"
+    if not (isinstance(spec, list) and spec):
+        raise SceneError(f"{key} = {fmt(spec)}: {KEYS[key].allowed}")
+    out = []
+    for i, m in enumerate(spec):
+        where = f"{key}[{i}]"
+        if not isinstance(m, dict):
+            raise SceneError(f"{where} = {fmt(m)}: {KEYS[key].allowed}")
+        for k in m:
+            if f"floor.{k}" not in FLOOR_AXES:
+                raise SceneError(f"{where}.{k}: unknown key (allowed: period, damping, "
+                                 "participation)")
+        vals = []
+        for k in FLOOR_AXES:
+            short = k.split(".")[1]
+            v = m.get(short)
+            if v is None:
+                raise SceneError(f"{where}.{short}: missing required key "
+                                 f"({KEYS[k].allowed.removeprefix('must be ')})")
+            x = as_float(v) if is_number(v) else math.nan
+            if check_values(k, np.array([x])) is not None or (
+                    k == "floor.participation" and x == 0.0):
+                raise SceneError(f"{where}.{short} = {fmt(v)}: {KEYS[k].allowed}")
+            vals.append(x)
+        out.append(Mode(*vals))
+    return tuple(out)
+
+
+def _excitation_path(raw: dict, ground: dict, kind: str, free: bool,
+                     record: GroundRecord | None, suite: Suite | None, base: Path | None,
+                     physical: dict | None, given_h2: GroundRecord | None = None
+                     ) -> tuple[GroundPath | None, list[tuple[str, str, str, Any]],
+                                tuple[str, ...]]:
+    """A scene's excitation path (``physics.path``): the second horizontal component
+    (``ground.h2``, or a suite's paired H2 files) with the ``angle`` axis, and the
+    ``floor`` section's building (its one-mode keys as axes named ``floor.period``,
+    ``floor.damping``, ``floor.participation``, or ``floor.modes``). Returns (the path,
+    None without those keys; the axes' specs (name, key, form, spec); files read)."""
+    specs: list[tuple[str, str, str, Any]] = []
+    inputs: tuple[str, ...] = ()
+    h2: tuple = ()
+    if ground.get("h2") is not None:
+        if suite is not None:
+            raise SceneError("ground.h2: not with ground.records (a folder of PEER "
+                             "downloads pairs each record's components by name)")
+        second = _record(ground, base, "h2") if given_h2 is None else given_h2
+        why = check_pair(record, second)
+        if why is not None:
+            raise SceneError(f"ground.h2: {second.name}: {why}")
+        h2 = (second,)
+        inputs = (str(second.source),) if given_h2 is None else ()
+    elif suite is not None and any(r is not None for r in suite.h2):
+        h2 = suite.h2
+    if ground.get("angle") is not None and not h2:
+        raise SceneError(f"ground.angle = {fmt(ground['angle'])}: needs the second "
+                         "horizontal component (ground.h2, or a suite of PEER folders with "
+                         "both horizontals)")
+    if h2:
+        specs.append(("angle", "ground.angle",
+                      *_axis_spec("ground.angle", ground.get("angle", 0.0))[:2]))
+    modes = None
+    if raw.get("floor") is not None:
+        if free:
+            raise SceneError(f"floor = {fmt(raw['floor'])}: a free-rocking scene (no pulse "
+                             "or ground section) has no ground motion for a building to "
+                             "carry; give a pulse or a ground motion")
+        sec = _section(raw, "floor", kind, required=False)
+        if sec.get("modes") is not None:
+            for k in FLOOR_AXES:
+                if sec.get(k.split(".")[1]) is not None:
+                    raise SceneError(f"{k}: not with floor.modes (give one mode's keys or "
+                                     "the list of modes)")
+            modes = _modes(sec["modes"])
+        else:
+            for k in FLOOR_AXES:
+                short = k.split(".")[1]
+                if sec.get(short) is None:
+                    raise SceneError(f"{k}: missing required key ({_AXIS_HINT}; or give "
+                                     "floor.modes)")
+                form, spec, _ = _axis_spec(k, sec[short])
+                if k == "floor.participation" and np.any(_axis_values(k, form, spec) == 0):
+                    raise SceneError(f"{k} = 0.0: {KEYS[k].allowed}")
+                specs.append((k, k, form, spec))
+    if not h2 and raw.get("floor") is None:
+        return None, specs, inputs
+    p = float(physical["p"]) if physical is not None else 1.0
+    return (GroundPath(h2=h2, modes=modes, floor=raw.get("floor") is not None, p=p),
+            specs, inputs)
+
+
+_AXIS_HINT = "a number, a list of numbers or a range {start, stop, num}"
 
 
 def _where(v: str, base: Path | None) -> Path:
@@ -652,7 +752,8 @@ def _suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...] | No
 
 def _parse(text: str, overrides: list[str], base: Path | None = None,
            given_record: GroundRecord | None = None,
-           given_records: tuple[GroundRecord, ...] | None = None) -> Scene:
+           given_records: tuple[GroundRecord, ...] | None = None,
+           given_h2: GroundRecord | None = None) -> Scene:
     try:
         raw = _load_yaml(text)
     except _YamlError as err:
@@ -693,6 +794,7 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     free = raw.get("ground") is None and raw.get("pulse") is None
     record = suite = stripe = None
     inputs: tuple[str, ...] = ()
+    ground: dict = {}
     if free:  # no ground motion: free vibration from the initial state
         pulse = {"shape": FREE, "w_over_p": 0.0, "A_ratio": 0.0}
     elif raw.get("ground") is not None:
@@ -762,6 +864,11 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
         specs.append(("record", "ground.record", "words", suite.names))
         if stripe is not None:
             specs.append((stripe[0], f"ground.{stripe[0]}", "stripes", stripe[1:]))
+    # the orientation and the floor: after the records, before the ground's own axes
+    path, path_specs, path_inputs = _excitation_path(raw, ground, kind, free, record, suite,
+                                                     base, physical, given_h2)
+    specs.extend(path_specs)
+    inputs = (*inputs, *path_inputs)
     for k in pulse_axes:
         if free:  # not the user's: no check (w_over_p = 0 is no ground motion)
             specs.append((k, f"{section}.{k}", "given", pulse[k]))
@@ -803,11 +910,12 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     scene = Scene(name=name or "rocksweep scene", kind=kind, axes=tuple(axes),
                   numerics=numerics, single_numerics=single, energy=energy, text=text,
                   contact=contact, check=check, record=record, refine=_refine(raw, kind),
-                  suite=suite, inputs=inputs, physical=physical)
+                  suite=suite, inputs=inputs, physical=physical, path=path)
     if scene.contact and scene.ground:
         # the contact outputs are compiled into the sine/cosine variants only (a kernel
         # variant per combination costs compile time no scene has asked for yet)
-        what = "a recorded ground motion" if scene.recorded else "ricker and mp pulses"
+        what = ("a recorded ground motion" if scene.recorded else "a floor" if scene.floor
+                else "ricker and mp pulses")
         raise SceneError(f"outputs.contact = true: not available with {what} yet; contact "
                          "outputs work with sine and cosine pulses")
     bodies = _candidate_bodies(scene)

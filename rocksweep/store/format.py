@@ -126,7 +126,8 @@ def variables_for(stored: dict) -> dict:
     files of adaptive sweeps)."""
 
     return {**fields.variables(bool(stored.get("energy")), bool(stored.get("contact")),
-                               bool(stored.get("check"))),
+                               bool(stored.get("check")),
+                               bool((stored.get("path") or {}).get("floor"))),
             **({"computed": COMPUTED_VARIABLE} if stored.get("adaptive") else {})}
 
 
@@ -205,6 +206,9 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
         for k, v in record_attrs(scene.record).items():
             a[f"record_{k}"] = v
         _store_record(f, scene.record)
+    if scene.path is not None:  # the orientation's second component and the building
+        for k, v in path_attrs(scene).items():
+            a[k] = v
     if scene.suite is not None:  # the stripes' IM ("none": a cloud) and Sa's period [s]
         a["scale_im"] = scene.suite.im or "none"
         a["scale_period"] = float(scene.suite.period)
@@ -261,6 +265,8 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
                               dcpl=dcpl, fill_time="alloc")
         f_ = fields.BY_NAME.get(name)
         meta = (fields.field_attrs(f_, scene.kind) if f_ is not None
+                else {"long_name": "peak floor acceleration", "description": text,
+                      "units": "g"} if name == fields.FLOOR_PFA
                 else {"long_name": "computed flag", "description": text})
         if name in FLAG_VARIABLES:
             meta.pop("rocksweep_units", None)
@@ -284,6 +290,27 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
             ds.dims[i].attach_scale(sc)
     if scene.suite is not None:
         _write_suite(f, scene, {s.name.lstrip("/"): s for s in scales})
+
+
+def path_attrs(scene: Scene) -> dict[str, str]:
+    """The attributes stating a scene's excitation path: ``floor`` (the building, one
+    line, and the stopping rule of its ring-down) and ``ground_h2`` (the second horizontal
+    component: name, SHA-256, path read)."""
+    from rocksweep.physics import floor
+
+    out = {}
+    if scene.floor:
+        out["floor"] = (f"{scene.floor_words()}; cascade (the body does not load the "
+                        "building); floor motion a_g + sum Gamma phi q'' exact for the "
+                        "piecewise-linear ground at >= "
+                        f"{floor.POINTS_PER_PERIOD} samples per period, ring-down until "
+                        f"below {floor.RINGDOWN_SHARE:g} of the floor's peak; floor.period "
+                        "in s" + ("" if scene.recorded else
+                                  f" with the pulse timed by p = {scene.path.p:g} rad/s"))
+    h2 = [r for r in scene.path.h2 if r is not None]
+    if h2 and scene.suite is None:
+        out["ground_h2"] = f"{h2[0].name} sha256 {h2[0].sha256} ({h2[0].source})"
+    return out
 
 
 def suite_variables(scene: Scene) -> dict[str, tuple[tuple[str, ...], np.ndarray]]:

@@ -27,10 +27,24 @@ def resolved_scene(scene: Scene, overrides: tuple[str, ...] | list[str] = (),
         **({"check": True} if scene.check else {}),
         **({"record": record_attrs(scene.record)} if scene.record is not None else {}),
         **({"suite": suite_attrs(scene.suite)} if scene.suite is not None else {}),
+        **({"path": path_resolved(scene)} if scene.path is not None else {}),
     }
     if adaptive is not None:
         d["adaptive"] = dict(adaptive)
     return d
+
+
+def path_resolved(scene: Scene) -> dict:
+    """A scene's excitation path as the resolved scene states it: the second horizontal
+    components (name, SHA-256, path read; None where a record has none), the floor's
+    modes given as a list (None: the one-mode axes) and whether there is a floor, and the
+    pulse's p [rad/s]."""
+    pa = scene.path
+    return {"h2": [None if r is None else {"name": r.name, "sha256": r.sha256,
+                                           "source": str(r.source)} for r in pa.h2],
+            "floor": pa.floor, "p": pa.p,
+            "modes": None if pa.modes is None else [
+                [m.period, m.damping, m.participation] for m in pa.modes]}
 
 
 def _adaptive_words(a: dict) -> str:
@@ -127,6 +141,13 @@ def scene_differences(stored: dict, new: dict) -> list[str]:
                          ("a suite" if new.get("suite") else "no suite"))
         else:
             diffs += _suite_differences(stored["suite"], new["suite"])
+    ps, pn = stored.get("path") or {}, new.get("path") or {}
+    for k in ("floor", "modes", "p"):
+        if ps.get(k) != pn.get(k):
+            diffs.append(f"floor ({k}): file {_short(ps.get(k))}, scene {_short(pn.get(k))}")
+    if [h and h.get("sha256") for h in ps.get("h2") or []] != [
+            h and h.get("sha256") for h in pn.get("h2") or []]:
+        diffs.append("ground.h2: the second horizontal components differ (sha256)")
     sn, nn = stored.get("numerics", {}), new.get("numerics", {})
     for key in dict.fromkeys([*sn, *nn]):
         if sn.get(key) != nn.get(key):
