@@ -319,6 +319,15 @@ RECORD_VARIABLES: dict[str, tuple[str, str | None, str]] = {
     "record_v_end": ("ground velocity at the end of the record", "m/s",
                      "the trapezoidal integral of the record as given at its last sample; far "
                      "from 0: the record drifts (not baseline-corrected)"),
+    "record_pga_v": ("peak vertical ground acceleration of the record", "g",
+                     "max |acc| of the vertical component (UP) as recorded"),
+    "record_v_over_h": ("vertical to horizontal peak ratio", "1",
+                        "PGA_v / PGA_h, PGA_h of the component the suite scales (H1's, or "
+                        "RotD50's with ground.scale.component: RotD50 and a PGA stripe)"),
+    "record_rotd50": ("RotD50 of the stripe IM", None,
+                      "the median over orientations 0-179 deg of the stripe IM of the two "
+                      "horizontals projected (Boore 2010): what scales the records with "
+                      "ground.scale.component: RotD50"),
     "record_npts": ("number of samples of the record", "1", "NPTS"),
     "record_dt": ("sample interval of the record", "s", "DT"),
     "record_duration": ("duration of the record", "s", "(NPTS - 1) DT"),

@@ -206,6 +206,15 @@ KEYS: dict[str, Key] = {
                                0.0, math.inf, lo_in=False, hi_in=False),
     "ground.scale.period": Key("number", "must be in (0, 100] s (the period of Sa)", 0.0,
                                100.0, lo_in=False),
+    "ground.scale.component": Key("choice", "must be H1 (the first horizontal's IM) or "
+                                  "RotD50 (the median over orientations of both "
+                                  "horizontals', NGA-West2's convention; a suite of PEER "
+                                  "folders)", choices=("H1", "RotD50"), required=False,
+                                  default="H1"),
+    "ground.missing": Key("choice", "must be error (a record of a PEER folder without one "
+                          "of its components is refused) or skip (left out, with a "
+                          "warning)", choices=("error", "skip"), required=False,
+                          default="error"),
     "ground.scale.factor": Key("number", "must be a finite number > 0 (every record times "
                                "this factor)", 0.0, math.inf, lo_in=False, hi_in=False),
     "ground.periods": Key("string", "must be a list of periods in [0, 100] s (Sa stored per "

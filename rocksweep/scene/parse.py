@@ -35,7 +35,9 @@ from rocksweep.physics.points import FREE, INITIAL, RECORD
 from rocksweep.physics.records import GroundRecord, RecordError, read_record
 from rocksweep.physics.suite import (
     AVGSA_RANGE,
+    COMPONENTS,
     DEFAULT_PERIODS,
+    ROTD50,
     SCALE_IMS,
     Suite,
     SuiteError,
@@ -669,9 +671,9 @@ def _scale(ground: dict) -> tuple[str | None, str, Any, float, float]:
             raise SceneError(f"{key}.factor = {fmt(f)}: {KEYS[key + '.factor'].allowed}")
         return None, "", None, math.nan, as_float(f)
     for k in v:
-        if k not in ("im", "values", "period"):
-            raise SceneError(f"{key}.{k}: unknown key (allowed: im, values, period; or "
-                             "factor alone)")
+        if k not in ("im", "values", "period", "component"):
+            raise SceneError(f"{key}.{k}: unknown key (allowed: im, values, period, "
+                             "component; or factor alone)")
     im = v.get("im")
     if not isinstance(im, str) or im not in SCALE_IMS:
         raise SceneError(f"{key}.im = {fmt(im)}: {KEYS[key + '.im'].allowed}")
@@ -726,10 +728,26 @@ def _suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...] | No
                      else "a list in ground.records")
             raise SceneError(f"ground.{k}: not with ground.records (use {other})")
     im, form, spec, period, factor = _scale(ground)
-    if given is not None:
+    scale = ground.get("scale")
+    component = scale.get("component", "H1") if isinstance(scale, dict) else "H1"
+    if component not in COMPONENTS:
+        raise SceneError(f"ground.scale.component = {fmt(component)}: "
+                         f"{KEYS['ground.scale.component'].allowed}")
+    missing = ground.get("missing", "error")
+    if missing not in ("error", "skip"):
+        raise SceneError(f"ground.missing = {fmt(missing)}: {KEYS['ground.missing'].allowed}")
+    folder = _peer_folder(ground["records"], base)
+    if folder is None and missing != "error":
+        raise SceneError("ground.missing: applies to a folder of PEER downloads "
+                         "(ground.records: FOLDER)")
+    h2: tuple = ()
+    vertical: tuple = ()
+    read: tuple[str, ...] = ()
+    if folder is not None:  # read again on a rebuild: the pairs are the folder's
+        records, h2, vertical, names, read = _peer_suite(folder, missing == "skip")
+    elif given is not None:
         records = list(given)
         names = [Path(r.source).name for r in records]
-        read: tuple[str, ...] = ()
     else:
         paths, listings, named = _record_paths(ground["records"], base)
         records = []
@@ -741,13 +759,81 @@ def _suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...] | No
                 raise SceneError(f"ground.records: {where}{err}") from None
         names = [p.name for p in paths]
         read = tuple(str(p) for p in (*paths, *listings))
+    if component == ROTD50 and not h2:
+        raise SceneError("ground.scale.component = 'RotD50': needs both horizontals of "
+                         "every record (ground.records: a folder of PEER downloads)")
+    if component == ROTD50 and im is None:
+        raise SceneError("ground.scale.component = 'RotD50': scales stripes (ground.scale: "
+                         "{im: ..., values: ...})")
     values = _axis_values("ground.scale.values", form, spec).tolist() if im else []
     try:
         suite = make_suite(records, names, im, values, period, factor,
-                           _periods(ground), *_avgsa(ground, period))
+                           _periods(ground), *_avgsa(ground, period), h2=h2,
+                           vertical=vertical, component=component)
     except SuiteError as err:
         raise SceneError(f"ground.records: {err}") from None
     return suite, ((im, form, spec) if im else None), read
+
+
+def _peer_folder(spec: Any, base: Path | None) -> Path | None:
+    """The folder of ``ground.records: FOLDER`` (one entry that is a directory), else
+    None."""
+    entry = spec[0] if isinstance(spec, list) and len(spec) == 1 else spec
+    if not (isinstance(entry, str) and entry.strip()) or "\0" in entry:
+        return None
+    path = _where(entry, base)
+    return path if path.is_dir() else None
+
+
+def _peer_suite(folder: Path, skip: bool) -> tuple:
+    """The records of a folder of PEER downloads (``scene.peer``): (H1s, H2s, verticals
+    (empty: none in the folder), names (H1's file names), files read). A record without
+    one of its components is refused with one line, or left out with a RecordWarning
+    (``skip``)."""
+    import warnings
+
+    from rocksweep.physics.suite import RecordWarning
+    from rocksweep.scene.peer import peer_components
+
+    key = "ground.records"
+    files = [p for p in folder.iterdir() if p.suffix.lower() == ".at2" and p.is_file()]
+    comps, _ = peer_components(files)
+    if not comps:
+        raise SceneError(f"{key}: {shown(folder)}: no PEER record files in the folder "
+                         "(RSN<n>_<EVENT>_<STATION><COMPONENT>.AT2)")
+    with_up = any(c.up is not None for c in comps)
+    kept = []
+    for c in comps:
+        miss = c.missing(with_up)
+        if not miss:
+            kept.append(c)
+            continue
+        found = ", ".join(p.name for p in (c.h1, c.h2, c.up) if p is not None)
+        what = f"{c.rsn} has no {' and no '.join(miss)} file (found {found})"
+        need = "H1, H2 and UP" if with_up else "H1 and H2"
+        if not skip:
+            raise SceneError(f"{key}: {shown(folder)}: {what}; every record needs {need} "
+                             "(or ground.missing: skip)")
+        warnings.warn(RecordWarning(f"{key}: {what}: skipped"), stacklevel=2)
+    if not kept:
+        raise SceneError(f"{key}: {shown(folder)}: no record has all its components")
+    h1s, h2s, ups = [], [], []
+    for c in kept:
+        try:
+            one = [read_record(p) for p in (c.h1, c.h2, *([c.up] if with_up else []))]
+        except RecordError as err:
+            raise SceneError(f"{key}: {err}") from None
+        for other, what in zip(one[1:], ("H2", "UP"), strict=False):
+            why = check_pair(one[0], other)
+            if why is not None:
+                raise SceneError(f"{key}: {c.rsn}: {what} {other.name}: " + why.replace(
+                    "the two horizontal components", "the components of a record"))
+        h1s.append(one[0])
+        h2s.append(one[1])
+        ups.append(one[2] if with_up else None)
+    read = tuple(str(p) for c in kept for p in (c.h1, c.h2, c.up) if p is not None)
+    return (h1s, tuple(h2s), tuple(ups) if with_up else (), [c.h1.name for c in kept],
+            read)
 
 
 def _parse(text: str, overrides: list[str], base: Path | None = None,

@@ -212,6 +212,7 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
     if scene.suite is not None:  # the stripes' IM ("none": a cloud) and Sa's period [s]
         a["scale_im"] = scene.suite.im or "none"
         a["scale_period"] = float(scene.suite.period)
+        a["scale_component"] = scene.suite.component  # H1, or RotD50 of both horizontals
         _store_suite_records(f, scene.suite)
     for k, v in vers.items():
         a[f"{k}_version"] = v
@@ -332,6 +333,9 @@ def suite_variables(scene: Scene) -> dict[str, tuple[tuple[str, ...], np.ndarray
         "record_dt": (("record",), np.array([r.dt for r in su.records], float)),
         "record_duration": (("record",), np.array([r.duration for r in su.records], float)),
         "record_sha256": (("record",), np.array([r.sha256 for r in su.records], object)),
+        **{k: (("record",), v) for k, v in su.vertical_ims().items()},
+        **({"record_rotd50": (("record",), np.asarray(su.rotd50, float))}
+           if su.rotd50 is not None else {}),
     }
     r = np.arange(R)
     if su.im is None:

@@ -73,6 +73,12 @@ def suite_attrs(suite) -> dict:
 
     return {"im": suite.im, "period": num(suite.period), "factor": num(suite.factor),
             "periods": list(suite.periods),
+            # multi-component records (a PEER folder): the scaling component, each
+            # record's H2 and vertical (name, SHA-256); only when there are some
+            **({"component": suite.component,
+                "h2": [{"name": r.name, "sha256": r.sha256} for r in suite.h2],
+                "vertical": [None if r is None else {"name": r.name, "sha256": r.sha256}
+                             for r in suite.vertical]} if suite.h2 else {}),
             "records": [{"name": n, "sha256": r.sha256, "source": str(r.source)}
                         for n, r in zip(suite.names, suite.records, strict=True)]}
 
@@ -80,7 +86,7 @@ def suite_attrs(suite) -> dict:
 def _suite_differences(ss: dict, sn: dict) -> list[str]:
     """One phrase per difference between two ``suite_attrs`` dicts (records by name)."""
     diffs = []
-    for k in ("im", "period", "factor", "periods"):
+    for k in ("im", "period", "factor", "periods", "component", "h2", "vertical"):
         if ss.get(k) != sn.get(k):
             diffs.append(f"ground.scale {k}: file {ss.get(k)!r}, scene {sn.get(k)!r}"
                          if k != "periods" else

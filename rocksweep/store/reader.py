@@ -630,6 +630,7 @@ def result_scene(result: SweepResult) -> Scene:
     rec = result.scene.get("record")
     suite = result.scene.get("suite")
     record = None
+    added = 0  # overrides added here, not the file's
     if rec:
         # the file's own copy first (a result stands alone); a file without one re-reads
         # the record from where the sweep read it, checked against its SHA-256
@@ -648,13 +649,18 @@ def result_scene(result: SweepResult) -> Scene:
                 raise StoreError(f"{shown(result.path)}: the record {rec['source']} changed "
                                  f"since the sweep (sha256 {record.sha256[:12]}, the result "
                                  f"has {rec['sha256'][:12]})")
-    records = stored_records(result.path, suite) if suite and result.in_file else None
-    if suite and records is None:
+    records = (stored_records(result.path, suite) if suite and result.in_file
+               and not suite.get("h2") else None)  # a PEER folder is paired anew
+    if suite and suite.get("h2"):
+        overrides.append("ground.records=" + json.dumps(
+            str(Path(str(suite["records"][0]["source"])).parent)))
+        added += 1
+    elif suite and records is None:
         # a file without copies (older rocksweep) or a Dataset made in memory: the records
         # where the sweep read them (their SHA-256s are compared below)
         overrides.append("ground.records=" + json.dumps(
             [str(r.get("source")) for r in suite.get("records") or []]))
-    added = int(bool(suite) and not rec and records is None)  # overrides not the file's
+        added += 1
     h2 = [r for r in (result.scene.get("path") or {}).get("h2") or [] if r]
     if h2 and not suite:  # the second component, read where the sweep read it
         overrides.append("ground.h2=" + json.dumps(str(h2[0]["source"])))
