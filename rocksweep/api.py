@@ -229,6 +229,19 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3, search: bool = True) -> xr.Datas
 
 
 @speaks_python
+def floor_spectrum(ds: xr.Dataset, rtol: float = 1e-2, search: bool = True) -> xr.Dataset:
+    """The floor spectrum of a complete sweep over ``floor.period``: a record suite's
+    P(overturn) over (floor.period, stripe, ...) (with an ``angle`` axis for each
+    orientation answer: ``orientation`` each/worst), or one record's or a pulse's A_min
+    over floor.period, bisected to ``rtol`` (``rocksweep.analysis.floors``). Its figure:
+    ``rocksweep.plot``."""
+    from rocksweep.analysis.floors import floor_spectrum as compute
+
+    _register()
+    return compute(ds, rtol, search)
+
+
+@speaks_python
 def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
     """Incremental dynamic analysis per record of a scaled record-suite sweep: the
     smallest IM (the stripe IM: PGA [g], PGV [m/s], Sa [g], ...) that overturns each
@@ -269,12 +282,16 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     should not be trusted as it is: also a ``FragilityWarning``), the counts
     ``n_records``, ``n_excluded``, ``n_not_run``, the fitted ``curve`` and its bands over
     ``im_grid``; for stripes ``fraction`` per stripe and ``first_level``,
-    ``resurrection`` per record.
+    ``resurrection`` per record. A sweep over ``angle`` gives both answers along an
+    ``orientation`` dimension: "each" (every (record, angle) a sample) and "worst" (the
+    worst angle per record: overturns at any angle).
     """
+    from rocksweep.analysis.floors import by_orientation
     from rocksweep.analysis.fragility import fragility as fit
 
-    return fit(_dataset_arg(ds, "ds"), state=state, im=im, period=period,
-               bootstrap=bootstrap, seed=seed, ci=ci)
+    # with an angle axis: every orientation a sample, and the worst per record
+    return by_orientation(_dataset_arg(ds, "ds"), lambda d: fit(
+        d, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci))
 
 
 @speaks_python

@@ -16,6 +16,7 @@ SIGNATURES: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("fragility", ("im_median", "beta")),
     ("fragility", ("median", "beta")),
     ("ida", ("ida_im",)),
+    ("floor_spectrum", ("p_overturn", "n_counted")),
     ("sweep", ("outcome", "status")),
     ("spectra", ("A_min", "theta_max_over_alpha", "outcome")),
     ("boundaries", ("A_min",)),

@@ -18,6 +18,10 @@ def plot_analysis(ds: Any, *, ax: Any = None, width: str | None = None) -> Any:
     kind = dataset_kind(ds)
     if kind == "fragility":
         return fragility_figure(ds, ax=ax, width=width or "single")
+    if kind == "floor_spectrum":
+        from rocksweep.figures.floors import floor_spectrum_figure
+
+        return floor_spectrum_figure(ds, ax=ax, width=width or "single")
     draw = {"risk": results.risk_figure, "ida": results.ida_figure,
             "spectra": results.spectra_dataset_figure,
             "boundaries": results.boundaries_figure,
