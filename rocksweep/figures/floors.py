@@ -42,6 +42,6 @@ def floor_spectrum_figure(fs: xr.Dataset, *, ax: Any = None,
     ax.set_title(title, fontsize="small")
     ax.grid(True, alpha=0.25, linewidth=0.5)
     if ax.get_legend_handles_labels()[0]:
-        ax.legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.2),
-                  frameon=False, ncol=2)
+        ax.legend(fontsize="x-small", loc="upper left", bbox_to_anchor=(1.02, 1.0),
+                  frameon=False)
     return fig
