@@ -1,7 +1,6 @@
-"""``python -m rocksweep``: the command line, with Ctrl-C during start-up answered as an
-interrupt (exit 130), not a traceback from inside an import."""
+"""``python -m rocksweep``: the console command (``rocksweep.cli.entry``), with Ctrl-C during
+start-up answered as an interrupt (exit 130), not a traceback from inside an import."""
 
-import os
 import sys
 
 from rocksweep import interrupts
@@ -9,9 +8,8 @@ from rocksweep import interrupts
 interrupts.install()
 try:
     from rocksweep.cli import entry
-except KeyboardInterrupt:
+except KeyboardInterrupt:  # only click and the command modules load here: nothing written
     sys.stderr.write("\ninterrupted\n")
-    sys.stderr.flush()
-    os._exit(130)  # half-imported modules: no teardown (nothing was written)
+    raise SystemExit(130) from None
 
 entry()

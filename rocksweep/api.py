@@ -1,8 +1,8 @@
 """The Python API, a thin facade: run a scene's grid, open a result, simulate one point,
 and the analyses of a Dataset. Each function hands over to the room that does the work
 and checks its arguments: scenes (``rocksweep.scene.inputs``), the sweep session
-(``rocksweep.store.session``), a result as a Dataset (``rocksweep.store.dataset``), a
-run's history (``rocksweep.store.history``), the analyses (``rocksweep.analysis``), the
+(``rocksweep.compute.session``), a result as a Dataset (``rocksweep.store.dataset``), a
+run's history (``rocksweep.compute.history``), the analyses (``rocksweep.analysis``), the
 figures (``rocksweep.figures``), ``ds.rocksweep`` (``rocksweep.accessor``). Errors speak
 Python (``rocksweep.errors.speaks_python``).
 
@@ -13,10 +13,12 @@ still importable from here (``api.load``, ``api.sweep_file``, ...: PEP 562).
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+import functools
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from rocksweep.accessor import register_accessor
 from rocksweep.errors import ApiError, speaks_python  # noqa: F401 (ApiError: the API's)
 from rocksweep.simulation import Simulation  # what simulate returns
 
@@ -31,10 +33,10 @@ if TYPE_CHECKING:
 _MOVED = {name: module for module, names in {
     "rocksweep.compute.driver": ("WRITE_EVERY", "SweepInterrupted", "SweepReport"),
     "rocksweep.scene.inputs": ("load", "override_strings"),
-    "rocksweep.store.history": ("MAX_RUNS", "API_MAX_RUNS", "simulate_runs",
+    "rocksweep.compute.history": ("MAX_RUNS", "API_MAX_RUNS", "simulate_runs",
                                 "history_dataset", "swept_values", "write_history_csv"),
     "rocksweep.compute.adaptive": ("adaptive_options",),
-    "rocksweep.store.session": ("sweep_file",),
+    "rocksweep.compute.session": ("sweep_file",),
     "rocksweep.store.dataset": ("result_dataset",),
     "rocksweep.accessor": ("RocksweepAccessor",),
 }.items() for name in names}
@@ -48,9 +50,25 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module 'rocksweep.api' has no attribute {name!r}")
 
 
+def _public(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """A function of the API: errors in Python's words, and ``ds.rocksweep`` registered
+    after every call (once xarray is loaded: the Datasets it returns have the accessor,
+    whatever was called first)."""
+    fn = speaks_python(fn)
+
+    @functools.wraps(fn)
+    def call(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return fn(*args, **kwargs)
+        finally:
+            register_accessor()
+
+    return call
+
+
 # --- rocksweep.run and rocksweep.open ----------------------------------------------------
 
-@speaks_python
+@_public
 def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
         overrides: Overrides = (), progress: bool = False, overwrite: bool = False,
         resume: bool = False, client: Any = None, adaptive: bool = False,
@@ -91,7 +109,7 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
     ``output``. A wrong type (``jobs="2"``, ``overrides=5``) is a TypeError naming the
     argument; every argument is checked before the output is touched.
     """
-    from rocksweep.store.session import run_session  # checks every argument first
+    from rocksweep.compute.session import run_session  # checks every argument first
 
     out = run_session(scene, output, overrides=overrides, jobs=jobs, resume=resume,
                       overwrite=overwrite, progress=progress, client=client,
@@ -99,11 +117,10 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
                       settings={"coarse": coarse, "audit": audit, "axes": axes,
                                 "margin": margin, "final_margin": final_margin,
                                 "seed": seed, "threshold": threshold})
-    _register()
     return out
 
 
-@speaks_python
+@_public
 def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xarray's)
     """A sweep result file as an xarray Dataset, loaded in memory (the file is closed).
 
@@ -119,25 +136,15 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
     """
     from rocksweep.store.dataset import open_result
 
-    _register()
     return open_result(path)
 
 
-def _register() -> None:
-    """``ds.rocksweep``: the accessor, calling this module's analyses."""
-    from rocksweep.accessor import register_accessor
-
-    register_accessor({f.__name__: f for f in (plot, boundaries, boundary_lines, spectra,
-                                               fragility, ida, risk, im_efficiency, table,
-                                               calibrated_overrides)})
-
-
+@_public
 def open_any(path: str | Path) -> xr.Dataset:
     """Any rocksweep Dataset from a file (``rocksweep.analysis.files.open_any``), with
     ``ds.rocksweep``."""
     from rocksweep.analysis.files import open_any as open_file
 
-    _register()
     return open_file(path)
 
 
@@ -145,13 +152,12 @@ def _dataset_arg(ds: Any, what: str) -> xr.Dataset:
     """A Dataset, or a path to one (``analysis.files._as_dataset``), with ``ds.rocksweep``."""
     from rocksweep.analysis.files import _as_dataset
 
-    _register()
     return _as_dataset(ds, what)
 
 
 # --- Analyses: a result Dataset in, a Dataset, a DataFrame or a Figure out ---------------
 
-@speaks_python
+@_public
 def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any = None,
          curves: bool = False, show_computed: bool = False, mu: bool = False,
          width: str | None = None, compare: str | None = None,
@@ -182,7 +188,7 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
                     width=width, compare=compare, names=_names)
 
 
-@speaks_python
+@_public
 def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None,
                search: bool = True) -> xr.Dataset:
     """A_min: the smallest amplitude (A_ratio) that overturns, for every x (w_over_p or
@@ -202,11 +208,10 @@ def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None,
     """
     from rocksweep.analysis.boundaries import boundaries_dataset
 
-    _register()  # the result's ds.rocksweep, whatever was called first
     return boundaries_dataset(ds, rtol, mode, search)
 
 
-@speaks_python
+@_public
 def boundary_lines(ds: xr.Dataset) -> Any:
     """The lines between classes of a complete result's diagrams as a tidy
     ``pandas.DataFrame``: one row per vertex with the panel's other swept keys, ``line``,
@@ -216,7 +221,7 @@ def boundary_lines(ds: xr.Dataset) -> Any:
     return boundary_lines_frame(ds)
 
 
-@speaks_python
+@_public
 def spectra(ds: xr.Dataset, rtol: float = 1e-3, search: bool = True) -> xr.Dataset:
     """Rocking and overturning spectra of a complete sweep over p (a record) or w_over_p,
     A_ratio and optionally lam: ``theta_max_over_alpha`` and ``outcome`` over (lam,
@@ -224,11 +229,10 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3, search: bool = True) -> xr.Datas
     (search=False: the grid's bracket bisected only, as for ``boundaries``)."""
     from rocksweep.analysis.spectrum import spectra as compute_spectra
 
-    _register()  # the result's ds.rocksweep, whatever was called first
     return compute_spectra(ds, rtol, search).to_dataset()
 
 
-@speaks_python
+@_public
 def floor_spectrum(ds: xr.Dataset, rtol: float = 1e-2, search: bool = True) -> xr.Dataset:
     """The floor spectrum of a complete sweep over ``floor.period``: a record suite's
     P(overturn) over (floor.period, stripe, ...) (with an ``angle`` axis for each
@@ -237,11 +241,10 @@ def floor_spectrum(ds: xr.Dataset, rtol: float = 1e-2, search: bool = True) -> x
     ``rocksweep.plot``."""
     from rocksweep.analysis.floors import floor_spectrum as compute
 
-    _register()
     return compute(ds, rtol, search)
 
 
-@speaks_python
+@_public
 def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
     """Incremental dynamic analysis per record of a scaled record-suite sweep: the
     smallest IM (the stripe IM: PGA [g], PGV [m/s], Sa [g], ...) that overturns each
@@ -253,11 +256,10 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
     curves ``rocksweep.plot`` draws)."""
     from rocksweep.analysis.ida import ida_dataset
 
-    _register()  # the result's ds.rocksweep, whatever was called first
     return ida_dataset(ds, rtol)
 
 
-@speaks_python
+@_public
 def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
               im: str | None = None, period: float | None = None,
               bootstrap: int | None = None, seed: int = 0, ci: float = 0.9) -> xr.Dataset:
@@ -294,7 +296,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
         d, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci))
 
 
-@speaks_python
+@_public
 def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = None
          ) -> xr.Dataset:
     """Mean annual rate and probability in ``years`` of each state of a fragility:
@@ -310,7 +312,7 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = N
     return compute(_dataset_arg(fr, "fr"), hazard, years, site=site)
 
 
-@speaks_python
+@_public
 def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
     """Which IM explains ``state`` (as ``fragility``'s) best: for every IM of a
     record-suite sweep's records (``rocksweep.physics.suite.RECORD_IMS``: PGA, PGV, Sa(T),
@@ -324,7 +326,7 @@ def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
     return compute(_dataset_arg(ds, "ds"), state=state)
 
 
-@speaks_python
+@_public
 def table(ds: xr.Dataset) -> Any:
     """A tidy ``pandas.DataFrame`` of any rocksweep Dataset (or its file): one row per run
     of a sweep with its coordinates, unswept scene values, result fields, record, the
@@ -337,7 +339,7 @@ def table(ds: xr.Dataset) -> Any:
     return make(_dataset_arg(ds, "ds"))
 
 
-@speaks_python
+@_public
 def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> Any:
     """What ``run`` of this scene (with ``overrides``, as for ``run``) will cost on this
     machine, without running it: points, RK4 steps and evaluations expected, seconds of
@@ -354,7 +356,7 @@ def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> A
 
 # --- rocksweep.simulate ------------------------------------------------------------------
 
-@speaks_python
+@_public
 def simulate(scene: SceneLike, overrides: Overrides = (), /,
              **keys: Any) -> Simulation | list[Simulation]:
     """Run one point of a scene with its energy balance and time history.
@@ -365,10 +367,10 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     ``default`` if it names none, as a sweep's (one point, one answer). Returns a ``Simulation``
     (summary dict, history Dataset over p*t, and ``.figure()``); a scene with lists gives
     one ``Simulation`` per combination, in grid order (at most
-    ``rocksweep.store.history.API_MAX_RUNS``, 100; sweeps are for ``run``).
+    ``rocksweep.compute.history.API_MAX_RUNS``, 100; sweeps are for ``run``).
     """
+    from rocksweep.compute.history import API_MAX_RUNS, titled_runs
     from rocksweep.scene.inputs import load, override_strings
-    from rocksweep.store.history import API_MAX_RUNS, titled_runs
 
     sc, _ = load(scene, [*override_strings(overrides), *override_strings(keys)])
     out = [Simulation(r.summary(), hist, r, title)
@@ -376,9 +378,9 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     return out[0] if sc.size == 1 else out
 
 
-# --- Calibration (issue 30): scene numbers fitted to a measured history ------------------
+# --- Calibration: scene numbers fitted to a measured history ------------------
 
-@speaks_python
+@_public
 def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impact.lam",),
               *, bounds: Mapping[str, Sequence[float]] | None = None,
               overrides: Overrides = (), ci: float = 0.95, p: float | None = None
@@ -400,10 +402,10 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     from rocksweep.analysis.calibrate import calibrate_scene
 
     out = calibrate_scene(scene, measured, fit, bounds, ci, p, overrides)
-    _register()  # out.rocksweep.as_overrides()
     return out
 
 
+@_public
 def calibrated_overrides(fit: xr.Dataset, which: str = "all") -> dict[str, Any]:
     """Overrides {key: value} of a calibration (``calibrate``'s Dataset) to sweep a scene
     at the estimate and at both ends of the interval: ``which="all"`` gives [lo, estimate,

@@ -10,10 +10,15 @@
   FIFO or a socket is refused even with ``overwrite``.
 - The directory must exist and be writable, and the name must fit the file system.
 - Files appear atomically: they are written under a temporary name unique to the process
-  (``tempfile.mkstemp`` in the target's directory) and renamed over the target when
+  (``partial_prefix``: the writer's pid, in the target's directory) and published when
   complete (``publish``, the one rename of every output, result files included), so an
   output is either complete or absent, and two processes writing the same path never
   share a temporary file. A new file gets the mode the umask gives (``new_file_mode``).
+- One publish rule: a file the command was not told to replace is never replaced. Without
+  ``overwrite`` the temporary file is hard-linked to the target, which fails if a file
+  appeared there while the command computed; with ``overwrite`` only the file
+  ``check_output`` saw is replaced. The temporary files of a killed command are removed by
+  the next command writing the same path (``clean_stale_partials``).
 
 Every refusal is an ``OutputError`` (a ``RocksweepError``) with one line naming the path
 and the reason.
@@ -24,8 +29,10 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import re
 import stat
 import tempfile
+import time
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
@@ -166,6 +173,8 @@ def check_output(path: str | Path, *, overwrite: bool = False,
     if len(os.fsencode(path.name)) > name_max:
         raise OutputError(f"{shown(path)}: file name too long "
                           f"({len(os.fsencode(path.name))} bytes, at most {name_max})")
+    _CHECKED[os.path.abspath(path)] = None if st is None else (st.st_dev, st.st_ino,
+                                                               st.st_ctime_ns)
     return path
 
 
@@ -184,32 +193,39 @@ def new_file_mode() -> int:
     return 0o666 & ~mask
 
 
-def publish(tmp: Path, path: Path, *, replace: bool = True, old_fd: int | None = None) -> None:
+def publish(tmp: Path, path: Path, *, old: tuple[int, int, int] | None = None,
+            old_fd: int | None = None) -> None:
     """Rename the finished temporary file ``tmp`` to ``path`` with a new file's mode: the
-    one rename of every output. replace: over whatever is at ``path`` (its checks were
-    made, ``check_output``); else over the file held open by ``old_fd`` only if it is
-    still the one at ``path``, or, without ``old_fd``, only if nothing is at ``path``
-    (another process may have made it since it was checked: a hard link, which fails
-    then). OutputError when another process got there first."""
+    one rename of every output, and its one rule: never replace a file the command was not
+    told to replace. Without ``old``/``old_fd``, ``path`` must still be absent (``tmp`` is
+    hard-linked to it, which fails if another process made it since it was checked);
+    with ``old`` (``file_seen`` of the file the command was told to overwrite) or
+    ``old_fd`` (that file held open), that file is replaced only if it is still the one at
+    ``path`` (and if it vanished meanwhile, ``path`` is made as a new file). OutputError
+    when another process got there first; ``tmp`` is then left for the caller to remove."""
     os.chmod(tmp, new_file_mode())
-    if replace:
-        os.replace(tmp, path)
-        return
-    if old_fd is not None:
-        try:
-            same = os.path.samestat(os.fstat(old_fd), os.stat(path))
-        except OSError:
-            same = False
-        if not same:
+    if old is not None or old_fd is not None:
+        if old_fd is not None:  # held open: its inode cannot be reused
+            try:
+                now = os.stat(path)
+                same = os.path.samestat(os.fstat(old_fd), now)
+            except OSError:
+                now, same = None, False
+            there = now is not None or os.path.lexists(path)
+        else:
+            seen = file_seen(path)
+            same, there = seen == old, seen is not None
+        if same:
+            os.replace(tmp, path)
+            return
+        if there:
             raise OutputError(f"{shown(path)}: replaced by another process meanwhile; not "
                               "overwritten")
-        os.replace(tmp, path)
-        return
     try:
         os.link(tmp, path)
     except FileExistsError:
-        raise OutputError(f"{shown(path)}: made by another process meanwhile (a sweep "
-                          "started at the same time?); not overwritten") from None
+        raise OutputError(f"{shown(path)}: made by another process meanwhile (the same "
+                          "command started at the same time?); not overwritten") from None
     except OSError as err:
         if err.errno not in (errno.EPERM, errno.ENOTSUP, errno.EOPNOTSUPP, errno.EXDEV,
                              errno.EMLINK):
@@ -223,26 +239,122 @@ def publish(tmp: Path, path: Path, *, replace: bool = True, old_fd: int | None =
         os.unlink(tmp)
 
 
-@contextlib.contextmanager
-def atomic_path(path: str | Path) -> Iterator[Path]:
-    """A temporary path next to ``path``, unique to this process, renamed to ``path`` when
-    the block ends without an exception (removed otherwise). OSErrors become OutputError.
+def file_seen(path: str | Path) -> tuple[int, int, int] | None:
+    """What is at ``path``: (device, inode, status-change time [ns]) of the file (links
+    followed; the time tells a new file from an old one that reused the inode), (-1, -1,
+    -1) for a dangling link, None when nothing is."""
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return (-1, -1, -1) if os.path.lexists(path) else None
+    return st.st_dev, st.st_ino, st.st_ctime_ns
 
-        with atomic_path(out) as tmp:
+
+# What ``check_output`` saw at each output path (absolute path -> ``file_seen``, None:
+# absent): the file ``atomic_path(..., overwrite=True)`` may replace is that one, not one
+# that appeared while the command computed.
+_CHECKED: dict[str, tuple[int, int, int] | None] = {}
+
+_PARTIAL = re.compile(r"\.(?:(\d+)-)?[a-z0-9_]{8}\.partial(?:\.[A-Za-z0-9]{1,8})?")
+STALE_AGE = 60.0  # [s] a partial file without a writer's pid is stale when this old
+
+
+def partial_prefix(path: Path) -> str:
+    """The prefix of the temporary names an output at ``path`` is made under: the
+    writer's pid is part of the name (``.out.h5.1234-abcd1234.partial``, a suffix such as
+    ``.h5`` or ``.png`` may follow), so that a later run can tell a killed writer's file."""
+    return f".{path.name[:40]}.{os.getpid()}-"
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # exists, another user's
+        return True
+    return True
+
+
+def clean_stale_partials(path: Path) -> list[tuple[str, int]]:
+    """Remove the temporary files of earlier attempts to make ``path`` that no live writer
+    owns (a command killed while writing leaves one; a sweep's has the reserved size): its
+    writer's process is gone (or, for a name without a pid, it is older than STALE_AGE)
+    and no process holds its lock (HDF5's writer lock, flock). Returns (name, bytes) of
+    each file removed."""
+    import fcntl
+
+    path = Path(path)
+    parent = path.parent if str(path.parent) else Path(".")
+    # files of older versions were named after the stem (``.risk.abcd1234.partial.h5``)
+    heads = {f".{path.name[:40]}", f".{path.stem[:40]}"}
+    removed = []
+    try:
+        names = [n for n in os.listdir(parent) if ".partial" in n
+                 and any(n.startswith(h) for h in heads)]
+    except OSError:
+        return []
+    for name in names:
+        m = next((m for h in heads if name.startswith(h)
+                  and (m := _PARTIAL.fullmatch(name[len(h):])) is not None), None)
+        if m is None:
+            continue
+        full = parent / name
+        try:
+            st = os.lstat(full)
+        except OSError:
+            continue
+        if not stat.S_ISREG(st.st_mode):
+            continue
+        if m.group(1) is not None:
+            if int(m.group(1)) == os.getpid() or _alive(int(m.group(1))):
+                continue
+        elif time.time() - st.st_mtime < STALE_AGE:
+            continue
+        try:
+            fd = os.open(full, os.O_RDONLY | getattr(os, "O_CLOEXEC", 0))
+        except OSError:
+            continue
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            os.unlink(full)
+            removed.append((name, st.st_size))
+        except OSError:  # locked: a live writer (or no flock here: leave it)
+            pass
+        finally:
+            os.close(fd)
+    return removed
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | Path, *, overwrite: bool = False) -> Iterator[Path]:
+    """A temporary path next to ``path``, unique to this process, published to ``path``
+    when the block ends without an exception (removed otherwise): ``publish``'s rule, so a
+    file at ``path`` is replaced only with ``overwrite`` and only if it is the one
+    ``check_output`` saw (or, unchecked, the one there when the block began); a file that
+    appeared meanwhile is never replaced. Temporary files of killed earlier attempts are
+    removed first (``clean_stale_partials``). OSErrors become OutputError.
+
+        with atomic_path(out, overwrite=overwrite) as tmp:
             fig.savefig(tmp)
     """
     path = Path(path)
+    key = os.path.abspath(path)
+    old = _CHECKED.pop(key) if key in _CHECKED else file_seen(path)
+    if not overwrite:
+        old = None
     parent = path.parent if str(path.parent) else Path(".")
+    clean_stale_partials(path)
     try:
-        fd, name = tempfile.mkstemp(prefix=f".{path.stem[:40]}.", suffix=f".partial{path.suffix}",
-                                    dir=parent)
+        fd, name = tempfile.mkstemp(prefix=partial_prefix(path),
+                                    suffix=f".partial{path.suffix[:9]}", dir=parent)
         os.close(fd)
     except OSError as err:
         raise OutputError(f"{shown(path)}: cannot be written ({_reason(err)})") from None
     tmp = Path(name)
     try:
         yield tmp
-        publish(tmp, path)
+        publish(tmp, path, old=old)
     except OutputError:
         raise
     except OSError as err:
@@ -252,8 +364,9 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
             tmp.unlink()
 
 
-def write_atomic(path: str | Path, write: Callable[[Path], None]) -> None:
-    """``write(tmp)`` to a unique temporary file, then rename it to ``path`` (see
-    ``atomic_path``)."""
-    with atomic_path(path) as tmp:
+def write_atomic(path: str | Path, write: Callable[[Path], None], *,
+                 overwrite: bool = False) -> None:
+    """``write(tmp)`` to a unique temporary file, then publish it at ``path`` (see
+    ``atomic_path``: an existing file is replaced only with ``overwrite``)."""
+    with atomic_path(path, overwrite=overwrite) as tmp:
         write(tmp)

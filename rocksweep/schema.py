@@ -25,9 +25,10 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.numerics import MIN_EVENT_TOL, PRESETS, ROOTS
+from rocksweep.numerics import MIN_EVENT_TOL
 from rocksweep.vocab.ground import SCALE_IMS, SHAPES
 from rocksweep.vocab.laws import DEFAULT_LAW, LAWS
+from rocksweep.vocab.settings import PRESET_NAMES, ROOTS
 
 RATIO_MAX = 1e6  # bound of the body's ratios (see the module docstring)
 ANGLE_MIN = 1e-6  # [rad] smallest slenderness: h/b = 1e6
@@ -61,7 +62,6 @@ class Key:
     default: Any = None
 
 
-_AXIS = "a number, a list of numbers or a range {start, stop, num}"
 _RATIO = f"[1e-06, {RATIO_MAX:g}]"
 _ANGLE = f"must be in [{ANGLE_MIN:g}, pi/2) rad"
 
@@ -124,8 +124,8 @@ KEYS: dict[str, Key] = {
     "pulse.A_ratio": Key("axis",
                          "must be a finite number (negative: a pulse in the other direction)",
                          -math.inf, math.inf, lo_in=False, hi_in=False),
-    "numerics.accuracy": Key("choice", f"must be one of {', '.join(PRESETS)}",
-                             choices=tuple(PRESETS), required=False),
+    "numerics.accuracy": Key("choice", f"must be one of {', '.join(PRESET_NAMES)}",
+                             choices=PRESET_NAMES, required=False),
     "numerics.steps_per_period": Key("integer", "must be an integer in [4, 1e9]", 4, 1e9,
                                      required=False),
     "numerics.pulse_steps": Key("integer", "must be an integer in [4, 1e9] (RK4 steps per "

@@ -132,11 +132,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"   rocksweep fragility (200 bootstrap resamples): {t_fr:.2f} s")
 
         # 2. per run against the reference
-        from rocksweep.compute.grid import Grid
         from rocksweep.compute.sweep import _run_record, level
         from rocksweep.kernel import chunk_kernel
         from rocksweep.kernel import layout as L  # noqa: N812
         from rocksweep.physics.reference import reference_run
+        from rocksweep.scene.grid import Grid
         from rocksweep.scene.parse import load_scene
 
         sc = load_scene(scene)

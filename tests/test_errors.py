@@ -1,5 +1,5 @@
-"""Every error class in ``rocksweep.errors``, and the shared argument checks written once
-(issue 31): an error class defined in another module, or the rtol / integer wording typed
+"""Every error class in ``rocksweep.errors``, and the shared argument checks written once:
+an error class defined in another module, or the rtol / integer wording typed
 again, fails here."""
 
 from __future__ import annotations

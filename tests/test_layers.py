@@ -14,7 +14,7 @@ from pathlib import Path
 PKG = Path(__file__).resolve().parents[1] / "rocksweep"
 
 # lowest first: errors and the vocabulary (rocksweep.vocab), kernel, the model, scenes,
-# computing, files, analyses, figures, the facade, the command line
+# files, computing, analyses, figures, the facade, the command line
 FLOORS: list[tuple[str, ...]] = [
     ("errors", "vocab"),
     ("outputs", "interrupts", "kernel"),
@@ -23,8 +23,8 @@ FLOORS: list[tuple[str, ...]] = [
     ("physics",),
     ("fields",),
     ("scene",),
-    ("compute",),
     ("store",),
+    ("compute",),
     ("analysis",),
     ("figures",),
     ("api", "accessor", "simulation", "__init__"),

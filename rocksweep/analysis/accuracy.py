@@ -36,7 +36,7 @@ import dataclasses
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -44,17 +44,11 @@ import numpy as np
 from rocksweep import fields
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import warm_up
-from rocksweep.numerics import (
-    PRESET_PULSE,
-    PRESET_REFINE,
-    PRESET_ROTATION,
-    PRESETS,
-    ROOTS,
-    Numerics,
-)
+from rocksweep.numerics import PRESETS, Numerics
 from rocksweep.scene.model import Scene, SceneError
 from rocksweep.vocab.axes import DIAGRAM_AXES, RECORD_X
 from rocksweep.vocab.outcomes import CLASSES
+from rocksweep.vocab.settings import DEFAULT_PRESET, ROOTS
 
 OUTCOMES = CLASSES  # codes 0, 1, 2
 # Per-point fields of the report: all the outcome-level kernel fills (no energies).
@@ -73,8 +67,9 @@ TAIL_LABELS = {
 }
 # theta_rel is taken where the reference's theta_max is at least this x alpha_cg
 THETA_REL_FLOOR = fields.THETA_REL_FLOOR
-# Error bounds against which ``--check`` scores the per-point error estimates (issue 15's
-# targets for the 95th percentiles): overturning time [p*t] and relative max|theta|.
+# Error bounds against which ``--check`` scores the per-point error estimates (the
+# `accurate` preset's targets for the 95th percentiles, docs/accuracy.md): overturning
+# time [p*t] and relative max|theta|.
 CHECK_TARGETS = {"t_overturn": 0.05, "theta_rel": 0.01}
 
 
@@ -110,16 +105,12 @@ def _tols(spp: int, tols: tuple[float, ...]) -> list[Setting]:
 
 
 def _presets() -> list[Setting]:
-    return [Setting(name, spp, tol, "preset", rotation_step=PRESET_ROTATION[name],
-                    pulse_steps=PRESET_PULSE[name], refine=PRESET_REFINE[name])
-            for name, (spp, tol) in PRESETS.items()]
+    return [Setting(name, group="preset", **asdict(p)) for name, p in PRESETS.items()]
 
 
 def _roots() -> list[Setting]:
-    return [Setting(f"{name}-{root}", spp, tol, f"root {root}", root,
-                    rotation_step=PRESET_ROTATION[name], pulse_steps=PRESET_PULSE[name],
-                    refine=PRESET_REFINE[name])
-            for root in ROOTS for name, (spp, tol) in PRESETS.items()]
+    return [Setting(f"{name}-{root}", group=f"root {root}", root=root, **asdict(p))
+            for root in ROOTS for name, p in PRESETS.items()]
 
 
 LADDERS: dict[str, Callable[[], list[Setting]]] = {
@@ -131,9 +122,9 @@ LADDERS: dict[str, Callable[[], list[Setting]]] = {
     # the cheap settings the default preset is chosen from (docs/accuracy.md)
     # (with the default preset's rotation limit)
     "candidates": lambda: (_steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-6, True,
-                                  PRESET_ROTATION["default"])
+                                  PRESETS[DEFAULT_PRESET].rotation_step)
                            + _steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-8, True,
-                                    PRESET_ROTATION["default"])
+                                    PRESETS[DEFAULT_PRESET].rotation_step)
                            + _presets()),
     # the presets alone: their tails on a scene far from the paper's (configs/wide-space.yaml)
     "presets": _presets,
@@ -269,7 +260,7 @@ def sample_scene(scene: Scene, n: int | None, seed: int = 0) -> Sample:
     no classification pass).
     """
     from rocksweep.compute.driver import sweep_arrays
-    from rocksweep.compute.grid import Grid
+    from rocksweep.scene.grid import Grid
 
     grid = Grid(scene)
     if n is None or n >= grid.size:
@@ -311,8 +302,8 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
     ``repeat`` rounds (the machine's noise only ever adds time). Compilation is excluded.
     """
     from rocksweep.compute.dispatch import run_variant
-    from rocksweep.compute.grid import Grid
     from rocksweep.physics.points import with_record
+    from rocksweep.scene.grid import Grid
 
     _no_suite(scene)
     cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
@@ -358,8 +349,8 @@ def run_reference(scene: Scene, flat: np.ndarray,
     int64[n]: the reference's self-check, see ``reference_run``). The first point is run
     once untimed before: the reference's first call in a process loads (or compiles) the
     jitted equations it shares with the kernel, ~0.25 s that is no point's cost."""
-    from rocksweep.compute.grid import Grid
     from rocksweep.physics.reference import reference_run, result_row
+    from rocksweep.scene.grid import Grid
 
     grid = Grid(scene)
     values = grid.index_values(flat)
@@ -420,8 +411,8 @@ def run_energy(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray
     """The energy-accounting kernel on the given points (untimed): float64[n, N_OUT].
     Through the sweep's dispatch (``compute.sweep.run_rows``), so Ricker, MP and record
     scenes run their ground variants with the record's samples."""
-    from rocksweep.compute.grid import Grid
     from rocksweep.compute.sweep import run_rows
+    from rocksweep.scene.grid import Grid
 
     sc = _with_numerics(scene, numerics)
     cr = Grid(sc).rows_at(flat)
@@ -431,8 +422,8 @@ def run_energy(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray
 def run_half(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray:
     """The half-step reruns of ``outputs.check`` (``fields.check_rows``) on the given
     points, outcome-only kernel, untimed: float64[n, N_OUT] (the sweep's dispatch)."""
-    from rocksweep.compute.grid import Grid
     from rocksweep.compute.sweep import run_rows
+    from rocksweep.scene.grid import Grid
 
     _no_suite(scene)
     sc = _with_numerics(scene, numerics)
@@ -649,7 +640,7 @@ def accuracy_study(scene: Scene, n_points: int | None = 200,
     check: also rerun every setting at half the step and score the per-point error
     estimates of ``outputs.check`` against the true errors (``estimate_scores``).
     """
-    from rocksweep.compute.grid import Grid
+    from rocksweep.scene.grid import Grid
 
     _no_suite(scene)
     t_wall = time.perf_counter()
@@ -783,7 +774,8 @@ def format_table(study: Study) -> str:
     return "\n".join(lines)
 
 
-def write_report(study: Study, path: str | Path, command: str = "") -> None:
+def write_report(study: Study, path: str | Path, command: str = "", *,
+                 overwrite: bool = False) -> None:
     """Write the study to HDF5, atomically (a temporary file renamed at the end).
 
     Layout: attrs (scene name and YAML, sample description, reference tolerances, command,
@@ -802,7 +794,7 @@ def write_report(study: Study, path: str | Path, command: str = "") -> None:
     from rocksweep.outputs import atomic_path
     from rocksweep.physics.reference import ATOL, RTOL
 
-    with atomic_path(path) as tmp:
+    with atomic_path(path, overwrite=overwrite) as tmp:
         with h5py.File(tmp, "w") as f:
             f.attrs["format"] = "rocksweep-accuracy-1"
             f.attrs["scene_name"] = study.scene.name

@@ -34,7 +34,6 @@ import numpy as np
 from rocksweep.analysis.tolerance import DEFAULT_RTOL, MAX_RTOL, check_rtol
 from rocksweep.compute.adaptive import DIAGRAM_AXES, AdaptiveError, make_plan
 from rocksweep.compute.dispatch import run_variant
-from rocksweep.compute.grid import Grid
 from rocksweep.errors import BoundaryError  # noqa: F401 (re-exported)
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
@@ -53,6 +52,7 @@ from rocksweep.physics.points import (
     shape_code,
     with_record,
 )
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.model import Scene
 
 if TYPE_CHECKING:
@@ -242,7 +242,7 @@ A_MIN_METHODS = (
 # The search below the first overturning grid value (``_search_intervals``) scans grid
 # intervals at interior values spaced (relative to A) by: NEAR_STEP from the last value
 # without uplift up to NEAR_SPAN x the first uplifting value (the narrow first bands just
-# above the uplift threshold at omega/p ~ 1, issue 28: 0.01-0.1 wide at A ~ 1), FAR_STEP
+# above the uplift threshold at omega/p ~ 1: 0.01-0.1 wide at A ~ 1), FAR_STEP
 # from there up to UPLIFT_SPAN x it, and FAR_STEP in the intervals with an end whose
 # max|theta|/alpha_ref >= CLOSE (it came close to overturning), closest first; at most
 # SEARCH_RUNS kernel runs a column (a grid finer than the spacing adds none).
@@ -647,7 +647,8 @@ def write_curves_h5(path: str | Path, curves: Sequence[AMinCurve],
                     bounds: Sequence[PanelBoundaries], attrs: dict[str, Any] | None = None
                     ) -> None:
     """Write A_min curves and boundary lines to a new HDF5 file at ``path`` (meant for the
-    temporary path of ``rocksweep.outputs.write_atomic``; an existing file is replaced).
+    temporary path of ``rocksweep.outputs.write_atomic``; an existing file at ``path`` is
+    truncated).
 
     Layout (h5py; every ``a_min`` panel group also opens with
     ``xarray.open_dataset(path, group="a_min/panel_0", engine="h5netcdf")``):

@@ -1,5 +1,5 @@
 """Calibration: the scene numbers (lam, e, e_factor, zeta...) that reproduce a measured
-rocking history, with a confidence interval (issue 30).
+rocking history, with a confidence interval.
 
 The misfit: peak amplitudes per half cycle, aligned
 -----------------------------------------------------

@@ -34,7 +34,8 @@ import xarray as xr
 from scipy.optimize import minimize
 from scipy.special import log_ndtr
 
-from rocksweep.analysis.fragility import counted_points, fit_cloud, state_reached
+from rocksweep.analysis.fragility import fit_cloud
+from rocksweep.analysis.states import counted_points, state_reached
 from rocksweep.errors import EfficiencyError, RocksweepError  # noqa: F401 (re-exported)
 from rocksweep.physics.model import G
 from rocksweep.physics.suite import RECORD_IMS

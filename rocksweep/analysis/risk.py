@@ -30,16 +30,19 @@ Beyond the hazard curve's range the tool BOUNDS, it does not extrapolate the haz
   verdict ``below_hazard`` says when P(x_min) > ``LOW_P`` (the rate is then a lower bound).
 
 Hazard inputs (``read_hazard``): a two-column CSV with the header ``IM [unit],annual_rate``
-(e.g. ``PGA [g],annual_rate``; ``Sa(1.0) [g]`` for Sa at 1 s; lines starting with # are
-comments), the IM checked against the fragility's and the unit converted to the
-fragility's where both are known (``UNIT_SI``: g, m/s^2, cm/s^2 or gal; m/s, cm/s, mm/s;
-the factor is kept in the attribute ``hazard_unit``); or OpenQuake's hazard-curve
+(e.g. ``PGA [g],annual_rate``; ``Sa(1.0) [g]`` for Sa at 1 s; ``AvgSa [g]``, ``CAV
+[m/s]``, ``Arias [m/s]``; lines starting with # are comments), the IM checked against the
+fragility's and the unit converted to the fragility's where both are known (``UNIT_SI``:
+g, m/s^2, cm/s^2 or gal; m/s, cm/s, mm/s, g s; the factor is kept in the attribute
+``hazard_unit``); or OpenQuake's hazard-curve
 CSV (``oq export hcurves``: a comment line
 ``#,,,,,"generated_by=..., investigation_time=50.0, imt='PGA'"``, then
 ``lon,lat,depth,poe-<level>,...`` and one row per site): probabilities of exceedance in the
-investigation time T converted to rates lambda = -ln(1 - poe) / T; OpenQuake's PGA and SA
-are in g, its PGV in cm/s (converted to m/s); levels with poe = 1 (a rate without bound)
-are left out.
+investigation time T converted to rates lambda = -ln(1 - poe) / T; OpenQuake's PGA, SA
+and AvgSA are in g, its PGV in cm/s (converted to m/s), IA (Arias) in m/s, CAV in g s
+(converted to m/s); levels with poe = 1 (a rate without bound) are left out. An AvgSa
+hazard curve does not say its periods: it must be over the fragility's (the attribute
+``avgsa_periods``).
 """
 
 from __future__ import annotations
@@ -55,7 +58,7 @@ import xarray as xr
 
 from rocksweep.errors import RiskError, RocksweepError  # noqa: F401 (re-exported)
 from rocksweep.physics.model import G
-from rocksweep.vocab.ground import PGA, PGV, SA
+from rocksweep.vocab.ground import ARIAS, AVGSA, CAV, PGA, PGV, SA, SCALE_IMS
 
 __all__ = ["Hazard", "RiskError", "fragility_median", "hazard_frame", "read_hazard",
            "risk"]
@@ -65,8 +68,12 @@ TAIL_SHARE = 0.01  # above_hazard when the unknown tail exceeds this share of th
 LOW_P = 1e-3  # below_hazard when the fragility at the hazard's smallest IM exceeds this
 PLOT_POINTS = 200  # the figure's grid over the hazard's range
 RATE_COLUMN = "annual_rate"
-#: OpenQuake's IMT units, and the factor to rocksweep's
-OQ_UNITS = {PGA: ("g", 1.0), SA.upper(): ("g", 1.0), PGV: ("m/s", 0.01)}
+#: OpenQuake's IMTs (upper case) -> (rocksweep's IM, its unit, the factor from
+#: OpenQuake's unit to it): PGA, SA and AvgSA in g, PGV in cm/s, IA (Arias) in m/s, CAV
+#: in g s (``openquake.hazardlib.imt``)
+OQ_IMTS: dict[str, tuple[str, str, float]] = {
+    PGA: (PGA, "g", 1.0), SA.upper(): (SA, "g", 1.0), PGV: (PGV, "m/s", 0.01),
+    AVGSA.upper(): (AVGSA, "g", 1.0), "IA": (ARIAS, "m/s", 1.0), CAV: (CAV, "m/s", G)}
 #: Units a hazard curve may give its IM in: the factor to SI (accelerations to m/s^2,
 #: velocities to m/s); a hazard in another unit of the same kind is converted. g is G,
 #: the gravity of the model and of the records' PGV (9.81 m/s^2, not g_n = 9.80665)
@@ -74,7 +81,8 @@ UNIT_SI: dict[str, tuple[str, float]] = {
     "g": ("acceleration", G), "m/s^2": ("acceleration", 1.0), "m/s2": ("acceleration", 1.0),
     "cm/s^2": ("acceleration", 0.01), "cm/s2": ("acceleration", 0.01),
     "gal": ("acceleration", 0.01), "m/s": ("velocity", 1.0), "cm/s": ("velocity", 0.01),
-    "mm/s": ("velocity", 0.001)}
+    "mm/s": ("velocity", 0.001), "g s": ("velocity", G), "g-s": ("velocity", G),
+    "g*s": ("velocity", G), "g-sec": ("velocity", G)}
 _HEADER = re.compile(r"^\s*(?P<im>[A-Za-z][A-Za-z0-9_]*)\s*(?:\(\s*(?P<T>[0-9.eE+-]+)\s*\))?"
                      r"\s*\[(?P<unit>[^\]]*)\]\s*$")
 
@@ -100,13 +108,11 @@ class Hazard:
 
 
 def _im_name(text: str) -> str:
-    """An IM name as rocksweep spells it (SA, sa -> Sa; PGA, PGV upper case)."""
+    """An IM name as rocksweep spells it (the stripe IMs, ``SCALE_IMS``, in any case: SA ->
+    Sa, AVGSA -> AvgSa; OpenQuake's IA -> Arias); another name as given."""
     t = text.strip()
-    if t.lower() == SA.lower():
-        return SA
-    if t.upper() in (PGA, PGV):
-        return t.upper()
-    return t
+    spelled = {k.lower(): k for k in SCALE_IMS} | {"ia": ARIAS}
+    return spelled.get(t.lower(), t)
 
 
 def _checked(im: np.ndarray, rate: np.ndarray, name: str, unit: str, period: float,
@@ -179,9 +185,10 @@ def _openquake(lines: list[str], where: str, site: int | None) -> Hazard:
     if not (math.isfinite(T) and T > 0.0):
         raise RiskError(f"{where}: investigation_time = {t.group(1)}: must be > 0 years")
     mi = re.match(r"^\s*([A-Za-z]+)\s*(?:\(\s*([0-9.eE+-]+)\s*\))?\s*$", imt.group(1))
-    if mi is None or mi.group(1).upper() not in OQ_UNITS:
-        raise RiskError(f"{where}: imt = {imt.group(1)!r}: rocksweep reads PGA, PGV and SA(T)")
-    unit, factor = OQ_UNITS[mi.group(1).upper()]
+    if mi is None or mi.group(1).upper() not in OQ_IMTS:
+        known = ", ".join(k if k != SA.upper() else "SA(T)" for k in OQ_IMTS)
+        raise RiskError(f"{where}: imt = {imt.group(1)!r}: rocksweep reads {known}")
+    name, unit, factor = OQ_IMTS[mi.group(1).upper()]
     rows = list(csv.reader(lines[1:]))
     head = [h.strip() for h in rows[0]]
     levels = [h for h in head if h.startswith("poe-")]
@@ -208,8 +215,7 @@ def _openquake(lines: list[str], where: str, site: int | None) -> Hazard:
     keep = poe < 1.0  # poe = 1: the rate has no bound there
     with np.errstate(divide="ignore"):
         rate = -np.log1p(-poe[keep]) / T
-    name = _im_name(mi.group(1))
-    period = float(mi.group(2)) if mi.group(2) else math.nan
+    period = float(mi.group(2)) if mi.group(2) and name == SA else math.nan
     return _checked(x[keep], rate, name, unit, period, where)
 
 

@@ -1,25 +1,30 @@
 """The ``rocksweep`` command line (click): ``main`` (the group, ``cli/main.py``) and one
 module per command, each attaching itself to ``main`` when ``cli/commands.py`` imports
-it."""
+it. Importing it changes nothing in the process (no environment variable, no handler):
+what the console command needs is done by ``entry``."""
 
-import os
-
-# The commands do no linear algebra; OpenBLAS's thread pools (numpy's, scipy's) would spin
-# up at import and cost 0.1-0.2 s of CPU per command (docs/performance.md, start-up).
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-
-from rocksweep.cli import commands  # noqa: E402, F401  (attaches every command)
-from rocksweep.cli.main import main  # noqa: E402
+from rocksweep.cli import commands  # noqa: F401  (attaches every command)
+from rocksweep.cli.main import main
 
 
 def entry() -> None:
-    """The ``rocksweep`` command (and ``python -m rocksweep``): ``main``, then, after a
-    command that succeeded, an exit without the interpreter's teardown. Finalising numba
-    and LLVM takes ~0.15 s, a fifth of a small sweep; every file is closed and renamed into
-    place before a command returns, so nothing is left to do then. Errors and interrupts
-    exit as usual. (``main`` itself, for tests and embedding, exits as click does.)"""
+    """The ``rocksweep`` console command (and ``python -m rocksweep``): ``main``, then, after
+    a command that succeeded, an exit without the interpreter's teardown.
+
+    Two process-wide choices are made here, the console command's alone (``main`` itself,
+    for tests and embedding, changes nothing and exits as click does):
+    - ``OPENBLAS_NUM_THREADS=1`` unless set: the commands do no linear algebra, and
+      OpenBLAS's thread pools (numpy's, scipy's) would spin up at import and cost 0.1-0.2 s
+      of CPU per command (docs/performance.md, start-up). Set before numpy loads: importing
+      this package loads no numpy.
+    - ``os._exit`` after success: finalising numba and LLVM takes ~0.15 s, a fifth of a
+      small sweep; every file is closed and renamed into place before a command returns,
+      so nothing is left to do then (``atexit`` handlers do not run). Errors and
+      interrupts exit as usual."""
+    import os
     import sys
 
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     from rocksweep import interrupts
 
     interrupts.install()  # a Ctrl-C is remembered even where a library swallows it

@@ -97,7 +97,7 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
                  f"--repeat={repeat}", *(["--check"] if check else []),
                  *(["--overwrite"] if overwrite else [])]
         command = " ".join(shlex.quote(w) for w in words)
-        write_report(study, report_path, command)
+        write_report(study, report_path, command, overwrite=overwrite)
         click.echo(f"wrote {report_path}")
     if plot_path is not None:
         from rocksweep.figures.accuracy import work_precision

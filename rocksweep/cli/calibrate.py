@@ -69,8 +69,6 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
         from rocksweep.figures.common import FORMATS
 
         check_output(plot_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
-    if not scene_path.exists():
-        raise click.ClickException(f"{scene_path}: no such scene file")
     ds = fit_scene(scene_path, measured_path, list(fit), bounds=_bounds(bounds) or None,
                    overrides=list(overrides), p=p)
     for key in ds["parameter"].values.tolist():
@@ -87,7 +85,7 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
     if out_path is not None:
         from rocksweep.outputs import atomic_path
 
-        with atomic_path(out_path) as tmp:
+        with atomic_path(out_path, overwrite=overwrite) as tmp:
             ds.to_netcdf(tmp, engine="h5netcdf")
         click.echo(f"wrote {out_path}")
     if plot_path is not None:

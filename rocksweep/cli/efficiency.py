@@ -70,7 +70,7 @@ def efficiency(result_path: Path, state: str, out_path: Path | None, fig_path: P
     if out_path is not None:
         from rocksweep.cli.fragility import write_table
 
-        write_table(out_path, frame.to_csv(index=False), eff)
+        write_table(out_path, frame.to_csv(index=False), eff, overwrite)
         say(f"wrote {out_path}")
     if fig is not None:
         save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=inputs)

@@ -141,7 +141,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
             _print_ida(refined)
     say = click.echo if not as_json else (lambda m: click.echo(m, err=True))
     if out_path is not None:
-        write_table(out_path, csv_text(rows), frag)
+        write_table(out_path, csv_text(rows), frag, overwrite)
         say(f"wrote {out_path} ({len(rows)} curve{'s' * (len(rows) != 1)})")
     if fig_path is not None:
         from rocksweep.figures.fragility import fragility_figure
@@ -210,15 +210,16 @@ def check_table_outputs(out_path: Path | None, fig_path: Path | None,
         check_output(fig_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
 
 
-def write_table(out_path: Path, csv: str | None, ds) -> None:
+def write_table(out_path: Path, csv: str | None, ds, overwrite: bool) -> None:
     """An analysis's ``-o``: the table as CSV text (``csv``) for a .csv path, else the
-    Dataset ``ds`` as netCDF-4 (.h5, .hdf5, .nc); written under a temporary name."""
+    Dataset ``ds`` as netCDF-4 (.h5, .hdf5, .nc); written under a temporary name and
+    published by ``outputs.publish``'s rule (a file that appeared meanwhile is kept)."""
     from rocksweep.outputs import write_atomic
 
     if out_path.suffix.lower() == ".csv":
-        write_atomic(out_path, lambda tmp: tmp.write_text(csv))
+        write_atomic(out_path, lambda tmp: tmp.write_text(csv), overwrite=overwrite)
     else:
-        write_atomic(out_path, lambda tmp: _to_netcdf(ds, tmp))
+        write_atomic(out_path, lambda tmp: _to_netcdf(ds, tmp), overwrite=overwrite)
 
 
 def _print_table(frag, rows: list[dict]) -> None:

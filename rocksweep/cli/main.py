@@ -19,7 +19,7 @@ from rocksweep.cli.options import overwrite_option, scene_argument, set_option  
 from rocksweep.errors import RocksweepError, one_line
 
 # The library's messages may name the Python API's flags (``resume=True``); the command
-# line says its own (``--resume``): the reverse of ``api._FLAG_WORDS``.
+# line says its own (``--resume``): the reverse of ``errors._FLAG_WORDS``.
 _CLI_WORDS = re.compile(r"\b(resume|overwrite|adaptive|validate)=True\b")
 
 

@@ -123,7 +123,7 @@ def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, sta
     if out_path is not None:
         from rocksweep.cli.fragility import csv_text, write_table
 
-        write_table(out_path, csv_text(rows), rk)
+        write_table(out_path, csv_text(rows), rk, overwrite)
         say(f"wrote {out_path}")
     if fig is not None:
         save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=inputs)

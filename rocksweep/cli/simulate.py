@@ -78,7 +78,7 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
         for r in runs:
             _print_run(r, swept)
     if csv_path is not None:
-        write_history_csv(runs, swept, csv_path)
+        write_history_csv(runs, swept, csv_path, overwrite=overwrite)
         if not as_json:
             click.echo(f"wrote {csv_path}")
     if plot_path is not None:

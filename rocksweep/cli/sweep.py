@@ -200,7 +200,7 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
 
 def report_cells(scene, flat) -> list[str]:
     """The swept values of some grid points, as 'key=value, ...' texts."""
-    from rocksweep.compute.grid import Grid
+    from rocksweep.scene.grid import Grid
 
     values = Grid(scene).index_values(flat)
     swept = [a.name for a in scene.swept]

@@ -44,9 +44,10 @@ def table_command(result_path: Path, out_path: Path, overwrite: bool) -> None:
     frame = rocksweep.table(open_any(result_path))
     if suffix == ".csv":
         text = frame.to_csv(index=False)
-        write_atomic(out_path, lambda tmp: tmp.write_text(text))
+        write_atomic(out_path, lambda tmp: tmp.write_text(text), overwrite=overwrite)
     else:
         frame.attrs = {}  # pandas' attrs are not Parquet metadata
 
-        write_atomic(out_path, lambda tmp: frame.to_parquet(tmp, index=False))
+        write_atomic(out_path, lambda tmp: frame.to_parquet(tmp, index=False),
+                     overwrite=overwrite)
     click.echo(f"wrote {out_path} ({len(frame):,} rows x {frame.shape[1]} columns)")

@@ -1,4 +1,4 @@
-"""Adaptive stability diagrams: compute only where the class can change (issue 11).
+"""Adaptive stability diagrams: compute only where the class can change.
 
 A stability diagram is large uniform regions (safe, mode 1, mode 2) separated by thin
 boundaries. Over the two *diagram axes* (by default x = w_over_p, y = A_ratio; any two
@@ -41,7 +41,7 @@ matter. ``next_batch`` is therefore a pure function of
 chunking; a point's result depends only on the point), stores the results and calls it
 again, until it returns an empty batch. An interrupted sweep resumes from the file.
 
-Per point, the state is two arrays over the grid's flat indices (``rocksweep.compute.grid``):
+Per point, the state is two arrays over the grid's flat indices (``rocksweep.scene.grid``):
 ``outcome`` (int8, the kernel's class; read only where computed > 0) and ``computed``
 (int8, the flags below). Filled points keep the "not computed" fill values of every other
 variable (``rocksweep.compute.sweep.VARIABLES``).
@@ -57,12 +57,13 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.compute.grid import ChunkRows, Grid
 from rocksweep.errors import AdaptiveError, ApiError  # noqa: F401 (AdaptiveError: re-exported)
+from rocksweep.scene.grid import ChunkRows, Grid
 from rocksweep.scene.model import Scene
 from rocksweep.schema import check_option
 from rocksweep.vocab import outcomes as _out
 from rocksweep.vocab.axes import DIAGRAM_AXES
+from rocksweep.vocab.settings import ADAPTIVE_RESOLVED, ADAPTIVE_SETTINGS
 
 # ``computed`` flags (int8 per point).
 # (codes, words and meanings: ``rocksweep.vocab.outcomes``)
@@ -187,10 +188,6 @@ def make_plan(grid_or_scene: Grid | Scene, axes: Sequence[str] = DIAGRAM_AXES,
                 _checked("seed", seed, int), _checked("final_margin", final_margin, int))
 
 
-# the settings a user gives (the scene's refine: section, rocksweep.schema's ranges)
-SETTINGS = ("coarse", "audit", "margin", "final_margin", "seed", "threshold")
-
-
 def check_settings(values: dict[str, Any], label: Callable[[str], str]) -> str | None:
     """The first setting of ``values`` (name -> value; None: not given) outside its
     ``refine.<name>`` range, as one line naming it by ``label(name)`` ("margin =",
@@ -227,7 +224,7 @@ class Options:
     threshold: float = DEFAULT_AUDIT_THRESHOLD
 
     def __post_init__(self) -> None:
-        msg = check_settings({n: getattr(self, n) for n in SETTINGS}, lambda n: f"{n} =")
+        msg = check_settings({n: getattr(self, n) for n in ADAPTIVE_SETTINGS}, lambda n: f"{n} =")
         if msg is not None:
             raise AdaptiveError(msg)
 
@@ -250,9 +247,6 @@ class Options:
         return cls(tuple(d["axes"]), int(d["coarse"]), float(d["audit"]),
                    int(d["margin"]), int(d["final_margin"]), int(d["seed"]),
                    float(d["threshold"]))
-
-
-RESOLVED_KEYS = ("axes", "coarse", "margin", "final_margin", "audit", "seed", "threshold")
 
 
 def default_coarse(ny: int, nx: int) -> int:
@@ -852,7 +846,7 @@ def adaptive_options(adaptive: bool, base: dict | None = None,
     if base is not None:
         adaptive = True
         given = {**base, **given}
-    known = {"coarse", "audit", "axes", "margin", "final_margin", "seed", "threshold"}
+    known = set(ADAPTIVE_RESOLVED)
     unknown = sorted(set(given) - known)
     if unknown:
         raise AdaptiveError(f"{unknown[0]} = {given[unknown[0]]!r}: not a setting of an adaptive "

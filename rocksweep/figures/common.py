@@ -85,7 +85,7 @@ def save_figure(fig: Figure, path: str | Path, dpi: int = DEFAULT_DPI, *,
     """
     path = check_output(path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
     # TrueType fonts also for a figure the caller made (not a rocksweep Figure)
-    with atomic_path(path) as tmp, matplotlib.rc_context(SAVE_RC):
+    with atomic_path(path, overwrite=overwrite) as tmp, matplotlib.rc_context(SAVE_RC):
         fig.savefig(tmp, dpi=dpi, format=path.suffix[1:].lower())
     return path
 

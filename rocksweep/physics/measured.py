@@ -1,4 +1,4 @@
-"""Measured rocking histories: a CSV or a DataFrame -> normalised samples (issue 30).
+"""Measured rocking histories: a CSV or a DataFrame -> normalised samples.
 
 Two forms of the columns are read:
 

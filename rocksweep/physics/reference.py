@@ -547,13 +547,6 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
     return res
 
 
-def reference_row(point: Point, numerics: Numerics | None = None, **kw) -> np.ndarray:
-    """``reference_run`` packed as a kernel result row float64[N_OUT] (energy entries NaN;
-    OUT_STEPS holds DOP853 steps, OUT_EVENT_STEPS 0)."""
-    r = reference_run(point, numerics, **kw)
-    return result_row(r)
-
-
 def result_row(r: dict) -> np.ndarray:
     """A ``reference_run`` dict as a kernel result row float64[N_OUT]."""
     out = np.full(L.N_OUT, np.nan)

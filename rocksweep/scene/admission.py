@@ -15,12 +15,7 @@ from itertools import product
 
 import numpy as np
 
-from rocksweep.numerics import (
-    EVENT_STEP_ALLOWANCE,
-    MAX_POINT_STEPS,
-    PRESETS,
-    Numerics,
-)
+from rocksweep.numerics import EVENT_STEP_ALLOWANCE, MAX_POINT_STEPS, Numerics
 from rocksweep.physics.model import BodyError
 from rocksweep.physics.points import (
     body_omega_rock,
@@ -40,8 +35,8 @@ _TAME = {"body.wn_over_p": 2.43, "body.zeta": 0.05, "body.alpha_cg": 0.15,
          "body.alpha_A": 0.28, "body.mA_over_m": 0.47, "body.IA_ratio": 0.56,
          "body.alpha": 0.2618, "body.inertia": 4.0 / 3.0,
          "pulse.w_over_p": 1.0, "pulse.A_ratio": 1.0,
-         "numerics.steps_per_period": PRESETS["default"][0], "numerics.horizon": 200.0,
-         "numerics.max_events": Numerics().max_events}
+         **{f"numerics.{k}": getattr(Numerics(), k)
+            for k in ("steps_per_period", "horizon", "max_events")}}
 
 
 def _candidate_bodies(scene: Scene) -> list[dict[str, float]]:

@@ -37,6 +37,7 @@ from rocksweep.physics.suite import (
     AVGSA_RANGE,
     COMPONENTS,
     DEFAULT_PERIODS,
+    RECORD_IMS,
     ROTD50,
     SCALE_IMS,
     Suite,
@@ -60,6 +61,7 @@ from rocksweep.vocab.axes import DIAGRAM_AXES, alpha_symbol, axis_name
 from rocksweep.vocab.ground import MP
 from rocksweep.vocab.ground import PULSE_KEY_SHAPES as _PULSE_KEY_SHAPES
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
+from rocksweep.vocab.settings import DEFAULT_PRESET, FINE
 
 # Largest grid a scene may describe [points]. A sweep file stores 45 bytes a point (69
 # with energy metrics, ``rocksweep.fields.variables``): 2e8 points are a 9-14 GB file, one
@@ -338,8 +340,8 @@ def _numerics(sec: dict, contact: bool = False) -> tuple[Numerics, Numerics]:
             v = float(v) if spec.kind == "number" else v
         given[k] = v
     accuracy = given.pop("accuracy", None)
-    numerics = Numerics.preset(accuracy or ("fine" if contact else "default"), **given)
-    # One default (issue 28): a single run (simulate) runs what a sweep of the same point
+    numerics = Numerics.preset(accuracy or (FINE if contact else DEFAULT_PRESET), **given)
+    # One default: a single run (simulate) runs what a sweep of the same point
     # runs, so one point has one answer; the certification of close calls
     # (``compute.certify``) makes the default trustworthy for both.
     single = numerics
@@ -671,10 +673,13 @@ def _scale(ground: dict) -> tuple[str | None, str, Any, float, float]:
             raise SceneError(f"{key}.factor = {fmt(f)}: {KEYS[key + '.factor'].allowed}")
         return None, "", None, math.nan, as_float(f)
     for k in v:
-        if k not in ("im", "values", "period", "component"):
-            raise SceneError(f"{key}.{k}: unknown key (allowed: im, values, period, "
-                             "component; or factor alone)")
+        if k not in ("im", "values", "period"):
+            raise SceneError(f"{key}.{k}: unknown key (allowed: im, values, period; or "
+                             "factor alone)")
     im = v.get("im")
+    if isinstance(im, str) and RECORD_IMS.get(im, ("", "", 1))[2] == 0:
+        raise SceneError(f"{key}.im = {im}: does not change when a record is scaled, so no "
+                         f"factor can reach a stripe of it; {KEYS[key + '.im'].allowed}")
     if not isinstance(im, str) or im not in SCALE_IMS:
         raise SceneError(f"{key}.im = {fmt(im)}: {KEYS[key + '.im'].allowed}")
     if v.get("values") is None:
@@ -836,10 +841,77 @@ def _peer_suite(folder: Path, skip: bool) -> tuple:
             read)
 
 
+@dataclasses.dataclass
+class _Motion:
+    """The ground motion of a scene, as its sections give it (before the axes are built).
+
+    free: no ground motion (free vibration from the initial state); pulse: the raw keys of
+    the pulse axes (``pulse`` section, or the ``ground`` keys a record is scaled by);
+    record: one ground record; suite, stripe: a suite of records and its stripe axis
+    (im, form, spec) or None; inputs: the files read."""
+
+    free: bool
+    pulse: dict
+    record: GroundRecord | None = None
+    suite: Suite | None = None
+    stripe: tuple | None = None
+    inputs: tuple[str, ...] = ()
+    ground: dict = dataclasses.field(default_factory=dict)  # the ground section's keys
+
+
+@dataclasses.dataclass
+class _Forms:
+    """The motion's axes before their values: the shapes, the section and names of the
+    pulse axes, and the unswept pulse options."""
+
+    shapes: tuple[str, ...]
+    shape_swept: bool
+    section: str
+    pulse_axes: tuple[str, ...]
+    options: list[Axis]
+
+
 def _parse(text: str, overrides: list[str], base: Path | None = None,
            given_record: GroundRecord | None = None,
            given_records: tuple[GroundRecord, ...] | None = None,
            given_h2: GroundRecord | None = None) -> Scene:
+    """The scene of YAML text: each section parsed in turn, then the grid's size checked
+    before any axis value is built, then the scene's admission (initial state, cost)."""
+    raw = _document(text, overrides)
+    name = _name(raw)
+    body, kind, physical = _body(raw)
+    impact = _section(raw, "impact", kind, required=kind == "flexible")
+    if raw.get("ground") is not None and raw.get("pulse") is not None:
+        raise SceneError("pulse, ground: give one of them (a pulse, or a recorded ground "
+                         "motion)")
+    initial = _section(raw, "initial", kind, required=False)
+    motion = _motion(raw, kind, base, given_record, given_records)
+    numerics_sec = _section(raw, "numerics", kind, required=False)
+    energy, contact, check = _outputs(raw, kind, body.get("mu"))
+
+    # forms and lengths first: the grid's size is known before any value is built
+    forms = _forms(motion)
+    law_axis, law_specs = _impact_law(impact)
+    # the orientation and the floor: after the records, before the ground's own axes
+    path, path_specs, path_inputs = _excitation_path(
+        raw, motion.ground, kind, motion.free, motion.record, motion.suite, base, physical,
+        given_h2)
+    specs = _axis_specs(kind, body, impact, initial, motion, forms, law_specs, path_specs)
+    _check_size(motion, forms, specs, 1 if law_axis is None else len(law_axis.values))
+    axes = _axes(motion, forms, specs, law_axis)
+
+    numerics, single = _numerics(numerics_sec, contact)
+    scene = Scene(name=name or "rocksweep scene", kind=kind, axes=tuple(axes),
+                  numerics=numerics, single_numerics=single, energy=energy, text=text,
+                  contact=contact, check=check, record=motion.record,
+                  refine=_refine(raw, kind), suite=motion.suite,
+                  inputs=(*motion.inputs, *path_inputs), physical=physical, path=path)
+    _admit(scene)
+    return scene
+
+
+def _document(text: str, overrides: list[str]) -> dict:
+    """The scene's YAML mapping, overrides applied, its top-level keys checked."""
     try:
         raw = _load_yaml(text)
     except _YamlError as err:
@@ -853,58 +925,71 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     for k in raw:
         if k not in ("name", *SECTIONS):
             raise SceneError(f"{k}: unknown key (allowed: name, {', '.join(SECTIONS)})")
+    return raw
+
+
+def _name(raw: dict) -> str | None:
+    """The scene's ``name`` (None: not given)."""
     name = raw.get("name")
     if name is not None and not isinstance(name, str):
         raise SceneError(f"name = {fmt(name)}: {KEYS['name'].allowed}")
     if name is not None and _CONTROL.search(name):
         raise SceneError(f"name = {fmt(name)}: must not hold control characters (NUL, BEL, "
                          "ESC...): it is stored in the result file and printed")
+    return name
 
+
+def _body(raw: dict) -> tuple[dict, str, dict | None]:
+    """The ``body`` section: (keys, kind, physical). A ``physical`` body (the laboratory's
+    numbers) becomes a flexible one (its Pi groups and p); physical keeps its numbers."""
     body = _section(raw, "body", "flexible", required=True)
     kind = body.get("kind", "flexible")
-    physical = None
-    if kind == "physical":  # the laboratory's numbers -> the Pi groups and p
-        try:
-            physical = body_from_geometry(**{k: body.get(k, KEYS[f"body.{k}"].default)
-                                             for k in BODY_KEYS["physical"]})
-        except BodyError as err:
-            raise SceneError(str(err)) from None
-        body = {**{k: physical[k] for k in BODY_KEYS["flexible"]},
-                **({"mu": body["mu"]} if body.get("mu") is not None else {})}
-        kind = "flexible"
-    impact = _section(raw, "impact", kind, required=kind == "flexible")
-    if raw.get("ground") is not None and raw.get("pulse") is not None:
-        raise SceneError("pulse, ground: give one of them (a pulse, or a recorded ground "
-                         "motion)")
-    initial = _section(raw, "initial", kind, required=False)
-    free = raw.get("ground") is None and raw.get("pulse") is None
-    record = suite = stripe = None
-    inputs: tuple[str, ...] = ()
-    ground: dict = {}
-    if free:  # no ground motion: free vibration from the initial state
-        pulse = {"shape": FREE, "w_over_p": 0.0, "A_ratio": 0.0}
-    elif raw.get("ground") is not None:
-        ground = _section(raw, "ground", kind, required=True)
-        if ground.get("records") is not None:
-            suite, stripe, inputs = _suite(ground, base, given_records)
-            pulse = {"shape": RECORD, "p": ground["p"]}
-        else:
-            for k in ("scale", "periods", "avgsa"):
-                if ground.get(k) is not None:
-                    raise SceneError(f"ground.{k}: works with ground.records (a suite); one "
-                                     "ground.record is scaled by ground.A_ratio")
-            if ground.get("record") is None:
-                raise SceneError("ground.record: missing required key (a record file; or "
-                                 "ground.records and ground.scale for a suite)")
-            if ground.get("A_ratio") is None:
-                raise SceneError("ground.A_ratio: missing required key (a number, a list of "
-                                 "numbers or a range {start, stop, num})")
-            record = _record(ground, base) if given_record is None else given_record
-            inputs = (str(record.source),) if given_record is None else ()
-            pulse = {"shape": RECORD, "A_ratio": ground["A_ratio"], "p": ground["p"]}
-    else:
-        pulse = _section(raw, "pulse", kind, required=True)
-    numerics_sec = _section(raw, "numerics", kind, required=False)
+    if kind != "physical":
+        return body, kind, None
+    try:
+        physical = body_from_geometry(**{k: body.get(k, KEYS[f"body.{k}"].default)
+                                         for k in BODY_KEYS["physical"]})
+    except BodyError as err:
+        raise SceneError(str(err)) from None
+    body = {**{k: physical[k] for k in BODY_KEYS["flexible"]},
+            **({"mu": body["mu"]} if body.get("mu") is not None else {})}
+    return body, "flexible", physical
+
+
+def _motion(raw: dict, kind: str, base: Path | None, given_record: GroundRecord | None,
+            given_records: tuple[GroundRecord, ...] | None) -> _Motion:
+    """The ground motion: none (free vibration), a ``pulse``, or a ``ground`` section
+    (one record scaled by A_ratio, or a suite of records)."""
+    if raw.get("ground") is None and raw.get("pulse") is None:
+        return _Motion(free=True, pulse={"shape": FREE, "w_over_p": 0.0, "A_ratio": 0.0})
+    if raw.get("ground") is None:
+        return _Motion(free=False, pulse=_section(raw, "pulse", kind, required=True))
+    ground = _section(raw, "ground", kind, required=True)
+    if ground.get("records") is not None:
+        suite, stripe, inputs = _suite(ground, base, given_records)
+        return _Motion(free=False, pulse={"shape": RECORD, "p": ground["p"]}, suite=suite,
+                       stripe=stripe, inputs=inputs, ground=ground)
+    for k in ("scale", "periods", "avgsa"):
+        if ground.get(k) is not None:
+            raise SceneError(f"ground.{k}: works with ground.records (a suite); one "
+                             "ground.record is scaled by ground.A_ratio")
+    if ground.get("record") is None:
+        raise SceneError("ground.record: missing required key (a record file; or "
+                         "ground.records and ground.scale for a suite)")
+    if ground.get("A_ratio") is None:
+        raise SceneError("ground.A_ratio: missing required key (a number, a list of "
+                         "numbers or a range {start, stop, num})")
+    record = _record(ground, base) if given_record is None else given_record
+    return _Motion(free=False,
+                   pulse={"shape": RECORD, "A_ratio": ground["A_ratio"], "p": ground["p"]},
+                   record=record,
+                   inputs=(str(record.source),) if given_record is None else (),
+                   ground=ground)
+
+
+def _outputs(raw: dict, kind: str, mu_spec: Any) -> tuple[bool, bool, bool]:
+    """The ``outputs`` section: (energy, contact, check). ``body.mu`` (mu_spec, None: not
+    given) turns the contact outputs on."""
     outputs = _section(raw, "outputs", kind, required=False)
     energy = outputs.get("energy", KEYS["outputs.energy"].default)
     if not isinstance(energy, bool):
@@ -912,7 +997,6 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     contact = outputs.get("contact")
     if contact is not None and not isinstance(contact, bool):
         raise SceneError(f"outputs.contact = {fmt(contact)}: {KEYS['outputs.contact'].allowed}")
-    mu_spec = body.get("mu")
     if mu_spec is not None and contact is False:
         raise SceneError(f"body.mu = {fmt(mu_spec)}: the slides/lifts_off flags need the "
                          "contact outputs; remove outputs.contact: false (body.mu turns "
@@ -921,51 +1005,65 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     check = outputs.get("check", KEYS["outputs.check"].default)
     if not isinstance(check, bool):
         raise SceneError(f"outputs.check = {fmt(check)}: {KEYS['outputs.check'].allowed}")
+    return energy, contact, check
 
-    # forms and lengths first: the grid's size is known before any value is built
-    if free:
-        shapes, shape_swept = (FREE,), False
-        section, pulse_axes, options = "pulse", PULSE_AXES, []
-    elif record is None and suite is None:
-        shapes, shape_swept = _shapes(pulse["shape"])
-        section, pulse_axes = "pulse", PULSE_AXES
-        options = _pulse_options(pulse, shapes)
-    else:
-        shapes, shape_swept = (RECORD,), False
-        section, pulse_axes = "ground", ("A_ratio", "p") if suite is None else ("p",)
-        options = []
-    specs: list[tuple[str, str, str, Any]] = []  # (name, key, form, spec)
+
+def _forms(motion: _Motion) -> _Forms:
+    """The motion's shapes, the section and names of its pulse axes, its pulse options."""
+    if motion.free:
+        return _Forms((FREE,), False, "pulse", PULSE_AXES, [])
+    if motion.record is None and motion.suite is None:
+        shapes, shape_swept = _shapes(motion.pulse["shape"])
+        return _Forms(shapes, shape_swept, "pulse", PULSE_AXES,
+                      _pulse_options(motion.pulse, shapes))
+    return _Forms((RECORD,), False, "ground",
+                  ("A_ratio", "p") if motion.suite is None else ("p",), [])
+
+
+def _axis_specs(kind: str, body: dict, impact: dict, initial: dict, motion: _Motion,
+                forms: _Forms, law_specs: list[tuple[str, str, Any]],
+                path_specs: list[tuple[str, str, str, Any]] = ()
+                ) -> list[tuple[str, str, str, Any]]:
+    """(name, key, form, spec) of every axis after the shape, in the grid's order, their
+    forms checked but no value built: the body, lam (then the impact law's keys), the
+    initial state, a suite's records and stripes, the excitation path's (angle, floor),
+    the pulse axes, body.mu last."""
+    specs: list[tuple[str, str, str, Any]] = []
     for k in BODY_KEYS[kind]:
         spec = body.get(k, KEYS[f"body.{k}"].default)
         specs.append((k, f"body.{k}", *_axis_spec(f"body.{k}", spec)[:2]))
     lam = impact.get("lam", 0.0)  # a block without an impact section: Housner's corner
     specs.append(("lam", "impact.lam", *_axis_spec("impact.lam", lam)[:2]))
-    law_axis, law_specs = _impact_law(impact)
-    n_laws = 1 if law_axis is None else len(law_axis.values)
-    specs.extend(law_specs)  # after lam (and the law's axis, added below)
+    specs.extend(law_specs)  # after lam (and the law's axis, added by _axes)
     for k in INITIAL:  # the initial state's keys given (none: at rest, no axis)
         if initial.get(k) is not None:
             specs.append((k, f"initial.{k}", *_axis_spec(f"initial.{k}", initial[k])[:2]))
-    if suite is not None:  # the records (words), then the stripes, before p
-        specs.append(("record", "ground.record", "words", suite.names))
-        if stripe is not None:
-            specs.append((stripe[0], f"ground.{stripe[0]}", "stripes", stripe[1:]))
-    # the orientation and the floor: after the records, before the ground's own axes
-    path, path_specs, path_inputs = _excitation_path(raw, ground, kind, free, record, suite,
-                                                     base, physical, given_h2)
+    if motion.suite is not None:  # the records (words), then the stripes, before p
+        specs.append(("record", "ground.record", "words", motion.suite.names))
+        if motion.stripe is not None:
+            im = motion.stripe[0]
+            specs.append((im, f"ground.{im}", "stripes", motion.stripe[1:]))
     specs.extend(path_specs)
-    inputs = (*inputs, *path_inputs)
-    for k in pulse_axes:
-        if free:  # not the user's: no check (w_over_p = 0 is no ground motion)
-            specs.append((k, f"{section}.{k}", "given", pulse[k]))
+    for k in forms.pulse_axes:
+        key = f"{forms.section}.{k}"
+        if motion.free:  # not the user's: no check (w_over_p = 0 is no ground motion)
+            specs.append((k, key, "given", motion.pulse[k]))
             continue
-        specs.append((k, f"{section}.{k}", *_axis_spec(f"{section}.{k}", pulse[k])[:2]))
+        specs.append((k, key, *_axis_spec(key, motion.pulse[k])[:2]))
+    mu_spec = body.get("mu")
     if mu_spec is not None:  # the last axis: the same grid of runs, flagged per mu
         specs.append(("mu", "body.mu", *_axis_spec("body.mu", mu_spec)[:2]))
-    lengths = [len(shapes)] + [1 if form in ("scalar", "given") else
-                               (spec["num"] if form == "range" else
-                                len(suite.levels) if form == "stripes" else len(spec))
-                               for _, _, form, spec in specs]
+    return specs
+
+
+def _check_size(motion: _Motion, forms: _Forms, specs: list[tuple[str, str, str, Any]],
+                n_laws: int) -> None:
+    """Refuse a grid of more than MAX_POINTS points, from the axes' lengths alone."""
+    lengths = [len(forms.shapes)] + [
+        1 if form in ("scalar", "given") else
+        (spec["num"] if form == "range" else
+         len(motion.suite.levels) if form == "stripes" else len(spec))
+        for _, _, form, spec in specs]
     size = math.prod(lengths) * n_laws
     if size > MAX_POINTS:
         dims = " x ".join(f"{n:,} {key}" for n, (_, key, form, _) in
@@ -974,14 +1072,20 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
                          "points per scene (a sweep file stores 45 bytes a point); split it "
                          "into several scenes or use fewer values")
 
-    shape_key = ("ground.record" if record else "ground.shape" if suite else "pulse.shape")
-    axes = [Axis("shape", shape_key, shapes, shape_swept)]
+
+def _axes(motion: _Motion, forms: _Forms, specs: list[tuple[str, str, str, Any]],
+          law_axis: Axis | None) -> list[Axis]:
+    """The scene's axes, values built: the shape, the specs' (the impact law's after
+    lam), then the unswept pulse options."""
+    shape_key = ("ground.record" if motion.record else
+                 "ground.shape" if motion.suite else "pulse.shape")
+    axes = [Axis("shape", shape_key, forms.shapes, forms.shape_swept)]
     for name_, key, form, spec in specs:
         if form == "words":  # a suite's records: always a dimension
             axes.append(Axis(name_, key, tuple(spec), True))
             continue
         if form == "stripes":  # checked by _suite; always a dimension
-            axes.append(Axis(name_, key, suite.levels, True))
+            axes.append(Axis(name_, key, motion.suite.levels, True))
             continue
         if form == "given":  # a free scene's pulse axes (no ground motion)
             axes.append(Axis(name_, key, (float(spec),), False))
@@ -990,13 +1094,13 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
         axes.append(Axis(name_, key, tuple(values.tolist()), form != "scalar"))
         if name_ == "lam" and law_axis is not None:
             axes.append(law_axis)
-    axes.extend(options)  # unswept: the flat index and the result's shape stay as they are
+    axes.extend(forms.options)  # unswept: the flat index and the result's shape stay as they are
+    return axes
 
-    numerics, single = _numerics(numerics_sec, contact)
-    scene = Scene(name=name or "rocksweep scene", kind=kind, axes=tuple(axes),
-                  numerics=numerics, single_numerics=single, energy=energy, text=text,
-                  contact=contact, check=check, record=record, refine=_refine(raw, kind),
-                  suite=suite, inputs=inputs, physical=physical, path=path)
+
+def _admit(scene: Scene) -> None:
+    """Checks of the whole scene: outputs available with its motion, the initial state,
+    the cost of a point; a suite's drift and large factors as RecordWarnings."""
     if scene.contact and scene.ground:
         # the contact outputs are compiled into the sine/cosine variants only (a kernel
         # variant per combination costs compile time no scene has asked for yet)
@@ -1007,10 +1111,9 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     bodies = _candidate_bodies(scene)
     _check_initial(scene, bodies)
     _check_cost(scene, bodies)
-    if suite is not None:  # drift and large factors: one-line RecordWarnings
-        suite.warn(scene.axis(alpha_symbol(kind)).values,
-                   scene.axis("p").values)
-    return scene
+    if scene.suite is not None:
+        scene.suite.warn(scene.axis(alpha_symbol(scene.kind)).values,
+                         scene.axis("p").values)
 
 
 def _check_initial(scene: Scene, bodies: list[dict[str, float]]) -> None:

@@ -48,9 +48,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rocksweep import fields
-from rocksweep.compute.grid import Grid
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import _fixed, _now
 from rocksweep.store.identity import record_attrs, resolved_scene

@@ -41,6 +41,7 @@ from rocksweep.store.format import (
 from rocksweep.store.identity import resolved_scene, scene_differences
 from rocksweep.vocab.axes import axis_name
 from rocksweep.vocab.outcomes import CLASSES, OUTCOME_CODE
+from rocksweep.vocab.settings import ADAPTIVE_RESOLVED
 
 if TYPE_CHECKING:
     import h5py
@@ -91,9 +92,7 @@ def _check_scene(stored, path: Path) -> None:
             raise bad(f"unswept axis {key} has {len(ax['values'])} values")
     if "adaptive" in stored:
         a = stored["adaptive"]
-        from rocksweep.compute.adaptive import RESOLVED_KEYS
-
-        ok = (isinstance(a, dict) and set(a) == set(RESOLVED_KEYS)
+        ok = (isinstance(a, dict) and set(a) == set(ADAPTIVE_RESOLVED)
               and isinstance(a["axes"], list) and len(a["axes"]) == 2
               and all(isinstance(v, str) for v in a["axes"])
               and all(isinstance(a[k], int) and not isinstance(a[k], bool) and a[k] >= 0
@@ -207,11 +206,6 @@ def _layout(f: h5py.File, path: Path) -> _Layout:
             raise _damaged(path, f"variable '{name}' has dtype {ds.dtype}, expected "
                            f"{specs[name][0]}")
     return _Layout(stored, dims, shape, names)
-
-
-def _check_format(f: h5py.File, path: Path) -> None:
-    """Raise StoreError unless ``f`` is a valid rocksweep result (see ``_layout``)."""
-    _layout(f, path)
 
 
 def _is_hdf5(path: Path) -> bool:

@@ -1,11 +1,12 @@
-"""File-system safety of the writer (issue 16): space, stale temporary files, locks and
+"""File-system safety of the writer: space, stale temporary files, locks and
 the atomic rename.
 
 - A new file's size is known (every dataset is allocated at creation): a grid larger
   than the free space is refused before anything is written (``_check_space``), and the
   whole file's space is reserved before HDF5 writes (``_reserve``).
 - A new file is made under a temporary name unique to the process
-  (``partial_prefix``); those of killed attempts are removed (``clean_stale_partials``).
+  (``outputs.partial_prefix``); those of killed attempts are removed
+  (``outputs.clean_stale_partials``, as for every output).
 - A writer holds HDF5's exclusive lock (``flock``) on its file; ``create`` takes the same
   lock on a file it overwrites (``_lock_existing``), and holds the new file's lock before
   it is renamed into place (``_publish``), so no two processes write one path, whatever
@@ -19,10 +20,7 @@ from __future__ import annotations
 
 import errno
 import os
-import re
 import shutil
-import stat
-import time
 from pathlib import Path
 
 from rocksweep.errors import OutputError
@@ -87,71 +85,6 @@ def _check_space(path: Path, need: int, what: str) -> None:
                          f"{_mib(need)} ({need} bytes), {_mib(free)} free in {parent}")
 
 
-_PARTIAL = re.compile(r"\.(?:(\d+)-)?[a-z0-9_]{8}\.partial")
-STALE_AGE = 60.0  # [s] a partial file without a writer's pid is stale when this old
-
-
-def partial_prefix(path: Path) -> str:
-    """The prefix of the temporary names a new result file at ``path`` is made under: the
-    writer's pid is part of the name (``.out.h5.1234-abcd1234.partial``)."""
-    return f".{path.name[:40]}.{os.getpid()}-"
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except OSError:  # exists, another user's
-        return True
-    return True
-
-
-def clean_stale_partials(path: Path) -> list[tuple[str, int]]:
-    """Remove the temporary files of earlier attempts to make ``path`` that no live writer
-    owns (a sweep killed while the file was made leaves one of the reserved size): its
-    writer's process is gone (or, for a name without a pid, it is older than STALE_AGE)
-    and no process holds its lock. Returns (name, bytes) of each file removed."""
-    import fcntl
-
-    parent = path.parent if str(path.parent) else Path(".")
-    head = f".{path.name[:40]}"
-    removed = []
-    try:
-        names = [n for n in os.listdir(parent) if n.startswith(head) and n.endswith(".partial")]
-    except OSError:
-        return []
-    for name in names:
-        m = _PARTIAL.fullmatch(name[len(head):])
-        if m is None:
-            continue
-        full = parent / name
-        try:
-            st = os.lstat(full)
-        except OSError:
-            continue
-        if not stat.S_ISREG(st.st_mode):
-            continue
-        if m.group(1) is not None:
-            if int(m.group(1)) == os.getpid() or _alive(int(m.group(1))):
-                continue
-        elif time.time() - st.st_mtime < STALE_AGE:
-            continue
-        try:
-            fd = os.open(full, os.O_RDONLY | getattr(os, "O_CLOEXEC", 0))
-        except OSError:
-            continue
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # HDF5's writer lock
-            os.unlink(full)
-            removed.append((name, st.st_size))
-        except OSError:  # locked: a live writer (or no flock here: leave it)
-            pass
-        finally:
-            os.close(fd)
-    return removed
-
-
 def _lock_existing(path: Path) -> int:
     """Open the file at ``path`` and take the exclusive lock a writer holds (HDF5 locks
     with flock); returns the descriptor. StoreError if a sweep is writing it."""
@@ -177,6 +110,6 @@ def _publish(tmp: Path, path: Path, old_fd: int | None) -> None:
     of every output): over the file locked by ``old_fd``, or, without one, only if
     nothing is at ``path`` (another process may have made it since it was checked)."""
     try:
-        publish(tmp, path, replace=False, old_fd=old_fd)
+        publish(tmp, path, old_fd=old_fd)
     except OutputError as err:
         raise StoreError(str(err)) from None

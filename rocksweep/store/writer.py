@@ -24,12 +24,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rocksweep.compute.grid import Grid
-from rocksweep.compute.sweep import ChunkResult
 from rocksweep.errors import OutputError, RocksweepError
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.outputs import check_output, is_input, shown
+from rocksweep.outputs import check_output, clean_stale_partials, is_input, partial_prefix, shown
+from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import (
     _H5_ERRORS,
@@ -66,8 +65,6 @@ from rocksweep.store.safety import (
     _reserve,
     _reserve_bytes,
     _space_needed,
-    clean_stale_partials,
-    partial_prefix,
 )
 
 if TYPE_CHECKING:

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from bodies import FIG3_YAML
 from click.testing import CliRunner
 
 import rocksweep
@@ -22,9 +23,7 @@ ROOT = Path(__file__).resolve().parents[2]
 NAMES = ["SYN01.AT2", "SYN05.AT2", "SYN12.AT2"]
 SCENE = """
 name: ida test
-body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47,
-       IA_ratio: 0.56}
-impact: {lam: 0.0}
+""" + FIG3_YAML + """impact: {lam: 0.0}
 ground:
   records: suite/*.AT2
   scale: {im: PGA, values: [0.2, 0.4, 0.6, 0.8, 1.2, 1.6]}

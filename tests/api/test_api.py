@@ -18,9 +18,9 @@ import rocksweep
 import rocksweep.compute.sweep as sw
 from rocksweep import api, fields
 from rocksweep.cli import main
-from rocksweep.compute.grid import Grid
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.model import FlexibleBody
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.parse import load_scene
 from rocksweep.store.reader import read_result
 
@@ -207,7 +207,7 @@ def test_cache_state_of_a_fresh_cache(tmp_path):
     sc = load_scene(CI_SMALL)
     sw.prepare(Grid(sc), sw.level(sc))
     assert sw.kernel_cache_state(Grid(sc), sw.level(sc)) == (0, 0)
-    code = ("from rocksweep.compute import sweep as sw; from rocksweep.compute.grid import Grid; "
+    code = ("from rocksweep.compute import sweep as sw; from rocksweep.scene.grid import Grid; "
             "from rocksweep.scene.parse import load_scene; "
             f"sc = load_scene({str(CI_SMALL)!r}); "
             "print(sw.kernel_cache_state(Grid(sc), sw.level(sc)))")
@@ -248,7 +248,7 @@ def test_simulate_keywords_and_dict_agree_and_history_is_physical():
     assert abs(h.theta_over_alpha.values[-1]) == pytest.approx(math.pi / 2 / 0.15, rel=1e-6)
     balance = h.W_in_over_Eref - h.D_damp_over_Eref - h.E_impact_over_Eref
     # to the integration error of the work integral: ~1e-3 E_ref at `default` (the one
-    # default of sweeps and single runs, issue 28), ~1e-5 E_ref at `fine`
+    # default of sweeps and single runs), ~1e-5 E_ref at `fine`
     np.testing.assert_allclose(h.E_over_Eref.values, balance.values, atol=2e-3)
     hf = rocksweep.simulate(FIG5, impact__lam=0.4, numerics__accuracy="fine").history
     np.testing.assert_allclose(hf.E_over_Eref.values, (hf.W_in_over_Eref - hf.D_damp_over_Eref

@@ -1,10 +1,12 @@
-"""The thin facade (issue 31): each argument check and each piece of work lives in the room
+"""The thin facade: each argument check and each piece of work lives in the room
 that does it (analysis.boundaries, analysis.calibrate, analysis.fragility,
-analysis.spectrum, store.history, store.session), with the words the API always used, and
+analysis.spectrum, compute.history, compute.session), with the words the API always used, and
 what ``rocksweep.<function>`` returns is what it returned before."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
 import warnings
 
 import numpy as np
@@ -117,7 +119,7 @@ def test_spectra_say_their_kind_and_check_rtol_once():
 
 
 def test_run_checks_before_the_output_and_returns_the_file(tmp_path):
-    """run hands its checks to store.session.run_session: a bad argument leaves no file;
+    """run hands its checks to compute.session.run_session: a bad argument leaves no file;
     with output the Dataset is the file's, with the accessor."""
     out = tmp_path / "r.h5"
     scene = {"name": "run facade", "body": dict(FIG3), "impact": {"lam": 0.0},
@@ -151,3 +153,29 @@ def test_an_analysis_called_first_on_a_path_has_the_accessor(tmp_path):
                          text=True, cwd=tmp_path, timeout=300)
     assert res.returncode == 0, res.stderr
     assert res.stdout.split() == ["True", "Figure"]
+
+
+def _fresh(code: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120)
+
+
+def test_the_accessor_is_there_after_importing_xarray_then_rocksweep():
+    """``import xarray, rocksweep``: ``ds.rocksweep`` on any Dataset before any call of the
+    API; ``import rocksweep`` alone imports no xarray (and so registers nothing)."""
+    res = _fresh("import xarray as xr, rocksweep\n"
+                 "ds = xr.Dataset({'outcome': ('x', [0, 1])})\n"
+                 "print(type(ds.rocksweep).__name__)")
+    assert res.returncode == 0 and res.stdout.split() == ["RocksweepAccessor"], res.stderr
+    res = _fresh("import sys, rocksweep\nprint('xarray' in sys.modules)")
+    assert res.returncode == 0 and res.stdout.split() == ["False"], res.stderr
+
+
+def test_the_accessor_methods_take_keywords_only():
+    import inspect
+
+    from rocksweep.accessor import RocksweepAccessor
+
+    for name in ("plot", "boundaries", "spectra", "fragility", "ida", "im_efficiency"):
+        params = list(inspect.signature(getattr(RocksweepAccessor, name)).parameters.values())
+        assert [p.kind for p in params[1:]] == [inspect.Parameter.VAR_KEYWORD], name

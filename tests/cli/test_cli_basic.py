@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from bodies import FIG3_YAML
 from click.testing import CliRunner
 
 from rocksweep.cli import main
@@ -14,8 +15,7 @@ from rocksweep.cli import main
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
 GOOD = """
-body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47, IA_ratio: 0.56}
-impact: {lam: 0.4}
+""" + FIG3_YAML + """impact: {lam: 0.4}
 pulse: {shape: sine, w_over_p: 5.3, A_ratio: 5.0}
 """
 
@@ -194,3 +194,48 @@ def test_bad_usage_is_one_line(args, needle):
     res = CliRunner().invoke(main, args)
     line = one_line_error(res, code=2)
     assert line.startswith("Error: ") and needle in line
+
+
+def test_importing_the_command_line_changes_no_environment():
+    """Importing any ``rocksweep.cli`` module sets no environment variable (the console
+    entry alone sets OPENBLAS_NUM_THREADS, for its own process)."""
+    import os
+
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    code = ("import os, pkgutil, importlib, rocksweep.cli\n"
+            "before = dict(os.environ)\n"
+            "for m in pkgutil.iter_modules(rocksweep.cli.__path__):\n"
+            "    importlib.import_module('rocksweep.cli.' + m.name)\n"
+            "print(dict(os.environ) == before, 'OPENBLAS_NUM_THREADS' in os.environ)")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=env, timeout=120)
+    assert res.returncode == 0 and res.stdout.split() == ["True", "False"], res.stderr
+    entry = ("import os, sys\nfrom rocksweep.cli import entry\n"
+             "sys.argv = ['rocksweep', '--version']\n"
+             "import atexit\natexit.register(lambda: print('atexit'))\n"
+             "print(os.environ.get('OPENBLAS_NUM_THREADS'))\nentry()")
+    res = subprocess.run([sys.executable, "-c", entry], capture_output=True, text=True,
+                         env=env, timeout=120)
+    assert res.returncode == 0 and res.stdout.split()[0] == "None", res.stderr
+    assert "atexit" not in res.stdout  # the console entry exits without teardown
+
+
+def test_os_exit_is_called_only_by_the_console_entry():
+    """``os._exit`` (no teardown: no atexit handlers, no coverage) is the console command's
+    trade alone: it appears in ``rocksweep.cli.entry`` and nowhere else in the package."""
+    import ast
+    from pathlib import Path
+
+    import rocksweep
+
+    pkg = Path(rocksweep.__file__).parent
+    found = []
+    for path in sorted(pkg.rglob("*.py")):
+        tree = ast.parse(path.read_text())
+        for fn in [n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef)] + [tree]:
+            body = fn.body if fn is not tree else [s for s in tree.body
+                                                   if not isinstance(s, ast.FunctionDef)]
+            for node in (n for s in body for n in ast.walk(s)):
+                if isinstance(node, ast.Attribute) and node.attr == "_exit":
+                    found.append((str(path.relative_to(pkg)), getattr(fn, "name", "")))
+    assert set(found) == {("cli/__init__.py", "entry")}, found

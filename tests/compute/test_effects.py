@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 import pytest
-from bodies import SHARED
+from bodies import FIG3, SHARED
 
 from rocksweep.compute.single import history_capacity, simulate
 from rocksweep.kernel import chunk_kernel, point_kernel
@@ -80,8 +80,8 @@ def assert_covers_all_outcomes(outs: np.ndarray) -> None:
 @pytest.fixture(scope="module")
 def bodies() -> dict:
     return {
-        "flexible": FlexibleBody(wn_over_p=2.43, **TABLE3),
-        "undamped": FlexibleBody(wn_over_p=2.43, **{**TABLE3, "zeta": 0.0}),
+        "flexible": FlexibleBody(**FIG3),
+        "undamped": FlexibleBody(**{**FIG3, "zeta": 0.0}),
         "rigid": FlexibleBody(wn_over_p=math.inf, **TABLE3),
         "block": BlockBody(alpha=0.15),
     }

@@ -2,17 +2,17 @@
 
 import numpy as np
 import pytest
+from bodies import FIG3_YAML, body_yaml, table3
 
 import rocksweep.compute.sweep as sw
 from rocksweep import fields
 from rocksweep.compute.driver import sweep_arrays
-from rocksweep.compute.grid import Grid
 from rocksweep.compute.single import simulate
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.parse import parse_scene
 
-BODY3 = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, "
-         "mA_over_m: 0.47, IA_ratio: 0.56}\n")
+BODY3 = FIG3_YAML
 
 
 def small_scene(extra: str = "") -> object:
@@ -101,7 +101,7 @@ def test_merge_contiguous_joins_neighbours_in_any_order():
     rng = np.random.default_rng(3)
     bounds = [(0, 5), (5, 9), (9, 20), (30, 33), (33, 40), (50, 51)]
     full = {"x": rng.random(51), "n": np.arange(51)}
-    results = [sw.ChunkResult(a, b, {k: v[a:b] for k, v in full.items()}, 1.0, 0.5)
+    results = [ChunkResult(a, b, {k: v[a:b] for k, v in full.items()}, 1.0, 0.5)
                for a, b in bounds]
     merged = sw.merge_contiguous([results[i] for i in rng.permutation(len(results))])
     assert [(m.start, m.stop) for m in merged] == [(0, 20), (30, 40), (50, 51)]
@@ -144,8 +144,8 @@ def test_each_point_goes_to_its_kernel_variant(monkeypatch):
         return run
 
     monkeypatch.setattr(sw.kernel, "chunk_kernel", fake_kernel)
-    sc = parse_scene("body: {wn_over_p: [2.43, .inf], zeta: [0.0, 0.05], alpha_cg: 0.15, "
-                     "alpha_A: 0.28, mA_over_m: 0.47, IA_ratio: 0.56}\nimpact: {lam: 0.2}\n"
+    sc = parse_scene(body_yaml(table3(wn_over_p="[2.43, .inf]", zeta="[0.0, 0.05]"))
+                     + "impact: {lam: 0.2}\n"
                      "pulse: {shape: sine, w_over_p: [1.0, 2.0], A_ratio: 3.0}\n")
     g = Grid(sc)
     res = sw.run_chunk(g, 0, g.size, L.LEVEL_OUTCOME)

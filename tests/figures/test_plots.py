@@ -9,19 +9,19 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from bodies import body_yaml, table3
 from helpers import one_line_error
 from matplotlib.colors import to_rgb
 from matplotlib.figure import Figure
 
 from rocksweep.cli import main
-from rocksweep.compute.sweep import ChunkResult
 from rocksweep.errors import RocksweepError
+from rocksweep.scene.grid import ChunkResult
 from rocksweep.store.reader import read_result
 from rocksweep.store.writer import SweepFile
 
 ROOT = Path(__file__).resolve().parents[2]
-BODY3 = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: {start: 0.1, stop: 0.2, num: 3}, "
-         "alpha_A: 0.28, mA_over_m: 0.47, IA_ratio: 0.56}\n")
+BODY3 = body_yaml(table3(alpha_cg="{start: 0.1, stop: 0.2, num: 3}"))
 
 
 def visible_axes(fig: Figure) -> list:

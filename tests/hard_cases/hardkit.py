@@ -1,4 +1,4 @@
-"""Shared tools of the hard-case suite (issue 5): runs, events and the checks every case makes.
+"""Shared tools of the hard-case suite: runs, events and the checks every case makes.
 
 Every check here can fail: a history with NaN or inf, a run that hit a step or event cap,
 an energy balance that does not close, events that differ from the reference path's.
@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass, replace
 
 import numpy as np
+from bodies import table3
 
 from rocksweep.compute.single import Run, simulate
 from rocksweep.kernel import layout as L  # noqa: N812
@@ -42,10 +43,7 @@ def numerics(**overrides) -> Numerics:
 
 def table3_body(**changes) -> FlexibleBody:
     """Table 3's slender body of Figure 3 (wn/p = 2.43), with some Pi groups changed."""
-    pi = dict(wn_over_p=2.43, zeta=0.05, alpha_cg=0.15, alpha_A=0.28, mA_over_m=0.47,
-              IA_ratio=0.56)
-    pi.update(changes)
-    return FlexibleBody(**pi)
+    return FlexibleBody(**table3(**changes))
 
 
 def run(point: Point, num: Numerics | None = None) -> Run:

@@ -1,4 +1,4 @@
-"""The tails of the accuracy (issue 15): the worst cases of a wide-space sample
+"""The tails of the accuracy: the worst cases of a wide-space sample
 (scripts/wide_space.py), each against the scipy reference or a closed form, at the preset
 that should get them right.
 
@@ -17,6 +17,7 @@ import math
 
 import numpy as np
 import pytest
+from bodies import table3
 from scipy.integrate import quad
 
 from rocksweep.compute.single import simulate
@@ -27,7 +28,7 @@ from rocksweep.physics.model import FlexibleBody
 from rocksweep.physics.points import Point, point_row
 from rocksweep.physics.reference import reference_run
 
-# The huge slow cosine pulse of issue 15 on undamped bodies (wn/p = 1.56, zeta = 0): an
+# The huge slow cosine pulse of the wide-space sample on undamped bodies (wn/p = 1.56, zeta = 0): an
 # overturning without impact (mode 2) and one after an impact (mode 1).
 HUGE_COSINE = {
     "mode2": Point(FlexibleBody(1.56, 0.0, 0.45, 0.54, 0.05, 0.56), 0.4, "cosine", 0.33, -19.6),
@@ -57,7 +58,8 @@ def test_huge_slow_pulse_is_not_crossed_in_a_handful_of_steps(case):
 def _rigid_fall(alpha_cg: float, numerics: Numerics) -> tuple[np.ndarray, FlexibleBody, float]:
     """A rigid body started at theta = 0 with theta' 10% above what carries it over the top
     (no pulse: A_ratio = 0). Returns (energy kernel's result row, body, theta'_0)."""
-    body = FlexibleBody(math.inf, 0.05, alpha_cg, min(1.3, 2 * alpha_cg), 0.47, 0.56)
+    body = FlexibleBody(**table3(wn_over_p=math.inf, alpha_cg=alpha_cg,
+                                 alpha_A=min(1.3, 2 * alpha_cg)))
     w0 = 1.1 * math.sqrt(2 * (1 - math.cos(body.alpha_ref)))  # p = 1
     row = point_row(Point(body, 0.0, "sine", 12.0, 0.0), numerics)
     row[L.PAR_THETA_DOT0] = w0
@@ -75,7 +77,7 @@ def test_rigid_fall_time_and_energy_balance(alpha_cg):
     1/2 I_O theta'_0^2 (nothing acts on the body)."""
     # `default` steps the free fall at 2 pi/5 p*t or 0.25 alpha_cg of turning, whichever is
     # shorter (its zero-amplitude pulse, 0.52 p*t long, no longer sets the step after it
-    # ends: issue 28): 5.1e-4 p*t and 1.2e-4 E_ref off; `accurate` 1.8e-5 and 1.4e-6
+    # ends): 5.1e-4 p*t and 1.2e-4 E_ref off; `accurate` 1.8e-5 and 1.4e-6
     for preset, t_tol, e_tol in (("default", 1e-3, 2.5e-4), ("accurate", 1e-4, 2e-5)):
         out, body, w0 = _rigid_fall(alpha_cg, Numerics.preset(preset))
         a = body.alpha_ref

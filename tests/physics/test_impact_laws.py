@@ -1,4 +1,4 @@
-"""Impact laws (issue 21): vertical (eq. 1), locked, constant, and e_factor.
+"""Impact laws: vertical (eq. 1), locked, constant, and e_factor.
 
 Each law's e and energy loss are derived here with sympy from the impulse-momentum balance
 (angular momentum about the impulse point, plus the law's rule for the top mass), written
@@ -11,6 +11,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 import sympy as sp
+from bodies import FIG3_YAML
 from helpers import one_line_error
 
 from rocksweep.cli import main
@@ -232,8 +233,7 @@ def test_e_needs_law_constant_and_constant_needs_e(cli):
     assert msg.endswith("impact.e: missing; law constant needs its coefficient of "
                         "restitution e: a number in (0, 1], a list or a range"), msg
     with pytest.raises(SceneError, match=r"impact.law = \['vertical', 'vertical'\]: a law is"):
-        parse_scene("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, "
-                    "mA_over_m: 0.47, IA_ratio: 0.56}\nimpact: {lam: 0, law: [vertical, "
+        parse_scene(FIG3_YAML + "impact: {lam: 0, law: [vertical, "
                     "vertical]}\npulse: {shape: sine, w_over_p: 1, A_ratio: 1}")
 
 

@@ -4,6 +4,7 @@ import math
 
 import numpy as np
 import pytest
+from bodies import table3
 from numba import njit
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
@@ -56,7 +57,7 @@ def test_cosine_pulse_uplift_at_t0_brackets_static_threshold(body_fig3, factor, 
 
 def test_rigid_uplift_at_g_tan_alpha():
     """Rigid body, sine pulse: uplift when A sin(w t) first reaches g tan(alpha_cg)."""
-    bd = FlexibleBody(math.inf, 0.0, 0.15, 0.28, 0.47, 0.56)
+    bd = FlexibleBody(**table3(wn_over_p=math.inf, zeta=0.0))
     for a_ratio in (1.3, 3.0):
         run = simulate(Point(bd, 0.0, "sine", 2.0, a_ratio), NUM)
         h = run.history
@@ -126,7 +127,7 @@ def test_rk4_error_falls_16_fold_per_halving(body_fig3):
 
 def _free_flight_drift(steps_per_period):
     """Largest change of E/E_ref over one step between impacts, after the pulse, zeta = 0."""
-    bd = FlexibleBody(2.43, 0.0, 0.15, 0.28, 0.47, 0.56)
+    bd = FlexibleBody(**table3(zeta=0.0))
     num = Numerics.preset("default", horizon=30.0, steps_per_period=steps_per_period,
                           event_tol=1e-8)
     run = simulate(Point(bd, 0.2, "sine", 6.0, 3.0), num)

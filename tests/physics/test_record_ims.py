@@ -1,4 +1,4 @@
-"""The record IMs of issue 29 (Arias, CAV, D5-95, PGV/PGA, AvgSa) against independent
+"""The record IMs (Arias, CAV, D5-95, PGV/PGA, AvgSa) against independent
 computations on the shipped suite (records/suite), and the drift / scale warnings."""
 
 from __future__ import annotations
@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from bodies import FIG3
 from scipy import integrate, signal
 
 from rocksweep.physics import intensity as I  # noqa: E741
@@ -35,20 +36,30 @@ def records():
     return [read_record(p) for p in SUITE]
 
 
-def test_arias_cav_d595_within_1pct_of_scipy_on_the_shipped_suite(records):
+def test_arias_cav_d595_follow_the_sample_sum_on_the_shipped_suite(records):
+    # Arias by Parseval (the FFT's energy equals the samples' sum of squares), CAV and
+    # D5-95 by a plain loop over the samples, the first sample reaching 5% / 95%
     assert len(records) == 20
     for rec in records:
-        t, a = fine(rec)
-        arias = math.pi / (2 * G) * integrate.simpson(a * a, x=t)
-        cav = integrate.trapezoid(np.abs(a), t)
-        husid = integrate.cumulative_trapezoid(a * a, t, initial=0.0)
-        husid /= husid[-1]
-        d = t[np.searchsorted(husid, 0.95)] - t[np.searchsorted(husid, 0.05)]
-        assert I.arias(rec.acc, rec.dt) == pytest.approx(arias, rel=1e-2)
-        assert I.cav(rec.acc, rec.dt) == pytest.approx(cav, rel=1e-2)
-        assert I.significant_duration(rec.acc, rec.dt) == pytest.approx(d, rel=1e-2)
+        a = rec.acc * G
+        spectrum = np.fft.rfft(a, n=2 * a.size)  # zero-padded: every bin once or twice
+        energy = (2.0 * np.sum(np.abs(spectrum) ** 2) - abs(spectrum[0]) ** 2
+                  - abs(spectrum[-1]) ** 2) / (2 * a.size)
+        arias = math.pi / (2 * G) * energy * rec.dt
+        total, run, k5, k95 = math.fsum(a * a), 0.0, None, None
+        for k, x in enumerate(a):
+            run += x * x
+            if k5 is None and run >= 0.05 * total:
+                k5 = k
+            if k95 is None and run >= 0.95 * total:
+                k95 = k
+        assert I.arias(rec.acc, rec.dt) == pytest.approx(arias, rel=1e-9)
+        assert I.cav(rec.acc, rec.dt) == pytest.approx(math.fsum(np.abs(a)) * rec.dt,
+                                                       rel=1e-12)
+        assert I.significant_duration(rec.acc, rec.dt) == pytest.approx(
+            (k95 - k5) * rec.dt, abs=1e-9)
         # the realistic range of a 20-40 s far-field record's D5-95
-        assert 3.0 < d < 40.0
+        assert 3.0 < I.significant_duration(rec.acc, rec.dt) < 40.0
 
 
 def test_pgv_over_pga_and_avgsa_within_1pct_of_lsim(records):
@@ -71,22 +82,25 @@ def test_pgv_over_pga_and_avgsa_within_1pct_of_lsim(records):
         assert su.avgsa[0] == pytest.approx(np.exp(np.mean(np.log(sas))), rel=1e-2)
 
 
-def test_closed_forms_on_a_sine():
-    # a(t) = A sin(w t) over n whole cycles: Arias = pi/(2g) A^2 T_total / 2, CAV = 2 A
-    # T_total / pi, D5-95 = 0.9 T_total (the Husid curve is nearly linear)
-    A, w, dt, n = 0.3, 2 * np.pi, 0.001, 10
-    t = np.arange(0.0, n + dt / 2, dt)
-    acc = A * np.sin(w * t)
+def test_closed_forms_on_a_sampled_sine():
+    # a_i = A sin(2 pi i / N), n whole cycles of N samples: sum a_i^2 = A^2 n N / 2 and
+    # sum |a_i| = A n 2 cot(pi / N) (N even); the Husid sum grows by A^2 N / 2 a cycle
+    A, N, n = 0.3, 40, 10
+    dt = 1.0 / N
+    acc = A * np.sin(2 * np.pi * np.arange(n * N) / N)
     assert I.arias(acc, dt) == pytest.approx(math.pi / (2 * G) * (A * G) ** 2 * n / 2,
-                                             rel=1e-5)
-    assert I.cav(acc, dt) == pytest.approx(2 * A * G * n / math.pi, rel=1e-5)
-    assert I.significant_duration(acc, dt) == pytest.approx(0.9 * n, abs=0.05)
+                                             rel=1e-12)
+    assert I.cav(acc, dt) == pytest.approx(A * G * n * 2 / math.tan(math.pi / N) * dt,
+                                           rel=1e-12)
+    assert I.significant_duration(acc, dt) == pytest.approx(0.9 * n, abs=2 * dt)
 
 
-def test_cav_splits_a_step_at_its_zero():
-    # one step from +1 to -1 g over 1 s: |a| is two triangles of 0.5 s, area 0.5 g s
-    assert I.cav([1.0, -1.0], 1.0) == pytest.approx(0.5 * G, rel=1e-12)
-    assert I.cav([1.0, 1.0], 1.0) == pytest.approx(G, rel=1e-12)
+def test_a_sign_change_counts_both_samples_whole():
+    # the sample sum, not the interpolant's triangles: two samples of 1 g over 1 s each
+    assert I.cav([1.0, -1.0], 1.0) == pytest.approx(2.0 * G, rel=1e-12)
+    assert I.arias([1.0, -1.0], 1.0) == pytest.approx(math.pi / (2 * G) * 2 * G * G,
+                                                      rel=1e-12)
+    assert I.significant_duration([0.0, 1.0, 1.0, 0.0], 1.0) == pytest.approx(1.0)
 
 
 def test_scaled_ims_follow_their_exponents(records):
@@ -97,6 +111,20 @@ def test_scaled_ims_follow_their_exponents(records):
     assert I.cav(acc2, rec.dt) == pytest.approx(2.0 * base.cav[0], rel=1e-12)
     assert I.significant_duration(acc2, rec.dt) == pytest.approx(base.d5_95[0], rel=1e-12)
     assert I.avg_sa(acc2, rec.dt, 0.5, 2.0) == pytest.approx(2.0 * base.avgsa[0], rel=1e-9)
+
+
+@pytest.mark.parametrize(("im", "level", "of"), [
+    ("AvgSa", 0.4, lambda a, dt: I.avg_sa(a, dt, 0.5, 2.0)),
+    ("CAV", 3.0, I.cav),
+    ("Arias", 0.8, I.arias)])
+def test_avgsa_cav_and_arias_stripes_scale_each_record_to_the_level(records, im, level, of):
+    # the record times its factor has the stripe's IM, computed afresh from the samples
+    # (Arias grows as the factor squared: its factor is the square root of the ratio)
+    su = make_suite(records[:3], ["a", "b", "c"], im, [level], math.nan, math.nan, [1.0],
+                    (0.5, 2.0))
+    f = su.factors(np.arange(3), np.zeros(3, np.int64), np.full(3, 0.15), np.full(3, 2.0))
+    for rec, fi in zip(records[:3], f, strict=True):
+        assert of(fi * rec.acc, rec.dt) == pytest.approx(level, rel=1e-9)
 
 
 def caught(suite):
@@ -143,8 +171,7 @@ def test_cli_says_the_warning_in_one_line():
 
 
 def suite_scene(**ground):
-    return {"body": {"wn_over_p": 2.43, "zeta": 0.05, "alpha_cg": 0.15, "alpha_A": 0.28,
-                     "mA_over_m": 0.47, "IA_ratio": 0.56},
+    return {"body": dict(FIG3),
             "impact": {"lam": 0.0},
             "ground": {"records": [str(SUITE[0]), str(SUITE[1])], "p": 2.0, **ground}}
 

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 import pytest
-from bodies import BODY3
+from bodies import BODY3, table3
 from scipy.integrate import quad
 
 from rocksweep.compute.single import simulate
@@ -114,8 +114,7 @@ def test_rigid_block_bounded_exit_matches_the_kernel():
 
 @pytest.fixture(scope="module")
 def undamped_run():
-    body = FlexibleBody(wn_over_p=2.43, zeta=0.0, alpha_cg=0.15, alpha_A=0.28,
-                        mA_over_m=0.47, IA_ratio=0.56)
+    body = FlexibleBody(**table3(zeta=0.0))
     p = Point(body, 0.0, "sine", 3.0, 3.0)
     return body, p, reference_run(p, Numerics(horizon=30.0), events=True)
 

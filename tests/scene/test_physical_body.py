@@ -1,4 +1,4 @@
-"""A body from the laboratory's numbers (body.kind physical, issue 30 part 5): the Pi
+"""A body from the laboratory's numbers (body.kind physical): the Pi
 groups and p from the paper's definitions (section 3.1, Table 1), written out here."""
 
 from __future__ import annotations

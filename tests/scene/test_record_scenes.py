@@ -23,7 +23,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from bodies import FIG3
+from bodies import FIG3, FIG3_YAML
 from scipy import signal
 
 from rocksweep.compute.single import simulate
@@ -94,9 +94,7 @@ def test_full_contact_response_is_lsim_of_the_record():
 
 SCENE = """
 name: record test
-body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47,
-       IA_ratio: 0.56}
-impact: {lam: [0.0, 0.4]}
+""" + FIG3_YAML + """impact: {lam: [0.0, 0.4]}
 ground:
   record: %s
   A_ratio: {start: 1.0, stop: 6.0, num: 3}

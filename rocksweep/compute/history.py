@@ -49,17 +49,19 @@ def swept_values(run: Run, swept: Sequence[str]) -> list:
     return out
 
 
-def write_history_csv(runs: Sequence[Run], swept: Sequence[str], path: str | Path) -> None:
+def write_history_csv(runs: Sequence[Run], swept: Sequence[str], path: str | Path, *,
+                      overwrite: bool = False) -> None:
     """The runs' time histories to one CSV file, atomically: columns run, the swept
     keys, then ``rocksweep.fields.HISTORY`` (p_t, theta_over_alpha, u_over_ucr,
     E_over_Eref, ...); plain numbers (``repr`` of Python floats: nan, inf as such).
-    Check the path first with ``rocksweep.outputs.check_output``."""
+    Check the path first with ``rocksweep.outputs.check_output``; an existing file is
+    replaced only with ``overwrite`` (``outputs.publish``)."""
     import csv
 
     from rocksweep import fields
     from rocksweep.outputs import atomic_path
 
-    with atomic_path(path) as tmp, tmp.open("w", newline="") as f:
+    with atomic_path(path, overwrite=overwrite) as tmp, tmp.open("w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["run", *swept, *(c.name for c in fields.HISTORY)])
         for i, r in enumerate(runs):

@@ -70,7 +70,7 @@ def sweep_file(scene: Scene, path: str | Path | None, *, overrides: Sequence[str
     say = log or (lambda _line: None)
     settings = None
     if adaptive is not None:
-        from rocksweep.compute.grid import Grid
+        from rocksweep.scene.grid import Grid
 
         settings = adaptive.resolved(Grid(scene))  # bad axes or settings: before any file
 
