@@ -114,6 +114,6 @@ def test_a_floor_sweep_names_its_axes_and_stores_the_building(tmp_path):
     assert np.all(pfa > 0.0)
     back = rocksweep.open(tmp_path / "f.h5")
     assert (back["outcome"].values == ds["outcome"].values).all()
-    # the analyses rebuild the scene (ground.h2 read again): spectra reruns its points
-    sp = rocksweep.spectra(back, search=False)
-    assert "floor.period" in sp.dims and "angle" in sp.dims
+    # the analyses rebuild the scene (ground.h2 read again): A_min reruns its points
+    bd = rocksweep.boundaries(back, rtol=0.05, search=False)
+    assert "floor.period" in bd["A_min"].dims and "angle" in bd["A_min"].dims
