@@ -162,13 +162,14 @@ def spectra_dataset_figure(sp: xr.Dataset, *, ax: Any = None,
                            width: str | None = "double") -> Figure:
     """Rocking spectrum (max|theta|/alpha against the frequency axis, one curve per
     A_ratio and lam) and overturning spectrum (A_min per lam) of ``rocksweep.spectra``."""
-    freq = next(d for d in sp["A_min"].dims if d != "lam")
+    freq = sp["A_min"].dims[-1]
     if ax is not None:
         axes = np.atleast_1d(ax)
         fig = axes[0].figure
     else:
         fig, axes = _figure(width, 2, 0.45)
-    th = sp["theta_max_over_alpha"]
+    th = sp["theta_max_over_alpha"]  # other swept keys: the first value of each
+    th = th.isel({d: 0 for d in th.dims if d not in ("lam", "A_ratio", freq)})
     x = sp[freq].values
     kind = str(sp.attrs.get("kind", "flexible"))
     pick = np.unique(np.linspace(0, sp.sizes["A_ratio"] - 1,

@@ -3,6 +3,7 @@ the computation is ``rocksweep.analysis.spectrum``)."""
 
 from __future__ import annotations
 
+import dataclasses
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -21,7 +22,16 @@ def spectra_figure(sp: Spectra, figsize: tuple[float, float] | None = None) -> F
     """Rocking spectra (one panel per lam: max|theta|/alpha_ref against the frequency axis,
     one curve per A_ratio, overturned points marked x) and the overturning spectrum
     (the smallest A_ratio that overturns, one curve per lam, mode 1 filled circles, mode
-    2 open triangles). Returns a pyplot-free Figure."""
+    2 open triangles). Other swept keys (``sp.extra``): the spectra at the first value of
+    each, said in the figure's title. Returns a pyplot-free Figure."""
+    note = ""
+    if sp.extra:
+        nl = sp.lam.size
+        note = ", ".join(f"{d} = {v[0]}" for d, v in sp.extra)
+        sp = dataclasses.replace(
+            sp, theta_max=sp.theta_max.reshape(-1, *sp.theta_max.shape[-3:])[0],
+            outcome=sp.outcome.reshape(-1, *sp.outcome.shape[-3:])[0],
+            a_min=sp.a_min[:nl], extra=())
     nl = sp.lam.size
     alpha = _axes.alpha_latex(sp.kind)
     amp = _axes.latex("A_ratio", sp.kind)
@@ -66,5 +76,5 @@ def spectra_figure(sp: Spectra, figsize: tuple[float, float] | None = None) -> F
     ax.legend(fontsize=6, frameon=False)
     ax.tick_params(labelsize=7)
     fig.suptitle(sp.name + (f" ({sp.record})" if sp.record and sp.record not in sp.name
-                            else ""), fontsize=10)
+                            else "") + (f" at {note}" if note else ""), fontsize=10)
     return fig

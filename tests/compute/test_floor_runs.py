@@ -117,3 +117,20 @@ def test_a_floor_sweep_names_its_axes_and_stores_the_building(tmp_path):
     # the analyses rebuild the scene (ground.h2 read again): A_min reruns its points
     bd = rocksweep.boundaries(back, rtol=0.05, search=False)
     assert "floor.period" in bd["A_min"].dims and "angle" in bd["A_min"].dims
+
+
+def test_spectra_run_over_the_new_axes(tmp_path):
+    """A record sweep over p, A_ratio and the floor's period: one spectrum per period,
+    each the spectrum of that period's own sweep (its A_min equal, bisected alike)."""
+    scene = {"body": BLOCK, "ground": {"record": str(NEARFAULT), "A_ratio": [1.0, 2.0, 4.0],
+                                       "p": [2.0, 3.0]},
+             "floor": {"period": [0.3, 0.6], "damping": ZETA, "participation": GP}}
+    ds = rocksweep.run(scene, output=tmp_path / "f.h5")
+    sp = rocksweep.spectra(ds, rtol=0.05, search=False)
+    assert sp["A_min"].dims == ("floor.period", "lam", "p")
+    one = rocksweep.run({**scene, "floor": {**scene["floor"], "period": 0.6}},
+                        output=tmp_path / "one.h5")
+    sp1 = rocksweep.spectra(one, rtol=0.05, search=False)
+    assert np.array_equal(sp["A_min"].sel({"floor.period": 0.6}).values,
+                          sp1["A_min"].values, equal_nan=True)
+    assert rocksweep.plot(sp) is not None
