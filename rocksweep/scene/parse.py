@@ -673,9 +673,9 @@ def _scale(ground: dict) -> tuple[str | None, str, Any, float, float]:
             raise SceneError(f"{key}.factor = {fmt(f)}: {KEYS[key + '.factor'].allowed}")
         return None, "", None, math.nan, as_float(f)
     for k in v:
-        if k not in ("im", "values", "period"):
-            raise SceneError(f"{key}.{k}: unknown key (allowed: im, values, period; or "
-                             "factor alone)")
+        if k not in ("im", "values", "period", "component"):
+            raise SceneError(f"{key}.{k}: unknown key (allowed: im, values, period, "
+                             "component; or factor alone)")
     im = v.get("im")
     if isinstance(im, str) and RECORD_IMS.get(im, ("", "", 1))[2] == 0:
         raise SceneError(f"{key}.im = {im}: does not change when a record is scaled, so no "

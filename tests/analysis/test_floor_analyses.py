@@ -107,3 +107,14 @@ def test_a_min_floor_spectrum_of_one_record(tmp_path):
             lo = A[first - 1] if first > 0 else 0.0
             assert lo <= fs["A_min"].values[j] <= A[first]
     assert rocksweep.plot(fs) is not None
+
+
+def test_ida_table_and_plot_run_over_angle_and_floor_period(suite_on_floors):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ida = rocksweep.ida(suite_on_floors)
+        assert {"angle", "floor.period", "record"} <= set(ida["ida_im"].dims)
+        table = rocksweep.table(suite_on_floors)
+        assert {"angle", "floor.period", "floor_pfa"} <= set(table.columns)
+        assert len(table) == suite_on_floors["outcome"].size
+        assert rocksweep.plot(suite_on_floors) is not None
