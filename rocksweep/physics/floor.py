@@ -23,11 +23,13 @@ and the floor's absolute acceleration is
 
 For a piecewise-linear ground (a record, ``physics.records``) y_i and y_i' are exact at
 every sample: the Nigam-Jennings recurrence of the response spectra
-(``intensity.nj_response``, the one implementation). Between samples a_f is smooth, not
-linear, while the kernel interpolates a record linearly; so the ground is first refined
-(exactly: it is linear between samples) to h = DT / m, m = min(ceil(POINTS_PER_PERIOD DT /
-T_min), MAX_REFINE), at least POINTS_PER_PERIOD = 32 samples per period of the stiffest
-mode: linear interpolation then misses a_f's peaks by at most 1 - cos(pi / 32) = 0.5%.
+(``intensity.nj_response``, the one implementation). The floor motion is a record like any
+other, linear between its samples, at the ground's own samples (a floor record written by
+hand from the same building at the same samples, e.g. by ``scipy.signal.lsim``, runs the
+same), unless the stiffest mode's period spans fewer than POINTS_PER_PERIOD = 16 of them:
+then the ground is refined (exactly: it is linear between samples) to h = DT / m, m =
+min(ceil(POINTS_PER_PERIOD DT / T_min), MAX_REFINE), so that linear interpolation misses
+a_f's peaks by at most 1 - cos(pi / 16) = 1.9%.
 
 Ring-down: after the record the ground is at rest, but the building keeps vibrating. The
 floor motion goes on as the modes' free vibration (closed form, ``intensity.
@@ -57,9 +59,9 @@ import numpy as np
 from rocksweep.physics.intensity import free_vibration, nj_response, refined
 from rocksweep.physics.records import GroundRecord
 
-#: samples per period of the stiffest mode (the floor motion's linear interpolation is
-#: then within 1 - cos(pi / 32) = 0.5% of its peaks)
-POINTS_PER_PERIOD = 32
+#: fewest samples per period of the stiffest mode (the floor motion's linear
+#: interpolation is then within 1 - cos(pi / 16) = 1.9% of its peaks)
+POINTS_PER_PERIOD = 16
 #: most sub-steps per record sample (a mode much stiffer than DT: 64 per sample)
 MAX_REFINE = 64
 #: the ring-down stops where the floor's free vibration stays below this share of its peak
