@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from rocksweep.analysis.bisection import bisect_thresholds
 from rocksweep.analysis.tolerance import DEFAULT_RTOL, MAX_RTOL, check_rtol
 from rocksweep.compute.adaptive import DIAGRAM_AXES, AdaptiveError, make_plan
 from rocksweep.compute.dispatch import run_variant
@@ -529,23 +530,19 @@ def a_min(scene: Scene, outcome: np.ndarray, rtol: float = DEFAULT_RTOL,
         elif math.isnan(c.lo[j]):
             c.method[j] = A_MIN_METHODS.index("first grid value")
     todo = [col for col in cols if not math.isnan(col.curve.lo[col.j])]
-    while True:
-        active = [col for col in todo if col.curve.hi[col.j] - col.curve.lo[col.j]
-                  > rtol * abs(col.curve.hi[col.j])]
-        mids = [0.5 * (col.curve.lo[col.j] + col.curve.hi[col.j]) for col in active]
-        # float64 cannot split the bracket any further: done to its resolution
-        live = [(col, m) for col, m in zip(active, mids, strict=True)
-                if col.curve.lo[col.j] < m < col.curve.hi[col.j]]
-        if not live:
-            break
-        cls = evaluate([col.point(scene, axes[1], m) for col, m in live])
-        for (col, m), k in zip(live, cls, strict=True):
-            c, j = col.curve, col.j
-            c.runs[j] += 1
-            if int(k) in target:
-                c.hi[j], c.mode[j] = m, k
-            else:
-                c.lo[j] = m
+    lo, hi = (np.array([getattr(col.curve, e)[col.j] for col in todo], float)
+              for e in ("lo", "hi"))
+    modes = np.array([col.curve.mode[col.j] for col in todo], np.int64)
+
+    def classify(idx: np.ndarray, mids: np.ndarray) -> np.ndarray:
+        return evaluate([todo[i].point(scene, axes[1], m)
+                         for i, m in zip(idx, mids, strict=True)])
+
+    runs, _ = bisect_thresholds(lo, hi, modes, rtol, classify, target)
+    for q, col in enumerate(todo):
+        c, j = col.curve, col.j
+        c.lo[j], c.hi[j], c.mode[j] = lo[q], hi[q], modes[q]
+        c.runs[j] += runs[q]
     for c in curves:
         c.a_min[:] = c.hi
         c.mode[np.isnan(c.hi)] = 0
@@ -759,7 +756,7 @@ def check_search(search: Any) -> bool:
     ApiError."""
     from rocksweep.errors import ApiError
 
-    if not (isinstance(search, bool) or type(search).__name__ == "bool_"):
+    if not isinstance(search, bool | np.bool_):
         raise ApiError(f"search = {search!r}: must be True or False")
     return bool(search)
 

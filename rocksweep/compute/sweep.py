@@ -234,7 +234,7 @@ def _run_on_cluster(grid: Grid, chunks: list[tuple[int, int]], level: int,
     worker for ``NO_WORKERS_TIMEOUT`` seconds (none joined, or all left) is a
     ``SweepError``; the caller saves what finished.
     """
-    from distributed import Client, wait
+    from distributed import Client, KilledWorker, wait
     from distributed.client import FIRST_COMPLETED
 
     with Client(scheduler, timeout="10s") as client:
@@ -282,13 +282,11 @@ def _run_on_cluster(grid: Grid, chunks: list[tuple[int, int]], level: int,
                 except TimeoutError:
                     running[f] = (a, b)
                     continue
-                except Exception as err:
-                    if type(err).__name__ == "KilledWorker":
-                        raise SweepError(
-                            f"dask cluster {scheduler}: the chunk of points {a}..{b - 1} "
-                            "killed the workers that ran it (out of memory?); finished "
-                            "points are saved: rerun with --resume") from None
-                    raise
+                except KilledWorker:
+                    raise SweepError(
+                        f"dask cluster {scheduler}: the chunk of points {a}..{b - 1} "
+                        "killed the workers that ran it (out of memory?); finished "
+                        "points are saved: rerun with --resume") from None
                 submit(1)
                 yield res
 
