@@ -357,9 +357,11 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     from rocksweep.analysis.floors import by_orientation
     from rocksweep.analysis.fragility import fragility as fit
 
-    # with an angle axis: every orientation a sample, and the worst per record
-    return by_orientation(_dataset_arg(ds, "ds"), lambda d: fit(
-        d, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci))
+    ds = _dataset_arg(ds, "ds")
+    if "angle" in getattr(ds, "dims", ()):  # every orientation a sample, and the worst
+        return by_orientation(ds, lambda d: fit(
+            d, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci))
+    return fit(ds, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci)
 
 
 @_public
