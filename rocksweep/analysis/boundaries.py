@@ -309,8 +309,8 @@ def kernel_rows(scene: Scene, points: list[Point]) -> np.ndarray:
     # body object and the pulse's options filled at once (``fill_rows``)
     groups: dict[tuple, list[int]] = {}
     for i, p in enumerate(points):
-        key = (kernel_kind(p.body), p.ground, id(p.record), id(p.body), p.cycles, p.gamma,
-               p.nu)
+        key = (kernel_kind(p.body), p.ground, id(p.record), id(p.vertical), id(p.body),
+               p.cycles, p.gamma, p.nu)
         groups.setdefault(key, []).append(i)
     for (kind, ground, *_), idx in groups.items():
         warm_up(kind, L.LEVEL_OUTCOME, ground)
@@ -332,14 +332,19 @@ def _rows(points: list[Point], numerics: Numerics) -> np.ndarray:
     def column(name: str) -> np.ndarray:
         return np.array([getattr(p, name) for p in points], float)
 
+    vertical = p0.vertical_on_samples() if rec is not None else None
+    pv = None
+    if p0.pulse_vertical is not None:  # the vertical harmonic's keys, point by point
+        pv = tuple(np.array([getattr(p.pulse_vertical, k) for p in points], float)
+                   for k in ("amplitude", "w_over_p", "phase"))
     fill_rows(rows, np.broadcast_to(body_row(body), (n, L.N_PAR)),
               np.full(n, body_omega_rock(body)), np.full(n, body.alpha_ref), column("lam"),
               np.array([shape_code(p.shape) for p in points]),
               column("p") if rec is not None else column("w_over_p"), column("A_ratio"),
               numerics, p0.cycles, p0.gamma, p0.nu, rec, column("mu"),
               np.array([law_code(p.law) for p in points]), column("e"),
-              column("e_factor"))
-    return with_record(rows, rec)
+              column("e_factor"), vertical=vertical, pulse_vertical=pv)
+    return with_record(rows, rec, vertical)
 
 
 def kernel_evaluator(scene: Scene) -> Evaluator:

@@ -14,6 +14,7 @@ from typing import Any
 
 from rocksweep.vocab.kinds import (
     BOUNDARIES,
+    CALIBRATION,
     FLOOR_SPECTRUM,
     FRAGILITY,
     IDA,
@@ -33,6 +34,7 @@ SIGNATURES: tuple[tuple[str, tuple[str, ...]], ...] = (
     (FRAGILITY, ("im_median", "beta")),
     (FRAGILITY, ("median", "beta")),
     (IDA, ("ida_im",)),
+    (CALIBRATION, ("estimate", "measured_theta")),
     (FLOOR_SPECTRUM, ("p_overturn", "n_counted")),
     (SWEEP, ("outcome", "status")),
     (SPECTRA, ("A_min", "theta_max_over_alpha", "outcome")),

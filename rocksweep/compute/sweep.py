@@ -97,19 +97,23 @@ def run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene,
     to the scene's ``numerics.refine`` refinements)."""
     refine = scene.numerics.refine if certify else 0
     outs = np.empty((rows.shape[0], L.N_OUT))
+    vertical = scene.vertical_samples()  # a record's vertical component rides along
     for kind in np.unique(cr.kinds):
         sel = cr.kinds == kind
         if cr.records is not None:  # one record at a time, its samples shared
             for r in np.unique(cr.record_index[sel]):
                 part = sel & (cr.record_index == r)
-                outs[part] = run_variant(rows[part], int(kind), level, scene.ground, refine,
-                                         record=cr.records[int(r)])
+                outs[part] = run_variant(
+                    rows[part], int(kind), level, scene.ground, refine,
+                    record=cr.records[int(r)],
+                    vertical=None if cr.verticals is None else cr.verticals[int(r)])
         elif sel.all():
             run_variant(rows, int(kind), level, scene.ground, refine, record=scene.record,
-                        out=outs)
+                        out=outs, vertical=vertical)
         else:
             outs[sel] = run_variant(np.ascontiguousarray(rows[sel]), int(kind), level,
-                                    scene.ground, refine, record=scene.record)
+                                    scene.ground, refine, record=scene.record,
+                                    vertical=vertical)
     return outs
 
 

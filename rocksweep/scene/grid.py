@@ -28,6 +28,7 @@ from rocksweep.physics.points import (
     shape_code,
 )
 from rocksweep.scene.model import FLOOR_AXES, Scene
+from rocksweep.schema import VERTICAL_KEYS
 from rocksweep.vocab.ground import RECORD
 
 
@@ -52,6 +53,8 @@ class ChunkRows:
     # the records the points run, indexed by ``record_index`` (a suite's records, or the
     # motions of an excitation path, ``physics.path``), None otherwise
     records: tuple | None = None
+    # each of ``records``' vertical component on its samples [g] (None: none)
+    verticals: tuple | None = None
 
 
 @dataclass
@@ -108,6 +111,10 @@ class Grid:
                           [names.index(k) for k in ("record", "angle", *FLOOR_AXES)
                            if k in names]
                           + ([] if scene.recorded else [self._i_shape, self._i_w]))
+        # a pulse's vertical harmonic (pulse.vertical: amplitude, w_over_p, phase), or None
+        self._i_vert = ([names.index(f"vertical.{k}") for k in VERTICAL_KEYS]
+                        if "vertical.amplitude" in names else None)
+        self._vertical = scene.vertical_samples()  # a record's vertical component, or None
         self._values = [np.asarray(a.values, float)
                         if i not in (self._i_shape, self._i_rec, self._i_law) else None
                         for i, a in enumerate(scene.axes)]
@@ -185,7 +192,9 @@ class Grid:
                   self.scene.option("cycles"), self.scene.option("gamma"),
                   self.scene.option("nu"), self.scene.record,
                   np.nan if self._i_mu is None else self._values[self._i_mu][multi[self._i_mu]],
-                  law, e, e_factor, initial, u_cr)
+                  law, e, e_factor, initial, u_cr, self._vertical,
+                  None if self._i_vert is None else
+                  tuple(self._values[i][multi[i]] for i in self._i_vert))
         return ChunkRows(rows, b_kind[inverse], alpha_ref, b_E[inverse])
 
     def _suite_rows(self, multi, rows, body_rows, omega_rock, alpha_ref, kinds, E_ref,
@@ -254,6 +263,8 @@ class Grid:
             initial = tuple(np.broadcast_to(np.asarray(v, float), lam.shape) for v in initial)
         u_cr = np.broadcast_to(np.asarray(u_cr, float), lam.shape)
         code = np.full(n, shape_code(RECORD))
+        # a record's vertical reaches the floor unfiltered: on each motion's samples
+        verticals = tuple(sc.path_vertical(m) for m in motions)
         for j, motion in enumerate(motions):
             sel = inv == j
             part = np.empty((int(sel.sum()), L.N_PAR))
@@ -261,9 +272,9 @@ class Grid:
                       code[sel], p[sel], a_ratio[sel], sc.numerics, record=motion,
                       mu=mu[sel], law=law[sel], e=e[sel], e_factor=e_factor[sel],
                       initial=None if initial is None else tuple(v[sel] for v in initial),
-                      u_cr=u_cr[sel])
+                      u_cr=u_cr[sel], vertical=verticals[j])
             rows[sel] = part
-        return ChunkRows(rows, kinds, alpha_ref, E_ref, inv, tuple(motions))
+        return ChunkRows(rows, kinds, alpha_ref, E_ref, inv, tuple(motions), verticals)
 
     def kinds(self) -> list[int]:
         """The kernel kinds the grid's bodies need (each distinct body visited once)."""
