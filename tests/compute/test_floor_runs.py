@@ -134,3 +134,25 @@ def test_spectra_run_over_the_new_axes(tmp_path):
     assert np.array_equal(sp["A_min"].sel({"floor.period": 0.6}).values,
                           sp1["A_min"].values, equal_nan=True)
     assert rocksweep.plot(sp) is not None
+
+
+def test_the_vertical_reaches_the_floor_unfiltered(tmp_path):
+    """ground.vertical with a floor: the run equals the run on the lsim floor record with
+    the same vertical component (resampled onto its samples, at rest after its end)."""
+    rec = read_record(NEARFAULT)
+    write_at2(tmp_path / "up.AT2", 0.4 * np.roll(rec.acc, 200), rec.dt, "vertical")
+    t = np.arange(rec.npts + int(40.0 / rec.dt)) * rec.dt
+    ground = np.interp(t, rec.times(), rec.acc, right=0.0)
+    peak = lsim_floor_record(t, ground, tmp_path / "floor.txt")
+    up = str(tmp_path / "up.AT2")
+    on_floor = rocksweep.simulate({"body": BLOCK, "ground": {
+        "record": str(NEARFAULT), "vertical": up, "A_ratio": 1.5, "p": 2.0},
+        "floor": {"period": T, "damping": ZETA, "participation": GP}})
+    given = rocksweep.simulate({"body": BLOCK, "ground": {
+        "record": str(tmp_path / "floor.txt"), "vertical": up,
+        "A_ratio": 1.5 * peak / rec.pga, "p": 2.0}})
+    same_run(on_floor, given)
+    without = rocksweep.simulate({"body": BLOCK, "ground": {
+        "record": str(NEARFAULT), "A_ratio": 1.5, "p": 2.0},
+        "floor": {"period": T, "damping": ZETA, "participation": GP}})
+    assert without.summary["theta_max_over_alpha"] != on_floor.summary["theta_max_over_alpha"]
