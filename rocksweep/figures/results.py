@@ -15,7 +15,7 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.figures import WIDTHS
-from rocksweep.figures.common import Figure
+from rocksweep.figures.common import Figure, curve_colours
 from rocksweep.vocab.axes import alpha_latex, latex
 from rocksweep.vocab.axes import label as axis_label
 
@@ -69,8 +69,10 @@ def risk_figure(rk: xr.Dataset, *, ax: Any = None, width: str | None = "double")
     a0.set_ylabel("annual rate of exceedance [1/yr]")
     a0.set_title("hazard", fontsize="small")
     grid = rk["im_level"].values
-    for k, (label, sel, p) in enumerate(_curves(rk["fragility"], "im_level")):
-        c = f"C{k % 10}"
+    curves = list(_curves(rk["fragility"], "im_level"))
+    colours = curve_colours(len(curves))
+    for k, (label, sel, p) in enumerate(curves):
+        c = colours[k]
         rate = float(rk["annual_rate"].isel(sel))
         prob = float(rk["probability"].isel(sel))
         if len(axes) > 1:
@@ -181,6 +183,11 @@ def spectra_dataset_figure(sp: xr.Dataset, *, ax: Any = None,
                          label=f"${latex('A_ratio', kind)}$ = {sp['A_ratio'].values[ai]:.3g}"
                          if li == 0 else None)
     axes[0].set_yscale("log")
+    top = float(np.nanmax(np.where(th.values > 0, th.values, np.nan))) if np.any(
+        th.values > 0) else 1.0
+    # below 1e-3 of the largest rotation there is nothing to read: the log axis would
+    # otherwise reach down to a barely lifted body's 1e-6 and squash the curves
+    axes[0].set_ylim(bottom=max(axes[0].get_ylim()[0], 1e-3 * top))
     axes[0].set_xlabel(axis_label(freq, kind))
     axes[0].set_ylabel(rf"max|$\theta$|/${alpha_latex(kind)}$")
     axes[0].set_title("rocking spectrum (line style: lam)", fontsize="small")
