@@ -220,7 +220,7 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     (Figures 3 and 4; the options below), or the figure of a fragility (curves, stripe
     fractions sized by record count, bands, beta in the legend, IM on a log axis), IDA,
     spectra, risk (hazard, fragility, the rate's integrand) or IM-efficiency Dataset
-    (``rocksweep.figures.dispatch``; ``ax`` and ``width`` apply to all). A record-suite
+    (``rocksweep.figures.by_kind``; ``ax`` and ``width`` apply to all). A record-suite
     sweep is drawn as its overturning fragility (stripe fractions and the fitted curve).
 
     ds: what ``run`` or ``open`` returns. x, y: the swept keys on the axes (default
@@ -236,7 +236,7 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     plot --compare``). A result with per-point error estimates rings the points whose
     outcome changes at half the step.
     """
-    from rocksweep.figures.dispatch import plot_any
+    from rocksweep.figures.by_kind import plot_any
 
     _check_dataset("ds", ds)
     _check_ax(ax)

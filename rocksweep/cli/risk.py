@@ -84,7 +84,7 @@ def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, sta
     certain tail above its largest IM is added), never extrapolated."""
     import rocksweep
     from rocksweep.analysis.kinds import dataset_kind
-    from rocksweep.figures.common import save_figure
+    from rocksweep.figures.style import save_figure
     from rocksweep.store.reader import result_inputs
 
     # the fragility or sweep file (and a sweep's records), the hazard curve: never written
