@@ -118,7 +118,8 @@ def by_orientation(ds, analysis: Callable[[Any], Any]):
 
 def _p_overturn(ds):
     """P(overturn) over records of a suite sweep Dataset: (p_overturn, n_counted)."""
-    from rocksweep.analysis.fragility import OVERTURN, counted_points, state_reached
+    from rocksweep.analysis.states import counted_points, state_reached
+    from rocksweep.vocab.outcomes import OVERTURN
 
     counted = counted_points(ds)[0]
     hit = state_reached(ds, OVERTURN) & counted

@@ -28,8 +28,9 @@ def spectra_figure(sp: xr.Dataset | Spectra, *, ax: Any = None,
     (``rocksweep.spectra``; a ``Spectra`` is drawn through its ``to_dataset``): the rocking
     spectrum (max|theta|/alpha_ref, one colour per A_ratio, one line style per lam,
     overturned points marked x above 1; other swept keys at their first value) and the
-    overturning spectrum (the smallest A_ratio that overturns, one curve per lam, mode 1 filled circles, mode 2 open triangles). ax:
-    two axes to draw into; width: a journal width (``figures.WIDTHS``)."""
+    overturning spectrum (the smallest A_ratio that overturns, one curve per lam, mode 1
+    filled circles, mode 2 open triangles). ax: two axes to draw into; width: a journal
+    width (``figures.WIDTHS``)."""
     if hasattr(sp, "to_dataset"):
         sp = sp.to_dataset()
     freq = sp["A_min"].dims[-1]
