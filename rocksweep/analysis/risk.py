@@ -288,6 +288,9 @@ def read_hazard(source: Any, *, site: int | None = None) -> Hazard:
     if lines[0].lstrip().startswith("#") and any(
             ln.replace(" ", "").startswith("lon,lat") for ln in lines[1:3]):
         return _openquake(text.lstrip("\n\r \t"), where, site)
+    if site is not None:  # one curve: a site to choose means another file was meant
+        raise RiskError(f"site = {site!r}: {where} is one hazard curve (IM, {RATE_COLUMN}); "
+                        "a site is chosen in OpenQuake's files of several sites")
     table = csv_table(text, where, RiskError, "hazard curve",
                       expect=f"'IM [unit],{RATE_COLUMN}'")
     rows = [f"{where}, line {ln}" for ln in table.lines]

@@ -56,9 +56,9 @@ def _g(v) -> str:
               help="N: the probability of at least one occurrence in N years.")
 @click.option("--site", type=click.IntRange(0), default=None,
               help="OpenQuake files with several sites: the row to use (0 = first).")
-@click.option("--state", default="overturn", show_default=True,
+@click.option("--state", default=None,
               help="When FRAG.h5 is a suite sweep, the states to fit first (as "
-                   "rocksweep fragility --state).")
+                   "rocksweep fragility --state; default overturn).")
 @click.option("-o", "--output", "out_path", type=click.Path(dir_okay=False, path_type=Path),
               help="The rates as CSV (.csv, one row per curve) or the whole risk Dataset "
                    "(.h5, .hdf5, .nc).")
@@ -71,7 +71,7 @@ def _g(v) -> str:
 @dpi_option
 @overwrite_option
 @user_errors
-def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, state: str,
+def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, state: str | None,
          out_path: Path | None, fig_path: Path | None, as_json: bool, width: str, dpi: int,
          overwrite: bool) -> None:
     """Mean annual rate lambda = integral P(state | im) |d lambda_im| of each state of a
@@ -92,8 +92,12 @@ def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, sta
 
     ds = rocksweep.open(frag_path)
     check_fragility(ds, shown(frag_path), suites=True)
+    if dataset_kind(ds) != "sweep" and state is not None:
+        raise click.ClickException(f"--state {state}: {frag_path} is a fitted fragility (its "
+                                   "states are fixed); --state applies to a record-suite "
+                                   "sweep")
     if dataset_kind(ds) == "sweep":
-        states = [s.strip() for s in state.split(",") if s.strip()]
+        states = [s.strip() for s in (state or "overturn").split(",") if s.strip()]
         ds = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states)
     rk = rocksweep.risk(ds, hazard_path, years, site=site)
     rows = risk_rows(rk)

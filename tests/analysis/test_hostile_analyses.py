@@ -157,6 +157,18 @@ def test_measured_csv_with_semicolons(tmp_path):
     one_line(err, "m.csv, line 1", "semicolons")
 
 
+def test_options_that_would_be_ignored_are_refused(tmp_path):
+    """A site for a one-curve hazard, p for a dimensionless history: said, not ignored."""
+    path = tmp_path / "h.csv"
+    path.write_text(HAZARD)
+    with pytest.raises(RiskError) as err:
+        read_hazard(path, site=0)
+    one_line(err, "site = 0", "h.csv")
+    with pytest.raises(CalibrationError) as err:
+        rocksweep.calibrate(BLOCK, history(), "impact.lam", p=3.0)
+    one_line(err, "p = 3.0", "p_t, theta_over_alpha")
+
+
 # --- the API's door --------------------------------------------------------------------------
 
 @pytest.mark.parametrize("call, words", [
