@@ -276,9 +276,9 @@ def read_hazard(source: Any, *, site: int | None = None) -> Hazard:
         return source
     if hasattr(source, "columns") and hasattr(source, "iloc"):
         return hazard_frame(source)
-    if not isinstance(source, str | Path):
-        raise RiskError(f"hazard = {type(source).__name__}: a CSV path or a pandas DataFrame "
-                        f"('IM [unit]', '{RATE_COLUMN}')")
+    if not isinstance(source, str | Path):  # a wrong type: a TypeError, as every argument's
+        raise TypeError(f"hazard = {type(source).__name__}: must be a CSV path or a pandas "
+                        f"DataFrame ('IM [unit]', '{RATE_COLUMN}')")
     path = Path(source)
     where = shown(path)
     text = read_text(path, "hazard curve", RiskError, max_bytes=MAX_HAZARD_BYTES)

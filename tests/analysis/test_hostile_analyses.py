@@ -182,6 +182,10 @@ def test_options_that_would_be_ignored_are_refused(tmp_path):
     (lambda: rocksweep.calibrate(BLOCK, history(), "impact.lam", p="3"), "p = '3'"),
     (lambda: rocksweep.risk(fragility(0.3, 0.4), power_law(), site=1.5), "site = 1.5"),
     (lambda: rocksweep.risk(fragility(0.3, 0.4), power_law(), site=True), "site = True"),
+    (lambda: rocksweep.risk(fragility(0.3, 0.4), 5), "hazard = int"),
+    (lambda: rocksweep.calibrate(BLOCK, history(), None), "fit = None"),
+    (lambda: rocksweep.calibrated_overrides(5), "fit = 5"),
+    (lambda: rocksweep.open(5), "path = 5"),
 ])
 def test_a_wrong_type_is_one_typeerror(call, words):
     with pytest.raises(TypeError) as err:
