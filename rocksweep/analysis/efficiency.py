@@ -133,7 +133,10 @@ def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
                               "rocksweep.open of a scene with ground.records)")
     out_da = ds["outcome"]
     if "record" not in out_da.dims:
-        raise EfficiencyError("outcome has no 'record' dimension: not a record-suite sweep")
+        where = ds.encoding.get("source")  # the file it was opened from, if any
+        raise EfficiencyError(f"{where + ': ' if where else ''}outcome has no 'record' "
+                              "dimension: not a record-suite sweep (a scene with ground.records: a "
+                              "list of record files, and ground.scale)")
     table = record_im_table(ds)
     if not table:
         raise EfficiencyError("the Dataset stores no per-record IMs (record_pga, ...)")

@@ -15,7 +15,7 @@ from rocksweep.cli.main import (
     set_option,
     user_errors,
 )
-from rocksweep.vocab.settings import DEFAULT_LADDER, LADDER_NAMES, LADDERS
+from rocksweep.vocab.settings import DEFAULT_LADDER, LADDER_HELP, LADDER_NAMES
 
 
 @main.command()
@@ -32,7 +32,7 @@ from rocksweep.vocab.settings import DEFAULT_LADDER, LADDER_NAMES, LADDERS
               type=click.Choice(LADDER_NAMES),  # = accuracy.LADDERS (tests/test_vocab.py)
               default=DEFAULT_LADDER, show_default=True,
               help="Kernel settings to measure: " + ", ".join(
-                  f"{k} ({v})" for k, v in LADDERS.items()) + ".")
+                  f"{k} ({v})" for k, v in LADDER_HELP.items()) + ".")
 @click.option("--seed", type=int, default=0, show_default=True, help="Sampling seed.")
 @click.option("--repeat", type=click.IntRange(min=1), default=5, show_default=True,
               help="Kernel timings are the best of this many rounds.")
@@ -71,7 +71,7 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
     if report_path is not None:
         check_output(report_path, overwrite=overwrite, inputs=scene.inputs)
     if plot_path is not None:
-        from rocksweep.figures.common import FORMATS
+        from rocksweep.figures import FORMATS
 
         check_output(plot_path, overwrite=overwrite, inputs=scene.inputs, suffixes=FORMATS)
 
@@ -102,7 +102,7 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
         click.echo(f"wrote {report_path}")
     if plot_path is not None:
         from rocksweep.figures.accuracy import work_precision
-        from rocksweep.figures.common import save_figure
+        from rocksweep.figures.style import save_figure
 
         save_figure(work_precision(study), plot_path, overwrite=overwrite, inputs=scene.inputs)
         click.echo(f"wrote {plot_path}")
