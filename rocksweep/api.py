@@ -137,8 +137,11 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
     while a sweep is still writing the file (no lock is taken). A file that is not a
     rocksweep file is a one-line ``RocksweepError``.
     """
+    import os
+
     from rocksweep.analysis.files import open_any
 
+    _typed("path", path, isinstance(path, str | os.PathLike), "a path (str or pathlib.Path)")
     return open_any(path)
 
 
@@ -486,6 +489,9 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     """
     from rocksweep.analysis.calibrate import calibrate_scene
 
+    _typed("fit", fit, isinstance(fit, str) or (
+        isinstance(fit, Sequence) and all(isinstance(k, str) for k in fit)),
+        "a dotted scene key (e.g. 'impact.lam') or a list of them")
     _typed("bounds", bounds, bounds is None or isinstance(bounds, Mapping),
            "a mapping {key: (lo, hi)}, e.g. {'impact.lam': (0, 1)}, or None")
     _typed("p", p, p is None or _is_number(p), "a number (the body's p [rad/s]) or None")
@@ -501,6 +507,12 @@ def calibrated_overrides(fit: xr.Dataset, which: str = "all") -> dict[str, Any]:
     at the estimate and at both ends of the interval: ``which="all"`` gives [lo, estimate,
     hi] per key (a swept dimension), "estimate", "lo" or "hi" one value.
     ``rocksweep.run(scene, overrides=rocksweep.calibrated_overrides(fit))``."""
+    import xarray as xr
+
     from rocksweep.analysis.calibrate import calibrated_overrides as overrides_of
 
+    _typed("fit", fit, isinstance(fit, xr.Dataset), "the Dataset rocksweep.calibrate returns")
+    if "parameter" not in fit.coords or "estimate" not in fit.variables:
+        raise ApiError("fit: not a calibration (no parameter and estimate; what "
+                       "rocksweep.calibrate returns)")
     return overrides_of(fit, which)

@@ -788,6 +788,10 @@ def calibrate_scene(scene: Any, measured: Any, fit: str | Sequence[str],
     values = {a.name: a.values[0] for a in scene.axes}
     body = scene.point(values).body
     m = read_measured(measured, p=p_body, alpha_ref=body.alpha_ref, u_cr=body.u_cr or None)
+    if p is not None and not m.physical:
+        raise CalibrationError(f"p = {p!r}: {m.source} has the dimensionless columns p_t, "
+                               "theta_over_alpha; p reads physical columns t [s], theta "
+                               "[rad] only (leave it out)")
     _check_measured_span(m, body.alpha_ref)
     return calibrate_problem(Problem(scene, m, keys, bounds, noise), ci)
 
