@@ -321,11 +321,14 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
     safe again (``resurrection``). ds: what ``run`` or ``open`` returns. Returns a Dataset
     over the other swept keys and ``record`` (``rocksweep.analysis.ida.ida``), with the
     stripes' ``theta_max_over_alpha`` of the points that did not overturn (the IDA
-    curves ``rocksweep.plot`` draws)."""
+    curves ``rocksweep.plot`` draws). A sweep over ``angle``: every (record, angle) is a
+    sample (``ida_im`` over angle), and ``ida_im_worst`` / ``worst_angle`` give each
+    record's worst orientation (the least IM that overturns it at any angle)."""
+    from rocksweep.analysis.floors import worst_ida
     from rocksweep.analysis.ida import ida_dataset
 
     _check_dataset("ds", ds)
-    return ida_dataset(ds, rtol)
+    return worst_ida(ida_dataset(ds, rtol))
 
 
 @_public

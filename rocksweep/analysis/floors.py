@@ -116,6 +116,26 @@ def by_orientation(ds, analysis: Callable[[Any], Any]):
     return out
 
 
+def worst_ida(ida):
+    """An IDA Dataset with, when it runs over ``angle``, each record's worst orientation:
+    ``ida_im_worst`` (the least ``ida_im`` over the angles: the IM that overturns the
+    record at some angle; NaN where no angle overturns) and ``worst_angle`` [deg]."""
+    import xarray as xr
+
+    if "angle" not in ida.get("ida_im", xr.DataArray()).dims:
+        return ida
+    im = ida["ida_im"]
+    found = im.notnull().any("angle")
+    idx = im.fillna(np.inf).argmin("angle")
+    ida["ida_im_worst"] = im.min("angle", skipna=True)
+    ida["ida_im_worst"].attrs = {**im.attrs, "long_name": "least IM that overturns the "
+                                 "record at any angle (its worst orientation)"}
+    ida["worst_angle"] = xr.where(found, ida["angle"].isel(angle=idx).drop_vars("angle"),
+                                  np.nan)
+    ida["worst_angle"].attrs = {"long_name": "worst orientation", "units": "degree"}
+    return ida
+
+
 def _p_overturn(ds):
     """P(overturn) over records of a suite sweep Dataset: (p_overturn, n_counted)."""
     from rocksweep.analysis.states import counted_points, state_reached

@@ -114,6 +114,9 @@ def test_ida_table_and_plot_run_over_angle_and_floor_period(suite_on_floors):
         warnings.simplefilter("ignore")
         ida = rocksweep.ida(suite_on_floors)
         assert {"angle", "floor.period", "record"} <= set(ida["ida_im"].dims)
+        worst = ida["ida_im"].min("angle")  # the least IM over the angles, by hand
+        assert np.array_equal(ida["ida_im_worst"].values, worst.values, equal_nan=True)
+        assert "angle" not in ida["worst_angle"].dims
         table = rocksweep.table(suite_on_floors)
         assert {"angle", "floor.period", "floor_pfa"} <= set(table.columns)
         assert len(table) == suite_on_floors["outcome"].size
