@@ -33,7 +33,7 @@ if TYPE_CHECKING:
 _MOVED = {name: module for module, names in {
     "rocksweep.compute.driver": ("WRITE_EVERY", "SweepInterrupted", "SweepReport"),
     "rocksweep.scene.inputs": ("load", "override_strings"),
-    "rocksweep.compute.history": ("MAX_RUNS", "API_MAX_RUNS", "simulate_runs",
+    "rocksweep.compute.history": ("MAX_RUNS", "API_MAX_RUNS", "run_points",
                                 "history_dataset", "swept_values", "write_history_csv"),
     "rocksweep.compute.adaptive": ("adaptive_options",),
     "rocksweep.compute.session": ("sweep_file",),

@@ -3,7 +3,7 @@
 ``KEYS`` maps every dotted scene key to a ``Key``: the kind of value it holds, the range
 of admissible numbers (ends, inclusive or not, +inf allowed or not) and the text a user
 reads when a value is refused. The scene validator (``rocksweep.scene.parse``) and the body
-classes (``rocksweep.physics.model``) both check values here, so a body built from Python and a
+classes (``rocksweep.physics.bodies``) both check values here, so a body built from Python and a
 scene file get the same one-line message ``KEY = VALUE: what is allowed``.
 
 Bounds of the body's Pi groups. Beside the physical ranges (angles in (0, pi/2), lam in
@@ -92,7 +92,7 @@ KEYS: dict[str, Key] = {
     "body.inertia": Key("axis", f"must be in [1, {RATIO_MAX:g}] (I_O / (M R^2) >= 1)",
                         1.0, RATIO_MAX, required=False, default=4.0 / 3.0),
     # a body from the laboratory's numbers (body.kind physical): converted to the Pi groups
-    # above and p (rocksweep.physics.model.body_from_geometry)
+    # above and p (rocksweep.physics.bodies.body_from_geometry)
     "body.b": Key("number", "must be > 0 and finite (half-width of the base [m])", 0.0,
                   math.inf, lo_in=False, hi_in=False),
     "body.h": Key("number", "must be > 0 and finite (height of the top mass [m])", 0.0,

@@ -8,7 +8,7 @@ mapping), and as a body. ``table3(...)`` is FIG3 with some Pi groups changed.
 
 from __future__ import annotations
 
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 
 SHARED = {"zeta": 0.05, "alpha_cg": 0.15, "alpha_A": 0.28, "mA_over_m": 0.47,
           "IA_ratio": 0.56}

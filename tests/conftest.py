@@ -7,7 +7,7 @@ import pytest
 from bodies import BODY2, BODY3, BODY4, FIG3
 from click.testing import CliRunner
 
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 
 
 @pytest.fixture(scope="session")

@@ -16,7 +16,7 @@ PKG = Path(__file__).resolve().parents[1] / "rocksweep"
 # not user errors: click's usage and input errors of the CLI (how it says them), the YAML
 # loader's internal signal, the driver's interrupt (a KeyboardInterrupt carrying what was
 # saved)
-NOT_ERRORS = {"OneLineUsageError", "InputError", "_YamlError", "SweepInterrupted"}
+NOT_ERRORS = {"OneLineUsageError", "InputError", "YamlError", "SweepInterrupted"}
 
 
 def _bases(node: ast.ClassDef) -> list[str]:

@@ -68,8 +68,8 @@ from rocksweep.errors import CalibrationError, RocksweepError  # noqa: F401 (Cal
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import point_kernel, warm_up
 from rocksweep.numerics import Numerics, step_budget
+from rocksweep.physics.bodies import BodyError
 from rocksweep.physics.measured import Measured, noise_level, read_measured
-from rocksweep.physics.model import BodyError
 from rocksweep.physics.points import INITIAL, kernel_kind, point_row
 from rocksweep.schema import KEYS, fmt
 
@@ -321,7 +321,7 @@ class Problem:
             values[name] = float(v)
         return self.scene.point(values)
 
-    def simulate(self, x: np.ndarray) -> tuple[np.ndarray, dict] | None:
+    def run_candidate(self, x: np.ndarray) -> tuple[np.ndarray, dict] | None:
         """(result row, raw history columns) of a candidate; None if the candidate's body
         is not physical."""
         try:
@@ -373,7 +373,7 @@ class Problem:
     def _run(self, x: np.ndarray) -> tuple | None:
         """A candidate's simulated history at the measured times, its shift, excursions,
         impacts (measured time) and result row; None for a body that is not physical."""
-        got = self.simulate(x)
+        got = self.run_candidate(x)
         if got is None:
             return None
         out, h = got

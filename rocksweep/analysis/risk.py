@@ -57,7 +57,7 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.errors import RiskError, RocksweepError  # noqa: F401 (re-exported)
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 from rocksweep.vocab.ground import ARIAS, AVGSA, CAV, PGA, PGV, SA, SCALE_IMS
 
 __all__ = ["Hazard", "RiskError", "fragility_median", "hazard_frame", "read_hazard",

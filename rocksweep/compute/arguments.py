@@ -1,7 +1,8 @@
 """The arguments of a sweep, checked in one place before anything touches an output.
 
-``rocksweep sweep`` (``rocksweep.cli.sweep``), ``rocksweep.run`` and the driver they share
-(``rocksweep.api.sweep_file``) call ``check_sweep_arguments`` first: an argument that cannot
+``rocksweep sweep`` (``rocksweep.cli.sweep``) and ``rocksweep.run``
+(``rocksweep.compute.session``) call ``check_sweep_arguments`` once, first, and hand its
+``SweepArguments`` down: an argument that cannot
 be used is refused with one line while the output file is still as it was (an existing
 result is neither removed nor changed, no new file appears). A wrong type is a
 ``TypeError`` naming the argument (as Python users expect); a value out of range is a
@@ -18,7 +19,9 @@ import math
 import numbers
 import os
 import socket
+import sys
 import time
+from dataclasses import dataclass
 from typing import Any
 from urllib.parse import urlsplit
 
@@ -34,7 +37,8 @@ MAX_CONNECT_TIMEOUT = 3600.0
 
 def check_flag(name: str, v: Any) -> bool:
     """``v`` if it is a bool (numpy's too), else a TypeError naming ``name``."""
-    if isinstance(v, bool) or type(v).__name__ == "bool_":
+    np = sys.modules.get("numpy")  # a numpy bool exists only once numpy is loaded
+    if isinstance(v, bool) or (np is not None and isinstance(v, np.bool_)):
         return bool(v)
     raise TypeError(f"{name} = {v!r}: must be True or False")
 
@@ -73,14 +77,33 @@ def check_seconds(name: str, seconds: Any, *, lo: float = 0.0, hi: float = math.
     return s
 
 
+@dataclass(frozen=True)
+class SweepArguments:
+    """A sweep's arguments that decide nothing about the scene, checked once
+    (``check_sweep_arguments``) and handed down (``compute.session.sweep``): jobs as
+    given (-1: one per core) and n_workers, the local threads it means (1 for dask);
+    the others as ``sweep_file`` documents them."""
+
+    jobs: int = 1
+    n_workers: int = 1
+    resume: bool = False
+    overwrite: bool = False
+    validate: bool = False
+    backend: str = "threads"
+    scheduler: str | None = None
+    chunk_size: int | None = None
+    write_every: float = 1.0
+    connect_timeout: float = CONNECT_TIMEOUT
+
+
 def check_sweep_arguments(*, jobs: Any = 1, resume: Any = False, overwrite: Any = False,
-                          validate: Any = False, adaptive: Any = None,
-                          backend: Any = "threads", scheduler: Any = None,
-                          chunk_size: Any = None, write_every: Any = 1.0,
-                          connect_timeout: Any = CONNECT_TIMEOUT,
-                          cli: bool = False) -> int:
-    """Check every argument of a sweep that decides nothing about the scene; return the
-    number of local worker threads (1 for dask). Raises before any file is touched.
+                          validate: Any = False, backend: Any = "threads",
+                          scheduler: Any = None, chunk_size: Any = None,
+                          write_every: Any = 1.0, connect_timeout: Any = CONNECT_TIMEOUT,
+                          cli: bool = False) -> SweepArguments:
+    """Check every argument of a sweep that decides nothing about the scene; return them
+    as ``SweepArguments``. Raises before any file is touched. (Whether ``validate`` has
+    an adaptive sweep to check depends on the scene: ``compute.session.sweep`` asks.)
 
     cli: name the options as the command line spells them (``--jobs 0``), else as
     keywords (``jobs = 0``)."""
@@ -93,22 +116,24 @@ def check_sweep_arguments(*, jobs: Any = 1, resume: Any = False, overwrite: Any 
     if resume and overwrite:
         raise SweepError("resume and overwrite exclude each other" if not cli else
                          "--resume and --overwrite exclude each other")
-    if validate and adaptive is None:
-        raise SweepError("validate=True checks an adaptive sweep; add adaptive=True" if not cli
-                         else "--validate checks an adaptive sweep; add --adaptive")
-    check_seconds(n("write_every"), write_every,
-                  what="0: write every chunk as it finishes")
+    write_every = check_seconds(n("write_every"), write_every,
+                                what="0: write every chunk as it finishes")
     if chunk_size is not None:
         if not is_integer(chunk_size):
             raise TypeError(f"{n('chunk_size')} {chunk_size!r}: must be an integer >= 1")
         if chunk_size < 1:
             raise SweepError(f"{n('chunk_size')} {chunk_size}: must be >= 1")
-    check_seconds(n("connect_timeout"), connect_timeout, lo=0.1, hi=MAX_CONNECT_TIMEOUT)
+    connect_timeout = check_seconds(n("connect_timeout"), connect_timeout, lo=0.1,
+                                    hi=MAX_CONNECT_TIMEOUT)
+    checked = {"resume": resume, "overwrite": overwrite, "validate": validate,
+               "backend": backend, "chunk_size": chunk_size, "write_every": write_every,
+               "connect_timeout": connect_timeout}
     if backend == "threads":
         if scheduler:
             raise SweepError("a scheduler address works with backend='dask' only" if not cli
                              else "--scheduler works with --backend dask only")
-        return check_jobs(jobs, n("jobs"))
+        n_workers = check_jobs(jobs, n("jobs"))
+        return SweepArguments(jobs=int(jobs), n_workers=n_workers, **checked)
     if backend == "dask":
         if not (isinstance(scheduler, str) and scheduler.strip()):
             if scheduler is not None and not isinstance(scheduler, str):
@@ -119,7 +144,7 @@ def check_sweep_arguments(*, jobs: Any = 1, resume: Any = False, overwrite: Any 
         if any(ord(c) < 32 for c in scheduler):
             raise SweepError(f"scheduler {scheduler!r}: control characters in the address")
         _address_parts(scheduler)
-        return 1
+        return SweepArguments(jobs=1, n_workers=1, scheduler=scheduler, **checked)
     raise SweepError(f"backend = {backend!r}: must be threads or dask")
 
 

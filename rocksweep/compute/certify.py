@@ -20,7 +20,7 @@ the last refinement also STATUS_UNCERTIFIED (flagged: not a reliable classificat
 Its steps and event_steps count every run it took. The same rule runs wherever rows meet
 the kernel, through the one dispatch (``compute.dispatch.run_variant``): sweeps
 (``compute.sweep.run_rows``), adaptive sweeps (through the sweep's chunks), the A_min
-searches (``analysis.boundaries.kernel_rows``), single runs (``compute.single.simulate``)
+searches (``analysis.boundaries.kernel_rows``), single runs (``compute.single.run_point``)
 and the accuracy study (``analysis.accuracy.run_kernel``).
 """
 

@@ -38,7 +38,7 @@ from rocksweep.compute.arguments import (  # noqa: F401 (re-exported)
     check_jobs,
     probe_scheduler,
 )
-from rocksweep.compute.dispatch import _run_record, run_variant  # noqa: F401 (re-exported)
+from rocksweep.compute.dispatch import run_variant
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.scene.grid import ChunkResult, ChunkRows, Grid
 from rocksweep.scene.model import Scene

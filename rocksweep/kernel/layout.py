@@ -4,7 +4,7 @@ Numba reads module-level ints as compile-time constants, so these cost nothing i
 The kernel takes one parameter row per point (``PAR_*``) and fills one result row
 (``OUT_*``; the loop keeps its event counters there as it runs); single runs also fill a history
 buffer (``HIST_*`` columns). Inside the loop the state is a 6-tuple (``Y_*`` slots). All
-quantities are SI with m = 1 kg, g = 9.81 m/s^2 and p = 1 rad/s (see ``rocksweep.physics.model``),
+quantities are SI with m = 1 kg, g = 9.81 m/s^2 and p = 1 rad/s (see ``rocksweep.physics.bodies``),
 so times are p*t.
 """
 

@@ -21,7 +21,7 @@ from rocksweep.numerics import (
     step_budget,
     step_sizes,
 )
-from rocksweep.physics.model import Body, FlexibleBody, G
+from rocksweep.physics.bodies import Body, FlexibleBody, G
 from rocksweep.physics.records import GroundRecord
 from rocksweep.vocab.axes import INITIAL  # noqa: F401
 from rocksweep.vocab.ground import (  # noqa: F401

@@ -36,7 +36,7 @@ M g b, means a crossing was stepped over; it is then located on the dense output
 the previous extremum and that one. theta_max is the largest |theta| over the maxima of
 s*theta (located, not sampled) and the phase ends.
 
-Times are p*t (p = 1 rad/s), angles in rad, SI units with m = 1 kg (``rocksweep.physics.model``).
+Times are p*t (p = 1 rad/s), angles in rad, SI units with m = 1 kg (``rocksweep.physics.bodies``).
 """
 
 from __future__ import annotations

@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rocksweep.errors import SuiteError  # noqa: F401 (defined there; re-exported)
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 from rocksweep.physics.records import GroundRecord
 from rocksweep.vocab.ground import (  # noqa: F401
     ARIAS,

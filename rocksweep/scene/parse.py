@@ -28,7 +28,7 @@ import numpy as np
 
 from rocksweep.numerics import Numerics
 from rocksweep.outputs import input_problem, is_input, shown
-from rocksweep.physics.model import BodyError, body_from_geometry
+from rocksweep.physics.bodies import BodyError, body_from_geometry
 from rocksweep.physics.points import FREE, INITIAL, RECORD
 from rocksweep.physics.records import GroundRecord, RecordError, read_record
 from rocksweep.physics.suite import (
@@ -40,8 +40,8 @@ from rocksweep.physics.suite import (
     SuiteError,
     make_suite,
 )
-from rocksweep.scene.admission import _candidate_bodies, _check_cost
-from rocksweep.scene.loader import _CONTROL, _load_yaml, _YamlError
+from rocksweep.scene.admission import candidate_bodies, check_cost
+from rocksweep.scene.loader import CONTROL_CHARS, YamlError, load_yaml
 from rocksweep.scene.model import Axis, Scene, SceneError
 from rocksweep.schema import (
     BODY_KEYS,
@@ -84,8 +84,8 @@ def apply_overrides(raw: dict, overrides: list[str]) -> dict:
         if not all(parts):
             raise SceneError(f"--set {item!r}: expected KEY=VALUE, e.g. pulse.A_ratio=4.5")
         try:
-            value = _load_yaml(text)
-        except _YamlError as err:
+            value = load_yaml(text)
+        except YamlError as err:
             raise SceneError(f"--set {key}: value {fmt(text)} is not valid YAML "
                              f"({err})") from None
         node = raw
@@ -452,7 +452,7 @@ def _listing(path: Path, shown_as: str) -> list[tuple[int, str]]:
         raise SceneError(f"{key}: {shown_as}: not a text listing of record paths (byte "
                          f"{err.start} is not UTF-8); a listing is UTF-8 text, one record "
                          "path a line") from None
-    bad = _CONTROL.search(text.replace("\r", ""))
+    bad = CONTROL_CHARS.search(text.replace("\r", ""))
     if bad is not None:
         line = text.count("\n", 0, bad.start()) + 1
         raise SceneError(f"{key}: {shown_as}, line {line}: character {ord(bad.group()):#04x} "
@@ -721,8 +721,8 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
 def _document(text: str, overrides: list[str]) -> dict:
     """The scene's YAML mapping, overrides applied, its top-level keys checked."""
     try:
-        raw = _load_yaml(text)
-    except _YamlError as err:
+        raw = load_yaml(text)
+    except YamlError as err:
         raise SceneError(f"YAML {err}") from None
     if raw is None:
         raw = {}
@@ -741,7 +741,7 @@ def _name(raw: dict) -> str | None:
     name = raw.get("name")
     if name is not None and not isinstance(name, str):
         raise SceneError(f"name = {fmt(name)}: {KEYS['name'].allowed}")
-    if name is not None and _CONTROL.search(name):
+    if name is not None and CONTROL_CHARS.search(name):
         raise SceneError(f"name = {fmt(name)}: must not hold control characters (NUL, BEL, "
                          "ESC...): it is stored in the result file and printed")
     return name
@@ -911,9 +911,9 @@ def _admit(scene: Scene) -> None:
         what = "a recorded ground motion" if scene.recorded else "ricker and mp pulses"
         raise SceneError(f"outputs.contact = true: not available with {what} yet; contact "
                          "outputs work with sine and cosine pulses")
-    bodies = _candidate_bodies(scene)
+    bodies = candidate_bodies(scene)
     _check_initial(scene, bodies)
-    _check_cost(scene, bodies)
+    check_cost(scene, bodies)
     if scene.suite is not None:
         scene.suite.warn(scene.axis(alpha_symbol(scene.kind)).values,
                          scene.axis("p").values)

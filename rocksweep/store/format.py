@@ -1,5 +1,5 @@
 """The sweep result format (HDF5 through h5py): its constants and metadata, and the
-making of a new file's contents (``_initialise``).
+making of a new file's contents (``initialise``).
 
 Layout (netCDF-4 / CF-1.10, so ``xarray.open_dataset(path, engine="h5netcdf")`` and
 netCDF-4 readers open it):
@@ -50,9 +50,8 @@ import numpy as np
 from rocksweep import fields
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
-from rocksweep.scene.grid import Grid
 from rocksweep.scene.model import Scene
-from rocksweep.store._common import _fixed, _now
+from rocksweep.store._common import fixed_ascii, utc_now
 from rocksweep.store.identity import record_attrs, resolved_scene
 from rocksweep.vocab.axes import alpha_symbol
 from rocksweep.vocab.outcomes import COMPUTED_FLAGS, COMPUTED_MEANING
@@ -164,7 +163,6 @@ def file_bytes(scene: Scene, adaptive: bool = False) -> int:
     """Bytes the datasets of a result file of ``scene`` take (all allocated when the
     file is made): every variable's dtype size x grid points, plus the coordinates;
     adaptive: with the ``computed`` flags."""
-    grid = Grid(scene)
     per_point = sum(np.dtype(dt).itemsize for dt, _, _ in scene.variables().values())
     per_point += adaptive
     coords = sum(16 * len(a.values) for a in scene.axes)
@@ -172,13 +170,12 @@ def file_bytes(scene: Scene, adaptive: bool = False) -> int:
     if su is not None:  # the per-record variables (sha256: 64 characters) and factors
         R = len(su.records)
         coords += R * (8 * (5 + len(su.periods)) + 96) + 8 * R * max(1, len(su.levels))
-    return per_point * grid.size + coords
+    return per_point * scene.size + coords
 
 
-def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
+def initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
                 adaptive: dict | None = None) -> None:
     import h5py
-    grid = Grid(scene)
     vers = versions()
     a = f.attrs
     a["Conventions"] = CONVENTIONS
@@ -211,13 +208,13 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
         _store_suite_records(f, scene.suite)
     for k, v in vers.items():
         a[f"{k}_version"] = v
-    a["started"] = _now()
-    a["points_total"] = np.int64(grid.size)
+    a["started"] = utc_now()
+    a["points_total"] = np.int64(scene.size)
     # fixed-size attributes, updated in place by every session
     zeros = {"S": "", "i": 0, "f": 0.0}
     for name, dtype in SESSION_ATTRS.items():
         kind = np.dtype(dtype).kind
-        a.create(name, _fixed("", dtype) if kind == "S" else np.array(zeros[kind], dtype))
+        a.create(name, fixed_ascii("", dtype) if kind == "S" else np.array(zeros[kind], dtype))
     if adaptive is not None:
         a["adaptive"] = np.int8(1)
         a["adaptive_axes"] = " ".join(adaptive["axes"])
@@ -257,7 +254,7 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
     for name, (dtype, fill, text) in specs.items():
         dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
         dcpl.set_alloc_time(h5py.h5d.ALLOC_TIME_EARLY)  # no metadata changes later
-        ds = f.create_dataset(name, shape=grid.shape, dtype=dtype, fillvalue=fill,
+        ds = f.create_dataset(name, shape=scene.shape, dtype=dtype, fillvalue=fill,
                               dcpl=dcpl, fill_time="alloc")
         f_ = fields.BY_NAME.get(name)
         meta = (fields.field_attrs(f_, scene.kind) if f_ is not None

@@ -16,7 +16,7 @@ import rocksweep
 import rocksweep.analysis.boundaries as bd
 from rocksweep.cli import main
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.physics.points import Point
 from rocksweep.physics.reference import reference_run
 from rocksweep.store.reader import as_result

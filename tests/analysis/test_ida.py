@@ -15,9 +15,9 @@ from click.testing import CliRunner
 
 import rocksweep
 from rocksweep.cli import main
-from rocksweep.compute.single import simulate
+from rocksweep.compute.single import run_point
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 
 ROOT = Path(__file__).resolve().parents[2]
 NAMES = ["SYN01.AT2", "SYN05.AT2", "SYN12.AT2"]
@@ -73,7 +73,7 @@ def test_bisected_level_brackets_the_first_overturning(suite):
         for x, overturns in ((hi, True), (lo, False)):
             pt = dataclasses.replace(top, A_ratio=top.A_ratio * x / levels[j])
             assert pt.A == pytest.approx(x * G, rel=1e-12)
-            out = simulate(pt, sc.numerics, history=False).out
+            out = run_point(pt, sc.numerics, history=False).out
             assert (out[L.OUT_OUTCOME] in (1, 2)) is overturns
         checked += 1
     assert checked >= 1  # at least one record is bisected between two stripes

@@ -16,7 +16,7 @@ from scipy.stats import norm
 import rocksweep
 from rocksweep.analysis.risk import RiskError, read_hazard
 from rocksweep.cli import main
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 
 
 def fragility(median, beta, **extra):

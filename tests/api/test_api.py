@@ -19,7 +19,7 @@ import rocksweep.compute.sweep as sw
 from rocksweep import api, fields
 from rocksweep.cli import main
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.scene.grid import Grid
 from rocksweep.scene.parse import load_scene
 from rocksweep.store.reader import read_result
@@ -69,7 +69,7 @@ def test_public_names_have_docstrings_and_version(cli):
 def test_importing_single_runs_keeps_the_api_functions():
     """Importing the single-run module (rocksweep/compute/single.py) leaves rocksweep.run and
     rocksweep.open the API functions (a module named run.py used to replace rocksweep.run)."""
-    code = ("import rocksweep\nfrom rocksweep.compute.single import simulate\n"
+    code = ("import rocksweep\nfrom rocksweep.compute.single import run_point\n"
             "import rocksweep.compute.single\n"
             "print(rocksweep.run is rocksweep.api.run, rocksweep.open is rocksweep.api.open)")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
@@ -298,10 +298,10 @@ def test_one_field_table():
     sc = load_scene(FIG5, ["impact.lam=0.2"])
     g = Grid(sc)
     chunk = sw.run_chunk(g, 0, 1, sw.level(sc))
-    from rocksweep.compute.single import simulate
+    from rocksweep.compute.single import run_point
 
-    one = simulate(sc.point({a.name: a.values[0] for a in sc.axes}), sc.numerics,
-                   history=False)
+    one = run_point(sc.point({a.name: a.values[0] for a in sc.axes}), sc.numerics,
+                    history=False)
     assert chunk.arrays["steps"][0] == one.summary()["steps"] == one.out[L.OUT_STEPS]
     assert chunk.arrays["event_steps"][0] == one.summary()["event_steps"]
 

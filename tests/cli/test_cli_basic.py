@@ -172,7 +172,7 @@ def test_console_script_error_has_no_traceback(tmp_path):
 def test_kernel_import_pulls_no_io_libraries():
     """The layers point one way: the kernel knows nothing of files, CLI or plots.
     (yaml is not checked: numba itself imports it to read its config file.)"""
-    code = ("import sys, rocksweep.kernel, rocksweep.physics.model, rocksweep.physics.points;"
+    code = ("import sys, rocksweep.kernel, rocksweep.physics.bodies, rocksweep.physics.points;"
             "bad = [m for m in ('h5py', 'click', 'matplotlib', 'pydantic') if m in sys.modules];"
             "print(','.join(bad))")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)

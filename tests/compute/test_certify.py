@@ -23,11 +23,11 @@ from bodies import BODY3
 
 from rocksweep.compute.certify import certify
 from rocksweep.compute.driver import sweep_arrays
-from rocksweep.compute.single import simulate
+from rocksweep.compute.single import run_point
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import OVERTURN_CLOSE, Numerics
-from rocksweep.physics.model import BlockBody, FlexibleBody
+from rocksweep.physics.bodies import BlockBody, FlexibleBody
 from rocksweep.physics.points import Point, kernel_kind, point_row
 from rocksweep.physics.reference import reference_run
 from rocksweep.scene.parse import parse_scene
@@ -55,7 +55,7 @@ def test_default_classifies_the_reproduced_cases_like_the_reference(point, expec
     the same. Before the step rule, `default` gave safe / mode 1 here."""
     ref = reference_run(point)
     assert ref["outcome"] == expected
-    run = simulate(point, Numerics.preset("default"), history=False)
+    run = run_point(point, Numerics.preset("default"), history=False)
     assert run.out[L.OUT_OUTCOME] == expected
     if expected == L.OUTCOME_MODE1:  # and overturns after the same single impact
         assert run.impacts == ref["impacts"] == 1
@@ -85,7 +85,7 @@ def test_close_calls_are_refined_and_clear_ones_are_not():
         bound = point_row(point, n)[L.PAR_CLOSE]
         close = bare[L.OUT_MARGIN] < bound * (OVERTURN_CLOSE if fell else 1.0)
         wide += bool(close and bare[L.OUT_MARGIN] >= bound)
-        run = simulate(point, n, history=False)
+        run = run_point(point, n, history=False)
         is_refined = bool(int(run.out[L.OUT_STATUS]) & L.STATUS_REFINED)
         assert is_refined == close, A
         assert ("refined" in run.status) == close
@@ -145,7 +145,7 @@ def test_simulate_and_sweep_give_one_point_one_answer():
     swept = {k: np.ravel(v) for k, v in sweep_arrays(scene)[0].items()}
     fixed = {a.name: a.values[0] for a in scene.axes}
     for i, A in enumerate((10.9, 11.1, 14.0)):
-        run = simulate(scene.point({**fixed, "A_ratio": A}), scene.single_numerics)
+        run = run_point(scene.point({**fixed, "A_ratio": A}), scene.single_numerics)
         for k in ("outcome", "status", "impacts", "t_overturn", "theta_max_over_alpha",
                   "steps", "event_steps"):
             assert np.array_equal(np.asarray(run.get(k) if run.get(k) is not None

@@ -26,7 +26,7 @@ from rocksweep.fields import CHECK_FIELDS, check_rows
 from rocksweep.kernel import chunk_kernel
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import PRESETS, Numerics
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.physics.points import Point, kernel_kind, point_row
 from rocksweep.physics.reference import reference_run
 from rocksweep.scene.parse import parse_scene

@@ -26,7 +26,7 @@ from bodies import FIG3_YAML
 import rocksweep
 from rocksweep.kernel import layout as L
 from rocksweep.physics import intensity
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 from rocksweep.physics.records import read_record, write_at2
 from rocksweep.scene.grid import Grid
 from rocksweep.scene.model import SceneError

@@ -7,7 +7,7 @@ from bodies import FIG3_YAML, body_yaml, table3
 import rocksweep.compute.sweep as sw
 from rocksweep import fields
 from rocksweep.compute.driver import sweep_arrays
-from rocksweep.compute.single import simulate
+from rocksweep.compute.single import run_point
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.parse import parse_scene
@@ -65,7 +65,7 @@ def test_sweep_equals_single_runs(reference):
     rng = np.random.default_rng(0)
     for flat in rng.choice(g.size, 6, replace=False):
         values = {k: v[0] for k, v in g.index_values(np.array([flat])).items()}
-        run = simulate(sc.point(values), sc.numerics, history=False)
+        run = run_point(sc.point(values), sc.numerics, history=False)
         idx = np.unravel_index(flat, g.shape)
         assert ref["outcome"][idx] == run.out[L.OUT_OUTCOME]
         assert ref["impacts"][idx] == run.impacts
@@ -171,7 +171,7 @@ def test_energy_outputs_match_the_single_run_bookkeeping():
     g = Grid(sc)
     for flat in range(g.size):
         values = {k: v[0] for k, v in g.index_values(np.array([flat])).items()}
-        s = simulate(sc.point(values), sc.numerics, history=True).summary()
+        s = run_point(sc.point(values), sc.numerics, history=True).summary()
         idx = np.unravel_index(flat, g.shape)
         for name, key in (("work_in_over_Eref", "work_in_over_Eref"),
                           ("damper_loss_over_Eref", "damper_loss_over_Eref"),

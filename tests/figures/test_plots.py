@@ -225,13 +225,13 @@ def test_stability_diagram_draws_into_given_axes(acg_result):
 
 @pytest.fixture(scope="module")
 def fig5_runs():
-    from rocksweep.compute.single import simulate
+    from rocksweep.compute.single import run_point
     from rocksweep.scene.parse import load_scene
 
     scene = load_scene(ROOT / "configs" / "fig5.yaml")
     fixed = {a.name: a.values[0] for a in scene.axes}
     lam = next(a for a in scene.axes if a.name == "lam")
-    return [simulate(scene.point({**fixed, "lam": v}), scene.single_numerics)
+    return [run_point(scene.point({**fixed, "lam": v}), scene.single_numerics)
             for v in lam.values]
 
 
@@ -257,7 +257,7 @@ def test_time_history_has_the_input_pulse_and_guide_legend(fig5_runs):
 
 def test_restitution_map_u0_curve_is_dark(body_fig2):
     from rocksweep.figures.common import restitution_map
-    from rocksweep.physics.model import restitution, restitution_rigid
+    from rocksweep.physics.bodies import restitution, restitution_rigid
 
     lam = np.linspace(0, 1, 11)
     u = np.linspace(-2, 2, 9)

@@ -7,7 +7,7 @@ import pytest
 from hardkit import BASE, FINE, assert_sane, kernel_events, numerics, reference_events, run
 from hardkit import table3_body as body
 
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 from rocksweep.physics.points import Point
 
 pytestmark = pytest.mark.hard

@@ -9,7 +9,7 @@ from hardkit import assert_sane, kernel_events, reference_events, run
 
 from rocksweep.kernel.equations import restitution as kernel_restitution
 from rocksweep.kernel.layout import PAR_LAM
-from rocksweep.physics.model import BlockBody, impact_energy_loss, restitution
+from rocksweep.physics.bodies import BlockBody, impact_energy_loss, restitution
 from rocksweep.physics.points import Point, body_row
 
 pytestmark = pytest.mark.hard
@@ -86,7 +86,7 @@ def test_e_above_1_records_the_energy_gained_and_stays_finite(lam, shape, w, a_r
     assert {"e_above_1", "energy_gain"} <= set(r.status)
     h = r.history
     # every rocking-to-rocking impact, checked against eq. (1) and eq. (6) of the paper
-    # (rocksweep.physics.model, written independently of the kernel): e, theta'^+ and the energy
+    # (rocksweep.physics.bodies, written independently of the kernel): e, theta'^+ and the energy
     e_all, gained, n_gaining = [], 0.0, 0
     for i in np.flatnonzero(np.diff(h["t"]) == 0.0):
         s0, s1 = int(h["phase"][i]), int(h["phase"][i + 1])

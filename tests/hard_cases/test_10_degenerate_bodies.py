@@ -9,7 +9,7 @@ from hardkit import assert_sane, numerics, reference_events, run
 from hardkit import table3_body as body
 
 from rocksweep.kernel.layout import KIND_FLEXIBLE_UNDAMPED
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 from rocksweep.physics.points import Point, kernel_kind
 
 pytestmark = pytest.mark.hard

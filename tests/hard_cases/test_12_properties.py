@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, assume, event, example, given, settings
 from hypothesis import strategies as st
 
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import BodyError, FlexibleBody
+from rocksweep.physics.bodies import BodyError, FlexibleBody
 from rocksweep.physics.points import Point
 
 pytestmark = pytest.mark.hard

@@ -13,7 +13,7 @@ from bodies import FIG4
 
 from rocksweep.compute.driver import sweep_arrays
 from rocksweep.numerics import PRESETS, Numerics, spring_steps, step_sizes
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.physics.points import body_omega_rock, body_zeta_rock
 from rocksweep.physics.reference import reference_run
 from rocksweep.scene.parse import load_scene

@@ -20,11 +20,11 @@ import pytest
 from bodies import table3
 from scipy.integrate import quad
 
-from rocksweep.compute.single import simulate
+from rocksweep.compute.single import run_point
 from rocksweep.kernel import chunk_kernel
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.physics.points import Point, point_row
 from rocksweep.physics.reference import reference_run
 
@@ -46,11 +46,11 @@ def test_huge_slow_pulse_is_not_crossed_in_a_handful_of_steps(case):
     p = HUGE_COSINE[case]
     ref = reference_run(p, Numerics())
     assert ref["outcome"] == (L.OUTCOME_MODE2 if case == "mode2" else L.OUTCOME_MODE1)
-    acc = simulate(p, Numerics.preset("accurate"), history=False)
+    acc = run_point(p, Numerics.preset("accurate"), history=False)
     assert acc.outcome == case
     assert abs(acc.t_overturn - ref["t_overturn"]) <= (0.05 if case == "mode2" else 0.02)
     # the body turns through pi/2 = 3.5 alpha_cg: at most 0.25 alpha_cg per step
-    d = simulate(p, Numerics.preset("default"), history=False)
+    d = run_point(p, Numerics.preset("default"), history=False)
     assert d.get("steps") >= math.pi / 2 / (0.25 * p.body.alpha_ref) - 1
     assert abs(d.t_overturn - ref["t_overturn"]) <= 0.15
 
@@ -101,7 +101,7 @@ def test_energy_gaining_impacts_resolved_at_accurate():
     p = Point(body, 1.3, "sine", 8.14, -2.894)
     ref = reference_run(p, Numerics())
     assert ref["status"] & L.STATUS_E_ABOVE_1 and ref["outcome"] == L.OUTCOME_MODE1
-    r = simulate(p, Numerics.preset("accurate"), history=False)
+    r = run_point(p, Numerics.preset("accurate"), history=False)
     assert "e_above_1" in r.status and r.outcome == "mode1"
     assert r.impacts == ref["impacts"]
     assert abs(r.t_overturn - ref["t_overturn"]) <= 0.05
@@ -117,7 +117,7 @@ def test_chattering_cut_short_by_the_rest_rate_is_not_rest():
     body = FlexibleBody(22.5, 0.0, 0.195, 0.644, 0.359, 0.582)
     p = Point(body, 0.334, "cosine", 4.78, 15.9)
     for name in ("draft", "default", "accurate", "fine"):
-        r = simulate(p, Numerics.preset(name), history=False)
+        r = run_point(p, Numerics.preset(name), history=False)
         assert r.status == ["horizon", "settled"] and r.outcome == "safe", (name, r.status)
         assert r.impacts > 1000, name  # chattering on to the horizon, as the reference does
 
@@ -126,6 +126,6 @@ def test_rest_still_proven_without_the_rule():
     """The other side: a flexible body whose pulse never lifts it (A below the uplift
     threshold) ends "rest" at the pulse's end, with no "settled"."""
     body = FlexibleBody(22.5, 0.0, 0.195, 0.644, 0.359, 0.582)
-    r = simulate(Point(body, 0.334, "sine", 4.78, 0.3), Numerics.preset("default"),
-                 history=False)
+    r = run_point(Point(body, 0.334, "sine", 4.78, 0.3), Numerics.preset("default"),
+                  history=False)
     assert r.status == ["rest"] and r.get("uplifts") == 0

@@ -23,7 +23,7 @@ from rocksweep.kernel import chunk_kernel, contact, point_kernel
 from rocksweep.kernel import equations as eq
 from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import BlockBody, FlexibleBody
+from rocksweep.physics.bodies import BlockBody, FlexibleBody
 from rocksweep.physics.points import Point, point_row
 from rocksweep.scene.model import SceneError
 from rocksweep.scene.parse import parse_scene

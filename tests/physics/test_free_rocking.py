@@ -22,7 +22,7 @@ from scipy.integrate import quad
 
 import rocksweep
 from rocksweep.errors import RocksweepError
-from rocksweep.physics.model import FlexibleBody, G
+from rocksweep.physics.bodies import FlexibleBody, G
 
 ALPHA = 0.25
 

@@ -19,7 +19,7 @@ from rocksweep.physics.suite import MAX_FACTOR, RecordWarning, make_suite
 
 ROOT = Path(__file__).resolve().parents[2]
 SUITE = sorted((ROOT / "records" / "suite").glob("*.AT2"))
-from rocksweep.physics.model import G  # noqa: E402 (the units of acc: g = G m/s^2)
+from rocksweep.physics.bodies import G  # noqa: E402 (the units of acc: g = G m/s^2)
 
 SUB = 8  # the test's own fine resampling of the piecewise-linear record
 

@@ -8,10 +8,10 @@ import pytest
 from bodies import BODY3, table3
 from scipy.integrate import quad
 
-from rocksweep.compute.single import simulate
+from rocksweep.compute.single import run_point
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import BlockBody, FlexibleBody, impact_energy_loss, restitution_rigid
+from rocksweep.physics.bodies import BlockBody, FlexibleBody, impact_energy_loss, restitution_rigid
 from rocksweep.physics.points import Point
 from rocksweep.physics.reference import reference_run
 
@@ -97,7 +97,7 @@ def test_rigid_block_bounded_exit_matches_the_kernel():
     paths stop at the same impact and predict the same largest rotation."""
     p = Point(BLOCK, 0.0, "sine", 6.0, 2.0)
     ref = reference_run(p)
-    run = simulate(p, Numerics(steps_per_period=40, event_tol=1e-12), history=False)
+    run = run_point(p, Numerics(steps_per_period=40, event_tol=1e-12), history=False)
     assert ref["status"] & L.STATUS_BOUNDED and int(run.out[L.OUT_STATUS]) & L.STATUS_BOUNDED
     assert ref["outcome"] == run.out[L.OUT_OUTCOME] == L.OUTCOME_SAFE
     assert ref["impacts"] == run.out[L.OUT_IMPACTS]
@@ -183,7 +183,7 @@ def test_kernel_agrees_with_the_reference_tighter_as_the_step_shrinks(name, refe
     ref_impacts = [e["t"] for e in _impacts(ref)][:3]
     for spp in (10, 20, 40):
         bound = 5e-3 * (10 / spp) ** 4  # RK4: error ~ step^4
-        run = simulate(CASES[name], Numerics(steps_per_period=spp, event_tol=1e-12))
+        run = run_point(CASES[name], Numerics(steps_per_period=spp, event_tol=1e-12))
         o = run.out
         assert o[L.OUT_OUTCOME] == ref["outcome"], spp
         assert o[L.OUT_IMPACTS] == ref["impacts"], spp

@@ -26,7 +26,7 @@ from scipy.integrate import quad, solve_ivp
 from rocksweep.kernel import chunk_kernel, point_kernel
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import BlockBody, FlexibleBody, G, restitution_rigid
+from rocksweep.physics.bodies import BlockBody, FlexibleBody, G, restitution_rigid
 from rocksweep.physics.points import Point, kernel_kind, point_row
 
 ALPHA = 0.2618  # the classic slender block (15 degrees)

@@ -11,7 +11,7 @@ import pytest
 
 import rocksweep
 from rocksweep.errors import RocksweepError
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 
 LAB = {"b": 0.1, "h": 0.9, "h_A": 0.3, "m": 20.0, "m_A": 9.4, "I_A": 0.25, "k": 4000.0,
        "c": 10.0}

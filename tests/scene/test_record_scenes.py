@@ -26,10 +26,10 @@ import pytest
 from bodies import FIG3, FIG3_YAML
 from scipy import signal
 
-from rocksweep.compute.single import simulate
+from rocksweep.compute.single import run_point
 from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.physics.points import RECORD, Point
 from rocksweep.physics.records import read_record
 from rocksweep.scene.model import SceneError
@@ -50,8 +50,8 @@ def test_sine_record_is_the_sine_pulse(lam, w_over_p, A_ratio):
     body = FlexibleBody(**FIG3)
     rec = read_record(SINE)
     fine = Numerics.preset("fine", steps_per_period=320, event_tol=1e-10)
-    pulse = simulate(Point(body, lam, "sine", w_over_p, A_ratio), fine, history=False)
-    record = simulate(Point(body, lam, RECORD, math.nan, A_ratio, record=rec,
+    pulse = run_point(Point(body, lam, "sine", w_over_p, A_ratio), fine, history=False)
+    record = run_point(Point(body, lam, RECORD, math.nan, A_ratio, record=rec,
                             p=4 * math.pi / w_over_p), fine, history=False)
     assert record.outcome == pulse.outcome
     assert record.impacts == pulse.impacts and record.uplifts == pulse.uplifts
@@ -64,7 +64,7 @@ def test_sine_record_is_the_sine_pulse(lam, w_over_p, A_ratio):
 
 def test_the_overturning_point_is_among_them():
     body = FlexibleBody(**FIG3)
-    run = simulate(Point(body, 0.4, "sine", 5.3, 5.0), Numerics.preset("fine"), history=False)
+    run = run_point(Point(body, 0.4, "sine", 5.3, 5.0), Numerics.preset("fine"), history=False)
     assert run.outcome == "mode1"  # the comparison above covers an overturning point
 
 
@@ -73,7 +73,7 @@ def test_full_contact_response_is_lsim_of_the_record():
     rec = read_record(NEARFAULT)
     p, A_ratio = 2.0, 0.05  # far below uplift: the base never leaves the ground
     pt = Point(body, 0.0, RECORD, math.nan, A_ratio, record=rec, p=p)
-    run = simulate(pt, Numerics.preset("fine"))
+    run = run_point(pt, Numerics.preset("fine"))
     assert run.uplifts == 0
     h = run.history
     dt_k = p * rec.dt

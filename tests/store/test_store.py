@@ -173,7 +173,7 @@ def test_create_failure_leaves_no_file(tmp_path, scene, monkeypatch):
     def boom(*args):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(writer, "_initialise", boom)
+    monkeypatch.setattr(writer, "initialise", boom)
     with pytest.raises(StoreError) as err:
         SweepFile.create(path, scene)
     assert str(err.value) == f"{path}: cannot write (no space left on the device); nothing written"
