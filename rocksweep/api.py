@@ -7,8 +7,8 @@ figures (``rocksweep.figures``), ``ds.rocksweep`` (``rocksweep.accessor``). Erro
 Python (``rocksweep.errors.speaks_python``).
 
 Nothing heavy is imported here at module level (numba, h5py, xarray, matplotlib load
-inside the functions), so ``import rocksweep`` stays light; the names that moved out are
-still importable from here (``api.load``, ``api.sweep_file``, ...: PEP 562).
+inside the functions), so ``import rocksweep`` stays light. The names the API builds on
+are imported from their homes (``rocksweep.compute.session.sweep_file``, ...), not from here.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rocksweep.accessor import register_accessor
-from rocksweep.errors import ApiError, speaks_python  # noqa: F401 (ApiError: the API's)
+from rocksweep.errors import speaks_python
 from rocksweep.simulation import Simulation  # what simulate returns
 
 if TYPE_CHECKING:
@@ -27,27 +27,6 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
     from rocksweep.scene.inputs import Overrides, SceneLike
-
-# Names that live in their rooms, importable from here as before (loaded on first use):
-# SweepInterrupted is what ``run`` raises on Ctrl-C.
-_MOVED = {name: module for module, names in {
-    "rocksweep.compute.driver": ("WRITE_EVERY", "SweepInterrupted", "SweepReport"),
-    "rocksweep.scene.inputs": ("load", "override_strings"),
-    "rocksweep.compute.history": ("MAX_RUNS", "API_MAX_RUNS", "run_points",
-                                "history_dataset", "swept_values", "write_history_csv"),
-    "rocksweep.compute.adaptive": ("adaptive_options",),
-    "rocksweep.compute.session": ("sweep_file",),
-    "rocksweep.store.dataset": ("result_dataset",),
-    "rocksweep.accessor": ("RocksweepAccessor",),
-}.items() for name in names}
-
-
-def __getattr__(name: str) -> Any:
-    if name in _MOVED:
-        from importlib import import_module
-
-        return getattr(import_module(_MOVED[name]), name)
-    raise AttributeError(f"module 'rocksweep.api' has no attribute {name!r}")
 
 
 def _public(fn: Callable[..., Any]) -> Callable[..., Any]:

@@ -72,7 +72,7 @@ from rocksweep.analysis.accuracy import (
     run_reference,
     stratified_sample,
 )
-from rocksweep.compute.single import history_capacity
+from rocksweep.compute.dispatch import history_capacity
 from rocksweep.compute.sweep import auto_chunk_size, level, plan_chunks, prepare
 from rocksweep.kernel import chunk_kernel, point_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812

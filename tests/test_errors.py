@@ -39,16 +39,9 @@ def test_every_error_class_lives_in_errors_py():
     assert not elsewhere, "error classes outside rocksweep/errors.py:\n" + "\n".join(elsewhere)
 
 
-def test_old_import_paths_keep_working():
-    from rocksweep.analysis.spectrum import SpectrumError
-    from rocksweep.compute.adaptive import AdaptiveError
-    from rocksweep.figures.diagrams import DiagramError
-    from rocksweep.scene.model import SceneError
-    from rocksweep.store._common import StoreError
-
-    assert SceneError is errors.SceneError and StoreError is errors.StoreError
-    assert issubclass(DiagramError, errors.FigureError) and SpectrumError is errors.SpectrumError
-    assert issubclass(errors.BoundaryError, AdaptiveError)
+def test_error_classes_form_one_hierarchy():
+    assert issubclass(errors.DiagramError, errors.FigureError)
+    assert issubclass(errors.BoundaryError, errors.AdaptiveError)
     assert all(issubclass(getattr(errors, n), errors.RocksweepError)
                for n in dir(errors) if n.endswith("Error") and n != "RocksweepError")
 
@@ -72,7 +65,8 @@ def test_rtol_and_integer_checks_have_one_wording():
 
 
 def test_adaptive_settings_are_checked_once_with_the_schema_wording():
-    from rocksweep.compute.adaptive import AdaptiveError, Options, check_settings
+    from rocksweep.compute.adaptive import Options, check_settings
+    from rocksweep.errors import AdaptiveError
 
     cli = check_settings({"margin": 9, "seed": 1}, lambda k: f"--{k}")
     assert cli.startswith("--margin 9: must be an integer in [0, 8]")

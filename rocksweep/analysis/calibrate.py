@@ -63,15 +63,15 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.compute.single import history_capacity
-from rocksweep.errors import CalibrationError, RocksweepError  # noqa: F401 (CalibrationError re-exported)
+from rocksweep.compute.dispatch import history_capacity
+from rocksweep.errors import BodyError, CalibrationError
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import point_kernel, warm_up
 from rocksweep.numerics import Numerics, step_budget
-from rocksweep.physics.bodies import BodyError
 from rocksweep.physics.measured import Measured, noise_level, read_measured
-from rocksweep.physics.points import INITIAL, kernel_kind, point_row
+from rocksweep.physics.points import kernel_kind, point_row
 from rocksweep.schema import KEYS, fmt
+from rocksweep.vocab.axes import INITIAL
 
 ACCURACY = "fine"  # the least accuracy of a calibration's runs (``calibration_numerics``)
 H_NOISE = 4.0  # threshold of an excursion, in noise standard deviations ...

@@ -91,7 +91,7 @@ from rocksweep.vocab.ground import CLOUD_IMS as CLOUD_IM_VARIABLES
 from rocksweep.vocab.ground import SCALE_IMS
 from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, UPLIFT
 
-__all__ = ["DEFAULT_BOOTSTRAP", "Fit", "FragilityWarning", "REASONS", "STRIPE_IMS",
+__all__ = ["Fit", "FragilityWarning", "REASONS", "STRIPE_IMS",
            "curves_json", "fit_cloud", "fit_stripes", "fragility", "probability"]
 
 #: stripe dimension names (the sweep's ``scale_im``) and their units

@@ -31,6 +31,7 @@ from rocksweep.errors import IdaError, check_rtol
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.store.reader import as_result, result_scene
+from rocksweep.vocab.outcomes import FLAGGED, OUTCOME_MODE1, OUTCOME_MODE2
 
 # Bisection steps at most (a relative tolerance of 1e-12 takes ~40 from a stripe gap).
 MAX_ITER = 60
@@ -72,10 +73,10 @@ def ida(ds: Any, rtol: float = 1e-2) -> Any:
     others = [d for d in dims if d not in (im, "record")]
     order = [*others, "record", im]
     perm = [dims.index(d) for d in order]
-    flagged = np.transpose((np.asarray(result.arrays["status"]) & L.STATUS_FLAGGED) != 0,
+    flagged = np.transpose((np.asarray(result.arrays["status"]) & FLAGGED) != 0,
                            perm)
     modes = np.transpose(outcome, perm)
-    over = np.isin(modes, (L.OUTCOME_MODE1, L.OUTCOME_MODE2)) & ~flagged
+    over = np.isin(modes, (OUTCOME_MODE1, OUTCOME_MODE2)) & ~flagged
     safe = ~over & ~flagged
     levels = np.asarray(result.coords[im], float)
     if not np.all(np.diff(levels) > 0):
@@ -123,9 +124,9 @@ def ida(ds: Any, rtol: float = 1e-2) -> Any:
             out = run_point(pt, scene.numerics, history=False).out
             runs[i] += 1
             g = int(out[L.OUT_OUTCOME])
-            if int(out[L.OUT_STATUS]) & L.STATUS_FLAGGED:
+            if int(out[L.OUT_STATUS]) & FLAGGED:
                 unresolved[i] = 1
-            elif g in (L.OUTCOME_MODE1, L.OUTCOME_MODE2):
+            elif g in (OUTCOME_MODE1, OUTCOME_MODE2):
                 hi[i], mode[i] = mid, g
             else:
                 lo[i] = mid

@@ -72,7 +72,7 @@ def restitution_table(scene: Scene, n_lam: int = 101, n_u: int = 81) -> Restitut
     with the energy-admissible lam for each u/u_cr. The scene must hold one body and one
     impact law (a SceneError names a swept key otherwise); lam and the pulse are not used.
     """
-    from rocksweep.scene.model import SceneError
+    from rocksweep.errors import SceneError
 
     names = [a.name for a in scene.axes]
     for a in (*scene.body_axes(), *(scene.axis(k) for k in ("law", "e", "e_factor")

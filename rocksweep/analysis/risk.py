@@ -56,11 +56,11 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from rocksweep.errors import RiskError, RocksweepError  # noqa: F401 (re-exported)
+from rocksweep.errors import RiskError
 from rocksweep.physics.bodies import G
 from rocksweep.vocab.ground import ARIAS, AVGSA, CAV, PGA, PGV, SA, SCALE_IMS
 
-__all__ = ["Hazard", "RiskError", "fragility_median", "hazard_frame", "read_hazard",
+__all__ = ["Hazard", "fragility_median", "hazard_frame", "read_hazard",
            "risk"]
 
 SUB = 8  # pieces per hazard segment, 2 Gauss-Legendre nodes each

@@ -7,14 +7,8 @@ from pathlib import Path
 
 import click
 
-from rocksweep.cli.main import (
-    load,
-    main,
-    overwrite_option,
-    scene_argument,
-    set_option,
-    user_errors,
-)
+from rocksweep.cli.main import load, main, user_errors
+from rocksweep.cli.options import overwrite_option, scene_argument, set_option
 from rocksweep.vocab.settings import DEFAULT_LADDER, LADDER_NAMES, LADDERS
 
 
@@ -71,7 +65,7 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
     if report_path is not None:
         check_output(report_path, overwrite=overwrite, inputs=scene.inputs)
     if plot_path is not None:
-        from rocksweep.figures.common import FORMATS
+        from rocksweep.figures import FORMATS
 
         check_output(plot_path, overwrite=overwrite, inputs=scene.inputs, suffixes=FORMATS)
 

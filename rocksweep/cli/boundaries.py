@@ -39,7 +39,8 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
     and how it was found (column method); and the lines between classes as polylines.
     Works on adaptive and regular results."""
     from rocksweep.analysis import boundaries as bd
-    from rocksweep.figures.common import FORMATS, save_figure
+    from rocksweep.figures import FORMATS
+    from rocksweep.figures.common import save_figure
     from rocksweep.outputs import check_distinct, check_output, write_atomic
     from rocksweep.store.reader import read_result
 

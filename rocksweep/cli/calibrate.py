@@ -66,7 +66,7 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
     if out_path is not None:
         check_output(out_path, overwrite=overwrite, inputs=inputs, suffixes=(".h5", ".nc"))
     if plot_path is not None:
-        from rocksweep.figures.common import FORMATS
+        from rocksweep.figures import FORMATS
 
         check_output(plot_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
     ds = fit_scene(scene_path, measured_path, list(fit), bounds=_bounds(bounds) or None,

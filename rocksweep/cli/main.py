@@ -15,7 +15,6 @@ from pathlib import Path
 import click
 
 import rocksweep
-from rocksweep.cli.options import overwrite_option, scene_argument, set_option  # noqa: F401
 from rocksweep.errors import RocksweepError, one_line
 
 # The library's messages may name the Python API's flags (``resume=True``); the command

@@ -7,7 +7,8 @@ from pathlib import Path
 
 import click
 
-from rocksweep.analysis.tolerance import DEFAULT_RTOL, MAX_RTOL
+from rocksweep.analysis.tolerance import DEFAULT_RTOL
+from rocksweep.errors import MAX_RTOL
 from rocksweep.figures import DEFAULT_DPI, DPI_RANGE
 
 scene_argument = click.argument(
@@ -22,8 +23,7 @@ overwrite_option = click.option("--overwrite", is_flag=True,
 
 
 def _rtol(_ctx: click.Context, _param: click.Parameter, value: float) -> float:
-    from rocksweep.analysis.tolerance import check_rtol
-    from rocksweep.errors import RocksweepError
+    from rocksweep.errors import RocksweepError, check_rtol
 
     try:
         return check_rtol(value, name="--rtol")

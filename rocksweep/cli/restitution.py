@@ -9,14 +9,8 @@ from pathlib import Path
 
 import click
 
-from rocksweep.cli.main import (
-    load,
-    main,
-    overwrite_option,
-    scene_argument,
-    set_option,
-    user_errors,
-)
+from rocksweep.cli.main import load, main, user_errors
+from rocksweep.cli.options import overwrite_option, scene_argument, set_option
 from rocksweep.vocab.laws import CONSTANT, LAWS, LOCKED, law_origin
 
 
@@ -59,7 +53,7 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
                      *(("impact.e=null",) if law != CONSTANT else ()))
     scene = load(scene_path, overrides)
     if plot_path is not None:  # the scene file, its records: never written over
-        from rocksweep.figures.common import FORMATS
+        from rocksweep.figures import FORMATS
 
         check_output(plot_path, overwrite=overwrite, inputs=scene.inputs, suffixes=FORMATS)
     table = restitution_table(scene, n_lam, n_u)

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from typing import Any
 from urllib.parse import urlsplit
 
-from rocksweep.errors import SweepError, is_integer  # noqa: F401 (defined there; re-exported)
+from rocksweep.errors import SweepError, is_integer
 
 # Local worker threads allowed per core: the chunk kernels keep a core busy, so threads
 # beyond a few per core only wait (and a typo like 99999999999999999999 must not start them).

@@ -78,7 +78,7 @@ def run_points(scene: Scene, max_runs: int = MAX_RUNS) -> list[Run]:
     from itertools import product
 
     from rocksweep.compute.single import run_point
-    from rocksweep.scene.model import SceneError
+    from rocksweep.errors import SceneError
 
     if scene.size > max_runs:
         big = max(scene.swept, key=lambda a: len(a.values))

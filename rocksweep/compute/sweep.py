@@ -31,14 +31,13 @@ from rocksweep import (
     fields,
     kernel,  # lazy: numba loads at the first kernel.chunk_kernel
 )
-from rocksweep.compute.arguments import (  # noqa: F401 (re-exported)
+from rocksweep.compute.arguments import (
     CONNECT_TIMEOUT,
-    MAX_JOBS_PER_CORE,
-    SweepError,
     check_jobs,
     probe_scheduler,
 )
 from rocksweep.compute.dispatch import run_variant
+from rocksweep.errors import SweepError
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.scene.grid import ChunkResult, ChunkRows, Grid
 from rocksweep.scene.model import Scene

@@ -21,7 +21,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rocksweep.analysis.accuracy import MEASURE_LABELS, Study
-from rocksweep.figures.common import DEFAULT_DPI, Figure, given_axes, new_axes, save_figure
+from rocksweep.figures import DEFAULT_DPI
+from rocksweep.figures.common import Figure, given_axes, new_axes, save_figure
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

@@ -31,8 +31,8 @@ if TYPE_CHECKING:
 
     from rocksweep.compute.single import Run
 
-from rocksweep.errors import FigureError  # noqa: F401 (defined there; re-exported)
-from rocksweep.figures import DEFAULT_DPI, FORMATS, WIDTHS  # noqa: E402,F401
+from rocksweep.errors import FigureError
+from rocksweep.figures import DEFAULT_DPI, FORMATS, WIDTHS  # noqa: E402
 
 # What every saved figure gets, whoever saves it: TrueType fonts in PDF and PostScript
 # (Type 42), as journals ask, instead of matplotlib's Type 3.

@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 from rocksweep.analysis.kinds import dataset_kind
-from rocksweep.errors import ApiError, PlotError, RocksweepError  # noqa: F401 (re-exported)
+from rocksweep.errors import ApiError, PlotError
 
 
 def plot_analysis(ds: Any, *, ax: Any = None, width: str | None = None) -> Any:

@@ -57,7 +57,7 @@ from scipy.signal import lfilter
 from rocksweep.physics.bodies import G  # gravity [m/s^2], the one definition
 from rocksweep.vocab.ground import AVGSA_POINTS, SA_DAMPING
 
-__all__ = ["AVGSA_POINTS", "G", "arias", "avg_sa", "avgsa_periods", "cav", "duration",
+__all__ = ["arias", "avg_sa", "avgsa_periods", "cav", "duration",
            "final_velocity", "husid", "pga", "pgv", "sa",
            "significant_duration", "velocity"]
 

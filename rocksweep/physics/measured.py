@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.errors import MeasuredError, RocksweepError  # noqa: F401 (MeasuredError re-exported)
+from rocksweep.errors import MeasuredError
 from rocksweep.outputs import input_problem, shown
 
 MIN_SAMPLES = 8  # fewer samples describe no rocking history

@@ -15,15 +15,15 @@ from itertools import product
 
 import numpy as np
 
+from rocksweep.errors import BodyError, SceneError
 from rocksweep.numerics import EVENT_STEP_ALLOWANCE, MAX_POINT_STEPS, Numerics
-from rocksweep.physics.bodies import BodyError
 from rocksweep.physics.points import (
     body_omega_rock,
     body_zeta_rock,
     record_cost,
     run_cost,
 )
-from rocksweep.scene.model import Scene, SceneError
+from rocksweep.scene.model import Scene
 from rocksweep.schema import KEYS, fmt
 
 # Body grids up to this many distinct bodies are checked body by body; larger ones at the

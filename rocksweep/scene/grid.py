@@ -19,7 +19,6 @@ import numpy as np
 
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.points import (
-    INITIAL,
     body_omega_rock,
     body_row,
     fill_rows,
@@ -28,6 +27,7 @@ from rocksweep.physics.points import (
     shape_code,
 )
 from rocksweep.scene.model import Scene
+from rocksweep.vocab.axes import INITIAL
 
 
 @dataclass

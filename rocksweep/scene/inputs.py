@@ -69,7 +69,8 @@ def load(scene: SceneLike | Scene, overrides: Overrides | None = ()) -> tuple[Sc
     mapping (the YAML's structure); or a ``Scene`` (then without overrides). Errors are
     one-line SceneErrors.
     """
-    from rocksweep.scene.model import Scene, SceneError
+    from rocksweep.errors import SceneError
+    from rocksweep.scene.model import Scene
     from rocksweep.scene.parse import load_scene, parse_scene
 
     ov = override_strings(overrides)

@@ -10,14 +10,15 @@ from typing import Any
 import numpy as np
 
 from rocksweep import fields
-from rocksweep.errors import SceneError  # noqa: F401 (defined there; re-exported)
+from rocksweep.errors import SceneError
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody, Body, FlexibleBody
-from rocksweep.physics.points import FREE, INITIAL, RECORD, Point
+from rocksweep.physics.points import Point
 from rocksweep.physics.records import GroundRecord
 from rocksweep.physics.suite import Suite
 from rocksweep.schema import KEYS
-from rocksweep.vocab.ground import PAPER_SHAPES, pulse_duration
+from rocksweep.vocab.axes import INITIAL
+from rocksweep.vocab.ground import FREE, PAPER_SHAPES, RECORD, pulse_duration
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
 
 

@@ -26,23 +26,15 @@ from typing import Any
 
 import numpy as np
 
+from rocksweep.errors import BodyError, RecordError, SceneError, SuiteError
 from rocksweep.numerics import Numerics
 from rocksweep.outputs import input_problem, is_input, shown
-from rocksweep.physics.bodies import BodyError, body_from_geometry
-from rocksweep.physics.points import FREE, INITIAL, RECORD
-from rocksweep.physics.records import GroundRecord, RecordError, read_record
-from rocksweep.physics.suite import (
-    AVGSA_RANGE,
-    DEFAULT_PERIODS,
-    RECORD_IMS,
-    SCALE_IMS,
-    Suite,
-    SuiteError,
-    make_suite,
-)
+from rocksweep.physics.bodies import body_from_geometry
+from rocksweep.physics.records import GroundRecord, read_record
+from rocksweep.physics.suite import AVGSA_RANGE, Suite, make_suite
 from rocksweep.scene.admission import candidate_bodies, check_cost
 from rocksweep.scene.loader import CONTROL_CHARS, YamlError, load_yaml
-from rocksweep.scene.model import Axis, Scene, SceneError
+from rocksweep.scene.model import Axis, Scene
 from rocksweep.schema import (
     BODY_KEYS,
     KEYS,
@@ -53,8 +45,8 @@ from rocksweep.schema import (
     is_number,
     section_keys,
 )
-from rocksweep.vocab.axes import DIAGRAM_AXES, alpha_symbol
-from rocksweep.vocab.ground import MP
+from rocksweep.vocab.axes import DIAGRAM_AXES, INITIAL, alpha_symbol
+from rocksweep.vocab.ground import DEFAULT_PERIODS, FREE, MP, RECORD, RECORD_IMS, SCALE_IMS
 from rocksweep.vocab.ground import PULSE_KEY_SHAPES as _PULSE_KEY_SHAPES
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
 from rocksweep.vocab.settings import DEFAULT_PRESET, FINE

@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rocksweep.errors import OutputError, RocksweepError
+from rocksweep.errors import OutputError, RocksweepError, StoreError
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outputs import check_output, clean_stale_partials, is_input, partial_prefix, shown
@@ -32,7 +32,6 @@ from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import (
     H5_ERRORS,
-    StoreError,
     close_quietly,
     damaged,
     error_reason,

@@ -18,9 +18,11 @@ from scipy.optimize import minimize
 from scipy.stats import norm
 
 import rocksweep
+from rocksweep import errors
 from rocksweep.analysis import fragility as F
 from rocksweep.cli import main
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.scene.inputs import load
 
 ROOT = Path(__file__).resolve().parents[2]
 LEVELS = np.geomspace(0.1, 1.6, 12)
@@ -353,13 +355,12 @@ def test_a_partial_file_is_fitted_as_incomplete_naming_the_missing_points(suite_
     """A file a sweep stopped writing (as after a kill, or while it still runs): the CLI
     warns with the missing points and marks the fit; nothing is silently dropped."""
     import rocksweep.compute.sweep as sw
-    from rocksweep import api
     from rocksweep.scene.grid import Grid
     from rocksweep.store.writer import SweepFile
 
     d, scene = suite_scene
     part = d / "part.h5"
-    sc, _ = api.load(scene)
+    sc, _ = load(scene)
     sf = SweepFile.create(part, sc)
     g = Grid(sc)
     sf.write(sw.run_chunk(g, 0, 18, sw.level(sc)))  # 18 of 24 points
@@ -378,10 +379,10 @@ def test_an_adaptive_suite_refuses_states_its_fill_cannot_know(tmp_path, cli):
     ds["uplifts"] = ds["outcome"].astype(np.int32)
     ds["computed"] = xr.zeros_like(ds["outcome"]) + 1
     ds["computed"][::2, ::3] = 0  # 5 x 4 points filled from the class around them
-    with pytest.raises(F.FragilityError, match=r"state 'uplift': 20 points of this adaptive "
+    with pytest.raises(errors.FragilityError, match=r"state 'uplift': 20 points of this adaptive "
                        "sweep were filled"):
         F.fragility(ds, state="uplift", bootstrap=0)
-    with pytest.raises(F.FragilityError, match="theta:0.5"):
+    with pytest.raises(errors.FragilityError, match="theta:0.5"):
         F.fragility(ds, state=["overturn", "theta:0.5"], bootstrap=0)
     # the class is known at a filled point: overturn and the modes are fitted
     assert str(F.fragility(ds, bootstrap=0)["reason"].values) == "ok"
@@ -408,14 +409,14 @@ def test_ida_takes_no_flagged_stripe_as_safe_and_stops_at_a_flagged_run(suite_sc
     # a bisection run that comes back flagged stops the record's bisection
     import rocksweep.analysis.ida as ida_mod
 
-    real = ida_mod.simulate
+    real = ida_mod.run_point
 
     def flagged_run(pt, numerics, history=False):
         run = real(pt, numerics, history=history)
         run.out[L.OUT_STATUS] = int(run.out[L.OUT_STATUS]) | L.STATUS_EVENT_CAP
         return run
 
-    monkeypatch.setattr(ida_mod, "simulate", flagged_run)
+    monkeypatch.setattr(ida_mod, "run_point", flagged_run)
     stopped = rocksweep.ida(ds, rtol=1e-3).sel(record=name)
     assert int(stopped["unresolved"]) == 1 and int(stopped["runs"]) == 1
     assert float(stopped["ida_lo"]) == levels[j - 1] and float(stopped["ida_hi"]) == levels[j]

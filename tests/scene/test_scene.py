@@ -14,11 +14,10 @@ import pytest
 from bodies import FIG3, FIG3_YAML
 
 from rocksweep.cli import main
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import BodyError, RocksweepError, SceneError
 from rocksweep.numerics import MAX_POINT_STEPS
-from rocksweep.physics.bodies import BlockBody, BodyError, FlexibleBody
+from rocksweep.physics.bodies import BlockBody, FlexibleBody
 from rocksweep.physics.points import body_omega_rock
-from rocksweep.scene.model import SceneError
 from rocksweep.scene.parse import MAX_POINTS, load_scene, parse_scene
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
