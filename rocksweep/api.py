@@ -101,37 +101,91 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
 
 @_public
 def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xarray's)
-    """A sweep result file as an xarray Dataset, loaded in memory (the file is closed).
+    """Any file rocksweep writes as an xarray Dataset, loaded in memory (the file is
+    closed): a sweep result, or what an analysis wrote (fragility, risk, IM efficiency,
+    calibration ``-o .h5``, boundaries and accuracy HDF5), whose ``attrs["rocksweep_kind"]``
+    names its kind (``rocksweep.analysis.files``).
 
-    Each variable carries its unit (``rocksweep_units``: ``rocksweep.fields.UNITS``, e.g.
-    alpha_ref, 1/p, E_ref; CF ``units`` "1") and a description; ``outcome`` its codes
-    and words as CF flags (``flag_values`` -1 0 1 2, ``flag_meanings`` "not_run safe
-    mode1 mode2"), ``status`` its bits (``flag_masks``, ``flag_meanings``,
-    ``flagged_mask``). The attributes are the file's provenance (all of them:
-    ``rocksweep.store.format``): ``scene`` (the YAML verbatim), ``scene_resolved``,
+    A sweep result: each variable carries its unit (``rocksweep_units``:
+    ``rocksweep.fields.UNITS``, e.g. alpha_ref, 1/p, E_ref; CF ``units`` "1") and a
+    description; ``outcome`` its codes and words as CF flags (``flag_values`` -1 0 1 2,
+    ``flag_meanings`` "not_run safe mode1 mode2"), ``status`` its bits (``flag_masks``,
+    ``flag_meanings``, ``flagged_mask``). The attributes are the file's provenance (all of
+    them: ``rocksweep.store.format``): ``scene`` (the YAML verbatim), ``scene_resolved``,
     ``overrides``, ``numerics``, ``accuracy``, versions, times, ``complete``. Works
     while a sweep is still writing the file (no lock is taken). A file that is not a
-    rocksweep result is a one-line ``RocksweepError``.
+    rocksweep file is a one-line ``RocksweepError``.
     """
-    from rocksweep.store.dataset import open_result
+    from rocksweep.analysis.files import open_any
 
-    return open_result(path)
-
-
-@_public
-def open_any(path: str | Path) -> xr.Dataset:
-    """Any rocksweep Dataset from a file (``rocksweep.analysis.files.open_any``), with
-    ``ds.rocksweep``."""
-    from rocksweep.analysis.files import open_any as open_file
-
-    return open_file(path)
+    return open_any(path)
 
 
 def _dataset_arg(ds: Any, what: str) -> xr.Dataset:
-    """A Dataset, or a path to one (``analysis.files._as_dataset``), with ``ds.rocksweep``."""
-    from rocksweep.analysis.files import _as_dataset
+    """A Dataset, or a path to one (``analysis.files.as_dataset``), with ``ds.rocksweep``."""
+    from rocksweep.analysis.files import as_dataset
 
-    return _as_dataset(ds, what)
+    _check_dataset(what, ds)
+    return as_dataset(ds, what)
+
+
+def _typed(name: str, value: Any, ok: bool, allowed: str) -> None:
+    """The API's one type check of an argument: a one-line TypeError naming it, the value
+    (shortened) and what is allowed, unless ``ok``."""
+    if not ok:
+        text = repr(value)
+        text = text if len(text) <= 60 else f"{text[:40]}...{text[-12:]}"
+        raise TypeError(f"{name} = {text}: must be {allowed}")
+
+
+def _is_int(v: Any) -> bool:
+    """An integer, not a bool (True is no row number)."""
+    import numbers
+
+    return isinstance(v, numbers.Integral) and not isinstance(v, bool)
+
+
+def _is_number(v: Any) -> bool:
+    """A real number, not a bool."""
+    import numbers
+
+    return isinstance(v, numbers.Real) and not isinstance(v, bool)
+
+
+def _check_dataset(name: str, ds: Any) -> None:
+    import xarray as xr
+
+    _typed(name, ds, isinstance(ds, xr.Dataset | str | Path),
+           "an xarray Dataset (rocksweep.run, rocksweep.open or an analysis) or a path to "
+           "one")
+
+
+def _check_optional_text(**given: Any) -> None:
+    for name, v in given.items():
+        _typed(name, v, v is None or isinstance(v, str), "a string or None")
+
+
+def _check_flags(**given: Any) -> None:
+    import numpy as np
+
+    for name, v in given.items():
+        _typed(name, v, isinstance(v, bool | np.bool_), "True or False")
+
+
+def _check_ax(ax: Any) -> None:
+    """None, a matplotlib Axes or a sequence (list, array) of them."""
+    if ax is None:
+        return
+    from matplotlib.axes import Axes
+
+    if isinstance(ax, Axes):
+        return
+    import numpy as np
+
+    items = list(np.ravel(np.asarray(ax, dtype=object))) if isinstance(
+        ax, list | tuple | np.ndarray) else None
+    _typed("ax", ax, bool(items) and all(isinstance(a, Axes) for a in items),
+           "a matplotlib Axes, a sequence of them (one per panel) or None")
 
 
 # --- Analyses: a result Dataset in, a Dataset, a DataFrame or a Figure out ---------------
@@ -163,6 +217,14 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     """
     from rocksweep.figures.dispatch import plot_any
 
+    _check_dataset("ds", ds)
+    _check_ax(ax)
+    _check_optional_text(**{_names[0]: x, _names[1]: y, _names[2]: compare, "width": width})
+    _check_flags(curves=curves, show_computed=show_computed, mu=mu)
+    if isinstance(ds, str | Path):
+        from rocksweep.analysis.files import open_any
+
+        ds = open_any(ds)
     return plot_any(ds, x, y, ax=ax, curves=curves, show_computed=show_computed, mu=mu,
                     width=width, compare=compare, names=_names)
 
@@ -187,6 +249,7 @@ def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None,
     """
     from rocksweep.analysis.boundaries import boundaries_dataset
 
+    _check_dataset("ds", ds)
     return boundaries_dataset(ds, rtol, mode, search)
 
 
@@ -197,6 +260,7 @@ def boundary_lines(ds: xr.Dataset) -> Any:
     ``classes`` (e.g. "safe|mode1"), ``closed``, ``vertex``, ``x``, ``y`` (axis values)."""
     from rocksweep.analysis.boundaries import boundary_lines_frame
 
+    _check_dataset("ds", ds)
     return boundary_lines_frame(ds)
 
 
@@ -208,6 +272,7 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3, search: bool = True) -> xr.Datas
     (search=False: the grid's bracket bisected only, as for ``boundaries``)."""
     from rocksweep.analysis.spectrum import spectra as compute_spectra
 
+    _check_dataset("ds", ds)
     return compute_spectra(ds, rtol, search).to_dataset()
 
 
@@ -223,6 +288,7 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
     curves ``rocksweep.plot`` draws)."""
     from rocksweep.analysis.ida import ida_dataset
 
+    _check_dataset("ds", ds)
     return ida_dataset(ds, rtol)
 
 
@@ -272,7 +338,16 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = N
     ``reason``; beyond the hazard's range the rate is bounded, never extrapolated."""
     from rocksweep.analysis.risk import risk as compute
 
-    return compute(_dataset_arg(fr, "fr"), hazard, years, site=site)
+    _check_dataset("fr", fr)
+    _typed("years", years, _is_number(years), "a number of years > 0")
+    _typed("site", site, site is None or _is_int(site),
+           "an integer row number (0 = the first site) or None")
+    from rocksweep.analysis.risk import check_fragility
+    from rocksweep.outputs import shown
+
+    ds = _dataset_arg(fr, "fr")
+    check_fragility(ds, shown(fr) if isinstance(fr, str | Path) else "fr")
+    return compute(ds, hazard, years, site=site)
 
 
 @_public
@@ -364,6 +439,9 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     """
     from rocksweep.analysis.calibrate import calibrate_scene
 
+    _typed("bounds", bounds, bounds is None or isinstance(bounds, Mapping),
+           "a mapping {key: (lo, hi)}, e.g. {'impact.lam': (0, 1)}, or None")
+    _typed("p", p, p is None or _is_number(p), "a number (the body's p [rad/s]) or None")
     out = calibrate_scene(scene, measured, fit, bounds, ci, p, overrides)
     return out
 

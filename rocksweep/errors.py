@@ -101,6 +101,17 @@ class PlotError(RocksweepError, ValueError):
     """A Dataset that has no figure (figures.dispatch)."""
 
 
+class AnalysisWarning(UserWarning):
+    """An analysis of points that cannot all be trusted (``analysis.states.trust``: not
+    computed, flagged): the result is marked, and this warning says why (the command line
+    prints it as one ``Warning:`` line)."""
+
+
+class FragilityWarning(AnalysisWarning):
+    """A fitted fragility curve that should not be trusted as it is (its ``reason`` is
+    not "ok")."""
+
+
 class ApiError(RocksweepError, ValueError):
     """An argument of the Python API that cannot be used (api)."""
 

@@ -35,6 +35,8 @@ ANGLE_MIN = 1e-6  # [rad] smallest slenderness: h/b = 1e6
 CYCLES_MAX = 1000  # pulse.cycles: more cycles than this are no pulse
 GAMMA_MAX = 100.0  # pulse.gamma: MP's gamma is 1-3 for near-fault records; 100 is plenty
 E_FACTOR_MAX = 10.0  # impact.e_factor: experiments scale e by a few tens of per cent
+# initial rate and top-mass state: 1e3 x the scales (theta' = 1e3 p alpha overturns at once)
+INITIAL_MAX = 1e3
 
 
 @dataclass(frozen=True)
@@ -217,20 +219,41 @@ KEYS: dict[str, Key] = {
         "rocking on one corner, < 0 on the other)", -math.inf, math.inf, lo_in=False,
         hi_in=False, required=False, default=0.0),
     "initial.thetadot_over_palpha": Key(
-        "axis", "must be a finite number (theta'/(p alpha_cg) at t = 0)", -math.inf,
-        math.inf, lo_in=False, hi_in=False, required=False, default=0.0),
+        "axis", f"must be in [-{INITIAL_MAX:g}, {INITIAL_MAX:g}] (theta'/(p alpha_cg) at "
+        "t = 0)", -INITIAL_MAX, INITIAL_MAX, required=False, default=0.0),
     "initial.u_over_ucr": Key(
-        "axis", "must be a finite number (u/u_cr of the top mass at t = 0)", -math.inf,
-        math.inf, lo_in=False, hi_in=False, required=False, default=0.0),
+        "axis", f"must be in [-{INITIAL_MAX:g}, {INITIAL_MAX:g}] (u/u_cr of the top mass "
+        "at t = 0)", -INITIAL_MAX, INITIAL_MAX, required=False, default=0.0),
     "initial.udot_over_pucr": Key(
-        "axis", "must be a finite number (u'/(p u_cr) at t = 0)", -math.inf, math.inf,
-        lo_in=False, hi_in=False, required=False, default=0.0),
+        "axis", f"must be in [-{INITIAL_MAX:g}, {INITIAL_MAX:g}] (u'/(p u_cr) at t = 0)",
+        -INITIAL_MAX, INITIAL_MAX, required=False, default=0.0),
     "ground.avgsa": Key("string", "must be [T_lo, T_hi], periods in (0, 100] s with T_lo <= "
                         "T_hi (AvgSa's range; default 0.2-3 x scale.period for Sa stripes, "
                         "else 0.2-3 x 2 pi/p)", 0.0, 100.0, required=False),
     "ground.p": Key("axis", f"must be in [1e-3, {1e3:g}] rad/s (the body's frequency "
                     "parameter p)", 1e-3, 1e3),
+    # the vertical ground acceleration a_v, positive up (docs/vertical.md): a record's
+    # vertical component, scaled with ground.record, or a harmonic while the pulse acts
+    "ground.vertical": Key("string", "must be the path of the record's vertical component, "
+                           "a PEER .AT2 (UP) file or a two-column file (t [s], a_v [g], "
+                           "positive up), relative to the scene file, with ground.record",
+                           required=False),
+    "pulse.vertical": Key("string", "must be {amplitude: a [g], w_over_p: w_v/p, phase: "
+                          "deg} (a_v = a g sin(w_v t + phase) while the pulse acts)",
+                          required=False),
+    "pulse.vertical.amplitude": Key("axis", "must be a finite number [g] (the vertical "
+                                    "harmonic's amplitude; negative: the opposite sign)",
+                                    -math.inf, math.inf, lo_in=False, hi_in=False),
+    "pulse.vertical.w_over_p": Key("axis", "must be > 0 and finite (the vertical harmonic's "
+                                   "frequency w_v/p)", 0.0, math.inf, lo_in=False,
+                                   hi_in=False),
+    "pulse.vertical.phase": Key("axis", "must be a finite angle in degrees (the vertical "
+                                "harmonic's phase at t = 0)", -math.inf, math.inf,
+                                lo_in=False, hi_in=False, required=False, default=0.0),
 }
+# the vertical harmonic's keys (pulse.vertical.*), in the grid's dimension order; their
+# dimensions are named vertical.<key>
+VERTICAL_KEYS: tuple[str, ...] = ("amplitude", "w_over_p", "phase")
 
 # Keys of each body kind, in the grid's dimension order.
 BODY_KEYS: dict[str, tuple[str, ...]] = {

@@ -17,7 +17,7 @@ PKG = Path(__file__).resolve().parents[1] / "rocksweep"
 # files, computing, analyses, figures, the facade, the command line
 FLOORS: list[tuple[str, ...]] = [
     ("errors", "vocab"),
-    ("outputs", "interrupts", "kernel"),
+    ("outputs", "inputs", "interrupts", "kernel"),
     ("numerics", "outcomes"),
     ("schema",),
     ("physics",),

@@ -37,7 +37,6 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
-from pathlib import Path
 
 import numpy as np
 
@@ -308,7 +307,8 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
 
     _no_suite(scene)
     cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
-    rows_all = with_record(cr.rows, scene.record)  # a record's samples ride on each row
+    # a record's samples (and its vertical's) ride on each row
+    rows_all = with_record(cr.rows, scene.record, scene.vertical_samples())
     ground = scene.ground  # the Ricker, MP and records run the GROUND variants
     n = len(flat)
     outs = np.empty((n, L.N_OUT))
@@ -773,85 +773,3 @@ def format_table(study: Study) -> str:
         lines.append(f"  WARNING: the reference's self-check failed on {bad} points "
                      "(an impact with theta' pointing away from theta = 0)")
     return "\n".join(lines)
-
-
-def write_report(study: Study, path: str | Path, command: str = "", *,
-                 overwrite: bool = False) -> None:
-    """Write the study to HDF5, atomically (a temporary file renamed at the end).
-
-    Layout: attrs (scene name and YAML, sample description, reference tolerances, command,
-    observed orders); /table: one dataset per column, one entry per setting; /flips:
-    int64[settings, 3, 3] (reference outcome, kernel outcome); /sample: flat index, stratum,
-    weight and axis values per point, stratum names and sizes; /reference and
-    /kernel/<setting>: per point, every result field of the outcome-level kernel
-    (``REPORT_FIELDS``: outcome, impacts, uplifts, theta_max_over_alpha, t_overturn,
-    status, steps (regular RK4 steps), event_steps, t_end, t_first_impact, e_max,
-    returns_to_contact, each with ``units``) and seconds (with ``check``, also the
-    ``fields.CHECK_FIELDS`` of the half-step reruns). In /reference, steps are
-    DOP853's steps and event_steps 0 (``reference.result_row``).
-    """
-    import h5py
-
-    from rocksweep.outputs import atomic_path
-    from rocksweep.physics.reference import ATOL, RTOL
-
-    with atomic_path(path, overwrite=overwrite) as tmp:
-        with h5py.File(tmp, "w") as f:
-            f.attrs["format"] = "rocksweep-accuracy-1"
-            f.attrs["scene_name"] = study.scene.name
-            f.attrs["scene_yaml"] = study.scene.text
-            f.attrs["numerics"] = study.scene.numerics.describe()
-            f.attrs["command"] = command
-            f.attrs["reference"] = f"scipy solve_ivp DOP853, rtol {RTOL:g}, atol {ATOL:g}"
-            f.attrs["points_in_scene"] = study.sample.size
-            f.attrs["points_sampled"] = len(study.sample.flat)
-            f.attrs["classify_seconds"] = study.sample.classify_seconds
-            f.attrs["wall_seconds"] = study.wall_seconds
-            f.attrs["time_per_point"] = ("median: each point timed as a 1-row chunk; mean: "
-                                         "weighted by stratum (scene estimate); total_s: one "
-                                         "call on the sample, best of repeats")
-            for m, orders in study.orders.items():
-                f.attrs[f"observed_order_{m}"] = np.array(
-                    [(a, b, p) for a, b, p in orders], float).reshape(-1, 3)
-            table = study.table()
-            g = f.create_group("table")
-            for key in table[0]:
-                col = [d[key] for d in table]
-                if isinstance(col[0], str):
-                    g.create_dataset(key, data=np.array(col, dtype=h5py.string_dtype()))
-                else:
-                    g.create_dataset(key, data=np.asarray(col))
-            f.create_dataset("flips", data=np.stack([r.flips for r in study.results]))
-            f["flips"].attrs["axes"] = "setting, reference outcome, kernel outcome"
-            f["flips"].attrs["outcomes"] = ", ".join(OUTCOMES)
-            s = f.create_group("sample")
-            s.create_dataset("flat_index", data=study.sample.flat)
-            s.create_dataset("stratum", data=study.sample.stratum)
-            s.create_dataset("weight", data=study.sample.weight)
-            s.create_dataset("strata", data=np.array(study.sample.strata,
-                                                     dtype=h5py.string_dtype()))
-            s.create_dataset("stratum_size", data=study.sample.stratum_size)
-            for k, v in study.values.items():
-                v = np.asarray(v)
-                s.create_dataset(k, data=v.astype(h5py.string_dtype()) if v.dtype.kind in "US"
-                                 else v)
-            g = f.create_group("reference")
-            _write_runs(g, study.reference, study.reference_seconds, study.alpha_ref)
-            if study.reference_anomalies is not None:
-                g.create_dataset("anomalies", data=study.reference_anomalies)
-            k = f.create_group("kernel")
-            for r in study.results:
-                g = k.create_group(r.setting.name)
-                _write_runs(g, r.outs, r.seconds, study.alpha_ref)
-                if r.half is not None:  # the per-point estimates, as a sweep stores them
-                    for name, arr in fields.convert_check(r.outs, r.half,
-                                                          study.alpha_ref).items():
-                        g.create_dataset(name, data=arr).attrs["units"] = fields.UNITS[name]
-
-
-def _write_runs(g, outs: np.ndarray, seconds: np.ndarray, alpha_ref: np.ndarray) -> None:
-    # every field the outcome-level kernel reports (rocksweep.fields), in its unit
-    for name, arr in fields.convert(outs, alpha_ref, np.nan, REPORT_FIELDS).items():
-        ds = g.create_dataset(name, data=arr)
-        ds.attrs["units"] = fields.UNITS[name]
-    g.create_dataset("seconds", data=seconds)

@@ -85,13 +85,13 @@ from rocksweep.analysis.states import (
     state_groups,
     state_reached,
 )
-from rocksweep.errors import FragilityError
+from rocksweep.errors import FragilityError, FragilityWarning
 from rocksweep.fields import plain
 from rocksweep.vocab.ground import CLOUD_IMS as CLOUD_IM_VARIABLES
 from rocksweep.vocab.ground import SCALE_IMS
 from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, UPLIFT
 
-__all__ = ["Fit", "FragilityWarning", "REASONS", "STRIPE_IMS",
+__all__ = ["Fit", "REASONS", "STRIPE_IMS",
            "curves_json", "fit_cloud", "fit_stripes", "fragility", "probability"]
 
 #: stripe dimension names (the sweep's ``scale_im``) and their units
@@ -110,10 +110,6 @@ NONMONOTONE_SIMS = 400
 NONMONOTONE_BATCH = 25  # simulations between checks of whether the verdict is decided
 CENSORED_SHARE = 0.1
 FLAGGED_SHIFT = 0.01
-
-
-class FragilityWarning(UserWarning):
-    """A fitted curve that should not be trusted as it is (its ``reason`` is not "ok")."""
 
 
 class Fit(tuple):

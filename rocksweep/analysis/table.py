@@ -52,6 +52,10 @@ def table(ds: xr.Dataset) -> Any:
     kind = dataset_kind(ds)
     if kind is None:
         raise TableError("not a rocksweep Dataset (a sweep or an analysis's result)")
+    if kind == "sweep":  # every row is written; a partial file's are said to be missing
+        from rocksweep.analysis.states import trust
+
+        trust(ds, "table")
     main = ROW_VARIABLE[kind]
     main = next((m for m in (main if isinstance(main, tuple) else (main,)) if m in ds),
                 None)

@@ -22,7 +22,14 @@ from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outputs import shown
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import H5_ERRORS, close_quietly, cut_repr, damaged, error_reason
-from rocksweep.store.format import FORMAT, FORMAT_VERSION, RECORD_GROUP, SUITE_GROUP, variables_for
+from rocksweep.store.format import (
+    FORMAT,
+    FORMAT_VERSION,
+    RECORD_GROUP,
+    SUITE_GROUP,
+    VERTICAL_GROUP,
+    variables_for,
+)
 from rocksweep.store.identity import resolved_scene, scene_differences
 from rocksweep.vocab.outcomes import CLASSES, COMPUTED_FLAGS, OUTCOME_CODE, OUTCOME_WORDS
 from rocksweep.vocab.settings import ADAPTIVE_RESOLVED
@@ -533,13 +540,14 @@ def as_result(data, names: list[str] | None = None) -> SweepResult:
     return result_of(data)
 
 
-def stored_record(path: Path, rec: dict):
-    """The record a result file keeps (``_store_record``) as a ``GroundRecord`` with the
-    sweep's source path, checked against the file's SHA-256; None for a file that keeps
-    no copy (made before records were stored). StoreError if the copy is damaged."""
+def stored_record(path: Path, rec: dict, group: str = RECORD_GROUP):
+    """The record a result file keeps (``_store_record``; ``group`` VERTICAL_GROUP: its
+    vertical component's) as a ``GroundRecord`` with the sweep's source path, checked
+    against the file's SHA-256; None for a file that keeps no copy (made before records
+    were stored). StoreError if the copy is damaged."""
     f = open_h5(path, "r")
     try:
-        g = f.get(RECORD_GROUP)
+        g = f.get(group)
         d = g.get("file") if g is not None else None
         if d is None:
             return None
@@ -628,6 +636,9 @@ def result_scene(result: SweepResult) -> Scene:
                 raise StoreError(f"{shown(result.path)}: the record {rec['source']} changed "
                                  f"since the sweep (sha256 {record.sha256[:12]}, the result "
                                  f"has {rec['sha256'][:12]})")
+    vert = result.scene.get("vertical")
+    vertical = (stored_record(result.path, vert, VERTICAL_GROUP) if vert and result.in_file
+                else None)  # None: re-read from where the sweep read it (sha256 compared)
     records = stored_records(result.path, suite) if suite and result.in_file else None
     if suite and records is None:
         # a file without copies (older rocksweep) or a Dataset made in memory: the records
@@ -636,7 +647,7 @@ def result_scene(result: SweepResult) -> Scene:
             [str(r.get("source")) for r in suite.get("records") or []]))
     try:
         sc = parse_scene(str(a["scene"]), str(result.path), overrides, record=record,
-                         records=records)
+                         records=records, vertical=vertical)
     except RocksweepError as err:
         raise StoreError(f"{shown(result.path)}: cannot rebuild its scene ({err})") from None
     stored = {k: v for k, v in result.scene.items() if k != "adaptive"}

@@ -43,9 +43,9 @@ from rocksweep.store.format import (
     ADAPTIVE_COUNT_ATTRS,
     HISTORY_BYTES,
     SESSION_ATTRS,
-    file_bytes,
     flat_slabs,
     initialise,
+    metadata,
     versions,
 )
 from rocksweep.store.identity import resolved_scene, scene_differences
@@ -173,8 +173,8 @@ class SweepFile:
         if existed and not overwrite:
             raise StoreError(f"{shown(path)}: already exists; use --resume to finish it or "
                              "--overwrite to replace it")
-        nbytes = file_bytes(scene, adaptive is not None)
-        reserve = reserve_bytes(scene, nbytes)
+        meta = metadata(scene, overrides, adaptive)  # before anything is made
+        reserve = reserve_bytes(scene, meta.nbytes)
         removed = clean_stale_partials(path)  # a killed attempt's reserved space back
         if removed and log is not None:
             log(f"removed {len(removed)} stale temporary file{'s' * (len(removed) > 1)} of "
@@ -195,7 +195,7 @@ class SweepFile:
             g = h5py.File(tmp, "w", track_order=True)  # truncates: reserve again
             try:
                 reserve_space(tmp, reserve)
-                initialise(g, scene, overrides, adaptive)
+                initialise(g, meta)
                 g.flush()
                 size = g.id.get_filesize()  # HDF5's end of allocation (eof is stale)
             except BaseException:
@@ -239,7 +239,7 @@ class SweepFile:
         name = f"rocksweep-memory-{os.getpid()}-{id(scene)}.h5"
         f = h5py.File(name, "w", driver="core", backing_store=False, track_order=True)
         try:
-            initialise(f, scene, overrides, adaptive)
+            initialise(f, metadata(scene, overrides, adaptive))
             self = cls(Path("memory"), f, grid if grid is not None else Grid(scene),
                        backend, adaptive)
             self._start_session()

@@ -230,7 +230,7 @@ def test_cli_writes_csv_and_h5(tmp_path, frag_file):
     h5 = tmp_path / "r.h5"
     assert CliRunner().invoke(main, ["risk", str(frag_file), "--hazard", str(hz), "-o",
                                      str(h5)]).exit_code == 0
-    back = rocksweep.api.open_any(h5)
+    back = rocksweep.open(h5)
     assert back.attrs["rocksweep_kind"] == "risk"
     fig = rocksweep.plot(back)
     assert len(fig.axes) == 3

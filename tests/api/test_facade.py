@@ -99,9 +99,9 @@ def test_fragility_of_a_path_is_that_of_its_dataset(suite_result, suite_ds):
 
 
 def test_fragility_of_neither_is_one_line():
-    with pytest.raises(ApiError) as exc:
+    with pytest.raises(TypeError) as exc:  # a wrong type is a TypeError naming the argument
         rocksweep.fragility(5)
-    assert str(exc.value).startswith("ds = int: must be an xarray Dataset")
+    assert str(exc.value).startswith("ds = 5: must be an xarray Dataset")
     assert "\n" not in str(exc.value)
 
 

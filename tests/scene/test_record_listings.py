@@ -61,7 +61,7 @@ def test_a_utf8_listing_is_read_with_or_without_a_bom(d, head, end):
 @pytest.mark.parametrize("data, words", [
     ("r/SYN01.AT2\nr/SYN02.AT2\n".encode("utf-16"), "UTF-16"),
     ("r/SYN01.AT2\n".encode("utf-16-be"), "a NUL byte"),
-    (bytes(range(1, 256)) * 2, "not a text listing"),
+    (bytes(range(1, 256)) * 2, "is not UTF-8"),
     (b"r/SYN01.AT2\x00\nr/SYN02.AT2\n", "line 1: a NUL byte"),
     (b"r/SYN01.AT2\nr/SYN02.AT2\x1b[0m\n", "line 2: character 0x1b"),
 ])

@@ -107,7 +107,7 @@ def test_scene_errors_are_one_line(tmp_path):
     both = SCENE % "x.AT2" + "pulse: {shape: sine, w_over_p: 1, A_ratio: 1}\n"
     with pytest.raises(SceneError, match="pulse, ground: give one of them"):
         parse_scene(both)
-    with pytest.raises(SceneError, match=r"ground.record: .*missing.AT2.*cannot be read"):
+    with pytest.raises(SceneError, match=r"ground.record: .*missing.AT2: no such record file"):
         parse_scene(SCENE % "missing.AT2", base=tmp_path)
     bad = tmp_path / "bad.AT2"
     bad.write_text("a\nb\nc\nNPTS= 3, DT= .01 SEC\n1 2\n")
