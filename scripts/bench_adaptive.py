@@ -1,4 +1,4 @@
-"""Adaptive vs full sweeps, side by side in one run (issue 11).
+"""Adaptive vs full sweeps, side by side in one run.
 
 For each scene: the full grid and the adaptive sweep (default settings), both in memory
 through the sweep driver (``rocksweep.compute.driver.sweep_arrays``) with the same workers; prints

@@ -1,4 +1,4 @@
-"""The issue-29 study, timed stage by stage: 44 records x 16 PGA stripes x 3 lam, a fit with
+"""A record-suite risk study, timed stage by stage: 44 records x 16 PGA stripes x 3 lam, a fit with
 3 damage states, the IM efficiency and the risk over a hazard curve (target: < 15 s on 2
 cores, everything in).
 
