@@ -37,7 +37,15 @@ Verdicts (``reason``: "ok", or the words below joined by ","; never "ok" for the
 - "bootstrap_undefined": more than (1 - ci) / 2 of the resamples have no finite fit (then
   the interval's tail on that side is not known);
 - "censored": a mode fitted alone while the other mode holds >= ``CENSORED_SHARE`` of the
-  overturning points (fit state=["mode1", "mode2"] for the competing-risk fit);
+  overturning points (fit state=["mode1", "mode2"], joint=True for the competing-risk
+  fit);
+- "crossing" (separate fits, the default): a more severe nested state's curve lies above a
+  milder one's by more than ``CROSSING_TOL`` inside the IM range of the data (a point
+  cannot reach overturning without reaching theta:X): the curves are not both right there;
+  said on both states;
+- "parallel_rejected" (``joint=True``): the likelihood-ratio test of the ordinal fit's
+  common beta against a beta per state (``likelihood.parallel_lr``) rejects it at
+  ``PARALLEL_P``: the joint curves misstate the data; fit the states separately;
 - "incomplete": points of the curve not computed (outcome -1: a partial file, or a sweep
   still writing it); "flagged": points flagged by the kernel (horizon, caps) are left out
   and counting them as reaching the state, or as not, moves im_median by more than
@@ -60,6 +68,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from rocksweep.analysis.counts import STRIPE_IMS, Counts, IMAxis, count_points, im_axis
 from rocksweep.analysis.likelihood import (
     BOOT_ELEMENTS,
     CODE,
@@ -72,35 +81,29 @@ from rocksweep.analysis.likelihood import (
     isotonic_lr,
     lognormal_cdf,
     mle_batch,
+    parallel_lr,
     percentile_interval,
     resample_weights,
     stripe_rules,
 )
 from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP
 from rocksweep.analysis.states import (
-    counted_points,
-    parse_state,
     parse_states,
     required,
+    severity,
     state_groups,
-    state_reached,
 )
 from rocksweep.errors import FragilityError, FragilityWarning
 from rocksweep.fields import plain
-from rocksweep.vocab.ground import CLOUD_IMS as CLOUD_IM_VARIABLES
-from rocksweep.vocab.ground import SCALE_IMS
-from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, UPLIFT
+from rocksweep.vocab.ground import AVGSA
+from rocksweep.vocab.outcomes import MODE1, MODE2
 
-__all__ = ["Fit", "REASONS", "STRIPE_IMS",
+__all__ = ["Fit", "REASONS",
            "curves_json", "fit_cloud", "fit_stripes", "fragility", "probability"]
 
-#: stripe dimension names (the sweep's ``scale_im``) and their units
-STRIPE_IMS = SCALE_IMS
-#: cloud IMs and the per-record variables they come from
-CLOUD_IMS = {im: (var, SCALE_IMS[im]) for im, var in CLOUD_IM_VARIABLES.items()}
 #: the quality words that follow how a fit ended (``likelihood.ENDINGS``)
 QUALITY = ("beta_undetermined", "non_monotone", "extrapolated", "bootstrap_undefined",
-           "censored", "incomplete", "flagged")
+           "censored", "incomplete", "flagged", "crossing", "parallel_rejected")
 REASONS = ENDINGS + QUALITY
 BAND_POINTS = 101
 #: the pointwise band is taken over at most this many resamples (the first ones)
@@ -109,6 +112,13 @@ NONMONOTONE_P = 0.01
 NONMONOTONE_SIMS = 400
 NONMONOTONE_BATCH = 25  # simulations between checks of whether the verdict is decided
 CENSORED_SHARE = 0.1
+#: "crossing": a more severe state's separate curve above a milder one's by more than this
+#: probability somewhere inside the stripes' (or the records') IM range (one percentage
+#: point: theta:0.5 and overturning of a slender body, nearly one state, cross by 0.003
+#: on the demo suite, less than a reader can see)
+CROSSING_TOL = 0.01
+#: "parallel_rejected": the common beta of a joint ordinal fit rejected at this level
+PARALLEL_P = 0.05
 FLAGGED_SHIFT = 0.01
 
 
@@ -266,41 +276,6 @@ def fit_cloud(im: Sequence[float] | np.ndarray, failed: Sequence[bool] | np.ndar
 # ---------------------------------------------------------------------------------------
 
 
-def _cloud_im(ds: xr.Dataset, im: str | None, period: float | None
-              ) -> tuple[np.ndarray, str, str, float]:
-    name = "PGA" if im is None else str(im)
-    if name not in CLOUD_IMS:
-        raise FragilityError(f"im = {im!r}: a cloud (no stripe dimension) takes one of "
-                             f"{', '.join(CLOUD_IMS)}")
-    var, unit = CLOUD_IMS[name]
-    da = required(ds, var, f"the per-record {name} of a cloud")
-    per = math.nan
-    if name == "Sa":
-        if "period" not in da.dims:
-            raise FragilityError(f"{var} has no 'period' dimension")
-        periods = np.asarray(da["period"].values, dtype=np.float64)
-        if period is None:
-            if periods.size != 1:
-                raise FragilityError(f"im = 'Sa' needs period= (one of "
-                                     f"{', '.join(f'{p:g}' for p in periods)} s)")
-            period = float(periods[0])
-        hit = np.flatnonzero(np.isclose(periods, float(period), rtol=1e-9, atol=0.0))
-        if hit.size == 0:
-            raise FragilityError(f"period = {period!r}: {var} holds periods "
-                                 f"{', '.join(f'{p:g}' for p in periods)} s")
-        da = da.isel(period=int(hit[0]))
-        per = float(periods[hit[0]])
-    if set(da.dims) != {"record"}:
-        raise FragilityError(f"{var} must lie along 'record' only, has {da.dims}")
-    x = np.asarray(da.transpose("record").values, dtype=np.float64)
-    if "scale_factor" in ds.variables:
-        x = x * np.asarray(ds["scale_factor"].transpose("record").values, dtype=np.float64)
-    if np.any(~np.isfinite(x) | (x <= 0.0)):
-        bad = ds["record"].values[~np.isfinite(x) | (x <= 0.0)][0]
-        raise FragilityError(f"record {bad}: {name} must be finite and > 0 for a cloud fit")
-    return x, name, unit, per
-
-
 def _check_args(ds: Any, im: Any, period: Any, seed: Any) -> None:
     if not isinstance(ds, xr.Dataset):
         raise FragilityError(f"ds = {type(ds).__name__}: must be a result Dataset "
@@ -314,24 +289,6 @@ def _check_args(ds: Any, im: Any, period: Any, seed: Any) -> None:
                              "stored ground.periods), with im='Sa'")
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
         raise FragilityError(f"seed = {seed!r}: must be an integer >= 0")
-
-
-def _refuse_filled(ds: xr.Dataset, states: Sequence[str], counted: xr.DataArray) -> None:
-    """An adaptive sweep's filled points carry only the class: refuse states that need
-    more (uplift, theta:X)."""
-    if "computed" not in ds.variables:
-        return
-    from rocksweep.compute.adaptive import FILLED
-
-    filled = (ds["computed"] == FILLED) & counted
-    n = int(filled.sum())
-    need = [s for s in states if parse_state(s)[0] in (UPLIFT, "theta")]
-    if n and need:
-        raise FragilityError(
-            f"state {need[0]!r}: {n} points of this adaptive sweep were filled from the class "
-            "around them, not computed, so their uplift and theta are unknown; only "
-            f"{OVERTURN}, {MODE1} and {MODE2} can be fitted (a sweep that computes every "
-            "point can give it)")
 
 
 def _missing_text(not_run: np.ndarray, levels: np.ndarray | None, unit: str,
@@ -356,7 +313,7 @@ def _missing_text(not_run: np.ndarray, levels: np.ndarray | None, unit: str,
 def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
               im: str | None = None, period: float | None = None,
               bootstrap: int | None = None, seed: int = 0, ci: float = 0.9,
-              warn: bool = True) -> xr.Dataset:
+              warn: bool = True, joint: bool = False) -> xr.Dataset:
     """Lognormal fragility curves of a record-suite sweep (Baker 2015) with their verdicts.
 
     ds (the sweep's contract): variables ``outcome`` (int8: -1 not computed, 0 safe, 1
@@ -372,8 +329,11 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
 
     state: one state word or a list (then a ``state`` dimension): "overturn" (outcome 1 or
     2), "mode1", "mode2", "uplift" (uplifts > 0 or overturned), "theta:X"
-    (theta_max_over_alpha >= X or overturned, 0 < X <= 1). Two or more of uplift, theta:X,
-    overturn are fitted as ordered damage states (one beta: the curves never cross);
+    (theta_max_over_alpha >= X or overturned, 0 < X <= 1). Every state is fitted alone
+    (its numbers do not depend on the other states asked for; nested curves that cross
+    inside the data say "crossing"); ``joint=True`` fits two or more of uplift, theta:X,
+    overturn as ordered damage states (one beta: the curves never cross; the likelihood-
+    ratio test of that beta is stored, "parallel_rejected" where the data reject it) and
     mode1 with mode2 as competing risks (module docstring). bootstrap: resamples over
     records (0: no intervals, NaN; None: ``DEFAULT_BOOTSTRAP``; at most
     ``MAX_BOOTSTRAP``); seed: the Generator's
@@ -391,18 +351,26 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     ``n_failed`` over (state, others, stripe) and ``n_counted`` over (others, stripe), and
     per record ``first_level`` (smallest level that reaches the state; NaN if none) and
     ``resurrection`` (a higher counted level does not reach it) over (state, others,
-    record). attrs: rocksweep_kind "fragility" (``analysis.kinds``), title (the sweep's),
-    method ("stripes-mle" | "cloud-mle"), im, im_units, period (Sa), states, bootstrap,
-    seed, ci, reference.
+    record). With ``joint`` and an ordinal group, over the other dims: ``parallel_lr``
+    (2 ln of the likelihood ratio, beta per state against the common one),
+    ``parallel_dof``, ``parallel_p`` (chi-square p-value) and ``parallel_rejected``
+    (parallel_p < ``PARALLEL_P``). attrs: rocksweep_kind "fragility" (``analysis.kinds``),
+    title (the sweep's), method ("stripes-mle" | "cloud-mle"), im, im_units, period (Sa),
+    avgsa_periods (AvgSa stripes), states, joint, bootstrap, seed, ci, reference.
     """
     states, N, ci = _request(ds, state, im, period, bootstrap, seed, ci)
+    if not isinstance(joint, bool | np.bool_):
+        raise FragilityError(f"joint = {joint!r}: True or False (one beta for nested damage "
+                             "states, competing risks for mode1 with mode2)")
     out_da = ds["outcome"]
-    axis = _im_axis(ds, out_da, im, period)
-    counts = _count(ds, states, axis, out_da)
+    axis = im_axis(ds, out_da, im, period)
+    counts = count_points(ds, states, axis, out_da)
     N = check_bootstrap(N, len(states) * counts.n_o)
     grid = np.geomspace(axis.x.min() / 2.0, axis.x.max() * 1.5, BAND_POINTS)
-    groups = state_groups(states)
+    groups = state_groups(states, bool(joint))
     fits = _point_fits(counts, groups, states, axis, grid, N)
+    if not joint:
+        _crossing(fits, counts, states, axis)
     if N:
         _bootstrap_fits(fits, counts, groups, axis, N, seed)
         _bootstrap_intervals(fits, groups, grid, N, ci)
@@ -414,6 +382,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
             for i in range(len(states)):
                 fits.why[i][o]["incomplete"] = text
     out = _dataset(ds, state, states, axis, counts, fits, grid, N, seed, ci)
+    out.attrs["joint"] = np.int8(bool(joint))
     if warn:
         for text in verdict_lines(out, fits.why):
             warnings.warn(text, FragilityWarning, stacklevel=2)
@@ -431,113 +400,14 @@ def _request(ds: Any, state: Any, im: Any, period: Any, bootstrap: Any, seed: An
     N = check_bootstrap(bootstrap, 1)
     out_da = required(ds, "outcome", "outcome codes")
     if "record" not in out_da.dims:
-        raise FragilityError("outcome has no 'record' dimension: not a record-suite sweep")
+        where = ds.encoding.get("source")  # the file it was opened from, if any
+        raise FragilityError(f"{where + ': ' if where else ''}outcome has no 'record' "
+                             "dimension: not a record-suite sweep (a scene with ground.records: a "
+                             "list of record files, and ground.scale)")
     names = [str(r) for r in ds["record"].values]
     if len(set(names)) != len(names):
         raise FragilityError("record: the coordinate lists a record twice")
     return states, N, ci
-
-
-@dataclass(frozen=True)
-class _Axis:
-    """The IM of a fit: stripes (``stripe`` the dimension, ``x`` its levels (S,)) or a
-    cloud (``stripe`` None, ``x`` the records' IMs (R,)); [unit] each."""
-
-    stripe: str | None
-    x: np.ndarray
-    im_name: str
-    unit: str
-    period: float  # Sa's period [s], NaN for other IMs
-    method: str  # "stripes-mle" | "cloud-mle"
-
-    @property
-    def stripes(self) -> bool:
-        return self.stripe is not None
-
-
-def _im_axis(ds: xr.Dataset, out_da: xr.DataArray, im: str | None, period: float | None
-             ) -> _Axis:
-    """Stripes if the outcome lies along the sweep's ``scale_im``, else a cloud."""
-    scale_im = ds.attrs.get("scale_im")
-    stripe = str(scale_im) if scale_im is not None and str(scale_im) in out_da.dims else None
-    if scale_im not in (None, "", "none") and stripe is None:
-        raise FragilityError(f"scale_im = {scale_im!r} but outcome has no such dimension")
-    if stripe is None:
-        if period is not None and (im is None or str(im) != "Sa"):
-            raise FragilityError(f"period = {period!r}: only with im='Sa'")
-        rec_im, im_name, unit, per = _cloud_im(ds, im, period)
-        return _Axis(None, rec_im, im_name, unit, per, "cloud-mle")
-    if stripe not in STRIPE_IMS:
-        raise FragilityError(f"scale_im = {stripe!r}: one of {', '.join(STRIPE_IMS)}")
-    if im is not None and str(im) != stripe:
-        raise FragilityError(f"im = {im!r}: the stripes are levels of {stripe}; a "
-                             "stripe fit uses that IM")
-    levels = np.asarray(ds[stripe].values, dtype=np.float64)
-    if np.any(~np.isfinite(levels) | (levels <= 0.0)):
-        raise FragilityError(f"{stripe}: every stripe level must be finite and > 0")
-    per = float(ds.attrs.get("scale_period", math.nan)) if stripe == "Sa" else math.nan
-    if period is not None and not (stripe == "Sa" and math.isclose(
-            float(period), per, rel_tol=1e-9)):
-        raise FragilityError(f"period = {period!r}: the stripes are {stripe}"
-                             + (f" at T = {per:g} s" if stripe == "Sa" else "")
-                             + "; leave period out")
-    return _Axis(stripe, levels, stripe, STRIPE_IMS[stripe], per, "stripes-mle")
-
-
-@dataclass(frozen=True)
-class _Counts:
-    """The points of every curve: the other dims (``others``, sizes ``shape_o``) flattened
-    to n_o curves; bool arrays over (n_o, R[, S]) (records, stripes), ``hits`` over
-    (states, n_o, R[, S])."""
-
-    others: list[str]
-    shape_o: tuple[int, ...]
-    names: list[str]  # the records
-    counted: np.ndarray
-    flagged: np.ndarray
-    not_run: np.ndarray
-    hits: np.ndarray  # the point reaches the state
-    over_all: np.ndarray  # the point overturns (either mode)
-
-    @property
-    def n_o(self) -> int:
-        return self.counted.shape[0]
-
-    @property
-    def R(self) -> int:
-        return self.counted.shape[1]
-
-    def onehot(self, kind: str, idxs: list[int], o: int, mask: np.ndarray) -> np.ndarray:
-        """(C, R[, S]) float: each point of ``mask`` in its category of the group."""
-        h = self.hits[idxs, o] & mask[None]
-        if kind == "single":
-            cat = h[0].astype(np.int64)
-        else:  # ordinal: the most severe reached; competing: 1 mode 1, 2 mode 2
-            cat = np.max(np.stack([(j + 1) * h[j] for j in range(len(idxs))]), 0)
-        C = len(idxs) + 1
-        return np.stack([(cat == c) & mask for c in range(C)]).astype(np.float64)
-
-
-def _count(ds: xr.Dataset, states: list[str], axis: _Axis, out_da: xr.DataArray
-           ) -> _Counts:
-    """Which points are counted, flagged, not run, and reach each state."""
-    others = [d for d in out_da.dims if d not in ("record", axis.stripe)]
-    order = others + ["record"] + ([axis.stripe] if axis.stripes else [])
-    counted_da, flagged_da, not_run_da = counted_points(ds)
-    _refuse_filled(ds, states, counted_da)
-    shape_o = tuple(ds.sizes[d] for d in others)
-    n_o = int(np.prod(shape_o)) if shape_o else 1
-    R = ds.sizes["record"]
-    tail = (R, ds.sizes[axis.stripe]) if axis.stripes else (R,)
-
-    def flat(da: xr.DataArray) -> np.ndarray:
-        return da.transpose(*order).values.reshape((n_o,) + tail)
-
-    hits = np.stack([state_reached(ds, s).transpose(*order).values for s in states])
-    return _Counts(others, shape_o, [str(r) for r in ds["record"].values],
-                   flat(counted_da), flat(flagged_da), flat(not_run_da),
-                   hits.reshape((len(states), n_o) + tail),
-                   flat(state_reached(ds, OVERTURN)))
 
 
 @dataclass
@@ -554,14 +424,16 @@ class _Fits:
     band: np.ndarray
     samples: np.ndarray
     n_undef: np.ndarray
+    #: the joint ordinal fit's test of its common beta per curve: (statistic, dof) (n_o,)
+    parallel: tuple[np.ndarray, np.ndarray] | None = None
 
 
 _UNDETERMINED = {"one_stripe": "one IM level counted",
                  "separated": "separated data: the likelihood grows as beta -> 0"}
 
 
-def _point_fits(c: _Counts, groups: list[tuple[str, list[int]]], states: list[str],
-                axis: _Axis, grid: np.ndarray, N: int) -> _Fits:
+def _point_fits(c: Counts, groups: list[tuple[str, list[int]]], states: list[str],
+                axis: IMAxis, grid: np.ndarray, N: int) -> _Fits:
     """The fit of the counted points of every group and curve, with its data verdicts."""
     nS, n_o = len(states), c.n_o
     f = _Fits({v: np.full((nS, n_o), np.nan) for v in
@@ -590,11 +462,72 @@ def _point_fits(c: _Counts, groups: list[tuple[str, list[int]]], states: list[st
                         ending, "fewer than 2 distinct stripe fractions strictly between 0 "
                         "and 1")
             _verdicts(kind, idxs, o, lnx, m, med[0], bet[0], f.why, c, states, axis.stripes)
+            if kind == "ordinal":
+                _parallel(f, o, idxs, lnx, m[0], med[0], bet[0])
     return f
 
 
-def _bootstrap_fits(f: _Fits, c: _Counts, groups: list[tuple[str, list[int]]],
-                    axis: _Axis, N: int, seed: int) -> None:
+def _parallel(f: _Fits, o: int, idxs: list[int], lnx: np.ndarray, m: np.ndarray,
+              med: np.ndarray, bet: np.ndarray) -> None:
+    """The likelihood-ratio test of an ordinal fit's common beta (``likelihood.
+    parallel_lr``) for curve o, on the states it fitted (finite im_median and beta), and
+    the "parallel_rejected" verdict."""
+    from scipy.stats import chi2
+
+    if f.parallel is None:
+        f.parallel = (np.full(f.n_undef.shape[1], np.nan),
+                      np.zeros(f.n_undef.shape[1], np.int64))
+    use = [q for q in range(len(idxs)) if np.isfinite(med[q]) and np.isfinite(bet[q])]
+    if len(use) < 2:
+        return
+    # the counts of the fitted states: the categories of the others merged downwards
+    reach = np.cumsum(m[::-1], 0)[::-1]  # (K+1, P): reaching category c or above
+    sub_reach = reach[[0] + [q + 1 for q in use]]
+    sub = sub_reach - np.concatenate([sub_reach[1:], np.zeros((1, m.shape[1]))], 0)
+    stat, dof = parallel_lr(lnx, sub, med[use], float(bet[use[0]]))
+    f.parallel[0][o], f.parallel[1][o] = stat, dof
+    p = float(chi2.sf(stat, dof))
+    if p < PARALLEL_P:
+        for q in use:
+            f.why[idxs[q]][o]["parallel_rejected"] = (
+                f"likelihood ratio {stat:.3g} on {dof} dof, p = {p:.2g}: one beta does "
+                "not fit these states; fit them separately (joint=False)")
+
+
+def _crossing(f: _Fits, c: Counts, states: list[str], axis: IMAxis) -> None:
+    """The "crossing" verdict of separate fits: a more severe nested state's curve above
+    a milder one's by more than ``CROSSING_TOL`` inside the IM range of the counted
+    data (stripes with a counted point; a cloud's counted records)."""
+    nested = sorted((i for i, s in enumerate(states) if not math.isnan(severity(s))),
+                    key=lambda i: severity(states[i]))
+    if len(nested) < 2:
+        return
+    for o in range(c.n_o):
+        if axis.stripes:
+            have = c.counted[o].any(0)
+            x = axis.x[have]
+        else:
+            x = axis.x[c.counted[o].astype(bool)]
+        if x.size < 2:
+            continue
+        xs = np.geomspace(x.min(), x.max(), BAND_POINTS)
+        for a, mild in enumerate(nested):
+            for severe in nested[a + 1:]:
+                pm = lognormal_cdf(xs, f.res["im_median"][mild, o], f.res["beta"][mild, o])
+                ps = lognormal_cdf(xs, f.res["im_median"][severe, o],
+                                   f.res["beta"][severe, o])
+                gap = ps - pm
+                if not np.any(np.isfinite(gap)) or np.nanmax(gap) <= CROSSING_TOL:
+                    continue
+                at = xs[int(np.nanargmax(gap))]
+                text = (f"{states[severe]} above {states[mild]} by up to "
+                        f"{np.nanmax(gap):.3g} (at {at:.3g} {axis.unit}) inside the data")
+                f.why[mild][o]["crossing"] = text
+                f.why[severe][o]["crossing"] = text
+
+
+def _bootstrap_fits(f: _Fits, c: Counts, groups: list[tuple[str, list[int]]],
+                    axis: IMAxis, N: int, seed: int) -> None:
     """Every group refitted on N resamples of the records (in ``f.samples``), started from
     the point fit; resamples without a finite fit are NaN."""
     lnx = np.log(axis.x)
@@ -649,7 +582,7 @@ def _bootstrap_intervals(f: _Fits, groups: list[tuple[str, list[int]]], grid: np
                         f.band[:, i, o, gs] = np.percentile(cq, q, axis=0)
 
 
-def _dataset(ds: xr.Dataset, state: Any, states: list[str], axis: _Axis, c: _Counts,
+def _dataset(ds: xr.Dataset, state: Any, states: list[str], axis: IMAxis, c: Counts,
              f: _Fits, grid: np.ndarray, N: int, seed: int, ci: float) -> xr.Dataset:
     """The fragility Dataset (``fragility``'s docstring): a ``state`` dimension when
     ``state`` is a list."""
@@ -717,10 +650,28 @@ def _dataset(ds: xr.Dataset, state: Any, states: list[str], axis: _Axis, c: _Cou
                           "using dynamic structural analysis, Earthquake Spectra 31(1)"}
     if axis.im_name == "Sa":
         attrs["period"] = axis.period
+    if axis.im_name == AVGSA and "record_avgsa" in ds.variables:
+        attrs["avgsa_periods"] = np.asarray(ds["record_avgsa"].attrs.get(
+            "avgsa_periods", [math.nan, math.nan]), np.float64)
+    if f.parallel is not None:
+        from scipy.stats import chi2
+
+        stat, dof = f.parallel
+        with np.errstate(invalid="ignore"):
+            pv = np.where(np.isfinite(stat), chi2.sf(stat, np.maximum(dof, 1)), np.nan)
+        data["parallel_lr"] = (others, stat.reshape(shape_o), {
+            "long_name": "likelihood-ratio statistic of the common beta against a beta per "
+                         "state (2 ln LR; NaN: fewer than 2 states fitted)"})
+        data["parallel_dof"] = (others, dof.reshape(shape_o),
+                                {"long_name": "degrees of freedom of parallel_lr"})
+        data["parallel_p"] = (others, pv.reshape(shape_o),
+                              {"long_name": "chi-square p-value of parallel_lr"})
+        data["parallel_rejected"] = (others, (pv < PARALLEL_P).reshape(shape_o), {
+            "long_name": f"the common beta rejected at p < {PARALLEL_P:g}"})
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
-def _stripe_variables(c: _Counts, axis: _Axis, dims_c: list[str],
+def _stripe_variables(c: Counts, axis: IMAxis, dims_c: list[str],
                       shaped: Callable[..., np.ndarray]) -> dict[str, Any]:
     """The stripes' own variables: fraction, n_failed, n_counted, and per record
     first_level and resurrection."""
@@ -749,7 +700,7 @@ def _stripe_variables(c: _Counts, axis: _Axis, dims_c: list[str],
 
 def _verdicts(kind: str, idxs: list[int], o: int, lnx: np.ndarray, m: np.ndarray,
               med: np.ndarray, bet: np.ndarray, why: list[list[dict[str, str]]],
-              c: _Counts, states: list[str], stripes: bool) -> None:
+              c: Counts, states: list[str], stripes: bool) -> None:
     """The data verdicts of one group's point fit (in ``why``): extrapolated,
     non_monotone (stripes), censored (a mode alone), flagged (the excluded points could
     move it)."""
@@ -780,7 +731,8 @@ def _verdicts(kind: str, idxs: list[int], o: int, lnx: np.ndarray, m: np.ndarray
             other = int(over.sum() - own.sum())
             if over.sum() and other >= CENSORED_SHARE * over.sum():
                 w["censored"] = (f"the other mode holds {other} of {int(over.sum())} "
-                                 "overturning points; fit mode1 and mode2 together")
+                                 "overturning points; fit mode1 and mode2 together "
+                                 "(joint=True)")
     if flagged.any():
         base = np.array([med[q] for q in range(len(idxs))])
         for as_cat in (0, len(idxs)):

@@ -112,6 +112,7 @@ class Hazard:
     unit: str
     period: float
     source: str
+    notes: str = ""  # what reading it left out (OpenQuake's poe = 1 levels)
 
 
 # ---------------------------------------------------------------------------------------
@@ -208,9 +209,10 @@ def _openquake(text: str, where: str, site: int | None) -> Hazard:
     meta = head_line.strip()
     t = re.search(r"investigation_time\s*=\s*'?([^,'\"\s]*)", meta)
     imt = re.search(r"imt\s*=\s*['\"]([^'\"]*)['\"]", meta)  # 'PGA' (3.x), "PGA" (2.x)
-    if t is None or imt is None:
-        raise RiskError(f"{where}, line 1: OpenQuake header without investigation_time and "
-                        f"imt: {meta[:80]!r}")
+    missing = [k for k, v in (("investigation_time", t), ("imt", imt)) if v is None]
+    if missing:  # only what is missing
+        raise RiskError(f"{where}, line 1: the OpenQuake header has no "
+                        f"{' and no '.join(missing)}: {meta[:80]!r}")
     T = _positive(t.group(1))
     if math.isnan(T):
         raise RiskError(f"{where}, line 1: investigation_time = {t.group(1)!r}: must be a "
@@ -261,8 +263,12 @@ def _openquake(text: str, where: str, site: int | None) -> Hazard:
     keep = poe < 1.0  # poe = 1: the rate has no bound there
     rate = -np.log1p(-poe[keep]) / T
     period = _positive(mi.group(2)) if mi.group(2) and name == SA else math.nan
-    return _checked(x[keep], rate, name, unit, period, where,
-                    [n for n, kept in zip(names, keep, strict=True) if kept])
+    hz = _checked(x[keep], rate, name, unit, period, where,
+                  [n for n, kept in zip(names, keep, strict=True) if kept])
+    if not keep.all():
+        hz = replace(hz, notes=f"{int((~keep).sum())} level(s) with poe = 1 left out (no "
+                               f"finite rate): {name} <= {float(x[~keep].max()):.4g} {unit}")
+    return hz
 
 
 def read_hazard(source: Any, *, site: int | None = None) -> Hazard:
@@ -697,6 +703,8 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50.0, *,
                           "seismic performance assessment, PEER Center News 3(2)"}
     if math.isfinite(hz.period):
         attrs["period"] = hz.period
+    if hz.notes:
+        attrs["hazard_notes"] = hz.notes
     if read.unit != hz.unit:
         attrs["hazard_unit"] = (f"{read.unit}, converted to {hz.unit} "
                                 f"(x {_unit_factor(read.unit, hz.unit):.6g})")

@@ -80,10 +80,14 @@ def severity(state: str) -> float:
     return {UPLIFT: 0.0, "theta": x, OVERTURN: math.inf}.get(kind, math.nan)
 
 
-def state_groups(states: Sequence[str]) -> list[tuple[str, list[int]]]:
-    """How the states are fitted: [(kind, indices into states)]: "ordinal" for two or more
-    nested damage states (uplift, theta:X, overturn; indices in severity order),
-    "competing" for mode1 with mode2, "single" for every other one."""
+def state_groups(states: Sequence[str], joint: bool = False) -> list[tuple[str, list[int]]]:
+    """How the states are fitted: [(kind, indices into states)]. By default every state
+    alone ("single": a curve's numbers do not depend on the other states asked for); with
+    ``joint`` "ordinal" for two or more nested damage states (uplift, theta:X, overturn;
+    indices in severity order; one beta), "competing" for mode1 with mode2, "single" for
+    every other one."""
+    if not joint:
+        return [("single", [i]) for i in range(len(states))]
     nested = sorted((i for i, s in enumerate(states) if not math.isnan(severity(s))),
                     key=lambda i: severity(states[i]))
     modes = [states.index(s) for s in (MODE1, MODE2) if s in states]

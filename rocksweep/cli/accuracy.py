@@ -9,7 +9,7 @@ import click
 
 from rocksweep.cli.main import load, main, user_errors
 from rocksweep.cli.options import overwrite_option, scene_argument, set_option
-from rocksweep.vocab.settings import DEFAULT_LADDER, LADDER_NAMES, LADDERS
+from rocksweep.vocab.settings import DEFAULT_LADDER, LADDER_HELP, LADDER_NAMES
 
 
 @main.command()
@@ -26,7 +26,7 @@ from rocksweep.vocab.settings import DEFAULT_LADDER, LADDER_NAMES, LADDERS
               type=click.Choice(LADDER_NAMES),  # = accuracy.LADDERS (tests/test_vocab.py)
               default=DEFAULT_LADDER, show_default=True,
               help="Kernel settings to measure: " + ", ".join(
-                  f"{k} ({v})" for k, v in LADDERS.items()) + ".")
+                  f"{k} ({v})" for k, v in LADDER_HELP.items()) + ".")
 @click.option("--seed", type=int, default=0, show_default=True, help="Sampling seed.")
 @click.option("--repeat", type=click.IntRange(min=1), default=5, show_default=True,
               help="Kernel timings are the best of this many rounds.")
@@ -96,7 +96,7 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
         click.echo(f"wrote {report_path}")
     if plot_path is not None:
         from rocksweep.figures.accuracy import work_precision
-        from rocksweep.figures.common import save_figure
+        from rocksweep.figures.style import save_figure
 
         save_figure(work_precision(study), plot_path, overwrite=overwrite, inputs=scene.inputs)
         click.echo(f"wrote {plot_path}")

@@ -22,8 +22,13 @@ from rocksweep.errors import RocksweepError, one_line
 _CLI_WORDS = re.compile(r"\b(resume|overwrite|adaptive|validate)=True\b")
 
 
+# a keyword the message asks for, "name= (a number)", is the option "--name VALUE"
+_CLI_KEYWORDS = re.compile(r"\b(p)= \(a number\)")
+
+
 def cli_words(message: str) -> str:
     """A library message with the API's flags said as the command line's options."""
+    message = _CLI_KEYWORDS.sub(lambda m: f"--{m.group(1)} VALUE", message)
     return _CLI_WORDS.sub(lambda m: f"--{m.group(1)}", message)
 
 

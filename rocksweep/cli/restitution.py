@@ -82,7 +82,8 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
                  else _lam_text(float(lim.min())))
         click.echo(f"  over u/u_cr in [-2, 2]: {worst}")
     if plot_path is not None:
-        from rocksweep.figures.common import restitution_map, save_figure
+        from rocksweep.figures.restitution import restitution_map
+        from rocksweep.figures.style import save_figure
 
         fig = restitution_map(table.lam, table.u_over_ucr, table.e_upper, table.e_housner,
                               table.title, lam_limit=table.lam_limit, law=table.law)

@@ -64,7 +64,7 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     swept = [a.name for a in scene.swept]
 
     if as_json:
-        docs = [_json_safe(r.summary()) for r in runs]
+        docs = [_json_safe({**r.summary(), **scene.physical_summary()}) for r in runs]
         click.echo(json.dumps(docs[0] if len(docs) == 1 else docs, indent=2))
     else:
         if scene.physical is not None:
@@ -76,7 +76,8 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
         if not as_json:
             click.echo(f"wrote {csv_path}")
     if plot_path is not None:
-        from rocksweep.figures.common import save_figure, time_history
+        from rocksweep.figures.history import time_history
+        from rocksweep.figures.style import save_figure
 
         save_figure(time_history(runs, swept, scene.name), plot_path, overwrite=overwrite,
                     inputs=scene.inputs)

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rocksweep.errors import FigureError
-from rocksweep.figures.common import given_axes, new_axes
+from rocksweep.figures.style import given_axes, new_axes
 
 if TYPE_CHECKING:
     import xarray as xr

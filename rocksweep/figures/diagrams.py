@@ -43,7 +43,7 @@ from matplotlib.patches import Patch
 from rocksweep.errors import DiagramError
 from rocksweep.fields import WORD_AXES
 from rocksweep.figures import DEFAULT_DPI
-from rocksweep.figures.common import Figure, given_axes, new_axes, save_figure, wrap_title
+from rocksweep.figures.style import Figure, given_axes, new_axes, save_figure, wrap_title
 from rocksweep.store.reader import SweepResult
 from rocksweep.vocab import axes as _axes
 from rocksweep.vocab.axes import DIAGRAM_AXES, RECORD_X
@@ -252,7 +252,7 @@ def _title(result: SweepResult, on_axes: Sequence[str]) -> str:
 
 
 def _fit(title: str, fig: Figure) -> str:
-    """A title wrapped to the figure's width at 11 pt (``common.wrap_title``)."""
+    """A title wrapped to the figure's width at 11 pt (``style.wrap_title``)."""
     return wrap_title(title, fig.get_figwidth(), 11.0)
 
 

@@ -26,7 +26,7 @@ from rocksweep.analysis.likelihood import lognormal_cdf
 from rocksweep.analysis.risk import fragility_median
 from rocksweep.errors import FragilityFigureError
 from rocksweep.figures import WIDTHS
-from rocksweep.figures.common import Figure
+from rocksweep.figures.style import Figure
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

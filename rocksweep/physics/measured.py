@@ -105,8 +105,9 @@ def read_measured(measured: Any, *, p: float | None = None, alpha_ref: float | N
     elif "t" in cols and "theta" in cols:
         if p is None or alpha_ref is None:
             raise MeasuredError(f"{src}: columns t [s], theta [rad] need the body's p "
-                                "[rad/s] (a physical body, kind: physical, or a record "
-                                "scene's ground.p); or give p_t, theta_over_alpha")
+                                "[rad/s]: give p= (a number), or a physical body (kind: "
+                                "physical) or a record scene's ground.p; or give columns "
+                                "p_t, theta_over_alpha")
         t = column("t") * p
         theta = column("theta", gaps=True) / alpha_ref
         u = None

@@ -76,6 +76,12 @@ class Scene:
                                           "mA_over_m", "IA_ratio"))
                 + f", p = {d['p']:.5g} rad/s, h_cg = {d['h_cg']:.4g} m")
 
+    def physical_summary(self) -> dict[str, float]:
+        """A physical body's frequency parameter {"p": p [rad/s]} (the key of
+        ``rocksweep.simulate``'s summary, ``simulate --json`` and a result file's attrs);
+        {} for a body of Pi groups."""
+        return {} if self.physical is None else {"p": float(self.physical["p"])}
+
     def variables(self) -> dict[str, tuple[str, float, str]]:
         """The per-point variables a sweep of this scene stores, name -> (dtype, fill value
         of a point not computed, meaning): ``fields.variables`` of its outputs."""

@@ -224,6 +224,8 @@ def metadata(scene: Scene, overrides: tuple[str, ...] = (),
     if scene.vertical is not None:  # its vertical component: the same, and its IMs
         for k, v in vertical_attrs(scene.vertical, scene.record).items():
             a[f"vertical_{k}"] = v
+    for k, v in scene.physical_summary().items():  # a physical body's p [rad/s]
+        a[k] = v
     if scene.suite is not None:  # the stripes' IM ("none": a cloud) and Sa's period [s]
         a["scale_im"] = scene.suite.im or "none"
         a["scale_period"] = float(scene.suite.period)

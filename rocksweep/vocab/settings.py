@@ -2,8 +2,8 @@
 ``--ladder``).
 
 The presets' values live with the numerics (``rocksweep.numerics.PRESETS``, keyed by
-``PRESET_NAMES``); the ladders' settings with the accuracy study
-(``rocksweep.analysis.accuracy.LADDERS``, keyed by ``LADDER_NAMES``).
+``PRESET_NAMES``); the ladders' descriptions here (``LADDER_HELP``), their settings with
+the accuracy study (``rocksweep.analysis.accuracy.LADDERS``, keyed by ``LADDER_NAMES``).
 """
 
 from __future__ import annotations
@@ -19,14 +19,14 @@ ROOTS: tuple[str, ...] = tuple(ROOT_CODE)
 DEFAULT_ROOT = HERMITE
 
 #: the ladders of ``rocksweep accuracy --ladder`` and what each measures
-LADDERS: dict[str, str] = {
+LADDER_HELP: dict[str, str] = {
     "full": "steps per period 5..160, event_tol 1e-4..1e-8, presets",
     "short": "a quick check",
     "candidates": "the cheap settings the default preset is chosen from",
     "presets": "the presets alone: their tails on a scene of your own",
     "roots": "every preset with every event root finder",
 }
-LADDER_NAMES: tuple[str, ...] = tuple(LADDERS)
+LADDER_NAMES: tuple[str, ...] = tuple(LADDER_HELP)
 DEFAULT_LADDER = "full"
 
 #: the settings of an adaptive sweep a user gives (the scene's ``refine:`` section, the

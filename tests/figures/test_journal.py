@@ -17,7 +17,7 @@ from matplotlib.text import Text
 
 import rocksweep
 from rocksweep.figures import WIDTHS
-from rocksweep.figures.common import Figure
+from rocksweep.figures.style import Figure
 
 ROOT = Path(__file__).resolve().parents[2]
 PKG = ROOT / "rocksweep"
@@ -44,7 +44,7 @@ def test_every_figure_module_builds_rocksweep_figures():
     write Type 3 fonts, a notebook would not show it); annotations may name it."""
     bare = []
     for path in sorted(PKG.rglob("*.py")):
-        if path == PKG / "figures" / "common.py":
+        if path == PKG / "figures" / "style.py":
             continue
         tree = ast.parse(path.read_text())
         mpl = any(isinstance(n, ast.ImportFrom) and n.module == "matplotlib.figure"
@@ -52,7 +52,7 @@ def test_every_figure_module_builds_rocksweep_figures():
         bare += [f"{path.relative_to(ROOT)}:{n.lineno}" for n in ast.walk(tree)
                  if mpl and isinstance(n, ast.Call) and isinstance(n.func, ast.Name)
                  and n.func.id == "Figure"]
-    assert not bare, "matplotlib's Figure imported (use rocksweep.figures.common.Figure): " \
+    assert not bare, "matplotlib's Figure imported (use rocksweep.figures.style.Figure): " \
         + ", ".join(bare)
 
 
