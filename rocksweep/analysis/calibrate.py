@@ -87,7 +87,7 @@ from rocksweep.numerics import Numerics, step_budget
 from rocksweep.physics.measured import Measured, noise_level, read_measured
 from rocksweep.physics.points import kernel_kind, point_row
 from rocksweep.schema import KEYS, fmt
-from rocksweep.vocab.axes import INITIAL
+from rocksweep.vocab.axes import INITIAL, axis_name
 from rocksweep.vocab.kinds import CALIBRATION, KIND_ATTR
 from rocksweep.vocab.laws import CONSTANT
 
@@ -349,7 +349,7 @@ def check_fit_key(scene: Any, key: Any) -> str:
     if key not in allowed:
         raise CalibrationError(f"fit {key}: not a number of this scene (fit one of "
                                f"{', '.join(allowed)})")
-    return key.split(".", 1)[1]
+    return axis_name(key)
 
 
 def check_bounds(key: str, given: Any) -> tuple[float, float]:
@@ -787,6 +787,10 @@ def calibrate_scene(scene: Any, measured: Any, fit: str | Sequence[str],
     values = {a.name: a.values[0] for a in scene.axes}
     body = scene.point(values).body
     m = read_measured(measured, p=p_body, alpha_ref=body.alpha_ref, u_cr=body.u_cr or None)
+    if p is not None and not m.physical:
+        raise CalibrationError(f"p = {p!r}: {m.source} has the dimensionless columns p_t, "
+                               "theta_over_alpha; p reads physical columns t [s], theta "
+                               "[rad] only (leave it out)")
     _check_measured_span(m, body.alpha_ref)
     return calibrate_problem(Problem(scene, m, keys, bounds, noise), ci)
 

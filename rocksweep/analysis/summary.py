@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rocksweep.fields import THETA_REL_FLOOR, plain
+from rocksweep.vocab.axes import axis_name
 from rocksweep.vocab.outcomes import (
     COMPUTED,
     FILLED,
@@ -213,7 +214,7 @@ def info_dict(result: SweepResult) -> dict:
     """
     a = result.attrs
     done = result.done
-    keys = {k.split(".", 1)[1]: k for k in result.scene["axes"]}
+    keys = {axis_name(k): k for k in result.scene["axes"]}
     dims = {d: {"size": len(result.coords[d]), "scene_key": keys[d],
                 "values": [plain(v) for v in result.coords[d]]} for d in result.dims}
     return {

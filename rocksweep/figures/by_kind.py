@@ -10,6 +10,7 @@ from rocksweep.errors import ApiError, PlotError
 from rocksweep.vocab.kinds import (
     BOUNDARIES,
     CALIBRATION,
+    FLOOR_SPECTRUM,
     FRAGILITY,
     IDA,
     IM_EFFICIENCY,
@@ -31,6 +32,10 @@ def plot_analysis(ds: Any, *, ax: Any = None, width: str | None = None) -> Any:
         return fragility_figure(ds, ax=ax, width=width or "single")
     if kind == CALIBRATION:
         return calibration_figure(ds, ax=ax)
+    if kind == FLOOR_SPECTRUM:
+        from rocksweep.figures.floors import floor_spectrum_figure
+
+        return floor_spectrum_figure(ds, ax=ax, width=width or "single")
     draw = {RISK: results.risk_figure, IDA: results.ida_figure, SPECTRA: spectra_figure,
             BOUNDARIES: results.boundaries_figure,
             IM_EFFICIENCY: results.efficiency_figure}.get(kind or "")

@@ -15,7 +15,7 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.figures import WIDTHS
-from rocksweep.figures.style import Figure
+from rocksweep.figures.style import Figure, curve_colours
 from rocksweep.vocab.axes import label as axis_label
 
 # height / width of one panel stacked in a single column (``_figure``)
@@ -68,8 +68,10 @@ def risk_figure(rk: xr.Dataset, *, ax: Any = None, width: str | None = "double")
     a0.set_ylabel("annual rate of exceedance [1/yr]")
     a0.set_title("hazard", fontsize="small")
     grid = rk["im_level"].values
-    for k, (label, sel, p) in enumerate(_curves(rk["fragility"], "im_level")):
-        c = f"C{k % 10}"
+    curves = list(_curves(rk["fragility"], "im_level"))
+    colours = curve_colours(len(curves))
+    for k, (label, sel, p) in enumerate(curves):
+        c = colours[k]
         rate = float(rk["annual_rate"].isel(sel))
         prob = float(rk["probability"].isel(sel))
         if len(axes) > 1:

@@ -100,6 +100,17 @@ def width_style(width: str | None) -> dict:
             "xtick.labelsize": pt - 1, "ytick.labelsize": pt - 1, "lines.markersize": 3}
 
 
+def curve_colours(n: int) -> list:
+    """``n`` colours no two alike: matplotlib's cycle C0-C9 up to 10 curves, tab20 up to
+    20, then viridis sampled evenly (the cycle repeats after 10: twelve risk curves had
+    two pairs of one colour)."""
+    if n <= 10:
+        return [f"C{i}" for i in range(n)]
+    if n <= 20:
+        return [matplotlib.colormaps["tab20"](i) for i in range(n)]
+    return [matplotlib.colormaps["viridis"](x) for x in np.linspace(0.0, 0.95, n)]
+
+
 def wrap_title(title: str, inches: float, pt: float = 11.0) -> str:
     """``title`` wrapped to a width of ``inches`` at ``pt`` points (about 100/pt
     characters an inch), so a long scene name is not cut at the edges; words inside
