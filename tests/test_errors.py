@@ -72,10 +72,17 @@ def test_rtol_and_integer_checks_have_one_wording():
 
 
 def test_adaptive_settings_are_checked_once_with_the_schema_wording():
-    from rocksweep.compute.adaptive import AdaptiveError, Options, check_settings
+    from rocksweep.cli.main import said
+    from rocksweep.compute.adaptive import AdaptiveError, Options, Plan, check_settings
 
-    cli = check_settings({"margin": 9, "seed": 1}, lambda k: f"--{k}")
-    assert cli.startswith("--margin 9: must be an integer in [0, 8]")
-    assert check_settings({"margin": 2, "seed": None}, lambda k: k) is None
+    with pytest.raises(AdaptiveError) as err:
+        check_settings({"margin": 9, "seed": 1})
+    assert str(err.value).startswith("margin = 9: must be an integer in [0, 8]")
+    assert said(err.value).startswith("--margin 9: must be an integer in [0, 8]")
+    check_settings({"margin": 2, "seed": None})
     with pytest.raises(AdaptiveError, match=r"^audit = 1\.5: must be in \[0, 1\]"):
         Options(audit=1.5)
+    # a Plan made directly is held to the same table as Options
+    for make in (lambda: Options(margin=9), lambda: Plan((64, 64), 1, 0, margin=9, coarse=3)):
+        with pytest.raises(AdaptiveError, match=r"^margin = 9: must be an integer in \[0, 8\]"):
+            make()

@@ -64,7 +64,7 @@ from typing import Any
 import numpy as np
 
 from rocksweep.compute.single import history_capacity
-from rocksweep.errors import CalibrationError, RocksweepError  # noqa: F401 (CalibrationError re-exported)
+from rocksweep.errors import CalibrationError, RocksweepError, set_key  # noqa: F401 (CalibrationError re-exported)
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import point_kernel, warm_up
 from rocksweep.numerics import Numerics, step_budget
@@ -473,7 +473,8 @@ def _single_values(scene: Any, fitted: Sequence[str]) -> dict[str, Any]:
     for a in scene.axes:
         if len(a.values) != 1 and a.name not in fitted:
             raise CalibrationError(f"{a.key} has {len(a.values)} values: a calibration "
-                                   f"fits one point; pick one with --set {a.key}=VALUE")
+                                   "fits one point; pick one with {fix}",
+                                   fix=set_key(a.key, "set_fix"))
     return {a.name: a.values[0] for a in scene.axes}
 
 

@@ -1107,8 +1107,8 @@ def _missing_text(not_run: np.ndarray, levels: np.ndarray | None, unit: str,
     if len(recs) < len(names):
         where.append("record" + "s" * (len(recs) > 1) + " " + ", ".join(recs[:3])
                      + (f" and {len(recs) - 3} more" if len(recs) > 3 else ""))
-    state = (" (the file is not complete: a sweep still running or stopped; finish it with "
-             "--resume)") if complete in (0, False) else ""
+    state = (" (the file is not complete: a sweep still running or stopped; a resume "
+             "finishes it)") if complete in (0, False) else ""
     return f"{n} points not computed at {', '.join(where)} left out{state}" if where else \
         f"{n} points not computed left out{state}"
 

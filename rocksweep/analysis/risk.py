@@ -53,7 +53,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from rocksweep.errors import RiskError, RocksweepError  # noqa: F401 (re-exported)
+from rocksweep.errors import Arg, RiskError, RocksweepError  # noqa: F401 (re-exported)
 from rocksweep.physics.model import G
 from rocksweep.vocab.ground import PGA, PGV, SA
 
@@ -191,8 +191,8 @@ def _openquake(lines: list[str], where: str, site: int | None) -> Hazard:
     if not data:
         raise RiskError(f"{where}: no site rows")
     if site is None and len(data) > 1:
-        raise RiskError(f"{where}: {len(data)} sites; choose one with site= (0 to "
-                        f"{len(data) - 1}, the row order; --site on the command line)")
+        raise RiskError(f"{where}: {len(data)} sites; choose one with {{site}} (0 to "
+                        f"{len(data) - 1}, the row order)", site=Arg("site"))
     k = 0 if site is None else int(site)
     if not 0 <= k < len(data):
         raise RiskError(f"{where}: site = {site!r}: the file has sites 0 to {len(data) - 1}")

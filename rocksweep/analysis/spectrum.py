@@ -122,10 +122,7 @@ def spectra(data, rtol: float = DEFAULT_RTOL, search: bool = True) -> Spectra:
     if other:
         raise SpectrumError(f"{result.path}: spectra are drawn over {freq}, A_ratio and lam; "
                             f"also swept: {', '.join(other)} (sweep one value of each)")
-    if not result.done.all():
-        n = int((~result.done).sum())
-        raise SpectrumError(f"{result.path}: {n} points not computed; finish the sweep "
-                            "(rocksweep sweep SCENE -o OUT --resume) first")
+    result.require_complete(SpectrumError, "a spectrum")
     A = np.asarray(result.coords["A_ratio"], float)
     if not np.all(np.diff(A) > 0):
         raise SpectrumError(f"{result.path}: A_ratio must increase along its axis")

@@ -21,14 +21,19 @@ overwrite_option = click.option("--overwrite", is_flag=True,
                                 help="Replace existing output files.")
 
 
-def _rtol(_ctx: click.Context, _param: click.Parameter, value: float) -> float:
+def _rtol(_ctx: click.Context, _param: click.Parameter, value: float | None) -> float | None:
+    """The library's one check of rtol, while the options are parsed: a bad value is a
+    usage error (exit 2) before any work."""
     from rocksweep.analysis.tolerance import check_rtol
+    from rocksweep.cli.main import said
     from rocksweep.errors import RocksweepError
 
+    if value is None:
+        return None
     try:
-        return check_rtol(value, name="--rtol")
-    except RocksweepError as err:  # a bad option value: a usage error (exit 2)
-        raise click.UsageError(str(err)) from None
+        return check_rtol(value)
+    except RocksweepError as err:
+        raise click.UsageError(said(err)) from None
 
 
 rtol_option = click.option(

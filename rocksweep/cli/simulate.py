@@ -13,6 +13,7 @@ from rocksweep.cli.main import (
     load,
     main,
     overwrite_option,
+    said,
     scene_argument,
     set_option,
     user_errors,
@@ -66,7 +67,7 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     try:
         runs = simulate_runs(scene, MAX_POINTS)
     except SceneError as err:  # name the file, as scene errors do
-        raise click.ClickException(f"{scene_path}: {err}") from None
+        raise click.ClickException(f"{scene_path}: {said(err)}") from None
     swept = [a.name for a in scene.swept]
 
     if as_json:

@@ -111,12 +111,10 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     # the arguments that need no scene, before it is read (all again in api.sweep_file)
     check_sweep_arguments(jobs=jobs, resume=resume, overwrite=overwrite, backend=backend,
                           scheduler=scheduler, chunk_size=chunk_size, write_every=write_every,
-                          connect_timeout=connect_timeout, cli=True)
-    msg = check_settings({"coarse": coarse, "audit": audit, "margin": margin,
-                          "final_margin": final_margin, "seed": seed, "threshold": threshold},
-                         lambda k: f"--{k.replace('_', '-')}")
-    if msg is not None:  # the ranges of the scene's refine: section, one table
-        raise click.ClickException(msg)
+                          connect_timeout=connect_timeout)
+    # the ranges of the scene's refine: section, one table
+    check_settings({"coarse": coarse, "audit": audit, "margin": margin,
+                    "final_margin": final_margin, "seed": seed, "threshold": threshold})
     settings = {"coarse": coarse, "audit": audit, "axes": adaptive_axes, "margin": margin,
                 "final_margin": final_margin, "seed": seed, "threshold": threshold}
     given = [k for k, v in settings.items() if v is not None]
@@ -146,7 +144,7 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
                                 chunk_size=chunk_size, write_every=write_every,
                                 progress=not quiet, log=say, inputs=[scene_path],
                                 adaptive=options, validate=validate,
-                                connect_timeout=connect_timeout, cli=True)
+                                connect_timeout=connect_timeout)
     except api.SweepInterrupted as stop:
         r = stop.report
         click.echo(f"\ninterrupted: {r.points_done} of {r.points_total} points saved in "

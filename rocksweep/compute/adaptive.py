@@ -58,7 +58,7 @@ from typing import Any
 import numpy as np
 
 from rocksweep.compute.grid import ChunkRows, Grid
-from rocksweep.errors import AdaptiveError, ApiError  # noqa: F401 (AdaptiveError: re-exported)
+from rocksweep.errors import AdaptiveError, ApiError, Arg  # noqa: F401 (AdaptiveError: re-exported)
 from rocksweep.scene.model import Scene
 from rocksweep.schema import check_option
 from rocksweep.vocab import outcomes as _out
@@ -116,14 +116,9 @@ class Plan:
         if self.coarse is None:
             object.__setattr__(self, "coarse", default_coarse(self.full_shape[self.y],
                                                               self.full_shape[self.x]))
-        if not (isinstance(self.coarse, int | np.integer) and 0 <= self.coarse <= 20):
-            raise AdaptiveError(f"coarse = {self.coarse!r}: must be an integer in [0, 20]")
-        for name in ("margin", "final_margin", "seed"):
-            v = getattr(self, name)
-            if not (isinstance(v, int | np.integer) and v >= 0):
-                raise AdaptiveError(f"{name} = {v!r}: must be an integer >= 0")
-        if not (isinstance(self.audit, float | int) and 0.0 <= self.audit <= 1.0):
-            raise AdaptiveError(f"audit = {self.audit!r}: must be a share in [0, 1]")
+        # the ranges of the scene's refine: section (rocksweep.schema), as Options
+        check_settings({n: getattr(self, n) for n in ("coarse", "margin", "final_margin",
+                                                      "audit", "seed")})
         if self.x == self.y:
             raise AdaptiveError(f"diagram axes {self.names}: must be two different axes")
         for pos, name in zip((self.x, self.y), self.names, strict=True):
@@ -168,7 +163,7 @@ def make_plan(grid_or_scene: Grid | Scene, axes: Sequence[str] = DIAGRAM_AXES,
     if isinstance(axes, str) or len(axes) != 2:
         raise AdaptiveError(f"axes = {axes!r}: give two axis names (x, y)")
     by_key = {a.key: a.name for a in scene.axes}
-    # a dotted scene key (pulse.w_over_p) names its axis, as in refine.axes and plot --x
+    # a dotted scene key (pulse.w_over_p) names its axis, as in refine.axes and plot's x
     axes = [by_key.get(a, a) if isinstance(a, str) else a for a in axes]
     pos = []
     for name in axes:
@@ -191,32 +186,29 @@ def make_plan(grid_or_scene: Grid | Scene, axes: Sequence[str] = DIAGRAM_AXES,
 SETTINGS = ("coarse", "audit", "margin", "final_margin", "seed", "threshold")
 
 
-def check_settings(values: dict[str, Any], label: Callable[[str], str]) -> str | None:
-    """The first setting of ``values`` (name -> value; None: not given) outside its
-    ``refine.<name>`` range, as one line naming it by ``label(name)`` ("margin =",
-    "--margin"); None if all are admissible. The one check of the adaptive settings: the
-    command line, ``Options`` and ``make_plan`` call it."""
+def check_settings(values: dict[str, Any]) -> None:
+    """An ``AdaptiveError`` naming the first setting of ``values`` (name -> value; None:
+    not given) outside its ``refine.<name>`` range (``rocksweep.schema``), ``margin = 9:
+    must be an integer in [0, 8]``. The one check of the adaptive settings: the command
+    line, ``Options``, ``make_plan`` and ``Plan`` call it."""
     for name, v in values.items():
-        msg = check_option(f"refine.{name}", v, label(name))
-        if msg is not None:
-            return msg
-    return None
+        allowed = check_option(f"refine.{name}", v)
+        if allowed is not None:
+            raise AdaptiveError("{arg}: {allowed}", arg=Arg(name, v), allowed=allowed)
 
 
 def _checked(name: str, v: Any, kind: type) -> Any:
-    msg = check_settings({name: v}, lambda n: f"{n} =")
-    if msg is not None:
-        raise AdaptiveError(msg)
+    check_settings({name: v})
     return kind(v)
 
 
 @dataclass(frozen=True)
 class Options:
-    """Settings of an adaptive sweep as a user gives them (``rocksweep sweep --adaptive``,
-    ``rocksweep.run(..., adaptive=True)``). axes: (x, y) diagram axis names; coarse: None
-    for ``default_coarse``; audit: share of points audited, in [0, 1]; threshold: share of
-    disagreeing audit points above which a run warns, in [0, 1]; margin, final_margin,
-    seed: see ``Plan``."""
+    """Settings of an adaptive sweep as a user gives them (``rocksweep.run(...,
+    adaptive=True)``, the sweep command's adaptive options). axes: (x, y) diagram axis
+    names; coarse: None for ``default_coarse``; audit: share of points audited, in [0, 1];
+    threshold: share of disagreeing audit points above which a run warns, in [0, 1];
+    margin, final_margin, seed: see ``Plan``."""
 
     axes: tuple[str, str] = DIAGRAM_AXES
     coarse: int | None = None
@@ -227,9 +219,7 @@ class Options:
     threshold: float = DEFAULT_AUDIT_THRESHOLD
 
     def __post_init__(self) -> None:
-        msg = check_settings({n: getattr(self, n) for n in SETTINGS}, lambda n: f"{n} =")
-        if msg is not None:
-            raise AdaptiveError(msg)
+        check_settings({n: getattr(self, n) for n in SETTINGS})
 
     def plan(self, grid_or_scene: Grid | Scene) -> Plan:
         """The plan of a grid (AdaptiveError for bad axes or settings)."""

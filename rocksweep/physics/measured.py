@@ -109,7 +109,7 @@ def read_measured(measured: Any, *, p: float | None = None, alpha_ref: float | N
         if runs.size > 1:
             raise MeasuredError(f"{src}: column run holds {runs.size} runs "
                                 f"({', '.join(f'{r:g}' for r in runs[:4])}...); give one "
-                                "run's rows (simulate --csv of one point)")
+                                "run's rows (the history CSV of one point)")
     if "p_t" in cols and "theta_over_alpha" in cols:
         t = _column(frame, "p_t", src)
         theta = _column(frame, "theta_over_alpha", src)
@@ -133,8 +133,8 @@ def read_measured(measured: Any, *, p: float | None = None, alpha_ref: float | N
         missing = "theta_over_alpha" if "p_t" in cols else (
             "theta" if "t" in cols else "p_t, theta_over_alpha")
         raise MeasuredError(f"{src}: no column {missing} (columns: {have}); a measured "
-                            "history needs p_t and theta_over_alpha (as simulate --csv "
-                            "writes), or t [s] and theta [rad]")
+                            "history needs p_t and theta_over_alpha (as a simulated "
+                            "history's CSV has), or t [s] and theta [rad]")
     if t.size == 0:
         raise MeasuredError(f"{src}: no rows")
     if not np.all(np.isfinite(t)):

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from rocksweep import fields
-from rocksweep.errors import SceneError  # noqa: F401 (defined there; re-exported)
+from rocksweep.errors import SceneError, set_key  # noqa: F401 (SceneError: re-exported)
 from rocksweep.numerics import Numerics
 from rocksweep.physics.model import BlockBody, Body, FlexibleBody
 from rocksweep.physics.points import FREE, INITIAL, RECORD, Point
@@ -183,6 +183,6 @@ class Scene:
         for a in self.axes:
             if len(a.values) != 1:
                 raise SceneError(
-                    f"{a.key} has {len(a.values)} values: this command runs one point; "
-                    f"pick one with --set {a.key}=VALUE")
+                    f"{a.key} has {len(a.values)} values: this runs one point; pick one "
+                    "with {fix}", fix=set_key(a.key, "set_fix"))
         return self.point({a.name: a.values[0] for a in self.axes})

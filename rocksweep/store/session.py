@@ -10,8 +10,9 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from rocksweep.compute.arguments import CONNECT_TIMEOUT
 from rocksweep.compute.driver import WRITE_EVERY, SweepReport
-from rocksweep.errors import ApiError
+from rocksweep.errors import ApiError, Arg, flag
 
 if TYPE_CHECKING:
     from typing import Any
@@ -28,8 +29,8 @@ def sweep_file(scene: Scene, path: str | Path | None, *, overrides: Sequence[str
                chunk_size: int | None = None, write_every: float = WRITE_EVERY,
                progress: bool = False, log: Callable[[str], None] | None = None,
                inputs: Iterable[str | Path] = (), adaptive: Options | None = None,
-               validate: bool = False, connect_timeout: float = 20.0,
-               cli: bool = False) -> SweepReport:
+               validate: bool = False, connect_timeout: float = CONNECT_TIMEOUT
+               ) -> SweepReport:
     """Sweep ``scene`` into the result file ``path`` (``rocksweep sweep``), or with ``path``
     None into a file in memory (its bytes: ``report.image``; ``rocksweep.run``).
 
@@ -48,19 +49,18 @@ def sweep_file(scene: Scene, path: str | Path | None, *, overrides: Sequence[str
     records the settings, and a resume must give the same); validate: with adaptive,
     also compute the filled points of a coarse uniform lattice and report those whose
     class differs from the fill (``report.validation``; the file is not changed);
-    connect_timeout: seconds to wait for the dask scheduler to answer; cli: name options
-    as the command line spells them. Every argument is checked
-    (``rocksweep.compute.arguments``) before the output is touched. Returns a
+    connect_timeout: seconds to wait for the dask scheduler to answer. Every argument is
+    checked (``rocksweep.compute.arguments``) before the output is touched. Returns a
     ``SweepReport``.
     """
     from rocksweep.compute.arguments import check_sweep_arguments
-    from rocksweep.outputs import OutputError, check_output, check_path_text, shown
+    from rocksweep.outputs import check_output, check_path_text, exists_error
 
     # every argument before anything touches the output (one place: the CLI's too)
     n_workers = check_sweep_arguments(
         jobs=jobs, resume=resume, overwrite=overwrite, validate=validate, adaptive=adaptive,
         backend=backend, scheduler=scheduler, chunk_size=chunk_size, write_every=write_every,
-        connect_timeout=connect_timeout, cli=cli)
+        connect_timeout=connect_timeout)
     if path is not None:  # None: in memory (rocksweep.run without output=)
         check_path_text(path)
     if backend == "dask":
@@ -83,7 +83,8 @@ def sweep_file(scene: Scene, path: str | Path | None, *, overrides: Sequence[str
     how = f"threads x {n_workers}" if backend == "threads" else f"dask {scheduler}"
     if path is None:  # in memory: nothing touches a disk (rocksweep.run without output)
         if resume:
-            raise ApiError("resume=True needs output= (the file to finish)")
+            raise ApiError("{resume} needs {output} (the file to finish)",
+                           resume=flag("resume"), output=Arg("output"))
         sf = SweepFile.in_memory(scene, overrides, backend=how, adaptive=settings)
         return drive(sf, None, report_of := SweepReport(Path("memory"), sf.grid.size, 0, 0,
                                                           0.0, 0.0, 0.0),
@@ -103,8 +104,7 @@ def sweep_file(scene: Scene, path: str | Path | None, *, overrides: Sequence[str
         sf = SweepFile.resume(path, scene, overrides, backend=how, adaptive=settings)
     else:
         if path.is_file() and not overwrite:
-            raise OutputError(f"{shown(path)}: already exists; use --resume to finish it or "
-                              "--overwrite to replace it")
+            raise exists_error(path, resumable=True)
         check_output(path, overwrite=overwrite, inputs=inputs)
         sf = SweepFile.create(path, scene, overrides, overwrite=overwrite, backend=how,
                               adaptive=settings, log=say)

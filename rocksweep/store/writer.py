@@ -4,7 +4,7 @@ Datasets are allocated in full when the file is made, under a temporary name uni
 the process, renamed when complete (``rocksweep.store.safety``), so later writes touch
 raw data only: a killed run leaves a well-formed file whose ``outcome`` marks exactly the
 finished points (each chunk's other variables are flushed before its ``outcome``).
-``--resume`` reopens it and computes the rest.
+A resume reopens it and computes the rest.
 
 The attributes a session changes (``SESSION_ATTRS``) are overwritten in place
 (``attrs.modify``): reopening, writing results and finishing never need new space in the
@@ -26,10 +26,17 @@ import numpy as np
 
 from rocksweep.compute.grid import Grid
 from rocksweep.compute.sweep import ChunkResult
-from rocksweep.errors import OutputError, RocksweepError
+from rocksweep.errors import Arg, RocksweepError, flag
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.outputs import check_output, clean_stale_partials, is_input, partial_prefix, shown
+from rocksweep.outputs import (
+    check_output,
+    clean_stale_partials,
+    exists_error,
+    is_input,
+    partial_prefix,
+    shown,
+)
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import (
     _H5_ERRORS,
@@ -143,22 +150,19 @@ class SweepFile:
         adaptive: resolved settings of an adaptive sweep (``adaptive.Options.resolved``):
         the file gets the ``computed`` flags and the settings' attributes.
 
-        Refused (StoreError) before anything is written: an existing path without
-        ``overwrite``, a directory, device or FIFO, a missing directory, a grid larger
-        than the free space, a file another process is writing. ``backend``: how the
+        Refused before anything is written: an existing path without ``overwrite``, a
+        directory, device or FIFO, a missing directory (``OutputError``, as every output
+        path); a grid larger than the free space, a file another process is writing
+        (``StoreError``). ``backend``: how the
         points are computed (e.g. "threads x 2"), recorded with the host in the file.
         """
         import h5py
         path = Path(path)
-        try:
-            # devices, directories, missing dirs, the scene's own files
-            check_output(path, overwrite=True, inputs=scene.inputs)
-        except OutputError as err:
-            raise StoreError(str(err)) from None
+        # devices, directories, missing dirs, the scene's own files (OutputError)
+        check_output(path, overwrite=True, inputs=scene.inputs)
         existed = os.path.lexists(path)
         if existed and not overwrite:
-            raise StoreError(f"{shown(path)}: already exists; use --resume to finish it or "
-                             "--overwrite to replace it")
+            raise exists_error(path, resumable=True)
         grid = Grid(scene)
         nbytes = file_bytes(scene, adaptive is not None)
         reserve = _reserve_bytes(scene, nbytes)
@@ -262,12 +266,14 @@ class SweepFile:
         diffs = scene_differences(stored, resolved_scene(scene, overrides, adaptive))
         if diffs:
             done = int((outcome != L.OUTCOME_NOT_RUN).sum())
-            keep = (f"resume with the scene, --set values and options it was made with, or "
-                    f"sweep this scene to another -o; --overwrite would discard the {done} "
-                    "points it holds" if done else "use --overwrite to start again: it "
-                    "holds no computed point")
-            raise StoreError(f"{shown(path)}: cannot resume, the scene differs from the "
-                             "file's: " + "; ".join(diffs) + f" ({keep})")
+            keep = (f"resume with the scene, {{overrides}} values and options it was made "
+                    f"with, or sweep this scene to another {{output}}; {{overwrite}} would "
+                    f"discard the {done} points it holds" if done else "use {overwrite} to "
+                    "start again: it holds no computed point")
+            raise StoreError("{path}: cannot resume, the scene differs from the file's: "
+                             "{diffs} (" + keep + ")", path=shown(path),
+                             diffs="; ".join(diffs), overrides=Arg("overrides"),
+                             output=Arg("output"), overwrite=flag("overwrite"))
         f = _open(path, "r+")
         try:
             _layout(f, path)  # the file locked now (another may have replaced the first)
@@ -349,8 +355,9 @@ class SweepFile:
             self.f.flush()
         except _H5_ERRORS as err:
             raise self._fail(StoreError(
-                f"{shown(self.path)}: cannot write results ({_why(err)}); the points "
-                "written before are kept, finish with --resume")) from None
+                "{path}: cannot write results ({why}); the points written before are kept, "
+                "finish with {resume}", path=shown(self.path), why=_why(err),
+                resume=flag("resume"))) from None
 
     def write_filled(self, outcome: np.ndarray, counts: dict[str, int]) -> None:
         """The end of an adaptive sweep: ``outcome`` (int8[size], flat: computed classes
@@ -364,8 +371,8 @@ class SweepFile:
             self.put_counts(counts)
         except _H5_ERRORS as err:
             raise self._fail(StoreError(
-                f"{shown(self.path)}: cannot write the filled outcomes ({_why(err)}); "
-                "finish with --resume")) from None
+                "{path}: cannot write the filled outcomes ({why}); finish with {resume}",
+                path=shown(self.path), why=_why(err), resume=flag("resume"))) from None
 
     def put_counts(self, counts: dict[str, int]) -> None:
         """Update the adaptive counts (``ADAPTIVE_COUNT_ATTRS``) in place."""
@@ -377,7 +384,7 @@ class SweepFile:
         """Write one chunk's results; ``outcome`` last, each step flushed to the OS.
 
         A failed write (StoreError) leaves the chunk's points "not computed" and every
-        point written before intact; the file is closed (finish it with --resume).
+        point written before intact; the file is closed (a resume finishes it).
         """
         if self._broken:
             raise self._broken
@@ -395,8 +402,9 @@ class SweepFile:
             self.f.flush()
         except _H5_ERRORS as err:
             raise self._fail(StoreError(
-                f"{shown(self.path)}: cannot write results ({_why(err)}); the points "
-                "written before are kept, finish with --resume")) from None
+                "{path}: cannot write results ({why}); the points written before are kept, "
+                "finish with {resume}", path=shown(self.path), why=_why(err),
+                resume=flag("resume"))) from None
 
     def finish(self, wall_seconds: float, cpu_seconds: float, *,
                backend: str | None = None) -> dict:

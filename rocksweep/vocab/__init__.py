@@ -11,7 +11,7 @@ kernel codes, figure labels and stored attributes are derived from these tables
 - ``axes``: the swept keys' names, units and symbols; the default diagram axes;
 - ``outcomes``: outcome classes, status bits, fragility states, ``computed`` flags (their
   codes, words and meanings);
-- ``settings``: accuracy preset and ladder names.
+- ``settings``: accuracy preset and ladder names, sweep backends.
 
 No module here imports numpy, numba or another rocksweep module: every floor may read it.
 """

@@ -1,4 +1,5 @@
-"""Names of the accuracy settings a user picks (``numerics.accuracy``, ``--ladder``).
+"""Names of the settings a user picks: accuracy presets (``numerics.accuracy``), accuracy
+ladders, the backends a sweep runs on.
 
 The presets' values live with the numerics (``rocksweep.numerics.PRESETS``, keyed by
 ``PRESET_NAMES``); the ladders' settings with the accuracy study
@@ -19,3 +20,7 @@ LADDERS: dict[str, str] = {
 }
 LADDER_NAMES: tuple[str, ...] = tuple(LADDERS)
 DEFAULT_LADDER = "full"
+
+#: where a sweep's chunks run: local worker threads, or a dask.distributed cluster
+BACKENDS: tuple[str, ...] = ("threads", "dask")
+DEFAULT_BACKEND = "threads"

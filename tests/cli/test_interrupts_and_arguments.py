@@ -23,8 +23,9 @@ from helpers import one_line_error
 import rocksweep
 from rocksweep import interrupts
 from rocksweep.cli import main
-from rocksweep.cli.main import cli_words
+from rocksweep.cli.main import said
 from rocksweep.compute.driver import SweepInterrupted
+from rocksweep.errors import Arg, SceneError, SweepError, flag, set_key
 from rocksweep.store.reader import read_result
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -141,6 +142,14 @@ def test_an_e_the_law_ignores_is_refused(cli, tmp_path, law):
 
 
 def test_cli_messages_name_the_cli_flags():
-    assert cli_words("resume=True needs output=; add adaptive=True") == \
-        "--resume needs output=; add --adaptive"
-    assert cli_words("resume = True; no_resume=True") == "resume = True; no_resume=True"
+    """One message, two callers: the API's keywords in ``str()``, the command line's
+    options where the CLI says it (no rewriting of text: a value that looks like a keyword
+    stays as it is)."""
+    err = SweepError("{resume} needs {output}; add {adaptive}; {jobs}: resume=True stays",
+                     resume=flag("resume"), output=Arg("output"), adaptive=flag("adaptive"),
+                     jobs=Arg("jobs", 0))
+    assert str(err) == "resume=True needs output; add adaptive=True; jobs = 0: resume=True stays"
+    assert said(err) == "--resume needs --output; add --adaptive; --jobs 0: resume=True stays"
+    fix = SceneError("pick one with {fix}", fix=set_key("impact.lam", "set_fix"))
+    assert (str(fix), said(fix)) == ("pick one with overrides={'impact.lam': ...}",
+                                     "pick one with --set impact.lam=VALUE")
