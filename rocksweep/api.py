@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rocksweep.accessor import register_accessor
+from rocksweep.analysis.resampling import DEFAULT_CI, DEFAULT_SEED
 from rocksweep.errors import ApiError  # noqa: F401 (the API's)
 from rocksweep.simulation import Simulation  # what simulate returns
 
@@ -246,7 +247,8 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
 @_public
 def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
               im: str | None = None, period: float | None = None,
-              bootstrap: int | None = None, seed: int = 0, ci: float = 0.9) -> xr.Dataset:
+              bootstrap: int | None = None, seed: int = DEFAULT_SEED,
+              ci: float = DEFAULT_CI) -> xr.Dataset:
     """Lognormal fragility curves P(state | IM = x) = Phi(ln(x / im_median) / beta) of a
     record-suite sweep (a scene with ``ground.records``), fitted by maximum likelihood
     (Baker 2015) to the counts at each stripe of a scaled suite ("stripes-mle") or to the

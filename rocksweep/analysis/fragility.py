@@ -81,8 +81,14 @@ import numpy as np
 import xarray as xr
 from scipy.special import log_ndtr, ndtr, ndtri, owens_t
 
-from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP, MAX_BOOTSTRAP
-from rocksweep.errors import FragilityError, RocksweepError  # noqa: F401 (re-exported)
+from rocksweep.analysis.resampling import (
+    DEFAULT_BOOTSTRAP,
+    DEFAULT_CI,
+    DEFAULT_SEED,
+    MAX_BOOTSTRAP,
+    check_ci,
+)
+from rocksweep.errors import Arg, FragilityError, RocksweepError  # noqa: F401 (re-exported)
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L
 from rocksweep.vocab.ground import CLOUD_IMS as CLOUD_IM_VARIABLES
@@ -861,7 +867,8 @@ def _interval(v: np.ndarray, ci: float) -> tuple[float, float]:
 def bootstrap_records(im: Sequence[float] | np.ndarray, failed: np.ndarray,
                       counted: np.ndarray | None = None, *,
                       n_boot: int = DEFAULT_BOOTSTRAP,
-                      seed: int | np.random.Generator = 0, ci: float = 0.9) -> Bootstrap:
+                      seed: int | np.random.Generator = DEFAULT_SEED,
+                      ci: float = DEFAULT_CI) -> Bootstrap:
     """Bootstrap the fragility fit over records.
 
     Stripes: im float[S] (levels), failed bool[R, S] (record r reaches the state at level
@@ -873,7 +880,7 @@ def bootstrap_records(im: Sequence[float] | np.ndarray, failed: np.ndarray,
     x = np.asarray(im, dtype=np.float64)
     f = np.asarray(failed).astype(bool)
     c = np.ones_like(f) if counted is None else np.asarray(counted).astype(bool)
-    ci = _check_ci(ci)
+    ci = check_ci(ci)
     n_boot = _check_bootstrap(n_boot, 1)
     cloud = f.ndim == 1
     if cloud and not (x.shape == f.shape == c.shape):
@@ -892,13 +899,6 @@ def bootstrap_records(im: Sequence[float] | np.ndarray, failed: np.ndarray,
     med, bet = np.where(undefined, np.nan, med), np.where(undefined, np.nan, bet)
     return Bootstrap(_interval(med, ci), _interval(bet, ci), med, bet, int(undefined.sum()),
                      ci)
-
-
-def _check_ci(ci: Any) -> float:
-    if isinstance(ci, bool) or not isinstance(ci, int | float | np.integer | np.floating) \
-            or not (0.0 < float(ci) < 1.0):
-        raise FragilityError(f"ci = {ci!r}: must be a number in (0, 1), e.g. 0.9")
-    return float(ci)
 
 
 def _check_bootstrap(n: Any, curves: int) -> int:
@@ -1073,7 +1073,7 @@ def _check_args(ds: Any, im: Any, period: Any, seed: Any) -> None:
         raise FragilityError(f"period = {period!r}: a period in s (a number > 0, one of the "
                              "stored ground.periods), with im='Sa'")
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-        raise FragilityError(f"seed = {seed!r}: must be an integer >= 0")
+        raise FragilityError("{seed}: must be an integer >= 0", seed=Arg("seed", seed))
 
 
 def _refuse_filled(ds: xr.Dataset, states: Sequence[str], counted: xr.DataArray) -> None:
@@ -1115,7 +1115,7 @@ def _missing_text(not_run: np.ndarray, levels: np.ndarray | None, unit: str,
 
 def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
               im: str | None = None, period: float | None = None,
-              bootstrap: int | None = None, seed: int = 0, ci: float = 0.9,
+              bootstrap: int | None = None, seed: int = DEFAULT_SEED, ci: float = DEFAULT_CI,
               warn: bool = True) -> xr.Dataset:
     """Lognormal fragility curves of a record-suite sweep (Baker 2015) with their verdicts.
 
@@ -1158,7 +1158,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     _check_args(ds, im, period, seed)
     bootstrap = DEFAULT_BOOTSTRAP if bootstrap is None else bootstrap
     states = parse_states(state)
-    ci = _check_ci(ci)
+    ci = check_ci(ci)
     _check_bootstrap(bootstrap, 1)
     out_da = _need(ds, "outcome", "outcome codes")
     if "record" not in out_da.dims:

@@ -69,8 +69,6 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
         from rocksweep.figures.common import FORMATS
 
         check_output(plot_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
-    if not scene_path.exists():
-        raise click.ClickException(f"{scene_path}: no such scene file")
     ds = fit_scene(scene_path, measured_path, list(fit), bounds=_bounds(bounds) or None,
                    overrides=list(overrides), p=p)
     for key in ds["parameter"].values.tolist():

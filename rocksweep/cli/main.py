@@ -20,7 +20,7 @@ from rocksweep.cli.options import overwrite_option, scene_argument, set_option  
 from rocksweep.errors import Arg, RocksweepError, one_line
 
 # The library's argument names whose option is not ``--NAME`` (underscores as dashes)
-OPTIONS = {"overrides": "--set"}
+OPTIONS = {"overrides": "--set", "output": "-o"}
 
 
 def option_words(arg: Arg) -> str:

@@ -18,6 +18,7 @@ from rocksweep.cli.main import (
     set_option,
     user_errors,
 )
+from rocksweep.cli.options import json_option
 from rocksweep.vocab.axes import alpha_symbol
 
 MAX_POINTS = 12  # = rocksweep.api.MAX_RUNS: simulate overlays a few runs
@@ -26,8 +27,7 @@ MAX_POINTS = 12  # = rocksweep.api.MAX_RUNS: simulate overlays a few runs
 @main.command()
 @scene_argument
 @set_option
-@click.option("--json", "as_json", is_flag=True,
-              help="Print one JSON object (a JSON list if the scene has several points).")
+@json_option("one object (a list if the scene has several points)")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Draw Figure 5 (theta/alpha_cg and E/E_ref against p*t) to this file "
                    "(.png, .pdf, .svg).")

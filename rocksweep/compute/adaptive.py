@@ -63,6 +63,15 @@ from rocksweep.scene.model import Scene
 from rocksweep.schema import check_option
 from rocksweep.vocab import outcomes as _out
 from rocksweep.vocab.axes import DIAGRAM_AXES
+from rocksweep.vocab.settings import (
+    ADAPTIVE_SETTINGS,
+    DEFAULT_AUDIT,
+    DEFAULT_AUDIT_THRESHOLD,
+    DEFAULT_FINAL_MARGIN,
+    DEFAULT_MARGIN,
+    DEFAULT_SEED,
+    MIN_COARSE_CELLS,
+)
 
 # ``computed`` flags (int8 per point).
 # (codes, words and meanings: ``rocksweep.vocab.outcomes``)
@@ -72,18 +81,7 @@ AUDIT = _out.COMPUTED_CODE[_out.AUDIT_AGREED]  # an audit point; its class equal
 AUDIT_MISS = _out.COMPUTED_CODE[_out.AUDIT_DISAGREED]  # an audit point; differs (refined)
 COMPUTED_MEANING = _out.COMPUTED_MEANING
 
-# Default coarse level: the largest k whose coarse lattice keeps >= MIN_COARSE_CELLS cells
-# along both diagram axes (80: k = 2, 400: k = 4, 1000: k = 5); see ``default_coarse``.
-MIN_COARSE_CELLS = 16
-DEFAULT_MARGIN = 1
-# No margin at the last level: there it caught only one-point-tall slivers (40 of 480 000
-# points of Figure 4(b) at 400 x 400) for 17-27% more points computed. 0 also selects the
-# light rules of the last two levels (module docstring); >= 1 refines whole cells there.
-DEFAULT_FINAL_MARGIN = 0
-DEFAULT_AUDIT = 0.02
-DEFAULT_SEED = 0
-# A run warns when more than this share of its audit points disagree with their fill.
-DEFAULT_AUDIT_THRESHOLD = 0.002
+# The settings' defaults (MIN_COARSE_CELLS, DEFAULT_MARGIN, ...): rocksweep.vocab.settings
 
 _NO_CLASS = np.int8(127)  # above every class, for minima over computed points
 
@@ -182,9 +180,6 @@ def make_plan(grid_or_scene: Grid | Scene, axes: Sequence[str] = DIAGRAM_AXES,
                 _checked("seed", seed, int), _checked("final_margin", final_margin, int))
 
 
-# the settings a user gives (the scene's refine: section, rocksweep.schema's ranges)
-SETTINGS = ("coarse", "audit", "margin", "final_margin", "seed", "threshold")
-
 
 def check_settings(values: dict[str, Any]) -> None:
     """An ``AdaptiveError`` naming the first setting of ``values`` (name -> value; None:
@@ -219,7 +214,7 @@ class Options:
     threshold: float = DEFAULT_AUDIT_THRESHOLD
 
     def __post_init__(self) -> None:
-        check_settings({n: getattr(self, n) for n in SETTINGS})
+        check_settings({n: getattr(self, n) for n in ADAPTIVE_SETTINGS})
 
     def plan(self, grid_or_scene: Grid | Scene) -> Plan:
         """The plan of a grid (AdaptiveError for bad axes or settings)."""

@@ -43,6 +43,7 @@ from rocksweep.compute.dispatch import _run_record, run_variant  # noqa: F401 (r
 from rocksweep.compute.grid import ChunkRows, Grid
 from rocksweep.errors import flag
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.numerics import point_seconds
 from rocksweep.scene.model import Scene
 from rocksweep.vocab.settings import BACKENDS
 
@@ -314,11 +315,8 @@ def _run_on_cluster(grid: Grid, chunks: list[tuple[int, int]], level: int,
 # What a sweep will cost, before it runs (rocksweep.estimate; the sweep command's dry run)
 # ---------------------------------------------------------------------------------------
 
-# Kernel time per RK4 evaluation [s] on the paper's figures at the default preset
-# (scripts/bench_compile.py: core-us per point over RK4 evaluations per point, 75-83 ns on
-# the four figures on the 2-core reference machine): the price of a step when no sample
-# can be run because the kernel is not compiled yet.
-SECONDS_PER_EVALUATION = 85e-9
+# The price of a step when no sample can be run because the kernel is not compiled yet:
+# ``numerics.SECONDS_PER_EVALUATION``.
 # Points run to measure the cost when the kernel variant is compiled: ~10 ms of work.
 ESTIMATE_SAMPLE = 256
 
@@ -391,7 +389,7 @@ def estimate(scene: Scene, jobs: int = 1, sample: int = ESTIMATE_SAMPLE,
         sampled = len(flat)
     else:
         evaluations = float(steps_bound)
-        seconds = evaluations * SECONDS_PER_EVALUATION / workers
+        seconds = point_seconds(evaluations) / workers
     return Estimate(n, steps_bound, evaluations, seconds, bool(to_compile or unknown),
                     COMPILE_SECONDS * (to_compile + unknown), len(grid.kinds()), sampled,
                     workers)

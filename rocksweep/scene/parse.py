@@ -119,7 +119,8 @@ def parse_scene(text: str, source: str = "scene", overrides: list[str] | None = 
 
 def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
     """The validated scene of a YAML file (a regular file: a FIFO, device or directory is
-    refused before it is opened, never waited on)."""
+    refused before it is opened, never waited on; a missing file is "no such scene file":
+    the one place that says it)."""
     path = Path(path)
     problem = input_problem(path)
     if problem is not None:

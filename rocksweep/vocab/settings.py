@@ -20,6 +20,26 @@ LADDERS: dict[str, str] = {
 }
 LADDER_NAMES: tuple[str, ...] = tuple(LADDERS)
 DEFAULT_LADDER = "full"
+#: the seed of the accuracy study's stratified sample when a caller gives none
+DEFAULT_SAMPLE_SEED = 0
+
+# Adaptive sweeps (``rocksweep.compute.adaptive`` explains each setting): the settings a
+# user gives (the scene's refine: section, the API's keywords, the sweep command's options;
+# their ranges: ``rocksweep.schema``) and their defaults.
+ADAPTIVE_SETTINGS: tuple[str, ...] = ("coarse", "audit", "margin", "final_margin", "seed",
+                                      "threshold")
+# Default coarse level: the largest k whose coarse lattice keeps >= MIN_COARSE_CELLS cells
+# along both diagram axes (80: k = 2, 400: k = 4, 1000: k = 5); see ``default_coarse``.
+MIN_COARSE_CELLS = 16
+DEFAULT_MARGIN = 1
+# No margin at the last level: there it caught only one-point-tall slivers (40 of 480 000
+# points of Figure 4(b) at 400 x 400) for 17-27% more points computed. 0 also selects the
+# light rules of the last two levels (module docstring); >= 1 refines whole cells there.
+DEFAULT_FINAL_MARGIN = 0
+DEFAULT_AUDIT = 0.02
+DEFAULT_SEED = 0
+# A run warns when more than this share of its audit points disagree with their fill.
+DEFAULT_AUDIT_THRESHOLD = 0.002
 
 #: where a sweep's chunks run: local worker threads, or a dask.distributed cluster
 BACKENDS: tuple[str, ...] = ("threads", "dask")

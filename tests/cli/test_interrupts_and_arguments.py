@@ -149,7 +149,28 @@ def test_cli_messages_name_the_cli_flags():
                      resume=flag("resume"), output=Arg("output"), adaptive=flag("adaptive"),
                      jobs=Arg("jobs", 0))
     assert str(err) == "resume=True needs output; add adaptive=True; jobs = 0: resume=True stays"
-    assert said(err) == "--resume needs --output; add --adaptive; --jobs 0: resume=True stays"
+    assert said(err) == "--resume needs -o; add --adaptive; --jobs 0: resume=True stays"
     fix = SceneError("pick one with {fix}", fix=set_key("impact.lam", "set_fix"))
     assert (str(fix), said(fix)) == ("pick one with overrides={'impact.lam': ...}",
                                      "pick one with --set impact.lam=VALUE")
+
+
+@pytest.mark.parametrize("rtol", ["0.3", "0", "nan"])
+def test_fragility_rtol_is_refused_before_any_work(cli, suite_result, tmp_path, monkeypatch,
+                                                   rtol):
+    """``fragility --rtol`` is the shared option: the library's range (0, MAX_RTOL], refused
+    while the options are parsed (exit 2, one line naming --rtol), before the result is
+    opened or any curve fitted, nothing written."""
+
+    def no_work(*_args, **_kwargs):
+        raise AssertionError("work started before the options were checked")
+
+    for name in ("open", "fragility", "ida"):
+        monkeypatch.setattr(rocksweep, name, no_work)
+    out, fig = tmp_path / "f.csv", tmp_path / "f.png"
+    res = cli.invoke(main, ["fragility", str(suite_result), "--rtol", rtol, "-o", str(out),
+                            "--plot", str(fig)])
+    line = one_line_error(res, 2)
+    assert line.startswith(f"Error: --rtol {float(rtol)!r}: must be a relative tolerance in "
+                           f"(0, {rocksweep.errors.MAX_RTOL:g}]"), line
+    assert list(tmp_path.iterdir()) == []

@@ -12,8 +12,8 @@ import pytest
 import rocksweep.store.writer as writer
 from rocksweep.compute.grid import Grid
 from rocksweep.compute.sweep import ChunkResult, plan_chunks
-from rocksweep.scene.parse import parse_scene
 from rocksweep.errors import OutputError
+from rocksweep.scene.parse import parse_scene
 from rocksweep.store import StoreError
 from rocksweep.store.format import FORMAT_VERSION, flat_slabs
 from rocksweep.store.reader import read_result
