@@ -1,8 +1,8 @@
 """The Python API, a thin facade: run a scene's grid, open a result, simulate one point,
 and the analyses of a Dataset. Each function hands over to the room that does the work
 and checks its arguments: scenes (``rocksweep.scene.inputs``), the sweep session
-(``rocksweep.store.session``), a result as a Dataset (``rocksweep.store.dataset``), a
-run's history (``rocksweep.store.history``), the analyses (``rocksweep.analysis``), the
+(``rocksweep.compute.session``), a result as a Dataset (``rocksweep.store.dataset``), a
+run's history (``rocksweep.compute.history``), the analyses (``rocksweep.analysis``), the
 figures (``rocksweep.figures``), ``ds.rocksweep`` (``rocksweep.accessor``). Errors name
 the API's arguments (``rocksweep.errors.Arg``).
 
@@ -34,10 +34,10 @@ if TYPE_CHECKING:
 _MOVED = {name: module for module, names in {
     "rocksweep.compute.driver": ("WRITE_EVERY", "SweepInterrupted", "SweepReport"),
     "rocksweep.scene.inputs": ("load", "override_strings"),
-    "rocksweep.store.history": ("MAX_RUNS", "API_MAX_RUNS", "simulate_runs",
+    "rocksweep.compute.history": ("MAX_RUNS", "API_MAX_RUNS", "run_points",
                                 "history_dataset", "swept_values", "write_history_csv"),
     "rocksweep.compute.adaptive": ("adaptive_options",),
-    "rocksweep.store.session": ("sweep_file",),
+    "rocksweep.compute.session": ("sweep_file",),
     "rocksweep.store.dataset": ("result_dataset",),
     "rocksweep.accessor": ("RocksweepAccessor",),
 }.items() for name in names}
@@ -108,7 +108,7 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
     ``output``. A wrong type (``jobs="2"``, ``overrides=5``) is a TypeError naming the
     argument; every argument is checked before the output is touched.
     """
-    from rocksweep.store.session import run_session  # checks every argument first
+    from rocksweep.compute.session import run_session  # checks every argument first
 
     out = run_session(scene, output, overrides=overrides, jobs=jobs, resume=resume,
                       overwrite=overwrite, progress=progress, client=client,
@@ -121,37 +121,91 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
 
 @_public
 def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xarray's)
-    """A sweep result file as an xarray Dataset, loaded in memory (the file is closed).
+    """Any file rocksweep writes as an xarray Dataset, loaded in memory (the file is
+    closed): a sweep result, or what an analysis wrote (fragility, risk, IM efficiency,
+    calibration ``-o .h5``, boundaries and accuracy HDF5), whose ``attrs["rocksweep_kind"]``
+    names its kind (``rocksweep.analysis.files``).
 
-    Each variable carries its unit (``rocksweep_units``: ``rocksweep.fields.UNITS``, e.g.
-    alpha_ref, 1/p, E_ref; CF ``units`` "1") and a description; ``outcome`` its codes
-    and words as CF flags (``flag_values`` -1 0 1 2, ``flag_meanings`` "not_run safe
-    mode1 mode2"), ``status`` its bits (``flag_masks``, ``flag_meanings``,
-    ``flagged_mask``). The attributes are the file's provenance (all of them:
-    ``rocksweep.store.format``): ``scene`` (the YAML verbatim), ``scene_resolved``,
+    A sweep result: each variable carries its unit (``rocksweep_units``:
+    ``rocksweep.fields.UNITS``, e.g. alpha_ref, 1/p, E_ref; CF ``units`` "1") and a
+    description; ``outcome`` its codes and words as CF flags (``flag_values`` -1 0 1 2,
+    ``flag_meanings`` "not_run safe mode1 mode2"), ``status`` its bits (``flag_masks``,
+    ``flag_meanings``, ``flagged_mask``). The attributes are the file's provenance (all of
+    them: ``rocksweep.store.format``): ``scene`` (the YAML verbatim), ``scene_resolved``,
     ``overrides``, ``numerics``, ``accuracy``, versions, times, ``complete``. Works
     while a sweep is still writing the file (no lock is taken). A file that is not a
-    rocksweep result is a one-line ``RocksweepError``.
+    rocksweep file is a one-line ``RocksweepError``.
     """
-    from rocksweep.store.dataset import open_result
+    from rocksweep.analysis.files import open_any
 
-    return open_result(path)
-
-
-@_public
-def open_any(path: str | Path) -> xr.Dataset:
-    """Any rocksweep Dataset from a file (``rocksweep.analysis.files.open_any``), with
-    ``ds.rocksweep``."""
-    from rocksweep.analysis.files import open_any as open_file
-
-    return open_file(path)
+    return open_any(path)
 
 
 def _dataset_arg(ds: Any, what: str) -> xr.Dataset:
-    """A Dataset, or a path to one (``analysis.files._as_dataset``), with ``ds.rocksweep``."""
-    from rocksweep.analysis.files import _as_dataset
+    """A Dataset, or a path to one (``analysis.files.as_dataset``), with ``ds.rocksweep``."""
+    from rocksweep.analysis.files import as_dataset
 
-    return _as_dataset(ds, what)
+    _check_dataset(what, ds)
+    return as_dataset(ds, what)
+
+
+def _typed(name: str, value: Any, ok: bool, allowed: str) -> None:
+    """The API's one type check of an argument: a one-line TypeError naming it, the value
+    (shortened) and what is allowed, unless ``ok``."""
+    if not ok:
+        text = repr(value)
+        text = text if len(text) <= 60 else f"{text[:40]}...{text[-12:]}"
+        raise TypeError(f"{name} = {text}: must be {allowed}")
+
+
+def _is_int(v: Any) -> bool:
+    """An integer, not a bool (True is no row number)."""
+    import numbers
+
+    return isinstance(v, numbers.Integral) and not isinstance(v, bool)
+
+
+def _is_number(v: Any) -> bool:
+    """A real number, not a bool."""
+    import numbers
+
+    return isinstance(v, numbers.Real) and not isinstance(v, bool)
+
+
+def _check_dataset(name: str, ds: Any) -> None:
+    import xarray as xr
+
+    _typed(name, ds, isinstance(ds, xr.Dataset | str | Path),
+           "an xarray Dataset (rocksweep.run, rocksweep.open or an analysis) or a path to "
+           "one")
+
+
+def _check_optional_text(**given: Any) -> None:
+    for name, v in given.items():
+        _typed(name, v, v is None or isinstance(v, str), "a string or None")
+
+
+def _check_flags(**given: Any) -> None:
+    import numpy as np
+
+    for name, v in given.items():
+        _typed(name, v, isinstance(v, bool | np.bool_), "True or False")
+
+
+def _check_ax(ax: Any) -> None:
+    """None, a matplotlib Axes or a sequence (list, array) of them."""
+    if ax is None:
+        return
+    from matplotlib.axes import Axes
+
+    if isinstance(ax, Axes):
+        return
+    import numpy as np
+
+    items = list(np.ravel(np.asarray(ax, dtype=object))) if isinstance(
+        ax, list | tuple | np.ndarray) else None
+    _typed("ax", ax, bool(items) and all(isinstance(a, Axes) for a in items),
+           "a matplotlib Axes, a sequence of them (one per panel) or None")
 
 
 # --- Analyses: a result Dataset in, a Dataset, a DataFrame or a Figure out ---------------
@@ -181,6 +235,14 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     """
     from rocksweep.figures.dispatch import plot_any
 
+    _check_dataset("ds", ds)
+    _check_ax(ax)
+    _check_optional_text(x=x, y=y, compare=compare, width=width)
+    _check_flags(curves=curves, show_computed=show_computed, mu=mu)
+    if isinstance(ds, str | Path):
+        from rocksweep.analysis.files import open_any
+
+        ds = open_any(ds)
     return plot_any(ds, x, y, ax=ax, curves=curves, show_computed=show_computed, mu=mu,
                     width=width, compare=compare)
 
@@ -205,6 +267,7 @@ def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None,
     """
     from rocksweep.analysis.boundaries import boundaries_dataset
 
+    _check_dataset("ds", ds)
     return boundaries_dataset(ds, rtol, mode, search)
 
 
@@ -215,6 +278,7 @@ def boundary_lines(ds: xr.Dataset) -> Any:
     ``classes`` (e.g. "safe|mode1"), ``closed``, ``vertex``, ``x``, ``y`` (axis values)."""
     from rocksweep.analysis.boundaries import boundary_lines_frame
 
+    _check_dataset("ds", ds)
     return boundary_lines_frame(ds)
 
 
@@ -226,6 +290,7 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3, search: bool = True) -> xr.Datas
     (search=False: the grid's bracket bisected only, as for ``boundaries``)."""
     from rocksweep.analysis.spectrum import spectra as compute_spectra
 
+    _check_dataset("ds", ds)
     return compute_spectra(ds, rtol, search).to_dataset()
 
 
@@ -241,6 +306,7 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
     curves ``rocksweep.plot`` draws)."""
     from rocksweep.analysis.ida import ida_dataset
 
+    _check_dataset("ds", ds)
     return ida_dataset(ds, rtol)
 
 
@@ -291,6 +357,10 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = N
     ``reason``; beyond the hazard's range the rate is bounded, never extrapolated."""
     from rocksweep.analysis.risk import risk as compute
 
+    _check_dataset("fr", fr)
+    _typed("years", years, _is_number(years), "a number of years > 0")
+    _typed("site", site, site is None or _is_int(site),
+           "an integer row number (0 = the first site) or None")
     return compute(_dataset_arg(fr, "fr"), hazard, years, site=site)
 
 
@@ -349,10 +419,10 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     ``default`` if it names none, as a sweep's (one point, one answer). Returns a ``Simulation``
     (summary dict, history Dataset over p*t, and ``.figure()``); a scene with lists gives
     one ``Simulation`` per combination, in grid order (at most
-    ``rocksweep.store.history.API_MAX_RUNS``, 100; sweeps are for ``run``).
+    ``rocksweep.compute.history.API_MAX_RUNS``, 100; sweeps are for ``run``).
     """
+    from rocksweep.compute.history import API_MAX_RUNS, titled_runs
     from rocksweep.scene.inputs import load, override_strings
-    from rocksweep.store.history import API_MAX_RUNS, titled_runs
 
     sc, _ = load(scene, [*override_strings(overrides), *override_strings(keys)])
     out = [Simulation(r.summary(), hist, r, title)
@@ -360,7 +430,7 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     return out[0] if sc.size == 1 else out
 
 
-# --- Calibration (issue 30): scene numbers fitted to a measured history ------------------
+# --- Calibration: scene numbers fitted to a measured history ------------------
 
 @_public
 def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impact.lam",),
@@ -383,6 +453,9 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     """
     from rocksweep.analysis.calibrate import calibrate_scene
 
+    _typed("bounds", bounds, bounds is None or isinstance(bounds, Mapping),
+           "a mapping {key: (lo, hi)}, e.g. {'impact.lam': (0, 1)}, or None")
+    _typed("p", p, p is None or _is_number(p), "a number (the body's p [rad/s]) or None")
     out = calibrate_scene(scene, measured, fit, bounds, ci, p, overrides)
     return out
 

@@ -106,7 +106,7 @@ class OutputError(RocksweepError, OSError):
 # working); tests/test_errors.py fails on an error class defined anywhere else.
 
 class BodyError(RocksweepError, ValueError):
-    """A body that is not physical; names the key and value (physics.model)."""
+    """A body that is not physical; names the key and value (physics.bodies)."""
 
 
 class RecordError(RocksweepError, ValueError):

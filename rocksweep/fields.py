@@ -8,7 +8,7 @@ says its dtype, the fill value of a point not computed, its unit, its meaning, t
 slot it comes from and the per-point scale it is divided by (theta by alpha_ref, energies
 by E_ref). ``HISTORY`` does the same for the columns of a time history (``HIST_*``).
 
-Units follow the conventions of ``rocksweep.physics.model``: times are p*t (unit ``1/p``),
+Units follow the conventions of ``rocksweep.physics.bodies``: times are p*t (unit ``1/p``),
 rotations theta/alpha_ref (unit ``alpha_ref``: alpha_cg of a flexible body, alpha of a
 block), lateral displacements u/u_cr, energies E/E_ref; ``1`` is a count, a code or a
 pure number.
@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 from rocksweep.vocab.axes import AXES, AxisMeta, alpha_symbol  # noqa: F401
 from rocksweep.vocab.ground import AVGSA_POINTS, RECORD_IMS, SA, SA_DAMPING, SCALE_IMS
 

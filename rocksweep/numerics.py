@@ -8,85 +8,49 @@ presets' figures on the shipped paper scenes.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass, fields, replace
 
 import numpy as np
 
-# Event root finders (``rocksweep.kernel.events._locate``); each keeps the bracket and
-# stops at event_tol. Hermite (the default) takes 2-5 RK4 re-integrations per event (3.8
-# on Figure 3(a)) where bisection takes log2(step/event_tol) ~ 20, with bisection steps as
-# its safeguard; on the four figures' accuracy samples all three give the same outcomes at
-# every preset (`rocksweep accuracy configs/fig3a.yaml --points 1000 --ladder roots`).
-ROOTS = ("bisection", "illinois", "hermite")
+from rocksweep.vocab.settings import ACCURATE, DEFAULT_PRESET, DEFAULT_ROOT, DRAFT, FINE
 
-# name -> (steps_per_period, event_tol). A preset is these with rotation_step
-# (PRESET_ROTATION), pulse_steps (PRESET_PULSE) and refine (PRESET_REFINE).
-#
-# Issue 28 (the step follows what acts, close calls certified): `default` classifies the
-# four figures like `fine` on all but 0/0/0/1 of their 19 200 cells each (the rule before
-# it: 72/32/1/2), at 0.4-4.6% more RK4 evaluations (1-11% more time) than that
-# rule (`python scripts/bench_step_rule.py`), and the held-out-style spectra (blocks alpha
-# 0.1/0.25/0.4, three flexible bodies, sine and cosine, omega/p 1-12, A/(g tan alpha) to
-# 30 on a 1000-value grid) like `fine` on every curve's first overturning value and mode.
-# `draft` is the smallest step allowed (4) with the pulse at 10 steps and no
-# certification; `fine` 20 steps per period, the pulse at 40, event_tol 1e-8; the agreement
-# of each with the reference and its price: docs/accuracy.md
-# (`rocksweep accuracy FIG.yaml --points 1000 --ladder roots`, `scripts/accuracy_tables.py`).
-# event_tol 1e-5 and above keep chattering above the rest rate (runs hit the event cap).
-#
-# `accurate` (issue 15) is fit for every stored quantity far outside the paper's region:
-# the 95th percentile of the overturning-time error is below 0.05 p*t and of the safe runs'
-# max|theta| relative error below 1% on the held-out wide-space samples (scripts/
-# wide_space.py --seed 2 and 3) and on the stratified sample of configs/wide-space.yaml
-# (`rocksweep accuracy configs/wide-space.yaml --points 300 --ladder presets`), where 8
-# steps per period left the overturning time at 0.086 p*t (lam = 1.5: energy-gaining
-# impacts). `default` keeps 5 steps per period and meets neither there; `sweep --check`
-# stores a per-point estimate of what it misses.
-PRESETS: dict[str, tuple[int, float]] = {
-    "draft": (4, 1e-6),
-    "default": (5, 1e-6),
-    "fine": (20, 1e-8),
-    "accurate": (10, 1e-8),
-}
 
-# name -> rotation_step: the largest rotation one rocking step may make, as a fraction of
-# alpha_cg (the kernel's PAR_ROT_STEP = rotation_step * alpha_ref; 0: no such limit). The
-# spring, pulse and rocking time scales above set the step in the paper's region; far
-# outside it (a pulse 20x the uplift threshold, a fall to overturning, a rigid body) the body
-# turns through alpha_cg or more in one step, and the overturning time and max|theta| lose
-# their digits (issue 15; measured with scripts/wide_space.py, see docs/accuracy.md).
-# A quarter of alpha_cg costs the four figures 3.5% more RK4 evaluations at `default` (0.1:
-# 15%) and halves the overturning-time tail of the wide-space sample; `accurate` and `fine`
-# take 0.1 (0.05 buys little more).
-PRESET_ROTATION: dict[str, float] = {
-    "draft": 0.25,
-    "default": 0.25,
-    "fine": 0.1,
-    "accurate": 0.1,
-}
+@dataclass(frozen=True)
+class Preset:
+    """The values an accuracy preset (``numerics.accuracy``) sets; each field is the
+    ``Numerics`` field of the same name."""
 
-# name -> pulse_steps: RK4 steps per pulse period while the pulse acts (at least
-# steps_per_period; ``step_sizes``). At 5 (the rule before issue 28) the pulse's work on a
-# uniform block (alpha 0.25, sine, omega/p = 8) was ~2% off and its mode-1 band A/(g tan
-# alpha) in [10.86, 11.41] (the reference's) vanished; 10 finds [10.87, 11.40], 12 and
-# more [10.86, 11.41] (scanned at steps of 0.01). On blocks at omega/p 3-12 (A to 30),
-# 12 differs from `fine` on 3 of 18 000 cells (5: 17), for 11% more RK4 evaluations than
-# 5; on the four figures it costs 1-3%.
-PRESET_PULSE: dict[str, int] = {
-    "draft": 10,
-    "default": 12,
-    "fine": 40,
-    "accurate": 20,
-}
+    steps_per_period: int
+    event_tol: float
+    rotation_step: float
+    pulse_steps: int
+    refine: int
 
-# name -> refine: most refinements (2x, 4x, ... the steps) of a close call before its
-# outcome is called uncertified (``rocksweep.compute.certify``; 0: no certification).
-PRESET_REFINE: dict[str, int] = {
-    "draft": 0,
-    "default": 3,
-    "fine": 3,
-    "accurate": 3,
+
+# How each value was chosen, with its measured price and agreement with the reference:
+# docs/accuracy.md ("Where the presets' values come from" and the tables above it).
+# - steps_per_period 5 and pulse_steps 12 (`default`): the fewest steps that classify the
+#   four figures like `fine` (0/0/0/1 of 19 200 cells) and the held-out spectra's first
+#   overturning values; fewer pulse steps lose a uniform block's narrow mode-1 band.
+# - event_tol: 1e-5 and above keep chattering above the rest rate (runs hit the event cap).
+# - rotation_step (a fraction of alpha_cg; 0: no limit): far outside the paper's region a
+#   body would turn through alpha_cg or more in one step; a quarter halves the
+#   overturning-time tail of the wide-space sample for a few percent more steps.
+# - refine: most refinements of a close call (``rocksweep.compute.certify``); `draft`
+#   certifies nothing.
+# - `accurate`: every stored quantity to 0.05 p*t and 1% (95th percentile) far outside the
+#   paper's region, where `default` meets neither; `fine` for histories and energies.
+PRESETS: dict[str, Preset] = {
+    DRAFT: Preset(steps_per_period=4, event_tol=1e-6, rotation_step=0.25, pulse_steps=10,
+                  refine=0),
+    DEFAULT_PRESET: Preset(steps_per_period=5, event_tol=1e-6, rotation_step=0.25,
+                           pulse_steps=12, refine=3),
+    FINE: Preset(steps_per_period=20, event_tol=1e-8, rotation_step=0.1, pulse_steps=40,
+                 refine=3),
+    ACCURATE: Preset(steps_per_period=10, event_tol=1e-8, rotation_step=0.1, pulse_steps=20,
+                     refine=3),
 }
+_DEFAULT = PRESETS[DEFAULT_PRESET]
 
 # Smallest event_tol [p*t] a scene may ask for. An event's time is t0 + tau in float64; at
 # t ~ 1e2 (a run lasts the pulse plus the 200-long horizon) its spacing is 1.4e-14, and
@@ -106,12 +70,11 @@ EVENT_STEP_ALLOWANCE = 200.0
 # be run) and the cost of a point at the cap below (``point_seconds``) are derived.
 SECONDS_PER_EVALUATION = 85e-9
 
-# Cap on one point's step budget (``step_budget``, PAR_MAXSTEPS) that a scene may imply.
-# A point that runs to it takes ``point_seconds(MAX_POINT_STEPS)`` (~8.5 s) of one core:
-# the longest a single point may take before the
-# values are taken for a mistake (w_over_p = 1e-9, a pulse of 6e9 p*t; wn_over_p = 1e5 at
-# steps of 1e-5). The shipped scenes need at most 1.5e6 (fig4b at `fine`), of which the
-# default allowance for 5000 events is 1e6.
+# Cap on one point's step budget (``step_budget``, PAR_MAXSTEPS) that a scene may imply:
+# a point that long takes ``point_seconds(MAX_POINT_STEPS)`` (~8.5 s) of one core, the
+# longest a single point may take before its values are taken for a mistake (w_over_p =
+# 1e-9, a pulse of 6e9 p*t; wn_over_p = 1e5 at steps of 1e-5). The shipped scenes need at
+# most 1.5e6 (fig4b at `fine`), of which the default allowance for 5000 events is 1e6.
 MAX_POINT_STEPS = 1e8
 
 
@@ -137,39 +100,37 @@ class Numerics:
         contact (ends a chattering sequence after finitely many impacts).
     max_events: cap on impacts + uplifts per run (reported as a status flag).
     max_steps_factor: cap on RK4 evaluations per run, as a multiple of horizon/step.
-    root: event root finder, one of ROOTS (see ``rocksweep.kernel.events._locate``).
+    root: event root finder, one of ``vocab.settings.ROOTS`` (``kernel.events._locate``):
+        each keeps the bracket and stops at event_tol; Hermite takes 2-5 re-integrations
+        per event where bisection takes ~20, with the same outcomes (docs/accuracy.md).
     rotation_step: largest rotation of one rocking step, a fraction of alpha_cg (0: none);
         the step is shortened to it from theta' and the last step's theta'' and a step that
         turned more than twice as far is taken again (``rocksweep.kernel.loop``).
     """
 
-    accuracy: str = "default"
-    steps_per_period: int = PRESETS["default"][0]
-    event_tol: float = PRESETS["default"][1]
+    accuracy: str = DEFAULT_PRESET
+    steps_per_period: int = _DEFAULT.steps_per_period
+    event_tol: float = _DEFAULT.event_tol
     horizon: float = 200.0
     rest_rate: float = 1e-4
     max_events: int = 5000
     max_steps_factor: float = 20.0
-    root: str = "hermite"
-    rotation_step: float = PRESET_ROTATION["default"]
-    pulse_steps: int = PRESET_PULSE["default"]
-    refine: int = PRESET_REFINE["default"]
+    root: str = DEFAULT_ROOT
+    rotation_step: float = _DEFAULT.rotation_step
+    pulse_steps: int = _DEFAULT.pulse_steps
+    refine: int = _DEFAULT.refine
 
     @classmethod
-    def preset(cls, accuracy: str = "default", **overrides) -> Numerics:
-        spp, tol = PRESETS[accuracy]
-        return replace(cls(accuracy=accuracy, steps_per_period=spp, event_tol=tol,
-                           rotation_step=PRESET_ROTATION[accuracy],
-                           pulse_steps=PRESET_PULSE[accuracy],
-                           refine=PRESET_REFINE[accuracy]), **overrides)
+    def preset(cls, accuracy: str = DEFAULT_PRESET, **overrides) -> Numerics:
+        return replace(cls(accuracy=accuracy, **asdict(PRESETS[accuracy])), **overrides)
+
+    def preset_values(self) -> Preset:
+        """The values of these numerics that a preset sets."""
+        return Preset(**{f.name: getattr(self, f.name) for f in fields(Preset)})
 
     def describe(self) -> str:
         label = self.accuracy
-        base = PRESETS.get(self.accuracy)
-        if base is None or base != (self.steps_per_period, self.event_tol) or (
-                PRESET_ROTATION[self.accuracy] != self.rotation_step) or (
-                PRESET_PULSE[self.accuracy] != self.pulse_steps) or (
-                PRESET_REFINE[self.accuracy] != self.refine):
+        if PRESETS.get(self.accuracy) != self.preset_values():
             label = "custom"
         return (f"{label} (steps_per_period={self.steps_per_period}, "
                 f"pulse_steps={self.pulse_steps}, "
@@ -196,40 +157,26 @@ class Numerics:
 # A softer spring holds more of the energy, ~(p/omega_rock)^2, and RK4 takes ~n^-5 of it
 # per unit time (its numerical damping), so a spring below OMEGA_SPRING x p gets
 # (OMEGA_SPRING/omega_rock)^(2/5) times the steps: the energy error of Figure 4's spring
-# (omega_rock/p = 27.5) at 5 steps. Figure 3(a)'s spring (6.8) gets 1.75x: 73 cells that
-# went safe where `fine` overturns (mode 1) became 2, for 0% more RK4 evaluations (the
-# rotation limit sets most of its rocking steps).
+# (omega_rock/p = 27.5) at 5 steps, which classifies like `fine` (docs/accuracy.md).
 OMEGA_SPRING = 27.5
 
 # A stiffer spring holds less energy but is damped faster: -ln|R(iy)| per step is
 # y^6/144 to leading order, a decay rate of the spring's amplitude of
-# omega_rock (2 pi/n)^5/144 per unit p*t, growing with omega_rock at fixed n. At 5 steps
-# per period Figure 4's spring (27.5) lost 0.49 p to the integrator (exactly; 0.60 to
-# leading order), on top of its physical zeta' omega' = zeta omega_n Gamma = 3.8 p while the
-# top mass is over the corner (``rocking_spring_omega``) and 0.49 p in full contact: near
-# the uplift threshold under long pulses (A_ratio 0.9-1.4, w_over_p 0.15-1.2, hundreds of
-# small uplifts) `default` then classed 10 and 16 of 6579 cells of Figures 4(a)/(b) unlike
-# `fine` and the scipy reference, none flagged. So an oscillating spring (zeta' < 1) also
-# gets the steps that hold that numerical decay rate to ``spring_decay`` at 5 steps per
-# period, (5/steps_per_period)^5 of it at others (the presets keep their order; a
+# omega_rock (2 pi/n)^5/144 per unit p*t, growing with omega_rock at fixed n. Near the
+# uplift threshold under long pulses (hundreds of small uplifts) that numerical damping,
+# beside the physical zeta' omega', decided outcomes. So an oscillating spring (zeta' < 1)
+# also gets the steps that hold that numerical decay rate to ``spring_decay`` at 5 steps
+# per period, (5/steps_per_period)^5 of it at others (the presets keep their order; a
 # refinement's doubling halves every step):
 #
 #     SPRING_DECAY_FREE + SPRING_DECAY_REL x zeta' omega_rock, at most SPRING_DECAY [p].
 #
-# What the error does to the spring's amplitude depends on what else damps it: driven and
-# damped at zeta' omega', the amplitude is off by ~sigma/(zeta' omega'), 1/38 = 2.6% at
-# SPRING_DECAY_REL; an undamped spring (zeta = 0) keeps the whole error for as long as the
-# run lasts (~50 p*t under a long pulse near the threshold) and gets SPRING_DECAY_FREE,
-# 10% of its amplitude over 50 p*t. Measured (scripts/bench_threshold.py; cells of the
-# band unlike `fine`, the reference siding with `fine`): at 0.1 p Figure 4's body (3.8 p:
-# 0.1) 10/16 -> 2/3, stiffer damped bodies (wn/p = 20, 50) 6 -> 0 and 9 -> 3, and 0.05 or
-# 0.02 fix ~nothing more there; three undamped bodies kept 36-127 wrong cells before,
-# 19-95 at a flat 0.1 p, 4-26 at a floor of 0.01 p, 5-9 at 0.002 (docs/accuracy.md).
-# Price: +15% RK4 evaluations on the four figures at `default`
-# (Figures 4(a)/(b) +23%/+22%, their spring's steps 1.43x; `fine` there +38%/+37%), 1.4-1.6x
-# on the stiffer damped bodies' band, 3.0-4.6x on the undamped ones' (docs/accuracy.md,
-# "Stiff springs near the uplift threshold"); Figure 3's body (6.8 p, zeta' omega' = 0.95
-# p), the block and the rigid bodies keep their steps, bit for bit.
+# Driven and damped at zeta' omega', the amplitude is off by ~sigma/(zeta' omega'), 1/38 =
+# 2.6% at SPRING_DECAY_REL; an undamped spring (zeta = 0) keeps the whole error for as long
+# as the run lasts (~50 p*t under a long pulse near the threshold) and gets
+# SPRING_DECAY_FREE, 10% of its amplitude over 50 p*t. Smaller bounds fixed nothing more;
+# the cells each bound fixes and its price: docs/accuracy.md, "Stiff springs near the
+# uplift threshold".
 SPRING_DECAY = 0.1
 SPRING_DECAY_FREE = 0.002
 SPRING_DECAY_REL = 1.0 / 38.0
@@ -266,15 +213,12 @@ def spring_steps(omega_rock: np.ndarray | float, steps_per_period: int,
 # A rigid body under a pulse just above its uplift threshold (A_ratio = 1: A = g tan
 # alpha_ref) rocks in tiny chattering arcs driven by the small difference between the
 # ground's push and gravity, (A - 1)/A of the push: the step that integrates the push to the
-# pulse's accuracy leaves an error that is large beside that difference. Measured on the
-# classic block (configs/block.yaml, sine and cosine, A_ratio 0.9-1.4 x w_over_p 0.15-1.2,
-# 4386 cells; `default` against `fine`, the scipy reference siding with `fine`): 31 cells
-# differed at pulse_steps alone; (A/(A - 1))^(1/4) more steps left 7, (A/(A - 1))^(1/2)
-# left 1, for 69 -> 82 RK4 evaluations a point on that band. So a rigid body's pulse gets
-# min(THRESHOLD_CAP, sqrt(A/(A - 1))) times the pulse steps above the threshold: 1.41x at
-# A_ratio 2, 1.05x at 10, THRESHOLD_CAP within 7% of 1 (below it a rigid body does not
-# lift off). Flexible bodies are left alone: Figure 3's body showed no such cell on the
-# same band, and Figure 4's were the spring's (SPRING_DECAY).
+# pulse's accuracy leaves an error that is large beside that difference. So a rigid body's
+# pulse gets min(THRESHOLD_CAP, sqrt(A/(A - 1))) times the pulse steps above the threshold
+# (the square root, not the fourth root, matched the reference; docs/accuracy.md, "Rigid
+# bodies just above the uplift threshold"): 1.41x at A_ratio 2, 1.05x at 10, THRESHOLD_CAP
+# within 7% of 1 (below it a rigid body does not lift off). Flexible bodies are left
+# alone: their spring sets their steps there (SPRING_DECAY).
 THRESHOLD_CAP = 4.0
 
 
@@ -304,7 +248,7 @@ def step_sizes(omega_rock: np.ndarray | float, omega: np.ndarray | float,
     rocking time scale 2 pi/omega_amp (``amplitude_frequency``; 0 leaves it out) over
     steps_per_period: dt_on <= dt. A short, strong pulse thus gets the steps its work on
     the body needs (at 5 steps per pulse period that work is ~2% off, enough to flip
-    outcomes: issue 28), and the free rocking after it is not stepped at the pulse's rate.
+    outcomes), and the free rocking after it is not stepped at the pulse's rate.
     While the body rocks, the kernel shortens either further so that one step turns the
     body by at most ``Numerics.rotation_step`` x alpha_cg (PAR_ROT_STEP,
     ``rocksweep.kernel.loop``). omega = 0 (a record: no period) leaves the pulse out. A
@@ -339,11 +283,20 @@ def step_budget(t_pulse: np.ndarray | float, t_end: np.ndarray | float,
 
 
 # The margin (OUT_MARGIN, alpha_ref) below which a run is a close call, re-run finer
-# (``close_margin``), at 5 steps per period. Measured on the four figures at `default`
-# against `fine` (scripts/bench_certify.py): the outcomes that differ before the
-# certification came within 0.005 of the saddle (Figure 3(a), with the spring's steps of
-# ``spring_steps``; 0.044 at 5 steps per spring period), 0.003 on Figures 4(a)/(b).
+# (``close_margin``), at 5 steps per period: a few times the closest approach of any run
+# of the four figures whose `default` outcome differed from `fine`'s before certification
+# (docs/accuracy.md, "Where the presets' values come from").
 CLOSE_MARGIN = 0.0125
+# An overturn is a close call up to this many times the row's PAR_CLOSE: a run that commits
+# to falling carries the error of every step before it into that one approach, and an
+# overturn that the finer runs survive can commit with a margin well above CLOSE_MARGIN.
+# Measured on a flexible body near its mode-1 threshold (wn/p 2.96, zeta 0.097, alpha_cg
+# 0.124, alpha_A 0.41, mA/m 1.41, IA 0.69, lam 0.32, sine w/p 4.61): `default` overturns
+# after 3 impacts with margins up to 0.040 (3.2 x CLOSE_MARGIN) at A_ratio in [3.110,
+# 3.122], where `fine` and the reference survive 138-216 impacts. On the four figures
+# 0.3-0.8% of the steps belong to overturns between 1 and 2 x PAR_CLOSE, 0.8-2.4% to those
+# between 1 and 4 x (``compute.certify``, docs/accuracy.md).
+OVERTURN_CLOSE = 4.0
 
 
 def close_margin(steps_per_period: int) -> float:
@@ -364,6 +317,6 @@ def amplitude_frequency(A_ratio: np.ndarray | float, alpha_ref: np.ndarray | flo
     turns the body through a radian in about 1/(p sqrt(A/g)). Below A = g (the paper's
     ranges) this is slower than the rocking scale p and changes nothing; far above it
     (A_ratio = 1e3 overturns the body in a few hundredths of 2 pi/p) a step following only
-    2 pi/p would jump over the whole motion (issue 5, "A_ratio huge").
+    2 pi/p would jump over the whole motion.
     """
     return np.sqrt(np.abs(np.asarray(A_ratio, float)) * np.tan(np.asarray(alpha_ref, float)))

@@ -40,7 +40,7 @@ from pathlib import Path
 from rocksweep.errors import OutputError, flag
 
 
-def _reason(err: OSError) -> str:
+def os_reason(err: OSError) -> str:
     if err.errno == errno.ENOSPC:
         return "no space left on the device"
     if err.errno == errno.ENAMETOOLONG:
@@ -104,7 +104,7 @@ def input_problem(path: str | Path) -> str | None:
     except FileNotFoundError:
         return "no such file"
     except (OSError, ValueError) as err:  # ValueError: a NUL byte in the name
-        return _reason(err) if isinstance(err, OSError) else "not a valid file name"
+        return os_reason(err) if isinstance(err, OSError) else "not a valid file name"
     if stat.S_ISDIR(st.st_mode):
         return "is a directory, not a file"
     if not stat.S_ISREG(st.st_mode):
@@ -161,7 +161,7 @@ def check_output(path: str | Path, *, overwrite: bool = False,
     except FileNotFoundError:
         st = None
     except OSError as err:
-        raise OutputError(f"{shown(path)}: cannot be written ({_reason(err)})") from None
+        raise OutputError(f"{shown(path)}: cannot be written ({os_reason(err)})") from None
     if st is not None:
         if stat.S_ISDIR(st.st_mode):
             raise OutputError(f"{shown(path)}: is a directory; give a file name")
@@ -363,7 +363,7 @@ def atomic_path(path: str | Path, *, overwrite: bool = False) -> Iterator[Path]:
                                     suffix=f".partial{path.suffix[:9]}", dir=parent)
         os.close(fd)
     except OSError as err:
-        raise OutputError(f"{shown(path)}: cannot be written ({_reason(err)})") from None
+        raise OutputError(f"{shown(path)}: cannot be written ({os_reason(err)})") from None
     tmp = Path(name)
     try:
         yield tmp
@@ -371,7 +371,7 @@ def atomic_path(path: str | Path, *, overwrite: bool = False) -> Iterator[Path]:
     except OutputError:
         raise
     except OSError as err:
-        raise OutputError(f"{shown(path)}: cannot be written ({_reason(err)})") from None
+        raise OutputError(f"{shown(path)}: cannot be written ({os_reason(err)})") from None
     finally:
         with contextlib.suppress(OSError):
             tmp.unlink()

@@ -3,7 +3,7 @@
 ``KEYS`` maps every dotted scene key to a ``Key``: the kind of value it holds, the range
 of admissible numbers (ends, inclusive or not, +inf allowed or not) and the text a user
 reads when a value is refused. The scene validator (``rocksweep.scene.parse``) and the body
-classes (``rocksweep.physics.model``) both check values here, so a body built from Python and a
+classes (``rocksweep.physics.bodies``) both check values here, so a body built from Python and a
 scene file get the same one-line message ``KEY = VALUE: what is allowed``.
 
 Bounds of the body's Pi groups. Beside the physical ranges (angles in (0, pi/2), lam in
@@ -25,15 +25,18 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.numerics import MIN_EVENT_TOL, PRESETS, ROOTS
+from rocksweep.numerics import MIN_EVENT_TOL
 from rocksweep.vocab.ground import SCALE_IMS, SHAPES
 from rocksweep.vocab.laws import DEFAULT_LAW, LAWS
+from rocksweep.vocab.settings import PRESET_NAMES, ROOTS
 
 RATIO_MAX = 1e6  # bound of the body's ratios (see the module docstring)
 ANGLE_MIN = 1e-6  # [rad] smallest slenderness: h/b = 1e6
 CYCLES_MAX = 1000  # pulse.cycles: more cycles than this are no pulse
 GAMMA_MAX = 100.0  # pulse.gamma: MP's gamma is 1-3 for near-fault records; 100 is plenty
 E_FACTOR_MAX = 10.0  # impact.e_factor: experiments scale e by a few tens of per cent
+# initial rate and top-mass state: 1e3 x the scales (theta' = 1e3 p alpha overturns at once)
+INITIAL_MAX = 1e3
 
 
 @dataclass(frozen=True)
@@ -61,7 +64,6 @@ class Key:
     default: Any = None
 
 
-_AXIS = "a number, a list of numbers or a range {start, stop, num}"
 _RATIO = f"[1e-06, {RATIO_MAX:g}]"
 _ANGLE = f"must be in [{ANGLE_MIN:g}, pi/2) rad"
 
@@ -92,7 +94,7 @@ KEYS: dict[str, Key] = {
     "body.inertia": Key("axis", f"must be in [1, {RATIO_MAX:g}] (I_O / (M R^2) >= 1)",
                         1.0, RATIO_MAX, required=False, default=4.0 / 3.0),
     # a body from the laboratory's numbers (body.kind physical): converted to the Pi groups
-    # above and p (rocksweep.physics.model.body_from_geometry)
+    # above and p (rocksweep.physics.bodies.body_from_geometry)
     "body.b": Key("number", "must be > 0 and finite (half-width of the base [m])", 0.0,
                   math.inf, lo_in=False, hi_in=False),
     "body.h": Key("number", "must be > 0 and finite (height of the top mass [m])", 0.0,
@@ -124,8 +126,8 @@ KEYS: dict[str, Key] = {
     "pulse.A_ratio": Key("axis",
                          "must be a finite number (negative: a pulse in the other direction)",
                          -math.inf, math.inf, lo_in=False, hi_in=False),
-    "numerics.accuracy": Key("choice", f"must be one of {', '.join(PRESETS)}",
-                             choices=tuple(PRESETS), required=False),
+    "numerics.accuracy": Key("choice", f"must be one of {', '.join(PRESET_NAMES)}",
+                             choices=PRESET_NAMES, required=False),
     "numerics.steps_per_period": Key("integer", "must be an integer in [4, 1e9]", 4, 1e9,
                                      required=False),
     "numerics.pulse_steps": Key("integer", "must be an integer in [4, 1e9] (RK4 steps per "
@@ -217,14 +219,14 @@ KEYS: dict[str, Key] = {
         "rocking on one corner, < 0 on the other)", -math.inf, math.inf, lo_in=False,
         hi_in=False, required=False, default=0.0),
     "initial.thetadot_over_palpha": Key(
-        "axis", "must be a finite number (theta'/(p alpha_cg) at t = 0)", -math.inf,
-        math.inf, lo_in=False, hi_in=False, required=False, default=0.0),
+        "axis", f"must be in [-{INITIAL_MAX:g}, {INITIAL_MAX:g}] (theta'/(p alpha_cg) at "
+        "t = 0)", -INITIAL_MAX, INITIAL_MAX, required=False, default=0.0),
     "initial.u_over_ucr": Key(
-        "axis", "must be a finite number (u/u_cr of the top mass at t = 0)", -math.inf,
-        math.inf, lo_in=False, hi_in=False, required=False, default=0.0),
+        "axis", f"must be in [-{INITIAL_MAX:g}, {INITIAL_MAX:g}] (u/u_cr of the top mass "
+        "at t = 0)", -INITIAL_MAX, INITIAL_MAX, required=False, default=0.0),
     "initial.udot_over_pucr": Key(
-        "axis", "must be a finite number (u'/(p u_cr) at t = 0)", -math.inf, math.inf,
-        lo_in=False, hi_in=False, required=False, default=0.0),
+        "axis", f"must be in [-{INITIAL_MAX:g}, {INITIAL_MAX:g}] (u'/(p u_cr) at t = 0)",
+        -INITIAL_MAX, INITIAL_MAX, required=False, default=0.0),
     "ground.avgsa": Key("string", "must be [T_lo, T_hi], periods in (0, 100] s with T_lo <= "
                         "T_hi (AvgSa's range; default 0.2-3 x scale.period for Sa stripes, "
                         "else 0.2-3 x 2 pi/p)", 0.0, 100.0, required=False),

@@ -30,14 +30,8 @@ import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
 import h5py
 import numpy as np
 
-from rocksweep.numerics import (
-    PRESET_PULSE,
-    PRESET_REFINE,
-    PRESET_ROTATION,
-    PRESETS,
-    ROOTS,
-    Numerics,
-)
+from rocksweep.numerics import PRESETS, Numerics
+from rocksweep.vocab.settings import ROOTS
 
 TARGET = 0.995
 
@@ -111,8 +105,9 @@ def main() -> None:
         d0 = reports[0]["rows"].get(name, reports[0]["rows"].get(f"{name}-{Numerics().root}"))
         if d0 is None:
             continue
-        print(f"| {name} | {int(d0['steps_per_period'])}, {PRESET_PULSE[name]}, "
-              f"{d0['event_tol']:.0e}, {PRESET_ROTATION[name]:g}, {PRESET_REFINE[name]} | "
+        p = PRESETS[name]
+        print(f"| {name} | {int(d0['steps_per_period'])}, {p.pulse_steps}, "
+              f"{d0['event_tol']:.0e}, {p.rotation_step:g}, {p.refine} | "
               + " | ".join(cells) + " |")
     print()
     _tails(reports, short)

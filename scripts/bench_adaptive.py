@@ -40,7 +40,7 @@ import numpy as np
 from rocksweep.compute import adaptive as ad
 from rocksweep.compute import sweep as sw
 from rocksweep.compute.driver import sweep_arrays
-from rocksweep.compute.grid import Grid
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.model import Scene
 from rocksweep.scene.parse import load_scene, parse_scene
 

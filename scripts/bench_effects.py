@@ -5,8 +5,8 @@ Grid: the Figure 4(a) pulse ranges (sine, omega/p in [0.15, 12], A/(g tan alpha_
 
   everything on   flexible body wn/p = 9.82, zeta = 0.05 (Table 3), energy accounting and
                   a time history (the single-run kernel ``point_kernel``, once per point)
-  simulate() loop the same, one ``rocksweep.compute.single.simulate`` call per point (what a script
-                  looping over single runs pays: rows built and histories copied per point)
+  run_point loop  the same, one ``rocksweep.compute.single.run_point`` call per point (what a
+                  script looping over single runs pays: rows built and histories copied)
   energy          same body, energy accounting, no history (``outputs: {energy: true}``)
   outcome-only    same body, outcome and summary metrics only (what sweeps run)
   zeta=0 general  Table 3 body with zeta = 0 through the damped kernel ...
@@ -36,12 +36,12 @@ import time
 import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
 import numpy as np
 
-from rocksweep.compute.single import history_capacity, simulate
+from rocksweep.compute.single import history_capacity, run_point
 from rocksweep.fields import check_rows
 from rocksweep.kernel import chunk_kernel, point_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import BlockBody, FlexibleBody
+from rocksweep.physics.bodies import BlockBody, FlexibleBody
 from rocksweep.physics.points import Point, body_omega_rock, body_row, fill_rows, shape_code
 
 TABLE3 = dict(wn_over_p=9.82, zeta=0.05, alpha_cg=0.15, alpha_A=0.28, mA_over_m=0.47,
@@ -99,10 +99,10 @@ def run_history(kind: int):
     return run
 
 
-def run_simulate(numerics: Numerics):
-    """What a script looping over ``rocksweep.compute.single.simulate`` pays (energy + history)."""
+def run_point_loop(numerics: Numerics):
+    """What a script looping over ``rocksweep.compute.single.run_point`` pays (energy + history)."""
     def run(points: np.ndarray) -> np.ndarray:
-        return np.array([simulate(p, numerics, history=True).out for p in points])
+        return np.array([run_point(p, numerics, history=True).out for p in points])
     return run
 
 
@@ -122,7 +122,7 @@ def main() -> None:
     variants = [  # (label, rows, runner, kind, level)
         ("flexible 9.82, energy + history (all on)", flex, run_history(L.KIND_FLEXIBLE),
          L.KIND_FLEXIBLE, None),
-        ("simulate() loop, energy + history", flex, run_simulate(numerics),
+        ("run_point() loop, energy + history", flex, run_point_loop(numerics),
          L.KIND_FLEXIBLE, None),
         ("flexible 9.82, energy", flex, run_chunk(L.KIND_FLEXIBLE, L.LEVEL_ENERGY),
          L.KIND_FLEXIBLE, L.LEVEL_ENERGY),
@@ -150,7 +150,7 @@ def main() -> None:
     rows["flexible 9.82, outcome-only, accurate"] = grid_rows(flex, args.n,
                                                               Numerics.preset("accurate"))
     w, a = grid_values(args.n)
-    rows["simulate() loop, energy + history"] = np.array(
+    rows["run_point() loop, energy + history"] = np.array(
         [Point(flex, 0.0, "sine", float(wi), float(ai)) for wi, ai in zip(w, a, strict=True)],
         dtype=object)
 

@@ -11,7 +11,7 @@ Prints, measured side by side in one run:
 2. the cost of one run against the scipy reference (``rocksweep.physics.reference``,
    DOP853 with event location) on the same record, body and scaled amplitude: a few
    points across the stripes (``--ref-points``), the kernel's CPU time per run (each run
-   through the sweep's own path, ``compute.sweep._run_record``, best of 5) and the
+   through the sweep's own path, ``compute.dispatch.run_record``, best of 5) and the
    reference's wall time (target: kernel <= 1/300 of the reference).
 3. the per-record intensity measures (PGA, PGV, Sa at 0.2 and 1 s: ``make_suite``) as a
    share of the sweep's wall time (target: < 1 %).
@@ -132,11 +132,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"   rocksweep fragility (200 bootstrap resamples): {t_fr:.2f} s")
 
         # 2. per run against the reference
-        from rocksweep.compute.grid import Grid
-        from rocksweep.compute.sweep import _run_record, level
+        from rocksweep.compute.dispatch import run_record
+        from rocksweep.compute.sweep import level
         from rocksweep.kernel import chunk_kernel
         from rocksweep.kernel import layout as L  # noqa: N812
         from rocksweep.physics.reference import reference_run
+        from rocksweep.scene.grid import Grid
         from rocksweep.scene.parse import load_scene
 
         sc = load_scene(scene)
@@ -163,7 +164,7 @@ def main(argv: list[str] | None = None) -> int:
             best = np.inf
             for _ in range(5):
                 c0 = time.thread_time()
-                _run_record(kernel, rows, sel, outs, sc.suite.records[rec_i])
+                run_record(kernel, rows, sel, outs, sc.suite.records[rec_i])
                 best = min(best, time.thread_time() - c0)
             point = sc.point({**{a.name: a.values[0] for a in sc.axes},
                               **{k: v[j] for k, v in vals.items()}})

@@ -72,16 +72,16 @@ from rocksweep.analysis.accuracy import (
     run_reference,
     stratified_sample,
 )
-from rocksweep.compute.grid import Grid
 from rocksweep.compute.single import history_capacity
 from rocksweep.compute.sweep import auto_chunk_size, level, plan_chunks, prepare
 from rocksweep.kernel import chunk_kernel, point_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel.equations import contact_rhs, ground_acc, rocking_rhs
 from rocksweep.kernel.stepping import rk4_step
-from rocksweep.numerics import ROOTS
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.model import Scene
 from rocksweep.scene.parse import load_scene
+from rocksweep.vocab.settings import ROOTS
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIGS = ROOT / "configs"

@@ -108,7 +108,7 @@ def curve_key(c: dict[str, Any]) -> str:
 
 
 def make_body(spec: dict[str, Any]):
-    from rocksweep.physics.model import BlockBody, FlexibleBody
+    from rocksweep.physics.bodies import BlockBody, FlexibleBody
 
     spec = dict(spec)
     if spec.pop("kind", "flexible") == "block":

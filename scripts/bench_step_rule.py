@@ -39,12 +39,12 @@ from pathlib import Path
 import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
 import numpy as np
 
-from rocksweep.compute.grid import Grid
 from rocksweep.compute.sweep import level, run_rows
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import warm_up
 from rocksweep.numerics import Numerics, amplitude_frequency
 from rocksweep.physics.points import body_omega_rock
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.parse import load_scene, parse_scene
 
 ROOT = Path(__file__).resolve().parents[1]

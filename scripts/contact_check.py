@@ -17,11 +17,11 @@ import math
 import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
 import numpy as np
 
-from rocksweep.compute.grid import Grid
 from rocksweep.kernel import chunk_kernel
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.points import kernel_kind, point_row
 from rocksweep.physics.reference import reference_run
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.parse import load_scene
 
 NAMES = (("mu_required", L.OUT_MU_REQ), ("normal_min_over_Mg", L.OUT_N_MIN),

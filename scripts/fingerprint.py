@@ -32,7 +32,7 @@ def collect() -> dict[str, np.ndarray]:
     from itertools import product
 
     from rocksweep.compute.driver import sweep_arrays
-    from rocksweep.compute.single import simulate
+    from rocksweep.compute.single import run_point
     from rocksweep.scene.parse import load_scene
 
     arrays: dict[str, np.ndarray] = {}
@@ -46,8 +46,8 @@ def collect() -> dict[str, np.ndarray]:
         scene = load_scene(ROOT / "configs" / f"{name}.yaml")
         names = [a.name for a in scene.axes]
         for i, combo in enumerate(product(*(a.values for a in scene.axes))):
-            run = simulate(scene.point(dict(zip(names, combo, strict=True))),
-                           scene.single_numerics)
+            run = run_point(scene.point(dict(zip(names, combo, strict=True))),
+                            scene.single_numerics)
             arrays[f"{name}[{i}]/out"] = np.asarray(run.out)
             for k, v in (run.history or {}).items():
                 arrays[f"{name}[{i}]/history/{k}"] = np.asarray(v)

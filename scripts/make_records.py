@@ -62,8 +62,8 @@ def sine_record() -> tuple[np.ndarray, float, str]:
 
 def mp_pulse_acc(t: np.ndarray) -> np.ndarray:
     """The record's MP pulse, ground acceleration [g] at times t [s]."""
+    from rocksweep.physics.bodies import G
     from rocksweep.physics.excitation import PulseShape, mp_peak
-    from rocksweep.physics.model import G
 
     p = NF_PULSE
     w = 2.0 * math.pi / p["T_p"]

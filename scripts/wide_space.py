@@ -49,7 +49,7 @@ from rocksweep.fields import THETA_REL_FLOOR, check_rows
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import PRESETS, Numerics
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.physics.points import Point, kernel_kind, point_row
 
 RIGID_SHARE = 0.15

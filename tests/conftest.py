@@ -4,30 +4,28 @@ import os
 import stat
 
 import pytest
-from bodies import FIG3
+from bodies import BODY2, BODY3, BODY4, FIG3
 from click.testing import CliRunner
 
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 
 
 @pytest.fixture(scope="session")
 def body_fig2() -> FlexibleBody:
     """Table 2: stocky, laterally flexible body of Figure 2."""
-    return FlexibleBody(wn_over_p=2.43, zeta=0.05, alpha_cg=0.35, alpha_A=0.6,
-                        mA_over_m=0.47, IA_ratio=0.56)
+    return BODY2
 
 
 @pytest.fixture(scope="session")
 def body_fig3() -> FlexibleBody:
     """Table 3, Figure 3: slender flexible body (wn/p = 2.43)."""
-    return FlexibleBody(**FIG3)
+    return BODY3
 
 
 @pytest.fixture(scope="session")
 def body_fig4() -> FlexibleBody:
     """Table 3, Figure 4: slender stiff body (wn/p = 9.82)."""
-    return FlexibleBody(wn_over_p=9.82, zeta=0.05, alpha_cg=0.15, alpha_A=0.28,
-                        mA_over_m=0.47, IA_ratio=0.56)
+    return BODY4
 
 
 @pytest.fixture()
@@ -52,7 +50,7 @@ def device_node(tmp_path):
 
 @pytest.fixture(scope="session")
 def suite_result(tmp_path_factory):
-    """A small finished record-suite sweep (issue 29's analyses): 6 records of
+    """A small finished record-suite sweep (for the suite analyses): 6 records of
     records/suite x 6 PGA stripes x 2 lam, written to a result file."""
     import warnings
     from pathlib import Path

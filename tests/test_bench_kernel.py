@@ -70,7 +70,7 @@ def test_tiny_run_prints_every_section():
 
 def test_inlined_roofline_is_the_kernels_rk4(bench):
     """The roofline loop integrates the same equations as the kernel's ``rk4_step``."""
-    from rocksweep.compute.grid import Grid
+    from rocksweep.scene.grid import Grid
 
     prm = Grid(bench.scene_of("fig3a", 4)).rows(0, 1).rows[0]
     y0 = (0.01, -0.02, 1e-3, 0.0, 0.0, 0.0)

@@ -1,5 +1,5 @@
-"""Every error class in ``rocksweep.errors``, and the shared argument checks written once
-(issue 31): an error class defined in another module, or the rtol / integer wording typed
+"""Every error class in ``rocksweep.errors``, and the shared argument checks written once:
+an error class defined in another module, or the rtol / integer wording typed
 again, fails here."""
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ PKG = Path(__file__).resolve().parents[1] / "rocksweep"
 # not user errors: click's usage and input errors of the CLI (how it says them), the YAML
 # loader's internal signal, the driver's interrupt (a KeyboardInterrupt carrying what was
 # saved)
-NOT_ERRORS = {"OneLineUsageError", "InputError", "_YamlError", "SweepInterrupted"}
+NOT_ERRORS = {"OneLineUsageError", "InputError", "YamlError", "SweepInterrupted"}
 
 
 def _bases(node: ast.ClassDef) -> list[str]:
@@ -139,9 +139,9 @@ def _refusals(tmp_path: Path) -> list[tuple[str, object]]:
     import rocksweep
     from rocksweep.compute.adaptive import Options, Plan
     from rocksweep.compute.arguments import check_sweep_arguments
+    from rocksweep.compute.history import run_points
+    from rocksweep.compute.session import sweep_file
     from rocksweep.scene.parse import load_scene
-    from rocksweep.store.history import simulate_runs
-    from rocksweep.store.session import sweep_file
     from rocksweep.store.writer import SweepFile
 
     scene_path = tmp_path / "s.yaml"
@@ -157,14 +157,15 @@ def _refusals(tmp_path: Path) -> list[tuple[str, object]]:
         ("resume and overwrite", lambda: rocksweep.run(scene_path, output=tmp_path / "n.h5",
                                                        resume=True, overwrite=True)),
         ("jobs", lambda: rocksweep.run(scene_path, jobs=0)),
-        ("validate without adaptive", lambda: check_sweep_arguments(validate=True)),
+        ("validate without adaptive", lambda: sweep_file(scene, tmp_path / "v.h5",
+                                                         validate=True)),
         ("dask without a scheduler", lambda: check_sweep_arguments(backend="dask")),
         ("a scheduler without dask", lambda: check_sweep_arguments(scheduler="tcp://h:1")),
         ("connect timeout", lambda: check_sweep_arguments(connect_timeout=0)),
         ("margin", lambda: Options(margin=9)),
         ("plan margin", lambda: Plan((64, 64), 1, 0, margin=9, coarse=3)),
         ("an override without =", lambda: rocksweep.run(scene_path, overrides=["impactlam"])),
-        ("too many points to simulate", lambda: simulate_runs(scene, 2)),
+        ("too many points to simulate", lambda: run_points(scene, 2)),
         ("one point of many", lambda: rocksweep.calibrate(
             scene_path, pd.DataFrame({"p_t": np.arange(20.0), "theta_over_alpha": np.zeros(20)}),
             fit="impact.e_factor")),

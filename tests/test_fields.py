@@ -1,5 +1,5 @@
 """rocksweep.fields: the one definition of a result field, a record variable and a stored
-value as plain Python (review 3: fields had no test module of its own)."""
+value as plain Python."""
 
 from __future__ import annotations
 

@@ -14,17 +14,17 @@ from pathlib import Path
 PKG = Path(__file__).resolve().parents[1] / "rocksweep"
 
 # lowest first: errors and the vocabulary (rocksweep.vocab), kernel, the model, scenes,
-# computing, files, analyses, figures, the facade, the command line
+# files, computing, analyses, figures, the facade, the command line
 FLOORS: list[tuple[str, ...]] = [
     ("errors", "vocab"),
-    ("outputs", "interrupts", "kernel"),
+    ("outputs", "inputs", "interrupts", "kernel"),
     ("numerics", "outcomes"),
     ("schema",),
     ("physics",),
     ("fields",),
     ("scene",),
-    ("compute",),
     ("store",),
+    ("compute",),
     ("analysis",),
     ("figures",),
     ("api", "accessor", "simulation", "__init__"),
@@ -95,8 +95,8 @@ def test_no_import_climbs_a_floor():
 def test_the_checker_sees_a_climb():
     """The check itself: a physics module importing the store is reported."""
     src = "def f():\n    from rocksweep.store.reader import read_result\n"
-    found = imports(ast.parse(src), "rocksweep.physics.model")
+    found = imports(ast.parse(src), "rocksweep.physics.bodies")
     assert found == [(2, "rocksweep.store.reader")]
-    assert floor_of(found[0][1]) > floor_of("rocksweep.physics.model")
+    assert floor_of(found[0][1]) > floor_of("rocksweep.physics.bodies")
     typed = "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    import rocksweep.api\n"
-    assert imports(ast.parse(typed), "rocksweep.physics.model") == []
+    assert imports(ast.parse(typed), "rocksweep.physics.bodies") == []

@@ -1,4 +1,4 @@
-"""One file-safety path (issue 32): every output, result files included, is renamed into
+"""One file-safety path: every output, result files included, is renamed into
 place by ``outputs.publish`` with the mode ``outputs.new_file_mode`` reads from the umask,
 and no other module renames files or reads the umask."""
 
@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from bodies import FIG3_YAML
 
 PKG = Path(__file__).resolve().parents[1] / "rocksweep"
 ROOT = PKG.parent
@@ -39,8 +40,7 @@ def test_every_output_gets_the_umask_mode(tmp_path):
     """A result file, a figure and a CSV made under umask 027 are 0640 (mkstemp's 0600
     would hide them from the group; 0644 would ignore the user's umask)."""
     scene = tmp_path / "p.yaml"
-    scene.write_text("name: p\nbody: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: "
-                     "0.28, mA_over_m: 0.47, IA_ratio: 0.56}\nimpact: {lam: 0.0}\npulse: "
+    scene.write_text("name: p\n" + FIG3_YAML + "impact: {lam: 0.0}\npulse: "
                      "{shape: sine, w_over_p: [1, 2], A_ratio: 3}\n")
     code = ("import os; os.umask(0o027); from rocksweep.cli import main; main()")
     env = {**os.environ, "PYTHONPATH": str(ROOT)}

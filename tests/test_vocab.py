@@ -30,6 +30,7 @@ FAMILIES: dict[str, tuple[str, ...]] = {
     "fragility states": outcomes.STATES,
     "computed flags": tuple(outcomes.COMPUTED_CODE),
     "accuracy presets": settings.PRESET_NAMES,
+    "event root finders": settings.ROOTS,
     "accuracy ladders": settings.LADDER_NAMES,
     "alpha_ref keys": axes.ALPHA_KEYS,
     "alpha_ref LaTeX": tuple(tex for _, tex in axes.ALPHA_REF.values()),
@@ -37,7 +38,6 @@ FAMILIES: dict[str, tuple[str, ...]] = {
 # Concepts whose values (not names) live elsewhere, keyed by the vocabulary's names: the
 # one dict literal allowed, checked to hold exactly the vocabulary's names below.
 HOMES = {
-    ("accuracy presets", "rocksweep/numerics.py"),
     ("accuracy ladders", "rocksweep/analysis/accuracy.py"),
 }
 
@@ -138,6 +138,9 @@ def test_kernel_codes_are_the_vocabulary_codes():
         ground.SHAPE_CODE[s] for s in (*ground.SHAPES, ground.RECORD)]
     assert [L.LAW_VERTICAL, L.LAW_LOCKED, L.LAW_CONSTANT] == [laws.LAW_CODE[w]
                                                                for w in laws.LAWS]
+    assert [L.ROOT_BISECT, L.ROOT_ILLINOIS, L.ROOT_HERMITE] == [settings.ROOT_CODE[w]
+                                                                for w in settings.ROOTS]
+    assert len(set(settings.ROOT_CODE.values())) == len(settings.ROOT_CODE)
     # codes distinct, status bits one bit each
     assert len(set(ground.SHAPE_CODE.values())) == len(ground.SHAPE_CODE)
     assert all(b & (b - 1) == 0 for b in outcomes.STATUS_BIT.values())
@@ -160,7 +163,7 @@ def test_axis_labels_name_units_and_the_body_kind():
 
 
 def test_e_max_is_labelled_by_the_impact_law_not_eq_1_alone():
-    """Review 3: e_max said "(eq. 1)" under every impact law."""
+    """e_max once said "(eq. 1)" under every impact law, whose formula it is not."""
     from rocksweep import fields
 
     meaning = fields.BY_NAME["e_max"].meaning

@@ -36,26 +36,18 @@ import dataclasses
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from pathlib import Path
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
 from rocksweep import fields
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import warm_up
-from rocksweep.numerics import (
-    PRESET_PULSE,
-    PRESET_REFINE,
-    PRESET_ROTATION,
-    PRESETS,
-    ROOTS,
-    Numerics,
-)
+from rocksweep.numerics import PRESETS, Numerics
 from rocksweep.scene.model import Scene, SceneError
 from rocksweep.vocab.axes import DIAGRAM_AXES, RECORD_X
 from rocksweep.vocab.outcomes import CLASSES
-from rocksweep.vocab.settings import DEFAULT_SAMPLE_SEED
+from rocksweep.vocab.settings import DEFAULT_PRESET, DEFAULT_SAMPLE_SEED, ROOTS
 
 OUTCOMES = CLASSES  # codes 0, 1, 2
 # Per-point fields of the report: all the outcome-level kernel fills (no energies).
@@ -74,8 +66,9 @@ TAIL_LABELS = {
 }
 # theta_rel is taken where the reference's theta_max is at least this x alpha_cg
 THETA_REL_FLOOR = fields.THETA_REL_FLOOR
-# Error bounds against which ``--check`` scores the per-point error estimates (issue 15's
-# targets for the 95th percentiles): overturning time [p*t] and relative max|theta|.
+# Error bounds against which ``--check`` scores the per-point error estimates (the
+# `accurate` preset's targets for the 95th percentiles, docs/accuracy.md): overturning
+# time [p*t] and relative max|theta|.
 CHECK_TARGETS = {"t_overturn": 0.05, "theta_rel": 0.01}
 
 
@@ -111,16 +104,12 @@ def _tols(spp: int, tols: tuple[float, ...]) -> list[Setting]:
 
 
 def _presets() -> list[Setting]:
-    return [Setting(name, spp, tol, "preset", rotation_step=PRESET_ROTATION[name],
-                    pulse_steps=PRESET_PULSE[name], refine=PRESET_REFINE[name])
-            for name, (spp, tol) in PRESETS.items()]
+    return [Setting(name, group="preset", **asdict(p)) for name, p in PRESETS.items()]
 
 
 def _roots() -> list[Setting]:
-    return [Setting(f"{name}-{root}", spp, tol, f"root {root}", root,
-                    rotation_step=PRESET_ROTATION[name], pulse_steps=PRESET_PULSE[name],
-                    refine=PRESET_REFINE[name])
-            for root in ROOTS for name, (spp, tol) in PRESETS.items()]
+    return [Setting(f"{name}-{root}", group=f"root {root}", root=root, **asdict(p))
+            for root in ROOTS for name, p in PRESETS.items()]
 
 
 LADDERS: dict[str, Callable[[], list[Setting]]] = {
@@ -132,9 +121,9 @@ LADDERS: dict[str, Callable[[], list[Setting]]] = {
     # the cheap settings the default preset is chosen from (docs/accuracy.md)
     # (with the default preset's rotation limit)
     "candidates": lambda: (_steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-6, True,
-                                  PRESET_ROTATION["default"])
+                                  PRESETS[DEFAULT_PRESET].rotation_step)
                            + _steps((4, 5, 6, 8, 10, 12, 16, 20), 1e-8, True,
-                                    PRESET_ROTATION["default"])
+                                    PRESETS[DEFAULT_PRESET].rotation_step)
                            + _presets()),
     # the presets alone: their tails on a scene far from the paper's (configs/wide-space.yaml)
     "presets": _presets,
@@ -270,7 +259,7 @@ def sample_scene(scene: Scene, n: int | None, seed: int = DEFAULT_SAMPLE_SEED) -
     no classification pass).
     """
     from rocksweep.compute.driver import sweep_arrays
-    from rocksweep.compute.grid import Grid
+    from rocksweep.scene.grid import Grid
 
     grid = Grid(scene)
     if n is None or n >= grid.size:
@@ -312,8 +301,8 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
     ``repeat`` rounds (the machine's noise only ever adds time). Compilation is excluded.
     """
     from rocksweep.compute.dispatch import run_variant
-    from rocksweep.compute.grid import Grid
     from rocksweep.physics.points import with_record
+    from rocksweep.scene.grid import Grid
 
     _no_suite(scene)
     cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
@@ -359,8 +348,8 @@ def run_reference(scene: Scene, flat: np.ndarray,
     int64[n]: the reference's self-check, see ``reference_run``). The first point is run
     once untimed before: the reference's first call in a process loads (or compiles) the
     jitted equations it shares with the kernel, ~0.25 s that is no point's cost."""
-    from rocksweep.compute.grid import Grid
     from rocksweep.physics.reference import reference_run, result_row
+    from rocksweep.scene.grid import Grid
 
     grid = Grid(scene)
     values = grid.index_values(flat)
@@ -421,8 +410,8 @@ def run_energy(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray
     """The energy-accounting kernel on the given points (untimed): float64[n, N_OUT].
     Through the sweep's dispatch (``compute.sweep.run_rows``), so Ricker, MP and record
     scenes run their ground variants with the record's samples."""
-    from rocksweep.compute.grid import Grid
     from rocksweep.compute.sweep import run_rows
+    from rocksweep.scene.grid import Grid
 
     sc = _with_numerics(scene, numerics)
     cr = Grid(sc).rows_at(flat)
@@ -432,8 +421,8 @@ def run_energy(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray
 def run_half(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray:
     """The half-step reruns of ``outputs.check`` (``fields.check_rows``) on the given
     points, outcome-only kernel, untimed: float64[n, N_OUT] (the sweep's dispatch)."""
-    from rocksweep.compute.grid import Grid
     from rocksweep.compute.sweep import run_rows
+    from rocksweep.scene.grid import Grid
 
     _no_suite(scene)
     sc = _with_numerics(scene, numerics)
@@ -651,7 +640,7 @@ def accuracy_study(scene: Scene, n_points: int | None = 200,
     check: also rerun every setting at half the step and score the per-point error
     estimates of ``outputs.check`` against the true errors (``estimate_scores``).
     """
-    from rocksweep.compute.grid import Grid
+    from rocksweep.scene.grid import Grid
 
     _no_suite(scene)
     t_wall = time.perf_counter()
@@ -783,85 +772,3 @@ def format_table(study: Study) -> str:
         lines.append(f"  WARNING: the reference's self-check failed on {bad} points "
                      "(an impact with theta' pointing away from theta = 0)")
     return "\n".join(lines)
-
-
-def write_report(study: Study, path: str | Path, command: str = "", *,
-                 overwrite: bool = False) -> None:
-    """Write the study to HDF5, atomically (a temporary file renamed at the end).
-
-    Layout: attrs (scene name and YAML, sample description, reference tolerances, command,
-    observed orders); /table: one dataset per column, one entry per setting; /flips:
-    int64[settings, 3, 3] (reference outcome, kernel outcome); /sample: flat index, stratum,
-    weight and axis values per point, stratum names and sizes; /reference and
-    /kernel/<setting>: per point, every result field of the outcome-level kernel
-    (``REPORT_FIELDS``: outcome, impacts, uplifts, theta_max_over_alpha, t_overturn,
-    status, steps (regular RK4 steps), event_steps, t_end, t_first_impact, e_max,
-    returns_to_contact, each with ``units``) and seconds (with ``check``, also the
-    ``fields.CHECK_FIELDS`` of the half-step reruns). In /reference, steps are
-    DOP853's steps and event_steps 0 (``reference.result_row``).
-    """
-    import h5py
-
-    from rocksweep.outputs import atomic_path
-    from rocksweep.physics.reference import ATOL, RTOL
-
-    with atomic_path(path, overwrite=overwrite) as tmp:
-        with h5py.File(tmp, "w") as f:
-            f.attrs["format"] = "rocksweep-accuracy-1"
-            f.attrs["scene_name"] = study.scene.name
-            f.attrs["scene_yaml"] = study.scene.text
-            f.attrs["numerics"] = study.scene.numerics.describe()
-            f.attrs["command"] = command
-            f.attrs["reference"] = f"scipy solve_ivp DOP853, rtol {RTOL:g}, atol {ATOL:g}"
-            f.attrs["points_in_scene"] = study.sample.size
-            f.attrs["points_sampled"] = len(study.sample.flat)
-            f.attrs["classify_seconds"] = study.sample.classify_seconds
-            f.attrs["wall_seconds"] = study.wall_seconds
-            f.attrs["time_per_point"] = ("median: each point timed as a 1-row chunk; mean: "
-                                         "weighted by stratum (scene estimate); total_s: one "
-                                         "call on the sample, best of repeats")
-            for m, orders in study.orders.items():
-                f.attrs[f"observed_order_{m}"] = np.array(
-                    [(a, b, p) for a, b, p in orders], float).reshape(-1, 3)
-            table = study.table()
-            g = f.create_group("table")
-            for key in table[0]:
-                col = [d[key] for d in table]
-                if isinstance(col[0], str):
-                    g.create_dataset(key, data=np.array(col, dtype=h5py.string_dtype()))
-                else:
-                    g.create_dataset(key, data=np.asarray(col))
-            f.create_dataset("flips", data=np.stack([r.flips for r in study.results]))
-            f["flips"].attrs["axes"] = "setting, reference outcome, kernel outcome"
-            f["flips"].attrs["outcomes"] = ", ".join(OUTCOMES)
-            s = f.create_group("sample")
-            s.create_dataset("flat_index", data=study.sample.flat)
-            s.create_dataset("stratum", data=study.sample.stratum)
-            s.create_dataset("weight", data=study.sample.weight)
-            s.create_dataset("strata", data=np.array(study.sample.strata,
-                                                     dtype=h5py.string_dtype()))
-            s.create_dataset("stratum_size", data=study.sample.stratum_size)
-            for k, v in study.values.items():
-                v = np.asarray(v)
-                s.create_dataset(k, data=v.astype(h5py.string_dtype()) if v.dtype.kind in "US"
-                                 else v)
-            g = f.create_group("reference")
-            _write_runs(g, study.reference, study.reference_seconds, study.alpha_ref)
-            if study.reference_anomalies is not None:
-                g.create_dataset("anomalies", data=study.reference_anomalies)
-            k = f.create_group("kernel")
-            for r in study.results:
-                g = k.create_group(r.setting.name)
-                _write_runs(g, r.outs, r.seconds, study.alpha_ref)
-                if r.half is not None:  # the per-point estimates, as a sweep stores them
-                    for name, arr in fields.convert_check(r.outs, r.half,
-                                                          study.alpha_ref).items():
-                        g.create_dataset(name, data=arr).attrs["units"] = fields.UNITS[name]
-
-
-def _write_runs(g, outs: np.ndarray, seconds: np.ndarray, alpha_ref: np.ndarray) -> None:
-    # every field the outcome-level kernel reports (rocksweep.fields), in its unit
-    for name, arr in fields.convert(outs, alpha_ref, np.nan, REPORT_FIELDS).items():
-        ds = g.create_dataset(name, data=arr)
-        ds.attrs["units"] = fields.UNITS[name]
-    g.create_dataset("seconds", data=seconds)

@@ -12,21 +12,19 @@ For every panel (a value of each non-diagram axis: shape, body keys, lam) of a d
   A_ratio between it and the grid value below (single kernel runs at the sweep's numerics)
   to a relative tolerance, so the curve is not limited by the grid spacing.
 
-Rows for CSV (``a_min_rows``, ``boundary_rows``, ``csv_text``) export them; the figures
-are in ``rocksweep.figures.diagrams`` (``a_min_figure``, and ``rocksweep plot --curves``).
+Rows for CSV (``a_min_rows``, ``boundary_rows``; ``analysis.files.csv_text``) export
+them; the figures are in ``rocksweep.figures.diagrams`` (``a_min_figure``, and
+``rocksweep plot --curves``).
 ``result_curves`` does it all for a result file (``rocksweep boundaries``). Units: those
 of the axes (w_over_p = omega/p, A_ratio = A/(g tan alpha_cg), eq. 2).
 """
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 from collections import defaultdict
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -34,7 +32,6 @@ import numpy as np
 from rocksweep.analysis.tolerance import DEFAULT_RTOL, MAX_RTOL, check_rtol
 from rocksweep.compute.adaptive import DIAGRAM_AXES, AdaptiveError, make_plan
 from rocksweep.compute.dispatch import run_variant
-from rocksweep.compute.grid import Grid
 from rocksweep.errors import BoundaryError  # noqa: F401 (re-exported)
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
@@ -53,6 +50,7 @@ from rocksweep.physics.points import (
     shape_code,
     with_record,
 )
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.model import Scene
 
 if TYPE_CHECKING:
@@ -242,7 +240,7 @@ A_MIN_METHODS = (
 # The search below the first overturning grid value (``_search_intervals``) scans grid
 # intervals at interior values spaced (relative to A) by: NEAR_STEP from the last value
 # without uplift up to NEAR_SPAN x the first uplifting value (the narrow first bands just
-# above the uplift threshold at omega/p ~ 1, issue 28: 0.01-0.1 wide at A ~ 1), FAR_STEP
+# above the uplift threshold at omega/p ~ 1: 0.01-0.1 wide at A ~ 1), FAR_STEP
 # from there up to UPLIFT_SPAN x it, and FAR_STEP in the intervals with an end whose
 # max|theta|/alpha_ref >= CLOSE (it came close to overturning), closest first; at most
 # SEARCH_RUNS kernel runs a column (a grid finer than the spacing adds none).
@@ -602,17 +600,6 @@ def a_min_rows(curves: Sequence[AMinCurve]) -> list[dict[str, Any]]:
     return rows
 
 
-def csv_text(rows: Sequence[dict[str, Any]]) -> str:
-    """CSV text of rows (the keys of the first row as the header)."""
-    buf = io.StringIO()
-    if rows:
-        w = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
-        w.writeheader()
-        for r in rows:
-            w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in r.items()})
-    return buf.getvalue()
-
-
 def boundary_rows(bounds: Sequence[PanelBoundaries], axes: Sequence[str] | None = None
                   ) -> list[dict[str, Any]]:
     """One row per vertex of every boundary polyline: the non-diagram axis values, line
@@ -629,102 +616,6 @@ def boundary_rows(bounds: Sequence[PanelBoundaries], axes: Sequence[str] | None 
 
 
 CURVE_SUFFIXES = (".csv", ".h5", ".hdf5")  # ``rocksweep boundaries -o``: CSV or HDF5
-H5_FORMAT = 1  # version of the layout ``write_curves_h5`` writes
-
-
-def _h5_attr(v: Any) -> Any:
-    """An attribute value h5py stores and netCDF readers understand (no bool, no None)."""
-    if isinstance(v, bool | np.bool_):
-        return np.int8(v)
-    if isinstance(v, str):
-        return v
-    if isinstance(v, int | np.integer):
-        return np.int64(v)
-    return np.float64(v)
-
-
-def write_curves_h5(path: str | Path, curves: Sequence[AMinCurve],
-                    bounds: Sequence[PanelBoundaries], attrs: dict[str, Any] | None = None
-                    ) -> None:
-    """Write A_min curves and boundary lines to a new HDF5 file at ``path`` (meant for the
-    temporary path of ``rocksweep.outputs.write_atomic``; an existing file at ``path`` is
-    truncated).
-
-    Layout (h5py; every ``a_min`` panel group also opens with
-    ``xarray.open_dataset(path, group="a_min/panel_0", engine="h5netcdf")``):
-
-    - root attributes: ``title``, ``format`` (``H5_FORMAT``), ``x_axis``, ``y_axis``
-      (diagram axis names), ``panels`` (count) and ``attrs`` (e.g. ``source``, ``rtol``);
-    - ``a_min/panel_<i>``, one group per panel in the grid's order, with the panel's
-      value of every other swept axis as attributes (e.g. ``lam`` = 0.2, ``shape`` =
-      "sine"; their names, in order, in ``where``): ``<x_axis>`` float64[nx], the
-      dimension scale, and over it ``A_min`` float64[nx] (NaN: no value of the column
-      overturns), ``mode`` int8[nx] (1, 2; 0 where A_min is NaN), ``lo``/``hi``
-      float64[nx] (the final bisection bracket, lo = NaN when the first grid value
-      already overturns), ``upper_bound`` int8[nx] (1: A_min is that first grid value,
-      only an upper bound), ``runs`` int64[nx] (kernel runs of the search and the
-      bisection), ``A_min_method`` int8[nx] (how A_min was found: an index into the
-      attribute ``flag_meanings``, the words of ``A_MIN_METHODS`` joined by ";"). Units
-      those of the axes (w_over_p = omega/p, A_ratio = A/(g tan alpha_cg));
-    - ``lines/panel_<i>``: the same attributes, one dataset ``line_<n>`` per boundary
-      polyline (n as the ``line`` column of the CSV), float64[vertices, 2], columns
-      (x_axis, y_axis) in axis values, attributes ``classes`` (e.g. "safe|mode1"),
-      ``class_a`` < ``class_b`` (int8 outcome codes), ``closed`` (int8 0/1).
-
-    The rows of ``a_min_rows`` / ``boundary_rows`` (what the CSV files hold) are these
-    arrays' entries: A_min rows where A_min is not NaN, line rows one per vertex.
-    """
-    import h5py
-
-    xname = curves[0].xname if curves else DIAGRAM_AXES[0]
-    yname = curves[0].yname if curves else DIAGRAM_AXES[1]
-    with h5py.File(path, "w") as f:
-        f.attrs["title"] = "rocksweep boundaries: A_min curves and boundary lines"
-        f.attrs["format"] = np.int64(H5_FORMAT)
-        f.attrs["x_axis"], f.attrs["y_axis"] = xname, yname
-        f.attrs["panels"] = np.int64(len(curves))
-        for k, v in (attrs or {}).items():
-            f.attrs[k] = _h5_attr(v)
-
-        def panel_group(parent: str, i: int, where: dict[str, Any]) -> h5py.Group:
-            g = f.require_group(parent).create_group(f"panel_{i}")
-            for k, v in where.items():
-                g.attrs[k] = _h5_attr(v)
-            g.attrs["where"] = " ".join(where)
-            return g
-
-        for i, c in enumerate(curves):
-            g = panel_group("a_min", i, c.where)
-            xs = g.create_dataset(c.xname, data=np.asarray(c.x, float))
-            xs.make_scale(c.xname)
-            xs.attrs["units"] = "1"
-            data = {"A_min": (c.a_min, f"smallest {c.yname} that overturns (bisected)"),
-                    "mode": (c.mode.astype(np.int8), "overturning mode at A_min (0: none)"),
-                    "lo": (c.lo, f"largest {c.yname} known not to overturn"),
-                    "hi": (c.hi, f"smallest {c.yname} known to overturn"),
-                    "upper_bound": (np.isnan(c.lo) & ~np.isnan(c.a_min),
-                                    "1: A_min is the first grid value, an upper bound"),
-                    "runs": (c.runs.astype(np.int64),
-                             "kernel runs of the search and the bisection"),
-                    "A_min_method": (c.method.astype(np.int8), "how A_min was found")}
-            for name, (v, text) in data.items():
-                arr = np.asarray(v)
-                ds = g.create_dataset(name, data=arr.astype(np.int8) if arr.dtype == bool
-                                      else arr)
-                ds.attrs["long_name"] = text
-                if name == "A_min_method":
-                    ds.attrs["flag_values"] = np.arange(len(A_MIN_METHODS), dtype=np.int8)
-                    ds.attrs["flag_meanings"] = ";".join(A_MIN_METHODS)
-                ds.dims[0].attach_scale(xs)
-        for i, b in enumerate(bounds):
-            g = panel_group("lines", i, b.where)
-            for n, line in enumerate(b.lines):
-                ds = g.create_dataset(f"line_{n}", data=np.asarray(line.xy, float))
-                ds.attrs["classes"] = line.label
-                ds.attrs["class_a"], ds.attrs["class_b"] = (np.int8(c) for c in line.classes)
-                ds.attrs["closed"] = np.int8(len(line.xy) > 2
-                                             and np.array_equal(line.xy[0], line.xy[-1]))
-                ds.attrs["columns"] = f"{xname} {yname}"
 
 
 # --- result files -----------------------------------------------------------------------

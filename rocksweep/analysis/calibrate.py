@@ -1,5 +1,5 @@
 """Calibration: the scene numbers (lam, e, e_factor, zeta...) that reproduce a measured
-rocking history, with a confidence interval (issue 30).
+rocking history, with a confidence interval.
 
 The misfit: peak amplitudes per half cycle, aligned
 -----------------------------------------------------
@@ -63,15 +63,16 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.compute.single import history_capacity
+from rocksweep.compute.dispatch import run_variant
 from rocksweep.errors import CalibrationError, RocksweepError, set_key  # noqa: F401 (CalibrationError re-exported)
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.kernel import point_kernel, warm_up
+from rocksweep.kernel import warm_up
 from rocksweep.numerics import Numerics, step_budget
+from rocksweep.physics.bodies import BodyError
 from rocksweep.physics.measured import Measured, noise_level, read_measured
-from rocksweep.physics.model import BodyError
 from rocksweep.physics.points import INITIAL, kernel_kind, point_row
 from rocksweep.schema import KEYS, fmt
+from rocksweep.vocab.kinds import CALIBRATION, KIND_ATTR
 
 ACCURACY = "fine"  # the least accuracy of a calibration's runs (``calibration_numerics``)
 H_NOISE = 4.0  # threshold of an excursion, in noise standard deviations ...
@@ -87,6 +88,10 @@ DEFAULT_BOUNDS = {"impact.lam": (0.0, 2.0), "impact.e": (0.02, 1.0),
                   "impact.e_factor": (0.2, 2.0), "body.zeta": (0.0, 0.5)}
 # keys of a scene's point a fit may set although the scene does not give them
 OPTIONAL_NAMES = ("e_factor", *INITIAL)
+# Longest measured history fitted [p t]: a free-rocking block comes to rest within ~100.
+MAX_SPAN = 1e4
+# Largest |theta| [rad] of a measurement: pi/2 (the body on its side) and 5% for noise.
+THETA_LIMIT = 1.05 * math.pi / 2
 
 
 def calibration_numerics(n: Numerics) -> Numerics:
@@ -321,7 +326,7 @@ class Problem:
             values[name] = float(v)
         return self.scene.point(values)
 
-    def simulate(self, x: np.ndarray) -> tuple[np.ndarray, dict] | None:
+    def run_candidate(self, x: np.ndarray) -> tuple[np.ndarray, dict] | None:
         """(result row, raw history columns) of a candidate; None if the candidate's body
         is not physical."""
         try:
@@ -335,9 +340,12 @@ class Problem:
             row[L.PAR_TEND] = need
             row[L.PAR_MAXSTEPS] = step_budget(row[L.PAR_TPULSE], need, row[L.PAR_DT],
                                               row[L.PAR_DT_ON], self.numerics)
-        out = np.empty(L.N_OUT)
-        hist = np.empty((history_capacity(row), L.N_HIST))
-        point_kernel(kernel_kind(point.body), point.ground)(row, out, hist)
+        # the one dispatch of every run: close calls certified as ``rocksweep.simulate``'s
+        # (the finest run's history kept)
+        hists: list = [None]
+        out = run_variant(row[None, :], kernel_kind(point.body), L.LEVEL_OUTCOME,
+                          point.ground, self.numerics.refine, histories=hists)[0]
+        hist = hists[0]
         self.runs += 1
         n = int(out[L.OUT_HIST_ROWS])
         a = point.body.alpha_ref
@@ -373,7 +381,7 @@ class Problem:
     def _run(self, x: np.ndarray) -> tuple | None:
         """A candidate's simulated history at the measured times, its shift, excursions,
         impacts (measured time) and result row; None for a body that is not physical."""
-        got = self.simulate(x)
+        got = self.run_candidate(x)
         if got is None:
             return None
         out, h = got
@@ -425,7 +433,15 @@ def fittable(scene: Any) -> list[str]:
     out = [a.key for a in scene.axes if KEYS.get(a.key) is not None
            and KEYS[a.key].kind == "axis" and a.key != "body.mu"]
     out += [f"impact.{n}" if n == "e_factor" else f"initial.{n}" for n in OPTIONAL_NAMES]
-    return list(dict.fromkeys(k for k in out if not (scene.free and k.startswith("pulse."))))
+    values = {a.name: a.values[0] for a in scene.axes}
+    try:
+        rigid = scene.make_body(**{a.name: values[a.name] for a in scene.body_axes()}).rigid
+    except (BodyError, ValueError):
+        rigid = False
+    return list(dict.fromkeys(
+        k for k in out if not (scene.free and k.startswith("pulse."))
+        # a rigid body has no top mass: its displacement and rate mean nothing
+        and not (rigid and k in ("initial.u_over_ucr", "initial.udot_over_pucr"))))
 
 
 def check_fit_key(scene: Any, key: Any) -> str:
@@ -761,6 +777,7 @@ def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
     ds["misfit"].attrs = {"long_name": "RMS error of the half-cycle peaks at the estimate",
                           "units": "theta/alpha_ref"}
     ds.attrs = {
+        KIND_ATTR: CALIBRATION,
         "title": f"calibration of {', '.join(problem.keys)}",
         "ci": ci,
         "interval": "profile likelihood: misfit <= min + chi2_1(ci) s^2, s^2 = max(S_min/"
@@ -793,15 +810,48 @@ def calibrate_scene(scene: Any, measured: Any, fit: str | Sequence[str],
         raise CalibrationError("fit = []: give at least one key, e.g. impact.lam")
     if len(set(keys)) < len(keys):
         raise CalibrationError(f"fit = {keys}: a key is given twice")
-    if not (isinstance(ci, float | int) and 0.5 <= ci < 1):
+    if isinstance(ci, bool) or not (isinstance(ci, float | int) and 0.5 <= ci < 1):
         raise CalibrationError(f"ci = {ci!r}: must be in [0.5, 1)")
     ci = float(ci)
+    if bounds is not None:
+        if not isinstance(bounds, Mapping):
+            raise TypeError(f"bounds = {bounds!r}: must be a mapping {{key: (lo, hi)}}, e.g. "
+                            "{'impact.lam': (0, 1)}")
+        for k in bounds:
+            if k not in keys:
+                raise CalibrationError(f"bounds {k!r}: not a fitted key (fitted: "
+                                       f"{', '.join(map(str, keys))}); give bounds of the "
+                                       "fitted keys only")
+    if p is not None:
+        if isinstance(p, bool) or not isinstance(p, int | float | np.integer | np.floating):
+            raise TypeError(f"p = {p!r}: must be a number (the body's p [rad/s]) or None")
+        if not (math.isfinite(p) and p > 0):
+            raise CalibrationError(f"p = {p!r}: must be a finite number > 0 [rad/s]")
     scene, _ = load(scene, overrides)
     p_body = _body_p(scene) if p is None else float(p)
     values = {a.name: a.values[0] for a in scene.axes}
     body = scene.point(values).body
     m = read_measured(measured, p=p_body, alpha_ref=body.alpha_ref, u_cr=body.u_cr or None)
+    _check_measured_span(m, body.alpha_ref)
     return calibrate_problem(Problem(scene, m, keys, bounds), ci)
+
+
+def _check_measured_span(m: Measured, alpha_ref: float) -> None:
+    """Refuse a measured history no rocking body of this scene can have (one line): |theta|
+    reaching pi/2 (the body would lie on its side: the wrong column, unit or body), or a
+    span longer than MAX_SPAN (each candidate is simulated over all of it)."""
+    amax = float(np.max(np.abs(m.theta)))
+    if amax * alpha_ref > THETA_LIMIT:
+        raise CalibrationError(f"{m.source}: |theta_over_alpha| reaches {amax:.4g}, |theta| "
+                               f"= {amax * alpha_ref:.4g} rad for this body (alpha "
+                               f"{alpha_ref:.4g} rad); a rocking body's |theta| stays below "
+                               "pi/2, where it lies on its side (is it the wrong column, unit "
+                               "or body?)")
+    span = m.duration
+    if span > MAX_SPAN:
+        raise CalibrationError(f"{m.source}: the history spans {span:.4g} p*t; at most "
+                               f"{MAX_SPAN:g} (each candidate is simulated over all of it: "
+                               "cut the history to the rocking)")
 
 
 def _body_p(scene: Any) -> float | None:

@@ -34,9 +34,10 @@ import xarray as xr
 from scipy.optimize import minimize
 from scipy.special import log_ndtr
 
-from rocksweep.analysis.fragility import counted_points, fit_cloud, state_reached
+from rocksweep.analysis.fragility import fit_cloud
+from rocksweep.analysis.states import counted_points, state_reached
 from rocksweep.errors import EfficiencyError, RocksweepError  # noqa: F401 (re-exported)
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 from rocksweep.physics.suite import RECORD_IMS
 from rocksweep.vocab.axes import ALPHA_KEYS
 from rocksweep.vocab.ground import PGA_RATIO, PGV_OVER_PGA, PGV_RATIO, SA, SCALE_IMS

@@ -4,7 +4,7 @@ A scaled suite's sweep runs every record at every stripe of its intensity measur
 PGA, PGV, Sa, PGA_ratio or PGV_ratio). Its stripes say, per record, the first level that
 overturns the body; ``ida`` refines that level: between the last stripe below it (which
 does not overturn) and it, the record's scale is bisected to a relative tolerance with
-single kernel runs at the sweep's numerics (``compute.single.simulate``: each run
+single kernel runs at the sweep's numerics (``compute.single.run_point``: each run
 certified as a single run is). The scaled record's peak, and so the kernel's amplitude,
 is linear in the IM, so a level x between stripes is the stripe's point with its amplitude times
 x / stripe. Overturning means outcome 1 or 2 (mode 1, mode 2).
@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.compute.single import simulate
+from rocksweep.compute.single import run_point
 from rocksweep.errors import IdaError, check_rtol
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
@@ -118,7 +118,7 @@ def ida(ds: Any, rtol: float = 1e-2) -> Any:
             mid = 0.5 * (lo[i] + hi[i])
             pt = dataclasses.replace(points[i],
                                      A_ratio=points[i].A_ratio * mid / levels[first[i]])
-            out = simulate(pt, scene.numerics, history=False).out
+            out = run_point(pt, scene.numerics, history=False).out
             runs[i] += 1
             g = int(out[L.OUT_OUTCOME])
             if int(out[L.OUT_STATUS]) & L.STATUS_FLAGGED:

@@ -1,32 +1,48 @@
 """Which rocksweep Dataset is this? The one place that tells a sweep from an analysis's
-result (``rocksweep.plot``, ``rocksweep.table`` and the command line dispatch on it).
+result (``rocksweep.plot``, ``rocksweep.table``, ``rocksweep.open`` and the command line
+dispatch on it).
 
-A Dataset says its kind in ``attrs["rocksweep_kind"]`` when the analysis that made it sets
-it (risk, im_efficiency); the others are known by the variables that only they hold.
+A Dataset says its kind in ``attrs["rocksweep_kind"]`` (``vocab.kinds``): every analysis
+sets it, and every file ``rocksweep.analysis.files`` writes carries it. Datasets without
+it (a sweep result, or an analysis's file written before the attribute was set) are known
+by the variables that only they hold.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-#: kind -> the variables that identify it (all of them present), checked in this order
-SIGNATURES: tuple[tuple[str, tuple[str, ...]], ...] = (
-    ("risk", ("annual_rate",)),
-    ("im_efficiency", ("beta", "exponent")),
-    ("fragility", ("im_median", "beta")),
-    ("fragility", ("median", "beta")),
-    ("ida", ("ida_im",)),
-    ("sweep", ("outcome", "status")),
-    ("spectra", ("A_min", "theta_max_over_alpha", "outcome")),
-    ("boundaries", ("A_min",)),
+from rocksweep.vocab.kinds import (
+    BOUNDARIES,
+    FRAGILITY,
+    IDA,
+    IM_EFFICIENCY,
+    KIND_ATTR,
+    KIND_NAMES,
+    RISK,
+    SPECTRA,
+    SWEEP,
 )
-KINDS = tuple(dict.fromkeys(k for k, _ in SIGNATURES))
+
+#: kind -> the variables that identify it (all of them present), checked in this order:
+#: the fallback for a Dataset without ``rocksweep_kind``
+SIGNATURES: tuple[tuple[str, tuple[str, ...]], ...] = (
+    (RISK, ("annual_rate",)),
+    (IM_EFFICIENCY, ("beta", "exponent")),
+    (FRAGILITY, ("im_median", "beta")),
+    (FRAGILITY, ("median", "beta")),
+    (IDA, ("ida_im",)),
+    (SWEEP, ("outcome", "status")),
+    (SPECTRA, ("A_min", "theta_max_over_alpha", "outcome")),
+    (BOUNDARIES, ("A_min",)),
+)
+KINDS = KIND_NAMES
 
 
 def dataset_kind(ds: Any) -> str | None:
-    """"sweep", "fragility", "ida", "spectra", "boundaries", "risk" or "im_efficiency";
-    None for a Dataset rocksweep did not make."""
-    kind = getattr(ds, "attrs", {}).get("rocksweep_kind")
+    """A kind of ``vocab.kinds`` ("sweep", "fragility", "calibration", ...); None for a
+    Dataset rocksweep did not make."""
+    kind = getattr(ds, "attrs", {}).get(KIND_ATTR)
     if kind in KINDS:
         return str(kind)
     names = set(getattr(ds, "variables", ()))

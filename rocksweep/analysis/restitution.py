@@ -9,9 +9,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from rocksweep.physics.bodies import Body, FlexibleBody, restitution_rigid
 from rocksweep.physics.impact import lam_energy_limit
 from rocksweep.physics.impact import restitution as law_restitution
-from rocksweep.physics.model import Body, FlexibleBody, restitution_rigid
 
 if TYPE_CHECKING:
 

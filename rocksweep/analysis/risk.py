@@ -30,16 +30,19 @@ Beyond the hazard curve's range the tool BOUNDS, it does not extrapolate the haz
   verdict ``below_hazard`` says when P(x_min) > ``LOW_P`` (the rate is then a lower bound).
 
 Hazard inputs (``read_hazard``): a two-column CSV with the header ``IM [unit],annual_rate``
-(e.g. ``PGA [g],annual_rate``; ``Sa(1.0) [g]`` for Sa at 1 s; lines starting with # are
-comments), the IM checked against the fragility's and the unit converted to the
-fragility's where both are known (``UNIT_SI``: g, m/s^2, cm/s^2 or gal; m/s, cm/s, mm/s;
-the factor is kept in the attribute ``hazard_unit``); or OpenQuake's hazard-curve
+(e.g. ``PGA [g],annual_rate``; ``Sa(1.0) [g]`` for Sa at 1 s; ``AvgSa [g]``, ``CAV
+[m/s]``, ``Arias [m/s]``; lines starting with # are comments), the IM checked against the
+fragility's and the unit converted to the fragility's where both are known (``UNIT_SI``:
+g, m/s^2, cm/s^2 or gal; m/s, cm/s, mm/s, g s; the factor is kept in the attribute
+``hazard_unit``); or OpenQuake's hazard-curve
 CSV (``oq export hcurves``: a comment line
 ``#,,,,,"generated_by=..., investigation_time=50.0, imt='PGA'"``, then
 ``lon,lat,depth,poe-<level>,...`` and one row per site): probabilities of exceedance in the
-investigation time T converted to rates lambda = -ln(1 - poe) / T; OpenQuake's PGA and SA
-are in g, its PGV in cm/s (converted to m/s); levels with poe = 1 (a rate without bound)
-are left out.
+investigation time T converted to rates lambda = -ln(1 - poe) / T; OpenQuake's PGA, SA
+and AvgSA are in g, its PGV in cm/s (converted to m/s), IA (Arias) in m/s, CAV in g s
+(converted to m/s); levels with poe = 1 (a rate without bound) are left out. An AvgSa
+hazard curve does not say its periods: it must be over the fragility's (the attribute
+``avgsa_periods``).
 """
 
 from __future__ import annotations
@@ -54,19 +57,33 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.errors import Arg, RiskError, RocksweepError  # noqa: F401 (re-exported)
-from rocksweep.physics.model import G
-from rocksweep.vocab.ground import PGA, PGV, SA
+from rocksweep.inputs import check_columns, csv_table, number, number_column, read_text
+from rocksweep.outputs import shown
+from rocksweep.physics.bodies import G
+from rocksweep.vocab.ground import ARIAS, AVGSA, CAV, PGA, PGV, SA, SCALE_IMS
 
 __all__ = ["Hazard", "RiskError", "fragility_median", "hazard_frame", "read_hazard",
            "risk"]
 
-SUB = 8  # pieces per hazard segment, 2 Gauss-Legendre nodes each
+SUB = 8  # at most this many pieces per hazard segment, 2 Gauss-Legendre nodes each
+PIECE = 0.05  # [ln IM] widest piece (a 40-level curve over 1e-4-100 g: 8 a segment)
 TAIL_SHARE = 0.01  # above_hazard when the unknown tail exceeds this share of the rate
 LOW_P = 1e-3  # below_hazard when the fragility at the hazard's smallest IM exceeds this
 PLOT_POINTS = 200  # the figure's grid over the hazard's range
+MAX_HAZARD_BYTES = 200 << 20  # [bytes] largest hazard file read (~4 million levels of CSV)
+MAX_LEVELS = 1_000_000  # hazard levels of one curve (the integral's memory: docs/faults.md)
+#: the integral takes the quadrature nodes in chunks of at most this many (curve, node)
+#: values: memory ~ 8 x this x a few temporaries, whatever the hazard's length
+CHUNK_ELEMENTS = 1 << 21
+Z_TAIL = 8.0  # a lognormal curve's transition: median exp(+-Z_TAIL beta) (1e-15 beyond)
+Z_NODES = 64  # Gauss-Legendre nodes over it (``_narrow``)
 RATE_COLUMN = "annual_rate"
-#: OpenQuake's IMT units, and the factor to rocksweep's
-OQ_UNITS = {PGA: ("g", 1.0), SA.upper(): ("g", 1.0), PGV: ("m/s", 0.01)}
+#: OpenQuake's IMTs (upper case) -> (rocksweep's IM, its unit, the factor from
+#: OpenQuake's unit to it): PGA, SA and AvgSA in g, PGV in cm/s, IA (Arias) in m/s, CAV
+#: in g s (``openquake.hazardlib.imt``)
+OQ_IMTS: dict[str, tuple[str, str, float]] = {
+    PGA: (PGA, "g", 1.0), SA.upper(): (SA, "g", 1.0), PGV: (PGV, "m/s", 0.01),
+    AVGSA.upper(): (AVGSA, "g", 1.0), "IA": (ARIAS, "m/s", 1.0), CAV: (CAV, "m/s", G)}
 #: Units a hazard curve may give its IM in: the factor to SI (accelerations to m/s^2,
 #: velocities to m/s); a hazard in another unit of the same kind is converted. g is G,
 #: the gravity of the model and of the records' PGV (9.81 m/s^2, not g_n = 9.80665)
@@ -74,7 +91,8 @@ UNIT_SI: dict[str, tuple[str, float]] = {
     "g": ("acceleration", G), "m/s^2": ("acceleration", 1.0), "m/s2": ("acceleration", 1.0),
     "cm/s^2": ("acceleration", 0.01), "cm/s2": ("acceleration", 0.01),
     "gal": ("acceleration", 0.01), "m/s": ("velocity", 1.0), "cm/s": ("velocity", 0.01),
-    "mm/s": ("velocity", 0.001)}
+    "mm/s": ("velocity", 0.001), "g s": ("velocity", G), "g-s": ("velocity", G),
+    "g*s": ("velocity", G), "g-sec": ("velocity", G)}
 _HEADER = re.compile(r"^\s*(?P<im>[A-Za-z][A-Za-z0-9_]*)\s*(?:\(\s*(?P<T>[0-9.eE+-]+)\s*\))?"
                      r"\s*\[(?P<unit>[^\]]*)\]\s*$")
 
@@ -100,124 +118,158 @@ class Hazard:
 
 
 def _im_name(text: str) -> str:
-    """An IM name as rocksweep spells it (SA, sa -> Sa; PGA, PGV upper case)."""
+    """An IM name as rocksweep spells it (the stripe IMs, ``SCALE_IMS``, in any case: SA ->
+    Sa, AVGSA -> AvgSa; OpenQuake's IA -> Arias); another name as given."""
     t = text.strip()
-    if t.lower() == SA.lower():
-        return SA
-    if t.upper() in (PGA, PGV):
-        return t.upper()
-    return t
+    spelled = {k.lower(): k for k in SCALE_IMS} | {"ia": ARIAS}
+    return spelled.get(t.lower(), t)
 
 
 def _checked(im: np.ndarray, rate: np.ndarray, name: str, unit: str, period: float,
-             where: str) -> Hazard:
-    """The one validation of a hazard curve (bad input: one line naming it)."""
+             where: str, rows: list[str]) -> Hazard:
+    """The one validation of a hazard curve (bad input: one line naming it and the row,
+    ``rows[i]``: the file and line of level i)."""
     if im.size < 2:
         raise RiskError(f"{where}: {im.size} hazard level{'s' * (im.size != 1)}; a hazard "
                         "curve needs at least 2 (IM, annual rate) rows")
-    for what, v in (("IM", im), (RATE_COLUMN, rate)):
-        bad = ~np.isfinite(v)
-        if bad.any():
-            raise RiskError(f"{where}: row {int(np.argmax(bad)) + 1}: {what} = "
-                            f"{v[bad][0]!r}: must be a finite number")
+    if im.size > MAX_LEVELS:
+        raise RiskError(f"{where}: {im.size:,} hazard levels; at most {MAX_LEVELS:,} (a "
+                        "hazard curve is smooth: thin it)")
     if np.any(im <= 0.0):
         i = int(np.argmax(im <= 0.0))
-        raise RiskError(f"{where}: row {i + 1}: IM = {im[i]!r}: must be > 0")
+        raise RiskError(f"{rows[i]}: IM = {float(im[i])!r}: must be > 0")
     if np.any(rate < 0.0):
         i = int(np.argmax(rate < 0.0))
-        raise RiskError(f"{where}: row {i + 1}: {RATE_COLUMN} = {rate[i]!r}: must be >= 0 "
+        raise RiskError(f"{rows[i]}: {RATE_COLUMN} = {float(rate[i])!r}: must be >= 0 "
                         "(an annual rate of exceedance)")
     if np.any(np.diff(im) <= 0.0):
         i = int(np.argmax(np.diff(im) <= 0.0)) + 1
-        raise RiskError(f"{where}: row {i + 1}: IM = {im[i]!r} after {im[i - 1]!r}: the IM "
+        raise RiskError(f"{rows[i]}: IM = {float(im[i])!r} after {float(im[i - 1])!r}: the IM "
                         "levels must increase")
     if np.any(np.diff(rate) > 0.0):
         i = int(np.argmax(np.diff(rate) > 0.0)) + 1
-        raise RiskError(f"{where}: row {i + 1}: {RATE_COLUMN} = {rate[i]!r} after "
-                        f"{rate[i - 1]!r}: the rates of exceedance must not increase with "
+        raise RiskError(f"{rows[i]}: {RATE_COLUMN} = {float(rate[i])!r} after "
+                        f"{float(rate[i - 1])!r}: the rates of exceedance must not increase with "
                         "the IM")
     if not rate[0] > 0.0:
         raise RiskError(f"{where}: every {RATE_COLUMN} is 0: no hazard")
     return Hazard(im, rate, name, unit, period, where)
 
 
-def hazard_frame(df: Any, where: str = "hazard") -> Hazard:
-    """A hazard curve from a two-column pandas DataFrame: ``IM [unit]`` (e.g. ``PGA [g]``,
-    ``Sa(1.0) [g]``) and ``annual_rate`` [1/yr], one row per IM level."""
-    cols = [str(c) for c in df.columns]
+def _two_columns(cols: list[str], im_vals: Any, rate_vals: Any, rows: list[str],
+                 where: str) -> Hazard:
+    """A hazard curve from its header ``IM [unit]``, ``annual_rate`` and the two columns'
+    values (``rows[i]`` names row i in messages)."""
     if len(cols) != 2:
         raise RiskError(f"{where}: {len(cols)} columns ({', '.join(cols)}); a hazard curve "
                         f"has 2: 'IM [unit]' and '{RATE_COLUMN}' (e.g. 'PGA [g],"
                         f"{RATE_COLUMN}')")
     m = _HEADER.match(cols[0])
-    if m is None:
+    period = _positive(m["T"]) if m is not None and m["T"] else math.nan
+    if m is None or (m["T"] and math.isnan(period)):
         raise RiskError(f"{where}: first column {cols[0]!r}: must name the IM and its unit, "
                         "e.g. 'PGA [g]', 'PGV [m/s]' or 'Sa(1.0) [g]'")
-    if cols[1].strip() != RATE_COLUMN:
+    if cols[1] != RATE_COLUMN:
         raise RiskError(f"{where}: second column {cols[1]!r}: must be '{RATE_COLUMN}' (mean "
                         "annual rate of exceedance [1/yr])")
-    try:
-        im = np.asarray(df.iloc[:, 0], dtype=np.float64)
-        rate = np.asarray(df.iloc[:, 1], dtype=np.float64)
-    except (TypeError, ValueError) as err:
-        raise RiskError(f"{where}: a value is not a number ({err})") from None
-    period = float(m["T"]) if m["T"] else math.nan
-    return _checked(im, rate, _im_name(m["im"]), m["unit"].strip(), period, where)
+    im = number_column(im_vals, rows, "IM", RiskError)
+    rate = number_column(rate_vals, rows, RATE_COLUMN, RiskError)
+    return _checked(im, rate, _im_name(m["im"]), m["unit"].strip(), period, where, rows)
 
 
-def _openquake(lines: list[str], where: str, site: int | None) -> Hazard:
+def hazard_frame(df: Any, where: str = "hazard") -> Hazard:
+    """A hazard curve from a two-column pandas DataFrame: ``IM [unit]`` (e.g. ``PGA [g]``,
+    ``Sa(1.0) [g]``) and ``annual_rate`` [1/yr], one row per IM level."""
+    cols = check_columns(list(df.columns), where, RiskError)
+    if len(cols) != 2:
+        return _two_columns(cols, [], [], [], where)  # its one-line refusal
+    rows = [f"{where}: row {i + 1}" for i in range(len(df))]
+    return _two_columns(cols, df.iloc[:, 0].to_numpy(), df.iloc[:, 1].to_numpy(), rows,
+                        where)
+
+
+_NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+
+
+def _positive(text: str) -> float:
+    """A number > 0 written plainly (``50.0``, ``1e-1``), else NaN (``50.0.1``, ``e``)."""
+    t = text.strip()
+    if not re.fullmatch(_NUM, t):
+        return math.nan
+    x = float(t)
+    return x if math.isfinite(x) and x > 0.0 else math.nan
+
+
+def _openquake(text: str, where: str, site: int | None) -> Hazard:
     """OpenQuake's hazard-curve CSV (module docstring) -> Hazard in rates."""
-    import csv
-
-    meta = lines[0]
-    t = re.search(r"investigation_time\s*=\s*'?([0-9.eE+-]+)", meta)
-    imt = re.search(r"imt\s*=\s*['\"]([^'\"]+)['\"]", meta)  # 'PGA' (3.x), "PGA" (2.x)
+    head_line, _, rest = text.partition("\n")
+    meta = head_line.strip()
+    t = re.search(r"investigation_time\s*=\s*'?([^,'\"\s]*)", meta)
+    imt = re.search(r"imt\s*=\s*['\"]([^'\"]*)['\"]", meta)  # 'PGA' (3.x), "PGA" (2.x)
     if t is None or imt is None:
-        raise RiskError(f"{where}: OpenQuake header without investigation_time and imt: "
-                        f"{meta[:80]!r}")
-    T = float(t.group(1))
-    if not (math.isfinite(T) and T > 0.0):
-        raise RiskError(f"{where}: investigation_time = {t.group(1)}: must be > 0 years")
-    mi = re.match(r"^\s*([A-Za-z]+)\s*(?:\(\s*([0-9.eE+-]+)\s*\))?\s*$", imt.group(1))
-    if mi is None or mi.group(1).upper() not in OQ_UNITS:
-        raise RiskError(f"{where}: imt = {imt.group(1)!r}: rocksweep reads PGA, PGV and SA(T)")
-    unit, factor = OQ_UNITS[mi.group(1).upper()]
-    rows = list(csv.reader(lines[1:]))
-    head = [h.strip() for h in rows[0]]
-    levels = [h for h in head if h.startswith("poe-")]
+        raise RiskError(f"{where}, line 1: OpenQuake header without investigation_time and "
+                        f"imt: {meta[:80]!r}")
+    T = _positive(t.group(1))
+    if math.isnan(T):
+        raise RiskError(f"{where}, line 1: investigation_time = {t.group(1)!r}: must be a "
+                        "number of years > 0")
+    mi = re.fullmatch(r"\s*([A-Za-z]+)\s*(?:\(\s*([^)]*?)\s*\))?\s*", imt.group(1))
+    if mi is None or mi.group(1).upper() not in OQ_IMTS or (
+            mi.group(2) is not None and math.isnan(_positive(mi.group(2)))):
+        known = ", ".join(k if k != SA.upper() else "SA(T)" for k in OQ_IMTS)
+        raise RiskError(f"{where}, line 1: imt = {imt.group(1)!r}: rocksweep reads {known} "
+                        "(T a period > 0 [s])")
+    name, unit, factor = OQ_IMTS[mi.group(1).upper()]
+    # the table starts on line 2: its line numbers are the file's minus one
+    table = csv_table(rest, where, RiskError, "hazard curve")
+    lines = [ln + 1 for ln in table.lines]
+    levels = [h for h in table.columns if h.startswith("poe-")]
     if not levels:
-        raise RiskError(f"{where}: no poe-<level> columns in {','.join(head)[:80]!r}")
-    data = [r for r in rows[1:] if any(c.strip() for c in r)]
-    if not data:
+        raise RiskError(f"{where}: no poe-<level> columns in "
+                        f"{','.join(table.columns)[:80]!r}")
+    if not table.rows:
         raise RiskError(f"{where}: no site rows")
-    if site is None and len(data) > 1:
-        raise RiskError(f"{where}: {len(data)} sites; choose one with {{site}} (0 to "
-                        f"{len(data) - 1}, the row order)", site=Arg("site"))
-    k = 0 if site is None else int(site)
-    if not 0 <= k < len(data):
-        raise RiskError(f"{where}: site = {site!r}: the file has sites 0 to {len(data) - 1}")
-    row = dict(zip(head, data[k], strict=False))
-    try:
-        x = np.array([float(h[4:]) for h in levels]) * factor
-        poe = np.array([float(row[h]) for h in levels])
-    except (ValueError, KeyError) as err:
-        raise RiskError(f"{where}: site {k}: a value is not a number ({err})") from None
-    if np.any(~np.isfinite(poe) | (poe < 0.0) | (poe > 1.0)):
-        bad = poe[~np.isfinite(poe) | (poe < 0.0) | (poe > 1.0)][0]
-        raise RiskError(f"{where}: site {k}: poe = {bad!r}: a probability in [0, 1]")
+    if site is None and len(table.rows) > 1:
+        raise RiskError(f"{where}: {len(table.rows)} sites; choose one with {{site}} (0 to "
+                        f"{len(table.rows) - 1}, the row order)", site=Arg("site"))
+    k = 0 if site is None else site
+    if not 0 <= k < len(table.rows):
+        raise RiskError(f"{where}: site = {site!r}: the file has sites 0 to "
+                        f"{len(table.rows) - 1}")
+    row = dict(zip(table.columns, table.rows[k], strict=True))
+    at = f"{where}, line {lines[k]}"
+    x = np.array([number(h[4:], f"{where}, line 2", "level", RiskError)
+                  for h in levels]) * factor
+    poe = np.array([number(row[h], at, h, RiskError) for h in levels])
+    names = [f"{at}, {h}" for h in levels]
+    bad = (poe < 0.0) | (poe > 1.0)
+    if bad.any():
+        raise RiskError(f"{names[int(np.argmax(bad))]}: poe = {float(poe[bad][0])!r}: a "
+                        "probability in [0, 1]")
+    # every level is checked, poe = 1 too, before those are left out: a poe that rises
+    # with the IM is refused wherever it rises
+    if np.any(np.diff(x) <= 0.0):
+        i = int(np.argmax(np.diff(x) <= 0.0)) + 1
+        raise RiskError(f"{where}, line 2: level {levels[i]} after {levels[i - 1]}: the IM "
+                        "levels must increase")
+    if np.any(np.diff(poe) > 0.0):
+        i = int(np.argmax(np.diff(poe) > 0.0)) + 1
+        raise RiskError(f"{names[i]}: poe = {float(poe[i])!r} after {float(poe[i - 1])!r}: the "
+                        "probabilities of exceedance must not increase with the IM")
     keep = poe < 1.0  # poe = 1: the rate has no bound there
-    with np.errstate(divide="ignore"):
-        rate = -np.log1p(-poe[keep]) / T
-    name = _im_name(mi.group(1))
-    period = float(mi.group(2)) if mi.group(2) else math.nan
-    return _checked(x[keep], rate, name, unit, period, where)
+    rate = -np.log1p(-poe[keep]) / T
+    period = _positive(mi.group(2)) if mi.group(2) and name == SA else math.nan
+    return _checked(x[keep], rate, name, unit, period, where,
+                    [n for n, kept in zip(names, keep, strict=True) if kept])
 
 
 def read_hazard(source: Any, *, site: int | None = None) -> Hazard:
     """A hazard curve from a path (a two-column CSV ``IM [unit],annual_rate`` or
     OpenQuake's hazard-curve CSV, told apart by its ``#`` first line), a pandas DataFrame
     of the two columns, or a ``Hazard``. site: the row of an OpenQuake file with several
-    sites. Bad input is a one-line ``RiskError`` naming the file, the row and the value."""
+    sites. Bad input is a one-line ``RiskError`` naming the file, the line and the value
+    (the file read through ``rocksweep.inputs``: a regular UTF-8 file of at most
+    ``MAX_HAZARD_BYTES``, comma-separated)."""
     if isinstance(source, Hazard):
         return source
     if hasattr(source, "columns") and hasattr(source, "iloc"):
@@ -226,37 +278,21 @@ def read_hazard(source: Any, *, site: int | None = None) -> Hazard:
         raise RiskError(f"hazard = {type(source).__name__}: a CSV path or a pandas DataFrame "
                         f"('IM [unit]', '{RATE_COLUMN}')")
     path = Path(source)
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as err:
-        raise RiskError(f"{path}: cannot read the hazard curve "
-                        f"({getattr(err, 'strerror', None) or type(err).__name__})") from None
+    where = shown(path)
+    text = read_text(path, "hazard curve", RiskError, max_bytes=MAX_HAZARD_BYTES)
     lines = [ln for ln in text.splitlines() if ln.strip()]
     if not lines:
-        raise RiskError(f"{path}: empty hazard file")
+        raise RiskError(f"{where}: empty hazard file")
     if lines[0].lstrip().startswith("#") and any(
             ln.replace(" ", "").startswith("lon,lat") for ln in lines[1:3]):
-        return _openquake(lines, str(path), site)
-    lines = [ln for ln in lines if not ln.lstrip().startswith("#")]  # comments
-    if not lines:
-        raise RiskError(f"{path}: no header 'IM [unit],{RATE_COLUMN}'")
-    import csv
-
-    rows = list(csv.reader(lines))
-    head, body = rows[0], rows[1:]
-    if any(len(r) != len(head) for r in body):
-        i = next(i for i, r in enumerate(body) if len(r) != len(head))
-        raise RiskError(f"{path}: row {i + 1}: {len(body[i])} values, the header has "
-                        f"{len(head)}")
-    import pandas as pd
-
-    try:
-        df = pd.DataFrame([[float(c) for c in r] for r in body], columns=head)
-    except ValueError as err:
-        raise RiskError(f"{path}: a value is not a number ({err})") from None
-    if not body:
-        df = pd.DataFrame(columns=head)
-    return hazard_frame(df, str(path))
+        return _openquake(text.lstrip("\n\r \t"), where, site)
+    table = csv_table(text, where, RiskError, "hazard curve",
+                      expect=f"'IM [unit],{RATE_COLUMN}'")
+    rows = [f"{where}, line {ln}" for ln in table.lines]
+    if len(table.columns) != 2:
+        return _two_columns(table.columns, [], [], [], where)  # its one-line refusal
+    return _two_columns(table.columns, table.column(table.columns[0]),
+                        table.column(table.columns[1]), rows, where)
 
 
 # ---------------------------------------------------------------------------------------
@@ -306,27 +342,30 @@ def _fragility_p(x: np.ndarray, median: np.ndarray, beta: np.ndarray) -> np.ndar
 
 
 def _nodes(hz: Hazard) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss-Legendre nodes x_j and weights w_j (2 per piece, ``SUB`` pieces per hazard
-    segment evenly in u = ln x) with sum_j f(x_j) w_j ~ integral f |d lambda| over the
-    hazard's range: w_j = the quadrature weight times |d lambda / d u| at the node (exact
-    for the log-log interpolant: lambda' = s lambda on a segment of log-log slope s;
-    a segment that ends at rate 0 is linear in lambda: constant lambda')."""
+    """Gauss-Legendre nodes x_j and weights w_j (2 per piece; a hazard segment cut evenly in
+    u = ln x into pieces of at most ``PIECE`` in u, at most ``SUB`` of them) with
+    sum_j f(x_j) w_j ~ integral f |d lambda| over the hazard's range: w_j = the quadrature
+    weight times |d lambda / d u| at the node (exact for the log-log interpolant:
+    lambda' = s lambda on a segment of log-log slope s; a segment that ends at rate 0 is
+    linear in lambda: constant lambda'). Vectorised: a dense hazard (many narrow segments)
+    gets one piece a segment, so the nodes grow as 2 x its levels."""
     g = np.array([-1.0, 1.0]) / math.sqrt(3.0)  # 2-point Gauss-Legendre on [-1, 1]
     lx = np.log(hz.im)
-    xs, ws = [], []
-    for i in range(hz.im.size - 1):
-        r0, r1 = hz.rate[i], hz.rate[i + 1]
-        du = (lx[i + 1] - lx[i]) / SUB
-        centres = lx[i] + du * (np.arange(SUB) + 0.5)
-        u = (centres[:, None] + 0.5 * du * g[None, :]).ravel()
-        if r1 > 0.0:
-            slope = (math.log(r1) - math.log(r0)) / (lx[i + 1] - lx[i])
-            dens = -slope * r0 * np.exp(slope * (u - lx[i]))
-        else:
-            dens = np.full(u.size, (r0 - r1) / (lx[i + 1] - lx[i]))
-        xs.append(u)
-        ws.append(0.5 * du * dens)
-    return np.exp(np.concatenate(xs)), np.concatenate(ws)
+    width = np.diff(lx)
+    pieces = np.clip(np.ceil(width / PIECE), 1, SUB).astype(np.int64)
+    seg = np.repeat(np.arange(width.size), pieces)  # the segment of every piece
+    k = np.arange(seg.size) - np.repeat(np.cumsum(pieces) - pieces, pieces)
+    du = width[seg] / pieces[seg]
+    centres = lx[seg] + du * (k + 0.5)
+    u = (centres[:, None] + 0.5 * du[:, None] * g[None, :]).ravel()
+    s2 = np.repeat(seg, 2)
+    r0, r1 = hz.rate[s2], hz.rate[s2 + 1]
+    pos = r1 > 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope = (np.log(np.where(pos, r1, 1.0)) - np.log(r0)) / width[s2]
+        dens = np.where(pos, -slope * r0 * np.exp(slope * (u - lx[s2])),
+                        (r0 - r1) / width[s2])
+    return np.exp(u), 0.5 * np.repeat(du, 2) * dens
 
 
 def _curve_p(fr: xr.Dataset, med: xr.DataArray, beta: xr.DataArray, dims: list[str]):
@@ -351,15 +390,106 @@ def _curve_p(fr: xr.Dataset, med: xr.DataArray, beta: xr.DataArray, dims: list[s
     return lambda x: _fragility_p(x, m, b)
 
 
-def _rates(hz: Hazard, p) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _rates(hz: Hazard, p, lognormal: tuple[np.ndarray, np.ndarray] | None = None
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(annual_rate, annual_rate_max, P at x_min, P at x_max) for the fragility curves
-    x -> p(x) float[..., x] (module docstring)."""
+    x -> p(x) float[..., x] (module docstring). The quadrature nodes are taken in chunks
+    of at most ``CHUNK_ELEMENTS`` / curves (memory: ``CHUNK_ELEMENTS`` x 8 bytes a few
+    times, whatever the hazard's length). lognormal: the curves' (median, beta) when they
+    are lognormal: a curve whose transition median exp(+-Z_TAIL beta) lies between two
+    hazard levels is integrated exactly there instead (``_narrow``)."""
     x, w = _nodes(hz)
-    inside = p(x) @ w
     ends = p(hz.im[[0, -1]])
+    n_curves = max(1, int(np.prod(ends.shape[:-1])))
+    step = max(1, CHUNK_ELEMENTS // n_curves)
+    inside = np.zeros(ends.shape[:-1])
+    for k in range(0, x.size, step):
+        inside = inside + p(x[k:k + step]) @ w[k:k + step]
     p_lo, p_hi = ends[..., 0], ends[..., 1]
     top = hz.rate[-1]
-    return inside + p_hi * top, inside + top, p_lo, p_hi
+    rate = inside + p_hi * top
+    if lognormal is not None:
+        narrow = _narrow(hz, *lognormal)
+        if narrow is not None:
+            use, value = narrow
+            rate = np.where(use, value, rate)
+            inside = np.where(use, value - p_hi * top, inside)
+    return rate, inside + top, p_lo, p_hi
+
+
+def _hazard_at(hz: Hazard, x: np.ndarray) -> np.ndarray:
+    """lambda(x) of the log-log interpolated hazard inside its range (a segment ending at
+    rate 0: linear in lambda)."""
+    lx = np.log(hz.im)
+    u = np.log(x)
+    i = np.clip(np.searchsorted(lx, u, side="right") - 1, 0, lx.size - 2)
+    r0, r1 = hz.rate[i], hz.rate[i + 1]
+    f = (u - lx[i]) / (lx[i + 1] - lx[i])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        pos = r1 > 0.0
+        loglin = np.exp(np.log(r0) + f * (np.log(np.where(pos, r1, 1.0)) - np.log(r0)))
+    return np.where(pos, loglin, r0 + f * (r1 - r0))
+
+
+def _narrow(hz: Hazard, med: np.ndarray, beta: np.ndarray
+            ) -> tuple[np.ndarray, np.ndarray] | None:
+    """The rate of lognormal curves whose transition is narrow, by parts: annual_rate =
+    P(x_min) lambda(x_min) + integral lambda dP over the hazard's range, dP the lognormal
+    density, integrated over z = ln(x / median) / beta in [-Z_TAIL, Z_TAIL] by
+    ``Z_NODES``-point Gauss-Legendre (the hazard a power law there: converges
+    exponentially), exact for beta = 0 (lambda(median)). Used where no hazard level lies
+    strictly inside median exp(+-Z_TAIL beta) (a kink there would slow it down); a steep
+    curve is exactly that case, and the shared quadrature's worst. Returns (use, rate) or
+    None when no curve qualifies."""
+    from scipy.special import ndtr
+
+    med = np.asarray(med, np.float64)
+    beta = np.asarray(beta, np.float64)
+    ok = np.isfinite(med) & (med > 0) & np.isfinite(beta) & (beta >= 0)
+    if not ok.any():
+        return None
+    m = np.where(ok, med, 1.0)
+    b = np.where(ok, beta, 0.0)
+    lx = np.log(hz.im)
+    lo_u, hi_u = np.log(m) - Z_TAIL * b, np.log(m) + Z_TAIL * b
+    # no hazard level strictly inside the transition
+    inner = np.searchsorted(lx, hi_u, side="left") - np.searchsorted(lx, lo_u, side="right")
+    use = ok & (inner <= 0) & (lo_u >= lx[0]) & (hi_u <= lx[-1])
+    if not use.any():
+        return None
+    z, wz = np.polynomial.legendre.leggauss(Z_NODES)
+    z, wz = z * Z_TAIL, wz * Z_TAIL
+    dens = np.exp(-0.5 * z * z) / math.sqrt(2.0 * math.pi)
+    mu, bu = m[use], b[use]
+    xs = mu[:, None] * np.exp(bu[:, None] * z[None, :])
+    lam = _hazard_at(hz, np.clip(xs, hz.im[0], hz.im[-1]))
+    mass = ndtr(Z_TAIL) - ndtr(-Z_TAIL)  # the tails beyond: lambda at the ends' values
+    val = lam @ (wz * dens) / (wz * dens).sum() * mass
+    val = val + ndtr(-Z_TAIL) * _hazard_at(hz, mu * math.exp(-Z_TAIL) ** bu) \
+        + ndtr(-Z_TAIL) * _hazard_at(hz, mu * math.exp(Z_TAIL) ** bu)
+    out = np.zeros(med.shape)
+    out[use] = val
+    return use, out
+
+
+def _check_curves(fr: xr.Dataset, med: xr.DataArray, dims: list[str]) -> None:
+    """Refuse (one line) a fragility whose numbers no fit gives: a median <= 0 or
+    infinite, a beta < 0 or infinite (NaN: no fit, carried as such)."""
+    beta = fr["beta"]
+    for name, da, bad in (
+            ("im_median", med, lambda v: np.isinf(v) | (v <= 0.0)),
+            ("beta", beta, lambda v: np.isinf(v) | (v < 0.0))):
+        v = np.asarray(da.values, np.float64)
+        with np.errstate(invalid="ignore"):
+            wrong = bad(v) & ~np.isnan(v)
+        if wrong.any():
+            k = np.unravel_index(int(np.argmax(wrong)), v.shape)
+            at = ", ".join(f"{d} = {da[d].values[i]}" for d, i in zip(da.dims, k, strict=True)
+                           if d in da.coords)
+            src = fr.attrs.get("source") or "the fragility Dataset"
+            raise RiskError(f"{src}: {name} = {float(v[k])!r}{f' at {at}' if at else ''}: "
+                            f"must be {'> 0' if name == 'im_median' else '>= 0'} and finite "
+                            "(a fragility from rocksweep.fragility)")
 
 
 def _interval(v: np.ndarray, ci: float) -> tuple[np.ndarray, np.ndarray]:
@@ -452,15 +582,24 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50.0, *,
     read = read_hazard(hazard, site=site)
     hz = _check_match(fr, read)
     dims = list(med_da.dims)
+    _check_curves(fr, med_da, dims)
     curve = _curve_p(fr, med_da, fr["beta"], dims)
-    rate, rate_max, p_lo, p_hi = _rates(hz, curve)
+    competing = "fit" in fr.data_vars and "competing" in np.atleast_1d(
+        np.asarray(fr["fit"].values)).astype(str)
+    logn = None if competing else (
+        np.asarray(med_da.transpose(*dims).values, np.float64),
+        np.asarray(fr["beta"].transpose(*dims).values, np.float64))
+    rate, rate_max, p_lo, p_hi = _rates(hz, curve, logn)
     ci = float(fr.attrs.get("ci", 0.9))
     lo = hi = np.full(rate.shape, np.nan)
     samples = f"{med_name}_samples"
     if samples in fr.data_vars and "beta_samples" in fr.data_vars:
         ms, bs = fr[samples], fr["beta_samples"]
         ok = np.isfinite(ms) & np.isfinite(bs)
-        r_s, _, _, _ = _rates(hz, _curve_p(fr, ms.where(ok), bs.where(ok), dims))
+        order = [*dims, *[d for d in ms.dims if d not in dims]]
+        r_s, _, _, _ = _rates(hz, _curve_p(fr, ms.where(ok), bs.where(ok), dims), None if
+                              competing else (np.asarray(ms.where(ok).transpose(*order).values),
+                                              np.asarray(bs.where(ok).transpose(*order).values)))
         lo, hi = _interval(r_s, ci)
     reasons = np.empty(rate.shape, dtype=object)
     unknown_top = rate_max - rate

@@ -24,7 +24,7 @@ import xarray as xr
 
 from rocksweep.analysis.kinds import dataset_kind
 from rocksweep.errors import RocksweepError, TableError  # noqa: F401 (re-exported)
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 from rocksweep.physics.suite import RECORD_IMS
 from rocksweep.vocab.axes import ALPHA_KEYS
 from rocksweep.vocab.ground import SA, SCALE_IMS

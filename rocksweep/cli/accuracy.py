@@ -81,7 +81,8 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
 
         check_output(plot_path, overwrite=overwrite, inputs=scene.inputs, suffixes=FORMATS)
 
-    from rocksweep.analysis.accuracy import accuracy_study, format_table, ladder, write_report
+    from rocksweep.analysis.accuracy import accuracy_study, format_table, ladder
+    from rocksweep.analysis.files import write_report
 
     def progress(stage: str, done: int, total: int) -> None:
         if quiet:

@@ -39,6 +39,7 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
     and how it was found (column method); and the lines between classes as polylines.
     Works on adaptive and regular results."""
     from rocksweep.analysis import boundaries as bd
+    from rocksweep.analysis.files import csv_text, write_curves_h5
     from rocksweep.figures.common import FORMATS, save_figure
     from rocksweep.outputs import check_distinct, check_output, write_atomic
     from rocksweep.store.reader import read_result
@@ -72,19 +73,19 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
     if h5:
         attrs = {"source": str(result_path), "rtol": rtol, "search": int(search),
                  "mode": "any" if mode is None else f"mode{mode}"}
-        write_atomic(out, lambda tmp: bd.write_curves_h5(tmp, curves, bounds, attrs),
+        write_atomic(out, lambda tmp: write_curves_h5(tmp, curves, bounds, attrs),
                      overwrite=overwrite)
         n = sum(len(b.lines) for b in bounds)
         also = f", {n} boundary lines"
     else:
-        write_atomic(out, write_text(bd.csv_text(rows)), overwrite=overwrite)
+        write_atomic(out, write_text(csv_text(rows)), overwrite=overwrite)
         also = ""
     click.echo(f"wrote {out} ({len(rows)} A_min values over {len(curves)} panel(s){also}, "
                f"{runs} kernel runs for the search and the bisection to rtol {rtol:g}"
                f"{_methods(curves)})")
     if lines_path is not None:
         lrows = bd.boundary_rows(bounds)
-        write_atomic(lines_path, write_text(bd.csv_text(lrows)), overwrite=overwrite)
+        write_atomic(lines_path, write_text(csv_text(lrows)), overwrite=overwrite)
         n = sum(len(b.lines) for b in bounds)
         click.echo(f"wrote {lines_path} ({n} boundary lines, {len(lrows)} vertices)")
     if fig_path is not None:

@@ -8,6 +8,7 @@ import click
 
 from rocksweep.cli.main import load, main, user_errors
 from rocksweep.cli.options import dpi_option, overwrite_option, scene_argument, set_option
+from rocksweep.vocab.kinds import CALIBRATION
 
 
 def _bounds(items: tuple[str, ...]) -> dict[str, tuple[str, str]]:
@@ -16,7 +17,7 @@ def _bounds(items: tuple[str, ...]) -> dict[str, tuple[str, str]]:
     for item in items:
         key, sep, rng = item.partition("=")
         parts = rng.split(",")
-        if not sep or len(parts) != 2:
+        if not sep or not key.strip() or len(parts) != 2:
             raise click.ClickException(f"--bounds {item!r}: expected KEY=LO,HI, e.g. "
                                        "impact.lam=0,1")
         try:
@@ -58,17 +59,11 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
     the interval is a 95% profile likelihood. Prints the estimate, the interval and the
     misfit; -o keeps the fit, --plot draws it."""
     from rocksweep.api import calibrate as fit_scene
-    from rocksweep.outputs import check_distinct, check_output
+    from rocksweep.cli.helpers import check_table_outputs, write_table
 
-    check_distinct({"-o": out_path, "--plot": plot_path})
     # the scene file and what it reads (a record), the measured CSV: never written over
     inputs = [*load(scene_path, overrides).inputs, measured_path]
-    if out_path is not None:
-        check_output(out_path, overwrite=overwrite, inputs=inputs, suffixes=(".h5", ".nc"))
-    if plot_path is not None:
-        from rocksweep.figures.common import FORMATS
-
-        check_output(plot_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
+    check_table_outputs(out_path, plot_path, (".h5", ".nc"), inputs, overwrite)
     ds = fit_scene(scene_path, measured_path, list(fit), bounds=_bounds(bounds) or None,
                    overrides=list(overrides), p=p)
     for key in ds["parameter"].values.tolist():
@@ -83,10 +78,7 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
     if ds.attrs["notes"]:
         click.echo(f"measured: {ds.attrs['notes']}")
     if out_path is not None:
-        from rocksweep.outputs import atomic_path
-
-        with atomic_path(out_path, overwrite=overwrite) as tmp:
-            ds.to_netcdf(tmp, engine="h5netcdf")
+        write_table(out_path, None, ds, CALIBRATION, overwrite)
         click.echo(f"wrote {out_path}")
     if plot_path is not None:
         from rocksweep.figures.calibration import calibration_figure

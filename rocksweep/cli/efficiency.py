@@ -8,6 +8,7 @@ from pathlib import Path
 
 import click
 
+from rocksweep.cli.helpers import check_table_outputs, write_table
 from rocksweep.cli.main import main, user_errors
 from rocksweep.cli.options import (
     dpi_option,
@@ -16,6 +17,7 @@ from rocksweep.cli.options import (
     result_argument,
     width_option,
 )
+from rocksweep.vocab.kinds import IM_EFFICIENCY
 from rocksweep.vocab.outcomes import STATES, THETA_STATE
 
 SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
@@ -47,8 +49,6 @@ def efficiency(result_path: Path, state: str, out_path: Path | None, fig_path: P
     from rocksweep.store.reader import result_inputs
 
     inputs = result_inputs(result_path)  # the result and its records: never written over
-    from rocksweep.cli.fragility import check_table_outputs
-
     check_table_outputs(out_path, fig_path, SUFFIXES, inputs, overwrite)
     eff = rocksweep.im_efficiency(rocksweep.open(result_path), state=state)
     frame = eff[["beta", "beta_scale", "im_median", "slope", "n_records",
@@ -72,9 +72,7 @@ def efficiency(result_path: Path, state: str, out_path: Path | None, fig_path: P
     say = click.echo if not as_json else (lambda m: click.echo(m, err=True))
     fig = rocksweep.plot(eff, width=width) if fig_path is not None else None
     if out_path is not None:
-        from rocksweep.cli.fragility import write_table
-
-        write_table(out_path, frame.to_csv(index=False), eff, overwrite)
+        write_table(out_path, frame, eff, IM_EFFICIENCY, overwrite)
         say(f"wrote {out_path}")
     if fig is not None:
         save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=inputs)

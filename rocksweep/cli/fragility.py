@@ -10,6 +10,7 @@ from pathlib import Path
 import click
 
 from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP, DEFAULT_SEED, MAX_BOOTSTRAP
+from rocksweep.cli.helpers import check_table_outputs, write_table
 from rocksweep.cli.main import main, user_errors
 from rocksweep.cli.options import (
     ci_option,
@@ -21,6 +22,7 @@ from rocksweep.cli.options import (
     seed_option,
     width_option,
 )
+from rocksweep.vocab.kinds import FRAGILITY
 from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, STATES, UPLIFT
 
 CURVE_SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
@@ -37,19 +39,6 @@ def curve_rows(frag) -> list[dict]:
         row["beta_lo"], row["beta_hi"] = c["beta_ci"]
         rows.append(row)
     return rows
-
-
-def csv_text(rows: list[dict]) -> str:
-    import csv
-    import io
-
-    buf = io.StringIO()
-    if rows:
-        w = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
-        w.writeheader()
-        for r in rows:
-            w.writerow({k: "" if v is None else v for k, v in r.items()})
-    return buf.getvalue()
 
 
 def _g(v) -> str:
@@ -144,7 +133,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
             _print_ida(refined)
     say = click.echo if not as_json else (lambda m: click.echo(m, err=True))
     if out_path is not None:
-        write_table(out_path, csv_text(rows), frag, overwrite)
+        write_table(out_path, rows, frag, FRAGILITY, overwrite)
         say(f"wrote {out_path} ({len(rows)} curve{'s' * (len(rows) != 1)})")
     if fig_path is not None:
         from rocksweep.figures.fragility import fragility_figure
@@ -180,49 +169,6 @@ def _print_ida(refined) -> None:
             click.echo(f"    {flagged} flagged stripe points (neither safe nor overturning); "
                        f"{stopped} bisections stopped at a flagged run (bracket wider than "
                        "rtol)")
-
-
-def _to_netcdf(frag, path: Path) -> None:
-    """The fragility Dataset as netCDF-4 (h5netcdf): strings as fixed text, attrs plain."""
-    out = frag.copy()
-    out.attrs = {k: (json.dumps(v) if isinstance(v, list | dict) else v)
-                 for k, v in frag.attrs.items()}
-    for name in list(out.variables):
-        if out[name].dtype.kind in ("U", "O"):
-            out[name] = out[name].astype(str)
-    out.to_netcdf(path, engine="h5netcdf")
-
-
-def check_table_outputs(out_path: Path | None, fig_path: Path | None,
-                        suffixes: tuple[str, ...], inputs, overwrite: bool) -> None:
-    """An analysis command's ``-o`` (a table: one of ``suffixes``) and ``--plot`` (a
-    figure), refused in one line before anything is computed: the same file twice, an
-    unknown suffix, an existing file without --overwrite, or one of the command's
-    ``inputs`` (``outputs.check_output``)."""
-    from rocksweep.figures.common import FORMATS
-    from rocksweep.outputs import check_distinct, check_output
-
-    check_distinct({"-o": out_path, "--plot": fig_path})
-    if out_path is not None:
-        if out_path.suffix.lower() not in suffixes:
-            raise click.ClickException(
-                f"-o {out_path}: unsupported suffix {out_path.suffix or '(none)'!r}; use "
-                f"{', '.join(suffixes[:-1])} or {suffixes[-1]}")
-        check_output(out_path, overwrite=overwrite, inputs=inputs)
-    if fig_path is not None:
-        check_output(fig_path, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
-
-
-def write_table(out_path: Path, csv: str | None, ds, overwrite: bool) -> None:
-    """An analysis's ``-o``: the table as CSV text (``csv``) for a .csv path, else the
-    Dataset ``ds`` as netCDF-4 (.h5, .hdf5, .nc); written under a temporary name and
-    published by ``outputs.publish``'s rule (a file that appeared meanwhile is kept)."""
-    from rocksweep.outputs import write_atomic
-
-    if out_path.suffix.lower() == ".csv":
-        write_atomic(out_path, lambda tmp: tmp.write_text(csv), overwrite=overwrite)
-    else:
-        write_atomic(out_path, lambda tmp: _to_netcdf(ds, tmp), overwrite=overwrite)
 
 
 def _print_table(frag, rows: list[dict]) -> None:

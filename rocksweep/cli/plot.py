@@ -64,7 +64,7 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
     check_output(fig_out, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
     if mu_map and compare_key is not None:
         raise click.ClickException("--mu and --compare draw different figures; give one")
-    ds = api.open_any(result_path)  # a sweep, or an analysis's -o .h5 (its own figure)
+    ds = api.open(result_path)  # a sweep, or an analysis's -o .h5 (its own figure)
     from rocksweep.analysis.kinds import dataset_kind
 
     if dataset_kind(ds) != "sweep":

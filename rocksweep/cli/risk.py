@@ -10,8 +10,10 @@ from pathlib import Path
 
 import click
 
+from rocksweep.cli.helpers import check_table_outputs, write_table
 from rocksweep.cli.main import main, user_errors
 from rocksweep.cli.options import dpi_option, json_option, overwrite_option, width_option
+from rocksweep.vocab.kinds import RISK
 
 RISK_SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
 
@@ -77,16 +79,13 @@ def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, sta
     certain tail above its largest IM is added), never extrapolated."""
     import rocksweep
     from rocksweep.analysis.kinds import dataset_kind
-    from rocksweep.api import open_any
     from rocksweep.figures.common import save_figure
     from rocksweep.store.reader import result_inputs
 
     # the fragility or sweep file (and a sweep's records), the hazard curve: never written
     inputs = [*result_inputs(frag_path), hazard_path]
-    from rocksweep.cli.fragility import check_table_outputs
-
     check_table_outputs(out_path, fig_path, RISK_SUFFIXES, inputs, overwrite)
-    ds = open_any(frag_path)
+    ds = rocksweep.open(frag_path)
     if dataset_kind(ds) == "sweep":
         states = [s.strip() for s in state.split(",") if s.strip()]
         ds = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states)
@@ -119,9 +118,7 @@ def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, sta
     if fig_path is not None:  # drawn before anything is written
         fig = rocksweep.plot(rk, width=width)
     if out_path is not None:
-        from rocksweep.cli.fragility import csv_text, write_table
-
-        write_table(out_path, csv_text(rows), rk, overwrite)
+        write_table(out_path, rows, rk, RISK, overwrite)
         say(f"wrote {out_path}")
     if fig is not None:
         save_figure(fig, fig_path, dpi, overwrite=overwrite, inputs=inputs)

@@ -1,5 +1,5 @@
 """``rocksweep simulate``: single runs with energy (Figure 5); the runs come from
-``rocksweep.api.simulate_runs``, the CSV from ``rocksweep.api.write_history_csv``."""
+``rocksweep.compute.history.run_points``, the CSV from its ``write_history_csv``."""
 
 from __future__ import annotations
 
@@ -48,7 +48,7 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     impact), impacts, uplifts, max |theta|/alpha_cg, the overturning time p*t, the energy
     lost in impacts and in the damper, and the accuracy setting with its cost.
     """
-    from rocksweep.api import simulate_runs, write_history_csv
+    from rocksweep.compute.history import run_points, write_history_csv
     from rocksweep.outputs import check_distinct, check_output
 
     check_distinct({"--plot": plot_path, "--csv": csv_path})  # by resolved path
@@ -65,7 +65,7 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     from rocksweep.scene.model import SceneError
 
     try:
-        runs = simulate_runs(scene, MAX_POINTS)
+        runs = run_points(scene, MAX_POINTS)
     except SceneError as err:  # name the file, as scene errors do
         raise click.ClickException(f"{scene_path}: {said(err)}") from None
     swept = [a.name for a in scene.swept]

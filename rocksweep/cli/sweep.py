@@ -1,5 +1,5 @@
 """``rocksweep sweep``: a scene's grid across workers into a resumable HDF5 file (through
-``rocksweep.api.sweep_file`` into ``rocksweep.compute.driver``; this command parses
+``rocksweep.compute.session.sweep`` into ``rocksweep.compute.driver``; this command parses
 options and prints)."""
 
 from __future__ import annotations
@@ -97,11 +97,13 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     from rocksweep import api
     from rocksweep.compute.adaptive import check_settings
     from rocksweep.compute.arguments import check_sweep_arguments
+    from rocksweep.compute.session import sweep as sweep_checked
 
-    # the arguments that need no scene, before it is read (all again in api.sweep_file)
-    check_sweep_arguments(jobs=jobs, resume=resume, overwrite=overwrite, backend=backend,
-                          scheduler=scheduler, chunk_size=chunk_size, write_every=write_every,
-                          connect_timeout=connect_timeout)
+    # the arguments that need no scene, before it is read (checked once: handed down)
+    args = check_sweep_arguments(jobs=jobs, resume=resume, overwrite=overwrite,
+                                 validate=validate, backend=backend, scheduler=scheduler,
+                                 chunk_size=chunk_size, write_every=write_every,
+                                 connect_timeout=connect_timeout)
     # the ranges of the scene's refine: section, one table
     check_settings({"coarse": coarse, "audit": audit, "margin": margin,
                     "final_margin": final_margin, "seed": seed, "threshold": threshold})
@@ -129,12 +131,8 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
             click.echo(line, err=True)
 
     try:
-        report = api.sweep_file(scene, out, overrides=overrides, jobs=jobs, resume=resume,
-                                overwrite=overwrite, backend=backend, scheduler=scheduler,
-                                chunk_size=chunk_size, write_every=write_every,
-                                progress=not quiet, log=say, inputs=[scene_path],
-                                adaptive=options, validate=validate,
-                                connect_timeout=connect_timeout)
+        report = sweep_checked(scene, out, args, overrides=overrides, progress=not quiet,
+                               log=say, inputs=[scene_path], adaptive=options)
     except api.SweepInterrupted as stop:
         r = stop.report
         click.echo(f"\ninterrupted: {r.points_done} of {r.points_total} points saved in "
@@ -188,7 +186,7 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
 
 def report_cells(scene, flat) -> list[str]:
     """The swept values of some grid points, as 'key=value, ...' texts."""
-    from rocksweep.compute.grid import Grid
+    from rocksweep.scene.grid import Grid
 
     values = Grid(scene).index_values(flat)
     swept = [a.name for a in scene.swept]

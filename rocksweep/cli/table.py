@@ -26,7 +26,6 @@ def table_command(result_path: Path, out_path: Path, overwrite: bool) -> None:
     per curve of an analysis's file (fragility, risk, efficiency -o .h5); no row
     repeated."""
     import rocksweep
-    from rocksweep.api import open_any
     from rocksweep.outputs import check_output, write_atomic
     from rocksweep.store.reader import result_inputs
 
@@ -41,9 +40,11 @@ def table_command(result_path: Path, out_path: Path, overwrite: bool) -> None:
             raise click.ClickException(f"-o {out_path}: Parquet needs pyarrow (pip install "
                                        "pyarrow); or write .csv") from None
     check_output(out_path, overwrite=overwrite, inputs=result_inputs(result_path))
-    frame = rocksweep.table(open_any(result_path))
+    frame = rocksweep.table(rocksweep.open(result_path))
     if suffix == ".csv":
-        text = frame.to_csv(index=False)
+        from rocksweep.analysis.files import csv_text
+
+        text = csv_text(frame)
         write_atomic(out_path, lambda tmp: tmp.write_text(text), overwrite=overwrite)
     else:
         frame.attrs = {}  # pandas' attrs are not Parquet metadata

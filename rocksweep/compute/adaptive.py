@@ -1,4 +1,4 @@
-"""Adaptive stability diagrams: compute only where the class can change (issue 11).
+"""Adaptive stability diagrams: compute only where the class can change.
 
 A stability diagram is large uniform regions (safe, mode 1, mode 2) separated by thin
 boundaries. Over the two *diagram axes* (by default x = w_over_p, y = A_ratio; any two
@@ -41,7 +41,7 @@ matter. ``next_batch`` is therefore a pure function of
 chunking; a point's result depends only on the point), stores the results and calls it
 again, until it returns an empty batch. An interrupted sweep resumes from the file.
 
-Per point, the state is two arrays over the grid's flat indices (``rocksweep.compute.grid``):
+Per point, the state is two arrays over the grid's flat indices (``rocksweep.scene.grid``):
 ``outcome`` (int8, the kernel's class; read only where computed > 0) and ``computed``
 (int8, the flags below). Filled points keep the "not computed" fill values of every other
 variable (``rocksweep.compute.sweep.VARIABLES``).
@@ -57,13 +57,14 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.compute.grid import ChunkRows, Grid
 from rocksweep.errors import AdaptiveError, ApiError, Arg  # noqa: F401 (AdaptiveError: re-exported)
+from rocksweep.scene.grid import ChunkRows, Grid
 from rocksweep.scene.model import Scene
 from rocksweep.schema import check_option
 from rocksweep.vocab import outcomes as _out
 from rocksweep.vocab.axes import DIAGRAM_AXES
 from rocksweep.vocab.settings import (
+    ADAPTIVE_RESOLVED,
     ADAPTIVE_SETTINGS,
     DEFAULT_AUDIT,
     DEFAULT_AUDIT_THRESHOLD,
@@ -235,9 +236,6 @@ class Options:
         return cls(tuple(d["axes"]), int(d["coarse"]), float(d["audit"]),
                    int(d["margin"]), int(d["final_margin"]), int(d["seed"]),
                    float(d["threshold"]))
-
-
-RESOLVED_KEYS = ("axes", "coarse", "margin", "final_margin", "audit", "seed", "threshold")
 
 
 def default_coarse(ny: int, nx: int) -> int:
@@ -837,7 +835,7 @@ def adaptive_options(adaptive: bool, base: dict | None = None,
     if base is not None:
         adaptive = True
         given = {**base, **given}
-    known = {"coarse", "audit", "axes", "margin", "final_margin", "seed", "threshold"}
+    known = set(ADAPTIVE_RESOLVED)
     unknown = sorted(set(given) - known)
     if unknown:
         raise AdaptiveError(f"{unknown[0]} = {given[unknown[0]]!r}: not a setting of an adaptive "

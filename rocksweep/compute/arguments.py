@@ -1,7 +1,8 @@
 """The arguments of a sweep, checked in one place before anything touches an output.
 
-``rocksweep sweep`` (``rocksweep.cli.sweep``), ``rocksweep.run`` and the driver they share
-(``rocksweep.api.sweep_file``) call ``check_sweep_arguments`` first: an argument that cannot
+``rocksweep sweep`` (``rocksweep.cli.sweep``) and ``rocksweep.run``
+(``rocksweep.compute.session``) call ``check_sweep_arguments`` once, first, and hand its
+``SweepArguments`` down: an argument that cannot
 be used is refused with one line while the output file is still as it was (an existing
 result is neither removed nor changed, no new file appears). A wrong type is a
 ``TypeError`` naming the argument (as Python users expect); a value out of range is a
@@ -18,7 +19,9 @@ import math
 import numbers
 import os
 import socket
+import sys
 import time
+from dataclasses import dataclass
 from typing import Any
 from urllib.parse import urlsplit
 
@@ -37,7 +40,8 @@ RETRY = "then run it again (with {resume} to finish a file already started)"
 
 def check_flag(name: str, v: Any) -> bool:
     """``v`` if it is a bool (numpy's too), else a TypeError naming ``name``."""
-    if isinstance(v, bool) or type(v).__name__ == "bool_":
+    np = sys.modules.get("numpy")  # a numpy bool exists only once numpy is loaded
+    if isinstance(v, bool) or (np is not None and isinstance(v, np.bool_)):
         return bool(v)
     raise TypeError(f"{name} = {v!r}: must be True or False")
 
@@ -77,34 +81,57 @@ def check_seconds(name: str, seconds: Any, *, lo: float = 0.0, hi: float = math.
     return s
 
 
+@dataclass(frozen=True)
+class SweepArguments:
+    """A sweep's arguments that decide nothing about the scene, checked once
+    (``check_sweep_arguments``) and handed down (``compute.session.sweep``): jobs as
+    given (-1: one per core) and n_workers, the local threads it means (1 for dask);
+    the others as ``sweep_file`` documents them."""
+
+    jobs: int = 1
+    n_workers: int = 1
+    resume: bool = False
+    overwrite: bool = False
+    validate: bool = False
+    backend: str = DEFAULT_BACKEND
+    scheduler: str | None = None
+    chunk_size: int | None = None
+    write_every: float = 1.0
+    connect_timeout: float = CONNECT_TIMEOUT
+
+
 def check_sweep_arguments(*, jobs: Any = 1, resume: Any = False, overwrite: Any = False,
-                          validate: Any = False, adaptive: Any = None,
-                          backend: Any = DEFAULT_BACKEND, scheduler: Any = None,
-                          chunk_size: Any = None, write_every: Any = 1.0,
-                          connect_timeout: Any = CONNECT_TIMEOUT) -> int:
-    """Check every argument of a sweep that decides nothing about the scene; return the
-    number of local worker threads (1 for dask). Raises before any file is touched."""
+                          validate: Any = False, backend: Any = DEFAULT_BACKEND,
+                          scheduler: Any = None, chunk_size: Any = None,
+                          write_every: Any = 1.0, connect_timeout: Any = CONNECT_TIMEOUT
+                          ) -> SweepArguments:
+    """Check every argument of a sweep that decides nothing about the scene; return them
+    as ``SweepArguments``. Raises before any file is touched. (Whether ``validate`` has
+    an adaptive sweep to check depends on the scene: ``compute.session.sweep`` asks.)"""
     resume = check_flag("resume", resume)
     overwrite = check_flag("overwrite", overwrite)
     validate = check_flag("validate", validate)
     if resume and overwrite:
         raise SweepError("{resume} and {overwrite} exclude each other",
                          resume=flag("resume"), overwrite=flag("overwrite"))
-    if validate and adaptive is None:
-        raise SweepError("{validate} checks an adaptive sweep; add {adaptive}",
-                         validate=flag("validate"), adaptive=flag("adaptive"))
-    check_seconds("write_every", write_every, what="0: write every chunk as it finishes")
+    write_every = check_seconds("write_every", write_every,
+                                what="0: write every chunk as it finishes")
     if chunk_size is not None:
         if not is_integer(chunk_size):
             raise TypeError(f"chunk_size = {chunk_size!r}: must be an integer >= 1")
         if chunk_size < 1:
             raise SweepError("{arg}: must be >= 1", arg=Arg("chunk_size", chunk_size))
-    check_seconds("connect_timeout", connect_timeout, lo=0.1, hi=MAX_CONNECT_TIMEOUT)
+    connect_timeout = check_seconds("connect_timeout", connect_timeout, lo=0.1,
+                                    hi=MAX_CONNECT_TIMEOUT)
+    checked = {"resume": resume, "overwrite": overwrite, "validate": validate,
+               "backend": backend, "chunk_size": chunk_size, "write_every": write_every,
+               "connect_timeout": connect_timeout}
     if backend == "threads":
         if scheduler:
             raise SweepError("{scheduler} works with {dask} only", scheduler=Arg("scheduler"),
                              dask=Arg("backend", "dask"))
-        return check_jobs(jobs)
+        n_workers = check_jobs(jobs)
+        return SweepArguments(jobs=int(jobs), n_workers=n_workers, **checked)
     if backend == "dask":
         if not (isinstance(scheduler, str) and scheduler.strip()):
             if scheduler is not None and not isinstance(scheduler, str):
@@ -115,7 +142,7 @@ def check_sweep_arguments(*, jobs: Any = 1, resume: Any = False, overwrite: Any 
         if any(ord(c) < 32 for c in scheduler):
             raise SweepError(f"scheduler {scheduler!r}: control characters in the address")
         _address_parts(scheduler)
-        return 1
+        return SweepArguments(jobs=1, n_workers=1, scheduler=scheduler, **checked)
     raise SweepError(f"{{backend}}: must be {' or '.join(BACKENDS)}",
                      backend=Arg("backend", backend))
 

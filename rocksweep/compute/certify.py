@@ -3,10 +3,12 @@
 A run decides between overturning and not by a margin of energy. Where that margin is
 small, the step's error can decide the class: at 5 steps per spring period the top mass's
 spring loses ~2% of its energy to RK4 each step, and on Figure 3(a) 73 of 19 200 points
-went safe where the reference overturns in mode 1 (issue 28). The kernel reports how
+went safe where the reference overturns in mode 1 (docs/accuracy.md). The kernel reports how
 close the free rocking came to the overturning saddle (``OUT_MARGIN``, ``loop._saddle``:
 the vertex of the hyperbola it rocks on, in alpha_ref, ~ sqrt(|E - E_barrier|/E_ref)); a
-run below the row's PAR_CLOSE (``numerics.close_margin``) is a close call. A close call
+run below the row's PAR_CLOSE (``numerics.close_margin``) is a close call, and so is an
+overturn below ``numerics.OVERTURN_CLOSE`` x PAR_CLOSE: the overturn side of the
+threshold is certified as the safe side is. A close call
 is run again at half the steps (``refine_rows``: every step and the rotation limit
 halved, the step cap doubled), and again, until two consecutive runs give the same
 outcome (the finer one is kept) or ``Numerics.refine`` refinements were made. Only the
@@ -18,7 +20,7 @@ the last refinement also STATUS_UNCERTIFIED (flagged: not a reliable classificat
 Its steps and event_steps count every run it took. The same rule runs wherever rows meet
 the kernel, through the one dispatch (``compute.dispatch.run_variant``): sweeps
 (``compute.sweep.run_rows``), adaptive sweeps (through the sweep's chunks), the A_min
-searches (``analysis.boundaries.kernel_rows``), single runs (``compute.single.simulate``)
+searches (``analysis.boundaries.kernel_rows``), single runs (``compute.single.run_point``)
 and the accuracy study (``analysis.accuracy.run_kernel``).
 """
 
@@ -30,13 +32,20 @@ import numpy as np
 
 from rocksweep.fields import CHECK_SCALE
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.numerics import OVERTURN_CLOSE
 
 
 def close_calls(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     """bool[n]: the runs (parameter rows float64[n, >= N_PAR], result rows float64[n,
-    N_OUT]) whose outcome was a close call: their free rocking came within the row's
-    PAR_CLOSE x alpha_ref of the overturning saddle (``numerics.close_margin``)."""
-    return outs[:, L.OUT_MARGIN] < rows[:, L.PAR_CLOSE]
+    N_OUT]) whose outcome was a close call on either side of the saddle: their free
+    rocking came within the row's PAR_CLOSE x alpha_ref of the overturning saddle
+    (``numerics.close_margin``), or they overturned with a margin below
+    ``numerics.OVERTURN_CLOSE`` times that (an overturn commits to falling on one
+    approach, with the error of every step before it)."""
+    fell = (outs[:, L.OUT_OUTCOME] == L.OUTCOME_MODE1) | (
+        outs[:, L.OUT_OUTCOME] == L.OUTCOME_MODE2)
+    bound = np.where(fell, OVERTURN_CLOSE, 1.0) * rows[:, L.PAR_CLOSE]
+    return outs[:, L.OUT_MARGIN] < bound
 
 
 def refine_rows(rows: np.ndarray, level: int) -> np.ndarray:

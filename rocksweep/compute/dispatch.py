@@ -1,7 +1,7 @@
 """Parameter rows through one compiled kernel variant: the one dispatch of every run.
 
 Sweeps (``compute.sweep.run_rows``, one call per body kind and record of a chunk), the
-A_min searches of ``analysis.boundaries``, single runs (``compute.single.simulate``) and
+A_min searches of ``analysis.boundaries``, single runs (``compute.single.run_point``) and
 the accuracy study (``analysis.accuracy.run_kernel``) all run their rows through
 ``run_variant``: the kernel variant of (body kind, bookkeeping level, ground), a record's
 samples riding on the rows, and the close calls certified (``compute.certify``).
@@ -41,7 +41,7 @@ def run_variant(rows: np.ndarray, kind: int, level: int, ground: bool, refine: i
 
     refine: close calls re-run finer, up to this many refinements (``compute.certify``,
     ``Numerics.refine``; 0: none). record: a record all rows share (its samples written
-    once into one wide row, ``_run_record``), or None (the rows carry their samples or
+    once into one wide row, ``run_record``), or None (the rows carry their samples or
     need none). histories: a list of n entries to receive each run's history
     (float64[capacity, N_HIST], the finest run's when certified): the energy-accounting
     point kernel runs instead (``level`` unused). out: where to write the result rows
@@ -63,7 +63,7 @@ def run_variant(rows: np.ndarray, kind: int, level: int, ground: bool, refine: i
             if record is None:
                 fn(sub, res)
             else:
-                _run_record(fn, sub, np.ones(sub.shape[0], bool), res, record)
+                run_record(fn, sub, np.ones(sub.shape[0], bool), res, record)
 
     call(rows, outs, range(n))  # idx: the rows' places in ``histories``
     if refine > 0:
@@ -76,7 +76,7 @@ def run_variant(rows: np.ndarray, kind: int, level: int, ground: bool, refine: i
     return outs
 
 
-def _run_record(kernel_fn, rows: np.ndarray, sel: np.ndarray, outs: np.ndarray,
+def run_record(kernel_fn, rows: np.ndarray, sel: np.ndarray, outs: np.ndarray,
                 record) -> None:
     """Run the selected rows of a record scene, all driven by ``record``.
 

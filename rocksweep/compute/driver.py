@@ -5,9 +5,9 @@
 The sink is a result file or one in memory (``rocksweep.store.writer.SweepFile``; the
 driver needs only its ``grid`` and its methods ``done``, ``write``, ``state``,
 ``write_points``, ``write_filled``, ``finish``, ``image`` and ``close``): made, and every
-argument checked, by ``rocksweep.api.sweep_file``, the one way in for ``rocksweep.run``
-and ``rocksweep sweep``. Light at import (numpy, the kernel and tqdm load inside the
-functions), so the command line's options can read ``WRITE_EVERY`` from here.
+argument checked, by the sweep session (``rocksweep.compute.session``), the one way in
+for ``rocksweep.run`` and ``rocksweep sweep``. Light at import (numpy, the kernel and
+tqdm load inside the functions), so the command line's options can read ``WRITE_EVERY`` from here.
 """
 
 from __future__ import annotations
@@ -119,9 +119,9 @@ class ArraySink:
     until written; ``computed`` flags of an adaptive sweep): what ``sweep_arrays`` drives
     for the library's own in-memory sweeps, with the same loops as a result file. Not the
     in-memory result file (``store.writer.SweepFile`` with no path, ``rocksweep.run``):
-    that one costs ~85 ms more a sweep (an HDF5 image written, then read into a Dataset;
-    ci-small, 256 points: 13 ms here against 98 ms), which the accuracy study and the
-    tests would pay on every call, and it would take the compute room up to the store's."""
+    that one writes an HDF5 image and reads it back into a Dataset, several times the
+    cost of a small sweep, which the accuracy study and the tests would pay on every
+    call."""
 
     def __init__(self, grid: Any) -> None:
         import numpy as np
@@ -184,7 +184,7 @@ def sweep_arrays(scene: Scene, jobs: int = 1, chunk_size: int | None = None,
     Identical, bit for bit, whatever ``jobs``, ``chunk_size`` and backend, and to the
     result file of ``rocksweep sweep``. For the library's own studies and tests;
     ``rocksweep.run`` returns the same as a Dataset."""
-    from rocksweep.compute.grid import Grid
+    from rocksweep.scene.grid import Grid
 
     sink = ArraySink(Grid(scene))
     report = SweepReport(Path("memory"), sink.grid.size, 0, 0, 0.0, 0.0, 0.0)

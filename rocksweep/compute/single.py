@@ -102,7 +102,7 @@ class Run:
         impact is the pair of rows at one time whose first rocks (phase != 0): the jump of
         the impacts' cumulative loss across it."""
         if self.history is None:
-            raise ValueError("this run has no history (simulate with history=True)")
+            raise ValueError("this run has no history (run_point with history=True)")
         t = np.asarray(self.history["t"])
         phase = np.asarray(self.history["phase"])
         lost = np.asarray(self.history["E_impact"])
@@ -113,12 +113,12 @@ class Run:
         """The time history normalised (``rocksweep.fields.HISTORY``: p_t,
         theta_over_alpha, u_over_ucr, E_over_Eref, ...): name -> float64[rows]."""
         if self.history is None:
-            raise ValueError("this run has no history (simulate with history=True)")
+            raise ValueError("this run has no history (run_point with history=True)")
         return fields.history_columns(self.history, self.point.body)
 
 
-def simulate(point: Point, numerics: Numerics, history: bool = True,
-             contact: bool = False) -> Run:
+def run_point(point: Point, numerics: Numerics, history: bool = True,
+              contact: bool = False) -> Run:
     """Run one point. With ``history`` the energy-accounting kernel records every step
     (it tracks the ground reactions too); without, the outcome-only kernel of the point's
     kind runs (what sweeps run), or the contact kernel with ``contact``. ``contact``: the

@@ -4,7 +4,7 @@ No I/O here: ``run_chunks`` yields each chunk's result arrays as it finishes and
 sweep driver (``rocksweep.compute.driver``) writes them to its sink: a result file
 (``rocksweep.store.writer``, behind ``rocksweep sweep`` and ``rocksweep.run``) or plain
 arrays in memory (``driver.sweep_arrays``, the library's own studies). A chunk is a
-contiguous range of flat point indices (``rocksweep.compute.grid``) and costs one call into
+contiguous range of flat point indices (``rocksweep.scene.grid``) and costs one call into
 the jitted kernel per kernel kind present in the chunk; there is no Python per point.
 
 Local workers are threads of this process (joblib's threading backend): the chunk kernels
@@ -39,11 +39,11 @@ from rocksweep.compute.arguments import (  # noqa: F401 (re-exported)
     check_jobs,
     probe_scheduler,
 )
-from rocksweep.compute.dispatch import _run_record, run_variant  # noqa: F401 (re-exported)
-from rocksweep.compute.grid import ChunkRows, Grid
+from rocksweep.compute.dispatch import run_variant
 from rocksweep.errors import flag
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import point_seconds
+from rocksweep.scene.grid import ChunkResult, ChunkRows, Grid
 from rocksweep.scene.model import Scene
 from rocksweep.vocab.settings import BACKENDS
 
@@ -65,21 +65,6 @@ def level(scene: Scene) -> int:
     if scene.contact:
         return L.LEVEL_CONTACT
     return L.LEVEL_ENERGY if scene.energy else L.LEVEL_OUTCOME
-
-
-@dataclass
-class ChunkResult:
-    """Results of the points ``start <= i < stop`` (flat indices).
-
-    arrays: name -> array[stop - start] (``Scene.variables``); seconds: wall time of the
-    chunk in its worker; cpu_seconds: CPU time of the worker thread that ran it.
-    """
-
-    start: int
-    stop: int
-    arrays: dict[str, np.ndarray]
-    seconds: float
-    cpu_seconds: float = 0.0
 
 
 def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:

@@ -228,8 +228,8 @@ def time_history(runs: Sequence[Run], swept: Sequence[str] = (), title: str = ""
     column over the point's amplitude A), (b) theta/alpha_cg, (c) E/E_ref, (d) the energy
     dissipated in impacts and the damper / E_ref; one colour per run.
 
-    runs: Runs with a history (``rocksweep.compute.single.simulate(..., history=True)``); swept: the
-    scene's swept axis names, which label the runs; axes: 4 axes to draw into (else a new
+    runs: Runs with a history (``rocksweep.compute.single.run_point``, history=True); swept:
+    the scene's swept axis names, which label the runs; axes: 4 axes to draw into (else a new
     figure). Returns the figure.
     """
     if axes is None:

@@ -22,7 +22,7 @@ import matplotlib.colors
 import numpy as np
 import xarray as xr
 
-from rocksweep.analysis.fragility import lognormal_cdf
+from rocksweep.analysis.likelihood import lognormal_cdf
 from rocksweep.analysis.risk import fragility_median
 from rocksweep.errors import FragilityFigureError, RocksweepError  # noqa: F401 (re-exported)
 from rocksweep.figures import WIDTHS

@@ -1,4 +1,4 @@
-"""The pulse shapes' figure (the README's plot of ``rocksweep.physics.excitation``)."""
+"""The pulse shapes' figure (docs/excitations.md's plot of ``rocksweep.physics.excitation``)."""
 
 from __future__ import annotations
 

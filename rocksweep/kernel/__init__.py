@@ -11,6 +11,8 @@ effect set; ``warm_up`` compiles one now. One idea per module:
 - ``stepping``: the right-hand side on the state and one RK4 step;
 - ``events``: event functions, detection inside a step and location of the root;
 - ``transitions``: uplift, the impact map, the rest and rigid-bound early exits;
+- ``contact``: the ground's reactions, friction demand and impact impulses (where the
+  model holds; the contact variants);
 - ``loop``: ``simulate_point``, one point from start to outcome;
 - ``variants``: the compiled entry points and their tables;
 - ``_static``: calls that a variant's flags make dead, left out while typing;

@@ -8,7 +8,7 @@ sources.
 
 numba also keys its cache directory by the source file's path, so two copies of the same
 sources (the repository run by ``python -m pytest`` and a non-editable ``pip install .`` in
-site-packages) would each compile the nine variants again. The cache is therefore one
+site-packages) would each compile every variant again. The cache is therefore one
 per-user directory per kernel hash, ``$NUMBA_CACHE_DIR/rocksweep/<hash>`` if
 NUMBA_CACHE_DIR is set, else ``$XDG_CACHE_HOME/rocksweep/numba/<hash>`` (default
 ``~/.cache/rocksweep/numba/<hash>``), shared by every copy of the same sources; if it

@@ -1,7 +1,7 @@
 """Equations of motion, uplift and impact of the flexible rocking oscillator (jitted).
 
 Everything here is a pure function of scalars and the parameter row ``prm`` (see
-``layout``). Conventions (``rocksweep.physics.model``): theta > 0 clockwise = rocking on the +b
+``layout``). Conventions (``rocksweep.physics.bodies``): theta > 0 clockwise = rocking on the +b
 corner (s = +1), u along the body's x axis, SI units with m = 1, g = 9.81, p = 1.
 
 Derivation (section 2 of the paper; Lagrange's equations in the frame of the ground,

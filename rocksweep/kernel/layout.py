@@ -4,13 +4,14 @@ Numba reads module-level ints as compile-time constants, so these cost nothing i
 The kernel takes one parameter row per point (``PAR_*``) and fills one result row
 (``OUT_*``; the loop keeps its event counters there as it runs); single runs also fill a history
 buffer (``HIST_*`` columns). Inside the loop the state is a 6-tuple (``Y_*`` slots). All
-quantities are SI with m = 1 kg, g = 9.81 m/s^2 and p = 1 rad/s (see ``rocksweep.physics.model``),
+quantities are SI with m = 1 kg, g = 9.81 m/s^2 and p = 1 rad/s (see ``rocksweep.physics.bodies``),
 so times are p*t.
 """
 
 from rocksweep.vocab import ground as _ground
 from rocksweep.vocab import laws as _laws
 from rocksweep.vocab import outcomes as _out
+from rocksweep.vocab import settings as _settings
 
 # --- parameter row ---------------------------------------------------------------------
 PAR_M = 0  # top mass m [kg]
@@ -28,8 +29,9 @@ PAR_HCG = 11  # h_cg [m]
 PAR_IO = 12  # I_O about a corner with u = 0 [kg m^2]
 PAR_AMP = 13  # pulse amplitude A [m/s^2] (signed)
 PAR_OMEGA = 14  # pulse frequency omega [rad/s]
-PAR_SHAPE = 15  # SHAPE_SINE or SHAPE_COSINE
-PAR_TPULSE = 16  # pulse end 2 pi / omega [s]
+PAR_SHAPE = 15  # SHAPE_* code (``vocab.ground.SHAPE_CODE``)
+PAR_TPULSE = 16  # end of the ground motion [s]: the pulse's duration (its cycles, Ricker's and
+#                  MP's own: ``vocab.ground.pulse_duration``), a record's length; 0 for FREE
 PAR_LAM = 17  # lam (Pi10)
 PAR_DT = 18  # RK4 step once the ground is still (after the pulse or record) [s]
 PAR_TOL = 19  # event tolerance: width of the final bracket on time [s]
@@ -74,9 +76,9 @@ SHAPE_RECORD = _ground.SHAPE_CODE[_ground.RECORD]
 LAW_VERTICAL = _laws.LAW_CODE[_laws.VERTICAL]
 LAW_LOCKED = _laws.LAW_CODE[_laws.LOCKED]
 LAW_CONSTANT = _laws.LAW_CODE[_laws.CONSTANT]
-ROOT_BISECT = 0.0
-ROOT_ILLINOIS = 1.0
-ROOT_HERMITE = 2.0
+ROOT_BISECT = _settings.ROOT_CODE[_settings.BISECTION]
+ROOT_ILLINOIS = _settings.ROOT_CODE[_settings.ILLINOIS]
+ROOT_HERMITE = _settings.ROOT_CODE[_settings.HERMITE]
 
 # --- result row ------------------------------------------------------------------------
 OUT_OUTCOME = 0  # OUTCOME_* code
@@ -112,7 +114,6 @@ Y_U = 2  # u, the top mass's lateral displacement [m] (0 for a rigid body)
 Y_U_DOT = 3  # u' [m/s]
 Y_W_IN = 4  # work of the ground motion so far [J] (energy variants; else stays 0)
 Y_D_DAMP = 5  # energy dissipated by the damper so far [J] (energy variants; else stays 0)
-N_Y = 6
 
 # --- history columns ---------------------------------------------------------------------
 HIST_T = 0
@@ -164,5 +165,5 @@ KIND_FLEXIBLE_UNDAMPED = 1
 KIND_RIGID = 2
 LEVEL_OUTCOME = 0  # outcome and summary metrics only
 LEVEL_ENERGY = 1  # + energy accounting
-LEVEL_HISTORY = 2  # + energy accounting + time history
 LEVEL_CONTACT = 3  # + energy accounting + ground reactions (outputs.contact)
+# (a single run with its time history: ``point_kernel``, not a level of the chunk kernels)

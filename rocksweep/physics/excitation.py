@@ -1,10 +1,11 @@
 """Reference definitions of the ground-acceleration pulses (pure numpy, no numba).
 
-This module is the pulses' reference in physics units and the source of the README's plot
-of the shapes. The Ricker and MP formulas are written once, in ``rocksweep.vocab.ground``,
-and evaluated here per sample and compiled into the kernel; tests/physics/test_excitation.py
-checks them against independent closed forms (the Ricker's roots and side lobes, the
-Lambert-W uplift, OpenSees' MPAcc and its velocity, finite differences).
+This module is the pulses' reference in physics units and the source of the plot of
+the shapes in docs/excitations.md (``figures.pulses``). The Ricker and MP formulas are
+written once, in ``rocksweep.vocab.ground``, and evaluated here per sample and compiled
+into the kernel; tests/physics/test_excitation.py checks them against independent closed
+forms (the Ricker's roots and side lobes, the Lambert-W uplift, OpenSees' MPAcc and its
+velocity, finite differences).
 
 Every shape is a function of the phase ``phi = w t`` (w = w_over_p * p [rad/s], t [s];
 in kernel time p = 1, so phi = w_over_p * (p t)) and is normalised so that its peak |xg''| is A:
@@ -220,7 +221,7 @@ class PulseShape:
 
 
 def default_shapes() -> tuple[PulseShape, ...]:
-    """The shapes the README plots: sine and cosine (1 and 2 cycles), Ricker, MP."""
+    """The shapes docs/excitations.md plots: sine and cosine (1 and 2 cycles), Ricker, MP."""
     return (PulseShape("sine"), PulseShape("sine", cycles=2), PulseShape("cosine"),
             PulseShape("cosine", cycles=2), PulseShape("ricker"),
             PulseShape("mp", gamma=2.0, nu_deg=90.0), PulseShape("mp", gamma=2.0, nu_deg=0.0))

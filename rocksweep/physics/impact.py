@@ -34,7 +34,7 @@ T = 1/2 m (u' + h w)^2 + 1/2 (I_A + m_A R_A^2 + m a^2) w^2, a = u - s b:
   locked impact gains energy depends on u' too. ``lam_energy_limit`` uses u' = 0 for it
   (the top mass at rest relative to the base).
 
-Conventions as in ``rocksweep.physics.model``: ``upper`` is the paper's upper sign (rocking
+Conventions as in ``rocksweep.physics.bodies``: ``upper`` is the paper's upper sign (rocking
 on the +b corner ends, the future corner is -b, u positive toward +b).
 """
 
@@ -44,8 +44,8 @@ import math
 
 import numpy as np
 
-from rocksweep.physics.model import Body, FlexibleBody, impact_energy_loss, restitution_rigid
-from rocksweep.physics.model import restitution as restitution_eq1
+from rocksweep.physics.bodies import Body, FlexibleBody, impact_energy_loss, restitution_rigid
+from rocksweep.physics.bodies import restitution as restitution_eq1
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW, LAWS, LOCKED, VERTICAL
 
 # The u/u_cr range over which a body's energy-admissible lam is taken (Figure 2's range)

@@ -54,7 +54,7 @@ import math
 import numpy as np
 from scipy.signal import lfilter
 
-from rocksweep.physics.model import G  # gravity [m/s^2], the one definition
+from rocksweep.physics.bodies import G  # gravity [m/s^2], the one definition
 from rocksweep.vocab.ground import AVGSA_POINTS, SA_DAMPING
 
 __all__ = ["AVGSA_POINTS", "G", "arias", "avg_sa", "avgsa_periods", "cav", "duration",

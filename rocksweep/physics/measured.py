@@ -1,4 +1,4 @@
-"""Measured rocking histories: a CSV or a DataFrame -> normalised samples (issue 30).
+"""Measured rocking histories: a CSV or a DataFrame -> normalised samples.
 
 Two forms of the columns are read:
 
@@ -26,7 +26,8 @@ from typing import Any
 import numpy as np
 
 from rocksweep.errors import MeasuredError, RocksweepError  # noqa: F401 (MeasuredError re-exported)
-from rocksweep.outputs import input_problem, shown
+from rocksweep.inputs import check_columns, csv_table, number_column, read_text
+from rocksweep.outputs import shown
 
 MIN_SAMPLES = 8  # fewer samples describe no rocking history
 # largest file read [bytes]: 1e7 samples of a few columns (a test at 1 kHz for hours)
@@ -53,44 +54,26 @@ class Measured:
         return float(self.t[-1] - self.t[0])
 
 
-def _frame(measured: Any) -> tuple[Any, str]:
-    """(DataFrame, source words) of a path or a DataFrame."""
+def _columns(measured: Any) -> tuple[dict[str, Any], list[str], str]:
+    """({column: values}, each row's place in messages, source words) of a CSV path or a
+    DataFrame; the file read through ``rocksweep.inputs`` (a regular UTF-8 file of at
+    most MAX_BYTES, comma-separated, each column named once)."""
     import pandas as pd
 
     if isinstance(measured, pd.DataFrame):
-        return measured, "measured DataFrame"
+        src = "measured DataFrame"
+        cols = check_columns(list(measured.columns), src, MeasuredError)
+        values = {c: measured.iloc[:, k].to_numpy() for k, c in enumerate(cols)}
+        return values, [f"{src}, row {i + 1}" for i in range(len(measured))], src
     if not isinstance(measured, str | Path):
         raise TypeError(f"measured = {measured!r}: give a CSV path or a pandas DataFrame")
     path = Path(measured)
-    problem = input_problem(path)
-    if problem is not None:
-        raise MeasuredError(f"{shown(path)}: {problem}" if problem != "no such file"
-                            else f"{shown(path)}: no such measured history (CSV) file")
-    if path.stat().st_size > MAX_BYTES:
-        raise MeasuredError(f"{shown(path)}: {path.stat().st_size:,} bytes; at most "
-                            f"{MAX_BYTES:,} (resample the history)")
-    try:
-        frame = pd.read_csv(path, comment="#", skipinitialspace=True)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError,
-            ValueError) as err:
-        first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
-        raise MeasuredError(f"{shown(path)}: not a CSV table with a header line "
-                            f"({first})") from None
-    except OSError as err:
-        raise MeasuredError(f"{shown(path)}: cannot read ({err.strerror})") from None
-    return frame, shown(path)
-
-
-def _column(frame: Any, name: str, src: str) -> np.ndarray:
-    import pandas as pd
-
-    col = pd.to_numeric(frame[name], errors="coerce").to_numpy(dtype=float)
-    bad = frame[name].notna().to_numpy() & np.isnan(col)
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
-        raise MeasuredError(f"{src}: column {name}, row {i + 1}: {frame[name].iloc[i]!r} is "
-                            "not a number")
-    return col
+    src = shown(path)
+    text = read_text(path, "measured history (CSV)", MeasuredError, max_bytes=MAX_BYTES)
+    table = csv_table(text, src, MeasuredError, "measured history",
+                      expect="'p_t,theta_over_alpha' or 't,theta'")
+    return ({c: table.column(c) for c in table.columns},
+            [f"{src}, line {ln}" for ln in table.lines], src)
 
 
 def read_measured(measured: Any, *, p: float | None = None, alpha_ref: float | None = None,
@@ -100,31 +83,35 @@ def read_measured(measured: Any, *, p: float | None = None, alpha_ref: float | N
     p [rad/s], alpha_ref [rad], u_cr [m]: the body's, to read physical columns t, theta,
     u (None: not known; then only the dimensionless columns are accepted).
     """
-    frame, src = _frame(measured)
-    cols = [str(c).strip() for c in frame.columns]
-    frame = frame.set_axis(cols, axis=1)
+    frame, where, src = _columns(measured)
+    cols = list(frame)
     notes: list[str] = []
+
+    def column(name: str, gaps: bool = False) -> np.ndarray:
+        return number_column(frame[name], where, name, MeasuredError, gaps=gaps)
+
     if "run" in cols:
-        runs = np.unique(_column(frame, "run", src)[~frame["run"].isna().to_numpy()])
+        runs = np.unique(column("run", gaps=True))
+        runs = runs[~np.isnan(runs)]
         if runs.size > 1:
             raise MeasuredError(f"{src}: column run holds {runs.size} runs "
                                 f"({', '.join(f'{r:g}' for r in runs[:4])}...); give one "
                                 "run's rows (the history CSV of one point)")
     if "p_t" in cols and "theta_over_alpha" in cols:
-        t = _column(frame, "p_t", src)
-        theta = _column(frame, "theta_over_alpha", src)
-        u = _column(frame, "u_over_ucr", src) if "u_over_ucr" in cols else None
+        t = column("p_t")
+        theta = column("theta_over_alpha", gaps=True)
+        u = column("u_over_ucr", gaps=True) if "u_over_ucr" in cols else None
         tname, thname = "p_t", "theta_over_alpha"
     elif "t" in cols and "theta" in cols:
         if p is None or alpha_ref is None:
             raise MeasuredError(f"{src}: columns t [s], theta [rad] need the body's p "
                                 "[rad/s] (a physical body, kind: physical, or a record "
                                 "scene's ground.p); or give p_t, theta_over_alpha")
-        t = _column(frame, "t", src) * p
-        theta = _column(frame, "theta", src) / alpha_ref
+        t = column("t") * p
+        theta = column("theta", gaps=True) / alpha_ref
         u = None
         if "u" in cols and u_cr:
-            u = _column(frame, "u", src) / u_cr
+            u = column("u", gaps=True) / u_cr
         tname, thname = "t", "theta"
         notes.append(f"physical columns t [s], theta [rad] read with p = {p:.6g} rad/s, "
                      f"alpha = {alpha_ref:.6g} rad")
@@ -139,19 +126,19 @@ def read_measured(measured: Any, *, p: float | None = None, alpha_ref: float | N
         raise MeasuredError(f"{src}: no rows")
     if not np.all(np.isfinite(t)):
         i = int(np.flatnonzero(~np.isfinite(t))[0])
-        raise MeasuredError(f"{src}: column {tname}, row {i + 1}: {t[i]!r}; time must be a "
+        raise MeasuredError(f"{where[i]}: {tname} = {float(t[i])!r}; time must be a "
                             "finite number in every row")
     dec = np.flatnonzero(np.diff(t) < 0)
     if dec.size:
         i = int(dec[0]) + 1
-        raise MeasuredError(f"{src}: column {tname}, row {i + 1}: {t[i]!r} after "
-                            f"{t[i - 1]!r}; time must not decrease")
+        raise MeasuredError(f"{where[i]}: {tname} = {float(t[i])!r} after "
+                            f"{float(t[i - 1])!r}; time must not decrease")
     keep = np.isfinite(theta)
     if not keep.any():
         raise MeasuredError(f"{src}: column {thname} is NaN in every row; nothing measured")
     if np.isinf(theta).any():
         i = int(np.flatnonzero(np.isinf(theta))[0])
-        raise MeasuredError(f"{src}: column {thname}, row {i + 1}: {theta[i]!r}; must be "
+        raise MeasuredError(f"{where[i]}: {thname} = {float(theta[i])!r}; must be "
                             "finite (NaN for a gap)")
     n_gap = int((~keep).sum())
     if n_gap:

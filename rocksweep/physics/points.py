@@ -15,14 +15,13 @@ from rocksweep.kernel import layout as L
 from rocksweep.kernel.spring import rocking_spring_omega
 from rocksweep.numerics import (
     EVENT_STEP_ALLOWANCE,
-    ROOTS,
     Numerics,
     amplitude_frequency,
     close_margin,
     step_budget,
     step_sizes,
 )
-from rocksweep.physics.model import Body, FlexibleBody, G
+from rocksweep.physics.bodies import Body, FlexibleBody, G
 from rocksweep.physics.records import GroundRecord
 from rocksweep.vocab.axes import INITIAL  # noqa: F401
 from rocksweep.vocab.ground import (  # noqa: F401
@@ -40,6 +39,7 @@ from rocksweep.vocab.ground import (  # noqa: F401
     pulse_duration,
 )
 from rocksweep.vocab.laws import DEFAULT_LAW, LAW_CODE, LAWS  # noqa: F401
+from rocksweep.vocab.settings import ROOT_CODE
 
 if TYPE_CHECKING:
     from rocksweep.physics.excitation import PulseShape
@@ -49,7 +49,6 @@ if TYPE_CHECKING:
 # branch of the kernel for nothing)
 _SHAPE_CODE = {**SHAPE_CODE, FREE: SHAPE_CODE[SINE]}
 _LAW_CODE = LAW_CODE
-_ROOT_CODE = dict(zip(ROOTS, (L.ROOT_BISECT, L.ROOT_ILLINOIS, L.ROOT_HERMITE), strict=True))
 
 
 @dataclass(frozen=True)
@@ -161,7 +160,7 @@ def body_omega_rock(body: Body) -> float:
     used. Above a damping ratio of 1 the mode is overdamped and its fast root,
     omega (zeta' + sqrt(zeta'^2 - 1)), is what an explicit RK4 step must resolve (it is
     unstable beyond |lambda dt| ~ 2.8): a slender, tall body with a light base (m h^2 >>
-    I_A + m_A R_A^2) and zeta ~ 0.2 has zeta' ~ 5 (issue 5, found by the property test).
+    I_A + m_A R_A^2) and zeta ~ 0.2 has zeta' ~ 5 (found by the hard cases' property test).
     """
     if body.rigid:
         return 0.0
@@ -302,7 +301,7 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     rows[:, L.PAR_MAXSTEPS] = max_steps
     rows[:, L.PAR_MAXEVENTS] = numerics.max_events
     rows[:, L.PAR_RESTRATE] = numerics.rest_rate * alpha_ref  # p = 1
-    rows[:, L.PAR_ROOT] = _ROOT_CODE[numerics.root]
+    rows[:, L.PAR_ROOT] = ROOT_CODE[numerics.root]
     rows[:, L.PAR_MU] = mu
     rows[:, L.PAR_ROT_STEP] = numerics.rotation_step * alpha_ref
     rows[:, L.PAR_ALPHA_REF] = alpha_ref

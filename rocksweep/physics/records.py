@@ -54,6 +54,7 @@ from pathlib import Path
 import numpy as np
 
 from rocksweep.errors import RecordError  # noqa: F401 (defined there; re-exported)
+from rocksweep.inputs import read_input
 from rocksweep.outputs import check_output, input_problem, shown, write_atomic
 
 
@@ -164,6 +165,8 @@ DT_MIN, DT_MAX = 1e-6, 10.0
 # normal float: a subnormal peak (1e-310) or a huge one (1e300) would overflow the scale
 # factor or the spectra (numpy's RuntimeWarnings, inf factors).
 PGA_MIN, PGA_MAX = 1e-100, 1e100
+# Largest record file read [bytes]: ~3e7 samples of AT2 text, hours at 1 kHz.
+MAX_RECORD_BYTES = 500 << 20
 
 
 def _where(src: str, line: int | None = None) -> str:
@@ -251,6 +254,9 @@ def _parse_two_column(lines: list[str], src: str) -> tuple[float, np.ndarray, st
         if not s or s.startswith("#"):
             continue
         fields = [f for f in re.split(r"[,\s]+", s) if f]
+        if len(fields) != 2 and ";" in s:
+            raise RecordError(f"{_where(src, k + 1)}: fields separated by semicolons; a record's "
+                              "two columns are separated by spaces or a comma")
         if len(fields) != 2:
             raise RecordError(f"{_where(src, k + 1)}: expected 2 columns (t [s], xg'' [g]), "
                               f"found {len(fields)}; a header line must start with #")
@@ -313,18 +319,12 @@ def parse_record(data: bytes, source: str | Path) -> GroundRecord:
 
 
 def read_record(path: str | Path) -> GroundRecord:
-    """Read a ``.AT2`` (NGA-West2 or older PEER) or two-column record file (a regular
-    file: a FIFO, device or directory is refused before it is opened, never waited on)."""
-    problem = input_problem(path)
-    if problem == "is a directory, not a file":
+    """Read a ``.AT2`` (NGA-West2 or older PEER) or two-column record file through
+    ``rocksweep.inputs.read_input`` (a regular file of at most MAX_RECORD_BYTES: a FIFO,
+    device or directory is refused before it is opened, never waited on)."""
+    if input_problem(path) == "is a directory, not a file":
         raise RecordError(f"{_where(str(path))}: is a directory, not a record file")
-    if problem is not None and problem != "no such file":
-        raise RecordError(f"{_where(str(path))}: {problem}")
-    try:
-        data = Path(path).read_bytes()
-    except OSError as err:
-        raise RecordError(f"{_where(str(path))}: cannot be read "
-                          f"({err.strerror or type(err).__name__})") from None
+    data = read_input(path, "record", RecordError, max_bytes=MAX_RECORD_BYTES)
     return parse_record(data, path)
 
 

@@ -36,7 +36,7 @@ M g b, means a crossing was stepped over; it is then located on the dense output
 the previous extremum and that one. theta_max is the largest |theta| over the maxima of
 s*theta (located, not sampled) and the phase ends.
 
-Times are p*t (p = 1 rad/s), angles in rad, SI units with m = 1 kg (``rocksweep.physics.model``).
+Times are p*t (p = 1 rad/s), angles in rad, SI units with m = 1 kg (``rocksweep.physics.bodies``).
 """
 
 from __future__ import annotations
@@ -545,13 +545,6 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
     if log is not None:
         res["events"] = log
     return res
-
-
-def reference_row(point: Point, numerics: Numerics | None = None, **kw) -> np.ndarray:
-    """``reference_run`` packed as a kernel result row float64[N_OUT] (energy entries NaN;
-    OUT_STEPS holds DOP853 steps, OUT_EVENT_STEPS 0)."""
-    r = reference_run(point, numerics, **kw)
-    return result_row(r)
 
 
 def result_row(r: dict) -> np.ndarray:

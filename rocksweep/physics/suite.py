@@ -6,7 +6,8 @@ list is ``RECORD_IMS``: PGA [g], PGV [m/s], Sa(T) [g] at 5% damping, Arias inten
 CAV [m/s], D5-95 [s], PGV/PGA [s], AvgSa [g]) and the scaling rule ``ground.scale``:
 
 - stripes, ``{im: IM, values: [x_1, ...]}``: at stripe j every record is multiplied by the
-  factor that makes its IM equal x_j: PGA, PGV, Sa (at ``scale.period``) directly;
+  factor that makes its IM equal x_j: PGA, PGV, Sa (at ``scale.period``), AvgSa (over
+  ``avgsa_range``) and CAV by x_j / IM, Arias (F^2 times the record's) by sqrt(x_j / IM);
   PGA_ratio = PGA / (g tan alpha_ref) (the A_ratio of a single-record scene) and
   PGV_ratio = PGV p / (g tan alpha_ref) (Dimitrakopoulos & Paraskeva 2015), whose factor
   also depends on the body's slenderness alpha_ref (alpha_cg, or alpha for a block) and,
@@ -37,7 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rocksweep.errors import SuiteError  # noqa: F401 (defined there; re-exported)
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 from rocksweep.physics.records import GroundRecord
 from rocksweep.vocab.ground import (  # noqa: F401
     ARIAS,
@@ -158,6 +159,9 @@ class Suite:
             return self.pgv
         if self.im == "Sa":
             return self.scale_sa
+        own = {AVGSA: self.avgsa, CAV: self.cav, ARIAS: self.arias}
+        if self.im in own:
+            return own[self.im]
         raise ValueError("a cloud has no stripe IM")
 
     def factors(self, r: np.ndarray, s: np.ndarray | None, alpha_ref: np.ndarray,
@@ -175,7 +179,10 @@ class Suite:
             return x * np.tan(alpha_ref) / own
         if self.im == "PGV_ratio":
             return x * G * np.tan(alpha_ref) / (np.asarray(p, np.float64) * own)
-        return np.broadcast_to(x / own, np.broadcast_shapes(
+        # the IM of the record times F is F^n times its IM (``RECORD_IMS``; Arias: n = 2)
+        n = RECORD_IMS[self.im][2] if self.im in RECORD_IMS else 1
+        ratio = x / own if n == 1 else (x / own) ** (1.0 / n)
+        return np.broadcast_to(ratio, np.broadcast_shapes(
             r.shape, np.shape(alpha_ref), np.shape(p))).copy()
 
     def peak_ratio(self, r: np.ndarray, s: np.ndarray | None, alpha_ref: np.ndarray,

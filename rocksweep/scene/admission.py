@@ -3,7 +3,7 @@
 Every point's cap on RK4 evaluations (the kernel's PAR_MAXSTEPS, ``points.run_cost``,
 ``points.record_cost``) must be at most ``numerics.MAX_POINT_STEPS``, at the sweep's and
 at the single runs' accuracy; the bodies checked stand for the grid's
-(``_candidate_bodies``), and a refused scene's message names the value that makes a point
+(``candidate_bodies``), and a refused scene's message names the value that makes a point
 costly and the bound it must keep (``_cost_message``).
 """
 
@@ -18,11 +18,10 @@ import numpy as np
 from rocksweep.numerics import (
     EVENT_STEP_ALLOWANCE,
     MAX_POINT_STEPS,
-    PRESETS,
     Numerics,
     point_seconds,
 )
-from rocksweep.physics.model import BodyError
+from rocksweep.physics.bodies import BodyError
 from rocksweep.physics.points import (
     body_omega_rock,
     body_zeta_rock,
@@ -33,7 +32,7 @@ from rocksweep.scene.model import Scene, SceneError
 from rocksweep.schema import KEYS, fmt
 
 # Body grids up to this many distinct bodies are checked body by body; larger ones at the
-# combinations of each key's extreme values (``_candidate_bodies``).
+# combinations of each key's extreme values (``candidate_bodies``).
 MAX_BODIES_CHECKED = 1024
 # Typical values (Table 3; the `default` numerics) that the cost check puts in place of a
 # value, one at a time, to find which value makes a point too costly.
@@ -41,11 +40,11 @@ _TAME = {"body.wn_over_p": 2.43, "body.zeta": 0.05, "body.alpha_cg": 0.15,
          "body.alpha_A": 0.28, "body.mA_over_m": 0.47, "body.IA_ratio": 0.56,
          "body.alpha": 0.2618, "body.inertia": 4.0 / 3.0,
          "pulse.w_over_p": 1.0, "pulse.A_ratio": 1.0,
-         "numerics.steps_per_period": PRESETS["default"][0], "numerics.horizon": 200.0,
-         "numerics.max_events": Numerics().max_events}
+         **{f"numerics.{k}": getattr(Numerics(), k)
+            for k in ("steps_per_period", "horizon", "max_events")}}
 
 
-def _candidate_bodies(scene: Scene) -> list[dict[str, float]]:
+def candidate_bodies(scene: Scene) -> list[dict[str, float]]:
     """Body values (by key name) that stand for the grid's bodies; each is built, so a body
     that is not physical raises its ``BodyError`` (as a SceneError).
 
@@ -177,7 +176,7 @@ def _runs(scene: Scene) -> tuple[tuple[Numerics, str], ...]:
     return tuple(runs)
 
 
-def _check_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
+def check_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
     """Refuse a scene with a point whose step cap exceeds MAX_POINT_STEPS.
 
     The cap grows with the run's length t_pulse + horizon and with 1/step; over the pulse

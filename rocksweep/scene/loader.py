@@ -1,7 +1,7 @@
 """The scene's YAML loader (``SceneLoader``): PyYAML's safe loader with YAML 1.2 numbers
 (``1e-6`` is a number), a key given twice in a mapping refused, nesting limited to
 MAX_DEPTH levels, the expansion of aliases bounded (MAX_EXPANDED, an alias bomb is refused
-before it is built) and control characters refused. Problems raise ``_YamlError``."""
+before it is built) and control characters refused. Problems raise ``YamlError``."""
 
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ MAX_DEPTH = 20
 MAX_EXPANDED = 4_000_000
 
 
-class _YamlError(Exception):
+class YamlError(Exception):
     """A YAML text the scene refuses; ``str()`` says where (1-based line) and why."""
 
 
@@ -57,7 +57,7 @@ class SceneLoader(yaml.SafeLoader):
             if key in sizes:
                 return sizes[key]
             if key in active:
-                raise _YamlError(f"error at line {node.start_mark.line + 1}: an alias "
+                raise YamlError(f"error at line {node.start_mark.line + 1}: an alias "
                                  "refers to a node that contains it (a recursive structure)")
             active.add(key)
             if isinstance(node, yaml.ScalarNode):
@@ -68,7 +68,7 @@ class SceneLoader(yaml.SafeLoader):
                 n = 1 + sum(size(k) + size(v) for k, v in node.value)
             active.discard(key)
             if n > self._limit:
-                raise _YamlError(f"expands to more than {self._limit:,} characters (aliases "
+                raise YamlError(f"expands to more than {self._limit:,} characters (aliases "
                                  "repeated at every use, e.g. an alias bomb); write the "
                                  "values out or use fewer aliases")
             sizes[key] = n
@@ -81,7 +81,7 @@ class SceneLoader(yaml.SafeLoader):
         try:
             if self._depth > MAX_DEPTH:
                 mark = self.peek_event().start_mark
-                raise _YamlError(f"error at line {mark.line + 1}: nested more than "
+                raise YamlError(f"error at line {mark.line + 1}: nested more than "
                                  f"{MAX_DEPTH} levels deep")
             return super().compose_node(parent, index)
         finally:
@@ -99,7 +99,7 @@ class SceneLoader(yaml.SafeLoader):
             except TypeError:  # an unhashable key: PyYAML reports it below
                 continue
             if dup:
-                raise _YamlError(f"error at line {key_node.start_mark.line + 1}: key "
+                raise YamlError(f"error at line {key_node.start_mark.line + 1}: key "
                                  f"{fmt(key)} given twice in one mapping")
         return super().construct_mapping(node, deep=deep)
 
@@ -112,7 +112,7 @@ SceneLoader.add_implicit_resolver(
 
 _NOT_YAML = re.compile(  # PyYAML's reader refuses these (yaml.reader.Reader.NON_PRINTABLE)
     r"[^\x09\x0a\x0d\x20-\x7e\x85\xa0-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
-_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f]")  # C0 controls but tab and newline
+CONTROL_CHARS = re.compile(r"[\x00-\x08\x0b-\x1f\x7f]")  # C0 controls but tab and newline
 
 
 def _control_character(text: str) -> str | None:
@@ -126,11 +126,11 @@ def _control_character(text: str) -> str | None:
     return f"character {ord(m.group()):#04x} at line {line}, column {column}"
 
 
-def _load_yaml(text: str) -> Any:
-    """Parse YAML text with ``SceneLoader``; problems raise ``_YamlError``."""
+def load_yaml(text: str) -> Any:
+    """Parse YAML text with ``SceneLoader``; problems raise ``YamlError``."""
     bad = _control_character(text)
     if bad is not None:
-        raise _YamlError(f"error: {bad} is a control character (NUL, BEL, ESC...); a "
+        raise YamlError(f"error: {bad} is a control character (NUL, BEL, ESC...); a "
                          "scene is plain text")
     loader = SceneLoader(text)
     try:
@@ -139,8 +139,8 @@ def _load_yaml(text: str) -> Any:
         mark = getattr(err, "problem_mark", None)
         problem = getattr(err, "problem", None) or "invalid YAML"
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        raise _YamlError(f"syntax error{where}: {problem}") from None
+        raise YamlError(f"syntax error{where}: {problem}") from None
     except RecursionError:
-        raise _YamlError("error: nested too deeply") from None
+        raise YamlError("error: nested too deeply") from None
     finally:
         loader.dispose()

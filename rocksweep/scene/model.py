@@ -12,7 +12,7 @@ import numpy as np
 from rocksweep import fields
 from rocksweep.errors import SceneError, set_key  # noqa: F401 (SceneError: re-exported)
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import BlockBody, Body, FlexibleBody
+from rocksweep.physics.bodies import BlockBody, Body, FlexibleBody
 from rocksweep.physics.points import FREE, INITIAL, RECORD, Point
 from rocksweep.physics.records import GroundRecord
 from rocksweep.physics.suite import Suite
@@ -57,7 +57,7 @@ class Scene:
     # listings (paths as read); an output is never one of them (``outputs.check_output``)
     inputs: tuple[str, ...] = field(default=(), repr=False)
     # a body given by the laboratory's numbers (body.kind physical): its Pi groups, p
-    # [rad/s], omega_n [rad/s] and h_cg [m] (``physics.model.body_from_geometry``), else None
+    # [rad/s], omega_n [rad/s] and h_cg [m] (``physics.bodies.body_from_geometry``), else None
     physical: dict | None = field(default=None, repr=False)
 
     def physical_words(self) -> str:

@@ -27,21 +27,23 @@ from typing import Any
 import numpy as np
 
 from rocksweep.errors import set_key
+from rocksweep.inputs import decode_text, read_input
 from rocksweep.numerics import Numerics
 from rocksweep.outputs import input_problem, is_input, shown
-from rocksweep.physics.model import BodyError, body_from_geometry
+from rocksweep.physics.bodies import BodyError, body_from_geometry
 from rocksweep.physics.points import FREE, INITIAL, RECORD
 from rocksweep.physics.records import GroundRecord, RecordError, read_record
 from rocksweep.physics.suite import (
     AVGSA_RANGE,
     DEFAULT_PERIODS,
+    RECORD_IMS,
     SCALE_IMS,
     Suite,
     SuiteError,
     make_suite,
 )
-from rocksweep.scene.admission import _candidate_bodies, _check_cost
-from rocksweep.scene.loader import _CONTROL, _load_yaml, _YamlError
+from rocksweep.scene.admission import candidate_bodies, check_cost
+from rocksweep.scene.loader import CONTROL_CHARS, YamlError, load_yaml
 from rocksweep.scene.model import Axis, Scene, SceneError
 from rocksweep.schema import (
     BODY_KEYS,
@@ -57,6 +59,7 @@ from rocksweep.vocab.axes import DIAGRAM_AXES, alpha_symbol
 from rocksweep.vocab.ground import MP
 from rocksweep.vocab.ground import PULSE_KEY_SHAPES as _PULSE_KEY_SHAPES
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
+from rocksweep.vocab.settings import DEFAULT_PRESET, FINE
 
 # Largest grid a scene may describe [points]. A sweep file stores 45 bytes a point (69
 # with energy metrics, ``rocksweep.fields.variables``): 2e8 points are a 9-14 GB file, one
@@ -85,8 +88,8 @@ def apply_overrides(raw: dict, overrides: list[str]) -> dict:
             raise SceneError("{entry}: expected KEY=VALUE, e.g. pulse.A_ratio=4.5",
                              entry=set_key(item, "set_entry"))
         try:
-            value = _load_yaml(text)
-        except _YamlError as err:
+            value = load_yaml(text)
+        except YamlError as err:
             raise SceneError("{key}: value {text} is not valid YAML ({why})",
                              key=set_key(key), text=fmt(text), why=err) from None
         node = raw
@@ -144,6 +147,9 @@ def _section(raw: dict, name: str, kind: str, required: bool) -> dict:
         if not (isinstance(kind, str) and kind in BODY_KEYS):
             raise SceneError(f"body.kind = {fmt(kind)}: {KEYS['body.kind'].allowed}")
     allowed = section_keys(name, kind)
+    if sec is None and name in raw:  # ``pulse:`` or ``pulse: null`` is no absent section
+        raise SceneError(f"{name} = null: must be a mapping with keys {', '.join(allowed)}, "
+                         "or leave the section out")
     if sec is None:
         if required:
             needed = ", ".join(k for k in allowed if KEYS[f"{name}.{k}"].required)
@@ -160,6 +166,10 @@ def _section(raw: dict, name: str, kind: str, required: bool) -> dict:
         if k not in allowed:
             what = f" for a {kind} body" if name == "body" else ""
             raise SceneError(f"{name}.{k}: unknown key{what} (allowed: {', '.join(allowed)})")
+    for k, v in sec.items():  # a number left empty is not its default
+        if v is None and KEYS[f"{name}.{k}"].kind == "axis":
+            raise SceneError(f"{name}.{k} = null: {KEYS[f'{name}.{k}'].allowed}, or leave "
+                             "the key out")
     for k in allowed:
         spec = KEYS[f"{name}.{k}"]
         if spec.required and sec.get(k) is None:
@@ -337,8 +347,8 @@ def _numerics(sec: dict, contact: bool = False) -> tuple[Numerics, Numerics]:
             v = float(v) if spec.kind == "number" else v
         given[k] = v
     accuracy = given.pop("accuracy", None)
-    numerics = Numerics.preset(accuracy or ("fine" if contact else "default"), **given)
-    # One default (issue 28): a single run (simulate) runs what a sweep of the same point
+    numerics = Numerics.preset(accuracy or (FINE if contact else DEFAULT_PRESET), **given)
+    # One default: a single run (simulate) runs what a sweep of the same point
     # runs, so one point has one answer; the certification of close calls
     # (``compute.certify``) makes the default trustworthy for both.
     single = numerics
@@ -398,6 +408,7 @@ def _where(v: str, base: Path | None) -> Path:
 # Most records a suite may hold (a scene's axis holds at most MAX_AXIS_VALUES values;
 # FEMA P695's sets are 44 and 28 records).
 MAX_RECORDS = 10_000
+MAX_LISTING_BYTES = 16 << 20  # [bytes] a listing of MAX_RECORDS paths is far less
 _LIST_SUFFIXES = (".txt", ".list", ".lst")
 
 
@@ -436,30 +447,12 @@ def _listing(path: Path, shown_as: str) -> list[tuple[int, str]]:
     """(line number, entry) of a listing: UTF-8 text (a byte-order mark, as Notepad
     saves it, is skipped), one path a line, blank lines and # comments skipped."""
     key = "ground.records"
-    try:
-        data = path.read_bytes()
-    except OSError as err:
-        raise SceneError(f"{key}: {shown_as}: cannot be read ({err.strerror})") from None
-    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
-        raise SceneError(f"{key}: {shown_as}: a listing saved as UTF-16; save it as UTF-8 "
-                         "text (one record path a line)")
-    if b"\0" in data:
-        line = data.count(b"\n", 0, data.index(b"\0")) + 1
-        raise SceneError(f"{key}: {shown_as}, line {line}: a NUL byte (UTF-16 without a "
-                         "byte-order mark, or a binary file?); a listing is UTF-8 text, one "
-                         "record path a line")
-    try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError as err:
-        raise SceneError(f"{key}: {shown_as}: not a text listing of record paths (byte "
-                         f"{err.start} is not UTF-8); a listing is UTF-8 text, one record "
-                         "path a line") from None
-    bad = _CONTROL.search(text.replace("\r", ""))
-    if bad is not None:
-        line = text.count("\n", 0, bad.start()) + 1
-        raise SceneError(f"{key}: {shown_as}, line {line}: character {ord(bad.group()):#04x} "
-                         "is a control character (NUL, BEL, ESC...); a listing is plain "
-                         "text, one record path a line")
+    try:  # the one guard of input files: regular, bounded, UTF-8 text
+        text = decode_text(read_input(path, "listing", SceneError,
+                                      max_bytes=MAX_LISTING_BYTES),
+                           shown_as, SceneError, "listing of record paths (one a line)")
+    except SceneError as err:
+        raise SceneError(f"{key}: {err}") from None
     return [(i + 1, ln.strip()) for i, ln in enumerate(text.splitlines())
             if ln.strip() and not ln.strip().startswith("#")]
 
@@ -577,6 +570,9 @@ def _scale(ground: dict) -> tuple[str | None, str, Any, float, float]:
             raise SceneError(f"{key}.{k}: unknown key (allowed: im, values, period; or "
                              "factor alone)")
     im = v.get("im")
+    if isinstance(im, str) and RECORD_IMS.get(im, ("", "", 1))[2] == 0:
+        raise SceneError(f"{key}.im = {im}: does not change when a record is scaled, so no "
+                         f"factor can reach a stripe of it; {KEYS[key + '.im'].allowed}")
     if not isinstance(im, str) or im not in SCALE_IMS:
         raise SceneError(f"{key}.im = {fmt(im)}: {KEYS[key + '.im'].allowed}")
     if v.get("values") is None:
@@ -720,8 +716,8 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
 def _document(text: str, overrides: list[str]) -> dict:
     """The scene's YAML mapping, overrides applied, its top-level keys checked."""
     try:
-        raw = _load_yaml(text)
-    except _YamlError as err:
+        raw = load_yaml(text)
+    except YamlError as err:
         raise SceneError(f"YAML {err}") from None
     if raw is None:
         raw = {}
@@ -740,7 +736,7 @@ def _name(raw: dict) -> str | None:
     name = raw.get("name")
     if name is not None and not isinstance(name, str):
         raise SceneError(f"name = {fmt(name)}: {KEYS['name'].allowed}")
-    if name is not None and _CONTROL.search(name):
+    if name is not None and CONTROL_CHARS.search(name):
         raise SceneError(f"name = {fmt(name)}: must not hold control characters (NUL, BEL, "
                          "ESC...): it is stored in the result file and printed")
     return name
@@ -767,6 +763,9 @@ def _motion(raw: dict, kind: str, base: Path | None, given_record: GroundRecord 
             given_records: tuple[GroundRecord, ...] | None) -> _Motion:
     """The ground motion: none (free vibration), a ``pulse``, or a ``ground`` section
     (one record scaled by A_ratio, or a suite of records)."""
+    for name in ("pulse", "ground"):
+        if name in raw and raw[name] is None:  # refused as every null section
+            _section(raw, name, kind, required=False)
     if raw.get("ground") is None and raw.get("pulse") is None:
         return _Motion(free=True, pulse={"shape": FREE, "w_over_p": 0.0, "A_ratio": 0.0})
     if raw.get("ground") is None:
@@ -910,9 +909,9 @@ def _admit(scene: Scene) -> None:
         what = "a recorded ground motion" if scene.recorded else "ricker and mp pulses"
         raise SceneError(f"outputs.contact = true: not available with {what} yet; contact "
                          "outputs work with sine and cosine pulses")
-    bodies = _candidate_bodies(scene)
+    bodies = candidate_bodies(scene)
     _check_initial(scene, bodies)
-    _check_cost(scene, bodies)
+    check_cost(scene, bodies)
     if scene.suite is not None:
         scene.suite.warn(scene.axis(alpha_symbol(scene.kind)).values,
                          scene.axis("p").values)

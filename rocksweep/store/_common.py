@@ -1,5 +1,5 @@
 """What the store's modules share: the one error (``StoreError``), what h5py raises
-(``_H5_ERRORS``), one-line reasons (``_why``) and small helpers for attribute values,
+(``H5_ERRORS``), one-line reasons (``error_reason``) and small helpers for attribute values,
 sizes and times."""
 
 from __future__ import annotations
@@ -13,18 +13,18 @@ from pathlib import Path
 import numpy as np
 
 from rocksweep.errors import StoreError  # noqa: F401 (defined there; re-exported)
-from rocksweep.outputs import _reason, shown
+from rocksweep.outputs import os_reason, shown
 
 # What h5py raises for I/O and damaged files (HDF5 errors surface as any of these).
-_H5_ERRORS = (OSError, RuntimeError, ValueError, KeyError, TypeError, IndexError)
+H5_ERRORS = (OSError, RuntimeError, ValueError, KeyError, TypeError, IndexError)
 
 
 
-def _now() -> str:
+def utc_now() -> str:
     return datetime.now(timezone.utc).isoformat(timespec="seconds")
 
 
-def _why(err: BaseException) -> str:
+def error_reason(err: BaseException) -> str:
     """One short phrase for an OS or HDF5 error (from its errno where it has one)."""
     if isinstance(err, KeyError) and err.args:
         err = RuntimeError(str(err.args[0]))  # KeyError's str() adds quotes
@@ -33,7 +33,7 @@ def _why(err: BaseException) -> str:
         m = re.search(r"errno = (\d+)", str(err))
         no = int(m.group(1)) if m else None
     if no:
-        return _reason(OSError(no, os.strerror(no)))
+        return os_reason(OSError(no, os.strerror(no)))
     text = str(err).strip().splitlines()
     if not text:
         return type(err).__name__
@@ -42,26 +42,26 @@ def _why(err: BaseException) -> str:
     return (m.group(1) if m else text[0])[:160]
 
 
-def _mib(n: float) -> str:
+def mib(n: float) -> str:
     return f"{n / 2**20:.1f} MiB"
 
 
-def _cut(v, n: int = 40) -> str:
+def cut_repr(v, n: int = 40) -> str:
     text = repr(v)
     return text if len(text) <= n else text[: n - 3] + "..."
 
 
-def _damaged(path: Path, what: str) -> StoreError:
+def damaged(path: Path, what: str) -> StoreError:
     return StoreError(f"{shown(path)}: damaged rocksweep result ({what})")
 
 
-def _close_quietly(f) -> None:
+def close_quietly(f) -> None:
     """Close after an error: a second error must not hide the first."""
     with contextlib.suppress(Exception):
         f.close()
 
 
-def _fixed(text: str, dtype: str) -> np.ndarray:
+def fixed_ascii(text: str, dtype: str) -> np.ndarray:
     """``text`` as a fixed-length ASCII string of ``dtype`` (cut to fit)."""
     n = np.dtype(dtype).itemsize
     return np.array(text.encode("ascii", "replace")[:n], dtype=dtype)

@@ -35,9 +35,9 @@ def result_dataset(source: Path | Any) -> xr.Dataset:
             with xr.open_dataset(source, engine="h5netcdf", **kwds) as ds:
                 ds = ds.load()
         except OSError as err:  # open here through another handle: take its lock flags
-            from rocksweep.store.reader import READER_LOCKING, _open_here
+            from rocksweep.store.reader import READER_LOCKING, opened_here
 
-            if not (kwds and _open_here(err)):
+            if not (kwds and opened_here(err)):
                 raise
             for locking in READER_LOCKING:
                 try:

@@ -1,5 +1,5 @@
 """The sweep result format (HDF5 through h5py): its constants and metadata, and the
-making of a new file's contents (``_initialise``).
+making of a new file's contents: ``metadata``, built once, written by ``initialise``.
 
 Layout (netCDF-4 / CF-1.10, so ``xarray.open_dataset(path, engine="h5netcdf")`` and
 netCDF-4 readers open it):
@@ -43,16 +43,16 @@ from __future__ import annotations
 import json
 import math
 import platform
-from typing import TYPE_CHECKING
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from rocksweep import fields
-from rocksweep.compute.grid import Grid
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
 from rocksweep.scene.model import Scene
-from rocksweep.store._common import _fixed, _now
+from rocksweep.store._common import fixed_ascii, utc_now
 from rocksweep.store.identity import record_attrs, resolved_scene
 from rocksweep.vocab.axes import alpha_symbol
 from rocksweep.vocab.outcomes import COMPUTED_FLAGS, COMPUTED_MEANING
@@ -164,7 +164,6 @@ def file_bytes(scene: Scene, adaptive: bool = False) -> int:
     """Bytes the datasets of a result file of ``scene`` take (all allocated when the
     file is made): every variable's dtype size x grid points, plus the coordinates;
     adaptive: with the ``computed`` flags."""
-    grid = Grid(scene)
     per_point = sum(np.dtype(dt).itemsize for dt, _, _ in scene.variables().values())
     per_point += adaptive
     coords = sum(16 * len(a.values) for a in scene.axes)
@@ -172,15 +171,34 @@ def file_bytes(scene: Scene, adaptive: bool = False) -> int:
     if su is not None:  # the per-record variables (sha256: 64 characters) and factors
         R = len(su.records)
         coords += R * (8 * (5 + len(su.periods)) + 96) + 8 * R * max(1, len(su.levels))
-    return per_point * grid.size + coords
+    return per_point * scene.size + coords
 
 
-def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
-                adaptive: dict | None = None) -> None:
+@dataclass(frozen=True)
+class Metadata:
+    """A new result file's contents but its points, built once (``metadata``) and written
+    by ``initialise``, which computes nothing: attrs, the global attributes in order;
+    coords, the swept axes (dimension scales, in the grid's order) and scalars, the
+    unswept ones (0-d coordinates): name -> (values, attributes); variables: name ->
+    (dtype, fill value, attributes), every per-point variable; nbytes: what its datasets
+    take (``file_bytes``); scene: whose record or suite's files the file keeps."""
+
+    scene: Scene
+    attrs: dict[str, Any]
+    coords: dict[str, tuple[Any, dict[str, Any]]]
+    scalars: dict[str, tuple[Any, dict[str, Any]]]
+    variables: dict[str, tuple[str, Any, dict[str, Any]]]
+    nbytes: int
+
+
+def metadata(scene: Scene, overrides: tuple[str, ...] = (),
+             adaptive: dict | None = None) -> Metadata:
+    """The ``Metadata`` of a new result file of ``scene`` (made with ``overrides``; adaptive:
+    the resolved settings of an adaptive sweep, ``adaptive.Options.resolved``)."""
     import h5py
-    grid = Grid(scene)
+
     vers = versions()
-    a = f.attrs
+    a: dict[str, Any] = {}
     a["Conventions"] = CONVENTIONS
     a["title"] = scene.name
     a["source"] = f"rocksweep {vers['rocksweep']} (rocksweep sweep)"
@@ -204,20 +222,18 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
     if scene.record is not None:  # the record: name, SHA-256, NPTS, DT [s], PGA [g]
         for k, v in record_attrs(scene.record).items():
             a[f"record_{k}"] = v
-        _store_record(f, scene.record)
     if scene.suite is not None:  # the stripes' IM ("none": a cloud) and Sa's period [s]
         a["scale_im"] = scene.suite.im or "none"
         a["scale_period"] = float(scene.suite.period)
-        _store_suite_records(f, scene.suite)
     for k, v in vers.items():
         a[f"{k}_version"] = v
-    a["started"] = _now()
-    a["points_total"] = np.int64(grid.size)
+    a["started"] = utc_now()
+    a["points_total"] = np.int64(scene.size)
     # fixed-size attributes, updated in place by every session
     zeros = {"S": "", "i": 0, "f": 0.0}
     for name, dtype in SESSION_ATTRS.items():
         kind = np.dtype(dtype).kind
-        a.create(name, _fixed("", dtype) if kind == "S" else np.array(zeros[kind], dtype))
+        a[name] = fixed_ascii("", dtype) if kind == "S" else np.array(zeros[kind], dtype)
     if adaptive is not None:
         a["adaptive"] = np.int8(1)
         a["adaptive_axes"] = " ".join(adaptive["axes"])
@@ -226,60 +242,86 @@ def _initialise(f: h5py.File, scene: Scene, overrides: tuple[str, ...],
         for k in ("audit", "threshold"):
             a[f"adaptive_{k}"] = np.float64(adaptive[k])
         for name, dtype in ADAPTIVE_COUNT_ATTRS.items():
-            a.create(name, np.array(0, dtype))
-        a["comment"] = (str(a["comment"]) + " Adaptive sweep: computed flags each point "
+            a[name] = np.array(0, dtype)
+        a["comment"] = (a.pop("comment") + " Adaptive sweep: computed flags each point "
                         "(0 filled: outcome from the uniform cell around it, the other "
                         "variables at their fill values; 1 computed; 2/3 audit points that "
                         "agreed/disagreed with their fill).")
 
-    scales = []
-    for axis in scene.swept:
-        data = (np.array(axis.values, dtype=h5py.string_dtype())
-                if axis.name in fields.WORD_AXES else np.asarray(axis.values, float))
-        ds = f.create_dataset(axis.name, data=data)
-        ds.make_scale(axis.name)
-        _coord_attrs(ds, axis, scene.kind)
-        scales.append(ds)
-    scalars = []
-    for axis in scene.axes:
-        if axis.swept:
-            continue
-        v = axis.values[0]
-        ds = f.create_dataset(axis.name, data=(np.array(v, dtype=h5py.string_dtype())
-                                               if axis.name in fields.WORD_AXES
-                                               else float(v)))
-        _coord_attrs(ds, axis, scene.kind)
-        scalars.append(axis.name)
-
+    words = h5py.string_dtype()
+    coords = {axis.name: (np.array(axis.values, dtype=words) if axis.name in fields.WORD_AXES
+                          else np.asarray(axis.values, float),
+                          coord_attrs(axis, scene.kind))
+              for axis in scene.swept}
+    scalars = {axis.name: (np.array(axis.values[0], dtype=words)
+                           if axis.name in fields.WORD_AXES else float(axis.values[0]),
+                           coord_attrs(axis, scene.kind))
+               for axis in scene.axes if not axis.swept}
     specs = dict(scene.variables())
     if adaptive is not None:
         specs["computed"] = COMPUTED_VARIABLE
-    for name, (dtype, fill, text) in specs.items():
+    variables = {name: (dtype, fill, variable_attrs(name, text, scene.kind, tuple(scalars)))
+                 for name, (dtype, fill, text) in specs.items()}
+    return Metadata(scene, a, coords, scalars, variables,
+                    file_bytes(scene, adaptive is not None))
+
+
+def variable_attrs(name: str, text: str, kind: str, scalars: tuple[str, ...]
+                   ) -> dict[str, Any]:
+    """The attributes of the per-point variable ``name`` (text: its description, for one
+    that is not a result field) in a file of a ``kind`` body whose unswept axes are
+    ``scalars``: CF units and flags, long_name, rocksweep_units, coordinates."""
+    out: dict[str, Any] = {}
+    f_ = fields.BY_NAME.get(name)
+    meta = (fields.field_attrs(f_, kind) if f_ is not None
+            else {"long_name": "computed flag", "description": text})
+    if name in FLAG_VARIABLES:
+        meta.pop("rocksweep_units", None)
+    else:
+        out["units"] = "1"
+    out.update(meta)
+    if name == "outcome":  # CF-style flag attributes, for xarray users
+        out["flag_values"] = np.array(list(OUTCOME_WORDS), np.int8)
+        out["flag_meanings"] = " ".join(OUTCOME_WORDS.values())
+    elif name == "computed":
+        out["flag_values"] = np.array(list(COMPUTED_FLAGS), np.int8)
+        out["flag_meanings"] = " ".join(COMPUTED_FLAGS.values())
+    elif name == "status":
+        out["flag_masks"] = np.array(list(STATUS_WORDS), np.int32)
+        out["flag_meanings"] = " ".join(STATUS_WORDS.values())
+        out["flagged_mask"] = np.int32(L.STATUS_FLAGGED)
+    if scalars:
+        out["coordinates"] = " ".join(scalars)
+    return out
+
+
+def initialise(f: h5py.File, meta: Metadata) -> None:
+    """Write ``meta`` into the new, empty file ``f``: the attributes, the record or suite
+    files kept, the coordinates, every variable allocated in full at its fill value (no
+    metadata changes later), and a suite's per-record variables."""
+    import h5py
+
+    for k, v in meta.attrs.items():
+        f.attrs[k] = v
+    scene = meta.scene
+    if scene.record is not None:
+        _store_record(f, scene.record)
+    if scene.suite is not None:
+        _store_suite_records(f, scene.suite)
+    scales = []
+    for name, (data, attrs) in meta.coords.items():
+        ds = f.create_dataset(name, data=data)
+        ds.make_scale(name)
+        ds.attrs.update(attrs)
+        scales.append(ds)
+    for name, (data, attrs) in meta.scalars.items():
+        f.create_dataset(name, data=data).attrs.update(attrs)
+    for name, (dtype, fill, attrs) in meta.variables.items():
         dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
         dcpl.set_alloc_time(h5py.h5d.ALLOC_TIME_EARLY)  # no metadata changes later
-        ds = f.create_dataset(name, shape=grid.shape, dtype=dtype, fillvalue=fill,
+        ds = f.create_dataset(name, shape=scene.shape, dtype=dtype, fillvalue=fill,
                               dcpl=dcpl, fill_time="alloc")
-        f_ = fields.BY_NAME.get(name)
-        meta = (fields.field_attrs(f_, scene.kind) if f_ is not None
-                else {"long_name": "computed flag", "description": text})
-        if name in FLAG_VARIABLES:
-            meta.pop("rocksweep_units", None)
-        else:
-            ds.attrs["units"] = "1"
-        for k, v in meta.items():
-            ds.attrs[k] = v
-        if name == "outcome":  # CF-style flag attributes, for xarray users
-            ds.attrs["flag_values"] = np.array(list(OUTCOME_WORDS), np.int8)
-            ds.attrs["flag_meanings"] = " ".join(OUTCOME_WORDS.values())
-        elif name == "computed":
-            ds.attrs["flag_values"] = np.array(list(COMPUTED_FLAGS), np.int8)
-            ds.attrs["flag_meanings"] = " ".join(COMPUTED_FLAGS.values())
-        elif name == "status":
-            ds.attrs["flag_masks"] = np.array(list(STATUS_WORDS), np.int32)
-            ds.attrs["flag_meanings"] = " ".join(STATUS_WORDS.values())
-            ds.attrs["flagged_mask"] = np.int32(L.STATUS_FLAGGED)
-        if scalars:
-            ds.attrs["coordinates"] = " ".join(scalars)
+        ds.attrs.update(attrs)
         for i, sc in enumerate(scales):
             ds.dims[i].attach_scale(sc)
     if scene.suite is not None:
@@ -361,10 +403,9 @@ def _write_suite(f: h5py.File, scene: Scene, scales: dict) -> None:
             ds.dims[i].attach_scale(scales[d])
 
 
-def _coord_attrs(ds, axis, kind: str = "flexible") -> None:
-    for k, v in fields.axis_attrs(axis.name, kind).items():
-        ds.attrs[k] = v
-    ds.attrs["scene_key"] = axis.key
+def coord_attrs(axis, kind: str = "flexible") -> dict[str, Any]:
+    """The attributes of an axis's coordinate in a file of a ``kind`` body."""
+    return {**fields.axis_attrs(axis.name, kind), "scene_key": axis.key}
 
 
 RECORD_GROUP = "record"  # a record sweep's copy of its record: file (bytes), acceleration

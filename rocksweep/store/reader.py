@@ -23,12 +23,12 @@ from rocksweep.outcomes import OUTCOME_WORDS
 from rocksweep.outputs import shown
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import (
-    _H5_ERRORS,
+    H5_ERRORS,
     StoreError,
-    _close_quietly,
-    _cut,
-    _damaged,
-    _why,
+    close_quietly,
+    cut_repr,
+    damaged,
+    error_reason,
 )
 from rocksweep.store.format import (
     COMPUTED_FLAGS,
@@ -40,13 +40,14 @@ from rocksweep.store.format import (
 )
 from rocksweep.store.identity import resolved_scene, scene_differences
 from rocksweep.vocab.outcomes import CLASSES, OUTCOME_CODE
+from rocksweep.vocab.settings import ADAPTIVE_RESOLVED
 
 if TYPE_CHECKING:
     import h5py
 
 
 @dataclass
-class _Layout:
+class FileLayout:
     """What a valid file holds: its resolved scene, swept dims and their sizes."""
 
     scene: dict
@@ -60,39 +61,37 @@ def _attr_str(f: h5py.File, key: str) -> str:
     if isinstance(v, bytes | np.bytes_):
         return bytes(v).decode("utf-8", "replace")
     if not isinstance(v, str):
-        raise TypeError(f"attribute {key} is {_cut(plain(v))}, not text")
+        raise TypeError(f"attribute {key} is {cut_repr(plain(v))}, not text")
     return v
 
 
 def _check_scene(stored, path: Path) -> None:
     """The resolved scene dict as ``resolved_scene`` makes it, or StoreError."""
     def bad(what: str) -> StoreError:
-        return _damaged(path, f"attribute scene_resolved: {what}")
+        return damaged(path, f"attribute scene_resolved: {what}")
 
     if not isinstance(stored, dict):
-        raise bad(f"{_cut(stored)} is not a JSON object")
+        raise bad(f"{cut_repr(stored)} is not a JSON object")
     for key, typ in (("name", str), ("kind", str), ("energy", bool), ("axes", dict),
                      ("numerics", dict)):
         if not isinstance(stored.get(key), typ):
-            raise bad(f"'{key}' is {_cut(stored.get(key))}, not a {typ.__name__}")
+            raise bad(f"'{key}' is {cut_repr(stored.get(key))}, not a {typ.__name__}")
     if not stored["axes"]:
         raise bad("no axes")
     for key, ax in stored["axes"].items():
         if not (isinstance(key, str) and "." in key and isinstance(ax, dict)
                 and isinstance(ax.get("swept"), bool) and isinstance(ax.get("values"), list)
                 and ax["values"]):
-            raise bad(f"axis {_cut(key)} is {_cut(ax)}")
+            raise bad(f"axis {cut_repr(key)} is {cut_repr(ax)}")
         words = key in fields.WORD_KEYS
         kinds = (str,) if words else (int, float)
         if not all(isinstance(v, kinds) and not isinstance(v, bool) for v in ax["values"]):
-            raise bad(f"axis {key} has values {_cut(ax['values'])}")
+            raise bad(f"axis {key} has values {cut_repr(ax['values'])}")
         if not ax["swept"] and len(ax["values"]) != 1:
             raise bad(f"unswept axis {key} has {len(ax['values'])} values")
     if "adaptive" in stored:
         a = stored["adaptive"]
-        from rocksweep.compute.adaptive import RESOLVED_KEYS
-
-        ok = (isinstance(a, dict) and set(a) == set(RESOLVED_KEYS)
+        ok = (isinstance(a, dict) and set(a) == set(ADAPTIVE_RESOLVED)
               and isinstance(a["axes"], list) and len(a["axes"]) == 2
               and all(isinstance(v, str) for v in a["axes"])
               and all(isinstance(a[k], int) and not isinstance(a[k], bool) and a[k] >= 0
@@ -100,22 +99,22 @@ def _check_scene(stored, path: Path) -> None:
               and all(isinstance(a[k], int | float) and not isinstance(a[k], bool)
                       and 0 <= a[k] <= 1 for k in ("audit", "threshold")))
         if not ok:
-            raise bad(f"'adaptive' is {_cut(a)}")
+            raise bad(f"'adaptive' is {cut_repr(a)}")
 
 
 def _json_attr(f: h5py.File, key: str, path: Path, typ: type):
     try:
         text = _attr_str(f, key)
     except KeyError:
-        raise _damaged(path, f"attribute {key} missing") from None
+        raise damaged(path, f"attribute {key} missing") from None
     except TypeError as err:
-        raise _damaged(path, str(err)) from None
+        raise damaged(path, str(err)) from None
     try:
         value = json.loads(text)
     except ValueError:
-        raise _damaged(path, f"attribute {key} is not JSON: {_cut(text)}") from None
+        raise damaged(path, f"attribute {key} is not JSON: {cut_repr(text)}") from None
     if not isinstance(value, typ):
-        raise _damaged(path, f"attribute {key} is {_cut(text)}, not a JSON "
+        raise damaged(path, f"attribute {key} is {cut_repr(text)}, not a JSON "
                        f"{'object' if typ is dict else 'list'}")
     return value
 
@@ -133,24 +132,24 @@ def _looks_like_ours(f: h5py.File, fmt) -> bool:
     try:
         a = f.attrs
         return "scene_resolved" in a or ("format_version" in a and "outcome" in f)
-    except _H5_ERRORS:
+    except H5_ERRORS:
         return False
 
 
-def _layout(f: h5py.File, path: Path) -> _Layout:
+def read_layout(f: h5py.File, path: Path) -> FileLayout:
     """Validate the format, the resolved scene, the coordinates and the variables."""
     import h5py
 
     try:  # h5py's attrs.get hides damage as "missing"
         fmt = f.attrs["rocksweep_format"] if "rocksweep_format" in f.attrs else None
-    except _H5_ERRORS as err:
+    except H5_ERRORS as err:
         raise StoreError(f"{shown(path)}: damaged HDF5 file, its attributes cannot be read "
-                         f"({_why(err)})") from None
+                         f"({error_reason(err)})") from None
     if isinstance(fmt, bytes | np.bytes_):
         fmt = bytes(fmt).decode("utf-8", "replace")
     try:
         resaved = NETCDF_MARK in f.attrs
-    except _H5_ERRORS:
+    except H5_ERRORS:
         resaved = False
     if resaved:  # the netCDF library's mark: rocksweep writes with h5py, never sets it
         raise StoreError(f"{shown(path)}: not written by rocksweep: a result saved again by "
@@ -159,21 +158,21 @@ def _layout(f: h5py.File, path: Path) -> _Layout:
                          "file; this one opens with xarray.open_dataset)")
     if fmt != FORMAT:
         if _looks_like_ours(f, fmt):  # a damaged result is not a foreign file
-            raise _damaged(path, "attribute rocksweep_format " + (
-                "missing" if fmt is None else f"is {_cut(plain(fmt))}"))
+            raise damaged(path, "attribute rocksweep_format " + (
+                "missing" if fmt is None else f"is {cut_repr(plain(fmt))}"))
         raise StoreError(f"{shown(path)}: an HDF5 file, but not a rocksweep sweep result "
                          "(no rocksweep_format attribute)")
     try:
         ver = int(f.attrs.get("format_version", -1))
     except (TypeError, ValueError):
-        raise _damaged(path, f"format_version = {_cut(plain(f.attrs['format_version']))}"
+        raise damaged(path, f"format_version = {cut_repr(plain(f.attrs['format_version']))}"
                        ) from None
     if ver > FORMAT_VERSION:
         raise StoreError(f"{shown(path)}: written in result format {ver} by a newer "
                          f"rocksweep; this version reads formats 1 to {FORMAT_VERSION}; "
                          "upgrade rocksweep")
     if ver < 1:
-        raise _damaged(path, f"format_version = {ver}")
+        raise damaged(path, f"format_version = {ver}")
     stored = _json_attr(f, "scene_resolved", path, object)
     _check_scene(stored, path)
     swept = {k.split(".", 1)[1]: v["values"] for k, v in stored["axes"].items() if v["swept"]}
@@ -182,9 +181,9 @@ def _layout(f: h5py.File, path: Path) -> _Layout:
     for d, values in swept.items():
         ds = f.get(d)
         if not isinstance(ds, h5py.Dataset):
-            raise _damaged(path, f"coordinate '{d}' missing")
+            raise damaged(path, f"coordinate '{d}' missing")
         if ds.shape != (len(values),):
-            raise _damaged(path, f"coordinate '{d}' has shape {ds.shape}, the scene "
+            raise damaged(path, f"coordinate '{d}' has shape {ds.shape}, the scene "
                            f"{len(values)} values")
         data = ds[()]
         if d in fields.WORD_AXES:
@@ -192,36 +191,31 @@ def _layout(f: h5py.File, path: Path) -> _Layout:
         else:
             ok = data.dtype.kind == "f" and np.array_equal(data, np.asarray(values, float))
         if not ok:
-            raise _damaged(path, f"coordinate '{d}' holds {_cut(data.tolist())}, the scene "
-                           f"{_cut(values)}")
+            raise damaged(path, f"coordinate '{d}' holds {cut_repr(data.tolist())}, the scene "
+                           f"{cut_repr(values)}")
     names = ["outcome", *(n for n in variables_for(stored) if n != "outcome")]
     specs = variables_for(stored)
     for name in names:
         ds = f.get(name)
         if not isinstance(ds, h5py.Dataset):
-            raise _damaged(path, f"variable '{name}' missing")
+            raise damaged(path, f"variable '{name}' missing")
         if ds.shape != shape:
-            raise _damaged(path, f"variable '{name}' has shape {ds.shape}, the grid {shape}")
+            raise damaged(path, f"variable '{name}' has shape {ds.shape}, the grid {shape}")
         if ds.dtype != np.dtype(specs[name][0]):
-            raise _damaged(path, f"variable '{name}' has dtype {ds.dtype}, expected "
+            raise damaged(path, f"variable '{name}' has dtype {ds.dtype}, expected "
                            f"{specs[name][0]}")
-    return _Layout(stored, dims, shape, names)
-
-
-def _check_format(f: h5py.File, path: Path) -> None:
-    """Raise StoreError unless ``f`` is a valid rocksweep result (see ``_layout``)."""
-    _layout(f, path)
+    return FileLayout(stored, dims, shape, names)
 
 
 def _is_hdf5(path: Path) -> bool:
     import h5py
     try:
         return bool(h5py.is_hdf5(path))
-    except _H5_ERRORS:
+    except H5_ERRORS:
         return False
 
 
-def _open(path: Path, mode: str) -> h5py.File:
+def open_h5(path: Path, mode: str) -> h5py.File:
     """Open an existing file; foreign, damaged, locked or unreadable files give a one-line
     StoreError. Writers (mode "r+") take HDF5's exclusive lock; readers take none."""
     import h5py
@@ -230,7 +224,7 @@ def _open(path: Path, mode: str) -> h5py.File:
     except FileNotFoundError:
         raise StoreError(f"{shown(path)}: no such file") from None
     except OSError as err:
-        raise StoreError(f"{shown(path)}: cannot be read ({_why(err)})") from None
+        raise StoreError(f"{shown(path)}: cannot be read ({error_reason(err)})") from None
     if os.path.isdir(path):
         raise StoreError(f"{shown(path)}: is a directory, not a sweep result")
     if not os.path.isfile(path):
@@ -242,12 +236,12 @@ def _open(path: Path, mode: str) -> h5py.File:
         # readers do not lock: `info` and `plot` work while a sweep writes (datasets are
         # allocated up front, so a running sweep changes raw data only)
         return h5py.File(path, mode, locking=(mode != "r"))
-    except _H5_ERRORS as err:
-        if mode == "r" and _open_here(err):
+    except H5_ERRORS as err:
+        if mode == "r" and opened_here(err):
             # open in this process through another handle (xarray's, h5py's): HDF5 wants
             # the same locking flags; a reader takes them
             for locking in READER_LOCKING:
-                with contextlib.suppress(*_H5_ERRORS):
+                with contextlib.suppress(*H5_ERRORS):
                     return h5py.File(path, mode, locking=locking)
         _open_error(path, mode, err)
 
@@ -266,7 +260,7 @@ def _open_error(path: Path, mode: str, err: BaseException) -> NoReturn:
     if isinstance(err, BlockingIOError) or "unable to lock" in text:
         raise StoreError(f"{shown(path)}: open for writing by another process (a sweep "
                          "still running?)") from None
-    if _open_here(err):
+    if opened_here(err):
         raise StoreError(f"{shown(path)}: already open in this process through another "
                          "HDF5 handle (HDF5's file lock: e.g. xr.open_dataset(..., "
                          "engine='h5netcdf') or h5py.File); the file is not damaged: "
@@ -274,17 +268,17 @@ def _open_error(path: Path, mode: str, err: BaseException) -> NoReturn:
                          "loads the file and closes it at once") from None
     if no in (errno.EACCES, errno.EPERM, errno.EROFS):
         doing = "written" if mode != "r" else "read"
-        raise StoreError(f"{shown(path)}: cannot be {doing} ({_why(err)})") from None
+        raise StoreError(f"{shown(path)}: cannot be {doing} ({error_reason(err)})") from None
     if not _is_hdf5(path):
         raise StoreError(f"{shown(path)}: not an HDF5 file (expected a rocksweep sweep "
                          "result)") from None
     raise StoreError(f"{shown(path)}: damaged or truncated HDF5 file, cannot be opened "
-                     f"({_why(err)}); its points cannot be read back: if it is a copy, "
+                     f"({error_reason(err)}); its points cannot be read back: if it is a copy, "
                      "copy it again from the original; else sweep again to a new file "
                      "(-o NEW.h5) and remove this one after") from None
 
 
-def _open_here(err: BaseException) -> bool:
+def opened_here(err: BaseException) -> bool:
     """Whether h5py's error says the file is open in this process through another handle
     with other settings (a lock, not damage)."""
     return any(w in str(err).lower() for w in _OPEN_HERE)
@@ -316,48 +310,48 @@ def _attr_ok(key: str, v) -> bool:
     return v in (0, 1)  # a flag: int8 (format 2) or bool (format 1)
 
 
-def _check_outcome(outcome: np.ndarray, path: Path) -> None:
+def check_outcome(outcome: np.ndarray, path: Path) -> None:
     codes = np.array([L.OUTCOME_NOT_RUN, *OUTCOME_WORDS], np.int8)
     bad = ~np.isin(outcome, codes)
     if bad.any():
-        raise _damaged(path, f"variable 'outcome' holds {int(bad.sum())} invalid codes, "
+        raise damaged(path, f"variable 'outcome' holds {int(bad.sum())} invalid codes, "
                        f"e.g. {int(outcome[bad][0])} (valid: -1, 0, 1, 2)")
 
 
-def _check_computed(computed: np.ndarray, outcome: np.ndarray | None, path: Path) -> None:
+def check_computed(computed: np.ndarray, outcome: np.ndarray | None, path: Path) -> None:
     """The ``computed`` flags of an adaptive file: codes 0..3, and no computed point
     without an outcome (outcome is written before the flag)."""
     bad = ~np.isin(computed, np.array(list(COMPUTED_FLAGS), np.int8))
     if bad.any():
-        raise _damaged(path, f"variable 'computed' holds {int(bad.sum())} invalid codes, "
+        raise damaged(path, f"variable 'computed' holds {int(bad.sum())} invalid codes, "
                        f"e.g. {int(computed[bad][0])} (valid: 0, 1, 2, 3)")
     if outcome is not None:
         lost = (computed > 0) & (outcome == L.OUTCOME_NOT_RUN)
         if lost.any():
-            raise _damaged(path, f"{int(lost.sum())} points flagged computed have no "
+            raise damaged(path, f"{int(lost.sum())} points flagged computed have no "
                            "outcome")
 
 
-def _checked_attrs(f: h5py.File, path: Path) -> dict:
+def checked_attrs(f: h5py.File, path: Path) -> dict:
     """The file's attributes as plain Python values, those readers use validated."""
     attrs = {}
     for k in f.attrs:
         try:
             attrs[k] = plain(f.attrs[k])
-        except _H5_ERRORS as err:
-            raise _damaged(path, f"attribute {k} unreadable: {_why(err)}") from None
+        except H5_ERRORS as err:
+            raise damaged(path, f"attribute {k} unreadable: {error_reason(err)}") from None
     _json_attr(f, "numerics", path, dict)
     overrides = _json_attr(f, "overrides", path, list)
     if not all(isinstance(o, str) for o in overrides):
-        raise _damaged(path, f"attribute overrides is {_cut(overrides)}, not a list of text")
+        raise damaged(path, f"attribute overrides is {cut_repr(overrides)}, not a list of text")
     for k in (*_TEXT_ATTRS, *_NUMBER_ATTRS, *_COUNT_ATTRS, *_FLAG_ATTRS):
         if k not in attrs:
-            raise _damaged(path, f"attribute {k} missing")
+            raise damaged(path, f"attribute {k} missing")
         if not _attr_ok(k, attrs[k]):
-            raise _damaged(path, f"attribute {k} is {_cut(attrs[k])}")
+            raise damaged(path, f"attribute {k} is {cut_repr(attrs[k])}")
     for k, v in attrs.items():  # the versions the writer records are text (info shows them)
         if k.endswith("_version") and k != "format_version" and not isinstance(v, str):
-            raise _damaged(path, f"attribute {k} is {_cut(v)}, not a version text "
+            raise damaged(path, f"attribute {k} is {cut_repr(v)}, not a version text "
                                  "(not as rocksweep writes it)")
     return attrs
 
@@ -439,15 +433,15 @@ class SweepResult:
 def _reading(path: Path):
     """The result file open for reading; h5py's errors inside become one-line StoreErrors
     (damaged file), the library's pass as they are; closed whatever happens."""
-    f = _open(path, "r")
+    f = open_h5(path, "r")
     try:
         yield f
     except RocksweepError:
         raise
-    except _H5_ERRORS as err:
-        raise _damaged(path, _why(err)) from None
+    except H5_ERRORS as err:
+        raise damaged(path, error_reason(err)) from None
     finally:
-        _close_quietly(f)
+        close_quietly(f)
 
 
 def read_result(path: str | Path, names: list[str] | None = None,
@@ -461,7 +455,7 @@ def read_result(path: str | Path, names: list[str] | None = None,
     """
     path = Path(path)
     with _reading(path) as f:
-        lay = _layout(f, path)
+        lay = read_layout(f, path)
         stored = lay.scene
         known = variables_for(stored)
         wanted = list(names) if names else list(known)
@@ -482,10 +476,10 @@ def read_result(path: str | Path, names: list[str] | None = None,
                 scalars[name] = ax["values"][0]
         arrays = {n: f[n][()] for n in wanted}
         if "outcome" in arrays:
-            _check_outcome(arrays["outcome"], path)
+            check_outcome(arrays["outcome"], path)
         if "computed" in arrays:
-            _check_computed(arrays["computed"], arrays.get("outcome"), path)
-        attrs = _checked_attrs(f, path)
+            check_computed(arrays["computed"], arrays.get("outcome"), path)
+        attrs = checked_attrs(f, path)
     return SweepResult(path, lay.dims, lay.shape, coords, scalars, arrays, attrs, stored)
 
 
@@ -494,7 +488,7 @@ def stored_scene(path: str | Path) -> dict:
     ``read_result`` validates it, without reading any variable."""
     path = Path(path)
     with _reading(path) as f:
-        return _layout(f, path).scene
+        return read_layout(f, path).scene
 
 
 def result_inputs(path: str | Path) -> tuple[str, ...]:
@@ -568,17 +562,17 @@ def stored_record(path: Path, rec: dict):
     """The record a result file keeps (``_store_record``) as a ``GroundRecord`` with the
     sweep's source path, checked against the file's SHA-256; None for a file that keeps
     no copy (made before records were stored). StoreError if the copy is damaged."""
-    f = _open(path, "r")
+    f = open_h5(path, "r")
     try:
         g = f.get(RECORD_GROUP)
         d = g.get("file") if g is not None else None
         if d is None:
             return None
         data = bytes(np.asarray(d[()], dtype=np.uint8).tobytes())
-    except _H5_ERRORS as err:
-        raise _damaged(path, f"its copy of the record: {_why(err)}") from None
+    except H5_ERRORS as err:
+        raise damaged(path, f"its copy of the record: {error_reason(err)}") from None
     finally:
-        _close_quietly(f)
+        close_quietly(f)
     return _stored_copy(path, data, rec, "its copy of the record")
 
 
@@ -588,11 +582,11 @@ def _stored_copy(path: Path, data: bytes, rec: dict, what: str):
     from rocksweep.physics.records import RecordError, digest, parse_record
 
     if digest(data) != rec.get("sha256"):
-        raise _damaged(path, f"{what} does not match its SHA-256")
+        raise damaged(path, f"{what} does not match its SHA-256")
     try:
         return parse_record(data, str(rec.get("source")))
     except RecordError as err:
-        raise _damaged(path, f"{what}: {err}") from None
+        raise damaged(path, f"{what}: {err}") from None
 
 
 def stored_records(path: Path, suite: dict) -> tuple | None:
@@ -601,7 +595,7 @@ def stored_records(path: Path, suite: dict) -> tuple | None:
     scene states; None for a file that keeps no copies (made before suites stored them).
     StoreError if a copy is damaged."""
     want = suite.get("records") or []
-    f = _open(path, "r")
+    f = open_h5(path, "r")
     try:
         g = f.get(SUITE_GROUP)
         if g is None:
@@ -610,12 +604,12 @@ def stored_records(path: Path, suite: dict) -> tuple | None:
         for i, r in enumerate(want):
             d = g.get(str(i))
             if d is None:
-                raise _damaged(path, f"its copy of record {r.get('name')!r} is missing")
+                raise damaged(path, f"its copy of record {r.get('name')!r} is missing")
             blobs.append(bytes(np.asarray(d[()], dtype=np.uint8).tobytes()))
-    except _H5_ERRORS as err:
-        raise _damaged(path, f"its copies of the records: {_why(err)}") from None
+    except H5_ERRORS as err:
+        raise damaged(path, f"its copies of the records: {error_reason(err)}") from None
     finally:
-        _close_quietly(f)
+        close_quietly(f)
     return tuple(_stored_copy(path, data, r, f"its copy of record {r.get('name')!r}")
                  for r, data in zip(want, blobs, strict=True))
 

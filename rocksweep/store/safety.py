@@ -1,15 +1,15 @@
-"""File-system safety of the writer (issue 16): space, stale temporary files, locks and
+"""File-system safety of the writer: space, stale temporary files, locks and
 the atomic rename.
 
 - A new file's size is known (every dataset is allocated at creation): a grid larger
-  than the free space is refused before anything is written (``_check_space``), and the
-  whole file's space is reserved before HDF5 writes (``_reserve``).
+  than the free space is refused before anything is written (``check_space``), and the
+  whole file's space is reserved before HDF5 writes (``reserve_space``).
 - A new file is made under a temporary name unique to the process
   (``outputs.partial_prefix``); those of killed attempts are removed
   (``outputs.clean_stale_partials``, as for every output).
 - A writer holds HDF5's exclusive lock (``flock``) on its file; ``create`` takes the same
-  lock on a file it overwrites (``_lock_existing``), and holds the new file's lock before
-  it is renamed into place (``_publish``), so no two processes write one path, whatever
+  lock on a file it overwrites (``lock_existing``), and holds the new file's lock before
+  it is renamed into place (``publish_result``), so no two processes write one path, whatever
   ``--resume``/``--overwrite`` they are given. Without ``overwrite`` the rename is a hard
   link, which fails if another process made the path meanwhile. The rename, the new
   file's mode and the rule that an input is never an output are ``rocksweep.outputs``'s,
@@ -26,9 +26,9 @@ from pathlib import Path
 from rocksweep.errors import OutputError
 from rocksweep.outputs import publish, shown
 from rocksweep.scene.model import Scene
-from rocksweep.store._common import StoreError, _mib, _why
+from rocksweep.store._common import StoreError, error_reason, mib
 
-# Free space required beyond the space a new file reserves (``_space_needed``): a share of
+# Free space required beyond the space a new file reserves (``space_needed``): a share of
 # the file, at least this many bytes [bytes], so that a small sweep fits a small disk and
 # a large one leaves room for the file system's own blocks.
 SPACE_MARGIN = 64 << 10
@@ -41,7 +41,7 @@ UPDATE_MARGIN = 1 << 20
 METADATA_RESERVE = 256 << 10
 
 
-def _reserve(path: Path, nbytes: int) -> None:
+def reserve_space(path: Path, nbytes: int) -> None:
     """Allocate ``nbytes`` of disk space to the file at ``path`` (``posix_fallocate``):
     writes within them cannot fail for want of space. OSError(ENOSPC) if there is no
     room; file systems without the call are left as they are."""
@@ -55,7 +55,7 @@ def _reserve(path: Path, nbytes: int) -> None:
         os.close(fd)
 
 
-def _reserve_bytes(scene: Scene, nbytes: int) -> int:
+def reserve_bytes(scene: Scene, nbytes: int) -> int:
     """Bytes a new result file of ``scene`` reserves: its datasets (``nbytes``), HDF5's
     metadata, the scene text and the records (a record's file and samples,
     ``_store_record``; a suite's files, ``_store_suite_records``)."""
@@ -66,13 +66,13 @@ def _reserve_bytes(scene: Scene, nbytes: int) -> int:
     return nbytes + METADATA_RESERVE + 4 * len(scene.text.encode()) + rec
 
 
-def _space_needed(reserve: int) -> int:
+def space_needed(reserve: int) -> int:
     """Free space required to make a file that reserves ``reserve`` bytes: those and a
     margin that scales with them (``SPACE_SHARE``, at least ``SPACE_MARGIN``)."""
     return reserve + max(SPACE_MARGIN, int(reserve * SPACE_SHARE))
 
 
-def _check_space(path: Path, need: int, what: str) -> None:
+def check_space(path: Path, need: int, what: str) -> None:
     """Refuse (StoreError) when the file system of ``path`` has less than ``need`` bytes
     free."""
     parent = path.parent if str(path.parent) else Path(".")
@@ -82,10 +82,10 @@ def _check_space(path: Path, need: int, what: str) -> None:
         return  # cannot tell: the writes themselves will say
     if free < need:
         raise StoreError(f"{shown(path)}: not enough free space for {what}: needs about "
-                         f"{_mib(need)} ({need} bytes), {_mib(free)} free in {parent}")
+                         f"{mib(need)} ({need} bytes), {mib(free)} free in {parent}")
 
 
-def _lock_existing(path: Path) -> int:
+def lock_existing(path: Path) -> int:
     """Open the file at ``path`` and take the exclusive lock a writer holds (HDF5 locks
     with flock); returns the descriptor. StoreError if a sweep is writing it."""
     import fcntl
@@ -93,7 +93,7 @@ def _lock_existing(path: Path) -> int:
     try:
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_CLOEXEC", 0))
     except OSError as err:
-        raise StoreError(f"{shown(path)}: cannot be replaced ({_why(err)})") from None
+        raise StoreError(f"{shown(path)}: cannot be replaced ({error_reason(err)})") from None
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except BlockingIOError:
@@ -105,7 +105,7 @@ def _lock_existing(path: Path) -> int:
     return fd
 
 
-def _publish(tmp: Path, path: Path, old_fd: int | None) -> None:
+def publish_result(tmp: Path, path: Path, old_fd: int | None) -> None:
     """Rename the finished temporary file to ``path`` (``outputs.publish``, the one rename
     of every output): over the file locked by ``old_fd``, or, without one, only if
     nothing is at ``path`` (another process may have made it since it was checked)."""

@@ -24,8 +24,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rocksweep.compute.grid import Grid
-from rocksweep.compute.sweep import ChunkResult
 from rocksweep.errors import Arg, RocksweepError, flag
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
@@ -37,42 +35,43 @@ from rocksweep.outputs import (
     partial_prefix,
     shown,
 )
+from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import (
-    _H5_ERRORS,
+    H5_ERRORS,
     StoreError,
-    _close_quietly,
-    _damaged,
-    _fixed,
-    _mib,
-    _now,
-    _why,
+    close_quietly,
+    damaged,
+    error_reason,
+    fixed_ascii,
+    mib,
+    utc_now,
 )
 from rocksweep.store.format import (
     ADAPTIVE_COUNT_ATTRS,
     HISTORY_BYTES,
     SESSION_ATTRS,
-    _initialise,
-    file_bytes,
     flat_slabs,
+    initialise,
+    metadata,
     versions,
 )
 from rocksweep.store.identity import resolved_scene, scene_differences
 from rocksweep.store.reader import (
-    _check_computed,
-    _check_outcome,
-    _checked_attrs,
-    _layout,
-    _open,
+    check_computed,
+    check_outcome,
+    checked_attrs,
+    open_h5,
+    read_layout,
 )
 from rocksweep.store.safety import (
     UPDATE_MARGIN,
-    _check_space,
-    _lock_existing,
-    _publish,
-    _reserve,
-    _reserve_bytes,
-    _space_needed,
+    check_space,
+    lock_existing,
+    publish_result,
+    reserve_bytes,
+    reserve_space,
+    space_needed,
 )
 
 if TYPE_CHECKING:
@@ -82,7 +81,7 @@ if TYPE_CHECKING:
 def _put(f: h5py.File, name: str, value) -> None:
     """Overwrite a session attribute in place (its fixed type and size)."""
     dtype = SESSION_ATTRS.get(name) or ADAPTIVE_COUNT_ATTRS[name]
-    arr = _fixed(value, dtype) if dtype.startswith("S") else np.array(value, dtype=dtype)
+    arr = fixed_ascii(value, dtype) if dtype.startswith("S") else np.array(value, dtype=dtype)
     f.attrs.modify(name, arr)
 
 
@@ -93,7 +92,7 @@ def _in_place(f: h5py.File) -> bool:
         try:
             if name not in a or a.get_id(name).dtype != np.dtype(dtype):
                 return False
-        except _H5_ERRORS:
+        except H5_ERRORS:
             return False
     return True
 
@@ -112,7 +111,7 @@ def _upgrade_session_attrs(f: h5py.File) -> None:
             old = "" if dtype.startswith("S") else 0
         if name in a:
             del a[name]
-        a.create(name, _fixed(old, dtype) if dtype.startswith("S")
+        a.create(name, fixed_ascii(old, dtype) if dtype.startswith("S")
                  else np.array(old, dtype=dtype))
 
 
@@ -120,14 +119,15 @@ class SweepFile:
     """A result file open for writing (by the parent process only; it holds the file's
     exclusive lock until ``close``)."""
 
-    def __init__(self, path: Path, f: h5py.File, scene: Scene,
+    def __init__(self, path: Path, f: h5py.File, grid: Grid,
                  backend: str | None = None, adaptive: dict | None = None) -> None:
         self.path = path
         self.f = f
-        self.grid = Grid(scene)
+        self.grid = grid  # the scene's points (the driver runs them; shape: the file's)
+        scene = grid.scene
         self.names = list(scene.variables())
         self.adaptive = adaptive  # resolved adaptive settings, None: every point
-        self.session_start = _now()
+        self.session_start = utc_now()
         self.backend = backend or "unspecified"
         self._history = ""  # the file's history before this session
         self._session_line = ""
@@ -136,7 +136,7 @@ class SweepFile:
     def _fail(self, err: StoreError) -> StoreError:
         """Close the file after a failed write (nothing more is written) and remember why:
         later calls repeat this error, not a second one about a closed file."""
-        _close_quietly(self.f)
+        close_quietly(self.f)
         self._broken = err
         return err
 
@@ -145,10 +145,12 @@ class SweepFile:
     def create(cls, path: str | Path, scene: Scene, overrides: tuple[str, ...] = (),
                overwrite: bool = False, *, backend: str | None = None,
                adaptive: dict | None = None,
-               log: Callable[[str], None] | None = None) -> SweepFile:
+               log: Callable[[str], None] | None = None,
+               grid: Grid | None = None) -> SweepFile:
         """Make a new result file (all points not computed), atomically, and open it.
         adaptive: resolved settings of an adaptive sweep (``adaptive.Options.resolved``):
-        the file gets the ``computed`` flags and the settings' attributes.
+        the file gets the ``computed`` flags and the settings' attributes; grid: the
+        scene's ``Grid`` when the caller has made it (made here otherwise).
 
         Refused before anything is written: an existing path without ``overwrite``, a
         directory, device or FIFO, a missing directory (``OutputError``, as every output
@@ -156,24 +158,37 @@ class SweepFile:
         (``StoreError``). ``backend``: how the
         points are computed (e.g. "threads x 2"), recorded with the host in the file.
         """
-        import h5py
         path = Path(path)
         # devices, directories, missing dirs, the scene's own files (OutputError)
         check_output(path, overwrite=True, inputs=scene.inputs)
+        return cls.make(path, scene, overrides, overwrite, backend=backend,
+                        adaptive=adaptive, log=log, grid=grid)
+
+    @classmethod
+    def make(cls, path: Path, scene: Scene, overrides: tuple[str, ...] = (),
+             overwrite: bool = False, *, backend: str | None = None,
+             adaptive: dict | None = None, log: Callable[[str], None] | None = None,
+             grid: Grid | None = None) -> SweepFile:
+        """``create`` at a path its caller has checked (``outputs.check_output``, as the
+        sweep session does, naming the command's inputs): refused are only what may have
+        changed since, an existing path without ``overwrite`` (``OutputError``, the one
+        "already exists"), too little free space, a file another process is writing
+        (``StoreError``)."""
+        import h5py
+        grid = grid if grid is not None else Grid(scene)
         existed = os.path.lexists(path)
         if existed and not overwrite:
             raise exists_error(path, resumable=True)
-        grid = Grid(scene)
-        nbytes = file_bytes(scene, adaptive is not None)
-        reserve = _reserve_bytes(scene, nbytes)
+        meta = metadata(scene, overrides, adaptive)  # before anything is made
+        reserve = reserve_bytes(scene, meta.nbytes)
         removed = clean_stale_partials(path)  # a killed attempt's reserved space back
         if removed and log is not None:
             log(f"removed {len(removed)} stale temporary file{'s' * (len(removed) > 1)} of "
                 f"{shown(path)} left by a sweep killed while making it ({removed[0][0]}"
                 f"{', ...' if len(removed) > 1 else ''}; "
-                f"{_mib(sum(n for _, n in removed))})")
-        _check_space(path, _space_needed(reserve), f"a grid of {grid.size} points")
-        old_fd = _lock_existing(path) if existed else None
+                f"{mib(sum(n for _, n in removed))})")
+        check_space(path, space_needed(reserve), f"a grid of {grid.size} points")
+        old_fd = lock_existing(path) if existed else None
         tmp: Path | None = None
         f = None
         try:
@@ -182,33 +197,33 @@ class SweepFile:
                                         dir=parent)
             os.close(fd)
             tmp = Path(name)
-            _reserve(tmp, reserve)  # room for all of it, or ENOSPC before HDF5 writes
+            reserve_space(tmp, reserve)  # room for all of it, or ENOSPC before HDF5 writes
             g = h5py.File(tmp, "w", track_order=True)  # truncates: reserve again
             try:
-                _reserve(tmp, reserve)
-                _initialise(g, scene, overrides, adaptive)
+                reserve_space(tmp, reserve)
+                initialise(g, meta)
                 g.flush()
                 size = g.id.get_filesize()  # HDF5's end of allocation (eof is stale)
             except BaseException:
-                _close_quietly(g)
+                close_quietly(g)
                 raise
             g.close()
             if 0 < size < reserve:
                 os.truncate(tmp, size)  # give back what the metadata did not use
             f = h5py.File(tmp, "r+", locking=True)  # locked before anyone can see it
-            self = cls(path, f, scene, backend, adaptive)
+            self = cls(path, f, grid, backend, adaptive)
             self._start_session()  # before the file has its name: failing leaves nothing
-            _publish(tmp, path, old_fd)
+            publish_result(tmp, path, old_fd)
             tmp = None
             return self
         except StoreError:
             if f is not None:
-                _close_quietly(f)
+                close_quietly(f)
             raise
-        except _H5_ERRORS as err:
+        except H5_ERRORS as err:
             if f is not None:
-                _close_quietly(f)
-            raise StoreError(f"{shown(path)}: cannot write ({_why(err)}); nothing written"
+                close_quietly(f)
+            raise StoreError(f"{shown(path)}: cannot write ({error_reason(err)}); nothing written"
                              ) from None
         finally:
             if tmp is not None:
@@ -219,20 +234,23 @@ class SweepFile:
 
     @classmethod
     def in_memory(cls, scene: Scene, overrides: tuple[str, ...] = (), *,
-                  backend: str | None = None, adaptive: dict | None = None) -> SweepFile:
+                  backend: str | None = None, adaptive: dict | None = None,
+                  grid: Grid | None = None) -> SweepFile:
         """The same result, held in memory (HDF5's core driver, no backing store): the
         sink of ``rocksweep.run`` without ``output``. Nothing touches a disk; ``image``
-        gives the file's bytes, exactly what ``create`` would have written."""
+        gives the file's bytes, exactly what ``create`` would have written. grid: as
+        for ``create``."""
         import h5py
 
         name = f"rocksweep-memory-{os.getpid()}-{id(scene)}.h5"
         f = h5py.File(name, "w", driver="core", backing_store=False, track_order=True)
         try:
-            _initialise(f, scene, overrides, adaptive)
-            self = cls(Path("memory"), f, scene, backend, adaptive)
+            initialise(f, metadata(scene, overrides, adaptive))
+            self = cls(Path("memory"), f, grid if grid is not None else Grid(scene),
+                       backend, adaptive)
             self._start_session()
         except BaseException:
-            _close_quietly(f)
+            close_quietly(f)
             raise
         return self
 
@@ -243,26 +261,27 @@ class SweepFile:
 
     @classmethod
     def resume(cls, path: str | Path, scene: Scene, overrides: tuple[str, ...] = (),
-               *, backend: str | None = None, adaptive: dict | None = None) -> SweepFile:
+               *, backend: str | None = None, adaptive: dict | None = None,
+               grid: Grid | None = None) -> SweepFile:
         """Reopen a result file of the same scene (and the same adaptive settings, None
         for a sweep of every point) to finish it (its points are kept whatever happens:
-        the session's attributes are updated in place)."""
+        the session's attributes are updated in place). grid: as for ``create``."""
         path = Path(path)
         if is_input(path, scene.inputs):  # written in place: only the identity rule
             raise StoreError(f"{shown(path)}: is this command's input; choose another "
                              "output path")
-        f = _open(path, "r")
+        f = open_h5(path, "r")
         try:
-            stored = _layout(f, path).scene
-            _checked_attrs(f, path)  # what readers need, before any point is computed
+            stored = read_layout(f, path).scene
+            checked_attrs(f, path)  # what readers need, before any point is computed
             outcome = f["outcome"][()]
-            _check_outcome(outcome, path)
+            check_outcome(outcome, path)
             if stored.get("adaptive"):
-                _check_computed(f["computed"][()], outcome, path)
-        except _H5_ERRORS as err:
-            raise _damaged(path, _why(err)) from None
+                check_computed(f["computed"][()], outcome, path)
+        except H5_ERRORS as err:
+            raise damaged(path, error_reason(err)) from None
         finally:
-            _close_quietly(f)
+            close_quietly(f)
         diffs = scene_differences(stored, resolved_scene(scene, overrides, adaptive))
         if diffs:
             done = int((outcome != L.OUTCOME_NOT_RUN).sum())
@@ -274,16 +293,16 @@ class SweepFile:
                              "{diffs} (" + keep + ")", path=shown(path),
                              diffs="; ".join(diffs), overrides=Arg("overrides"),
                              output=Arg("output"), overwrite=flag("overwrite"))
-        f = _open(path, "r+")
+        f = open_h5(path, "r+")
         try:
-            _layout(f, path)  # the file locked now (another may have replaced the first)
-            self = cls(path, f, scene, backend, adaptive)
+            read_layout(f, path)  # the file locked now (another may have replaced the first)
+            self = cls(path, f, grid if grid is not None else Grid(scene), backend, adaptive)
             self._start_session()
         except BaseException as err:
-            _close_quietly(f)
-            if isinstance(err, _H5_ERRORS) and not isinstance(err, RocksweepError):
+            close_quietly(f)
+            if isinstance(err, H5_ERRORS) and not isinstance(err, RocksweepError):
                 raise StoreError(f"{shown(path)}: cannot update its attributes "
-                                 f"({_why(err)}); its points are kept") from None
+                                 f"({error_reason(err)}); its points are kept") from None
             raise
         return self
 
@@ -292,7 +311,7 @@ class SweepFile:
         h5py's errors (the callers say what they mean for the file)."""
         f = self.f
         if not _in_place(f):  # a format-1 file: its attributes change type once
-            _check_space(self.path, UPDATE_MARGIN, "updating its attributes")
+            check_space(self.path, UPDATE_MARGIN, "updating its attributes")
             _upgrade_session_attrs(f)
             f.flush()
         n = int(f.attrs["sessions"]) + 1
@@ -353,10 +372,10 @@ class SweepFile:
             self.f.flush()
             self._write_at("computed", coords, computed)
             self.f.flush()
-        except _H5_ERRORS as err:
+        except H5_ERRORS as err:
             raise self._fail(StoreError(
                 "{path}: cannot write results ({why}); the points written before are kept, "
-                "finish with {resume}", path=shown(self.path), why=_why(err),
+                "finish with {resume}", path=shown(self.path), why=error_reason(err),
                 resume=flag("resume"))) from None
 
     def write_filled(self, outcome: np.ndarray, counts: dict[str, int]) -> None:
@@ -369,10 +388,10 @@ class SweepFile:
             self.f["outcome"][...] = np.asarray(outcome, np.int8).reshape(self.grid.shape)
             self.f.flush()
             self.put_counts(counts)
-        except _H5_ERRORS as err:
+        except H5_ERRORS as err:
             raise self._fail(StoreError(
                 "{path}: cannot write the filled outcomes ({why}); finish with {resume}",
-                path=shown(self.path), why=_why(err), resume=flag("resume"))) from None
+                path=shown(self.path), why=error_reason(err), resume=flag("resume"))) from None
 
     def put_counts(self, counts: dict[str, int]) -> None:
         """Update the adaptive counts (``ADAPTIVE_COUNT_ATTRS``) in place."""
@@ -400,10 +419,10 @@ class SweepFile:
                                 for s, n in zip(index, ds.shape, strict=True))
                     ds[index] = arr[a - res.start:b - res.start].reshape(box)
             self.f.flush()
-        except _H5_ERRORS as err:
+        except H5_ERRORS as err:
             raise self._fail(StoreError(
                 "{path}: cannot write results ({why}); the points written before are kept, "
-                "finish with {resume}", path=shown(self.path), why=_why(err),
+                "finish with {resume}", path=shown(self.path), why=error_reason(err),
                 resume=flag("resume"))) from None
 
     def finish(self, wall_seconds: float, cpu_seconds: float, *,
@@ -424,7 +443,7 @@ class SweepFile:
                 "complete": bool(done.all()),
                 "steps_total": int(f["steps"][()].sum()),
                 "event_steps_total": int(f["event_steps"][()].sum()),
-                "last_finished": _now(),
+                "last_finished": utc_now(),
             }
             if done.all() and not plain(a["finished"]):
                 attrs["finished"] = attrs["last_finished"]
@@ -438,9 +457,9 @@ class SweepFile:
             for k, v in attrs.items():
                 _put(f, k, int(v) if k == "complete" else v)
             f.flush()
-        except _H5_ERRORS as err:
+        except H5_ERRORS as err:
             raise self._fail(StoreError(
-                f"{shown(self.path)}: cannot record the session's totals ({_why(err)}); "
+                f"{shown(self.path)}: cannot record the session's totals ({error_reason(err)}); "
                 "its points are kept")) from None
         return attrs
 
@@ -449,8 +468,8 @@ class SweepFile:
             return  # closed when it broke
         try:
             self.f.close()
-        except _H5_ERRORS as err:
-            raise StoreError(f"{shown(self.path)}: cannot close ({_why(err)})") from None
+        except H5_ERRORS as err:
+            raise StoreError(f"{shown(self.path)}: cannot close ({error_reason(err)})") from None
 
     def __enter__(self) -> SweepFile:
         return self
@@ -459,7 +478,7 @@ class SweepFile:
         if exc[0] is None:
             self.close()
         else:
-            _close_quietly(self.f)
+            close_quietly(self.f)
 
 
 def _history(before: str, line: str) -> str:

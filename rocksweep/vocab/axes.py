@@ -54,6 +54,10 @@ AXES: dict[str, AxisMeta] = {
                           "PGA/(g tan alpha_ref)", r"PGA/(g\,\tan\alpha_{ref})"),
     "PGV_ratio": AxisMeta("PGV p of the scaled record over g tan(alpha_ref)", "1",
                           "PGV p/(g tan alpha_ref)", r"PGV\,p/(g\,\tan\alpha_{ref})"),
+    "AvgSa": AxisMeta("AvgSa of the scaled record: geometric mean of Sa (5% damping) over "
+                      "the periods avgsa_periods", "g", "AvgSa", r"S_{a,avg}"),
+    "CAV": AxisMeta("cumulative absolute velocity of the scaled record", "m/s", "CAV", "CAV"),
+    "Arias": AxisMeta("Arias intensity of the scaled record", "m/s", "I_A", r"I_A"),
     "period": AxisMeta("period of the oscillator of Sa (5% damping)", "s", "T", "T"),
     # the state at t = 0 (scene section ``initial``; INITIAL below)
     "theta_over_alpha": AxisMeta("initial rotation", "1", "theta_0/alpha_ref",

@@ -6,8 +6,8 @@ the phase phi = w t, the kernel evaluates the same formulas, ``pulse_acc``): ``s
 ``MPAcc``). A record (``ground.record``/``ground.records``) runs as the shape ``record``.
 
 Intensity measures of a suite (``ground.scale.im``): PGA [g], PGV [m/s], Sa(T) [g] at
-``SA_DAMPING`` (5%), and the slenderness-normalised PGA_ratio = PGA/(g tan alpha_ref),
-PGV_ratio = PGV p/(g tan alpha_ref) [-].
+``SA_DAMPING`` (5%), the slenderness-normalised PGA_ratio = PGA/(g tan alpha_ref),
+PGV_ratio = PGV p/(g tan alpha_ref) [-], AvgSa [g], CAV [m/s] and Arias [m/s].
 """
 
 from __future__ import annotations
@@ -93,8 +93,12 @@ def mp_raw_rate(phi: float, gamma: float, nu: float) -> float:
 # ---------------------------------------------------------------------------------------
 
 PGA, PGV, SA, PGA_RATIO, PGV_RATIO = "PGA", "PGV", "Sa", "PGA_ratio", "PGV_ratio"
-#: the IMs a suite can be scaled to (its stripe dimension's name) and their CF units
-SCALE_IMS: dict[str, str] = {PGA: "g", PGV: "m/s", SA: "g", PGA_RATIO: "1", PGV_RATIO: "1"}
+ARIAS, CAV, D5_95, PGV_OVER_PGA, AVGSA = "Arias", "CAV", "D5_95", "PGV_over_PGA", "AvgSa"
+#: the IMs a suite can be scaled to (its stripe dimension's name) and their CF units: every
+#: IM that a scale factor F changes (Arias as F^2, the others as F); D5-95 and PGV/PGA do
+#: not change with F and cannot be stripes
+SCALE_IMS: dict[str, str] = {PGA: "g", PGV: "m/s", SA: "g", PGA_RATIO: "1", PGV_RATIO: "1",
+                             AVGSA: "g", CAV: "m/s", ARIAS: "m/s"}
 #: the IMs of the records as recorded (a cloud) and the per-record variables holding them
 CLOUD_IMS: dict[str, str] = {PGA: "record_pga", PGV: "record_pgv", SA: "record_sa"}
 #: what each ratio IM divides (its physical IM)
@@ -102,7 +106,6 @@ RATIO_OF: dict[str, str] = {PGA_RATIO: PGA, PGV_RATIO: PGV}
 SA_DAMPING = 0.05  # damping ratio of the spectral acceleration (5%)
 AVGSA_POINTS = 10  # periods of AvgSa, evenly spaced in ln T
 DEFAULT_PERIODS = (0.2, 1.0)  # [s] Sa stored per record
-ARIAS, CAV, D5_95, PGV_OVER_PGA, AVGSA = "Arias", "CAV", "D5_95", "PGV_over_PGA", "AvgSa"
 #: The record IMs stored per record (the one list): name -> (variable, units, exponent n:
 #: the IM of the record times F is F^n times its IM; 0: scale-invariant). Sa(T) is
 #: ``record_sa`` along ``period`` (n = 1).

@@ -1,4 +1,4 @@
-"""A_min independent of the grid (issue 28): the search below the first overturning grid
+"""A_min independent of the grid: the search below the first overturning grid
 value finds a first overturning band narrower than the grid step, checked against the
 reference path (scipy DOP853, ``rocksweep.physics.reference``, an integrator independent
 of the kernel); and the bad inputs of boundaries / spectra (rtol, one A value, a
@@ -9,13 +9,14 @@ import math
 
 import numpy as np
 import pytest
+from bodies import FIG4
 from click.testing import CliRunner
 
 import rocksweep
 import rocksweep.analysis.boundaries as bd
 from rocksweep.cli import main
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.physics.points import Point
 from rocksweep.physics.reference import reference_run
 from rocksweep.store.reader import as_result
@@ -23,8 +24,7 @@ from rocksweep.store.reader import as_result
 # Figure 4's stiff body (Table 3, wn/p = 9.82) under a cosine pulse at omega/p = 1: the
 # reference overturns first in a band from A_ratio ~1.025 that ends before 1.1, while the
 # grid below (step 0.1) overturns first at 1.2.
-BODY = {"wn_over_p": 9.82, "zeta": 0.05, "alpha_cg": 0.15, "alpha_A": 0.28,
-        "mA_over_m": 0.47, "IA_ratio": 0.56}
+BODY = dict(FIG4)
 SCENE = {"name": "narrow first band", "body": BODY, "impact": {"lam": 0.0},
          "pulse": {"shape": "cosine", "w_over_p": [1.0, 1.2],
                    "A_ratio": {"start": 0.3, "stop": 2.0, "num": 18}}}

@@ -5,6 +5,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from bodies import FIG3_YAML
 
 from rocksweep.analysis.accuracy import (
     Sample,
@@ -20,9 +21,7 @@ from rocksweep.kernel import layout as L  # noqa: N812
 
 SCENE = """\
 name: tiny accuracy scene
-body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47,
-       IA_ratio: 0.56}
-impact: {lam: 0.2}
+""" + FIG3_YAML + """impact: {lam: 0.2}
 pulse: {shape: sine, w_over_p: [2.0, 5.3], A_ratio: [1.5, 3.0, 5.0]}
 """
 
@@ -172,7 +171,7 @@ ROOT = Path(__file__).resolve().parents[2]
                           "impact.lam=0.2"]),
 ])
 def test_energy_and_half_step_runs_use_the_scene_ground_motion(name, sets):
-    """Review defect b: the accuracy study's energy runs (and half-step reruns) must run
+    """The accuracy study's energy runs (and half-step reruns) must run
     the Ricker pulse and the record, not the sine/cosine variant: they equal the sweep's
     own energy outputs and check reruns of the same points."""
     from rocksweep import fields
@@ -195,7 +194,7 @@ def test_energy_and_half_step_runs_use_the_scene_ground_motion(name, sets):
 
 
 def _values(sc):
-    from rocksweep.compute.grid import Grid
+    from rocksweep.scene.grid import Grid
 
     vals = Grid(sc).index_values(np.arange(sc.size))
     return [{k: v[i] for k, v in vals.items()} for i in range(sc.size)]

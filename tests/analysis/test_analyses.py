@@ -1,4 +1,4 @@
-"""Analyses on Datasets (issue 22): every analysis takes what ``rocksweep.run`` and
+"""Analyses on Datasets: every analysis takes what ``rocksweep.run`` and
 ``rocksweep.open`` return, and the command line gives the same answers from a file."""
 
 from __future__ import annotations
@@ -121,7 +121,7 @@ def test_estimate_measures_on_a_sample(pair):
 
 
 def test_estimate_counts_the_half_step_rerun_of_a_check_sweep(pair):
-    """Review 3: ``outputs.check`` reruns every point at half the step, which alone costs
+    """``outputs.check`` reruns every point at half the step, which alone costs
     about twice the first run: the sweep costs ~3x, the estimate said 2x."""
     plain = rocksweep.estimate(CI_SMALL, overrides=SINE)
     check = rocksweep.estimate(CI_SMALL, overrides={**SINE, "outputs.check": True})
@@ -135,7 +135,7 @@ def test_estimate_counts_the_half_step_rerun_of_a_check_sweep(pair):
 
 
 def test_check_fields_carry_their_units(tmp_path):
-    """Review defect a: the per-point estimates were written with rocksweep_units "1"."""
+    """The per-point estimates were once written with rocksweep_units "1"."""
     ds = rocksweep.run(CI_SMALL, overrides={**SINE, "impact.lam": 0.0,
                                             "outputs.check": True})
     assert ds.check_t_overturn_diff.attrs["rocksweep_units"] == "1/p"
@@ -184,7 +184,7 @@ def test_spectra_dataset(tmp_path):
 
 
 def test_spectra_of_a_block_name_its_alpha():
-    """Review 3: a block's spectra labelled its theta with the flexible body's alpha_cg."""
+    """A block's spectra once labelled its theta with the flexible body's alpha_cg."""
     from rocksweep.figures.spectrum import spectra_figure
 
     ds = rocksweep.run(ROOT / "configs" / "block.yaml",

@@ -6,6 +6,7 @@ import pytest
 from bodies import FIG3_YAML
 
 import rocksweep.analysis.boundaries as bd
+from rocksweep.analysis.files import csv_text
 from rocksweep.compute.driver import sweep_arrays
 from rocksweep.figures.diagrams import a_min_figure
 from rocksweep.scene.parse import parse_scene
@@ -117,7 +118,7 @@ def test_a_min_of_a_synthetic_threshold_and_csv():
         assert (c.mode == 2).all()
     rows = bd.a_min_rows(curves)
     assert list(rows[0]) == ["shape", "w_over_p", "A_min", "mode", "upper_bound", "method"]
-    text = bd.csv_text(rows)
+    text = csv_text(rows)
     assert text.splitlines()[0] == "shape,w_over_p,A_min,mode,upper_bound,method"
     assert len(text.splitlines()) == 1 + 10 and "cosine,3.0," in text
     fig = a_min_figure(curves, bd.diagram_boundaries(sc, outcome), title="t")

@@ -1,4 +1,4 @@
-"""Calibration (issue 30, parts 2-4): measured histories in, scene numbers out.
+"""Calibration: measured histories in, scene numbers out.
 
 The free-rocking measurement is made here, independently of the kernel: the classic block
 theta'' = -sign(theta) sin(alpha - |theta|) (p = 1) integrated by scipy's DOP853 with an
@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from bodies import FIG3
 from scipy.integrate import solve_ivp
 
 import rocksweep
@@ -27,8 +28,7 @@ ALPHA = 0.2
 BLOCK = {"name": "free block", "body": {"kind": "block", "alpha": ALPHA},
          "impact": {"lam": 0.0, "law": "constant", "e": 0.8},
          "initial": {"theta_over_alpha": 0.7}}
-FLEX = {"name": "flexible", "body": {"wn_over_p": 2.43, "zeta": 0.05, "alpha_cg": 0.15,
-                                     "alpha_A": 0.28, "mA_over_m": 0.47, "IA_ratio": 0.56},
+FLEX = {"name": "flexible", "body": dict(FIG3),
         "impact": {"lam": 0.0}, "pulse": {"shape": "sine", "w_over_p": 4.0, "A_ratio": 2.0}}
 
 

@@ -12,6 +12,7 @@ from scipy.optimize import minimize
 from scipy.stats import norm
 
 from rocksweep.analysis import fragility as F
+from rocksweep.analysis import likelihood as LK
 from rocksweep.kernel import layout as L
 
 MEDIAN, BETA = 0.4, 0.4
@@ -82,8 +83,8 @@ def test_bootstrap_interval_covers_the_true_median():
     hit99 = hit90 = 0
     for trial in range(100):
         failed = capacities_failed(np.random.default_rng(1000 + trial))
-        b99 = F.bootstrap_records(LEVELS, failed, n_boot=200, seed=trial, ci=0.99)
-        b90 = F.bootstrap_records(LEVELS, failed, n_boot=200, seed=trial, ci=0.90)
+        b99 = LK.bootstrap_records(LEVELS, failed, n_boot=200, seed=trial, ci=0.99)
+        b90 = LK.bootstrap_records(LEVELS, failed, n_boot=200, seed=trial, ci=0.90)
         hit99 += b99.median_ci[0] <= MEDIAN <= b99.median_ci[1]
         hit90 += b90.median_ci[0] <= MEDIAN <= b90.median_ci[1]
     assert hit99 >= 95
@@ -92,9 +93,9 @@ def test_bootstrap_interval_covers_the_true_median():
 
 def test_bootstrap_is_seeded():
     failed = capacities_failed(np.random.default_rng(5))
-    a = F.bootstrap_records(LEVELS, failed, n_boot=50, seed=3)
-    b = F.bootstrap_records(LEVELS, failed, n_boot=50, seed=3)
-    c = F.bootstrap_records(LEVELS, failed, n_boot=50, seed=4)
+    a = LK.bootstrap_records(LEVELS, failed, n_boot=50, seed=3)
+    b = LK.bootstrap_records(LEVELS, failed, n_boot=50, seed=3)
+    c = LK.bootstrap_records(LEVELS, failed, n_boot=50, seed=4)
     assert np.array_equal(a.medians, b.medians, equal_nan=True)
     assert not np.array_equal(a.medians, c.medians, equal_nan=True)
     assert a.medians.shape == (50,)
@@ -389,7 +390,7 @@ def test_bootstrap_of_nearly_degenerate_data_counts_undefined_resamples():
     failed = np.zeros((12, LEVELS.size), dtype=bool)
     failed[0, -3:] = True
     failed[1, [-3, -1]] = True
-    b = F.bootstrap_records(LEVELS, failed, n_boot=300, seed=0)
+    b = LK.bootstrap_records(LEVELS, failed, n_boot=300, seed=0)
     p_undef = 2 * (11 / 12) ** 12 - (10 / 12) ** 12
     sd = math.sqrt(300 * p_undef * (1 - p_undef))
     assert abs(b.n_undefined - 300 * p_undef) < 4 * sd

@@ -44,7 +44,7 @@ def test_one_colour_per_lam_with_band_points_and_median_differences(tmp_path):
 
 
 def test_stripe_markers_at_the_same_place_stay_readable():
-    """Issue 31: two lam values with the same fractions at the same stripes drew opaque
+    """Two lam values with the same fractions at the same stripes drew opaque
     markers over each other; each colour has its own shape and a translucent face."""
     ds = suite_dataset(n_records=20, lams=(0.0, 0.2, 0.4), medians=(0.5, 0.5, 0.5))
     fr = fragility(ds, bootstrap=0)

@@ -1,5 +1,5 @@
-"""Fits that say when not to trust them (issue 29 parts 1-2, issue 32's analyses on files
-they should not trust): one test per class of verdict, the competing-risk and ordinal
+"""Fits that say when not to trust them (and analyses of files they should not
+trust): one test per class of verdict, the competing-risk and ordinal
 fits against independent scipy optimisations, damage-state curves that never cross on
 the demo suite, partial and adaptive files, flagged points in IDA, bad arguments."""
 
@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+from bodies import FIG3_YAML
 from helpers import one_line_error
 from scipy.optimize import minimize
 from scipy.stats import norm
@@ -102,6 +103,23 @@ def test_falling_fractions_are_non_monotone_and_resurrection_noise_is_not():
     out[np.flatnonzero(out[:, 7])[:3], 8] = 0  # overturned at stripe 7, safe at 8
     fr = F.fragility(stripes_ds(out), bootstrap=0)
     assert np.diff(fr["fraction"].values).min() < 0 and str(fr["reason"].values) == "ok"
+
+
+def test_pool_adjacent_violators_is_the_min_max_isotonic_fit():
+    # the isotonic fit's closed form: iso[s] = max_{i<=s} min_{j>=s} mean(i..j), the
+    # weighted means of the counts over stripes i..j, by brute force
+    from rocksweep.analysis.likelihood import isotonic_fit
+
+    rng = np.random.default_rng(3)
+    for S in (1, 2, 5, 13):
+        n = rng.integers(1, 7, S).astype(float)
+        k = rng.binomial(n.astype(int), 0.5, size=(40, S)).astype(float)
+        want = np.empty_like(k)
+        for b in range(k.shape[0]):
+            for s in range(S):
+                want[b, s] = max(min(k[b, i:j + 1].sum() / n[i:j + 1].sum()
+                                     for j in range(s, S)) for i in range(s + 1))
+        np.testing.assert_allclose(isotonic_fit(k, n), want, rtol=1e-12, atol=0.0)
 
 
 def test_median_or_16_84_points_outside_the_stripes_are_extrapolated():
@@ -314,9 +332,7 @@ def test_one_state_fits_equal_the_single_fit_and_the_ordinal_mle_is_the_mle(demo
 
 SUITE = """
 name: trust test
-body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47,
-       IA_ratio: 0.56}
-impact: {lam: 0.0}
+""" + FIG3_YAML + """impact: {lam: 0.0}
 ground:
   records: [ROOT/records/suite/SYN01.AT2, ROOT/records/suite/SYN05.AT2,
             ROOT/records/suite/SYN12.AT2, ROOT/records/suite/SYN17.AT2]
@@ -338,7 +354,7 @@ def test_a_partial_file_is_fitted_as_incomplete_naming_the_missing_points(suite_
     warns with the missing points and marks the fit; nothing is silently dropped."""
     import rocksweep.compute.sweep as sw
     from rocksweep import api
-    from rocksweep.compute.grid import Grid
+    from rocksweep.scene.grid import Grid
     from rocksweep.store.writer import SweepFile
 
     d, scene = suite_scene
@@ -432,8 +448,8 @@ def test_cli_bad_arguments_write_nothing(suite_scene, cli, tmp_path):
         assert not (tmp_path / "c.csv").exists()
 
 
-def test_the_issues_eight_record_mode2_curve_is_not_ok():
-    """Issue 29's measurement: mode 2 counts 0 0 0 0 0 0 0 1 1 2 3 1 3 1 0 0 of 8 over PGA
+def test_a_mode2_curve_that_falls_again_at_high_pga_is_not_ok():
+    """An eight-record measurement: mode 2 counts 0 0 0 0 0 0 0 1 1 2 3 1 3 1 0 0 of 8 over PGA
     0.1-1.6 g, mode 1 taking over at high PGA, was fitted "ok" with its median above every
     stripe."""
     lv = np.linspace(0.1, 1.6, 16)

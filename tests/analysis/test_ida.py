@@ -10,21 +10,20 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from bodies import FIG3_YAML
 from click.testing import CliRunner
 
 import rocksweep
 from rocksweep.cli import main
-from rocksweep.compute.single import simulate
+from rocksweep.compute.single import run_point
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 
 ROOT = Path(__file__).resolve().parents[2]
 NAMES = ["SYN01.AT2", "SYN05.AT2", "SYN12.AT2"]
 SCENE = """
 name: ida test
-body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47,
-       IA_ratio: 0.56}
-impact: {lam: 0.0}
+""" + FIG3_YAML + """impact: {lam: 0.0}
 ground:
   records: suite/*.AT2
   scale: {im: PGA, values: [0.2, 0.4, 0.6, 0.8, 1.2, 1.6]}
@@ -74,7 +73,7 @@ def test_bisected_level_brackets_the_first_overturning(suite):
         for x, overturns in ((hi, True), (lo, False)):
             pt = dataclasses.replace(top, A_ratio=top.A_ratio * x / levels[j])
             assert pt.A == pytest.approx(x * G, rel=1e-12)
-            out = simulate(pt, sc.numerics, history=False).out
+            out = run_point(pt, sc.numerics, history=False).out
             assert (out[L.OUT_OUTCOME] in (1, 2)) is overturns
         checked += 1
     assert checked >= 1  # at least one record is bisected between two stripes

@@ -16,7 +16,7 @@ from scipy.stats import norm
 import rocksweep
 from rocksweep.analysis.risk import RiskError, read_hazard
 from rocksweep.cli import main
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 
 
 def fragility(median, beta, **extra):
@@ -229,7 +229,7 @@ def test_cli_writes_csv_and_h5(tmp_path, frag_file):
     h5 = tmp_path / "r.h5"
     assert CliRunner().invoke(main, ["risk", str(frag_file), "--hazard", str(hz), "-o",
                                      str(h5)]).exit_code == 0
-    back = rocksweep.api.open_any(h5)
+    back = rocksweep.open(h5)
     assert back.attrs["rocksweep_kind"] == "risk"
     fig = rocksweep.plot(back)
     assert len(fig.axes) == 3
@@ -307,3 +307,26 @@ def test_competing_modes_integrate_their_own_probabilities():
             {"PGA [g]": x, "annual_rate": k0 * x ** -k})).annual_rate[0])
         if s == 1:  # mode 2, censored by mode 1: far from its lognormal reading
             assert abs(got / plain - 1) > 0.05
+
+
+def test_openquake_avgsa_ia_and_cav_are_read_in_rocksweeps_units(tmp_path):
+    # openquake.hazardlib.imt: AvgSA in g, IA (Arias) in m/s, CAV in g s
+    hz = read_hazard(oq_file(tmp_path / "avg.csv", 1.0, "AvgSA", [0.1, 0.5], [[0.1, 0.01]]))
+    assert (hz.name, hz.unit) == ("AvgSa", "g") and hz.im.tolist() == pytest.approx([0.1, 0.5])
+    ia = read_hazard(oq_file(tmp_path / "ia.csv", 1.0, "IA", [0.1, 0.5], [[0.1, 0.01]]))
+    assert (ia.name, ia.unit) == ("Arias", "m/s")
+    cav = read_hazard(oq_file(tmp_path / "cav.csv", 1.0, "CAV", [0.1, 0.5], [[0.1, 0.01]]))
+    assert (cav.name, cav.unit) == ("CAV", "m/s")
+    assert cav.im.tolist() == pytest.approx([0.1 * G, 0.5 * G])
+
+
+def test_an_avgsa_hazard_meets_the_closed_form():
+    k0, k, median, beta = 1e-4, 2.0, 0.3, 0.4
+    fr = fragility(median, beta)
+    fr.attrs["im"] = "AvgSa"
+    hz = power_law(k0, k).rename(columns={"PGA [g]": "AvgSa [g]"})
+    rk = rocksweep.risk(fr, hz, years=50)
+    exact = k0 * median ** -k * math.exp(k * k * beta * beta / 2.0)
+    assert float(rk.annual_rate[0]) == pytest.approx(exact, rel=1e-6)
+    with pytest.raises(RiskError, match="not the fragility's IM AvgSa"):
+        rocksweep.risk(fr, power_law(k0, k), years=50)

@@ -12,7 +12,7 @@ from matplotlib.figure import Figure
 import rocksweep
 from rocksweep.analysis.kinds import dataset_kind
 from rocksweep.cli import main
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 
 
 @pytest.fixture(scope="module")

@@ -18,9 +18,9 @@ import rocksweep
 import rocksweep.compute.sweep as sw
 from rocksweep import api, fields
 from rocksweep.cli import main
-from rocksweep.compute.grid import Grid
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.parse import load_scene
 from rocksweep.store.reader import read_result
 
@@ -69,7 +69,7 @@ def test_public_names_have_docstrings_and_version(cli):
 def test_importing_single_runs_keeps_the_api_functions():
     """Importing the single-run module (rocksweep/compute/single.py) leaves rocksweep.run and
     rocksweep.open the API functions (a module named run.py used to replace rocksweep.run)."""
-    code = ("import rocksweep\nfrom rocksweep.compute.single import simulate\n"
+    code = ("import rocksweep\nfrom rocksweep.compute.single import run_point\n"
             "import rocksweep.compute.single\n"
             "print(rocksweep.run is rocksweep.api.run, rocksweep.open is rocksweep.api.open)")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
@@ -207,7 +207,7 @@ def test_cache_state_of_a_fresh_cache(tmp_path):
     sc = load_scene(CI_SMALL)
     sw.prepare(Grid(sc), sw.level(sc))
     assert sw.kernel_cache_state(Grid(sc), sw.level(sc)) == (0, 0)
-    code = ("from rocksweep.compute import sweep as sw; from rocksweep.compute.grid import Grid; "
+    code = ("from rocksweep.compute import sweep as sw; from rocksweep.scene.grid import Grid; "
             "from rocksweep.scene.parse import load_scene; "
             f"sc = load_scene({str(CI_SMALL)!r}); "
             "print(sw.kernel_cache_state(Grid(sc), sw.level(sc)))")
@@ -252,7 +252,7 @@ def test_simulate_keywords_and_dict_agree_and_history_is_physical():
     assert abs(h.theta_over_alpha.values[-1]) == pytest.approx(math.pi / 2 / 0.15, rel=1e-6)
     balance = h.W_in_over_Eref - h.D_damp_over_Eref - h.E_impact_over_Eref
     # to the integration error of the work integral: ~1e-3 E_ref at `default` (the one
-    # default of sweeps and single runs, issue 28), ~1e-5 E_ref at `fine`
+    # default of sweeps and single runs), ~1e-5 E_ref at `fine`
     np.testing.assert_allclose(h.E_over_Eref.values, balance.values, atol=2e-3)
     hf = rocksweep.simulate(FIG5, impact__lam=0.4, numerics__accuracy="fine").history
     np.testing.assert_allclose(hf.E_over_Eref.values, (hf.W_in_over_Eref - hf.D_damp_over_Eref
@@ -302,10 +302,10 @@ def test_one_field_table():
     sc = load_scene(FIG5, ["impact.lam=0.2"])
     g = Grid(sc)
     chunk = sw.run_chunk(g, 0, 1, sw.level(sc))
-    from rocksweep.compute.single import simulate
+    from rocksweep.compute.single import run_point
 
-    one = simulate(sc.point({a.name: a.values[0] for a in sc.axes}), sc.numerics,
-                   history=False)
+    one = run_point(sc.point({a.name: a.values[0] for a in sc.axes}), sc.numerics,
+                    history=False)
     assert chunk.arrays["steps"][0] == one.summary()["steps"] == one.out[L.OUT_STEPS]
     assert chunk.arrays["event_steps"][0] == one.summary()["event_steps"]
 

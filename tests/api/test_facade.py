@@ -1,6 +1,6 @@
-"""The thin facade (issue 31): each argument check and each piece of work lives in the room
+"""The thin facade: each argument check and each piece of work lives in the room
 that does it (analysis.boundaries, analysis.calibrate, analysis.fragility,
-analysis.spectrum, store.history, store.session), with the words the API always used, and
+analysis.spectrum, compute.history, compute.session), with the words the API always used, and
 what ``rocksweep.<function>`` returns is what it returned before."""
 
 from __future__ import annotations
@@ -99,9 +99,9 @@ def test_fragility_of_a_path_is_that_of_its_dataset(suite_result, suite_ds):
 
 
 def test_fragility_of_neither_is_one_line():
-    with pytest.raises(ApiError) as exc:
+    with pytest.raises(TypeError) as exc:  # a wrong type is a TypeError naming the argument
         rocksweep.fragility(5)
-    assert str(exc.value).startswith("ds = int: must be an xarray Dataset")
+    assert str(exc.value).startswith("ds = 5: must be an xarray Dataset")
     assert "\n" not in str(exc.value)
 
 
@@ -119,7 +119,7 @@ def test_spectra_say_their_kind_and_check_rtol_once():
 
 
 def test_run_checks_before_the_output_and_returns_the_file(tmp_path):
-    """run hands its checks to store.session.run_session: a bad argument leaves no file;
+    """run hands its checks to compute.session.run_session: a bad argument leaves no file;
     with output the Dataset is the file's, with the accessor."""
     out = tmp_path / "r.h5"
     scene = {"name": "run facade", "body": dict(FIG3), "impact": {"lam": 0.0},

@@ -203,7 +203,7 @@ def test_sigkill_and_resume_equals_uninterrupted_run(cli, tmp_path):
                      " A_ratio: {start: 0.3, stop: 8, num: 100}}\n")
     killed = tmp_path / "killed.h5"
     sc = parse_scene(scene.read_text())
-    from rocksweep.compute.grid import Grid
+    from rocksweep.scene.grid import Grid
 
     prepare(Grid(sc), level(sc))  # the subprocess loads numba's cache and starts at once
     kill_sweep_when([str(scene), "-o", str(killed), "--adaptive", "--jobs", "1",
@@ -227,7 +227,7 @@ def test_sigkill_and_resume_equals_uninterrupted_run(cli, tmp_path):
     assert res.exit_code == 0 and "computed 0 points" in res.output, res.output
 
 
-# a file with results is never to be written over as the first remedy (issue 32)
+# a file with results is never to be written over as the first remedy
 def keep(path) -> str:
     """The remedy said for a file of ``path``'s points that another scene cannot resume."""
     from rocksweep.store.reader import read_result
@@ -417,7 +417,7 @@ def test_validate_reports_filled_cells_that_differ(fig3_files, cli, tmp_path):
     sc = parse_scene(FIG3_SMALL)
     r = read_result(adapt)
     outcome, computed = r.arrays["outcome"].ravel(), r.arrays["computed"].ravel()
-    from rocksweep.compute.grid import Grid
+    from rocksweep.scene.grid import Grid
 
     plan = ad.make_plan(sc, coarse=2)
     v0 = ad.validate(Grid(sc), plan, outcome, computed, stride=3)

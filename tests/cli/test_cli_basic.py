@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from bodies import FIG3_YAML
 from click.testing import CliRunner
 
 from rocksweep.cli import main
@@ -14,8 +15,7 @@ from rocksweep.cli import main
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
 GOOD = """
-body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47, IA_ratio: 0.56}
-impact: {lam: 0.4}
+""" + FIG3_YAML + """impact: {lam: 0.4}
 pulse: {shape: sine, w_over_p: 5.3, A_ratio: 5.0}
 """
 
@@ -172,7 +172,7 @@ def test_console_script_error_has_no_traceback(tmp_path):
 def test_kernel_import_pulls_no_io_libraries():
     """The layers point one way: the kernel knows nothing of files, CLI or plots.
     (yaml is not checked: numba itself imports it to read its config file.)"""
-    code = ("import sys, rocksweep.kernel, rocksweep.physics.model, rocksweep.physics.points;"
+    code = ("import sys, rocksweep.kernel, rocksweep.physics.bodies, rocksweep.physics.points;"
             "bad = [m for m in ('h5py', 'click', 'matplotlib', 'pydantic') if m in sys.modules];"
             "print(','.join(bad))")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)

@@ -16,8 +16,8 @@ from bodies import FIG3_YAML
 from helpers import kill_sweep_when, one_line_error
 
 from rocksweep.cli import main
-from rocksweep.compute.sweep import ChunkResult
 from rocksweep.numerics import PRESETS
+from rocksweep.scene.grid import ChunkResult
 from rocksweep.store.reader import read_result
 from rocksweep.store.writer import SweepFile
 
@@ -49,7 +49,7 @@ def ci_result(tmp_path_factory):
 def test_sweep_summary(ci_result):
     out, text = ci_result
     assert "mode1" in text and "mode2" in text and "safe" in text and "flagged" in text
-    spp = PRESETS["default"][0]
+    spp = PRESETS["default"].steps_per_period
     assert "points/s" in text and f"accuracy: default (steps_per_period={spp}" in text
     assert "RK4 steps:" in text
     # one summary row per (shape, lam)
@@ -84,7 +84,7 @@ def test_info_text_and_json(ci_result, cli):
     assert d["dims"]["shape"]["scene_key"] == "pulse.shape"
     assert d["points_done"] == d["points_total"] == 256
     assert sum(c["safe"] + c["mode1"] + c["mode2"] for c in d["counts"]) == 256
-    assert d["numerics"]["steps_per_period"] == PRESETS["default"][0]
+    assert d["numerics"]["steps_per_period"] == PRESETS["default"].steps_per_period
     assert d["provenance"]["numba_version"]
     assert d["scene"] == CI_SMALL.read_text()
 
@@ -259,7 +259,7 @@ def test_info_counts_per_swept_key_in_ranges(cli, tmp_path):
 
 
 def test_plot_block_scene_with_panels_and_partial_file(cli, tmp_path):
-    """A block-body scene (issue 6) with a swept body key: one panel per alpha; points
+    """A block-body scene with a swept body key: one panel per alpha; points
     not computed yet are drawn grey with a warning. Results are synthetic (no kernel)."""
     from rocksweep.scene.parse import parse_scene
 
@@ -302,8 +302,8 @@ def test_kill_and_resume_equals_uninterrupted_run(cli, tmp_path):
     killed = tmp_path / "killed.h5"
     total = 3200
     # compile here if need be, so the subprocess loads numba's cache and starts at once
-    from rocksweep.compute.grid import Grid
     from rocksweep.compute.sweep import level, prepare
+    from rocksweep.scene.grid import Grid
     from rocksweep.scene.parse import load_scene
 
     sc = load_scene(scene)
@@ -337,8 +337,8 @@ def test_ctrl_c_writes_every_finished_chunk_before_it_exits(tmp_path):
                      "pulse: {shape: sine, w_over_p: {start: 0.3, stop: 6, num: 600},"
                      " A_ratio: {start: 0.3, stop: 8, num: 600}}\n")
     out = tmp_path / "int.h5"
-    from rocksweep.compute.grid import Grid
     from rocksweep.compute.sweep import level, prepare
+    from rocksweep.scene.grid import Grid
     from rocksweep.scene.parse import load_scene
 
     sc = load_scene(scene)

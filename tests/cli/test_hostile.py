@@ -1,4 +1,4 @@
-"""Hostile input (issue 23, "Every input answered"): each case answers in one line.
+"""Hostile input, every input answered: each case answers in one line.
 
 Every case runs the command line in a subprocess with a timeout (a hang fails the test
 by the timeout, not by a timed assertion) and asserts a non-zero exit, one line on
@@ -21,6 +21,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from bodies import FIG3_YAML
 
 import rocksweep
 from rocksweep.physics.records import at2_text
@@ -29,8 +30,7 @@ pytestmark = pytest.mark.faults
 
 ROOT = Path(__file__).resolve().parents[2]
 RECORD = ROOT / "records" / "synthetic_nearfault.AT2"
-BODY = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47, "
-        "IA_ratio: 0.56}\nimpact: {lam: 0.0}\n")
+BODY = FIG3_YAML + "impact: {lam: 0.0}\n"
 SCENE = ("name: hostile\n" + BODY + "pulse: {shape: sine, w_over_p: {start: 0.5, stop: 6, "
          "num: 4}, A_ratio: {start: 1, stop: 8, num: 4}}\n")
 ONE = "name: one\n" + BODY + "pulse: {shape: sine, w_over_p: 2, A_ratio: 4}\n"

@@ -1,4 +1,4 @@
-"""An output is never an input of its command (issue 32, "Data loss").
+"""An output is never an input of its command: a run never destroys its own data.
 
 Every file a command reads (the scene, its record, a suite's records and their listing, the
 result an analysis reads and the records that result names) is refused as any of the
@@ -15,6 +15,7 @@ import shutil
 from pathlib import Path
 
 import pytest
+from bodies import FIG3_YAML
 from helpers import one_line_error
 
 import rocksweep
@@ -25,8 +26,7 @@ from rocksweep.physics.records import read_record
 
 ROOT = Path(__file__).resolve().parents[2]
 SUITE = ROOT / "records" / "suite"
-BODY = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47, "
-        "IA_ratio: 0.56}\nimpact: {lam: 0.0}\n")
+BODY = FIG3_YAML + "impact: {lam: 0.0}\n"
 REFUSED = "is this command's input; choose another output path"
 
 

@@ -1,4 +1,4 @@
-"""Ctrl-C is never lost, and arguments that cannot work are one line (issue 32).
+"""Ctrl-C is never lost, and arguments that cannot work are one line.
 
 - An interrupt whose KeyboardInterrupt a library callback swallowed (llvmlite's ctypes
   callbacks while the kernel loads) still stops the sweep at its next checkpoint, with
@@ -18,6 +18,7 @@ import threading
 from pathlib import Path
 
 import pytest
+from bodies import FIG3_YAML
 from helpers import one_line_error
 
 import rocksweep
@@ -29,8 +30,7 @@ from rocksweep.errors import Arg, SceneError, SweepError, flag, set_key
 from rocksweep.store.reader import read_result
 
 ROOT = Path(__file__).resolve().parents[2]
-BODY = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47, "
-        "IA_ratio: 0.56}\nimpact: {lam: 0.0}\n")
+BODY = FIG3_YAML + "impact: {lam: 0.0}\n"
 GRID = ("name: g\n" + BODY + "pulse: {shape: sine, w_over_p: {start: 0.5, stop: 6, num: 40}, "
         "A_ratio: {start: 1, stop: 8, num: 40}}\n")
 

@@ -1,7 +1,7 @@
 """One policy for every file a command writes (rocksweep.outputs), through every command.
 
 Each case: one line naming the path and the reason, exit code 2, no traceback, and nothing
-written (issue 16, "Output paths").
+written.
 """
 
 import os

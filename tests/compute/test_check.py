@@ -1,4 +1,4 @@
-"""Per-point error estimates (issue 15, ``outputs.check`` / ``rocksweep sweep --check``):
+"""Per-point error estimates (``outputs.check`` / ``rocksweep sweep --check``):
 every point rerun at half the step, the differences stored.
 
 - the rerun is the run at twice steps_per_period and half rotation_step, bit for bit (an
@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 import pytest
+from bodies import body_yaml, table3
 from helpers import one_line_error
 
 from rocksweep.cli import main
@@ -24,17 +25,15 @@ from rocksweep.compute.driver import sweep_arrays
 from rocksweep.fields import CHECK_FIELDS, check_rows
 from rocksweep.kernel import chunk_kernel
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.numerics import PRESET_PULSE, PRESET_ROTATION, PRESETS, Numerics
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.numerics import PRESETS, Numerics
+from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.physics.points import Point, kernel_kind, point_row
 from rocksweep.physics.reference import reference_run
 from rocksweep.scene.parse import parse_scene
 
 SCENE = """
 name: check grid
-body: {wn_over_p: [2.43, .inf], zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28,
-       mA_over_m: 0.47, IA_ratio: 0.56}
-impact: {lam: [0.0, 1.2]}
+""" + body_yaml(table3(wn_over_p="[2.43, .inf]")) + """impact: {lam: [0.0, 1.2]}
 pulse: {shape: [sine, cosine], w_over_p: {start: 0.5, stop: 6, num: 6},
         A_ratio: {start: -8, stop: 8, num: 7}}
 """
@@ -52,11 +51,12 @@ def test_rerun_is_the_sweep_at_half_the_step():
     check."""
     plain = sweep_arrays(parse_scene(SCENE))[0]
     checked = sweep_arrays(parse_scene(SCENE, overrides=["outputs.check=true"]))[0]
-    spp, _ = PRESETS["default"]
+    default = PRESETS["default"]
+    spp = default.steps_per_period
     half = sweep_arrays(parse_scene(SCENE, overrides=[
         f"numerics.steps_per_period={2 * spp}",
-        f"numerics.pulse_steps={2 * PRESET_PULSE['default']}",
-        f"numerics.rotation_step={PRESET_ROTATION['default'] / 2}"]))[0]
+        f"numerics.pulse_steps={2 * default.pulse_steps}",
+        f"numerics.rotation_step={default.rotation_step / 2}"]))[0]
     assert set(checked) == set(plain) | set(CHECK_NAMES)
     for k, v in plain.items():
         assert _same(checked[k], v), k

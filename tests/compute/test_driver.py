@@ -1,4 +1,4 @@
-"""One sweep driver (issue 31): the library's in-memory sweeps (``driver.sweep_arrays``)
+"""One sweep driver: the library's in-memory sweeps (``driver.sweep_arrays``)
 run the loops of ``rocksweep sweep`` (``driver.drive``) into an array sink and give what
 the result file holds, bit for bit; the adaptive loop is written once
 (``adaptive.run_plan``), for the kernel and for a planted class function alike."""
@@ -69,14 +69,15 @@ def _calls(name: str) -> list[str]:
 
 def test_one_driver():
     """The chunk loop, the adaptive loop and the driver each have one caller in the
-    package: nothing else loops over chunks or plans (review 3's three drivers)."""
+    package: nothing else loops over chunks or plans (there were three drivers,
+    each with its own loop)."""
     assert _calls("next_step") == ["rocksweep/compute/adaptive.py"]  # in run_plan
     assert sorted(_calls("run_plan")) == ["rocksweep/compute/adaptive.py",  # on a function
                                           "rocksweep/compute/driver.py"]  # adaptive_loop
     assert sorted(_calls("run_chunks")) == ["rocksweep/compute/adaptive.py",  # run_batch
                                             "rocksweep/compute/driver.py"]  # every_point
     assert sorted(set(_calls("drive"))) == ["rocksweep/compute/driver.py",  # sweep_arrays
-                                            "rocksweep/store/session.py"]  # sweep_file
+                                            "rocksweep/compute/session.py"]  # sweep_file
     for retired in ("compute", "adaptive_compute"):
         assert not hasattr(__import__("rocksweep.compute.sweep", fromlist=["x"]), retired)
         assert not hasattr(ad, retired)

@@ -13,13 +13,13 @@ import math
 
 import numpy as np
 import pytest
-from bodies import SHARED
+from bodies import FIG3, SHARED
 
-from rocksweep.compute.single import history_capacity, simulate
+from rocksweep.compute.single import history_capacity, run_point
 from rocksweep.kernel import chunk_kernel, point_kernel
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import BlockBody, FlexibleBody, G, restitution, restitution_rigid
+from rocksweep.physics.bodies import BlockBody, FlexibleBody, G, restitution, restitution_rigid
 from rocksweep.physics.points import Point, kernel_kind, point_row
 
 TABLE3 = dict(SHARED)  # Table 3 without omega_n/p
@@ -80,8 +80,8 @@ def assert_covers_all_outcomes(outs: np.ndarray) -> None:
 @pytest.fixture(scope="module")
 def bodies() -> dict:
     return {
-        "flexible": FlexibleBody(wn_over_p=2.43, **TABLE3),
-        "undamped": FlexibleBody(wn_over_p=2.43, **{**TABLE3, "zeta": 0.0}),
+        "flexible": FlexibleBody(**FIG3),
+        "undamped": FlexibleBody(**{**FIG3, "zeta": 0.0}),
         "rigid": FlexibleBody(wn_over_p=math.inf, **TABLE3),
         "block": BlockBody(alpha=0.15),
     }
@@ -170,8 +170,8 @@ def test_rigid_energy_balance(bodies, name):
 
 def test_simulate_runs_bookkeeping_only_when_asked(bodies):
     point = Point(bodies["flexible"], 0.2, "sine", 3.0, 2.5)
-    lean = simulate(point, NUM, history=False)
-    full = simulate(point, NUM, history=True)
+    lean = run_point(point, NUM, history=False)
+    full = run_point(point, NUM, history=True)
     assert lean.history is None and "work_in_over_Eref" not in lean.summary()
     assert full.history is not None and "work_in_over_Eref" in full.summary()
     np.testing.assert_array_equal(lean.out[OUTCOME_COLS], full.out[OUTCOME_COLS])

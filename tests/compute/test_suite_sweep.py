@@ -21,13 +21,14 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from bodies import FIG3_YAML
 
 import rocksweep
-from rocksweep.compute.grid import Grid
 from rocksweep.kernel import layout as L
 from rocksweep.physics import intensity
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 from rocksweep.physics.records import read_record, write_at2
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.model import SceneError
 from rocksweep.scene.parse import load_scene, parse_scene
 
@@ -37,9 +38,7 @@ NAMES = ["SYN01.AT2", "SYN05.AT2", "SYN12.AT2"]
 
 SCENE = """
 name: suite test
-body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47,
-       IA_ratio: 0.56}
-impact: {lam: [0.0, 0.4]}
+""" + FIG3_YAML + """impact: {lam: [0.0, 0.4]}
 ground:
   records: %s
   scale: %s
@@ -281,3 +280,17 @@ def test_suite_on_a_dask_cluster(tmp_path, suite_dir):
         on = sweep_arrays(sc, backend="dask", scheduler=cluster.scheduler_address, chunk_size=4)[0]
     for name, v in local.items():
         np.testing.assert_array_equal(on[name], v, err_msg=name)
+
+
+def test_avgsa_cav_arias_are_stripe_ims_and_scale_invariant_ims_are_refused(tmp_path,
+                                                                           suite_dir):
+    sc = load_scene(write_scene(tmp_path, scale="{im: AvgSa, values: [0.1, 0.3]}"))
+    assert [a.name for a in sc.swept] == ["lam", "record", "AvgSa"]
+    assert sc.suite.avgsa_range[0] < sc.suite.avgsa_range[1]  # the range it scales to
+    for im in ("CAV", "Arias"):
+        assert load_scene(write_scene(tmp_path, scale=f"{{im: {im}, values: [1.0]}}")
+                          ).suite.im == im
+    with pytest.raises(SceneError, match=r"ground.scale.im = D5_95: does not change when a "
+                       r"record is scaled") as err:
+        load_scene(write_scene(tmp_path, scale="{im: D5_95, values: [10]}"))
+    assert "\n" not in str(err.value)

@@ -2,17 +2,17 @@
 
 import numpy as np
 import pytest
+from bodies import FIG3_YAML, body_yaml, table3
 
 import rocksweep.compute.sweep as sw
 from rocksweep import fields
 from rocksweep.compute.driver import sweep_arrays
-from rocksweep.compute.grid import Grid
-from rocksweep.compute.single import simulate
+from rocksweep.compute.single import run_point
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.parse import parse_scene
 
-BODY3 = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, "
-         "mA_over_m: 0.47, IA_ratio: 0.56}\n")
+BODY3 = FIG3_YAML
 
 
 def small_scene(extra: str = "") -> object:
@@ -65,7 +65,7 @@ def test_sweep_equals_single_runs(reference):
     rng = np.random.default_rng(0)
     for flat in rng.choice(g.size, 6, replace=False):
         values = {k: v[0] for k, v in g.index_values(np.array([flat])).items()}
-        run = simulate(sc.point(values), sc.numerics, history=False)
+        run = run_point(sc.point(values), sc.numerics, history=False)
         idx = np.unravel_index(flat, g.shape)
         assert ref["outcome"][idx] == run.out[L.OUT_OUTCOME]
         assert ref["impacts"][idx] == run.impacts
@@ -101,7 +101,7 @@ def test_merge_contiguous_joins_neighbours_in_any_order():
     rng = np.random.default_rng(3)
     bounds = [(0, 5), (5, 9), (9, 20), (30, 33), (33, 40), (50, 51)]
     full = {"x": rng.random(51), "n": np.arange(51)}
-    results = [sw.ChunkResult(a, b, {k: v[a:b] for k, v in full.items()}, 1.0, 0.5)
+    results = [ChunkResult(a, b, {k: v[a:b] for k, v in full.items()}, 1.0, 0.5)
                for a, b in bounds]
     merged = sw.merge_contiguous([results[i] for i in rng.permutation(len(results))])
     assert [(m.start, m.stop) for m in merged] == [(0, 20), (30, 40), (50, 51)]
@@ -144,8 +144,8 @@ def test_each_point_goes_to_its_kernel_variant(monkeypatch):
         return run
 
     monkeypatch.setattr(sw.kernel, "chunk_kernel", fake_kernel)
-    sc = parse_scene("body: {wn_over_p: [2.43, .inf], zeta: [0.0, 0.05], alpha_cg: 0.15, "
-                     "alpha_A: 0.28, mA_over_m: 0.47, IA_ratio: 0.56}\nimpact: {lam: 0.2}\n"
+    sc = parse_scene(body_yaml(table3(wn_over_p="[2.43, .inf]", zeta="[0.0, 0.05]"))
+                     + "impact: {lam: 0.2}\n"
                      "pulse: {shape: sine, w_over_p: [1.0, 2.0], A_ratio: 3.0}\n")
     g = Grid(sc)
     res = sw.run_chunk(g, 0, g.size, L.LEVEL_OUTCOME)
@@ -171,7 +171,7 @@ def test_energy_outputs_match_the_single_run_bookkeeping():
     g = Grid(sc)
     for flat in range(g.size):
         values = {k: v[0] for k, v in g.index_values(np.array([flat])).items()}
-        s = simulate(sc.point(values), sc.numerics, history=True).summary()
+        s = run_point(sc.point(values), sc.numerics, history=True).summary()
         idx = np.unravel_index(flat, g.shape)
         for name, key in (("work_in_over_Eref", "work_in_over_Eref"),
                           ("damper_loss_over_Eref", "damper_loss_over_Eref"),

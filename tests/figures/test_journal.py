@@ -1,4 +1,4 @@
-"""Figures ready for a journal and a notebook (issue 31): every Figure rocksweep returns
+"""Figures ready for a journal and a notebook: every Figure rocksweep returns
 saves TrueType fonts through its own ``savefig``, fits a journal width without clipping a
 legend or a label, keeps titles no larger than its labels, and shows itself in a notebook
 as a PNG without ``%matplotlib inline``."""
@@ -96,7 +96,7 @@ def analyses(laws, suite_result):
 
 @pytest.mark.parametrize("width", list(WIDTHS))
 def test_every_analysis_figure_fits_the_journal_widths(analyses, width, tmp_path):
-    """Issue 31: every figure rocksweep returns, the analyses' too, at single and double
+    """Every figure rocksweep returns, the analyses' too, at single and double
     column width: nothing outside the figure, TrueType in a PDF."""
     for kind, ds in analyses.items():
         fig = rocksweep.plot(ds, width=width)

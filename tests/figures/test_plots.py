@@ -9,19 +9,19 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from bodies import body_yaml, table3
 from helpers import one_line_error
 from matplotlib.colors import to_rgb
 from matplotlib.figure import Figure
 
 from rocksweep.cli import main
-from rocksweep.compute.sweep import ChunkResult
 from rocksweep.errors import RocksweepError
+from rocksweep.scene.grid import ChunkResult
 from rocksweep.store.reader import read_result
 from rocksweep.store.writer import SweepFile
 
 ROOT = Path(__file__).resolve().parents[2]
-BODY3 = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: {start: 0.1, stop: 0.2, num: 3}, "
-         "alpha_A: 0.28, mA_over_m: 0.47, IA_ratio: 0.56}\n")
+BODY3 = body_yaml(table3(alpha_cg="{start: 0.1, stop: 0.2, num: 3}"))
 
 
 def visible_axes(fig: Figure) -> list:
@@ -225,13 +225,13 @@ def test_stability_diagram_draws_into_given_axes(acg_result):
 
 @pytest.fixture(scope="module")
 def fig5_runs():
-    from rocksweep.compute.single import simulate
+    from rocksweep.compute.single import run_point
     from rocksweep.scene.parse import load_scene
 
     scene = load_scene(ROOT / "configs" / "fig5.yaml")
     fixed = {a.name: a.values[0] for a in scene.axes}
     lam = next(a for a in scene.axes if a.name == "lam")
-    return [simulate(scene.point({**fixed, "lam": v}), scene.single_numerics)
+    return [run_point(scene.point({**fixed, "lam": v}), scene.single_numerics)
             for v in lam.values]
 
 
@@ -257,7 +257,7 @@ def test_time_history_has_the_input_pulse_and_guide_legend(fig5_runs):
 
 def test_restitution_map_u0_curve_is_dark(body_fig2):
     from rocksweep.figures.common import restitution_map
-    from rocksweep.physics.model import restitution, restitution_rigid
+    from rocksweep.physics.bodies import restitution, restitution_rigid
 
     lam = np.linspace(0, 1, 11)
     u = np.linspace(-2, 2, 9)

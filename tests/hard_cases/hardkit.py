@@ -1,8 +1,8 @@
-"""Shared tools of the hard-case suite (issue 5): runs, events and the checks every case makes.
+"""Shared tools of the hard-case suite: runs, events and the checks every case makes.
 
 Every check here can fail: a history with NaN or inf, a run that hit a step or event cap,
 an energy balance that does not close, events that differ from the reference path's.
-Runs use ``rocksweep.compute.single.simulate`` (the kernel's history variant: energy accounting and
+Runs use ``rocksweep.compute.single.run_point`` (the kernel's history variant: energy accounting and
 one row per step and per action) and, for agreement, ``rocksweep.physics.reference.reference_run``
 (scipy's DOP853 with its own event handling, sharing only the equations with the kernel).
 """
@@ -13,11 +13,12 @@ import math
 from dataclasses import dataclass, replace
 
 import numpy as np
+from bodies import table3
 
-from rocksweep.compute.single import Run, simulate
+from rocksweep.compute.single import Run, run_point
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.physics.points import Point, point_row
 from rocksweep.physics.reference import reference_run
 
@@ -42,15 +43,12 @@ def numerics(**overrides) -> Numerics:
 
 def table3_body(**changes) -> FlexibleBody:
     """Table 3's slender body of Figure 3 (wn/p = 2.43), with some Pi groups changed."""
-    pi = dict(wn_over_p=2.43, zeta=0.05, alpha_cg=0.15, alpha_A=0.28, mA_over_m=0.47,
-              IA_ratio=0.56)
-    pi.update(changes)
-    return FlexibleBody(**pi)
+    return FlexibleBody(**table3(**changes))
 
 
 def run(point: Point, num: Numerics | None = None) -> Run:
     """One kernel run with its full history (energy-accounting variant); BASE numerics."""
-    return simulate(point, num or BASE, history=True)
+    return run_point(point, num or BASE, history=True)
 
 
 @dataclass(frozen=True)

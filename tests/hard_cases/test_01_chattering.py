@@ -7,7 +7,7 @@ import pytest
 from hardkit import BASE, FINE, assert_sane, kernel_events, numerics, reference_events, run
 from hardkit import table3_body as body
 
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 from rocksweep.physics.points import Point
 
 pytestmark = pytest.mark.hard
@@ -54,8 +54,8 @@ def test_chattering_ends_in_full_contact_after_finitely_many_impacts():
     r = run(POINT)
     assert_sane(r)
     assert r.outcome == "safe"
-    # the rest-rate rule ended the sequences: the run says "settled", never "rest" (a
-    # proof), issue 15
+    # the rest-rate rule ended the sequences: the run says "settled" (a rule), never "rest"
+    # (which would be a proof)
     assert "settled" in set(r.status) and "rest" not in set(r.status)
     seqs = _sequences(kernel_events(r))
     assert len(seqs) == 3  # three episodes, each chattering down to full contact

@@ -10,7 +10,7 @@ from scipy.integrate import solve_ivp
 
 from rocksweep.kernel.layout import PAR_DT
 from rocksweep.numerics import spring_steps
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 from rocksweep.physics.points import Point, body_omega_rock, point_row
 
 pytestmark = pytest.mark.hard

@@ -4,11 +4,12 @@ import math
 
 import numpy as np
 import pytest
+from bodies import BODY2
 from hardkit import assert_sane, kernel_events, reference_events, run
 
 from rocksweep.kernel.equations import restitution as kernel_restitution
 from rocksweep.kernel.layout import PAR_LAM
-from rocksweep.physics.model import BlockBody, FlexibleBody, impact_energy_loss, restitution
+from rocksweep.physics.bodies import BlockBody, impact_energy_loss, restitution
 from rocksweep.physics.points import Point, body_row
 
 pytestmark = pytest.mark.hard
@@ -20,8 +21,7 @@ BLOCK = BlockBody(alpha=math.pi / 3)
 LAM0_BLOCK = 2.0 - BLOCK.I_O / (BLOCK.M * BLOCK.b**2)
 # Table 2's stocky flexible body (Figure 2); its lam_0 is < -0.2 for |u| <= 2 u_cr, so
 # lam = -1 gives e < 0 at every impact; near lam = 1 and with large |u|, e > 1.
-FIG2 = FlexibleBody(wn_over_p=2.43, zeta=0.05, alpha_cg=0.35, alpha_A=0.6, mA_over_m=0.47,
-                    IA_ratio=0.56)
+FIG2 = BODY2
 
 NON_POSITIVE = {
     "block e = 0, uplift again at once": (BLOCK, LAM0_BLOCK, "sine", 2.0, 1.5),
@@ -86,7 +86,7 @@ def test_e_above_1_records_the_energy_gained_and_stays_finite(lam, shape, w, a_r
     assert {"e_above_1", "energy_gain"} <= set(r.status)
     h = r.history
     # every rocking-to-rocking impact, checked against eq. (1) and eq. (6) of the paper
-    # (rocksweep.physics.model, written independently of the kernel): e, theta'^+ and the energy
+    # (rocksweep.physics.bodies, written independently of the kernel): e, theta'^+ and the energy
     e_all, gained, n_gaining = [], 0.0, 0
     for i in np.flatnonzero(np.diff(h["t"]) == 0.0):
         s0, s1 = int(h["phase"][i]), int(h["phase"][i + 1])

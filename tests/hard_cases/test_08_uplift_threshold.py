@@ -7,7 +7,7 @@ import pytest
 from hardkit import assert_sane, kernel_events, reference_events, run
 from hardkit import table3_body as body
 
-from rocksweep.physics.model import BlockBody
+from rocksweep.physics.bodies import BlockBody
 from rocksweep.physics.points import Point
 
 pytestmark = pytest.mark.hard

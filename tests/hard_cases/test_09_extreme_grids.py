@@ -8,7 +8,7 @@ from hardkit import BASE, assert_sane, kernel_events, reference_events, run
 from hardkit import table3_body as body
 
 from rocksweep.kernel.layout import PAR_DT, PAR_DT_ON, PAR_ROT_STEP, PAR_TPULSE
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 from rocksweep.physics.points import Point, point_row
 
 pytestmark = pytest.mark.hard

@@ -4,11 +4,12 @@ import math
 
 import numpy as np
 import pytest
+from bodies import FIG3
 from hardkit import assert_sane, numerics, reference_events, run
 from hardkit import table3_body as body
 
 from rocksweep.kernel.layout import KIND_FLEXIBLE_UNDAMPED
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 from rocksweep.physics.points import Point, kernel_kind
 
 pytestmark = pytest.mark.hard
@@ -17,7 +18,7 @@ OUTCOME = {0: "safe", 1: "mode1", 2: "mode2"}
 # The top mass sits above the base while h > 0, i.e. tan(alpha_cg) < (1 + mu)/mu tan(alpha_A)
 # (mu = m_A/m): for Table 3 (mu = 0.47, alpha_A = 0.28) alpha_cg < 0.7325. 0.999 of that
 # puts the top mass at h = 0.0024 b: u_cr ~ 1/h is huge, the lever arm tiny.
-ALPHA_MAX = math.atan((1 + 0.47) / 0.47 * math.tan(0.28))
+ALPHA_MAX = math.atan((1 + FIG3["mA_over_m"]) / FIG3["mA_over_m"] * math.tan(FIG3["alpha_A"]))
 CASES = {
     "zeta = 0": (dict(zeta=0.0), [("sine", 5.3, 5.0), ("cosine", 2.0, 1.5)]),
     "m_A/m = 1e-4": (dict(mA_over_m=1e-4), [("cosine", 4.0, 2.0), ("sine", 5.3, 5.0)]),

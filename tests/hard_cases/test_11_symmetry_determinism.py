@@ -13,7 +13,7 @@ from joblib import Parallel, delayed
 
 from rocksweep.kernel import chunk_kernel
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.physics.model import BlockBody
+from rocksweep.physics.bodies import BlockBody
 from rocksweep.physics.points import Point, point_row
 
 pytestmark = pytest.mark.hard

@@ -5,13 +5,14 @@ from datetime import timedelta
 
 import numpy as np
 import pytest
+from bodies import BODY2
 from hardkit import BALANCE_TOL, BASE, balance_residual, numerics, run
 from hardkit import table3_body as body
 from hypothesis import HealthCheck, assume, event, example, given, settings
 from hypothesis import strategies as st
 
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import BodyError, FlexibleBody
+from rocksweep.physics.bodies import BodyError, FlexibleBody
 from rocksweep.physics.points import Point
 
 pytestmark = pytest.mark.hard
@@ -89,7 +90,7 @@ NAMED = {
     "event at t = 0": Point(body(), 0.2, "cosine", 6.0, 6.2),
     "pulse end": Point(body(), 0.2, "cosine", 4.25, 1.3),
     "stiff": Point(body(wn_over_p=200.0), 0.2, "cosine", 4.0, 2.0),
-    "e > 1": Point(FlexibleBody(2.43, 0.05, 0.35, 0.6, 0.47, 0.56), 0.95, "sine", 4.0, 3.0),
+    "e > 1": Point(BODY2, 0.95, "sine", 4.0, 3.0),
     "a hair above": Point(body(wn_over_p=math.inf), 0.2, "sine", 0.7, 1.0 + 1e-6),
     "tiny amplitude": Point(body(), 0.2, "sine", 2.0, 1e-9),
     "zeta = 0": Point(body(zeta=0.0), 0.2, "sine", 5.3, 5.0),

@@ -1,4 +1,4 @@
-"""What a command pays at start-up for the compiled kernel (issue 24): a cached variant
+"""What a command pays at start-up for the compiled kernel: a cached variant
 loads without numba's registries (``kernel._cache.EntryCache``), and reading a result
 loads no numba at all.
 
@@ -17,7 +17,7 @@ import numpy as np
 
 from rocksweep.compute import sweep as sw
 from rocksweep.compute.driver import sweep_arrays
-from rocksweep.compute.grid import Grid
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.parse import load_scene
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -60,7 +60,7 @@ def test_a_process_that_loaded_a_variant_still_compiles_new_code():
     sw.prepare(Grid(scene), sw.level(scene))
     out = _python(
         "import sys, numpy as np, numba; from rocksweep.compute import sweep as sw; "
-        "from rocksweep.compute.grid import Grid; from rocksweep.scene.parse import load_scene; "
+        "from rocksweep.scene.grid import Grid; from rocksweep.scene.parse import load_scene; "
         f"sc = load_scene({str(CI_SMALL)!r}); sw.prepare(Grid(sc), sw.level(sc)); "
         f"before = {REFRESHED!r} in sys.modules; "
         "f = numba.njit(lambda a: np.cumsum(a)[-1] + np.linalg.norm(a)); "

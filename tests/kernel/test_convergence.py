@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from bodies import BODY3, BODY4
 
-from rocksweep.compute.single import simulate
+from rocksweep.compute.single import run_point
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
 from rocksweep.physics.points import Point
@@ -27,8 +27,8 @@ def test_error_falls_sixteenfold_per_halving_of_the_step(name):
     truth = reference_run(point)[key]
     errors = []
     for spp in (10, 20, 40, 80):
-        out = simulate(point, Numerics(steps_per_period=spp, event_tol=1e-13),
-                       history=False).out
+        out = run_point(point, Numerics(steps_per_period=spp, event_tol=1e-13),
+                        history=False).out
         errors.append(abs(out[index] - truth))
     ratios = np.array(errors[:-1]) / np.array(errors[1:])
     assert np.all(ratios > 1), errors  # monotone over the ladder
@@ -53,7 +53,7 @@ def test_event_times_converge_to_the_reference_as_the_tolerance_shrinks(root):
     floor = 1e-8
     errors = []
     for tol in (1e-3, 1e-4, 1e-5, 1e-6, 1e-8):
-        run = simulate(point, Numerics(steps_per_period=160, event_tol=tol, root=root))
+        run = run_point(point, Numerics(steps_per_period=160, event_tol=tol, root=root))
         times = _event_times(run)
         d_uplift = times[0] - t_uplift
         d_impact = run.out[L.OUT_T_FIRST_IMPACT] - t_impact

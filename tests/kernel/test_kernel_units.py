@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 import pytest
+from bodies import BODY3
 from numba import njit
 
 from rocksweep.kernel import layout as L  # noqa: N812
@@ -31,12 +32,11 @@ from rocksweep.kernel.events import (
     hermite_root,
 )
 from rocksweep.kernel.stepping import first_stage, rk4_step
-from rocksweep.physics.model import FlexibleBody
 from rocksweep.physics.points import body_omega_rock
+from rocksweep.vocab.settings import ROOT_CODE
 
 # Newton's stopping step in units of the step, as _locate asks for (0.05 tol / width).
 XTOL = 1e-8
-ROOTS = {"bisect": L.ROOT_BISECT, "illinois": L.ROOT_ILLINOIS, "hermite": L.ROOT_HERMITE}
 
 
 # ------------------------------------------------------------------------------------
@@ -196,19 +196,19 @@ CASES = {"uplift (sine pulse)": _uplift_case, "impact (linear theta)": _impact_c
 @pytest.mark.parametrize("tol", [1e-6, 1e-9])
 def test_locate_brackets_the_closed_form_root_to_the_tolerance(case, tol):
     trials = {}
-    for name, code in ROOTS.items():
+    for name, code in ROOT_CODE.items():
         prm, ev, t0, y0, h, s, on, tau_star = CASES[case](code, tol)
         tau, n, g_tau, g_before = _locate_in_step(ev, t0, y0, h, s, on, prm)
         # the event has happened at tau and not tol before it: the root is in (tau - tol, tau]
         assert g_tau <= 0.0 < g_before, name
         assert -1e-15 <= tau - tau_star <= tol * (1 + 1e-6) + 1e-15, name
         trials[name] = n
-    assert trials["bisect"] == math.ceil(math.log2(h / tol))
-    assert trials["hermite"] < trials["bisect"]
+    assert trials["bisection"] == math.ceil(math.log2(h / tol))
+    assert trials["hermite"] < trials["bisection"]
     if case == "uplift (sine pulse)":
         # (on the linear g the first secant lands on the root, after which every secant
         # falls within tol/2 of that end and the safeguard bisects: no gain there)
-        assert trials["illinois"] < trials["bisect"]
+        assert trials["illinois"] < trials["bisection"]
 
 
 def test_hermite_closes_the_chattering_impacts_of_figure_3a_in_under_4_trials():
@@ -235,8 +235,7 @@ def test_hermite_closes_the_chattering_impacts_of_figure_3a_in_under_4_trials():
 
 
 def test_rocking_spring_omega_matches_the_model_at_lever_arm_b_and_is_largest_at_zero():
-    body = FlexibleBody(wn_over_p=2.43, zeta=0.05, alpha_cg=0.15, alpha_A=0.28,
-                        mA_over_m=0.47, IA_ratio=0.56)
+    body = BODY3
     i_a0 = body.I_A + body.m_A * body.R_A**2
     at_b = rocking_spring_omega(body.omega_n, 0.0, body.m, body.h, i_a0, body.b)
     # at u = 0 (a = b): omega_n sqrt(I_O / (I_A + m_A R_A^2 + m b^2)), written from I_O

@@ -1,6 +1,6 @@
 """A kernel you can step through: with NUMBA_DISABLE_JIT=1 the same kernel code runs as
 plain Python (a debugger, coverage) and gives the jitted results; and the cache loader's
-private numba names each have a fallback (issue 31)."""
+private numba names each have a fallback."""
 
 from __future__ import annotations
 

@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 from numba import njit
 
-from rocksweep.compute.grid import Grid
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel.loop import _near_saddle, _saddle, _saddle_bounds
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.parse import load_scene
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"

@@ -9,10 +9,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from bodies import FIG4
 
 from rocksweep.compute.driver import sweep_arrays
 from rocksweep.numerics import PRESETS, Numerics, spring_steps, step_sizes
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.physics.points import body_omega_rock, body_zeta_rock
 from rocksweep.physics.reference import reference_run
 from rocksweep.scene.parse import load_scene
@@ -49,7 +50,8 @@ def test_spring_decay_bounded(omega_rock: float, zeta_rock: float, spp: int) -> 
     """At the rule's step (where the spring sets it) RK4 damps an oscillating spring by at
     most the bound per unit p*t; the leading-order y^6/144 the rule uses bounds the exact
     rate from above, and the rule takes no more steps than that needs."""
-    dt, _ = step_sizes(omega_rock, 1.0, spp, PRESETS["default"][0], zeta_rock=zeta_rock)
+    dt, _ = step_sizes(omega_rock, 1.0, spp, PRESETS["default"].steps_per_period,
+                       zeta_rock=zeta_rock)
     n = float(spring_steps(omega_rock, spp, zeta_rock))
     assert float(dt) == pytest.approx(2 * math.pi / (omega_rock * n))
     rate = rk4_decay_rate(omega_rock, float(dt))
@@ -99,7 +101,7 @@ def test_an_overdamped_spring_gets_no_damping_bound() -> None:
     ``body_zeta_rock`` tells the two apart (Gamma = 1 + m h^2 / (I_A + m_A R_A^2), eq. of
     the rocking phase linearised at the top mass over the corner)."""
     for zeta, overdamped in ((0.05, False), (0.3, False), (3.0, True)):
-        body = FlexibleBody(9.82, zeta, 0.15, 0.28, 0.47, 0.56)  # Figure 4's, other zeta
+        body = FlexibleBody(**{**FIG4, "zeta": zeta})  # Figure 4's, other zeta
         gamma = 1 + body.m * body.h ** 2 / (body.I_A + body.m_A * body.R_A ** 2)
         zr = zeta * math.sqrt(gamma)
         assert (zr >= 1) == overdamped

@@ -1,4 +1,4 @@
-"""The tails of the accuracy (issue 15): the worst cases of a wide-space sample
+"""The tails of the accuracy: the worst cases of a wide-space sample
 (scripts/wide_space.py), each against the scipy reference or a closed form, at the preset
 that should get them right.
 
@@ -17,17 +17,18 @@ import math
 
 import numpy as np
 import pytest
+from bodies import table3
 from scipy.integrate import quad
 
-from rocksweep.compute.single import simulate
+from rocksweep.compute.single import run_point
 from rocksweep.kernel import chunk_kernel
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.physics.points import Point, point_row
 from rocksweep.physics.reference import reference_run
 
-# The huge slow cosine pulse of issue 15 on undamped bodies (wn/p = 1.56, zeta = 0): an
+# The huge slow cosine pulse of the wide-space sample on undamped bodies (wn/p = 1.56, zeta = 0): an
 # overturning without impact (mode 2) and one after an impact (mode 1).
 HUGE_COSINE = {
     "mode2": Point(FlexibleBody(1.56, 0.0, 0.45, 0.54, 0.05, 0.56), 0.4, "cosine", 0.33, -19.6),
@@ -45,11 +46,11 @@ def test_huge_slow_pulse_is_not_crossed_in_a_handful_of_steps(case):
     p = HUGE_COSINE[case]
     ref = reference_run(p, Numerics())
     assert ref["outcome"] == (L.OUTCOME_MODE2 if case == "mode2" else L.OUTCOME_MODE1)
-    acc = simulate(p, Numerics.preset("accurate"), history=False)
+    acc = run_point(p, Numerics.preset("accurate"), history=False)
     assert acc.outcome == case
     assert abs(acc.t_overturn - ref["t_overturn"]) <= (0.05 if case == "mode2" else 0.02)
     # the body turns through pi/2 = 3.5 alpha_cg: at most 0.25 alpha_cg per step
-    d = simulate(p, Numerics.preset("default"), history=False)
+    d = run_point(p, Numerics.preset("default"), history=False)
     assert d.get("steps") >= math.pi / 2 / (0.25 * p.body.alpha_ref) - 1
     assert abs(d.t_overturn - ref["t_overturn"]) <= 0.15
 
@@ -57,7 +58,8 @@ def test_huge_slow_pulse_is_not_crossed_in_a_handful_of_steps(case):
 def _rigid_fall(alpha_cg: float, numerics: Numerics) -> tuple[np.ndarray, FlexibleBody, float]:
     """A rigid body started at theta = 0 with theta' 10% above what carries it over the top
     (no pulse: A_ratio = 0). Returns (energy kernel's result row, body, theta'_0)."""
-    body = FlexibleBody(math.inf, 0.05, alpha_cg, min(1.3, 2 * alpha_cg), 0.47, 0.56)
+    body = FlexibleBody(**table3(wn_over_p=math.inf, alpha_cg=alpha_cg,
+                                 alpha_A=min(1.3, 2 * alpha_cg)))
     w0 = 1.1 * math.sqrt(2 * (1 - math.cos(body.alpha_ref)))  # p = 1
     row = point_row(Point(body, 0.0, "sine", 12.0, 0.0), numerics)
     row[L.PAR_THETA_DOT0] = w0
@@ -75,7 +77,7 @@ def test_rigid_fall_time_and_energy_balance(alpha_cg):
     1/2 I_O theta'_0^2 (nothing acts on the body)."""
     # `default` steps the free fall at 2 pi/5 p*t or 0.25 alpha_cg of turning, whichever is
     # shorter (its zero-amplitude pulse, 0.52 p*t long, no longer sets the step after it
-    # ends: issue 28): 5.1e-4 p*t and 1.2e-4 E_ref off; `accurate` 1.8e-5 and 1.4e-6
+    # ends): 5.1e-4 p*t and 1.2e-4 E_ref off; `accurate` 1.8e-5 and 1.4e-6
     for preset, t_tol, e_tol in (("default", 1e-3, 2.5e-4), ("accurate", 1e-4, 2e-5)):
         out, body, w0 = _rigid_fall(alpha_cg, Numerics.preset(preset))
         a = body.alpha_ref
@@ -99,7 +101,7 @@ def test_energy_gaining_impacts_resolved_at_accurate():
     p = Point(body, 1.3, "sine", 8.14, -2.894)
     ref = reference_run(p, Numerics())
     assert ref["status"] & L.STATUS_E_ABOVE_1 and ref["outcome"] == L.OUTCOME_MODE1
-    r = simulate(p, Numerics.preset("accurate"), history=False)
+    r = run_point(p, Numerics.preset("accurate"), history=False)
     assert "e_above_1" in r.status and r.outcome == "mode1"
     assert r.impacts == ref["impacts"]
     assert abs(r.t_overturn - ref["t_overturn"]) <= 0.05
@@ -115,7 +117,7 @@ def test_chattering_cut_short_by_the_rest_rate_is_not_rest():
     body = FlexibleBody(22.5, 0.0, 0.195, 0.644, 0.359, 0.582)
     p = Point(body, 0.334, "cosine", 4.78, 15.9)
     for name in ("draft", "default", "accurate", "fine"):
-        r = simulate(p, Numerics.preset(name), history=False)
+        r = run_point(p, Numerics.preset(name), history=False)
         assert r.status == ["horizon", "settled"] and r.outcome == "safe", (name, r.status)
         assert r.impacts > 1000, name  # chattering on to the horizon, as the reference does
 
@@ -124,6 +126,6 @@ def test_rest_still_proven_without_the_rule():
     """The other side: a flexible body whose pulse never lifts it (A below the uplift
     threshold) ends "rest" at the pulse's end, with no "settled"."""
     body = FlexibleBody(22.5, 0.0, 0.195, 0.644, 0.359, 0.582)
-    r = simulate(Point(body, 0.334, "sine", 4.78, 0.3), Numerics.preset("default"),
-                 history=False)
+    r = run_point(Point(body, 0.334, "sine", 4.78, 0.3), Numerics.preset("default"),
+                  history=False)
     assert r.status == ["rest"] and r.get("uplifts") == 0

@@ -1,4 +1,4 @@
-"""Where the model holds (issue 14): ground reactions, friction demand, lift-off, impulses.
+"""Where the model holds: ground reactions, friction demand, lift-off, impulses.
 
 The reactions are derived here independently with sympy from the masses' positions in the
 ground frame (``test_derivations._positions``, the kinematics of the equations of motion):
@@ -14,6 +14,7 @@ import h5py
 import numpy as np
 import pytest
 import sympy as sp
+from bodies import FIG3_YAML, table3
 from test_derivations import _positions
 
 from rocksweep.cli.main import main
@@ -22,7 +23,7 @@ from rocksweep.kernel import chunk_kernel, contact, point_kernel
 from rocksweep.kernel import equations as eq
 from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import BlockBody, FlexibleBody
+from rocksweep.physics.bodies import BlockBody, FlexibleBody
 from rocksweep.physics.points import Point, point_row
 from rocksweep.scene.model import SceneError
 from rocksweep.scene.parse import parse_scene
@@ -130,9 +131,8 @@ def test_rigid_body_without_uplift_needs_A_over_g(shape, A):
     """A rigid body that never uplifts (A_ratio < 1): mu_req = |A|/g = A_ratio tan(alpha),
     the peak of the pulse, located inside a step (the sine's peak falls between steps);
     N = M g throughout; no impact, no impulse."""
-    for body in (BlockBody(alpha=0.2), FlexibleBody(wn_over_p=math.inf, zeta=0.0,
-                                                    alpha_cg=0.15, alpha_A=0.28,
-                                                    mA_over_m=0.47, IA_ratio=0.56)):
+    for body in (BlockBody(alpha=0.2), FlexibleBody(**table3(wn_over_p=math.inf,
+                                                                 zeta=0.0))):
         out = _run(body, A=A, w=1.7, shape=shape)
         assert out[L.OUT_UPLIFTS] == 0
         assert out[L.OUT_MU_REQ] == pytest.approx(A * math.tan(body.alpha_ref), rel=1e-9)
@@ -258,9 +258,7 @@ def test_status_bits_follow_mu(body_fig3):
 
 
 SCENE = """
-body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47,
-       IA_ratio: 0.56}
-impact: {lam: [0.0, 0.4]}
+""" + FIG3_YAML + """impact: {lam: [0.0, 0.4]}
 pulse: {shape: sine, w_over_p: {start: 0.5, stop: 6, num: 5}, A_ratio: {start: 0.5, stop: 8,
         num: 5}}
 """

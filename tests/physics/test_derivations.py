@@ -12,7 +12,7 @@ import sympy as sp
 from rocksweep.kernel import equations as eq
 from rocksweep.kernel.layout import PAR_LAM
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import impact_energy_loss, restitution
+from rocksweep.physics.bodies import impact_energy_loss, restitution
 from rocksweep.physics.points import Point, point_row
 
 t = sp.symbols("t")

@@ -1,4 +1,4 @@
-"""Impact laws (issue 21): vertical (eq. 1), locked, constant, and e_factor.
+"""Impact laws: vertical (eq. 1), locked, constant, and e_factor.
 
 Each law's e and energy loss are derived here with sympy from the impulse-momentum balance
 (angular momentum about the impulse point, plus the law's rule for the top mass), written
@@ -11,16 +11,17 @@ from dataclasses import replace
 import numpy as np
 import pytest
 import sympy as sp
+from bodies import FIG3_YAML
 from helpers import one_line_error
 
 from rocksweep.cli import main
 from rocksweep.compute.driver import sweep_arrays
-from rocksweep.compute.single import simulate
+from rocksweep.compute.single import run_point
 from rocksweep.kernel import equations as eq
 from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
 from rocksweep.physics import impact
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.physics.points import Point, point_row
 from rocksweep.scene.model import SceneError
 from rocksweep.scene.parse import load_scene, parse_scene
@@ -136,8 +137,8 @@ def test_locked_at_u_0_is_the_rigid_kernels_own_impacts(body_fig3):
     rigid = replace(body_fig3, wn_over_p=math.inf)
     for lam_v in (0.0, 0.4):
         e_locked = eq.restitution(1, 0.0, _row(body_fig3, "locked", lam_v), True)
-        run = simulate(Point(rigid, lam_v, "sine", 6.0, 1.5, cycles=6, law="locked"),
-                       Numerics(), history=False)
+        run = run_point(Point(rigid, lam_v, "sine", 6.0, 1.5, cycles=6, law="locked"),
+                        Numerics(), history=False)
         assert run.impacts >= 5
         assert run.out[L.OUT_E_MAX] == pytest.approx(e_locked, rel=1e-13)
         i_o, mb2 = rigid.I_O, rigid.M * rigid.b**2
@@ -151,13 +152,13 @@ def test_constant_e_1_conserves_a_rigid_bodys_energy(body_fig3):
     move beyond the event location's overshoot, ~1e-8 E_ref)."""
     rigid = replace(body_fig3, wn_over_p=math.inf)
     p = Point(rigid, 0.0, "sine", 6.0, 1.5, cycles=6, law="constant", e=1.0)
-    run = simulate(p, Numerics.preset("fine"))
+    run = run_point(p, Numerics.preset("fine"))
     assert run.impacts >= 10
     steps = np.abs(np.diff(run.history["E_impact"]))
     assert steps.max() < 1e-7 * rigid.E_ref
     assert run.out[L.OUT_N_GAINING] == 0
     # the same body under eq. (1)'s rigid e loses energy at its impacts
-    lossy = simulate(replace(p, law="vertical", e=math.nan), Numerics.preset("fine"))
+    lossy = run_point(replace(p, law="vertical", e=math.nan), Numerics.preset("fine"))
     assert lossy.out[L.OUT_E_IMPACT] > 1e-3 * rigid.E_ref
 
 
@@ -201,7 +202,7 @@ def test_reference_follows_each_law(body_fig3):
     for law, e in (("vertical", math.nan), ("locked", math.nan), ("constant", 0.77)):
         p = Point(body_fig3, 0.4, "sine", 5.0, 4.0, law=law, e=e)
         ref = reference_run(p, Numerics.preset("fine"))
-        run = simulate(p, Numerics.preset("fine"), history=False)
+        run = run_point(p, Numerics.preset("fine"), history=False)
         assert ref["outcome"] == int(run.out[L.OUT_OUTCOME])
         assert ref["e_max"] == pytest.approx(run.out[L.OUT_E_MAX], rel=1e-3)
         seen.add(round(ref["e_max"], 3))
@@ -232,8 +233,7 @@ def test_e_needs_law_constant_and_constant_needs_e(cli):
     assert msg.endswith("impact.e: missing; law constant needs its coefficient of "
                         "restitution e: a number in (0, 1], a list or a range"), msg
     with pytest.raises(SceneError, match=r"impact.law = \['vertical', 'vertical'\]: a law is"):
-        parse_scene("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, "
-                    "mA_over_m: 0.47, IA_ratio: 0.56}\nimpact: {lam: 0, law: [vertical, "
+        parse_scene(FIG3_YAML + "impact: {lam: 0, law: [vertical, "
                     "vertical]}\npulse: {shape: sine, w_over_p: 1, A_ratio: 1}")
 
 

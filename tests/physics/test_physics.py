@@ -4,15 +4,16 @@ import math
 
 import numpy as np
 import pytest
+from bodies import table3
 from numba import njit
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from rocksweep.compute.single import simulate
+from rocksweep.compute.single import run_point
 from rocksweep.kernel import equations as eq
 from rocksweep.kernel import stepping as ki
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import FlexibleBody, G, restitution, restitution_rigid
+from rocksweep.physics.bodies import FlexibleBody, G, restitution, restitution_rigid
 from rocksweep.physics.points import Point, point_row
 
 # Physics checks run at a pinned accuracy, independent of how the presets are tuned.
@@ -47,7 +48,7 @@ def test_cosine_pulse_uplift_at_t0_brackets_static_threshold(body_fig3, factor, 
     bd = body_fig3
     a_crit = bd.M * G * bd.b / (bd.m_A * bd.h_A)
     a_ratio = factor * a_crit / (G * math.tan(bd.alpha_cg))
-    run = simulate(Point(bd, 0.2, "cosine", 3.0, -a_ratio), NUM)
+    run = run_point(Point(bd, 0.2, "cosine", 3.0, -a_ratio), NUM)
     h = run.history
     first = np.flatnonzero(h["phase"] != 0)
     assert bool(h["t"][first[0]] == 0.0) is lifts_at_zero
@@ -56,13 +57,13 @@ def test_cosine_pulse_uplift_at_t0_brackets_static_threshold(body_fig3, factor, 
 
 def test_rigid_uplift_at_g_tan_alpha():
     """Rigid body, sine pulse: uplift when A sin(w t) first reaches g tan(alpha_cg)."""
-    bd = FlexibleBody(math.inf, 0.0, 0.15, 0.28, 0.47, 0.56)
+    bd = FlexibleBody(**table3(wn_over_p=math.inf, zeta=0.0))
     for a_ratio in (1.3, 3.0):
-        run = simulate(Point(bd, 0.0, "sine", 2.0, a_ratio), NUM)
+        run = run_point(Point(bd, 0.0, "sine", 2.0, a_ratio), NUM)
         h = run.history
         t_up = h["t"][np.flatnonzero(h["phase"] != 0)[0]]
         assert t_up == pytest.approx(math.asin(1 / a_ratio) / 2.0, abs=1e-7)
-    assert simulate(Point(bd, 0.0, "sine", 2.0, 0.999), NUM).uplifts == 0
+    assert run_point(Point(bd, 0.0, "sine", 2.0, 0.999), NUM).uplifts == 0
 
 
 def test_flexible_uplift_time_matches_independent_integration(body_fig3):
@@ -88,7 +89,7 @@ def test_flexible_uplift_time_matches_independent_integration(body_fig3):
     i = int(np.argmax(vals >= 0))
     assert vals[i] >= 0 > vals[i - 1]
     t_star = brentq(excess, ts[i - 1], ts[i], xtol=1e-13)
-    run = simulate(Point(bd, 0.2, "sine", w, a_ratio), NUM)
+    run = run_point(Point(bd, 0.2, "sine", w, a_ratio), NUM)
     h = run.history
     t_up = h["t"][np.flatnonzero(h["phase"] != 0)[0]]
     assert t_up == pytest.approx(t_star, abs=1e-6)
@@ -126,10 +127,10 @@ def test_rk4_error_falls_16_fold_per_halving(body_fig3):
 
 def _free_flight_drift(steps_per_period):
     """Largest change of E/E_ref over one step between impacts, after the pulse, zeta = 0."""
-    bd = FlexibleBody(2.43, 0.0, 0.15, 0.28, 0.47, 0.56)
+    bd = FlexibleBody(**table3(zeta=0.0))
     num = Numerics.preset("default", horizon=30.0, steps_per_period=steps_per_period,
                           event_tol=1e-8)
-    run = simulate(Point(bd, 0.2, "sine", 6.0, 3.0), num)
+    run = run_point(Point(bd, 0.2, "sine", 6.0, 3.0), num)
     h = run.history
     after = h["t"] > 2 * math.pi / 6.0 + 1e-9
     assert run.impacts > 0 and after.sum() > 50
@@ -149,7 +150,7 @@ def test_energy_conserved_between_impacts_without_damping_or_ground_motion():
 def test_energy_balance_closes_on_fig5(body_fig3):
     """Work in - damper loss - impact losses = E(t), over the whole Figure 5 run."""
     for lam in (0.0, 0.4):
-        h = simulate(Point(body_fig3, lam, "sine", 5.3, 5.0), NUM).history
+        h = run_point(Point(body_fig3, lam, "sine", 5.3, 5.0), NUM).history
         bal = h["E"] - (h["W_in"] - h["D_damp"] - h["E_impact"])
         assert np.abs(bal).max() / body_fig3.E_ref < 1e-4
 
@@ -163,8 +164,8 @@ def test_energy_balance_closes_on_fig5(body_fig3):
                                          ("sine", 1.0, 1.5)])
 def test_mirror_symmetry(body_fig3, shape, w, a):
     """A -> -A mirrors theta and u (exactly: every formula is odd in them) and the outcome."""
-    r1 = simulate(Point(body_fig3, 0.2, shape, w, a), NUM)
-    r2 = simulate(Point(body_fig3, 0.2, shape, w, -a), NUM)
+    r1 = run_point(Point(body_fig3, 0.2, shape, w, a), NUM)
+    r2 = run_point(Point(body_fig3, 0.2, shape, w, -a), NUM)
     assert r1.outcome == r2.outcome and r1.impacts == r2.impacts
     np.testing.assert_allclose(r2.history["theta"], -r1.history["theta"], atol=1e-9)
     np.testing.assert_allclose(r2.history["u"], -r1.history["u"], atol=1e-9)
@@ -199,7 +200,7 @@ def test_e_far_below_housner(body_fig2):
 
 def test_fig5_lam_04_overturns_and_dissipates_less(body_fig3):
     """Figure 5: less energy dissipated for larger lam; lam = 0.4 overturns, 0 and 0.2 not."""
-    runs = {lam: simulate(Point(body_fig3, lam, "sine", 5.3, 5.0), NUM) for lam in (0, 0.2, 0.4)}
+    runs = {lam: run_point(Point(body_fig3, lam, "sine", 5.3, 5.0), NUM) for lam in (0, 0.2, 0.4)}
     assert runs[0.4].outcome == "mode1"
     assert runs[0].outcome == "safe" and runs[0.2].outcome == "safe"
 

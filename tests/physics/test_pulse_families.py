@@ -18,12 +18,12 @@ import math
 import numpy as np
 import pytest
 
-from rocksweep.compute.single import simulate
+from rocksweep.compute.single import run_point
 from rocksweep.kernel import layout as L
 from rocksweep.kernel.equations import ground_acc, ground_jerk
 from rocksweep.numerics import Numerics
+from rocksweep.physics.bodies import BlockBody
 from rocksweep.physics.excitation import PulseShape
-from rocksweep.physics.model import BlockBody
 from rocksweep.physics.points import Point, point_row
 from rocksweep.scene.model import SceneError
 from rocksweep.scene.parse import parse_scene
@@ -68,15 +68,15 @@ def test_rigid_block_uplifts_when_the_shape_reaches_g_tan_alpha(shape, cycles, g
     phi = ref.uplift_phase(A_ratio)
     assert phi is not None
     w = 1.7
-    run = simulate(_point(shape, cycles, gamma, nu, w_over_p=w, A_ratio=A_ratio),
-                   Numerics.preset("fine"))
+    run = run_point(_point(shape, cycles, gamma, nu, w_over_p=w, A_ratio=A_ratio),
+                    Numerics.preset("fine"))
     assert run.uplifts >= 1
     assert _first_uplift(run) == pytest.approx(phi / w, abs=1e-7)
 
 
 def test_no_uplift_below_the_threshold():
     for shape in ("ricker", "mp"):
-        run = simulate(_point(shape, 1, 2.0, 90.0, A_ratio=0.99), Numerics())
+        run = run_point(_point(shape, 1, 2.0, 90.0, A_ratio=0.99), Numerics())
         assert run.uplifts == 0 and run.outcome == "safe"
 
 
@@ -90,9 +90,9 @@ def test_two_cycles_are_one_cycle_after_another():
     w, A = 3.0, 3.2
     T = 2 * math.pi / w
     fine = Numerics.preset("fine")
-    two = simulate(_point("sine", 2, 2.0, 90.0, w_over_p=w, A_ratio=A), fine)
+    two = run_point(_point("sine", 2, 2.0, 90.0, w_over_p=w, A_ratio=A), fine)
     assert two.outcome != "safe" and two.t_overturn > T
-    one = simulate(_point("sine", 1, 2.0, 90.0, w_over_p=w, A_ratio=A), fine)
+    one = run_point(_point("sine", 1, 2.0, 90.0, w_over_p=w, A_ratio=A), fine)
     h = one.history
     k = int(np.flatnonzero(h["t"] == T)[0])  # the step landed on the pulse's end
     assert h["phase"][k] != 0  # rocking at T

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from bodies import FIG3
 from scipy import integrate, signal
 
 from rocksweep.physics import intensity as I  # noqa: E741
@@ -18,7 +19,7 @@ from rocksweep.physics.suite import MAX_FACTOR, RecordWarning, make_suite
 
 ROOT = Path(__file__).resolve().parents[2]
 SUITE = sorted((ROOT / "records" / "suite").glob("*.AT2"))
-from rocksweep.physics.model import G  # noqa: E402 (the units of acc: g = G m/s^2)
+from rocksweep.physics.bodies import G  # noqa: E402 (the units of acc: g = G m/s^2)
 
 SUB = 8  # the test's own fine resampling of the piecewise-linear record
 
@@ -112,6 +113,20 @@ def test_scaled_ims_follow_their_exponents(records):
     assert I.avg_sa(acc2, rec.dt, 0.5, 2.0) == pytest.approx(2.0 * base.avgsa[0], rel=1e-9)
 
 
+@pytest.mark.parametrize(("im", "level", "of"), [
+    ("AvgSa", 0.4, lambda a, dt: I.avg_sa(a, dt, 0.5, 2.0)),
+    ("CAV", 3.0, I.cav),
+    ("Arias", 0.8, I.arias)])
+def test_avgsa_cav_and_arias_stripes_scale_each_record_to_the_level(records, im, level, of):
+    # the record times its factor has the stripe's IM, computed afresh from the samples
+    # (Arias grows as the factor squared: its factor is the square root of the ratio)
+    su = make_suite(records[:3], ["a", "b", "c"], im, [level], math.nan, math.nan, [1.0],
+                    (0.5, 2.0))
+    f = su.factors(np.arange(3), np.zeros(3, np.int64), np.full(3, 0.15), np.full(3, 2.0))
+    for rec, fi in zip(records[:3], f, strict=True):
+        assert of(fi * rec.acc, rec.dt) == pytest.approx(level, rel=1e-9)
+
+
 def caught(suite):
     with warnings.catch_warnings(record=True) as got:
         warnings.simplefilter("always")
@@ -156,8 +171,7 @@ def test_cli_says_the_warning_in_one_line():
 
 
 def suite_scene(**ground):
-    return {"body": {"wn_over_p": 2.43, "zeta": 0.05, "alpha_cg": 0.15, "alpha_A": 0.28,
-                     "mA_over_m": 0.47, "IA_ratio": 0.56},
+    return {"body": dict(FIG3),
             "impact": {"lam": 0.0},
             "ground": {"records": [str(SUITE[0]), str(SUITE[1])], "p": 2.0, **ground}}
 

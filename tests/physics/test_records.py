@@ -185,7 +185,7 @@ def test_empty_velocity_and_motionless_files(tmp_path):
 
 def test_unreadable_paths(tmp_path):
     missing = tmp_path / "nope.AT2"
-    assert _error(missing) == f"{missing}: cannot be read (No such file or directory)"
+    assert _error(missing) == f"{missing}: no such record file"
     assert _error(tmp_path) == f"{tmp_path}: is a directory, not a record file"
 
 

@@ -5,13 +5,13 @@ import math
 
 import numpy as np
 import pytest
-from bodies import BODY3
+from bodies import BODY3, table3
 from scipy.integrate import quad
 
-from rocksweep.compute.single import simulate
+from rocksweep.compute.single import run_point
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import BlockBody, FlexibleBody, impact_energy_loss, restitution_rigid
+from rocksweep.physics.bodies import BlockBody, FlexibleBody, impact_energy_loss, restitution_rigid
 from rocksweep.physics.points import Point
 from rocksweep.physics.reference import reference_run
 
@@ -97,7 +97,7 @@ def test_rigid_block_bounded_exit_matches_the_kernel():
     paths stop at the same impact and predict the same largest rotation."""
     p = Point(BLOCK, 0.0, "sine", 6.0, 2.0)
     ref = reference_run(p)
-    run = simulate(p, Numerics(steps_per_period=40, event_tol=1e-12), history=False)
+    run = run_point(p, Numerics(steps_per_period=40, event_tol=1e-12), history=False)
     assert ref["status"] & L.STATUS_BOUNDED and int(run.out[L.OUT_STATUS]) & L.STATUS_BOUNDED
     assert ref["outcome"] == run.out[L.OUT_OUTCOME] == L.OUTCOME_SAFE
     assert ref["impacts"] == run.out[L.OUT_IMPACTS]
@@ -114,8 +114,7 @@ def test_rigid_block_bounded_exit_matches_the_kernel():
 
 @pytest.fixture(scope="module")
 def undamped_run():
-    body = FlexibleBody(wn_over_p=2.43, zeta=0.0, alpha_cg=0.15, alpha_A=0.28,
-                        mA_over_m=0.47, IA_ratio=0.56)
+    body = FlexibleBody(**table3(zeta=0.0))
     p = Point(body, 0.0, "sine", 3.0, 3.0)
     return body, p, reference_run(p, Numerics(horizon=30.0), events=True)
 
@@ -184,7 +183,7 @@ def test_kernel_agrees_with_the_reference_tighter_as_the_step_shrinks(name, refe
     ref_impacts = [e["t"] for e in _impacts(ref)][:3]
     for spp in (10, 20, 40):
         bound = 5e-3 * (10 / spp) ** 4  # RK4: error ~ step^4
-        run = simulate(CASES[name], Numerics(steps_per_period=spp, event_tol=1e-12))
+        run = run_point(CASES[name], Numerics(steps_per_period=spp, event_tol=1e-12))
         o = run.out
         assert o[L.OUT_OUTCOME] == ref["outcome"], spp
         assert o[L.OUT_IMPACTS] == ref["impacts"], spp

@@ -20,12 +20,13 @@ import math
 
 import numpy as np
 import pytest
+from bodies import table3
 from scipy.integrate import quad, solve_ivp
 
 from rocksweep.kernel import chunk_kernel, point_kernel
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import BlockBody, FlexibleBody, G, restitution_rigid
+from rocksweep.physics.bodies import BlockBody, FlexibleBody, G, restitution_rigid
 from rocksweep.physics.points import Point, kernel_kind, point_row
 
 ALPHA = 0.2618  # the classic slender block (15 degrees)
@@ -182,8 +183,7 @@ def test_uplift_at_once_under_a_cosine_pulse():
 
 def test_uplift_of_the_welded_flexible_body():
     """wn_over_p = inf: the two-mass body uplifts at |xg''| = g tan(alpha_cg) too."""
-    body = FlexibleBody(wn_over_p=math.inf, zeta=0.05, alpha_cg=0.15, alpha_A=0.28,
-                        mA_over_m=0.47, IA_ratio=0.56)
+    body = FlexibleBody(**table3(wn_over_p=math.inf))
     out, hist = run_history(Point(body, 0.0, "sine", 2.0, 1.5), PRECISE)
     first = np.nonzero(hist[:, L.HIST_PHASE] != 0)[0][0]
     assert hist[first, L.HIST_T] == pytest.approx(math.asin(1 / 1.5) / 2.0, abs=1e-9)

@@ -1,4 +1,4 @@
-"""A body from the laboratory's numbers (body.kind physical, issue 30 part 5): the Pi
+"""A body from the laboratory's numbers (body.kind physical): the Pi
 groups and p from the paper's definitions (section 3.1, Table 1), written out here."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import pytest
 
 import rocksweep
 from rocksweep.errors import RocksweepError
-from rocksweep.physics.model import G
+from rocksweep.physics.bodies import G
 
 LAB = {"b": 0.1, "h": 0.9, "h_A": 0.3, "m": 20.0, "m_A": 9.4, "I_A": 0.25, "k": 4000.0,
        "c": 10.0}

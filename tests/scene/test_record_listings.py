@@ -1,4 +1,4 @@
-"""How a suite's ``ground.records`` is read (issue 32): listings, glob characters in file
+"""How a suite's ``ground.records`` is read: listings, glob characters in file
 names, links, and the files that are not what they claim.
 
 - a listing is UTF-8 text (a byte-order mark, as Notepad saves it, is read); UTF-16 or
@@ -19,6 +19,7 @@ import warnings
 from pathlib import Path
 
 import pytest
+from bodies import FIG3_YAML
 
 from rocksweep.physics.records import RecordError, parse_record
 from rocksweep.scene.model import SceneError
@@ -26,8 +27,7 @@ from rocksweep.scene.parse import load_scene
 
 ROOT = Path(__file__).resolve().parents[2]
 SUITE = ROOT / "records" / "suite"
-BODY = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47, "
-        "IA_ratio: 0.56}\nimpact: {lam: 0.0}\n")
+BODY = FIG3_YAML + "impact: {lam: 0.0}\n"
 
 
 def scene(d: Path, records: str, extra: str = "  scale: {im: PGA, values: [0.2, 0.6]}\n"
@@ -61,7 +61,7 @@ def test_a_utf8_listing_is_read_with_or_without_a_bom(d, head, end):
 @pytest.mark.parametrize("data, words", [
     ("r/SYN01.AT2\nr/SYN02.AT2\n".encode("utf-16"), "UTF-16"),
     ("r/SYN01.AT2\n".encode("utf-16-be"), "a NUL byte"),
-    (bytes(range(1, 256)) * 2, "not a text listing"),
+    (bytes(range(1, 256)) * 2, "is not UTF-8"),
     (b"r/SYN01.AT2\x00\nr/SYN02.AT2\n", "line 1: a NUL byte"),
     (b"r/SYN01.AT2\nr/SYN02.AT2\x1b[0m\n", "line 2: character 0x1b"),
 ])

@@ -23,13 +23,13 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from bodies import FIG3
+from bodies import FIG3, FIG3_YAML
 from scipy import signal
 
-from rocksweep.compute.single import simulate
+from rocksweep.compute.single import run_point
 from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
-from rocksweep.physics.model import FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.physics.points import RECORD, Point
 from rocksweep.physics.records import read_record
 from rocksweep.scene.model import SceneError
@@ -50,8 +50,8 @@ def test_sine_record_is_the_sine_pulse(lam, w_over_p, A_ratio):
     body = FlexibleBody(**FIG3)
     rec = read_record(SINE)
     fine = Numerics.preset("fine", steps_per_period=320, event_tol=1e-10)
-    pulse = simulate(Point(body, lam, "sine", w_over_p, A_ratio), fine, history=False)
-    record = simulate(Point(body, lam, RECORD, math.nan, A_ratio, record=rec,
+    pulse = run_point(Point(body, lam, "sine", w_over_p, A_ratio), fine, history=False)
+    record = run_point(Point(body, lam, RECORD, math.nan, A_ratio, record=rec,
                             p=4 * math.pi / w_over_p), fine, history=False)
     assert record.outcome == pulse.outcome
     assert record.impacts == pulse.impacts and record.uplifts == pulse.uplifts
@@ -64,7 +64,7 @@ def test_sine_record_is_the_sine_pulse(lam, w_over_p, A_ratio):
 
 def test_the_overturning_point_is_among_them():
     body = FlexibleBody(**FIG3)
-    run = simulate(Point(body, 0.4, "sine", 5.3, 5.0), Numerics.preset("fine"), history=False)
+    run = run_point(Point(body, 0.4, "sine", 5.3, 5.0), Numerics.preset("fine"), history=False)
     assert run.outcome == "mode1"  # the comparison above covers an overturning point
 
 
@@ -73,7 +73,7 @@ def test_full_contact_response_is_lsim_of_the_record():
     rec = read_record(NEARFAULT)
     p, A_ratio = 2.0, 0.05  # far below uplift: the base never leaves the ground
     pt = Point(body, 0.0, RECORD, math.nan, A_ratio, record=rec, p=p)
-    run = simulate(pt, Numerics.preset("fine"))
+    run = run_point(pt, Numerics.preset("fine"))
     assert run.uplifts == 0
     h = run.history
     dt_k = p * rec.dt
@@ -94,9 +94,7 @@ def test_full_contact_response_is_lsim_of_the_record():
 
 SCENE = """
 name: record test
-body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47,
-       IA_ratio: 0.56}
-impact: {lam: [0.0, 0.4]}
+""" + FIG3_YAML + """impact: {lam: [0.0, 0.4]}
 ground:
   record: %s
   A_ratio: {start: 1.0, stop: 6.0, num: 3}
@@ -108,7 +106,7 @@ def test_scene_errors_are_one_line(tmp_path):
     both = SCENE % "x.AT2" + "pulse: {shape: sine, w_over_p: 1, A_ratio: 1}\n"
     with pytest.raises(SceneError, match="pulse, ground: give one of them"):
         parse_scene(both)
-    with pytest.raises(SceneError, match=r"ground.record: .*missing.AT2.*cannot be read"):
+    with pytest.raises(SceneError, match=r"ground.record: .*missing.AT2: no such record file"):
         parse_scene(SCENE % "missing.AT2", base=tmp_path)
     bad = tmp_path / "bad.AT2"
     bad.write_text("a\nb\nc\nNPTS= 3, DT= .01 SEC\n1 2\n")

@@ -1,8 +1,7 @@
 """Scene validation: one table of keys, a prompt one-line answer for every input.
 
-Each refused input asserts the exact message (issue 13 "One validation path", "Every input
-gets a prompt answer"; issue 16 "Absurd but accepted values", "Values that hang",
-"Duplicate keys"), that it is a SceneError (a RocksweepError) and that the answer comes at
+Each refused input (absurd values, values that hang, duplicate keys) asserts the exact
+message, that it is a SceneError (a RocksweepError) and that the answer comes at
 once (< 5 s, generous: the inputs below hung or crashed before).
 """
 
@@ -12,22 +11,20 @@ import time
 from pathlib import Path
 
 import pytest
-from bodies import FIG3
+from bodies import FIG3, FIG3_YAML
 
 from rocksweep.cli import main
 from rocksweep.errors import RocksweepError
 from rocksweep.numerics import MAX_POINT_STEPS
-from rocksweep.physics.model import BlockBody, BodyError, FlexibleBody
+from rocksweep.physics.bodies import BlockBody, BodyError, FlexibleBody
 from rocksweep.physics.points import body_omega_rock
 from rocksweep.scene.model import SceneError
 from rocksweep.scene.parse import MAX_POINTS, load_scene, parse_scene
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
-TABLE3 = dict(FIG3)
 GOOD = """
-body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47, IA_ratio: 0.56}
-impact: {lam: 0.4}
+""" + FIG3_YAML + """impact: {lam: 0.4}
 pulse: {shape: sine, w_over_p: 5.3, A_ratio: 5.0}
 """
 SRC = "s.yaml"
@@ -89,9 +86,9 @@ def test_out_of_range_value(old, new, message):
 ])
 def test_a_body_from_python_gets_the_scenes_message(key, value, message):
     with pytest.raises(BodyError) as info:
-        FlexibleBody(**{**TABLE3, key: value})
+        FlexibleBody(**{**FIG3, key: value})
     assert str(info.value) == message
-    assert refused(sub(f"{key}: {TABLE3[key]}", f"{key}: {value!r}".replace("nan", ".nan"))
+    assert refused(sub(f"{key}: {FIG3[key]}", f"{key}: {value!r}".replace("nan", ".nan"))
                    ) == message
     with pytest.raises(BodyError, match=re.escape("body.inertia = 0.5: must be in [1, 1e+06]")):
         BlockBody(alpha=0.2, inertia=0.5)
@@ -105,8 +102,7 @@ def test_overrides_use_the_same_checks():
 # -- structure: sections, unknown and missing keys, types -----------------------------
 
 STRUCTURE_CASES = [
-    (GOOD.replace("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, "
-                  "mA_over_m: 0.47, IA_ratio: 0.56}", "body: 3"),
+    (GOOD.replace(FIG3_YAML, "body: 3\n"),
      "body = 3: must be a mapping with keys wn_over_p, zeta, alpha_cg, alpha_A, mA_over_m, "
      "IA_ratio (a flexible body), or kind: block, alpha, inertia"),
     (GOOD.replace("pulse: {shape: sine, w_over_p: 5.3, A_ratio: 5.0}", "pulse: [1, 2]"),
@@ -257,10 +253,11 @@ def test_scene_size_and_sweep_bytes():
 
 # -- cost: every accepted point runs in bounded time ----------------------------------
 
-def _expected_steps(w: float, A: float, wn: float = 2.43, zeta: float = 0.05,
-                    mu: float = 0.47, spp: int = 5 * 8, ps: int = 12 * 8,
+def _expected_steps(w: float, A: float, wn: float = FIG3["wn_over_p"],
+                    zeta: float = FIG3["zeta"], mu: float = FIG3["mA_over_m"],
+                    spp: int = 5 * 8, ps: int = 12 * 8,
                     horizon: float = 200.0, max_events: int = 5000) -> float:
-    """PAR_MAXSTEPS as the kernel's docs define it (issue 28): 20 x (ceil(t_pulse/dt_on) +
+    """PAR_MAXSTEPS as the kernel's docs define it: 20 x (ceil(t_pulse/dt_on) +
     ceil(horizon/dt)) + 200 x max_events, t_pulse = 2 pi/w; dt = the shorter of the spring's
     period over spp x max(1, (27.5/omega_rock)^(2/5)) (or, for a spring that oscillates
     while rocking, zeta' < 1, over the n at which RK4's leading-order damping of it,
@@ -269,7 +266,7 @@ def _expected_steps(w: float, A: float, wn: float = 2.43, zeta: float = 0.05,
     dt_on = dt, the pulse's period over max(ps, spp) and the amplitude's (2 pi/sqrt(|A| tan
     alpha_cg)) over spp, the shortest. Default: `default`'s finest refinement (3 doublings
     of 5 steps per period and 12 per pulse period), the scene's costliest run."""
-    body = FlexibleBody(**{**TABLE3, "wn_over_p": wn, "zeta": zeta, "mA_over_m": mu})
+    body = FlexibleBody(**{**FIG3, "wn_over_p": wn, "zeta": zeta, "mA_over_m": mu})
     omega_rock = body_omega_rock(body)
     n_spring = spp * max(1.0, (27.5 / omega_rock) ** 0.4)
     zeta_rock = body.zeta * omega_rock / body.omega_n  # zeta sqrt(Gamma) if underdamped

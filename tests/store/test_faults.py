@@ -1,4 +1,4 @@
-"""Fault injection for the result file (issue 16, "Nothing lost, no traceback").
+"""Fault injection for the result file: nothing lost, no traceback.
 
 Full disks are real: a tmpfs of a few pages mounted in a private mount namespace
 (``unshare --mount``, root or user namespaces; nobody else sees it), filled to the last
@@ -29,12 +29,13 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from bodies import FIG3_YAML
 from helpers import one_line_error
 
 from rocksweep.cli import main
-from rocksweep.compute.grid import Grid
-from rocksweep.compute.sweep import ChunkResult, level, prepare
+from rocksweep.compute.sweep import level, prepare
 from rocksweep.fields import plain
+from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.parse import load_scene, parse_scene
 from rocksweep.store import StoreError
 from rocksweep.store.format import SESSION_ATTRS
@@ -48,9 +49,7 @@ CI_SMALL = ROOT / "configs" / "ci-small.yaml"
 
 # 2 x 3 x 4 x 5 = 120 points, synthetic results (no kernel)
 TEXT = """name: fault test
-body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47,
-       IA_ratio: 0.56}
-impact: {lam: [0.0, 0.2, 0.4]}
+""" + FIG3_YAML + """impact: {lam: [0.0, 0.2, 0.4]}
 pulse: {shape: [sine, cosine], w_over_p: {start: 0.5, stop: 6, num: 5},
         A_ratio: {start: 1, stop: 8, num: 4}}
 """
@@ -170,7 +169,7 @@ def test_disk_full_while_the_file_is_made_leaves_nothing_and_no_crash(tmp_path):
         import os, json
         import rocksweep.store.writer as st
         from rocksweep.scene.parse import load_scene
-        st._check_space = lambda *a: None  # as if the disk filled up after the check
+        st.check_space = lambda *a: None  # as if the disk filled up after the check
         try:
             st.SweepFile.create("{fs}/a.h5", load_scene("{CI_SMALL}"))
             msg = None
@@ -470,7 +469,7 @@ def test_read_only_directory_really_read_only(tmp_path):
 # fake_chunk for the scripts of other processes (they import rocksweep only)
 FAKE_CHUNK = """
 import numpy as np
-from rocksweep.compute.sweep import ChunkResult
+from rocksweep.scene.grid import ChunkResult
 def fake_chunk(scene, a, b):
     i = np.arange(a, b)
     return ChunkResult(a, b, {n: ((i % 3) if n == "outcome" else i * 7 + len(n)).astype(d)

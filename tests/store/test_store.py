@@ -8,11 +8,12 @@ import json
 import h5py
 import numpy as np
 import pytest
+from bodies import FIG3_YAML
 
 import rocksweep.store.writer as writer
-from rocksweep.compute.grid import Grid
-from rocksweep.compute.sweep import ChunkResult, plan_chunks
+from rocksweep.compute.sweep import plan_chunks
 from rocksweep.errors import OutputError
+from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.parse import parse_scene
 from rocksweep.store import StoreError
 from rocksweep.store.format import FORMAT_VERSION, flat_slabs
@@ -21,9 +22,7 @@ from rocksweep.store.writer import SweepFile
 
 TEXT = """# a comment kept verbatim
 name: store test
-body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47,
-       IA_ratio: 0.56}
-impact: {lam: [0.0, 0.2, 0.4]}
+""" + FIG3_YAML + """impact: {lam: [0.0, 0.2, 0.4]}
 pulse: {shape: [sine, cosine], w_over_p: {start: 0.5, stop: 6, num: 5},
         A_ratio: {start: 1, stop: 8, num: 4}}
 """
@@ -163,8 +162,8 @@ def test_resume_with_a_different_scene_says_what_differs(tmp_path, scene):
     finer = parse_scene(TEXT + "numerics: {accuracy: fine}\n")
     from rocksweep.numerics import PRESETS
 
-    want = (f"numerics.steps_per_period: file {PRESETS['default'][0]}, "
-            f"scene {PRESETS['fine'][0]}")
+    want = (f"numerics.steps_per_period: file {PRESETS['default'].steps_per_period}, "
+            f"scene {PRESETS['fine'].steps_per_period}")
     with pytest.raises(StoreError, match=want):
         SweepFile.resume(path, finer)
     # a comment is not a different scene
@@ -177,7 +176,7 @@ def test_create_failure_leaves_no_file(tmp_path, scene, monkeypatch):
     def boom(*args):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(writer, "_initialise", boom)
+    monkeypatch.setattr(writer, "initialise", boom)
     with pytest.raises(StoreError) as err:
         SweepFile.create(path, scene)
     assert str(err.value) == f"{path}: cannot write (no space left on the device); nothing written"
@@ -233,7 +232,7 @@ def test_resolved_scene_is_stored(tmp_path, scene):
 
 
 def test_cf_attributes_survive_netcdf_readers(tmp_path, scene):
-    """Issue 13: Conventions, units, int8 flags and per-session provenance (host, backend)
+    """CF conventions, units, int8 flags and per-session provenance (host, backend)
     as netCDF-4 readers (xarray + h5netcdf) see them."""
     import platform
 

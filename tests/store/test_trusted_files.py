@@ -1,4 +1,4 @@
-"""What a result file is, said right (issue 32):
+"""What a result file is, said right:
 
 - a good file held open by another handle of this process (xarray's h5netcdf) is read, or
   for writing refused as a lock with how to release it: never "damaged", never advice
@@ -21,6 +21,7 @@ import h5py
 import numpy as np
 import pytest
 import xarray as xr
+from bodies import FIG3_YAML
 from helpers import one_line_error
 
 import rocksweep
@@ -30,8 +31,7 @@ from rocksweep.store.reader import read_result, result_scene
 
 ROOT = Path(__file__).resolve().parents[2]
 SUITE = ROOT / "records" / "suite"
-BODY = ("body: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47, "
-        "IA_ratio: 0.56}\nimpact: {lam: 0.0}\n")
+BODY = FIG3_YAML + "impact: {lam: 0.0}\n"
 PULSE = "name: p\n" + BODY + "pulse: {shape: sine, w_over_p: [1, 2], A_ratio: [2, 4]}\n"
 
 

@@ -6,15 +6,15 @@ from itertools import product
 
 import numpy as np
 import pytest
+from bodies import body_yaml, table3
 
-import rocksweep.compute.grid as grid_mod
-from rocksweep.compute.grid import Grid
+import rocksweep.scene.grid as grid_mod
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.points import kernel_kind, point_row
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.parse import parse_scene
 
-BODY = ("body: {wn_over_p: %s, zeta: %s, alpha_cg: 0.15, alpha_A: 0.28, mA_over_m: 0.47, "
-        "IA_ratio: 0.56}\n")
+BODY = body_yaml(table3(wn_over_p="%s", zeta="%s"))
 
 
 def scene(wn="2.43", zeta="0.05", lam="[0.0, 0.4]", shape="[sine, cosine]",

@@ -50,6 +50,21 @@ class ChunkRows:
     record_index: np.ndarray | None = None
 
 
+@dataclass
+class ChunkResult:
+    """Results of the points ``start <= i < stop`` (flat indices).
+
+    arrays: name -> array[stop - start] (``Scene.variables``); seconds: wall time of the
+    chunk in its worker; cpu_seconds: CPU time of the worker thread that ran it.
+    """
+
+    start: int
+    stop: int
+    arrays: dict[str, np.ndarray]
+    seconds: float
+    cpu_seconds: float = 0.0
+
+
 class Grid:
     """The points of a scene, addressed by flat index.
 

@@ -1,6 +1,8 @@
-"""``sweep_file``: the one way into the sweep driver (``rocksweep.compute.driver``) for
-``rocksweep.run`` and ``rocksweep sweep``: every argument checked, the sink made (a result
-file, or one in memory), the driver handed it."""
+"""``sweep``: the one way into the sweep driver (``rocksweep.compute.driver``) for
+``rocksweep.run`` (``run_session``) and ``rocksweep sweep``: the arguments checked once
+(``compute.arguments.SweepArguments``), the scene's grid made once, the sink made (a
+result file, or one in memory), the driver handed both. ``sweep_file``: the same with
+loose keyword arguments."""
 
 from __future__ import annotations
 
@@ -10,9 +12,9 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from rocksweep.compute.arguments import CONNECT_TIMEOUT
+from rocksweep.compute.arguments import CONNECT_TIMEOUT, SweepArguments
 from rocksweep.compute.driver import WRITE_EVERY, SweepReport
-from rocksweep.errors import ApiError, Arg, flag
+from rocksweep.errors import ApiError, Arg, SweepError, flag
 
 if TYPE_CHECKING:
     from typing import Any
@@ -50,68 +52,79 @@ def sweep_file(scene: Scene, path: str | Path | None, *, overrides: Sequence[str
     also compute the filled points of a coarse uniform lattice and report those whose
     class differs from the fill (``report.validation``; the file is not changed);
     connect_timeout: seconds to wait for the dask scheduler to answer. Every argument is
-    checked (``rocksweep.compute.arguments``) before the output is touched. Returns a
-    ``SweepReport``.
+    checked (``rocksweep.compute.arguments``) before the output is touched, then ``sweep``
+    runs. Returns a ``SweepReport``.
     """
     from rocksweep.compute.arguments import check_sweep_arguments
-    from rocksweep.outputs import check_output, check_path_text, exists_error
+    from rocksweep.outputs import check_path_text
 
-    # every argument before anything touches the output (one place: the CLI's too)
-    n_workers = check_sweep_arguments(
-        jobs=jobs, resume=resume, overwrite=overwrite, validate=validate, adaptive=adaptive,
-        backend=backend, scheduler=scheduler, chunk_size=chunk_size, write_every=write_every,
+    args = check_sweep_arguments(
+        jobs=jobs, resume=resume, overwrite=overwrite, validate=validate, backend=backend,
+        scheduler=scheduler, chunk_size=chunk_size, write_every=write_every,
         connect_timeout=connect_timeout)
     if path is not None:  # None: in memory (rocksweep.run without output=)
-        check_path_text(path)
-    if backend == "dask":
-        from rocksweep.compute import sweep as sw
+        path = check_path_text(path)
+    return sweep(scene, path, args, overrides=overrides, progress=progress, log=log,
+                 inputs=inputs, adaptive=adaptive)
 
-        sw.check_scheduler(scheduler, connect_timeout)  # before any file is made
-    say = log or (lambda _line: None)
-    settings = None
-    if adaptive is not None:
-        from rocksweep.compute.grid import Grid
 
-        settings = adaptive.resolved(Grid(scene))  # bad axes or settings: before any file
-
+def sweep(scene: Scene, path: Path | None, args: SweepArguments, *,
+          overrides: Sequence[str] = (), progress: bool = False,
+          log: Callable[[str], None] | None = None, inputs: Iterable[str | Path] = (),
+          adaptive: Options | None = None) -> SweepReport:
+    """``sweep_file`` with its arguments checked (``check_sweep_arguments``, once, by the
+    caller: ``rocksweep sweep``, ``run_session``, ``sweep_file``). The scene's grid is
+    made here, once, and handed to the sink and the driver; the output path is checked
+    once (``outputs.check_output``) before the file is made or reopened."""
     from rocksweep.compute.driver import drive
+    from rocksweep.outputs import check_output, exists_error
+    from rocksweep.scene.grid import Grid
     from rocksweep.store.writer import SweepFile
 
+    if args.validate and adaptive is None:
+        raise SweepError("{validate} checks an adaptive sweep; add {adaptive}",
+                         validate=flag("validate"), adaptive=flag("adaptive"))
+    if args.backend == "dask":
+        from rocksweep.compute.sweep import check_scheduler
+
+        check_scheduler(args.scheduler, args.connect_timeout)  # before any file is made
+    grid = Grid(scene)
+    # bad axes or settings: before any file
+    settings = adaptive.resolved(grid) if adaptive is not None else None
+    say = log or (lambda _line: None)
+    n = args.n_workers
     t0 = time.perf_counter()
-    where = (f"{n_workers} worker{'s' * (n_workers > 1)}" if backend == "threads"
-             else f"dask cluster {scheduler}")
-    how = f"threads x {n_workers}" if backend == "threads" else f"dask {scheduler}"
+    where = (f"{n} worker{'s' * (n > 1)}" if args.backend == "threads"
+             else f"dask cluster {args.scheduler}")
+    how = f"threads x {n}" if args.backend == "threads" else f"dask {args.scheduler}"
     if path is None:  # in memory: nothing touches a disk (rocksweep.run without output)
-        if resume:
+        if args.resume:
             raise ApiError("{resume} needs {output} (the file to finish)",
                            resume=flag("resume"), output=Arg("output"))
-        sf = SweepFile.in_memory(scene, overrides, backend=how, adaptive=settings)
-        return drive(sf, None, report_of := SweepReport(Path("memory"), sf.grid.size, 0, 0,
-                                                          0.0, 0.0, 0.0),
-                      t0, adaptive, validate, jobs=jobs, backend=backend,
-                      scheduler=scheduler, chunk_size=chunk_size, where=where,
-                      write_every=write_every, progress=progress, say=say) or report_of
-    path = Path(path)
-    inputs = [*inputs, *scene.inputs]  # the scene's records and listings: never written over
-    try:
-        path.stat()
-    except FileNotFoundError:
-        pass
-    except OSError:  # a name too long, a path through a file...: one line, not a traceback
-        check_output(path, overwrite=overwrite, inputs=inputs)
-    if resume and path.exists():
-        check_output(path, overwrite=True, inputs=inputs)
-        sf = SweepFile.resume(path, scene, overrides, backend=how, adaptive=settings)
+        sf = SweepFile.in_memory(scene, overrides, backend=how, adaptive=settings, grid=grid)
     else:
-        if path.is_file() and not overwrite:
-            raise exists_error(path, resumable=True)
-        check_output(path, overwrite=overwrite, inputs=inputs)
-        sf = SweepFile.create(path, scene, overrides, overwrite=overwrite, backend=how,
-                              adaptive=settings, log=say)
-    report = SweepReport(path, sf.grid.size, 0, 0, 0.0, 0.0, 0.0)
-    return drive(sf, path, report, t0, adaptive, validate, jobs=jobs, backend=backend,
-                  scheduler=scheduler, chunk_size=chunk_size, where=where,
-                  write_every=write_every, progress=progress, say=say)
+        inputs = [*inputs, *scene.inputs]  # the scene's records and listings: never written over
+        try:
+            path.stat()
+        except FileNotFoundError:
+            pass
+        except OSError:  # a name too long, a path through a file...: one line, no traceback
+            check_output(path, overwrite=args.overwrite, inputs=inputs)
+        if args.resume and path.exists():
+            check_output(path, overwrite=True, inputs=inputs)
+            sf = SweepFile.resume(path, scene, overrides, backend=how, adaptive=settings,
+                                  grid=grid)
+        else:
+            if path.is_file() and not args.overwrite:
+                raise exists_error(path, resumable=True)
+            check_output(path, overwrite=args.overwrite, inputs=inputs)
+            sf = SweepFile.make(path, scene, overrides, overwrite=args.overwrite,
+                                backend=how, adaptive=settings, log=say, grid=grid)
+    report = SweepReport(path or Path("memory"), grid.size, 0, 0, 0.0, 0.0, 0.0)
+    return drive(sf, path, report, t0, adaptive, args.validate, jobs=args.jobs,
+                 backend=args.backend, scheduler=args.scheduler,
+                 chunk_size=args.chunk_size, where=where, write_every=args.write_every,
+                 progress=progress, say=say)
 
 
 def _stderr(line: str) -> None:
@@ -125,8 +138,9 @@ def client_backend(client: Any) -> dict[str, str]:
     if client is None:
         return {"backend": "threads"}
     address = getattr(getattr(client, "scheduler", None), "address", None)
-    if type(client).__name__ == "Client" and getattr(client, "status", None) in (
-            "closed", "closing"):
+    distributed = sys.modules.get("distributed")  # a Client exists only once it is loaded
+    if (distributed is not None and isinstance(client, distributed.Client)
+            and getattr(client, "status", None) in ("closed", "closing")):
         raise ApiError(f"client = {client!r}: this dask Client is closed; make a new one "
                        "(Client(cluster) or Client('tcp://host:8786')) and pass it")
     if not isinstance(address, str):
@@ -155,10 +169,10 @@ def run_session(scene: SceneLike | Scene, output: str | Path | None, *,
     # types and ranges first: nothing below may touch ``output`` before all are checked
     check_flag("progress", progress)
     check_flag("adaptive", adaptive)
-    check_sweep_arguments(jobs=jobs if client is None else 1, resume=resume,
-                          overwrite=overwrite, validate=validate, adaptive=True)
-    if output is not None:
-        check_path_text(output, "output")
+    where = client_backend(client)
+    args = check_sweep_arguments(jobs=jobs if client is None else 1, resume=resume,
+                                 overwrite=overwrite, validate=validate, **where)
+    path = check_path_text(output, "output") if output is not None else None
     from rocksweep.compute.adaptive import adaptive_options
     from rocksweep.scene.inputs import load, override_strings
     from rocksweep.store.dataset import open_result, result_dataset
@@ -166,17 +180,11 @@ def run_session(scene: SceneLike | Scene, output: str | Path | None, *,
     scene, source = load(scene, overrides)
     opts = adaptive_options(adaptive, base=scene.refine, **(settings or {}))
     overrides = override_strings(overrides)
-    where = client_backend(client)
     log = _stderr if progress else None
-    if output is None:
+    report = sweep(scene, path, args, overrides=overrides, progress=progress, log=log,
+                   inputs=[source] if source and path is not None else (), adaptive=opts)
+    if path is None:
         import io
 
-        report = sweep_file(scene, None, overrides=overrides, jobs=jobs, resume=resume,
-                            progress=progress, log=log, adaptive=opts, validate=validate,
-                            **where)
         return result_dataset(io.BytesIO(report.image))
-    sweep_file(scene, output, overrides=overrides, jobs=jobs, resume=resume,
-               overwrite=overwrite, progress=progress, log=log,
-               inputs=[source] if source else (), adaptive=opts, validate=validate,
-               **where)
-    return open_result(output)
+    return open_result(path)

@@ -71,13 +71,13 @@ def write_history_csv(runs: Sequence[Run], swept: Sequence[str], path: str | Pat
                 w.writerow([i, *fixed, *(repr(float(c[j])) for c in cols)])
 
 
-def simulate_runs(scene: Scene, max_runs: int = MAX_RUNS) -> list[Run]:
+def run_points(scene: Scene, max_runs: int = MAX_RUNS) -> list[Run]:
     """Each point of a small scene as a single run with history (``rocksweep simulate``
     overlays them); a SceneError naming the longest swept key if there are more than
     ``max_runs`` points."""
     from itertools import product
 
-    from rocksweep.compute.single import simulate as run_point
+    from rocksweep.compute.single import run_point
     from rocksweep.errors import SceneError, set_key
 
     if scene.size > max_runs:
@@ -95,7 +95,7 @@ def titled_runs(scene: Scene, max_runs: int = MAX_RUNS) -> list[tuple[Run, xr.Da
     """``rocksweep.simulate``'s runs: (run, its history Dataset, its title) of every point
     of ``scene``, in grid order. One point: the scene's own point and accuracy
     (``Scene.single_point``, ``single_numerics``), titled with the scene's name; more:
-    ``simulate_runs``, each titled with its swept values ("lam = 0.2, A_ratio = 3"). More
+    ``run_points``, each titled with its swept values ("lam = 0.2, A_ratio = 3"). More
     than ``max_runs`` points: an ApiError naming the longest swept key (in the API's
     words: an override, or ``rocksweep.run`` for a grid)."""
     if scene.size > max_runs:
@@ -106,13 +106,13 @@ def titled_runs(scene: Scene, max_runs: int = MAX_RUNS) -> list[tuple[Run, xr.Da
                        f"values): simulate runs at most {max_runs}; pass "
                        f"overrides={{{big.key!r}: ...}}, or use rocksweep.run for a grid")
     if scene.size == 1:
-        from rocksweep.compute.single import simulate as run_point
+        from rocksweep.compute.single import run_point
 
         r = run_point(scene.single_point(), scene.single_numerics, contact=scene.contact)
         return [(r, history_dataset(r, scene.name), scene.name)]
     swept = [a.name for a in scene.swept]
     out = []
-    for r in simulate_runs(scene, max_runs):
+    for r in run_points(scene, max_runs):
         title = ", ".join(f"{k} = {v}" for k, v in zip(swept, swept_values(r, swept),
                                                         strict=True))
         out.append((r, history_dataset(r, title), title))

@@ -1,0 +1,123 @@
+"""Damage states of a record-suite sweep: their words (``state=``), how several are
+fitted together, and which points of a result Dataset reach each one and are counted.
+
+States (``rocksweep.vocab.outcomes``): "overturn" (outcome 1 or 2), "mode1", "mode2",
+"uplift" (uplifts > 0 or overturned), "theta:X" (max|theta|/alpha_cg >= X or overturned,
+0 < X <= 1). uplift < theta:X < overturn are nested (a point that reaches one reaches the
+milder ones); the two modes are not.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from rocksweep.errors import FragilityError
+from rocksweep.kernel import layout as L
+from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, STATES, THETA_STATE, UPLIFT
+
+STATE_WORDS = (*STATES, THETA_STATE)
+
+
+def parse_state(state: str) -> tuple[str, float]:
+    """("overturn" | "mode1" | "mode2" | "uplift" | "theta", threshold) of a state word;
+    "theta:X" is max|theta|/alpha_cg >= X (0 < X <= 1) or overturned."""
+    if not isinstance(state, str):
+        raise FragilityError(f"state = {state!r}: a state is a string, one of "
+                             f"{', '.join(STATE_WORDS)} (or a list of them)")
+    s = state.strip()
+    if s in STATES:
+        return s, math.nan
+    if s.startswith("theta:"):
+        try:
+            x = float(s[6:])
+        except ValueError:
+            x = math.nan
+        if math.isfinite(x) and 0.0 < x <= 1.0:
+            return "theta", x
+        raise FragilityError(f"state {state!r}: theta:X needs a number 0 < X <= 1 "
+                             "(max|theta|/alpha_cg)")
+    raise FragilityError(f"state {state!r}: expected one of {', '.join(STATE_WORDS)}")
+
+
+def parse_states(state: Any) -> list[str]:
+    """The list of state words of ``state`` (a word or a list/tuple of words), checked:
+    each word ``parse_state``, none twice, at least one."""
+    if isinstance(state, str):
+        states = [state]
+    elif isinstance(state, list | tuple):
+        states = list(state)
+    else:
+        raise FragilityError(f"state = {state!r}: a state word or a list of them "
+                             f"({', '.join(STATE_WORDS)})")
+    if not states:
+        raise FragilityError("state = []: give at least one state")
+    for s in states:
+        parse_state(s)
+    if len({s.strip() for s in states}) != len(states):
+        raise FragilityError(f"state = {states!r}: lists a state twice")
+    return [s.strip() for s in states]
+
+
+def severity(state: str) -> float:
+    """Order of the nested damage states: uplift (0) < theta:X (X) < overturn (inf); NaN
+    for the modes (not nested)."""
+    kind, x = parse_state(state)
+    return {UPLIFT: 0.0, "theta": x, OVERTURN: math.inf}.get(kind, math.nan)
+
+
+def state_groups(states: Sequence[str]) -> list[tuple[str, list[int]]]:
+    """How the states are fitted: [(kind, indices into states)]: "ordinal" for two or more
+    nested damage states (uplift, theta:X, overturn; indices in severity order),
+    "competing" for mode1 with mode2, "single" for every other one."""
+    nested = sorted((i for i, s in enumerate(states) if not math.isnan(severity(s))),
+                    key=lambda i: severity(states[i]))
+    modes = [states.index(s) for s in (MODE1, MODE2) if s in states]
+    groups: list[tuple[str, list[int]]] = []
+    if len(nested) >= 2:
+        groups.append(("ordinal", nested))
+    else:
+        groups += [("single", [i]) for i in nested]
+    if len(modes) == 2:
+        groups.append(("competing", modes))
+    else:
+        groups += [("single", [i]) for i in modes]
+    return groups
+
+
+def required(ds: xr.Dataset, name: str, why: str) -> xr.DataArray:
+    if name not in ds.variables:
+        raise FragilityError(f"the Dataset has no variable {name!r} ({why})")
+    return ds[name]
+
+
+def state_reached(ds: xr.Dataset, state: str) -> xr.DataArray:
+    """bool DataArray (the outcome's dims): the point reaches ``state`` (``parse_state``)."""
+    kind, x = parse_state(state)
+    out = required(ds, "outcome", "outcome codes")
+    over = (out == L.OUTCOME_MODE1) | (out == L.OUTCOME_MODE2)
+    if kind == "overturn":
+        return over
+    if kind == "mode1":
+        return out == L.OUTCOME_MODE1
+    if kind == "mode2":
+        return out == L.OUTCOME_MODE2
+    if kind == "uplift":
+        return (required(ds, "uplifts", f"state {state}") > 0) | over
+    return (required(ds, "theta_max_over_alpha", f"state {state}") >= x) | over
+
+
+def counted_points(ds: xr.Dataset) -> tuple[xr.DataArray, xr.DataArray, xr.DataArray]:
+    """(counted, flagged, not_run) bool DataArrays: flagged = status &
+    ``kernel.layout.STATUS_FLAGGED`` (horizon, step cap, event cap, non-finite: the one
+    definition of a flagged point, as ``rocksweep.fields`` documents it), not_run = outcome
+    -1 and not flagged; counted = neither."""
+    out = required(ds, "outcome", "outcome codes")
+    status = required(ds, "status", "status bit flags: flagged points are excluded")
+    flagged = (status.astype(np.int64) & int(L.STATUS_FLAGGED)) != 0
+    not_run = (out == L.OUTCOME_NOT_RUN) & ~flagged
+    return ~flagged & ~not_run, flagged, not_run
