@@ -18,7 +18,6 @@ from __future__ import annotations
 import math
 import numbers
 import os
-import socket
 import sys
 import time
 from dataclasses import dataclass
@@ -175,6 +174,8 @@ def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
         host, port = None, None
     if not host or port is None:
         raise SweepError(f"scheduler {address}: not an address like tcp://host:8786")
+    import socket  # here: the command line's options read this module's constants
+
     deadline = time.monotonic() + timeout
     try:
         sock = socket.create_connection((host, port), timeout=timeout)
