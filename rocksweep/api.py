@@ -314,7 +314,7 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
 def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
               im: str | None = None, period: float | None = None,
               bootstrap: int | None = None, seed: int = DEFAULT_SEED,
-              ci: float = DEFAULT_CI) -> xr.Dataset:
+              ci: float = DEFAULT_CI, joint: bool = False) -> xr.Dataset:
     """Lognormal fragility curves P(state | IM = x) = Phi(ln(x / im_median) / beta) of a
     record-suite sweep (a scene with ``ground.records``), fitted by maximum likelihood
     (Baker 2015) to the counts at each stripe of a scaled suite ("stripes-mle") or to the
@@ -324,8 +324,11 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
 
     ds: what ``run`` or ``open`` returns (or a result file's path). state: "overturn"
     (either mode), "mode1", "mode2", "uplift", "theta:X" (max|theta|/alpha_cg >= X, or
-    overturned, 0 < X <= 1), or a list of them (a ``state`` dimension: damage states
-    share one beta, mode1 with mode2 is a competing-risk fit). im: a cloud's IM, "PGA"
+    overturned, 0 < X <= 1), or a list of them (a ``state`` dimension; each state fitted
+    alone, its numbers the same whatever else is asked for; nested curves that cross in
+    the data say "crossing"). joint: damage states share one beta (an ordinal fit, its
+    likelihood-ratio test stored: ``parallel_rejected``), mode1 with mode2 a
+    competing-risk fit. im: a cloud's IM, "PGA"
     (default), "PGV" or "Sa" with period [s] one of the stored periods. bootstrap:
     resamples over records for the intervals and bands (0: none; None:
     ``rocksweep.analysis.resampling.DEFAULT_BOOTSTRAP``, 200); seed: their generator's
@@ -341,7 +344,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     from rocksweep.analysis.fragility import fragility as fit
 
     return fit(_dataset_arg(ds, "ds"), state=state, im=im, period=period,
-               bootstrap=bootstrap, seed=seed, ci=ci)
+               bootstrap=bootstrap, seed=seed, ci=ci, joint=joint)
 
 
 @_public
@@ -361,7 +364,12 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = N
     _typed("years", years, _is_number(years), "a number of years > 0")
     _typed("site", site, site is None or _is_int(site),
            "an integer row number (0 = the first site) or None")
-    return compute(_dataset_arg(fr, "fr"), hazard, years, site=site)
+    from rocksweep.analysis.risk import check_fragility
+    from rocksweep.outputs import shown
+
+    ds = _dataset_arg(fr, "fr")
+    check_fragility(ds, shown(fr) if isinstance(fr, str | Path) else "fr")
+    return compute(ds, hazard, years, site=site)
 
 
 @_public
@@ -425,7 +433,7 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     from rocksweep.scene.inputs import load, override_strings
 
     sc, _ = load(scene, [*override_strings(overrides), *override_strings(keys)])
-    out = [Simulation(r.summary(), hist, r, title)
+    out = [Simulation({**r.summary(), **sc.physical_summary()}, hist, r, title)
            for r, hist, title in titled_runs(sc, API_MAX_RUNS)]
     return out[0] if sc.size == 1 else out
 
@@ -435,8 +443,8 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
 @_public
 def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impact.lam",),
               *, bounds: Mapping[str, Sequence[float]] | None = None,
-              overrides: Overrides = (), ci: float = 0.95, p: float | None = None
-              ) -> xr.Dataset:
+              overrides: Overrides = (), ci: float = 0.95, p: float | None = None,
+              noise: float | None = None) -> xr.Dataset:
     """Fit scene numbers to a measured rocking history.
 
     scene, overrides: as for ``run``. fit: the key or distinct keys to fit (``impact.lam``,
@@ -447,16 +455,20 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     admissible range (default: ``analysis.calibrate.DEFAULT_BOUNDS`` or the range). ci:
     the interval's level, in [0.5, 1). Returns a Dataset over ``parameter`` (the fitted
     keys): ``estimate``, ``lo``, ``hi`` (the ``ci`` interval by profile likelihood, ``ci``
-    in attrs), scalar ``misfit`` (RMS error of the half-cycle peaks, theta/alpha_ref),
-    and the measured and fitted histories over p_t with the fitted impacts
-    (``rocksweep.analysis.calibrate``).
+    in attrs), scalar ``misfit`` (RMS error of the half-cycle peaks, theta/alpha_ref)
+    with ``noise`` (the measurement's, estimated from the history or ``noise=``, in
+    theta/alpha_ref) and ``dof``, ``reason`` ("ok" or misfit, unidentifiable, at_bound
+    joined by ",", also a ``CalibrationWarning``), and the measured and fitted histories
+    over p_t with the fitted impacts (``rocksweep.analysis.calibrate``).
     """
     from rocksweep.analysis.calibrate import calibrate_scene
 
     _typed("bounds", bounds, bounds is None or isinstance(bounds, Mapping),
            "a mapping {key: (lo, hi)}, e.g. {'impact.lam': (0, 1)}, or None")
     _typed("p", p, p is None or _is_number(p), "a number (the body's p [rad/s]) or None")
-    out = calibrate_scene(scene, measured, fit, bounds, ci, p, overrides)
+    _typed("noise", noise, noise is None or _is_number(noise),
+           "a number (the measurement noise, theta/alpha_ref) or None")
+    out = calibrate_scene(scene, measured, fit, bounds, ci, p, overrides, noise)
     return out
 
 

@@ -61,6 +61,7 @@ class Arg:
     caller); value: as given, or none. kind:
     - ``value``: ``rtol = 0.3`` (the name alone without a value),
     - ``flag``: a flag to switch on, ``resume=True``,
+    - ``keyword``: an argument to give, its value the caller's, ``p=...``,
     - ``set_key``: a scene key set by ``overrides`` (value: the key),
       ``overrides['pulse.A_ratio']``,
     - ``set_fix``: the same as a remedy, ``overrides={'pulse.A_ratio': ...}``,
@@ -78,6 +79,8 @@ class Arg:
     def __str__(self) -> str:
         if self.kind == "flag":
             return f"{self.name}=True"
+        if self.kind == "keyword":
+            return f"{self.name}=..."
         if self.kind == "set_key":
             return f"overrides[{self.value!r}]"
         if self.kind == "set_fix":
@@ -176,6 +179,17 @@ class FragilityFigureError(RocksweepError, ValueError):
 
 class PlotError(RocksweepError, ValueError):
     """A Dataset that has no figure (figures.dispatch)."""
+
+
+class AnalysisWarning(UserWarning):
+    """An analysis of points that cannot all be trusted (``analysis.states.trust``: not
+    computed, flagged): the result is marked, and this warning says why (the command line
+    prints it as one ``Warning:`` line)."""
+
+
+class FragilityWarning(AnalysisWarning):
+    """A fitted fragility curve that should not be trusted as it is (its ``reason`` is
+    not "ok")."""
 
 
 class ApiError(RocksweepError, ValueError):

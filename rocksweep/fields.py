@@ -67,7 +67,7 @@ class Field:
         return self.label or self.meaning
 
 
-_FLAGGED = "status & (horizon | step_cap | event_cap | nonfinite | uncertified)"
+_FLAGGED = "status & (horizon | step_cap | event_cap | nonfinite | uncertified | airborne)"
 
 FIELDS: tuple[Field, ...] = (
     Field("outcome", "int8", L.OUTCOME_NOT_RUN, "1",

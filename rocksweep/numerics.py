@@ -268,6 +268,17 @@ def step_sizes(omega_rock: np.ndarray | float, omega: np.ndarray | float,
     return free, on
 
 
+def vertical_step(dt_on: np.ndarray | float, omega_v: np.ndarray | float,
+                  steps_per_period: int, pulse_steps: int = 0) -> np.ndarray:
+    """dt_on [p*t] shortened to resolve a vertical harmonic of frequency omega_v [rad/s]
+    (p = 1) as ``step_sizes`` resolves the pulse: its period over max(pulse_steps,
+    steps_per_period). (A vertical record needs nothing more: it is on the horizontal's
+    samples, which the steps land on.)"""
+    n_on = max(int(pulse_steps), int(steps_per_period))
+    with np.errstate(divide="ignore"):
+        return np.minimum(dt_on, 2 * math.pi / np.asarray(omega_v, float) / n_on)
+
+
 def step_budget(t_pulse: np.ndarray | float, t_end: np.ndarray | float,
                 dt: np.ndarray | float, dt_on: np.ndarray | float,
                 numerics: Numerics) -> np.ndarray:

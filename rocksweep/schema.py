@@ -232,7 +232,28 @@ KEYS: dict[str, Key] = {
                         "else 0.2-3 x 2 pi/p)", 0.0, 100.0, required=False),
     "ground.p": Key("axis", f"must be in [1e-3, {1e3:g}] rad/s (the body's frequency "
                     "parameter p)", 1e-3, 1e3),
+    # the vertical ground acceleration a_v, positive up (docs/vertical.md): a record's
+    # vertical component, scaled with ground.record, or a harmonic while the pulse acts
+    "ground.vertical": Key("string", "must be the path of the record's vertical component, "
+                           "a PEER .AT2 (UP) file or a two-column file (t [s], a_v [g], "
+                           "positive up), relative to the scene file, with ground.record",
+                           required=False),
+    "pulse.vertical": Key("string", "must be {amplitude: a [g], w_over_p: w_v/p, phase: "
+                          "deg} (a_v = a g sin(w_v t + phase) while the pulse acts)",
+                          required=False),
+    "pulse.vertical.amplitude": Key("axis", "must be a finite number [g] (the vertical "
+                                    "harmonic's amplitude; negative: the opposite sign)",
+                                    -math.inf, math.inf, lo_in=False, hi_in=False),
+    "pulse.vertical.w_over_p": Key("axis", "must be > 0 and finite (the vertical harmonic's "
+                                   "frequency w_v/p)", 0.0, math.inf, lo_in=False,
+                                   hi_in=False),
+    "pulse.vertical.phase": Key("axis", "must be a finite angle in degrees (the vertical "
+                                "harmonic's phase at t = 0)", -math.inf, math.inf,
+                                lo_in=False, hi_in=False, required=False, default=0.0),
 }
+# the vertical harmonic's keys (pulse.vertical.*), in the grid's dimension order; their
+# dimensions are named vertical.<key>
+VERTICAL_KEYS: tuple[str, ...] = ("amplitude", "w_over_p", "phase")
 
 # Keys of each body kind, in the grid's dimension order.
 BODY_KEYS: dict[str, tuple[str, ...]] = {

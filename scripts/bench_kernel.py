@@ -120,22 +120,23 @@ _contact = njit(inline="always")(contact_rhs.py_func)
 @njit
 def _bare_rocking(prm, y0, h, n_runs, n_steps, s, on):
     """n_runs runs of n_steps classical RK4 steps rocking on corner s (flexible, damped)."""
+    g = prm[L.PAR_G]  # the kernel's gravity without a vertical: the row's
     acc = 0.0
     for _ in range(n_runs):
         t = 0.0
         th, w, u, v = y0[0], y0[1], y0[2], y0[3]
         for _ in range(n_steps):
             x = _acc(t, on, prm)
-            a1, b1, _, _ = _rocking(th, w, u, v, s, x, prm, True)
+            a1, b1, _, _ = _rocking(th, w, u, v, s, x, g, prm, True)
             x = _acc(t + 0.5 * h, on, prm)
             hh = 0.5 * h
             th2, w2, u2, v2 = th + hh * w, w + hh * a1, u + hh * v, v + hh * b1
-            a2, b2, _, _ = _rocking(th2, w2, u2, v2, s, x, prm, True)
+            a2, b2, _, _ = _rocking(th2, w2, u2, v2, s, x, g, prm, True)
             th3, w3, u3, v3 = th + hh * w2, w + hh * a2, u + hh * v2, v + hh * b2
-            a3, b3, _, _ = _rocking(th3, w3, u3, v3, s, x, prm, True)
+            a3, b3, _, _ = _rocking(th3, w3, u3, v3, s, x, g, prm, True)
             x = _acc(t + h, on, prm)
             th4, w4, u4, v4 = th + h * w3, w + h * a3, u + h * v3, v + h * b3
-            a4, b4, _, _ = _rocking(th4, w4, u4, v4, s, x, prm, True)
+            a4, b4, _, _ = _rocking(th4, w4, u4, v4, s, x, g, prm, True)
             c = h / 6.0
             th, w = th + c * (w + 2.0 * (w2 + w3) + w4), w + c * (a1 + 2.0 * (a2 + a3) + a4)
             u, v = u + c * (v + 2.0 * (v2 + v3) + v4), v + c * (b1 + 2.0 * (b2 + b3) + b4)

@@ -4,7 +4,8 @@ A record-suite sweep of 3 shipped records at 2 PGA stripes is run once (the real
 Dataset's variables and attributes); its stripes are then widened to S levels with a
 synthetic response (each record's capacity lognormal, theta_max growing towards it,
 the stripes' order mixed by noise so the fractions are not monotone), and every analysis
-that reads a suite runs on it: ``fragility`` (overturn; then 3 nested states), the IM
+that reads a suite runs on it: ``fragility`` (overturn; 3 nested states, each alone and
+``joint``), the IM
 ``efficiency``, ``risk`` over a power-law hazard and the per-run ``table``. Each line
 prints the points (records x stripes), the input Dataset's bytes, the analysis's peak
 traced allocation (``tracemalloc``: numpy's arrays included) and its wall time.
@@ -94,6 +95,8 @@ def main() -> None:
         measure(f"fragility overturn S={S}", lambda ds=ds: rocksweep.fragility(ds), n, nb)
         three = measure(f"fragility 3 states S={S}", lambda ds=ds: rocksweep.fragility(
             ds, state=["theta:0.25", "theta:0.5", "overturn"]), n, nb)
+        measure(f"fragility 3 joint S={S}", lambda ds=ds: rocksweep.fragility(
+            ds, state=["theta:0.25", "theta:0.5", "overturn"], joint=True), n, nb)
         measure(f"efficiency S={S}", lambda ds=ds: rocksweep.im_efficiency(ds), n, nb)
         measure(f"risk S={S}", lambda fr=three: rocksweep.risk(fr, hazard), n, nb)
         measure(f"table S={S}", lambda ds=ds: rocksweep.table(ds), n, nb)

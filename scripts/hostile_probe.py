@@ -12,7 +12,12 @@ Each case is classified:
 - dataloss: an input file changed or vanished;
 - traceback: a traceback, a warning or several lines, a hang (timeout), or a refusal
   where the case must work (reported as such).
+- hang: no answer within TIMEOUT;
+- wrong: a wrong answer (exit 0 where a refusal is due, a refusal that wrote a file, a
+  number off its stated tolerance, a verdict left out).
 The counts are printed last; the exit status is 1 if any case is neither ok nor clean.
+The analysis cases share fixtures made once per run (a suite sweep, its fragility, a
+partial file, a measured history: ``fixtures``).
 """
 
 from __future__ import annotations
@@ -111,6 +116,7 @@ def py(d: Path, code: str) -> subprocess.CompletedProcess:
 
 CASES: list[tuple[str, str, object]] = []  # (name, expected 'ok'|'clean', function)
 FROZEN: dict[str, str] = {}  # the inputs of the running case (``freeze``)
+LOST: list[str] = []  # what a case found lost beyond its inputs (a file made meanwhile)
 
 
 def freeze(d: Path) -> None:
@@ -552,6 +558,9 @@ def _interrupt(d: Path, delay: float, after_header: bool) -> subprocess.Complete
         r.stderr = f"EXIT {p.returncode}: " + err
         r.returncode = 99 if p.returncode == 0 else p.returncode
         return r
+    if (d / "b.h5").exists() and "points saved in" not in err:
+        # a file was made: the answer says how many points it holds and how to go on
+        return wrong(r, "exit 130 without the 'interrupted: N of M points saved' line")
     if (d / "b.h5").exists():
         r2 = cli(d, ["sweep", "big.yaml", "-o", "b.h5", "-q", "--resume"])
         if r2.returncode:
@@ -602,19 +611,358 @@ def _(d):
     return cli(d, ["restitution", "pulse.yaml", "--law", "vertical", "--set", "impact.e=0.5"])
 
 
+# --- the analyses held to the sweeps' standard ------------------------------------------
+# Shared fixtures, made once per probe run (``fixtures``) and copied into a case's folder:
+# s.h5 a suite sweep (2 records x 2 PGA stripes), f.h5 its fragility, p.h5 a pulse sweep,
+# part.h5 a suite file a sweep stopped writing, one.h5 a one-stripe suite, m.csv a
+# free-rocking block's history (simulate --csv), free.yaml its scene, hz.csv a hazard.
+
+FIXTURES: dict[str, Path] = {}
+FREE = ("name: free\nbody: {kind: block, alpha: 0.2}\nimpact: {lam: 0.0}\n"
+        "initial: {theta_over_alpha: 0.7}\n")
+HAZARD = ("PGA [g],annual_rate\n0.05,0.01\n0.1,0.003\n0.3,0.0004\n1.0,0.00002\n"
+          "3.0,0.000001\n")
+PARTIAL = """
+import sys
+from rocksweep import api
+import rocksweep.compute.sweep as sw
+from rocksweep.scene.grid import Grid
+from rocksweep.store.writer import SweepFile
+sc, _ = api.load('suite.yaml')
+sf = SweepFile.create('part.h5', sc)
+sf.write(sw.run_chunk(Grid(sc), 0, 3, sw.level(sc)))
+sf.close()
+"""
+
+
+def fixtures() -> Path:
+    """The folder of the analysis fixtures (made on first use)."""
+    if "dir" in FIXTURES:
+        return FIXTURES["dir"]
+    d = Path(tempfile.mkdtemp(prefix="probe-fixtures-"))
+    setup(d)
+    (d / "free.yaml").write_text(FREE)
+    (d / "hz.csv").write_text(HAZARD)
+    (d / "onestripe.yaml").write_text(suite_scene("r/*.AT2").replace("[0.2, 0.6]", "[0.6]"))
+    e = {**os.environ, "PYTHONPATH": str(ROOT)}
+    for args in (["sweep", "suite.yaml", "-o", "s.h5", "-q"],
+                 ["sweep", "onestripe.yaml", "-o", "one.h5", "-q"],
+                 ["sweep", "pulse.yaml", "-o", "p.h5", "-q"],
+                 ["fragility", "s.h5", "-o", "f.h5", "--bootstrap", "20"],
+                 ["simulate", "free.yaml", "--csv", "m.csv"]):
+        subprocess.run([sys.executable, "-m", "rocksweep", *args], cwd=d, env=e,
+                       capture_output=True, text=True, timeout=600)
+    subprocess.run([sys.executable, "-c", PARTIAL], cwd=d, env=e, capture_output=True,
+                   text=True, timeout=600)
+    FIXTURES["dir"] = d
+    return d
+
+
+def fixture(d: Path, *names: str) -> None:
+    for n in names:
+        shutil.copy(fixtures() / n, d / n)
+
+
+def wrong(r: subprocess.CompletedProcess, why: str) -> subprocess.CompletedProcess:
+    """Mark a case's answer wrong (classified as such, whatever its exit)."""
+    r.stderr = f"WRONG: {why} | " + (r.stderr or "") + (r.stdout or "")
+    r.returncode = 98
+    return r
+
+
+def api_call(d: Path, code: str) -> subprocess.CompletedProcess:
+    """Python code whose wrong argument types must be a one-line TypeError/ValueError
+    (or a RocksweepError): printed as REFUSED, anything else a traceback."""
+    prog = ("import sys, rocksweep\n"
+            "try:\n" + textwrap.indent(textwrap.dedent(code), "    ") +
+            "\nexcept (rocksweep.RocksweepError, TypeError, ValueError) as err:\n"
+            "    if '\\n' in str(err) or type(err).__name__ in ('AttributeError',):\n"
+            "        raise\n"
+            "    print('REFUSED', type(err).__name__, str(err))\n"
+            "    sys.exit(1)\n")
+    freeze(d)
+    e = {**os.environ, "PYTHONPATH": str(ROOT)}
+    return subprocess.run([sys.executable, "-c", prog], cwd=d, env=e, capture_output=True,
+                          text=True, timeout=TIMEOUT)
+
+
+# A file made at the output path while the command computes (by the first temporary file
+# the command makes: after it checked the path) is the user's: it must be kept.
+APPEARS = """
+import sys, tempfile
+target, args = sys.argv[1], sys.argv[2:]
+real = tempfile.mkstemp
+def mkstemp(*a, **k):
+    try:
+        with open(target, 'x') as f:
+            f.write('mine')
+    except FileExistsError:
+        pass
+    return real(*a, **k)
+tempfile.mkstemp = mkstemp
+from rocksweep.cli import main
+sys.argv = ['rocksweep', *args]
+main()
+"""
+
+
+def appears(d: Path, target: str, args: list[str]) -> subprocess.CompletedProcess:
+    freeze(d)
+    e = {**os.environ, "PYTHONPATH": str(ROOT)}
+    r = subprocess.run([sys.executable, "-c", APPEARS, target, *args], cwd=d, env=e,
+                       capture_output=True, text=True, timeout=TIMEOUT)
+    if not (d / target).exists() or (d / target).read_text(errors="replace") != "mine":
+        LOST.append(f"{target} (made meanwhile) replaced")
+    freeze(d)  # the user's file is an input now: the check above said if it was lost
+    errors = [ln for ln in r.stderr.splitlines() if ln.startswith("Error: ")]
+    if r.returncode and len(errors) == 1 and "Traceback" not in r.stderr:
+        # the command did its work and said so; its refusal to publish is the answer
+        r = subprocess.CompletedProcess(r.args, r.returncode, "", errors[0])
+    return r
+
+
+for _name, _files, _target, _args in (
+        ("table -o", ("s.h5",), "t.csv", ["table", "s.h5", "-o", "t.csv"]),
+        ("risk -o", ("f.h5", "hz.csv"), "r.csv", ["risk", "f.h5", "--hazard", "hz.csv",
+                                                  "-o", "r.csv"]),
+        ("efficiency -o", ("s.h5",), "e.csv", ["efficiency", "s.h5", "-o", "e.csv"]),
+        ("fragility -o", ("s.h5",), "fr.h5", ["fragility", "s.h5", "--bootstrap", "0", "-o",
+                                              "fr.h5"]),
+        ("fragility --plot", ("s.h5",), "fr.png", ["fragility", "s.h5", "--bootstrap", "0",
+                                                   "--plot", "fr.png"]),
+        ("calibrate -o", ("free.yaml", "m.csv"), "fit.h5",
+         ["calibrate", "free.yaml", "m.csv", "--fit", "impact.lam", "-o", "fit.h5"]),
+        ("simulate --csv", (), "h.csv", ["simulate", "pulse.yaml", "--set",
+                                         "pulse.w_over_p=1", "--set", "pulse.A_ratio=2",
+                                         "--csv", "h.csv"])):
+    case(f"dataloss: a file made at {_name}'s path meanwhile is kept")(
+        lambda d, f=_files, t=_target, a=_args: (fixture(d, *f), appears(d, t, a))[1])
+
+
+@case("two table -o t.csv at once: one writes, the other refuses", "ok")
+def _(d):
+    fixture(d, "s.h5")
+    freeze(d)
+    e = {**os.environ, "PYTHONPATH": str(ROOT)}
+    slow = APPEARS.replace("    try:\n        with open(target, 'x') as f:\n"
+                           "            f.write('mine')\n    except FileExistsError:\n"
+                           "        pass\n", "    import time; time.sleep(2)\n")
+    assert "sleep" in slow
+    # both check t.csv, then both wait 2 s before writing it: they overlap
+    procs = [subprocess.Popen([sys.executable, "-c", slow, "t.csv", "table", "s.h5", "-o",
+                               "t.csv"], cwd=d, env=e, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    outs = [p.communicate(timeout=TIMEOUT) for p in procs]
+    r = subprocess.CompletedProcess([], 0, outs[0][0] + outs[1][0], "")
+    wrote = sum("wrote" in o for o, _ in outs)
+    if wrote != 1 and not all(p.returncode == 0 for p in procs):
+        return wrong(r, f"{wrote} wrote")
+    if wrote == 2:  # both published: the second replaced the first's file
+        return wrong(r, "both wrote t.csv")
+    return r
+
+
+@case("a killed risk -o's temporary files are removed by the next risk -o", "ok")
+def _(d):
+    fixture(d, "f.h5", "hz.csv")
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True).stdout.strip()
+    (d / f".r.h5.{dead}-abcd1234.partial.h5").write_bytes(b"half")
+    old = d / ".r.abcd1234.partial.h5"
+    old.write_bytes(b"half")
+    os.utime(old, (time.time() - 3600, time.time() - 3600))
+    r = cli(d, ["risk", "f.h5", "--hazard", "hz.csv", "-o", "r.h5"])
+    left = [p.name for p in d.iterdir() if ".partial" in p.name]
+    freeze(d)  # the killed writers' files are no inputs: their removal is the point
+    return wrong(r, f"left {left}") if left else r
+
+
+# hangs: every case answers in TIMEOUT
+
+@case("hang: calibrate --fit initial.u_over_ucr of a rigid block")
+def _(d):
+    fixture(d, "free.yaml", "m.csv")
+    return cli(d, ["calibrate", "free.yaml", "m.csv", "--fit", "initial.u_over_ucr"])
+
+
+@case("hang: risk --hazard a FIFO")
+def _(d):
+    fixture(d, "f.h5")
+    os.mkfifo(d / "hz.csv")
+    return cli(d, ["risk", "f.h5", "--hazard", "hz.csv"])
+
+
+@case("hang: calibrate of a FIFO measured history")
+def _(d):
+    fixture(d, "free.yaml")
+    os.mkfifo(d / "m.csv")
+    return cli(d, ["calibrate", "free.yaml", "m.csv", "--fit", "impact.lam"])
+
+
+def _oq(d: Path, T: str, imt: str, poes: str = "0.5,0.1,0.01") -> subprocess.CompletedProcess:
+    fixture(d, "f.h5")
+    (d / "oq.csv").write_text(f"#,,,,,\"generated_by='OpenQuake engine 3.16', "
+                              f"investigation_time={T}, imt='{imt}'\"\n"
+                              "lon,lat,depth,poe-0.1,poe-0.3,poe-1.0\n"
+                              f"10.0,45.0,0.0,{poes}\n")
+    return cli(d, ["risk", "f.h5", "--hazard", "oq.csv"])
+
+
+for _T, _imt in (("50.0.1", "PGA"), ("e", "PGA"), ("50.0", "SA(1.0.0)"), ("50.0", "SA(e)")):
+    case(f"OpenQuake header investigation_time={_T}, imt='{_imt}'")(
+        lambda d, T=_T, i=_imt: _oq(d, T, i))
+case("OpenQuake poe = 1.0 at a higher level than a poe below 1 (rising)")(
+    lambda d: _oq(d, "50.0", "PGA", "0.5,1.0,1.0"))
+
+
+def _measured(d: Path, text: str, fit: str = "impact.lam") -> subprocess.CompletedProcess:
+    fixture(d, "free.yaml")
+    (d / "mm.csv").write_text(text)
+    return cli(d, ["calibrate", "free.yaml", "mm.csv", "--fit", fit])
+
+
+def _history(scale: float = 1.0, t_scale: float = 1.0, head: str = "p_t,theta_over_alpha",
+             sep: str = ",", dup: bool = False) -> str:
+    import math
+    rows = [head]
+    for i in range(300):
+        t = i * 0.05
+        th = scale * 0.7 * math.cos(1.3 * t) * math.exp(-0.05 * t)
+        rows.append(sep.join([repr(t * t_scale)] * (2 if dup else 1) + [repr(th)]))
+    return "\n".join(rows) + "\n"
+
+
+case("measured CSV with a duplicated column 'p_t ,p_t'")(
+    lambda d: _measured(d, _history(head="p_t ,p_t,theta_over_alpha", dup=True)))
+case("measured p_t near 1e300")(lambda d: _measured(d, _history(t_scale=1e298)))
+case("measured |theta| up to 10 rad on a block of alpha 0.2")(
+    lambda d: _measured(d, _history(scale=10 / 0.2 / 0.7)))
+case("measured CSV separated by semicolons")(
+    lambda d: _measured(d, _history(sep=";").replace("p_t,theta", "p_t;theta")))
+case("calibrate --bounds of a key that is not fitted")(
+    lambda d: (fixture(d, "free.yaml", "m.csv"), cli(d, [
+        "calibrate", "free.yaml", "m.csv", "--fit", "impact.lam", "--bounds",
+        "impact.e_factor=0.5,1"]))[1])
+case("calibrate --bounds =0,1")(
+    lambda d: (fixture(d, "free.yaml", "m.csv"), cli(d, [
+        "calibrate", "free.yaml", "m.csv", "--fit", "impact.lam", "--bounds", "=0,1"]))[1])
+
+
+def _hazard(d: Path, text: str) -> subprocess.CompletedProcess:
+    fixture(d, "f.h5")
+    (d / "h.csv").write_text(text)
+    r = cli(d, ["risk", "f.h5", "--hazard", "h.csv"])
+    if r.returncode and "line" not in r.stderr:
+        return wrong(r, "the refusal does not name the line")
+    return r
+
+
+case("hazard separated by semicolons")(lambda d: _hazard(d, HAZARD.replace(",", ";")))
+case("hazard separated by tabs")(lambda d: _hazard(d, HAZARD.replace(",", "\t")))
+
+
+def _scene(d: Path, extra: str, body: str = BODY) -> subprocess.CompletedProcess:
+    (d / "x.yaml").write_text("name: x\n" + body + extra + "\n")
+    return cli(d, ["simulate", "x.yaml"])
+
+
+BLOCK = "body: {kind: block, alpha: 0.2}\nimpact: {lam: 0.0}\n"
+case("initial: {u_over_ucr: 1e300} on a flexible body")(
+    lambda d: _scene(d, "initial: {u_over_ucr: 1e300}"))
+case("initial: {thetadot_over_palpha: 1e300} on a block")(
+    lambda d: _scene(d, "initial: {thetadot_over_palpha: 1e300}", BLOCK))
+case("initial: {theta_over_alpha: null} is not 0")(
+    lambda d: _scene(d, "initial: {theta_over_alpha: null}", BLOCK))
+case("pulse: null is refused as pulse: {} is")(lambda d: _scene(d, "pulse: null", BLOCK))
+case("efficiency of a one-stripe suite")(
+    lambda d: (fixture(d, "one.h5"), cli(d, ["efficiency", "one.h5"]))[1])
+case("risk of a pulse sweep names the file")(
+    lambda d: (fixture(d, "p.h5", "hz.csv"), _named(cli(d, ["risk", "p.h5", "--hazard",
+                                                             "hz.csv"]), "p.h5"))[1])
+
+
+def _named(r: subprocess.CompletedProcess, name: str) -> subprocess.CompletedProcess:
+    return r if r.returncode == 0 or name in r.stderr else wrong(r, f"{name} not named")
+
+
+@case("risk of a risk file names the file")
+def _(d):
+    fixture(d, "f.h5", "hz.csv")
+    r = cli(d, ["risk", "f.h5", "--hazard", "hz.csv", "-o", "r.h5"])
+    if r.returncode:
+        return r
+    return _named(cli(d, ["risk", "r.h5", "--hazard", "hz.csv"]), "r.h5")
+
+
+@case("efficiency of a partial file says incomplete", "ok")
+def _(d):
+    fixture(d, "part.h5")
+    r = cli(d, ["efficiency", "part.h5"])
+    return r if r.returncode or "incomplete" in r.stderr else wrong(r, "no 'incomplete'")
+
+
+@case("fragility of a partial file says incomplete", "ok")
+def _(d):
+    fixture(d, "part.h5")
+    r = cli(d, ["fragility", "part.h5", "--bootstrap", "0"])
+    return r if r.returncode or "incomplete" in r.stderr else wrong(r, "no 'incomplete'")
+
+
+@case("fragility --rtol of a partial file: one line, no fit warnings first")
+def _(d):
+    fixture(d, "part.h5")
+    return cli(d, ["fragility", "part.h5", "--bootstrap", "0", "--rtol", "0.01"])
+
+
+def _frag_beta(d: Path, beta: float) -> subprocess.CompletedProcess:
+    return api_call(d, f"""
+        import math
+        import numpy as np, pandas as pd, xarray as xr
+        fr = xr.Dataset({{"im_median": (("lam",), [0.3]), "beta": (("lam",), [{beta!r}])}},
+                        coords={{"lam": [0.0]}}, attrs={{"im": "PGA", "im_units": "g"}})
+        x = np.geomspace(1e-4, 1e2, 40)
+        hz = pd.DataFrame({{"PGA [g]": x, "annual_rate": 1e-4 * x ** -2.0}})
+        rk = rocksweep.risk(fr, hz)
+        exact = 1e-4 * 0.3 ** -2.0 * math.exp(4.0 * {beta!r} ** 2 / 2)
+        err = abs(float(rk.annual_rate[0]) / exact - 1)
+        print("OK" if err <= 1e-6 else f"WRONG rate off by {{err:.2e}}")
+        sys.exit(0 if err <= 1e-6 else 98)""")
+
+
+case("risk of a fragility with beta = -0.4")(lambda d: _frag_beta(d, -0.4))
+case("risk with beta = 1e-6 meets the closed form to 1e-6", "ok")(
+    lambda d: _frag_beta(d, 1e-6))
+case("risk with beta = 0 meets the closed form to 1e-6", "ok")(lambda d: _frag_beta(d, 0.0))
+
+for _code in ("rocksweep.plot(None)", "rocksweep.plot(5)", "rocksweep.plot([1, 2])",
+              "rocksweep.plot(rocksweep.open('p.h5'), ax=5)",
+              "rocksweep.calibrate('free.yaml', 'm.csv', 'impact.lam', bounds=[0, 1])",
+              "rocksweep.calibrate('free.yaml', 'm.csv', 'impact.lam', p='3')",
+              "rocksweep.risk('f.h5', 'hz.csv', site=1.5)",
+              "rocksweep.risk('f.h5', 'hz.csv', site=True)",
+              "rocksweep.table(None)", "rocksweep.fragility([1, 2])"):
+    case(f"API type: {_code}")(
+        lambda d, c=_code: (fixture(d, "p.h5", "f.h5", "hz.csv", "free.yaml", "m.csv"),
+                            api_call(d, c))[1])
+
+
 # --- the run -------------------------------------------------------------------------------
 
 def classify(r: subprocess.CompletedProcess, before: dict, after: dict,
              expect: str) -> tuple[str, str]:
-    lost = [k for k, v in before.items() if after.get(k) != v]
+    lost = [k for k, v in before.items() if after.get(k) != v] + LOST
     text = (r.stderr.strip() + " " + r.stdout.strip()).strip()
     if lost:
         return "dataloss", f"changed: {', '.join(lost)} | {text[:200]}"
+    if r.returncode == 124 and "HANG" in r.stderr:
+        return "hang", text[:200]
+    if r.returncode == 98:
+        return "wrong", text[:300]
     # Python's warnings (RuntimeWarning: ...), not the library's own "Warning: ..." verdicts
     if "Traceback" in r.stderr or re.search(r"\b[A-Z]\w*Warning\b", r.stderr):
         return "traceback", r.stderr.strip()[-400:]
     if r.returncode == 0:
-        return ("ok" if expect in ("ok", "any") else "traceback",
+        return ("ok" if expect in ("ok", "any") else "wrong",
                 text[:200] or "(exit 0)")
     lines = [ln for ln in r.stderr.strip().splitlines() if ln.strip()]
     if r.stdout.startswith("REFUSED"):
@@ -622,6 +970,9 @@ def classify(r: subprocess.CompletedProcess, before: dict, after: dict,
     one = len(lines) == 1 and (lines[0].startswith(("Error: ", "REFUSED")))
     if not one or expect == "ok" or r.returncode == 99:
         return "traceback", text[:400]
+    new = sorted(set(after) - set(before))
+    if new:  # a refusal writes nothing
+        return "wrong", f"refused but wrote {', '.join(new)} | {lines[0][:200]}"
     return "clean", lines[0][:200]
 
 
@@ -665,6 +1016,7 @@ def main() -> int:
         with tempfile.TemporaryDirectory(prefix="probe-") as tmp:
             d = Path(tmp)
             setup(d)
+            LOST.clear()
             try:
                 r = fn(d)
             except subprocess.TimeoutExpired:
@@ -672,12 +1024,15 @@ def main() -> int:
             after = snapshot(d)
             kind, why = classify(r, dict(FROZEN), after, expect)
         counts[kind] += 1
-        if a.v or kind in ("dataloss", "traceback"):
+        if a.v or kind in ("dataloss", "traceback", "hang", "wrong"):
             print(f"{kind:9s} {name}\n          {why}", flush=True)
     total = sum(counts.values())
     print(f"\n{total} cases in {time.perf_counter() - t0:.0f} s: " +
-          ", ".join(f"{k} {counts[k]}" for k in ("clean", "ok", "dataloss", "traceback")))
-    return 1 if counts["dataloss"] or counts["traceback"] else 0
+          ", ".join(f"{k} {counts[k]}" for k in ("clean", "ok", "dataloss", "traceback",
+                                                    "hang", "wrong")))
+    if "dir" in FIXTURES:
+        shutil.rmtree(FIXTURES["dir"], ignore_errors=True)
+    return 1 if any(counts[k] for k in ("dataloss", "traceback", "hang", "wrong")) else 0
 
 
 if __name__ == "__main__":

@@ -306,7 +306,8 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
 
     _no_suite(scene)
     cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
-    rows_all = with_record(cr.rows, scene.record)  # a record's samples ride on each row
+    # a record's samples (and its vertical's) ride on each row
+    rows_all = with_record(cr.rows, scene.record, scene.vertical_samples())
     ground = scene.ground  # the Ricker, MP and records run the GROUND variants
     n = len(flat)
     outs = np.empty((n, L.N_OUT))

@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from rocksweep.analysis.bisection import bisect_thresholds
 from rocksweep.analysis.tolerance import DEFAULT_RTOL, MAX_RTOL, check_rtol
 from rocksweep.compute.adaptive import DIAGRAM_AXES, AdaptiveError, make_plan
 from rocksweep.compute.dispatch import run_variant
@@ -308,8 +309,8 @@ def kernel_rows(scene: Scene, points: list[Point]) -> np.ndarray:
     # body object and the pulse's options filled at once (``fill_rows``)
     groups: dict[tuple, list[int]] = {}
     for i, p in enumerate(points):
-        key = (kernel_kind(p.body), p.ground, id(p.record), id(p.body), p.cycles, p.gamma,
-               p.nu)
+        key = (kernel_kind(p.body), p.ground, id(p.record), id(p.vertical), id(p.body),
+               p.cycles, p.gamma, p.nu)
         groups.setdefault(key, []).append(i)
     for (kind, ground, *_), idx in groups.items():
         warm_up(kind, L.LEVEL_OUTCOME, ground)
@@ -331,14 +332,19 @@ def _rows(points: list[Point], numerics: Numerics) -> np.ndarray:
     def column(name: str) -> np.ndarray:
         return np.array([getattr(p, name) for p in points], float)
 
+    vertical = p0.vertical_on_samples() if rec is not None else None
+    pv = None
+    if p0.pulse_vertical is not None:  # the vertical harmonic's keys, point by point
+        pv = tuple(np.array([getattr(p.pulse_vertical, k) for p in points], float)
+                   for k in ("amplitude", "w_over_p", "phase"))
     fill_rows(rows, np.broadcast_to(body_row(body), (n, L.N_PAR)),
               np.full(n, body_omega_rock(body)), np.full(n, body.alpha_ref), column("lam"),
               np.array([shape_code(p.shape) for p in points]),
               column("p") if rec is not None else column("w_over_p"), column("A_ratio"),
               numerics, p0.cycles, p0.gamma, p0.nu, rec, column("mu"),
               np.array([law_code(p.law) for p in points]), column("e"),
-              column("e_factor"))
-    return with_record(rows, rec)
+              column("e_factor"), vertical=vertical, pulse_vertical=pv)
+    return with_record(rows, rec, vertical)
 
 
 def kernel_evaluator(scene: Scene) -> Evaluator:
@@ -529,23 +535,19 @@ def a_min(scene: Scene, outcome: np.ndarray, rtol: float = DEFAULT_RTOL,
         elif math.isnan(c.lo[j]):
             c.method[j] = A_MIN_METHODS.index("first grid value")
     todo = [col for col in cols if not math.isnan(col.curve.lo[col.j])]
-    while True:
-        active = [col for col in todo if col.curve.hi[col.j] - col.curve.lo[col.j]
-                  > rtol * abs(col.curve.hi[col.j])]
-        mids = [0.5 * (col.curve.lo[col.j] + col.curve.hi[col.j]) for col in active]
-        # float64 cannot split the bracket any further: done to its resolution
-        live = [(col, m) for col, m in zip(active, mids, strict=True)
-                if col.curve.lo[col.j] < m < col.curve.hi[col.j]]
-        if not live:
-            break
-        cls = evaluate([col.point(scene, axes[1], m) for col, m in live])
-        for (col, m), k in zip(live, cls, strict=True):
-            c, j = col.curve, col.j
-            c.runs[j] += 1
-            if int(k) in target:
-                c.hi[j], c.mode[j] = m, k
-            else:
-                c.lo[j] = m
+    lo, hi = (np.array([getattr(col.curve, e)[col.j] for col in todo], float)
+              for e in ("lo", "hi"))
+    modes = np.array([col.curve.mode[col.j] for col in todo], np.int64)
+
+    def classify(idx: np.ndarray, mids: np.ndarray) -> np.ndarray:
+        return evaluate([todo[i].point(scene, axes[1], m)
+                         for i, m in zip(idx, mids, strict=True)])
+
+    runs, _ = bisect_thresholds(lo, hi, modes, rtol, classify, target)
+    for q, col in enumerate(todo):
+        c, j = col.curve, col.j
+        c.lo[j], c.hi[j], c.mode[j] = lo[q], hi[q], modes[q]
+        c.runs[j] += runs[q]
     for c in curves:
         c.a_min[:] = c.hi
         c.mode[np.isnan(c.hi)] = 0
@@ -755,7 +757,7 @@ def check_search(search: Any) -> bool:
     ApiError."""
     from rocksweep.errors import ApiError
 
-    if not (isinstance(search, bool) or type(search).__name__ == "bool_"):
+    if not isinstance(search, bool | np.bool_):
         raise ApiError(f"search = {search!r}: must be True or False")
     return bool(search)
 

@@ -49,6 +49,21 @@ across it rises by the same amount plus twice the profile's scatter about the pa
 (the union of both is kept). Less noise gives a smaller s^2 and a narrower
 interval; an interval that reaches a bound is stated (``lo_at_bound``/``hi_at_bound``).
 
+Verdicts
+--------
+``reason``: "ok", or the words below joined by "," (with a ``CalibrationWarning`` giving
+the numbers): "misfit" when the peaks' RMS error over the degrees of freedom, sqrt(S_min /
+(N - k)), exceeds MISFIT_RATIO times the noise (``noise``: the measurement's, estimated
+from the history or given, and at least NOISE_FLOOR of the largest |theta/alpha|, the
+agreement a right model reaches on a noise-free measurement): the model cannot reproduce
+the measurement at any value inside the bounds, and the interval is not an uncertainty of
+a right model; "unidentifiable" when a key's interval spans its bounds (the profile is
+flat: the history does not say the key, or the key does not change it); "at_bound" when
+an estimate sits on a search bound (within AT_BOUND of the span: the minimum may lie
+beyond; not at the key's own limit, as lam = 0, where nothing lies beyond).
+A fitted key that cannot change the scene's runs (lam under law constant) is refused
+before any run.
+
 Speed: each misfit evaluation is one run of the single-run history kernel (no plot, no
 Dataset): the scene's point is made once and each candidate rewrites its own row.
 """
@@ -73,6 +88,7 @@ from rocksweep.physics.measured import Measured, noise_level, read_measured
 from rocksweep.physics.points import INITIAL, kernel_kind, point_row
 from rocksweep.schema import KEYS, fmt
 from rocksweep.vocab.kinds import CALIBRATION, KIND_ATTR
+from rocksweep.vocab.laws import CONSTANT
 
 ACCURACY = "fine"  # the least accuracy of a calibration's runs (``calibration_numerics``)
 H_NOISE = 4.0  # threshold of an excursion, in noise standard deviations ...
@@ -92,6 +108,20 @@ OPTIONAL_NAMES = ("e_factor", *INITIAL)
 MAX_SPAN = 1e4
 # Largest |theta| [rad] of a measurement: pi/2 (the body on its side) and 5% for noise.
 THETA_LIMIT = 1.05 * math.pi / 2
+#: "misfit": the peaks' RMS error over the degrees of freedom above this many noises. Good
+#: fits of independent histories (scipy's block at 0-1% noise, a flexible body at 0.2-1%)
+#: give 0.14-1.04; a block under the vertical law fitted to e = 0.6 (no lam gives it) 210
+MISFIT_RATIO = 3.0
+#: the least noise a misfit is compared with, as a share of the largest |theta/alpha|
+NOISE_FLOOR = 0.002
+#: "at_bound": an estimate within this share of its bounds' span from one of them
+AT_BOUND = 1e-3
+VERDICTS = ("ok", "misfit", "unidentifiable", "at_bound")
+
+
+class CalibrationWarning(UserWarning):
+    """A fit that should not be trusted as it is (its ``reason`` is not "ok"); ``str()``
+    is one line with the numbers."""
 
 
 def calibration_numerics(n: Numerics) -> Numerics:
@@ -281,7 +311,8 @@ class Problem:
     candidate values (``misfit``) and the histories behind it (``evaluate``)."""
 
     def __init__(self, scene: Any, measured: Measured, fit: Sequence[str],
-                 bounds: Mapping[str, Sequence[float]] | None = None) -> None:
+                 bounds: Mapping[str, Sequence[float]] | None = None,
+                 noise: float | None = None) -> None:
         self.scene = scene
         self.m = measured
         self.keys = tuple(fit)
@@ -291,7 +322,10 @@ class Problem:
         self.numerics = calibration_numerics(scene.single_numerics)
         base = scene.point(self.values)
         self.alpha = base.body.alpha_ref
-        self.sigma = noise_level(measured.t, measured.theta)
+        # the measurement's noise [theta/alpha_ref]: given, or estimated from the history
+        self.noise_given = noise is not None
+        self.sigma = float(noise) if noise is not None else noise_level(measured.t,
+                                                                          measured.theta)
         amp = float(np.max(np.abs(measured.theta)))
         self.h = max(H_NOISE * self.sigma, H_REL * amp)
         self.t_onset = _onset(measured.t, measured.theta, self.h)
@@ -452,6 +486,11 @@ def check_fit_key(scene: Any, key: Any) -> str:
     if key == "impact.e" and "e" not in {a.name for a in scene.axes}:
         raise CalibrationError("fit impact.e: only law constant uses e; give impact: "
                                "{law: constant, e: ...} in the scene (or fit impact.e_factor)")
+    laws = {str(v) for a in scene.axes if a.name == "law" for v in a.values}
+    if key == "impact.lam" and laws and laws <= {CONSTANT}:
+        raise CalibrationError("fit impact.lam: law constant does not use lam (its e is "
+                               "impact.e), so no lam changes a run; fit impact.e or "
+                               "impact.e_factor, or use law vertical or locked")
     allowed = fittable(scene)
     if key not in allowed:
         raise CalibrationError(f"fit {key}: not a number of this scene (fit one of "
@@ -747,6 +786,7 @@ def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
         hi[i], hi_b[i] = _profile_end(problem, i, x_hat, s_min, limit, +1)
         lo[i], hi[i], lo_b[i], hi_b[i] = _smooth_profile(problem, i, x_hat, lo[i], hi[i],
                                                          limit, lo_b[i], hi_b[i])
+    reason, why, noise, dof = _verdict(problem, x_hat, s_min, lo, hi, lo_b, hi_b)
     wall = time.perf_counter() - t0
     m = problem.m
     pairs = best["pairs"]
@@ -763,6 +803,14 @@ def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
          "bound_lo": ("parameter", problem.bounds[:, 0]),
          "bound_hi": ("parameter", problem.bounds[:, 1]),
          "misfit": ((), math.sqrt(s_min / n)),
+         "noise": ((), noise, {"long_name": "the measurement's noise the misfit is compared "
+                                            "with (estimated from the history, or given; at "
+                                            "least NOISE_FLOOR x max |theta/alpha|)",
+                               "units": "theta/alpha_ref"}),
+         "dof": ((), np.int64(dof), {"long_name": "degrees of freedom: measured half "
+                                                  "cycles less fitted keys"}),
+         "reason": ((), reason, {"long_name": "verdict: ok, or the reasons joined by ',' ("
+                                              + ", ".join(VERDICTS[1:]) + ")"}),
          "measured_theta": ("p_t", m.theta,
                             {"long_name": "measured theta / alpha_ref"}),
          "fitted_theta": ("p_t", best["theta"],
@@ -789,14 +837,61 @@ def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
         "measured": m.source, "notes": "; ".join(notes) if notes else "",
         "scene": problem.scene.text, "accuracy": problem.numerics.describe(),
         "outcome": int(best["out"][L.OUT_OUTCOME]),
+        "noise_given": int(problem.noise_given),
     }
+    if reason != "ok":
+        import warnings
+
+        warnings.warn(CalibrationWarning(
+            f"calibration of {', '.join(problem.keys)}: " + "; ".join(
+                f"{w} ({why[w]})" for w in reason.split(","))), stacklevel=2)
     return ds
+
+
+def _verdict(problem: Problem, x_hat: np.ndarray, s_min: float, lo: np.ndarray,
+             hi: np.ndarray, lo_b: np.ndarray, hi_b: np.ndarray
+             ) -> tuple[str, dict[str, str], float, int]:
+    """(reason, {word: the numbers}, noise, dof) of a fit (module docstring, Verdicts)."""
+    n, k = problem.peaks.value.size, len(problem.keys)
+    dof = n - k
+    amp = float(np.max(np.abs(problem.m.theta)))
+    noise = max(problem.sigma, NOISE_FLOOR * amp)
+    why: dict[str, str] = {}
+    rms = math.sqrt(s_min / max(dof, 1))
+    if rms > MISFIT_RATIO * noise:
+        whose = "given" if problem.noise_given else "estimated"
+        why["misfit"] = (f"the peaks' RMS error {rms:.3g} on {dof} dof is {rms / noise:.3g} "
+                         f"times the {whose} noise {noise:.3g}: the model does not reproduce "
+                         "the measurement inside the bounds")
+    span = problem.bounds[:, 1] - problem.bounds[:, 0]
+    flat, edge = [], []
+    for i, key in enumerate(problem.keys):
+        if lo_b[i] and hi_b[i]:
+            ends = [problem.misfit(np.where(np.arange(k) == i, b, x_hat))
+                    for b in problem.bounds[i]]
+            same = all(math.isclose(e, s_min, rel_tol=1e-9, abs_tol=1e-300) for e in ends)
+            flat.append(f"{key} in [{lo[i]:.4g}, {hi[i]:.4g}] spans its bounds" +
+                        (": it does not change the simulated history" if same else ""))
+        x = float(x_hat[i])
+        b_lo, b_hi = problem.bounds[i]
+        near = b_lo if x - b_lo < b_hi - x else b_hi
+        # a bound that is the key's own limit (lam = 0, e = 1) has nothing beyond it
+        limit = near in (KEYS[key].lo, KEYS[key].hi)
+        if min(x - b_lo, b_hi - x) <= AT_BOUND * span[i] and not limit:
+            edge.append(f"{key} = {x:.4g} on the bound {near:g}; the least misfit may lie "
+                        "beyond")
+    if flat:
+        why["unidentifiable"] = "; ".join(flat)
+    if edge:
+        why["at_bound"] = "; ".join(edge)
+    return (",".join(why) or "ok"), why, noise, dof
 
 
 
 def calibrate_scene(scene: Any, measured: Any, fit: str | Sequence[str],
                     bounds: Mapping[str, Sequence[float]] | None = None, ci: float = 0.95,
-                    p: float | None = None, overrides: Any = ()) -> Any:
+                    p: float | None = None, overrides: Any = (),
+                    noise: float | None = None) -> Any:
     """``rocksweep.calibrate`` (its arguments documented there): ``fit`` (a key or a
     non-empty list of distinct keys) and ``ci`` (in [0.5, 1)) checked first, then the scene
     loaded (``scene.inputs.load``: a Scene, a path, YAML text or a dict, with
@@ -827,13 +922,20 @@ def calibrate_scene(scene: Any, measured: Any, fit: str | Sequence[str],
             raise TypeError(f"p = {p!r}: must be a number (the body's p [rad/s]) or None")
         if not (math.isfinite(p) and p > 0):
             raise CalibrationError(f"p = {p!r}: must be a finite number > 0 [rad/s]")
+    if noise is not None:
+        if isinstance(noise, bool) or not isinstance(noise, int | float | np.integer
+                                                     | np.floating):
+            raise TypeError(f"noise = {noise!r}: must be a number (theta/alpha_ref) or None")
+        if not (math.isfinite(noise) and noise >= 0):
+            raise CalibrationError(f"noise = {noise!r}: must be a finite number >= 0 (the "
+                                   "measurement noise's standard deviation, theta/alpha_ref)")
     scene, _ = load(scene, overrides)
     p_body = _body_p(scene) if p is None else float(p)
     values = {a.name: a.values[0] for a in scene.axes}
     body = scene.point(values).body
     m = read_measured(measured, p=p_body, alpha_ref=body.alpha_ref, u_cr=body.u_cr or None)
     _check_measured_span(m, body.alpha_ref)
-    return calibrate_problem(Problem(scene, m, keys, bounds), ci)
+    return calibrate_problem(Problem(scene, m, keys, bounds, noise), ci)
 
 
 def _check_measured_span(m: Measured, alpha_ref: float) -> None:

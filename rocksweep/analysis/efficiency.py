@@ -35,7 +35,7 @@ from scipy.optimize import minimize
 from scipy.special import log_ndtr
 
 from rocksweep.analysis.fragility import fit_cloud
-from rocksweep.analysis.states import counted_points, state_reached
+from rocksweep.analysis.states import counted_points, state_reached, trust
 from rocksweep.errors import EfficiencyError, RocksweepError  # noqa: F401 (re-exported)
 from rocksweep.physics.bodies import G
 from rocksweep.physics.suite import RECORD_IMS
@@ -133,16 +133,25 @@ def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
                               "rocksweep.open of a scene with ground.records)")
     out_da = ds["outcome"]
     if "record" not in out_da.dims:
-        raise EfficiencyError("outcome has no 'record' dimension: not a record-suite sweep")
+        where = ds.encoding.get("source")  # the file it was opened from, if any
+        raise EfficiencyError(f"{where + ': ' if where else ''}outcome has no 'record' "
+                              "dimension: not a record-suite sweep (a scene with ground.records: a "
+                              "list of record files, and ground.scale)")
     table = record_im_table(ds)
     if not table:
         raise EfficiencyError("the Dataset stores no per-record IMs (record_pga, ...)")
     stripe = ds.attrs.get("scale_im")
     stripe = str(stripe) if stripe and str(stripe) in out_da.dims else None
+    if stripe is not None and ds.sizes[stripe] < 2:
+        level = float(np.atleast_1d(ds[stripe].values)[0])
+        raise EfficiencyError(f"one {stripe} stripe ({stripe} = {level:g}): a record's "
+                              "capacity is only known to lie below or above it; IM "
+                              "efficiency needs a suite of at least 2 stripes")
     others = [d for d in out_da.dims if d not in ("record", stripe)]
     order = [*others, "record"] + ([stripe] if stripe else [])
     reached = state_reached(ds, state)
     counted, _, _ = counted_points(ds)
+    verdict = trust(ds, f"IM efficiency, state {state}")
     hit = (reached & counted).transpose(*order).values
     cnt = counted.transpose(*order).values
     if "scale_factor" in ds.variables:
@@ -246,7 +255,7 @@ def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
                      {"long_name": "the IM of a record scaled by F is F^exponent times it"}),
         "method": (("im",), np.array(methods, dtype=str)),
     }
-    attrs = {"rocksweep_kind": "im_efficiency", "state": str(state),
+    attrs = {"rocksweep_kind": "im_efficiency", "state": str(state), "reason": verdict,
              "stripe_im": stripe or "none",
              "reference": "Luco & Cornell (2007), Structural seismic demand analysis: "
                           "consideration of near-fault ground motions, Earthquake Spectra "

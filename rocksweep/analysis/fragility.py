@@ -37,7 +37,15 @@ Verdicts (``reason``: "ok", or the words below joined by ","; never "ok" for the
 - "bootstrap_undefined": more than (1 - ci) / 2 of the resamples have no finite fit (then
   the interval's tail on that side is not known);
 - "censored": a mode fitted alone while the other mode holds >= ``CENSORED_SHARE`` of the
-  overturning points (fit state=["mode1", "mode2"] for the competing-risk fit);
+  overturning points (fit state=["mode1", "mode2"], joint=True for the competing-risk
+  fit);
+- "crossing" (separate fits, the default): a more severe nested state's curve lies above a
+  milder one's by more than ``CROSSING_TOL`` inside the IM range of the data (a point
+  cannot reach overturning without reaching theta:X): the curves are not both right there;
+  said on both states;
+- "parallel_rejected" (``joint=True``): the likelihood-ratio test of the ordinal fit's
+  common beta against a beta per state (``likelihood.parallel_lr``) rejects it at
+  ``PARALLEL_P``: the joint curves misstate the data; fit the states separately;
 - "incomplete": points of the curve not computed (outcome -1: a partial file, or a sweep
   still writing it); "flagged": points flagged by the kernel (horizon, caps) are left out
   and counting them as reaching the state, or as not, moves im_median by more than
@@ -71,6 +79,7 @@ from rocksweep.analysis.likelihood import (
     isotonic_lr,
     lognormal_cdf,
     mle_batch,
+    parallel_lr,
     percentile_interval,
     resample_weights,
     stripe_rules,
@@ -86,13 +95,14 @@ from rocksweep.analysis.states import (
     parse_state,
     parse_states,
     required,
+    severity,
     state_groups,
     state_reached,
 )
-from rocksweep.errors import Arg, FragilityError
+from rocksweep.errors import Arg, FragilityError, FragilityWarning
 from rocksweep.fields import plain
+from rocksweep.vocab.ground import AVGSA, SCALE_IMS
 from rocksweep.vocab.ground import CLOUD_IMS as CLOUD_IM_VARIABLES
-from rocksweep.vocab.ground import SCALE_IMS
 from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, UPLIFT
 
 __all__ = ["DEFAULT_BOOTSTRAP", "Fit", "FragilityWarning", "REASONS", "STRIPE_IMS",
@@ -104,7 +114,7 @@ STRIPE_IMS = SCALE_IMS
 CLOUD_IMS = {im: (var, SCALE_IMS[im]) for im, var in CLOUD_IM_VARIABLES.items()}
 #: the quality words that follow how a fit ended (``likelihood.ENDINGS``)
 QUALITY = ("beta_undetermined", "non_monotone", "extrapolated", "bootstrap_undefined",
-           "censored", "incomplete", "flagged")
+           "censored", "incomplete", "flagged", "crossing", "parallel_rejected")
 REASONS = ENDINGS + QUALITY
 BAND_POINTS = 101
 #: the pointwise band is taken over at most this many resamples (the first ones)
@@ -113,11 +123,14 @@ NONMONOTONE_P = 0.01
 NONMONOTONE_SIMS = 400
 NONMONOTONE_BATCH = 25  # simulations between checks of whether the verdict is decided
 CENSORED_SHARE = 0.1
+#: "crossing": a more severe state's separate curve above a milder one's by more than this
+#: probability somewhere inside the stripes' (or the records') IM range (one percentage
+#: point: theta:0.5 and overturning of a slender body, nearly one state, cross by 0.003
+#: on the demo suite, less than a reader can see)
+CROSSING_TOL = 0.01
+#: "parallel_rejected": the common beta of a joint ordinal fit rejected at this level
+PARALLEL_P = 0.05
 FLAGGED_SHIFT = 0.01
-
-
-class FragilityWarning(UserWarning):
-    """A fitted curve that should not be trusted as it is (its ``reason`` is not "ok")."""
 
 
 class Fit(tuple):
@@ -364,7 +377,7 @@ def _missing_text(not_run: np.ndarray, levels: np.ndarray | None, unit: str,
 def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
               im: str | None = None, period: float | None = None,
               bootstrap: int | None = None, seed: int = DEFAULT_SEED, ci: float = DEFAULT_CI,
-              warn: bool = True) -> xr.Dataset:
+              warn: bool = True, joint: bool = False) -> xr.Dataset:
     """Lognormal fragility curves of a record-suite sweep (Baker 2015) with their verdicts.
 
     ds (the sweep's contract): variables ``outcome`` (int8: -1 not computed, 0 safe, 1
@@ -380,8 +393,11 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
 
     state: one state word or a list (then a ``state`` dimension): "overturn" (outcome 1 or
     2), "mode1", "mode2", "uplift" (uplifts > 0 or overturned), "theta:X"
-    (theta_max_over_alpha >= X or overturned, 0 < X <= 1). Two or more of uplift, theta:X,
-    overturn are fitted as ordered damage states (one beta: the curves never cross);
+    (theta_max_over_alpha >= X or overturned, 0 < X <= 1). Every state is fitted alone
+    (its numbers do not depend on the other states asked for; nested curves that cross
+    inside the data say "crossing"); ``joint=True`` fits two or more of uplift, theta:X,
+    overturn as ordered damage states (one beta: the curves never cross; the likelihood-
+    ratio test of that beta is stored, "parallel_rejected" where the data reject it) and
     mode1 with mode2 as competing risks (module docstring). bootstrap: resamples over
     records (0: no intervals, NaN; None: ``DEFAULT_BOOTSTRAP``; at most
     ``MAX_BOOTSTRAP``); seed: the Generator's
@@ -399,18 +415,26 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     ``n_failed`` over (state, others, stripe) and ``n_counted`` over (others, stripe), and
     per record ``first_level`` (smallest level that reaches the state; NaN if none) and
     ``resurrection`` (a higher counted level does not reach it) over (state, others,
-    record). attrs: rocksweep_kind "fragility" (``analysis.kinds``), title (the sweep's),
-    method ("stripes-mle" | "cloud-mle"), im, im_units, period (Sa), states, bootstrap,
-    seed, ci, reference.
+    record). With ``joint`` and an ordinal group, over the other dims: ``parallel_lr``
+    (2 ln of the likelihood ratio, beta per state against the common one),
+    ``parallel_dof``, ``parallel_p`` (chi-square p-value) and ``parallel_rejected``
+    (parallel_p < ``PARALLEL_P``). attrs: rocksweep_kind "fragility" (``analysis.kinds``),
+    title (the sweep's), method ("stripes-mle" | "cloud-mle"), im, im_units, period (Sa),
+    avgsa_periods (AvgSa stripes), states, joint, bootstrap, seed, ci, reference.
     """
     states, N, ci = _request(ds, state, im, period, bootstrap, seed, ci)
+    if not isinstance(joint, bool | np.bool_):
+        raise FragilityError(f"joint = {joint!r}: True or False (one beta for nested damage "
+                             "states, competing risks for mode1 with mode2)")
     out_da = ds["outcome"]
     axis = _im_axis(ds, out_da, im, period)
     counts = _count(ds, states, axis, out_da)
     N = check_bootstrap(N, len(states) * counts.n_o)
     grid = np.geomspace(axis.x.min() / 2.0, axis.x.max() * 1.5, BAND_POINTS)
-    groups = state_groups(states)
+    groups = state_groups(states, bool(joint))
     fits = _point_fits(counts, groups, states, axis, grid, N)
+    if not joint:
+        _crossing(fits, counts, states, axis)
     if N:
         _bootstrap_fits(fits, counts, groups, axis, N, seed)
         _bootstrap_intervals(fits, groups, grid, N, ci)
@@ -422,6 +446,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
             for i in range(len(states)):
                 fits.why[i][o]["incomplete"] = text
     out = _dataset(ds, state, states, axis, counts, fits, grid, N, seed, ci)
+    out.attrs["joint"] = np.int8(bool(joint))
     if warn:
         for text in verdict_lines(out, fits.why):
             warnings.warn(text, FragilityWarning, stacklevel=2)
@@ -439,7 +464,10 @@ def _request(ds: Any, state: Any, im: Any, period: Any, bootstrap: Any, seed: An
     N = check_bootstrap(bootstrap, 1)
     out_da = required(ds, "outcome", "outcome codes")
     if "record" not in out_da.dims:
-        raise FragilityError("outcome has no 'record' dimension: not a record-suite sweep")
+        where = ds.encoding.get("source")  # the file it was opened from, if any
+        raise FragilityError(f"{where + ': ' if where else ''}outcome has no 'record' "
+                             "dimension: not a record-suite sweep (a scene with ground.records: a "
+                             "list of record files, and ground.scale)")
     names = [str(r) for r in ds["record"].values]
     if len(set(names)) != len(names):
         raise FragilityError("record: the coordinate lists a record twice")
@@ -562,6 +590,8 @@ class _Fits:
     band: np.ndarray
     samples: np.ndarray
     n_undef: np.ndarray
+    #: the joint ordinal fit's test of its common beta per curve: (statistic, dof) (n_o,)
+    parallel: tuple[np.ndarray, np.ndarray] | None = None
 
 
 _UNDETERMINED = {"one_stripe": "one IM level counted",
@@ -598,7 +628,68 @@ def _point_fits(c: _Counts, groups: list[tuple[str, list[int]]], states: list[st
                         ending, "fewer than 2 distinct stripe fractions strictly between 0 "
                         "and 1")
             _verdicts(kind, idxs, o, lnx, m, med[0], bet[0], f.why, c, states, axis.stripes)
+            if kind == "ordinal":
+                _parallel(f, o, idxs, lnx, m[0], med[0], bet[0])
     return f
+
+
+def _parallel(f: _Fits, o: int, idxs: list[int], lnx: np.ndarray, m: np.ndarray,
+              med: np.ndarray, bet: np.ndarray) -> None:
+    """The likelihood-ratio test of an ordinal fit's common beta (``likelihood.
+    parallel_lr``) for curve o, on the states it fitted (finite im_median and beta), and
+    the "parallel_rejected" verdict."""
+    from scipy.stats import chi2
+
+    if f.parallel is None:
+        f.parallel = (np.full(f.n_undef.shape[1], np.nan),
+                      np.zeros(f.n_undef.shape[1], np.int64))
+    use = [q for q in range(len(idxs)) if np.isfinite(med[q]) and np.isfinite(bet[q])]
+    if len(use) < 2:
+        return
+    # the counts of the fitted states: the categories of the others merged downwards
+    reach = np.cumsum(m[::-1], 0)[::-1]  # (K+1, P): reaching category c or above
+    sub_reach = reach[[0] + [q + 1 for q in use]]
+    sub = sub_reach - np.concatenate([sub_reach[1:], np.zeros((1, m.shape[1]))], 0)
+    stat, dof = parallel_lr(lnx, sub, med[use], float(bet[use[0]]))
+    f.parallel[0][o], f.parallel[1][o] = stat, dof
+    p = float(chi2.sf(stat, dof))
+    if p < PARALLEL_P:
+        for q in use:
+            f.why[idxs[q]][o]["parallel_rejected"] = (
+                f"likelihood ratio {stat:.3g} on {dof} dof, p = {p:.2g}: one beta does "
+                "not fit these states; fit them separately (joint=False)")
+
+
+def _crossing(f: _Fits, c: _Counts, states: list[str], axis: _Axis) -> None:
+    """The "crossing" verdict of separate fits: a more severe nested state's curve above
+    a milder one's by more than ``CROSSING_TOL`` inside the IM range of the counted
+    data (stripes with a counted point; a cloud's counted records)."""
+    nested = sorted((i for i, s in enumerate(states) if not math.isnan(severity(s))),
+                    key=lambda i: severity(states[i]))
+    if len(nested) < 2:
+        return
+    for o in range(c.n_o):
+        if axis.stripes:
+            have = c.counted[o].any(0)
+            x = axis.x[have]
+        else:
+            x = axis.x[c.counted[o].astype(bool)]
+        if x.size < 2:
+            continue
+        xs = np.geomspace(x.min(), x.max(), BAND_POINTS)
+        for a, mild in enumerate(nested):
+            for severe in nested[a + 1:]:
+                pm = lognormal_cdf(xs, f.res["im_median"][mild, o], f.res["beta"][mild, o])
+                ps = lognormal_cdf(xs, f.res["im_median"][severe, o],
+                                   f.res["beta"][severe, o])
+                gap = ps - pm
+                if not np.any(np.isfinite(gap)) or np.nanmax(gap) <= CROSSING_TOL:
+                    continue
+                at = xs[int(np.nanargmax(gap))]
+                text = (f"{states[severe]} above {states[mild]} by up to "
+                        f"{np.nanmax(gap):.3g} (at {at:.3g} {axis.unit}) inside the data")
+                f.why[mild][o]["crossing"] = text
+                f.why[severe][o]["crossing"] = text
 
 
 def _bootstrap_fits(f: _Fits, c: _Counts, groups: list[tuple[str, list[int]]],
@@ -725,6 +816,24 @@ def _dataset(ds: xr.Dataset, state: Any, states: list[str], axis: _Axis, c: _Cou
                           "using dynamic structural analysis, Earthquake Spectra 31(1)"}
     if axis.im_name == "Sa":
         attrs["period"] = axis.period
+    if axis.im_name == AVGSA and "record_avgsa" in ds.variables:
+        attrs["avgsa_periods"] = np.asarray(ds["record_avgsa"].attrs.get(
+            "avgsa_periods", [math.nan, math.nan]), np.float64)
+    if f.parallel is not None:
+        from scipy.stats import chi2
+
+        stat, dof = f.parallel
+        with np.errstate(invalid="ignore"):
+            pv = np.where(np.isfinite(stat), chi2.sf(stat, np.maximum(dof, 1)), np.nan)
+        data["parallel_lr"] = (others, stat.reshape(shape_o), {
+            "long_name": "likelihood-ratio statistic of the common beta against a beta per "
+                         "state (2 ln LR; NaN: fewer than 2 states fitted)"})
+        data["parallel_dof"] = (others, dof.reshape(shape_o),
+                                {"long_name": "degrees of freedom of parallel_lr"})
+        data["parallel_p"] = (others, pv.reshape(shape_o),
+                              {"long_name": "chi-square p-value of parallel_lr"})
+        data["parallel_rejected"] = (others, (pv < PARALLEL_P).reshape(shape_o), {
+            "long_name": f"the common beta rejected at p < {PARALLEL_P:g}"})
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
@@ -788,7 +897,8 @@ def _verdicts(kind: str, idxs: list[int], o: int, lnx: np.ndarray, m: np.ndarray
             other = int(over.sum() - own.sum())
             if over.sum() and other >= CENSORED_SHARE * over.sum():
                 w["censored"] = (f"the other mode holds {other} of {int(over.sum())} "
-                                 "overturning points; fit mode1 and mode2 together")
+                                 "overturning points; fit mode1 and mode2 together "
+                                 "(joint=True)")
     if flagged.any():
         base = np.array([med[q] for q in range(len(idxs))])
         for as_cat in (0, len(idxs)):

@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from rocksweep.analysis.bisection import UNDECIDED, bisect_thresholds
 from rocksweep.compute.single import run_point
 from rocksweep.errors import IdaError, check_rtol
 from rocksweep.fields import plain
@@ -34,7 +35,7 @@ from rocksweep.store.reader import as_result, result_scene
 
 # Bisection steps at most (a relative tolerance of 1e-12 takes ~40 from a stripe gap).
 MAX_ITER = 60
-
+OVERTURNED = (L.OUTCOME_MODE1, L.OUTCOME_MODE2)
 
 
 def ida(ds: Any, rtol: float = 1e-2) -> Any:
@@ -53,88 +54,123 @@ def ida(ds: Any, rtol: float = 1e-2) -> Any:
     ``unresolved`` (1: a bisection run came back flagged; the bracket is wider than
     rtol).
     """
-    import xarray as xr
-
-    from rocksweep import fields
-
     check_rtol(rtol, IdaError)
     result = as_result(ds, ["outcome", "status"])
+    s = _stripes(result)
+    b = _brackets(s)
+    scene = result_scene(result)
+    # the point at each bracket's top stripe: its amplitude scales with the level
+    base = {a.name: a.values[0] for a in scene.axes}
+    points = {}
+    for i in np.flatnonzero(np.isfinite(b.lo)):
+        values = dict(base)
+        for d, k in zip([*s.others, "record"], np.unravel_index(i, s.lead), strict=True):
+            values[d] = result.coords[d][k]
+        values[s.im] = s.levels[b.first[i]]
+        points[i] = scene.point({k: plain(v) for k, v in values.items()})
+
+    def classify(idx: np.ndarray, mids: np.ndarray) -> list[int]:
+        classes = []
+        for i, mid in zip(idx, mids, strict=True):
+            pt = dataclasses.replace(points[i],
+                                     A_ratio=points[i].A_ratio * mid / s.levels[b.first[i]])
+            out = run_point(pt, scene.numerics, history=False).out
+            flagged = int(out[L.OUT_STATUS]) & L.STATUS_FLAGGED
+            classes.append(UNDECIDED if flagged else int(out[L.OUT_OUTCOME]))
+        return classes
+
+    runs, unresolved = bisect_thresholds(b.lo, b.hi, b.mode, rtol, classify, OVERTURNED,
+                                         max_iter=MAX_ITER)
+    return _dataset(result, s, b, runs, unresolved.astype(np.int8), rtol)
+
+
+@dataclasses.dataclass(frozen=True)
+class _Stripes:
+    """A scaled suite's stripes: ``im`` the stripe dimension, ``levels`` (S,) increasing;
+    over (others..., record) flattened to n rows: ``over``, ``safe``, ``flagged`` bool
+    (n, S) and the outcome codes ``modes`` (n, S); ``lead`` the unflattened shape."""
+
+    im: str
+    levels: np.ndarray
+    others: list[str]
+    lead: tuple[int, ...]
+    over: np.ndarray
+    safe: np.ndarray
+    flagged: np.ndarray
+    modes: np.ndarray
+
+
+def _stripes(result: Any) -> _Stripes:
+    """The stripes of a complete scaled record suite (one-line IdaErrors otherwise)."""
     im = result.attrs.get("scale_im")
     if not im or im not in result.dims or "record" not in result.dims:
         raise IdaError(f"{result.path}: IDA needs a scaled record suite (ground.records with "
                        "ground.scale stripes)")
     result.require_complete(IdaError, "IDA")
     outcome = np.asarray(result.arrays["outcome"])
-    scene = result_scene(result)
     dims = list(result.dims)
     others = [d for d in dims if d not in (im, "record")]
-    order = [*others, "record", im]
-    perm = [dims.index(d) for d in order]
+    perm = [dims.index(d) for d in [*others, "record", im]]
     flagged = np.transpose((np.asarray(result.arrays["status"]) & L.STATUS_FLAGGED) != 0,
                            perm)
     modes = np.transpose(outcome, perm)
-    over = np.isin(modes, (L.OUTCOME_MODE1, L.OUTCOME_MODE2)) & ~flagged
-    safe = ~over & ~flagged
+    over = np.isin(modes, OVERTURNED) & ~flagged
     levels = np.asarray(result.coords[im], float)
     if not np.all(np.diff(levels) > 0):
         raise IdaError(f"{result.path}: the {im} stripes must increase")
-    lead = over.shape[:-1]  # (others..., record)
-    flat_over = over.reshape(-1, levels.size)
-    flat_safe = safe.reshape(-1, levels.size)
-    flat_mode = modes.reshape(-1, levels.size)
-    n = flat_over.shape[0]
-    first = np.where(flat_over.any(-1), flat_over.argmax(-1), -1)
-    safe_above = np.array([j >= 0 and bool(flat_safe[i, j:].any())
+    return _Stripes(im, levels, others, over.shape[:-1], over.reshape(-1, levels.size),
+                    (~over & ~flagged).reshape(-1, levels.size),
+                    flagged.reshape(-1, levels.size), modes.reshape(-1, levels.size))
+
+
+@dataclasses.dataclass(frozen=True)
+class _Brackets:
+    """Per row: ``first`` overturning stripe (-1: none), ``bottom`` the highest stripe
+    below it decided safe (-1: none), the bracket ``lo``/``hi`` [IM units] and the
+    ``mode`` at hi (bisected in place), ``safe_above`` (a resurrection)."""
+
+    first: np.ndarray
+    bottom: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    mode: np.ndarray
+    safe_above: np.ndarray
+
+
+def _brackets(s: _Stripes) -> _Brackets:
+    n, S = s.over.shape
+    first = np.where(s.over.any(-1), s.over.argmax(-1), -1)
+    safe_above = np.array([j >= 0 and bool(s.safe[i, j:].any())
                            for i, j in enumerate(first)])
     # the bracket's bottom: the highest stripe below the first overturning one decided safe
-    below = flat_safe & (np.arange(levels.size)[None, :] < np.where(first >= 0, first, 0)[:,
-                                                                                          None])
-    bottom = np.where(below.any(-1), levels.size - 1 - below[:, ::-1].argmax(-1), -1)
+    below = s.safe & (np.arange(S)[None, :] < np.where(first >= 0, first, 0)[:, None])
+    bottom = np.where(below.any(-1), S - 1 - below[:, ::-1].argmax(-1), -1)
     lo = np.full(n, np.nan)
     hi = np.full(n, np.nan)
     mode = np.zeros(n, np.int8)
-    runs = np.zeros(n, np.int64)
-    unresolved = np.zeros(n, np.int8)
     has = first >= 0
-    hi[has] = levels[first[has]]
-    mode[has] = flat_mode[has, first[has]]
+    hi[has] = s.levels[first[has]]
+    mode[has] = s.modes[has, first[has]]
     inner = np.flatnonzero(has & (bottom >= 0))
-    lo[inner] = levels[bottom[inner]]
-    # the point at each bracket's top stripe: its amplitude scales with the level
-    base = {a.name: a.values[0] for a in scene.axes}
-    points = {}
-    for i in inner:
-        idx = np.unravel_index(i, lead)
-        values = dict(base)
-        for d, k in zip([*others, "record"], idx, strict=True):
-            values[d] = result.coords[d][k]
-        values[im] = levels[first[i]]
-        points[i] = scene.point({k: plain(v) for k, v in values.items()})
-    active = [i for i in inner if hi[i] - lo[i] > rtol * hi[i]]
-    for _ in range(MAX_ITER):
-        if not active:
-            break
-        for i in active:
-            mid = 0.5 * (lo[i] + hi[i])
-            pt = dataclasses.replace(points[i],
-                                     A_ratio=points[i].A_ratio * mid / levels[first[i]])
-            out = run_point(pt, scene.numerics, history=False).out
-            runs[i] += 1
-            g = int(out[L.OUT_OUTCOME])
-            if int(out[L.OUT_STATUS]) & L.STATUS_FLAGGED:
-                unresolved[i] = 1
-            elif g in (L.OUTCOME_MODE1, L.OUTCOME_MODE2):
-                hi[i], mode[i] = mid, g
-            else:
-                lo[i] = mid
-        active = [i for i in active if not unresolved[i] and hi[i] - lo[i] > rtol * hi[i]]
+    lo[inner] = s.levels[bottom[inner]]
+    return _Brackets(first, bottom, lo, hi, mode, safe_above)
+
+
+def _dataset(result: Any, s: _Stripes, b: _Brackets, runs: np.ndarray,
+             unresolved: np.ndarray, rtol: float) -> Any:
+    import xarray as xr
+
+    from rocksweep import fields
+
+    im, shape = s.im, s.lead
+    lo, hi = b.lo, b.hi
     est = np.where(np.isfinite(lo), np.sqrt(lo * hi), hi)
-    n_flag = flagged.reshape(-1, levels.size).sum(-1)
-    shape = lead
+    n_flag = s.flagged.sum(-1)
+    has = b.first >= 0
     unit = fields.axis_attrs(im).get("units", "1")
     coords = {d: (d, np.asarray(result.coords[d]), fields.axis_attrs(d))
-              for d in [*others, "record"]}
-    dims_out = [*others, "record"]
+              for d in [*s.others, "record"]}
+    dims_out = [*s.others, "record"]
     data = {
         "ida_im": (dims_out, est.reshape(shape),
                    {"long_name": f"smallest {im} that overturns the record (the bracket's "
@@ -144,14 +180,14 @@ def ida(ds: Any, rtol: float = 1e-2) -> Any:
                    {"long_name": "bracket: largest level decided safe", "units": unit}),
         "ida_hi": (dims_out, hi.reshape(shape),
                    {"long_name": "bracket: smallest level that overturns", "units": unit}),
-        "upper_bound": (dims_out, (has & (bottom < 0)).astype(np.int8).reshape(shape),
+        "upper_bound": (dims_out, (has & (b.bottom < 0)).astype(np.int8).reshape(shape),
                         {"long_name": "1: no stripe below ida_hi is decided safe (ida_im is "
                                       "an upper bound)"}),
-        "mode": (dims_out, mode.reshape(shape),
+        "mode": (dims_out, b.mode.reshape(shape),
                  {"long_name": "overturning mode at ida_hi", "flag_values": [0, 1, 2],
                   "flag_meanings": "none mode1 mode2"}),
         "runs": (dims_out, runs.reshape(shape), {"long_name": "kernel runs of the bisection"}),
-        "resurrection": (dims_out, safe_above.astype(np.int8).reshape(shape),
+        "resurrection": (dims_out, b.safe_above.astype(np.int8).reshape(shape),
                          {"long_name": "1: a stripe above ida_hi is decided safe"}),
         "n_flagged": (dims_out, n_flag.reshape(shape),
                       {"long_name": "flagged stripe points (status & STATUS_FLAGGED): "

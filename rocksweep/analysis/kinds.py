@@ -14,6 +14,7 @@ from typing import Any
 
 from rocksweep.vocab.kinds import (
     BOUNDARIES,
+    CALIBRATION,
     FRAGILITY,
     IDA,
     IM_EFFICIENCY,
@@ -32,6 +33,7 @@ SIGNATURES: tuple[tuple[str, tuple[str, ...]], ...] = (
     (FRAGILITY, ("im_median", "beta")),
     (FRAGILITY, ("median", "beta")),
     (IDA, ("ida_im",)),
+    (CALIBRATION, ("estimate", "measured_theta")),
     (SWEEP, ("outcome", "status")),
     (SPECTRA, ("A_min", "theta_max_over_alpha", "outcome")),
     (BOUNDARIES, ("A_min",)),

@@ -419,6 +419,36 @@ def _fit_ordinal(lnx: np.ndarray, m: np.ndarray, start: tuple | None = None
     return np.exp(mu[:, None] + sd[:, None] * t), sd / s, conv
 
 
+def parallel_lr(lnx: np.ndarray, m: np.ndarray, med: np.ndarray, beta: float
+                ) -> tuple[float, int]:
+    """The likelihood-ratio test of the ordinal probit's common beta: (2 (ll_free -
+    ll_common), degrees of freedom K - 1) for category counts m (K+1, P) at ln IM lnx (P,)
+    and the common-beta fit (im_median (K,), beta). ll_free is the multinomial likelihood
+    maximised with a beta per state, P(DS >= j) = Phi(ln(x / im_median_j) / beta_j) (the
+    non-parallel, generalised ordinal probit), started from the common fit: the ascent
+    only accepts steps that raise it, so the statistic is >= 0. Curves that cross where
+    there are counts make a category's probability 0 (the likelihood -inf there)."""
+    K = m.shape[0] - 1
+    n = m.sum(0)
+    mu, sd = _standardise(lnx[None], n[None])
+    z = (lnx - mu[0]) / sd[0]
+
+    def prob(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        t, s = theta[:, :K], np.exp(theta[:, K:])
+        cum = ndtr(s[:, :, None] * (z[None, None, :] - t[:, :, None]))  # P(DS >= j)
+        one = np.ones((theta.shape[0], 1, z.size))
+        p = np.concatenate([one, cum], 1) - np.concatenate([cum, 0.0 * one], 1)
+        return np.maximum(p, 0.0)
+
+    t0 = (np.log(np.asarray(med, np.float64)) - mu[0]) / sd[0]
+    theta0 = np.concatenate([t0, np.full(K, np.log(sd[0] / beta))])[None]
+    common = _multinomial_ll(prob(theta0, np.zeros(1, np.int64)), m[None])[0]
+    limit = np.array([60.0] * K + [15.0] * K)
+    theta, _ = _maximise(prob, m[None], theta0, limit, tol=1e-9)
+    free = _multinomial_ll(prob(theta, np.zeros(1, np.int64)), m[None])[0]
+    return max(0.0, 2.0 * float(free - common)), K - 1
+
+
 def _cif(z: np.ndarray, t: np.ndarray, sig: np.ndarray) -> tuple[np.ndarray, ...]:
     """Competing lognormal capacities in standardised ln IM: z (..., P), t and sig (..., 2)
     the two capacities' means and deviations. Returns (P(safe), P(mode 1), P(mode 2))

@@ -76,7 +76,9 @@ MAX_LEVELS = 1_000_000  # hazard levels of one curve (the integral's memory: doc
 #: values: memory ~ 8 x this x a few temporaries, whatever the hazard's length
 CHUNK_ELEMENTS = 1 << 21
 Z_TAIL = 8.0  # a lognormal curve's transition: median exp(+-Z_TAIL beta) (1e-15 beyond)
-Z_NODES = 64  # Gauss-Legendre nodes over it (``_narrow``)
+Z_PIECES = 16  # pieces of it (``_narrow``), cut also at the hazard levels inside
+Z_PIECE_NODES = 8  # Gauss-Legendre nodes a piece
+MAX_INNER = 16  # the levels inside a transition integrated that way (more: the shared rule)
 RATE_COLUMN = "annual_rate"
 #: OpenQuake's IMTs (upper case) -> (rocksweep's IM, its unit, the factor from
 #: OpenQuake's unit to it): PGA, SA and AvgSA in g, PGV in cm/s, IA (Arias) in m/s, CAV
@@ -110,6 +112,7 @@ class Hazard:
     unit: str
     period: float
     source: str
+    notes: str = ""  # what reading it left out (OpenQuake's poe = 1 levels)
 
 
 # ---------------------------------------------------------------------------------------
@@ -206,9 +209,10 @@ def _openquake(text: str, where: str, site: int | None) -> Hazard:
     meta = head_line.strip()
     t = re.search(r"investigation_time\s*=\s*'?([^,'\"\s]*)", meta)
     imt = re.search(r"imt\s*=\s*['\"]([^'\"]*)['\"]", meta)  # 'PGA' (3.x), "PGA" (2.x)
-    if t is None or imt is None:
-        raise RiskError(f"{where}, line 1: OpenQuake header without investigation_time and "
-                        f"imt: {meta[:80]!r}")
+    missing = [k for k, v in (("investigation_time", t), ("imt", imt)) if v is None]
+    if missing:  # only what is missing
+        raise RiskError(f"{where}, line 1: the OpenQuake header has no "
+                        f"{' and no '.join(missing)}: {meta[:80]!r}")
     T = _positive(t.group(1))
     if math.isnan(T):
         raise RiskError(f"{where}, line 1: investigation_time = {t.group(1)!r}: must be a "
@@ -259,8 +263,12 @@ def _openquake(text: str, where: str, site: int | None) -> Hazard:
     keep = poe < 1.0  # poe = 1: the rate has no bound there
     rate = -np.log1p(-poe[keep]) / T
     period = _positive(mi.group(2)) if mi.group(2) and name == SA else math.nan
-    return _checked(x[keep], rate, name, unit, period, where,
-                    [n for n, kept in zip(names, keep, strict=True) if kept])
+    hz = _checked(x[keep], rate, name, unit, period, where,
+                  [n for n, kept in zip(names, keep, strict=True) if kept])
+    if not keep.all():
+        hz = replace(hz, notes=f"{int((~keep).sum())} level(s) with poe = 1 left out (no "
+                               f"finite rate): {name} <= {float(x[~keep].max()):.4g} {unit}")
+    return hz
 
 
 def read_hazard(source: Any, *, site: int | None = None) -> Hazard:
@@ -298,6 +306,26 @@ def read_hazard(source: Any, *, site: int | None = None) -> Hazard:
 # ---------------------------------------------------------------------------------------
 # the fragility's names (29a renames median -> im_median; both are read, here only)
 # ---------------------------------------------------------------------------------------
+
+
+def check_fragility(ds: Any, src: str, suites: bool = False) -> None:
+    """Refuse (one line naming ``src``, the file or argument) a Dataset that is no
+    fragility: another analysis's, or a sweep (with ``suites``, a record-suite sweep is
+    let through: the command line fits it first)."""
+    from rocksweep.analysis.kinds import dataset_kind
+
+    kind = dataset_kind(ds)
+    if kind == "fragility":
+        return
+    if kind == "sweep":
+        if suites and "record" in ds["outcome"].dims:
+            return
+        what = ("a record-suite sweep" if "record" in ds["outcome"].dims else
+                "a sweep without records (a pulse or one-record sweep)")
+    else:
+        what = f"a {kind} Dataset" if kind else "not a rocksweep Dataset"
+    raise RiskError(f"{src}: {what}, not a fragility; risk takes what rocksweep.fragility "
+                    "returns (rocksweep fragility -o FRAG.h5) of a record-suite sweep")
 
 
 def fragility_median(fr: xr.Dataset) -> tuple[xr.DataArray, str]:
@@ -436,11 +464,11 @@ def _narrow(hz: Hazard, med: np.ndarray, beta: np.ndarray
     """The rate of lognormal curves whose transition is narrow, by parts: annual_rate =
     P(x_min) lambda(x_min) + integral lambda dP over the hazard's range, dP the lognormal
     density, integrated over z = ln(x / median) / beta in [-Z_TAIL, Z_TAIL] by
-    ``Z_NODES``-point Gauss-Legendre (the hazard a power law there: converges
-    exponentially), exact for beta = 0 (lambda(median)). Used where no hazard level lies
-    strictly inside median exp(+-Z_TAIL beta) (a kink there would slow it down); a steep
-    curve is exactly that case, and the shared quadrature's worst. Returns (use, rate) or
-    None when no curve qualifies."""
+    Gauss-Legendre, cut at the hazard levels inside (between them the hazard is a power
+    law: the rule converges exponentially); exact for beta = 0 (lambda(median)). Used for
+    the curves whose transition median exp(+-Z_TAIL beta) lies inside the hazard's range
+    and holds at most ``MAX_INNER`` hazard levels: the steep curves, the shared
+    quadrature's worst case. Returns (use, rate) or None when no curve qualifies."""
     from scipy.special import ndtr
 
     med = np.asarray(med, np.float64)
@@ -452,24 +480,37 @@ def _narrow(hz: Hazard, med: np.ndarray, beta: np.ndarray
     b = np.where(ok, beta, 0.0)
     lx = np.log(hz.im)
     lo_u, hi_u = np.log(m) - Z_TAIL * b, np.log(m) + Z_TAIL * b
-    # no hazard level strictly inside the transition
-    inner = np.searchsorted(lx, hi_u, side="left") - np.searchsorted(lx, lo_u, side="right")
-    use = ok & (inner <= 0) & (lo_u >= lx[0]) & (hi_u <= lx[-1])
+    first = np.searchsorted(lx, lo_u, side="right")  # the levels strictly inside
+    inner = np.searchsorted(lx, hi_u, side="left") - first
+    use = ok & (inner <= MAX_INNER) & (lo_u >= lx[0]) & (hi_u <= lx[-1])
     if not use.any():
         return None
-    z, wz = np.polynomial.legendre.leggauss(Z_NODES)
-    z, wz = z * Z_TAIL, wz * Z_TAIL
-    dens = np.exp(-0.5 * z * z) / math.sqrt(2.0 * math.pi)
-    mu, bu = m[use], b[use]
-    xs = mu[:, None] * np.exp(bu[:, None] * z[None, :])
-    lam = _hazard_at(hz, np.clip(xs, hz.im[0], hz.im[-1]))
-    mass = ndtr(Z_TAIL) - ndtr(-Z_TAIL)  # the tails beyond: lambda at the ends' values
-    val = lam @ (wz * dens) / (wz * dens).sum() * mass
-    val = val + ndtr(-Z_TAIL) * _hazard_at(hz, mu * math.exp(-Z_TAIL) ** bu) \
-        + ndtr(-Z_TAIL) * _hazard_at(hz, mu * math.exp(Z_TAIL) ** bu)
+    tail = ndtr(-Z_TAIL)  # beyond +-Z_TAIL: lambda at the ends' values
     out = np.zeros(med.shape)
-    out[use] = val
-    return use, out
+    zs, ws = np.polynomial.legendre.leggauss(Z_PIECE_NODES)
+    grid = np.linspace(-Z_TAIL, Z_TAIL, Z_PIECES + 1)  # pieces of 1 in z: phi is smooth there
+
+    def rule(edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Nodes z and weights w phi(z) of the rule on the pieces between ``edges``."""
+        half, mid = 0.5 * np.diff(edges), 0.5 * (edges[1:] + edges[:-1])
+        zz = (mid[:, None] + half[:, None] * zs[None, :]).ravel()
+        return zz, (half[:, None] * ws[None, :]).ravel() * np.exp(-0.5 * zz * zz) / \
+            math.sqrt(2.0 * math.pi)
+
+    one = use & (inner <= 0)  # no level inside: one rule for all of them at once
+    z, w = rule(grid)
+    mu, bu = m[one], b[one]
+    out[one] = _hazard_at(hz, np.clip(mu[:, None] * np.exp(bu[:, None] * z[None, :]),
+                                      hz.im[0], hz.im[-1])) @ w
+    for idx in zip(*np.nonzero(use & (inner > 0)), strict=True):  # cut at the levels too
+        lm, bi = math.log(m[idx]), b[idx]
+        cuts = (lx[first[idx]:first[idx] + inner[idx]] - lm) / bi
+        z, w = rule(np.union1d(grid, cuts))
+        out[idx] = _hazard_at(hz, np.clip(m[idx] * np.exp(bi * z), hz.im[0],
+                                          hz.im[-1])) @ w
+    out = out + tail * (_hazard_at(hz, np.exp(np.clip(lo_u, lx[0], lx[-1])))
+                        + _hazard_at(hz, np.exp(np.clip(hi_u, lx[0], lx[-1]))))
+    return use, np.where(use, out, 0.0)
 
 
 def _check_curves(fr: xr.Dataset, med: xr.DataArray, dims: list[str]) -> None:
@@ -662,6 +703,8 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50.0, *,
                           "seismic performance assessment, PEER Center News 3(2)"}
     if math.isfinite(hz.period):
         attrs["period"] = hz.period
+    if hz.notes:
+        attrs["hazard_notes"] = hz.notes
     if read.unit != hz.unit:
         attrs["hazard_unit"] = (f"{read.unit}, converted to {hz.unit} "
                                 f"(x {_unit_factor(read.unit, hz.unit):.6g})")

@@ -70,10 +70,14 @@ def severity(state: str) -> float:
     return {UPLIFT: 0.0, "theta": x, OVERTURN: math.inf}.get(kind, math.nan)
 
 
-def state_groups(states: Sequence[str]) -> list[tuple[str, list[int]]]:
-    """How the states are fitted: [(kind, indices into states)]: "ordinal" for two or more
-    nested damage states (uplift, theta:X, overturn; indices in severity order),
-    "competing" for mode1 with mode2, "single" for every other one."""
+def state_groups(states: Sequence[str], joint: bool = False) -> list[tuple[str, list[int]]]:
+    """How the states are fitted: [(kind, indices into states)]. By default every state
+    alone ("single": a curve's numbers do not depend on the other states asked for); with
+    ``joint`` "ordinal" for two or more nested damage states (uplift, theta:X, overturn;
+    indices in severity order; one beta), "competing" for mode1 with mode2, "single" for
+    every other one."""
+    if not joint:
+        return [("single", [i]) for i in range(len(states))]
     nested = sorted((i for i, s in enumerate(states) if not math.isnan(severity(s))),
                     key=lambda i: severity(states[i]))
     modes = [states.index(s) for s in (MODE1, MODE2) if s in states]
@@ -121,3 +125,36 @@ def counted_points(ds: xr.Dataset) -> tuple[xr.DataArray, xr.DataArray, xr.DataA
     flagged = (status.astype(np.int64) & int(L.STATUS_FLAGGED)) != 0
     not_run = (out == L.OUTCOME_NOT_RUN) & ~flagged
     return ~flagged & ~not_run, flagged, not_run
+
+
+def trust(ds: xr.Dataset, what: str, warn: bool = True) -> str:
+    """The one verdict of every analysis on the points it reads: "ok", or why they cannot
+    all be trusted, one clause each: "incomplete: N of M points not computed" (a file a
+    sweep stopped writing or still writes: its ``complete`` attribute is 0) and "flagged:
+    K of M points flagged by the kernel (horizon, caps) left out". Not-computed and
+    flagged points are left out by ``counted_points``; this says so. With ``warn``, an
+    ``AnalysisWarning`` "<what>: <verdict>" too. A Dataset without outcome/status (not a
+    sweep) is "ok"."""
+    import warnings
+
+    from rocksweep.errors import AnalysisWarning
+
+    if "outcome" not in ds.variables or "status" not in ds.variables:
+        return "ok"
+    _, flagged, not_run = counted_points(ds)
+    total = int(np.prod(ds["outcome"].shape))
+    words = []
+    n = int(not_run.sum())
+    if n:
+        state = (" (the file is not complete: a sweep still running or stopped; finish it "
+                 "with --resume)") if ds.attrs.get("complete") in (0, False) else ""
+        words.append(f"incomplete: {n} of {total} points not computed, left out{state}")
+    k = int(flagged.sum())
+    if k:
+        words.append(f"flagged: {k} of {total} points flagged by the kernel (horizon, caps),"
+                     " left out")
+    verdict = "; ".join(words) or "ok"
+    if warn and words:
+        warnings.warn(f"{what}: {verdict}", AnalysisWarning, stacklevel=3)
+    return verdict
+

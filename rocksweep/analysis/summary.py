@@ -219,6 +219,7 @@ def info_dict(result: SweepResult) -> dict:
         "title": result.name,
         "format_version": a.get("format_version"),
         "body_kind": result.kind,
+        "p": _json_value(float(a["p"])) if "p" in a else None,  # a physical body's [rad/s]
         "dims": dims,
         "fixed": {k: _json_value(v) for k, v in result.scalars.items()},
         "points_total": int(done.size),
@@ -291,6 +292,8 @@ def format_info(d: dict) -> list[str]:
         lines.append(f"  {name:<10} {dim['size']:>6}  [{span}]   ({dim['scene_key']})")
     if d["fixed"]:
         lines.append("  fixed: " + ", ".join(f"{k} = {v}" for k, v in d["fixed"].items()))
+    if d.get("p") is not None:
+        lines.append(f"  physical body: p = {d['p']:.5g} rad/s")
     pct = 100 * d["points_done"] / max(1, d["points_total"])
     state = ("complete" if d["complete"] else
              "INCOMPLETE (a resume of its sweep finishes it)")

@@ -11,8 +11,12 @@ more short dimension (``record_sa`` over ``period``) as one column per value,
 ``record_sa(0.2)``; and for a record suite the IMs of the ground motion each run saw, the
 record's IM times scale_factor^n (``physics.suite.RECORD_IMS``): ``pga`` [g], ``pgv``
 [m/s], ``arias`` [m/s], ``cav`` [m/s], ``d5_95`` [s], ``pgv_over_pga`` [s], ``avgsa`` [g],
-``sa(T)`` [g], and PGA/(g tan alpha) ``pga_ratio``, PGV p/(g tan alpha) ``pgv_ratio``. The
-units of every column are in ``DataFrame.attrs["units"]``.
+``sa(T)`` [g], and PGA/(g tan alpha) ``pga_ratio``, PGV p/(g tan alpha) ``pgv_ratio``. A
+sweep's ``outcome`` and ``status`` codes are also given in words: ``outcome_word``,
+``status_words`` (the status bits' words joined by ","). The units of every column are
+in ``DataFrame.attrs["units"]`` (``rocksweep table`` writes them into the CSV header,
+``name [unit]`` for every column with a dimension, and into Parquet's field metadata,
+``units``).
 """
 
 from __future__ import annotations
@@ -53,6 +57,10 @@ def table(ds: xr.Dataset) -> Any:
     kind = dataset_kind(ds)
     if kind is None:
         raise TableError("not a rocksweep Dataset (a sweep or an analysis's result)")
+    if kind == "sweep":  # every row is written; a partial file's are said to be missing
+        from rocksweep.analysis.states import trust
+
+        trust(ds, "table")
     main = ROW_VARIABLE[kind]
     main = next((m for m in (main if isinstance(main, tuple) else (main,)) if m in ds),
                 None)
@@ -114,6 +122,14 @@ def table(ds: xr.Dataset) -> Any:
                 label = f"sa({float(T):g})"
                 cols[label] = flat(ds["record_sa"].isel(period=i)) * f
                 units[label] = SCALE_IMS[SA]
+    if kind == "sweep" and "status" in cols:  # the codes in words, beside the codes
+        from rocksweep.vocab.outcomes import OUTCOME_WORDS, status_words
+
+        cols["outcome_word"] = np.array([OUTCOME_WORDS.get(int(c), str(c))
+                                         for c in cols["outcome"]], dtype=object)
+        cols["status_words"] = np.array([",".join(status_words(int(b))) for b in
+                                         cols["status"]], dtype=object)
+        units["outcome_word"] = units["status_words"] = ""
     out = pd.DataFrame(cols)
     for c in out.columns:  # words as plain strings (parquet, csv)
         if out[c].dtype == object or out[c].dtype.kind in "US":

@@ -40,6 +40,9 @@ def _bounds(items: tuple[str, ...]) -> dict[str, tuple[str, str]]:
 @click.option("--p", "p", type=float, default=None,
               help="The body's p [rad/s], to read a CSV with physical columns t [s], "
                    "theta [rad] (a physical body or a record scene gives it).")
+@click.option("--noise", "noise", type=float, default=None,
+              help="The measurement noise's standard deviation [theta/alpha_ref] the misfit "
+                   "is judged against [default: estimated from the history].")
 @click.option("-o", "--output", "out_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Write the fit (estimate, interval, histories) to this file (.h5, .nc).")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path),
@@ -49,7 +52,8 @@ def _bounds(items: tuple[str, ...]) -> dict[str, tuple[str, str]]:
 @overwrite_option
 @user_errors
 def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
-              bounds: tuple[str, ...], p: float | None, out_path: Path | None,
+              bounds: tuple[str, ...], p: float | None, noise: float | None,
+              out_path: Path | None,
               plot_path: Path | None, overrides: tuple[str, ...], dpi: int,
               overwrite: bool) -> None:
     """Fit scene numbers of SCENE.yaml to the rocking history in MEASURED.csv (columns
@@ -64,8 +68,19 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
     # the scene file and what it reads (a record), the measured CSV: never written over
     inputs = [*load(scene_path, overrides).inputs, measured_path]
     check_table_outputs(out_path, plot_path, (".h5", ".nc"), inputs, overwrite)
-    ds = fit_scene(scene_path, measured_path, list(fit), bounds=_bounds(bounds) or None,
-                   overrides=list(overrides), p=p)
+    import warnings
+
+    from rocksweep.analysis.calibrate import CalibrationWarning
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", CalibrationWarning)
+        ds = fit_scene(scene_path, measured_path, list(fit), bounds=_bounds(bounds) or None,
+                       overrides=list(overrides), p=p, noise=noise)
+    for w in caught:
+        if issubclass(w.category, CalibrationWarning):
+            click.echo(f"Warning: {w.message}", err=True)
+        else:
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     for key in ds["parameter"].values.tolist():
         s = ds.sel(parameter=key)
         edge = (" (lo at the bound)" if bool(s["lo_at_bound"]) else "") + (
@@ -73,7 +88,8 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
         click.echo(f"{key} = {float(s['estimate']):.5g}   {ds.attrs['ci']:.0%} interval "
                    f"[{float(s['lo']):.5g}, {float(s['hi']):.5g}]{edge}")
     click.echo(f"misfit {float(ds['misfit']):.4g} (RMS error of {ds.attrs['n_peaks']} "
-               f"half-cycle peaks, theta/alpha); noise {ds.attrs['noise_sigma']:.3g}; "
+               f"half-cycle peaks, theta/alpha; {int(ds['dof'])} dof); noise "
+               f"{float(ds['noise']):.3g}; fit {ds['reason'].item()}; "
                f"{ds.attrs['runs']} runs in {ds.attrs['wall_time_s']:.2f} s")
     if ds.attrs["notes"]:
         click.echo(f"measured: {ds.attrs['notes']}")

@@ -68,7 +68,8 @@ def efficiency(result_path: Path, state: str, out_path: Path | None, fig_path: P
                                                          strict=False))
             best = "  ".join(f"{r.im} {r.beta_scale:.3f}" for r in grp.itertuples()
                              if r.beta_scale == r.beta_scale)
-            click.echo(f"  {where or 'all'}: {best}")
+            none = "no IM has a finite beta (no record reaches the state, or all at once)"
+            click.echo(f"  {where or 'all'}: {best or none}")
     say = click.echo if not as_json else (lambda m: click.echo(m, err=True))
     fig = rocksweep.plot(eff, width=width) if fig_path is not None else None
     if out_path is not None:

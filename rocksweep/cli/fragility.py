@@ -57,8 +57,11 @@ def _g(v) -> str:
 @click.option("--state", default="overturn", show_default=True,
               help="What the curve gives the probability of: " + ", ".join(STATES)
               + " or theta:X (max|theta|/alpha_cg >= X, 0 < X <= 1); several separated by "
-              f"commas: damage states ({UPLIFT}, theta:X, {OVERTURN}) are fitted with one "
-              f"beta so their curves never cross, {MODE1},{MODE2} as competing risks.")
+              "commas, each fitted alone (the same curve whatever else is asked for).")
+@click.option("--joint", is_flag=True,
+              help=f"Fit damage states ({UPLIFT}, theta:X, {OVERTURN}) with one beta so their "
+                   f"curves never cross (the likelihood-ratio test of that beta is stored), "
+                   f"{MODE1},{MODE2} as competing risks.")
 @click.option("--im", default=None,
               help="Unscaled suites (clouds): the IM, PGA (default), PGV or Sa; stripes use "
                    "the IM they were scaled to.")
@@ -79,8 +82,8 @@ def _g(v) -> str:
 @overwrite_option
 @user_errors
 def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, state: str,
-              im: str | None, period: float | None, bootstrap: int, seed: int, ci: float,
-              as_json: bool, width: str, dpi: int, overwrite: bool,
+              joint: bool, im: str | None, period: float | None, bootstrap: int, seed: int,
+              ci: float, as_json: bool, width: str, dpi: int, overwrite: bool,
               rtol: float | None) -> None:
     """Fragility curves of a record-suite sweep (a scene with ground.records): the
     lognormal P(state | IM = x) = Phi(ln(x/median)/beta) fitted by maximum likelihood to
@@ -105,20 +108,20 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
     from rocksweep.analysis.fragility import FragilityWarning
 
     ds = rocksweep.open(result_path)
+    # --rtol's IDA first: refused, it says so in one line before any word about the fit
+    refined = rocksweep.ida(ds, rtol) if rtol is not None else None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", FragilityWarning)
         frag = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states,
                                    im=im, period=period, bootstrap=bootstrap, seed=seed,
-                                   ci=ci)
+                                   ci=ci, joint=joint)
     for w in caught:
         if issubclass(w.category, FragilityWarning):
             click.echo(f"Warning: {w.message}", err=True)
         else:
             warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     frag.attrs["source"] = str(result_path)
-    refined = None
-    if rtol is not None:
-        refined = rocksweep.ida(ds, rtol)
+    if refined is not None:
         for name in ("ida_im", "ida_lo", "ida_hi", "runs", "n_flagged", "unresolved"):
             frag[name if name in ("ida_im", "ida_lo", "ida_hi") else f"ida_{name}"] = \
                 refined[name]

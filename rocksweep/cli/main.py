@@ -34,6 +34,8 @@ def option_words(arg: Arg) -> str:
         return f"--set {arg.value}=VALUE"
     if arg.kind == "set_entry":
         return f"--set {arg.value!r}"
+    if arg.kind == "keyword":
+        return f"{option} VALUE"
     if arg.kind == "flag" or not arg.given:
         return option
     return f"{option} {arg.value}"

@@ -58,6 +58,9 @@ def _g(v) -> str:
 @click.option("--state", default="overturn", show_default=True,
               help="When FRAG.h5 is a suite sweep, the states to fit first (as "
                    "rocksweep fragility --state).")
+@click.option("--joint", is_flag=True,
+              help="When FRAG.h5 is a suite sweep: fit the states jointly (as rocksweep "
+                   "fragility --joint).")
 @click.option("-o", "--output", "out_path", type=click.Path(dir_okay=False, path_type=Path),
               help="The rates as CSV (.csv, one row per curve) or the whole risk Dataset "
                    "(.h5, .hdf5, .nc).")
@@ -70,8 +73,8 @@ def _g(v) -> str:
 @overwrite_option
 @user_errors
 def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, state: str,
-         out_path: Path | None, fig_path: Path | None, as_json: bool, width: str, dpi: int,
-         overwrite: bool) -> None:
+         joint: bool, out_path: Path | None, fig_path: Path | None, as_json: bool, width: str,
+         dpi: int, overwrite: bool) -> None:
     """Mean annual rate lambda = integral P(state | im) |d lambda_im| of each state of a
     fragility (FRAG.h5 from rocksweep fragility -o, or a record-suite sweep) over a
     hazard curve, and the probability 1 - exp(-lambda N) in N years, with the band of the
@@ -85,10 +88,15 @@ def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, sta
     # the fragility or sweep file (and a sweep's records), the hazard curve: never written
     inputs = [*result_inputs(frag_path), hazard_path]
     check_table_outputs(out_path, fig_path, RISK_SUFFIXES, inputs, overwrite)
+    from rocksweep.analysis.risk import check_fragility
+    from rocksweep.outputs import shown
+
     ds = rocksweep.open(frag_path)
+    check_fragility(ds, shown(frag_path), suites=True)
     if dataset_kind(ds) == "sweep":
         states = [s.strip() for s in state.split(",") if s.strip()]
-        ds = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states)
+        ds = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states,
+                                 joint=joint)
     rk = rocksweep.risk(ds, hazard_path, years, site=site)
     rows = risk_rows(rk)
     if as_json:
@@ -98,6 +106,8 @@ def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, sta
         a = rk.attrs
         click.echo(f"risk over {a['hazard_source']} ({a['im']} [{a['im_units']}]), "
                    f"{a['years']:g} years; {a['extrapolation']}")
+        if a.get("hazard_notes"):
+            click.echo(f"hazard: {a['hazard_notes']}")
         keys = [k for k in rows[0] if k not in ("annual_rate", "annual_rate_lo",
                                                  "annual_rate_hi", "annual_rate_max",
                                                  "probability", "probability_lo",

@@ -41,14 +41,22 @@ def table_command(result_path: Path, out_path: Path, overwrite: bool) -> None:
                                        "pyarrow); or write .csv") from None
     check_output(out_path, overwrite=overwrite, inputs=result_inputs(result_path))
     frame = rocksweep.table(rocksweep.open(result_path))
+    units = frame.attrs.get("units", {})
     if suffix == ".csv":
         from rocksweep.analysis.files import csv_text
 
-        text = csv_text(frame)
+        # the units in the header: "name [unit]" (a dimensionless column, "1", or one
+        # without units keeps its name)
+        text = csv_text(frame.rename(columns={c: f"{c} [{units[c]}]" for c in frame.columns
+                                              if units.get(c) not in (None, "", "1")}))
         write_atomic(out_path, lambda tmp: tmp.write_text(text), overwrite=overwrite)
     else:
-        frame.attrs = {}  # pandas' attrs are not Parquet metadata
+        import pyarrow as pa
+        import pyarrow.parquet as pq
 
-        write_atomic(out_path, lambda tmp: frame.to_parquet(tmp, index=False),
-                     overwrite=overwrite)
+        frame.attrs = {}  # pandas' attrs are not Parquet metadata: the units go in fields'
+        tbl = pa.Table.from_pandas(frame, preserve_index=False)
+        tbl = tbl.cast(pa.schema([f.with_metadata({"units": units.get(f.name, "")})
+                                  for f in tbl.schema], metadata=tbl.schema.metadata))
+        write_atomic(out_path, lambda tmp: pq.write_table(tbl, tmp), overwrite=overwrite)
     click.echo(f"wrote {out_path} ({len(frame):,} rows x {frame.shape[1]} columns)")

@@ -31,13 +31,15 @@ def history_capacity(row: np.ndarray) -> int:
     return int(steps + 3 * row[L.PAR_MAXEVENTS] + 16)
 
 
-def run_variant(rows: np.ndarray, kind: int, level: int, ground: bool, refine: int = 0,
+def run_variant(rows: np.ndarray, kind: int, level: int, ground: int, refine: int = 0,
                 record=None, histories: list | None = None,
-                out: np.ndarray | None = None) -> np.ndarray:
+                out: np.ndarray | None = None, vertical: np.ndarray | None = None
+                ) -> np.ndarray:
     """Result rows float64[n, N_OUT] of parameter rows float64[n, N_PAR (+ a record's
     samples)] run through the kernel variant of body ``kind`` (``physics.points.
-    kernel_kind``), bookkeeping ``level`` (``kernel.layout.LEVEL_*``) and ``ground`` (the
-    GROUND variants: Ricker, MP, records).
+    kernel_kind``), bookkeeping ``level`` (``kernel.layout.LEVEL_*``) and ``ground``
+    (``kernel.layout.GROUND_*``: the variants of Ricker, MP and records, and of a vertical
+    ground acceleration).
 
     refine: close calls re-run finer, up to this many refinements (``compute.certify``,
     ``Numerics.refine``; 0: none). record: a record all rows share (its samples written
@@ -45,7 +47,9 @@ def run_variant(rows: np.ndarray, kind: int, level: int, ground: bool, refine: i
     need none). histories: a list of n entries to receive each run's history
     (float64[capacity, N_HIST], the finest run's when certified): the energy-accounting
     point kernel runs instead (``level`` unused). out: where to write the result rows
-    (float64[n, N_OUT]; default a new array). Returns the result rows."""
+    (float64[n, N_OUT]; default a new array). vertical: the record's vertical component
+    [g] on its samples (``records.vertical_samples``), riding on the wide row with it.
+    Returns the result rows."""
     n = rows.shape[0]
     outs = np.empty((n, L.N_OUT)) if out is None else out
     if histories is not None:
@@ -63,7 +67,7 @@ def run_variant(rows: np.ndarray, kind: int, level: int, ground: bool, refine: i
             if record is None:
                 fn(sub, res)
             else:
-                run_record(fn, sub, np.ones(sub.shape[0], bool), res, record)
+                run_record(fn, sub, np.ones(sub.shape[0], bool), res, record, vertical)
 
     call(rows, outs, range(n))  # idx: the rows' places in ``histories``
     if refine > 0:
@@ -77,7 +81,7 @@ def run_variant(rows: np.ndarray, kind: int, level: int, ground: bool, refine: i
 
 
 def run_record(kernel_fn, rows: np.ndarray, sel: np.ndarray, outs: np.ndarray,
-                record) -> None:
+               record, vertical: np.ndarray | None = None) -> None:
     """Run the selected rows of a record scene, all driven by ``record``.
 
     The GROUND chunk kernel reads the ground motion from the row after the parameters
@@ -90,7 +94,7 @@ def run_record(kernel_fn, rows: np.ndarray, sel: np.ndarray, outs: np.ndarray,
     idx = np.flatnonzero(sel)
     if idx.size == 0:
         return
-    wide = with_record(rows[idx[:1]], record)  # float64[1, N_PAR + npts]
+    wide = with_record(rows[idx[:1]], record, vertical)  # float64[1, N_PAR + npts (+ ...)]
     res = np.empty((1, L.N_OUT))
     head = wide[0, :L.N_PAR]
     for i in idx.tolist():

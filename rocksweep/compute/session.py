@@ -6,6 +6,7 @@ loose keyword arguments."""
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
@@ -76,7 +77,7 @@ def sweep(scene: Scene, path: Path | None, args: SweepArguments, *,
     caller: ``rocksweep sweep``, ``run_session``, ``sweep_file``). The scene's grid is
     made here, once, and handed to the sink and the driver; the output path is checked
     once (``outputs.check_output``) before the file is made or reopened."""
-    from rocksweep.compute.driver import drive
+    from rocksweep.compute.driver import SweepInterrupted, drive
     from rocksweep.outputs import check_output, exists_error
     from rocksweep.scene.grid import Grid
     from rocksweep.store.writer import SweepFile
@@ -121,10 +122,20 @@ def sweep(scene: Scene, path: Path | None, args: SweepArguments, *,
             sf = SweepFile.make(path, scene, overrides, overwrite=args.overwrite,
                                 backend=how, adaptive=settings, log=say, grid=grid)
     report = SweepReport(path or Path("memory"), grid.size, 0, 0, 0.0, 0.0, 0.0)
-    return drive(sf, path, report, t0, adaptive, args.validate, jobs=args.jobs,
-                 backend=args.backend, scheduler=args.scheduler,
-                 chunk_size=args.chunk_size, where=where, write_every=args.write_every,
-                 progress=progress, say=say)
+    try:
+        return drive(sf, path, report, t0, adaptive, args.validate, jobs=args.jobs,
+                     backend=args.backend, scheduler=args.scheduler,
+                     chunk_size=args.chunk_size, where=where,
+                     write_every=args.write_every, progress=progress, say=say)
+    except KeyboardInterrupt as err:
+        if isinstance(err, SweepInterrupted):
+            raise
+        # a Ctrl-C between the file's making and the driver's own handler: the file is
+        # there (its points saved), so the answer is the interrupted sweep's, resume line
+        # and all, not a bare interrupt
+        with contextlib.suppress(Exception):
+            sf.close()
+        raise SweepInterrupted(report) from None
 
 
 def _stderr(line: str) -> None:

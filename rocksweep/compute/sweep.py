@@ -98,6 +98,7 @@ def run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene,
     to the scene's ``numerics.refine`` refinements)."""
     refine = scene.numerics.refine if certify else 0
     outs = np.empty((rows.shape[0], L.N_OUT))
+    vertical = scene.vertical_samples()  # a record's vertical component rides along
     for kind in np.unique(cr.kinds):
         sel = cr.kinds == kind
         if scene.suite is not None:  # one record at a time, its samples shared
@@ -107,10 +108,11 @@ def run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene,
                                          record=scene.suite.records[int(r)])
         elif sel.all():
             run_variant(rows, int(kind), level, scene.ground, refine, record=scene.record,
-                        out=outs)
+                        out=outs, vertical=vertical)
         else:
             outs[sel] = run_variant(np.ascontiguousarray(rows[sel]), int(kind), level,
-                                    scene.ground, refine, record=scene.record)
+                                    scene.ground, refine, record=scene.record,
+                                    vertical=vertical)
     return outs
 
 
@@ -234,7 +236,7 @@ def _run_on_cluster(grid: Grid, chunks: list[tuple[int, int]], level: int,
     worker for ``NO_WORKERS_TIMEOUT`` seconds (none joined, or all left) is a
     ``SweepError``; the caller saves what finished.
     """
-    from distributed import Client, wait
+    from distributed import Client, KilledWorker, wait
     from distributed.client import FIRST_COMPLETED
 
     with Client(scheduler, timeout="10s") as client:
@@ -284,14 +286,12 @@ def _run_on_cluster(grid: Grid, chunks: list[tuple[int, int]], level: int,
                 except TimeoutError:
                     running[f] = (a, b)
                     continue
-                except Exception as err:
-                    if type(err).__name__ == "KilledWorker":
-                        raise SweepError(
-                            f"dask cluster {scheduler}: the chunk of points {a}..{b - 1} "
-                            "killed the workers that ran it (out of memory?); finished "
-                            "points are saved: rerun with {resume}", resume=flag("resume")
-                        ) from None
-                    raise
+                except KilledWorker:
+                    raise SweepError(
+                        f"dask cluster {scheduler}: the chunk of points {a}..{b - 1} "
+                        "killed the workers that ran it (out of memory?); finished "
+                        "points are saved: rerun with {resume}", resume=flag("resume")
+                    ) from None
                 submit(1)
                 yield res
 

@@ -10,22 +10,26 @@ from rocksweep.errors import ApiError, Arg, PlotError, RocksweepError, flag  # n
 
 
 def plot_analysis(ds: Any, *, ax: Any = None, width: str | None = None) -> Any:
-    """The figure of a fragility, IDA, spectra, boundaries, risk or IM-efficiency Dataset
-    (a sweep's diagram is ``rocksweep.figures.diagrams``)."""
+    """The figure of a fragility, IDA, spectra, boundaries, risk, IM-efficiency or
+    calibration Dataset (a sweep's diagram is ``rocksweep.figures.diagrams``)."""
     from rocksweep.figures import results
     from rocksweep.figures.fragility import fragility_figure
 
     kind = dataset_kind(ds)
     if kind == "fragility":
         return fragility_figure(ds, ax=ax, width=width or "single")
+    if kind == "calibration":  # the command line's --plot figure
+        from rocksweep.figures.calibration import calibration_figure
+
+        return calibration_figure(ds, ax=ax)
     draw = {"risk": results.risk_figure, "ida": results.ida_figure,
             "spectra": results.spectra_dataset_figure,
             "boundaries": results.boundaries_figure,
             "im_efficiency": results.efficiency_figure}.get(kind or "")
     if draw is None:
         raise PlotError(f"a {kind or 'foreign'} Dataset has no figure (rocksweep.plot draws "
-                        "sweeps, fragility, IDA, spectra, boundaries, risk and "
-                        "IM-efficiency Datasets)")
+                        "sweeps, fragility, IDA, spectra, boundaries, risk, "
+                        "IM-efficiency and calibration Datasets)")
     return draw(ds, ax=ax, width=width)
 
 

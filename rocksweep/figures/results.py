@@ -244,7 +244,7 @@ def efficiency_figure(eff: xr.Dataset, *, ax: Any = None,
         ax.bar(np.arange(len(ims)) + (k - (len(series) - 1) / 2) * wbar, v, wbar,
                color=f"C{k % 10}", label=label or None)
     ax.set_xticks(np.arange(len(ims)), ims, rotation=45, ha="right")
-    ax.set_ylabel("dispersion beta (lower: more efficient)")
+    ax.set_ylabel(r"$\beta$ in ln(scale factor) (lower: better)")
     state = eff.attrs.get("state", "overturn")
     ax.set_title(f"IM efficiency for {state}", fontsize="small")
     ax.grid(True, axis="y", alpha=0.25, linewidth=0.5)

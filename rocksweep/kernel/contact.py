@@ -36,7 +36,13 @@ import numpy as np
 from numba import literally, njit
 
 from rocksweep.kernel._cache import INLINE, INTERNAL
-from rocksweep.kernel.equations import contact_rhs, ground_acc, rigid_rhs, rocking_rhs
+from rocksweep.kernel.equations import (
+    contact_rhs,
+    ground_acc,
+    ground_gravity,
+    rigid_rhs,
+    rocking_rhs,
+)
 from rocksweep.kernel.layout import (
     OUT_IMPULSE_MAX,
     OUT_MU_REQ,
@@ -77,10 +83,11 @@ PEAK_NORMAL = np.int64(1)  # -N/(M g)
 
 
 @njit(cache=True, **INLINE)
-def ground_reactions(theta, theta_dot, u, u_dot, s, xg, prm, FLEX, DAMPED):
+def ground_reactions(theta, theta_dot, u, u_dot, s, xg, g, prm, FLEX, DAMPED):
     """(H [N], N [N]): the ground's horizontal and vertical reaction on the body in phase
-    s (0 full contact) at the state (theta, theta', u, u') and ground acceleration xg."""
-    M, g = prm[PAR_MTOT], prm[PAR_G]
+    s (0 full contact) at the state (theta, theta', u, u'), ground acceleration xg and
+    gravity g (``equations.ground_gravity``: g + a_v with a vertical)."""
+    M = prm[PAR_MTOT]
     if s == 0:
         if FLEX:
             u_dd = contact_rhs(u, u_dot, xg, prm, DAMPED)[0]
@@ -91,12 +98,12 @@ def ground_reactions(theta, theta_dot, u, u_dot, s, xg, prm, FLEX, DAMPED):
     w2 = theta_dot * theta_dot
     if not FLEX:
         hcg = prm[PAR_HCG]
-        th_dd = rigid_rhs(theta, theta_dot, s, xg, prm)[0]
+        th_dd = rigid_rhs(theta, theta_dot, s, xg, g, prm)[0]
         h_ = M * (xg + th_dd * (hcg * cth + sb * sth) + w2 * (sb * cth - hcg * sth))
         n_ = M * (g + th_dd * (sb * cth - hcg * sth) - w2 * (sb * sth + hcg * cth))
         return h_, n_
     m, m_A, h, h_A = prm[PAR_M], prm[PAR_MA], prm[PAR_H], prm[PAR_HA]
-    th_dd, u_dd, _, _ = rocking_rhs(theta, theta_dot, u, u_dot, s, xg, prm, DAMPED)
+    th_dd, u_dd, _, _ = rocking_rhs(theta, theta_dot, u, u_dot, s, xg, g, prm, DAMPED)
     a = u - sb
     xp = (xg + u_dd * cth - 2.0 * u_dot * sth * theta_dot + th_dd * (h * cth - a * sth)
           - w2 * (a * cth + h * sth))
@@ -137,7 +144,8 @@ def impulse_ratio(j_x, j_y):
 def _values(t, y, s, on, prm, FLEX, DAMPED):
     """(|H|/N or +inf when N <= 0, N/(M g)) at (t, y) in phase s."""
     h_, n_ = ground_reactions(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s,
-                              ground_acc(t, on, prm), prm, FLEX, DAMPED)
+                              ground_acc(t, on, prm), ground_gravity(t, on, prm), prm, FLEX,
+                              DAMPED)
     ratio = abs(h_) / n_ if n_ > 0.0 else math.inf
     return ratio, n_ / (prm[PAR_MTOT] * prm[PAR_G])
 

@@ -22,6 +22,12 @@ with I_O(u) = I_A + m_A R_A^2 + m (h^2 + a^2),
 
 solved as theta'' = (F_theta - h F_u) / (I_A + m_A R_A^2 + m a^2), u'' = F_u/m - h theta''.
 Full contact (theta = 0):  m u'' + c u' + k u = -m xg''.
+
+A vertical ground acceleration a_v(t) (positive up) adds the d'Alembert loads -m_i a_v
+along y: in the ground's frame gravity is g + a_v(t) in every term above (V, so F_theta,
+F_u, Q and the tipping moment M g b). The functions take that gravity as their argument
+``g`` (``ground_gravity``: the row's PAR_G itself without a vertical); the impact map has
+no g (a finite a_v gives no impulse). docs/vertical.md.
 """
 
 import math
@@ -61,6 +67,10 @@ from rocksweep.kernel.layout import (
     PAR_REC,
     PAR_REC_DT,
     PAR_SHAPE,
+    PAR_V_AMP,
+    PAR_V_OMEGA,
+    PAR_V_PHASE,
+    PAR_V_REC,
     SHAPE_COSINE,
     SHAPE_RECORD,
     SHAPE_RICKER,
@@ -154,16 +164,22 @@ def ground_jerk(t, on, prm):
 
 
 @njit(cache=True, **INLINE)
-def _record_segment(t, prm):
-    """(a_k, x - k, a_k+1 - a_k), x = t / PAR_REC_DT: the first sample of the record's
-    linear segment [t_k, t_k+1] that holds t, the fraction of it at t, and the samples'
-    difference. At a sample time either neighbour
-    gives the same value (the interpolant is continuous), so the loop's steps, which land
-    on sample times, always see one segment's straight line."""
+def _samples_segment(t, prm, first, last):
+    """(a_k, x - k, a_k+1 - a_k), x = t / PAR_REC_DT: the first sample of the linear
+    segment [t_k, t_k+1] that holds t of the samples prm[first:], the fraction of it at t,
+    and the samples' difference; k <= last (the last segment at the end). At a sample
+    time either neighbour gives the same value (the interpolant is continuous), so the
+    loop's steps, which land on sample times, always see one segment's straight line."""
     x = t / prm[PAR_REC_DT]
-    k = min(max(int(x), 0), prm.shape[0] - PAR_REC - 2)  # the last segment at the end
-    a0 = prm[PAR_REC + k]
-    return a0, x - k, prm[PAR_REC + k + 1] - a0
+    k = min(max(int(x), 0), last)
+    a0 = prm[first + k]
+    return a0, x - k, prm[first + k + 1] - a0
+
+
+@njit(cache=True, **INLINE)
+def _record_segment(t, prm):
+    """``_samples_segment`` of the horizontal record (its samples from PAR_REC on)."""
+    return _samples_segment(t, prm, PAR_REC, prm.shape[0] - PAR_REC - 2)
 
 
 @njit(cache=True, **INTERNAL)
@@ -213,18 +229,136 @@ def ground_jerk_any(t, prm):
 
 
 # ----------------------------------------------------------------------------------------
+# The vertical ground acceleration a_v (positive up): gravity is g + a_v while the ground
+# moves. The type of ``on`` says whether there is one: a float (the loop's GROUND =
+# GROUND_VERTICAL, every horizontal shape too) or not (a bool or an int: the row's g, the
+# code every other variant always ran, with nothing added to it).
+# ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True, **INTERNAL)
+def vertical_acc_any(t, prm):
+    """a_v(t) [m/s^2] while the ground moves: PAR_V_AMP sin(PAR_V_OMEGA t + PAR_V_PHASE)
+    (a harmonic), or PAR_V_AMP times the vertical record's samples (PAR_V_REC > 0: on the
+    horizontal's times, interpolated linearly)."""
+    first = prm[PAR_V_REC]
+    if first > 0.0:
+        i = int(first)
+        a0, frac, da = _samples_segment(t, prm, i, prm.shape[0] - i - 2)
+        return prm[PAR_V_AMP] * (a0 + frac * da)
+    return prm[PAR_V_AMP] * math.sin(prm[PAR_V_OMEGA] * t + prm[PAR_V_PHASE])
+
+
+@njit(cache=True, **INTERNAL)
+def vertical_jerk_any(t, prm):
+    """d a_v/dt [m/s^3] of ``vertical_acc_any`` (a record: its segment's slope)."""
+    first = prm[PAR_V_REC]
+    if first > 0.0:
+        i = int(first)
+        _, _, da = _samples_segment(t, prm, i, prm.shape[0] - i - 2)
+        return prm[PAR_V_AMP] * da / prm[PAR_REC_DT]
+    w = prm[PAR_V_OMEGA]
+    return prm[PAR_V_AMP] * w * math.cos(w * t + prm[PAR_V_PHASE])
+
+
+def _row_gravity(t, on, prm):
+    return prm[PAR_G]
+
+
+def _moving_gravity(t, on, prm):
+    if not on:
+        return prm[PAR_G]
+    return prm[PAR_G] + vertical_acc_any(t, prm)
+
+
+def _no_gravity_rate(t, on, prm):
+    return 0.0
+
+
+def _gravity_rate(t, on, prm):
+    if not on:
+        return 0.0
+    return vertical_jerk_any(t, prm)
+
+
+def _vertical(on) -> bool:
+    """Plain Python: whether ``on`` is of the vertical variants' type (a float)."""
+    return isinstance(on, float | np.floating)
+
+
+def ground_gravity(t, on, prm):
+    """g + a_v(t) [m/s^2]: the gravity of the ground's frame (the row's g without a
+    vertical, or when the ground is still)."""
+    return (_moving_gravity if _vertical(on) else _row_gravity)(t, on, prm)
+
+
+def gravity_rate(t, on, prm):
+    """d(g + a_v)/dt [m/s^3] (0 without a vertical)."""
+    return (_gravity_rate if _vertical(on) else _no_gravity_rate)(t, on, prm)
+
+
+@overload(ground_gravity, jit_options=INLINE)
+def _ground_gravity_overload(t, on, prm):
+    return _moving_gravity if isinstance(on, types.Float) else _row_gravity
+
+
+@overload(gravity_rate, jit_options=INLINE)
+def _gravity_rate_overload(t, on, prm):
+    return _gravity_rate if isinstance(on, types.Float) else _no_gravity_rate
+
+
+@njit(cache=True, **INLINE)
+def vertical_power(p_in, theta, theta_dot, u, u_dot, s, g, prm, FLEX):
+    """p_in plus the power [W] of the vertical d'Alembert loads -m_i a_v on the masses'
+    heights Y_i (a_v = g - PAR_G): -a_v sum m_i Y_i' (full contact: 0). The work of a_v
+    is counted with the ground's (W_in), the energy E keeps the constant g: E(t) - E(0) =
+    W_in - D_damp - E_impact holds with a vertical too (docs/vertical.md)."""
+    if s == 0:
+        return p_in
+    a_v = g - prm[PAR_G]
+    cth, sth = math.cos(theta), math.sin(theta)
+    sb = s * prm[PAR_B]
+    if not FLEX:
+        return p_in - a_v * prm[PAR_MTOT] * (sb * cth - prm[PAR_HCG] * sth) * theta_dot
+    a, h = u - sb, prm[PAR_H]
+    y_p = -u_dot * sth - (a * cth + h * sth) * theta_dot  # Y_P = -a sin + h cos
+    y_a = (sb * cth - prm[PAR_HA] * sth) * theta_dot  # Y_A = s b sin + h_A cos
+    return p_in - a_v * (prm[PAR_M] * y_p + prm[PAR_MA] * y_a)
+
+
+def _power_plain(p_in, on, theta, theta_dot, u, u_dot, s, g, prm, FLEX):
+    return p_in
+
+
+def _power_vertical(p_in, on, theta, theta_dot, u, u_dot, s, g, prm, FLEX):
+    return vertical_power(p_in, theta, theta_dot, u, u_dot, s, g, prm, FLEX)
+
+
+def with_vertical_power(p_in, on, theta, theta_dot, u, u_dot, s, g, prm, FLEX):
+    """``vertical_power`` with a vertical (``on`` a float), else p_in itself."""
+    fn = _power_vertical if _vertical(on) else _power_plain
+    return fn(p_in, on, theta, theta_dot, u, u_dot, s, g, prm, FLEX)
+
+
+@overload(with_vertical_power, jit_options=INLINE)
+def _with_vertical_power_overload(p_in, on, theta, theta_dot, u, u_dot, s, g, prm, FLEX):
+    return _power_vertical if isinstance(on, types.Float) else _power_plain
+
+
+# ----------------------------------------------------------------------------------------
 # Rocking phases
 # ----------------------------------------------------------------------------------------
 
 
 @njit(cache=True, **INLINE)
-def rocking_rhs(theta, theta_dot, u, u_dot, s, xg, prm, DAMPED):
-    """Accelerations while rocking on corner s (+1 / -1), and the input and damper powers.
+def rocking_rhs(theta, theta_dot, u, u_dot, s, xg, g, prm, DAMPED):
+    """Accelerations while rocking on corner s (+1 / -1), and the input and damper powers,
+    under ground acceleration xg [m/s^2] and gravity g [m/s^2] (``ground_gravity``).
 
-    Returns (theta'' [rad/s^2], u'' [m/s^2], ground power [W], damper power [W]).
+    Returns (theta'' [rad/s^2], u'' [m/s^2], horizontal ground power [W], damper power [W]).
     """
     m, m_A, h, h_A = prm[PAR_M], prm[PAR_MA], prm[PAR_H], prm[PAR_HA]
-    g, k, sb = prm[PAR_G], prm[PAR_K], s * prm[PAR_B]
+    k, sb = prm[PAR_K], s * prm[PAR_B]
     cth, sth = math.cos(theta), math.sin(theta)
     a = u - sb
     f_damp = prm[PAR_C] * u_dot if DAMPED else 0.0
@@ -239,16 +373,17 @@ def rocking_rhs(theta, theta_dot, u, u_dot, s, xg, prm, DAMPED):
 
 
 @njit(cache=True, **INLINE)
-def rigid_rhs(theta, theta_dot, s, xg, prm):
+def rigid_rhs(theta, theta_dot, s, xg, g, prm):
     """Rigid body (top mass welded, or a block): I_O theta'' = moment about corner s.
 
     I_O theta'' = -M g (s b cos - h_cg sin) - M xg'' (h_cg cos + s b sin); this is
-    ``rocking_rhs`` with u = u' = 0 and no u equation. Returns (theta'', ground power).
+    ``rocking_rhs`` with u = u' = 0 and no u equation (g: ``ground_gravity``). Returns
+    (theta'', horizontal ground power).
     """
     M, sb, hcg = prm[PAR_MTOT], s * prm[PAR_B], prm[PAR_HCG]
     cth, sth = math.cos(theta), math.sin(theta)
     lever = M * (hcg * cth + sb * sth)
-    theta_dd = (-M * prm[PAR_G] * (sb * cth - hcg * sth) - xg * lever) / prm[PAR_IO]
+    theta_dd = (-M * g * (sb * cth - hcg * sth) - xg * lever) / prm[PAR_IO]
     return theta_dd, -xg * lever * theta_dot
 
 
@@ -266,8 +401,8 @@ def contact_rhs(u, u_dot, xg, prm, DAMPED):
 
 
 @njit(cache=True, **INLINE)
-def uplift_moment(u, u_dot, xg, prm, FLEX, DAMPED):
-    """Q [N m]: the moment that tips the body in full contact.
+def uplift_moment(u, u_dot, xg, g, prm, FLEX, DAMPED):
+    """Q [N m]: the moment that tips the body in full contact (g: ``ground_gravity``).
 
     In full contact the ground reaction N = M g acts at x_R in [-b, b]; holding theta'' = 0
     in the theta equation about corner s (theta = theta' = 0, u'' from full contact) gives
@@ -282,23 +417,48 @@ def uplift_moment(u, u_dot, xg, prm, FLEX, DAMPED):
     if not FLEX:
         return -prm[PAR_MTOT] * prm[PAR_HCG] * xg
     f = prm[PAR_K] * u + (prm[PAR_C] * u_dot if DAMPED else 0.0)
-    return prm[PAR_H] * f + prm[PAR_M] * prm[PAR_G] * u - prm[PAR_MA] * prm[PAR_HA] * xg
+    return prm[PAR_H] * f + prm[PAR_M] * g * u - prm[PAR_MA] * prm[PAR_HA] * xg
 
 
 @njit(cache=True, **INLINE)
-def uplift_moment_rate(u, u_dot, xg, jerk, prm, FLEX, DAMPED):
-    """dQ/dt [N m/s] in full contact."""
+def uplift_moment_rate(u, u_dot, xg, jerk, g, prm, FLEX, DAMPED):
+    """dQ/dt [N m/s] in full contact, at constant g (a vertical's rate: ``uplift_rates``)."""
     if not FLEX:
         return -prm[PAR_MTOT] * prm[PAR_HCG] * jerk
     u_dd = contact_rhs(u, u_dot, xg, prm, DAMPED)[0]
     df = prm[PAR_K] * u_dot + (prm[PAR_C] * u_dd if DAMPED else 0.0)
-    return prm[PAR_H] * df + prm[PAR_M] * prm[PAR_G] * u_dot - prm[PAR_MA] * prm[PAR_HA] * jerk
+    return prm[PAR_H] * df + prm[PAR_M] * g * u_dot - prm[PAR_MA] * prm[PAR_HA] * jerk
 
 
 @njit(cache=True, **INLINE)
-def tip_moment(prm):
-    """M g b [N m]: the moment about a corner that the body's weight resists uplift with."""
-    return prm[PAR_MTOT] * prm[PAR_G] * prm[PAR_B]
+def tip_moment(g, prm):
+    """M g b [N m]: the moment about a corner that the body's weight resists uplift with
+    (g: ``ground_gravity``, or the row's PAR_G)."""
+    return prm[PAR_MTOT] * g * prm[PAR_B]
+
+
+def _uplift_rates_plain(dq, t, u, on, prm, FLEX):
+    return -dq, dq
+
+
+def _uplift_rates_vertical(dq, t, u, on, prm, FLEX):
+    dg = gravity_rate(t, on, prm)
+    dq_all = dq + prm[PAR_M] * dg * u if FLEX else dq  # Q's m g u
+    d_mgb = prm[PAR_MTOT] * dg * prm[PAR_B]
+    return d_mgb - dq_all, d_mgb + dq_all
+
+
+def uplift_rates(dq, t, u, on, prm, FLEX):
+    """(d/dt (M g b - Q), d/dt (M g b + Q)): the uplift events' rates from dQ/dt at
+    constant g (``uplift_moment_rate``), plus, with a vertical, those of g + a_v in Q and
+    M g b."""
+    fn = _uplift_rates_vertical if _vertical(on) else _uplift_rates_plain
+    return fn(dq, t, u, on, prm, FLEX)
+
+
+@overload(uplift_rates, jit_options=INLINE)
+def _uplift_rates_overload(dq, t, u, on, prm, FLEX):
+    return _uplift_rates_vertical if isinstance(on, types.Float) else _uplift_rates_plain
 
 
 @njit(cache=True, **INLINE)
@@ -315,7 +475,7 @@ def rest_margin(u, u_dot, prm):
     l_v = h * prm[PAR_C]
     e2 = m * u_dot * u_dot + k * u * u  # 2 E
     q_max2 = e2 * (l_u * l_u / k + l_v * l_v / m)
-    mgb = tip_moment(prm)
+    mgb = tip_moment(prm[PAR_G], prm)
     return q_max2 - mgb * mgb
 
 

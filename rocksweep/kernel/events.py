@@ -4,7 +4,8 @@ Event functions g (the event fires when g crosses from > 0 to <= 0):
 
   impact     g = s theta              (rocking on corner s)
   overturn   g = pi/2 - s theta
-  uplift     g = M g b - s Q          (full contact, each corner s; Q from ``uplift_moment``)
+  uplift     g = M g b - s Q          (full contact, each corner s; Q from ``uplift_moment``;
+                                       with a vertical, g + a_v in both)
 
 The pulse end is not searched for: the loop shortens the step to land on it exactly.
 
@@ -23,10 +24,12 @@ from numba import literally, njit
 from rocksweep.kernel._cache import INLINE, INTERNAL
 from rocksweep.kernel.equations import (
     ground_acc,
+    ground_gravity,
     ground_jerk,
     tip_moment,
     uplift_moment,
     uplift_moment_rate,
+    uplift_rates,
 )
 from rocksweep.kernel.layout import (
     PAR_ROOT,
@@ -80,8 +83,9 @@ def event_value(ev, t, y, s, on, prm, FLEX, DAMPED):
         return s * y[Y_THETA]
     if ev == EV_OVERTURN:
         return prm[PAR_THETA_OVER] - s * y[Y_THETA]
-    q = uplift_moment(y[Y_U], y[Y_U_DOT], ground_acc(t, on, prm), prm, FLEX, DAMPED)
-    mgb = tip_moment(prm)
+    g = ground_gravity(t, on, prm)
+    q = uplift_moment(y[Y_U], y[Y_U_DOT], ground_acc(t, on, prm), g, prm, FLEX, DAMPED)
+    mgb = tip_moment(g, prm)
     return mgb - q if ev == EV_UPLIFT_POS else mgb + q
 
 
@@ -93,8 +97,10 @@ def event_rate(ev, t, y, s, on, prm, FLEX, DAMPED):
     if ev == EV_OVERTURN:
         return -s * y[Y_THETA_DOT]
     dq = uplift_moment_rate(y[Y_U], y[Y_U_DOT], ground_acc(t, on, prm),
-                            ground_jerk(t, on, prm), prm, FLEX, DAMPED)
-    return -dq if ev == EV_UPLIFT_POS else dq
+                            ground_jerk(t, on, prm), ground_gravity(t, on, prm), prm, FLEX,
+                            DAMPED)
+    rate_pos, rate_neg = uplift_rates(dq, t, y[Y_U], on, prm, FLEX)
+    return rate_pos if ev == EV_UPLIFT_POS else rate_neg
 
 
 # ----------------------------------------------------------------------------------------

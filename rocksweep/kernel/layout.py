@@ -63,9 +63,20 @@ PAR_U_DOT0 = 42  # initial u' [m/s]
 # history to show (free rocking, a calibration); the bound still decides the class
 # (STATUS_BOUNDED, never flagged at the horizon). 0: the run ends at the bound.
 PAR_TO_REST = 43
-N_PAR = 44
+# The vertical ground acceleration a_v (positive up; the vertical variants only, else 0):
+# while the ground moves, gravity is g + a_v(t) (docs/vertical.md)
+PAR_V_AMP = 44  # a_v per unit of the vertical's shape [m/s^2]: a harmonic's amplitude, or
+#                 a record's scale |xg''|/shape, the horizontal's (one factor for both)
+PAR_V_OMEGA = 45  # the harmonic's angular frequency [rad/s] (p = 1)
+PAR_V_PHASE = 46  # the harmonic's phase [rad]: a_v = PAR_V_AMP sin(PAR_V_OMEGA t + phase)
+PAR_V_REC = 47  # index in the row of the vertical record's first sample (0: the harmonic)
+PAR_T_AIR = 48  # first time g + a_v <= 0 [s] (inf: never): the run stops there, airborne
+N_PAR = 49
 # A record's row is longer: its samples xg''/PGA (float64[npts], in [-1, 1]) follow the
-# N_PAR parameters, PAR_REC = N_PAR the first (``points.with_record``).
+# N_PAR parameters, PAR_REC = N_PAR the first (``points.with_record``). With a vertical
+# record: then one copy of the last horizontal sample (the horizontal's reader clamps at
+# the row's end: past its last sample it sees a flat segment) and the vertical's samples
+# a_v/(g PGA) on the horizontal's times, from PAR_V_REC = PAR_REC + npts + 1.
 PAR_REC = N_PAR
 
 SHAPE_SINE = _ground.SHAPE_CODE[_ground.SINE]
@@ -153,6 +164,8 @@ STATUS_E_ABOVE_1 = _out.STATUS_BIT["e_above_1"]  # at least one impact had e > 1
 STATUS_BOUNDED = _out.STATUS_BIT["bounded"]
 STATUS_SLIDES = _out.STATUS_BIT["slides"]
 STATUS_LIFTS_OFF = _out.STATUS_BIT["lifts_off"]
+# g + a_v <= 0: the ground falls faster than gravity, the body leaves it (outside the model)
+STATUS_AIRBORNE = _out.STATUS_BIT["airborne"]
 # Set after the kernel, by the certification of close calls (``rocksweep.compute.certify``)
 STATUS_REFINED = _out.STATUS_BIT["refined"]  # a close call, re-run finer until stable
 STATUS_UNCERTIFIED = _out.STATUS_BIT["uncertified"]  # still changed at the last refinement
@@ -167,3 +180,8 @@ LEVEL_OUTCOME = 0  # outcome and summary metrics only
 LEVEL_ENERGY = 1  # + energy accounting
 LEVEL_CONTACT = 3  # + energy accounting + ground reactions (outputs.contact)
 # (a single run with its time history: ``point_kernel``, not a level of the chunk kernels)
+# ground motions: the paper's sine and cosine; every horizontal shape and records; those
+# with a vertical component (the loop's GROUND flag, ``variants``)
+GROUND_PULSE = False
+GROUND_ANY = 1
+GROUND_VERTICAL = 2

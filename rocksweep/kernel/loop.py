@@ -48,6 +48,7 @@ from rocksweep.kernel.events import (
     hermite_min,
 )
 from rocksweep.kernel.layout import (
+    GROUND_VERTICAL,
     HIST_D_DAMP,
     HIST_E,
     HIST_E_IMPACT,
@@ -98,6 +99,7 @@ from rocksweep.kernel.layout import (
     PAR_MU,
     PAR_REC_H,
     PAR_ROT_STEP,
+    PAR_T_AIR,
     PAR_TEND,
     PAR_THETA0,
     PAR_THETA_DOT0,
@@ -105,6 +107,7 @@ from rocksweep.kernel.layout import (
     PAR_TPULSE,
     PAR_U0,
     PAR_U_DOT0,
+    STATUS_AIRBORNE,
     STATUS_BOUNDED,
     STATUS_E_ABOVE_1,
     STATUS_ENERGY_GAIN,
@@ -143,18 +146,27 @@ SADDLE_SLACK = 1e-9
 
 
 def _acting(t, t_pulse, GROUND):
-    """Plain Python (NUMBA_DISABLE_JIT=1): the overload's choice, by GROUND's type."""
+    """Plain Python (NUMBA_DISABLE_JIT=1): the overload's choice, by GROUND."""
     if isinstance(GROUND, bool | np.bool_):
         return t < t_pulse
+    if GROUND == GROUND_VERTICAL:
+        return np.float64(t < t_pulse)
     return np.int64(t < t_pulse)
 
 
-@overload(_acting)
+@overload(_acting, prefer_literal=True)
 def _acting_overload(t, t_pulse, GROUND):
     """Does the ground move at t? A bool for the paper's pulses (GROUND = False), an int
     for every ground motion (GROUND = 1, an int; the type of ``on`` selects the code of
-    ``equations.ground_acc``). An overload, so that GROUND's type picks one function at
-    typing time: a plain branch on it would type both returns and unify them to int."""
+    ``equations.ground_acc``), a float for every ground motion with a vertical component
+    (GROUND = 2: ``equations.ground_gravity``). An overload, so that GROUND's type picks
+    one function at typing time: a plain branch on it would type both returns and unify
+    them."""
+    if isinstance(GROUND, types.IntegerLiteral) and GROUND.literal_value == GROUND_VERTICAL:
+        def vertical(t, t_pulse, GROUND):
+            return np.float64(t < t_pulse)
+        return vertical
+
     if isinstance(GROUND, types.Integer):
         def ground(t, t_pulse, GROUND):
             return np.int64(t < t_pulse)
@@ -176,6 +188,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     the friction demand, the lowest normal force and the impacts' impulse ratio; every
     sample is a state the loop reaches anyway (step ends, event states before and after the
     action), taken with ``contact_sample``. None: no tracking (the code is not compiled).
+    GROUND (``layout.GROUND_*``): GROUND_VERTICAL also steps to land on PAR_T_AIR, where
+    g + a_v reaches 0, and stops there (STATUS_AIRBORNE).
     """
     literally(FLEX)
     literally(DAMPED)
@@ -186,16 +200,9 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     max_steps, max_events = prm[PAR_MAXSTEPS], prm[PAR_MAXEVENTS]
     # > 0: a record, whose samples the steps land on while it acts (GROUND variants only)
     h_rec = prm[PAR_REC_H] if GROUND else 0.0
-    # the initial state (runtime values of the row; 0: at rest)
-    y = (prm[PAR_THETA0], prm[PAR_THETA_DOT0], prm[PAR_U0], prm[PAR_U_DOT0], 0.0, 0.0)
-    _reset(out)
-    on = _acting(0.0, t_pulse, GROUND)
-    if y[Y_THETA] != 0.0 or y[Y_THETA_DOT] != 0.0:
-        # a given initial state: rocking on the corner theta (else theta') points to
-        s = 1 if y[Y_THETA] > 0.0 or (y[Y_THETA] == 0.0 and y[Y_THETA_DOT] > 0.0) else -1
-    else:
-        s = _uplift(t, y, on, prm, out, FLEX, DAMPED)  # at t = 0: a cosine pulse's peak
-    _record(hist, t, y, s, on, prm, out, FLEX)
+    vertical = GROUND == GROUND_VERTICAL  # a constant of the variant
+    t_air = prm[PAR_T_AIR] if vertical else math.inf
+    y, s = _start(prm, out, hist, _acting(0.0, t_pulse, GROUND), FLEX, DAMPED, CONTACT)
     # rigid: test rigid_bounded at the next loop top after the pulse (PAR_TO_REST: then go
     # on to rest; a history of free rocking from a tilt would end at once otherwise)
     free_check = True
@@ -203,11 +210,9 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     steps, event_steps, theta_max = 0, 0, abs(y[Y_THETA])
     # contact tracker (contact.contact_sample): unused, and removed, without CONTACT
     ct = (0.0, 0.0, y, 0.0, 0.0, 0.0, y, 0.0, 0.0)
-    out[OUT_MU_REQ] = 0.0 if CONTACT is not None else np.nan
-    out[OUT_N_MIN] = np.inf if CONTACT is not None else np.nan
-    out[OUT_IMPULSE_MAX] = 0.0 if CONTACT is not None else np.nan
     if CONTACT is not None:
-        ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED, ENERGY)
+        ct = contact_sample(ct, t, y, s, _acting(0.0, t_pulse, GROUND), SAMPLE_START, prm, out,
+                            FLEX, DAMPED, ENERGY)
     # The rotation limit (PAR_ROT_STEP, 0: off): a rocking step may turn the body by at most
     # rot, predicted from theta' and the last step's |theta''| (acc), and checked after
     # the step: a huge slow pulse or a fall is not crossed in a handful of steps.
@@ -232,6 +237,9 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             if not int(out[OUT_STATUS]) & STATUS_BOUNDED:  # else: decided, went on to show
                 _flag(out, STATUS_HORIZON)
             break
+        if vertical and t >= t_air:
+            _flag(out, STATUS_AIRBORNE)
+            break
         if not FLEX and s != 0 and not on and free_check:
             free_check = False  # E is constant between impacts after the pulse: test once
             margin = _rigid_margin(FLEX, y, s, prm, margin)
@@ -249,10 +257,13 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             _flag(out, STATUS_EVENT_CAP)
             break
         h, lands = _step_length(t, on, dt, dt_on, t_pulse, t_end, h_rec)
+        air = vertical and t + h >= t_air  # the step lands where g + a_v reaches 0
+        if air:
+            h, lands = t_air - t, False
         if s != 0 and rot > 0.0:
             h_rot = _rotation_step(y[Y_THETA_DOT], acc, rot)
             if h_rot < h:
-                h, lands = h_rot, False
+                h, lands, air = h_rot, False, False
         k1 = first_stage(t, y, s, on, prm, FLEX, DAMPED, ENERGY)  # shared by every step from y
         y1 = rk4_from(t, y, h, k1, s, on, prm, FLEX, DAMPED, ENERGY)
         steps += 1
@@ -262,7 +273,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             # shorter (the turn grows like h to h^2); NaN ends the loop (caught below)
             turn = abs(y1[Y_THETA] - y[Y_THETA])
             while turn > 2.0 * rot:
-                h, lands = h * max(0.25, 0.9 * math.sqrt(rot / turn)), False
+                h, lands, air = h * max(0.25, 0.9 * math.sqrt(rot / turn)), False, False
                 y1 = rk4_from(t, y, h, k1, s, on, prm, FLEX, DAMPED, ENERGY)
                 steps += 1
                 turn = abs(y1[Y_THETA] - y[Y_THETA])
@@ -276,24 +287,15 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             theta_max = _theta_max(y, y_ev, tau, s, theta_max)  # (y_ev, tau) = (y1, h) if none
 
         if ev == EV_NONE:
-            t, y = (t_pulse if lands else t + h), y1
+            t, y = (t_pulse if lands else (t_air if air else t + h)), y1
             if s != 0 and not on and _near_saddle(y, s, near):
                 margin = _saddle(y, s, prm, margin)
             _record(hist, t, y, s, _acting(t, t_pulse, GROUND), prm, out, FLEX)
             if CONTACT is not None:  # the step's end, with the step's own ground motion
                 ct = contact_sample(ct, t, y, s, on, SAMPLE_STEP, prm, out, FLEX, DAMPED, ENERGY)
-            if lands and s == 0:
-                # The pulse ends with a jump of xg'' (a cosine pulse ends at its peak), and
-                # Q jumps with it by m_A h_A xg'': the state may now be past the uplift
-                # threshold, which no crossing inside the next step would show. Checked at
-                # once, as at t = 0 and after an impact.
-                off = _acting(t_pulse, t_pulse, GROUND)  # false, of the type of ``on``
-                s = _uplift(t, y, off, prm, out, FLEX, DAMPED)
-                if s != 0:
-                    _record(hist, t, y, s, off, prm, out, FLEX)
-            if CONTACT is not None and lands:  # H jumps with xg'': a new segment without the pulse
-                ct = contact_sample(ct, t, y, s, _acting(t_pulse, t_pulse, GROUND),
-                                    SAMPLE_START, prm, out, FLEX, DAMPED, ENERGY)
+            if lands:
+                s, ct = _pulse_end(t, y, s, ct, prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT,
+                                   GROUND)
             continue
 
         t, y = t + tau, y_ev
@@ -303,16 +305,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
         if ev == EV_OVERTURN:
             _overturned(t, out)
             break
-        if ev == EV_IMPACT:
-            y_minus, s_minus = y, s
-            y, s = _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY)
-            if CONTACT is not None:
-                contact_impact(y_minus, s_minus, y, s, prm, out, FLEX)
-            free_check = True
-        else:  # uplift: theta = theta' = 0 exactly, now rocking on the located corner
-            s = 1 if ev == EV_UPLIFT_POS else -1
-            y = (0.0, 0.0, y[Y_U], y[Y_U_DOT], y[Y_W_IN], y[Y_D_DAMP])
-            out[OUT_UPLIFTS] += 1.0
+        y, s = _act(ev, t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, CONTACT)
+        free_check = free_check or ev == EV_IMPACT
         _record(hist, t, y, s, on, prm, out, FLEX)
         if CONTACT is not None:  # the state after the action starts the next phase's samples
             ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED, ENERGY)
@@ -320,6 +314,59 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     _finish(t, y, s, steps, event_steps, theta_max, prm, out, FLEX, ENERGY)
     if CONTACT is not None:
         _contact_status(prm, out)
+
+
+@njit(cache=True, **INTERNAL)
+def _start(prm, out, hist, on, FLEX, DAMPED, CONTACT):
+    """The state at t = 0 and its phase: at rest (uplifted at once if the ground's motion
+    at t = 0 tips the body, a cosine pulse's peak), or the row's initial state, rocking on
+    the corner theta (else theta') points to; the result row reset, the first history row
+    written, the contact outputs' starting values (NaN without CONTACT). Returns (y, s)."""
+    y = (prm[PAR_THETA0], prm[PAR_THETA_DOT0], prm[PAR_U0], prm[PAR_U_DOT0], 0.0, 0.0)
+    _reset(out)
+    if y[Y_THETA] != 0.0 or y[Y_THETA_DOT] != 0.0:
+        s = 1 if y[Y_THETA] > 0.0 or (y[Y_THETA] == 0.0 and y[Y_THETA_DOT] > 0.0) else -1
+    else:
+        s = _uplift(0.0, y, on, prm, out, FLEX, DAMPED)
+    _record(hist, 0.0, y, s, on, prm, out, FLEX)
+    out[OUT_MU_REQ] = 0.0 if CONTACT is not None else np.nan
+    out[OUT_N_MIN] = np.inf if CONTACT is not None else np.nan
+    out[OUT_IMPULSE_MAX] = 0.0 if CONTACT is not None else np.nan
+    return y, s
+
+
+@njit(cache=True, **INTERNAL)
+def _pulse_end(t, y, s, ct, prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
+    """A step landed on the pulse's end (t = PAR_TPULSE). Returns (s, ct).
+
+    The pulse ends with a jump of xg'' (a cosine pulse ends at its peak), and Q jumps with
+    it by m_A h_A xg'': a body in full contact may now be past the uplift threshold, which
+    no crossing inside the next step would show. Checked at once, as at t = 0 and after an
+    impact. The contact bookkeeping starts a new segment (H jumps with xg'')."""
+    off = _acting(t, t, GROUND)  # false, of the type of ``on``
+    if s == 0:
+        s = _uplift(t, y, off, prm, out, FLEX, DAMPED)
+        if s != 0:
+            _record(hist, t, y, s, off, prm, out, FLEX)
+    if CONTACT is not None:
+        ct = contact_sample(ct, t, y, s, off, SAMPLE_START, prm, out, FLEX, DAMPED, ENERGY)
+    return s, ct
+
+
+@njit(cache=True, **INTERNAL)
+def _act(ev, t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, CONTACT):
+    """The action of an impact or an uplift located at (t, y) in phase s. Returns (y, s).
+
+    Impact: the impact map (``_apply_impact``; its impulse into the contact outputs).
+    Uplift: theta = theta' = 0 exactly, now rocking on the located corner."""
+    if ev == EV_IMPACT:
+        y_new, s_new = _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY)
+        if CONTACT is not None:
+            contact_impact(y, s, y_new, s_new, prm, out, FLEX)
+        return y_new, s_new
+    out[OUT_UPLIFTS] += 1.0
+    return (0.0, 0.0, y[Y_U], y[Y_U_DOT], y[Y_W_IN], y[Y_D_DAMP]), (1 if ev == EV_UPLIFT_POS
+                                                                     else -1)
 
 
 # ----------------------------------------------------------------------------------------

@@ -13,14 +13,22 @@ them at every call site), so an RK4 step makes no function call.
 from numba import njit
 
 from rocksweep.kernel._cache import INLINE
-from rocksweep.kernel.equations import contact_rhs, ground_acc, rigid_rhs, rocking_rhs
+from rocksweep.kernel.equations import (
+    contact_rhs,
+    ground_acc,
+    ground_gravity,
+    rigid_rhs,
+    rocking_rhs,
+    with_vertical_power,
+)
 from rocksweep.kernel.layout import Y_THETA, Y_THETA_DOT, Y_U, Y_U_DOT
 
 
 @njit(cache=True, **INLINE)
 def derivatives(t, y, s, on, prm, FLEX, DAMPED, ENERGY):
     """dy/dt (a 6-tuple in the ``Y_*`` slot order) at (t, y) in phase s (0 full contact,
-    +-1 rocking on that corner); ``on``: the pulse acts."""
+    +-1 rocking on that corner); ``on``: the pulse acts (a float: with a vertical, whose
+    gravity g + a_v the rocking phases feel and whose work W_in counts)."""
     theta, theta_dot, u, u_dot = y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT]
     xg = ground_acc(t, on, prm)
     if s == 0:
@@ -30,13 +38,17 @@ def derivatives(t, y, s, on, prm, FLEX, DAMPED, ENERGY):
         if ENERGY:
             return (0.0, 0.0, u_dot, u_dd, p_in, p_damp)
         return (0.0, 0.0, u_dot, u_dd, 0.0, 0.0)
+    g = ground_gravity(t, on, prm)
     if not FLEX:
-        theta_dd, p_in = rigid_rhs(theta, theta_dot, s, xg, prm)
+        theta_dd, p_in = rigid_rhs(theta, theta_dot, s, xg, g, prm)
         if ENERGY:
+            p_in = with_vertical_power(p_in, on, theta, theta_dot, 0.0, 0.0, s, g, prm, FLEX)
             return (theta_dot, theta_dd, 0.0, 0.0, p_in, 0.0)
         return (theta_dot, theta_dd, 0.0, 0.0, 0.0, 0.0)
-    theta_dd, u_dd, p_in, p_damp = rocking_rhs(theta, theta_dot, u, u_dot, s, xg, prm, DAMPED)
+    theta_dd, u_dd, p_in, p_damp = rocking_rhs(theta, theta_dot, u, u_dot, s, xg, g, prm,
+                                               DAMPED)
     if ENERGY:
+        p_in = with_vertical_power(p_in, on, theta, theta_dot, u, u_dot, s, g, prm, FLEX)
         return (theta_dot, theta_dd, u_dot, u_dd, p_in, p_damp)
     return (theta_dot, theta_dd, u_dot, u_dd, 0.0, 0.0)
 

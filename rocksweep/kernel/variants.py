@@ -23,6 +23,8 @@ from numba import njit
 
 from rocksweep.kernel._cache import ENTRY, loads_fast
 from rocksweep.kernel.layout import (
+    GROUND_PULSE,
+    GROUND_VERTICAL,
     KIND_FLEXIBLE,
     KIND_FLEXIBLE_UNDAMPED,
     KIND_RIGID,
@@ -36,6 +38,7 @@ from rocksweep.kernel.layout import (
     PAR_G,
     PAR_M,
     PAR_MTOT,
+    PAR_T_AIR,
     PAR_TEND,
     PAR_TPULSE,
 )
@@ -164,6 +167,59 @@ def point_rigid_history_ground(prm, out, hist):
     simulate_point(prm, out, hist, False, False, True, True, 1)
 
 
+# GROUND = 2 (GROUND_VERTICAL): every ground motion with a vertical component (``on`` a
+# float: gravity g + a_v, ``equations.ground_gravity``); compiled only when a scene asks.
+@njit(cache=True, nogil=True, **ENTRY)
+def chunk_flexible_vertical(prms, outs):
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, True, True, False, None, 2)
+
+
+@njit(cache=True, nogil=True, **ENTRY)
+def chunk_flexible_undamped_vertical(prms, outs):
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, True, False, False, None, 2)
+
+
+@njit(cache=True, nogil=True, **ENTRY)
+def chunk_rigid_vertical(prms, outs):
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, False, False, False, None, 2)
+
+
+@njit(cache=True, nogil=True, **ENTRY)
+def chunk_flexible_energy_vertical(prms, outs):
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, True, True, True, None, 2)
+
+
+@njit(cache=True, nogil=True, **ENTRY)
+def chunk_flexible_undamped_energy_vertical(prms, outs):
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, True, False, True, None, 2)
+
+
+@njit(cache=True, nogil=True, **ENTRY)
+def chunk_rigid_energy_vertical(prms, outs):
+    for i in range(prms.shape[0]):
+        simulate_point(prms[i], outs[i], None, False, False, True, None, 2)
+
+
+@njit(cache=True, **ENTRY)
+def point_flexible_history_vertical(prm, out, hist):
+    simulate_point(prm, out, hist, True, True, True, True, 2)
+
+
+@njit(cache=True, **ENTRY)
+def point_flexible_undamped_history_vertical(prm, out, hist):
+    simulate_point(prm, out, hist, True, False, True, True, 2)
+
+
+@njit(cache=True, **ENTRY)
+def point_rigid_history_vertical(prm, out, hist):
+    simulate_point(prm, out, hist, False, False, True, True, 2)
+
+
 _CHUNK = {
     (KIND_FLEXIBLE, LEVEL_OUTCOME): chunk_flexible,
     (KIND_FLEXIBLE_UNDAMPED, LEVEL_OUTCOME): chunk_flexible_undamped,
@@ -193,28 +249,50 @@ _POINT_GROUND = {
     KIND_FLEXIBLE_UNDAMPED: point_flexible_undamped_history_ground,
     KIND_RIGID: point_rigid_history_ground,
 }
+_CHUNK_VERTICAL = {
+    (KIND_FLEXIBLE, LEVEL_OUTCOME): chunk_flexible_vertical,
+    (KIND_FLEXIBLE_UNDAMPED, LEVEL_OUTCOME): chunk_flexible_undamped_vertical,
+    (KIND_RIGID, LEVEL_OUTCOME): chunk_rigid_vertical,
+    (KIND_FLEXIBLE, LEVEL_ENERGY): chunk_flexible_energy_vertical,
+    (KIND_FLEXIBLE_UNDAMPED, LEVEL_ENERGY): chunk_flexible_undamped_energy_vertical,
+    (KIND_RIGID, LEVEL_ENERGY): chunk_rigid_energy_vertical,
+}
+_POINT_VERTICAL = {
+    KIND_FLEXIBLE: point_flexible_history_vertical,
+    KIND_FLEXIBLE_UNDAMPED: point_flexible_undamped_history_vertical,
+    KIND_RIGID: point_rigid_history_vertical,
+}
 for _entry in (*_CHUNK.values(), *_CHUNK_GROUND.values(), *_POINT.values(),
-               *_POINT_GROUND.values()):
+               *_POINT_GROUND.values(), *_CHUNK_VERTICAL.values(), *_POINT_VERTICAL.values()):
     loads_fast(_entry)  # a cached variant loads in ~5 ms, not ~0.25 s (_cache.EntryCache)
 
 
-def chunk_kernel(kind: int, level: int, ground: bool = False):
+def _tables(ground: int) -> tuple[dict, dict]:
+    """(chunk table, point table) of a ground code (``layout.GROUND_*``; True is GROUND_ANY)."""
+    if ground == GROUND_VERTICAL:
+        return _CHUNK_VERTICAL, _POINT_VERTICAL
+    return (_CHUNK_GROUND, _POINT_GROUND) if ground else (_CHUNK, _POINT)
+
+
+def chunk_kernel(kind: int, level: int, ground: int = GROUND_PULSE):
     """Jitted ``f(prms[n, N_PAR], outs[n, N_OUT])`` for a kernel kind and bookkeeping level;
-    ``ground``: the variant for every ground motion (Ricker, MP, records; rows of a record
-    carry its samples, ``points.with_record``), else sine and cosine pulses only."""
-    table = _CHUNK_GROUND if ground else _CHUNK
+    ``ground`` (``layout.GROUND_*``): GROUND_ANY (or True) the variant for every ground
+    motion (Ricker, MP, records; rows of a record carry its samples,
+    ``points.with_record``), GROUND_VERTICAL the same with a vertical component (rows with
+    PAR_V_*), else sine and cosine pulses only."""
+    table = _tables(ground)[0]
     if (kind, level) not in table:  # the scene refuses this combination first
         raise ValueError(f"no kernel variant for kind {kind}, level {level}, ground {ground}")
     return table[(kind, level)]
 
 
-def point_kernel(kind: int, ground: bool = False):
+def point_kernel(kind: int, ground: int = GROUND_PULSE):
     """Jitted ``f(prm[N_PAR], out[N_OUT], hist[n, N_HIST])`` with energy, ground reactions
-    and history; ``ground``: the variant for every ground motion."""
-    return (_POINT_GROUND if ground else _POINT)[kind]
+    and history; ``ground``: as ``chunk_kernel``'s."""
+    return _tables(ground)[1][kind]
 
 
-def warm_up(kind: int, level: int | None = None, ground: bool = False) -> None:
+def warm_up(kind: int, level: int | None = None, ground: int = GROUND_PULSE) -> None:
     """Compile (or load from numba's cache) a variant now, so timings exclude compilation.
 
     ``level=None`` warms the single-run (history) variant of ``kind``.
@@ -225,6 +303,7 @@ def warm_up(kind: int, level: int | None = None, ground: bool = False) -> None:
     prm[0, PAR_M] = prm[0, PAR_MTOT] = prm[0, PAR_G] = prm[0, PAR_B] = 1.0
     prm[0, PAR_TPULSE] = 1.0  # pulse on: no rest test (it divides by k)
     out = np.empty((1, N_OUT))
+    prm[0, PAR_T_AIR] = np.inf
     if level is None:
         point_kernel(kind, ground)(prm[0], out[0], np.empty((1, N_HIST)))
     else:

@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.errors import MeasuredError, RocksweepError  # noqa: F401 (MeasuredError re-exported)
+from rocksweep.errors import Arg, MeasuredError, RocksweepError  # noqa: F401 (MeasuredError re-exported)
 from rocksweep.inputs import check_columns, csv_table, number_column, read_text
 from rocksweep.outputs import shown
 
@@ -104,9 +104,10 @@ def read_measured(measured: Any, *, p: float | None = None, alpha_ref: float | N
         tname, thname = "p_t", "theta_over_alpha"
     elif "t" in cols and "theta" in cols:
         if p is None or alpha_ref is None:
-            raise MeasuredError(f"{src}: columns t [s], theta [rad] need the body's p "
-                                "[rad/s] (a physical body, kind: physical, or a record "
-                                "scene's ground.p); or give p_t, theta_over_alpha")
+            raise MeasuredError("{src}: columns t [s], theta [rad] need the body's p "
+                                "[rad/s]: give {p} (a number), or a physical body (kind: "
+                                "physical) or a record scene's ground.p; or give columns "
+                                "p_t, theta_over_alpha", src=src, p=Arg("p", kind="keyword"))
         t = column("t") * p
         theta = column("theta", gaps=True) / alpha_ref
         u = None

@@ -20,9 +20,11 @@ from rocksweep.numerics import (
     close_margin,
     step_budget,
     step_sizes,
+    vertical_step,
 )
 from rocksweep.physics.bodies import Body, FlexibleBody, G
-from rocksweep.physics.records import GroundRecord
+from rocksweep.physics.records import GroundRecord, vertical_samples
+from rocksweep.physics.vertical import VerticalHarmonic, air_time_harmonic, air_time_record
 from rocksweep.vocab.axes import INITIAL  # noqa: F401
 from rocksweep.vocab.ground import (  # noqa: F401
     CYCLES,
@@ -81,6 +83,11 @@ class Point:
     e_factor: float = 1.0
     # the state at t = 0 (``INITIAL``, normalised; all 0: at rest in full contact)
     initial: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
+    # a vertical ground acceleration (docs/vertical.md): the record's vertical component
+    # (with ``record``, ``ground.vertical``), or a harmonic while the pulse acts
+    # (``pulse.vertical``)
+    vertical: GroundRecord | None = None
+    pulse_vertical: VerticalHarmonic | None = None
 
     @property
     def omega(self) -> float:
@@ -92,9 +99,18 @@ class Point:
         return self.A_ratio * G * math.tan(self.body.alpha_ref)
 
     @property
-    def ground(self) -> bool:
-        """Whether the point needs the kernel's GROUND variants (``kernel.variants``)."""
-        return self.shape not in (*PAPER_SHAPES, FREE)
+    def ground(self) -> int:
+        """The kernel variants' ground code the point needs (``layout.GROUND_*``):
+        GROUND_VERTICAL with a vertical, GROUND_ANY for the shapes beyond the paper's."""
+        if self.vertical is not None or self.pulse_vertical is not None:
+            return L.GROUND_VERTICAL
+        return L.GROUND_ANY if self.shape not in (*PAPER_SHAPES, FREE) else L.GROUND_PULSE
+
+    def vertical_on_samples(self) -> np.ndarray | None:
+        """The vertical record [g] on the horizontal record's samples (None without)."""
+        if self.vertical is None or self.record is None:
+            return None
+        return vertical_samples(self.vertical, self.record)
 
     @property
     def pulse(self) -> PulseShape | None:
@@ -250,7 +266,9 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
               record: GroundRecord | None = None,
               mu: np.ndarray | float = math.nan, law: np.ndarray | float = L.LAW_VERTICAL,
               e: np.ndarray | float = math.nan, e_factor: np.ndarray | float = 1.0,
-              initial: tuple | None = None, u_cr: np.ndarray | float = 0.0) -> None:
+              initial: tuple | None = None, u_cr: np.ndarray | float = 0.0,
+              vertical: np.ndarray | None = None,
+              pulse_vertical: tuple | None = None) -> None:
     """Fill parameter rows in place, vectorised over points.
 
     rows: float64[n, N_PAR] (out); body_rows: float64[n, N_PAR] from ``body_row``;
@@ -263,6 +281,11 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     initial: the state at t = 0 as four float64[n] or scalars in ``INITIAL``'s order
     (theta/alpha_ref, theta'/(p alpha_ref), u/u_cr, u'/(p u_cr)), None: at rest; u_cr [m]
     float64[n] or a scalar (0 for a rigid body). PAR_THETA0.. PAR_U_DOT0 in SI (p = 1).
+    vertical: with ``record``, its vertical component [g] on its samples
+    (``records.vertical_samples``; the rows then lack its samples too: ``with_record``);
+    pulse_vertical: (amplitude [g], w_over_p, phase [deg]), float64[n] or scalars, a
+    harmonic while the pulse acts. Either fills PAR_V_* and PAR_T_AIR (``physics.vertical``)
+    and runs on the GROUND_VERTICAL variants; without, PAR_T_AIR is inf.
     """
     rows[:] = body_rows
     omega = np.asarray(w_over_p, float)  # p = 1 rad/s
@@ -289,6 +312,24 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
             rows[:, L.PAR_GAMMA] = gamma
             rows[:, L.PAR_NU] = math.radians(nu_deg)
             rows[:, L.PAR_AMP_NORM] = 1.0 / mp_peak(float(gamma), float(nu_deg))
+    rows[:, L.PAR_T_AIR] = np.inf
+    if pulse_vertical is not None:
+        amp_v, w_v, phase_v = (np.asarray(v, float) for v in pulse_vertical)
+        rows[:, L.PAR_V_AMP] = amp_v * G
+        rows[:, L.PAR_V_OMEGA] = w_v
+        rows[:, L.PAR_V_PHASE] = np.radians(phase_v)
+        rows[:, L.PAR_T_AIR] = air_time_harmonic(amp_v, w_v, phase_v, t_pulse)
+        # the step resolves the vertical as it does the pulse; the cap follows
+        dt_on = vertical_step(dt_on, w_v, numerics.steps_per_period, numerics.pulse_steps)
+        max_steps = step_budget(t_pulse, t_end, dt, dt_on, numerics)
+    elif vertical is not None:
+        # one factor for both components: a_v = |A| acc_v / PGA_h (A's sign turns the
+        # horizontal round only)
+        scale = np.abs(A_ratio * G * np.tan(alpha_ref))
+        rows[:, L.PAR_V_AMP] = scale
+        rows[:, L.PAR_V_REC] = L.PAR_REC + record.npts + 1
+        rows[:, L.PAR_T_AIR] = air_time_record(np.asarray(vertical) / record.pga,
+                                               rows[:, L.PAR_REC_DT], scale / G)
     rows[:, L.PAR_AMP] = A_ratio * G * np.tan(alpha_ref)
     rows[:, L.PAR_OMEGA] = omega
     rows[:, L.PAR_SHAPE] = code
@@ -317,12 +358,18 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
         rows[:, L.PAR_U_DOT0] = np.asarray(ud, float) * u_cr
 
 
-def with_record(rows: np.ndarray, record: GroundRecord | None) -> np.ndarray:
+def with_record(rows: np.ndarray, record: GroundRecord | None,
+                vertical: np.ndarray | None = None) -> np.ndarray:
     """Rows float64[n, N_PAR] -> float64[n, N_PAR + npts] with the record's samples
-    xg''/PGA after the parameters (``layout.PAR_REC``); ``rows`` itself without one."""
+    xg''/PGA after the parameters (``layout.PAR_REC``); ``rows`` itself without one.
+    vertical: its vertical component [g] on its samples: the rows are then float64[n,
+    N_PAR + 2 npts + 1], the last horizontal sample once more, then a_v/(g PGA)
+    (``layout.PAR_V_REC``)."""
     if record is None:
         return rows
     shape = record.acc / record.pga
+    if vertical is not None:
+        shape = np.concatenate((shape, shape[-1:], np.asarray(vertical, float) / record.pga))
     out = np.empty((rows.shape[0], L.N_PAR + shape.size))
     out[:, :L.N_PAR] = rows
     out[:, L.N_PAR:] = shape
@@ -335,14 +382,17 @@ def point_row(point: Point, numerics: Numerics) -> np.ndarray:
     body = point.body
     rows = np.empty((1, L.N_PAR))
     rec = point.record if point.shape == RECORD else None
+    vertical = point.vertical_on_samples() if rec is not None else None
+    pv = point.pulse_vertical
     fill_rows(rows, body_row(body)[None, :], np.array([body_omega_rock(body)]),
               np.array([body.alpha_ref]), np.array([point.lam]),
               np.array([_SHAPE_CODE[point.shape]]),
               np.array([point.p if rec is not None else point.w_over_p]),
               np.array([point.A_ratio]), numerics, point.cycles, point.gamma, point.nu, rec,
               point.mu, law_code(point.law), point.e, point.e_factor,
-              point.initial if any(point.initial) else None, body.u_cr)
-    return with_record(rows, rec)[0]
+              point.initial if any(point.initial) else None, body.u_cr, vertical,
+              None if pv is None else (pv.amplitude, pv.w_over_p, pv.phase))
+    return with_record(rows, rec, vertical)[0]
 
 
 def shape_code(shape: str) -> float:

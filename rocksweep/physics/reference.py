@@ -36,6 +36,12 @@ M g b, means a crossing was stepped over; it is then located on the dense output
 the previous extremum and that one. theta_max is the largest |theta| over the maxima of
 s*theta (located, not sampled) and the phase ends.
 
+A vertical ground acceleration a_v (``Point.vertical``, ``Point.pulse_vertical``) is
+evaluated here from the point itself, not from the kernel's reader of its row
+(``_vertical``): the equations above are called with gravity g + a_v(t) in place of g,
+the uplift events compare Q with M (g + a_v) b, and the run stops, ``airborne``, at the
+first time g + a_v <= 0, located by its own root search (``_air_time``).
+
 Times are p*t (p = 1 rad/s), angles in rad, SI units with m = 1 kg (``rocksweep.physics.bodies``).
 """
 
@@ -66,6 +72,7 @@ from rocksweep.kernel.equations import (
     uplift_moment_rate,
 )
 from rocksweep.numerics import Numerics
+from rocksweep.physics.bodies import G
 from rocksweep.physics.points import Point, point_row
 
 RTOL = 1e-10
@@ -77,7 +84,8 @@ _NONE, _IMPACT, _OVERTURN, _UPLIFT, _REST = 0, 1, 2, 3, 4
 class _Problem:
     """One point's parameters and the phase right-hand sides and event functions."""
 
-    def __init__(self, prm: np.ndarray, flex: bool, damped: bool, rtol: float, atol: float):
+    def __init__(self, prm: np.ndarray, flex: bool, damped: bool, rtol: float, atol: float,
+                 vertical: tuple | None = None):
         self.prm = prm
         self.flex = flex
         self.damped = damped
@@ -85,7 +93,11 @@ class _Problem:
         self.atol = atol
         self.omega = float(prm[L.PAR_OMEGA])
         self.t_pulse = float(prm[L.PAR_TPULSE])
-        self.mgb = float(tip_moment(prm))
+        self.g = float(prm[L.PAR_G])
+        self.mgb = float(tip_moment(self.g, prm))
+        # (a_v(t), d a_v/dt(t), t_air) while the ground moves (``_vertical``), or None
+        self.vertical = vertical
+        self.t_air = math.inf if vertical is None else vertical[2]
         self.theta_over = float(prm[L.PAR_THETA_OVER])
         self.rest_rate = float(prm[L.PAR_RESTRATE])
         self.h = float(prm[L.PAR_H])
@@ -115,22 +127,43 @@ class _Problem:
     def jerk(self, t: float, on: bool) -> float:
         return ground_jerk(t, int(on), self.prm)
 
+    def gravity(self, t: float, on: bool) -> float:
+        """g + a_v(t) [m/s^2] (g without a vertical, or when the ground is still)."""
+        return self.g + self.vertical[0](t) if on and self.vertical is not None else self.g
+
+    def gravity_rate(self, t: float, on: bool) -> float:
+        return self.vertical[1](t) if on and self.vertical is not None else 0.0
+
     # --- full contact ------------------------------------------------------------------
     def q(self, t: float, y, on: bool) -> float:
         """Uplift moment Q [N m] in full contact, y = (u, u')."""
-        return uplift_moment(y[0], y[1], self.xg(t, on), self.prm, self.flex, self.damped)
+        return uplift_moment(y[0], y[1], self.xg(t, on), self.gravity(t, on), self.prm,
+                             self.flex, self.damped)
 
-    def q_rate(self, t: float, y, on: bool) -> float:
-        """dQ/dt [N m/s] in full contact, y = (u, u')."""
-        return uplift_moment_rate(y[0], y[1], self.xg(t, on), self.jerk(t, on), self.prm,
-                                  self.flex, self.damped)
+    def weight(self, t: float, on: bool) -> float:
+        """M (g + a_v) b [N m]: what resists uplift at t."""
+        return self.mgb if self.vertical is None else tip_moment(self.gravity(t, on), self.prm)
+
+    def ratio_rate(self, t: float, y, on: bool) -> float:
+        """d/dt (Q / (M (g + a_v) b)) times (M (g + a_v) b)^2, y = (u, u'): its zeros are
+        the extrema of Q against the weight's moment (of Q itself without a vertical)."""
+        g = self.gravity(t, on)
+        dq = uplift_moment_rate(y[0], y[1], self.xg(t, on), self.jerk(t, on), g, self.prm,
+                                self.flex, self.damped)
+        if self.vertical is None:
+            return dq * self.mgb
+        dg = self.gravity_rate(t, on)
+        if self.flex:
+            dq += self.prm[L.PAR_M] * dg * y[0]  # Q's m (g + a_v) u
+        w = self.weight(t, on)
+        return dq * w - self.q(t, y, on) * self.prm[L.PAR_MTOT] * dg * self.prm[L.PAR_B]
 
     def uplift_corner(self, t: float, y, on: bool) -> int:
         """Corner the body uplifts on from full contact at (t, y): s with s Q >= M g b, or 0."""
-        q = self.q(t, y, on)
-        if q >= self.mgb:
+        q, w = self.q(t, y, on), self.weight(t, on)
+        if q >= w:
             return 1
-        if q <= -self.mgb:
+        if q <= -w:
             return -1
         return 0
 
@@ -162,13 +195,14 @@ class _Problem:
         if not self.flex:
             def fun(t, y):
                 self.nfev += 1
-                return (y[1], rigid_rhs(y[0], y[1], s, self.xg(t, on), prm)[0])
+                return (y[1], rigid_rhs(y[0], y[1], s, self.xg(t, on), self.gravity(t, on),
+                                        prm)[0])
             return fun
 
         def fun(t, y):
             self.nfev += 1
-            th_dd, u_dd, _, _ = rocking_rhs(y[0], y[1], y[2], y[3], s, self.xg(t, on), prm,
-                                            damped)
+            th_dd, u_dd, _, _ = rocking_rhs(y[0], y[1], y[2], y[3], s, self.xg(t, on),
+                                            self.gravity(t, on), prm, damped)
             return (y[1], th_dd, y[3], u_dd)
         return fun
 
@@ -237,11 +271,13 @@ def _first_hidden(sol, t0: float, t_end: float, extrema, minima, g) -> float | N
 
 def _contact(pb: _Problem, t0: float, y0, t1: float, on: bool):
     """Full contact from t0 to t1 at most. Returns (event, t, y) with y = (u, u')."""
-    mgb = pb.mgb
+    def mgb(t):
+        return pb.weight(t, on)
+
     events = [
-        _event(lambda t, y: mgb - pb.q(t, y, on), t0, -1.0, True),
-        _event(lambda t, y: mgb + pb.q(t, y, on), t0, -1.0, True),
-        _event(lambda t, y: pb.q_rate(t, y, on), t0, 0.0, False),
+        _event(lambda t, y: mgb(t) - pb.q(t, y, on), t0, -1.0, True),
+        _event(lambda t, y: mgb(t) + pb.q(t, y, on), t0, -1.0, True),
+        _event(lambda t, y: pb.ratio_rate(t, y, on), t0, 0.0, False),
     ]
     rest = not on and pb.flex
     if rest:
@@ -256,11 +292,11 @@ def _contact(pb: _Problem, t0: float, y0, t1: float, on: bool):
                 t_stop, kind = sol.t_events[i][0], k
     # an uplift stepped over inside one step: an extremum of Q beyond M g b
     t_hid = _first_hidden(sol, t0, t_stop, sol.t_events[2], sol.t_events[2],
-                          lambda t: mgb - abs(pb.q(t, sol.sol(t), on)))
+                          lambda t: mgb(t) - abs(pb.q(t, sol.sol(t), on)))
     if t_hid is not None:
         t_stop, kind = t_hid, _UPLIFT
     if kind == _UPLIFT:  # land on the far side: s Q >= M g b at the uplift state
-        t_stop = _far_side(lambda t: mgb - abs(pb.q(t, sol.sol(t), on)), t_stop)
+        t_stop = _far_side(lambda t: mgb(t) - abs(pb.q(t, sol.sol(t), on)), t_stop)
     y = tuple(sol.sol(t_stop)) if t_stop != sol.t[-1] else tuple(sol.y[:, -1])
     return kind, t_stop, y
 
@@ -334,8 +370,8 @@ class _Contact:
 
     def _values(self, sol, t: float, s: int, on: bool) -> tuple[float, float]:
         th, w, u, v = self._state(sol, t, s)
-        h_, n_ = ground_reactions(th, w, u, v, s, self.pb.xg(t, on), self.pb.prm,
-                                  self.pb.flex, self.pb.damped)
+        h_, n_ = ground_reactions(th, w, u, v, s, self.pb.xg(t, on), self.pb.gravity(t, on),
+                                  self.pb.prm, self.pb.flex, self.pb.damped)
         return (abs(h_) / n_ if n_ > 0.0 else math.inf), n_ / self.mg
 
     def phase(self, t0: float, t1: float, s: int, on: bool) -> None:
@@ -373,6 +409,139 @@ class _Contact:
         self.impulse = max(self.impulse, impulse_ratio(j_x, j_y))
 
 
+class _Tally:
+    """A reference run's counters, flags and event log (the kernel's result row's)."""
+
+    def __init__(self, pb: _Problem, theta0: float, events: bool) -> None:
+        self.pb = pb
+        self.status, self.outcome = 0, L.OUTCOME_SAFE
+        self.impacts = self.uplifts = self.contacts = self.anomalies = 0
+        self.theta_max, self.e_max = abs(theta0), 0.0
+        self.t_over = self.t_first = math.nan
+        self.log: list[dict] | None = [] if events else None
+
+    def energy(self, y, s: int) -> float:
+        return mechanical_energy(y[0], y[1], y[2], y[3], s, self.pb.prm, self.pb.flex)
+
+    def note(self, kind: str, t: float, s0: int, s1: int, y0, y1, e: float = math.nan):
+        if self.log is not None:
+            self.log.append({"t": t, "kind": kind, "s_before": s0, "s_after": s1,
+                             "theta_dot_before": y0[1], "theta_dot_after": y1[1], "u": y0[2],
+                             "u_dot_before": y0[3], "u_dot_after": y1[3], "e": e,
+                             "energy_before": self.energy(y0, s0),
+                             "energy_after": self.energy(y1, s1)})
+
+    def uplift(self, t: float, y, on: bool) -> int:
+        """Full contact at (t, y): the corner the body uplifts on (counted), or 0."""
+        s = self.pb.uplift_corner(t, (y[2], y[3]), on)
+        if s != 0:
+            self.uplifts += 1
+            self.note("uplift", t, 0, s, y, y)
+        return s
+
+    def impact(self, t: float, y, s: int, on: bool, ct) -> tuple[tuple, int]:
+        """Impact at theta = 0 ending rocking on corner s (eq. 1, the settling rule, the
+        top mass's rule; uplift checked at once back in full contact). Returns (y, s)."""
+        pb = self.pb
+        self.impacts += 1
+        if self.impacts == 1:
+            self.t_first = t
+        if s * y[1] > 0.0:  # moving away from theta = 0: not a crossing (a bug if seen)
+            self.anomalies += 1
+        e = float(restitution(s, y[2], pb.prm, pb.flex))
+        self.e_max = max(self.e_max, e)
+        if e > 1.0:
+            self.status |= L.STATUS_E_ABOVE_1
+        w_minus = y[1]
+        if e > 0.0 and abs(e * w_minus) >= pb.rest_rate:
+            s_new, w_plus = -s, e * w_minus
+        else:
+            s_new, w_plus = 0, 0.0
+            self.contacts += 1
+            if e > 0.0:
+                self.status |= L.STATUS_SETTLED
+        if not pb.flex:
+            u_dot = 0.0
+        elif pb.law == L.LAW_LOCKED:  # the top mass moves with the base: u' is kept
+            u_dot = y[3]
+        else:  # the spring and damper carry no impulse: m (u' + h theta') is conserved
+            u_dot = y[3] + pb.h * (w_minus - w_plus)
+        y_new = (0.0, w_plus, y[2], u_dot)
+        if ct is not None:
+            ct.impact(y, s, y_new, s_new)
+        self.note("impact", t, s, s_new, y, y_new, e)
+        if s_new == 0:
+            s_new = self.uplift(t, y_new, on)
+        return y_new, s_new
+
+    def result(self, t: float, wall: float, ct) -> dict:
+        res = {
+            "outcome": self.outcome, "status": self.status, "impacts": self.impacts,
+            "uplifts": self.uplifts, "contacts": self.contacts, "theta_max": self.theta_max,
+            "t_overturn": self.t_over, "t_first_impact": self.t_first, "t_end": t,
+            "e_max": self.e_max, "steps": self.pb.steps, "nfev": self.pb.nfev,
+            "anomalies": self.anomalies, "wall_time": wall,
+        }
+        if ct is not None:
+            finite = math.isfinite(ct.n_min)
+            res.update({"mu_required": ct.mu if finite else math.nan,
+                        "normal_min_over_Mg": ct.n_min if finite else math.nan,
+                        "impulse_ratio_max": ct.impulse})
+        if self.log is not None:
+            res["events"] = self.log
+        return res
+
+
+def _air_time(a_v, t_pulse: float, period: float) -> float:
+    """First t in [0, t_pulse) with g + a_v(t) <= 0 (inf: none): a_v sampled 64 times a
+    ``period`` (the vertical's period, or its sample interval), the first sign change
+    refined by Brent's method."""
+    if not t_pulse > 0.0:
+        return math.inf
+    n = max(2, int(math.ceil(64 * t_pulse / period)) + 1)
+    ts = np.linspace(0.0, t_pulse, n)
+    f = np.array([G + a_v(t) for t in ts])
+    hit = np.flatnonzero(f <= 0.0)
+    if hit.size == 0 or ts[hit[0]] >= t_pulse:
+        return math.inf
+    i = int(hit[0])
+    if i == 0:
+        return 0.0
+    return _root(lambda t: G + a_v(t), float(ts[i - 1]), float(ts[i]))
+
+
+def _vertical(point: Point, prm: np.ndarray) -> tuple | None:
+    """(a_v(t) [m/s^2], its rate, t_air) of the point's vertical in kernel time, from the
+    point (not from the row's PAR_V_*), or None."""
+    t_pulse = float(prm[L.PAR_TPULSE])
+    pv = point.pulse_vertical
+    if pv is not None:
+        amp, w, ph = pv.amplitude * G, float(pv.w_over_p), math.radians(pv.phase)
+
+        def a_v(t):
+            return amp * math.sin(w * t + ph)
+
+        def rate(t):
+            return amp * w * math.cos(w * t + ph)
+        return a_v, rate, _air_time(a_v, t_pulse, 2 * math.pi / w)
+    if point.vertical is None:
+        return None
+    rec = point.record
+    # the documented rule: the vertical's linear interpolant at the horizontal's samples
+    tk = point.p * rec.times()
+    vert = np.interp(rec.times(), point.vertical.times(), point.vertical.acc, right=0.0)
+    av = abs(point.A) / rec.pga * vert  # one factor for both components [m/s^2]
+    dtk = point.p * rec.dt
+
+    def a_v(t):
+        return float(np.interp(t, tk, av))
+
+    def rate(t):
+        k = min(max(int(t / dtk), 0), av.size - 2)
+        return float((av[k + 1] - av[k]) / dtk)
+    return a_v, rate, _air_time(a_v, t_pulse, dtk)
+
+
 def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = RTOL,
                   atol: float = ATOL, events: bool = False, early_exit: bool = True,
                   theta0: float | None = None, theta_dot0: float | None = None,
@@ -396,69 +565,51 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
     """
     numerics = numerics or Numerics()
     prm = point_row(point, numerics)
-    body = point.body
-    flex = not body.rigid
-    pb = _Problem(prm, flex, bool(body.zeta > 0) and flex, rtol, atol)
+    flex = not point.body.rigid
+    pb = _Problem(prm, flex, bool(point.body.zeta > 0) and flex, rtol, atol,
+                  _vertical(point, prm))
     t_end = float(prm[L.PAR_TEND])
     max_events = int(prm[L.PAR_MAXEVENTS])
-    log: list[dict] | None = [] if events else None
     t0_wall = time.perf_counter()
-
     th0 = float(prm[L.PAR_THETA0]) if theta0 is None else float(theta0)
     thd0 = float(prm[L.PAR_THETA_DOT0]) if theta_dot0 is None else float(theta_dot0)
     t = 0.0
     y = (th0, thd0, float(prm[L.PAR_U0]), float(prm[L.PAR_U_DOT0]))  # theta, theta', u, u'
-    status, outcome = 0, L.OUTCOME_SAFE
-    impacts = uplifts = contacts = anomalies = 0
-    theta_max, e_max = abs(th0), 0.0
-    t_over = t_first = math.nan
+    tally = _Tally(pb, th0, events)
     free_check = True  # rigid: test the bounded-energy exit once per excursion
     ct = _Contact(pb) if contact else None
-
-    def energy(y, s):
-        return mechanical_energy(y[0], y[1], y[2], y[3], s, prm, flex)
-
-    def note(kind, t, s0, s1, y0, y1, e=math.nan):
-        if log is not None:
-            log.append({"t": t, "kind": kind, "s_before": s0, "s_after": s1,
-                        "theta_dot_before": y0[1], "theta_dot_after": y1[1], "u": y0[2],
-                        "u_dot_before": y0[3], "u_dot_after": y1[3], "e": e,
-                        "energy_before": energy(y0, s0), "energy_after": energy(y1, s1)})
-
     if th0 != 0.0 or thd0 != 0.0:  # rocking from the given state, on the corner it points to
         s = 1 if th0 > 0.0 or (th0 == 0.0 and thd0 > 0.0) else -1
     else:
-        s = pb.uplift_corner(t, (y[2], y[3]), pb.t_pulse > 0.0)
-        if s != 0:
-            uplifts += 1
-            note("uplift", t, 0, s, y, y)
+        s = tally.uplift(t, y, pb.t_pulse > 0.0)
     while True:
         on = t < pb.t_pulse
         if s == 0 and not on and pb.rest_margin((y[2], y[3])) < 0.0:
-            if not status & L.STATUS_SETTLED:  # "rest" only where no rest-rate rule acted
-                status |= L.STATUS_REST
+            if not tally.status & L.STATUS_SETTLED:  # "rest" only where no rest-rate rule acted
+                tally.status |= L.STATUS_REST
             break
         if t >= t_end:
-            status |= L.STATUS_HORIZON
+            tally.status |= L.STATUS_HORIZON
+            break
+        if t >= pb.t_air:  # g + a_v <= 0: the body leaves the ground
+            tally.status |= L.STATUS_AIRBORNE
             break
         if early_exit and not flex and s != 0 and not on and free_check:
             free_check = False
             peak = rigid_peak(y[0], y[1], s, prm)  # the kernel's STATUS_BOUNDED rule
             if peak >= 0.0:
-                theta_max = max(theta_max, peak)
-                status |= L.STATUS_BOUNDED
+                tally.theta_max = max(tally.theta_max, peak)
+                tally.status |= L.STATUS_BOUNDED
                 break
-        if impacts + uplifts >= max_events:
-            status |= L.STATUS_EVENT_CAP
+        if tally.impacts + tally.uplifts >= max_events:
+            tally.status |= L.STATUS_EVENT_CAP
             break
-        t_stop = pb.t_pulse if on else t_end
+        t_stop = min(pb.t_pulse, pb.t_air) if on else t_end
         if on and pb.rec_dt > 0.0:  # a record: integrate sample interval by interval
             t_stop = min(t_stop, (math.floor(t / pb.rec_dt + 1e-9) + 1.0) * pb.rec_dt)
         if s == 0:
-            s = pb.uplift_corner(t, (y[2], y[3]), on)  # e.g. the cosine pulse's end
+            s = tally.uplift(t, y, on)  # e.g. the cosine pulse's end
             if s != 0:
-                uplifts += 1
-                note("uplift", t, 0, s, y, y)
                 continue
             pb.last_sol = None
             kind, t_ev, yc = _contact(pb, t, (y[2], y[3]), t_stop, on)
@@ -466,85 +617,39 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
         else:
             pb.last_sol = None
             kind, t_ev, y_ev, th = _rocking(pb, t, y, s, t_stop, on)
-            theta_max = max(theta_max, th)
+            tally.theta_max = max(tally.theta_max, th)
         if ct is not None and kind >= 0:
             ct.phase(t, t_ev, s, on)
         if kind < 0 or not all(math.isfinite(v) for v in y_ev):
-            status |= L.STATUS_NONFINITE
+            tally.status |= L.STATUS_NONFINITE
             t = t_ev
             break
         t, y = t_ev, y_ev
         if kind == _NONE:
-            if t_stop == pb.t_pulse:
-                t = pb.t_pulse  # exactly, so that the pulse is off from here on
+            if t_stop in (pb.t_pulse, pb.t_air):
+                t = t_stop  # exactly, so that the pulse is off (or the run stops) from here on
             continue
         if kind == _REST:
-            if not status & L.STATUS_SETTLED:
-                status |= L.STATUS_REST
+            if not tally.status & L.STATUS_SETTLED:
+                tally.status |= L.STATUS_REST
             break
         if kind == _OVERTURN:
-            outcome = L.OUTCOME_MODE1 if impacts > 0 else L.OUTCOME_MODE2
-            t_over = t
-            status |= L.STATUS_OVERTURNED
+            tally.outcome = L.OUTCOME_MODE1 if tally.impacts > 0 else L.OUTCOME_MODE2
+            tally.t_over = t
+            tally.status |= L.STATUS_OVERTURNED
             break
         if kind == _UPLIFT:
             s_new = pb.uplift_corner(t, (y[2], y[3]), on)
             if s_new == 0:  # the far-side search failed to land past the root
                 s_new = 1 if pb.q(t, (y[2], y[3]), on) > 0 else -1
             y_new = (0.0, 0.0, y[2], y[3])
-            note("uplift", t, 0, s_new, y, y_new)
+            tally.note("uplift", t, 0, s_new, y, y_new)
             s, y = s_new, y_new
-            uplifts += 1
+            tally.uplifts += 1
             continue
-        # impact at theta = 0 ending rocking on corner s (eq. 1)
-        impacts += 1
         free_check = True
-        if impacts == 1:
-            t_first = t
-        if s * y[1] > 0.0:  # moving away from theta = 0: not a crossing (a bug if seen)
-            anomalies += 1
-        e = float(restitution(s, y[2], prm, flex))
-        e_max = max(e_max, e)
-        if e > 1.0:
-            status |= L.STATUS_E_ABOVE_1
-        w_minus = y[1]
-        if e > 0.0 and abs(e * w_minus) >= pb.rest_rate:
-            s_new, w_plus = -s, e * w_minus
-        else:
-            s_new, w_plus = 0, 0.0
-            contacts += 1
-            if e > 0.0:
-                status |= L.STATUS_SETTLED
-        if not flex:
-            u_dot = 0.0
-        elif pb.law == L.LAW_LOCKED:  # the top mass moves with the base: u' is kept
-            u_dot = y[3]
-        else:  # the spring and damper carry no impulse: m (u' + h theta') is conserved
-            u_dot = y[3] + pb.h * (w_minus - w_plus)
-        y_new = (0.0, w_plus, y[2], u_dot)
-        if ct is not None:
-            ct.impact(y, s, y_new, s_new)
-        note("impact", t, s, s_new, y, y_new, e)
-        s, y = s_new, y_new
-        if s == 0:
-            s = pb.uplift_corner(t, (y[2], y[3]), on)
-            if s != 0:
-                uplifts += 1
-                note("uplift", t, 0, s, y, y)
-
-    res = {
-        "outcome": outcome, "status": status, "impacts": impacts, "uplifts": uplifts,
-        "contacts": contacts, "theta_max": theta_max, "t_overturn": t_over,
-        "t_first_impact": t_first, "t_end": t, "e_max": e_max, "steps": pb.steps,
-        "nfev": pb.nfev, "anomalies": anomalies, "wall_time": time.perf_counter() - t0_wall,
-    }
-    if ct is not None:
-        res.update({"mu_required": ct.mu if math.isfinite(ct.n_min) else math.nan,
-                    "normal_min_over_Mg": ct.n_min if math.isfinite(ct.n_min) else math.nan,
-                    "impulse_ratio_max": ct.impulse})
-    if log is not None:
-        res["events"] = log
-    return res
+        y, s = tally.impact(t, y, s, on, ct)
+    return tally.result(t, time.perf_counter() - t0_wall, ct)
 
 
 def result_row(r: dict) -> np.ndarray:

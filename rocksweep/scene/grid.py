@@ -28,6 +28,7 @@ from rocksweep.physics.points import (
     shape_code,
 )
 from rocksweep.scene.model import Scene
+from rocksweep.schema import VERTICAL_KEYS
 
 
 @dataclass
@@ -99,6 +100,10 @@ class Grid:
                            np.array([law_code(w) for w in scene.axes[self._i_law].values]))
         # the initial state's axes, when the scene gives them (vocab.axes.INITIAL; else at rest)
         self._i_init = [names.index(k) if k in names else None for k in INITIAL]
+        # a pulse's vertical harmonic (pulse.vertical: amplitude, w_over_p, phase), or None
+        self._i_vert = ([names.index(f"vertical.{k}") for k in VERTICAL_KEYS]
+                        if "vertical.amplitude" in names else None)
+        self._vertical = scene.vertical_samples()  # a record's vertical component, or None
         self._values = [np.asarray(a.values, float)
                         if i not in (self._i_shape, self._i_rec, self._i_law) else None
                         for i, a in enumerate(scene.axes)]
@@ -172,7 +177,9 @@ class Grid:
                   self.scene.option("cycles"), self.scene.option("gamma"),
                   self.scene.option("nu"), self.scene.record,
                   np.nan if self._i_mu is None else self._values[self._i_mu][multi[self._i_mu]],
-                  law, e, e_factor, initial, u_cr)
+                  law, e, e_factor, initial, u_cr, self._vertical,
+                  None if self._i_vert is None else
+                  tuple(self._values[i][multi[i]] for i in self._i_vert))
         return ChunkRows(rows, b_kind[inverse], alpha_ref, b_E[inverse])
 
     def _suite_rows(self, multi, rows, body_rows, omega_rock, alpha_ref, kinds, E_ref,

@@ -11,11 +11,13 @@ import numpy as np
 
 from rocksweep import fields
 from rocksweep.errors import SceneError, set_key  # noqa: F401 (SceneError: re-exported)
+from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody, Body, FlexibleBody
 from rocksweep.physics.points import FREE, INITIAL, RECORD, Point
-from rocksweep.physics.records import GroundRecord
+from rocksweep.physics.records import GroundRecord, vertical_samples
 from rocksweep.physics.suite import Suite
+from rocksweep.physics.vertical import VerticalHarmonic
 from rocksweep.schema import KEYS
 from rocksweep.vocab.ground import PAPER_SHAPES, pulse_duration
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
@@ -59,6 +61,9 @@ class Scene:
     # a body given by the laboratory's numbers (body.kind physical): its Pi groups, p
     # [rad/s], omega_n [rad/s] and h_cg [m] (``physics.bodies.body_from_geometry``), else None
     physical: dict | None = field(default=None, repr=False)
+    # the record's vertical component (``ground.vertical``, read at load), else None; a
+    # pulse's vertical harmonic is three axes, vertical.amplitude, .w_over_p and .phase
+    vertical: GroundRecord | None = field(default=None, repr=False)
 
     def physical_words(self) -> str:
         """One line stating what a physical body became ('' for a body of Pi groups)."""
@@ -69,6 +74,12 @@ class Scene:
             f"{k} = {d[k]:.5g}" for k in ("wn_over_p", "zeta", "alpha_cg", "alpha_A",
                                           "mA_over_m", "IA_ratio"))
                 + f", p = {d['p']:.5g} rad/s, h_cg = {d['h_cg']:.4g} m")
+
+    def physical_summary(self) -> dict[str, float]:
+        """A physical body's frequency parameter {"p": p [rad/s]} (the key of
+        ``rocksweep.simulate``'s summary, ``simulate --json`` and a result file's attrs);
+        {} for a body of Pi groups."""
+        return {} if self.physical is None else {"p": float(self.physical["p"])}
 
     def variables(self) -> dict[str, tuple[str, float, str]]:
         """The per-point variables a sweep of this scene stores, name -> (dtype, fill value
@@ -87,11 +98,31 @@ class Scene:
         return self.record is not None or self.suite is not None
 
     @property
-    def ground(self) -> bool:
-        """Whether the scene needs the kernel's GROUND variants (a Ricker or MP pulse, or a
-        record); the paper's sine and cosine (n cycles too) run the pulse variants."""
-        return self.recorded or any(
-            sh not in (*PAPER_SHAPES, FREE) for sh in self.axis("shape").values)
+    def ground(self) -> int:
+        """The kernel variants' ground code the scene needs (``layout.GROUND_*``, false
+        for the pulse variants): GROUND_VERTICAL with a vertical ground acceleration,
+        GROUND_ANY for a Ricker or MP pulse or a record; the paper's sine and cosine (n
+        cycles too) run the pulse variants."""
+        if self.has_vertical:
+            return L.GROUND_VERTICAL
+        if self.recorded or any(
+                sh not in (*PAPER_SHAPES, FREE) for sh in self.axis("shape").values):
+            return L.GROUND_ANY
+        return L.GROUND_PULSE
+
+    @property
+    def has_vertical(self) -> bool:
+        """Whether the ground has a vertical acceleration (``ground.vertical`` or
+        ``pulse.vertical``)."""
+        return self.vertical is not None or any(a.name == "vertical.amplitude"
+                                                for a in self.axes)
+
+    def vertical_samples(self):
+        """The vertical record [g] on the horizontal record's samples
+        (``records.vertical_samples``; float64[npts]), None without one."""
+        if self.vertical is None:
+            return None
+        return vertical_samples(self.vertical, self.record)
 
     def option(self, name: str) -> Any:
         """A pulse option's value (cycles, gamma, nu [deg]): the scene's or the default."""
@@ -152,14 +183,24 @@ class Scene:
         if self.record is not None:
             return Point(body, float(values["lam"]), RECORD, math.nan,
                          float(values["A_ratio"]), record=self.record, p=float(values["p"]),
-                         **self._law(values), initial=self.initial_state(values))
+                         **self._law(values), initial=self.initial_state(values),
+                         vertical=self.vertical)
         return Point(body, float(values["lam"]), str(values["shape"]),
                      float(values["w_over_p"]), float(values["A_ratio"]),
                      int(values.get("cycles", self.option("cycles"))),
                      float(values.get("gamma", self.option("gamma"))),
                      float(values.get("nu", self.option("nu"))),
                      mu=float(values.get("mu", math.nan)), **self._law(values),
-                     initial=self.initial_state(values))
+                     initial=self.initial_state(values),
+                     pulse_vertical=self._pulse_vertical(values))
+
+    def _pulse_vertical(self, values: dict[str, Any]) -> VerticalHarmonic | None:
+        """A point's vertical harmonic (``pulse.vertical``) from axis values, or None."""
+        if "vertical.amplitude" not in values:
+            return None
+        return VerticalHarmonic(float(values["vertical.amplitude"]),
+                                float(values["vertical.w_over_p"]),
+                                float(values["vertical.phase"]))
 
     @property
     def free(self) -> bool:

@@ -49,6 +49,7 @@ from rocksweep.schema import (
     BODY_KEYS,
     KEYS,
     SECTIONS,
+    VERTICAL_KEYS,
     as_float,
     check_values,
     fmt,
@@ -105,17 +106,18 @@ def apply_overrides(raw: dict, overrides: list[str]) -> dict:
 
 def parse_scene(text: str, source: str = "scene", overrides: list[str] | None = None,
                 base: str | Path | None = None, record: GroundRecord | None = None,
-                records: tuple[GroundRecord, ...] | None = None) -> Scene:
+                records: tuple[GroundRecord, ...] | None = None,
+                vertical: GroundRecord | None = None) -> Scene:
     """Validate scene YAML text. Raises SceneError (one line, prefixed by ``source``).
 
     base: the directory a ``ground.record`` path is relative to (the scene file's; None:
     the working directory); record: the record of a ``ground`` section, already read (a
     result file's stored copy): the ``ground.record`` path is then not read; records: the
     same for a suite's ``ground.records`` (in the suite's order; their file names label
-    the record dimension)."""
+    the record dimension); vertical: the same for ``ground.vertical``."""
     try:
         return _parse(text, overrides or [], Path(base) if base is not None else None,
-                      record, records)
+                      record, records, vertical)
     except SceneError as err:
         raise SceneError("{source}: {err}", source=source, err=err) from None
 
@@ -383,17 +385,18 @@ def _pulse_options(pulse: dict, shapes: tuple[str, ...]) -> list[Axis]:
     return out
 
 
-def _record(ground: dict, base: Path | None) -> GroundRecord:
-    """The record of a ``ground`` section, read (and hashed) now."""
-    spec = KEYS["ground.record"]
-    v = ground["record"]
+def _record(ground: dict, base: Path | None, key: str = "record") -> GroundRecord:
+    """The record (or, key ``vertical``, its vertical component) of a ``ground`` section,
+    read (and hashed) now."""
+    spec = KEYS[f"ground.{key}"]
+    v = ground[key]
     if not (isinstance(v, str) and v.strip()):
-        raise SceneError(f"ground.record = {fmt(v)}: {spec.allowed}")
+        raise SceneError(f"ground.{key} = {fmt(v)}: {spec.allowed}")
     path = _where(v, base)
     try:
         return read_record(path)
     except RecordError as err:
-        raise SceneError(f"ground.record: {err}") from None
+        raise SceneError(f"ground.{key}: {err}") from None
 
 
 def _where(v: str, base: Path | None) -> Path:
@@ -665,6 +668,10 @@ class _Motion:
     suite: Suite | None = None
     stripe: tuple | None = None
     inputs: tuple[str, ...] = ()
+    # the vertical ground acceleration: a record's vertical component (ground.vertical)
+    # or the raw keys of a pulse's vertical harmonic (pulse.vertical)
+    vertical: GroundRecord | None = None
+    pulse_vertical: dict | None = None
 
 
 @dataclasses.dataclass
@@ -681,7 +688,8 @@ class _Forms:
 
 def _parse(text: str, overrides: list[str], base: Path | None = None,
            given_record: GroundRecord | None = None,
-           given_records: tuple[GroundRecord, ...] | None = None) -> Scene:
+           given_records: tuple[GroundRecord, ...] | None = None,
+           given_vertical: GroundRecord | None = None) -> Scene:
     """The scene of YAML text: each section parsed in turn, then the grid's size checked
     before any axis value is built, then the scene's admission (initial state, cost)."""
     raw = _document(text, overrides)
@@ -692,7 +700,7 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
         raise SceneError("pulse, ground: give one of them (a pulse, or a recorded ground "
                          "motion)")
     initial = _section(raw, "initial", kind, required=False)
-    motion = _motion(raw, kind, base, given_record, given_records)
+    motion = _motion(raw, kind, base, given_record, given_records, given_vertical)
     numerics_sec = _section(raw, "numerics", kind, required=False)
     energy, contact, check = _outputs(raw, kind, body.get("mu"))
 
@@ -708,7 +716,7 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
                   numerics=numerics, single_numerics=single, energy=energy, text=text,
                   contact=contact, check=check, record=motion.record,
                   refine=_refine(raw, kind), suite=motion.suite, inputs=motion.inputs,
-                  physical=physical)
+                  physical=physical, vertical=motion.vertical)
     _admit(scene)
     return scene
 
@@ -760,17 +768,24 @@ def _body(raw: dict) -> tuple[dict, str, dict | None]:
 
 
 def _motion(raw: dict, kind: str, base: Path | None, given_record: GroundRecord | None,
-            given_records: tuple[GroundRecord, ...] | None) -> _Motion:
-    """The ground motion: none (free vibration), a ``pulse``, or a ``ground`` section
-    (one record scaled by A_ratio, or a suite of records)."""
+            given_records: tuple[GroundRecord, ...] | None,
+            given_vertical: GroundRecord | None = None) -> _Motion:
+    """The ground motion: none (free vibration), a ``pulse`` (with its vertical harmonic,
+    if given), or a ``ground`` section (one record scaled by A_ratio, with its vertical
+    component if given, or a suite of records)."""
     for name in ("pulse", "ground"):
         if name in raw and raw[name] is None:  # refused as every null section
             _section(raw, name, kind, required=False)
     if raw.get("ground") is None and raw.get("pulse") is None:
         return _Motion(free=True, pulse={"shape": FREE, "w_over_p": 0.0, "A_ratio": 0.0})
     if raw.get("ground") is None:
-        return _Motion(free=False, pulse=_section(raw, "pulse", kind, required=True))
+        pulse = _section(raw, "pulse", kind, required=True)
+        return _Motion(free=False, pulse=pulse, pulse_vertical=_pulse_vertical(pulse))
     ground = _section(raw, "ground", kind, required=True)
+    if ground.get("vertical") is not None and ground.get("record") is None:
+        raise SceneError(f"ground.vertical = {fmt(ground['vertical'])}: works with one "
+                         "ground.record (its horizontal component) only, not with "
+                         "ground.records")
     if ground.get("records") is not None:
         suite, stripe, inputs = _suite(ground, base, given_records)
         return _Motion(free=False, pulse={"shape": RECORD, "p": ground["p"]}, suite=suite,
@@ -786,10 +801,34 @@ def _motion(raw: dict, kind: str, base: Path | None, given_record: GroundRecord 
         raise SceneError("ground.A_ratio: missing required key (a number, a list of "
                          "numbers or a range {start, stop, num})")
     record = _record(ground, base) if given_record is None else given_record
+    inputs = (str(record.source),) if given_record is None else ()
+    vertical = given_vertical
+    if ground.get("vertical") is not None and vertical is None:
+        vertical = _record(ground, base, "vertical")
+        inputs = (*inputs, str(vertical.source))
     return _Motion(free=False,
                    pulse={"shape": RECORD, "A_ratio": ground["A_ratio"], "p": ground["p"]},
-                   record=record,
-                   inputs=(str(record.source),) if given_record is None else ())
+                   record=record, inputs=inputs,
+                   vertical=vertical if ground.get("vertical") is not None else None)
+
+
+def _pulse_vertical(pulse: dict) -> dict | None:
+    """The raw keys of ``pulse.vertical`` (a mapping of VERTICAL_KEYS; amplitude and
+    w_over_p required), checked as a section's are; None when not given."""
+    spec = pulse.get("vertical")
+    if spec is None:
+        return None
+    if not isinstance(spec, dict):
+        raise SceneError(f"pulse.vertical = {fmt(spec)}: {KEYS['pulse.vertical'].allowed}")
+    for k in spec:
+        if k not in VERTICAL_KEYS:
+            raise SceneError(f"pulse.vertical.{k}: unknown key (allowed: "
+                             f"{', '.join(VERTICAL_KEYS)})")
+    for k in VERTICAL_KEYS:
+        if KEYS[f"pulse.vertical.{k}"].required and spec.get(k) is None:
+            raise SceneError(f"pulse.vertical.{k}: missing required key (a number, a list "
+                             "of numbers or a range {start, stop, num})")
+    return spec
 
 
 def _outputs(raw: dict, kind: str, mu_spec: Any) -> tuple[bool, bool, bool]:
@@ -841,6 +880,10 @@ def _axis_specs(kind: str, body: dict, impact: dict, initial: dict, motion: _Mot
     for k in INITIAL:  # the initial state's keys given (none: at rest, no axis)
         if initial.get(k) is not None:
             specs.append((k, f"initial.{k}", *_axis_spec(f"initial.{k}", initial[k])[:2]))
+    for k in VERTICAL_KEYS if motion.pulse_vertical is not None else ():
+        spec = motion.pulse_vertical.get(k, KEYS[f"pulse.vertical.{k}"].default)
+        key = f"pulse.vertical.{k}"
+        specs.append((f"vertical.{k}", key, *_axis_spec(key, spec)[:2]))
     if motion.suite is not None:  # the records (words), then the stripes, before p
         specs.append(("record", "ground.record", "words", motion.suite.names))
         if motion.stripe is not None:
@@ -906,15 +949,44 @@ def _admit(scene: Scene) -> None:
     if scene.contact and scene.ground:
         # the contact outputs are compiled into the sine/cosine variants only (a kernel
         # variant per combination costs compile time no scene has asked for yet)
-        what = "a recorded ground motion" if scene.recorded else "ricker and mp pulses"
+        what = ("a vertical ground acceleration" if scene.has_vertical else
+                "a recorded ground motion" if scene.recorded else "ricker and mp pulses")
         raise SceneError(f"outputs.contact = true: not available with {what} yet; contact "
                          "outputs work with sine and cosine pulses")
     bodies = candidate_bodies(scene)
+    _check_vertical_start(scene)
     _check_initial(scene, bodies)
     check_cost(scene, bodies)
     if scene.suite is not None:
         scene.suite.warn(scene.axis(alpha_symbol(scene.kind)).values,
                          scene.axis("p").values)
+
+
+def _check_vertical_start(scene: Scene) -> None:
+    """Refuse (one line) a vertical with g + a_v <= 0 at t = 0 for some point: the body
+    would leave the ground before anything else happens (``airborne`` is for a run that
+    gets there later). A harmonic: 1 + a sin(phase) <= 0; a record: its first sample
+    scaled with the largest |A_ratio| g tan(alpha_ref) of the grid."""
+    if "vertical.amplitude" in {a.name for a in scene.axes}:
+        amp = np.asarray(scene.axis("vertical.amplitude").values, float)
+        phase = np.asarray(scene.axis("vertical.phase").values, float)
+        a0 = amp[:, None] * np.sin(np.radians(phase))[None, :]
+        i, j = np.unravel_index(np.argmin(a0), a0.shape)
+        if 1.0 + a0[i, j] <= 0.0:
+            raise SceneError(f"pulse.vertical.amplitude = {fmt(float(amp[i]))}: with "
+                             f"pulse.vertical.phase = {fmt(float(phase[j]))} deg, a_v = "
+                             f"{a0[i, j]:.4g} g at t = 0, so g + a_v <= 0 (the body leaves "
+                             "the ground); a sin(phase) must be > -1 at t = 0")
+    if scene.vertical is not None:
+        first = float(scene.vertical_samples()[0]) / scene.record.pga  # per unit of A
+        a_ratio = float(np.max(np.abs(scene.axis("A_ratio").values)))
+        alpha = float(np.max(scene.axis(alpha_symbol(scene.kind)).values))
+        a0 = a_ratio * math.tan(alpha) * first
+        if 1.0 + a0 <= 0.0:
+            raise SceneError(f"ground.vertical = {shown(scene.vertical.source)}: its first "
+                             f"sample scaled with ground.A_ratio = {fmt(a_ratio)} is a_v = "
+                             f"{a0:.4g} g at t = 0, so g + a_v <= 0 (the body leaves the "
+                             "ground); the vertical at t = 0 must be > -1 g")
 
 
 def _check_initial(scene: Scene, bodies: list[dict[str, float]]) -> None:

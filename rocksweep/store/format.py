@@ -53,7 +53,7 @@ from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import fixed_ascii, utc_now
-from rocksweep.store.identity import record_attrs, resolved_scene
+from rocksweep.store.identity import record_attrs, resolved_scene, vertical_attrs
 from rocksweep.vocab.axes import alpha_symbol
 from rocksweep.vocab.outcomes import COMPUTED_FLAGS, COMPUTED_MEANING
 
@@ -222,6 +222,11 @@ def metadata(scene: Scene, overrides: tuple[str, ...] = (),
     if scene.record is not None:  # the record: name, SHA-256, NPTS, DT [s], PGA [g]
         for k, v in record_attrs(scene.record).items():
             a[f"record_{k}"] = v
+    if scene.vertical is not None:  # its vertical component: the same, and its IMs
+        for k, v in vertical_attrs(scene.vertical, scene.record).items():
+            a[f"vertical_{k}"] = v
+    for k, v in scene.physical_summary().items():  # a physical body's p [rad/s]
+        a[k] = v
     if scene.suite is not None:  # the stripes' IM ("none": a cloud) and Sa's period [s]
         a["scale_im"] = scene.suite.im or "none"
         a["scale_period"] = float(scene.suite.period)
@@ -306,6 +311,8 @@ def initialise(f: h5py.File, meta: Metadata) -> None:
     scene = meta.scene
     if scene.record is not None:
         _store_record(f, scene.record)
+    if scene.vertical is not None:
+        _store_file(f.create_group(VERTICAL_GROUP), "file", scene.vertical)
     if scene.suite is not None:
         _store_suite_records(f, scene.suite)
     scales = []
@@ -409,6 +416,7 @@ def coord_attrs(axis, kind: str = "flexible") -> dict[str, Any]:
 
 
 RECORD_GROUP = "record"  # a record sweep's copy of its record: file (bytes), acceleration
+VERTICAL_GROUP = "vertical"  # its vertical component's copy (ground.vertical): file (bytes)
 SUITE_GROUP = "records"  # a suite sweep's copies of its records' files: 0, 1, ... (bytes)
 
 

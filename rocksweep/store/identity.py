@@ -26,6 +26,8 @@ def resolved_scene(scene: Scene, overrides: tuple[str, ...] | list[str] = (),
         **({"contact": True} if scene.contact else {}),
         **({"check": True} if scene.check else {}),
         **({"record": record_attrs(scene.record)} if scene.record is not None else {}),
+        **({"vertical": vertical_attrs(scene.vertical, scene.record)}
+           if scene.vertical is not None else {}),
         **({"suite": suite_attrs(scene.suite)} if scene.suite is not None else {}),
     }
     if adaptive is not None:
@@ -45,6 +47,15 @@ def record_attrs(record) -> dict:
     return {"name": record.name, "sha256": record.sha256, "npts": int(record.npts),
             "dt": float(record.dt), "pga": float(record.pga), "title": record.title,
             "source": str(record.source)}
+
+
+def vertical_attrs(vertical, record) -> dict:
+    """A record's vertical component (``ground.vertical``) as the file states it
+    (``vertical_*`` attributes): ``record_attrs`` of its file and its IMs, PGA_v [g] and
+    the V/H ratio (``records.vertical_ims``)."""
+    from rocksweep.physics.records import vertical_ims
+
+    return {**record_attrs(vertical), **vertical_ims(vertical, record)}
 
 
 def suite_attrs(suite) -> dict:

@@ -36,6 +36,7 @@ from rocksweep.store.format import (
     FORMAT_VERSION,
     RECORD_GROUP,
     SUITE_GROUP,
+    VERTICAL_GROUP,
     variables_for,
 )
 from rocksweep.store.identity import resolved_scene, scene_differences
@@ -558,13 +559,14 @@ def as_result(data, names: list[str] | None = None) -> SweepResult:
     return result_of(data)
 
 
-def stored_record(path: Path, rec: dict):
-    """The record a result file keeps (``_store_record``) as a ``GroundRecord`` with the
-    sweep's source path, checked against the file's SHA-256; None for a file that keeps
-    no copy (made before records were stored). StoreError if the copy is damaged."""
+def stored_record(path: Path, rec: dict, group: str = RECORD_GROUP):
+    """The record a result file keeps (``_store_record``; ``group`` VERTICAL_GROUP: its
+    vertical component's) as a ``GroundRecord`` with the sweep's source path, checked
+    against the file's SHA-256; None for a file that keeps no copy (made before records
+    were stored). StoreError if the copy is damaged."""
     f = open_h5(path, "r")
     try:
-        g = f.get(RECORD_GROUP)
+        g = f.get(group)
         d = g.get("file") if g is not None else None
         if d is None:
             return None
@@ -651,6 +653,9 @@ def result_scene(result: SweepResult) -> Scene:
                 raise StoreError(f"{shown(result.path)}: the record {rec['source']} changed "
                                  f"since the sweep (sha256 {record.sha256[:12]}, the result "
                                  f"has {rec['sha256'][:12]})")
+    vert = result.scene.get("vertical")
+    vertical = (stored_record(result.path, vert, VERTICAL_GROUP) if vert and result.in_file
+                else None)  # None: re-read from where the sweep read it (sha256 compared)
     records = stored_records(result.path, suite) if suite and result.in_file else None
     if suite and records is None:
         # a file without copies (older rocksweep) or a Dataset made in memory: the records
@@ -659,7 +664,7 @@ def result_scene(result: SweepResult) -> Scene:
             [str(r.get("source")) for r in suite.get("records") or []]))
     try:
         sc = parse_scene(str(a["scene"]), str(result.path), overrides, record=record,
-                         records=records)
+                         records=records, vertical=vertical)
     except RocksweepError as err:
         raise StoreError("{path}: cannot rebuild its scene ({err})", path=shown(result.path),
                          err=err) from None

@@ -19,6 +19,7 @@ CLASSES: tuple[str, ...] = (SAFE, MODE1, MODE2)
 MODE_WORDS: tuple[str, ...] = ("none", MODE1, MODE2)
 
 SLIDES, LIFTS_OFF = "slides", "lifts_off"  # the contact status words (outputs.contact)
+AIRBORNE = "airborne"  # the ground falls faster than gravity: the body leaves it
 STATUS_BIT: dict[str, int] = {
     "rest": 1,
     "horizon": 2,
@@ -36,11 +37,14 @@ STATUS_BIT: dict[str, int] = {
     # set after the kernel by the certification of close calls (rocksweep.compute.certify)
     "refined": 8192,
     "uncertified": 16384,
+    # g + a_v <= 0 (a vertical ground acceleration): the body leaves the ground; the run
+    # stops there (kernel)
+    AIRBORNE: 32768,
 }
 STATUS_WORDS: dict[int, str] = {b: w for w, b in STATUS_BIT.items()}
 #: the bits that make a run's class unreliable ("flagged")
 FLAGGED_WORDS: tuple[str, ...] = ("horizon", "step_cap", "event_cap", "nonfinite",
-                                   "uncertified")
+                                   "uncertified", AIRBORNE)
 FLAGGED = 0
 for _w in FLAGGED_WORDS:
     FLAGGED |= STATUS_BIT[_w]
@@ -69,6 +73,8 @@ STATUS_MEANING: dict[str, str] = {
                "run's result is kept (rocksweep.compute.certify)",
     "uncertified": "a close call whose outcome still changed at the last refinement "
                    "(numerics.refine) (flagged)",
+    AIRBORNE: "g + a_v <= 0: the vertical ground acceleration reached -g, the body leaves "
+              "the ground (outside the model); the run stopped there (flagged)",
 }
 
 #: the limit states a fragility curve can count (besides "theta:X")

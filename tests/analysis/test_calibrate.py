@@ -85,6 +85,8 @@ def test_restitution_of_a_freely_rocking_block_from_an_independent_history():
     assert float(est.lo) <= 0.88 <= float(est.hi)
     assert fit.attrs["ci"] == 0.95
     assert fit.misfit.ndim == 0 and float(fit.misfit) < 0.05
+    assert fit["reason"].item() == "ok" and fit["noise"].ndim == 0
+    assert int(fit["dof"]) == fit.attrs["n_peaks"] - 1
 
 
 def test_lam_of_a_flexible_body_under_a_pulse_and_an_honest_interval():
@@ -121,6 +123,21 @@ def test_physical_columns_with_the_body_s_p():
         rocksweep.calibrate(BLOCK, df, ["impact.e"])
 
 
+def test_the_command_line_names_p_as_its_option(tmp_path):
+    # the way out in the command line's words: --p, not the API's p=
+    import yaml
+    from click.testing import CliRunner
+
+    from rocksweep.cli import main
+
+    t, theta = free_block_history(0.85, t_end=6.0)
+    scene, meas = tmp_path / "block.yaml", tmp_path / "lab.csv"
+    scene.write_text(yaml.safe_dump(BLOCK))
+    pd.DataFrame({"t": t / 3.0, "theta": theta}).to_csv(meas, index=False)
+    run = CliRunner().invoke(main, ["calibrate", str(scene), str(meas), "--fit", "impact.e"])
+    assert run.exit_code == 2 and "give --p VALUE" in run.output and "p=" not in run.output
+
+
 GOOD_T = np.arange(0.0, 10.0, 0.05)
 
 
@@ -132,6 +149,7 @@ GOOD_T = np.arange(0.0, 10.0, 0.05)
     (pd.DataFrame({"p_t": GOOD_T, "theta_over_alpha": np.nan}), ["impact.e"], None,
      "NaN in every row"),
     (None, ["pulse.shape"], None, "fit pulse.shape: not a number of this scene"),
+    (None, ["impact.lam"], None, "fit impact.lam: law constant does not use lam"),
     (None, ["impact.e"], {"impact.e": (0.5, 1.5)}, "bounds impact.e = (0.5, 1.5): 1.5 is "
      "outside the key's admissible range"),
     (pd.DataFrame({"p_t": GOOD_T, "theta_over_alpha": 0.7 - 0.001 * GOOD_T**2}),
@@ -181,3 +199,44 @@ def test_command_line_writes_the_fit_and_the_figure(tmp_path):
     assert run.stderr.strip().count("\n") == 0 and run.stderr.startswith("Error: ")
     assert "no column p_t, theta_over_alpha" in run.stderr
     assert not out2.exists()
+
+
+def test_a_model_that_cannot_reproduce_the_measurement_says_misfit(tmp_path):
+    # a block under the vertical law, whose e for any lam in [0, 2] is far above the
+    # measured block's 0.6: the fit ends somewhere, the verdict says it means nothing
+    import yaml
+
+    t, theta = free_block_history(0.6)
+    scene, meas = tmp_path / "vertical.yaml", tmp_path / "measured.csv"
+    scene.write_text(yaml.safe_dump({**BLOCK, "impact": {"lam": 0.0}}))
+    noisy(t, theta / ALPHA, 0.01).to_csv(meas, index=False)
+    cmd = [sys.executable, "-m", "rocksweep", "calibrate", str(scene), str(meas),
+           "--fit", "impact.lam", "-o", str(tmp_path / "fit.h5")]
+    run = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
+    assert run.returncode == 0, run.stderr
+    warn = [ln for ln in run.stderr.splitlines() if ln.startswith("Warning: ")]
+    assert len(warn) == 1 and "misfit (the peaks' RMS error" in warn[0]
+    assert "times the estimated noise" in warn[0]
+    import xarray as xr
+
+    fit = xr.open_dataset(tmp_path / "fit.h5", engine="h5netcdf")
+    assert "misfit" in fit["reason"].item().split(",")
+    noise, dof = float(fit["noise"]), int(fit["dof"])
+    n = fit.attrs["n_peaks"]
+    assert dof == n - 1
+    # the RMS error over the dof, recomputed from the stored misfit (sqrt(S / n))
+    assert float(fit["misfit"]) * math.sqrt(n / dof) > 3 * noise
+
+
+def test_a_flat_profile_is_unidentifiable_and_an_edge_estimate_at_bound():
+    t, theta = free_block_history(0.88)
+    frame = noisy(t, theta / ALPHA, 0.01)
+    with pytest.warns(Warning, match="unidentifiable .impact.e in"):
+        flat = rocksweep.calibrate(BLOCK, frame, ["impact.e"],
+                                   bounds={"impact.e": (0.8799, 0.8801)})
+    assert "unidentifiable" in flat["reason"].item().split(",")
+    fig = rocksweep.plot(flat)  # the command line's --plot figure, from Python
+    assert len(fig.axes[0].get_lines()) >= 2  # measured and fitted histories
+    edge = rocksweep.calibrate(BLOCK, frame, ["impact.e"], bounds={"impact.e": (0.5, 0.8)})
+    words = edge["reason"].item().split(",")
+    assert "at_bound" in words and float(edge.estimate[0]) == pytest.approx(0.8, abs=1e-3)

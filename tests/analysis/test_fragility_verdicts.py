@@ -169,7 +169,7 @@ def test_a_mode_fitted_alone_is_censored_by_the_other_and_the_joint_fit_is_not()
     with pytest.warns(F.FragilityWarning, match="censored"):
         alone = F.fragility(ds, state="mode2", bootstrap=0)
     assert "censored" in reasons(alone)
-    joint = F.fragility(ds, state=["mode1", "mode2"], bootstrap=0, warn=False)
+    joint = F.fragility(ds, state=["mode1", "mode2"], bootstrap=0, warn=False, joint=True)
     assert list(joint["fit"].values) == ["competing", "competing"]
     assert not any("censored" in r for r in joint["reason"].values)
     # mode 2 rising then vanishing (20 records): no competing-risk curve can fall
@@ -179,7 +179,8 @@ def test_a_mode_fitted_alone_is_censored_by_the_other_and_the_joint_fit_is_not()
     for s in range(12):
         out[:k1[s], s] = 1
         out[k1[s]:k1[s] + k2[s], s] = 2
-    hump = F.fragility(stripes_ds(out), state=["mode1", "mode2"], bootstrap=0, warn=False)
+    hump = F.fragility(stripes_ds(out), state=["mode1", "mode2"], bootstrap=0, warn=False,
+                       joint=True)
     assert "non_monotone" in str(hump["reason"].sel(state="mode2").values).split(",")
     assert "ok" not in hump["reason"].values
 
@@ -240,7 +241,7 @@ def test_competing_risk_fit_equals_an_independent_multinomial_mle():
     for s in range(lv.size):
         out[:, s] = np.repeat([0, 1, 2], cnt[s])
     fr = F.fragility(stripes_ds(out, levels=lv), state=["mode1", "mode2"], bootstrap=0,
-                     warn=False)
+                     warn=False, joint=True)
 
     def nll(t):
         ps, p1, p2 = cif_trapezoid(lv, *np.exp(t))
@@ -277,10 +278,15 @@ def demo():
     return rocksweep.run(ROOT / "configs" / "fragility-demo.yaml")
 
 
-def test_damage_states_never_cross_on_the_demo_suite(demo):
-    fr = rocksweep.fragility(demo, state=DAMAGE, bootstrap=50)
+def test_joint_damage_states_never_cross_on_the_demo_suite(demo):
+    fr = rocksweep.fragility(demo, state=DAMAGE, bootstrap=50, joint=True)
     assert list(fr["fit"].values) == ["ordinal"] * 4
-    assert np.all(fr["reason"].values == "ok")
+    # the one beta may be rejected by its likelihood-ratio test, nothing else is said
+    assert set(fr["reason"].values.ravel()) <= {"ok", "parallel_rejected"}
+    rejected = fr["parallel_rejected"].values
+    np.testing.assert_array_equal(rejected, fr["parallel_p"].values < F.PARALLEL_P)
+    for j, bad in enumerate(rejected):
+        assert np.all((fr["reason"].values[:, j] == "parallel_rejected") == bad)
     c = fr["curve"].transpose("lam", "state", "im_grid").values
     assert np.all(np.diff(c, axis=1) <= 1e-12)  # each state at most the one before
     med = fr["im_median"].transpose("lam", "state").values
@@ -301,7 +307,7 @@ def test_one_state_fits_equal_the_single_fit_and_the_ordinal_mle_is_the_mle(demo
         direct = F.fit_stripes(demo["PGA"].values, k, n)
         assert float(one["im_median"]) == pytest.approx(direct.im_median, rel=1e-9)
     # the ordinal fit of lam = 0 against Nelder-Mead on the multinomial likelihood
-    fr = rocksweep.fragility(demo, state=DAMAGE, bootstrap=0).isel(lam=0)
+    fr = rocksweep.fragility(demo, state=DAMAGE, bootstrap=0, joint=True).isel(lam=0)
     lv = demo["PGA"].values
     reach = fr["n_failed"].values.astype(float)  # (state, S), nested
     n = fr["n_counted"].values.astype(float)
@@ -470,7 +476,7 @@ def test_the_figure_draws_a_competing_mode_by_its_own_model_not_a_lognormal():
 
     lv = np.geomspace(0.1, 2.0, 12)
     fr = F.fragility(stripes_ds(competing_outcomes(40, seed=1, levels=lv), levels=lv),
-                     state=["mode1", "mode2"], bootstrap=0, warn=False)
+                     state=["mode1", "mode2"], bootstrap=0, warn=False, joint=True)
     med, beta = fr["im_median"].values, fr["beta"].values
     lines = [ln for ln in fragility_figure(fr).axes[0].get_lines() if len(ln.get_xdata())]
     assert len(lines) == 2
@@ -480,3 +486,98 @@ def test_the_figure_draws_a_competing_mode_by_its_own_model_not_a_lognormal():
     _, _, p2 = cif_trapezoid(x, med[0], beta[0], med[1], beta[1], n_u=20001)
     np.testing.assert_allclose(lines[1].get_ydata(), p2, atol=1e-4)
     assert np.max(np.abs(norm.cdf(np.log(x / med[1]) / beta[1]) - p2)) > 0.05
+
+
+# ---------------------------------------------------------------------------------------
+# one question, one answer: separate fits by default, the joint fit tested
+# ---------------------------------------------------------------------------------------
+
+
+def nested_ds(n_records: int, med_mild: float, beta_mild: float, med_severe: float,
+              beta_severe: float, seed: int, levels=LEVELS) -> xr.Dataset:
+    """Two nested states: theta:0.5 from one lognormal capacity, overturning (mode 1)
+    from a second capacity, never below the first (a record overturns only once past
+    theta:0.5)."""
+    rng = np.random.default_rng(seed)
+    c1 = rng.lognormal(math.log(med_mild), beta_mild, n_records)
+    c2 = np.maximum(c1, rng.lognormal(math.log(med_severe), beta_severe, n_records))
+    x = levels[None, :]
+    ds = stripes_ds(np.where(x >= c2[:, None], 1, 0), levels)
+    ds["theta_max_over_alpha"] = (("record", "PGA"), np.where(x >= c1[:, None], 0.8, 0.1))
+    return ds
+
+
+def test_a_states_numbers_do_not_depend_on_the_other_states(demo):
+    alone = rocksweep.fragility(demo, state="overturn", bootstrap=40)
+    many = rocksweep.fragility(demo, state=DAMAGE, bootstrap=40).sel(state="overturn")
+    for v in ("im_median", "beta", "im_median_samples", "beta_samples", "curve"):
+        np.testing.assert_array_equal(alone[v].values, many[v].values)
+    hz = ROOT / "configs" / "hazard-example.csv"
+    a = rocksweep.risk(alone, hz)["annual_rate"].values
+    b = rocksweep.risk(many.expand_dims(state=["overturn"]), hz)["annual_rate"].values[0]
+    np.testing.assert_allclose(a, b, rtol=1e-12, atol=0.0)
+
+
+def test_separate_curves_that_cross_in_the_data_say_crossing():
+    # theta:0.5 spread wide, overturning steep just above its median: the separate
+    # overturning curve passes above theta:0.5's at the top stripes
+    ds = nested_ds(60, 0.5, 0.8, 0.55, 0.05, seed=3)
+    fr = F.fragility(ds, state=["theta:0.5", "overturn"], bootstrap=0, warn=False)
+    c = fr["curve"].values
+    grid = fr["im_grid"].values
+    inside = (grid >= LEVELS[0]) & (grid <= LEVELS[-1])
+    assert np.max(c[1, inside] - c[0, inside]) > F.CROSSING_TOL  # they do cross
+    assert all("crossing" in str(r).split(",") for r in fr["reason"].values)
+    # one shared capacity: the same curve twice, nothing crosses
+    same = nested_ds(60, 0.5, 0.4, 0.01, 0.1, seed=3)
+    fr2 = F.fragility(same, state=["theta:0.5", "overturn"], bootstrap=0, warn=False)
+    assert not any("crossing" in str(r) for r in fr2["reason"].values)
+
+
+def test_the_joint_fits_parallel_test_is_a_likelihood_ratio_and_rejects_unequal_betas():
+    from scipy.stats import chi2
+
+    ds = nested_ds(80, 0.4, 0.8, 0.7, 0.15, seed=5)
+    fr = F.fragility(ds, state=["theta:0.5", "overturn"], bootstrap=0, warn=False,
+                     joint=True)
+    # the free (beta per state) multinomial likelihood by Nelder-Mead, against the common
+    k = fr["n_failed"].values.astype(float)  # (2, S) reaching each state
+    n = fr["n_counted"].values.astype(float)
+    cats = np.vstack([n - k[0], k[0] - k[1], k[1]])
+
+    def nll(t):
+        q = norm.cdf(np.log(LEVELS[None, :] / np.exp(t[:2, None])) / np.exp(t[2:, None]))
+        q = np.vstack([np.ones(LEVELS.size), q, np.zeros(LEVELS.size)])
+        return -np.sum(cats * np.log(np.maximum(q[:-1] - q[1:], 1e-300)))
+
+    med, beta = fr["im_median"].values, float(fr["beta"].values[0])
+    common = nll(np.log([med[0], med[1], beta, beta]))
+    free = minimize(nll, np.log([med[0], med[1], beta, beta]), method="Nelder-Mead",
+                    options={"xatol": 1e-10, "fatol": 1e-12, "maxiter": 20000}).fun
+    assert float(fr["parallel_lr"]) == pytest.approx(2 * (common - free), rel=1e-4)
+    assert int(fr["parallel_dof"]) == 1
+    assert float(fr["parallel_p"]) == pytest.approx(chi2.sf(2 * (common - free), 1), rel=1e-3)
+    assert bool(fr["parallel_rejected"]) and float(fr["parallel_p"]) < 1e-3
+    assert all("parallel_rejected" in str(r) for r in fr["reason"].values)
+    # the states drawn with one beta: not rejected
+    ok = F.fragility(nested_ds(80, 0.4, 0.4, 0.7, 0.4, seed=5), state=["theta:0.5",
+                     "overturn"], bootstrap=0, warn=False, joint=True)
+    assert not bool(ok["parallel_rejected"])
+
+
+def test_a_file_without_records_is_named_with_the_way_out(tmp_path):
+    import yaml
+    from click.testing import CliRunner
+
+    scene = tmp_path / "one.yaml"
+    scene.write_text(yaml.safe_dump({"body": {"kind": "block", "alpha": 0.2},
+                                     "impact": {"lam": 0.0},
+                                     "pulse": {"shape": "sine", "w_over_p": 4.0,
+                                               "A_ratio": [2.0, 3.0]}}))
+    out = tmp_path / "one.h5"
+    assert CliRunner().invoke(main, ["sweep", str(scene), "-o", str(out), "--quiet"]
+                              ).exit_code == 0
+    run = CliRunner().invoke(main, ["fragility", str(out)])
+    assert run.exit_code != 0
+    assert str(out) in run.output and "ground.records" in run.output
+    assert run.output.count("\n") == 1

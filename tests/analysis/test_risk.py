@@ -151,6 +151,9 @@ def test_openquake_poe_becomes_a_rate(tmp_path):
     poe[0] = 1.0  # a level certain to be exceeded: no rate, left out
     hz = read_hazard(oq_file(tmp_path / "hc.csv", T, "PGA", levels, [poe]))
     assert hz.name == "PGA" and hz.unit == "g"
+    assert hz.notes.startswith("1 level(s) with poe = 1 left out") and "0.005 g" in hz.notes
+    rk = rocksweep.risk(fragility(0.3, 0.4), hz)
+    assert rk.attrs["hazard_notes"] == hz.notes  # the result says what was left out
     np.testing.assert_allclose(hz.im, levels[1:], rtol=1e-5)  # 7 decimals in the header
     np.testing.assert_allclose(hz.rate, rate[1:], rtol=1e-5)
     # OpenQuake's PGV is in cm/s
@@ -288,7 +291,7 @@ def test_competing_modes_integrate_their_own_probabilities():
                      "status": (("lam", "record", "PGA"), np.zeros((1, R, 12), np.int32))},
                     coords={"lam": [0.0], "record": [f"r{i}" for i in range(R)],
                             "PGA": levels}, attrs={"scale_im": "PGA"})
-    fr = rocksweep.fragility(ds, state=["mode1", "mode2"], bootstrap=10)
+    fr = rocksweep.fragility(ds, state=["mode1", "mode2"], bootstrap=10, joint=True)
     assert set(fr.fit.values.tolist()) == {"competing"}
     x = np.geomspace(0.01, 5.0, 30)
     k0, k = 1e-4, 2.0
@@ -330,3 +333,12 @@ def test_an_avgsa_hazard_meets_the_closed_form():
     assert float(rk.annual_rate[0]) == pytest.approx(exact, rel=1e-6)
     with pytest.raises(RiskError, match="not the fragility's IM AvgSa"):
         rocksweep.risk(fr, power_law(k0, k), years=50)
+
+
+def test_an_openquake_header_says_only_what_it_misses(tmp_path):
+    path = oq_file(tmp_path / "hc.csv", 1.0, "PGA", [0.1, 0.2], [[0.1, 0.01]])
+    text = path.read_text().replace("investigation_time=1.0, ", "")
+    path.write_text(text)
+    with pytest.raises(RiskError, match="has no investigation_time: ") as err:
+        read_hazard(path)
+    assert "and no imt" not in str(err.value)  # imt is there: not named missing

@@ -52,11 +52,24 @@ def test_cli_table_csv_and_parquet(ds, suite_result, tmp_path):
     assert res.exit_code == 0, res.output
     back = pd.read_csv(csv)
     assert len(back) == ds.outcome.size and not back.duplicated().any()
+    # units in the header; the status in words
+    assert {"arias [m/s]", "PGA [g]", "d5_95 [s]", "outcome", "status_words"} <= set(
+        back.columns)
+    words = dict(zip(back["status"], back["status_words"].fillna(""), strict=True))
+    from rocksweep.kernel import layout as L  # noqa: N812
+
+    for bits, text in words.items():
+        assert ("overturned" in text.split(",")) == bool(bits & L.STATUS_OVERTURNED)
+    assert set(back["outcome_word"]) <= {"safe", "mode1", "mode2"}
     pq = tmp_path / "runs.parquet"
     pytest.importorskip("pyarrow", reason="Parquet needs pyarrow (the test extra)")
     assert CliRunner().invoke(main, ["table", str(suite_result), "-o", str(pq)]).exit_code == 0
     pd.testing.assert_frame_equal(pd.read_parquet(pq), rocksweep.table(ds),
                                   check_dtype=False)
+    import pyarrow.parquet as pqf
+
+    schema = pqf.read_schema(pq)
+    assert schema.field("arias").metadata[b"units"] == b"m/s"
     bad = CliRunner().invoke(main, ["table", str(suite_result), "-o", str(tmp_path / "x.txt")])
     assert bad.exit_code != 0 and bad.output.startswith("Error:") and ".parquet" in bad.output
 

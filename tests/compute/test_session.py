@@ -67,3 +67,48 @@ def test_the_command_checks_its_arguments_once(counts, cli, tmp_path):
     assert res.exit_code == 0, res.output
     assert counts["check_sweep_arguments"] == 1 and counts["check_output"] == 1
     assert counts["Grid"] == 1
+
+
+def test_flags_take_python_and_numpy_bools_only():
+    import numpy as np
+
+    from rocksweep.analysis.boundaries import check_search
+    from rocksweep.compute.arguments import check_flag
+    from rocksweep.errors import ApiError
+
+    assert check_flag("resume", np.True_) is True and check_flag("resume", False) is False
+    assert check_search(np.False_) is False
+    for bad in (1, "yes", np.int8(1), None):
+        with pytest.raises(TypeError, match="must be True or False"):
+            check_flag("resume", bad)
+        with pytest.raises(ApiError, match="must be True or False"):
+            check_search(bad)
+
+
+def test_a_closed_dask_client_is_refused_by_its_type():
+    distributed = pytest.importorskip("distributed")
+    from rocksweep.compute.session import client_backend
+    from rocksweep.errors import ApiError
+
+    class Scheduler:
+        address = "tcp://127.0.0.1:8786"
+
+    class Closed(distributed.Client):  # dask's type, without a cluster
+        def __init__(self) -> None:
+            self.status, self.scheduler = "closed", Scheduler()
+
+        def __repr__(self) -> str:
+            return "<Client: closed>"
+
+        def __del__(self) -> None:
+            pass
+
+    closed = Closed()
+    with pytest.raises(ApiError, match="this dask Client is closed"):
+        client_backend(closed)
+
+    class LookAlike:  # named Client, with a scheduler, but not dask's
+        status, scheduler = "closed", Scheduler()
+
+    LookAlike.__name__ = "Client"
+    assert client_backend(LookAlike()) == {"backend": "dask", "scheduler": Scheduler.address}

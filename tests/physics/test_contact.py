@@ -85,8 +85,8 @@ def test_rocking_reactions_equal_sympy_derivation(body_fig3, reactions_sympy):
         uu, v, xg = rng.uniform(-0.5, 0.5), rng.uniform(-2, 2), rng.uniform(-20, 20)
         for s in (1, -1):
             for damped in (True, False):
-                got = contact.ground_reactions(th, w, uu, v, s, xg, row, True, damped)
-                thdd, udd, _, _ = eq.rocking_rhs(th, w, uu, v, s, xg, row, damped)
+                got = contact.ground_reactions(th, w, uu, v, s, xg, 9.81, row, True, damped)
+                thdd, udd, _, _ = eq.rocking_rhs(th, w, uu, v, s, xg, 9.81, row, damped)
                 args = (th, w, uu, v, thdd, udd, xg, s, bd.m, bd.m_A, bd.h, bd.h_A, bd.b, 9.81)
                 scale = bd.M * (9.81 + abs(xg))
                 assert got[0] == pytest.approx(f_H(*args), abs=1e-11 * scale)
@@ -103,8 +103,8 @@ def test_rigid_reactions_equal_sympy_derivation(reactions_sympy):
     for _ in range(30):
         th, w, xg = rng.uniform(-1.3, 1.3), rng.uniform(-2, 2), rng.uniform(-10, 10)
         for s in (1, -1):
-            got = contact.ground_reactions(th, w, 0.0, 0.0, s, xg, row, False, False)
-            thdd = eq.rigid_rhs(th, w, s, xg, row)[0]
+            got = contact.ground_reactions(th, w, 0.0, 0.0, s, xg, 9.81, row, False, False)
+            thdd = eq.rigid_rhs(th, w, s, xg, 9.81, row)[0]
             args = (th, w, 0.0, 0.0, thdd, 0.0, xg, s, blk.M, 0.0, blk.h_cg, 0.0, blk.b, 9.81)
             assert got[0] == pytest.approx(f_H(*args), rel=1e-11, abs=1e-11)
             assert got[1] == pytest.approx(f_N(*args), rel=1e-11, abs=1e-11)
@@ -116,7 +116,7 @@ def test_full_contact_reactions(body_fig4, reactions_sympy):
     bd = body_fig4
     row = _row(bd)
     for uu, v, xg in [(0.1, -0.3, 4.0), (-0.2, 0.5, -7.0), (0.0, 0.0, 2.5)]:
-        H, N = contact.ground_reactions(0.0, 0.0, uu, v, 0, xg, row, True, True)
+        H, N = contact.ground_reactions(0.0, 0.0, uu, v, 0, xg, 9.81, row, True, True)
         assert N == bd.M * 9.81
         udd = eq.contact_rhs(uu, v, xg, row, True)[0]
         want = f_H(0.0, 0.0, uu, v, 0.0, udd, xg, 1, bd.m, bd.m_A, bd.h, bd.h_A, bd.b, 9.81)

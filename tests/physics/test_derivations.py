@@ -69,7 +69,7 @@ def test_rocking_equations_equal_lagrange_derivation(body_fig3, lagrange_solutio
         th, w = rng.uniform(-1.2, 1.2), rng.uniform(-2, 2)
         uu, v, xg = rng.uniform(-0.5, 0.5), rng.uniform(-2, 2), rng.uniform(-20, 20)
         for corner in (1, -1):
-            got = eq.rocking_rhs(th, w, uu, v, corner, xg, row, True)
+            got = eq.rocking_rhs(th, w, uu, v, corner, xg, 9.81, row, True)
             args = (th, w, uu, v, corner, xg, bd.m, bd.m_A, bd.I_A, bd.h, bd.h_A, bd.b, 9.81,
                     bd.k, bd.c)
             want = accelerations(*args)
@@ -97,7 +97,7 @@ def test_rigid_equation_is_welded_flexible_one(body_fig3):
         rhs = sp.lambdify((th, xg_), (-sp.diff(bd.M * 9.81 * G[1], th)
                                       - xg_ * bd.M * sp.diff(G[0], th)) / bd.I_O)
         for theta, xg in [(0.05, 3.0), (0.4, -2.0), (-0.3, 1.0)]:
-            assert eq.rigid_rhs(theta, 0.7, corner, xg, row)[0] == pytest.approx(
+            assert eq.rigid_rhs(theta, 0.7, corner, xg, 9.81, row)[0] == pytest.approx(
                 rhs(theta, xg), rel=1e-12)
 
 

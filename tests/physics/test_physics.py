@@ -34,9 +34,9 @@ def test_uplift_moment_matches_rocking_equation_at_rest(body_fig3):
     rng = np.random.default_rng(3)
     for _ in range(50):
         u, v, xg = rng.uniform(-0.3, 0.3), rng.uniform(-1, 1), rng.uniform(-10, 10)
-        q = eq.uplift_moment(u, v, xg, row, True, True)
+        q = eq.uplift_moment(u, v, xg, G, row, True, True)
         for s in (1, -1):
-            th_dd = eq.rocking_rhs(0.0, 0.0, u, v, s, xg, row, True)[0]
+            th_dd = eq.rocking_rhs(0.0, 0.0, u, v, s, xg, G, row, True)[0]
             # theta'' (I_A0 + m a^2) = Q - s M g b: rocking on s starts iff s Q > M g b
             assert s * th_dd > 0 if s * q > mgb else s * th_dd <= 0
 

@@ -59,6 +59,39 @@ def test_the_same_run_as_its_pi_groups():
         assert a[key] == b[key]
 
 
+def test_a_physical_bodys_p_is_in_the_summary_json_file_and_info(tmp_path):
+    import json
+
+    import yaml
+    from click.testing import CliRunner
+
+    from rocksweep.cli import main
+
+    M = LAB["m"] + LAB["m_A"]
+    hcg = (LAB["m"] * LAB["h"] + LAB["m_A"] * LAB["h_A"]) / M
+    b = LAB["b"]
+    p = math.sqrt(M * G * math.hypot(b, hcg) / (LAB["I_A"] + LAB["m_A"] * (b * b + LAB["h_A"]
+                  ** 2) + LAB["m"] * (b * b + LAB["h"] ** 2)))
+    assert rocksweep.simulate(scene()).summary["p"] == pytest.approx(p, rel=1e-12)
+    path = tmp_path / "lab.yaml"
+    path.write_text(yaml.safe_dump(scene()))
+    run = CliRunner().invoke(main, ["simulate", str(path), "--json"])
+    assert run.exit_code == 0, run.output
+    assert json.loads(run.output)["p"] == pytest.approx(p, rel=1e-12)
+    out = tmp_path / "lab.h5"
+    two = {**scene(), "impact": {"lam": [0.1, 0.2]}}
+    path.write_text(yaml.safe_dump(two))
+    assert CliRunner().invoke(main, ["sweep", str(path), "-o", str(out), "--quiet"]
+                              ).exit_code == 0
+    assert float(rocksweep.open(out).attrs["p"]) == pytest.approx(p, rel=1e-12)
+    info = CliRunner().invoke(main, ["info", str(out), "--json"])
+    assert json.loads(info.output)["p"] == pytest.approx(p, rel=1e-12)
+    assert f"p = {p:.5g} rad/s" in CliRunner().invoke(main, ["info", str(out)]).output
+    # a body of Pi groups has no p of its own
+    assert "p" not in rocksweep.simulate({**scene(), "body": {"kind": "block",
+                                                               "alpha": 0.2}}).summary
+
+
 def test_physical_columns_use_the_body_s_p():
     """A measured history in seconds and radians is read with the body's own p."""
     sim = rocksweep.simulate(scene(), {"impact.lam": 0.3, "numerics.steps_per_period": 200})

@@ -106,7 +106,8 @@ STRUCTURE_CASES = [
      "body = 3: must be a mapping with keys wn_over_p, zeta, alpha_cg, alpha_A, mA_over_m, "
      "IA_ratio (a flexible body), or kind: block, alpha, inertia"),
     (GOOD.replace("pulse: {shape: sine, w_over_p: 5.3, A_ratio: 5.0}", "pulse: [1, 2]"),
-     "pulse = [1, 2]: must be a mapping with keys shape, w_over_p, A_ratio, cycles, gamma, nu"),
+     "pulse = [1, 2]: must be a mapping with keys shape, w_over_p, A_ratio, cycles, gamma, nu, "
+     "vertical"),
     (sub("wn_over_p: 2.43", "kind: [block], wn_over_p: 2.43"),
      "body.kind = ['block']: must be one of flexible, block, physical"),
     (sub("zeta: 0.05", "zeta: 0.05, zta: 1"),
