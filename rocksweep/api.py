@@ -136,8 +136,11 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
     while a sweep is still writing the file (no lock is taken). A file that is not a
     rocksweep file is a one-line ``RocksweepError``.
     """
+    import os
+
     from rocksweep.analysis.files import open_any
 
+    _typed("path", path, isinstance(path, str | os.PathLike), "a path (str or pathlib.Path)")
     return open_any(path)
 
 
@@ -218,7 +221,7 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     (Figures 3 and 4; the options below), or the figure of a fragility (curves, stripe
     fractions sized by record count, bands, beta in the legend, IM on a log axis), IDA,
     spectra, risk (hazard, fragility, the rate's integrand) or IM-efficiency Dataset
-    (``rocksweep.figures.dispatch``; ``ax`` and ``width`` apply to all). A record-suite
+    (``rocksweep.figures.by_kind``; ``ax`` and ``width`` apply to all). A record-suite
     sweep is drawn as its overturning fragility (stripe fractions and the fitted curve).
 
     ds: what ``run`` or ``open`` returns. x, y: the swept keys on the axes (default
@@ -233,7 +236,7 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     are compared on one diagram, coloured by which of them overturn each cell. A result
     with per-point error estimates rings the points whose outcome changes at half the step.
     """
-    from rocksweep.figures.dispatch import plot_any
+    from rocksweep.figures.by_kind import plot_any
 
     _check_dataset("ds", ds)
     _check_ax(ax)
@@ -295,6 +298,18 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3, search: bool = True) -> xr.Datas
 
 
 @_public
+def floor_spectrum(ds: xr.Dataset, rtol: float = 1e-2, search: bool = True) -> xr.Dataset:
+    """The floor spectrum of a complete sweep over ``floor.period``: a record suite's
+    P(overturn) over (floor.period, stripe, ...) (with an ``angle`` axis for each
+    orientation answer: ``orientation`` each/worst), or one record's or a pulse's A_min
+    over floor.period, bisected to ``rtol`` (``rocksweep.analysis.floors``). Its figure:
+    ``rocksweep.plot``."""
+    from rocksweep.analysis.floors import floor_spectrum as compute
+
+    return compute(ds, rtol, search)
+
+
+@_public
 def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
     """Incremental dynamic analysis per record of a scaled record-suite sweep: the
     smallest IM (the stripe IM: PGA [g], PGV [m/s], Sa [g], ...) that overturns each
@@ -303,11 +318,14 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
     safe again (``resurrection``). ds: what ``run`` or ``open`` returns. Returns a Dataset
     over the other swept keys and ``record`` (``rocksweep.analysis.ida.ida``), with the
     stripes' ``theta_max_over_alpha`` of the points that did not overturn (the IDA
-    curves ``rocksweep.plot`` draws)."""
+    curves ``rocksweep.plot`` draws). A sweep over ``angle``: every (record, angle) is a
+    sample (``ida_im`` over angle), and ``ida_im_worst`` / ``worst_angle`` give each
+    record's worst orientation (the least IM that overturns it at any angle)."""
+    from rocksweep.analysis.floors import worst_ida
     from rocksweep.analysis.ida import ida_dataset
 
     _check_dataset("ds", ds)
-    return ida_dataset(ds, rtol)
+    return worst_ida(ida_dataset(ds, rtol))
 
 
 @_public
@@ -339,12 +357,20 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     should not be trusted as it is: also a ``FragilityWarning``), the counts
     ``n_records``, ``n_excluded``, ``n_not_run``, the fitted ``curve`` and its bands over
     ``im_grid``; for stripes ``fraction`` per stripe and ``first_level``,
-    ``resurrection`` per record.
+    ``resurrection`` per record. A sweep over ``angle`` gives both answers along an
+    ``orientation`` dimension: "each" (every (record, angle) a sample) and "worst" (the
+    worst angle per record: overturns at any angle).
     """
+    from rocksweep.analysis.floors import by_orientation
     from rocksweep.analysis.fragility import fragility as fit
 
-    return fit(_dataset_arg(ds, "ds"), state=state, im=im, period=period,
-               bootstrap=bootstrap, seed=seed, ci=ci, joint=joint)
+    ds = _dataset_arg(ds, "ds")
+    if "angle" in getattr(ds, "dims", ()):  # every orientation a sample, and the worst
+        return by_orientation(ds, lambda d: fit(
+            d, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci,
+            joint=joint))
+    return fit(ds, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci,
+               joint=joint)
 
 
 @_public
@@ -463,6 +489,9 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     """
     from rocksweep.analysis.calibrate import calibrate_scene
 
+    _typed("fit", fit, isinstance(fit, str) or (
+        isinstance(fit, Sequence) and all(isinstance(k, str) for k in fit)),
+        "a dotted scene key (e.g. 'impact.lam') or a list of them")
     _typed("bounds", bounds, bounds is None or isinstance(bounds, Mapping),
            "a mapping {key: (lo, hi)}, e.g. {'impact.lam': (0, 1)}, or None")
     _typed("p", p, p is None or _is_number(p), "a number (the body's p [rad/s]) or None")
@@ -478,6 +507,12 @@ def calibrated_overrides(fit: xr.Dataset, which: str = "all") -> dict[str, Any]:
     at the estimate and at both ends of the interval: ``which="all"`` gives [lo, estimate,
     hi] per key (a swept dimension), "estimate", "lo" or "hi" one value.
     ``rocksweep.run(scene, overrides=rocksweep.calibrated_overrides(fit))``."""
+    import xarray as xr
+
     from rocksweep.analysis.calibrate import calibrated_overrides as overrides_of
 
+    _typed("fit", fit, isinstance(fit, xr.Dataset), "the Dataset rocksweep.calibrate returns")
+    if "parameter" not in fit.coords or "estimate" not in fit.variables:
+        raise ApiError("fit: not a calibration (no parameter and estimate; what "
+                       "rocksweep.calibrate returns)")
     return overrides_of(fit, which)

@@ -178,7 +178,7 @@ class FragilityFigureError(RocksweepError, ValueError):
 
 
 class PlotError(RocksweepError, ValueError):
-    """A Dataset that has no figure (figures.dispatch)."""
+    """A Dataset that has no figure (figures.by_kind)."""
 
 
 class AnalysisWarning(UserWarning):

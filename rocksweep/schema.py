@@ -208,6 +208,15 @@ KEYS: dict[str, Key] = {
                                0.0, math.inf, lo_in=False, hi_in=False),
     "ground.scale.period": Key("number", "must be in (0, 100] s (the period of Sa)", 0.0,
                                100.0, lo_in=False),
+    "ground.scale.component": Key("choice", "must be H1 (the first horizontal's IM) or "
+                                  "RotD50 (the median over orientations of both "
+                                  "horizontals', NGA-West2's convention; a suite of PEER "
+                                  "folders)", choices=("H1", "RotD50"), required=False,
+                                  default="H1"),
+    "ground.missing": Key("choice", "must be error (a record of a PEER folder without one "
+                          "of its components is refused) or skip (left out, with a "
+                          "warning)", choices=("error", "skip"), required=False,
+                          default="error"),
     "ground.scale.factor": Key("number", "must be a finite number > 0 (every record times "
                                "this factor)", 0.0, math.inf, lo_in=False, hi_in=False),
     "ground.periods": Key("string", "must be a list of periods in [0, 100] s (Sa stored per "
@@ -230,6 +239,26 @@ KEYS: dict[str, Key] = {
     "ground.avgsa": Key("string", "must be [T_lo, T_hi], periods in (0, 100] s with T_lo <= "
                         "T_hi (AvgSa's range; default 0.2-3 x scale.period for Sa stripes, "
                         "else 0.2-3 x 2 pi/p)", 0.0, 100.0, required=False),
+    # the excitation path (rocksweep.physics.path): a second horizontal component and the
+    # body's orientation; a building's floor between the ground and the body
+    "ground.h2": Key("string", "must be the path of the second horizontal component (PEER "
+                     ".AT2 or two-column, the first component's DT), relative to the scene "
+                     "file", required=False),
+    "ground.angle": Key("axis", "must be in [0, 360) deg (the angle between the body's "
+                        "rocking plane and the first horizontal component)", 0.0, 360.0,
+                        hi_in=False, required=False, default=0.0),
+    "floor.period": Key("axis", "must be a finite number > 0 [s] (the building mode's "
+                        "period)", 0.0, math.inf, lo_in=False, hi_in=False, required=False),
+    "floor.damping": Key("axis", "must be in (0, 1) (the building mode's damping ratio; an "
+                         "undamped building would ring for ever)", 0.0, 1.0, lo_in=False,
+                         hi_in=False, required=False),
+    "floor.participation": Key("axis", "must be a finite number other than 0 (Gamma phi: "
+                               "the mode's participation factor times its shape at the "
+                               "floor)", -math.inf, math.inf, lo_in=False, hi_in=False,
+                               required=False),
+    "floor.modes": Key("string", "must be a list of modes {period: T [s], damping: zeta, "
+                       "participation: Gamma phi} (numbers; sweep the one-mode form "
+                       "floor: {period, damping, participation})", required=False),
     "ground.p": Key("axis", f"must be in [1e-3, {1e3:g}] rad/s (the body's frequency "
                     "parameter p)", 1e-3, 1e3),
     # the vertical ground acceleration a_v, positive up (docs/vertical.md): a record's
@@ -261,7 +290,8 @@ BODY_KEYS: dict[str, tuple[str, ...]] = {
     "block": ("alpha", "inertia"),
     "physical": ("b", "h", "h_A", "m", "m_A", "I_A", "k", "c"),
 }
-SECTIONS = ("body", "impact", "pulse", "numerics", "outputs", "ground", "refine", "initial")
+SECTIONS = ("body", "impact", "pulse", "numerics", "outputs", "ground", "refine", "initial",
+            "floor")
 
 
 def section_keys(section: str, kind: str = "flexible") -> tuple[str, ...]:

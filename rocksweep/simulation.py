@@ -34,6 +34,6 @@ class Simulation:
     def figure(self) -> Figure:
         """Figure 5 for this run (pulse, theta/alpha, E/E_ref, dissipated energy against
         p*t) as a pyplot-free matplotlib Figure: show it in a notebook or ``savefig``."""
-        from rocksweep.figures.common import time_history
+        from rocksweep.figures.history import time_history
 
         return time_history([self.run], (), self.title)

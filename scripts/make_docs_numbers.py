@@ -15,6 +15,11 @@ Numbers (``COMPUTE``):
 - ``impact_laws``: the mode 1 share of the 80 x 80 grid of ``configs/impact-laws.yaml``
   per law and lam (``rocksweep sweep``; ~1 min on 2 cores): the table of
   docs/impact_laws.md and the sentence of README.md.
+- ``demo``: the demo suite (``configs/fragility-demo.yaml``, 960 runs): every IM's
+  ``beta_scale`` (``rocksweep.im_efficiency``) and the annual rates of theta:0.25 and
+  overturning under ``configs/hazard-example.csv`` (``rocksweep.fragility`` of
+  theta:0.25, theta:0.5, overturn, each alone; ``rocksweep.risk``, 50 years): the
+  sentences of docs/risk.md.
 """
 
 from __future__ import annotations
@@ -22,6 +27,7 @@ from __future__ import annotations
 import json
 import re
 import sys
+import textwrap
 from pathlib import Path
 
 import _here  # noqa: F401 (this checkout's package first)
@@ -56,7 +62,30 @@ def compute_impact_laws() -> dict:
                        "of the 80 x 80 grid)", "shares": shares}
 
 
-COMPUTE = {"impact_laws": compute_impact_laws}
+def compute_demo() -> dict:
+    """The demo suite's beta_scale per IM and lam, and its rates (module docstring)."""
+    import warnings
+
+    import rocksweep
+
+    warnings.simplefilter("ignore")  # the demo's record warnings: said in the docs
+    ds = rocksweep.run(ROOT / "configs" / "fragility-demo.yaml", jobs=2)
+    eff = rocksweep.im_efficiency(ds)
+    lams = [f"{v:g}" for v in ds["lam"].values]
+    beta = {str(im): [round(float(v), 2) for v in eff["beta_scale"].sel(im=im).values]
+            for im in eff["im"].values}
+    fr = rocksweep.fragility(ds, state=["theta:0.25", "theta:0.5", "overturn"])
+    rk = rocksweep.risk(fr, ROOT / "configs" / "hazard-example.csv", years=50)
+    rate = {st: [float(f"{float(v):.2g}") for v in rk["annual_rate"].sel(state=st).values]
+            for st in ("theta:0.25", "overturn")}
+    prob = [round(100.0 * float(v), 1) for v in rk["probability"].sel(state="overturn")]
+    return {"command": "rocksweep.run(configs/fragility-demo.yaml); im_efficiency; "
+                       "fragility(theta:0.25, theta:0.5, overturn); risk(hazard-example, "
+                       "50 years)", "lam": lams, "beta_scale": beta, "rate": rate,
+            "p50_overturn": prob}
+
+
+COMPUTE = {"impact_laws": compute_impact_laws, "demo": compute_demo}
 
 
 def _pct(v: float) -> str:
@@ -83,7 +112,52 @@ def render_impact_laws(d: dict) -> dict[str, str]:
     return {"docs/impact_laws.md": "\n".join(rows), "README.md": sentence}
 
 
-RENDER = {"impact_laws": render_impact_laws}
+#: how docs/risk.md names the efficiency's IMs
+IM_LABEL = {"PGV_over_PGA": "PGV/PGA", "D5_95": "D5-95", "Sa(1)": "Sa(1 s)",
+            "Sa(0.2)": "Sa(0.2 s)", "PGA_ratio": "PGA/(g tan alpha)",
+            "PGV_ratio": "PGV p/(g tan alpha)"}
+
+
+def _rate(x: float) -> str:
+    """7.1e-4 (two digits, the exponent without padding)."""
+    m, e = f"{x:.1e}".split("e")
+    return f"{m}e{int(e)}"
+
+
+def _span(v: list[float], fmt=_rate) -> str:
+    lo, hi = (fmt(x) for x in (min(v), max(v)))
+    return lo if lo == hi else f"{lo}-{hi}"
+
+
+def _two(x: float) -> str:
+    return f"{x:.2f}"
+
+
+def _one(x: float) -> str:
+    return f"{x:.1f}"
+
+
+def render_demo(d: dict) -> dict[str, str]:
+    """docs/risk.md's two sentences: the IMs best first (beta_scale per lam, or its span
+    over lam), and the rates."""
+    lams = " / ".join(d["lam"])
+    best = sorted(((im, v) for im, v in d["beta_scale"].items()
+                   if im not in ("PGA_ratio", "PGV_ratio")),  # PGA's and PGV's own beta
+                  key=lambda kv: sum(kv[1]))
+    parts = [f"{IM_LABEL.get(im, im)} {' / '.join(f'{x:.2f}' for x in v)}" if k < 2 else
+             f"{IM_LABEL.get(im, im)} {_span(v, _two)}" for k, (im, v) in enumerate(best)]
+    eff = (f"On the demo suite (Figure 3(a) body, 20 records, PGA stripes), beta_scale per "
+           f"lam {lams}: " + ", ".join(parts) + ".")
+    r, p = d["rate"], d["p50_overturn"]
+    risk = (f"with the illustrative `configs/hazard-example.csv` (each state fitted alone): "
+            f"overturning {_span(r['overturn'])} /yr (lam {d['lam'][0]} to "
+            f"{d['lam'][-1]}), P(50 yr) {_span(p, _one)}%; theta:0.25 "
+            f"{_span(r['theta:0.25'])} /yr.")
+    return {"docs/risk.md": {"demo_efficiency": textwrap.fill(eff, 90),
+                             "demo_risk": textwrap.fill(risk, 90)}}
+
+
+RENDER = {"impact_laws": render_impact_laws, "demo": render_demo}
 
 
 def _markers(name: str) -> tuple[str, str]:
@@ -110,7 +184,9 @@ def pages(numbers: dict) -> dict[Path, str]:
     for name, render in RENDER.items():
         for page, body in render(numbers[name]).items():
             path = ROOT / page
-            out[path] = with_block(out.get(path, path.read_text()), name, body)
+            # a page may hold several blocks of one computation: {block name: text}
+            for block, text in (body.items() if isinstance(body, dict) else [(name, body)]):
+                out[path] = with_block(out.get(path, path.read_text()), block, text)
     return out
 
 

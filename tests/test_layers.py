@@ -100,3 +100,18 @@ def test_the_checker_sees_a_climb():
     assert floor_of(found[0][1]) > floor_of("rocksweep.physics.bodies")
     typed = "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    import rocksweep.api\n"
     assert imports(ast.parse(typed), "rocksweep.physics.bodies") == []
+
+
+def test_the_store_scenes_and_computing_take_no_private_name_from_another_module():
+    """What a module of ``store/``, ``scene/`` or ``compute/`` takes from another module is
+    public there: a leading underscore says "used here only", and nothing else does."""
+    taken = []
+    for room in ("store", "scene", "compute"):
+        for path in sorted((PKG / room).rglob("*.py")):
+            for node in ast.walk(ast.parse(path.read_text())):
+                if isinstance(node, ast.ImportFrom) and (node.module or "").startswith(
+                        "rocksweep"):
+                    taken += [f"{path.relative_to(PKG.parent)}:{node.lineno} {a.name}"
+                              for a in node.names
+                              if a.name.startswith("_") and not a.name.startswith("__")]
+    assert not taken, "private names imported from another module:\n" + "\n".join(taken)

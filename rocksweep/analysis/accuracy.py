@@ -59,11 +59,6 @@ MEASURE_LABELS = {
     "t_overturn": "|d t_overturn| (p*t)",
     "impacts": "mean |d impacts|",
 }
-# measures of the tails only (not drawn in the work-precision diagram)
-TAIL_LABELS = {
-    "theta_rel": "|d theta_max|/theta_max",
-    "energy": "|energy balance|/E_ref",
-}
 # theta_rel is taken where the reference's theta_max is at least this x alpha_cg
 THETA_REL_FLOOR = fields.THETA_REL_FLOOR
 # Error bounds against which ``--check`` scores the per-point error estimates (the

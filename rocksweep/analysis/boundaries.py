@@ -373,7 +373,7 @@ class _Column:
         """The column's point with ``name`` (the searched axis) = value: the first grid
         point with A_ratio replaced (one body object for the column: its rows are filled
         at once), else ``scene.point``."""
-        if name != "A_ratio" or scene.suite is not None:
+        if name != "A_ratio" or scene.suite is not None or scene.path is not None:
             return scene.point({**self.values, name: value})
         if self.base is None:
             self.base = scene.point(self.values)

@@ -73,11 +73,12 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
+from rocksweep.analysis.peaks import Peaks, alignment_cost, excursions, hermite, onset
 from rocksweep.compute.dispatch import run_variant
 from rocksweep.errors import CalibrationError, RocksweepError, set_key  # noqa: F401 (CalibrationError re-exported)
 from rocksweep.kernel import layout as L  # noqa: N812
@@ -87,14 +88,13 @@ from rocksweep.physics.bodies import BodyError
 from rocksweep.physics.measured import Measured, noise_level, read_measured
 from rocksweep.physics.points import INITIAL, kernel_kind, point_row
 from rocksweep.schema import KEYS, fmt
+from rocksweep.vocab.axes import axis_name
 from rocksweep.vocab.kinds import CALIBRATION, KIND_ATTR
 from rocksweep.vocab.laws import CONSTANT
 
 ACCURACY = "fine"  # the least accuracy of a calibration's runs (``calibration_numerics``)
 H_NOISE = 4.0  # threshold of an excursion, in noise standard deviations ...
 H_REL = 0.02  # ... and at least this share of the largest |theta|
-PEAK_TOP = 0.5  # a peak's parabola goes through the samples above this share of it ...
-PEAK_RAMP = 0.2  # ... weighted from 0 there to 1 at PEAK_TOP + PEAK_RAMP
 GRID = 21  # first look of a one-parameter fit: GRID values across the bounds
 GRID_2D = 9  # ... and GRID_2D^2 for two parameters
 STAGES = (3, 6, 12, 24, 48, 96, 192)  # half cycles compared at each stage of ``_fit``
@@ -135,15 +135,6 @@ def calibration_numerics(n: Numerics) -> Numerics:
     return replace(fine, horizon=n.horizon, rest_rate=n.rest_rate, max_events=n.max_events)
 
 
-@dataclass(frozen=True)
-class Peaks:
-    """Excursions of a history: signed peak (theta/alpha) float64[n], peak time float64[n]."""
-
-    value: np.ndarray
-    time: np.ndarray
-    area: np.ndarray | None = None  # integral of |theta| over each excursion [theta/alpha p t]
-
-
 class _Result:
     """What a one-dimensional minimisation found (``x``, ``fun``), as scipy's result."""
 
@@ -170,142 +161,6 @@ def _golden(f: Any, bounds: tuple[float, float], xatol: float) -> _Result:
     return _Result(a, fa) if fa <= fb else _Result(b, fb)
 
 
-def excursions(t: np.ndarray, theta: np.ndarray, h: float) -> Peaks:
-    """The excursions of a sampled history beyond the threshold h (see the module
-    docstring, step 1). t: float64[n] increasing; theta: float64[n]."""
-    big = np.flatnonzero(np.abs(theta) > h)
-    if big.size == 0:
-        return Peaks(np.zeros(0), np.zeros(0), np.zeros(0))
-    sign = np.sign(theta[big])
-    new = np.ones(big.size, bool)
-    new[1:] = sign[1:] != sign[:-1]
-    starts = np.flatnonzero(new)
-    # the largest sample of each group of samples beyond h
-    signed = sign * theta[big]
-    ends = np.append(starts[1:], big.size)
-    arg = np.array([s + int(np.argmax(signed[s:e])) for s, e in zip(starts, ends,
-                                                                       strict=True)])
-    k = big[arg]
-    sg = sign[starts]
-    value, when = theta[k].copy(), t[k].copy()
-    # a parabola through the top of each excursion (the samples within PEAK_TOP of its
-    # largest): the largest sample alone is biased up by the noise (the largest of several
-    # noisy samples), a least-squares fit through many is not
-    first = big[starts]
-    last = big[ends - 1]
-    n = t.size
-    area = np.empty(k.size)
-    for j in range(k.size):
-        a, b = int(first[j]), int(last[j]) + 1
-        seg = sg[j] * theta[a:b]
-        # the area beyond the threshold, int max(|theta| - h, 0) dt from the sample before
-        # to the sample after: many samples average the noise, and a sample near the
-        # threshold (or after a gap) weighs ~0, so the area is continuous in the parameters
-        a0, b0 = max(a - 1, 0), min(b + 1, n)
-        over = np.maximum(sg[j] * theta[a0:b0] - h, 0.0)
-        area[j] = float(np.sum(0.5 * (over[1:] + over[:-1]) * np.diff(t[a0:b0])))
-        # weights rise from 0 at PEAK_TOP of the largest to 1 at PEAK_TOP + PEAK_RAMP:
-        # a sample entering the top as the parameters change enters with weight 0, so the
-        # peak is continuous in the parameters
-        wgt = np.clip((seg / seg.max() - PEAK_TOP) / PEAK_RAMP, 0.0, 1.0)
-        top = np.flatnonzero(wgt > 0) + a
-        if top.size < 4:
-            continue
-        tt = t[top] - t[k[j]]
-        c2, c1, c0 = np.polyfit(tt, theta[top], 2, w=np.sqrt(wgt[top - a]))
-        tv = -c1 / (2 * c2) if sg[j] * c2 < 0 else (tt[0] if sg[j] * c1 < 0 else tt[-1])
-        tv = min(max(tv, tt[0]), tt[-1])  # the top at an end (a release from a tilt)
-        value[j] = c0 + c1 * tv + c2 * tv * tv
-        when[j] = t[k[j]] + tv
-    return Peaks(value, when, area)
-
-
-def alignment_cost(a: np.ndarray, b: np.ndarray, h: float, band: int = 12,
-                   area_a: np.ndarray | None = None, area_b: np.ndarray | None = None,
-                   t_scale: float = 1.0) -> tuple[float, list[tuple[int, int]]]:
-    """Least cost of aligning two signed peak sequences (module docstring, step 2) and the
-    pairs (i, j) of that alignment. ``band``: pairs with |i - j| beyond it are not tried
-    (the cost of the rest is exact within the band)."""
-    fa = np.maximum(np.abs(a) - h, 0.0)
-    fb = np.maximum(np.abs(b) - h, 0.0)
-    if area_a is not None and area_b is not None:  # the areas, as mean levels
-        ga, gb = area_a / t_scale, area_b / t_scale
-        fa = np.stack([fa, ga], axis=1)
-        fb = np.stack([fb, gb], axis=1)
-    else:
-        fa, fb = fa[:, None], fb[:, None]
-    fa2, fb2 = np.sum(fa**2, axis=1), np.sum(fb**2, axis=1)
-    n, m = a.size, b.size
-    inf = math.inf
-    d = np.full((n + 1, m + 1), inf)
-    d[0, 0] = 0.0
-    sa, sb = np.sign(a), np.sign(b)
-
-    def pair(i: int, j: int) -> float:
-        if sa[i] == sb[j]:
-            return float(np.sum((fa[i] - fb[j]) ** 2))
-        return float(fa2[i] + fb2[j])
-
-    for j in range(1, m + 1):
-        d[0, j] = d[0, j - 1] + fb2[j - 1] if j <= band else inf
-    for i in range(1, n + 1):
-        if i <= band:
-            d[i, 0] = d[i - 1, 0] + fa2[i - 1]
-        lo, hi = max(1, i - band), min(m, i + band)
-        for j in range(lo, hi + 1):
-            d[i, j] = min(d[i - 1, j - 1] + pair(i - 1, j - 1), d[i - 1, j] + fa2[i - 1],
-                          d[i, j - 1] + fb2[j - 1])
-    if not math.isfinite(d[n, m]):  # longer than the band allows: the rest unpaired
-        return float(np.sum(fa2) + np.sum(fb2)), []
-    pairs = []
-    i, j = n, m
-    while i > 0 and j > 0:
-        if math.isclose(d[i, j], d[i - 1, j - 1] + pair(i - 1, j - 1), rel_tol=1e-12,
-                        abs_tol=1e-300):
-            if sa[i - 1] == sb[j - 1]:
-                pairs.append((i - 1, j - 1))
-            i, j = i - 1, j - 1
-        elif math.isclose(d[i, j], d[i - 1, j] + fa2[i - 1], rel_tol=1e-12, abs_tol=1e-300):
-            i -= 1
-        else:
-            j -= 1
-    return float(d[n, m]), pairs[::-1]
-
-
-def hermite(t_h: np.ndarray, y: np.ndarray, dy: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """A history's y at times t by cubic Hermite interpolation of (y, y') between its rows
-    (t_h non-decreasing; at a repeated time, as after an event, the later row is used);
-    beyond its ends, its first or last value."""
-    i = np.searchsorted(t_h, t, side="right") - 1
-    i = np.clip(i, 0, t_h.size - 2)
-    t0, t1 = t_h[i], t_h[i + 1]
-    h = t1 - t0
-    with np.errstate(invalid="ignore", divide="ignore"):
-        s = np.where(h > 0, (t - t0) / h, 0.0)
-    s = np.clip(s, 0.0, 1.0)
-    h00 = 2 * s**3 - 3 * s**2 + 1
-    h10 = s**3 - 2 * s**2 + s
-    h01 = -2 * s**3 + 3 * s**2
-    h11 = s**3 - s**2
-    out = h00 * y[i] + h10 * h * dy[i] + h01 * y[i + 1] + h11 * h * dy[i + 1]
-    out = np.where(t >= t_h[-1], y[-1], out)
-    return np.where(t <= t_h[0], y[0], out)
-
-
-def _onset(t: np.ndarray, theta: np.ndarray, level: float) -> float:
-    """The time a history first departs from its first value by ``level``, interpolated
-    between samples."""
-    d = np.abs(theta - theta[0])
-    k = np.flatnonzero(d > level)
-    if k.size == 0:
-        return math.nan
-    i = int(k[0])
-    if i == 0:
-        return float(t[0])
-    f = (level - d[i - 1]) / (d[i] - d[i - 1])
-    return float(t[i - 1] + f * (t[i] - t[i - 1]))
-
-
 class Problem:
     """A scene's one point, a measured history and the keys to fit: the misfit of any
     candidate values (``misfit``) and the histories behind it (``evaluate``)."""
@@ -328,7 +183,7 @@ class Problem:
                                                                           measured.theta)
         amp = float(np.max(np.abs(measured.theta)))
         self.h = max(H_NOISE * self.sigma, H_REL * amp)
-        self.t_onset = _onset(measured.t, measured.theta, self.h)
+        self.t_onset = onset(measured.t, measured.theta, self.h)
         if not math.isfinite(self.t_onset):
             raise CalibrationError(f"{measured.source}: theta_over_alpha never departs from "
                                    f"its first value by more than {self.h:.3g} (4 x the "
@@ -436,10 +291,10 @@ class Problem:
         gently for the threshold alone)."""
         t_rel = self.m.t - self.m.t[0]
         th = hermite(h["t"], h["theta"], h["theta_dot"], t_rel)
-        onset = _onset(t_rel, th, self.h)
-        if not math.isfinite(onset):
+        t_sim = onset(t_rel, th, self.h)
+        if not math.isfinite(t_sim):
             return self.t_onset
-        shift0 = self.t_onset - onset
+        shift0 = self.t_onset - t_sim
         w = self.window
         tt, yy = self.m.t[w], self.m.theta[w]
 
@@ -495,7 +350,7 @@ def check_fit_key(scene: Any, key: Any) -> str:
     if key not in allowed:
         raise CalibrationError(f"fit {key}: not a number of this scene (fit one of "
                                f"{', '.join(allowed)})")
-    return key.split(".", 1)[1]
+    return axis_name(key)
 
 
 def check_bounds(key: str, given: Any) -> tuple[float, float]:
@@ -934,6 +789,10 @@ def calibrate_scene(scene: Any, measured: Any, fit: str | Sequence[str],
     values = {a.name: a.values[0] for a in scene.axes}
     body = scene.point(values).body
     m = read_measured(measured, p=p_body, alpha_ref=body.alpha_ref, u_cr=body.u_cr or None)
+    if p is not None and not m.physical:
+        raise CalibrationError(f"p = {p!r}: {m.source} has the dimensionless columns p_t, "
+                               "theta_over_alpha; p reads physical columns t [s], theta "
+                               "[rad] only (leave it out)")
     _check_measured_span(m, body.alpha_ref)
     return calibrate_problem(Problem(scene, m, keys, bounds, noise), ci)
 

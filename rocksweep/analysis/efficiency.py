@@ -182,54 +182,78 @@ def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
                        "capacity" if n > 0 else "regression")
     for o in range(n_o):
         if stripe is None:  # a cloud: probit on ln(J F^n)
-            for i, name in enumerate(names):
-                n = table[name][2]
-                x = vals[name][o] * fac[o] ** n
-                use = cnt[o] & np.isfinite(x) & (x > 0)
-                if use.sum() < 2:
-                    continue
-                med, beta = fit_cloud(x[use], hit[o][use])[:2]  # (median, beta)
-                res["beta"][i, o] = beta
-                res["beta_scale"][i, o] = beta / max(n, 1)
-                res["im_median"][i, o] = med
-                n_rec[i, o] = int(use.sum())
+            _cloud_fits(o, names, table, vals, fac, cnt, hit, res, n_rec)
+        else:
+            _stripe_fits(o, np.asarray(ds[stripe].values, np.float64), names, table, vals,
+                         fac, cnt, hit, res, n_rec, n_cens)
+    return _dataset(ds, state, verdict, stripe, others, shape_o, names, table, methods,
+                    res, n_rec, n_cens)
+
+
+def _cloud_fits(o: int, names: list[str], table: dict, vals: dict, fac: np.ndarray,
+                cnt: np.ndarray, hit: np.ndarray, res: dict, n_rec: np.ndarray) -> None:
+    """A cloud's curve o: a probit on ln(J F^n) per IM (in ``res``, ``n_rec``)."""
+    for i, name in enumerate(names):
+        n = table[name][2]
+        x = vals[name][o] * fac[o] ** n
+        use = cnt[o] & np.isfinite(x) & (x > 0)
+        if use.sum() < 2:
             continue
-        levels = np.asarray(ds[stripe].values, np.float64)
-        h, c, f = hit[o], cnt[o], fac[o]
-        first = np.where(h.any(-1), np.argmax(h, -1), -1)
-        keep = c.any(-1)
-        # the interval of the scale factor at capacity: (F at the stripe below, F at it]
-        f_hi = np.where(first >= 0, np.take_along_axis(f, np.maximum(first, 0)[:, None],
-                                                       1)[:, 0], np.inf)
-        below = np.maximum(first - 1, 0)
-        f_lo = np.where(first > 0, np.take_along_axis(f, below[:, None], 1)[:, 0],
-                        np.where(first == 0, 0.0, f[:, -1]))
-        x_hi = np.where(first >= 0, levels[np.maximum(first, 0)], np.inf)
-        x_lo = np.where(first > 0, levels[below], np.where(first == 0, 0.0, levels[-1]))
-        with np.errstate(divide="ignore"):
-            lnf_lo, lnf_hi = np.log(f_lo[keep]), np.log(f_hi[keep])
-            lnx_lo, lnx_hi = np.log(x_lo[keep]), np.log(x_hi[keep])
-        if not np.isfinite(lnf_hi).any():  # nothing reaches the state
+        med, beta = fit_cloud(x[use], hit[o][use])[:2]  # (median, beta)
+        res["beta"][i, o] = beta
+        res["beta_scale"][i, o] = beta / max(n, 1)
+        res["im_median"][i, o] = med
+        n_rec[i, o] = int(use.sum())
+
+
+def _stripe_fits(o: int, levels: np.ndarray, names: list[str], table: dict, vals: dict,
+                 fac: np.ndarray, cnt: np.ndarray, hit: np.ndarray, res: dict,
+                 n_rec: np.ndarray, n_cens: np.ndarray) -> None:
+    """Stripes' curve o: each record's capacity bracketed between two stripes, fitted per
+    IM by interval-censored maximum likelihood (in ``res``, ``n_rec``, ``n_cens``)."""
+    h, c, f = hit[o], cnt[o], fac[o]
+    first = np.where(h.any(-1), np.argmax(h, -1), -1)
+    keep = c.any(-1)
+    # the interval of the scale factor at capacity: (F at the stripe below, F at it]
+    f_hi = np.where(first >= 0, np.take_along_axis(f, np.maximum(first, 0)[:, None],
+                                                   1)[:, 0], np.inf)
+    below = np.maximum(first - 1, 0)
+    f_lo = np.where(first > 0, np.take_along_axis(f, below[:, None], 1)[:, 0],
+                    np.where(first == 0, 0.0, f[:, -1]))
+    x_hi = np.where(first >= 0, levels[np.maximum(first, 0)], np.inf)
+    x_lo = np.where(first > 0, levels[below], np.where(first == 0, 0.0, levels[-1]))
+    with np.errstate(divide="ignore"):
+        lnf_lo, lnf_hi = np.log(f_lo[keep]), np.log(f_hi[keep])
+        lnx_lo, lnx_hi = np.log(x_lo[keep]), np.log(x_hi[keep])
+    if not np.isfinite(lnf_hi).any():  # nothing reaches the state
+        return
+    for i, name in enumerate(names):
+        n = table[name][2]
+        J = vals[name][o][keep]
+        ok = np.isfinite(J) & (J > 0)
+        if ok.sum() < 3:
             continue
-        for i, name in enumerate(names):
-            n = table[name][2]
-            J = vals[name][o][keep]
-            ok = np.isfinite(J) & (J > 0)
-            if ok.sum() < 3:
-                continue
-            lnJ = np.log(J[ok])
-            if n > 0:
-                a, _, s = _interval_mle(n * lnf_lo[ok] + lnJ, n * lnf_hi[ok] + lnJ, None)
-                res["im_median"][i, o] = math.exp(a)
-                res["beta"][i, o] = s
-                res["beta_scale"][i, o] = s / n
-            else:
-                a, b, s = _interval_mle(lnx_lo[ok], lnx_hi[ok], lnJ)
-                res["beta"][i, o] = s
-                res["beta_scale"][i, o] = s
-                res["slope"][i, o] = b
-            n_rec[i, o] = int(ok.sum())
-            n_cens[i, o] = int((~np.isfinite(lnf_hi[ok])).sum())
+        lnJ = np.log(J[ok])
+        if n > 0:
+            a, _, s = _interval_mle(n * lnf_lo[ok] + lnJ, n * lnf_hi[ok] + lnJ, None)
+            res["im_median"][i, o] = math.exp(a)
+            res["beta"][i, o] = s
+            res["beta_scale"][i, o] = s / n
+        else:
+            a, b, s = _interval_mle(lnx_lo[ok], lnx_hi[ok], lnJ)
+            res["beta"][i, o] = s
+            res["beta_scale"][i, o] = s
+            res["slope"][i, o] = b
+        n_rec[i, o] = int(ok.sum())
+        n_cens[i, o] = int((~np.isfinite(lnf_hi[ok])).sum())
+
+
+def _dataset(ds: xr.Dataset, state: str, verdict: Any, stripe: str | None,
+             others: list[str], shape_o: tuple[int, ...], names: list[str], table: dict,
+             methods: list[str], res: dict, n_rec: np.ndarray, n_cens: np.ndarray
+             ) -> xr.Dataset:
+    """``im_efficiency``'s Dataset (its docstring)."""
+    nI = len(names)
     dims = ["im", *others]
 
     def shaped(a: np.ndarray) -> np.ndarray:

@@ -68,6 +68,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from rocksweep.analysis.counts import STRIPE_IMS, Counts, IMAxis, count_points, im_axis
 from rocksweep.analysis.likelihood import (
     BOOT_ELEMENTS,
     CODE,
@@ -91,27 +92,19 @@ from rocksweep.analysis.resampling import (
     check_ci,
 )
 from rocksweep.analysis.states import (
-    counted_points,
-    parse_state,
     parse_states,
     required,
     severity,
     state_groups,
-    state_reached,
 )
 from rocksweep.errors import Arg, FragilityError, FragilityWarning
 from rocksweep.fields import plain
-from rocksweep.vocab.ground import AVGSA, SCALE_IMS
-from rocksweep.vocab.ground import CLOUD_IMS as CLOUD_IM_VARIABLES
-from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, UPLIFT
+from rocksweep.vocab.ground import AVGSA
+from rocksweep.vocab.outcomes import MODE1, MODE2
 
 __all__ = ["DEFAULT_BOOTSTRAP", "Fit", "FragilityWarning", "REASONS", "STRIPE_IMS",
            "curves_json", "fit_cloud", "fit_stripes", "fragility", "probability"]
 
-#: stripe dimension names (the sweep's ``scale_im``) and their units
-STRIPE_IMS = SCALE_IMS
-#: cloud IMs and the per-record variables they come from
-CLOUD_IMS = {im: (var, SCALE_IMS[im]) for im, var in CLOUD_IM_VARIABLES.items()}
 #: the quality words that follow how a fit ended (``likelihood.ENDINGS``)
 QUALITY = ("beta_undetermined", "non_monotone", "extrapolated", "bootstrap_undefined",
            "censored", "incomplete", "flagged", "crossing", "parallel_rejected")
@@ -287,41 +280,6 @@ def fit_cloud(im: Sequence[float] | np.ndarray, failed: Sequence[bool] | np.ndar
 # ---------------------------------------------------------------------------------------
 
 
-def _cloud_im(ds: xr.Dataset, im: str | None, period: float | None
-              ) -> tuple[np.ndarray, str, str, float]:
-    name = "PGA" if im is None else str(im)
-    if name not in CLOUD_IMS:
-        raise FragilityError(f"im = {im!r}: a cloud (no stripe dimension) takes one of "
-                             f"{', '.join(CLOUD_IMS)}")
-    var, unit = CLOUD_IMS[name]
-    da = required(ds, var, f"the per-record {name} of a cloud")
-    per = math.nan
-    if name == "Sa":
-        if "period" not in da.dims:
-            raise FragilityError(f"{var} has no 'period' dimension")
-        periods = np.asarray(da["period"].values, dtype=np.float64)
-        if period is None:
-            if periods.size != 1:
-                raise FragilityError(f"im = 'Sa' needs period= (one of "
-                                     f"{', '.join(f'{p:g}' for p in periods)} s)")
-            period = float(periods[0])
-        hit = np.flatnonzero(np.isclose(periods, float(period), rtol=1e-9, atol=0.0))
-        if hit.size == 0:
-            raise FragilityError(f"period = {period!r}: {var} holds periods "
-                                 f"{', '.join(f'{p:g}' for p in periods)} s")
-        da = da.isel(period=int(hit[0]))
-        per = float(periods[hit[0]])
-    if set(da.dims) != {"record"}:
-        raise FragilityError(f"{var} must lie along 'record' only, has {da.dims}")
-    x = np.asarray(da.transpose("record").values, dtype=np.float64)
-    if "scale_factor" in ds.variables:
-        x = x * np.asarray(ds["scale_factor"].transpose("record").values, dtype=np.float64)
-    if np.any(~np.isfinite(x) | (x <= 0.0)):
-        bad = ds["record"].values[~np.isfinite(x) | (x <= 0.0)][0]
-        raise FragilityError(f"record {bad}: {name} must be finite and > 0 for a cloud fit")
-    return x, name, unit, per
-
-
 def _check_args(ds: Any, im: Any, period: Any, seed: Any) -> None:
     if not isinstance(ds, xr.Dataset):
         raise FragilityError(f"ds = {type(ds).__name__}: must be a result Dataset "
@@ -335,24 +293,6 @@ def _check_args(ds: Any, im: Any, period: Any, seed: Any) -> None:
                              "stored ground.periods), with im='Sa'")
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
         raise FragilityError("{seed}: must be an integer >= 0", seed=Arg("seed", seed))
-
-
-def _refuse_filled(ds: xr.Dataset, states: Sequence[str], counted: xr.DataArray) -> None:
-    """An adaptive sweep's filled points carry only the class: refuse states that need
-    more (uplift, theta:X)."""
-    if "computed" not in ds.variables:
-        return
-    from rocksweep.compute.adaptive import FILLED
-
-    filled = (ds["computed"] == FILLED) & counted
-    n = int(filled.sum())
-    need = [s for s in states if parse_state(s)[0] in (UPLIFT, "theta")]
-    if n and need:
-        raise FragilityError(
-            f"state {need[0]!r}: {n} points of this adaptive sweep were filled from the class "
-            "around them, not computed, so their uplift and theta are unknown; only "
-            f"{OVERTURN}, {MODE1} and {MODE2} can be fitted (a sweep that computes every "
-            "point can give it)")
 
 
 def _missing_text(not_run: np.ndarray, levels: np.ndarray | None, unit: str,
@@ -427,8 +367,8 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
         raise FragilityError(f"joint = {joint!r}: True or False (one beta for nested damage "
                              "states, competing risks for mode1 with mode2)")
     out_da = ds["outcome"]
-    axis = _im_axis(ds, out_da, im, period)
-    counts = _count(ds, states, axis, out_da)
+    axis = im_axis(ds, out_da, im, period)
+    counts = count_points(ds, states, axis, out_da)
     N = check_bootstrap(N, len(states) * counts.n_o)
     grid = np.geomspace(axis.x.min() / 2.0, axis.x.max() * 1.5, BAND_POINTS)
     groups = state_groups(states, bool(joint))
@@ -474,108 +414,6 @@ def _request(ds: Any, state: Any, im: Any, period: Any, bootstrap: Any, seed: An
     return states, N, ci
 
 
-@dataclass(frozen=True)
-class _Axis:
-    """The IM of a fit: stripes (``stripe`` the dimension, ``x`` its levels (S,)) or a
-    cloud (``stripe`` None, ``x`` the records' IMs (R,)); [unit] each."""
-
-    stripe: str | None
-    x: np.ndarray
-    im_name: str
-    unit: str
-    period: float  # Sa's period [s], NaN for other IMs
-    method: str  # "stripes-mle" | "cloud-mle"
-
-    @property
-    def stripes(self) -> bool:
-        return self.stripe is not None
-
-
-def _im_axis(ds: xr.Dataset, out_da: xr.DataArray, im: str | None, period: float | None
-             ) -> _Axis:
-    """Stripes if the outcome lies along the sweep's ``scale_im``, else a cloud."""
-    scale_im = ds.attrs.get("scale_im")
-    stripe = str(scale_im) if scale_im is not None and str(scale_im) in out_da.dims else None
-    if scale_im not in (None, "", "none") and stripe is None:
-        raise FragilityError(f"scale_im = {scale_im!r} but outcome has no such dimension")
-    if stripe is None:
-        if period is not None and (im is None or str(im) != "Sa"):
-            raise FragilityError(f"period = {period!r}: only with im='Sa'")
-        rec_im, im_name, unit, per = _cloud_im(ds, im, period)
-        return _Axis(None, rec_im, im_name, unit, per, "cloud-mle")
-    if stripe not in STRIPE_IMS:
-        raise FragilityError(f"scale_im = {stripe!r}: one of {', '.join(STRIPE_IMS)}")
-    if im is not None and str(im) != stripe:
-        raise FragilityError(f"im = {im!r}: the stripes are levels of {stripe}; a "
-                             "stripe fit uses that IM")
-    levels = np.asarray(ds[stripe].values, dtype=np.float64)
-    if np.any(~np.isfinite(levels) | (levels <= 0.0)):
-        raise FragilityError(f"{stripe}: every stripe level must be finite and > 0")
-    per = float(ds.attrs.get("scale_period", math.nan)) if stripe == "Sa" else math.nan
-    if period is not None and not (stripe == "Sa" and math.isclose(
-            float(period), per, rel_tol=1e-9)):
-        raise FragilityError(f"period = {period!r}: the stripes are {stripe}"
-                             + (f" at T = {per:g} s" if stripe == "Sa" else "")
-                             + "; leave period out")
-    return _Axis(stripe, levels, stripe, STRIPE_IMS[stripe], per, "stripes-mle")
-
-
-@dataclass(frozen=True)
-class _Counts:
-    """The points of every curve: the other dims (``others``, sizes ``shape_o``) flattened
-    to n_o curves; bool arrays over (n_o, R[, S]) (records, stripes), ``hits`` over
-    (states, n_o, R[, S])."""
-
-    others: list[str]
-    shape_o: tuple[int, ...]
-    names: list[str]  # the records
-    counted: np.ndarray
-    flagged: np.ndarray
-    not_run: np.ndarray
-    hits: np.ndarray  # the point reaches the state
-    over_all: np.ndarray  # the point overturns (either mode)
-
-    @property
-    def n_o(self) -> int:
-        return self.counted.shape[0]
-
-    @property
-    def R(self) -> int:
-        return self.counted.shape[1]
-
-    def onehot(self, kind: str, idxs: list[int], o: int, mask: np.ndarray) -> np.ndarray:
-        """(C, R[, S]) float: each point of ``mask`` in its category of the group."""
-        h = self.hits[idxs, o] & mask[None]
-        if kind == "single":
-            cat = h[0].astype(np.int64)
-        else:  # ordinal: the most severe reached; competing: 1 mode 1, 2 mode 2
-            cat = np.max(np.stack([(j + 1) * h[j] for j in range(len(idxs))]), 0)
-        C = len(idxs) + 1
-        return np.stack([(cat == c) & mask for c in range(C)]).astype(np.float64)
-
-
-def _count(ds: xr.Dataset, states: list[str], axis: _Axis, out_da: xr.DataArray
-           ) -> _Counts:
-    """Which points are counted, flagged, not run, and reach each state."""
-    others = [d for d in out_da.dims if d not in ("record", axis.stripe)]
-    order = others + ["record"] + ([axis.stripe] if axis.stripes else [])
-    counted_da, flagged_da, not_run_da = counted_points(ds)
-    _refuse_filled(ds, states, counted_da)
-    shape_o = tuple(ds.sizes[d] for d in others)
-    n_o = int(np.prod(shape_o)) if shape_o else 1
-    R = ds.sizes["record"]
-    tail = (R, ds.sizes[axis.stripe]) if axis.stripes else (R,)
-
-    def flat(da: xr.DataArray) -> np.ndarray:
-        return da.transpose(*order).values.reshape((n_o,) + tail)
-
-    hits = np.stack([state_reached(ds, s).transpose(*order).values for s in states])
-    return _Counts(others, shape_o, [str(r) for r in ds["record"].values],
-                   flat(counted_da), flat(flagged_da), flat(not_run_da),
-                   hits.reshape((len(states), n_o) + tail),
-                   flat(state_reached(ds, OVERTURN)))
-
-
 @dataclass
 class _Fits:
     """Every state's (nS) fit of every curve (n_o): ``res`` im_median, beta and their
@@ -598,8 +436,8 @@ _UNDETERMINED = {"one_stripe": "one IM level counted",
                  "separated": "separated data: the likelihood grows as beta -> 0"}
 
 
-def _point_fits(c: _Counts, groups: list[tuple[str, list[int]]], states: list[str],
-                axis: _Axis, grid: np.ndarray, N: int) -> _Fits:
+def _point_fits(c: Counts, groups: list[tuple[str, list[int]]], states: list[str],
+                axis: IMAxis, grid: np.ndarray, N: int) -> _Fits:
     """The fit of the counted points of every group and curve, with its data verdicts."""
     nS, n_o = len(states), c.n_o
     f = _Fits({v: np.full((nS, n_o), np.nan) for v in
@@ -660,7 +498,7 @@ def _parallel(f: _Fits, o: int, idxs: list[int], lnx: np.ndarray, m: np.ndarray,
                 "not fit these states; fit them separately (joint=False)")
 
 
-def _crossing(f: _Fits, c: _Counts, states: list[str], axis: _Axis) -> None:
+def _crossing(f: _Fits, c: Counts, states: list[str], axis: IMAxis) -> None:
     """The "crossing" verdict of separate fits: a more severe nested state's curve above
     a milder one's by more than ``CROSSING_TOL`` inside the IM range of the counted
     data (stripes with a counted point; a cloud's counted records)."""
@@ -692,8 +530,8 @@ def _crossing(f: _Fits, c: _Counts, states: list[str], axis: _Axis) -> None:
                 f.why[severe][o]["crossing"] = text
 
 
-def _bootstrap_fits(f: _Fits, c: _Counts, groups: list[tuple[str, list[int]]],
-                    axis: _Axis, N: int, seed: int) -> None:
+def _bootstrap_fits(f: _Fits, c: Counts, groups: list[tuple[str, list[int]]],
+                    axis: IMAxis, N: int, seed: int) -> None:
     """Every group refitted on N resamples of the records (in ``f.samples``), started from
     the point fit; resamples without a finite fit are NaN."""
     lnx = np.log(axis.x)
@@ -748,7 +586,7 @@ def _bootstrap_intervals(f: _Fits, groups: list[tuple[str, list[int]]], grid: np
                         f.band[:, i, o, gs] = np.percentile(cq, q, axis=0)
 
 
-def _dataset(ds: xr.Dataset, state: Any, states: list[str], axis: _Axis, c: _Counts,
+def _dataset(ds: xr.Dataset, state: Any, states: list[str], axis: IMAxis, c: Counts,
              f: _Fits, grid: np.ndarray, N: int, seed: int, ci: float) -> xr.Dataset:
     """The fragility Dataset (``fragility``'s docstring): a ``state`` dimension when
     ``state`` is a list."""
@@ -837,7 +675,7 @@ def _dataset(ds: xr.Dataset, state: Any, states: list[str], axis: _Axis, c: _Cou
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
-def _stripe_variables(c: _Counts, axis: _Axis, dims_c: list[str],
+def _stripe_variables(c: Counts, axis: IMAxis, dims_c: list[str],
                       shaped: Callable[..., np.ndarray]) -> dict[str, Any]:
     """The stripes' own variables: fraction, n_failed, n_counted, and per record
     first_level and resurrection."""
@@ -866,7 +704,7 @@ def _stripe_variables(c: _Counts, axis: _Axis, dims_c: list[str],
 
 def _verdicts(kind: str, idxs: list[int], o: int, lnx: np.ndarray, m: np.ndarray,
               med: np.ndarray, bet: np.ndarray, why: list[list[dict[str, str]]],
-              c: _Counts, states: list[str], stripes: bool) -> None:
+              c: Counts, states: list[str], stripes: bool) -> None:
     """The data verdicts of one group's point fit (in ``why``): extrapolated,
     non_monotone (stripes), censored (a mode alone), flagged (the excluded points could
     move it)."""

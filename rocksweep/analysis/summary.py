@@ -18,6 +18,7 @@ import numpy as np
 
 from rocksweep.fields import THETA_REL_FLOOR, plain
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.vocab.axes import axis_name
 from rocksweep.vocab.outcomes import (
     COMPUTED,
     FILLED,
@@ -211,7 +212,7 @@ def info_dict(result: SweepResult) -> dict:
     """
     a = result.attrs
     done = result.done
-    keys = {k.split(".", 1)[1]: k for k in result.scene["axes"]}
+    keys = {axis_name(k): k for k in result.scene["axes"]}
     dims = {d: {"size": len(result.coords[d]), "scene_key": keys[d],
                 "values": [plain(v) for v in result.coords[d]]} for d in result.dims}
     return {

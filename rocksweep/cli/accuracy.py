@@ -19,8 +19,8 @@ from rocksweep.cli.options import seed_option
 from rocksweep.vocab.settings import (
     DEFAULT_LADDER,
     DEFAULT_SAMPLE_SEED,
+    LADDER_HELP,
     LADDER_NAMES,
-    LADDERS,
 )
 
 
@@ -38,7 +38,7 @@ from rocksweep.vocab.settings import (
               type=click.Choice(LADDER_NAMES),  # = accuracy.LADDERS (tests/test_vocab.py)
               default=DEFAULT_LADDER, show_default=True,
               help="Kernel settings to measure: " + ", ".join(
-                  f"{k} ({v})" for k, v in LADDERS.items()) + ".")
+                  f"{k} ({v})" for k, v in LADDER_HELP.items()) + ".")
 @seed_option(DEFAULT_SAMPLE_SEED, "Sampling seed.")
 @click.option("--repeat", type=click.IntRange(min=1), default=5, show_default=True,
               help="Kernel timings are the best of this many rounds.")
@@ -77,7 +77,7 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
     if report_path is not None:
         check_output(report_path, overwrite=overwrite, inputs=scene.inputs)
     if plot_path is not None:
-        from rocksweep.figures.common import FORMATS
+        from rocksweep.figures import FORMATS
 
         check_output(plot_path, overwrite=overwrite, inputs=scene.inputs, suffixes=FORMATS)
 
@@ -108,7 +108,7 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
         click.echo(f"wrote {report_path}")
     if plot_path is not None:
         from rocksweep.figures.accuracy import work_precision
-        from rocksweep.figures.common import save_figure
+        from rocksweep.figures.style import save_figure
 
         save_figure(work_precision(study), plot_path, overwrite=overwrite, inputs=scene.inputs)
         click.echo(f"wrote {plot_path}")

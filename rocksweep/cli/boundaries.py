@@ -40,7 +40,8 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
     Works on adaptive and regular results."""
     from rocksweep.analysis import boundaries as bd
     from rocksweep.analysis.files import csv_text, write_curves_h5
-    from rocksweep.figures.common import FORMATS, save_figure
+    from rocksweep.figures import FORMATS
+    from rocksweep.figures.style import save_figure
     from rocksweep.outputs import check_distinct, check_output, write_atomic
     from rocksweep.store.reader import read_result
 

@@ -98,7 +98,7 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
         click.echo(f"wrote {out_path}")
     if plot_path is not None:
         from rocksweep.figures.calibration import calibration_figure
-        from rocksweep.figures.common import save_figure
+        from rocksweep.figures.style import save_figure
 
         save_figure(calibration_figure(ds), plot_path, dpi, overwrite=overwrite,
                     inputs=inputs)

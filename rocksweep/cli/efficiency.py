@@ -45,7 +45,7 @@ def efficiency(result_path: Path, state: str, out_path: Path | None, fig_path: P
     import numpy as np
 
     import rocksweep
-    from rocksweep.figures.common import save_figure
+    from rocksweep.figures.style import save_figure
     from rocksweep.store.reader import result_inputs
 
     inputs = result_inputs(result_path)  # the result and its records: never written over

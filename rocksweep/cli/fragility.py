@@ -96,7 +96,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
     import warnings
 
     import rocksweep
-    from rocksweep.figures.common import save_figure
+    from rocksweep.figures.style import save_figure
 
     states = [s.strip() for s in state.split(",") if s.strip()]
     if not states:

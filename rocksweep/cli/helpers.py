@@ -18,7 +18,7 @@ def check_table_outputs(out_path: Path | None, fig_path: Path | None,
     figure), refused in one line before anything is computed: the same file twice, an
     unknown suffix, an existing file without --overwrite, or one of the command's
     ``inputs`` (``outputs.check_output``)."""
-    from rocksweep.figures.common import FORMATS
+    from rocksweep.figures import FORMATS
     from rocksweep.outputs import check_distinct, check_output
 
     inputs = list(inputs)

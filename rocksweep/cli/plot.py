@@ -51,8 +51,8 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
     draws one diagram coloured by which of KEY's values overturn each cell."""
     from rocksweep import api
     from rocksweep.figures import FORMATS
-    from rocksweep.figures.common import save_figure
     from rocksweep.figures.diagrams import missing_warnings
+    from rocksweep.figures.style import save_figure
     from rocksweep.outputs import check_output
     from rocksweep.store.reader import as_result
 

@@ -60,7 +60,7 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
                      *(("impact.e=null",) if law != CONSTANT else ()))
     scene = load(scene_path, overrides)
     if plot_path is not None:  # the scene file, its records: never written over
-        from rocksweep.figures.common import FORMATS
+        from rocksweep.figures import FORMATS
 
         check_output(plot_path, overwrite=overwrite, inputs=scene.inputs, suffixes=FORMATS)
     table = restitution_table(scene, n_lam, n_u)
@@ -89,7 +89,8 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
                  else _lam_text(float(lim.min())))
         click.echo(f"  over u/u_cr in [-2, 2]: {worst}")
     if plot_path is not None:
-        from rocksweep.figures.common import restitution_map, save_figure
+        from rocksweep.figures.restitution import restitution_map
+        from rocksweep.figures.style import save_figure
 
         fig = restitution_map(table.lam, table.u_over_ucr, table.e_upper, table.e_housner,
                               table.title, lam_limit=table.lam_limit, law=table.law)

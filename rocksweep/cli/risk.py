@@ -55,9 +55,9 @@ def _g(v) -> str:
               help="N: the probability of at least one occurrence in N years.")
 @click.option("--site", type=click.IntRange(0), default=None,
               help="OpenQuake files with several sites: the row to use (0 = first).")
-@click.option("--state", default="overturn", show_default=True,
+@click.option("--state", default=None,
               help="When FRAG.h5 is a suite sweep, the states to fit first (as "
-                   "rocksweep fragility --state).")
+                   "rocksweep fragility --state; default overturn).")
 @click.option("--joint", is_flag=True,
               help="When FRAG.h5 is a suite sweep: fit the states jointly (as rocksweep "
                    "fragility --joint).")
@@ -72,9 +72,9 @@ def _g(v) -> str:
 @dpi_option
 @overwrite_option
 @user_errors
-def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, state: str,
-         joint: bool, out_path: Path | None, fig_path: Path | None, as_json: bool, width: str,
-         dpi: int, overwrite: bool) -> None:
+def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None,
+         state: str | None, joint: bool, out_path: Path | None, fig_path: Path | None,
+         as_json: bool, width: str, dpi: int, overwrite: bool) -> None:
     """Mean annual rate lambda = integral P(state | im) |d lambda_im| of each state of a
     fragility (FRAG.h5 from rocksweep fragility -o, or a record-suite sweep) over a
     hazard curve, and the probability 1 - exp(-lambda N) in N years, with the band of the
@@ -82,7 +82,7 @@ def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, sta
     certain tail above its largest IM is added), never extrapolated."""
     import rocksweep
     from rocksweep.analysis.kinds import dataset_kind
-    from rocksweep.figures.common import save_figure
+    from rocksweep.figures.style import save_figure
     from rocksweep.store.reader import result_inputs
 
     # the fragility or sweep file (and a sweep's records), the hazard curve: never written
@@ -93,8 +93,12 @@ def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, sta
 
     ds = rocksweep.open(frag_path)
     check_fragility(ds, shown(frag_path), suites=True)
+    if dataset_kind(ds) != "sweep" and (state is not None or joint):
+        given = f"--state {state}" if state is not None else "--joint"
+        raise click.ClickException(f"{given}: {frag_path} is a fitted fragility (its states "
+                                   "are fixed); it applies to a record-suite sweep")
     if dataset_kind(ds) == "sweep":
-        states = [s.strip() for s in state.split(",") if s.strip()]
+        states = [s.strip() for s in (state or "overturn").split(",") if s.strip()]
         ds = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states,
                                  joint=joint)
     rk = rocksweep.risk(ds, hazard_path, years, site=site)

@@ -57,7 +57,7 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     scene = load(scene_path, overrides)
     # the scene file, its record: never written over
     if plot_path is not None:
-        from rocksweep.figures.common import FORMATS
+        from rocksweep.figures import FORMATS
 
         check_output(plot_path, overwrite=overwrite, inputs=scene.inputs, suffixes=FORMATS)
     if csv_path is not None:
@@ -83,7 +83,8 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
         if not as_json:
             click.echo(f"wrote {csv_path}")
     if plot_path is not None:
-        from rocksweep.figures.common import save_figure, time_history
+        from rocksweep.figures.history import time_history
+        from rocksweep.figures.style import save_figure
 
         save_figure(time_history(runs, swept, scene.name), plot_path, overwrite=overwrite,
                     inputs=scene.inputs)

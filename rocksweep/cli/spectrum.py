@@ -26,8 +26,9 @@ def spectrum(result_path: Path, fig_path: Path | None, rtol: float, search: bool
     overturning spectrum (smallest A_ratio that overturns against p, one curve per lam,
     by mode, refined by bisection) of a sweep over p (a record) or w_over_p, and A_ratio."""
     from rocksweep.analysis.spectrum import spectra
-    from rocksweep.figures.common import FORMATS, save_figure
+    from rocksweep.figures import FORMATS
     from rocksweep.figures.spectrum import spectra_figure
+    from rocksweep.figures.style import save_figure
     from rocksweep.outputs import check_output
     from rocksweep.store.reader import result_inputs
 

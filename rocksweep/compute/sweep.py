@@ -43,6 +43,7 @@ from rocksweep.compute.dispatch import run_variant
 from rocksweep.errors import flag
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import point_seconds
+from rocksweep.physics.bodies import G
 from rocksweep.scene.grid import ChunkResult, ChunkRows, Grid
 from rocksweep.scene.model import Scene
 from rocksweep.vocab.settings import BACKENDS
@@ -81,6 +82,8 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
     stored = fields.sweep_fields(scene.energy if contact else level == L.LEVEL_ENERGY,
                                  contact, scene.check)
     arrays = fields.convert(outs, cr.alpha_ref, cr.E_ref, stored)
+    if scene.floor:  # the peak the body was driven by [g]: the kernel's amplitude / g
+        arrays[fields.FLOOR_PFA] = cr.rows[:, L.PAR_AMP] / G
     if scene.check:
         half = run_rows(cr, fields.check_rows(cr.rows), level, scene)
         arrays.update(fields.convert_check(outs, half, cr.alpha_ref))
@@ -101,11 +104,13 @@ def run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene,
     vertical = scene.vertical_samples()  # a record's vertical component rides along
     for kind in np.unique(cr.kinds):
         sel = cr.kinds == kind
-        if scene.suite is not None:  # one record at a time, its samples shared
+        if cr.records is not None:  # one record at a time, its samples shared
             for r in np.unique(cr.record_index[sel]):
                 part = sel & (cr.record_index == r)
-                outs[part] = run_variant(rows[part], int(kind), level, scene.ground, refine,
-                                         record=scene.suite.records[int(r)])
+                outs[part] = run_variant(
+                    rows[part], int(kind), level, scene.ground, refine,
+                    record=cr.records[int(r)],
+                    vertical=None if cr.verticals is None else cr.verticals[int(r)])
         elif sel.all():
             run_variant(rows, int(kind), level, scene.ground, refine, record=scene.record,
                         out=outs, vertical=vertical)

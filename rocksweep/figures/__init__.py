@@ -1,10 +1,12 @@
-"""Every figure (``rocksweep.plot(ds)`` is the facade): ``diagrams`` (stability
-diagrams, Figures 3-4, friction maps, A_min), ``common`` (axes, saving, time histories
-(Figure 5), the restitution map (Figure 2)), ``spectrum`` (rocking spectra),
-``accuracy`` (work-precision), ``fragility`` (fragility curves), ``pulses`` (the pulse
-shapes). Every figure is a ``rocksweep.figures.common.Figure`` (TrueType fonts in any
-saved PDF, a PNG in a notebook). Figures are built
-without pyplot (``matplotlib.figure.Figure``), so nothing here needs a display.
+"""Every figure (``rocksweep.plot(ds)`` is the facade; ``by_kind`` picks a Dataset's
+figure): ``style`` (the Figure class, journal widths, saving), ``restitution`` (Figure 2),
+``diagrams`` (stability diagrams, Figures 3-4, friction maps, A_min), ``history`` (time
+histories, Figure 5), ``spectrum`` (rocking and overturning spectra), ``fragility``
+(fragility curves), ``results`` (risk, IDA, boundaries, IM efficiency), ``calibration``,
+``accuracy`` (work-precision), ``pulses`` (the pulse shapes). Every figure is a
+``rocksweep.figures.style.Figure`` (TrueType fonts in any saved PDF, a PNG in a notebook).
+Figures are built without pyplot (``matplotlib.figure.Figure``), so nothing here needs a
+display.
 """
 
 # Figure files (the suffix picks the format) and raster resolution [dots per inch]: light
@@ -17,4 +19,5 @@ DPI_RANGE = (20, 2400)
 WIDTHS: dict[str, tuple[float, float]] = {"single": (3.5, 7.0), "double": (7.2, 8.0)}
 
 # the public modules
-__all__ = ["accuracy", "common", "diagrams", "fragility", "pulses", "spectrum"]
+__all__ = ["accuracy", "by_kind", "calibration", "diagrams", "fragility", "history",
+           "pulses", "restitution", "results", "spectrum", "style"]

@@ -15,13 +15,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from rocksweep.analysis.accuracy import MEASURE_LABELS, Study
-from rocksweep.figures.common import DEFAULT_DPI, Figure, given_axes, new_axes, save_figure
+from rocksweep.figures.style import Figure, given_axes, new_axes
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -130,9 +129,3 @@ def work_precision(study: Study, axes: Sequence[Axes] | None = None) -> Figure:
         fig.suptitle(f"{study.scene.name}: work-precision, {n} of {size} points; "
                      f"event root finder: {', '.join(roots)}", fontsize=11)
     return fig
-
-
-def work_precision_figure(study: Study, path: str | Path, *, dpi: int = DEFAULT_DPI,
-                          overwrite: bool = True) -> None:
-    """``work_precision`` saved to ``path`` (the call of ``rocksweep accuracy --plot``)."""
-    save_figure(work_precision(study), path, dpi, overwrite=overwrite)

@@ -8,7 +8,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rocksweep.figures.common import FigureError, given_axes, new_axes
+from rocksweep.errors import FigureError
+from rocksweep.figures.style import given_axes, new_axes
 
 if TYPE_CHECKING:
     import xarray as xr

@@ -42,15 +42,8 @@ from matplotlib.patches import Patch
 
 from rocksweep.errors import Arg, DiagramError, flag  # noqa: F401 (DiagramError: re-exported)
 from rocksweep.fields import WORD_AXES
-from rocksweep.figures.common import (
-    DEFAULT_DPI,
-    FORMATS,
-    Figure,
-    given_axes,
-    new_axes,
-    save_figure,
-    wrap_title,
-)
+from rocksweep.figures import DEFAULT_DPI, FORMATS
+from rocksweep.figures.style import Figure, given_axes, new_axes, save_figure, wrap_title
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.store.reader import SweepResult
 from rocksweep.vocab import axes as _axes
@@ -255,7 +248,7 @@ def _title(result: SweepResult, on_axes: Sequence[str]) -> str:
 
 
 def _fit(title: str, fig: Figure) -> str:
-    """A title wrapped to the figure's width at 11 pt (``common.wrap_title``)."""
+    """A title wrapped to the figure's width at 11 pt (``style.wrap_title``)."""
     return wrap_title(title, fig.get_figwidth(), 11.0)
 
 

@@ -19,6 +19,7 @@ import math
 from typing import TYPE_CHECKING
 
 import matplotlib.colors
+import matplotlib.font_manager
 import numpy as np
 import xarray as xr
 
@@ -26,7 +27,7 @@ from rocksweep.analysis.likelihood import lognormal_cdf
 from rocksweep.analysis.risk import fragility_median
 from rocksweep.errors import FragilityFigureError, RocksweepError  # noqa: F401 (re-exported)
 from rocksweep.figures import WIDTHS
-from rocksweep.figures.common import Figure
+from rocksweep.figures.style import Figure, curve_colours
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -79,7 +80,12 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
     rest = [d for d in dims if d != colour_dim]
     grid = frag["im_grid"].values
     n_col = frag.sizes[colour_dim] if colour_dim else 1
-    colours = [f"C{i % 10}" for i in range(n_col)]
+    colours = curve_colours(n_col)
+    # a legend entry's lines wrapped to the figure's width at the legend's font (about
+    # 100/pt characters an inch, as titles): a long verdict no longer widens the legend
+    # past the figure and squeezes the axes
+    pt = matplotlib.font_manager.FontProperties(size="x-small").get_size_in_points()
+    chars = max(24, int(100.0 / pt * fig.get_figwidth() * 0.95))
     n_max = float(frag["n_counted"].max()) if "n_counted" in frag else 1.0
     rest_pos = list(itertools.product(*(range(frag.sizes[d]) for d in rest)))
     for ri, rpos in enumerate(rest_pos):
@@ -110,11 +116,11 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
                 y = (one["curve"].values if "curve" in one
                      else lognormal_cdf(grid, med, beta))
                 ax.plot(grid, y, style, color=colour,
-                        label=(", ".join(label_bits) + "\n" + text).lstrip())
+                        label=_wrapped(", ".join(label_bits) + "\n" + text, chars))
             else:
                 reason = str(one["reason"].values) if "reason" in one else "no fit"
                 ax.plot([], [], style, color=colour,
-                        label=", ".join(label_bits + [f"no fit ({reason})"]))
+                        label=_wrapped(", ".join(label_bits + [f"no fit ({reason})"]), chars))
             if "band_lo" in one:
                 lo, hi = one["band_lo"].values, one["band_hi"].values
                 if np.any(np.isfinite(lo)):
@@ -140,11 +146,18 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
     ax.set_title(title, fontsize="small")
     # below the axes: the curves and stripe markers fill the plot, a legend inside would
     # cover them
-    n_entries = len(ax.get_legend_handles_labels()[0])
     ax.legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.2),
               frameon=False)
-    if own:  # two lines per entry below the axes: the figure grows to hold them
+    if own:  # the entries' lines below the axes: the figure grows to hold them
+        n_lines = sum(lab.count("\n") + 1 for lab in ax.get_legend_handles_labels()[1])
         w, h = fig.get_size_inches()
-        fig.set_size_inches(w, h + 0.22 * max(n_entries - 3, 0))
+        fig.set_size_inches(w, h + 0.11 * max(n_lines - 6, 0))
     ax.grid(True, which="both", alpha=0.25, linewidth=0.5)
     return fig
+
+
+def _wrapped(label: str, chars: int) -> str:
+    """Each line of a legend label wrapped at ``chars`` characters (words kept whole)."""
+    import textwrap
+
+    return "\n".join(textwrap.fill(line, chars) for line in label.strip().split("\n"))

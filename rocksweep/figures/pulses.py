@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rocksweep.figures.common import Figure
+from rocksweep.figures.style import Figure
 from rocksweep.physics.excitation import PulseShape, default_shapes
 from rocksweep.vocab.ground import SHAPE_TITLE, SHAPES
 

@@ -1,7 +1,7 @@
 """Figures of the analyses' Datasets that have no figure module of their own: a risk result
 (hazard curve, fragility, the rate's integrand), an IDA (the first overturning level per
-record), spectra (rocking and overturning spectra from the Dataset), boundaries (A_min
-against x) and the IM efficiency (beta per IM). ``rocksweep.figures.dispatch`` picks one by
+record), boundaries (A_min
+against x) and the IM efficiency (beta per IM). ``rocksweep.figures.by_kind`` picks one by
 the Dataset's kind. Each returns a pyplot-free ``matplotlib.figure.Figure``; the legend
 sits outside the data.
 """
@@ -15,8 +15,7 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.figures import WIDTHS
-from rocksweep.figures.common import Figure
-from rocksweep.vocab.axes import alpha_latex, latex
+from rocksweep.figures.style import Figure, curve_colours
 from rocksweep.vocab.axes import label as axis_label
 
 # height / width of one panel stacked in a single column (``_figure``)
@@ -69,8 +68,10 @@ def risk_figure(rk: xr.Dataset, *, ax: Any = None, width: str | None = "double")
     a0.set_ylabel("annual rate of exceedance [1/yr]")
     a0.set_title("hazard", fontsize="small")
     grid = rk["im_level"].values
-    for k, (label, sel, p) in enumerate(_curves(rk["fragility"], "im_level")):
-        c = f"C{k % 10}"
+    curves = list(_curves(rk["fragility"], "im_level"))
+    colours = curve_colours(len(curves))
+    for k, (label, sel, p) in enumerate(curves):
+        c = colours[k]
         rate = float(rk["annual_rate"].isel(sel))
         prob = float(rk["probability"].isel(sel))
         if len(axes) > 1:
@@ -155,45 +156,6 @@ def ida_figure(ida: xr.Dataset, *, ax: Any = None, width: str | None = "single")
     if not curves and axes[0].get_legend_handles_labels()[0]:
         axes[0].legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.18),
                        frameon=False)
-    return fig
-
-
-def spectra_dataset_figure(sp: xr.Dataset, *, ax: Any = None,
-                           width: str | None = "double") -> Figure:
-    """Rocking spectrum (max|theta|/alpha against the frequency axis, one curve per
-    A_ratio and lam) and overturning spectrum (A_min per lam) of ``rocksweep.spectra``."""
-    freq = next(d for d in sp["A_min"].dims if d != "lam")
-    if ax is not None:
-        axes = np.atleast_1d(ax)
-        fig = axes[0].figure
-    else:
-        fig, axes = _figure(width, 2, 0.45)
-    th = sp["theta_max_over_alpha"]
-    x = sp[freq].values
-    kind = str(sp.attrs.get("kind", "flexible"))
-    pick = np.unique(np.linspace(0, sp.sizes["A_ratio"] - 1,
-                                 min(6, sp.sizes["A_ratio"])).round().astype(int))
-    for li in range(sp.sizes.get("lam", 1)):
-        one = th.isel(lam=li) if "lam" in th.dims else th
-        for j, ai in enumerate(pick):
-            axes[0].plot(x, one.isel(A_ratio=ai).values, color=f"C{j}",
-                         ls=("-", "--", ":", "-.")[li % 4],
-                         label=f"${latex('A_ratio', kind)}$ = {sp['A_ratio'].values[ai]:.3g}"
-                         if li == 0 else None)
-    axes[0].set_yscale("log")
-    axes[0].set_xlabel(axis_label(freq, kind))
-    axes[0].set_ylabel(rf"max|$\theta$|/${alpha_latex(kind)}$")
-    axes[0].set_title("rocking spectrum (line style: lam)", fontsize="small")
-    for label, _sel, v in _curves(sp["A_min"], freq):
-        axes[-1].plot(x, v, "o-", ms=3, label=label)
-    axes[-1].set_xlabel(axis_label(freq, kind))
-    axes[-1].set_ylabel(f"{axis_label('A_ratio', kind)} at overturning onset")
-    axes[-1].set_title("overturning spectrum", fontsize="small")
-    for a in axes:
-        a.grid(True, alpha=0.25, linewidth=0.5)
-        if a.get_legend_handles_labels()[0]:
-            a.legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.2),
-                     frameon=False, ncol=3)
     return fig
 
 

@@ -40,7 +40,8 @@ class Measured:
 
     t: p t, float64[n], strictly increasing; theta: theta / alpha_ref, float64[n] finite;
     u: u / u_cr float64[n] or None (NaN where not measured); source: where it came from;
-    notes: what was accepted (uneven sampling, gaps, a quiet start...), one sentence each.
+    notes: what was accepted (uneven sampling, gaps, a quiet start...), one sentence each;
+    physical: whether the columns were t [s], theta [rad] (made dimensionless here).
     """
 
     t: np.ndarray
@@ -48,6 +49,7 @@ class Measured:
     u: np.ndarray | None
     source: str
     notes: tuple[str, ...] = field(default=())
+    physical: bool = False  # read from t [s], theta [rad] (with p and alpha_ref)
 
     @property
     def duration(self) -> float:
@@ -162,7 +164,7 @@ def read_measured(measured: Any, *, p: float | None = None, alpha_ref: float | N
         u = None
     if u is not None:
         notes.append("u_over_ucr read (shown, not fitted: the misfit is on theta)")
-    return Measured(t, theta, u, src, tuple(notes))
+    return Measured(t, theta, u, src, tuple(notes), physical=tname == "t")
 
 
 def noise_level(t: np.ndarray, theta: np.ndarray) -> float:

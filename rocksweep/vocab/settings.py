@@ -3,8 +3,8 @@ root finders (``numerics.root``), accuracy ladders, adaptive settings and their 
 the backends a sweep runs on.
 
 The presets' values live with the numerics (``rocksweep.numerics.PRESETS``, keyed by
-``PRESET_NAMES``); the ladders' settings with the accuracy study
-(``rocksweep.analysis.accuracy.LADDERS``, keyed by ``LADDER_NAMES``).
+``PRESET_NAMES``); the ladders' descriptions here (``LADDER_HELP``), their settings with
+the accuracy study (``rocksweep.analysis.accuracy.LADDERS``, keyed by ``LADDER_NAMES``).
 """
 
 from __future__ import annotations
@@ -20,14 +20,14 @@ ROOTS: tuple[str, ...] = tuple(ROOT_CODE)
 DEFAULT_ROOT = HERMITE
 
 #: the ladders of ``rocksweep accuracy --ladder`` and what each measures
-LADDERS: dict[str, str] = {
+LADDER_HELP: dict[str, str] = {
     "full": "steps per period 5..160, event_tol 1e-4..1e-8, presets",
     "short": "a quick check",
     "candidates": "the cheap settings the default preset is chosen from",
     "presets": "the presets alone: their tails on a scene of your own",
     "roots": "every preset with every event root finder",
 }
-LADDER_NAMES: tuple[str, ...] = tuple(LADDERS)
+LADDER_NAMES: tuple[str, ...] = tuple(LADDER_HELP)
 DEFAULT_LADDER = "full"
 #: the seed of the accuracy study's stratified sample when a caller gives none
 DEFAULT_SAMPLE_SEED = 0

@@ -69,7 +69,7 @@ def test_plot_width_presets_and_given_axes(pair):
 
 def test_pdf_has_truetype_fonts(pair, tmp_path):
     mem, _, _ = pair
-    from rocksweep.figures.common import save_figure
+    from rocksweep.figures.style import save_figure
 
     path = save_figure(rocksweep.plot(mem), tmp_path / "f.pdf")
     data = path.read_bytes()

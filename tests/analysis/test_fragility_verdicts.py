@@ -414,14 +414,14 @@ def test_ida_takes_no_flagged_stripe_as_safe_and_stops_at_a_flagged_run(suite_sc
     # a bisection run that comes back flagged stops the record's bisection
     import rocksweep.analysis.ida as ida_mod
 
-    real = ida_mod.simulate
+    real = ida_mod.run_point
 
     def flagged_run(pt, numerics, history=False):
         run = real(pt, numerics, history=history)
         run.out[L.OUT_STATUS] = int(run.out[L.OUT_STATUS]) | L.STATUS_EVENT_CAP
         return run
 
-    monkeypatch.setattr(ida_mod, "simulate", flagged_run)
+    monkeypatch.setattr(ida_mod, "run_point", flagged_run)
     stopped = rocksweep.ida(ds, rtol=1e-3).sel(record=name)
     assert int(stopped["unresolved"]) == 1 and int(stopped["runs"]) == 1
     assert float(stopped["ida_lo"]) == levels[j - 1] and float(stopped["ida_hi"]) == levels[j]

@@ -17,7 +17,7 @@ from matplotlib.text import Text
 
 import rocksweep
 from rocksweep.figures import WIDTHS
-from rocksweep.figures.common import Figure
+from rocksweep.figures.style import Figure
 
 ROOT = Path(__file__).resolve().parents[2]
 PKG = ROOT / "rocksweep"
@@ -44,7 +44,7 @@ def test_every_figure_module_builds_rocksweep_figures():
     write Type 3 fonts, a notebook would not show it); annotations may name it."""
     bare = []
     for path in sorted(PKG.rglob("*.py")):
-        if path == PKG / "figures" / "common.py":
+        if path == PKG / "figures" / "style.py":
             continue
         tree = ast.parse(path.read_text())
         mpl = any(isinstance(n, ast.ImportFrom) and n.module == "matplotlib.figure"
@@ -52,7 +52,7 @@ def test_every_figure_module_builds_rocksweep_figures():
         bare += [f"{path.relative_to(ROOT)}:{n.lineno}" for n in ast.walk(tree)
                  if mpl and isinstance(n, ast.Call) and isinstance(n.func, ast.Name)
                  and n.func.id == "Figure"]
-    assert not bare, "matplotlib's Figure imported (use rocksweep.figures.common.Figure): " \
+    assert not bare, "matplotlib's Figure imported (use rocksweep.figures.style.Figure): " \
         + ", ".join(bare)
 
 
@@ -181,3 +181,30 @@ def test_shapes_figure_has_a_panel_per_family():
     fig.savefig(buf, format="png", dpi=50)
     assert buf.getvalue()[:8] == PNG
     assert np.isfinite(fig.get_size_inches()).all()
+
+
+def test_long_legends_and_many_curves_fit_a_single_column(suite_result):
+    """Verdict-laden legend entries are wrapped, not allowed to squeeze the axes or run
+    off the figure; twelve risk curves get twelve colours."""
+    import warnings
+
+    import pandas as pd
+    from matplotlib.colors import to_rgba
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        suite = rocksweep.open(suite_result)
+        modes = rocksweep.fragility(suite, state=["mode1", "mode2"], bootstrap=10)
+        six = rocksweep.fragility(suite, state=["uplift", "theta:0.1", "theta:0.25",
+                                                "theta:0.5", "overturn", "mode1"],
+                                  bootstrap=0)
+    fig = rocksweep.plot(modes, width="single")
+    _fits(fig, "fragility mode1,mode2", "single")
+    assert fig.axes[0].get_position().width > 0.7  # of the figure's width
+    x = np.geomspace(0.01, 5.0, 20)
+    rk = rocksweep.risk(six, pd.DataFrame({"PGA [g]": x, "annual_rate": 1e-4 * x ** -2.0}))
+    fig = rocksweep.plot(rk, width="single")
+    _fits(fig, "risk of 12 curves", "single")
+    lines = [ln for ln in fig.axes[1].get_lines() if not ln.get_label().startswith("_")]
+    assert len(lines) == 12
+    assert len({to_rgba(ln.get_color()) for ln in lines}) == 12

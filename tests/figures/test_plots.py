@@ -236,7 +236,7 @@ def fig5_runs():
 
 
 def test_time_history_has_the_input_pulse_and_guide_legend(fig5_runs):
-    from rocksweep.figures.common import time_history
+    from rocksweep.figures.history import time_history
 
     fig = time_history(fig5_runs, ["lam"], "Figure 5")
     assert isinstance(fig, Figure) and len(fig.axes) == 4
@@ -256,7 +256,7 @@ def test_time_history_has_the_input_pulse_and_guide_legend(fig5_runs):
 
 
 def test_restitution_map_u0_curve_is_dark(body_fig2):
-    from rocksweep.figures.common import restitution_map
+    from rocksweep.figures.restitution import restitution_map
     from rocksweep.physics.bodies import restitution, restitution_rigid
 
     lam = np.linspace(0, 1, 11)
@@ -285,7 +285,7 @@ def test_work_precision_returns_two_axes(tmp_path):
 
 
 def test_save_figure_policy(tmp_path, device_node):
-    from rocksweep.figures.common import save_figure
+    from rocksweep.figures.style import save_figure
 
     fig = Figure()
     fig.add_subplot().plot([0, 1], [0, 1])
@@ -309,9 +309,10 @@ def test_no_backend_switch_and_no_pyplot():
 import sys, tempfile, os
 import matplotlib
 matplotlib.use("svg")
-import rocksweep.figures.common, rocksweep.figures.diagrams
+import rocksweep.figures.style, rocksweep.figures.diagrams
 import rocksweep.figures.accuracy, rocksweep.cli.plot
-from rocksweep.figures.common import restitution_map, save_figure
+from rocksweep.figures.restitution import restitution_map
+from rocksweep.figures.style import save_figure
 import numpy as np
 fig = restitution_map(np.linspace(0, 1, 3), np.linspace(-2, 2, 5), np.ones((3, 5)), 0.8)
 save_figure(fig, os.path.join(tempfile.mkdtemp(), "r.png"))
@@ -322,7 +323,7 @@ print(matplotlib.get_backend(), "matplotlib.pyplot" in sys.modules)
     assert proc.stdout.split() == ["svg", "False"]
     # without a backend chosen, importing the modules resolves none (no Agg forced)
     code = ("import matplotlib, sys; before = matplotlib.rcParams._get_backend_or_none();"
-            "import rocksweep.figures.common, rocksweep.figures.diagrams;"
+            "import rocksweep.figures.style, rocksweep.figures.diagrams;"
             "import rocksweep.figures.accuracy;"
             "print(before == matplotlib.rcParams._get_backend_or_none(),"
             " 'matplotlib.pyplot' in sys.modules)")

@@ -118,7 +118,7 @@ STRUCTURE_CASES = [
      "event_tol, horizon, rest_rate, max_events, root, rotation_step)"),
     (GOOD + "foo: 1\n",
      "foo: unknown key (allowed: name, body, impact, pulse, numerics, outputs, ground, "
-     "refine, initial)"),
+     "refine, initial, floor)"),
     (sub(", A_ratio: 5.0", ""),
      "pulse.A_ratio: missing required key (a number, a list of numbers or a range "
      "{start, stop, num})"),
@@ -131,7 +131,7 @@ STRUCTURE_CASES = [
      "outputs.energy = 'yes': must be true or false (store energy metrics)"),
     (GOOD + "name: 3\n", "name = 3: must be a string (the scene's title)"),
     ("[1, 2]", "a scene is a YAML mapping with sections body, impact, pulse, numerics, "
-     "outputs, ground, refine, initial (got [1, 2])"),
+     "outputs, ground, refine, initial, floor (got [1, 2])"),
 ]
 
 

@@ -7,29 +7,42 @@ from typing import Any
 
 from rocksweep.analysis.kinds import dataset_kind
 from rocksweep.errors import ApiError, Arg, PlotError, RocksweepError, flag  # noqa: F401 (re-exported)
+from rocksweep.vocab.kinds import (
+    BOUNDARIES,
+    CALIBRATION,
+    FLOOR_SPECTRUM,
+    FRAGILITY,
+    IDA,
+    IM_EFFICIENCY,
+    RISK,
+    SPECTRA,
+)
 
 
 def plot_analysis(ds: Any, *, ax: Any = None, width: str | None = None) -> Any:
     """The figure of a fragility, IDA, spectra, boundaries, risk, IM-efficiency or
     calibration Dataset (a sweep's diagram is ``rocksweep.figures.diagrams``)."""
     from rocksweep.figures import results
+    from rocksweep.figures.calibration import calibration_figure
     from rocksweep.figures.fragility import fragility_figure
+    from rocksweep.figures.spectrum import spectra_figure
 
     kind = dataset_kind(ds)
-    if kind == "fragility":
+    if kind == FRAGILITY:
         return fragility_figure(ds, ax=ax, width=width or "single")
-    if kind == "calibration":  # the command line's --plot figure
-        from rocksweep.figures.calibration import calibration_figure
-
+    if kind == CALIBRATION:
         return calibration_figure(ds, ax=ax)
-    draw = {"risk": results.risk_figure, "ida": results.ida_figure,
-            "spectra": results.spectra_dataset_figure,
-            "boundaries": results.boundaries_figure,
-            "im_efficiency": results.efficiency_figure}.get(kind or "")
+    if kind == FLOOR_SPECTRUM:
+        from rocksweep.figures.floors import floor_spectrum_figure
+
+        return floor_spectrum_figure(ds, ax=ax, width=width or "single")
+    draw = {RISK: results.risk_figure, IDA: results.ida_figure, SPECTRA: spectra_figure,
+            BOUNDARIES: results.boundaries_figure,
+            IM_EFFICIENCY: results.efficiency_figure}.get(kind or "")
     if draw is None:
         raise PlotError(f"a {kind or 'foreign'} Dataset has no figure (rocksweep.plot draws "
-                        "sweeps, fragility, IDA, spectra, boundaries, risk, "
-                        "IM-efficiency and calibration Datasets)")
+                        "sweeps, fragility, IDA, spectra, boundaries, risk, IM-efficiency "
+                        "and calibration Datasets)")
     return draw(ds, ax=ax, width=width)
 
 
@@ -41,8 +54,8 @@ def plot_any(ds: Any, x: str | None = None, y: str | None = None, *, ax: Any = N
     fragility, an analysis's figure (``plot_analysis``), at the journal ``width``."""
     import matplotlib
 
-    from rocksweep.figures.common import fit_width, width_style
     from rocksweep.figures.diagrams import friction_map, sweep_figure
+    from rocksweep.figures.style import fit_width, width_style
     from rocksweep.store.reader import as_result
 
     kind = dataset_kind(ds)
