@@ -71,7 +71,8 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     swept = [a.name for a in scene.swept]
 
     if as_json:
-        docs = [_json_safe({**r.summary(), **scene.physical_summary()}) for r in runs]
+        docs = [_json_safe({**r.summary(), **scene.physical_summary(),
+                            **scene.floor_summary(r.point)}) for r in runs]
         click.echo(json.dumps(docs[0] if len(docs) == 1 else docs, indent=2))
     else:
         if scene.physical is not None:
