@@ -857,6 +857,15 @@ def _hazard(d: Path, text: str) -> subprocess.CompletedProcess:
     return r
 
 
+case("risk --site of a one-curve hazard")(
+    lambda d: (fixture(d, "f.h5", "hz.csv"), cli(d, ["risk", "f.h5", "--hazard", "hz.csv",
+                                                     "--site", "0"]))[1])
+case("risk --state of a fitted fragility")(
+    lambda d: (fixture(d, "f.h5", "hz.csv"), cli(d, ["risk", "f.h5", "--hazard", "hz.csv",
+                                                     "--state", "mode1"]))[1])
+case("calibrate --p of a dimensionless history")(
+    lambda d: (fixture(d, "free.yaml", "m.csv"), cli(d, [
+        "calibrate", "free.yaml", "m.csv", "--fit", "impact.lam", "--p", "3"]))[1])
 case("hazard separated by semicolons")(lambda d: _hazard(d, HAZARD.replace(",", ";")))
 case("hazard separated by tabs")(lambda d: _hazard(d, HAZARD.replace(",", "\t")))
 

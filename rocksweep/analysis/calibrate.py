@@ -80,7 +80,7 @@ import numpy as np
 
 from rocksweep.analysis.peaks import Peaks, alignment_cost, excursions, hermite, onset
 from rocksweep.compute.dispatch import run_variant
-from rocksweep.errors import CalibrationError, RocksweepError  # noqa: F401 (CalibrationError re-exported)
+from rocksweep.errors import CalibrationError, RocksweepError, set_key  # noqa: F401 (CalibrationError re-exported)
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import warm_up
 from rocksweep.numerics import Numerics, step_budget
@@ -88,6 +88,7 @@ from rocksweep.physics.bodies import BodyError
 from rocksweep.physics.measured import Measured, noise_level, read_measured
 from rocksweep.physics.points import INITIAL, kernel_kind, point_row
 from rocksweep.schema import KEYS, fmt
+from rocksweep.vocab.axes import axis_name
 from rocksweep.vocab.kinds import CALIBRATION, KIND_ATTR
 from rocksweep.vocab.laws import CONSTANT, LAWS
 
@@ -350,7 +351,7 @@ def check_fit_key(scene: Any, key: Any) -> str:
     if key not in allowed:
         raise CalibrationError(f"fit {key}: not a number of this scene (fit one of "
                                f"{', '.join(allowed)})")
-    return key.split(".", 1)[1]
+    return axis_name(key)
 
 
 def check_bounds(key: str, given: Any) -> tuple[float, float]:
@@ -383,7 +384,8 @@ def _single_values(scene: Any, fitted: Sequence[str]) -> dict[str, Any]:
     for a in scene.axes:
         if len(a.values) != 1 and a.name not in fitted:
             raise CalibrationError(f"{a.key} has {len(a.values)} values: a calibration "
-                                   f"fits one point; pick one with --set {a.key}=VALUE")
+                                   "fits one point; pick one with {fix}",
+                                   fix=set_key(a.key, "set_fix"))
     return {a.name: a.values[0] for a in scene.axes}
 
 
@@ -788,6 +790,10 @@ def calibrate_scene(scene: Any, measured: Any, fit: str | Sequence[str],
     values = {a.name: a.values[0] for a in scene.axes}
     body = scene.point(values).body
     m = read_measured(measured, p=p_body, alpha_ref=body.alpha_ref, u_cr=body.u_cr or None)
+    if p is not None and not m.physical:
+        raise CalibrationError(f"p = {p!r}: {m.source} has the dimensionless columns p_t, "
+                               "theta_over_alpha; p reads physical columns t [s], theta "
+                               "[rad] only (leave it out)")
     _check_measured_span(m, body.alpha_ref)
     return calibrate_problem(Problem(scene, m, keys, bounds, noise), ci)
 

@@ -56,7 +56,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from rocksweep.errors import RiskError, RocksweepError  # noqa: F401 (re-exported)
+from rocksweep.errors import Arg, RiskError, RocksweepError  # noqa: F401 (re-exported)
 from rocksweep.inputs import check_columns, csv_table, number, number_column, read_text
 from rocksweep.outputs import shown
 from rocksweep.physics.bodies import G
@@ -234,8 +234,8 @@ def _openquake(text: str, where: str, site: int | None) -> Hazard:
     if not table.rows:
         raise RiskError(f"{where}: no site rows")
     if site is None and len(table.rows) > 1:
-        raise RiskError(f"{where}: {len(table.rows)} sites; choose one with site= (0 to "
-                        f"{len(table.rows) - 1}, the row order; --site on the command line)")
+        raise RiskError(f"{where}: {len(table.rows)} sites; choose one with {{site}} (0 to "
+                        f"{len(table.rows) - 1}, the row order)", site=Arg("site"))
     k = 0 if site is None else site
     if not 0 <= k < len(table.rows):
         raise RiskError(f"{where}: site = {site!r}: the file has sites 0 to "
@@ -282,9 +282,9 @@ def read_hazard(source: Any, *, site: int | None = None) -> Hazard:
         return source
     if hasattr(source, "columns") and hasattr(source, "iloc"):
         return hazard_frame(source)
-    if not isinstance(source, str | Path):
-        raise RiskError(f"hazard = {type(source).__name__}: a CSV path or a pandas DataFrame "
-                        f"('IM [unit]', '{RATE_COLUMN}')")
+    if not isinstance(source, str | Path):  # a wrong type: a TypeError, as every argument's
+        raise TypeError(f"hazard = {type(source).__name__}: must be a CSV path or a pandas "
+                        f"DataFrame ('IM [unit]', '{RATE_COLUMN}')")
     path = Path(source)
     where = shown(path)
     text = read_text(path, "hazard curve", RiskError, max_bytes=MAX_HAZARD_BYTES)
@@ -294,6 +294,9 @@ def read_hazard(source: Any, *, site: int | None = None) -> Hazard:
     if lines[0].lstrip().startswith("#") and any(
             ln.replace(" ", "").startswith("lon,lat") for ln in lines[1:3]):
         return _openquake(text.lstrip("\n\r \t"), where, site)
+    if site is not None:  # one curve: a site to choose means another file was meant
+        raise RiskError(f"site = {site!r}: {where} is one hazard curve (IM, {RATE_COLUMN}); "
+                        "a site is chosen in OpenQuake's files of several sites")
     table = csv_table(text, where, RiskError, "hazard curve",
                       expect=f"'IM [unit],{RATE_COLUMN}'")
     rows = [f"{where}, line {ln}" for ln in table.lines]

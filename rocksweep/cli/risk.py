@@ -12,8 +12,7 @@ import click
 
 from rocksweep.cli.helpers import check_table_outputs, write_table
 from rocksweep.cli.main import main, user_errors
-from rocksweep.cli.options import dpi_option, overwrite_option
-from rocksweep.figures import WIDTHS
+from rocksweep.cli.options import dpi_option, json_option, overwrite_option, width_option
 from rocksweep.vocab.kinds import RISK
 
 RISK_SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
@@ -56,9 +55,9 @@ def _g(v) -> str:
               help="N: the probability of at least one occurrence in N years.")
 @click.option("--site", type=click.IntRange(0), default=None,
               help="OpenQuake files with several sites: the row to use (0 = first).")
-@click.option("--state", default="overturn", show_default=True,
+@click.option("--state", default=None,
               help="When FRAG.h5 is a suite sweep, the states to fit first (as "
-                   "rocksweep fragility --state).")
+                   "rocksweep fragility --state; default overturn).")
 @click.option("--joint", is_flag=True,
               help="When FRAG.h5 is a suite sweep: fit the states jointly (as rocksweep "
                    "fragility --joint).")
@@ -68,15 +67,14 @@ def _g(v) -> str:
 @click.option("--plot", "fig_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Figure: hazard curve, fragility and the rate's integrand (.png, .pdf, "
                    ".svg).")
-@click.option("--json", "as_json", is_flag=True, help="Print the rows as JSON.")
-@click.option("--width", type=click.Choice(list(WIDTHS)), default="double",
-              show_default=True, help="Figure width: a journal's single or double column.")
+@json_option("the rows")
+@width_option("double")
 @dpi_option
 @overwrite_option
 @user_errors
-def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, state: str,
-         joint: bool, out_path: Path | None, fig_path: Path | None, as_json: bool, width: str,
-         dpi: int, overwrite: bool) -> None:
+def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None,
+         state: str | None, joint: bool, out_path: Path | None, fig_path: Path | None,
+         as_json: bool, width: str, dpi: int, overwrite: bool) -> None:
     """Mean annual rate lambda = integral P(state | im) |d lambda_im| of each state of a
     fragility (FRAG.h5 from rocksweep fragility -o, or a record-suite sweep) over a
     hazard curve, and the probability 1 - exp(-lambda N) in N years, with the band of the
@@ -95,8 +93,12 @@ def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None, sta
 
     ds = rocksweep.open(frag_path)
     check_fragility(ds, shown(frag_path), suites=True)
+    if dataset_kind(ds) != "sweep" and (state is not None or joint):
+        given = f"--state {state}" if state is not None else "--joint"
+        raise click.ClickException(f"{given}: {frag_path} is a fitted fragility (its states "
+                                   "are fixed); it applies to a record-suite sweep")
     if dataset_kind(ds) == "sweep":
-        states = [s.strip() for s in state.split(",") if s.strip()]
+        states = [s.strip() for s in (state or "overturn").split(",") if s.strip()]
         ds = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states,
                                  joint=joint)
     rk = rocksweep.risk(ds, hazard_path, years, site=site)

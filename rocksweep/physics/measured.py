@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.errors import MeasuredError, RocksweepError  # noqa: F401 (MeasuredError re-exported)
+from rocksweep.errors import Arg, MeasuredError, RocksweepError  # noqa: F401 (MeasuredError re-exported)
 from rocksweep.inputs import check_columns, csv_table, number_column, read_text
 from rocksweep.outputs import shown
 
@@ -40,7 +40,8 @@ class Measured:
 
     t: p t, float64[n], strictly increasing; theta: theta / alpha_ref, float64[n] finite;
     u: u / u_cr float64[n] or None (NaN where not measured); source: where it came from;
-    notes: what was accepted (uneven sampling, gaps, a quiet start...), one sentence each.
+    notes: what was accepted (uneven sampling, gaps, a quiet start...), one sentence each;
+    physical: whether the columns were t [s], theta [rad] (made dimensionless here).
     """
 
     t: np.ndarray
@@ -48,6 +49,7 @@ class Measured:
     u: np.ndarray | None
     source: str
     notes: tuple[str, ...] = field(default=())
+    physical: bool = False  # read from t [s], theta [rad] (with p and alpha_ref)
 
     @property
     def duration(self) -> float:
@@ -96,7 +98,7 @@ def read_measured(measured: Any, *, p: float | None = None, alpha_ref: float | N
         if runs.size > 1:
             raise MeasuredError(f"{src}: column run holds {runs.size} runs "
                                 f"({', '.join(f'{r:g}' for r in runs[:4])}...); give one "
-                                "run's rows (simulate --csv of one point)")
+                                "run's rows (the history CSV of one point)")
     if "p_t" in cols and "theta_over_alpha" in cols:
         t = column("p_t")
         theta = column("theta_over_alpha", gaps=True)
@@ -104,10 +106,10 @@ def read_measured(measured: Any, *, p: float | None = None, alpha_ref: float | N
         tname, thname = "p_t", "theta_over_alpha"
     elif "t" in cols and "theta" in cols:
         if p is None or alpha_ref is None:
-            raise MeasuredError(f"{src}: columns t [s], theta [rad] need the body's p "
-                                "[rad/s]: give p= (a number), or a physical body (kind: "
+            raise MeasuredError("{src}: columns t [s], theta [rad] need the body's p "
+                                "[rad/s]: give {p} (a number), or a physical body (kind: "
                                 "physical) or a record scene's ground.p; or give columns "
-                                "p_t, theta_over_alpha")
+                                "p_t, theta_over_alpha", src=src, p=Arg("p", kind="keyword"))
         t = column("t") * p
         theta = column("theta", gaps=True) / alpha_ref
         u = None
@@ -121,8 +123,8 @@ def read_measured(measured: Any, *, p: float | None = None, alpha_ref: float | N
         missing = "theta_over_alpha" if "p_t" in cols else (
             "theta" if "t" in cols else "p_t, theta_over_alpha")
         raise MeasuredError(f"{src}: no column {missing} (columns: {have}); a measured "
-                            "history needs p_t and theta_over_alpha (as simulate --csv "
-                            "writes), or t [s] and theta [rad]")
+                            "history needs p_t and theta_over_alpha (as a simulated "
+                            "history's CSV has), or t [s] and theta [rad]")
     if t.size == 0:
         raise MeasuredError(f"{src}: no rows")
     if not np.all(np.isfinite(t)):
@@ -162,7 +164,7 @@ def read_measured(measured: Any, *, p: float | None = None, alpha_ref: float | N
         u = None
     if u is not None:
         notes.append("u_over_ucr read (shown, not fitted: the misfit is on theta)")
-    return Measured(t, theta, u, src, tuple(notes))
+    return Measured(t, theta, u, src, tuple(notes), physical=tname == "t")
 
 
 def noise_level(t: np.ndarray, theta: np.ndarray) -> float:

@@ -157,6 +157,18 @@ def test_measured_csv_with_semicolons(tmp_path):
     one_line(err, "m.csv, line 1", "semicolons")
 
 
+def test_options_that_would_be_ignored_are_refused(tmp_path):
+    """A site for a one-curve hazard, p for a dimensionless history: said, not ignored."""
+    path = tmp_path / "h.csv"
+    path.write_text(HAZARD)
+    with pytest.raises(RiskError) as err:
+        read_hazard(path, site=0)
+    one_line(err, "site = 0", "h.csv")
+    with pytest.raises(CalibrationError) as err:
+        rocksweep.calibrate(BLOCK, history(), "impact.lam", p=3.0)
+    one_line(err, "p = 3.0", "p_t, theta_over_alpha")
+
+
 # --- the API's door --------------------------------------------------------------------------
 
 @pytest.mark.parametrize("call, words", [
@@ -170,6 +182,10 @@ def test_measured_csv_with_semicolons(tmp_path):
     (lambda: rocksweep.calibrate(BLOCK, history(), "impact.lam", p="3"), "p = '3'"),
     (lambda: rocksweep.risk(fragility(0.3, 0.4), power_law(), site=1.5), "site = 1.5"),
     (lambda: rocksweep.risk(fragility(0.3, 0.4), power_law(), site=True), "site = True"),
+    (lambda: rocksweep.risk(fragility(0.3, 0.4), 5), "hazard = int"),
+    (lambda: rocksweep.calibrate(BLOCK, history(), None), "fit = None"),
+    (lambda: rocksweep.calibrated_overrides(5), "fit = 5"),
+    (lambda: rocksweep.open(5), "path = 5"),
 ])
 def test_a_wrong_type_is_one_typeerror(call, words):
     with pytest.raises(TypeError) as err:

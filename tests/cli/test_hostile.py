@@ -357,3 +357,32 @@ def test_simulate_and_open_answer_in_one_line(work):
         with pytest.raises(error) as info:
             call()
         assert words in str(info.value) and "\n" not in str(info.value), str(info.value)
+
+
+@pytest.mark.parametrize("args", [["table", "RESULT", "-o", "out.csv"],
+                                  ["plot", "RESULT", "-o", "out.png"]])
+def test_a_file_made_meanwhile_at_the_output_is_kept(result, tmp_path, monkeypatch, args):
+    """The command checks its output, computes, then publishes: a file made at that path
+    in between (here: when the command makes its temporary file) is the user's and is
+    kept; the command refuses in one line and leaves no temporary file."""
+    import tempfile
+
+    from click.testing import CliRunner
+
+    from rocksweep.cli import main
+
+    out = tmp_path / args[-1]
+    real = tempfile.mkstemp
+
+    def mkstemp(*a, **k):
+        if not out.exists():
+            out.write_text("mine")
+        return real(*a, **k)
+
+    monkeypatch.setattr(tempfile, "mkstemp", mkstemp)
+    r = CliRunner().invoke(main, [str(result) if a == "RESULT" else
+                                  str(out) if a == args[-1] else a for a in args])
+    assert r.exit_code == 2, r.output
+    assert "made by another process meanwhile" in r.output
+    assert out.read_text() == "mine"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [out.name]
