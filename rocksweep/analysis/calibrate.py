@@ -80,7 +80,7 @@ import numpy as np
 
 from rocksweep.analysis.peaks import Peaks, alignment_cost, excursions, hermite, onset
 from rocksweep.compute.dispatch import run_variant
-from rocksweep.errors import CalibrationError, RocksweepError  # noqa: F401 (CalibrationError re-exported)
+from rocksweep.errors import CalibrationError, RocksweepError, set_key  # noqa: F401 (CalibrationError re-exported)
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import warm_up
 from rocksweep.numerics import Numerics, step_budget
@@ -383,7 +383,8 @@ def _single_values(scene: Any, fitted: Sequence[str]) -> dict[str, Any]:
     for a in scene.axes:
         if len(a.values) != 1 and a.name not in fitted:
             raise CalibrationError(f"{a.key} has {len(a.values)} values: a calibration "
-                                   f"fits one point; pick one with --set {a.key}=VALUE")
+                                   "fits one point; pick one with {fix}",
+                                   fix=set_key(a.key, "set_fix"))
     return {a.name: a.values[0] for a in scene.axes}
 
 

@@ -38,7 +38,13 @@ from typing import Any
 import numpy as np
 from scipy.special import log_ndtr, ndtr, ndtri, owens_t
 
-from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP, MAX_BOOTSTRAP
+from rocksweep.analysis.resampling import (
+    DEFAULT_BOOTSTRAP,
+    DEFAULT_CI,
+    DEFAULT_SEED,
+    MAX_BOOTSTRAP,
+    check_ci,
+)
 from rocksweep.errors import FragilityError
 
 #: how a fit ended (the codes the batched fits return are indices into this)
@@ -707,7 +713,8 @@ class Bootstrap:
 def bootstrap_records(im: Sequence[float] | np.ndarray, failed: np.ndarray,
                       counted: np.ndarray | None = None, *,
                       n_boot: int = DEFAULT_BOOTSTRAP,
-                      seed: int | np.random.Generator = 0, ci: float = 0.9) -> Bootstrap:
+                      seed: int | np.random.Generator = DEFAULT_SEED,
+                      ci: float = DEFAULT_CI) -> Bootstrap:
     """Bootstrap the fragility fit over records.
 
     Stripes: im float[S] (levels), failed bool[R, S] (record r reaches the state at level
@@ -738,13 +745,6 @@ def bootstrap_records(im: Sequence[float] | np.ndarray, failed: np.ndarray,
     med, bet = np.where(undefined, np.nan, med), np.where(undefined, np.nan, bet)
     return Bootstrap(percentile_interval(med, ci), percentile_interval(bet, ci), med, bet,
                      int(undefined.sum()), ci)
-
-
-def check_ci(ci: Any) -> float:
-    if isinstance(ci, bool) or not isinstance(ci, int | float | np.integer | np.floating) \
-            or not (0.0 < float(ci) < 1.0):
-        raise FragilityError(f"ci = {ci!r}: must be a number in (0, 1), e.g. 0.9")
-    return float(ci)
 
 
 def check_bootstrap(n: Any, curves: int) -> int:

@@ -27,8 +27,9 @@ def floor_spectrum(result_path: Path, fig_path: Path | None, rtol: float, search
     suite (each and worst orientation with an angle axis), or A_min of one record or a
     pulse, against the building's period."""
     from rocksweep.analysis.floors import floor_spectrum as compute
-    from rocksweep.figures.common import FORMATS, save_figure
+    from rocksweep.figures import FORMATS
     from rocksweep.figures.floors import floor_spectrum_figure
+    from rocksweep.figures.style import save_figure
     from rocksweep.outputs import check_output
     from rocksweep.store.dataset import result_dataset
     from rocksweep.store.reader import result_inputs
