@@ -641,13 +641,9 @@ def check_result(result: SweepResult, axes: Sequence[str] | None = None) -> Scen
         check_amplitudes(sc, axes[1])
         make_plan(sc, axes, coarse=0, audit=0.0)
     except AdaptiveError as err:
-        raise BoundaryError(f"{result.path}: {err}; boundaries need a diagram over two "
-                            "swept axes") from None
-    missing = int((np.asarray(result.arrays["outcome"]) < 0).sum())
-    if missing:
-        raise BoundaryError(f"{result.path}: incomplete result ({missing} of "
-                            f"{result.arrays['outcome'].size} points not computed yet); "
-                            "finish it with rocksweep sweep SCENE.yaml -o FILE --resume")
+        raise BoundaryError("{path}: {err}; boundaries need a diagram over two swept axes",
+                            path=result.path, err=err) from None
+    result.require_complete(BoundaryError, "A_min")
     return sc
 
 

@@ -131,10 +131,7 @@ def spectra(data, rtol: float = DEFAULT_RTOL, search: bool = True) -> Spectra:
                             f"w_over_p, and A_ratio; not swept: {', '.join(missing)} "
                             f"(swept: {', '.join(result.dims) or 'none'})")
     extra = [d for d in result.dims if d not in (freq, "A_ratio", "lam")]
-    if not result.done.all():
-        n = int((~result.done).sum())
-        raise SpectrumError(f"{result.path}: {n} points not computed; finish the sweep "
-                            "(rocksweep sweep SCENE -o OUT --resume) first")
+    result.require_complete(SpectrumError, "a spectrum")
     A = np.asarray(result.coords["A_ratio"], float)
     if not np.all(np.diff(A) > 0):
         raise SpectrumError(f"{result.path}: A_ratio must increase along its axis")

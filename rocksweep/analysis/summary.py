@@ -299,7 +299,7 @@ def format_info(d: dict) -> list[str]:
         lines.append(f"  physical body: p = {d['p']:.5g} rad/s")
     pct = 100 * d["points_done"] / max(1, d["points_total"])
     state = ("complete" if d["complete"] else
-             "INCOMPLETE (finish it with rocksweep sweep SCENE.yaml -o FILE --resume)")
+             "INCOMPLETE (a resume of its sweep finishes it)")
     lines.append(f"points: {d['points_done']} of {d['points_total']} done ({pct:.1f}%), "
                  f"{state}")
     ad = d.get("adaptive")
@@ -337,5 +337,5 @@ def format_info(d: dict) -> list[str]:
                  f"numpy {p['numpy_version']}, h5py {p['h5py_version']} "
                  f"(HDF5 {p['hdf5_version']}), Python {p['python_version']}")
     if p["overrides"]:
-        lines.append("overrides: " + " ".join(f"--set {o}" for o in p["overrides"]))
+        lines.append("overrides: " + ", ".join(p["overrides"]))
     return lines

@@ -38,7 +38,10 @@ def floor_spectrum_figure(fs: xr.Dataset, *, ax: Any = None,
                   f"{axis_label('A_ratio')} at overturning onset (ground)")
     if var == "p_overturn":
         ax.set_ylim(-0.02, 1.02)
-    title = "floor spectrum" + (f" ({len(curves)} curves, every {step})" if step > 1 else "")
+    im = str(fs.attrs.get("scale_im", "") or "")
+    title = ("floor spectrum" + (f", {im} of the ground motion" if var == "p_overturn" and im
+                                 and im != "none" else "")
+             + (f" ({len(curves)} curves, every {step})" if step > 1 else ""))
     ax.set_title(title, fontsize="small")
     ax.grid(True, alpha=0.25, linewidth=0.5)
     if ax.get_legend_handles_labels()[0]:

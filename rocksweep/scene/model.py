@@ -10,10 +10,10 @@ from typing import Any
 import numpy as np
 
 from rocksweep import fields
-from rocksweep.errors import SceneError
+from rocksweep.errors import SceneError, set_key
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
-from rocksweep.physics.bodies import BlockBody, Body, FlexibleBody
+from rocksweep.physics.bodies import BlockBody, Body, FlexibleBody, G
 from rocksweep.physics.path import GroundPath
 from rocksweep.physics.points import Point
 from rocksweep.physics.records import GroundRecord, vertical_samples
@@ -109,6 +109,11 @@ class Scene:
         ``rocksweep.simulate``'s summary, ``simulate --json`` and a result file's attrs);
         {} for a body of Pi groups."""
         return {} if self.physical is None else {"p": float(self.physical["p"])}
+
+    def floor_summary(self, point: Point) -> dict[str, float]:
+        """A run's peak floor acceleration {"floor_pfa": [g]} (a scene with a floor: the
+        peak of the motion that drove it, as a sweep stores it); {} without a floor."""
+        return {fields.FLOOR_PFA: point.A / G} if self.floor else {}
 
     def variables(self) -> dict[str, tuple[str, float, str]]:
         """The per-point variables a sweep of this scene stores, name -> (dtype, fill value
@@ -300,6 +305,6 @@ class Scene:
         for a in self.axes:
             if len(a.values) != 1:
                 raise SceneError(
-                    f"{a.key} has {len(a.values)} values: this command runs one point; "
-                    f"pick one with --set {a.key}=VALUE")
+                    f"{a.key} has {len(a.values)} values: this runs one point; pick one "
+                    "with {fix}", fix=set_key(a.key, "set_fix"))
         return self.point({a.name: a.values[0] for a in self.axes})

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, NoReturn
 import numpy as np
 
 from rocksweep import fields
-from rocksweep.errors import RocksweepError, StoreError
+from rocksweep.errors import RocksweepError, StoreError, flag
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outputs import shown
@@ -381,6 +381,16 @@ class SweepResult:
     def done(self) -> np.ndarray:
         return self.arrays["outcome"] != L.OUTCOME_NOT_RUN
 
+    def require_complete(self, error: type[RocksweepError], needs: str) -> None:
+        """The one refusal of an incomplete result by an analysis that needs every point
+        (``needs``: what it computes, e.g. "A_min"): ``error`` naming the file, how many
+        points are missing, and the resume that finishes it."""
+        missing = int((~self.done).sum())
+        if missing:
+            raise error(f"{shown(self.path)}: incomplete result ({missing} of "
+                        f"{self.done.size} points not computed yet); {needs} needs every "
+                        "point: finish the sweep with {resume}", resume=flag("resume"))
+
     @property
     def flagged(self) -> np.ndarray:
         return (self.arrays["status"] & L.STATUS_FLAGGED) != 0
@@ -661,7 +671,8 @@ def result_scene(result: SweepResult) -> Scene:
         sc = parse_scene(str(a["scene"]), str(result.path), overrides, record=record,
                          records=records, vertical=vertical)
     except RocksweepError as err:
-        raise StoreError(f"{shown(result.path)}: cannot rebuild its scene ({err})") from None
+        raise StoreError("{path}: cannot rebuild its scene ({err})", path=shown(result.path),
+                         err=err) from None
     stored = {k: v for k, v in result.scene.items() if k != "adaptive"}
     diffs = scene_differences(stored, resolved_scene(sc, overrides[:len(overrides) - added]))
     if diffs:

@@ -62,11 +62,12 @@ def suite_on_floors(tmp_path_factory):
              "floor": {"period": [0.2, 0.5, 1.0], "damping": 0.05, "participation": 1.3}}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return rocksweep.run(scene, output=d / "s.h5")
+        rocksweep.run(scene, output=d / "s.h5")
+    return d / "s.h5"
 
 
 def test_p_overturn_counts_the_records(suite_on_floors):
-    ds = suite_on_floors
+    ds = rocksweep.open(suite_on_floors)
     fs = rocksweep.floor_spectrum(ds)
     over = ds["outcome"].isin([1, 2])
     each = over.mean(("record", "angle")).transpose("PGA", "floor.period")
@@ -81,7 +82,7 @@ def test_p_overturn_counts_the_records(suite_on_floors):
 def test_fragility_gives_both_orientation_answers(suite_on_floors):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        fr = rocksweep.fragility(suite_on_floors, bootstrap=0)
+        fr = rocksweep.fragility(rocksweep.open(suite_on_floors), bootstrap=0)
     assert list(fr["orientation"].values) == ["each", "worst"]
     assert "floor.period" in fr["im_median"].dims
     assert fr["n_records"].sel(orientation="each").max() == 6  # 3 records x 2 angles
@@ -110,6 +111,7 @@ def test_a_min_floor_spectrum_of_one_record(tmp_path):
 
 
 def test_ida_table_and_plot_run_over_angle_and_floor_period(suite_on_floors):
+    suite_on_floors = rocksweep.open(suite_on_floors)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ida = rocksweep.ida(suite_on_floors)
@@ -121,3 +123,12 @@ def test_ida_table_and_plot_run_over_angle_and_floor_period(suite_on_floors):
         assert {"angle", "floor.period", "floor_pfa"} <= set(table.columns)
         assert len(table) == suite_on_floors["outcome"].size
         assert rocksweep.plot(suite_on_floors) is not None
+
+
+def test_the_floor_spectrum_command_writes_its_figure(suite_on_floors, tmp_path, cli):
+    from rocksweep.cli import main
+
+    fig = tmp_path / "floors.png"
+    res = cli.invoke(main, ["floor-spectrum", str(suite_on_floors), "-o", str(fig)])
+    assert res.exit_code == 0, res.output
+    assert fig.stat().st_size > 1000 and "share of records" in res.output

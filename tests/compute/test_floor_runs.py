@@ -156,3 +156,14 @@ def test_the_vertical_reaches_the_floor_unfiltered(tmp_path):
         "record": str(NEARFAULT), "A_ratio": 1.5, "p": 2.0},
         "floor": {"period": T, "damping": ZETA, "participation": GP}})
     assert without.summary["theta_max_over_alpha"] != on_floor.summary["theta_max_over_alpha"]
+
+
+def test_a_single_run_states_its_floor_pfa_as_the_sweep_stores_it(tmp_path):
+    scene = {"body": BLOCK, "ground": {"record": str(NEARFAULT), "A_ratio": 1.5, "p": 2.0},
+             "floor": {"period": T, "damping": ZETA, "participation": GP}}
+    one = rocksweep.simulate(scene)
+    ds = rocksweep.run(scene)
+    assert one.summary["floor_pfa"] == pytest.approx(float(ds["floor_pfa"]), rel=1e-12)
+    # the ground's peak is A_ratio g tan(alpha) = 1.5 tan(0.2) g; this building amplifies it
+    assert one.summary["floor_pfa"] > 1.5 * math.tan(0.2)
+    assert "floor_pfa" not in rocksweep.simulate({**scene, "floor": None}).summary
