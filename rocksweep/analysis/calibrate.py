@@ -90,7 +90,7 @@ from rocksweep.physics.points import INITIAL, kernel_kind, point_row
 from rocksweep.schema import KEYS, fmt
 from rocksweep.vocab.axes import axis_name
 from rocksweep.vocab.kinds import CALIBRATION, KIND_ATTR
-from rocksweep.vocab.laws import CONSTANT
+from rocksweep.vocab.laws import CONSTANT, LAWS
 
 ACCURACY = "fine"  # the least accuracy of a calibration's runs (``calibration_numerics``)
 H_NOISE = 4.0  # threshold of an excursion, in noise standard deviations ...
@@ -343,9 +343,10 @@ def check_fit_key(scene: Any, key: Any) -> str:
                                "{law: constant, e: ...} in the scene (or fit impact.e_factor)")
     laws = {str(v) for a in scene.axes if a.name == "law" for v in a.values}
     if key == "impact.lam" and laws and laws <= {CONSTANT}:
-        raise CalibrationError("fit impact.lam: law constant does not use lam (its e is "
+        others = " or ".join(law for law in LAWS if law != CONSTANT)
+        raise CalibrationError(f"fit impact.lam: law {CONSTANT} does not use lam (its e is "
                                "impact.e), so no lam changes a run; fit impact.e or "
-                               "impact.e_factor, or use law vertical or locked")
+                               f"impact.e_factor, or use law {others}")
     allowed = fittable(scene)
     if key not in allowed:
         raise CalibrationError(f"fit {key}: not a number of this scene (fit one of "

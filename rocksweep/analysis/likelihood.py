@@ -31,7 +31,7 @@ Every fit returns an ending code into ``ENDINGS`` per data set.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -663,7 +663,8 @@ def fitted_curves(kind: str, grid: np.ndarray, med: np.ndarray, bet: np.ndarray
 # ---------------------------------------------------------------------------------------
 
 
-def resample_weights(n_records: int, n_boot: int, seed: int | np.random.Generator, per: int):
+def resample_weights(n_records: int, n_boot: int, seed: int | np.random.Generator,
+                     per: int) -> Iterator[tuple[int, np.ndarray]]:
     """Resample weights in chunks: yields (start, w float (nb, R)), w[r] = how often record
     r is drawn; one Generator draws R indices a resample, as a single draw would."""
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)

@@ -94,6 +94,8 @@ def state_groups(states: Sequence[str], joint: bool = False) -> list[tuple[str, 
 
 
 def required(ds: xr.Dataset, name: str, why: str) -> xr.DataArray:
+    """ds[name], or a one-line FragilityError saying the Dataset lacks it and ``why`` it
+    is needed."""
     if name not in ds.variables:
         raise FragilityError(f"the Dataset has no variable {name!r} ({why})")
     return ds[name]
