@@ -190,3 +190,22 @@ def test_already_exists_is_one_error_everywhere(tmp_path):
         texts.add(str(err.value))
     assert texts == {f"{tmp_path / 'old.h5'}: already exists; use resume=True to finish it "
                      "or overwrite=True to replace it"}
+
+
+def test_an_incomplete_result_is_refused_in_one_wording(suite_result, tmp_path):
+    """boundaries, spectra and IDA refuse a result with points not computed through one
+    function (``SweepResult.require_complete``): one wording, naming what is missing and
+    the resume that finishes it."""
+    import rocksweep
+
+    sweep = rocksweep.run(SCENE)
+    suite = rocksweep.open(suite_result)
+    wording = (r": incomplete result \(1 of {} points not computed yet\); {} needs every "
+               r"point: finish the sweep with resume=True$")
+    for ds, call, what in ((sweep, rocksweep.boundaries, "A_min"),
+                           (sweep, rocksweep.spectra, "a spectrum"),
+                           (suite, rocksweep.ida, "IDA")):
+        outcome = ds["outcome"].values.copy()
+        outcome.flat[0] = -1
+        with pytest.raises(errors.RocksweepError, match=wording.format(outcome.size, what)):
+            call(ds.assign(outcome=(ds["outcome"].dims, outcome)))
