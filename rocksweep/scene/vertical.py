@@ -8,9 +8,10 @@ import math
 
 import numpy as np
 
+from rocksweep.errors import SceneError
 from rocksweep.outputs import shown
 from rocksweep.scene.admission import check_vertical_cost
-from rocksweep.scene.model import Scene, SceneError
+from rocksweep.scene.model import Scene
 from rocksweep.schema import KEYS, VERTICAL_KEYS, fmt
 from rocksweep.vocab.axes import alpha_symbol
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from helpers import one_line_error
 
+from rocksweep.errors import SceneError
 from rocksweep.kernel import layout as L
-from rocksweep.scene.model import SceneError
 from rocksweep.scene.parse import parse_scene
 
 BLOCK = "body: {kind: block, alpha: 0.2}\n"
