@@ -76,7 +76,11 @@ PULSE_KEY_SHAPES = _PULSE_KEY_SHAPES
 
 
 def apply_overrides(raw: dict, overrides: list[str]) -> dict:
-    """Apply ``section.key=VALUE`` overrides (VALUE parsed as YAML) to a raw scene."""
+    """Apply ``section.key=VALUE`` overrides (VALUE parsed as YAML) to a raw scene.
+
+    ``section.key=null`` leaves the key out (its default, or none), the one way an override
+    can take a key away (switching ``impact.law`` away from ``constant`` drops ``impact.e``);
+    a null written in a scene file is refused instead, where it would read as a value."""
     for item in overrides:
         if "=" not in item:
             raise SceneError("{entry}: expected KEY=VALUE, e.g. pulse.A_ratio=4.5",
@@ -92,14 +96,21 @@ def apply_overrides(raw: dict, overrides: list[str]) -> dict:
         except YamlError as err:
             raise SceneError("{key}: value {text} is not valid YAML ({why})",
                              key=set_key(key), text=fmt(text), why=err) from None
-        node = raw
+        node: Any = raw
         for p in parts[:-1]:
             if node.get(p) is None:
+                if value is None:  # the section is not there: nothing to leave out
+                    node = None
+                    break
                 node[p] = {}
             node = node[p]
             if not isinstance(node, dict):
                 raise SceneError("{key}: {p} is not a section", key=set_key(key), p=p)
-        node[parts[-1]] = value
+        if value is None:
+            if node is not None:
+                node.pop(parts[-1], None)
+        else:
+            node[parts[-1]] = value
     return raw
 
 
