@@ -65,6 +65,10 @@ class SpectrumError(RocksweepError, ValueError):
     """A result that has no spectra: wrong axes, incomplete (analysis.spectrum)."""
 
 
+class FloorError(RocksweepError, ValueError):
+    """A Dataset with no floor spectrum or orientation to give (analysis.floors)."""
+
+
 class FragilityError(RocksweepError, ValueError):
     """A Dataset or a request that fragility cannot answer (analysis.fragility)."""
 
