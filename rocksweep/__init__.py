@@ -34,7 +34,6 @@ from __future__ import annotations
 
 from rocksweep.accessor import register_accessor
 from rocksweep.api import (  # noqa: A004
-    Simulation,
     boundaries,
     boundary_lines,
     calibrate,
@@ -53,6 +52,7 @@ from rocksweep.api import (  # noqa: A004
     table,
 )
 from rocksweep.errors import RocksweepError
+from rocksweep.simulation import Simulation
 
 register_accessor()  # ds.rocksweep, if xarray is already imported (it is never imported here)
 

@@ -73,7 +73,7 @@ class RocksweepAccessor:
         """``outcome`` as words (not_run, safe, mode1, mode2), an object DataArray."""
         import numpy as np
 
-        from rocksweep.outcomes import OUTCOME_WORDS
+        from rocksweep.vocab.outcomes import OUTCOME_WORDS
 
         o = self._ds["outcome"]
         return o.copy(data=np.vectorize(OUTCOME_WORDS.get, otypes=[object])(o.values))

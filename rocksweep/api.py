@@ -3,12 +3,12 @@ and the analyses of a Dataset. Each function hands over to the room that does th
 and checks its arguments: scenes (``rocksweep.scene.inputs``), the sweep session
 (``rocksweep.compute.session``), a result as a Dataset (``rocksweep.store.dataset``), a
 run's history (``rocksweep.compute.history``), the analyses (``rocksweep.analysis``), the
-figures (``rocksweep.figures``), ``ds.rocksweep`` (``rocksweep.accessor``). Errors speak
-Python (``rocksweep.errors.speaks_python``).
+figures (``rocksweep.figures``), ``ds.rocksweep`` (``rocksweep.accessor``). Errors name
+the API's arguments (``rocksweep.errors.Arg``).
 
 Nothing heavy is imported here at module level (numba, h5py, xarray, matplotlib load
-inside the functions), so ``import rocksweep`` stays light; the names that moved out are
-still importable from here (``api.load``, ``api.sweep_file``, ...: PEP 562).
+inside the functions), so ``import rocksweep`` stays light. The names the API builds on
+are imported from their homes (``rocksweep.compute.session.sweep_file``, ...), not from here.
 """
 
 from __future__ import annotations
@@ -19,7 +19,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rocksweep.accessor import register_accessor
-from rocksweep.errors import ApiError, speaks_python  # noqa: F401 (ApiError: the API's)
+from rocksweep.analysis.resampling import DEFAULT_CI, DEFAULT_SEED
+from rocksweep.errors import ApiError
 from rocksweep.simulation import Simulation  # what simulate returns
 
 if TYPE_CHECKING:
@@ -28,33 +29,10 @@ if TYPE_CHECKING:
 
     from rocksweep.scene.inputs import Overrides, SceneLike
 
-# Names that live in their rooms, importable from here as before (loaded on first use):
-# SweepInterrupted is what ``run`` raises on Ctrl-C.
-_MOVED = {name: module for module, names in {
-    "rocksweep.compute.driver": ("WRITE_EVERY", "SweepInterrupted", "SweepReport"),
-    "rocksweep.scene.inputs": ("load", "override_strings"),
-    "rocksweep.compute.history": ("MAX_RUNS", "API_MAX_RUNS", "run_points",
-                                "history_dataset", "swept_values", "write_history_csv"),
-    "rocksweep.compute.adaptive": ("adaptive_options",),
-    "rocksweep.compute.session": ("sweep_file",),
-    "rocksweep.store.dataset": ("result_dataset",),
-    "rocksweep.accessor": ("RocksweepAccessor",),
-}.items() for name in names}
-
-
-def __getattr__(name: str) -> Any:
-    if name in _MOVED:
-        from importlib import import_module
-
-        return getattr(import_module(_MOVED[name]), name)
-    raise AttributeError(f"module 'rocksweep.api' has no attribute {name!r}")
-
 
 def _public(fn: Callable[..., Any]) -> Callable[..., Any]:
-    """A function of the API: errors in Python's words, and ``ds.rocksweep`` registered
-    after every call (once xarray is loaded: the Datasets it returns have the accessor,
-    whatever was called first)."""
-    fn = speaks_python(fn)
+    """A function of the API: ``ds.rocksweep`` registered after every call (once xarray is
+    loaded: the Datasets it returns have the accessor, whatever was called first)."""
 
     @functools.wraps(fn)
     def call(*args: Any, **kwargs: Any) -> Any:
@@ -217,8 +195,7 @@ def _check_ax(ax: Any) -> None:
 @_public
 def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any = None,
          curves: bool = False, show_computed: bool = False, mu: bool = False,
-         width: str | None = None, compare: str | None = None,
-         _names: tuple[str, ...] = ("x", "y", "compare")) -> Figure:
+         width: str | None = None, compare: str | None = None) -> Figure:
     """The figure of any rocksweep Dataset, pyplot-free: a sweep's stability diagram
     (Figures 3 and 4; the options below), or the figure of a fragility (curves, stripe
     fractions sized by record count, bands, beta in the legend, IM on a log axis), IDA,
@@ -235,22 +212,21 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     result with contact outputs) as a contour map instead of the classes. width:
     "single" or "double" (journal column widths with fonts to match), None for
     matplotlib's defaults. compare: a swept key (e.g. "impact.law" or "lam") whose values
-    are compared on one diagram, coloured by which of them overturn each cell (``rocksweep
-    plot --compare``). A result with per-point error estimates rings the points whose
-    outcome changes at half the step.
+    are compared on one diagram, coloured by which of them overturn each cell. A result
+    with per-point error estimates rings the points whose outcome changes at half the step.
     """
     from rocksweep.figures.by_kind import plot_any
 
     _check_dataset("ds", ds)
     _check_ax(ax)
-    _check_optional_text(**{_names[0]: x, _names[1]: y, _names[2]: compare, "width": width})
+    _check_optional_text(x=x, y=y, compare=compare, width=width)
     _check_flags(curves=curves, show_computed=show_computed, mu=mu)
     if isinstance(ds, str | Path):
         from rocksweep.analysis.files import open_any
 
         ds = open_any(ds)
     return plot_any(ds, x, y, ax=ax, curves=curves, show_computed=show_computed, mu=mu,
-                    width=width, compare=compare, names=_names)
+                    width=width, compare=compare)
 
 
 @_public
@@ -334,8 +310,8 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
 @_public
 def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
               im: str | None = None, period: float | None = None,
-              bootstrap: int | None = None, seed: int = 0, ci: float = 0.9,
-              joint: bool = False) -> xr.Dataset:
+              bootstrap: int | None = None, seed: int = DEFAULT_SEED,
+              ci: float = DEFAULT_CI, joint: bool = False) -> xr.Dataset:
     """Lognormal fragility curves P(state | IM = x) = Phi(ln(x / im_median) / beta) of a
     record-suite sweep (a scene with ``ground.records``), fitted by maximum likelihood
     (Baker 2015) to the counts at each stripe of a scaled suite ("stripes-mle") or to the

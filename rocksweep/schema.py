@@ -159,8 +159,8 @@ KEYS: dict[str, Key] = {
     "outputs.check": Key("bool", "must be true or false (rerun every point at half the step "
                          "and store the differences: an error estimate per point)",
                          required=False, default=False),
-    # adaptive sweeps (rocksweep.compute.adaptive, as `rocksweep sweep --adaptive`): the section's
-    # presence turns them on; CLI flags override its values
+    # adaptive sweeps (rocksweep.compute.adaptive): the section's presence turns them on; the
+    # API's keywords and the command line's options override its values (one range each)
     "refine.axes": Key("string", "must be a list of the two diagram axes, swept ranges of "
                        "the scene, e.g. [w_over_p, A_ratio]", required=False),
     "refine.coarse": Key("integer", "must be an integer in [0, 20] (the coarse pass takes "
@@ -357,11 +357,11 @@ def is_number(v: Any) -> bool:
     return isinstance(v, numbers.Real) and not isinstance(v, bool | np.bool_)
 
 
-def check_option(key: str, value: Any, label: str) -> str | None:
-    """None if ``value`` is admissible for ``key`` (None: not given), else one line
-    ``LABEL VALUE: allowed``. The command line's options (``--margin 9``) and the Python
-    API's keywords (``margin = 9``) that set a scene key are checked here, against the
-    same table as the scene's own section."""
+def check_option(key: str, value: Any) -> str | None:
+    """None if ``value`` is admissible for ``key`` (None: not given), else what is allowed
+    (``KEYS[key].allowed``). The settings the Python API's keywords and the command line's
+    options give for a scene key (``margin=9``) are checked here, against the same table
+    as the scene's own section."""
     if value is None:
         return None
     spec = KEYS[key]
@@ -371,4 +371,4 @@ def check_option(key: str, value: Any, label: str) -> str | None:
         ok = is_number(value)
     if ok:
         ok = check_value(key, as_float(value)) is None and not math.isnan(as_float(value))
-    return None if ok else f"{label} {fmt(value)}: {spec.allowed}"
+    return None if ok else spec.allowed

@@ -1,6 +1,6 @@
 """What a new user waits for, and what a point costs: compile, start-up, per point, vs reference.
 
-Prints, measured side by side in one run (issue 24):
+Prints, measured side by side in one run:
 
 1. cold compile: each kernel variant compiled alone in a fresh process with an empty
    NUMBA_CACHE_DIR (what the first sweep of a scene pays on a fresh machine, and every
@@ -33,8 +33,8 @@ Run it against another copy of the package (e.g. the code before a change) with
 5. A/B (``--against DIR``, DIR holding another copy's ``rocksweep`` package, e.g. ``git
    archive main | tar -x -C DIR``): rounds alternating between this copy and DIR, each
    measurement in a fresh process: item 1's cold compile of Figure 3(a)'s variant (CPU s),
-   the warm whole-process wall time of a 1-point ``rocksweep sweep`` (issue 31's start-up
-   target), and item 3's core-us per point of Figure 3(a) (this copy's
+   the warm whole-process wall time of a 1-point ``rocksweep sweep`` (the start-up
+   target: under 0.5 s), and item 3's core-us per point of Figure 3(a) (this copy's
    ``bench_kernel.best_pass`` on DIR's package), the order swapped every round; the
    median of each and the ratio this / DIR. Alone (``--against DIR --ab-only``) it takes
    ~25 s per round on 2 cores.
@@ -181,7 +181,7 @@ bk.kernel_pass(scene)
 p = bk.best_pass(scene, int(sys.argv[3]))
 print(json.dumps({"us": p["cpu"] / p["outs"].shape[0] * 1e6, "package": rocksweep.__file__}))
 """
-# a 1-point sweep (Figure 3(a)'s body at one pulse and lam): issue 31's start-up target
+# a 1-point sweep (Figure 3(a)'s body at one pulse and lam): the start-up target
 ONE_POINT = ["--set", "pulse.w_over_p=2.0", "--set", "pulse.A_ratio=3.0",
              "--set", "impact.lam=0.2"]
 

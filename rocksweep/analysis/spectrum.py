@@ -34,8 +34,11 @@ from rocksweep.analysis.boundaries import (
     grid_response,
     kernel_evaluator,
 )
-from rocksweep.analysis.tolerance import DEFAULT_RTOL, check_rtol
-from rocksweep.errors import SpectrumError  # noqa: F401 (defined there; re-exported)
+from rocksweep.analysis.tolerance import DEFAULT_RTOL
+from rocksweep.errors import (
+    SpectrumError,
+    check_rtol,
+)
 from rocksweep.vocab.outcomes import MODE_WORDS, OUTCOME_WORDS, flag_attrs
 
 
@@ -128,10 +131,7 @@ def spectra(data, rtol: float = DEFAULT_RTOL, search: bool = True) -> Spectra:
                             f"w_over_p, and A_ratio; not swept: {', '.join(missing)} "
                             f"(swept: {', '.join(result.dims) or 'none'})")
     extra = [d for d in result.dims if d not in (freq, "A_ratio", "lam")]
-    if not result.done.all():
-        n = int((~result.done).sum())
-        raise SpectrumError(f"{result.path}: {n} points not computed; finish the sweep "
-                            "(rocksweep sweep SCENE -o OUT --resume) first")
+    result.require_complete(SpectrumError, "a spectrum")
     A = np.asarray(result.coords["A_ratio"], float)
     if not np.all(np.diff(A) > 0):
         raise SpectrumError(f"{result.path}: A_ratio must increase along its axis")

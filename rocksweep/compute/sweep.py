@@ -31,18 +31,20 @@ from rocksweep import (
     fields,
     kernel,  # lazy: numba loads at the first kernel.chunk_kernel
 )
-from rocksweep.compute.arguments import (  # noqa: F401 (re-exported)
+from rocksweep.compute.arguments import (
     CONNECT_TIMEOUT,
-    MAX_JOBS_PER_CORE,
-    SweepError,
+    RETRY,
     check_jobs,
     probe_scheduler,
 )
 from rocksweep.compute.dispatch import run_variant
+from rocksweep.errors import SweepError, flag
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.numerics import point_seconds
 from rocksweep.physics.bodies import G
 from rocksweep.scene.grid import ChunkResult, ChunkRows, Grid
 from rocksweep.scene.model import Scene
+from rocksweep.vocab.settings import BACKENDS
 
 # Upper bound of the automatic chunk size [points]; see ``auto_chunk_size``.
 MAX_CHUNK = 1024
@@ -193,9 +195,8 @@ def check_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
         Client(address, timeout=f"{timeout}s").close()
     except (OSError, TimeoutError, ValueError) as err:
         raise SweepError(f"scheduler {address}: cannot reach a dask scheduler there "
-                         f"({type(err).__name__}); check the address, then run the same "
-                         "command again (with --resume to finish a file already started)"
-                         ) from None
+                         f"({type(err).__name__}); check the address, {RETRY}",
+                         resume=flag("resume")) from None
 
 
 def run_chunks(grid: Grid, chunks: Iterable[tuple[int, int]], level: int, jobs: int = 1,
@@ -208,8 +209,8 @@ def run_chunks(grid: Grid, chunks: Iterable[tuple[int, int]], level: int, jobs: 
     (never in this process), at most two chunks per worker thread in flight.
     """
     chunks = list(chunks)
-    if backend not in ("threads", "dask"):
-        raise ValueError(f"backend = {backend!r}: must be threads or dask")
+    if backend not in BACKENDS:
+        raise ValueError(f"backend = {backend!r}: must be {' or '.join(BACKENDS)}")
     n_jobs = check_jobs(jobs) if backend == "threads" else 1
     if not chunks:
         return
@@ -247,7 +248,8 @@ def _run_on_cluster(grid: Grid, chunks: list[tuple[int, int]], level: int,
         except TimeoutError:
             raise SweepError(f"dask cluster {scheduler}: no worker joined in "
                              f"{NO_WORKERS_TIMEOUT:g} s; start workers (dask worker "
-                             f"{scheduler}), then rerun with --resume") from None
+                             f"{scheduler}), then rerun with {{resume}}",
+                             resume=flag("resume")) from None
         in_flight = 2 * max(1, sum(client.nthreads().values()))
         todo = iter(chunks)
         running: dict = {}
@@ -275,7 +277,8 @@ def _run_on_cluster(grid: Grid, chunks: list[tuple[int, int]], level: int,
                     raise SweepError(
                         f"dask cluster {scheduler}: lost all its workers (none for "
                         f"{NO_WORKERS_TIMEOUT:g} s) with {len(running)} chunks unfinished; "
-                        "finished points are saved: start workers, then rerun with --resume")
+                        "finished points are saved: start workers, then rerun with {resume}",
+                        resume=flag("resume"))
                 continue
             for f in done:
                 a, b = running.pop(f)
@@ -290,20 +293,18 @@ def _run_on_cluster(grid: Grid, chunks: list[tuple[int, int]], level: int,
                     raise SweepError(
                         f"dask cluster {scheduler}: the chunk of points {a}..{b - 1} "
                         "killed the workers that ran it (out of memory?); finished "
-                        "points are saved: rerun with --resume") from None
+                        "points are saved: rerun with {resume}", resume=flag("resume")
+                    ) from None
                 submit(1)
                 yield res
 
 
 # ---------------------------------------------------------------------------------------
-# What a sweep will cost, before it runs (rocksweep.estimate, rocksweep sweep --dry-run)
+# What a sweep will cost, before it runs (rocksweep.estimate; the sweep command's dry run)
 # ---------------------------------------------------------------------------------------
 
-# Kernel time per RK4 evaluation [s] on the paper's figures at the default preset
-# (scripts/bench_compile.py: core-us per point over RK4 evaluations per point, 75-83 ns on
-# the four figures on the 2-core reference machine): the price of a step when no sample
-# can be run because the kernel is not compiled yet.
-SECONDS_PER_EVALUATION = 85e-9
+# The price of a step when no sample can be run because the kernel is not compiled yet:
+# ``numerics.SECONDS_PER_EVALUATION``.
 # Points run to measure the cost when the kernel variant is compiled: ~10 ms of work.
 ESTIMATE_SAMPLE = 256
 
@@ -376,7 +377,7 @@ def estimate(scene: Scene, jobs: int = 1, sample: int = ESTIMATE_SAMPLE,
         sampled = len(flat)
     else:
         evaluations = float(steps_bound)
-        seconds = evaluations * SECONDS_PER_EVALUATION / workers
+        seconds = point_seconds(evaluations) / workers
     return Estimate(n, steps_bound, evaluations, seconds, bool(to_compile or unknown),
                     COMPILE_SECONDS * (to_compile + unknown), len(grid.kinds()), sampled,
                     workers)

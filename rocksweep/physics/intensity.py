@@ -52,12 +52,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.signal import lfilter
 
 from rocksweep.physics.bodies import G  # gravity [m/s^2], the one definition
 from rocksweep.vocab.ground import AVGSA_POINTS, SA_DAMPING
 
-__all__ = ["AVGSA_POINTS", "G", "arias", "avg_sa", "avgsa_periods", "cav", "duration",
+__all__ = ["arias", "avg_sa", "avgsa_periods", "cav", "duration",
            "final_velocity", "free_vibration", "husid", "nj_response", "pga", "pgv",
            "refined", "sa", "significant_duration", "velocity"]
 
@@ -219,6 +218,9 @@ def nj_response(x, w: float, zeta: float, h: float, *, rate: bool = False):
     Returns (u, v_end): u float64[n] at the samples and the rate u' at the last sample;
     with ``rate`` (u, v), v = u' float64[n] at every sample (a second filter, same
     denominator)."""
+    # here, not at import: scipy.signal costs a scene (and every command) ~0.3 s of start-up
+    from scipy.signal import lfilter
+
     A, B0, B1 = _nj_coefficients(w, zeta, h)
     # the recurrence as a filter: u = H(z) x with
     # H = [B1u, B0u - a22 B1u + a12 B1v, a12 B0v - a22 B0u] / [1, -tr A, det A]

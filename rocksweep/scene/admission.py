@@ -15,15 +15,20 @@ from itertools import product
 
 import numpy as np
 
-from rocksweep.numerics import EVENT_STEP_ALLOWANCE, MAX_POINT_STEPS, Numerics
-from rocksweep.physics.bodies import BodyError
+from rocksweep.errors import BodyError, SceneError
+from rocksweep.numerics import (
+    EVENT_STEP_ALLOWANCE,
+    MAX_POINT_STEPS,
+    Numerics,
+    point_seconds,
+)
 from rocksweep.physics.points import (
     body_omega_rock,
     body_zeta_rock,
     record_cost,
     run_cost,
 )
-from rocksweep.scene.model import FLOOR_AXES, Scene, SceneError
+from rocksweep.scene.model import FLOOR_AXES, Scene
 from rocksweep.schema import KEYS, fmt
 
 # Body grids up to this many distinct bodies are checked body by body; larger ones at the
@@ -334,7 +339,8 @@ def _cost_message(scene: Scene, point: dict) -> str:
     why = (f"{n.max_steps_factor:g} x a run of {t_end:.3g} p*t in steps of {dt:.3g} p*t, "
            f"plus {EVENT_STEP_ALLOWANCE:g} per event x max_events {n.max_events}")
     head = (f"one point could need {cap:.2g} RK4 steps{label} ({why}), more than the cap of "
-            f"{MAX_POINT_STEPS:.0e} a point (~17 s of one core)")
+            f"{MAX_POINT_STEPS:.0e} a point (~{point_seconds(MAX_POINT_STEPS):.2g} s of one "
+            "core)")
     # which value of the point makes it costly: the one whose typical value cuts the most
     current = {**point, **{f"numerics.{k}": getattr(n, k)
                            for k in ("steps_per_period", "horizon", "max_events")}}

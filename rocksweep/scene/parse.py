@@ -26,26 +26,22 @@ from typing import Any
 
 import numpy as np
 
+from rocksweep.errors import BodyError, RecordError, SceneError, SuiteError, set_key
 from rocksweep.inputs import decode_text, read_input
 from rocksweep.numerics import Numerics
 from rocksweep.outputs import input_problem, is_input, shown
-from rocksweep.physics.bodies import BodyError, body_from_geometry
-from rocksweep.physics.points import FREE, INITIAL, RECORD
-from rocksweep.physics.records import GroundRecord, RecordError, read_record
+from rocksweep.physics.bodies import body_from_geometry
+from rocksweep.physics.records import GroundRecord, read_record
 from rocksweep.physics.suite import (
     AVGSA_RANGE,
     COMPONENTS,
-    DEFAULT_PERIODS,
-    RECORD_IMS,
     ROTD50,
-    SCALE_IMS,
     Suite,
-    SuiteError,
     make_suite,
 )
 from rocksweep.scene.admission import candidate_bodies, check_cost
 from rocksweep.scene.loader import CONTROL_CHARS, YamlError, load_yaml
-from rocksweep.scene.model import Axis, Scene, SceneError
+from rocksweep.scene.model import Axis, Scene
 from rocksweep.scene.peer import peer_suite
 from rocksweep.schema import (
     BODY_KEYS,
@@ -58,8 +54,8 @@ from rocksweep.schema import (
     is_number,
     section_keys,
 )
-from rocksweep.vocab.axes import DIAGRAM_AXES, alpha_symbol, axis_name
-from rocksweep.vocab.ground import MP
+from rocksweep.vocab.axes import DIAGRAM_AXES, INITIAL, alpha_symbol, axis_name
+from rocksweep.vocab.ground import DEFAULT_PERIODS, FREE, MP, RECORD, RECORD_IMS, SCALE_IMS
 from rocksweep.vocab.ground import PULSE_KEY_SHAPES as _PULSE_KEY_SHAPES
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
 from rocksweep.vocab.settings import DEFAULT_PRESET, FINE
@@ -79,27 +75,29 @@ PULSE_KEY_SHAPES = _PULSE_KEY_SHAPES
 
 
 def apply_overrides(raw: dict, overrides: list[str]) -> dict:
-    """Apply ``--set section.key=VALUE`` overrides (VALUE parsed as YAML) to a raw scene."""
+    """Apply ``section.key=VALUE`` overrides (VALUE parsed as YAML) to a raw scene."""
     for item in overrides:
         if "=" not in item:
-            raise SceneError(f"--set {item!r}: expected KEY=VALUE, e.g. pulse.A_ratio=4.5")
+            raise SceneError("{entry}: expected KEY=VALUE, e.g. pulse.A_ratio=4.5",
+                             entry=set_key(item, "set_entry"))
         key, text = item.split("=", 1)
         key = key.strip()
         parts = key.split(".")
         if not all(parts):
-            raise SceneError(f"--set {item!r}: expected KEY=VALUE, e.g. pulse.A_ratio=4.5")
+            raise SceneError("{entry}: expected KEY=VALUE, e.g. pulse.A_ratio=4.5",
+                             entry=set_key(item, "set_entry"))
         try:
             value = load_yaml(text)
         except YamlError as err:
-            raise SceneError(f"--set {key}: value {fmt(text)} is not valid YAML "
-                             f"({err})") from None
+            raise SceneError("{key}: value {text} is not valid YAML ({why})",
+                             key=set_key(key), text=fmt(text), why=err) from None
         node = raw
         for p in parts[:-1]:
             if node.get(p) is None:
                 node[p] = {}
             node = node[p]
             if not isinstance(node, dict):
-                raise SceneError(f"--set {key}: {p} is not a section")
+                raise SceneError("{key}: {p} is not a section", key=set_key(key), p=p)
         node[parts[-1]] = value
     return raw
 
@@ -121,12 +119,13 @@ def parse_scene(text: str, source: str = "scene", overrides: list[str] | None = 
         return _parse(text, overrides or [], Path(base) if base is not None else None,
                       record, records, h2, vertical)
     except SceneError as err:
-        raise SceneError(f"{source}: {err}") from None
+        raise SceneError("{source}: {err}", source=source, err=err) from None
 
 
 def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
     """The validated scene of a YAML file (a regular file: a FIFO, device or directory is
-    refused before it is opened, never waited on)."""
+    refused before it is opened, never waited on; a missing file is "no such scene file":
+    the one place that says it)."""
     path = Path(path)
     problem = input_problem(path)
     if problem is not None:

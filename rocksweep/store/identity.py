@@ -50,11 +50,9 @@ def path_resolved(scene: Scene) -> dict:
 
 
 def _adaptive_words(a: dict) -> str:
-    """Adaptive settings as the command-line options that give them."""
-    return (f"--adaptive --axes {','.join(a.get('axes', []))} --coarse {a.get('coarse')} "
-            f"--audit {a.get('audit')!r} --margin {a.get('margin')} --final-margin "
-            f"{a.get('final_margin')} --seed {a.get('seed')} --threshold "
-            f"{a.get('threshold')!r}")
+    """Adaptive settings as words: ``axes w_over_p,A_ratio, coarse 4, ...``."""
+    return ", ".join(f"{k} {','.join(map(str, v)) if k == 'axes' else v}"
+                     for k, v in a.items())
 
 
 def record_attrs(record) -> dict:

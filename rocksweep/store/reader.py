@@ -16,22 +16,13 @@ from typing import TYPE_CHECKING, NoReturn
 import numpy as np
 
 from rocksweep import fields
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import RocksweepError, StoreError, flag
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.outcomes import OUTCOME_WORDS
 from rocksweep.outputs import shown
 from rocksweep.scene.model import Scene
-from rocksweep.store._common import (
-    H5_ERRORS,
-    StoreError,
-    close_quietly,
-    cut_repr,
-    damaged,
-    error_reason,
-)
+from rocksweep.store._common import H5_ERRORS, close_quietly, cut_repr, damaged, error_reason
 from rocksweep.store.format import (
-    COMPUTED_FLAGS,
     FORMAT,
     FORMAT_VERSION,
     RECORD_GROUP,
@@ -41,7 +32,7 @@ from rocksweep.store.format import (
 )
 from rocksweep.store.identity import resolved_scene, scene_differences
 from rocksweep.vocab.axes import axis_name
-from rocksweep.vocab.outcomes import CLASSES, OUTCOME_CODE
+from rocksweep.vocab.outcomes import CLASSES, COMPUTED_FLAGS, OUTCOME_CODE, OUTCOME_WORDS
 from rocksweep.vocab.settings import ADAPTIVE_RESOLVED
 
 if TYPE_CHECKING:
@@ -390,6 +381,16 @@ class SweepResult:
     def done(self) -> np.ndarray:
         return self.arrays["outcome"] != L.OUTCOME_NOT_RUN
 
+    def require_complete(self, error: type[RocksweepError], needs: str) -> None:
+        """The one refusal of an incomplete result by an analysis that needs every point
+        (``needs``: what it computes, e.g. "A_min"): ``error`` naming the file, how many
+        points are missing, and the resume that finishes it."""
+        missing = int((~self.done).sum())
+        if missing:
+            raise error(f"{shown(self.path)}: incomplete result ({missing} of "
+                        f"{self.done.size} points not computed yet); {needs} needs every "
+                        "point: finish the sweep with {resume}", resume=flag("resume"))
+
     @property
     def flagged(self) -> np.ndarray:
         return (self.arrays["status"] & L.STATUS_FLAGGED) != 0
@@ -572,7 +573,8 @@ def stored_record(path: Path, rec: dict, group: str = RECORD_GROUP):
 def _stored_copy(path: Path, data: bytes, rec: dict, what: str):
     """A record's copy in a result file as a ``GroundRecord``, checked against the SHA-256
     the file states for it (``rec``: its ``sha256`` and ``source``)."""
-    from rocksweep.physics.records import RecordError, digest, parse_record
+    from rocksweep.errors import RecordError
+    from rocksweep.physics.records import digest, parse_record
 
     if digest(data) != rec.get("sha256"):
         raise damaged(path, f"{what} does not match its SHA-256")
@@ -633,7 +635,8 @@ def result_scene(result: SweepResult) -> Scene:
         # a Dataset made in memory (rocksweep.run without output) has no file to read
         record = stored_record(result.path, rec) if result.in_file else None
         if record is None:
-            from rocksweep.physics.records import RecordError, read_record
+            from rocksweep.errors import RecordError
+            from rocksweep.physics.records import read_record
 
             try:
                 record = read_record(rec["source"])
@@ -668,7 +671,8 @@ def result_scene(result: SweepResult) -> Scene:
         sc = parse_scene(str(a["scene"]), str(result.path), overrides, record=record,
                          records=records, vertical=vertical)
     except RocksweepError as err:
-        raise StoreError(f"{shown(result.path)}: cannot rebuild its scene ({err})") from None
+        raise StoreError("{path}: cannot rebuild its scene ({err})", path=shown(result.path),
+                         err=err) from None
     stored = {k: v for k, v in result.scene.items() if k != "adaptive"}
     diffs = scene_differences(stored, resolved_scene(sc, overrides[:len(overrides) - added]))
     if diffs:

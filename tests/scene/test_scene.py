@@ -14,11 +14,10 @@ import pytest
 from bodies import FIG3, FIG3_YAML
 
 from rocksweep.cli import main
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import BodyError, RocksweepError, SceneError
 from rocksweep.numerics import MAX_POINT_STEPS
-from rocksweep.physics.bodies import BlockBody, BodyError, FlexibleBody
+from rocksweep.physics.bodies import BlockBody, FlexibleBody
 from rocksweep.physics.points import body_omega_rock
-from rocksweep.scene.model import SceneError
 from rocksweep.scene.parse import MAX_POINTS, load_scene, parse_scene
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
@@ -160,7 +159,7 @@ def test_deep_nesting_is_one_line():
     deep = "[" * 3000 + "]" * 3000
     assert refused(GOOD + f"name: {deep}\n") == (
         "YAML error at line 5: nested more than 20 levels deep")
-    assert refused(GOOD, (f"name={deep}",)).startswith("--set name: value '[[[[")
+    assert refused(GOOD, (f"name={deep}",)).startswith("overrides['name']: value '[[[[")
     assert refused(GOOD, (f"name={deep}",)).endswith(
         "is not valid YAML (error at line 1: nested more than 20 levels deep)")
 
@@ -310,7 +309,7 @@ def test_a_point_beyond_the_step_cap_is_refused_with_the_bound(old, new, key, kw
     lead = (f"{key.strip('|')} = {float(value)!r}: one point could need {steps:.2g} RK4 steps"
             + REFINED)
     assert msg.startswith(lead), msg
-    assert ("more than the cap of 1e+08 a point (~17 s of one core); with the scene's other "
+    assert ("more than the cap of 1e+08 a point (~8.5 s of one core); with the scene's other "
             f"values {key} must be {op} ") in msg
     bound = float(msg.rsplit(" ", 1)[1])
     # the bound is where the cap is reached: at it the scene is accepted, 2% beyond refused

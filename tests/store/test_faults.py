@@ -34,10 +34,10 @@ from helpers import one_line_error
 
 from rocksweep.cli import main
 from rocksweep.compute.sweep import level, prepare
+from rocksweep.errors import OutputError, StoreError
 from rocksweep.fields import plain
 from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.parse import load_scene, parse_scene
-from rocksweep.store import StoreError
 from rocksweep.store.format import SESSION_ATTRS
 from rocksweep.store.reader import peek_done, read_result
 from rocksweep.store.writer import SweepFile
@@ -260,7 +260,7 @@ def test_resume_of_a_format_1_file_on_a_full_disk_is_one_line_and_changes_nothin
     out = in_namespace(f"mount -t tmpfs -o size=1m tmpfs {fs}", f"""
         import os, shutil, json, hashlib
         from rocksweep.scene.parse import parse_scene
-        from rocksweep.store import StoreError
+        from rocksweep.errors import StoreError
         from rocksweep.store.writer import SweepFile
         path = "{fs}/v1.h5"
         shutil.copy("{src}", path)
@@ -386,7 +386,7 @@ def test_device_paths_are_refused_even_with_overwrite(minor, device_node, cli):
     before = os.stat(dev)
     msg = (f"{dev}: not a regular file (a device, FIFO or socket); outputs are written to "
            "regular files only")
-    with pytest.raises(StoreError) as err:
+    with pytest.raises(OutputError) as err:  # an output path's problem, as from run
         SweepFile.create(dev, parse_scene(TEXT), overwrite=True)
     assert str(err.value) == msg
     assert one_line(cli.invoke(main, ["sweep", str(CI_SMALL), "-o", str(dev), "--overwrite"])) \
@@ -398,7 +398,7 @@ def test_device_paths_are_refused_even_with_overwrite(minor, device_node, cli):
 def test_fifo_is_refused(tmp_path):
     fifo = tmp_path / "pipe.h5"
     os.mkfifo(fifo)
-    with pytest.raises(StoreError) as err:
+    with pytest.raises(OutputError) as err:
         SweepFile.create(fifo, parse_scene(TEXT), overwrite=True)
     assert str(err.value) == (f"{fifo}: not a regular file (a device, FIFO or socket); "
                               "outputs are written to regular files only")
@@ -408,7 +408,7 @@ def test_fifo_is_refused(tmp_path):
 
 def test_missing_directory(tmp_path, cli):
     path = tmp_path / "nope" / "r.h5"
-    with pytest.raises(StoreError) as err:
+    with pytest.raises(OutputError) as err:
         SweepFile.create(path, parse_scene(TEXT))
     assert str(err.value) == f"{path}: directory {path.parent} does not exist"
     assert one_line(cli.invoke(main, ["sweep", str(CI_SMALL), "-o", str(path)])) == \
@@ -427,6 +427,7 @@ def test_read_only_directory_really_read_only(tmp_path):
     out = in_namespace(f"mount --bind {ro} {ro} && mount -o remount,bind,ro {ro}", f"""
         import json, os, subprocess, sys
         import rocksweep.store.writer as st
+        from rocksweep.errors import RocksweepError
         from rocksweep.scene.parse import parse_scene
         sc = parse_scene({TEXT!r})
         msgs = {{}}
@@ -436,7 +437,7 @@ def test_read_only_directory_really_read_only(tmp_path):
             try:
                 call()
                 msgs[key] = None
-            except st.StoreError as err:
+            except RocksweepError as err:  # OutputError (create), StoreError (resume)
                 msgs[key] = str(err)
         st.check_output = lambda *a, **k: None  # past the check: mkstemp itself fails
         try:
@@ -544,7 +545,7 @@ def test_overwrite_and_resume_refused_while_another_process_writes(tmp_path, cli
 RACER = FAKE_CHUNK + """
 import json, sys, time
 from rocksweep.scene.parse import parse_scene
-from rocksweep.store import StoreError
+from rocksweep.errors import StoreError
 from rocksweep.store.writer import SweepFile
 sc = parse_scene(@TEXT@)
 while time.time() < @START@:
