@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from bodies import FIG3_YAML
 
 from rocksweep import errors
 
@@ -121,8 +122,7 @@ def test_the_scan_sees_an_option():
     assert not OPTION.search("use overwrite=True; a-b--c; e.g. 1e-3")
 
 
-SCENE = ("name: t\nbody: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, "
-         "mA_over_m: 0.47, IA_ratio: 0.56}\nimpact: {lam: [0.0, 0.2]}\n"
+SCENE = ("name: t\n" + FIG3_YAML + "impact: {lam: [0.0, 0.2]}\n"
          "pulse: {shape: sine, w_over_p: [1.0, 2.0], A_ratio: [1.0, 2.0]}\n")
 
 

@@ -174,7 +174,7 @@ def test_the_accessor_is_there_after_importing_xarray_then_rocksweep():
 def test_the_accessor_methods_take_keywords_only():
     import inspect
 
-    from rocksweep.accessor import RocksweepAccessor
+    from rocksweep.api import RocksweepAccessor
 
     for name in ("plot", "boundaries", "spectra", "fragility", "ida", "im_efficiency"):
         params = list(inspect.signature(getattr(RocksweepAccessor, name)).parameters.values())
