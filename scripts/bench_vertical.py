@@ -16,13 +16,23 @@ turn within each round (the machine may be shared: load average printed).
 
     python scripts/bench_vertical.py            # ~1-2 min on 2 cores after compiling
     python scripts/bench_vertical.py --n 20     # quicker
+
+``--against DIR --rounds N`` (DIR holding another copy's ``rocksweep``, e.g. ``git archive
+REV | tar -x -C DIR``): scenes without a vertical, this copy against DIR, each
+measurement a fresh process, the order swapped every round: core-us per point of the
+outcome kernel (best of 7 passes) on Figures 3(a), 4(a), the block and the Ricker scene
+at small grids; the medians and their ratio.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
+import subprocess
+import sys
 import time
+from pathlib import Path
 
 import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
 import bench_kernel as bk
@@ -77,14 +87,68 @@ def one_pass(rows: np.ndarray, kinds: np.ndarray, ground: int) -> tuple[np.ndarr
     return outs, cpu
 
 
+_AB_SNIPPET = """
+import json, sys, time
+import numpy as np
+from rocksweep.kernel import chunk_kernel, warm_up
+from rocksweep.kernel import layout as L
+from rocksweep.scene.grid import Grid
+from rocksweep.scene.parse import load_scene
+res = {}
+for name, n in (("fig3a", 30), ("fig4a", 24), ("block", 40), ("ricker", 24)):
+    sc = load_scene(f"{sys.argv[1]}/configs/{name}.yaml", [
+        f"pulse.w_over_p={{start: 0.2, stop: 6, num: {n}}}",
+        f"pulse.A_ratio={{start: 0.3, stop: 12, num: {n}}}"])
+    cr = Grid(sc).rows(0, sc.size)
+    jobs = []
+    for kind in np.unique(cr.kinds):
+        warm_up(int(kind), L.LEVEL_OUTCOME, sc.ground)
+        jobs.append((chunk_kernel(int(kind), L.LEVEL_OUTCOME, sc.ground),
+                     np.ascontiguousarray(cr.rows[cr.kinds == kind])))
+    best = np.inf
+    for _ in range(7):
+        c0 = time.thread_time()
+        for fn, rows in jobs:
+            fn(rows, np.empty((rows.shape[0], L.N_OUT)))
+        best = min(best, time.thread_time() - c0)
+    res[name] = best / sc.size * 1e6
+print(json.dumps(res))
+"""
+
+
+def against(other: Path, rounds: int) -> None:
+    """Scenes without a vertical, this copy against ``other``, alternating (see above)."""
+    here = Path(__file__).resolve().parents[1]
+    got: dict[Path, list[dict]] = {here: [], other: []}
+    for r in range(rounds):
+        for tree in (here, other) if r % 2 == 0 else (other, here):
+            env = {**os.environ, "PYTHONPATH": str(tree)}
+            res = subprocess.run([sys.executable, "-c", _AB_SNIPPET, str(tree)], env=env,
+                                 capture_output=True, text=True, check=True)
+            got[tree].append(json.loads(res.stdout.splitlines()[-1]))
+            print(f"  round {r + 1} {'this ' if tree == here else 'other'} "
+                  + "  ".join(f"{k} {v:.2f}" for k, v in got[tree][-1].items()), flush=True)
+    print(f"  {'median core-us/point':<22}{'this':>8}{'other':>8}{'this/other':>12}")
+    for k in got[here][0]:
+        a = float(np.median([g[k] for g in got[here]]))
+        b = float(np.median([g[k] for g in got[other]]))
+        print(f"  {k:<22}{a:>8.3f}{b:>8.3f}{a / b:>12.4f}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=40, help="values per diagram axis")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--amplitude", type=float, default=0.3, help="[g]")
     ap.add_argument("--ratio", type=float, default=3.0, help="w_v / w of the pulse")
+    ap.add_argument("--against", type=Path, help="another copy's tree (A/B, no vertical)")
+    ap.add_argument("--rounds", type=int, default=6)
     args = ap.parse_args()
     print(f"bench_vertical: {os.cpu_count()} cores, load average {bk.load_avg()}")
+    if args.against is not None:
+        against(args.against.resolve(), args.rounds)
+        print(f"load average at end {bk.load_avg()}")
+        return
     for name in ("fig3a", "block"):
         scene = bk.scene_of(name, args.n)
         rows, kinds = rows_of(scene)
