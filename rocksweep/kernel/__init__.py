@@ -15,6 +15,8 @@ effect set; ``warm_up`` compiles one now. One idea per module:
   model holds; the contact variants);
 - ``loop``: ``simulate_point``, one point from start to outcome;
 - ``variants``: the compiled entry points and their tables;
+- ``vertical_variants``: the entry points of a vertical ground acceleration (imported on
+  first use);
 - ``_static``: calls that a variant's flags make dead, left out while typing;
 - ``_cache``: where numba caches them, stamped by the hash of these sources (imported
   by every module that defines a jitted function, before its first ``@njit(cache=True)``),

@@ -168,59 +168,6 @@ def point_rigid_history_ground(prm, out, hist):
     simulate_point(prm, out, hist, False, False, True, True, 1)
 
 
-# GROUND = 2 (GROUND_VERTICAL): every ground motion with a vertical component (``on`` a
-# float: gravity g + a_v, ``equations.ground_gravity``); compiled only when a scene asks.
-@njit(cache=True, nogil=True, **ENTRY)
-def chunk_flexible_vertical(prms, outs):
-    for i in range(prms.shape[0]):
-        simulate_point(prms[i], outs[i], None, True, True, False, None, 2)
-
-
-@njit(cache=True, nogil=True, **ENTRY)
-def chunk_flexible_undamped_vertical(prms, outs):
-    for i in range(prms.shape[0]):
-        simulate_point(prms[i], outs[i], None, True, False, False, None, 2)
-
-
-@njit(cache=True, nogil=True, **ENTRY)
-def chunk_rigid_vertical(prms, outs):
-    for i in range(prms.shape[0]):
-        simulate_point(prms[i], outs[i], None, False, False, False, None, 2)
-
-
-@njit(cache=True, nogil=True, **ENTRY)
-def chunk_flexible_energy_vertical(prms, outs):
-    for i in range(prms.shape[0]):
-        simulate_point(prms[i], outs[i], None, True, True, True, None, 2)
-
-
-@njit(cache=True, nogil=True, **ENTRY)
-def chunk_flexible_undamped_energy_vertical(prms, outs):
-    for i in range(prms.shape[0]):
-        simulate_point(prms[i], outs[i], None, True, False, True, None, 2)
-
-
-@njit(cache=True, nogil=True, **ENTRY)
-def chunk_rigid_energy_vertical(prms, outs):
-    for i in range(prms.shape[0]):
-        simulate_point(prms[i], outs[i], None, False, False, True, None, 2)
-
-
-@njit(cache=True, **ENTRY)
-def point_flexible_history_vertical(prm, out, hist):
-    simulate_point(prm, out, hist, True, True, True, True, 2)
-
-
-@njit(cache=True, **ENTRY)
-def point_flexible_undamped_history_vertical(prm, out, hist):
-    simulate_point(prm, out, hist, True, False, True, True, 2)
-
-
-@njit(cache=True, **ENTRY)
-def point_rigid_history_vertical(prm, out, hist):
-    simulate_point(prm, out, hist, False, False, True, True, 2)
-
-
 _CHUNK = {
     (KIND_FLEXIBLE, LEVEL_OUTCOME): chunk_flexible,
     (KIND_FLEXIBLE_UNDAMPED, LEVEL_OUTCOME): chunk_flexible_undamped,
@@ -250,28 +197,17 @@ _POINT_GROUND = {
     KIND_FLEXIBLE_UNDAMPED: point_flexible_undamped_history_ground,
     KIND_RIGID: point_rigid_history_ground,
 }
-_CHUNK_VERTICAL = {
-    (KIND_FLEXIBLE, LEVEL_OUTCOME): chunk_flexible_vertical,
-    (KIND_FLEXIBLE_UNDAMPED, LEVEL_OUTCOME): chunk_flexible_undamped_vertical,
-    (KIND_RIGID, LEVEL_OUTCOME): chunk_rigid_vertical,
-    (KIND_FLEXIBLE, LEVEL_ENERGY): chunk_flexible_energy_vertical,
-    (KIND_FLEXIBLE_UNDAMPED, LEVEL_ENERGY): chunk_flexible_undamped_energy_vertical,
-    (KIND_RIGID, LEVEL_ENERGY): chunk_rigid_energy_vertical,
-}
-_POINT_VERTICAL = {
-    KIND_FLEXIBLE: point_flexible_history_vertical,
-    KIND_FLEXIBLE_UNDAMPED: point_flexible_undamped_history_vertical,
-    KIND_RIGID: point_rigid_history_vertical,
-}
 for _entry in (*_CHUNK.values(), *_CHUNK_GROUND.values(), *_POINT.values(),
-               *_POINT_GROUND.values(), *_CHUNK_VERTICAL.values(), *_POINT_VERTICAL.values()):
+               *_POINT_GROUND.values()):
     loads_fast(_entry)  # a cached variant loads in ~5 ms, not ~0.25 s (_cache.EntryCache)
 
 
 def _tables(ground: int) -> tuple[dict, dict]:
     """(chunk table, point table) of a ground code (``layout.GROUND_*``; True is GROUND_ANY)."""
-    if ground == GROUND_VERTICAL:
-        return _CHUNK_VERTICAL, _POINT_VERTICAL
+    if ground == GROUND_VERTICAL:  # imported on first use: a scene without one never does
+        from rocksweep.kernel import vertical_variants as vv
+
+        return vv.CHUNK, vv.POINT
     return (_CHUNK_GROUND, _POINT_GROUND) if ground else (_CHUNK, _POINT)
 
 
