@@ -40,6 +40,7 @@ from rocksweep.api import (  # noqa: A004
     calibrate,
     calibrated_overrides,
     estimate,
+    floor_spectrum,
     fragility,
     ida,
     im_efficiency,
@@ -84,5 +85,5 @@ def __getattr__(name: str) -> str:
 
 
 __all__ = ["RocksweepError", "Simulation", "__version__", "boundaries", "boundary_lines",
-           "calibrate", "calibrated_overrides", "estimate", "fragility", "ida",
-           "im_efficiency", "open", "plot", "risk", "run", "simulate", "spectra", "table"]
+           "calibrate", "calibrated_overrides", "estimate", "floor_spectrum", "fragility",
+           "ida", "im_efficiency", "open", "plot", "risk", "run", "simulate", "spectra", "table"]

@@ -3,8 +3,8 @@ and the analyses of a Dataset. Each function hands over to the room that does th
 and checks its arguments: scenes (``rocksweep.scene.inputs``), the sweep session
 (``rocksweep.compute.session``), a result as a Dataset (``rocksweep.store.dataset``), a
 run's history (``rocksweep.compute.history``), the analyses (``rocksweep.analysis``), the
-figures (``rocksweep.figures``), ``ds.rocksweep`` (``rocksweep.accessor``). Errors speak
-Python (``rocksweep.errors.speaks_python``).
+figures (``rocksweep.figures``), ``ds.rocksweep`` (``rocksweep.accessor``). Errors name
+the API's arguments (``rocksweep.errors.Arg``).
 
 Nothing heavy is imported here at module level (numba, h5py, xarray, matplotlib load
 inside the functions), so ``import rocksweep`` stays light; the names that moved out are
@@ -19,7 +19,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rocksweep.accessor import register_accessor
-from rocksweep.errors import ApiError, speaks_python  # noqa: F401 (ApiError: the API's)
+from rocksweep.analysis.resampling import DEFAULT_CI, DEFAULT_SEED
+from rocksweep.errors import ApiError  # noqa: F401 (the API's)
 from rocksweep.simulation import Simulation  # what simulate returns
 
 if TYPE_CHECKING:
@@ -51,10 +52,8 @@ def __getattr__(name: str) -> Any:
 
 
 def _public(fn: Callable[..., Any]) -> Callable[..., Any]:
-    """A function of the API: errors in Python's words, and ``ds.rocksweep`` registered
-    after every call (once xarray is loaded: the Datasets it returns have the accessor,
-    whatever was called first)."""
-    fn = speaks_python(fn)
+    """A function of the API: ``ds.rocksweep`` registered after every call (once xarray is
+    loaded: the Datasets it returns have the accessor, whatever was called first)."""
 
     @functools.wraps(fn)
     def call(*args: Any, **kwargs: Any) -> Any:
@@ -217,8 +216,7 @@ def _check_ax(ax: Any) -> None:
 @_public
 def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any = None,
          curves: bool = False, show_computed: bool = False, mu: bool = False,
-         width: str | None = None, compare: str | None = None,
-         _names: tuple[str, ...] = ("x", "y", "compare")) -> Figure:
+         width: str | None = None, compare: str | None = None) -> Figure:
     """The figure of any rocksweep Dataset, pyplot-free: a sweep's stability diagram
     (Figures 3 and 4; the options below), or the figure of a fragility (curves, stripe
     fractions sized by record count, bands, beta in the legend, IM on a log axis), IDA,
@@ -235,22 +233,21 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     result with contact outputs) as a contour map instead of the classes. width:
     "single" or "double" (journal column widths with fonts to match), None for
     matplotlib's defaults. compare: a swept key (e.g. "impact.law" or "lam") whose values
-    are compared on one diagram, coloured by which of them overturn each cell (``rocksweep
-    plot --compare``). A result with per-point error estimates rings the points whose
-    outcome changes at half the step.
+    are compared on one diagram, coloured by which of them overturn each cell. A result
+    with per-point error estimates rings the points whose outcome changes at half the step.
     """
     from rocksweep.figures.by_kind import plot_any
 
     _check_dataset("ds", ds)
     _check_ax(ax)
-    _check_optional_text(**{_names[0]: x, _names[1]: y, _names[2]: compare, "width": width})
+    _check_optional_text(x=x, y=y, compare=compare, width=width)
     _check_flags(curves=curves, show_computed=show_computed, mu=mu)
     if isinstance(ds, str | Path):
         from rocksweep.analysis.files import open_any
 
         ds = open_any(ds)
     return plot_any(ds, x, y, ax=ax, curves=curves, show_computed=show_computed, mu=mu,
-                    width=width, compare=compare, names=_names)
+                    width=width, compare=compare)
 
 
 @_public
@@ -301,6 +298,18 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3, search: bool = True) -> xr.Datas
 
 
 @_public
+def floor_spectrum(ds: xr.Dataset, rtol: float = 1e-2, search: bool = True) -> xr.Dataset:
+    """The floor spectrum of a complete sweep over ``floor.period``: a record suite's
+    P(overturn) over (floor.period, stripe, ...) (with an ``angle`` axis for each
+    orientation answer: ``orientation`` each/worst), or one record's or a pulse's A_min
+    over floor.period, bisected to ``rtol`` (``rocksweep.analysis.floors``). Its figure:
+    ``rocksweep.plot``."""
+    from rocksweep.analysis.floors import floor_spectrum as compute
+
+    return compute(ds, rtol, search)
+
+
+@_public
 def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
     """Incremental dynamic analysis per record of a scaled record-suite sweep: the
     smallest IM (the stripe IM: PGA [g], PGV [m/s], Sa [g], ...) that overturns each
@@ -309,18 +318,21 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
     safe again (``resurrection``). ds: what ``run`` or ``open`` returns. Returns a Dataset
     over the other swept keys and ``record`` (``rocksweep.analysis.ida.ida``), with the
     stripes' ``theta_max_over_alpha`` of the points that did not overturn (the IDA
-    curves ``rocksweep.plot`` draws)."""
+    curves ``rocksweep.plot`` draws). A sweep over ``angle``: every (record, angle) is a
+    sample (``ida_im`` over angle), and ``ida_im_worst`` / ``worst_angle`` give each
+    record's worst orientation (the least IM that overturns it at any angle)."""
+    from rocksweep.analysis.floors import worst_ida
     from rocksweep.analysis.ida import ida_dataset
 
     _check_dataset("ds", ds)
-    return ida_dataset(ds, rtol)
+    return worst_ida(ida_dataset(ds, rtol))
 
 
 @_public
 def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
               im: str | None = None, period: float | None = None,
-              bootstrap: int | None = None, seed: int = 0, ci: float = 0.9,
-              joint: bool = False) -> xr.Dataset:
+              bootstrap: int | None = None, seed: int = DEFAULT_SEED,
+              ci: float = DEFAULT_CI, joint: bool = False) -> xr.Dataset:
     """Lognormal fragility curves P(state | IM = x) = Phi(ln(x / im_median) / beta) of a
     record-suite sweep (a scene with ``ground.records``), fitted by maximum likelihood
     (Baker 2015) to the counts at each stripe of a scaled suite ("stripes-mle") or to the
@@ -345,12 +357,20 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     should not be trusted as it is: also a ``FragilityWarning``), the counts
     ``n_records``, ``n_excluded``, ``n_not_run``, the fitted ``curve`` and its bands over
     ``im_grid``; for stripes ``fraction`` per stripe and ``first_level``,
-    ``resurrection`` per record.
+    ``resurrection`` per record. A sweep over ``angle`` gives both answers along an
+    ``orientation`` dimension: "each" (every (record, angle) a sample) and "worst" (the
+    worst angle per record: overturns at any angle).
     """
+    from rocksweep.analysis.floors import by_orientation
     from rocksweep.analysis.fragility import fragility as fit
 
-    return fit(_dataset_arg(ds, "ds"), state=state, im=im, period=period,
-               bootstrap=bootstrap, seed=seed, ci=ci, joint=joint)
+    ds = _dataset_arg(ds, "ds")
+    if "angle" in getattr(ds, "dims", ()):  # every orientation a sample, and the worst
+        return by_orientation(ds, lambda d: fit(
+            d, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci,
+            joint=joint))
+    return fit(ds, state=state, im=im, period=period, bootstrap=bootstrap, seed=seed, ci=ci,
+               joint=joint)
 
 
 @_public
@@ -439,7 +459,8 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     from rocksweep.scene.inputs import load, override_strings
 
     sc, _ = load(scene, [*override_strings(overrides), *override_strings(keys)])
-    out = [Simulation({**r.summary(), **sc.physical_summary()}, hist, r, title)
+    out = [Simulation({**r.summary(), **sc.physical_summary(), **sc.floor_summary(r.point)},
+                      hist, r, title)
            for r, hist, title in titled_runs(sc, API_MAX_RUNS)]
     return out[0] if sc.size == 1 else out
 

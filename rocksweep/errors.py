@@ -9,15 +9,95 @@ no traceback; from Python it is an ordinary exception (``except rocksweep.Rocksw
 
 from __future__ import annotations
 
-import functools
+import dataclasses
 import numbers
-import re
 from collections.abc import Callable
 from typing import Any
 
 
 class RocksweepError(Exception):
-    """A problem the user can fix; ``str()`` is one line."""
+    """A problem the user can fix; ``str()`` is one line.
+
+    A message that names an argument of the caller (``rtol = 0.3``, "pass
+    ``resume=True``") is a template whose fields are ``Arg``s: ``str()`` says them as the
+    Python API's keywords, ``said(words)`` in another caller's words (the command line's
+    options: ``rocksweep.cli.main``); a field that is itself a ``RocksweepError`` (a message
+    wrapping another) is said in the same words. The library never writes a command-line
+    option."""
+
+    def __init__(self, message: str = "", /, *args: Any, **fields: Any) -> None:
+        self.template = message
+        self.fields = fields
+        super().__init__(_filled(message, fields), *args)
+
+    def said(self, words: Callable[[Arg], str]) -> str:
+        """The message with each ``Arg`` said by ``words``."""
+        if not self.fields:
+            return str(self)
+        return _filled(self.template, {
+            k: words(v) if isinstance(v, Arg) else v.said(words)
+            if isinstance(v, RocksweepError) else v for k, v in self.fields.items()})
+
+
+def _filled(template: str, fields: dict[str, Any]) -> str:
+    """``template`` with its fields; as it is if it has none (or is no template: a brace
+    that came with a value)."""
+    if not fields:
+        return template
+    try:
+        return template.format(**fields)
+    except (KeyError, IndexError, ValueError):
+        return template
+
+
+_NO_VALUE = object()
+
+
+@dataclasses.dataclass(frozen=True)
+class Arg:
+    """An argument a message names, said by ``str()`` as the Python API's keyword.
+
+    name: the keyword (``rtol``, ``resume``; ``overrides`` for a scene key set by the
+    caller); value: as given, or none. kind:
+    - ``value``: ``rtol = 0.3`` (the name alone without a value),
+    - ``flag``: a flag to switch on, ``resume=True``,
+    - ``keyword``: an argument to give, its value the caller's, ``p=...``,
+    - ``set_key``: a scene key set by ``overrides`` (value: the key),
+      ``overrides['pulse.A_ratio']``,
+    - ``set_fix``: the same as a remedy, ``overrides={'pulse.A_ratio': ...}``,
+    - ``set_entry``: an entry of ``overrides`` as given, ``overrides entry 'x'``."""
+
+    name: str
+    value: Any = _NO_VALUE
+    kind: str = "value"
+
+    @property
+    def given(self) -> bool:
+        """Whether a value is named."""
+        return self.value is not _NO_VALUE
+
+    def __str__(self) -> str:
+        if self.kind == "flag":
+            return f"{self.name}=True"
+        if self.kind == "keyword":
+            return f"{self.name}=..."
+        if self.kind == "set_key":
+            return f"overrides[{self.value!r}]"
+        if self.kind == "set_fix":
+            return f"overrides={{{self.value!r}: ...}}"
+        if self.kind == "set_entry":
+            return f"overrides entry {self.value!r}"
+        return f"{self.name} = {self.value!r}" if self.given else self.name
+
+
+def flag(name: str) -> Arg:
+    """A flag the message asks for (``resume=True``)."""
+    return Arg(name, True, "flag")
+
+
+def set_key(key: str, kind: str = "set_key") -> Arg:
+    """A scene key set through ``overrides`` (``set_key``), or to set (``set_fix``)."""
+    return Arg("overrides", key, kind)
 
 
 class OutputError(RocksweepError, OSError):
@@ -143,12 +223,13 @@ def check_integer(name: str, v: Any, error: type[Exception] = TypeError) -> int:
 MAX_RTOL = 0.1  # rtol is in (0, MAX_RTOL]: a "minimum" looser than 10% is not one
 
 
-def check_rtol(rtol: Any, error: type[Exception] = ApiError, name: str = "rtol") -> float:
+def check_rtol(rtol: Any, error: type[RocksweepError] = ApiError) -> float:
     """A bisection's relative tolerance as a float in (0, MAX_RTOL], or ``error`` (one line
-    naming ``name``: ``rtol`` in Python, ``--rtol`` on the command line)."""
+    naming ``rtol``)."""
     if (isinstance(rtol, bool) or not isinstance(rtol, numbers.Real)
             or not 0 < rtol <= MAX_RTOL):
-        raise error(f"{name} = {rtol!r}: must be a relative tolerance in (0, {MAX_RTOL:g}]")
+        raise error(f"{{rtol}}: must be a relative tolerance in (0, {MAX_RTOL:g}]",
+                    rtol=Arg("rtol", rtol))
     return float(rtol)
 
 
@@ -158,50 +239,3 @@ def one_line(text: str) -> str:
     escaped as in Python (``\\n``, ``\\udc91``); printable non-ASCII kept."""
     return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii")
                    for c in text)
-
-
-# ---------------------------------------------------------------------------------------
-# Errors in Python's words (the API's functions)
-# ---------------------------------------------------------------------------------------
-
-# The library's messages name command-line flags where the CLI is the usual way in; the
-# API says the same in its own arguments.
-_FLAG_WORDS = (
-    (re.compile(r"--set '([^']*)'"), r"overrides entry '\1'"),
-    (re.compile(r"--set ([\w.]+)=VALUE"), r"overrides={'\1': ...}"),
-    (re.compile(r"--set ([\w.]+)=(\S+)"), r"overrides={'\1': \2}"),
-    (re.compile(r"--set ([\w.]+)"), r"overrides['\1']"),
-    (re.compile(r"--resume\b"), "resume=True"),
-    (re.compile(r"--overwrite\b"), "overwrite=True"),
-    (re.compile(r"--adaptive\b"), "adaptive=True"),
-    (re.compile(r"--jobs\b"), "jobs"),
-)
-
-
-def _pythonic(message: str) -> str:
-    """A one-line message with the command line's flags said as API arguments."""
-    for pattern, words in _FLAG_WORDS:
-        message = pattern.sub(words, message)
-    return message
-
-
-def speaks_python(fn: Callable) -> Callable:
-    """Re-raise the library's one-line errors with the flags they name said as the API's
-    arguments (``--set impact.lam=VALUE`` -> ``overrides={'impact.lam': ...}``)."""
-
-    @functools.wraps(fn)
-    def wrapper(*args: Any, **kwargs: Any) -> Any:
-        try:
-            return fn(*args, **kwargs)
-        except RocksweepError as err:
-            text = str(err)
-            said = _pythonic(text)
-            if said == text:
-                raise
-            try:
-                new = type(err)(said)
-            except TypeError:  # an error class with another constructor: as it is
-                raise err from None
-            raise new from None
-
-    return wrapper

@@ -176,12 +176,25 @@ def sweep_fields(energy: bool, contact: bool = False, check: bool = False
             + (CONTACT_FIELDS if contact else ()) + (CHECK_FIELDS if check else ()))
 
 
-def variables(energy: bool = False, contact: bool = False, check: bool = False
-              ) -> dict[str, tuple[str, float, str]]:
+#: the per-point variable of a scene with a ``floor:`` (not a kernel output: the peak of
+#: the floor motion the point's body was driven by, ``rocksweep.physics.floor``) [g]
+FLOOR_PFA = "floor_pfa"
+FLOOR_PFA_VARIABLE = ("float64", math.nan,
+                      "peak floor acceleration: max |a_f| of the floor motion that drove "
+                      "the body (the building's response to the scaled ground motion, its "
+                      "ring-down included), in g")
+
+
+def variables(energy: bool = False, contact: bool = False, check: bool = False,
+              floor: bool = False) -> dict[str, tuple[str, float, str]]:
     """The per-point variables a sweep stores: name -> (dtype, fill value of a point not
-    computed, meaning), from ``sweep_fields`` (the one table, ``FIELDS``)."""
-    return {f.name: (f.dtype, f.fill, f.meaning)
-            for f in sweep_fields(energy, contact, check)}
+    computed, meaning), from ``sweep_fields`` (the one table, ``FIELDS``), and
+    ``floor_pfa`` [g] with ``floor`` (a scene with a building)."""
+    out = {f.name: (f.dtype, f.fill, f.meaning)
+           for f in sweep_fields(energy, contact, check)}
+    if floor:
+        out[FLOOR_PFA] = FLOOR_PFA_VARIABLE
+    return out
 
 
 # Relative max|theta| errors (the accuracy study's theta_rel, the error estimates' tails in
@@ -306,6 +319,15 @@ RECORD_VARIABLES: dict[str, tuple[str, str | None, str]] = {
     "record_v_end": ("ground velocity at the end of the record", "m/s",
                      "the trapezoidal integral of the record as given at its last sample; far "
                      "from 0: the record drifts (not baseline-corrected)"),
+    "record_pga_v": ("peak vertical ground acceleration of the record", "g",
+                     "max |acc| of the vertical component (UP) as recorded"),
+    "record_v_over_h": ("vertical to horizontal peak ratio", "1",
+                        "PGA_v / PGA_h, PGA_h of the component the suite scales (H1's, or "
+                        "RotD50's with ground.scale.component: RotD50 and a PGA stripe)"),
+    "record_rotd50": ("RotD50 of the stripe IM", None,
+                      "the median over orientations 0-179 deg of the stripe IM of the two "
+                      "horizontals projected (Boore 2010): what scales the records with "
+                      "ground.scale.component: RotD50"),
     "record_npts": ("number of samples of the record", "1", "NPTS"),
     "record_dt": ("sample interval of the record", "s", "DT"),
     "record_duration": ("duration of the record", "s", "(NPTS - 1) DT"),

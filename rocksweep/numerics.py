@@ -63,13 +63,25 @@ MIN_EVENT_TOL = 1e-12
 # (``step_budget``): bisection takes log2(step/event_tol) ~ 20-40, Hermite 2-5.
 EVENT_STEP_ALLOWANCE = 200.0
 
+# Kernel time per RK4 evaluation [s] on the paper's figures at the default preset
+# (scripts/bench_compile.py: core-us per point over RK4 evaluations per point, 75-83 ns on
+# the four figures on the 2-core reference machine; docs/performance.md): the one price of
+# a step, from which a sweep's estimate (``compute.sweep.estimate``, before a sample can
+# be run) and the cost of a point at the cap below (``point_seconds``) are derived.
+SECONDS_PER_EVALUATION = 85e-9
+
 # Cap on one point's step budget (``step_budget``, PAR_MAXSTEPS) that a scene may imply:
-# a point that long takes seconds of one core (docs/performance.md gives the kernel's cost
-# per RK4 evaluation), the longest a single point may take before its values are taken
-# for a mistake (w_over_p = 1e-9, a pulse of 6e9 p*t; wn_over_p = 1e5 at steps of 1e-5).
-# The shipped scenes need at most 1.5e6 (fig4b at `fine`), of which the default allowance
-# for 5000 events is 1e6.
+# a point that long takes ``point_seconds(MAX_POINT_STEPS)`` (~8.5 s) of one core, the
+# longest a single point may take before its values are taken for a mistake (w_over_p =
+# 1e-9, a pulse of 6e9 p*t; wn_over_p = 1e5 at steps of 1e-5). The shipped scenes need at
+# most 1.5e6 (fig4b at `fine`), of which the default allowance for 5000 events is 1e6.
 MAX_POINT_STEPS = 1e8
+
+
+def point_seconds(steps: float) -> float:
+    """Seconds of one core a point of ``steps`` RK4 evaluations takes (at
+    ``SECONDS_PER_EVALUATION``)."""
+    return steps * SECONDS_PER_EVALUATION
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,7 @@
 """Output files: one policy for every command that writes one (no I/O libraries here).
 
-- An existing path is refused unless the user said ``overwrite`` (``--overwrite``).
+- An existing path is refused unless the caller said ``overwrite`` (``exists_error``: the
+  one "already exists", an ``OutputError`` from every writer, result files included).
 - A path that is a command's own input is refused even with ``overwrite``: every file the
   command reads (the scene, its records and record listings, the result being plotted,
   a hazard or measured CSV), compared by the file's identity (device and inode: a
@@ -36,7 +37,7 @@ import time
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
-from rocksweep.errors import OutputError
+from rocksweep.errors import OutputError, flag
 
 
 def os_reason(err: OSError) -> str:
@@ -131,6 +132,18 @@ def check_distinct(paths: dict[str, str | Path | None]) -> None:
         seen[key] = option
 
 
+def exists_error(path: str | Path, resumable: bool = False) -> OutputError:
+    """The one refusal of an existing output, from every writer: an ``OutputError`` (an
+    ``OSError``, as ``FileExistsError``; the output path's problem, like the others of this
+    module), saying how to go on: ``overwrite``, and for a result file ``resume``."""
+    if resumable:
+        return OutputError("{path}: already exists; use {resume} to finish it or {overwrite} "
+                           "to replace it", path=shown(path), resume=flag("resume"),
+                           overwrite=flag("overwrite"))
+    return OutputError("{path}: already exists; use {overwrite} to replace it",
+                       path=shown(path), overwrite=flag("overwrite"))
+
+
 def check_output(path: str | Path, *, overwrite: bool = False,
                  inputs: Iterable[str | Path] = (), suffixes: Iterable[str] = ()) -> Path:
     """Check that ``path`` may be written; return it as a Path, or raise OutputError.
@@ -159,7 +172,7 @@ def check_output(path: str | Path, *, overwrite: bool = False,
             raise OutputError(f"{shown(path)}: is this command's input; choose another "
                               "output path")
         if not overwrite:
-            raise OutputError(f"{shown(path)}: already exists; use --overwrite to replace it")
+            raise exists_error(path)
     parent = path.parent if str(path.parent) else Path(".")
     if not parent.is_dir():
         raise OutputError(f"{shown(path)}: directory {shown(parent)} does not exist")

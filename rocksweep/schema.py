@@ -159,8 +159,8 @@ KEYS: dict[str, Key] = {
     "outputs.check": Key("bool", "must be true or false (rerun every point at half the step "
                          "and store the differences: an error estimate per point)",
                          required=False, default=False),
-    # adaptive sweeps (rocksweep.compute.adaptive, as `rocksweep sweep --adaptive`): the section's
-    # presence turns them on; CLI flags override its values
+    # adaptive sweeps (rocksweep.compute.adaptive): the section's presence turns them on; the
+    # API's keywords and the command line's options override its values (one range each)
     "refine.axes": Key("string", "must be a list of the two diagram axes, swept ranges of "
                        "the scene, e.g. [w_over_p, A_ratio]", required=False),
     "refine.coarse": Key("integer", "must be an integer in [0, 20] (the coarse pass takes "
@@ -208,6 +208,15 @@ KEYS: dict[str, Key] = {
                                0.0, math.inf, lo_in=False, hi_in=False),
     "ground.scale.period": Key("number", "must be in (0, 100] s (the period of Sa)", 0.0,
                                100.0, lo_in=False),
+    "ground.scale.component": Key("choice", "must be H1 (the first horizontal's IM) or "
+                                  "RotD50 (the median over orientations of both "
+                                  "horizontals', NGA-West2's convention; a suite of PEER "
+                                  "folders)", choices=("H1", "RotD50"), required=False,
+                                  default="H1"),
+    "ground.missing": Key("choice", "must be error (a record of a PEER folder without one "
+                          "of its components is refused) or skip (left out, with a "
+                          "warning)", choices=("error", "skip"), required=False,
+                          default="error"),
     "ground.scale.factor": Key("number", "must be a finite number > 0 (every record times "
                                "this factor)", 0.0, math.inf, lo_in=False, hi_in=False),
     "ground.periods": Key("string", "must be a list of periods in [0, 100] s (Sa stored per "
@@ -230,6 +239,26 @@ KEYS: dict[str, Key] = {
     "ground.avgsa": Key("string", "must be [T_lo, T_hi], periods in (0, 100] s with T_lo <= "
                         "T_hi (AvgSa's range; default 0.2-3 x scale.period for Sa stripes, "
                         "else 0.2-3 x 2 pi/p)", 0.0, 100.0, required=False),
+    # the excitation path (rocksweep.physics.path): a second horizontal component and the
+    # body's orientation; a building's floor between the ground and the body
+    "ground.h2": Key("string", "must be the path of the second horizontal component (PEER "
+                     ".AT2 or two-column, the first component's DT), relative to the scene "
+                     "file", required=False),
+    "ground.angle": Key("axis", "must be in [0, 360) deg (the angle between the body's "
+                        "rocking plane and the first horizontal component)", 0.0, 360.0,
+                        hi_in=False, required=False, default=0.0),
+    "floor.period": Key("axis", "must be a finite number > 0 [s] (the building mode's "
+                        "period)", 0.0, math.inf, lo_in=False, hi_in=False, required=False),
+    "floor.damping": Key("axis", "must be in (0, 1) (the building mode's damping ratio; an "
+                         "undamped building would ring for ever)", 0.0, 1.0, lo_in=False,
+                         hi_in=False, required=False),
+    "floor.participation": Key("axis", "must be a finite number other than 0 (Gamma phi: "
+                               "the mode's participation factor times its shape at the "
+                               "floor)", -math.inf, math.inf, lo_in=False, hi_in=False,
+                               required=False),
+    "floor.modes": Key("string", "must be a list of modes {period: T [s], damping: zeta, "
+                       "participation: Gamma phi} (numbers; sweep the one-mode form "
+                       "floor: {period, damping, participation})", required=False),
     "ground.p": Key("axis", f"must be in [1e-3, {1e3:g}] rad/s (the body's frequency "
                     "parameter p)", 1e-3, 1e3),
     # the vertical ground acceleration a_v, positive up (docs/vertical.md): a record's
@@ -261,7 +290,8 @@ BODY_KEYS: dict[str, tuple[str, ...]] = {
     "block": ("alpha", "inertia"),
     "physical": ("b", "h", "h_A", "m", "m_A", "I_A", "k", "c"),
 }
-SECTIONS = ("body", "impact", "pulse", "numerics", "outputs", "ground", "refine", "initial")
+SECTIONS = ("body", "impact", "pulse", "numerics", "outputs", "ground", "refine", "initial",
+            "floor")
 
 
 def section_keys(section: str, kind: str = "flexible") -> tuple[str, ...]:
@@ -327,11 +357,11 @@ def is_number(v: Any) -> bool:
     return isinstance(v, numbers.Real) and not isinstance(v, bool | np.bool_)
 
 
-def check_option(key: str, value: Any, label: str) -> str | None:
-    """None if ``value`` is admissible for ``key`` (None: not given), else one line
-    ``LABEL VALUE: allowed``. The command line's options (``--margin 9``) and the Python
-    API's keywords (``margin = 9``) that set a scene key are checked here, against the
-    same table as the scene's own section."""
+def check_option(key: str, value: Any) -> str | None:
+    """None if ``value`` is admissible for ``key`` (None: not given), else what is allowed
+    (``KEYS[key].allowed``). The settings the Python API's keywords and the command line's
+    options give for a scene key (``margin=9``) are checked here, against the same table
+    as the scene's own section."""
     if value is None:
         return None
     spec = KEYS[key]
@@ -341,4 +371,4 @@ def check_option(key: str, value: Any, label: str) -> str | None:
         ok = is_number(value)
     if ok:
         ok = check_value(key, as_float(value)) is None and not math.isnan(as_float(value))
-    return None if ok else f"{label} {fmt(value)}: {spec.allowed}"
+    return None if ok else spec.allowed

@@ -15,6 +15,8 @@ Runs the shipped commands, exactly as the README shows them:
 - ``rocksweep efficiency``, ``rocksweep fragility --state theta:0.25,theta:0.5,overturn -o``
   and ``rocksweep risk --hazard configs/hazard-example.csv --plot`` on that suite (``risk``:
   docs/efficiency.png, docs/risk.png);
+- ``rocksweep sweep configs/floor-spectrum.yaml`` and ``rocksweep floor-spectrum``
+  (docs/floor_spectrum.png);
 - with ``--accuracy``: ``rocksweep accuracy configs/fig3a.yaml --points 200 --plot``.
 
 Everything is written to a temporary directory first and moved into docs/ when the
@@ -54,13 +56,14 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--dpi", type=int, default=200, help="resolution of the PNGs [200]")
     ap.add_argument("--only", nargs="+", metavar="NAME",
                     choices=[*DIAGRAMS, "fig3a_check", "fig5", "fig2", "fragility",
-                             "accuracy_fig3a", "impact_laws", "fig2_locked", "risk"],
+                             "accuracy_fig3a", "impact_laws", "fig2_locked", "risk",
+                             "floor_spectrum"],
                     help="regenerate only these figures")
     ap.add_argument("--docs", type=Path, default=ROOT / "docs", help="output directory")
     ap.add_argument("--keep", type=Path, metavar="DIR", help="keep the sweep results here")
     args = ap.parse_args(argv)
     wanted = set(args.only or [*DIAGRAMS, "fig3a_check", "fig5", "fig2", "fragility",
-                               "impact_laws", "fig2_locked", "risk"]
+                               "impact_laws", "fig2_locked", "risk", "floor_spectrum"]
                  + (["accuracy_fig3a"] if args.accuracy else []))
     args.docs.mkdir(parents=True, exist_ok=True)
     if args.keep:
@@ -131,6 +134,13 @@ def main(argv: list[str] | None = None) -> None:
             rocksweep("plot", str(h5), "--compare", "impact.law", "-o",
                       str(tmp / "impact_laws.png"), "--dpi", str(args.dpi))
             publish("impact_laws")
+        if "floor_spectrum" in wanted:  # contents on a building's floor (docs/floors.md)
+            h5 = (args.keep or tmp) / "floor_spectrum.h5"
+            rocksweep("sweep", str(cfg / "floor-spectrum.yaml"), "-o", str(h5), "--jobs",
+                      str(args.jobs), "--quiet", "--overwrite")
+            rocksweep("floor-spectrum", str(h5), "-o", str(tmp / "floor_spectrum.png"),
+                      "--dpi", str(args.dpi))
+            publish("floor_spectrum")
         if "fig2_locked" in wanted:
             rocksweep("restitution", str(cfg / "fig2.yaml"), "--law", "locked", "--plot",
                       str(tmp / "fig2_locked.png"))

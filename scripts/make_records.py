@@ -124,6 +124,7 @@ def write_records(out: Path, generated, *, check: bool, overwrite: bool, describ
     print ``describe(path, record read back)``; with ``check``, only say whether each file
     equals what would be written. Returns the exit status (1: a file differs or cannot be
     written). Shared with ``make_suite.py``."""
+    from rocksweep.cli.main import said  # the message in this command's words (--overwrite)
     from rocksweep.errors import RocksweepError
     from rocksweep.physics.records import at2_text, read_record, write_at2
 
@@ -139,7 +140,7 @@ def write_records(out: Path, generated, *, check: bool, overwrite: bool, describ
             write_at2(path, acc, dt, title, overwrite=overwrite)
             rec = read_record(path)
         except RocksweepError as err:
-            print(f"Error: {err}", file=sys.stderr)
+            print(f"Error: {said(err)}", file=sys.stderr)
             return 1
         print(describe(path, rec))
     return status

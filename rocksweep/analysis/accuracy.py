@@ -47,7 +47,7 @@ from rocksweep.numerics import PRESETS, Numerics
 from rocksweep.scene.model import Scene, SceneError
 from rocksweep.vocab.axes import DIAGRAM_AXES, RECORD_X
 from rocksweep.vocab.outcomes import CLASSES
-from rocksweep.vocab.settings import DEFAULT_PRESET, ROOTS
+from rocksweep.vocab.settings import DEFAULT_PRESET, DEFAULT_SAMPLE_SEED, ROOTS
 
 OUTCOMES = CLASSES  # codes 0, 1, 2
 # Per-point fields of the report: all the outcome-level kernel fills (no energies).
@@ -197,8 +197,8 @@ class Sample:
 
 
 def stratified_sample(outcome: np.ndarray, boundary: np.ndarray, n: int | None,
-                      seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str],
-                                              np.ndarray]:
+                      seed: int = DEFAULT_SAMPLE_SEED
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str], np.ndarray]:
     """Draw the sample (see the module docstring). outcome, boundary: flat arrays [size].
 
     Returns (flat indices sorted, stratum per point, weight per point, strata names,
@@ -247,7 +247,7 @@ def stratified_sample(outcome: np.ndarray, boundary: np.ndarray, n: int | None,
             np.concatenate(weight)[order], names, np.asarray(sizes, np.int64))
 
 
-def sample_scene(scene: Scene, n: int | None, seed: int = 0) -> Sample:
+def sample_scene(scene: Scene, n: int | None, seed: int = DEFAULT_SAMPLE_SEED) -> Sample:
     """Classify every point at the scene's numerics, then draw the stratified sample.
 
     ``n`` None or >= the scene's size takes every point (one stratum "all", weights 1,
@@ -625,7 +625,8 @@ def _e_ref(scene: Scene, values: dict[str, np.ndarray], n: int) -> np.ndarray:
 
 
 def accuracy_study(scene: Scene, n_points: int | None = 200,
-                   settings: list[Setting] | None = None, seed: int = 0, repeat: int = 5,
+                   settings: list[Setting] | None = None, seed: int = DEFAULT_SAMPLE_SEED,
+                   repeat: int = 5,
                    progress: Callable[[str, int, int], None] | None = None,
                    check: bool = False) -> Study:
     """Measure time and error of each kernel setting against the reference on a sample.

@@ -373,7 +373,7 @@ class _Column:
         """The column's point with ``name`` (the searched axis) = value: the first grid
         point with A_ratio replaced (one body object for the column: its rows are filled
         at once), else ``scene.point``."""
-        if name != "A_ratio" or scene.suite is not None:
+        if name != "A_ratio" or scene.suite is not None or scene.path is not None:
             return scene.point({**self.values, name: value})
         if self.base is None:
             self.base = scene.point(self.values)
@@ -640,13 +640,9 @@ def check_result(result: SweepResult, axes: Sequence[str] | None = None) -> Scen
         check_amplitudes(sc, axes[1])
         make_plan(sc, axes, coarse=0, audit=0.0)
     except AdaptiveError as err:
-        raise BoundaryError(f"{result.path}: {err}; boundaries need a diagram over two "
-                            "swept axes") from None
-    missing = int((np.asarray(result.arrays["outcome"]) < 0).sum())
-    if missing:
-        raise BoundaryError(f"{result.path}: incomplete result ({missing} of "
-                            f"{result.arrays['outcome'].size} points not computed yet); "
-                            "finish it with rocksweep sweep SCENE.yaml -o FILE --resume")
+        raise BoundaryError("{path}: {err}; boundaries need a diagram over two swept axes",
+                            path=result.path, err=err) from None
+    result.require_complete(BoundaryError, "A_min")
     return sc
 
 

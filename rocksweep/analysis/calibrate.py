@@ -80,7 +80,7 @@ import numpy as np
 
 from rocksweep.analysis.peaks import Peaks, alignment_cost, excursions, hermite, onset
 from rocksweep.compute.dispatch import run_variant
-from rocksweep.errors import CalibrationError, RocksweepError  # noqa: F401 (CalibrationError re-exported)
+from rocksweep.errors import CalibrationError, RocksweepError, set_key  # noqa: F401 (CalibrationError re-exported)
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import warm_up
 from rocksweep.numerics import Numerics, step_budget
@@ -88,8 +88,9 @@ from rocksweep.physics.bodies import BodyError
 from rocksweep.physics.measured import Measured, noise_level, read_measured
 from rocksweep.physics.points import INITIAL, kernel_kind, point_row
 from rocksweep.schema import KEYS, fmt
+from rocksweep.vocab.axes import axis_name
 from rocksweep.vocab.kinds import CALIBRATION, KIND_ATTR
-from rocksweep.vocab.laws import CONSTANT
+from rocksweep.vocab.laws import CONSTANT, LAWS
 
 ACCURACY = "fine"  # the least accuracy of a calibration's runs (``calibration_numerics``)
 H_NOISE = 4.0  # threshold of an excursion, in noise standard deviations ...
@@ -342,14 +343,15 @@ def check_fit_key(scene: Any, key: Any) -> str:
                                "{law: constant, e: ...} in the scene (or fit impact.e_factor)")
     laws = {str(v) for a in scene.axes if a.name == "law" for v in a.values}
     if key == "impact.lam" and laws and laws <= {CONSTANT}:
-        raise CalibrationError("fit impact.lam: law constant does not use lam (its e is "
+        others = " or ".join(law for law in LAWS if law != CONSTANT)
+        raise CalibrationError(f"fit impact.lam: law {CONSTANT} does not use lam (its e is "
                                "impact.e), so no lam changes a run; fit impact.e or "
-                               "impact.e_factor, or use law vertical or locked")
+                               f"impact.e_factor, or use law {others}")
     allowed = fittable(scene)
     if key not in allowed:
         raise CalibrationError(f"fit {key}: not a number of this scene (fit one of "
                                f"{', '.join(allowed)})")
-    return key.split(".", 1)[1]
+    return axis_name(key)
 
 
 def check_bounds(key: str, given: Any) -> tuple[float, float]:
@@ -382,7 +384,8 @@ def _single_values(scene: Any, fitted: Sequence[str]) -> dict[str, Any]:
     for a in scene.axes:
         if len(a.values) != 1 and a.name not in fitted:
             raise CalibrationError(f"{a.key} has {len(a.values)} values: a calibration "
-                                   f"fits one point; pick one with --set {a.key}=VALUE")
+                                   "fits one point; pick one with {fix}",
+                                   fix=set_key(a.key, "set_fix"))
     return {a.name: a.values[0] for a in scene.axes}
 
 

@@ -75,7 +75,6 @@ from rocksweep.analysis.likelihood import (
     ENDINGS,
     category_counts,
     check_bootstrap,
-    check_ci,
     fit_counts,
     fitted_curves,
     isotonic_lr,
@@ -86,14 +85,19 @@ from rocksweep.analysis.likelihood import (
     resample_weights,
     stripe_rules,
 )
-from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP
+from rocksweep.analysis.resampling import (
+    DEFAULT_BOOTSTRAP,
+    DEFAULT_CI,
+    DEFAULT_SEED,
+    check_ci,
+)
 from rocksweep.analysis.states import (
     parse_states,
     required,
     severity,
     state_groups,
 )
-from rocksweep.errors import FragilityError, FragilityWarning
+from rocksweep.errors import Arg, FragilityError, FragilityWarning
 from rocksweep.fields import plain
 from rocksweep.vocab.ground import AVGSA
 from rocksweep.vocab.outcomes import MODE1, MODE2
@@ -288,7 +292,7 @@ def _check_args(ds: Any, im: Any, period: Any, seed: Any) -> None:
         raise FragilityError(f"period = {period!r}: a period in s (a number > 0, one of the "
                              "stored ground.periods), with im='Sa'")
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-        raise FragilityError(f"seed = {seed!r}: must be an integer >= 0")
+        raise FragilityError("{seed}: must be an integer >= 0", seed=Arg("seed", seed))
 
 
 def _missing_text(not_run: np.ndarray, levels: np.ndarray | None, unit: str,
@@ -304,15 +308,15 @@ def _missing_text(not_run: np.ndarray, levels: np.ndarray | None, unit: str,
     if len(recs) < len(names):
         where.append("record" + "s" * (len(recs) > 1) + " " + ", ".join(recs[:3])
                      + (f" and {len(recs) - 3} more" if len(recs) > 3 else ""))
-    state = (" (the file is not complete: a sweep still running or stopped; finish it with "
-             "--resume)") if complete in (0, False) else ""
+    state = (" (the file is not complete: a sweep still running or stopped; a resume "
+             "finishes it)") if complete in (0, False) else ""
     return f"{n} points not computed at {', '.join(where)} left out{state}" if where else \
         f"{n} points not computed left out{state}"
 
 
 def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
               im: str | None = None, period: float | None = None,
-              bootstrap: int | None = None, seed: int = 0, ci: float = 0.9,
+              bootstrap: int | None = None, seed: int = DEFAULT_SEED, ci: float = DEFAULT_CI,
               warn: bool = True, joint: bool = False) -> xr.Dataset:
     """Lognormal fragility curves of a record-suite sweep (Baker 2015) with their verdicts.
 

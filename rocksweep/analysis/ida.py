@@ -106,10 +106,8 @@ def _stripes(result: Any) -> _Stripes:
     if not im or im not in result.dims or "record" not in result.dims:
         raise IdaError(f"{result.path}: IDA needs a scaled record suite (ground.records with "
                        "ground.scale stripes)")
+    result.require_complete(IdaError, "IDA")
     outcome = np.asarray(result.arrays["outcome"])
-    if (outcome < 0).any():
-        raise IdaError(f"{result.path}: {int((outcome < 0).sum())} points not computed; "
-                       "finish the sweep (--resume) first")
     dims = list(result.dims)
     others = [d for d in dims if d not in (im, "record")]
     perm = [dims.index(d) for d in [*others, "record", im]]

@@ -15,6 +15,7 @@ from typing import Any
 from rocksweep.vocab.kinds import (
     BOUNDARIES,
     CALIBRATION,
+    FLOOR_SPECTRUM,
     FRAGILITY,
     IDA,
     IM_EFFICIENCY,
@@ -34,6 +35,7 @@ SIGNATURES: tuple[tuple[str, tuple[str, ...]], ...] = (
     (FRAGILITY, ("median", "beta")),
     (IDA, ("ida_im",)),
     (CALIBRATION, ("estimate", "measured_theta")),
+    (FLOOR_SPECTRUM, ("p_overturn", "n_counted")),
     (SWEEP, ("outcome", "status")),
     (SPECTRA, ("A_min", "theta_max_over_alpha", "outcome")),
     (BOUNDARIES, ("A_min",)),

@@ -31,14 +31,20 @@ Every fit returns an ending code into ``ENDINGS`` per data set.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from scipy.special import log_ndtr, ndtr, ndtri, owens_t
 
-from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP, MAX_BOOTSTRAP
+from rocksweep.analysis.resampling import (
+    DEFAULT_BOOTSTRAP,
+    DEFAULT_CI,
+    DEFAULT_SEED,
+    MAX_BOOTSTRAP,
+    check_ci,
+)
 from rocksweep.errors import FragilityError
 
 #: how a fit ended (the codes the batched fits return are indices into this)
@@ -657,7 +663,8 @@ def fitted_curves(kind: str, grid: np.ndarray, med: np.ndarray, bet: np.ndarray
 # ---------------------------------------------------------------------------------------
 
 
-def resample_weights(n_records: int, n_boot: int, seed: int | np.random.Generator, per: int):
+def resample_weights(n_records: int, n_boot: int, seed: int | np.random.Generator,
+                     per: int) -> Iterator[tuple[int, np.ndarray]]:
     """Resample weights in chunks: yields (start, w float (nb, R)), w[r] = how often record
     r is drawn; one Generator draws R indices a resample, as a single draw would."""
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
@@ -706,7 +713,8 @@ class Bootstrap:
 def bootstrap_records(im: Sequence[float] | np.ndarray, failed: np.ndarray,
                       counted: np.ndarray | None = None, *,
                       n_boot: int = DEFAULT_BOOTSTRAP,
-                      seed: int | np.random.Generator = 0, ci: float = 0.9) -> Bootstrap:
+                      seed: int | np.random.Generator = DEFAULT_SEED,
+                      ci: float = DEFAULT_CI) -> Bootstrap:
     """Bootstrap the fragility fit over records.
 
     Stripes: im float[S] (levels), failed bool[R, S] (record r reaches the state at level
@@ -737,13 +745,6 @@ def bootstrap_records(im: Sequence[float] | np.ndarray, failed: np.ndarray,
     med, bet = np.where(undefined, np.nan, med), np.where(undefined, np.nan, bet)
     return Bootstrap(percentile_interval(med, ci), percentile_interval(bet, ci), med, bet,
                      int(undefined.sum()), ci)
-
-
-def check_ci(ci: Any) -> float:
-    if isinstance(ci, bool) or not isinstance(ci, int | float | np.integer | np.floating) \
-            or not (0.0 < float(ci) < 1.0):
-        raise FragilityError(f"ci = {ci!r}: must be a number in (0, 1), e.g. 0.9")
-    return float(ci)
 
 
 def check_bootstrap(n: Any, curves: int) -> int:

@@ -72,7 +72,7 @@ def restitution_table(scene: Scene, n_lam: int = 101, n_u: int = 81) -> Restitut
     with the energy-admissible lam for each u/u_cr. The scene must hold one body and one
     impact law (a SceneError names a swept key otherwise); lam and the pulse are not used.
     """
-    from rocksweep.scene.model import SceneError
+    from rocksweep.errors import Arg, SceneError, set_key
 
     names = [a.name for a in scene.axes]
     for a in (*scene.body_axes(), *(scene.axis(k) for k in ("law", "e", "e_factor")
@@ -80,8 +80,9 @@ def restitution_table(scene: Scene, n_lam: int = 101, n_u: int = 81) -> Restitut
         if len(a.values) != 1:
             what = "one body" if a.key.startswith("body.") else "one impact law"
             raise SceneError(f"{a.key} has {len(a.values)} values: restitution needs {what}; "
-                             f"pick one with --set {a.key}=VALUE" + (
-                                 " or --law" if a.key == "impact.law" else ""))
+                             "pick one with {fix}" + (" or {law}" if a.key == "impact.law"
+                                                      else ""),
+                             fix=set_key(a.key, "set_fix"), law=Arg("law"))
     for name, n in (("n_lam", n_lam), ("n_u", n_u)):
         if n < 2:
             raise SceneError(f"{name} = {n}: must be >= 2")
@@ -139,4 +140,4 @@ def energy_note(scene: Scene, max_bodies: int = 64) -> str | None:
     parts = [f"{k} {v:.3g}" if v >= 0 else f"{k}: at every lam" for k, v in over.items()]
     return (f"note: lam = {lam:g} exceeds the largest lam at which no impact of this body "
             f"with |u/u_cr| <= {U_RANGE:g} can gain energy ({', '.join(parts)}; see "
-            "rocksweep restitution --law)")
+            "the restitution table of each law)")

@@ -56,7 +56,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from rocksweep.errors import RiskError, RocksweepError  # noqa: F401 (re-exported)
+from rocksweep.errors import Arg, RiskError, RocksweepError  # noqa: F401 (re-exported)
 from rocksweep.inputs import check_columns, csv_table, number, number_column, read_text
 from rocksweep.outputs import shown
 from rocksweep.physics.bodies import G
@@ -234,8 +234,8 @@ def _openquake(text: str, where: str, site: int | None) -> Hazard:
     if not table.rows:
         raise RiskError(f"{where}: no site rows")
     if site is None and len(table.rows) > 1:
-        raise RiskError(f"{where}: {len(table.rows)} sites; choose one with site= (0 to "
-                        f"{len(table.rows) - 1}, the row order; --site on the command line)")
+        raise RiskError(f"{where}: {len(table.rows)} sites; choose one with {{site}} (0 to "
+                        f"{len(table.rows) - 1}, the row order)", site=Arg("site"))
     k = 0 if site is None else site
     if not 0 <= k < len(table.rows):
         raise RiskError(f"{where}: site = {site!r}: the file has sites 0 to "

@@ -1,7 +1,8 @@
 """Rocking and overturning spectra of a sweep over the time scale and A_ratio.
 
 A sweep over ``p`` (a record scene: the body's frequency parameter [rad/s]) or
-``w_over_p`` (a pulse scene), ``A_ratio`` and, optionally, ``lam`` gives:
+``w_over_p`` (a pulse scene), ``A_ratio`` and, optionally, ``lam`` and other keys (an
+orientation ``angle``, a building's ``floor.period``: one spectrum per value) gives:
 
 - the rocking spectrum: max |theta| / alpha_cg against p, one curve per A_ratio and lam
   (overturned points marked; their max |theta| is the overturning angle's pi/2);
@@ -64,6 +65,10 @@ class Spectra:
     record: str = ""
     kind: str = "flexible"
     search: bool = True
+    # other swept keys (an orientation ``angle``, a building's ``floor.period``, body
+    # keys...): their names and values; theta_max and outcome then lead with their
+    # dimensions (float64[*extra, nl, nA, nx]) and ``a_min`` runs over them in C order
+    extra: tuple[tuple[str, np.ndarray], ...] = ()
 
     def to_dataset(self):
         """The spectra as an ``xarray.Dataset``: ``theta_max_over_alpha`` and ``outcome``
@@ -76,24 +81,28 @@ class Spectra:
 
         from rocksweep import fields
 
-        a_min = np.array([c.a_min for c in self.a_min], float).reshape(len(self.lam), -1)
+        lead = tuple(v.size for _, v in self.extra) + (len(self.lam),)
+        a_min = np.array([c.a_min for c in self.a_min], float).reshape(*lead, -1)
         mode = np.array([c.mode for c in self.a_min], np.int8).reshape(a_min.shape)
         method = np.array([c.method_words for c in self.a_min], str).reshape(a_min.shape)
         f = self.freq
+        ex = tuple(d for d, _ in self.extra)
         theta_attrs = fields.field_attrs(fields.BY_NAME["theta_max_over_alpha"], self.kind)
         return xr.Dataset(
-            {"theta_max_over_alpha": (("lam", "A_ratio", f), self.theta_max, theta_attrs),
-             "outcome": (("lam", "A_ratio", f), self.outcome,
+            {"theta_max_over_alpha": ((*ex, "lam", "A_ratio", f), self.theta_max,
+                                      theta_attrs),
+             "outcome": ((*ex, "lam", "A_ratio", f), self.outcome,
                          {"long_name": "outcome class", **flag_attrs(OUTCOME_WORDS)}),
-             "A_min": (("lam", f), a_min,
+             "A_min": ((*ex, "lam", f), a_min,
                        {**fields.axis_attrs("A_ratio", self.kind),
                         "long_name": "smallest overturning amplitude ratio"}),
-             "mode": (("lam", f), mode, {"long_name": "overturning mode at A_min",
-                                         **flag_attrs(MODE_WORDS)}),
-             "A_min_method": (("lam", f), method,
+             "mode": ((*ex, "lam", f), mode, {"long_name": "overturning mode at A_min",
+                                              **flag_attrs(MODE_WORDS)}),
+             "A_min_method": ((*ex, "lam", f), method,
                               {"long_name": "how A_min was found",
                                "flag_meanings": ";".join(A_MIN_METHODS)})},
-            coords={"lam": ("lam", self.lam, fields.axis_attrs("lam")),
+            coords={**{d: (d, v, fields.axis_attrs(d, self.kind)) for d, v in self.extra},
+                    "lam": ("lam", self.lam, fields.axis_attrs("lam")),
                     "A_ratio": ("A_ratio", self.A, fields.axis_attrs("A_ratio", self.kind)),
                     f: (f, self.x, fields.axis_attrs(f))},
             attrs={"rocksweep_kind": "spectra", "kind": self.kind, "title": self.name,
@@ -118,30 +127,33 @@ def spectra(data, rtol: float = DEFAULT_RTOL, search: bool = True) -> Spectra:
         raise SpectrumError(f"{result.path}: spectra need a sweep over p (a record) or "
                             f"w_over_p, and A_ratio; not swept: {', '.join(missing)} "
                             f"(swept: {', '.join(result.dims) or 'none'})")
-    other = [d for d in result.dims if d not in (freq, "A_ratio", "lam")]
-    if other:
-        raise SpectrumError(f"{result.path}: spectra are drawn over {freq}, A_ratio and lam; "
-                            f"also swept: {', '.join(other)} (sweep one value of each)")
-    if not result.done.all():
-        n = int((~result.done).sum())
-        raise SpectrumError(f"{result.path}: {n} points not computed; finish the sweep "
-                            "(rocksweep sweep SCENE -o OUT --resume) first")
+    extra = [d for d in result.dims if d not in (freq, "A_ratio", "lam")]
+    result.require_complete(SpectrumError, "a spectrum")
     A = np.asarray(result.coords["A_ratio"], float)
     if not np.all(np.diff(A) > 0):
         raise SpectrumError(f"{result.path}: A_ratio must increase along its axis")
-    order = [d for d in ("lam", "A_ratio", freq) if d in result.dims]
+    order = [d for d in (*extra, "lam", "A_ratio", freq) if d in result.dims]
     perm = [result.dims.index(d) for d in order]
     theta = np.transpose(result.arrays["theta_max_over_alpha"], perm)
     outcome = np.transpose(result.arrays["outcome"], perm)
     if "lam" not in result.dims:
-        theta, outcome = theta[None], outcome[None]
+        theta, outcome = theta[..., None, :, :], outcome[..., None, :, :]
         lam = np.array([float(result.scalars.get("lam", np.nan))])
     else:
         lam = np.asarray(result.coords["lam"], float)
     scene = result_scene(result)
     curves = a_min(scene, result.arrays["outcome"], rtol, axes=(freq, "A_ratio"),
                    evaluate=kernel_evaluator(scene), **grid_response(result), search=search)
+    # the curves come in the grid's order of the other dims: as (*extra, lam)
+    grid_order = [d for d in result.dims if d not in (freq, "A_ratio")]
+    sizes = [len(result.coords[d]) for d in grid_order]
+    pos = np.arange(len(curves)).reshape(sizes or [1])
+    if grid_order:
+        pos = np.transpose(pos, [grid_order.index(d) for d in (*extra, "lam")
+                                 if d in grid_order])
+    curves = [curves[int(i)] for i in pos.ravel()]
     rec = result.scene.get("record") or {}
+    coords = tuple((d, np.asarray(result.coords[d])) for d in extra)
     return Spectra(result.name, freq, np.asarray(result.coords[freq], float), A, lam,
                    theta, outcome, curves, rtol, int(sum(c.runs.sum() for c in curves)),
-                   rec.get("name", ""), result.kind, search)
+                   rec.get("name", ""), result.kind, search, coords)

@@ -94,6 +94,8 @@ def state_groups(states: Sequence[str], joint: bool = False) -> list[tuple[str, 
 
 
 def required(ds: xr.Dataset, name: str, why: str) -> xr.DataArray:
+    """ds[name], or a one-line FragilityError saying the Dataset lacks it and ``why`` it
+    is needed."""
     if name not in ds.variables:
         raise FragilityError(f"the Dataset has no variable {name!r} ({why})")
     return ds[name]
@@ -146,8 +148,8 @@ def trust(ds: xr.Dataset, what: str, warn: bool = True) -> str:
     words = []
     n = int(not_run.sum())
     if n:
-        state = (" (the file is not complete: a sweep still running or stopped; finish it "
-                 "with --resume)") if ds.attrs.get("complete") in (0, False) else ""
+        state = (" (the file is not complete: a sweep still running or stopped; a resume "
+                 "finishes it)") if ds.attrs.get("complete") in (0, False) else ""
         words.append(f"incomplete: {n} of {total} points not computed, left out{state}")
     k = int(flagged.sum())
     if k:

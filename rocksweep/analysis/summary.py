@@ -18,6 +18,7 @@ import numpy as np
 
 from rocksweep.fields import THETA_REL_FLOOR, plain
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.vocab.axes import axis_name
 from rocksweep.vocab.outcomes import (
     COMPUTED,
     FILLED,
@@ -211,7 +212,7 @@ def info_dict(result: SweepResult) -> dict:
     """
     a = result.attrs
     done = result.done
-    keys = {k.split(".", 1)[1]: k for k in result.scene["axes"]}
+    keys = {axis_name(k): k for k in result.scene["axes"]}
     dims = {d: {"size": len(result.coords[d]), "scene_key": keys[d],
                 "values": [plain(v) for v in result.coords[d]]} for d in result.dims}
     return {
@@ -296,7 +297,7 @@ def format_info(d: dict) -> list[str]:
         lines.append(f"  physical body: p = {d['p']:.5g} rad/s")
     pct = 100 * d["points_done"] / max(1, d["points_total"])
     state = ("complete" if d["complete"] else
-             "INCOMPLETE (finish it with rocksweep sweep SCENE.yaml -o FILE --resume)")
+             "INCOMPLETE (a resume of its sweep finishes it)")
     lines.append(f"points: {d['points_done']} of {d['points_total']} done ({pct:.1f}%), "
                  f"{state}")
     ad = d.get("adaptive")
@@ -334,5 +335,5 @@ def format_info(d: dict) -> list[str]:
                  f"numpy {p['numpy_version']}, h5py {p['h5py_version']} "
                  f"(HDF5 {p['hdf5_version']}), Python {p['python_version']}")
     if p["overrides"]:
-        lines.append("overrides: " + " ".join(f"--set {o}" for o in p["overrides"]))
+        lines.append("overrides: " + ", ".join(p["overrides"]))
     return lines

@@ -15,7 +15,13 @@ from rocksweep.cli.main import (
     set_option,
     user_errors,
 )
-from rocksweep.vocab.settings import DEFAULT_LADDER, LADDER_HELP, LADDER_NAMES
+from rocksweep.cli.options import seed_option
+from rocksweep.vocab.settings import (
+    DEFAULT_LADDER,
+    DEFAULT_SAMPLE_SEED,
+    LADDER_HELP,
+    LADDER_NAMES,
+)
 
 
 @main.command()
@@ -33,7 +39,7 @@ from rocksweep.vocab.settings import DEFAULT_LADDER, LADDER_HELP, LADDER_NAMES
               default=DEFAULT_LADDER, show_default=True,
               help="Kernel settings to measure: " + ", ".join(
                   f"{k} ({v})" for k, v in LADDER_HELP.items()) + ".")
-@click.option("--seed", type=int, default=0, show_default=True, help="Sampling seed.")
+@seed_option(DEFAULT_SAMPLE_SEED, "Sampling seed.")
 @click.option("--repeat", type=click.IntRange(min=1), default=5, show_default=True,
               help="Kernel timings are the best of this many rounds.")
 @click.option("--check", is_flag=True,

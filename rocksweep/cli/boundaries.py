@@ -18,7 +18,7 @@ from rocksweep.cli.options import dpi_option, overwrite_option, rtol_option, sea
                    "lines too [default: OUT-amin.csv].")
 @click.option("--lines", "lines_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Also write the boundary polylines as CSV (one row per vertex).")
-@rtol_option
+@rtol_option()
 @search_option
 @click.option("--mode", type=click.Choice(["1", "2"]), default=None,
               help="A_min of this overturning mode only [default: either].")

@@ -5,6 +5,7 @@ from rocksweep.cli import (  # noqa: F401
     boundaries,
     calibrate,
     efficiency,
+    floors,
     fragility,
     info,
     plot,

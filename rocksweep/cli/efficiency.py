@@ -10,8 +10,13 @@ import click
 
 from rocksweep.cli.helpers import check_table_outputs, write_table
 from rocksweep.cli.main import main, user_errors
-from rocksweep.cli.options import dpi_option, overwrite_option, result_argument
-from rocksweep.figures import WIDTHS
+from rocksweep.cli.options import (
+    dpi_option,
+    json_option,
+    overwrite_option,
+    result_argument,
+    width_option,
+)
 from rocksweep.vocab.kinds import IM_EFFICIENCY
 from rocksweep.vocab.outcomes import STATES, THETA_STATE
 
@@ -26,9 +31,8 @@ SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
               help="The table as CSV (.csv) or the Dataset (.h5, .hdf5, .nc).")
 @click.option("--plot", "fig_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Bar chart of beta per IM (.png, .pdf, .svg).")
-@click.option("--json", "as_json", is_flag=True, help="Print the table as JSON.")
-@click.option("--width", type=click.Choice(list(WIDTHS)), default="single",
-              show_default=True, help="Figure width: a journal's single or double column.")
+@json_option("the table")
+@width_option("single")
 @dpi_option
 @overwrite_option
 @user_errors

@@ -9,11 +9,19 @@ from pathlib import Path
 
 import click
 
-from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP, MAX_BOOTSTRAP
+from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP, DEFAULT_SEED, MAX_BOOTSTRAP
 from rocksweep.cli.helpers import check_table_outputs, write_table
 from rocksweep.cli.main import main, user_errors
-from rocksweep.cli.options import dpi_option, overwrite_option, result_argument
-from rocksweep.figures import WIDTHS
+from rocksweep.cli.options import (
+    ci_option,
+    dpi_option,
+    json_option,
+    overwrite_option,
+    result_argument,
+    rtol_option,
+    seed_option,
+    width_option,
+)
 from rocksweep.vocab.kinds import FRAGILITY
 from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, STATES, UPLIFT
 
@@ -62,19 +70,14 @@ def _g(v) -> str:
 @click.option("--bootstrap", type=click.IntRange(0, MAX_BOOTSTRAP), default=DEFAULT_BOOTSTRAP,
               show_default=True,
               help="Bootstrap resamples over records for the intervals and bands (0: none).")
-@click.option("--seed", type=click.IntRange(0, 2**63 - 1), default=0, show_default=True,
-              help="Seed of the bootstrap's random generator.")
-@click.option("--ci", type=float, default=0.9, show_default=True,
-              help="Level of the bootstrap intervals and bands.")
-@click.option("--json", "as_json", is_flag=True,
-              help="Print the curves as JSON ({\"curves\": [...]}) instead of a table.")
-@click.option("--width", type=click.Choice(list(WIDTHS)), default="single", show_default=True,
-              help="Figure width: a journal's single or double column.")
-@click.option("--rtol", type=click.FloatRange(1e-9, 0.5), default=None,
-              help="Also refine each record's first overturning level by bisection to this "
+@seed_option(DEFAULT_SEED, "Seed of the bootstrap's random generator.")
+@ci_option
+@json_option('the curves ({"curves": [...]}) instead of a table')
+@width_option("single")
+@rtol_option(None, "Also refine each record's first overturning level by bisection to this "
                    "relative tolerance (an IDA per record, kernel runs at the sweep's "
                    "accuracy): variables ida_im, ida_lo, ida_hi along record in -o "
-                   "(.h5/.nc) and the spread in the table [default: stripes only].")
+                   "(.h5/.nc) and the spread in the table [default: stripes only]")
 @dpi_option
 @overwrite_option
 @user_errors

@@ -9,11 +9,12 @@ from pathlib import Path
 import click
 
 from rocksweep.cli.main import main, user_errors
+from rocksweep.cli.options import json_option
 
 
 @main.command()
 @click.argument("result_path", metavar="OUT.h5", type=click.Path(path_type=Path))
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+@json_option("one object")
 @user_errors
 def info(result_path: Path, as_json: bool) -> None:
     """Dimensions, completeness, counts per class (per pulse shape and lam, and per swept

@@ -3,34 +3,47 @@
 Each command lives in its own module and is thin: it turns options into arguments and
 calls the library. Errors the user can fix (a bad scene, a foreign file, an existing
 output) reach the terminal as one line through ``click.ClickException``: no traceback, a
-non-zero exit.
+non-zero exit. The library's messages name the arguments of its functions
+(``rocksweep.errors.Arg``); the command line says them as its options (``option_words``):
+the one place that knows the options' names.
 """
 
 from __future__ import annotations
 
 import functools
-import re
 from pathlib import Path
 
 import click
 
 import rocksweep
 from rocksweep.cli.options import overwrite_option, scene_argument, set_option  # noqa: F401
-from rocksweep.errors import RocksweepError, one_line
+from rocksweep.errors import Arg, RocksweepError, one_line
 
-# The library's messages may name the Python API's flags (``resume=True``); the command
-# line says its own (``--resume``): the reverse of ``errors._FLAG_WORDS``.
-_CLI_WORDS = re.compile(r"\b(resume|overwrite|adaptive|validate)=True\b")
-
-
-# a keyword the message asks for, "name= (a number)", is the option "--name VALUE"
-_CLI_KEYWORDS = re.compile(r"\b(p)= \(a number\)")
+# The library's argument names whose option is not ``--NAME`` (underscores as dashes)
+OPTIONS = {"overrides": "--set", "output": "-o"}
 
 
-def cli_words(message: str) -> str:
-    """A library message with the API's flags said as the command line's options."""
-    message = _CLI_KEYWORDS.sub(lambda m: f"--{m.group(1)} VALUE", message)
-    return _CLI_WORDS.sub(lambda m: f"--{m.group(1)}", message)
+def option_words(arg: Arg) -> str:
+    """An argument a library message names, said as the command line's option: ``rtol =
+    0.3`` as ``--rtol 0.3``, ``resume=True`` as ``--resume``, ``overrides={'pulse.A_ratio':
+    ...}`` as ``--set pulse.A_ratio=VALUE``."""
+    option = OPTIONS.get(arg.name, f"--{arg.name.replace('_', '-')}")
+    if arg.kind == "set_key":
+        return f"--set {arg.value}"
+    if arg.kind == "set_fix":
+        return f"--set {arg.value}=VALUE"
+    if arg.kind == "set_entry":
+        return f"--set {arg.value!r}"
+    if arg.kind == "keyword":
+        return f"{option} VALUE"
+    if arg.kind == "flag" or not arg.given:
+        return option
+    return f"{option} {arg.value}"
+
+
+def said(err: RocksweepError) -> str:
+    """A library error as the command line says it: one line, naming its options."""
+    return one_line(err.said(option_words))
 
 
 class InputError(click.ClickException):
@@ -42,14 +55,14 @@ class InputError(click.ClickException):
 
 def user_errors(fn):
     """Turn the library's user-facing errors (``RocksweepError``) into one-line click
-    errors, in the command line's words (``cli_words``)."""
+    errors naming the command line's options (``said``)."""
 
     @functools.wraps(fn)
     def wrapper(*args, **kwargs):
         try:
             return fn(*args, **kwargs)
         except RocksweepError as err:
-            raise InputError(cli_words(one_line(str(err)))) from None
+            raise InputError(said(err)) from None
         except click.ClickException as err:
             if type(err) is click.ClickException:  # a command's own one-line refusal
                 err.exit_code = InputError.exit_code

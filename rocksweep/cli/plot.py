@@ -73,7 +73,7 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
         click.echo(f"wrote {fig_out}")
         return
     fig = api.plot(ds, x_key, y_key, curves=curves, show_computed=show_computed, mu=mu_map,
-                   compare=compare_key, _names=("--x", "--y", "--compare"))
+                   compare=compare_key)
     save_figure(fig, fig_out, dpi, overwrite=overwrite, inputs=inputs)
     for w in missing_warnings(as_result(ds)):
         click.echo(f"warning: {w}", err=True)

@@ -17,13 +17,14 @@ from rocksweep.cli.main import (
     set_option,
     user_errors,
 )
+from rocksweep.cli.options import json_option
 from rocksweep.vocab.laws import CONSTANT, LAWS, LOCKED, law_origin
 
 
 @main.command(name="restitution")
 @scene_argument
 @set_option
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+@json_option("one object")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Draw Figure 2 to this file (.png, .pdf, .svg).")
 @overwrite_option

@@ -12,8 +12,7 @@ import click
 
 from rocksweep.cli.helpers import check_table_outputs, write_table
 from rocksweep.cli.main import main, user_errors
-from rocksweep.cli.options import dpi_option, overwrite_option
-from rocksweep.figures import WIDTHS
+from rocksweep.cli.options import dpi_option, json_option, overwrite_option, width_option
 from rocksweep.vocab.kinds import RISK
 
 RISK_SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
@@ -68,9 +67,8 @@ def _g(v) -> str:
 @click.option("--plot", "fig_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Figure: hazard curve, fragility and the rate's integrand (.png, .pdf, "
                    ".svg).")
-@click.option("--json", "as_json", is_flag=True, help="Print the rows as JSON.")
-@click.option("--width", type=click.Choice(list(WIDTHS)), default="double",
-              show_default=True, help="Figure width: a journal's single or double column.")
+@json_option("the rows")
+@width_option("double")
 @dpi_option
 @overwrite_option
 @user_errors

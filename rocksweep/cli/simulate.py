@@ -13,10 +13,12 @@ from rocksweep.cli.main import (
     load,
     main,
     overwrite_option,
+    said,
     scene_argument,
     set_option,
     user_errors,
 )
+from rocksweep.cli.options import json_option
 from rocksweep.vocab.axes import alpha_symbol
 
 MAX_POINTS = 12  # = rocksweep.api.MAX_RUNS: simulate overlays a few runs
@@ -25,8 +27,7 @@ MAX_POINTS = 12  # = rocksweep.api.MAX_RUNS: simulate overlays a few runs
 @main.command()
 @scene_argument
 @set_option
-@click.option("--json", "as_json", is_flag=True,
-              help="Print one JSON object (a JSON list if the scene has several points).")
+@json_option("one object (a list if the scene has several points)")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Draw Figure 5 (theta/alpha_cg and E/E_ref against p*t) to this file "
                    "(.png, .pdf, .svg).")
@@ -66,11 +67,12 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     try:
         runs = run_points(scene, MAX_POINTS)
     except SceneError as err:  # name the file, as scene errors do
-        raise click.ClickException(f"{scene_path}: {err}") from None
+        raise click.ClickException(f"{scene_path}: {said(err)}") from None
     swept = [a.name for a in scene.swept]
 
     if as_json:
-        docs = [_json_safe({**r.summary(), **scene.physical_summary()}) for r in runs]
+        docs = [_json_safe({**r.summary(), **scene.physical_summary(),
+                            **scene.floor_summary(r.point)}) for r in runs]
         click.echo(json.dumps(docs[0] if len(docs) == 1 else docs, indent=2))
     else:
         if scene.physical is not None:

@@ -15,7 +15,7 @@ from rocksweep.cli.options import dpi_option, overwrite_option, rtol_option, sea
 @click.argument("result_path", metavar="OUT.h5", type=click.Path(path_type=Path))
 @click.option("-o", "--output", "fig_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Figure file, .png, .pdf or .svg [default: OUT-spectra.png].")
-@rtol_option
+@rtol_option()
 @search_option
 @dpi_option
 @overwrite_option

@@ -10,7 +10,15 @@ from pathlib import Path
 import click
 
 from rocksweep.cli.main import load, main, user_errors
-from rocksweep.cli.options import overwrite_option, scene_argument, set_option
+from rocksweep.cli.options import (
+    ADAPTIVE,
+    backend_option,
+    connect_timeout_option,
+    overwrite_option,
+    scene_argument,
+    seed_option,
+    set_option,
+)
 from rocksweep.compute.driver import WRITE_EVERY
 
 
@@ -26,15 +34,10 @@ from rocksweep.compute.driver import WRITE_EVERY
                    "missing points).")
 @overwrite_option
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar and no summary.")
-@click.option("--backend", type=click.Choice(["threads", "dask"]), default="threads",
-              show_default=True,
-              help="Local worker threads (the kernel runs outside the GIL) or a "
-                   "dask.distributed cluster.")
+@backend_option
 @click.option("--scheduler", metavar="ADDRESS",
               help="dask scheduler address (with --backend dask), e.g. tcp://host:8786.")
-@click.option("--connect-timeout", "connect_timeout", type=float, default=20.0,
-              show_default=True, metavar="SECONDS",
-              help="With --backend dask: wait this long for the scheduler to answer.")
+@connect_timeout_option
 @click.option("--chunk-size", type=click.IntRange(1, None), default=None,
               help="Points per chunk [default: about 32 chunks per worker, at most 1024].")
 @click.option("--write-every", "write_every", type=float, default=WRITE_EVERY,
@@ -46,31 +49,18 @@ from rocksweep.compute.driver import WRITE_EVERY
                    "refinement of every cell whose corners differ (and its neighbours), "
                    "then a random audit; the other points take the class of the uniform "
                    "cell around them (flag `computed` in the file).")
-@click.option("--coarse", type=int, default=None, metavar="K",
-              help="Adaptive: the coarse pass takes every 2^K-th point of both diagram "
-                   "axes [default: 16 coarse cells per axis]. Regions smaller than a "
-                   "coarse cell and touching no boundary can be missed: lower K to be "
-                   "safer.")
-@click.option("--audit", type=float, default=None, metavar="SHARE",
-              help="Adaptive: share of all points computed as a check of the fill "
-                   "[default: 0.02].")
-@click.option("--axes", "adaptive_axes", metavar="X,Y", default=None,
-              help="Adaptive: the two diagram axes [default: w_over_p,A_ratio].")
+@click.option("--coarse", type=int, default=None, metavar="K", help=ADAPTIVE["coarse"])
+@click.option("--audit", type=float, default=None, metavar="SHARE", help=ADAPTIVE["audit"])
+@click.option("--axes", "adaptive_axes", metavar="X,Y", default=None, help=ADAPTIVE["axes"])
 @click.option("--validate", is_flag=True,
               help="Adaptive: also compute the filled points of a uniform lattice (half a "
                    "coarse cell apart) and report those whose class differs from the "
                    "fill; the file keeps the adaptive result.")
-@click.option("--margin", type=int, default=None,
-              help="Adaptive: cells refined around a mixed cell [default: 1].")
+@click.option("--margin", type=int, default=None, help=ADAPTIVE["margin"])
 @click.option("--final-margin", "final_margin", type=int, default=None,
-              help="Adaptive: the same at the last level [default: 0: the last level "
-                   "computes only the edges a boundary crosses, the level before probes "
-                   "its margin cells' centres; >= 1 refines whole cells at both].")
-@click.option("--seed", type=int, default=None,
-              help="Adaptive: seed of the audit sample [default: 0].")
-@click.option("--threshold", type=float, default=None,
-              help="Adaptive: warn when more than this share of audit points disagree "
-                   "[default: 0.002].")
+              help=ADAPTIVE["final_margin"])
+@seed_option(None, ADAPTIVE["seed"])
+@click.option("--threshold", type=float, default=None, help=ADAPTIVE["threshold"])
 @click.option("--contact", is_flag=True,
               help="Also store the friction demand mu_required, the smallest normal force "
                    "and the impulse ratio per point (as outputs.contact: true).")
@@ -113,12 +103,10 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     args = check_sweep_arguments(jobs=jobs, resume=resume, overwrite=overwrite,
                                  validate=validate, backend=backend, scheduler=scheduler,
                                  chunk_size=chunk_size, write_every=write_every,
-                                 connect_timeout=connect_timeout, cli=True)
-    msg = check_settings({"coarse": coarse, "audit": audit, "margin": margin,
-                          "final_margin": final_margin, "seed": seed, "threshold": threshold},
-                         lambda k: f"--{k.replace('_', '-')}")
-    if msg is not None:  # the ranges of the scene's refine: section, one table
-        raise click.ClickException(msg)
+                                 connect_timeout=connect_timeout)
+    # the ranges of the scene's refine: section, one table
+    check_settings({"coarse": coarse, "audit": audit, "margin": margin,
+                    "final_margin": final_margin, "seed": seed, "threshold": threshold})
     settings = {"coarse": coarse, "audit": audit, "axes": adaptive_axes, "margin": margin,
                 "final_margin": final_margin, "seed": seed, "threshold": threshold}
     given = [k for k, v in settings.items() if v is not None]

@@ -57,13 +57,22 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.errors import AdaptiveError, ApiError  # noqa: F401 (AdaptiveError: re-exported)
+from rocksweep.errors import AdaptiveError, ApiError, Arg  # noqa: F401 (AdaptiveError: re-exported)
 from rocksweep.scene.grid import ChunkRows, Grid
 from rocksweep.scene.model import Scene
 from rocksweep.schema import check_option
 from rocksweep.vocab import outcomes as _out
 from rocksweep.vocab.axes import DIAGRAM_AXES
-from rocksweep.vocab.settings import ADAPTIVE_RESOLVED, ADAPTIVE_SETTINGS
+from rocksweep.vocab.settings import (
+    ADAPTIVE_RESOLVED,
+    ADAPTIVE_SETTINGS,
+    DEFAULT_AUDIT,
+    DEFAULT_AUDIT_THRESHOLD,
+    DEFAULT_FINAL_MARGIN,
+    DEFAULT_MARGIN,
+    DEFAULT_SEED,
+    MIN_COARSE_CELLS,
+)
 
 # ``computed`` flags (int8 per point).
 # (codes, words and meanings: ``rocksweep.vocab.outcomes``)
@@ -73,18 +82,7 @@ AUDIT = _out.COMPUTED_CODE[_out.AUDIT_AGREED]  # an audit point; its class equal
 AUDIT_MISS = _out.COMPUTED_CODE[_out.AUDIT_DISAGREED]  # an audit point; differs (refined)
 COMPUTED_MEANING = _out.COMPUTED_MEANING
 
-# Default coarse level: the largest k whose coarse lattice keeps >= MIN_COARSE_CELLS cells
-# along both diagram axes (80: k = 2, 400: k = 4, 1000: k = 5); see ``default_coarse``.
-MIN_COARSE_CELLS = 16
-DEFAULT_MARGIN = 1
-# No margin at the last level: there it caught only one-point-tall slivers (40 of 480 000
-# points of Figure 4(b) at 400 x 400) for 17-27% more points computed. 0 also selects the
-# light rules of the last two levels (module docstring); >= 1 refines whole cells there.
-DEFAULT_FINAL_MARGIN = 0
-DEFAULT_AUDIT = 0.02
-DEFAULT_SEED = 0
-# A run warns when more than this share of its audit points disagree with their fill.
-DEFAULT_AUDIT_THRESHOLD = 0.002
+# The settings' defaults (MIN_COARSE_CELLS, DEFAULT_MARGIN, ...): rocksweep.vocab.settings
 
 _NO_CLASS = np.int8(127)  # above every class, for minima over computed points
 
@@ -117,14 +115,9 @@ class Plan:
         if self.coarse is None:
             object.__setattr__(self, "coarse", default_coarse(self.full_shape[self.y],
                                                               self.full_shape[self.x]))
-        if not (isinstance(self.coarse, int | np.integer) and 0 <= self.coarse <= 20):
-            raise AdaptiveError(f"coarse = {self.coarse!r}: must be an integer in [0, 20]")
-        for name in ("margin", "final_margin", "seed"):
-            v = getattr(self, name)
-            if not (isinstance(v, int | np.integer) and v >= 0):
-                raise AdaptiveError(f"{name} = {v!r}: must be an integer >= 0")
-        if not (isinstance(self.audit, float | int) and 0.0 <= self.audit <= 1.0):
-            raise AdaptiveError(f"audit = {self.audit!r}: must be a share in [0, 1]")
+        # the ranges of the scene's refine: section (rocksweep.schema), as Options
+        check_settings({n: getattr(self, n) for n in ("coarse", "margin", "final_margin",
+                                                      "audit", "seed")})
         if self.x == self.y:
             raise AdaptiveError(f"diagram axes {self.names}: must be two different axes")
         for pos, name in zip((self.x, self.y), self.names, strict=True):
@@ -169,7 +162,7 @@ def make_plan(grid_or_scene: Grid | Scene, axes: Sequence[str] = DIAGRAM_AXES,
     if isinstance(axes, str) or len(axes) != 2:
         raise AdaptiveError(f"axes = {axes!r}: give two axis names (x, y)")
     by_key = {a.key: a.name for a in scene.axes}
-    # a dotted scene key (pulse.w_over_p) names its axis, as in refine.axes and plot --x
+    # a dotted scene key (pulse.w_over_p) names its axis, as in refine.axes and plot's x
     axes = [by_key.get(a, a) if isinstance(a, str) else a for a in axes]
     pos = []
     for name in axes:
@@ -188,32 +181,30 @@ def make_plan(grid_or_scene: Grid | Scene, axes: Sequence[str] = DIAGRAM_AXES,
                 _checked("seed", seed, int), _checked("final_margin", final_margin, int))
 
 
-def check_settings(values: dict[str, Any], label: Callable[[str], str]) -> str | None:
-    """The first setting of ``values`` (name -> value; None: not given) outside its
-    ``refine.<name>`` range, as one line naming it by ``label(name)`` ("margin =",
-    "--margin"); None if all are admissible. The one check of the adaptive settings: the
-    command line, ``Options`` and ``make_plan`` call it."""
+
+def check_settings(values: dict[str, Any]) -> None:
+    """An ``AdaptiveError`` naming the first setting of ``values`` (name -> value; None:
+    not given) outside its ``refine.<name>`` range (``rocksweep.schema``), ``margin = 9:
+    must be an integer in [0, 8]``. The one check of the adaptive settings: the command
+    line, ``Options``, ``make_plan`` and ``Plan`` call it."""
     for name, v in values.items():
-        msg = check_option(f"refine.{name}", v, label(name))
-        if msg is not None:
-            return msg
-    return None
+        allowed = check_option(f"refine.{name}", v)
+        if allowed is not None:
+            raise AdaptiveError("{arg}: {allowed}", arg=Arg(name, v), allowed=allowed)
 
 
 def _checked(name: str, v: Any, kind: type) -> Any:
-    msg = check_settings({name: v}, lambda n: f"{n} =")
-    if msg is not None:
-        raise AdaptiveError(msg)
+    check_settings({name: v})
     return kind(v)
 
 
 @dataclass(frozen=True)
 class Options:
-    """Settings of an adaptive sweep as a user gives them (``rocksweep sweep --adaptive``,
-    ``rocksweep.run(..., adaptive=True)``). axes: (x, y) diagram axis names; coarse: None
-    for ``default_coarse``; audit: share of points audited, in [0, 1]; threshold: share of
-    disagreeing audit points above which a run warns, in [0, 1]; margin, final_margin,
-    seed: see ``Plan``."""
+    """Settings of an adaptive sweep as a user gives them (``rocksweep.run(...,
+    adaptive=True)``, the sweep command's adaptive options). axes: (x, y) diagram axis
+    names; coarse: None for ``default_coarse``; audit: share of points audited, in [0, 1];
+    threshold: share of disagreeing audit points above which a run warns, in [0, 1];
+    margin, final_margin, seed: see ``Plan``."""
 
     axes: tuple[str, str] = DIAGRAM_AXES
     coarse: int | None = None
@@ -224,9 +215,7 @@ class Options:
     threshold: float = DEFAULT_AUDIT_THRESHOLD
 
     def __post_init__(self) -> None:
-        msg = check_settings({n: getattr(self, n) for n in ADAPTIVE_SETTINGS}, lambda n: f"{n} =")
-        if msg is not None:
-            raise AdaptiveError(msg)
+        check_settings({n: getattr(self, n) for n in ADAPTIVE_SETTINGS})
 
     def plan(self, grid_or_scene: Grid | Scene) -> Plan:
         """The plan of a grid (AdaptiveError for bad axes or settings)."""

@@ -78,12 +78,13 @@ def run_points(scene: Scene, max_runs: int = MAX_RUNS) -> list[Run]:
     from itertools import product
 
     from rocksweep.compute.single import run_point
-    from rocksweep.scene.model import SceneError
+    from rocksweep.errors import SceneError, set_key
 
     if scene.size > max_runs:
         big = max(scene.swept, key=lambda a: len(a.values))
-        raise SceneError(f"{scene.size} points; simulate runs at most {max_runs} (use "
-                         f"`rocksweep sweep`, or pick a value with --set {big.key}=VALUE)")
+        raise SceneError(f"{scene.size} points; simulate runs at most {max_runs} (sweep "
+                         "the scene, or pick a value with {fix})",
+                         fix=set_key(big.key, "set_fix"))
     names = [a.name for a in scene.axes]
     return [run_point(scene.point(dict(zip(names, combo, strict=True))), scene.single_numerics,
                       contact=scene.contact)

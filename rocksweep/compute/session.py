@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 from rocksweep.compute.arguments import CONNECT_TIMEOUT, SweepArguments
 from rocksweep.compute.driver import WRITE_EVERY, SweepReport
-from rocksweep.errors import ApiError, OutputError, SweepError
+from rocksweep.errors import ApiError, Arg, SweepError, flag
 
 if TYPE_CHECKING:
     from typing import Any
@@ -32,8 +32,8 @@ def sweep_file(scene: Scene, path: str | Path | None, *, overrides: Sequence[str
                chunk_size: int | None = None, write_every: float = WRITE_EVERY,
                progress: bool = False, log: Callable[[str], None] | None = None,
                inputs: Iterable[str | Path] = (), adaptive: Options | None = None,
-               validate: bool = False, connect_timeout: float = CONNECT_TIMEOUT,
-               cli: bool = False) -> SweepReport:
+               validate: bool = False, connect_timeout: float = CONNECT_TIMEOUT
+               ) -> SweepReport:
     """Sweep ``scene`` into the result file ``path`` (``rocksweep sweep``), or with ``path``
     None into a file in memory (its bytes: ``report.image``; ``rocksweep.run``).
 
@@ -52,10 +52,9 @@ def sweep_file(scene: Scene, path: str | Path | None, *, overrides: Sequence[str
     records the settings, and a resume must give the same); validate: with adaptive,
     also compute the filled points of a coarse uniform lattice and report those whose
     class differs from the fill (``report.validation``; the file is not changed);
-    connect_timeout: seconds to wait for the dask scheduler to answer; cli: name options
-    as the command line spells them. Every argument is checked
-    (``rocksweep.compute.arguments``) before the output is touched, then ``sweep`` runs.
-    Returns a ``SweepReport``.
+    connect_timeout: seconds to wait for the dask scheduler to answer. Every argument is
+    checked (``rocksweep.compute.arguments``) before the output is touched, then ``sweep``
+    runs. Returns a ``SweepReport``.
     """
     from rocksweep.compute.arguments import check_sweep_arguments
     from rocksweep.outputs import check_path_text
@@ -63,7 +62,7 @@ def sweep_file(scene: Scene, path: str | Path | None, *, overrides: Sequence[str
     args = check_sweep_arguments(
         jobs=jobs, resume=resume, overwrite=overwrite, validate=validate, backend=backend,
         scheduler=scheduler, chunk_size=chunk_size, write_every=write_every,
-        connect_timeout=connect_timeout, cli=cli)
+        connect_timeout=connect_timeout)
     if path is not None:  # None: in memory (rocksweep.run without output=)
         path = check_path_text(path)
     return sweep(scene, path, args, overrides=overrides, progress=progress, log=log,
@@ -79,12 +78,13 @@ def sweep(scene: Scene, path: Path | None, args: SweepArguments, *,
     made here, once, and handed to the sink and the driver; the output path is checked
     once (``outputs.check_output``) before the file is made or reopened."""
     from rocksweep.compute.driver import SweepInterrupted, drive
-    from rocksweep.outputs import check_output, shown
+    from rocksweep.outputs import check_output, exists_error
     from rocksweep.scene.grid import Grid
     from rocksweep.store.writer import SweepFile
 
     if args.validate and adaptive is None:
-        raise SweepError("validate=True checks an adaptive sweep; add adaptive=True")
+        raise SweepError("{validate} checks an adaptive sweep; add {adaptive}",
+                         validate=flag("validate"), adaptive=flag("adaptive"))
     if args.backend == "dask":
         from rocksweep.compute.sweep import check_scheduler
 
@@ -100,7 +100,8 @@ def sweep(scene: Scene, path: Path | None, args: SweepArguments, *,
     how = f"threads x {n}" if args.backend == "threads" else f"dask {args.scheduler}"
     if path is None:  # in memory: nothing touches a disk (rocksweep.run without output)
         if args.resume:
-            raise ApiError("resume=True needs output= (the file to finish)")
+            raise ApiError("{resume} needs {output} (the file to finish)",
+                           resume=flag("resume"), output=Arg("output"))
         sf = SweepFile.in_memory(scene, overrides, backend=how, adaptive=settings, grid=grid)
     else:
         inputs = [*inputs, *scene.inputs]  # the scene's records and listings: never written over
@@ -116,8 +117,7 @@ def sweep(scene: Scene, path: Path | None, args: SweepArguments, *,
                                   grid=grid)
         else:
             if path.is_file() and not args.overwrite:
-                raise OutputError(f"{shown(path)}: already exists; use --resume to finish it "
-                                  "or --overwrite to replace it")
+                raise exists_error(path, resumable=True)
             check_output(path, overwrite=args.overwrite, inputs=inputs)
             sf = SweepFile.make(path, scene, overrides, overwrite=args.overwrite,
                                 backend=how, adaptive=settings, log=say, grid=grid)

@@ -34,14 +34,19 @@ from rocksweep import (
 from rocksweep.compute.arguments import (  # noqa: F401 (re-exported)
     CONNECT_TIMEOUT,
     MAX_JOBS_PER_CORE,
+    RETRY,
     SweepError,
     check_jobs,
     probe_scheduler,
 )
 from rocksweep.compute.dispatch import run_variant
+from rocksweep.errors import flag
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.numerics import point_seconds
+from rocksweep.physics.bodies import G
 from rocksweep.scene.grid import ChunkResult, ChunkRows, Grid
 from rocksweep.scene.model import Scene
+from rocksweep.vocab.settings import BACKENDS
 
 # Upper bound of the automatic chunk size [points]; see ``auto_chunk_size``.
 MAX_CHUNK = 1024
@@ -77,6 +82,8 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
     stored = fields.sweep_fields(scene.energy if contact else level == L.LEVEL_ENERGY,
                                  contact, scene.check)
     arrays = fields.convert(outs, cr.alpha_ref, cr.E_ref, stored)
+    if scene.floor:  # the peak the body was driven by [g]: the kernel's amplitude / g
+        arrays[fields.FLOOR_PFA] = cr.rows[:, L.PAR_AMP] / G
     if scene.check:
         half = run_rows(cr, fields.check_rows(cr.rows), level, scene)
         arrays.update(fields.convert_check(outs, half, cr.alpha_ref))
@@ -97,11 +104,13 @@ def run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene,
     vertical = scene.vertical_samples()  # a record's vertical component rides along
     for kind in np.unique(cr.kinds):
         sel = cr.kinds == kind
-        if scene.suite is not None:  # one record at a time, its samples shared
+        if cr.records is not None:  # one record at a time, its samples shared
             for r in np.unique(cr.record_index[sel]):
                 part = sel & (cr.record_index == r)
-                outs[part] = run_variant(rows[part], int(kind), level, scene.ground, refine,
-                                         record=scene.suite.records[int(r)])
+                outs[part] = run_variant(
+                    rows[part], int(kind), level, scene.ground, refine,
+                    record=cr.records[int(r)],
+                    vertical=None if cr.verticals is None else cr.verticals[int(r)])
         elif sel.all():
             run_variant(rows, int(kind), level, scene.ground, refine, record=scene.record,
                         out=outs, vertical=vertical)
@@ -188,9 +197,8 @@ def check_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
         Client(address, timeout=f"{timeout}s").close()
     except (OSError, TimeoutError, ValueError) as err:
         raise SweepError(f"scheduler {address}: cannot reach a dask scheduler there "
-                         f"({type(err).__name__}); check the address, then run the same "
-                         "command again (with --resume to finish a file already started)"
-                         ) from None
+                         f"({type(err).__name__}); check the address, {RETRY}",
+                         resume=flag("resume")) from None
 
 
 def run_chunks(grid: Grid, chunks: Iterable[tuple[int, int]], level: int, jobs: int = 1,
@@ -203,8 +211,8 @@ def run_chunks(grid: Grid, chunks: Iterable[tuple[int, int]], level: int, jobs: 
     (never in this process), at most two chunks per worker thread in flight.
     """
     chunks = list(chunks)
-    if backend not in ("threads", "dask"):
-        raise ValueError(f"backend = {backend!r}: must be threads or dask")
+    if backend not in BACKENDS:
+        raise ValueError(f"backend = {backend!r}: must be {' or '.join(BACKENDS)}")
     n_jobs = check_jobs(jobs) if backend == "threads" else 1
     if not chunks:
         return
@@ -242,7 +250,8 @@ def _run_on_cluster(grid: Grid, chunks: list[tuple[int, int]], level: int,
         except TimeoutError:
             raise SweepError(f"dask cluster {scheduler}: no worker joined in "
                              f"{NO_WORKERS_TIMEOUT:g} s; start workers (dask worker "
-                             f"{scheduler}), then rerun with --resume") from None
+                             f"{scheduler}), then rerun with {{resume}}",
+                             resume=flag("resume")) from None
         in_flight = 2 * max(1, sum(client.nthreads().values()))
         todo = iter(chunks)
         running: dict = {}
@@ -270,7 +279,8 @@ def _run_on_cluster(grid: Grid, chunks: list[tuple[int, int]], level: int,
                     raise SweepError(
                         f"dask cluster {scheduler}: lost all its workers (none for "
                         f"{NO_WORKERS_TIMEOUT:g} s) with {len(running)} chunks unfinished; "
-                        "finished points are saved: start workers, then rerun with --resume")
+                        "finished points are saved: start workers, then rerun with {resume}",
+                        resume=flag("resume"))
                 continue
             for f in done:
                 a, b = running.pop(f)
@@ -285,20 +295,18 @@ def _run_on_cluster(grid: Grid, chunks: list[tuple[int, int]], level: int,
                     raise SweepError(
                         f"dask cluster {scheduler}: the chunk of points {a}..{b - 1} "
                         "killed the workers that ran it (out of memory?); finished "
-                        "points are saved: rerun with --resume") from None
+                        "points are saved: rerun with {resume}", resume=flag("resume")
+                    ) from None
                 submit(1)
                 yield res
 
 
 # ---------------------------------------------------------------------------------------
-# What a sweep will cost, before it runs (rocksweep.estimate, rocksweep sweep --dry-run)
+# What a sweep will cost, before it runs (rocksweep.estimate; the sweep command's dry run)
 # ---------------------------------------------------------------------------------------
 
-# Kernel time per RK4 evaluation [s] on the paper's figures at the default preset
-# (scripts/bench_compile.py: core-us per point over RK4 evaluations per point, 75-83 ns on
-# the four figures on the 2-core reference machine): the price of a step when no sample
-# can be run because the kernel is not compiled yet.
-SECONDS_PER_EVALUATION = 85e-9
+# The price of a step when no sample can be run because the kernel is not compiled yet:
+# ``numerics.SECONDS_PER_EVALUATION``.
 # Points run to measure the cost when the kernel variant is compiled: ~10 ms of work.
 ESTIMATE_SAMPLE = 256
 
@@ -371,7 +379,7 @@ def estimate(scene: Scene, jobs: int = 1, sample: int = ESTIMATE_SAMPLE,
         sampled = len(flat)
     else:
         evaluations = float(steps_bound)
-        seconds = evaluations * SECONDS_PER_EVALUATION / workers
+        seconds = point_seconds(evaluations) / workers
     return Estimate(n, steps_bound, evaluations, seconds, bool(to_compile or unknown),
                     COMPILE_SECONDS * (to_compile + unknown), len(grid.kinds()), sampled,
                     workers)

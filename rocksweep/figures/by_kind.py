@@ -6,10 +6,11 @@ from __future__ import annotations
 from typing import Any
 
 from rocksweep.analysis.kinds import dataset_kind
-from rocksweep.errors import ApiError, PlotError, RocksweepError  # noqa: F401 (re-exported)
+from rocksweep.errors import ApiError, Arg, PlotError, RocksweepError, flag  # noqa: F401 (re-exported)
 from rocksweep.vocab.kinds import (
     BOUNDARIES,
     CALIBRATION,
+    FLOOR_SPECTRUM,
     FRAGILITY,
     IDA,
     IM_EFFICIENCY,
@@ -31,6 +32,10 @@ def plot_analysis(ds: Any, *, ax: Any = None, width: str | None = None) -> Any:
         return fragility_figure(ds, ax=ax, width=width or "single")
     if kind == CALIBRATION:
         return calibration_figure(ds, ax=ax)
+    if kind == FLOOR_SPECTRUM:
+        from rocksweep.figures.floors import floor_spectrum_figure
+
+        return floor_spectrum_figure(ds, ax=ax, width=width or "single")
     draw = {RISK: results.risk_figure, IDA: results.ida_figure, SPECTRA: spectra_figure,
             BOUNDARIES: results.boundaries_figure,
             IM_EFFICIENCY: results.efficiency_figure}.get(kind or "")
@@ -43,12 +48,10 @@ def plot_analysis(ds: Any, *, ax: Any = None, width: str | None = None) -> Any:
 
 def plot_any(ds: Any, x: str | None = None, y: str | None = None, *, ax: Any = None,
              curves: bool = False, show_computed: bool = False, mu: bool = False,
-             width: str | None = None, compare: str | None = None,
-             names: tuple[str, ...] = ("x", "y", "compare")) -> Any:
+             width: str | None = None, compare: str | None = None) -> Any:
     """``rocksweep.plot``'s figure of any rocksweep Dataset (its arguments documented
     there): a sweep's diagram (``figures.diagrams``), a record suite's overturning
-    fragility, an analysis's figure (``plot_analysis``), at the journal ``width``.
-    names: the options' names in the caller's words (x, y, compare or --x, --y, ...)."""
+    fragility, an analysis's figure (``plot_analysis``), at the journal ``width``."""
     import matplotlib
 
     from rocksweep.figures.diagrams import friction_map, sweep_figure
@@ -61,14 +64,14 @@ def plot_any(ds: Any, x: str | None = None, y: str | None = None, *, ax: Any = N
         # rocksweep.fragility for other states and bands)
         from rocksweep.analysis.fragility import fragility as fit
 
-        given = [n for n, v in zip((*names[:2], "curves", "mu", names[2],
-                                    "show_computed"),
-                                   (x, y, curves, mu, compare, show_computed), strict=True)
+        given = [Arg(n, v) if v is not True else flag(n) for n, v in
+                 zip(("x", "y", "curves", "mu", "compare", "show_computed"),
+                     (x, y, curves, mu, compare, show_computed), strict=True)
                  if v not in (None, False)]
         if given:
-            raise ApiError(f"{given[0]}: a record-suite sweep is drawn as its fragility "
-                           "curves; the diagram's options do not apply (rocksweep.fragility "
-                           "for states and bands)")
+            raise ApiError("{arg}: a record-suite sweep is drawn as its fragility curves; the "
+                           "diagram's options do not apply (rocksweep.fragility for states "
+                           "and bands)", arg=given[0])
 
         ds, kind = fit(ds, state="overturn", bootstrap=0), "fragility"
     if kind not in (None, "sweep"):  # an analysis's Dataset: the figure of its kind
@@ -81,11 +84,10 @@ def plot_any(ds: Any, x: str | None = None, y: str | None = None, *, ax: Any = N
     style = width_style(width)
     with matplotlib.rc_context(style):
         if mu:
-            fig = friction_map(result, x, y, option_names=names[:2])
+            fig = friction_map(result, x, y)
         else:
-            fig = sweep_figure(result, x, y, axes=ax, option_names=names[:2], curves=curves,
-                               show_computed=show_computed, compare=compare,
-                               compare_option=names[2])
+            fig = sweep_figure(result, x, y, axes=ax, curves=curves,
+                               show_computed=show_computed, compare=compare)
     if style and ax is None:  # the preset's width, the layout's aspect, what fits in it
         fit_width(fig, width)
     return fig

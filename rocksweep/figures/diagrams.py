@@ -40,7 +40,7 @@ from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from rocksweep.errors import DiagramError  # noqa: F401 (defined there; re-exported)
+from rocksweep.errors import Arg, DiagramError, flag  # noqa: F401 (DiagramError: re-exported)
 from rocksweep.fields import WORD_AXES
 from rocksweep.figures import DEFAULT_DPI, FORMATS
 from rocksweep.figures.style import Figure, given_axes, new_axes, save_figure, wrap_title
@@ -121,39 +121,43 @@ def plottable(result: SweepResult) -> list[str]:
     return [d for d in result.dims if d not in WORD_AXES and len(result.coords[d]) >= 2]
 
 
-def _check_key(result: SweepResult, key: str, option: str) -> str:
+def _check_key(result: SweepResult, key: str, arg: str) -> str:
+    """The dimension a swept ``key`` (a name or a scene key) names; a DiagramError naming
+    the argument ``arg`` (x, y) otherwise."""
     name = key.split(".", 1)[1] if key.startswith(("body.", "pulse.", "impact.")) else key
     ok = plottable(result)
     if name not in ok:
         why = ("pulse shapes are drawn as panels, not along an axis" if name == "shape"
-               else "impact laws are drawn as panels (or --compare impact.law), not along "
+               else "impact laws are drawn as panels (or compared: {compare}), not along "
                "an axis" if name == "law"
                else "has one value" if name in result.dims
                else "not swept" if name in result.scalars
                else "no such axis")
-        raise DiagramError(f"{result.path}: {option} {key}: {why}; swept axes: "
-                           f"{', '.join(ok) or '(none with two or more values)'}")
+        raise DiagramError(f"{{path}}: {{arg}}: {why}; swept axes: "
+                           f"{', '.join(ok) or '(none with two or more values)'}",
+                           path=result.path, arg=Arg(arg, key),
+                           compare=Arg("compare", "impact.law"))
     return name
 
 
-def choose_axes(result: SweepResult, x: str | None = None, y: str | None = None,
-                option_names: tuple[str, str] = ("x", "y")) -> tuple[str, str | None]:
+def choose_axes(result: SweepResult, x: str | None = None, y: str | None = None
+                ) -> tuple[str, str | None]:
     """The (x, y) dimensions to draw; y None: a 1-D line plot over x.
 
     Defaults: x = w_over_p and y = A_ratio when swept, else other swept axes (lam last:
     it is layered in the colours when on neither axis). With fewer than two swept axes
     besides lam, a line plot over the one left (one line per lam). Keys may be given as
-    names (``alpha_cg``) or scene keys (``body.alpha_cg``). option_names: how errors call
-    x and y (the CLI passes ("--x", "--y")).
+    names (``alpha_cg``) or scene keys (``body.alpha_cg``); errors name them as the
+    arguments ``x`` and ``y``.
     """
     if x is not None:
-        x = _check_key(result, x, option_names[0])
+        x = _check_key(result, x, "x")
     if y is not None:
-        y = _check_key(result, y, option_names[1])
+        y = _check_key(result, y, "y")
     if x is not None and x == y:
-        raise DiagramError(f"{result.path}: {option_names[0]} and {option_names[1]} are both "
-                           f"{x}; choose two different swept axes: "
-                           f"{', '.join(plottable(result))}")
+        raise DiagramError(f"{{path}}: {{x}} and {{y}} are both {x}; choose two different "
+                           f"swept axes: {', '.join(plottable(result))}", path=result.path,
+                           x=Arg("x"), y=Arg("y"))
     axes = plottable(result)
     if not axes:
         raise DiagramError(f"{result.path}: no swept axis with two or more values to draw; "
@@ -171,8 +175,8 @@ def choose_axes(result: SweepResult, x: str | None = None, y: str | None = None,
                     or (["lam"] if "lam" in axes and y != "lam" else []))
             x = pool[0] if pool else None
             if x is None:
-                raise DiagramError(f"{result.path}: {option_names[1]} {y}: no other swept "
-                                   f"axis for x; swept axes: {', '.join(axes)}")
+                raise DiagramError(f"{{path}}: {{y}}: no other swept axis for x; swept axes: "
+                                   f"{', '.join(axes)}", path=result.path, y=Arg("y", y))
         rest = [d for d in rest if d != x]
     if y is None and rest:
         y = DEFAULT_Y if DEFAULT_Y in rest else DEFAULT_X if DEFAULT_X in rest else rest[0]
@@ -208,7 +212,7 @@ def _panels(result: SweepResult, panel_dims: list[str]) -> list[tuple[int, ...]]
     if len(panels) > MAX_PANELS:
         raise DiagramError(f"{result.path}: {len(panels)} panels "
                            f"({' x '.join(panel_dims)}); at most {MAX_PANELS} fit a figure; "
-                           "choose other --x/--y or sweep fewer values")
+                           "choose other axes x and y or sweep fewer values")
     return panels
 
 
@@ -263,7 +267,6 @@ def _place_axes(axes, n: int, rows_cols: tuple[int, int], size: tuple[float, flo
 
 def stability_diagram(result: SweepResult, x: str | None = None, y: str | None = None, *,
                       axes: Axes | Sequence[Axes] | None = None,
-                      option_names: tuple[str, str] = ("x", "y"),
                       curves: bool = False, show_computed: bool = False) -> Figure:
     """The stability diagram of ``result`` over swept axes x and y (see the module
     docstring; defaults from ``choose_axes``). Needs the ``outcome`` and ``status``
@@ -271,10 +274,10 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
     the boundary lines of every lam; show_computed: shade the cells an adaptive sweep
     computed at some lam (needs the ``computed`` array). Returns the figure.
     """
-    x, y = choose_axes(result, x, y, option_names)
+    x, y = choose_axes(result, x, y)
     if y is None:
         raise DiagramError(f"{result.path}: one swept axis besides lam ({x}); a stability "
-                           "diagram needs two: draw it with line_diagram (rocksweep plot "
+                           "diagram needs two: draw it with line_diagram (rocksweep.plot "
                            "does) or sweep another key")
     dims = list(result.dims)
     layered = "lam" in dims and "lam" not in (x, y)
@@ -444,7 +447,7 @@ def _legend_outside(ax: Axes, handles: list) -> None:
 
 
 # ---------------------------------------------------------------------------------------
-# Comparing the values of one swept key (rocksweep plot --compare impact.law)
+# Comparing the values of one swept key (rocksweep.plot(compare="impact.law"))
 # ---------------------------------------------------------------------------------------
 
 MAX_COMPARED = 4  # values of the compared key: 2^4 - 1 overturning sets at most
@@ -499,8 +502,7 @@ def _set_label(mask: int, labels: list[str], what: str) -> str:
 
 def compare_diagram(result: SweepResult, key: str, x: str | None = None,
                     y: str | None = None, *, axes: Axes | Sequence[Axes] | None = None,
-                    option_names: tuple[str, str] = ("x", "y"), curves: bool = False,
-                    option: str = "compare") -> Figure:
+                    curves: bool = False) -> Figure:
     """One diagram per panel comparing the values of the swept key ``key`` (e.g.
     ``impact.law`` or ``lam``): each cell is coloured by which values overturn it (under
     both, only under ``locked``, only under ``vertical``, ...; blue: mode 2 under every
@@ -512,17 +514,19 @@ def compare_diagram(result: SweepResult, key: str, x: str | None = None,
         swept = [d for d in result.dims if len(result.coords[d]) >= 2]
         why = "has one value" if name in result.dims else (
             "not swept" if name in result.scalars else "no such key")
-        raise DiagramError(f"{result.path}: {option} {key}: {why}; keys with two or more "
-                           f"values: {', '.join(swept) or '(none)'}")
+        raise DiagramError(f"{{path}}: {{key}}: {why}; keys with two or more values: "
+                           f"{', '.join(swept) or '(none)'}", path=result.path,
+                           key=Arg("compare", key))
     n = len(result.coords[name])
     if n > MAX_COMPARED:
-        raise DiagramError(f"{result.path}: {option} {key}: {n} values; at most "
-                           f"{MAX_COMPARED} can be compared in one diagram")
-    x, y = choose_axes(result, x, y, option_names)
+        raise DiagramError(f"{{path}}: {{key}}: {n} values; at most {MAX_COMPARED} can be "
+                           "compared in one diagram", path=result.path,
+                           key=Arg("compare", key))
+    x, y = choose_axes(result, x, y)
     if y is None or name in (x, y):
-        raise DiagramError(f"{result.path}: {option} {key}: needs two other swept axes for "
-                           f"the diagram (x {x}, y {y}); choose them with {option_names[0]}"
-                           f" and {option_names[1]}")
+        raise DiagramError(f"{{path}}: {{key}}: needs two other swept axes for the diagram "
+                           f"(x {x}, y {y}); choose them with {{x}} and {{y}}",
+                           path=result.path, key=Arg("compare", key), x=Arg("x"), y=Arg("y"))
     dims = list(result.dims)
     panel_dims = [d for d in dims if d not in (x, y, name)]
     order = [*panel_dims, name, y, x]
@@ -608,21 +612,21 @@ def _no_suite(result: SweepResult) -> None:
     """A record suite's result (a ``record`` dimension of file names) is no diagram."""
     if "record" in result.dims:
         raise DiagramError(f"{result.path}: a record-suite result (dimension record); draw "
-                           "its fragility curves with rocksweep fragility --plot (Python: "
-                           "rocksweep.fragility)")
+                           "its fragility curves (rocksweep.fragility)")
 
 
-def friction_map(result: SweepResult, x: str | None = None, y: str | None = None, *,
-                 option_names: tuple[str, str] = ("x", "y")) -> Figure:
-    """The friction demand mu_required over swept axes x and y (``rocksweep plot --mu``):
+def friction_map(result: SweepResult, x: str | None = None, y: str | None = None
+                 ) -> Figure:
+    """The friction demand mu_required over swept axes x and y (``rocksweep.plot(mu=True)``):
     filled contours, one panel per value of every other swept key (lam included), labelled
     contour lines at mu = 0.4, 0.6, 0.8; points whose normal force went below zero (infinite
     demand, mostly on the way to overturning) in the top colour. Needs a result with
     contact outputs (``outputs.contact``)."""
     if "mu_required" not in result.arrays:
         raise DiagramError(f"{result.path}: no mu_required in this result; sweep with "
-                           "--contact (outputs.contact: true) to draw the friction demand")
-    x, y = choose_axes(result, x, y, option_names)
+                           "contact outputs (outputs.contact: true) to draw the friction "
+                           "demand")
+    x, y = choose_axes(result, x, y)
     if y is None:
         raise DiagramError(f"{result.path}: one swept axis besides lam ({x}); the friction "
                            "map needs two")
@@ -667,17 +671,16 @@ _OUTCOME_STYLE = {  # outcome code -> (marker, face colour, legend label)
 
 
 def line_diagram(result: SweepResult, x: str | None = None, *,
-                 axes: Axes | Sequence[Axes] | None = None,
-                 option_names: tuple[str, str] = ("x", "y")) -> Figure:
+                 axes: Axes | Sequence[Axes] | None = None) -> Figure:
     """A 1-D sweep: max|theta|/alpha_ref against x, one line per lam (when lam is swept
     and not x), markers by outcome (safe, mode 1, mode 2, not computed); one panel per
     value of any other swept key. Without ``theta_max_over_alpha`` in the result's arrays
     the outcome itself is drawn. axes: one Axes per panel (else a new figure).
     """
     if x is None:
-        x, _ = choose_axes(result, None, None, option_names)
+        x, _ = choose_axes(result, None, None)
     else:
-        x = _check_key(result, x, option_names[0])
+        x = _check_key(result, x, "x")
     dims = list(result.dims)
     series = "lam" in dims and x != "lam"
     panel_dims = [d for d in dims if d != x and not (series and d == "lam")]
@@ -736,29 +739,29 @@ def line_diagram(result: SweepResult, x: str | None = None, *,
 
 def sweep_figure(result: SweepResult, x: str | None = None, y: str | None = None, *,
                  axes: Axes | Sequence[Axes] | None = None,
-                 option_names: tuple[str, str] = ("x", "y"), curves: bool = False,
-                 show_computed: bool = False, compare: str | None = None,
-                 compare_option: str = "compare") -> Figure:
+                 curves: bool = False, show_computed: bool = False,
+                 compare: str | None = None) -> Figure:
     """The figure ``rocksweep plot`` draws: a stability diagram over (x, y), or a line
     plot when the result has one swept axis besides lam (see ``choose_axes``); curves:
-    the boundary lines over the diagram (``rocksweep plot --curves``); show_computed: the
-    cells an adaptive sweep computed shaded (``--show-computed``); compare: a swept key
-    whose values are compared on one diagram (``compare_diagram``, ``--compare``)."""
+    the boundary lines over the diagram; show_computed: the cells an adaptive sweep
+    computed shaded; compare: a swept key whose values are compared on one diagram
+    (``compare_diagram``)."""
     _no_suite(result)
     if compare is not None:
         if show_computed:
-            raise DiagramError(f"{result.path}: --show-computed draws on the stability "
-                               f"diagram, not with {compare_option}")
-        return compare_diagram(result, compare, x, y, axes=axes, option_names=option_names,
-                               curves=curves, option=compare_option)
-    x, y = choose_axes(result, x, y, option_names)
+            raise DiagramError("{path}: {show} draws on the stability diagram, not with "
+                               "{compare}", path=result.path, show=flag("show_computed"),
+                               compare=Arg("compare"))
+        return compare_diagram(result, compare, x, y, axes=axes, curves=curves)
+    x, y = choose_axes(result, x, y)
     if y is None:
         if curves or show_computed:
-            raise DiagramError(f"{result.path}: --curves and --show-computed draw on a "
-                               f"stability diagram; this result has one swept axis ({x}) "
-                               "besides lam")
-        return line_diagram(result, x, axes=axes, option_names=option_names)
-    return stability_diagram(result, x, y, axes=axes, option_names=option_names,
+            raise DiagramError(f"{{path}}: {{curves}} and {{show}} draw on a stability "
+                               f"diagram; this result has one swept axis ({x}) besides lam",
+                               path=result.path, curves=flag("curves"),
+                               show=flag("show_computed"))
+        return line_diagram(result, x, axes=axes)
+    return stability_diagram(result, x, y, axes=axes,
                              curves=curves, show_computed=show_computed)
 
 
@@ -782,7 +785,7 @@ def missing_warnings(result: SweepResult) -> list[str]:
     n_missing = int((outcome == L.OUTCOME_NOT_RUN).sum())
     if n_missing:
         return [f"{n_missing} of {outcome.size} points not computed yet (grey); "
-                "finish the sweep with --resume"]
+                "a resume of the sweep computes them"]
     return []
 
 
@@ -797,7 +800,7 @@ def stability_figure(result: SweepResult, path: str | Path, *, x: str | None = N
 
 
 # ---------------------------------------------------------------------------------------
-# A_min curves (rocksweep boundaries --plot)
+# A_min curves (the boundaries command's figure)
 # ---------------------------------------------------------------------------------------
 
 def _where_label(where: dict[str, Any]) -> str:

@@ -27,12 +27,13 @@ def spectra_figure(sp: xr.Dataset | Spectra, *, ax: Any = None,
     """Two panels against the frequency axis (p or w_over_p) of the spectra Dataset
     (``rocksweep.spectra``; a ``Spectra`` is drawn through its ``to_dataset``): the rocking
     spectrum (max|theta|/alpha_ref, one colour per A_ratio, one line style per lam,
-    overturned points marked x above 1) and the overturning spectrum (the smallest A_ratio
-    that overturns, one curve per lam, mode 1 filled circles, mode 2 open triangles). ax:
-    two axes to draw into; width: a journal width (``figures.WIDTHS``)."""
+    overturned points marked x above 1; other swept keys at their first value) and the
+    overturning spectrum (the smallest A_ratio that overturns, one curve per lam, mode 1
+    filled circles, mode 2 open triangles). ax: two axes to draw into; width: a journal
+    width (``figures.WIDTHS``)."""
     if hasattr(sp, "to_dataset"):
         sp = sp.to_dataset()
-    freq = next(d for d in sp["A_min"].dims if d != "lam")
+    freq = sp["A_min"].dims[-1]
     if ax is not None:
         axes = np.atleast_1d(ax)
         fig = axes[0].figure
@@ -42,6 +43,10 @@ def spectra_figure(sp: xr.Dataset | Spectra, *, ax: Any = None,
     x = sp[freq].values
     th = sp["theta_max_over_alpha"]
     over = sp["outcome"] > 0 if "outcome" in sp else th.isnull()
+    # other swept keys (an angle, a floor's period): the rocking spectrum at the first
+    # value of each (the overturning spectrum draws every combination)
+    first = {d: 0 for d in th.dims if d not in ("lam", "A_ratio", freq)}
+    th, over = th.isel(first), over.isel(first)
     A = sp["A_ratio"].values
     pick = np.unique(np.linspace(0, A.size - 1, min(MAX_CURVES, A.size)).round().astype(int))
     n_lam = sp.sizes.get("lam", 1)

@@ -52,14 +52,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.signal import lfilter
 
 from rocksweep.physics.bodies import G  # gravity [m/s^2], the one definition
 from rocksweep.vocab.ground import AVGSA_POINTS, SA_DAMPING
 
 __all__ = ["AVGSA_POINTS", "G", "arias", "avg_sa", "avgsa_periods", "cav", "duration",
-           "final_velocity", "husid", "pga", "pgv", "sa",
-           "significant_duration", "velocity"]
+           "final_velocity", "free_vibration", "husid", "nj_response", "pga", "pgv",
+           "refined", "sa", "significant_duration", "velocity"]
 
 
 def _check(acc, dt: float) -> np.ndarray:
@@ -205,6 +204,62 @@ def _free_peak(u: float, v: float, w: float, zeta: float) -> float:
     return max(abs(u), abs(u1))  # later extrema are smaller: u(t + pi/wd) = -decay u(t)
 
 
+def refined(acc: np.ndarray, dt: float, m: int) -> np.ndarray:
+    """The piecewise-linear record at m times its samples (exact: it is linear between
+    samples): float64[(n - 1) m + 1] at t = k dt / m."""
+    t_f = np.arange((acc.size - 1) * m + 1) * (dt / m)
+    return np.interp(t_f, np.arange(acc.size) * dt, acc)
+
+
+def nj_response(x, w: float, zeta: float, h: float, *, rate: bool = False):
+    """The exact response of u'' + 2 zeta w u' + w^2 u = x(t), at rest at t = 0, to the
+    piecewise-linear load x (float64[n], x_k at t = k h): the Nigam-Jennings recurrence
+    (``_nj_coefficients``) written as a second-order recursive filter (``lfilter``).
+    Returns (u, v_end): u float64[n] at the samples and the rate u' at the last sample;
+    with ``rate`` (u, v), v = u' float64[n] at every sample (a second filter, same
+    denominator)."""
+    # here, not at import: scipy.signal costs a scene (and every command) ~0.3 s of start-up
+    from scipy.signal import lfilter
+
+    A, B0, B1 = _nj_coefficients(w, zeta, h)
+    # the recurrence as a filter: u = H(z) x with
+    # H = [B1u, B0u - a22 B1u + a12 B1v, a12 B0v - a22 B0u] / [1, -tr A, det A]
+    den = np.array([1.0, -(A[0, 0] + A[1, 1]), A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]])
+    nu = np.array([B1[0], B0[0] - A[1, 1] * B1[0] + A[0, 1] * B1[1],
+                   A[0, 1] * B0[1] - A[1, 1] * B0[0]])
+    # initial filter state (transposed direct form II) that starts the state at rest
+    # with x_0 possibly != 0: u_0 = 0 and u_1 = B0[0] x_0 + B1[0] x_1
+    zu = np.array([-nu[0] * x[0], (B0[0] - nu[1]) * x[0]])
+    u = lfilter(nu, den, x, zi=zu)[0]
+    if rate:
+        # V = [B1v, B0v - a11 B1v + a21 B1u, a21 B0u - a11 B0v] / the same denominator
+        nv = np.array([B1[1], B0[1] - A[0, 0] * B1[1] + A[1, 0] * B1[0],
+                       A[1, 0] * B0[0] - A[0, 0] * B0[1]])
+        zv = np.array([-nv[0] * x[0], (B0[1] - nv[1]) * x[0]])
+        return u, lfilter(nv, den, x, zi=zv)[0]
+    # the rate at the end only (for the free vibration after the record), from the
+    # recurrence's first row over the last step, then its second row: one filter
+    # instead of two (u' over the whole record is never needed)
+    if u.size > 1:
+        v_prev = (u[-1] - A[0, 0] * u[-2] - B0[0] * x[-2] - B1[0] * x[-1]) / A[0, 1]
+        v_end = A[1, 0] * u[-2] + A[1, 1] * v_prev + B0[1] * x[-2] + B1[1] * x[-1]
+    else:
+        v_end = 0.0
+    return u, v_end
+
+
+def free_vibration(u: float, v: float, w: float, zeta: float, tau) -> tuple:
+    """The free vibration of u'' + 2 zeta w u' + w^2 u = 0 from (u, v) at tau = 0:
+    (u(tau), u'(tau)), float64 like ``tau`` [s] (0 <= zeta < 1)."""
+    wd = w * math.sqrt(1.0 - zeta * zeta)
+    tau = np.asarray(tau, dtype=np.float64)
+    B = (v + zeta * w * u) / wd
+    e = np.exp(-zeta * w * tau)
+    c, s = np.cos(wd * tau), np.sin(wd * tau)
+    return (e * (u * c + B * s),
+            e * ((B * wd - zeta * w * u) * c - (u * wd + zeta * w * B) * s))
+
+
 def sa(acc, dt: float, periods, zeta: float = SA_DAMPING, *, points_per_period: int = 32,
        max_refine: int = 64) -> np.ndarray:
     """Pseudo-spectral acceleration Sa(T) = (2 pi / T)^2 max_t |u(t)| [units of acc: g for
@@ -220,7 +275,6 @@ def sa(acc, dt: float, periods, zeta: float = SA_DAMPING, *, points_per_period: 
     if not (0.0 <= zeta < 1.0):
         raise ValueError(f"zeta = {zeta!r}: must be in [0, 1)")
     out = np.empty(T.size)
-    t_in = np.arange(a.size) * dt
     resampled: dict[int, np.ndarray] = {1: a}
     for j, Tj in enumerate(T):
         if Tj == 0.0:
@@ -229,27 +283,9 @@ def sa(acc, dt: float, periods, zeta: float = SA_DAMPING, *, points_per_period: 
         w = 2.0 * math.pi / Tj
         m = int(min(max(math.ceil(points_per_period * dt / Tj), 1), max_refine))
         if m not in resampled:
-            t_f = np.arange((a.size - 1) * m + 1) * (dt / m)
-            resampled[m] = np.interp(t_f, t_in, a)
+            resampled[m] = refined(a, dt, m)
         x = -resampled[m]  # u'' + 2 zeta w u' + w^2 u = -xg''
-        A, B0, B1 = _nj_coefficients(w, zeta, dt / m)
-        # the recurrence as a filter: u = H(z) x with
-        # H = [B1u, B0u - a22 B1u + a12 B1v, a12 B0v - a22 B0u] / [1, -tr A, det A]
-        den = np.array([1.0, -(A[0, 0] + A[1, 1]), A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]])
-        nu = np.array([B1[0], B0[0] - A[1, 1] * B1[0] + A[0, 1] * B1[1],
-                       A[0, 1] * B0[1] - A[1, 1] * B0[0]])
-        # initial filter state (transposed direct form II) that starts the state at rest
-        # with x_0 possibly != 0: u_0 = 0 and u_1 = B0[0] x_0 + B1[0] x_1
-        zu = np.array([-nu[0] * x[0], (B0[0] - nu[1]) * x[0]])
-        u = lfilter(nu, den, x, zi=zu)[0]
-        # the rate at the end only (for the free vibration after the record), from the
-        # recurrence's first row over the last step, then its second row: one filter
-        # instead of two (u' over the whole record is never needed)
-        if u.size > 1:
-            v_prev = (u[-1] - A[0, 0] * u[-2] - B0[0] * x[-2] - B1[0] * x[-1]) / A[0, 1]
-            v_end = A[1, 0] * u[-2] + A[1, 1] * v_prev + B0[1] * x[-2] + B1[1] * x[-1]
-        else:
-            v_end = 0.0
+        u, v_end = nj_response(x, w, zeta, dt / m)
         peak = max(float(np.max(np.abs(u))), _free_peak(float(u[-1]), float(v_end), w, zeta))
         out[j] = w * w * peak
     return out

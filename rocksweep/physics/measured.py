@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.errors import MeasuredError, RocksweepError  # noqa: F401 (MeasuredError re-exported)
+from rocksweep.errors import Arg, MeasuredError, RocksweepError  # noqa: F401 (MeasuredError re-exported)
 from rocksweep.inputs import check_columns, csv_table, number_column, read_text
 from rocksweep.outputs import shown
 
@@ -98,7 +98,7 @@ def read_measured(measured: Any, *, p: float | None = None, alpha_ref: float | N
         if runs.size > 1:
             raise MeasuredError(f"{src}: column run holds {runs.size} runs "
                                 f"({', '.join(f'{r:g}' for r in runs[:4])}...); give one "
-                                "run's rows (simulate --csv of one point)")
+                                "run's rows (the history CSV of one point)")
     if "p_t" in cols and "theta_over_alpha" in cols:
         t = column("p_t")
         theta = column("theta_over_alpha", gaps=True)
@@ -106,10 +106,10 @@ def read_measured(measured: Any, *, p: float | None = None, alpha_ref: float | N
         tname, thname = "p_t", "theta_over_alpha"
     elif "t" in cols and "theta" in cols:
         if p is None or alpha_ref is None:
-            raise MeasuredError(f"{src}: columns t [s], theta [rad] need the body's p "
-                                "[rad/s]: give p= (a number), or a physical body (kind: "
+            raise MeasuredError("{src}: columns t [s], theta [rad] need the body's p "
+                                "[rad/s]: give {p} (a number), or a physical body (kind: "
                                 "physical) or a record scene's ground.p; or give columns "
-                                "p_t, theta_over_alpha")
+                                "p_t, theta_over_alpha", src=src, p=Arg("p", kind="keyword"))
         t = column("t") * p
         theta = column("theta", gaps=True) / alpha_ref
         u = None
@@ -123,8 +123,8 @@ def read_measured(measured: Any, *, p: float | None = None, alpha_ref: float | N
         missing = "theta_over_alpha" if "p_t" in cols else (
             "theta" if "t" in cols else "p_t, theta_over_alpha")
         raise MeasuredError(f"{src}: no column {missing} (columns: {have}); a measured "
-                            "history needs p_t and theta_over_alpha (as simulate --csv "
-                            "writes), or t [s] and theta [rad]")
+                            "history needs p_t and theta_over_alpha (as a simulated "
+                            "history's CSV has), or t [s] and theta [rad]")
     if t.size == 0:
         raise MeasuredError(f"{src}: no rows")
     if not np.all(np.isfinite(t)):

@@ -66,6 +66,9 @@ AVGSA_RANGE = (0.2, 3.0)
 DRIFT_SHARE = 0.1
 #: warn when a record is scaled by more than this factor
 MAX_FACTOR = 5.0
+#: the horizontal components a suite's IM may be taken of (``ground.scale.component``)
+H1, ROTD50 = "H1", "RotD50"
+COMPONENTS = (H1, ROTD50)
 
 
 
@@ -106,6 +109,25 @@ class Suite:
     v_end: np.ndarray = field(repr=False, default=None)
     avgsa_range: tuple[float, float] = (math.nan, math.nan)
     avgsa_rule: str = ""
+    # a suite of multi-component records (a folder of PEER downloads): each record's
+    # second horizontal and vertical (empty: single-component records); the horizontal
+    # whose IM scales the records: "H1" (the first component) or "RotD50" (the median over
+    # orientations of the two horizontals, ``path.rotd50_peaks``), its values float64[R]
+    h2: tuple = ()
+    vertical: tuple = ()
+    component: str = H1
+    rotd50: np.ndarray | None = field(repr=False, default=None)
+
+    def vertical_ims(self) -> dict[str, np.ndarray]:
+        """``record_pga_v`` [g] (the vertical's peak) and ``record_v_over_h`` (PGA_v over
+        the scaling component's PGA: H1's or RotD50's), float64[R]; {} without
+        verticals."""
+        if not self.vertical:
+            return {}
+        pga_v = np.array([np.nan if v is None else v.pga for v in self.vertical])
+        pga_h = self.rotd50 if (self.component == ROTD50 and self.im in (PGA, PGA_RATIO)) \
+            else self.pga
+        return {"record_pga_v": pga_v, "record_v_over_h": pga_v / pga_h}
 
     def record_ims(self) -> dict[str, np.ndarray]:
         """Each ``RECORD_IMS`` variable (not Sa) -> float64[R], the records as recorded."""
@@ -153,6 +175,8 @@ class Suite:
     def record_im(self) -> np.ndarray:
         """Each record's own value of the stripe IM (PGA_ratio: its PGA, PGV_ratio: its
         PGV), float64[R]."""
+        if self.component == ROTD50:
+            return self.rotd50
         if self.im in (PGA, PGA_RATIO):
             return self.pga
         if self.im in (PGV, PGV_RATIO):
@@ -189,7 +213,7 @@ class Suite:
                    p: np.ndarray) -> np.ndarray:
         """The scaled record's peak |xg''| / (g tan alpha_ref): the A_ratio the kernel's
         rows take (PGA_ratio stripes: the stripe value itself)."""
-        if self.im == "PGA_ratio":
+        if self.im == "PGA_ratio" and self.component == H1:
             x = np.asarray(self.levels, np.float64)[np.asarray(s, np.int64)]
             return np.broadcast_to(x, np.broadcast_shapes(
                 x.shape, np.shape(alpha_ref), np.shape(p))).copy()
@@ -207,7 +231,8 @@ class Suite:
 def make_suite(records: list[GroundRecord], names: list[str], im: str | None,
                levels: list[float], period: float, factor: float,
                periods: list[float], avgsa_range: tuple[float, float] | None = None,
-               avgsa_rule: str = "") -> Suite:
+               avgsa_rule: str = "", h2: tuple = (), vertical: tuple = (),
+               component: str = H1) -> Suite:
     """A Suite with every record's IMs computed (once). avgsa_range: (T_lo, T_hi) [s] of
     AvgSa (default ``AVGSA_RANGE`` times ``period``, or times 1 s without one). A record
     whose IM to scale is not a finite number > 0 (PGV 0, Sa 0) is a ``SuiteError`` naming
@@ -238,11 +263,16 @@ def make_suite(records: list[GroundRecord], names: list[str], im: str | None,
             hit = [j for j, t in enumerate(periods) if t == period]
             scale_sa[i] = (sa[i, hit[0]] if hit else
                            float(intensity.sa(rec.acc, rec.dt, [period], ZETA)[0]))
+    rotd50 = None
+    if component == ROTD50:  # the stripe IM of the two horizontals, median over angles
+        rotd50 = np.array([rotd50_im(r, s, im, period) for r, s in zip(records, h2,
+                                                                         strict=True)])
     suite = Suite(tuple(records), tuple(names), im, tuple(float(v) for v in levels),
                   float(period), float(factor), tuple(float(t) for t in periods), pga, pgv,
                   sa, scale_sa, **more,
                   avgsa_range=(float(avgsa_range[0]), float(avgsa_range[1])),
-                  avgsa_rule=avgsa_rule)
+                  avgsa_rule=avgsa_rule, h2=tuple(h2), vertical=tuple(vertical),
+                  component=component, rotd50=rotd50)
     if im is not None:
         own = suite.record_im()
         for i, rec in enumerate(records):
@@ -253,3 +283,30 @@ def make_suite(records: list[GroundRecord], names: list[str], im: str | None,
                 raise SuiteError(f"{rec.source}: {what}{per} = {v!r}: cannot be scaled to "
                                  f"a {im} stripe (needs a record with {what} > 0)")
     return suite
+
+
+def rotd50_im(h1: GroundRecord, h2: GroundRecord, im: str | None, period: float) -> float:
+    """RotD50 (Boore 2010) of a two-component record's IM: PGA (and PGA_ratio's) [g], PGV
+    (and PGV_ratio's) [m/s] of the velocities at the samples, or Sa(period) [g] at 5%
+    damping of the oscillator's responses (its free vibration one period past the record
+    included): the median over the angles 0..179 deg of the peak of the projected series."""
+    from rocksweep.physics import intensity
+    from rocksweep.physics.path import rotd50_peaks
+
+    n = max(h1.npts, h2.npts)
+    a1, a2 = (np.pad(r.acc, (0, n - r.npts)) for r in (h1, h2))
+    if im in (PGA, PGA_RATIO):
+        return rotd50_peaks(a1, a2)
+    if im in (PGV, PGV_RATIO):
+        return rotd50_peaks(intensity.velocity(a1, h1.dt), intensity.velocity(a2, h1.dt))
+    w = 2.0 * math.pi / period
+    m = int(min(max(math.ceil(32 * h1.dt / period), 1), 64))
+    h = h1.dt / m
+    tau = np.arange(1, int(math.ceil(period / h)) + 1) * h
+    us = []
+    for a in (a1, a2):
+        x = -intensity.refined(a, h1.dt, m)
+        u, v = intensity.nj_response(x, w, ZETA, h, rate=True)
+        us.append(np.concatenate((u, intensity.free_vibration(
+            float(u[-1]), float(v[-1]), w, ZETA, tau)[0])))
+    return w * w * rotd50_peaks(*us)

@@ -15,7 +15,12 @@ from itertools import product
 
 import numpy as np
 
-from rocksweep.numerics import EVENT_STEP_ALLOWANCE, MAX_POINT_STEPS, Numerics
+from rocksweep.numerics import (
+    EVENT_STEP_ALLOWANCE,
+    MAX_POINT_STEPS,
+    Numerics,
+    point_seconds,
+)
 from rocksweep.physics.bodies import BodyError
 from rocksweep.physics.points import (
     body_omega_rock,
@@ -23,7 +28,7 @@ from rocksweep.physics.points import (
     record_cost,
     run_cost,
 )
-from rocksweep.scene.model import Scene, SceneError
+from rocksweep.scene.model import FLOOR_AXES, Scene, SceneError
 from rocksweep.schema import KEYS, fmt
 
 # Body grids up to this many distinct bodies are checked body by body; larger ones at the
@@ -155,6 +160,74 @@ def _check_suite_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
                         "shorter horizon")
 
 
+def _path_ends(scene: Scene) -> list[dict]:
+    """Values of the axes a path's motion depends on that stand for its longest and
+    finest motions: every record (or pulse shape), the ends of w_over_p and of the
+    angle, the floor's longest ring-down (largest period, least damping, largest
+    |participation|) and its finest sampling (least period)."""
+    names = {a.name for a in scene.axes}
+    choices: dict[str, list] = {}
+    for a in scene.axes:
+        if a.name in ("record", "shape"):
+            choices[a.name] = list(a.values)
+        elif a.name in ("angle", "w_over_p") and (a.name != "w_over_p" or not scene.recorded):
+            choices[a.name] = sorted({min(a.values), max(a.values)})
+    floors = [{}]
+    if scene.floor and scene.path.modes is None:
+        per, damp, part = (scene.axis(k).values for k in FLOOR_AXES)
+        big = max(part, key=abs)
+        floors = [{"floor.period": max(per), "floor.damping": min(damp),
+                   "floor.participation": big},
+                  {"floor.period": min(per), "floor.damping": min(damp),
+                   "floor.participation": big}]
+    out = []
+    for combo in product(*choices.values()):
+        for fl in floors:
+            out.append({**dict(zip(choices, combo, strict=True)), **fl})
+    return [v for v in out if all(k in names for k in v)]
+
+
+def _check_path_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
+    """A scene with an excitation path: the step cap of its longest and finest motions
+    (``_path_ends``) at the ends of p (a record's) and of the ground's amplitude."""
+    if scene.recorded:
+        p = np.asarray(scene.axis("p").values)
+        p_ends = np.array([p.min(), p.max()])
+    else:
+        p_ends = np.array([scene.path.p] * 2)
+    su = scene.suite
+    for values in _path_ends(scene):
+        motion, peak, r = scene.path_motion(values)
+        for b in bodies:
+            body = scene.make_body(**b)
+            alpha = body.alpha_ref
+            if su is not None:
+                s = np.arange(len(su.levels)) if su.im else None
+                fac = su.factors(np.full(1 if s is None else s.size, r), s,
+                                 np.array([alpha]), p_ends[:1])
+                amp = float(np.max(np.abs(fac))) * su.pga[r] / math.tan(alpha)
+            else:
+                amp = float(np.max(np.abs(scene.axis("A_ratio").values)))
+            A = np.array([amp * motion.pga / peak] * 2)
+            for n, label in _runs(scene):
+                _, h_rec, _, _, cap = record_cost(np.array([body_omega_rock(body)] * 2),
+                                                  np.array([alpha] * 2), p_ends, A,
+                                                  motion, n, body_zeta_rock(body))
+                worst = int(np.argmax(np.where(np.isnan(cap), math.inf, cap)))
+                c = float(cap[worst])
+                if not (c <= MAX_POINT_STEPS):
+                    at = ", ".join(f"{k} = {fmt(v)}" for k, v in values.items())
+                    raise SceneError(
+                        f"the motion the body feels at {at or 'the scene'}: "
+                        f"{motion.npts} samples at DT = {motion.dt:.3g} s "
+                        f"({motion.duration:.4g} s with the floor's ring-down): one point "
+                        f"could need {c:.2g} RK4 steps{label} (steps of "
+                        f"{float(h_rec[worst]):.3g} p*t, then {n.horizon:g} p*t of free "
+                        f"vibration), more than the cap of {MAX_POINT_STEPS:.0e} a point; "
+                        "use a smaller p, a more damped or stiffer building, fewer "
+                        "steps_per_period or a shorter horizon")
+
+
 def _runs(scene: Scene) -> tuple[tuple[Numerics, str], ...]:
     """The numerics a scene's points run at, with the words that name them: the sweeps'
     (the single runs' are the same) and, with the certification of close calls
@@ -180,6 +253,9 @@ def check_cost(scene: Scene, bodies: list[dict[str, float]]) -> None:
     A_ratio also at the smallest |A| above 1, where a rigid body's pulse steps are most
     (``numerics.threshold_factor``).
     """
+    if scene.path is not None:
+        _check_path_cost(scene, bodies)
+        return
     if scene.record is not None:
         _check_record_cost(scene, bodies)
         return
@@ -263,7 +339,8 @@ def _cost_message(scene: Scene, point: dict) -> str:
     why = (f"{n.max_steps_factor:g} x a run of {t_end:.3g} p*t in steps of {dt:.3g} p*t, "
            f"plus {EVENT_STEP_ALLOWANCE:g} per event x max_events {n.max_events}")
     head = (f"one point could need {cap:.2g} RK4 steps{label} ({why}), more than the cap of "
-            f"{MAX_POINT_STEPS:.0e} a point (~17 s of one core)")
+            f"{MAX_POINT_STEPS:.0e} a point (~{point_seconds(MAX_POINT_STEPS):.2g} s of one "
+            "core)")
     # which value of the point makes it costly: the one whose typical value cuts the most
     current = {**point, **{f"numerics.{k}": getattr(n, k)
                            for k in ("steps_per_period", "horizon", "max_events")}}

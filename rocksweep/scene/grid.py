@@ -27,8 +27,9 @@ from rocksweep.physics.points import (
     law_code,
     shape_code,
 )
-from rocksweep.scene.model import Scene
+from rocksweep.scene.model import FLOOR_AXES, Scene
 from rocksweep.schema import VERTICAL_KEYS
+from rocksweep.vocab.ground import RECORD
 
 
 @dataclass
@@ -49,6 +50,11 @@ class ChunkRows:
     # a suite's points: the index of each point's record (int64[n], into
     # ``Scene.suite.records``), None otherwise
     record_index: np.ndarray | None = None
+    # the records the points run, indexed by ``record_index`` (a suite's records, or the
+    # motions of an excitation path, ``physics.path``), None otherwise
+    records: tuple | None = None
+    # each of ``records``' vertical component on its samples [g] (None: none)
+    verticals: tuple | None = None
 
 
 @dataclass
@@ -100,6 +106,11 @@ class Grid:
                            np.array([law_code(w) for w in scene.axes[self._i_law].values]))
         # the initial state's axes, when the scene gives them (vocab.axes.INITIAL; else at rest)
         self._i_init = [names.index(k) if k in names else None for k in INITIAL]
+        # the axes an excitation path's motion depends on (``physics.path``)
+        self._path_pos = ([] if scene.path is None else
+                          [names.index(k) for k in ("record", "angle", *FLOOR_AXES)
+                           if k in names]
+                          + ([] if scene.recorded else [self._i_shape, self._i_w]))
         # a pulse's vertical harmonic (pulse.vertical: amplitude, w_over_p, phase), or None
         self._i_vert = ([names.index(f"vertical.{k}") for k in VERTICAL_KEYS]
                         if "vertical.amplitude" in names else None)
@@ -165,6 +176,10 @@ class Grid:
         initial = (None if all(i is None for i in self._i_init) else
                    tuple(0.0 if i is None else self._values[i][multi[i]] for i in self._i_init))
         u_cr = b_ucr[inverse]
+        if self.scene.path is not None:
+            return self._path_rows(multi, rows, b_rows[inverse], b_omega[inverse], alpha_ref,
+                                   b_kind[inverse], b_E[inverse], (law, e, e_factor),
+                                   initial, u_cr)
         if self.scene.suite is not None:
             return self._suite_rows(multi, rows, b_rows[inverse], b_omega[inverse], alpha_ref,
                                     b_kind[inverse], b_E[inverse], (law, e, e_factor),
@@ -208,7 +223,58 @@ class Grid:
                       initial=None if initial is None else tuple(v[sel] for v in initial),
                       u_cr=u_cr[sel])
             rows[sel] = part
-        return ChunkRows(rows, kinds, alpha_ref, E_ref, rec)
+        return ChunkRows(rows, kinds, alpha_ref, E_ref, rec, su.records)
+
+    def _path_rows(self, multi, rows, body_rows, omega_rock, alpha_ref, kinds, E_ref,
+                   impact: tuple, initial: tuple | None = None, u_cr=0.0) -> ChunkRows:
+        """Rows of a scene with an excitation path: each distinct motion of the chunk
+        computed once (``Scene.path_motion``), the kernel's A_ratio the ground's times the
+        motion's gain (``Scene._path_point``, vectorised), filled motion by motion."""
+        sc = self.scene
+        n = alpha_ref.size
+        key = (np.stack([np.asarray(multi[i], np.int64) for i in self._path_pos], 1)
+               if self._path_pos else np.zeros((n, 1), np.int64))
+        distinct, inv = np.unique(key, axis=0, return_inverse=True)
+        inv = inv.reshape(-1)
+        motions, peaks = [], []
+        for row in distinct:
+            values = {sc.axes[i].name: sc.axes[i].values[int(j)]
+                      for i, j in zip(self._path_pos, row, strict=True)}
+            m, peak, _ = sc.path_motion(values)
+            motions.append(m)
+            peaks.append(peak)
+        m_pga = np.array([m.pga for m in motions])[inv]
+        lam = self._values[self._i_lam][multi[self._i_lam]]
+        if sc.suite is not None:
+            su = sc.suite
+            stripe = None if self._i_stripe is None else np.asarray(multi[self._i_stripe])
+            p = self._values[self._i_w][multi[self._i_w]]
+            rec = np.asarray(multi[self._i_rec], np.int64)
+            a_ratio = su.factors(rec, stripe, alpha_ref, p) * m_pga / np.tan(alpha_ref)
+        else:
+            p = (self._values[self._i_w][multi[self._i_w]] if sc.recorded
+                 else np.full(n, sc.path.p))
+            a_ratio = (self._values[self._i_A][multi[self._i_A]] * m_pga
+                       / np.array(peaks)[inv])
+        mu = np.nan if self._i_mu is None else self._values[self._i_mu][multi[self._i_mu]]
+        law, e, e_factor, mu = (np.broadcast_to(np.asarray(v, float), lam.shape)
+                                for v in (*impact, mu))
+        if initial is not None:
+            initial = tuple(np.broadcast_to(np.asarray(v, float), lam.shape) for v in initial)
+        u_cr = np.broadcast_to(np.asarray(u_cr, float), lam.shape)
+        code = np.full(n, shape_code(RECORD))
+        # a record's vertical reaches the floor unfiltered: on each motion's samples
+        verticals = tuple(sc.path_vertical(m) for m in motions)
+        for j, motion in enumerate(motions):
+            sel = inv == j
+            part = np.empty((int(sel.sum()), L.N_PAR))
+            fill_rows(part, body_rows[sel], omega_rock[sel], alpha_ref[sel], lam[sel],
+                      code[sel], p[sel], a_ratio[sel], sc.numerics, record=motion,
+                      mu=mu[sel], law=law[sel], e=e[sel], e_factor=e_factor[sel],
+                      initial=None if initial is None else tuple(v[sel] for v in initial),
+                      u_cr=u_cr[sel], vertical=verticals[j])
+            rows[sel] = part
+        return ChunkRows(rows, kinds, alpha_ref, E_ref, inv, tuple(motions), verticals)
 
     def kinds(self) -> list[int]:
         """The kernel kinds the grid's bodies need (each distinct body visited once)."""

@@ -6,7 +6,6 @@ turns them into a validated ``Scene`` (the Python API's and the command line's w
 
 from __future__ import annotations
 
-import os
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Union
@@ -69,7 +68,7 @@ def load(scene: SceneLike | Scene, overrides: Overrides | None = ()) -> tuple[Sc
     mapping (the YAML's structure); or a ``Scene`` (then without overrides). Errors are
     one-line SceneErrors.
     """
-    from rocksweep.scene.model import Scene, SceneError
+    from rocksweep.scene.model import Scene
     from rocksweep.scene.parse import load_scene, parse_scene
 
     ov = override_strings(overrides)
@@ -87,9 +86,8 @@ def load(scene: SceneLike | Scene, overrides: Overrides | None = ()) -> tuple[Sc
     if not isinstance(scene, str | Path):
         raise ApiError(f"scene = {scene!r}: give a path, YAML text or a dict")
     path = Path(scene)
-    if not os.path.lexists(path):
-        raise SceneError(f"{path}: no such scene file")
-    return load_scene(path, ov), path  # a loop of links, a FIFO...: its one line
+    # a missing file, a loop of links, a FIFO...: load_scene's one line
+    return load_scene(path, ov), path
 
 
 def _is_file(text: str) -> bool:

@@ -10,10 +10,11 @@ from typing import Any
 import numpy as np
 
 from rocksweep import fields
-from rocksweep.errors import SceneError  # noqa: F401 (defined there; re-exported)
+from rocksweep.errors import SceneError, set_key  # noqa: F401 (SceneError: re-exported)
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
-from rocksweep.physics.bodies import BlockBody, Body, FlexibleBody
+from rocksweep.physics.bodies import BlockBody, Body, FlexibleBody, G
+from rocksweep.physics.path import GroundPath
 from rocksweep.physics.points import FREE, INITIAL, RECORD, Point
 from rocksweep.physics.records import GroundRecord, vertical_samples
 from rocksweep.physics.suite import Suite
@@ -21,6 +22,10 @@ from rocksweep.physics.vertical import VerticalHarmonic
 from rocksweep.schema import KEYS
 from rocksweep.vocab.ground import PAPER_SHAPES, pulse_duration
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
+
+#: the one-mode floor's keys, the names of their axes (``floor.period`` is a dimension of
+#: its own: a suite's ``period`` is the Sa periods')
+FLOOR_AXES = ("floor.period", "floor.damping", "floor.participation")
 
 
 @dataclass(frozen=True)
@@ -64,6 +69,29 @@ class Scene:
     # the record's vertical component (``ground.vertical``, read at load), else None; a
     # pulse's vertical harmonic is three axes, vertical.amplitude, .w_over_p and .phase
     vertical: GroundRecord | None = field(default=None, repr=False)
+    # the excitation path (``ground.h2``/``ground.angle``, ``floor:``): what the body
+    # feels is computed from the ground motion (``physics.path``); None without those keys
+    path: GroundPath | None = field(default=None, repr=False)
+
+    @property
+    def floor(self) -> bool:
+        """Whether the body stands on a building's floor (a ``floor:`` section)."""
+        return self.path is not None and self.path.floor
+
+    def floor_words(self) -> str:
+        """One line stating the building ('' without a floor)."""
+        if not self.floor:
+            return ""
+        if self.path.modes is not None:
+            modes = self.path.modes
+            return ("floor of a linear building, modes (period [s], damping, "
+                    "participation): " + "; ".join(
+                        f"({m.period:g}, {m.damping:g}, {m.participation:g})" for m in modes))
+        vals = ", ".join(f"{k.split('.')[1]} = " + (
+            f"{self.axis(k).values[0]:g}" if len(self.axis(k).values) == 1 else
+            f"{len(self.axis(k).values)} values {min(self.axis(k).values):g}.."
+            f"{max(self.axis(k).values):g}") for k in FLOOR_AXES)
+        return f"floor of a linear building, one mode: {vals}"
 
     def physical_words(self) -> str:
         """One line stating what a physical body became ('' for a body of Pi groups)."""
@@ -81,10 +109,15 @@ class Scene:
         {} for a body of Pi groups."""
         return {} if self.physical is None else {"p": float(self.physical["p"])}
 
+    def floor_summary(self, point: Point) -> dict[str, float]:
+        """A run's peak floor acceleration {"floor_pfa": [g]} (a scene with a floor: the
+        peak of the motion that drove it, as a sweep stores it); {} without a floor."""
+        return {fields.FLOOR_PFA: point.A / G} if self.floor else {}
+
     def variables(self) -> dict[str, tuple[str, float, str]]:
         """The per-point variables a sweep of this scene stores, name -> (dtype, fill value
         of a point not computed, meaning): ``fields.variables`` of its outputs."""
-        return fields.variables(self.energy, self.contact, self.check)
+        return fields.variables(self.energy, self.contact, self.check, self.floor)
 
     @property
     def freq_axis(self) -> str:
@@ -105,7 +138,7 @@ class Scene:
         cycles too) run the pulse variants."""
         if self.has_vertical:
             return L.GROUND_VERTICAL
-        if self.recorded or any(
+        if self.recorded or self.floor or any(
                 sh not in (*PAPER_SHAPES, FREE) for sh in self.axis("shape").values):
             return L.GROUND_ANY
         return L.GROUND_PULSE
@@ -123,6 +156,13 @@ class Scene:
         if self.vertical is None:
             return None
         return vertical_samples(self.vertical, self.record)
+
+    def path_vertical(self, motion: GroundRecord):
+        """The record's vertical [g] on the samples of a motion of the excitation path
+        (``physics.path``: it reaches the floor unfiltered), None without one."""
+        if self.vertical is None:
+            return None
+        return vertical_samples(self.vertical, motion)
 
     def option(self, name: str) -> Any:
         """A pulse option's value (cycles, gamma, nu [deg]): the scene's or the default."""
@@ -169,6 +209,8 @@ class Scene:
     def point(self, values: dict[str, Any]) -> Point:
         """The point with the given value of every axis (by name)."""
         body = self.make_body(**{a.name: values[a.name] for a in self.body_axes()})
+        if self.path is not None:
+            return self._path_point(body, values)
         if self.suite is not None:
             su = self.suite
             r = su.names.index(str(values["record"]))
@@ -202,6 +244,44 @@ class Scene:
                                 float(values["vertical.w_over_p"]),
                                 float(values["vertical.phase"]))
 
+    def path_motion(self, values: dict[str, Any]):
+        """(the motion the body feels per unit of ground motion, the ground's peak that
+        A_ratio scales, record index) at one point (``physics.path``)."""
+        pa = self.path
+        angle = float(values.get("angle", 0.0))
+        floor = (tuple(float(values[k]) for k in FLOOR_AXES)
+                 if pa.floor and pa.modes is None else None)
+        if self.suite is not None:
+            r = self.suite.names.index(str(values["record"]))
+            ground = self.suite.records[r]
+            return pa.motion(ground, r, angle, floor), ground.pga, r
+        if self.record is not None:
+            return pa.motion(self.record, 0, angle, floor), self.record.pga, 0
+        from rocksweep.physics.excitation import PulseShape
+
+        shape = PulseShape(str(values["shape"]), int(self.option("cycles")),
+                           float(self.option("gamma")), float(self.option("nu")))
+        return pa.motion(None, 0, 0.0, floor, (shape, float(values["w_over_p"]))), 1.0, 0
+
+    def _path_point(self, body: Body, values: dict[str, Any]) -> Point:
+        """A point of a scene with an excitation path: driven by its computed motion, the
+        kernel's A_ratio the ground's scaled by the motion's gain."""
+        motion, ground_peak, r = self.path_motion(values)
+        if self.suite is not None:
+            su = self.suite
+            s = (np.array([self.axis(su.im).values.index(float(values[su.im]))])
+                 if su.im else None)
+            p = float(values["p"])
+            fac = float(su.factors(np.array([r]), s, np.array([body.alpha_ref]),
+                                   np.array([p]))[0])
+            a_ratio = fac * motion.pga / math.tan(body.alpha_ref)
+        else:
+            a_ratio = float(values["A_ratio"]) * motion.pga / ground_peak
+            p = float(values["p"]) if self.recorded else self.path.p
+        return Point(body, float(values["lam"]), RECORD, math.nan, a_ratio, record=motion,
+                     p=p, **self._law(values), initial=self.initial_state(values),
+                     vertical=self.vertical)
+
     @property
     def free(self) -> bool:
         """No ground motion (neither ``pulse`` nor ``ground``): free vibration from the
@@ -224,6 +304,6 @@ class Scene:
         for a in self.axes:
             if len(a.values) != 1:
                 raise SceneError(
-                    f"{a.key} has {len(a.values)} values: this command runs one point; "
-                    f"pick one with --set {a.key}=VALUE")
+                    f"{a.key} has {len(a.values)} values: this runs one point; pick one "
+                    "with {fix}", fix=set_key(a.key, "set_fix"))
         return self.point({a.name: a.values[0] for a in self.axes})

@@ -26,16 +26,21 @@ from typing import Any
 
 import numpy as np
 
+from rocksweep.errors import set_key
 from rocksweep.inputs import decode_text, read_input
 from rocksweep.numerics import Numerics
 from rocksweep.outputs import input_problem, is_input, shown
 from rocksweep.physics.bodies import BodyError, body_from_geometry
+from rocksweep.physics.floor import Mode
+from rocksweep.physics.path import GroundPath, check_pair
 from rocksweep.physics.points import FREE, INITIAL, RECORD
 from rocksweep.physics.records import GroundRecord, RecordError, read_record
 from rocksweep.physics.suite import (
     AVGSA_RANGE,
+    COMPONENTS,
     DEFAULT_PERIODS,
     RECORD_IMS,
+    ROTD50,
     SCALE_IMS,
     Suite,
     SuiteError,
@@ -43,7 +48,7 @@ from rocksweep.physics.suite import (
 )
 from rocksweep.scene.admission import candidate_bodies, check_cost
 from rocksweep.scene.loader import CONTROL_CHARS, YamlError, load_yaml
-from rocksweep.scene.model import Axis, Scene, SceneError
+from rocksweep.scene.model import FLOOR_AXES, Axis, Scene, SceneError
 from rocksweep.schema import (
     BODY_KEYS,
     KEYS,
@@ -55,7 +60,7 @@ from rocksweep.schema import (
     is_number,
     section_keys,
 )
-from rocksweep.vocab.axes import DIAGRAM_AXES, alpha_symbol
+from rocksweep.vocab.axes import DIAGRAM_AXES, alpha_symbol, axis_name
 from rocksweep.vocab.ground import MP
 from rocksweep.vocab.ground import PULSE_KEY_SHAPES as _PULSE_KEY_SHAPES
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
@@ -76,27 +81,29 @@ PULSE_KEY_SHAPES = _PULSE_KEY_SHAPES
 
 
 def apply_overrides(raw: dict, overrides: list[str]) -> dict:
-    """Apply ``--set section.key=VALUE`` overrides (VALUE parsed as YAML) to a raw scene."""
+    """Apply ``section.key=VALUE`` overrides (VALUE parsed as YAML) to a raw scene."""
     for item in overrides:
         if "=" not in item:
-            raise SceneError(f"--set {item!r}: expected KEY=VALUE, e.g. pulse.A_ratio=4.5")
+            raise SceneError("{entry}: expected KEY=VALUE, e.g. pulse.A_ratio=4.5",
+                             entry=set_key(item, "set_entry"))
         key, text = item.split("=", 1)
         key = key.strip()
         parts = key.split(".")
         if not all(parts):
-            raise SceneError(f"--set {item!r}: expected KEY=VALUE, e.g. pulse.A_ratio=4.5")
+            raise SceneError("{entry}: expected KEY=VALUE, e.g. pulse.A_ratio=4.5",
+                             entry=set_key(item, "set_entry"))
         try:
             value = load_yaml(text)
         except YamlError as err:
-            raise SceneError(f"--set {key}: value {fmt(text)} is not valid YAML "
-                             f"({err})") from None
+            raise SceneError("{key}: value {text} is not valid YAML ({why})",
+                             key=set_key(key), text=fmt(text), why=err) from None
         node = raw
         for p in parts[:-1]:
             if node.get(p) is None:
                 node[p] = {}
             node = node[p]
             if not isinstance(node, dict):
-                raise SceneError(f"--set {key}: {p} is not a section")
+                raise SceneError("{key}: {p} is not a section", key=set_key(key), p=p)
         node[parts[-1]] = value
     return raw
 
@@ -104,6 +111,7 @@ def apply_overrides(raw: dict, overrides: list[str]) -> dict:
 def parse_scene(text: str, source: str = "scene", overrides: list[str] | None = None,
                 base: str | Path | None = None, record: GroundRecord | None = None,
                 records: tuple[GroundRecord, ...] | None = None,
+                h2: GroundRecord | None = None,
                 vertical: GroundRecord | None = None) -> Scene:
     """Validate scene YAML text. Raises SceneError (one line, prefixed by ``source``).
 
@@ -111,17 +119,19 @@ def parse_scene(text: str, source: str = "scene", overrides: list[str] | None = 
     the working directory); record: the record of a ``ground`` section, already read (a
     result file's stored copy): the ``ground.record`` path is then not read; records: the
     same for a suite's ``ground.records`` (in the suite's order; their file names label
-    the record dimension); vertical: the same for ``ground.vertical``."""
+    the record dimension); h2, vertical: the same for ``ground.h2`` and
+    ``ground.vertical``."""
     try:
         return _parse(text, overrides or [], Path(base) if base is not None else None,
-                      record, records, vertical)
+                      record, records, h2, vertical)
     except SceneError as err:
-        raise SceneError(f"{source}: {err}") from None
+        raise SceneError("{source}: {err}", source=source, err=err) from None
 
 
 def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
     """The validated scene of a YAML file (a regular file: a FIFO, device or directory is
-    refused before it is opened, never waited on)."""
+    refused before it is opened, never waited on; a missing file is "no such scene file":
+    the one place that says it)."""
     path = Path(path)
     problem = input_problem(path)
     if problem is not None:
@@ -306,7 +316,7 @@ def _refine(raw: dict, kind: str) -> dict | None:
             if not (isinstance(v, list) and len(v) == 2
                     and all(isinstance(a, str) for a in v) and v[0] != v[1]):
                 raise SceneError(f"{key} = {fmt(v)}: {spec.allowed}")
-            out[k] = (v[0].split(".")[-1], v[1].split(".")[-1])
+            out[k] = tuple(axis_name(a) if "." in a else a for a in v)
             continue
         if spec.kind == "integer" and not (isinstance(v, int) and not isinstance(v, bool)):
             raise SceneError(f"{key} = {fmt(v)}: {spec.allowed}")
@@ -382,8 +392,8 @@ def _pulse_options(pulse: dict, shapes: tuple[str, ...]) -> list[Axis]:
 
 
 def _record(ground: dict, base: Path | None, key: str = "record") -> GroundRecord:
-    """The record (or, key ``vertical``, its vertical component) of a ``ground`` section,
-    read (and hashed) now."""
+    """The record of a ``ground`` section (``ground.record``; key ``h2``: the second
+    horizontal, ``vertical``: the vertical component), read (and hashed) now."""
     spec = KEYS[f"ground.{key}"]
     v = ground[key]
     if not (isinstance(v, str) and v.strip()):
@@ -393,6 +403,102 @@ def _record(ground: dict, base: Path | None, key: str = "record") -> GroundRecor
         return read_record(path)
     except RecordError as err:
         raise SceneError(f"ground.{key}: {err}") from None
+
+
+def _modes(spec: Any) -> tuple[Mode, ...]:
+    """The building's modes of ``floor.modes`` (numbers, each checked as the one-mode
+    form's keys)."""
+    key = "floor.modes"
+    if not (isinstance(spec, list) and spec):
+        raise SceneError(f"{key} = {fmt(spec)}: {KEYS[key].allowed}")
+    out = []
+    for i, m in enumerate(spec):
+        where = f"{key}[{i}]"
+        if not isinstance(m, dict):
+            raise SceneError(f"{where} = {fmt(m)}: {KEYS[key].allowed}")
+        for k in m:
+            if f"floor.{k}" not in FLOOR_AXES:
+                raise SceneError(f"{where}.{k}: unknown key (allowed: period, damping, "
+                                 "participation)")
+        vals = []
+        for k in FLOOR_AXES:
+            short = k.split(".")[1]
+            v = m.get(short)
+            if v is None:
+                raise SceneError(f"{where}.{short}: missing required key "
+                                 f"({KEYS[k].allowed.removeprefix('must be ')})")
+            x = as_float(v) if is_number(v) else math.nan
+            if check_values(k, np.array([x])) is not None or (
+                    k == "floor.participation" and x == 0.0):
+                raise SceneError(f"{where}.{short} = {fmt(v)}: {KEYS[k].allowed}")
+            vals.append(x)
+        out.append(Mode(*vals))
+    return tuple(out)
+
+
+def _excitation_path(raw: dict, ground: dict, kind: str, free: bool,
+                     record: GroundRecord | None, suite: Suite | None, base: Path | None,
+                     physical: dict | None, given_h2: GroundRecord | None = None
+                     ) -> tuple[GroundPath | None, list[tuple[str, str, str, Any]],
+                                tuple[str, ...]]:
+    """A scene's excitation path (``physics.path``): the second horizontal component
+    (``ground.h2``, or a suite's paired H2 files) with the ``angle`` axis, and the
+    ``floor`` section's building (its one-mode keys as axes named ``floor.period``,
+    ``floor.damping``, ``floor.participation``, or ``floor.modes``). Returns (the path,
+    None without those keys; the axes' specs (name, key, form, spec); files read)."""
+    specs: list[tuple[str, str, str, Any]] = []
+    inputs: tuple[str, ...] = ()
+    h2: tuple = ()
+    if ground.get("h2") is not None:
+        if suite is not None:
+            raise SceneError("ground.h2: not with ground.records (a folder of PEER "
+                             "downloads pairs each record's components by name)")
+        second = _record(ground, base, "h2") if given_h2 is None else given_h2
+        why = check_pair(record, second)
+        if why is not None:
+            raise SceneError(f"ground.h2: {second.name}: {why}")
+        h2 = (second,)
+        inputs = (str(second.source),) if given_h2 is None else ()
+    elif suite is not None and any(r is not None for r in suite.h2):
+        h2 = suite.h2
+    if ground.get("angle") is not None and not h2:
+        raise SceneError(f"ground.angle = {fmt(ground['angle'])}: needs the second "
+                         "horizontal component (ground.h2, or a suite of PEER folders with "
+                         "both horizontals)")
+    if h2:
+        specs.append(("angle", "ground.angle",
+                      *_axis_spec("ground.angle", ground.get("angle", 0.0))[:2]))
+    modes = None
+    if raw.get("floor") is not None:
+        if free:
+            raise SceneError(f"floor = {fmt(raw['floor'])}: a free-rocking scene (no pulse "
+                             "or ground section) has no ground motion for a building to "
+                             "carry; give a pulse or a ground motion")
+        sec = _section(raw, "floor", kind, required=False)
+        if sec.get("modes") is not None:
+            for k in FLOOR_AXES:
+                if sec.get(k.split(".")[1]) is not None:
+                    raise SceneError(f"{k}: not with floor.modes (give one mode's keys or "
+                                     "the list of modes)")
+            modes = _modes(sec["modes"])
+        else:
+            for k in FLOOR_AXES:
+                short = k.split(".")[1]
+                if sec.get(short) is None:
+                    raise SceneError(f"{k}: missing required key ({_AXIS_HINT}; or give "
+                                     "floor.modes)")
+                form, spec, _ = _axis_spec(k, sec[short])
+                if k == "floor.participation" and np.any(_axis_values(k, form, spec) == 0):
+                    raise SceneError(f"{k} = 0.0: {KEYS[k].allowed}")
+                specs.append((k, k, form, spec))
+    if not h2 and raw.get("floor") is None:
+        return None, specs, inputs
+    p = float(physical["p"]) if physical is not None else 1.0
+    return (GroundPath(h2=h2, modes=modes, floor=raw.get("floor") is not None, p=p),
+            specs, inputs)
+
+
+_AXIS_HINT = "a number, a list of numbers or a range {start, stop, num}"
 
 
 def _where(v: str, base: Path | None) -> Path:
@@ -565,9 +671,9 @@ def _scale(ground: dict) -> tuple[str | None, str, Any, float, float]:
             raise SceneError(f"{key}.factor = {fmt(f)}: {KEYS[key + '.factor'].allowed}")
         return None, "", None, math.nan, as_float(f)
     for k in v:
-        if k not in ("im", "values", "period"):
-            raise SceneError(f"{key}.{k}: unknown key (allowed: im, values, period; or "
-                             "factor alone)")
+        if k not in ("im", "values", "period", "component"):
+            raise SceneError(f"{key}.{k}: unknown key (allowed: im, values, period, "
+                             "component; or factor alone)")
     im = v.get("im")
     if isinstance(im, str) and RECORD_IMS.get(im, ("", "", 1))[2] == 0:
         raise SceneError(f"{key}.im = {im}: does not change when a record is scaled, so no "
@@ -625,10 +731,26 @@ def _suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...] | No
                      else "a list in ground.records")
             raise SceneError(f"ground.{k}: not with ground.records (use {other})")
     im, form, spec, period, factor = _scale(ground)
-    if given is not None:
+    scale = ground.get("scale")
+    component = scale.get("component", "H1") if isinstance(scale, dict) else "H1"
+    if component not in COMPONENTS:
+        raise SceneError(f"ground.scale.component = {fmt(component)}: "
+                         f"{KEYS['ground.scale.component'].allowed}")
+    missing = ground.get("missing", "error")
+    if missing not in ("error", "skip"):
+        raise SceneError(f"ground.missing = {fmt(missing)}: {KEYS['ground.missing'].allowed}")
+    folder = _peer_folder(ground["records"], base)
+    if folder is None and missing != "error":
+        raise SceneError("ground.missing: applies to a folder of PEER downloads "
+                         "(ground.records: FOLDER)")
+    h2: tuple = ()
+    vertical: tuple = ()
+    read: tuple[str, ...] = ()
+    if folder is not None:  # read again on a rebuild: the pairs are the folder's
+        records, h2, vertical, names, read = _peer_suite(folder, missing == "skip")
+    elif given is not None:
         records = list(given)
         names = [Path(r.source).name for r in records]
-        read: tuple[str, ...] = ()
     else:
         paths, listings, named = _record_paths(ground["records"], base)
         records = []
@@ -640,13 +762,81 @@ def _suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...] | No
                 raise SceneError(f"ground.records: {where}{err}") from None
         names = [p.name for p in paths]
         read = tuple(str(p) for p in (*paths, *listings))
+    if component == ROTD50 and not h2:
+        raise SceneError("ground.scale.component = 'RotD50': needs both horizontals of "
+                         "every record (ground.records: a folder of PEER downloads)")
+    if component == ROTD50 and im is None:
+        raise SceneError("ground.scale.component = 'RotD50': scales stripes (ground.scale: "
+                         "{im: ..., values: ...})")
     values = _axis_values("ground.scale.values", form, spec).tolist() if im else []
     try:
         suite = make_suite(records, names, im, values, period, factor,
-                           _periods(ground), *_avgsa(ground, period))
+                           _periods(ground), *_avgsa(ground, period), h2=h2,
+                           vertical=vertical, component=component)
     except SuiteError as err:
         raise SceneError(f"ground.records: {err}") from None
     return suite, ((im, form, spec) if im else None), read
+
+
+def _peer_folder(spec: Any, base: Path | None) -> Path | None:
+    """The folder of ``ground.records: FOLDER`` (one entry that is a directory), else
+    None."""
+    entry = spec[0] if isinstance(spec, list) and len(spec) == 1 else spec
+    if not (isinstance(entry, str) and entry.strip()) or "\0" in entry:
+        return None
+    path = _where(entry, base)
+    return path if path.is_dir() else None
+
+
+def _peer_suite(folder: Path, skip: bool) -> tuple:
+    """The records of a folder of PEER downloads (``scene.peer``): (H1s, H2s, verticals
+    (empty: none in the folder), names (H1's file names), files read). A record without
+    one of its components is refused with one line, or left out with a RecordWarning
+    (``skip``)."""
+    import warnings
+
+    from rocksweep.physics.suite import RecordWarning
+    from rocksweep.scene.peer import peer_components
+
+    key = "ground.records"
+    files = [p for p in folder.iterdir() if p.suffix.lower() == ".at2" and p.is_file()]
+    comps, _ = peer_components(files)
+    if not comps:
+        raise SceneError(f"{key}: {shown(folder)}: no PEER record files in the folder "
+                         "(RSN<n>_<EVENT>_<STATION><COMPONENT>.AT2)")
+    with_up = any(c.up is not None for c in comps)
+    kept = []
+    for c in comps:
+        miss = c.missing(with_up)
+        if not miss:
+            kept.append(c)
+            continue
+        found = ", ".join(p.name for p in (c.h1, c.h2, c.up) if p is not None)
+        what = f"{c.rsn} has no {' and no '.join(miss)} file (found {found})"
+        need = "H1, H2 and UP" if with_up else "H1 and H2"
+        if not skip:
+            raise SceneError(f"{key}: {shown(folder)}: {what}; every record needs {need} "
+                             "(or ground.missing: skip)")
+        warnings.warn(RecordWarning(f"{key}: {what}: skipped"), stacklevel=2)
+    if not kept:
+        raise SceneError(f"{key}: {shown(folder)}: no record has all its components")
+    h1s, h2s, ups = [], [], []
+    for c in kept:
+        try:
+            one = [read_record(p) for p in (c.h1, c.h2, *([c.up] if with_up else []))]
+        except RecordError as err:
+            raise SceneError(f"{key}: {err}") from None
+        for other, what in zip(one[1:], ("H2", "UP"), strict=False):
+            why = check_pair(one[0], other)
+            if why is not None:
+                raise SceneError(f"{key}: {c.rsn}: {what} {other.name}: " + why.replace(
+                    "the two horizontal components", "the components of a record"))
+        h1s.append(one[0])
+        h2s.append(one[1])
+        ups.append(one[2] if with_up else None)
+    read = tuple(str(p) for c in kept for p in (c.h1, c.h2, c.up) if p is not None)
+    return (h1s, tuple(h2s), tuple(ups) if with_up else (), [c.h1.name for c in kept],
+            read)
 
 
 @dataclasses.dataclass
@@ -668,6 +858,7 @@ class _Motion:
     # or the raw keys of a pulse's vertical harmonic (pulse.vertical)
     vertical: GroundRecord | None = None
     pulse_vertical: dict | None = None
+    ground: dict = dataclasses.field(default_factory=dict)  # the ground section's keys
 
 
 @dataclasses.dataclass
@@ -685,6 +876,7 @@ class _Forms:
 def _parse(text: str, overrides: list[str], base: Path | None = None,
            given_record: GroundRecord | None = None,
            given_records: tuple[GroundRecord, ...] | None = None,
+           given_h2: GroundRecord | None = None,
            given_vertical: GroundRecord | None = None) -> Scene:
     """The scene of YAML text: each section parsed in turn, then the grid's size checked
     before any axis value is built, then the scene's admission (initial state, cost)."""
@@ -703,7 +895,15 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     # forms and lengths first: the grid's size is known before any value is built
     forms = _forms(motion)
     law_axis, law_specs = _impact_law(impact)
-    specs = _axis_specs(kind, body, impact, initial, motion, forms, law_specs)
+    if motion.pulse_vertical is not None and raw.get("floor") is not None:
+        raise SceneError("floor: not with pulse.vertical (a pulse's vertical harmonic acts "
+                         "while the pulse acts; on a floor give the ground motion as a "
+                         "record with ground.vertical, which reaches the floor unfiltered)")
+    # the orientation and the floor: after the records, before the ground's own axes
+    path, path_specs, path_inputs = _excitation_path(
+        raw, motion.ground, kind, motion.free, motion.record, motion.suite, base, physical,
+        given_h2)
+    specs = _axis_specs(kind, body, impact, initial, motion, forms, law_specs, path_specs)
     _check_size(motion, forms, specs, 1 if law_axis is None else len(law_axis.values))
     axes = _axes(motion, forms, specs, law_axis)
 
@@ -711,8 +911,9 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     scene = Scene(name=name or "rocksweep scene", kind=kind, axes=tuple(axes),
                   numerics=numerics, single_numerics=single, energy=energy, text=text,
                   contact=contact, check=check, record=motion.record,
-                  refine=_refine(raw, kind), suite=motion.suite, inputs=motion.inputs,
-                  physical=physical, vertical=motion.vertical)
+                  refine=_refine(raw, kind), suite=motion.suite,
+                  inputs=(*motion.inputs, *path_inputs), physical=physical,
+                  vertical=motion.vertical, path=path)
     _admit(scene)
     return scene
 
@@ -785,7 +986,7 @@ def _motion(raw: dict, kind: str, base: Path | None, given_record: GroundRecord 
     if ground.get("records") is not None:
         suite, stripe, inputs = _suite(ground, base, given_records)
         return _Motion(free=False, pulse={"shape": RECORD, "p": ground["p"]}, suite=suite,
-                       stripe=stripe, inputs=inputs)
+                       stripe=stripe, inputs=inputs, ground=ground)
     for k in ("scale", "periods", "avgsa"):
         if ground.get(k) is not None:
             raise SceneError(f"ground.{k}: works with ground.records (a suite); one "
@@ -805,7 +1006,8 @@ def _motion(raw: dict, kind: str, base: Path | None, given_record: GroundRecord 
     return _Motion(free=False,
                    pulse={"shape": RECORD, "A_ratio": ground["A_ratio"], "p": ground["p"]},
                    record=record, inputs=inputs,
-                   vertical=vertical if ground.get("vertical") is not None else None)
+                   vertical=vertical if ground.get("vertical") is not None else None,
+                   ground=ground)
 
 
 def _pulse_vertical(pulse: dict) -> dict | None:
@@ -861,11 +1063,13 @@ def _forms(motion: _Motion) -> _Forms:
 
 
 def _axis_specs(kind: str, body: dict, impact: dict, initial: dict, motion: _Motion,
-                forms: _Forms, law_specs: list[tuple[str, str, Any]]
+                forms: _Forms, law_specs: list[tuple[str, str, Any]],
+                path_specs: list[tuple[str, str, str, Any]] = ()
                 ) -> list[tuple[str, str, str, Any]]:
     """(name, key, form, spec) of every axis after the shape, in the grid's order, their
     forms checked but no value built: the body, lam (then the impact law's keys), the
-    initial state, a suite's records and stripes, the pulse axes, body.mu last."""
+    initial state, a suite's records and stripes, the excitation path's (angle, floor),
+    the pulse axes, body.mu last."""
     specs: list[tuple[str, str, str, Any]] = []
     for k in BODY_KEYS[kind]:
         spec = body.get(k, KEYS[f"body.{k}"].default)
@@ -885,6 +1089,7 @@ def _axis_specs(kind: str, body: dict, impact: dict, initial: dict, motion: _Mot
         if motion.stripe is not None:
             im = motion.stripe[0]
             specs.append((im, f"ground.{im}", "stripes", motion.stripe[1:]))
+    specs.extend(path_specs)
     for k in forms.pulse_axes:
         key = f"{forms.section}.{k}"
         if motion.free:  # not the user's: no check (w_over_p = 0 is no ground motion)
@@ -946,7 +1151,8 @@ def _admit(scene: Scene) -> None:
         # the contact outputs are compiled into the sine/cosine variants only (a kernel
         # variant per combination costs compile time no scene has asked for yet)
         what = ("a vertical ground acceleration" if scene.has_vertical else
-                "a recorded ground motion" if scene.recorded else "ricker and mp pulses")
+                "a recorded ground motion" if scene.recorded else "a floor" if scene.floor
+                else "ricker and mp pulses")
         raise SceneError(f"outputs.contact = true: not available with {what} yet; contact "
                          "outputs work with sine and cosine pulses")
     bodies = candidate_bodies(scene)

@@ -126,7 +126,8 @@ def variables_for(stored: dict) -> dict:
     files of adaptive sweeps)."""
 
     return {**fields.variables(bool(stored.get("energy")), bool(stored.get("contact")),
-                               bool(stored.get("check"))),
+                               bool(stored.get("check")),
+                               bool((stored.get("path") or {}).get("floor"))),
             **({"computed": COMPUTED_VARIABLE} if stored.get("adaptive") else {})}
 
 
@@ -222,6 +223,9 @@ def metadata(scene: Scene, overrides: tuple[str, ...] = (),
     if scene.record is not None:  # the record: name, SHA-256, NPTS, DT [s], PGA [g]
         for k, v in record_attrs(scene.record).items():
             a[f"record_{k}"] = v
+    if scene.path is not None:  # the orientation's second component and the building
+        for k, v in path_attrs(scene).items():
+            a[k] = v
     if scene.vertical is not None:  # its vertical component: the same, and its IMs
         for k, v in vertical_attrs(scene.vertical, scene.record).items():
             a[f"vertical_{k}"] = v
@@ -230,6 +234,7 @@ def metadata(scene: Scene, overrides: tuple[str, ...] = (),
     if scene.suite is not None:  # the stripes' IM ("none": a cloud) and Sa's period [s]
         a["scale_im"] = scene.suite.im or "none"
         a["scale_period"] = float(scene.suite.period)
+        a["scale_component"] = scene.suite.component  # H1, or RotD50 of both horizontals
     for k, v in vers.items():
         a[f"{k}_version"] = v
     a["started"] = utc_now()
@@ -279,6 +284,8 @@ def variable_attrs(name: str, text: str, kind: str, scalars: tuple[str, ...]
     out: dict[str, Any] = {}
     f_ = fields.BY_NAME.get(name)
     meta = (fields.field_attrs(f_, kind) if f_ is not None
+            else {"long_name": "peak floor acceleration", "description": text,
+                  "units": "g"} if name == fields.FLOOR_PFA
             else {"long_name": "computed flag", "description": text})
     if name in FLAG_VARIABLES:
         meta.pop("rocksweep_units", None)
@@ -335,6 +342,27 @@ def initialise(f: h5py.File, meta: Metadata) -> None:
         _write_suite(f, scene, {s.name.lstrip("/"): s for s in scales})
 
 
+def path_attrs(scene: Scene) -> dict[str, str]:
+    """The attributes stating a scene's excitation path: ``floor`` (the building, one
+    line, and the stopping rule of its ring-down) and ``ground_h2`` (the second horizontal
+    component: name, SHA-256, path read)."""
+    from rocksweep.physics import floor
+
+    out = {}
+    if scene.floor:
+        out["floor"] = (f"{scene.floor_words()}; cascade (the body does not load the "
+                        "building); floor motion a_g + sum Gamma phi q'' exact for the "
+                        "piecewise-linear ground at >= "
+                        f"{floor.POINTS_PER_PERIOD} samples per period, ring-down until "
+                        f"below {floor.RINGDOWN_SHARE:g} of the floor's peak; floor.period "
+                        "in s" + ("" if scene.recorded else
+                                  f" with the pulse timed by p = {scene.path.p:g} rad/s"))
+    h2 = [r for r in scene.path.h2 if r is not None]
+    if h2 and scene.suite is None:
+        out["ground_h2"] = f"{h2[0].name} sha256 {h2[0].sha256} ({h2[0].source})"
+    return out
+
+
 def suite_variables(scene: Scene) -> dict[str, tuple[tuple[str, ...], np.ndarray]]:
     """The per-record variables of a suite scene's result: name -> (dims, values):
     ``record_pga`` [g], ``record_pgv`` [m/s], ``record_sa`` (record, period) [g],
@@ -354,6 +382,9 @@ def suite_variables(scene: Scene) -> dict[str, tuple[tuple[str, ...], np.ndarray
         "record_dt": (("record",), np.array([r.dt for r in su.records], float)),
         "record_duration": (("record",), np.array([r.duration for r in su.records], float)),
         "record_sha256": (("record",), np.array([r.sha256 for r in su.records], object)),
+        **{k: (("record",), v) for k, v in su.vertical_ims().items()},
+        **({"record_rotd50": (("record",), np.asarray(su.rotd50, float))}
+           if su.rotd50 is not None else {}),
     }
     r = np.arange(R)
     if su.im is None:

@@ -29,18 +29,30 @@ def resolved_scene(scene: Scene, overrides: tuple[str, ...] | list[str] = (),
         **({"vertical": vertical_attrs(scene.vertical, scene.record)}
            if scene.vertical is not None else {}),
         **({"suite": suite_attrs(scene.suite)} if scene.suite is not None else {}),
+        **({"path": path_resolved(scene)} if scene.path is not None else {}),
     }
     if adaptive is not None:
         d["adaptive"] = dict(adaptive)
     return d
 
 
+def path_resolved(scene: Scene) -> dict:
+    """A scene's excitation path as the resolved scene states it: the second horizontal
+    components (name, SHA-256, path read; None where a record has none), the floor's
+    modes given as a list (None: the one-mode axes) and whether there is a floor, and the
+    pulse's p [rad/s]."""
+    pa = scene.path
+    return {"h2": [None if r is None else {"name": r.name, "sha256": r.sha256,
+                                           "source": str(r.source)} for r in pa.h2],
+            "floor": pa.floor, "p": pa.p,
+            "modes": None if pa.modes is None else [
+                [m.period, m.damping, m.participation] for m in pa.modes]}
+
+
 def _adaptive_words(a: dict) -> str:
-    """Adaptive settings as the command-line options that give them."""
-    return (f"--adaptive --axes {','.join(a.get('axes', []))} --coarse {a.get('coarse')} "
-            f"--audit {a.get('audit')!r} --margin {a.get('margin')} --final-margin "
-            f"{a.get('final_margin')} --seed {a.get('seed')} --threshold "
-            f"{a.get('threshold')!r}")
+    """Adaptive settings as words: ``axes w_over_p,A_ratio, coarse 4, ...``."""
+    return ", ".join(f"{k} {','.join(map(str, v)) if k == 'axes' else v}"
+                     for k, v in a.items())
 
 
 def record_attrs(record) -> dict:
@@ -70,6 +82,12 @@ def suite_attrs(suite) -> dict:
 
     return {"im": suite.im, "period": num(suite.period), "factor": num(suite.factor),
             "periods": list(suite.periods),
+            # multi-component records (a PEER folder): the scaling component, each
+            # record's H2 and vertical (name, SHA-256); only when there are some
+            **({"component": suite.component,
+                "h2": [{"name": r.name, "sha256": r.sha256} for r in suite.h2],
+                "vertical": [None if r is None else {"name": r.name, "sha256": r.sha256}
+                             for r in suite.vertical]} if suite.h2 else {}),
             "records": [{"name": n, "sha256": r.sha256, "source": str(r.source)}
                         for n, r in zip(suite.names, suite.records, strict=True)]}
 
@@ -77,7 +95,7 @@ def suite_attrs(suite) -> dict:
 def _suite_differences(ss: dict, sn: dict) -> list[str]:
     """One phrase per difference between two ``suite_attrs`` dicts (records by name)."""
     diffs = []
-    for k in ("im", "period", "factor", "periods"):
+    for k in ("im", "period", "factor", "periods", "component", "h2", "vertical"):
         if ss.get(k) != sn.get(k):
             diffs.append(f"ground.scale {k}: file {ss.get(k)!r}, scene {sn.get(k)!r}"
                          if k != "periods" else
@@ -138,6 +156,13 @@ def scene_differences(stored: dict, new: dict) -> list[str]:
                          ("a suite" if new.get("suite") else "no suite"))
         else:
             diffs += _suite_differences(stored["suite"], new["suite"])
+    ps, pn = stored.get("path") or {}, new.get("path") or {}
+    for k in ("floor", "modes", "p"):
+        if ps.get(k) != pn.get(k):
+            diffs.append(f"floor ({k}): file {_short(ps.get(k))}, scene {_short(pn.get(k))}")
+    if [h and h.get("sha256") for h in ps.get("h2") or []] != [
+            h and h.get("sha256") for h in pn.get("h2") or []]:
+        diffs.append("ground.h2: the second horizontal components differ (sha256)")
     sn, nn = stored.get("numerics", {}), new.get("numerics", {})
     for key in dict.fromkeys([*sn, *nn]):
         if sn.get(key) != nn.get(key):

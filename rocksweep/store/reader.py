@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, NoReturn
 import numpy as np
 
 from rocksweep import fields
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import RocksweepError, flag
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outcomes import OUTCOME_WORDS
@@ -40,6 +40,7 @@ from rocksweep.store.format import (
     variables_for,
 )
 from rocksweep.store.identity import resolved_scene, scene_differences
+from rocksweep.vocab.axes import axis_name
 from rocksweep.vocab.outcomes import CLASSES, OUTCOME_CODE
 from rocksweep.vocab.settings import ADAPTIVE_RESOLVED
 
@@ -176,7 +177,7 @@ def read_layout(f: h5py.File, path: Path) -> FileLayout:
         raise damaged(path, f"format_version = {ver}")
     stored = _json_attr(f, "scene_resolved", path, object)
     _check_scene(stored, path)
-    swept = {k.split(".", 1)[1]: v["values"] for k, v in stored["axes"].items() if v["swept"]}
+    swept = {axis_name(k): v["values"] for k, v in stored["axes"].items() if v["swept"]}
     dims = tuple(swept)
     shape = tuple(len(v) for v in swept.values())
     for d, values in swept.items():
@@ -389,6 +390,16 @@ class SweepResult:
     def done(self) -> np.ndarray:
         return self.arrays["outcome"] != L.OUTCOME_NOT_RUN
 
+    def require_complete(self, error: type[RocksweepError], needs: str) -> None:
+        """The one refusal of an incomplete result by an analysis that needs every point
+        (``needs``: what it computes, e.g. "A_min"): ``error`` naming the file, how many
+        points are missing, and the resume that finishes it."""
+        missing = int((~self.done).sum())
+        if missing:
+            raise error(f"{shown(self.path)}: incomplete result ({missing} of "
+                        f"{self.done.size} points not computed yet); {needs} needs every "
+                        "point: finish the sweep with {resume}", resume=flag("resume"))
+
     @property
     def flagged(self) -> np.ndarray:
         return (self.arrays["status"] & L.STATUS_FLAGGED) != 0
@@ -457,7 +468,7 @@ def read_result(path: str | Path, names: list[str] | None = None,
                                  f"holds {', '.join(known)})")
         coords, scalars = {}, {}
         for key, ax in stored["axes"].items():
-            name = key.split(".", 1)[1]
+            name = axis_name(key)
             if ax["swept"]:
                 vals = f[name][()]
                 if name in fields.WORD_AXES:
@@ -526,7 +537,7 @@ def result_of(ds) -> SweepResult:
         raise StoreError(f"{where}: attribute scene_resolved is not JSON") from None
     _check_scene(stored, where)
     dims = tuple(str(d) for d in ds["outcome"].dims)
-    grid_order = tuple(k.split(".", 1)[1] for k, ax in stored["axes"].items() if ax["swept"])
+    grid_order = tuple(axis_name(k) for k, ax in stored["axes"].items() if ax["swept"])
     if set(grid_order) == set(dims):  # a transposed Dataset: back in the grid's order
         dims = grid_order
     coords = {d: np.asarray(ds[d].values) for d in dims}
@@ -625,6 +636,7 @@ def result_scene(result: SweepResult) -> Scene:
     rec = result.scene.get("record")
     suite = result.scene.get("suite")
     record = None
+    added = 0  # overrides added here, not the file's
     if rec:
         # the file's own copy first (a result stands alone); a file without one re-reads
         # the record from where the sweep read it, checked against its SHA-256
@@ -646,19 +658,29 @@ def result_scene(result: SweepResult) -> Scene:
     vert = result.scene.get("vertical")
     vertical = (stored_record(result.path, vert, VERTICAL_GROUP) if vert and result.in_file
                 else None)  # None: re-read from where the sweep read it (sha256 compared)
-    records = stored_records(result.path, suite) if suite and result.in_file else None
-    if suite and records is None:
+    records = (stored_records(result.path, suite) if suite and result.in_file
+               and not suite.get("h2") else None)  # a PEER folder is paired anew
+    if suite and suite.get("h2"):
+        overrides.append("ground.records=" + json.dumps(
+            str(Path(str(suite["records"][0]["source"])).parent)))
+        added += 1
+    elif suite and records is None:
         # a file without copies (older rocksweep) or a Dataset made in memory: the records
         # where the sweep read them (their SHA-256s are compared below)
         overrides.append("ground.records=" + json.dumps(
             [str(r.get("source")) for r in suite.get("records") or []]))
+        added += 1
+    h2 = [r for r in (result.scene.get("path") or {}).get("h2") or [] if r]
+    if h2 and not suite:  # the second component, read where the sweep read it
+        overrides.append("ground.h2=" + json.dumps(str(h2[0]["source"])))
+        added += 1
     try:
         sc = parse_scene(str(a["scene"]), str(result.path), overrides, record=record,
                          records=records, vertical=vertical)
     except RocksweepError as err:
-        raise StoreError(f"{shown(result.path)}: cannot rebuild its scene ({err})") from None
+        raise StoreError("{path}: cannot rebuild its scene ({err})", path=shown(result.path),
+                         err=err) from None
     stored = {k: v for k, v in result.scene.items() if k != "adaptive"}
-    added = bool(suite) and not rec and records is None  # the override is not the file's
     diffs = scene_differences(stored, resolved_scene(sc, overrides[:len(overrides) - added]))
     if diffs:
         raise StoreError(f"{shown(result.path)}: its scene YAML no longer gives its grid "

@@ -4,7 +4,7 @@ Datasets are allocated in full when the file is made, under a temporary name uni
 the process, renamed when complete (``rocksweep.store.safety``), so later writes touch
 raw data only: a killed run leaves a well-formed file whose ``outcome`` marks exactly the
 finished points (each chunk's other variables are flushed before its ``outcome``).
-``--resume`` reopens it and computes the rest.
+A resume reopens it and computes the rest.
 
 The attributes a session changes (``SESSION_ATTRS``) are overwritten in place
 (``attrs.modify``): reopening, writing results and finishing never need new space in the
@@ -24,10 +24,17 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rocksweep.errors import OutputError, RocksweepError
+from rocksweep.errors import Arg, RocksweepError, flag
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.outputs import check_output, clean_stale_partials, is_input, partial_prefix, shown
+from rocksweep.outputs import (
+    check_output,
+    clean_stale_partials,
+    exists_error,
+    is_input,
+    partial_prefix,
+    shown,
+)
 from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import (
@@ -145,17 +152,15 @@ class SweepFile:
         the file gets the ``computed`` flags and the settings' attributes; grid: the
         scene's ``Grid`` when the caller has made it (made here otherwise).
 
-        Refused (StoreError) before anything is written: an existing path without
-        ``overwrite``, a directory, device or FIFO, a missing directory, a grid larger
-        than the free space, a file another process is writing. ``backend``: how the
+        Refused before anything is written: an existing path without ``overwrite``, a
+        directory, device or FIFO, a missing directory (``OutputError``, as every output
+        path); a grid larger than the free space, a file another process is writing
+        (``StoreError``). ``backend``: how the
         points are computed (e.g. "threads x 2"), recorded with the host in the file.
         """
         path = Path(path)
-        try:
-            # devices, directories, missing dirs, the scene's own files
-            check_output(path, overwrite=True, inputs=scene.inputs)
-        except OutputError as err:
-            raise StoreError(str(err)) from None
+        # devices, directories, missing dirs, the scene's own files (OutputError)
+        check_output(path, overwrite=True, inputs=scene.inputs)
         return cls.make(path, scene, overrides, overwrite, backend=backend,
                         adaptive=adaptive, log=log, grid=grid)
 
@@ -165,15 +170,15 @@ class SweepFile:
              adaptive: dict | None = None, log: Callable[[str], None] | None = None,
              grid: Grid | None = None) -> SweepFile:
         """``create`` at a path its caller has checked (``outputs.check_output``, as the
-        sweep session does, naming the command's inputs): refused (StoreError) are only
-        what may have changed since, an existing path without ``overwrite``, too little
-        free space, a file another process is writing."""
+        sweep session does, naming the command's inputs): refused are only what may have
+        changed since, an existing path without ``overwrite`` (``OutputError``, the one
+        "already exists"), too little free space, a file another process is writing
+        (``StoreError``)."""
         import h5py
         grid = grid if grid is not None else Grid(scene)
         existed = os.path.lexists(path)
         if existed and not overwrite:
-            raise StoreError(f"{shown(path)}: already exists; use --resume to finish it or "
-                             "--overwrite to replace it")
+            raise exists_error(path, resumable=True)
         meta = metadata(scene, overrides, adaptive)  # before anything is made
         reserve = reserve_bytes(scene, meta.nbytes)
         removed = clean_stale_partials(path)  # a killed attempt's reserved space back
@@ -280,12 +285,14 @@ class SweepFile:
         diffs = scene_differences(stored, resolved_scene(scene, overrides, adaptive))
         if diffs:
             done = int((outcome != L.OUTCOME_NOT_RUN).sum())
-            keep = (f"resume with the scene, --set values and options it was made with, or "
-                    f"sweep this scene to another -o; --overwrite would discard the {done} "
-                    "points it holds" if done else "use --overwrite to start again: it "
-                    "holds no computed point")
-            raise StoreError(f"{shown(path)}: cannot resume, the scene differs from the "
-                             "file's: " + "; ".join(diffs) + f" ({keep})")
+            keep = (f"resume with the scene, {{overrides}} values and options it was made "
+                    f"with, or sweep this scene to another {{output}}; {{overwrite}} would "
+                    f"discard the {done} points it holds" if done else "use {overwrite} to "
+                    "start again: it holds no computed point")
+            raise StoreError("{path}: cannot resume, the scene differs from the file's: "
+                             "{diffs} (" + keep + ")", path=shown(path),
+                             diffs="; ".join(diffs), overrides=Arg("overrides"),
+                             output=Arg("output"), overwrite=flag("overwrite"))
         f = open_h5(path, "r+")
         try:
             read_layout(f, path)  # the file locked now (another may have replaced the first)
@@ -367,8 +374,9 @@ class SweepFile:
             self.f.flush()
         except H5_ERRORS as err:
             raise self._fail(StoreError(
-                f"{shown(self.path)}: cannot write results ({error_reason(err)}); the points "
-                "written before are kept, finish with --resume")) from None
+                "{path}: cannot write results ({why}); the points written before are kept, "
+                "finish with {resume}", path=shown(self.path), why=error_reason(err),
+                resume=flag("resume"))) from None
 
     def write_filled(self, outcome: np.ndarray, counts: dict[str, int]) -> None:
         """The end of an adaptive sweep: ``outcome`` (int8[size], flat: computed classes
@@ -382,8 +390,8 @@ class SweepFile:
             self.put_counts(counts)
         except H5_ERRORS as err:
             raise self._fail(StoreError(
-                f"{shown(self.path)}: cannot write the filled outcomes ({error_reason(err)}); "
-                "finish with --resume")) from None
+                "{path}: cannot write the filled outcomes ({why}); finish with {resume}",
+                path=shown(self.path), why=error_reason(err), resume=flag("resume"))) from None
 
     def put_counts(self, counts: dict[str, int]) -> None:
         """Update the adaptive counts (``ADAPTIVE_COUNT_ATTRS``) in place."""
@@ -395,7 +403,7 @@ class SweepFile:
         """Write one chunk's results; ``outcome`` last, each step flushed to the OS.
 
         A failed write (StoreError) leaves the chunk's points "not computed" and every
-        point written before intact; the file is closed (finish it with --resume).
+        point written before intact; the file is closed (a resume finishes it).
         """
         if self._broken:
             raise self._broken
@@ -413,8 +421,9 @@ class SweepFile:
             self.f.flush()
         except H5_ERRORS as err:
             raise self._fail(StoreError(
-                f"{shown(self.path)}: cannot write results ({error_reason(err)}); the points "
-                "written before are kept, finish with --resume")) from None
+                "{path}: cannot write results ({why}); the points written before are kept, "
+                "finish with {resume}", path=shown(self.path), why=error_reason(err),
+                resume=flag("resume"))) from None
 
     def finish(self, wall_seconds: float, cpu_seconds: float, *,
                backend: str | None = None) -> dict:

@@ -11,7 +11,8 @@ kernel codes, figure labels and stored attributes are derived from these tables
 - ``axes``: the swept keys' names, units and symbols; the default diagram axes;
 - ``outcomes``: outcome classes, status bits, fragility states, ``computed`` flags (their
   codes, words and meanings);
-- ``settings``: accuracy preset, event root finder (with kernel codes) and ladder names;
+- ``settings``: accuracy preset, event root finder (with kernel codes) and ladder names,
+  adaptive settings and their defaults, sweep backends;
 - ``kinds``: the kinds of Dataset rocksweep writes and opens (``rocksweep_kind``).
 
 No module here imports numpy, numba or another rocksweep module: every floor may read it.

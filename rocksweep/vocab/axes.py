@@ -69,7 +69,24 @@ AXES: dict[str, AxisMeta] = {
                            r"u_0/u_{cr}"),
     "udot_over_pucr": AxisMeta("initial velocity of the top mass", "1", "u'_0/(p u_cr)",
                                r"\dot u_0/(p\,u_{cr})"),
+    "angle": AxisMeta("angle of the rocking plane to the first horizontal component",
+                      "degree", "angle", r"\beta"),
+    "floor.period": AxisMeta("period of the building's mode", "s", "T_b", r"T_b"),
+    "floor.damping": AxisMeta("damping ratio of the building's mode", "1", "zeta_b",
+                              r"\zeta_b"),
+    "floor.participation": AxisMeta("participation of the building's mode at the floor",
+                                    "1", "Gamma phi", r"\Gamma\phi"),
 }
+
+#: the sections whose keys name their axes in full (``floor.period``: a suite's ``period``
+#: is the Sa periods' dimension); every other key's axis is its last part (``body.zeta``)
+FULL_NAME_SECTIONS: tuple[str, ...] = ("floor",)
+
+
+def axis_name(key: str) -> str:
+    """The dimension name of a scene key: ``floor.period`` as is, ``body.zeta`` -> zeta."""
+    section, _, rest = key.partition(".")
+    return key if section in FULL_NAME_SECTIONS else rest
 
 #: the initial state's keys (scene section ``initial``, each sweepable), normalised as
 #: ``simulate --csv`` writes them: theta/alpha_ref, theta'/(p alpha_ref), u/u_cr, u'/(p u_cr)

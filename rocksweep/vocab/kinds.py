@@ -19,6 +19,7 @@ RISK = "risk"
 IM_EFFICIENCY = "im_efficiency"
 CALIBRATION = "calibration"
 ACCURACY = "accuracy"
+FLOOR_SPECTRUM = "floor_spectrum"
 
 #: every kind, with what it holds
 KINDS: dict[str, str] = {
@@ -31,5 +32,6 @@ KINDS: dict[str, str] = {
     IM_EFFICIENCY: "the dispersion of each IM's fragility (which IM predicts best)",
     CALIBRATION: "scene parameters fitted to a measured rocking history",
     ACCURACY: "the accuracy study of a ladder of numerical settings",
+    FLOOR_SPECTRUM: "P(overturn) or A_min against a building's period (floor spectra)",
 }
 KIND_NAMES: tuple[str, ...] = tuple(KINDS)

@@ -1,5 +1,6 @@
-"""Names of the accuracy settings a user picks (``numerics.accuracy``, ``numerics.root``,
-``--ladder``).
+"""Names of the settings a user picks: accuracy presets (``numerics.accuracy``), event
+root finders (``numerics.root``), accuracy ladders, adaptive settings and their defaults,
+the backends a sweep runs on.
 
 The presets' values live with the numerics (``rocksweep.numerics.PRESETS``, keyed by
 ``PRESET_NAMES``); the ladders' descriptions here (``LADDER_HELP``), their settings with
@@ -28,12 +29,32 @@ LADDER_HELP: dict[str, str] = {
 }
 LADDER_NAMES: tuple[str, ...] = tuple(LADDER_HELP)
 DEFAULT_LADDER = "full"
+#: the seed of the accuracy study's stratified sample when a caller gives none
+DEFAULT_SAMPLE_SEED = 0
 
 #: the settings of an adaptive sweep a user gives (the scene's ``refine:`` section, the
-#: keywords of ``rocksweep.run``; their ranges: ``rocksweep.schema``)
+#: keywords of ``rocksweep.run``, the sweep command's options; their ranges:
+#: ``rocksweep.schema``; ``rocksweep.compute.adaptive`` explains each)
 ADAPTIVE_SETTINGS: tuple[str, ...] = ("coarse", "audit", "margin", "final_margin", "seed",
                                       "threshold")
 #: the adaptive settings that decide a result (the diagram's axes too, the default coarse
 #: level resolved): what a result file records and a resume compares
 ADAPTIVE_RESOLVED: tuple[str, ...] = ("axes", "coarse", "margin", "final_margin", "audit",
                                       "seed", "threshold")
+# The defaults. Default coarse level: the largest k whose coarse lattice keeps >=
+# MIN_COARSE_CELLS cells along both diagram axes (80: k = 2, 400: k = 4, 1000: k = 5).
+MIN_COARSE_CELLS = 16
+DEFAULT_MARGIN = 1
+# No margin at the last level: there it caught only one-point-tall slivers (40 of 480 000
+# points of Figure 4(b) at 400 x 400) for 17-27% more points computed. 0 also selects the
+# light rules of the last two levels (``rocksweep.compute.adaptive``); >= 1 refines whole
+# cells there.
+DEFAULT_FINAL_MARGIN = 0
+DEFAULT_AUDIT = 0.02
+DEFAULT_SEED = 0
+# A run warns when more than this share of its audit points disagree with their fill.
+DEFAULT_AUDIT_THRESHOLD = 0.002
+
+#: where a sweep's chunks run: local worker threads, or a dask.distributed cluster
+BACKENDS: tuple[str, ...] = ("threads", "dask")
+DEFAULT_BACKEND = "threads"

@@ -138,7 +138,7 @@ def test_cli_bad_rtol_is_a_usage_error_and_writes_nothing(narrow, tmp_path, comm
     res = CliRunner().invoke(main, [command, str(out), "-o", str(target), "--rtol", rtol])
     assert res.exit_code == 2, res.output
     lines = res.output.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f"Error: --rtol = {float(rtol)!r}: "
+    assert len(lines) == 1 and lines[0].startswith(f"Error: --rtol {float(rtol)!r}: "
                                                    "must be a relative tolerance in (0, 0.1]")
     assert not target.exists() and list(tmp_path.iterdir()) == []
 

@@ -141,6 +141,6 @@ def test_plot_of_ida_and_spectra_datasets(ds):
 def test_diagram_options_on_a_suite_are_one_line(suite_result):
     res = CliRunner().invoke(main, ["plot", str(suite_result), "--x", "lam", "-o",
                                     str(suite_result.with_name("x.png"))])
-    assert res.exit_code != 0 and res.output.startswith("Error: --x: a record-suite")
+    assert res.exit_code != 0 and res.output.startswith("Error: --x lam: a record-suite")
     assert len(res.output.strip().splitlines()) == 1
     assert not suite_result.with_name("x.png").exists()

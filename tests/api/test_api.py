@@ -143,7 +143,7 @@ def test_open_and_run_errors_are_one_line(tmp_path):
         (lambda: rocksweep.open(bad), "not an HDF5 file"),
         (lambda: rocksweep.open(tmp_path / "none.h5"), "no such file"),
         (lambda: rocksweep.run(SMALL, jobs=0), "jobs = 0: give a number >= 1"),
-        (lambda: rocksweep.run(SMALL, resume=True), "resume=True needs output="),
+        (lambda: rocksweep.run(SMALL, resume=True), "resume=True needs output"),
         (lambda: rocksweep.run({**SMALL, "impact": {"lam": 3}}), "impact.lam = 3.0"),
         (lambda: rocksweep.run(tmp_path / "none.yaml"), "no such scene file"),
         (lambda: rocksweep.run(SMALL, output=bad), "already exists; use resume=True"),
@@ -221,12 +221,16 @@ def test_cache_state_of_a_fresh_cache(tmp_path):
 @pytest.mark.parametrize("jobs", [0, -5, 10**20])
 def test_jobs_limits(jobs):
     n = os.cpu_count() or 1
+    from rocksweep.cli.main import said
+
     with pytest.raises(sw.SweepError) as exc:
-        sw.check_jobs(jobs, "--jobs")
+        sw.check_jobs(jobs)
     if jobs < 1:
-        assert str(exc.value) == f"--jobs {jobs}: give a number >= 1, or -1 for all cores"
+        assert str(exc.value) == f"jobs = {jobs}: give a number >= 1, or -1 for all cores"
+        assert said(exc.value) == f"--jobs {jobs}: give a number >= 1, or -1 for all cores"
     else:
-        assert str(exc.value).startswith(f"--jobs {jobs}: at most {4 * n} (4 x the {n} core")
+        assert str(exc.value).startswith(f"jobs = {jobs}: at most {4 * n} (4 x the {n} core")
+        assert said(exc.value).startswith(f"--jobs {jobs}: at most {4 * n} (4 x the {n} core")
     assert sw.check_jobs(-1) == n and sw.check_jobs(4 * n) == 4 * n
 
 
@@ -371,7 +375,7 @@ def test_dask_losing_every_worker_mid_sweep_saves_and_stops(tmp_path, monkeypatc
             api.sweep_file(sc, out, backend="dask", scheduler=cluster.scheduler_address,
                            chunk_size=1, write_every=1000.0)
     msg = str(exc.value)
-    assert "lost all its workers" in msg and "--resume" in msg and "\n" not in msg
+    assert "lost all its workers" in msg and "resume=True" in msg and "\n" not in msg
     r = read_result(out)
     assert 3 <= int(r.done.sum()) < 256  # what finished was written before the error
     assert not r.attrs["complete"]

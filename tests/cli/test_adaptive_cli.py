@@ -250,8 +250,8 @@ def test_resume_with_other_settings_is_refused(fig3_files, cli, tmp_path):
     res = cli.invoke(main, ["sweep", str(scene), "-o", str(out), "--resume"])
     assert one_line_error(res) == (
         f"Error: {out}: cannot resume, the scene differs from the file's: adaptive: file "
-        "adaptive (--adaptive --axes w_over_p,A_ratio --coarse 2 --audit 0.02 --margin 1 "
-        "--final-margin 0 --seed 0 --threshold 0.002), this run not (" + keep(out))
+        "adaptive (axes w_over_p,A_ratio, coarse 2, margin 1, final_margin 0, audit 0.02, "
+        "seed 0, threshold 0.002), this run not (" + keep(out))
     other = tmp_path / "full.h5"
     other.write_bytes(full.read_bytes())
     res = cli.invoke(main, ["sweep", str(scene), "-o", str(other), "--resume", "--adaptive"])

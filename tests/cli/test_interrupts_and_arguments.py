@@ -24,8 +24,9 @@ from helpers import one_line_error
 import rocksweep
 from rocksweep import interrupts
 from rocksweep.cli import main
-from rocksweep.cli.main import cli_words
+from rocksweep.cli.main import said
 from rocksweep.compute.driver import SweepInterrupted
+from rocksweep.errors import Arg, SceneError, SweepError, flag, set_key
 from rocksweep.store.reader import read_result
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -141,6 +142,35 @@ def test_an_e_the_law_ignores_is_refused(cli, tmp_path, law):
 
 
 def test_cli_messages_name_the_cli_flags():
-    assert cli_words("resume=True needs output=; add adaptive=True") == \
-        "--resume needs output=; add --adaptive"
-    assert cli_words("resume = True; no_resume=True") == "resume = True; no_resume=True"
+    """One message, two callers: the API's keywords in ``str()``, the command line's
+    options where the CLI says it (no rewriting of text: a value that looks like a keyword
+    stays as it is)."""
+    err = SweepError("{resume} needs {output}; add {adaptive}; {jobs}: resume=True stays",
+                     resume=flag("resume"), output=Arg("output"), adaptive=flag("adaptive"),
+                     jobs=Arg("jobs", 0))
+    assert str(err) == "resume=True needs output; add adaptive=True; jobs = 0: resume=True stays"
+    assert said(err) == "--resume needs -o; add --adaptive; --jobs 0: resume=True stays"
+    fix = SceneError("pick one with {fix}", fix=set_key("impact.lam", "set_fix"))
+    assert (str(fix), said(fix)) == ("pick one with overrides={'impact.lam': ...}",
+                                     "pick one with --set impact.lam=VALUE")
+
+
+@pytest.mark.parametrize("rtol", ["0.3", "0", "nan"])
+def test_fragility_rtol_is_refused_before_any_work(cli, suite_result, tmp_path, monkeypatch,
+                                                   rtol):
+    """``fragility --rtol`` is the shared option: the library's range (0, MAX_RTOL], refused
+    while the options are parsed (exit 2, one line naming --rtol), before the result is
+    opened or any curve fitted, nothing written."""
+
+    def no_work(*_args, **_kwargs):
+        raise AssertionError("work started before the options were checked")
+
+    for name in ("open", "fragility", "ida"):
+        monkeypatch.setattr(rocksweep, name, no_work)
+    out, fig = tmp_path / "f.csv", tmp_path / "f.png"
+    res = cli.invoke(main, ["fragility", str(suite_result), "--rtol", rtol, "-o", str(out),
+                            "--plot", str(fig)])
+    line = one_line_error(res, 2)
+    assert line.startswith(f"Error: --rtol {float(rtol)!r}: must be a relative tolerance in "
+                           f"(0, {rocksweep.errors.MAX_RTOL:g}]"), line
+    assert list(tmp_path.iterdir()) == []

@@ -77,7 +77,7 @@ def test_check_output_policy(tmp_path, device_node):
     mask = os.umask(0o022)
     os.umask(mask)
     assert stat.S_IMODE(os.stat(f).st_mode) == 0o666 & ~mask
-    with pytest.raises(OutputError, match="already exists; use --overwrite to replace it"):
+    with pytest.raises(OutputError, match="already exists; use overwrite=True to replace it"):
         check_output(f)
     assert check_output(f, overwrite=True) == f
     with pytest.raises(OutputError, match="is this command's input"):

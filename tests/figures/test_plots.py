@@ -217,8 +217,8 @@ def test_stability_diagram_draws_into_given_axes(acg_result):
     ax = mine.add_subplot()
     assert stability_diagram(result, axes=ax) is mine
     assert len(ax.collections) >= 1  # the mesh
-    with pytest.raises(DiagramError, match="--x w_over_p: not swept"):
-        stability_diagram(result, "w_over_p", option_names=("--x", "--y"))
+    with pytest.raises(DiagramError, match="x = 'w_over_p': not swept"):
+        stability_diagram(result, "w_over_p")
     with pytest.raises(RocksweepError, match="are both alpha_cg"):
         stability_diagram(result, "alpha_cg", "alpha_cg")
 
@@ -291,7 +291,7 @@ def test_save_figure_policy(tmp_path, device_node):
     fig.add_subplot().plot([0, 1], [0, 1])
     out = save_figure(fig, tmp_path / "a.svg")
     assert out.read_bytes().startswith(b"<?xml")
-    with pytest.raises(RocksweepError, match="already exists; use --overwrite"):
+    with pytest.raises(RocksweepError, match="already exists; use overwrite=True"):
         save_figure(fig, out)
     with pytest.raises(RocksweepError, match=r"unsupported file type '\.gif'"):
         save_figure(fig, tmp_path / "a.gif")

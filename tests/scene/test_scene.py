@@ -118,7 +118,7 @@ STRUCTURE_CASES = [
      "event_tol, horizon, rest_rate, max_events, root, rotation_step)"),
     (GOOD + "foo: 1\n",
      "foo: unknown key (allowed: name, body, impact, pulse, numerics, outputs, ground, "
-     "refine, initial)"),
+     "refine, initial, floor)"),
     (sub(", A_ratio: 5.0", ""),
      "pulse.A_ratio: missing required key (a number, a list of numbers or a range "
      "{start, stop, num})"),
@@ -131,7 +131,7 @@ STRUCTURE_CASES = [
      "outputs.energy = 'yes': must be true or false (store energy metrics)"),
     (GOOD + "name: 3\n", "name = 3: must be a string (the scene's title)"),
     ("[1, 2]", "a scene is a YAML mapping with sections body, impact, pulse, numerics, "
-     "outputs, ground, refine, initial (got [1, 2])"),
+     "outputs, ground, refine, initial, floor (got [1, 2])"),
 ]
 
 
@@ -160,7 +160,7 @@ def test_deep_nesting_is_one_line():
     deep = "[" * 3000 + "]" * 3000
     assert refused(GOOD + f"name: {deep}\n") == (
         "YAML error at line 5: nested more than 20 levels deep")
-    assert refused(GOOD, (f"name={deep}",)).startswith("--set name: value '[[[[")
+    assert refused(GOOD, (f"name={deep}",)).startswith("overrides['name']: value '[[[[")
     assert refused(GOOD, (f"name={deep}",)).endswith(
         "is not valid YAML (error at line 1: nested more than 20 levels deep)")
 
@@ -310,7 +310,7 @@ def test_a_point_beyond_the_step_cap_is_refused_with_the_bound(old, new, key, kw
     lead = (f"{key.strip('|')} = {float(value)!r}: one point could need {steps:.2g} RK4 steps"
             + REFINED)
     assert msg.startswith(lead), msg
-    assert ("more than the cap of 1e+08 a point (~17 s of one core); with the scene's other "
+    assert ("more than the cap of 1e+08 a point (~8.5 s of one core); with the scene's other "
             f"values {key} must be {op} ") in msg
     bound = float(msg.rsplit(" ", 1)[1])
     # the bound is where the cap is reached: at it the scene is accepted, 2% beyond refused

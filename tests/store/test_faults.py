@@ -34,6 +34,7 @@ from helpers import one_line_error
 
 from rocksweep.cli import main
 from rocksweep.compute.sweep import level, prepare
+from rocksweep.errors import OutputError
 from rocksweep.fields import plain
 from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.parse import load_scene, parse_scene
@@ -386,7 +387,7 @@ def test_device_paths_are_refused_even_with_overwrite(minor, device_node, cli):
     before = os.stat(dev)
     msg = (f"{dev}: not a regular file (a device, FIFO or socket); outputs are written to "
            "regular files only")
-    with pytest.raises(StoreError) as err:
+    with pytest.raises(OutputError) as err:  # an output path's problem, as from run
         SweepFile.create(dev, parse_scene(TEXT), overwrite=True)
     assert str(err.value) == msg
     assert one_line(cli.invoke(main, ["sweep", str(CI_SMALL), "-o", str(dev), "--overwrite"])) \
@@ -398,7 +399,7 @@ def test_device_paths_are_refused_even_with_overwrite(minor, device_node, cli):
 def test_fifo_is_refused(tmp_path):
     fifo = tmp_path / "pipe.h5"
     os.mkfifo(fifo)
-    with pytest.raises(StoreError) as err:
+    with pytest.raises(OutputError) as err:
         SweepFile.create(fifo, parse_scene(TEXT), overwrite=True)
     assert str(err.value) == (f"{fifo}: not a regular file (a device, FIFO or socket); "
                               "outputs are written to regular files only")
@@ -408,7 +409,7 @@ def test_fifo_is_refused(tmp_path):
 
 def test_missing_directory(tmp_path, cli):
     path = tmp_path / "nope" / "r.h5"
-    with pytest.raises(StoreError) as err:
+    with pytest.raises(OutputError) as err:
         SweepFile.create(path, parse_scene(TEXT))
     assert str(err.value) == f"{path}: directory {path.parent} does not exist"
     assert one_line(cli.invoke(main, ["sweep", str(CI_SMALL), "-o", str(path)])) == \
@@ -427,6 +428,7 @@ def test_read_only_directory_really_read_only(tmp_path):
     out = in_namespace(f"mount --bind {ro} {ro} && mount -o remount,bind,ro {ro}", f"""
         import json, os, subprocess, sys
         import rocksweep.store.writer as st
+        from rocksweep.errors import RocksweepError
         from rocksweep.scene.parse import parse_scene
         sc = parse_scene({TEXT!r})
         msgs = {{}}
@@ -436,7 +438,7 @@ def test_read_only_directory_really_read_only(tmp_path):
             try:
                 call()
                 msgs[key] = None
-            except st.StoreError as err:
+            except RocksweepError as err:  # OutputError (create), StoreError (resume)
                 msgs[key] = str(err)
         st.check_output = lambda *a, **k: None  # past the check: mkstemp itself fails
         try:

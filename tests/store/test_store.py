@@ -12,6 +12,7 @@ from bodies import FIG3_YAML
 
 import rocksweep.store.writer as writer
 from rocksweep.compute.sweep import plan_chunks
+from rocksweep.errors import OutputError
 from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.parse import parse_scene
 from rocksweep.store import StoreError
@@ -140,7 +141,9 @@ def test_unfinished_file_marks_missing_points(tmp_path, scene):
 def test_existing_file_is_not_overwritten(tmp_path, scene):
     path = tmp_path / "r.h5"
     path.write_bytes(b"precious")
-    with pytest.raises(StoreError, match="already exists.*--overwrite"):
+    # the one "already exists" of every writer (rocksweep.run's too): an OutputError
+    with pytest.raises(OutputError, match="already exists; use resume=True to finish it or "
+                                          "overwrite=True to replace it"):
         SweepFile.create(path, scene)
     assert path.read_bytes() == b"precious"
     SweepFile.create(path, scene, overwrite=True).close()
@@ -181,7 +184,7 @@ def test_create_failure_leaves_no_file(tmp_path, scene, monkeypatch):
 
 
 def test_missing_directory_is_a_clear_error(tmp_path, scene):
-    with pytest.raises(StoreError, match="does not exist"):
+    with pytest.raises(OutputError, match="does not exist"):  # an output path's problem
         SweepFile.create(tmp_path / "nope" / "r.h5", scene)
 
 

@@ -1,0 +1,113 @@
+"""A folder of PEER downloads as a suite: components paired by their names, a record
+missing a component refused (one line) or skipped, RotD50 scaling, the vertical's IMs.
+
+RotD50 is checked on closed forms: a one-component motion a1 = s(t), a2 = 0 projects to
+|cos b| max|s|, whose median over b in [0, 180) is cos(45 deg) max|s|; a circular motion
+(cos, sin) has the same peak at every angle.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+import rocksweep
+from rocksweep.physics.path import rotd50_peaks
+from rocksweep.physics.records import write_at2
+from rocksweep.physics.suite import RecordWarning
+from rocksweep.scene.model import SceneError
+from rocksweep.scene.parse import parse_scene
+from rocksweep.scene.peer import peer_components
+
+DT = 0.01
+
+
+def motion(seed: int, n: int = 600) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) * DT
+    env = (t / 1.5) ** 2 * np.exp(2 * (1 - t / 1.5))
+    return 0.3 * env * np.convolve(rng.normal(size=n), np.ones(5) / 5, "same")
+
+
+def folder(tmp_path, n: int = 3, drop: str = "", up: bool = True):
+    """PEER-named files of n records (H1 = motion, H2 = 0.8 H1, UP = 5/3 H1); ``drop`` a
+    component of the second one."""
+    d = tmp_path / "peer"
+    d.mkdir()
+    for i in range(n):
+        rsn = f"RSN{100 + i}_EVENT_STA"
+        for comp, scale in (("000", 0.3), ("090", 0.24), ("-UP", 0.5)):
+            if (comp == "-UP" and not up) or (i == 1 and comp == drop):
+                continue
+            write_at2(d / f"{rsn}{comp}.AT2", scale / 0.3 * motion(3 * i + 3), DT, rsn)
+    return d
+
+
+def scene(d, **ground):
+    return {"body": {"kind": "block", "alpha": 0.2, "inertia": 4 / 3},
+            "ground": {"records": str(d), "p": 2.0, **ground}}
+
+
+def test_peer_names_pair_by_rsn(tmp_path):
+    names = ["RSN1158_KOCAELI_DZC270.AT2", "RSN1158_KOCAELI_DZC180.AT2",
+             "RSN1158_KOCAELI_DZC-UP.AT2", "RSN9_BORREGO_B-ELC000.AT2",
+             "RSN9_BORREGO_B-ELC-UP.AT2", "notes.AT2"]
+    comps, odd = peer_components([tmp_path / n for n in names])
+    assert [c.rsn for c in comps] == ["RSN9", "RSN1158"]
+    k = comps[1]
+    assert (k.h1.name, k.h2.name, k.up.name) == (names[1], names[0], names[2])
+    assert comps[0].missing(True) == ["H2"]
+    assert [p.name for p in odd] == ["notes.AT2"]
+
+
+def test_a_folder_runs_as_a_suite_with_angles_and_rotd50(tmp_path):
+    d = folder(tmp_path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RecordWarning)
+        ds = rocksweep.run(scene(d, angle=[0.0, 90.0], scale={
+            "im": "PGA", "values": [0.2, 0.4], "component": "RotD50"}))
+    assert ds["outcome"].dims == ("record", "PGA", "angle")
+    assert ds.attrs["scale_component"] == "RotD50"
+    # the vertical's peak as written, to the files' 7 digits
+    pga_v = ds["record_pga_v"].values
+    assert np.allclose(pga_v, [np.abs(0.5 / 0.3 * motion(3 * i + 3)).max() for i in range(3)],
+                       rtol=1e-6)
+    rot = ds["record_rotd50"].values
+    assert np.allclose(ds["record_v_over_h"].values, pga_v / rot)
+    # H2 = 0.8 H1 here: the projection is sqrt(1 + 0.8^2) |cos(b - phi)| H1, whose median
+    # over b is sqrt(1.64) cos(45 deg) max|H1|
+    h1 = np.array([np.abs(motion(3 * i + 3)).max() for i in range(3)])
+    assert np.allclose(rot, math.sqrt(1.64) * math.cos(math.radians(45)) * h1, rtol=0.01)
+
+
+def test_rotd50_of_closed_forms():
+    t = np.linspace(0.0, 2.0, 4001)
+    s = np.sin(2 * math.pi * t) * np.exp(-t)
+    assert rotd50_peaks(s, np.zeros_like(s)) == pytest.approx(
+        math.cos(math.radians(45)) * np.abs(s).max(), rel=0.01)
+    c = np.cos(2 * math.pi * 3 * t)
+    assert rotd50_peaks(c, np.sin(2 * math.pi * 3 * t)) == pytest.approx(1.0, rel=1e-3)
+
+
+def test_a_missing_component_is_one_line_or_skipped(tmp_path):
+    d = folder(tmp_path, drop="090")
+    with pytest.raises(SceneError) as err:
+        parse_scene(__import__("yaml").safe_dump(scene(d)))
+    msg = str(err.value)
+    assert "\n" not in msg and "RSN101 has no H2 file" in msg and "ground.missing" in msg
+    with pytest.warns(RecordWarning, match="RSN101"):
+        sc = parse_scene(__import__("yaml").safe_dump(scene(d, missing="skip")))
+    assert len(sc.suite.records) == 2 and len(sc.suite.h2) == 2
+
+
+def test_rotd50_needs_both_horizontals(tmp_path):
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2] / "records" / "suite"
+    with pytest.raises(SceneError, match="RotD50.*both horizontals"):
+        parse_scene(__import__("yaml").safe_dump(scene(
+            str(root / "SYN0*.AT2"), scale={"im": "PGA", "values": [0.3],
+                                             "component": "RotD50"})))
