@@ -26,6 +26,7 @@ times are less sensitive to load than wall times.
 
     python scripts/bench_compile.py            # ~3-4 min on 2 cores
     python scripts/bench_compile.py --quick    # ~30 s: Figure 3(a)'s variant and scene only
+    python scripts/bench_compile.py --vertical # item 1 alone: vertical and ground variants
 
 Run it against another copy of the package (e.g. the code before a change) with
 ``PYTHONPATH=/path/to/that/copy``: every subprocess inherits the environment.
@@ -79,8 +80,13 @@ LEVELS = {L.LEVEL_OUTCOME: "chunk", L.LEVEL_ENERGY: "chunk_energy",
           L.LEVEL_CONTACT: "chunk_contact", None: "point_history"}
 # (kind, level, ground): Figure 3(a) needs the first (flexible, damped, outcome level)
 ALL_VARIANTS = ([(k, lv, False) for lv in LEVELS for k in KINDS]
-                + [(k, L.LEVEL_OUTCOME, True) for k in KINDS])
+                + [(k, L.LEVEL_OUTCOME, True) for k in KINDS]
+                + [(k, L.LEVEL_OUTCOME, L.GROUND_VERTICAL) for k in KINDS])
 QUICK_VARIANTS = [(L.KIND_FLEXIBLE, L.LEVEL_OUTCOME, False)]
+# --vertical: the vertical ground acceleration's variants beside the ground variants they
+# extend (docs/vertical.md), each level a scene can ask for
+VERTICAL_VARIANTS = [(k, lv, g) for k in KINDS for lv in (L.LEVEL_OUTCOME, None)
+                     for g in (L.GROUND_ANY, L.GROUND_VERTICAL)]
 
 _COMPILE_SNIPPET = """
 import json, sys, time
@@ -106,8 +112,9 @@ def child_env(tree: Path | None = None, **extra: str) -> dict[str, str]:
     return {**os.environ, "PYTHONPATH": path, **extra}
 
 
-def variant_name(kind: int, level: int | None, ground: bool) -> str:
-    return f"{LEVELS[level]}_{KINDS[kind]}{'_ground' if ground else ''}"
+def variant_name(kind: int, level: int | None, ground: int) -> str:
+    suffix = ("_vertical" if ground == L.GROUND_VERTICAL else "_ground" if ground else "")
+    return f"{LEVELS[level]}_{KINDS[kind]}{suffix}"
 
 
 def cold_compile(variant: tuple[int, int | None, bool], tree: Path | None = None) -> dict:
@@ -256,6 +263,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true",
                     help="Figure 3(a) only: its variant, its scene, 20 reference points")
+    ap.add_argument("--vertical", action="store_true",
+                    help="item 1 only, for the vertical variants beside the ground ones")
     ap.add_argument("--repeat", type=int, default=3, help="best of this many (items 2-4)")
     ap.add_argument("--ref-points", type=int, default=100,
                     help="reference sample per figure (default 100)")
@@ -273,7 +282,8 @@ def main() -> None:
         against(args.against.resolve(), args.rounds, args.repeat)
         print(f"load average at end {bk.load_avg()}")
         return
-    variants = QUICK_VARIANTS if args.quick else ALL_VARIANTS
+    variants = (VERTICAL_VARIANTS if args.vertical else QUICK_VARIANTS if args.quick
+                else ALL_VARIANTS)
     figures = ["fig3a"] if args.quick else list(bk.FOUR)
     ref_points = 20 if args.quick else args.ref_points
 
@@ -291,6 +301,9 @@ def main() -> None:
                 raise SystemExit(f"the subprocess imported {r['package']}")
             print(f"    {variant_name(*v):<36}{r['cpu']:>8.2f}{r['wall']:>8.2f}"
                   f"{r['import_cpu']:>14.2f}", flush=True)
+    if args.vertical:
+        print(f"load average at end {bk.load_avg()}")
+        return
 
     print(f"\n[2] warm start-up (numba's cache filled), best of {args.repeat}")
     print(f"    {'command':<40}{'wall s':>8}{'CPU s':>8}")

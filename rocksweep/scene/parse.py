@@ -43,6 +43,7 @@ from rocksweep.scene.admission import candidate_bodies, check_cost
 from rocksweep.scene.loader import CONTROL_CHARS, YamlError, load_yaml
 from rocksweep.scene.model import Axis, Scene
 from rocksweep.scene.peer import peer_suite
+from rocksweep.scene.vertical import check_vertical_start, pulse_vertical
 from rocksweep.schema import (
     BODY_KEYS,
     KEYS,
@@ -75,7 +76,11 @@ PULSE_KEY_SHAPES = _PULSE_KEY_SHAPES
 
 
 def apply_overrides(raw: dict, overrides: list[str]) -> dict:
-    """Apply ``section.key=VALUE`` overrides (VALUE parsed as YAML) to a raw scene."""
+    """Apply ``section.key=VALUE`` overrides (VALUE parsed as YAML) to a raw scene.
+
+    ``section.key=null`` leaves the key out (its default, or none), the one way an override
+    can take a key away (switching ``impact.law`` away from ``constant`` drops ``impact.e``);
+    a null written in a scene file is refused instead, where it would read as a value."""
     for item in overrides:
         if "=" not in item:
             raise SceneError("{entry}: expected KEY=VALUE, e.g. pulse.A_ratio=4.5",
@@ -91,14 +96,21 @@ def apply_overrides(raw: dict, overrides: list[str]) -> dict:
         except YamlError as err:
             raise SceneError("{key}: value {text} is not valid YAML ({why})",
                              key=set_key(key), text=fmt(text), why=err) from None
-        node = raw
+        node: Any = raw
         for p in parts[:-1]:
             if node.get(p) is None:
+                if value is None:  # the section is not there: nothing to leave out
+                    node = None
+                    break
                 node[p] = {}
             node = node[p]
             if not isinstance(node, dict):
                 raise SceneError("{key}: {p} is not a section", key=set_key(key), p=p)
-        node[parts[-1]] = value
+        if value is None:
+            if node is not None:
+                node.pop(parts[-1], None)
+        else:
+            node[parts[-1]] = value
     return raw
 
 
@@ -826,7 +838,7 @@ def _motion(raw: dict, kind: str, base: Path | None, given_record: GroundRecord 
         return _Motion(free=True, pulse={"shape": FREE, "w_over_p": 0.0, "A_ratio": 0.0})
     if raw.get("ground") is None:
         pulse = _section(raw, "pulse", kind, required=True)
-        return _Motion(free=False, pulse=pulse, pulse_vertical=_pulse_vertical(pulse))
+        return _Motion(free=False, pulse=pulse, pulse_vertical=pulse_vertical(pulse))
     ground = _section(raw, "ground", kind, required=True)
     if ground.get("vertical") is not None and ground.get("record") is None:
         raise SceneError(f"ground.vertical = {fmt(ground['vertical'])}: works with one "
@@ -857,25 +869,6 @@ def _motion(raw: dict, kind: str, base: Path | None, given_record: GroundRecord 
                    record=record, inputs=inputs,
                    vertical=vertical if ground.get("vertical") is not None else None,
                    ground=ground)
-
-
-def _pulse_vertical(pulse: dict) -> dict | None:
-    """The raw keys of ``pulse.vertical`` (a mapping of VERTICAL_KEYS; amplitude and
-    w_over_p required), checked as a section's are; None when not given."""
-    spec = pulse.get("vertical")
-    if spec is None:
-        return None
-    if not isinstance(spec, dict):
-        raise SceneError(f"pulse.vertical = {fmt(spec)}: {KEYS['pulse.vertical'].allowed}")
-    for k in spec:
-        if k not in VERTICAL_KEYS:
-            raise SceneError(f"pulse.vertical.{k}: unknown key (allowed: "
-                             f"{', '.join(VERTICAL_KEYS)})")
-    for k in VERTICAL_KEYS:
-        if KEYS[f"pulse.vertical.{k}"].required and spec.get(k) is None:
-            raise SceneError(f"pulse.vertical.{k}: missing required key (a number, a list "
-                             "of numbers or a range {start, stop, num})")
-    return spec
 
 
 def _outputs(raw: dict, kind: str, mu_spec: Any) -> tuple[bool, bool, bool]:
@@ -1005,39 +998,12 @@ def _admit(scene: Scene) -> None:
         raise SceneError(f"outputs.contact = true: not available with {what} yet; contact "
                          "outputs work with sine and cosine pulses")
     bodies = candidate_bodies(scene)
-    _check_vertical_start(scene)
+    check_vertical_start(scene)
     _check_initial(scene, bodies)
     check_cost(scene, bodies)
     if scene.suite is not None:
         scene.suite.warn(scene.axis(alpha_symbol(scene.kind)).values,
                          scene.axis("p").values)
-
-
-def _check_vertical_start(scene: Scene) -> None:
-    """Refuse (one line) a vertical with g + a_v <= 0 at t = 0 for some point: the body
-    would leave the ground before anything else happens (``airborne`` is for a run that
-    gets there later). A harmonic: 1 + a sin(phase) <= 0; a record: its first sample
-    scaled with the largest |A_ratio| g tan(alpha_ref) of the grid."""
-    if "vertical.amplitude" in {a.name for a in scene.axes}:
-        amp = np.asarray(scene.axis("vertical.amplitude").values, float)
-        phase = np.asarray(scene.axis("vertical.phase").values, float)
-        a0 = amp[:, None] * np.sin(np.radians(phase))[None, :]
-        i, j = np.unravel_index(np.argmin(a0), a0.shape)
-        if 1.0 + a0[i, j] <= 0.0:
-            raise SceneError(f"pulse.vertical.amplitude = {fmt(float(amp[i]))}: with "
-                             f"pulse.vertical.phase = {fmt(float(phase[j]))} deg, a_v = "
-                             f"{a0[i, j]:.4g} g at t = 0, so g + a_v <= 0 (the body leaves "
-                             "the ground); a sin(phase) must be > -1 at t = 0")
-    if scene.vertical is not None:
-        first = float(scene.vertical_samples()[0]) / scene.record.pga  # per unit of A
-        a_ratio = float(np.max(np.abs(scene.axis("A_ratio").values)))
-        alpha = float(np.max(scene.axis(alpha_symbol(scene.kind)).values))
-        a0 = a_ratio * math.tan(alpha) * first
-        if 1.0 + a0 <= 0.0:
-            raise SceneError(f"ground.vertical = {shown(scene.vertical.source)}: its first "
-                             f"sample scaled with ground.A_ratio = {fmt(a_ratio)} is a_v = "
-                             f"{a0:.4g} g at t = 0, so g + a_v <= 0 (the body leaves the "
-                             "ground); the vertical at t = 0 must be > -1 g")
 
 
 def _check_initial(scene: Scene, bodies: list[dict[str, float]]) -> None:

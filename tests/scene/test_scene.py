@@ -98,6 +98,19 @@ def test_overrides_use_the_same_checks():
         "body.mA_over_m = 1e-300: must be in [1e-06, 1e+06]")
 
 
+def test_an_override_to_null_leaves_the_key_out_and_a_null_in_the_file_is_refused():
+    with_e = GOOD.replace("impact: {lam: 0.4}", "impact: {law: constant, e: 0.9}")
+    s = parse_scene(with_e, SRC, overrides=["impact.law=vertical", "impact.e=null",
+                                            "impact.lam=0.3"])
+    assert s.axis("law").values == ("vertical",) and "e" not in [a.name for a in s.axes]
+    # leaving out a key of a section the scene does not have adds no section
+    plain = parse_scene(GOOD, SRC)
+    free = parse_scene(GOOD, SRC, overrides=["initial.theta_over_alpha=null"])
+    assert [a.name for a in free.axes] == [a.name for a in plain.axes] and free.text == plain.text
+    assert refused(GOOD.replace("impact: {lam: 0.4}", "impact: {lam: null}"), ()) == (
+        "impact.lam = null: must be in [0, 2], or leave the key out")
+
+
 # -- structure: sections, unknown and missing keys, types -----------------------------
 
 STRUCTURE_CASES = [
