@@ -26,15 +26,13 @@ The Python API (see the README's "Python API"):
 - ``rocksweep.RocksweepError``: the base of every error a user can fix (one line).
 
 Importing the package is light: numba, h5py, xarray and matplotlib load on first use.
-``ds.rocksweep`` (``rocksweep.accessor``) is there after ``import xarray, rocksweep``, and
-after any call of the API.
+``ds.rocksweep`` (``rocksweep.api.RocksweepAccessor``) is there after ``import xarray,
+rocksweep``, and after any call of the API.
 """
 
 from __future__ import annotations
 
-from rocksweep.accessor import register_accessor
 from rocksweep.api import (  # noqa: A004
-    Simulation,
     boundaries,
     boundary_lines,
     calibrate,
@@ -46,6 +44,7 @@ from rocksweep.api import (  # noqa: A004
     im_efficiency,
     open,
     plot,
+    register_accessor,
     risk,
     run,
     simulate,
@@ -53,6 +52,7 @@ from rocksweep.api import (  # noqa: A004
     table,
 )
 from rocksweep.errors import RocksweepError
+from rocksweep.simulation import Simulation
 
 register_accessor()  # ds.rocksweep, if xarray is already imported (it is never imported here)
 

@@ -3,24 +3,24 @@ and the analyses of a Dataset. Each function hands over to the room that does th
 and checks its arguments: scenes (``rocksweep.scene.inputs``), the sweep session
 (``rocksweep.compute.session``), a result as a Dataset (``rocksweep.store.dataset``), a
 run's history (``rocksweep.compute.history``), the analyses (``rocksweep.analysis``), the
-figures (``rocksweep.figures``), ``ds.rocksweep`` (``rocksweep.accessor``). Errors name
+figures (``rocksweep.figures``), ``ds.rocksweep`` (``RocksweepAccessor``, at the end). Errors name
 the API's arguments (``rocksweep.errors.Arg``).
 
 Nothing heavy is imported here at module level (numba, h5py, xarray, matplotlib load
-inside the functions), so ``import rocksweep`` stays light; the names that moved out are
-still importable from here (``api.load``, ``api.sweep_file``, ...: PEP 562).
+inside the functions), so ``import rocksweep`` stays light. The names the API builds on
+are imported from their homes (``rocksweep.compute.session.sweep_file``, ...), not from here.
 """
 
 from __future__ import annotations
 
 import functools
+import sys
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rocksweep.accessor import register_accessor
 from rocksweep.analysis.resampling import DEFAULT_CI, DEFAULT_SEED
-from rocksweep.errors import ApiError  # noqa: F401 (the API's)
+from rocksweep.errors import ApiError
 from rocksweep.simulation import Simulation  # what simulate returns
 
 if TYPE_CHECKING:
@@ -28,27 +28,6 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
     from rocksweep.scene.inputs import Overrides, SceneLike
-
-# Names that live in their rooms, importable from here as before (loaded on first use):
-# SweepInterrupted is what ``run`` raises on Ctrl-C.
-_MOVED = {name: module for module, names in {
-    "rocksweep.compute.driver": ("WRITE_EVERY", "SweepInterrupted", "SweepReport"),
-    "rocksweep.scene.inputs": ("load", "override_strings"),
-    "rocksweep.compute.history": ("MAX_RUNS", "API_MAX_RUNS", "run_points",
-                                "history_dataset", "swept_values", "write_history_csv"),
-    "rocksweep.compute.adaptive": ("adaptive_options",),
-    "rocksweep.compute.session": ("sweep_file",),
-    "rocksweep.store.dataset": ("result_dataset",),
-    "rocksweep.accessor": ("RocksweepAccessor",),
-}.items() for name in names}
-
-
-def __getattr__(name: str) -> Any:
-    if name in _MOVED:
-        from importlib import import_module
-
-        return getattr(import_module(_MOVED[name]), name)
-    raise AttributeError(f"module 'rocksweep.api' has no attribute {name!r}")
 
 
 def _public(fn: Callable[..., Any]) -> Callable[..., Any]:
@@ -517,3 +496,80 @@ def calibrated_overrides(fit: xr.Dataset, which: str = "all") -> dict[str, Any]:
         raise ApiError("fit: not a calibration (no parameter and estimate; what "
                        "rocksweep.calibrate returns)")
     return overrides_of(fit, which)
+
+
+# --- ds.rocksweep: the same functions as methods of a Dataset (as rioxarray's ``.rio``) ----
+# Registered on ``import rocksweep`` when xarray is already imported, and after every call
+# of the API once xarray is loaded; ``import rocksweep`` alone never imports xarray.
+
+_REGISTERED = False
+
+
+
+class RocksweepAccessor:
+    """``ds.rocksweep.<analysis>(...)`` is ``rocksweep.<analysis>(ds, ...)``."""
+
+    def __init__(self, ds: Any) -> None:
+        self._ds = ds
+
+    def plot(self, **kwargs: Any) -> Any:
+        """``rocksweep.plot(ds, ...)``: the figure of the Dataset (a sweep's stability
+        diagram, an analysis's figure)."""
+        return plot(self._ds, **kwargs)
+
+    def boundaries(self, **kwargs: Any) -> Any:
+        """``rocksweep.boundaries(ds, ...)``: A_min as a Dataset."""
+        return boundaries(self._ds, **kwargs)
+
+    def boundary_lines(self) -> Any:
+        """``rocksweep.boundary_lines(ds)``: the class boundary polylines (DataFrame)."""
+        return boundary_lines(self._ds)
+
+    def spectra(self, **kwargs: Any) -> Any:
+        """``rocksweep.spectra(ds, ...)``: rocking and overturning spectra."""
+        return spectra(self._ds, **kwargs)
+
+    def fragility(self, **kwargs: Any) -> Any:
+        """``rocksweep.fragility(ds, ...)``: lognormal fragility curves of a suite."""
+        return fragility(self._ds, **kwargs)
+
+    def ida(self, **kwargs: Any) -> Any:
+        """``rocksweep.ida(ds, ...)``: the first overturning level of each record."""
+        return ida(self._ds, **kwargs)
+
+    def risk(self, hazard: Any, years: float = 50, **kwargs: Any) -> Any:
+        """``rocksweep.risk(ds, hazard, years)``: annual rate and probability per state."""
+        return risk(self._ds, hazard, years, **kwargs)
+
+    def im_efficiency(self, **kwargs: Any) -> Any:
+        """``rocksweep.im_efficiency(ds, ...)``: beta of the fragility in every IM."""
+        return im_efficiency(self._ds, **kwargs)
+
+    def table(self) -> Any:
+        """``rocksweep.table(ds)``: one row per run (a DataFrame)."""
+        return table(self._ds)
+
+    def as_overrides(self, which: str = "all") -> dict[str, Any]:
+        """``rocksweep.calibrated_overrides(ds, which)`` of a calibration Dataset."""
+        return calibrated_overrides(self._ds, which)
+
+    def outcome_words(self) -> Any:
+        """``outcome`` as words (not_run, safe, mode1, mode2), an object DataArray."""
+        import numpy as np
+
+        from rocksweep.vocab.outcomes import OUTCOME_WORDS
+
+        o = self._ds["outcome"]
+        return o.copy(data=np.vectorize(OUTCOME_WORDS.get, otypes=[object])(o.values))
+
+
+def register_accessor() -> None:
+    """Register ``ds.rocksweep`` with xarray, once, if xarray is imported (this never
+    imports it: cheap enough for every API call)."""
+    global _REGISTERED
+    if _REGISTERED or "xarray" not in sys.modules:
+        return
+    import xarray as xr
+
+    xr.register_dataset_accessor("rocksweep")(RocksweepAccessor)
+    _REGISTERED = True

@@ -153,6 +153,10 @@ class IdaError(RocksweepError, ValueError):
     """A result that has no IDA: not a scaled suite, not finished (analysis.ida)."""
 
 
+class FloorError(RocksweepError):
+    """A Dataset that has no floor spectrum or orientation to give (analysis.floors)."""
+
+
 class EfficiencyError(RocksweepError, ValueError):
     """A Dataset that has no IM efficiency (analysis.efficiency)."""
 

@@ -27,7 +27,7 @@ import numpy as np
 
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.bodies import G
-from rocksweep.vocab.axes import AXES, AxisMeta, alpha_symbol  # noqa: F401
+from rocksweep.vocab.axes import AXES, alpha_symbol
 from rocksweep.vocab.ground import AVGSA_POINTS, RECORD_IMS, SA, SA_DAMPING, SCALE_IMS
 
 
@@ -86,7 +86,7 @@ FIELDS: tuple[Field, ...] = (
           L.OUT_T_OVERTURN,
           label="overturning time", symbol="p t_overturn"),
     Field("status", "int32", 0, "1",
-          f"bit flags (rocksweep.outcomes.STATUS_WORDS); flagged = {_FLAGGED}", L.OUT_STATUS,
+          f"bit flags (rocksweep.vocab.outcomes.STATUS_WORDS); flagged = {_FLAGGED}", L.OUT_STATUS,
           label="status flags"),
     Field("steps", "int64", 0, "1", "regular RK4 steps taken", L.OUT_STEPS,
           label="RK4 steps"),

@@ -300,13 +300,8 @@ def step_budget(t_pulse: np.ndarray | float, t_end: np.ndarray | float,
 CLOSE_MARGIN = 0.0125
 # An overturn is a close call up to this many times the row's PAR_CLOSE: a run that commits
 # to falling carries the error of every step before it into that one approach, and an
-# overturn that the finer runs survive can commit with a margin well above CLOSE_MARGIN.
-# Measured on a flexible body near its mode-1 threshold (wn/p 2.96, zeta 0.097, alpha_cg
-# 0.124, alpha_A 0.41, mA/m 1.41, IA 0.69, lam 0.32, sine w/p 4.61): `default` overturns
-# after 3 impacts with margins up to 0.040 (3.2 x CLOSE_MARGIN) at A_ratio in [3.110,
-# 3.122], where `fine` and the reference survive 138-216 impacts. On the four figures
-# 0.3-0.8% of the steps belong to overturns between 1 and 2 x PAR_CLOSE, 0.8-2.4% to those
-# between 1 and 4 x (``compute.certify``, docs/accuracy.md).
+# overturn that the finer runs survive can commit with a margin well above CLOSE_MARGIN
+# (measured: docs/accuracy.md, "Close calls on the overturning side").
 OVERTURN_CLOSE = 4.0
 
 

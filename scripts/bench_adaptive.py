@@ -1,4 +1,4 @@
-"""Adaptive vs full sweeps, side by side in one run (issue 11).
+"""Adaptive vs full sweeps, side by side in one run.
 
 For each scene: the full grid and the adaptive sweep (default settings), both in memory
 through the sweep driver (``rocksweep.compute.driver.sweep_arrays``) with the same workers; prints
@@ -14,7 +14,7 @@ looked up) for every coarse level, which is how the default coarse level was cho
     python scripts/bench_adaptive.py --fine --file        # ... and through a result file
 
 ``--file`` adds the time of the same adaptive sweep written to an HDF5 result file
-(``rocksweep.api.sweep_file``, what ``rocksweep sweep --adaptive`` runs) and checks that
+(``rocksweep.compute.session.sweep_file``, what ``rocksweep sweep --adaptive`` runs) and checks that
 its outcome equals the in-memory one.
 
 Targets: equal outcome on >= 99.9% of cells; <= 10% of the points computed at 400 x 400,
@@ -43,6 +43,7 @@ from rocksweep.compute.driver import sweep_arrays
 from rocksweep.scene.grid import Grid
 from rocksweep.scene.model import Scene
 from rocksweep.scene.parse import load_scene, parse_scene
+from rocksweep.vocab.axes import DIAGRAM_AXES
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGS = ("fig3a", "fig3b", "fig4a", "fig4b", "block")
@@ -75,7 +76,7 @@ def scene(name: str, res: int) -> Scene:
     if not res:
         return base
     ov = []
-    for ax in ad.DIAGRAM_AXES:
+    for ax in DIAGRAM_AXES:
         v = base.axis(ax).values
         ov.append(f"pulse.{ax}={{start: {v[0]!r}, stop: {v[-1]!r}, num: {res}}}")
     if name in THIN:
@@ -144,7 +145,7 @@ def main() -> None:
         if args.file:
             import tempfile
 
-            from rocksweep.api import sweep_file
+            from rocksweep.compute.session import sweep_file
             from rocksweep.store.reader import read_result
 
             with tempfile.TemporaryDirectory() as tmp:

@@ -1,4 +1,4 @@
-"""Recovery errors, interval coverage and times of ``rocksweep.calibrate`` (issue 30).
+"""Recovery errors, interval coverage and times of ``rocksweep.calibrate``.
 
     python scripts/bench_calibrate.py            # every case, ~1 min on 2 cores
     python scripts/bench_calibrate.py --quick    # a few cases
@@ -9,7 +9,7 @@ sampled uniformly at dt = 0.02 p t (or unevenly, with gaps), plus Gaussian noise
 ``noise`` x max |theta|. Each is fitted back from a different starting scene value. Prints
 per case the truth, the estimate, the error, the 95% interval (and whether it covers the
 truth), its width at 1% and 0.3% noise, the number of impacts of the truth, and the fit's
-compute time; then the totals against the issue's targets (lam within +-0.03, e within
+compute time; then the totals against the targets (lam within +-0.03, e within
 +-0.02, a one-parameter fit < 10 s on 2 cores including start-up, measured here as the
 command line's wall time in a fresh process).
 """

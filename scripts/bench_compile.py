@@ -1,6 +1,6 @@
 """What a new user waits for, and what a point costs: compile, start-up, per point, vs reference.
 
-Prints, measured side by side in one run (issue 24):
+Prints, measured side by side in one run:
 
 1. cold compile: each kernel variant compiled alone in a fresh process with an empty
    NUMBA_CACHE_DIR (what the first sweep of a scene pays on a fresh machine, and every
@@ -26,6 +26,7 @@ times are less sensitive to load than wall times.
 
     python scripts/bench_compile.py            # ~3-4 min on 2 cores
     python scripts/bench_compile.py --quick    # ~30 s: Figure 3(a)'s variant and scene only
+    python scripts/bench_compile.py --vertical # item 1 alone: vertical and ground variants
 
 Run it against another copy of the package (e.g. the code before a change) with
 ``PYTHONPATH=/path/to/that/copy``: every subprocess inherits the environment.
@@ -33,8 +34,8 @@ Run it against another copy of the package (e.g. the code before a change) with
 5. A/B (``--against DIR``, DIR holding another copy's ``rocksweep`` package, e.g. ``git
    archive main | tar -x -C DIR``): rounds alternating between this copy and DIR, each
    measurement in a fresh process: item 1's cold compile of Figure 3(a)'s variant (CPU s),
-   the warm whole-process wall time of a 1-point ``rocksweep sweep`` (issue 31's start-up
-   target), and item 3's core-us per point of Figure 3(a) (this copy's
+   the warm whole-process wall time of a 1-point ``rocksweep sweep`` (the start-up
+   target: under 0.5 s), and item 3's core-us per point of Figure 3(a) (this copy's
    ``bench_kernel.best_pass`` on DIR's package), the order swapped every round; the
    median of each and the ratio this / DIR. Alone (``--against DIR --ab-only``) it takes
    ~25 s per round on 2 cores.
@@ -79,8 +80,13 @@ LEVELS = {L.LEVEL_OUTCOME: "chunk", L.LEVEL_ENERGY: "chunk_energy",
           L.LEVEL_CONTACT: "chunk_contact", None: "point_history"}
 # (kind, level, ground): Figure 3(a) needs the first (flexible, damped, outcome level)
 ALL_VARIANTS = ([(k, lv, False) for lv in LEVELS for k in KINDS]
-                + [(k, L.LEVEL_OUTCOME, True) for k in KINDS])
+                + [(k, L.LEVEL_OUTCOME, True) for k in KINDS]
+                + [(k, L.LEVEL_OUTCOME, L.GROUND_VERTICAL) for k in KINDS])
 QUICK_VARIANTS = [(L.KIND_FLEXIBLE, L.LEVEL_OUTCOME, False)]
+# --vertical: the vertical ground acceleration's variants beside the ground variants they
+# extend (docs/vertical.md), each level a scene can ask for
+VERTICAL_VARIANTS = [(k, lv, g) for k in KINDS for lv in (L.LEVEL_OUTCOME, None)
+                     for g in (L.GROUND_ANY, L.GROUND_VERTICAL)]
 
 _COMPILE_SNIPPET = """
 import json, sys, time
@@ -106,8 +112,9 @@ def child_env(tree: Path | None = None, **extra: str) -> dict[str, str]:
     return {**os.environ, "PYTHONPATH": path, **extra}
 
 
-def variant_name(kind: int, level: int | None, ground: bool) -> str:
-    return f"{LEVELS[level]}_{KINDS[kind]}{'_ground' if ground else ''}"
+def variant_name(kind: int, level: int | None, ground: int) -> str:
+    suffix = ("_vertical" if ground == L.GROUND_VERTICAL else "_ground" if ground else "")
+    return f"{LEVELS[level]}_{KINDS[kind]}{suffix}"
 
 
 def cold_compile(variant: tuple[int, int | None, bool], tree: Path | None = None) -> dict:
@@ -181,7 +188,7 @@ bk.kernel_pass(scene)
 p = bk.best_pass(scene, int(sys.argv[3]))
 print(json.dumps({"us": p["cpu"] / p["outs"].shape[0] * 1e6, "package": rocksweep.__file__}))
 """
-# a 1-point sweep (Figure 3(a)'s body at one pulse and lam): issue 31's start-up target
+# a 1-point sweep (Figure 3(a)'s body at one pulse and lam): the start-up target
 ONE_POINT = ["--set", "pulse.w_over_p=2.0", "--set", "pulse.A_ratio=3.0",
              "--set", "impact.lam=0.2"]
 
@@ -256,6 +263,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true",
                     help="Figure 3(a) only: its variant, its scene, 20 reference points")
+    ap.add_argument("--vertical", action="store_true",
+                    help="item 1 only, for the vertical variants beside the ground ones")
     ap.add_argument("--repeat", type=int, default=3, help="best of this many (items 2-4)")
     ap.add_argument("--ref-points", type=int, default=100,
                     help="reference sample per figure (default 100)")
@@ -273,7 +282,8 @@ def main() -> None:
         against(args.against.resolve(), args.rounds, args.repeat)
         print(f"load average at end {bk.load_avg()}")
         return
-    variants = QUICK_VARIANTS if args.quick else ALL_VARIANTS
+    variants = (VERTICAL_VARIANTS if args.vertical else QUICK_VARIANTS if args.quick
+                else ALL_VARIANTS)
     figures = ["fig3a"] if args.quick else list(bk.FOUR)
     ref_points = 20 if args.quick else args.ref_points
 
@@ -291,6 +301,9 @@ def main() -> None:
                 raise SystemExit(f"the subprocess imported {r['package']}")
             print(f"    {variant_name(*v):<36}{r['cpu']:>8.2f}{r['wall']:>8.2f}"
                   f"{r['import_cpu']:>14.2f}", flush=True)
+    if args.vertical:
+        print(f"load average at end {bk.load_avg()}")
+        return
 
     print(f"\n[2] warm start-up (numba's cache filled), best of {args.repeat}")
     print(f"    {'command':<40}{'wall s':>8}{'CPU s':>8}")

@@ -36,7 +36,8 @@ import time
 import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
 import numpy as np
 
-from rocksweep.compute.single import history_capacity, run_point
+from rocksweep.compute.dispatch import history_capacity
+from rocksweep.compute.single import run_point
 from rocksweep.fields import check_rows
 from rocksweep.kernel import chunk_kernel, point_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812

@@ -1,4 +1,4 @@
-"""A FEMA-P695-sized fragility study, timed: 44 records x 16 PGA stripes x 3 lam (issue 20).
+"""A FEMA-P695-sized fragility study, timed: 44 records x 16 PGA stripes x 3 lam.
 
 Prints, measured side by side in one run:
 

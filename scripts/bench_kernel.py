@@ -1,6 +1,6 @@
 """How close the kernel runs to a bare RK4 loop, and how much faster than the reference.
 
-Prints, measured side by side in one run (issue 7's benchmark):
+Prints, measured side by side in one run:
 
 1. roofline: a bare fixed-step RK4 loop over the same right-hand side (``rk4_step`` of the
    flexible damped kernel, outcome level), no events, no bookkeeping: ns per step while
@@ -72,7 +72,7 @@ from rocksweep.analysis.accuracy import (
     run_reference,
     stratified_sample,
 )
-from rocksweep.compute.single import history_capacity
+from rocksweep.compute.dispatch import history_capacity
 from rocksweep.compute.sweep import auto_chunk_size, level, plan_chunks, prepare
 from rocksweep.kernel import chunk_kernel, point_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812

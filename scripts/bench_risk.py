@@ -1,4 +1,4 @@
-"""The issue-29 study, timed stage by stage: 44 records x 16 PGA stripes x 3 lam, a fit with
+"""A record-suite risk study, timed stage by stage: 44 records x 16 PGA stripes x 3 lam, a fit with
 3 damage states, the IM efficiency and the risk over a hazard curve (target: < 15 s on 2
 cores, everything in).
 
@@ -7,7 +7,8 @@ Stages, each timed in one Python process (``time.perf_counter``), printed with i
 0. start-up: ``python -c "import rocksweep"`` in a fresh process (what every command pays
    once before computing; reported apart, not in the study's total);
 1. scene: reading the 44 records, their IMs (PGA, PGV, Sa at 0.2 and 1 s, Arias, CAV,
-   D5-95, PGV/PGA, AvgSa over 10 periods) and the admission checks (``rocksweep.api.load``);
+   D5-95, PGV/PGA, AvgSa over 10 periods) and the admission checks
+   (``rocksweep.scene.inputs.load``);
 2. sweep: ``rocksweep.run(scene, jobs=2)``, 2 112 kernel runs of 20-40 s records (the
    kernel from numba's cache; a cold cache is filled first and reported apart);
 3. fragility: ``rocksweep.fragility(ds, state=["theta:0.25", "theta:0.5", "overturn"],
@@ -57,8 +58,8 @@ def main() -> int:
     import pandas as pd
 
     import rocksweep
-    from rocksweep.api import load
     from rocksweep.kernel import variants  # noqa: F401  (imported before timing)
+    from rocksweep.scene.inputs import load
 
     times: dict[str, float] = {}
     with tempfile.TemporaryDirectory() as tmp:

@@ -1,4 +1,4 @@
-"""Held-out overturning spectra: A_min(omega/p) of a 300-value sweep against references (issue 28).
+"""Held-out overturning spectra: A_min(omega/p) of a 300-value sweep against references.
 
 The curves: uniform blocks (``kind: block``, alpha 0.1, 0.25, 0.4), three flexible bodies
 (Table 3's body of Figures 3(a)/(b), wn/p = 2.43; the stiff body of Figure 4, wn/p = 9.82;

@@ -1,4 +1,4 @@
-"""The step rule and the certification of close calls (issue 28): accuracy and price on the
+"""The step rule and the certification of close calls: accuracy and price on the
 four figures, side by side in one run.
 
     python scripts/bench_step_rule.py                 # the four figures, 3 rounds
@@ -7,7 +7,7 @@ four figures, side by side in one run.
 For each figure (configs/fig3a.yaml, fig3b, fig4a, fig4b; 19 200 points each) three
 settings run through the same sweep dispatch (``compute.sweep.run_rows``) in one process:
 
-- ``today``: the step rule before issue 28, set explicitly: one step per point, the
+- ``today``: the step rule before the current one, set explicitly: one step per point, the
   shortest of the spring period while rocking, the pulse period, 2 pi and the pulse's
   rocking scale over 5 steps (``legacy_rows``), event_tol 1e-6, rotation_step 0.25, no
   certification;
@@ -59,7 +59,7 @@ pulse: {shape: [sine, cosine], w_over_p: {start: 4, stop: 12, num: 40},
 
 
 def legacy_rows(scene, rows: np.ndarray) -> np.ndarray:
-    """The rows of today's step rule (before issue 28) at 5 steps per period: one step
+    """The rows of today's step rule (before the current one) at 5 steps per period: one step
     min(2 pi/omega_rock, 2 pi/omega, 2 pi, 2 pi/omega_amp)/5 for the whole run, the step
     cap from it (20 x t_end/dt + 200 x max_events), certification off (PAR_CLOSE 0)."""
     out = rows.copy()

@@ -1,4 +1,4 @@
-"""The kernel's contact outputs against the reference path (issue 14).
+"""The kernel's contact outputs against the reference path.
 
     python scripts/contact_check.py configs/fig4a.yaml --points 30 [--seed 0]
 

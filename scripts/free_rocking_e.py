@@ -26,7 +26,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def free_rocking_e(scene_path: Path, law: str = "vertical", theta0: float = 0.8,
                    n_impacts: int = 4, floor: float = 0.05) -> tuple[list[float], float]:
-    from rocksweep.compute.single import history_capacity
+    from rocksweep.compute.dispatch import history_capacity
     from rocksweep.kernel import layout as L
     from rocksweep.kernel import point_kernel
     from rocksweep.physics.points import Point, kernel_kind, point_row

@@ -1,4 +1,4 @@
-"""Hostile probe of issue 32: every case of the issue (except the fragility/IDA argument
+"""Hostile probe: every hostile-input case (except the fragility/IDA argument
 errors), run against the command line or the Python API in a fresh directory.
 
     python scripts/hostile_probe.py            # every case

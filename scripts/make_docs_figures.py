@@ -113,7 +113,7 @@ def main(argv: list[str] | None = None) -> None:
                       str(args.dpi))
             publish("fragility")
             print(f"  fragility: {time.perf_counter() - t0:.1f} s", flush=True)
-        if "risk" in wanted:  # issue 29: IM efficiency and risk on the demo suite
+        if "risk" in wanted:  # IM efficiency and risk on the demo suite
             h5 = (args.keep or tmp) / "fragility.h5"
             if not h5.exists():
                 rocksweep("sweep", str(cfg / "fragility-demo.yaml"), "-o", str(h5),
@@ -127,7 +127,7 @@ def main(argv: list[str] | None = None) -> None:
                       "--plot", str(tmp / "risk.png"), "--dpi", str(args.dpi))
             publish("efficiency")
             publish("risk")
-        if "impact_laws" in wanted:  # issue 21: which laws overturn each cell
+        if "impact_laws" in wanted:  # which laws overturn each cell
             h5 = (args.keep or tmp) / "impact_laws.h5"
             rocksweep("sweep", str(cfg / "impact-laws.yaml"), "-o", str(h5), "--jobs",
                       str(args.jobs), "--quiet", "--overwrite")

@@ -1,4 +1,4 @@
-"""Accuracy of every stored quantity far outside the paper's region (issue 15).
+"""Accuracy of every stored quantity far outside the paper's region.
 
 Draws a sample of random points over a wide Pi space (fixed seed): flexible bodies with
 wn/p in [1, 60] (log-uniform), zeta in [0, 0.3] (a sixth exactly 0), alpha_cg in

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from bodies import FIG3_YAML
 
 from rocksweep import errors
 
@@ -40,16 +41,9 @@ def test_every_error_class_lives_in_errors_py():
     assert not elsewhere, "error classes outside rocksweep/errors.py:\n" + "\n".join(elsewhere)
 
 
-def test_old_import_paths_keep_working():
-    from rocksweep.analysis.spectrum import SpectrumError
-    from rocksweep.compute.adaptive import AdaptiveError
-    from rocksweep.figures.diagrams import DiagramError
-    from rocksweep.scene.model import SceneError
-    from rocksweep.store._common import StoreError
-
-    assert SceneError is errors.SceneError and StoreError is errors.StoreError
-    assert issubclass(DiagramError, errors.FigureError) and SpectrumError is errors.SpectrumError
-    assert issubclass(errors.BoundaryError, AdaptiveError)
+def test_error_classes_form_one_hierarchy():
+    assert issubclass(errors.DiagramError, errors.FigureError)
+    assert issubclass(errors.BoundaryError, errors.AdaptiveError)
     assert all(issubclass(getattr(errors, n), errors.RocksweepError)
                for n in dir(errors) if n.endswith("Error") and n != "RocksweepError")
 
@@ -74,7 +68,8 @@ def test_rtol_and_integer_checks_have_one_wording():
 
 def test_adaptive_settings_are_checked_once_with_the_schema_wording():
     from rocksweep.cli.main import said
-    from rocksweep.compute.adaptive import AdaptiveError, Options, Plan, check_settings
+    from rocksweep.compute.adaptive import Options, Plan, check_settings
+    from rocksweep.errors import AdaptiveError
 
     with pytest.raises(AdaptiveError) as err:
         check_settings({"margin": 9, "seed": 1})
@@ -127,8 +122,7 @@ def test_the_scan_sees_an_option():
     assert not OPTION.search("use overwrite=True; a-b--c; e.g. 1e-3")
 
 
-SCENE = ("name: t\nbody: {wn_over_p: 2.43, zeta: 0.05, alpha_cg: 0.15, alpha_A: 0.28, "
-         "mA_over_m: 0.47, IA_ratio: 0.56}\nimpact: {lam: [0.0, 0.2]}\n"
+SCENE = ("name: t\n" + FIG3_YAML + "impact: {lam: [0.0, 0.2]}\n"
          "pulse: {shape: sine, w_over_p: [1.0, 2.0], A_ratio: [1.0, 2.0]}\n")
 
 

@@ -27,7 +27,7 @@ FLOORS: list[tuple[str, ...]] = [
     ("compute",),
     ("analysis",),
     ("figures",),
-    ("api", "accessor", "simulation", "__init__"),
+    ("api", "simulation", "__init__"),
     ("cli", "__main__"),
 ]
 

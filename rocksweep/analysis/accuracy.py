@@ -41,12 +41,13 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from rocksweep import fields
+from rocksweep.errors import SceneError
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import warm_up
 from rocksweep.numerics import PRESETS, Numerics
-from rocksweep.scene.model import Scene, SceneError
+from rocksweep.scene.model import Scene
 from rocksweep.vocab.axes import DIAGRAM_AXES, RECORD_X
-from rocksweep.vocab.outcomes import CLASSES
+from rocksweep.vocab.outcomes import CLASSES, FLAGGED, OUTCOME_NOT_RUN, OUTCOME_SAFE
 from rocksweep.vocab.settings import DEFAULT_PRESET, DEFAULT_SAMPLE_SEED, ROOTS
 
 OUTCOMES = CLASSES  # codes 0, 1, 2
@@ -260,7 +261,7 @@ def sample_scene(scene: Scene, n: int | None, seed: int = DEFAULT_SAMPLE_SEED) -
     if n is None or n >= grid.size:
         return Sample(np.arange(grid.size, dtype=np.int64), np.zeros(grid.size, np.int64),
                       np.ones(grid.size), ["all"], np.array([grid.size], np.int64),
-                      grid.size, np.full(grid.size, L.OUTCOME_NOT_RUN, np.int8), 0.0)
+                      grid.size, np.full(grid.size, OUTCOME_NOT_RUN, np.int8), 0.0)
     t0 = time.perf_counter()
     outcome = sweep_arrays(scene)[0]["outcome"]
     secs = time.perf_counter() - t0
@@ -385,7 +386,7 @@ def point_errors(k: np.ndarray, r: np.ndarray, alpha_ref: np.ndarray,
     """
     ko, ro = k[:, L.OUT_OUTCOME], r[:, L.OUT_OUTCOME]
     nan = np.full(len(k), np.nan)
-    both_safe = (ko == L.OUTCOME_SAFE) & (ro == L.OUTCOME_SAFE)
+    both_safe = (ko == OUTCOME_SAFE) & (ro == OUTCOME_SAFE)
     d_theta = np.where(both_safe, np.abs(k[:, L.OUT_THETA_MAX] - r[:, L.OUT_THETA_MAX])
                        / alpha_ref, nan)
     d_imp = np.abs(k[:, L.OUT_T_FIRST_IMPACT] - r[:, L.OUT_T_FIRST_IMPACT])
@@ -455,7 +456,7 @@ def estimate_scores(k: np.ndarray, half: np.ndarray, r: np.ndarray,
                   "real": int((flagged & (e > bound / 2)).sum()),
                   "ratio": float(np.median(x[above] / e[above])) if above.any() else math.nan}
     st = k[:, L.OUT_STATUS].astype(np.int64) | r[:, L.OUT_STATUS].astype(np.int64)
-    wrong = ((st & L.STATUS_FLAGGED) == 0) & (k[:, L.OUT_OUTCOME] != r[:, L.OUT_OUTCOME])
+    wrong = ((st & FLAGGED) == 0) & (k[:, L.OUT_OUTCOME] != r[:, L.OUT_OUTCOME])
     changes = half[:, L.OUT_OUTCOME] != k[:, L.OUT_OUTCOME]
     out["outcome"] = {"wrong": int(wrong.sum()), "wrong_changes": int((wrong & changes).sum()),
                       "changes": int(changes.sum())}
@@ -664,7 +665,7 @@ def accuracy_study(scene: Scene, n_points: int | None = 200,
         outs_e = run_energy(scene, sample.flat, numerics)
         agree = outs[:, L.OUT_OUTCOME] == ref[:, L.OUT_OUTCOME]
         share, se = _agreement(agree, sample)
-        flagged = int(np.sum((outs[:, L.OUT_STATUS].astype(np.int64) & L.STATUS_FLAGGED) != 0))
+        flagged = int(np.sum((outs[:, L.OUT_STATUS].astype(np.int64) & FLAGGED) != 0))
         errors = point_errors(outs, ref, cr.alpha_ref, outs_e, e_ref)
         half = run_half(scene, sample.flat, numerics) if check else None
         results.append(SettingResult(
@@ -760,7 +761,7 @@ def format_table(study: Study) -> str:
         lines.append("  flagged runs (horizon, caps, nonfinite): "
                      + ", ".join(f"{nm} {c}" for nm, c in flagged))
     ref_flagged = int(np.sum((study.reference[:, L.OUT_STATUS].astype(np.int64)
-                              & L.STATUS_FLAGGED) != 0))
+                              & FLAGGED) != 0))
     if ref_flagged:
         lines.append(f"  reference flagged runs: {ref_flagged}")
     if study.reference_anomalies is not None and study.reference_anomalies.any():

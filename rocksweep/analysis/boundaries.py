@@ -30,17 +30,20 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from rocksweep.analysis.bisection import bisect_thresholds
-from rocksweep.analysis.tolerance import DEFAULT_RTOL, MAX_RTOL, check_rtol
-from rocksweep.compute.adaptive import DIAGRAM_AXES, AdaptiveError, make_plan
+from rocksweep.analysis.tolerance import DEFAULT_RTOL
+from rocksweep.compute.adaptive import make_plan
 from rocksweep.compute.dispatch import run_variant
-from rocksweep.errors import BoundaryError  # noqa: F401 (re-exported)
+from rocksweep.errors import (
+    MAX_RTOL,
+    AdaptiveError,
+    BoundaryError,
+    check_rtol,
+)
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import warm_up
 from rocksweep.numerics import MAX_POINT_STEPS, Numerics
-from rocksweep.outcomes import outcome_word
 from rocksweep.physics.points import (
-    RECORD,
     Point,
     body_omega_rock,
     body_row,
@@ -53,11 +56,14 @@ from rocksweep.physics.points import (
 )
 from rocksweep.scene.grid import Grid
 from rocksweep.scene.model import Scene
+from rocksweep.vocab.axes import DIAGRAM_AXES
+from rocksweep.vocab.ground import RECORD
+from rocksweep.vocab.outcomes import OUTCOME_MODE1, OUTCOME_MODE2, outcome_word
 
 if TYPE_CHECKING:
     from rocksweep.store.reader import SweepResult
 
-OVERTURNED = (L.OUTCOME_MODE1, L.OUTCOME_MODE2)
+OVERTURNED = (OUTCOME_MODE1, OUTCOME_MODE2)
 
 
 # --- panels -----------------------------------------------------------------------------
@@ -463,7 +469,7 @@ def a_min(scene: Scene, outcome: np.ndarray, rtol: float = DEFAULT_RTOL,
     runs' step caps would exceed MAX_REFINE_STEPS.
     """
     rtol = check_rtol(rtol, AdaptiveError)
-    if mode not in (None, L.OUTCOME_MODE1, L.OUTCOME_MODE2):
+    if mode not in (None, OUTCOME_MODE1, OUTCOME_MODE2):
         raise AdaptiveError(f"mode = {mode!r}: must be None (any), 1 or 2")
     target = OVERTURNED if mode is None else (mode,)
     yv = check_amplitudes(scene, axes[1])
@@ -623,18 +629,13 @@ CURVE_SUFFIXES = (".csv", ".h5", ".hdf5")  # ``rocksweep boundaries -o``: CSV or
 # --- result files -----------------------------------------------------------------------
 
 
-def scene_of(result: SweepResult) -> Scene:
-    """The scene a result was computed from (``rocksweep.store.reader.result_scene``)."""
-    from rocksweep.store.reader import result_scene
-
-    return result_scene(result)
-
-
 def check_result(result: SweepResult, axes: Sequence[str] | None = None) -> Scene:
     """The scene of a complete result with the diagram axes ``axes`` (x, y; None: the
     scene's, ``default_axes``); one-line BoundaryErrors for a result that has no such
     diagram or is not finished."""
-    sc = scene_of(result)
+    from rocksweep.store.reader import result_scene
+
+    sc = result_scene(result)
     axes = default_axes(sc) if axes is None else axes
     try:
         check_amplitudes(sc, axes[1])

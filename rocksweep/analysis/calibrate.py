@@ -80,15 +80,14 @@ import numpy as np
 
 from rocksweep.analysis.peaks import Peaks, alignment_cost, excursions, hermite, onset
 from rocksweep.compute.dispatch import run_variant
-from rocksweep.errors import CalibrationError, RocksweepError, set_key  # noqa: F401 (CalibrationError re-exported)
+from rocksweep.errors import BodyError, CalibrationError, set_key
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import warm_up
 from rocksweep.numerics import Numerics, step_budget
-from rocksweep.physics.bodies import BodyError
 from rocksweep.physics.measured import Measured, noise_level, read_measured
-from rocksweep.physics.points import INITIAL, kernel_kind, point_row
+from rocksweep.physics.points import kernel_kind, point_row
 from rocksweep.schema import KEYS, fmt
-from rocksweep.vocab.axes import axis_name
+from rocksweep.vocab.axes import INITIAL, axis_name
 from rocksweep.vocab.kinds import CALIBRATION, KIND_ATTR
 from rocksweep.vocab.laws import CONSTANT, LAWS
 

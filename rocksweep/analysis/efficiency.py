@@ -36,13 +36,12 @@ from scipy.special import log_ndtr
 
 from rocksweep.analysis.fragility import fit_cloud
 from rocksweep.analysis.states import counted_points, state_reached, trust
-from rocksweep.errors import EfficiencyError, RocksweepError  # noqa: F401 (re-exported)
+from rocksweep.errors import EfficiencyError
 from rocksweep.physics.bodies import G
-from rocksweep.physics.suite import RECORD_IMS
 from rocksweep.vocab.axes import ALPHA_KEYS
-from rocksweep.vocab.ground import PGA_RATIO, PGV_OVER_PGA, PGV_RATIO, SA, SCALE_IMS
+from rocksweep.vocab.ground import PGA_RATIO, PGV_OVER_PGA, PGV_RATIO, RECORD_IMS, SA, SCALE_IMS
 
-__all__ = ["EfficiencyError", "im_efficiency", "record_im_table"]
+__all__ = ["im_efficiency", "record_im_table"]
 
 
 

@@ -31,14 +31,10 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import FloorError
 
 ORIENTATIONS = ("each", "worst")
 FLOOR_X = "floor.period"
-
-
-class FloorError(RocksweepError):
-    """A Dataset that has no floor spectrum or orientation to give (one line)."""
 
 
 def worst_orientation(ds):

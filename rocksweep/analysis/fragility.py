@@ -102,7 +102,7 @@ from rocksweep.fields import plain
 from rocksweep.vocab.ground import AVGSA
 from rocksweep.vocab.outcomes import MODE1, MODE2
 
-__all__ = ["DEFAULT_BOOTSTRAP", "Fit", "FragilityWarning", "REASONS", "STRIPE_IMS",
+__all__ = ["Fit", "REASONS",
            "curves_json", "fit_cloud", "fit_stripes", "fragility", "probability"]
 
 #: the quality words that follow how a fit ended (``likelihood.ENDINGS``)

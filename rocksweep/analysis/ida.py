@@ -32,10 +32,11 @@ from rocksweep.errors import IdaError, check_rtol
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.store.reader import as_result, result_scene
+from rocksweep.vocab.outcomes import FLAGGED, OUTCOME_MODE1, OUTCOME_MODE2
 
 # Bisection steps at most (a relative tolerance of 1e-12 takes ~40 from a stripe gap).
 MAX_ITER = 60
-OVERTURNED = (L.OUTCOME_MODE1, L.OUTCOME_MODE2)
+OVERTURNED = (OUTCOME_MODE1, OUTCOME_MODE2)
 
 
 def ida(ds: Any, rtol: float = 1e-2) -> Any:
@@ -75,7 +76,7 @@ def ida(ds: Any, rtol: float = 1e-2) -> Any:
             pt = dataclasses.replace(points[i],
                                      A_ratio=points[i].A_ratio * mid / s.levels[b.first[i]])
             out = run_point(pt, scene.numerics, history=False).out
-            flagged = int(out[L.OUT_STATUS]) & L.STATUS_FLAGGED
+            flagged = int(out[L.OUT_STATUS]) & FLAGGED
             classes.append(UNDECIDED if flagged else int(out[L.OUT_OUTCOME]))
         return classes
 
@@ -111,7 +112,7 @@ def _stripes(result: Any) -> _Stripes:
     dims = list(result.dims)
     others = [d for d in dims if d not in (im, "record")]
     perm = [dims.index(d) for d in [*others, "record", im]]
-    flagged = np.transpose((np.asarray(result.arrays["status"]) & L.STATUS_FLAGGED) != 0,
+    flagged = np.transpose((np.asarray(result.arrays["status"]) & FLAGGED) != 0,
                            perm)
     modes = np.transpose(outcome, perm)
     over = np.isin(modes, OVERTURNED) & ~flagged

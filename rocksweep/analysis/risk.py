@@ -56,13 +56,13 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from rocksweep.errors import Arg, RiskError, RocksweepError  # noqa: F401 (re-exported)
+from rocksweep.errors import Arg, RiskError
 from rocksweep.inputs import check_columns, csv_table, number, number_column, read_text
 from rocksweep.outputs import shown
 from rocksweep.physics.bodies import G
 from rocksweep.vocab.ground import ARIAS, AVGSA, CAV, PGA, PGV, SA, SCALE_IMS
 
-__all__ = ["Hazard", "RiskError", "fragility_median", "hazard_frame", "read_hazard",
+__all__ = ["Hazard", "fragility_median", "hazard_frame", "read_hazard",
            "risk"]
 
 SUB = 8  # at most this many pieces per hazard segment, 2 Gauss-Legendre nodes each

@@ -34,8 +34,11 @@ from rocksweep.analysis.boundaries import (
     grid_response,
     kernel_evaluator,
 )
-from rocksweep.analysis.tolerance import DEFAULT_RTOL, check_rtol
-from rocksweep.errors import SpectrumError  # noqa: F401 (defined there; re-exported)
+from rocksweep.analysis.tolerance import DEFAULT_RTOL
+from rocksweep.errors import (
+    SpectrumError,
+    check_rtol,
+)
 from rocksweep.vocab.outcomes import MODE_WORDS, OUTCOME_WORDS, flag_attrs
 
 

@@ -17,8 +17,18 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.errors import FragilityError
-from rocksweep.kernel import layout as L
-from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, STATES, THETA_STATE, UPLIFT
+from rocksweep.vocab.outcomes import (
+    FLAGGED,
+    MODE1,
+    MODE2,
+    OUTCOME_MODE1,
+    OUTCOME_MODE2,
+    OUTCOME_NOT_RUN,
+    OVERTURN,
+    STATES,
+    THETA_STATE,
+    UPLIFT,
+)
 
 STATE_WORDS = (*STATES, THETA_STATE)
 
@@ -105,13 +115,13 @@ def state_reached(ds: xr.Dataset, state: str) -> xr.DataArray:
     """bool DataArray (the outcome's dims): the point reaches ``state`` (``parse_state``)."""
     kind, x = parse_state(state)
     out = required(ds, "outcome", "outcome codes")
-    over = (out == L.OUTCOME_MODE1) | (out == L.OUTCOME_MODE2)
+    over = (out == OUTCOME_MODE1) | (out == OUTCOME_MODE2)
     if kind == "overturn":
         return over
     if kind == "mode1":
-        return out == L.OUTCOME_MODE1
+        return out == OUTCOME_MODE1
     if kind == "mode2":
-        return out == L.OUTCOME_MODE2
+        return out == OUTCOME_MODE2
     if kind == "uplift":
         return (required(ds, "uplifts", f"state {state}") > 0) | over
     return (required(ds, "theta_max_over_alpha", f"state {state}") >= x) | over
@@ -124,8 +134,8 @@ def counted_points(ds: xr.Dataset) -> tuple[xr.DataArray, xr.DataArray, xr.DataA
     -1 and not flagged; counted = neither."""
     out = required(ds, "outcome", "outcome codes")
     status = required(ds, "status", "status bit flags: flagged points are excluded")
-    flagged = (status.astype(np.int64) & int(L.STATUS_FLAGGED)) != 0
-    not_run = (out == L.OUTCOME_NOT_RUN) & ~flagged
+    flagged = (status.astype(np.int64) & FLAGGED) != 0
+    not_run = (out == OUTCOME_NOT_RUN) & ~flagged
     return ~flagged & ~not_run, flagged, not_run
 
 

@@ -17,15 +17,17 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rocksweep.fields import THETA_REL_FLOOR, plain
-from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.vocab.axes import axis_name
 from rocksweep.vocab.outcomes import (
     COMPUTED,
     FILLED,
+    FLAGGED,
     LIFTS_OFF,
     MODE1,
     MODE2,
     OUTCOME_CODE,
+    OUTCOME_NOT_RUN,
+    OUTCOME_SAFE,
     SAFE,
     SLIDES,
     STATUS_BIT,
@@ -65,11 +67,11 @@ def class_counts(result: SweepResult, by: Sequence[str]) -> list[dict]:
     rest = [i for i in range(len(result.dims)) if i not in pos]
     shape = [result.shape[i] for i in pos]
     o = np.transpose(out, [*pos, *rest]).reshape(*shape, -1)
-    fl = np.transpose((status & L.STATUS_FLAGGED) != 0, [*pos, *rest]).reshape(o.shape)
-    fl &= o != L.OUTCOME_NOT_RUN
+    fl = np.transpose((status & FLAGGED) != 0, [*pos, *rest]).reshape(o.shape)
+    fl &= o != OUTCOME_NOT_RUN
     contact = bool(getattr(result, "scene", {}).get("contact"))
     extra = {c: np.transpose((status & STATUS_BIT[c]) != 0, [*pos, *rest]).reshape(o.shape)
-             & (o != L.OUTCOME_NOT_RUN) for c in (CONTACT_COUNTS if contact else ())}
+             & (o != OUTCOME_NOT_RUN) for c in (CONTACT_COUNTS if contact else ())}
     rows = []
     for idx in np.ndindex(*shape):
         label = {d: (plain(result.coords[d][idx[swept.index(d)]]) if d in swept
@@ -78,7 +80,7 @@ def class_counts(result: SweepResult, by: Sequence[str]) -> list[dict]:
         rows.append({**label,
                      **{w: int((cell == OUTCOME_CODE[w]).sum()) for w in CLASSES[:3]},
                      "flagged": int(fl[idx].sum()),
-                     "not_computed": int((cell == L.OUTCOME_NOT_RUN).sum()),
+                     "not_computed": int((cell == OUTCOME_NOT_RUN).sum()),
                      **{c: int(v[idx].sum()) for c, v in extra.items()}})
     return rows
 
@@ -192,9 +194,9 @@ def check_info(result: SweepResult) -> dict | None:
         return None
     a = result.arrays
     out, chk = np.asarray(a["outcome"]), np.asarray(a["check_outcome"])
-    run = out != L.OUTCOME_NOT_RUN
+    run = out != OUTCOME_NOT_RUN
     theta = np.asarray(a["theta_max_over_alpha"])
-    safe = run & (out == L.OUTCOME_SAFE) & (chk == L.OUTCOME_SAFE) & (theta >= THETA_REL_FLOOR)
+    safe = run & (out == OUTCOME_SAFE) & (chk == OUTCOME_SAFE) & (theta >= THETA_REL_FLOOR)
     with np.errstate(invalid="ignore", divide="ignore"):
         rel = np.abs(np.asarray(a["check_theta_max_diff"])[safe]) / theta[safe]
     return {"points": int(run.sum()),

@@ -27,13 +27,12 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.analysis.kinds import dataset_kind
-from rocksweep.errors import RocksweepError, TableError  # noqa: F401 (re-exported)
+from rocksweep.errors import TableError
 from rocksweep.physics.bodies import G
-from rocksweep.physics.suite import RECORD_IMS
 from rocksweep.vocab.axes import ALPHA_KEYS
-from rocksweep.vocab.ground import SA, SCALE_IMS
+from rocksweep.vocab.ground import RECORD_IMS, SA, SCALE_IMS
 
-__all__ = ["ROW_VARIABLE", "TableError", "table"]
+__all__ = ["ROW_VARIABLE", "table"]
 
 #: the variable whose dims are a kind's rows
 ROW_VARIABLE = {"sweep": "outcome", "fragility": ("im_median", "median"), "ida": "ida_im",

@@ -5,8 +5,4 @@ numba, h5py or matplotlib)."""
 
 from __future__ import annotations
 
-from rocksweep.errors import MAX_RTOL, check_rtol
-
-__all__ = ["DEFAULT_RTOL", "MAX_RTOL", "check_rtol"]
-
 DEFAULT_RTOL = 1e-3

@@ -7,15 +7,8 @@ from pathlib import Path
 
 import click
 
-from rocksweep.cli.main import (
-    load,
-    main,
-    overwrite_option,
-    scene_argument,
-    set_option,
-    user_errors,
-)
-from rocksweep.cli.options import seed_option
+from rocksweep.cli.main import load, main, user_errors
+from rocksweep.cli.options import overwrite_option, scene_argument, seed_option, set_option
 from rocksweep.vocab.settings import (
     DEFAULT_LADDER,
     DEFAULT_SAMPLE_SEED,

@@ -105,7 +105,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
 
     inputs = result_inputs(result_path)  # the result and its records: never written over
     check_table_outputs(out_path, fig_path, CURVE_SUFFIXES, inputs, overwrite)
-    from rocksweep.analysis.fragility import FragilityWarning
+    from rocksweep.errors import FragilityWarning
 
     ds = rocksweep.open(result_path)
     # --rtol's IDA first: refused, it says so in one line before any word about the fit

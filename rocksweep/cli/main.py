@@ -16,7 +16,6 @@ from pathlib import Path
 import click
 
 import rocksweep
-from rocksweep.cli.options import overwrite_option, scene_argument, set_option  # noqa: F401
 from rocksweep.errors import Arg, RocksweepError, one_line
 
 # The library's argument names whose option is not ``--NAME`` (underscores as dashes)

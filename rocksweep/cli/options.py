@@ -21,8 +21,9 @@ from typing import Any
 import click
 
 from rocksweep.analysis.resampling import DEFAULT_CI, check_ci
-from rocksweep.analysis.tolerance import DEFAULT_RTOL, MAX_RTOL
+from rocksweep.analysis.tolerance import DEFAULT_RTOL
 from rocksweep.compute.arguments import CONNECT_TIMEOUT, MAX_CONNECT_TIMEOUT
+from rocksweep.errors import MAX_RTOL
 from rocksweep.figures import DEFAULT_DPI, DPI_RANGE, WIDTHS
 from rocksweep.vocab import settings as _settings
 from rocksweep.vocab.axes import DIAGRAM_AXES
@@ -64,7 +65,7 @@ def checked_by(check: Callable[[Any], Any]) -> Callable[..., Any]:
 
 
 def _check_rtol(value: float) -> float:
-    from rocksweep.analysis.tolerance import check_rtol
+    from rocksweep.errors import check_rtol
 
     return check_rtol(value)
 

@@ -9,15 +9,8 @@ from pathlib import Path
 
 import click
 
-from rocksweep.cli.main import (
-    load,
-    main,
-    overwrite_option,
-    scene_argument,
-    set_option,
-    user_errors,
-)
-from rocksweep.cli.options import json_option
+from rocksweep.cli.main import load, main, user_errors
+from rocksweep.cli.options import json_option, overwrite_option, scene_argument, set_option
 from rocksweep.vocab.laws import CONSTANT, LAWS, LOCKED, law_origin
 
 

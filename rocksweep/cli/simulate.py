@@ -9,19 +9,11 @@ from pathlib import Path
 
 import click
 
-from rocksweep.cli.main import (
-    load,
-    main,
-    overwrite_option,
-    said,
-    scene_argument,
-    set_option,
-    user_errors,
-)
-from rocksweep.cli.options import json_option
+from rocksweep.cli.main import load, main, said, user_errors
+from rocksweep.cli.options import json_option, overwrite_option, scene_argument, set_option
 from rocksweep.vocab.axes import alpha_symbol
 
-MAX_POINTS = 12  # = rocksweep.api.MAX_RUNS: simulate overlays a few runs
+MAX_POINTS = 12  # = rocksweep.compute.history.MAX_RUNS: simulate overlays a few runs
 
 
 @main.command()
@@ -62,7 +54,7 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
         check_output(plot_path, overwrite=overwrite, inputs=scene.inputs, suffixes=FORMATS)
     if csv_path is not None:
         check_output(csv_path, overwrite=overwrite, inputs=scene.inputs)
-    from rocksweep.scene.model import SceneError
+    from rocksweep.errors import SceneError
 
     try:
         runs = run_points(scene, MAX_POINTS)
@@ -99,7 +91,7 @@ def _json_safe(d: dict) -> dict:
 
 
 def _print_run(r, swept: list[str]) -> None:
-    from rocksweep.api import swept_values
+    from rocksweep.compute.history import swept_values
 
     s = r.summary()
     where = ", ".join(f"{k}={v}" for k, v in zip(swept, swept_values(r, swept), strict=True))

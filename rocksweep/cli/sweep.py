@@ -94,9 +94,9 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
         overrides = (*overrides, "outputs.contact=true")
     if check:
         overrides = (*overrides, "outputs.check=true")
-    from rocksweep import api
-    from rocksweep.compute.adaptive import check_settings
+    from rocksweep.compute.adaptive import adaptive_options, check_settings
     from rocksweep.compute.arguments import check_sweep_arguments
+    from rocksweep.compute.driver import SweepInterrupted
     from rocksweep.compute.session import sweep as sweep_checked
 
     # the arguments that need no scene, before it is read (checked once: handed down)
@@ -116,7 +116,7 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     if given and not (adaptive or scene.refine is not None):
         raise click.ClickException(f"--{given[0].replace('_', '-')} is a setting of "
                                    "adaptive sweeps; add --adaptive")
-    options = api.adaptive_options(adaptive, base=scene.refine, **settings)
+    options = adaptive_options(adaptive, base=scene.refine, **settings)
     if dry_run:
         from rocksweep.compute.sweep import estimate
 
@@ -133,7 +133,7 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     try:
         report = sweep_checked(scene, out, args, overrides=overrides, progress=not quiet,
                                log=say, inputs=[scene_path], adaptive=options)
-    except api.SweepInterrupted as stop:
+    except SweepInterrupted as stop:
         r = stop.report
         click.echo(f"\ninterrupted: {r.points_done} of {r.points_total} points saved in "
                    f"{out}; finish with: rocksweep sweep {scene_path} -o {out} --resume",

@@ -57,7 +57,7 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.errors import AdaptiveError, ApiError, Arg  # noqa: F401 (AdaptiveError: re-exported)
+from rocksweep.errors import AdaptiveError, ApiError, Arg
 from rocksweep.scene.grid import ChunkRows, Grid
 from rocksweep.scene.model import Scene
 from rocksweep.schema import check_option

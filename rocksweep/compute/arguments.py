@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from typing import Any
 from urllib.parse import urlsplit
 
-from rocksweep.errors import Arg, SweepError, flag, is_integer  # noqa: F401 (SweepError: re-exported)
+from rocksweep.errors import Arg, SweepError, flag, is_integer
 from rocksweep.vocab.settings import BACKENDS, DEFAULT_BACKEND
 
 # Local worker threads allowed per core: the chunk kernels keep a core busy, so threads

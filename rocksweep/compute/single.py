@@ -9,13 +9,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from rocksweep import fields
-from rocksweep.compute.dispatch import history_capacity, run_variant  # noqa: F401 (re-exported)
+from rocksweep.compute.dispatch import run_variant
 from rocksweep.kernel import layout as L
 from rocksweep.kernel import warm_up
 from rocksweep.numerics import Numerics
-from rocksweep.outcomes import outcome_word, status_words
 from rocksweep.physics.points import Point, kernel_kind, point_row
 from rocksweep.vocab.ground import FREE
+from rocksweep.vocab.outcomes import outcome_word, status_words
 
 
 @dataclass

@@ -31,16 +31,14 @@ from rocksweep import (
     fields,
     kernel,  # lazy: numba loads at the first kernel.chunk_kernel
 )
-from rocksweep.compute.arguments import (  # noqa: F401 (re-exported)
+from rocksweep.compute.arguments import (
     CONNECT_TIMEOUT,
-    MAX_JOBS_PER_CORE,
     RETRY,
-    SweepError,
     check_jobs,
     probe_scheduler,
 )
 from rocksweep.compute.dispatch import run_variant
-from rocksweep.errors import flag
+from rocksweep.errors import SweepError, flag
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import point_seconds
 from rocksweep.physics.bodies import G

@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 from rocksweep.analysis.kinds import dataset_kind
-from rocksweep.errors import ApiError, Arg, PlotError, RocksweepError, flag  # noqa: F401 (re-exported)
+from rocksweep.errors import ApiError, Arg, PlotError, flag
 from rocksweep.vocab.kinds import (
     BOUNDARIES,
     CALIBRATION,

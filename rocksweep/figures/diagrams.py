@@ -40,21 +40,29 @@ from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from rocksweep.errors import Arg, DiagramError, flag  # noqa: F401 (DiagramError: re-exported)
+from rocksweep.errors import Arg, DiagramError, flag
 from rocksweep.fields import WORD_AXES
-from rocksweep.figures import DEFAULT_DPI, FORMATS
+from rocksweep.figures import DEFAULT_DPI
 from rocksweep.figures.style import Figure, given_axes, new_axes, save_figure, wrap_title
-from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.store.reader import SweepResult
 from rocksweep.vocab import axes as _axes
 from rocksweep.vocab.axes import DIAGRAM_AXES, RECORD_X
+from rocksweep.vocab.outcomes import (
+    LIFTS_OFF,
+    OUTCOME_MODE1,
+    OUTCOME_MODE2,
+    OUTCOME_NOT_RUN,
+    OUTCOME_SAFE,
+    SLIDES,
+    STATUS_BIT,
+)
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
     from rocksweep.analysis.boundaries import AMinCurve, PanelBoundaries
 
-__all__ = ["FORMATS", "DiagramError", "choose_axes", "stability_diagram", "line_diagram",
+__all__ = ["choose_axes", "stability_diagram", "line_diagram",
            "compare_diagram", "compare_categories",
            "sweep_figure", "stability_figure", "missing_warnings", "categories", "y_label",
            "a_min_figure"]
@@ -93,13 +101,13 @@ def categories(outcome: np.ndarray) -> np.ndarray:
     """
     n_lam = outcome.shape[0]
     cat = np.zeros(outcome.shape[1:], np.int64)
-    done_all = (outcome != L.OUTCOME_NOT_RUN).all(axis=0)
-    cat[done_all & (outcome == L.OUTCOME_SAFE).all(axis=0)] = 1
-    mode1 = outcome == L.OUTCOME_MODE1
+    done_all = (outcome != OUTCOME_NOT_RUN).all(axis=0)
+    cat[done_all & (outcome == OUTCOME_SAFE).all(axis=0)] = 1
+    mode1 = outcome == OUTCOME_MODE1
     first = np.where(mode1.any(axis=0), mode1.argmax(axis=0), n_lam)
     for k in range(n_lam):
         cat[first == k] = 3 + k
-    cat[outcome[0] == L.OUTCOME_MODE2] = 2
+    cat[outcome[0] == OUTCOME_MODE2] = 2
     return cat
 
 
@@ -292,8 +300,8 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
     # contact outputs (outputs.contact, body.mu): points where the model stops holding
     status = np.asarray(result.arrays["status"])
     contact = bool(result.scene.get("contact")) and "status" in result.arrays
-    slides = ((status & L.STATUS_SLIDES) != 0) & result.done
-    lifts = ((status & L.STATUS_LIFTS_OFF) != 0) & result.done
+    slides = ((status & STATUS_BIT[SLIDES]) != 0) & result.done
+    lifts = ((status & STATUS_BIT[LIFTS_OFF]) != 0) & result.done
     # per-point error estimates (outputs.check): the outcome changes at half the step
     unsure = np.zeros(result.shape, bool)
     if "check_outcome" in result.arrays:
@@ -325,11 +333,11 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
         cat = categories(po)
         used[np.unique(cat)] = True
         ax.pcolormesh(xs, ys, cat, cmap=cmap, norm=norm, shading="nearest", rasterized=True)
-        m1_any = po == L.OUTCOME_MODE1
+        m1_any = po == OUTCOME_MODE1
         # mode 1 at some lam, safe at a larger one: against the paper's trend
         later_safe = np.zeros(cat.shape, bool)
         for k in range(n_lam - 1):
-            later_safe |= m1_any[k] & (po[k + 1:] == L.OUTCOME_SAFE).any(axis=0)
+            later_safe |= m1_any[k] & (po[k + 1:] == OUTCOME_SAFE).any(axis=0)
         if later_safe.any():
             any_back = True
             yy, xx = np.nonzero(later_safe)
@@ -349,10 +357,10 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
         if contact:  # hatched where the base would slide (at some lam), outlined: lift-off
             any_slide |= _hatch(ax, xs, ys, sl[idx].any(axis=0), "////", "k")
             any_lift |= _hatch(ax, xs, ys, lo[idx].any(axis=0), "....", "0.25")
-        done = po != L.OUTCOME_NOT_RUN
+        done = po != OUTCOME_NOT_RUN
 
         def share(k: int, po=po, done=done) -> str:
-            return (f"{100 * (po[k] == L.OUTCOME_MODE1).sum() / done[k].sum():.1f}%"
+            return (f"{100 * (po[k] == OUTCOME_MODE1).sum() / done[k].sum():.1f}%"
                     if done[k].any() else "-")
 
         area = ([f"${lam_sym}$ = {_fmt(lv)}: {share(k)}" for k, lv in enumerate(lam)]
@@ -465,13 +473,13 @@ def compare_categories(outcome: np.ndarray) -> np.ndarray:
     overturns the cell (mode 1 or mode 2).
     """
     n = outcome.shape[0]
-    over = (outcome == L.OUTCOME_MODE1) | (outcome == L.OUTCOME_MODE2)
+    over = (outcome == OUTCOME_MODE1) | (outcome == OUTCOME_MODE2)
     mask = np.zeros(outcome.shape[1:], np.int64)
     for k in range(n):
         mask |= over[k].astype(np.int64) << k
     cat = np.where(mask > 0, 2 + mask, 1)
-    cat[(outcome == L.OUTCOME_MODE2).all(axis=0)] = 2
-    cat[(outcome == L.OUTCOME_NOT_RUN).any(axis=0)] = 0
+    cat[(outcome == OUTCOME_MODE2).all(axis=0)] = 2
+    cat[(outcome == OUTCOME_NOT_RUN).any(axis=0)] = 0
     return cat
 
 
@@ -553,8 +561,8 @@ def compare_diagram(result: SweepResult, key: str, x: str | None = None,
         if curves:
             _draw_boundaries(ax, po, xs, ys)
         any_flag |= _mark_flagged(ax, pf, xs, ys)
-        done = po != L.OUTCOME_NOT_RUN
-        area = [f"{lab}: {100 * (po[k] == L.OUTCOME_MODE1).sum() / done[k].sum():.1f}%"
+        done = po != OUTCOME_NOT_RUN
+        area = [f"{lab}: {100 * (po[k] == OUTCOME_MODE1).sum() / done[k].sum():.1f}%"
                 if done[k].any() else f"{lab}: -" for k, lab in enumerate(labels)]
         _label_panel(ax, result, panel_dims, idx, x, y, area)
 
@@ -663,10 +671,10 @@ def friction_map(result: SweepResult, x: str | None = None, y: str | None = None
 
 
 _OUTCOME_STYLE = {  # outcome code -> (marker, face colour, legend label)
-    L.OUTCOME_SAFE: ("o", _SAFE, "safe"),
-    L.OUTCOME_MODE1: ("^", mode1_colours(1)[0], "mode 1 (overturned after impacts)"),
-    L.OUTCOME_MODE2: ("s", _MODE2, "mode 2 (overturned, no impact)"),
-    L.OUTCOME_NOT_RUN: ("o", _NOT_RUN, "not computed"),
+    OUTCOME_SAFE: ("o", _SAFE, "safe"),
+    OUTCOME_MODE1: ("^", mode1_colours(1)[0], "mode 1 (overturned after impacts)"),
+    OUTCOME_MODE2: ("s", _MODE2, "mode 2 (overturned, no impact)"),
+    OUTCOME_NOT_RUN: ("o", _NOT_RUN, "not computed"),
 }
 
 
@@ -708,7 +716,7 @@ def line_diagram(result: SweepResult, x: str | None = None, *,
             colour = cmap(0.85 * k / max(1, len(lam) - 1)) if len(lam) > 1 else "0.3"
             label = f"${_axes.latex('lam')}$ = {_fmt(lv)}" if lv is not None else None
             yv = pv[k].astype(float)
-            yv[po[k] == L.OUTCOME_NOT_RUN] = np.nan
+            yv[po[k] == OUTCOME_NOT_RUN] = np.nan
             ax.plot(xs, yv, "-", color=colour, lw=1.1, label=label, zorder=1)
             for code, (marker, face, _) in _OUTCOME_STYLE.items():
                 sel = po[k] == code
@@ -782,7 +790,7 @@ def _draw_boundaries(ax: Axes, po: np.ndarray, xs: np.ndarray, ys: np.ndarray) -
 def missing_warnings(result: SweepResult) -> list[str]:
     """Warnings for the user about a result (e.g. points not computed yet)."""
     outcome = result.arrays["outcome"]
-    n_missing = int((outcome == L.OUTCOME_NOT_RUN).sum())
+    n_missing = int((outcome == OUTCOME_NOT_RUN).sum())
     if n_missing:
         return [f"{n_missing} of {outcome.size} points not computed yet (grey); "
                 "a resume of the sweep computes them"]
@@ -817,7 +825,7 @@ def a_min_figure(curves: Sequence[AMinCurve], bounds: Sequence[PanelBoundaries] 
     colour per panel (e.g. per lam), solid where the onset is mode 1, dashed where mode 2;
     with the boundary lines of ``bounds`` drawn thin in the same colours when given.
     kind: the body kind (labels the amplitude axis). No pyplot."""
-    from rocksweep.outcomes import outcome_word
+    from rocksweep.vocab.outcomes import outcome_word
 
     fig = Figure(figsize=(6.4, 4.8), layout="constrained")
     ax = fig.add_subplot()
@@ -826,7 +834,7 @@ def a_min_figure(curves: Sequence[AMinCurve], bounds: Sequence[PanelBoundaries] 
         for line in b.lines:
             ax.plot(line.xy[:, 0], line.xy[:, 1], lw=0.5, color=colours[k], alpha=0.5)
     for k, c in enumerate(curves):
-        for m, style in ((L.OUTCOME_MODE1, "-"), (L.OUTCOME_MODE2, "--")):
+        for m, style in ((OUTCOME_MODE1, "-"), (OUTCOME_MODE2, "--")):
             y = np.where(c.mode == m, c.a_min, np.nan)
             ax.plot(c.x, y, style, color=colours[k], lw=1.5, marker=".", ms=2,
                     label=f"{_where_label(c.where)} ({outcome_word(m)})"

@@ -25,7 +25,7 @@ import xarray as xr
 
 from rocksweep.analysis.likelihood import lognormal_cdf
 from rocksweep.analysis.risk import fragility_median
-from rocksweep.errors import FragilityFigureError, RocksweepError  # noqa: F401 (re-exported)
+from rocksweep.errors import FragilityFigureError
 from rocksweep.figures import WIDTHS
 from rocksweep.figures.style import Figure, curve_colours
 

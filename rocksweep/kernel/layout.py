@@ -142,10 +142,10 @@ N_HIST = 11
 
 # --- outcome and status codes ----------------------------------------------------------
 # (codes and words: ``rocksweep.vocab.outcomes``)
-OUTCOME_NOT_RUN = _out.OUTCOME_CODE[_out.NOT_RUN]
-OUTCOME_SAFE = _out.OUTCOME_CODE[_out.SAFE]
-OUTCOME_MODE1 = _out.OUTCOME_CODE[_out.MODE1]  # overturned after one or more impacts
-OUTCOME_MODE2 = _out.OUTCOME_CODE[_out.MODE2]  # overturned without impact
+OUTCOME_NOT_RUN = _out.OUTCOME_NOT_RUN
+OUTCOME_SAFE = _out.OUTCOME_SAFE
+OUTCOME_MODE1 = _out.OUTCOME_MODE1  # overturned after one or more impacts
+OUTCOME_MODE2 = _out.OUTCOME_MODE2  # overturned without impact
 
 STATUS_REST = _out.STATUS_BIT["rest"]
 STATUS_HORIZON = _out.STATUS_BIT["horizon"]  # horizon reached before the outcome was decided

@@ -10,8 +10,9 @@ events are calls (``_cache.INTERNAL``). No kernel function counts references
 (``_nrt=False``), so passing ``prm`` or ``out`` costs nothing beyond the call.
 
 Compile-time specialisation: the functions take the flags FLEX, DAMPED and ENERGY (and
-``simulate_point`` GROUND: every ground motion, not only the paper's sine and cosine; it
-reaches the ground motion as the type of ``on``, see ``equations.ground_acc``) and call
+``simulate_point`` GROUND, ``layout.GROUND_*``: every ground motion, not only the paper's
+sine and cosine, and with a vertical component; it reaches the ground motion as the type
+of ``on``, see ``equations.ground_acc`` and ``equations.ground_gravity``) and call
 ``numba.literally`` on them, so numba compiles one specialisation per flag value (a
 ``Literal[bool]`` type) and the branches a variant does not need are removed at compile
 time (by LLVM: numba still types and lowers them, its own dead-branch pruning does not

@@ -14,8 +14,9 @@ of calls is one more LLVM optimisation of the whole kernel at compile time).
   point_*: one point with energy accounting, the ground reactions and a history buffer
       float64[n, N_HIST] (the reactions cost a single run ~nothing: no variant without)
 
-``chunk_kernel(kind, level)`` and ``point_kernel(kind)`` pick one by ``KIND_*`` and
-``LEVEL_*`` (``layout``); ``warm_up`` compiles (or loads) one now.
+``chunk_kernel(kind, level, ground)`` and ``point_kernel(kind, ground)`` pick one by
+``KIND_*``, ``LEVEL_*`` and ``GROUND_*`` (``layout``); ``warm_up`` compiles (or loads) one
+now.
 """
 
 import numpy as np

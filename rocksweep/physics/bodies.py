@@ -52,7 +52,7 @@ from functools import cached_property
 
 import numpy as np
 
-from rocksweep.errors import BodyError  # noqa: F401 (defined there; re-exported)
+from rocksweep.errors import BodyError
 from rocksweep.schema import BODY_KEYS, check_value, fmt, is_number
 
 G = 9.81  # m/s^2

@@ -56,14 +56,12 @@ from functools import lru_cache
 
 import numpy as np
 
-from rocksweep.vocab.ground import (  # noqa: F401
-    MP,
+from rocksweep.vocab.ground import (
     PAPER_SHAPES,
     RICKER,
     RICKER_TAU0,
     SHAPE_TITLE,
     SHAPES,
-    SINE,
     mp_raw,
     mp_raw_rate,
     pulse_duration,

@@ -56,7 +56,7 @@ import numpy as np
 from rocksweep.physics.bodies import G  # gravity [m/s^2], the one definition
 from rocksweep.vocab.ground import AVGSA_POINTS, SA_DAMPING
 
-__all__ = ["AVGSA_POINTS", "G", "arias", "avg_sa", "avgsa_periods", "cav", "duration",
+__all__ = ["arias", "avg_sa", "avgsa_periods", "cav", "duration",
            "final_velocity", "free_vibration", "husid", "nj_response", "pga", "pgv",
            "refined", "sa", "significant_duration", "velocity"]
 

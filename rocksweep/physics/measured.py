@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.errors import Arg, MeasuredError, RocksweepError  # noqa: F401 (MeasuredError re-exported)
+from rocksweep.errors import Arg, MeasuredError
 from rocksweep.inputs import check_columns, csv_table, number_column, read_text
 from rocksweep.outputs import shown
 

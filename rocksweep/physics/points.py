@@ -25,8 +25,7 @@ from rocksweep.numerics import (
 from rocksweep.physics.bodies import Body, FlexibleBody, G
 from rocksweep.physics.records import GroundRecord, vertical_samples
 from rocksweep.physics.vertical import VerticalHarmonic, air_time_harmonic, air_time_record
-from rocksweep.vocab.axes import INITIAL  # noqa: F401
-from rocksweep.vocab.ground import (  # noqa: F401
+from rocksweep.vocab.ground import (
     CYCLES,
     FREE,
     GAMMA,
@@ -36,11 +35,10 @@ from rocksweep.vocab.ground import (  # noqa: F401
     RECORD,
     RICKER,
     SHAPE_CODE,
-    SHAPES,
     SINE,
     pulse_duration,
 )
-from rocksweep.vocab.laws import DEFAULT_LAW, LAW_CODE, LAWS  # noqa: F401
+from rocksweep.vocab.laws import DEFAULT_LAW, LAW_CODE
 from rocksweep.vocab.settings import ROOT_CODE
 
 if TYPE_CHECKING:

@@ -53,7 +53,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rocksweep.errors import RecordError  # noqa: F401 (defined there; re-exported)
+from rocksweep.errors import RecordError
 from rocksweep.inputs import read_input
 from rocksweep.outputs import check_output, input_problem, shown, write_atomic
 

@@ -37,15 +37,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rocksweep.errors import SuiteError  # noqa: F401 (defined there; re-exported)
+from rocksweep.errors import SuiteError
 from rocksweep.physics.bodies import G
 from rocksweep.physics.records import GroundRecord
-from rocksweep.vocab.ground import (  # noqa: F401
+from rocksweep.vocab.ground import (
     ARIAS,
     AVGSA,
     CAV,
     D5_95,
-    DEFAULT_PERIODS,
     PGA,
     PGA_RATIO,
     PGV,
@@ -53,7 +52,6 @@ from rocksweep.vocab.ground import (  # noqa: F401
     PGV_RATIO,
     RATIO_OF,
     RECORD_IMS,
-    SA,
     SA_DAMPING,
     SCALE_IMS,
 )

@@ -15,20 +15,20 @@ from itertools import product
 
 import numpy as np
 
+from rocksweep.errors import BodyError, SceneError
 from rocksweep.numerics import (
     EVENT_STEP_ALLOWANCE,
     MAX_POINT_STEPS,
     Numerics,
     point_seconds,
 )
-from rocksweep.physics.bodies import BodyError
 from rocksweep.physics.points import (
     body_omega_rock,
     body_zeta_rock,
     record_cost,
     run_cost,
 )
-from rocksweep.scene.model import FLOOR_AXES, Scene, SceneError
+from rocksweep.scene.model import FLOOR_AXES, Scene
 from rocksweep.schema import KEYS, fmt
 
 # Body grids up to this many distinct bodies are checked body by body; larger ones at the
@@ -369,3 +369,22 @@ def _cost_message(scene: Scene, point: dict) -> str:
     else:
         rule = f"{best_key} must be {'<=' if value > tame(best_key) else '>='} {shown}"
     return f"{best_key} = {fmt(value)}: {head}; with the scene's other values {rule}"
+
+
+def check_vertical_cost(scene: Scene) -> None:
+    """Refuse a vertical harmonic whose steps (``numerics.vertical_step``: its period over
+    max(pulse_steps, steps_per_period) while the pulse acts) alone would put a point's
+    step cap above MAX_POINT_STEPS, at the scene's costliest numerics: the largest
+    w_v/p over the longest pulse (the smallest pulse.w_over_p)."""
+    w_v = float(np.max(scene.axis("vertical.w_over_p").values))
+    w = float(np.min(scene.axis("w_over_p").values))
+    t_pulse = scene.phase_max() / w
+    for n, words in _runs(scene):
+        per_rad = max(n.pulse_steps, n.steps_per_period) / (2 * math.pi)
+        cap = n.max_steps_factor * t_pulse * w_v * per_rad
+        if cap > MAX_POINT_STEPS:
+            bound = MAX_POINT_STEPS / (n.max_steps_factor * t_pulse * per_rad)
+            raise SceneError(f"pulse.vertical.w_over_p = {fmt(w_v)}: with pulse.w_over_p = "
+                             f"{fmt(w)} its steps while the pulse acts cap a point at "
+                             f"{cap:.3g} RK4 steps{words}, above {MAX_POINT_STEPS:.0e}; "
+                             f"pulse.vertical.w_over_p must be <= {bound:.3g}")

@@ -19,7 +19,6 @@ import numpy as np
 
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.points import (
-    INITIAL,
     body_omega_rock,
     body_row,
     fill_rows,
@@ -29,6 +28,7 @@ from rocksweep.physics.points import (
 )
 from rocksweep.scene.model import FLOOR_AXES, Scene
 from rocksweep.schema import VERTICAL_KEYS
+from rocksweep.vocab.axes import INITIAL
 from rocksweep.vocab.ground import RECORD
 
 

@@ -10,17 +10,18 @@ from typing import Any
 import numpy as np
 
 from rocksweep import fields
-from rocksweep.errors import SceneError, set_key  # noqa: F401 (SceneError: re-exported)
+from rocksweep.errors import SceneError, set_key
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody, Body, FlexibleBody, G
 from rocksweep.physics.path import GroundPath
-from rocksweep.physics.points import FREE, INITIAL, RECORD, Point
+from rocksweep.physics.points import Point
 from rocksweep.physics.records import GroundRecord, vertical_samples
 from rocksweep.physics.suite import Suite
 from rocksweep.physics.vertical import VerticalHarmonic
 from rocksweep.schema import KEYS
-from rocksweep.vocab.ground import PAPER_SHAPES, pulse_duration
+from rocksweep.vocab.axes import INITIAL
+from rocksweep.vocab.ground import FREE, PAPER_SHAPES, RECORD, pulse_duration
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
 
 #: the one-mode floor's keys, the names of their axes (``floor.period`` is a dimension of

@@ -26,29 +26,24 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.errors import set_key
+from rocksweep.errors import BodyError, RecordError, SceneError, SuiteError, set_key
 from rocksweep.inputs import decode_text, read_input
 from rocksweep.numerics import Numerics
 from rocksweep.outputs import input_problem, is_input, shown
-from rocksweep.physics.bodies import BodyError, body_from_geometry
-from rocksweep.physics.floor import Mode
-from rocksweep.physics.path import GroundPath, check_pair
-from rocksweep.physics.points import FREE, INITIAL, RECORD
-from rocksweep.physics.records import GroundRecord, RecordError, read_record
+from rocksweep.physics.bodies import body_from_geometry
+from rocksweep.physics.records import GroundRecord, read_record
 from rocksweep.physics.suite import (
     AVGSA_RANGE,
     COMPONENTS,
-    DEFAULT_PERIODS,
-    RECORD_IMS,
     ROTD50,
-    SCALE_IMS,
     Suite,
-    SuiteError,
     make_suite,
 )
 from rocksweep.scene.admission import candidate_bodies, check_cost
 from rocksweep.scene.loader import CONTROL_CHARS, YamlError, load_yaml
-from rocksweep.scene.model import FLOOR_AXES, Axis, Scene, SceneError
+from rocksweep.scene.model import Axis, Scene
+from rocksweep.scene.peer import peer_suite
+from rocksweep.scene.vertical import check_vertical_start, pulse_vertical
 from rocksweep.schema import (
     BODY_KEYS,
     KEYS,
@@ -60,8 +55,8 @@ from rocksweep.schema import (
     is_number,
     section_keys,
 )
-from rocksweep.vocab.axes import DIAGRAM_AXES, alpha_symbol, axis_name
-from rocksweep.vocab.ground import MP
+from rocksweep.vocab.axes import DIAGRAM_AXES, INITIAL, alpha_symbol, axis_name
+from rocksweep.vocab.ground import DEFAULT_PERIODS, FREE, MP, RECORD, RECORD_IMS, SCALE_IMS
 from rocksweep.vocab.ground import PULSE_KEY_SHAPES as _PULSE_KEY_SHAPES
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
 from rocksweep.vocab.settings import DEFAULT_PRESET, FINE
@@ -81,7 +76,11 @@ PULSE_KEY_SHAPES = _PULSE_KEY_SHAPES
 
 
 def apply_overrides(raw: dict, overrides: list[str]) -> dict:
-    """Apply ``section.key=VALUE`` overrides (VALUE parsed as YAML) to a raw scene."""
+    """Apply ``section.key=VALUE`` overrides (VALUE parsed as YAML) to a raw scene.
+
+    ``section.key=null`` leaves the key out (its default, or none), the one way an override
+    can take a key away (switching ``impact.law`` away from ``constant`` drops ``impact.e``);
+    a null written in a scene file is refused instead, where it would read as a value."""
     for item in overrides:
         if "=" not in item:
             raise SceneError("{entry}: expected KEY=VALUE, e.g. pulse.A_ratio=4.5",
@@ -97,14 +96,21 @@ def apply_overrides(raw: dict, overrides: list[str]) -> dict:
         except YamlError as err:
             raise SceneError("{key}: value {text} is not valid YAML ({why})",
                              key=set_key(key), text=fmt(text), why=err) from None
-        node = raw
+        node: Any = raw
         for p in parts[:-1]:
             if node.get(p) is None:
+                if value is None:  # the section is not there: nothing to leave out
+                    node = None
+                    break
                 node[p] = {}
             node = node[p]
             if not isinstance(node, dict):
                 raise SceneError("{key}: {p} is not a section", key=set_key(key), p=p)
-        node[parts[-1]] = value
+        if value is None:
+            if node is not None:
+                node.pop(parts[-1], None)
+        else:
+            node[parts[-1]] = value
     return raw
 
 
@@ -405,102 +411,6 @@ def _record(ground: dict, base: Path | None, key: str = "record") -> GroundRecor
         raise SceneError(f"ground.{key}: {err}") from None
 
 
-def _modes(spec: Any) -> tuple[Mode, ...]:
-    """The building's modes of ``floor.modes`` (numbers, each checked as the one-mode
-    form's keys)."""
-    key = "floor.modes"
-    if not (isinstance(spec, list) and spec):
-        raise SceneError(f"{key} = {fmt(spec)}: {KEYS[key].allowed}")
-    out = []
-    for i, m in enumerate(spec):
-        where = f"{key}[{i}]"
-        if not isinstance(m, dict):
-            raise SceneError(f"{where} = {fmt(m)}: {KEYS[key].allowed}")
-        for k in m:
-            if f"floor.{k}" not in FLOOR_AXES:
-                raise SceneError(f"{where}.{k}: unknown key (allowed: period, damping, "
-                                 "participation)")
-        vals = []
-        for k in FLOOR_AXES:
-            short = k.split(".")[1]
-            v = m.get(short)
-            if v is None:
-                raise SceneError(f"{where}.{short}: missing required key "
-                                 f"({KEYS[k].allowed.removeprefix('must be ')})")
-            x = as_float(v) if is_number(v) else math.nan
-            if check_values(k, np.array([x])) is not None or (
-                    k == "floor.participation" and x == 0.0):
-                raise SceneError(f"{where}.{short} = {fmt(v)}: {KEYS[k].allowed}")
-            vals.append(x)
-        out.append(Mode(*vals))
-    return tuple(out)
-
-
-def _excitation_path(raw: dict, ground: dict, kind: str, free: bool,
-                     record: GroundRecord | None, suite: Suite | None, base: Path | None,
-                     physical: dict | None, given_h2: GroundRecord | None = None
-                     ) -> tuple[GroundPath | None, list[tuple[str, str, str, Any]],
-                                tuple[str, ...]]:
-    """A scene's excitation path (``physics.path``): the second horizontal component
-    (``ground.h2``, or a suite's paired H2 files) with the ``angle`` axis, and the
-    ``floor`` section's building (its one-mode keys as axes named ``floor.period``,
-    ``floor.damping``, ``floor.participation``, or ``floor.modes``). Returns (the path,
-    None without those keys; the axes' specs (name, key, form, spec); files read)."""
-    specs: list[tuple[str, str, str, Any]] = []
-    inputs: tuple[str, ...] = ()
-    h2: tuple = ()
-    if ground.get("h2") is not None:
-        if suite is not None:
-            raise SceneError("ground.h2: not with ground.records (a folder of PEER "
-                             "downloads pairs each record's components by name)")
-        second = _record(ground, base, "h2") if given_h2 is None else given_h2
-        why = check_pair(record, second)
-        if why is not None:
-            raise SceneError(f"ground.h2: {second.name}: {why}")
-        h2 = (second,)
-        inputs = (str(second.source),) if given_h2 is None else ()
-    elif suite is not None and any(r is not None for r in suite.h2):
-        h2 = suite.h2
-    if ground.get("angle") is not None and not h2:
-        raise SceneError(f"ground.angle = {fmt(ground['angle'])}: needs the second "
-                         "horizontal component (ground.h2, or a suite of PEER folders with "
-                         "both horizontals)")
-    if h2:
-        specs.append(("angle", "ground.angle",
-                      *_axis_spec("ground.angle", ground.get("angle", 0.0))[:2]))
-    modes = None
-    if raw.get("floor") is not None:
-        if free:
-            raise SceneError(f"floor = {fmt(raw['floor'])}: a free-rocking scene (no pulse "
-                             "or ground section) has no ground motion for a building to "
-                             "carry; give a pulse or a ground motion")
-        sec = _section(raw, "floor", kind, required=False)
-        if sec.get("modes") is not None:
-            for k in FLOOR_AXES:
-                if sec.get(k.split(".")[1]) is not None:
-                    raise SceneError(f"{k}: not with floor.modes (give one mode's keys or "
-                                     "the list of modes)")
-            modes = _modes(sec["modes"])
-        else:
-            for k in FLOOR_AXES:
-                short = k.split(".")[1]
-                if sec.get(short) is None:
-                    raise SceneError(f"{k}: missing required key ({_AXIS_HINT}; or give "
-                                     "floor.modes)")
-                form, spec, _ = _axis_spec(k, sec[short])
-                if k == "floor.participation" and np.any(_axis_values(k, form, spec) == 0):
-                    raise SceneError(f"{k} = 0.0: {KEYS[k].allowed}")
-                specs.append((k, k, form, spec))
-    if not h2 and raw.get("floor") is None:
-        return None, specs, inputs
-    p = float(physical["p"]) if physical is not None else 1.0
-    return (GroundPath(h2=h2, modes=modes, floor=raw.get("floor") is not None, p=p),
-            specs, inputs)
-
-
-_AXIS_HINT = "a number, a list of numbers or a range {start, stop, num}"
-
-
 def _where(v: str, base: Path | None) -> Path:
     """A path of the scene, relative to ``base`` (the scene file's directory), absolute:
     the file records where it read a record (spectra re-read it)."""
@@ -747,7 +657,7 @@ def _suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...] | No
     vertical: tuple = ()
     read: tuple[str, ...] = ()
     if folder is not None:  # read again on a rebuild: the pairs are the folder's
-        records, h2, vertical, names, read = _peer_suite(folder, missing == "skip")
+        records, h2, vertical, names, read = peer_suite(folder, missing == "skip")
     elif given is not None:
         records = list(given)
         names = [Path(r.source).name for r in records]
@@ -786,57 +696,6 @@ def _peer_folder(spec: Any, base: Path | None) -> Path | None:
         return None
     path = _where(entry, base)
     return path if path.is_dir() else None
-
-
-def _peer_suite(folder: Path, skip: bool) -> tuple:
-    """The records of a folder of PEER downloads (``scene.peer``): (H1s, H2s, verticals
-    (empty: none in the folder), names (H1's file names), files read). A record without
-    one of its components is refused with one line, or left out with a RecordWarning
-    (``skip``)."""
-    import warnings
-
-    from rocksweep.physics.suite import RecordWarning
-    from rocksweep.scene.peer import peer_components
-
-    key = "ground.records"
-    files = [p for p in folder.iterdir() if p.suffix.lower() == ".at2" and p.is_file()]
-    comps, _ = peer_components(files)
-    if not comps:
-        raise SceneError(f"{key}: {shown(folder)}: no PEER record files in the folder "
-                         "(RSN<n>_<EVENT>_<STATION><COMPONENT>.AT2)")
-    with_up = any(c.up is not None for c in comps)
-    kept = []
-    for c in comps:
-        miss = c.missing(with_up)
-        if not miss:
-            kept.append(c)
-            continue
-        found = ", ".join(p.name for p in (c.h1, c.h2, c.up) if p is not None)
-        what = f"{c.rsn} has no {' and no '.join(miss)} file (found {found})"
-        need = "H1, H2 and UP" if with_up else "H1 and H2"
-        if not skip:
-            raise SceneError(f"{key}: {shown(folder)}: {what}; every record needs {need} "
-                             "(or ground.missing: skip)")
-        warnings.warn(RecordWarning(f"{key}: {what}: skipped"), stacklevel=2)
-    if not kept:
-        raise SceneError(f"{key}: {shown(folder)}: no record has all its components")
-    h1s, h2s, ups = [], [], []
-    for c in kept:
-        try:
-            one = [read_record(p) for p in (c.h1, c.h2, *([c.up] if with_up else []))]
-        except RecordError as err:
-            raise SceneError(f"{key}: {err}") from None
-        for other, what in zip(one[1:], ("H2", "UP"), strict=False):
-            why = check_pair(one[0], other)
-            if why is not None:
-                raise SceneError(f"{key}: {c.rsn}: {what} {other.name}: " + why.replace(
-                    "the two horizontal components", "the components of a record"))
-        h1s.append(one[0])
-        h2s.append(one[1])
-        ups.append(one[2] if with_up else None)
-    read = tuple(str(p) for c in kept for p in (c.h1, c.h2, c.up) if p is not None)
-    return (h1s, tuple(h2s), tuple(ups) if with_up else (), [c.h1.name for c in kept],
-            read)
 
 
 @dataclasses.dataclass
@@ -900,7 +759,9 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
                          "while the pulse acts; on a floor give the ground motion as a "
                          "record with ground.vertical, which reaches the floor unfiltered)")
     # the orientation and the floor: after the records, before the ground's own axes
-    path, path_specs, path_inputs = _excitation_path(
+    from rocksweep.scene.floors import excitation_path  # it uses this module's helpers
+
+    path, path_specs, path_inputs = excitation_path(
         raw, motion.ground, kind, motion.free, motion.record, motion.suite, base, physical,
         given_h2)
     specs = _axis_specs(kind, body, impact, initial, motion, forms, law_specs, path_specs)
@@ -977,7 +838,7 @@ def _motion(raw: dict, kind: str, base: Path | None, given_record: GroundRecord 
         return _Motion(free=True, pulse={"shape": FREE, "w_over_p": 0.0, "A_ratio": 0.0})
     if raw.get("ground") is None:
         pulse = _section(raw, "pulse", kind, required=True)
-        return _Motion(free=False, pulse=pulse, pulse_vertical=_pulse_vertical(pulse))
+        return _Motion(free=False, pulse=pulse, pulse_vertical=pulse_vertical(pulse))
     ground = _section(raw, "ground", kind, required=True)
     if ground.get("vertical") is not None and ground.get("record") is None:
         raise SceneError(f"ground.vertical = {fmt(ground['vertical'])}: works with one "
@@ -1008,25 +869,6 @@ def _motion(raw: dict, kind: str, base: Path | None, given_record: GroundRecord 
                    record=record, inputs=inputs,
                    vertical=vertical if ground.get("vertical") is not None else None,
                    ground=ground)
-
-
-def _pulse_vertical(pulse: dict) -> dict | None:
-    """The raw keys of ``pulse.vertical`` (a mapping of VERTICAL_KEYS; amplitude and
-    w_over_p required), checked as a section's are; None when not given."""
-    spec = pulse.get("vertical")
-    if spec is None:
-        return None
-    if not isinstance(spec, dict):
-        raise SceneError(f"pulse.vertical = {fmt(spec)}: {KEYS['pulse.vertical'].allowed}")
-    for k in spec:
-        if k not in VERTICAL_KEYS:
-            raise SceneError(f"pulse.vertical.{k}: unknown key (allowed: "
-                             f"{', '.join(VERTICAL_KEYS)})")
-    for k in VERTICAL_KEYS:
-        if KEYS[f"pulse.vertical.{k}"].required and spec.get(k) is None:
-            raise SceneError(f"pulse.vertical.{k}: missing required key (a number, a list "
-                             "of numbers or a range {start, stop, num})")
-    return spec
 
 
 def _outputs(raw: dict, kind: str, mu_spec: Any) -> tuple[bool, bool, bool]:
@@ -1156,39 +998,12 @@ def _admit(scene: Scene) -> None:
         raise SceneError(f"outputs.contact = true: not available with {what} yet; contact "
                          "outputs work with sine and cosine pulses")
     bodies = candidate_bodies(scene)
-    _check_vertical_start(scene)
+    check_vertical_start(scene)
     _check_initial(scene, bodies)
     check_cost(scene, bodies)
     if scene.suite is not None:
         scene.suite.warn(scene.axis(alpha_symbol(scene.kind)).values,
                          scene.axis("p").values)
-
-
-def _check_vertical_start(scene: Scene) -> None:
-    """Refuse (one line) a vertical with g + a_v <= 0 at t = 0 for some point: the body
-    would leave the ground before anything else happens (``airborne`` is for a run that
-    gets there later). A harmonic: 1 + a sin(phase) <= 0; a record: its first sample
-    scaled with the largest |A_ratio| g tan(alpha_ref) of the grid."""
-    if "vertical.amplitude" in {a.name for a in scene.axes}:
-        amp = np.asarray(scene.axis("vertical.amplitude").values, float)
-        phase = np.asarray(scene.axis("vertical.phase").values, float)
-        a0 = amp[:, None] * np.sin(np.radians(phase))[None, :]
-        i, j = np.unravel_index(np.argmin(a0), a0.shape)
-        if 1.0 + a0[i, j] <= 0.0:
-            raise SceneError(f"pulse.vertical.amplitude = {fmt(float(amp[i]))}: with "
-                             f"pulse.vertical.phase = {fmt(float(phase[j]))} deg, a_v = "
-                             f"{a0[i, j]:.4g} g at t = 0, so g + a_v <= 0 (the body leaves "
-                             "the ground); a sin(phase) must be > -1 at t = 0")
-    if scene.vertical is not None:
-        first = float(scene.vertical_samples()[0]) / scene.record.pga  # per unit of A
-        a_ratio = float(np.max(np.abs(scene.axis("A_ratio").values)))
-        alpha = float(np.max(scene.axis(alpha_symbol(scene.kind)).values))
-        a0 = a_ratio * math.tan(alpha) * first
-        if 1.0 + a0 <= 0.0:
-            raise SceneError(f"ground.vertical = {shown(scene.vertical.source)}: its first "
-                             f"sample scaled with ground.A_ratio = {fmt(a_ratio)} is a_v = "
-                             f"{a0:.4g} g at t = 0, so g + a_v <= 0 (the body leaves the "
-                             "ground); the vertical at t = 0 must be > -1 g")
 
 
 def _check_initial(scene: Scene, bodies: list[dict[str, float]]) -> None:

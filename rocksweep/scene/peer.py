@@ -1,6 +1,9 @@
 """A folder of PEER NGA-West2 downloads as a suite of multi-component records: the files
 paired by their names (no file is read here).
 
+``peer_suite`` reads a folder's records so paired (a one-line SceneError for a record
+without one of its components, or a warning where ``ground.missing: skip``).
+
 PEER names each component of a record ``RSN<n>_<EVENT>_<STATION><COMPONENT>.AT2``: the
 horizontals end in their azimuth or direction (``RSN1158_KOCAELI_DZC180.AT2``,
 ``..._DZC270.AT2``; ``RSN9_BORREGO_B-ELC000.AT2``, ``...-ELC090.AT2``), the vertical in
@@ -14,6 +17,9 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from pathlib import Path
+
+from rocksweep.errors import SceneError
+from rocksweep.outputs import shown
 
 _RSN = re.compile(r"^(RSN\d+)_", re.IGNORECASE)
 _VERTICAL = re.compile(r"(?:[-_]?(?:UP|DWN)|[-_]V)$", re.IGNORECASE)
@@ -62,3 +68,55 @@ def peer_components(files: list[Path]) -> tuple[list[Components], list[Path]]:
         out.append(Components(rsn, hor[0] if hor else None, hor[1] if len(hor) > 1 else None,
                               vert[0] if vert else None))
     return out, odd
+
+
+def peer_suite(folder: Path, skip: bool) -> tuple:
+    """The records of a folder of PEER downloads (``peer_components``): (H1s, H2s, verticals
+    (empty: none in the folder), names (H1's file names), files read). A record without
+    one of its components is a one-line SceneError, or left out with a RecordWarning
+    (``skip``)."""
+    import warnings
+
+    from rocksweep.physics.path import check_pair
+    from rocksweep.physics.records import RecordError, read_record
+    from rocksweep.physics.suite import RecordWarning
+
+    key = "ground.records"
+    files = [p for p in folder.iterdir() if p.suffix.lower() == ".at2" and p.is_file()]
+    comps, _ = peer_components(files)
+    if not comps:
+        raise SceneError(f"{key}: {shown(folder)}: no PEER record files in the folder "
+                         "(RSN<n>_<EVENT>_<STATION><COMPONENT>.AT2)")
+    with_up = any(c.up is not None for c in comps)
+    kept = []
+    for c in comps:
+        miss = c.missing(with_up)
+        if not miss:
+            kept.append(c)
+            continue
+        found = ", ".join(p.name for p in (c.h1, c.h2, c.up) if p is not None)
+        what = f"{c.rsn} has no {' and no '.join(miss)} file (found {found})"
+        need = "H1, H2 and UP" if with_up else "H1 and H2"
+        if not skip:
+            raise SceneError(f"{key}: {shown(folder)}: {what}; every record needs {need} "
+                             "(or ground.missing: skip)")
+        warnings.warn(RecordWarning(f"{key}: {what}: skipped"), stacklevel=2)
+    if not kept:
+        raise SceneError(f"{key}: {shown(folder)}: no record has all its components")
+    h1s, h2s, ups = [], [], []
+    for c in kept:
+        try:
+            one = [read_record(p) for p in (c.h1, c.h2, *([c.up] if with_up else []))]
+        except RecordError as err:
+            raise SceneError(f"{key}: {err}") from None
+        for other, what in zip(one[1:], ("H2", "UP"), strict=False):
+            why = check_pair(one[0], other)
+            if why is not None:
+                raise SceneError(f"{key}: {c.rsn}: {what} {other.name}: " + why.replace(
+                    "the two horizontal components", "the components of a record"))
+        h1s.append(one[0])
+        h2s.append(one[1])
+        ups.append(one[2] if with_up else None)
+    read = tuple(str(p) for c in kept for p in (c.h1, c.h2, c.up) if p is not None)
+    return (h1s, tuple(h2s), tuple(ups) if with_up else (), [c.h1.name for c in kept],
+            read)

@@ -3,9 +3,8 @@ checks (``identity``), file-system safety (``safety``: space, stale files, locks
 writer that survives SIGKILL and full disks (``writer.SweepFile``), the reader and its
 validation (``reader.read_result``)."""
 
-from rocksweep.store._common import StoreError
 from rocksweep.store.reader import SweepResult, peek_done, read_result, stored_scene
 from rocksweep.store.writer import SweepFile
 
-__all__ = ["StoreError", "SweepFile", "SweepResult", "peek_done", "read_result",
+__all__ = ["SweepFile", "SweepResult", "peek_done", "read_result",
            "stored_scene"]

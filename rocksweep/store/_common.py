@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rocksweep.errors import StoreError  # noqa: F401 (defined there; re-exported)
+from rocksweep.errors import StoreError
 from rocksweep.outputs import os_reason, shown
 
 # What h5py raises for I/O and damaged files (HDF5 errors surface as any of these).

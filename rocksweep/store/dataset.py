@@ -27,7 +27,7 @@ def result_dataset(source: Path | Any) -> xr.Dataset:
     import xarray as xr
 
     from rocksweep import fields
-    from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
+    from rocksweep.vocab.outcomes import OUTCOME_WORDS, STATUS_WORDS
 
     kwds = {"driver_kwds": {"locking": False}} if isinstance(source, Path) else {}
     try:
@@ -53,8 +53,8 @@ def result_dataset(source: Path | Any) -> xr.Dataset:
             IndexError, RuntimeError, MemoryError) as err:
         # xarray's CF decoding of a damaged attribute; HDF5's of damaged dimension scales
         # (H5DSget_num_scales: RuntimeError), a damaged shape's allocation
+        from rocksweep.errors import StoreError
         from rocksweep.outputs import shown
-        from rocksweep.store import StoreError
 
         where = shown(source) if isinstance(source, Path) else "result in memory"
         why = (str(err).strip().splitlines() or [type(err).__name__])[0]

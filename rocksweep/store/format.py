@@ -50,12 +50,11 @@ import numpy as np
 
 from rocksweep import fields
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.outcomes import OUTCOME_WORDS, STATUS_WORDS
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import fixed_ascii, utc_now
 from rocksweep.store.identity import record_attrs, resolved_scene, vertical_attrs
 from rocksweep.vocab.axes import alpha_symbol
-from rocksweep.vocab.outcomes import COMPUTED_FLAGS, COMPUTED_MEANING
+from rocksweep.vocab.outcomes import COMPUTED_FLAGS, COMPUTED_MEANING, OUTCOME_WORDS, STATUS_WORDS
 
 if TYPE_CHECKING:
     import h5py

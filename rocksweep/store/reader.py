@@ -16,22 +16,13 @@ from typing import TYPE_CHECKING, NoReturn
 import numpy as np
 
 from rocksweep import fields
-from rocksweep.errors import RocksweepError, flag
+from rocksweep.errors import RocksweepError, StoreError, flag
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.outcomes import OUTCOME_WORDS
 from rocksweep.outputs import shown
 from rocksweep.scene.model import Scene
-from rocksweep.store._common import (
-    H5_ERRORS,
-    StoreError,
-    close_quietly,
-    cut_repr,
-    damaged,
-    error_reason,
-)
+from rocksweep.store._common import H5_ERRORS, close_quietly, cut_repr, damaged, error_reason
 from rocksweep.store.format import (
-    COMPUTED_FLAGS,
     FORMAT,
     FORMAT_VERSION,
     RECORD_GROUP,
@@ -41,7 +32,7 @@ from rocksweep.store.format import (
 )
 from rocksweep.store.identity import resolved_scene, scene_differences
 from rocksweep.vocab.axes import axis_name
-from rocksweep.vocab.outcomes import CLASSES, OUTCOME_CODE
+from rocksweep.vocab.outcomes import CLASSES, COMPUTED_FLAGS, OUTCOME_CODE, OUTCOME_WORDS
 from rocksweep.vocab.settings import ADAPTIVE_RESOLVED
 
 if TYPE_CHECKING:
@@ -582,7 +573,8 @@ def stored_record(path: Path, rec: dict, group: str = RECORD_GROUP):
 def _stored_copy(path: Path, data: bytes, rec: dict, what: str):
     """A record's copy in a result file as a ``GroundRecord``, checked against the SHA-256
     the file states for it (``rec``: its ``sha256`` and ``source``)."""
-    from rocksweep.physics.records import RecordError, digest, parse_record
+    from rocksweep.errors import RecordError
+    from rocksweep.physics.records import digest, parse_record
 
     if digest(data) != rec.get("sha256"):
         raise damaged(path, f"{what} does not match its SHA-256")
@@ -643,7 +635,8 @@ def result_scene(result: SweepResult) -> Scene:
         # a Dataset made in memory (rocksweep.run without output) has no file to read
         record = stored_record(result.path, rec) if result.in_file else None
         if record is None:
-            from rocksweep.physics.records import RecordError, read_record
+            from rocksweep.errors import RecordError
+            from rocksweep.physics.records import read_record
 
             try:
                 record = read_record(rec["source"])

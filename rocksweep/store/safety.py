@@ -23,10 +23,10 @@ import os
 import shutil
 from pathlib import Path
 
-from rocksweep.errors import OutputError
+from rocksweep.errors import OutputError, StoreError
 from rocksweep.outputs import publish, shown
 from rocksweep.scene.model import Scene
-from rocksweep.store._common import StoreError, error_reason, mib
+from rocksweep.store._common import error_reason, mib
 
 # Free space required beyond the space a new file reserves (``space_needed``): a share of
 # the file, at least this many bytes [bytes], so that a small sweep fits a small disk and

@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rocksweep.errors import Arg, RocksweepError, flag
+from rocksweep.errors import Arg, RocksweepError, StoreError, flag
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outputs import (
@@ -39,7 +39,6 @@ from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import (
     H5_ERRORS,
-    StoreError,
     close_quietly,
     damaged,
     error_reason,

@@ -12,6 +12,9 @@ from __future__ import annotations
 
 NOT_RUN, SAFE, MODE1, MODE2 = "not_run", "safe", "mode1", "mode2"
 OUTCOME_CODE: dict[str, int] = {NOT_RUN: -1, SAFE: 0, MODE1: 1, MODE2: 2}
+#: the codes by name (the kernel's ``layout.OUTCOME_*`` are these)
+OUTCOME_NOT_RUN, OUTCOME_SAFE = OUTCOME_CODE[NOT_RUN], OUTCOME_CODE[SAFE]
+OUTCOME_MODE1, OUTCOME_MODE2 = OUTCOME_CODE[MODE1], OUTCOME_CODE[MODE2]
 OUTCOME_WORDS: dict[int, str] = {c: w for w, c in OUTCOME_CODE.items()}
 #: the classes of a run that ran, in code order (0, 1, 2)
 CLASSES: tuple[str, ...] = (SAFE, MODE1, MODE2)

@@ -177,7 +177,7 @@ def test_boundaries_h5_holds_what_the_csv_files_hold(cli, tmp_path):
                 return v
         return v.item() if isinstance(v, np.generic) else v
 
-    from rocksweep.outcomes import outcome_word
+    from rocksweep.vocab.outcomes import outcome_word
 
     a_rows, l_rows = [], []
     with h5py.File(h5, "r") as f:

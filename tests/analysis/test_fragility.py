@@ -11,6 +11,7 @@ import xarray as xr
 from scipy.optimize import minimize
 from scipy.stats import norm
 
+from rocksweep import errors
 from rocksweep.analysis import fragility as F
 from rocksweep.analysis import likelihood as LK
 from rocksweep.kernel import layout as L
@@ -145,9 +146,9 @@ def test_stripes_with_no_records_are_ignored():
 
 
 def test_bad_counts_are_errors():
-    with pytest.raises(F.FragilityError):
+    with pytest.raises(errors.FragilityError):
         F.fit_stripes([0.1, 0.2], [3, 1], [2, 2])
-    with pytest.raises(F.FragilityError):
+    with pytest.raises(errors.FragilityError):
         F.fit_stripes([0.0, 0.2], [0, 1], [2, 2])
 
 
@@ -307,10 +308,10 @@ def test_a_single_state_has_no_state_dimension():
 def test_bad_requests_are_one_line_errors():
     ds = small_dataset()
     for kw in ({"state": "topple"}, {"state": "theta:-1"}, {"im": "PGV"}, {"ci": 1.5}):
-        with pytest.raises(F.FragilityError) as err:
+        with pytest.raises(errors.FragilityError) as err:
             F.fragility(ds, **kw)
         assert "\n" not in str(err.value)
-    with pytest.raises(F.FragilityError):
+    with pytest.raises(errors.FragilityError):
         F.fragility(ds.drop_vars("status"))
 
 
@@ -341,7 +342,7 @@ def test_cloud_dataset_uses_the_scaled_record_ims():
     sa = F.fragility(ds, im="Sa", period=1.0)
     assert float(sa["im_median"][0]) == pytest.approx(1.2 * float(fr["im_median"][0]), rel=1e-9)
     assert sa.attrs["period"] == 1.0
-    with pytest.raises(F.FragilityError):
+    with pytest.raises(errors.FragilityError):
         F.fragility(ds, im="Sa")  # two periods: which one?
     assert "fraction" not in fr and "first_level" not in fr
 

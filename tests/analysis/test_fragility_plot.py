@@ -13,7 +13,8 @@ from matplotlib.figure import Figure  # noqa: E402
 from test_fragility import suite_dataset  # noqa: E402
 
 from rocksweep.analysis.fragility import fragility  # noqa: E402
-from rocksweep.figures.fragility import FragilityFigureError, fragility_figure  # noqa: E402
+from rocksweep.errors import FragilityFigureError
+from rocksweep.figures.fragility import fragility_figure  # noqa: E402
 
 
 def test_one_colour_per_lam_with_band_points_and_median_differences(tmp_path):

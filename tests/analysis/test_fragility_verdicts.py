@@ -18,9 +18,11 @@ from scipy.optimize import minimize
 from scipy.stats import norm
 
 import rocksweep
+from rocksweep import errors
 from rocksweep.analysis import fragility as F
 from rocksweep.cli import main
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.scene.inputs import load
 
 ROOT = Path(__file__).resolve().parents[2]
 LEVELS = np.geomspace(0.1, 1.6, 12)
@@ -73,7 +75,7 @@ def test_one_stripe_leaves_beta_undetermined_never_zero():
     assert set(fit.reason.split(",")) == {"one_stripe", "beta_undetermined"}
     assert math.isnan(fit.beta) and math.isnan(fit.im_median)
     ds = stripes_ds([[0], [1]], levels=np.array([0.5]))
-    with pytest.warns(F.FragilityWarning, match="one_stripe"):
+    with pytest.warns(errors.FragilityWarning, match="one_stripe"):
         fr = F.fragility(ds, bootstrap=0)
     assert {"one_stripe", "beta_undetermined"} <= reasons(fr) and np.isnan(fr["beta"])
 
@@ -126,7 +128,7 @@ def test_median_or_16_84_points_outside_the_stripes_are_extrapolated():
     # PGV-like stripes 0.05-0.8 with the capacity median above the top stripe
     lv = np.geomspace(0.05, 0.8, 8)
     ds = stripes_ds(capacity_outcomes(40, 0.93, 0.5, seed=2, levels=lv), levels=lv)
-    with pytest.warns(F.FragilityWarning, match=r"extrapolated \(im_median .* above"):
+    with pytest.warns(errors.FragilityWarning, match=r"extrapolated \(im_median .* above"):
         fr = F.fragility(ds, bootstrap=0)
     assert float(fr["im_median"]) > lv.max() and "extrapolated" in reasons(fr)
     # median inside, 84% point above the stripes: also extrapolated
@@ -166,7 +168,7 @@ def competing_outcomes(n_records=30, seed=0, levels=LEVELS):
 
 def test_a_mode_fitted_alone_is_censored_by_the_other_and_the_joint_fit_is_not():
     ds = stripes_ds(competing_outcomes())
-    with pytest.warns(F.FragilityWarning, match="censored"):
+    with pytest.warns(errors.FragilityWarning, match="censored"):
         alone = F.fragility(ds, state="mode2", bootstrap=0)
     assert "censored" in reasons(alone)
     joint = F.fragility(ds, state=["mode1", "mode2"], bootstrap=0, warn=False, joint=True)
@@ -192,7 +194,7 @@ def test_partial_data_are_incomplete_with_the_missing_stripes_named():
     st[out < 0] = 0
     ds = stripes_ds(out, status=st)
     ds.attrs["complete"] = 0
-    with pytest.warns(F.FragilityWarning, match=rf"60 points not computed at PGA "
+    with pytest.warns(errors.FragilityWarning, match=rf"60 points not computed at PGA "
                       rf"{LEVELS[-3]:.3g}-1.6 g left out \(the file is not complete"):
         fr = F.fragility(ds, bootstrap=0)
     assert "incomplete" in reasons(fr) and int(fr["n_not_run"]) == 60
@@ -205,7 +207,7 @@ def test_flagged_points_that_could_move_the_fit_mark_it():
     rows = np.flatnonzero(out[:, j] > 0)[:4]
     st[rows, j] = L.STATUS_HORIZON
     out[rows, j] = 0
-    with pytest.warns(F.FragilityWarning, match="4 flagged points left out"):
+    with pytest.warns(errors.FragilityWarning, match="4 flagged points left out"):
         fr = F.fragility(stripes_ds(out, status=st), bootstrap=0)
     assert "flagged" in reasons(fr) and int(fr["n_excluded"]) == 4
     assert int(fr["n_counted"][j]) == 16
@@ -359,13 +361,12 @@ def test_a_partial_file_is_fitted_as_incomplete_naming_the_missing_points(suite_
     """A file a sweep stopped writing (as after a kill, or while it still runs): the CLI
     warns with the missing points and marks the fit; nothing is silently dropped."""
     import rocksweep.compute.sweep as sw
-    from rocksweep import api
     from rocksweep.scene.grid import Grid
     from rocksweep.store.writer import SweepFile
 
     d, scene = suite_scene
     part = d / "part.h5"
-    sc, _ = api.load(scene)
+    sc, _ = load(scene)
     sf = SweepFile.create(part, sc)
     g = Grid(sc)
     sf.write(sw.run_chunk(g, 0, 18, sw.level(sc)))  # 18 of 24 points
@@ -384,10 +385,10 @@ def test_an_adaptive_suite_refuses_states_its_fill_cannot_know(tmp_path, cli):
     ds["uplifts"] = ds["outcome"].astype(np.int32)
     ds["computed"] = xr.zeros_like(ds["outcome"]) + 1
     ds["computed"][::2, ::3] = 0  # 5 x 4 points filled from the class around them
-    with pytest.raises(F.FragilityError, match=r"state 'uplift': 20 points of this adaptive "
+    with pytest.raises(errors.FragilityError, match=r"state 'uplift': 20 points of this adaptive "
                        "sweep were filled"):
         F.fragility(ds, state="uplift", bootstrap=0)
-    with pytest.raises(F.FragilityError, match="theta:0.5"):
+    with pytest.raises(errors.FragilityError, match="theta:0.5"):
         F.fragility(ds, state=["overturn", "theta:0.5"], bootstrap=0)
     # the class is known at a filled point: overturn and the modes are fitted
     assert str(F.fragility(ds, bootstrap=0)["reason"].values) == "ok"
@@ -465,7 +466,7 @@ def test_a_mode2_curve_that_falls_again_at_high_pga_is_not_ok():
     for s in range(16):
         out[:k1[s], s] = 1
         out[k1[s]:k1[s] + k2[s], s] = 2
-    with pytest.warns(F.FragilityWarning):
+    with pytest.warns(errors.FragilityWarning):
         fr = F.fragility(stripes_ds(out, levels=lv), state="mode2", bootstrap=200)
     assert {"censored", "extrapolated"} <= reasons(fr)
     assert float(fr["im_median"]) > lv.max()

@@ -34,6 +34,7 @@ from rocksweep.errors import (
 )
 from rocksweep.physics.measured import read_measured
 from rocksweep.physics.records import read_record
+from rocksweep.scene.inputs import load
 
 pytestmark = pytest.mark.faults
 
@@ -221,7 +222,7 @@ def test_calibration_refuses_what_it_cannot_fit(kwargs, words):
 ])
 def test_null_and_huge_initial_states_are_refused(extra, words):
     with pytest.raises(SceneError) as err:
-        rocksweep.api.load({**BLOCK, **extra})
+        load({**BLOCK, **extra})
     one_line(err, words)
 
 

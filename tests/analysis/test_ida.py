@@ -18,6 +18,7 @@ from rocksweep.cli import main
 from rocksweep.compute.single import run_point
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.bodies import G
+from rocksweep.scene.inputs import load
 
 ROOT = Path(__file__).resolve().parents[2]
 NAMES = ["SYN01.AT2", "SYN05.AT2", "SYN12.AT2"]
@@ -50,7 +51,7 @@ def test_bisected_level_brackets_the_first_overturning(suite):
     assert r.ida_im.dims == ("record",)
     levels = ds.PGA.values
     over = np.isin(ds.outcome.transpose("record", "PGA").values, (1, 2))
-    sc = rocksweep.api.load(d / "s.yaml")[0]
+    sc = load(d / "s.yaml")[0]
     checked = 0
     for k, name in enumerate(ds.record.values):
         if not over[k].any():

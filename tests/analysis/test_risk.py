@@ -14,8 +14,9 @@ from scipy import integrate
 from scipy.stats import norm
 
 import rocksweep
-from rocksweep.analysis.risk import RiskError, read_hazard
+from rocksweep.analysis.risk import read_hazard
 from rocksweep.cli import main
+from rocksweep.errors import RiskError
 from rocksweep.physics.bodies import G
 
 

@@ -16,11 +16,14 @@ from bodies import FIG3
 
 import rocksweep
 import rocksweep.compute.sweep as sw
-from rocksweep import api, fields
+from rocksweep import errors, fields
 from rocksweep.cli import main
+from rocksweep.compute.arguments import check_jobs
+from rocksweep.compute.session import sweep_file
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.scene.grid import Grid
+from rocksweep.scene.inputs import load
 from rocksweep.scene.parse import load_scene
 from rocksweep.store.reader import read_result
 
@@ -55,14 +58,14 @@ def test_import_and_help_are_light():
 
 def test_public_names_have_docstrings_and_version(cli):
     for obj in (rocksweep.run, rocksweep.open, rocksweep.simulate, rocksweep.RocksweepError,
-                api.Simulation, api.sweep_file):
+                rocksweep.Simulation, sweep_file):
         assert obj.__doc__ and len(obj.__doc__) > 40, obj
     from importlib.metadata import version
 
     assert rocksweep.__version__ == version("rocksweep")
     res = cli.invoke(main, ["--version"])
     assert res.exit_code == 0 and res.output.strip() == f"rocksweep {version('rocksweep')}"
-    assert issubclass(sw.SweepError, rocksweep.RocksweepError)
+    assert issubclass(errors.SweepError, rocksweep.RocksweepError)
 
 
 
@@ -171,7 +174,7 @@ def test_run_resumes_a_partial_file(tmp_path):
 
     out = tmp_path / "part.h5"
     full = rocksweep.run(SMALL)
-    sc, _ = api.load(SMALL)  # the dict scene as the API parses it
+    sc, _ = load(SMALL)  # the dict scene as the API parses it
     sf = SweepFile.create(out, sc)
     g = Grid(sc)
     sf.write(sw.run_chunk(g, 0, 17, sw.level(sc)))
@@ -190,14 +193,14 @@ def test_driver_says_compiling_before_an_uncached_kernel(tmp_path, monkeypatch):
     monkeypatch.setattr(sw, "_in_cache", lambda dispatcher: False)
     lines: list[str] = []
     sc = load_scene(CI_SMALL)
-    rep = api.sweep_file(sc, tmp_path / "c.h5", log=lines.append)
+    rep = sweep_file(sc, tmp_path / "c.h5", log=lines.append)
     assert rep.complete and rep.computed == 256
     i = next(i for i, ln in enumerate(lines) if ln.startswith("compiling the kernel"))
     assert re.fullmatch(r"compiling the kernel \(once per machine, ~\d+ s\)\.\.\.", lines[i])
     assert re.fullmatch(r"kernel compiled in \d+\.\d s", lines[i + 1])
     monkeypatch.setattr(sw, "_in_cache", lambda dispatcher: None)
     lines.clear()
-    api.sweep_file(sc, tmp_path / "d.h5", log=lines.append)
+    sweep_file(sc, tmp_path / "d.h5", log=lines.append)
     assert "loading or compiling the kernel..." in lines
 
 
@@ -223,15 +226,15 @@ def test_jobs_limits(jobs):
     n = os.cpu_count() or 1
     from rocksweep.cli.main import said
 
-    with pytest.raises(sw.SweepError) as exc:
-        sw.check_jobs(jobs)
+    with pytest.raises(errors.SweepError) as exc:
+        check_jobs(jobs)
     if jobs < 1:
         assert str(exc.value) == f"jobs = {jobs}: give a number >= 1, or -1 for all cores"
         assert said(exc.value) == f"--jobs {jobs}: give a number >= 1, or -1 for all cores"
     else:
         assert str(exc.value).startswith(f"jobs = {jobs}: at most {4 * n} (4 x the {n} core")
         assert said(exc.value).startswith(f"--jobs {jobs}: at most {4 * n} (4 x the {n} core")
-    assert sw.check_jobs(-1) == n and sw.check_jobs(4 * n) == 4 * n
+    assert check_jobs(-1) == n and check_jobs(4 * n) == 4 * n
 
 
 # --- simulate -------------------------------------------------------------------------------
@@ -332,7 +335,7 @@ def test_dask_one_thread_cluster_computes_every_chunk(tmp_path, cli_file, monkey
     out = tmp_path / "d.h5"
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
                                   dashboard_address=None) as cluster:
-        api.sweep_file(load_scene(CI_SMALL), out, backend="dask",
+        sweep_file(load_scene(CI_SMALL), out, backend="dask",
                        scheduler=cluster.scheduler_address, chunk_size=16)
     assert len(RAN_IN_MAIN_THREAD) == 16 and not any(RAN_IN_MAIN_THREAD)
     a, b = read_result(out), read_result(cli_file)
@@ -371,8 +374,8 @@ def test_dask_losing_every_worker_mid_sweep_saves_and_stops(tmp_path, monkeypatc
                 yield res
 
         monkeypatch.setattr(sw, "run_chunks", run_then_lose_workers)
-        with pytest.raises(sw.SweepError) as exc:
-            api.sweep_file(sc, out, backend="dask", scheduler=cluster.scheduler_address,
+        with pytest.raises(errors.SweepError) as exc:
+            sweep_file(sc, out, backend="dask", scheduler=cluster.scheduler_address,
                            chunk_size=1, write_every=1000.0)
     msg = str(exc.value)
     assert "lost all its workers" in msg and "resume=True" in msg and "\n" not in msg

@@ -14,9 +14,10 @@ from helpers import kill_sweep_when, one_line_error
 
 import rocksweep
 import rocksweep.compute.adaptive as ad
-from rocksweep import api
+from rocksweep import errors
 from rocksweep.cli import main
-from rocksweep.compute.driver import sweep_arrays
+from rocksweep.compute.driver import SweepInterrupted, sweep_arrays
+from rocksweep.compute.session import sweep_file
 from rocksweep.compute.sweep import level, prepare
 from rocksweep.scene.parse import parse_scene
 from rocksweep.store.reader import read_result
@@ -173,15 +174,15 @@ def test_interrupted_in_any_batch_resumes_to_the_same_file(fig3_files, tmp_path,
 
         monkeypatch.setattr(SweepFile, "_write_at", torn)
     opts = ad.Options(coarse=2)
-    with pytest.raises(api.SweepInterrupted):
-        api.sweep_file(sc, out, jobs=1, chunk_size=20, write_every=0.0, adaptive=opts)
+    with pytest.raises(SweepInterrupted):
+        sweep_file(sc, out, jobs=1, chunk_size=20, write_every=0.0, adaptive=opts)
     monkeypatch.undo()
     part = read_result(out)
     assert not part.attrs["complete"]
     assert (part.arrays["computed"] > 0).sum() < part.arrays["computed"].size
     if stop_in == "audit":
         assert (part.arrays["computed"] >= 2).any()  # cut inside the audit batch
-    rep = api.sweep_file(sc, out, jobs=2, resume=True, adaptive=opts)
+    rep = sweep_file(sc, out, jobs=2, resume=True, adaptive=opts)
     assert rep.done_before == (part.arrays["computed"] > 0).sum()
     assert_same_files(out, adapt)
 
@@ -334,7 +335,7 @@ def test_plot_with_curves_and_run_api(fig3_files, cli, tmp_path):
     assert "not an adaptive sweep (no 'computed' flags)" in one_line_error(res)
     ds = rocksweep.run(FIG3_SMALL, jobs=2, adaptive=True, coarse=2)
     np.testing.assert_array_equal(ds["computed"].values, read_result(adapt).arrays["computed"])
-    with pytest.raises(api.ApiError, match="coarse = 2: an adaptive setting"):
+    with pytest.raises(errors.ApiError, match="coarse = 2: an adaptive setting"):
         rocksweep.run(FIG3_SMALL, coarse=2)
 
 

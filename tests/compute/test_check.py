@@ -29,6 +29,7 @@ from rocksweep.numerics import PRESETS, Numerics
 from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.physics.points import Point, kernel_kind, point_row
 from rocksweep.physics.reference import reference_run
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.parse import parse_scene
 
 SCENE = """
@@ -112,14 +113,14 @@ def test_scene_without_check_stores_and_runs_nothing_more():
     assert not scene.check
     assert not set(CHECK_NAMES) & set(scene.variables())
     calls = []
-    grid = sw.Grid(scene)
+    grid = Grid(scene)
     orig = sw.run_rows
     try:
         sw.run_rows = lambda *a: calls.append(1) or orig(*a)
         sw.run_chunk(grid, 0, 8, sw.level(scene))
         assert len(calls) == 1
         checked = parse_scene(SCENE, overrides=["outputs.check=true"])
-        sw.run_chunk(sw.Grid(checked), 0, 8, sw.level(checked))
+        sw.run_chunk(Grid(checked), 0, 8, sw.level(checked))
         assert len(calls) == 3
     finally:
         sw.run_rows = orig
@@ -136,7 +137,7 @@ def test_record_scene_half_step(tmp_path):
                         overrides=["outputs.check=true", "ground.A_ratio=[0.8, 2.5]",
                                    "ground.p=[1.0, 2.0, 4.0]"])
     res = sweep_arrays(scene)[0]
-    rows = sw.Grid(scene).rows(0, 2).rows
+    rows = Grid(scene).rows(0, 2).rows
     assert np.array_equal(check_rows(rows)[:, L.PAR_REC_H], rows[:, L.PAR_REC_H] / 2)
     assert (res["check_outcome"] >= 0).all()
     d = res["check_t_overturn_diff"]

@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 from bodies import FIG3, SHARED
 
-from rocksweep.compute.single import history_capacity, run_point
+from rocksweep.compute.dispatch import history_capacity
+from rocksweep.compute.single import run_point
 from rocksweep.kernel import chunk_kernel, point_kernel
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics

@@ -24,12 +24,12 @@ import pytest
 from bodies import FIG3_YAML
 
 import rocksweep
+from rocksweep.errors import SceneError
 from rocksweep.kernel import layout as L
 from rocksweep.physics import intensity
 from rocksweep.physics.bodies import G
 from rocksweep.physics.records import read_record, write_at2
 from rocksweep.scene.grid import Grid
-from rocksweep.scene.model import SceneError
 from rocksweep.scene.parse import load_scene, parse_scene
 
 ROOT = Path(__file__).resolve().parents[2]

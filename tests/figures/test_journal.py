@@ -170,7 +170,7 @@ def test_no_progress_bar_class_from_a_notebook_without_progress(monkeypatch):
 
 def test_shapes_figure_has_a_panel_per_family():
     from rocksweep.figures.pulses import shapes_figure
-    from rocksweep.physics.excitation import SHAPES
+    from rocksweep.vocab.ground import SHAPES
 
     fig = shapes_figure()
     assert len(fig.axes) == len(SHAPES)

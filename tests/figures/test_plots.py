@@ -210,7 +210,8 @@ def test_title_says_the_pulse_shape_once(tmp_path):
 # ---------------------------------------------------------------------------------------
 
 def test_stability_diagram_draws_into_given_axes(acg_result):
-    from rocksweep.figures.diagrams import DiagramError, stability_diagram
+    from rocksweep.errors import DiagramError
+    from rocksweep.figures.diagrams import stability_diagram
 
     result = read_result(acg_result)
     mine = Figure()

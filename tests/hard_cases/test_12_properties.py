@@ -11,8 +11,9 @@ from hardkit import table3_body as body
 from hypothesis import HealthCheck, assume, event, example, given, settings
 from hypothesis import strategies as st
 
+from rocksweep.errors import BodyError
 from rocksweep.numerics import Numerics
-from rocksweep.physics.bodies import BodyError, FlexibleBody
+from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.physics.points import Point
 
 pytestmark = pytest.mark.hard

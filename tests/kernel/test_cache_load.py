@@ -73,7 +73,7 @@ def test_reading_a_result_loads_no_numba(tmp_path):
     (~0.1 s) nor kernel."""
     scene = load_scene(CI_SMALL)
     path = tmp_path / "r.h5"
-    from rocksweep.api import sweep_file
+    from rocksweep.compute.session import sweep_file
 
     sweep_file(scene, path)
     out = _python(

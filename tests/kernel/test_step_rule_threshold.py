@@ -51,10 +51,10 @@ def test_the_cost_check_sees_the_threshold_factor(monkeypatch):
     """The admission's step cap (largest at the grid's corners, except along A_ratio just
     above 1, where a rigid body's pulse takes the most steps): a cap between the corners'
     and the near-threshold point's refuses the scene at that point."""
+    from rocksweep.errors import SceneError
     from rocksweep.numerics import Numerics
     from rocksweep.physics.points import run_cost
     from rocksweep.scene import admission
-    from rocksweep.scene.model import SceneError
 
     grid = ["pulse.shape=sine", "pulse.w_over_p=6.0", "pulse.A_ratio=[0.5, 1.02, 8.0]"]
     num = Numerics()

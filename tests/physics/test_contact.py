@@ -18,14 +18,14 @@ from bodies import FIG3_YAML, table3
 from test_derivations import _positions
 
 from rocksweep.cli.main import main
-from rocksweep.compute.single import history_capacity
+from rocksweep.compute.dispatch import history_capacity
+from rocksweep.errors import SceneError
 from rocksweep.kernel import chunk_kernel, contact, point_kernel
 from rocksweep.kernel import equations as eq
 from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody, FlexibleBody
 from rocksweep.physics.points import Point, point_row
-from rocksweep.scene.model import SceneError
 from rocksweep.scene.parse import parse_scene
 
 t = sp.symbols("t")

@@ -17,13 +17,13 @@ from helpers import one_line_error
 from rocksweep.cli import main
 from rocksweep.compute.driver import sweep_arrays
 from rocksweep.compute.single import run_point
+from rocksweep.errors import SceneError
 from rocksweep.kernel import equations as eq
 from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
 from rocksweep.physics import impact
 from rocksweep.physics.bodies import FlexibleBody
 from rocksweep.physics.points import Point, point_row
-from rocksweep.scene.model import SceneError
 from rocksweep.scene.parse import load_scene, parse_scene
 
 m, mA, IA, h, hA, b, lam = sp.symbols("m m_A I_A h h_A b lambda", positive=True)

@@ -9,6 +9,7 @@ import pytest
 from scipy.signal import lsim
 
 from rocksweep.physics import intensity as im
+from rocksweep.physics.bodies import G
 
 
 def sine(a: float, period: float, cycles: int, steps_per_cycle: int):
@@ -37,9 +38,9 @@ def test_pga_and_pgv_of_a_sine():
     w = 2.0 * math.pi / period
     assert im.pga(acc) == pytest.approx(a, rel=1e-12)
     # v(t) = (a g / w)(1 - cos w t): peak 2 a g / w at each half cycle
-    assert im.pgv(acc, dt) == pytest.approx(2.0 * a * im.G / w, rel=1e-6)
+    assert im.pgv(acc, dt) == pytest.approx(2.0 * a * G / w, rel=1e-6)
     # in m/s^2: the same number with g = 1
-    assert im.pgv(acc * im.G, dt, g=1.0) == pytest.approx(2.0 * a * im.G / w, rel=1e-6)
+    assert im.pgv(acc * G, dt, g=1.0) == pytest.approx(2.0 * a * G / w, rel=1e-6)
     assert im.duration(acc, dt) == pytest.approx(3 * period, rel=1e-12)
 
 
@@ -47,14 +48,14 @@ def test_pgv_extremum_between_samples():
     # acc = [1, -1] over one step: v(t) = g (t - t^2/dt) peaks at t = dt/2 with g dt / 4,
     # while at the samples v = 0 and v(dt) = 0
     dt = 0.02
-    assert im.pgv(np.array([1.0, -1.0]), dt) == pytest.approx(im.G * dt / 4.0, rel=1e-12)
+    assert im.pgv(np.array([1.0, -1.0]), dt) == pytest.approx(G * dt / 4.0, rel=1e-12)
     assert np.allclose(im.velocity(np.array([1.0, -1.0]), dt), 0.0)
 
 
 def test_pgv_has_no_baseline_correction():
     # a constant acceleration keeps accelerating: v = g a t
     acc = np.full(101, 0.1)
-    assert im.pgv(acc, 0.01) == pytest.approx(im.G * 0.1 * 1.0, rel=1e-12)
+    assert im.pgv(acc, 0.01) == pytest.approx(G * 0.1 * 1.0, rel=1e-12)
 
 
 def test_sa_undamped_resonance_growth_is_exact():

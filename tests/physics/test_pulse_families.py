@@ -19,13 +19,13 @@ import numpy as np
 import pytest
 
 from rocksweep.compute.single import run_point
+from rocksweep.errors import SceneError
 from rocksweep.kernel import layout as L
 from rocksweep.kernel.equations import ground_acc, ground_jerk
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody
 from rocksweep.physics.excitation import PulseShape
 from rocksweep.physics.points import Point, point_row
-from rocksweep.scene.model import SceneError
 from rocksweep.scene.parse import parse_scene
 
 BLOCK = BlockBody(alpha=0.2618, inertia=4.0 / 3.0)

@@ -177,7 +177,7 @@ def suite_scene(**ground):
 
 
 def test_avgsa_range_from_the_scene():
-    from rocksweep.api import load
+    from rocksweep.scene.inputs import load
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RecordWarning)
@@ -195,8 +195,8 @@ def test_avgsa_range_from_the_scene():
 
 @pytest.mark.parametrize("bad", [[2.0, 1.0], [0.0, 1.0], [1.0], "x", [1.0, 200.0]])
 def test_bad_avgsa_range_is_one_line(bad):
-    from rocksweep.api import load
     from rocksweep.errors import RocksweepError
+    from rocksweep.scene.inputs import load
 
     with pytest.raises(RocksweepError) as err:
         load(suite_scene(avgsa=bad))

@@ -12,11 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rocksweep.errors import OutputError, RocksweepError
+from rocksweep.errors import OutputError, RecordError, RocksweepError
 from rocksweep.physics.excitation import PulseShape
 from rocksweep.physics.records import (
     GroundRecord,
-    RecordError,
     at2_text,
     fortran_e,
     kernel_series,

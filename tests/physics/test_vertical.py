@@ -22,20 +22,20 @@ import math
 import numpy as np
 import pytest
 import sympy as sp
+from bodies import FIG4
 
 from rocksweep.compute.single import run_point
 from rocksweep.kernel import equations as eq
 from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody, FlexibleBody
-from rocksweep.physics.points import RECORD, Point, point_row
+from rocksweep.physics.points import Point, point_row
 from rocksweep.physics.records import parse_record
 from rocksweep.physics.reference import reference_run
 from rocksweep.physics.vertical import VerticalHarmonic, air_time_harmonic, air_time_record
+from rocksweep.vocab.ground import RECORD
 
 G = 9.81
-FIG4 = dict(wn_over_p=9.82, zeta=0.05, alpha_cg=0.15, alpha_A=0.28, mA_over_m=0.47,
-            IA_ratio=0.56)
 
 
 # ------------------------------------------------------------------------------------

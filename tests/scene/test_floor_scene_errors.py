@@ -11,8 +11,8 @@ import yaml
 from helpers import one_line_error
 
 from rocksweep.cli import main
+from rocksweep.errors import SceneError
 from rocksweep.physics.records import read_record, write_at2
-from rocksweep.scene.model import SceneError
 from rocksweep.scene.parse import parse_scene
 
 ROOT = Path(__file__).resolve().parents[2]

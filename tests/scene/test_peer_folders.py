@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 
 import rocksweep
+from rocksweep.errors import SceneError
 from rocksweep.physics.path import rotd50_peaks
 from rocksweep.physics.records import write_at2
 from rocksweep.physics.suite import RecordWarning
-from rocksweep.scene.model import SceneError
 from rocksweep.scene.parse import parse_scene
 from rocksweep.scene.peer import peer_components
 

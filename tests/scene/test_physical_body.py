@@ -24,7 +24,7 @@ def scene(**body):
 
 
 def test_pi_groups_and_p_of_a_lab_specimen():
-    from rocksweep.api import load
+    from rocksweep.scene.inputs import load
 
     sc, _ = load(scene())
     d = sc.physical
@@ -48,7 +48,7 @@ def test_pi_groups_and_p_of_a_lab_specimen():
 
 
 def test_the_same_run_as_its_pi_groups():
-    from rocksweep.api import load
+    from rocksweep.scene.inputs import load
 
     sc, _ = load(scene())
     pis = {k: sc.physical[k] for k in ("wn_over_p", "zeta", "alpha_cg", "alpha_A",
@@ -99,7 +99,7 @@ def test_physical_columns_use_the_body_s_p():
     t, th = h.p_t.values, h.theta_over_alpha.values
     keep = np.r_[t[1:] != t[:-1], True]
     ts = np.arange(0.0, t[keep][-1] + 2.0, 0.02)
-    from rocksweep.api import load
+    from rocksweep.scene.inputs import load
 
     d = load(scene())[0].physical
     df = pd.DataFrame({"t": ts / d["p"],

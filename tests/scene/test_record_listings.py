@@ -21,8 +21,8 @@ from pathlib import Path
 import pytest
 from bodies import FIG3_YAML
 
-from rocksweep.physics.records import RecordError, parse_record
-from rocksweep.scene.model import SceneError
+from rocksweep.errors import RecordError, SceneError
+from rocksweep.physics.records import parse_record
 from rocksweep.scene.parse import load_scene
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -27,13 +27,14 @@ from bodies import FIG3, FIG3_YAML
 from scipy import signal
 
 from rocksweep.compute.single import run_point
+from rocksweep.errors import SceneError
 from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import FlexibleBody
-from rocksweep.physics.points import RECORD, Point
+from rocksweep.physics.points import Point
 from rocksweep.physics.records import read_record
-from rocksweep.scene.model import SceneError
 from rocksweep.scene.parse import load_scene, parse_scene
+from rocksweep.vocab.ground import RECORD
 
 ROOT = Path(__file__).resolve().parents[2]
 SINE = ROOT / "records" / "sine_1cycle.AT2"

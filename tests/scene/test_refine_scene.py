@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from rocksweep.cli import main
-from rocksweep.scene.model import SceneError
+from rocksweep.errors import SceneError
 from rocksweep.scene.parse import parse_scene
 
 SCENE = """

@@ -14,11 +14,10 @@ import pytest
 from bodies import FIG3, FIG3_YAML
 
 from rocksweep.cli import main
-from rocksweep.errors import RocksweepError
+from rocksweep.errors import BodyError, RocksweepError, SceneError
 from rocksweep.numerics import MAX_POINT_STEPS
-from rocksweep.physics.bodies import BlockBody, BodyError, FlexibleBody
+from rocksweep.physics.bodies import BlockBody, FlexibleBody
 from rocksweep.physics.points import body_omega_rock
-from rocksweep.scene.model import SceneError
 from rocksweep.scene.parse import MAX_POINTS, load_scene, parse_scene
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
@@ -97,6 +96,19 @@ def test_a_body_from_python_gets_the_scenes_message(key, value, message):
 def test_overrides_use_the_same_checks():
     assert refused(GOOD, ("body.mA_over_m=[1.0e-300, 1.0e+300]",)) == (
         "body.mA_over_m = 1e-300: must be in [1e-06, 1e+06]")
+
+
+def test_an_override_to_null_leaves_the_key_out_and_a_null_in_the_file_is_refused():
+    with_e = GOOD.replace("impact: {lam: 0.4}", "impact: {law: constant, e: 0.9}")
+    s = parse_scene(with_e, SRC, overrides=["impact.law=vertical", "impact.e=null",
+                                            "impact.lam=0.3"])
+    assert s.axis("law").values == ("vertical",) and "e" not in [a.name for a in s.axes]
+    # leaving out a key of a section the scene does not have adds no section
+    plain = parse_scene(GOOD, SRC)
+    free = parse_scene(GOOD, SRC, overrides=["initial.theta_over_alpha=null"])
+    assert [a.name for a in free.axes] == [a.name for a in plain.axes] and free.text == plain.text
+    assert refused(GOOD.replace("impact: {lam: 0.4}", "impact: {lam: null}"), ()) == (
+        "impact.lam = null: must be in [0, 2], or leave the key out")
 
 
 # -- structure: sections, unknown and missing keys, types -----------------------------

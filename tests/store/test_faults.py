@@ -34,11 +34,10 @@ from helpers import one_line_error
 
 from rocksweep.cli import main
 from rocksweep.compute.sweep import level, prepare
-from rocksweep.errors import OutputError
+from rocksweep.errors import OutputError, StoreError
 from rocksweep.fields import plain
 from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.parse import load_scene, parse_scene
-from rocksweep.store import StoreError
 from rocksweep.store.format import SESSION_ATTRS
 from rocksweep.store.reader import peek_done, read_result
 from rocksweep.store.writer import SweepFile
@@ -261,7 +260,7 @@ def test_resume_of_a_format_1_file_on_a_full_disk_is_one_line_and_changes_nothin
     out = in_namespace(f"mount -t tmpfs -o size=1m tmpfs {fs}", f"""
         import os, shutil, json, hashlib
         from rocksweep.scene.parse import parse_scene
-        from rocksweep.store import StoreError
+        from rocksweep.errors import StoreError
         from rocksweep.store.writer import SweepFile
         path = "{fs}/v1.h5"
         shutil.copy("{src}", path)
@@ -546,7 +545,7 @@ def test_overwrite_and_resume_refused_while_another_process_writes(tmp_path, cli
 RACER = FAKE_CHUNK + """
 import json, sys, time
 from rocksweep.scene.parse import parse_scene
-from rocksweep.store import StoreError
+from rocksweep.errors import StoreError
 from rocksweep.store.writer import SweepFile
 sc = parse_scene(@TEXT@)
 while time.time() < @START@:

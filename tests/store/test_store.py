@@ -12,10 +12,9 @@ from bodies import FIG3_YAML
 
 import rocksweep.store.writer as writer
 from rocksweep.compute.sweep import plan_chunks
-from rocksweep.errors import OutputError
+from rocksweep.errors import OutputError, StoreError
 from rocksweep.scene.grid import ChunkResult, Grid
 from rocksweep.scene.parse import parse_scene
-from rocksweep.store import StoreError
 from rocksweep.store.format import FORMAT_VERSION, flat_slabs
 from rocksweep.store.reader import read_result
 from rocksweep.store.writer import SweepFile

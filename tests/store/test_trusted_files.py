@@ -26,7 +26,7 @@ from helpers import one_line_error
 
 import rocksweep
 from rocksweep.cli import main
-from rocksweep.store import StoreError
+from rocksweep.errors import StoreError
 from rocksweep.store.reader import read_result, result_scene
 
 ROOT = Path(__file__).resolve().parents[2]
