@@ -18,9 +18,10 @@ import numpy as np
 from rocksweep.compute.single import run_point
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody
-from rocksweep.physics.points import RECORD, Point
+from rocksweep.physics.points import Point
 from rocksweep.physics.records import parse_record
 from rocksweep.physics.reference import reference_run
+from rocksweep.vocab.ground import RECORD
 
 
 def two(t, a, name):

@@ -1,7 +1,7 @@
 """The scene keys of the excitation path: a record's second horizontal component and the
 body's orientation (``ground.h2``, ``ground.angle``) and the building under the body
 (``floor:``), parsed into a ``physics.path.GroundPath`` and the axes they sweep (docs/
-floors.md). Called by ``scene.parse`` (whose section and axis helpers it uses)."""
+floors.md). Called by ``scene.parse``; the section and axis forms are ``scene.sections``'."""
 
 from __future__ import annotations
 
@@ -16,8 +16,9 @@ from rocksweep.physics.floor import Mode
 from rocksweep.physics.path import GroundPath, check_pair
 from rocksweep.physics.records import GroundRecord
 from rocksweep.physics.suite import Suite
-from rocksweep.scene import parse as P  # noqa: N812
+from rocksweep.scene.ground import ground_record
 from rocksweep.scene.model import FLOOR_AXES
+from rocksweep.scene.sections import axis_spec, axis_values, section
 from rocksweep.schema import KEYS, as_float, check_values, fmt, is_number
 
 
@@ -69,7 +70,7 @@ def excitation_path(raw: dict, ground: dict, kind: str, free: bool,
         if suite is not None:
             raise SceneError("ground.h2: not with ground.records (a folder of PEER "
                              "downloads pairs each record's components by name)")
-        second = P._record(ground, base, "h2") if given_h2 is None else given_h2
+        second = ground_record(ground, base, "h2") if given_h2 is None else given_h2
         why = check_pair(record, second)
         if why is not None:
             raise SceneError(f"ground.h2: {second.name}: {why}")
@@ -83,14 +84,14 @@ def excitation_path(raw: dict, ground: dict, kind: str, free: bool,
                          "both horizontals)")
     if h2:
         specs.append(("angle", "ground.angle",
-                      *P._axis_spec("ground.angle", ground.get("angle", 0.0))[:2]))
+                      *axis_spec("ground.angle", ground.get("angle", 0.0))[:2]))
     building = None
     if raw.get("floor") is not None:
         if free:
             raise SceneError(f"floor = {fmt(raw['floor'])}: a free-rocking scene (no pulse "
                              "or ground section) has no ground motion for a building to "
                              "carry; give a pulse or a ground motion")
-        sec = P._section(raw, "floor", kind, required=False)
+        sec = section(raw, "floor", kind, required=False)
         if sec.get("modes") is not None:
             for k in FLOOR_AXES:
                 if sec.get(k.split(".")[1]) is not None:
@@ -103,8 +104,8 @@ def excitation_path(raw: dict, ground: dict, kind: str, free: bool,
                 if sec.get(short) is None:
                     raise SceneError(f"{k}: missing required key ({AXIS_HINT}; or give "
                                      "floor.modes)")
-                form, spec, _ = P._axis_spec(k, sec[short])
-                if k == "floor.participation" and np.any(P._axis_values(k, form, spec) == 0):
+                form, spec, _ = axis_spec(k, sec[short])
+                if k == "floor.participation" and np.any(axis_values(k, form, spec) == 0):
                     raise SceneError(f"{k} = 0.0: {KEYS[k].allowed}")
                 specs.append((k, k, form, spec))
     if not h2 and raw.get("floor") is None:

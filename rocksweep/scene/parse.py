@@ -19,30 +19,25 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import os
-from glob import glob, has_magic
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from rocksweep.errors import BodyError, RecordError, SceneError, SuiteError, set_key
-from rocksweep.inputs import decode_text, read_input
+from rocksweep.errors import BodyError, SceneError, set_key
 from rocksweep.numerics import Numerics
-from rocksweep.outputs import input_problem, is_input, shown
+from rocksweep.outputs import input_problem, shown
 from rocksweep.physics.bodies import body_from_geometry
-from rocksweep.physics.records import GroundRecord, read_record
+from rocksweep.physics.records import GroundRecord
 from rocksweep.physics.suite import (
-    AVGSA_RANGE,
-    COMPONENTS,
-    ROTD50,
     Suite,
-    make_suite,
 )
 from rocksweep.scene.admission import candidate_bodies, check_cost
+from rocksweep.scene.floors import excitation_path
+from rocksweep.scene.ground import ground_record, ground_suite
 from rocksweep.scene.loader import CONTROL_CHARS, YamlError, load_yaml
 from rocksweep.scene.model import Axis, Scene
-from rocksweep.scene.peer import peer_suite
+from rocksweep.scene.sections import axis_spec, axis_values, section, shape_words, words
 from rocksweep.scene.vertical import check_vertical_start, pulse_vertical
 from rocksweep.schema import (
     BODY_KEYS,
@@ -53,10 +48,9 @@ from rocksweep.schema import (
     check_values,
     fmt,
     is_number,
-    section_keys,
 )
 from rocksweep.vocab.axes import DIAGRAM_AXES, INITIAL, alpha_symbol, axis_name
-from rocksweep.vocab.ground import DEFAULT_PERIODS, FREE, MP, RECORD, RECORD_IMS, SCALE_IMS
+from rocksweep.vocab.ground import FREE, MP, RECORD
 from rocksweep.vocab.ground import PULSE_KEY_SHAPES as _PULSE_KEY_SHAPES
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
 from rocksweep.vocab.settings import DEFAULT_PRESET, FINE
@@ -66,9 +60,6 @@ from rocksweep.vocab.settings import DEFAULT_PRESET, FINE
 # float64 variable read back for a figure or xarray is 1.6 GB of memory, and at tens of
 # microseconds a point (docs/performance.md) the sweep takes hours of one core.
 MAX_POINTS = 200_000_000
-# Values per axis: an axis is kept as a tuple of Python floats (~32 bytes a value; 1e6
-# values are 32 MB and 0.1 s to build); a figure's axis needs a few thousand at most.
-MAX_AXIS_VALUES = 1_000_000
 PULSE_AXES = tuple(reversed(DIAGRAM_AXES))  # (A_ratio, w_over_p)
 # The pulse shapes each optional pulse key means something for (rocksweep.physics.excitation);
 # given for none of the scene's shapes, the key is refused (it would be silently ignored).
@@ -153,135 +144,6 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
     return dataclasses.replace(scene, inputs=(str(path), *scene.inputs))
 
 
-def _section(raw: dict, name: str, kind: str, required: bool) -> dict:
-    """The mapping of a section, with its keys checked against the table."""
-    sec = raw.get(name)
-    if name == "body" and isinstance(sec, dict):
-        kind = sec.get("kind", "flexible")
-        if not (isinstance(kind, str) and kind in BODY_KEYS):
-            raise SceneError(f"body.kind = {fmt(kind)}: {KEYS['body.kind'].allowed}")
-    allowed = section_keys(name, kind)
-    if sec is None and name in raw:  # ``pulse:`` or ``pulse: null`` is no absent section
-        raise SceneError(f"{name} = null: must be a mapping with keys {', '.join(allowed)}, "
-                         "or leave the section out")
-    if sec is None:
-        if required:
-            needed = ", ".join(k for k in allowed if KEYS[f"{name}.{k}"].required)
-            raise SceneError(f"{name}: missing required section ({name}: {{{needed}}})")
-        return {}
-    if not isinstance(sec, dict):
-        if name == "body":
-            what = (f"keys {', '.join(BODY_KEYS['flexible'])} (a flexible body), "
-                    f"or kind: block, {', '.join(BODY_KEYS['block'])}")
-        else:
-            what = f"keys {', '.join(allowed)}"
-        raise SceneError(f"{name} = {fmt(sec)}: must be a mapping with {what}")
-    for k in sec:
-        if k not in allowed:
-            what = f" for a {kind} body" if name == "body" else ""
-            raise SceneError(f"{name}.{k}: unknown key{what} (allowed: {', '.join(allowed)})")
-    for k, v in sec.items():  # a number left empty is not its default
-        if v is None and KEYS[f"{name}.{k}"].kind == "axis":
-            raise SceneError(f"{name}.{k} = null: {KEYS[f'{name}.{k}'].allowed}, or leave "
-                             "the key out")
-    for k in allowed:
-        spec = KEYS[f"{name}.{k}"]
-        if spec.required and sec.get(k) is None:
-            hint = {"axis": "a number, a list of numbers or a range {start, stop, num}",
-                    "choices": spec.allowed.removeprefix("must be ")}.get(
-                        spec.kind, spec.allowed.removeprefix("must be "))
-            raise SceneError(f"{name}.{k}: missing required key ({hint})")
-    return sec
-
-
-def _axis_spec(key: str, spec: Any) -> tuple[str, Any, int]:
-    """Check an axis's form, without building its values: (form, spec, length)."""
-    if is_number(spec):
-        return "scalar", as_float(spec), 1
-    if isinstance(spec, list):
-        if not spec:
-            raise SceneError(f"{key} = []: an empty list; give at least one value")
-        for v in spec:
-            if not is_number(v):
-                raise SceneError(f"{key} = {fmt(v)}: each value must be a number")
-        if len(spec) > MAX_AXIS_VALUES:
-            raise SceneError(f"{key}: {len(spec):,} values; at most {MAX_AXIS_VALUES:,} "
-                             "per axis")
-        return "list", [as_float(v) for v in spec], len(spec)
-    if isinstance(spec, dict):
-        for k in spec:
-            if k not in ("start", "stop", "num"):
-                raise SceneError(f"{key}.{k}: unknown key in a range (allowed: start, stop, "
-                                 "num)")
-        for k in ("start", "stop", "num"):
-            if k not in spec:
-                raise SceneError(f"{key}.{k}: missing (a range is {{start, stop, num}}, "
-                                 "num values from start to stop inclusive)")
-        num = spec["num"]
-        if not (isinstance(num, int) and not isinstance(num, bool) and num >= 1):
-            raise SceneError(f"{key}.num = {fmt(num)}: must be an integer >= 1")
-        if num > MAX_AXIS_VALUES:
-            raise SceneError(f"{key}.num = {num}: at most {MAX_AXIS_VALUES:,} values per axis")
-        for k in ("start", "stop"):
-            v = spec[k]
-            if not (is_number(v) and math.isfinite(as_float(v))):
-                raise SceneError(f"{key}.{k} = {fmt(v)}: must be a finite number")
-        return "range", {**spec, "start": float(spec["start"]), "stop": float(spec["stop"])}, num
-    raise SceneError(f"{key} = {fmt(spec)}: must be a number, a list of numbers or a range "
-                     "{start, stop, num}")
-
-
-def _axis_values(key: str, form: str, spec: Any) -> np.ndarray:
-    """The values of a checked axis spec (float64[n]), each admissible and distinct."""
-    if form == "range":
-        values = np.linspace(float(spec["start"]), float(spec["stop"]), spec["num"])
-    else:
-        values = np.array(spec if form == "list" else [spec], dtype=float)
-    msg = check_values(key, values)
-    if msg is not None:
-        raise SceneError(msg)
-    if values.size > 1:
-        ordered = np.sort(values)
-        same = ordered[1:] == ordered[:-1]
-        if same.any():
-            dup = float(ordered[1:][same][0])
-            if form == "range":
-                why = ("start = stop" if spec["start"] == spec["stop"]
-                       else "its step is below float64's resolution")
-                raise SceneError(
-                    f"{key} = {{start: {fmt(spec['start'])}, stop: {fmt(spec['stop'])}, "
-                    f"num: {spec['num']}}}: {why}, so the value {fmt(dup)} repeats; the "
-                    "values of an axis must differ (they label the result's coordinates)")
-            raise SceneError(f"{key}: the value {fmt(dup)} is given twice; the values of an "
-                             "axis must differ (they label the result's coordinates)")
-    return values
-
-
-def _words(key: str, spec: Any) -> tuple[tuple[str, ...], bool]:
-    """A word axis (``pulse.shape``, ``impact.law``): one of the key's choices or a list of
-    them (a swept axis). Returns (values, swept)."""
-    allowed = KEYS[key]
-    words = ", ".join(allowed.choices)
-    if isinstance(spec, list):
-        if not spec:
-            raise SceneError(f"{key} = []: an empty list; give one or more of {words}")
-        for v in spec:
-            if not (isinstance(v, str) and v in allowed.choices):
-                raise SceneError(f"{key} = {fmt(v)}: {allowed.allowed}")
-        if len(set(spec)) < len(spec):
-            noun = key.split(".")[1]  # shape, law
-            raise SceneError(f"{key} = {fmt(spec)}: a {noun} is given twice; the values "
-                             "of an axis must differ")
-        return tuple(spec), True
-    if not (isinstance(spec, str) and spec in allowed.choices):
-        raise SceneError(f"{key} = {fmt(spec)}: {allowed.allowed}")
-    return (spec,), False
-
-
-def _shapes(spec: Any) -> tuple[tuple[str, ...], bool]:
-    return _words("pulse.shape", spec)
-
-
 def _impact_law(impact: dict) -> tuple[Axis | None, list[tuple[str, str, Any]]]:
     """The impact law's axes: the law (a word axis; None when the scene does not name
     one: eq. 1, ``vertical``) and the specs of ``impact.e`` and ``impact.e_factor`` given.
@@ -289,7 +151,7 @@ def _impact_law(impact: dict) -> tuple[Axis | None, list[tuple[str, str, Any]]]:
     law_axis = None
     laws: tuple[str, ...] = (DEFAULT_LAW,)
     if impact.get("law") is not None:
-        laws, swept = _words("impact.law", impact["law"])
+        laws, swept = words("impact.law", impact["law"])
         law_axis = Axis("law", "impact.law", laws, swept)
     specs = []
     e_spec = impact.get("e")
@@ -301,10 +163,10 @@ def _impact_law(impact: dict) -> tuple[Axis | None, list[tuple[str, str, Any]]]:
             raise SceneError(f"impact.e = {fmt(e_spec)}: only law constant uses e (the law "
                              f"here is {', '.join(laws)}); remove impact.e or add law: "
                              "constant")
-        specs.append(("e", "impact.e", *_axis_spec("impact.e", e_spec)[:2]))
+        specs.append(("e", "impact.e", *axis_spec("impact.e", e_spec)[:2]))
     if impact.get("e_factor") is not None:
         specs.append(("e_factor", "impact.e_factor",
-                      *_axis_spec("impact.e_factor", impact["e_factor"])[:2]))
+                      *axis_spec("impact.e_factor", impact["e_factor"])[:2]))
     return law_axis, specs
 
 
@@ -313,7 +175,7 @@ def _refine(raw: dict, kind: str) -> dict | None:
     or None."""
     if raw.get("refine") is None:
         return None
-    sec = _section(raw, "refine", kind, required=False)
+    sec = section(raw, "refine", kind, required=False)
     out: dict[str, Any] = {}
     for k, v in sec.items():
         key = f"refine.{k}"
@@ -397,307 +259,6 @@ def _pulse_options(pulse: dict, shapes: tuple[str, ...]) -> list[Axis]:
     return out
 
 
-def _record(ground: dict, base: Path | None, key: str = "record") -> GroundRecord:
-    """The record of a ``ground`` section (``ground.record``; key ``h2``: the second
-    horizontal, ``vertical``: the vertical component), read (and hashed) now."""
-    spec = KEYS[f"ground.{key}"]
-    v = ground[key]
-    if not (isinstance(v, str) and v.strip()):
-        raise SceneError(f"ground.{key} = {fmt(v)}: {spec.allowed}")
-    path = _where(v, base)
-    try:
-        return read_record(path)
-    except RecordError as err:
-        raise SceneError(f"ground.{key}: {err}") from None
-
-
-def _where(v: str, base: Path | None) -> Path:
-    """A path of the scene, relative to ``base`` (the scene file's directory), absolute:
-    the file records where it read a record (spectra re-read it)."""
-    path = Path(v).expanduser()
-    if not path.is_absolute() and base is not None:
-        path = base / path
-    return path.absolute()
-
-
-# Most records a suite may hold (a scene's axis holds at most MAX_AXIS_VALUES values;
-# FEMA P695's sets are 44 and 28 records).
-MAX_RECORDS = 10_000
-MAX_LISTING_BYTES = 16 << 20  # [bytes] a listing of MAX_RECORDS paths is far less
-_LIST_SUFFIXES = (".txt", ".list", ".lst")
-
-
-def _is_listing(path: Path) -> bool:
-    """A text file listing record paths (suffix .txt, .list or .lst, and its first line
-    that is not blank or a # comment is not two numbers: a two-column record's is).
-    A file of that suffix that is not text (UTF-16, random bytes) counts as a listing:
-    ``_listing`` says why it cannot be read."""
-    if path.suffix.lower() not in _LIST_SUFFIXES or input_problem(path) is not None:
-        return False
-    try:
-        with path.open("rb") as fh:
-            head = fh.read(1 << 16)
-    except OSError:
-        return False
-    try:
-        text = head.decode("utf-8-sig")
-    except UnicodeDecodeError:
-        return True
-    if "\0" in text:
-        return True
-    for line in text.splitlines():
-        t = line.strip()
-        if not t or t.startswith("#"):
-            continue
-        fields = t.replace(",", " ").split()
-        try:
-            [float(x) for x in fields]
-        except ValueError:
-            return True
-        return len(fields) != 2  # a record's row is two numbers; '123' names a file
-    return True
-
-
-def _listing(path: Path, shown_as: str) -> list[tuple[int, str]]:
-    """(line number, entry) of a listing: UTF-8 text (a byte-order mark, as Notepad
-    saves it, is skipped), one path a line, blank lines and # comments skipped."""
-    key = "ground.records"
-    try:  # the one guard of input files: regular, bounded, UTF-8 text
-        text = decode_text(read_input(path, "listing", SceneError,
-                                      max_bytes=MAX_LISTING_BYTES),
-                           shown_as, SceneError, "listing of record paths (one a line)")
-    except SceneError as err:
-        raise SceneError(f"{key}: {err}") from None
-    return [(i + 1, ln.strip()) for i, ln in enumerate(text.splitlines())
-            if ln.strip() and not ln.strip().startswith("#")]
-
-
-def _record_paths(spec: Any, base: Path | None) -> tuple[list[Path], list[Path],
-                                                          dict[Path, str]]:
-    """The files of ``ground.records`` in order: each entry a path (a file that exists is
-    that file, even if its name holds glob characters such as ``r[1].AT2``), else a glob
-    (sorted), or a listing (one path a line, relative to the listing's directory; #
-    comments; a listed path is a path, never a glob). Returns (records, listings read,
-    where each listed record was named: 'suite.txt, line 3')."""
-    key = "ground.records"
-    entries = spec if isinstance(spec, list) else [spec]
-    if isinstance(spec, list) and not spec:
-        raise SceneError(f"{key} = []: an empty list; {KEYS[key].allowed}")
-    out: list[Path] = []
-    listings: list[Path] = []
-    named: dict[Path, str] = {}
-    for e in entries:
-        if not (isinstance(e, str) and e.strip()):
-            raise SceneError(f"{key} = {fmt(e)}: {KEYS[key].allowed}")
-        if "\0" in e:
-            raise SceneError(f"{key} = {fmt(e)}: a NUL byte in a file name; no file can "
-                             "have it")
-        path = _where(e, base)
-        if has_magic(e) and not os.path.lexists(path):
-            pattern = str(path)
-            found = sorted(Path(p) for p in glob(pattern) if Path(p).is_file())
-            if not found:
-                raise SceneError(f"{key}: {e!r} matches no file (looked for {pattern})")
-            out.extend(found)
-            continue
-        problem = input_problem(path)
-        if problem is not None and problem != "no such file":
-            raise SceneError(f"{key}: {shown(path)}: {problem}")
-        if _is_listing(path):
-            listings.append(path)
-            listed = _listing(path, shown(e))
-            if not listed:
-                raise SceneError(f"{key}: {e} lists no record file")
-            for line, entry in listed:
-                where = f"{shown(e)}, line {line}"
-                if "\0" in entry:
-                    raise SceneError(f"{key}: {where}: a NUL byte in a file name")
-                p = _where(entry, path.parent)
-                if is_input(p, [path]) or (input_problem(p) is None and _is_listing(p)):
-                    what = "the listing itself" if is_input(p, [path]) else "a listing"
-                    raise SceneError(f"{key}: {where}: {shown(entry)} is {what}; a listing "
-                                     "names record files (.AT2 or two-column), one a line")
-                named[p] = where
-                out.append(p)
-                if len(out) > MAX_RECORDS:
-                    break
-        else:
-            out.append(path)
-        if len(out) > MAX_RECORDS:
-            break
-    if len(out) > MAX_RECORDS:
-        raise SceneError(f"{key}: more than {MAX_RECORDS:,} records; split the suite")
-    seen: dict[str, Path] = {}
-    for path in out:
-        problem = input_problem(path)
-        if problem is not None:
-            where = f"{named[path]}: " if path in named else ""
-            raise SceneError(f"{key}: {where}{shown(path)}: {problem}")
-        real = os.path.realpath(path)
-        if real in seen:
-            raise SceneError(f"{key}: {shown(path)} is listed twice (each record once: the "
-                             "file names label the record dimension)")
-        seen[real] = path
-    names: dict[str, Path] = {}
-    for path in out:
-        if path.name in names:
-            raise SceneError(f"{key}: two records named {path.name} ({names[path.name]} and "
-                             f"{path}): the file names label the record dimension, rename "
-                             "one")
-        names[path.name] = path
-    return out, listings, named
-
-
-def _periods(ground: dict) -> list[float]:
-    key = "ground.periods"
-    spec = ground.get("periods", list(DEFAULT_PERIODS))
-    values = spec if isinstance(spec, list) else [spec]
-    if not values or not all(is_number(v) for v in values):
-        raise SceneError(f"{key} = {fmt(spec)}: {KEYS[key].allowed}")
-    out = [as_float(v) for v in values]
-    for v in out:
-        if not (0.0 <= v <= 100.0):
-            raise SceneError(f"{key} = {fmt(v)}: {KEYS[key].allowed}")
-    if len(set(out)) != len(out):
-        raise SceneError(f"{key} = {fmt(spec)}: a period is given twice")
-    return out
-
-
-def _scale(ground: dict) -> tuple[str | None, str, Any, float, float]:
-    """(im or None, form, values spec, period [s] or NaN, cloud factor or NaN) of
-    ``ground.scale``."""
-    key = "ground.scale"
-    v = ground.get("scale", "none")
-    if v is None or v == "none":
-        return None, "", None, math.nan, 1.0
-    if not isinstance(v, dict):
-        raise SceneError(f"{key} = {fmt(v)}: {KEYS[key].allowed}")
-    if "factor" in v:
-        extra = sorted(set(v) - {"factor"})
-        if extra:
-            raise SceneError(f"{key}.{extra[0]}: not with factor ({KEYS[key].allowed})")
-        f = v["factor"]
-        if not is_number(f) or check_values(f"{key}.factor", np.array([as_float(f)])):
-            raise SceneError(f"{key}.factor = {fmt(f)}: {KEYS[key + '.factor'].allowed}")
-        return None, "", None, math.nan, as_float(f)
-    for k in v:
-        if k not in ("im", "values", "period", "component"):
-            raise SceneError(f"{key}.{k}: unknown key (allowed: im, values, period, "
-                             "component; or factor alone)")
-    im = v.get("im")
-    if isinstance(im, str) and RECORD_IMS.get(im, ("", "", 1))[2] == 0:
-        raise SceneError(f"{key}.im = {im}: does not change when a record is scaled, so no "
-                         f"factor can reach a stripe of it; {KEYS[key + '.im'].allowed}")
-    if not isinstance(im, str) or im not in SCALE_IMS:
-        raise SceneError(f"{key}.im = {fmt(im)}: {KEYS[key + '.im'].allowed}")
-    if v.get("values") is None:
-        raise SceneError(f"{key}.values: missing required key (the stripes' {im} values: "
-                         "a number, a list of numbers or a range {start, stop, num})")
-    form, spec, _ = _axis_spec(f"{key}.values", v["values"])
-    period = math.nan
-    if im == "Sa":
-        T = v.get("period")
-        if T is None:
-            raise SceneError(f"{key}.period: missing required key (Sa's period [s])")
-        if not is_number(T) or check_values(f"{key}.period", np.array([as_float(T)])):
-            raise SceneError(f"{key}.period = {fmt(T)}: {KEYS[key + '.period'].allowed}")
-        period = as_float(T)
-    elif v.get("period") is not None:
-        raise SceneError(f"{key}.period = {fmt(v['period'])}: only with im: Sa")
-    return im, form, spec, period, math.nan
-
-
-def _avgsa(ground: dict, period: float) -> tuple[tuple[float, float], str]:
-    """AvgSa's period range [s] and how it was chosen (``rocksweep.physics.suite``):
-    ``ground.avgsa``, else AVGSA_RANGE x T_ref, T_ref the Sa stripes' period or 2 pi / p."""
-    key = "ground.avgsa"
-    spec = ground.get("avgsa")
-    if spec is not None:
-        ok = (isinstance(spec, list) and len(spec) == 2 and all(is_number(v) for v in spec))
-        lo, hi = (as_float(spec[0]), as_float(spec[1])) if ok else (math.nan, math.nan)
-        if not (ok and 0.0 < lo <= hi <= 100.0):
-            raise SceneError(f"{key} = {fmt(spec)}: {KEYS[key].allowed}")
-        return (lo, hi), f"ground.avgsa = [{lo:g}, {hi:g}] s"
-    if math.isfinite(period):
-        t_ref, why = period, "scale.period"
-    else:
-        form, pspec, _ = _axis_spec("ground.p", ground["p"])
-        p = _axis_values("ground.p", form, pspec)
-        t_ref = 2.0 * math.pi / float(np.exp(np.mean(np.log(p))))
-        why = "2 pi / p" if p.size == 1 else "2 pi / p (geometric mean of the swept p)"
-    a, b = AVGSA_RANGE
-    return (a * t_ref, b * t_ref), f"{a:g}-{b:g} x T_ref, T_ref = {why} = {t_ref:.4g} s"
-
-
-def _suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...] | None = None
-           ) -> tuple[Suite, tuple[str, str, Any] | None, tuple[str, ...]]:
-    """The suite of a ``ground.records`` section (records read and hashed, IMs computed
-    now), the stripe axis's (name, form, spec), None for a cloud, and the files read
-    (records and listings). given: the records already read (a result file's stored
-    copies): ``ground.records`` is then not read."""
-    for k in ("record", "A_ratio"):
-        if ground.get(k) is not None:
-            other = ("ground.scale: {im: PGA_ratio, values: ...}" if k == "A_ratio"
-                     else "a list in ground.records")
-            raise SceneError(f"ground.{k}: not with ground.records (use {other})")
-    im, form, spec, period, factor = _scale(ground)
-    scale = ground.get("scale")
-    component = scale.get("component", "H1") if isinstance(scale, dict) else "H1"
-    if component not in COMPONENTS:
-        raise SceneError(f"ground.scale.component = {fmt(component)}: "
-                         f"{KEYS['ground.scale.component'].allowed}")
-    missing = ground.get("missing", "error")
-    if missing not in ("error", "skip"):
-        raise SceneError(f"ground.missing = {fmt(missing)}: {KEYS['ground.missing'].allowed}")
-    folder = _peer_folder(ground["records"], base)
-    if folder is None and missing != "error":
-        raise SceneError("ground.missing: applies to a folder of PEER downloads "
-                         "(ground.records: FOLDER)")
-    h2: tuple = ()
-    vertical: tuple = ()
-    read: tuple[str, ...] = ()
-    if folder is not None:  # read again on a rebuild: the pairs are the folder's
-        records, h2, vertical, names, read = peer_suite(folder, missing == "skip")
-    elif given is not None:
-        records = list(given)
-        names = [Path(r.source).name for r in records]
-    else:
-        paths, listings, named = _record_paths(ground["records"], base)
-        records = []
-        for path in paths:
-            try:
-                records.append(read_record(path))
-            except RecordError as err:
-                where = f"{named[path]}: " if path in named else ""
-                raise SceneError(f"ground.records: {where}{err}") from None
-        names = [p.name for p in paths]
-        read = tuple(str(p) for p in (*paths, *listings))
-    if component == ROTD50 and not h2:
-        raise SceneError("ground.scale.component = 'RotD50': needs both horizontals of "
-                         "every record (ground.records: a folder of PEER downloads)")
-    if component == ROTD50 and im is None:
-        raise SceneError("ground.scale.component = 'RotD50': scales stripes (ground.scale: "
-                         "{im: ..., values: ...})")
-    values = _axis_values("ground.scale.values", form, spec).tolist() if im else []
-    try:
-        suite = make_suite(records, names, im, values, period, factor,
-                           _periods(ground), *_avgsa(ground, period), h2=h2,
-                           vertical=vertical, component=component)
-    except SuiteError as err:
-        raise SceneError(f"ground.records: {err}") from None
-    return suite, ((im, form, spec) if im else None), read
-
-
-def _peer_folder(spec: Any, base: Path | None) -> Path | None:
-    """The folder of ``ground.records: FOLDER`` (one entry that is a directory), else
-    None."""
-    entry = spec[0] if isinstance(spec, list) and len(spec) == 1 else spec
-    if not (isinstance(entry, str) and entry.strip()) or "\0" in entry:
-        return None
-    path = _where(entry, base)
-    return path if path.is_dir() else None
-
-
 @dataclasses.dataclass
 class _Motion:
     """The ground motion of a scene, as its sections give it (before the axes are built).
@@ -742,13 +303,13 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     raw = _document(text, overrides)
     name = _name(raw)
     body, kind, physical = _body(raw)
-    impact = _section(raw, "impact", kind, required=kind == "flexible")
+    impact = section(raw, "impact", kind, required=kind == "flexible")
     if raw.get("ground") is not None and raw.get("pulse") is not None:
         raise SceneError("pulse, ground: give one of them (a pulse, or a recorded ground "
                          "motion)")
-    initial = _section(raw, "initial", kind, required=False)
+    initial = section(raw, "initial", kind, required=False)
     motion = _motion(raw, kind, base, given_record, given_records, given_vertical)
-    numerics_sec = _section(raw, "numerics", kind, required=False)
+    numerics_sec = section(raw, "numerics", kind, required=False)
     energy, contact, check = _outputs(raw, kind, body.get("mu"))
 
     # forms and lengths first: the grid's size is known before any value is built
@@ -759,7 +320,6 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
                          "while the pulse acts; on a floor give the ground motion as a "
                          "record with ground.vertical, which reaches the floor unfiltered)")
     # the orientation and the floor: after the records, before the ground's own axes
-    from rocksweep.scene.floors import excitation_path  # it uses this module's helpers
 
     path, path_specs, path_inputs = excitation_path(
         raw, motion.ground, kind, motion.free, motion.record, motion.suite, base, physical,
@@ -811,7 +371,7 @@ def _name(raw: dict) -> str | None:
 def _body(raw: dict) -> tuple[dict, str, dict | None]:
     """The ``body`` section: (keys, kind, physical). A ``physical`` body (the laboratory's
     numbers) becomes a flexible one (its Pi groups and p); physical keeps its numbers."""
-    body = _section(raw, "body", "flexible", required=True)
+    body = section(raw, "body", "flexible", required=True)
     kind = body.get("kind", "flexible")
     if kind != "physical":
         return body, kind, None
@@ -833,19 +393,19 @@ def _motion(raw: dict, kind: str, base: Path | None, given_record: GroundRecord 
     component if given, or a suite of records)."""
     for name in ("pulse", "ground"):
         if name in raw and raw[name] is None:  # refused as every null section
-            _section(raw, name, kind, required=False)
+            section(raw, name, kind, required=False)
     if raw.get("ground") is None and raw.get("pulse") is None:
         return _Motion(free=True, pulse={"shape": FREE, "w_over_p": 0.0, "A_ratio": 0.0})
     if raw.get("ground") is None:
-        pulse = _section(raw, "pulse", kind, required=True)
+        pulse = section(raw, "pulse", kind, required=True)
         return _Motion(free=False, pulse=pulse, pulse_vertical=pulse_vertical(pulse))
-    ground = _section(raw, "ground", kind, required=True)
+    ground = section(raw, "ground", kind, required=True)
     if ground.get("vertical") is not None and ground.get("record") is None:
         raise SceneError(f"ground.vertical = {fmt(ground['vertical'])}: works with one "
                          "ground.record (its horizontal component) only, not with "
                          "ground.records")
     if ground.get("records") is not None:
-        suite, stripe, inputs = _suite(ground, base, given_records)
+        suite, stripe, inputs = ground_suite(ground, base, given_records)
         return _Motion(free=False, pulse={"shape": RECORD, "p": ground["p"]}, suite=suite,
                        stripe=stripe, inputs=inputs, ground=ground)
     for k in ("scale", "periods", "avgsa"):
@@ -858,11 +418,11 @@ def _motion(raw: dict, kind: str, base: Path | None, given_record: GroundRecord 
     if ground.get("A_ratio") is None:
         raise SceneError("ground.A_ratio: missing required key (a number, a list of "
                          "numbers or a range {start, stop, num})")
-    record = _record(ground, base) if given_record is None else given_record
+    record = ground_record(ground, base) if given_record is None else given_record
     inputs = (str(record.source),) if given_record is None else ()
     vertical = given_vertical
     if ground.get("vertical") is not None and vertical is None:
-        vertical = _record(ground, base, "vertical")
+        vertical = ground_record(ground, base, "vertical")
         inputs = (*inputs, str(vertical.source))
     return _Motion(free=False,
                    pulse={"shape": RECORD, "A_ratio": ground["A_ratio"], "p": ground["p"]},
@@ -874,7 +434,7 @@ def _motion(raw: dict, kind: str, base: Path | None, given_record: GroundRecord 
 def _outputs(raw: dict, kind: str, mu_spec: Any) -> tuple[bool, bool, bool]:
     """The ``outputs`` section: (energy, contact, check). ``body.mu`` (mu_spec, None: not
     given) turns the contact outputs on."""
-    outputs = _section(raw, "outputs", kind, required=False)
+    outputs = section(raw, "outputs", kind, required=False)
     energy = outputs.get("energy", KEYS["outputs.energy"].default)
     if not isinstance(energy, bool):
         raise SceneError(f"outputs.energy = {fmt(energy)}: {KEYS['outputs.energy'].allowed}")
@@ -897,7 +457,7 @@ def _forms(motion: _Motion) -> _Forms:
     if motion.free:
         return _Forms((FREE,), False, "pulse", PULSE_AXES, [])
     if motion.record is None and motion.suite is None:
-        shapes, shape_swept = _shapes(motion.pulse["shape"])
+        shapes, shape_swept = shape_words(motion.pulse["shape"])
         return _Forms(shapes, shape_swept, "pulse", PULSE_AXES,
                       _pulse_options(motion.pulse, shapes))
     return _Forms((RECORD,), False, "ground",
@@ -915,17 +475,17 @@ def _axis_specs(kind: str, body: dict, impact: dict, initial: dict, motion: _Mot
     specs: list[tuple[str, str, str, Any]] = []
     for k in BODY_KEYS[kind]:
         spec = body.get(k, KEYS[f"body.{k}"].default)
-        specs.append((k, f"body.{k}", *_axis_spec(f"body.{k}", spec)[:2]))
+        specs.append((k, f"body.{k}", *axis_spec(f"body.{k}", spec)[:2]))
     lam = impact.get("lam", 0.0)  # a block without an impact section: Housner's corner
-    specs.append(("lam", "impact.lam", *_axis_spec("impact.lam", lam)[:2]))
+    specs.append(("lam", "impact.lam", *axis_spec("impact.lam", lam)[:2]))
     specs.extend(law_specs)  # after lam (and the law's axis, added by _axes)
     for k in INITIAL:  # the initial state's keys given (none: at rest, no axis)
         if initial.get(k) is not None:
-            specs.append((k, f"initial.{k}", *_axis_spec(f"initial.{k}", initial[k])[:2]))
+            specs.append((k, f"initial.{k}", *axis_spec(f"initial.{k}", initial[k])[:2]))
     for k in VERTICAL_KEYS if motion.pulse_vertical is not None else ():
         spec = motion.pulse_vertical.get(k, KEYS[f"pulse.vertical.{k}"].default)
         key = f"pulse.vertical.{k}"
-        specs.append((f"vertical.{k}", key, *_axis_spec(key, spec)[:2]))
+        specs.append((f"vertical.{k}", key, *axis_spec(key, spec)[:2]))
     if motion.suite is not None:  # the records (words), then the stripes, before p
         specs.append(("record", "ground.record", "words", motion.suite.names))
         if motion.stripe is not None:
@@ -937,10 +497,10 @@ def _axis_specs(kind: str, body: dict, impact: dict, initial: dict, motion: _Mot
         if motion.free:  # not the user's: no check (w_over_p = 0 is no ground motion)
             specs.append((k, key, "given", motion.pulse[k]))
             continue
-        specs.append((k, key, *_axis_spec(key, motion.pulse[k])[:2]))
+        specs.append((k, key, *axis_spec(key, motion.pulse[k])[:2]))
     mu_spec = body.get("mu")
     if mu_spec is not None:  # the last axis: the same grid of runs, flagged per mu
-        specs.append(("mu", "body.mu", *_axis_spec("body.mu", mu_spec)[:2]))
+        specs.append(("mu", "body.mu", *axis_spec("body.mu", mu_spec)[:2]))
     return specs
 
 
@@ -972,13 +532,13 @@ def _axes(motion: _Motion, forms: _Forms, specs: list[tuple[str, str, str, Any]]
         if form == "words":  # a suite's records: always a dimension
             axes.append(Axis(name_, key, tuple(spec), True))
             continue
-        if form == "stripes":  # checked by _suite; always a dimension
+        if form == "stripes":  # checked by ground_suite; always a dimension
             axes.append(Axis(name_, key, motion.suite.levels, True))
             continue
         if form == "given":  # a free scene's pulse axes (no ground motion)
             axes.append(Axis(name_, key, (float(spec),), False))
             continue
-        values = _axis_values(key, form, spec)
+        values = axis_values(key, form, spec)
         axes.append(Axis(name_, key, tuple(values.tolist()), form != "scalar"))
         if name_ == "lam" and law_axis is not None:
             axes.append(law_axis)

@@ -77,8 +77,9 @@ def peer_suite(folder: Path, skip: bool) -> tuple:
     (``skip``)."""
     import warnings
 
+    from rocksweep.errors import RecordError
     from rocksweep.physics.path import check_pair
-    from rocksweep.physics.records import RecordError, read_record
+    from rocksweep.physics.records import read_record
     from rocksweep.physics.suite import RecordWarning
 
     key = "ground.records"
