@@ -15,15 +15,13 @@ from collections.abc import Callable
 from typing import Any
 
 
-class RocksweepError(Exception):
-    """A problem the user can fix; ``str()`` is one line.
-
-    A message that names an argument of the caller (``rtol = 0.3``, "pass
-    ``resume=True``") is a template whose fields are ``Arg``s: ``str()`` says them as the
-    Python API's keywords, ``said(words)`` in another caller's words (the command line's
-    options: ``rocksweep.cli.main``); a field that is itself a ``RocksweepError`` (a message
-    wrapping another) is said in the same words. The library never writes a command-line
-    option."""
+class Said:
+    """A message that may name arguments of the caller: a template whose fields are
+    ``Arg``s (``rtol = 0.3``, "pass ``resume=True``"). ``str()`` says them as the Python
+    API's keywords, ``said(words)`` in another caller's words (the command line's options:
+    ``rocksweep.cli.main``); a field that is itself a ``Said`` (a message wrapping another)
+    is said in the same words. The library never writes a command-line option. The base of
+    ``RocksweepError`` and of ``AnalysisWarning``: an error and a warning are said alike."""
 
     def __init__(self, message: str = "", /, *args: Any, **fields: Any) -> None:
         self.template = message
@@ -36,7 +34,12 @@ class RocksweepError(Exception):
             return str(self)
         return _filled(self.template, {
             k: words(v) if isinstance(v, Arg) else v.said(words)
-            if isinstance(v, RocksweepError) else v for k, v in self.fields.items()})
+            if isinstance(v, Said) else v for k, v in self.fields.items()})
+
+
+class RocksweepError(Said, Exception):
+    """A problem the user can fix; ``str()`` is one line, its arguments said as ``Said``
+    says them."""
 
 
 def _filled(template: str, fields: dict[str, Any]) -> str:
@@ -60,7 +63,8 @@ class Arg:
     name: the keyword (``rtol``, ``resume``; ``overrides`` for a scene key set by the
     caller); value: as given, or none. kind:
     - ``value``: ``rtol = 0.3`` (the name alone without a value),
-    - ``flag``: a flag to switch on, ``resume=True``,
+    - ``flag``: a flag to switch on, ``resume=True`` (value True), or off, ``joint=False``
+      (value False),
     - ``keyword``: an argument to give, its value the caller's, ``p=...``,
     - ``set_key``: a scene key set by ``overrides`` (value: the key),
       ``overrides['pulse.A_ratio']``,
@@ -78,7 +82,7 @@ class Arg:
 
     def __str__(self) -> str:
         if self.kind == "flag":
-            return f"{self.name}=True"
+            return f"{self.name}={self.value}"
         if self.kind == "keyword":
             return f"{self.name}=..."
         if self.kind == "set_key":
@@ -90,9 +94,10 @@ class Arg:
         return f"{self.name} = {self.value!r}" if self.given else self.name
 
 
-def flag(name: str) -> Arg:
-    """A flag the message asks for (``resume=True``)."""
-    return Arg(name, True, "flag")
+def flag(name: str, on: bool = True) -> Arg:
+    """A flag the message asks for (``resume=True``), or asks to leave off (``on=False``:
+    ``joint=False``)."""
+    return Arg(name, bool(on), "flag")
 
 
 def set_key(key: str, kind: str = "set_key") -> Arg:
@@ -185,10 +190,10 @@ class PlotError(RocksweepError, ValueError):
     """A Dataset that has no figure (figures.by_kind)."""
 
 
-class AnalysisWarning(UserWarning):
+class AnalysisWarning(Said, UserWarning):
     """An analysis of points that cannot all be trusted (``analysis.states.trust``: not
     computed, flagged): the result is marked, and this warning says why (the command line
-    prints it as one ``Warning:`` line)."""
+    prints it as one ``Warning:`` line, its arguments said as options, as an error's)."""
 
 
 class FragilityWarning(AnalysisWarning):

@@ -3,6 +3,8 @@ tests/ on sys.path, there being no package)."""
 
 from __future__ import annotations
 
+import ast
+
 
 def one_line_error(result, code: int | None = None) -> str:
     """The single line a failed CLI run printed (a click ``Result``): a non-zero exit
@@ -50,3 +52,15 @@ def kill_sweep_when(args: list[str], cwd, ready, timeout: float = 300.0) -> None
             proc.kill()
         proc.communicate(timeout=30)
     assert proc.returncode == -signal.SIGKILL
+
+
+def docstring_ids(tree: ast.AST) -> set[int]:
+    """ids of the docstring constants of a module's, classes' and functions' bodies (scans
+    of message strings leave them out)."""
+    ids = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Module | ast.ClassDef | ast.FunctionDef | ast.AsyncFunctionDef):
+            body = node.body
+            if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
+                ids.add(id(body[0].value))
+    return ids

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from bodies import FIG3_YAML
+from helpers import docstring_ids
 
 from rocksweep import errors
 
@@ -89,16 +90,6 @@ def test_adaptive_settings_are_checked_once_with_the_schema_wording():
 OPTION = re.compile(r"(?<![\w-])--[a-z]")
 
 
-def _docstrings(tree: ast.AST) -> set[int]:
-    ids = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Module | ast.ClassDef | ast.FunctionDef | ast.AsyncFunctionDef):
-            body = node.body
-            if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
-                ids.add(id(body[0].value))
-    return ids
-
-
 def test_no_library_string_names_a_command_line_option():
     """The library (everything but ``rocksweep/cli/``) writes its messages in its own
     terms: no string of its code (docstrings and comments aside) names a ``--option``; the
@@ -108,7 +99,7 @@ def test_no_library_string_names_a_command_line_option():
         if path.relative_to(PKG).parts[0] == "cli":
             continue
         tree = ast.parse(path.read_text())
-        docs = _docstrings(tree)
+        docs = docstring_ids(tree)
         for node in ast.walk(tree):
             if (isinstance(node, ast.Constant) and isinstance(node.value, str)
                     and id(node) not in docs and len(node.value) > 3

@@ -16,6 +16,7 @@ import re
 from pathlib import Path
 
 import pytest
+from helpers import docstring_ids
 
 from rocksweep.vocab import axes, ground, laws, outcomes, settings
 
@@ -42,16 +43,6 @@ HOMES = {
 }
 
 
-def _docstrings(tree: ast.AST) -> set[int]:
-    ids = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Module | ast.ClassDef | ast.FunctionDef | ast.AsyncFunctionDef):
-            body = node.body
-            if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
-                ids.add(id(body[0].value))
-    return ids
-
-
 def _strings(nodes) -> list[str]:
     return [n.value for n in nodes if isinstance(n, ast.Constant) and isinstance(n.value, str)]
 
@@ -59,7 +50,7 @@ def _strings(nodes) -> list[str]:
 def redefinitions(src: str, where: str) -> list[str]:
     """Lines of ``src`` that type a list of one family's names (see the module docstring)."""
     tree = ast.parse(src)
-    docs = _docstrings(tree)
+    docs = docstring_ids(tree)
     found = []
     for node in ast.walk(tree):
         if isinstance(node, ast.IfExp):  # "alpha" if block else "alpha_cg": a mapping

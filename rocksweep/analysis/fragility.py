@@ -97,7 +97,7 @@ from rocksweep.analysis.states import (
     severity,
     state_groups,
 )
-from rocksweep.errors import Arg, FragilityError, FragilityWarning
+from rocksweep.errors import Arg, FragilityError, FragilityWarning, flag
 from rocksweep.fields import plain
 from rocksweep.vocab.ground import AVGSA
 from rocksweep.vocab.outcomes import MODE1, MODE2
@@ -388,8 +388,8 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     out = _dataset(ds, state, states, axis, counts, fits, grid, N, seed, ci)
     out.attrs["joint"] = np.int8(bool(joint))
     if warn:
-        for text in verdict_lines(out, fits.why):
-            warnings.warn(text, FragilityWarning, stacklevel=2)
+        for line in verdict_lines(out, fits.why):
+            warnings.warn(line, stacklevel=2)
     return out
 
 
@@ -422,7 +422,7 @@ class _Fits:
     beta of each resample; ``n_undef`` (nS, n_o) resamples without a finite fit."""
 
     res: dict[str, np.ndarray]
-    why: list[list[dict[str, str]]]
+    why: list[list[dict[str, Any]]]
     fit_kind: np.ndarray
     curve: np.ndarray
     band: np.ndarray
@@ -493,9 +493,10 @@ def _parallel(f: _Fits, o: int, idxs: list[int], lnx: np.ndarray, m: np.ndarray,
     p = float(chi2.sf(stat, dof))
     if p < PARALLEL_P:
         for q in use:
-            f.why[idxs[q]][o]["parallel_rejected"] = (
+            f.why[idxs[q]][o]["parallel_rejected"] = FragilityWarning(
                 f"likelihood ratio {stat:.3g} on {dof} dof, p = {p:.2g}: one beta does "
-                "not fit these states; fit them separately (joint=False)")
+                "not fit these states; fit them separately ({joint})",
+                joint=flag("joint", False))
 
 
 def _crossing(f: _Fits, c: Counts, states: list[str], axis: IMAxis) -> None:
@@ -703,7 +704,7 @@ def _stripe_variables(c: Counts, axis: IMAxis, dims_c: list[str],
 
 
 def _verdicts(kind: str, idxs: list[int], o: int, lnx: np.ndarray, m: np.ndarray,
-              med: np.ndarray, bet: np.ndarray, why: list[list[dict[str, str]]],
+              med: np.ndarray, bet: np.ndarray, why: list[list[dict[str, Any]]],
               c: Counts, states: list[str], stripes: bool) -> None:
     """The data verdicts of one group's point fit (in ``why``): extrapolated,
     non_monotone (stripes), censored (a mode alone), flagged (the excluded points could
@@ -734,9 +735,9 @@ def _verdicts(kind: str, idxs: list[int], o: int, lnx: np.ndarray, m: np.ndarray
             over = c.over_all[o] & counted
             other = int(over.sum() - own.sum())
             if over.sum() and other >= CENSORED_SHARE * over.sum():
-                w["censored"] = (f"the other mode holds {other} of {int(over.sum())} "
-                                 "overturning points; fit mode1 and mode2 together "
-                                 "(joint=True)")
+                w["censored"] = FragilityWarning(
+                    f"the other mode holds {other} of {int(over.sum())} overturning points; "
+                    "fit mode1 and mode2 together ({joint})", joint=flag("joint"))
     if flagged.any():
         base = np.array([med[q] for q in range(len(idxs))])
         for as_cat in (0, len(idxs)):
@@ -753,10 +754,12 @@ def _verdicts(kind: str, idxs: list[int], o: int, lnx: np.ndarray, m: np.ndarray
                                             "could move im_median")
 
 
-def verdict_lines(frag: xr.Dataset, why: list[list[dict[str, str]]] | None = None
-                  ) -> list[str]:
-    """One line per curve of a ``fragility`` Dataset whose ``reason`` is not "ok": where,
-    which state, and why (with the numbers of ``why[state][curve]`` when given)."""
+def verdict_lines(frag: xr.Dataset, why: list[list[dict[str, Any]]] | None = None
+                  ) -> list[FragilityWarning]:
+    """One ``FragilityWarning`` per curve of a ``fragility`` Dataset whose ``reason`` is
+    not "ok": where, which state, and why (with the numbers of ``why[state][curve]`` when
+    given: a text, or a ``FragilityWarning`` that names an argument). ``str()`` of each is
+    the line in the Python API's words; the command line says it with its options."""
     lines = []
     reason = frag["reason"]
     dims = [d for d in reason.dims if d != "state"]
@@ -775,10 +778,19 @@ def verdict_lines(frag: xr.Dataset, why: list[list[dict[str, str]]] | None = Non
             where = ", ".join(f"{d} = {_json(frag[d].values[i]) if d in frag.coords else i}"
                               for d, i in sel.items())
             detail = why[si][o] if why is not None else {}
-            parts = [f"{wd} ({detail[wd]})" if detail.get(wd) else wd
-                     for wd in words.split(",")]
-            lines.append(f"fragility{' ' + where if where else ''}, state {st}: "
-                         + "; ".join(parts))
+            # the words and places are fields, not template text: a brace in a coordinate
+            # or a record's name is not a field
+            fields: dict[str, Any] = {"where": " " + where if where else "", "state": st}
+            parts = []
+            for k, wd in enumerate(words.split(",")):
+                fields[f"w{k}"] = wd
+                if detail.get(wd):
+                    fields[f"d{k}"] = detail[wd]
+                    parts.append(f"{{w{k}}} ({{d{k}}})")
+                else:
+                    parts.append(f"{{w{k}}}")
+            lines.append(FragilityWarning("fragility{where}, state {state}: "
+                                          + "; ".join(parts), **fields))
     return lines
 
 

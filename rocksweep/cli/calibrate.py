@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from rocksweep.cli.main import load, main, user_errors
+from rocksweep.cli.main import load, main, user_errors, warning_line
 from rocksweep.cli.options import dpi_option, overwrite_option, scene_argument, set_option
 from rocksweep.vocab.kinds import CALIBRATION
 
@@ -78,7 +78,7 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
                        overrides=list(overrides), p=p, noise=noise)
     for w in caught:
         if issubclass(w.category, CalibrationWarning):
-            click.echo(f"Warning: {w.message}", err=True)
+            click.echo(warning_line(w.message), err=True)
         else:
             warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     for key in ds["parameter"].values.tolist():

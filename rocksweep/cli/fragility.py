@@ -11,7 +11,7 @@ import click
 
 from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP, DEFAULT_SEED, MAX_BOOTSTRAP
 from rocksweep.cli.helpers import check_table_outputs, write_table
-from rocksweep.cli.main import main, user_errors
+from rocksweep.cli.main import main, user_errors, warning_line
 from rocksweep.cli.options import (
     ci_option,
     dpi_option,
@@ -117,7 +117,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
                                    ci=ci, joint=joint)
     for w in caught:
         if issubclass(w.category, FragilityWarning):
-            click.echo(f"Warning: {w.message}", err=True)
+            click.echo(warning_line(w.message), err=True)
         else:
             warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     frag.attrs["source"] = str(result_path)

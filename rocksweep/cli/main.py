@@ -16,7 +16,7 @@ from pathlib import Path
 import click
 
 import rocksweep
-from rocksweep.errors import Arg, RocksweepError, one_line
+from rocksweep.errors import Arg, RocksweepError, Said, one_line
 
 # The library's argument names whose option is not ``--NAME`` (underscores as dashes)
 OPTIONS = {"overrides": "--set", "output": "-o"}
@@ -25,7 +25,7 @@ OPTIONS = {"overrides": "--set", "output": "-o"}
 def option_words(arg: Arg) -> str:
     """An argument a library message names, said as the command line's option: ``rtol =
     0.3`` as ``--rtol 0.3``, ``resume=True`` as ``--resume``, ``overrides={'pulse.A_ratio':
-    ...}`` as ``--set pulse.A_ratio=VALUE``."""
+    ...}`` as ``--set pulse.A_ratio=VALUE``, ``joint=False`` as ``without --joint``."""
     option = OPTIONS.get(arg.name, f"--{arg.name.replace('_', '-')}")
     if arg.kind == "set_key":
         return f"--set {arg.value}"
@@ -35,6 +35,8 @@ def option_words(arg: Arg) -> str:
         return f"--set {arg.value!r}"
     if arg.kind == "keyword":
         return f"{option} VALUE"
+    if arg.kind == "flag" and arg.value is False:
+        return f"without {option}"
     if arg.kind == "flag" or not arg.given:
         return option
     return f"{option} {arg.value}"
@@ -43,6 +45,13 @@ def option_words(arg: Arg) -> str:
 def said(err: RocksweepError) -> str:
     """A library error as the command line says it: one line, naming its options."""
     return one_line(err.said(option_words))
+
+
+def warning_line(message: Warning | str) -> str:
+    """A library warning as the command line says it: ``Warning: ...``, one line, naming
+    its options (``said``) where it names arguments (a ``Said`` warning)."""
+    text = message.said(option_words) if isinstance(message, Said) else str(message)
+    return f"Warning: {one_line(text)}"
 
 
 class InputError(click.ClickException):
@@ -147,6 +156,6 @@ def _one_line_warnings() -> None:
     import warnings
 
     def show(message, category, filename, lineno, file=None, line=None) -> None:
-        click.echo(f"Warning: {one_line(str(message))}", err=True)
+        click.echo(warning_line(message), err=True)
 
     warnings.showwarning = show

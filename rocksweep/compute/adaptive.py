@@ -57,7 +57,7 @@ from typing import Any
 
 import numpy as np
 
-from rocksweep.errors import AdaptiveError, ApiError, Arg
+from rocksweep.errors import AdaptiveError, ApiError, Arg, flag
 from rocksweep.scene.grid import ChunkRows, Grid
 from rocksweep.scene.model import Scene
 from rocksweep.schema import check_option
@@ -843,7 +843,8 @@ def adaptive_options(adaptive: bool, base: dict | None = None,
     if not adaptive:
         if given:
             k = sorted(given)[0]
-            raise ApiError(f"{k} = {given[k]!r}: an adaptive setting; add adaptive=True")
+            raise ApiError("{setting}: an adaptive setting; add {adaptive}",
+                           setting=Arg(k, given[k]), adaptive=flag("adaptive"))
         return None
     if "axes" in given:
         axes = given["axes"]

@@ -582,3 +582,27 @@ def test_a_file_without_records_is_named_with_the_way_out(tmp_path):
     assert run.exit_code != 0
     assert str(out) in run.output and "ground.records" in run.output
     assert run.output.count("\n") == 1
+
+
+def test_a_verdicts_way_out_is_said_in_the_callers_words():
+    """The way out a verdict names is an argument: Python reads ``joint=True`` /
+    ``joint=False``, the command line's ``Warning:`` line ``--joint`` / ``without --joint``
+    (through the one map of options, as an error's)."""
+    from rocksweep.cli.main import warning_line
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", errors.FragilityWarning)
+        F.fragility(stripes_ds(competing_outcomes()), state="mode2", bootstrap=0)
+        F.fragility(nested_ds(80, 0.4, 0.8, 0.7, 0.15, seed=5),
+                    state=["theta:0.5", "overturn"], bootstrap=0, joint=True)
+    censored = [w.message for w in caught if "censored" in str(w.message)]
+    rejected = [w.message for w in caught if "parallel_rejected" in str(w.message)]
+    assert censored and rejected
+    for m in censored:
+        assert str(m).endswith("fit mode1 and mode2 together (joint=True))")
+        assert warning_line(m).startswith("Warning: fragility, state mode2: ")
+        assert warning_line(m).endswith("fit mode1 and mode2 together (--joint))")
+    for m in rejected:
+        assert "fit them separately (joint=False)" in str(m) and "--" not in str(m)
+        assert "fit them separately (without --joint)" in warning_line(m)
+        assert "joint=" not in warning_line(m)

@@ -18,6 +18,7 @@ import rocksweep
 from rocksweep.analysis.boundaries import boundaries_dataset
 from rocksweep.analysis.calibrate import calibrate_scene
 from rocksweep.analysis.kinds import dataset_kind
+from rocksweep.cli.main import said
 from rocksweep.errors import ApiError, CalibrationError
 
 
@@ -126,8 +127,10 @@ def test_run_checks_before_the_output_and_returns_the_file(tmp_path):
              "pulse": {"shape": "sine", "w_over_p": 2.0, "A_ratio": [1.0, 4.0]}}
     with pytest.raises(TypeError, match="^progress = 1: must be True or False$"):
         rocksweep.run(scene, output=out, progress=1)
-    with pytest.raises(ApiError, match="^coarse = 2: an adaptive setting"):
+    with pytest.raises(ApiError, match="^coarse = 2: an adaptive setting; add adaptive=True$"
+                       ) as err:
         rocksweep.run(scene, output=out, coarse=2)
+    assert said(err.value) == "--coarse 2: an adaptive setting; add --adaptive"
     assert not out.exists()
     ds = rocksweep.run(scene, output=out)
     xr.testing.assert_identical(ds, rocksweep.open(out))
