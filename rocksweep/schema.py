@@ -265,7 +265,9 @@ KEYS: dict[str, Key] = {
     # vertical component, scaled with ground.record, or a harmonic while the pulse acts
     "ground.vertical": Key("string", "must be the path of the record's vertical component, "
                            "a PEER .AT2 (UP) file or a two-column file (t [s], a_v [g], "
-                           "positive up), relative to the scene file, with ground.record",
+                           "positive up), relative to the scene file, with ground.record; "
+                           "with a folder of PEER downloads in ground.records: true or "
+                           "false (whether each record's UP file acts on the body)",
                            required=False),
     "pulse.vertical": Key("string", "must be {amplitude: a [g], w_over_p: w_v/p, phase: "
                           "deg} (a_v = a g sin(w_v t + phase) while the pulse acts)",

@@ -115,6 +115,14 @@ class Suite:
     vertical: tuple = ()
     component: str = H1
     rotd50: np.ndarray | None = field(repr=False, default=None)
+    # whether each record's vertical acts on the body (``ground.vertical: true|false`` of a
+    # folder suite; default: when the folder has UP files), scaled by the record's factor
+    vertical_acts: bool = False
+
+    def acting_vertical(self, r: int) -> GroundRecord | None:
+        """Record r's vertical component when it acts on the body (``vertical_acts``),
+        else None."""
+        return self.vertical[r] if self.vertical_acts else None
 
     def vertical_ims(self) -> dict[str, np.ndarray]:
         """``record_pga_v`` [g] (the vertical's peak) and ``record_v_over_h`` (PGA_v over
@@ -230,7 +238,7 @@ def make_suite(records: list[GroundRecord], names: list[str], im: str | None,
                levels: list[float], period: float, factor: float,
                periods: list[float], avgsa_range: tuple[float, float] | None = None,
                avgsa_rule: str = "", h2: tuple = (), vertical: tuple = (),
-               component: str = H1) -> Suite:
+               component: str = H1, vertical_acts: bool = False) -> Suite:
     """A Suite with every record's IMs computed (once). avgsa_range: (T_lo, T_hi) [s] of
     AvgSa (default ``AVGSA_RANGE`` times ``period``, or times 1 s without one). A record
     whose IM to scale is not a finite number > 0 (PGV 0, Sa 0) is a ``SuiteError`` naming
@@ -270,7 +278,8 @@ def make_suite(records: list[GroundRecord], names: list[str], im: str | None,
                   sa, scale_sa, **more,
                   avgsa_range=(float(avgsa_range[0]), float(avgsa_range[1])),
                   avgsa_rule=avgsa_rule, h2=tuple(h2), vertical=tuple(vertical),
-                  component=component, rotd50=rotd50)
+                  component=component, rotd50=rotd50,
+                  vertical_acts=bool(vertical_acts and vertical))
     if im is not None:
         own = suite.record_im()
         for i, rec in enumerate(records):

@@ -26,6 +26,7 @@ from rocksweep.physics.points import (
     law_code,
     shape_code,
 )
+from rocksweep.physics.records import vertical_samples
 from rocksweep.scene.model import FLOOR_AXES, Scene
 from rocksweep.schema import VERTICAL_KEYS
 from rocksweep.vocab.axes import INITIAL
@@ -115,6 +116,11 @@ class Grid:
         self._i_vert = ([names.index(f"vertical.{k}") for k in VERTICAL_KEYS]
                         if "vertical.amplitude" in names else None)
         self._vertical = scene.vertical_samples()  # a record's vertical component, or None
+        # a folder suite's acting verticals, each on its record's samples (None: none act)
+        self._suite_verticals = (
+            tuple(vertical_samples(v, h) for v, h in zip(suite.vertical, suite.records,
+                                                          strict=True))
+            if suite is not None and suite.vertical_acts else None)
         self._values = [np.asarray(a.values, float)
                         if i not in (self._i_shape, self._i_rec, self._i_law) else None
                         for i, a in enumerate(scene.axes)]
@@ -221,9 +227,11 @@ class Grid:
                       record=su.records[int(r)], law=law[sel], e=e[sel],
                       e_factor=e_factor[sel],
                       initial=None if initial is None else tuple(v[sel] for v in initial),
-                      u_cr=u_cr[sel])
+                      u_cr=u_cr[sel], vertical=None if self._suite_verticals is None
+                      else self._suite_verticals[int(r)])
             rows[sel] = part
-        return ChunkRows(rows, kinds, alpha_ref, E_ref, rec, su.records)
+        return ChunkRows(rows, kinds, alpha_ref, E_ref, rec, su.records,
+                         self._suite_verticals)
 
     def _path_rows(self, multi, rows, body_rows, omega_rock, alpha_ref, kinds, E_ref,
                    impact: tuple, initial: tuple | None = None, u_cr=0.0) -> ChunkRows:
@@ -236,13 +244,15 @@ class Grid:
                if self._path_pos else np.zeros((n, 1), np.int64))
         distinct, inv = np.unique(key, axis=0, return_inverse=True)
         inv = inv.reshape(-1)
-        motions, peaks = [], []
+        motions, peaks, verticals = [], [], []
         for row in distinct:
             values = {sc.axes[i].name: sc.axes[i].values[int(j)]
                       for i, j in zip(self._path_pos, row, strict=True)}
-            m, peak, _ = sc.path_motion(values)
+            m, peak, r = sc.path_motion(values)
             motions.append(m)
             peaks.append(peak)
+            # the record's vertical reaches the floor unfiltered: on the motion's samples
+            verticals.append(sc.path_vertical(m, r))
         m_pga = np.array([m.pga for m in motions])[inv]
         lam = self._values[self._i_lam][multi[self._i_lam]]
         if sc.suite is not None:
@@ -263,8 +273,6 @@ class Grid:
             initial = tuple(np.broadcast_to(np.asarray(v, float), lam.shape) for v in initial)
         u_cr = np.broadcast_to(np.asarray(u_cr, float), lam.shape)
         code = np.full(n, shape_code(RECORD))
-        # a record's vertical reaches the floor unfiltered: on each motion's samples
-        verticals = tuple(sc.path_vertical(m) for m in motions)
         for j, motion in enumerate(motions):
             sel = inv == j
             part = np.empty((int(sel.sum()), L.N_PAR))
@@ -274,7 +282,7 @@ class Grid:
                       initial=None if initial is None else tuple(v[sel] for v in initial),
                       u_cr=u_cr[sel], vertical=verticals[j])
             rows[sel] = part
-        return ChunkRows(rows, kinds, alpha_ref, E_ref, inv, tuple(motions), verticals)
+        return ChunkRows(rows, kinds, alpha_ref, E_ref, inv, tuple(motions), tuple(verticals))
 
     def kinds(self) -> list[int]:
         """The kernel kinds the grid's bodies need (each distinct body visited once)."""

@@ -294,11 +294,19 @@ def ground_suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...
     if folder is None and missing != "error":
         raise SceneError("ground.missing: applies to a folder of PEER downloads "
                          "(ground.records: FOLDER)")
+    acts = ground.get("vertical")
+    if acts is not None and (folder is None or not isinstance(acts, bool)):
+        raise SceneError(f"ground.vertical = {fmt(acts)}: with ground.records, true or false "
+                         "for a folder of PEER downloads (whether each record's UP file acts "
+                         "on the body); a path works with one ground.record")
     h2: tuple = ()
     vertical: tuple = ()
     read: tuple[str, ...] = ()
     if folder is not None:  # read again on a rebuild: the pairs are the folder's
         records, h2, vertical, names, read = peer_suite(folder, missing == "skip")
+        if acts and not vertical:
+            raise SceneError(f"ground.vertical = true: {shown(folder)} has no vertical (UP) "
+                             "files; give them, or leave ground.vertical out")
     elif given is not None:
         records = list(given)
         names = [Path(r.source).name for r in records]
@@ -323,7 +331,8 @@ def ground_suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...
     try:
         suite = make_suite(records, names, im, values, period, factor,
                            _periods(ground), *_avgsa(ground, period), h2=h2,
-                           vertical=vertical, component=component)
+                           vertical=vertical, component=component,
+                           vertical_acts=acts is not False)
     except SuiteError as err:
         raise SceneError(f"ground.records: {err}") from None
     return suite, ((im, form, spec) if im else None), read

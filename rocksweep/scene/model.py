@@ -148,8 +148,9 @@ class Scene:
     def has_vertical(self) -> bool:
         """Whether the ground has a vertical acceleration (``ground.vertical`` or
         ``pulse.vertical``)."""
-        return self.vertical is not None or any(a.name == "vertical.amplitude"
-                                                for a in self.axes)
+        return (self.vertical is not None or (self.suite is not None
+                                              and self.suite.vertical_acts)
+                or any(a.name == "vertical.amplitude" for a in self.axes))
 
     def vertical_samples(self):
         """The vertical record [g] on the horizontal record's samples
@@ -158,12 +159,18 @@ class Scene:
             return None
         return vertical_samples(self.vertical, self.record)
 
-    def path_vertical(self, motion: GroundRecord):
-        """The record's vertical [g] on the samples of a motion of the excitation path
+    def record_vertical(self, r: int = 0) -> GroundRecord | None:
+        """The vertical component acting with record r: ``ground.vertical``, or a folder
+        suite's record r's UP file (``Suite.acting_vertical``); None without one."""
+        if self.suite is not None:
+            return self.suite.acting_vertical(r)
+        return self.vertical
+
+    def path_vertical(self, motion: GroundRecord, r: int = 0):
+        """Record r's vertical [g] on the samples of a motion of the excitation path
         (``physics.path``: it reaches the floor unfiltered), None without one."""
-        if self.vertical is None:
-            return None
-        return vertical_samples(self.vertical, motion)
+        vertical = self.record_vertical(r)
+        return None if vertical is None else vertical_samples(vertical, motion)
 
     def option(self, name: str) -> Any:
         """A pulse option's value (cycles, gamma, nu [deg]): the scene's or the default."""
@@ -222,7 +229,7 @@ class Scene:
                                           np.array([p]))[0])
             return Point(body, float(values["lam"]), RECORD, math.nan, a_ratio,
                          record=su.records[r], p=p, **self._law(values),
-                         initial=self.initial_state(values))
+                         initial=self.initial_state(values), vertical=su.acting_vertical(r))
         if self.record is not None:
             return Point(body, float(values["lam"]), RECORD, math.nan,
                          float(values["A_ratio"]), record=self.record, p=float(values["p"]),
@@ -281,7 +288,7 @@ class Scene:
             p = float(values["p"]) if self.recorded else self.path.p
         return Point(body, float(values["lam"]), RECORD, math.nan, a_ratio, record=motion,
                      p=p, **self._law(values), initial=self.initial_state(values),
-                     vertical=self.vertical)
+                     vertical=self.record_vertical(r))
 
     @property
     def free(self) -> bool:

@@ -400,10 +400,11 @@ def _motion(raw: dict, kind: str, base: Path | None, given_record: GroundRecord 
         pulse = section(raw, "pulse", kind, required=True)
         return _Motion(free=False, pulse=pulse, pulse_vertical=pulse_vertical(pulse))
     ground = section(raw, "ground", kind, required=True)
-    if ground.get("vertical") is not None and ground.get("record") is None:
+    if (ground.get("vertical") is not None and ground.get("record") is None
+            and ground.get("records") is None):
         raise SceneError(f"ground.vertical = {fmt(ground['vertical'])}: works with one "
-                         "ground.record (its horizontal component) only, not with "
-                         "ground.records")
+                         "ground.record (its horizontal component), or as true/false with "
+                         "a folder of PEER downloads in ground.records")
     if ground.get("records") is not None:
         suite, stripe, inputs = ground_suite(ground, base, given_records)
         return _Motion(free=False, pulse={"shape": RECORD, "p": ground["p"]}, suite=suite,

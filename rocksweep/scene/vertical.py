@@ -10,6 +10,7 @@ import numpy as np
 
 from rocksweep.errors import SceneError
 from rocksweep.outputs import shown
+from rocksweep.physics.records import vertical_samples
 from rocksweep.scene.admission import check_vertical_cost
 from rocksweep.scene.model import Scene
 from rocksweep.schema import KEYS, VERTICAL_KEYS, fmt
@@ -51,6 +52,9 @@ def check_vertical_start(scene: Scene) -> None:
                              f"{a0[i, j]:.4g} g at t = 0, so g + a_v <= 0 (the body leaves "
                              "the ground); a sin(phase) must be > -1 at t = 0")
         check_vertical_cost(scene)
+    su = scene.suite
+    if su is not None and su.vertical_acts:
+        _check_suite_start(scene)
     if scene.vertical is not None:
         first = float(scene.vertical_samples()[0]) / scene.record.pga  # per unit of A
         a_ratio = float(np.max(np.abs(scene.axis("A_ratio").values)))
@@ -61,3 +65,26 @@ def check_vertical_start(scene: Scene) -> None:
                              f"sample scaled with ground.A_ratio = {fmt(a_ratio)} is a_v = "
                              f"{a0:.4g} g at t = 0, so g + a_v <= 0 (the body leaves the "
                              "ground); the vertical at t = 0 must be > -1 g")
+
+
+def _check_suite_start(scene: Scene) -> None:
+    """A folder suite's verticals at t = 0: each record's first vertical sample on its
+    horizontal's samples times the largest factor the grid gives that record
+    (``Suite.factors`` over stripes, alpha_ref and p) must be > -1 g."""
+    su = scene.suite
+    alpha = np.asarray(scene.axis(alpha_symbol(scene.kind)).values, float)
+    p = np.asarray(scene.axis("p").values, float)
+    stripes = np.arange(max(len(su.levels), 1))
+    for r, (v, h) in enumerate(zip(su.vertical, su.records, strict=True)):
+        first = float(vertical_samples(v, h)[0])
+        if first >= 0.0:
+            continue
+        s, a, pp = (x.ravel() for x in np.meshgrid(stripes, alpha, p, indexing="ij"))
+        f = float(np.max(su.factors(np.full(s.size, r), None if su.im is None else s, a,
+                                    pp)))
+        if 1.0 + f * first <= 0.0:
+            raise SceneError(f"ground.records: {v.name} (the vertical of {su.names[r]}) "
+                             f"scaled by the factor {f:.4g} of its record is a_v = "
+                             f"{f * first:.4g} g at t = 0, so g + a_v <= 0 (the body leaves "
+                             "the ground); the vertical at t = 0 must be > -1 g (or "
+                             "ground.vertical: false)")

@@ -88,6 +88,9 @@ def suite_attrs(suite) -> dict:
                 "h2": [{"name": r.name, "sha256": r.sha256} for r in suite.h2],
                 "vertical": [None if r is None else {"name": r.name, "sha256": r.sha256}
                              for r in suite.vertical]} if suite.h2 else {}),
+            # whether the verticals act on the body (ground.vertical: true|false); only
+            # stated when it is true (files before it was: the verticals did not act)
+            **({"vertical_acts": True} if suite.vertical_acts else {}),
             "records": [{"name": n, "sha256": r.sha256, "source": str(r.source)}
                         for n, r in zip(suite.names, suite.records, strict=True)]}
 
@@ -95,6 +98,10 @@ def suite_attrs(suite) -> dict:
 def _suite_differences(ss: dict, sn: dict) -> list[str]:
     """One phrase per difference between two ``suite_attrs`` dicts (records by name)."""
     diffs = []
+    if bool(ss.get("vertical_acts")) != bool(sn.get("vertical_acts")):
+        diffs.append(f"ground.vertical: the file's records' verticals "
+                     f"{'act' if ss.get('vertical_acts') else 'do not act'} on the body, "
+                     f"the scene's {'do' if sn.get('vertical_acts') else 'do not'}")
     for k in ("im", "period", "factor", "periods", "component", "h2", "vertical"):
         if ss.get(k) != sn.get(k):
             diffs.append(f"ground.scale {k}: file {ss.get(k)!r}, scene {sn.get(k)!r}"

@@ -65,7 +65,7 @@ def test_record_vertical_with_another_dt_is_resampled(files):
     ("ground: {record: h.txt, vertical: v_down.txt, A_ratio: [1.0, 8.0], p: 2.0}",
      "ground.vertical = "),
     ("ground: {records: [h.txt], vertical: v.txt, p: 2.0}",
-     "ground.vertical = 'v.txt': works with one ground.record"),
+     "ground.vertical = 'v.txt': with ground.records, true or false"),
 ])
 def test_bad_vertical_is_one_line(files, ground, message):
     with pytest.raises(SceneError) as err:
