@@ -39,3 +39,15 @@ def test_a_hand_edit_inside_a_block_is_caught():
     body = mod.blocks(page)["impact_laws"]
     edited = mod.with_block(page, "impact_laws", body.replace("%", " %", 1))
     assert edited != page and mod.blocks(edited)["impact_laws"] != body
+
+
+def test_the_cheap_numbers_are_what_their_commands_compute_now():
+    """The numbers of seconds (``CHEAP``: the shipped small scenes' point count, Figure 5's
+    runs, Figure 2's restitution values) recomputed: a change of the code that moves one
+    fails here, not only when someone reruns the script."""
+    mod = _script()
+    stored = json.loads((ROOT / "docs" / "numbers.json").read_text())
+    assert mod.CHEAP and set(mod.CHEAP) <= set(mod.COMPUTE)
+    for name in mod.CHEAP:
+        assert mod.COMPUTE[name]() == stored[name], \
+            f"{name} moved: run python scripts/make_docs_numbers.py"
