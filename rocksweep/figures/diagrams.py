@@ -43,7 +43,14 @@ from matplotlib.patches import Patch
 from rocksweep.errors import Arg, DiagramError, flag
 from rocksweep.fields import WORD_AXES
 from rocksweep.figures import DEFAULT_DPI
-from rocksweep.figures.style import Figure, given_axes, new_axes, save_figure, wrap_title
+from rocksweep.figures.style import (
+    Figure,
+    curve_colours,
+    given_axes,
+    new_axes,
+    save_figure,
+    wrap_title,
+)
 from rocksweep.store.reader import SweepResult
 from rocksweep.vocab import axes as _axes
 from rocksweep.vocab.axes import DIAGRAM_AXES, RECORD_X
@@ -827,24 +834,34 @@ def a_min_figure(curves: Sequence[AMinCurve], bounds: Sequence[PanelBoundaries] 
     kind: the body kind (labels the amplitude axis). No pyplot."""
     from rocksweep.vocab.outcomes import outcome_word
 
-    fig = Figure(figsize=(6.4, 4.8), layout="constrained")
+    # one legend entry per panel and one per line style, below the axes in two columns:
+    # the figure grows with the entries rather than the legend covering the curves
+    rows = -(-(len(curves) + 2) // 2) if curves else 0
+    fig = Figure(figsize=(6.4, 4.8 + 0.2 * rows), layout="constrained")
     ax = fig.add_subplot()
-    colours = [f"C{k % 10}" for k in range(max(len(curves), len(bounds)))]
+    colours = curve_colours(max(len(curves), len(bounds)))
     for k, b in enumerate(bounds):
         for line in b.lines:
             ax.plot(line.xy[:, 0], line.xy[:, 1], lw=0.5, color=colours[k], alpha=0.5)
+    styles = ((OUTCOME_MODE1, "-"), (OUTCOME_MODE2, "--"))
     for k, c in enumerate(curves):
-        for m, style in ((OUTCOME_MODE1, "-"), (OUTCOME_MODE2, "--")):
+        labelled = False
+        for m, style in styles:
             y = np.where(c.mode == m, c.a_min, np.nan)
+            drawn = np.isfinite(y).any()
             ax.plot(c.x, y, style, color=colours[k], lw=1.5, marker=".", ms=2,
-                    label=f"{_where_label(c.where)} ({outcome_word(m)})"
-                    if np.isfinite(y).any() else None)
+                    label=_where_label(c.where) if drawn and not labelled else None)
+            labelled = labelled or drawn
     if curves:
+        for m, style in styles:  # the line styles of the modes drawn
+            if any(np.isfinite(np.where(c.mode == m, c.a_min, np.nan)).any() for c in curves):
+                ax.plot([], [], style, color="0.3", lw=1.5, label=outcome_word(m))
         ax.set_xlabel(axis_label(curves[0].xname, kind))
         ax.set_ylabel(f"{axis_label(curves[0].yname, kind)} at overturning onset "
                       "($A_{min}$)")
     if ax.get_legend_handles_labels()[0]:
-        ax.legend(fontsize="small")
+        ax.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.12),
+                  frameon=False, ncol=2)
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     return fig

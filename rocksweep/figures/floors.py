@@ -11,6 +11,7 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.figures.results import _curves, _figure
+from rocksweep.figures.style import curve_colours
 from rocksweep.vocab.axes import label as axis_label
 
 X = "floor.period"
@@ -30,8 +31,10 @@ def floor_spectrum_figure(fs: xr.Dataset, *, ax: Any = None,
     curves = list(_curves(da, X))
     step = max(1, int(np.ceil(len(curves) / MAX_CURVES)))
     x = fs[X].values
-    for k, (label, _sel, v) in enumerate(curves[::step]):
-        ax.plot(x, v, "o-", ms=3, color=f"C{k % 10}", label=label or None)
+    drawn = curves[::step]
+    colours = curve_colours(len(drawn))
+    for k, (label, _sel, v) in enumerate(drawn):
+        ax.plot(x, v, "o-", ms=3, color=colours[k], label=label or None)
     ax.set_xscale("log")
     ax.set_xlabel(axis_label(X))
     ax.set_ylabel("P(overturn)" if var == "p_overturn" else

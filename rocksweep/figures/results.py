@@ -119,14 +119,16 @@ def ida_figure(ida: xr.Dataset, *, ax: Any = None, width: str | None = "single")
         if curves and len(panels) > 1 and width != "single":  # side by side
             w = fig.get_size_inches()[0]
             fig.set_size_inches(w, w * 0.8 / len(panels) + 0.8)
+    panel_colours = curve_colours(len(panels))
     for k, (label, sel, v) in enumerate(panels):
         if curves:
             a = axes[min(k, len(axes) - 1)]
             th = ida["theta_max_over_alpha"].isel(sel).transpose("record", im)
             x = ida[im].values
+            colours = curve_colours(th.sizes["record"])
             for r in range(th.sizes["record"]):
                 y = th.values[r]
-                c = f"C{r % 10}"
+                c = colours[r]
                 xs, ys = list(x[np.isfinite(y)]), list(y[np.isfinite(y)])
                 if np.isfinite(v[r]):  # up to the bisected first overturning level
                     keep = [i for i, xx in enumerate(xs) if xx < v[r]]
@@ -148,7 +150,7 @@ def ida_figure(ida: xr.Dataset, *, ax: Any = None, width: str | None = "single")
         hi = ida["ida_hi"].isel(sel).values[order] if "ida_hi" in ida else v[order]
         a.errorbar(v[order], y + 0.15 * k, xerr=[v[order] - np.fmin(lo, v[order]),
                                                np.fmax(hi, v[order]) - v[order]],
-                   fmt="o", ms=3, color=f"C{k % 10}", label=label or None)
+                   fmt="o", ms=3, color=panel_colours[k], label=label or None)
         a.set_xscale("log")
         a.set_xlabel(f"first overturning {xlabel}")
         a.set_ylabel("record (sorted)")
@@ -173,11 +175,13 @@ def boundaries_figure(bd: xr.Dataset, *, ax: Any = None,
         ax = axes[0]
     x = bd[xname].values
     modes = {lab: v for lab, _sel, v in _curves(bd["mode"], xname)}
-    for k, (lab, _sel, a_min) in enumerate(_curves(bd["A_min"], xname)):
+    lines = list(_curves(bd["A_min"], xname))
+    colours = curve_colours(len(lines))
+    for k, (lab, _sel, a_min) in enumerate(lines):
         for m, style, word in ((1, "-", "mode 1"), (2, "--", "mode 2")):
             y = np.where(modes[lab] == m, a_min, np.nan)
             if np.isfinite(y).any():
-                ax.plot(x, y, style, color=f"C{k % 10}", marker=".", ms=3,
+                ax.plot(x, y, style, color=colours[k], marker=".", ms=3,
                         label=f"{lab} ({word})" if lab else word)
     ax.set_xlabel(axis_label(xname, kind))
     ax.set_ylabel(f"{axis_label(str(bd.attrs.get('y_axis', 'A_ratio')), kind)} at "
@@ -202,9 +206,10 @@ def efficiency_figure(eff: xr.Dataset, *, ax: Any = None,
     ims = [str(v) for v in eff["im"].values]
     series = list(_curves(da, "im"))
     wbar = 0.8 / max(len(series), 1)
+    colours = curve_colours(len(series))
     for k, (label, _sel, v) in enumerate(series):
         ax.bar(np.arange(len(ims)) + (k - (len(series) - 1) / 2) * wbar, v, wbar,
-               color=f"C{k % 10}", label=label or None)
+               color=colours[k], label=label or None)
     ax.set_xticks(np.arange(len(ims)), ims, rotation=45, ha="right")
     ax.set_ylabel(r"$\beta$ in ln(scale factor) (lower: better)")
     state = eff.attrs.get("state", "overturn")

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from rocksweep.figures.results import _curves, _figure
-from rocksweep.figures.style import Figure
+from rocksweep.figures.style import Figure, curve_colours
 from rocksweep.vocab import axes as _axes
 
 if TYPE_CHECKING:
@@ -50,17 +50,18 @@ def spectra_figure(sp: xr.Dataset | Spectra, *, ax: Any = None,
     A = sp["A_ratio"].values
     pick = np.unique(np.linspace(0, A.size - 1, min(MAX_CURVES, A.size)).round().astype(int))
     n_lam = sp.sizes.get("lam", 1)
+    pick_colours = curve_colours(len(pick))
     for li in range(n_lam):
         one, gone = ((th.isel(lam=li), over.isel(lam=li)) if "lam" in th.dims
                      else (th, over))
         for n, ai in enumerate(pick):
             o = gone.isel(A_ratio=ai).values
-            axes[0].plot(x, np.where(o, np.nan, one.isel(A_ratio=ai).values), color=f"C{n}",
+            axes[0].plot(x, np.where(o, np.nan, one.isel(A_ratio=ai).values), color=pick_colours[n],
                          ls=LAM_STYLES[li % 4], lw=1.2,
                          label=f"${_axes.latex('A_ratio', kind)}$ = {A[ai]:.3g}"
                          if li == 0 else None)
             # overturned: a row of x per curve above 1, stacked so that none hides another
-            axes[0].plot(x[o], np.full(int(o.sum()), 1.03 + 0.025 * n), "x", color=f"C{n}",
+            axes[0].plot(x[o], np.full(int(o.sum()), 1.03 + 0.025 * n), "x", color=pick_colours[n],
                          ms=3)
     axes[0].axhline(1.0, color="0.5", lw=0.6, ls=":")
     axes[0].set_ylim(0.0, 1.06 + 0.025 * len(pick))
@@ -69,8 +70,10 @@ def spectra_figure(sp: xr.Dataset | Spectra, *, ax: Any = None,
     axes[0].set_title("rocking spectrum" + (" (line style: lam)" if n_lam > 1 else ""),
                       fontsize="small")
     modes = {lab: v for lab, _sel, v in _curves(sp["mode"], freq)} if "mode" in sp else {}
-    for k, (lab, _sel, v) in enumerate(_curves(sp["A_min"], freq)):
-        c = f"C{k % 10}"
+    onsets = list(_curves(sp["A_min"], freq))
+    colours = curve_colours(len(onsets))
+    for k, (lab, _sel, v) in enumerate(onsets):
+        c = colours[k]
         axes[-1].plot(x, v, color=c, lw=1.2, label=lab or None)
         m = modes.get(lab, np.zeros(v.shape))
         axes[-1].plot(x[m == 1], v[m == 1], "o", color=c, ms=3)

@@ -123,7 +123,9 @@ def test_a_min_of_a_synthetic_threshold_and_csv():
     assert len(text.splitlines()) == 1 + 10 and "cosine,3.0," in text
     fig = a_min_figure(curves, bd.diagram_boundaries(sc, outcome), title="t")
     assert type(fig).__name__ == "Figure" and len(fig.axes) == 1
-    assert len(fig.axes[0].get_legend().get_texts()) == 2  # one per panel (mode 2 only)
+    # one entry per panel and one for the line style of the mode drawn (mode 2 only)
+    assert [t.get_text() for t in fig.axes[0].get_legend().get_texts()][-1:] == ["mode2"]
+    assert len(fig.axes[0].get_legend().get_texts()) == 3
 
 
 def test_a_min_first_value_overturns_is_an_upper_bound():

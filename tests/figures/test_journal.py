@@ -208,3 +208,116 @@ def test_long_legends_and_many_curves_fit_a_single_column(suite_result):
     lines = [ln for ln in fig.axes[1].get_lines() if not ln.get_label().startswith("_")]
     assert len(lines) == 12
     assert len({to_rgba(ln.get_color()) for ln in lines}) == 12
+
+
+def _many_curve_datasets(n: int = 12) -> dict:
+    """Synthetic Datasets of every analysis figure that draws one curve per value of
+    another dim, with ``n`` such values (lam, records, series)."""
+    import xarray as xr
+
+    lam = np.round(np.linspace(0.0, 0.55, n), 3)
+    w = np.geomspace(0.5, 6.0, 8)
+    a_min = 1.0 + lam[:, None] + 0.2 * w[None, :]
+    mode = np.where(w[None, :] < 2.0, 1, 2).repeat(n, 0).astype(np.int8)
+    bd = xr.Dataset({"A_min": (("lam", "w_over_p"), a_min), "mode": (("lam", "w_over_p"), mode)},
+                    coords={"lam": lam, "w_over_p": w},
+                    attrs={"rocksweep_kind": "boundaries", "x_axis": "w_over_p",
+                           "y_axis": "A_ratio"})
+    ims = ["PGA", "PGV", "Sa(0.5)", "CAV"]
+    eff = xr.Dataset({"beta_scale": (("im", "lam"), 0.3 + 0.01 * np.arange(4 * n).reshape(4, n)),
+                      "beta": (("im", "lam"), 0.3 + 0.01 * np.arange(4 * n).reshape(4, n))},
+                     coords={"im": ims, "lam": lam}, attrs={"rocksweep_kind": "im_efficiency"})
+    pga = np.geomspace(0.1, 1.6, 6)
+    first = np.geomspace(0.3, 1.2, n)
+    th = np.where(pga[None, :] < first[:, None], pga[None, :] / first[:, None], np.nan)
+    ida = xr.Dataset({"ida_im": (("record",), first),
+                      "theta_max_over_alpha": (("record", "PGA"), th)},
+                     coords={"record": [f"SYN{r:02d}.AT2" for r in range(n)], "PGA": pga},
+                     attrs={"rocksweep_kind": "ida", "im": "PGA", "im_units": "g"})
+    A = np.linspace(0.5, 8.0, 6)
+    theta = np.clip(A[None, :, None] / (2.0 + a_min[:, None, :]), 0.0, 0.99)
+    out = (theta > 0.9).astype(np.int8)
+    sp = xr.Dataset({"A_min": (("lam", "w_over_p"), a_min), "mode": (("lam", "w_over_p"), mode),
+                     "theta_max_over_alpha": (("lam", "A_ratio", "w_over_p"), theta),
+                     "outcome": (("lam", "A_ratio", "w_over_p"), out)},
+                    coords={"lam": lam, "A_ratio": A, "w_over_p": w},
+                    attrs={"rocksweep_kind": "spectra"})
+    return {"boundaries": bd, "im_efficiency": eff, "ida": ida, "spectra": sp}
+
+
+def _curve_colours(ax) -> list:
+    from matplotlib.colors import to_rgba
+
+    lines = [ln for ln in ax.get_lines() if not ln.get_label().startswith("_")
+             and ln.get_linestyle() not in ("None", "")]
+    return [to_rgba(ln.get_color()) for ln in lines]
+
+
+@pytest.mark.parametrize("width", list(WIDTHS))
+def test_twelve_curves_fit_and_get_twelve_colours(width):
+    """Twelve curves (lam values, records, series): every figure fits the journal width
+    (legend neither cut nor squeezing the axes) and no two curves share a colour (the
+    colour cycle repeats after ten)."""
+    from matplotlib.colors import to_rgba
+
+    from rocksweep.figures.results import ida_figure
+
+    for kind, ds in _many_curve_datasets(12).items():
+        fig = rocksweep.plot(ds, width=width)
+        _fits(fig, f"{kind} of 12 curves", width)
+        ax = fig.axes[-1]
+        if kind == "im_efficiency":
+            colours = {to_rgba(p.get_facecolor()) for p in ax.patches}
+        elif kind == "ida":
+            colours = {to_rgba(ln.get_color()) for ln in ax.get_lines()}
+        else:
+            colours = set(_curve_colours(ax)) - {to_rgba("0.3")}
+        assert len(colours) == 12, (kind, width, len(colours))
+        legends = [leg for leg in [*fig.legends, *(a.get_legend() for a in fig.axes)]
+                   if leg is not None]
+        for leg in legends:
+            _legend_clear_of_axes(fig, leg, kind)
+        r = FigureCanvasAgg(fig).get_renderer()
+        boxes = [leg.get_window_extent(r) for leg in legends]
+        assert not any(boxes[i].overlaps(boxes[j]) for i in range(len(boxes))
+                       for j in range(i)), f"{kind} at {width}: legends overlap"
+    assert ida_figure  # the ida Dataset is drawn by ida_figure (its kind)
+
+
+def _legend_clear_of_axes(fig, leg, name):
+    """A legend placed outside its axes does not lie over any axes' plotting area."""
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    lb = leg.get_window_extent(canvas.get_renderer())
+    for a in fig.axes:
+        if a.get_legend() is leg:
+            continue
+        ab = a.get_window_extent()
+        assert not lb.overlaps(ab), f"{name}: legend over an axes"
+
+
+def test_a_min_figure_of_twelve_panels_has_twelve_colours_and_a_clear_legend():
+    from matplotlib.colors import to_rgba
+
+    from rocksweep.analysis.boundaries import AMinCurve
+    from rocksweep.figures.diagrams import a_min_figure
+
+    x = np.geomspace(0.5, 6.0, 8)
+    curves = [AMinCurve({"lam": round(0.05 * k, 2)}, x, 1.0 + 0.1 * k + 0.2 * x,
+                        np.where(x < 2.0, 1, 2).astype(np.int8), x * np.nan, x * np.nan,
+                        np.zeros(8, np.int64)) for k in range(12)]
+    fig = a_min_figure(curves, title="twelve lam")
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    r = canvas.get_renderer()
+    ax = fig.axes[0]
+    assert len({to_rgba(ln.get_color()) for ln in ax.get_lines()
+                if not ln.get_label().startswith("_")} - {to_rgba("0.3")}) == 12
+    legends = [*fig.legends, ax.get_legend()]
+    for leg in legends:
+        if leg is None:
+            continue
+        lb = leg.get_window_extent(r)
+        assert fig.bbox.x0 <= lb.x0 and lb.x1 <= fig.bbox.x1 and fig.bbox.y0 <= lb.y0 \
+            and lb.y1 <= fig.bbox.y1
+        assert not lb.overlaps(ax.get_window_extent()), "a_min legend over the curves"
