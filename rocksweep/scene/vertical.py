@@ -5,6 +5,7 @@ steps within the step cap)."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 
@@ -83,7 +84,8 @@ def _check_suite_start(scene: Scene) -> None:
         f = float(np.max(su.factors(np.full(s.size, r), None if su.im is None else s, a,
                                     pp)))
         if 1.0 + f * first <= 0.0:
-            raise SceneError(f"ground.records: {v.name} (the vertical of {su.names[r]}) "
+            raise SceneError(f"ground.records: {Path(str(v.source)).name} (the vertical "
+                             f"of {su.names[r]}) "
                              f"scaled by the factor {f:.4g} of its record is a_v = "
                              f"{f * first:.4g} g at t = 0, so g + a_v <= 0 (the body leaves "
                              "the ground); the vertical at t = 0 must be > -1 g (or "

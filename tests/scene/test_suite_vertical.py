@@ -121,3 +121,37 @@ def test_rotated_suite_carries_each_records_vertical(tmp_path):
     plain = suite_run(d)
     for k in RUN_VARS:
         assert np.array_equal(ds[k].sel(angle=0.0).values, plain[k].values), k
+
+
+def test_up_file_at_another_dt_is_resampled_as_ground_vertical_is(tmp_path):
+    """An UP file sampled at DT/2 is resampled onto H1's samples (not refused): the suite's
+    runs are those of ``ground.record`` + ``ground.vertical`` of the same files."""
+    from rocksweep.physics.records import read_record, write_at2
+
+    d = folder(tmp_path, n=2)
+    up = d / "RSN101_EVENT_STA-UP.AT2"
+    r = read_record(up)
+    fine = np.interp(np.arange(2 * r.npts - 1) * r.dt / 2, r.times(), r.acc)
+    up.unlink()
+    write_at2(up, 0.9 * fine, r.dt / 2, "RSN101")
+    assert_same_runs(suite_run(d), single_runs(d, vertical=True))
+
+
+def test_a_vertical_below_minus_g_at_the_start_is_refused(tmp_path):
+    """A record's UP starting at -1 g, scaled by its factor (> 1 at this stripe), gives
+    g + a_v <= 0 at t = 0: one line naming the file."""
+    from rocksweep.physics.records import read_record, write_at2
+
+    d = folder(tmp_path, n=2)
+    up = d / "RSN100_EVENT_STA-UP.AT2"
+    r = read_record(up)
+    up.unlink()
+    write_at2(up, np.where(np.arange(r.npts) == 0, -1.0, r.acc), r.dt, "RSN100")
+    spec = yaml.safe_dump(scene(d, scale={"im": "PGA_ratio", "values": [3.0]}))
+    with pytest.raises(SceneError) as err:
+        parse_scene(spec)
+    assert "RSN100_EVENT_STA-UP.AT2" in str(err.value) and "g + a_v <= 0" in str(err.value)
+    assert "\n" not in str(err.value)
+    # switched off, the same folder runs
+    parse_scene(yaml.safe_dump(scene(d, scale={"im": "PGA_ratio", "values": [3.0]},
+                                     vertical=False)))
