@@ -25,7 +25,8 @@ Numbers (``COMPUTE``):
   configs/fig5.yaml``: outcome, impacts, p*t at overturning per lam) and Figure 2's
   restitution values (``rocksweep restitution configs/fig2.yaml``: e at lam = 0, u = 0; at
   lam = 1, u/u_cr = -2; Housner's e of the body welded rigid): README.md's quick start and
-  single-run paragraphs.
+  single-run paragraphs; the mode 1 points per lam of the four figures' 80 x 80 grids
+  (``rocksweep info``; ~3 s): docs/diagrams.md.
 
 Benchmark timings quoted in the docs are not regenerated here (they vary with the
 machine and its load); docs/performance.md lists each with the script that measures it.
@@ -94,8 +95,28 @@ def compute_demo() -> dict:
             "p50_overturn": prob}
 
 
+FIGURES = ("fig3a", "fig3b", "fig4a", "fig4b")
+
+
+def _mode1_counts(name: str) -> dict:
+    """{lam: mode 1 points} of configs/NAME.yaml and the points per lam."""
+    import numpy as np
+
+    from rocksweep.compute.driver import sweep_arrays
+    from rocksweep.kernel import layout as L  # noqa: N812
+    from rocksweep.scene.parse import load_scene
+
+    scene = load_scene(ROOT / "configs" / f"{name}.yaml")
+    out = np.asarray(sweep_arrays(scene, jobs=2)[0]["outcome"])
+    i = [a.name for a in scene.swept].index("lam")
+    lams = scene.axis("lam").values
+    return {"mode1": {f"{lam:g}": int((np.take(out, [k], axis=i) == L.OUTCOME_MODE1).sum())
+                      for k, lam in enumerate(lams)},
+            "points_per_lam": int(out.size // out.shape[i])}
+
+
 def compute_quick() -> dict:
-    """The numbers of the shipped small scenes (module docstring), in seconds."""
+    """The numbers of the shipped scenes that take seconds (module docstring)."""
     import math
 
     import rocksweep
@@ -115,6 +136,7 @@ def compute_quick() -> dict:
                        "configs/fig2.yaml",
             "fig3a_points": math.prod(len(a.values) for a in fig3a.swept),
             "fig5": fig5,
+            "mode1_points": {name[3:]: _mode1_counts(name) for name in FIGURES},
             "fig2": {"e_at_rest": round(t.e_at_rest, 3),
                      "e_lam1_u_minus2": round(float(t.e_upper[lam1, u_m2]), 2),
                      "e_housner_rigid": round(t.e_housner, 3)}}
@@ -220,8 +242,20 @@ def render_quick(d: dict) -> dict[str, str]:
              f"({e['e_lam1_u_minus2']:.2f}), and e at lam = 0, u = 0 is {e['e_at_rest']:.3f}, "
              f"far below Housner's {e['e_housner_rigid']:.3f} for the same body welded rigid; "
              "e is not monotonic in u/u_cr (Figure 2(b)).")
+    counts = d["mode1_points"]
+    lams = list(next(iter(counts.values()))["mode1"])
+    each = {c["points_per_lam"] for c in counts.values()}
+    per = (f"of {each.pop()} each" if len(each) == 1 else
+           "of " + " / ".join(str(c["points_per_lam"]) for c in counts.values()))
+    mode1 = ("- Raising lam expands the mode 1 area in all four figures; safe points turn into "
+             f"mode 1 points. Mode 1 points at lam = {' / '.join(lams)} (`rocksweep info`): "
+             + ", ".join(f"{fig} " + " / ".join(str(v) for v in c["mode1"].values())
+                         for fig, c in zip(("3(a)", "3(b)", "4(a)", "4(b)"), counts.values(),
+                                           strict=True)) + f" ({per}).")
     return {"README.md": {"quick_start": textwrap.fill(start, 90),
-                          "single_runs": textwrap.fill(shows, 90)}}
+                          "single_runs": textwrap.fill(shows, 90)},
+            "docs/diagrams.md": {"mode1_points": textwrap.fill(
+                mode1, 90, subsequent_indent="  ")}}
 
 
 RENDER = {"impact_laws": render_impact_laws, "demo": render_demo, "quick": render_quick}
