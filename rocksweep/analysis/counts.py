@@ -13,7 +13,7 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.analysis.states import counted_points, parse_state, required, state_reached
-from rocksweep.errors import FragilityError
+from rocksweep.errors import Arg, FragilityError
 from rocksweep.vocab.ground import CLOUD_IMS as CLOUD_IM_VARIABLES
 from rocksweep.vocab.ground import SCALE_IMS
 from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, UPLIFT
@@ -103,7 +103,8 @@ def im_axis(ds: xr.Dataset, out_da: xr.DataArray, im: str | None, period: float 
         raise FragilityError(f"scale_im = {scale_im!r} but outcome has no such dimension")
     if stripe is None:
         if period is not None and (im is None or str(im) != "Sa"):
-            raise FragilityError(f"period = {period!r}: only with im='Sa'")
+            raise FragilityError("{period}: only with {im}", period=Arg("period", period),
+                                 im=Arg("im", "Sa"))
         rec_im, im_name, unit, per = cloud_im(ds, im, period)
         return IMAxis(None, rec_im, im_name, unit, per, "cloud-mle")
     if stripe not in STRIPE_IMS:

@@ -289,8 +289,9 @@ def _check_args(ds: Any, im: Any, period: Any, seed: Any) -> None:
     if period is not None and (isinstance(period, bool) or not isinstance(
             period, int | float | np.integer | np.floating) or not math.isfinite(period)
             or period <= 0):
-        raise FragilityError(f"period = {period!r}: a period in s (a number > 0, one of the "
-                             "stored ground.periods), with im='Sa'")
+        raise FragilityError("{period}: a period in s (a number > 0, one of the stored "
+                             "ground.periods), with {im}", period=Arg("period", period),
+                             im=Arg("im", "Sa"))
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
         raise FragilityError("{seed}: must be an integer >= 0", seed=Arg("seed", seed))
 

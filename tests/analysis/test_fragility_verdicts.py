@@ -606,3 +606,18 @@ def test_a_verdicts_way_out_is_said_in_the_callers_words():
         assert "fit them separately (joint=False)" in str(m) and "--" not in str(m)
         assert "fit them separately (without --joint)" in warning_line(m)
         assert "joint=" not in warning_line(m)
+
+
+def test_a_period_without_sa_names_the_im_in_the_callers_words():
+    from rocksweep.cli.main import said
+
+    ds = stripes_ds(capacity_outcomes(10, 0.5, 0.4, seed=8))
+    ds.attrs.pop("scale_im")  # a cloud: the IM per record
+    with pytest.raises(errors.FragilityError) as err:
+        F.fragility(ds, period=1.0, bootstrap=0)
+    assert str(err.value) == "period = 1.0: only with im = 'Sa'"
+    assert said(err.value) == "--period 1.0: only with --im Sa"
+    with pytest.raises(errors.FragilityError) as err:
+        F.fragility(ds, im="Sa", period=-1.0, bootstrap=0)
+    assert said(err.value).startswith("--period -1.0: a period in s") \
+        and said(err.value).endswith("with --im Sa")
