@@ -155,3 +155,31 @@ def test_a_vertical_below_minus_g_at_the_start_is_refused(tmp_path):
     # switched off, the same folder runs
     parse_scene(yaml.safe_dump(scene(d, scale={"im": "PGA_ratio", "values": [3.0]},
                                      vertical=False)))
+
+
+def test_a_floor_suite_with_verticals_equals_each_records_floor_run_and_fits(tmp_path):
+    """Under ``floor:`` each record's UP acts too (unfiltered, on the floor motion's
+    samples): the suite equals the single-record floor runs of ``ground.record`` +
+    ``ground.vertical``; and fragility reads such a file (airborne runs are flagged points,
+    said by its verdict, not counted as safe)."""
+    d = folder(tmp_path, n=2)
+    building = {"period": 0.3, "damping": 0.05, "participation": 1.3}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RecordWarning)
+        ds = rocksweep.run({**scene(d, scale={"im": "PGA_ratio", "values": STRIPES}),
+                            "floor": building})
+        h1s = sorted(p for p in d.iterdir() if p.stem.endswith("000"))
+        want = {k: [] for k in RUN_VARS}
+        for h1 in h1s:
+            g = {"record": str(h1), "A_ratio": STRIPES, "p": 2.0,
+                 "vertical": str(h1.with_name(h1.name.replace("000", "-UP")))}
+            one = rocksweep.run({"body": scene(d)["body"], "ground": g, "floor": building})
+            for k in RUN_VARS:
+                want[k].append(one[k].values)
+    assert_same_runs(ds, {k: np.array(v) for k, v in want.items()})
+    assert (ds["floor_pfa"].values > 0).all()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fr = rocksweep.fragility(ds, bootstrap=0)
+    assert (ds["status"].values & L.STATUS_AIRBORNE).any()  # the second record, at 3.0
+    assert "flagged" in str(fr["reason"].values.ravel()[0]).split(",")
