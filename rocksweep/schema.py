@@ -275,9 +275,9 @@ KEYS: dict[str, Key] = {
     "pulse.vertical.amplitude": Key("axis", "must be a finite number [g] (the vertical "
                                     "harmonic's amplitude; negative: the opposite sign)",
                                     -math.inf, math.inf, lo_in=False, hi_in=False),
-    "pulse.vertical.w_over_p": Key("axis", "must be > 0 and finite (the vertical harmonic's "
-                                   "frequency w_v/p)", 0.0, math.inf, lo_in=False,
-                                   hi_in=False),
+    "pulse.vertical.w_over_p": Key("axis", "must be >= 0 and finite (the vertical harmonic's "
+                                   "frequency w_v/p; 0: a constant a_v = a g sin(phase))",
+                                   0.0, math.inf, hi_in=False),
     "pulse.vertical.phase": Key("axis", "must be a finite angle in degrees (the vertical "
                                 "harmonic's phase at t = 0)", -math.inf, math.inf,
                                 lo_in=False, hi_in=False, required=False, default=0.0),

@@ -160,8 +160,8 @@ def test_block_uplifts_where_xg_is_g_plus_av_tan_alpha(a_v_g):
 
 
 def _constant(c: float) -> VerticalHarmonic:
-    """a_v = c g exactly: sin(0 t + pi/2) = 1 (a frequency 1e-300 rounds w t to 0)."""
-    return VerticalHarmonic(c, 1e-300, 90.0)
+    """a_v = c g exactly: sin(0 t + pi/2) = 1 (``pulse.vertical.w_over_p: 0``)."""
+    return VerticalHarmonic(c, 0.0, 90.0)
 
 
 @pytest.mark.parametrize("c, lam, A_ratio", [(0.5, 0.2, 4.0), (-0.3, 0.6, 2.5)])

@@ -61,7 +61,7 @@ def test_record_vertical_with_another_dt_is_resampled(files):
     ("pulse: {shape: sine, w_over_p: 3.0, A_ratio: 1.5, vertical: {amplitude: 0.3, "
      "w_over_p: 9.0, period: 2}}", "pulse.vertical.period: unknown key"),
     ("pulse: {shape: sine, w_over_p: 3.0, A_ratio: 1.5, vertical: {amplitude: 0.3, "
-     "w_over_p: 0}}", "pulse.vertical.w_over_p = 0.0: must be > 0"),
+     "w_over_p: -1}}", "pulse.vertical.w_over_p = -1.0: must be >= 0"),
     ("ground: {record: h.txt, vertical: v_down.txt, A_ratio: [1.0, 8.0], p: 2.0}",
      "ground.vertical = "),
     ("ground: {records: [h.txt], vertical: v.txt, p: 2.0}",
@@ -104,3 +104,17 @@ def test_record_vertical_sweep_keeps_the_vertical(cli, files):
     (files / "v.txt").unlink()  # the file's own copy rebuilds the scene
     sc = result_scene(read_result(out))
     assert sc.vertical is not None and sc.ground == L.GROUND_VERTICAL
+
+
+@pytest.mark.parametrize("c, A_ratio, uplifts", [
+    (0.5, 1.45, False), (0.5, 1.55, True), (-0.5, 0.45, False), (-0.5, 0.55, True)])
+def test_a_constant_vertical_moves_a_blocks_uplift_threshold_to_one_plus_c(c, A_ratio, uplifts):
+    """``w_over_p: 0`` is a constant a_v = a g sin(phase) while the pulse acts: a rigid
+    block then uplifts where |a_h| > (g + a_v) tan alpha, i.e. above A_ratio = 1 + c (a
+    sine pulse's peak is A)."""
+    import rocksweep
+
+    sim = rocksweep.simulate(BLOCK + f"impact: {{lam: 0.0}}\npulse: {{shape: sine, "
+                             f"w_over_p: 3.0, A_ratio: {A_ratio}, vertical: {{amplitude: {c}, "
+                             "w_over_p: 0, phase: 90}}")
+    assert (sim.summary["uplifts"] > 0) == uplifts, sim.summary
