@@ -133,8 +133,8 @@ FIELDS: tuple[Field, ...] = (
           label="smallest normal reaction", symbol="N_min/(M g)"),
     Field("saddle_margin", "float64", math.nan, "alpha_ref",
           "closest approach of the free rocking to the overturning saddle (inf: never "
-          "within 0.5); below 0.05 the run is a close call, re-run finer "
-          "(rocksweep.compute.certify)", L.OUT_MARGIN, stored=False,
+          "within 0.5); below 0.05 (an overturn: 0.1) at 5 steps per period the run is "
+          "near its threshold, re-run or checked finer (rocksweep.compute.certify)", L.OUT_MARGIN, stored=False,
           label="closest approach to the overturning saddle"),
     Field("impulse_ratio_max", "float64", math.nan, "1",
           "largest |horizontal|/vertical ground impulse of an impact (0: no impact)",

@@ -293,25 +293,43 @@ def step_budget(t_pulse: np.ndarray | float, t_end: np.ndarray | float,
     return numerics.max_steps_factor * steps + EVENT_STEP_ALLOWANCE * numerics.max_events
 
 
-# The margin (OUT_MARGIN, alpha_ref) below which a run is a close call, re-run finer
+# The margin (OUT_MARGIN, alpha_ref) below which a safe run is a close call, re-run finer
 # (``close_margin``), at 5 steps per period: a few times the closest approach of any run
 # of the four figures whose `default` outcome differed from `fine`'s before certification
 # (docs/accuracy.md, "Where the presets' values come from").
 CLOSE_MARGIN = 0.0125
-# An overturn is a close call up to this many times the row's PAR_CLOSE: a run that commits
-# to falling carries the error of every step before it into that one approach, and an
-# overturn that the finer runs survive can commit with a margin well above CLOSE_MARGIN
-# (measured: docs/accuracy.md, "Close calls on the overturning side").
-OVERTURN_CLOSE = 4.0
+# A safe run is near its threshold up to this many times CLOSE_MARGIN (``close_band``, the
+# kernel's PAR_CLOSE): a near-miss turns back on one approach with the error of every step
+# before it (a finer run overturned one that `default` turned back with a margin of
+# 3.3 x CLOSE_MARGIN; docs/accuracy.md, "Close calls on both sides").
+CLOSE_BAND = 4.0
+# An overturn is a close call up to this many times CLOSE_MARGIN: it commits to falling on
+# one approach with the error of every step before it (finer runs survived overturns that
+# `default` committed to with margins to 6.5 x CLOSE_MARGIN). Overturns are short runs, so
+# the wider band costs less than the safe side's.
+OVERTURN_BAND = 8.0
+# A safe run between the margin and the band is checked by a finer run that stops this long
+# [p t] after the run was last within the band (OUT_T_CLOSE): long enough for a body that
+# passes the saddle there to reach theta = pi/2 (~ln(pi/alpha_ref)/p from alpha_ref/2
+# past the saddle: < 6 for alpha_ref > 0.01), short of the rocking to rest that holds most
+# of such a run's steps.
+CLOSE_AFTER = 4.0 * math.pi
 
 
 def close_margin(steps_per_period: int) -> float:
     """How close [alpha_ref] the free rocking may come to the overturning saddle before a
-    run counts as a close call (the kernel's PAR_CLOSE): CLOSE_MARGIN at 5 steps per
-    period, (5/steps_per_period)^(5/2) of it at more (the energy's error falls as the
-    step^5 per unit time, the margin it can flip, ~ sqrt(|E - E_barrier|/E_ref), as its
-    square root)."""
+    safe run counts as a close call: CLOSE_MARGIN at 5 steps per period,
+    (5/steps_per_period)^(5/2) of it at more (the energy's error falls as the step^5 per
+    unit time, the margin it can flip, ~ sqrt(|E - E_barrier|/E_ref), as its square
+    root). CLOSE_BAND and OVERTURN_BAND are powers of two: the bounds of
+    ``compute.certify`` are exact multiples of each other."""
     return CLOSE_MARGIN * (5.0 / steps_per_period) ** 2.5
+
+
+def close_band(steps_per_period: int) -> float:
+    """CLOSE_BAND x ``close_margin``: the margin [alpha_ref] below which a run is near its
+    threshold on either side (the kernel's PAR_CLOSE; ``compute.certify``)."""
+    return CLOSE_BAND * close_margin(steps_per_period)
 
 
 def amplitude_frequency(A_ratio: np.ndarray | float, alpha_ref: np.ndarray | float

@@ -5,21 +5,30 @@ small, the step's error can decide the class: at 5 steps per spring period the t
 spring loses ~2% of its energy to RK4 each step, and on Figure 3(a) 73 of 19 200 points
 went safe where the reference overturns in mode 1 (docs/accuracy.md). The kernel reports how
 close the free rocking came to the overturning saddle (``OUT_MARGIN``, ``loop._saddle``:
-the vertex of the hyperbola it rocks on, in alpha_ref, ~ sqrt(|E - E_barrier|/E_ref)); a
-run below the row's PAR_CLOSE (``numerics.close_margin``) is a close call, and so is an
-overturn below ``numerics.OVERTURN_CLOSE`` x PAR_CLOSE: the overturn side of the
-threshold is certified as the safe side is. A close call
-is run again at half the steps (``refine_rows``: every step and the rotation limit
-halved, the step cap doubled), and again, until two consecutive runs give the same
-outcome (the finer one is kept) or ``Numerics.refine`` refinements were made. Only the
-close calls pay: ~1-2% of the paper figures' points, whose reruns cost 1-3x what the
-point did (``scripts/bench_certify.py``).
+the vertex of the hyperbola it rocks on, in alpha_ref, ~ sqrt(|E - E_barrier|/E_ref)) and
+when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the threshold:
 
-Every refined point has STATUS_REFINED in its status; one whose outcome still changed at
-the last refinement also STATUS_UNCERTIFIED (flagged: not a reliable classification).
-Its steps and event_steps count every run it took. The same rule runs wherever rows meet
-the kernel, through the one dispatch (``compute.dispatch.run_variant``): sweeps
-(``compute.sweep.run_rows``), adaptive sweeps (through the sweep's chunks), the A_min
+- a safe run below ``numerics.close_margin``, or an overturn below OVERTURN_BAND times
+  it, is run again at half the steps (``refine_rows``: every step and the rotation limit
+  halved, the step cap doubled), and again, until two consecutive runs give the same
+  outcome (the finer one is kept) or ``Numerics.refine`` refinements were made;
+- a safe run between the close-call margin and the row's PAR_CLOSE (``numerics.
+  close_band``, CLOSE_BAND times it: a near-miss, which turned back with a margin a
+  coarse step's error can still reverse) is checked by a run at half the steps that stops
+  ``numerics.CLOSE_AFTER`` after OUT_T_CLOSE, its last time within the band
+  (``probe_rows``): past its last approach, not through the rocking to rest that holds
+  most of its steps. If the finer run overturns, the point is a close call as above (its
+  full runs from the first refinement on); if not, the run's own result is kept.
+
+Only the runs near a threshold pay: on the paper's figures 5-17% more RK4 evaluations
+(``scripts/fingerprint.py diff``); within 0.5% of a threshold, where every run pays, the
+certified runs take ~2x the bare ones' (``scripts/threshold_sample.py``).
+
+Every refined or checked point has STATUS_REFINED in its status; one whose outcome still
+changed at the last refinement also STATUS_UNCERTIFIED (flagged: not a reliable
+classification). Its steps and event_steps count every run it took. The same rule runs
+wherever rows meet the kernel, through the one dispatch (``compute.dispatch.run_variant``):
+sweeps (``compute.sweep.run_rows``), adaptive sweeps (through the sweep's chunks), the A_min
 searches (``analysis.boundaries.kernel_rows``), single runs (``compute.single.run_point``)
 and the accuracy study (``analysis.accuracy.run_kernel``).
 """
@@ -32,20 +41,28 @@ import numpy as np
 
 from rocksweep.fields import CHECK_SCALE
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.numerics import OVERTURN_CLOSE
+from rocksweep.numerics import CLOSE_AFTER, CLOSE_BAND, OVERTURN_BAND
+
+
+def _fell(outs: np.ndarray) -> np.ndarray:
+    return ((outs[:, L.OUT_OUTCOME] == L.OUTCOME_MODE1)
+            | (outs[:, L.OUT_OUTCOME] == L.OUTCOME_MODE2))
 
 
 def close_calls(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     """bool[n]: the runs (parameter rows float64[n, >= N_PAR], result rows float64[n,
-    N_OUT]) whose outcome was a close call on either side of the saddle: their free
-    rocking came within the row's PAR_CLOSE x alpha_ref of the overturning saddle
-    (``numerics.close_margin``), or they overturned with a margin below
-    ``numerics.OVERTURN_CLOSE`` times that (an overturn commits to falling on one
-    approach, with the error of every step before it)."""
-    fell = (outs[:, L.OUT_OUTCOME] == L.OUTCOME_MODE1) | (
-        outs[:, L.OUT_OUTCOME] == L.OUTCOME_MODE2)
-    bound = np.where(fell, OVERTURN_CLOSE, 1.0) * rows[:, L.PAR_CLOSE]
+    N_OUT]) re-run in full: they stayed safe with a margin below the close-call margin
+    (``numerics.close_margin``: the row's PAR_CLOSE / CLOSE_BAND, in alpha_ref) or
+    overturned with one below OVERTURN_BAND times it."""
+    bound = np.where(_fell(outs), OVERTURN_BAND, 1.0) * (rows[:, L.PAR_CLOSE] / CLOSE_BAND)
     return outs[:, L.OUT_MARGIN] < bound
+
+
+def near_misses(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
+    """bool[n]: the safe runs whose margin lies in [1/CLOSE_BAND, 1) x PAR_CLOSE: checked
+    by a finer run up to their last approach (``probe_rows``) before they are trusted."""
+    m, band = outs[:, L.OUT_MARGIN], rows[:, L.PAR_CLOSE]
+    return ~_fell(outs) & (m >= band / CLOSE_BAND) & (m < band)
 
 
 def refine_rows(rows: np.ndarray, level: int) -> np.ndarray:
@@ -59,19 +76,36 @@ def refine_rows(rows: np.ndarray, level: int) -> np.ndarray:
     return out
 
 
-def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[[np.ndarray, np.ndarray],
-            np.ndarray], levels: int) -> np.ndarray:
+def probe_rows(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
+    """The first refinement of ``rows`` (float64[k, >= N_PAR]), stopping CLOSE_AFTER [p t]
+    after each run's last approach to the saddle (``outs[:, OUT_T_CLOSE]``; float64[k,
+    N_OUT] the runs' results)."""
+    out = refine_rows(rows, 1)
+    out[:, L.PAR_TEND] = np.minimum(out[:, L.PAR_TEND], outs[:, L.OUT_T_CLOSE] + CLOSE_AFTER)
+    return out
+
+
+def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
+            levels: int) -> np.ndarray:
     """Re-run the close calls among ``outs`` finer until their outcome is stable.
 
     rows: float64[n, N_PAR] the runs' parameter rows; outs: float64[n, N_OUT] their
-    results (updated in place and returned); run(rows_subset, index) -> result rows: the
-    kernel on rows float64[k, N_PAR] of the points ``index`` (int64[k], into rows);
-    levels: most refinements a point may take (``Numerics.refine``; 0: none). Returns
-    outs.
+    results (updated in place and returned); run(rows_subset, index, keep=True) -> result
+    rows: the kernel on rows float64[k, N_PAR] of the points ``index`` (int64[k], into
+    rows); keep=False: a probe, whose by-products (a history) are not kept; levels: most
+    refinements a point may take (``Numerics.refine``; 0: none). Returns outs.
     """
     if levels <= 0 or outs.shape[0] == 0:
         return outs
     idx = np.flatnonzero(close_calls(rows, outs))
+    near = np.flatnonzero(near_misses(rows, outs))
+    if near.size:
+        probe = run(probe_rows(rows[near], outs[near]), near, keep=False)
+        outs[near, L.OUT_STEPS] += probe[:, L.OUT_STEPS]
+        outs[near, L.OUT_EVENT_STEPS] += probe[:, L.OUT_EVENT_STEPS]
+        outs[near, L.OUT_STATUS] = outs[near, L.OUT_STATUS].astype(np.int64) | L.STATUS_REFINED
+        # a near-miss the finer run overturns is a close call: its full runs from level 1
+        idx = np.union1d(idx, near[_fell(probe)])
     for level in range(1, levels + 1):
         if idx.size == 0:
             break
@@ -88,4 +122,3 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[[np.ndarray, np.nd
         outs[idx, L.OUT_STATUS] = (outs[idx, L.OUT_STATUS].astype(np.int64)
                                    | L.STATUS_UNCERTIFIED)
     return outs
-

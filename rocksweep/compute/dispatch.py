@@ -55,15 +55,18 @@ def run_variant(rows: np.ndarray, kind: int, level: int, ground: int, refine: in
     if histories is not None:
         fn = kernel.point_kernel(kind, ground)
 
-        def call(sub: np.ndarray, res: np.ndarray, idx: Sequence[int]) -> None:
+        def call(sub: np.ndarray, res: np.ndarray, idx: Sequence[int],
+                 keep: bool = True) -> None:
             for j, i in enumerate(idx):
                 hist = np.empty((history_capacity(sub[j]), L.N_HIST))
                 fn(sub[j], res[j], hist)
-                histories[int(i)] = hist
+                if keep:  # a probe's (``certify``) is not the point's history
+                    histories[int(i)] = hist
     else:
         fn = kernel.chunk_kernel(kind, level, ground)
 
-        def call(sub: np.ndarray, res: np.ndarray, idx: Sequence[int]) -> None:
+        def call(sub: np.ndarray, res: np.ndarray, idx: Sequence[int],
+                 keep: bool = True) -> None:
             if record is None:
                 fn(sub, res)
             else:
@@ -71,9 +74,9 @@ def run_variant(rows: np.ndarray, kind: int, level: int, ground: int, refine: in
 
     call(rows, outs, range(n))  # idx: the rows' places in ``histories``
     if refine > 0:
-        def rerun(sub: np.ndarray, idx: np.ndarray) -> np.ndarray:
+        def rerun(sub: np.ndarray, idx: np.ndarray, keep: bool = True) -> np.ndarray:
             res = np.empty((sub.shape[0], L.N_OUT))
-            call(np.ascontiguousarray(sub), res, idx)
+            call(np.ascontiguousarray(sub), res, idx, keep)
             return res
 
         certify(rows, outs, rerun, refine)

@@ -55,8 +55,9 @@ PAR_E = 36  # LAW_CONSTANT's coefficient of restitution (unused by the other law
 PAR_E_FACTOR = 37  # multiplies the law's e (1: the law's own e)
 PAR_DT_ON = 38  # RK4 step while the ground moves, t < PAR_TPULSE (<= PAR_DT) [s]
 PAR_ALPHA_REF = 39  # alpha_ref: alpha_cg of a flexible body, alpha of a block [rad]
-PAR_CLOSE = 40  # OUT_MARGIN below which the run is a close call (read after the kernel,
-#                 by ``rocksweep.compute.certify``) [alpha_ref]
+PAR_CLOSE = 40  # OUT_MARGIN below which the run is near its threshold (``numerics.
+#                 close_band``; certified after the kernel, ``rocksweep.compute.certify``)
+#                 [alpha_ref]
 PAR_U0 = 41  # initial u [m] (flexible bodies; with PAR_THETA0, PAR_THETA_DOT0 the state at t = 0)
 PAR_U_DOT0 = 42  # initial u' [m/s]
 # 1: a rigid body's run goes on past its analytic bound (rigid_bounded) to rest, for a
@@ -116,7 +117,9 @@ OUT_N_MIN = 20  # smallest normal reaction N/(M g) over the run (contact variant
 OUT_IMPULSE_MAX = 21  # largest |horizontal|/vertical impulse of an impact (contact variants)
 OUT_MARGIN = 22  # closest approach of the free rocking to the overturning saddle
 #                  [alpha_ref] (inf: never near it): a small value is a close call
-N_OUT = 23
+OUT_T_CLOSE = 23  # last time [s] the free rocking came within PAR_CLOSE of the saddle
+#                   (NaN: never): after it the run decided nothing near its threshold
+N_OUT = 24
 
 # --- state tuple y (the loop's 6 slots, a UniTuple(float64, 6)) ----------------------------
 Y_THETA = 0  # theta [rad] (0 in full contact)

@@ -78,6 +78,7 @@ from rocksweep.kernel.layout import (
     OUT_OUTCOME,
     OUT_STATUS,
     OUT_STEPS,
+    OUT_T_CLOSE,
     OUT_T_END,
     OUT_T_FIRST_IMPACT,
     OUT_T_OVERTURN,
@@ -89,6 +90,7 @@ from rocksweep.kernel.layout import (
     OUTCOME_SAFE,
     PAR_ALPHA_REF,
     PAR_B,
+    PAR_CLOSE,
     PAR_DT,
     PAR_DT_ON,
     PAR_G,
@@ -220,6 +222,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     rot = prm[PAR_ROT_STEP]
     acc = 0.0
     margin = np.inf  # OUT_MARGIN, in a register
+    t_close = np.nan  # OUT_T_CLOSE
     # ``_near_saddle``'s bounds, once per run (saddle0 = NaN: no gate, every free rocking
     # step takes ``_saddle``'s test; a row without a body, as warm_up's)
     near = _saddle_bounds(prm)
@@ -244,6 +247,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
         if not FLEX and s != 0 and not on and free_check:
             free_check = False  # E is constant between impacts after the pulse: test once
             margin = _rigid_margin(FLEX, y, s, prm, margin)
+            if margin < prm[PAR_CLOSE]:
+                t_close = t
             peak = _rigid_bounded(FLEX, y, s, prm, FLEX)
             if peak >= 0.0:
                 if peak > theta_max:
@@ -290,7 +295,10 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
         if ev == EV_NONE:
             t, y = (t_pulse if lands else (t_air if air else t + h)), y1
             if s != 0 and not on and _near_saddle(y, s, near):
-                margin = _saddle(y, s, prm, margin)
+                q = _saddle(y, s, prm)
+                if q < prm[PAR_CLOSE]:
+                    t_close = t
+                margin = min(margin, q)
             _record(hist, t, y, s, _acting(t, t_pulse, GROUND), prm, out, FLEX)
             if CONTACT is not None:  # the step's end, with the step's own ground motion
                 ct = contact_sample(ct, t, y, s, on, SAMPLE_STEP, prm, out, FLEX, DAMPED, ENERGY)
@@ -312,6 +320,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
         if CONTACT is not None:  # the state after the action starts the next phase's samples
             ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED, ENERGY)
     out[OUT_MARGIN] = margin
+    out[OUT_T_CLOSE] = t_close
     _finish(t, y, s, steps, event_steps, theta_max, prm, out, FLEX, ENERGY)
     if CONTACT is not None:
         _contact_status(prm, out)
@@ -545,9 +554,10 @@ def _near_saddle(y, s, near):
 
 
 @njit(cache=True, **INTERNAL)
-def _saddle(y, s, prm, margin):
-    """The smallest distance so far of the free rocking motion from the overturning
-    saddle, in units of alpha_ref (OUT_MARGIN; ``rocksweep.compute.certify``).
+def _saddle(y, s, prm):
+    """The distance of the free rocking motion from the overturning saddle, in units of
+    alpha_ref (its smallest over the run is OUT_MARGIN; ``rocksweep.compute.certify``);
+    inf outside the window |x|, |v| < 1/2.
 
     Rocking on corner s, the body's centre of gravity is above the corner at
     theta_s = s atan((b - s m u / M) / h_cg) (the spring's u shifts it). With x = (s theta -
@@ -565,10 +575,8 @@ def _saddle(y, s, prm, margin):
     x = (s * y[Y_THETA] - th_s) / a_ref
     v = y[Y_THETA_DOT] / a_ref
     if abs(x) < 0.5 and abs(v) < 0.5:
-        q = math.sqrt(abs(v * v - x * x))
-        if q < margin:
-            return q
-    return margin
+        return math.sqrt(abs(v * v - x * x))
+    return np.inf
 
 
 @njit(cache=True, **INTERNAL)

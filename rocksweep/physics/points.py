@@ -17,7 +17,7 @@ from rocksweep.numerics import (
     EVENT_STEP_ALLOWANCE,
     Numerics,
     amplitude_frequency,
-    close_margin,
+    close_band,
     step_budget,
     step_sizes,
     vertical_step,
@@ -344,7 +344,7 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     rows[:, L.PAR_MU] = mu
     rows[:, L.PAR_ROT_STEP] = numerics.rotation_step * alpha_ref
     rows[:, L.PAR_ALPHA_REF] = alpha_ref
-    rows[:, L.PAR_CLOSE] = close_margin(numerics.steps_per_period)
+    rows[:, L.PAR_CLOSE] = close_band(numerics.steps_per_period)
     rows[:, L.PAR_LAW] = law
     rows[:, L.PAR_E] = e
     rows[:, L.PAR_E_FACTOR] = e_factor

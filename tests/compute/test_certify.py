@@ -7,11 +7,12 @@ scipy's DOP853 at rtol 1e-10 with located events).
   pulse period its work on the block was ~2% off and `default` called the band safe);
   Figure 3(b)'s body under a cosine at omega/p = 4, A = 5.47-5.66 chatters to rest
   (`default` overturned it after one impact);
-- a close call (the run came within PAR_CLOSE of the saddle, or overturned within
-  OVERTURN_CLOSE x PAR_CLOSE of it) is re-run and says so in its status; a clear one is
-  not; an outcome that keeps changing is flagged uncertified;
-- an overturn on the overturning side of a threshold: a flexible body that `default`
-  overturned after 3 impacts where the reference survives ~140;
+- a run near its threshold (it came within PAR_CLOSE of the saddle) is re-run or, a safe
+  one between the close-call margin and the band, probed, and says so in its status; a
+  clear one is not; an outcome that keeps changing is flagged uncertified;
+- both sides of a threshold: a flexible body that `default` overturned after 3 impacts
+  where the reference survives ~140, and one that `default` rocked to rest with a margin
+  of 3.3 x the close-call margin where the reference overturns after one impact;
 - ``simulate`` and a sweep give one point one answer.
 """
 
@@ -26,7 +27,7 @@ from rocksweep.compute.driver import sweep_arrays
 from rocksweep.compute.single import run_point
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.numerics import OVERTURN_CLOSE, Numerics
+from rocksweep.numerics import CLOSE_AFTER, CLOSE_BAND, OVERTURN_BAND, Numerics
 from rocksweep.physics.bodies import BlockBody, FlexibleBody
 from rocksweep.physics.points import Point, kernel_kind, point_row
 from rocksweep.physics.reference import reference_run
@@ -44,12 +45,17 @@ CASES = [
     (Point(FlexibleBody(wn_over_p=2.9574, zeta=0.0968, alpha_cg=0.1243, alpha_A=0.4078,
                         mA_over_m=1.4056, IA_ratio=0.6851), 0.3216, "sine", 4.6059, 3.1123),
      L.OUTCOME_SAFE),
+    # near its mode-1 threshold: the bare default run rocks to rest with a margin of 3.3 x
+    # the close-call margin; the reference overturns after 1 impact
+    (Point(FlexibleBody(wn_over_p=2.52, zeta=0.046, alpha_cg=0.173, alpha_A=0.213,
+                        mA_over_m=0.82, IA_ratio=0.96), 0.229, "sine", 3.71, 3.8515),
+     L.OUTCOME_MODE1),
 ]
 
 
 @pytest.mark.parametrize("point,expected", CASES,
                          ids=["block-10.9", "block-11.35", "fig3b-5.47", "fig3b-5.66",
-                              "flexible-overturn-side"])
+                              "flexible-overturn-side", "flexible-safe-side"])
 def test_default_classifies_the_reproduced_cases_like_the_reference(point, expected):
     """The reference's outcome is the one written here; `default` (sweep kernel and simulate) gives
     the same. Before the step rule, `default` gave safe / mode 1 here."""
@@ -73,29 +79,72 @@ def _bare(point: Point, numerics: Numerics) -> np.ndarray:
 
 def test_close_calls_are_refined_and_clear_ones_are_not():
     """Over a scan of A across the block's mode-1 band: a run is refined exactly when its
-    bare run came within PAR_CLOSE of the saddle (OVERTURN_CLOSE x PAR_CLOSE if it
-    overturned); the scan holds both kinds and overturns refined for the wider bound; a
-    clear run's result is the bare run's, bit for bit."""
+    bare run came within PAR_CLOSE of the saddle (OVERTURN_BAND / CLOSE_BAND x PAR_CLOSE
+    if it overturned); the scan holds overturns and near-misses
+    (safe, between PAR_CLOSE / CLOSE_BAND and PAR_CLOSE: probed, their own result kept
+    but for the steps) and clear runs, whose result is the bare run's, bit for bit."""
     n = Numerics.preset("default")
-    refined = clear = wide = 0
+    refined = clear = probed = 0
     for A in np.linspace(10.0, 12.0, 41):
         point = Point(BLOCK, 0.0, "sine", 8.0, float(A))
         bare = _bare(point, n)
+        band = point_row(point, n)[L.PAR_CLOSE]
         fell = bare[L.OUT_OUTCOME] != L.OUTCOME_SAFE
-        bound = point_row(point, n)[L.PAR_CLOSE]
-        close = bare[L.OUT_MARGIN] < bound * (OVERTURN_CLOSE if fell else 1.0)
-        wide += bool(close and bare[L.OUT_MARGIN] >= bound)
+        close = bare[L.OUT_MARGIN] < band * (OVERTURN_BAND / CLOSE_BAND if fell else 1.0)
         run = run_point(point, n, history=False)
         is_refined = bool(int(run.out[L.OUT_STATUS]) & L.STATUS_REFINED)
         assert is_refined == close, A
         assert ("refined" in run.status) == close
+        near_miss = close and not fell and bare[L.OUT_MARGIN] >= band / CLOSE_BAND
+        if near_miss and run.out[L.OUT_OUTCOME] == L.OUTCOME_SAFE:
+            probed += 1
+            for slot in (L.OUT_T_END, L.OUT_THETA_MAX, L.OUT_IMPACTS, L.OUT_MARGIN):
+                assert run.out[slot] == bare[slot], A
         if close:
             refined += 1
             assert run.out[L.OUT_STEPS] > bare[L.OUT_STEPS]  # every run's steps counted
         else:
             clear += 1
             assert np.array_equal(run.out, bare, equal_nan=True)
-    assert refined >= 2 and clear >= 10 and wide >= 1
+    assert refined >= 2 and clear >= 10 and probed >= 1
+
+
+def test_a_near_miss_is_probed_to_its_last_approach():
+    """certify's rule on a stand-in kernel: a safe run between PAR_CLOSE / CLOSE_BAND and
+    PAR_CLOSE is run once at half the step, up to CLOSE_AFTER past its last approach
+    (OUT_T_CLOSE), without keeping a history; one whose probe stays safe keeps its own
+    result (steps added, refined); one whose probe overturns is re-run in full from the
+    first refinement on, as a close call."""
+    rows = np.zeros((3, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = 0.04
+    rows[:, L.PAR_DT] = 1.0
+    rows[:, L.PAR_TEND] = 100.0
+    outs = np.zeros((3, L.N_OUT))
+    outs[:, L.OUT_MARGIN] = [0.02, 0.03, 0.5]  # two near-misses, one clear
+    outs[:, L.OUT_T_CLOSE] = [5.0, 7.0, np.nan]
+    outs[:, L.OUT_T_END] = 40.0
+    outs[:, L.OUT_STEPS] = 100
+    calls = []
+
+    def run(sub, idx, keep=True):
+        calls.append((idx.tolist(), sub[:, L.PAR_DT].tolist(), sub[:, L.PAR_TEND].tolist(),
+                      keep))
+        res = np.zeros((len(idx), L.N_OUT))
+        res[:, L.OUT_OUTCOME] = np.where(idx == 1, L.OUTCOME_MODE1, L.OUTCOME_SAFE)
+        res[:, L.OUT_STEPS] = 10
+        return res
+
+    certify(rows, outs, run, 3)
+    assert calls[0] == ([0, 1], [0.5, 0.5], [5.0 + CLOSE_AFTER, 7.0 + CLOSE_AFTER], False)
+    # the flipped one: full runs at levels 1 and 2 (stable there), kept
+    assert calls[1:] == [([1], [0.5], [100.0], True), ([1], [0.25], [100.0], True)]
+    st = outs[:, L.OUT_STATUS].astype(int)
+    assert st[0] & L.STATUS_REFINED and not st[0] & L.STATUS_FLAGGED
+    assert outs[0, L.OUT_OUTCOME] == L.OUTCOME_SAFE and outs[0, L.OUT_T_END] == 40.0
+    assert outs[0, L.OUT_STEPS] == 110
+    assert outs[1, L.OUT_OUTCOME] == L.OUTCOME_MODE1 and outs[1, L.OUT_STEPS] == 130
+    assert st[1] & L.STATUS_REFINED and not st[1] & L.STATUS_UNCERTIFIED
+    assert st[2] == 0 and outs[2, L.OUT_STEPS] == 100
 
 
 def test_an_outcome_that_keeps_changing_is_uncertified():
@@ -110,7 +159,7 @@ def test_an_outcome_that_keeps_changing_is_uncertified():
     outs[:, L.OUT_OUTCOME] = [0, 0, 0]
     calls = []
 
-    def run(sub, idx):
+    def run(sub, idx, keep=True):
         calls.append((idx.tolist(), sub[:, L.PAR_DT].tolist()))
         res = np.zeros((len(idx), L.N_OUT))
         level = round(-np.log2(sub[0, L.PAR_DT]))

@@ -34,7 +34,7 @@ def _gate_and_full(prm, states, sides):
     for i in range(n):
         y = (states[i, 0], states[i, 1], states[i, 2], states[i, 3], 0.0, 0.0)
         near[i] = _near_saddle(y, sides[i], bounds)
-        margin[i] = _saddle(y, sides[i], prm, np.inf)
+        margin[i] = _saddle(y, sides[i], prm)
     return near, margin
 
 

@@ -1,0 +1,129 @@
+"""Classes within 0.5% of their thresholds: does `default` call them right, or flag them?
+
+Draws random bodies and pulses (fixed seed), scans A_ratio at `fine` for every change of
+class (safe, mode 1, mode 2), bisects a few of them to a threshold A*, and runs points
+drawn uniformly within +-0.5% of A* at `default` (certified, ``compute.certify``), at
+`default` with certification off (bare) and at `fine`. Where `default`'s unflagged class
+differs from `fine`'s, the independent reference (``physics.reference``, DOP853 at rtol
+1e-10) decides which is right. Printed: points, refined (re-run or probed), flagged, and
+`default`'s classes that are wrong and unflagged (each one listed), with the RK4
+evaluations of the certified and the bare runs (their ratio: what the certification costs
+on points this close, the worst case; on a whole diagram it is a few percent,
+``scripts/fingerprint.py diff``).
+
+    python scripts/threshold_sample.py --bodies 30 --seed 1
+    python scripts/threshold_sample.py --bodies 30 --seed 1 --before   # the rule before
+
+``--before`` runs the certification as it was before near-misses were checked (safe runs
+between the close-call margin and the band, ``certify.near_misses``) and before the
+overturn band was widened from 4 to 8 x the close-call margin.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
+import numpy as np
+
+from rocksweep.compute import certify
+from rocksweep.compute.dispatch import run_variant
+from rocksweep.errors import BodyError
+from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.numerics import Numerics
+from rocksweep.physics.bodies import BlockBody, FlexibleBody
+from rocksweep.physics.points import Point, kernel_kind, point_row
+from rocksweep.physics.reference import reference_run
+
+FELL = (L.OUTCOME_MODE1, L.OUTCOME_MODE2)
+
+
+def draw(rng: np.random.Generator) -> tuple:
+    """(body, lam, shape, w_over_p): a flexible body (a block one time in six)."""
+    if rng.random() < 1 / 6:
+        body = BlockBody(alpha=rng.uniform(0.1, 0.35), inertia=4.0 / 3.0)
+    else:
+        while True:
+            try:
+                body = FlexibleBody(
+                    wn_over_p=rng.uniform(1.5, 8.0), zeta=rng.uniform(0.0, 0.15),
+                    alpha_cg=rng.uniform(0.08, 0.35), alpha_A=rng.uniform(0.15, 0.6),
+                    mA_over_m=rng.uniform(0.2, 3.0), IA_ratio=rng.uniform(0.3, 1.0))
+                break
+            except BodyError:  # the top mass below the base: draw again
+                continue
+    return (body, rng.uniform(0.0, 0.5), str(rng.choice(["sine", "cosine"])),
+            rng.uniform(1.2, 9.0))
+
+
+def run(points: list[Point], numerics: Numerics, refine: int | None = None) -> np.ndarray:
+    """Result rows float64[n, N_OUT] of points (all of one body)."""
+    rows = np.stack([point_row(p, numerics) for p in points])
+    kind = kernel_kind(points[0].body)
+    return run_variant(rows, kind, L.LEVEL_OUTCOME, L.GROUND_PULSE,
+                       numerics.refine if refine is None else refine)
+
+
+def thresholds(body, lam, shape, w, fine: Numerics, rng, per_body: int) -> list[float]:
+    """Up to per_body thresholds A* [A_ratio] of `fine`'s class on A_ratio in [1, 16]."""
+    grid = np.linspace(1.0, 16.0, 61)
+    cls = run([Point(body, lam, shape, w, float(a)) for a in grid], fine)[:, L.OUT_OUTCOME]
+    change = np.flatnonzero(cls[1:] != cls[:-1])
+    found = []
+    for i in rng.permutation(change)[:per_body]:
+        lo, hi, c_lo = grid[i], grid[i + 1], cls[i]
+        for _ in range(18):
+            mid = 0.5 * (lo + hi)
+            c = run([Point(body, lam, shape, w, mid)], fine)[0, L.OUT_OUTCOME]
+            lo, hi = (mid, hi) if c == c_lo else (lo, mid)
+        found.append(0.5 * (lo + hi))
+    return found
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--bodies", type=int, default=30)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--per-body", type=int, default=2, help="thresholds per body")
+    ap.add_argument("--points", type=int, default=5, help="points per threshold")
+    ap.add_argument("--preset", default="default", help="the preset checked (default)")
+    ap.add_argument("--before", action="store_true",
+                    help="the certification before near-misses were checked")
+    a = ap.parse_args()
+    if a.before:
+        certify.near_misses = lambda rows, outs: np.zeros(outs.shape[0], bool)
+        certify.OVERTURN_BAND = 4.0
+    rng = np.random.default_rng(a.seed)
+    default, fine = Numerics.preset(a.preset), Numerics.preset("fine")
+    n = refined = flagged = wrong = 0
+    cost = bare_cost = 0.0
+    t0 = time.perf_counter()
+    for _ in range(a.bodies):
+        body, lam, shape, w = draw(rng)
+        for a_star in thresholds(body, lam, shape, w, fine, rng, a.per_body):
+            pts = [Point(body, lam, shape, w, float(a_star * (1 + u)))
+                   for u in rng.uniform(-0.005, 0.005, a.points)]
+            got, bare, ref = run(pts, default), run(pts, default, 0), run(pts, fine)
+            for p, g, b, f in zip(pts, got, bare, ref, strict=True):
+                n += 1
+                st = int(g[L.OUT_STATUS])
+                refined += bool(st & L.STATUS_REFINED)
+                flagged += bool(st & L.STATUS_FLAGGED)
+                cost += g[L.OUT_STEPS] + g[L.OUT_EVENT_STEPS]
+                bare_cost += b[L.OUT_STEPS] + b[L.OUT_EVENT_STEPS]
+                if st & L.STATUS_FLAGGED or g[L.OUT_OUTCOME] == f[L.OUT_OUTCOME]:
+                    continue
+                truth = reference_run(p)["outcome"]
+                if truth != g[L.OUT_OUTCOME]:
+                    wrong += 1
+                    print(f"WRONG {p}: default {int(g[L.OUT_OUTCOME])} (bare "
+                          f"{int(b[L.OUT_OUTCOME])}, margin {b[L.OUT_MARGIN]:.4g}), fine "
+                          f"{int(f[L.OUT_OUTCOME])}, reference {truth}", flush=True)
+    print(f"points {n}  refined {refined}  flagged {flagged}  wrong and unflagged {wrong}  "
+          f"RK4 evaluations certified/bare {cost / bare_cost:.3f}  "
+          f"({time.perf_counter() - t0:.0f} s)")
+
+
+if __name__ == "__main__":
+    main()
