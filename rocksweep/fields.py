@@ -134,7 +134,8 @@ FIELDS: tuple[Field, ...] = (
     Field("saddle_margin", "float64", math.nan, "alpha_ref",
           "closest approach of the free rocking to the overturning saddle (inf: never "
           "within 0.5); below 0.05 (an overturn: 0.1) at 5 steps per period the run is "
-          "near its threshold, re-run or checked finer (rocksweep.compute.certify)", L.OUT_MARGIN, stored=False,
+          "near its threshold, re-run or checked finer (rocksweep.compute.certify)",
+          L.OUT_MARGIN, stored=False,
           label="closest approach to the overturning saddle"),
     Field("impulse_ratio_max", "float64", math.nan, "1",
           "largest |horizontal|/vertical ground impulse of an impact (0: no impact)",
