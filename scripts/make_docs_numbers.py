@@ -27,9 +27,24 @@ Numbers (``COMPUTE``):
   lam = 1, u/u_cr = -2; Housner's e of the body welded rigid): README.md's quick start and
   single-run paragraphs; the mode 1 points per lam of the four figures' 80 x 80 grids
   (``rocksweep info``; ~3 s): docs/diagrams.md.
+- ``calibration`` (seconds, recomputed in the test): docs/calibration.md's worked examples:
+  ``rocksweep simulate`` + ``calibrate`` of configs/free-rocking.yaml as the page shows
+  them (the truth at ``fine``, and at ``default``), the Figure 3(a) body's fit and its
+  diagram at the interval (``FLEX_EXAMPLE``, ``FLEX_PLANE``), and the misfit verdict of a
+  block under eq. (1) fitted to a block whose e is 0.6.
+- ``fragility`` (seconds, recomputed): docs/fragility.md's demo-suite sentences: the
+  overturning fractions' dips and the non-monotone verdict, the crossing of theta:0.5 and
+  overturning, where ``joint=True``'s common beta is rejected, the IDA's kernel runs.
+- ``api_example`` (seconds, recomputed): what README.md's Python example prints (its
+  scene is read from the README's code).
+- ``accuracy`` (~10-20 s): docs/accuracy.md's cells where ``default`` differs from
+  ``fine`` on the four figures, ``block`` and ``fig4a-rigid``, and Figure 3(a) with
+  ``--check`` (``rocksweep info``'s tails).
 
 Benchmark timings quoted in the docs are not regenerated here (they vary with the
-machine and its load); docs/performance.md lists each with the script that measures it.
+machine and its load); docs/performance.md and docs/accuracy.md name the script that
+measures each. Nor are the measurements of a change (before -> after tables), nor the
+benchmarks' own tables (scripts/bench_*.py, scripts/accuracy_tables.py, wide_space.py).
 """
 
 from __future__ import annotations
