@@ -77,15 +77,11 @@ def mle_batch(lnx: np.ndarray, k: np.ndarray, n: np.ndarray,
     B = k.shape[0]
     median = np.full(B, np.nan)
     beta = np.full(B, np.nan)
-    reason = np.zeros(B, dtype=np.int64)
+    reason = empty_ending(k, n)
     has = n > 0
     fails = has & (k > 0)
     safes = has & (n - k > 0)
-    nk, ns = fails.any(-1), safes.any(-1)
-    reason[~nk] = CODE["no_failures"]
-    reason[nk & ~ns] = CODE["all_failed"]
-    reason[~has.any(-1)] = CODE["no_data"]
-    both = nk & ns
+    both = reason == CODE["ok"]
     x_safe_max = np.where(safes, lnx, -np.inf).max(-1)
     x_fail_min = np.where(fails, lnx, np.inf).min(-1)
     sep = both & (x_fail_min >= x_safe_max)
@@ -105,6 +101,20 @@ def mle_batch(lnx: np.ndarray, k: np.ndarray, n: np.ndarray,
         rsn[~up] = CODE["decreasing"]
         median[todo], beta[todo], reason[todo] = med, bet, rsn
     return median, beta, reason
+
+
+def empty_ending(k: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """How a fit of counts k of n (B, S) ends before any fitting: "no_failures" (no
+    counted point reaches the state), "all_failed" (every one does), "no_data" (none
+    counted), else "ok" (a fit is needed): int (B,) codes into ENDINGS."""
+    has = n > 0
+    nk = (has & (k > 0)).any(-1)
+    ns = (has & (n - k > 0)).any(-1)
+    reason = np.zeros(k.shape[0], dtype=np.int64)
+    reason[~nk] = CODE["no_failures"]
+    reason[nk & ~ns] = CODE["all_failed"]
+    reason[~has.any(-1)] = CODE["no_data"]
+    return reason
 
 
 def _log_cdf(e: np.ndarray) -> np.ndarray:
@@ -288,14 +298,16 @@ def _multinomial_ll(p: np.ndarray, m: np.ndarray) -> np.ndarray:
 
 
 def _maximise(prob: Callable[[np.ndarray, np.ndarray], np.ndarray], m: np.ndarray,
-              theta0: np.ndarray, limit: np.ndarray, iters: int = 100, tol: float = 1e-10
+              theta0: np.ndarray, limit: np.ndarray, iters: int = 100, tol: float = 1e-10,
+              jac: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
               ) -> tuple[np.ndarray, np.ndarray]:
     """Maximum likelihood of multinomial counts m (B, C, P) (C categories at P IM levels)
     under probabilities prob(theta (b, p), rows (b,)) -> (b, C, P), for every row of
     theta0 (B, p): Fisher scoring (information sum over c, s of n_s J J^T / p, J = dp /
-    dtheta by central differences), damped (Levenberg-Marquardt) until the likelihood
-    rises. A row whose |theta| passes ``limit`` (p,) runs away to a boundary (separated
-    data: no maximum) and stops, not converged. Returns (theta (B, p), converged (B,))."""
+    dtheta (b, p, C, P): ``jac(theta, rows)`` if given, else central differences),
+    damped (Levenberg-Marquardt) until the likelihood rises. A row whose |theta| passes
+    ``limit`` (p,) runs away to a boundary (separated data: no maximum) and stops, not
+    converged. Returns (theta (B, p), converged (B,))."""
     B, P = theta0.shape
     n = m.sum(1)
     th = theta0.copy()
@@ -311,10 +323,13 @@ def _maximise(prob: Callable[[np.ndarray, np.ndarray], np.ndarray], m: np.ndarra
         if idx.size == 0:
             break
         t = th[idx]
-        both = np.concatenate([t[:, None, :] + h * eye, t[:, None, :] - h * eye], 1)
-        vals = prob(both.reshape(-1, P), np.repeat(idx, 2 * P)).reshape(
-            (idx.size, 2 * P) + pr.shape[1:])
-        J = (vals[:, :P] - vals[:, P:]) / (2.0 * h)  # (b, p, C, P)
+        if jac is not None:
+            J = jac(t, idx)
+        else:
+            both = np.concatenate([t[:, None, :] + h * eye, t[:, None, :] - h * eye], 1)
+            vals = prob(both.reshape(-1, P), np.repeat(idx, 2 * P)).reshape(
+                (idx.size, 2 * P) + pr.shape[1:])
+            J = (vals[:, :P] - vals[:, P:]) / (2.0 * h)  # (b, p, C, P)
         inv = 1.0 / np.maximum(pr[idx], 1e-300)
         g = np.einsum("bkcs,bcs->bk", J, m[idx] * inv)
         info = np.einsum("bkcs,bjcs,bcs->bkj", J, J, n[idx][:, None, :] * inv)
@@ -385,6 +400,29 @@ def _ordinal_probs(z: np.ndarray, theta: np.ndarray) -> np.ndarray:
         return np.log(np.maximum(p, 0.0))
 
 
+def _ordinal_jac(z: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """d P(category c | z) / d theta (b, K+1, K+1, P) (parameter, category, level) of
+    ``_ordinal_probs``' model, analytic: with e_j = s (z - t_j), q_j = Phi(e_j) = P(DS >=
+    j), dq_j = phi(e_j) (e_j dlog s - s dt_j), t_j = theta_0 + sum_{1 <= i < j}
+    exp(theta_i) (states j = 0..K-1), and P(c) = q_{c-1} - q_c (q_{-1} = 1, q_K = 0)."""
+    b, K1 = theta.shape
+    K = K1 - 1
+    t = np.cumsum(np.concatenate([theta[:, :1], np.exp(theta[:, 1:K])], 1), 1)  # (b, K)
+    s = np.exp(theta[:, K])
+    e = s[:, None, None] * (z[:, None, :] - t[:, :, None])  # (b, K, P)
+    phi = np.exp(-0.5 * e * e) * (1.0 / math.sqrt(2.0 * math.pi))
+    # dt_j / dtheta_i (b, K, K): 1 for i = 0, exp(theta_i) for 1 <= i <= j
+    dt = np.tril(np.broadcast_to(np.concatenate([np.ones((b, 1)), np.exp(theta[:, 1:K])],
+                                                1)[:, None, :], (b, K, K)))
+    dq = np.empty((b, K1, K + 2) + z.shape[-1:])  # (b, parameter, q_{-1}..q_K, P)
+    dq[:, :, 0] = 0.0
+    dq[:, :, -1] = 0.0
+    dq[:, :K, 1:-1] = -(s[:, None, None, None] * dt.transpose(0, 2, 1)[..., None]) * \
+        phi[:, None]
+    dq[:, K, 1:-1] = e * phi
+    return dq[:, :, :-1] - dq[:, :, 1:]
+
+
 def _fit_ordinal(lnx: np.ndarray, m: np.ndarray, start: tuple | None = None
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Ordinal probit with a common beta (module docstring). lnx (b, P) ln IM; m (b, K+1,
@@ -413,7 +451,11 @@ def _fit_ordinal(lnx: np.ndarray, m: np.ndarray, start: tuple | None = None
         return np.exp(_ordinal_probs(z[rows], theta))
 
     limit = np.array([60.0] + [40.0] * (K - 1) + [15.0])
-    theta, conv = _maximise(prob, m, theta0, limit, tol=1e-10 if start is None else 1e-7)
+    def jac(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        return _ordinal_jac(z[rows], theta)
+
+    theta, conv = _maximise(prob, m, theta0, limit, tol=1e-10 if start is None else 1e-7,
+                            jac=jac)
     t = np.cumsum(np.concatenate([theta[:, :1], np.exp(theta[:, 1:K])], 1), 1)
     s = np.exp(theta[:, K])
     return np.exp(mu[:, None] + sd[:, None] * t), sd / s, conv
@@ -546,11 +588,9 @@ def _fit_ordinal_counts(lnx, m, n, stripes, start=None):
     bet = np.full((b, K), np.nan)
     code = np.zeros((b, K), np.int64)
     und = np.zeros((b, K), bool)
-    marg = [mle_batch(lnx, reach[:, j], n) for j in range(K)]
-    mcode = np.stack([c for _, _, c in marg], 1)
-    for j in range(K):
-        code[:, j] = mcode[:, j]
-    fitted = ~np.isin(mcode, [CODE[w] for w in ("no_failures", "all_failed", "no_data")])
+    # the states nothing or everything reaches need no fit (their ending is all there is)
+    code[:] = np.stack([empty_ending(reach[:, j], n) for j in range(K)], 1)
+    fitted = code == CODE["ok"]
     # eligible states are contiguous in severity (nested): fit each pattern once
     patterns, inv = np.unique(fitted, axis=0, return_inverse=True)
     inv = np.asarray(inv).ravel()

@@ -566,6 +566,42 @@ def test_the_joint_fits_parallel_test_is_a_likelihood_ratio_and_rejects_unequal_
     assert not bool(ok["parallel_rejected"])
 
 
+def test_each_joint_resample_fit_is_the_ordinal_mle_of_the_records_it_draws():
+    # 4 records: 40 resamples draw 20 distinct multisets of records (repeats are fitted
+    # once); each resample refitted from scratch as a Dataset of the records it draws
+    R, N, seed = 4, 40, 1
+    ds = nested_ds(R, 0.4, 0.5, 0.7, 0.5, seed=2, levels=np.geomspace(0.1, 1.6, 24))
+    states = ["theta:0.5", "overturn"]
+    fr = F.fragility(ds, state=states, joint=True, bootstrap=N, seed=seed, warn=False)
+    draws = np.random.default_rng(seed).integers(0, R, size=(N, R))
+    assert len({tuple(sorted(d)) for d in draws}) < N
+    med_s, beta_s = fr["im_median_samples"].values, fr["beta_samples"].values
+    finite = 0
+    for i, d in enumerate(draws):
+        one = ds.isel(record=d).assign_coords(record=[f"D{j}.AT2" for j in range(R)])
+        ref = F.fragility(one, state=states, joint=True, bootstrap=0, warn=False)
+        med, beta = ref["im_median"].values, ref["beta"].values
+        fin = np.isfinite(med) & np.isfinite(beta)
+        np.testing.assert_array_equal(np.isfinite(med_s[:, i]), fin)
+        np.testing.assert_allclose(med_s[fin, i], med[fin], rtol=1e-6)
+        np.testing.assert_allclose(beta_s[fin, i], beta[fin], rtol=1e-6)
+        finite += int(fin.all())
+    assert finite > N // 2
+
+
+def test_the_ordinal_jacobian_equals_central_differences_of_its_probabilities():
+    from rocksweep.analysis.likelihood import _ordinal_jac, _ordinal_probs
+
+    rng = np.random.default_rng(4)
+    z = rng.standard_normal((2, 9))
+    theta = 0.5 * rng.standard_normal((2, 4))  # K = 3 states
+    h = 1e-6
+    num = np.stack([(np.exp(_ordinal_probs(z, theta + h * e))
+                     - np.exp(_ordinal_probs(z, theta - h * e))) / (2 * h)
+                    for e in np.eye(4)], 1)
+    np.testing.assert_allclose(_ordinal_jac(z, theta), num, atol=1e-8)
+
+
 def test_a_file_without_records_is_named_with_the_way_out(tmp_path):
     import yaml
     from click.testing import CliRunner
