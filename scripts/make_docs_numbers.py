@@ -210,6 +210,7 @@ def compute_calibration() -> dict:
     import tempfile
     import warnings
 
+    import numpy as np
     import pandas as pd
 
     import rocksweep
@@ -223,7 +224,7 @@ def compute_calibration() -> dict:
                  f"numerics.accuracy={acc}", "--csv", str(truth))
             t = pd.read_csv(truth)  # the page's noise, line for line
             t["theta_over_alpha"] += 0.01 * t.theta_over_alpha.abs().max() * \
-                __import__("numpy").random.default_rng(1).standard_normal(len(t))
+                np.random.default_rng(1).standard_normal(len(t))
             t[["p_t", "theta_over_alpha"]].to_csv(meas, index=False)
             out = _cli("calibrate", free, str(meas), "--fit", "impact.lam")
             # the fit's time is the machine's (scripts/bench_calibrate.py measures it)
@@ -300,9 +301,9 @@ def compute_fragility() -> dict:
         ida = rocksweep.ida(ds, rtol=1e-2)
     drops = -np.diff(fr["n_failed"].transpose("lam", ...).values, axis=-1)
     dips = drops[drops > 0]
-    lo, hi = float(ds[fr.attrs.get("im", "PGA")].min()), float(ds["PGA"].max())
+    stripes = ds[ds.attrs["scale_im"]].values  # the crossing verdict's range: the stripes'
     grid = two["im_grid"].values
-    inside = (grid >= lo) & (grid <= hi)
+    inside = (grid >= stripes.min()) & (grid <= stripes.max())
     gap = (two["curve"].sel(state="overturn") - two["curve"].sel(state="theta:0.5")
            ).transpose("lam", "im_grid").values[:, inside].max(axis=1)
     k = int(np.argmax(gap))
