@@ -5,7 +5,8 @@ Prints, measured side by side in one run:
 1. the study's wall time through ``python -m rocksweep sweep SCENE -o OUT --jobs 2``, start-up
    (Python, imports, numba's cache load, reading and hashing the 44 records, their IMs)
    and HDF5 writing included: 2 112 runs of 20-40 s records on the Figure 3(a) body
-   (target: < 10 s on 2 cores), then ``rocksweep fragility`` on it. The first sweep fills
+   (target: < 10 s on 2 cores), then ``rocksweep fragility`` on it (overturning; then 3
+   nested states, each alone and ``--joint``). The first sweep fills
    numba's cache if it is cold and is reported apart; the timed sweep is the best of
    ``--repeat``.
 2. the cost of one run against the scipy reference (``rocksweep.physics.reference``,
@@ -130,6 +131,11 @@ def main(argv: list[str] | None = None) -> int:
         fr = [sys.executable, "-m", "rocksweep", "fragility", str(out), "--json"]
         t_fr = timed(fr, env)
         print(f"   rocksweep fragility (200 bootstrap resamples): {t_fr:.2f} s")
+        three = fr + ["--state", "theta:0.25,theta:0.5,overturn"]
+        t_sep, t_joint = timed(three, env), timed(three + ["--joint"], env)
+        print(f"   rocksweep fragility --state theta:0.25,theta:0.5,overturn: each state "
+              f"alone {t_sep:.2f} s, --joint (one beta, its likelihood-ratio test) "
+              f"{t_joint:.2f} s")
 
         # 2. per run against the reference
         from rocksweep.compute.dispatch import run_record

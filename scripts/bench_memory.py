@@ -13,7 +13,8 @@ traced allocation (``tracemalloc``: numpy's arrays included) and its wall time.
     python scripts/bench_memory.py                    # S = 100, 600, 2000
     python scripts/bench_memory.py --stripes 2000     # one size
 
-Target (fragility of 2000 stripes x 3 records): < 1 GB and < 10 s.
+Target (fragility of 2000 stripes x 3 records, each state alone and ``joint``): < 1 GB
+and < 10 s; the fragility lines at 2000 stripes or more say "met" or "NOT met".
 """
 
 from __future__ import annotations
@@ -65,15 +66,23 @@ def widened(ds, S: int, seed: int = 1):
     return wide
 
 
-def measure(what: str, fn, points: int, nbytes: int):
-    """fn() timed and its peak traced allocation printed; returns what fn returned."""
+#: the fragility target at 2000 stripes x 3 records: peak bytes, wall seconds
+TARGET = (1e9, 10.0)
+
+
+def measure(what: str, fn, points: int, nbytes: int, target: bool = False):
+    """fn() timed and its peak traced allocation printed (with target: against
+    ``TARGET``); returns what fn returned."""
     tracemalloc.start()
     t0 = time.perf_counter()
     out = fn()
     wall = time.perf_counter() - t0
     _, peak = tracemalloc.get_traced_memory()
     tracemalloc.stop()
-    print(f"{what:<28}{points:>9}{nbytes / 1e6:>12.2f}{peak / 1e6:>12.1f}{wall:>9.2f}",
+    met = ""
+    if target:
+        met = "  met" if peak < TARGET[0] and wall < TARGET[1] else "  NOT met"
+    print(f"{what:<28}{points:>9}{nbytes / 1e6:>12.2f}{peak / 1e6:>12.1f}{wall:>9.2f}{met}",
           flush=True)
     return out
 
@@ -92,11 +101,13 @@ def main() -> None:
     for S in args.stripes:
         ds = widened(base, S)
         n, nb = ds.sizes["record"] * S, int(ds.nbytes)
-        measure(f"fragility overturn S={S}", lambda ds=ds: rocksweep.fragility(ds), n, nb)
+        big = S >= 2000  # the target's size: say whether it is met
+        measure(f"fragility overturn S={S}", lambda ds=ds: rocksweep.fragility(ds), n, nb,
+                big)
         three = measure(f"fragility 3 states S={S}", lambda ds=ds: rocksweep.fragility(
-            ds, state=["theta:0.25", "theta:0.5", "overturn"]), n, nb)
+            ds, state=["theta:0.25", "theta:0.5", "overturn"]), n, nb, big)
         measure(f"fragility 3 joint S={S}", lambda ds=ds: rocksweep.fragility(
-            ds, state=["theta:0.25", "theta:0.5", "overturn"], joint=True), n, nb)
+            ds, state=["theta:0.25", "theta:0.5", "overturn"], joint=True), n, nb, big)
         measure(f"efficiency S={S}", lambda ds=ds: rocksweep.im_efficiency(ds), n, nb)
         measure(f"risk S={S}", lambda fr=three: rocksweep.risk(fr, hazard), n, nb)
         measure(f"table S={S}", lambda ds=ds: rocksweep.table(ds), n, nb)

@@ -27,9 +27,27 @@ Numbers (``COMPUTE``):
   lam = 1, u/u_cr = -2; Housner's e of the body welded rigid): README.md's quick start and
   single-run paragraphs; the mode 1 points per lam of the four figures' 80 x 80 grids
   (``rocksweep info``; ~3 s): docs/diagrams.md.
+- ``calibration`` (seconds, recomputed in the test): docs/calibration.md's worked examples:
+  ``rocksweep simulate`` + ``calibrate`` of configs/free-rocking.yaml as the page shows
+  them (the truth at ``fine``, and at ``default``), the Figure 3(a) body's fit and its
+  diagram at the interval (``FLEX_EXAMPLE``, ``FLEX_PLANE``), and the misfit verdict of a
+  block under eq. (1) fitted to a block whose e is 0.6.
+- ``fragility`` (seconds, recomputed): docs/fragility.md's demo-suite sentences: the
+  overturning fractions' dips and the non-monotone verdict, the crossing of theta:0.5 and
+  overturning, where ``joint=True``'s common beta is rejected, the IDA's kernel runs.
+- ``api_example`` (seconds, recomputed): what README.md's Python example prints (its
+  scene is read from the README's code).
+- ``accuracy`` (~10-20 s): docs/accuracy.md's cells where ``default`` differs from
+  ``fine`` on the four figures, ``block`` and ``fig4a-rigid``, and Figure 3(a) with
+  ``--check`` (``rocksweep info``'s tails).
+- ``calibration_bench`` (~1 min): the recovery errors and interval coverage that
+  ``scripts/bench_calibrate.py`` prints (its cases, fitted the same way), in
+  docs/calibration.md's "Measured" section; the script's times are not stored.
 
 Benchmark timings quoted in the docs are not regenerated here (they vary with the
-machine and its load); docs/performance.md lists each with the script that measures it.
+machine and its load); docs/performance.md and docs/accuracy.md name the script that
+measures each. Nor are the measurements of a change (before -> after tables), nor the
+benchmarks' own tables (scripts/bench_*.py, scripts/accuracy_tables.py, wide_space.py).
 """
 
 from __future__ import annotations
@@ -74,12 +92,9 @@ def compute_impact_laws() -> dict:
 
 def compute_demo() -> dict:
     """The demo suite's beta_scale per IM and lam, and its rates (module docstring)."""
-    import warnings
-
     import rocksweep
 
-    warnings.simplefilter("ignore")  # the demo's record warnings: said in the docs
-    ds = rocksweep.run(ROOT / "configs" / "fragility-demo.yaml", jobs=2)
+    ds = _demo_suite()
     eff = rocksweep.im_efficiency(ds)
     lams = [f"{v:g}" for v in ds["lam"].values]
     beta = {str(im): [round(float(v), 2) for v in eff["beta_scale"].sel(im=im).values]
@@ -142,9 +157,276 @@ def compute_quick() -> dict:
                      "e_housner_rigid": round(t.e_housner, 3)}}
 
 
-COMPUTE = {"impact_laws": compute_impact_laws, "demo": compute_demo, "quick": compute_quick}
-#: the computations of seconds, rerun by tests/test_docs_numbers.py (the others take minutes)
-CHEAP = ("quick",)
+def _cli(*args: str) -> str:
+    """What ``rocksweep ARGS`` prints (stdout), run in this process; exit 0 checked."""
+    from click.testing import CliRunner
+
+    from rocksweep.cli import main as cli
+
+    res = CliRunner().invoke(cli, list(args))
+    if res.exit_code != 0:
+        raise SystemExit(f"rocksweep {' '.join(args)}: exit {res.exit_code}: {res.output}")
+    return res.stdout
+
+
+def _sampled(history, every: float, noise: float, seed: int):
+    """DataFrame (p_t, theta_over_alpha) of a simulated history sampled every ``every``
+    p*t (linear between its rows, one row per time) with Gaussian noise of ``noise`` x
+    max|theta|: a synthetic measurement (as scripts/bench_calibrate.py makes them)."""
+    import numpy as np
+    import pandas as pd
+
+    t, th = history.p_t.values, history.theta_over_alpha.values
+    keep = np.r_[t[1:] != t[:-1], True]
+    t, th = t[keep], th[keep]
+    ts = np.arange(0.0, t[-1] + 4.0, every)
+    y = np.interp(ts, t, th)
+    y += noise * np.abs(th).max() * np.random.default_rng(seed).standard_normal(ts.size)
+    return pd.DataFrame({"p_t": ts, "theta_over_alpha": y})
+
+
+#: docs/calibration.md's flexible-body example: the Figure 3(a) body under a sine pulse
+FLEX_EXAMPLE = {"name": "Figure 3(a) body, sine pulse",
+                "body": {"wn_over_p": 2.43, "zeta": 0.05, "alpha_cg": 0.15, "alpha_A": 0.28,
+                         "mA_over_m": 0.47, "IA_ratio": 0.56},
+                "impact": {"lam": 0.0}, "pulse": {"shape": "sine", "w_over_p": 4.0,
+                                                 "A_ratio": 2.0}}
+#: ... and the (omega/p, A) plane it is swept over at the fitted interval
+FLEX_PLANE = {"w_over_p": {"start": 0.5, "stop": 6.0, "num": 23},
+              "A_ratio": {"start": 0.5, "stop": 8.0, "num": 31}}
+
+
+def _interval(fit) -> dict:
+    s = fit.isel(parameter=0)
+    return {"estimate": round(float(s["estimate"]), 4), "lo": round(float(s["lo"]), 4),
+            "hi": round(float(s["hi"]), 4)}
+
+
+def compute_calibration() -> dict:
+    """docs/calibration.md's worked examples (seconds): the command lines of the free
+    block (truth at ``fine``; and at ``default``: the generator's own error), the flexible
+    body fitted and swept at its interval, and a model that cannot reproduce a
+    measurement (a block under eq. (1) fitted to a block whose e is 0.6)."""
+    import tempfile
+    import warnings
+
+    import numpy as np
+    import pandas as pd
+
+    import rocksweep
+
+    free = str(ROOT / "configs" / "free-rocking.yaml")
+    lines: dict[str, list[str]] = {}
+    with tempfile.TemporaryDirectory() as d:
+        for acc in ("fine", "default"):
+            truth, meas = Path(d, f"truth-{acc}.csv"), Path(d, f"measured-{acc}.csv")
+            _cli("simulate", free, "--set", "impact.lam=0.3", "--set",
+                 f"numerics.accuracy={acc}", "--csv", str(truth))
+            t = pd.read_csv(truth)  # the page's noise, line for line
+            t["theta_over_alpha"] += 0.01 * t.theta_over_alpha.abs().max() * \
+                np.random.default_rng(1).standard_normal(len(t))
+            t[["p_t", "theta_over_alpha"]].to_csv(meas, index=False)
+            out = _cli("calibrate", free, str(meas), "--fit", "impact.lam")
+            # the fit's time is the machine's (scripts/bench_calibrate.py measures it)
+            lines[acc] = [re.sub(r"runs in [0-9.]+ s", "runs in T s", ln)
+                          for ln in out.strip().splitlines()]
+    default_impacts = int(rocksweep.simulate(free, {"impact.lam": 0.3})
+                          .summary["impacts"])
+    sim = rocksweep.simulate(FLEX_EXAMPLE, {"impact.lam": 0.25,
+                                            "numerics.accuracy": "fine"})
+    fit = rocksweep.calibrate(FLEX_EXAMPLE, _sampled(sim.history, 0.02, 0.01, 1),
+                              ["impact.lam"])
+    plane = {**FLEX_EXAMPLE, "pulse": {"shape": "sine", **FLEX_PLANE}}
+    ds = rocksweep.run(plane, jobs=2, overrides=rocksweep.calibrated_overrides(fit))
+    mode1 = (ds.outcome == 1).sum(["w_over_p", "A_ratio"]).values.tolist()
+    block = {"name": "free block", "body": {"kind": "block", "alpha": 0.2},
+             "initial": {"theta_over_alpha": 0.7}}
+    measured = rocksweep.simulate({**block, "impact": {"lam": 0.0, "law": "constant", "e": 0.6}},
+                                  {"numerics.accuracy": "fine"})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the misfit's warning: its numbers are the point
+        bad = rocksweep.calibrate({**block, "impact": {"lam": 0.0}},
+                                  _sampled(measured.history, 0.02, 0.01, 0), ["impact.lam"])
+    n, dof = bad.attrs["n_peaks"], int(bad["dof"])
+    ratio = float(bad["misfit"]) * (n / dof) ** 0.5 / float(bad["noise"])
+    return {"command": "rocksweep simulate/calibrate configs/free-rocking.yaml as "
+                       "docs/calibration.md's worked example (truth at fine and at default); "
+                       "rocksweep.calibrate of FLEX_EXAMPLE (truth lam 0.25 at fine, every "
+                       "0.02 p*t, 1% noise, seed 1) and rocksweep.run of FLEX_PLANE at "
+                       "calibrated_overrides; a block (law constant, e 0.6) fitted under "
+                       "eq. (1)",
+            "free_fine": lines["fine"], "free_default": lines["default"],
+            "free_default_impacts": default_impacts,
+            "flex": {"impacts": int(sim.summary["impacts"]), **_interval(fit),
+                     "runs": int(fit.attrs["runs"]), "reason": fit["reason"].item(),
+                     "mode1": mode1, "points": int(ds.outcome.size // len(mode1))},
+            "misfit": {"reason": bad["reason"].item(), "ratio": round(ratio),
+                       "dof": dof}}
+
+
+_DEMO: list = []
+
+
+def _demo_suite():
+    """The demo suite's Dataset (configs/fragility-demo.yaml), run once per process."""
+    import warnings
+
+    import rocksweep
+
+    if not _DEMO:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the demo's record warnings: said in the docs
+            _DEMO.append(rocksweep.run(ROOT / "configs" / "fragility-demo.yaml", jobs=2))
+    return _DEMO[0]
+
+
+def compute_fragility() -> dict:
+    """docs/fragility.md's numbers of the demo suite (seconds): the overturning fractions'
+    dips and the non-monotone verdict, how far theta:0.5's and overturning's separate
+    curves cross, where the joint fit's common beta is rejected, and the IDA's runs."""
+    import warnings
+
+    import numpy as np
+
+    import rocksweep
+
+    ds = _demo_suite()
+    lams = [f"{v:g}" for v in ds["lam"].values]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the verdicts are read from `reason`
+        fr = rocksweep.fragility(ds)
+        two = rocksweep.fragility(ds, state=["theta:0.5", "overturn"])
+        joint = rocksweep.fragility(ds, state=["theta:0.1", "theta:0.25", "theta:0.5",
+                                               "overturn"], joint=True, bootstrap=0)
+        ida = rocksweep.ida(ds, rtol=1e-2)
+    drops = -np.diff(fr["n_failed"].transpose("lam", ...).values, axis=-1)
+    dips = drops[drops > 0]
+    stripes = ds[ds.attrs["scale_im"]].values  # the crossing verdict's range: the stripes'
+    grid = two["im_grid"].values
+    inside = (grid >= stripes.min()) & (grid <= stripes.max())
+    gap = (two["curve"].sel(state="overturn") - two["curve"].sel(state="theta:0.5")
+           ).transpose("lam", "im_grid").values[:, inside].max(axis=1)
+    k = int(np.argmax(gap))
+    return {"command": "rocksweep.run(configs/fragility-demo.yaml); fragility (overturn; "
+                       "theta:0.5 and overturn; theta:0.1/0.25/0.5/overturn joint, no "
+                       "bootstrap); ida(rtol=1e-2)",
+            "lam": lams, "n_records": int(ds.sizes["record"]), "runs": int(ds.outcome.size),
+            "dip_min": int(dips.min()) if dips.size else 0,
+            "dip_max": int(dips.max()) if dips.size else 0,
+            "overturn_reason": [str(r) for r in fr["reason"].values],
+            "crossing_gap": float(f"{gap[k]:.1g}"), "crossing_lam": lams[k],
+            "crossing_said": bool(any("crossing" in str(r) for r in
+                                      np.ravel(two["reason"].values))),
+            "parallel_rejected": [lam for lam, r in zip(
+                lams, joint["parallel_rejected"].values, strict=True) if bool(r)],
+            "ida_runs": int(ida["runs"].sum())}
+
+
+def compute_api_example() -> dict:
+    """What README.md's Python API example prints (seconds): its scene (read from the
+    README's code, so that the numbers are of the scene shown), its points, mode 1 points
+    per lam and the two runs at Figure 5's pulse."""
+    import ast
+
+    import rocksweep
+
+    code = re.search(r"```python\n(.*?)```", (ROOT / "README.md").read_text(), re.S)[1]
+    scene = ast.literal_eval(re.search(r"^scene = (\{.*?^\})", code, re.S | re.M)[1])
+    est = rocksweep.estimate(scene, jobs=2)
+    ds = rocksweep.run(scene, jobs=2)
+    mode1 = (ds.outcome == 1).sum(["A_ratio", "w_over_p"])
+    sims = rocksweep.simulate(scene, {"pulse.w_over_p": 5.3, "pulse.A_ratio": 5.0})
+    return {"command": "README.md's Python API example (its scene, estimate, run, simulate)",
+            "points": int(est.points),
+            "mode1": repr(dict(zip(ds.lam.values.tolist(), mode1.values.tolist(),
+                                   strict=True))),
+            "runs": repr([(s.title, s.summary["outcome"], s.summary["impacts"])
+                          for s in sims])}
+
+
+#: the shipped scenes whose `default` classes docs/accuracy.md compares with `fine`
+ACCURACY_SCENES = ("fig3a", "fig3b", "fig4a", "fig4b", "block", "fig4a-rigid")
+
+
+def compute_accuracy() -> dict:
+    """docs/accuracy.md's counts of the shipped scenes (~10-20 s): cells whose class at
+    `default` differs from `fine`'s and the points the certification refined; Figure
+    3(a) with ``--check`` (``rocksweep sweep --check``; ``rocksweep info``'s tails)."""
+    import json as _json
+    import tempfile
+
+    import rocksweep
+
+    differ, points = {}, {}
+    for name in ACCURACY_SCENES:
+        path = ROOT / "configs" / f"{name}.yaml"
+        d = rocksweep.run(path, jobs=2, overrides={"numerics.accuracy": "default"})
+        f = rocksweep.run(path, jobs=2, overrides={"numerics.accuracy": "fine"})
+        differ[name] = int((d.outcome != f.outcome).sum())
+        points[name] = int(d.outcome.size)
+    with tempfile.TemporaryDirectory() as tmp:
+        out = str(Path(tmp, "f.h5"))
+        _cli("sweep", str(ROOT / "configs" / "fig3a.yaml"), "--check", "-o", out,
+             "--quiet", "--jobs", "2")
+        chk = _json.loads(_cli("info", out, "--json"))["check"]
+        ds = rocksweep.open(out)
+        changed = (ds.check_outcome != ds.outcome).sum(["w_over_p", "A_ratio"])
+        by_lam = {f"{v:g}": int(n) for v, n in zip(ds.lam.values, changed.values,
+                                                   strict=True)}
+        ds.close()
+    return {"command": "rocksweep.run(configs/NAME.yaml) at numerics.accuracy default and "
+                       "fine; rocksweep sweep configs/fig3a.yaml --check; rocksweep info "
+                       "--json",
+            "differ": differ, "points": points,
+            "check": {"points": chk["points"], "changes": chk["outcome_changes"],
+                      "changes_by_lam": by_lam,
+                      "t_p95": float(f"{chk['t_overturn_diff']['p95']:.2g}"),
+                      "theta_p95": round(100 * chk["theta_max_rel_diff"]["p95"], 1)}}
+
+
+def compute_calibration_bench() -> dict:
+    """scripts/bench_calibrate.py's recovery numbers (~1 min): its cases (``CASES``) fitted
+    back from 1% and 0.3% noise as the script fits them; the truths' impacts, the largest
+    errors, the intervals that cover the truth and those narrower at 0.3% noise. Its
+    times are the script's to print, not stored here."""
+    import importlib.util
+    import warnings
+
+    spec = importlib.util.spec_from_file_location(
+        "bench_calibrate", ROOT / "scripts" / "bench_calibrate.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    impacts: dict[str, list[int]] = {"pulse": [], "free": []}
+    worst = {"impact.lam": 0.0, "impact.e": 0.0}
+    covered = narrower = 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # a verdict's warning: the numbers are read here
+        for label, scene, key, truth, start, _tol in bench.CASES:
+            df, n_imp = bench.measurement(scene, key, truth, 0.01, 1,
+                                          uneven="cos" in label, steps=200)
+            f, _ = bench.fit_case(scene, key, start, df)
+            df3, _ = bench.measurement(scene, key, truth, 0.003, 2, steps=200)
+            f3, _ = bench.fit_case(scene, key, start, df3)
+            impacts["free" if "free" in label else "pulse"].append(int(n_imp))
+            if key in worst:
+                worst[key] = max(worst[key], abs(float(f.estimate) - truth))
+            covered += float(f.lo) <= truth <= float(f.hi)
+            narrower += float(f3.hi - f3.lo) < float(f.hi - f.lo)
+    return {"command": "python scripts/bench_calibrate.py (its CASES, truths at 200 steps "
+                       "per period; times not stored)",
+            "cases": len(bench.CASES),
+            "impacts": {k: [min(v), max(v)] for k, v in impacts.items()},
+            "worst": {k: round(v, 4) for k, v in worst.items()},
+            "covered": covered, "narrower": narrower}
+
+
+COMPUTE = {"impact_laws": compute_impact_laws, "demo": compute_demo, "quick": compute_quick,
+           "calibration": compute_calibration, "fragility": compute_fragility,
+           "api_example": compute_api_example, "accuracy": compute_accuracy,
+           "calibration_bench": compute_calibration_bench}
+#: the computations of seconds, rerun by tests/test_docs_numbers.py (the others take
+#: more: ``--check`` reruns them)
+CHEAP = ("quick", "calibration", "fragility", "api_example")
 
 
 def _pct(v: float) -> str:
@@ -258,7 +540,155 @@ def render_quick(d: dict) -> dict[str, str]:
                 mode1, 90, subsequent_indent="  ")}}
 
 
-RENDER = {"impact_laws": render_impact_laws, "demo": render_demo, "quick": render_quick}
+def render_calibration(d: dict) -> dict[str, dict[str, str]]:
+    """docs/calibration.md: the worked example's output, the default-preset generator's
+    fit, the flexible body's fit and diagram, the misfit example."""
+    iv = {k: re.search(r"\[([0-9.]+), ([0-9.]+)\]", d[k][0]).groups()
+          for k in ("free_fine", "free_default")}
+    est = {k: re.search(r"= ([0-9.]+)", d[k][0])[1] for k in iv}
+    step = re.search(r"to ([0-9.]+) p\*t", d["free_default"][-1])
+    lam3 = lambda x: f"{float(x):.3f}"  # noqa: E731
+    generator = (
+        "A \"measurement\" made with `simulate` and 1% noise, fitted back (the block of "
+        "`configs/free-rocking.yaml` released from 0.7 alpha, truth lam = 0.3; the CSV rows "
+        "are the kernel's own steps at `fine`, unevenly spaced, with the event rows). The "
+        "truth is made at `fine`: at the `default` preset (5 steps per period, rows up to "
+        f"{step[1] if step else '?'} p*t apart) the simulated \"measurement\" of "
+        f"{d['free_default_impacts']} impacts carries that preset's own integration error, "
+        "and the fit, which runs at least at `fine`, recovers lam = "
+        f"{lam3(est['free_default'])} [{lam3(iv['free_default'][0])}, "
+        f"{lam3(iv['free_default'][1])}] from it: the error of the generator, not of the "
+        "fit.")
+    out = ("```\n" + "\n".join(d["free_fine"]) + "\n```\n\n(T: the fit's compute time, "
+           "~1 s on the 2-core machine; `python scripts/bench_calibrate.py` measures it.)")
+    f = d["flex"]
+    m1 = ", ".join(str(v) for v in f["mode1"])
+    moved = max(f["mode1"]) - min(f["mode1"])
+    flex = (
+        "```python\n"
+        "fit = rocksweep.calibrate(scene, measured, fit=[\"impact.lam\"])\n"
+        f"# impact.lam = {f['estimate']:.4f} [{f['lo']:.4f}, {f['hi']:.4f}], {f['runs']} "
+        f"runs, fit {f['reason']}\n"
+        "ds = rocksweep.run(diagram, overrides=rocksweep.calibrated_overrides(fit))\n"
+        "(ds.outcome == 1).sum([\"w_over_p\", \"A_ratio\"])   # mode 1 points: "
+        f"{m1} of {f['points']}\n```\n\n"
+        + textwrap.fill(
+            f"Here the calibrated interval moves the diagram by {moved} "
+            f"point{'' if moved == 1 else 's'} of {f['points']}: the fitted lam is known "
+            "well enough for the stability question. A wider interval (more noise, fewer "
+            "impacts) shows directly how much of the diagram is uncertain.", 90))
+    flex_intro = textwrap.fill(
+        "The paper's question for a flexible body: the Figure 3(a) body under a sine pulse "
+        f"(omega/p = 4, A/(g tan alpha_cg) = 2, {f['impacts']} impacts), truth lam = 0.25 "
+        "(simulated at `fine`), sampled every 0.02 p*t with 1% noise, fitted back and then "
+        "swept over the (omega/p, A) plane (`FLEX_PLANE` of scripts/make_docs_numbers.py, "
+        f"{f['points']} points) at the interval's ends and the estimate:", 90)
+    m = d["misfit"]
+    misfit = textwrap.fill(
+        "A model that cannot reproduce the measurement: a block under the vertical law "
+        "fitted to a block whose e is 0.6 (both released from 0.7 alpha, the measurement "
+        f"sampled every 0.02 p*t with 1% noise) says `{m['reason']}`, its peaks' RMS error "
+        f"{m['ratio']} times the noise on {m['dof']} dof.", 90)
+    return {"docs/calibration.md": {
+        "calibration_generator": textwrap.fill(generator, 90),
+        "calibration_output": out, "calibration_flex_intro": flex_intro,
+        "calibration_flex": flex, "calibration_misfit": misfit}}
+
+
+def render_fragility(d: dict) -> dict[str, dict[str, str]]:
+    """docs/fragility.md's sentences on the demo suite."""
+    lams = d["lam"]
+    dips = (f"{d['dip_min']}" if d["dip_min"] == d["dip_max"] else
+            f"{d['dip_min']}-{d['dip_max']}")
+    fires = [lam for lam, r in zip(lams, d["overturn_reason"], strict=True)
+             if "non_monotone" in r]
+    monotone = (f"On the demo suite, whose overturning fractions dip by {dips} of "
+                f"{d['n_records']} records, it " + (
+                    "does not fire." if not fires else
+                    f"fires at lam = {' and '.join(fires)}."))
+    crossing = (f"On the demo suite, theta:0.5 and overturning of its slender body, nearly "
+                f"one state, cross by {d['crossing_gap']:g} at lam = {d['crossing_lam']}: "
+                + ("said." if d["crossing_said"] else "not said."))
+    rej = d["parallel_rejected"]
+    parallel = ("On the demo suite (theta:0.1/0.25/0.5/overturn, `--joint`) the common "
+                "beta is " + (f"rejected at lam = {' and '.join(rej)}" if rej else
+                              "not rejected at any lam") +
+                f" (of {', '.join(lams)}).")
+    ida = (f"On the demo suite ({d['n_records']} records x {len(lams)} lam) the IDA "
+           f"(`--rtol 1e-2`) takes {d['ida_runs']} kernel runs.")
+    commands = ("```sh\n"
+                f"rocksweep sweep configs/fragility-demo.yaml -o frag.h5     # {d['runs']} runs, "
+                "seconds\n"
+                "rocksweep fragility frag.h5 --plot frag.png                 # lognormal MLE, "
+                "bootstrap bands\n```")
+    return {"README.md": {"fragility_commands": commands},
+            "docs/fragility.md": {
+        "fragility_monotone": textwrap.fill(monotone, 90),
+        "fragility_crossing": textwrap.fill(crossing, 90),
+        "fragility_parallel": textwrap.fill(parallel, 90),
+        "fragility_ida": textwrap.fill(ida, 90)}}
+
+
+def render_api_example(d: dict) -> dict[str, dict[str, str]]:
+    """README.md: what the Python API example prints."""
+    text = ("What it prints, besides the estimate's RK4 evaluations and seconds (this "
+            f"machine's): {d['points']} points; mode 1 points per lam `{d['mode1']}`; "
+            f"the two runs `{d['runs']}`.")
+    return {"README.md": {"api_example": textwrap.fill(text, 90)}}
+
+
+def render_calibration_bench(d: dict) -> dict[str, dict[str, str]]:
+    """docs/calibration.md's "Measured" paragraph (the recovery, not the times)."""
+    span = {k: f"{lo}-{hi}" if lo != hi else f"{lo}" for k, (lo, hi) in d["impacts"].items()}
+    n = d["cases"]
+    text = (
+        "Synthetic truths at 200 steps per period (10x the fit's), 1% noise of max|theta|, "
+        "fitted back from another start value: flexible and stiff bodies under sine and "
+        f"cosine pulses (safe, {span['pulse']} impacts; the cosine cases unevenly sampled "
+        f"with a NaN gap), rigid blocks rocking freely ({span['free']} impacts). Largest "
+        f"error: lam {d['worst']['impact.lam']:.4f} (target 0.03), e "
+        f"{d['worst']['impact.e']:.4f} (target 0.02); {d['covered']}/{n} intervals cover "
+        "the truth and " + ("all are" if d["narrower"] == n else f"{d['narrower']}/{n} are")
+        + " narrower at 0.3% noise than at 1%.")
+    return {"docs/calibration.md": {"calibration_bench": textwrap.fill(text, 90)}}
+
+
+#: how docs/accuracy.md names the shipped scenes
+SCENE_LABEL = {"fig3a": "3(a)", "fig3b": "3(b)", "fig4a": "4(a)", "fig4b": "4(b)"}
+
+
+def render_accuracy(d: dict) -> dict[str, dict[str, str]]:
+    """docs/accuracy.md: `default` against `fine` on the shipped scenes; Figure 3(a)'s
+    half-step check."""
+    figs = [k for k in d["differ"] if k in SCENE_LABEL]
+    others = [k for k in d["differ"] if k not in SCENE_LABEL]
+    each = {d["points"][k] for k in figs}
+    per = (f"of their {_thousands(each.pop())} cells each" if len(each) == 1 else
+           "of " + "/".join(_thousands(d["points"][k]) for k in figs) + " cells")
+    vs = ("With the rules as they stand, `default` classifies the four figures like "
+          "`fine` on all but "
+          + "/".join(str(d["differ"][k]) for k in figs) + f" {per} (Figures "
+          + ", ".join(SCENE_LABEL[k] for k in figs) + "), and differs from `fine` on "
+          + ", ".join(f"{d['differ'][k]} of {_thousands(d['points'][k])} cells of "
+                      f"`configs/{k}.yaml`" for k in others)
+          + " (`scripts/make_docs_numbers.py`, group `accuracy`).")
+    c = d["check"]
+    lams = " / ".join(c["changes_by_lam"])
+    counts = " / ".join(str(n) for n in c["changes_by_lam"].values())
+    check = ((f"{c['changes']} of {_thousands(c['points'])} points change (at lam = {lams}: "
+              f"{counts}), knife-edge runs" if c["changes"] else
+              f"No point of {_thousands(c['points'])} changes")
+             + "; the overturning time's estimate is below "
+             f"{c['t_p95']:g} p t at the 95th percentile, max|theta|'s below "
+             f"{c['theta_p95']:g}%.")
+    return {"docs/accuracy.md": {"accuracy_fine": textwrap.fill(vs, 90),
+                                 "accuracy_check": textwrap.fill(check, 90)}}
+
+
+RENDER = {"impact_laws": render_impact_laws, "demo": render_demo, "quick": render_quick,
+          "calibration": render_calibration, "fragility": render_fragility,
+          "api_example": render_api_example, "accuracy": render_accuracy,
+          "calibration_bench": render_calibration_bench}
 
 
 def _markers(name: str) -> tuple[str, str]:

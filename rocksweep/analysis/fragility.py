@@ -540,12 +540,17 @@ def _bootstrap_fits(f: _Fits, c: Counts, groups: list[tuple[str, list[int]]],
     per_fit = max(c.R * (axis.x.size if axis.stripes else 1), 1) * 3
     for start, w in resample_weights(c.R, N, seed, per_fit):
         sl = slice(start, start + w.shape[0])
+        # resamples that draw the same records (most of them, with few records) have the
+        # same counts and so the same fit: each distinct one is fitted once
+        wu, inv = np.unique(w, axis=0, return_inverse=True)
+        inv = np.asarray(inv).ravel()
         for o in range(c.n_o):
             for kind, idxs in groups:
                 oh = c.onehot(kind, idxs, o, c.counted[o])
                 st = (f.res["im_median"][idxs, o], f.res["beta"][idxs, o])
                 med, bet, _, _ = fit_counts(kind, lnx, category_counts(
-                    w, oh, axis.stripes), axis.stripes, start=st)
+                    wu, oh, axis.stripes), axis.stripes, start=st)
+                med, bet = med[inv], bet[inv]
                 bad = ~(np.isfinite(med) & np.isfinite(bet))
                 med[bad], bet[bad] = np.nan, np.nan
                 for q, i in enumerate(idxs):

@@ -53,6 +53,9 @@ ENDINGS = ("ok", "no_failures", "all_failed", "separated", "decreasing", "no_dat
 CODE = {w: i for i, w in enumerate(ENDINGS)}
 #: endings that say all there is (nothing reaches the state, all do, nothing counted)
 EMPTY = [CODE[w] for w in ("no_failures", "all_failed", "no_data")]
+#: the smallest competing-risk probability ``_cif`` resolves (Owen's T: differences of O(1)
+#: terms, absolute error ~1e-16)
+COMPETING_RESOLVED = 1e-12
 #: resamples are fitted in chunks of at most this many count entries (bounded memory)
 BOOT_ELEMENTS = 1 << 20
 
@@ -77,15 +80,11 @@ def mle_batch(lnx: np.ndarray, k: np.ndarray, n: np.ndarray,
     B = k.shape[0]
     median = np.full(B, np.nan)
     beta = np.full(B, np.nan)
-    reason = np.zeros(B, dtype=np.int64)
+    reason = empty_ending(k, n)
     has = n > 0
     fails = has & (k > 0)
     safes = has & (n - k > 0)
-    nk, ns = fails.any(-1), safes.any(-1)
-    reason[~nk] = CODE["no_failures"]
-    reason[nk & ~ns] = CODE["all_failed"]
-    reason[~has.any(-1)] = CODE["no_data"]
-    both = nk & ns
+    both = reason == CODE["ok"]
     x_safe_max = np.where(safes, lnx, -np.inf).max(-1)
     x_fail_min = np.where(fails, lnx, np.inf).min(-1)
     sep = both & (x_fail_min >= x_safe_max)
@@ -105,6 +104,20 @@ def mle_batch(lnx: np.ndarray, k: np.ndarray, n: np.ndarray,
         rsn[~up] = CODE["decreasing"]
         median[todo], beta[todo], reason[todo] = med, bet, rsn
     return median, beta, reason
+
+
+def empty_ending(k: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """How a fit of counts k of n (B, S) ends before any fitting: "no_failures" (no
+    counted point reaches the state), "all_failed" (every one does), "no_data" (none
+    counted), else "ok" (a fit is needed): int (B,) codes into ENDINGS."""
+    has = n > 0
+    nk = (has & (k > 0)).any(-1)
+    ns = (has & (n - k > 0)).any(-1)
+    reason = np.zeros(k.shape[0], dtype=np.int64)
+    reason[~nk] = CODE["no_failures"]
+    reason[nk & ~ns] = CODE["all_failed"]
+    reason[~has.any(-1)] = CODE["no_data"]
+    return reason
 
 
 def _log_cdf(e: np.ndarray) -> np.ndarray:
@@ -288,14 +301,20 @@ def _multinomial_ll(p: np.ndarray, m: np.ndarray) -> np.ndarray:
 
 
 def _maximise(prob: Callable[[np.ndarray, np.ndarray], np.ndarray], m: np.ndarray,
-              theta0: np.ndarray, limit: np.ndarray, iters: int = 100, tol: float = 1e-10
-              ) -> tuple[np.ndarray, np.ndarray]:
+              theta0: np.ndarray, limit: np.ndarray, iters: int = 100, tol: float = 1e-10,
+              jac: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None,
+              resolved: float = 1e-300) -> tuple[np.ndarray, np.ndarray]:
     """Maximum likelihood of multinomial counts m (B, C, P) (C categories at P IM levels)
     under probabilities prob(theta (b, p), rows (b,)) -> (b, C, P), for every row of
     theta0 (B, p): Fisher scoring (information sum over c, s of n_s J J^T / p, J = dp /
-    dtheta by central differences), damped (Levenberg-Marquardt) until the likelihood
-    rises. A row whose |theta| passes ``limit`` (p,) runs away to a boundary (separated
-    data: no maximum) and stops, not converged. Returns (theta (B, p), converged (B,))."""
+    dtheta (b, p, C, P): ``jac(theta, rows)`` if given, else central differences),
+    damped (Levenberg-Marquardt) until the likelihood rises. A row whose |theta| passes
+    ``limit`` (p,) runs away to a boundary (separated data: no maximum) and stops, not
+    converged. resolved: the smallest probability prob resolves (a difference of O(1)
+    terms loses the rest): cells below it leave the information (an exact ``jac`` there
+    against a p that cancelled to ~0 would make J^2 / p explode and stall the ascent); the
+    gradient keeps them, so the maximum is the same. Returns (theta (B, p), converged
+    (B,))."""
     B, P = theta0.shape
     n = m.sum(1)
     th = theta0.copy()
@@ -311,12 +330,17 @@ def _maximise(prob: Callable[[np.ndarray, np.ndarray], np.ndarray], m: np.ndarra
         if idx.size == 0:
             break
         t = th[idx]
-        both = np.concatenate([t[:, None, :] + h * eye, t[:, None, :] - h * eye], 1)
-        vals = prob(both.reshape(-1, P), np.repeat(idx, 2 * P)).reshape(
-            (idx.size, 2 * P) + pr.shape[1:])
-        J = (vals[:, :P] - vals[:, P:]) / (2.0 * h)  # (b, p, C, P)
+        if jac is not None:
+            J = jac(t, idx)
+        else:
+            both = np.concatenate([t[:, None, :] + h * eye, t[:, None, :] - h * eye], 1)
+            vals = prob(both.reshape(-1, P), np.repeat(idx, 2 * P)).reshape(
+                (idx.size, 2 * P) + pr.shape[1:])
+            J = (vals[:, :P] - vals[:, P:]) / (2.0 * h)  # (b, p, C, P)
         inv = 1.0 / np.maximum(pr[idx], 1e-300)
         g = np.einsum("bkcs,bcs->bk", J, m[idx] * inv)
+        if resolved > 1e-300:
+            inv = np.where(pr[idx] >= resolved, inv, 0.0)
         info = np.einsum("bkcs,bjcs,bcs->bkj", J, J, n[idx][:, None, :] * inv)
         f0 = ll[idx]
         bad = ~(np.all(np.isfinite(g), -1) & np.all(np.isfinite(info), (-1, -2)))
@@ -385,6 +409,29 @@ def _ordinal_probs(z: np.ndarray, theta: np.ndarray) -> np.ndarray:
         return np.log(np.maximum(p, 0.0))
 
 
+def _ordinal_jac(z: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """d P(category c | z) / d theta (b, K+1, K+1, P) (parameter, category, level) of
+    ``_ordinal_probs``' model, analytic: with e_j = s (z - t_j), q_j = Phi(e_j) = P(DS >=
+    j), dq_j = phi(e_j) (e_j dlog s - s dt_j), t_j = theta_0 + sum_{1 <= i < j}
+    exp(theta_i) (states j = 0..K-1), and P(c) = q_{c-1} - q_c (q_{-1} = 1, q_K = 0)."""
+    b, K1 = theta.shape
+    K = K1 - 1
+    t = np.cumsum(np.concatenate([theta[:, :1], np.exp(theta[:, 1:K])], 1), 1)  # (b, K)
+    s = np.exp(theta[:, K])
+    e = s[:, None, None] * (z[:, None, :] - t[:, :, None])  # (b, K, P)
+    phi = np.exp(-0.5 * e * e) * (1.0 / math.sqrt(2.0 * math.pi))
+    # dt_j / dtheta_i (b, K, K): 1 for i = 0, exp(theta_i) for 1 <= i <= j
+    dt = np.tril(np.broadcast_to(np.concatenate([np.ones((b, 1)), np.exp(theta[:, 1:K])],
+                                                1)[:, None, :], (b, K, K)))
+    dq = np.empty((b, K1, K + 2) + z.shape[-1:])  # (b, parameter, q_{-1}..q_K, P)
+    dq[:, :, 0] = 0.0
+    dq[:, :, -1] = 0.0
+    dq[:, :K, 1:-1] = -(s[:, None, None, None] * dt.transpose(0, 2, 1)[..., None]) * \
+        phi[:, None]
+    dq[:, K, 1:-1] = e * phi
+    return dq[:, :, :-1] - dq[:, :, 1:]
+
+
 def _fit_ordinal(lnx: np.ndarray, m: np.ndarray, start: tuple | None = None
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Ordinal probit with a common beta (module docstring). lnx (b, P) ln IM; m (b, K+1,
@@ -413,7 +460,11 @@ def _fit_ordinal(lnx: np.ndarray, m: np.ndarray, start: tuple | None = None
         return np.exp(_ordinal_probs(z[rows], theta))
 
     limit = np.array([60.0] + [40.0] * (K - 1) + [15.0])
-    theta, conv = _maximise(prob, m, theta0, limit, tol=1e-10 if start is None else 1e-7)
+    def jac(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        return _ordinal_jac(z[rows], theta)
+
+    theta, conv = _maximise(prob, m, theta0, limit, tol=1e-10 if start is None else 1e-7,
+                            jac=jac)
     t = np.cumsum(np.concatenate([theta[:, :1], np.exp(theta[:, 1:K])], 1), 1)
     s = np.exp(theta[:, K])
     return np.exp(mu[:, None] + sd[:, None] * t), sd / s, conv
@@ -481,6 +532,41 @@ def _phi2(h: np.ndarray, k: np.ndarray, rho: np.ndarray) -> np.ndarray:
     return np.clip(p, 0.0, 1.0)
 
 
+def _cif_jac(z: np.ndarray, t: np.ndarray, sig: np.ndarray) -> np.ndarray:
+    """d (P(safe), P(mode 1), P(mode 2)) / d (t_1, log sig_1, t_2, log sig_2) (b, 4, 3, P)
+    of ``_cif``, analytic: P(mode k | z) = integral to z of f_k S_o (f_k the density of
+    U_k, S_o the survival of the other), so with the Gaussian product f_k f_o = C N(m, v)
+    (C the N(0, sig_k^2 + sig_o^2) density at t_k - t_o), I0 = integral to z of f_k f_o
+    = C Phi(w), I1 = integral to z of u f_k f_o = C (m Phi(w) - sqrt(v) phi(w)), w = (z -
+    m) / sqrt(v): dP_k/dt_o = I0, dP_k/dlog sig_o = I1 - t_o I0, dP_k/dt_k = -f_k(z)
+    S_o(z) - I0, dP_k/dlog sig_k = -(z - t_k) f_k(z) S_o(z) - (I1 - t_k I0) (by parts);
+    P(safe) = 1 - P(mode 1) - P(mode 2)."""
+    t1, t2 = t[:, :1], t[:, 1:]
+    v1, v2 = sig[:, :1] ** 2, sig[:, 1:] ** 2
+    tot = v1 + v2
+    c = np.exp(-0.5 * (t1 - t2) ** 2 / tot) / np.sqrt(2.0 * math.pi * tot)  # (b, 1)
+    m = (t1 * v2 + t2 * v1) / tot
+    sv = np.sqrt(v1 * v2 / tot)
+    w = (z - m) / sv  # (b, P)
+    cdf_w = ndtr(w)
+    pdf_w = np.exp(-0.5 * w * w) / math.sqrt(2.0 * math.pi)
+    i0 = c * cdf_w
+    i1 = c * (m * cdf_w - sv * pdf_w)
+    J = np.empty((z.shape[0], 4, 3, z.shape[1]))
+    for k in (0, 1):
+        o = 1 - k
+        tk, to = t[:, k:k + 1], t[:, o:o + 1]
+        hk = (z - tk) / sig[:, k:k + 1]
+        fk_so = np.exp(-0.5 * hk * hk) / (math.sqrt(2.0 * math.pi) * sig[:, k:k + 1]) * \
+            ndtr(-(z - to) / sig[:, o:o + 1])
+        J[:, 2 * k, k + 1] = -fk_so - i0
+        J[:, 2 * k + 1, k + 1] = -(z - tk) * fk_so - (i1 - tk * i0)
+        J[:, 2 * o, k + 1] = i0
+        J[:, 2 * o + 1, k + 1] = i1 - to * i0
+    J[:, :, 0] = -(J[:, :, 1] + J[:, :, 2])
+    return J
+
+
 def _fit_competing(lnx: np.ndarray, k1: np.ndarray, k2: np.ndarray, n: np.ndarray,
                    start: np.ndarray, tol: float | None = None
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -497,9 +583,13 @@ def _fit_competing(lnx: np.ndarray, k1: np.ndarray, k2: np.ndarray, n: np.ndarra
     def prob(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
         return np.stack(_cif(z[rows], theta[:, [0, 2]], np.exp(theta[:, [1, 3]])), 1)
 
+    def jac(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        return _cif_jac(z[rows], theta[:, [0, 2]], np.exp(theta[:, [1, 3]]))
+
     th0 = np.where(np.isfinite(th0), th0, 0.0)
     theta, conv = _maximise(prob, counts, th0, np.array([60.0, 12.0, 60.0, 12.0]),
-                            tol=1e-10 if tol is None else tol)
+                            tol=1e-10 if tol is None else tol, jac=jac,
+                            resolved=COMPETING_RESOLVED)
     with np.errstate(over="ignore"):
         med = np.exp(mu[:, None] + sd[:, None] * theta[:, [0, 2]])
         beta = sd[:, None] * np.exp(theta[:, [1, 3]])
@@ -546,11 +636,9 @@ def _fit_ordinal_counts(lnx, m, n, stripes, start=None):
     bet = np.full((b, K), np.nan)
     code = np.zeros((b, K), np.int64)
     und = np.zeros((b, K), bool)
-    marg = [mle_batch(lnx, reach[:, j], n) for j in range(K)]
-    mcode = np.stack([c for _, _, c in marg], 1)
-    for j in range(K):
-        code[:, j] = mcode[:, j]
-    fitted = ~np.isin(mcode, [CODE[w] for w in ("no_failures", "all_failed", "no_data")])
+    # the states nothing or everything reaches need no fit (their ending is all there is)
+    code[:] = np.stack([empty_ending(reach[:, j], n) for j in range(K)], 1)
+    fitted = code == CODE["ok"]
     # eligible states are contiguous in severity (nested): fit each pattern once
     patterns, inv = np.unique(fitted, axis=0, return_inverse=True)
     inv = np.asarray(inv).ravel()
