@@ -240,3 +240,23 @@ def test_a_flat_profile_is_unidentifiable_and_an_edge_estimate_at_bound():
     edge = rocksweep.calibrate(BLOCK, frame, ["impact.e"], bounds={"impact.e": (0.5, 0.8)})
     words = edge["reason"].item().split(",")
     assert "at_bound" in words and float(edge.estimate[0]) == pytest.approx(0.8, abs=1e-3)
+
+
+def test_a_fit_that_stops_short_of_the_least_misfit_says_not_converged(monkeypatch):
+    # the fit's search ends 0.01 in e away from its minimum (as a search stopped at its cap
+    # would): the profiles run into lower misfits, and the verdict says so
+    from rocksweep.analysis import calibrate as C
+
+    t, theta = free_block_history(0.88)
+    frame = noisy(t, theta / ALPHA, 0.01)
+    real = C._fit
+
+    def short(problem):
+        x, _ = real(problem)
+        x = x - 0.01
+        return x, problem.misfit(x)
+
+    monkeypatch.setattr(C, "_fit", short)
+    with pytest.warns(C.CalibrationWarning, match="not_converged .a run at impact.e"):
+        fit = rocksweep.calibrate(BLOCK, frame, ["impact.e"])
+    assert "not_converged" in fit["reason"].item().split(",")
