@@ -199,16 +199,6 @@ class Problem:
                                    "noise): no motion to fit")
         self.quiet = self.t_onset - float(measured.t[0])
         self.peaks = excursions(measured.t, measured.theta, self.h)
-        # an excursion at pi/2 within the noise: the body lies on its side (overturned);
-        # the plateau after it is no rocking, and its area depends only on when it fell
-        top = math.pi / 2 / self.alpha - H_NOISE * self.sigma
-        fell = np.flatnonzero(np.abs(self.peaks.value) >= top)
-        if fell.size:
-            raise CalibrationError(
-                f"{measured.source}: the body overturns (|theta_over_alpha| reaches "
-                f"{abs(self.peaks.value[fell[0]]):.4g}, pi/2 within the noise, at p_t "
-                f"{self.peaks.time[fell[0]]:.4g}); fit the rocking before it: cut the "
-                "history before the overturning half cycle")
         if self.peaks.value.size < 2:
             raise CalibrationError(
                 f"{measured.source}: {self.peaks.value.size} half cycle(s) beyond the noise "

@@ -260,17 +260,3 @@ def test_a_fit_that_stops_short_of_the_least_misfit_says_not_converged(monkeypat
     with pytest.warns(C.CalibrationWarning, match="not_converged .a run at impact.e"):
         fit = rocksweep.calibrate(BLOCK, frame, ["impact.e"])
     assert "not_converged" in fit["reason"].item().split(",")
-
-
-def test_a_history_that_overturns_is_refused_in_one_line():
-    # the body falls after 3 impacts: the plateau at pi/2 is no rocking (its area depends
-    # only on when the body fell); the fit is refused, naming what to cut
-    h = rocksweep.simulate(FLEX, {"pulse.A_ratio": 3.0,
-                                  "numerics.steps_per_period": 200}).history
-    t, th = h.p_t.values, h.theta_over_alpha.values
-    keep = np.r_[t[1:] != t[:-1], True]
-    ts = np.arange(0.0, t[keep][-1] + 3.0, 0.02)
-    frame = noisy(ts, np.interp(ts, t[keep], th[keep]), 0.01)
-    with pytest.raises(RocksweepError, match="the body overturns") as err:
-        rocksweep.calibrate(FLEX, frame, ["impact.lam"])
-    assert "\n" not in str(err.value) and "cut the history" in str(err.value)
