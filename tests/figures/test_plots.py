@@ -2,6 +2,7 @@
 figures, Figure-returning functions, and no matplotlib backend switch."""
 
 import os
+import re
 import stat
 import subprocess
 import sys
@@ -254,6 +255,33 @@ def test_time_history_has_the_input_pulse_and_guide_legend(fig5_runs):
     assert len(words) == 3 + 2  # three runs, the |theta| = alpha_cg line, overturning
     assert any("alpha_{cg}" in s and "corner" in s for s in words)
     assert any("overturning" in s for s in words)
+
+
+def test_a_run_without_history_is_refused_in_pythons_words(fig5_runs):
+    """A Run made without its history (``run_point(..., history=False)``, as sweeps make
+    them) asked for one: the figure and the Run say how Python gets one (not "simulate
+    with history=True": rocksweep.simulate has no such keyword). The command line cannot
+    make such a Run: its runs (``run_points``, rocksweep simulate's) all record one."""
+    import inspect
+
+    import rocksweep
+    from rocksweep.compute.history import run_points
+    from rocksweep.compute.single import run_point
+    from rocksweep.errors import FigureError
+    from rocksweep.figures.history import time_history
+    from rocksweep.scene.parse import load_scene
+
+    bare = run_point(fig5_runs[0].point, fig5_runs[0].numerics, history=False)
+    want = "run_point(..., history=True) records one (rocksweep.simulate always does)"
+    with pytest.raises(FigureError) as err:
+        time_history([bare])
+    assert str(err.value) == f"time history: this run has no history: {want}"
+    for ask in (bare.impact_losses, bare.history_columns):
+        with pytest.raises(ValueError, match=re.escape(want)):
+            ask()
+    assert "history" not in inspect.signature(rocksweep.simulate).parameters
+    scene = load_scene(ROOT / "configs" / "fig5.yaml", ["impact.lam=0"])
+    assert all(r.history is not None for r in run_points(scene))
 
 
 def test_restitution_map_u0_curve_is_dark(body_fig2):
