@@ -40,6 +40,10 @@ class Run:
     history: dict | None
     wall_time: float
     contact: bool = False  # the contact fields were asked for (outputs.contact)
+    # the scene's value of each axis at this point (by name), when a scene's grid made it
+    # (``compute.history.run_points``): a suite's record name and stripe level, which the
+    # point holds as a record and an amplitude
+    where: dict | None = None
 
     def get(self, name: str) -> int | float | None:
         """One result field by name (``rocksweep.fields.FIELDS``) in its unit; None for
