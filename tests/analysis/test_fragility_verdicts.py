@@ -590,21 +590,21 @@ def test_each_joint_resample_fit_is_the_ordinal_mle_of_the_records_it_draws():
 
 
 def test_the_joint_models_jacobians_equal_central_differences_of_their_probabilities():
-    from rocksweep.analysis.likelihood import _cif, _cif_jac, _ordinal_jac, _ordinal_probs
+    from rocksweep.analysis.joint_models import cif, cif_jac, ordinal_jac, ordinal_probs
 
     rng = np.random.default_rng(4)
     z = 1.5 * rng.standard_normal((2, 9))
     theta = 0.5 * rng.standard_normal((2, 4))  # ordinal: K = 3 states; competing: 2 modes
 
     def ordinal(th):
-        return np.exp(_ordinal_probs(z, th))
+        return np.exp(ordinal_probs(z, th))
 
     def competing(th):
-        return np.stack(_cif(z, th[:, [0, 2]], np.exp(th[:, [1, 3]])), 1)
+        return np.stack(cif(z, th[:, [0, 2]], np.exp(th[:, [1, 3]])), 1)
 
     h = 1e-6
-    for prob, jac in ((ordinal, _ordinal_jac(z, theta)),
-                      (competing, _cif_jac(z, theta[:, [0, 2]], np.exp(theta[:, [1, 3]])))):
+    for prob, jac in ((ordinal, ordinal_jac(z, theta)),
+                      (competing, cif_jac(z, theta[:, [0, 2]], np.exp(theta[:, [1, 3]])))):
         num = np.stack([(prob(theta + h * e) - prob(theta - h * e)) / (2 * h)
                         for e in np.eye(4)], 1)
         np.testing.assert_allclose(jac, num, atol=1e-8)
@@ -751,12 +751,12 @@ def test_a_fit_stopped_by_its_iteration_cap_says_not_converged(monkeypatch, join
 
 
 def test_the_parallel_tests_jacobian_equals_central_differences_of_its_probabilities():
-    from rocksweep.analysis.likelihood import _free_ordinal_jac, _free_ordinal_probs
+    from rocksweep.analysis.joint_models import free_ordinal_jac, free_ordinal_probs
 
     rng = np.random.default_rng(7)
     z = 1.5 * rng.standard_normal(9)
     theta = np.array([[-0.8, 0.1, 0.9, 0.2, -0.1, 0.3], [-0.5, 0.4, 1.2, 0.0, 0.2, -0.2]])
     h = 1e-6
-    num = np.stack([(_free_ordinal_probs(z, theta + h * e)
-                     - _free_ordinal_probs(z, theta - h * e)) / (2 * h) for e in np.eye(6)], 1)
-    np.testing.assert_allclose(_free_ordinal_jac(z, theta), num, atol=1e-8)
+    num = np.stack([(free_ordinal_probs(z, theta + h * e)
+                     - free_ordinal_probs(z, theta - h * e)) / (2 * h) for e in np.eye(6)], 1)
+    np.testing.assert_allclose(free_ordinal_jac(z, theta), num, atol=1e-8)
