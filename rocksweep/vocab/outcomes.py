@@ -77,7 +77,8 @@ STATUS_MEANING: dict[str, str] = {
                "times the steps past its last approach that stayed safe, its own result "
                "kept (rocksweep.compute.certify)",
     "uncertified": "a close call whose outcome still changed at the last refinement "
-                   "(numerics.refine) (flagged)",
+                   "(numerics.refine), or which was still a close call there: a knife "
+                   "edge (flagged)",
     AIRBORNE: "g + a_v <= 0: the vertical ground acceleration reached -g, the body leaves "
               "the ground (outside the model); the run stopped there (flagged)",
 }
