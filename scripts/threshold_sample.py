@@ -13,11 +13,10 @@ on points this close, the worst case; on a whole diagram it is a few percent,
 ``scripts/fingerprint.py diff``).
 
     python scripts/threshold_sample.py --bodies 30 --seed 1
-    python scripts/threshold_sample.py --bodies 30 --seed 1 --before   # the rule before
+    PYTHONPATH=/path/to/other/checkout python scripts/threshold_sample.py --bodies 30 --seed 1
 
-``--before`` runs the certification as it was before near-misses were checked (safe runs
-between the close-call margin and the band, ``certify.near_misses``) and before the
-overturn band was widened from 4 to 8 x the close-call margin.
+The second form measures another checkout's package (an older certification) on the same
+points (``scripts/_here.py``).
 """
 
 from __future__ import annotations
@@ -28,7 +27,6 @@ import time
 import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
 import numpy as np
 
-from rocksweep.compute import certify
 from rocksweep.compute.dispatch import run_variant
 from rocksweep.errors import BodyError
 from rocksweep.kernel import layout as L  # noqa: N812
@@ -92,12 +90,7 @@ def main() -> None:
     ap.add_argument("--all-reference", action="store_true",
                     help="run the reference on every point, not only where default and "
                          "fine differ (slow: ~1 s a point)")
-    ap.add_argument("--before", action="store_true",
-                    help="the certification before near-misses were checked")
     a = ap.parse_args()
-    if a.before:
-        certify.near_misses = lambda rows, outs: np.zeros(outs.shape[0], bool)
-        certify.OVERTURN_BAND = 4.0
     rng = np.random.default_rng(a.seed)
     default, fine = Numerics.preset(a.preset), Numerics.preset("fine")
     n = refined = flagged = wrong = fine_wrong = 0
