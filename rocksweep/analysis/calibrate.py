@@ -61,6 +61,12 @@ a right model; "unidentifiable" when a key's interval spans its bounds (the prof
 flat: the history does not say the key, or the key does not change it); "at_bound" when
 an estimate sits on a search bound (within AT_BOUND of the span: the minimum may lie
 beyond; not at the key's own limit, as lam = 0, where nothing lies beyond).
+"not_converged" when a minimisation stopped without meeting its test (Nelder-Mead at its
+evaluation cap on the full history; a profile's inner minimisation at its cap, or with its
+minimum still at the edge of its widened bracket: the profile misfit is then too high and
+the interval may be too narrow), or when any run of the fit or the profiles found a
+misfit below the estimate's by more than LOWER_SHARE of the interval's rise (the estimate
+is not the least misfit). Golden-section searches stop only at their tolerance.
 A fitted key that cannot change the scene's runs (lam under law constant) is refused
 before any run.
 
@@ -115,7 +121,11 @@ MISFIT_RATIO = 3.0
 NOISE_FLOOR = 0.002
 #: "at_bound": an estimate within this share of its bounds' span from one of them
 AT_BOUND = 1e-3
-VERDICTS = ("ok", "misfit", "unidentifiable", "at_bound")
+#: "not_converged": a run whose misfit is below the estimate's by more than this share of
+#: the interval's rise chi2_1(ci) s^2 (less is the misfit's roughness at the scale of the
+#: search's tolerance, and moves no interval end)
+LOWER_SHARE = 0.01
+VERDICTS = ("ok", "misfit", "unidentifiable", "at_bound", "not_converged")
 
 
 class CalibrationWarning(UserWarning):
@@ -189,6 +199,16 @@ class Problem:
                                    "noise): no motion to fit")
         self.quiet = self.t_onset - float(measured.t[0])
         self.peaks = excursions(measured.t, measured.theta, self.h)
+        # an excursion at pi/2 within the noise: the body lies on its side (overturned);
+        # the plateau after it is no rocking, and its area depends only on when it fell
+        top = math.pi / 2 / self.alpha - H_NOISE * self.sigma
+        fell = np.flatnonzero(np.abs(self.peaks.value) >= top)
+        if fell.size:
+            raise CalibrationError(
+                f"{measured.source}: the body overturns (|theta_over_alpha| reaches "
+                f"{abs(self.peaks.value[fell[0]]):.4g}, pi/2 within the noise, at p_t "
+                f"{self.peaks.time[fell[0]]:.4g}); fit the rocking before it: cut the "
+                "history before the overturning half cycle")
         if self.peaks.value.size < 2:
             raise CalibrationError(
                 f"{measured.source}: {self.peaks.value.size} half cycle(s) beyond the noise "
@@ -206,6 +226,11 @@ class Problem:
         self.dt_shift = 0.1 * max(float(t_end - self.t_onset), 1e-3)
         self.runs = 0
         self.n_use: int | None = None  # compare the first n_use half cycles (None: all)
+        # the least misfit of every candidate on all half cycles, and where (``_verdict``:
+        # a profile that finds less than the estimate's says the fit did not converge)
+        self.least: tuple[float, np.ndarray | None] = (math.inf, None)
+        #: minimisations that stopped without meeting their test: {where: how many}
+        self.unconverged: dict[str, int] = {}
         self._cache: dict[tuple, tuple | None] = {}
 
     def point(self, x: np.ndarray) -> Any:
@@ -308,7 +333,14 @@ class Problem:
         if np.any(x < self.bounds[:, 0]) or np.any(x > self.bounds[:, 1]):
             return math.inf
         got = self.evaluate(x)
-        return math.inf if got is None or not math.isfinite(got["S"]) else got["S"]
+        s = math.inf if got is None or not math.isfinite(got["S"]) else got["S"]
+        if self.n_use is None and s < self.least[0]:
+            self.least = (s, x.copy())
+        return s
+
+    def stopped(self, where: str) -> None:
+        """Count a minimisation that stopped without meeting its test."""
+        self.unconverged[where] = self.unconverged.get(where, 0) + 1
 
 
 # ---------------------------------------------------------------------------------------
@@ -434,6 +466,8 @@ def _minimise(problem: Problem, free: list[int], fixed: dict[int, float],
     r = minimize(lambda z: problem.misfit(full(z)), z0, method="Nelder-Mead",
                  options={"initial_simplex": simplex, "xatol": 1e-5 * span.min(),
                           "fatol": 1e-12, "maxfev": 400})
+    if not r.success and problem.n_use is None:
+        problem.stopped("fit")
     return full(r.x), float(r.fun)
 
 
@@ -598,6 +632,8 @@ def _minimise_local(problem: Problem, free: list[int], fixed: dict[int, float],
             if not at_edge or (lo <= b[0, 0] and hi >= b[0, 1]):
                 break
             half *= 4
+        if at_edge and not (lo <= b[0, 0] and hi >= b[0, 1]):
+            problem.stopped("profile")  # the minimum still at its widened bracket's edge
         y = x.copy()
         y[k] = best[0]
         return y, best[1]
@@ -610,6 +646,8 @@ def _minimise_local(problem: Problem, free: list[int], fixed: dict[int, float],
 
     r = minimize(g, x[free], method="Nelder-Mead",
                  options={"xatol": 1e-4 * span.min(), "fatol": 1e-12, "maxfev": 200})
+    if not r.success:
+        problem.stopped("profile")
     y = x.copy()
     y[free] = r.x
     return y, float(r.fun)
@@ -641,7 +679,7 @@ def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
         hi[i], hi_b[i] = _profile_end(problem, i, x_hat, s_min, limit, +1)
         lo[i], hi[i], lo_b[i], hi_b[i] = _smooth_profile(problem, i, x_hat, lo[i], hi[i],
                                                          limit, lo_b[i], hi_b[i])
-    reason, why, noise, dof = _verdict(problem, x_hat, s_min, lo, hi, lo_b, hi_b)
+    reason, why, noise, dof = _verdict(problem, x_hat, s_min, lo, hi, lo_b, hi_b, limit)
     wall = time.perf_counter() - t0
     m = problem.m
     pairs = best["pairs"]
@@ -704,9 +742,10 @@ def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
 
 
 def _verdict(problem: Problem, x_hat: np.ndarray, s_min: float, lo: np.ndarray,
-             hi: np.ndarray, lo_b: np.ndarray, hi_b: np.ndarray
+             hi: np.ndarray, lo_b: np.ndarray, hi_b: np.ndarray, limit: float
              ) -> tuple[str, dict[str, str], float, int]:
-    """(reason, {word: the numbers}, noise, dof) of a fit (module docstring, Verdicts)."""
+    """(reason, {word: the numbers}, noise, dof) of a fit (module docstring, Verdicts);
+    limit: the interval's rise of the misfit."""
     n, k = problem.peaks.value.size, len(problem.keys)
     dof = n - k
     amp = float(np.max(np.abs(problem.m.theta)))
@@ -739,6 +778,17 @@ def _verdict(problem: Problem, x_hat: np.ndarray, s_min: float, lo: np.ndarray,
         why["unidentifiable"] = "; ".join(flat)
     if edge:
         why["at_bound"] = "; ".join(edge)
+    stops = []
+    least, where = problem.least
+    if where is not None and least < s_min - LOWER_SHARE * limit:
+        at = ", ".join(f"{k} = {v:.4g}" for k, v in zip(problem.keys, where, strict=True))
+        stops.append(f"a run at {at} has misfit S {least:.4g} below the estimate's "
+                     f"{s_min:.4g}: the fit missed the least misfit")
+    for place, count in problem.unconverged.items():
+        cap = "its evaluation cap" if place == "fit" else "a cap or its bracket's edge"
+        stops.append(f"{count} {place} minimisation{'s' * (count > 1)} stopped at {cap}")
+    if stops:
+        why["not_converged"] = "; ".join(stops)
     return (",".join(why) or "ok"), why, noise, dof
 
 

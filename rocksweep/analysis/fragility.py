@@ -25,7 +25,9 @@ Verdicts (``reason``: "ok", or the words below joined by ","; never "ok" for the
   every one that does not: the likelihood grows as beta -> 0; im_median = the geometric
   mean of the largest safe and the smallest failing IM, beta = NaN, never 0);
   "decreasing" (the best probit slope is <= 0); "no_data"; "one_stripe" (one IM level
-  counted: NaN, NaN); "not_converged" (a joint fit found no maximum);
+  counted: NaN, NaN); "not_converged" (the fit's ascent stopped without meeting its
+  convergence test: ``likelihood``'s module docstring; also said where the parallel test's
+  free fit did not converge and its lower bound does not reject);
 - "beta_undetermined": one stripe, separation, or fewer than two distinct stripe fractions
   strictly between 0 and 1 (no slope is seen): beta = NaN;
 - "non_monotone": the stripe fractions fall with the IM by more than binomial noise: the
@@ -489,9 +491,14 @@ def _parallel(f: _Fits, o: int, idxs: list[int], lnx: np.ndarray, m: np.ndarray,
     reach = np.cumsum(m[::-1], 0)[::-1]  # (K+1, P): reaching category c or above
     sub_reach = reach[[0] + [q + 1 for q in use]]
     sub = sub_reach - np.concatenate([sub_reach[1:], np.zeros((1, m.shape[1]))], 0)
-    stat, dof = parallel_lr(lnx, sub, med[use], float(bet[use[0]]))
+    stat, dof, conv = parallel_lr(lnx, sub, med[use], float(bet[use[0]]))
     f.parallel[0][o], f.parallel[1][o] = stat, dof
     p = float(chi2.sf(stat, dof))
+    if not conv and p >= PARALLEL_P:  # a lower bound of the statistic decides nothing
+        for q in use:
+            f.why[idxs[q]][o]["not_converged"] = (
+                f"the test of the common beta: the fit with a beta per state did not "
+                f"converge; its likelihood ratio {stat:.3g} on {dof} dof is a lower bound")
     if p < PARALLEL_P:
         for q in use:
             f.why[idxs[q]][o]["parallel_rejected"] = FragilityWarning(

@@ -26,6 +26,13 @@ The joint fits are maximised by a batched Levenberg-Marquardt ascent (``_maximis
 ``fit_counts`` fits one group of states from category counts; ``resample_weights`` draws
 the bootstrap's resamples over records as count weights, in chunks of bounded memory.
 Every fit returns an ending code into ``ENDINGS`` per data set.
+
+Convergence (every maximiser here): a fit has converged when, at the point where its
+ascent stops, the undamped scoring step d = I^-1 U (U the gradient, I the information) is
+below the step tolerance, |d|_inf < tol (1 + |theta|_inf), or the rise it predicts, U . d /
+2, is below ``RISE_TOL`` (1 + |loglik|). An ascent that stops otherwise (its iteration cap,
+no step that raises the likelihood, a parameter running away) is "not_converged", never
+"ok".
 """
 
 from __future__ import annotations
@@ -58,6 +65,14 @@ EMPTY = [CODE[w] for w in ("no_failures", "all_failed", "no_data")]
 COMPETING_RESOLVED = 1e-12
 #: resamples are fitted in chunks of at most this many count entries (bounded memory)
 BOOT_ELEMENTS = 1 << 20
+#: iteration caps of the single-state scoring (``_score``) and the joint ascent
+#: (``_maximise``): a row still moving after them is "not_converged"
+SCORE_ITER = 200
+MAX_ITER = 100
+#: a fit has converged when the undamped scoring step from its point is below its step
+#: tolerance, or the rise that step predicts, U . I^-1 U / 2, is below this share of
+#: 1 + |loglik| (the rounding of a sum of ~1e4 log terms: no step can be told from none)
+RISE_TOL = 1e-12
 
 
 # ---------------------------------------------------------------------------------------
@@ -73,7 +88,8 @@ def mle_batch(lnx: np.ndarray, k: np.ndarray, n: np.ndarray,
     lnx, k, n: float64 (B, S): ln IM, points reaching the state, points counted (n = 0: the
     entry is absent); start: (im_median, beta) to start the scoring from (resamples: the
     full data's fit), tol: its relative tolerance. Returns (im_median (B,), beta (B,),
-    ending code (B,) into ENDINGS); separated data give the step's IM and beta = NaN.
+    ending code (B,) into ENDINGS); separated data give the step's IM and beta = NaN; a
+    scoring that stops without converging (module docstring) NaN, NaN, "not_converged".
     """
     lnx, k, n = (np.atleast_2d(np.asarray(v, dtype=np.float64)) for v in (lnx, k, n))
     lnx = np.broadcast_to(lnx, k.shape)
@@ -96,12 +112,13 @@ def mle_batch(lnx: np.ndarray, k: np.ndarray, n: np.ndarray,
         if start is not None and np.all(np.isfinite(start)) and start[1] > 0:
             st = np.broadcast_to([-math.log(start[0]) / start[1], 1.0 / start[1]],
                                  (int(todo.sum()), 2))
-        a, b = _score(lnx[todo], k[todo], n[todo], tol=tol, start=st)
+        a, b, conv = _score(lnx[todo], k[todo], n[todo], tol=tol, start=st)
         med, bet, rsn = np.full(a.size, np.nan), np.full(a.size, np.nan), np.zeros(a.size, int)
         up = b > 0.0
         med[up] = np.exp(-a[up] / b[up])
         bet[up] = 1.0 / b[up]
         rsn[~up] = CODE["decreasing"]
+        med[~conv], bet[~conv], rsn[~conv] = np.nan, np.nan, CODE["not_converged"]
         median[todo], beta[todo], reason[todo] = med, bet, rsn
     return median, beta, reason
 
@@ -132,14 +149,19 @@ def _log_cdf(e: np.ndarray) -> np.ndarray:
     return out
 
 
-def _score(lnx: np.ndarray, k: np.ndarray, n: np.ndarray, iters: int = 200,
+def _score(lnx: np.ndarray, k: np.ndarray, n: np.ndarray, iters: int | None = None,
            tol: float = 1e-10, start: np.ndarray | None = None
-           ) -> tuple[np.ndarray, np.ndarray]:
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Fisher scoring with step halving for Phi(a + b lnx), batched over rows (each row
     has points on both sides: the maximum exists). start: (B, 2) (a, b) to start from
     (bootstrap resamples: the full data's fit; then Newton steps on the observed
     information, which converge in a few steps from there); default the pooled fraction,
-    slope 0. Returns (a, b) per row."""
+    slope 0. A row stops when its accepted step is below tol (relative), or when halving
+    finds no step that does not lower the likelihood; it has converged if the full
+    scoring step from where it stopped meets the module docstring's test (else it goes
+    on: a halved step is small because it was halved). iters: at most this many steps
+    (None: ``SCORE_ITER``). Returns (a, b, converged) per row."""
+    iters = SCORE_ITER if iters is None else iters
     # standardise ln x per row for conditioning: eta = c0 + c1 z, z = (lnx - m) / s
     w = n / n.sum(-1, keepdims=True)
     m = np.sum(w * lnx, -1, keepdims=True)
@@ -158,6 +180,7 @@ def _score(lnx: np.ndarray, k: np.ndarray, n: np.ndarray, iters: int = 200,
     lpos, lneg = _log_cdf(eta), _log_cdf(-eta)  # log Phi(eta), log Phi(-eta)
     ll = np.sum(k * lpos + (n - k) * lneg, -1)
     active = np.ones(frac.size, dtype=bool)
+    conv = np.zeros(frac.size, dtype=bool)
     for _ in range(iters):
         idx = np.flatnonzero(active)
         if idx.size == 0:
@@ -199,14 +222,20 @@ def _score(lnx: np.ndarray, k: np.ndarray, n: np.ndarray, iters: int = 200,
             if not pending.any():
                 break
         delta = np.abs(c_new - c[idx]).max(-1)
+        scale = 1.0 + np.abs(c_new).max(-1)
+        # the test on the full step from the point just left (a point no worse is kept)
+        met = (np.maximum(np.abs(d0), np.abs(d1)) < tol * scale) | (
+            0.5 * (U0 * d0 + U1 * d1) <= RISE_TOL * (1.0 + np.abs(ll0)))
         c[idx] = c_new
         eta[idx] = c_new[:, :1] + c_new[:, 1:] * zz
         ll[idx] = ll_new
         lpos[idx], lneg[idx] = lp_new, ln_new
-        active[idx[(delta < tol * (1.0 + np.abs(c_new).max(-1))) | pending]] = False
+        stop = ((delta < tol * scale) & met) | pending
+        conv[idx[stop & met]] = True
+        active[idx[stop]] = False
     a = c[:, 0] - c[:, 1] * m[:, 0] / s[:, 0]
     b = c[:, 1] / s[:, 0]
-    return a, b
+    return a, b, conv
 
 
 def distinct_inner(lnx: np.ndarray, k: np.ndarray, n: np.ndarray) -> tuple[np.ndarray,
@@ -301,7 +330,8 @@ def _multinomial_ll(p: np.ndarray, m: np.ndarray) -> np.ndarray:
 
 
 def _maximise(prob: Callable[[np.ndarray, np.ndarray], np.ndarray], m: np.ndarray,
-              theta0: np.ndarray, limit: np.ndarray, iters: int = 100, tol: float = 1e-10,
+              theta0: np.ndarray, limit: np.ndarray, iters: int | None = None,
+              tol: float = 1e-10,
               jac: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None,
               resolved: float = 1e-300) -> tuple[np.ndarray, np.ndarray]:
     """Maximum likelihood of multinomial counts m (B, C, P) (C categories at P IM levels)
@@ -313,8 +343,12 @@ def _maximise(prob: Callable[[np.ndarray, np.ndarray], np.ndarray], m: np.ndarra
     converged. resolved: the smallest probability prob resolves (a difference of O(1)
     terms loses the rest): cells below it leave the information (an exact ``jac`` there
     against a p that cancelled to ~0 would make J^2 / p explode and stall the ascent); the
-    gradient keeps them, so the maximum is the same. Returns (theta (B, p), converged
-    (B,))."""
+    gradient keeps them, so the maximum is the same. A row stops when an accepted step is
+    below tol (relative) or leaves the likelihood flat, or when no damping finds a step
+    that raises it; it has converged only if the undamped step from where it stopped meets
+    the module docstring's test (a step small because it was damped goes on). iters: at
+    most this many steps (None: ``MAX_ITER``). Returns (theta (B, p), converged (B,))."""
+    iters = MAX_ITER if iters is None else iters
     B, P = theta0.shape
     n = m.sum(1)
     th = theta0.copy()
@@ -344,6 +378,8 @@ def _maximise(prob: Callable[[np.ndarray, np.ndarray], np.ndarray], m: np.ndarra
         info = np.einsum("bkcs,bjcs,bcs->bkj", J, J, n[idx][:, None, :] * inv)
         f0 = ll[idx]
         bad = ~(np.all(np.isfinite(g), -1) & np.all(np.isfinite(info), (-1, -2)))
+        met = np.zeros(idx.size, bool)
+        met[~bad] = _scoring_met(g[~bad], info[~bad], t[~bad], f0[~bad], tol)
         pending = ~bad
         done_rows = np.zeros(idx.size, bool)
         for _try in range(40):
@@ -367,7 +403,7 @@ def _maximise(prob: Callable[[np.ndarray, np.ndarray], np.ndarray], m: np.ndarra
             lam[idx[acc]] = np.maximum(lam[idx[acc]] * 0.1, 1e-9)
             small = np.abs(d[up]).max(-1) < tol * (1.0 + np.abs(cand[up]).max(-1))
             flat = np.abs(lc[up] - f0[pi][up]) <= 1e-14 * (1.0 + np.abs(f0[pi][up]))
-            done_rows[acc[small | flat]] = True
+            done_rows[acc[(small | flat) & met[acc]]] = True
             pending[acc] = False
             rej = pi[~up]
             lam[idx[rej]] = np.maximum(lam[idx[rej]] * 10.0, 1e-4)
@@ -375,9 +411,25 @@ def _maximise(prob: Callable[[np.ndarray, np.ndarray], np.ndarray], m: np.ndarra
             done_rows[stuck] = True
             pending[stuck] = False
         away = np.any(np.abs(th[idx]) > limit, -1)
-        conv[idx[done_rows & ~away]] = True
+        conv[idx[done_rows & met & ~away]] = True
         active[idx[done_rows | bad | away]] = False
     return th, conv
+
+
+def _scoring_met(g: np.ndarray, info: np.ndarray, theta: np.ndarray, ll: np.ndarray,
+                 tol: float) -> np.ndarray:
+    """The convergence test (module docstring) at points theta (b, p) with gradient g (b,
+    p), information info (b, p, p) and log-likelihood ll (b,): bool (b,)."""
+    if g.shape[0] == 0:
+        return np.zeros(0, bool)
+    try:
+        d = np.linalg.solve(info, g[..., None])[..., 0]
+    except np.linalg.LinAlgError:  # a singular information: the least-norm step
+        d = np.stack([np.linalg.lstsq(a, b, rcond=None)[0] for a, b in
+                      zip(info, g, strict=True)])
+    small = np.abs(d).max(-1) < tol * (1.0 + np.abs(theta).max(-1))
+    rise = 0.5 * np.sum(g * d, -1) <= RISE_TOL * (1.0 + np.abs(ll))
+    return np.all(np.isfinite(d), -1) & (small | rise)
 
 
 def _standardise(lnx: np.ndarray, n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -471,33 +523,64 @@ def _fit_ordinal(lnx: np.ndarray, m: np.ndarray, start: tuple | None = None
 
 
 def parallel_lr(lnx: np.ndarray, m: np.ndarray, med: np.ndarray, beta: float
-                ) -> tuple[float, int]:
+                ) -> tuple[float, int, bool]:
     """The likelihood-ratio test of the ordinal probit's common beta: (2 (ll_free -
     ll_common), degrees of freedom K - 1) for category counts m (K+1, P) at ln IM lnx (P,)
     and the common-beta fit (im_median (K,), beta). ll_free is the multinomial likelihood
     maximised with a beta per state, P(DS >= j) = Phi(ln(x / im_median_j) / beta_j) (the
     non-parallel, generalised ordinal probit), started from the common fit: the ascent
     only accepts steps that raise it, so the statistic is >= 0. Curves that cross where
-    there are counts make a category's probability 0 (the likelihood -inf there)."""
+    there are counts make a category's probability 0 (the likelihood -inf there).
+    Returns (statistic, dof, converged): a free fit that did not converge (module
+    docstring) gives a lower bound of the statistic."""
     K = m.shape[0] - 1
     n = m.sum(0)
     mu, sd = _standardise(lnx[None], n[None])
     z = (lnx - mu[0]) / sd[0]
 
     def prob(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
-        t, s = theta[:, :K], np.exp(theta[:, K:])
-        cum = ndtr(s[:, :, None] * (z[None, None, :] - t[:, :, None]))  # P(DS >= j)
-        one = np.ones((theta.shape[0], 1, z.size))
-        p = np.concatenate([one, cum], 1) - np.concatenate([cum, 0.0 * one], 1)
-        return np.maximum(p, 0.0)
+        return _free_ordinal_probs(z, theta)
+
+    def jac(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        return _free_ordinal_jac(z, theta)
 
     t0 = (np.log(np.asarray(med, np.float64)) - mu[0]) / sd[0]
     theta0 = np.concatenate([t0, np.full(K, np.log(sd[0] / beta))])[None]
     common = _multinomial_ll(prob(theta0, np.zeros(1, np.int64)), m[None])[0]
     limit = np.array([60.0] * K + [15.0] * K)
-    theta, _ = _maximise(prob, m[None], theta0, limit, tol=1e-9)
+    theta, conv = _maximise(prob, m[None], theta0, limit, tol=1e-9, jac=jac)
     free = _multinomial_ll(prob(theta, np.zeros(1, np.int64)), m[None])[0]
-    return max(0.0, 2.0 * float(free - common)), K - 1
+    return max(0.0, 2.0 * float(free - common)), K - 1, bool(conv[0])
+
+
+def _free_ordinal_probs(z: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """P(category c | z) (b, K+1, P) of the ordinal probit with a beta per state: theta
+    (b, 2K) = (t_1..t_K, log s_1..log s_K), P(DS >= j) = q_j = Phi(s_j (z - t_j)), P(c) =
+    q_{c-1} - q_c (q_0 = 1, q_{K+1} = 0), 0 where the curves cross."""
+    K = theta.shape[1] // 2
+    t, s = theta[:, :K], np.exp(theta[:, K:])
+    cum = ndtr(s[:, :, None] * (z[None, None, :] - t[:, :, None]))  # P(DS >= j)
+    one = np.ones((theta.shape[0], 1, z.size))
+    return np.maximum(np.concatenate([one, cum], 1) - np.concatenate([cum, 0.0 * one], 1),
+                      0.0)
+
+
+def _free_ordinal_jac(z: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """d P(category c | z) / d theta (b, 2K, K+1, P) of ``_free_ordinal_probs``, analytic:
+    dq_j/dt_j = -s_j phi(e_j), dq_j/dlog s_j = e_j phi(e_j), e_j = s_j (z - t_j); 0 where
+    the probability is clipped to 0."""
+    K = theta.shape[1] // 2
+    t, s = theta[:, :K], np.exp(theta[:, K:])
+    e = s[:, :, None] * (z[None, None, :] - t[:, :, None])  # (b, K, P)
+    phi = np.exp(-0.5 * e * e) / math.sqrt(2.0 * math.pi)
+    dq = np.zeros((theta.shape[0], 2 * K, K + 2, z.size))  # q_0..q_{K+1}
+    j = np.arange(K)
+    dq[:, j, j + 1] = -s[:, :, None] * phi
+    dq[:, K + j, j + 1] = e * phi
+    cum = ndtr(e)
+    one = np.ones((theta.shape[0], 1, z.size))
+    raw = np.concatenate([one, cum], 1) - np.concatenate([cum, 0.0 * one], 1)
+    return np.where(raw[:, None] > 0.0, dq[:, :, :-1] - dq[:, :, 1:], 0.0)
 
 
 def _cif(z: np.ndarray, t: np.ndarray, sig: np.ndarray) -> tuple[np.ndarray, ...]:

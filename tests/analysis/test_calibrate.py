@@ -240,3 +240,37 @@ def test_a_flat_profile_is_unidentifiable_and_an_edge_estimate_at_bound():
     edge = rocksweep.calibrate(BLOCK, frame, ["impact.e"], bounds={"impact.e": (0.5, 0.8)})
     words = edge["reason"].item().split(",")
     assert "at_bound" in words and float(edge.estimate[0]) == pytest.approx(0.8, abs=1e-3)
+
+
+def test_a_fit_that_stops_short_of_the_least_misfit_says_not_converged(monkeypatch):
+    # the fit's search ends 0.01 in e away from its minimum (as a search stopped at its cap
+    # would): the profiles run into lower misfits, and the verdict says so
+    from rocksweep.analysis import calibrate as C
+
+    t, theta = free_block_history(0.88)
+    frame = noisy(t, theta / ALPHA, 0.01)
+    real = C._fit
+
+    def short(problem):
+        x, _ = real(problem)
+        x = x - 0.01
+        return x, problem.misfit(x)
+
+    monkeypatch.setattr(C, "_fit", short)
+    with pytest.warns(C.CalibrationWarning, match="not_converged .a run at impact.e"):
+        fit = rocksweep.calibrate(BLOCK, frame, ["impact.e"])
+    assert "not_converged" in fit["reason"].item().split(",")
+
+
+def test_a_history_that_overturns_is_refused_in_one_line():
+    # the body falls after 3 impacts: the plateau at pi/2 is no rocking (its area depends
+    # only on when the body fell); the fit is refused, naming what to cut
+    h = rocksweep.simulate(FLEX, {"pulse.A_ratio": 3.0,
+                                  "numerics.steps_per_period": 200}).history
+    t, th = h.p_t.values, h.theta_over_alpha.values
+    keep = np.r_[t[1:] != t[:-1], True]
+    ts = np.arange(0.0, t[keep][-1] + 3.0, 0.02)
+    frame = noisy(ts, np.interp(ts, t[keep], th[keep]), 0.01)
+    with pytest.raises(RocksweepError, match="the body overturns") as err:
+        rocksweep.calibrate(FLEX, frame, ["impact.lam"])
+    assert "\n" not in str(err.value) and "cut the history" in str(err.value)

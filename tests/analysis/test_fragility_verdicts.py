@@ -688,3 +688,75 @@ def test_a_period_without_sa_names_the_im_in_the_callers_words():
         F.fragility(ds, im="Sa", period=-1.0, bootstrap=0)
     assert said(err.value).startswith("--period -1.0: a period in s") \
         and said(err.value).endswith("with --im Sa")
+
+
+# ---------------------------------------------------------------------------------------
+# convergence: an ascent that stops without meeting its test says so
+# ---------------------------------------------------------------------------------------
+
+
+def test_an_ascent_that_cannot_raise_a_quantised_likelihood_is_not_converged():
+    # the parameters rounded to 0.01 inside the probabilities: every small step leaves the
+    # likelihood flat while its gradient (the smooth model's) is not 0; stopping there is
+    # no maximum (the ascent used to call it converged)
+    from rocksweep.analysis.likelihood import _maximise
+
+    z = np.linspace(-2.0, 2.0, 9)
+    n = np.full(z.size, 20.0)
+    k = np.round(n * norm.cdf(0.3 + 1.2 * z))
+    m = np.stack([n - k, k])[None]  # (1, 2, P)
+
+    def smooth(th):
+        return norm.cdf(th[:, :1] + th[:, 1:] * z)
+
+    def prob(th, rows):
+        p = smooth(np.round(th, 2))
+        return np.stack([1.0 - p, p], 1)
+
+    def jac(th, rows):
+        d = norm.pdf(th[:, :1] + th[:, 1:] * z)
+        dp = np.stack([d, d * z], 1)  # (b, 2, P)
+        return np.stack([-dp, dp], 2)
+
+    start = np.array([[0.25, 1.1], [0.0, 0.5], [1.0, 3.0]])
+    mm = np.repeat(m, 3, 0)
+    _, conv = _maximise(prob, mm, start, np.array([60.0, 60.0]), jac=jac)
+    assert not conv.any()
+    # the same ascent on the smooth probabilities reaches the maximum and says so
+    theta, conv = _maximise(lambda th, r: np.stack([1.0 - smooth(th), smooth(th)], 1), mm,
+                            start, np.array([60.0, 60.0]), jac=jac)
+    assert conv.all()
+    ref = minimize(lambda t: -np.sum(k * norm.logcdf(t[0] + t[1] * z)
+                                     + (n - k) * norm.logsf(t[0] + t[1] * z)), [0.0, 1.0],
+                   method="Nelder-Mead", options={"xatol": 1e-10, "fatol": 1e-12})
+    np.testing.assert_allclose(theta, np.repeat(ref.x[None], 3, 0), atol=1e-6)
+
+
+@pytest.mark.parametrize("joint", [False, True])
+def test_a_fit_stopped_by_its_iteration_cap_says_not_converged(monkeypatch, joint):
+    from rocksweep.analysis import likelihood as LK
+
+    ds = nested_ds(60, 0.4, 0.5, 0.7, 0.5, seed=5)
+    states = ["theta:0.5", "overturn"]
+    fr = F.fragility(ds, state=states, bootstrap=0, warn=False, joint=joint)
+    assert set(fr["reason"].values) == {"ok"}
+    monkeypatch.setattr(LK, "SCORE_ITER", 1)
+    monkeypatch.setattr(LK, "MAX_ITER", 1)
+    with pytest.warns(errors.FragilityWarning, match="not_converged"):
+        capped = F.fragility(ds, state=states, bootstrap=0, joint=joint)
+    assert all("not_converged" in str(r).split(",") for r in capped["reason"].values)
+    assert np.all(np.isnan(capped["im_median"].values))
+    assert "not_converged" in F.fit_stripes(LEVELS, [0, 1, 2, 5, 9, 12, 14, 17, 18, 19, 20,
+                                                     20], [20] * 12).reason
+
+
+def test_the_parallel_tests_jacobian_equals_central_differences_of_its_probabilities():
+    from rocksweep.analysis.likelihood import _free_ordinal_jac, _free_ordinal_probs
+
+    rng = np.random.default_rng(7)
+    z = 1.5 * rng.standard_normal(9)
+    theta = np.array([[-0.8, 0.1, 0.9, 0.2, -0.1, 0.3], [-0.5, 0.4, 1.2, 0.0, 0.2, -0.2]])
+    h = 1e-6
+    num = np.stack([(_free_ordinal_probs(z, theta + h * e)
+                     - _free_ordinal_probs(z, theta - h * e)) / (2 * h) for e in np.eye(6)], 1)
+    np.testing.assert_allclose(_free_ordinal_jac(z, theta), num, atol=1e-8)
