@@ -73,8 +73,8 @@ SECONDS_PER_EVALUATION = 85e-9
 # Cap on one point's step budget (``step_budget``, PAR_MAXSTEPS) that a scene may imply:
 # a point that long takes ``point_seconds(MAX_POINT_STEPS)`` (~8.5 s) of one core, the
 # longest a single point may take before its values are taken for a mistake (w_over_p =
-# 1e-9, a pulse of 6e9 p*t; wn_over_p = 1e5 at steps of 1e-5). The shipped scenes need at
-# most 1.5e6 (fig4b at `fine`), of which the default allowance for 5000 events is 1e6.
+# 1e-9, a pulse of 6e9 p*t; wn_over_p = 1e5 at steps of 1e-5). The shipped scenes' largest
+# caps and what their points spend: docs/accuracy.md (scripts/make_docs_numbers.py).
 MAX_POINT_STEPS = 1e8
 
 

@@ -14,13 +14,13 @@ The bodies, pulses, truths and noise draws are none of scripts/bench_calibrate.p
 tests'. Two cases must not be ok: a block under the vertical law fitted to a block whose
 e (0.6, law constant) no lam gives ("misfit"), and the damping of a stiff body (wn_over_p
 60: the spring hardly moves) searched within bounds (0.05, 0.15) narrower than what the
-history resolves ("unidentifiable": its interval spans them). A flexible body that
-overturns after one impact is refused (the plateau at pi/2 is no rocking).
+history resolves ("unidentifiable": its interval spans them). The last three are a right
+model whose body overturns after one impact (reported apart: ok while off by more than
+the tolerance is a wrong verdict; unidentifiable or misfit is not).
 
 Prints per case: truth, estimate, 95% interval, reason, the misfit ratio (the peaks' RMS
 error over the dof / the noise the verdict compares it with, ``MISFIT_RATIO`` = 3 the
-limit); then how many good fits are ok and within lam +-0.03, e +-0.02, and how many of
-the others say so.
+limit); then how many good fits are ok and within lam +-0.03, e +-0.02.
 """
 
 from __future__ import annotations
@@ -40,7 +40,6 @@ sys.path.insert(0, str(ROOT))
 import rocksweep  # noqa: E402
 from rocksweep.analysis import calibrate as C  # noqa: E402
 from rocksweep.analysis.peaks import hermite  # noqa: E402
-from rocksweep.errors import RocksweepError  # noqa: E402
 from rocksweep.physics import reference as R  # noqa: E402
 from rocksweep.scene.inputs import load  # noqa: E402
 
@@ -119,9 +118,10 @@ CASES = [
     ("rigid-ish zeta", lambda v: flexible({**RIGIDISH, "zeta": v}, "sine", 4.0, 1.4,
                                           "vertical", 0.2), "body.zeta", 0.1, 0.12, "fine",
      0.01, "unidentifiable"),
-    # overturns after one impact: refused (the plateau at pi/2 is no rocking)
-    ("squat sine const", lambda v: flexible(SQUAT, "sine", 3.5, 2.0, "constant", v),
-     "impact.e", 0.7, 0.85, "fine", 0.015, "refused"),
+    # the model is right, but the body overturns after one impact (2 half cycles, the
+    # second a plateau at pi/2)
+    *(("squat sine const fall", lambda v: flexible(SQUAT, "sine", 3.5, 2.0, "constant", v),
+       "impact.e", 0.7, 0.85, "fine", level, "fall") for level in (0.005, 0.01, 0.015)),
 ]
 #: search bounds of a case (default: the fit's): the stiff body's damping is resolved to
 #: ~[0.01, 0.5] at 1% noise (its profile is flat across these narrower bounds)
@@ -187,26 +187,26 @@ def main() -> int:
           f"{'95% interval':>17} {'ratio':>6}  reason")
     good = within = ok = 0
     bad_said = []
+    falls: list[bool] = []
     t_all = time.perf_counter()
     for i, (label, make, key, truth, start, src, noise, expect) in enumerate(cases):
         df = measurement(make, truth, src, noise, seed=100 + i)
         scene = make(start)
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                fit = rocksweep.calibrate(scene, df, [key], bounds=BOUNDS.get(label))
-        except RocksweepError as err:
-            bad_said.append(expect == "refused")
-            print(f"{label:<22} {src:<4} {100 * noise:>4.1f}% {key.split('.')[1]:<10} "
-                  f"{truth:>6.3f} refused: {str(err)[:70]}...")
-            continue
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            fit = rocksweep.calibrate(scene, df, [key], bounds=BOUNDS.get(label))
         one = fit.sel(parameter=key)
         est, lo, hi = float(one.estimate), float(one.lo), float(one.hi)
         reason = str(fit["reason"].item())
         n, dof = int(fit.attrs["n_peaks"]), int(fit["dof"])
         ratio = float(fit["misfit"]) * math.sqrt(n / max(dof, 1)) / float(fit["noise"])
         mark = ""
-        if expect == "ok":
+        if expect == "fall":
+            inside = abs(est - truth) <= TOL[key]
+            wrong = reason == "ok" and not inside
+            falls.append(wrong)
+            mark = "  <-- ok and beyond the target" if wrong else ""
+        elif expect == "ok":
             good += 1
             inside = abs(est - truth) <= TOL[key] if key in TOL else True
             ok += reason == "ok"
@@ -221,9 +221,12 @@ def main() -> int:
               f"{truth:>6.3f} {est:>7.4f} [{lo:>7.4f}, {hi:>7.4f}] {ratio:>6.2f}  "
               f"{reason}{mark}")
     print(f"\ngood fits ok: {ok}/{good}; ok and within lam +-0.03, e +-0.02: "
-          f"{within}/{good}; misfit/unidentifiable/overturned cases that say so: "
+          f"{within}/{good}; misfit/unidentifiable cases that say so: "
           f"{sum(bad_said)}/{len(bad_said)} (MISFIT_RATIO {C.MISFIT_RATIO:g}); "
           f"{time.perf_counter() - t_all:.0f} s")
+    if falls:
+        print(f"a body overturning after one impact: {sum(falls)}/{len(falls)} say ok with "
+              "an estimate beyond the target")
     return 0
 
 

@@ -39,7 +39,8 @@ Numbers (``COMPUTE``):
   scene is read from the README's code).
 - ``accuracy`` (~10-20 s): docs/accuracy.md's cells where ``default`` differs from
   ``fine`` on the four figures, ``block`` and ``fig4a-rigid``, and Figure 3(a) with
-  ``--check`` (``rocksweep info``'s tails).
+  ``--check`` (``rocksweep info``'s tails); the shipped scenes' step caps (``CAP_SCENES``)
+  and the most RK4 evaluations a point of the four figures spends at ``fine``.
 - ``calibration_bench`` (~1 min): the recovery errors and interval coverage that
   ``scripts/bench_calibrate.py`` prints (its cases, fitted the same way), in
   docs/calibration.md's "Measured" section; the script's times are not stored.
@@ -348,22 +349,64 @@ def compute_api_example() -> dict:
 ACCURACY_SCENES = ("fig3a", "fig3b", "fig4a", "fig4b", "block", "fig4a-rigid")
 
 
+#: the shipped scenes (configs/) whose step caps docs/accuracy.md states: every sweep
+#: scene but fig3a-fine (Figure 3(a)'s plane at 1000 x 1000: fig3a's bodies and ranges)
+CAP_SCENES = ("fig3a", "fig3b", "fig4a", "fig4b", "block", "fig4a-rigid", "ricker",
+              "impact-laws", "record-demo", "fragility-demo", "floor-spectrum", "ci-small",
+              "wide-space")
+
+
+def _step_caps(name: str, accuracy: str | None = None) -> float:
+    """The largest step cap (the kernel's PAR_MAXSTEPS, ``numerics.step_budget``) of a
+    point of configs/NAME.yaml at its numerics (or at ``accuracy``) and at the finest
+    rerun its certification may make (``Numerics.refined``): what the scene's cost
+    admission holds to ``numerics.MAX_POINT_STEPS``."""
+    from dataclasses import replace
+
+    import numpy as np
+
+    from rocksweep.kernel import layout as L  # noqa: N812
+    from rocksweep.numerics import Numerics
+    from rocksweep.scene.grid import Grid
+    from rocksweep.scene.parse import load_scene
+
+    scene = load_scene(ROOT / "configs" / f"{name}.yaml")
+    n = scene.numerics if accuracy is None else Numerics.preset(accuracy)
+    worst = 0.0
+    for run in (n, n.refined(n.refine)):
+        grid = Grid(replace(scene, numerics=run))
+        for start in range(0, grid.size, 50_000):
+            rows = grid.rows(start, min(start + 50_000, grid.size)).rows
+            worst = max(worst, float(np.max(rows[:, L.PAR_MAXSTEPS])))
+    return worst
+
+
 def compute_accuracy() -> dict:
     """docs/accuracy.md's counts of the shipped scenes (~10-20 s): cells whose class at
     `default` differs from `fine`'s and the points the certification refined; Figure
-    3(a) with ``--check`` (``rocksweep sweep --check``; ``rocksweep info``'s tails)."""
+    3(a) with ``--check`` (``rocksweep sweep --check``; ``rocksweep info``'s tails); the
+    step caps of the shipped scenes (``_step_caps``) and the most RK4 evaluations a point
+    of the four figures spends at `fine` (its steps and event re-integrations, the
+    certification's reruns included)."""
     import json as _json
     import tempfile
+    import warnings
 
     import rocksweep
 
-    differ, points = {}, {}
+    differ, points, spent = {}, {}, {}
     for name in ACCURACY_SCENES:
         path = ROOT / "configs" / f"{name}.yaml"
         d = rocksweep.run(path, jobs=2, overrides={"numerics.accuracy": "default"})
         f = rocksweep.run(path, jobs=2, overrides={"numerics.accuracy": "fine"})
         differ[name] = int((d.outcome != f.outcome).sum())
         points[name] = int(d.outcome.size)
+        if name in FIGURES:
+            spent[name] = int((f.steps + f.event_steps).max())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the demo suites' scaled records: said elsewhere
+        caps = {name: float(f"{_step_caps(name):.3g}") for name in CAP_SCENES}
+        caps_fine = {name: float(f"{_step_caps(name, 'fine'):.3g}") for name in FIGURES}
     with tempfile.TemporaryDirectory() as tmp:
         out = str(Path(tmp, "f.h5"))
         _cli("sweep", str(ROOT / "configs" / "fig3a.yaml"), "--check", "-o", out,
@@ -378,6 +421,7 @@ def compute_accuracy() -> dict:
                        "fine; rocksweep sweep configs/fig3a.yaml --check; rocksweep info "
                        "--json",
             "differ": differ, "points": points,
+            "step_cap": caps, "step_cap_fine": caps_fine, "spent_fine_max": spent,
             "check": {"points": chk["points"], "changes": chk["outcome_changes"],
                       "changes_by_lam": by_lam,
                       "t_p95": float(f"{chk['t_overturn_diff']['p95']:.2g}"),
@@ -681,8 +725,32 @@ def render_accuracy(d: dict) -> dict[str, dict[str, str]]:
              + "; the overturning time's estimate is below "
              f"{c['t_p95']:g} p t at the 95th percentile, max|theta|'s below "
              f"{c['theta_p95']:g}%.")
+    cap = d["step_cap"]
+    top = max(cap, key=cap.get)
+    rest = max((k for k in cap if k != top), key=cap.get)
+    fine = d["step_cap_fine"]
+    top_fine = max(fine, key=fine.get)
+    spent = d["spent_fine_max"]
+    top_spent = max(spent, key=spent.get)
+    from rocksweep.numerics import EVENT_STEP_ALLOWANCE, Numerics
+
+    def sci(x: float) -> str:
+        return f"{x:.3g}".replace("e+0", "e").replace("e+", "e")
+
+    events = Numerics().max_events
+    caps = (f"The shipped scenes' largest step cap of a point (PAR_MAXSTEPS at their own "
+            "numerics and at the finest rerun of a close call, what the cost admission "
+            f"holds to the cap) is {sci(cap[top])} (`configs/{top}.yaml`), next "
+            f"{sci(cap[rest])} (`configs/{rest}.yaml`); the four figures' at `fine` reach "
+            f"{sci(fine[top_fine])} (Figure {SCENE_LABEL[top_fine]}). Most of a cap is the "
+            f"allowance for max_events events ({sci(EVENT_STEP_ALLOWANCE * events)} at the "
+            f"default {events}): the runs spend far "
+            f"less, at most {_thousands(spent[top_spent])} RK4 evaluations a point on the "
+            f"four figures at `fine` (Figure {SCENE_LABEL[top_spent]}; `scripts/"
+            "make_docs_numbers.py`, group `accuracy`).")
     return {"docs/accuracy.md": {"accuracy_fine": textwrap.fill(vs, 90),
-                                 "accuracy_check": textwrap.fill(check, 90)}}
+                                 "accuracy_check": textwrap.fill(check, 90),
+                                 "accuracy_step_cap": textwrap.fill(caps, 90)}}
 
 
 RENDER = {"impact_laws": render_impact_laws, "demo": render_demo, "quick": render_quick,

@@ -27,8 +27,9 @@ def bisect_thresholds(lo: np.ndarray, hi: np.ndarray, mode: np.ndarray, rtol: fl
     classify(idx int[k], mid float64[k]) -> the class of a run at ``mid`` of each bracket
     ``idx`` (k of them): one of ``target`` (it reaches the threshold: hi, mode = mid,
     class), ``UNDECIDED`` (the bracket stops, unresolved), anything else (lo = mid).
-    max_iter: at most this many steps (None: until every bracket is done). Returns (runs
-    int64[n], unresolved bool[n])."""
+    max_iter: at most this many steps (None: until every bracket is done); a bracket still
+    wider than rtol |hi| when they run out (and float64 could split it) is unresolved, as
+    one stopped by an undecided run. Returns (runs int64[n], unresolved bool[n])."""
     n = lo.size
     runs = np.zeros(n, np.int64)
     unresolved = np.zeros(n, bool)
@@ -52,4 +53,9 @@ def bisect_thresholds(lo: np.ndarray, hi: np.ndarray, mode: np.ndarray, rtol: fl
                 hi[i], mode[i] = m, k
             else:
                 lo[i] = m
+    else:  # the step cap ran out: brackets still open did not converge
+        for i in todo:
+            m = 0.5 * (lo[i] + hi[i])
+            if not unresolved[i] and hi[i] - lo[i] > rtol * abs(hi[i]) and lo[i] < m < hi[i]:
+                unresolved[i] = True
     return runs, unresolved

@@ -425,6 +425,9 @@ def check_amplitudes(scene: Scene, name: str) -> np.ndarray:
     """The values (float64[ny]) of the axis A_min is searched along (``name``, A_ratio),
     or a one-line AdaptiveError naming its key and values: it needs at least two,
     increasing."""
+    names = [a.name for a in scene.axes]
+    if name not in names:  # a record suite's stripes: no A_ratio axis
+        raise AdaptiveError(f"{name}: not an axis of the scene (axes: {', '.join(names)})")
     ax = scene.axis(name)
     yv = np.asarray(ax.values, float)
     if yv.size < 2:

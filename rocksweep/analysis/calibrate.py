@@ -23,7 +23,9 @@ is on the sequence of excursion peaks.
    the threshold or next to a gap weighs ~0, so the area is continuous in the
    parameters). h = max(H_NOISE x sigma, H_REL x max |theta|), sigma the measured noise
    (``measured.noise_level``): the small rebounds of a chattering body, near the noise,
-   do not count.
+   do not count. An excursion whose peak reaches pi/2 within H_NOISE sigma is a fall
+   (the body lies on its side): its area is set to 0, so it is compared by its peak
+   alone (the plateau's area measures how long the record goes on after the fall).
 2. The two sequences are aligned by a sequence alignment (dynamic programming, as an edit
    distance): a pair of excursions of one sign costs the squared differences of their
    features, (f(a) - f(b))^2 + (g_a - g_b)^2 with f(a) = max(|a| - h, 0) and g the area
@@ -170,6 +172,17 @@ def _golden(f: Any, bounds: tuple[float, float], xatol: float) -> _Result:
     return _Result(a, fa) if fa <= fb else _Result(b, fb)
 
 
+def _fallen(peaks: Peaks, top: float) -> Peaks:
+    """The excursions with the area of those whose |peak| reaches ``top`` (pi/2 within the
+    noise, theta/alpha_ref: the body overturned) set to 0: after the fall the body lies on
+    its side, and that plateau's area measures how long the record goes on after it, not
+    the rocking; the fall is compared by its peak."""
+    fell = np.abs(peaks.value) >= top
+    if not fell.any() or peaks.area is None:
+        return peaks
+    return Peaks(peaks.value, peaks.time, np.where(fell, 0.0, peaks.area))
+
+
 class Problem:
     """A scene's one point, a measured history and the keys to fit: the misfit of any
     candidate values (``misfit``) and the histories behind it (``evaluate``)."""
@@ -198,17 +211,9 @@ class Problem:
                                    f"its first value by more than {self.h:.3g} (4 x the "
                                    "noise): no motion to fit")
         self.quiet = self.t_onset - float(measured.t[0])
-        self.peaks = excursions(measured.t, measured.theta, self.h)
-        # an excursion at pi/2 within the noise: the body lies on its side (overturned);
-        # the plateau after it is no rocking, and its area depends only on when it fell
-        top = math.pi / 2 / self.alpha - H_NOISE * self.sigma
-        fell = np.flatnonzero(np.abs(self.peaks.value) >= top)
-        if fell.size:
-            raise CalibrationError(
-                f"{measured.source}: the body overturns (|theta_over_alpha| reaches "
-                f"{abs(self.peaks.value[fell[0]]):.4g}, pi/2 within the noise, at p_t "
-                f"{self.peaks.time[fell[0]]:.4g}); fit the rocking before it: cut the "
-                "history before the overturning half cycle")
+        # a peak at pi/2 within the noise: the body lies on its side (``_fallen``)
+        self.top = math.pi / 2 / self.alpha - H_NOISE * self.sigma
+        self.peaks = _fallen(excursions(measured.t, measured.theta, self.h), self.top)
         if self.peaks.value.size < 2:
             raise CalibrationError(
                 f"{measured.source}: {self.peaks.value.size} half cycle(s) beyond the noise "
@@ -300,7 +305,7 @@ class Problem:
         out, h = got
         shift = self._shift(h)
         theta = hermite(h["t"], h["theta"], h["theta_dot"], self.m.t - shift)
-        peaks = excursions(self.m.t, theta, self.h)
+        peaks = _fallen(excursions(self.m.t, theta, self.h), self.top)
         t, ph = h["t"], h["phase"]
         ev = np.flatnonzero((t[1:] == t[:-1]) & (ph[:-1] != 0) & (ph[1:] != ph[:-1]))
         impacts = t[ev] + shift

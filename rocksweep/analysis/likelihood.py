@@ -378,10 +378,9 @@ def _maximise(prob: Callable[[np.ndarray, np.ndarray], np.ndarray], m: np.ndarra
         info = np.einsum("bkcs,bjcs,bcs->bkj", J, J, n[idx][:, None, :] * inv)
         f0 = ll[idx]
         bad = ~(np.all(np.isfinite(g), -1) & np.all(np.isfinite(info), (-1, -2)))
-        met = np.zeros(idx.size, bool)
-        met[~bad] = _scoring_met(g[~bad], info[~bad], t[~bad], f0[~bad], tol)
         pending = ~bad
         done_rows = np.zeros(idx.size, bool)
+        ends = np.zeros(idx.size, bool)  # an accepted step small or flat: test the point
         for _try in range(40):
             pi = np.flatnonzero(pending)
             if pi.size == 0:
@@ -403,13 +402,18 @@ def _maximise(prob: Callable[[np.ndarray, np.ndarray], np.ndarray], m: np.ndarra
             lam[idx[acc]] = np.maximum(lam[idx[acc]] * 0.1, 1e-9)
             small = np.abs(d[up]).max(-1) < tol * (1.0 + np.abs(cand[up]).max(-1))
             flat = np.abs(lc[up] - f0[pi][up]) <= 1e-14 * (1.0 + np.abs(f0[pi][up]))
-            done_rows[acc[(small | flat) & met[acc]]] = True
+            ends[acc[small | flat]] = True
             pending[acc] = False
             rej = pi[~up]
             lam[idx[rej]] = np.maximum(lam[idx[rej]] * 10.0, 1e-4)
             stuck = rej[lam[idx[rej]] > 1e12]
             done_rows[stuck] = True
             pending[stuck] = False
+        # the test at the point each stopping row's last step left (only those rows)
+        met = np.zeros(idx.size, bool)
+        test = np.flatnonzero(ends | done_rows)
+        met[test] = _scoring_met(g[test], info[test], t[test], f0[test], tol)
+        done_rows |= ends & met
         away = np.any(np.abs(th[idx]) > limit, -1)
         conv[idx[done_rows & met & ~away]] = True
         active[idx[done_rows | bad | away]] = False

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from rocksweep.cli.main import load, main, user_errors, warning_line
+from rocksweep.cli.main import load, main, release_warnings, user_errors, warning_line
 from rocksweep.cli.options import dpi_option, overwrite_option, scene_argument, set_option
 from rocksweep.vocab.kinds import CALIBRATION
 
@@ -76,6 +76,7 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
         warnings.simplefilter("always", CalibrationWarning)
         ds = fit_scene(scene_path, measured_path, list(fit), bounds=_bounds(bounds) or None,
                        overrides=list(overrides), p=p, noise=noise)
+    release_warnings()  # fitted: the scene's warnings before the fit's verdicts
     for w in caught:
         if issubclass(w.category, CalibrationWarning):
             click.echo(warning_line(w.message), err=True)

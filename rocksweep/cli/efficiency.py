@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 
 from rocksweep.cli.helpers import check_table_outputs, write_table
-from rocksweep.cli.main import main, user_errors
+from rocksweep.cli.main import main, release_warnings, user_errors
 from rocksweep.cli.options import (
     dpi_option,
     json_option,
@@ -51,6 +51,7 @@ def efficiency(result_path: Path, state: str, out_path: Path | None, fig_path: P
     inputs = result_inputs(result_path)  # the result and its records: never written over
     check_table_outputs(out_path, fig_path, SUFFIXES, inputs, overwrite)
     eff = rocksweep.im_efficiency(rocksweep.open(result_path), state=state)
+    release_warnings()  # a partial file's words before the ranking
     frame = eff[["beta", "beta_scale", "im_median", "slope", "n_records",
                  "n_censored"]].to_dataframe().reset_index()
     frame = frame.merge(eff[["units", "exponent", "method"]].to_dataframe().reset_index(),

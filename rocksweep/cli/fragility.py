@@ -11,7 +11,7 @@ import click
 
 from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP, DEFAULT_SEED, MAX_BOOTSTRAP
 from rocksweep.cli.helpers import check_table_outputs, write_table
-from rocksweep.cli.main import main, user_errors, warning_line
+from rocksweep.cli.main import main, release_warnings, user_errors, warning_line
 from rocksweep.cli.options import (
     ci_option,
     dpi_option,
@@ -115,6 +115,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
         frag = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states,
                                    im=im, period=period, bootstrap=bootstrap, seed=seed,
                                    ci=ci, joint=joint)
+    release_warnings()  # fitted: the warnings before the fit's verdicts and the table
     for w in caught:
         if issubclass(w.category, FragilityWarning):
             click.echo(warning_line(w.message), err=True)

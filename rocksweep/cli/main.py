@@ -61,20 +61,70 @@ class InputError(click.ClickException):
     exit_code = 2
 
 
+class _HeldWarnings:
+    """The library's warnings during one command, held until it can no longer refuse:
+    said (``warning_line``) when it releases them (``release_warnings``) or ends, dropped
+    when it refuses, so that a refusal is its one line (a scene's record warning or a
+    fit's verdict before "Error: ..." was a second line about a run that did not
+    happen)."""
+
+    def __init__(self) -> None:
+        self.held: list[Warning | str] = []
+        self.released = False
+
+    def show(self, message, category, filename, lineno, file=None, line=None) -> None:
+        if self.released:
+            click.echo(warning_line(message), err=True)
+        else:
+            self.held.append(message)
+
+    def release(self) -> None:
+        self.released = True
+        held, self.held = self.held, []
+        for message in held:
+            click.echo(warning_line(message), err=True)
+
+
+_HOLDS: list[_HeldWarnings] = []  # the running commands' (one, or nested in tests)
+
+
+def release_warnings() -> None:
+    """Say the running command's held warnings now, and later ones as they come: a
+    command calls it once nothing it still checks can refuse (a sweep before its first
+    point, an analysis once it has fitted), so its warnings precede its work and output."""
+    if _HOLDS:
+        _HOLDS[-1].release()
+
+
 def user_errors(fn):
     """Turn the library's user-facing errors (``RocksweepError``) into one-line click
-    errors naming the command line's options (``said``)."""
+    errors naming the command line's options (``said``); the library's warnings are held
+    until the command can no longer refuse (``_HeldWarnings``)."""
 
     @functools.wraps(fn)
     def wrapper(*args, **kwargs):
+        import warnings
+
+        hold = _HeldWarnings()
+        before = warnings.showwarning
+        warnings.showwarning = hold.show
+        _HOLDS.append(hold)
         try:
-            return fn(*args, **kwargs)
+            result = fn(*args, **kwargs)
         except RocksweepError as err:
-            raise InputError(said(err)) from None
+            raise InputError(said(err)) from None  # the refusal alone: held ones dropped
         except click.ClickException as err:
             if type(err) is click.ClickException:  # a command's own one-line refusal
                 err.exit_code = InputError.exit_code
             raise
+        except Exception:
+            hold.release()  # not a refusal (a fault): everything said
+            raise
+        finally:
+            _HOLDS.remove(hold)
+            warnings.showwarning = before
+        hold.release()
+        return result
 
     return wrapper
 

@@ -11,7 +11,7 @@ from pathlib import Path
 import click
 
 from rocksweep.cli.helpers import check_table_outputs, write_table
-from rocksweep.cli.main import main, user_errors
+from rocksweep.cli.main import main, release_warnings, user_errors
 from rocksweep.cli.options import dpi_option, json_option, overwrite_option, width_option
 from rocksweep.vocab.kinds import RISK
 
@@ -101,7 +101,10 @@ def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None,
         states = [s.strip() for s in (state or "overturn").split(",") if s.strip()]
         ds = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states,
                                  joint=joint)
+    # a sweep's fragility warns (no_failures, incomplete...) before the hazard is read:
+    # said once the rates are computed, so that a refused hazard is one line
     rk = rocksweep.risk(ds, hazard_path, years, site=site)
+    release_warnings()
     rows = risk_rows(rk)
     if as_json:
         click.echo(json.dumps({"years": rk.attrs["years"], "im": rk.attrs["im"],

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import click
 
-from rocksweep.cli.main import load, main, user_errors
+from rocksweep.cli.main import load, main, release_warnings, user_errors
 from rocksweep.cli.options import (
     ADAPTIVE,
     backend_option,
@@ -127,6 +127,7 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     out = out_path if out_path is not None else Path(scene_path.stem + ".h5")
 
     def say(line: str) -> None:
+        release_warnings()  # the sweep starts (its first line): nothing left to refuse
         if not quiet:
             click.echo(line, err=True)
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from rocksweep.cli.main import main, user_errors
+from rocksweep.cli.main import main, release_warnings, user_errors
 from rocksweep.cli.options import overwrite_option, result_argument
 
 TABLE_SUFFIXES = (".csv", ".parquet")
@@ -41,6 +41,7 @@ def table_command(result_path: Path, out_path: Path, overwrite: bool) -> None:
                                        "pyarrow); or write .csv") from None
     check_output(out_path, overwrite=overwrite, inputs=result_inputs(result_path))
     frame = rocksweep.table(rocksweep.open(result_path))
+    release_warnings()  # a partial file's words before what is written
     units = frame.attrs.get("units", {})
     if suffix == ".csv":
         from rocksweep.analysis.files import csv_text

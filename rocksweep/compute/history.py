@@ -40,12 +40,16 @@ def history_dataset(run: Run, title: str = "") -> xr.Dataset:
 
 
 def swept_values(run: Run, swept: Sequence[str]) -> list:
-    """The run's value of each swept key, as plain Python (str for shape, else float)."""
+    """The run's value of each swept key, as plain Python (str for shape and a suite's
+    record, else float)."""
     p = run.point
     out = []
     for k in swept:
-        v = getattr(p, k) if hasattr(p, k) else getattr(p.body, k)
-        out.append(v if isinstance(v, str) else float(v))
+        if run.where is not None and k in run.where:
+            v = run.where[k]
+        else:
+            v = getattr(p, k) if hasattr(p, k) else getattr(p.body, k)
+        out.append(str(v) if isinstance(v, str) else float(v))
     return out
 
 
@@ -86,9 +90,13 @@ def run_points(scene: Scene, max_runs: int = MAX_RUNS) -> list[Run]:
                          "the scene, or pick a value with {fix})",
                          fix=set_key(big.key, "set_fix"))
     names = [a.name for a in scene.axes]
-    return [run_point(scene.point(dict(zip(names, combo, strict=True))), scene.single_numerics,
-                      contact=scene.contact)
-            for combo in product(*(a.values for a in scene.axes))]
+    runs = []
+    for combo in product(*(a.values for a in scene.axes)):
+        values = dict(zip(names, combo, strict=True))
+        run = run_point(scene.point(values), scene.single_numerics, contact=scene.contact)
+        run.where = values
+        runs.append(run)
+    return runs
 
 
 def titled_runs(scene: Scene, max_runs: int = MAX_RUNS) -> list[tuple[Run, xr.Dataset, str]]:

@@ -17,6 +17,12 @@ from rocksweep.physics.points import Point, kernel_kind, point_row
 from rocksweep.vocab.ground import FREE
 from rocksweep.vocab.outcomes import outcome_word, status_words
 
+# What a Run made without its history says when one is asked of it: only Python makes such
+# a Run (``run_point(..., history=False)``, as sweeps and the IDA run points); every command
+# and ``rocksweep.simulate`` record the history, so the words are Python's.
+NO_HISTORY = ("this run has no history: run_point(..., history=True) records one "
+              "(rocksweep.simulate always does)")
+
 
 @dataclass
 class Run:
@@ -34,6 +40,10 @@ class Run:
     history: dict | None
     wall_time: float
     contact: bool = False  # the contact fields were asked for (outputs.contact)
+    # the scene's value of each axis at this point (by name), when a scene's grid made it
+    # (``compute.history.run_points``): a suite's record name and stripe level, which the
+    # point holds as a record and an amplitude
+    where: dict | None = None
 
     def get(self, name: str) -> int | float | None:
         """One result field by name (``rocksweep.fields.FIELDS``) in its unit; None for
@@ -102,7 +112,7 @@ class Run:
         impact is the pair of rows at one time whose first rocks (phase != 0): the jump of
         the impacts' cumulative loss across it."""
         if self.history is None:
-            raise ValueError("this run has no history (run_point with history=True)")
+            raise ValueError(NO_HISTORY)
         t = np.asarray(self.history["t"])
         phase = np.asarray(self.history["phase"])
         lost = np.asarray(self.history["E_impact"])
@@ -113,7 +123,7 @@ class Run:
         """The time history normalised (``rocksweep.fields.HISTORY``: p_t,
         theta_over_alpha, u_over_ucr, E_over_Eref, ...): name -> float64[rows]."""
         if self.history is None:
-            raise ValueError("this run has no history (run_point with history=True)")
+            raise ValueError(NO_HISTORY)
         return fields.history_columns(self.history, self.point.body)
 
 

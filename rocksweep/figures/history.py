@@ -51,8 +51,9 @@ def time_history(runs: Sequence[Run], swept: Sequence[str] = (), title: str = ""
         raise FigureError("time history: no runs to draw")
     for run in runs:
         if run.history is None:
-            raise FigureError("time history: a run without a history (simulate with "
-                              "history=True)")
+            from rocksweep.compute.single import NO_HISTORY
+
+            raise FigureError(f"time history: {NO_HISTORY}")
     alpha = _axes.alpha_latex(getattr(runs[0].point.body, "kind", "flexible"))
     # one input line when every run has the same pulse shape and frequency (xg''/A is then
     # the same curve), else one per run in the run's colour

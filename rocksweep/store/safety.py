@@ -23,7 +23,7 @@ import os
 import shutil
 from pathlib import Path
 
-from rocksweep.errors import OutputError, StoreError
+from rocksweep.errors import StoreError
 from rocksweep.outputs import publish, shown
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import error_reason, mib
@@ -110,8 +110,7 @@ def lock_existing(path: Path) -> int:
 def publish_result(tmp: Path, path: Path, old_fd: int | None) -> None:
     """Rename the finished temporary file to ``path`` (``outputs.publish``, the one rename
     of every output): over the file locked by ``old_fd``, or, without one, only if
-    nothing is at ``path`` (another process may have made it since it was checked)."""
-    try:
-        publish(tmp, path, old_fd=old_fd)
-    except OutputError as err:
-        raise StoreError(str(err)) from None
+    nothing is at ``path`` (another process may have made it since it was checked). A
+    file that appeared or was replaced meanwhile is publish's ``OutputError``, as for
+    every other output."""
+    publish(tmp, path, old_fd=old_fd)

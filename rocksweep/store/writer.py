@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rocksweep.errors import Arg, RocksweepError, StoreError, flag
+from rocksweep.errors import Arg, OutputError, RocksweepError, StoreError, flag
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outputs import (
@@ -171,8 +171,9 @@ class SweepFile:
         """``create`` at a path its caller has checked (``outputs.check_output``, as the
         sweep session does, naming the command's inputs): refused are only what may have
         changed since, an existing path without ``overwrite`` (``OutputError``, the one
-        "already exists"), too little free space, a file another process is writing
-        (``StoreError``)."""
+        "already exists") or a file made or replaced at it meanwhile (``OutputError``, as
+        ``outputs.publish`` says for every output), too little free space, a file another
+        process is writing (``StoreError``)."""
         import h5py
         grid = grid if grid is not None else Grid(scene)
         existed = os.path.lexists(path)
@@ -215,7 +216,7 @@ class SweepFile:
             publish_result(tmp, path, old_fd)
             tmp = None
             return self
-        except StoreError:
+        except (StoreError, OutputError):
             if f is not None:
                 close_quietly(f)
             raise

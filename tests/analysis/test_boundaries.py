@@ -234,3 +234,15 @@ def test_boundaries_output_suffix_is_csv_or_h5(cli, tmp_path, name):
     assert (f"'.{suffix}'" if suffix else "'(none)'") in line
     assert line.endswith("use .csv, .h5 or .hdf5")
     assert not (tmp_path / name).exists()
+
+
+def test_boundaries_of_a_record_suite_is_one_line(cli, suite_result):
+    """A suite sweep has stripes, not an A_ratio axis: A_min has no diagram to search (it
+    was a KeyError traceback)."""
+    from helpers import one_line_error
+
+    from rocksweep.cli import main
+
+    line = one_line_error(cli.invoke(main, ["boundaries", str(suite_result)]), 2)
+    assert line.startswith(f"Error: {suite_result}: A_ratio: not an axis of the scene"), line
+    assert "record, PGA" in line and "boundaries need a diagram over two swept axes" in line

@@ -1,6 +1,7 @@
 """The Python API (rocksweep.run / open / simulate), the library sweep driver, the field
 table, the dask backend, and the README's "Python API" example."""
 
+import json
 import math
 import os
 import re
@@ -278,6 +279,31 @@ def test_simulate_runs_each_point_of_a_small_scene():
     assert [s.run.point.lam for s in sims] == [0.0, 0.2, 0.4]
     one = rocksweep.simulate(FIG5, impact__lam=0.4)
     assert one.summary == {**sims[2].summary, "wall_time_s": one.summary["wall_time_s"]}
+
+
+def test_simulate_runs_each_record_and_stripe_of_a_small_suite(tmp_path):
+    """A suite of 2 records x 2 stripes simulated: one run per point, titled and written
+    with its record's name and stripe level (the point holds a record and an amplitude:
+    reading them back was a TypeError, from the API and the command)."""
+    from click.testing import CliRunner
+
+    suite = Path(__file__).resolve().parents[2] / "records" / "suite"
+    scene = {"name": "suite", "body": {**FIG3}, "impact": {"lam": 0.0},
+             "ground": {"records": [str(suite / "SYN01.AT2"), str(suite / "SYN02.AT2")],
+                        "scale": {"im": "PGA", "values": [0.2, 0.6]}, "p": 2.0}}
+    sims = rocksweep.simulate(scene)
+    assert [s.title for s in sims] == [f"record = {r}, PGA = {g}" for r in
+                                       ("SYN01.AT2", "SYN02.AT2") for g in (0.2, 0.6)]
+    path = tmp_path / "suite.yaml"
+    path.write_text(json.dumps(scene))
+    res = CliRunner().invoke(main, ["simulate", str(path), "--csv", str(tmp_path / "h.csv")])
+    assert res.exit_code == 0, res.output
+    heads = [ln.split("]")[0] for ln in res.stdout.splitlines() if ln.startswith("[")]
+    assert heads == [f"[record={r}, PGA={g}" for r in ("SYN01.AT2", "SYN02.AT2")
+                     for g in (0.2, 0.6)]
+    first = (tmp_path / "h.csv").read_text().splitlines()[:2]
+    assert first[0].startswith("run,record,PGA,p_t,") and first[1].startswith(
+        "0,SYN01.AT2,0.2,"), first
 
 
 # --- fields ---------------------------------------------------------------------------------

@@ -386,3 +386,48 @@ def test_a_file_made_meanwhile_at_the_output_is_kept(result, tmp_path, monkeypat
     assert "made by another process meanwhile" in r.output
     assert out.read_text() == "mine"
     assert sorted(p.name for p in tmp_path.iterdir()) == [out.name]
+
+
+# --- a refusal is one line, whatever the library warned before it -------------------------
+
+SUITE_DIR = ROOT / "records" / "suite"
+
+
+def _suite_scene(work: Path, stripes: str) -> Path:
+    """A 2-record suite (its records copied next to it) at the PGA ``stripes``."""
+    for name in ("SYN01.AT2", "SYN02.AT2"):
+        shutil.copy(SUITE_DIR / name, work / name)
+    path = work / "suite.yaml"
+    path.write_text("name: suite\n" + BODY + "ground:\n  records: [SYN01.AT2, SYN02.AT2]\n"
+                    f"  scale: {{im: PGA, values: {stripes}}}\n  p: 2.0\n")
+    return path
+
+
+def test_a_refused_sweep_says_no_warning_of_its_scene_first(work):
+    """The scene's records are scaled 100x (a RecordWarning when it is read); the output
+    exists: the refusal is one line, and the same scene swept says its warning."""
+    scene = _suite_scene(work, "[0.2, 60]")
+    (work / "taken.h5").write_bytes(b"x")
+    refused(["sweep", scene.name, "-o", "taken.h5"], work, "taken.h5: already exists")
+    r = run_cli(["sweep", scene.name, "-o", "new.h5", "--dry-run"], work)
+    assert r.returncode == 0, r.stderr
+    assert r.stderr.startswith("Warning: ground.scale: 2 of 2 records are scaled by more "
+                               "than 5x"), r.stderr
+
+
+def test_risk_of_a_sweep_refuses_its_hazard_without_the_fits_warning(work):
+    """risk of a suite sweep fits the fragility first (no record overturns: a
+    no_failures warning); a hazard in another IM is then refused in one line, and a
+    good hazard gets the warning before the rates."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rocksweep.run(str(_suite_scene(work, "[0.1, 0.2]")), output=work / "s.h5")
+    (work / "pgv.csv").write_text("PGV [m/s],annual_rate\n0.1,1e-2\n1.0,1e-4\n")
+    (work / "pga.csv").write_text("PGA [g],annual_rate\n0.1,1e-2\n1.0,1e-4\n")
+    refused(["risk", "s.h5", "--hazard", "pgv.csv"], work,
+            "pgv.csv: hazard IM PGV [m/s] is not the fragility's IM PGA [g]")
+    r = run_cli(["risk", "s.h5", "--hazard", "pga.csv"], work)
+    assert r.returncode == 0, r.stderr
+    assert r.stderr.strip() == "Warning: fragility, state overturn: no_failures", r.stderr

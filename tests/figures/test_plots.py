@@ -2,6 +2,7 @@
 figures, Figure-returning functions, and no matplotlib backend switch."""
 
 import os
+import re
 import stat
 import subprocess
 import sys
@@ -256,6 +257,33 @@ def test_time_history_has_the_input_pulse_and_guide_legend(fig5_runs):
     assert any("overturning" in s for s in words)
 
 
+def test_a_run_without_history_is_refused_in_pythons_words(fig5_runs):
+    """A Run made without its history (``run_point(..., history=False)``, as sweeps make
+    them) asked for one: the figure and the Run say how Python gets one (not "simulate
+    with history=True": rocksweep.simulate has no such keyword). The command line cannot
+    make such a Run: its runs (``run_points``, rocksweep simulate's) all record one."""
+    import inspect
+
+    import rocksweep
+    from rocksweep.compute.history import run_points
+    from rocksweep.compute.single import run_point
+    from rocksweep.errors import FigureError
+    from rocksweep.figures.history import time_history
+    from rocksweep.scene.parse import load_scene
+
+    bare = run_point(fig5_runs[0].point, fig5_runs[0].numerics, history=False)
+    want = "run_point(..., history=True) records one (rocksweep.simulate always does)"
+    with pytest.raises(FigureError) as err:
+        time_history([bare])
+    assert str(err.value) == f"time history: this run has no history: {want}"
+    for ask in (bare.impact_losses, bare.history_columns):
+        with pytest.raises(ValueError, match=re.escape(want)):
+            ask()
+    assert "history" not in inspect.signature(rocksweep.simulate).parameters
+    scene = load_scene(ROOT / "configs" / "fig5.yaml", ["impact.lam=0"])
+    assert all(r.history is not None for r in run_points(scene))
+
+
 def test_restitution_map_u0_curve_is_dark(body_fig2):
     from rocksweep.figures.restitution import restitution_map
     from rocksweep.physics.bodies import restitution, restitution_rigid
@@ -339,8 +367,9 @@ print(matplotlib.get_backend(), "matplotlib.pyplot" in sys.modules)
 
 def test_check_files_ring_the_points_whose_outcome_changes(tmp_path):
     """A sweep with outputs.check: the cells whose check_outcome differs from outcome (at
-    any lam) get a ring, at exactly those coordinates, and a legend entry; a file without
-    check, none."""
+    any lam) get a ring, at exactly those coordinates, and a legend entry; a checked file
+    where nothing changes says so in its legend (it looked like an unchecked one); a file
+    without check, neither."""
     from rocksweep.figures.diagrams import stability_diagram
     from rocksweep.scene.parse import parse_scene
 
@@ -348,13 +377,13 @@ def test_check_files_ring_the_points_whose_outcome_changes(tmp_path):
             + "impact: {lam: [0.0, 0.2]}\n"
             "pulse: {shape: sine, w_over_p: [1.0, 2.0, 3.0], A_ratio: [1.0, 2.0]}\n")
     labels = {}
-    for check in (False, True):
-        sc = parse_scene(text + f"outputs: {{check: {str(check).lower()}}}\n")
+    for check in (False, True, "none"):
+        sc = parse_scene(text + f"outputs: {{check: {str(bool(check)).lower()}}}\n")
         out = tmp_path / f"c{check}.h5"
         sf = SweepFile.create(out, sc)
         arrays = {k: np.full(sf.grid.size, 0, dtype)
                   for k, (dtype, _, _) in sc.variables().items()}
-        if check:  # grid order (lam, A_ratio, w_over_p): flip two points
+        if check is True:  # grid order (lam, A_ratio, w_over_p): flip two points
             arrays["check_outcome"][[1, 6 + 5]] = 1  # lam 0 (A 1, w 2); lam 0.2 (A 2, w 3)
         sf.write(ChunkResult(0, sf.grid.size, arrays, 0.0))
         sf.close()
@@ -362,10 +391,11 @@ def test_check_files_ring_the_points_whose_outcome_changes(tmp_path):
         ax = fig.axes[0]
         rings = [ln for ln in ax.lines if ln.get_marker() == "o"]
         labels[check] = [t.get_text() for t in fig.legends[0].get_texts()]
-        if check:
+        if check is True:
             assert len(rings) == 1
             assert sorted(zip(*rings[0].get_data(), strict=True)) == [(2.0, 1.0), (3.0, 2.0)]
         else:
             assert rings == []
     assert "outcome changes at half the step" in labels[True]
-    assert "outcome changes at half the step" not in labels[False]
+    assert "outcome changes at half the step: none" in labels["none"]
+    assert not any("half the step" in t for t in labels[False])

@@ -545,14 +545,14 @@ def test_overwrite_and_resume_refused_while_another_process_writes(tmp_path, cli
 RACER = FAKE_CHUNK + """
 import json, sys, time
 from rocksweep.scene.parse import parse_scene
-from rocksweep.errors import StoreError
+from rocksweep.errors import RocksweepError
 from rocksweep.store.writer import SweepFile
 sc = parse_scene(@TEXT@)
 while time.time() < @START@:
     pass
 try:
     sf = SweepFile.create(@PATH@, sc, overwrite=@OVERWRITE@)
-except StoreError as err:
+except RocksweepError as err:  # OutputError (made meanwhile), StoreError (locked)
     print(json.dumps({"error": str(err)}))
     sys.exit(0)
 time.sleep(0.5)  # a sweep: the other one must not take the path meanwhile

@@ -149,6 +149,31 @@ def test_existing_file_is_not_overwritten(tmp_path, scene):
     assert read_result(path).shape == (2, 3, 4, 5)
 
 
+@pytest.mark.parametrize("overwrite", [False, True])
+def test_a_file_made_meanwhile_is_an_output_error_as_for_every_output(tmp_path, scene,
+                                                                      monkeypatch, overwrite):
+    """A file another process puts at the path after the sweep checked it (here: while
+    the new file is made) is kept, and the refusal is the OutputError every output's
+    publish raises, not a StoreError of its own."""
+    path = tmp_path / "r.h5"
+    if overwrite:
+        path.write_bytes(b"old")
+    real = writer.initialise
+
+    def meanwhile(*args):
+        if path.exists():
+            path.unlink()  # the file told to be overwritten, replaced by another's
+        path.write_bytes(b"mine")
+        return real(*args)
+
+    monkeypatch.setattr(writer, "initialise", meanwhile)
+    with pytest.raises(OutputError, match="by another process meanwhile") as err:
+        SweepFile.create(path, scene, overwrite=overwrite)
+    assert not isinstance(err.value, StoreError)
+    assert path.read_bytes() == b"mine"
+    assert [p.name for p in tmp_path.iterdir()] == ["r.h5"]
+
+
 def test_resume_with_a_different_scene_says_what_differs(tmp_path, scene):
     path = tmp_path / "r.h5"
     SweepFile.create(path, scene).close()
