@@ -966,6 +966,39 @@ for _code in ("rocksweep.plot(None)", "rocksweep.plot(5)", "rocksweep.plot([1, 2
                             api_call(d, c))[1])
 
 
+# --- a refusal is one line after the library warned; suites where a grid is read ----------
+
+@case("risk of a suite sweep (fit warns no_failures), hazard in PGV: one line")
+def _(d):
+    fixture(d, "s.h5")
+    (d / "hzv.csv").write_text(HAZARD.replace("PGA [g]", "PGV [m/s]"))
+    return cli(d, ["risk", "s.h5", "--hazard", "hzv.csv"])
+
+
+@case("sweep of a suite scaled 100x (a record warning) to an existing file: one line")
+def _(d):
+    (d / "big.yaml").write_text(suite_scene("r/*.AT2").replace("[0.2, 0.6]", "[0.2, 60]"))
+    (d / "taken.h5").write_text("x")
+    return cli(d, ["sweep", "big.yaml", "-o", "taken.h5"])
+
+
+@case("boundaries of a suite sweep (no A_ratio axis)")
+def _(d):
+    fixture(d, "s.h5")
+    return cli(d, ["boundaries", "s.h5"])
+
+
+@case("info of a fragility result (an analysis's file, not a sweep's)")
+def _(d):
+    fixture(d, "f.h5")
+    return cli(d, ["info", "f.h5"])
+
+
+@case("simulate of a 2-record x 2-stripe suite runs each point", "ok")
+def _(d):
+    return cli(d, ["simulate", "suite.yaml"])
+
+
 # --- the run -------------------------------------------------------------------------------
 
 def classify(r: subprocess.CompletedProcess, before: dict, after: dict,

@@ -1,6 +1,6 @@
 """Regenerate every figure in docs/ from the current code, by one command.
 
-    python scripts/make_docs_figures.py              # ~1 min on 2 cores
+    python scripts/make_docs_figures.py              # ~2 min on 2 cores
     python scripts/make_docs_figures.py --accuracy   # also docs/accuracy_fig3a.png (+~1 min)
 
 Runs the shipped commands, exactly as the README shows them:
@@ -17,6 +17,15 @@ Runs the shipped commands, exactly as the README shows them:
   docs/efficiency.png, docs/risk.png);
 - ``rocksweep sweep configs/floor-spectrum.yaml`` and ``rocksweep floor-spectrum``
   (docs/floor_spectrum.png);
+- ``rocksweep sweep configs/ricker.yaml`` and ``rocksweep plot`` (docs/ricker.png),
+  ``rocksweep sweep configs/record-demo.yaml`` and ``rocksweep spectrum``
+  (docs/record_spectra.png), and the pulse shapes (``figures.pulses.shapes_figure``,
+  docs/pulse_shapes.png): docs/excitations.md;
+- ``rocksweep sweep configs/fig4a.yaml --set body.mu=0.6 --set outputs.contact=true`` and
+  ``rocksweep plot`` (docs/fig4a_mu06.png, docs/contact.md);
+- docs/calibration.md's example: ``rocksweep simulate configs/free-rocking.yaml`` at lam =
+  0.3 and `fine` to CSV, 1% noise added (seed 1), ``rocksweep calibrate ... --fit
+  impact.lam --plot`` (docs/calibration.png);
 - with ``--accuracy``: ``rocksweep accuracy configs/fig3a.yaml --points 200 --plot``.
 
 Everything is written to a temporary directory first and moved into docs/ when the
@@ -37,6 +46,12 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 DIAGRAMS = ("fig3a", "fig3b", "fig4a", "fig4b", "block")
+OTHERS = ("fig3a_check", "fig5", "fig2", "fragility", "impact_laws", "fig2_locked", "risk",
+          "floor_spectrum", "ricker", "fig4a_mu06", "record_spectra", "pulse_shapes",
+          "calibration")
+#: every PNG it writes into docs/ ("risk" writes efficiency.png too; "accuracy_fig3a" with
+#: --accuracy): tests/test_docs_figures.py holds docs/ to these
+PNGS = (*DIAGRAMS, *OTHERS, "efficiency", "accuracy_fig3a")
 
 
 def rocksweep(*args: str) -> None:
@@ -55,15 +70,12 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--jobs", type=int, default=2, help="sweep worker threads [2]")
     ap.add_argument("--dpi", type=int, default=200, help="resolution of the PNGs [200]")
     ap.add_argument("--only", nargs="+", metavar="NAME",
-                    choices=[*DIAGRAMS, "fig3a_check", "fig5", "fig2", "fragility",
-                             "accuracy_fig3a", "impact_laws", "fig2_locked", "risk",
-                             "floor_spectrum"],
+                    choices=[*DIAGRAMS, *OTHERS, "accuracy_fig3a"],
                     help="regenerate only these figures")
     ap.add_argument("--docs", type=Path, default=ROOT / "docs", help="output directory")
     ap.add_argument("--keep", type=Path, metavar="DIR", help="keep the sweep results here")
     args = ap.parse_args(argv)
-    wanted = set(args.only or [*DIAGRAMS, "fig3a_check", "fig5", "fig2", "fragility",
-                               "impact_laws", "fig2_locked", "risk", "floor_spectrum"]
+    wanted = set(args.only or [*DIAGRAMS, *OTHERS]
                  + (["accuracy_fig3a"] if args.accuracy else []))
     args.docs.mkdir(parents=True, exist_ok=True)
     if args.keep:
@@ -145,6 +157,52 @@ def main(argv: list[str] | None = None) -> None:
             rocksweep("restitution", str(cfg / "fig2.yaml"), "--law", "locked", "--plot",
                       str(tmp / "fig2_locked.png"))
             publish("fig2_locked")
+        if "ricker" in wanted:  # docs/excitations.md
+            h5 = (args.keep or tmp) / "ricker.h5"
+            rocksweep("sweep", str(cfg / "ricker.yaml"), "-o", str(h5), "--jobs",
+                      str(args.jobs), "--quiet", "--overwrite")
+            rocksweep("plot", str(h5), "-o", str(tmp / "ricker.png"), "--dpi", str(args.dpi))
+            publish("ricker")
+        if "fig4a_mu06" in wanted:  # docs/contact.md: sliding at mu = 0.6 hatched
+            h5 = (args.keep or tmp) / "fig4a_mu06.h5"
+            rocksweep("sweep", str(cfg / "fig4a.yaml"), "--set", "body.mu=0.6", "--set",
+                      "outputs.contact=true", "-o", str(h5), "--jobs", str(args.jobs),
+                      "--quiet", "--overwrite")
+            rocksweep("plot", str(h5), "-o", str(tmp / "fig4a_mu06.png"), "--dpi",
+                      str(args.dpi))
+            publish("fig4a_mu06")
+        if "record_spectra" in wanted:  # docs/excitations.md
+            h5 = (args.keep or tmp) / "record_demo.h5"
+            rocksweep("sweep", str(cfg / "record-demo.yaml"), "-o", str(h5), "--jobs",
+                      str(args.jobs), "--quiet", "--overwrite")
+            rocksweep("spectrum", str(h5), "-o", str(tmp / "record_spectra.png"), "--dpi",
+                      str(args.dpi))
+            publish("record_spectra")
+        if "pulse_shapes" in wanted:  # docs/excitations.md (Python: no command draws it)
+            code = ("import sys; from rocksweep.figures.pulses import shapes_figure; "
+                    "from rocksweep.figures.style import save_figure; "
+                    f"save_figure(shapes_figure(), sys.argv[1], {args.dpi})")
+            print("$ python -c 'shapes_figure()'", flush=True)
+            proc = subprocess.run([sys.executable, "-c", code, str(tmp / "pulse_shapes.png")],
+                                  cwd=ROOT)
+            if proc.returncode != 0:
+                sys.exit(f"failed ({proc.returncode}): the pulse shapes' figure")
+            publish("pulse_shapes")
+        if "calibration" in wanted:  # docs/calibration.md's example, as the page runs it
+            truth, measured = tmp / "truth.csv", tmp / "measured.csv"
+            rocksweep("simulate", str(cfg / "free-rocking.yaml"), "--set", "impact.lam=0.3",
+                      "--set", "numerics.accuracy=fine", "--csv", str(truth))
+            import numpy as np
+            import pandas as pd
+
+            d = pd.read_csv(truth)
+            d["theta_over_alpha"] += 0.01 * d.theta_over_alpha.abs().max() * \
+                np.random.default_rng(1).standard_normal(len(d))
+            d[["p_t", "theta_over_alpha"]].to_csv(measured, index=False)
+            rocksweep("calibrate", str(cfg / "free-rocking.yaml"), str(measured), "--fit",
+                      "impact.lam", "--plot", str(tmp / "calibration.png"), "--dpi",
+                      str(args.dpi))
+            publish("calibration")
         if "accuracy_fig3a" in wanted:
             t0 = time.perf_counter()
             rocksweep("accuracy", str(cfg / "fig3a.yaml"), "--points", "200", "--quiet",

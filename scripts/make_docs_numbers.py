@@ -26,7 +26,8 @@ Numbers (``COMPUTE``):
   restitution values (``rocksweep restitution configs/fig2.yaml``: e at lam = 0, u = 0; at
   lam = 1, u/u_cr = -2; Housner's e of the body welded rigid): README.md's quick start and
   single-run paragraphs; the mode 1 points per lam of the four figures' 80 x 80 grids
-  (``rocksweep info``; ~3 s): docs/diagrams.md.
+  (``rocksweep info``; ~3 s) and their cells in mode 1 at one lam and safe at a larger
+  one (the plots' dots): docs/diagrams.md.
 - ``calibration`` (seconds, recomputed in the test): docs/calibration.md's worked examples:
   ``rocksweep simulate`` + ``calibrate`` of configs/free-rocking.yaml as the page shows
   them (the truth at ``fine``, and at ``default``), the Figure 3(a) body's fit and its
@@ -124,11 +125,20 @@ def _mode1_counts(name: str) -> dict:
 
     scene = load_scene(ROOT / "configs" / f"{name}.yaml")
     out = np.asarray(sweep_arrays(scene, jobs=2)[0]["outcome"])
-    i = [a.name for a in scene.swept].index("lam")
+    names = [a.name for a in scene.swept]
+    i = names.index("lam")
     lams = scene.axis("lam").values
+    # cells in mode 1 at one lam and safe at a larger one (the plot's dots)
+    by_lam = np.moveaxis(out, i, 0)
+    back = np.zeros(by_lam.shape[1:], bool)
+    for k in range(len(lams) - 1):
+        back |= (by_lam[k] == L.OUTCOME_MODE1) & (by_lam[k + 1:] == L.OUTCOME_SAFE).any(0)
+    rest = [a for a in scene.swept if a.name != "lam"]
+    cells = [{a.name: float(a.values[j]) for a, j in zip(rest, idx, strict=True)}
+             for idx in zip(*np.nonzero(back), strict=True)]
     return {"mode1": {f"{lam:g}": int((np.take(out, [k], axis=i) == L.OUTCOME_MODE1).sum())
                       for k, lam in enumerate(lams)},
-            "points_per_lam": int(out.size // out.shape[i])}
+            "points_per_lam": int(out.size // out.shape[i]), "safe_again": cells}
 
 
 def compute_quick() -> dict:
@@ -578,6 +588,13 @@ def render_quick(d: dict) -> dict[str, str]:
              + ", ".join(f"{fig} " + " / ".join(str(v) for v in c["mode1"].values())
                          for fig, c in zip(("3(a)", "3(b)", "4(a)", "4(b)"), counts.values(),
                                            strict=True)) + f" ({per}).")
+    again = [(fig, cell) for fig, c in zip(("3(a)", "3(b)", "4(a)", "4(b)"), counts.values(),
+                                           strict=True) for cell in c["safe_again"]]
+    mode1 += (" No cell is in mode 1 at one lam and safe at a larger one." if not again else
+              f" {len(again)} cell{'s' * (len(again) > 1)} in mode 1 at one lam and safe "
+              "at a larger one (the figures' black dots): " + "; ".join(
+                  f"{fig} at " + ", ".join(f"{k} = {v:g}" for k, v in cell.items())
+                  for fig, cell in again) + ".")
     return {"README.md": {"quick_start": textwrap.fill(start, 90),
                           "single_runs": textwrap.fill(shows, 90)},
             "docs/diagrams.md": {"mode1_points": textwrap.fill(

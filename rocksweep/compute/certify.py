@@ -11,7 +11,9 @@ when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the th
 - a safe run below ``numerics.close_margin``, or an overturn below OVERTURN_BAND times
   it, is run again at half the steps (``refine_rows``: every step and the rotation limit
   halved, the step cap doubled), and again, until two consecutive runs give the same
-  outcome (the finer one is kept) or ``Numerics.refine`` refinements were made;
+  outcome and the finer one is no close call at its own step (its margins scale with the
+  step, ``numerics.close_margin``: a knife edge repeats itself at every step it is a
+  close call at) or ``Numerics.refine`` refinements were made; the finest run is kept;
 - a safe run between the close-call margin and the row's PAR_CLOSE (``numerics.
   close_band``, CLOSE_BAND times it: a near-miss, which turned back with a margin a
   coarse step's error can still reverse) is checked by a run at half the steps that stops
@@ -25,10 +27,11 @@ Only the runs near a threshold pay: on the paper's figures 5-17% more RK4 evalua
 certified runs take ~2x the bare ones' (``scripts/threshold_sample.py``).
 
 Every refined or checked point has STATUS_REFINED in its status; one whose outcome still
-changed at the last refinement also STATUS_UNCERTIFIED (flagged: not a reliable
-classification). Its steps and event_steps count every run it took. The same rule runs
-wherever rows meet the kernel, through the one dispatch (``compute.dispatch.run_variant``):
-sweeps (``compute.sweep.run_rows``), adaptive sweeps (through the sweep's chunks), the A_min
+changed at the last refinement, or which was still a close call there, also
+STATUS_UNCERTIFIED (flagged: not a reliable classification). Its steps and event_steps
+count every run it took. The same rule runs wherever rows meet the kernel, through the one
+dispatch (``compute.dispatch.run_variant``): sweeps (``compute.sweep.run_rows``), adaptive
+sweeps (through the sweep's chunks), the A_min
 searches (``analysis.boundaries.kernel_rows``), single runs (``compute.single.run_point``)
 and the accuracy study (``analysis.accuracy.run_kernel``).
 """
@@ -110,8 +113,12 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
         if idx.size == 0:
             break
         spent_now = outs[idx][:, [L.OUT_STEPS, L.OUT_EVENT_STEPS]]
-        new = run(refine_rows(rows[idx], level), idx)
-        stable = new[:, L.OUT_OUTCOME] == outs[idx, L.OUT_OUTCOME]
+        finer = refine_rows(rows[idx], level)
+        new = run(finer, idx)
+        # the same outcome twice, and the finer run clear of the saddle by its own step's
+        # margin: a knife edge agrees with itself at every step it is a close call at
+        stable = ((new[:, L.OUT_OUTCOME] == outs[idx, L.OUT_OUTCOME])
+                  & ~close_calls(finer, new))
         status = new[:, L.OUT_STATUS].astype(np.int64) | L.STATUS_REFINED
         new[:, L.OUT_STATUS] = status
         new[:, L.OUT_STEPS] += spent_now[:, 0]

@@ -311,7 +311,8 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
     lifts = ((status & STATUS_BIT[LIFTS_OFF]) != 0) & result.done
     # per-point error estimates (outputs.check): the outcome changes at half the step
     unsure = np.zeros(result.shape, bool)
-    if "check_outcome" in result.arrays:
+    checked = "check_outcome" in result.arrays
+    if checked:
         unsure = (np.asarray(result.arrays["check_outcome"])
                   != np.asarray(result.arrays["outcome"])) & result.done
     o, fl, cp, sl, lo, un = _arrays(result, order,
@@ -400,6 +401,9 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
     if any_unsure:
         handles.append(Line2D([], [], ls="", marker="o", mfc="none", mec=_UNSURE,
                               label="outcome changes at half the step"))
+    elif checked:  # a checked file without rings says so: the check found nothing
+        handles.append(Line2D([], [], ls="", marker="o", mfc="none", mec=_UNSURE,
+                              label="outcome changes at half the step: none"))
     if show_computed:
         handles.append(Patch(fc="black", alpha=0.35, ec="0.5",
                              label="computed (adaptive; clear: filled)"))

@@ -32,6 +32,7 @@ from rocksweep.store.format import (
 )
 from rocksweep.store.identity import resolved_scene, scene_differences
 from rocksweep.vocab.axes import axis_name
+from rocksweep.vocab.kinds import KIND_ATTR, KINDS, SWEEP
 from rocksweep.vocab.outcomes import CLASSES, COMPUTED_FLAGS, OUTCOME_CODE, OUTCOME_WORDS
 from rocksweep.vocab.settings import ADAPTIVE_RESOLVED
 
@@ -129,6 +130,18 @@ def _looks_like_ours(f: h5py.File, fmt) -> bool:
         return False
 
 
+def _analysis_kind(f: h5py.File) -> str | None:
+    """The kind of an analysis's result file (``vocab.kinds``: its ``rocksweep_kind``
+    attribute, but a sweep's), else None."""
+    try:
+        kind = f.attrs.get(KIND_ATTR)
+    except H5_ERRORS:
+        return None
+    if isinstance(kind, bytes | np.bytes_):
+        kind = bytes(kind).decode("utf-8", "replace")
+    return kind if isinstance(kind, str) and kind in KINDS and kind != SWEEP else None
+
+
 def read_layout(f: h5py.File, path: Path) -> FileLayout:
     """Validate the format, the resolved scene, the coordinates and the variables."""
     import h5py
@@ -144,6 +157,11 @@ def read_layout(f: h5py.File, path: Path) -> FileLayout:
         resaved = NETCDF_MARK in f.attrs
     except H5_ERRORS:
         resaved = False
+    kind = _analysis_kind(f) if resaved else None
+    if kind is not None:  # an analysis's result (written with xarray): not a sweep's file
+        raise StoreError(f"{shown(path)}: a {kind} result ({KINDS[kind]}), not a sweep "
+                         "result; this reads the file a sweep writes (rocksweep.open reads "
+                         "both)")
     if resaved:  # the netCDF library's mark: rocksweep writes with h5py, never sets it
         raise StoreError(f"{shown(path)}: not written by rocksweep: a result saved again by "
                          "xarray (to_netcdf) or another netCDF writer, which changes its "

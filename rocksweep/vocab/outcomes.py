@@ -71,11 +71,14 @@ STATUS_MEANING: dict[str, str] = {
               "(outputs.contact)",
     LIFTS_OFF: "normal reaction below zero: the body would leave the ground "
                  "(outputs.contact)",
-    "refined": "a close call (the free rocking came near the overturning saddle): re-run "
-               "with 2, 4, ... times the steps until its outcome was stable; the finest "
-               "run's result is kept (rocksweep.compute.certify)",
+    "refined": "near its threshold (the free rocking came near the overturning saddle): "
+               "re-run with 2, 4, ... times the steps until its outcome was stable, the "
+               "finest run's result kept, or, a safe near-miss, checked by a run at 2 "
+               "times the steps past its last approach that stayed safe, its own result "
+               "kept (rocksweep.compute.certify)",
     "uncertified": "a close call whose outcome still changed at the last refinement "
-                   "(numerics.refine) (flagged)",
+                   "(numerics.refine), or which was still a close call there: a knife "
+                   "edge (flagged)",
     AIRBORNE: "g + a_v <= 0: the vertical ground acceleration reached -g, the body leaves "
               "the ground (outside the model); the run stopped there (flagged)",
 }

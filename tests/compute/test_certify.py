@@ -132,6 +132,7 @@ def test_a_near_miss_is_probed_to_its_last_approach():
         res = np.zeros((len(idx), L.N_OUT))
         res[:, L.OUT_OUTCOME] = np.where(idx == 1, L.OUTCOME_MODE1, L.OUTCOME_SAFE)
         res[:, L.OUT_STEPS] = 10
+        res[:, L.OUT_MARGIN] = 1.0
         return res
 
     certify(rows, outs, run, 3)
@@ -165,6 +166,7 @@ def test_an_outcome_that_keeps_changing_is_uncertified():
         level = round(-np.log2(sub[0, L.PAR_DT]))
         res[:, L.OUT_OUTCOME] = np.where(idx == 0, level % 2, 0)  # point 0 flips
         res[:, L.OUT_STEPS] = 10
+        res[:, L.OUT_MARGIN] = 1.0  # the finer runs are clear of the saddle
         return res
 
     certify(rows, outs, run, 3)
@@ -175,6 +177,37 @@ def test_an_outcome_that_keeps_changing_is_uncertified():
     assert st[1] & L.STATUS_REFINED and not st[1] & L.STATUS_UNCERTIFIED
     assert st[2] == 0
     assert outs[0, L.OUT_STEPS] == 30 and outs[1, L.OUT_STEPS] == 10
+
+
+def test_a_knife_edge_is_refined_until_clear_or_flagged():
+    """certify's rule on a stand-in kernel: an outcome the finer run repeats is certified
+    only where that run is itself clear of the saddle by its own step's margin (PAR_CLOSE
+    scales with the step): a run whose margin stays below it at every refinement is
+    refined to the last level and flagged uncertified though its outcome never changed;
+    one whose finer run clears it stops there."""
+    rows = np.zeros((2, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = 0.04  # close-call margin 0.01 at level 0
+    rows[:, L.PAR_DT] = 1.0
+    outs = np.zeros((2, L.N_OUT))
+    outs[:, L.OUT_MARGIN] = 0.001
+    levels_run = {0: [], 1: []}
+
+    def run(sub, idx, keep=True):
+        res = np.zeros((len(idx), L.N_OUT))
+        level = round(-np.log2(sub[0, L.PAR_DT]))
+        for i in idx:
+            levels_run[int(i)].append(level)
+        # point 0: a knife edge (margin 1e-5 at every step); point 1 clears the level-1
+        # close-call margin (0.01 x 2^-2.5 = 0.0018) at 0.005
+        res[:, L.OUT_MARGIN] = np.where(idx == 0, 1e-5, 0.005)
+        return res
+
+    certify(rows, outs, run, 3)
+    assert levels_run == {0: [1, 2, 3], 1: [1]}
+    st = outs[:, L.OUT_STATUS].astype(int)
+    assert st[0] & L.STATUS_UNCERTIFIED and st[0] & L.STATUS_FLAGGED
+    assert st[1] & L.STATUS_REFINED and not st[1] & L.STATUS_UNCERTIFIED
+    assert (outs[:, L.OUT_OUTCOME] == L.OUTCOME_SAFE).all()
 
 
 SCENE = """

@@ -367,8 +367,9 @@ print(matplotlib.get_backend(), "matplotlib.pyplot" in sys.modules)
 
 def test_check_files_ring_the_points_whose_outcome_changes(tmp_path):
     """A sweep with outputs.check: the cells whose check_outcome differs from outcome (at
-    any lam) get a ring, at exactly those coordinates, and a legend entry; a file without
-    check, none."""
+    any lam) get a ring, at exactly those coordinates, and a legend entry; a checked file
+    where nothing changes says so in its legend (it looked like an unchecked one); a file
+    without check, neither."""
     from rocksweep.figures.diagrams import stability_diagram
     from rocksweep.scene.parse import parse_scene
 
@@ -376,13 +377,13 @@ def test_check_files_ring_the_points_whose_outcome_changes(tmp_path):
             + "impact: {lam: [0.0, 0.2]}\n"
             "pulse: {shape: sine, w_over_p: [1.0, 2.0, 3.0], A_ratio: [1.0, 2.0]}\n")
     labels = {}
-    for check in (False, True):
-        sc = parse_scene(text + f"outputs: {{check: {str(check).lower()}}}\n")
+    for check in (False, True, "none"):
+        sc = parse_scene(text + f"outputs: {{check: {str(bool(check)).lower()}}}\n")
         out = tmp_path / f"c{check}.h5"
         sf = SweepFile.create(out, sc)
         arrays = {k: np.full(sf.grid.size, 0, dtype)
                   for k, (dtype, _, _) in sc.variables().items()}
-        if check:  # grid order (lam, A_ratio, w_over_p): flip two points
+        if check is True:  # grid order (lam, A_ratio, w_over_p): flip two points
             arrays["check_outcome"][[1, 6 + 5]] = 1  # lam 0 (A 1, w 2); lam 0.2 (A 2, w 3)
         sf.write(ChunkResult(0, sf.grid.size, arrays, 0.0))
         sf.close()
@@ -390,10 +391,11 @@ def test_check_files_ring_the_points_whose_outcome_changes(tmp_path):
         ax = fig.axes[0]
         rings = [ln for ln in ax.lines if ln.get_marker() == "o"]
         labels[check] = [t.get_text() for t in fig.legends[0].get_texts()]
-        if check:
+        if check is True:
             assert len(rings) == 1
             assert sorted(zip(*rings[0].get_data(), strict=True)) == [(2.0, 1.0), (3.0, 2.0)]
         else:
             assert rings == []
     assert "outcome changes at half the step" in labels[True]
-    assert "outcome changes at half the step" not in labels[False]
+    assert "outcome changes at half the step: none" in labels["none"]
+    assert not any("half the step" in t for t in labels[False])

@@ -101,6 +101,22 @@ def test_a_file_resaved_by_xarray_is_not_rocksweeps(pulse_result, tmp_path, cli)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["x.h5"]
 
 
+def test_an_analysis_result_is_named_as_such_where_a_sweep_is_read(tmp_path, cli):
+    """An analysis's file (``rocksweep fragility -o``: xarray writes it, with its kind)
+    given where a sweep's file is read: one line naming what it is (it said "not written
+    by rocksweep: saved again by xarray")."""
+    out = tmp_path / "frag.h5"
+    xr.Dataset({"beta": (("lam",), [0.4])}, coords={"lam": [0.0]},
+               attrs={"rocksweep_kind": "fragility"}).to_netcdf(out, engine="h5netcdf")
+    for args in (["info", str(out)], ["boundaries", str(out)]):
+        line = one_line_error(cli.invoke(main, args))
+        assert line == (f"Error: {out}: a fragility result (lognormal fragility curves of a "
+                        "record suite, with verdicts), not a sweep result; this reads the "
+                        "file a sweep writes (rocksweep.open reads both)"), line
+    with pytest.raises(StoreError, match="a fragility result"):
+        read_result(out)
+
+
 @pytest.mark.parametrize("value", [np.array([1.0, 2.0]), np.int64(3), np.array([b"a", b"b"])])
 def test_a_version_attribute_that_is_not_text_is_damage(pulse_result, tmp_path, cli, value):
     path = copy(pulse_result, tmp_path)
