@@ -124,7 +124,8 @@ def _mode1_counts(name: str) -> dict:
     from rocksweep.scene.parse import load_scene
 
     scene = load_scene(ROOT / "configs" / f"{name}.yaml")
-    out = np.asarray(sweep_arrays(scene, jobs=2)[0]["outcome"])
+    arrays = sweep_arrays(scene, jobs=2)[0]
+    out = np.asarray(arrays["outcome"])
     names = [a.name for a in scene.swept]
     i = names.index("lam")
     lams = scene.axis("lam").values
@@ -136,9 +137,17 @@ def _mode1_counts(name: str) -> dict:
     rest = [a for a in scene.swept if a.name != "lam"]
     cells = [{a.name: float(a.values[j]) for a, j in zip(rest, idx, strict=True)}
              for idx in zip(*np.nonzero(back), strict=True)]
+    from rocksweep.vocab.outcomes import FLAGGED_WORDS, status_words
+
+    status = np.asarray(arrays["status"]).astype(np.int64)
+    flagged = (status & L.STATUS_FLAGGED) != 0
+    # what flagged them (uncertified, horizon, the caps, ...)
+    words = sorted({w for v in np.unique(status[flagged]) for w in status_words(int(v))
+                    if w in FLAGGED_WORDS})
     return {"mode1": {f"{lam:g}": int((np.take(out, [k], axis=i) == L.OUTCOME_MODE1).sum())
                       for k, lam in enumerate(lams)},
-            "points_per_lam": int(out.size // out.shape[i]), "safe_again": cells}
+            "points_per_lam": int(out.size // out.shape[i]), "safe_again": cells,
+            "flagged": int(flagged.sum()), "flag_words": words}
 
 
 def compute_quick() -> dict:
@@ -595,6 +604,11 @@ def render_quick(d: dict) -> dict[str, str]:
               "at a larger one (the figures' black dots): " + "; ".join(
                   f"{fig} at " + ", ".join(f"{k} = {v:g}" for k, v in cell.items())
                   for fig, cell in again) + ".")
+    flags = [c["flagged"] for c in counts.values()]
+    why = sorted({w for c in counts.values() for w in c["flag_words"]})
+    mode1 += (" No point is flagged in the four diagrams." if not any(flags) else
+              " Points flagged (drawn x; status " + ", ".join(f"`{w}`" for w in why)
+              + "): " + " / ".join(str(n) for n in flags) + ".")
     return {"README.md": {"quick_start": textwrap.fill(start, 90),
                           "single_runs": textwrap.fill(shows, 90)},
             "docs/diagrams.md": {"mode1_points": textwrap.fill(

@@ -55,6 +55,7 @@ from rocksweep.store.reader import SweepResult
 from rocksweep.vocab import axes as _axes
 from rocksweep.vocab.axes import DIAGRAM_AXES, RECORD_X
 from rocksweep.vocab.outcomes import (
+    FLAGGED_WORDS,
     LIFTS_OFF,
     OUTCOME_MODE1,
     OUTCOME_MODE2,
@@ -134,6 +135,14 @@ def mode1_colours(n_lam: int) -> list:
 def plottable(result: SweepResult) -> list[str]:
     """Swept numeric dimensions with two or more values (what x and y may be)."""
     return [d for d in result.dims if d not in WORD_AXES and len(result.coords[d]) >= 2]
+
+
+def _flag_label(result: SweepResult) -> str:
+    """The legend's words for the x marks: the flags (``FLAGGED_WORDS``) the drawn points
+    carry, e.g. "flagged (uncertified)"."""
+    status = np.asarray(result.arrays["status"]).astype(np.int64)[result.flagged & result.done]
+    bits = int(np.bitwise_or.reduce(status)) if status.size else 0
+    return "flagged (" + ", ".join(w for w in FLAGGED_WORDS if bits & STATUS_BIT[w]) + ")"
 
 
 def _check_key(result: SweepResult, key: str, arg: str) -> str:
@@ -397,7 +406,7 @@ def stability_diagram(result: SweepResult, x: str | None = None, y: str | None =
                               label=f"mode 1, safe again at a larger ${lam_sym}$"))
     if any_flag:
         handles.append(Line2D([], [], ls="", marker="x", color="k",
-                              label="flagged (horizon/step/event cap, non-finite)"))
+                              label=_flag_label(result)))
     if any_unsure:
         handles.append(Line2D([], [], ls="", marker="o", mfc="none", mec=_UNSURE,
                               label="outcome changes at half the step"))
@@ -591,7 +600,7 @@ def compare_diagram(result: SweepResult, key: str, x: str | None = None,
         handles.append(Patch(fc=_NOT_RUN, ec="0.5", label="not computed"))
     if any_flag:
         handles.append(Line2D([], [], ls="", marker="x", color="k",
-                              label="flagged (horizon/step/event cap, non-finite)"))
+                              label=_flag_label(result)))
     if curves:
         for k, lab in enumerate(labels):
             handles.append(Line2D([], [], color=CURVE_COLOURS[k % len(CURVE_COLOURS)], lw=1.0,

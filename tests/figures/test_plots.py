@@ -284,6 +284,29 @@ def test_a_run_without_history_is_refused_in_pythons_words(fig5_runs):
     assert all(r.history is not None for r in run_points(scene))
 
 
+def test_the_flag_marks_legend_names_the_flags_the_points_carry(tmp_path):
+    """The x marks' legend entry says which flags the drawn points carry (a close call
+    left uncertified, a step cap), not a fixed list that missed `uncertified`."""
+    from rocksweep.figures.diagrams import stability_diagram
+    from rocksweep.scene.parse import parse_scene
+    from rocksweep.vocab.outcomes import STATUS_BIT
+
+    text = ("name: flags\n" + BODY3.replace("{start: 0.1, stop: 0.2, num: 3}", "0.15")
+            + "impact: {lam: 0.0}\n"
+            "pulse: {shape: sine, w_over_p: [1.0, 2.0, 3.0], A_ratio: [1.0, 2.0]}\n")
+    sc = parse_scene(text)
+    out = tmp_path / "f.h5"
+    sf = SweepFile.create(out, sc)
+    arrays = {k: np.full(sf.grid.size, 0, dtype) for k, (dtype, _, _) in sc.variables().items()}
+    arrays["status"][1] = STATUS_BIT["uncertified"] | STATUS_BIT["refined"]
+    arrays["status"][4] = STATUS_BIT["step_cap"]
+    sf.write(ChunkResult(0, sf.grid.size, arrays, 0.0))
+    sf.close()
+    fig = stability_diagram(read_result(out))
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert "flagged (step_cap, uncertified)" in labels, labels
+
+
 def test_restitution_map_u0_curve_is_dark(body_fig2):
     from rocksweep.figures.restitution import restitution_map
     from rocksweep.physics.bodies import restitution, restitution_rigid
