@@ -463,9 +463,9 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     keys): ``estimate``, ``lo``, ``hi`` (the ``ci`` interval by profile likelihood, ``ci``
     in attrs), scalar ``misfit`` (RMS error of the half-cycle peaks, theta/alpha_ref)
     with ``noise`` (the measurement's, estimated from the history or ``noise=``, in
-    theta/alpha_ref) and ``dof``, ``reason`` ("ok" or misfit, unidentifiable, at_bound
-    joined by ",", also a ``CalibrationWarning``), and the measured and fitted histories
-    over p_t with the fitted impacts (``rocksweep.analysis.calibrate``).
+    theta/alpha_ref) and ``dof``, ``reason`` ("ok" or misfit, unidentifiable, at_bound,
+    not_converged joined by ",", also a ``CalibrationWarning``), and the measured and
+    fitted histories over p_t with the fitted impacts (``rocksweep.analysis.calibrate``).
     """
     from rocksweep.analysis.calibrate import calibrate_scene
 
