@@ -4,6 +4,12 @@ tests/ on sys.path, there being no package)."""
 from __future__ import annotations
 
 import ast
+import importlib.util
+import sys
+from pathlib import Path
+from types import ModuleType
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def one_line_error(result, code: int | None = None) -> str:
@@ -64,3 +70,16 @@ def docstring_ids(tree: ast.AST) -> set[int]:
             if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
                 ids.add(id(body[0].value))
     return ids
+
+
+def load_script(name: str) -> ModuleType:
+    """scripts/NAME.py imported as a module (its ``_here`` import found as when it runs as
+    a script), without running its ``main``."""
+    sys.path.insert(0, str(ROOT / "scripts"))
+    try:
+        spec = importlib.util.spec_from_file_location(name, ROOT / "scripts" / f"{name}.py")
+        mod = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(mod)
+    finally:
+        sys.path.remove(str(ROOT / "scripts"))
+    return mod

@@ -4,24 +4,16 @@ reruns the commands): no marked block is edited by hand or left stale."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
-import sys
 from pathlib import Path
+
+from helpers import load_script
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def _script():
-    sys.path.insert(0, str(ROOT / "scripts"))  # its _here import, as when run as a script
-    try:
-        spec = importlib.util.spec_from_file_location(
-            "make_docs_numbers", ROOT / "scripts" / "make_docs_numbers.py")
-        mod = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(mod)
-    finally:
-        sys.path.remove(str(ROOT / "scripts"))
-    return mod
+    return load_script("make_docs_numbers")
 
 
 def _pages_on_disk() -> dict[Path, str]:

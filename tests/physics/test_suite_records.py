@@ -2,25 +2,18 @@
 
 from __future__ import annotations
 
-import importlib.util
 import math
 from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import load_script
 
 from rocksweep.physics.intensity import velocity
 from rocksweep.physics.records import at2_text, read_record
 
 ROOT = Path(__file__).resolve().parents[2]
 SUITE = ROOT / "records" / "suite"
-
-
-def load_script():
-    spec = importlib.util.spec_from_file_location("make_suite", ROOT / "scripts" / "make_suite.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
 
 
 def test_every_suite_file_parses():
@@ -39,14 +32,14 @@ def test_every_suite_file_parses():
 
 @pytest.mark.parametrize("index", [0, 13])
 def test_suite_files_match_the_generator(index):
-    mod = load_script()
+    mod = load_script("make_suite")
     acc, dt, title = mod.suite_record(index)
     path = SUITE / f"SYN{index + 1:02d}.AT2"
     assert path.read_text("ascii") == at2_text(acc, dt, title)
 
 
 def test_envelope_hits_its_arias_targets():
-    mod = load_script()
+    mod = load_script("make_suite")
     ia, d595, tmid = 0.1, 15.0, 9.0
     a1, a2, a3 = mod.envelope_params(ia, d595, tmid)
     t = np.arange(0.0, 200.0, 0.001)
