@@ -100,6 +100,9 @@ def test_close_calls_are_refined_and_clear_ones_are_not():
             probed += 1
             for slot in (L.OUT_T_END, L.OUT_THETA_MAX, L.OUT_IMPACTS, L.OUT_MARGIN):
                 assert run.out[slot] == bare[slot], A
+            # the shorter check's history is not the point's: its own runs to its end
+            t = run_point(point, n, history=True).history["t"]
+            assert t[-1] == bare[L.OUT_T_END], A
         if close:
             refined += 1
             assert run.out[L.OUT_STEPS] > bare[L.OUT_STEPS]  # every run's steps counted
