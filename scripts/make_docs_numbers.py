@@ -46,6 +46,10 @@ Numbers (``COMPUTE``):
   ``scripts/bench_calibrate.py`` prints (its cases, fitted the same way), in
   docs/calibration.md's "Measured" section; the script's times are not stored.
 
+- ``contact`` (~6-10 s at `fine`, ``--check`` reruns it): docs/contact.md's table of the
+  shares that slide and lift off per figure and class, and the safe points' median
+  demand (``rocksweep.run`` with ``outputs.contact``).
+
 Benchmark timings quoted in the docs are not regenerated here (they vary with the
 machine and its load); docs/performance.md and docs/accuracy.md name the script that
 measures each. Nor are the measurements of a change (before -> after tables), nor the
@@ -113,6 +117,8 @@ def compute_demo() -> dict:
 
 
 FIGURES = ("fig3a", "fig3b", "fig4a", "fig4b")
+#: the friction coefficients docs/contact.md's table is read at
+CONTACT_MU = (0.4, 0.6, 0.8)
 
 
 def _mode1_counts(name: str) -> dict:
@@ -447,6 +453,36 @@ def compute_accuracy() -> dict:
                       "theta_p95": round(100 * chk["theta_max_rel_diff"]["p95"], 1)}}
 
 
+def compute_contact() -> dict:
+    """docs/contact.md's table (~10 s at `fine`): per figure and class (safe, mode 1, mode
+    2), its points, the share whose friction demand exceeds each of ``CONTACT_MU``
+    (``mu_required`` > mu) and the share that lifts off (``normal_min_over_Mg`` < 0), and
+    the median demand of the safe points (``rocksweep.run`` with ``outputs.contact``,
+    which runs `fine`)."""
+    import numpy as np
+
+    import rocksweep
+
+    out = {}
+    for name in FIGURES:
+        ds = rocksweep.run(ROOT / "configs" / f"{name}.yaml", jobs=2,
+                           overrides={"outputs.contact": True})
+        oc, mu = ds.outcome.values, ds.mu_required.values
+        lift = ds.normal_min_over_Mg.values < 0.0
+        fig = {}
+        for word, code in (("safe", 0), ("mode1", 1), ("mode2", 2)):
+            sel = oc == code
+            n = int(sel.sum())
+            fig[word] = {"points": n,
+                         "slides": [round(100 * float((mu[sel] > m).mean()), 1) if n else None
+                                    for m in CONTACT_MU],
+                         "lifts_off": round(100 * float(lift[sel].mean()), 1) if n else None}
+        fig["safe_median_mu"] = round(float(np.median(mu[oc == 0])), 2)
+        out[name] = fig
+    return {"command": "rocksweep.run(configs/NAME.yaml, overrides={'outputs.contact': True})",
+            "mu": list(CONTACT_MU), "figures": out}
+
+
 def compute_calibration_bench() -> dict:
     """scripts/bench_calibrate.py's recovery numbers (~1 min): its cases (``CASES``) fitted
     back from 1% and 0.3% noise as the script fits them; the truths' impacts, the largest
@@ -486,7 +522,7 @@ def compute_calibration_bench() -> dict:
 COMPUTE = {"impact_laws": compute_impact_laws, "demo": compute_demo, "quick": compute_quick,
            "calibration": compute_calibration, "fragility": compute_fragility,
            "api_example": compute_api_example, "accuracy": compute_accuracy,
-           "calibration_bench": compute_calibration_bench}
+           "calibration_bench": compute_calibration_bench, "contact": compute_contact}
 #: the computations of seconds, rerun by tests/test_docs_numbers.py (the others take
 #: more: ``--check`` reruns them)
 CHEAP = ("quick", "calibration", "fragility", "api_example")
@@ -784,10 +820,45 @@ def render_accuracy(d: dict) -> dict[str, dict[str, str]]:
                                  "accuracy_step_cap": textwrap.fill(caps, 90)}}
 
 
+def render_contact(d: dict) -> dict[str, dict[str, str]]:
+    """docs/contact.md: the shares that slide and lift off per figure and class, and the
+    safe points' median demand."""
+    def share(v: list) -> str:
+        if all(x == 100.0 for x in v):
+            return "100%"
+        return " / ".join(f"{x:.1f}" for x in v) + "%"
+
+    mus = " / ".join(f"{m:g}" for m in d["mu"])
+    rows = ["| figure | safe (points) | mode 1 | mode 2 | lifts off (safe / mode 1 / mode 2) |",
+            "|---|---|---|---|---|"]
+    for name, f in d["figures"].items():
+        cells = [f"{share(f['safe']['slides'])} ({f['safe']['points']})"]
+        cells += [share(f[w]["slides"]) if f[w]["points"] else "no points"
+                  for w in ("mode1", "mode2")]
+        lifts = " / ".join("-" if f[w]["lifts_off"] is None else
+                           f"{f[w]['lifts_off']:g}" if f[w]["lifts_off"] in (0.0, 100.0) else
+                           f"{f[w]['lifts_off']:.1f}" for w in ("safe", "mode1", "mode2"))
+        rows.append(f"| {SCENE_LABEL[name]} | " + " | ".join(cells) + f" | {lifts}% |")
+    med = [f["safe_median_mu"] for f in d["figures"].values()]
+    # the least mu at which under 1% of every figure's safe points would slide
+    holds = next((m for k, m in enumerate(d["mu"]) if all(
+        f["safe"]["slides"][k] < 1.0 for f in d["figures"].values())), None)
+    head = (f"Share of each class that slides at mu = {mus}, and that lifts off (shipped 80 x "
+            "80 x 3 grids with `--set outputs.contact=true`, which sweeps at `fine`; "
+            "`scripts/make_docs_numbers.py`, group `contact`):")
+    median = ((f"So the safe part of every diagram holds for mu >= {holds:g} (under 1% of its "
+               "points would slide; " if holds is not None else
+               "So the safe part of some diagram slides at every mu of the table (")
+              + f"the median demand of safe points is {min(med):.2f}-{max(med):.2f});")
+    return {"docs/contact.md": {"contact_table": textwrap.fill(head, 90) + "\n\n"
+                                + "\n".join(rows),
+                                "contact_median": textwrap.fill(median, 90)}}
+
+
 RENDER = {"impact_laws": render_impact_laws, "demo": render_demo, "quick": render_quick,
           "calibration": render_calibration, "fragility": render_fragility,
           "api_example": render_api_example, "accuracy": render_accuracy,
-          "calibration_bench": render_calibration_bench}
+          "calibration_bench": render_calibration_bench, "contact": render_contact}
 
 
 def _markers(name: str) -> tuple[str, str]:
