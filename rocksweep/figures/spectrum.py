@@ -26,8 +26,9 @@ def spectra_figure(sp: xr.Dataset | Spectra, *, ax: Any = None,
                    width: str | None = "double") -> Figure:
     """Two panels against the frequency axis (p or w_over_p) of the spectra Dataset
     (``rocksweep.spectra``; a ``Spectra`` is drawn through its ``to_dataset``): the rocking
-    spectrum (max|theta|/alpha_ref, one colour per A_ratio, one line style per lam,
-    overturned points marked x above 1; other swept keys at their first value) and the
+    spectrum (max|theta|/alpha_ref, one colour per A_ratio, one line style per lam (named
+    in the legend up to four lam values), overturned points marked x above 1; other swept
+    keys at their first value, named in the panel's title) and the
     overturning spectrum (the smallest A_ratio that overturns, one curve per lam, mode 1
     filled circles, mode 2 open triangles). ax: two axes to draw into; width: a journal
     width (``figures.WIDTHS``)."""
@@ -63,11 +64,17 @@ def spectra_figure(sp: xr.Dataset | Spectra, *, ax: Any = None,
             # overturned: a row of x per curve above 1, stacked so that none hides another
             axes[0].plot(x[o], np.full(int(o.sum()), 1.03 + 0.025 * n), "x", color=pick_colours[n],
                          ms=3)
+    if 1 < n_lam <= len(LAM_STYLES):  # one style per lam value: say which is which
+        for li, v in enumerate(sp["lam"].values):
+            axes[0].plot([], [], color="0.3", ls=LAM_STYLES[li], lw=1.2,
+                         label=f"${_axes.latex('lam')}$ = {v:g}")
     axes[0].axhline(1.0, color="0.5", lw=0.6, ls=":")
     axes[0].set_ylim(0.0, 1.06 + 0.025 * len(pick))
     axes[0].set_xlabel(_axes.label(freq, kind))
     axes[0].set_ylabel(rf"max$|\theta|/{_axes.alpha_latex(kind)}$ (x: overturned)")
-    axes[0].set_title("rocking spectrum" + (" (line style: lam)" if n_lam > 1 else ""),
+    at = ", ".join(f"{d} = {sp[d].values[0]:g}" if d in sp.coords else d for d in first)
+    axes[0].set_title("rocking spectrum" + (f" at {at}" if at else "")
+                      + (" (line style: lam)" if n_lam > len(LAM_STYLES) else ""),
                       fontsize="small")
     modes = {lab: v for lab, _sel, v in _curves(sp["mode"], freq)} if "mode" in sp else {}
     onsets = list(_curves(sp["A_min"], freq))

@@ -321,3 +321,15 @@ def test_a_min_figure_of_twelve_panels_has_twelve_colours_and_a_clear_legend():
         assert fig.bbox.x0 <= lb.x0 and lb.x1 <= fig.bbox.x1 and fig.bbox.y0 <= lb.y0 \
             and lb.y1 <= fig.bbox.y1
         assert not lb.overlaps(ax.get_window_extent()), "a_min legend over the curves"
+
+
+def test_the_rocking_spectrum_names_its_line_styles_and_the_values_it_shows():
+    """With up to four lam values the rocking panel's legend says which line style is
+    which lam; a swept key the panel does not draw (an angle) is named at the value drawn."""
+    sp = _many_curve_datasets(3)["spectra"]
+    labels = rocksweep.plot(sp).axes[0].get_legend_handles_labels()[1]
+    lams = [lb for lb in labels if lb.startswith("$\\lambda$")]
+    assert len(lams) == 3, labels
+    angled = sp.expand_dims(angle=[30.0, 60.0])
+    fig = rocksweep.plot(angled)
+    assert "angle = 30" in fig.axes[0].get_title()
