@@ -27,6 +27,7 @@ import time
 import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
 import numpy as np
 
+from rocksweep.analysis.bisection import bisect_thresholds
 from rocksweep.compute.dispatch import run_variant
 from rocksweep.errors import BodyError
 from rocksweep.kernel import layout as L  # noqa: N812
@@ -69,15 +70,18 @@ def thresholds(body, lam, shape, w, fine: Numerics, rng, per_body: int) -> list[
     grid = np.linspace(1.0, 16.0, 61)
     cls = run([Point(body, lam, shape, w, float(a)) for a in grid], fine)[:, L.OUT_OUTCOME]
     change = np.flatnonzero(cls[1:] != cls[:-1])
-    found = []
-    for i in rng.permutation(change)[:per_body]:
-        lo, hi, c_lo = grid[i], grid[i + 1], cls[i]
-        for _ in range(18):
-            mid = 0.5 * (lo + hi)
-            c = run([Point(body, lam, shape, w, mid)], fine)[0, L.OUT_OUTCOME]
-            lo, hi = (mid, hi) if c == c_lo else (lo, mid)
-        found.append(0.5 * (lo + hi))
-    return found
+    pick = rng.permutation(change)[:per_body]
+    lo, hi = grid[pick].copy(), grid[pick + 1].copy()
+    c_lo = cls[pick]
+
+    def classify(idx: np.ndarray, mid: np.ndarray) -> np.ndarray:
+        # 1: the class across the change (hi's side), 0: lo's
+        got = run([Point(body, lam, shape, w, float(m)) for m in mid], fine)
+        return (got[:, L.OUT_OUTCOME] != c_lo[idx]).astype(int)
+
+    # 18 halvings of each bracket (rtol 0: none stops early)
+    bisect_thresholds(lo, hi, np.zeros(pick.size, int), 0.0, classify, (1,), max_iter=18)
+    return list(0.5 * (lo + hi))
 
 
 def main() -> None:
