@@ -93,20 +93,24 @@ def main(argv: list[str] | None = None) -> None:
             os.replace(part, dest)
             made.append(dest)
 
+        def sweep(scene: str, result: str, *extra: str) -> Path:
+            """``rocksweep sweep configs/SCENE.yaml EXTRA... -o RESULT.h5`` (kept with
+            --keep); returns the result's path."""
+            h5 = (args.keep or tmp) / f"{result}.h5"
+            rocksweep("sweep", str(cfg / f"{scene}.yaml"), *extra, "-o", str(h5), "--jobs",
+                      str(args.jobs), "--quiet", "--overwrite")
+            return h5
+
         for name in DIAGRAMS:
             if name not in wanted:
                 continue
             t0 = time.perf_counter()
-            h5 = (args.keep or tmp) / f"{name}.h5"
-            rocksweep("sweep", str(cfg / f"{name}.yaml"), "-o", str(h5), "--jobs",
-                      str(args.jobs), "--quiet", "--overwrite")
+            h5 = sweep(name, name)
             rocksweep("plot", str(h5), "-o", str(tmp / f"{name}.png"), "--dpi", str(args.dpi))
             publish(name)
             print(f"  {name}: {time.perf_counter() - t0:.1f} s", flush=True)
         if "fig3a_check" in wanted:  # per-point error estimates: rings where unsure
-            h5 = (args.keep or tmp) / "fig3a_check.h5"
-            rocksweep("sweep", str(cfg / "fig3a.yaml"), "--check", "-o", str(h5), "--jobs",
-                      str(args.jobs), "--quiet", "--overwrite")
+            h5 = sweep("fig3a", "fig3a_check", "--check")
             rocksweep("plot", str(h5), "-o", str(tmp / "fig3a_check.png"), "--dpi",
                       str(args.dpi))
             publish("fig3a_check")
@@ -118,9 +122,7 @@ def main(argv: list[str] | None = None) -> None:
             publish("fig2")
         if "fragility" in wanted:  # the record suite: overturning fragility per lam
             t0 = time.perf_counter()
-            h5 = (args.keep or tmp) / "fragility.h5"
-            rocksweep("sweep", str(cfg / "fragility-demo.yaml"), "-o", str(h5), "--jobs",
-                      str(args.jobs), "--quiet", "--overwrite")
+            h5 = sweep("fragility-demo", "fragility")
             rocksweep("fragility", str(h5), "--plot", str(tmp / "fragility.png"), "--dpi",
                       str(args.dpi))
             publish("fragility")
@@ -128,8 +130,7 @@ def main(argv: list[str] | None = None) -> None:
         if "risk" in wanted:  # IM efficiency and risk on the demo suite
             h5 = (args.keep or tmp) / "fragility.h5"
             if not h5.exists():
-                rocksweep("sweep", str(cfg / "fragility-demo.yaml"), "-o", str(h5),
-                          "--jobs", str(args.jobs), "--quiet", "--overwrite")
+                sweep("fragility-demo", "fragility")
             rocksweep("efficiency", str(h5), "--plot", str(tmp / "efficiency.png"), "--dpi",
                       str(args.dpi))
             curves = tmp / "curves.h5"
@@ -140,16 +141,12 @@ def main(argv: list[str] | None = None) -> None:
             publish("efficiency")
             publish("risk")
         if "impact_laws" in wanted:  # which laws overturn each cell
-            h5 = (args.keep or tmp) / "impact_laws.h5"
-            rocksweep("sweep", str(cfg / "impact-laws.yaml"), "-o", str(h5), "--jobs",
-                      str(args.jobs), "--quiet", "--overwrite")
+            h5 = sweep("impact-laws", "impact_laws")
             rocksweep("plot", str(h5), "--compare", "impact.law", "-o",
                       str(tmp / "impact_laws.png"), "--dpi", str(args.dpi))
             publish("impact_laws")
         if "floor_spectrum" in wanted:  # contents on a building's floor (docs/floors.md)
-            h5 = (args.keep or tmp) / "floor_spectrum.h5"
-            rocksweep("sweep", str(cfg / "floor-spectrum.yaml"), "-o", str(h5), "--jobs",
-                      str(args.jobs), "--quiet", "--overwrite")
+            h5 = sweep("floor-spectrum", "floor_spectrum")
             rocksweep("floor-spectrum", str(h5), "-o", str(tmp / "floor_spectrum.png"),
                       "--dpi", str(args.dpi))
             publish("floor_spectrum")
@@ -158,23 +155,17 @@ def main(argv: list[str] | None = None) -> None:
                       str(tmp / "fig2_locked.png"))
             publish("fig2_locked")
         if "ricker" in wanted:  # docs/excitations.md
-            h5 = (args.keep or tmp) / "ricker.h5"
-            rocksweep("sweep", str(cfg / "ricker.yaml"), "-o", str(h5), "--jobs",
-                      str(args.jobs), "--quiet", "--overwrite")
+            h5 = sweep("ricker", "ricker")
             rocksweep("plot", str(h5), "-o", str(tmp / "ricker.png"), "--dpi", str(args.dpi))
             publish("ricker")
         if "fig4a_mu06" in wanted:  # docs/contact.md: sliding at mu = 0.6 hatched
-            h5 = (args.keep or tmp) / "fig4a_mu06.h5"
-            rocksweep("sweep", str(cfg / "fig4a.yaml"), "--set", "body.mu=0.6", "--set",
-                      "outputs.contact=true", "-o", str(h5), "--jobs", str(args.jobs),
-                      "--quiet", "--overwrite")
+            h5 = sweep("fig4a", "fig4a_mu06", "--set", "body.mu=0.6", "--set",
+                       "outputs.contact=true")
             rocksweep("plot", str(h5), "-o", str(tmp / "fig4a_mu06.png"), "--dpi",
                       str(args.dpi))
             publish("fig4a_mu06")
         if "record_spectra" in wanted:  # docs/excitations.md
-            h5 = (args.keep or tmp) / "record_demo.h5"
-            rocksweep("sweep", str(cfg / "record-demo.yaml"), "-o", str(h5), "--jobs",
-                      str(args.jobs), "--quiet", "--overwrite")
+            h5 = sweep("record-demo", "record_demo")
             rocksweep("spectrum", str(h5), "-o", str(tmp / "record_spectra.png"), "--dpi",
                       str(args.dpi))
             publish("record_spectra")
