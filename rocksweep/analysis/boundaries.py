@@ -58,6 +58,7 @@ from rocksweep.scene.grid import Grid
 from rocksweep.scene.model import Scene
 from rocksweep.vocab.axes import DIAGRAM_AXES
 from rocksweep.vocab.ground import RECORD
+from rocksweep.vocab.kinds import BOUNDARIES, KIND_ATTR
 from rocksweep.vocab.outcomes import OUTCOME_MODE1, OUTCOME_MODE2, outcome_word
 
 if TYPE_CHECKING:
@@ -781,7 +782,7 @@ def boundaries_dataset(ds: Any, rtol: float = DEFAULT_RTOL, mode: int | None = N
     search = check_search(search)
     result = as_result(ds, list(RESPONSE))
     curves, _ = result_curves(result, rtol, mode, search=search)
-    return curves_dataset(curves, {"rocksweep_kind": "boundaries", "kind": result.kind,
+    return curves_dataset(curves, {KIND_ATTR: BOUNDARIES, "kind": result.kind,
                                    "title": result.name, "rtol": rtol,
                                    "search": int(search),
                                    "mode": "any" if mode is None else f"mode{mode}"})

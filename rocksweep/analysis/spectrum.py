@@ -39,6 +39,7 @@ from rocksweep.errors import (
     SpectrumError,
     check_rtol,
 )
+from rocksweep.vocab.kinds import KIND_ATTR, SPECTRA
 from rocksweep.vocab.outcomes import MODE_WORDS, OUTCOME_WORDS, flag_attrs
 
 
@@ -108,7 +109,7 @@ class Spectra:
                     "lam": ("lam", self.lam, fields.axis_attrs("lam")),
                     "A_ratio": ("A_ratio", self.A, fields.axis_attrs("A_ratio", self.kind)),
                     f: (f, self.x, fields.axis_attrs(f))},
-            attrs={"rocksweep_kind": "spectra", "kind": self.kind, "title": self.name,
+            attrs={KIND_ATTR: SPECTRA, "kind": self.kind, "title": self.name,
                    "rtol": self.rtol,
                    "search": int(self.search),
                    "runs": self.runs, "record": self.record})

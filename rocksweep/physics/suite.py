@@ -45,6 +45,7 @@ from rocksweep.vocab.ground import (
     AVGSA,
     CAV,
     D5_95,
+    H1,
     PGA,
     PGA_RATIO,
     PGV,
@@ -52,6 +53,7 @@ from rocksweep.vocab.ground import (
     PGV_RATIO,
     RATIO_OF,
     RECORD_IMS,
+    ROTD50,
     SA_DAMPING,
     SCALE_IMS,
 )
@@ -64,9 +66,6 @@ AVGSA_RANGE = (0.2, 3.0)
 DRIFT_SHARE = 0.1
 #: warn when a record is scaled by more than this factor
 MAX_FACTOR = 5.0
-#: the horizontal components a suite's IM may be taken of (``ground.scale.component``)
-H1, ROTD50 = "H1", "RotD50"
-COMPONENTS = (H1, ROTD50)
 
 
 
@@ -219,7 +218,7 @@ class Suite:
                    p: np.ndarray) -> np.ndarray:
         """The scaled record's peak |xg''| / (g tan alpha_ref): the A_ratio the kernel's
         rows take (PGA_ratio stripes: the stripe value itself)."""
-        if self.im == "PGA_ratio" and self.component == H1:
+        if self.im == PGA_RATIO and self.component == H1:
             x = np.asarray(self.levels, np.float64)[np.asarray(s, np.int64)]
             return np.broadcast_to(x, np.broadcast_shapes(
                 x.shape, np.shape(alpha_ref), np.shape(p))).copy()
