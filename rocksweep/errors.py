@@ -222,6 +222,20 @@ def is_integer(v: Any) -> bool:
     return isinstance(v, numbers.Integral) and not isinstance(v, bool)
 
 
+def is_real(v: Any) -> bool:
+    """A real number (Python's or numpy's), not a bool."""
+    return isinstance(v, numbers.Real) and not isinstance(v, bool)
+
+
+def check_type(name: str, value: Any, ok: bool, allowed: str) -> None:
+    """The Python API's one type check of an argument: unless ``ok``, a one-line TypeError
+    naming it, the value (shortened) and what is ``allowed``."""
+    if not ok:
+        text = repr(value)
+        text = text if len(text) <= 60 else f"{text[:40]}...{text[-12:]}"
+        raise TypeError(f"{name} = {text}: must be {allowed}")
+
+
 def check_integer(name: str, v: Any, error: type[Exception] = TypeError) -> int:
     """``int(v)``, or ``error("NAME = V: must be an integer")``."""
     if not is_integer(v):

@@ -41,7 +41,7 @@ SMALL = {"name": "api test", "body": BODY3, "impact": {"lam": [0.0, 0.4]},
 def _modules_after(code: str) -> list[str]:
     probe = (f"import sys\n{code}\n"
              "print('LOADED:' + ','.join(m for m in ('numba', 'h5py', 'matplotlib', 'xarray', "
-             "'scipy') if m in sys.modules))")
+             "'scipy', 'numpy', 'pandas', 'yaml', 'dask', 'tqdm') if m in sys.modules))")
     proc = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     last = proc.stdout.split("LOADED:")[-1].strip()  # after any --help text
@@ -49,8 +49,11 @@ def _modules_after(code: str) -> list[str]:
 
 
 def test_import_and_help_are_light():
-    """`import rocksweep` and `rocksweep --help` load none of the heavy libraries."""
+    """`import rocksweep`, the command line's module and `rocksweep --help` load none of
+    the heavy libraries (not even numpy: the console command sets OPENBLAS_NUM_THREADS
+    before it loads)."""
     assert _modules_after("import rocksweep; rocksweep.run, rocksweep.open") == []
+    assert _modules_after("import rocksweep.cli.main") == []
     assert _modules_after("from rocksweep.cli import main\ntry:\n    main(['--help'])\n"
                           "except SystemExit:\n    pass") == []
     assert _modules_after("from rocksweep.cli import main\ntry:\n    main(['sweep', '--help'])"
