@@ -19,7 +19,7 @@ from rocksweep.cli.options import (
     seed_option,
     set_option,
 )
-from rocksweep.compute.driver import WRITE_EVERY
+from rocksweep.compute.arguments import WRITE_EVERY
 
 
 @main.command()

@@ -13,8 +13,8 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from rocksweep.compute.arguments import CONNECT_TIMEOUT, SweepArguments
-from rocksweep.compute.driver import WRITE_EVERY, SweepReport
+from rocksweep.compute.arguments import CONNECT_TIMEOUT, WRITE_EVERY, SweepArguments
+from rocksweep.compute.driver import SweepReport
 from rocksweep.errors import ApiError, Arg, SweepError, flag
 
 if TYPE_CHECKING:
