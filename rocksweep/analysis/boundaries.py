@@ -13,8 +13,8 @@ For every panel (a value of each non-diagram axis: shape, body keys, lam) of a d
   to a relative tolerance, so the curve is not limited by the grid spacing.
 
 Rows for CSV (``a_min_rows``, ``boundary_rows``; ``analysis.files.csv_text``) export
-them; the figures are in ``rocksweep.figures.diagrams`` (``a_min_figure``, and
-``rocksweep plot --curves``).
+them; the figures are ``rocksweep.figures.a_min.a_min_figure`` and the curves of
+``rocksweep plot --curves`` (``figures.panels.draw_boundaries``).
 ``result_curves`` does it all for a result file (``rocksweep boundaries``). Units: those
 of the axes (w_over_p = omega/p, A_ratio = A/(g tan alpha_cg), eq. 2).
 """

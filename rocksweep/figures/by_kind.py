@@ -16,8 +16,9 @@ from rocksweep.compute.arguments import check_flag
 from rocksweep.errors import ApiError, Arg, PlotError, check_type, flag
 from rocksweep.figures import results
 from rocksweep.figures.calibration import calibration_figure
-from rocksweep.figures.diagrams import friction_map, sweep_figure
+from rocksweep.figures.diagrams import sweep_figure
 from rocksweep.figures.floors import floor_spectrum_figure
+from rocksweep.figures.friction import friction_map
 from rocksweep.figures.spectrum import spectra_figure
 from rocksweep.figures.style import fit_width, width_style
 from rocksweep.store.reader import as_result
