@@ -109,9 +109,8 @@ class OutputError(RocksweepError, OSError):
     """An output path that cannot be written (exists, is a device, no such directory...)."""
 
 
-# Every error class of the package, lowest layer first, each with the module that raises it.
-# Each module re-exports its own (``from rocksweep.scene.model import SceneError`` keeps
-# working); tests/test_errors.py fails on an error class defined anywhere else.
+# Every error class of the package, lowest layer first, each with the module that raises it
+# (imported from here: tests/test_errors.py fails on an error class defined anywhere else).
 
 class BodyError(RocksweepError, ValueError):
     """A body that is not physical; names the key and value (physics.bodies)."""
