@@ -54,12 +54,14 @@ class _Accessor:
 
     def as_overrides(self, which: str = "all") -> dict[str, Any]:
         """``rocksweep.calibrated_overrides(ds, which)`` of a calibration Dataset."""
+        # rocksweep.api on first use: import rocksweep does not load it
         from rocksweep.api import calibrated_overrides
 
         return calibrated_overrides(self._ds, which)
 
     def outcome_words(self) -> Any:
         """``outcome`` as words (not_run, safe, mode1, mode2), an object DataArray."""
+        # numpy: import rocksweep loads none
         import numpy as np
 
         from rocksweep.vocab.outcomes import OUTCOME_WORDS
@@ -72,6 +74,7 @@ class _Accessor:
 def accessor_class() -> type:
     """``RocksweepAccessor``: ``_Accessor`` with a method per ``rocksweep.api.ANALYSES``
     (made once, on first use: ~40 function signatures read)."""
+    # rocksweep.api on first use: import rocksweep does not load it
     from rocksweep.api import ANALYSES
 
     methods = {fn.__name__: _method(fn) for fn in ANALYSES}
@@ -80,6 +83,7 @@ def accessor_class() -> type:
 
 def register() -> None:
     """Register ``ds.rocksweep`` with xarray (loaded by now), once."""
+    # loaded by now: watch() registers once xarray is imported
     import xarray as xr
 
     if getattr(xr.Dataset, "rocksweep", None) is not accessor_class():

@@ -7,10 +7,11 @@ figures (``rocksweep.figures``). Errors name the API's arguments (``rocksweep.er
 The functions of a Dataset (``@analysis``: ``ANALYSES``) are also its methods,
 ``ds.rocksweep.<analysis>(...)`` (``rocksweep.accessor``).
 
-Nothing heavy is imported here at module level: ``import rocksweep`` and the command line's
-start-up load no numpy, numba, h5py, xarray or matplotlib (tests/api/test_api.py), so each
-function imports its room when called. The names the API builds on are imported from their
-homes (``rocksweep.compute.session.sweep_file``, ...), not from here.
+Each function imports its room when called (the one module whose imports are all inside
+its functions, by design): the rooms load numba, h5py, xarray, scipy and matplotlib, 1-6 s
+together (docs/performance.md, start-up), and one function needs a few of them. The names
+the API builds on are imported from their homes (``rocksweep.compute.session.sweep_file``,
+...), not from here.
 """
 
 from __future__ import annotations
@@ -20,9 +21,11 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from rocksweep.accessor import accessor_class
 from rocksweep.analysis.resampling import DEFAULT_CI, DEFAULT_SEED
 from rocksweep.analysis.tolerance import DEFAULT_RTOL, DEFAULT_RTOL_MANY
 from rocksweep.errors import ApiError, check_type, is_integer, is_real
+from rocksweep.outputs import shown
 from rocksweep.simulation import Simulation  # what simulate returns
 
 if TYPE_CHECKING:
@@ -45,8 +48,6 @@ def analysis(fn: Callable[..., Any]) -> Callable[..., Any]:
 def __getattr__(name: str) -> Any:
     """``RocksweepAccessor``: ``ds.rocksweep``'s class, made on first use."""
     if name == "RocksweepAccessor":
-        from rocksweep.accessor import accessor_class
-
         return accessor_class()
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
@@ -309,15 +310,13 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = N
     ``probability`` per state and lam, their ``_lo``/``_hi`` from the fragility's
     bootstrap resamples, ``annual_rate_max`` (the tail above the hazard at its largest),
     ``reason``; beyond the hazard's range the rate is bounded, never extrapolated."""
+    from rocksweep.analysis.risk import check_fragility
     from rocksweep.analysis.risk import risk as compute
 
     _check_dataset("fr", fr)
     check_type("years", years, is_real(years), "a number of years > 0")
     check_type("site", site, site is None or is_integer(site),
                "an integer row number (0 = the first site) or None")
-    from rocksweep.analysis.risk import check_fragility
-    from rocksweep.outputs import shown
-
     ds = _dataset_arg(fr, "fr")
     check_fragility(ds, shown(fr) if isinstance(fr, str | Path) else "fr")
     return compute(ds, hazard, years, site=site)

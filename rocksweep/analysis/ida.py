@@ -25,7 +25,9 @@ import dataclasses
 from typing import Any
 
 import numpy as np
+import xarray as xr
 
+from rocksweep import fields
 from rocksweep.analysis.bisection import UNDECIDED, bisect_thresholds
 from rocksweep.analysis.tolerance import DEFAULT_RTOL_MANY
 from rocksweep.compute.single import run_point
@@ -161,10 +163,6 @@ def _brackets(s: _Stripes) -> _Brackets:
 
 def _dataset(result: Any, s: _Stripes, b: _Brackets, runs: np.ndarray,
              unresolved: np.ndarray, rtol: float) -> Any:
-    import xarray as xr
-
-    from rocksweep import fields
-
     im, shape = s.im, s.lead
     lo, hi = b.lo, b.hi
     est = np.where(np.isfinite(lo), np.sqrt(lo * hi), hi)

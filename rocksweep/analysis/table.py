@@ -24,14 +24,17 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+import pandas as pd
 import xarray as xr
 
 from rocksweep.analysis.kinds import dataset_kind
+from rocksweep.analysis.states import trust
 from rocksweep.errors import TableError
 from rocksweep.physics.bodies import G
 from rocksweep.vocab.axes import ALPHA_KEYS
 from rocksweep.vocab.ground import RECORD_IMS, SA, SCALE_IMS
 from rocksweep.vocab.kinds import BOUNDARIES, FRAGILITY, IDA, IM_EFFICIENCY, RISK, SPECTRA, SWEEP
+from rocksweep.vocab.outcomes import OUTCOME_WORDS, status_words
 
 __all__ = ["ROW_VARIABLE", "table"]
 
@@ -52,14 +55,10 @@ def table(ds: xr.Dataset) -> Any:
     """The tidy ``pandas.DataFrame`` of a rocksweep Dataset (module docstring): one row
     per run of a sweep (prod of outcome's dim sizes rows), or per entry of an analysis's
     main variable. ``.attrs["units"]``: column -> units."""
-    import pandas as pd
-
     kind = dataset_kind(ds)
     if kind is None:
         raise TableError("not a rocksweep Dataset (a sweep or an analysis's result)")
     if kind == SWEEP:  # every row is written; a partial file's are said to be missing
-        from rocksweep.analysis.states import trust
-
         trust(ds, "table")
     main = ROW_VARIABLE[kind]
     main = next((m for m in (main if isinstance(main, tuple) else (main,)) if m in ds),
@@ -123,8 +122,6 @@ def table(ds: xr.Dataset) -> Any:
                 cols[label] = flat(ds["record_sa"].isel(period=i)) * f
                 units[label] = SCALE_IMS[SA]
     if kind == SWEEP and "status" in cols:  # the codes in words, beside the codes
-        from rocksweep.vocab.outcomes import OUTCOME_WORDS, status_words
-
         cols["outcome_word"] = np.array([OUTCOME_WORDS.get(int(c), str(c))
                                          for c in cols["outcome"]], dtype=object)
         cols["status_words"] = np.array([",".join(status_words(int(b))) for b in

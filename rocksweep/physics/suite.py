@@ -38,7 +38,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rocksweep.errors import SuiteError
+from rocksweep.physics import intensity
 from rocksweep.physics.bodies import G
+from rocksweep.physics.path import rotd50_peaks
 from rocksweep.physics.records import GroundRecord
 from rocksweep.vocab.ground import (
     ARIAS,
@@ -242,8 +244,6 @@ def make_suite(records: list[GroundRecord], names: list[str], im: str | None,
     AvgSa (default ``AVGSA_RANGE`` times ``period``, or times 1 s without one). A record
     whose IM to scale is not a finite number > 0 (PGV 0, Sa 0) is a ``SuiteError`` naming
     its file."""
-    from rocksweep.physics import intensity  # scipy.signal: loaded by suite scenes only
-
     n = len(records)
     pga = np.empty(n)
     pgv = np.empty(n)
@@ -296,9 +296,6 @@ def rotd50_im(h1: GroundRecord, h2: GroundRecord, im: str | None, period: float)
     (and PGV_ratio's) [m/s] of the velocities at the samples, or Sa(period) [g] at 5%
     damping of the oscillator's responses (its free vibration one period past the record
     included): the median over the angles 0..179 deg of the peak of the projected series."""
-    from rocksweep.physics import intensity
-    from rocksweep.physics.path import rotd50_peaks
-
     n = max(h1.npts, h2.npts)
     a1, a2 = (np.pad(r.acc, (0, n - r.npts)) for r in (h1, h2))
     if im in (PGA, PGA_RATIO):

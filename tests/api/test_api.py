@@ -60,6 +60,22 @@ def test_import_and_help_are_light():
                           "\nexcept SystemExit:\n    pass") == []
 
 
+def test_the_command_line_starts_without_the_facade_the_driver_or_outputs():
+    """`import rocksweep.cli.main` (all `rocksweep --help` imports) loads none of the API
+    facade (rocksweep.api: on first use), the sweep driver or outputs.py: they would add
+    23% to its start-up where no .pyc is written, 10% with .pyc files (docs/performance.md,
+    the command line's imports); a command loads them when it runs."""
+    code = ("import sys, rocksweep.cli.main\n"
+            "print(','.join(m for m in ('rocksweep.api', 'rocksweep.simulation', "
+            "'rocksweep.compute.driver', 'rocksweep.outputs') if m in sys.modules))")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == ""
+    code = "import rocksweep, sys\nrocksweep.run\nprint('rocksweep.api' in sys.modules)"
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.stdout.split() == ["True"], proc.stderr
+
+
 def test_public_names_have_docstrings_and_version(cli):
     for obj in (rocksweep.run, rocksweep.open, rocksweep.simulate, rocksweep.RocksweepError,
                 rocksweep.Simulation, sweep_file):
