@@ -7,9 +7,9 @@ figures (``rocksweep.figures``). Errors name the API's arguments (``rocksweep.er
 The functions of a Dataset (``@analysis``: ``ANALYSES``) are also its methods,
 ``ds.rocksweep.<analysis>(...)`` (``rocksweep.accessor``).
 
-Each function imports its room when called (the one module whose imports are all inside
-its functions, by design): the rooms load numba, h5py, xarray, scipy and matplotlib, 1-6 s
-together (docs/performance.md, start-up), and one function needs a few of them. The names
+Each function imports its room when called: the rooms load numba, h5py, xarray, scipy and
+matplotlib, 0.1-2 s each (docs/performance.md, the command line's imports), and one
+function needs a few of them. The names
 the API builds on are imported from their homes (``rocksweep.compute.session.sweep_file``,
 ...), not from here.
 """
