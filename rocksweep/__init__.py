@@ -35,6 +35,7 @@ as both rocksweep and xarray are imported, in either order.
 
 from __future__ import annotations
 
+import importlib
 from typing import TYPE_CHECKING
 
 from rocksweep.accessor import watch
@@ -91,12 +92,15 @@ def _version() -> str:
 
 def __getattr__(name: str) -> object:
     """The API's functions and ``Simulation`` on first use (``rocksweep.api``: ~25 kB of
-    source the command line's start-up need not compile), and ``__version__``
+    source the command line's start-up need not compile), the modules ``import rocksweep``
+    used to load (``rocksweep.api``, ...), and ``__version__``
     (importlib.metadata costs ~20 ms of every command)."""
     if name == "Simulation":
         from rocksweep import simulation
 
         value = simulation.Simulation
+    elif name in ("api", "simulation", "analysis"):  # bound by import rocksweep before
+        value = importlib.import_module(f"rocksweep.{name}")
     elif name in _API:
         from rocksweep import api
 

@@ -71,9 +71,11 @@ def test_the_command_line_starts_without_the_facade_the_driver_or_outputs():
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == ""
-    code = "import rocksweep, sys\nrocksweep.run\nprint('rocksweep.api' in sys.modules)"
+    # loaded on first use: through a function or the module's old name alike
+    code = ("import rocksweep, sys\nprint('rocksweep.api' in sys.modules, "
+            "rocksweep.api.open is rocksweep.open, 'rocksweep.api' in sys.modules)")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
-    assert proc.stdout.split() == ["True"], proc.stderr
+    assert proc.stdout.split() == ["False", "True", "True"], proc.stderr
 
 
 def test_public_names_have_docstrings_and_version(cli):
