@@ -8,7 +8,8 @@ keywords. Two more: ``as_overrides`` (``rocksweep.calibrated_overrides`` of a ca
 and ``outcome_words``.
 
 Registered with xarray once per process, without importing it: ``import rocksweep`` never
-loads xarray (~0.3 s, its pandas and numpy; the command line's start-up would pay it).
+loads xarray (with pandas 1.3 G instructions, 0.4-1.5 s; the command line's start-up would
+pay it: docs/performance.md).
 ``watch()`` (called by ``import rocksweep``) registers at once if xarray is loaded, else
 when it is: a finder first on ``sys.meta_path`` lets the real finders find xarray and
 registers the accessor when the module has run (the post-import hook of ``wrapt`` and
@@ -73,7 +74,7 @@ class _Accessor:
 @functools.cache
 def accessor_class() -> type:
     """``RocksweepAccessor``: ``_Accessor`` with a method per ``rocksweep.api.ANALYSES``
-    (made once, on first use: ~40 function signatures read)."""
+    (made once, on first use)."""
     # rocksweep.api on first use: import rocksweep does not load it
     from rocksweep.api import ANALYSES
 
