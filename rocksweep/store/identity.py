@@ -67,7 +67,7 @@ def vertical_attrs(vertical, record) -> dict:
     """A record's vertical component (``ground.vertical``) as the file states it
     (``vertical_*`` attributes): ``record_attrs`` of its file and its IMs, PGA_v [g] and
     the V/H ratio (``records.vertical_ims``)."""
-    from rocksweep.physics.records import vertical_ims
+    from rocksweep.physics.ground_motion import vertical_ims
 
     return {**record_attrs(vertical), **vertical_ims(vertical, record)}
 
