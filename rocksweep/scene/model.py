@@ -167,6 +167,16 @@ class Scene:
                                               and self.suite.vertical_acts)
                 or any(a.name == _HARMONIC[0] for a in self.axes))
 
+    def ground_files(self) -> dict[str, GroundRecord]:
+        """The files of the scene's one ground record by role: ``record`` and, when
+        given, its vertical component (``vertical``, ``ground.vertical``); what a result
+        file keeps and states under those names (``store.format``, ``store.identity``);
+        {} without one record (a suite keeps its own)."""
+        if self.record is None:
+            return {}
+        return {"record": self.record,
+                **({"vertical": self.vertical} if self.vertical is not None else {})}
+
     def option(self, name: str) -> Any:
         """A pulse option's value (cycles, gamma, nu [deg]): the scene's or the default."""
         for a in self.axes:
