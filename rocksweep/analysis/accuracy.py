@@ -306,7 +306,7 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
 
     _no_suite(scene)
     cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
-    # a record's samples (and its vertical's) ride on each row
+    # the excitation's samples ride on each row
     rows_all = cr.with_samples()
     ground = scene.ground  # the Ricker, MP and records run the GROUND variants
     n = len(flat)

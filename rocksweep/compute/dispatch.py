@@ -38,8 +38,8 @@ def run_variant(rows: np.ndarray, kind: int, level: int, ground: int, refine: in
     """Result rows float64[n, N_OUT] of parameter rows float64[n, N_PAR (+ samples)] run
     through the kernel variant of body ``kind`` (``physics.points.kernel_kind``),
     bookkeeping ``level`` (``kernel.layout.LEVEL_*``) and ``ground``
-    (``kernel.layout.GROUND_*``: the variants of Ricker, MP and samples, and of a vertical
-    ground acceleration; ``ground_motion.shared_ground``).
+    (``kernel.layout.GROUND_*``: the variants of Ricker, MP and samples, and of a moving
+    gravity g + a_v; ``ground_motion.shared_ground``).
 
     refine: close calls re-run finer, up to this many refinements (``compute.certify``,
     ``Numerics.refine``; 0: none). excitation: the excitation all rows share, whose

@@ -307,7 +307,7 @@ def fill_rows(rows: np.ndarray, bodies: Bodies, excitation: Excitation, columns:
     """Fill the parameter rows float64[n, N_PAR] (out) of n points that share one
     excitation, vectorised over them: the bodies' part (``Bodies``), the ground motion's
     (its time scale, length and steps: ``run_cost``, or ``record_cost`` for samples, which
-    the rows then still lack: ``Excitation.with_samples``; its vertical:
+    the rows then still lack: ``Excitation.with_samples``; gravity g + a_v:
     ``Excitation.fill_gravity``), the points' own numbers (``Columns``; PAR_THETA0..
     PAR_U_DOT0 in SI, p = 1) and the numerics' settings."""
     ex = excitation

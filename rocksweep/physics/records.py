@@ -33,8 +33,8 @@ A_ratio * g tan(alpha_cg): xg''(t) = A_ratio g tan(alpha_cg) acc(t) / pga. For a
 rocking frequency p [rad/s] the kernel's time is p t, so the record's samples fall every
 p * dt in kernel time (``kernel_series``).
 
-Every component of a record (a second horizontal, the vertical, positive up) is read by
-the same ``read_record``; how the kernel takes them: ``physics.ground_motion``.
+Each component of a record (the two horizontals, the up component, positive upwards) is
+read by the same ``read_record``; how the kernel takes them: ``physics.ground_motion``.
 """
 
 from __future__ import annotations
