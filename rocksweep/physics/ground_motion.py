@@ -255,16 +255,13 @@ class Excitations:
     shipped to another process (dask) starts empty."""
 
     def __init__(self) -> None:
-        self.__setstate__({})
-
-    def __getstate__(self) -> dict:
-        return {}
-
-    def __setstate__(self, state: dict) -> None:
         self._kept: OrderedDict = OrderedDict()
         self._making: dict = {}
         self._bytes = 0
         self._lock = threading.Lock()
+
+    def __reduce__(self) -> tuple:  # pickled (dask ships the scene) and copied: empty
+        return (Excitations, ())
 
     def __len__(self) -> int:
         return len(self._kept)

@@ -5,6 +5,7 @@ kernel's ground code is one rule (the scene's the most general of its points')."
 
 from __future__ import annotations
 
+import pickle
 from pathlib import Path
 
 import numpy as np
@@ -88,6 +89,18 @@ def test_a_folder_suite_computes_each_records_vertical_once(tmp_path, counted):
     excitations = {scene.excitation({**first, "record": n}) for n in scene.suite.names}
     assert len(excitations) == 2 and all(ex.vertical_acc is not None for ex in excitations)
     assert counted["vertical"] == 2
+
+
+def test_a_scene_shipped_to_another_process_makes_its_motions_there(tmp_path, counted):
+    """dask pickles the scene: the copy starts with no motions and makes its own, once,
+    with the same rows."""
+    scene = floor_scene(tmp_path, [0.4])
+    rows = Grid(scene).rows(0, 4).rows
+    copy = pickle.loads(pickle.dumps(scene))
+    assert len(copy.motions) == 0 and len(scene.motions) == 1
+    assert np.array_equal(Grid(copy).rows(0, 4).rows, rows, equal_nan=True)
+    Grid(copy).rows(0, 4)
+    assert len(copy.motions) == 1 and counted == {"floor": 2, "vertical": 2}
 
 
 @pytest.mark.parametrize(("pulse", "scene_code", "codes"), [
