@@ -14,6 +14,7 @@ from the result shape, which leaves the flat index unchanged.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -122,6 +123,7 @@ class Grid:
         self._i_init = [names.index(k) if k in names else None for k in INITIAL]
         # the axes a point's excitation depends on (``Scene.excitation_axes``)
         self._motion_pos = [names.index(k) for k in scene.excitation_axes]
+        self._motion_dims = [self.full_shape[i] for i in self._motion_pos]
         self._values = [np.asarray(a.values, float)
                         if i not in (self._i_shape, self._i_rec, self._i_law) else None
                         for i, a in enumerate(scene.axes)]
@@ -183,14 +185,17 @@ class Grid:
         """(which: int64[n], the chunk's distinct excitations): each asked of the scene
         once (``Scene.excitation``: made once a run)."""
         axes = self.scene.axes
-        if not self._motion_pos:
-            return np.zeros(n, np.int64), (self.scene.excitation({}),)
-        key = np.stack([np.asarray(multi[i], np.int64) for i in self._motion_pos], 1)
-        distinct, inv = np.unique(key, axis=0, return_inverse=True)
-        excitations = tuple(self.scene.excitation({axes[i].name: axes[i].values[int(j)]
-                                                   for i, j in zip(self._motion_pos, row,
-                                                                   strict=True)})
-                            for row in distinct)
+        pos, dims = self._motion_pos, self._motion_dims
+        if math.prod(dims) == 1:  # one excitation for the whole grid
+            return np.zeros(n, np.int64), (self.scene.excitation(
+                {axes[i].name: axes[i].values[0] for i in pos}),)
+        code = np.ravel_multi_index([multi[i] for i in pos], dims)
+        distinct, inv = np.unique(code, return_inverse=True)
+        excitations = tuple(
+            self.scene.excitation({axes[i].name: axes[i].values[int(j)]
+                                   for i, j in zip(pos, np.unravel_index(c, dims),
+                                                   strict=True)})
+            for c in distinct.tolist())
         return inv.reshape(-1).astype(np.int64), excitations
 
     def _columns(self, multi: tuple, bodies: Bodies, excitations: tuple[Excitation, ...],
