@@ -80,11 +80,6 @@ CACHE_BYTES = 256 << 20
 SAME_DT = 1e-9
 
 
-def shape_code(shape: str) -> float:
-    """The kernel's code (PAR_SHAPE) of a pulse shape, RECORD or FREE."""
-    return _SHAPE_CODE[shape]
-
-
 def ground_code(shape: str, vertical: bool) -> int:
     """The kernel variants' ground code (``layout.GROUND_*``) a motion needs: GROUND_VERTICAL
     with a vertical ground acceleration, GROUND_PULSE for the paper's sine and cosine (n

@@ -256,16 +256,14 @@ class Bodies:
         first: dict[int, int] = {}
         index = np.array([first.setdefault(id(b), len(first)) for b in bodies], np.int64)
         distinct = list({id(b): b for b in bodies}.values())
-        n = len(distinct)
-        rows = np.empty((n, L.N_PAR))
+        rows = np.empty((len(distinct), L.N_PAR))
         for j, b in enumerate(distinct):
             rows[j] = body_row(b)
-        return cls(rows, np.array([body_omega_rock(b) for b in distinct], float).reshape(n),
-                   np.array([b.alpha_ref for b in distinct], float).reshape(n),
-                   np.array([b.E_ref for b in distinct], float).reshape(n),
-                   np.array([b.u_cr for b in distinct], float).reshape(n),
-                   np.array([kernel_kind(b) for b in distinct], np.int64).reshape(n)
-                   ).take(index)
+        return cls(rows, np.array([body_omega_rock(b) for b in distinct], float),
+                   np.array([b.alpha_ref for b in distinct], float),
+                   np.array([b.E_ref for b in distinct], float),
+                   np.array([b.u_cr for b in distinct], float),
+                   np.array([kernel_kind(b) for b in distinct], np.int64)).take(index)
 
     def take(self, index: np.ndarray) -> Bodies:
         """The entries at ``index`` (int64[m] or bool[n])."""
