@@ -63,7 +63,9 @@ class ChunkResult:
     """Results of the points ``start <= i < stop`` (flat indices).
 
     arrays: name -> array[stop - start] (``Scene.variables``); seconds: wall time of the
-    chunk in its worker; cpu_seconds: CPU time of the worker thread that ran it.
+    chunk in its worker; cpu_seconds: CPU time of the worker thread that ran it;
+    refine_evaluations: RK4 evaluations of the certification's runs of its points (in
+    their steps and event_steps too: ``fields`` ``refine_evaluations``).
     """
 
     start: int
@@ -71,6 +73,7 @@ class ChunkResult:
     arrays: dict[str, np.ndarray]
     seconds: float
     cpu_seconds: float = 0.0
+    refine_evaluations: int = 0
 
 
 class Grid:
