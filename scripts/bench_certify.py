@@ -71,8 +71,10 @@ def sweep_once(name: str, res: int, jobs: int, adaptive: bool) -> dict:
     arr, rep = sweep_arrays(sc, jobs=jobs, adaptive=ad.Options() if adaptive else None)
     wall = time.perf_counter() - t0
     computed = rep.adaptive.computed if adaptive else int(arr["outcome"].size)
+    # the certification's share (reports before it was counted have none: -1)
+    refine = int(getattr(rep, "refine_evaluations", -1))
     return {"evals": evaluations(arr), "computed": computed, "wall": wall,
-            "cpu": rep.cpu_s, "arrays": arr}
+            "cpu": rep.cpu_s, "refine": refine, "arrays": arr}
 
 
 def rules(name: str, res: int, arr: dict, jobs: int) -> dict:
@@ -201,14 +203,18 @@ def main() -> None:
                   f"(load average {load:.2f} -> {os.getloadavg()[0]:.2f})", flush=True)
     this = sides["this"]
     other = sides["other"]
-    print("| figure | RK4 evaluations | computed | wall s (best) | cpu s |"
+    print("| figure | RK4 evaluations | of them certification | computed | wall s (best) "
+          "| cpu s |"
           + (" other's evaluations | ratio | other's wall s | ratio |" if other else ""))
     tot = {"e": 0, "w": 0.0, "oe": 0, "ow": 0.0}
     for name in args.figures:
         e = this[0][name]["evals"]
         w = min(r[name]["wall"] for r in this)
-        line = (f"| {name} | {e / 1e6:.1f}M | {this[0][name]['computed']} | {w:.2f} | "
-                f"{this[0][name]['cpu']:.1f} |")
+        r = this[0][name]["refine"]
+        share = (f"{r / 1e6:.1f}M ({e / (e - r):.3f}x the points' own)" if r >= 0
+                 else "not counted")
+        line = (f"| {name} | {e / 1e6:.1f}M | {share} | {this[0][name]['computed']} | "
+                f"{w:.2f} | {this[0][name]['cpu']:.1f} |")
         tot["e"] += e
         tot["w"] += w
         if other:
@@ -219,7 +225,7 @@ def main() -> None:
             line += f" {oe / 1e6:.1f}M | {e / oe:.3f} | {ow:.2f} | {w / ow:.3f} |"
         print(line)
     if other:
-        print(f"| all four | {tot['e'] / 1e6:.1f}M | | {tot['w']:.2f} | | "
+        print(f"| all four | {tot['e'] / 1e6:.1f}M | | | {tot['w']:.2f} | | "
               f"{tot['oe'] / 1e6:.1f}M | {tot['e'] / tot['oe']:.3f} | {tot['ow']:.2f} | "
               f"{tot['w'] / tot['ow']:.3f} |")
     if args.rules:
