@@ -745,13 +745,20 @@ def run_on_function(plan: Plan, evaluate: Callable[[np.ndarray, Batch], np.ndarr
 class BatchResult:
     """Results of some points of a batch: flat: int64[n] (increasing), arrays: name ->
     array[n] (``rocksweep.compute.sweep.VARIABLES``), seconds / cpu_seconds of the chunk,
-    refine_evaluations: the RK4 evaluations of its certification (``ChunkResult``)."""
+    refine_evaluations: int64[n], the RK4 evaluations of each point's certification, or
+    None (``ChunkResult``)."""
 
     flat: np.ndarray
     arrays: dict[str, np.ndarray]
     seconds: float
     cpu_seconds: float
-    refine_evaluations: int = 0
+    refine_evaluations: np.ndarray | None = None
+
+    @property
+    def refine_total(self) -> int:
+        """The RK4 evaluations of the certification of its points (0: none counted)."""
+        r = self.refine_evaluations
+        return 0 if r is None else int(r.sum())
 
 
 class Subset:

@@ -111,7 +111,7 @@ def drive(sf, path: Path | None, report: SweepReport, t0: float,
         raise
     report.wall_s = time.perf_counter() - t0
     report.attrs = sf.finish(report.wall_s, report.cpu_s,
-                                     refine_evaluations=report.refine_evaluations)
+                             refine_evaluations=report.refine_evaluations)
     if path is None:
         report.image = sf.image()
     sf.close()
@@ -246,7 +246,8 @@ def every_point_loop(sf, report: SweepReport, _options: None, *, jobs: int, back
             for res in sw.run_chunks(sf.grid, chunks, lvl, jobs, backend, scheduler):
                 pending.append(res)
                 report.cpu_s += res.cpu_seconds
-                report.refine_evaluations += res.refine_evaluations
+                if res.refine_evaluations is not None:
+                    report.refine_evaluations += int(res.refine_evaluations.sum())
                 report.computed += res.stop - res.start
                 bar.update(res.stop - res.start)
                 raise_pending()  # this chunk is kept: written on the way out
@@ -350,7 +351,7 @@ def adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backe
                 pending.append(res)
                 pending_flags.append(flags)
                 report.cpu_s += res.cpu_seconds
-                report.refine_evaluations += res.refine_evaluations
+                report.refine_evaluations += res.refine_total
                 report.computed += len(res.flat)
                 bar.update(len(res.flat))
                 raise_pending()  # this chunk is kept: written on the way out

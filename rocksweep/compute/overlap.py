@@ -8,7 +8,6 @@ time with the audit candidates, which are known before the sweep starts.
 
 from __future__ import annotations
 
-from collections import deque
 from collections.abc import Iterator
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 
@@ -17,6 +16,33 @@ import numpy as np
 from rocksweep.compute import sweep as sw
 from rocksweep.compute.adaptive import FILLED, BatchResult, Plan, Subset, audit_mask
 from rocksweep.scene.grid import Grid
+
+# A spare chunk's length [s] at the pace of the chunks so far: a batch planned meanwhile
+# may wait this long for a worker; at ~50 us a point (the four figures) about 400 points.
+SPARE_SECONDS = 0.02
+# ... at least this many points (a chunk's own Python costs ~1 ms)
+SPARE_MIN = 16
+
+
+def _member(x: np.ndarray, sorted_want: np.ndarray) -> np.ndarray:
+    """bool[len(x)]: which of x are in sorted_want (increasing): a binary search each, not
+    a sort of both (np.isin) for every small chunk."""
+    if sorted_want.size == 0:
+        return np.zeros(x.shape, bool)
+    pos = np.minimum(np.searchsorted(sorted_want, x), sorted_want.size - 1)
+    return sorted_want[pos] == x
+
+
+def _merged(parts: list[BatchResult]) -> BatchResult:
+    """One result of several (times added; flat in no particular order)."""
+    if len(parts) == 1:
+        return parts[0]
+    refine = [p.refine_evaluations for p in parts]
+    return BatchResult(np.concatenate([p.flat for p in parts]),
+                       {k: np.concatenate([p.arrays[k] for p in parts])
+                        for k in parts[0].arrays},
+                       sum(p.seconds for p in parts), sum(p.cpu_seconds for p in parts),
+                       None if any(r is None for r in refine) else np.concatenate(refine))
 
 
 class Runner:
@@ -31,7 +57,9 @@ class Runner:
     results wait in memory until a batch asks for their points (``run``), which then gets
     them as if they had just been computed: what the state machine sees, and so the
     result, is unchanged (a point's result depends only on the point). A batch's own
-    chunks go first: a spare chunk is started only while fewer chunks than workers run.
+    chunks go first: a spare chunk is started only while fewer chunks than workers run,
+    and it is short (``SPARE_SECONDS`` at the points' pace so far), so that the next
+    batch, on the sweep's critical path, waits for no long one.
     """
 
     def __init__(self, grid: Grid, plan: Plan, computed: np.ndarray, jobs: int = 2,
@@ -39,9 +67,10 @@ class Runner:
         self.grid, self.level = grid, sw.level(grid.scene)
         self.workers = sw.effective_jobs(jobs)
         self.chunk_size = chunk_size
-        spare = np.flatnonzero(audit_mask(plan) & (np.asarray(computed).ravel() == FILLED))
-        size = chunk_size or sw.auto_chunk_size(spare.size, self.workers)
-        self.spare = deque(spare[i:i + size] for i in range(0, spare.size, size))
+        # the audit candidates not computed yet, in order (int64[k])
+        self.spare = np.flatnonzero(audit_mask(plan)
+                                    & (np.asarray(computed).ravel() == FILLED))
+        self.pace = [0.0, 0]  # seconds, points of the chunks so far
         self.ready: list[BatchResult] = []  # spare chunks done, points not asked for yet
         self.running: dict = {}  # future -> (flat, spare?)
         self.pool = ThreadPoolExecutor(self.workers)
@@ -54,57 +83,53 @@ class Runner:
         return BatchResult(flat, r.arrays, r.seconds, r.cpu_seconds, r.refine_evaluations)
 
     def _top_up(self) -> None:
-        while self.spare and len(self.running) < self.workers:
-            self._submit(self.spare.popleft(), True)
+        while self.spare.size and len(self.running) < self.workers:
+            per_point = self.pace[0] / self.pace[1] if self.pace[1] else 1e-3
+            n = max(SPARE_MIN, int(SPARE_SECONDS / max(per_point, 1e-9)))
+            n = min(n, self.chunk_size or n)
+            self._submit(self.spare[:n], True)
+            self.spare = self.spare[n:]
 
-    def _take(self, want: np.ndarray, res: BatchResult) -> tuple[BatchResult | None,
-                                                                    BatchResult | None]:
-        """(the part of res at points in want, the rest), each None if empty."""
-        hit = np.isin(res.flat, want)
-        parts = []
-        for m in (hit, ~hit):
-            if not m.any():
-                parts.append(None)
-            elif m.all():
-                parts.append(res)
-            else:  # times and certification counted with the part asked for first
-                share = m.mean() if m is hit else 0.0
-                sub = {k: v[m] for k, v in res.arrays.items()}
-                parts.append(BatchResult(res.flat[m], sub, res.seconds * share,
-                                         res.cpu_seconds * share,
-                                         int(round(res.refine_evaluations * share))
-                                         if m is hit else 0))
-        if parts[0] is not None and parts[1] is not None:  # the rest keeps what is left
-            rest = parts[1]
-            parts[1] = BatchResult(rest.flat, rest.arrays, res.seconds - parts[0].seconds,
-                                   res.cpu_seconds - parts[0].cpu_seconds,
-                                   res.refine_evaluations - parts[0].refine_evaluations)
-        return parts[0], parts[1]
+    def _take(self, want: np.ndarray, res: BatchResult
+              ) -> tuple[BatchResult | None, BatchResult | None]:
+        """(the part of res at points in want, the rest), each None if empty; the chunk's
+        times go with the part asked for first."""
+        hit = _member(res.flat, want)
+        if hit.all() or not hit.any():
+            return (res, None) if hit.all() else (None, res)
+
+        def part(m: np.ndarray, seconds: float, cpu: float) -> BatchResult:
+            r = res.refine_evaluations
+            return BatchResult(res.flat[m], {k: v[m] for k, v in res.arrays.items()},
+                               seconds, cpu, None if r is None else r[m])
+
+        return part(hit, res.seconds, res.cpu_seconds), part(~hit, 0.0, 0.0)
 
     def run(self, flat: np.ndarray) -> Iterator[BatchResult]:
         """The results of the points ``flat`` (int64[n], increasing), in chunks, as they
         are ready (spare results first)."""
         want = np.asarray(flat, np.int64)
         todo = np.ones(want.size, bool)
-        kept = []
-        for res in self.ready:
-            got, rest = self._take(want, res)
-            if rest is not None:
-                kept.append(rest)
+        if self.ready:
+            got, rest = self._take(want, _merged(self.ready))
+            self.ready = [] if rest is None else [rest]
             if got is not None:
+                order = np.argsort(got.flat, kind="stable")  # batches give increasing flat
+                got = BatchResult(got.flat[order], {k: v[order] for k, v in got.arrays.items()},
+                                  got.seconds, got.cpu_seconds,
+                                  None if got.refine_evaluations is None
+                                  else got.refine_evaluations[order])
                 todo[np.searchsorted(want, got.flat)] = False
                 yield got
-        self.ready = kept
         for part, spare in list(self.running.values()):  # spare chunks on their way
-            if spare and np.isin(part, want).any():
-                todo[np.isin(want, part)] = False
+            if spare:
+                todo[np.searchsorted(want, part[_member(part, want)])] = False
         need = want[todo]
         size = self.chunk_size or sw.auto_chunk_size(need.size, self.workers)
         for i in range(0, need.size, size):
             self._submit(need[i:i + size], False)
-        self.spare = type(self.spare)(c[~np.isin(c, want)] for c in self.spare)
-        self.spare = type(self.spare)(c for c in self.spare if c.size)
-        left = int(todo.sum()) + sum(int(np.isin(p, want).sum())
+        self.spare = self.spare[~_member(self.spare, want)]
+        left = int(todo.sum()) + sum(int(_member(p, want).sum())
                                       for p, sp in self.running.values() if sp)
         self._top_up()
         while left > 0:
@@ -112,6 +137,8 @@ class Runner:
             for f in done:
                 part, spare = self.running.pop(f)
                 res = f.result()
+                self.pace[0] += res.seconds
+                self.pace[1] += res.flat.size
                 if spare:
                     got, rest = self._take(want, res)
                     if rest is not None:
@@ -125,7 +152,7 @@ class Runner:
 
     def close(self) -> None:
         """Stop: spare chunks not started are dropped, running ones finish."""
-        self.spare.clear()
+        self.spare = self.spare[:0]
         for f in list(self.running):
             f.cancel()
         self.pool.shutdown(wait=True)

@@ -86,7 +86,7 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
         half = run_rows(cr, fields.check_rows(cr.rows), level, scene)
         arrays.update(fields.convert_check(outs, half, cr.alpha_ref))
     return ChunkResult(start, stop, arrays, time.perf_counter() - t0,
-                       time.thread_time() - c0, int(outs[:, L.OUT_REFINE_EVALS].sum()))
+                       time.thread_time() - c0, outs[:, L.OUT_REFINE_EVALS].astype(np.int64))
 
 
 def run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene,
@@ -130,7 +130,8 @@ def merge_contiguous(results: Iterable[ChunkResult]) -> list[ChunkResult]:
                 last.start, r.stop,
                 {k: np.concatenate((v, r.arrays[k])) for k, v in last.arrays.items()},
                 last.seconds + r.seconds, last.cpu_seconds + r.cpu_seconds,
-                last.refine_evaluations + r.refine_evaluations)
+                None if last.refine_evaluations is None or r.refine_evaluations is None
+                else np.concatenate((last.refine_evaluations, r.refine_evaluations)))
         else:
             merged.append(r)
     return merged

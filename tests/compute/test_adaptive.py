@@ -110,13 +110,14 @@ def test_spare_workers_compute_the_audit_early_without_changing_anything(block_l
         return real(grid, start, stop, level)
 
     monkeypatch.setattr(sw, "run_chunk", counted)
-    a, sa = adaptive(sc, jobs=2, chunk_size=5)
+    a, ra = sweep_arrays(sc, jobs=2, chunk_size=5, adaptive=ad.Options())
     assert sorted(runs) == sorted(set(runs))  # every point once
-    assert len(runs) == sa.computed
+    assert len(runs) == ra.adaptive.computed
     monkeypatch.setattr(ov, "Runner", lambda *args, **kw: None)  # each batch alone
-    b, sb = adaptive(sc, jobs=2, chunk_size=5)
+    b, rb = sweep_arrays(sc, jobs=2, chunk_size=5, adaptive=ad.Options())
     assert_same(a, b)
-    assert sa.batches == sb.batches
+    assert ra.adaptive.batches == rb.adaptive.batches
+    assert ra.refine_evaluations == rb.refine_evaluations
 
 # --- planted maps (synthetic classifier) --------------------------------------------------
 

@@ -253,15 +253,23 @@ def test_adaptive_sweeps_certify_as_the_full_sweep_does():
     point has the full sweep's result, status bits (refined) included, and some of them
     were close calls."""
     import rocksweep.compute.adaptive as ad
+    from rocksweep.compute.dispatch import run_variant
+    from rocksweep.scene.grid import Grid
 
     sc = parse_scene(ADAPTIVE)
     full = sweep_arrays(sc)[0]
-    arr, _ = sweep_arrays(sc, jobs=1, adaptive=ad.Options())
+    arr, rep = sweep_arrays(sc, jobs=2, chunk_size=3, adaptive=ad.Options())
     c = arr["computed"] > 0
     for k in ("outcome", "status", "steps", "t_overturn"):
         np.testing.assert_array_equal(arr[k][c], full[k][c], err_msg=k)
     assert ((arr["status"][c] & L.STATUS_REFINED) != 0).any()
     np.testing.assert_array_equal(arr["outcome"], full["outcome"])
+    # its count of the certification's evaluations: those of its computed points, each
+    # once (spare workers compute some early, in chunks split between batches)
+    cr = Grid(sc).rows_at(np.flatnonzero(c.ravel()))
+    own = run_variant(cr.rows, int(cr.kinds[0]), L.LEVEL_OUTCOME, sc.ground,
+                      sc.numerics.refine)
+    assert rep.refine_evaluations == own[:, L.OUT_REFINE_EVALS].sum() > 0
 
 
 def test_a_file_states_what_its_certification_cost(tmp_path):
