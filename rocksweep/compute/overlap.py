@@ -18,8 +18,10 @@ from rocksweep.compute.adaptive import FILLED, BatchResult, Plan, Subset, audit_
 from rocksweep.scene.grid import Grid
 
 # A spare chunk's length [s] at the pace of the chunks so far: a batch planned meanwhile
-# may wait this long for a worker; at ~50 us a point (the four figures) about 400 points.
-SPARE_SECONDS = 0.02
+# may wait this long for a worker; at ~50 us a point (the four figures) about 1000 points
+# (shorter chunks cost more of their own Python: ~1 s of CPU more on Figure 3(b) at 1000 x
+# 1000 x 3 lam at 0.02 s)
+SPARE_SECONDS = 0.05
 # ... at least this many points (a chunk's own Python costs ~1 ms)
 SPARE_MIN = 16
 
@@ -31,18 +33,6 @@ def _member(x: np.ndarray, sorted_want: np.ndarray) -> np.ndarray:
         return np.zeros(x.shape, bool)
     pos = np.minimum(np.searchsorted(sorted_want, x), sorted_want.size - 1)
     return sorted_want[pos] == x
-
-
-def _merged(parts: list[BatchResult]) -> BatchResult:
-    """One result of several (times added; flat in no particular order)."""
-    if len(parts) == 1:
-        return parts[0]
-    refine = [p.refine_evaluations for p in parts]
-    return BatchResult(np.concatenate([p.flat for p in parts]),
-                       {k: np.concatenate([p.arrays[k] for p in parts])
-                        for k in parts[0].arrays},
-                       sum(p.seconds for p in parts), sum(p.cpu_seconds for p in parts),
-                       None if any(r is None for r in refine) else np.concatenate(refine))
 
 
 class Runner:
@@ -110,17 +100,15 @@ class Runner:
         are ready (spare results first)."""
         want = np.asarray(flat, np.int64)
         todo = np.ones(want.size, bool)
-        if self.ready:
-            got, rest = self._take(want, _merged(self.ready))
-            self.ready = [] if rest is None else [rest]
+        kept = []
+        for res in self.ready:  # chunk by chunk, as if computed now
+            got, rest = self._take(want, res)
+            if rest is not None:
+                kept.append(rest)
             if got is not None:
-                order = np.argsort(got.flat, kind="stable")  # batches give increasing flat
-                got = BatchResult(got.flat[order], {k: v[order] for k, v in got.arrays.items()},
-                                  got.seconds, got.cpu_seconds,
-                                  None if got.refine_evaluations is None
-                                  else got.refine_evaluations[order])
                 todo[np.searchsorted(want, got.flat)] = False
                 yield got
+        self.ready = kept
         for part, spare in list(self.running.values()):  # spare chunks on their way
             if spare:
                 todo[np.searchsorted(want, part[_member(part, want)])] = False
