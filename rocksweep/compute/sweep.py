@@ -71,7 +71,7 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
     (``fields.check_rows``) through the same kernel, and the chunk's result holds the
     differences (``fields.CHECK_FIELDS``)."""
     t0, c0 = time.perf_counter(), time.thread_time()
-    # a Grid, or adaptive's view of one (``adaptive._Subset``: the grid as ``.grid``)
+    # a Grid, or adaptive's view of one (``adaptive.Subset``: the grid as ``.grid``)
     scene = grid.scene if hasattr(grid, "scene") else grid.grid.scene
     cr = grid.rows(start, stop)
     outs = run_rows(cr, cr.rows, level, scene)
@@ -85,7 +85,7 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
         half = run_rows(cr, fields.check_rows(cr.rows), level, scene)
         arrays.update(fields.convert_check(outs, half, cr.alpha_ref))
     return ChunkResult(start, stop, arrays, time.perf_counter() - t0,
-                       time.thread_time() - c0)
+                       time.thread_time() - c0, outs[:, L.OUT_REFINE_EVALS].astype(np.int64))
 
 
 def run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene,
@@ -119,7 +119,9 @@ def merge_contiguous(results: Iterable[ChunkResult]) -> list[ChunkResult]:
             merged[-1] = ChunkResult(
                 last.start, r.stop,
                 {k: np.concatenate((v, r.arrays[k])) for k, v in last.arrays.items()},
-                last.seconds + r.seconds, last.cpu_seconds + r.cpu_seconds)
+                last.seconds + r.seconds, last.cpu_seconds + r.cpu_seconds,
+                None if last.refine_evaluations is None or r.refine_evaluations is None
+                else np.concatenate((last.refine_evaluations, r.refine_evaluations)))
         else:
             merged.append(r)
     return merged

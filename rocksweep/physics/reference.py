@@ -669,6 +669,7 @@ def result_row(r: dict) -> np.ndarray:
     out[L.OUT_E_MAX] = r["e_max"]
     out[L.OUT_CONTACTS] = r["contacts"]
     out[L.OUT_HIST_ROWS] = 0.0
+    out[L.OUT_REFINE_EVALS] = 0.0
     out[L.OUT_MU_REQ] = r.get("mu_required", np.nan)
     out[L.OUT_N_MIN] = r.get("normal_min_over_Mg", np.nan)
     out[L.OUT_IMPULSE_MAX] = r.get("impulse_ratio_max", np.nan)

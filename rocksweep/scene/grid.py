@@ -78,7 +78,10 @@ class ChunkResult:
     """Results of the points ``start <= i < stop`` (flat indices).
 
     arrays: name -> array[stop - start] (``Scene.variables``); seconds: wall time of the
-    chunk in its worker; cpu_seconds: CPU time of the worker thread that ran it.
+    chunk in its worker; cpu_seconds: CPU time of the worker thread that ran it;
+    refine_evaluations: int64[stop - start], the RK4 evaluations of the certification's
+    runs of each point (in its steps and event_steps too: ``fields``
+    ``refine_evaluations``; not a file variable: a file keeps their total), or None.
     """
 
     start: int
@@ -86,6 +89,7 @@ class ChunkResult:
     arrays: dict[str, np.ndarray]
     seconds: float
     cpu_seconds: float = 0.0
+    refine_evaluations: np.ndarray | None = None
 
 
 class Grid:

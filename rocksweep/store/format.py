@@ -82,6 +82,9 @@ SESSION_ATTRS: dict[str, str] = {
     "complete": "int8",
     "steps_total": "int64",
     "event_steps_total": "int64",
+    # RK4 evaluations of the certification's runs (part of the steps above; -1: not
+    # recorded, a file of a rocksweep before the count resumed)
+    "refine_evaluations": "int64",
     "host": "S256",
     "backend": "S256",
     "history": f"S{HISTORY_BYTES}",
