@@ -131,6 +131,12 @@ FIELDS: tuple[Field, ...] = (
           "smallest normal reaction N/(M g) over the run (< 0: the body would lift off)",
           L.OUT_N_MIN, contact=True,
           label="smallest normal reaction", symbol="N_min/(M g)"),
+    Field("refine_evaluations", "int64", 0, "1",
+          "RK4 evaluations (regular + event) of the certification's checks and reruns of a "
+          "close call (rocksweep.compute.certify), counted in steps and event_steps too; a "
+          "sweep file keeps their total (attribute refine_evaluations)",
+          L.OUT_REFINE_EVALS, stored=False,
+          label="RK4 evaluations of the certification"),
     Field("saddle_margin", "float64", math.nan, "alpha_ref",
           "closest approach of the free rocking to the overturning saddle (inf: never "
           "within 0.5); below 0.05 (an overturn: 0.1) at 5 steps per period the run is "

@@ -170,7 +170,7 @@ def main(argv: list[str] | None = None) -> int:
             best = np.inf
             for _ in range(5):
                 c0 = time.thread_time()
-                run_record(kernel, rows, sel, outs, sc.suite.records[rec_i])
+                run_record(kernel, rows, sel, outs, cr.excitations[int(cr.which[j])])
                 best = min(best, time.thread_time() - c0)
             point = sc.point({**{a.name: a.values[0] for a in sc.axes},
                               **{k: v[j] for k, v in vals.items()}})

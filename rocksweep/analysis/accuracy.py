@@ -48,7 +48,6 @@ from rocksweep.errors import SceneError
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import warm_up
 from rocksweep.numerics import PRESETS, Numerics
-from rocksweep.physics.points import with_record
 from rocksweep.physics.reference import reference_run, result_row
 from rocksweep.scene.grid import Grid
 from rocksweep.scene.model import Scene
@@ -280,10 +279,15 @@ def sample_scene(scene: Scene, n: int | None, seed: int = DEFAULT_SAMPLE_SEED) -
 
 
 def _no_suite(scene: Scene) -> None:
-    """The accuracy study runs one record a scene (its rows carry the record's samples)."""
+    """The accuracy study runs one recorded motion a scene (its rows carry its samples)."""
     if scene.suite is not None:
         raise SceneError(f"ground.records: the accuracy study takes one record "
                          f"(ground.record: one of {scene.suite.names[0]}, ...), not a suite")
+    if scene.path is not None:
+        for k in scene.excitation_axes:
+            if len(scene.axis(k).values) > 1:
+                raise SceneError(f"{scene.axis(k).key}: the accuracy study takes one "
+                                 "motion the body feels; give one value")
 
 
 def _with_numerics(scene: Scene, numerics: Numerics) -> Scene:
@@ -301,8 +305,8 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
     """
     _no_suite(scene)
     cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
-    # a record's samples (and its vertical's) ride on each row
-    rows_all = with_record(cr.rows, scene.record, scene.vertical_samples())
+    # the excitation's samples ride on each row
+    rows_all = cr.with_samples()
     ground = scene.ground  # the Ricker, MP and records run the GROUND variants
     n = len(flat)
     outs = np.empty((n, L.N_OUT))

@@ -235,6 +235,7 @@ def info_dict(result: SweepResult) -> dict:
         "energy": bool(a.get("energy", False)),
         "steps_total": int(result.arrays["steps"].sum()),
         "event_steps_total": int(result.arrays["event_steps"].sum()),
+        "certification": certification_info(result),
         "provenance": {
             **{k: a.get(k) for k in ("rocksweep_version", "numba_version", "numpy_version",
                                      "h5py_version", "hdf5_version", "python_version",
@@ -247,6 +248,18 @@ def info_dict(result: SweepResult) -> dict:
         "check": check_info(result),
         "scene": a.get("scene"),
     }
+
+
+def certification_info(result: SweepResult) -> dict:
+    """What the certification of close calls cost (``compute.certify``): points_refined
+    (status ``refined``: checked or re-run finer), points_uncertified, and
+    refine_evaluations, the RK4 evaluations (regular + event) of its runs, part of the
+    steps totals (None where not recorded: a file of a rocksweep before the count)."""
+    status = np.asarray(result.arrays["status"])
+    n = int(result.attrs.get("refine_evaluations", -1))
+    return {"points_refined": int(((status & STATUS_BIT["refined"]) != 0).sum()),
+            "points_uncertified": int(((status & STATUS_BIT["uncertified"]) != 0).sum()),
+            "refine_evaluations": n if n >= 0 else None}
 
 
 def adaptive_info(result: SweepResult) -> dict | None:
@@ -281,6 +294,21 @@ def format_check(ck: dict) -> list[str]:
             f"  |t_overturn change|: {tail(ck['t_overturn_diff'], ' p*t')}",
             f"  |max|theta| change| / max|theta| of safe runs: "
             f"{tail(ck['theta_max_rel_diff'], '')}"]
+
+
+def format_certification(c: dict, evaluations: int) -> str:
+    """The line of ``rocksweep info`` on the certification's price (``certification_info``;
+    evaluations: the file's RK4 evaluations, regular + event)."""
+    pts = (f"{c['points_refined']} points refined (checked or re-run finer), "
+           f"{c['points_uncertified']} uncertified")
+    n = c["refine_evaluations"]
+    if n is None:
+        return (f"  certification of close calls: {pts}; its share of the steps not recorded "
+                "(written before rocksweep counted it)")
+    own = evaluations - n
+    ratio = f", {evaluations / own:.3f}x the points' own" if own > 0 else ""
+    return (f"  certification of close calls: {n} of them ({100 * n / max(1, evaluations):.1f}%"
+            f"{ratio}); {pts}")
 
 
 def format_info(d: dict) -> list[str]:
@@ -327,6 +355,8 @@ def format_info(d: dict) -> list[str]:
     lines.append(f"accuracy: {d['accuracy']}")
     lines.append(f"RK4 steps: {d['steps_total']} + {d['event_steps_total']} event "
                  "re-integrations")
+    lines.append(format_certification(d["certification"],
+                                      d["steps_total"] + d["event_steps_total"]))
     wall = p["wall_time_s"] or 0.0
     lines.append(f"run: started {p['started']}, finished {p['finished'] or '-'}, "
                  f"{p['sessions']} session(s), {wall:.2f} s wall time, "

@@ -41,7 +41,6 @@ from rocksweep.compute.dispatch import run_variant
 from rocksweep.errors import SweepError, flag
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import point_seconds
-from rocksweep.physics.bodies import G
 from rocksweep.scene.grid import ChunkResult, ChunkRows, Grid
 from rocksweep.scene.model import Scene
 from rocksweep.vocab.settings import BACKENDS
@@ -72,7 +71,7 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
     (``fields.check_rows``) through the same kernel, and the chunk's result holds the
     differences (``fields.CHECK_FIELDS``)."""
     t0, c0 = time.perf_counter(), time.thread_time()
-    # a Grid, or adaptive's view of one (``adaptive._Subset``: the grid as ``.grid``)
+    # a Grid, or adaptive's view of one (``adaptive.Subset``: the grid as ``.grid``)
     scene = grid.scene if hasattr(grid, "scene") else grid.grid.scene
     cr = grid.rows(start, stop)
     outs = run_rows(cr, cr.rows, level, scene)
@@ -80,42 +79,33 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
     stored = fields.sweep_fields(scene.energy if contact else level == L.LEVEL_ENERGY,
                                  contact, scene.check)
     arrays = fields.convert(outs, cr.alpha_ref, cr.E_ref, stored)
-    if scene.floor:  # the peak the body was driven by [g]: the kernel's amplitude / g
-        arrays[fields.FLOOR_PFA] = cr.rows[:, L.PAR_AMP] / G
+    if scene.floor:  # the peak the body was driven by [g]
+        arrays[fields.FLOOR_PFA] = scene.floor_pfa(cr.rows[:, L.PAR_AMP])
     if scene.check:
         half = run_rows(cr, fields.check_rows(cr.rows), level, scene)
         arrays.update(fields.convert_check(outs, half, cr.alpha_ref))
     return ChunkResult(start, stop, arrays, time.perf_counter() - t0,
-                       time.thread_time() - c0)
+                       time.thread_time() - c0, outs[:, L.OUT_REFINE_EVALS].astype(np.int64))
 
 
 def run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene,
              certify: bool = True) -> np.ndarray:
     """Result rows float64[n, N_OUT] of ``rows`` (float64[n, N_PAR], those of ``cr`` or
     their half-step reruns) at bookkeeping ``level``: one call of the one dispatch
-    (``compute.dispatch.run_variant``) per body kind present (and per record of a
-    suite), the scene's ground variant (Ricker, MP, records) with a record's samples
-    riding on the rows. certify: re-run the close calls finer (``compute.certify``, up
-    to the scene's ``numerics.refine`` refinements)."""
+    (``compute.dispatch.run_variant``) per body kind present and batch of the chunk
+    (``ChunkRows.batches``: the points of one excitation with samples, which ride on its
+    rows, or every pulse), on the scene's ground variant. certify: re-run the close calls
+    finer (``compute.certify``, up to the scene's ``numerics.refine`` refinements)."""
     refine = scene.numerics.refine if certify else 0
     outs = np.empty((rows.shape[0], L.N_OUT))
-    vertical = scene.vertical_samples()  # a record's vertical component rides along
     for kind in np.unique(cr.kinds):
-        sel = cr.kinds == kind
-        if cr.records is not None:  # one record at a time, its samples shared
-            for r in np.unique(cr.record_index[sel]):
-                part = sel & (cr.record_index == r)
-                outs[part] = run_variant(
-                    rows[part], int(kind), level, scene.ground, refine,
-                    record=cr.records[int(r)],
-                    vertical=None if cr.verticals is None else cr.verticals[int(r)])
-        elif sel.all():
-            run_variant(rows, int(kind), level, scene.ground, refine, record=scene.record,
-                        out=outs, vertical=vertical)
-        else:
-            outs[sel] = run_variant(np.ascontiguousarray(rows[sel]), int(kind), level,
-                                    scene.ground, refine, record=scene.record,
-                                    vertical=vertical)
+        for part, ex in cr.batches(cr.kinds == kind):
+            if part.all():
+                run_variant(rows, int(kind), level, scene.ground, refine, excitation=ex,
+                            out=outs)
+            else:
+                outs[part] = run_variant(np.ascontiguousarray(rows[part]), int(kind), level,
+                                         scene.ground, refine, excitation=ex)
     return outs
 
 
@@ -129,7 +119,9 @@ def merge_contiguous(results: Iterable[ChunkResult]) -> list[ChunkResult]:
             merged[-1] = ChunkResult(
                 last.start, r.stop,
                 {k: np.concatenate((v, r.arrays[k])) for k, v in last.arrays.items()},
-                last.seconds + r.seconds, last.cpu_seconds + r.cpu_seconds)
+                last.seconds + r.seconds, last.cpu_seconds + r.cpu_seconds,
+                None if last.refine_evaluations is None or r.refine_evaluations is None
+                else np.concatenate((last.refine_evaluations, r.refine_evaluations)))
         else:
             merged.append(r)
     return merged

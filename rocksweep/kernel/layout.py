@@ -119,7 +119,10 @@ OUT_MARGIN = 22  # closest approach of the free rocking to the overturning saddl
 #                  [alpha_ref] (inf: never near it): a small value is a close call
 OUT_T_CLOSE = 23  # last time [s] the free rocking came within PAR_CLOSE of the saddle
 #                   (NaN: never): after it the run decided nothing near its threshold
-N_OUT = 24
+OUT_REFINE_EVALS = 24  # RK4 evaluations (regular + event) of the certification's runs of
+#                        this point, counted in OUT_STEPS/OUT_EVENT_STEPS too (0 from the
+#                        kernel; set by ``rocksweep.compute.certify``)
+N_OUT = 25
 
 # --- state tuple y (the loop's 6 slots, a UniTuple(float64, 6)) ----------------------------
 Y_THETA = 0  # theta [rad] (0 in full contact)

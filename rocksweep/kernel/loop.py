@@ -76,6 +76,7 @@ from rocksweep.kernel.layout import (
     OUT_N_GAINING,
     OUT_N_MIN,
     OUT_OUTCOME,
+    OUT_REFINE_EVALS,
     OUT_STATUS,
     OUT_STEPS,
     OUT_T_CLOSE,
@@ -406,6 +407,7 @@ def _reset(out):
     out[OUT_N_GAINING] = 0.0
     out[OUT_E_MAX] = 0.0
     out[OUT_HIST_ROWS] = 0.0
+    out[OUT_REFINE_EVALS] = 0.0  # the certification's reruns add theirs (compute.certify)
 
 
 @njit(cache=True, **INLINE)

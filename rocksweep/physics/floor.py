@@ -45,7 +45,7 @@ record sampled at PULSE_POINTS = 64 points per 2 pi of its phase w t, the last s
 its end (``pulse_record``); the linear interpolation of the samples is within
 1 - cos(pi / 64) = 0.12% of the pulse.
 
-The vertical component reaches the floor unfiltered (no vertical mode is modelled).
+The building filters the horizontal motion only (``physics.ground_motion``).
 """
 
 from __future__ import annotations

@@ -36,11 +36,11 @@ M g b, means a crossing was stepped over; it is then located on the dense output
 the previous extremum and that one. theta_max is the largest |theta| over the maxima of
 s*theta (located, not sampled) and the phase ends.
 
-A vertical ground acceleration a_v (``Point.vertical``, ``Point.pulse_vertical``) is
-evaluated here from the point itself, not from the kernel's reader of its row
-(``_vertical``): the equations above are called with gravity g + a_v(t) in place of g,
-the uplift events compare Q with M (g + a_v) b, and the run stops, ``airborne``, at the
-first time g + a_v <= 0, located by its own root search (``_air_time``).
+A vertical ground acceleration a_v (the point's ``Excitation``: ``vertical``, the
+component as read, or ``harmonic``) is evaluated here from the point itself, not from the
+kernel's reader of its row (``_vertical``): the equations above are called with gravity
+g + a_v(t) in place of g, the uplift events compare Q with M (g + a_v) b, and the run
+stops, ``airborne``, at the first time g + a_v <= 0, located by its own root search (``_air_time``).
 
 Times are p*t (p = 1 rad/s), angles in rad, SI units with m = 1 kg (``rocksweep.physics.bodies``).
 """
@@ -514,7 +514,7 @@ def _vertical(point: Point, prm: np.ndarray) -> tuple | None:
     """(a_v(t) [m/s^2], its rate, t_air) of the point's vertical in kernel time, from the
     point (not from the row's PAR_V_*), or None."""
     t_pulse = float(prm[L.PAR_TPULSE])
-    pv = point.pulse_vertical
+    pv = point.excitation.harmonic
     if pv is not None:
         amp, w, ph = pv.amplitude * G, float(pv.w_over_p), math.radians(pv.phase)
 
@@ -524,12 +524,13 @@ def _vertical(point: Point, prm: np.ndarray) -> tuple | None:
         def rate(t):
             return amp * w * math.cos(w * t + ph)
         return a_v, rate, _air_time(a_v, t_pulse, 2 * math.pi / w)
-    if point.vertical is None:
+    up = point.excitation.vertical
+    if up is None:
         return None
     rec = point.record
     # the documented rule: the vertical's linear interpolant at the horizontal's samples
     tk = point.p * rec.times()
-    vert = np.interp(rec.times(), point.vertical.times(), point.vertical.acc, right=0.0)
+    vert = np.interp(rec.times(), up.times(), up.acc, right=0.0)
     av = abs(point.A) / rec.pga * vert  # one factor for both components [m/s^2]
     dtk = point.p * rec.dt
 
@@ -668,6 +669,7 @@ def result_row(r: dict) -> np.ndarray:
     out[L.OUT_E_MAX] = r["e_max"]
     out[L.OUT_CONTACTS] = r["contacts"]
     out[L.OUT_HIST_ROWS] = 0.0
+    out[L.OUT_REFINE_EVALS] = 0.0
     out[L.OUT_MU_REQ] = r.get("mu_required", np.nan)
     out[L.OUT_N_MIN] = r.get("normal_min_over_Mg", np.nan)
     out[L.OUT_IMPULSE_MAX] = r.get("impulse_ratio_max", np.nan)

@@ -98,8 +98,9 @@ def _in_place(f: h5py.File) -> bool:
 
 
 def _upgrade_session_attrs(f: h5py.File) -> None:
-    """Give a format-1 file's session attributes their fixed types (needs a little space,
-    checked before; only the first resume of such a file does this)."""
+    """Give a format-1 file's session attributes their fixed types, and an older format-2
+    file the ones it lacks (needs a little space, checked before; only the first resume
+    of such a file does this)."""
     a = f.attrs
     for name, dtype in SESSION_ATTRS.items():
         if name in a and a.get_id(name).dtype == np.dtype(dtype):
@@ -107,6 +108,8 @@ def _upgrade_session_attrs(f: h5py.File) -> None:
         old = plain(a[name]) if name in a else None
         if name == "complete":
             old = int(bool(old))
+        elif name == "refine_evaluations" and old is None:
+            old = -1  # the sessions before did not count it
         elif old is None or (dtype.startswith("S") and not isinstance(old, str)):
             old = "" if dtype.startswith("S") else 0
         if name in a:
@@ -422,10 +425,11 @@ class SweepFile:
                 resume=flag("resume"))) from None
 
     def finish(self, wall_seconds: float, cpu_seconds: float, *,
-               backend: str | None = None) -> dict:
-        """Record this session's wall time [s], the workers' CPU time on its points [s]
-        and the file's totals (in place); returns the attributes set (plain Python
-        values; ``complete`` a bool)."""
+               backend: str | None = None, refine_evaluations: int = 0) -> dict:
+        """Record this session's wall time [s], the workers' CPU time on its points [s],
+        the RK4 evaluations its certification took (``refine_evaluations``: part of the
+        points' steps) and the file's totals (in place); returns the attributes set
+        (plain Python values; ``complete`` a bool)."""
         if self._broken:
             raise self._broken
         f = self.f
@@ -435,6 +439,9 @@ class SweepFile:
             attrs = {
                 "wall_time": float(a.get("wall_time", 0.0)) + wall_seconds,
                 "cpu_time": float(a.get("cpu_time", 0.0)) + cpu_seconds,
+                # -1 (not recorded before) stays so: the total would be short
+                "refine_evaluations": (-1 if int(a.get("refine_evaluations", -1)) < 0 else
+                                       int(a["refine_evaluations"]) + int(refine_evaluations)),
                 "points_done": int(done.sum()),
                 "complete": bool(done.all()),
                 "steps_total": int(f["steps"][()].sum()),

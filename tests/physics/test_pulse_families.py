@@ -25,6 +25,7 @@ from rocksweep.kernel.equations import ground_acc, ground_jerk
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody
 from rocksweep.physics.excitation import PulseShape
+from rocksweep.physics.ground_motion import pulse
 from rocksweep.physics.points import Point, point_row
 from rocksweep.scene.parse import parse_scene
 
@@ -35,7 +36,7 @@ CASES = [("sine", 1, 2.0, 90.0), ("sine", 3, 2.0, 90.0), ("cosine", 2, 2.0, 90.0
 
 
 def _point(shape, cycles, gamma, nu, w_over_p=2.0, A_ratio=1.7, body=BLOCK, lam=0.0):
-    return Point(body, lam, shape, w_over_p, A_ratio, cycles, gamma, nu)
+    return Point(body, lam, pulse(shape, cycles, gamma, nu), w_over_p, A_ratio)
 
 
 @pytest.mark.parametrize("shape, cycles, gamma, nu", CASES)
@@ -130,7 +131,7 @@ def test_shapes_and_options_in_a_scene():
     assert sc.option("cycles") == 3 and sc.option("nu") == 45.0 and sc.option("gamma") == 2.0
     assert sc.phase_max() == pytest.approx(6 * math.pi)  # 3 cycles and the Ricker: 6 pi
     assert sc.point({"alpha": 0.2618, "inertia": 4 / 3, "lam": 0.0, "shape": "mp",
-                     "w_over_p": 2.0, "A_ratio": 2.0}).nu == 45.0
+                     "w_over_p": 2.0, "A_ratio": 2.0}).excitation.nu == 45.0
     plain = parse_scene(BODY % ("sine", ""))  # the paper's scenes get no new axes
     assert [a.name for a in plain.axes] == ["shape", "alpha", "inertia", "lam", "A_ratio",
                                             "w_over_p"]

@@ -38,13 +38,13 @@ def test_pulse_vertical_axes_and_variant():
     assert [a.name for a in sc.swept] == ["vertical.amplitude"]
     assert sc.axis("vertical.phase").values == (0.0,)
     p = sc.point({a.name: a.values[-1] for a in sc.axes})
-    assert (p.pulse_vertical.amplitude, p.pulse_vertical.w_over_p) == (0.5, 9.0)
+    assert (p.excitation.harmonic.amplitude, p.excitation.harmonic.w_over_p) == (0.5, 9.0)
 
 
 def test_record_vertical_with_another_dt_is_resampled(files):
     sc = parse_scene(BLOCK + "ground: {record: h.txt, vertical: v_fine.txt, A_ratio: 1.0, "
                      "p: 2.0}", base=files)
-    v = sc.vertical_samples()
+    v = sc.excitation({}).vertical_acc
     t = sc.record.times()
     assert v.shape == (sc.record.npts,)
     np.testing.assert_allclose(v, np.where(t <= 1.5 + 1e-9, 0.1 - 0.2 * t, 0.0), atol=1e-9)
