@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import fcntl
 import os
 import re
 import stat
@@ -295,8 +296,6 @@ def clean_stale_partials(path: Path) -> list[tuple[str, int]]:
     writer's process is gone (or, for a name without a pid, it is older than STALE_AGE)
     and no process holds its lock (HDF5's writer lock, flock). Returns (name, bytes) of
     each file removed."""
-    import fcntl
-
     path = Path(path)
     parent = path.parent if str(path.parent) else Path(".")
     # files of older versions were named after the stem (``.risk.abcd1234.partial.h5``)

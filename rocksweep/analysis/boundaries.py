@@ -13,8 +13,8 @@ For every panel (a value of each non-diagram axis: shape, body keys, lam) of a d
   to a relative tolerance, so the curve is not limited by the grid spacing.
 
 Rows for CSV (``a_min_rows``, ``boundary_rows``; ``analysis.files.csv_text``) export
-them; the figures are in ``rocksweep.figures.diagrams`` (``a_min_figure``, and
-``rocksweep plot --curves``).
+them; the figures are ``rocksweep.figures.a_min.a_min_figure`` and the curves of
+``rocksweep plot --curves`` (``figures.panels.draw_boundaries``).
 ``result_curves`` does it all for a result file (``rocksweep boundaries``). Units: those
 of the axes (w_over_p = omega/p, A_ratio = A/(g tan alpha_cg), eq. 2).
 """
@@ -47,6 +47,7 @@ from rocksweep.physics.points import Point, kernel_kind, points_rows
 from rocksweep.scene.grid import Grid
 from rocksweep.scene.model import Scene
 from rocksweep.vocab.axes import DIAGRAM_AXES
+from rocksweep.vocab.kinds import BOUNDARIES, KIND_ATTR
 from rocksweep.vocab.outcomes import OUTCOME_MODE1, OUTCOME_MODE2, outcome_word
 
 if TYPE_CHECKING:
@@ -740,7 +741,7 @@ def boundaries_dataset(ds: Any, rtol: float = DEFAULT_RTOL, mode: int | None = N
     search = check_search(search)
     result = as_result(ds, list(RESPONSE))
     curves, _ = result_curves(result, rtol, mode, search=search)
-    return curves_dataset(curves, {"rocksweep_kind": "boundaries", "kind": result.kind,
+    return curves_dataset(curves, {KIND_ATTR: BOUNDARIES, "kind": result.kind,
                                    "title": result.name, "rtol": rtol,
                                    "search": int(search),
                                    "mode": "any" if mode is None else f"mode{mode}"})

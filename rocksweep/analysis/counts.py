@@ -13,6 +13,7 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.analysis.states import counted_points, parse_state, required, state_reached
+from rocksweep.compute.adaptive import FILLED
 from rocksweep.errors import Arg, FragilityError
 from rocksweep.vocab.ground import CLOUD_IMS as CLOUD_IM_VARIABLES
 from rocksweep.vocab.ground import SCALE_IMS
@@ -64,8 +65,6 @@ def refuse_filled(ds: xr.Dataset, states: Sequence[str], counted: xr.DataArray) 
     more (uplift, theta:X)."""
     if "computed" not in ds.variables:
         return
-    from rocksweep.compute.adaptive import FILLED
-
     filled = (ds["computed"] == FILLED) & counted
     n = int(filled.sum())
     need = [s for s in states if parse_state(s)[0] in (UPLIFT, "theta")]

@@ -40,6 +40,7 @@ from rocksweep.errors import EfficiencyError
 from rocksweep.physics.bodies import G
 from rocksweep.vocab.axes import ALPHA_KEYS
 from rocksweep.vocab.ground import PGA_RATIO, PGV_OVER_PGA, PGV_RATIO, RECORD_IMS, SA, SCALE_IMS
+from rocksweep.vocab.kinds import IM_EFFICIENCY, KIND_ATTR
 
 __all__ = ["im_efficiency", "record_im_table"]
 
@@ -278,7 +279,7 @@ def _dataset(ds: xr.Dataset, state: str, verdict: Any, stripe: str | None,
                      {"long_name": "the IM of a record scaled by F is F^exponent times it"}),
         "method": (("im",), np.array(methods, dtype=str)),
     }
-    attrs = {"rocksweep_kind": "im_efficiency", "state": str(state), "reason": verdict,
+    attrs = {KIND_ATTR: IM_EFFICIENCY, "state": str(state), "reason": verdict,
              "stripe_im": stripe or "none",
              "reference": "Luco & Cornell (2007), Structural seismic demand analysis: "
                           "consideration of near-fault ground motions, Earthquake Spectra "

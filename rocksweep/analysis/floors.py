@@ -31,9 +31,11 @@ from typing import Any
 
 import numpy as np
 
+from rocksweep.analysis.tolerance import DEFAULT_RTOL_MANY
 from rocksweep.errors import FloorError
+from rocksweep.vocab.ground import ORIENTATIONS
+from rocksweep.vocab.kinds import FLOOR_SPECTRUM, KIND_ATTR
 
-ORIENTATIONS = ("each", "worst")
 FLOOR_X = "floor.period"
 
 
@@ -148,7 +150,7 @@ def _p_overturn(ds):
     return p, n
 
 
-def floor_spectrum(ds, rtol: float = 1e-2, search: bool = True):
+def floor_spectrum(ds, rtol: float = DEFAULT_RTOL_MANY, search: bool = True):
     """The floor spectrum of a complete sweep over ``floor.period`` (module docstring) as a
     Dataset (attrs rocksweep_kind "floor_spectrum", the building's ``floor`` line): a
     suite's ``p_overturn`` and ``n_counted`` over (floor.period, stripe, others[,
@@ -159,7 +161,7 @@ def floor_spectrum(ds, rtol: float = 1e-2, search: bool = True):
     if FLOOR_X not in ds.dims:
         raise FloorError(f"floor spectrum: the sweep has no {FLOOR_X} dimension (sweep "
                          "floor.period in the scene's floor section)")
-    attrs = {"rocksweep_kind": "floor_spectrum", "title": ds.attrs.get("title", ""),
+    attrs = {KIND_ATTR: FLOOR_SPECTRUM, "title": ds.attrs.get("title", ""),
              "floor": ds.attrs.get("floor", ""), "scale_im": ds.attrs.get("scale_im", "")}
     if "record" in ds["outcome"].dims:
         def one(d):

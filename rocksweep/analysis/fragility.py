@@ -102,6 +102,7 @@ from rocksweep.analysis.states import (
 from rocksweep.errors import Arg, FragilityError, FragilityWarning, flag
 from rocksweep.fields import plain
 from rocksweep.vocab.ground import AVGSA
+from rocksweep.vocab.kinds import FRAGILITY, KIND_ATTR
 from rocksweep.vocab.outcomes import MODE1, MODE2
 
 __all__ = ["Fit", "REASONS",
@@ -660,7 +661,7 @@ def _dataset(ds: xr.Dataset, state: Any, states: list[str], axis: IMAxis, c: Cou
         coords[axis.stripe] = ds[axis.stripe]
         coords["record"] = ds["record"]
         data.update(_stripe_variables(c, axis, dims_c, shaped))
-    attrs = {"rocksweep_kind": "fragility", "title": str(ds.attrs.get("title", "")),
+    attrs = {KIND_ATTR: FRAGILITY, "title": str(ds.attrs.get("title", "")),
              "method": axis.method, "im": axis.im_name, "im_units": unit,
              "states": list(states), "bootstrap": int(N), "seed": int(seed),
              "ci": float(ci),

@@ -10,13 +10,14 @@ milder ones); the two modes are not.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from rocksweep.errors import FragilityError
+from rocksweep.errors import AnalysisWarning, FragilityError
 from rocksweep.vocab.outcomes import (
     FLAGGED,
     MODE1,
@@ -147,10 +148,6 @@ def trust(ds: xr.Dataset, what: str, warn: bool = True) -> str:
     flagged points are left out by ``counted_points``; this says so. With ``warn``, an
     ``AnalysisWarning`` "<what>: <verdict>" too. A Dataset without outcome/status (not a
     sweep) is "ok"."""
-    import warnings
-
-    from rocksweep.errors import AnalysisWarning
-
     if "outcome" not in ds.variables or "status" not in ds.variables:
         return "ok"
     _, flagged, not_run = counted_points(ds)

@@ -16,7 +16,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from rocksweep.compute.adaptive import stats_of
 from rocksweep.fields import THETA_REL_FLOOR, plain
+from rocksweep.store.reader import read_result, stored_scene
 from rocksweep.vocab.axes import axis_name
 from rocksweep.vocab.outcomes import (
     COMPUTED,
@@ -169,8 +171,6 @@ def _json_value(v):
 
 def read_info(path) -> SweepResult:
     """The variables of a result file that ``info_dict`` reports on."""
-    from rocksweep.store.reader import read_result, stored_scene
-
     check = bool(stored_scene(path).get("check"))
     return read_result(path, INFO_VARIABLES + (CHECK_INFO_VARIABLES if check else []),
                        INFO_OPTIONAL)
@@ -270,8 +270,6 @@ def adaptive_info(result: SweepResult) -> dict | None:
     settings = result.scene.get("adaptive")
     if not settings or "computed" not in result.arrays:
         return None
-    from rocksweep.compute.adaptive import stats_of
-
     c = np.asarray(result.arrays["computed"])
     st = stats_of(c, settings.get("threshold", 0.0))
     filled = int(((c == 0) & result.done).sum())

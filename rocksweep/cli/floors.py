@@ -7,6 +7,7 @@ from pathlib import Path
 
 import click
 
+from rocksweep.analysis.tolerance import DEFAULT_RTOL_MANY
 from rocksweep.cli.main import main, user_errors
 from rocksweep.cli.options import dpi_option, overwrite_option, search_option
 
@@ -15,7 +16,7 @@ from rocksweep.cli.options import dpi_option, overwrite_option, search_option
 @click.argument("result_path", metavar="OUT.h5", type=click.Path(path_type=Path))
 @click.option("-o", "--output", "fig_path", type=click.Path(dir_okay=False, path_type=Path),
               help="Figure file, .png, .pdf or .svg [default: OUT-floors.png].")
-@click.option("--rtol", type=float, default=1e-2, show_default=True,
+@click.option("--rtol", type=float, default=DEFAULT_RTOL_MANY, show_default=True,
               help="Relative tolerance of A_min (one record or a pulse).")
 @search_option
 @dpi_option

@@ -7,7 +7,7 @@ driver needs only its ``grid`` and its methods ``done``, ``write``, ``state``,
 ``write_points``, ``write_filled``, ``finish``, ``image`` and ``close``): made, and every
 argument checked, by the sweep session (``rocksweep.compute.session``), the one way in
 for ``rocksweep.run`` and ``rocksweep sweep``. Light at import (numpy, the kernel and
-tqdm load inside the functions), so the command line's options can read ``WRITE_EVERY`` from here.
+tqdm load inside the functions).
 """
 
 from __future__ import annotations
@@ -27,11 +27,6 @@ from rocksweep.interrupts import raise_pending
 if TYPE_CHECKING:
     from rocksweep.compute.adaptive import AdaptiveStats, Options, Validation
     from rocksweep.scene.model import Scene
-
-# Finished chunks are written to the file at most this often [s] by default: a write
-# (several hyperslabs per variable, two flushes) costs ~10 ms, as much as a chunk of easy
-# points, and holds the GIL that worker threads need between kernel calls.
-WRITE_EVERY = 1.0
 
 
 @dataclass

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import textwrap
 from typing import TYPE_CHECKING
 
 import matplotlib.colors
@@ -158,6 +159,4 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
 
 def _wrapped(label: str, chars: int) -> str:
     """Each line of a legend label wrapped at ``chars`` characters (words kept whole)."""
-    import textwrap
-
     return "\n".join(textwrap.fill(line, chars) for line in label.strip().split("\n"))

@@ -14,12 +14,15 @@ Figure 5 ``rocksweep.figures.history``.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterable, Sequence
+from io import BytesIO
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import matplotlib
 import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure as _MplFigure
 
 from rocksweep.errors import FigureError
@@ -47,8 +50,6 @@ class Figure(_MplFigure):
             return super().savefig(fname, *args, **kwargs)
 
     def _repr_png_(self) -> bytes:
-        from io import BytesIO
-
         buf = BytesIO()
         self.savefig(buf, format="png", dpi=NOTEBOOK_DPI)
         return buf.getvalue()
@@ -154,10 +155,6 @@ def fit_width(fig: Figure, width: str) -> Figure:
     in as many columns as fit, and as much height as the panels, labels and legends need
     (the layout's aspect at least; every axes at least ``MIN_ASPECT`` as tall as wide).
     Nothing drawn lies outside the figure (tests/figures/test_journal.py). Returns ``fig``."""
-    import warnings
-
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-
     inches, pt = WIDTHS[width]
     w, h = fig.get_size_inches()
     fig.set_size_inches(inches, h * inches / w)

@@ -19,6 +19,7 @@ the atomic rename.
 from __future__ import annotations
 
 import errno
+import fcntl
 import os
 import shutil
 from pathlib import Path
@@ -91,8 +92,6 @@ def check_space(path: Path, need: int, what: str) -> None:
 def lock_existing(path: Path) -> int:
     """Open the file at ``path`` and take the exclusive lock a writer holds (HDF5 locks
     with flock); returns the descriptor. StoreError if a sweep is writing it."""
-    import fcntl
-
     try:
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_CLOEXEC", 0))
     except OSError as err:

@@ -22,6 +22,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import h5py
 import numpy as np
 
 from rocksweep.errors import Arg, OutputError, RocksweepError, StoreError, flag
@@ -177,7 +178,6 @@ class SweepFile:
         "already exists") or a file made or replaced at it meanwhile (``OutputError``, as
         ``outputs.publish`` says for every output), too little free space, a file another
         process is writing (``StoreError``)."""
-        import h5py
         grid = grid if grid is not None else Grid(scene)
         existed = os.path.lexists(path)
         if existed and not overwrite:
@@ -243,8 +243,6 @@ class SweepFile:
         sink of ``rocksweep.run`` without ``output``. Nothing touches a disk; ``image``
         gives the file's bytes, exactly what ``create`` would have written. grid: as
         for ``create``."""
-        import h5py
-
         name = f"rocksweep-memory-{os.getpid()}-{id(scene)}.h5"
         f = h5py.File(name, "w", driver="core", backing_store=False, track_order=True)
         try:
@@ -343,8 +341,6 @@ class SweepFile:
     def _write_at(self, name: str, coords: np.ndarray, values: np.ndarray) -> None:
         """Write values[n] at the grid points coords (uint64[n, rank]): one HDF5 point
         selection, so scattered points cost one call."""
-        import h5py
-
         ds = self.f[name]
         fspace = ds.id.get_space()
         fspace.select_elements(coords)

@@ -41,7 +41,7 @@ SMALL = {"name": "api test", "body": BODY3, "impact": {"lam": [0.0, 0.4]},
 def _modules_after(code: str) -> list[str]:
     probe = (f"import sys\n{code}\n"
              "print('LOADED:' + ','.join(m for m in ('numba', 'h5py', 'matplotlib', 'xarray', "
-             "'scipy') if m in sys.modules))")
+             "'scipy', 'numpy', 'pandas', 'yaml', 'dask', 'tqdm') if m in sys.modules))")
     proc = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     last = proc.stdout.split("LOADED:")[-1].strip()  # after any --help text
@@ -49,12 +49,33 @@ def _modules_after(code: str) -> list[str]:
 
 
 def test_import_and_help_are_light():
-    """`import rocksweep` and `rocksweep --help` load none of the heavy libraries."""
+    """`import rocksweep`, the command line's module and `rocksweep --help` load none of
+    the heavy libraries (not even numpy: the console command sets OPENBLAS_NUM_THREADS
+    before it loads)."""
     assert _modules_after("import rocksweep; rocksweep.run, rocksweep.open") == []
+    assert _modules_after("import rocksweep.cli.main") == []
     assert _modules_after("from rocksweep.cli import main\ntry:\n    main(['--help'])\n"
                           "except SystemExit:\n    pass") == []
     assert _modules_after("from rocksweep.cli import main\ntry:\n    main(['sweep', '--help'])"
                           "\nexcept SystemExit:\n    pass") == []
+
+
+def test_the_command_line_starts_without_the_facade_the_driver_or_outputs():
+    """`import rocksweep.cli.main` (all `rocksweep --help` imports) loads none of the API
+    facade (rocksweep.api: on first use), the sweep driver or outputs.py: they would add
+    23% to its start-up where no .pyc is written, 10% with .pyc files (docs/performance.md,
+    the command line's imports); a command loads them when it runs."""
+    code = ("import sys, rocksweep.cli.main\n"
+            "print(','.join(m for m in ('rocksweep.api', 'rocksweep.simulation', "
+            "'rocksweep.compute.driver', 'rocksweep.outputs') if m in sys.modules))")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == ""
+    # loaded on first use: through a function or the module's old name alike
+    code = ("import rocksweep, sys\nprint('rocksweep.api' in sys.modules, "
+            "rocksweep.api.open is rocksweep.open, 'rocksweep.api' in sys.modules)")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.stdout.split() == ["False", "True", "True"], proc.stderr
 
 
 def test_public_names_have_docstrings_and_version(cli):

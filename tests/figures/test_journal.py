@@ -300,7 +300,7 @@ def test_a_min_figure_of_twelve_panels_has_twelve_colours_and_a_clear_legend():
     from matplotlib.colors import to_rgba
 
     from rocksweep.analysis.boundaries import AMinCurve
-    from rocksweep.figures.diagrams import a_min_figure
+    from rocksweep.figures.a_min import a_min_figure
 
     x = np.geomspace(0.5, 6.0, 8)
     curves = [AMinCurve({"lam": round(0.05 * k, 2)}, x, 1.0 + 0.1 * k + 0.2 * x,

@@ -278,7 +278,7 @@ def test_law_axis_sweeps_resumes_compares_and_refuses_a_changed_law(cli, tmp_pat
 
 
 def test_compare_categories():
-    from rocksweep.figures.diagrams import compare_categories
+    from rocksweep.figures.compare import compare_categories
 
     S, M1, M2, NR = L.OUTCOME_SAFE, L.OUTCOME_MODE1, L.OUTCOME_MODE2, L.OUTCOME_NOT_RUN
     o = np.array([[S, M1, S, M1, M2, NR], [S, S, M1, M1, M2, M1]])
