@@ -337,8 +337,9 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     ``n_records``, ``n_excluded``, ``n_not_run``, the fitted ``curve`` and its bands over
     ``im_grid``; for stripes ``fraction`` per stripe and ``first_level``,
     ``resurrection`` per record. A sweep over ``angle`` gives both answers along an
-    ``orientation`` dimension: "each" (every (record, angle) a sample) and "worst" (the
-    worst angle per record: overturns at any angle).
+    ``orientation`` dimension: "each" (every (record, angle) a sample, pooled; records
+    counted and resampled with all their angles) and "worst" (the worst angle per record:
+    overturns at any angle).
     """
     from rocksweep.analysis.floors import by_orientation
     from rocksweep.analysis.fragility import fragility as fit

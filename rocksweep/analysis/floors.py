@@ -3,8 +3,11 @@ the floor spectrum over ``floor.period``.
 
 Orientation. A sweep over ``angle`` answers two questions (``ORIENTATIONS``):
 
-- ``each``: every orientation is a sample: the (record, angle) pairs are the records
-  (``each_orientation``: the record coordinate becomes "name@angle deg");
+- ``each``: every orientation is a sample of the demand: the (record, angle) pairs are the
+  samples along ``record`` (``each_orientation``: the record coordinate becomes "name@angle
+  deg", ``record_of`` names the record); a fit pools them, but they are not independent
+  records: ``n_records`` counts records and the bootstrap resamples records, each with all
+  its angles (a cluster bootstrap), so the intervals are those of the records at hand;
 - ``worst``: the worst orientation per record (``worst_orientation``): at every other
   point of the grid, the angle whose run overturned (any angle) or, none overturning,
   rotated the most (largest max|theta|/alpha_ref); its variables are that run's,
@@ -31,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from rocksweep.analysis.counts import RECORD_OF
 from rocksweep.errors import FloorError
 
 ORIENTATIONS = ("each", "worst")
@@ -73,14 +77,19 @@ def worst_orientation(ds):
 
 
 def each_orientation(ds):
-    """The sweep Dataset with every (record, angle) pair a record "name@angle deg" (the
-    orientations as samples); per-record variables repeat over the angles."""
+    """The sweep Dataset with every (record, angle) pair a sample "name@angle deg" along
+    ``record`` (the orientations as samples of the demand), ``record_of`` naming its record
+    (``counts.RECORD_OF``: a fit counts records and its bootstrap resamples records, each
+    with all its angles); per-record variables repeat over the angles."""
     if "angle" not in ds.dims or "record" not in ds.dims:
         raise FloorError("each orientation: the Dataset needs record and angle dimensions")
     names = [f"{r}@{float(a):g}deg" for r in ds["record"].values for a in ds["angle"].values]
+    of = [str(r) for r in ds["record"].values for _ in ds["angle"].values]
     st = ds.stack(_sample=("record", "angle"))
     st = st.drop_vars(["record", "angle", "_sample"]).rename({"_sample": "record"})
-    st = st.assign_coords(record=("record", np.array(names, dtype=object)))
+    st = st.assign_coords(record=("record", np.array(names, dtype=object)),
+                          **{RECORD_OF: ("record", np.array(of, dtype=object),
+                                         {"long_name": "the record the sample is of"})})
     dims = [d for d in ds["outcome"].dims if d not in ("record", "angle")]
     order = list(ds["outcome"].dims)
     pos = order.index("record")
@@ -103,11 +112,14 @@ def by_orientation(ds, analysis: Callable[[Any], Any]):
     if "angle" not in ds.dims:
         return analysis(ds)
     parts = [analysis(each_orientation(ds)), analysis(worst_orientation(ds))]
+    # the answers' record dimensions differ (the samples of each, the records of worst):
+    # joined outer, NaN where an answer has no such sample
     out = xr.concat(parts, dim="orientation", coords="minimal", compat="override",
-                    combine_attrs="override")
+                    combine_attrs="override", join="outer")
     out = out.assign_coords(orientation=("orientation", list(ORIENTATIONS)))
-    out.attrs["orientation"] = ("each: every (record, angle) a sample; worst: the worst "
-                                "angle per record (overturns at any angle, else the largest "
+    out.attrs["orientation"] = ("each: every (record, angle) a sample, records resampled "
+                                "with all their angles; worst: the worst angle per record "
+                                "(overturns at any angle, else the largest "
                                 "max|theta|/alpha_ref)")
     return out
 

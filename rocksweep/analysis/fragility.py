@@ -545,7 +545,7 @@ def _bootstrap_fits(f: _Fits, c: Counts, groups: list[tuple[str, list[int]]],
     the point fit; resamples without a finite fit are NaN."""
     lnx = np.log(axis.x)
     per_fit = max(c.R * (axis.x.size if axis.stripes else 1), 1) * 3
-    for start, w in resample_weights(c.R, N, seed, per_fit):
+    for start, w in resample_weights(c.R, N, seed, per_fit, c.groups):
         sl = slice(start, start + w.shape[0])
         # resamples that draw the same records (most of them, with few records) have the
         # same counts and so the same fit: each distinct one is fitted once
@@ -636,8 +636,7 @@ def _dataset(ds: xr.Dataset, state: Any, states: list[str], axis: IMAxis, c: Cou
                                  "one beta) or competing (mode1 with mode2)"})
     data["n_boot_undefined"] = (dims_c, shaped(f.n_undef),
                                 {"long_name": "bootstrap resamples without a finite fit"})
-    n_records = c.counted.reshape(c.n_o, c.R, -1).any(-1).sum(-1)
-    data["n_records"] = (others, n_records.reshape(shape_o).astype(np.int64),
+    data["n_records"] = (others, c.records_counted().reshape(shape_o).astype(np.int64),
                          {"long_name": "records with at least one counted point"})
     data["n_excluded"] = (others, c.flagged.reshape(c.n_o, -1).sum(-1).reshape(shape_o),
                           {"long_name": "flagged points (status & STATUS_FLAGGED) left out"})
@@ -824,7 +823,12 @@ def probability(frag: xr.Dataset, x: Sequence[float] | np.ndarray) -> xr.DataArr
     bet = frag["beta"].transpose(*(["state"] if lead else []), *dims).values
     med, bet = (np.asarray(a, dtype=np.float64) if lead else np.asarray(a)[None]
                 for a in (med, bet))
-    kinds = np.atleast_1d(np.asarray(frag["fit"].values)) if "fit" in frag else \
+    # a state's model, whatever other dims ``fit`` gained (an orientation's answers,
+    # ``floors.by_orientation``, stack one fit per answer: the same model for a state)
+    fit = frag["fit"] if "fit" in frag else None
+    if fit is not None and any(d != "state" for d in fit.dims):
+        fit = fit.isel({d: 0 for d in fit.dims if d != "state"})
+    kinds = np.atleast_1d(np.asarray(fit.values)) if fit is not None else \
         np.array(["single"] * med.shape[0])
     states = list(np.atleast_1d(np.asarray(frag["state"].values)))
     out = np.full(med.shape + (xs.size,), np.nan)

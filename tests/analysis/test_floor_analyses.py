@@ -85,7 +85,9 @@ def test_fragility_gives_both_orientation_answers(suite_on_floors):
         fr = rocksweep.fragility(rocksweep.open(suite_on_floors), bootstrap=0)
     assert list(fr["orientation"].values) == ["each", "worst"]
     assert "floor.period" in fr["im_median"].dims
-    assert fr["n_records"].sel(orientation="each").max() == 6  # 3 records x 2 angles
+    # each: 3 records x 2 angles counted at a stripe, but 3 records (not 6 pairs)
+    assert fr["n_counted"].sel(orientation="each").max() == 6
+    assert fr["n_records"].sel(orientation="each").max() == 3
     assert fr["n_records"].sel(orientation="worst").max() == 3
 
 
@@ -132,3 +134,41 @@ def test_the_floor_spectrum_command_writes_its_figure(suite_on_floors, tmp_path,
     res = cli.invoke(main, ["floor-spectrum", str(suite_on_floors), "-o", str(fig)])
     assert res.exit_code == 0, res.output
     assert fig.stat().st_size > 1000 and "share of records" in res.output
+
+
+def test_each_orientation_resamples_records_not_record_angle_pairs():
+    """``each`` pools the (record, angle) pairs but resamples records with all their
+    angles (issue 45): two angles that repeat a record's runs double every count, so the
+    pooled fit, its bootstrap intervals and n_records equal the fit of the records alone
+    (the same records drawn by the same seed). Resampling the 2R pairs instead gave
+    narrower intervals and n_records 2R."""
+    from rocksweep.analysis.fragility import fragility
+
+    rng = np.random.default_rng(3)
+    levels = np.array([0.1, 0.2, 0.3, 0.4, 0.6, 0.8])
+    cap = np.exp(np.log(0.35) + 0.4 * rng.standard_normal(12))
+    over = levels[None, :] >= cap[:, None]
+    ds = xr.Dataset({"outcome": (("record", "PGA"), over.astype(np.int8)),
+                     "theta_max_over_alpha": (("record", "PGA"),
+                                              np.where(over, np.nan, levels / cap[:, None])),
+                     "uplifts": (("record", "PGA"), np.ones(over.shape, np.int32)),
+                     "status": (("record", "PGA"), np.zeros(over.shape, np.int32))},
+                    coords={"record": [f"r{i}" for i in range(12)], "PGA": levels},
+                    attrs={"scale_im": "PGA"})
+    alone = fragility(ds, bootstrap=50, seed=4)
+    full = rocksweep.fragility(ds.expand_dims(angle=[0.0, 90.0], axis=-1).copy(),
+                               bootstrap=50, seed=4)
+    both = full.sel(orientation="each")
+    for v in ("im_median", "beta", "im_median_lo", "im_median_hi", "beta_lo", "beta_hi"):
+        assert float(both[v]) == pytest.approx(float(alone[v]), rel=1e-6), v
+    assert int(both["n_records"]) == 12
+    assert list(both["record_of"].dropna("record").values[:2]) == ["r0", "r0"]
+    # risk of a fragility with an orientation dimension (an IndexError before): each
+    # answer's rate and interval are those of its own curve
+    import pandas as pd
+
+    x = np.geomspace(0.01, 3.0, 30)
+    hz = pd.DataFrame({"PGA [g]": x, "annual_rate": 1e-4 * x ** -2.0})
+    rk, own = rocksweep.risk(full, hz), rocksweep.risk(alone, hz)
+    for v in ("annual_rate", "annual_rate_lo", "annual_rate_hi"):
+        assert float(rk[v].sel(orientation="each")) == pytest.approx(float(own[v]), rel=1e-6)
