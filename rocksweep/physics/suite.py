@@ -52,6 +52,7 @@ from rocksweep.vocab.ground import (
     PGV_RATIO,
     RATIO_OF,
     RECORD_IMS,
+    SA,
     SA_DAMPING,
     SCALE_IMS,
 )
@@ -67,6 +68,10 @@ MAX_FACTOR = 5.0
 #: the horizontal components a suite's IM may be taken of (``ground.scale.component``)
 H1, ROTD50 = "H1", "RotD50"
 COMPONENTS = (H1, ROTD50)
+#: the stripe IMs RotD50 is taken of (Boore 2010: the median over orientations of a
+#: peak: the acceleration's, the velocity's, the 5% oscillator's); AvgSa, CAV and Arias
+#: have no RotD50 convention (refused in one line, ``ground.scale.component``)
+ROTD50_IMS = (PGA, PGA_RATIO, PGV, PGV_RATIO, SA)
 
 
 
@@ -300,6 +305,8 @@ def rotd50_im(h1: GroundRecord, h2: GroundRecord, im: str | None, period: float)
     from rocksweep.physics import intensity
     from rocksweep.physics.path import rotd50_peaks
 
+    if im not in ROTD50_IMS:
+        raise SuiteError(f"RotD50 of {im}: defined for {', '.join(ROTD50_IMS)} only")
     n = max(h1.npts, h2.npts)
     a1, a2 = (np.pad(r.acc, (0, n - r.npts)) for r in (h1, h2))
     if im in (PGA, PGA_RATIO):

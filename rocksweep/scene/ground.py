@@ -23,6 +23,7 @@ from rocksweep.physics.suite import (
     AVGSA_RANGE,
     COMPONENTS,
     ROTD50,
+    ROTD50_IMS,
     Suite,
     make_suite,
 )
@@ -327,6 +328,11 @@ def ground_suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...
     if component == ROTD50 and im is None:
         raise SceneError("ground.scale.component = 'RotD50': scales stripes (ground.scale: "
                          "{im: ..., values: ...})")
+    if component == ROTD50 and im not in ROTD50_IMS:
+        raise SceneError(f"ground.scale.component = 'RotD50': with ground.scale.im = {im}; "
+                         f"RotD50 (the median over orientations of a peak, Boore 2010) is "
+                         f"taken of {', '.join(ROTD50_IMS)} stripes; use component H1 for "
+                         f"{im}")
     values = axis_values("ground.scale.values", form, spec).tolist() if im else []
     try:
         suite = make_suite(records, names, im, values, period, factor,

@@ -111,3 +111,15 @@ def test_rotd50_needs_both_horizontals(tmp_path):
         parse_scene(__import__("yaml").safe_dump(scene(
             str(root / "SYN0*.AT2"), scale={"im": "PGA", "values": [0.3],
                                              "component": "RotD50"})))
+
+
+@pytest.mark.parametrize("im", ["AvgSa", "CAV", "Arias"])
+def test_rotd50_of_an_im_without_that_convention_is_one_line(tmp_path, im):
+    """RotD50 is the median over orientations of a peak (PGA, PGV, Sa); AvgSa, CAV and
+    Arias stripes with it ended in "cannot convert float NaN to integer" (issue 45)."""
+    d = folder(tmp_path, n=2, up=False)
+    scale = {"im": im, "values": [0.3], "component": "RotD50"}
+    with pytest.raises(SceneError) as err:
+        parse_scene(__import__("yaml").safe_dump(scene(d, scale=scale)))
+    msg = str(err.value)
+    assert "\n" not in msg and f"ground.scale.im = {im}" in msg and "use component H1" in msg
