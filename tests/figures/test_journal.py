@@ -333,3 +333,7 @@ def test_the_rocking_spectrum_names_its_line_styles_and_the_values_it_shows():
     angled = sp.expand_dims(angle=[30.0, 60.0])
     fig = rocksweep.plot(angled)
     assert "angle = 30" in fig.axes[0].get_title()
+    # a word axis (pulse.shape) is named as itself: formatting it as a number was a
+    # ValueError (issue 45)
+    shaped = sp.expand_dims(shape=["cosine", "sine"])
+    assert "shape = cosine" in rocksweep.plot(shaped).axes[0].get_title()
