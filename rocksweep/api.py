@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rocksweep.analysis.resampling import DEFAULT_CI, DEFAULT_SEED
+from rocksweep.analysis.tolerance import FLOOR_RTOL
 from rocksweep.errors import ApiError
 from rocksweep.simulation import Simulation  # what simulate returns
 
@@ -277,14 +278,18 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3, search: bool = True) -> xr.Datas
 
 
 @_public
-def floor_spectrum(ds: xr.Dataset, rtol: float = 1e-2, search: bool = True) -> xr.Dataset:
+def floor_spectrum(ds: xr.Dataset, rtol: float = FLOOR_RTOL, search: bool = True
+                   ) -> xr.Dataset:
     """The floor spectrum of a complete sweep over ``floor.period``: a record suite's
     P(overturn) over (floor.period, stripe, ...) (with an ``angle`` axis for each
     orientation answer: ``orientation`` each/worst), or one record's or a pulse's A_min
-    over floor.period, bisected to ``rtol`` (``rocksweep.analysis.floors``). Its figure:
-    ``rocksweep.plot``."""
+    over floor.period, bisected to ``rtol`` (in (0, 0.1]; search=False: the grid's bracket
+    only, as for ``spectra``) (``rocksweep.analysis.floors``). ds: what ``run`` or ``open``
+    returns, or a result file's path. Its figure: ``rocksweep.plot``; its table:
+    ``rocksweep.table``."""
     from rocksweep.analysis.floors import floor_spectrum as compute
 
+    _check_dataset("ds", ds)
     return compute(ds, rtol, search)
 
 

@@ -35,20 +35,31 @@ from typing import Any
 import numpy as np
 
 from rocksweep.analysis.counts import RECORD_OF
+from rocksweep.analysis.tolerance import FLOOR_RTOL
 from rocksweep.errors import FloorError
 
 ORIENTATIONS = ("each", "worst")
 FLOOR_X = "floor.period"
 
 
+def _where(ds) -> str:
+    """A Dataset as messages name it: its file, else its title."""
+    source = ds.encoding.get("source")
+    return str(source) if source else f"result in memory ({ds.attrs.get('title') or 'untitled'})"
+
+
 def worst_orientation(ds):
-    """The sweep Dataset with its ``angle`` dimension reduced to the worst orientation
-    (module docstring): the same variables, ``worst_angle`` [deg]; attrs ``orientation``
-    says how it was chosen."""
+    """The sweep Dataset (or a result file's path) with its ``angle`` dimension reduced to
+    the worst orientation (module docstring): the same variables, ``worst_angle`` [deg];
+    attrs ``orientation`` says how it was chosen."""
     import xarray as xr
 
-    if "angle" not in ds.dims:
-        raise FloorError("worst orientation: the Dataset has no angle dimension")
+    from rocksweep.analysis.files import as_dataset
+
+    ds = as_dataset(ds, "ds")
+    if "angle" not in ds.dims or "outcome" not in ds.data_vars:
+        raise FloorError(f"{_where(ds)}: worst orientation: not a sweep over angle (no "
+                         "angle dimension and outcome)")
     out = ds["outcome"]
     theta = ds["theta_max_over_alpha"].fillna(-1.0)
     key = xr.where(out > 0, np.inf, theta)
@@ -160,17 +171,28 @@ def _p_overturn(ds):
     return p, n
 
 
-def floor_spectrum(ds, rtol: float = 1e-2, search: bool = True):
+def floor_spectrum(ds, rtol: float = FLOOR_RTOL, search: bool = True):
     """The floor spectrum of a complete sweep over ``floor.period`` (module docstring) as a
     Dataset (attrs rocksweep_kind "floor_spectrum", the building's ``floor`` line): a
     suite's ``p_overturn`` and ``n_counted`` over (floor.period, stripe, others[,
     orientation]); one record's or a pulse's ``A_min``, ``mode``, ``A_min_method`` over
-    (others, floor.period)."""
+    (others, floor.period). ds: a sweep Dataset or a result file's path; rtol (in (0,
+    MAX_RTOL]) and search (a bool) are checked first, as ``spectra`` checks them; an
+    incomplete result (an interrupted sweep) is refused in one line."""
     import xarray as xr
 
-    if FLOOR_X not in ds.dims:
-        raise FloorError(f"floor spectrum: the sweep has no {FLOOR_X} dimension (sweep "
-                         "floor.period in the scene's floor section)")
+    from rocksweep.analysis.boundaries import check_search
+    from rocksweep.analysis.files import as_dataset
+    from rocksweep.errors import check_rtol
+    from rocksweep.store.reader import as_result
+
+    rtol = check_rtol(rtol)
+    search = check_search(search)
+    ds = as_dataset(ds, "ds")
+    if "outcome" in ds.data_vars and FLOOR_X not in ds.dims:
+        raise FloorError(f"{_where(ds)}: floor spectrum: the sweep has no {FLOOR_X} "
+                         "dimension (sweep floor.period in the scene's floor section)")
+    as_result(ds, ["outcome"]).require_complete(FloorError, "a floor spectrum")
     attrs = {"rocksweep_kind": "floor_spectrum", "title": ds.attrs.get("title", ""),
              "floor": ds.attrs.get("floor", ""), "scale_im": ds.attrs.get("scale_im", "")}
     if "record" in ds["outcome"].dims:
@@ -187,12 +209,12 @@ def floor_spectrum(ds, rtol: float = 1e-2, search: bool = True):
         grid_response,
         kernel_evaluator,
     )
-    from rocksweep.store.reader import as_result, result_scene
+    from rocksweep.store.reader import result_scene
 
     result = as_result(ds, ["outcome", "theta_max_over_alpha", "uplifts", "status"])
     if "A_ratio" not in result.dims:
-        raise FloorError("floor spectrum: one record's or a pulse's needs A_ratio swept "
-                         "(A_min is searched along it)")
+        raise FloorError(f"{_where(ds)}: floor spectrum: one record's or a pulse's needs "
+                         "A_ratio swept (A_min is searched along it)")
     scene = result_scene(result)
     curves = a_min(scene, result.arrays["outcome"], rtol, axes=(FLOOR_X, "A_ratio"),
                    evaluate=kernel_evaluator(scene), **grid_response(result), search=search)

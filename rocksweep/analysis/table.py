@@ -37,7 +37,8 @@ __all__ = ["ROW_VARIABLE", "table"]
 #: the variable whose dims are a kind's rows
 ROW_VARIABLE = {"sweep": "outcome", "fragility": ("im_median", "median"), "ida": "ida_im",
                 "risk": "annual_rate", "im_efficiency": "beta",
-                "spectra": "theta_max_over_alpha", "boundaries": "A_min"}
+                "spectra": "theta_max_over_alpha", "boundaries": "A_min",
+                "floor_spectrum": ("p_overturn", "A_min")}
 MAX_SPREAD = 32  # an extra dimension at most this long becomes columns
 SKIP = ("record_sha256",)  # identity, not data: in the file, not in every row
 

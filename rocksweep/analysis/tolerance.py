@@ -6,3 +6,6 @@ numba, h5py or matplotlib)."""
 from __future__ import annotations
 
 DEFAULT_RTOL = 1e-3
+#: the floor spectrum's A_min (``analysis.floors``): one bisection per building period and
+#: value of the other keys, so a coarser default (its A_min to 1%)
+FLOOR_RTOL = 1e-2

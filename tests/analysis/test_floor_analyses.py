@@ -127,13 +127,69 @@ def test_ida_table_and_plot_run_over_angle_and_floor_period(suite_on_floors):
         assert rocksweep.plot(suite_on_floors) is not None
 
 
-def test_the_floor_spectrum_command_writes_its_figure(suite_on_floors, tmp_path, cli):
+def test_the_floor_spectrum_command_writes_its_figure_and_numbers(suite_on_floors, tmp_path,
+                                                                    cli):
+    import pandas as pd
+
     from rocksweep.cli import main
 
-    fig = tmp_path / "floors.png"
-    res = cli.invoke(main, ["floor-spectrum", str(suite_on_floors), "-o", str(fig)])
+    fig, csv, h5 = tmp_path / "floors.png", tmp_path / "f.csv", tmp_path / "f.h5"
+    res = cli.invoke(main, ["floor-spectrum", str(suite_on_floors), "-o", str(fig), "-o",
+                            str(csv)])
     assert res.exit_code == 0, res.output
     assert fig.stat().st_size > 1000 and "share of records" in res.output
+    assert cli.invoke(main, ["floor-spectrum", str(suite_on_floors), "-o",
+                             str(h5)]).exit_code == 0
+    # the numbers: the share of overturning (record, angle) pairs, counted here
+    ds = rocksweep.open(suite_on_floors)
+    each = ds["outcome"].isin([1, 2]).mean(("record", "angle"))
+    rows = pd.read_csv(csv)
+    one = rows[(rows["orientation"] == "each") & (rows["PGA"] == 0.6)
+               & (rows["floor.period"] == 0.5)]
+    assert float(one["p_overturn"].iloc[0]) == pytest.approx(
+        float(each.sel(PGA=0.6, **{"floor.period": 0.5})))
+    assert rocksweep.open(h5).attrs["rocksweep_kind"] == "floor_spectrum"
+
+
+def test_floor_spectrum_answers_bad_input_in_one_line(suite_on_floors, tmp_path, cli):
+    """Issue 43 item 3 and issue 45: the shared --rtol (refused while parsing, before the
+    file is read: exit 2), the shared reader (a missing file, a FIFO that must not
+    block), an interrupted sweep refused (its figure was written), and the API's types."""
+    import os
+    import shutil
+
+    import h5py
+    from helpers import one_line_error
+
+    from rocksweep.cli import main
+    from rocksweep.errors import RocksweepError
+
+    def line(args, code=None):
+        return one_line_error(cli.invoke(main, ["floor-spectrum", *args]), code)
+
+    assert "--rtol" in line([str(suite_on_floors), "--rtol", "-5"], 2)
+    assert "--rtol" in line([str(tmp_path / "none.h5"), "--rtol", "0.3"], 2)
+    assert "no such file" in line([str(tmp_path / "none.h5")])
+    os.mkfifo(tmp_path / "fifo.h5")
+    assert "not a regular file" in line([str(tmp_path / "fifo.h5")])
+    part = tmp_path / "part.h5"
+    shutil.copy(suite_on_floors, part)
+    with h5py.File(part, "r+") as f:
+        out = f["outcome"][()]
+        out.flat[-3:] = -1
+        f["outcome"][()] = out
+        f.attrs["complete"] = np.int8(0)
+    assert "incomplete result (3 of" in line([str(part), "-o", str(tmp_path / "p.png")])
+    assert not (tmp_path / "p.png").exists()
+    for bad in (None, 5, [1, 2], {}):
+        with pytest.raises(TypeError, match="ds = "):
+            rocksweep.floor_spectrum(bad)
+    for kw, word in (({"rtol": "x"}, "rtol"), ({"search": "no"}, "search")):
+        with pytest.raises(RocksweepError, match=word):
+            rocksweep.floor_spectrum(suite_on_floors, **kw)
+    with pytest.raises(RocksweepError, match="ds = NoneType"):
+        worst_orientation(None)
+    assert worst_orientation(suite_on_floors).sizes["record"] == 3  # a path, as elsewhere
 
 
 def test_each_orientation_resamples_records_not_record_angle_pairs():
