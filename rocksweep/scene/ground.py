@@ -137,7 +137,8 @@ def _record_paths(spec: Any, base: Path | None) -> tuple[list[Path], list[Path],
         path = _where(e, base)
         if has_magic(e) and not os.path.lexists(path):
             pattern = str(path)
-            found = sorted(Path(p) for p in glob(pattern) if Path(p).is_file())
+            # a folder it matches is no record; a FIFO or a dangling link is named below
+            found = sorted(Path(p) for p in glob(pattern) if not Path(p).is_dir())
             if not found:
                 raise SceneError(f"{key}: {e!r} matches no file (looked for {pattern})")
             out.extend(found)
