@@ -49,7 +49,7 @@ Verdicts (``reason``: "ok", or the words below joined by ","; never "ok" for the
   common beta against a beta per state (``likelihood.parallel_lr``) rejects it at
   ``PARALLEL_P``: the joint curves misstate the data; fit the states separately;
 - "incomplete": points of the curve not computed (outcome -1: a partial file, or a sweep
-  still writing it); "flagged": points flagged by the kernel (horizon, caps) are left out
+  still writing it); "flagged": points flagged by the kernel (horizon, caps, airborne) are left out
   and counting them as reaching the state, or as not, moves im_median by more than
   ``FLAGGED_SHIFT`` (relative).
 

@@ -60,7 +60,7 @@ def table(ds: xr.Dataset) -> Any:
     if kind == "sweep":  # every row is written; a partial file's are said to be missing
         from rocksweep.analysis.states import trust
 
-        trust(ds, "table")
+        trust(ds, "table", kept=True)
     main = ROW_VARIABLE[kind]
     main = next((m for m in (main if isinstance(main, tuple) else (main,)) if m in ds),
                 None)
