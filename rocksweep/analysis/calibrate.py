@@ -37,8 +37,13 @@ is on the sequence of excursion peaks.
 
 The starts are aligned: the measured history may begin with a quiet part of any length
 (before a release, or before the pulse lifts the body); the simulated history is shifted
-so that both depart from their first value by the threshold at the same time, refined by
-least squares on theta over the first half cycles (before any phase drift).
+so that both depart from their first value by the threshold at the same time (the
+measurement's first value the median of its first samples, its departure held at two
+samples in a row: one noise sample cannot start it), refined by least squares on theta
+over the first half cycles (before any phase drift): a grid across half that window either
+side, then a golden section in its best cell. A slow start (a release from a tilt) departs
+by the threshold at a time the noise moves by a good part of a half cycle, so the
+onsets alone are no bracket.
 
 The interval
 ------------
@@ -105,6 +110,7 @@ H_REL = 0.02  # ... and at least this share of the largest |theta|
 GRID = 21  # first look of a one-parameter fit: GRID values across the bounds
 GRID_2D = 9  # ... and GRID_2D^2 for two parameters
 STAGES = (3, 6, 12, 24, 48, 96, 192)  # half cycles compared at each stage of ``_fit``
+SHIFT_GRID = 41  # the start's shift: a grid across its bracket first (``Problem._shift``)
 PROFILE_POINTS = 15  # values of the profile misfit a parabola is fitted to (``_smooth_profile``)
 # practical default bounds of a fitted key (inside the key's admissible range)
 DEFAULT_BOUNDS = {"impact.lam": (0.0, 2.0), "impact.e": (0.02, 1.0),
@@ -205,7 +211,7 @@ class Problem:
                                                                           measured.theta)
         amp = float(np.max(np.abs(measured.theta)))
         self.h = max(H_NOISE * self.sigma, H_REL * amp)
-        self.t_onset = onset(measured.t, measured.theta, self.h)
+        self.t_onset = onset(measured.t, measured.theta, self.h, noisy=True)
         if not math.isfinite(self.t_onset):
             raise CalibrationError(f"{measured.source}: theta_over_alpha never departs from "
                                    f"its first value by more than {self.h:.3g} (4 x the "
@@ -225,10 +231,12 @@ class Problem:
             dur = self.peaks.area / np.maximum(np.abs(self.peaks.value) - self.h, 1e-300)
         self.t_scale = float(np.median(dur[dur > 0])) if np.any(dur > 0) else 1.0
         # the start window of the shift (``_shift``): from the first sample to the second
-        # half-cycle peak; the shift is searched within a tenth of that window
+        # half-cycle peak; the shift is searched within half that window of the onsets'
+        # (a slow start, as a release from a tilt, departs by the threshold at a time the
+        # noise moves by a good part of the window: 0.43 p*t of 3 for 1% noise)
         t_end = self.peaks.time[1] if self.peaks.time.size > 1 else measured.t[-1]
         self.window = np.flatnonzero(measured.t <= t_end)
-        self.dt_shift = 0.1 * max(float(t_end - self.t_onset), 1e-3)
+        self.dt_shift = 0.5 * max(float(t_end - self.t_onset), 1e-3)
         self.runs = 0
         self.n_use: int | None = None  # compare the first n_use half cycles (None: all)
         # the least misfit of every candidate on all half cycles, and where (``_verdict``:
@@ -330,7 +338,13 @@ class Problem:
         def ss(sh: float) -> float:
             return float(np.sum((hermite(h["t"], h["theta"], h["theta_dot"], tt - sh) - yy)
                                 ** 2))
-        r = _golden(ss, (shift0 - self.dt_shift, shift0 + self.dt_shift), 1e-6)
+        # a grid across the bracket, then a golden section in the best cell: the squares
+        # are unimodal near the right shift only
+        grid = np.linspace(shift0 - self.dt_shift, shift0 + self.dt_shift, SHIFT_GRID)
+        sims = hermite(h["t"], h["theta"], h["theta_dot"], (tt[None, :] - grid[:, None])
+                       .ravel()).reshape(grid.size, tt.size)  # every shift in one call
+        k = int(np.argmin(np.sum((sims - yy[None, :]) ** 2, axis=1)))
+        r = _golden(ss, (grid[max(k - 1, 0)], grid[min(k + 1, SHIFT_GRID - 1)]), 1e-6)
         return float(r.x) if r.fun <= ss(shift0) else shift0
 
     def misfit(self, x: np.ndarray) -> float:
