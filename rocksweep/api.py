@@ -464,7 +464,7 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     CSV path or a pandas DataFrame with columns p_t, theta_over_alpha (as ``simulate
     --csv`` writes), or t [s], theta [rad] (then p [rad/s]: the keyword, a physical
     body's or a record scene's ground.p). bounds: {key: (lo, hi)} inside each key's
-    admissible range (default: ``analysis.calibrate.DEFAULT_BOUNDS`` or the range). ci:
+    admissible range (default: ``analysis.fit_keys.DEFAULT_BOUNDS`` or the range). ci:
     the interval's level, in [0.5, 1). Returns a Dataset over ``parameter`` (the fitted
     keys): ``estimate``, ``lo``, ``hi`` (the ``ci`` interval by profile likelihood, ``ci``
     in attrs), scalar ``misfit`` (RMS error of the half-cycle peaks, theta/alpha_ref)

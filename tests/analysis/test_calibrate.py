@@ -249,14 +249,14 @@ def test_a_fit_that_stops_short_of_the_least_misfit_says_not_converged(monkeypat
 
     t, theta = free_block_history(0.88)
     frame = noisy(t, theta / ALPHA, 0.01)
-    real = C._fit
+    real = C.fit
 
     def short(problem):
         x, _ = real(problem)
         x = x - 0.01
         return x, problem.misfit(x)
 
-    monkeypatch.setattr(C, "_fit", short)
+    monkeypatch.setattr(C, "fit", short)
     with pytest.warns(C.CalibrationWarning, match="not_converged .a run at impact.e"):
         fit = rocksweep.calibrate(BLOCK, frame, ["impact.e"])
     assert "not_converged" in fit["reason"].item().split(",")
@@ -292,7 +292,7 @@ def test_the_exact_model_at_its_own_noise_says_ok():
     cannot make."""
     import warnings
 
-    from rocksweep.analysis.calibrate import Problem
+    from rocksweep.analysis.misfit import Problem
     from rocksweep.physics.measured import read_measured
     from rocksweep.scene.inputs import load
 
