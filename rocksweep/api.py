@@ -456,7 +456,7 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
 def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impact.lam",),
               *, bounds: Mapping[str, Sequence[float]] | None = None,
               overrides: Overrides = (), ci: float = 0.95, p: float | None = None,
-              noise: float | None = None) -> xr.Dataset:
+              noise: float | None = None, progress: bool = False) -> xr.Dataset:
     """Fit scene numbers to a measured rocking history.
 
     scene, overrides: as for ``run``. fit: the key or distinct keys to fit (``impact.lam``,
@@ -472,6 +472,8 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     theta/alpha_ref) and ``dof``, ``reason`` ("ok" or misfit, unidentifiable, at_bound,
     not_converged joined by ",", also a ``CalibrationWarning``), and the measured and
     fitted histories over p_t with the fitted impacts (``rocksweep.analysis.calibrate``).
+    progress: say on stderr when the fit's kernel variant must be compiled first (once per
+    machine) and what that costs.
     """
     from rocksweep.analysis.calibrate import calibrate_scene
 
@@ -483,7 +485,9 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     _typed("p", p, p is None or _is_number(p), "a number (the body's p [rad/s]) or None")
     _typed("noise", noise, noise is None or _is_number(noise),
            "a number (the measurement noise, theta/alpha_ref) or None")
-    out = calibrate_scene(scene, measured, fit, bounds, ci, p, overrides, noise)
+    _check_flags(progress=progress)
+    say = (lambda m: print(m, file=sys.stderr, flush=True)) if progress else None
+    out = calibrate_scene(scene, measured, fit, bounds, ci, p, overrides, noise, say)
     return out
 
 

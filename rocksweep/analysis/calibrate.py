@@ -34,16 +34,16 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
 from rocksweep.analysis.fit_search import fit, profile_end, smooth_profile
 from rocksweep.analysis.misfit import Problem
+from rocksweep.compute.compile_cost import prepare_point
 from rocksweep.errors import CalibrationError
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.kernel import warm_up
 from rocksweep.physics.measured import Measured, read_measured
 from rocksweep.physics.points import kernel_kind
 from rocksweep.schema import KEYS
@@ -73,8 +73,11 @@ class CalibrationWarning(UserWarning):
     is one line with the numbers."""
 
 
-def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
-    """Fit a ``Problem``: the Dataset of ``rocksweep.calibrate`` (see ``calibrate``)."""
+def calibrate_problem(problem: Problem, ci: float = 0.95,
+                      say: Callable[[str], None] | None = None) -> Any:
+    """Fit a ``Problem``: the Dataset of ``rocksweep.calibrate`` (see ``calibrate``).
+    say: told when the runs' kernel variant compiles first, and what it costs
+    (``compile_cost.prepare_point``)."""
     from statistics import NormalDist
 
     import xarray as xr
@@ -82,7 +85,7 @@ def calibrate_problem(problem: Problem, ci: float = 0.95) -> Any:
     t0 = time.perf_counter()
     k = len(problem.keys)
     kind = kernel_kind(problem.point(problem.bounds.mean(axis=1)).body)
-    warm_up(kind, None, problem.scene.ground)
+    prepare_point(kind, problem.scene.ground, say or (lambda _m: None))
     x_hat, s_min = fit(problem)
     if not math.isfinite(s_min):
         raise CalibrationError("no candidate inside the bounds gives a physical body; "
@@ -216,7 +219,8 @@ def _verdict(problem: Problem, x_hat: np.ndarray, s_min: float, lo: np.ndarray,
 def calibrate_scene(scene: Any, measured: Any, fit: str | Sequence[str],
                     bounds: Mapping[str, Sequence[float]] | None = None, ci: float = 0.95,
                     p: float | None = None, overrides: Any = (),
-                    noise: float | None = None) -> Any:
+                    noise: float | None = None,
+                    say: Callable[[str], None] | None = None) -> Any:
     """``rocksweep.calibrate`` (its arguments documented there): ``fit`` (a key or a
     non-empty list of distinct keys) and ``ci`` (in [0.5, 1)) checked first, then the scene
     loaded (``scene.inputs.load``: a Scene, a path, YAML text or a dict, with
@@ -264,7 +268,7 @@ def calibrate_scene(scene: Any, measured: Any, fit: str | Sequence[str],
                                "theta_over_alpha; p reads physical columns t [s], theta "
                                "[rad] only (leave it out)")
     _check_measured_span(m, body.alpha_ref)
-    return calibrate_problem(Problem(scene, m, keys, bounds, noise), ci)
+    return calibrate_problem(Problem(scene, m, keys, bounds, noise), ci, say)
 
 
 def _check_measured_span(m: Measured, alpha_ref: float) -> None:

@@ -66,7 +66,8 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
     from rocksweep.cli.helpers import check_table_outputs, write_table
 
     # the scene file and what it reads (a record), the measured CSV: never written over
-    inputs = [*load(scene_path, overrides).inputs, measured_path]
+    scene = load(scene_path, overrides)
+    inputs = [*scene.inputs, measured_path]
     check_table_outputs(out_path, plot_path, (".h5", ".nc"), inputs, overwrite)
     import warnings
 
@@ -75,7 +76,7 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", CalibrationWarning)
         ds = fit_scene(scene_path, measured_path, list(fit), bounds=_bounds(bounds) or None,
-                       overrides=list(overrides), p=p, noise=noise)
+                       overrides=list(overrides), p=p, noise=noise, progress=True)
     release_warnings()  # fitted: the scene's warnings before the fit's verdicts
     for w in caught:
         if issubclass(w.category, CalibrationWarning):
