@@ -38,6 +38,7 @@ from rocksweep.api import (  # noqa: A004
     calibrate,
     calibrated_overrides,
     estimate,
+    felt_motion,
     floor_spectrum,
     fragility,
     ida,
@@ -85,5 +86,6 @@ def __getattr__(name: str) -> str:
 
 
 __all__ = ["RocksweepError", "Simulation", "__version__", "boundaries", "boundary_lines",
-           "calibrate", "calibrated_overrides", "estimate", "floor_spectrum", "fragility",
+           "calibrate", "calibrated_overrides", "estimate", "felt_motion", "floor_spectrum",
+           "fragility",
            "ida", "im_efficiency", "open", "plot", "risk", "run", "simulate", "spectra", "table"]

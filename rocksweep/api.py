@@ -450,6 +450,23 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     return out[0] if sc.size == 1 else out
 
 
+@_public
+def felt_motion(scene: SceneLike, overrides: Overrides = (), /, **keys: Any) -> xr.Dataset:
+    """The motion the body feels at one point of a scene, as samples (no run): ``a_h`` [g]
+    the horizontal acceleration after the orientation (``ground.angle``) and the building
+    (``floor``), scaled as the point runs it, ``a_v`` [g] the vertical acting with it,
+    ``a_ground`` [g] the ground's H1 at the same scale (with an excitation path), over
+    ``t`` [s] (``rocksweep.compute.motion``). scene and overrides as for ``simulate`` (one
+    point). The kernel runs exactly these samples, linear between them;
+    ``rocksweep.physics.records.write_at2(path, ds.a_h.values, ds.attrs["dt"], title)``
+    keeps one as a record."""
+    from rocksweep.compute.motion import felt_motion as felt
+    from rocksweep.scene.inputs import load, override_strings
+
+    sc, _ = load(scene, [*override_strings(overrides), *override_strings(keys)])
+    return felt(sc)
+
+
 # --- Calibration: scene numbers fitted to a measured history ------------------
 
 @_public
