@@ -234,6 +234,6 @@ def floor_spectrum(ds, rtol: float = FLOOR_RTOL, search: bool = True):
                                          "flag_meanings": ";".join(A_MIN_METHODS)})},
         coords=coords)
     out[FLOOR_X].attrs = {"long_name": "period of the building's mode", "units": "s"}
-    out.attrs = {**attrs, "method": "A_min", "rtol": rtol,
+    out.attrs = {**attrs, "method": "A_min", "rtol": rtol, "kind": result.kind,
                  "runs": int(sum(c.runs.sum() for c in curves))}
     return out
