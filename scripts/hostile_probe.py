@@ -751,27 +751,31 @@ for _name, _files, _target, _args in (
         lambda d, f=_files, t=_target, a=_args: (fixture(d, *f), appears(d, t, a))[1])
 
 
-@case("two table -o t.csv at once: one writes, the other refuses", "ok")
-def _(d):
-    fixture(d, "s.h5")
+def two_writers(d: Path, target: str, args: list[str]) -> subprocess.CompletedProcess:
+    """The same command writing ``target`` twice at once: both check the path, then both
+    wait 2 s before writing it (they overlap): one writes, the other refuses."""
     freeze(d)
     e = {**os.environ, "PYTHONPATH": str(ROOT)}
     slow = APPEARS.replace("    try:\n        with open(target, 'x') as f:\n"
                            "            f.write('mine')\n    except FileExistsError:\n"
                            "        pass\n", "    import time; time.sleep(2)\n")
     assert "sleep" in slow
-    # both check t.csv, then both wait 2 s before writing it: they overlap
-    procs = [subprocess.Popen([sys.executable, "-c", slow, "t.csv", "table", "s.h5", "-o",
-                               "t.csv"], cwd=d, env=e, stdout=subprocess.PIPE,
-                              stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    procs = [subprocess.Popen([sys.executable, "-c", slow, target, *args], cwd=d, env=e,
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+             for _ in range(2)]
     outs = [p.communicate(timeout=TIMEOUT) for p in procs]
     r = subprocess.CompletedProcess([], 0, outs[0][0] + outs[1][0], "")
     wrote = sum("wrote" in o for o, _ in outs)
     if wrote != 1 and not all(p.returncode == 0 for p in procs):
         return wrong(r, f"{wrote} wrote")
     if wrote == 2:  # both published: the second replaced the first's file
-        return wrong(r, "both wrote t.csv")
+        return wrong(r, f"both wrote {target}")
     return r
+
+
+case("two table -o t.csv at once: one writes, the other refuses", "ok")(
+    lambda d: (fixture(d, "s.h5"), two_writers(d, "t.csv", ["table", "s.h5", "-o",
+                                                             "t.csv"]))[1])
 
 
 @case("a killed risk -o's temporary files are removed by the next risk -o", "ok")
@@ -1345,23 +1349,9 @@ def _(d):
     return r3
 
 
-@case("two floor-spectrum -o f.csv at once: one writes, the other refuses", "ok")
-def _(d):
-    axes_fixture(d, "fl.h5")
-    freeze(d)
-    e = {**os.environ, "PYTHONPATH": str(ROOT)}
-    slow = APPEARS.replace("    try:\n        with open(target, 'x') as f:\n"
-                           "            f.write('mine')\n    except FileExistsError:\n"
-                           "        pass\n", "    import time; time.sleep(2)\n")
-    procs = [subprocess.Popen([sys.executable, "-c", slow, "f.csv", "floor-spectrum", "fl.h5",
-                               "-o", "f.csv"], cwd=d, env=e, stdout=subprocess.PIPE,
-                              stderr=subprocess.PIPE, text=True) for _ in range(2)]
-    outs = [p.communicate(timeout=TIMEOUT) for p in procs]
-    r = subprocess.CompletedProcess([], 0, outs[0][0] + outs[1][0], "")
-    wrote = sum("wrote" in o for o, _ in outs)
-    if wrote != 1:
-        return wrong(r, f"{wrote} wrote")
-    return r
+case("two floor-spectrum -o f.csv at once: one writes, the other refuses", "ok")(
+    lambda d: (axes_fixture(d, "fl.h5"), two_writers(d, "f.csv", [
+        "floor-spectrum", "fl.h5", "-o", "f.csv"]))[1])
 
 
 # --- the run -------------------------------------------------------------------------------
