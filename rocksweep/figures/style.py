@@ -213,7 +213,7 @@ def grow_to_fit(fig: Figure, *, narrow_legends: bool = True) -> Figure:
             lack = max(MIN_ASPECT * p.width * inches - p.height * fh for p in pos)
             grow += max(0.0, lack) * rows
         if grow < 0.01:
-            break
+            return fig  # laid out as it is drawn: no draw more
         fig.set_size_inches(inches, fh + grow + 0.02)
     canvas.draw()
     return fig
