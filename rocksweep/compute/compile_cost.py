@@ -21,6 +21,8 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from rocksweep.outputs import write_atomic
+
 #: [s] a variant's cold compile on a quiet 2-core machine (scripts/bench_compile.py)
 BENCH_SECONDS = 6.0
 #: [s] a "compile" quicker than this was a load (the variant was in memory): not kept
@@ -60,11 +62,10 @@ def record(names: Sequence[str], seconds: float) -> None:
     for n in names:
         data[n] = round(seconds / len(names), 2)
     path = _store()
-    try:
+    text = json.dumps(data, sort_keys=True)
+    try:  # the one publish rule (a writer at the same time: its numbers are as good)
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{_FILE}.{os.getpid()}")
-        tmp.write_text(json.dumps(data, sort_keys=True))
-        os.replace(tmp, path)
+        write_atomic(path, lambda tmp: tmp.write_text(text), overwrite=True)
     except OSError:
         pass
 
