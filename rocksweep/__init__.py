@@ -48,6 +48,7 @@ if TYPE_CHECKING:  # what __getattr__ gives, for type checkers and editors
         calibrate,
         calibrated_overrides,
         estimate,
+        felt_motion,
         floor_spectrum,
         fragility,
         ida,
@@ -63,8 +64,9 @@ if TYPE_CHECKING:  # what __getattr__ gives, for type checkers and editors
     from rocksweep.simulation import Simulation
 
 __all__ = ["RocksweepError", "Simulation", "__version__", "boundaries", "boundary_lines",
-           "calibrate", "calibrated_overrides", "estimate", "floor_spectrum", "fragility",
-           "ida", "im_efficiency", "open", "plot", "risk", "run", "simulate", "spectra", "table"]
+           "calibrate", "calibrated_overrides", "estimate", "felt_motion", "floor_spectrum",
+           "fragility", "ida", "im_efficiency", "open", "plot", "risk", "run", "simulate",
+           "spectra", "table"]
 #: ``rocksweep.api``'s names (the functions, and ``Simulation``, what simulate returns)
 _API = frozenset(__all__) - {"RocksweepError", "__version__"}
 

@@ -17,6 +17,7 @@ the API builds on are imported from their homes (``rocksweep.compute.session.swe
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -24,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 from rocksweep.accessor import accessor_class
 from rocksweep.analysis.resampling import DEFAULT_CI, DEFAULT_SEED
 from rocksweep.analysis.tolerance import DEFAULT_RTOL, DEFAULT_RTOL_MANY
+from rocksweep.compute.arguments import check_flag
 from rocksweep.errors import ApiError, check_type, is_integer, is_real
 from rocksweep.outputs import shown
 from rocksweep.simulation import Simulation  # what simulate returns
@@ -228,10 +230,13 @@ def floor_spectrum(ds: xr.Dataset, rtol: float = DEFAULT_RTOL_MANY, search: bool
     """The floor spectrum of a complete sweep over ``floor.period``: a record suite's
     P(overturn) over (floor.period, stripe, ...) (with an ``angle`` axis for each
     orientation answer: ``orientation`` each/worst), or one record's or a pulse's A_min
-    over floor.period, bisected to ``rtol`` (``rocksweep.analysis.floors``). Its figure:
-    ``rocksweep.plot``."""
+    over floor.period, bisected to ``rtol`` (in (0, 0.1]; search=False: the grid's bracket
+    only, as for ``spectra``) (``rocksweep.analysis.floors``). ds: what ``run`` or ``open``
+    returns, or a result file's path. Its figure: ``rocksweep.plot``; its table:
+    ``rocksweep.table``."""
     from rocksweep.analysis.floors import floor_spectrum as compute
 
+    _check_dataset("ds", ds)
     return compute(ds, rtol, search)
 
 
@@ -284,8 +289,9 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     ``n_records``, ``n_excluded``, ``n_not_run``, the fitted ``curve`` and its bands over
     ``im_grid``; for stripes ``fraction`` per stripe and ``first_level``,
     ``resurrection`` per record. A sweep over ``angle`` gives both answers along an
-    ``orientation`` dimension: "each" (every (record, angle) a sample) and "worst" (the
-    worst angle per record: overturns at any angle).
+    ``orientation`` dimension: "each" (every (record, angle) a sample, pooled; records
+    counted and resampled with all their angles) and "worst" (the worst angle per record:
+    overturns at any angle).
     """
     from rocksweep.analysis.floors import by_orientation
     from rocksweep.analysis.fragility import fragility as fit
@@ -387,12 +393,28 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     return out[0] if sc.size == 1 else out
 
 
+def felt_motion(scene: SceneLike, overrides: Overrides = (), /, **keys: Any) -> xr.Dataset:
+    """The motion the body feels at one point of a scene, as samples (no run): ``a_h`` [g]
+    the horizontal acceleration after the orientation (``ground.angle``) and the building
+    (``floor``), scaled as the point runs it, ``a_v`` [g] the vertical acting with it,
+    ``a_ground`` [g] the ground's H1 at the same scale (with an excitation path), over
+    ``t`` [s] (``rocksweep.compute.motion``). scene and overrides as for ``simulate`` (one
+    point). The kernel runs exactly these samples, linear between them;
+    ``rocksweep.physics.records.write_at2(path, ds.a_h.values, ds.attrs["dt"], title)``
+    keeps one as a record."""
+    from rocksweep.compute.motion import felt_motion as felt
+    from rocksweep.scene.inputs import load, override_strings
+
+    sc, _ = load(scene, [*override_strings(overrides), *override_strings(keys)])
+    return felt(sc)
+
+
 # --- Calibration: scene numbers fitted to a measured history ------------------
 
 def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impact.lam",),
               *, bounds: Mapping[str, Sequence[float]] | None = None,
               overrides: Overrides = (), ci: float = 0.95, p: float | None = None,
-              noise: float | None = None) -> xr.Dataset:
+              noise: float | None = None, progress: bool = False) -> xr.Dataset:
     """Fit scene numbers to a measured rocking history.
 
     scene, overrides: as for ``run``. fit: the key or distinct keys to fit (``impact.lam``,
@@ -400,7 +422,7 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     CSV path or a pandas DataFrame with columns p_t, theta_over_alpha (as ``simulate
     --csv`` writes), or t [s], theta [rad] (then p [rad/s]: the keyword, a physical
     body's or a record scene's ground.p). bounds: {key: (lo, hi)} inside each key's
-    admissible range (default: ``analysis.calibrate.DEFAULT_BOUNDS`` or the range). ci:
+    admissible range (default: ``analysis.fit_keys.DEFAULT_BOUNDS`` or the range). ci:
     the interval's level, in [0.5, 1). Returns a Dataset over ``parameter`` (the fitted
     keys): ``estimate``, ``lo``, ``hi`` (the ``ci`` interval by profile likelihood, ``ci``
     in attrs), scalar ``misfit`` (RMS error of the half-cycle peaks, theta/alpha_ref)
@@ -408,6 +430,8 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     theta/alpha_ref) and ``dof``, ``reason`` ("ok" or misfit, unidentifiable, at_bound,
     not_converged joined by ",", also a ``CalibrationWarning``), and the measured and
     fitted histories over p_t with the fitted impacts (``rocksweep.analysis.calibrate``).
+    progress: say on stderr when the fit's kernel variant must be compiled first (once per
+    machine) and what that costs.
     """
     from rocksweep.analysis.calibrate import calibrate_scene
 
@@ -419,7 +443,9 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     check_type("p", p, p is None or is_real(p), "a number (the body's p [rad/s]) or None")
     check_type("noise", noise, noise is None or is_real(noise),
                "a number (the measurement noise, theta/alpha_ref) or None")
-    return calibrate_scene(scene, measured, fit, bounds, ci, p, overrides, noise)
+    check_flag("progress", progress)
+    say = (lambda m: print(m, file=sys.stderr, flush=True)) if progress else None
+    return calibrate_scene(scene, measured, fit, bounds, ci, p, overrides, noise, say)
 
 
 def calibrated_overrides(fit: xr.Dataset, which: str = "all") -> dict[str, Any]:

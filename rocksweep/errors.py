@@ -158,7 +158,8 @@ class IdaError(RocksweepError, ValueError):
 
 
 class FloorError(RocksweepError):
-    """A Dataset that has no floor spectrum or orientation to give (analysis.floors)."""
+    """A Dataset that has no floor spectrum or orientation to give (analysis.floors), or
+    a building whose floor motion would exceed its memory bound (physics.floor)."""
 
 
 class EfficiencyError(RocksweepError, ValueError):

@@ -103,7 +103,8 @@ def input_problem(path: str | Path) -> str | None:
     try:
         st = os.stat(path)
     except FileNotFoundError:
-        return "no such file"
+        return "a symbolic link to a missing file" if os.path.lexists(path) else \
+            "no such file"
     except (OSError, ValueError) as err:  # ValueError: a NUL byte in the name
         return os_reason(err) if isinstance(err, OSError) else "not a valid file name"
     if stat.S_ISDIR(st.st_mode):

@@ -246,6 +246,7 @@ def info_dict(result: SweepResult) -> dict:
         },
         "adaptive": adaptive_info(result),
         "check": check_info(result),
+        "vertical": vertical_info(result),
         "scene": a.get("scene"),
     }
 
@@ -260,6 +261,38 @@ def certification_info(result: SweepResult) -> dict:
     return {"points_refined": int(((status & STATUS_BIT["refined"]) != 0).sum()),
             "points_uncertified": int(((status & STATUS_BIT["uncertified"]) != 0).sum()),
             "refine_evaluations": n if n >= 0 else None}
+
+
+def vertical_info(result: SweepResult) -> dict:
+    """Whether a vertical ground acceleration acted on the body, from the resolved scene:
+    {"acted": bool, "source": "ground.vertical" | "pulse.vertical" | "up files" | None,
+    "words": one line}. A folder suite's UP files read but not acting (``ground.vertical:
+    false``) say so: their peaks are stored, the body did not feel them."""
+    sc = result.scene
+    rec = sc.get("vertical")
+    if isinstance(rec, dict):
+        peak = rec.get("PGA_v")
+        return {"acted": True, "source": "ground.vertical",
+                "words": f"acted: ground.vertical {rec.get('name')} (PGA_v "
+                         f"{peak if peak is None else f'{peak:.4g}'} g as recorded, scaled with "
+                         "the record), the kernel's vertical variant"}
+    amp = (sc.get("axes") or {}).get("pulse.vertical.amplitude")
+    if isinstance(amp, dict):
+        acted = any(isinstance(v, int | float) and v != 0 for v in amp.get("values") or [])
+        return {"acted": acted, "source": "pulse.vertical",
+                "words": ("acted: pulse.vertical (a harmonic), the kernel's vertical variant"
+                          if acted else "none: pulse.vertical's amplitude is 0")}
+    suite = sc.get("suite") if isinstance(sc.get("suite"), dict) else {}
+    ups = [v for v in suite.get("vertical") or [] if v]
+    if ups:
+        acts = bool(suite.get("vertical_acts"))
+        return {"acted": acts, "source": "up files",
+                "words": (f"acted: the {len(ups)} records' UP files, scaled with each record "
+                          "(the kernel's vertical variant)" if acts else
+                          f"did not act: the {len(ups)} records' UP files were read "
+                          "(record_pga_v, record_v_over_h) but ground.vertical: false kept "
+                          "them off the body")}
+    return {"acted": False, "source": None, "words": "none (gravity alone)"}
 
 
 def adaptive_info(result: SweepResult) -> dict | None:
@@ -339,6 +372,8 @@ def format_info(d: dict) -> list[str]:
                      + (f", {ad['undecided']} not decided yet" if ad["undecided"] else ""))
         lines.append(f"  audit: {ad['audited']} points, {ad['audit_misses']} disagreed with "
                      "their fill" + (f" (warning: {ad['warning']})" if ad["warning"] else ""))
+    if d.get("vertical"):
+        lines.append(f"vertical ground acceleration: {d['vertical']['words']}")
     law = bool(d["counts"]) and "law" in d["counts"][0]
     lines.append(f"counts per pulse shape{', impact law' if law else ''} and lam:")
     lines += format_counts(in_ranges(d["counts"], "lam"), "  ")

@@ -33,7 +33,16 @@ from rocksweep.errors import TableError
 from rocksweep.physics.bodies import G
 from rocksweep.vocab.axes import ALPHA_KEYS
 from rocksweep.vocab.ground import RECORD_IMS, SA, SCALE_IMS
-from rocksweep.vocab.kinds import BOUNDARIES, FRAGILITY, IDA, IM_EFFICIENCY, RISK, SPECTRA, SWEEP
+from rocksweep.vocab.kinds import (
+    BOUNDARIES,
+    FLOOR_SPECTRUM,
+    FRAGILITY,
+    IDA,
+    IM_EFFICIENCY,
+    RISK,
+    SPECTRA,
+    SWEEP,
+)
 from rocksweep.vocab.outcomes import OUTCOME_WORDS, status_words
 
 __all__ = ["ROW_VARIABLE", "table"]
@@ -41,7 +50,8 @@ __all__ = ["ROW_VARIABLE", "table"]
 #: the variable whose dims are a kind's rows
 ROW_VARIABLE = {SWEEP: "outcome", FRAGILITY: ("im_median", "median"), IDA: "ida_im",
                 RISK: "annual_rate", IM_EFFICIENCY: "beta",
-                SPECTRA: "theta_max_over_alpha", BOUNDARIES: "A_min"}
+                SPECTRA: "theta_max_over_alpha", BOUNDARIES: "A_min",
+                FLOOR_SPECTRUM: ("p_overturn", "A_min")}
 MAX_SPREAD = 32  # an extra dimension at most this long becomes columns
 SKIP = ("record_sha256",)  # identity, not data: in the file, not in every row
 
@@ -59,7 +69,7 @@ def table(ds: xr.Dataset) -> Any:
     if kind is None:
         raise TableError("not a rocksweep Dataset (a sweep or an analysis's result)")
     if kind == SWEEP:  # every row is written; a partial file's are said to be missing
-        trust(ds, "table")
+        trust(ds, "table", kept=True)
     main = ROW_VARIABLE[kind]
     main = next((m for m in (main if isinstance(main, tuple) else (main,)) if m in ds),
                 None)

@@ -66,7 +66,8 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
     the interval is a 95% profile likelihood. Prints the estimate, the interval and the
     misfit; -o keeps the fit, --plot draws it."""
     # the scene file and what it reads (a record), the measured CSV: never written over
-    inputs = [*load(scene_path, overrides).inputs, measured_path]
+    scene = load(scene_path, overrides)
+    inputs = [*scene.inputs, measured_path]
     check_table_outputs(out_path, plot_path, (".h5", ".nc"), inputs, overwrite)
     # run time, not --help: numpy, h5py, numba, matplotlib (0.1-2 s each), outputs (+7%)
     from rocksweep.analysis.calibrate import CalibrationWarning
@@ -75,7 +76,7 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
         warnings.simplefilter("always", CalibrationWarning)
         ds = rocksweep.calibrate(scene_path, measured_path, list(fit),
                                  bounds=_bounds(bounds) or None, overrides=list(overrides),
-                                 p=p, noise=noise)
+                                 p=p, noise=noise, progress=True)
     release_warnings()  # fitted: the scene's warnings before the fit's verdicts
     for w in caught:
         if issubclass(w.category, CalibrationWarning):

@@ -50,3 +50,20 @@ def write_table(out_path: Path, rows: Sequence[Mapping[str, Any]] | Any, ds: Any
         write_atomic(out_path, lambda tmp: tmp.write_text(text), overwrite=overwrite)
     else:
         write_dataset(ds, out_path, kind, overwrite=overwrite)
+
+
+def prepare_point_kernel(scene: Any) -> None:
+    """The single-run kernel variant of the scene's first point compiled (or loaded) now,
+    said on stderr when it compiles: how long it will take (``compile_cost``); ``simulate``
+    and ``calibrate`` run it. A point the scene cannot make is left to the command's own
+    refusal."""
+    from rocksweep.compute.compile_cost import prepare_point
+    from rocksweep.errors import RocksweepError
+    from rocksweep.physics.points import kernel_kind
+
+    try:
+        point = scene.point({a.name: a.values[0] for a in scene.axes})
+        kind = kernel_kind(point.body)
+    except (RocksweepError, ValueError):
+        return
+    prepare_point(kind, point.ground, lambda m: click.echo(m, err=True))

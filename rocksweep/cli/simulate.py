@@ -43,6 +43,7 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     lost in impacts and in the damper, and the accuracy setting with its cost.
     """
     # run time, not --help: numpy, h5py, numba, matplotlib (0.1-2 s each), outputs (+7%)
+    from rocksweep.cli.helpers import prepare_point_kernel
     from rocksweep.compute.history import run_points, write_history_csv
     from rocksweep.outputs import check_distinct, check_output
 
@@ -56,6 +57,8 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     if csv_path is not None:
         check_output(csv_path, overwrite=overwrite, inputs=scene.inputs)
 
+    if scene.size <= MAX_POINTS:  # said when it compiles (once per machine)
+        prepare_point_kernel(scene)
     try:
         runs = run_points(scene, MAX_POINTS)
     except SceneError as err:  # name the file, as scene errors do

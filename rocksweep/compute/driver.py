@@ -254,22 +254,15 @@ def every_point_loop(sf, report: SweepReport, _options: None, *, jobs: int, back
 
 
 def prepare_kernel(sf, lvl: int, report: SweepReport, say: Callable[[str], None]) -> None:
-    """Compile or load the kernel variants the grid needs, saying what happens."""
+    """Compile or load the kernel variants the grid needs, saying what happens: the
+    variants to compile, named, and what they took here before
+    (``compile_cost.prepare``)."""
+    from rocksweep.compute import compile_cost
     from rocksweep.compute import sweep as sw
 
-    to_compile, unknown = sw.kernel_cache_state(sf.grid, lvl)
-    if to_compile:
-        say(f"compiling the kernel (once per machine, "
-            f"~{to_compile * sw.COMPILE_SECONDS:.0f} s)...")
-    elif unknown:
-        say("loading or compiling the kernel...")
-    t_prep = time.perf_counter()
-    sw.prepare(sf.grid, lvl)
-    report.compile_s = time.perf_counter() - t_prep
+    report.compile_s = compile_cost.prepare(sw.chunk_variants(sf.grid, lvl),
+                                            lambda: sw.prepare(sf.grid, lvl), say)
     raise_pending()  # a Ctrl-C that numba's callbacks swallowed while loading
-    if to_compile or unknown or report.compile_s > 1.0:
-        how = "compiled" if to_compile else "compiled or loaded from numba's cache"
-        say(f"kernel {how} in {report.compile_s:.1f} s")
 
 
 def adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backend: str,

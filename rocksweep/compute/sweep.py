@@ -31,6 +31,7 @@ from rocksweep import (
     fields,
     kernel,  # lazy: numba loads at the first kernel.chunk_kernel
 )
+from rocksweep.compute import compile_cost
 from rocksweep.compute.arguments import (
     CONNECT_TIMEOUT,
     RETRY,
@@ -52,9 +53,6 @@ MAX_CHUNK = 1024
 NO_WORKERS_TIMEOUT = 60.0
 # How often [s] the dask driver checks the cluster while no chunk finishes.
 CLUSTER_POLL = 1.0
-# Cold compile of one kernel variant [s], measured: 5.0-7.2 s CPU a variant
-# (scripts/bench_compile.py, docs/performance.md).
-COMPILE_SECONDS = 6.0
 
 
 def level(scene: Scene) -> int:
@@ -158,18 +156,15 @@ def prepare(grid: Grid, level: int) -> None:
         kernel.warm_up(kind, level, grid.scene.ground)
 
 
-def _in_cache(dispatcher) -> bool | None:
-    """``kernel._cache.in_cache`` (numba's private cache names stay there)."""
-    from rocksweep.kernel._cache import in_cache
-
-    return in_cache(dispatcher)
+def chunk_variants(grid: Grid, level: int) -> list:
+    """The kernel variants (``kernel.chunk_kernel``) ``prepare`` compiles or loads."""
+    return [kernel.chunk_kernel(kind, level, grid.scene.ground) for kind in grid.kinds()]
 
 
 def kernel_cache_state(grid: Grid, level: int) -> tuple[int, int]:
     """(variants to compile, variants of unknown state) among those ``prepare`` needs:
     what a sweep says before the kernel is compiled or loaded."""
-    states = [_in_cache(kernel.chunk_kernel(kind, level, grid.scene.ground))
-              for kind in grid.kinds()]
+    states = [compile_cost.in_cache(d) for d in chunk_variants(grid, level)]
     return sum(s is False for s in states), sum(s is None for s in states)
 
 
@@ -355,10 +350,12 @@ def estimate(scene: Scene, jobs: int = 1, sample: int = ESTIMATE_SAMPLE,
             per = per + (np.ceil(t_pulse / r[:, L.PAR_DT_ON])
                          + np.ceil((r[:, L.PAR_TEND] - t_pulse) / r[:, L.PAR_DT]))
     steps_bound = int(round(float(np.nanmean(per)) * n))
-    to_compile, unknown = kernel_cache_state(grid, lvl)
+    variants = chunk_variants(grid, lvl)
+    unready = [compile_cost.variant_name(d) for d in variants
+               if compile_cost.in_cache(d) is not True]
     workers = check_jobs(jobs)
     sampled = 0
-    if to_compile == 0 and unknown == 0:
+    if not unready:
         prepare(grid, lvl)  # loads the cached variant (no compile)
         c0 = time.thread_time()
         outs = [run_rows(cr, r, lvl, scene) for r in runs]
@@ -370,6 +367,5 @@ def estimate(scene: Scene, jobs: int = 1, sample: int = ESTIMATE_SAMPLE,
     else:
         evaluations = float(steps_bound)
         seconds = point_seconds(evaluations) / workers
-    return Estimate(n, steps_bound, evaluations, seconds, bool(to_compile or unknown),
-                    COMPILE_SECONDS * (to_compile + unknown), len(grid.kinds()), sampled,
-                    workers)
+    return Estimate(n, steps_bound, evaluations, seconds, bool(unready),
+                    compile_cost.forecast(unready)[0], len(grid.kinds()), sampled, workers)

@@ -56,6 +56,7 @@ from rocksweep.vocab.ground import (
     RATIO_OF,
     RECORD_IMS,
     ROTD50,
+    ROTD50_IMS,
     SA_DAMPING,
     SCALE_IMS,
 )
@@ -296,6 +297,8 @@ def rotd50_im(h1: GroundRecord, h2: GroundRecord, im: str | None, period: float)
     (and PGV_ratio's) [m/s] of the velocities at the samples, or Sa(period) [g] at 5%
     damping of the oscillator's responses (its free vibration one period past the record
     included): the median over the angles 0..179 deg of the peak of the projected series."""
+    if im not in ROTD50_IMS:
+        raise SuiteError(f"RotD50 of {im}: defined for {', '.join(ROTD50_IMS)} only")
     n = max(h1.npts, h2.npts)
     a1, a2 = (np.pad(r.acc, (0, n - r.npts)) for r in (h1, h2))
     if im in (PGA, PGA_RATIO):

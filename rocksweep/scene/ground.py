@@ -31,10 +31,12 @@ from rocksweep.schema import (
 )
 from rocksweep.vocab.ground import (
     DEFAULT_PERIODS,
+    H1,
     MISSING_ERROR,
     MISSING_SKIP,
     RECORD_IMS,
     ROTD50,
+    ROTD50_IMS,
     SCALE_IMS,
 )
 
@@ -137,7 +139,8 @@ def _record_paths(spec: Any, base: Path | None) -> tuple[list[Path], list[Path],
         path = _where(e, base)
         if has_magic(e) and not os.path.lexists(path):
             pattern = str(path)
-            found = sorted(Path(p) for p in glob(pattern) if Path(p).is_file())
+            # a folder it matches is no record; a FIFO or a dangling link is named below
+            found = sorted(Path(p) for p in glob(pattern) if not Path(p).is_dir())
             if not found:
                 raise SceneError(f"{key}: {e!r} matches no file (looked for {pattern})")
             out.extend(found)
@@ -324,6 +327,11 @@ def ground_suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...
     if component == ROTD50 and im is None:
         raise SceneError(f"ground.scale.component = {fmt(ROTD50)}: scales stripes "
                          "(ground.scale: {im: ..., values: ...})")
+    if component == ROTD50 and im not in ROTD50_IMS:
+        raise SceneError(f"ground.scale.component = {fmt(ROTD50)}: with ground.scale.im = "
+                         f"{im}; RotD50 (the median over orientations of a peak, Boore 2010) "
+                         f"is taken of {', '.join(ROTD50_IMS)} stripes; use component "
+                         f"{fmt(H1)} for {im}")
     values = axis_values("ground.scale.values", form, spec).tolist() if im else []
     try:
         suite = make_suite(records, names, im, values, period, factor,

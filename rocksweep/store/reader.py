@@ -509,16 +509,54 @@ def stored_scene(path: str | Path) -> dict:
 
 def result_inputs(path: str | Path) -> tuple[str, ...]:
     """The files a command that reads the result at ``path`` never writes over: the
-    result and the records it names where the sweep read them (a single record's or a
-    suite's; an analysis may re-read them). Only ``(path,)`` for a file that is not a
-    readable result (its own error comes when it is read)."""
+    result and every file its sweep read (``resolved_inputs``: an analysis may re-read
+    them). Only ``(path,)`` for a file that is not a readable result (its own error comes
+    when it is read)."""
     try:
         sc = stored_scene(path)
     except RocksweepError:
         return (str(path),)
-    recs = [sc.get("record") or {}, *((sc.get("suite") or {}).get("records") or [])]
-    return (str(path), *(str(r["source"]) for r in recs
-                         if isinstance(r, dict) and isinstance(r.get("source"), str)))
+    return (str(path), *resolved_inputs(sc))
+
+
+def resolved_inputs(stored: dict) -> tuple[str, ...]:
+    """Every file a resolved scene (``store.identity.resolved_scene``) says its sweep read:
+    each ``source`` it holds, at any depth (a record, its second horizontal and vertical
+    components, a suite's records), and a PEER folder suite's H2 and UP files, which it
+    names beside their H1 (``scene.peer``: one folder holds a record's files)."""
+    out: list[str] = []
+
+    def walk(v) -> None:
+        if isinstance(v, dict):
+            if isinstance(v.get("source"), str) and v["source"]:
+                out.append(v["source"])
+            for x in v.values():
+                walk(x)
+        elif isinstance(v, list):
+            for x in v:
+                walk(x)
+
+    walk(stored)
+    suite = stored.get("suite") if isinstance(stored.get("suite"), dict) else {}
+    records = suite.get("records") if isinstance(suite.get("records"), list) else []
+    folders: dict[Path, dict[str, list[str]]] = {}
+    for key in ("h2", "vertical"):
+        named = suite.get(key) if isinstance(suite.get(key), list) else []
+        for rec, comp in zip(records, named, strict=False):
+            if not (isinstance(rec, dict) and isinstance(rec.get("source"), str)
+                    and isinstance(comp, dict) and isinstance(comp.get("name"), str)):
+                continue
+            folder = Path(rec["source"]).parent
+            if folder not in folders:  # the folder's files by stem (a name has no suffix)
+                try:
+                    names = os.listdir(folder)
+                except OSError:
+                    names = []
+                folders[folder] = {}
+                for n in names:
+                    folders[folder].setdefault(Path(n).stem, []).append(n)
+            out.extend(str(folder / n) for n in folders[folder].get(comp["name"], ()))
+    return tuple(dict.fromkeys(out))
 
 
 def peek_done(path: str | Path) -> tuple[int, int] | None:

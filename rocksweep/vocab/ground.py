@@ -113,6 +113,10 @@ DEFAULT_PERIODS = (0.2, 1.0)  # [s] Sa stored per record
 #: (Boore 2010; NGA-West2's convention)
 H1, ROTD50 = "H1", "RotD50"
 COMPONENTS: tuple[str, ...] = (H1, ROTD50)
+#: the stripe IMs RotD50 is taken of (Boore 2010: the median over orientations of a
+#: peak: the acceleration's, the velocity's, the 5% oscillator's); AvgSa, CAV and Arias
+#: have no RotD50 convention (refused in one line, ``ground.scale.component``)
+ROTD50_IMS: tuple[str, ...] = (PGA, PGA_RATIO, PGV, PGV_RATIO, SA)
 #: a record of a folder of PEER downloads without one of its components
 #: (``ground.missing``): refused, or left out with a warning
 MISSING_ERROR, MISSING_SKIP = "error", "skip"

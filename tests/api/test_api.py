@@ -210,17 +210,36 @@ def test_run_resumes_a_partial_file(tmp_path):
 # --- the driver: messages -----------------------------------------------------------------
 
 def test_driver_says_compiling_before_an_uncached_kernel(tmp_path, monkeypatch):
-    """When numba's cache lacks the variant, the sweep says so before compiling (the
-    state is faked here; the real check is test_cache_state_of_a_fresh_cache)."""
-    monkeypatch.setattr(sw, "_in_cache", lambda dispatcher: False)
+    """When numba's cache lacks the variant, the sweep says so before compiling: how many
+    variants, which, and their cost (the state is faked here; the real check is
+    test_cache_state_of_a_fresh_cache). The time a compile takes is kept, and said the
+    next time that variant compiles (issue 45: "~6 s" where variants took 22-59 s)."""
+    from rocksweep.compute import compile_cost
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "cache"))  # the times' file only
+    monkeypatch.setattr(compile_cost, "in_cache", lambda dispatcher: False)
     lines: list[str] = []
     sc = load_scene(CI_SMALL)
+    name = compile_cost.variant_name(sw.chunk_variants(Grid(sc), sw.level(sc))[0])
     rep = sweep_file(sc, tmp_path / "c.h5", log=lines.append)
     assert rep.complete and rep.computed == 256
-    i = next(i for i, ln in enumerate(lines) if ln.startswith("compiling the kernel"))
-    assert re.fullmatch(r"compiling the kernel \(once per machine, ~\d+ s\)\.\.\.", lines[i])
+    i = next(i for i, ln in enumerate(lines) if ln.startswith("compiling"))
+    assert lines[i] == (f"compiling 1 kernel variant this run needs ({name}), once per "
+                        f"machine: ~{compile_cost.BENCH_SECONDS:.0f} s (~"
+                        f"{compile_cost.BENCH_SECONDS:.0f} s a variant on a quiet 2-core "
+                        "machine, more on a busy one)..."), lines[i]
     assert re.fullmatch(r"kernel compiled in \d+\.\d s", lines[i + 1])
-    monkeypatch.setattr(sw, "_in_cache", lambda dispatcher: None)
+    # a compile's time is kept per variant and forecast the next time (a variant never
+    # compiled here: the median of those that were)
+    compile_cost.record([name], 23.0)
+    compile_cost.record(["other_a", "other_b"], 20.0)
+    assert compile_cost.forecast([name]) == (23.0, "as measured here")
+    assert compile_cost.forecast([name, "never"])[0] == pytest.approx(23.0 + 10.0)
+    lines.clear()
+    sweep_file(sc, tmp_path / "e.h5", log=lines.append)
+    assert any(ln.endswith(f"({name}), once per machine: ~23 s (as measured here)...")
+               for ln in lines), lines
+    monkeypatch.setattr(compile_cost, "in_cache", lambda dispatcher: None)
     lines.clear()
     sweep_file(sc, tmp_path / "d.h5", log=lines.append)
     assert "loading or compiling the kernel..." in lines

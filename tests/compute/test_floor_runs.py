@@ -200,3 +200,28 @@ def test_a_list_of_modes_sweeps_without_an_angle(tmp_path, motion):
                               two["floor_pfa"].values.ravel(), strict=True):
         assert run.summary["outcome"] == words[int(code)]
         assert run.summary["floor_pfa"] == pfa  # the one definition, bit for bit
+
+
+def test_felt_motion_is_what_the_kernel_runs(tmp_path):
+    """rocksweep.felt_motion (issue 45: a public way to the motion the body feels): the
+    samples after the angle and the floor, scaled as the point runs, equal the ground
+    acceleration the kernel recorded in its history at every row (linear between
+    samples), up to the record's end; the ground's H1 at the same scale has the point's
+    peak A_ratio g tan(alpha)."""
+    from rocksweep.errors import RocksweepError
+
+    rec = ROOT / "records" / "suite"
+    scene = {"name": "felt", "body": {"kind": "block", "alpha": 0.2},
+             "impact": {"lam": 0.0},
+             "ground": {"record": str(rec / "SYN01.AT2"), "h2": str(rec / "SYN02.AT2"),
+                        "angle": 30.0, "A_ratio": 0.8, "p": 2.0},
+             "floor": {"period": 0.5, "damping": 0.05, "participation": 1.3}}
+    ds = rocksweep.felt_motion(scene)
+    h = rocksweep.simulate(scene).history
+    t = h.p_t.values / 2.0
+    inside = t < ds.t.values[-1]
+    felt = np.interp(t[inside], ds.t.values, ds.a_h.values)
+    assert np.max(np.abs(felt - h.xg_over_g.values[inside])) < 1e-9 * np.max(np.abs(felt))
+    assert np.max(np.abs(ds.a_ground.values)) == pytest.approx(0.8 * math.tan(0.2), rel=1e-6)
+    with pytest.raises(RocksweepError, match="2 points"):
+        rocksweep.felt_motion(scene, {"ground.angle": [0, 90]})
