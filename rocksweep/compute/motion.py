@@ -50,8 +50,9 @@ def felt_motion(scene: Scene) -> Any:
         t = np.arange(rec.npts) * rec.dt
         unit = "s"
         a_h = rec.acc * factor
-        vertical = point.vertical_on_samples()
-        a_v = None if vertical is None else np.asarray(vertical, float) * factor
+        vertical = point.excitation.vertical_acc
+        # one factor for both components; A's sign turns the horizontal round only
+        a_v = None if vertical is None else np.asarray(vertical, float) * abs(factor)
         attrs.update(record=rec.name, dt=float(rec.dt), p=float(point.p))
         if scene.path is not None:
             _, _, r = scene.path_motion(values)
@@ -68,7 +69,7 @@ def felt_motion(scene: Scene) -> Any:
         physical = scene.physical is not None
         unit = "s" if physical else "1/p"
         a_h = acc * point.A / G
-        pv = point.pulse_vertical
+        pv = point.excitation.harmonic
         a_v = None
         if pv is not None:
             p = point.body.p

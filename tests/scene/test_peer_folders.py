@@ -123,7 +123,7 @@ def test_rotd50_of_an_im_without_that_convention_is_one_line(tmp_path, im):
     with pytest.raises(SceneError) as err:
         parse_scene(__import__("yaml").safe_dump(scene(d, scale=scale)))
     msg = str(err.value)
-    assert "\n" not in msg and f"ground.scale.im = {im}" in msg and "use component H1" in msg
+    assert "\n" not in msg and f"ground.scale.im = {im}" in msg and "use component 'H1'" in msg
 
 
 def test_a_duplicate_download_is_never_paired(tmp_path):
