@@ -491,7 +491,7 @@ def restitution(s, u, prm, FLEX):
 
     The vertical impulse acts at x_Q = s' b (1 - lam), lam*b from the future corner
     s' = -s. Angular momentum of the whole body about x_Q is conserved (a horizontal
-    impulse at the ground has no moment about it). LAW_VERTICAL: the spring and damper
+    impulse at the ground has no moment about it). LAW_EQ1: the spring and damper
     carry no impulse, so the top mass's horizontal momentum m (u' + h theta') is conserved
     too; eliminating u'^+:
 
@@ -565,7 +565,7 @@ def impact_loss(s, s_new, u, u_dot, w_minus, w_plus, prm, FLEX):
 
     At theta = 0 the potential energy is the same before and after. With a = u - s b the
     top mass's lever arm about corner s, the kinetic energy at theta = 0 is
-    1/2 m (u' + h w)^2 + 1/2 (I_A + m_A R_A^2 + m a^2) w^2. Under LAW_VERTICAL and
+    1/2 m (u' + h w)^2 + 1/2 (I_A + m_A R_A^2 + m a^2) w^2. Under LAW_EQ1 and
     LAW_CONSTANT the top mass keeps its horizontal velocity u' + h w (no impulse reaches
     it), so only the rest changes:
 

@@ -46,7 +46,7 @@ import numpy as np
 
 from rocksweep.physics.bodies import Body, FlexibleBody, impact_energy_loss, restitution_rigid
 from rocksweep.physics.bodies import restitution as restitution_eq1
-from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW, LAWS, LOCKED, VERTICAL
+from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW, EQ1, LAWS, LOCKED
 
 # The u/u_cr range over which a body's energy-admissible lam is taken (Figure 2's range)
 U_RANGE = 2.0
@@ -64,11 +64,11 @@ def restitution(body: Body, lam, u, upper: bool = True, law: str = DEFAULT_LAW,
     u = np.asarray(u, float)
     if law == CONSTANT:
         return np.broadcast_to(np.float64(e * e_factor), np.broadcast(lam, u).shape).copy()
-    if law not in (VERTICAL, LOCKED):
+    if law not in (EQ1, LOCKED):
         raise ValueError(f"impact law {law!r}: must be one of {', '.join(LAWS)}")
     if not _flexible(body):  # top mass welded: the rigid body's e
         return np.asarray(restitution_rigid(body, lam), float) * e_factor + 0.0 * u
-    if law == VERTICAL:
+    if law == EQ1:
         return restitution_eq1(body, lam, u, upper) * e_factor
     sg = 1.0 if upper else -1.0
     m, m_A, b = body.m, body.m_A, body.b

@@ -146,7 +146,7 @@ def body_row(body: Body) -> np.ndarray:
     row[L.PAR_HCG] = body.h_cg
     row[L.PAR_IO] = body.I_O
     row[L.PAR_THETA_OVER] = math.pi / 2
-    row[L.PAR_LAW] = L.LAW_VERTICAL  # eq. (1), unless fill_rows is told otherwise
+    row[L.PAR_LAW] = L.LAW_EQ1  # eq. (1), unless fill_rows is told otherwise
     row[L.PAR_E] = math.nan
     row[L.PAR_E_FACTOR] = 1.0
     if isinstance(body, FlexibleBody):
@@ -262,7 +262,7 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
               w_over_p: np.ndarray, A_ratio: np.ndarray, numerics: Numerics,
               cycles: int = CYCLES, gamma: float = GAMMA, nu_deg: float = NU_DEG,
               record: GroundRecord | None = None,
-              mu: np.ndarray | float = math.nan, law: np.ndarray | float = L.LAW_VERTICAL,
+              mu: np.ndarray | float = math.nan, law: np.ndarray | float = L.LAW_EQ1,
               e: np.ndarray | float = math.nan, e_factor: np.ndarray | float = 1.0,
               initial: tuple | None = None, u_cr: np.ndarray | float = 0.0,
               vertical: np.ndarray | None = None,

@@ -174,7 +174,7 @@ class Grid:
         n = flat.size
         rows = np.empty((n, L.N_PAR))
         alpha_ref = b_alpha[inverse]
-        law = (L.LAW_VERTICAL if self._i_law is None
+        law = (L.LAW_EQ1 if self._i_law is None
                else self._law_codes[multi[self._i_law]])
         e = np.nan if self._i_e is None else self._values[self._i_e][multi[self._i_e]]
         e = np.where(law == L.LAW_CONSTANT, e, np.nan)  # e is law constant's alone
