@@ -37,7 +37,7 @@ from numba import njit
 from numba.core import types
 from numba.extending import overload
 
-from rocksweep.kernel import spring
+from rocksweep.kernel import eq1, spring
 from rocksweep.kernel._cache import INLINE, INTERNAL, PUBLIC
 from rocksweep.kernel.layout import (
     LAW_CONSTANT,
@@ -85,6 +85,10 @@ _ricker = njit(**INLINE)(_ground.ricker)
 _ricker_rate = njit(**INLINE)(_ground.ricker_rate)
 _mp_raw = njit(**INLINE)(_ground.mp_raw)
 _mp_raw_rate = njit(**INLINE)(_ground.mp_raw_rate)
+# Eq. (1) and its rigid limit, written once in ``eq1`` (plain Python: the physics evaluates
+# the same functions on arrays); compiled here, inlined by LLVM.
+_e_eq1 = njit(**INLINE)(eq1.restitution)
+_e_rigid = njit(**INLINE)(eq1.restitution_rigid)
 
 # ----------------------------------------------------------------------------------------
 # Eq. (2): the pulse (n cycles of a sine or cosine), and the other ground motions. ``on``
@@ -489,36 +493,20 @@ def restitution(s, u, prm, FLEX):
     """e = theta'^+ / theta'^- for an impact that ends rocking on corner s, under the row's
     impact law (PAR_LAW, ``rocksweep.physics.impact``), times PAR_E_FACTOR.
 
-    The vertical impulse acts at x_Q = s' b (1 - lam), lam*b from the future corner
-    s' = -s. Angular momentum of the whole body about x_Q is conserved (a horizontal
-    impulse at the ground has no moment about it). LAW_EQ1: the spring and damper
-    carry no impulse, so the top mass's horizontal momentum m (u' + h theta') is conserved
-    too; eliminating u'^+:
-
-        e = [I_A + m_A (h_A^2 + x_Q s b)  + m (u - x_Q)(u - s b)]
-          / [I_A + m_A (h_A^2 + x_Q s' b) + m (u - x_Q)(u - s' b)],
-
-    which is eq. (1) (upper sign: s = +1). LAW_LOCKED: u' is kept instead (the top mass
-    moves with the base), which adds m h^2 to both. LAW_CONSTANT: e = PAR_E. Rigid body
-    (vertical and locked are one law: the top mass is welded):
-    (I_O - M b^2 (2 - lam)) / (I_O - lam M b^2).
+    LAW_EQ1: eq. (1) (``eq1.restitution``, the one definition). LAW_LOCKED: the top mass
+    keeps u' (moves with the base), which adds m h^2 to eq. (1)'s numerator and
+    denominator. LAW_CONSTANT: e = PAR_E. Rigid body (eq. 1 and locked are one law: the
+    top mass is welded): ``eq1.restitution_rigid``.
     """
     law = prm[PAR_LAW]
     if law == LAW_CONSTANT:
         return prm[PAR_E] * prm[PAR_E_FACTOR]
     b, lam = prm[PAR_B], prm[PAR_LAM]
     if not FLEX:
-        mb2 = prm[PAR_MTOT] * b * b
-        return (prm[PAR_IO] - mb2 * (2.0 - lam)) / (prm[PAR_IO] - lam * mb2) * prm[PAR_E_FACTOR]
-    m, m_A = prm[PAR_M], prm[PAR_MA]
-    x_q = -s * b * (1.0 - lam)
-    num = prm[PAR_IAH] + m_A * x_q * s * b + m * (u - x_q) * (u - s * b)
-    den = prm[PAR_IAH] - m_A * x_q * s * b + m * (u - x_q) * (u + s * b)
-    if law == LAW_LOCKED:
-        mh2 = m * prm[PAR_H] * prm[PAR_H]
-        num += mh2
-        den += mh2
-    return num / den * prm[PAR_E_FACTOR]
+        return _e_rigid(prm[PAR_IO], prm[PAR_MTOT] * b * b, lam) * prm[PAR_E_FACTOR]
+    m = prm[PAR_M]
+    mh2 = m * prm[PAR_H] * prm[PAR_H] if law == LAW_LOCKED else 0.0
+    return _e_eq1(s, u, lam, m, prm[PAR_MA], b, prm[PAR_IAH], mh2) * prm[PAR_E_FACTOR]
 
 
 @njit(cache=True, **INLINE)

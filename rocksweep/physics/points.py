@@ -22,7 +22,7 @@ from rocksweep.numerics import (
     step_sizes,
     vertical_step,
 )
-from rocksweep.physics.bodies import Body, FlexibleBody, G
+from rocksweep.physics.bodies import Body, FlexibleBody, G, u_cr
 from rocksweep.physics.records import GroundRecord, vertical_samples
 from rocksweep.physics.vertical import VerticalHarmonic, air_time_harmonic, air_time_record
 from rocksweep.vocab.ground import (
@@ -388,7 +388,7 @@ def point_row(point: Point, numerics: Numerics) -> np.ndarray:
               np.array([point.p if rec is not None else point.w_over_p]),
               np.array([point.A_ratio]), numerics, point.cycles, point.gamma, point.nu, rec,
               point.mu, law_code(point.law), point.e, point.e_factor,
-              point.initial if any(point.initial) else None, body.u_cr, vertical,
+              point.initial if any(point.initial) else None, u_cr(body), vertical,
               None if pv is None else (pv.amplitude, pv.w_over_p, pv.phase))
     return with_record(rows, rec, vertical)[0]
 

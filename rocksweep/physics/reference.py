@@ -566,7 +566,7 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
     numerics = numerics or Numerics()
     prm = point_row(point, numerics)
     flex = not point.body.rigid
-    pb = _Problem(prm, flex, bool(point.body.zeta > 0) and flex, rtol, atol,
+    pb = _Problem(prm, flex, flex and bool(point.body.zeta > 0), rtol, atol,
                   _vertical(point, prm))
     t_end = float(prm[L.PAR_TEND])
     max_events = int(prm[L.PAR_MAXEVENTS])

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.physics.bodies import u_cr as body_u_cr
 from rocksweep.physics.points import (
     body_omega_rock,
     body_row,
@@ -155,7 +156,7 @@ class Grid:
             alpha_ref[j] = body.alpha_ref
             E_ref[j] = body.E_ref
             kinds[j] = kernel_kind(body)
-            u_cr[j] = body.u_cr
+            u_cr[j] = body_u_cr(body)
         return rows, omega_rock, alpha_ref, E_ref, kinds, u_cr
 
     def rows(self, start: int, stop: int) -> ChunkRows:
