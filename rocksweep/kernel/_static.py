@@ -1,15 +1,53 @@
-"""Compile-time selection: a call that a variant's flags make dead is not even typed (numba).
+"""Compile-time selection: a variant's choices made while typing, by a literal's value (numba).
 
 numba types and lowers both branches of ``if FLAG:`` even when FLAG is a literal (its
 dead-branch pruning does not read literal arguments; LLVM removes the dead code later),
-so a call inside a dead branch still costs its compile time. ``skipped_when`` wraps a
-function so that the choice is made while typing, by the flag's literal type.
+so a call inside a dead branch still costs its compile time. ``chosen`` picks one
+function of a table by the value of a literal key (a variant's GROUND, REACTIONS or
+contact model: integer or boolean literals, ``variants``) while typing, so that the
+others are not typed or compiled at all; ``skipped_when`` is its two-entry case of a
+constant.
 """
 
-from numba.core import types
+from numba.core import errors, types
 from numba.extending import overload
 
 from rocksweep.kernel._cache import INLINE
+
+
+def chosen(table: dict, name: str, general=None):
+    """A function ``g(KEY, *args)``: ``table[KEY](*args)``, the entry picked while typing by
+    KEY's literal value (``Literal[int]`` or ``Literal[bool]``, as the variants pass their
+    flags); the other entries are not typed. Entries are jitted functions (a call from
+    jitted code). A KEY that is not a literal (a call from Python with a plain int) runs
+    ``general(KEY, *args)`` (a jitted function choosing at run time), or is a typing error
+    without one. Plain Python (NUMBA_DISABLE_JIT=1): ``table[KEY](*args)``."""
+
+    def stub(key, *args):
+        """Plain Python (NUMBA_DISABLE_JIT=1): the overload's choice, by value."""
+        return table[key](*args)
+
+    @overload(stub, jit_options=INLINE, prefer_literal=True)
+    def _select(key, *args):
+        if isinstance(key, types.Literal):
+            if key.literal_value not in table:
+                raise errors.TypingError(f"{name}: no entry for {key.literal_value!r} "
+                                         f"(entries: {sorted(table)})")
+            fn = table[key.literal_value]
+
+            def static(key, *args):
+                return fn(*args)
+            return static
+        if general is None:
+            raise errors.TypingError(f"{name}: its key must be a literal (a variant's flag: "
+                                     f"a constant or a literal argument), not {key}")
+
+        def run_time(key, *args):
+            return general(key, *args)
+        return run_time
+
+    stub.__name__ = stub.__qualname__ = name
+    return stub
 
 
 def skipped_when(value, fn, result):

@@ -183,8 +183,11 @@ LEVEL_OUTCOME = 0  # outcome and summary metrics only
 LEVEL_ENERGY = 1  # + energy accounting
 LEVEL_CONTACT = 3  # + energy accounting + ground reactions (outputs.contact)
 # (a single run with its time history: ``point_kernel``, not a level of the chunk kernels)
-# ground motions: the paper's sine and cosine; every horizontal shape and records; those
-# with a vertical component (the loop's GROUND flag, ``variants``)
-GROUND_PULSE = False
+# ground kinds (``ground.GROUNDS``): the paper's sine and cosine; every horizontal shape and
+# records; those with a vertical component
+GROUND_PULSE = 0
 GROUND_ANY = 1
 GROUND_VERTICAL = 2
+# contact models (``variants.CONTACTS``): how the body touches the ground; the paper's:
+# rocking on a corner or in full contact, never sliding
+CONTACT_NOSLIP = 0

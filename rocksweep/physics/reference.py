@@ -58,8 +58,6 @@ from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel.contact import ground_reactions, impact_impulses, impulse_ratio
 from rocksweep.kernel.equations import (
     contact_rhs,
-    ground_acc,
-    ground_jerk,
     mechanical_energy,
     rest_margin,
     restitution,
@@ -71,6 +69,7 @@ from rocksweep.kernel.equations import (
     uplift_moment,
     uplift_moment_rate,
 )
+from rocksweep.kernel.ground import ground_acc, ground_jerk
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import G
 from rocksweep.physics.points import Point, point_row
@@ -120,12 +119,11 @@ class _Problem:
 
     # --- eq. (2) -----------------------------------------------------------------------
     def xg(self, t: float, on: bool) -> float:
-        # on as an int: the kernel's code for every shape (a bool would compile the
-        # sine/cosine-only code, ``equations.ground_acc``)
-        return ground_acc(t, int(on), self.prm)
+        # every shape (GROUND_ANY: a plain int from Python computes them all)
+        return ground_acc(t, on, self.prm, L.GROUND_ANY)
 
     def jerk(self, t: float, on: bool) -> float:
-        return ground_jerk(t, int(on), self.prm)
+        return ground_jerk(t, on, self.prm, L.GROUND_ANY)
 
     def gravity(self, t: float, on: bool) -> float:
         """g + a_v(t) [m/s^2] (g without a vertical, or when the ground is still)."""
