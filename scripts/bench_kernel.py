@@ -114,7 +114,7 @@ def scene_of(name: str, n: int | None) -> Scene:
 
 # The same right-hand side (the kernel's own equations), inlined into the loop at numba's
 # IR level: no calls, no reference counting, as tight as numba compiles this RHS.
-_pulse = njit(inline="always")(pulse_acc.py_func)
+_pulse = njit(inline="always")(pulse_acc)
 _rocking = njit(inline="always")(rocking_rhs.py_func)
 _contact = njit(inline="always")(contact_rhs.py_func)
 
@@ -122,7 +122,7 @@ _contact = njit(inline="always")(contact_rhs.py_func)
 @njit(inline="always")
 def _acc(t, on, prm):
     """xg'' of the paper's pulses (``ground.ground_acc`` under GROUND_PULSE)."""
-    return _pulse(t, prm) if on else 0.0
+    return _pulse(GROUND_PULSE, t, on, prm)
 
 
 @njit

@@ -156,7 +156,7 @@ def impulse_ratio(j_x, j_y):
 def _values(t, y, s, on, prm, FLEX, DAMPED, GROUND):
     """(|H|/N or +inf when N <= 0, N/(M g)) at (t, y) in phase s."""
     h_, n_ = ground_reactions(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s,
-                              ground_acc(t, on, prm, GROUND), ground_gravity(t, on, prm, GROUND),
+                              ground_acc(GROUND, t, on, prm), ground_gravity(GROUND, t, on, prm),
                               prm, FLEX, DAMPED)
     ratio = abs(h_) / n_ if n_ > 0.0 else math.inf
     return ratio, n_ / (prm[PAR_MTOT] * prm[PAR_G])
@@ -186,7 +186,6 @@ def _refine(which, t_a, y_a, f_a, t_b, y_b, f_b, t_c, f_c, s, on, prm, FLEX, DAM
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
-    literally(GROUND)
     x0, f0, x1, f1, x2, f2 = t_a, f_a, t_b, f_b, t_c, f_c
     best = f_b
     xtol = REFINE_XTOL * (t_c - t_a)
@@ -248,7 +247,6 @@ def contact_sample(track, t, y, s, on, mode, prm, out, FLEX, DAMPED, ENERGY, GRO
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
-    literally(GROUND)
     r, n = _values(t, y, s, on, prm, FLEX, DAMPED, GROUND)
     _take(out, r, n)
     cnt, t_a, y_a, r_a, n_a, t_b, y_b, r_b, n_b = track
@@ -290,8 +288,15 @@ def contact_impact(y_minus, s, y_plus, s_new, prm, out, FLEX):
         out[OUT_IMPULSE_MAX] = q
 
 
-@njit(cache=True, **INTERNAL)
-def contact_begin(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, GROUND):
+# ----------------------------------------------------------------------------------------
+# The bookkeeping as the loop sees it: four calls at its sample points, each a no-op (its
+# work not even typed) in a variant without REACTIONS (``variants``: outputs.contact and
+# the single runs), so the loop holds no test of the flag and no tracker's insides. The
+# entries take REACTIONS first (``_static.chosen``).
+# ----------------------------------------------------------------------------------------
+
+
+def _begin(REACTIONS, t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, GROUND):
     """The contact outputs' starting values (no demand yet, N never seen) and the first
     sample, at the run's start (t, y): its ``Track``."""
     out[OUT_MU_REQ] = 0.0
@@ -302,8 +307,31 @@ def contact_begin(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, GROUND):
                           GROUND)
 
 
-@njit(cache=True, **INTERNAL)
-def contact_end(prm, out):
+def _no_begin(REACTIONS, t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, GROUND):
+    """The contact outputs are NaN (not tracked); no tracker."""
+    out[OUT_MU_REQ] = np.nan
+    out[OUT_N_MIN] = np.nan
+    out[OUT_IMPULSE_MAX] = np.nan
+    return None
+
+
+def _sample(REACTIONS, track, t, y, s, on, mode, prm, out, FLEX, DAMPED, ENERGY, GROUND):
+    return contact_sample(track, t, y, s, on, mode, prm, out, FLEX, DAMPED, ENERGY, GROUND)
+
+
+def _no_sample(REACTIONS, track, t, y, s, on, mode, prm, out, FLEX, DAMPED, ENERGY, GROUND):
+    return track
+
+
+def _impact(REACTIONS, y_minus, s, y_plus, s_new, prm, out, FLEX):
+    contact_impact(y_minus, s, y_plus, s_new, prm, out, FLEX)
+
+
+def _no_impact(REACTIONS, y_minus, s, y_plus, s_new, prm, out, FLEX):
+    return None
+
+
+def _end(REACTIONS, prm, out):
     """STATUS_SLIDES when the friction demand exceeds PAR_MU (never when PAR_MU is NaN),
     STATUS_LIFTS_OFF when the normal reaction went below zero."""
     if out[OUT_MU_REQ] > prm[PAR_MU]:
@@ -312,42 +340,15 @@ def contact_end(prm, out):
         out[OUT_STATUS] = int(out[OUT_STATUS]) | STATUS_LIFTS_OFF
 
 
-# ----------------------------------------------------------------------------------------
-# The bookkeeping as the loop sees it: four calls at its sample points, each a no-op (its
-# work not even typed) in a variant without REACTIONS (``variants``: outputs.contact and
-# the single runs), so the loop holds no test of the flag and no tracker's insides.
-# ----------------------------------------------------------------------------------------
-
-
-@njit(**INLINE)
-def _no_begin(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, GROUND):
-    """The contact outputs are NaN (not tracked); no tracker."""
-    out[OUT_MU_REQ] = np.nan
-    out[OUT_N_MIN] = np.nan
-    out[OUT_IMPULSE_MAX] = np.nan
-    return None
-
-
-@njit(**INLINE)
-def _no_sample(track, t, y, s, on, mode, prm, out, FLEX, DAMPED, ENERGY, GROUND):
-    return track
-
-
-@njit(**INLINE)
-def _no_impact(y_minus, s, y_plus, s_new, prm, out, FLEX):
-    return None
-
-
-@njit(**INLINE)
-def _no_end(prm, out):
+def _no_end(REACTIONS, prm, out):
     return None
 
 
 #: (REACTIONS, t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, GROUND) -> tracker
-reactions_begin = chosen({True: contact_begin, False: _no_begin}, "reactions_begin")
+reactions_begin = chosen({True: _begin, False: _no_begin}, "reactions_begin")
 #: (REACTIONS, tracker, t, y, s, on, mode, prm, out, FLEX, DAMPED, ENERGY, GROUND) -> tracker
-reactions_sample = chosen({True: contact_sample, False: _no_sample}, "reactions_sample")
+reactions_sample = chosen({True: _sample, False: _no_sample}, "reactions_sample")
 #: (REACTIONS, y_minus, s, y_plus, s_new, prm, out, FLEX): an impact's impulse ratio
-reactions_impact = chosen({True: contact_impact, False: _no_impact}, "reactions_impact")
+reactions_impact = chosen({True: _impact, False: _no_impact}, "reactions_impact")
 #: (REACTIONS, prm, out): the run's verdicts (STATUS_SLIDES, STATUS_LIFTS_OFF)
-reactions_end = chosen({True: contact_end, False: _no_end}, "reactions_end")
+reactions_end = chosen({True: _end, False: _no_end}, "reactions_end")

@@ -60,9 +60,10 @@ from rocksweep.kernel.layout import (
 )
 
 # Eq. (1) and its rigid limit, written once in ``eq1`` (plain Python: the physics evaluates
-# the same functions on arrays); compiled here, inlined by LLVM.
-_e_eq1 = njit(**INLINE)(eq1.restitution)
-_e_rigid = njit(**INLINE)(eq1.restitution_rigid)
+# the same functions on arrays); inlined into ``restitution``, their one call site, by numba
+# (not compiled on their own)
+_e_eq1 = njit(inline="always")(eq1.restitution)
+_e_rigid = njit(inline="always")(eq1.restitution_rigid)
 
 # ----------------------------------------------------------------------------------------
 # The vertical ground acceleration's power (the ground motions themselves: ``ground``)
@@ -88,20 +89,19 @@ def vertical_power(p_in, theta, theta_dot, u, u_dot, s, g, prm, FLEX):
     return p_in - a_v * (prm[PAR_M] * y_p + prm[PAR_MA] * y_a)
 
 
-@njit(**INLINE)
-def _power_plain(p_in, theta, theta_dot, u, u_dot, s, g, prm, FLEX):
+def _power_plain(GROUND, p_in, theta, theta_dot, u, u_dot, s, g, prm, FLEX):
     return p_in
 
 
-_power = per_ground(lambda k: vertical_power if k.vertical else _power_plain,
-                    "vertical_power_of")
+def _power_vertical(GROUND, p_in, theta, theta_dot, u, u_dot, s, g, prm, FLEX):
+    return vertical_power(p_in, theta, theta_dot, u, u_dot, s, g, prm, FLEX)
 
 
-@njit(cache=True, **INLINE)
-def with_vertical_power(p_in, theta, theta_dot, u, u_dot, s, g, prm, FLEX, GROUND):
-    """``vertical_power`` under a ground kind with a vertical (``ground.GROUNDS``), else
-    p_in itself (the other variants compile nothing of it)."""
-    return _power(GROUND, p_in, theta, theta_dot, u, u_dot, s, g, prm, FLEX)
+#: (GROUND, p_in, theta, theta', u, u', s, g, prm, FLEX) -> ``vertical_power`` under a
+#: ground kind with a vertical (``ground.GROUNDS``), else p_in itself (the other variants
+#: compile nothing of it)
+with_vertical_power = per_ground(lambda k: _power_vertical if k.vertical else _power_plain,
+                                 "with_vertical_power")
 
 
 # ----------------------------------------------------------------------------------------
@@ -196,28 +196,22 @@ def tip_moment(g, prm):
     return prm[PAR_MTOT] * g * prm[PAR_B]
 
 
-@njit(**INLINE)
-def _rates_plain(dq, dg, u, prm, FLEX):
+def _rates_plain(GROUND, dq, t, u, on, prm, FLEX):
     return -dq, dq
 
 
-@njit(**INLINE)
-def _rates_vertical(dq, dg, u, prm, FLEX):
+def _rates_vertical(GROUND, dq, t, u, on, prm, FLEX):
+    dg = gravity_rate(GROUND, t, on, prm)
     dq_all = dq + prm[PAR_M] * dg * u if FLEX else dq  # Q's m g u
     d_mgb = prm[PAR_MTOT] * dg * prm[PAR_B]
     return d_mgb - dq_all, d_mgb + dq_all
 
 
-_rates = per_ground(lambda k: _rates_vertical if k.vertical else _rates_plain,
-                    "uplift_rates_of")
-
-
-@njit(cache=True, **INLINE)
-def uplift_rates(dq, t, u, on, prm, FLEX, GROUND):
-    """(d/dt (M g b - Q), d/dt (M g b + Q)): the uplift events' rates from dQ/dt at
-    constant g (``uplift_moment_rate``), plus, under a ground kind with a vertical, those
-    of g + a_v in Q and M g b (``ground.gravity_rate``)."""
-    return _rates(GROUND, dq, gravity_rate(t, on, prm, GROUND), u, prm, FLEX)
+#: (GROUND, dq, t, u, on, prm, FLEX) -> (d/dt (M g b - Q), d/dt (M g b + Q)): the uplift
+#: events' rates from dQ/dt at constant g (``uplift_moment_rate``), plus, under a ground
+#: kind with a vertical, those of g + a_v in Q and M g b (``ground.gravity_rate``)
+uplift_rates = per_ground(lambda k: _rates_vertical if k.vertical else _rates_plain,
+                          "uplift_rates")
 
 
 @njit(cache=True, **INLINE)

@@ -81,8 +81,8 @@ def event_value(ev, t, y, s, on, prm, FLEX, DAMPED, GROUND):
         return s * y[Y_THETA]
     if ev == EV_OVERTURN:
         return prm[PAR_THETA_OVER] - s * y[Y_THETA]
-    g = ground_gravity(t, on, prm, GROUND)
-    q = uplift_moment(y[Y_U], y[Y_U_DOT], ground_acc(t, on, prm, GROUND), g, prm, FLEX, DAMPED)
+    g = ground_gravity(GROUND, t, on, prm)
+    q = uplift_moment(y[Y_U], y[Y_U_DOT], ground_acc(GROUND, t, on, prm), g, prm, FLEX, DAMPED)
     mgb = tip_moment(g, prm)
     return mgb - q if ev == EV_UPLIFT_POS else mgb + q
 
@@ -94,10 +94,10 @@ def event_rate(ev, t, y, s, on, prm, FLEX, DAMPED, GROUND):
         return s * y[Y_THETA_DOT]
     if ev == EV_OVERTURN:
         return -s * y[Y_THETA_DOT]
-    dq = uplift_moment_rate(y[Y_U], y[Y_U_DOT], ground_acc(t, on, prm, GROUND),
-                            ground_jerk(t, on, prm, GROUND), ground_gravity(t, on, prm, GROUND),
+    dq = uplift_moment_rate(y[Y_U], y[Y_U_DOT], ground_acc(GROUND, t, on, prm),
+                            ground_jerk(GROUND, t, on, prm), ground_gravity(GROUND, t, on, prm),
                             prm, FLEX, DAMPED)
-    rate_pos, rate_neg = uplift_rates(dq, t, y[Y_U], on, prm, FLEX, GROUND)
+    rate_pos, rate_neg = uplift_rates(GROUND, dq, t, y[Y_U], on, prm, FLEX)
     return rate_pos if ev == EV_UPLIFT_POS else rate_neg
 
 
@@ -231,7 +231,6 @@ def _locate(ev, t0, y0, k1, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, ENER
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
-    literally(GROUND)
     lo = 0.0
     tol = prm[PAR_TOL]
     illinois = prm[PAR_ROOT] == ROOT_ILLINOIS
@@ -332,7 +331,6 @@ def _dip(ev, t0, y0, k1, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERG
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
-    literally(GROUND)
     if not (0.0 < tau < h):
         tau = 0.5 * h
     lo, r_lo, f_lo, hi, r_hi, f_hi = 0.0, d0, d0, h, d1, d1
@@ -374,7 +372,6 @@ def _first_event(t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY, GROUND):
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
-    literally(GROUND)
     # The two event codes of a phase go through variables (type int64, not a literal), so
     # that numba compiles _crossing, _locate, event_value and event_rate once, not once per
     # code (a literal argument is a specialisation of its own: 4x the compile time).

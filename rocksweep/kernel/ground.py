@@ -29,7 +29,7 @@ from dataclasses import dataclass
 from numba import njit
 from numba.extending import overload
 
-from rocksweep.kernel._cache import INLINE, INTERNAL
+from rocksweep.kernel._cache import INLINE, INTERNAL, PUBLIC
 from rocksweep.kernel._static import chosen
 from rocksweep.kernel.layout import (
     GROUND_ANY,
@@ -69,17 +69,20 @@ _mp_raw_rate = njit(**INLINE)(_ground.mp_raw_rate)
 # ----------------------------------------------------------------------------------------
 
 
-@njit(**INLINE)
-def pulse_acc(t, prm):
-    """Eq. (2): A sin(w t) or A cos(w t) (the paper's sine and cosine, n cycles)."""
+def pulse_acc(GROUND, t, on, prm):
+    """Eq. (2): A sin(w t) or A cos(w t) (the paper's sine and cosine, n cycles); 0 when
+    the ground is still."""
+    if not on:
+        return 0.0
     if prm[PAR_SHAPE] == SHAPE_COSINE:
         return prm[PAR_AMP] * math.cos(prm[PAR_OMEGA] * t)
     return prm[PAR_AMP] * math.sin(prm[PAR_OMEGA] * t)
 
 
-@njit(**INLINE)
-def pulse_jerk(t, prm):
+def pulse_jerk(GROUND, t, on, prm):
     """d/dt of ``pulse_acc``."""
+    if not on:
+        return 0.0
     w = prm[PAR_OMEGA]
     if prm[PAR_SHAPE] == SHAPE_COSINE:
         return -prm[PAR_AMP] * w * math.sin(w * t)
@@ -182,21 +185,40 @@ def vertical_jerk_any(t, prm):
     return prm[PAR_V_AMP] * w * math.cos(w * t + prm[PAR_V_PHASE])
 
 
-@njit(**INLINE)
-def row_gravity(t, prm):
+def any_acc(GROUND, t, on, prm):
+    """``ground_acc_any``: every shape; 0 when the ground is still."""
+    if not on:
+        return 0.0
+    return ground_acc_any(t, prm)
+
+
+def any_jerk(GROUND, t, on, prm):
+    if not on:
+        return 0.0
+    return ground_jerk_any(t, prm)
+
+
+def row_gravity(GROUND, t, on, prm):
     """The row's g [m/s^2]: no vertical component."""
     return prm[PAR_G]
 
 
-@njit(**INLINE)
-def vertical_gravity(t, prm):
-    """g + a_v(t) [m/s^2] while the ground moves."""
+def vertical_gravity(GROUND, t, on, prm):
+    """g + a_v(t) [m/s^2] while the ground moves, g when it is still."""
+    if not on:
+        return prm[PAR_G]
     return prm[PAR_G] + vertical_acc_any(t, prm)
 
 
-@njit(**INLINE)
-def no_gravity_rate(t, prm):
+def no_gravity_rate(GROUND, t, on, prm):
     return 0.0
+
+
+def vertical_gravity_rate(GROUND, t, on, prm):
+    """d a_v/dt [m/s^3] while the ground moves."""
+    if not on:
+        return 0.0
+    return vertical_jerk_any(t, prm)
 
 
 # ----------------------------------------------------------------------------------------
@@ -206,13 +228,14 @@ def no_gravity_rate(t, prm):
 
 @dataclass(frozen=True)
 class GroundKind:
-    """What a ground kind does to the equations while the ground moves (each a jitted
-    ``f(t, prm)``) and to the loop."""
+    """What a ground kind does to the equations, each a plain-Python
+    ``f(GROUND, t, on, prm)`` (``on``: the ground moves; the variant's GROUND first, as
+    ``_static.chosen``'s entries take it), and to the loop."""
 
     name: str  # its entry points' suffix (``variants``): "" for the paper's pulses
     acc: Callable  # xg''(t) [m/s^2]
     jerk: Callable  # d xg''/dt [m/s^3]
-    gravity: Callable  # g + a_v(t) [m/s^2]
+    gravity: Callable  # g + a_v(t) [m/s^2]: the gravity of the ground's frame
     gravity_rate: Callable  # d(g + a_v)/dt [m/s^3]
     records: bool  # a record's samples may drive it: the steps land on them (PAR_REC_H)
     vertical: bool  # a vertical acts: its work counts, the run stops at PAR_T_AIR
@@ -221,82 +244,56 @@ class GroundKind:
 GROUNDS: dict[int, GroundKind] = {
     GROUND_PULSE: GroundKind("", pulse_acc, pulse_jerk, row_gravity, no_gravity_rate,
                              records=False, vertical=False),
-    GROUND_ANY: GroundKind("_ground", ground_acc_any, ground_jerk_any, row_gravity,
-                           no_gravity_rate, records=True, vertical=False),
-    GROUND_VERTICAL: GroundKind("_vertical", ground_acc_any, ground_jerk_any,
-                                vertical_gravity, vertical_jerk_any, records=True,
-                                vertical=True),
+    GROUND_ANY: GroundKind("_ground", any_acc, any_jerk, row_gravity, no_gravity_rate,
+                           records=True, vertical=False),
+    GROUND_VERTICAL: GroundKind("_vertical", any_acc, any_jerk, vertical_gravity,
+                                vertical_gravity_rate, records=True, vertical=True),
 }
 
 
-def per_ground(pick: Callable[[GroundKind], Callable], name: str, general=None):
-    """``_static.chosen`` over ``GROUNDS``: ``g(GROUND, *args)`` = ``pick(row)(*args)`` of
-    the variant's ground kind, picked while typing."""
-    return chosen({code: pick(kind) for code, kind in GROUNDS.items()}, name, general)
+def per_ground(pick: Callable[[GroundKind], Callable], name: str):
+    """``_static.chosen`` over ``GROUNDS``: ``g(GROUND, *args)`` = ``pick(row)(GROUND,
+    *args)`` of the variant's ground kind, picked while typing."""
+    return chosen({code: pick(kind) for code, kind in GROUNDS.items()}, name)
 
 
-@njit(**INLINE)
-def _any_acc(ground, t, prm):
-    return ground_acc_any(t, prm)
+#: (GROUND, t, on, prm) -> xg''(t) [m/s^2] (0 when the ground is still)
+ground_acc = per_ground(lambda k: k.acc, "ground_acc")
+#: (GROUND, t, on, prm) -> d xg''/dt [m/s^3], for locating an uplift inside a step
+ground_jerk = per_ground(lambda k: k.jerk, "ground_jerk")
+#: (GROUND, t, on, prm) -> g + a_v(t) [m/s^2] (the row's g without a vertical or when the
+#: ground is still)
+ground_gravity = per_ground(lambda k: k.gravity, "ground_gravity")
+#: (GROUND, t, on, prm) -> d(g + a_v)/dt [m/s^3]
+gravity_rate = per_ground(lambda k: k.gravity_rate, "gravity_rate")
 
 
-@njit(**INLINE)
-def _any_jerk(ground, t, prm):
-    return ground_jerk_any(t, prm)
+def ground_flags(GROUND):
+    """(records, vertical) of ground kind GROUND (``GroundKind``): constants of the variant
+    (jitted: GROUND a literal)."""
+    kind = GROUNDS[GROUND]
+    return kind.records, kind.vertical
 
 
-# a call from Python (GROUND a plain int: the reference path, tests) computes any shape
-# (the pulses' sine and cosine are among them, the same arithmetic)
-_acc = per_ground(lambda k: k.acc, "ground_acc_of", general=_any_acc)
-_jerk = per_ground(lambda k: k.jerk, "ground_jerk_of", general=_any_jerk)
-_gravity = per_ground(lambda k: k.gravity, "ground_gravity_of")
-_gravity_rate = per_ground(lambda k: k.gravity_rate, "gravity_rate_of")
+@overload(ground_flags, jit_options=INLINE, prefer_literal=True)
+def _ground_flags(GROUND):
+    kind = GROUNDS[GROUND.literal_value]
+    records, vertical = kind.records, kind.vertical
+
+    def constants(GROUND):
+        return records, vertical
+    return constants
 
 
-@njit(cache=True, **INLINE)
-def ground_acc(t, on, prm, GROUND):
-    """xg''(t) [m/s^2] of the row's shape under ground kind GROUND; 0 when ``on`` is
-    false (Python callers: any GROUND_* as a plain int computes every shape)."""
-    if not on:
-        return 0.0
-    return _acc(GROUND, t, prm)
+# From Python (the reference path, tests): any shape (GROUND_ANY; the paper's sine and
+# cosine are among them, the same arithmetic)
+@njit(cache=True, **PUBLIC)
+def any_ground_acc(t, on, prm):
+    """xg''(t) [m/s^2] of the row's shape, 0 when ``on`` is false."""
+    return ground_acc(GROUND_ANY, t, on, prm)
 
 
-@njit(cache=True, **INLINE)
-def ground_jerk(t, on, prm, GROUND):
-    """d xg''/dt [m/s^3], for locating an uplift inside a step."""
-    if not on:
-        return 0.0
-    return _jerk(GROUND, t, prm)
-
-
-@njit(cache=True, **INLINE)
-def ground_gravity(t, on, prm, GROUND):
-    """g + a_v(t) [m/s^2]: the gravity of the ground's frame (the row's g without a
-    vertical, or when the ground is still)."""
-    if not on:
-        return prm[PAR_G]
-    return _gravity(GROUND, t, prm)
-
-
-@njit(cache=True, **INLINE)
-def gravity_rate(t, on, prm, GROUND):
-    """d(g + a_v)/dt [m/s^3] (0 without a vertical, or when the ground is still)."""
-    if not on:
-        return 0.0
-    return _gravity_rate(GROUND, t, prm)
-
-
-def ground_is(GROUND, what):
-    """Whether ground kind GROUND has the property ``what`` ("records", "vertical"): a
-    constant of the variant (jitted: GROUND and ``what`` literals)."""
-    return getattr(GROUNDS[GROUND], what)
-
-
-@overload(ground_is, jit_options=INLINE, prefer_literal=True)
-def _ground_is(GROUND, what):
-    value = getattr(GROUNDS[GROUND.literal_value], what.literal_value)
-
-    def constant(GROUND, what):
-        return value
-    return constant
+@njit(cache=True, **PUBLIC)
+def any_ground_jerk(t, on, prm):
+    """d xg''/dt [m/s^3] of the row's shape, 0 when ``on`` is false."""
+    return ground_jerk(GROUND_ANY, t, on, prm)

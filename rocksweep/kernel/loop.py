@@ -48,7 +48,7 @@ from rocksweep.kernel.events import (
     _first_event,
     hermite_min,
 )
-from rocksweep.kernel.ground import ground_acc, ground_is
+from rocksweep.kernel.ground import ground_acc, ground_flags
 from rocksweep.kernel.layout import (
     HIST_D_DAMP,
     HIST_E,
@@ -160,15 +160,13 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
-    literally(REACTIONS)
-    literally(GROUND)
     t, dt, t_pulse, t_end = 0.0, prm[PAR_DT], prm[PAR_TPULSE], prm[PAR_TEND]
     dt_on = prm[PAR_DT_ON]  # the step while the ground moves (``numerics.step_sizes``)
     max_steps, max_events = prm[PAR_MAXSTEPS], prm[PAR_MAXEVENTS]
     # > 0: a record, whose samples the steps land on while it acts (a ground kind with
-    # records only; ``ground_is``: a constant of the variant)
-    h_rec = prm[PAR_REC_H] if ground_is(GROUND, "records") else 0.0
-    vertical = ground_is(GROUND, "vertical")
+    # records only; ``ground_flags``: constants of the variant)
+    records, vertical = ground_flags(GROUND)
+    h_rec = prm[PAR_REC_H] if records else 0.0
     t_air = prm[PAR_T_AIR] if vertical else math.inf
     on = 0.0 < t_pulse
     y, s = _start(prm, out, hist, on, FLEX, DAMPED, GROUND)
@@ -564,7 +562,6 @@ def _record(hist, t, y, s, on, prm, out, FLEX, GROUND):
 @njit(cache=True, **INTERNAL)
 def _write_row(hist, row, t, y, s, on, prm, e_imp, FLEX, GROUND):
     literally(FLEX)
-    literally(GROUND)
     if row >= hist.shape[0]:
         return False
     hist[row, HIST_T] = t
@@ -578,7 +575,7 @@ def _write_row(hist, row, t, y, s, on, prm, e_imp, FLEX, GROUND):
     hist[row, HIST_W_IN] = y[Y_W_IN]
     hist[row, HIST_D_DAMP] = y[Y_D_DAMP]
     hist[row, HIST_E_IMPACT] = e_imp
-    hist[row, HIST_XG] = ground_acc(t, on, prm, GROUND)
+    hist[row, HIST_XG] = ground_acc(GROUND, t, on, prm)
     return True
 
 

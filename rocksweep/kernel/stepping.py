@@ -25,7 +25,7 @@ def derivatives(t, y, s, on, prm, FLEX, DAMPED, ENERGY, GROUND):
     +-1 rocking on that corner); ``on``: the ground moves (under GROUND's kind: with a
     vertical, its gravity g + a_v the rocking phases feel and its work W_in counts)."""
     theta, theta_dot, u, u_dot = y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT]
-    xg = ground_acc(t, on, prm, GROUND)
+    xg = ground_acc(GROUND, t, on, prm)
     if s == 0:
         if not FLEX:
             return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
@@ -33,18 +33,18 @@ def derivatives(t, y, s, on, prm, FLEX, DAMPED, ENERGY, GROUND):
         if ENERGY:
             return (0.0, 0.0, u_dot, u_dd, p_in, p_damp)
         return (0.0, 0.0, u_dot, u_dd, 0.0, 0.0)
-    g = ground_gravity(t, on, prm, GROUND)
+    g = ground_gravity(GROUND, t, on, prm)
     if not FLEX:
         theta_dd, p_in = rigid_rhs(theta, theta_dot, s, xg, g, prm)
         if ENERGY:
-            p_in = with_vertical_power(p_in, theta, theta_dot, 0.0, 0.0, s, g, prm, FLEX,
-                                       GROUND)
+            p_in = with_vertical_power(GROUND, p_in, theta, theta_dot, 0.0, 0.0, s, g, prm,
+                                       FLEX)
             return (theta_dot, theta_dd, 0.0, 0.0, p_in, 0.0)
         return (theta_dot, theta_dd, 0.0, 0.0, 0.0, 0.0)
     theta_dd, u_dd, p_in, p_damp = rocking_rhs(theta, theta_dot, u, u_dot, s, xg, g, prm,
                                                DAMPED)
     if ENERGY:
-        p_in = with_vertical_power(p_in, theta, theta_dot, u, u_dot, s, g, prm, FLEX, GROUND)
+        p_in = with_vertical_power(GROUND, p_in, theta, theta_dot, u, u_dot, s, g, prm, FLEX)
         return (theta_dot, theta_dd, u_dot, u_dd, p_in, p_damp)
     return (theta_dot, theta_dd, u_dot, u_dd, 0.0, 0.0)
 

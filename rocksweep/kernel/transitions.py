@@ -40,8 +40,8 @@ from rocksweep.kernel.layout import (
 def uplift_side(t, y, on, prm, FLEX, DAMPED, GROUND):
     """Corner (+1 / -1) the body uplifts on from full contact at (t, y), or 0 (with a
     vertical: under g + a_v(t), in Q and in M g b alike)."""
-    g = ground_gravity(t, on, prm, GROUND)
-    q = uplift_moment(y[Y_U], y[Y_U_DOT], ground_acc(t, on, prm, GROUND), g, prm, FLEX, DAMPED)
+    g = ground_gravity(GROUND, t, on, prm)
+    q = uplift_moment(y[Y_U], y[Y_U_DOT], ground_acc(GROUND, t, on, prm), g, prm, FLEX, DAMPED)
     mgb = tip_moment(g, prm)
     if q >= mgb:
         return 1

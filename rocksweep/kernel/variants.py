@@ -13,6 +13,9 @@ A variant is one row of four columns, each a small table here or in ``ground``:
   point with its state, phases and transitions: today the no-slip rocking of the paper
   (``loop.simulate_point``).
 
+REACTIONS (a level's bookkeeping of what the ground does) and the contact model (what the
+ground lets the body do) are separate columns: any level runs under any model.
+
 An entry point fixes a row's flags as literals of ``simulate_point`` (numba compiles one
 specialisation per row, the branches a row does not need removed) and calls it itself (no
 shared chunk loop in between: every level of calls is one more LLVM optimisation of the
@@ -33,8 +36,8 @@ the shared per-user cache of these kernel sources (``_cache``), and loads in ~5 
 (``_cache.EntryCache``).
 
 A new ground kind is a row of ``ground.GROUNDS``; a new contact model a row of
-``CONTACTS`` (its loop function, ``simulate_point``'s signature); the entry points of
-every combination follow.
+``CONTACTS`` (the two entry bodies calling its loop, which takes ``simulate_point``'s
+arguments); the entry points of every combination follow.
 """
 
 import threading
@@ -45,7 +48,6 @@ import numpy as np
 from numba import njit
 
 from rocksweep.kernel._cache import ENTRY, loads_fast
-from rocksweep.kernel._static import chosen
 from rocksweep.kernel.ground import GROUNDS
 from rocksweep.kernel.layout import (
     CONTACT_NOSLIP,
@@ -86,12 +88,17 @@ class Level:
 
 @dataclass(frozen=True)
 class ContactModel:
-    """A contact model: how the body touches the ground, as one loop function with
-    ``simulate_point``'s signature ``(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS,
-    GROUND)`` (the flags literals)."""
+    """A contact model: how the body touches the ground, as the two entry points' bodies
+    made from a row's flags, ``chunk(FLEX, DAMPED, ENERGY, REACTIONS, GROUND)`` -> a Python
+    ``f(prms, outs)`` and ``point(...)`` -> ``f(prm, out, hist)``, each calling the model's
+    loop (for the paper's: ``simulate_point``) with the flags. A function of the model's
+    own module, so that the loop is a global name of the entry point: a closure cell
+    holding it would put numba's per-process dispatcher id into the cache key, and a
+    selection in between one more compiled function."""
 
-    name: str  # the entry point's suffix ("" for the paper's)
-    simulate: Callable
+    name: str  # the entry points' suffix ("" for the paper's)
+    chunk: Callable
+    point: Callable
 
 
 KINDS: dict[int, Kind] = {
@@ -105,25 +112,25 @@ LEVELS: dict[int, Level] = {
     LEVEL_CONTACT: Level("_contact", energy=True, reactions=True),
 }
 HISTORY = Level("_history", energy=True, reactions=True)  # the single runs (point entries)
-CONTACTS: dict[int, ContactModel] = {
-    CONTACT_NOSLIP: ContactModel("", simulate_point),  # the paper's: rocking, no sliding
-}
-
-# the contact model's loop, picked while typing by the entry point's CONTACT literal
-_simulate = chosen({code: model.simulate for code, model in CONTACTS.items()}, "simulate")
 
 
-def _chunk_entry(FLEX, DAMPED, ENERGY, REACTIONS, GROUND, CONTACT):
+def _noslip_chunk(FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     def chunk(prms, outs):
         for i in range(prms.shape[0]):
-            _simulate(CONTACT, prms[i], outs[i], None, FLEX, DAMPED, ENERGY, REACTIONS, GROUND)
+            simulate_point(prms[i], outs[i], None, FLEX, DAMPED, ENERGY, REACTIONS, GROUND)
     return chunk
 
 
-def _point_entry(FLEX, DAMPED, ENERGY, REACTIONS, GROUND, CONTACT):
+def _noslip_point(FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     def point(prm, out, hist):
-        _simulate(CONTACT, prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND)
+        simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND)
     return point
+
+
+CONTACTS: dict[int, ContactModel] = {
+    # the paper's: rocking on a corner or in full contact, never sliding
+    CONTACT_NOSLIP: ContactModel("", _noslip_chunk, _noslip_point),
+}
 
 
 _MADE: dict[tuple, Callable] = {}  # (kind, level or None, ground, contact) -> entry point
@@ -151,8 +158,8 @@ def _entry(kind, level, ground, contact):
         if fn is None:
             k, lvl = KINDS[row[0]], (HISTORY if level is None else LEVELS[row[1]])
             g, c = GROUNDS[row[2]], CONTACTS[row[3]]
-            flags = (k.flex, k.damped, lvl.energy, lvl.reactions, row[2], row[3])
-            py = (_point_entry if level is None else _chunk_entry)(*flags)
+            flags = (k.flex, k.damped, lvl.energy, lvl.reactions, row[2])
+            py = (c.point if level is None else c.chunk)(*flags)
             # the name numba caches it under (module, name): one cache entry per row
             name = ("point" if level is None else "chunk") + "_" + k.name
             py.__name__ = py.__qualname__ = name + lvl.name + g.name + c.name

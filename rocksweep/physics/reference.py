@@ -69,7 +69,7 @@ from rocksweep.kernel.equations import (
     uplift_moment,
     uplift_moment_rate,
 )
-from rocksweep.kernel.ground import ground_acc, ground_jerk
+from rocksweep.kernel.ground import any_ground_acc, any_ground_jerk
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import G
 from rocksweep.physics.points import Point, point_row
@@ -119,11 +119,10 @@ class _Problem:
 
     # --- eq. (2) -----------------------------------------------------------------------
     def xg(self, t: float, on: bool) -> float:
-        # every shape (GROUND_ANY: a plain int from Python computes them all)
-        return ground_acc(t, on, self.prm, L.GROUND_ANY)
+        return any_ground_acc(t, on, self.prm)
 
     def jerk(self, t: float, on: bool) -> float:
-        return ground_jerk(t, on, self.prm, L.GROUND_ANY)
+        return any_ground_jerk(t, on, self.prm)
 
     def gravity(self, t: float, on: bool) -> float:
         """g + a_v(t) [m/s^2] (g without a vertical, or when the ground is still)."""

@@ -52,7 +52,7 @@ def test_every_row_of_the_table_makes_its_entry_point_named_after_it():
                     assert k.name in name and name.endswith(lvl.name + g.name)
                     assert _cells(entry) == {
                         "FLEX": k.flex, "DAMPED": k.damped, "ENERGY": lvl.energy,
-                        "REACTIONS": lvl.reactions, "GROUND": ground, "CONTACT": contact}
+                        "REACTIONS": lvl.reactions, "GROUND": ground}
                     seen.add(name)
                     again = (point_kernel(np.int64(kind), ground) if level is None
                              else chunk_kernel(np.int64(kind), np.int64(level), ground))

@@ -21,7 +21,7 @@ import pytest
 from rocksweep.compute.single import run_point
 from rocksweep.errors import SceneError
 from rocksweep.kernel import layout as L
-from rocksweep.kernel.ground import ground_acc, ground_jerk
+from rocksweep.kernel.ground import any_ground_acc, any_ground_jerk
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody
 from rocksweep.physics.excitation import PulseShape
@@ -46,13 +46,12 @@ def test_kernel_ground_motion_is_the_reference_shape(shape, cycles, gamma, nu):
     w = 1.3  # p = 1 in the kernel
     assert row[L.PAR_TPULSE] == pytest.approx(ref.duration / w, rel=1e-15)
     t = np.linspace(0.0, row[L.PAR_TPULSE], 1001)
-    acc = np.array([ground_acc(x, True, row, L.GROUND_ANY) for x in t])
-    jerk = np.array([ground_jerk(x, True, row, L.GROUND_ANY) for x in t])
+    acc = np.array([any_ground_acc(x, True, row) for x in t])
+    jerk = np.array([any_ground_jerk(x, True, row) for x in t])
     np.testing.assert_allclose(acc, pt.A * ref.acc(w * t), rtol=1e-12, atol=1e-12 * abs(pt.A))
     np.testing.assert_allclose(jerk, pt.A * w * ref.rate(w * t), rtol=1e-12,
                                atol=1e-12 * abs(pt.A) * w)
-    assert (ground_acc(0.3, False, row, L.GROUND_ANY) == 0.0
-            and ground_jerk(0.3, False, row, L.GROUND_ANY) == 0.0)
+    assert any_ground_acc(0.3, False, row) == 0.0 and any_ground_jerk(0.3, False, row) == 0.0
     assert np.max(np.abs(acc)) <= abs(pt.A) * (1 + 1e-12)  # A is the peak
 
 
