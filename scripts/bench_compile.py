@@ -182,7 +182,7 @@ def per_point(names: list[str], repeat: int) -> dict[str, dict]:
 
 _PER_POINT_SNIPPET = """
 import json, sys
-sys.path.insert(0, sys.argv[1])
+sys.path.append(sys.argv[1])  # last: first, _here would put this checkout before PYTHONPATH's
 import bench_kernel as bk
 import rocksweep
 scene = bk.scene_of(sys.argv[2], None)
@@ -215,6 +215,8 @@ def ab_round(tree: Path | None, repeat: int, tmp: str) -> dict[str, float]:
                           "fig3a", str(repeat)], env=child_env(tree), cwd=tmp,
                          capture_output=True, text=True, check=True)
     pp = json.loads(res.stdout.splitlines()[-1])
+    if not pp["package"].startswith(package):
+        raise SystemExit(f"the per-point subprocess imported {pp['package']}, not {package}")
     return {"compile": comp["cpu"], "start": min(walls), "us": pp["us"]}
 
 
