@@ -155,7 +155,7 @@ def main(argv: list[str] | None = None) -> int:
         # flat indices of (lam 0.2, record rec_i, stripe s)
         flat = np.array([np.ravel_multi_index((1, rec_i, s), grid.shape) for s in picks])
         cr = grid.rows_at(flat)
-        kernel = chunk_kernel(int(cr.kinds[0]), level(sc), True)
+        kernel = chunk_kernel(int(cr.kinds[0]), level(sc), L.GROUND_ANY)
         rows = cr.rows
         outs = np.empty((flat.size, L.N_OUT))
         print(f"\n2. one run against the scipy reference (record {name}, lam 0.2, "

@@ -150,7 +150,7 @@ def test_kernel_codes_are_the_vocabulary_codes():
 
     assert [L.SHAPE_SINE, L.SHAPE_COSINE, L.SHAPE_RICKER, L.SHAPE_MP, L.SHAPE_RECORD] == [
         ground.SHAPE_CODE[s] for s in (*ground.SHAPES, ground.RECORD)]
-    assert [L.LAW_VERTICAL, L.LAW_LOCKED, L.LAW_CONSTANT] == [laws.LAW_CODE[w]
+    assert [L.LAW_EQ1, L.LAW_LOCKED, L.LAW_CONSTANT] == [laws.LAW_CODE[w]
                                                                for w in laws.LAWS]
     assert [L.ROOT_BISECT, L.ROOT_ILLINOIS, L.ROOT_HERMITE] == [settings.ROOT_CODE[w]
                                                                 for w in settings.ROOTS]

@@ -44,6 +44,7 @@ from rocksweep.analysis.misfit import Problem
 from rocksweep.compute.compile_cost import prepare_point
 from rocksweep.errors import CalibrationError
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.physics.bodies import u_cr
 from rocksweep.physics.measured import Measured, read_measured
 from rocksweep.physics.points import kernel_kind
 from rocksweep.schema import KEYS
@@ -262,7 +263,7 @@ def calibrate_scene(scene: Any, measured: Any, fit: str | Sequence[str],
     p_body = _body_p(scene) if p is None else float(p)
     values = {a.name: a.values[0] for a in scene.axes}
     body = scene.point(values).body
-    m = read_measured(measured, p=p_body, alpha_ref=body.alpha_ref, u_cr=body.u_cr or None)
+    m = read_measured(measured, p=p_body, alpha_ref=body.alpha_ref, u_cr=u_cr(body) or None)
     if p is not None and not m.physical:
         raise CalibrationError(f"p = {p!r}: {m.source} has the dimensionless columns p_t, "
                                "theta_over_alpha; p reads physical columns t [s], theta "

@@ -91,7 +91,7 @@ def run_record(kernel_fn, rows: np.ndarray, sel: np.ndarray, outs: np.ndarray,
     ``excitation``.
 
     The GROUND chunk kernel reads the ground motion from the row after the parameters
-    (``kernel.equations.ground_acc``, ``Excitation.with_samples``). The runs share one
+    (``kernel.ground.ground_acc``, ``Excitation.with_samples``). The runs share one
     wide row: the samples are written into it once, and each point's N_PAR parameters are
     copied in before its kernel call (one call a point, ~1 us of dispatch against the
     milliseconds a run of a record takes), so no point copies the samples. Each point's

@@ -24,7 +24,7 @@ from rocksweep.numerics import (
     step_budget,
     step_sizes,
 )
-from rocksweep.physics.bodies import Body, FlexibleBody, G
+from rocksweep.physics.bodies import Body, FlexibleBody, G, u_cr
 from rocksweep.physics.ground_motion import Excitation, pulse
 from rocksweep.physics.records import GroundRecord
 from rocksweep.vocab.ground import FREE, RECORD, pulse_duration
@@ -262,7 +262,7 @@ class Bodies:
         return cls(rows, np.array([body_omega_rock(b) for b in distinct], float),
                    np.array([b.alpha_ref for b in distinct], float),
                    np.array([b.E_ref for b in distinct], float),
-                   np.array([b.u_cr for b in distinct], float),
+                   np.array([u_cr(b) for b in distinct], float),
                    np.array([kernel_kind(b) for b in distinct], np.int64)).take(index)
 
     def take(self, index: np.ndarray) -> Bodies:

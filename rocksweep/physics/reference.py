@@ -58,8 +58,6 @@ from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel.contact import ground_reactions, impact_impulses, impulse_ratio
 from rocksweep.kernel.equations import (
     contact_rhs,
-    ground_acc,
-    ground_jerk,
     mechanical_energy,
     rest_margin,
     restitution,
@@ -71,6 +69,7 @@ from rocksweep.kernel.equations import (
     uplift_moment,
     uplift_moment_rate,
 )
+from rocksweep.kernel.ground import any_ground_acc, any_ground_jerk
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import G
 from rocksweep.physics.points import Point, point_row
@@ -120,12 +119,10 @@ class _Problem:
 
     # --- eq. (2) -----------------------------------------------------------------------
     def xg(self, t: float, on: bool) -> float:
-        # on as an int: the kernel's code for every shape (a bool would compile the
-        # sine/cosine-only code, ``equations.ground_acc``)
-        return ground_acc(t, int(on), self.prm)
+        return any_ground_acc(t, on, self.prm)
 
     def jerk(self, t: float, on: bool) -> float:
-        return ground_jerk(t, int(on), self.prm)
+        return any_ground_jerk(t, on, self.prm)
 
     def gravity(self, t: float, on: bool) -> float:
         """g + a_v(t) [m/s^2] (g without a vertical, or when the ground is still)."""
@@ -567,7 +564,7 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
     numerics = numerics or Numerics()
     prm = point_row(point, numerics)
     flex = not point.body.rigid
-    pb = _Problem(prm, flex, bool(point.body.zeta > 0) and flex, rtol, atol,
+    pb = _Problem(prm, flex, flex and bool(point.body.zeta > 0), rtol, atol,
                   _vertical(point, prm))
     t_end = float(prm[L.PAR_TEND])
     max_events = int(prm[L.PAR_MAXEVENTS])

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.physics.bodies import u_cr as body_u_cr
 from rocksweep.physics.ground_motion import Excitation
 from rocksweep.physics.points import (
     Bodies,
@@ -162,7 +163,7 @@ class Grid:
             alpha_ref[j] = body.alpha_ref
             E_ref[j] = body.E_ref
             kinds[j] = kernel_kind(body)
-            u_cr[j] = body.u_cr
+            u_cr[j] = body_u_cr(body)
         return Bodies(rows, omega_rock, alpha_ref, E_ref, u_cr, kinds)
 
     def rows(self, start: int, stop: int) -> ChunkRows:

@@ -71,9 +71,9 @@ def _bare(point: Point, numerics: Numerics) -> np.ndarray:
     """One kernel run without certification: the result row."""
     row = point_row(point, numerics)
     kind = kernel_kind(point.body)
-    warm_up(kind, L.LEVEL_OUTCOME, False)
+    warm_up(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)
     out = np.empty((1, L.N_OUT))
-    chunk_kernel(kind, L.LEVEL_OUTCOME, False)(row[None, :], out)
+    chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)(row[None, :], out)
     return out[0]
 
 

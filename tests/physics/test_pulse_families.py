@@ -21,7 +21,7 @@ import pytest
 from rocksweep.compute.single import run_point
 from rocksweep.errors import SceneError
 from rocksweep.kernel import layout as L
-from rocksweep.kernel.equations import ground_acc, ground_jerk
+from rocksweep.kernel.ground import any_ground_acc, any_ground_jerk
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody
 from rocksweep.physics.excitation import PulseShape
@@ -47,12 +47,12 @@ def test_kernel_ground_motion_is_the_reference_shape(shape, cycles, gamma, nu):
     w = 1.3  # p = 1 in the kernel
     assert row[L.PAR_TPULSE] == pytest.approx(ref.duration / w, rel=1e-15)
     t = np.linspace(0.0, row[L.PAR_TPULSE], 1001)
-    acc = np.array([ground_acc(x, 1, row) for x in t])
-    jerk = np.array([ground_jerk(x, 1, row) for x in t])
+    acc = np.array([any_ground_acc(x, True, row) for x in t])
+    jerk = np.array([any_ground_jerk(x, True, row) for x in t])
     np.testing.assert_allclose(acc, pt.A * ref.acc(w * t), rtol=1e-12, atol=1e-12 * abs(pt.A))
     np.testing.assert_allclose(jerk, pt.A * w * ref.rate(w * t), rtol=1e-12,
                                atol=1e-12 * abs(pt.A) * w)
-    assert ground_acc(0.3, 0, row) == 0.0 and ground_jerk(0.3, 0, row) == 0.0
+    assert any_ground_acc(0.3, False, row) == 0.0 and any_ground_jerk(0.3, False, row) == 0.0
     assert np.max(np.abs(acc)) <= abs(pt.A) * (1 + 1e-12)  # A is the peak
 
 
@@ -100,7 +100,7 @@ def test_two_cycles_are_one_cycle_after_another():
     row = point_row(_point("sine", 1, 2.0, 90.0, w_over_p=w, A_ratio=A), fine)
     row[L.PAR_THETA0], row[L.PAR_THETA_DOT0] = h["theta"][k], h["theta_dot"][k]
     out = np.empty(L.N_OUT)
-    point_kernel(L.KIND_RIGID, False)(row, out, np.empty((200_000, L.N_HIST)))
+    point_kernel(L.KIND_RIGID, L.GROUND_PULSE)(row, out, np.empty((200_000, L.N_HIST)))
     assert out[L.OUT_OUTCOME] != L.OUTCOME_SAFE
     # 1e-5: `fine`'s error; the restarted run's steps differ after T (the rotation limit
     # predicts each step from the last one's theta'', which a restart does not carry over)
