@@ -58,6 +58,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import _here  # noqa: E402, F401 (this checkout's rocksweep, not an installed one)
 import bench_kernel as bk  # noqa: E402  (scripts/bench_kernel.py: best_pass, scene_of)
@@ -211,7 +212,11 @@ def ab_round(tree: Path | None, repeat: int, tmp: str) -> dict[str, float]:
         t0 = time.perf_counter()
         subprocess.run(sweep, check=True, capture_output=True, env=child_env(tree), cwd=tmp)
         walls.append(time.perf_counter() - t0)
-    res = subprocess.run([sys.executable, "-c", _PER_POINT_SNIPPET, str(Path(__file__).parent),
+    # the copy's own bench_kernel where it has one: this copy's imports names an old
+    # package lacks; both time the same thing (``best_pass`` of ``kernel_pass``)
+    own = None if tree is None else tree / "scripts"
+    scripts = own if own is not None and (own / "bench_kernel.py").is_file() else HERE
+    res = subprocess.run([sys.executable, "-c", _PER_POINT_SNIPPET, str(scripts),
                           "fig3a", str(repeat)], env=child_env(tree), cwd=tmp,
                          capture_output=True, text=True, check=True)
     pp = json.loads(res.stdout.splitlines()[-1])
