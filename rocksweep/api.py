@@ -273,7 +273,9 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
 
     ds: what ``run`` or ``open`` returns (or a result file's path). state: "overturn"
     (either mode), "mode1", "mode2", "uplift", "theta:X" (max|theta|/alpha_cg >= X, or
-    overturned, 0 < X <= 1), or a list of them (a ``state`` dimension; each state fitted
+    overturned, 0 < X <= 1), "slide:D" (the base's sliding displacement slide_max >= D, or
+    overturned, D > 0 in slide_max's units: b, metres for a physical body; a scene with
+    body.mu), or a list of them (a ``state`` dimension; each state fitted
     alone, its numbers the same whatever else is asked for; nested curves that cross in
     the data say "crossing"). joint: damage states share one beta (an ordinal fit, its
     likelihood-ratio test stored: ``parallel_rejected``), mode1 with mode2 a

@@ -26,7 +26,15 @@ from rocksweep.cli.options import (
 )
 from rocksweep.errors import FragilityWarning
 from rocksweep.vocab.kinds import FRAGILITY
-from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, STATES, UPLIFT
+from rocksweep.vocab.outcomes import (
+    MODE1,
+    MODE2,
+    OVERTURN,
+    SLIDE_STATE,
+    STATES,
+    THETA_STATE,
+    UPLIFT,
+)
 
 CURVE_SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
 
@@ -60,12 +68,15 @@ def _g(v) -> str:
                    "each stripe, .png, .pdf or .svg.")
 @click.option("--state", default="overturn", show_default=True,
               help="What the curve gives the probability of: " + ", ".join(STATES)
-              + " or theta:X (max|theta|/alpha_cg >= X, 0 < X <= 1); several separated by "
-              "commas, each fitted alone (the same curve whatever else is asked for).")
+              + f", {THETA_STATE} (max|theta|/alpha_cg >= X, 0 < X <= 1) or {SLIDE_STATE} "
+              "(the base's sliding displacement slide_max >= D, D > 0 in units of b, metres "
+              "for a physical body; a scene with body.mu); several separated by commas, each "
+              "fitted alone (the same curve whatever else is asked for).")
 @click.option("--joint", is_flag=True,
-              help=f"Fit damage states ({UPLIFT}, theta:X, {OVERTURN}) with one beta so their "
-                   f"curves never cross (the likelihood-ratio test of that beta is stored), "
-                   f"{MODE1},{MODE2} as competing risks.")
+              help=f"Fit damage states of one chain ({UPLIFT}, {THETA_STATE}, {OVERTURN}; or "
+                   f"{SLIDE_STATE}, {OVERTURN}) with one beta so their curves never cross "
+                   f"(the likelihood-ratio test of that beta is stored), {MODE1},{MODE2} as "
+                   "competing risks.")
 @click.option("--im", default=None,
               help="Unscaled suites (clouds): the IM, PGA (default), PGV or Sa; stripes use "
                    "the IM they were scaled to.")
