@@ -241,22 +241,26 @@ def floor_spectrum(ds: xr.Dataset, rtol: float = DEFAULT_RTOL_MANY, search: bool
 
 
 @analysis
-def ida(ds: xr.Dataset, rtol: float = DEFAULT_RTOL_MANY) -> xr.Dataset:
+def ida(ds: xr.Dataset, rtol: float = DEFAULT_RTOL_MANY, *, state: str = "overturn"
+        ) -> xr.Dataset:
     """Incremental dynamic analysis per record of a scaled record-suite sweep: the
     smallest IM (the stripe IM: PGA [g], PGV [m/s], Sa [g], ...) that overturns each
     record, bisected to ``rtol`` between the last stripe below the first overturning one
     and that stripe (kernel runs at the sweep's accuracy), and whether a higher stripe is
-    safe again (``resurrection``). ds: what ``run`` or ``open`` returns. Returns a Dataset
+    safe again (``resurrection``). state: another damage state in overturning's place, as
+    ``fragility``'s (e.g. "slide:0.5": the smallest IM that slides the base 0.5 b, or
+    overturns it; "theta:0.5"). ds: what ``run`` or ``open`` returns. Returns a Dataset
     over the other swept keys and ``record`` (``rocksweep.analysis.ida.ida``), with the
-    stripes' ``theta_max_over_alpha`` of the points that did not overturn (the IDA
-    curves ``rocksweep.plot`` draws). A sweep over ``angle``: every (record, angle) is a
-    sample (``ida_im`` over angle), and ``ida_im_worst`` / ``worst_angle`` give each
-    record's worst orientation (the least IM that overturns it at any angle)."""
+    stripes' ``theta_max_over_alpha`` (``slide_max`` for "slide:D") of the points that
+    did not overturn (the IDA curves ``rocksweep.plot`` draws). A sweep over ``angle``:
+    every (record, angle) is a sample (``ida_im`` over angle), and ``ida_im_worst`` /
+    ``worst_angle`` give each record's worst orientation (the least IM that overturns it
+    at any angle)."""
     from rocksweep.analysis.floors import worst_ida
     from rocksweep.analysis.ida import ida_dataset
 
     _check_dataset("ds", ds)
-    return worst_ida(ida_dataset(ds, rtol))
+    return worst_ida(ida_dataset(ds, rtol, state))
 
 
 @analysis

@@ -151,6 +151,14 @@ def state_groups(states: Sequence[str], joint: bool = False) -> list[tuple[str, 
     return groups
 
 
+def needed_variables(state: str) -> tuple[str, ...]:
+    """The result variables ``state_reached`` reads for ``state`` besides ``outcome``:
+    uplifts (uplift), theta_max_over_alpha (theta:X), slide_max (slide:D), none else."""
+    kind, _ = parse_state(state)
+    return ("uplifts",) if kind == UPLIFT else (
+        (THRESHOLD_VARIABLE[kind],) if kind in THRESHOLD_VARIABLE else ())
+
+
 def required(ds: xr.Dataset, name: str, why: str) -> xr.DataArray:
     """ds[name], or a one-line FragilityError saying the Dataset lacks it and ``why`` it
     is needed."""

@@ -89,10 +89,11 @@ def _g(v) -> str:
 @ci_option
 @json_option('the curves ({"curves": [...]}) instead of a table')
 @width_option("single")
-@rtol_option(None, "Also refine each record's first overturning level by bisection to this "
-                   "relative tolerance (an IDA per record, kernel runs at the sweep's "
-                   "accuracy): variables ida_im, ida_lo, ida_hi along record in -o "
-                   "(.h5/.nc) and the spread in the table [default: stripes only]")
+@rtol_option(None, "Also refine each record's first level reaching the (first) --state, "
+                   "e.g. overturning, by bisection to this relative tolerance (an IDA per "
+                   "record, kernel runs at the sweep's accuracy): variables ida_im, ida_lo, "
+                   "ida_hi along record in -o (.h5/.nc) and the spread in the table "
+                   "[default: stripes only]")
 @dpi_option
 @overwrite_option
 @user_errors
@@ -122,7 +123,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
 
     ds = rocksweep.open(result_path)
     # --rtol's IDA first: refused, it says so in one line before any word about the fit
-    refined = rocksweep.ida(ds, rtol) if rtol is not None else None
+    refined = rocksweep.ida(ds, rtol, state=states[0]) if rtol is not None else None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", FragilityWarning)
         frag = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states,
@@ -161,16 +162,20 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
 
 
 def _print_ida(refined) -> None:
-    """One line per value of the other swept keys: the records' first overturning levels
-    (bisected), their median and range, resurrections."""
+    """One line per value of the other swept keys: the records' first levels reaching the
+    IDA's state (bisected; overturning by default), their median and range,
+    resurrections."""
     # run time, not --help: numpy, h5py, numba, matplotlib (0.1-2 s each), outputs (+7%)
     import numpy as np
 
     a = refined.attrs
     other = [d for d in refined.ida_im.dims if d != "record"]
     stacked = refined.stack(_k=other) if other else refined.expand_dims(_k=[0])
-    click.echo(f"IDA per record (first overturning {a['im']} [{a['im_units']}], bisected to "
+    first = (f"first overturning {a['im']}" if a["state"] == OVERTURN
+             else f"first {a['im']} reaching {a['state']}")
+    click.echo(f"IDA per record ({first} [{a['im_units']}], bisected to "
                f"rtol {a['rtol']:g}, {int(refined.runs.sum())} kernel runs):")
+    verb = "overturn" if a["state"] == OVERTURN else f"reach {a['state']}"
     for k in range(stacked.sizes["_k"]):
         one = stacked.isel(_k=k)
         where = ", ".join(f"{d} = {one[d].item()}" for d in other) or "all"
@@ -178,10 +183,10 @@ def _print_ida(refined) -> None:
         ok = v[~np.isnan(v)]
         if ok.size:
             click.echo(f"  {where}: median {np.median(ok):.4g}, range {ok.min():.4g} to "
-                       f"{ok.max():.4g} ({ok.size} of {v.size} records overturn; "
+                       f"{ok.max():.4g} ({ok.size} of {v.size} records {verb}; "
                        f"{int(one.resurrection.sum())} resurrect above it)")
         else:
-            click.echo(f"  {where}: no record overturns at any stripe")
+            click.echo(f"  {where}: no record {verb}s at any stripe")
         flagged, stopped = int(one.n_flagged.sum()), int(one.unresolved.sum())
         if flagged or stopped:
             click.echo(f"    {flagged} flagged stripe points (neither safe nor overturning); "
