@@ -176,6 +176,7 @@ def _print_ida(refined) -> None:
     click.echo(f"IDA per record ({first} [{a['im_units']}], bisected to "
                f"rtol {a['rtol']:g}, {int(refined.runs.sum())} kernel runs):")
     verb = "overturn" if a["state"] == OVERTURN else f"reach {a['state']}"
+    verbs = "overturns" if a["state"] == OVERTURN else f"reaches {a['state']}"
     for k in range(stacked.sizes["_k"]):
         one = stacked.isel(_k=k)
         where = ", ".join(f"{d} = {one[d].item()}" for d in other) or "all"
@@ -186,7 +187,7 @@ def _print_ida(refined) -> None:
                        f"{ok.max():.4g} ({ok.size} of {v.size} records {verb}; "
                        f"{int(one.resurrection.sum())} resurrect above it)")
         else:
-            click.echo(f"  {where}: no record {verb}s at any stripe")
+            click.echo(f"  {where}: no record {verbs} at any stripe")
         flagged, stopped = int(one.n_flagged.sum()), int(one.unresolved.sum())
         if flagged or stopped:
             click.echo(f"    {flagged} flagged stripe points (neither safe nor overturning); "
