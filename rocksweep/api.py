@@ -150,7 +150,8 @@ def _check_dataset(name: str, ds: Any) -> None:
 @analysis
 def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any = None,
          curves: bool = False, show_computed: bool = False, mu: bool = False,
-         width: str | None = None, compare: str | None = None) -> Figure:
+         width: str | None = None, compare: str | None = None,
+         regime: bool = False) -> Figure:
     """The figure of any rocksweep Dataset, pyplot-free: a sweep's stability diagram
     (Figures 3 and 4; the options below), or the figure of a fragility (curves, stripe
     fractions sized by record count, bands, beta in the legend, IM on a log axis), IDA,
@@ -169,12 +170,17 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     matplotlib's defaults. compare: a swept key (e.g. "impact.law" or "lam") whose values
     are compared on one diagram, coloured by which of them overturn each cell. A result
     with per-point error estimates rings the points whose outcome changes at half the step.
+    regime: the contact regimes of a sweep with a sliding base (``body.mu``: its
+    ``regime`` variable) instead of the classes, e.g. x = "body.mu", y = "A_ratio"
+    (Shenton's diagram): each cell coloured by the phases its run visited (rest only,
+    slide, rock, slide-rock and their mixtures), overturned cells marked by mode
+    (``rocksweep.figures.regimes``).
     """
     from rocksweep.figures.by_kind import plot_any
 
     _check_dataset("ds", ds)
     return plot_any(ds, x, y, ax=ax, curves=curves, show_computed=show_computed, mu=mu,
-                    width=width, compare=compare)
+                    width=width, compare=compare, regime=regime)
 
 
 @analysis
