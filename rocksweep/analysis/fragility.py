@@ -96,7 +96,9 @@ from rocksweep.analysis.resampling import (
     check_ci,
 )
 from rocksweep.analysis.states import (
+    SLIDE,
     nested,
+    parse_state,
     parse_states,
     required,
     severity,
@@ -371,7 +373,8 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     ``parallel_dof``, ``parallel_p`` (chi-square p-value) and ``parallel_rejected``
     (parallel_p < ``PARALLEL_P``). attrs: rocksweep_kind "fragility" (``analysis.kinds``),
     title (the sweep's), method ("stripes-mle" | "cloud-mle"), im, im_units, period (Sa),
-    avgsa_periods (AvgSa stripes), states, joint, bootstrap, seed, ci, reference.
+    avgsa_periods (AvgSa stripes), states, joint, bootstrap, seed, ci, reference;
+    slide_max_units (slide:D states: D's units, those of the sweep's slide_max).
     """
     states, N, ci = _request(ds, state, im, period, bootstrap, seed, ci)
     if not isinstance(joint, bool | np.bool_):
@@ -673,6 +676,8 @@ def _dataset(ds: xr.Dataset, state: Any, states: list[str], axis: IMAxis, c: Cou
              "ci": float(ci),
              "reference": "Baker (2015), Efficient analytical fragility function fitting "
                           "using dynamic structural analysis, Earthquake Spectra 31(1)"}
+    if any(parse_state(s)[0] == SLIDE for s in states):  # D's units: slide_max's
+        attrs["slide_max_units"] = str(ds["slide_max"].attrs.get("units", ""))
     if axis.im_name == "Sa":
         attrs["period"] = axis.period
     if axis.im_name == AVGSA and "record_avgsa" in ds.variables:
