@@ -194,6 +194,30 @@ def test_joint_slide_states_and_their_risk_are_ordered():
     assert float(rate.sel(state="slide:0.2")) >= float(rate.sel(state="overturn")) > 0
 
 
+def test_efficiency_of_a_slide_state_finds_the_im_that_sets_the_sliding():
+    """The base slides 0.3 b where the scaled PGV reaches 0.2 m/s (overturning never):
+    PGV explains slide:0.3 exactly, PGA keeps the scatter of ln(capacity)."""
+    rng = np.random.default_rng(5)
+    n, levels = 60, np.geomspace(0.05, 5.0, 400)
+    pga = rng.uniform(0.1, 0.4, n)
+    pgv = pga * rng.lognormal(np.log(0.08), 0.4, n) * 9.81
+    cap = 0.2 * pga / pgv  # the capacity in PGA (scaled PGV = PGV * level / pga)
+    lev = levels[None, :] / cap[:, None]
+    dims = ("record", "PGA")
+    ds = xr.Dataset(
+        {"outcome": (dims, np.zeros(lev.shape, np.int8)),
+         "status": (dims, np.zeros(lev.shape, np.int32)),
+         "slide_max": (dims, 0.3 * lev, {"units": "b"}),
+         "record_pga": (("record",), pga), "record_pgv": (("record",), pgv),
+         "scale_factor": (dims, levels[None, :] / pga[:, None])},
+        coords={"record": [f"r{i}.AT2" for i in range(n)], "PGA": levels},
+        attrs={"scale_im": "PGA"})
+    b = rocksweep.im_efficiency(ds, state="slide:0.3").beta.to_series()
+    step = np.log(levels[1] / levels[0])
+    assert b["PGV"] < step
+    assert b["PGA"] == pytest.approx(np.std(np.log(cap)), rel=0.03)
+
+
 # ---------------------------------------------------------------------------------------
 # slide:D in IDA: the stripes from the Dataset, the bisection from runs (a stand-in for
 # the kernel whose sliding displacement is known in closed form)
