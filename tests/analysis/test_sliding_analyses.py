@@ -94,6 +94,8 @@ def test_physical_units_are_the_datasets_and_said():
     assert fr.attrs["slide_max_units"] == "m"
     assert "slide_max_units" not in F.fragility(slide_suite(), state="overturn",
                                                 bootstrap=0, warn=False).attrs
+    fig = rocksweep.plot(fr)
+    assert any("D in m" in a.get_title() for a in fig.axes)
 
 
 @pytest.mark.parametrize("state, words", [
