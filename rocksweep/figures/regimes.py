@@ -18,13 +18,13 @@ from rocksweep.errors import DiagramError
 from rocksweep.figures.diagrams import OUTCOME_STYLE
 from rocksweep.figures.panels import (
     NOT_RUN_COLOUR,
-    choose_axes,
     coord,
     figure_title,
     fitted_title,
     flag_label,
     grid_shape,
     in_order,
+    map_axes,
     mark_flagged,
     panel_indices,
     panel_title,
@@ -50,13 +50,7 @@ def regime_map(result: SweepResult, x: str | None = None, y: str | None = None) 
     if REGIME not in result.arrays:
         raise DiagramError(f"{result.path}: no {REGIME} in this result; the contact regimes "
                            "are those of a sliding base: sweep a scene with body.mu")
-    x, y = choose_axes(result, x, y)
-    if y is None:
-        raise DiagramError(f"{result.path}: one swept axis besides lam ({x}); the regime "
-                           "map needs two")
-    dims = list(result.dims)
-    panel_dims = [d for d in dims if d not in (x, y)]
-    order = [*panel_dims, y, x]
+    x, y, panel_dims, order = map_axes(result, x, y, "the regime map")
     flagged = result.flagged & result.done
     cat = np.where(result.done, regime_index(result.arrays[REGIME]), -1)
     bad = result.done & (cat < 0)

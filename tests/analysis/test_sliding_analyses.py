@@ -240,15 +240,20 @@ CAPACITY = {"SYN01": 0.3137, "SYN05": 0.6571, "SYN12": 0.9}
 D = 0.5
 
 
-def suite_file(tmp_path: Path, with_slide: bool = True) -> tuple[Path, xr.Dataset]:
-    sc = parse_scene(SUITE.replace("ROOT", str(ROOT)))
-    out = tmp_path / "suite.h5"
+def zero_sweep(scene: str, out: Path) -> xr.Dataset:
+    """The result file of ``scene`` with every variable 0 (no kernel runs), opened."""
+    sc = parse_scene(scene)
     sf = SweepFile.create(out, sc)
     n = sf.grid.size
     arrays = {k: np.full(n, 0, dt) for k, (dt, _, _) in sc.variables().items()}
     sf.write(ChunkResult(0, n, arrays, 0.0))
     sf.close()
-    ds = rocksweep.open(out)
+    return rocksweep.open(out)
+
+
+def suite_file(tmp_path: Path, with_slide: bool = True) -> tuple[Path, xr.Dataset]:
+    out = tmp_path / "suite.h5"
+    ds = zero_sweep(SUITE.replace("ROOT", str(ROOT)), out)
     if with_slide:
         level = ds["PGA"] * xr.ones_like(ds["outcome"], float)
         cap = xr.DataArray([CAPACITY[Path(str(r)).stem] for r in ds["record"].values],
@@ -368,15 +373,9 @@ OUT = np.array([[0, 0, 0],
 
 
 def regime_sweep(tmp_path: Path) -> tuple[Path, xr.Dataset]:
-    sc = parse_scene("name: shenton\nbody: {kind: block, alpha: 0.2, mu: [0.1, 0.3, 0.5]}\n"
-                     "pulse: {shape: sine, w_over_p: 3, A_ratio: [0.5, 1.0, 2.0, 3.0]}\n")
     out = tmp_path / "regime.h5"
-    sf = SweepFile.create(out, sc)
-    n = sf.grid.size
-    arrays = {k: np.full(n, 0, dt) for k, (dt, _, _) in sc.variables().items()}
-    sf.write(ChunkResult(0, n, arrays, 0.0))
-    sf.close()
-    ds = rocksweep.open(out)
+    ds = zero_sweep("name: shenton\nbody: {kind: block, alpha: 0.2, mu: [0.1, 0.3, 0.5]}\n"
+                    "pulse: {shape: sine, w_over_p: 3, A_ratio: [0.5, 1.0, 2.0, 3.0]}\n", out)
     grid = xr.DataArray(REGIME, dims=("A_ratio", "mu"), coords={"A_ratio": AS, "mu": MUS})
     ds["regime"] = grid.transpose(*ds["outcome"].dims)
     ds["outcome"] = xr.DataArray(OUT, dims=("A_ratio", "mu")).transpose(*ds["outcome"].dims)
