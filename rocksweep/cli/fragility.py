@@ -89,9 +89,9 @@ def _g(v) -> str:
 @ci_option
 @json_option('the curves ({"curves": [...]}) instead of a table')
 @width_option("single")
-@rtol_option(None, "Also refine each record's first level reaching the (first) --state, "
-                   "e.g. overturning, by bisection to this relative tolerance (an IDA per "
-                   "record, kernel runs at the sweep's accuracy): variables ida_im, ida_lo, "
+@rtol_option(None, "Also refine each record's first level reaching a --state (overturning "
+                   "when it is one of them, else the first), by bisection to this "
+                   "relative tolerance (an IDA per record, kernel runs at the sweep's accuracy): variables ida_im, ida_lo, "
                    "ida_hi along record in -o (.h5/.nc) and the spread in the table "
                    "[default: stripes only]")
 @dpi_option
@@ -123,7 +123,9 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
 
     ds = rocksweep.open(result_path)
     # --rtol's IDA first: refused, it says so in one line before any word about the fit
-    refined = rocksweep.ida(ds, rtol, state=states[0]) if rtol is not None else None
+    # overturning where asked (as before sliding's states), else the first state
+    bisected = OVERTURN if OVERTURN in states else states[0]
+    refined = rocksweep.ida(ds, rtol, state=bisected) if rtol is not None else None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", FragilityWarning)
         frag = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states,
