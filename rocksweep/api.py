@@ -150,7 +150,8 @@ def _check_dataset(name: str, ds: Any) -> None:
 @analysis
 def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any = None,
          curves: bool = False, show_computed: bool = False, mu: bool = False,
-         width: str | None = None, compare: str | None = None) -> Figure:
+         width: str | None = None, compare: str | None = None,
+         regime: bool = False) -> Figure:
     """The figure of any rocksweep Dataset, pyplot-free: a sweep's stability diagram
     (Figures 3 and 4; the options below), or the figure of a fragility (curves, stripe
     fractions sized by record count, bands, beta in the legend, IM on a log axis), IDA,
@@ -169,12 +170,17 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     matplotlib's defaults. compare: a swept key (e.g. "impact.law" or "lam") whose values
     are compared on one diagram, coloured by which of them overturn each cell. A result
     with per-point error estimates rings the points whose outcome changes at half the step.
+    regime: the contact regimes of a sweep with a sliding base (``body.mu``: its
+    ``regime`` variable) instead of the classes, e.g. x = "body.mu", y = "A_ratio"
+    (Shenton's diagram): each cell coloured by the phases its run visited (rest only,
+    slide, rock, slide-rock and their mixtures), overturned cells marked by mode
+    (``rocksweep.figures.regimes``).
     """
     from rocksweep.figures.by_kind import plot_any
 
     _check_dataset("ds", ds)
     return plot_any(ds, x, y, ax=ax, curves=curves, show_computed=show_computed, mu=mu,
-                    width=width, compare=compare)
+                    width=width, compare=compare, regime=regime)
 
 
 @analysis
@@ -241,22 +247,26 @@ def floor_spectrum(ds: xr.Dataset, rtol: float = DEFAULT_RTOL_MANY, search: bool
 
 
 @analysis
-def ida(ds: xr.Dataset, rtol: float = DEFAULT_RTOL_MANY) -> xr.Dataset:
+def ida(ds: xr.Dataset, rtol: float = DEFAULT_RTOL_MANY, *, state: str = "overturn"
+        ) -> xr.Dataset:
     """Incremental dynamic analysis per record of a scaled record-suite sweep: the
     smallest IM (the stripe IM: PGA [g], PGV [m/s], Sa [g], ...) that overturns each
     record, bisected to ``rtol`` between the last stripe below the first overturning one
     and that stripe (kernel runs at the sweep's accuracy), and whether a higher stripe is
-    safe again (``resurrection``). ds: what ``run`` or ``open`` returns. Returns a Dataset
+    safe again (``resurrection``). state: another damage state in overturning's place, as
+    ``fragility``'s (e.g. "slide:0.5": the smallest IM that slides the base 0.5 b, or
+    overturns it; "theta:0.5"). ds: what ``run`` or ``open`` returns. Returns a Dataset
     over the other swept keys and ``record`` (``rocksweep.analysis.ida.ida``), with the
-    stripes' ``theta_max_over_alpha`` of the points that did not overturn (the IDA
-    curves ``rocksweep.plot`` draws). A sweep over ``angle``: every (record, angle) is a
-    sample (``ida_im`` over angle), and ``ida_im_worst`` / ``worst_angle`` give each
-    record's worst orientation (the least IM that overturns it at any angle)."""
+    stripes' ``theta_max_over_alpha`` (``slide_max`` for "slide:D") of the points that
+    did not overturn (the IDA curves ``rocksweep.plot`` draws). A sweep over ``angle``:
+    every (record, angle) is a sample (``ida_im`` over angle), and ``ida_im_worst`` /
+    ``worst_angle`` give each record's worst orientation (the least IM that overturns it
+    at any angle)."""
     from rocksweep.analysis.floors import worst_ida
     from rocksweep.analysis.ida import ida_dataset
 
     _check_dataset("ds", ds)
-    return worst_ida(ida_dataset(ds, rtol))
+    return worst_ida(ida_dataset(ds, rtol, state))
 
 
 @analysis
@@ -273,7 +283,9 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
 
     ds: what ``run`` or ``open`` returns (or a result file's path). state: "overturn"
     (either mode), "mode1", "mode2", "uplift", "theta:X" (max|theta|/alpha_cg >= X, or
-    overturned, 0 < X <= 1), or a list of them (a ``state`` dimension; each state fitted
+    overturned, 0 < X <= 1), "slide:D" (the base's sliding displacement slide_max >= D, or
+    overturned, D > 0 in slide_max's units: b, metres for a physical body; a scene with
+    body.mu), or a list of them (a ``state`` dimension; each state fitted
     alone, its numbers the same whatever else is asked for; nested curves that cross in
     the data say "crossing"). joint: damage states share one beta (an ordinal fit, its
     likelihood-ratio test stored: ``parallel_rejected``), mode1 with mode2 a

@@ -20,7 +20,7 @@ from pathlib import Path
 import pytest
 from helpers import docstring_ids
 
-from rocksweep.vocab import axes, ground, kinds, laws, outcomes, settings
+from rocksweep.vocab import axes, ground, kinds, laws, outcomes, phases, settings
 
 PKG = Path(__file__).resolve().parents[1] / "rocksweep"
 
@@ -41,6 +41,7 @@ FAMILIES: dict[str, tuple[str, ...]] = {
     "IM components": ground.COMPONENTS,
     "missing components": ground.MISSING,
     "orientation answers": ground.ORIENTATIONS,
+    "contact phases": phases.PHASES,
 }
 # Single words with one home: typed as a string anywhere else (not in a docstring) they fail.
 WORDS: dict[str, str] = {

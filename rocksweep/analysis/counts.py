@@ -12,7 +12,14 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from rocksweep.analysis.states import counted_points, parse_state, required, state_reached
+from rocksweep.analysis.states import (
+    SLIDE,
+    THETA,
+    counted_points,
+    parse_state,
+    required,
+    state_reached,
+)
 from rocksweep.compute.adaptive import FILLED
 from rocksweep.errors import Arg, FragilityError
 from rocksweep.vocab.ground import CLOUD_IMS as CLOUD_IM_VARIABLES
@@ -66,16 +73,16 @@ def cloud_im(ds: xr.Dataset, im: str | None, period: float | None
 
 def refuse_filled(ds: xr.Dataset, states: Sequence[str], counted: xr.DataArray) -> None:
     """An adaptive sweep's filled points carry only the class: refuse states that need
-    more (uplift, theta:X)."""
+    more (uplift, theta:X, slide:D)."""
     if "computed" not in ds.variables:
         return
     filled = (ds["computed"] == FILLED) & counted
     n = int(filled.sum())
-    need = [s for s in states if parse_state(s)[0] in (UPLIFT, "theta")]
+    need = [s for s in states if parse_state(s)[0] in (UPLIFT, THETA, SLIDE)]
     if n and need:
         raise FragilityError(
             f"state {need[0]!r}: {n} points of this adaptive sweep were filled from the class "
-            "around them, not computed, so their uplift and theta are unknown; only "
+            "around them, not computed, so their uplift, theta and sliding are unknown; only "
             f"{OVERTURN}, {MODE1} and {MODE2} can be fitted (a sweep that computes every "
             "point can give it)")
 

@@ -164,7 +164,7 @@ def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
 
     ds: what ``rocksweep.run`` / ``rocksweep.open`` returns for a scene with
     ``ground.records`` (IMs read from its ``record_*`` variables). state: as
-    ``fragility``'s ("overturn", "mode1", "mode2", "uplift", "theta:X").
+    ``fragility``'s ("overturn", "mode1", "mode2", "uplift", "theta:X", "slide:D").
 
     Returns a Dataset over (im, other dims): ``beta`` [-] (in ln of that IM),
     ``beta_scale`` (beta / n: in ln of the scale factor, comparable across IMs),

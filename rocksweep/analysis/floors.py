@@ -148,8 +148,11 @@ def worst_ida(ida):
     found = im.notnull().any("angle")
     idx = im.fillna(np.inf).argmin("angle")
     ida["ida_im_worst"] = im.min("angle", skipna=True)
-    ida["ida_im_worst"].attrs = {**im.attrs, "long_name": "least IM that overturns the "
-                                 "record at any angle (its worst orientation)"}
+    from rocksweep.vocab.outcomes import OVERTURN
+
+    state = ida.attrs.get("state", OVERTURN)
+    ida["ida_im_worst"].attrs = {**im.attrs, "long_name": f"least IM at which the record "
+                                 f"reaches {state} at any angle (its worst orientation)"}
     ida["worst_angle"] = xr.where(found, ida["angle"].isel(angle=idx).drop_vars("angle"),
                                   np.nan)
     ida["worst_angle"].attrs = {"long_name": "worst orientation", "units": "degree"}

@@ -12,11 +12,12 @@ Fits (the likelihoods and their maximisers: ``rocksweep.analysis.likelihood``):
   one, (x_i, 0/1): probit regression on ln IM, the same likelihood with n_i = 1.
 
 Several states at once (docs/fragility.md, "Several states: one fit for all"): two or more
-nested damage states (uplift < theta:X < overturn) as one ordinal probit with a common beta,
-so the curves never cross; mode1 with mode2 as competing risks with independent lognormal
-capacities, so P(safe) + P(mode 1) + P(mode 2) = 1 at every x (im_median_k and beta_k
-describe mode k's capacity with the other mode censoring it; ``curve`` holds the fitted
-P(mode k | x) themselves). A single mode fitted alone treats the other's points as safe.
+nested damage states of one chain (uplift < theta:X < overturn, or slide:D < overturn:
+``analysis.states``) as one ordinal probit with a common beta, so the curves never cross;
+mode1 with mode2 as competing risks with independent lognormal capacities, so P(safe) +
+P(mode 1) + P(mode 2) = 1 at every x (im_median_k and beta_k describe mode k's capacity
+with the other mode censoring it; ``curve`` holds the fitted P(mode k | x) themselves).
+A single mode fitted alone treats the other's points as safe.
 
 Verdicts (``reason``: "ok", or the words below joined by ","; never "ok" for these):
 
@@ -43,7 +44,8 @@ Verdicts (``reason``: "ok", or the words below joined by ","; never "ok" for the
   fit);
 - "crossing" (separate fits, the default): a more severe nested state's curve lies above a
   milder one's by more than ``CROSSING_TOL`` inside the IM range of the data (a point
-  cannot reach overturning without reaching theta:X): the curves are not both right there;
+  cannot reach overturning without reaching theta:X or slide:D): the curves are not both
+  right there;
   said on both states;
 - "parallel_rejected" (``joint=True``): the likelihood-ratio test of the ordinal fit's
   common beta against a beta per state (``likelihood.parallel_lr``) rejects it at
@@ -94,6 +96,9 @@ from rocksweep.analysis.resampling import (
     check_ci,
 )
 from rocksweep.analysis.states import (
+    SLIDE,
+    nested,
+    parse_state,
     parse_states,
     required,
     severity,
@@ -327,7 +332,9 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     ds (the sweep's contract): variables ``outcome`` (int8: -1 not computed, 0 safe, 1
     mode 1, 2 mode 2), ``status`` (int32 bit flags; points with status &
     STATUS_FLAGGED are excluded and counted), ``uplifts`` (int32; state "uplift"),
-    ``theta_max_over_alpha`` (float64; states "theta:X"); dimension ``record`` (coordinate:
+    ``theta_max_over_alpha`` (float64; states "theta:X"), ``slide_max`` (float64, the
+    base's largest sliding displacement in its ``units``; states "slide:D": a sweep of a
+    scene with ``body.mu``); dimension ``record`` (coordinate:
     unique file names); for stripes one dimension named by ``ds.attrs["scale_im"]`` (PGA
     [g], PGV [m/s], Sa [g], PGA_ratio, PGV_ratio [-]) whose coordinate holds the levels;
     any other dims (lam, p, body keys): one curve per combination. Without a stripe
@@ -337,10 +344,12 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
 
     state: one state word or a list (then a ``state`` dimension): "overturn" (outcome 1 or
     2), "mode1", "mode2", "uplift" (uplifts > 0 or overturned), "theta:X"
-    (theta_max_over_alpha >= X or overturned, 0 < X <= 1). Every state is fitted alone
+    (theta_max_over_alpha >= X or overturned, 0 < X <= 1), "slide:D" (slide_max >= D or
+    overturned, D > 0 in slide_max's units). Every state is fitted alone
     (its numbers do not depend on the other states asked for; nested curves that cross
     inside the data say "crossing"); ``joint=True`` fits two or more of uplift, theta:X,
-    overturn as ordered damage states (one beta: the curves never cross; the likelihood-
+    overturn (or of slide:D, overturn: one chain, ``analysis.states``) as ordered damage
+    states (one beta: the curves never cross; the likelihood-
     ratio test of that beta is stored, "parallel_rejected" where the data reject it) and
     mode1 with mode2 as competing risks (module docstring). bootstrap: resamples over
     records (0: no intervals, NaN; None: ``DEFAULT_BOOTSTRAP``; at most
@@ -364,7 +373,8 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     ``parallel_dof``, ``parallel_p`` (chi-square p-value) and ``parallel_rejected``
     (parallel_p < ``PARALLEL_P``). attrs: rocksweep_kind "fragility" (``analysis.kinds``),
     title (the sweep's), method ("stripes-mle" | "cloud-mle"), im, im_units, period (Sa),
-    avgsa_periods (AvgSa stripes), states, joint, bootstrap, seed, ci, reference.
+    avgsa_periods (AvgSa stripes), states, joint, bootstrap, seed, ci, reference;
+    slide_max_units (slide:D states: D's units, those of the sweep's slide_max).
     """
     states, N, ci = _request(ds, state, im, period, bootstrap, seed, ci)
     if not isinstance(joint, bool | np.bool_):
@@ -512,9 +522,11 @@ def _crossing(f: _Fits, c: Counts, states: list[str], axis: IMAxis) -> None:
     """The "crossing" verdict of separate fits: a more severe nested state's curve above
     a milder one's by more than ``CROSSING_TOL`` inside the IM range of the counted
     data (stripes with a counted point; a cloud's counted records)."""
-    nested = sorted((i for i, s in enumerate(states) if not math.isnan(severity(s))),
-                    key=lambda i: severity(states[i]))
-    if len(nested) < 2:
+    order = sorted((i for i, s in enumerate(states) if not math.isnan(severity(s))),
+                   key=lambda i: severity(states[i]))
+    pairs = [(mild, severe) for a, mild in enumerate(order) for severe in order[a + 1:]
+             if nested(states[mild], states[severe])]
+    if not pairs:
         return
     for o in range(c.n_o):
         if axis.stripes:
@@ -525,19 +537,17 @@ def _crossing(f: _Fits, c: Counts, states: list[str], axis: IMAxis) -> None:
         if x.size < 2:
             continue
         xs = np.geomspace(x.min(), x.max(), BAND_POINTS)
-        for a, mild in enumerate(nested):
-            for severe in nested[a + 1:]:
-                pm = lognormal_cdf(xs, f.res["im_median"][mild, o], f.res["beta"][mild, o])
-                ps = lognormal_cdf(xs, f.res["im_median"][severe, o],
-                                   f.res["beta"][severe, o])
-                gap = ps - pm
-                if not np.any(np.isfinite(gap)) or np.nanmax(gap) <= CROSSING_TOL:
-                    continue
-                at = xs[int(np.nanargmax(gap))]
-                text = (f"{states[severe]} above {states[mild]} by up to "
-                        f"{np.nanmax(gap):.3g} (at {at:.3g} {axis.unit}) inside the data")
-                f.why[mild][o]["crossing"] = text
-                f.why[severe][o]["crossing"] = text
+        for mild, severe in pairs:
+            pm = lognormal_cdf(xs, f.res["im_median"][mild, o], f.res["beta"][mild, o])
+            ps = lognormal_cdf(xs, f.res["im_median"][severe, o], f.res["beta"][severe, o])
+            gap = ps - pm
+            if not np.any(np.isfinite(gap)) or np.nanmax(gap) <= CROSSING_TOL:
+                continue
+            at = xs[int(np.nanargmax(gap))]
+            text = (f"{states[severe]} above {states[mild]} by up to "
+                    f"{np.nanmax(gap):.3g} (at {at:.3g} {axis.unit}) inside the data")
+            f.why[mild][o]["crossing"] = text
+            f.why[severe][o]["crossing"] = text
 
 
 def _bootstrap_fits(f: _Fits, c: Counts, groups: list[tuple[str, list[int]]],
@@ -666,6 +676,8 @@ def _dataset(ds: xr.Dataset, state: Any, states: list[str], axis: IMAxis, c: Cou
              "ci": float(ci),
              "reference": "Baker (2015), Efficient analytical fragility function fitting "
                           "using dynamic structural analysis, Earthquake Spectra 31(1)"}
+    if any(parse_state(s)[0] == SLIDE for s in states):  # D's units: slide_max's
+        attrs["slide_max_units"] = str(ds["slide_max"].attrs.get("units", ""))
     if axis.im_name == "Sa":
         attrs["period"] = axis.period
     if axis.im_name == AVGSA and "record_avgsa" in ds.variables:

@@ -9,6 +9,12 @@ certified as a single run is). The scaled record's peak, and so the kernel's amp
 is linear in the IM, so a level x between stripes is the stripe's point with its amplitude times
 x / stripe. Overturning means outcome 1 or 2 (mode 1, mode 2).
 
+Any damage state (``state=``, as the fragility's: ``analysis.states``) may take
+overturning's place: "slide:0.5" gives, per record, the smallest IM whose run slides the
+base 0.5 b (or overturns), "theta:0.5" the smallest that rocks it to half its slenderness.
+The stripes say which points reach the state (``state_reached`` of the sweep's variables),
+a bisection run the same of its own result (``Run.get`` of those variables by name).
+
 "Resurrection" (Vamvatsikos & Cornell 2002): a stripe above the first overturning level
 where the record does not overturn.
 
@@ -29,39 +35,56 @@ import xarray as xr
 
 from rocksweep import fields
 from rocksweep.analysis.bisection import UNDECIDED, bisect_thresholds
+from rocksweep.analysis.states import (
+    SLIDE,
+    THETA,
+    THRESHOLD_VARIABLE,
+    needed_variables,
+    parse_state,
+    parse_states,
+    state_reached,
+)
 from rocksweep.analysis.tolerance import DEFAULT_RTOL_MANY
-from rocksweep.compute.single import run_point
-from rocksweep.errors import IdaError, check_rtol
+from rocksweep.compute.single import Run, run_point
+from rocksweep.errors import FragilityError, IdaError, check_rtol
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.store.reader import as_result, result_scene
 from rocksweep.vocab.kinds import IDA, KIND_ATTR
-from rocksweep.vocab.outcomes import FLAGGED, OUTCOME_MODE1, OUTCOME_MODE2
+from rocksweep.vocab.outcomes import CLASSES, FLAGGED, OUTCOME_CODE, OVERTURN, UPLIFT
 
 # Bisection steps at most (a relative tolerance of 1e-12 takes ~40 from a stripe gap).
 MAX_ITER = 60
-OVERTURNED = (OUTCOME_MODE1, OUTCOME_MODE2)
+#: the class of a bisection run that reaches the state: its outcome code (safe, mode 1,
+#: mode 2; overturning reaches every state); one that does not: ``_BELOW``
+REACHED = tuple(OUTCOME_CODE[w] for w in CLASSES)
+_BELOW = -2
 
 
-def ida(ds: Any, rtol: float = DEFAULT_RTOL_MANY) -> Any:
-    """The smallest IM that overturns each record, bisected to ``rtol`` between stripes.
+def ida(ds: Any, rtol: float = DEFAULT_RTOL_MANY, state: str = OVERTURN) -> Any:
+    """The smallest IM that brings each record to ``state`` (default: overturns it),
+    bisected to ``rtol`` between stripes.
 
     ds: a complete sweep of a scaled record suite (what ``rocksweep.run`` or
     ``rocksweep.open`` returns; the stripe dimension is named by ``ds.attrs["scale_im"]``).
+    state: one damage state word as the fragility's (``analysis.states``: "overturn",
+    "mode1", "mode2", "uplift", "theta:X", "slide:D"; its variable in ds).
     Returns an ``xarray.Dataset`` over the other swept keys (lam, p, ...) and ``record``:
-    ``ida_lo``/``ida_hi`` [IM units] (the final bracket: lo is decided safe, hi
-    overturns; NaN hi: no stripe overturns the record; NaN lo: no stripe below hi is
-    decided safe, ``upper_bound`` = 1), ``ida_im`` (the estimate of the smallest
-    overturning level: the bracket's geometric middle, within rtol / 2 of both ends;
-    ida_hi where lo is NaN), ``mode`` (1 or 2 at ida_hi; 0 where NaN), ``runs`` (kernel
-    runs of the bisection), ``resurrection`` (1: a higher decided stripe is safe again),
-    ``n_flagged`` (flagged stripe points of the record: neither safe nor overturning),
-    ``unresolved`` (1: a bisection run came back flagged; the bracket is wider than
-    rtol).
+    ``ida_lo``/``ida_hi`` [IM units] (the final bracket: lo is decided not to reach the
+    state, hi reaches it; NaN hi: no stripe reaches it; NaN lo: no stripe below hi is
+    decided, ``upper_bound`` = 1), ``ida_im`` (the estimate of the smallest level that
+    reaches the state: the bracket's geometric middle, within rtol / 2 of both ends;
+    ida_hi where lo is NaN), ``mode`` (the outcome at ida_hi: 1 or 2 overturned, 0 the
+    state reached without overturning or no ida_hi), ``runs`` (kernel runs of the
+    bisection), ``resurrection`` (1: a higher decided stripe does not reach it again),
+    ``n_flagged`` (flagged stripe points of the record: undecided), ``unresolved`` (1: a
+    bisection run came back flagged; the bracket is wider than rtol). attrs: im,
+    im_units, rtol, state, title.
     """
     check_rtol(rtol, IdaError)
-    result = as_result(ds, ["outcome", "status"])
-    s = _stripes(result)
+    state = _one_state(state)
+    result = as_result(ds, ["outcome", "status"], optional=needed_variables(state))
+    s = _stripes(result, state)
     b = _brackets(s)
     scene = result_scene(result)
     # the point at each bracket's top stripe: its amplitude scales with the level
@@ -79,14 +102,39 @@ def ida(ds: Any, rtol: float = DEFAULT_RTOL_MANY) -> Any:
         for i, mid in zip(idx, mids, strict=True):
             pt = dataclasses.replace(points[i],
                                      A_ratio=points[i].A_ratio * mid / s.levels[b.first[i]])
-            out = run_point(pt, scene.numerics, history=False).out
-            flagged = int(out[L.OUT_STATUS]) & FLAGGED
-            classes.append(UNDECIDED if flagged else int(out[L.OUT_OUTCOME]))
+            classes.append(run_class(run_point(pt, scene.numerics, history=False), state))
         return classes
 
-    runs, unresolved = bisect_thresholds(b.lo, b.hi, b.mode, rtol, classify, OVERTURNED,
+    runs, unresolved = bisect_thresholds(b.lo, b.hi, b.mode, rtol, classify, REACHED,
                                          max_iter=MAX_ITER)
-    return _dataset(result, s, b, runs, unresolved.astype(np.int8), rtol)
+    return _dataset(result, s, b, runs, unresolved.astype(np.int8), rtol, state)
+
+
+def _one_state(state: Any) -> str:
+    """``state`` as one checked state word (an IdaError in one line otherwise)."""
+    try:
+        states = parse_states(state)
+    except FragilityError as err:
+        raise IdaError(str(err)) from None
+    if len(states) != 1:
+        raise IdaError(f"state = {state!r}: an IDA bisects one state's level; give one")
+    return states[0]
+
+
+def run_class(run: Run, state: str) -> int:
+    """A bisection run's class: ``UNDECIDED`` (flagged), its outcome code when it reaches
+    ``state`` (``state_reached`` of its result fields by name), else ``_BELOW``."""
+    if int(run.out[L.OUT_STATUS]) & FLAGGED:
+        return UNDECIDED
+    code = int(run.out[L.OUT_OUTCOME])
+    values = {"outcome": code, **{n: _number(run.get(n)) for n in needed_variables(state)}}
+    one = xr.Dataset({n: ((), v) for n, v in values.items()})
+    return code if bool(state_reached(one, state)) else _BELOW
+
+
+def _number(v: Any) -> float:
+    """A result field as a number (None, a time or value that does not exist: NaN)."""
+    return float("nan") if v is None else v
 
 
 @dataclasses.dataclass(frozen=True)
@@ -105,8 +153,9 @@ class _Stripes:
     modes: np.ndarray
 
 
-def _stripes(result: Any) -> _Stripes:
-    """The stripes of a complete scaled record suite (one-line IdaErrors otherwise)."""
+def _stripes(result: Any, state: str = OVERTURN) -> _Stripes:
+    """The stripes of a complete scaled record suite (one-line IdaErrors otherwise);
+    ``over``: the points that reach ``state``."""
     im = result.attrs.get("scale_im")
     if not im or im not in result.dims or "record" not in result.dims:
         raise IdaError(f"{result.path}: IDA needs a scaled record suite (ground.records with "
@@ -119,7 +168,13 @@ def _stripes(result: Any) -> _Stripes:
     flagged = np.transpose((np.asarray(result.arrays["status"]) & FLAGGED) != 0,
                            perm)
     modes = np.transpose(outcome, perm)
-    over = np.isin(modes, OVERTURNED) & ~flagged
+    arrays = xr.Dataset({n: (dims, result.arrays[n]) for n in ["outcome", *(
+        v for v in needed_variables(state) if v in result.arrays)]})
+    try:
+        reached = state_reached(arrays, state).values
+    except FragilityError as err:
+        raise IdaError(f"{result.path}: {err}") from None
+    over = np.transpose(reached, perm) & ~flagged
     levels = np.asarray(result.coords[im], float)
     if not np.all(np.diff(levels) > 0):
         raise IdaError(f"{result.path}: the {im} stripes must increase")
@@ -162,8 +217,9 @@ def _brackets(s: _Stripes) -> _Brackets:
 
 
 def _dataset(result: Any, s: _Stripes, b: _Brackets, runs: np.ndarray,
-             unresolved: np.ndarray, rtol: float) -> Any:
+             unresolved: np.ndarray, rtol: float, state: str = OVERTURN) -> Any:
     im, shape = s.im, s.lead
+    reaches = "overturns" if state == OVERTURN else f"reaches {state}"
     lo, hi = b.lo, b.hi
     est = np.where(np.isfinite(lo), np.sqrt(lo * hi), hi)
     n_flag = s.flagged.sum(-1)
@@ -174,43 +230,63 @@ def _dataset(result: Any, s: _Stripes, b: _Brackets, runs: np.ndarray,
     dims_out = [*s.others, "record"]
     data = {
         "ida_im": (dims_out, est.reshape(shape),
-                   {"long_name": f"smallest {im} that overturns the record (the bracket's "
-                                 "geometric middle; ida_hi where ida_lo is NaN)",
+                   {"long_name": f"smallest {im} at which the record {reaches} (the "
+                                 "bracket's geometric middle; ida_hi where ida_lo is NaN)",
                     "units": unit}),
         "ida_lo": (dims_out, lo.reshape(shape),
-                   {"long_name": "bracket: largest level decided safe", "units": unit}),
+                   {"long_name": f"bracket: largest level decided not to reach {state}",
+                    "units": unit}),
         "ida_hi": (dims_out, hi.reshape(shape),
-                   {"long_name": "bracket: smallest level that overturns", "units": unit}),
+                   {"long_name": f"bracket: smallest level that {reaches}", "units": unit}),
         "upper_bound": (dims_out, (has & (b.bottom < 0)).astype(np.int8).reshape(shape),
-                        {"long_name": "1: no stripe below ida_hi is decided safe (ida_im is "
-                                      "an upper bound)"}),
+                        {"long_name": f"1: no stripe below ida_hi is decided not to reach "
+                                      f"{state} (ida_im is an upper bound)"}),
         "mode": (dims_out, b.mode.reshape(shape),
-                 {"long_name": "overturning mode at ida_hi", "flag_values": [0, 1, 2],
+                 {"long_name": "outcome at ida_hi (0: no ida_hi, or the state reached "
+                               "without overturning)", "flag_values": [0, 1, 2],
                   "flag_meanings": "none mode1 mode2"}),
         "runs": (dims_out, runs.reshape(shape), {"long_name": "kernel runs of the bisection"}),
         "resurrection": (dims_out, b.safe_above.astype(np.int8).reshape(shape),
-                         {"long_name": "1: a stripe above ida_hi is decided safe"}),
+                         {"long_name": f"1: a stripe above ida_hi is decided not to reach "
+                                       f"{state}"}),
         "n_flagged": (dims_out, n_flag.reshape(shape),
                       {"long_name": "flagged stripe points (status & STATUS_FLAGGED): "
-                                    "neither safe nor overturning"}),
+                                    f"undecided whether they reach {state}"}),
         "unresolved": (dims_out, unresolved.reshape(shape),
                        {"long_name": "1: a bisection run came back flagged; the bracket "
                                      "is wider than rtol"}),
     }
     return xr.Dataset(data, coords=coords,
                       attrs={"im": im, "im_units": unit, "rtol": float(rtol),
-                             "title": result.name})
+                             "state": state, "title": result.name})
 
 
-def ida_dataset(ds: Any, rtol: float = DEFAULT_RTOL_MANY) -> Any:
-    """``rocksweep.ida``: ``ida`` with the IDA curves on the stripes
-    (``theta_max_over_alpha`` against the IM, per record, NaN where a point overturned:
-    what the figure draws) and its kind for ``rocksweep.plot`` (``analysis.kinds``)."""
-    out = ida(ds, rtol)
+def ida_dataset(ds: Any, rtol: float = DEFAULT_RTOL_MANY, state: str = OVERTURN) -> Any:
+    """``rocksweep.ida``: ``ida`` with the IDA curves on the stripes (the state's demand
+    against the IM, per record, NaN where a point overturned: ``theta_max_over_alpha``,
+    or ``slide_max`` for "slide:D"; what the figure draws) and its kind for
+    ``rocksweep.plot`` (``analysis.kinds``)."""
+    out = ida(ds, rtol, state)
     out.attrs[KIND_ATTR] = IDA
     im = out.attrs.get("im")
-    if hasattr(ds, "data_vars") and "theta_max_over_alpha" in ds.data_vars and im in ds.dims:
-        theta = ds["theta_max_over_alpha"].where(ds["outcome"] == 0)
-        out["theta_max_over_alpha"] = theta.drop_vars(
-            [c for c in theta.coords if c not in theta.dims])
+    demand = curve_variable(out.attrs["state"])
+    if hasattr(ds, "data_vars") and demand in ds.data_vars and im in ds.dims:
+        curve = ds[demand].where(ds["outcome"] == 0)
+        out[demand] = curve.drop_vars([c for c in curve.coords if c not in curve.dims])
     return out
+
+
+def curve_end(state: str) -> float:
+    """Where an IDA curve of ``state`` ends, at ida_im, in its demand's units
+    (``curve_variable``): the threshold X of "theta:X" and D of "slide:D", 0 for uplift
+    (the rocking starts), 1 (max|theta| = alpha_ref, the overturning limit) for the
+    overturning states."""
+    kind, x = parse_state(state)
+    return x if kind in THRESHOLD_VARIABLE else 0.0 if kind == UPLIFT else 1.0
+
+
+def curve_variable(state: str) -> str:
+    """The demand an IDA curve of ``state`` draws against the IM: the sliding displacement
+    for "slide:D", else max|theta|/alpha_ref."""
+    kind, _ = parse_state(state)
+    return THRESHOLD_VARIABLE[SLIDE if kind == SLIDE else THETA]

@@ -3,8 +3,14 @@ fitted together, and which points of a result Dataset reach each one and are cou
 
 States (``rocksweep.vocab.outcomes``): "overturn" (outcome 1 or 2), "mode1", "mode2",
 "uplift" (uplifts > 0 or overturned), "theta:X" (max|theta|/alpha_cg >= X or overturned,
-0 < X <= 1). uplift < theta:X < overturn are nested (a point that reaches one reaches the
-milder ones); the two modes are not.
+0 < X <= 1), "slide:D" (slide_max >= D or overturned, D > 0 in the units of the
+Dataset's ``slide_max``: the base half-width b, metres for a physical body; a sweep of a
+scene with ``body.mu``).
+
+Two chains of nested states (a point that reaches one reaches the milder ones of its
+chain): rocking, uplift < theta:X < overturn, and sliding, slide:D < overturn (slide:D1 <
+slide:D2 for D1 < D2). The chains share overturning only: a body may slide without
+rocking and rock without sliding. The two modes are nested with nothing.
 """
 
 from __future__ import annotations
@@ -27,33 +33,51 @@ from rocksweep.vocab.outcomes import (
     OUTCOME_MODE2,
     OUTCOME_NOT_RUN,
     OVERTURN,
+    SLIDE_STATE,
     STATES,
     STATUS_BIT,
     THETA_STATE,
     UPLIFT,
 )
 
-STATE_WORDS = (*STATES, THETA_STATE)
+STATE_WORDS = (*STATES, THETA_STATE, SLIDE_STATE)
+#: the kinds of the threshold states (``parse_state``'s first answer): "theta", "slide"
+THETA, SLIDE = (w.split(":", 1)[0] for w in (THETA_STATE, SLIDE_STATE))
+#: the variable a threshold state compares with its number (``state_reached``)
+THRESHOLD_VARIABLE = {THETA: "theta_max_over_alpha", SLIDE: "slide_max"}
+#: the chains of nested damage states (the module docstring)
+ROCKING, SLIDING = "rocking", "sliding"
+_CHAINS: dict[str, frozenset[str]] = {
+    UPLIFT: frozenset({ROCKING}), THETA: frozenset({ROCKING}),
+    SLIDE: frozenset({SLIDING}), OVERTURN: frozenset({ROCKING, SLIDING})}
 
 
 def parse_state(state: str) -> tuple[str, float]:
-    """("overturn" | "mode1" | "mode2" | "uplift" | "theta", threshold) of a state word;
-    "theta:X" is max|theta|/alpha_cg >= X (0 < X <= 1) or overturned."""
+    """("overturn" | "mode1" | "mode2" | "uplift" | "theta" | "slide", threshold) of a state
+    word; "theta:X" is max|theta|/alpha_cg >= X (0 < X <= 1) or overturned, "slide:D"
+    slide_max >= D (D > 0, finite) or overturned."""
     if not isinstance(state, str):
         raise FragilityError(f"state = {state!r}: a state is a string, one of "
                              f"{', '.join(STATE_WORDS)} (or a list of them)")
     s = state.strip()
     if s in STATES:
         return s, math.nan
-    if s.startswith("theta:"):
+    kind, sep, number = s.partition(":")
+    if sep and kind in (THETA, SLIDE):
         try:
-            x = float(s[6:])
+            x = float(number)
         except ValueError:
             x = math.nan
-        if math.isfinite(x) and 0.0 < x <= 1.0:
-            return "theta", x
-        raise FragilityError(f"state {state!r}: theta:X needs a number 0 < X <= 1 "
-                             "(max|theta|/alpha_cg)")
+        if kind == THETA and math.isfinite(x) and 0.0 < x <= 1.0:
+            return THETA, x
+        if kind == SLIDE and math.isfinite(x) and x > 0.0:
+            return SLIDE, x
+        if kind == THETA:
+            raise FragilityError(f"state {state!r}: theta:X needs a number 0 < X <= 1 "
+                                 "(max|theta|/alpha_cg)")
+        raise FragilityError(f"state {state!r}: slide:D needs a number D > 0 (slide_max >= D: "
+                             "the base's largest sliding displacement, in units of its "
+                             "half-width b, metres for a physical body)")
     raise FragilityError(f"state {state!r}: expected one of {', '.join(STATE_WORDS)}")
 
 
@@ -77,33 +101,62 @@ def parse_states(state: Any) -> list[str]:
 
 
 def severity(state: str) -> float:
-    """Order of the nested damage states: uplift (0) < theta:X (X) < overturn (inf); NaN
-    for the modes (not nested)."""
+    """A damage state's place in its chain (``chains``): uplift (0) < theta:X (X) <
+    overturn (inf), slide:D (D) < overturn; NaN for the modes (not nested). Compare two
+    states' severities only where they share a chain (``nested``)."""
     kind, x = parse_state(state)
-    return {UPLIFT: 0.0, "theta": x, OVERTURN: math.inf}.get(kind, math.nan)
+    return {UPLIFT: 0.0, THETA: x, SLIDE: x, OVERTURN: math.inf}.get(kind, math.nan)
+
+
+def chains(state: str) -> frozenset[str]:
+    """The chains of nested damage states ``state`` is on (``ROCKING``, ``SLIDING``; both
+    for overturn, none for the modes)."""
+    return _CHAINS.get(parse_state(state)[0], frozenset())
+
+
+def nested(a: str, b: str) -> bool:
+    """Whether one of two states implies the other (they share a chain): the more severe
+    one's curve cannot lie above the milder one's."""
+    return bool(chains(a) & chains(b))
 
 
 def state_groups(states: Sequence[str], joint: bool = False) -> list[tuple[str, list[int]]]:
     """How the states are fitted: [(kind, indices into states)]. By default every state
     alone ("single": a curve's numbers do not depend on the other states asked for); with
-    ``joint`` "ordinal" for two or more nested damage states (uplift, theta:X, overturn;
-    indices in severity order; one beta), "competing" for mode1 with mode2, "single" for
-    every other one."""
+    ``joint`` "ordinal" for two or more nested damage states of one chain (uplift,
+    theta:X, overturn; or slide:D, overturn; indices in severity order; one beta),
+    "competing" for mode1 with mode2, "single" for every other one. Two chains of two or
+    more states each is a FragilityError: one ordinal fit holds one chain."""
     if not joint:
         return [("single", [i]) for i in range(len(states))]
-    nested = sorted((i for i, s in enumerate(states) if not math.isnan(severity(s))),
-                    key=lambda i: severity(states[i]))
+    members = {c: sorted((i for i, s in enumerate(states) if c in chains(s)),
+                         key=lambda i: severity(states[i])) for c in (ROCKING, SLIDING)}
+    long = [c for c, m in members.items() if len(m) >= 2]
+    if len(long) == 2:
+        said = " and ".join(f"{', '.join(states[i] for i in members[c])} ({c})" for c in long)
+        raise FragilityError(
+            f"state = {list(states)!r}: a joint fit orders one chain of nested damage "
+            f"states, these form two, {said}: a body may slide without rocking and rock "
+            "without sliding; fit each chain in its own call, or every state alone "
+            "(joint=False)")
+    chain = members[long[0]] if long else []
     modes = [states.index(s) for s in (MODE1, MODE2) if s in states]
     groups: list[tuple[str, list[int]]] = []
-    if len(nested) >= 2:
-        groups.append(("ordinal", nested))
-    else:
-        groups += [("single", [i]) for i in nested]
+    if chain:
+        groups.append(("ordinal", chain))
     if len(modes) == 2:
         groups.append(("competing", modes))
-    else:
-        groups += [("single", [i]) for i in modes]
+    groups += [("single", [i]) for i in range(len(states))
+               if i not in chain and not (len(modes) == 2 and i in modes)]
     return groups
+
+
+def needed_variables(state: str) -> tuple[str, ...]:
+    """The result variables ``state_reached`` reads for ``state`` besides ``outcome``:
+    uplifts (uplift), theta_max_over_alpha (theta:X), slide_max (slide:D), none else."""
+    kind, _ = parse_state(state)
+    return ("uplifts",) if kind == UPLIFT else (
+        (THRESHOLD_VARIABLE[kind],) if kind in THRESHOLD_VARIABLE else ())
 
 
 def required(ds: xr.Dataset, name: str, why: str) -> xr.DataArray:
@@ -127,7 +180,13 @@ def state_reached(ds: xr.Dataset, state: str) -> xr.DataArray:
         return out == OUTCOME_MODE2
     if kind == "uplift":
         return (required(ds, "uplifts", f"state {state}") > 0) | over
-    return (required(ds, "theta_max_over_alpha", f"state {state}") >= x) | over
+    name = THRESHOLD_VARIABLE[kind]
+    if kind == SLIDE and name not in ds.variables:
+        raise FragilityError(
+            f"state {state!r}: the Dataset has no variable {name!r} (the base's sliding "
+            "displacement: a sweep of a scene with body.mu has it); without it the states "
+            f"are {', '.join((*STATES, THETA_STATE))}")
+    return (required(ds, name, f"state {state}") >= x) | over
 
 
 def counted_points(ds: xr.Dataset) -> tuple[xr.DataArray, xr.DataArray, xr.DataArray]:

@@ -19,7 +19,7 @@ from rocksweep.cli.options import (
     width_option,
 )
 from rocksweep.vocab.kinds import IM_EFFICIENCY
-from rocksweep.vocab.outcomes import STATES, THETA_STATE
+from rocksweep.vocab.outcomes import SLIDE_STATE, STATES, THETA_STATE
 
 SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
 
@@ -27,7 +27,7 @@ SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
 @main.command()
 @result_argument
 @click.option("--state", default="overturn", show_default=True,
-              help=", ".join(STATES) + " or " + THETA_STATE + ".")
+              help=", ".join((*STATES, THETA_STATE)) + " or " + SLIDE_STATE + ".")
 @click.option("-o", "--output", "out_path", type=click.Path(dir_okay=False, path_type=Path),
               help="The table as CSV (.csv) or the Dataset (.h5, .hdf5, .nc).")
 @click.option("--plot", "fig_path", type=click.Path(dir_okay=False, path_type=Path),

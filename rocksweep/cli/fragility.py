@@ -26,7 +26,15 @@ from rocksweep.cli.options import (
 )
 from rocksweep.errors import FragilityWarning
 from rocksweep.vocab.kinds import FRAGILITY
-from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, STATES, UPLIFT
+from rocksweep.vocab.outcomes import (
+    MODE1,
+    MODE2,
+    OVERTURN,
+    SLIDE_STATE,
+    STATES,
+    THETA_STATE,
+    UPLIFT,
+)
 
 CURVE_SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
 
@@ -60,12 +68,15 @@ def _g(v) -> str:
                    "each stripe, .png, .pdf or .svg.")
 @click.option("--state", default="overturn", show_default=True,
               help="What the curve gives the probability of: " + ", ".join(STATES)
-              + " or theta:X (max|theta|/alpha_cg >= X, 0 < X <= 1); several separated by "
-              "commas, each fitted alone (the same curve whatever else is asked for).")
+              + f", {THETA_STATE} (max|theta|/alpha_cg >= X, 0 < X <= 1) or {SLIDE_STATE} "
+              "(the base's sliding displacement slide_max >= D, D > 0 in units of b, metres "
+              "for a physical body; a scene with body.mu); several separated by commas, each "
+              "fitted alone (the same curve whatever else is asked for).")
 @click.option("--joint", is_flag=True,
-              help=f"Fit damage states ({UPLIFT}, theta:X, {OVERTURN}) with one beta so their "
-                   f"curves never cross (the likelihood-ratio test of that beta is stored), "
-                   f"{MODE1},{MODE2} as competing risks.")
+              help=f"Fit damage states of one chain ({UPLIFT}, {THETA_STATE}, {OVERTURN}; or "
+                   f"{SLIDE_STATE}, {OVERTURN}) with one beta so their curves never cross "
+                   f"(the likelihood-ratio test of that beta is stored), {MODE1},{MODE2} as "
+                   "competing risks.")
 @click.option("--im", default=None,
               help="Unscaled suites (clouds): the IM, PGA (default), PGV or Sa; stripes use "
                    "the IM they were scaled to.")
@@ -78,10 +89,11 @@ def _g(v) -> str:
 @ci_option
 @json_option('the curves ({"curves": [...]}) instead of a table')
 @width_option("single")
-@rtol_option(None, "Also refine each record's first overturning level by bisection to this "
+@rtol_option(None, "Also refine each record's first level reaching a --state (overturning "
+                   "when it is one of them, else the first), by bisection to this "
                    "relative tolerance (an IDA per record, kernel runs at the sweep's "
-                   "accuracy): variables ida_im, ida_lo, ida_hi along record in -o "
-                   "(.h5/.nc) and the spread in the table [default: stripes only]")
+                   "accuracy): variables ida_im, ida_lo, ida_hi along record in -o (.h5/.nc) and the spread in the table "
+                   "[default: stripes only]")
 @dpi_option
 @overwrite_option
 @user_errors
@@ -111,7 +123,9 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
 
     ds = rocksweep.open(result_path)
     # --rtol's IDA first: refused, it says so in one line before any word about the fit
-    refined = rocksweep.ida(ds, rtol) if rtol is not None else None
+    # overturning where asked (as before sliding's states), else the first state
+    bisected = OVERTURN if OVERTURN in states else states[0]
+    refined = rocksweep.ida(ds, rtol, state=bisected) if rtol is not None else None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", FragilityWarning)
         frag = rocksweep.fragility(ds, state=states[0] if len(states) == 1 else states,
@@ -150,16 +164,21 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
 
 
 def _print_ida(refined) -> None:
-    """One line per value of the other swept keys: the records' first overturning levels
-    (bisected), their median and range, resurrections."""
+    """One line per value of the other swept keys: the records' first levels reaching the
+    IDA's state (bisected; overturning by default), their median and range,
+    resurrections."""
     # run time, not --help: numpy, h5py, numba, matplotlib (0.1-2 s each), outputs (+7%)
     import numpy as np
 
     a = refined.attrs
     other = [d for d in refined.ida_im.dims if d != "record"]
     stacked = refined.stack(_k=other) if other else refined.expand_dims(_k=[0])
-    click.echo(f"IDA per record (first overturning {a['im']} [{a['im_units']}], bisected to "
+    first = (f"first overturning {a['im']}" if a["state"] == OVERTURN
+             else f"first {a['im']} reaching {a['state']}")
+    click.echo(f"IDA per record ({first} [{a['im_units']}], bisected to "
                f"rtol {a['rtol']:g}, {int(refined.runs.sum())} kernel runs):")
+    verb = "overturn" if a["state"] == OVERTURN else f"reach {a['state']}"
+    verbs = "overturns" if a["state"] == OVERTURN else f"reaches {a['state']}"
     for k in range(stacked.sizes["_k"]):
         one = stacked.isel(_k=k)
         where = ", ".join(f"{d} = {one[d].item()}" for d in other) or "all"
@@ -167,10 +186,10 @@ def _print_ida(refined) -> None:
         ok = v[~np.isnan(v)]
         if ok.size:
             click.echo(f"  {where}: median {np.median(ok):.4g}, range {ok.min():.4g} to "
-                       f"{ok.max():.4g} ({ok.size} of {v.size} records overturn; "
+                       f"{ok.max():.4g} ({ok.size} of {v.size} records {verb}; "
                        f"{int(one.resurrection.sum())} resurrect above it)")
         else:
-            click.echo(f"  {where}: no record overturns at any stripe")
+            click.echo(f"  {where}: no record {verbs} at any stripe")
         flagged, stopped = int(one.n_flagged.sum()), int(one.unresolved.sum())
         if flagged or stopped:
             click.echo(f"    {flagged} flagged stripe points (neither safe nor overturning); "

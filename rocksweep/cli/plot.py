@@ -28,6 +28,10 @@ from rocksweep.vocab.kinds import SWEEP
 @click.option("--mu", "mu_map", is_flag=True,
               help="Draw the friction demand mu_required (a result with contact outputs) as "
                    "a contour map instead of the classes.")
+@click.option("--regime", "regime_map", is_flag=True,
+              help="Draw the contact regimes of a sliding base (a sweep with body.mu) "
+                   "instead of the classes: the phases each run visited (rest, slide, rock, "
+                   "slide-rock), overturned points marked, e.g. --x body.mu --y A_ratio.")
 @overwrite_option
 @click.option("--curves", is_flag=True,
               help="Overlay the boundary lines between classes, one colour per lam "
@@ -42,7 +46,7 @@ from rocksweep.vocab.kinds import SWEEP
 @user_errors
 def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str | None,
          dpi: int, overwrite: bool, curves: bool, show_computed: bool,
-         mu_map: bool, compare_key: str | None) -> None:
+         mu_map: bool, compare_key: str | None, regime_map: bool) -> None:
     """Draw the stability diagram of a sweep: by default x = omega/p, y = A/(g tan
     alpha_cg); --x/--y pick any two swept axes. Mode 1 / mode 2 / safe regions, one panel
     per pulse shape and per other swept key, the growth of the mode 1 area with lam in
@@ -51,7 +55,8 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
     ones. With contact outputs and body.mu, the points that would slide are hatched (and
     those that would lift off dotted); --mu draws mu_required. A sweep with --check rings
     the points whose outcome changes at half the step. --compare KEY (e.g. impact.law)
-    draws one diagram coloured by which of KEY's values overturn each cell."""
+    draws one diagram coloured by which of KEY's values overturn each cell. --regime draws
+    the contact regimes of a sliding base (body.mu) over the two axes."""
     # run time, not --help: numpy, h5py, numba, matplotlib (0.1-2 s each), outputs (+7%)
     from rocksweep.figures.diagrams import missing_warnings
     from rocksweep.figures.style import save_figure
@@ -64,8 +69,11 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
 
     inputs = result_inputs(result_path)  # the result and its records: never written over
     check_output(fig_out, overwrite=overwrite, inputs=inputs, suffixes=FORMATS)
-    if mu_map and compare_key is not None:
-        raise click.ClickException("--mu and --compare draw different figures; give one")
+    chosen = [o for o, v in (("--mu", mu_map), ("--regime", regime_map),
+                             ("--compare", compare_key is not None)) if v]
+    if len(chosen) > 1:
+        raise click.ClickException(f"{chosen[0]} and {chosen[1]} draw different figures; "
+                                   "give one")
     ds = rocksweep.open(result_path)  # a sweep, or an analysis's -o .h5 (its own figure)
     from rocksweep.analysis.kinds import dataset_kind
 
@@ -75,7 +83,7 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
         click.echo(f"wrote {fig_out}")
         return
     fig = rocksweep.plot(ds, x_key, y_key, curves=curves, show_computed=show_computed,
-                         mu=mu_map, compare=compare_key)
+                         mu=mu_map, compare=compare_key, regime=regime_map)
     save_figure(fig, fig_out, dpi, overwrite=overwrite, inputs=inputs)
     for w in missing_warnings(as_result(ds)):
         click.echo(f"warning: {w}", err=True)

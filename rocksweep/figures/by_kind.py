@@ -19,6 +19,7 @@ from rocksweep.figures.calibration import calibration_figure
 from rocksweep.figures.diagrams import sweep_figure
 from rocksweep.figures.floors import floor_spectrum_figure
 from rocksweep.figures.friction import friction_map
+from rocksweep.figures.regimes import regime_map
 from rocksweep.figures.spectrum import spectra_figure
 from rocksweep.figures.style import fit_width, width_style
 from rocksweep.store.reader import as_result
@@ -60,7 +61,8 @@ def plot_analysis(ds: Any, *, ax: Any = None, width: str | None = None) -> Any:
 
 def plot_any(ds: Any, x: str | None = None, y: str | None = None, *, ax: Any = None,
              curves: bool = False, show_computed: bool = False, mu: bool = False,
-             width: str | None = None, compare: str | None = None) -> Any:
+             width: str | None = None, compare: str | None = None,
+             regime: bool = False) -> Any:
     """``rocksweep.plot``'s figure of any rocksweep Dataset or its file (the arguments,
     checked here first, are documented there): a sweep's diagram (``figures.diagrams``), a
     record suite's overturning fragility, an analysis's figure (``plot_analysis``), at the
@@ -68,8 +70,14 @@ def plot_any(ds: Any, x: str | None = None, y: str | None = None, *, ax: Any = N
     _check_ax(ax)
     for name, v in {"x": x, "y": y, "compare": compare, "width": width}.items():
         check_type(name, v, v is None or isinstance(v, str), "a string or None")
-    for name, v in {"curves": curves, "show_computed": show_computed, "mu": mu}.items():
+    for name, v in {"curves": curves, "show_computed": show_computed, "mu": mu,
+                    "regime": regime}.items():
         check_flag(name, v)
+    chosen = [a for a, v in ((flag("mu"), mu), (flag("regime"), regime),
+                             (Arg("compare", compare), compare is not None)) if v]
+    if len(chosen) > 1:
+        raise ApiError("{a} and {b} draw different figures; give one", a=chosen[0],
+                       b=chosen[1])
     if isinstance(ds, str | Path):
         ds = open_any(ds)
     kind = dataset_kind(ds)
@@ -79,8 +87,8 @@ def plot_any(ds: Any, x: str | None = None, y: str | None = None, *, ax: Any = N
         from rocksweep.analysis.fragility import fragility as fit  # scipy.stats: ~1 s
 
         given = [Arg(n, v) if v is not True else flag(n) for n, v in
-                 zip(("x", "y", "curves", "mu", "compare", "show_computed"),
-                     (x, y, curves, mu, compare, show_computed), strict=True)
+                 zip(("x", "y", "curves", "mu", "compare", "show_computed", "regime"),
+                     (x, y, curves, mu, compare, show_computed, regime), strict=True)
                  if v not in (None, False)]
         if given:
             raise ApiError("{arg}: a record-suite sweep is drawn as its fragility curves; the "
@@ -99,6 +107,12 @@ def plot_any(ds: Any, x: str | None = None, y: str | None = None, *, ax: Any = N
     with matplotlib.rc_context(style):
         if mu:
             fig = friction_map(result, x, y)
+        elif regime:
+            if ax is not None or curves or show_computed:
+                raise ApiError("{regime} draws its own figure, without {arg}", regime=flag(
+                    "regime"), arg=Arg("ax") if ax is not None else flag(
+                    "curves" if curves else "show_computed"))
+            fig = regime_map(result, x, y)
         else:
             fig = sweep_figure(result, x, y, axes=ax, curves=curves,
                                show_computed=show_computed, compare=compare)

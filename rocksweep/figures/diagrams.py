@@ -299,7 +299,9 @@ def _no_suite(result: SweepResult) -> None:
                            "its fragility curves (rocksweep.fragility)")
 
 
-_OUTCOME_STYLE = {  # outcome code -> (marker, face colour, legend label)
+#: the outcome marks of a point (the line plot's, the regime map's): code -> (marker, face
+#: colour, legend label)
+OUTCOME_STYLE = {
     OUTCOME_SAFE: ("o", SAFE_COLOUR, "safe"),
     OUTCOME_MODE1: ("^", mode1_colours(1)[0], "mode 1 (overturned after impacts)"),
     OUTCOME_MODE2: ("s", MODE2_COLOUR, "mode 2 (overturned, no impact)"),
@@ -345,7 +347,7 @@ def line_diagram(result: SweepResult, x: str | None = None, *,
             yv = pv[k].astype(float)
             yv[po[k] == OUTCOME_NOT_RUN] = np.nan
             ax.plot(xs, yv, "-", color=colour, lw=1.1, label=label, zorder=1)
-            for code, (marker, face, _) in _OUTCOME_STYLE.items():
+            for code, (marker, face, _) in OUTCOME_STYLE.items():
                 sel = po[k] == code
                 if sel.any():
                     used.add(code)
@@ -360,7 +362,7 @@ def line_diagram(result: SweepResult, x: str | None = None, *,
             ax.set_yticks([0, 1, 2], ["safe", "mode 1", "mode 2"])
         ax.grid(alpha=0.3)
     handles = [Line2D([], [], ls="", marker=m, mfc=f, mec="0.3", label=lab)
-               for code, (m, f, lab) in _OUTCOME_STYLE.items() if code in used]
+               for code, (m, f, lab) in OUTCOME_STYLE.items() if code in used]
     handles += [h for h in flat[0].get_legend_handles_labels()[0]]
     if own:
         ncols = grid_shape(result, panel_dims, len(panels))[1]

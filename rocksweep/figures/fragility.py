@@ -144,6 +144,8 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
     boot = int(frag.attrs.get("bootstrap", 0))
     title = method + (f", {frag.attrs.get('ci', 0.9):g} band of {boot} resamples"
                       if boot else "")
+    if frag.attrs.get("slide_max_units"):  # slide:D states: D's units (slide_max's)
+        title += f"; slide:D with D in {frag.attrs['slide_max_units']}"
     ax.set_title(title, fontsize="small")
     # below the axes: the curves and stripe markers fill the plot, a legend inside would
     # cover them

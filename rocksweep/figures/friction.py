@@ -11,11 +11,11 @@ from matplotlib.colors import BoundaryNorm
 
 from rocksweep.errors import DiagramError
 from rocksweep.figures.panels import (
-    choose_axes,
     coord,
     figure_title,
     grid_shape,
     in_order,
+    map_axes,
     panel_indices,
     panel_title,
     place_axes,
@@ -36,13 +36,7 @@ def friction_map(result: SweepResult, x: str | None = None, y: str | None = None
         raise DiagramError(f"{result.path}: no mu_required in this result; sweep with "
                            "contact outputs (outputs.contact: true) to draw the friction "
                            "demand")
-    x, y = choose_axes(result, x, y)
-    if y is None:
-        raise DiagramError(f"{result.path}: one swept axis besides lam ({x}); the friction "
-                           "map needs two")
-    dims = list(result.dims)
-    panel_dims = [d for d in dims if d not in (x, y)]
-    order = [*panel_dims, y, x]
+    x, y, panel_dims, order = map_axes(result, x, y, "the friction map")
     (mu_req,) = in_order(result, order, ["mu_required"])
     panels = panel_indices(result, panel_dims)
     xs, ys = coord(result, x), coord(result, y)

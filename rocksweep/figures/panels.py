@@ -122,6 +122,20 @@ def choose_axes(result: SweepResult, x: str | None = None, y: str | None = None
     return x, y
 
 
+def map_axes(result: SweepResult, x: str | None, y: str | None, what: str
+             ) -> tuple[str, str, list[str], list[str]]:
+    """The axes of a map over two swept keys with one panel per value of every other
+    (lam included: the friction map, the regime map): (x, y, panel dims, the arrays'
+    drawing order); a one-line DiagramError naming ``what`` when only one axis is swept
+    besides lam."""
+    x, y = choose_axes(result, x, y)
+    if y is None:
+        raise DiagramError(f"{result.path}: one swept axis besides lam ({x}); {what} needs "
+                           "two")
+    panel_dims = [d for d in result.dims if d not in (x, y)]
+    return x, y, panel_dims, [*panel_dims, y, x]
+
+
 # ---------------------------------------------------------------------------------------
 # Panels: arrays in drawing order, their grid, titles and marks
 # ---------------------------------------------------------------------------------------

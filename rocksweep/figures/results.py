@@ -14,9 +14,11 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from rocksweep.analysis.ida import curve_end, curve_variable
 from rocksweep.figures import WIDTHS
 from rocksweep.figures.style import Figure, curve_colours, grow_to_fit, log_ticks, wrap_title
 from rocksweep.vocab.axes import label as axis_label
+from rocksweep.vocab.outcomes import OVERTURN
 
 # height / width of one panel stacked in a single column (``_figure``)
 STACKED_ASPECT = 0.62
@@ -109,11 +111,15 @@ def ida_figure(ida: xr.Dataset, *, ax: Any = None, width: str | None = "single")
     evenly chosen, the suptitle says how many of how many), in two columns beyond one
     (one at the single column width), the stripes' safe points joined, each record
     ending at its bisected first overturning level ``ida_im`` (drawn at max|theta|/alpha
-    = 1, the overturning limit). Without the stripes' curves: each record's ``ida_im``
-    and bracket, sorted."""
+    = 1, the overturning limit). An IDA of another state (attrs ``state``) ends at that
+    state's level (``analysis.ida.curve_end``): "slide:D" draws the sliding displacement
+    ``slide_max`` against the IM, D dashed. Without the stripes' curves: each record's
+    ``ida_im`` and bracket, sorted."""
     im, unit = ida.attrs.get("im", "IM"), ida.attrs.get("im_units", "")
     xlabel = f"{im} [{unit}]" if unit and unit != "1" else im
-    curves = "theta_max_over_alpha" in ida.data_vars and im in ida["theta_max_over_alpha"].dims
+    state = str(ida.attrs.get("state", OVERTURN))
+    demand, end = curve_variable(state), curve_end(state)
+    curves = demand in ida.data_vars and im in ida[demand].dims
     every = list(_curves(ida["ida_im"], "record"))
     keep = np.unique(np.linspace(0, len(every) - 1, min(MAX_IDA_PANELS, len(every)))
                      .round().astype(int))
@@ -139,24 +145,30 @@ def ida_figure(ida: xr.Dataset, *, ax: Any = None, width: str | None = "single")
     for k, (label, sel, v) in enumerate(panels):
         if curves:
             a = axes[min(k, len(axes) - 1)]
-            th = ida["theta_max_over_alpha"].isel(sel).transpose("record", im)
+            th = ida[demand].isel(sel).transpose("record", im)
             x = ida[im].values
             colours = curve_colours(th.sizes["record"])
             for r in range(th.sizes["record"]):
                 y = th.values[r]
                 c = colours[r]
                 xs, ys = list(x[np.isfinite(y)]), list(y[np.isfinite(y)])
-                if np.isfinite(v[r]):  # up to the bisected first overturning level
+                if np.isfinite(v[r]):  # up to the bisected first level reaching the state
                     keep_r = [i for i, xx in enumerate(xs) if xx < v[r]]
-                    xs, ys = [xs[i] for i in keep_r] + [v[r]], [ys[i] for i in keep_r] + [1.0]
+                    xs, ys = [xs[i] for i in keep_r] + [v[r]], [ys[i] for i in keep_r] + [end]
                 a.plot(xs, ys, "-", color=c, lw=0.8, alpha=0.8)
                 if np.isfinite(v[r]):
-                    a.plot([v[r]], [1.0], "o", color=c, ms=2.5)
+                    a.plot([v[r]], [end], "o", color=c, ms=2.5)
             a.set_xscale("log")
             log_ticks(a.xaxis, x)
-            a.set_ylim(0.0, 1.05)
             a.set_xlabel(xlabel)
-            a.set_ylabel(r"max|$\theta$|/$\alpha$")
+            if demand == "theta_max_over_alpha":
+                a.set_ylim(0.0, 1.05)
+                a.set_ylabel(r"max|$\theta$|/$\alpha$")
+            else:  # the sliding displacement, its threshold D dashed
+                a.set_ylim(0.0, None)
+                a.axhline(end, color="0.4", lw=0.6, ls="--")
+                du = ida[demand].attrs.get("units", "")
+                a.set_ylabel("max sliding |x|" + (f" [{du}]" if du and du != "1" else ""))
             a.set_title(wrap_title(label or "IDA", fig.get_figwidth() / cols, 8.0),
                         fontsize="small")
             a.grid(True, which="both", alpha=0.25, linewidth=0.5)
@@ -171,7 +183,8 @@ def ida_figure(ida: xr.Dataset, *, ax: Any = None, width: str | None = "single")
                    fmt="o", ms=3, color=panel_colours[k], label=label or None)
         a.set_xscale("log")
         log_ticks(a.xaxis)
-        a.set_xlabel(f"first overturning {xlabel}")
+        a.set_xlabel(f"first overturning {xlabel}" if state == OVERTURN
+                     else f"first {xlabel} reaching {state}")
         a.set_ylabel("record (sorted)")
         a.grid(True, which="both", alpha=0.25, linewidth=0.5)
     if not curves and axes[0].get_legend_handles_labels()[0]:

@@ -600,13 +600,14 @@ def result_of(ds) -> SweepResult:
                        arrays, attrs, stored, in_file)
 
 
-def as_result(data, names: list[str] | None = None) -> SweepResult:
+def as_result(data, names: list[str] | None = None,
+              optional: tuple[str, ...] = ()) -> SweepResult:
     """A ``SweepResult`` from a result Dataset, a ``SweepResult`` or a result file's path
-    (read with ``names``)."""
+    (read with ``names`` and ``optional``, as ``read_result``)."""
     if isinstance(data, SweepResult):
         return data
     if isinstance(data, str | Path):
-        return read_result(data, names)
+        return read_result(data, names, optional)
     return result_of(data)
 
 

@@ -4,7 +4,8 @@
   impacts), mode2 (overturned without impact);
 - status bits (``status``, a bit set): how the run ended and what it met on the way; a run
   with any ``FLAGGED`` bit is not a reliable classification;
-- fragility states (``state=``): overturn (either mode), mode1, mode2, uplift, theta:X;
+- fragility states (``state=``): overturn (either mode), mode1, mode2, uplift, theta:X,
+  slide:D;
 - ``computed`` flags of an adaptive sweep (int8): filled, computed, audit agreed/disagreed.
 """
 
@@ -54,10 +55,13 @@ FLAGGED = 0
 for _w in FLAGGED_WORDS:
     FLAGGED |= STATUS_BIT[_w]
 
-#: the limit states a fragility curve can count (besides "theta:X")
+#: the limit states a fragility curve can count (besides "theta:X" and "slide:D")
 OVERTURN, UPLIFT = "overturn", "uplift"
 STATES: tuple[str, ...] = (OVERTURN, MODE1, MODE2, UPLIFT)
 THETA_STATE = "theta:X"  # max|theta|/alpha_cg >= X, or overturned
+#: slide_max >= D (the base's largest sliding displacement, in the units of the Dataset's
+#: slide_max: the base half-width b, metres for a physical body), or overturned
+SLIDE_STATE = "slide:D"
 
 #: ``computed`` flags of an adaptive sweep (int8 per point): word -> code
 FILLED, COMPUTED, AUDIT_AGREED, AUDIT_DISAGREED = (
