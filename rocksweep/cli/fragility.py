@@ -92,7 +92,8 @@ def _g(v) -> str:
 @rtol_option(None, "Also refine each record's first level reaching a --state (overturning "
                    "when it is one of them, else the first), by bisection to this "
                    "relative tolerance (an IDA per record, kernel runs at the sweep's "
-                   "accuracy): variables ida_im, ida_lo, ida_hi along record in -o (.h5/.nc) and the spread in the table "
+                   "accuracy): variables ida_im, ida_lo, ida_hi along record in -o "
+                   "(.h5/.nc) and the spread in the table "
                    "[default: stripes only]")
 @dpi_option
 @overwrite_option
