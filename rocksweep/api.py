@@ -8,10 +8,7 @@ The functions of a Dataset (``@analysis``: ``ANALYSES``) are also its methods,
 ``ds.rocksweep.<analysis>(...)`` (``rocksweep.accessor``).
 
 Each function imports its room when called: the rooms load numba, h5py, xarray, scipy and
-matplotlib, 0.1-2 s each (docs/performance.md, the command line's imports), and one
-function needs a few of them. The names
-the API builds on are imported from their homes (``rocksweep.compute.session.sweep_file``,
-...), not from here.
+matplotlib, 0.1-2 s each (docs/performance.md), and one function needs a few of them.
 """
 
 from __future__ import annotations
@@ -170,11 +167,9 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     matplotlib's defaults. compare: a swept key (e.g. "impact.law" or "lam") whose values
     are compared on one diagram, coloured by which of them overturn each cell. A result
     with per-point error estimates rings the points whose outcome changes at half the step.
-    regime: the contact regimes of a sweep with a sliding base (``body.mu``: its
-    ``regime`` variable) instead of the classes, e.g. x = "body.mu", y = "A_ratio"
-    (Shenton's diagram): each cell coloured by the phases its run visited (rest only,
-    slide, rock, slide-rock and their mixtures), overturned cells marked by mode
-    (``rocksweep.figures.regimes``).
+    regime: the contact phases each run of a sliding base (``body.mu``) visited instead
+    of the classes, e.g. x = "body.mu", y = "A_ratio" (Shenton's diagram;
+    ``rocksweep.figures.regimes``).
     """
     from rocksweep.figures.by_kind import plot_any
 
@@ -256,12 +251,9 @@ def ida(ds: xr.Dataset, rtol: float = DEFAULT_RTOL_MANY, *, state: str = "overtu
     safe again (``resurrection``). state: another damage state in overturning's place, as
     ``fragility``'s (e.g. "slide:0.5": the smallest IM that slides the base 0.5 b, or
     overturns it; "theta:0.5"). ds: what ``run`` or ``open`` returns. Returns a Dataset
-    over the other swept keys and ``record`` (``rocksweep.analysis.ida.ida``), with the
-    stripes' ``theta_max_over_alpha`` (``slide_max`` for "slide:D") of the points that
-    did not overturn (the IDA curves ``rocksweep.plot`` draws). A sweep over ``angle``:
-    every (record, angle) is a sample (``ida_im`` over angle), and ``ida_im_worst`` /
-    ``worst_angle`` give each record's worst orientation (the least IM that overturns it
-    at any angle)."""
+    over the other swept keys and ``record`` (``rocksweep.analysis.ida.ida``) with the
+    IDA curves ``rocksweep.plot`` draws. A sweep over ``angle``: every (record, angle) a
+    sample, and ``ida_im_worst`` / ``worst_angle`` each record's worst orientation."""
     from rocksweep.analysis.floors import worst_ida
     from rocksweep.analysis.ida import ida_dataset
 
@@ -295,15 +287,11 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     ``rocksweep.analysis.resampling.DEFAULT_BOOTSTRAP``, 200); seed: their generator's
     seed; ci: the interval's level. Points flagged undecided are left out, counted.
 
-    Returns a Dataset: ``im_median`` [IM units] and ``beta``, their bootstrap intervals
-    (``_lo``/``_hi``) and resamples' fits (``_samples``), ``reason`` ("ok" or why the curve
-    should not be trusted as it is: also a ``FragilityWarning``), the counts
-    ``n_records``, ``n_excluded``, ``n_not_run``, the fitted ``curve`` and its bands over
-    ``im_grid``; for stripes ``fraction`` per stripe and ``first_level``,
-    ``resurrection`` per record. A sweep over ``angle`` gives both answers along an
-    ``orientation`` dimension: "each" (every (record, angle) a sample, pooled; records
-    counted and resampled with all their angles) and "worst" (the worst angle per record:
-    overturns at any angle).
+    Returns a Dataset: ``im_median`` [IM units], ``beta``, their intervals, ``reason``
+    ("ok" or why the curve should not be trusted: also a ``FragilityWarning``), the counts
+    and the fitted ``curve`` over ``im_grid`` (in full: the analysis's docstring). A sweep
+    over ``angle`` gives an ``orientation`` dimension: "each" (every (record, angle) a
+    sample, records resampled with all their angles) and "worst" (the worst angle per record).
     """
     from rocksweep.analysis.floors import by_orientation
     from rocksweep.analysis.fragility import fragility as fit
@@ -343,12 +331,10 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = N
 @analysis
 def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
     """Which IM explains ``state`` (as ``fragility``'s) best: for every IM of a
-    record-suite sweep's records (``rocksweep.physics.suite.RECORD_IMS``: PGA, PGV, Sa(T),
-    Arias, D5-95, PGA/(g tan alpha), ...) the lognormal dispersion ``beta`` of the
-    fragility in that IM and ``beta_scale`` (comparable across IMs; lower is better), per
-    value of the other swept keys; how (``rocksweep.analysis.efficiency``): each record's
-    first overturning level re-expressed in the IM, or a regression for the IMs scaling
-    leaves unchanged."""
+    record-suite sweep's records (``rocksweep.physics.suite.RECORD_IMS``) the lognormal
+    dispersion ``beta`` of the fragility in that IM and ``beta_scale`` (comparable across
+    IMs; lower is better), per value of the other swept keys
+    (``rocksweep.analysis.efficiency``)."""
     from rocksweep.analysis.efficiency import im_efficiency as compute
 
     return compute(_dataset_arg(ds, "ds"), state=state)
@@ -370,8 +356,7 @@ def table(ds: xr.Dataset) -> Any:
 def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> Any:
     """What ``run`` of this scene (with ``overrides``, as for ``run``) will cost on this
     machine, without running it: points, RK4 steps and evaluations expected, seconds of
-    compute with ``jobs`` workers, and
-    whether a kernel variant must be compiled first (and for how long). Measured on a
+    compute with ``jobs`` workers, and any kernel variant to compile first. Measured on a
     sample of 256 points when the kernel is compiled (~10 ms), else from the step bound.
     Returns ``rocksweep.compute.sweep.Estimate`` (``str()`` is one line)."""
     from rocksweep.compute.sweep import estimate as sweep_estimate
@@ -411,9 +396,8 @@ def felt_motion(scene: SceneLike, overrides: Overrides = (), /, **keys: Any) -> 
     (``floor``), scaled as the point runs it, ``a_v`` [g] the vertical acting with it,
     ``a_ground`` [g] the ground's H1 at the same scale (with an excitation path), over
     ``t`` [s] (``rocksweep.compute.motion``). scene and overrides as for ``simulate`` (one
-    point). The kernel runs exactly these samples, linear between them;
-    ``rocksweep.physics.records.write_at2(path, ds.a_h.values, ds.attrs["dt"], title)``
-    keeps one as a record."""
+    point). The kernel runs exactly these samples, linear between them
+    (``rocksweep.physics.records.write_at2`` keeps one as a record)."""
     from rocksweep.compute.motion import felt_motion as felt
     from rocksweep.scene.inputs import load, override_strings
 
@@ -436,25 +420,14 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     body's or a record scene's ground.p). bounds: {key: (lo, hi)} inside each key's
     admissible range (default: ``analysis.fit_keys.DEFAULT_BOUNDS`` or the range). ci:
     the interval's level, in [0.5, 1). Returns a Dataset over ``parameter`` (the fitted
-    keys): ``estimate``, ``lo``, ``hi`` (the ``ci`` interval by profile likelihood, ``ci``
-    in attrs), scalar ``misfit`` (RMS error of the half-cycle peaks, theta/alpha_ref)
-    with ``noise`` (the measurement's, estimated from the history or ``noise=``, in
-    theta/alpha_ref) and ``dof``, ``reason`` ("ok" or misfit, unidentifiable, at_bound,
-    not_converged joined by ",", also a ``CalibrationWarning``), and the measured and
-    fitted histories over p_t with the fitted impacts (``rocksweep.analysis.calibrate``).
+    keys): ``estimate``, ``lo``, ``hi`` (profile likelihood), ``misfit`` with ``noise``
+    and ``dof``, ``reason`` ("ok" or why not, also a ``CalibrationWarning``) and the
+    measured and fitted histories (in full: ``rocksweep.analysis.calibrate``).
     progress: say on stderr when the fit's kernel variant must be compiled first (once per
     machine) and what that costs.
     """
     from rocksweep.analysis.calibrate import calibrate_scene
 
-    check_type("fit", fit, isinstance(fit, str) or (
-        isinstance(fit, Sequence) and all(isinstance(k, str) for k in fit)),
-        "a dotted scene key (e.g. 'impact.lam') or a list of them")
-    check_type("bounds", bounds, bounds is None or isinstance(bounds, Mapping),
-               "a mapping {key: (lo, hi)}, e.g. {'impact.lam': (0, 1)}, or None")
-    check_type("p", p, p is None or is_real(p), "a number (the body's p [rad/s]) or None")
-    check_type("noise", noise, noise is None or is_real(noise),
-               "a number (the measurement noise, theta/alpha_ref) or None")
     check_flag("progress", progress)
     say = (lambda m: print(m, file=sys.stderr, flush=True)) if progress else None
     return calibrate_scene(scene, measured, fit, bounds, ci, p, overrides, noise, say)

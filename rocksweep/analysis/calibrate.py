@@ -42,7 +42,7 @@ import numpy as np
 from rocksweep.analysis.fit_search import fit, profile_end, smooth_profile
 from rocksweep.analysis.misfit import Problem
 from rocksweep.compute.compile_cost import prepare_point
-from rocksweep.errors import CalibrationError
+from rocksweep.errors import CalibrationError, check_type, is_real
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.bodies import u_cr
 from rocksweep.physics.measured import Measured, read_measured
@@ -230,6 +230,14 @@ def calibrate_scene(scene: Any, measured: Any, fit: str | Sequence[str],
     the keys fitted (``calibrate_problem``)."""
     from rocksweep.scene.inputs import load
 
+    check_type("fit", fit, isinstance(fit, str) or (
+        isinstance(fit, Sequence) and all(isinstance(k, str) for k in fit)),
+        "a dotted scene key (e.g. 'impact.lam') or a list of them")
+    check_type("bounds", bounds, bounds is None or isinstance(bounds, Mapping),
+               "a mapping {key: (lo, hi)}, e.g. {'impact.lam': (0, 1)}, or None")
+    check_type("p", p, p is None or is_real(p), "a number (the body's p [rad/s]) or None")
+    check_type("noise", noise, noise is None or is_real(noise),
+               "a number (the measurement noise, theta/alpha_ref) or None")
     keys = [fit] if isinstance(fit, str) else list(fit)
     if not keys:
         raise CalibrationError("fit = []: give at least one key, e.g. impact.lam")
@@ -239,9 +247,6 @@ def calibrate_scene(scene: Any, measured: Any, fit: str | Sequence[str],
         raise CalibrationError(f"ci = {ci!r}: must be in [0.5, 1)")
     ci = float(ci)
     if bounds is not None:
-        if not isinstance(bounds, Mapping):
-            raise TypeError(f"bounds = {bounds!r}: must be a mapping {{key: (lo, hi)}}, e.g. "
-                            "{'impact.lam': (0, 1)}")
         for k in bounds:
             if k not in keys:
                 raise CalibrationError(f"bounds {k!r}: not a fitted key (fitted: "
