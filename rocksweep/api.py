@@ -356,9 +356,8 @@ def table(ds: xr.Dataset) -> Any:
 def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> Any:
     """What ``run`` of this scene (with ``overrides``, as for ``run``) will cost on this
     machine, without running it: points, RK4 steps and evaluations expected, seconds of
-    compute with ``jobs`` workers, and any kernel variant to compile first. Measured on a
-    sample of 256 points when the kernel is compiled (~10 ms), else from the step bound.
-    Returns ``rocksweep.compute.sweep.Estimate`` (``str()`` is one line)."""
+    compute with ``jobs`` workers, and any kernel variant to compile first (measured on
+    256 points, ~10 ms). Returns ``rocksweep.compute.sweep.Estimate`` (``str()``: a line)."""
     from rocksweep.compute.sweep import estimate as sweep_estimate
     from rocksweep.scene.inputs import load
 
@@ -366,7 +365,7 @@ def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> A
     return sweep_estimate(sc, jobs=jobs)
 
 
-# --- rocksweep.simulate ------------------------------------------------------------------
+# --- rocksweep.simulate and the motion a point feels --------------------------------------
 
 def simulate(scene: SceneLike, overrides: Overrides = (), /,
              **keys: Any) -> Simulation | list[Simulation]:
