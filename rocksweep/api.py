@@ -357,7 +357,7 @@ def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> A
     """What ``run`` of this scene (with ``overrides``, as for ``run``) will cost on this
     machine, without running it: points, RK4 steps and evaluations expected, seconds of
     compute with ``jobs`` workers, and any kernel variant to compile first (measured on
-    256 points, ~10 ms). Returns ``rocksweep.compute.sweep.Estimate`` (``str()``: a line)."""
+    256 points, ~10 ms; uncompiled: the step bound). Returns ``rocksweep.compute.sweep.Estimate`` (``str()``: a line)."""
     from rocksweep.compute.sweep import estimate as sweep_estimate
     from rocksweep.scene.inputs import load
 
