@@ -354,10 +354,10 @@ def table(ds: xr.Dataset) -> Any:
 
 
 def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> Any:
-    """What ``run`` of this scene (with ``overrides``, as for ``run``) will cost on this
-    machine, without running it: points, RK4 steps and evaluations expected, seconds of
-    compute with ``jobs`` workers, and any kernel variant to compile first (measured on
-    256 points, ~10 ms; uncompiled: the step bound). Returns ``rocksweep.compute.sweep.Estimate`` (``str()``: a line)."""
+    """What ``run`` of this scene (``overrides`` as for ``run``) costs here, without running
+    it: points, RK4 steps and evaluations expected, seconds with ``jobs`` workers, any
+    kernel variant to compile first (measured on 256 points, ~10 ms; uncompiled: the step
+    bound). Returns ``rocksweep.compute.sweep.Estimate`` (``str()``: one line)."""
     from rocksweep.compute.sweep import estimate as sweep_estimate
     from rocksweep.scene.inputs import load
 
