@@ -45,7 +45,14 @@ import numpy as np
 
 from rocksweep.fields import CHECK_SCALE
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.numerics import CLOSE_AFTER, CLOSE_BAND, OVERTURN_BAND
+from rocksweep.numerics import (
+    CLOSE_AFTER,
+    CLOSE_BAND,
+    ENERGY_ORDER,
+    OVERTURN_BAND,
+    RICHARDSON_SAFETY,
+    SAME_FALL,
+)
 
 
 def _fell(outs: np.ndarray) -> np.ndarray:
@@ -65,6 +72,25 @@ def close_calls(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     overturned with one below OVERTURN_BAND times it."""
     bound = np.where(_fell(outs), OVERTURN_BAND, 1.0) * (rows[:, L.PAR_CLOSE] / CLOSE_BAND)
     return outs[:, L.OUT_MARGIN] < bound
+
+
+def converged(coarse_rows: np.ndarray, coarse: np.ndarray, fine_rows: np.ndarray,
+              fine: np.ndarray) -> np.ndarray:
+    """bool[n]: overturns whose margin has converged between two runs of the same points
+    (parameter rows float64[n, >= N_PAR] and result rows float64[n, N_OUT] of a run and of
+    its refinement at half the steps): both fell, within ``numerics.SAME_FALL`` [p t] of
+    each other (on the same approach), the finer one clear of its own step's close-call
+    margin (PAR_CLOSE / CLOSE_BAND), and its squared margin (~ |E - E_barrier|/E_ref) at
+    least RICHARDSON_SAFETY times Richardson's estimate of its error, |m_f^2 - m_c^2| /
+    (2^ENERGY_ORDER - 1): the class does not hang on the step."""
+    m_c, m_f = coarse[:, L.OUT_MARGIN], fine[:, L.OUT_MARGIN]
+    err = np.abs(m_f * m_f - m_c * m_c) / (2.0 ** ENERGY_ORDER - 1.0)
+    same_fall = (np.abs(fine[:, L.OUT_T_OVERTURN] - coarse[:, L.OUT_T_OVERTURN])
+                 <= SAME_FALL)
+    with np.errstate(invalid="ignore"):  # inf - inf: a margin never taken
+        return (_fell(coarse) & _fell(fine) & same_fall
+                & (m_f >= fine_rows[:, L.PAR_CLOSE] / CLOSE_BAND)
+                & (m_f * m_f >= RICHARDSON_SAFETY * err))
 
 
 def near_misses(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
@@ -121,13 +147,16 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
     for level in range(1, levels + 1):
         if idx.size == 0:
             break
-        spent_now = outs[idx][:, [L.OUT_STEPS, L.OUT_EVENT_STEPS, L.OUT_REFINE_EVALS]]
+        before = outs[idx]
+        spent_now = before[:, [L.OUT_STEPS, L.OUT_EVENT_STEPS, L.OUT_REFINE_EVALS]]
         finer = refine_rows(rows[idx], level)
         new = run(finer, idx)
         # the same outcome twice, and the finer run clear of the saddle by its own step's
-        # margin: a knife edge agrees with itself at every step it is a close call at
-        stable = ((new[:, L.OUT_OUTCOME] == outs[idx, L.OUT_OUTCOME])
-                  & ~close_calls(finer, new))
+        # margin (a knife edge agrees with itself at every step it is a close call at), or
+        # an overturn whose margin converged between the two runs
+        stable = ((new[:, L.OUT_OUTCOME] == before[:, L.OUT_OUTCOME])
+                  & (~close_calls(finer, new)
+                     | converged(refine_rows(rows[idx], level - 1), before, finer, new)))
         status = new[:, L.OUT_STATUS].astype(np.int64) | L.STATUS_REFINED
         new[:, L.OUT_STATUS] = status
         new[:, L.OUT_REFINE_EVALS] = spent_now[:, 2] + _evaluations(new)

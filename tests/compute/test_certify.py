@@ -213,6 +213,49 @@ def test_a_knife_edge_is_refined_until_clear_or_flagged():
     assert (outs[:, L.OUT_OUTCOME] == L.OUTCOME_SAFE).all()
 
 
+def test_a_repeated_overturn_whose_margin_converged_stops_there():
+    """certify's rule on a stand-in kernel: a repeated overturn still inside the overturn
+    band at its own step is certified where its margins converged between the two runs
+    (the same fall, within SAME_FALL; the finer squared margin at least RICHARDSON_SAFETY
+    times |m_f^2 - m_c^2| / (2^ENERGY_ORDER - 1); the finer margin clear of its own step's
+    close-call margin), not otherwise; a safe run's converged margin certifies nothing."""
+    # close-call margin b_L = 0.01 x 2^(-2.5 L): 0.01, 0.00177, 0.000313, 5.5e-5
+    rows = np.zeros((5, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = 0.04
+    rows[:, L.PAR_DT] = 1.0
+    fell, safe = L.OUTCOME_MODE1, L.OUTCOME_SAFE
+    # per point and level 0..3: (outcome, margin, overturning time)
+    ladder = {
+        # converged at level 1: 0.0105^2 = 1.1e-4 >= 2 x |1.1e-4 - 4e-4| / 15 = 3.9e-5
+        0: [(fell, 0.02, 10.0), (fell, 0.0105, 10.01)],
+        # the same margins, but the finer run fell 2 p t later: another approach
+        1: [(fell, 0.02, 10.0), (fell, 0.0105, 12.0), (fell, 0.0104, 12.0)],
+        # level 1's margin is mostly the coarse step's error (it fell by 10x): one more
+        2: [(fell, 0.05, 10.0), (fell, 0.005, 10.0), (fell, 0.0049, 10.0)],
+        # converged, but below the finer step's own close-call margin (0.00177)
+        3: [(fell, 0.0012, 10.0), (fell, 0.0012, 10.0), (fell, 0.0012, 10.0)],
+        # safe with converged margins below its close-call margin: the rule as before
+        4: [(safe, 0.0016, np.nan), (safe, 0.0015, np.nan), (safe, 0.0015, np.nan)],
+    }
+    outs = np.zeros((5, L.N_OUT))
+    for i, steps in ladder.items():
+        outs[i, [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN]] = steps[0]
+    levels_run = {i: [] for i in ladder}
+
+    def run(sub, idx, keep=True):
+        res = np.zeros((len(idx), L.N_OUT))
+        level = round(-np.log2(sub[0, L.PAR_DT]))
+        for j, i in enumerate(idx):
+            levels_run[int(i)].append(level)
+            res[j, [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN]] = ladder[int(i)][level]
+        return res
+
+    certify(rows, outs, run, 3)
+    assert levels_run == {0: [1], 1: [1, 2], 2: [1, 2], 3: [1, 2], 4: [1, 2]}
+    st = outs[:, L.OUT_STATUS].astype(int)
+    assert (st & L.STATUS_REFINED).all() and not (st & L.STATUS_UNCERTIFIED).any()
+
+
 SCENE = """
 name: one point
 body: {kind: block, alpha: 0.25}
