@@ -13,7 +13,12 @@ when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the th
   halved, the step cap doubled), and again, until two consecutive runs give the same
   outcome and the finer one is no close call at its own step (its margins scale with the
   step, ``numerics.close_margin``: a knife edge repeats itself at every step it is a
-  close call at) or ``Numerics.refine`` refinements were made; the finest run is kept;
+  close call at) or ``Numerics.refine`` refinements were made; the finest run is kept.
+  A repeated overturn still inside the band at its own step is certified too where its
+  margin converged between the two runs (``converged``: the same fall, and the finer
+  squared margin, ~ the energy past the barrier, clear of Richardson's estimate of its
+  error): most of the knife-edge rule's reruns were overturns whose margin had already
+  settled at level 1, the coarse step's band being far wider than its error there;
 - a safe run between the close-call margin and the row's PAR_CLOSE (``numerics.
   close_band``, CLOSE_BAND times it: a near-miss, which turned back with a margin a
   coarse step's error can still reverse) is checked by a run at half the steps that stops
