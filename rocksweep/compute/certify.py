@@ -17,8 +17,9 @@ when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the th
   A repeated overturn still inside the band at its own step is certified too where its
   margin converged between the two runs (``converged``: the same fall, and the finer
   squared margin, ~ the energy past the barrier, clear of Richardson's estimate of its
-  error): most of the knife-edge rule's reruns were overturns whose margin had already
-  settled at level 1, the coarse step's band being far wider than its error there;
+  error) and a finer run would follow (at the last level the verdict is as before): most
+  of the knife-edge rule's reruns were overturns whose margin had already settled at
+  level 1, the coarse step's band being far wider than its error there;
 - a safe run between the close-call margin and the row's PAR_CLOSE (``numerics.
   close_band``, CLOSE_BAND times it: a near-miss, which turned back with a margin a
   coarse step's error can still reverse) is checked by a run at half the steps that stops
@@ -157,11 +158,15 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
         finer = refine_rows(rows[idx], level)
         new = run(finer, idx)
         # the same outcome twice, and the finer run clear of the saddle by its own step's
-        # margin (a knife edge agrees with itself at every step it is a close call at), or
-        # an overturn whose margin converged between the two runs
-        stable = ((new[:, L.OUT_OUTCOME] == before[:, L.OUT_OUTCOME])
-                  & (~close_calls(finer, new)
-                     | converged(refine_rows(rows[idx], level - 1), before, finer, new)))
+        # margin (a knife edge agrees with itself at every step it is a close call at), or,
+        # where it spares a finer run, an overturn whose margin converged between the two:
+        # at the last level it would spare nothing, and its verdict stays as strict as
+        # before (knife edges whose margins settle at ~1e-4 alpha_ref still differ from
+        # `fine`'s finer event tolerance there)
+        close = close_calls(finer, new)
+        if level < levels:
+            close &= ~converged(refine_rows(rows[idx], level - 1), before, finer, new)
+        stable = (new[:, L.OUT_OUTCOME] == before[:, L.OUT_OUTCOME]) & ~close
         status = new[:, L.OUT_STATUS].astype(np.int64) | L.STATUS_REFINED
         new[:, L.OUT_STATUS] = status
         new[:, L.OUT_REFINE_EVALS] = spent_now[:, 2] + _evaluations(new)

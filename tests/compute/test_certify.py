@@ -228,9 +228,10 @@ def test_a_repeated_overturn_whose_margin_converged_stops_there():
     band at its own step is certified where its margins converged between the two runs
     (the same fall, within SAME_FALL; the finer squared margin at least RICHARDSON_SAFETY
     times |m_f^2 - m_c^2| / (2^ENERGY_ORDER - 1); the finer margin clear of its own step's
-    close-call margin), not otherwise; a safe run's converged margin certifies nothing."""
+    close-call margin) and a finer run would follow, not otherwise; a safe run's converged
+    margin certifies nothing."""
     # close-call margin b_L = 0.01 x 2^(-2.5 L): 0.01, 0.00177, 0.000313, 5.5e-5
-    rows = np.zeros((5, L.N_PAR))
+    rows = np.zeros((6, L.N_PAR))
     rows[:, L.PAR_CLOSE] = 0.04
     rows[:, L.PAR_DT] = 1.0
     fell, safe = L.OUTCOME_MODE1, L.OUTCOME_SAFE
@@ -246,8 +247,11 @@ def test_a_repeated_overturn_whose_margin_converged_stops_there():
         3: [(fell, 0.0012, 10.0), (fell, 0.0012, 10.0), (fell, 0.0012, 10.0)],
         # safe with converged margins below its close-call margin: the rule as before
         4: [(safe, 0.0016, np.nan), (safe, 0.0015, np.nan), (safe, 0.0015, np.nan)],
+        # converged only at the last level, still inside the band there (8 x 5.5e-5):
+        # it would spare no run, and the verdict stays as before: uncertified
+        5: [(fell, 0.05, 10.0), (fell, 0.005, 10.0), (fell, 3e-4, 10.0), (fell, 3e-4, 10.0)],
     }
-    outs = np.zeros((5, L.N_OUT))
+    outs = np.zeros((6, L.N_OUT))
     for i, steps in ladder.items():
         outs[i, [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN]] = steps[0]
     levels_run = {i: [] for i in ladder}
@@ -261,9 +265,10 @@ def test_a_repeated_overturn_whose_margin_converged_stops_there():
         return res
 
     certify(rows, outs, run, 3)
-    assert levels_run == {0: [1], 1: [1, 2], 2: [1, 2], 3: [1, 2], 4: [1, 2]}
+    assert levels_run == {0: [1], 1: [1, 2], 2: [1, 2], 3: [1, 2], 4: [1, 2], 5: [1, 2, 3]}
     st = outs[:, L.OUT_STATUS].astype(int)
-    assert (st & L.STATUS_REFINED).all() and not (st & L.STATUS_UNCERTIFIED).any()
+    assert (st & L.STATUS_REFINED).all() and not (st[:5] & L.STATUS_UNCERTIFIED).any()
+    assert st[5] & L.STATUS_UNCERTIFIED
 
 
 SCENE = """
