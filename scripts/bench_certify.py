@@ -213,30 +213,36 @@ def main() -> None:
                   f"(load average {load:.2f} -> {os.getloadavg()[0]:.2f})", flush=True)
     this = sides["this"]
     print("| figure | RK4 evaluations | of them certification | computed | wall s (best) "
-          "| cpu s |" + "".join(f" {o}: evaluations | ratio | wall s | ratio |"
-                               for o in others))
-    tot = {"e": 0, "w": 0.0, **{o: [0, 0.0] for o in others}}
+          "| cpu s (best) |" + "".join(f" {o}: evaluations | ratio | wall s | ratio | cpu s "
+                                      "| ratio |" for o in others))
+    tot = {"e": 0, "w": 0.0, "c": 0.0, **{o: [0, 0.0, 0.0] for o in others}}
     for name in args.figures:
         e = this[0][name]["evals"]
         w = min(r[name]["wall"] for r in this)
         r = this[0][name]["refine"]
         share = (f"{r / 1e6:.1f}M ({e / (e - r):.3f}x the points' own)" if r >= 0
                  else "not counted")
+        c = min(r[name]["cpu"] for r in this)
         line = (f"| {name} | {e / 1e6:.1f}M | {share} | {this[0][name]['computed']} | "
-                f"{w:.2f} | {this[0][name]['cpu']:.1f} |")
+                f"{w:.2f} | {c:.1f} |")
         tot["e"] += e
         tot["w"] += w
+        tot["c"] += c
         for o in others:
             oe = sides[o][0][name]["evals"]
             ow = min(r[name]["wall"] for r in sides[o])
+            oc = min(r[name]["cpu"] for r in sides[o])
             tot[o][0] += oe
             tot[o][1] += ow
-            line += f" {oe / 1e6:.1f}M | {e / oe:.3f} | {ow:.2f} | {w / ow:.3f} |"
+            tot[o][2] += oc
+            line += (f" {oe / 1e6:.1f}M | {e / oe:.3f} | {ow:.2f} | {w / ow:.3f} | {oc:.1f} | "
+                     f"{c / oc:.3f} |")
         print(line)
     if others:
-        print(f"| all | {tot['e'] / 1e6:.1f}M | | | {tot['w']:.2f} | |" + "".join(
+        print(f"| all | {tot['e'] / 1e6:.1f}M | | | {tot['w']:.2f} | {tot['c']:.1f} |" + "".join(
             f" {tot[o][0] / 1e6:.1f}M | {tot['e'] / tot[o][0]:.3f} | {tot[o][1]:.2f} | "
-            f"{tot['w'] / tot[o][1]:.3f} |" for o in others))
+            f"{tot['w'] / tot[o][1]:.3f} | {tot[o][2]:.1f} | {tot['c'] / tot[o][2]:.3f} |"
+            for o in others))
     if args.rules:
         for name in args.figures:
             t = this[0][name]["rules"]
