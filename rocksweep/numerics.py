@@ -314,6 +314,18 @@ OVERTURN_BAND = 8.0
 # past the saddle: < 6 for alpha_ref > 0.01), short of the rocking to rest that holds most
 # of such a run's steps.
 CLOSE_AFTER = 4.0 * math.pi
+# A repeated overturn still inside the overturn band at its own step, below the last
+# level, is certified if its margins have converged (``compute.certify.converged``): both
+# runs fell within SAME_FALL [p t] of each other (on the same approach), and the finer
+# run's squared margin (~ the energy past the barrier, m^2 ~ |E - E_barrier|/E_ref) is at
+# least RICHARDSON_SAFETY times Richardson's estimate of its error, |m_f^2 - m_c^2| /
+# (2^ENERGY_ORDER - 1), the energy's error taken to fall as the step^4, one order below
+# the step^5 of ``close_margin``, so the estimate errs large. Without the same fall, order
+# 5 and safety 1 certified a held-out overturn that finer runs rock to rest (docs/
+# accuracy.md, "What the certification costs").
+ENERGY_ORDER = 4
+RICHARDSON_SAFETY = 2.0
+SAME_FALL = 1.0
 
 
 def close_margin(steps_per_period: int) -> float:

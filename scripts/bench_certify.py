@@ -14,11 +14,13 @@ rule that made them close calls and by refinement level), replayed on the comput
     python scripts/bench_certify.py --full --res 80       # full grids, certified vs bare
     PYTHONPATH=/path/to/other/checkout python scripts/bench_certify.py   # another checkout
     python scripts/bench_certify.py --against /path/to/other/checkout --rounds 2
+    python scripts/bench_certify.py --against /path/before --against /path/older   # both
 
-``--against`` runs the same sweeps of another checkout in a subprocess, alternating with
-this one's (round by round, each process warm: its kernels compiled before it times), and
-prints both and their ratios with the load average: the one side-by-side measurement of
-wall time on a shared machine (RK4 evaluations are deterministic).
+``--against`` (repeatable) runs the same sweeps of other checkouts in subprocesses,
+alternating with this one's (round by round, the order reversed each round, each process
+warm: its kernels compiled before it times), and prints all of them and this one's ratios
+to each with the load average: the one side-by-side measurement of wall time on a shared
+machine (RK4 evaluations are deterministic).
 """
 
 from __future__ import annotations
@@ -158,6 +160,7 @@ def measure(args) -> dict:
             item["rules"] = rules(name, args.res, r["arrays"], jobs)
         if args.classes:
             np.save(Path(args.classes) / f"{name}.npy", r["arrays"]["outcome"])
+            np.save(Path(args.classes) / f"{name}_status.npy", r["arrays"]["status"])
         out[name] = item
     return out
 
@@ -169,9 +172,11 @@ def main() -> None:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--full", action="store_true", help="full grids, not adaptive")
     ap.add_argument("--rules", action="store_true", help="evaluations per rule (replay)")
-    ap.add_argument("--classes", help="save each figure's outcome here (DIR/NAME.npy)")
+    ap.add_argument("--classes", help="save each figure's outcome here (DIR/NAME.npy; "
+                    "DIR/this/NAME.npy and one folder per --against tree)")
     ap.add_argument("--json", action="store_true", help="print one JSON line (--against)")
-    ap.add_argument("--against", help="another checkout, run alternately in a subprocess")
+    ap.add_argument("--against", action="append",
+                    help="another checkout, run alternately in a subprocess (repeatable)")
     ap.add_argument("--rounds", type=int, default=1)
     args = ap.parse_args()
     if args.json:
@@ -181,19 +186,24 @@ def main() -> None:
     print(f"cores: {os.cpu_count()}, jobs: {args.jobs}, {kind} "
           f"at {args.res} x {args.res} x 3 lam; load average at start: "
           + ", ".join(f"{x:.2f}" for x in os.getloadavg()), flush=True)
-    sides = {"this": [], "other": []}
+    others = list(args.against or [])
+    sides: dict[str, list] = {"this": [], **{o: [] for o in others}}
     for rnd in range(args.rounds):
-        order = ["other", "this"] if args.against and rnd % 2 == 0 else ["this", "other"]
+        # alternate which tree goes first, round by round
+        order = list(sides) if rnd % 2 else list(sides)[::-1]
         for side in order:
-            if side == "other" and not args.against:
-                continue
             env = dict(os.environ)
-            if side == "other":
-                env["PYTHONPATH"] = args.against
+            if side != "this":
+                env["PYTHONPATH"] = side
             cmd = [sys.executable, str(Path(__file__)), *args.figures, "--res",
                    str(args.res), "--jobs", str(args.jobs), "--json"]
             cmd += ["--full"] if args.full else []
             cmd += ["--rules"] if args.rules and side == "this" else []
+            if args.classes:  # each tree's in a folder of its own
+                sub = Path(args.classes) / ("this" if side == "this"
+                                            else side.strip("/").replace("/", "_"))
+                sub.mkdir(parents=True, exist_ok=True)
+                cmd += ["--classes", str(sub)]
             load = os.getloadavg()[0]
             got = json.loads(subprocess.run(cmd, env=env, check=True, capture_output=True,
                                             text=True).stdout.strip().splitlines()[-1])
@@ -202,32 +212,37 @@ def main() -> None:
             print(f"round {rnd + 1} {side}: {wall:.1f} s wall for the figures "
                   f"(load average {load:.2f} -> {os.getloadavg()[0]:.2f})", flush=True)
     this = sides["this"]
-    other = sides["other"]
     print("| figure | RK4 evaluations | of them certification | computed | wall s (best) "
-          "| cpu s |"
-          + (" other's evaluations | ratio | other's wall s | ratio |" if other else ""))
-    tot = {"e": 0, "w": 0.0, "oe": 0, "ow": 0.0}
+          "| cpu s (best) |" + "".join(f" {o}: evaluations | ratio | wall s | ratio | cpu s "
+                                      "| ratio |" for o in others))
+    tot = {"e": 0, "w": 0.0, "c": 0.0, **{o: [0, 0.0, 0.0] for o in others}}
     for name in args.figures:
         e = this[0][name]["evals"]
         w = min(r[name]["wall"] for r in this)
         r = this[0][name]["refine"]
         share = (f"{r / 1e6:.1f}M ({e / (e - r):.3f}x the points' own)" if r >= 0
                  else "not counted")
+        c = min(r[name]["cpu"] for r in this)
         line = (f"| {name} | {e / 1e6:.1f}M | {share} | {this[0][name]['computed']} | "
-                f"{w:.2f} | {this[0][name]['cpu']:.1f} |")
+                f"{w:.2f} | {c:.1f} |")
         tot["e"] += e
         tot["w"] += w
-        if other:
-            oe = other[0][name]["evals"]
-            ow = min(r[name]["wall"] for r in other)
-            tot["oe"] += oe
-            tot["ow"] += ow
-            line += f" {oe / 1e6:.1f}M | {e / oe:.3f} | {ow:.2f} | {w / ow:.3f} |"
+        tot["c"] += c
+        for o in others:
+            oe = sides[o][0][name]["evals"]
+            ow = min(r[name]["wall"] for r in sides[o])
+            oc = min(r[name]["cpu"] for r in sides[o])
+            tot[o][0] += oe
+            tot[o][1] += ow
+            tot[o][2] += oc
+            line += (f" {oe / 1e6:.1f}M | {e / oe:.3f} | {ow:.2f} | {w / ow:.3f} | {oc:.1f} | "
+                     f"{c / oc:.3f} |")
         print(line)
-    if other:
-        print(f"| all four | {tot['e'] / 1e6:.1f}M | | | {tot['w']:.2f} | | "
-              f"{tot['oe'] / 1e6:.1f}M | {tot['e'] / tot['oe']:.3f} | {tot['ow']:.2f} | "
-              f"{tot['w'] / tot['ow']:.3f} |")
+    if others:
+        print(f"| all | {tot['e'] / 1e6:.1f}M | | | {tot['w']:.2f} | {tot['c']:.1f} |" + "".join(
+            f" {tot[o][0] / 1e6:.1f}M | {tot['e'] / tot[o][0]:.3f} | {tot[o][1]:.2f} | "
+            f"{tot['w'] / tot[o][1]:.3f} | {tot[o][2]:.1f} | {tot['c'] / tot[o][2]:.3f} |"
+            for o in others))
     if args.rules:
         for name in args.figures:
             t = this[0][name]["rules"]

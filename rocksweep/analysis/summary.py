@@ -329,19 +329,25 @@ def format_check(ck: dict) -> list[str]:
             f"{tail(ck['theta_max_rel_diff'], '')}"]
 
 
+def certification_share(n: int | None, evaluations: int) -> str:
+    """The certification's share of a file's RK4 evaluations (n of evaluations, regular +
+    event; None or < 0: not recorded), as ``rocksweep info`` and ``sweep`` say it."""
+    if n is None or n < 0:
+        return "its share of the steps not recorded (written before rocksweep counted it)"
+    own = evaluations - n
+    ratio = f", {evaluations / own:.3f}x the points' own" if own > 0 else ""
+    return f"{n} of them ({100 * n / max(1, evaluations):.1f}%{ratio})"
+
+
 def format_certification(c: dict, evaluations: int) -> str:
     """The line of ``rocksweep info`` on the certification's price (``certification_info``;
     evaluations: the file's RK4 evaluations, regular + event)."""
     pts = (f"{c['points_refined']} points refined (checked or re-run finer), "
            f"{c['points_uncertified']} uncertified")
-    n = c["refine_evaluations"]
-    if n is None:
-        return (f"  certification of close calls: {pts}; its share of the steps not recorded "
-                "(written before rocksweep counted it)")
-    own = evaluations - n
-    ratio = f", {evaluations / own:.3f}x the points' own" if own > 0 else ""
-    return (f"  certification of close calls: {n} of them ({100 * n / max(1, evaluations):.1f}%"
-            f"{ratio}); {pts}")
+    share = certification_share(c["refine_evaluations"], evaluations)
+    if c["refine_evaluations"] is None:
+        return f"  certification of close calls: {pts}; {share}"
+    return f"  certification of close calls: {share}; {pts}"
 
 
 def format_info(d: dict) -> list[str]:

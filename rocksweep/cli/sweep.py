@@ -142,7 +142,13 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
         sys.exit(130)
     if quiet:
         return
-    from rocksweep.analysis.summary import check_info, counts_lines, format_check, read_info
+    from rocksweep.analysis.summary import (
+        certification_share,
+        check_info,
+        counts_lines,
+        format_check,
+        read_info,
+    )
     from rocksweep.store.reader import read_result
 
     # one read of the file: with error estimates, what info reports on them too
@@ -181,6 +187,10 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     click.echo(f"accuracy: {scene.numerics.describe()}")
     click.echo(f"RK4 steps: {a['steps_total']} + {a['event_steps_total']} event "
                f"re-integrations (all points in the file)")
+    if scene.numerics.refine > 0:
+        share = certification_share(int(a.get("refine_evaluations", -1)),
+                                    int(a["steps_total"]) + int(a["event_steps_total"]))
+        click.echo(f"  certification of close calls: {share}")
     state = "complete" if a["complete"] else f"{a['points_done']} points done"
     click.echo(f"wrote {out} ({state})")
 

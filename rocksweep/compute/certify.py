@@ -13,7 +13,13 @@ when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the th
   halved, the step cap doubled), and again, until two consecutive runs give the same
   outcome and the finer one is no close call at its own step (its margins scale with the
   step, ``numerics.close_margin``: a knife edge repeats itself at every step it is a
-  close call at) or ``Numerics.refine`` refinements were made; the finest run is kept;
+  close call at) or ``Numerics.refine`` refinements were made; the finest run is kept.
+  A repeated overturn still inside the band at its own step is certified too where its
+  margin converged between the two runs (``converged``: the same fall, and the finer
+  squared margin, ~ the energy past the barrier, clear of Richardson's estimate of its
+  error) and a finer run would follow (at the last level the verdict is as before): most
+  of the knife-edge rule's reruns were overturns whose margin had already settled at
+  level 1, the coarse step's band being far wider than its error there;
 - a safe run between the close-call margin and the row's PAR_CLOSE (``numerics.
   close_band``, CLOSE_BAND times it: a near-miss, which turned back with a margin a
   coarse step's error can still reverse) is checked by a run at half the steps that stops
@@ -22,9 +28,10 @@ when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the th
   most of its steps. If the finer run overturns, the point is a close call as above (its
   full runs from the first refinement on); if not, the run's own result is kept.
 
-Only the runs near a threshold pay: on the paper's figures 5-17% more RK4 evaluations
-(``scripts/fingerprint.py diff``); within 0.5% of a threshold, where every run pays, the
-certified runs take ~2x the bare ones' (``scripts/threshold_sample.py``).
+Only the runs near a threshold pay: on the paper's figures' full grids 10-28% more RK4
+evaluations than the points' own, on their adaptive sweeps (almost only points near a
+boundary) 1.5-1.9x (``scripts/bench_certify.py``); within 0.5% of a threshold, where every
+run pays, the certified runs take 2.3-2.8x the bare ones' (``scripts/threshold_sample.py``).
 
 Every refined or checked point has STATUS_REFINED in its status; one whose outcome still
 changed at the last refinement, or which was still a close call there, also
@@ -45,7 +52,14 @@ import numpy as np
 
 from rocksweep.fields import CHECK_SCALE
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.numerics import CLOSE_AFTER, CLOSE_BAND, OVERTURN_BAND
+from rocksweep.numerics import (
+    CLOSE_AFTER,
+    CLOSE_BAND,
+    ENERGY_ORDER,
+    OVERTURN_BAND,
+    RICHARDSON_SAFETY,
+    SAME_FALL,
+)
 
 
 def _fell(outs: np.ndarray) -> np.ndarray:
@@ -65,6 +79,25 @@ def close_calls(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     overturned with one below OVERTURN_BAND times it."""
     bound = np.where(_fell(outs), OVERTURN_BAND, 1.0) * (rows[:, L.PAR_CLOSE] / CLOSE_BAND)
     return outs[:, L.OUT_MARGIN] < bound
+
+
+def converged(coarse_rows: np.ndarray, coarse: np.ndarray, fine_rows: np.ndarray,
+              fine: np.ndarray) -> np.ndarray:
+    """bool[n]: overturns whose margin has converged between two runs of the same points
+    (parameter rows float64[n, >= N_PAR] and result rows float64[n, N_OUT] of a run and of
+    its refinement at half the steps): both fell, within ``numerics.SAME_FALL`` [p t] of
+    each other (on the same approach), the finer one clear of its own step's close-call
+    margin (PAR_CLOSE / CLOSE_BAND), and its squared margin (~ |E - E_barrier|/E_ref) at
+    least RICHARDSON_SAFETY times Richardson's estimate of its error, |m_f^2 - m_c^2| /
+    (2^ENERGY_ORDER - 1): the class does not hang on the step."""
+    m_c, m_f = coarse[:, L.OUT_MARGIN], fine[:, L.OUT_MARGIN]
+    err = np.abs(m_f * m_f - m_c * m_c) / (2.0 ** ENERGY_ORDER - 1.0)
+    same_fall = (np.abs(fine[:, L.OUT_T_OVERTURN] - coarse[:, L.OUT_T_OVERTURN])
+                 <= SAME_FALL)
+    with np.errstate(invalid="ignore"):  # inf - inf: a margin never taken
+        return (_fell(coarse) & _fell(fine) & same_fall
+                & (m_f >= fine_rows[:, L.PAR_CLOSE] / CLOSE_BAND)
+                & (m_f * m_f >= RICHARDSON_SAFETY * err))
 
 
 def near_misses(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
@@ -121,13 +154,20 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
     for level in range(1, levels + 1):
         if idx.size == 0:
             break
-        spent_now = outs[idx][:, [L.OUT_STEPS, L.OUT_EVENT_STEPS, L.OUT_REFINE_EVALS]]
+        before = outs[idx]
+        spent_now = before[:, [L.OUT_STEPS, L.OUT_EVENT_STEPS, L.OUT_REFINE_EVALS]]
         finer = refine_rows(rows[idx], level)
         new = run(finer, idx)
         # the same outcome twice, and the finer run clear of the saddle by its own step's
-        # margin: a knife edge agrees with itself at every step it is a close call at
-        stable = ((new[:, L.OUT_OUTCOME] == outs[idx, L.OUT_OUTCOME])
-                  & ~close_calls(finer, new))
+        # margin (a knife edge agrees with itself at every step it is a close call at), or,
+        # where it spares a finer run, an overturn whose margin converged between the two:
+        # at the last level it would spare nothing, and its verdict stays as strict as
+        # before (knife edges whose margins settle at ~1e-4 alpha_ref still differ from
+        # `fine`'s finer event tolerance there)
+        close = close_calls(finer, new)
+        if level < levels:
+            close &= ~converged(refine_rows(rows[idx], level - 1), before, finer, new)
+        stable = (new[:, L.OUT_OUTCOME] == before[:, L.OUT_OUTCOME]) & ~close
         status = new[:, L.OUT_STATUS].astype(np.int64) | L.STATUS_REFINED
         new[:, L.OUT_STATUS] = status
         new[:, L.OUT_REFINE_EVALS] = spent_now[:, 2] + _evaluations(new)

@@ -52,6 +52,11 @@ def test_sweep_summary(ci_result):
     spp = PRESETS["default"].steps_per_period
     assert "points/s" in text and f"accuracy: default (steps_per_period={spp}" in text
     assert "RK4 steps:" in text
+    # the certification's share of the steps, as the file records it (``rocksweep info``)
+    with h5py.File(out, "r") as f:
+        n = int(f.attrs["refine_evaluations"])
+        total = int(f.attrs["steps_total"]) + int(f.attrs["event_steps_total"])
+    assert f"certification of close calls: {n} of them ({100 * n / total:.1f}%" in text
     # one summary row per (shape, lam)
     rows = [ln.split() for ln in text.splitlines() if ln.startswith(("sine", "cosine"))]
     assert [(r[0], float(r[1])) for r in rows] == [("sine", 0.0), ("sine", 0.4),

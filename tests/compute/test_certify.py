@@ -50,12 +50,22 @@ CASES = [
     (Point(FlexibleBody(wn_over_p=2.52, zeta=0.046, alpha_cg=0.173, alpha_A=0.213,
                         mA_over_m=0.82, IA_ratio=0.96), 0.229, "sine", 3.71, 3.8515),
      L.OUTCOME_MODE1),
+    # a held-out threshold sample's point (seed 3): `default` overturns in mode 1 at 5 and
+    # 10 steps a period (at 12.15 and 17.7 p t, margins 5.7 and 4.3 x the steps' close-call
+    # margins); 20 and 40 steps and the reference rock to rest after ~90 impacts. Its
+    # margins have not converged (the finer squared margin is 0.55 x Richardson's estimate
+    # of its error even at order 5), nor did it fall on the same approach twice
+    (Point(FlexibleBody(wn_over_p=4.2221, zeta=0.02553, alpha_cg=0.29953, alpha_A=0.19599,
+                        mA_over_m=0.31736, IA_ratio=0.84879), 0.36736, "cosine", 4.2632,
+           8.7676),
+     L.OUTCOME_SAFE),
 ]
 
 
 @pytest.mark.parametrize("point,expected", CASES,
                          ids=["block-10.9", "block-11.35", "fig3b-5.47", "fig3b-5.66",
-                              "flexible-overturn-side", "flexible-safe-side"])
+                              "flexible-overturn-side", "flexible-safe-side",
+                              "flexible-overturn-unconverged"])
 def test_default_classifies_the_reproduced_cases_like_the_reference(point, expected):
     """The reference's outcome is the one written here; `default` (sweep kernel and simulate) gives
     the same. Before the step rule, `default` gave safe / mode 1 here."""
@@ -211,6 +221,54 @@ def test_a_knife_edge_is_refined_until_clear_or_flagged():
     assert st[0] & L.STATUS_UNCERTIFIED and st[0] & L.STATUS_FLAGGED
     assert st[1] & L.STATUS_REFINED and not st[1] & L.STATUS_UNCERTIFIED
     assert (outs[:, L.OUT_OUTCOME] == L.OUTCOME_SAFE).all()
+
+
+def test_a_repeated_overturn_whose_margin_converged_stops_there():
+    """certify's rule on a stand-in kernel: a repeated overturn still inside the overturn
+    band at its own step is certified where its margins converged between the two runs
+    (the same fall, within SAME_FALL; the finer squared margin at least RICHARDSON_SAFETY
+    times |m_f^2 - m_c^2| / (2^ENERGY_ORDER - 1); the finer margin clear of its own step's
+    close-call margin) and a finer run would follow, not otherwise; a safe run's converged
+    margin certifies nothing."""
+    # close-call margin b_L = 0.01 x 2^(-2.5 L): 0.01, 0.00177, 0.000313, 5.5e-5
+    rows = np.zeros((6, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = 0.04
+    rows[:, L.PAR_DT] = 1.0
+    fell, safe = L.OUTCOME_MODE1, L.OUTCOME_SAFE
+    # per point and level 0..3: (outcome, margin, overturning time)
+    ladder = {
+        # converged at level 1: 0.0105^2 = 1.1e-4 >= 2 x |1.1e-4 - 4e-4| / 15 = 3.9e-5
+        0: [(fell, 0.02, 10.0), (fell, 0.0105, 10.01)],
+        # the same margins, but the finer run fell 2 p t later: another approach
+        1: [(fell, 0.02, 10.0), (fell, 0.0105, 12.0), (fell, 0.0104, 12.0)],
+        # level 1's margin is mostly the coarse step's error (it fell by 10x): one more
+        2: [(fell, 0.05, 10.0), (fell, 0.005, 10.0), (fell, 0.0049, 10.0)],
+        # converged, but below the finer step's own close-call margin (0.00177)
+        3: [(fell, 0.0012, 10.0), (fell, 0.0012, 10.0), (fell, 0.0012, 10.0)],
+        # safe with converged margins below its close-call margin: the rule as before
+        4: [(safe, 0.0016, np.nan), (safe, 0.0015, np.nan), (safe, 0.0015, np.nan)],
+        # converged only at the last level, still inside the band there (8 x 5.5e-5):
+        # it would spare no run, and the verdict stays as before: uncertified
+        5: [(fell, 0.05, 10.0), (fell, 0.005, 10.0), (fell, 3e-4, 10.0), (fell, 3e-4, 10.0)],
+    }
+    outs = np.zeros((6, L.N_OUT))
+    for i, steps in ladder.items():
+        outs[i, [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN]] = steps[0]
+    levels_run = {i: [] for i in ladder}
+
+    def run(sub, idx, keep=True):
+        res = np.zeros((len(idx), L.N_OUT))
+        level = round(-np.log2(sub[0, L.PAR_DT]))
+        for j, i in enumerate(idx):
+            levels_run[int(i)].append(level)
+            res[j, [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN]] = ladder[int(i)][level]
+        return res
+
+    certify(rows, outs, run, 3)
+    assert levels_run == {0: [1], 1: [1, 2], 2: [1, 2], 3: [1, 2], 4: [1, 2], 5: [1, 2, 3]}
+    st = outs[:, L.OUT_STATUS].astype(int)
+    assert (st & L.STATUS_REFINED).all() and not (st[:5] & L.STATUS_UNCERTIFIED).any()
+    assert st[5] & L.STATUS_UNCERTIFIED
 
 
 SCENE = """
