@@ -432,6 +432,7 @@ def routh(v0, jxn, jyn, alpha, beta, mu, mu_s, v_rest):
     settling rule of x', which ends a Zeno sequence of ever smaller slips between impacts
     as the rest rate ends one of ever smaller rotations.
     """
+    mu_s = max(mu_s, mu)  # (a scene's mu_s >= mu; kept so whatever the caller passes)
     d = alpha * jyn - beta * jxn
     if not (jyn > 0.0 and d > 0.0):  # the law needs no push from the ground: frictionless
         return -jxn / alpha, NO_PUSH, 0.0
