@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 from helpers import docstring_ids
 
-from rocksweep.vocab import axes, ground, laws, outcomes, settings
+from rocksweep.vocab import axes, ground, laws, outcomes, phases, settings
 
 PKG = Path(__file__).resolve().parents[1] / "rocksweep"
 
@@ -35,6 +35,7 @@ FAMILIES: dict[str, tuple[str, ...]] = {
     "accuracy ladders": settings.LADDER_NAMES,
     "alpha_ref keys": axes.ALPHA_KEYS,
     "alpha_ref LaTeX": tuple(tex for _, tex in axes.ALPHA_REF.values()),
+    "contact phases": phases.PHASES,
 }
 # Concepts whose values (not names) live elsewhere, keyed by the vocabulary's names: the
 # one dict literal allowed, checked to hold exactly the vocabulary's names below.
@@ -132,6 +133,11 @@ def test_kernel_codes_are_the_vocabulary_codes():
     assert [L.ROOT_BISECT, L.ROOT_ILLINOIS, L.ROOT_HERMITE] == [settings.ROOT_CODE[w]
                                                                 for w in settings.ROOTS]
     assert len(set(settings.ROOT_CODE.values())) == len(settings.ROOT_CODE)
+    from rocksweep.kernel import sliding
+
+    # a phase's code is 2 (rocking) + 1 (slipping) of its corner s and slip sigma
+    assert [sliding.phase_code(s, sg) for s, sg in ((0, 0), (0, 1), (1, 0), (-1, -1))] == [
+        phases.PHASE_CODE[w] for w in phases.PHASES]
     # codes distinct, status bits one bit each
     assert len(set(ground.SHAPE_CODE.values())) == len(ground.SHAPE_CODE)
     assert all(b & (b - 1) == 0 for b in outcomes.STATUS_BIT.values())

@@ -19,7 +19,7 @@ from rocksweep.physics.points import Point
 from rocksweep.physics.records import GroundRecord, vertical_samples
 from rocksweep.physics.suite import Suite
 from rocksweep.physics.vertical import VerticalHarmonic
-from rocksweep.schema import KEYS
+from rocksweep.schema import FRICTION_KEYS, KEYS
 from rocksweep.vocab.axes import INITIAL
 from rocksweep.vocab.ground import FREE, PAPER_SHAPES, RECORD, pulse_duration
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
@@ -205,11 +205,15 @@ class Scene:
         return math.prod(self.shape)
 
     def body_axes(self) -> tuple[Axis, ...]:
-        """The axes that make the body (body.mu is the ground's, not the body's)."""
-        return tuple(a for a in self.axes if a.key.startswith("body.") and a.key != "body.mu")
+        """The axes that make the body (body.mu, body.mu_static are the ground's, not the
+        body's: ``schema.FRICTION_KEYS``)."""
+        return tuple(a for a in self.axes if a.key.startswith("body.")
+                     and a.key[5:] not in FRICTION_KEYS)
 
     def make_body(self, **values: float) -> Body:
-        """A body from values of the body keys (as in ``body_axes``)."""
+        """A body from values of the body keys (as in ``body_axes``; friction keys among
+        them are the ground's and left out)."""
+        values = {k: v for k, v in values.items() if k not in FRICTION_KEYS}
         if self.kind == "block":
             return BlockBody(**values)
         return FlexibleBody(**values)
