@@ -91,6 +91,11 @@ PHASE_SLIDE_ROCK = _phases.PHASE_CODE[_phases.SLIDE_ROCK]
 JAM = 1
 NO_PUSH = 2
 SLIP_SETTLED = 4
+LIFT_OFF = 8  # N <= 0 while rocking: the corner held as in the no-slip model (flagged)
+# Relative round-off allowed where a sliding body's uplift moment equals M g b: a rigid
+# body sliding at mu = tan(alpha_cg) exactly has Q = M g b for good (it slides, the normal
+# force at its leading corner, theta'' = 0), which float64 may miss by an ulp or two
+TIP_ROUNDOFF = 1e-12
 
 
 @njit(cache=True, **INLINE)
@@ -236,13 +241,16 @@ def choose_phase(theta, theta_dot, u, u_dot, s, xg, g, mu, mu_s, prm, FLEX, DAMP
       rest        |H| <= mu_s N and s' Q < M g b for both corners s' (today's uplift rule);
       rock s'     s' Q >= M g b (the body tips onto s'), N > 0, |H| <= mu_s N on s';
       slide sg    sg x'' > 0 (friction mu N cannot hold it), no uplift while sliding
-                  (|Q| < M g b under the slip's acceleration, ``slide_uplift_moment``);
+                  (|Q| <= M g b under the slip's acceleration, ``slide_uplift_moment``:
+                  at equality it slides with theta'' = 0, TIP_ROUNDOFF);
       slide-rock  (s', sg): sg x'' > 0, s' Q >= M g b under the slip's acceleration,
                   N > 0, den > 0 (``slip_state``).
     s != 0 (rocking on s): rock if |H| <= mu_s N, else slide-rock in the direction whose
-    x'' agrees (sg = -sign(H)).
+    x'' agrees (sg = -sign(H)) with N > 0.
     flag: 0, or JAM where no phase is consistent (Painleve: the contact is stuck by a
-    tangential impulse: rock on the corner the body tips to, or stays on). The stuck
+    tangential impulse: rock on the corner the body tips to, or stays on), or LIFT_OFF
+    where N <= 0 while rocking (the ground would have to pull: outside the model; the
+    corner is held as the no-slip model holds it, and flagged as it is). The stuck
     phases come first: static friction holds while it can (with mu_s > mu a base at rest
     may be consistent both stuck and slipping; it stays stuck).
     """
@@ -250,10 +258,12 @@ def choose_phase(theta, theta_dot, u, u_dot, s, xg, g, mu, mu_s, prm, FLEX, DAMP
         h, n = ground_reactions(theta, theta_dot, u, u_dot, s, xg, g, prm, FLEX, DAMPED)
         if abs(h) <= mu_s * n:
             return s, 0, 0
+        if not n > 0.0:  # the ground would have to pull: outside the model, held
+            return s, 0, LIFT_OFF
         for sg in (1, -1):
             x_dd, n2, den = slip_state(theta, theta_dot, u, u_dot, s, sg, xg, g, mu, prm,
                                        FLEX, DAMPED)
-            if den > 0.0 and sg * x_dd > 0.0:
+            if den > 0.0 and n2 > 0.0 and sg * x_dd > 0.0:
                 return s, sg, 0
         return s, 0, JAM
     mgb = tip_moment(g, prm)
@@ -269,7 +279,7 @@ def choose_phase(theta, theta_dot, u, u_dot, s, xg, g, mu, mu_s, prm, FLEX, DAMP
     for sg in (1, -1):
         x_dd, n, den = slip_state(0.0, 0.0, u, u_dot, 0, sg, xg, g, mu, prm, FLEX, DAMPED)
         if sg * x_dd > 0.0 and abs(uplift_moment(u, u_dot, xg + x_dd, g, prm, FLEX,
-                                                 DAMPED)) < mgb:
+                                                 DAMPED)) <= mgb * (1.0 + TIP_ROUNDOFF):
             return 0, sg, 0
     for sc in (1, -1):
         for sg in (1, -1):

@@ -18,7 +18,8 @@ tan alpha_cg, a = |A|):
     rest         a <= mu_s g  and  a < g t
     rock         a >= g t  and
                  a (I_G + M b^2 - mu_s M b h_cg) <= g (mu_s (I_G + M h_cg^2) - M b h_cg)
-    slide        mu < t                       (a > mu g holds once rest fails)
+    slide        mu <= t                      (a > mu g holds once rest fails; at
+                                              mu = t it slides with theta'' = 0)
     slide-rock   mu > t, den = I_G + M b^2 - mu M b h_cg > 0 and a > A_r(mu),
                  A_r(mu) = g (mu (I_G + M h_cg^2) - M b h_cg) / den
 
@@ -77,7 +78,7 @@ def _onset_rigid(body: Body, A: float, mu: float, mu_s: float) -> tuple[str, int
     if a >= G * t and a * (i_g + M * b * b - mu_s * M * b * h) <= G * (
             mu_s * (i_g + M * h * h) - M * b * h):
         return ROCK, d, 0
-    if mu < t:
+    if mu <= t:  # (at mu = t it slides, the normal force at its leading corner)
         return SLIDE, 0, d
     a_r, den = rock_threshold(body, mu)
     if mu > t and den > 0 and a > a_r:

@@ -178,11 +178,11 @@ def choose(body: _Body, t, y, s: int, xg: float, g: float, mu: float, mu_s: floa
     """(s, sigma, jam) consistent with the forces where x' = 0 (module docstring)."""
     if s != 0:
         _, force, big_n, _, _ = _Phase(body, s, 0, mu).solve(t, y, xg, g)
-        if abs(force) <= mu_s * big_n:
+        if abs(force) <= mu_s * big_n or big_n <= 0:  # (N <= 0: held, as no-slip)
             return s, 0, False
         for sg in (1, -1):
-            qdd, _, _, den, _ = _Phase(body, s, sg, mu).solve(t, y, xg, g)
-            if den > 0 and sg * qdd[_X] > 0:
+            qdd, _, big_n, den, _ = _Phase(body, s, sg, mu).solve(t, y, xg, g)
+            if den > 0 and big_n > 0 and sg * qdd[_X] > 0:
                 return s, sg, False
         return s, 0, True
     rest = _Phase(body, 0, 0, mu)
@@ -199,7 +199,8 @@ def choose(body: _Body, t, y, s: int, xg: float, g: float, mu: float, mu_s: floa
         ph = _Phase(body, 0, sg, mu)
         qdd, _, _, _, mp = ph.solve(t, y, xg, g, corner=1)
         mm = ph.solve(t, y, xg, g, corner=-1)[4]
-        if sg * qdd[_X] > 0 and mp > 0 and -mm > 0:
+        tol = 1e-12 * body.M * g * body.b  # (mu = tan alpha: slides, theta'' = 0)
+        if sg * qdd[_X] > 0 and mp > -tol and -mm > -tol:
             return 0, sg, False
     for c in (1, -1):
         for sg in (1, -1):

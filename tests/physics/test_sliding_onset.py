@@ -101,3 +101,30 @@ def test_reference_enters_the_same_phase(body):
             s, sigma, jam = ref.choose(rb, 0.0, y, 0, a * G, G, mu, mu)
             word = friction.JAM if jam else PHASES[(2 if s else 0) + (1 if sigma else 0)]
             assert (word, s, sigma) == friction.onset(body, a * G, mu), (mu, a)
+
+
+@pytest.mark.parametrize("alpha", [0.15, 0.3])
+def test_mu_exactly_tan_alpha_slides(alpha):
+    """mu = tan(alpha) exactly: a sliding rigid body's uplift moment is M g b for good
+    (the normal force at its leading corner, theta'' = 0): it slides, in the closed form
+    and in the kernel (float64's ulp at the equality allowed for)."""
+    blk = BlockBody(alpha=alpha)
+    row = _row(blk)
+    mu = math.tan(alpha)
+    for a in (1.2, 2.0, -1.5):
+        want = friction.onset(blk, a * mu * G, mu)
+        assert want == ("slide", 0, -1 if a > 0 else 1)
+        assert _kernel_word(blk, row, a * mu * G, mu, mu) == want
+
+
+def test_a_rocking_body_the_ground_would_have_to_pull_is_held():
+    """N <= 0 while rocking (spun fast enough): no friction can act; the corner is held as
+    the no-slip model holds it, flagged LIFT_OFF (outside the model, as lifts_off)."""
+    blk = BlockBody(alpha=0.2)
+    row = _row(blk)
+    s, sigma, flag = sliding.choose_phase(0.1, 4.0, 0.0, 0.0, 1, 0.0, G, 0.3, 0.3, row,
+                                          False, False)
+    from rocksweep.kernel import contact
+
+    assert contact.ground_reactions(0.1, 4.0, 0.0, 0.0, 1, 0.0, G, row, False, False)[1] < 0
+    assert (s, sigma, flag) == (1, 0, sliding.LIFT_OFF)
