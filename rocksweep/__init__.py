@@ -16,8 +16,9 @@ The Python API (see the README's "Python API"):
   curves of a record-suite sweep; ``rocksweep.risk(fr, hazard, years=50)`` -> Dataset of
   the annual rate and probability of each state over a hazard curve;
   ``rocksweep.im_efficiency(ds)`` -> Dataset of the dispersion of a suite's fragility in
-  every IM (which IM explains overturning best); ``rocksweep.table(ds)`` -> DataFrame, one
-  row per run.
+  every IM (which IM explains overturning best); ``rocksweep.floor_spectrum(ds)`` ->
+  Dataset of the response against a building's period; ``rocksweep.table(ds)`` ->
+  DataFrame, one row per run.
   Each analysis takes what ``run`` and ``open`` return.
 - ``rocksweep.calibrate(scene, measured, fit=["impact.lam"], bounds=)`` -> Dataset of the
   fitted keys (estimate, lo, hi, misfit) of a measured history;
@@ -25,40 +26,56 @@ The Python API (see the README's "Python API"):
   and the interval's ends.
 - ``rocksweep.RocksweepError``: the base of every error a user can fix (one line).
 
-Importing the package is light: numba, h5py, xarray and matplotlib load on first use.
-``ds.rocksweep`` (``rocksweep.api.RocksweepAccessor``) is there after ``import xarray,
-rocksweep``, and after any call of the API.
+Importing the package is light: the functions above are ``rocksweep.api``'s, loaded on
+first use (as SciPy's subpackages, PEP 562), and numba, h5py, xarray and matplotlib load
+when a function needs them: the command line's start-up pays for none of them.
+``ds.rocksweep`` (``rocksweep.accessor``: every analysis above as a method) is there as soon
+as both rocksweep and xarray are imported, in either order.
 """
 
 from __future__ import annotations
 
-from rocksweep.api import (  # noqa: A004
-    boundaries,
-    boundary_lines,
-    calibrate,
-    calibrated_overrides,
-    estimate,
-    floor_spectrum,
-    fragility,
-    ida,
-    im_efficiency,
-    open,
-    plot,
-    register_accessor,
-    risk,
-    run,
-    simulate,
-    spectra,
-    table,
-)
-from rocksweep.errors import RocksweepError
-from rocksweep.simulation import Simulation
+import importlib
+from typing import TYPE_CHECKING
 
-register_accessor()  # ds.rocksweep, if xarray is already imported (it is never imported here)
+from rocksweep.accessor import watch
+from rocksweep.errors import RocksweepError
+
+if TYPE_CHECKING:  # what __getattr__ gives, for type checkers and editors
+    from rocksweep.api import (  # noqa: A004
+        boundaries,
+        boundary_lines,
+        calibrate,
+        calibrated_overrides,
+        estimate,
+        felt_motion,
+        floor_spectrum,
+        fragility,
+        ida,
+        im_efficiency,
+        open,
+        plot,
+        risk,
+        run,
+        simulate,
+        spectra,
+        table,
+    )
+    from rocksweep.simulation import Simulation
+
+__all__ = ["RocksweepError", "Simulation", "__version__", "boundaries", "boundary_lines",
+           "calibrate", "calibrated_overrides", "estimate", "felt_motion", "floor_spectrum",
+           "fragility", "ida", "im_efficiency", "open", "plot", "risk", "run", "simulate",
+           "spectra", "table"]
+#: ``rocksweep.api``'s names (the functions, and ``Simulation``, what simulate returns)
+_API = frozenset(__all__) - {"RocksweepError", "__version__"}
+
+watch()  # ds.rocksweep once xarray is imported (it is never imported here)
 
 
 def _version() -> str:
     """The installed distribution's version; from pyproject.toml in a source tree."""
+    # importlib.metadata: ~20 ms, for --version alone
     from importlib.metadata import PackageNotFoundError, version
 
     try:
@@ -75,15 +92,28 @@ def _version() -> str:
         return f"{m.group(1)}+source" if m else "0+unknown"
 
 
-def __getattr__(name: str) -> str:
-    """``__version__`` on first use (importlib.metadata costs ~20 ms of every command)."""
-    if name == "__version__":
-        global __version__
-        __version__ = _version()
-        return __version__
-    raise AttributeError(f"module 'rocksweep' has no attribute {name!r}")
+def __getattr__(name: str) -> object:
+    """The API's functions and ``Simulation`` on first use (``rocksweep.api``: ~25 kB of
+    source the command line's start-up need not compile), the modules ``import rocksweep``
+    used to load (``rocksweep.api``, ...), and ``__version__``
+    (importlib.metadata costs ~20 ms of every command)."""
+    if name == "Simulation":
+        from rocksweep import simulation
+
+        value = simulation.Simulation
+    elif name in ("api", "simulation", "analysis"):  # bound by import rocksweep before
+        value = importlib.import_module(f"rocksweep.{name}")
+    elif name in _API:
+        from rocksweep import api
+
+        value = getattr(api, name)
+    elif name == "__version__":
+        value = _version()
+    else:
+        raise AttributeError(f"module 'rocksweep' has no attribute {name!r}")
+    globals()[name] = value
+    return value
 
 
-__all__ = ["RocksweepError", "Simulation", "__version__", "boundaries", "boundary_lines",
-           "calibrate", "calibrated_overrides", "estimate", "floor_spectrum", "fragility",
-           "ida", "im_efficiency", "open", "plot", "risk", "run", "simulate", "spectra", "table"]
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

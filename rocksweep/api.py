@@ -3,24 +3,31 @@ and the analyses of a Dataset. Each function hands over to the room that does th
 and checks its arguments: scenes (``rocksweep.scene.inputs``), the sweep session
 (``rocksweep.compute.session``), a result as a Dataset (``rocksweep.store.dataset``), a
 run's history (``rocksweep.compute.history``), the analyses (``rocksweep.analysis``), the
-figures (``rocksweep.figures``), ``ds.rocksweep`` (``RocksweepAccessor``, at the end). Errors name
-the API's arguments (``rocksweep.errors.Arg``).
+figures (``rocksweep.figures``). Errors name the API's arguments (``rocksweep.errors.Arg``).
+The functions of a Dataset (``@analysis``: ``ANALYSES``) are also its methods,
+``ds.rocksweep.<analysis>(...)`` (``rocksweep.accessor``).
 
-Nothing heavy is imported here at module level (numba, h5py, xarray, matplotlib load
-inside the functions), so ``import rocksweep`` stays light. The names the API builds on
-are imported from their homes (``rocksweep.compute.session.sweep_file``, ...), not from here.
+Each function imports its room when called: the rooms load numba, h5py, xarray, scipy and
+matplotlib, 0.1-2 s each (docs/performance.md, the command line's imports), and one
+function needs a few of them. The names
+the API builds on are imported from their homes (``rocksweep.compute.session.sweep_file``,
+...), not from here.
 """
 
 from __future__ import annotations
 
-import functools
+import os
 import sys
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from rocksweep.accessor import accessor_class
 from rocksweep.analysis.resampling import DEFAULT_CI, DEFAULT_SEED
-from rocksweep.errors import ApiError
+from rocksweep.analysis.tolerance import DEFAULT_RTOL, DEFAULT_RTOL_MANY
+from rocksweep.compute.arguments import check_flag
+from rocksweep.errors import ApiError, check_type, is_integer, is_real
+from rocksweep.outputs import shown
 from rocksweep.simulation import Simulation  # what simulate returns
 
 if TYPE_CHECKING:
@@ -29,24 +36,26 @@ if TYPE_CHECKING:
 
     from rocksweep.scene.inputs import Overrides, SceneLike
 
+#: the functions whose first argument is a Dataset (or its file), in the order
+#: ``ds.rocksweep`` lists them as methods (``rocksweep.accessor``)
+ANALYSES: list[Callable[..., Any]] = []
 
-def _public(fn: Callable[..., Any]) -> Callable[..., Any]:
-    """A function of the API: ``ds.rocksweep`` registered after every call (once xarray is
-    loaded: the Datasets it returns have the accessor, whatever was called first)."""
 
-    @functools.wraps(fn)
-    def call(*args: Any, **kwargs: Any) -> Any:
-        try:
-            return fn(*args, **kwargs)
-        finally:
-            register_accessor()
+def analysis(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """Mark a function of a Dataset: ``ds.rocksweep.<name>(...)`` is ``<name>(ds, ...)``."""
+    ANALYSES.append(fn)
+    return fn
 
-    return call
+
+def __getattr__(name: str) -> Any:
+    """``RocksweepAccessor``: ``ds.rocksweep``'s class, made on first use."""
+    if name == "RocksweepAccessor":
+        return accessor_class()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 # --- rocksweep.run and rocksweep.open ----------------------------------------------------
 
-@_public
 def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
         overrides: Overrides = (), progress: bool = False, overwrite: bool = False,
         resume: bool = False, client: Any = None, adaptive: bool = False,
@@ -89,16 +98,14 @@ def run(scene: SceneLike, *, jobs: int = 1, output: str | Path | None = None,
     """
     from rocksweep.compute.session import run_session  # checks every argument first
 
-    out = run_session(scene, output, overrides=overrides, jobs=jobs, resume=resume,
-                      overwrite=overwrite, progress=progress, client=client,
-                      adaptive=adaptive, validate=validate,
-                      settings={"coarse": coarse, "audit": audit, "axes": axes,
-                                "margin": margin, "final_margin": final_margin,
-                                "seed": seed, "threshold": threshold})
-    return out
+    return run_session(scene, output, overrides=overrides, jobs=jobs, resume=resume,
+                       overwrite=overwrite, progress=progress, client=client,
+                       adaptive=adaptive, validate=validate,
+                       settings={"coarse": coarse, "audit": audit, "axes": axes,
+                                 "margin": margin, "final_margin": final_margin,
+                                 "seed": seed, "threshold": threshold})
 
 
-@_public
 def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xarray's)
     """Any file rocksweep writes as an xarray Dataset, loaded in memory (the file is
     closed): a sweep result, or what an analysis wrote (fragility, risk, IM efficiency,
@@ -115,84 +122,32 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
     while a sweep is still writing the file (no lock is taken). A file that is not a
     rocksweep file is a one-line ``RocksweepError``.
     """
-    import os
-
     from rocksweep.analysis.files import open_any
 
-    _typed("path", path, isinstance(path, str | os.PathLike), "a path (str or pathlib.Path)")
+    check_type("path", path, isinstance(path, str | os.PathLike),
+               "a path (str or pathlib.Path)")
     return open_any(path)
 
 
 def _dataset_arg(ds: Any, what: str) -> xr.Dataset:
-    """A Dataset, or a path to one (``analysis.files.as_dataset``), with ``ds.rocksweep``."""
+    """A Dataset, or a path to one opened (``analysis.files.as_dataset``)."""
     from rocksweep.analysis.files import as_dataset
 
     _check_dataset(what, ds)
     return as_dataset(ds, what)
 
 
-def _typed(name: str, value: Any, ok: bool, allowed: str) -> None:
-    """The API's one type check of an argument: a one-line TypeError naming it, the value
-    (shortened) and what is allowed, unless ``ok``."""
-    if not ok:
-        text = repr(value)
-        text = text if len(text) <= 60 else f"{text[:40]}...{text[-12:]}"
-        raise TypeError(f"{name} = {text}: must be {allowed}")
-
-
-def _is_int(v: Any) -> bool:
-    """An integer, not a bool (True is no row number)."""
-    import numbers
-
-    return isinstance(v, numbers.Integral) and not isinstance(v, bool)
-
-
-def _is_number(v: Any) -> bool:
-    """A real number, not a bool."""
-    import numbers
-
-    return isinstance(v, numbers.Real) and not isinstance(v, bool)
-
-
 def _check_dataset(name: str, ds: Any) -> None:
     import xarray as xr
 
-    _typed(name, ds, isinstance(ds, xr.Dataset | str | Path),
-           "an xarray Dataset (rocksweep.run, rocksweep.open or an analysis) or a path to "
-           "one")
-
-
-def _check_optional_text(**given: Any) -> None:
-    for name, v in given.items():
-        _typed(name, v, v is None or isinstance(v, str), "a string or None")
-
-
-def _check_flags(**given: Any) -> None:
-    import numpy as np
-
-    for name, v in given.items():
-        _typed(name, v, isinstance(v, bool | np.bool_), "True or False")
-
-
-def _check_ax(ax: Any) -> None:
-    """None, a matplotlib Axes or a sequence (list, array) of them."""
-    if ax is None:
-        return
-    from matplotlib.axes import Axes
-
-    if isinstance(ax, Axes):
-        return
-    import numpy as np
-
-    items = list(np.ravel(np.asarray(ax, dtype=object))) if isinstance(
-        ax, list | tuple | np.ndarray) else None
-    _typed("ax", ax, bool(items) and all(isinstance(a, Axes) for a in items),
-           "a matplotlib Axes, a sequence of them (one per panel) or None")
+    check_type(name, ds, isinstance(ds, xr.Dataset | str | Path),
+               "an xarray Dataset (rocksweep.run, rocksweep.open or an analysis) or a path "
+               "to one")
 
 
 # --- Analyses: a result Dataset in, a Dataset, a DataFrame or a Figure out ---------------
 
-@_public
+@analysis
 def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any = None,
          curves: bool = False, show_computed: bool = False, mu: bool = False,
          width: str | None = None, compare: str | None = None) -> Figure:
@@ -218,19 +173,12 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     from rocksweep.figures.by_kind import plot_any
 
     _check_dataset("ds", ds)
-    _check_ax(ax)
-    _check_optional_text(x=x, y=y, compare=compare, width=width)
-    _check_flags(curves=curves, show_computed=show_computed, mu=mu)
-    if isinstance(ds, str | Path):
-        from rocksweep.analysis.files import open_any
-
-        ds = open_any(ds)
     return plot_any(ds, x, y, ax=ax, curves=curves, show_computed=show_computed, mu=mu,
                     width=width, compare=compare)
 
 
-@_public
-def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None,
+@analysis
+def boundaries(ds: xr.Dataset, rtol: float = DEFAULT_RTOL, mode: int | None = None,
                search: bool = True) -> xr.Dataset:
     """A_min: the smallest amplitude (A_ratio) that overturns, for every x (w_over_p or
     p) of the diagram to the relative tolerance ``rtol`` (in (0, 0.1]), whatever the grid's
@@ -253,7 +201,7 @@ def boundaries(ds: xr.Dataset, rtol: float = 1e-3, mode: int | None = None,
     return boundaries_dataset(ds, rtol, mode, search)
 
 
-@_public
+@analysis
 def boundary_lines(ds: xr.Dataset) -> Any:
     """The lines between classes of a complete result's diagrams as a tidy
     ``pandas.DataFrame``: one row per vertex with the panel's other swept keys, ``line``,
@@ -264,8 +212,8 @@ def boundary_lines(ds: xr.Dataset) -> Any:
     return boundary_lines_frame(ds)
 
 
-@_public
-def spectra(ds: xr.Dataset, rtol: float = 1e-3, search: bool = True) -> xr.Dataset:
+@analysis
+def spectra(ds: xr.Dataset, rtol: float = DEFAULT_RTOL, search: bool = True) -> xr.Dataset:
     """Rocking and overturning spectra of a complete sweep over p (a record) or w_over_p,
     A_ratio and optionally lam: ``theta_max_over_alpha`` and ``outcome`` over (lam,
     A_ratio, p), ``A_min`` and ``mode`` over (lam, p), A_min to ``rtol`` whatever the grid
@@ -276,20 +224,24 @@ def spectra(ds: xr.Dataset, rtol: float = 1e-3, search: bool = True) -> xr.Datas
     return compute_spectra(ds, rtol, search).to_dataset()
 
 
-@_public
-def floor_spectrum(ds: xr.Dataset, rtol: float = 1e-2, search: bool = True) -> xr.Dataset:
+@analysis
+def floor_spectrum(ds: xr.Dataset, rtol: float = DEFAULT_RTOL_MANY, search: bool = True
+                   ) -> xr.Dataset:
     """The floor spectrum of a complete sweep over ``floor.period``: a record suite's
     P(overturn) over (floor.period, stripe, ...) (with an ``angle`` axis for each
     orientation answer: ``orientation`` each/worst), or one record's or a pulse's A_min
-    over floor.period, bisected to ``rtol`` (``rocksweep.analysis.floors``). Its figure:
-    ``rocksweep.plot``."""
+    over floor.period, bisected to ``rtol`` (in (0, 0.1]; search=False: the grid's bracket
+    only, as for ``spectra``) (``rocksweep.analysis.floors``). ds: what ``run`` or ``open``
+    returns, or a result file's path. Its figure: ``rocksweep.plot``; its table:
+    ``rocksweep.table``."""
     from rocksweep.analysis.floors import floor_spectrum as compute
 
+    _check_dataset("ds", ds)
     return compute(ds, rtol, search)
 
 
-@_public
-def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
+@analysis
+def ida(ds: xr.Dataset, rtol: float = DEFAULT_RTOL_MANY) -> xr.Dataset:
     """Incremental dynamic analysis per record of a scaled record-suite sweep: the
     smallest IM (the stripe IM: PGA [g], PGV [m/s], Sa [g], ...) that overturns each
     record, bisected to ``rtol`` between the last stripe below the first overturning one
@@ -307,7 +259,7 @@ def ida(ds: xr.Dataset, rtol: float = 1e-2) -> xr.Dataset:
     return worst_ida(ida_dataset(ds, rtol))
 
 
-@_public
+@analysis
 def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
               im: str | None = None, period: float | None = None,
               bootstrap: int | None = None, seed: int = DEFAULT_SEED,
@@ -337,8 +289,9 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     ``n_records``, ``n_excluded``, ``n_not_run``, the fitted ``curve`` and its bands over
     ``im_grid``; for stripes ``fraction`` per stripe and ``first_level``,
     ``resurrection`` per record. A sweep over ``angle`` gives both answers along an
-    ``orientation`` dimension: "each" (every (record, angle) a sample) and "worst" (the
-    worst angle per record: overturns at any angle).
+    ``orientation`` dimension: "each" (every (record, angle) a sample, pooled; records
+    counted and resampled with all their angles) and "worst" (the worst angle per record:
+    overturns at any angle).
     """
     from rocksweep.analysis.floors import by_orientation
     from rocksweep.analysis.fragility import fragility as fit
@@ -352,7 +305,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
                joint=joint)
 
 
-@_public
+@analysis
 def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = None
          ) -> xr.Dataset:
     """Mean annual rate and probability in ``years`` of each state of a fragility:
@@ -363,21 +316,19 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = N
     ``probability`` per state and lam, their ``_lo``/``_hi`` from the fragility's
     bootstrap resamples, ``annual_rate_max`` (the tail above the hazard at its largest),
     ``reason``; beyond the hazard's range the rate is bounded, never extrapolated."""
+    from rocksweep.analysis.risk import check_fragility
     from rocksweep.analysis.risk import risk as compute
 
     _check_dataset("fr", fr)
-    _typed("years", years, _is_number(years), "a number of years > 0")
-    _typed("site", site, site is None or _is_int(site),
-           "an integer row number (0 = the first site) or None")
-    from rocksweep.analysis.risk import check_fragility
-    from rocksweep.outputs import shown
-
+    check_type("years", years, is_real(years), "a number of years > 0")
+    check_type("site", site, site is None or is_integer(site),
+               "an integer row number (0 = the first site) or None")
     ds = _dataset_arg(fr, "fr")
     check_fragility(ds, shown(fr) if isinstance(fr, str | Path) else "fr")
     return compute(ds, hazard, years, site=site)
 
 
-@_public
+@analysis
 def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
     """Which IM explains ``state`` (as ``fragility``'s) best: for every IM of a
     record-suite sweep's records (``rocksweep.physics.suite.RECORD_IMS``: PGA, PGV, Sa(T),
@@ -391,7 +342,7 @@ def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
     return compute(_dataset_arg(ds, "ds"), state=state)
 
 
-@_public
+@analysis
 def table(ds: xr.Dataset) -> Any:
     """A tidy ``pandas.DataFrame`` of any rocksweep Dataset (or its file): one row per run
     of a sweep with its coordinates, unswept scene values, result fields, record, the
@@ -404,7 +355,6 @@ def table(ds: xr.Dataset) -> Any:
     return make(_dataset_arg(ds, "ds"))
 
 
-@_public
 def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> Any:
     """What ``run`` of this scene (with ``overrides``, as for ``run``) will cost on this
     machine, without running it: points, RK4 steps and evaluations expected, seconds of
@@ -421,7 +371,6 @@ def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> A
 
 # --- rocksweep.simulate ------------------------------------------------------------------
 
-@_public
 def simulate(scene: SceneLike, overrides: Overrides = (), /,
              **keys: Any) -> Simulation | list[Simulation]:
     """Run one point of a scene with its energy balance and time history.
@@ -444,13 +393,28 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     return out[0] if sc.size == 1 else out
 
 
+def felt_motion(scene: SceneLike, overrides: Overrides = (), /, **keys: Any) -> xr.Dataset:
+    """The motion the body feels at one point of a scene, as samples (no run): ``a_h`` [g]
+    the horizontal acceleration after the orientation (``ground.angle``) and the building
+    (``floor``), scaled as the point runs it, ``a_v`` [g] the vertical acting with it,
+    ``a_ground`` [g] the ground's H1 at the same scale (with an excitation path), over
+    ``t`` [s] (``rocksweep.compute.motion``). scene and overrides as for ``simulate`` (one
+    point). The kernel runs exactly these samples, linear between them;
+    ``rocksweep.physics.records.write_at2(path, ds.a_h.values, ds.attrs["dt"], title)``
+    keeps one as a record."""
+    from rocksweep.compute.motion import felt_motion as felt
+    from rocksweep.scene.inputs import load, override_strings
+
+    sc, _ = load(scene, [*override_strings(overrides), *override_strings(keys)])
+    return felt(sc)
+
+
 # --- Calibration: scene numbers fitted to a measured history ------------------
 
-@_public
 def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impact.lam",),
               *, bounds: Mapping[str, Sequence[float]] | None = None,
               overrides: Overrides = (), ci: float = 0.95, p: float | None = None,
-              noise: float | None = None) -> xr.Dataset:
+              noise: float | None = None, progress: bool = False) -> xr.Dataset:
     """Fit scene numbers to a measured rocking history.
 
     scene, overrides: as for ``run``. fit: the key or distinct keys to fit (``impact.lam``,
@@ -458,7 +422,7 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     CSV path or a pandas DataFrame with columns p_t, theta_over_alpha (as ``simulate
     --csv`` writes), or t [s], theta [rad] (then p [rad/s]: the keyword, a physical
     body's or a record scene's ground.p). bounds: {key: (lo, hi)} inside each key's
-    admissible range (default: ``analysis.calibrate.DEFAULT_BOUNDS`` or the range). ci:
+    admissible range (default: ``analysis.fit_keys.DEFAULT_BOUNDS`` or the range). ci:
     the interval's level, in [0.5, 1). Returns a Dataset over ``parameter`` (the fitted
     keys): ``estimate``, ``lo``, ``hi`` (the ``ci`` interval by profile likelihood, ``ci``
     in attrs), scalar ``misfit`` (RMS error of the half-cycle peaks, theta/alpha_ref)
@@ -466,22 +430,24 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     theta/alpha_ref) and ``dof``, ``reason`` ("ok" or misfit, unidentifiable, at_bound,
     not_converged joined by ",", also a ``CalibrationWarning``), and the measured and
     fitted histories over p_t with the fitted impacts (``rocksweep.analysis.calibrate``).
+    progress: say on stderr when the fit's kernel variant must be compiled first (once per
+    machine) and what that costs.
     """
     from rocksweep.analysis.calibrate import calibrate_scene
 
-    _typed("fit", fit, isinstance(fit, str) or (
+    check_type("fit", fit, isinstance(fit, str) or (
         isinstance(fit, Sequence) and all(isinstance(k, str) for k in fit)),
         "a dotted scene key (e.g. 'impact.lam') or a list of them")
-    _typed("bounds", bounds, bounds is None or isinstance(bounds, Mapping),
-           "a mapping {key: (lo, hi)}, e.g. {'impact.lam': (0, 1)}, or None")
-    _typed("p", p, p is None or _is_number(p), "a number (the body's p [rad/s]) or None")
-    _typed("noise", noise, noise is None or _is_number(noise),
-           "a number (the measurement noise, theta/alpha_ref) or None")
-    out = calibrate_scene(scene, measured, fit, bounds, ci, p, overrides, noise)
-    return out
+    check_type("bounds", bounds, bounds is None or isinstance(bounds, Mapping),
+               "a mapping {key: (lo, hi)}, e.g. {'impact.lam': (0, 1)}, or None")
+    check_type("p", p, p is None or is_real(p), "a number (the body's p [rad/s]) or None")
+    check_type("noise", noise, noise is None or is_real(noise),
+               "a number (the measurement noise, theta/alpha_ref) or None")
+    check_flag("progress", progress)
+    say = (lambda m: print(m, file=sys.stderr, flush=True)) if progress else None
+    return calibrate_scene(scene, measured, fit, bounds, ci, p, overrides, noise, say)
 
 
-@_public
 def calibrated_overrides(fit: xr.Dataset, which: str = "all") -> dict[str, Any]:
     """Overrides {key: value} of a calibration (``calibrate``'s Dataset) to sweep a scene
     at the estimate and at both ends of the interval: ``which="all"`` gives [lo, estimate,
@@ -491,85 +457,9 @@ def calibrated_overrides(fit: xr.Dataset, which: str = "all") -> dict[str, Any]:
 
     from rocksweep.analysis.calibrate import calibrated_overrides as overrides_of
 
-    _typed("fit", fit, isinstance(fit, xr.Dataset), "the Dataset rocksweep.calibrate returns")
+    check_type("fit", fit, isinstance(fit, xr.Dataset),
+               "the Dataset rocksweep.calibrate returns")
     if "parameter" not in fit.coords or "estimate" not in fit.variables:
         raise ApiError("fit: not a calibration (no parameter and estimate; what "
                        "rocksweep.calibrate returns)")
     return overrides_of(fit, which)
-
-
-# --- ds.rocksweep: the same functions as methods of a Dataset (as rioxarray's ``.rio``) ----
-# Registered on ``import rocksweep`` when xarray is already imported, and after every call
-# of the API once xarray is loaded; ``import rocksweep`` alone never imports xarray.
-
-_REGISTERED = False
-
-
-
-class RocksweepAccessor:
-    """``ds.rocksweep.<analysis>(...)`` is ``rocksweep.<analysis>(ds, ...)``."""
-
-    def __init__(self, ds: Any) -> None:
-        self._ds = ds
-
-    def plot(self, **kwargs: Any) -> Any:
-        """``rocksweep.plot(ds, ...)``: the figure of the Dataset (a sweep's stability
-        diagram, an analysis's figure)."""
-        return plot(self._ds, **kwargs)
-
-    def boundaries(self, **kwargs: Any) -> Any:
-        """``rocksweep.boundaries(ds, ...)``: A_min as a Dataset."""
-        return boundaries(self._ds, **kwargs)
-
-    def boundary_lines(self) -> Any:
-        """``rocksweep.boundary_lines(ds)``: the class boundary polylines (DataFrame)."""
-        return boundary_lines(self._ds)
-
-    def spectra(self, **kwargs: Any) -> Any:
-        """``rocksweep.spectra(ds, ...)``: rocking and overturning spectra."""
-        return spectra(self._ds, **kwargs)
-
-    def fragility(self, **kwargs: Any) -> Any:
-        """``rocksweep.fragility(ds, ...)``: lognormal fragility curves of a suite."""
-        return fragility(self._ds, **kwargs)
-
-    def ida(self, **kwargs: Any) -> Any:
-        """``rocksweep.ida(ds, ...)``: the first overturning level of each record."""
-        return ida(self._ds, **kwargs)
-
-    def risk(self, hazard: Any, years: float = 50, **kwargs: Any) -> Any:
-        """``rocksweep.risk(ds, hazard, years)``: annual rate and probability per state."""
-        return risk(self._ds, hazard, years, **kwargs)
-
-    def im_efficiency(self, **kwargs: Any) -> Any:
-        """``rocksweep.im_efficiency(ds, ...)``: beta of the fragility in every IM."""
-        return im_efficiency(self._ds, **kwargs)
-
-    def table(self) -> Any:
-        """``rocksweep.table(ds)``: one row per run (a DataFrame)."""
-        return table(self._ds)
-
-    def as_overrides(self, which: str = "all") -> dict[str, Any]:
-        """``rocksweep.calibrated_overrides(ds, which)`` of a calibration Dataset."""
-        return calibrated_overrides(self._ds, which)
-
-    def outcome_words(self) -> Any:
-        """``outcome`` as words (not_run, safe, mode1, mode2), an object DataArray."""
-        import numpy as np
-
-        from rocksweep.vocab.outcomes import OUTCOME_WORDS
-
-        o = self._ds["outcome"]
-        return o.copy(data=np.vectorize(OUTCOME_WORDS.get, otypes=[object])(o.values))
-
-
-def register_accessor() -> None:
-    """Register ``ds.rocksweep`` with xarray, once, if xarray is imported (this never
-    imports it: cheap enough for every API call)."""
-    global _REGISTERED
-    if _REGISTERED or "xarray" not in sys.modules:
-        return
-    import xarray as xr
-
-    xr.register_dataset_accessor("rocksweep")(RocksweepAccessor)
-    _REGISTERED = True

@@ -109,9 +109,8 @@ class OutputError(RocksweepError, OSError):
     """An output path that cannot be written (exists, is a device, no such directory...)."""
 
 
-# Every error class of the package, lowest layer first, each with the module that raises it.
-# Each module re-exports its own (``from rocksweep.scene.model import SceneError`` keeps
-# working); tests/test_errors.py fails on an error class defined anywhere else.
+# Every error class of the package, lowest layer first, each with the module that raises it
+# (imported from here: tests/test_errors.py fails on an error class defined anywhere else).
 
 class BodyError(RocksweepError, ValueError):
     """A body that is not physical; names the key and value (physics.bodies)."""
@@ -159,7 +158,8 @@ class IdaError(RocksweepError, ValueError):
 
 
 class FloorError(RocksweepError):
-    """A Dataset that has no floor spectrum or orientation to give (analysis.floors)."""
+    """A Dataset that has no floor spectrum or orientation to give (analysis.floors), or
+    a building whose floor motion would exceed its memory bound (physics.floor)."""
 
 
 class EfficiencyError(RocksweepError, ValueError):
@@ -220,6 +220,20 @@ class CalibrationError(RocksweepError, ValueError):
 def is_integer(v: Any) -> bool:
     """An integer (Python's or numpy's), not a bool."""
     return isinstance(v, numbers.Integral) and not isinstance(v, bool)
+
+
+def is_real(v: Any) -> bool:
+    """A real number (Python's or numpy's), not a bool."""
+    return isinstance(v, numbers.Real) and not isinstance(v, bool)
+
+
+def check_type(name: str, value: Any, ok: bool, allowed: str) -> None:
+    """The Python API's one type check of an argument: unless ``ok``, a one-line TypeError
+    naming it, the value (shortened) and what is ``allowed``."""
+    if not ok:
+        text = repr(value)
+        text = text if len(text) <= 60 else f"{text[:40]}...{text[-12:]}"
+        raise TypeError(f"{name} = {text}: must be {allowed}")
 
 
 def check_integer(name: str, v: Any, error: type[Exception] = TypeError) -> int:

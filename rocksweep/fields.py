@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.physics.bodies import G
+from rocksweep.physics.bodies import G, u_cr
 from rocksweep.vocab.axes import AXES, alpha_symbol
 from rocksweep.vocab.ground import AVGSA_POINTS, RECORD_IMS, SA, SA_DAMPING, SCALE_IMS
 
@@ -131,6 +131,12 @@ FIELDS: tuple[Field, ...] = (
           "smallest normal reaction N/(M g) over the run (< 0: the body would lift off)",
           L.OUT_N_MIN, contact=True,
           label="smallest normal reaction", symbol="N_min/(M g)"),
+    Field("refine_evaluations", "int64", 0, "1",
+          "RK4 evaluations (regular + event) of the certification's checks and reruns of a "
+          "close call (rocksweep.compute.certify), counted in steps and event_steps too; a "
+          "sweep file keeps their total (attribute refine_evaluations)",
+          L.OUT_REFINE_EVALS, stored=False,
+          label="RK4 evaluations of the certification"),
     Field("saddle_margin", "float64", math.nan, "alpha_ref",
           "closest approach of the free rocking to the overturning saddle (inf: never "
           "within 0.5); below 0.05 (an overturn: 0.1) at 5 steps per period the run is "
@@ -421,7 +427,7 @@ HISTORY_RAW: tuple[str, ...] = tuple(c.raw for c in sorted(HISTORY, key=lambda c
 def history_columns(raw: dict[str, np.ndarray], body) -> dict[str, np.ndarray]:
     """A run's raw history (``Run.history``) -> name -> normalised float64 array, in
     ``HISTORY`` order. body: the run's body (alpha_ref, u_cr, E_ref)."""
-    u_cr = body.u_cr if body.u_cr else math.nan  # rigid bodies have no u_cr
-    scales = {"": 1.0, "alpha_ref": body.alpha_ref, "u_cr": u_cr, "E_ref": body.E_ref,
-              "g": G}
+    # a rigid body (welded, a block) has no u_cr: its u column (0) is NaN
+    scales = {"": 1.0, "alpha_ref": body.alpha_ref, "u_cr": u_cr(body) or math.nan,
+              "E_ref": body.E_ref, "g": G}
     return {c.name: np.asarray(raw[c.raw], float) / scales[c.scale] for c in HISTORY}

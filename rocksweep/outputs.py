@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import fcntl
 import os
 import re
 import stat
@@ -102,7 +103,8 @@ def input_problem(path: str | Path) -> str | None:
     try:
         st = os.stat(path)
     except FileNotFoundError:
-        return "no such file"
+        return "a symbolic link to a missing file" if os.path.lexists(path) else \
+            "no such file"
     except (OSError, ValueError) as err:  # ValueError: a NUL byte in the name
         return os_reason(err) if isinstance(err, OSError) else "not a valid file name"
     if stat.S_ISDIR(st.st_mode):
@@ -295,8 +297,6 @@ def clean_stale_partials(path: Path) -> list[tuple[str, int]]:
     writer's process is gone (or, for a name without a pid, it is older than STALE_AGE)
     and no process holds its lock (HDF5's writer lock, flock). Returns (name, bytes) of
     each file removed."""
-    import fcntl
-
     path = Path(path)
     parent = path.parent if str(path.parent) else Path(".")
     # files of older versions were named after the stem (``.risk.abcd1234.partial.h5``)

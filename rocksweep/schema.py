@@ -26,7 +26,16 @@ from typing import Any
 import numpy as np
 
 from rocksweep.numerics import MIN_EVENT_TOL
-from rocksweep.vocab.ground import SCALE_IMS, SHAPES
+from rocksweep.vocab.ground import (
+    COMPONENTS,
+    H1,
+    MISSING,
+    MISSING_ERROR,
+    MISSING_SKIP,
+    ROTD50,
+    SCALE_IMS,
+    SHAPES,
+)
 from rocksweep.vocab.laws import DEFAULT_LAW, LAWS
 from rocksweep.vocab.settings import PRESET_NAMES, ROOTS
 
@@ -212,15 +221,15 @@ KEYS: dict[str, Key] = {
                                0.0, math.inf, lo_in=False, hi_in=False),
     "ground.scale.period": Key("number", "must be in (0, 100] s (the period of Sa)", 0.0,
                                100.0, lo_in=False),
-    "ground.scale.component": Key("choice", "must be H1 (the first horizontal's IM) or "
-                                  "RotD50 (the median over orientations of both "
+    "ground.scale.component": Key("choice", f"must be {H1} (the first horizontal's IM) or "
+                                  f"{ROTD50} (the median over orientations of both "
                                   "horizontals', NGA-West2's convention; a suite of PEER "
-                                  "folders)", choices=("H1", "RotD50"), required=False,
-                                  default="H1"),
-    "ground.missing": Key("choice", "must be error (a record of a PEER folder without one "
-                          "of its components is refused) or skip (left out, with a "
-                          "warning)", choices=("error", "skip"), required=False,
-                          default="error"),
+                                  "folders)", choices=COMPONENTS, required=False,
+                                  default=H1),
+    "ground.missing": Key("choice", f"must be {MISSING_ERROR} (a record of a PEER folder "
+                          f"without one of its components is refused) or {MISSING_SKIP} "
+                          "(left out, with a warning)", choices=MISSING, required=False,
+                          default=MISSING_ERROR),
     "ground.scale.factor": Key("number", "must be a finite number > 0 (every record times "
                                "this factor)", 0.0, math.inf, lo_in=False, hi_in=False),
     "ground.periods": Key("string", "must be a list of periods in [0, 100] s (Sa stored per "

@@ -1,6 +1,7 @@
 """What ``rocksweep.simulate`` returns: one run of one point, its summary, its time
 history and its Figure 5. A result type of the API (``rocksweep.api``), on its floor: it
-draws through ``rocksweep.figures``, which the stores below may not import."""
+draws through ``rocksweep.figures``, which ``rocksweep.compute`` (where its run comes from,
+``compute.history``) may not import."""
 
 from __future__ import annotations
 
@@ -34,6 +35,7 @@ class Simulation:
     def figure(self) -> Figure:
         """Figure 5 for this run (pulse, theta/alpha, E/E_ref, dissipated energy against
         p*t) as a pyplot-free matplotlib Figure: show it in a notebook or ``savefig``."""
+        # matplotlib (~1 s): when the figure is asked for
         from rocksweep.figures.history import time_history
 
         return time_history([self.run], (), self.title)

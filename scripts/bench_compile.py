@@ -79,10 +79,10 @@ KINDS = {L.KIND_FLEXIBLE: "flexible", L.KIND_FLEXIBLE_UNDAMPED: "flexible_undamp
 LEVELS = {L.LEVEL_OUTCOME: "chunk", L.LEVEL_ENERGY: "chunk_energy",
           L.LEVEL_CONTACT: "chunk_contact", None: "point_history"}
 # (kind, level, ground): Figure 3(a) needs the first (flexible, damped, outcome level)
-ALL_VARIANTS = ([(k, lv, False) for lv in LEVELS for k in KINDS]
-                + [(k, L.LEVEL_OUTCOME, True) for k in KINDS]
+ALL_VARIANTS = ([(k, lv, L.GROUND_PULSE) for lv in LEVELS for k in KINDS]
+                + [(k, L.LEVEL_OUTCOME, L.GROUND_ANY) for k in KINDS]
                 + [(k, L.LEVEL_OUTCOME, L.GROUND_VERTICAL) for k in KINDS])
-QUICK_VARIANTS = [(L.KIND_FLEXIBLE, L.LEVEL_OUTCOME, False)]
+QUICK_VARIANTS = [(L.KIND_FLEXIBLE, L.LEVEL_OUTCOME, L.GROUND_PULSE)]
 # --vertical: the vertical ground acceleration's variants beside the ground variants they
 # extend (docs/vertical.md), each level a scene can ask for
 VERTICAL_VARIANTS = [(k, lv, g) for k in KINDS for lv in (L.LEVEL_OUTCOME, None)
@@ -112,12 +112,14 @@ def child_env(tree: Path | None = None, **extra: str) -> dict[str, str]:
     return {**os.environ, "PYTHONPATH": path, **extra}
 
 
+GROUNDS = {L.GROUND_PULSE: "", L.GROUND_ANY: "_ground", L.GROUND_VERTICAL: "_vertical"}
+
+
 def variant_name(kind: int, level: int | None, ground: int) -> str:
-    suffix = ("_vertical" if ground == L.GROUND_VERTICAL else "_ground" if ground else "")
-    return f"{LEVELS[level]}_{KINDS[kind]}{suffix}"
+    return f"{LEVELS[level]}_{KINDS[kind]}{GROUNDS[ground]}"
 
 
-def cold_compile(variant: tuple[int, int | None, bool], tree: Path | None = None) -> dict:
+def cold_compile(variant: tuple[int, int | None, int], tree: Path | None = None) -> dict:
     """Compile one variant in a fresh process with an empty NUMBA_CACHE_DIR."""
     with tempfile.TemporaryDirectory() as cache:
         res = subprocess.run([sys.executable, "-c", _COMPILE_SNIPPET, json.dumps(variant)],
@@ -180,7 +182,7 @@ def per_point(names: list[str], repeat: int) -> dict[str, dict]:
 
 _PER_POINT_SNIPPET = """
 import json, sys
-sys.path.insert(0, sys.argv[1])
+sys.path.append(sys.argv[1])  # last: first, _here would put this checkout before PYTHONPATH's
 import bench_kernel as bk
 import rocksweep
 scene = bk.scene_of(sys.argv[2], None)
@@ -213,6 +215,8 @@ def ab_round(tree: Path | None, repeat: int, tmp: str) -> dict[str, float]:
                           "fig3a", str(repeat)], env=child_env(tree), cwd=tmp,
                          capture_output=True, text=True, check=True)
     pp = json.loads(res.stdout.splitlines()[-1])
+    if not pp["package"].startswith(package):
+        raise SystemExit(f"the per-point subprocess imported {pp['package']}, not {package}")
     return {"compile": comp["cpu"], "start": min(walls), "us": pp["us"]}
 
 

@@ -43,7 +43,8 @@ from rocksweep.kernel import chunk_kernel, point_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody, FlexibleBody
-from rocksweep.physics.points import Point, body_omega_rock, body_row, fill_rows, shape_code
+from rocksweep.physics.ground_motion import pulse
+from rocksweep.physics.points import Bodies, Columns, Point, fill_rows
 
 TABLE3 = dict(wn_over_p=9.82, zeta=0.05, alpha_cg=0.15, alpha_A=0.28, mA_over_m=0.47,
               IA_ratio=0.56)
@@ -60,9 +61,8 @@ def grid_rows(body, n: int, numerics: Numerics) -> np.ndarray:
     w, a = grid_values(n)
     k = w.size
     rows = np.empty((k, L.N_PAR))
-    fill_rows(rows, np.repeat(body_row(body)[None, :], k, axis=0),
-              np.full(k, body_omega_rock(body)), np.full(k, body.alpha_ref), np.zeros(k),
-              np.full(k, shape_code("sine")), w, a, numerics)
+    fill_rows(rows, Bodies.of([body] * k), pulse("sine"), Columns(np.zeros(k), w, a),
+              numerics)
     return rows
 
 

@@ -155,7 +155,7 @@ def main(argv: list[str] | None = None) -> int:
         # flat indices of (lam 0.2, record rec_i, stripe s)
         flat = np.array([np.ravel_multi_index((1, rec_i, s), grid.shape) for s in picks])
         cr = grid.rows_at(flat)
-        kernel = chunk_kernel(int(cr.kinds[0]), level(sc), True)
+        kernel = chunk_kernel(int(cr.kinds[0]), level(sc), L.GROUND_ANY)
         rows = cr.rows
         outs = np.empty((flat.size, L.N_OUT))
         print(f"\n2. one run against the scipy reference (record {name}, lam 0.2, "
@@ -170,7 +170,7 @@ def main(argv: list[str] | None = None) -> int:
             best = np.inf
             for _ in range(5):
                 c0 = time.thread_time()
-                run_record(kernel, rows, sel, outs, sc.suite.records[rec_i])
+                run_record(kernel, rows, sel, outs, cr.excitations[int(cr.which[j])])
                 best = min(best, time.thread_time() - c0)
             point = sc.point({**{a.name: a.values[0] for a in sc.axes},
                               **{k: v[j] for k, v in vals.items()}})

@@ -140,11 +140,11 @@ def kernel_hints(cs: list[dict[str, Any]]) -> list[float]:
     for c in cs:
         body = make_body(c["body"])
         kind = kernel_kind(body)
-        warm_up(kind, L.LEVEL_OUTCOME, False)
+        warm_up(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)
         rows = np.stack([point_row(Point(body, c["lam"], c["shape"], c["w_over_p"], float(a)),
                                    num) for a in grid])
         outs = np.empty((len(grid), L.N_OUT))
-        chunk_kernel(kind, L.LEVEL_OUTCOME, False)(rows, outs)
+        chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)(rows, outs)
         over = np.flatnonzero(outs[:, L.OUT_OUTCOME] > 0)
         hints.append(float(grid[over[0]]) if over.size else math.nan)
     return hints

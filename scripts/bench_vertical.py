@@ -43,7 +43,7 @@ from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import step_budget, vertical_step
 from rocksweep.physics.bodies import G
-from rocksweep.physics.vertical import air_time_harmonic
+from rocksweep.physics.ground_motion import air_time_harmonic
 from rocksweep.scene.grid import Grid
 
 
@@ -56,7 +56,8 @@ def rows_of(scene) -> tuple[np.ndarray, np.ndarray]:
 
 def with_harmonic(rows: np.ndarray, amplitude: float, ratio: float, numerics) -> np.ndarray:
     """The rows with a vertical harmonic of ``amplitude`` g at ``ratio`` times the pulse's
-    frequency, phase 0, as ``points.fill_rows`` sets it (step, cap and t_air)."""
+    frequency, phase 0, as ``points.fill_rows`` sets it (step, cap and t_air:
+    ``Excitation.fill_gravity``)."""
     out = rows.copy()
     w_v = ratio * rows[:, L.PAR_OMEGA]
     out[:, L.PAR_V_AMP] = amplitude * G

@@ -39,7 +39,7 @@ def free_rocking_e(scene_path: Path, law: str = "vertical", theta0: float = 0.8,
     row[L.PAR_THETA0] = theta0 * body.alpha_cg
     out = np.empty(L.N_OUT)
     hist = np.empty((history_capacity(row), L.N_HIST))
-    point_kernel(kernel_kind(body), False)(row, out, hist)
+    point_kernel(kernel_kind(body), L.GROUND_PULSE)(row, out, hist)
     n = int(out[L.OUT_HIST_ROWS])
     theta, phase = hist[:n, L.HIST_THETA], hist[:n, L.HIST_PHASE]
     peaks, start = [], 0

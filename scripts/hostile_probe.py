@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import math
 import os
 import re
 import shutil
@@ -750,27 +751,31 @@ for _name, _files, _target, _args in (
         lambda d, f=_files, t=_target, a=_args: (fixture(d, *f), appears(d, t, a))[1])
 
 
-@case("two table -o t.csv at once: one writes, the other refuses", "ok")
-def _(d):
-    fixture(d, "s.h5")
+def two_writers(d: Path, target: str, args: list[str]) -> subprocess.CompletedProcess:
+    """The same command writing ``target`` twice at once: both check the path, then both
+    wait 2 s before writing it (they overlap): one writes, the other refuses."""
     freeze(d)
     e = {**os.environ, "PYTHONPATH": str(ROOT)}
     slow = APPEARS.replace("    try:\n        with open(target, 'x') as f:\n"
                            "            f.write('mine')\n    except FileExistsError:\n"
                            "        pass\n", "    import time; time.sleep(2)\n")
     assert "sleep" in slow
-    # both check t.csv, then both wait 2 s before writing it: they overlap
-    procs = [subprocess.Popen([sys.executable, "-c", slow, "t.csv", "table", "s.h5", "-o",
-                               "t.csv"], cwd=d, env=e, stdout=subprocess.PIPE,
-                              stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    procs = [subprocess.Popen([sys.executable, "-c", slow, target, *args], cwd=d, env=e,
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+             for _ in range(2)]
     outs = [p.communicate(timeout=TIMEOUT) for p in procs]
     r = subprocess.CompletedProcess([], 0, outs[0][0] + outs[1][0], "")
     wrote = sum("wrote" in o for o, _ in outs)
     if wrote != 1 and not all(p.returncode == 0 for p in procs):
         return wrong(r, f"{wrote} wrote")
     if wrote == 2:  # both published: the second replaced the first's file
-        return wrong(r, "both wrote t.csv")
+        return wrong(r, f"both wrote {target}")
     return r
+
+
+case("two table -o t.csv at once: one writes, the other refuses", "ok")(
+    lambda d: (fixture(d, "s.h5"), two_writers(d, "t.csv", ["table", "s.h5", "-o",
+                                                             "t.csv"]))[1])
 
 
 @case("a killed risk -o's temporary files are removed by the next risk -o", "ok")
@@ -999,6 +1004,356 @@ def _(d):
     return cli(d, ["simulate", "suite.yaml"])
 
 
+# --- issue 45: the new axes (vertical, floors, orientation, PEER folders) ------------------
+# Fixtures made once (``new_axes``): peer/ a PEER folder (3 records: 000, 090, -UP), h2.csv
+# and up.csv two-column components of rec.csv, three.yaml (record + h2 + vertical + angle),
+# fl.h5 a floor suite sweep over angle and floor.period, fla.h5 its fragility, flpart.h5
+# the same sweep interrupted, pfl.h5 a pulse floor sweep.
+
+BLOCK_BODY = "body: {kind: block, alpha: 0.2}\nimpact: {lam: 0.0}\n"
+FLOOR_SUITE = ("name: fl\n" + BLOCK_BODY + "ground:\n  records: peer\n  vertical: false\n"
+               "  angle: [0, 90]\n  scale: {im: PGA, values: [0.3, 0.6]}\n  p: 2.0\n"
+               "floor: {period: [0.2, 0.5], damping: 0.05, participation: 1.3}\n")
+PULSE_FLOOR = ("name: pfl\n" + BLOCK_BODY + "pulse: {shape: sine, w_over_p: 2, A_ratio: "
+               "[0.5, 1, 2, 4]}\nfloor: {period: [0.2, 1.0], damping: 0.05, "
+               "participation: 1.3}\n")
+NEW_AXES: dict[str, Path] = {}
+MAKE_PEER = """
+import sys
+import numpy as np
+from pathlib import Path
+from rocksweep.physics.records import read_record, write_at2
+src, d = Path(sys.argv[1]), Path('peer')
+d.mkdir()
+for i, name in enumerate(('SYN01', 'SYN02', 'SYN03')):
+    r = read_record(src / f'{name}.AT2')
+    write_at2(d / f'RSN{i + 1}_EV_ST000.AT2', r.acc, r.dt, name)
+    write_at2(d / f'RSN{i + 1}_EV_ST090.AT2', np.roll(r.acc, 50), r.dt, name)
+    write_at2(d / f'RSN{i + 1}_EV_ST-UP.AT2', 0.4 * np.roll(r.acc, 20), r.dt, name)
+r = read_record(src / 'SYN04.AT2')
+for name, a in (('h2.csv', np.roll(r.acc, 40)), ('up.csv', 0.3 * np.roll(r.acc, 10))):
+    Path(name).write_text(''.join(f'{k * r.dt:.4f},{v:.7e}\\n' for k, v in
+                                  enumerate(a[:1000])))
+"""
+
+
+def new_axes() -> Path:
+    """The folder of this section's fixtures (made on first use)."""
+    if "dir" in NEW_AXES:
+        return NEW_AXES["dir"]
+    d = Path(tempfile.mkdtemp(prefix="probe-axes-"))
+    setup(d)
+    e = {**os.environ, "PYTHONPATH": str(ROOT)}
+    _made(subprocess.run([sys.executable, "-c", MAKE_PEER, str(SUITE_DIR)], cwd=d, env=e,
+                         capture_output=True, text=True, timeout=600), "the PEER folder")
+    (d / "fl.yaml").write_text(FLOOR_SUITE)
+    (d / "pfl.yaml").write_text(PULSE_FLOOR)
+    (d / "three.yaml").write_text(
+        "name: three\n" + BLOCK_BODY + "ground: {record: rec.csv, h2: h2.csv, vertical: "
+        "up.csv, angle: [0, 90], A_ratio: [1, 3], p: [1.0, 2.0]}\n")
+    for args in (["sweep", "fl.yaml", "-o", "fl.h5", "-q"],
+                 ["sweep", "pfl.yaml", "-o", "pfl.h5", "-q"],
+                 ["sweep", "three.yaml", "-o", "three.h5", "-q"],
+                 ["fragility", "fl.h5", "-o", "fla.h5", "--bootstrap", "20"]):
+        _made(subprocess.run([sys.executable, "-m", "rocksweep", *args], cwd=d, env=e,
+                             capture_output=True, text=True, timeout=600), " ".join(args))
+    _made(subprocess.run([sys.executable, "-c", PARTIAL.replace("suite.yaml", "fl.yaml")
+                          .replace("part.h5", "flpart.h5")], cwd=d, env=e,
+                         capture_output=True, text=True, timeout=600), "the partial floor file")
+    NEW_AXES["dir"] = d
+    return d
+
+
+def axes_fixture(d: Path, *names: str) -> None:
+    for n in names:
+        src = new_axes() / n
+        if src.is_dir():
+            shutil.copytree(src, d / n, dirs_exist_ok=True)
+        else:
+            shutil.copy(src, d / n)
+
+
+def _with(d: Path, *names: str) -> Path:
+    axes_fixture(d, *names)
+    return d
+
+
+# item 0: one guard of every input of a scene
+for _name, _args in (
+        ("table -o the result's ground.vertical", ["table", "three.h5", "-o", "up.csv"]),
+        ("table -o the result's ground.h2", ["table", "three.h5", "-o", "h2.csv"]),
+        ("boundaries -o the result's ground.vertical", ["boundaries", "three.h5", "-o",
+                                                        "up.csv"]),
+        ("sweep -o its ground.vertical", ["sweep", "three.yaml", "-o", "up.csv", "-q"]),
+        ("simulate --csv its ground.h2", ["simulate", "three.yaml", "--set",
+                                          "ground.angle=0", "--set", "ground.A_ratio=1",
+                                          "--csv", "h2.csv"]),
+        ("sweep -o a PEER folder's UP file", ["sweep", "fl.yaml", "-o",
+                                              "peer/RSN2_EV_ST-UP.AT2", "-q"]),
+        ("sweep -o a PEER folder's H2 file", ["sweep", "fl.yaml", "-o",
+                                              "peer/RSN1_EV_ST090.AT2", "-q"])):
+    for _over in ([], ["--overwrite"]):
+        case(f"dataloss: {_name}{' --overwrite' if _over else ''}")(
+            lambda d, a=_args, o=_over: _guarded(d, [*a, *o]))
+
+
+def _guarded(d: Path, args: list[str]) -> subprocess.CompletedProcess:
+    """A command that writes over one of the inputs of a scene or result made here (the
+    result names the files where its sweep read them: this case's)."""
+    axes_fixture(d, "peer", "h2.csv", "up.csv", "three.yaml", "fl.yaml")
+    if "three.h5" in args:
+        r = cli(d, ["sweep", "three.yaml", "-o", "three.h5", "-q"])
+        if r.returncode:
+            return r
+    return cli(d, args)
+
+
+# item 1: crashes
+@case("risk of a fragility with an orientation dimension", "ok")
+def _(d):
+    axes_fixture(d, "fla.h5")
+    (d / "hz.csv").write_text(HAZARD)
+    return cli(d, ["risk", "fla.h5", "--hazard", "hz.csv"])
+for _im in ("AvgSa", "CAV", "Arias"):
+    case(f"ground.scale.component: RotD50 with {_im} stripes")(
+        lambda d, im=_im: (axes_fixture(d, "peer"), (d / "r.yaml").write_text(
+            FLOOR_SUITE.replace("im: PGA", f"im: {im}, component: RotD50")
+            .replace("[0.3, 0.6]", "[0.1, 0.2]")), cli(d, ["sweep", "r.yaml", "-q"]))[2])
+
+
+def _floor_value(d: Path, key: str, value: str) -> subprocess.CompletedProcess:
+    (d / "f.yaml").write_text("name: f\n" + BLOCK_BODY + "ground: {record: rec.AT2, "
+                              "A_ratio: [1, 3], p: 2.0}\nfloor: {period: 0.5, damping: 0.05, "
+                              "participation: 1.3}\n")
+    return cli(d, ["sweep", "f.yaml", "-q", "--set", f"floor.{key}={value}"])
+
+
+for _key, _value, _expect in (("period", "1e-300", "ok"), ("damping", "5e-324", "clean"),
+                              ("damping", "1e-7", "clean"), ("period", "1e6", "ok"),
+                              ("period", "-1", "clean"), ("period", "inf", "clean"),
+                              ("damping", "1", "clean"), ("participation", "0", "clean"),
+                              ("period", "x", "clean")):
+    case(f"floor.{_key}: {_value}", _expect)(
+        lambda d, k=_key, v=_value: _floor_value(d, k, v))
+case("floor: {modes: [...]} under one record, no angle axis", "ok")(
+    lambda d: ((d / "m.yaml").write_text(
+        "name: m\n" + BLOCK_BODY + "ground: {record: rec.AT2, A_ratio: [1, 3], p: 2.0}\n"
+        "floor: {modes: [{period: 0.5, damping: 0.05, participation: 1.3}]}\n"),
+        cli(d, ["sweep", "m.yaml", "-q"]))[1])
+case("floor: {modes: [...]} under a pulse, no angle axis", "ok")(
+    lambda d: ((d / "m.yaml").write_text(
+        "name: m\n" + BLOCK_BODY + "pulse: {shape: sine, w_over_p: 2, A_ratio: [1, 3]}\n"
+        "floor: {modes: [{period: 0.5, damping: 0.05, participation: 1.3}, {period: 0.2, "
+        "damping: 0.05, participation: -0.4}]}\n"), cli(d, ["sweep", "m.yaml", "-q"]))[1])
+case("spectrum of a sweep over pulse.shape", "ok")(
+    lambda d: ((d / "s.yaml").write_text(
+        "name: s\n" + BLOCK_BODY + "pulse: {shape: [sine, cosine], w_over_p: [1, 2], "
+        "A_ratio: [2, 4]}\n"), cli(d, ["sweep", "s.yaml", "-o", "s.h5", "-q"]),
+        cli(d, ["spectrum", "s.h5", "--rtol", "0.1"]))[2])
+# hostile values of the other new keys
+def _ground_value(d: Path, extra: str) -> subprocess.CompletedProcess:
+    """One record with ground.h2 and one hostile value of a new ground key."""
+    axes_fixture(d, "h2.csv")
+    rows = "".join(f"{k * 0.02:.4f},{0.1 * math.sin(k / 7):.6e}\n" for k in range(500))
+    (d / "h2dt.csv").write_text(rows)  # DT 0.02 against the record's 0.01
+    keys = {"record": "rec.csv", "h2": "h2.csv", "A_ratio": "1", "p": "2.0"}
+    k, v = extra.split(": ", 1)
+    keys[k] = v
+    (d / "g.yaml").write_text("name: g\n" + BLOCK_BODY + "ground: {" + ", ".join(
+        f"{a}: {b}" for a, b in keys.items()) + "}\n")
+    return cli(d, ["sweep", "g.yaml", "-q"])
+
+
+for _extra in ("angle: [400]", "angle: x", "angle: .nan", "angle: [-1]",
+               "h2: nothere.csv", "h2: h2dt.csv", "h2: rec.csv", "vertical: true",
+               "vertical: {a: 1}", "h2: g.yaml"):
+    case(f"ground.{_extra}", "ok" if _extra == "h2: rec.csv" else "clean")(
+        lambda d, x=_extra: _ground_value(d, x))
+for _val in ("rotd50", "[H1]", "maybe"):
+    case(f"ground.scale.component: {_val}")(
+        lambda d, v=_val: (axes_fixture(d, "peer"), (d / "c.yaml").write_text(
+            FLOOR_SUITE.replace("im: PGA", f"im: PGA, component: {v}")),
+            cli(d, ["sweep", "c.yaml", "-q"]))[2])
+case("ground.missing: maybe")(
+    lambda d: (axes_fixture(d, "peer"), (d / "c.yaml").write_text(
+        FLOOR_SUITE.replace("vertical: false", "vertical: false\n  missing: maybe")),
+        cli(d, ["sweep", "c.yaml", "-q"]))[2])
+
+
+# item 2: hangs and unbounded memory
+case("hang: floor-spectrum of a FIFO")(
+    lambda d: (os.mkfifo(d / "ff.h5"), cli(d, ["floor-spectrum", "ff.h5"]))[1])
+
+
+# item 3: silent wrong answers
+def _peer_hostile(d: Path, how: str, skip: bool = False) -> subprocess.CompletedProcess:
+    axes_fixture(d, "peer")
+    bad = d / "peer" / "RSN3_EV_ST090 (1).AT2"
+    if how == "duplicate":
+        shutil.copy(d / "peer" / "RSN3_EV_ST000.AT2", bad)
+    elif how == "fifo":
+        os.mkfifo(d / "peer" / "RSN4_EV_ST000.AT2")
+    elif how == "dangling":
+        os.symlink("gone.AT2", d / "peer" / "RSN4_EV_ST000.AT2")
+    elif how == "loop":
+        os.symlink("RSN4_EV_ST000.AT2", d / "peer" / "RSN4_EV_ST000.AT2")
+    elif how == "lying H2":  # another DT: refused, not resampled
+        text = (d / "peer" / "RSN2_EV_ST090.AT2").read_text().replace("DT=   .0100",
+                                                                    "DT=   .0200")
+        (d / "peer" / "RSN2_EV_ST090.AT2").write_text(text)
+    elif how == "empty UP":
+        (d / "peer" / "RSN2_EV_ST-UP.AT2").write_text("")
+    (d / "c.yaml").write_text(FLOOR_SUITE.replace("vertical: false", "vertical: false" + (
+        "\n  missing: skip" if skip else "")))
+    r = cli(d, ["sweep", "c.yaml", "-q", "-o", "c.h5"])
+    if skip and r.returncode == 0:
+        said = r.stderr
+        if "Warning" not in said:
+            return wrong(r, "skipped without a warning")
+        r.stderr = ""
+    return r
+
+
+for _how in ("duplicate", "fifo", "dangling", "loop", "lying H2", "empty UP"):
+    case(f"PEER folder with a {_how} component file")(
+        lambda d, h=_how: _peer_hostile(d, h))
+for _how in ("duplicate", "fifo"):
+    case(f"PEER folder with a {_how} under ground.missing: skip (warned)", "ok")(
+        lambda d, h=_how: _peer_hostile(d, h, skip=True))
+case("floor-spectrum of an interrupted floor sweep")(
+    lambda d: cli(_with(d, "flpart.h5"), ["floor-spectrum", "flpart.h5", "-o", "x.png"]))
+case("floor-spectrum --rtol -5 of a suite")(
+    lambda d: cli(_with(d, "fl.h5"), ["floor-spectrum", "fl.h5", "--rtol", "-5"]))
+case("floor-spectrum --rtol 0.3 of a pulse")(
+    lambda d: cli(_with(d, "pfl.h5"), ["floor-spectrum", "pfl.h5", "--rtol", "0.3"]))
+case("floor-spectrum of a missing file says so")(
+    lambda d: _named(cli(d, ["floor-spectrum", "none.h5"]), "no such file"))
+case("floor-spectrum -o CSV and PNG of a suite", "ok")(
+    lambda d: cli(_with(d, "fl.h5"), ["floor-spectrum", "fl.h5", "-o", "f.csv", "-o",
+                                      "f.png"]))
+
+
+@case("orientation each: n_records counts records, the bootstrap resamples them", "ok")
+def _(d):
+    axes_fixture(d, "fl.h5")
+    return py(d, """
+        import warnings
+        warnings.simplefilter('ignore')
+        ds = rocksweep.open('fl.h5')
+        fr = rocksweep.fragility(ds, bootstrap=0)
+        n = int(fr['n_records'].sel(orientation='each').max())
+        print('OK' if n == ds.sizes['record'] else f'WRONG n_records {n}')
+        sys.exit(0 if n == ds.sizes['record'] else 98)""")
+
+
+@case("efficiency of a 3-record sweep gives a verdict", "ok")
+def _(d):
+    axes_fixture(d, "fl.h5")
+    r = cli(d, ["efficiency", "fl.h5"])
+    if r.returncode == 0 and "few_records" not in r.stdout + r.stderr:
+        return wrong(r, "no verdict on 3 records")
+    r.stderr = ""  # its verdict is a warning line, as it should be
+    return r
+
+
+@case("table of a result with an airborne run: one rule (kept, said)", "ok")
+def _(d):
+    rows = "".join(f"{i * 0.01:.2f},{0.3 * math.sin(2 * math.pi * i * 0.01):.6e}\n"
+                   for i in range(401))
+    down = "".join(f"{i * 0.01:.2f},{-1.5 * math.sin(2 * math.pi * i * 0.01) ** 2 * (i > 50):.6e}\n"
+                   for i in range(401))
+    (d / "ah.csv").write_text(rows)
+    (d / "av.csv").write_text(down)
+    (d / "a.yaml").write_text("name: a\n" + BLOCK_BODY + "ground: {record: ah.csv, vertical: "
+                              "av.csv, A_ratio: [0.5, 1.0], p: 2.0}\n")
+    r = cli(d, ["sweep", "a.yaml", "-o", "a.h5", "-q"])
+    if r.returncode:
+        return r
+    r = cli(d, ["table", "a.h5", "-o", "a.csv"])
+    if "left out" in r.stderr:
+        return wrong(r, "the table says left out and keeps the rows")
+    r.stderr = ""
+    return r
+
+
+@case("calibrate of the exact model at its own noise says ok", "ok")
+def _(d):
+    return py(d, """
+        import warnings
+        import numpy as np, pandas as pd
+        from rocksweep.analysis.peaks import hermite
+        warnings.simplefilter('ignore')
+        sc = {'name': 'b', 'body': {'kind': 'block', 'alpha': 0.2}, 'impact': {'lam': 0.0,
+              'law': 'constant', 'e': 0.85}, 'initial': {'theta_over_alpha': 0.7}}
+        h = rocksweep.simulate(sc, {'numerics.accuracy': 'fine'}).history
+        tt, th, dth = (h[v].values for v in ('p_t', 'theta_over_alpha', 'theta_dot_over_alpha'))
+        bad = []
+        for seed in (3, 13, 21):
+            t = np.arange(0.0, tt[-1] + 3.0, 0.02)
+            y = np.where(t <= tt[-1], hermite(tt, th, dth, t), th[-1])
+            y = y + 0.01 * np.abs(y).max() * np.random.default_rng(seed).standard_normal(t.size)
+            fit = rocksweep.calibrate({**sc, 'impact': {**sc['impact'], 'e': 0.8}},
+                                      pd.DataFrame({'p_t': t, 'theta_over_alpha': y}), 'impact.e')
+            est = float(fit['estimate'][0])
+            if str(fit['reason'].item()) != 'ok' or abs(est - 0.85) > 0.01:
+                bad.append((seed, str(fit['reason'].item()), est))
+        print('OK' if not bad else f'WRONG {bad}')
+        sys.exit(0 if not bad else 98)""")
+
+
+# item 4: API types
+for _code in ("rocksweep.floor_spectrum(None)", "rocksweep.floor_spectrum(5)",
+              "rocksweep.floor_spectrum([1, 2])", "rocksweep.floor_spectrum({})",
+              "rocksweep.floor_spectrum('fl.h5', rtol='x')",
+              "rocksweep.floor_spectrum('fl.h5', search='no')",
+              "rocksweep.floor_spectrum('nothere.h5')",
+              "from rocksweep.analysis.floors import worst_orientation\n"
+              "worst_orientation(None)",
+              "rocksweep.felt_motion('fl.yaml')"):
+    case(f"API type: {_code.splitlines()[-1]}")(
+        lambda d, c=_code: (axes_fixture(d, "fl.h5", "fl.yaml", "peer"), api_call(d, c))[1])
+case("API: floor_spectrum of a path, as the other analyses take one", "ok")(
+    lambda d: (axes_fixture(d, "fl.h5"), py(d, "rocksweep.floor_spectrum('fl.h5')\n"
+                                             "print('OK')"))[1])
+
+
+# kills and resumes of floor sweeps; two writers
+@case("kill -9 of a floor sweep, then --resume: every point as one uninterrupted sweep", "ok")
+def _(d):
+    axes_fixture(d, "peer", "fl.h5")
+    big = FLOOR_SUITE.replace("[0.2, 0.5]", "{start: 0.1, stop: 2, num: 24}").replace(
+        "[0, 90]", "[0, 45, 90, 135]")
+    (d / "k.yaml").write_text(big)
+    e = {**os.environ, "PYTHONPATH": str(ROOT)}
+    freeze(d)
+    p = subprocess.Popen([sys.executable, "-m", "rocksweep", "sweep", "k.yaml", "-o", "k.h5",
+                          "-q"], cwd=d, env=e, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    time.sleep(4.0)
+    p.kill()
+    p.communicate(timeout=TIMEOUT)
+    r = cli(d, ["sweep", "k.yaml", "-o", "k.h5", "-q", "--resume"])
+    if r.returncode:
+        return r
+    r2 = cli(d, ["sweep", "k.yaml", "-o", "one.h5", "-q"])
+    if r2.returncode:
+        return r2
+    r3 = py(d, """
+        import numpy as np
+        a, b = rocksweep.open('k.h5'), rocksweep.open('one.h5')
+        same = np.array_equal(a['outcome'].values, b['outcome'].values) and np.allclose(
+            a['theta_max_over_alpha'].values, b['theta_max_over_alpha'].values, equal_nan=True)
+        print('OK' if same else 'WRONG the resumed file differs')
+        sys.exit(0 if same else 98)""")
+    freeze(d)  # the sweeps wrote their files, as they should
+    return r3
+
+
+case("two floor-spectrum -o f.csv at once: one writes, the other refuses", "ok")(
+    lambda d: (axes_fixture(d, "fl.h5"), two_writers(d, "f.csv", [
+        "floor-spectrum", "fl.h5", "-o", "f.csv"]))[1])
+
+
 # --- the run -------------------------------------------------------------------------------
 
 def classify(r: subprocess.CompletedProcess, before: dict, after: dict,
@@ -1086,8 +1441,9 @@ def main() -> int:
     print(f"\n{total} cases in {time.perf_counter() - t0:.0f} s: " +
           ", ".join(f"{k} {counts[k]}" for k in ("clean", "ok", "dataloss", "traceback",
                                                     "hang", "wrong")))
-    if "dir" in FIXTURES:
-        shutil.rmtree(FIXTURES["dir"], ignore_errors=True)
+    for made in (FIXTURES, NEW_AXES):
+        if "dir" in made:
+            shutil.rmtree(made["dir"], ignore_errors=True)
     return 1 if any(counts[k] for k in ("dataloss", "traceback", "hang", "wrong")) else 0
 
 

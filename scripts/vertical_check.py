@@ -18,10 +18,10 @@ import numpy as np
 from rocksweep.compute.single import run_point
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody
+from rocksweep.physics.ground_motion import recorded
 from rocksweep.physics.points import Point
 from rocksweep.physics.records import parse_record
 from rocksweep.physics.reference import reference_run
-from rocksweep.vocab.ground import RECORD
 
 
 def two(t, a, name):
@@ -43,8 +43,9 @@ for alpha, Tp, av, wv, ph in CASES:
     blk = BlockBody(alpha=alpha)
     p = 2 * np.pi / 1.5
     prev = None
+    motion = recorded(h, v)
     for A in np.arange(1.0, 6.0, 0.05):
-        pt = Point(blk, 1.0, RECORD, math.nan, float(A), record=h, p=p, vertical=v)
+        pt = Point(blk, 1.0, motion, math.nan, float(A), p=p)
         k = run_point(pt, num, history=False).outcome
         r = words[reference_run(pt, num)["outcome"]]
         tot += 1

@@ -18,7 +18,7 @@ PKG = Path(__file__).resolve().parents[1] / "rocksweep"
 FLOORS: list[tuple[str, ...]] = [
     ("errors", "vocab"),
     ("outputs", "inputs", "interrupts", "kernel"),
-    ("numerics", "outcomes"),
+    ("numerics",),
     ("schema",),
     ("physics",),
     ("fields",),
@@ -27,7 +27,7 @@ FLOORS: list[tuple[str, ...]] = [
     ("compute",),
     ("analysis",),
     ("figures",),
-    ("api", "simulation", "__init__"),
+    ("api", "simulation", "accessor", "__init__"),
     ("cli", "__main__"),
 ]
 

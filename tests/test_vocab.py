@@ -2,10 +2,12 @@
 again anywhere else in the package fails here, as the docs-keys test fails on a key
 table that drifted from the schema.
 
-A "list" is a tuple, list or set literal, or the keys of a dict literal, holding two or
-more names of one family, or a string (not a docstring) naming every member of a family of
-three or more (a message such as "must be sine, cosine, ricker or mp"). Single names in
-comparisons (``law == CONSTANT``) are uses, not definitions, and stay free.
+A "list" is a tuple, list or set literal (not ``__all__``'s names of Python objects), or
+the keys of a dict literal, holding two or more names of one family, or a string (not a
+docstring) naming every member of a family of three or more (a message such as "must be
+sine, cosine, ricker or mp"). Single names in comparisons (``law == CONSTANT``) are uses,
+not definitions, and stay free; a few single words (``WORDS``: the attribute naming a
+Dataset's kind) have one home and are typed nowhere else.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ from pathlib import Path
 import pytest
 from helpers import docstring_ids
 
-from rocksweep.vocab import axes, ground, laws, outcomes, phases, settings
+from rocksweep.vocab import axes, ground, kinds, laws, outcomes, phases, settings
 
 PKG = Path(__file__).resolve().parents[1] / "rocksweep"
 
@@ -36,6 +38,14 @@ FAMILIES: dict[str, tuple[str, ...]] = {
     "alpha_ref keys": axes.ALPHA_KEYS,
     "alpha_ref LaTeX": tuple(tex for _, tex in axes.ALPHA_REF.values()),
     "contact phases": phases.PHASES,
+    "dataset kinds": kinds.KIND_NAMES,
+    "IM components": ground.COMPONENTS,
+    "missing components": ground.MISSING,
+    "orientation answers": ground.ORIENTATIONS,
+}
+# Single words with one home: typed as a string anywhere else (not in a docstring) they fail.
+WORDS: dict[str, str] = {
+    kinds.KIND_ATTR: "the kind attribute (vocab.kinds.KIND_ATTR)",
 }
 # Concepts whose values (not names) live elsewhere, keyed by the vocabulary's names: the
 # one dict literal allowed, checked to hold exactly the vocabulary's names below.
@@ -52,8 +62,13 @@ def redefinitions(src: str, where: str) -> list[str]:
     """Lines of ``src`` that type a list of one family's names (see the module docstring)."""
     tree = ast.parse(src)
     docs = docstring_ids(tree)
+    exports = {id(node.value) for node in ast.walk(tree)  # module names, not vocabulary
+               if isinstance(node, ast.Assign)
+               and any(isinstance(t, ast.Name) and t.id == "__all__" for t in node.targets)}
     found = []
     for node in ast.walk(tree):
+        if id(node) in exports:
+            continue
         if isinstance(node, ast.IfExp):  # "alpha" if block else "alpha_cg": a mapping
             pair = set(_strings([node.body, node.orelse]))
             found += [f"{where}:{node.lineno}: {family} chosen by a condition"
@@ -66,6 +81,8 @@ def redefinitions(src: str, where: str) -> list[str]:
             names = _strings(k for k in node.keys if k is not None)
         elif (isinstance(node, ast.Constant) and isinstance(node.value, str)
               and id(node) not in docs):
+            if node.value in WORDS:
+                found.append(f"{where}:{node.lineno}: {WORDS[node.value]}")
             words = set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", node.value))
             for family, members in FAMILIES.items():
                 if len(members) >= 3 and set(members) <= words:
@@ -107,12 +124,18 @@ def test_the_checker_sees_a_copy():
            'key = "alpha" if kind == "block" else "alpha_cg"\n'
            'word = "mode1" if m == 1 else "mode2"\n'
            'ok = law == "constant"\n'
-           'def f():\n    """vertical, locked, constant in a docstring is prose."""\n')
-    found = redefinitions(src, "x.py")
+           'def f():\n    """vertical, locked, constant in a docstring is prose."""\n'
+           'attrs = {"rocksweep_kind": "ida"}\n'
+           'ANSWERS = ("each", "worst")\n'
+           'how = "skip" if lenient else "error"\n')
+    found = sorted(redefinitions(src, "x.py"), key=lambda f: int(f.split(":")[1]))
     assert found == ["x.py:1: impact laws ['constant', 'locked', 'vertical']",
                      "x.py:2: pulse shapes in a string",
                      "x.py:3: the diagram axes (vocab.axes.DIAGRAM_AXES)",
-                     "x.py:5: alpha_ref keys chosen by a condition"]
+                     "x.py:5: alpha_ref keys chosen by a condition",
+                     "x.py:10: the kind attribute (vocab.kinds.KIND_ATTR)",
+                     "x.py:11: orientation answers ['each', 'worst']",
+                     "x.py:12: missing components chosen by a condition"]
 
 
 def test_the_homes_hold_the_vocabulary_names():
@@ -128,7 +151,7 @@ def test_kernel_codes_are_the_vocabulary_codes():
 
     assert [L.SHAPE_SINE, L.SHAPE_COSINE, L.SHAPE_RICKER, L.SHAPE_MP, L.SHAPE_RECORD] == [
         ground.SHAPE_CODE[s] for s in (*ground.SHAPES, ground.RECORD)]
-    assert [L.LAW_VERTICAL, L.LAW_LOCKED, L.LAW_CONSTANT] == [laws.LAW_CODE[w]
+    assert [L.LAW_EQ1, L.LAW_LOCKED, L.LAW_CONSTANT] == [laws.LAW_CODE[w]
                                                                for w in laws.LAWS]
     assert [L.ROOT_BISECT, L.ROOT_ILLINOIS, L.ROOT_HERMITE] == [settings.ROOT_CODE[w]
                                                                 for w in settings.ROOTS]

@@ -41,10 +41,15 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from rocksweep import fields
+from rocksweep.compute.dispatch import run_variant
+from rocksweep.compute.driver import sweep_arrays
+from rocksweep.compute.sweep import run_rows
 from rocksweep.errors import SceneError
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import warm_up
 from rocksweep.numerics import PRESETS, Numerics
+from rocksweep.physics.reference import reference_run, result_row
+from rocksweep.scene.grid import Grid
 from rocksweep.scene.model import Scene
 from rocksweep.vocab.axes import DIAGRAM_AXES, RECORD_X
 from rocksweep.vocab.outcomes import CLASSES, FLAGGED, OUTCOME_NOT_RUN, OUTCOME_SAFE
@@ -254,9 +259,6 @@ def sample_scene(scene: Scene, n: int | None, seed: int = DEFAULT_SAMPLE_SEED) -
     ``n`` None or >= the scene's size takes every point (one stratum "all", weights 1,
     no classification pass).
     """
-    from rocksweep.compute.driver import sweep_arrays
-    from rocksweep.scene.grid import Grid
-
     grid = Grid(scene)
     if n is None or n >= grid.size:
         return Sample(np.arange(grid.size, dtype=np.int64), np.zeros(grid.size, np.int64),
@@ -277,10 +279,15 @@ def sample_scene(scene: Scene, n: int | None, seed: int = DEFAULT_SAMPLE_SEED) -
 
 
 def _no_suite(scene: Scene) -> None:
-    """The accuracy study runs one record a scene (its rows carry the record's samples)."""
+    """The accuracy study runs one recorded motion a scene (its rows carry its samples)."""
     if scene.suite is not None:
         raise SceneError(f"ground.records: the accuracy study takes one record "
                          f"(ground.record: one of {scene.suite.names[0]}, ...), not a suite")
+    if scene.path is not None:
+        for k in scene.excitation_axes:
+            if len(scene.axis(k).values) > 1:
+                raise SceneError(f"{scene.axis(k).key}: the accuracy study takes one "
+                                 "motion the body feels; give one value")
 
 
 def _with_numerics(scene: Scene, numerics: Numerics) -> Scene:
@@ -296,14 +303,10 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
     kernel); the sample is also timed as one call per kernel kind. Both are the best of
     ``repeat`` rounds (the machine's noise only ever adds time). Compilation is excluded.
     """
-    from rocksweep.compute.dispatch import run_variant
-    from rocksweep.physics.points import with_record
-    from rocksweep.scene.grid import Grid
-
     _no_suite(scene)
     cr = Grid(_with_numerics(scene, numerics)).rows_at(flat)
-    # a record's samples (and its vertical's) ride on each row
-    rows_all = with_record(cr.rows, scene.record, scene.vertical_samples())
+    # the excitation's samples ride on each row
+    rows_all = cr.with_samples()
     ground = scene.ground  # the Ricker, MP and records run the GROUND variants
     n = len(flat)
     outs = np.empty((n, L.N_OUT))
@@ -345,9 +348,6 @@ def run_reference(scene: Scene, flat: np.ndarray,
     int64[n]: the reference's self-check, see ``reference_run``). The first point is run
     once untimed before: the reference's first call in a process loads (or compiles) the
     jitted equations it shares with the kernel, ~0.25 s that is no point's cost."""
-    from rocksweep.physics.reference import reference_run, result_row
-    from rocksweep.scene.grid import Grid
-
     grid = Grid(scene)
     values = grid.index_values(flat)
     n = len(flat)
@@ -407,9 +407,6 @@ def run_energy(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray
     """The energy-accounting kernel on the given points (untimed): float64[n, N_OUT].
     Through the sweep's dispatch (``compute.sweep.run_rows``), so Ricker, MP and record
     scenes run their ground variants with the record's samples."""
-    from rocksweep.compute.sweep import run_rows
-    from rocksweep.scene.grid import Grid
-
     sc = _with_numerics(scene, numerics)
     cr = Grid(sc).rows_at(flat)
     return run_rows(cr, cr.rows, L.LEVEL_ENERGY, sc)
@@ -418,9 +415,6 @@ def run_energy(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray
 def run_half(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray:
     """The half-step reruns of ``outputs.check`` (``fields.check_rows``) on the given
     points, outcome-only kernel, untimed: float64[n, N_OUT] (the sweep's dispatch)."""
-    from rocksweep.compute.sweep import run_rows
-    from rocksweep.scene.grid import Grid
-
     _no_suite(scene)
     sc = _with_numerics(scene, numerics)
     cr = Grid(sc).rows_at(flat)
@@ -637,8 +631,6 @@ def accuracy_study(scene: Scene, n_points: int | None = 200,
     check: also rerun every setting at half the step and score the per-point error
     estimates of ``outputs.check`` against the true errors (``estimate_scores``).
     """
-    from rocksweep.scene.grid import Grid
-
     _no_suite(scene)
     t_wall = time.perf_counter()
     settings = settings if settings is not None else ladder("full")

@@ -13,8 +13,8 @@ For every panel (a value of each non-diagram axis: shape, body keys, lam) of a d
   to a relative tolerance, so the curve is not limited by the grid spacing.
 
 Rows for CSV (``a_min_rows``, ``boundary_rows``; ``analysis.files.csv_text``) export
-them; the figures are in ``rocksweep.figures.diagrams`` (``a_min_figure``, and
-``rocksweep plot --curves``).
+them; the figures are ``rocksweep.figures.a_min.a_min_figure`` and the curves of
+``rocksweep plot --curves`` (``figures.panels.draw_boundaries``).
 ``result_curves`` does it all for a result file (``rocksweep boundaries``). Units: those
 of the axes (w_over_p = omega/p, A_ratio = A/(g tan alpha_cg), eq. 2).
 """
@@ -42,22 +42,12 @@ from rocksweep.errors import (
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import warm_up
-from rocksweep.numerics import MAX_POINT_STEPS, Numerics
-from rocksweep.physics.points import (
-    Point,
-    body_omega_rock,
-    body_row,
-    fill_rows,
-    kernel_kind,
-    law_code,
-    point_row,
-    shape_code,
-    with_record,
-)
+from rocksweep.numerics import MAX_POINT_STEPS
+from rocksweep.physics.points import Point, kernel_kind, points_rows
 from rocksweep.scene.grid import Grid
 from rocksweep.scene.model import Scene
 from rocksweep.vocab.axes import DIAGRAM_AXES
-from rocksweep.vocab.ground import RECORD
+from rocksweep.vocab.kinds import BOUNDARIES, KIND_ATTR
 from rocksweep.vocab.outcomes import OUTCOME_MODE1, OUTCOME_MODE2, outcome_word
 
 if TYPE_CHECKING:
@@ -306,51 +296,22 @@ Evaluator = Callable[[list[Point]], np.ndarray]
 def kernel_rows(scene: Scene, points: list[Point]) -> np.ndarray:
     """The kernel's result rows float64[n, N_OUT] of arbitrary points, one run each
     (outcome-only kernel, the scene's sweep numerics, close calls certified as the grid's
-    were: ``compute.dispatch.run_variant``), for every
-    ground motion: sine and cosine pulses on the pulse variants, Ricker and MP pulses and
-    records on the ground variants (``point.ground``)."""
+    were: ``compute.dispatch.run_variant``), for every ground motion, each on its
+    excitation's ground variant (``Point.ground``)."""
     outs = np.empty((len(points), L.N_OUT))
-    # one kernel call per body kind, ground variant and record (a record's samples ride
-    # on its rows: rows of one call have one length); the rows of the points that share a
-    # body object and the pulse's options filled at once (``fill_rows``)
-    groups: dict[tuple, list[int]] = {}
-    for i, p in enumerate(points):
-        key = (kernel_kind(p.body), p.ground, id(p.record), id(p.vertical), id(p.body),
-               p.cycles, p.gamma, p.nu)
-        groups.setdefault(key, []).append(i)
-    for (kind, ground, *_), idx in groups.items():
-        warm_up(kind, L.LEVEL_OUTCOME, ground)
-        rows = _rows([points[i] for i in idx], scene.numerics)
+    # the rows of all points at once (``points.points_rows``); one kernel call per body
+    # kind and excitation (whose samples ride on its rows)
+    rows, excitations, which = points_rows(points, scene.numerics)
+    kinds = np.array([kernel_kind(p.body) for p in points], np.int64)
+    groups = np.unique(np.stack([kinds, which], 1), axis=0)
+    for kind, j in groups.tolist():
+        idx = np.flatnonzero((kinds == kind) & (which == j))
+        ex = excitations[j]
+        warm_up(kind, L.LEVEL_OUTCOME, ex.ground)
         # the close calls re-run finer, as the sweep's did (``compute.certify``)
-        outs[idx] = run_variant(rows, kind, L.LEVEL_OUTCOME, ground, scene.numerics.refine)
+        outs[idx] = run_variant(rows[idx], kind, L.LEVEL_OUTCOME, ex.ground,
+                                scene.numerics.refine, excitation=ex)
     return outs
-
-
-def _rows(points: list[Point], numerics: Numerics) -> np.ndarray:
-    """Parameter rows float64[n, N_PAR (+ samples)] of points sharing one body object,
-    record and pulse options (``point_row`` for each, vectorised: ``fill_rows``)."""
-    p0 = points[0]
-    body = p0.body
-    rec = p0.record if p0.shape == RECORD else None
-    n = len(points)
-    rows = np.empty((n, L.N_PAR))
-
-    def column(name: str) -> np.ndarray:
-        return np.array([getattr(p, name) for p in points], float)
-
-    vertical = p0.vertical_on_samples() if rec is not None else None
-    pv = None
-    if p0.pulse_vertical is not None:  # the vertical harmonic's keys, point by point
-        pv = tuple(np.array([getattr(p.pulse_vertical, k) for p in points], float)
-                   for k in ("amplitude", "w_over_p", "phase"))
-    fill_rows(rows, np.broadcast_to(body_row(body), (n, L.N_PAR)),
-              np.full(n, body_omega_rock(body)), np.full(n, body.alpha_ref), column("lam"),
-              np.array([shape_code(p.shape) for p in points]),
-              column("p") if rec is not None else column("w_over_p"), column("A_ratio"),
-              numerics, p0.cycles, p0.gamma, p0.nu, rec, column("mu"),
-              np.array([law_code(p.law) for p in points]), column("e"),
-              column("e_factor"), vertical=vertical, pulse_vertical=pv)
-    return with_record(rows, rec, vertical)
 
 
 def kernel_evaluator(scene: Scene) -> Evaluator:
@@ -581,8 +542,7 @@ def _check_budget(scene: Scene, axes: Sequence[str], cols: list[_Column],
         if scan:
             step = max(step, float(np.max(np.diff([yv[0], *scan]))))
         n = len(scan) + _bisection_steps(max(top - step, yv[0]), top, rtol)
-        cap = point_row(col.point(scene, axes[1], top),
-                        scene.numerics)[L.PAR_MAXSTEPS]
+        cap = points_rows([col.point(scene, axes[1], top)], scene.numerics)[0][0, L.PAR_MAXSTEPS]
         total += n * float(cap)
         runs += n
     if total > MAX_REFINE_STEPS:
@@ -781,7 +741,7 @@ def boundaries_dataset(ds: Any, rtol: float = DEFAULT_RTOL, mode: int | None = N
     search = check_search(search)
     result = as_result(ds, list(RESPONSE))
     curves, _ = result_curves(result, rtol, mode, search=search)
-    return curves_dataset(curves, {"rocksweep_kind": "boundaries", "kind": result.kind,
+    return curves_dataset(curves, {KIND_ATTR: BOUNDARIES, "kind": result.kind,
                                    "title": result.name, "rtol": rtol,
                                    "search": int(search),
                                    "mode": "any" if mode is None else f"mode{mode}"})

@@ -13,11 +13,16 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.analysis.states import counted_points, parse_state, required, state_reached
+from rocksweep.compute.adaptive import FILLED
 from rocksweep.errors import Arg, FragilityError
 from rocksweep.vocab.ground import CLOUD_IMS as CLOUD_IM_VARIABLES
 from rocksweep.vocab.ground import SCALE_IMS
 from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, UPLIFT
 
+#: the coordinate along ``record`` naming the record each sample was drawn from (a
+#: sample per (record, angle): ``floors.each_orientation``); the bootstrap resamples
+#: records, each with all its samples
+RECORD_OF = "record_of"
 #: stripe dimension names (the sweep's ``scale_im``) and their units
 STRIPE_IMS = SCALE_IMS
 #: cloud IMs and the per-record variables they come from
@@ -64,8 +69,6 @@ def refuse_filled(ds: xr.Dataset, states: Sequence[str], counted: xr.DataArray) 
     more (uplift, theta:X)."""
     if "computed" not in ds.variables:
         return
-    from rocksweep.compute.adaptive import FILLED
-
     filled = (ds["computed"] == FILLED) & counted
     n = int(filled.sum())
     need = [s for s in states if parse_state(s)[0] in (UPLIFT, "theta")]
@@ -138,6 +141,10 @@ class Counts:
     not_run: np.ndarray
     hits: np.ndarray  # the point reaches the state
     over_all: np.ndarray  # the point overturns (either mode)
+    # the record each sample of the record dimension was drawn from (int[R], 0..G-1):
+    # every (record, angle) pair of an ``each`` orientation answer is a sample of its
+    # record (``floors.each_orientation``'s ``RECORD_OF``); None: each sample a record
+    groups: np.ndarray | None = None
 
     @property
     def n_o(self) -> int:
@@ -146,6 +153,20 @@ class Counts:
     @property
     def R(self) -> int:
         return self.counted.shape[1]
+
+    @property
+    def n_groups(self) -> int:
+        """The records the samples come from (R when each sample is a record)."""
+        return self.R if self.groups is None else int(self.groups.max()) + 1
+
+    def records_counted(self) -> np.ndarray:
+        """int[n_o]: the records with at least one counted point (a record whose samples
+        are its orientations counts once)."""
+        per = self.counted.reshape(self.n_o, self.R, -1).any(-1)
+        if self.groups is None:
+            return per.sum(-1)
+        return np.stack([per[:, self.groups == g].any(-1)
+                         for g in range(self.n_groups)], -1).sum(-1)
 
     def onehot(self, kind: str, idxs: list[int], o: int, mask: np.ndarray) -> np.ndarray:
         """(C, R[, S]) float: each point of ``mask`` in its category of the group."""
@@ -174,7 +195,12 @@ def count_points(ds: xr.Dataset, states: list[str], axis: IMAxis, out_da: xr.Dat
         return da.transpose(*order).values.reshape((n_o,) + tail)
 
     hits = np.stack([state_reached(ds, s).transpose(*order).values for s in states])
+    groups = None
+    if RECORD_OF in ds.coords and ds[RECORD_OF].dims == ("record",):
+        of = [str(v) for v in ds[RECORD_OF].values]
+        first = {name: g for g, name in enumerate(dict.fromkeys(of))}  # records in order
+        groups = np.array([first[name] for name in of], np.int64)
     return Counts(others, shape_o, [str(r) for r in ds["record"].values],
                    flat(counted_da), flat(flagged_da), flat(not_run_da),
                    hits.reshape((len(states), n_o) + tail),
-                   flat(state_reached(ds, OVERTURN)))
+                   flat(state_reached(ds, OVERTURN)), groups)

@@ -22,6 +22,19 @@ that scale differently (Arias's beta is twice its sqrt's).
 
 Clouds (unscaled suites): a probit fit of the 0/1 outcome on ln J of each record times its
 factor^n (``fragility.fit_cloud``), beta = 1 / slope.
+
+Verdicts (``reason`` per IM and curve: "ok", or the words joined by ","; also an
+``AnalysisWarning``), as fragility's fits have them:
+
+- "separated": one value (a line in ln J, for a regression) lies inside every record's
+  capacity interval: the likelihood grows as beta -> 0, so beta is below what the stripes
+  resolve and its value (~0.001: where the optimiser stopped) is no measurement; such IMs
+  tie (the best, if the sample is large enough to tell). A linear-programming test of
+  the intervals (``_separated``), not of where the optimiser stopped. A cloud's probit
+  says it as fragility's does (beta NaN there);
+- "few_records": fewer than ``MIN_RECORDS`` records counted: beta's own relative standard
+  error (~ 1 / sqrt(2 n)) exceeds 20%, more than the differences a ranking rests on;
+- "no_failures": no record reaches the state (beta NaN).
 """
 
 from __future__ import annotations
@@ -40,8 +53,13 @@ from rocksweep.errors import EfficiencyError
 from rocksweep.physics.bodies import G
 from rocksweep.vocab.axes import ALPHA_KEYS
 from rocksweep.vocab.ground import PGA_RATIO, PGV_OVER_PGA, PGV_RATIO, RECORD_IMS, SA, SCALE_IMS
+from rocksweep.vocab.kinds import IM_EFFICIENCY, KIND_ATTR
 
 __all__ = ["im_efficiency", "record_im_table"]
+
+#: fewer records counted than this: the verdict "few_records" (beta's relative standard
+#: error ~ 1 / sqrt(2 n) is 22% at n = 10)
+MIN_RECORDS = 10
 
 
 
@@ -111,6 +129,35 @@ def _interval_mle(lo: np.ndarray, hi: np.ndarray, z: np.ndarray | None
     return float(th[0]), float(th[1]) if z is not None else 0.0, math.exp(float(th[-1]))
 
 
+def _separated(lo: np.ndarray, hi: np.ndarray, z: np.ndarray | None) -> bool:
+    """Whether one value a (a line a + b z) lies strictly inside every interval lo < y <=
+    hi (-inf, inf: censored; lo == hi an exact value, never strictly inside): the
+    interval likelihood then grows as the dispersion -> 0 (no finite MLE). A linear
+    programme: the largest margin t <= 1 with lo + t <= a + b z <= hi - t; separated iff
+    t > 0."""
+    from scipy.optimize import linprog
+
+    if np.any(lo >= hi):
+        return False
+    X = np.ones((lo.size, 1)) if z is None else np.column_stack([np.ones(lo.size), z])
+    k = X.shape[1]
+    rows, rhs = [], []
+    for r in range(lo.size):  # -(X a) + t <= -lo ;  X a + t <= hi
+        if np.isfinite(lo[r]):
+            rows.append(np.append(-X[r], 1.0))
+            rhs.append(-lo[r])
+        if np.isfinite(hi[r]):
+            rows.append(np.append(X[r], 1.0))
+            rhs.append(hi[r])
+    if not rows:
+        return True
+    c = np.zeros(k + 1)
+    c[-1] = -1.0  # maximise t
+    res = linprog(c, A_ub=np.array(rows), b_ub=np.array(rhs),
+                  bounds=[(None, None)] * k + [(None, 1.0)], method="highs")
+    return bool(res.status == 0 and -res.fun > 1e-12)
+
+
 def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
     """The dispersion beta of ``state``'s fragility in every IM of a record-suite sweep
     (module docstring), one value per IM and per value of the other swept keys (lam, ...).
@@ -123,9 +170,11 @@ def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
     ``beta_scale`` (beta / n: in ln of the scale factor, comparable across IMs),
     ``im_median`` (the median capacity in that IM; NaN for regressions), ``slope`` (the
     regression's b, NaN otherwise), ``n_records``, ``n_censored`` (never reached the
-    state); over (im,): ``units``, ``exponent`` n, ``method`` ("capacity", "regression"
-    or "cloud-probit"). attrs: rocksweep_kind = "im_efficiency", state, stripe_im,
-    reference.
+    state), ``reason`` (module docstring: "ok", or "separated", "few_records",
+    "no_failures" joined by ","; an ``AnalysisWarning`` says the non-ok ones); over
+    (im,): ``units``, ``exponent`` n, ``method`` ("capacity", "regression" or
+    "cloud-probit"). attrs: rocksweep_kind = "im_efficiency", state, stripe_im, reason
+    (the points' verdict), reference.
     """
     if not isinstance(ds, xr.Dataset) or "outcome" not in ds.variables:
         raise EfficiencyError("im_efficiency needs a record-suite sweep (rocksweep.run or "
@@ -174,6 +223,7 @@ def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
                                                    "slope")}
     n_rec = np.zeros((nI, n_o), np.int64)
     n_cens = np.zeros((nI, n_o), np.int64)
+    why = np.full((nI, n_o), "", dtype=object)  # the fits' own words (separated, ...)
     methods = []
     for name in names:
         n = table[name][2]
@@ -181,24 +231,67 @@ def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
                        "capacity" if n > 0 else "regression")
     for o in range(n_o):
         if stripe is None:  # a cloud: probit on ln(J F^n)
-            _cloud_fits(o, names, table, vals, fac, cnt, hit, res, n_rec)
+            _cloud_fits(o, names, table, vals, fac, cnt, hit, res, n_rec, why)
         else:
             _stripe_fits(o, np.asarray(ds[stripe].values, np.float64), names, table, vals,
-                         fac, cnt, hit, res, n_rec, n_cens)
+                         fac, cnt, hit, res, n_rec, n_cens, why)
+    reason = _reasons(why, n_rec, cnt.reshape(n_o, R, -1).any(-1).sum(-1))
+    _warn(state, names, reason)
     return _dataset(ds, state, verdict, stripe, others, shape_o, names, table, methods,
-                    res, n_rec, n_cens)
+                    res, n_rec, n_cens, reason)
+
+
+def _reasons(why: np.ndarray, n_rec: np.ndarray, counted: np.ndarray) -> np.ndarray:
+    """The verdict of every (IM, curve) (module docstring): the fit's own words, then
+    "few_records" where fewer than MIN_RECORDS records are counted, "no_failures" where
+    no record reached the state."""
+    out = np.empty(why.shape, dtype=object)
+    for idx in np.ndindex(*why.shape):
+        words = [w for w in str(why[idx]).split(",") if w and w != "ok"]
+        n = int(n_rec[idx]) or int(counted[idx[1]])
+        if n < MIN_RECORDS and "few_records" not in words:
+            words.append("few_records")
+        out[idx] = ",".join(dict.fromkeys(words)) or "ok"
+    return out
+
+
+def _warn(state: str, names: list[str], reason: np.ndarray) -> None:
+    """One ``AnalysisWarning`` naming the IMs each verdict word holds for."""
+    import warnings
+
+    from rocksweep.errors import AnalysisWarning
+
+    by: dict[str, list[str]] = {}
+    for i, name in enumerate(names):
+        for w in dict.fromkeys(x for r in reason[i] for x in str(r).split(",")):
+            if w != "ok":
+                by.setdefault(w, []).append(name)
+    if by:
+        meaning = {"separated": "beta below the stripes' resolution",
+                   "few_records": f"fewer than {MIN_RECORDS} records",
+                   "no_failures": "no record reaches the state"}
+        text = "; ".join(f"{w} ({', '.join(ims) if len(ims) < len(names) else 'every IM'}"
+                         f": {meaning.get(w, w)})" for w, ims in by.items())
+        warnings.warn(f"IM efficiency, state {state}: {text}; no ranking rests on those "
+                      "betas", AnalysisWarning, stacklevel=3)
 
 
 def _cloud_fits(o: int, names: list[str], table: dict, vals: dict, fac: np.ndarray,
-                cnt: np.ndarray, hit: np.ndarray, res: dict, n_rec: np.ndarray) -> None:
-    """A cloud's curve o: a probit on ln(J F^n) per IM (in ``res``, ``n_rec``)."""
+                cnt: np.ndarray, hit: np.ndarray, res: dict, n_rec: np.ndarray,
+                why: np.ndarray) -> None:
+    """A cloud's curve o: a probit on ln(J F^n) per IM (in ``res``, ``n_rec``; the
+    probit's own verdict in ``why``)."""
     for i, name in enumerate(names):
         n = table[name][2]
         x = vals[name][o] * fac[o] ** n
         use = cnt[o] & np.isfinite(x) & (x > 0)
         if use.sum() < 2:
             continue
-        med, beta = fit_cloud(x[use], hit[o][use])[:2]  # (median, beta)
+        fit = fit_cloud(x[use], hit[o][use])
+        med, beta = fit[:2]  # (median, beta)
+        why[i, o] = ",".join(w for w in fit.reason.split(",")
+                             if w in ("separated", "no_failures", "all_failed",
+                                      "beta_undetermined"))
         res["beta"][i, o] = beta
         res["beta_scale"][i, o] = beta / max(n, 1)
         res["im_median"][i, o] = med
@@ -207,9 +300,10 @@ def _cloud_fits(o: int, names: list[str], table: dict, vals: dict, fac: np.ndarr
 
 def _stripe_fits(o: int, levels: np.ndarray, names: list[str], table: dict, vals: dict,
                  fac: np.ndarray, cnt: np.ndarray, hit: np.ndarray, res: dict,
-                 n_rec: np.ndarray, n_cens: np.ndarray) -> None:
+                 n_rec: np.ndarray, n_cens: np.ndarray, why: np.ndarray) -> None:
     """Stripes' curve o: each record's capacity bracketed between two stripes, fitted per
-    IM by interval-censored maximum likelihood (in ``res``, ``n_rec``, ``n_cens``)."""
+    IM by interval-censored maximum likelihood (in ``res``, ``n_rec``, ``n_cens``;
+    "separated" in ``why`` where the intervals leave beta undetermined: NaN)."""
     h, c, f = hit[o], cnt[o], fac[o]
     first = np.where(h.any(-1), np.argmax(h, -1), -1)
     keep = c.any(-1)
@@ -225,6 +319,9 @@ def _stripe_fits(o: int, levels: np.ndarray, names: list[str], table: dict, vals
         lnf_lo, lnf_hi = np.log(f_lo[keep]), np.log(f_hi[keep])
         lnx_lo, lnx_hi = np.log(x_lo[keep]), np.log(x_hi[keep])
     if not np.isfinite(lnf_hi).any():  # nothing reaches the state
+        why[:, o] = "no_failures"
+        n_rec[:, o] = int(keep.sum())
+        n_cens[:, o] = int(keep.sum())
         return
     for i, name in enumerate(names):
         n = table[name][2]
@@ -233,13 +330,16 @@ def _stripe_fits(o: int, levels: np.ndarray, names: list[str], table: dict, vals
         if ok.sum() < 3:
             continue
         lnJ = np.log(J[ok])
+        lo, hi, z = ((n * lnf_lo[ok] + lnJ, n * lnf_hi[ok] + lnJ, None) if n > 0 else
+                     (lnx_lo[ok], lnx_hi[ok], lnJ))
+        a, b, s = _interval_mle(lo, hi, z)
+        if _separated(lo, hi, z):  # the likelihood grows as s -> 0: beta unresolved
+            why[i, o] = "separated"
         if n > 0:
-            a, _, s = _interval_mle(n * lnf_lo[ok] + lnJ, n * lnf_hi[ok] + lnJ, None)
             res["im_median"][i, o] = math.exp(a)
             res["beta"][i, o] = s
             res["beta_scale"][i, o] = s / n
         else:
-            a, b, s = _interval_mle(lnx_lo[ok], lnx_hi[ok], lnJ)
             res["beta"][i, o] = s
             res["beta_scale"][i, o] = s
             res["slope"][i, o] = b
@@ -249,8 +349,8 @@ def _stripe_fits(o: int, levels: np.ndarray, names: list[str], table: dict, vals
 
 def _dataset(ds: xr.Dataset, state: str, verdict: Any, stripe: str | None,
              others: list[str], shape_o: tuple[int, ...], names: list[str], table: dict,
-             methods: list[str], res: dict, n_rec: np.ndarray, n_cens: np.ndarray
-             ) -> xr.Dataset:
+             methods: list[str], res: dict, n_rec: np.ndarray, n_cens: np.ndarray,
+             reason: np.ndarray) -> xr.Dataset:
     """``im_efficiency``'s Dataset (its docstring)."""
     nI = len(names)
     dims = ["im", *others]
@@ -273,12 +373,15 @@ def _dataset(ds: xr.Dataset, state: str, verdict: Any, stripe: str | None,
         "n_records": (dims, shaped(n_rec)),
         "n_censored": (dims, shaped(n_cens), {"long_name": "records that never reach the "
                                               "state (right-censored)"}),
+        "reason": (dims, shaped(reason.astype(str)),
+                   {"long_name": "verdict: ok, or separated, few_records, no_failures "
+                                 "joined by ','"}),
         "units": (("im",), np.array([table[k][1] for k in names], dtype=str)),
         "exponent": (("im",), np.array([table[k][2] for k in names], np.int64),
                      {"long_name": "the IM of a record scaled by F is F^exponent times it"}),
         "method": (("im",), np.array(methods, dtype=str)),
     }
-    attrs = {"rocksweep_kind": "im_efficiency", "state": str(state), "reason": verdict,
+    attrs = {KIND_ATTR: IM_EFFICIENCY, "state": str(state), "reason": verdict,
              "stripe_im": stripe or "none",
              "reference": "Luco & Cornell (2007), Structural seismic demand analysis: "
                           "consideration of near-fault ground motions, Earthquake Spectra "

@@ -23,15 +23,23 @@ setting).
 
 from __future__ import annotations
 
+import csv
+import io
 import json
 import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from rocksweep import fields
+from rocksweep.analysis.kinds import dataset_kind
 from rocksweep.errors import ApiError
+from rocksweep.outputs import input_problem, shown, write_atomic
+from rocksweep.store.dataset import open_result
+from rocksweep.vocab.axes import DIAGRAM_AXES
 from rocksweep.vocab.kinds import ACCURACY, BOUNDARIES, KIND_ATTR, KIND_NAMES, SWEEP
 
 if TYPE_CHECKING:
@@ -58,9 +66,6 @@ def _field(v: Any) -> Any:
 def csv_text(rows: Sequence[Mapping[str, Any]] | pd.DataFrame) -> str:
     """CSV text of rows (the keys of the first row as the header) or of a DataFrame (its
     columns, no index): a float as its shortest repr, None and NaN as empty fields."""
-    import csv
-    import io
-
     if hasattr(rows, "to_csv"):  # a DataFrame: pandas writes floats by the same rule
         return rows.to_csv(index=False, lineterminator="\n", na_rep="")
     buf = io.StringIO()
@@ -93,8 +98,6 @@ def write_dataset(ds: xr.Dataset, path: str | Path, kind: str, *,
     """``to_netcdf`` published at ``path`` by the one publish rule
     (``outputs.write_atomic``: complete or absent, never over a file it was not told to
     replace)."""
-    from rocksweep.outputs import write_atomic
-
     write_atomic(path, lambda tmp: to_netcdf(ds, tmp, kind), overwrite=overwrite)
 
 
@@ -145,10 +148,10 @@ def write_curves_h5(path: str | Path, curves: Sequence[AMinCurve],
     The rows of ``a_min_rows`` / ``boundary_rows`` (what the CSV files hold) are these
     arrays' entries: A_min rows where A_min is not NaN, line rows one per vertex.
     """
+    # h5py (0.1 s) and analysis.boundaries (numba, 0.6 s): this file's writer only
     import h5py
 
     from rocksweep.analysis.boundaries import A_MIN_METHODS
-    from rocksweep.vocab.axes import DIAGRAM_AXES
 
     xname = curves[0].xname if curves else DIAGRAM_AXES[0]
     yname = curves[0].yname if curves else DIAGRAM_AXES[1]
@@ -218,15 +221,13 @@ def write_report(study: Study, path: str | Path, command: str = "", *,
     (with ``check``, also the ``fields.CHECK_FIELDS`` of the half-step reruns). In
     /reference, steps are DOP853's steps and event_steps 0 (``reference.result_row``).
     """
-    from rocksweep.outputs import write_atomic
-
     write_atomic(path, lambda tmp: _write_study(study, tmp, command), overwrite=overwrite)
 
 
 def _write_study(study: Study, path: Path, command: str) -> None:
+    # h5py (0.1 s), the accuracy study (numba, 0.6 s): its report's writer only
     import h5py
 
-    from rocksweep import fields
     from rocksweep.analysis.accuracy import OUTCOMES
     from rocksweep.physics.reference import ATOL, RTOL
 
@@ -287,7 +288,6 @@ def _write_study(study: Study, path: Path, command: str) -> None:
 def _write_runs(g: Any, outs: np.ndarray, seconds: np.ndarray, alpha_ref: np.ndarray
                 ) -> None:
     # every field the outcome-level kernel reports (rocksweep.fields), in its unit
-    from rocksweep import fields
     from rocksweep.analysis.accuracy import REPORT_FIELDS
 
     for name, arr in fields.convert(outs, alpha_ref, np.nan, REPORT_FIELDS).items():
@@ -305,14 +305,10 @@ def file_kind(path: str | Path) -> str | None:
     """The kind of a readable HDF5 file rocksweep wrote (its ``rocksweep_kind``, else
     guessed from its top-level variables); None for anything else (damaged, foreign,
     missing: ``open_result`` says why in one line)."""
-    from types import SimpleNamespace
-
-    from rocksweep.analysis.kinds import dataset_kind
-    from rocksweep.outputs import input_problem
-
     if input_problem(path) is not None:
         return None
     try:
+        # h5py (0.1 s): a file read only
         import h5py
 
         with h5py.File(path, "r") as f:
@@ -329,13 +325,9 @@ def open_any(path: str | Path) -> xr.Dataset:
     result (``store.dataset.open_result``), or what an analysis wrote, its JSON
     attributes decoded and ``attrs["rocksweep_kind"]`` its kind. Any other file gets
     ``open_result``'s one-line errors."""
-    from rocksweep.outputs import shown
-
     path = Path(path)
     kind = file_kind(path)
     if kind in (None, SWEEP):  # a sweep, or rocksweep.open's one-line error for the rest
-        from rocksweep.store.dataset import open_result
-
         return open_result(path)
     try:
         ds = (_open_boundaries(path) if kind == BOUNDARIES else
@@ -349,6 +341,7 @@ def open_any(path: str | Path) -> xr.Dataset:
 
 
 def _open_netcdf(path: Path) -> xr.Dataset:
+    # xarray (0.4-1.5 s): not for the HDF5 files the command line writes
     import xarray as xr
 
     with xr.open_dataset(path, engine="h5netcdf", phony_dims="sort") as ds:
@@ -375,6 +368,7 @@ def _plain_attr(v: Any) -> Any:
 def _open_boundaries(path: Path) -> xr.Dataset:
     """The A_min curves of a ``write_curves_h5`` file as ``boundaries.curves_dataset``
     gives them (the boundary lines stay in the file's ``lines`` groups)."""
+    # h5py (0.1 s) and analysis.boundaries (numba, 0.6 s): this file's reader only
     import h5py
 
     from rocksweep.analysis.boundaries import AMinCurve, curves_dataset
@@ -397,6 +391,7 @@ def _open_boundaries(path: Path) -> xr.Dataset:
 def _open_accuracy(path: Path) -> xr.Dataset:
     """An accuracy report's table (one entry per setting) and its attributes (the sample,
     the reference and the kernel's runs stay in the file's groups)."""
+    # h5py and xarray: this file's reader only
     import h5py
     import xarray as xr
 
@@ -412,6 +407,7 @@ def _open_accuracy(path: Path) -> xr.Dataset:
 
 def as_dataset(ds: Any, what: str) -> xr.Dataset:
     """A Dataset argument, or a path to one (``open_any``)."""
+    # xarray (0.4-1.5 s): not for the HDF5 files the command line writes
     import xarray as xr
 
     if isinstance(ds, str | Path):

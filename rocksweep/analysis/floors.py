@@ -3,8 +3,11 @@ the floor spectrum over ``floor.period``.
 
 Orientation. A sweep over ``angle`` answers two questions (``ORIENTATIONS``):
 
-- ``each``: every orientation is a sample: the (record, angle) pairs are the records
-  (``each_orientation``: the record coordinate becomes "name@angle deg");
+- ``each``: every orientation is a sample of the demand: the (record, angle) pairs are the
+  samples along ``record`` (``each_orientation``: the record coordinate becomes "name@angle
+  deg", ``record_of`` names the record); a fit pools them, but they are not independent
+  records: ``n_records`` counts records and the bootstrap resamples records, each with all
+  its angles (a cluster bootstrap), so the intervals are those of the records at hand;
 - ``worst``: the worst orientation per record (``worst_orientation``): at every other
   point of the grid, the angle whose run overturned (any angle) or, none overturning,
   rotated the most (largest max|theta|/alpha_ref); its variables are that run's,
@@ -31,20 +34,33 @@ from typing import Any
 
 import numpy as np
 
+from rocksweep.analysis.counts import RECORD_OF
+from rocksweep.analysis.tolerance import DEFAULT_RTOL_MANY
 from rocksweep.errors import FloorError
+from rocksweep.vocab.ground import ORIENTATIONS
+from rocksweep.vocab.kinds import FLOOR_SPECTRUM, KIND_ATTR
 
-ORIENTATIONS = ("each", "worst")
 FLOOR_X = "floor.period"
 
 
+def _where(ds) -> str:
+    """A Dataset as messages name it: its file, else its title."""
+    source = ds.encoding.get("source")
+    return str(source) if source else f"result in memory ({ds.attrs.get('title') or 'untitled'})"
+
+
 def worst_orientation(ds):
-    """The sweep Dataset with its ``angle`` dimension reduced to the worst orientation
-    (module docstring): the same variables, ``worst_angle`` [deg]; attrs ``orientation``
-    says how it was chosen."""
+    """The sweep Dataset (or a result file's path) with its ``angle`` dimension reduced to
+    the worst orientation (module docstring): the same variables, ``worst_angle`` [deg];
+    attrs ``orientation`` says how it was chosen."""
     import xarray as xr
 
-    if "angle" not in ds.dims:
-        raise FloorError("worst orientation: the Dataset has no angle dimension")
+    from rocksweep.analysis.files import as_dataset
+
+    ds = as_dataset(ds, "ds")
+    if "angle" not in ds.dims or "outcome" not in ds.data_vars:
+        raise FloorError(f"{_where(ds)}: worst orientation: not a sweep over angle (no "
+                         "angle dimension and outcome)")
     out = ds["outcome"]
     theta = ds["theta_max_over_alpha"].fillna(-1.0)
     key = xr.where(out > 0, np.inf, theta)
@@ -73,14 +89,19 @@ def worst_orientation(ds):
 
 
 def each_orientation(ds):
-    """The sweep Dataset with every (record, angle) pair a record "name@angle deg" (the
-    orientations as samples); per-record variables repeat over the angles."""
+    """The sweep Dataset with every (record, angle) pair a sample "name@angle deg" along
+    ``record`` (the orientations as samples of the demand), ``record_of`` naming its record
+    (``counts.RECORD_OF``: a fit counts records and its bootstrap resamples records, each
+    with all its angles); per-record variables repeat over the angles."""
     if "angle" not in ds.dims or "record" not in ds.dims:
         raise FloorError("each orientation: the Dataset needs record and angle dimensions")
     names = [f"{r}@{float(a):g}deg" for r in ds["record"].values for a in ds["angle"].values]
+    of = [str(r) for r in ds["record"].values for _ in ds["angle"].values]
     st = ds.stack(_sample=("record", "angle"))
     st = st.drop_vars(["record", "angle", "_sample"]).rename({"_sample": "record"})
-    st = st.assign_coords(record=("record", np.array(names, dtype=object)))
+    st = st.assign_coords(record=("record", np.array(names, dtype=object)),
+                          **{RECORD_OF: ("record", np.array(of, dtype=object),
+                                         {"long_name": "the record the sample is of"})})
     dims = [d for d in ds["outcome"].dims if d not in ("record", "angle")]
     order = list(ds["outcome"].dims)
     pos = order.index("record")
@@ -103,11 +124,14 @@ def by_orientation(ds, analysis: Callable[[Any], Any]):
     if "angle" not in ds.dims:
         return analysis(ds)
     parts = [analysis(each_orientation(ds)), analysis(worst_orientation(ds))]
+    # the answers' record dimensions differ (the samples of each, the records of worst):
+    # joined outer, NaN where an answer has no such sample
     out = xr.concat(parts, dim="orientation", coords="minimal", compat="override",
-                    combine_attrs="override")
+                    combine_attrs="override", join="outer")
     out = out.assign_coords(orientation=("orientation", list(ORIENTATIONS)))
-    out.attrs["orientation"] = ("each: every (record, angle) a sample; worst: the worst "
-                                "angle per record (overturns at any angle, else the largest "
+    out.attrs["orientation"] = ("each: every (record, angle) a sample, records resampled "
+                                "with all their angles; worst: the worst angle per record "
+                                "(overturns at any angle, else the largest "
                                 "max|theta|/alpha_ref)")
     return out
 
@@ -148,18 +172,29 @@ def _p_overturn(ds):
     return p, n
 
 
-def floor_spectrum(ds, rtol: float = 1e-2, search: bool = True):
+def floor_spectrum(ds, rtol: float = DEFAULT_RTOL_MANY, search: bool = True):
     """The floor spectrum of a complete sweep over ``floor.period`` (module docstring) as a
     Dataset (attrs rocksweep_kind "floor_spectrum", the building's ``floor`` line): a
     suite's ``p_overturn`` and ``n_counted`` over (floor.period, stripe, others[,
     orientation]); one record's or a pulse's ``A_min``, ``mode``, ``A_min_method`` over
-    (others, floor.period)."""
+    (others, floor.period). ds: a sweep Dataset or a result file's path; rtol (in (0,
+    MAX_RTOL]) and search (a bool) are checked first, as ``spectra`` checks them; an
+    incomplete result (an interrupted sweep) is refused in one line."""
     import xarray as xr
 
-    if FLOOR_X not in ds.dims:
-        raise FloorError(f"floor spectrum: the sweep has no {FLOOR_X} dimension (sweep "
-                         "floor.period in the scene's floor section)")
-    attrs = {"rocksweep_kind": "floor_spectrum", "title": ds.attrs.get("title", ""),
+    from rocksweep.analysis.boundaries import check_search
+    from rocksweep.analysis.files import as_dataset
+    from rocksweep.errors import check_rtol
+    from rocksweep.store.reader import as_result
+
+    rtol = check_rtol(rtol)
+    search = check_search(search)
+    ds = as_dataset(ds, "ds")
+    if "outcome" in ds.data_vars and FLOOR_X not in ds.dims:
+        raise FloorError(f"{_where(ds)}: floor spectrum: the sweep has no {FLOOR_X} "
+                         "dimension (sweep floor.period in the scene's floor section)")
+    as_result(ds, ["outcome"]).require_complete(FloorError, "a floor spectrum")
+    attrs = {KIND_ATTR: FLOOR_SPECTRUM, "title": ds.attrs.get("title", ""),
              "floor": ds.attrs.get("floor", ""), "scale_im": ds.attrs.get("scale_im", "")}
     if "record" in ds["outcome"].dims:
         def one(d):
@@ -175,12 +210,12 @@ def floor_spectrum(ds, rtol: float = 1e-2, search: bool = True):
         grid_response,
         kernel_evaluator,
     )
-    from rocksweep.store.reader import as_result, result_scene
+    from rocksweep.store.reader import result_scene
 
     result = as_result(ds, ["outcome", "theta_max_over_alpha", "uplifts", "status"])
     if "A_ratio" not in result.dims:
-        raise FloorError("floor spectrum: one record's or a pulse's needs A_ratio swept "
-                         "(A_min is searched along it)")
+        raise FloorError(f"{_where(ds)}: floor spectrum: one record's or a pulse's needs "
+                         "A_ratio swept (A_min is searched along it)")
     scene = result_scene(result)
     curves = a_min(scene, result.arrays["outcome"], rtol, axes=(FLOOR_X, "A_ratio"),
                    evaluate=kernel_evaluator(scene), **grid_response(result), search=search)
@@ -200,6 +235,6 @@ def floor_spectrum(ds, rtol: float = 1e-2, search: bool = True):
                                          "flag_meanings": ";".join(A_MIN_METHODS)})},
         coords=coords)
     out[FLOOR_X].attrs = {"long_name": "period of the building's mode", "units": "s"}
-    out.attrs = {**attrs, "method": "A_min", "rtol": rtol,
+    out.attrs = {**attrs, "method": "A_min", "rtol": rtol, "kind": result.kind,
                  "runs": int(sum(c.runs.sum() for c in curves))}
     return out

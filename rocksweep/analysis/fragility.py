@@ -49,7 +49,7 @@ Verdicts (``reason``: "ok", or the words below joined by ","; never "ok" for the
   common beta against a beta per state (``likelihood.parallel_lr``) rejects it at
   ``PARALLEL_P``: the joint curves misstate the data; fit the states separately;
 - "incomplete": points of the curve not computed (outcome -1: a partial file, or a sweep
-  still writing it); "flagged": points flagged by the kernel (horizon, caps) are left out
+  still writing it); "flagged": points flagged by the kernel (horizon, caps, airborne) are left out
   and counting them as reaching the state, or as not, moves im_median by more than
   ``FLAGGED_SHIFT`` (relative).
 
@@ -102,6 +102,7 @@ from rocksweep.analysis.states import (
 from rocksweep.errors import Arg, FragilityError, FragilityWarning, flag
 from rocksweep.fields import plain
 from rocksweep.vocab.ground import AVGSA
+from rocksweep.vocab.kinds import FRAGILITY, KIND_ATTR
 from rocksweep.vocab.outcomes import MODE1, MODE2
 
 __all__ = ["Fit", "REASONS",
@@ -545,7 +546,7 @@ def _bootstrap_fits(f: _Fits, c: Counts, groups: list[tuple[str, list[int]]],
     the point fit; resamples without a finite fit are NaN."""
     lnx = np.log(axis.x)
     per_fit = max(c.R * (axis.x.size if axis.stripes else 1), 1) * 3
-    for start, w in resample_weights(c.R, N, seed, per_fit):
+    for start, w in resample_weights(c.R, N, seed, per_fit, c.groups):
         sl = slice(start, start + w.shape[0])
         # resamples that draw the same records (most of them, with few records) have the
         # same counts and so the same fit: each distinct one is fitted once
@@ -636,8 +637,7 @@ def _dataset(ds: xr.Dataset, state: Any, states: list[str], axis: IMAxis, c: Cou
                                  "one beta) or competing (mode1 with mode2)"})
     data["n_boot_undefined"] = (dims_c, shaped(f.n_undef),
                                 {"long_name": "bootstrap resamples without a finite fit"})
-    n_records = c.counted.reshape(c.n_o, c.R, -1).any(-1).sum(-1)
-    data["n_records"] = (others, n_records.reshape(shape_o).astype(np.int64),
+    data["n_records"] = (others, c.records_counted().reshape(shape_o).astype(np.int64),
                          {"long_name": "records with at least one counted point"})
     data["n_excluded"] = (others, c.flagged.reshape(c.n_o, -1).sum(-1).reshape(shape_o),
                           {"long_name": "flagged points (status & STATUS_FLAGGED) left out"})
@@ -660,7 +660,7 @@ def _dataset(ds: xr.Dataset, state: Any, states: list[str], axis: IMAxis, c: Cou
         coords[axis.stripe] = ds[axis.stripe]
         coords["record"] = ds["record"]
         data.update(_stripe_variables(c, axis, dims_c, shaped))
-    attrs = {"rocksweep_kind": "fragility", "title": str(ds.attrs.get("title", "")),
+    attrs = {KIND_ATTR: FRAGILITY, "title": str(ds.attrs.get("title", "")),
              "method": axis.method, "im": axis.im_name, "im_units": unit,
              "states": list(states), "bootstrap": int(N), "seed": int(seed),
              "ci": float(ci),
@@ -824,7 +824,12 @@ def probability(frag: xr.Dataset, x: Sequence[float] | np.ndarray) -> xr.DataArr
     bet = frag["beta"].transpose(*(["state"] if lead else []), *dims).values
     med, bet = (np.asarray(a, dtype=np.float64) if lead else np.asarray(a)[None]
                 for a in (med, bet))
-    kinds = np.atleast_1d(np.asarray(frag["fit"].values)) if "fit" in frag else \
+    # a state's model, whatever other dims ``fit`` gained (an orientation's answers,
+    # ``floors.by_orientation``, stack one fit per answer: the same model for a state)
+    fit = frag["fit"] if "fit" in frag else None
+    if fit is not None and any(d != "state" for d in fit.dims):
+        fit = fit.isel({d: 0 for d in fit.dims if d != "state"})
+    kinds = np.atleast_1d(np.asarray(fit.values)) if fit is not None else \
         np.array(["single"] * med.shape[0])
     states = list(np.atleast_1d(np.asarray(frag["state"].values)))
     out = np.full(med.shape + (xs.size,), np.nan)

@@ -25,13 +25,17 @@ import dataclasses
 from typing import Any
 
 import numpy as np
+import xarray as xr
 
+from rocksweep import fields
 from rocksweep.analysis.bisection import UNDECIDED, bisect_thresholds
+from rocksweep.analysis.tolerance import DEFAULT_RTOL_MANY
 from rocksweep.compute.single import run_point
 from rocksweep.errors import IdaError, check_rtol
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.store.reader import as_result, result_scene
+from rocksweep.vocab.kinds import IDA, KIND_ATTR
 from rocksweep.vocab.outcomes import FLAGGED, OUTCOME_MODE1, OUTCOME_MODE2
 
 # Bisection steps at most (a relative tolerance of 1e-12 takes ~40 from a stripe gap).
@@ -39,7 +43,7 @@ MAX_ITER = 60
 OVERTURNED = (OUTCOME_MODE1, OUTCOME_MODE2)
 
 
-def ida(ds: Any, rtol: float = 1e-2) -> Any:
+def ida(ds: Any, rtol: float = DEFAULT_RTOL_MANY) -> Any:
     """The smallest IM that overturns each record, bisected to ``rtol`` between stripes.
 
     ds: a complete sweep of a scaled record suite (what ``rocksweep.run`` or
@@ -159,10 +163,6 @@ def _brackets(s: _Stripes) -> _Brackets:
 
 def _dataset(result: Any, s: _Stripes, b: _Brackets, runs: np.ndarray,
              unresolved: np.ndarray, rtol: float) -> Any:
-    import xarray as xr
-
-    from rocksweep import fields
-
     im, shape = s.im, s.lead
     lo, hi = b.lo, b.hi
     est = np.where(np.isfinite(lo), np.sqrt(lo * hi), hi)
@@ -202,12 +202,12 @@ def _dataset(result: Any, s: _Stripes, b: _Brackets, runs: np.ndarray,
                              "title": result.name})
 
 
-def ida_dataset(ds: Any, rtol: float = 1e-2) -> Any:
+def ida_dataset(ds: Any, rtol: float = DEFAULT_RTOL_MANY) -> Any:
     """``rocksweep.ida``: ``ida`` with the IDA curves on the stripes
     (``theta_max_over_alpha`` against the IM, per record, NaN where a point overturned:
     what the figure draws) and its kind for ``rocksweep.plot`` (``analysis.kinds``)."""
     out = ida(ds, rtol)
-    out.attrs["rocksweep_kind"] = "ida"
+    out.attrs[KIND_ATTR] = IDA
     im = out.attrs.get("im")
     if hasattr(ds, "data_vars") and "theta_max_over_alpha" in ds.data_vars and im in ds.dims:
         theta = ds["theta_max_over_alpha"].where(ds["outcome"] == 0)

@@ -704,16 +704,23 @@ def fitted_curves(kind: str, grid: np.ndarray, med: np.ndarray, bet: np.ndarray
 
 
 def resample_weights(n_records: int, n_boot: int, seed: int | np.random.Generator,
-                     per: int) -> Iterator[tuple[int, np.ndarray]]:
+                     per: int, groups: np.ndarray | None = None
+                     ) -> Iterator[tuple[int, np.ndarray]]:
     """Resample weights in chunks: yields (start, w float (nb, R)), w[r] = how often record
-    r is drawn; one Generator draws R indices a resample, as a single draw would."""
+    r is drawn; one Generator draws R indices a resample, as a single draw would.
+    groups: int[R], the record each of the R samples belongs to (0..G-1; several samples
+    of one record, e.g. its orientations): the G records are drawn, each with all its
+    samples (a cluster bootstrap: the samples of a record are not independent)."""
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    G = n_records if groups is None else int(groups.max()) + 1
     nb = max(1, min(n_boot, BOOT_ELEMENTS // max(per, 1)))
     for start in range(0, n_boot, nb):
         m = min(nb, n_boot - start)
-        idx = rng.integers(0, n_records, size=(m, n_records))
-        flat = (np.arange(m)[:, None] * n_records + idx).ravel()
-        w = np.bincount(flat, minlength=m * n_records).reshape(m, n_records)
+        idx = rng.integers(0, G, size=(m, G))
+        flat = (np.arange(m)[:, None] * G + idx).ravel()
+        w = np.bincount(flat, minlength=m * G).reshape(m, G)
+        if groups is not None:
+            w = w[:, groups]
         yield start, w.astype(np.float64)
 
 

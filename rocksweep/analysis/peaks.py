@@ -11,6 +11,7 @@ import numpy as np
 
 PEAK_TOP = 0.5  # a peak's parabola goes through the samples above this share of it ...
 PEAK_RAMP = 0.2  # ... weighted from 0 there to 1 at PEAK_TOP + PEAK_RAMP
+ONSET_SAMPLES = 5  # a measurement's first value: the median of its first samples
 
 
 @dataclass(frozen=True)
@@ -144,15 +145,22 @@ def hermite(t_h: np.ndarray, y: np.ndarray, dy: np.ndarray, t: np.ndarray) -> np
     return np.where(t <= t_h[0], y[0], out)
 
 
-def onset(t: np.ndarray, theta: np.ndarray, level: float) -> float:
+def onset(t: np.ndarray, theta: np.ndarray, level: float, *, noisy: bool = False) -> float:
     """The time a history first departs from its first value by ``level``, interpolated
-    between samples."""
-    d = np.abs(theta - theta[0])
-    k = np.flatnonzero(d > level)
+    between samples. ``noisy`` (a measurement): the first value is the median of the first
+    ONSET_SAMPLES samples and the departure must hold at two samples in a row, so one
+    noise sample (the first, or one beyond the level) cannot start the motion."""
+    ref = float(np.median(theta[:ONSET_SAMPLES])) if noisy else float(theta[0])
+    d = np.abs(theta - ref)
+    beyond = d > level
+    if noisy:
+        beyond[:-1] &= beyond[1:]
+        beyond[-1] = False
+    k = np.flatnonzero(beyond)
     if k.size == 0:
         return math.nan
     i = int(k[0])
     if i == 0:
         return float(t[0])
-    f = (level - d[i - 1]) / (d[i] - d[i - 1])
+    f = min(max((level - d[i - 1]) / (d[i] - d[i - 1]), 0.0), 1.0)
     return float(t[i - 1] + f * (t[i] - t[i - 1]))

@@ -5,12 +5,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from itertools import product
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from rocksweep.errors import Arg, SceneError, set_key
 from rocksweep.physics.bodies import Body, FlexibleBody, restitution_rigid
-from rocksweep.physics.impact import lam_energy_limit
+from rocksweep.physics.impact import U_RANGE, body_lam_limit, lam_energy_limit
 from rocksweep.physics.impact import restitution as law_restitution
 
 if TYPE_CHECKING:
@@ -72,8 +74,6 @@ def restitution_table(scene: Scene, n_lam: int = 101, n_u: int = 81) -> Restitut
     with the energy-admissible lam for each u/u_cr. The scene must hold one body and one
     impact law (a SceneError names a swept key otherwise); lam and the pulse are not used.
     """
-    from rocksweep.errors import Arg, SceneError, set_key
-
     names = [a.name for a in scene.axes]
     for a in (*scene.body_axes(), *(scene.axis(k) for k in ("law", "e", "e_factor")
                                     if k in names)):
@@ -114,10 +114,6 @@ def energy_note(scene: Scene, max_bodies: int = 64) -> str | None:
     some impact with |u/u_cr| <= 2 gains energy, which the paper says to avoid), else
     None. Not an error: such runs are flagged energy_gain where it happens. Scenes with
     more than ``max_bodies`` bodies are not checked."""
-    from itertools import product
-
-    from rocksweep.physics.impact import U_RANGE, body_lam_limit
-
     axes = scene.body_axes()
     if math.prod(len(a.values) for a in axes) > max_bodies:
         return None

@@ -61,6 +61,7 @@ from rocksweep.inputs import check_columns, csv_table, number, number_column, re
 from rocksweep.outputs import shown
 from rocksweep.physics.bodies import G
 from rocksweep.vocab.ground import ARIAS, AVGSA, CAV, PGA, PGV, SA, SCALE_IMS
+from rocksweep.vocab.kinds import KIND_ATTR, RISK
 
 __all__ = ["Hazard", "fragility_median", "hazard_frame", "read_hazard",
            "risk"]
@@ -697,7 +698,7 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50.0, *,
     }
     coords["hazard_im"] = ("hazard_im", hz.im, {"units": unit})
     coords["im_level"] = ("im_level", grid, {"units": unit})
-    attrs = {"rocksweep_kind": "risk", "years": N, "im": hz.name, "im_units": unit,
+    attrs = {KIND_ATTR: RISK, "years": N, "im": hz.name, "im_units": unit,
              "hazard_source": hz.source, "ci": ci,
              "extrapolation": "bound: above the hazard's largest IM the certain tail "
                               "P(x_max) lambda(x_max) is added (annual_rate_max: "

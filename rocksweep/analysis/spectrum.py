@@ -24,7 +24,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import xarray as xr
 
+from rocksweep import fields
 from rocksweep.analysis.boundaries import (
     A_MIN_METHODS,
     RESPONSE,
@@ -39,6 +41,8 @@ from rocksweep.errors import (
     SpectrumError,
     check_rtol,
 )
+from rocksweep.store.reader import as_result, result_scene
+from rocksweep.vocab.kinds import KIND_ATTR, SPECTRA
 from rocksweep.vocab.outcomes import MODE_WORDS, OUTCOME_WORDS, flag_attrs
 
 
@@ -80,10 +84,6 @@ class Spectra:
         freq) (the overturning spectrum, bisected to ``rtol``; NaN: no grid value
         overturns), freq being ``p`` [rad/s] or ``w_over_p``; attrs: rocksweep_kind
         "spectra" (``analysis.kinds``), title, rtol, runs, record."""
-        import xarray as xr
-
-        from rocksweep import fields
-
         lead = tuple(v.size for _, v in self.extra) + (len(self.lam),)
         a_min = np.array([c.a_min for c in self.a_min], float).reshape(*lead, -1)
         mode = np.array([c.mode for c in self.a_min], np.int8).reshape(a_min.shape)
@@ -108,7 +108,7 @@ class Spectra:
                     "lam": ("lam", self.lam, fields.axis_attrs("lam")),
                     "A_ratio": ("A_ratio", self.A, fields.axis_attrs("A_ratio", self.kind)),
                     f: (f, self.x, fields.axis_attrs(f))},
-            attrs={"rocksweep_kind": "spectra", "kind": self.kind, "title": self.name,
+            attrs={KIND_ATTR: SPECTRA, "kind": self.kind, "title": self.name,
                    "rtol": self.rtol,
                    "search": int(self.search),
                    "runs": self.runs, "record": self.record})
@@ -119,8 +119,6 @@ def spectra(data, rtol: float = DEFAULT_RTOL, search: bool = True) -> Spectra:
     ``rocksweep.run`` / ``rocksweep.open`` return), a ``SweepResult`` or a file's path.
     search: A_min searched below the first overturning grid value too (``a_min``); False:
     the grid's bracket bisected only (faster; A_min then depends on the grid)."""
-    from rocksweep.store.reader import as_result, result_scene
-
     rtol = check_rtol(rtol)
     search = check_search(search)
     result = as_result(data, [*RESPONSE, "status"])

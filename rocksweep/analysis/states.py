@@ -10,15 +10,17 @@ milder ones); the two modes are not.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from rocksweep.errors import FragilityError
+from rocksweep.errors import AnalysisWarning, FragilityError
 from rocksweep.vocab.outcomes import (
     FLAGGED,
+    FLAGGED_WORDS,
     MODE1,
     MODE2,
     OUTCOME_MODE1,
@@ -26,6 +28,7 @@ from rocksweep.vocab.outcomes import (
     OUTCOME_NOT_RUN,
     OVERTURN,
     STATES,
+    STATUS_BIT,
     THETA_STATE,
     UPLIFT,
 )
@@ -139,32 +142,34 @@ def counted_points(ds: xr.Dataset) -> tuple[xr.DataArray, xr.DataArray, xr.DataA
     return ~flagged & ~not_run, flagged, not_run
 
 
-def trust(ds: xr.Dataset, what: str, warn: bool = True) -> str:
+def trust(ds: xr.Dataset, what: str, warn: bool = True, kept: bool = False) -> str:
     """The one verdict of every analysis on the points it reads: "ok", or why they cannot
     all be trusted, one clause each: "incomplete: N of M points not computed" (a file a
     sweep stopped writing or still writes: its ``complete`` attribute is 0) and "flagged:
-    K of M points flagged by the kernel (horizon, caps) left out". Not-computed and
-    flagged points are left out by ``counted_points``; this says so. With ``warn``, an
-    ``AnalysisWarning`` "<what>: <verdict>" too. A Dataset without outcome/status (not a
-    sweep) is "ok"."""
-    import warnings
-
-    from rocksweep.errors import AnalysisWarning
-
+    K of M points flagged by the kernel (airborne 3, horizon 1) left out" (each flag's
+    word and count: ``vocab.outcomes.FLAGGED_WORDS``). Not-computed and flagged points are
+    left out by ``counted_points``; this says so. ``kept``: the caller keeps every point
+    (``table``: one row per run, the flag in ``status_words``), and says that instead. With
+    ``warn``, an ``AnalysisWarning`` "<what>: <verdict>" too. A Dataset without
+    outcome/status (not a sweep) is "ok"."""
     if "outcome" not in ds.variables or "status" not in ds.variables:
         return "ok"
     _, flagged, not_run = counted_points(ds)
     total = int(np.prod(ds["outcome"].shape))
+    fate = ("kept (their status_words say why; the analyses leave them out)" if kept
+            else "left out")
     words = []
     n = int(not_run.sum())
     if n:
         state = (" (the file is not complete: a sweep still running or stopped; a resume "
                  "finishes it)") if ds.attrs.get("complete") in (0, False) else ""
-        words.append(f"incomplete: {n} of {total} points not computed, left out{state}")
+        words.append(f"incomplete: {n} of {total} points not computed, {fate}{state}")
     k = int(flagged.sum())
     if k:
-        words.append(f"flagged: {k} of {total} points flagged by the kernel (horizon, caps),"
-                     " left out")
+        status = ds["status"].values.astype(np.int64)
+        why = ", ".join(f"{w} {c}" for w in FLAGGED_WORDS
+                        if (c := int(((status & STATUS_BIT[w]) != 0).sum())))
+        words.append(f"flagged: {k} of {total} points flagged by the kernel ({why}), {fate}")
     verdict = "; ".join(words) or "ok"
     if warn and words:
         warnings.warn(f"{what}: {verdict}", AnalysisWarning, stacklevel=3)

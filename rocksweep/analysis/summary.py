@@ -16,7 +16,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from rocksweep.compute.adaptive import stats_of
 from rocksweep.fields import THETA_REL_FLOOR, plain
+from rocksweep.store.reader import read_result, stored_scene
 from rocksweep.vocab.axes import axis_name
 from rocksweep.vocab.outcomes import (
     COMPUTED,
@@ -169,8 +171,6 @@ def _json_value(v):
 
 def read_info(path) -> SweepResult:
     """The variables of a result file that ``info_dict`` reports on."""
-    from rocksweep.store.reader import read_result, stored_scene
-
     check = bool(stored_scene(path).get("check"))
     return read_result(path, INFO_VARIABLES + (CHECK_INFO_VARIABLES if check else []),
                        INFO_OPTIONAL)
@@ -235,6 +235,7 @@ def info_dict(result: SweepResult) -> dict:
         "energy": bool(a.get("energy", False)),
         "steps_total": int(result.arrays["steps"].sum()),
         "event_steps_total": int(result.arrays["event_steps"].sum()),
+        "certification": certification_info(result),
         "provenance": {
             **{k: a.get(k) for k in ("rocksweep_version", "numba_version", "numpy_version",
                                      "h5py_version", "hdf5_version", "python_version",
@@ -245,8 +246,53 @@ def info_dict(result: SweepResult) -> dict:
         },
         "adaptive": adaptive_info(result),
         "check": check_info(result),
+        "vertical": vertical_info(result),
         "scene": a.get("scene"),
     }
+
+
+def certification_info(result: SweepResult) -> dict:
+    """What the certification of close calls cost (``compute.certify``): points_refined
+    (status ``refined``: checked or re-run finer), points_uncertified, and
+    refine_evaluations, the RK4 evaluations (regular + event) of its runs, part of the
+    steps totals (None where not recorded: a file of a rocksweep before the count)."""
+    status = np.asarray(result.arrays["status"])
+    n = int(result.attrs.get("refine_evaluations", -1))
+    return {"points_refined": int(((status & STATUS_BIT["refined"]) != 0).sum()),
+            "points_uncertified": int(((status & STATUS_BIT["uncertified"]) != 0).sum()),
+            "refine_evaluations": n if n >= 0 else None}
+
+
+def vertical_info(result: SweepResult) -> dict:
+    """Whether a vertical ground acceleration acted on the body, from the resolved scene:
+    {"acted": bool, "source": "ground.vertical" | "pulse.vertical" | "up files" | None,
+    "words": one line}. A folder suite's UP files read but not acting (``ground.vertical:
+    false``) say so: their peaks are stored, the body did not feel them."""
+    sc = result.scene
+    rec = sc.get("vertical")
+    if isinstance(rec, dict):
+        peak = rec.get("PGA_v")
+        return {"acted": True, "source": "ground.vertical",
+                "words": f"acted: ground.vertical {rec.get('name')} (PGA_v "
+                         f"{peak if peak is None else f'{peak:.4g}'} g as recorded, scaled with "
+                         "the record), the kernel's vertical variant"}
+    amp = (sc.get("axes") or {}).get("pulse.vertical.amplitude")
+    if isinstance(amp, dict):
+        acted = any(isinstance(v, int | float) and v != 0 for v in amp.get("values") or [])
+        return {"acted": acted, "source": "pulse.vertical",
+                "words": ("acted: pulse.vertical (a harmonic), the kernel's vertical variant"
+                          if acted else "none: pulse.vertical's amplitude is 0")}
+    suite = sc.get("suite") if isinstance(sc.get("suite"), dict) else {}
+    ups = [v for v in suite.get("vertical") or [] if v]
+    if ups:
+        acts = bool(suite.get("vertical_acts"))
+        return {"acted": acts, "source": "up files",
+                "words": (f"acted: the {len(ups)} records' UP files, scaled with each record "
+                          "(the kernel's vertical variant)" if acts else
+                          f"did not act: the {len(ups)} records' UP files were read "
+                          "(record_pga_v, record_v_over_h) but ground.vertical: false kept "
+                          "them off the body")}
+    return {"acted": False, "source": None, "words": "none (gravity alone)"}
 
 
 def adaptive_info(result: SweepResult) -> dict | None:
@@ -257,8 +303,6 @@ def adaptive_info(result: SweepResult) -> dict | None:
     settings = result.scene.get("adaptive")
     if not settings or "computed" not in result.arrays:
         return None
-    from rocksweep.compute.adaptive import stats_of
-
     c = np.asarray(result.arrays["computed"])
     st = stats_of(c, settings.get("threshold", 0.0))
     filled = int(((c == 0) & result.done).sum())
@@ -283,6 +327,21 @@ def format_check(ck: dict) -> list[str]:
             f"  |t_overturn change|: {tail(ck['t_overturn_diff'], ' p*t')}",
             f"  |max|theta| change| / max|theta| of safe runs: "
             f"{tail(ck['theta_max_rel_diff'], '')}"]
+
+
+def format_certification(c: dict, evaluations: int) -> str:
+    """The line of ``rocksweep info`` on the certification's price (``certification_info``;
+    evaluations: the file's RK4 evaluations, regular + event)."""
+    pts = (f"{c['points_refined']} points refined (checked or re-run finer), "
+           f"{c['points_uncertified']} uncertified")
+    n = c["refine_evaluations"]
+    if n is None:
+        return (f"  certification of close calls: {pts}; its share of the steps not recorded "
+                "(written before rocksweep counted it)")
+    own = evaluations - n
+    ratio = f", {evaluations / own:.3f}x the points' own" if own > 0 else ""
+    return (f"  certification of close calls: {n} of them ({100 * n / max(1, evaluations):.1f}%"
+            f"{ratio}); {pts}")
 
 
 def format_info(d: dict) -> list[str]:
@@ -313,6 +372,8 @@ def format_info(d: dict) -> list[str]:
                      + (f", {ad['undecided']} not decided yet" if ad["undecided"] else ""))
         lines.append(f"  audit: {ad['audited']} points, {ad['audit_misses']} disagreed with "
                      "their fill" + (f" (warning: {ad['warning']})" if ad["warning"] else ""))
+    if d.get("vertical"):
+        lines.append(f"vertical ground acceleration: {d['vertical']['words']}")
     law = bool(d["counts"]) and "law" in d["counts"][0]
     lines.append(f"counts per pulse shape{', impact law' if law else ''} and lam:")
     lines += format_counts(in_ranges(d["counts"], "lam"), "  ")
@@ -329,6 +390,8 @@ def format_info(d: dict) -> list[str]:
     lines.append(f"accuracy: {d['accuracy']}")
     lines.append(f"RK4 steps: {d['steps_total']} + {d['event_steps_total']} event "
                  "re-integrations")
+    lines.append(format_certification(d["certification"],
+                                      d["steps_total"] + d["event_steps_total"]))
     wall = p["wall_time_s"] or 0.0
     lines.append(f"run: started {p['started']}, finished {p['finished'] or '-'}, "
                  f"{p['sessions']} session(s), {wall:.2f} s wall time, "

@@ -24,20 +24,34 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+import pandas as pd
 import xarray as xr
 
 from rocksweep.analysis.kinds import dataset_kind
+from rocksweep.analysis.states import trust
 from rocksweep.errors import TableError
 from rocksweep.physics.bodies import G
 from rocksweep.vocab.axes import ALPHA_KEYS
 from rocksweep.vocab.ground import RECORD_IMS, SA, SCALE_IMS
+from rocksweep.vocab.kinds import (
+    BOUNDARIES,
+    FLOOR_SPECTRUM,
+    FRAGILITY,
+    IDA,
+    IM_EFFICIENCY,
+    RISK,
+    SPECTRA,
+    SWEEP,
+)
+from rocksweep.vocab.outcomes import OUTCOME_WORDS, status_words
 
 __all__ = ["ROW_VARIABLE", "table"]
 
 #: the variable whose dims are a kind's rows
-ROW_VARIABLE = {"sweep": "outcome", "fragility": ("im_median", "median"), "ida": "ida_im",
-                "risk": "annual_rate", "im_efficiency": "beta",
-                "spectra": "theta_max_over_alpha", "boundaries": "A_min"}
+ROW_VARIABLE = {SWEEP: "outcome", FRAGILITY: ("im_median", "median"), IDA: "ida_im",
+                RISK: "annual_rate", IM_EFFICIENCY: "beta",
+                SPECTRA: "theta_max_over_alpha", BOUNDARIES: "A_min",
+                FLOOR_SPECTRUM: ("p_overturn", "A_min")}
 MAX_SPREAD = 32  # an extra dimension at most this long becomes columns
 SKIP = ("record_sha256",)  # identity, not data: in the file, not in every row
 
@@ -51,15 +65,11 @@ def table(ds: xr.Dataset) -> Any:
     """The tidy ``pandas.DataFrame`` of a rocksweep Dataset (module docstring): one row
     per run of a sweep (prod of outcome's dim sizes rows), or per entry of an analysis's
     main variable. ``.attrs["units"]``: column -> units."""
-    import pandas as pd
-
     kind = dataset_kind(ds)
     if kind is None:
         raise TableError("not a rocksweep Dataset (a sweep or an analysis's result)")
-    if kind == "sweep":  # every row is written; a partial file's are said to be missing
-        from rocksweep.analysis.states import trust
-
-        trust(ds, "table")
+    if kind == SWEEP:  # every row is written; a partial file's are said to be missing
+        trust(ds, "table", kept=True)
     main = ROW_VARIABLE[kind]
     main = next((m for m in (main if isinstance(main, tuple) else (main,)) if m in ds),
                 None)
@@ -94,14 +104,14 @@ def table(ds: xr.Dataset) -> Any:
         if not extra:
             cols[name] = flat(da)
             units[name] = _units(da)
-        elif (kind == "sweep" and len(extra) == 1 and ds.sizes[extra[0]] <= MAX_SPREAD):
+        elif (kind == SWEEP and len(extra) == 1 and ds.sizes[extra[0]] <= MAX_SPREAD):
             e = extra[0]
             for i, v in enumerate(ds[e].values if e in ds.coords else range(ds.sizes[e])):
                 label = f"{name}({v:g})" if isinstance(v, float | np.floating) else \
                     f"{name}({v})"
                 cols[label] = flat(da.isel({e: i}))
                 units[label] = _units(da)
-    if kind == "sweep" and "scale_factor" in ds.data_vars and "record" in dims:
+    if kind == SWEEP and "scale_factor" in ds.data_vars and "record" in dims:
         f = flat(ds["scale_factor"])
         for im, (var, unit, k) in RECORD_IMS.items():
             if var in ds.data_vars:
@@ -121,9 +131,7 @@ def table(ds: xr.Dataset) -> Any:
                 label = f"sa({float(T):g})"
                 cols[label] = flat(ds["record_sa"].isel(period=i)) * f
                 units[label] = SCALE_IMS[SA]
-    if kind == "sweep" and "status" in cols:  # the codes in words, beside the codes
-        from rocksweep.vocab.outcomes import OUTCOME_WORDS, status_words
-
+    if kind == SWEEP and "status" in cols:  # the codes in words, beside the codes
         cols["outcome_word"] = np.array([OUTCOME_WORDS.get(int(c), str(c))
                                          for c in cols["outcome"]], dtype=object)
         cols["status_words"] = np.array([",".join(status_words(int(b))) for b in

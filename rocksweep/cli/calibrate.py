@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import click
 
+import rocksweep
+from rocksweep.cli.helpers import check_table_outputs, write_table
 from rocksweep.cli.main import load, main, release_warnings, user_errors, warning_line
 from rocksweep.cli.options import dpi_option, overwrite_option, scene_argument, set_option
 from rocksweep.vocab.kinds import CALIBRATION
@@ -62,20 +65,18 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
     The misfit compares the half-cycle peaks (robust to the phase drift of many impacts);
     the interval is a 95% profile likelihood. Prints the estimate, the interval and the
     misfit; -o keeps the fit, --plot draws it."""
-    from rocksweep.api import calibrate as fit_scene
-    from rocksweep.cli.helpers import check_table_outputs, write_table
-
     # the scene file and what it reads (a record), the measured CSV: never written over
-    inputs = [*load(scene_path, overrides).inputs, measured_path]
+    scene = load(scene_path, overrides)
+    inputs = [*scene.inputs, measured_path]
     check_table_outputs(out_path, plot_path, (".h5", ".nc"), inputs, overwrite)
-    import warnings
-
+    # run time, not --help: numpy, h5py, numba, matplotlib (0.1-2 s each), outputs (+7%)
     from rocksweep.analysis.calibrate import CalibrationWarning
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", CalibrationWarning)
-        ds = fit_scene(scene_path, measured_path, list(fit), bounds=_bounds(bounds) or None,
-                       overrides=list(overrides), p=p, noise=noise)
+        ds = rocksweep.calibrate(scene_path, measured_path, list(fit),
+                                 bounds=_bounds(bounds) or None, overrides=list(overrides),
+                                 p=p, noise=noise, progress=True)
     release_warnings()  # fitted: the scene's warnings before the fit's verdicts
     for w in caught:
         if issubclass(w.category, CalibrationWarning):

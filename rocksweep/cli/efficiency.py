@@ -8,6 +8,7 @@ from pathlib import Path
 
 import click
 
+import rocksweep
 from rocksweep.cli.helpers import check_table_outputs, write_table
 from rocksweep.cli.main import main, release_warnings, user_errors
 from rocksweep.cli.options import (
@@ -42,20 +43,17 @@ def efficiency(result_path: Path, state: str, out_path: Path | None, fig_path: P
     AvgSa, Arias, CAV, D5-95, PGV/PGA, PGA/(g tan alpha), PGV p/(g tan alpha)) the
     lognormal dispersion beta of the state's fragility in that IM, best first (lower beta
     = the IM explains the state better)."""
+    # run time, not --help: numpy, h5py, numba, matplotlib (0.1-2 s each), outputs (+7%)
     import numpy as np
 
-    import rocksweep
     from rocksweep.figures.style import save_figure
     from rocksweep.store.reader import result_inputs
 
     inputs = result_inputs(result_path)  # the result and its records: never written over
     check_table_outputs(out_path, fig_path, SUFFIXES, inputs, overwrite)
     eff = rocksweep.im_efficiency(rocksweep.open(result_path), state=state)
-    release_warnings()  # a partial file's words before the ranking
-    frame = eff[["beta", "beta_scale", "im_median", "slope", "n_records",
-                 "n_censored"]].to_dataframe().reset_index()
-    frame = frame.merge(eff[["units", "exponent", "method"]].to_dataframe().reset_index(),
-                        on="im")
+    release_warnings()  # a partial file's words and the fits' verdicts before the ranking
+    frame = rocksweep.table(eff)  # one row per (IM, curve), every column once
     others = [d for d in eff["beta"].dims if d != "im"]
     frame = frame.sort_values([*others, "beta_scale"])
     if as_json:
@@ -63,13 +61,18 @@ def efficiency(result_path: Path, state: str, out_path: Path | None, fig_path: P
             frame.to_json(orient="records"))}))
     else:
         click.echo(f"IM efficiency for {state} ({eff.attrs['stripe_im']} stripes; beta per "
-                   "unit of ln scale factor, best first):")
+                   "unit of ln scale factor, best first; [why] where a beta cannot rank):")
         for key, grp in (frame.groupby(others, sort=False) if others else [((), frame)]):
             where = ", ".join(f"{d} = {v}" for d, v in zip(others, np.atleast_1d(key),
                                                          strict=False))
-            best = "  ".join(f"{r.im} {r.beta_scale:.3f}" for r in grp.itertuples()
-                             if r.beta_scale == r.beta_scale)
-            none = "no IM has a finite beta (no record reaches the state, or all at once)"
+            best = "  ".join(f"{r.im} {r.beta_scale:.3f}" + (
+                f" [{r.reason}]" if r.reason != "ok" else "")
+                for r in grp.itertuples() if r.beta_scale == r.beta_scale)
+            held = sorted({w for r in grp.itertuples() if r.beta_scale != r.beta_scale
+                           for w in r.reason.split(",") if w != "ok"})
+            none = ("no IM has a finite beta" + (f" ({', '.join(held)})" if held else
+                                                 " (no record reaches the state, or all at "
+                                                 "once)"))
             click.echo(f"  {where or 'all'}: {best or none}")
     say = click.echo if not as_json else (lambda m: click.echo(m, err=True))
     fig = rocksweep.plot(eff, width=width) if fig_path is not None else None

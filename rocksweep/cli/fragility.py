@@ -5,10 +5,12 @@ JSON, CSV or HDF5 and a figure. A thin wrapper: the file is opened as a Dataset
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 
 import click
 
+import rocksweep
 from rocksweep.analysis.resampling import DEFAULT_BOOTSTRAP, DEFAULT_SEED, MAX_BOOTSTRAP
 from rocksweep.cli.helpers import check_table_outputs, write_table
 from rocksweep.cli.main import main, release_warnings, user_errors, warning_line
@@ -22,6 +24,7 @@ from rocksweep.cli.options import (
     seed_option,
     width_option,
 )
+from rocksweep.errors import FragilityWarning
 from rocksweep.vocab.kinds import FRAGILITY
 from rocksweep.vocab.outcomes import MODE1, MODE2, OVERTURN, STATES, UPLIFT
 
@@ -30,6 +33,7 @@ CURVE_SUFFIXES = (".csv", ".h5", ".hdf5", ".nc")
 
 def curve_rows(frag) -> list[dict]:
     """One flat row per curve (``curves_json`` with the intervals as columns)."""
+    # run time, not --help: numpy, h5py, numba, matplotlib (0.1-2 s each), outputs (+7%)
     from rocksweep.analysis.fragility import curves_json
 
     rows = []
@@ -93,9 +97,8 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
     A curve that should not be trusted as it is (extrapolated, beta undetermined,
     non-monotone fractions, censored by the other mode, points missing...) says why in
     its "fit" column and in a warning line on stderr."""
-    import warnings
 
-    import rocksweep
+    # run time, not --help: numpy, h5py, numba, matplotlib (0.1-2 s each), outputs (+7%)
     from rocksweep.figures.style import save_figure
 
     states = [s.strip() for s in state.split(",") if s.strip()]
@@ -105,7 +108,6 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
 
     inputs = result_inputs(result_path)  # the result and its records: never written over
     check_table_outputs(out_path, fig_path, CURVE_SUFFIXES, inputs, overwrite)
-    from rocksweep.errors import FragilityWarning
 
     ds = rocksweep.open(result_path)
     # --rtol's IDA first: refused, it says so in one line before any word about the fit
@@ -150,6 +152,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
 def _print_ida(refined) -> None:
     """One line per value of the other swept keys: the records' first overturning levels
     (bisected), their median and range, resurrections."""
+    # run time, not --help: numpy, h5py, numba, matplotlib (0.1-2 s each), outputs (+7%)
     import numpy as np
 
     a = refined.attrs

@@ -10,6 +10,8 @@ from typing import Any
 
 import click
 
+from rocksweep.figures import FORMATS
+
 
 def check_table_outputs(out_path: Path | None, fig_path: Path | None,
                         suffixes: tuple[str, ...], inputs: Iterable[Any],
@@ -18,7 +20,7 @@ def check_table_outputs(out_path: Path | None, fig_path: Path | None,
     figure), refused in one line before anything is computed: the same file twice, an
     unknown suffix, an existing file without --overwrite, or one of the command's
     ``inputs`` (``outputs.check_output``)."""
-    from rocksweep.figures import FORMATS
+    # run time, not --help: numpy, h5py, numba, matplotlib (0.1-2 s each), outputs (+7%)
     from rocksweep.outputs import check_distinct, check_output
 
     inputs = list(inputs)
@@ -39,6 +41,7 @@ def write_table(out_path: Path, rows: Sequence[Mapping[str, Any]] | Any, ds: Any
     the Dataset ``ds`` as netCDF-4 (.h5, .hdf5, .nc) marked with its ``kind``; published by
     ``outputs.write_atomic`` (complete or absent; a file that appeared meanwhile is
     kept)."""
+    # run time, not --help: numpy, h5py, numba, matplotlib (0.1-2 s each), outputs (+7%)
     from rocksweep.analysis.files import csv_text, write_dataset
     from rocksweep.outputs import write_atomic
 
@@ -47,3 +50,20 @@ def write_table(out_path: Path, rows: Sequence[Mapping[str, Any]] | Any, ds: Any
         write_atomic(out_path, lambda tmp: tmp.write_text(text), overwrite=overwrite)
     else:
         write_dataset(ds, out_path, kind, overwrite=overwrite)
+
+
+def prepare_point_kernel(scene: Any) -> None:
+    """The single-run kernel variant of the scene's first point compiled (or loaded) now,
+    said on stderr when it compiles: how long it will take (``compile_cost``); ``simulate``
+    and ``calibrate`` run it. A point the scene cannot make is left to the command's own
+    refusal."""
+    from rocksweep.compute.compile_cost import prepare_point
+    from rocksweep.errors import RocksweepError
+    from rocksweep.physics.points import kernel_kind
+
+    try:
+        point = scene.point({a.name: a.values[0] for a in scene.axes})
+        kind = kernel_kind(point.body)
+    except (RocksweepError, ValueError):
+        return
+    prepare_point(kind, point.ground, lambda m: click.echo(m, err=True))

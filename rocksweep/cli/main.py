@@ -11,6 +11,7 @@ the one place that knows the options' names.
 from __future__ import annotations
 
 import functools
+import warnings
 from pathlib import Path
 
 import click
@@ -103,8 +104,6 @@ def user_errors(fn):
 
     @functools.wraps(fn)
     def wrapper(*args, **kwargs):
-        import warnings
-
         hold = _HeldWarnings()
         before = warnings.showwarning
         warnings.showwarning = hold.show
@@ -132,6 +131,7 @@ def user_errors(fn):
 def load(scene_path: Path, overrides: tuple[str, ...] = ()):
     """The validated scene at ``scene_path`` (imports the scene machinery, and with it
     numba, only when a command runs: ``rocksweep --help`` stays fast)."""
+    # the scene machinery loads numpy and numba (~1 s): not at --help
     from rocksweep.scene.parse import load_scene
 
     # a missing file, a loop of links, a FIFO...: load_scene's one line (input_problem)
@@ -169,6 +169,7 @@ class OneLineGroup(click.Group):
     command_class = OneLineCommand
 
     def invoke(self, ctx: click.Context):
+        # interrupts (signal): +2% of --help, needed once a command runs
         from rocksweep import interrupts
 
         try:
@@ -203,8 +204,6 @@ def main() -> None:
 def _one_line_warnings() -> None:
     """The library's warnings (a drifting record, a large scale factor) as one line on
     stderr, ``Warning: ...``, instead of Python's two (file, line, source)."""
-    import warnings
-
     def show(message, category, filename, lineno, file=None, line=None) -> None:
         click.echo(warning_line(message), err=True)
 

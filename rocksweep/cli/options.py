@@ -22,8 +22,9 @@ import click
 
 from rocksweep.analysis.resampling import DEFAULT_CI, check_ci
 from rocksweep.analysis.tolerance import DEFAULT_RTOL
+from rocksweep.cli.main import said
 from rocksweep.compute.arguments import CONNECT_TIMEOUT, MAX_CONNECT_TIMEOUT
-from rocksweep.errors import MAX_RTOL
+from rocksweep.errors import MAX_RTOL, RocksweepError, check_rtol
 from rocksweep.figures import DEFAULT_DPI, DPI_RANGE, WIDTHS
 from rocksweep.vocab import settings as _settings
 from rocksweep.vocab.axes import DIAGRAM_AXES
@@ -51,9 +52,6 @@ def checked_by(check: Callable[[Any], Any]) -> Callable[..., Any]:
     options are parsed; its refusal is a usage error naming the option (exit 2)."""
 
     def callback(_ctx: click.Context, _param: click.Parameter, value: Any) -> Any:
-        from rocksweep.cli.main import said
-        from rocksweep.errors import RocksweepError
-
         if value is None:
             return None
         try:
@@ -65,8 +63,6 @@ def checked_by(check: Callable[[Any], Any]) -> Callable[..., Any]:
 
 
 def _check_rtol(value: float) -> float:
-    from rocksweep.errors import check_rtol
-
     return check_rtol(value)
 
 

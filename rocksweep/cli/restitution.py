@@ -11,6 +11,7 @@ import click
 
 from rocksweep.cli.main import load, main, user_errors
 from rocksweep.cli.options import json_option, overwrite_option, scene_argument, set_option
+from rocksweep.figures import FORMATS
 from rocksweep.vocab.laws import CONSTANT, LAWS, LOCKED, law_origin
 
 
@@ -39,6 +40,7 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     Both transition directions: "upper" is the paper's upper sign (in rocksweep: rocking on
     the +b corner ends, u positive toward +b), "lower" the other.
     """
+    # run time, not --help: numpy, h5py, numba, matplotlib (0.1-2 s each), outputs (+7%)
     from rocksweep.analysis.restitution import restitution_table
     from rocksweep.outputs import check_output
 
@@ -53,8 +55,6 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
                      *(("impact.e=null",) if law != CONSTANT else ()))
     scene = load(scene_path, overrides)
     if plot_path is not None:  # the scene file, its records: never written over
-        from rocksweep.figures import FORMATS
-
         check_output(plot_path, overwrite=overwrite, inputs=scene.inputs, suffixes=FORMATS)
     table = restitution_table(scene, n_lam, n_u)
     if as_json:

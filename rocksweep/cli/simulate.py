@@ -11,6 +11,8 @@ import click
 
 from rocksweep.cli.main import load, main, said, user_errors
 from rocksweep.cli.options import json_option, overwrite_option, scene_argument, set_option
+from rocksweep.errors import SceneError
+from rocksweep.figures import FORMATS
 from rocksweep.vocab.axes import alpha_symbol
 
 MAX_POINTS = 12  # = rocksweep.compute.history.MAX_RUNS: simulate overlays a few runs
@@ -40,6 +42,8 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     impact), impacts, uplifts, max |theta|/alpha_cg, the overturning time p*t, the energy
     lost in impacts and in the damper, and the accuracy setting with its cost.
     """
+    # run time, not --help: numpy, h5py, numba, matplotlib (0.1-2 s each), outputs (+7%)
+    from rocksweep.cli.helpers import prepare_point_kernel
     from rocksweep.compute.history import run_points, write_history_csv
     from rocksweep.outputs import check_distinct, check_output
 
@@ -49,13 +53,12 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     scene = load(scene_path, overrides)
     # the scene file, its record: never written over
     if plot_path is not None:
-        from rocksweep.figures import FORMATS
-
         check_output(plot_path, overwrite=overwrite, inputs=scene.inputs, suffixes=FORMATS)
     if csv_path is not None:
         check_output(csv_path, overwrite=overwrite, inputs=scene.inputs)
-    from rocksweep.errors import SceneError
 
+    if scene.size <= MAX_POINTS:  # said when it compiles (once per machine)
+        prepare_point_kernel(scene)
     try:
         runs = run_points(scene, MAX_POINTS)
     except SceneError as err:  # name the file, as scene errors do
@@ -91,6 +94,7 @@ def _json_safe(d: dict) -> dict:
 
 
 def _print_run(r, swept: list[str]) -> None:
+    # run time, not --help: numpy, h5py, numba, matplotlib (0.1-2 s each), outputs (+7%)
     from rocksweep.compute.history import swept_values
 
     s = r.summary()

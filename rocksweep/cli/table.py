@@ -7,6 +7,7 @@ from pathlib import Path
 
 import click
 
+import rocksweep
 from rocksweep.cli.main import main, release_warnings, user_errors
 from rocksweep.cli.options import overwrite_option, result_argument
 
@@ -25,7 +26,7 @@ def table_command(result_path: Path, out_path: Path, overwrite: bool) -> None:
     fields, the record and its IMs, as recorded and as scaled for the run), or one row
     per curve of an analysis's file (fragility, risk, efficiency -o .h5); no row
     repeated."""
-    import rocksweep
+    # run time, not --help: numpy, h5py, numba, matplotlib (0.1-2 s each), outputs (+7%)
     from rocksweep.outputs import check_output, write_atomic
     from rocksweep.store.reader import result_inputs
 

@@ -744,15 +744,24 @@ def run_on_function(plan: Plan, evaluate: Callable[[np.ndarray, Batch], np.ndarr
 @dataclass
 class BatchResult:
     """Results of some points of a batch: flat: int64[n] (increasing), arrays: name ->
-    array[n] (``rocksweep.compute.sweep.VARIABLES``), seconds / cpu_seconds of the chunk."""
+    array[n] (``rocksweep.compute.sweep.VARIABLES``), seconds / cpu_seconds of the chunk,
+    refine_evaluations: int64[n], the RK4 evaluations of each point's certification, or
+    None (``ChunkResult``)."""
 
     flat: np.ndarray
     arrays: dict[str, np.ndarray]
     seconds: float
     cpu_seconds: float
+    refine_evaluations: np.ndarray | None = None
+
+    @property
+    def refine_total(self) -> int:
+        """The RK4 evaluations of the certification of its points (0: none counted)."""
+        r = self.refine_evaluations
+        return 0 if r is None else int(r.sum())
 
 
-class _Subset:
+class Subset:
     """A grid seen through a list of flat indices: what ``rocksweep.compute.sweep.run_chunk`` needs
     (``rows(start, stop)`` over positions in the list, ``kinds()``), so a batch runs through
     the chunk machinery (threads or dask) unchanged."""
@@ -770,22 +779,28 @@ class _Subset:
 
 
 def run_batch(grid: Grid, flat: np.ndarray, jobs: int = 1, chunk_size: int | None = None,
-              backend: str = "threads", scheduler: str | None = None
-              ) -> Iterator[BatchResult]:
+              backend: str = "threads", scheduler: str | None = None,
+              runner: Any = None) -> Iterator[BatchResult]:
     """Compute the points ``flat`` (int64[n]) through ``rocksweep.compute.sweep.run_chunks``; yield
-    each chunk's results as it finishes (any order). Results depend only on the point."""
+    each chunk's results as it finishes (any order). Results depend only on the point.
+    runner: a sweep's ``compute.overlap.Runner`` (its worker threads, kept busy between
+    batches), which then runs them instead."""
     from rocksweep.compute import sweep as sw
 
     flat = np.asarray(flat, np.int64)
     if flat.size == 0:
         return
+    if runner is not None:
+        yield from runner.run(flat)
+        return
     n_workers = sw.effective_jobs(jobs) if backend == "threads" else 1
     size = chunk_size or sw.auto_chunk_size(flat.size, n_workers)
-    sub = _Subset(grid, flat)
+    sub = Subset(grid, flat)
     chunks = sw.plan_chunks(np.ones(flat.size, bool), size)
     for r in sw.run_chunks(sub, chunks, sw.level(grid.scene), jobs, backend,  # type: ignore[arg-type]
                            scheduler):
-        yield BatchResult(flat[r.start:r.stop], r.arrays, r.seconds, r.cpu_seconds)
+        yield BatchResult(flat[r.start:r.stop], r.arrays, r.seconds, r.cpu_seconds,
+                          r.refine_evaluations)
 
 
 @dataclass

@@ -33,6 +33,11 @@ MAX_JOBS_PER_CORE = 4
 # Seconds to wait for a dask scheduler to answer (``connect_timeout``).
 CONNECT_TIMEOUT = 20.0
 MAX_CONNECT_TIMEOUT = 3600.0
+# Finished chunks are written to the file at most this often [s] by default
+# (``write_every``): a write (several hyperslabs per variable, two flushes) costs ~10 ms, as
+# much as a chunk of easy points, and holds the GIL that worker threads need between
+# kernel calls.
+WRITE_EVERY = 1.0
 # the remedy of a scheduler that could not be reached (a message template's end: {resume})
 RETRY = "then run it again (with {resume} to finish a file already started)"
 
@@ -95,14 +100,14 @@ class SweepArguments:
     backend: str = DEFAULT_BACKEND
     scheduler: str | None = None
     chunk_size: int | None = None
-    write_every: float = 1.0
+    write_every: float = WRITE_EVERY
     connect_timeout: float = CONNECT_TIMEOUT
 
 
 def check_sweep_arguments(*, jobs: Any = 1, resume: Any = False, overwrite: Any = False,
                           validate: Any = False, backend: Any = DEFAULT_BACKEND,
                           scheduler: Any = None, chunk_size: Any = None,
-                          write_every: Any = 1.0, connect_timeout: Any = CONNECT_TIMEOUT
+                          write_every: Any = WRITE_EVERY, connect_timeout: Any = CONNECT_TIMEOUT
                           ) -> SweepArguments:
     """Check every argument of a sweep that decides nothing about the scene; return them
     as ``SweepArguments``. Raises before any file is touched. (Whether ``validate`` has

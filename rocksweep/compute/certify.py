@@ -29,9 +29,10 @@ certified runs take ~2x the bare ones' (``scripts/threshold_sample.py``).
 Every refined or checked point has STATUS_REFINED in its status; one whose outcome still
 changed at the last refinement, or which was still a close call there, also
 STATUS_UNCERTIFIED (flagged: not a reliable classification). Its steps and event_steps
-count every run it took. The same rule runs wherever rows meet the kernel, through the one
-dispatch (``compute.dispatch.run_variant``): sweeps (``compute.sweep.run_rows``), adaptive
-sweeps (through the sweep's chunks), the A_min
+count every run it took; OUT_REFINE_EVALS those of the certification's runs alone (the
+price of the certification, ``rocksweep info``). The same rule runs wherever rows meet
+the kernel, through the one dispatch (``compute.dispatch.run_variant``): sweeps
+(``compute.sweep.run_rows``), adaptive sweeps (through the sweep's chunks), the A_min
 searches (``analysis.boundaries.kernel_rows``), single runs (``compute.single.run_point``)
 and the accuracy study (``analysis.accuracy.run_kernel``).
 """
@@ -50,6 +51,11 @@ from rocksweep.numerics import CLOSE_AFTER, CLOSE_BAND, OVERTURN_BAND
 def _fell(outs: np.ndarray) -> np.ndarray:
     return ((outs[:, L.OUT_OUTCOME] == L.OUTCOME_MODE1)
             | (outs[:, L.OUT_OUTCOME] == L.OUTCOME_MODE2))
+
+
+def _evaluations(outs: np.ndarray) -> np.ndarray:
+    """RK4 evaluations (regular steps + event re-integrations) of result rows."""
+    return outs[:, L.OUT_STEPS] + outs[:, L.OUT_EVENT_STEPS]
 
 
 def close_calls(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
@@ -106,6 +112,7 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
         probe = run(probe_rows(rows[near], outs[near]), near, keep=False)
         outs[near, L.OUT_STEPS] += probe[:, L.OUT_STEPS]
         outs[near, L.OUT_EVENT_STEPS] += probe[:, L.OUT_EVENT_STEPS]
+        outs[near, L.OUT_REFINE_EVALS] += _evaluations(probe)
         outs[near, L.OUT_STATUS] = outs[near, L.OUT_STATUS].astype(np.int64) | L.STATUS_REFINED
         # a near-miss the finer run overturns is a close call: its full runs from level 1
         # (the probe's run is not reused as level 1: a history, where one is recorded,
@@ -114,7 +121,7 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
     for level in range(1, levels + 1):
         if idx.size == 0:
             break
-        spent_now = outs[idx][:, [L.OUT_STEPS, L.OUT_EVENT_STEPS]]
+        spent_now = outs[idx][:, [L.OUT_STEPS, L.OUT_EVENT_STEPS, L.OUT_REFINE_EVALS]]
         finer = refine_rows(rows[idx], level)
         new = run(finer, idx)
         # the same outcome twice, and the finer run clear of the saddle by its own step's
@@ -123,6 +130,7 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
                   & ~close_calls(finer, new))
         status = new[:, L.OUT_STATUS].astype(np.int64) | L.STATUS_REFINED
         new[:, L.OUT_STATUS] = status
+        new[:, L.OUT_REFINE_EVALS] = spent_now[:, 2] + _evaluations(new)
         new[:, L.OUT_STEPS] += spent_now[:, 0]
         new[:, L.OUT_EVENT_STEPS] += spent_now[:, 1]
         outs[idx] = new

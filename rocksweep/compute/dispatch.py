@@ -3,8 +3,9 @@
 Sweeps (``compute.sweep.run_rows``, one call per body kind and record of a chunk), the
 A_min searches of ``analysis.boundaries``, single runs (``compute.single.run_point``) and
 the accuracy study (``analysis.accuracy.run_kernel``) all run their rows through
-``run_variant``: the kernel variant of (body kind, bookkeeping level, ground), a record's
-samples riding on the rows, and the close calls certified (``compute.certify``).
+``run_variant``: the kernel variant of (body kind, bookkeeping level, ground), an
+excitation's samples riding on the rows, and the close calls certified
+(``compute.certify``).
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import numpy as np
 from rocksweep import kernel  # its variants looked up at each call (kernel.chunk_kernel)
 from rocksweep.compute.certify import certify
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.physics.points import with_record
+from rocksweep.physics.ground_motion import Excitation
 
 
 def history_capacity(row: np.ndarray) -> int:
@@ -32,34 +33,35 @@ def history_capacity(row: np.ndarray) -> int:
 
 
 def run_variant(rows: np.ndarray, kind: int, level: int, ground: int, refine: int = 0,
-                record=None, histories: list | None = None,
-                out: np.ndarray | None = None, vertical: np.ndarray | None = None
-                ) -> np.ndarray:
-    """Result rows float64[n, N_OUT] of parameter rows float64[n, N_PAR (+ a record's
-    samples)] run through the kernel variant of body ``kind`` (``physics.points.
-    kernel_kind``), bookkeeping ``level`` (``kernel.layout.LEVEL_*``) and ``ground``
-    (``kernel.layout.GROUND_*``: the variants of Ricker, MP and records, and of a vertical
-    ground acceleration).
+                excitation: Excitation | None = None, histories: list | None = None,
+                out: np.ndarray | None = None) -> np.ndarray:
+    """Result rows float64[n, N_OUT] of parameter rows float64[n, N_PAR (+ samples)] run
+    through the kernel variant of body ``kind`` (``physics.points.kernel_kind``),
+    bookkeeping ``level`` (``kernel.layout.LEVEL_*``) and ``ground``
+    (``kernel.layout.GROUND_*``: the variants of Ricker, MP and samples, and of a moving
+    gravity g + a_v; ``ground_motion.shared_ground``).
 
     refine: close calls re-run finer, up to this many refinements (``compute.certify``,
-    ``Numerics.refine``; 0: none). record: a record all rows share (its samples written
-    once into one wide row, ``run_record``), or None (the rows carry their samples or
-    need none). histories: a list of n entries to receive each run's history
-    (float64[capacity, N_HIST], the finest run's when certified): the energy-accounting
-    point kernel runs instead (``level`` unused). out: where to write the result rows
-    (float64[n, N_OUT]; default a new array). vertical: the record's vertical component
-    [g] on its samples (``records.vertical_samples``), riding on the wide row with it.
+    ``Numerics.refine``; 0: none). excitation: the excitation all rows share, whose
+    samples are written once into one wide row (``run_record``), or None (the rows carry
+    their samples, ``Excitation.with_samples``, or need none). histories: a list of n
+    entries to receive each run's history (float64[capacity, N_HIST], the finest run's
+    when certified): the energy-accounting point kernel runs instead (``level`` unused).
+    out: where to write the result rows (float64[n, N_OUT]; default a new array).
     Returns the result rows."""
     n = rows.shape[0]
     outs = np.empty((n, L.N_OUT)) if out is None else out
+    if excitation is not None and excitation.record is None:
+        excitation = None  # a pulse: nothing rides on its rows
     if histories is not None:
         fn = kernel.point_kernel(kind, ground)
 
         def call(sub: np.ndarray, res: np.ndarray, idx: Sequence[int],
                  keep: bool = True) -> None:
+            wide = sub if excitation is None else excitation.with_samples(sub)
             for j, i in enumerate(idx):
-                hist = np.empty((history_capacity(sub[j]), L.N_HIST))
-                fn(sub[j], res[j], hist)
+                hist = np.empty((history_capacity(wide[j]), L.N_HIST))
+                fn(wide[j], res[j], hist)
                 if keep:  # a probe's (``certify``) is not the point's history
                     histories[int(i)] = hist
     else:
@@ -67,10 +69,10 @@ def run_variant(rows: np.ndarray, kind: int, level: int, ground: int, refine: in
 
         def call(sub: np.ndarray, res: np.ndarray, idx: Sequence[int],
                  keep: bool = True) -> None:
-            if record is None:
+            if excitation is None:
                 fn(sub, res)
             else:
-                run_record(fn, sub, np.ones(sub.shape[0], bool), res, record, vertical)
+                run_record(fn, sub, np.ones(sub.shape[0], bool), res, excitation)
 
     call(rows, outs, range(n))  # idx: the rows' places in ``histories``
     if refine > 0:
@@ -84,23 +86,24 @@ def run_variant(rows: np.ndarray, kind: int, level: int, ground: int, refine: in
 
 
 def run_record(kernel_fn, rows: np.ndarray, sel: np.ndarray, outs: np.ndarray,
-               record, vertical: np.ndarray | None = None) -> None:
-    """Run the selected rows of a record scene, all driven by ``record``.
+               excitation: Excitation) -> None:
+    """Run the selected rows (float64[n, N_PAR]), all driven by the samples of
+    ``excitation``.
 
     The GROUND chunk kernel reads the ground motion from the row after the parameters
-    (``kernel.equations.ground_acc``, ``points.with_record``). The runs share one wide
-    row: the record's samples are written into it once, and each point's N_PAR
-    parameters are copied in before its kernel call (one call a point, ~1 us of
-    dispatch against the milliseconds a run of a record takes), so no point copies the
-    samples. Each point's result is the one a row of its own gives (the kernel runs
-    every row alone), bit for bit."""
+    (``kernel.ground.ground_acc``, ``Excitation.with_samples``). The runs share one
+    wide row: the samples are written into it once, and each point's N_PAR parameters are
+    copied in before its kernel call (one call a point, ~1 us of dispatch against the
+    milliseconds a run of a record takes), so no point copies the samples. Each point's
+    result is the one a row of its own gives (the kernel runs every row alone), bit for
+    bit."""
     idx = np.flatnonzero(sel)
     if idx.size == 0:
         return
-    wide = with_record(rows[idx[:1]], record, vertical)  # float64[1, N_PAR + npts (+ ...)]
+    wide = excitation.with_samples(rows[idx[:1], :L.N_PAR])  # float64[1, N_PAR + samples]
     res = np.empty((1, L.N_OUT))
     head = wide[0, :L.N_PAR]
     for i in idx.tolist():
-        head[:] = rows[i]
+        head[:] = rows[i, :L.N_PAR]
         kernel_fn(wide, res)
         outs[i] = res[0]

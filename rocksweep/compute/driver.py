@@ -7,7 +7,7 @@ driver needs only its ``grid`` and its methods ``done``, ``write``, ``state``,
 ``write_points``, ``write_filled``, ``finish``, ``image`` and ``close``): made, and every
 argument checked, by the sweep session (``rocksweep.compute.session``), the one way in
 for ``rocksweep.run`` and ``rocksweep sweep``. Light at import (numpy, the kernel and
-tqdm load inside the functions), so the command line's options can read ``WRITE_EVERY`` from here.
+tqdm load inside the functions).
 """
 
 from __future__ import annotations
@@ -28,11 +28,6 @@ if TYPE_CHECKING:
     from rocksweep.compute.adaptive import AdaptiveStats, Options, Validation
     from rocksweep.scene.model import Scene
 
-# Finished chunks are written to the file at most this often [s] by default: a write
-# (several hyperslabs per variable, two flushes) costs ~10 ms, as much as a chunk of easy
-# points, and holds the GIL that worker threads need between kernel calls.
-WRITE_EVERY = 1.0
-
 
 @dataclass
 class SweepReport:
@@ -41,7 +36,8 @@ class SweepReport:
     points_done: points in the file now; computed: points computed in this session;
     done_before: points the file held when the session started; compile_s: kernel
     compile or cache load; cpu_s: the workers' CPU time on this session's points;
-    attrs: the file's totals (``SweepFile.finish``).
+    refine_evaluations: the RK4 evaluations of the certification's runs among this
+    session's (``compute.certify``); attrs: the file's totals (``SweepFile.finish``).
     """
 
     path: Path
@@ -51,6 +47,7 @@ class SweepReport:
     wall_s: float
     cpu_s: float
     compile_s: float
+    refine_evaluations: int = 0
     attrs: dict = field(default_factory=dict)
     adaptive: AdaptiveStats | None = None  # adaptive sweeps: the file's counts
     validation: Validation | None = None  # adaptive sweeps with validate=True
@@ -98,7 +95,8 @@ def drive(sf, path: Path | None, report: SweepReport, t0: float,
     except BaseException as err:
         try:
             report.wall_s = time.perf_counter() - t0
-            report.attrs = sf.finish(report.wall_s, report.cpu_s)
+            report.attrs = sf.finish(report.wall_s, report.cpu_s,
+                                     refine_evaluations=report.refine_evaluations)
         finally:
             sf.close()
         if (isinstance(err, KeyboardInterrupt) or interrupt_pending()) and not isinstance(
@@ -107,7 +105,8 @@ def drive(sf, path: Path | None, report: SweepReport, t0: float,
             raise SweepInterrupted(report) from None
         raise
     report.wall_s = time.perf_counter() - t0
-    report.attrs = sf.finish(report.wall_s, report.cpu_s)
+    report.attrs = sf.finish(report.wall_s, report.cpu_s,
+                             refine_evaluations=report.refine_evaluations)
     if path is None:
         report.image = sf.image()
     sf.close()
@@ -154,7 +153,7 @@ class ArraySink:
         self.flat["outcome"][:] = outcome
         self.counts = counts
 
-    def finish(self, wall_s: float, cpu_s: float) -> dict:
+    def finish(self, wall_s: float, cpu_s: float, refine_evaluations: int = 0) -> dict:
         return dict(self.counts)
 
     def image(self) -> None:
@@ -242,6 +241,8 @@ def every_point_loop(sf, report: SweepReport, _options: None, *, jobs: int, back
             for res in sw.run_chunks(sf.grid, chunks, lvl, jobs, backend, scheduler):
                 pending.append(res)
                 report.cpu_s += res.cpu_seconds
+                if res.refine_evaluations is not None:
+                    report.refine_evaluations += int(res.refine_evaluations.sum())
                 report.computed += res.stop - res.start
                 bar.update(res.stop - res.start)
                 raise_pending()  # this chunk is kept: written on the way out
@@ -253,22 +254,15 @@ def every_point_loop(sf, report: SweepReport, _options: None, *, jobs: int, back
 
 
 def prepare_kernel(sf, lvl: int, report: SweepReport, say: Callable[[str], None]) -> None:
-    """Compile or load the kernel variants the grid needs, saying what happens."""
+    """Compile or load the kernel variants the grid needs, saying what happens: the
+    variants to compile, named, and what they took here before
+    (``compile_cost.prepare``)."""
+    from rocksweep.compute import compile_cost
     from rocksweep.compute import sweep as sw
 
-    to_compile, unknown = sw.kernel_cache_state(sf.grid, lvl)
-    if to_compile:
-        say(f"compiling the kernel (once per machine, "
-            f"~{to_compile * sw.COMPILE_SECONDS:.0f} s)...")
-    elif unknown:
-        say("loading or compiling the kernel...")
-    t_prep = time.perf_counter()
-    sw.prepare(sf.grid, lvl)
-    report.compile_s = time.perf_counter() - t_prep
+    report.compile_s = compile_cost.prepare(sw.chunk_variants(sf.grid, lvl),
+                                            lambda: sw.prepare(sf.grid, lvl), say)
     raise_pending()  # a Ctrl-C that numba's callbacks swallowed while loading
-    if to_compile or unknown or report.compile_s > 1.0:
-        how = "compiled" if to_compile else "compiled or loaded from numba's cache"
-        say(f"kernel {how} in {report.compile_s:.1f} s")
 
 
 def adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backend: str,
@@ -290,6 +284,7 @@ def adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backe
 
     from rocksweep.compute import adaptive as ad
     from rocksweep.compute import sweep as sw
+    from rocksweep.compute.overlap import Runner
 
     t_start = time.perf_counter()
     tqdm = progress_class(progress)
@@ -319,6 +314,9 @@ def adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backe
 
     prepared = False
     batches: list = []  # (kind, stride, points) per batch: AdaptiveStats.batches
+    # worker threads kept busy with the audit candidates between batches (``Runner``)
+    runner = (Runner(sf.grid, plan, computed, jobs, chunk_size)
+              if backend == "threads" else None)
     with tqdm(total=0, unit="pt", disable=not progress, file=sys.stderr, smoothing=0.1,
               dynamic_ncols=True) as bar:
 
@@ -331,7 +329,8 @@ def adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backe
             bar.total += len(b)  # the work grows as refinement finds boundaries
             bar.set_description(b.kind if b.kind != "refine" else f"refine {b.stride}")
             bar.refresh()
-            yield from ad.run_batch(sf.grid, b.flat, jobs, chunk_size, backend, scheduler)
+            yield from ad.run_batch(sf.grid, b.flat, jobs, chunk_size, backend, scheduler,
+                                    runner)
             write_pending()
 
         t_write = time.perf_counter()
@@ -340,6 +339,7 @@ def adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backe
                 pending.append(res)
                 pending_flags.append(flags)
                 report.cpu_s += res.cpu_seconds
+                report.refine_evaluations += res.refine_total
                 report.computed += len(res.flat)
                 bar.update(len(res.flat))
                 raise_pending()  # this chunk is kept: written on the way out
@@ -347,6 +347,8 @@ def adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backe
                     write_pending()
                     t_write = time.perf_counter()
         finally:
+            if runner is not None:
+                runner.close()
             write_pending()
     stats = ad.stats_of(computed, options.threshold)
     stats.batches, stats.seconds = batches, time.perf_counter() - t_start  # this session's

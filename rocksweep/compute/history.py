@@ -3,9 +3,16 @@
 
 from __future__ import annotations
 
+import csv
 from collections.abc import Sequence
+from itertools import product
 from pathlib import Path
 from typing import TYPE_CHECKING
+
+from rocksweep import fields
+from rocksweep.compute.single import Run, run_point
+from rocksweep.errors import ApiError, SceneError, set_key
+from rocksweep.outputs import atomic_path
 
 # `rocksweep simulate` overlays a few runs; larger grids are for sweeps.
 MAX_RUNS = 12
@@ -15,14 +22,11 @@ API_MAX_RUNS = 100
 if TYPE_CHECKING:
     import xarray as xr
 
-    from rocksweep.compute.single import Run
     from rocksweep.scene.model import Scene
 
 def history_dataset(run: Run, title: str = "") -> xr.Dataset:
     """A run's time history as an xarray Dataset over p_t (see ``Simulation``)."""
-    import xarray as xr
-
-    from rocksweep import fields
+    import xarray as xr  # ~0.4 s that ``rocksweep simulate`` (no Dataset) does not pay
 
     cols = run.history_columns()
     spec = {c.name: c for c in fields.HISTORY}
@@ -60,11 +64,6 @@ def write_history_csv(runs: Sequence[Run], swept: Sequence[str], path: str | Pat
     E_over_Eref, ...); plain numbers (``repr`` of Python floats: nan, inf as such).
     Check the path first with ``rocksweep.outputs.check_output``; an existing file is
     replaced only with ``overwrite`` (``outputs.publish``)."""
-    import csv
-
-    from rocksweep import fields
-    from rocksweep.outputs import atomic_path
-
     with atomic_path(path, overwrite=overwrite) as tmp, tmp.open("w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["run", *swept, *(c.name for c in fields.HISTORY)])
@@ -79,11 +78,6 @@ def run_points(scene: Scene, max_runs: int = MAX_RUNS) -> list[Run]:
     """Each point of a small scene as a single run with history (``rocksweep simulate``
     overlays them); a SceneError naming the longest swept key if there are more than
     ``max_runs`` points."""
-    from itertools import product
-
-    from rocksweep.compute.single import run_point
-    from rocksweep.errors import SceneError, set_key
-
     if scene.size > max_runs:
         big = max(scene.swept, key=lambda a: len(a.values))
         raise SceneError(f"{scene.size} points; simulate runs at most {max_runs} (sweep "
@@ -107,15 +101,11 @@ def titled_runs(scene: Scene, max_runs: int = MAX_RUNS) -> list[tuple[Run, xr.Da
     than ``max_runs`` points: an ApiError naming the longest swept key (in the API's
     words: an override, or ``rocksweep.run`` for a grid)."""
     if scene.size > max_runs:
-        from rocksweep.errors import ApiError
-
         big = max(scene.swept, key=lambda a: len(a.values))
         raise ApiError(f"the scene has {scene.size} points ({big.key} has {len(big.values)} "
-                       f"values): simulate runs at most {max_runs}; pass "
-                       f"overrides={{{big.key!r}: ...}}, or use rocksweep.run for a grid")
+                       f"values): simulate runs at most {max_runs}; pass {{fix}}, or use "
+                       "rocksweep.run for a grid", fix=set_key(big.key, "set_fix"))
     if scene.size == 1:
-        from rocksweep.compute.single import run_point
-
         r = run_point(scene.single_point(), scene.single_numerics, contact=scene.contact)
         return [(r, history_dataset(r, scene.name), scene.name)]
     swept = [a.name for a in scene.swept]

@@ -7,15 +7,27 @@ loose keyword arguments."""
 from __future__ import annotations
 
 import contextlib
+import io
 import sys
 import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from rocksweep.compute.arguments import CONNECT_TIMEOUT, SweepArguments
-from rocksweep.compute.driver import WRITE_EVERY, SweepReport
+from rocksweep.compute.adaptive import adaptive_options
+from rocksweep.compute.arguments import (
+    CONNECT_TIMEOUT,
+    WRITE_EVERY,
+    SweepArguments,
+    check_flag,
+    check_sweep_arguments,
+)
+from rocksweep.compute.driver import SweepInterrupted, SweepReport, drive
+from rocksweep.compute.sweep import check_scheduler
 from rocksweep.errors import ApiError, Arg, SweepError, flag
+from rocksweep.outputs import check_output, check_path_text, exists_error
+from rocksweep.scene.grid import Grid
+from rocksweep.store.writer import SweepFile
 
 if TYPE_CHECKING:
     from typing import Any
@@ -56,9 +68,6 @@ def sweep_file(scene: Scene, path: str | Path | None, *, overrides: Sequence[str
     checked (``rocksweep.compute.arguments``) before the output is touched, then ``sweep``
     runs. Returns a ``SweepReport``.
     """
-    from rocksweep.compute.arguments import check_sweep_arguments
-    from rocksweep.outputs import check_path_text
-
     args = check_sweep_arguments(
         jobs=jobs, resume=resume, overwrite=overwrite, validate=validate, backend=backend,
         scheduler=scheduler, chunk_size=chunk_size, write_every=write_every,
@@ -77,17 +86,10 @@ def sweep(scene: Scene, path: Path | None, args: SweepArguments, *,
     caller: ``rocksweep sweep``, ``run_session``, ``sweep_file``). The scene's grid is
     made here, once, and handed to the sink and the driver; the output path is checked
     once (``outputs.check_output``) before the file is made or reopened."""
-    from rocksweep.compute.driver import SweepInterrupted, drive
-    from rocksweep.outputs import check_output, exists_error
-    from rocksweep.scene.grid import Grid
-    from rocksweep.store.writer import SweepFile
-
     if args.validate and adaptive is None:
         raise SweepError("{validate} checks an adaptive sweep; add {adaptive}",
                          validate=flag("validate"), adaptive=flag("adaptive"))
     if args.backend == "dask":
-        from rocksweep.compute.sweep import check_scheduler
-
         check_scheduler(args.scheduler, args.connect_timeout)  # before any file is made
     grid = Grid(scene)
     # bad axes or settings: before any file
@@ -174,8 +176,9 @@ def run_session(scene: SceneLike | Scene, output: str | Path | None, *,
     progress bar; client: see ``client_backend``. Returns the result as the loaded Dataset
     (``store.dataset``: ``open_result`` of the file, or ``result_dataset`` of the
     in-memory file's image)."""
-    from rocksweep.compute.arguments import check_flag, check_sweep_arguments
-    from rocksweep.outputs import check_path_text
+    # rocksweep.run's alone: rocksweep sweep compiles neither at start-up (8 kB of source)
+    from rocksweep.scene.inputs import load, override_strings
+    from rocksweep.store.dataset import open_result, result_dataset
 
     # types and ranges first: nothing below may touch ``output`` before all are checked
     check_flag("progress", progress)
@@ -184,10 +187,6 @@ def run_session(scene: SceneLike | Scene, output: str | Path | None, *,
     args = check_sweep_arguments(jobs=jobs if client is None else 1, resume=resume,
                                  overwrite=overwrite, validate=validate, **where)
     path = check_path_text(output, "output") if output is not None else None
-    from rocksweep.compute.adaptive import adaptive_options
-    from rocksweep.scene.inputs import load, override_strings
-    from rocksweep.store.dataset import open_result, result_dataset
-
     scene, source = load(scene, overrides)
     opts = adaptive_options(adaptive, base=scene.refine, **(settings or {}))
     overrides = override_strings(overrides)
@@ -195,7 +194,5 @@ def run_session(scene: SceneLike | Scene, output: str | Path | None, *,
     report = sweep(scene, path, args, overrides=overrides, progress=progress, log=log,
                    inputs=[source] if source and path is not None else (), adaptive=opts)
     if path is None:
-        import io
-
         return result_dataset(io.BytesIO(report.image))
     return open_result(path)

@@ -31,6 +31,7 @@ from rocksweep import (
     fields,
     kernel,  # lazy: numba loads at the first kernel.chunk_kernel
 )
+from rocksweep.compute import compile_cost
 from rocksweep.compute.arguments import (
     CONNECT_TIMEOUT,
     RETRY,
@@ -41,7 +42,6 @@ from rocksweep.compute.dispatch import run_variant
 from rocksweep.errors import SweepError, flag
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import point_seconds
-from rocksweep.physics.bodies import G
 from rocksweep.scene.grid import ChunkResult, ChunkRows, Grid
 from rocksweep.scene.model import Scene
 from rocksweep.vocab.settings import BACKENDS
@@ -53,9 +53,6 @@ MAX_CHUNK = 1024
 NO_WORKERS_TIMEOUT = 60.0
 # How often [s] the dask driver checks the cluster while no chunk finishes.
 CLUSTER_POLL = 1.0
-# Cold compile of one kernel variant [s], measured: 5.0-7.2 s CPU a variant
-# (scripts/bench_compile.py, docs/performance.md).
-COMPILE_SECONDS = 6.0
 
 
 def level(scene: Scene) -> int:
@@ -72,7 +69,7 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
     (``fields.check_rows``) through the same kernel, and the chunk's result holds the
     differences (``fields.CHECK_FIELDS``)."""
     t0, c0 = time.perf_counter(), time.thread_time()
-    # a Grid, or adaptive's view of one (``adaptive._Subset``: the grid as ``.grid``)
+    # a Grid, or adaptive's view of one (``adaptive.Subset``: the grid as ``.grid``)
     scene = grid.scene if hasattr(grid, "scene") else grid.grid.scene
     cr = grid.rows(start, stop)
     outs = run_rows(cr, cr.rows, level, scene)
@@ -80,42 +77,33 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
     stored = fields.sweep_fields(scene.energy if contact else level == L.LEVEL_ENERGY,
                                  contact, scene.check)
     arrays = fields.convert(outs, cr.alpha_ref, cr.E_ref, stored)
-    if scene.floor:  # the peak the body was driven by [g]: the kernel's amplitude / g
-        arrays[fields.FLOOR_PFA] = cr.rows[:, L.PAR_AMP] / G
+    if scene.floor:  # the peak the body was driven by [g]
+        arrays[fields.FLOOR_PFA] = scene.floor_pfa(cr.rows[:, L.PAR_AMP])
     if scene.check:
         half = run_rows(cr, fields.check_rows(cr.rows), level, scene)
         arrays.update(fields.convert_check(outs, half, cr.alpha_ref))
     return ChunkResult(start, stop, arrays, time.perf_counter() - t0,
-                       time.thread_time() - c0)
+                       time.thread_time() - c0, outs[:, L.OUT_REFINE_EVALS].astype(np.int64))
 
 
 def run_rows(cr: ChunkRows, rows: np.ndarray, level: int, scene: Scene,
              certify: bool = True) -> np.ndarray:
     """Result rows float64[n, N_OUT] of ``rows`` (float64[n, N_PAR], those of ``cr`` or
     their half-step reruns) at bookkeeping ``level``: one call of the one dispatch
-    (``compute.dispatch.run_variant``) per body kind present (and per record of a
-    suite), the scene's ground variant (Ricker, MP, records) with a record's samples
-    riding on the rows. certify: re-run the close calls finer (``compute.certify``, up
-    to the scene's ``numerics.refine`` refinements)."""
+    (``compute.dispatch.run_variant``) per body kind present and batch of the chunk
+    (``ChunkRows.batches``: the points of one excitation with samples, which ride on its
+    rows, or every pulse), on the scene's ground variant. certify: re-run the close calls
+    finer (``compute.certify``, up to the scene's ``numerics.refine`` refinements)."""
     refine = scene.numerics.refine if certify else 0
     outs = np.empty((rows.shape[0], L.N_OUT))
-    vertical = scene.vertical_samples()  # a record's vertical component rides along
     for kind in np.unique(cr.kinds):
-        sel = cr.kinds == kind
-        if cr.records is not None:  # one record at a time, its samples shared
-            for r in np.unique(cr.record_index[sel]):
-                part = sel & (cr.record_index == r)
-                outs[part] = run_variant(
-                    rows[part], int(kind), level, scene.ground, refine,
-                    record=cr.records[int(r)],
-                    vertical=None if cr.verticals is None else cr.verticals[int(r)])
-        elif sel.all():
-            run_variant(rows, int(kind), level, scene.ground, refine, record=scene.record,
-                        out=outs, vertical=vertical)
-        else:
-            outs[sel] = run_variant(np.ascontiguousarray(rows[sel]), int(kind), level,
-                                    scene.ground, refine, record=scene.record,
-                                    vertical=vertical)
+        for part, ex in cr.batches(cr.kinds == kind):
+            if part.all():
+                run_variant(rows, int(kind), level, scene.ground, refine, excitation=ex,
+                            out=outs)
+            else:
+                outs[part] = run_variant(np.ascontiguousarray(rows[part]), int(kind), level,
+                                         scene.ground, refine, excitation=ex)
     return outs
 
 
@@ -129,7 +117,9 @@ def merge_contiguous(results: Iterable[ChunkResult]) -> list[ChunkResult]:
             merged[-1] = ChunkResult(
                 last.start, r.stop,
                 {k: np.concatenate((v, r.arrays[k])) for k, v in last.arrays.items()},
-                last.seconds + r.seconds, last.cpu_seconds + r.cpu_seconds)
+                last.seconds + r.seconds, last.cpu_seconds + r.cpu_seconds,
+                None if last.refine_evaluations is None or r.refine_evaluations is None
+                else np.concatenate((last.refine_evaluations, r.refine_evaluations)))
         else:
             merged.append(r)
     return merged
@@ -166,18 +156,15 @@ def prepare(grid: Grid, level: int) -> None:
         kernel.warm_up(kind, level, grid.scene.ground)
 
 
-def _in_cache(dispatcher) -> bool | None:
-    """``kernel._cache.in_cache`` (numba's private cache names stay there)."""
-    from rocksweep.kernel._cache import in_cache
-
-    return in_cache(dispatcher)
+def chunk_variants(grid: Grid, level: int) -> list:
+    """The kernel variants (``kernel.chunk_kernel``) ``prepare`` compiles or loads."""
+    return [kernel.chunk_kernel(kind, level, grid.scene.ground) for kind in grid.kinds()]
 
 
 def kernel_cache_state(grid: Grid, level: int) -> tuple[int, int]:
     """(variants to compile, variants of unknown state) among those ``prepare`` needs:
     what a sweep says before the kernel is compiled or loaded."""
-    states = [_in_cache(kernel.chunk_kernel(kind, level, grid.scene.ground))
-              for kind in grid.kinds()]
+    states = [compile_cost.in_cache(d) for d in chunk_variants(grid, level)]
     return sum(s is False for s in states), sum(s is None for s in states)
 
 
@@ -363,10 +350,12 @@ def estimate(scene: Scene, jobs: int = 1, sample: int = ESTIMATE_SAMPLE,
             per = per + (np.ceil(t_pulse / r[:, L.PAR_DT_ON])
                          + np.ceil((r[:, L.PAR_TEND] - t_pulse) / r[:, L.PAR_DT]))
     steps_bound = int(round(float(np.nanmean(per)) * n))
-    to_compile, unknown = kernel_cache_state(grid, lvl)
+    variants = chunk_variants(grid, lvl)
+    unready = [compile_cost.variant_name(d) for d in variants
+               if compile_cost.in_cache(d) is not True]
     workers = check_jobs(jobs)
     sampled = 0
-    if to_compile == 0 and unknown == 0:
+    if not unready:
         prepare(grid, lvl)  # loads the cached variant (no compile)
         c0 = time.thread_time()
         outs = [run_rows(cr, r, lvl, scene) for r in runs]
@@ -378,6 +367,5 @@ def estimate(scene: Scene, jobs: int = 1, sample: int = ESTIMATE_SAMPLE,
     else:
         evaluations = float(steps_bound)
         seconds = point_seconds(evaluations) / workers
-    return Estimate(n, steps_bound, evaluations, seconds, bool(to_compile or unknown),
-                    COMPILE_SECONDS * (to_compile + unknown), len(grid.kinds()), sampled,
-                    workers)
+    return Estimate(n, steps_bound, evaluations, seconds, bool(unready),
+                    compile_cost.forecast(unready)[0], len(grid.kinds()), sampled, workers)

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import textwrap
 from typing import TYPE_CHECKING
 
 import matplotlib.colors
@@ -27,7 +28,7 @@ from rocksweep.analysis.likelihood import lognormal_cdf
 from rocksweep.analysis.risk import fragility_median
 from rocksweep.errors import FragilityFigureError
 from rocksweep.figures import WIDTHS
-from rocksweep.figures.style import Figure, curve_colours
+from rocksweep.figures.style import Figure, curve_colours, grow_to_fit, log_ticks
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -148,16 +149,13 @@ def fragility_figure(frag: xr.Dataset, *, ax: Axes | None = None,
     # cover them
     ax.legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.2),
               frameon=False)
-    if own:  # the entries' lines below the axes: the figure grows to hold them
-        n_lines = sum(lab.count("\n") + 1 for lab in ax.get_legend_handles_labels()[1])
-        w, h = fig.get_size_inches()
-        fig.set_size_inches(w, h + 0.11 * max(n_lines - 6, 0))
     ax.grid(True, which="both", alpha=0.25, linewidth=0.5)
+    log_ticks(ax.xaxis, frag[stripe].values if stripe else None)
+    if own:  # the entries' lines below the axes: the figure grows to hold them, measured
+        grow_to_fit(fig)
     return fig
 
 
 def _wrapped(label: str, chars: int) -> str:
     """Each line of a legend label wrapped at ``chars`` characters (words kept whole)."""
-    import textwrap
-
     return "\n".join(textwrap.fill(line, chars) for line in label.strip().split("\n"))

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 from matplotlib.lines import Line2D
 
+from rocksweep.compute.single import NO_HISTORY
 from rocksweep.errors import FigureError
 from rocksweep.figures.style import Figure, given_axes, new_axes
 from rocksweep.vocab import axes as _axes
@@ -51,8 +52,6 @@ def time_history(runs: Sequence[Run], swept: Sequence[str] = (), title: str = ""
         raise FigureError("time history: no runs to draw")
     for run in runs:
         if run.history is None:
-            from rocksweep.compute.single import NO_HISTORY
-
             raise FigureError(f"time history: {NO_HISTORY}")
     alpha = _axes.alpha_latex(getattr(runs[0].point.body, "kind", "flexible"))
     # one input line when every run has the same pulse shape and frequency (xg''/A is then

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rocksweep.figures.style import Figure, given_axes, new_axes
-from rocksweep.vocab.laws import DEFAULT_LAW, VERTICAL, law_origin
+from rocksweep.vocab.laws import DEFAULT_LAW, EQ1, law_origin
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -66,11 +66,11 @@ def restitution_map(lam: np.ndarray, u_over_ucr: np.ndarray, e_upper: np.ndarray
     ax_a.axhline(0.0, color="0.5", lw=0.6)
     ax_a.set_xlabel(r"$\lambda$")
     ax_a.set_ylabel("$e$")
-    which = "upper sign of eq. 1" if law == VERTICAL else f"law {law}, upper sign"
+    which = "upper sign of eq. 1" if law == EQ1 else f"law {law}, upper sign"
     ax_a.set_title(rf"(a) $e$ against $\lambda$ ({which})", fontsize=10)
     ax_a.legend(fontsize=8)
     i0 = int(np.argmin(abs(lam)))
-    first = law_origin(law) if law == VERTICAL else f"law {law}"
+    first = law_origin(law) if law == EQ1 else f"law {law}"
     ax_b.plot(u_over_ucr, e_upper[i0], color="C0",
               label=rf"{first}, $\lambda$ = {lam[i0]:g}, upper sign")
     ax_b.plot(u_over_ucr, e_upper[i0, ::-1], color="C1", ls="--",

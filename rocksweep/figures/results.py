@@ -15,7 +15,7 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.figures import WIDTHS
-from rocksweep.figures.style import Figure, curve_colours
+from rocksweep.figures.style import Figure, curve_colours, grow_to_fit, log_ticks, wrap_title
 from rocksweep.vocab.axes import label as axis_label
 
 # height / width of one panel stacked in a single column (``_figure``)
@@ -100,25 +100,41 @@ def risk_figure(rk: xr.Dataset, *, ax: Any = None, width: str | None = "double")
     return fig
 
 
+MAX_IDA_PANELS = 6  # more combinations of the other keys: this many, evenly chosen
+
+
 def ida_figure(ida: xr.Dataset, *, ax: Any = None, width: str | None = "single") -> Figure:
     """IDA curves: max|theta|/alpha against the IM (log axis) per record, one panel per
-    value of the other swept keys (lam, ...; at most 4), the stripes' safe points joined,
-    each record ending at its bisected first overturning level ``ida_im`` (drawn at
-    max|theta|/alpha = 1, the overturning limit). Without the stripes' curves: each
-    record's ``ida_im`` and bracket, sorted."""
+    value of the other swept keys (lam, angle, floor.period...; at most MAX_IDA_PANELS,
+    evenly chosen, the suptitle says how many of how many), in two columns beyond one
+    (one at the single column width), the stripes' safe points joined, each record
+    ending at its bisected first overturning level ``ida_im`` (drawn at max|theta|/alpha
+    = 1, the overturning limit). Without the stripes' curves: each record's ``ida_im``
+    and bracket, sorted."""
     im, unit = ida.attrs.get("im", "IM"), ida.attrs.get("im_units", "")
     xlabel = f"{im} [{unit}]" if unit and unit != "1" else im
     curves = "theta_max_over_alpha" in ida.data_vars and im in ida["theta_max_over_alpha"].dims
-    panels = list(_curves(ida["ida_im"], "record"))[:4]
-    if ax is not None:
-        axes = np.atleast_1d(ax)
+    every = list(_curves(ida["ida_im"], "record"))
+    keep = np.unique(np.linspace(0, len(every) - 1, min(MAX_IDA_PANELS, len(every)))
+                     .round().astype(int))
+    panels = [every[i] for i in keep]
+    own = ax is None
+    cols = 1
+    if not own:
+        axes = np.atleast_1d(np.asarray(ax, dtype=object)).ravel()
         fig = axes[0].figure
+    elif curves and len(panels) > 1:
+        w = WIDTHS[width][0] if width in WIDTHS else 6.4
+        ncols = cols = 1 if width == "single" else 2
+        nrows = int(np.ceil(len(panels) / ncols))
+        fig = Figure(figsize=(w, w * (0.75 if ncols == 1 else 0.42) * nrows),
+                     layout="constrained")
+        grid = fig.subplots(nrows, ncols, squeeze=False)
+        axes = grid.ravel()
+        for a in axes[len(panels):]:
+            a.set_visible(False)
     else:
-        fig, axes = _figure(width, len(panels) if curves else 1,
-                            0.8 if curves and len(panels) > 1 else 0.9)
-        if curves and len(panels) > 1 and width != "single":  # side by side
-            w = fig.get_size_inches()[0]
-            fig.set_size_inches(w, w * 0.8 / len(panels) + 0.8)
+        fig, axes = _figure(width, 1, 0.9)
     panel_colours = curve_colours(len(panels))
     for k, (label, sel, v) in enumerate(panels):
         if curves:
@@ -131,16 +147,18 @@ def ida_figure(ida: xr.Dataset, *, ax: Any = None, width: str | None = "single")
                 c = colours[r]
                 xs, ys = list(x[np.isfinite(y)]), list(y[np.isfinite(y)])
                 if np.isfinite(v[r]):  # up to the bisected first overturning level
-                    keep = [i for i, xx in enumerate(xs) if xx < v[r]]
-                    xs, ys = [xs[i] for i in keep] + [v[r]], [ys[i] for i in keep] + [1.0]
+                    keep_r = [i for i, xx in enumerate(xs) if xx < v[r]]
+                    xs, ys = [xs[i] for i in keep_r] + [v[r]], [ys[i] for i in keep_r] + [1.0]
                 a.plot(xs, ys, "-", color=c, lw=0.8, alpha=0.8)
                 if np.isfinite(v[r]):
                     a.plot([v[r]], [1.0], "o", color=c, ms=2.5)
             a.set_xscale("log")
+            log_ticks(a.xaxis, x)
             a.set_ylim(0.0, 1.05)
             a.set_xlabel(xlabel)
             a.set_ylabel(r"max|$\theta$|/$\alpha$")
-            a.set_title(label or "IDA", fontsize="small")
+            a.set_title(wrap_title(label or "IDA", fig.get_figwidth() / cols, 8.0),
+                        fontsize="small")
             a.grid(True, which="both", alpha=0.25, linewidth=0.5)
             continue
         a = axes[0]
@@ -152,12 +170,18 @@ def ida_figure(ida: xr.Dataset, *, ax: Any = None, width: str | None = "single")
                                                np.fmax(hi, v[order]) - v[order]],
                    fmt="o", ms=3, color=panel_colours[k], label=label or None)
         a.set_xscale("log")
+        log_ticks(a.xaxis)
         a.set_xlabel(f"first overturning {xlabel}")
         a.set_ylabel("record (sorted)")
         a.grid(True, which="both", alpha=0.25, linewidth=0.5)
     if not curves and axes[0].get_legend_handles_labels()[0]:
         axes[0].legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.18),
                        frameon=False)
+    if own and len(panels) < len(every):
+        fig.suptitle(f"IDA: {len(panels)} of {len(every)} combinations of the other keys",
+                     fontsize="small")
+    if own:
+        grow_to_fit(fig)
     return fig
 
 

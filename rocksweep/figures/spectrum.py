@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from rocksweep.figures.results import _curves, _figure
+from rocksweep.figures.results import _curves, _figure, _label
 from rocksweep.figures.style import Figure, curve_colours
 from rocksweep.vocab import axes as _axes
 
@@ -72,7 +72,8 @@ def spectra_figure(sp: xr.Dataset | Spectra, *, ax: Any = None,
     axes[0].set_ylim(0.0, 1.06 + 0.025 * len(pick))
     axes[0].set_xlabel(_axes.label(freq, kind))
     axes[0].set_ylabel(rf"max$|\theta|/{_axes.alpha_latex(kind)}$ (x: overturned)")
-    at = ", ".join(f"{d} = {sp[d].values[0]:g}" if d in sp.coords else d for d in first)
+    # a word axis (pulse.shape) as itself, a number as %g
+    at = ", ".join(_label(d, sp[d].values[0]) if d in sp.coords else d for d in first)
     axes[0].set_title("rocking spectrum" + (f" at {at}" if at else "")
                       + (" (line style: lam)" if n_lam > len(LAM_STYLES) else ""),
                       fontsize="small")

@@ -14,12 +14,15 @@ Figure 5 ``rocksweep.figures.history``.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterable, Sequence
+from io import BytesIO
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import matplotlib
 import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure as _MplFigure
 
 from rocksweep.errors import FigureError
@@ -47,8 +50,6 @@ class Figure(_MplFigure):
             return super().savefig(fname, *args, **kwargs)
 
     def _repr_png_(self) -> bytes:
-        from io import BytesIO
-
         buf = BytesIO()
         self.savefig(buf, format="png", dpi=NOTEBOOK_DPI)
         return buf.getvalue()
@@ -154,10 +155,6 @@ def fit_width(fig: Figure, width: str) -> Figure:
     in as many columns as fit, and as much height as the panels, labels and legends need
     (the layout's aspect at least; every axes at least ``MIN_ASPECT`` as tall as wide).
     Nothing drawn lies outside the figure (tests/figures/test_journal.py). Returns ``fig``."""
-    import warnings
-
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-
     inches, pt = WIDTHS[width]
     w, h = fig.get_size_inches()
     fig.set_size_inches(inches, h * inches / w)
@@ -171,6 +168,17 @@ def fit_width(fig: Figure, width: str) -> Figure:
     for leg in [*fig.legends, *(a.get_legend() for a in fig.axes if a.get_legend())]:
         for t in leg.texts:
             t.set_fontsize(min(t.get_fontsize(), pt - 1))
+    grow_to_fit(fig)
+    return fig
+
+
+def grow_to_fit(fig: Figure, *, narrow_legends: bool = True) -> Figure:
+    """A finished figure made as tall as its panels, labels and legends need, at its own
+    width: nothing drawn outside it (a legend below the axes, a wrapped title) and every
+    axes at least ``MIN_ASPECT`` as tall as wide. ``narrow_legends``: a figure legend
+    wider than the figure loses a column first (``fit_width``). Text is measured as the
+    saved file will draw it. Returns ``fig``."""
+    inches = fig.get_figwidth()
     canvas = FigureCanvasAgg(fig)  # measures text as the saved file will
     for _ in range(FIT_ROUNDS):
         with warnings.catch_warnings():  # a layout too short to fit, until it grows
@@ -178,11 +186,11 @@ def fit_width(fig: Figure, width: str) -> Figure:
             canvas.draw()
         renderer = canvas.get_renderer()
         narrowed = False
-        for leg in list(fig.legends):
+        for leg in list(fig.legends) if narrow_legends else []:
             if leg._ncols > 1 and _wider(fig, renderer, leg):
                 handles, labels = leg.legend_handles, [t.get_text() for t in leg.texts]
                 loc = _OUTSIDE.get(getattr(leg, "_outside_loc", None) or "", "lower center")
-                size = leg.texts[0].get_fontsize() if leg.texts else pt - 1
+                size = leg.texts[0].get_fontsize() if leg.texts else None
                 ncol = leg._ncols - 1
                 leg.remove()
                 fig.legend(handles, labels, loc=loc, fontsize=size, frameon=False, ncol=ncol)
@@ -200,10 +208,31 @@ def fit_width(fig: Figure, width: str) -> Figure:
             lack = max(MIN_ASPECT * p.width * inches - p.height * fh for p in pos)
             grow += max(0.0, lack) * rows
         if grow < 0.01:
-            break
+            return fig  # laid out as it is drawn: no draw more
         fig.set_size_inches(inches, fh + grow + 0.02)
     canvas.draw()
     return fig
+
+
+def log_ticks(axis, values: Sequence[float] | np.ndarray | None = None) -> None:
+    """Readable labels on a log axis (``ax.xaxis`` or ``ax.yaxis``): matplotlib labels
+    the minor ticks of a range under a decade ("2x10^-1 3x10^-1 ...", overprinted at a
+    journal width); here the major ticks are the data's own values when they are few
+    (``values``: at most 6), else 1, 2, 5 a decade over ranges of up to two decades and
+    the decades beyond, each labelled as %g; minor ticks unlabelled."""
+    from matplotlib import ticker
+
+    vals = np.unique(np.asarray(values if values is not None else [], float))
+    vals = vals[np.isfinite(vals) & (vals > 0)]
+    if 1 < vals.size <= 6:
+        axis.set_major_locator(ticker.FixedLocator(vals))
+    else:
+        lo, hi = axis.get_view_interval()
+        decades = np.log10(max(hi, 1e-300) / max(lo, 1e-300)) if lo > 0 else 3.0
+        axis.set_major_locator(ticker.LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)
+                                                 if decades <= 2.0 else (1.0,)))
+    axis.set_major_formatter(ticker.FuncFormatter(lambda v, _pos: f"{v:g}"))
+    axis.set_minor_formatter(ticker.NullFormatter())
 
 
 # a figure legend's constrained-layout place (``Legend._outside_loc``) -> its loc

@@ -28,25 +28,29 @@ where three consecutive samples bracket a maximum of |H|/N (or a minimum of N) t
 matter (within ``REFINE_BAND`` of the running extremum), it is located on the integrator's
 own solution (fresh RK4 sub-steps from the start of the step it lies in, as events are) by
 safeguarded successive parabolic interpolation.
+
+The loop sees this bookkeeping as four calls at its sample points, ``reactions_begin``
+(the outputs' starting values, the first sample: a ``Track``), ``reactions_sample``,
+``reactions_impact`` and ``reactions_end`` (the run's STATUS_SLIDES / STATUS_LIFTS_OFF),
+each picked while typing by the variant's REACTIONS literal: without it they are no-ops
+(the outputs NaN, the tracker None) and none of this module's work is compiled.
 """
 
 import math
+from collections import namedtuple
 
 import numpy as np
 from numba import literally, njit
 
 from rocksweep.kernel._cache import INLINE, INTERNAL
-from rocksweep.kernel.equations import (
-    contact_rhs,
-    ground_acc,
-    ground_gravity,
-    rigid_rhs,
-    rocking_rhs,
-)
+from rocksweep.kernel._static import chosen
+from rocksweep.kernel.equations import contact_rhs, rigid_rhs, rocking_rhs
+from rocksweep.kernel.ground import ground_acc, ground_gravity
 from rocksweep.kernel.layout import (
     OUT_IMPULSE_MAX,
     OUT_MU_REQ,
     OUT_N_MIN,
+    OUT_STATUS,
     PAR_B,
     PAR_G,
     PAR_H,
@@ -55,6 +59,9 @@ from rocksweep.kernel.layout import (
     PAR_M,
     PAR_MA,
     PAR_MTOT,
+    PAR_MU,
+    STATUS_LIFTS_OFF,
+    STATUS_SLIDES,
     Y_THETA,
     Y_THETA_DOT,
     Y_U,
@@ -81,12 +88,17 @@ SAMPLE_EVENT = np.int64(2)
 PEAK_RATIO = np.int64(0)  # |H|/N
 PEAK_NORMAL = np.int64(1)  # -N/(M g)
 
+# The tracker of a segment's samples (``contact_sample``): how many it has had, and the two
+# before the current one (time, state, |H|/N, N/(M g)); a tuple to numba
+Track = namedtuple("Track", ["samples", "t_a", "y_a", "ratio_a", "normal_a",
+                             "t_b", "y_b", "ratio_b", "normal_b"])
+
 
 @njit(cache=True, **INLINE)
 def ground_reactions(theta, theta_dot, u, u_dot, s, xg, g, prm, FLEX, DAMPED):
     """(H [N], N [N]): the ground's horizontal and vertical reaction on the body in phase
     s (0 full contact) at the state (theta, theta', u, u'), ground acceleration xg and
-    gravity g (``equations.ground_gravity``: g + a_v with a vertical)."""
+    gravity g (``ground.ground_gravity``: g + a_v with a vertical)."""
     M = prm[PAR_MTOT]
     if s == 0:
         if FLEX:
@@ -141,11 +153,11 @@ def impulse_ratio(j_x, j_y):
 
 
 @njit(cache=True, **INLINE)
-def _values(t, y, s, on, prm, FLEX, DAMPED):
+def _values(t, y, s, on, prm, FLEX, DAMPED, GROUND):
     """(|H|/N or +inf when N <= 0, N/(M g)) at (t, y) in phase s."""
     h_, n_ = ground_reactions(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s,
-                              ground_acc(t, on, prm), ground_gravity(t, on, prm), prm, FLEX,
-                              DAMPED)
+                              ground_acc(GROUND, t, on, prm), ground_gravity(GROUND, t, on, prm),
+                              prm, FLEX, DAMPED)
     ratio = abs(h_) / n_ if n_ > 0.0 else math.inf
     return ratio, n_ / (prm[PAR_MTOT] * prm[PAR_G])
 
@@ -164,7 +176,7 @@ def _vertex(x0, f0, x1, f1, x2, f2):
 
 @njit(cache=True, **INTERNAL)
 def _refine(which, t_a, y_a, f_a, t_b, y_b, f_b, t_c, f_c, s, on, prm, FLEX, DAMPED,
-            ENERGY):
+            ENERGY, GROUND):
     """Largest value of f (which PEAK_RATIO: |H|/N; PEAK_NORMAL: -N/(M g)) on [t_a, t_c]
     around the sampled peak at t_b, on the integrator's own solution: a trial at tau in
     [t_a, t_b] is a fresh RK4 step from (t_a, y_a), one in [t_b, t_c] from (t_b, y_b).
@@ -188,10 +200,10 @@ def _refine(which, t_a, y_a, f_a, t_b, y_b, f_b, t_c, f_c, s, on, prm, FLEX, DAM
         if abs(x - x1) < eps:
             x = x1 + eps if x2 - x1 > x1 - x0 else x1 - eps
         if x <= t_b:
-            y_x = rk4_step(t_a, y_a, x - t_a, s, on, prm, FLEX, DAMPED, ENERGY)
+            y_x = rk4_step(t_a, y_a, x - t_a, s, on, prm, FLEX, DAMPED, ENERGY, GROUND)
         else:
-            y_x = rk4_step(t_b, y_b, x - t_b, s, on, prm, FLEX, DAMPED, ENERGY)
-        r, n = _values(x, y_x, s, on, prm, FLEX, DAMPED)
+            y_x = rk4_step(t_b, y_b, x - t_b, s, on, prm, FLEX, DAMPED, ENERGY, GROUND)
+        r, n = _values(x, y_x, s, on, prm, FLEX, DAMPED, GROUND)
         f = r if which == PEAK_RATIO else -n
         if not math.isfinite(f):
             return f
@@ -219,33 +231,32 @@ def _take(out, r, n):
 
 
 @njit(cache=True, **INTERNAL)
-def contact_sample(ct, t, y, s, on, mode, prm, out, FLEX, DAMPED, ENERGY):
+def contact_sample(track, t, y, s, on, mode, prm, out, FLEX, DAMPED, ENERGY, GROUND):
     """Take the sample (t, y) of phase s into the contact bookkeeping; returns the new
-    tracker ``ct``.
+    ``Track`` (the two samples before this one of the segment, r = |H|/N, n = N/(M g)).
 
-    ct = (samples in the segment, t_a, y_a, r_a, n_a, t_b, y_b, r_b, n_b): the two samples
-    before this one (r = |H|/N, n = N/(M g)). mode: SAMPLE_STEP (a step's end),
-    SAMPLE_START (the sample starts a new segment: after an action, the pulse's end) or
-    SAMPLE_EVENT (an event state, which ends the segment). Updates out[OUT_MU_REQ] (running
-    max of r) and out[OUT_N_MIN] (running min of n), refining a peak bracketed by the last
-    three samples of a segment (``_refine``). A segment that an event ends after less than
-    one step (chattering: rocking arcs shorter than a step) gets a midpoint sample (a fresh
-    RK4 half step), so that a peak inside it is bracketed too. ENERGY: the variant's flag,
-    for its RK4 steps (the energy slots are not used here; the other slots are the same).
+    mode: SAMPLE_STEP (a step's end), SAMPLE_START (the sample starts a new segment: after
+    an action, the pulse's end) or SAMPLE_EVENT (an event state, which ends the segment).
+    Updates out[OUT_MU_REQ] (running max of r) and out[OUT_N_MIN] (running min of n),
+    refining a peak bracketed by the last three samples of a segment (``_refine``). A
+    segment that an event ends after less than one step (chattering: rocking arcs shorter
+    than a step) gets a midpoint sample (a fresh RK4 half step), so that a peak inside it
+    is bracketed too. ENERGY: the variant's flag, for its RK4 steps (the energy slots are
+    not used here; the other slots are the same).
     """
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
-    r, n = _values(t, y, s, on, prm, FLEX, DAMPED)
+    r, n = _values(t, y, s, on, prm, FLEX, DAMPED, GROUND)
     _take(out, r, n)
-    cnt, t_a, y_a, r_a, n_a, t_b, y_b, r_b, n_b = ct
+    cnt, t_a, y_a, r_a, n_a, t_b, y_b, r_b, n_b = track
     if mode == SAMPLE_START:
-        return (1.0, t_b, y_b, r_b, n_b, t, y, r, n)
+        return Track(1.0, t_b, y_b, r_b, n_b, t, y, r, n)
     if mode == SAMPLE_EVENT and cnt == 1.0 and t_b < t:
         t_a, y_a, r_a, n_a = t_b, y_b, r_b, n_b
         t_b = 0.5 * (t_a + t)
-        y_b = rk4_step(t_a, y_a, t_b - t_a, s, on, prm, FLEX, DAMPED, ENERGY)
-        r_b, n_b = _values(t_b, y_b, s, on, prm, FLEX, DAMPED)
+        y_b = rk4_step(t_a, y_a, t_b - t_a, s, on, prm, FLEX, DAMPED, ENERGY, GROUND)
+        r_b, n_b = _values(t_b, y_b, s, on, prm, FLEX, DAMPED, GROUND)
         _take(out, r_b, n_b)
         cnt = 2.0
     if cnt >= 2.0 and t_a < t_b < t:
@@ -253,16 +264,16 @@ def contact_sample(ct, t, y, s, on, mode, prm, out, FLEX, DAMPED, ENERGY):
         if (r_b >= r_a and r_b >= r and (r_b > r_a or r_b > r) and math.isfinite(mu)
                 and r_b >= (1.0 - REFINE_BAND) * mu):
             f = _refine(PEAK_RATIO, t_a, y_a, r_a, t_b, y_b, r_b, t, r, s, on, prm, FLEX,
-                        DAMPED, ENERGY)
+                        DAMPED, ENERGY, GROUND)
             if f > out[OUT_MU_REQ]:
                 out[OUT_MU_REQ] = f
         if (n_b <= n_a and n_b <= n and (n_b < n_a or n_b < n)
                 and n_b <= out[OUT_N_MIN] + REFINE_BAND):
             f = _refine(PEAK_NORMAL, t_a, y_a, -n_a, t_b, y_b, -n_b, t, -n, s, on, prm, FLEX,
-                        DAMPED, ENERGY)
+                        DAMPED, ENERGY, GROUND)
             if -f < out[OUT_N_MIN]:
                 out[OUT_N_MIN] = -f
-    return (cnt + 1.0, t_b, y_b, r_b, n_b, t, y, r, n)
+    return Track(cnt + 1.0, t_b, y_b, r_b, n_b, t, y, r, n)
 
 
 @njit(cache=True, **INTERNAL)
@@ -275,3 +286,69 @@ def contact_impact(y_minus, s, y_plus, s_new, prm, out, FLEX):
     q = impulse_ratio(j_x, j_y)
     if q > out[OUT_IMPULSE_MAX]:
         out[OUT_IMPULSE_MAX] = q
+
+
+# ----------------------------------------------------------------------------------------
+# The bookkeeping as the loop sees it: four calls at its sample points, each a no-op (its
+# work not even typed) in a variant without REACTIONS (``variants``: outputs.contact and
+# the single runs), so the loop holds no test of the flag and no tracker's insides. The
+# entries take REACTIONS first (``_static.chosen``).
+# ----------------------------------------------------------------------------------------
+
+
+def _begin(REACTIONS, t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, GROUND):
+    """The contact outputs' starting values (no demand yet, N never seen) and the first
+    sample, at the run's start (t, y): its ``Track``."""
+    out[OUT_MU_REQ] = 0.0
+    out[OUT_N_MIN] = np.inf
+    out[OUT_IMPULSE_MAX] = 0.0
+    before = Track(0.0, 0.0, y, 0.0, 0.0, 0.0, y, 0.0, 0.0)  # no sample yet
+    return contact_sample(before, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED, ENERGY,
+                          GROUND)
+
+
+def _no_begin(REACTIONS, t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, GROUND):
+    """The contact outputs are NaN (not tracked); no tracker."""
+    out[OUT_MU_REQ] = np.nan
+    out[OUT_N_MIN] = np.nan
+    out[OUT_IMPULSE_MAX] = np.nan
+    return None
+
+
+def _sample(REACTIONS, track, t, y, s, on, mode, prm, out, FLEX, DAMPED, ENERGY, GROUND):
+    return contact_sample(track, t, y, s, on, mode, prm, out, FLEX, DAMPED, ENERGY, GROUND)
+
+
+def _no_sample(REACTIONS, track, t, y, s, on, mode, prm, out, FLEX, DAMPED, ENERGY, GROUND):
+    return track
+
+
+def _impact(REACTIONS, y_minus, s, y_plus, s_new, prm, out, FLEX):
+    contact_impact(y_minus, s, y_plus, s_new, prm, out, FLEX)
+
+
+def _no_impact(REACTIONS, y_minus, s, y_plus, s_new, prm, out, FLEX):
+    return None
+
+
+def _end(REACTIONS, prm, out):
+    """STATUS_SLIDES when the friction demand exceeds PAR_MU (never when PAR_MU is NaN),
+    STATUS_LIFTS_OFF when the normal reaction went below zero."""
+    if out[OUT_MU_REQ] > prm[PAR_MU]:
+        out[OUT_STATUS] = int(out[OUT_STATUS]) | STATUS_SLIDES
+    if out[OUT_N_MIN] < 0.0:
+        out[OUT_STATUS] = int(out[OUT_STATUS]) | STATUS_LIFTS_OFF
+
+
+def _no_end(REACTIONS, prm, out):
+    return None
+
+
+#: (REACTIONS, t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, GROUND) -> tracker
+reactions_begin = chosen({True: _begin, False: _no_begin}, "reactions_begin")
+#: (REACTIONS, tracker, t, y, s, on, mode, prm, out, FLEX, DAMPED, ENERGY, GROUND) -> tracker
+reactions_sample = chosen({True: _sample, False: _no_sample}, "reactions_sample")
+#: (REACTIONS, y_minus, s, y_plus, s_new, prm, out, FLEX): an impact's impulse ratio
+reactions_impact = chosen({True: _impact, False: _no_impact}, "reactions_impact")
+#: (REACTIONS, prm, out): the run's verdicts (STATUS_SLIDES, STATUS_LIFTS_OFF)
+reactions_end = chosen({True: _end, False: _no_end}, "reactions_end")

@@ -26,30 +26,25 @@ Full contact (theta = 0):  m u'' + c u' + k u = -m xg''.
 A vertical ground acceleration a_v(t) (positive up) adds the d'Alembert loads -m_i a_v
 along y: in the ground's frame gravity is g + a_v(t) in every term above (V, so F_theta,
 F_u, Q and the tipping moment M g b). The functions take that gravity as their argument
-``g`` (``ground_gravity``: the row's PAR_G itself without a vertical); the impact map has
-no g (a finite a_v gives no impulse). docs/vertical.md.
+``g`` (``ground.ground_gravity``: the row's PAR_G itself without a vertical); the impact
+map has no g (a finite a_v gives no impulse). docs/vertical.md.
 """
 
 import math
 
-import numpy as np
 from numba import njit
-from numba.core import types
-from numba.extending import overload
 
-from rocksweep.kernel import spring
-from rocksweep.kernel._cache import INLINE, INTERNAL, PUBLIC
+from rocksweep.kernel import eq1, spring
+from rocksweep.kernel._cache import INLINE, PUBLIC
+from rocksweep.kernel.ground import gravity_rate, per_ground
 from rocksweep.kernel.layout import (
     LAW_CONSTANT,
     LAW_LOCKED,
-    PAR_AMP,
-    PAR_AMP_NORM,
     PAR_B,
     PAR_C,
     PAR_E,
     PAR_E_FACTOR,
     PAR_G,
-    PAR_GAMMA,
     PAR_H,
     PAR_HA,
     PAR_HCG,
@@ -62,249 +57,17 @@ from rocksweep.kernel.layout import (
     PAR_M,
     PAR_MA,
     PAR_MTOT,
-    PAR_NU,
-    PAR_OMEGA,
-    PAR_REC,
-    PAR_REC_DT,
-    PAR_SHAPE,
-    PAR_V_AMP,
-    PAR_V_OMEGA,
-    PAR_V_PHASE,
-    PAR_V_REC,
-    SHAPE_COSINE,
-    SHAPE_RECORD,
-    SHAPE_RICKER,
-    SHAPE_SINE,
 )
-from rocksweep.vocab import ground as _ground
 
-# The Ricker and MP formulas, written once in ``rocksweep.vocab.ground`` (the physics
-# module evaluates the same functions per sample); compiled here, inlined by LLVM.
-_ricker_tau = njit(**INLINE)(_ground.ricker_tau)
-_ricker = njit(**INLINE)(_ground.ricker)
-_ricker_rate = njit(**INLINE)(_ground.ricker_rate)
-_mp_raw = njit(**INLINE)(_ground.mp_raw)
-_mp_raw_rate = njit(**INLINE)(_ground.mp_raw_rate)
+# Eq. (1) and its rigid limit, written once in ``eq1`` (plain Python: the physics evaluates
+# the same functions on arrays); inlined into ``restitution``, their one call site, by numba
+# (not compiled on their own)
+_e_eq1 = njit(inline="always")(eq1.restitution)
+_e_rigid = njit(inline="always")(eq1.restitution_rigid)
 
 # ----------------------------------------------------------------------------------------
-# Eq. (2): the pulse (n cycles of a sine or cosine), and the other ground motions. ``on``
-# is decided per step by the loop (the step that ends exactly at the pulse's end still
-# sees the pulse, the next one does not), so a jump at the end (the cosine's) is never
-# smeared across a step.
-#
-# The type of ``on`` picks the code at compile time: a bool (the loop's GROUND = False:
-# sine and cosine only, the paper's scenes, exactly the code they always ran) or an int
-# (GROUND = 1: every shape, the Ricker, MP and records too, chosen by PAR_SHAPE at run
-# time, ``ground_acc_any``). A run-time branch to the other shapes inside the pulse
-# variants cost 5% (inlined) to 60% (a call) on the paper's scenes, measured; the type
-# costs nothing there.
+# The vertical ground acceleration's power (the ground motions themselves: ``ground``)
 # ----------------------------------------------------------------------------------------
-
-
-def _pulse_acc(t, on, prm):
-    """Eq. (2): A sin(w t) or A cos(w t) (the paper's sine and cosine, n cycles)."""
-    if prm[PAR_SHAPE] == SHAPE_COSINE:
-        return prm[PAR_AMP] * math.cos(prm[PAR_OMEGA] * t)
-    return prm[PAR_AMP] * math.sin(prm[PAR_OMEGA] * t)
-
-
-def _pulse_jerk(t, on, prm):
-    """d/dt of ``_pulse_acc``."""
-    w = prm[PAR_OMEGA]
-    if prm[PAR_SHAPE] == SHAPE_COSINE:
-        return -prm[PAR_AMP] * w * math.sin(w * t)
-    return prm[PAR_AMP] * w * math.cos(w * t)
-
-
-def _any_acc(t, on, prm):
-    return ground_acc_any(t, prm)
-
-
-def _any_jerk(t, on, prm):
-    return ground_jerk_any(t, prm)
-
-
-def _shape_acc(t, on, prm):
-    """Plain Python (NUMBA_DISABLE_JIT=1): the overload's choice, by the type of ``on``."""
-    return (_pulse_acc if isinstance(on, bool | np.bool_) else _any_acc)(t, on, prm)
-
-
-def _shape_jerk(t, on, prm):
-    """Plain Python (NUMBA_DISABLE_JIT=1): the overload's choice, by the type of ``on``."""
-    return (_pulse_jerk if isinstance(on, bool | np.bool_) else _any_jerk)(t, on, prm)
-
-
-# compiled: the same functions, picked while typing (``on``: a bool or an int)
-@overload(_shape_acc, inline="always")
-def _shape_acc_overload(t, on, prm):
-    return _pulse_acc if isinstance(on, types.Boolean) else _any_acc
-
-
-@overload(_shape_jerk, inline="always")
-def _shape_jerk_overload(t, on, prm):
-    return _pulse_jerk if isinstance(on, types.Boolean) else _any_jerk
-
-
-@njit(cache=True, **INLINE)
-def ground_acc(t, on, prm):
-    """xg''(t) [m/s^2] of eq. (2) or of the row's other shape; 0 when ``on`` is false.
-
-    on: bool (sine and cosine only) or int (any shape; what Python callers pass)."""
-    if not on:
-        return 0.0
-    return _shape_acc(t, on, prm)
-
-
-@njit(cache=True, **INLINE)
-def ground_jerk(t, on, prm):
-    """d xg''/dt [m/s^3], for locating an uplift inside a step."""
-    if not on:
-        return 0.0
-    return _shape_jerk(t, on, prm)
-
-
-@njit(cache=True, **INLINE)
-def _samples_segment(t, prm, first, last):
-    """(a_k, x - k, a_k+1 - a_k), x = t / PAR_REC_DT: the first sample of the linear
-    segment [t_k, t_k+1] that holds t of the samples prm[first:], the fraction of it at t,
-    and the samples' difference; k <= last (the last segment at the end). At a sample
-    time either neighbour gives the same value (the interpolant is continuous), so the
-    loop's steps, which land on sample times, always see one segment's straight line."""
-    x = t / prm[PAR_REC_DT]
-    k = min(max(int(x), 0), last)
-    a0 = prm[first + k]
-    return a0, x - k, prm[first + k + 1] - a0
-
-
-@njit(cache=True, **INLINE)
-def _record_segment(t, prm):
-    """``_samples_segment`` of the horizontal record (its samples from PAR_REC on)."""
-    return _samples_segment(t, prm, PAR_REC, prm.shape[0] - PAR_REC - 2)
-
-
-@njit(cache=True, **INTERNAL)
-def ground_acc_any(t, prm):
-    """xg''(t) [m/s^2] while on, of any shape (``rocksweep.physics.excitation`` defines each as a
-    function of phi = w t); one call (inlining it into every right-hand side inlines
-    it again in each of the GROUND variant's call sites: numba's IR inliner warns).
-
-    Sine, cosine: A sin(phi), A cos(phi). Ricker: A (1 - 2 tau^2) exp(-tau^2), tau =
-    phi/2 - 3 pi/2 (t0 = 1.5/f, f = w/(2 pi)). MP: A/r_max [sin(phi/gamma) cos(psi) -
-    gamma (1 - cos(phi/gamma)) sin(psi)], psi = phi - pi gamma + nu (OpenSees' MPAcc;
-    PAR_AMP_NORM = 1/r_max). Record: A times the samples xg''/PGA interpolated linearly,
-    samples every PAR_REC_DT.
-    """
-    shape = prm[PAR_SHAPE]
-    amp = prm[PAR_AMP]
-    if shape == SHAPE_RECORD:
-        a0, frac, da = _record_segment(t, prm)
-        return amp * (a0 + frac * da)
-    phi = prm[PAR_OMEGA] * t
-    if shape == SHAPE_SINE:
-        return amp * math.sin(phi)
-    if shape == SHAPE_COSINE:
-        return amp * math.cos(phi)
-    if shape == SHAPE_RICKER:
-        return _ricker(_ricker_tau(phi), amp)
-    return amp * prm[PAR_AMP_NORM] * _mp_raw(phi, prm[PAR_GAMMA], prm[PAR_NU])
-
-
-@njit(cache=True, **INTERNAL)
-def ground_jerk_any(t, prm):
-    """d xg''/dt [m/s^3] of ``ground_acc_any`` (a record: its segment's constant slope)."""
-    shape = prm[PAR_SHAPE]
-    amp = prm[PAR_AMP]
-    if shape == SHAPE_RECORD:
-        _, _, da = _record_segment(t, prm)
-        return amp * da / prm[PAR_REC_DT]
-    w = prm[PAR_OMEGA]
-    phi = w * t
-    if shape == SHAPE_SINE:
-        return amp * w * math.cos(phi)
-    if shape == SHAPE_COSINE:
-        return -amp * w * math.sin(phi)
-    if shape == SHAPE_RICKER:
-        return _ricker_rate(_ricker_tau(phi), amp * w)
-    return amp * prm[PAR_AMP_NORM] * w * _mp_raw_rate(phi, prm[PAR_GAMMA], prm[PAR_NU])
-
-
-# ----------------------------------------------------------------------------------------
-# The vertical ground acceleration a_v (positive up): gravity is g + a_v while the ground
-# moves. The type of ``on`` says whether there is one: a float (the loop's GROUND =
-# GROUND_VERTICAL, every horizontal shape too) or not (a bool or an int: the row's g, the
-# code every other variant always ran, with nothing added to it).
-# ----------------------------------------------------------------------------------------
-
-
-@njit(cache=True, **INTERNAL)
-def vertical_acc_any(t, prm):
-    """a_v(t) [m/s^2] while the ground moves: PAR_V_AMP sin(PAR_V_OMEGA t + PAR_V_PHASE)
-    (a harmonic), or PAR_V_AMP times the vertical record's samples (PAR_V_REC > 0: on the
-    horizontal's times, interpolated linearly)."""
-    first = prm[PAR_V_REC]
-    if first > 0.0:
-        i = int(first)
-        a0, frac, da = _samples_segment(t, prm, i, prm.shape[0] - i - 2)
-        return prm[PAR_V_AMP] * (a0 + frac * da)
-    return prm[PAR_V_AMP] * math.sin(prm[PAR_V_OMEGA] * t + prm[PAR_V_PHASE])
-
-
-@njit(cache=True, **INTERNAL)
-def vertical_jerk_any(t, prm):
-    """d a_v/dt [m/s^3] of ``vertical_acc_any`` (a record: its segment's slope)."""
-    first = prm[PAR_V_REC]
-    if first > 0.0:
-        i = int(first)
-        _, _, da = _samples_segment(t, prm, i, prm.shape[0] - i - 2)
-        return prm[PAR_V_AMP] * da / prm[PAR_REC_DT]
-    w = prm[PAR_V_OMEGA]
-    return prm[PAR_V_AMP] * w * math.cos(w * t + prm[PAR_V_PHASE])
-
-
-def _row_gravity(t, on, prm):
-    return prm[PAR_G]
-
-
-def _moving_gravity(t, on, prm):
-    if not on:
-        return prm[PAR_G]
-    return prm[PAR_G] + vertical_acc_any(t, prm)
-
-
-def _no_gravity_rate(t, on, prm):
-    return 0.0
-
-
-def _gravity_rate(t, on, prm):
-    if not on:
-        return 0.0
-    return vertical_jerk_any(t, prm)
-
-
-def _vertical(on) -> bool:
-    """Plain Python: whether ``on`` is of the vertical variants' type (a float)."""
-    return isinstance(on, float | np.floating)
-
-
-def ground_gravity(t, on, prm):
-    """g + a_v(t) [m/s^2]: the gravity of the ground's frame (the row's g without a
-    vertical, or when the ground is still)."""
-    return (_moving_gravity if _vertical(on) else _row_gravity)(t, on, prm)
-
-
-def gravity_rate(t, on, prm):
-    """d(g + a_v)/dt [m/s^3] (0 without a vertical)."""
-    return (_gravity_rate if _vertical(on) else _no_gravity_rate)(t, on, prm)
-
-
-@overload(ground_gravity, jit_options=INLINE)
-def _ground_gravity_overload(t, on, prm):
-    return _moving_gravity if isinstance(on, types.Float) else _row_gravity
-
-
-@overload(gravity_rate, jit_options=INLINE)
-def _gravity_rate_overload(t, on, prm):
-    return _gravity_rate if isinstance(on, types.Float) else _no_gravity_rate
 
 
 @njit(cache=True, **INLINE)
@@ -326,23 +89,19 @@ def vertical_power(p_in, theta, theta_dot, u, u_dot, s, g, prm, FLEX):
     return p_in - a_v * (prm[PAR_M] * y_p + prm[PAR_MA] * y_a)
 
 
-def _power_plain(p_in, on, theta, theta_dot, u, u_dot, s, g, prm, FLEX):
+def _power_plain(GROUND, p_in, theta, theta_dot, u, u_dot, s, g, prm, FLEX):
     return p_in
 
 
-def _power_vertical(p_in, on, theta, theta_dot, u, u_dot, s, g, prm, FLEX):
+def _power_vertical(GROUND, p_in, theta, theta_dot, u, u_dot, s, g, prm, FLEX):
     return vertical_power(p_in, theta, theta_dot, u, u_dot, s, g, prm, FLEX)
 
 
-def with_vertical_power(p_in, on, theta, theta_dot, u, u_dot, s, g, prm, FLEX):
-    """``vertical_power`` with a vertical (``on`` a float), else p_in itself."""
-    fn = _power_vertical if _vertical(on) else _power_plain
-    return fn(p_in, on, theta, theta_dot, u, u_dot, s, g, prm, FLEX)
-
-
-@overload(with_vertical_power, jit_options=INLINE)
-def _with_vertical_power_overload(p_in, on, theta, theta_dot, u, u_dot, s, g, prm, FLEX):
-    return _power_vertical if isinstance(on, types.Float) else _power_plain
+#: (GROUND, p_in, theta, theta', u, u', s, g, prm, FLEX) -> ``vertical_power`` under a
+#: ground kind with a vertical (``ground.GROUNDS``), else p_in itself (the other variants
+#: compile nothing of it)
+with_vertical_power = per_ground(lambda k: _power_vertical if k.vertical else _power_plain,
+                                 "with_vertical_power")
 
 
 # ----------------------------------------------------------------------------------------
@@ -437,28 +196,22 @@ def tip_moment(g, prm):
     return prm[PAR_MTOT] * g * prm[PAR_B]
 
 
-def _uplift_rates_plain(dq, t, u, on, prm, FLEX):
+def _rates_plain(GROUND, dq, t, u, on, prm, FLEX):
     return -dq, dq
 
 
-def _uplift_rates_vertical(dq, t, u, on, prm, FLEX):
-    dg = gravity_rate(t, on, prm)
+def _rates_vertical(GROUND, dq, t, u, on, prm, FLEX):
+    dg = gravity_rate(GROUND, t, on, prm)
     dq_all = dq + prm[PAR_M] * dg * u if FLEX else dq  # Q's m g u
     d_mgb = prm[PAR_MTOT] * dg * prm[PAR_B]
     return d_mgb - dq_all, d_mgb + dq_all
 
 
-def uplift_rates(dq, t, u, on, prm, FLEX):
-    """(d/dt (M g b - Q), d/dt (M g b + Q)): the uplift events' rates from dQ/dt at
-    constant g (``uplift_moment_rate``), plus, with a vertical, those of g + a_v in Q and
-    M g b."""
-    fn = _uplift_rates_vertical if _vertical(on) else _uplift_rates_plain
-    return fn(dq, t, u, on, prm, FLEX)
-
-
-@overload(uplift_rates, jit_options=INLINE)
-def _uplift_rates_overload(dq, t, u, on, prm, FLEX):
-    return _uplift_rates_vertical if isinstance(on, types.Float) else _uplift_rates_plain
+#: (GROUND, dq, t, u, on, prm, FLEX) -> (d/dt (M g b - Q), d/dt (M g b + Q)): the uplift
+#: events' rates from dQ/dt at constant g (``uplift_moment_rate``), plus, under a ground
+#: kind with a vertical, those of g + a_v in Q and M g b (``ground.gravity_rate``)
+uplift_rates = per_ground(lambda k: _rates_vertical if k.vertical else _rates_plain,
+                          "uplift_rates")
 
 
 @njit(cache=True, **INLINE)
@@ -489,36 +242,20 @@ def restitution(s, u, prm, FLEX):
     """e = theta'^+ / theta'^- for an impact that ends rocking on corner s, under the row's
     impact law (PAR_LAW, ``rocksweep.physics.impact``), times PAR_E_FACTOR.
 
-    The vertical impulse acts at x_Q = s' b (1 - lam), lam*b from the future corner
-    s' = -s. Angular momentum of the whole body about x_Q is conserved (a horizontal
-    impulse at the ground has no moment about it). LAW_VERTICAL: the spring and damper
-    carry no impulse, so the top mass's horizontal momentum m (u' + h theta') is conserved
-    too; eliminating u'^+:
-
-        e = [I_A + m_A (h_A^2 + x_Q s b)  + m (u - x_Q)(u - s b)]
-          / [I_A + m_A (h_A^2 + x_Q s' b) + m (u - x_Q)(u - s' b)],
-
-    which is eq. (1) (upper sign: s = +1). LAW_LOCKED: u' is kept instead (the top mass
-    moves with the base), which adds m h^2 to both. LAW_CONSTANT: e = PAR_E. Rigid body
-    (vertical and locked are one law: the top mass is welded):
-    (I_O - M b^2 (2 - lam)) / (I_O - lam M b^2).
+    LAW_EQ1: eq. (1) (``eq1.restitution``, the one definition). LAW_LOCKED: the top mass
+    keeps u' (moves with the base), which adds m h^2 to eq. (1)'s numerator and
+    denominator. LAW_CONSTANT: e = PAR_E. Rigid body (eq. 1 and locked are one law: the
+    top mass is welded): ``eq1.restitution_rigid``.
     """
     law = prm[PAR_LAW]
     if law == LAW_CONSTANT:
         return prm[PAR_E] * prm[PAR_E_FACTOR]
     b, lam = prm[PAR_B], prm[PAR_LAM]
     if not FLEX:
-        mb2 = prm[PAR_MTOT] * b * b
-        return (prm[PAR_IO] - mb2 * (2.0 - lam)) / (prm[PAR_IO] - lam * mb2) * prm[PAR_E_FACTOR]
-    m, m_A = prm[PAR_M], prm[PAR_MA]
-    x_q = -s * b * (1.0 - lam)
-    num = prm[PAR_IAH] + m_A * x_q * s * b + m * (u - x_q) * (u - s * b)
-    den = prm[PAR_IAH] - m_A * x_q * s * b + m * (u - x_q) * (u + s * b)
-    if law == LAW_LOCKED:
-        mh2 = m * prm[PAR_H] * prm[PAR_H]
-        num += mh2
-        den += mh2
-    return num / den * prm[PAR_E_FACTOR]
+        return _e_rigid(prm[PAR_IO], prm[PAR_MTOT] * b * b, lam) * prm[PAR_E_FACTOR]
+    m = prm[PAR_M]
+    mh2 = m * prm[PAR_H] * prm[PAR_H] if law == LAW_LOCKED else 0.0
+    return _e_eq1(s, u, lam, m, prm[PAR_MA], b, prm[PAR_IAH], mh2) * prm[PAR_E_FACTOR]
 
 
 @njit(cache=True, **INLINE)
@@ -565,7 +302,7 @@ def impact_loss(s, s_new, u, u_dot, w_minus, w_plus, prm, FLEX):
 
     At theta = 0 the potential energy is the same before and after. With a = u - s b the
     top mass's lever arm about corner s, the kinetic energy at theta = 0 is
-    1/2 m (u' + h w)^2 + 1/2 (I_A + m_A R_A^2 + m a^2) w^2. Under LAW_VERTICAL and
+    1/2 m (u' + h w)^2 + 1/2 (I_A + m_A R_A^2 + m a^2) w^2. Under LAW_EQ1 and
     LAW_CONSTANT the top mass keeps its horizontal velocity u' + h w (no impulse reaches
     it), so only the rest changes:
 

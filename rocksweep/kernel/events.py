@@ -23,14 +23,12 @@ from numba import literally, njit
 
 from rocksweep.kernel._cache import INLINE, INTERNAL
 from rocksweep.kernel.equations import (
-    ground_acc,
-    ground_gravity,
-    ground_jerk,
     tip_moment,
     uplift_moment,
     uplift_moment_rate,
     uplift_rates,
 )
+from rocksweep.kernel.ground import ground_acc, ground_gravity, ground_jerk
 from rocksweep.kernel.layout import (
     PAR_ROOT,
     PAR_THETA_OVER,
@@ -77,29 +75,29 @@ DIP_MAX_TRIALS = 50
 
 
 @njit(cache=True, **INLINE)
-def event_value(ev, t, y, s, on, prm, FLEX, DAMPED):
+def event_value(ev, t, y, s, on, prm, FLEX, DAMPED, GROUND):
     """Value of event function ``ev`` at (t, y) in phase s."""
     if ev == EV_IMPACT:
         return s * y[Y_THETA]
     if ev == EV_OVERTURN:
         return prm[PAR_THETA_OVER] - s * y[Y_THETA]
-    g = ground_gravity(t, on, prm)
-    q = uplift_moment(y[Y_U], y[Y_U_DOT], ground_acc(t, on, prm), g, prm, FLEX, DAMPED)
+    g = ground_gravity(GROUND, t, on, prm)
+    q = uplift_moment(y[Y_U], y[Y_U_DOT], ground_acc(GROUND, t, on, prm), g, prm, FLEX, DAMPED)
     mgb = tip_moment(g, prm)
     return mgb - q if ev == EV_UPLIFT_POS else mgb + q
 
 
 @njit(cache=True, **INLINE)
-def event_rate(ev, t, y, s, on, prm, FLEX, DAMPED):
+def event_rate(ev, t, y, s, on, prm, FLEX, DAMPED, GROUND):
     """d/dt of event function ``ev`` at (t, y) (for the Hermite interpolant)."""
     if ev == EV_IMPACT:
         return s * y[Y_THETA_DOT]
     if ev == EV_OVERTURN:
         return -s * y[Y_THETA_DOT]
-    dq = uplift_moment_rate(y[Y_U], y[Y_U_DOT], ground_acc(t, on, prm),
-                            ground_jerk(t, on, prm), ground_gravity(t, on, prm), prm, FLEX,
-                            DAMPED)
-    rate_pos, rate_neg = uplift_rates(dq, t, y[Y_U], on, prm, FLEX)
+    dq = uplift_moment_rate(y[Y_U], y[Y_U_DOT], ground_acc(GROUND, t, on, prm),
+                            ground_jerk(GROUND, t, on, prm), ground_gravity(GROUND, t, on, prm),
+                            prm, FLEX, DAMPED)
+    rate_pos, rate_neg = uplift_rates(GROUND, dq, t, y[Y_U], on, prm, FLEX)
     return rate_pos if ev == EV_UPLIFT_POS else rate_neg
 
 
@@ -207,9 +205,9 @@ def hermite_newton(g0, d0, g1, d1, h, xtol):
 
 
 @njit(cache=True, **INTERNAL)
-def _locate(ev, t0, y0, k1, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, ENERGY):
-    """Shrink a bracket [lo, hi] (g(lo) >= 0 >= g(hi); lo = 0, y(lo) = y0) of event ``ev``
-    to PAR_TOL.
+def _locate(ev, t0, y0, k1, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, ENERGY, GROUND):
+    """Shrink a bracket [0, hi] (g(0) = g_lo >= 0 >= g(hi) = g_hi, y(0) = y0, y(hi) = y_hi)
+    of event ``ev`` to PAR_TOL.
 
     Every trial point is a fresh RK4 step of that length from (t0, y0), so the located
     state is the integrator's own solution, not an interpolant; all of them share the
@@ -233,6 +231,7 @@ def _locate(ev, t0, y0, k1, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, 
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
+    lo = 0.0
     tol = prm[PAR_TOL]
     illinois = prm[PAR_ROOT] == ROOT_ILLINOIS
     hermite = prm[PAR_ROOT] == ROOT_HERMITE
@@ -241,8 +240,8 @@ def _locate(ev, t0, y0, k1, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, 
     slow = 0  # trials running that did not halve the bracket (Hermite)
     d_lo = d_hi = 0.0
     if hermite:
-        d_lo = event_rate(ev, t0 + lo, y0, s, on, prm, FLEX, DAMPED)
-        d_hi = event_rate(ev, t0 + hi, y_hi, s, on, prm, FLEX, DAMPED)
+        d_lo = event_rate(ev, t0 + lo, y0, s, on, prm, FLEX, DAMPED, GROUND)
+        d_hi = event_rate(ev, t0 + hi, y_hi, s, on, prm, FLEX, DAMPED, GROUND)
     while hi - lo > tol:
         width = hi - lo
         if hermite:
@@ -263,9 +262,10 @@ def _locate(ev, t0, y0, k1, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, 
                 mid = 0.5 * (lo + hi)
         else:
             mid = 0.5 * (lo + hi)
-        y_mid = rk4_from(t0, y0, mid, k1, s, on, prm, FLEX, DAMPED, ENERGY)
-        g_mid = event_value(ev, t0 + mid, y_mid, s, on, prm, FLEX, DAMPED)
-        d_mid = event_rate(ev, t0 + mid, y_mid, s, on, prm, FLEX, DAMPED) if hermite else 0.0
+        y_mid = rk4_from(t0, y0, mid, k1, s, on, prm, FLEX, DAMPED, ENERGY, GROUND)
+        g_mid = event_value(ev, t0 + mid, y_mid, s, on, prm, FLEX, DAMPED, GROUND)
+        d_mid = (event_rate(ev, t0 + mid, y_mid, s, on, prm, FLEX, DAMPED, GROUND) if hermite
+                 else 0.0)
         n += 1
         if g_mid <= 0.0:
             hi, g_hi, d_hi, y_hi = mid, g_mid, d_mid, y_mid
@@ -285,7 +285,7 @@ def _locate(ev, t0, y0, k1, lo, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, 
 
 
 @njit(cache=True, **INLINE)
-def _crossing(ev, t0, y0, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
+def _crossing(ev, t0, y0, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY, GROUND):
     """Did event ``ev`` fire in the step (t0, y0) -> (t0 + h, y1)?
 
     Returns (tau, y_event, re-integrations); tau < 0 if it did not. A sign change at the
@@ -296,28 +296,30 @@ def _crossing(ev, t0, y0, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
     function at every step and is inlined into the loop (with ``_first_event``); the
     searches are calls.
     """
-    g0 = event_value(ev, t0, y0, s, on, prm, FLEX, DAMPED)
-    g1 = event_value(ev, t0 + h, y1, s, on, prm, FLEX, DAMPED)
+    g0 = event_value(ev, t0, y0, s, on, prm, FLEX, DAMPED, GROUND)
+    g1 = event_value(ev, t0 + h, y1, s, on, prm, FLEX, DAMPED, GROUND)
     if g1 <= 0.0:
         # g0 = 0 happens right after an action put the state on g = 0 (uplift leaves
         # theta = 0): if the motion turns straight back, that is an event just after t0.
-        return _locate(ev, t0, y0, k1, 0.0, g0, h, g1, y1, s, on, prm, FLEX, DAMPED, ENERGY)
+        return _locate(ev, t0, y0, k1, g0, h, g1, y1, s, on, prm, FLEX, DAMPED, ENERGY,
+                       GROUND)
     if g0 <= 0.0:
         return -1.0, y1, 0  # leaving g = 0 after an action: not an event
-    d0 = event_rate(ev, t0, y0, s, on, prm, FLEX, DAMPED)
+    d0 = event_rate(ev, t0, y0, s, on, prm, FLEX, DAMPED, GROUND)
     if d0 >= 0.0:
         return -1.0, y1, 0
-    d1 = event_rate(ev, t0 + h, y1, s, on, prm, FLEX, DAMPED)
+    d1 = event_rate(ev, t0 + h, y1, s, on, prm, FLEX, DAMPED, GROUND)
     if d1 <= 0.0:
         return -1.0, y1, 0
     tau, g_min = hermite_min(g0, d0, g1, d1, h)
     if g_min > min(g0, g1) - g_min:
         return -1.0, y1, 0  # far from zero compared with the dip: the cubic is good enough
-    return _dip(ev, t0, y0, k1, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERGY)
+    return _dip(ev, t0, y0, k1, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERGY,
+                GROUND)
 
 
 @njit(cache=True, **INTERNAL)
-def _dip(ev, t0, y0, k1, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERGY):
+def _dip(ev, t0, y0, k1, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERGY, GROUND):
     """A dip of g (g0 > 0, g(h) > 0, d0 < 0 < d1) whose cubic minimum (at tau) is near zero.
 
     The cubic is only an estimate: the minimum of the integrator's own solution (fresh RK4
@@ -335,14 +337,14 @@ def _dip(ev, t0, y0, k1, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERG
     side = 0
     n = 0
     while True:
-        y_m = rk4_from(t0, y0, tau, k1, s, on, prm, FLEX, DAMPED, ENERGY)
-        g_m = event_value(ev, t0 + tau, y_m, s, on, prm, FLEX, DAMPED)
+        y_m = rk4_from(t0, y0, tau, k1, s, on, prm, FLEX, DAMPED, ENERGY, GROUND)
+        g_m = event_value(ev, t0 + tau, y_m, s, on, prm, FLEX, DAMPED, GROUND)
         n += 1
         if g_m <= 0.0:
-            tau, y_e, k = _locate(ev, t0, y0, k1, 0.0, g0, tau, g_m, y_m, s, on, prm, FLEX,
-                                  DAMPED, ENERGY)
+            tau, y_e, k = _locate(ev, t0, y0, k1, g0, tau, g_m, y_m, s, on, prm, FLEX,
+                                  DAMPED, ENERGY, GROUND)
             return tau, y_e, n + k
-        d_m = event_rate(ev, t0 + tau, y_m, s, on, prm, FLEX, DAMPED)
+        d_m = event_rate(ev, t0 + tau, y_m, s, on, prm, FLEX, DAMPED, GROUND)
         if d_m < 0.0:
             lo, r_lo, f_lo = tau, d_m, d_m
             if side == -1:
@@ -362,7 +364,7 @@ def _dip(ev, t0, y0, k1, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERG
 
 
 @njit(cache=True, **INLINE)
-def _first_event(t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
+def _first_event(t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY, GROUND):
     """The first event in the step (t, y) -> (t + h, y1) of phase s.
 
     Returns (event code, tau, state at the event, re-integrations); EV_NONE and y1 if none.
@@ -377,10 +379,11 @@ def _first_event(t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY):
         ev_a, ev_b = EV_IMPACT, EV_OVERTURN
     else:
         ev_a, ev_b = EV_UPLIFT_POS, EV_UPLIFT_NEG
-    tau, y_ev, n = _crossing(ev_a, t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
+    tau, y_ev, n = _crossing(ev_a, t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY, GROUND)
     if s != 0 and tau >= 0.0:
         return ev_a, tau, y_ev, n  # the impact ends the phase before any overturning
-    tau2, y_ev2, n2 = _crossing(ev_b, t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
+    tau2, y_ev2, n2 = _crossing(ev_b, t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY,
+                                GROUND)
     if tau2 >= 0.0 and (tau < 0.0 or tau2 < tau):
         return ev_b, tau2, y_ev2, n + n2
     if tau >= 0.0:

@@ -50,7 +50,7 @@ PAR_AMP_NORM = 31  # Mavroeidis-Papageorgiou pulse: 1/r_max, so that A is its pe
 PAR_REC_DT = 32  # record: sample interval in kernel time, p * DT [s] (0: not a record)
 PAR_REC_H = 33  # record: RK4 step while it acts, PAR_REC_DT / m (m >= 1 an integer) [s]
 PAR_ROT_STEP = 34  # largest rotation of one rocking step [rad] (0: no such limit)
-PAR_LAW = 35  # impact law, read at impacts: LAW_VERTICAL (eq. 1), LAW_LOCKED, LAW_CONSTANT
+PAR_LAW = 35  # impact law, read at impacts: LAW_EQ1 (eq. 1), LAW_LOCKED, LAW_CONSTANT
 PAR_E = 36  # LAW_CONSTANT's coefficient of restitution (unused by the other laws)
 PAR_E_FACTOR = 37  # multiplies the law's e (1: the law's own e)
 PAR_DT_ON = 38  # RK4 step while the ground moves, t < PAR_TPULSE (<= PAR_DT) [s]
@@ -85,7 +85,7 @@ SHAPE_COSINE = _ground.SHAPE_CODE[_ground.COSINE]
 SHAPE_RICKER = _ground.SHAPE_CODE[_ground.RICKER]
 SHAPE_MP = _ground.SHAPE_CODE[_ground.MP]
 SHAPE_RECORD = _ground.SHAPE_CODE[_ground.RECORD]
-LAW_VERTICAL = _laws.LAW_CODE[_laws.VERTICAL]
+LAW_EQ1 = _laws.LAW_CODE[_laws.EQ1]
 LAW_LOCKED = _laws.LAW_CODE[_laws.LOCKED]
 LAW_CONSTANT = _laws.LAW_CODE[_laws.CONSTANT]
 ROOT_BISECT = _settings.ROOT_CODE[_settings.BISECTION]
@@ -119,7 +119,10 @@ OUT_MARGIN = 22  # closest approach of the free rocking to the overturning saddl
 #                  [alpha_ref] (inf: never near it): a small value is a close call
 OUT_T_CLOSE = 23  # last time [s] the free rocking came within PAR_CLOSE of the saddle
 #                   (NaN: never): after it the run decided nothing near its threshold
-N_OUT = 24
+OUT_REFINE_EVALS = 24  # RK4 evaluations (regular + event) of the certification's runs of
+#                        this point, counted in OUT_STEPS/OUT_EVENT_STEPS too (0 from the
+#                        kernel; set by ``rocksweep.compute.certify``)
+N_OUT = 25
 
 # --- state tuple y (the loop's 6 slots, a UniTuple(float64, 6)) ----------------------------
 Y_THETA = 0  # theta [rad] (0 in full contact)
@@ -183,8 +186,11 @@ LEVEL_OUTCOME = 0  # outcome and summary metrics only
 LEVEL_ENERGY = 1  # + energy accounting
 LEVEL_CONTACT = 3  # + energy accounting + ground reactions (outputs.contact)
 # (a single run with its time history: ``point_kernel``, not a level of the chunk kernels)
-# ground motions: the paper's sine and cosine; every horizontal shape and records; those
-# with a vertical component (the loop's GROUND flag, ``variants``)
-GROUND_PULSE = False
+# ground kinds (``ground.GROUNDS``): the paper's sine and cosine; every horizontal shape and
+# records; those with a vertical component
+GROUND_PULSE = 0
 GROUND_ANY = 1
 GROUND_VERTICAL = 2
+# contact models (``variants.CONTACTS``): how the body touches the ground; the paper's:
+# rocking on a corner or in full contact, never sliding
+CONTACT_NOSLIP = 0

@@ -9,26 +9,24 @@ below. Those on the path of every step are inlined by LLVM (``_cache.INLINE``); 
 events are calls (``_cache.INTERNAL``). No kernel function counts references
 (``_nrt=False``), so passing ``prm`` or ``out`` costs nothing beyond the call.
 
-Compile-time specialisation: the functions take the flags FLEX, DAMPED and ENERGY (and
-``simulate_point`` GROUND, ``layout.GROUND_*``: every ground motion, not only the paper's
-sine and cosine, and with a vertical component; it reaches the ground motion as the type
-of ``on``, see ``equations.ground_acc`` and ``equations.ground_gravity``) and call
-``numba.literally`` on them, so numba compiles one specialisation per flag value (a
-``Literal[bool]`` type) and the branches a variant does not need are removed at compile
-time (by LLVM: numba still types and lowers them, its own dead-branch pruning does not
-read literal arguments, so they cost compile time but no run time). The time history and
-the ground reactions are the exceptions: ``simulate_point`` gets ``hist=None`` and
-``CONTACT=None`` when there are none, and numba prunes the ``if hist is not None`` /
-``if CONTACT is not None`` branches before typing (the contact bookkeeping was half the
-compile time of a variant without it). The variants themselves are in ``variants``.
+Compile-time specialisation: the functions take the flags FLEX, DAMPED, ENERGY and GROUND
+(the ground kind, ``ground.GROUNDS``; ``simulate_point`` also REACTIONS) as literals
+(``Literal[bool]``, ``Literal[int]``), so numba compiles one specialisation per flag value
+and the branches a variant does not need are removed at compile time (by LLVM: numba still
+types and lowers both branches of an ``if``, its own dead-branch pruning does not read
+literal arguments, so they cost compile time but no run time). Where that compile time
+matters the choice is made while typing instead (``_static``): the ground kind's functions
+(``ground``), the ground reactions' bookkeeping (``contact``: four calls at the loop's
+sample points, no-ops without REACTIONS; it was half the compile time of a variant), the
+rigid bound and the energy. The time history is the other exception: ``simulate_point``
+gets ``hist=None`` when there is none, and numba prunes the ``if hist is not None``
+branches before typing. The entry points are made from one table in ``variants``.
 """
 
 import math
 
 import numpy as np
 from numba import literally, njit
-from numba.core import types
-from numba.extending import overload
 
 from rocksweep.kernel._cache import INLINE, INTERNAL
 from rocksweep.kernel._static import skipped_when
@@ -36,10 +34,12 @@ from rocksweep.kernel.contact import (
     SAMPLE_EVENT,
     SAMPLE_START,
     SAMPLE_STEP,
-    contact_impact,
-    contact_sample,
+    reactions_begin,
+    reactions_end,
+    reactions_impact,
+    reactions_sample,
 )
-from rocksweep.kernel.equations import ground_acc, mechanical_energy
+from rocksweep.kernel.equations import mechanical_energy
 from rocksweep.kernel.events import (
     EV_IMPACT,
     EV_NONE,
@@ -48,8 +48,8 @@ from rocksweep.kernel.events import (
     _first_event,
     hermite_min,
 )
+from rocksweep.kernel.ground import ground_acc, ground_flags
 from rocksweep.kernel.layout import (
-    GROUND_VERTICAL,
     HIST_D_DAMP,
     HIST_E,
     HIST_E_IMPACT,
@@ -70,12 +70,10 @@ from rocksweep.kernel.layout import (
     OUT_EVENT_STEPS,
     OUT_HIST_ROWS,
     OUT_IMPACTS,
-    OUT_IMPULSE_MAX,
     OUT_MARGIN,
-    OUT_MU_REQ,
     OUT_N_GAINING,
-    OUT_N_MIN,
     OUT_OUTCOME,
+    OUT_REFINE_EVALS,
     OUT_STATUS,
     OUT_STEPS,
     OUT_T_CLOSE,
@@ -99,7 +97,6 @@ from rocksweep.kernel.layout import (
     PAR_MAXEVENTS,
     PAR_MAXSTEPS,
     PAR_MTOT,
-    PAR_MU,
     PAR_REC_H,
     PAR_ROT_STEP,
     PAR_T_AIR,
@@ -117,12 +114,10 @@ from rocksweep.kernel.layout import (
     STATUS_EVENT_CAP,
     STATUS_HIST_FULL,
     STATUS_HORIZON,
-    STATUS_LIFTS_OFF,
     STATUS_NONFINITE,
     STATUS_OVERTURNED,
     STATUS_REST,
     STATUS_SETTLED,
-    STATUS_SLIDES,
     STATUS_STEP_CAP,
     Y_D_DAMP,
     Y_THETA,
@@ -148,74 +143,41 @@ ALIGN_SLACK = 1e-7
 SADDLE_SLACK = 1e-9
 
 
-def _acting(t, t_pulse, GROUND):
-    """Plain Python (NUMBA_DISABLE_JIT=1): the overload's choice, by GROUND."""
-    if isinstance(GROUND, bool | np.bool_):
-        return t < t_pulse
-    if GROUND == GROUND_VERTICAL:
-        return np.float64(t < t_pulse)
-    return np.int64(t < t_pulse)
-
-
-@overload(_acting, prefer_literal=True)
-def _acting_overload(t, t_pulse, GROUND):
-    """Does the ground move at t? A bool for the paper's pulses (GROUND = False), an int
-    for every ground motion (GROUND = 1, an int; the type of ``on`` selects the code of
-    ``equations.ground_acc``), a float for every ground motion with a vertical component
-    (GROUND = 2: ``equations.ground_gravity``). An overload, so that GROUND's type picks
-    one function at typing time: a plain branch on it would type both returns and unify
-    them."""
-    if isinstance(GROUND, types.IntegerLiteral) and GROUND.literal_value == GROUND_VERTICAL:
-        def vertical(t, t_pulse, GROUND):
-            return np.float64(t < t_pulse)
-        return vertical
-
-    if isinstance(GROUND, types.Integer):
-        def ground(t, t_pulse, GROUND):
-            return np.int64(t < t_pulse)
-        return ground
-
-    def pulse(t, t_pulse, GROUND):
-        return t < t_pulse
-    return pulse
-
-
 @njit(cache=True, **INTERNAL)
-def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
+def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     """Run one point from rest (or the given initial state) to a decided outcome, a cap or
-    the horizon.
+    the horizon: the no-slip rocking model (``variants.CONTACTS``).
 
     prm: float64[N_PAR] parameter row; out: float64[N_OUT] result row (filled);
     hist: float64[n, N_HIST] history buffer, or None: no history (the recording code is
-    then not compiled at all). CONTACT: True to track the ground reactions (``contact``):
-    the friction demand, the lowest normal force and the impacts' impulse ratio; every
+    then not compiled at all). REACTIONS: True to track the ground reactions
+    (``contact``: the friction demand, the lowest normal force and the impacts' impulse
+    ratio), False not to (the bookkeeping's calls are then no-ops, not compiled); every
     sample is a state the loop reaches anyway (step ends, event states before and after the
-    action), taken with ``contact_sample``. None: no tracking (the code is not compiled).
-    GROUND (``layout.GROUND_*``): GROUND_VERTICAL also steps to land on PAR_T_AIR, where
-    g + a_v reaches 0, and stops there (STATUS_AIRBORNE).
+    action). GROUND (``layout.GROUND_*``, a row of ``ground.GROUNDS``): the ground kind; one
+    with a vertical also steps to land on PAR_T_AIR, where g + a_v reaches 0, and stops
+    there (STATUS_AIRBORNE).
     """
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
-    literally(GROUND)
     t, dt, t_pulse, t_end = 0.0, prm[PAR_DT], prm[PAR_TPULSE], prm[PAR_TEND]
     dt_on = prm[PAR_DT_ON]  # the step while the ground moves (``numerics.step_sizes``)
     max_steps, max_events = prm[PAR_MAXSTEPS], prm[PAR_MAXEVENTS]
-    # > 0: a record, whose samples the steps land on while it acts (GROUND variants only)
-    h_rec = prm[PAR_REC_H] if GROUND else 0.0
-    vertical = GROUND == GROUND_VERTICAL  # a constant of the variant
+    # > 0: a record, whose samples the steps land on while it acts (a ground kind with
+    # records only; ``ground_flags``: constants of the variant)
+    records, vertical = ground_flags(GROUND)
+    h_rec = prm[PAR_REC_H] if records else 0.0
     t_air = prm[PAR_T_AIR] if vertical else math.inf
-    y, s = _start(prm, out, hist, _acting(0.0, t_pulse, GROUND), FLEX, DAMPED, CONTACT)
+    on = 0.0 < t_pulse
+    y, s = _start(prm, out, hist, on, FLEX, DAMPED, GROUND)
     # rigid: test rigid_bounded at the next loop top after the pulse (PAR_TO_REST: then go
     # on to rest; a history of free rocking from a tilt would end at once otherwise)
     free_check = True
     # the counters of every step stay in registers (in out: ~3% slower); the rest is in out
     steps, event_steps, theta_max = 0, 0, abs(y[Y_THETA])
-    # contact tracker (contact.contact_sample): unused, and removed, without CONTACT
-    ct = (0.0, 0.0, y, 0.0, 0.0, 0.0, y, 0.0, 0.0)
-    if CONTACT is not None:
-        ct = contact_sample(ct, t, y, s, _acting(0.0, t_pulse, GROUND), SAMPLE_START, prm, out,
-                            FLEX, DAMPED, ENERGY)
+    # the ground reactions' bookkeeping (``contact``): its tracker, None without REACTIONS
+    track = reactions_begin(REACTIONS, t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, GROUND)
     # The rotation limit (PAR_ROT_STEP, 0: off): a rocking step may turn the body by at most
     # rot, predicted from theta' and the last step's |theta''| (acc), and checked after
     # the step: a huge slow pulse or a fall is not crossed in a handful of steps.
@@ -228,7 +190,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
     near = _saddle_bounds(prm)
 
     while True:
-        on = _acting(t, t_pulse, GROUND)
+        on = t < t_pulse
         # why the run ends before this step, if it does (a STATUS_* bit); written out here,
         # not in a helper: a helper taking the arrays costs ~15% at every step
         if s == 0 and not on and rest_proven(y, prm, FLEX):
@@ -270,8 +232,9 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             h_rot = _rotation_step(y[Y_THETA_DOT], acc, rot)
             if h_rot < h:
                 h, lands, air = h_rot, False, False
-        k1 = first_stage(t, y, s, on, prm, FLEX, DAMPED, ENERGY)  # shared by every step from y
-        y1 = rk4_from(t, y, h, k1, s, on, prm, FLEX, DAMPED, ENERGY)
+        # k1: shared by every step from y
+        k1 = first_stage(t, y, s, on, prm, FLEX, DAMPED, ENERGY, GROUND)
+        y1 = rk4_from(t, y, h, k1, s, on, prm, FLEX, DAMPED, ENERGY, GROUND)
         steps += 1
         if s != 0 and rot > 0.0:
             # theta'' was not known before the step (after an uplift, or a pulse's rise):
@@ -280,14 +243,14 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
             turn = abs(y1[Y_THETA] - y[Y_THETA])
             while turn > 2.0 * rot:
                 h, lands, air = h * max(0.25, 0.9 * math.sqrt(rot / turn)), False, False
-                y1 = rk4_from(t, y, h, k1, s, on, prm, FLEX, DAMPED, ENERGY)
+                y1 = rk4_from(t, y, h, k1, s, on, prm, FLEX, DAMPED, ENERGY, GROUND)
                 steps += 1
                 turn = abs(y1[Y_THETA] - y[Y_THETA])
             acc = abs(y1[Y_THETA_DOT] - y[Y_THETA_DOT]) / h
         if not _finite(y1):
             _flag(out, STATUS_NONFINITE)
             break
-        ev, tau, y_ev, n = _first_event(t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY)
+        ev, tau, y_ev, n = _first_event(t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY, GROUND)
         event_steps += n
         if s != 0:
             theta_max = _theta_max(y, y_ev, tau, s, theta_max)  # (y_ev, tau) = (y1, h) if none
@@ -299,80 +262,79 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
                 if q < prm[PAR_CLOSE]:
                     t_close = t
                 margin = min(margin, q)
-            _record(hist, t, y, s, _acting(t, t_pulse, GROUND), prm, out, FLEX)
-            if CONTACT is not None:  # the step's end, with the step's own ground motion
-                ct = contact_sample(ct, t, y, s, on, SAMPLE_STEP, prm, out, FLEX, DAMPED, ENERGY)
+            _record(hist, t, y, s, t < t_pulse, prm, out, FLEX, GROUND)
+            # the step's end, with the step's own ground motion
+            track = reactions_sample(REACTIONS, track, t, y, s, on, SAMPLE_STEP, prm, out, FLEX,
+                                     DAMPED, ENERGY, GROUND)
             if lands:
-                s, ct = _pulse_end(t, y, s, ct, prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT,
-                                   GROUND)
+                s, track = _pulse_end(t, y, s, track, prm, out, hist, FLEX, DAMPED, ENERGY,
+                                      REACTIONS, GROUND)
             continue
 
         t, y = t + tau, y_ev
-        _record(hist, t, y, s, on, prm, out, FLEX)
-        if CONTACT is not None:  # the event state, last sample of its phase
-            ct = contact_sample(ct, t, y, s, on, SAMPLE_EVENT, prm, out, FLEX, DAMPED, ENERGY)
+        _record(hist, t, y, s, on, prm, out, FLEX, GROUND)
+        # the event state, last sample of its phase
+        track = reactions_sample(REACTIONS, track, t, y, s, on, SAMPLE_EVENT, prm, out, FLEX,
+                                 DAMPED, ENERGY, GROUND)
         if ev == EV_OVERTURN:
             _overturned(t, out)
             break
-        y, s = _act(ev, t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, CONTACT)
+        y, s = _act(ev, t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, REACTIONS, GROUND)
         free_check = free_check or ev == EV_IMPACT
-        _record(hist, t, y, s, on, prm, out, FLEX)
-        if CONTACT is not None:  # the state after the action starts the next phase's samples
-            ct = contact_sample(ct, t, y, s, on, SAMPLE_START, prm, out, FLEX, DAMPED, ENERGY)
+        _record(hist, t, y, s, on, prm, out, FLEX, GROUND)
+        # the state after the action starts the next phase's samples
+        track = reactions_sample(REACTIONS, track, t, y, s, on, SAMPLE_START, prm, out, FLEX,
+                                 DAMPED, ENERGY, GROUND)
     out[OUT_MARGIN] = margin
     out[OUT_T_CLOSE] = t_close
     _finish(t, y, s, steps, event_steps, theta_max, prm, out, FLEX, ENERGY)
-    if CONTACT is not None:
-        _contact_status(prm, out)
+    reactions_end(REACTIONS, prm, out)
 
 
 @njit(cache=True, **INTERNAL)
-def _start(prm, out, hist, on, FLEX, DAMPED, CONTACT):
+def _start(prm, out, hist, on, FLEX, DAMPED, GROUND):
     """The state at t = 0 and its phase: at rest (uplifted at once if the ground's motion
     at t = 0 tips the body, a cosine pulse's peak), or the row's initial state, rocking on
     the corner theta (else theta') points to; the result row reset, the first history row
-    written, the contact outputs' starting values (NaN without CONTACT). Returns (y, s)."""
+    written. Returns (y, s)."""
     y = (prm[PAR_THETA0], prm[PAR_THETA_DOT0], prm[PAR_U0], prm[PAR_U_DOT0], 0.0, 0.0)
     _reset(out)
     if y[Y_THETA] != 0.0 or y[Y_THETA_DOT] != 0.0:
         s = 1 if y[Y_THETA] > 0.0 or (y[Y_THETA] == 0.0 and y[Y_THETA_DOT] > 0.0) else -1
     else:
-        s = _uplift(0.0, y, on, prm, out, FLEX, DAMPED)
-    _record(hist, 0.0, y, s, on, prm, out, FLEX)
-    out[OUT_MU_REQ] = 0.0 if CONTACT is not None else np.nan
-    out[OUT_N_MIN] = np.inf if CONTACT is not None else np.nan
-    out[OUT_IMPULSE_MAX] = 0.0 if CONTACT is not None else np.nan
+        s = _uplift(0.0, y, on, prm, out, FLEX, DAMPED, GROUND)
+    _record(hist, 0.0, y, s, on, prm, out, FLEX, GROUND)
     return y, s
 
 
 @njit(cache=True, **INTERNAL)
-def _pulse_end(t, y, s, ct, prm, out, hist, FLEX, DAMPED, ENERGY, CONTACT, GROUND):
-    """A step landed on the pulse's end (t = PAR_TPULSE). Returns (s, ct).
+def _pulse_end(t, y, s, track, prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
+    """A step landed on the pulse's end (t = PAR_TPULSE). Returns (s, the reactions'
+    tracker).
 
     The pulse ends with a jump of xg'' (a cosine pulse ends at its peak), and Q jumps with
     it by m_A h_A xg'': a body in full contact may now be past the uplift threshold, which
     no crossing inside the next step would show. Checked at once, as at t = 0 and after an
     impact. The contact bookkeeping starts a new segment (H jumps with xg'')."""
-    off = _acting(t, t, GROUND)  # false, of the type of ``on``
+    off = t < t  # false: a bool value (a literal False would compile the callees again)
     if s == 0:
-        s = _uplift(t, y, off, prm, out, FLEX, DAMPED)
+        s = _uplift(t, y, off, prm, out, FLEX, DAMPED, GROUND)
         if s != 0:
-            _record(hist, t, y, s, off, prm, out, FLEX)
-    if CONTACT is not None:
-        ct = contact_sample(ct, t, y, s, off, SAMPLE_START, prm, out, FLEX, DAMPED, ENERGY)
-    return s, ct
+            _record(hist, t, y, s, off, prm, out, FLEX, GROUND)
+    track = reactions_sample(REACTIONS, track, t, y, s, off, SAMPLE_START, prm, out, FLEX,
+                             DAMPED, ENERGY, GROUND)
+    return s, track
 
 
 @njit(cache=True, **INTERNAL)
-def _act(ev, t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, CONTACT):
+def _act(ev, t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     """The action of an impact or an uplift located at (t, y) in phase s. Returns (y, s).
 
     Impact: the impact map (``_apply_impact``; its impulse into the contact outputs).
     Uplift: theta = theta' = 0 exactly, now rocking on the located corner."""
     if ev == EV_IMPACT:
-        y_new, s_new = _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY)
-        if CONTACT is not None:
-            contact_impact(y, s, y_new, s_new, prm, out, FLEX)
+        y_new, s_new = _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, GROUND)
+        reactions_impact(REACTIONS, y, s, y_new, s_new, prm, out, FLEX)
         return y_new, s_new
     out[OUT_UPLIFTS] += 1.0
     return (0.0, 0.0, y[Y_U], y[Y_U_DOT], y[Y_W_IN], y[Y_D_DAMP]), (1 if ev == EV_UPLIFT_POS
@@ -406,6 +368,7 @@ def _reset(out):
     out[OUT_N_GAINING] = 0.0
     out[OUT_E_MAX] = 0.0
     out[OUT_HIST_ROWS] = 0.0
+    out[OUT_REFINE_EVALS] = 0.0  # the certification's reruns add theirs (compute.certify)
 
 
 @njit(cache=True, **INLINE)
@@ -465,16 +428,16 @@ def _theta_max(y, y_end, h_end, s, theta_max):
 
 
 @njit(cache=True, **INTERNAL)
-def _uplift(t, y, on, prm, out, FLEX, DAMPED):
+def _uplift(t, y, on, prm, out, FLEX, DAMPED, GROUND):
     """Check uplift from full contact at (t, y) and count it. Returns the new phase."""
-    s = uplift_side(t, y, on, prm, FLEX, DAMPED)
+    s = uplift_side(t, y, on, prm, FLEX, DAMPED, GROUND)
     if s != 0:
         out[OUT_UPLIFTS] += 1.0
     return s
 
 
 @njit(cache=True, **INTERNAL)
-def _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY):
+def _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, GROUND):
     """Impact at (t, y) ending rocking on corner s: the impact map and its counters; back
     in full contact, uplift is checked again at once. Returns (y, new phase)."""
     out[OUT_IMPACTS] += 1.0
@@ -496,7 +459,7 @@ def _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY):
             out[OUT_N_GAINING] += 1.0
             _flag(out, STATUS_ENERGY_GAIN)
     if s_new == 0:
-        s_new = _uplift(t, y, on, prm, out, FLEX, DAMPED)
+        s_new = _uplift(t, y, on, prm, out, FLEX, DAMPED, GROUND)
     return y, s_new
 
 
@@ -580,16 +543,6 @@ def _saddle(y, s, prm):
 
 
 @njit(cache=True, **INTERNAL)
-def _contact_status(prm, out):
-    """STATUS_SLIDES when the friction demand exceeds PAR_MU (never when PAR_MU is NaN),
-    STATUS_LIFTS_OFF when the normal reaction went below zero."""
-    if out[OUT_MU_REQ] > prm[PAR_MU]:
-        _flag(out, STATUS_SLIDES)
-    if out[OUT_N_MIN] < 0.0:
-        _flag(out, STATUS_LIFTS_OFF)
-
-
-@njit(cache=True, **INTERNAL)
 def _overturned(t, out):
     out[OUT_OUTCOME] = OUTCOME_MODE1 if out[OUT_IMPACTS] > 0.0 else OUTCOME_MODE2
     out[OUT_T_OVERTURN] = t
@@ -597,19 +550,19 @@ def _overturned(t, out):
 
 
 @njit(cache=True, inline="always")
-def _record(hist, t, y, s, on, prm, out, FLEX):
+def _record(hist, t, y, s, on, prm, out, FLEX, GROUND):
     """Append a history row at (t, y) in phase s, or flag STATUS_HIST_FULL; nothing (not
     even compiled) without a history."""
     if hist is not None:
         if _write_row(hist, int(out[OUT_HIST_ROWS]), t, y, s, on, prm,
-                      out[OUT_E_IMPACT], FLEX):
+                      out[OUT_E_IMPACT], FLEX, GROUND):
             out[OUT_HIST_ROWS] += 1.0
         else:
             _flag(out, STATUS_HIST_FULL)
 
 
 @njit(cache=True, **INTERNAL)
-def _write_row(hist, row, t, y, s, on, prm, e_imp, FLEX):
+def _write_row(hist, row, t, y, s, on, prm, e_imp, FLEX, GROUND):
     literally(FLEX)
     if row >= hist.shape[0]:
         return False
@@ -624,7 +577,7 @@ def _write_row(hist, row, t, y, s, on, prm, e_imp, FLEX):
     hist[row, HIST_W_IN] = y[Y_W_IN]
     hist[row, HIST_D_DAMP] = y[Y_D_DAMP]
     hist[row, HIST_E_IMPACT] = e_imp
-    hist[row, HIST_XG] = ground_acc(t, on, prm)
+    hist[row, HIST_XG] = ground_acc(GROUND, t, on, prm)
     return True
 
 

@@ -24,7 +24,7 @@ in a:
   H(a) = -mu sigma N(a) gives a = -(H_0 + mu sigma N_0) / (H_a + mu sigma N_a). Flat,
   N_a = 0 and N = M g. Rocking, H_a + mu sigma N_a <= 0 is Painleve's paradox (no
   consistent slip): the corner sticks by a tangential impulse (``jam_impulse``);
-- gravity is g + a_v with a vertical (the ``g`` argument, ``equations.ground_gravity``).
+- gravity is g + a_v with a vertical (the ``g`` argument, ``ground.ground_gravity``).
 
 The phase entered when the base does not slip (from rest, at an uplift, where a slip
 stops, where a stuck contact's force leaves the cone) is the first consistent one of
@@ -48,16 +48,17 @@ from rocksweep.kernel._cache import INLINE, PUBLIC
 from rocksweep.kernel.contact import ground_reactions
 from rocksweep.kernel.equations import (
     contact_rhs,
-    ground_acc,
-    ground_gravity,
     mechanical_energy,
     restitution,
     rigid_rhs,
     rocking_rhs,
     tip_moment,
     uplift_moment,
+    with_vertical_power,
 )
+from rocksweep.kernel.ground import ground_acc, ground_gravity
 from rocksweep.kernel.layout import (
+    GROUND_ANY,
     LAW_LOCKED,
     PAR_B,
     PAR_C,
@@ -185,14 +186,15 @@ def sliding_energy(theta, theta_dot, u, u_dot, x_dot, s, prm, FLEX):
 
 
 @njit(cache=True, **INLINE)
-def sliding_derivatives(t, y, s, sigma, on, mu, prm, FLEX, DAMPED, ENERGY):
+def sliding_derivatives(t, y, s, sigma, on, mu, prm, FLEX, DAMPED, ENERGY, GROUND):
     """dy/dt, a 9-tuple, of y = (theta, theta', u, u', W_in, D_damp, x, x', D_fric) in
-    phase (s, sigma): the ground's power -xg'' (sum m_i X_i' + M x'), the damper's c u'^2,
-    friction's loss -F x' = mu N |x'| >= 0 (ENERGY; else 0). The vertical's own power
-    (``equations.vertical_power``) is the loop's to add, as for the 6-tuple."""
+    phase (s, sigma) under ground kind GROUND (``ground.GROUNDS``): the ground's power
+    -xg'' (sum m_i X_i' + M x') (a vertical's own, ``equations.vertical_power``, added
+    under a ground kind with one: x moves no mass up or down), the damper's c u'^2,
+    friction's loss -F x' = mu N |x'| >= 0 (ENERGY; else 0)."""
     theta, theta_dot, u, u_dot, x_dot = y[0], y[1], y[2], y[3], y[Y_X_DOT]
-    xg = ground_acc(t, on, prm)
-    g = ground_gravity(t, on, prm)
+    xg = ground_acc(GROUND, t, on, prm)
+    g = ground_gravity(GROUND, t, on, prm)
     th_dd, u_dd, x_dd, f = accelerations(theta, theta_dot, u, u_dot, s, sigma, xg, g, mu,
                                          prm, FLEX, DAMPED)
     if s == 0:
@@ -203,9 +205,17 @@ def sliding_derivatives(t, y, s, sigma, on, mu, prm, FLEX, DAMPED, ENERGY):
     if ENERGY:
         p_in = -xg * (relative_momentum(theta, theta_dot, u, u_dot, s, prm, FLEX)
                       + prm[PAR_MTOT] * x_dot)
+        p_in = with_vertical_power(GROUND, p_in, theta, theta_dot, u, u_dot, s, g, prm, FLEX)
         p_damp = prm[PAR_C] * u_dot * u_dot if (FLEX and DAMPED) else 0.0
         p_fric = -f * x_dot
     return (theta_dot, th_dd, u_dot, u_dd, p_in, p_damp, x_dot, x_dd, p_fric)
+
+
+@njit(cache=True, **PUBLIC)
+def any_sliding_derivatives(t, y, s, sigma, on, mu, prm, FLEX, DAMPED, ENERGY):
+    """``sliding_derivatives`` of any ground shape without a vertical (GROUND_ANY), from
+    Python (tests)."""
+    return sliding_derivatives(t, y, s, sigma, on, mu, prm, FLEX, DAMPED, ENERGY, GROUND_ANY)
 
 
 # ----------------------------------------------------------------------------------------

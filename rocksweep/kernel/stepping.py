@@ -4,33 +4,28 @@
 ``rk4_step`` knows nothing of events, phases changing or the loop.
 
 Compile-time flags (see ``variants``): FLEX (the top mass moves on its spring), DAMPED (the
-spring has a damper) and ENERGY (integrate the ground's work W_in and the damper's loss
-D_damp along). Both functions are inlined where they are called, by LLVM
-(``_cache.INLINE``: compiled once, then inlined; numba's own ``inline="always"`` retyped
-them at every call site), so an RK4 step makes no function call.
+spring has a damper), ENERGY (integrate the ground's work W_in and the damper's loss
+D_damp along) and GROUND (the ground kind, ``ground.GROUNDS``). The functions are
+inlined where they are called, by LLVM (``_cache.INLINE``: compiled once, then inlined;
+numba's own ``inline="always"`` retyped them at every call site), so an RK4 step makes no
+function call.
 """
 
 from numba import njit
 
 from rocksweep.kernel._cache import INLINE
-from rocksweep.kernel.equations import (
-    contact_rhs,
-    ground_acc,
-    ground_gravity,
-    rigid_rhs,
-    rocking_rhs,
-    with_vertical_power,
-)
+from rocksweep.kernel.equations import contact_rhs, rigid_rhs, rocking_rhs, with_vertical_power
+from rocksweep.kernel.ground import ground_acc, ground_gravity
 from rocksweep.kernel.layout import Y_THETA, Y_THETA_DOT, Y_U, Y_U_DOT
 
 
 @njit(cache=True, **INLINE)
-def derivatives(t, y, s, on, prm, FLEX, DAMPED, ENERGY):
+def derivatives(t, y, s, on, prm, FLEX, DAMPED, ENERGY, GROUND):
     """dy/dt (a 6-tuple in the ``Y_*`` slot order) at (t, y) in phase s (0 full contact,
-    +-1 rocking on that corner); ``on``: the pulse acts (a float: with a vertical, whose
-    gravity g + a_v the rocking phases feel and whose work W_in counts)."""
+    +-1 rocking on that corner); ``on``: the ground moves (under GROUND's kind: with a
+    vertical, its gravity g + a_v the rocking phases feel and its work W_in counts)."""
     theta, theta_dot, u, u_dot = y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT]
-    xg = ground_acc(t, on, prm)
+    xg = ground_acc(GROUND, t, on, prm)
     if s == 0:
         if not FLEX:
             return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
@@ -38,17 +33,18 @@ def derivatives(t, y, s, on, prm, FLEX, DAMPED, ENERGY):
         if ENERGY:
             return (0.0, 0.0, u_dot, u_dd, p_in, p_damp)
         return (0.0, 0.0, u_dot, u_dd, 0.0, 0.0)
-    g = ground_gravity(t, on, prm)
+    g = ground_gravity(GROUND, t, on, prm)
     if not FLEX:
         theta_dd, p_in = rigid_rhs(theta, theta_dot, s, xg, g, prm)
         if ENERGY:
-            p_in = with_vertical_power(p_in, on, theta, theta_dot, 0.0, 0.0, s, g, prm, FLEX)
+            p_in = with_vertical_power(GROUND, p_in, theta, theta_dot, 0.0, 0.0, s, g, prm,
+                                       FLEX)
             return (theta_dot, theta_dd, 0.0, 0.0, p_in, 0.0)
         return (theta_dot, theta_dd, 0.0, 0.0, 0.0, 0.0)
     theta_dd, u_dd, p_in, p_damp = rocking_rhs(theta, theta_dot, u, u_dot, s, xg, g, prm,
                                                DAMPED)
     if ENERGY:
-        p_in = with_vertical_power(p_in, on, theta, theta_dot, u, u_dot, s, g, prm, FLEX)
+        p_in = with_vertical_power(GROUND, p_in, theta, theta_dot, u, u_dot, s, g, prm, FLEX)
         return (theta_dot, theta_dd, u_dot, u_dd, p_in, p_damp)
     return (theta_dot, theta_dd, u_dot, u_dd, 0.0, 0.0)
 
@@ -61,18 +57,19 @@ def _axpy(y, a, k):
 
 
 @njit(cache=True, **INLINE)
-def first_stage(t, y, s, on, prm, FLEX, DAMPED, ENERGY):
+def first_stage(t, y, s, on, prm, FLEX, DAMPED, ENERGY, GROUND):
     """k1 = dy/dt at (t, y): the first stage of every RK4 step from (t, y), whatever its
     length. A step and the trial steps that locate an event in it (``events``), or the
     shorter retries of the rotation limit (``loop``), all start from the same (t, y):
     they share one k1 (``rk4_from``), bit for bit what each computed (the same inputs:
     t + 0 and y + 0 k, as the other stages form theirs)."""
     zero = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-    return derivatives(t + 0.0, _axpy(y, 0.0, zero), s, on, prm, FLEX, DAMPED, ENERGY)
+    return derivatives(t + 0.0, _axpy(y, 0.0, zero), s, on, prm, FLEX, DAMPED, ENERGY,
+                       GROUND)
 
 
 @njit(cache=True, **INLINE)
-def rk4_from(t, y, h, k1, s, on, prm, FLEX, DAMPED, ENERGY):
+def rk4_from(t, y, h, k1, s, on, prm, FLEX, DAMPED, ENERGY, GROUND):
     """One classical RK4 step of size h [s] from (t, y) in phase s whose first stage k1
     (``first_stage``) is known. Returns the new 6-tuple."""
     # The three stages share one call site of the inlined right-hand side (numba types and
@@ -81,7 +78,7 @@ def rk4_from(t, y, h, k1, s, on, prm, FLEX, DAMPED, ENERGY):
     k23 = k1
     for stage in range(1, 4):
         c = h if stage == 3 else 0.5 * h
-        k = derivatives(t + c, _axpy(y, c, k), s, on, prm, FLEX, DAMPED, ENERGY)
+        k = derivatives(t + c, _axpy(y, c, k), s, on, prm, FLEX, DAMPED, ENERGY, GROUND)
         if stage == 1:
             k23 = k
         elif stage == 2:
@@ -96,7 +93,7 @@ def rk4_from(t, y, h, k1, s, on, prm, FLEX, DAMPED, ENERGY):
 
 
 @njit(cache=True, **INLINE)
-def rk4_step(t, y, h, s, on, prm, FLEX, DAMPED, ENERGY):
+def rk4_step(t, y, h, s, on, prm, FLEX, DAMPED, ENERGY, GROUND):
     """One classical RK4 step of size h [s] from (t, y) in phase s. Returns the new 6-tuple."""
-    return rk4_from(t, y, h, first_stage(t, y, s, on, prm, FLEX, DAMPED, ENERGY), s, on, prm,
-                    FLEX, DAMPED, ENERGY)
+    return rk4_from(t, y, h, first_stage(t, y, s, on, prm, FLEX, DAMPED, ENERGY, GROUND), s,
+                    on, prm, FLEX, DAMPED, ENERGY, GROUND)

@@ -15,8 +15,6 @@ from numba import literally, njit
 from rocksweep.kernel._cache import INTERNAL
 from rocksweep.kernel._static import skipped_when
 from rocksweep.kernel.equations import (
-    ground_acc,
-    ground_gravity,
     impact_loss,
     mechanical_energy,
     rest_margin,
@@ -26,6 +24,7 @@ from rocksweep.kernel.equations import (
     top_mass_rate,
     uplift_moment,
 )
+from rocksweep.kernel.ground import ground_acc, ground_gravity
 from rocksweep.kernel.layout import (
     PAR_RESTRATE,
     Y_D_DAMP,
@@ -38,11 +37,11 @@ from rocksweep.kernel.layout import (
 
 
 @njit(cache=True, **INTERNAL)
-def uplift_side(t, y, on, prm, FLEX, DAMPED):
+def uplift_side(t, y, on, prm, FLEX, DAMPED, GROUND):
     """Corner (+1 / -1) the body uplifts on from full contact at (t, y), or 0 (with a
     vertical: under g + a_v(t), in Q and in M g b alike)."""
-    g = ground_gravity(t, on, prm)
-    q = uplift_moment(y[Y_U], y[Y_U_DOT], ground_acc(t, on, prm), g, prm, FLEX, DAMPED)
+    g = ground_gravity(GROUND, t, on, prm)
+    q = uplift_moment(y[Y_U], y[Y_U_DOT], ground_acc(GROUND, t, on, prm), g, prm, FLEX, DAMPED)
     mgb = tip_moment(g, prm)
     if q >= mgb:
         return 1

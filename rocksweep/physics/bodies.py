@@ -53,6 +53,7 @@ from functools import cached_property
 import numpy as np
 
 from rocksweep.errors import BodyError
+from rocksweep.kernel import eq1 as _eq1
 from rocksweep.schema import BODY_KEYS, check_value, fmt, is_number
 
 G = 9.81  # m/s^2
@@ -220,19 +221,12 @@ class BlockBody:
     alpha: float
     inertia: float = 4.0 / 3.0
 
+    # One mass M at its centre, no base/top split, no spring: none of FlexibleBody's m,
+    # m_A, h, h_A, I_A, k, c, zeta, u_cr (``u_cr(body)`` for any body; the kernel row of a
+    # block carries M, b, h_cg and I_O, ``rocksweep.physics.points.body_row``)
     kind = "block"
     rigid = True
-    zeta = 0.0
-    m = 0.0
-    m_A = 0.0
     M = 1.0
-    c = 0.0
-    I_A = 0.0
-    h_A = 0.0
-    h = 0.0
-    k = math.inf
-    wn_over_p = math.inf
-    u_cr = 0.0
 
     def __post_init__(self) -> None:
         _check_keys(self, BODY_KEYS["block"])
@@ -273,35 +267,34 @@ class BlockBody:
 Body = FlexibleBody | BlockBody
 
 
+def u_cr(body: Body) -> float:
+    """Eq. (4)'s normaliser of the top mass's u [m] (``FlexibleBody.u_cr``); 0 for a body
+    whose u stays 0: a welded top mass (wn_over_p = inf) or a block (no top mass)."""
+    return body.u_cr if isinstance(body, FlexibleBody) else 0.0
+
+
 def restitution(
     body: FlexibleBody, lam: float | np.ndarray, u: float | np.ndarray, upper: bool
 ) -> np.ndarray:
-    """Eq. (1): e = theta'^+ / theta'^- for a rocking-to-rocking impact.
+    """Eq. (1): e = theta'^+ / theta'^- for a rocking-to-rocking impact (the formula:
+    ``rocksweep.kernel.eq1.restitution``, the kernel's own).
 
     Parameters: lam (Pi10, impulse at lam*b from the future corner), u [m] at impact,
     ``upper`` selects the paper's upper sign (in rocksweep: rocking on the +b corner ends,
     future corner -b; see the module docstring). Arrays broadcast. Returns e (may be <= 0,
     meaning full contact follows, or > 1).
     """
-    sg = 1.0 if upper else -1.0
-    m, m_A, b = body.m, body.m_A, body.b
-    i0 = body.I_A + m_A * body.h_A**2
-    lam = np.asarray(lam, dtype=float)
-    u = np.asarray(u, dtype=float)
-    num = i0 + m * u * (-sg * b + u) + b * (1 - lam) * (-m_A * b - m * b + sg * m * u)
-    den = i0 + m * u * (sg * b + u) + b * (1 - lam) * (m_A * b + m * b + sg * m * u)
-    return num / den
+    return _eq1.restitution(1.0 if upper else -1.0, np.asarray(u, dtype=float),
+                            np.asarray(lam, dtype=float), body.m, body.m_A, body.b,
+                            body.I_A + body.m_A * body.h_A**2, 0.0)
 
 
 def restitution_rigid(body: Body, lam: float | np.ndarray) -> np.ndarray:
-    """Restitution of a rigid body for an impulse at lam*b from the future corner.
-
-    Angular momentum about the impulse point is conserved:
-    e = (I_O - M b^2 (2 - lam)) / (I_O - lam M b^2); lam = 0 is Housner's 1 - 2 M b^2/I_O.
-    """
-    lam = np.asarray(lam, dtype=float)
-    mb2 = body.M * body.b**2
-    return (body.I_O - mb2 * (2 - lam)) / (body.I_O - lam * mb2)
+    """Restitution of a rigid body for an impulse at lam*b from the future corner
+    (``rocksweep.kernel.eq1.restitution_rigid``): the angular momentum about the impulse
+    point is conserved, e = (I_O - M b^2 (2 - lam)) / (I_O - lam M b^2); lam = 0 is
+    Housner's 1 - 2 M b^2/I_O."""
+    return _eq1.restitution_rigid(body.I_O, body.M * body.b**2, np.asarray(lam, dtype=float))
 
 
 def impact_energy_loss(
@@ -314,15 +307,6 @@ def impact_energy_loss(
     i = body.I_A + body.m_A * body.R_A**2 + body.m * body.b**2 + body.m * np.asarray(u) ** 2
     w2 = np.asarray(theta_dot_minus, dtype=float) ** 2
     return -0.5 * i * (e**2 - 1) * w2 - sg * body.m * body.b * u * (e**2 + 1) * w2
-
-
-def lam_0(body: FlexibleBody, u: float, upper: bool) -> float:
-    """The lam at which eq. (1) gives e = 0 (full contact follows) for lateral u [m]."""
-    sg = 1.0 if upper else -1.0
-    m, m_A, b = body.m, body.m_A, body.b
-    i0 = body.I_A + m_A * body.h_A**2
-    # numerator of eq. (1) is linear in lam: i0 + m u (u - sg b) - b (1 - lam) (M b - sg m u)
-    return 1 - (i0 + m * u * (u - sg * b)) / (b * (body.M * b - sg * m * u))
 
 
 def body_from_geometry(b: float, h: float, h_A: float, m: float, m_A: float, I_A: float,

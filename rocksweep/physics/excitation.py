@@ -212,6 +212,7 @@ class PulseShape:
             return 0.0
         lo, hi = float(phi[i - 1]), float(phi[i])
         side = math.copysign(1.0, A_ratio * float(self.acc(hi)))
+        # scipy.optimize (~0.15-1 s): a pulse's uplift phase only, not at import
         from scipy.optimize import brentq
 
         return brentq(lambda p: A_ratio * float(self.acc(p)) - side, lo, hi,

@@ -38,14 +38,21 @@ sum_i |Gamma_i phi_i| w_i^2 R_i (1 + 2 zeta_i) exp(-zeta_i w_i tau) (R_i the fre
 vibration's amplitude), has fallen below RINGDOWN_SHARE = 1% of the floor's peak
 acceleration: the tail is then too weak to move a body the floor's motion drives (it
 changes max|theta| by far less than the 1% to which a run is compared to its reference,
-docs/floors.md). An undamped mode would ring for ever: damping must be > 0.
+docs/floors.md). An undamped mode would ring for ever: damping must be > 0; a motion
+(the refined record and its ring-down) of more than MAX_MOTION_SAMPLES = 2^24 samples
+(128 MiB: e.g. a damping of 1e-5 at a period of 2 s) is refused in one line before any of
+it is made.
+
+A mode so stiff that w h > RIGID_WH = 1e8 at the finest steps moves with the ground to
+float64's precision (its relative acceleration ~ (w h)^-2 of the ground's): it adds
+nothing and asks no refinement (a period of 1e-300 s would overflow w^2).
 
 A pulse (``pulse:`` with ``floor:``) is the ground motion; it reaches the building as a
 record sampled at PULSE_POINTS = 64 points per 2 pi of its phase w t, the last sample at
 its end (``pulse_record``); the linear interpolation of the samples is within
 1 - cos(pi / 64) = 0.12% of the pulse.
 
-The vertical component reaches the floor unfiltered (no vertical mode is modelled).
+The building filters the horizontal motion only (``physics.ground_motion``).
 """
 
 from __future__ import annotations
@@ -56,6 +63,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rocksweep.errors import FloorError
 from rocksweep.physics.intensity import free_vibration, nj_response, refined
 from rocksweep.physics.records import GroundRecord
 
@@ -66,6 +74,11 @@ POINTS_PER_PERIOD = 16
 MAX_REFINE = 64
 #: the ring-down stops where the floor's free vibration stays below this share of its peak
 RINGDOWN_SHARE = 0.01
+#: most samples of one motion the body feels (the ground refined, and the ring-down):
+#: 2^24, 128 MiB of float64; a building that needs more is refused in one line
+MAX_MOTION_SAMPLES = 1 << 24
+#: a mode with w h above this moves with the ground (its relative response ~ (w h)^-2)
+RIGID_WH = 1e8
 #: samples per 2 pi of a pulse's phase w t when a pulse drives a building
 PULSE_POINTS = 64
 
@@ -91,10 +104,30 @@ def project(a1: np.ndarray, a2: np.ndarray, angle_deg: float) -> np.ndarray:
     return out
 
 
+def rigid(mode: Mode, h: float) -> bool:
+    """Whether ``mode`` moves with the ground at steps h [s] to float64's precision: its
+    relative acceleration is ~(w h)^-2 of the ground's (quasi-static), below 1e-16 where
+    w h > RIGID_WH (a period of 1e-300 s: w^2 would overflow)."""
+    return not (2.0 * math.pi / mode.period * h <= RIGID_WH)
+
+
 def refinement(dt: float, modes: tuple[Mode, ...]) -> int:
-    """Sub-steps per record sample for these modes (module docstring)."""
-    t_min = min(m.period for m in modes)
-    return int(min(max(math.ceil(POINTS_PER_PERIOD * dt / t_min), 1), MAX_REFINE))
+    """Sub-steps per record sample for these modes (module docstring); the modes ``rigid``
+    even at the finest refinement need none."""
+    flexible = [m for m in modes if not rigid(m, dt / MAX_REFINE)]
+    if not flexible:
+        return 1
+    ratio = POINTS_PER_PERIOD * dt / min(m.period for m in flexible)
+    return int(min(max(math.ceil(ratio), 1), MAX_REFINE)) if ratio < MAX_REFINE \
+        else MAX_REFINE
+
+
+def _too_long(samples: float, h: float, why: str) -> FloorError:
+    return FloorError(
+        f"floor: the motion the body feels would need {samples:.3g} samples at steps of "
+        f"{h:.3g} s ({why}), more than {MAX_MOTION_SAMPLES:,} ({MAX_MOTION_SAMPLES * 8 >> 20}"
+        " MiB) a motion; give the building more damping or a shorter period, or a shorter "
+        "or coarser record")
 
 
 def floor_motion(acc: np.ndarray, dt: float, modes: tuple[Mode, ...]
@@ -102,28 +135,43 @@ def floor_motion(acc: np.ndarray, dt: float, modes: tuple[Mode, ...]
     """The floor's absolute acceleration (module docstring) of the piecewise-linear ground
     ``acc`` (float64[n], at t = k dt [s], units kept: g for records), with its ring-down:
     (a_f float64[N], h [s]), a_f[k] at t = k h, h = dt / ``refinement``; N - 1 >= (n - 1)
-    dt / h (the record), the samples after it its ring-down."""
+    dt / h (the record), the samples after it its ring-down. A mode ``rigid`` at h adds
+    nothing (the floor moves with the ground). More than MAX_MOTION_SAMPLES samples (the
+    refined record and the ring-down, counted before any is made) is a one-line
+    FloorError."""
     m = refinement(dt, modes)
     h = dt / m
+    n = (np.size(acc) - 1) * m + 1
+    if n > MAX_MOTION_SAMPLES:
+        raise _too_long(n, h, f"the record refined {m} times for the building's shortest "
+                              "period")
     x = refined(np.asarray(acc, np.float64), dt, m)
-    gp_sum = sum(md.participation for md in modes)
+    flexible = [md for md in modes if not rigid(md, h)]
+    gp_sum = sum(md.participation for md in flexible)
     floor = x * (1.0 - gp_sum)
     ends = []
-    for md in modes:
+    for md in flexible:
         w = 2.0 * math.pi / md.period
         y, v = nj_response(-x, w, md.damping, h, rate=True)
         floor -= md.participation * (2.0 * md.damping * w * v + w * w * y)
         ends.append((md, w, float(y[-1]), float(v[-1])))
     peak = float(np.max(np.abs(floor)))
     # ring-down: each mode's envelope below RINGDOWN_SHARE * peak / (number of modes)
-    stop = 0.0
+    stop, slowest = 0.0, None
     for md, w, y0, v0 in ends:
         wd = w * math.sqrt(1.0 - md.damping ** 2)
         amp = math.hypot(y0, (v0 + md.damping * w * y0) / wd)
         env = abs(md.participation) * w * w * amp * (1.0 + 2.0 * md.damping)
-        limit = RINGDOWN_SHARE * peak / len(modes)
+        limit = RINGDOWN_SHARE * peak / len(ends)
         if env > limit > 0.0:
-            stop = max(stop, math.log(env / limit) / (md.damping * w))
+            with np.errstate(over="ignore"):  # a damping of 5e-324: an endless ring-down
+                t = float(np.float64(math.log(env / limit)) / np.float64(md.damping * w))
+            if not t <= stop:
+                stop, slowest = t, md
+    if n + stop / h > MAX_MOTION_SAMPLES:
+        raise _too_long(n + stop / h, h, f"a ring-down of {stop:.3g} s until the mode of "
+                        f"period {slowest.period:g} s and damping {slowest.damping:g} "
+                        f"falls below {RINGDOWN_SHARE:.0%} of the floor's peak")
     n_tail = int(math.ceil(stop / h))
     if n_tail == 0:
         return floor, h

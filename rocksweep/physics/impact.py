@@ -44,9 +44,9 @@ import math
 
 import numpy as np
 
+from rocksweep.kernel import eq1 as _eq1
 from rocksweep.physics.bodies import Body, FlexibleBody, impact_energy_loss, restitution_rigid
-from rocksweep.physics.bodies import restitution as restitution_eq1
-from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW, LAWS, LOCKED, VERTICAL
+from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW, EQ1, LAWS, LOCKED
 
 # The u/u_cr range over which a body's energy-admissible lam is taken (Figure 2's range)
 U_RANGE = 2.0
@@ -64,18 +64,14 @@ def restitution(body: Body, lam, u, upper: bool = True, law: str = DEFAULT_LAW,
     u = np.asarray(u, float)
     if law == CONSTANT:
         return np.broadcast_to(np.float64(e * e_factor), np.broadcast(lam, u).shape).copy()
-    if law not in (VERTICAL, LOCKED):
+    if law not in (EQ1, LOCKED):
         raise ValueError(f"impact law {law!r}: must be one of {', '.join(LAWS)}")
     if not _flexible(body):  # top mass welded: the rigid body's e
         return np.asarray(restitution_rigid(body, lam), float) * e_factor + 0.0 * u
-    if law == VERTICAL:
-        return restitution_eq1(body, lam, u, upper) * e_factor
-    sg = 1.0 if upper else -1.0
-    m, m_A, b = body.m, body.m_A, body.b
-    i0 = body.I_A + m_A * body.h_A**2 + m * body.h**2  # eq. (1) + m h^2
-    num = i0 + m * u * (-sg * b + u) + b * (1 - lam) * (-m_A * b - m * b + sg * m * u)
-    den = i0 + m * u * (sg * b + u) + b * (1 - lam) * (m_A * b + m * b + sg * m * u)
-    return num / den * e_factor
+    # eq. (1), one definition (the kernel's, ``rocksweep.kernel.eq1``); locked: + m h^2
+    mh2 = body.m * body.h * body.h if law == LOCKED else 0.0
+    return _eq1.restitution(1.0 if upper else -1.0, u, lam, body.m, body.m_A, body.b,
+                            body.I_A + body.m_A * body.h_A**2, mh2) * e_factor
 
 
 def energy_loss(body: Body, e, u, theta_dot_minus, upper: bool = True,

@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
 
 from rocksweep.errors import Arg, MeasuredError
 from rocksweep.inputs import check_columns, csv_table, number_column, read_text
@@ -60,8 +61,6 @@ def _columns(measured: Any) -> tuple[dict[str, Any], list[str], str]:
     """({column: values}, each row's place in messages, source words) of a CSV path or a
     DataFrame; the file read through ``rocksweep.inputs`` (a regular UTF-8 file of at
     most MAX_BYTES, comma-separated, each column named once)."""
-    import pandas as pd
-
     if isinstance(measured, pd.DataFrame):
         src = "measured DataFrame"
         cols = check_columns(list(measured.columns), src, MeasuredError)

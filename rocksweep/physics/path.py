@@ -6,28 +6,23 @@ values (the ground motion r, the angle [deg], the floor's modes, a pulse's shape
 w_over_p): ``floor.project`` then ``floor.floor_motion`` (``rocksweep.physics.floor``),
 as a ``GroundRecord`` of peak ``pga`` = max |what the body feels| per unit of the ground
 motion. Scaling stays the ground motion's: a point's A_ratio (or a suite's factor) sets
-the ground's peak, and the kernel's peak is that times ``motion.pga / ground_peak`` (the
-record's H1 peak; 1 for a pulse, whose A_ratio is its peak).
+the ground's peak, and the kernel's peak is that times ``motion.pga`` over the ground's
+peak (the record's H1 PGA; 1 for a pulse, whose A_ratio is its peak:
+``Excitation.ground_pga``, ``Scene.drive_ratio``).
 
-Motions are computed when first asked for and kept (most recently used first) up to
-``CACHE_BYTES`` of samples: the chunks of a sweep vary p and A_ratio fastest, which share
-one motion, so each motion is computed about once.
+Each motion is computed once a run: it becomes an excitation that the scene keeps
+(``physics.ground_motion``, ``Scene.excitation``).
 """
 
 from __future__ import annotations
 
 import math
-import threading
-from collections import OrderedDict
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from rocksweep.physics.floor import Mode, derived_record, floor_motion, project, pulse_record
 from rocksweep.physics.records import GroundRecord
-
-#: samples of derived motions kept in memory [bytes]
-CACHE_BYTES = 256 << 20
 
 
 @dataclass(eq=False)
@@ -45,17 +40,6 @@ class GroundPath:
     modes: tuple[Mode, ...] | None = None
     floor: bool = False
     p: float = 1.0
-    _cache: OrderedDict = field(default_factory=OrderedDict, repr=False)
-    _bytes: list = field(default_factory=lambda: [0], repr=False)
-    _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
-
-    def __getstate__(self) -> dict:  # dask ships the scene: without the cache and lock
-        return {k: v for k, v in self.__dict__.items() if k not in ("_cache", "_lock",
-                                                                     "_bytes")}
-
-    def __setstate__(self, state: dict) -> None:
-        self.__dict__.update(state, _cache=OrderedDict(), _bytes=[0],
-                             _lock=threading.Lock())
 
     def building(self, values: tuple[float, float, float] | None) -> tuple[Mode, ...] | None:
         """The modes at one point: ``modes``, or the one mode (period, damping,
@@ -73,24 +57,6 @@ class GroundPath:
         record r of the scene (None for a pulse); angle [deg]; floor: the one mode's
         (period, damping, participation) (unused with ``modes``); pulse: (PulseShape, w
         [rad/s]) for a pulse scene."""
-        key = (r, float(angle), None if floor is None else tuple(map(float, floor)),
-               None if pulse is None else (pulse[0], float(pulse[1])))
-        with self._lock:
-            hit = self._cache.get(key)
-            if hit is not None:
-                self._cache.move_to_end(key)
-                return hit
-        rec = self._compute(ground, r, angle, floor, pulse, key)
-        with self._lock:
-            if key not in self._cache:
-                self._cache[key] = rec
-                self._bytes[0] += rec.acc.nbytes
-                while self._bytes[0] > CACHE_BYTES and len(self._cache) > 1:
-                    _, old = self._cache.popitem(last=False)
-                    self._bytes[0] -= old.acc.nbytes
-            return self._cache[key]
-
-    def _compute(self, ground, r, angle, floor, pulse, key) -> GroundRecord:
         if pulse is not None:
             acc, dt = pulse_record(pulse[0], pulse[1] * self.p)
             parts: tuple = ("pulse", pulse[0], float(pulse[1]), self.p)
@@ -109,12 +75,9 @@ class GroundPath:
             acc, dt = floor_motion(acc, dt, modes)
             parts += tuple((m.period, m.damping, m.participation) for m in modes)
             name += " on the floor"
+        key = (r, float(angle), None if floor is None else tuple(map(float, floor)),
+               None if pulse is None else (pulse[0], float(pulse[1])))
         return derived_record(acc, dt, name, parts + (key,))
-
-    def ground_peak(self, ground: GroundRecord | None) -> float:
-        """The ground motion's peak that A_ratio scales: the record's H1 PGA [g], 1 for a
-        pulse (its A_ratio is its peak)."""
-        return 1.0 if ground is None else ground.pga
 
 
 def check_pair(h1: GroundRecord, h2: GroundRecord) -> str | None:

@@ -1,13 +1,16 @@
-"""One point of a study (body, impact, pulse) -> the kernel's parameter row.
+"""One point of a study (body, impact, ground motion) -> the kernel's parameter row.
 
-This is the only place where the model's dimensional quantities are packed for the kernel.
+This is the only place where the model's dimensional quantities are packed for the kernel:
+``build_rows`` makes the rows of any points (a sweep's chunk, ``scene.grid``; a list of
+``Point``s, ``points_rows``), one ``fill_rows`` per excitation they share
+(``physics.ground_motion``).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -20,34 +23,15 @@ from rocksweep.numerics import (
     close_band,
     step_budget,
     step_sizes,
-    vertical_step,
 )
-from rocksweep.physics.bodies import Body, FlexibleBody, G
-from rocksweep.physics.records import GroundRecord, vertical_samples
-from rocksweep.physics.vertical import VerticalHarmonic, air_time_harmonic, air_time_record
-from rocksweep.vocab.ground import (
-    CYCLES,
-    FREE,
-    GAMMA,
-    MP,
-    NU_DEG,
-    PAPER_SHAPES,
-    RECORD,
-    RICKER,
-    SHAPE_CODE,
-    SINE,
-    pulse_duration,
-)
+from rocksweep.physics.bodies import Body, FlexibleBody, G, u_cr
+from rocksweep.physics.ground_motion import Excitation, pulse
+from rocksweep.physics.records import GroundRecord
+from rocksweep.vocab.ground import FREE, RECORD, pulse_duration
 from rocksweep.vocab.laws import DEFAULT_LAW, LAW_CODE
 from rocksweep.vocab.settings import ROOT_CODE
 
-if TYPE_CHECKING:
-    from rocksweep.physics.excitation import PulseShape
-
-# shapes, laws and their kernel codes: rocksweep.vocab (the names re-exported here)
-# FREE runs as a sine of amplitude 0 that ends at t = 0 (its own code would be a new
-# branch of the kernel for nothing)
-_SHAPE_CODE = {**SHAPE_CODE, FREE: SHAPE_CODE[SINE]}
+# the impact laws' kernel codes: rocksweep.vocab.laws
 _LAW_CODE = LAW_CODE
 
 
@@ -55,25 +39,23 @@ _LAW_CODE = LAW_CODE
 class Point:
     """One simulation: a body, the impulse position lam, and a ground motion.
 
-    A pulse (shape one of SHAPES, ``rocksweep.physics.excitation``): w_over_p = omega/p, cycles
-    (sine, cosine), gamma and nu [deg] (MP). A record (shape RECORD): ``record`` and the
-    body's frequency parameter p [rad/s], which fixes the body's size against the
-    record's seconds (kernel time p t); w_over_p is NaN. A is the peak |xg''| either way.
-    mu: the friction coefficient of the base on the ground (NaN: none given; only the
-    contact status bits read it). law, e, e_factor: the impact law (one of LAWS), the
-    coefficient of restitution of law ``constant`` (NaN for the others) and the factor on
-    the law's e (``rocksweep.physics.impact``).
+    excitation: the ground motion (``physics.ground_motion.Excitation``: a pulse, or
+    samples the body feels); a pulse shape's name (sine, cosine, ricker, mp, free) stands
+    for that pulse with its default options. A pulse is timed by w_over_p = omega/p
+    (p: NaN); samples by the body's frequency parameter p [rad/s], which fixes the body's
+    size against the record's seconds (kernel time p t; w_over_p: NaN). A_ratio: the
+    peak |xg''| of what the body feels over g tan(alpha_ref) (``A``). mu: the friction
+    coefficient of the base on the ground (NaN: none given; only the contact status bits
+    read it). law, e, e_factor: the impact law (one of LAWS), the coefficient of
+    restitution of law ``constant`` (NaN for the others) and the factor on the law's e
+    (``rocksweep.physics.impact``).
     """
 
     body: Body
     lam: float
-    shape: str
+    excitation: Excitation
     w_over_p: float
     A_ratio: float
-    cycles: int = CYCLES
-    gamma: float = GAMMA
-    nu: float = NU_DEG
-    record: GroundRecord | None = None
     p: float = math.nan
     mu: float = math.nan
     law: str = DEFAULT_LAW
@@ -81,11 +63,20 @@ class Point:
     e_factor: float = 1.0
     # the state at t = 0 (``INITIAL``, normalised; all 0: at rest in full contact)
     initial: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
-    # a vertical ground acceleration (docs/vertical.md): the record's vertical component
-    # (with ``record``, ``ground.vertical``), or a harmonic while the pulse acts
-    # (``pulse.vertical``)
-    vertical: GroundRecord | None = None
-    pulse_vertical: VerticalHarmonic | None = None
+
+    def __post_init__(self) -> None:
+        if isinstance(self.excitation, str):
+            object.__setattr__(self, "excitation", pulse(self.excitation))
+
+    @property
+    def shape(self) -> str:
+        """The pulse's shape, or RECORD for samples."""
+        return self.excitation.shape
+
+    @property
+    def record(self) -> GroundRecord | None:
+        """The samples the body feels (None for a pulse)."""
+        return self.excitation.record
 
     @property
     def omega(self) -> float:
@@ -93,31 +84,13 @@ class Point:
 
     @property
     def A(self) -> float:
-        """Pulse amplitude [m/s^2]: A_ratio * g tan(alpha_cg) (alpha for a block)."""
-        return self.A_ratio * G * math.tan(self.body.alpha_ref)
+        """Peak |xg''| of what the body feels [m/s^2] (``peak_acc``)."""
+        return float(peak_acc(self.A_ratio, self.body.alpha_ref))
 
     @property
     def ground(self) -> int:
-        """The kernel variants' ground code the point needs (``layout.GROUND_*``):
-        GROUND_VERTICAL with a vertical, GROUND_ANY for the shapes beyond the paper's."""
-        if self.vertical is not None or self.pulse_vertical is not None:
-            return L.GROUND_VERTICAL
-        return L.GROUND_ANY if self.shape not in (*PAPER_SHAPES, FREE) else L.GROUND_PULSE
-
-    def vertical_on_samples(self) -> np.ndarray | None:
-        """The vertical record [g] on the horizontal record's samples (None without)."""
-        if self.vertical is None or self.record is None:
-            return None
-        return vertical_samples(self.vertical, self.record)
-
-    @property
-    def pulse(self) -> PulseShape | None:
-        """The pulse's reference definition (None for a record)."""
-        from rocksweep.physics.excitation import PulseShape  # scipy: loaded when needed
-
-        if self.shape in (RECORD, FREE):
-            return None
-        return PulseShape(self.shape, int(self.cycles), float(self.gamma), float(self.nu))
+        """The kernel variants' ground code the point needs (its excitation's)."""
+        return self.excitation.ground
 
     @property
     def t_pulse(self) -> float:
@@ -127,7 +100,13 @@ class Point:
             return self.p * self.record.duration
         if self.shape == FREE:
             return 0.0
-        return self.pulse.duration / self.omega
+        return self.excitation.pulse.duration / self.omega
+
+
+def peak_acc(A_ratio: np.ndarray | float, alpha_ref: np.ndarray | float) -> np.ndarray:
+    """The peak |xg''| of what the body feels [m/s^2], A = A_ratio g tan(alpha_ref) (signed
+    like A_ratio; the kernel's PAR_AMP): the one definition, float64 like the input."""
+    return A_ratio * G * np.tan(alpha_ref)
 
 
 def kernel_kind(body: Body) -> int:
@@ -146,7 +125,7 @@ def body_row(body: Body) -> np.ndarray:
     row[L.PAR_HCG] = body.h_cg
     row[L.PAR_IO] = body.I_O
     row[L.PAR_THETA_OVER] = math.pi / 2
-    row[L.PAR_LAW] = L.LAW_VERTICAL  # eq. (1), unless fill_rows is told otherwise
+    row[L.PAR_LAW] = _LAW_CODE[DEFAULT_LAW]  # eq. (1), unless fill_rows is told otherwise
     row[L.PAR_E] = math.nan
     row[L.PAR_E_FACTOR] = 1.0
     if isinstance(body, FlexibleBody):
@@ -257,82 +236,112 @@ def record_cost(omega_rock: np.ndarray, alpha_ref: np.ndarray, p: np.ndarray,
     return dt, h_rec, t_pulse, t_end, max_steps
 
 
-def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
-              alpha_ref: np.ndarray, lam: np.ndarray, shape_code: np.ndarray,
-              w_over_p: np.ndarray, A_ratio: np.ndarray, numerics: Numerics,
-              cycles: int = CYCLES, gamma: float = GAMMA, nu_deg: float = NU_DEG,
-              record: GroundRecord | None = None,
-              mu: np.ndarray | float = math.nan, law: np.ndarray | float = L.LAW_VERTICAL,
-              e: np.ndarray | float = math.nan, e_factor: np.ndarray | float = 1.0,
-              initial: tuple | None = None, u_cr: np.ndarray | float = 0.0,
-              vertical: np.ndarray | None = None,
-              pulse_vertical: tuple | None = None) -> None:
-    """Fill parameter rows in place, vectorised over points.
+@dataclass(frozen=True)
+class Bodies:
+    """The bodies of n points, as the rows and the results take them (one entry a point):
+    rows float64[n, N_PAR] (``body_row``), omega_rock [rad/s] (``body_omega_rock``),
+    alpha_ref [rad], E_ref [J], u_cr [m] (0 for a rigid body): float64[n]; kinds: int64[n]
+    (``kernel_kind``)."""
 
-    rows: float64[n, N_PAR] (out); body_rows: float64[n, N_PAR] from ``body_row``;
-    omega_rock, alpha_ref, lam, shape_code, w_over_p, A_ratio: float64[n] (p = 1).
-    cycles (sine, cosine), gamma and nu_deg [deg] (MP): the pulse's optional keys, one
-    value for all points. With ``record``, every point is driven by it and w_over_p holds
-    the body's p [rad/s]; the rows then still lack the samples (``with_record``).
-    mu: friction coefficient, float64[n] or a scalar (NaN: none). law (a LAW_* code), e
-    (law constant's, else NaN) and e_factor: the impact law, float64[n] or scalars.
-    initial: the state at t = 0 as four float64[n] or scalars in ``INITIAL``'s order
-    (theta/alpha_ref, theta'/(p alpha_ref), u/u_cr, u'/(p u_cr)), None: at rest; u_cr [m]
-    float64[n] or a scalar (0 for a rigid body). PAR_THETA0.. PAR_U_DOT0 in SI (p = 1).
-    vertical: with ``record``, its vertical component [g] on its samples
-    (``records.vertical_samples``; the rows then lack its samples too: ``with_record``);
-    pulse_vertical: (amplitude [g], w_over_p, phase [deg]), float64[n] or scalars, a
-    harmonic while the pulse acts. Either fills PAR_V_* and PAR_T_AIR (``physics.vertical``)
-    and runs on the GROUND_VERTICAL variants; without, PAR_T_AIR is inf.
-    """
-    rows[:] = body_rows
-    omega = np.asarray(w_over_p, float)  # p = 1 rad/s
-    code = np.asarray(shape_code, float)
-    zeta_rock = rocking_spring_zeta(omega_rock, body_rows[:, L.PAR_K], body_rows[:, L.PAR_C])
-    if record is not None:
-        dt, h_rec, t_pulse, t_end, max_steps = record_cost(omega_rock, alpha_ref, omega,
-                                                           A_ratio, record, numerics,
+    rows: np.ndarray
+    omega_rock: np.ndarray
+    alpha_ref: np.ndarray
+    E_ref: np.ndarray
+    u_cr: np.ndarray
+    kinds: np.ndarray
+
+    @classmethod
+    def of(cls, bodies: Sequence[Body]) -> Bodies:
+        """The entries of these bodies (each computed once per distinct body object)."""
+        first: dict[int, int] = {}
+        index = np.array([first.setdefault(id(b), len(first)) for b in bodies], np.int64)
+        distinct = list({id(b): b for b in bodies}.values())
+        rows = np.empty((len(distinct), L.N_PAR))
+        for j, b in enumerate(distinct):
+            rows[j] = body_row(b)
+        return cls(rows, np.array([body_omega_rock(b) for b in distinct], float),
+                   np.array([b.alpha_ref for b in distinct], float),
+                   np.array([b.E_ref for b in distinct], float),
+                   np.array([u_cr(b) for b in distinct], float),
+                   np.array([kernel_kind(b) for b in distinct], np.int64)).take(index)
+
+    def take(self, index: np.ndarray) -> Bodies:
+        """The entries at ``index`` (int64[m] or bool[n])."""
+        return Bodies(*(np.asarray(v)[index] for v in (self.rows, self.omega_rock,
+                                                       self.alpha_ref, self.E_ref,
+                                                       self.u_cr, self.kinds)))
+
+
+@dataclass(frozen=True)
+class Columns:
+    """A point's own numbers, for n points: float64[n] arrays or scalars (one value for
+    all). lam; rate: a pulse's w_over_p, or the body's p [rad/s] against samples; A_ratio:
+    the kernel's (``Point.A_ratio``); mu (NaN: none); law (a LAW_* code), e (law
+    constant's, else NaN) and e_factor: the impact law; initial: the state at t = 0 as
+    four arrays or scalars in ``INITIAL``'s order (theta/alpha_ref, theta'/(p
+    alpha_ref), u/u_cr, u'/(p u_cr)), None: at rest."""
+
+    lam: np.ndarray | float
+    rate: np.ndarray | float
+    A_ratio: np.ndarray | float
+    mu: np.ndarray | float = math.nan
+    law: np.ndarray | float = _LAW_CODE[DEFAULT_LAW]
+    e: np.ndarray | float = math.nan
+    e_factor: np.ndarray | float = 1.0
+    initial: tuple | None = None
+
+    def take(self, sel: np.ndarray) -> Columns:
+        """The columns at ``sel`` (bool[n] or int64[m]); scalars stay."""
+        def part(v):
+            return v[sel] if np.ndim(v) else v
+
+        return replace(self, **{k: part(getattr(self, k)) for k in (
+            "lam", "rate", "A_ratio", "mu", "law", "e", "e_factor")},
+            initial=None if self.initial is None else tuple(part(v) for v in self.initial))
+
+
+def fill_rows(rows: np.ndarray, bodies: Bodies, excitation: Excitation, columns: Columns,
+              numerics: Numerics) -> None:
+    """Fill the parameter rows float64[n, N_PAR] (out) of n points that share one
+    excitation, vectorised over them: the bodies' part (``Bodies``), the ground motion's
+    (its time scale, length and steps: ``run_cost``, or ``record_cost`` for samples, which
+    the rows then still lack: ``Excitation.with_samples``; gravity g + a_v:
+    ``Excitation.fill_gravity``), the points' own numbers (``Columns``; PAR_THETA0..
+    PAR_U_DOT0 in SI, p = 1) and the numerics' settings."""
+    ex = excitation
+    rows[:] = bodies.rows
+    omega_rock, alpha_ref = bodies.omega_rock, bodies.alpha_ref
+    rate = np.asarray(columns.rate, float)  # p = 1 rad/s
+    zeta_rock = rocking_spring_zeta(omega_rock, bodies.rows[:, L.PAR_K], bodies.rows[:, L.PAR_C])
+    A_ratio = columns.A_ratio
+    if ex.record is not None:
+        dt, h_rec, t_pulse, t_end, max_steps = record_cost(omega_rock, alpha_ref, rate,
+                                                           A_ratio, ex.record, numerics,
                                                            zeta_rock)
-        rows[:, L.PAR_REC_DT] = omega * record.dt
+        rows[:, L.PAR_REC_DT] = rate * ex.record.dt
         rows[:, L.PAR_REC_H] = h_rec
         dt_on = h_rec
         omega = 0.0
     else:
-        # each point's duration in w t by its shape (``vocab.ground.pulse_duration``)
-        phase = np.select([code == L.SHAPE_RICKER, code == L.SHAPE_MP],
-                          [pulse_duration(RICKER), pulse_duration(MP, gamma=gamma)],
-                          pulse_duration(SINE, cycles=cycles))
-        dt, dt_on, t_pulse, t_end, max_steps = run_cost(omega_rock, alpha_ref, omega,
+        # the duration in w t of the shape (``vocab.ground.pulse_duration``)
+        phase = pulse_duration(ex.shape, cycles=ex.cycles, gamma=ex.gamma)
+        dt, dt_on, t_pulse, t_end, max_steps = run_cost(omega_rock, alpha_ref, rate,
                                                         A_ratio, numerics, phase, zeta_rock)
-        if np.any(code == L.SHAPE_MP):
-            from rocksweep.physics.excitation import mp_peak
-
-            rows[:, L.PAR_GAMMA] = gamma
-            rows[:, L.PAR_NU] = math.radians(nu_deg)
-            rows[:, L.PAR_AMP_NORM] = 1.0 / mp_peak(float(gamma), float(nu_deg))
-    rows[:, L.PAR_T_AIR] = np.inf
-    if pulse_vertical is not None:
-        amp_v, w_v, phase_v = (np.asarray(v, float) for v in pulse_vertical)
-        rows[:, L.PAR_V_AMP] = amp_v * G
-        rows[:, L.PAR_V_OMEGA] = w_v
-        rows[:, L.PAR_V_PHASE] = np.radians(phase_v)
-        rows[:, L.PAR_T_AIR] = air_time_harmonic(amp_v, w_v, phase_v, t_pulse)
-        # the step resolves the vertical as it does the pulse; the cap follows
-        dt_on = vertical_step(dt_on, w_v, numerics.steps_per_period, numerics.pulse_steps)
+        omega = rate
+        if not math.isnan(ex.mp_norm):
+            rows[:, L.PAR_GAMMA] = ex.gamma
+            rows[:, L.PAR_NU] = math.radians(ex.nu)
+            rows[:, L.PAR_AMP_NORM] = ex.mp_norm
+    A = peak_acc(A_ratio, alpha_ref)
+    ex.fill_gravity(rows, A, t_pulse)
+    if ex.harmonic is not None:  # the step resolves the harmonic as it does the pulse
+        dt_on = ex.step_on(dt_on, numerics)
         max_steps = step_budget(t_pulse, t_end, dt, dt_on, numerics)
-    elif vertical is not None:
-        # one factor for both components: a_v = |A| acc_v / PGA_h (A's sign turns the
-        # horizontal round only)
-        scale = np.abs(A_ratio * G * np.tan(alpha_ref))
-        rows[:, L.PAR_V_AMP] = scale
-        rows[:, L.PAR_V_REC] = L.PAR_REC + record.npts + 1
-        rows[:, L.PAR_T_AIR] = air_time_record(np.asarray(vertical) / record.pga,
-                                               rows[:, L.PAR_REC_DT], scale / G)
-    rows[:, L.PAR_AMP] = A_ratio * G * np.tan(alpha_ref)
+    rows[:, L.PAR_AMP] = A
     rows[:, L.PAR_OMEGA] = omega
-    rows[:, L.PAR_SHAPE] = code
+    rows[:, L.PAR_SHAPE] = ex.code
     rows[:, L.PAR_TPULSE] = t_pulse
-    rows[:, L.PAR_LAM] = lam
+    rows[:, L.PAR_LAM] = columns.lam
     rows[:, L.PAR_DT] = dt
     rows[:, L.PAR_DT_ON] = dt_on
     rows[:, L.PAR_TOL] = numerics.event_tol
@@ -341,60 +350,71 @@ def fill_rows(rows: np.ndarray, body_rows: np.ndarray, omega_rock: np.ndarray,
     rows[:, L.PAR_MAXEVENTS] = numerics.max_events
     rows[:, L.PAR_RESTRATE] = numerics.rest_rate * alpha_ref  # p = 1
     rows[:, L.PAR_ROOT] = ROOT_CODE[numerics.root]
-    rows[:, L.PAR_MU] = mu
+    rows[:, L.PAR_MU] = columns.mu
     rows[:, L.PAR_ROT_STEP] = numerics.rotation_step * alpha_ref
     rows[:, L.PAR_ALPHA_REF] = alpha_ref
     rows[:, L.PAR_CLOSE] = close_band(numerics.steps_per_period)
-    rows[:, L.PAR_LAW] = law
-    rows[:, L.PAR_E] = e
-    rows[:, L.PAR_E_FACTOR] = e_factor
-    if initial is not None:
-        th, thd, u, ud = initial
+    rows[:, L.PAR_LAW] = columns.law
+    rows[:, L.PAR_E] = columns.e
+    rows[:, L.PAR_E_FACTOR] = columns.e_factor
+    if columns.initial is not None:
+        th, thd, u, ud = columns.initial
         rows[:, L.PAR_THETA0] = np.asarray(th, float) * alpha_ref
         rows[:, L.PAR_THETA_DOT0] = np.asarray(thd, float) * alpha_ref
-        rows[:, L.PAR_U0] = np.asarray(u, float) * u_cr
-        rows[:, L.PAR_U_DOT0] = np.asarray(ud, float) * u_cr
+        rows[:, L.PAR_U0] = np.asarray(u, float) * bodies.u_cr
+        rows[:, L.PAR_U_DOT0] = np.asarray(ud, float) * bodies.u_cr
 
 
-def with_record(rows: np.ndarray, record: GroundRecord | None,
-                vertical: np.ndarray | None = None) -> np.ndarray:
-    """Rows float64[n, N_PAR] -> float64[n, N_PAR + npts] with the record's samples
-    xg''/PGA after the parameters (``layout.PAR_REC``); ``rows`` itself without one.
-    vertical: its vertical component [g] on its samples: the rows are then float64[n,
-    N_PAR + 2 npts + 1], the last horizontal sample once more, then a_v/(g PGA)
-    (``layout.PAR_V_REC``)."""
-    if record is None:
+def build_rows(bodies: Bodies, excitations: Sequence[Excitation], which: np.ndarray,
+               columns: Columns, numerics: Numerics) -> np.ndarray:
+    """The parameter rows float64[n, N_PAR] of n points: point i driven by
+    ``excitations[which[i]]`` (which: int64[n]), filled excitation by excitation
+    (``fill_rows``; each excitation's samples are added by ``Excitation.with_samples``
+    just before the kernel runs)."""
+    n = which.size
+    rows = np.empty((n, L.N_PAR))
+    if len(excitations) == 1:
+        fill_rows(rows, bodies, excitations[0], columns, numerics)
         return rows
-    shape = record.acc / record.pga
-    if vertical is not None:
-        shape = np.concatenate((shape, shape[-1:], np.asarray(vertical, float) / record.pga))
-    out = np.empty((rows.shape[0], L.N_PAR + shape.size))
-    out[:, :L.N_PAR] = rows
-    out[:, L.N_PAR:] = shape
-    return out
+    for j, ex in enumerate(excitations):
+        sel = which == j
+        if not sel.any():
+            continue
+        part = np.empty((int(sel.sum()), L.N_PAR))
+        fill_rows(part, bodies.take(sel), ex, columns.take(sel), numerics)
+        rows[sel] = part
+    return rows
+
+
+def points_rows(points: Sequence[Point], numerics: Numerics
+                ) -> tuple[np.ndarray, tuple[Excitation, ...], np.ndarray]:
+    """The rows of arbitrary points (``build_rows``): (rows float64[n, N_PAR], the
+    distinct excitations, which: int64[n], each point's index into them)."""
+    first: dict[int, int] = {}
+    which = np.array([first.setdefault(id(p.excitation), len(first)) for p in points],
+                     np.int64)
+    excitations = tuple({id(p.excitation): p.excitation for p in points}.values())
+
+    def column(name: str) -> np.ndarray:
+        return np.array([getattr(p, name) for p in points], float)
+
+    rate = np.array([p.w_over_p if p.record is None else p.p for p in points], float)
+    initial = (None if not any(any(p.initial) for p in points) else
+               tuple(np.array(v, float) for v in zip(*(p.initial for p in points),
+                                                      strict=True)))
+    columns = Columns(column("lam"), rate, column("A_ratio"), column("mu"),
+                      np.array([law_code(p.law) for p in points]), column("e"),
+                      column("e_factor"), initial)
+    rows = build_rows(Bodies.of([p.body for p in points]), excitations, which, columns,
+                      numerics)
+    return rows, excitations, which
 
 
 def point_row(point: Point, numerics: Numerics) -> np.ndarray:
     """The kernel's parameter row for one point: float64[N_PAR], or float64[N_PAR + npts]
-    with a record's samples."""
-    body = point.body
-    rows = np.empty((1, L.N_PAR))
-    rec = point.record if point.shape == RECORD else None
-    vertical = point.vertical_on_samples() if rec is not None else None
-    pv = point.pulse_vertical
-    fill_rows(rows, body_row(body)[None, :], np.array([body_omega_rock(body)]),
-              np.array([body.alpha_ref]), np.array([point.lam]),
-              np.array([_SHAPE_CODE[point.shape]]),
-              np.array([point.p if rec is not None else point.w_over_p]),
-              np.array([point.A_ratio]), numerics, point.cycles, point.gamma, point.nu, rec,
-              point.mu, law_code(point.law), point.e, point.e_factor,
-              point.initial if any(point.initial) else None, body.u_cr, vertical,
-              None if pv is None else (pv.amplitude, pv.w_over_p, pv.phase))
-    return with_record(rows, rec, vertical)[0]
-
-
-def shape_code(shape: str) -> float:
-    return _SHAPE_CODE[shape]
+    with its samples (``Excitation.with_samples``)."""
+    rows, _, _ = points_rows([point], numerics)
+    return point.excitation.with_samples(rows)[0]
 
 
 def law_code(law: str) -> float:

@@ -33,13 +33,8 @@ A_ratio * g tan(alpha_cg): xg''(t) = A_ratio g tan(alpha_cg) acc(t) / pga. For a
 rocking frequency p [rad/s] the kernel's time is p t, so the record's samples fall every
 p * dt in kernel time (``kernel_series``).
 
-A vertical component (``ground.vertical``, a PEER ``UP`` file or a two-column file, read by
-the same ``read_record``; positive up) is taken on the horizontal's samples
-(``vertical_samples``): as it is where DT and NPTS agree, else its linear interpolant at the
-horizontal's sample times (0 after its last sample; what lies after the horizontal's last
-sample is dropped: the ground moves while the horizontal record does). It scales with the
-horizontal's factor (one record's components scale together, ``docs/vertical.md``);
-``vertical_ims`` gives its intensity measures.
+Each component of a record (the two horizontals, the up component, positive upwards) is
+read by the same ``read_record``; how the kernel takes them: ``physics.ground_motion``.
 """
 
 from __future__ import annotations
@@ -112,38 +107,6 @@ def kernel_series(record: GroundRecord, p: float) -> tuple[float, np.ndarray]:
     if not (math.isfinite(p) and p > 0.0):
         raise RecordError(f"p = {p!r}: must be a finite number > 0 [rad/s]")
     return p * record.dt, np.ascontiguousarray(record.acc / record.pga, dtype=np.float64)
-
-
-# Relative difference of two sample spacings below which a vertical's samples are the
-# horizontal's as they are (a two-column file's DT is a mean of printed times).
-SAME_DT = 1e-9
-
-
-def same_grid(vertical: GroundRecord, horizontal: GroundRecord) -> bool:
-    """Whether the vertical has the horizontal's samples (NPTS equal, DT within SAME_DT)."""
-    return (vertical.npts == horizontal.npts
-            and abs(vertical.dt - horizontal.dt) <= SAME_DT * horizontal.dt)
-
-
-def vertical_samples(vertical: GroundRecord, horizontal: GroundRecord) -> np.ndarray:
-    """The vertical acceleration [g] (positive up) at the horizontal's sample times,
-    float64[horizontal.npts]: the vertical's samples where the grids agree (``same_grid``),
-    else its linear interpolant there (``GroundRecord.acc_at``: 0 after its last sample).
-    Linear interpolation keeps what the piecewise-linear vertical does between the
-    horizontal's samples only where its own samples fall on them: a vertical sampled finer
-    than the horizontal loses the peaks between (a PEER record's components share DT and
-    NPTS, where nothing is lost)."""
-    if same_grid(vertical, horizontal):
-        return np.array(vertical.acc, dtype=np.float64)
-    return np.asarray(vertical.acc_at(horizontal.times()), dtype=np.float64)
-
-
-def vertical_ims(vertical: GroundRecord, horizontal: GroundRecord) -> dict[str, float]:
-    """The vertical component's intensity measures, as recorded (before any scaling: the
-    components share one factor, so the ratio is that of the scaled motion too):
-    PGA_v [g] = max |a_v| of the file's samples and VH_ratio = PGA_v / PGA of the
-    horizontal."""
-    return {"PGA_v": float(vertical.pga), "VH_ratio": float(vertical.pga / horizontal.pga)}
 
 
 # ---------------------------------------------------------------------------------------

@@ -36,11 +36,11 @@ M g b, means a crossing was stepped over; it is then located on the dense output
 the previous extremum and that one. theta_max is the largest |theta| over the maxima of
 s*theta (located, not sampled) and the phase ends.
 
-A vertical ground acceleration a_v (``Point.vertical``, ``Point.pulse_vertical``) is
-evaluated here from the point itself, not from the kernel's reader of its row
-(``_vertical``): the equations above are called with gravity g + a_v(t) in place of g,
-the uplift events compare Q with M (g + a_v) b, and the run stops, ``airborne``, at the
-first time g + a_v <= 0, located by its own root search (``_air_time``).
+A vertical ground acceleration a_v (the point's ``Excitation``: ``vertical``, the
+component as read, or ``harmonic``) is evaluated here from the point itself, not from the
+kernel's reader of its row (``_vertical``): the equations above are called with gravity
+g + a_v(t) in place of g, the uplift events compare Q with M (g + a_v) b, and the run
+stops, ``airborne``, at the first time g + a_v <= 0, located by its own root search (``_air_time``).
 
 Times are p*t (p = 1 rad/s), angles in rad, SI units with m = 1 kg (``rocksweep.physics.bodies``).
 """
@@ -58,8 +58,6 @@ from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel.contact import ground_reactions, impact_impulses, impulse_ratio
 from rocksweep.kernel.equations import (
     contact_rhs,
-    ground_acc,
-    ground_jerk,
     mechanical_energy,
     rest_margin,
     restitution,
@@ -71,6 +69,7 @@ from rocksweep.kernel.equations import (
     uplift_moment,
     uplift_moment_rate,
 )
+from rocksweep.kernel.ground import any_ground_acc, any_ground_jerk
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import G
 from rocksweep.physics.points import Point, point_row
@@ -120,12 +119,10 @@ class _Problem:
 
     # --- eq. (2) -----------------------------------------------------------------------
     def xg(self, t: float, on: bool) -> float:
-        # on as an int: the kernel's code for every shape (a bool would compile the
-        # sine/cosine-only code, ``equations.ground_acc``)
-        return ground_acc(t, int(on), self.prm)
+        return any_ground_acc(t, on, self.prm)
 
     def jerk(self, t: float, on: bool) -> float:
-        return ground_jerk(t, int(on), self.prm)
+        return any_ground_jerk(t, on, self.prm)
 
     def gravity(self, t: float, on: bool) -> float:
         """g + a_v(t) [m/s^2] (g without a vertical, or when the ground is still)."""
@@ -514,7 +511,7 @@ def _vertical(point: Point, prm: np.ndarray) -> tuple | None:
     """(a_v(t) [m/s^2], its rate, t_air) of the point's vertical in kernel time, from the
     point (not from the row's PAR_V_*), or None."""
     t_pulse = float(prm[L.PAR_TPULSE])
-    pv = point.pulse_vertical
+    pv = point.excitation.harmonic
     if pv is not None:
         amp, w, ph = pv.amplitude * G, float(pv.w_over_p), math.radians(pv.phase)
 
@@ -524,12 +521,13 @@ def _vertical(point: Point, prm: np.ndarray) -> tuple | None:
         def rate(t):
             return amp * w * math.cos(w * t + ph)
         return a_v, rate, _air_time(a_v, t_pulse, 2 * math.pi / w)
-    if point.vertical is None:
+    up = point.excitation.vertical
+    if up is None:
         return None
     rec = point.record
     # the documented rule: the vertical's linear interpolant at the horizontal's samples
     tk = point.p * rec.times()
-    vert = np.interp(rec.times(), point.vertical.times(), point.vertical.acc, right=0.0)
+    vert = np.interp(rec.times(), up.times(), up.acc, right=0.0)
     av = abs(point.A) / rec.pga * vert  # one factor for both components [m/s^2]
     dtk = point.p * rec.dt
 
@@ -566,7 +564,7 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
     numerics = numerics or Numerics()
     prm = point_row(point, numerics)
     flex = not point.body.rigid
-    pb = _Problem(prm, flex, bool(point.body.zeta > 0) and flex, rtol, atol,
+    pb = _Problem(prm, flex, flex and bool(point.body.zeta > 0), rtol, atol,
                   _vertical(point, prm))
     t_end = float(prm[L.PAR_TEND])
     max_events = int(prm[L.PAR_MAXEVENTS])
@@ -668,6 +666,7 @@ def result_row(r: dict) -> np.ndarray:
     out[L.OUT_E_MAX] = r["e_max"]
     out[L.OUT_CONTACTS] = r["contacts"]
     out[L.OUT_HIST_ROWS] = 0.0
+    out[L.OUT_REFINE_EVALS] = 0.0
     out[L.OUT_MU_REQ] = r.get("mu_required", np.nan)
     out[L.OUT_N_MIN] = r.get("normal_min_over_Mg", np.nan)
     out[L.OUT_IMPULSE_MAX] = r.get("impulse_ratio_max", np.nan)

@@ -21,7 +21,7 @@ flexible body, a pulse or a record) on a ground with Coulomb friction ``point.mu
   flat, at both corners (the old corner's normal velocity kept 0), a horizontal one at the
   ground; Routh's process on the free body's own velocity responses.
 
-It shares with the kernel the ground motion (eq. 2, ``equations.ground_acc``), the law's e
+It shares with the kernel the ground motion (eq. 2, ``ground.any_ground_acc``), the law's e
 and the settling rule (``equations.restitution``), the no-slip rest proof
 (``equations.rest_margin``) and the parameter row (``points.point_row``). Times are p*t.
 """
@@ -34,7 +34,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.kernel.equations import ground_acc, rest_margin, restitution
+from rocksweep.kernel.equations import rest_margin, restitution
+from rocksweep.kernel.ground import any_ground_acc
 from rocksweep.numerics import Numerics
 from rocksweep.physics.points import Point, point_row
 from rocksweep.vocab.phases import PHASES
@@ -438,7 +439,7 @@ class _Run:
         self.phases: list[str] = []
 
     def xg(self, t: float, on: bool) -> float:
-        return float(ground_acc(t, int(on), self.prm)) if on else 0.0
+        return float(any_ground_acc(t, bool(on), self.prm)) if on else 0.0
 
     def enter(self, s: int, sigma: int) -> tuple[int, int]:
         word = _word(s, sigma)

@@ -38,13 +38,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rocksweep.errors import SuiteError
+from rocksweep.physics import intensity
 from rocksweep.physics.bodies import G
+from rocksweep.physics.path import rotd50_peaks
 from rocksweep.physics.records import GroundRecord
 from rocksweep.vocab.ground import (
     ARIAS,
     AVGSA,
     CAV,
     D5_95,
+    H1,
     PGA,
     PGA_RATIO,
     PGV,
@@ -52,6 +55,8 @@ from rocksweep.vocab.ground import (
     PGV_RATIO,
     RATIO_OF,
     RECORD_IMS,
+    ROTD50,
+    ROTD50_IMS,
     SA_DAMPING,
     SCALE_IMS,
 )
@@ -64,9 +69,6 @@ AVGSA_RANGE = (0.2, 3.0)
 DRIFT_SHARE = 0.1
 #: warn when a record is scaled by more than this factor
 MAX_FACTOR = 5.0
-#: the horizontal components a suite's IM may be taken of (``ground.scale.component``)
-H1, ROTD50 = "H1", "RotD50"
-COMPONENTS = (H1, ROTD50)
 
 
 
@@ -219,7 +221,7 @@ class Suite:
                    p: np.ndarray) -> np.ndarray:
         """The scaled record's peak |xg''| / (g tan alpha_ref): the A_ratio the kernel's
         rows take (PGA_ratio stripes: the stripe value itself)."""
-        if self.im == "PGA_ratio" and self.component == H1:
+        if self.im == PGA_RATIO and self.component == H1:
             x = np.asarray(self.levels, np.float64)[np.asarray(s, np.int64)]
             return np.broadcast_to(x, np.broadcast_shapes(
                 x.shape, np.shape(alpha_ref), np.shape(p))).copy()
@@ -243,8 +245,6 @@ def make_suite(records: list[GroundRecord], names: list[str], im: str | None,
     AvgSa (default ``AVGSA_RANGE`` times ``period``, or times 1 s without one). A record
     whose IM to scale is not a finite number > 0 (PGV 0, Sa 0) is a ``SuiteError`` naming
     its file."""
-    from rocksweep.physics import intensity  # scipy.signal: loaded by suite scenes only
-
     n = len(records)
     pga = np.empty(n)
     pgv = np.empty(n)
@@ -297,9 +297,8 @@ def rotd50_im(h1: GroundRecord, h2: GroundRecord, im: str | None, period: float)
     (and PGV_ratio's) [m/s] of the velocities at the samples, or Sa(period) [g] at 5%
     damping of the oscillator's responses (its free vibration one period past the record
     included): the median over the angles 0..179 deg of the peak of the projected series."""
-    from rocksweep.physics import intensity
-    from rocksweep.physics.path import rotd50_peaks
-
+    if im not in ROTD50_IMS:
+        raise SuiteError(f"RotD50 of {im}: defined for {', '.join(ROTD50_IMS)} only")
     n = max(h1.npts, h2.npts)
     a1, a2 = (np.pad(r.acc, (0, n - r.npts)) for r in (h1, h2))
     if im in (PGA, PGA_RATIO):

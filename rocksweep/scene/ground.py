@@ -19,15 +19,9 @@ from rocksweep.errors import RecordError, SceneError, SuiteError
 from rocksweep.inputs import decode_text, read_input
 from rocksweep.outputs import input_problem, is_input, shown
 from rocksweep.physics.records import GroundRecord, read_record
-from rocksweep.physics.suite import (
-    AVGSA_RANGE,
-    COMPONENTS,
-    ROTD50,
-    Suite,
-    make_suite,
-)
+from rocksweep.physics.suite import AVGSA_RANGE, Suite, make_suite
 from rocksweep.scene.peer import peer_suite
-from rocksweep.scene.sections import axis_spec, axis_values
+from rocksweep.scene.sections import axis_spec, axis_values, choice
 from rocksweep.schema import (
     KEYS,
     as_float,
@@ -35,7 +29,16 @@ from rocksweep.schema import (
     fmt,
     is_number,
 )
-from rocksweep.vocab.ground import DEFAULT_PERIODS, RECORD_IMS, SCALE_IMS
+from rocksweep.vocab.ground import (
+    DEFAULT_PERIODS,
+    H1,
+    MISSING_ERROR,
+    MISSING_SKIP,
+    RECORD_IMS,
+    ROTD50,
+    ROTD50_IMS,
+    SCALE_IMS,
+)
 
 
 def ground_record(ground: dict, base: Path | None, key: str = "record") -> GroundRecord:
@@ -136,7 +139,8 @@ def _record_paths(spec: Any, base: Path | None) -> tuple[list[Path], list[Path],
         path = _where(e, base)
         if has_magic(e) and not os.path.lexists(path):
             pattern = str(path)
-            found = sorted(Path(p) for p in glob(pattern) if Path(p).is_file())
+            # a folder it matches is no record; a FIFO or a dangling link is named below
+            found = sorted(Path(p) for p in glob(pattern) if not Path(p).is_dir())
             if not found:
                 raise SceneError(f"{key}: {e!r} matches no file (looked for {pattern})")
             out.extend(found)
@@ -283,15 +287,11 @@ def ground_suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...
             raise SceneError(f"ground.{k}: not with ground.records (use {other})")
     im, form, spec, period, factor = _scale(ground)
     scale = ground.get("scale")
-    component = scale.get("component", "H1") if isinstance(scale, dict) else "H1"
-    if component not in COMPONENTS:
-        raise SceneError(f"ground.scale.component = {fmt(component)}: "
-                         f"{KEYS['ground.scale.component'].allowed}")
-    missing = ground.get("missing", "error")
-    if missing not in ("error", "skip"):
-        raise SceneError(f"ground.missing = {fmt(missing)}: {KEYS['ground.missing'].allowed}")
+    component = choice("ground.scale.component",
+                       scale.get("component") if isinstance(scale, dict) else None)
+    missing = choice("ground.missing", ground.get("missing"))
     folder = _peer_folder(ground["records"], base)
-    if folder is None and missing != "error":
+    if folder is None and missing != MISSING_ERROR:
         raise SceneError("ground.missing: applies to a folder of PEER downloads "
                          "(ground.records: FOLDER)")
     acts = ground.get("vertical")
@@ -303,7 +303,7 @@ def ground_suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...
     vertical: tuple = ()
     read: tuple[str, ...] = ()
     if folder is not None:  # read again on a rebuild: the pairs are the folder's
-        records, h2, vertical, names, read = peer_suite(folder, missing == "skip")
+        records, h2, vertical, names, read = peer_suite(folder, missing == MISSING_SKIP)
         if acts and not vertical:
             raise SceneError(f"ground.vertical = true: {shown(folder)} has no vertical (UP) "
                              "files; give them, or leave ground.vertical out")
@@ -322,11 +322,16 @@ def ground_suite(ground: dict, base: Path | None, given: tuple[GroundRecord, ...
         names = [p.name for p in paths]
         read = tuple(str(p) for p in (*paths, *listings))
     if component == ROTD50 and not h2:
-        raise SceneError("ground.scale.component = 'RotD50': needs both horizontals of "
+        raise SceneError(f"ground.scale.component = {fmt(ROTD50)}: needs both horizontals of "
                          "every record (ground.records: a folder of PEER downloads)")
     if component == ROTD50 and im is None:
-        raise SceneError("ground.scale.component = 'RotD50': scales stripes (ground.scale: "
-                         "{im: ..., values: ...})")
+        raise SceneError(f"ground.scale.component = {fmt(ROTD50)}: scales stripes "
+                         "(ground.scale: {im: ..., values: ...})")
+    if component == ROTD50 and im not in ROTD50_IMS:
+        raise SceneError(f"ground.scale.component = {fmt(ROTD50)}: with ground.scale.im = "
+                         f"{im}; RotD50 (the median over orientations of a peak, Boore 2010) "
+                         f"is taken of {', '.join(ROTD50_IMS)} stripes; use component "
+                         f"{fmt(H1)} for {im}")
     values = axis_values("ground.scale.values", form, spec).tolist() if im else []
     try:
         suite = make_suite(records, names, im, values, period, factor,

@@ -10,7 +10,11 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Union
 
+import yaml
+
 from rocksweep.errors import ApiError
+from rocksweep.scene.model import Scene
+from rocksweep.scene.parse import load_scene, parse_scene
 
 if TYPE_CHECKING:
     from rocksweep.scene.model import Scene
@@ -23,8 +27,6 @@ Overrides = Union[Sequence[str], Mapping[str, Any]]  # noqa: UP007
 
 def _yaml_value(v: Any) -> str:
     """A Python value as the YAML text of a ``KEY=VALUE`` override (inf as .inf)."""
-    import yaml
-
     if hasattr(v, "tolist"):  # numpy scalars and arrays
         v = v.tolist()
     if isinstance(v, tuple):
@@ -68,17 +70,12 @@ def load(scene: SceneLike | Scene, overrides: Overrides | None = ()) -> tuple[Sc
     mapping (the YAML's structure); or a ``Scene`` (then without overrides). Errors are
     one-line SceneErrors.
     """
-    from rocksweep.scene.model import Scene
-    from rocksweep.scene.parse import load_scene, parse_scene
-
     ov = override_strings(overrides)
     if isinstance(scene, Scene):
         if ov:
             raise ApiError("overrides apply to a scene path, text or dict, not to a Scene")
         return scene, None
     if isinstance(scene, Mapping):
-        import yaml
-
         text = yaml.safe_dump(_plain_tree(scene), sort_keys=False, allow_unicode=False)
         return parse_scene(text, "scene", ov), None
     if isinstance(scene, str) and ("\n" in scene or (":" in scene and not _is_file(scene))):

@@ -1,5 +1,5 @@
 """The scene model: ``Scene`` (a validated study: its axes in the grid's order, numerics,
-outputs, record or suite) and ``Axis``, and ``SceneError``, the one error of scenes."""
+outputs, its ground motion and the excitations it makes of it) and ``Axis``."""
 
 from __future__ import annotations
 
@@ -11,22 +11,31 @@ import numpy as np
 
 from rocksweep import fields
 from rocksweep.errors import SceneError, set_key
-from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody, Body, FlexibleBody, G
+from rocksweep.physics.ground_motion import (
+    Excitation,
+    Excitations,
+    Harmonic,
+    ground_code,
+    pulse,
+    recorded,
+    shared_ground,
+)
 from rocksweep.physics.path import GroundPath
 from rocksweep.physics.points import Point
-from rocksweep.physics.records import GroundRecord, vertical_samples
+from rocksweep.physics.records import GroundRecord
 from rocksweep.physics.suite import Suite
-from rocksweep.physics.vertical import VerticalHarmonic
-from rocksweep.schema import FRICTION_KEYS, KEYS
+from rocksweep.schema import FRICTION_KEYS, KEYS, VERTICAL_KEYS
 from rocksweep.vocab.axes import INITIAL
-from rocksweep.vocab.ground import FREE, PAPER_SHAPES, RECORD, pulse_duration
+from rocksweep.vocab.ground import FREE, RECORD, pulse_duration
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
 
 #: the one-mode floor's keys, the names of their axes (``floor.period`` is a dimension of
 #: its own: a suite's ``period`` is the Sa periods')
 FLOOR_AXES = ("floor.period", "floor.damping", "floor.participation")
+# a pulse's vertical harmonic's axes (``pulse.vertical``: amplitude, w_over_p, phase)
+_HARMONIC = tuple(f"vertical.{k}" for k in VERTICAL_KEYS)
 
 
 @dataclass(frozen=True)
@@ -73,6 +82,9 @@ class Scene:
     # the excitation path (``ground.h2``/``ground.angle``, ``floor:``): what the body
     # feels is computed from the ground motion (``physics.path``); None without those keys
     path: GroundPath | None = field(default=None, repr=False)
+    # the excitations made of the ground motion (``excitation``), each once; shared by a
+    # ``dataclasses.replace`` copy, which keeps the ground motion (never replaced)
+    motions: Excitations = field(default_factory=Excitations, repr=False, compare=False)
 
     @property
     def floor(self) -> bool:
@@ -111,9 +123,16 @@ class Scene:
         return {} if self.physical is None else {"p": float(self.physical["p"])}
 
     def floor_summary(self, point: Point) -> dict[str, float]:
-        """A run's peak floor acceleration {"floor_pfa": [g]} (a scene with a floor: the
-        peak of the motion that drove it, as a sweep stores it); {} without a floor."""
-        return {fields.FLOOR_PFA: point.A / G} if self.floor else {}
+        """A run's peak floor acceleration {"floor_pfa": [g]} (a scene with a floor:
+        ``floor_pfa`` of the motion that drove it, as a sweep stores it); {} without a
+        floor."""
+        return {fields.FLOOR_PFA: self.floor_pfa(point.A)} if self.floor else {}
+
+    @staticmethod
+    def floor_pfa(A: np.ndarray | float) -> np.ndarray | float:
+        """The peak floor acceleration a run stores [g]: the peak A [m/s^2] of the motion
+        that drove it (``points.peak_acc``, the rows' PAR_AMP) over g."""
+        return A / G
 
     def variables(self) -> dict[str, tuple[str, float, str]]:
         """The per-point variables a sweep of this scene stores, name -> (dtype, fill value
@@ -133,16 +152,12 @@ class Scene:
 
     @property
     def ground(self) -> int:
-        """The kernel variants' ground code the scene needs (``layout.GROUND_*``, false
-        for the pulse variants): GROUND_VERTICAL with a vertical ground acceleration,
-        GROUND_ANY for a Ricker or MP pulse or a record; the paper's sine and cosine (n
-        cycles too) run the pulse variants."""
-        if self.has_vertical:
-            return L.GROUND_VERTICAL
-        if self.recorded or self.floor or any(
-                sh not in (*PAPER_SHAPES, FREE) for sh in self.axis("shape").values):
-            return L.GROUND_ANY
-        return L.GROUND_PULSE
+        """The kernel variants' ground code a sweep of the scene runs (``layout.GROUND_*``):
+        the most general of its excitations' (``ground_motion.shared_ground``; a path's
+        motions are samples)."""
+        shapes = ((RECORD,) if self.recorded or self.path is not None
+                  else self.axis("shape").values)
+        return shared_ground(ground_code(sh, self.has_vertical) for sh in shapes)
 
     @property
     def has_vertical(self) -> bool:
@@ -150,27 +165,17 @@ class Scene:
         ``pulse.vertical``)."""
         return (self.vertical is not None or (self.suite is not None
                                               and self.suite.vertical_acts)
-                or any(a.name == "vertical.amplitude" for a in self.axes))
+                or any(a.name == _HARMONIC[0] for a in self.axes))
 
-    def vertical_samples(self):
-        """The vertical record [g] on the horizontal record's samples
-        (``records.vertical_samples``; float64[npts]), None without one."""
-        if self.vertical is None:
-            return None
-        return vertical_samples(self.vertical, self.record)
-
-    def record_vertical(self, r: int = 0) -> GroundRecord | None:
-        """The vertical component acting with record r: ``ground.vertical``, or a folder
-        suite's record r's UP file (``Suite.acting_vertical``); None without one."""
-        if self.suite is not None:
-            return self.suite.acting_vertical(r)
-        return self.vertical
-
-    def path_vertical(self, motion: GroundRecord, r: int = 0):
-        """Record r's vertical [g] on the samples of a motion of the excitation path
-        (``physics.path``: it reaches the floor unfiltered), None without one."""
-        vertical = self.record_vertical(r)
-        return None if vertical is None else vertical_samples(vertical, motion)
+    def ground_files(self) -> dict[str, GroundRecord]:
+        """The files of the scene's one ground record by role: ``record`` and, when
+        given, its vertical component (``vertical``, ``ground.vertical``); what a result
+        file keeps and states under those names (``store.format``, ``store.identity``);
+        {} without one record (a suite keeps its own)."""
+        if self.record is None:
+            return {}
+        return {"record": self.record,
+                **({"vertical": self.vertical} if self.vertical is not None else {})}
 
     def option(self, name: str) -> Any:
         """A pulse option's value (cycles, gamma, nu [deg]): the scene's or the default."""
@@ -218,47 +223,93 @@ class Scene:
             return BlockBody(**values)
         return FlexibleBody(**values)
 
+    @property
+    def excitation_axes(self) -> tuple[str, ...]:
+        """The axes a point's excitation depends on (``excitation``): a suite's record,
+        the angle and the one-mode floor's keys of an excitation path, a pulse's shape
+        (and its w_over_p when a building samples it) and vertical harmonic; none for one
+        record. The other axes scale it (A_ratio, p, a pulse's w_over_p) or are the
+        body's."""
+        names = [a.name for a in self.axes]
+        if self.path is not None:
+            return tuple(k for k in ("record", "angle", *FLOOR_AXES) if k in names) + (
+                () if self.recorded else ("shape", "w_over_p"))
+        if self.recorded:
+            return ("record",) if self.suite is not None else ()
+        return ("shape", *(k for k in _HARMONIC if k in names))
+
+    def excitation(self, values: dict[str, Any]) -> Excitation:
+        """The excitation of the points with these axis values (``excitation_axes`` read;
+        ``physics.ground_motion``): made once, when first asked for, and kept
+        (``motions``)."""
+        key = tuple(str(values[k]) if k in ("shape", "record") else float(values[k])
+                    for k in self.excitation_axes)
+        return self.motions.get(key, lambda: self._make_excitation(values))
+
+    def _make_excitation(self, values: dict[str, Any]) -> Excitation:
+        if self.path is not None:
+            motion, ground_pga, r = self._path_motion(values)
+            return recorded(motion, self.suite.acting_vertical(r) if self.suite is not None
+                            else self.vertical, ground_pga)
+        if self.suite is not None:
+            r = self.suite.names.index(str(values["record"]))
+            return recorded(self.suite.records[r], self.suite.acting_vertical(r))
+        if self.record is not None:
+            return recorded(self.record, self.vertical)
+        harmonic = (Harmonic(*(float(values[k]) for k in _HARMONIC))
+                    if _HARMONIC[0] in values else None)
+        return pulse(str(values["shape"]), int(self.option("cycles")),
+                     float(self.option("gamma")), float(self.option("nu")), harmonic)
+
+    def drive_ratio(self, a_ratio: np.ndarray | None, rec: np.ndarray | None,
+                    stripe: np.ndarray | None, alpha_ref: np.ndarray, p: np.ndarray,
+                    excitations: tuple[Excitation, ...], which: np.ndarray) -> np.ndarray:
+        """The kernel's A_ratio of n points (``Point.A_ratio``: the peak of what the body
+        feels over g tan alpha_ref), float64[n]: the A_ratio axis's values (a_ratio), or a
+        suite's record rec (int64[n]) at stripe (int64[n], None for a cloud) scaled for
+        alpha_ref [rad] and p [rad/s] (``Suite.peak_ratio``); through an excitation path,
+        the ground's amplitude times the gain of point i's motion ``excitations[which[i]]``
+        (its peak over the ground's, ``Excitation.ground_pga``)."""
+        su = self.suite
+        if self.path is None:
+            return a_ratio if su is None else su.peak_ratio(rec, stripe, alpha_ref, p)
+        motion_pga = np.array([ex.record.pga for ex in excitations])[which]
+        if su is not None:
+            return su.factors(rec, stripe, alpha_ref, p) * motion_pga / np.tan(alpha_ref)
+        return a_ratio * motion_pga / np.array([ex.ground_pga for ex in excitations])[which]
+
     def point(self, values: dict[str, Any]) -> Point:
         """The point with the given value of every axis (by name)."""
         body = self.make_body(**{a.name: values[a.name] for a in self.body_axes()})
-        if self.path is not None:
-            return self._path_point(body, values)
-        if self.suite is not None:
+        ex = self.excitation(values)
+        if not self.recorded and self.path is None:
+            rate, a_ratio = float(values["w_over_p"]), float(values["A_ratio"])
+        else:
             su = self.suite
-            r = su.names.index(str(values["record"]))
-            s = (np.array([self.axis(su.im).values.index(float(values[su.im]))])
-                 if su.im else None)
-            p = float(values["p"])
-            a_ratio = float(su.peak_ratio(np.array([r]), s, np.array([body.alpha_ref]),
-                                          np.array([p]))[0])
-            return Point(body, float(values["lam"]), RECORD, math.nan, a_ratio,
-                         record=su.records[r], p=p, **self._law(values),
-                         initial=self.initial_state(values), vertical=su.acting_vertical(r))
-        if self.record is not None:
-            return Point(body, float(values["lam"]), RECORD, math.nan,
-                         float(values["A_ratio"]), record=self.record, p=float(values["p"]),
-                         **self._law(values), initial=self.initial_state(values),
-                         vertical=self.vertical)
-        return Point(body, float(values["lam"]), str(values["shape"]),
-                     float(values["w_over_p"]), float(values["A_ratio"]),
-                     int(values.get("cycles", self.option("cycles"))),
-                     float(values.get("gamma", self.option("gamma"))),
-                     float(values.get("nu", self.option("nu"))),
-                     mu=float(values.get("mu", math.nan)), **self._law(values),
-                     initial=self.initial_state(values),
-                     pulse_vertical=self._pulse_vertical(values))
+            rate = float(values["p"]) if self.recorded else self.path.p
+            rec = None if su is None else np.array([su.names.index(str(values["record"]))])
+            stripe = (np.array([self.axis(su.im).values.index(float(values[su.im]))])
+                      if su is not None and su.im else None)
+            a_ratio = float(self.drive_ratio(
+                None if su is not None else np.array([float(values["A_ratio"])]), rec,
+                stripe, np.array([body.alpha_ref]), np.array([rate]), (ex,),
+                np.zeros(1, np.int64))[0])
+        kw = {"mu": float(values.get("mu", math.nan)), **self._law(values),
+              "initial": self.initial_state(values)}
+        if ex.record is None:
+            return Point(body, float(values["lam"]), ex, rate, a_ratio, **kw)
+        return Point(body, float(values["lam"]), ex, math.nan, a_ratio, p=rate, **kw)
 
-    def _pulse_vertical(self, values: dict[str, Any]) -> VerticalHarmonic | None:
-        """A point's vertical harmonic (``pulse.vertical``) from axis values, or None."""
-        if "vertical.amplitude" not in values:
-            return None
-        return VerticalHarmonic(float(values["vertical.amplitude"]),
-                                float(values["vertical.w_over_p"]),
-                                float(values["vertical.phase"]))
-
-    def path_motion(self, values: dict[str, Any]):
+    def path_motion(self, values: dict[str, Any]) -> tuple[GroundRecord, float, int]:
         """(the motion the body feels per unit of ground motion, the ground's peak that
-        A_ratio scales, record index) at one point (``physics.path``)."""
+        A_ratio scales, record index) at one point (``physics.path``; the excitation's,
+        made once)."""
+        ex = self.excitation(values)
+        r = 0 if self.suite is None else self.suite.names.index(str(values["record"]))
+        return ex.record, ex.ground_pga, r
+
+    def _path_motion(self, values: dict[str, Any]) -> tuple[GroundRecord, float, int]:
+        """``path_motion`` computed (``GroundPath.motion``)."""
         pa = self.path
         angle = float(values.get("angle", 0.0))
         floor = (tuple(float(values[k]) for k in FLOOR_AXES)
@@ -274,25 +325,6 @@ class Scene:
         shape = PulseShape(str(values["shape"]), int(self.option("cycles")),
                            float(self.option("gamma")), float(self.option("nu")))
         return pa.motion(None, 0, 0.0, floor, (shape, float(values["w_over_p"]))), 1.0, 0
-
-    def _path_point(self, body: Body, values: dict[str, Any]) -> Point:
-        """A point of a scene with an excitation path: driven by its computed motion, the
-        kernel's A_ratio the ground's scaled by the motion's gain."""
-        motion, ground_peak, r = self.path_motion(values)
-        if self.suite is not None:
-            su = self.suite
-            s = (np.array([self.axis(su.im).values.index(float(values[su.im]))])
-                 if su.im else None)
-            p = float(values["p"])
-            fac = float(su.factors(np.array([r]), s, np.array([body.alpha_ref]),
-                                   np.array([p]))[0])
-            a_ratio = fac * motion.pga / math.tan(body.alpha_ref)
-        else:
-            a_ratio = float(values["A_ratio"]) * motion.pga / ground_peak
-            p = float(values["p"]) if self.recorded else self.path.p
-        return Point(body, float(values["lam"]), RECORD, math.nan, a_ratio, record=motion,
-                     p=p, **self._law(values), initial=self.initial_state(values),
-                     vertical=self.record_vertical(r))
 
     @property
     def free(self) -> bool:

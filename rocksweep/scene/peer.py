@@ -10,6 +10,12 @@ horizontals end in their azimuth or direction (``RSN1158_KOCAELI_DZC180.AT2``,
 ``UP`` or ``DWN`` (``RSN1158_KOCAELI_DZC-UP.AT2``; ``-V``/``V`` in a few older files). The
 files of one record share the ``RSN<n>`` prefix. Of its two horizontals H1 is the one whose
 file name sorts first (000 before 090, 180 before 270), H2 the other.
+
+Only what is unambiguous is paired: a record with more files than its components (a
+browser's second download ``..._STA000 (1).AT2`` beside ``..._STA000.AT2``), an ``.AT2``
+entry that is not a regular file (a FIFO, a dangling or looping link) is named in a
+one-line SceneError (or left out with a warning under ``ground.missing: skip``), and the
+``.AT2`` files not named as PEER names a component are left out with a warning naming them.
 """
 
 from __future__ import annotations
@@ -23,22 +29,42 @@ from rocksweep.outputs import shown
 
 _RSN = re.compile(r"^(RSN\d+)_", re.IGNORECASE)
 _VERTICAL = re.compile(r"(?:[-_]?(?:UP|DWN)|[-_]V)$", re.IGNORECASE)
+#: a browser's second download of a file: ``name (1).AT2``, ``name(2).AT2``
+_DUPLICATE = re.compile(r"\s*\(\d+\)$")
 
 
 @dataclass(frozen=True)
 class Components:
-    """One record's files: its RSN label, H1, H2 (None: missing) and the vertical (None:
-    none in the folder)."""
+    """One record's files: its RSN label, H1, H2 (None: missing), the vertical (None:
+    none in the folder) and ``extra``: the files beyond two horizontals and one vertical
+    (a browser's second download, ``..._STA000 (1).AT2``), which make the pairing
+    ambiguous."""
 
     rsn: str
     h1: Path | None
     h2: Path | None
     up: Path | None
+    extra: tuple[Path, ...] = ()
 
     def missing(self, vertical: bool) -> list[str]:
         """The components this record lacks (``vertical``: the folder's records have one)."""
         out = [n for n, p in (("H1", self.h1), ("H2", self.h2)) if p is None]
         return out + (["UP"] if vertical and self.up is None else [])
+
+    def files(self) -> list[Path]:
+        return [p for p in (self.h1, self.h2, self.up, *self.extra) if p is not None]
+
+    def ambiguity(self) -> str | None:
+        """Why this record's files cannot be paired (None: they can): more than two
+        horizontal or more than one vertical files, named, a browser's duplicate said."""
+        if not self.extra:
+            return None
+        names = ", ".join(p.name for p in sorted(self.files(), key=lambda p: p.name))
+        dup = [p.name for p in self.files() if _DUPLICATE.search(p.stem)]
+        why = (f"; {', '.join(dup)} looks like a second download of the same file"
+               if dup else "")
+        return (f"{self.rsn} has more than two horizontal or one vertical files ({names}): "
+                f"which are H1, H2 and UP is ambiguous{why}")
 
 
 def is_vertical(path: Path) -> bool:
@@ -48,9 +74,10 @@ def is_vertical(path: Path) -> bool:
 
 def peer_components(files: list[Path]) -> tuple[list[Components], list[Path]]:
     """The records of a folder's ``.AT2`` files, grouped by their ``RSN<n>`` prefix (in
-    RSN order), and the files that are not named as PEER names them. A group of more than
-    two horizontals or verticals keeps its first two / first one by name; the rest are
-    returned as unpaired."""
+    RSN order), and the files that are not named as PEER names them. Of a group's
+    horizontals H1 sorts first and H2 second, its vertical is the one vertical file; the
+    files beyond those are the record's ``extra`` (``Components.ambiguity``: a record so
+    named is never paired)."""
     groups: dict[str, list[Path]] = {}
     odd: list[Path] = []
     for f in sorted(files, key=lambda p: p.name):
@@ -64,17 +91,50 @@ def peer_components(files: list[Path]) -> tuple[list[Components], list[Path]]:
         fs = groups[rsn]
         vert = [f for f in fs if is_vertical(f)]
         hor = [f for f in fs if not is_vertical(f)]
-        odd += hor[2:] + vert[1:]
         out.append(Components(rsn, hor[0] if hor else None, hor[1] if len(hor) > 1 else None,
-                              vert[0] if vert else None))
+                              vert[0] if vert else None, tuple(hor[2:] + vert[1:])))
     return out, odd
+
+
+def folder_files(folder: Path, skip: bool) -> list[Path]:
+    """The ``.AT2`` entries of a folder that are regular files (links followed). An entry
+    that is not (a FIFO, a device, a dangling or looping link, a directory) is named in a
+    one-line SceneError, or left out with a RecordWarning (``skip``): never dropped
+    without a word."""
+    import warnings
+
+    from rocksweep.outputs import input_problem
+    from rocksweep.physics.suite import RecordWarning
+
+    key = "ground.records"
+    try:
+        entries = sorted(folder.iterdir(), key=lambda p: p.name)
+    except OSError as err:
+        raise SceneError(f"{key}: {shown(folder)}: cannot list the folder "
+                         f"({err.strerror or type(err).__name__})") from None
+    out = []
+    for p in entries:
+        if p.suffix.lower() != ".at2":
+            continue
+        problem = input_problem(p)
+        if problem is None:
+            out.append(p)
+            continue
+        what = f"{shown(folder)}: {p.name}: {problem}"
+        if not skip:
+            raise SceneError(f"{key}: {what}; remove it from the folder (or ground.missing: "
+                             "skip)")
+        warnings.warn(RecordWarning(f"{key}: {what}: left out"), stacklevel=3)
+    return out
 
 
 def peer_suite(folder: Path, skip: bool) -> tuple:
     """The records of a folder of PEER downloads (``peer_components``): (H1s, H2s, verticals
     (empty: none in the folder), names (H1's file names), files read). A record without
-    one of its components is a one-line SceneError, or left out with a RecordWarning
-    (``skip``)."""
+    one of its components, or with more files than its components (ambiguous), or an
+    entry that is not a regular file (``folder_files``) is a one-line SceneError naming
+    the files, or left out with a RecordWarning (``skip``); the ``.AT2`` files not named
+    as PEER names a component are left out with a RecordWarning naming them."""
     import warnings
 
     from rocksweep.errors import RecordError
@@ -83,25 +143,36 @@ def peer_suite(folder: Path, skip: bool) -> tuple:
     from rocksweep.physics.suite import RecordWarning
 
     key = "ground.records"
-    files = [p for p in folder.iterdir() if p.suffix.lower() == ".at2" and p.is_file()]
-    comps, _ = peer_components(files)
+    comps, odd = peer_components(folder_files(folder, skip))
     if not comps:
         raise SceneError(f"{key}: {shown(folder)}: no PEER record files in the folder "
                          "(RSN<n>_<EVENT>_<STATION><COMPONENT>.AT2)")
+    if odd:
+        shown_odd = ", ".join(p.name for p in odd[:5]) + (
+            f" and {len(odd) - 5} more" if len(odd) > 5 else "")
+        warnings.warn(RecordWarning(
+            f"{key}: {shown(folder)}: {len(odd)} .AT2 file{'s' if len(odd) > 1 else ''} not "
+            f"named RSN<n>_<EVENT>_<STATION><COMPONENT>.AT2 left out: {shown_odd}"),
+            stacklevel=2)
     with_up = any(c.up is not None for c in comps)
     kept = []
     for c in comps:
+        why = c.ambiguity()
         miss = c.missing(with_up)
-        if not miss:
+        if why is None and not miss:
             kept.append(c)
             continue
-        found = ", ".join(p.name for p in (c.h1, c.h2, c.up) if p is not None)
-        what = f"{c.rsn} has no {' and no '.join(miss)} file (found {found})"
-        need = "H1, H2 and UP" if with_up else "H1 and H2"
+        if why is None:
+            found = ", ".join(p.name for p in c.files())
+            why = f"{c.rsn} has no {' and no '.join(miss)} file (found {found})"
+            need = "H1, H2 and UP" if with_up else "H1 and H2"
+            how = f"every record needs {need}"
+        else:
+            how = "remove the extra files"
         if not skip:
-            raise SceneError(f"{key}: {shown(folder)}: {what}; every record needs {need} "
-                             "(or ground.missing: skip)")
-        warnings.warn(RecordWarning(f"{key}: {what}: skipped"), stacklevel=2)
+            raise SceneError(f"{key}: {shown(folder)}: {why}; {how} (or ground.missing: "
+                             "skip)")
+        warnings.warn(RecordWarning(f"{key}: {why}: skipped"), stacklevel=2)
     if not kept:
         raise SceneError(f"{key}: {shown(folder)}: no record has all its components")
     h1s, h2s, ups = [], [], []

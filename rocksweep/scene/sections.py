@@ -153,6 +153,18 @@ def words(key: str, spec: Any) -> tuple[tuple[str, ...], bool]:
     return (spec,), False
 
 
+def choice(key: str, value: Any) -> str:
+    """The word of a ``choice`` key (one word, not swept): the schema's default when not
+    given (None), else one of its choices; a one-line SceneError otherwise. The choices and
+    the default are the schema's alone (``KEYS[key]``)."""
+    spec = KEYS[key]
+    if value is None:
+        return spec.default
+    if not (isinstance(value, str) and value in spec.choices):
+        raise SceneError(f"{key} = {fmt(value)}: {spec.allowed}")
+    return value
+
+
 def shape_words(spec: Any) -> tuple[tuple[str, ...], bool]:
     return words("pulse.shape", spec)
 

@@ -11,7 +11,6 @@ import numpy as np
 
 from rocksweep.errors import SceneError
 from rocksweep.outputs import shown
-from rocksweep.physics.records import vertical_samples
 from rocksweep.scene.admission import check_vertical_cost
 from rocksweep.scene.model import Scene
 from rocksweep.schema import KEYS, VERTICAL_KEYS, fmt
@@ -57,7 +56,7 @@ def check_vertical_start(scene: Scene) -> None:
     if su is not None and su.vertical_acts:
         _check_suite_start(scene)
     if scene.vertical is not None:
-        first = float(scene.vertical_samples()[0]) / scene.record.pga  # per unit of A
+        first = float(scene.vertical.acc[0]) / scene.record.pga  # a_v(0) per unit of A
         a_ratio = float(np.max(np.abs(scene.axis("A_ratio").values)))
         alpha = float(np.max(scene.axis(alpha_symbol(scene.kind)).values))
         a0 = a_ratio * math.tan(alpha) * first
@@ -69,15 +68,15 @@ def check_vertical_start(scene: Scene) -> None:
 
 
 def _check_suite_start(scene: Scene) -> None:
-    """A folder suite's verticals at t = 0: each record's first vertical sample on its
-    horizontal's samples times the largest factor the grid gives that record
+    """A folder suite's verticals at t = 0: each record's first vertical sample (a_v at t
+    = 0, on any samples) times the largest factor the grid gives that record
     (``Suite.factors`` over stripes, alpha_ref and p) must be > -1 g."""
     su = scene.suite
     alpha = np.asarray(scene.axis(alpha_symbol(scene.kind)).values, float)
     p = np.asarray(scene.axis("p").values, float)
     stripes = np.arange(max(len(su.levels), 1))
-    for r, (v, h) in enumerate(zip(su.vertical, su.records, strict=True)):
-        first = float(vertical_samples(v, h)[0])
+    for r, v in enumerate(su.vertical):
+        first = float(v.acc[0]) if v is not None else 0.0
         if first >= 0.0:
             continue
         s, a, pp = (x.ravel() for x in np.meshgrid(stripes, alpha, p, indexing="ij"))

@@ -6,6 +6,12 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from rocksweep import fields
+from rocksweep.errors import StoreError
+from rocksweep.outputs import shown
+from rocksweep.store.reader import READER_LOCKING, opened_here, read_result
+from rocksweep.vocab.outcomes import OUTCOME_WORDS, STATUS_WORDS
+
 if TYPE_CHECKING:
     import xarray as xr
 
@@ -13,8 +19,6 @@ def open_result(path: str | Path) -> xr.Dataset:
     """A sweep result file as the loaded Dataset (``rocksweep.open``): a file that is not
     a rocksweep result, or is damaged, is a one-line error (``reader.read_result``) before
     ``result_dataset`` reads it."""
-    from rocksweep.store.reader import read_result
-
     path = Path(path)
     read_result(path, ["outcome"])
     return result_dataset(path)
@@ -24,10 +28,8 @@ def result_dataset(source: Path | Any) -> xr.Dataset:
     """A result file (a path, or a file object holding the bytes of one in memory) as the
     loaded Dataset that ``open`` and ``run`` return, with the accessor registered; a
     damaged variable attribute is a one-line StoreError."""
+    # xarray (0.4-1.5 s): rocksweep info and sweep read results without it
     import xarray as xr
-
-    from rocksweep import fields
-    from rocksweep.vocab.outcomes import OUTCOME_WORDS, STATUS_WORDS
 
     kwds = {"driver_kwds": {"locking": False}} if isinstance(source, Path) else {}
     try:
@@ -35,8 +37,6 @@ def result_dataset(source: Path | Any) -> xr.Dataset:
             with xr.open_dataset(source, engine="h5netcdf", **kwds) as ds:
                 ds = ds.load()
         except OSError as err:  # open here through another handle: take its lock flags
-            from rocksweep.store.reader import READER_LOCKING, opened_here
-
             if not (kwds and opened_here(err)):
                 raise
             for locking in READER_LOCKING:
@@ -53,9 +53,6 @@ def result_dataset(source: Path | Any) -> xr.Dataset:
             IndexError, RuntimeError, MemoryError) as err:
         # xarray's CF decoding of a damaged attribute; HDF5's of damaged dimension scales
         # (H5DSget_num_scales: RuntimeError), a damaged shape's allocation
-        from rocksweep.errors import StoreError
-        from rocksweep.outputs import shown
-
         where = shown(source) if isinstance(source, Path) else "result in memory"
         why = (str(err).strip().splitlines() or [type(err).__name__])[0]
         why = why if len(why) <= 160 else why[:157] + "..."

@@ -52,7 +52,7 @@ from rocksweep import fields
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import fixed_ascii, utc_now
-from rocksweep.store.identity import record_attrs, resolved_scene, vertical_attrs
+from rocksweep.store.identity import files_resolved, resolved_scene
 from rocksweep.vocab.axes import alpha_symbol
 from rocksweep.vocab.outcomes import COMPUTED_FLAGS, COMPUTED_MEANING, OUTCOME_WORDS, STATUS_WORDS
 
@@ -82,6 +82,9 @@ SESSION_ATTRS: dict[str, str] = {
     "complete": "int8",
     "steps_total": "int64",
     "event_steps_total": "int64",
+    # RK4 evaluations of the certification's runs (part of the steps above; -1: not
+    # recorded, a file of a rocksweep before the count resumed)
+    "refine_evaluations": "int64",
     "host": "S256",
     "backend": "S256",
     "history": f"S{HISTORY_BYTES}",
@@ -219,15 +222,13 @@ def metadata(scene: Scene, overrides: tuple[str, ...] = (),
     a["event_tol"] = n.event_tol
     a["horizon"] = n.horizon
     a["energy"] = np.int8(bool(scene.energy))
-    if scene.record is not None:  # the record: name, SHA-256, NPTS, DT [s], PGA [g]
-        for k, v in record_attrs(scene.record).items():
-            a[f"record_{k}"] = v
+    # the record and its components: name, SHA-256, NPTS, DT [s], PGA [g] (and IMs)
+    for role, attrs in files_resolved(scene).items():
+        for k, v in attrs.items():
+            a[f"{role}_{k}"] = v
     if scene.path is not None:  # the orientation's second component and the building
         for k, v in path_attrs(scene).items():
             a[k] = v
-    if scene.vertical is not None:  # its vertical component: the same, and its IMs
-        for k, v in vertical_attrs(scene.vertical, scene.record).items():
-            a[f"vertical_{k}"] = v
     for k, v in scene.physical_summary().items():  # a physical body's p [rad/s]
         a[k] = v
     if scene.suite is not None:  # the stripes' IM ("none": a cloud) and Sa's period [s]
@@ -315,10 +316,8 @@ def initialise(f: h5py.File, meta: Metadata) -> None:
     for k, v in meta.attrs.items():
         f.attrs[k] = v
     scene = meta.scene
-    if scene.record is not None:
-        _store_record(f, scene.record)
-    if scene.vertical is not None:
-        _store_file(f.create_group(VERTICAL_GROUP), "file", scene.vertical)
+    for role, rec in scene.ground_files().items():
+        _store_record(f, role, rec)
     if scene.suite is not None:
         _store_suite_records(f, scene.suite)
     scales = []
@@ -475,14 +474,16 @@ def _store_suite_records(f, suite) -> None:
             d.attrs["name"] = name
 
 
-def _store_record(f, record) -> None:
-    """Keep the record in the result file (group ``record``): the file's bytes (``file``,
-    uint8; the scene is rebuilt from them, ``result_scene``) and the samples
-    (``acceleration`` [g], at ``dt`` [s]) for readers. A result then stands alone: moved
-    to another machine, or kept after the record's folder is gone, it still plots and
-    gives boundaries and spectra."""
-    g = f.create_group(RECORD_GROUP)
+def _store_record(f, role: str, record) -> None:
+    """Keep a ground file of the scene in the result file (group ``role``: RECORD_GROUP,
+    VERTICAL_GROUP): the file's bytes (``file``, uint8; the scene is rebuilt from them,
+    ``result_scene``), and the record's samples (``acceleration`` [g], at ``dt`` [s]) for
+    readers. A result then stands alone: moved to another machine, or kept after the
+    record's folder is gone, it still plots and gives boundaries and spectra."""
+    g = f.create_group(role)
     _store_file(g, "file", record)
+    if role != RECORD_GROUP:
+        return
     acc = g.create_dataset("acceleration", data=np.asarray(record.acc, np.float64))
     acc.attrs["units"] = "g"
     acc.attrs["dt"] = float(record.dt)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 
+from rocksweep.physics.ground_motion import vertical_ims
 from rocksweep.scene.model import Scene
 from rocksweep.vocab.laws import DEFAULT_LAW
 
@@ -25,9 +26,7 @@ def resolved_scene(scene: Scene, overrides: tuple[str, ...] | list[str] = (),
         # only when asked: files without contact outputs keep their resolved scene
         **({"contact": True} if scene.contact else {}),
         **({"check": True} if scene.check else {}),
-        **({"record": record_attrs(scene.record)} if scene.record is not None else {}),
-        **({"vertical": vertical_attrs(scene.vertical, scene.record)}
-           if scene.vertical is not None else {}),
+        **files_resolved(scene),
         **({"suite": suite_attrs(scene.suite)} if scene.suite is not None else {}),
         **({"path": path_resolved(scene)} if scene.path is not None else {}),
     }
@@ -63,13 +62,15 @@ def record_attrs(record) -> dict:
             "source": str(record.source)}
 
 
-def vertical_attrs(vertical, record) -> dict:
-    """A record's vertical component (``ground.vertical``) as the file states it
-    (``vertical_*`` attributes): ``record_attrs`` of its file and its IMs, PGA_v [g] and
-    the V/H ratio (``records.vertical_ims``)."""
-    from rocksweep.physics.records import vertical_ims
-
-    return {**record_attrs(vertical), **vertical_ims(vertical, record)}
+def files_resolved(scene: Scene) -> dict[str, dict]:
+    """The files of the scene's one ground record as the file states them (the resolved
+    scene's keys and the attributes' prefixes, by role: ``Scene.ground_files``): each
+    file's ``record_attrs``; a component beside the record with its IMs, PGA_v [g] and
+    the V/H ratio (``ground_motion.vertical_ims``)."""
+    files = scene.ground_files()
+    return {role: record_attrs(r) if role == "record" else
+            {**record_attrs(r), **vertical_ims(r, files["record"])}
+            for role, r in files.items()}
 
 
 def suite_attrs(suite) -> dict:

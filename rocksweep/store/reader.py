@@ -16,11 +16,13 @@ from typing import TYPE_CHECKING, NoReturn
 import numpy as np
 
 from rocksweep import fields
-from rocksweep.errors import RocksweepError, StoreError, flag
+from rocksweep.errors import RecordError, RocksweepError, StoreError, flag
 from rocksweep.fields import plain
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.outputs import shown
+from rocksweep.physics.records import digest, parse_record, read_record
 from rocksweep.scene.model import Scene
+from rocksweep.scene.parse import parse_scene
 from rocksweep.store._common import H5_ERRORS, close_quietly, cut_repr, damaged, error_reason
 from rocksweep.store.format import (
     FORMAT,
@@ -144,6 +146,7 @@ def _analysis_kind(f: h5py.File) -> str | None:
 
 def read_layout(f: h5py.File, path: Path) -> FileLayout:
     """Validate the format, the resolved scene, the coordinates and the variables."""
+    # h5py (0.1 s): a result in memory reads no file
     import h5py
 
     try:  # h5py's attrs.get hides damage as "missing"
@@ -219,6 +222,7 @@ def read_layout(f: h5py.File, path: Path) -> FileLayout:
 
 
 def _is_hdf5(path: Path) -> bool:
+    # h5py (0.1 s): a result in memory reads no file
     import h5py
     try:
         return bool(h5py.is_hdf5(path))
@@ -229,6 +233,7 @@ def _is_hdf5(path: Path) -> bool:
 def open_h5(path: Path, mode: str) -> h5py.File:
     """Open an existing file; foreign, damaged, locked or unreadable files give a one-line
     StoreError. Writers (mode "r+") take HDF5's exclusive lock; readers take none."""
+    # h5py (0.1 s): a result in memory reads no file
     import h5py
     try:
         st = os.stat(path)
@@ -504,16 +509,54 @@ def stored_scene(path: str | Path) -> dict:
 
 def result_inputs(path: str | Path) -> tuple[str, ...]:
     """The files a command that reads the result at ``path`` never writes over: the
-    result and the records it names where the sweep read them (a single record's or a
-    suite's; an analysis may re-read them). Only ``(path,)`` for a file that is not a
-    readable result (its own error comes when it is read)."""
+    result and every file its sweep read (``resolved_inputs``: an analysis may re-read
+    them). Only ``(path,)`` for a file that is not a readable result (its own error comes
+    when it is read)."""
     try:
         sc = stored_scene(path)
     except RocksweepError:
         return (str(path),)
-    recs = [sc.get("record") or {}, *((sc.get("suite") or {}).get("records") or [])]
-    return (str(path), *(str(r["source"]) for r in recs
-                         if isinstance(r, dict) and isinstance(r.get("source"), str)))
+    return (str(path), *resolved_inputs(sc))
+
+
+def resolved_inputs(stored: dict) -> tuple[str, ...]:
+    """Every file a resolved scene (``store.identity.resolved_scene``) says its sweep read:
+    each ``source`` it holds, at any depth (a record, its second horizontal and vertical
+    components, a suite's records), and a PEER folder suite's H2 and UP files, which it
+    names beside their H1 (``scene.peer``: one folder holds a record's files)."""
+    out: list[str] = []
+
+    def walk(v) -> None:
+        if isinstance(v, dict):
+            if isinstance(v.get("source"), str) and v["source"]:
+                out.append(v["source"])
+            for x in v.values():
+                walk(x)
+        elif isinstance(v, list):
+            for x in v:
+                walk(x)
+
+    walk(stored)
+    suite = stored.get("suite") if isinstance(stored.get("suite"), dict) else {}
+    records = suite.get("records") if isinstance(suite.get("records"), list) else []
+    folders: dict[Path, dict[str, list[str]]] = {}
+    for key in ("h2", "vertical"):
+        named = suite.get(key) if isinstance(suite.get(key), list) else []
+        for rec, comp in zip(records, named, strict=False):
+            if not (isinstance(rec, dict) and isinstance(rec.get("source"), str)
+                    and isinstance(comp, dict) and isinstance(comp.get("name"), str)):
+                continue
+            folder = Path(rec["source"]).parent
+            if folder not in folders:  # the folder's files by stem (a name has no suffix)
+                try:
+                    names = os.listdir(folder)
+                except OSError:
+                    names = []
+                folders[folder] = {}
+                for n in names:
+                    folders[folder].setdefault(Path(n).stem, []).append(n)
+            out.extend(str(folder / n) for n in folders[folder].get(comp["name"], ()))
+    return tuple(dict.fromkeys(out))
 
 
 def peek_done(path: str | Path) -> tuple[int, int] | None:
@@ -529,8 +572,6 @@ def result_of(ds) -> SweepResult:
     """A result Dataset (what ``rocksweep.run`` and ``rocksweep.open`` return) as the
     ``SweepResult`` that ``read_result`` gives for its file: the analyses and figures take
     either. A Dataset that is not a rocksweep sweep result is a one-line StoreError."""
-    import json
-
     source = ds.encoding.get("source")
     in_file = isinstance(source, str | Path) and bool(str(source))
     # a Dataset made in memory is named by its title in messages, never opened by it
@@ -591,9 +632,6 @@ def stored_record(path: Path, rec: dict, group: str = RECORD_GROUP):
 def _stored_copy(path: Path, data: bytes, rec: dict, what: str):
     """A record's copy in a result file as a ``GroundRecord``, checked against the SHA-256
     the file states for it (``rec``: its ``sha256`` and ``source``)."""
-    from rocksweep.errors import RecordError
-    from rocksweep.physics.records import digest, parse_record
-
     if digest(data) != rec.get("sha256"):
         raise damaged(path, f"{what} does not match its SHA-256")
     try:
@@ -634,10 +672,6 @@ def result_scene(result: SweepResult) -> Scene:
     own copy (``stored_record``, checked against its SHA-256); a file made before records
     were stored re-reads it from where the sweep read it, checked against the SHA-256.
     One-line StoreErrors."""
-    import json
-
-    from rocksweep.scene.parse import parse_scene
-
     a = result.attrs
     try:
         overrides = list(json.loads(str(a.get("overrides", "[]"))))
@@ -653,9 +687,6 @@ def result_scene(result: SweepResult) -> Scene:
         # a Dataset made in memory (rocksweep.run without output) has no file to read
         record = stored_record(result.path, rec) if result.in_file else None
         if record is None:
-            from rocksweep.errors import RecordError
-            from rocksweep.physics.records import read_record
-
             try:
                 record = read_record(rec["source"])
             except RecordError as err:

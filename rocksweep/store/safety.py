@@ -19,6 +19,7 @@ the atomic rename.
 from __future__ import annotations
 
 import errno
+import fcntl
 import os
 import shutil
 from pathlib import Path
@@ -57,14 +58,15 @@ def reserve_space(path: Path, nbytes: int) -> None:
 
 def reserve_bytes(scene: Scene, nbytes: int) -> int:
     """Bytes a new result file of ``scene`` reserves: its datasets (``nbytes``), HDF5's
-    metadata, the scene text and the records (a record's file and samples,
-    ``_store_record``, its vertical's file; a suite's files, ``_store_suite_records``)."""
-    rec = (8 * int(scene.record.npts) + len(scene.record.data) + (16 << 10)
-           if scene.record is not None else 0)
-    if scene.suite is not None:  # each record's file (gzip: at most its size) and metadata
-        rec += sum(len(r.data) + (8 << 10) for r in scene.suite.records)
-    if scene.vertical is not None:  # its vertical component's file
-        rec += len(scene.vertical.data) + (8 << 10)
+    metadata, the scene text and the records (each ground file, ``Scene.ground_files``,
+    and the record's samples, ``_store_record``; a suite's files,
+    ``_store_suite_records``): each file (gzip: at most its size) and its metadata."""
+    files = list(scene.ground_files().values())
+    if scene.suite is not None:
+        files += scene.suite.records
+    rec = sum(len(r.data) + (8 << 10) for r in files)
+    if scene.record is not None:  # its samples
+        rec += 8 * int(scene.record.npts) + (8 << 10)
     return nbytes + METADATA_RESERVE + 4 * len(scene.text.encode()) + rec
 
 
@@ -90,8 +92,6 @@ def check_space(path: Path, need: int, what: str) -> None:
 def lock_existing(path: Path) -> int:
     """Open the file at ``path`` and take the exclusive lock a writer holds (HDF5 locks
     with flock); returns the descriptor. StoreError if a sweep is writing it."""
-    import fcntl
-
     try:
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_CLOEXEC", 0))
     except OSError as err:

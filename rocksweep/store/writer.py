@@ -22,6 +22,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import h5py
 import numpy as np
 
 from rocksweep.errors import Arg, OutputError, RocksweepError, StoreError, flag
@@ -97,8 +98,9 @@ def _in_place(f: h5py.File) -> bool:
 
 
 def _upgrade_session_attrs(f: h5py.File) -> None:
-    """Give a format-1 file's session attributes their fixed types (needs a little space,
-    checked before; only the first resume of such a file does this)."""
+    """Give a format-1 file's session attributes their fixed types, and an older format-2
+    file the ones it lacks (needs a little space, checked before; only the first resume
+    of such a file does this)."""
     a = f.attrs
     for name, dtype in SESSION_ATTRS.items():
         if name in a and a.get_id(name).dtype == np.dtype(dtype):
@@ -106,6 +108,8 @@ def _upgrade_session_attrs(f: h5py.File) -> None:
         old = plain(a[name]) if name in a else None
         if name == "complete":
             old = int(bool(old))
+        elif name == "refine_evaluations" and old is None:
+            old = -1  # the sessions before did not count it
         elif old is None or (dtype.startswith("S") and not isinstance(old, str)):
             old = "" if dtype.startswith("S") else 0
         if name in a:
@@ -174,7 +178,6 @@ class SweepFile:
         "already exists") or a file made or replaced at it meanwhile (``OutputError``, as
         ``outputs.publish`` says for every output), too little free space, a file another
         process is writing (``StoreError``)."""
-        import h5py
         grid = grid if grid is not None else Grid(scene)
         existed = os.path.lexists(path)
         if existed and not overwrite:
@@ -240,8 +243,6 @@ class SweepFile:
         sink of ``rocksweep.run`` without ``output``. Nothing touches a disk; ``image``
         gives the file's bytes, exactly what ``create`` would have written. grid: as
         for ``create``."""
-        import h5py
-
         name = f"rocksweep-memory-{os.getpid()}-{id(scene)}.h5"
         f = h5py.File(name, "w", driver="core", backing_store=False, track_order=True)
         try:
@@ -340,8 +341,6 @@ class SweepFile:
     def _write_at(self, name: str, coords: np.ndarray, values: np.ndarray) -> None:
         """Write values[n] at the grid points coords (uint64[n, rank]): one HDF5 point
         selection, so scattered points cost one call."""
-        import h5py
-
         ds = self.f[name]
         fspace = ds.id.get_space()
         fspace.select_elements(coords)
@@ -426,10 +425,11 @@ class SweepFile:
                 resume=flag("resume"))) from None
 
     def finish(self, wall_seconds: float, cpu_seconds: float, *,
-               backend: str | None = None) -> dict:
-        """Record this session's wall time [s], the workers' CPU time on its points [s]
-        and the file's totals (in place); returns the attributes set (plain Python
-        values; ``complete`` a bool)."""
+               backend: str | None = None, refine_evaluations: int = 0) -> dict:
+        """Record this session's wall time [s], the workers' CPU time on its points [s],
+        the RK4 evaluations its certification took (``refine_evaluations``: part of the
+        points' steps) and the file's totals (in place); returns the attributes set
+        (plain Python values; ``complete`` a bool)."""
         if self._broken:
             raise self._broken
         f = self.f
@@ -439,6 +439,9 @@ class SweepFile:
             attrs = {
                 "wall_time": float(a.get("wall_time", 0.0)) + wall_seconds,
                 "cpu_time": float(a.get("cpu_time", 0.0)) + cpu_seconds,
+                # -1 (not recorded before) stays so: the total would be short
+                "refine_evaluations": (-1 if int(a.get("refine_evaluations", -1)) < 0 else
+                                       int(a["refine_evaluations"]) + int(refine_evaluations)),
                 "points_done": int(done.sum()),
                 "complete": bool(done.all()),
                 "steps_total": int(f["steps"][()].sum()),

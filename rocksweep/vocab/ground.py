@@ -7,7 +7,9 @@ the phase phi = w t, the kernel evaluates the same formulas, ``pulse_acc``): ``s
 
 Intensity measures of a suite (``ground.scale.im``): PGA [g], PGV [m/s], Sa(T) [g] at
 ``SA_DAMPING`` (5%), the slenderness-normalised PGA_ratio = PGA/(g tan alpha_ref),
-PGV_ratio = PGV p/(g tan alpha_ref) [-], AvgSa [g], CAV [m/s] and Arias [m/s].
+PGV_ratio = PGV p/(g tan alpha_ref) [-], AvgSa [g], CAV [m/s] and Arias [m/s]; the
+component it is taken of (H1, RotD50); a PEER folder's missing components (error, skip);
+the two answers of a sweep over the motion's angle (each, worst).
 """
 
 from __future__ import annotations
@@ -106,6 +108,24 @@ RATIO_OF: dict[str, str] = {PGA_RATIO: PGA, PGV_RATIO: PGV}
 SA_DAMPING = 0.05  # damping ratio of the spectral acceleration (5%)
 AVGSA_POINTS = 10  # periods of AvgSa, evenly spaced in ln T
 DEFAULT_PERIODS = (0.2, 1.0)  # [s] Sa stored per record
+#: the horizontal component a suite's stripe IM is taken of (``ground.scale.component``):
+#: the first horizontal's, or RotD50, the median over orientations of both horizontals'
+#: (Boore 2010; NGA-West2's convention)
+H1, ROTD50 = "H1", "RotD50"
+COMPONENTS: tuple[str, ...] = (H1, ROTD50)
+#: the stripe IMs RotD50 is taken of (Boore 2010: the median over orientations of a
+#: peak: the acceleration's, the velocity's, the 5% oscillator's); AvgSa, CAV and Arias
+#: have no RotD50 convention (refused in one line, ``ground.scale.component``)
+ROTD50_IMS: tuple[str, ...] = (PGA, PGA_RATIO, PGV, PGV_RATIO, SA)
+#: a record of a folder of PEER downloads without one of its components
+#: (``ground.missing``): refused, or left out with a warning
+MISSING_ERROR, MISSING_SKIP = "error", "skip"
+MISSING: tuple[str, ...] = (MISSING_ERROR, MISSING_SKIP)
+#: the two answers of a sweep over the ground motion's ``angle`` (an analysis's
+#: ``orientation`` dimension): every (record, angle) a sample, or each record at its worst
+#: angle (it overturns at any angle)
+EACH, WORST = "each", "worst"
+ORIENTATIONS: tuple[str, ...] = (EACH, WORST)
 #: The record IMs stored per record (the one list): name -> (variable, units, exponent n:
 #: the IM of the record times F is F^n times its IM; 0: scale-invariant). Sa(T) is
 #: ``record_sa`` along ``period`` (n = 1).

@@ -23,6 +23,8 @@ MODE_WORDS: tuple[str, ...] = ("none", MODE1, MODE2)
 
 SLIDES, LIFTS_OFF = "slides", "lifts_off"  # the contact status words (outputs.contact)
 AIRBORNE = "airborne"  # the ground falls faster than gravity: the body leaves it
+#: the bits of a run's ``status``: word -> bit (what each means: docs/diagrams.md, "Status
+#: words")
 STATUS_BIT: dict[str, int] = {
     "rest": 1,
     "horizon": 2,
@@ -51,37 +53,6 @@ FLAGGED_WORDS: tuple[str, ...] = ("horizon", "step_cap", "event_cap", "nonfinite
 FLAGGED = 0
 for _w in FLAGGED_WORDS:
     FLAGGED |= STATUS_BIT[_w]
-
-STATUS_MEANING: dict[str, str] = {
-    "rest": "rest proven after the pulse (early exit); never after the rest-rate rule "
-            "ended a chattering sequence (then: settled)",
-    "horizon": "horizon reached before the outcome was decided (flagged)",
-    "step_cap": "RK4 step cap reached (flagged)",
-    "event_cap": "impact/uplift cap reached (flagged)",
-    "nonfinite": "state became NaN or infinite (flagged)",
-    "history_full": "history buffer full; later steps not recorded",
-    "energy_gain": "at least one impact gained energy",
-    "settled": "a chattering sequence ended in full contact by the rest-rate rule (not a "
-               "proof: the run ends without 'rest')",
-    "overturned": "the body reached |theta| = pi/2",
-    "e_above_1": "at least one impact had e > 1",
-    "bounded": "rigid body below its overturning energy after the pulse, |e| <= 1: "
-               "safe proven (early exit)",
-    SLIDES: "friction demand mu_required above body.mu: the base would slide "
-              "(outputs.contact)",
-    LIFTS_OFF: "normal reaction below zero: the body would leave the ground "
-                 "(outputs.contact)",
-    "refined": "near its threshold (the free rocking came near the overturning saddle): "
-               "re-run with 2, 4, ... times the steps until its outcome was stable, the "
-               "finest run's result kept, or, a safe near-miss, checked by a run at 2 "
-               "times the steps past its last approach that stayed safe, its own result "
-               "kept (rocksweep.compute.certify)",
-    "uncertified": "a close call whose outcome still changed at the last refinement "
-                   "(numerics.refine), or which was still a close call there: a knife "
-                   "edge (flagged)",
-    AIRBORNE: "g + a_v <= 0: the vertical ground acceleration reached -g, the body leaves "
-              "the ground (outside the model); the run stopped there (flagged)",
-}
 
 #: the limit states a fragility curve can count (besides "theta:X")
 OVERTURN, UPLIFT = "overturn", "uplift"

@@ -8,7 +8,7 @@ from bodies import FIG3_YAML
 import rocksweep.analysis.boundaries as bd
 from rocksweep.analysis.files import csv_text
 from rocksweep.compute.driver import sweep_arrays
-from rocksweep.figures.diagrams import a_min_figure
+from rocksweep.figures.a_min import a_min_figure
 from rocksweep.scene.parse import parse_scene
 
 BODY3 = FIG3_YAML

@@ -91,6 +91,14 @@ def test_cli_on_a_real_sweep(tmp_path, suite_result):
     assert {"PGA", "PGV", "Arias", "CAV", "D5_95", "PGV_over_PGA", "AvgSa"} <= set(
         eff.im.values.tolist())
     assert np.isfinite(eff.beta.sel(im="AvgSa")).all()
+    # every column once (shape_x / shape_y came from merging two frames), one row per
+    # (IM, curve), the verdict in its column
+    import pandas as pd
+
+    head = out.read_text().splitlines()[0].split(",")
+    assert len(head) == len(set(head)) and not any(c.endswith(("_x", "_y")) for c in head)
+    rows = pd.read_csv(out)
+    assert len(rows) == eff["beta"].size and "reason" in rows.columns
 
 
 def test_cloud_is_a_probit_per_im():
@@ -121,3 +129,44 @@ def test_cloud_is_a_probit_per_im():
         assert eff.beta.sel(im=im).item() == pytest.approx(beta, rel=1e-4)
         assert eff.im_median.sel(im=im).item() == pytest.approx(med, rel=1e-4)
     assert eff.beta.sel(im="PGV").item() < eff.beta.sel(im="PGA").item()
+
+
+def test_a_small_or_separated_sample_gets_a_verdict():
+    """4 records, one censored: beta 0.001-0.002 was ranked and said ok (issue 45). Four
+    records are few_records for every IM; three records whose capacities in PGA share a
+    value (0.2-0.4 g) are separated: beta there is below the stripes' resolution."""
+    import warnings
+
+    from rocksweep.analysis.efficiency import MIN_RECORDS, _separated
+    from rocksweep.errors import AnalysisWarning
+
+    levels = np.array([0.1, 0.2, 0.4, 0.8])
+    pga = np.array([0.2, 0.3, 0.25, 0.35])
+    cap = np.array([0.3, 0.35, 0.38, 0.7])  # all reach it between 0.2 and 0.8 g
+    over = levels[None, :] >= cap[:, None]
+    ds = xr.Dataset(
+        {"outcome": (("record", "PGA"), over.astype(np.int8)),
+         "status": (("record", "PGA"), np.zeros(over.shape, np.int32)),
+         "record_pga": (("record",), pga), "record_pgv": (("record",), 1.2 * pga),
+         "scale_factor": (("record", "PGA"), levels[None, :] / pga[:, None])},
+        coords={"record": [f"r{i}.AT2" for i in range(4)], "PGA": levels},
+        attrs={"scale_im": "PGA"})
+    with warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always")
+        eff = im_efficiency(ds)
+    # (0.2, 0.4] x 3 and (0.4, 0.8]: no common value; one record fewer: 0.3 g in all three
+    assert not _separated(np.log([0.2, 0.2, 0.2, 0.4]), np.log([0.4, 0.4, 0.4, 0.8]), None)
+    assert _separated(np.log([0.2, 0.2, 0.3]), np.log([0.4, 0.4, np.inf]), None)
+    assert list(eff["reason"].values) == ["few_records"] * eff.sizes["im"]
+    said = [str(w.message) for w in got if issubclass(w.category, AnalysisWarning)]
+    assert len(said) == 1 and "few_records (every IM: fewer than 10 records)" in said[0]
+    three = ds.isel(record=[0, 1, 2])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        e3 = im_efficiency(three)
+    assert "separated" in str(e3["reason"].sel(im="PGA").values)
+    assert MIN_RECORDS == 10
+    # a regression's line through every interval: separated (slope 1 through exact data)
+    z = np.log([1.0, 2.0, 4.0])
+    assert _separated(z - 0.1, z + 0.1, z) and not _separated(z - 0.1, z + 0.1,
+                                                               np.array([0.0, 1.0, 0.0]))

@@ -144,3 +144,28 @@ def test_diagram_options_on_a_suite_are_one_line(suite_result):
     assert res.exit_code != 0 and res.output.startswith("Error: --x lam: a record-suite")
     assert len(res.output.strip().splitlines()) == 1
     assert not suite_result.with_name("x.png").exists()
+
+
+def test_a_flagged_run_is_one_rule_kept_in_the_table_left_out_of_analyses(ds):
+    """An airborne run (the body left the ground) is stored safe and flagged; the table
+    said "flagged ... left out" yet kept its row (issue 45). One rule: the table keeps
+    every run and says so, naming the flag; the analyses leave it out."""
+    import warnings
+
+    from rocksweep.analysis.states import counted_points
+    from rocksweep.errors import AnalysisWarning
+    from rocksweep.vocab.outcomes import STATUS_BIT
+
+    one = ds.copy(deep=True)
+    st = one["status"].values
+    st.flat[0] = STATUS_BIT["airborne"] | STATUS_BIT["settled"]
+    one["outcome"].values.flat[0] = 0
+    with warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always")
+        t = rocksweep.table(one)
+    said = [str(w.message) for w in got if issubclass(w.category, AnalysisWarning)]
+    assert len(t) == one.outcome.size and "airborne" in t["status_words"].iloc[0]
+    assert said == [f"table: flagged: 1 of {one.outcome.size} points flagged by the kernel "
+                    "(airborne 1), kept (their status_words say why; the analyses leave "
+                    "them out)"]
+    assert not bool(counted_points(one)[0].values.flat[0])  # the analyses do not count it

@@ -41,7 +41,7 @@ SMALL = {"name": "api test", "body": BODY3, "impact": {"lam": [0.0, 0.4]},
 def _modules_after(code: str) -> list[str]:
     probe = (f"import sys\n{code}\n"
              "print('LOADED:' + ','.join(m for m in ('numba', 'h5py', 'matplotlib', 'xarray', "
-             "'scipy') if m in sys.modules))")
+             "'scipy', 'numpy', 'pandas', 'yaml', 'dask', 'tqdm') if m in sys.modules))")
     proc = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     last = proc.stdout.split("LOADED:")[-1].strip()  # after any --help text
@@ -49,12 +49,33 @@ def _modules_after(code: str) -> list[str]:
 
 
 def test_import_and_help_are_light():
-    """`import rocksweep` and `rocksweep --help` load none of the heavy libraries."""
+    """`import rocksweep`, the command line's module and `rocksweep --help` load none of
+    the heavy libraries (not even numpy: the console command sets OPENBLAS_NUM_THREADS
+    before it loads)."""
     assert _modules_after("import rocksweep; rocksweep.run, rocksweep.open") == []
+    assert _modules_after("import rocksweep.cli.main") == []
     assert _modules_after("from rocksweep.cli import main\ntry:\n    main(['--help'])\n"
                           "except SystemExit:\n    pass") == []
     assert _modules_after("from rocksweep.cli import main\ntry:\n    main(['sweep', '--help'])"
                           "\nexcept SystemExit:\n    pass") == []
+
+
+def test_the_command_line_starts_without_the_facade_the_driver_or_outputs():
+    """`import rocksweep.cli.main` (all `rocksweep --help` imports) loads none of the API
+    facade (rocksweep.api: on first use), the sweep driver or outputs.py: they would add
+    23% to its start-up where no .pyc is written, 10% with .pyc files (docs/performance.md,
+    the command line's imports); a command loads them when it runs."""
+    code = ("import sys, rocksweep.cli.main\n"
+            "print(','.join(m for m in ('rocksweep.api', 'rocksweep.simulation', "
+            "'rocksweep.compute.driver', 'rocksweep.outputs') if m in sys.modules))")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == ""
+    # loaded on first use: through a function or the module's old name alike
+    code = ("import rocksweep, sys\nprint('rocksweep.api' in sys.modules, "
+            "rocksweep.api.open is rocksweep.open, 'rocksweep.api' in sys.modules)")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.stdout.split() == ["False", "True", "True"], proc.stderr
 
 
 def test_public_names_have_docstrings_and_version(cli):
@@ -189,17 +210,36 @@ def test_run_resumes_a_partial_file(tmp_path):
 # --- the driver: messages -----------------------------------------------------------------
 
 def test_driver_says_compiling_before_an_uncached_kernel(tmp_path, monkeypatch):
-    """When numba's cache lacks the variant, the sweep says so before compiling (the
-    state is faked here; the real check is test_cache_state_of_a_fresh_cache)."""
-    monkeypatch.setattr(sw, "_in_cache", lambda dispatcher: False)
+    """When numba's cache lacks the variant, the sweep says so before compiling: how many
+    variants, which, and their cost (the state is faked here; the real check is
+    test_cache_state_of_a_fresh_cache). The time a compile takes is kept, and said the
+    next time that variant compiles (issue 45: "~6 s" where variants took 22-59 s)."""
+    from rocksweep.compute import compile_cost
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "cache"))  # the times' file only
+    monkeypatch.setattr(compile_cost, "in_cache", lambda dispatcher: False)
     lines: list[str] = []
     sc = load_scene(CI_SMALL)
+    name = compile_cost.variant_name(sw.chunk_variants(Grid(sc), sw.level(sc))[0])
     rep = sweep_file(sc, tmp_path / "c.h5", log=lines.append)
     assert rep.complete and rep.computed == 256
-    i = next(i for i, ln in enumerate(lines) if ln.startswith("compiling the kernel"))
-    assert re.fullmatch(r"compiling the kernel \(once per machine, ~\d+ s\)\.\.\.", lines[i])
+    i = next(i for i, ln in enumerate(lines) if ln.startswith("compiling"))
+    assert lines[i] == (f"compiling 1 kernel variant this run needs ({name}), once per "
+                        f"machine: ~{compile_cost.BENCH_SECONDS:.0f} s (~"
+                        f"{compile_cost.BENCH_SECONDS:.0f} s a variant on a quiet 2-core "
+                        "machine, more on a busy one)..."), lines[i]
     assert re.fullmatch(r"kernel compiled in \d+\.\d s", lines[i + 1])
-    monkeypatch.setattr(sw, "_in_cache", lambda dispatcher: None)
+    # a compile's time is kept per variant and forecast the next time (a variant never
+    # compiled here: the median of those that were)
+    compile_cost.record([name], 23.0)
+    compile_cost.record(["other_a", "other_b"], 20.0)
+    assert compile_cost.forecast([name]) == (23.0, "as measured here")
+    assert compile_cost.forecast([name, "never"])[0] == pytest.approx(23.0 + 10.0)
+    lines.clear()
+    sweep_file(sc, tmp_path / "e.h5", log=lines.append)
+    assert any(ln.endswith(f"({name}), once per machine: ~23 s (as measured here)...")
+               for ln in lines), lines
+    monkeypatch.setattr(compile_cost, "in_cache", lambda dispatcher: None)
     lines.clear()
     sweep_file(sc, tmp_path / "d.h5", log=lines.append)
     assert "loading or compiling the kernel..." in lines

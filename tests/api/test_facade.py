@@ -174,6 +174,54 @@ def test_the_accessor_is_there_after_importing_xarray_then_rocksweep():
     assert res.returncode == 0 and res.stdout.split() == ["False"], res.stderr
 
 
+def test_the_accessor_is_there_after_importing_rocksweep_then_xarray():
+    """``import rocksweep`` loads no xarray, yet ``ds.rocksweep`` is there once xarray is
+    imported, before any call of the API (rocksweep.accessor.watch)."""
+    res = _fresh("import sys, rocksweep\nloaded = 'xarray' in sys.modules\n"
+                 "import xarray as xr\n"
+                 "print(loaded, type(xr.Dataset().rocksweep).__name__)")
+    assert res.returncode == 0 and res.stdout.split() == ["False", "RocksweepAccessor"], \
+        res.stderr
+
+
+def test_every_analysis_is_on_the_accessor():
+    """Every public function whose first argument is a Dataset is a method of
+    ``ds.rocksweep`` (made from ``api.ANALYSES``; calibrated_overrides is as_overrides)."""
+    import inspect
+
+    from rocksweep.api import ANALYSES, RocksweepAccessor
+
+    renamed = {"calibrated_overrides": "as_overrides"}
+    of_a_dataset = []
+    for name in rocksweep.__all__:
+        fn = getattr(rocksweep, name)
+        first = next(iter(inspect.signature(fn).parameters.values()), None) \
+            if inspect.isfunction(fn) else None
+        if first is not None and "Dataset" in str(first.annotation):
+            of_a_dataset.append(name)
+            assert callable(getattr(RocksweepAccessor, renamed.get(name, name), None)), name
+    assert {"floor_spectrum", "im_efficiency", "plot", "fragility"} <= set(of_a_dataset)
+    assert sorted(f.__name__ for f in ANALYSES) == sorted(
+        n for n in of_a_dataset if n not in renamed)
+
+
+def test_an_accessor_method_hands_the_dataset_and_arguments_over():
+    """``ds.rocksweep.f(...)`` answers as ``rocksweep.f(ds, ...)``, for an analysis added
+    last (floor_spectrum) as for the first."""
+    from rocksweep.errors import FloorError
+
+    ds = xr.Dataset({"outcome": ("x", [0, 1])})
+    with pytest.raises(ApiError) as direct:
+        rocksweep.boundaries(ds, mode=3)
+    with pytest.raises(ApiError) as method:
+        ds.rocksweep.boundaries(mode=3)
+    assert str(method.value) == str(direct.value) == "mode = 3: must be None, 1 or 2"
+    with pytest.raises(FloorError, match="no floor.period dimension"):
+        ds.rocksweep.floor_spectrum()
+    with pytest.raises(TypeError, match=r"takes hazard by position"):
+        ds.rocksweep.risk("hazard.csv", 50)
+
+
 def test_the_accessor_methods_take_keywords_only():
     import inspect
 

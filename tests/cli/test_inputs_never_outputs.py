@@ -147,3 +147,38 @@ def test_the_scene_lists_every_file_it_read(work):
         work / "r" / "SYN02.AT2"}
     with pytest.raises(OutputError):
         check_output(work / "suite.txt", overwrite=True, inputs=sc.inputs)
+
+
+def test_every_file_a_result_was_computed_from_is_guarded(cli, work):
+    """ground.record, ground.h2 and ground.vertical of a result (issue 45: ``table -o`` of
+    the vertical replaced it), and a PEER folder's H2 and UP files, which the result names
+    beside their H1: refused by every command that writes, --overwrite or not."""
+    import numpy as np
+
+    from rocksweep.store.reader import resolved_inputs
+
+    t = np.arange(0.0, 2.0 + 0.005, 0.01)
+    for name, a in (("h.csv", 0.3 * np.sin(2 * np.pi * t) * (t <= 1.0)),
+                    ("h2.csv", 0.2 * np.cos(2 * np.pi * t) * (t <= 1.0)),
+                    ("v.csv", 0.1 * np.sin(6 * np.pi * t))):
+        np.savetxt(work / name, np.c_[t, a], delimiter=",")
+    (work / "three.yaml").write_text(
+        "name: three\nbody: {kind: block, alpha: 0.2}\nimpact: {lam: 0.0}\n"
+        "ground: {record: h.csv, h2: h2.csv, vertical: v.csv, angle: [0, 90], "
+        "A_ratio: 2.5, p: 2.0}\n")
+    assert cli.invoke(main, ["sweep", "three.yaml", "-o", "t.h5", "-q"]).exit_code == 0
+    for out in ("h.csv", "h2.csv", "v.csv"):
+        for over in (["--overwrite"], []):
+            refused(cli, ["table", "t.h5", "-o", out, *over], work, out)
+        refused(cli, ["boundaries", "t.h5", "-o", out, "--overwrite"], work, out)
+        refused(cli, ["sweep", "three.yaml", "-o", out, "--overwrite", "-q"], work, out)
+        refused(cli, ["simulate", "three.yaml", "--csv", out, "--overwrite"], work, out)
+    # a PEER folder suite names its H2 and UP files (no suffix) beside its records' H1
+    peer = {"suite": {"records": [{"name": "RSN1_E_S000.AT2",
+                                   "source": str(work / "p" / "RSN1_E_S000.AT2")}],
+                      "h2": [{"name": "RSN1_E_S090"}], "vertical": [{"name": "RSN1_E_S-UP"}]}}
+    (work / "p").mkdir()
+    for n in ("RSN1_E_S000.AT2", "RSN1_E_S090.AT2", "RSN1_E_S-UP.AT2", "other.AT2"):
+        (work / "p" / n).write_text("x")
+    assert {Path(p).name for p in resolved_inputs(peer)} == {
+        "RSN1_E_S000.AT2", "RSN1_E_S090.AT2", "RSN1_E_S-UP.AT2"}

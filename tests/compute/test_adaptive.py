@@ -91,6 +91,34 @@ def test_same_results_whatever_jobs_and_chunks(block_long):
     assert sa.batches == sb.batches
 
 
+
+def test_spare_workers_compute_the_audit_early_without_changing_anything(block_long,
+                                                                         monkeypatch):
+    """The worker threads take the audit candidates while batches leave them idle
+    (``compute.overlap.Runner``): the sweep equals the one that runs each batch alone
+    (``run_batch`` without a runner, the dask backend's way), and a point computed early
+    is not computed again when its batch asks for it."""
+    import rocksweep.compute.overlap as ov
+    from rocksweep.compute import sweep as sw
+
+    sc, _ = block_long
+    runs = []
+    real = sw.run_chunk
+
+    def counted(grid, start, stop, level):
+        runs.extend(grid.flat[start:stop].tolist())
+        return real(grid, start, stop, level)
+
+    monkeypatch.setattr(sw, "run_chunk", counted)
+    a, ra = sweep_arrays(sc, jobs=2, chunk_size=5, adaptive=ad.Options())
+    assert sorted(runs) == sorted(set(runs))  # every point once
+    assert len(runs) == ra.adaptive.computed
+    monkeypatch.setattr(ov, "Runner", lambda *args, **kw: None)  # each batch alone
+    b, rb = sweep_arrays(sc, jobs=2, chunk_size=5, adaptive=ad.Options())
+    assert_same(a, b)
+    assert ra.adaptive.batches == rb.adaptive.batches
+    assert ra.refine_evaluations == rb.refine_evaluations
+
 # --- planted maps (synthetic classifier) --------------------------------------------------
 
 def disc_map(shape, cx, cy, r):

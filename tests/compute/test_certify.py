@@ -71,9 +71,9 @@ def _bare(point: Point, numerics: Numerics) -> np.ndarray:
     """One kernel run without certification: the result row."""
     row = point_row(point, numerics)
     kind = kernel_kind(point.body)
-    warm_up(kind, L.LEVEL_OUTCOME, False)
+    warm_up(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)
     out = np.empty((1, L.N_OUT))
-    chunk_kernel(kind, L.LEVEL_OUTCOME, False)(row[None, :], out)
+    chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)(row[None, :], out)
     return out[0]
 
 
@@ -253,12 +253,70 @@ def test_adaptive_sweeps_certify_as_the_full_sweep_does():
     point has the full sweep's result, status bits (refined) included, and some of them
     were close calls."""
     import rocksweep.compute.adaptive as ad
+    from rocksweep.compute.dispatch import run_variant
+    from rocksweep.scene.grid import Grid
 
     sc = parse_scene(ADAPTIVE)
     full = sweep_arrays(sc)[0]
-    arr, _ = sweep_arrays(sc, jobs=1, adaptive=ad.Options())
+    arr, rep = sweep_arrays(sc, jobs=2, chunk_size=3, adaptive=ad.Options())
     c = arr["computed"] > 0
     for k in ("outcome", "status", "steps", "t_overturn"):
         np.testing.assert_array_equal(arr[k][c], full[k][c], err_msg=k)
     assert ((arr["status"][c] & L.STATUS_REFINED) != 0).any()
     np.testing.assert_array_equal(arr["outcome"], full["outcome"])
+    # its count of the certification's evaluations: those of its computed points, each
+    # once (spare workers compute some early, in chunks split between batches)
+    cr = Grid(sc).rows_at(np.flatnonzero(c.ravel()))
+    own = run_variant(cr.rows, int(cr.kinds[0]), L.LEVEL_OUTCOME, sc.ground,
+                      sc.numerics.refine)
+    assert rep.refine_evaluations == own[:, L.OUT_REFINE_EVALS].sum() > 0
+
+
+def test_a_file_states_what_its_certification_cost(tmp_path):
+    """A sweep file's attribute refine_evaluations is the RK4 evaluations its certification
+    took: the file's steps + event_steps less those of the same sweep without
+    certification (numerics.refine = 0); a near-miss or close call's own
+    OUT_REFINE_EVALS is its certified run's evaluations less its bare run's.
+    ``rocksweep info`` says it; a file from before the count (no attribute), and one
+    resumed from such a file, say it was not recorded."""
+    import h5py
+
+    from rocksweep.analysis.summary import format_info, info_dict, read_info
+    from rocksweep.compute.session import sweep_file
+
+    scene = parse_scene(SCENE)
+    out = sweep_file(scene, tmp_path / "a.h5")
+    bare = sweep_file(parse_scene(SCENE, overrides=["numerics.refine=0"]), tmp_path / "b.h5")
+    spent = {k: int(r.attrs["steps_total"]) + int(r.attrs["event_steps_total"])
+             for k, r in (("cert", out), ("bare", bare))}
+    assert out.attrs["refine_evaluations"] == spent["cert"] - spent["bare"] > 0
+    assert bare.attrs["refine_evaluations"] == 0
+    d = info_dict(read_info(tmp_path / "a.h5"))
+    assert d["certification"]["refine_evaluations"] == spent["cert"] - spent["bare"]
+    assert d["certification"]["points_refined"] >= 1
+    text = "\n".join(format_info(d))
+    assert f"certification of close calls: {spent['cert'] - spent['bare']} of them" in text
+    n = Numerics.preset("default")
+    for A in (10.9, 11.1, 14.0):
+        point = Point(BLOCK, 0.0, "sine", 8.0, A)
+        bare_out = _bare(point, n)
+        run = run_point(point, n, history=False)
+        own = bare_out[L.OUT_STEPS] + bare_out[L.OUT_EVENT_STEPS]
+        assert run.out[L.OUT_REFINE_EVALS] == (run.out[L.OUT_STEPS]
+                                               + run.out[L.OUT_EVENT_STEPS] - own), A
+    # a file from before the count: none recorded; a resume of it keeps "not recorded"
+    old = tmp_path / "old.h5"
+    two = parse_scene(SCENE, overrides=["pulse.A_ratio=[10.9, 11.1]"])
+    sweep_file(two, old)
+    with h5py.File(old, "r+") as f:
+        del f.attrs["refine_evaluations"]
+        for name in ("outcome",):  # one point left to compute
+            a = f[name][()]
+            a.flat[-1] = L.OUTCOME_NOT_RUN
+            f[name][...] = a
+    d = info_dict(read_info(old))
+    assert d["certification"]["refine_evaluations"] is None
+    assert "not recorded" in "\n".join(format_info(d))
+    again = sweep_file(two, old, resume=True)
+    assert again.computed == 1 and again.attrs["refine_evaluations"] == -1
+    assert info_dict(read_info(old))["certification"]["refine_evaluations"] is None

@@ -167,3 +167,61 @@ def test_a_single_run_states_its_floor_pfa_as_the_sweep_stores_it(tmp_path):
     # the ground's peak is A_ratio g tan(alpha) = 1.5 tan(0.2) g; this building amplifies it
     assert one.summary["floor_pfa"] > 1.5 * math.tan(0.2)
     assert "floor_pfa" not in rocksweep.simulate({**scene, "floor": None}).summary
+
+
+MODE = {"period": T, "damping": ZETA, "participation": GP}
+SECOND = {"period": 0.15, "damping": 0.03, "participation": -0.4}
+
+
+@pytest.mark.parametrize("motion", [
+    {"ground": {"record": str(NEARFAULT), "A_ratio": [1.0, 2.5], "p": [2.0, 3.0]}},
+    {"pulse": {"shape": "sine", "w_over_p": [1.5, 3.0], "A_ratio": [1.0, 2.5]}},
+], ids=["record", "pulse"])
+def test_a_list_of_modes_sweeps_without_an_angle(tmp_path, motion):
+    """``floor: {modes: [...]}`` (one mode or two) under one record or a pulse, no angle
+    axis: the sweep completes (issue 45: a worker's ValueError, an INCOMPLETE file); one
+    mode in the list is the one-mode keys' building, bit for bit; two modes are each
+    point's single run."""
+    one = rocksweep.run({"body": BLOCK, **motion, "floor": {"modes": [MODE]}},
+                        output=tmp_path / "one.h5")
+    keys = rocksweep.run({"body": BLOCK, **motion, "floor": MODE})
+    assert one.attrs["complete"] == 1
+    for k in ("outcome", "theta_max_over_alpha", "floor_pfa"):
+        assert np.array_equal(one[k].values, keys[k].values, equal_nan=True), k
+    assert (one["outcome"].values > 0).any()  # some overturn: a real comparison
+    two = rocksweep.run({"body": BLOCK, **motion, "floor": {"modes": [MODE, SECOND]}},
+                        output=tmp_path / "two.h5")
+    assert two.attrs["complete"] == 1
+    assert not np.array_equal(two["floor_pfa"].values, one["floor_pfa"].values)
+    singles = rocksweep.simulate({"body": BLOCK, **motion,
+                                  "floor": {"modes": [MODE, SECOND]}})  # in grid order
+    words = {0: "safe", 1: "mode1", 2: "mode2"}
+    for run, code, pfa in zip(singles, two["outcome"].values.ravel(),
+                              two["floor_pfa"].values.ravel(), strict=True):
+        assert run.summary["outcome"] == words[int(code)]
+        assert run.summary["floor_pfa"] == pfa  # the one definition, bit for bit
+
+
+def test_felt_motion_is_what_the_kernel_runs(tmp_path):
+    """rocksweep.felt_motion (issue 45: a public way to the motion the body feels): the
+    samples after the angle and the floor, scaled as the point runs, equal the ground
+    acceleration the kernel recorded in its history at every row (linear between
+    samples), up to the record's end; the ground's H1 at the same scale has the point's
+    peak A_ratio g tan(alpha)."""
+    from rocksweep.errors import RocksweepError
+
+    rec = ROOT / "records" / "suite"
+    scene = {"name": "felt", "body": {"kind": "block", "alpha": 0.2},
+             "impact": {"lam": 0.0},
+             "ground": {"record": str(rec / "SYN01.AT2"), "h2": str(rec / "SYN02.AT2"),
+                        "angle": 30.0, "A_ratio": 0.8, "p": 2.0},
+             "floor": {"period": 0.5, "damping": 0.05, "participation": 1.3}}
+    ds = rocksweep.felt_motion(scene)
+    h = rocksweep.simulate(scene).history
+    t = h.p_t.values / 2.0
+    inside = t < ds.t.values[-1]
+    felt = np.interp(t[inside], ds.t.values, ds.a_h.values)
+    assert np.max(np.abs(felt - h.xg_over_g.values[inside])) < 1e-9 * np.max(np.abs(felt))
+    assert np.max(np.abs(ds.a_ground.values)) == pytest.approx(0.8 * math.tan(0.2), rel=1e-6)
+    with pytest.raises(RocksweepError, match="2 points"):
+        rocksweep.felt_motion(scene, {"ground.angle": [0, 90]})

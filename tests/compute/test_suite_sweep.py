@@ -90,8 +90,8 @@ def _scaled_records(sc):
     vals = grid.index_values(np.arange(grid.size))
     out = []
     for i in range(grid.size):
-        r = int(cr.record_index[i])
-        rec = sc.suite.records[r]
+        rec = cr.excitations[int(cr.which[i])].record
+        r = sc.suite.records.index(rec)
         acc = cr.rows[i, L.PAR_AMP] / G * rec.acc / rec.pga
         out.append((r, vals[sc.suite.im][i], acc, cr.alpha_ref[i], vals["p"][i], rec.dt))
     return out

@@ -300,7 +300,7 @@ def test_a_min_figure_of_twelve_panels_has_twelve_colours_and_a_clear_legend():
     from matplotlib.colors import to_rgba
 
     from rocksweep.analysis.boundaries import AMinCurve
-    from rocksweep.figures.diagrams import a_min_figure
+    from rocksweep.figures.a_min import a_min_figure
 
     x = np.geomspace(0.5, 6.0, 8)
     curves = [AMinCurve({"lam": round(0.05 * k, 2)}, x, 1.0 + 0.1 * k + 0.2 * x,
@@ -333,3 +333,107 @@ def test_the_rocking_spectrum_names_its_line_styles_and_the_values_it_shows():
     angled = sp.expand_dims(angle=[30.0, 60.0])
     fig = rocksweep.plot(angled)
     assert "angle = 30" in fig.axes[0].get_title()
+    # a word axis (pulse.shape) is named as itself: formatting it as a number was a
+    # ValueError (issue 45)
+    shaped = sp.expand_dims(shape=["cosine", "sine"])
+    assert "shape = cosine" in rocksweep.plot(shaped).axes[0].get_title()
+
+
+def _texts_clear(fig, name):
+    """No two texts of a figure overprint (tick labels, axis labels, titles, legend
+    entries) and every one lies inside the figure."""
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    r = canvas.get_renderer()
+    texts = [fig._suptitle] if fig._suptitle is not None else []
+    for ax in fig.axes:
+        if not ax.get_visible():
+            continue
+        texts += [ax.title, ax.xaxis.label, ax.yaxis.label]
+        for axis in (ax.xaxis, ax.yaxis):  # the ticks drawn: inside the view interval
+            texts += [t.label1 for t in axis._update_ticks()]
+        if ax.get_legend() is not None:
+            texts += list(ax.get_legend().texts)
+    for leg in fig.legends:
+        texts += list(leg.texts)
+    boxes = [(t.get_text(), t.get_window_extent(r).shrunk(0.98, 0.9)) for t in texts
+             if t.get_visible() and t.get_text().strip()]
+    box = fig.bbox
+    for text, b in boxes:
+        assert (b.x0 >= box.x0 - 1 and b.x1 <= box.x1 + 1 and b.y0 >= box.y0 - 1
+                and b.y1 <= box.y1 + 1), f"{name}: {text!r} outside the figure"
+    for i in range(len(boxes)):
+        for j in range(i):
+            assert not boxes[i][1].overlaps(boxes[j][1]), \
+                f"{name}: {boxes[i][0]!r} over {boxes[j][0]!r}"
+
+
+def _floor_and_angle_datasets():
+    """Synthetic Datasets of the new axes' figures (issue 45): a suite's floor spectrum
+    over orientation x 2 stripes x 8 building periods x 8 damping values (16 curves a
+    panel, more than MAX_CURVES), a pulse's A_min floor spectrum, an IDA over 4 angles x
+    4 periods (16 panels' worth) and a fragility of 16 curves (4 angles x 4 periods)."""
+    import xarray as xr
+
+    T = np.geomspace(0.1, 2.0, 8)
+    damp = np.linspace(0.02, 0.09, 8)
+    p = np.clip(np.linspace(0, 1, 2 * 2 * 8 * 8).reshape(2, 2, 8, 8), 0, 1)
+    fs = xr.Dataset({"p_overturn": (("orientation", "PGA", "floor.damping", "floor.period"),
+                                    p)},
+                    coords={"orientation": ["each", "worst"], "PGA": [0.3, 0.6],
+                            "floor.damping": damp, "floor.period": T},
+                    attrs={"rocksweep_kind": "floor_spectrum", "scale_im": "PGA",
+                           "method": "share of records"})
+    fa = xr.Dataset({"A_min": (("floor.period",), 1.0 + 0.2 * np.log(T))},
+                    coords={"floor.period": T},
+                    attrs={"rocksweep_kind": "floor_spectrum", "method": "A_min",
+                           "kind": "block"})
+    pga = np.array([0.1, 0.2, 0.3, 0.45, 0.6])
+    first = np.geomspace(0.15, 0.5, 6)
+    th = np.where(pga[None, :] < first[:, None], pga[None, :] / first[:, None], np.nan)
+    th = np.broadcast_to(th, (4, 4, 6, 5)).copy()
+    ida = xr.Dataset({"ida_im": (("angle", "floor.period", "record"),
+                                 np.broadcast_to(first, (4, 4, 6)).copy()),
+                      "theta_max_over_alpha": (("angle", "floor.period", "record", "PGA"),
+                                               th)},
+                     coords={"angle": [0.0, 45.0, 90.0, 135.0], "floor.period": T[:4],
+                             "record": [f"RSN{r}_EV_ST000.AT2" for r in range(6)],
+                             "PGA": pga},
+                     attrs={"rocksweep_kind": "ida", "im": "PGA", "im_units": "g"})
+    grid = np.geomspace(0.1, 1.0, 50)
+    med = np.geomspace(0.2, 0.6, 16).reshape(4, 4)
+    from rocksweep.analysis.likelihood import lognormal_cdf
+
+    curve = lognormal_cdf(grid, med[..., None], 0.4)
+    fr = xr.Dataset({"im_median": (("angle", "floor.period"), med),
+                     "beta": (("angle", "floor.period"), np.full((4, 4), 0.4)),
+                     "reason": (("angle", "floor.period"), np.full((4, 4), "ok")),
+                     "curve": (("angle", "floor.period", "im_grid"), curve)},
+                    coords={"angle": [0.0, 45.0, 90.0, 135.0], "floor.period": T[:4],
+                            "im_grid": grid},
+                    attrs={"rocksweep_kind": "fragility", "im": "PGA", "im_units": "g",
+                           "method": "stripes-mle"})
+    return {"floor spectrum over angles": fs, "pulse A_min floor spectrum": fa,
+            "IDA panels": ida, "fragility of 16 curves": fr}
+
+
+@pytest.mark.parametrize("width", [None, "single"])
+def test_the_new_axes_figures_can_be_read(width):
+    """Issue 45: the floor spectrum over angles (clipped title, overprinted log ticks, a
+    legend of two thirds of the width), IDA panels (titles and ticks overlapping), the
+    pulse A_min floor spectrum (y label clipped), a fragility of 16 curves (legend
+    clipped): no text over another, none outside the figure, at the single column width
+    (the double's fit: ``_fits``, as for every figure), and the floor spectra at
+    matplotlib's default size too (what ``rocksweep floor-spectrum`` writes)."""
+    for name, ds in _floor_and_angle_datasets().items():
+        if width is None and "floor" not in name:
+            continue
+        fig = rocksweep.plot(ds, width=width)
+        if width is not None:
+            _fits(fig, name, width)
+        _texts_clear(fig, f"{name} at {width}")
+        if name == "floor spectrum over angles":
+            assert len(fig.axes) == 2 and len(fig.legends) == 1  # a panel per answer
+            assert "of 16 curves" in fig.axes[0].get_title()
+        if name == "IDA panels":
+            assert "6 of 16" in fig._suptitle.get_text()

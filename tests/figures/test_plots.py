@@ -92,7 +92,8 @@ def test_plot_of_alpha_cg_against_A(cli, acg_result, tmp_path):
     data = fig.read_bytes()
     assert data.startswith(b"\x89PNG") and len(data) > 10_000
     assert [p.name for p in tmp_path.iterdir()] == [fig.name]  # no temporary left
-    from rocksweep.figures.diagrams import choose_axes, sweep_figure
+    from rocksweep.figures.diagrams import sweep_figure
+    from rocksweep.figures.panels import choose_axes
 
     result = read_result(acg_result)
     assert choose_axes(result) == ("alpha_cg", "A_ratio")

@@ -6,7 +6,7 @@ from hardkit import kernel_events, numerics, reference_events, run
 from numba import njit
 from test_02_grazing import WINDOW, point, touch
 
-from rocksweep.kernel.layout import PAR_DT, PAR_TPULSE
+from rocksweep.kernel.layout import GROUND_PULSE, PAR_DT, PAR_TPULSE
 from rocksweep.kernel.stepping import rk4_step
 from rocksweep.physics.points import point_row
 
@@ -39,7 +39,8 @@ def _step_in_question(r, t_event):
 def _fresh_steps(t0, y0, taus, s, row):
     out = np.empty(taus.size)
     for i in range(taus.size):
-        out[i] = s * rk4_step(t0, y0, taus[i], s, True, row, True, True, True)[0]
+        out[i] = s * rk4_step(t0, y0, taus[i], s, True, row, True, True, True,
+                                  GROUND_PULSE)[0]
     return out
 
 

@@ -37,6 +37,7 @@ from rocksweep.vocab.settings import ROOT_CODE
 
 # Newton's stopping step in units of the step, as _locate asks for (0.05 tol / width).
 XTOL = 1e-8
+GROUND = L.GROUND_PULSE  # the rows below are sine pulses
 
 
 # ------------------------------------------------------------------------------------
@@ -153,15 +154,17 @@ def test_hermite_min_of_a_quadratic_takes_the_linear_branch():
 @njit
 def _locate_in_step(ev, t0, y0, h, s, on, prm):
     """Take the RK4 step (t0, y0) -> t0 + h of a rigid body and locate ``ev`` in it."""
-    y1 = rk4_step(t0, y0, h, s, on, prm, False, False, False)
-    g0 = event_value(ev, t0, y0, s, on, prm, False, False)
-    g1 = event_value(ev, t0 + h, y1, s, on, prm, False, False)
-    k1 = first_stage(t0, y0, s, on, prm, False, False, False)
-    tau, y_tau, n = _locate(ev, t0, y0, k1, 0.0, g0, h, g1, y1, s, on, prm, False, False,
-                            False)
-    g_tau = event_value(ev, t0 + tau, y_tau, s, on, prm, False, False)
-    y_before = rk4_step(t0, y0, tau - prm[L.PAR_TOL], s, on, prm, False, False, False)
-    g_before = event_value(ev, t0 + tau - prm[L.PAR_TOL], y_before, s, on, prm, False, False)
+    # FLEX, DAMPED, ENERGY false: a rigid body without energy accounting
+    y1 = rk4_step(t0, y0, h, s, on, prm, False, False, False, GROUND)
+    g0 = event_value(ev, t0, y0, s, on, prm, False, False, GROUND)
+    g1 = event_value(ev, t0 + h, y1, s, on, prm, False, False, GROUND)
+    k1 = first_stage(t0, y0, s, on, prm, False, False, False, GROUND)
+    tau, y_tau, n = _locate(ev, t0, y0, k1, g0, h, g1, y1, s, on, prm, False, False, False,
+                            GROUND)
+    g_tau = event_value(ev, t0 + tau, y_tau, s, on, prm, False, False, GROUND)
+    y_before = rk4_step(t0, y0, tau - prm[L.PAR_TOL], s, on, prm, False, False, False, GROUND)
+    g_before = event_value(ev, t0 + tau - prm[L.PAR_TOL], y_before, s, on, prm, False, False,
+                           GROUND)
     return tau, n, g_tau, g_before
 
 

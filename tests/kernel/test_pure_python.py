@@ -10,8 +10,6 @@ import subprocess
 import sys
 from pathlib import Path
 
-import pytest
-
 import rocksweep
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -22,8 +20,9 @@ import numba
 from numba.core import config
 assert config.DISABLE_JIT, "the kernel must run as plain Python here"
 import rocksweep
-from rocksweep.kernel import variants
-assert not hasattr(variants.chunk_flexible, "py_func")  # a plain function, no dispatcher
+from rocksweep.kernel import chunk_kernel, layout as L
+# a plain function (the table's closure), no dispatcher
+assert not hasattr(chunk_kernel(L.KIND_FLEXIBLE, L.LEVEL_OUTCOME), "py_func")
 out = {}
 for name in ("fig5", "fig5-rigid"):
     sims = rocksweep.simulate(f"configs/{name}.yaml")
@@ -76,7 +75,8 @@ def test_entry_cache_falls_back_to_numbas_load(monkeypatch):
     """EntryCache reads two private methods; without them it is numba's load."""
     from numba.core import caching
 
-    from rocksweep.kernel import _cache, variants
+    from rocksweep.kernel import _cache, chunk_kernel
+    from rocksweep.kernel import layout as L  # noqa: N812
 
     calls = []
 
@@ -88,13 +88,14 @@ def test_entry_cache_falls_back_to_numbas_load(monkeypatch):
                  if "_guard_against_spurious_io_errors" in vars(c))
     monkeypatch.delattr(owner, "_guard_against_spurious_io_errors")
     monkeypatch.setattr(caching.FunctionCache, "load_overload", numba_load)
-    cache = _cache.EntryCache(variants.chunk_rigid.py_func)
+    cache = _cache.EntryCache(chunk_kernel(L.KIND_RIGID, L.LEVEL_OUTCOME).py_func)
     assert cache.load_overload("sig", None) is None and calls == ["sig"]
 
 
-@pytest.mark.parametrize("name", ["chunk_rigid"])
-def test_in_cache_of_a_plain_function_needs_no_compile(name):
-    from rocksweep.kernel import _cache, variants
+def test_in_cache_of_a_plain_function_needs_no_compile():
+    from rocksweep.kernel import _cache, chunk_kernel
+    from rocksweep.kernel import layout as L  # noqa: N812
 
-    assert _cache.in_cache(getattr(variants, name).py_func) is True
-    assert _cache.in_cache(getattr(variants, name)) in (True, False)
+    entry = chunk_kernel(L.KIND_RIGID, L.LEVEL_OUTCOME)
+    assert _cache.in_cache(entry.py_func) is True
+    assert _cache.in_cache(entry) in (True, False)

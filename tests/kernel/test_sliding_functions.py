@@ -10,7 +10,7 @@ import math
 import pytest
 
 from rocksweep.kernel import sliding
-from rocksweep.kernel.equations import ground_acc
+from rocksweep.kernel.ground import any_ground_acc as ground_acc
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody, G
 from rocksweep.physics.friction import sliding_block
@@ -21,7 +21,7 @@ Y0 = (0.0,) * 9
 
 def _rk4(t, y, h, s, sigma, on, mu, row):
     def f(tt, yy):
-        return sliding.sliding_derivatives(tt, yy, s, sigma, on, mu, row, False, False, True)
+        return sliding.any_sliding_derivatives(tt, yy, s, sigma, on, mu, row, False, False, True)
 
     def ax(yy, a, k):
         return tuple(yi + a * ki for yi, ki in zip(yy, k, strict=True))
@@ -55,12 +55,12 @@ def _slide(row, mu, mu_s, t_pulse, n=800):
     slide_max, phases = 0.0, []
 
     def stick(tt, yy):
-        on = 1 if tt < t_pulse else 0
+        on = tt < t_pulse
         xg = ground_acc(tt, on, row)
         return sliding.stick_margin(0.0, 0.0, 0.0, 0.0, 0, xg, G, mu_s, row, False, False)
 
     while t < 100 * t_pulse:  # (after the pulse the slip decelerates by mu g: it stops)
-        on = 1 if t < t_pulse else 0
+        on = t < t_pulse
         if sigma == 0 and not on:
             break
         h = min(h_max, t_pulse - t) if on else h_max  # no step straddles the pulse's end

@@ -9,11 +9,14 @@ import numpy as np
 import pytest
 import sympy as sp
 
+from rocksweep.kernel import eq1
 from rocksweep.kernel import equations as eq
-from rocksweep.kernel.layout import PAR_LAM
+from rocksweep.kernel.layout import PAR_LAM, PAR_LAW
 from rocksweep.numerics import Numerics
-from rocksweep.physics.bodies import impact_energy_loss, restitution
+from rocksweep.physics import impact
+from rocksweep.physics.bodies import BlockBody, impact_energy_loss, restitution, restitution_rigid
 from rocksweep.physics.points import Point, point_row
+from rocksweep.vocab.laws import EQ1, LAW_CODE, LOCKED
 
 t = sp.symbols("t")
 m, mA, IA, h, hA, b, g, k, c, lam = sp.symbols("m m_A I_A h h_A b g k c lambda", positive=True)
@@ -157,6 +160,56 @@ def test_eq1_is_the_impulse_momentum_balance(impact_solution):
     for upper, s_val in ((True, 1), (False, -1)):
         paper = _paper_eq1(IA, mA, hA, m, uu, b, lam, upper)
         assert sp.simplify(e.subs(s_old, s_val) - paper) == 0
+
+
+def _locked_momentum(w, corner, x_q, uu, v):
+    """Angular momentum about (x_q, 0) of the body rotating clockwise at w about
+    (corner, 0), the top mass at (uu, h) sliding at v relative to the base."""
+    vp = sp.Matrix([w * h + v, -w * (uu - corner)])
+    va = sp.Matrix([w * hA, w * corner])
+    return (m * ((uu - x_q) * vp[1] - h * vp[0]) + mA * ((0 - x_q) * va[1] - hA * va[0])
+            - IA * w)
+
+
+def test_the_one_eq1_is_the_impulse_momentum_balance(impact_solution):
+    """``kernel.eq1.restitution`` (the one definition: the kernel compiles it, the physics
+    evaluates it on arrays) on sympy symbols equals the balance, for both corners; with
+    m h^2 added (law locked) it is the balance whose top mass keeps u' instead."""
+    uu, v_m, w_m, s_old = impact_solution["syms"]
+    for s_val in (1, -1):
+        coded = eq1.restitution(s_val, uu, lam, m, mA, b, IA + mA * hA**2, 0)
+        assert sp.simplify(coded - impact_solution["e"].subs(s_old, s_val)) == 0
+        # locked: the top mass moves with the base (u' kept): the angular momentum about
+        # the impulse point alone balances, one unknown
+        w_p = sp.Symbol("w_p")
+        x_q = -s_val * b * (1 - lam)
+        before = _locked_momentum(w_m, s_val * b, x_q, uu, v_m)
+        locked = sp.solve(_locked_momentum(w_p, -s_val * b, x_q, uu, v_m) - before, w_p)[0] / w_m
+        coded = eq1.restitution(s_val, uu, lam, m, mA, b, IA + mA * hA**2, m * h**2)
+        assert sp.simplify(coded - locked) == 0
+
+
+def test_every_eq1_caller_gives_the_kernels_bits(body_fig2):
+    """Eq. (1) in one place: the physics (``bodies.restitution``, ``impact.restitution``
+    under each law) and the kernel (``equations.restitution`` on the row) give the same
+    float64, bit for bit, and the rigid body's e likewise."""
+    bd = body_fig2
+    row = point_row(Point(bd, 0.0, "sine", 2.0, 3.0), Numerics())
+    for law in (EQ1, LOCKED):
+        row[PAR_LAW] = LAW_CODE[law]
+        for lam_v in (0.0, 0.3, 1.0, 1.7):
+            row[PAR_LAM] = lam_v
+            u_ = np.linspace(-2.0, 2.0, 9) * bd.u_cr
+            for upper in (True, False):
+                kernel = [eq.restitution(1 if upper else -1, x, row, True) for x in u_]
+                assert impact.restitution(bd, lam_v, u_, upper, law).tolist() == kernel
+                if law == EQ1:
+                    assert restitution(bd, lam_v, u_, upper).tolist() == kernel
+    block = BlockBody(alpha=0.3)
+    row = point_row(Point(block, 0.0, "sine", 2.0, 3.0), Numerics())
+    for lam_v in (0.0, 0.5, 1.0):
+        row[PAR_LAM] = lam_v
+        assert float(restitution_rigid(block, lam_v)) == eq.restitution(1, 0.0, row, False)
 
 
 def test_eq5_is_the_derivative_of_eq1(impact_solution):

@@ -19,8 +19,10 @@ import numpy as np
 import pytest
 from scipy import signal
 
+from rocksweep.errors import FloorError
 from rocksweep.physics.excitation import PulseShape
 from rocksweep.physics.floor import (
+    MAX_MOTION_SAMPLES,
     RINGDOWN_SHARE,
     Mode,
     floor_motion,
@@ -93,6 +95,39 @@ def test_a_stiff_floor_moves_with_the_ground():
     t = np.arange(af.size) * h
     ground = np.interp(t, np.arange(acc.size) * dt, acc, right=0.0)
     assert np.max(np.abs(af - ground)) < 0.02 * np.max(np.abs(acc))
+
+
+@pytest.mark.parametrize("damping", [5e-324, 1e-7])
+def test_an_endless_ringdown_is_refused_before_it_is_made(damping):
+    """The ring-down lasts ln(envelope / 1% of the peak) / (zeta w): 5e-324 overflowed it,
+    1e-7 asked 1.3 GiB and more (issue 45). Refused in one line, counted before any
+    sample of it is made."""
+    import tracemalloc
+
+    acc, dt = ten_seconds()
+    tracemalloc.start()
+    with pytest.raises(FloorError) as err:
+        floor_motion(acc, dt, (Mode(0.5, damping, 1.3),))
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    msg = str(err.value)
+    assert "\n" not in msg and f"{MAX_MOTION_SAMPLES:,}" in msg and "ring-down" in msg
+    assert peak < 8 * MAX_MOTION_SAMPLES / 16  # the record's few samples, not the tail
+    # the bound's edge: 1e-4 rings ln(...) / (1e-4 w) ~ 5e3 s = 5e5 samples: made
+    af, h = floor_motion(acc, dt, (Mode(0.5, 1e-4, 1.3),))
+    assert acc.size < af.size < MAX_MOTION_SAMPLES
+
+
+def test_a_period_of_1e_300_is_a_rigid_building():
+    """w = 2 pi / 1e-300 overflows w^2 (an OverflowError before): a mode with w h > 1e8
+    moves with the ground, its relative response (w h)^-2 below float64's precision; the
+    recurrence's own answer at 1e-9 s (w h ~ 1e5) is already the ground to 1e-9."""
+    acc, dt = ten_seconds()
+    af, h = floor_motion(acc, dt, (Mode(1e-300, 0.05, 1.3), Mode(1e-300, 5e-324, -2.0)))
+    assert h == dt and np.array_equal(af, acc)
+    af9, h9 = floor_motion(acc, dt, (Mode(1e-9, 0.05, 1.3),))
+    ground = np.interp(np.arange(af9.size) * h9, np.arange(acc.size) * dt, acc, right=0.0)
+    assert np.max(np.abs(af9 - ground)) < 1e-9 * np.max(np.abs(acc))
 
 
 def test_projection_rotates_the_horizontal_plane():

@@ -23,6 +23,7 @@ from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
 from rocksweep.physics import impact
 from rocksweep.physics.bodies import FlexibleBody
+from rocksweep.physics.ground_motion import pulse
 from rocksweep.physics.points import Point, point_row
 from rocksweep.scene.parse import load_scene, parse_scene
 
@@ -137,7 +138,7 @@ def test_locked_at_u_0_is_the_rigid_kernels_own_impacts(body_fig3):
     rigid = replace(body_fig3, wn_over_p=math.inf)
     for lam_v in (0.0, 0.4):
         e_locked = eq.restitution(1, 0.0, _row(body_fig3, "locked", lam_v), True)
-        run = run_point(Point(rigid, lam_v, "sine", 6.0, 1.5, cycles=6, law="locked"),
+        run = run_point(Point(rigid, lam_v, pulse("sine", cycles=6), 6.0, 1.5, law="locked"),
                         Numerics(), history=False)
         assert run.impacts >= 5
         assert run.out[L.OUT_E_MAX] == pytest.approx(e_locked, rel=1e-13)
@@ -151,7 +152,7 @@ def test_constant_e_1_conserves_a_rigid_bodys_energy(body_fig3):
     gains energy, at each of many impacts (the history's cumulative impact loss does not
     move beyond the event location's overshoot, ~1e-8 E_ref)."""
     rigid = replace(body_fig3, wn_over_p=math.inf)
-    p = Point(rigid, 0.0, "sine", 6.0, 1.5, cycles=6, law="constant", e=1.0)
+    p = Point(rigid, 0.0, pulse("sine", cycles=6), 6.0, 1.5, law="constant", e=1.0)
     run = run_point(p, Numerics.preset("fine"))
     assert run.impacts >= 10
     steps = np.abs(np.diff(run.history["E_impact"]))
@@ -277,7 +278,7 @@ def test_law_axis_sweeps_resumes_compares_and_refuses_a_changed_law(cli, tmp_pat
 
 
 def test_compare_categories():
-    from rocksweep.figures.diagrams import compare_categories
+    from rocksweep.figures.compare import compare_categories
 
     S, M1, M2, NR = L.OUTCOME_SAFE, L.OUTCOME_MODE1, L.OUTCOME_MODE2, L.OUTCOME_NOT_RUN
     o = np.array([[S, M1, S, M1, M2, NR], [S, S, M1, M1, M2, M1]])

@@ -12,6 +12,7 @@ from scipy.optimize import brentq
 from rocksweep.compute.single import run_point
 from rocksweep.kernel import equations as eq
 from rocksweep.kernel import stepping as ki
+from rocksweep.kernel.layout import GROUND_PULSE
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import FlexibleBody, G, restitution, restitution_rigid
 from rocksweep.physics.points import Point, point_row
@@ -106,7 +107,7 @@ def _rk4_loop(row, y0, t_total, n, s):
     # dispatcher on every call; from jitted code the flags are literals at compile time
     y, t, h = y0, 0.0, t_total / n
     for _ in range(n):
-        y = ki.rk4_step(t, y, h, s, True, row, True, True, True)
+        y = ki.rk4_step(t, y, h, s, True, row, True, True, True, GROUND_PULSE)
         t += h
     return y
 

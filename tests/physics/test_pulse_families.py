@@ -21,10 +21,11 @@ import pytest
 from rocksweep.compute.single import run_point
 from rocksweep.errors import SceneError
 from rocksweep.kernel import layout as L
-from rocksweep.kernel.equations import ground_acc, ground_jerk
+from rocksweep.kernel.ground import any_ground_acc, any_ground_jerk
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody
 from rocksweep.physics.excitation import PulseShape
+from rocksweep.physics.ground_motion import pulse
 from rocksweep.physics.points import Point, point_row
 from rocksweep.scene.parse import parse_scene
 
@@ -35,7 +36,7 @@ CASES = [("sine", 1, 2.0, 90.0), ("sine", 3, 2.0, 90.0), ("cosine", 2, 2.0, 90.0
 
 
 def _point(shape, cycles, gamma, nu, w_over_p=2.0, A_ratio=1.7, body=BLOCK, lam=0.0):
-    return Point(body, lam, shape, w_over_p, A_ratio, cycles, gamma, nu)
+    return Point(body, lam, pulse(shape, cycles, gamma, nu), w_over_p, A_ratio)
 
 
 @pytest.mark.parametrize("shape, cycles, gamma, nu", CASES)
@@ -46,12 +47,12 @@ def test_kernel_ground_motion_is_the_reference_shape(shape, cycles, gamma, nu):
     w = 1.3  # p = 1 in the kernel
     assert row[L.PAR_TPULSE] == pytest.approx(ref.duration / w, rel=1e-15)
     t = np.linspace(0.0, row[L.PAR_TPULSE], 1001)
-    acc = np.array([ground_acc(x, 1, row) for x in t])
-    jerk = np.array([ground_jerk(x, 1, row) for x in t])
+    acc = np.array([any_ground_acc(x, True, row) for x in t])
+    jerk = np.array([any_ground_jerk(x, True, row) for x in t])
     np.testing.assert_allclose(acc, pt.A * ref.acc(w * t), rtol=1e-12, atol=1e-12 * abs(pt.A))
     np.testing.assert_allclose(jerk, pt.A * w * ref.rate(w * t), rtol=1e-12,
                                atol=1e-12 * abs(pt.A) * w)
-    assert ground_acc(0.3, 0, row) == 0.0 and ground_jerk(0.3, 0, row) == 0.0
+    assert any_ground_acc(0.3, False, row) == 0.0 and any_ground_jerk(0.3, False, row) == 0.0
     assert np.max(np.abs(acc)) <= abs(pt.A) * (1 + 1e-12)  # A is the peak
 
 
@@ -99,7 +100,7 @@ def test_two_cycles_are_one_cycle_after_another():
     row = point_row(_point("sine", 1, 2.0, 90.0, w_over_p=w, A_ratio=A), fine)
     row[L.PAR_THETA0], row[L.PAR_THETA_DOT0] = h["theta"][k], h["theta_dot"][k]
     out = np.empty(L.N_OUT)
-    point_kernel(L.KIND_RIGID, False)(row, out, np.empty((200_000, L.N_HIST)))
+    point_kernel(L.KIND_RIGID, L.GROUND_PULSE)(row, out, np.empty((200_000, L.N_HIST)))
     assert out[L.OUT_OUTCOME] != L.OUTCOME_SAFE
     # 1e-5: `fine`'s error; the restarted run's steps differ after T (the rotation limit
     # predicts each step from the last one's theta'', which a restart does not carry over)
@@ -130,7 +131,7 @@ def test_shapes_and_options_in_a_scene():
     assert sc.option("cycles") == 3 and sc.option("nu") == 45.0 and sc.option("gamma") == 2.0
     assert sc.phase_max() == pytest.approx(6 * math.pi)  # 3 cycles and the Ricker: 6 pi
     assert sc.point({"alpha": 0.2618, "inertia": 4 / 3, "lam": 0.0, "shape": "mp",
-                     "w_over_p": 2.0, "A_ratio": 2.0}).nu == 45.0
+                     "w_over_p": 2.0, "A_ratio": 2.0}).excitation.nu == 45.0
     plain = parse_scene(BODY % ("sine", ""))  # the paper's scenes get no new axes
     assert [a.name for a in plain.axes] == ["shape", "alpha", "inertia", "lam", "A_ratio",
                                             "w_over_p"]

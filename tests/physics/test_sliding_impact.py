@@ -23,7 +23,7 @@ from rocksweep.numerics import Numerics
 from rocksweep.physics import sliding_reference as ref
 from rocksweep.physics.bodies import BlockBody
 from rocksweep.physics.points import Point, point_row
-from rocksweep.vocab.laws import CONSTANT, LOCKED, VERTICAL
+from rocksweep.vocab.laws import CONSTANT, EQ1, LOCKED
 
 VX, VY, OM, UD, U = sp.symbols("v_x v_y w ud u")
 
@@ -43,7 +43,7 @@ def _free_body_mass(body, locked: bool):
     return sp.lambdify(U, sp.hessian(T, z), "numpy"), len(z)
 
 
-def _row(body, lam=0.0, law=VERTICAL, e=math.nan, e_factor=1.0):
+def _row(body, lam=0.0, law=EQ1, e=math.nan, e_factor=1.0):
     return point_row(Point(body, lam, "sine", 2.0, 3.0, law=law, e=e, e_factor=e_factor),
                      Numerics())
 
@@ -105,10 +105,10 @@ def _locus(body, row, s, u, law):
 
 
 @pytest.mark.parametrize("body,law", [(bd, law) for bd in (BODY3, BODY2) for law in
-                                      (VERTICAL, LOCKED, CONSTANT)]
-                         + [(BlockBody(alpha=0.2), VERTICAL), (BlockBody(alpha=0.2), CONSTANT)],
+                                      (EQ1, LOCKED, CONSTANT)]
+                         + [(BlockBody(alpha=0.2), EQ1), (BlockBody(alpha=0.2), CONSTANT)],
                          ids=[f"{b}-{law}" for b in ("fig3", "fig2") for law in
-                              (VERTICAL, LOCKED, CONSTANT)] + ["block-vertical",
+                              (EQ1, LOCKED, CONSTANT)] + ["block-eq1",
                                                                "block-constant"])
 def test_impact_is_the_free_body_with_the_laws_locus(body, law):
     """Every law, random states, slipping or stuck before: the kernel's impulses at the
@@ -127,7 +127,7 @@ def test_impact_is_the_free_body_with_the_laws_locus(body, law):
         u = rng.uniform(-0.3, 0.3) * body.u_cr if flex else 0.0
         w, ud = -s * rng.uniform(0.05, 0.5), rng.uniform(-0.3, 0.3) if flex else 0.0
         x_q, e = _locus(body, row, s, u, law)
-        if law == VERTICAL:
+        if law == EQ1:
             assert x_q == pytest.approx(-s * body.b * (1 - lam), rel=1e-9)
         fb = FreeBody(body, u, law == LOCKED)
         for xd, mu in [(0.0, 10.0), (0.0, 0.05), (rng.uniform(-0.3, 0.3), 0.3),
@@ -232,7 +232,7 @@ def test_housner_impact_sticks(alpha):
 
 
 @pytest.mark.parametrize("body", [BODY3, BlockBody(alpha=0.2)], ids=["fig3", "block"])
-@pytest.mark.parametrize("law,e_factor", [(VERTICAL, 1.0), (VERTICAL, 0.8), (LOCKED, 1.0),
+@pytest.mark.parametrize("law,e_factor", [(EQ1, 1.0), (EQ1, 0.8), (LOCKED, 1.0),
                                           (CONSTANT, 1.0)])
 def test_kernel_impact_equals_the_reference_impact(body, law, e_factor):
     """The kernel's family-and-Routh impact and the reference's free-body Routh process

@@ -24,7 +24,7 @@ A_OVER_G = np.linspace(-1.6, 1.6, 33)
 
 def _kernel_word(body, row, A, mu, mu_s, u=0.0, u_dot=0.0):
     s, sigma, flag = sliding.choose_phase(0.0, 0.0, u, u_dot, 0, A, G, mu, mu_s, row,
-                                          not body.rigid, body.zeta > 0 and not body.rigid)
+                                          not body.rigid, not body.rigid and body.zeta > 0)
     if flag & sliding.JAM:
         return friction.JAM, 0, 0
     return PHASES[sliding.phase_code(s, sigma)], s, sigma

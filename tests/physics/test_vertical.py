@@ -29,11 +29,16 @@ from rocksweep.kernel import equations as eq
 from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody, FlexibleBody
+from rocksweep.physics.ground_motion import (
+    Harmonic,
+    air_time_harmonic,
+    air_time_record,
+    pulse,
+    recorded,
+)
 from rocksweep.physics.points import Point, point_row
 from rocksweep.physics.records import parse_record
 from rocksweep.physics.reference import reference_run
-from rocksweep.physics.vertical import VerticalHarmonic, air_time_harmonic, air_time_record
-from rocksweep.vocab.ground import RECORD
 
 G = 9.81
 
@@ -159,9 +164,9 @@ def test_block_uplifts_where_xg_is_g_plus_av_tan_alpha(a_v_g):
 # ------------------------------------------------------------------------------------
 
 
-def _constant(c: float) -> VerticalHarmonic:
+def _constant(c: float) -> Harmonic:
     """a_v = c g exactly: sin(0 t + pi/2) = 1 (``pulse.vertical.w_over_p: 0``)."""
-    return VerticalHarmonic(c, 0.0, 90.0)
+    return Harmonic(c, 0.0, 90.0)
 
 
 @pytest.mark.parametrize("c, lam, A_ratio", [(0.5, 0.2, 4.0), (-0.3, 0.6, 2.5)])
@@ -176,10 +181,10 @@ def test_constant_vertical_is_gravity_times_one_plus_c(c, lam, A_ratio):
     num = Numerics.preset("fine")
     body = FlexibleBody(**FIG4)
     scaled = FlexibleBody(**{**FIG4, "wn_over_p": FIG4["wn_over_p"] / math.sqrt(q)})
-    a = run_point(Point(body, lam, "sine", w_over_p, A_ratio, cycles=3,
-                       pulse_vertical=_constant(c)), num)
-    b = run_point(Point(scaled, lam, "sine", w_over_p / math.sqrt(q), A_ratio / q, cycles=3),
-                 num)
+    a = run_point(Point(body, lam, pulse("sine", cycles=3, harmonic=_constant(c)), w_over_p,
+                        A_ratio), num)
+    b = run_point(Point(scaled, lam, pulse("sine", cycles=3), w_over_p / math.sqrt(q),
+                        A_ratio / q), num)
     ha, hb = a.history_columns(), b.history_columns()
     t_pulse = 3 * 2 * math.pi / w_over_p
     ta = np.linspace(0.0, min(t_pulse, ha["p_t"][-1], hb["p_t"][-1] / math.sqrt(q)), 200)
@@ -215,8 +220,7 @@ def test_kernel_outcome_equals_reference_with_vertical_records(a_v, w_v, A_ratio
     t = np.arange(0.0, 2.0 + dt / 2, dt)
     h = _two_column(t, np.where(t <= 1.0, np.sin(2 * math.pi * t), 0.0), "h")
     v = _two_column(t, a_v * np.sin(w_v * t), "v")
-    point = Point(BlockBody(alpha=0.2), 1.0, RECORD, math.nan, A_ratio, record=h, p=p,
-                  vertical=v)
+    point = Point(BlockBody(alpha=0.2), 1.0, recorded(h, v), math.nan, A_ratio, p=p)
     num = Numerics()
     k = run_point(point, num, history=False)
     r = reference_run(point, num)
@@ -230,9 +234,8 @@ def test_zero_vertical_changes_nothing(body_fig3):
     """The vertical variant with a_v = 0 gives the horizontal variant's run (a check that
     the vertical code adds nothing but g + a_v)."""
     plain = run_point(Point(body_fig3, 0.4, "sine", 5.3, 5.0), Numerics(), history=False)
-    zero = run_point(Point(body_fig3, 0.4, "sine", 5.3, 5.0,
-                          pulse_vertical=VerticalHarmonic(0.0, 3.0, 0.0)), Numerics(),
-                    history=False)
+    zero = run_point(Point(body_fig3, 0.4, pulse("sine", harmonic=Harmonic(0.0, 3.0, 0.0)),
+                           5.3, 5.0), Numerics(), history=False)
     assert zero.outcome == plain.outcome == "mode1"
     assert zero.out[L.OUT_IMPACTS] == plain.out[L.OUT_IMPACTS]
     assert zero.out[L.OUT_T_OVERTURN] == pytest.approx(plain.out[L.OUT_T_OVERTURN], rel=1e-12)
@@ -243,8 +246,8 @@ def test_energy_balance_with_a_vertical(body_fig3):
     constant g), over a run with impacts, to the integrator's error (converged steps);
     the vertical's share of W_in is not small."""
     num = Numerics.preset("fine", steps_per_period=80, event_tol=1e-10)
-    run = run_point(Point(body_fig3, 0.2, "sine", 2.0, 1.5,
-                         pulse_vertical=VerticalHarmonic(0.6, 5.0, 20.0)), num)
+    run = run_point(Point(body_fig3, 0.2, pulse("sine", harmonic=Harmonic(0.6, 5.0, 20.0)),
+                          2.0, 1.5), num)
     o = run.out
     assert o[L.OUT_IMPACTS] >= 1
     balance = o[L.OUT_W_IN] - o[L.OUT_D_DAMP] - o[L.OUT_E_IMPACT]
@@ -278,8 +281,8 @@ def test_air_time_closed_forms():
 def test_airborne_stops_the_run_where_g_plus_av_reaches_zero():
     """A block under a 1.5 g harmonic: the run stops at the closed-form time, status
     airborne (a flagged run), in the kernel and the reference alike."""
-    pv = VerticalHarmonic(1.5, 6.0, 10.0)
-    point = Point(BlockBody(alpha=0.2), 1.0, "sine", 2.0, 1.5, pulse_vertical=pv)
+    pv = Harmonic(1.5, 6.0, 10.0)
+    point = Point(BlockBody(alpha=0.2), 1.0, pulse("sine", harmonic=pv), 2.0, 1.5)
     k = run_point(point, Numerics(), history=False)
     r = reference_run(point, Numerics())
     t_air = (math.pi + math.asin(1 / 1.5) - math.radians(10.0)) / 6.0

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rocksweep.physics.records import parse_record, same_grid, vertical_ims, vertical_samples
+from rocksweep.physics.ground_motion import same_grid, vertical_ims, vertical_samples
+from rocksweep.physics.records import parse_record
 
 
 def _two_column(t, a, name: str):

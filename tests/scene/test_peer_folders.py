@@ -61,6 +61,7 @@ def test_peer_names_pair_by_rsn(tmp_path):
     assert (k.h1.name, k.h2.name, k.up.name) == (names[1], names[0], names[2])
     assert comps[0].missing(True) == ["H2"]
     assert [p.name for p in odd] == ["notes.AT2"]
+    assert all(c.ambiguity() is None for c in comps)
 
 
 def test_a_folder_runs_as_a_suite_with_angles_and_rotd50(tmp_path):
@@ -111,3 +112,72 @@ def test_rotd50_needs_both_horizontals(tmp_path):
         parse_scene(__import__("yaml").safe_dump(scene(
             str(root / "SYN0*.AT2"), scale={"im": "PGA", "values": [0.3],
                                              "component": "RotD50"})))
+
+
+@pytest.mark.parametrize("im", ["AvgSa", "CAV", "Arias"])
+def test_rotd50_of_an_im_without_that_convention_is_one_line(tmp_path, im):
+    """RotD50 is the median over orientations of a peak (PGA, PGV, Sa); AvgSa, CAV and
+    Arias stripes with it ended in "cannot convert float NaN to integer" (issue 45)."""
+    d = folder(tmp_path, n=2, up=False)
+    scale = {"im": im, "values": [0.3], "component": "RotD50"}
+    with pytest.raises(SceneError) as err:
+        parse_scene(__import__("yaml").safe_dump(scene(d, scale=scale)))
+    msg = str(err.value)
+    assert "\n" not in msg and f"ground.scale.im = {im}" in msg and "use component 'H1'" in msg
+
+
+def test_a_duplicate_download_is_never_paired(tmp_path):
+    """A browser's second download beside the first: H1 became the duplicate, H2 the
+    original H1 and the real 090 was dropped, without a word (issue 45). Now the record
+    is named with its files (refused, or skipped with a warning), and .AT2 files that are
+    not PEER names are named in a warning."""
+    import shutil
+
+    d = folder(tmp_path, up=False)
+    shutil.copy(d / "RSN100_EVENT_STA000.AT2", d / "RSN100_EVENT_STA000 (1).AT2")
+    with pytest.raises(SceneError) as err:
+        parse_scene(__import__("yaml").safe_dump(scene(d)))
+    msg = str(err.value)
+    assert "\n" not in msg and "RSN100 has more than two horizontal" in msg
+    assert "RSN100_EVENT_STA000 (1).AT2 looks like a second download" in msg
+    (d / "notes.AT2").write_text("x")
+    with pytest.warns(RecordWarning) as got:
+        sc = parse_scene(__import__("yaml").safe_dump(scene(d, missing="skip")))
+    said = " | ".join(str(w.message) for w in got)
+    assert "RSN100 has more than two" in said and "left out: notes.AT2" in said
+    assert list(sc.suite.names) == ["RSN101_EVENT_STA000.AT2", "RSN102_EVENT_STA000.AT2"]
+    comps = dict((c.rsn, c) for c in peer_components(list(d.iterdir()))[0])
+    assert comps["RSN101"].h2.name == "RSN101_EVENT_STA090.AT2"
+
+
+@pytest.mark.parametrize("kind", ["fifo", "dangling", "loop"])
+def test_a_folder_entry_that_is_no_file_is_named(tmp_path, kind):
+    """FIFOs, dangling and looping links were dropped without a word (issue 45)."""
+    import os
+
+    d = folder(tmp_path, up=False)
+    bad = d / "RSN103_EVENT_STA000.AT2"
+    {"fifo": lambda: os.mkfifo(bad), "dangling": lambda: os.symlink("gone.AT2", bad),
+     "loop": lambda: os.symlink(bad.name, bad)}[kind]()
+    with pytest.raises(SceneError) as err:
+        parse_scene(__import__("yaml").safe_dump(scene(d)))
+    msg = str(err.value)
+    assert "\n" not in msg and bad.name in msg
+    assert {"fifo": "FIFO", "dangling": "link to a missing file",
+            "loop": "loop of symbolic links"}[kind] in msg
+    with pytest.warns(RecordWarning, match=bad.name):
+        sc = parse_scene(__import__("yaml").safe_dump(scene(d, missing="skip")))
+    assert len(sc.suite.records) == 3
+
+
+def test_a_glob_names_a_fifo_or_dangling_link_it_matches(tmp_path):
+    import os
+
+    d = folder(tmp_path, n=2, up=False)
+    os.symlink("gone.AT2", d / "zz.AT2")
+    with pytest.raises(SceneError, match=r"zz.AT2: a symbolic link to a missing file"):
+        parse_scene(__import__("yaml").safe_dump(scene(str(d / "*.AT2"))))
+    (d / "zz.AT2").unlink()
+    os.mkfifo(d / "zz.AT2")
+    with pytest.raises(SceneError, match=r"zz.AT2: is a FIFO"):
+        parse_scene(__import__("yaml").safe_dump(scene(str(d / "*.AT2"))))

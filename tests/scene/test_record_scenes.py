@@ -31,6 +31,7 @@ from rocksweep.errors import SceneError
 from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import FlexibleBody
+from rocksweep.physics.ground_motion import recorded
 from rocksweep.physics.points import Point
 from rocksweep.physics.records import read_record
 from rocksweep.scene.parse import load_scene, parse_scene
@@ -52,8 +53,8 @@ def test_sine_record_is_the_sine_pulse(lam, w_over_p, A_ratio):
     rec = read_record(SINE)
     fine = Numerics.preset("fine", steps_per_period=320, event_tol=1e-10)
     pulse = run_point(Point(body, lam, "sine", w_over_p, A_ratio), fine, history=False)
-    record = run_point(Point(body, lam, RECORD, math.nan, A_ratio, record=rec,
-                            p=4 * math.pi / w_over_p), fine, history=False)
+    record = run_point(Point(body, lam, recorded(rec), math.nan, A_ratio,
+                             p=4 * math.pi / w_over_p), fine, history=False)
     assert record.outcome == pulse.outcome
     assert record.impacts == pulse.impacts and record.uplifts == pulse.uplifts
     if pulse.t_overturn is not None:
@@ -73,7 +74,7 @@ def test_full_contact_response_is_lsim_of_the_record():
     body = FlexibleBody(**FIG3)
     rec = read_record(NEARFAULT)
     p, A_ratio = 2.0, 0.05  # far below uplift: the base never leaves the ground
-    pt = Point(body, 0.0, RECORD, math.nan, A_ratio, record=rec, p=p)
+    pt = Point(body, 0.0, recorded(rec), math.nan, A_ratio, p=p)
     run = run_point(pt, Numerics.preset("fine"))
     assert run.uplifts == 0
     h = run.history
@@ -192,8 +193,7 @@ def test_reference_path_runs_records_sample_by_sample():
     body = FlexibleBody(**FIG3)
     rec = read_record(SINE)
     a = reference_run(Point(body, 0.4, "sine", 5.3, 5.0))
-    b = reference_run(Point(body, 0.4, RECORD, math.nan, 5.0, record=rec,
-                            p=4 * math.pi / 5.3))
+    b = reference_run(Point(body, 0.4, recorded(rec), math.nan, 5.0, p=4 * math.pi / 5.3))
     assert a["outcome"] == b["outcome"] == L.OUTCOME_MODE1
     assert a["impacts"] == b["impacts"] and b["anomalies"] == 0
     assert b["t_overturn"] == pytest.approx(a["t_overturn"], abs=1e-6)

@@ -38,13 +38,13 @@ def test_pulse_vertical_axes_and_variant():
     assert [a.name for a in sc.swept] == ["vertical.amplitude"]
     assert sc.axis("vertical.phase").values == (0.0,)
     p = sc.point({a.name: a.values[-1] for a in sc.axes})
-    assert (p.pulse_vertical.amplitude, p.pulse_vertical.w_over_p) == (0.5, 9.0)
+    assert (p.excitation.harmonic.amplitude, p.excitation.harmonic.w_over_p) == (0.5, 9.0)
 
 
 def test_record_vertical_with_another_dt_is_resampled(files):
     sc = parse_scene(BLOCK + "ground: {record: h.txt, vertical: v_fine.txt, A_ratio: 1.0, "
                      "p: 2.0}", base=files)
-    v = sc.vertical_samples()
+    v = sc.excitation({}).vertical_acc
     t = sc.record.times()
     assert v.shape == (sc.record.npts,)
     np.testing.assert_allclose(v, np.where(t <= 1.5 + 1e-9, 0.1 - 0.2 * t, 0.0), atol=1e-9)
@@ -101,6 +101,19 @@ def test_record_vertical_sweep_keeps_the_vertical(cli, files):
     with h5py.File(out) as f:
         assert f.attrs["vertical_PGA_v"] == pytest.approx(0.4, rel=1e-6)
         assert f.attrs["vertical_VH_ratio"] == pytest.approx(0.4 / 0.3, rel=1e-6)
+    # info says whether the verticals acted (issue 45), a folder's UP files kept off too
+    from types import SimpleNamespace
+
+    from rocksweep.analysis.summary import format_info, info_dict, read_info, vertical_info
+
+    said = [ln for ln in format_info(info_dict(read_info(out))) if ln.startswith("vertical")]
+    assert said == ["vertical ground acceleration: acted: ground.vertical v (PGA_v 0.4 g as "
+                    "recorded, scaled with the record), the kernel's vertical variant"]
+    up = {"suite": {"vertical": [{"name": "RSN1-UP"}], "vertical_acts": False}}
+    assert vertical_info(SimpleNamespace(scene=up))["acted"] is False
+    up["suite"]["vertical_acts"] = True
+    assert vertical_info(SimpleNamespace(scene=up))["acted"] is True
+    assert not vertical_info(SimpleNamespace(scene={"axes": {}}))["acted"]
     (files / "v.txt").unlink()  # the file's own copy rebuilds the scene
     sc = result_scene(read_result(out))
     assert sc.vertical is not None and sc.ground == L.GROUND_VERTICAL

@@ -1,0 +1,146 @@
+"""The adaptive sweep's worker threads kept busy between its serial batches.
+
+Each batch of an adaptive sweep (``compute.adaptive``) is planned from the results of the
+one before, so between batches the workers wait: for the last chunks of a batch, then
+while the next one is planned and the finished chunks are written. ``Runner`` fills that
+time with the audit candidates, which are known before the sweep starts.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
+
+import numpy as np
+
+from rocksweep.compute import sweep as sw
+from rocksweep.compute.adaptive import FILLED, BatchResult, Plan, Subset, audit_mask
+from rocksweep.scene.grid import Grid
+
+# A spare chunk's length [s] at the pace of the chunks so far: a batch planned meanwhile
+# may wait this long for a worker; at ~50 us a point (the four figures) about 1000 points
+# (shorter chunks cost more of their own Python: ~1 s of CPU more on Figure 3(b) at 1000 x
+# 1000 x 3 lam at 0.02 s)
+SPARE_SECONDS = 0.05
+# ... at least this many points (a chunk's own Python costs ~1 ms)
+SPARE_MIN = 16
+
+
+def _member(x: np.ndarray, sorted_want: np.ndarray) -> np.ndarray:
+    """bool[len(x)]: which of x are in sorted_want (increasing): a binary search each, not
+    a sort of both (np.isin) for every small chunk."""
+    if sorted_want.size == 0:
+        return np.zeros(x.shape, bool)
+    pos = np.minimum(np.searchsorted(sorted_want, x), sorted_want.size - 1)
+    return sorted_want[pos] == x
+
+
+class Runner:
+    """The batches of one adaptive sweep on a pool of worker threads, the pool kept busy
+    meanwhile with the audit candidates (``audit_mask``) not computed yet.
+
+    The audit sample is fixed before the sweep starts, and every candidate is computed by
+    the time the sweep ends (by a refinement, or by the audit batch), so computing them
+    early costs nothing: it fills the time a worker would otherwise wait at the end of a
+    batch while the others finish its last chunks and the next batch is planned (the
+    passes are serial: each batch is planned from the results of the one before). Their
+    results wait in memory until a batch asks for their points (``run``), which then gets
+    them as if they had just been computed: what the state machine sees, and so the
+    result, is unchanged (a point's result depends only on the point). A batch's own
+    chunks go first: a spare chunk is started only while fewer chunks than workers run,
+    and it is short (``SPARE_SECONDS`` at the points' pace so far), so that the next
+    batch, on the sweep's critical path, waits for no long one.
+    """
+
+    def __init__(self, grid: Grid, plan: Plan, computed: np.ndarray, jobs: int = 2,
+                 chunk_size: int | None = None) -> None:
+        self.grid, self.level = grid, sw.level(grid.scene)
+        self.workers = sw.effective_jobs(jobs)
+        self.chunk_size = chunk_size
+        # the audit candidates not computed yet, in order (int64[k])
+        self.spare = np.flatnonzero(audit_mask(plan)
+                                    & (np.asarray(computed).ravel() == FILLED))
+        self.pace = [0.0, 0]  # seconds, points of the chunks so far
+        self.ready: list[BatchResult] = []  # spare chunks done, points not asked for yet
+        self.running: dict = {}  # future -> (flat, spare?)
+        self.pool = ThreadPoolExecutor(self.workers)
+
+    def _submit(self, flat: np.ndarray, spare: bool) -> None:
+        self.running[self.pool.submit(self._chunk, flat)] = (flat, spare)
+
+    def _chunk(self, flat: np.ndarray) -> BatchResult:
+        r = sw.run_chunk(Subset(self.grid, flat), 0, flat.size, self.level)
+        return BatchResult(flat, r.arrays, r.seconds, r.cpu_seconds, r.refine_evaluations)
+
+    def _top_up(self) -> None:
+        while self.spare.size and len(self.running) < self.workers:
+            per_point = self.pace[0] / self.pace[1] if self.pace[1] else 1e-3
+            n = max(SPARE_MIN, int(SPARE_SECONDS / max(per_point, 1e-9)))
+            n = min(n, self.chunk_size or n)
+            self._submit(self.spare[:n], True)
+            self.spare = self.spare[n:]
+
+    def _take(self, want: np.ndarray, res: BatchResult
+              ) -> tuple[BatchResult | None, BatchResult | None]:
+        """(the part of res at points in want, the rest), each None if empty; the chunk's
+        times go with the part asked for first."""
+        hit = _member(res.flat, want)
+        if hit.all() or not hit.any():
+            return (res, None) if hit.all() else (None, res)
+
+        def part(m: np.ndarray, seconds: float, cpu: float) -> BatchResult:
+            r = res.refine_evaluations
+            return BatchResult(res.flat[m], {k: v[m] for k, v in res.arrays.items()},
+                               seconds, cpu, None if r is None else r[m])
+
+        return part(hit, res.seconds, res.cpu_seconds), part(~hit, 0.0, 0.0)
+
+    def run(self, flat: np.ndarray) -> Iterator[BatchResult]:
+        """The results of the points ``flat`` (int64[n], increasing), in chunks, as they
+        are ready (spare results first)."""
+        want = np.asarray(flat, np.int64)
+        todo = np.ones(want.size, bool)
+        kept = []
+        for res in self.ready:  # chunk by chunk, as if computed now
+            got, rest = self._take(want, res)
+            if rest is not None:
+                kept.append(rest)
+            if got is not None:
+                todo[np.searchsorted(want, got.flat)] = False
+                yield got
+        self.ready = kept
+        for part, spare in list(self.running.values()):  # spare chunks on their way
+            if spare:
+                todo[np.searchsorted(want, part[_member(part, want)])] = False
+        need = want[todo]
+        size = self.chunk_size or sw.auto_chunk_size(need.size, self.workers)
+        for i in range(0, need.size, size):
+            self._submit(need[i:i + size], False)
+        self.spare = self.spare[~_member(self.spare, want)]
+        left = int(todo.sum()) + sum(int(_member(p, want).sum())
+                                      for p, sp in self.running.values() if sp)
+        self._top_up()
+        while left > 0:
+            done, _ = wait(list(self.running), return_when=FIRST_COMPLETED)
+            for f in done:
+                part, spare = self.running.pop(f)
+                res = f.result()
+                self.pace[0] += res.seconds
+                self.pace[1] += res.flat.size
+                if spare:
+                    got, rest = self._take(want, res)
+                    if rest is not None:
+                        self.ready.append(rest)
+                else:
+                    got = res
+                if got is not None:
+                    left -= got.flat.size
+                    yield got
+            self._top_up()
+
+    def close(self) -> None:
+        """Stop: spare chunks not started are dropped, running ones finish."""
+        self.spare = self.spare[:0]
+        for f in list(self.running):
+            f.cancel()
+        self.pool.shutdown(wait=True)

@@ -1,0 +1,244 @@
+"""What the certification of close calls costs, where its RK4 evaluations go, and what it
+changes: the four figures' adaptive sweeps (and full grids), side by side in one run.
+
+For each figure (Figures 3(a), 3(b), 4(a), 4(b) at RES x RES x 3 lam, default 1000):
+the adaptive sweep (default settings, in memory through the sweep driver,
+``compute.driver.sweep_arrays``, ``--jobs`` workers): its RK4 evaluations (regular +
+event re-integrations, every run of every computed point), the points computed, the wall
+time; with ``--rules`` also where the certification's evaluations go, rule by rule
+(``compute.certify``: the near-misses' probes, and the full reruns of close calls by the
+rule that made them close calls and by refinement level), replayed on the computed points.
+
+    python scripts/bench_certify.py                       # the four figures, adaptive
+    python scripts/bench_certify.py --rules               # ... and per rule
+    python scripts/bench_certify.py --full --res 80       # full grids, certified vs bare
+    PYTHONPATH=/path/to/other/checkout python scripts/bench_certify.py   # another checkout
+    python scripts/bench_certify.py --against /path/to/other/checkout --rounds 2
+
+``--against`` runs the same sweeps of another checkout in a subprocess, alternating with
+this one's (round by round, each process warm: its kernels compiled before it times), and
+prints both and their ratios with the load average: the one side-by-side measurement of
+wall time on a shared machine (RK4 evaluations are deterministic).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
+import numpy as np
+
+from rocksweep.compute import adaptive as ad
+from rocksweep.compute import sweep as sw
+from rocksweep.compute.driver import sweep_arrays
+from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.scene.parse import load_scene
+
+try:
+    from rocksweep.scene.grid import Grid
+except ImportError:  # an older checkout (--against): the grid lived in compute/
+    from rocksweep.compute.grid import Grid
+
+ROOT = Path(__file__).resolve().parents[1]
+FIGS = ("fig3a", "fig3b", "fig4a", "fig4b")
+
+
+def scene(name: str, res: int):
+    """A figure's scene with its two diagram axes at res x res (its ranges)."""
+    base = load_scene(ROOT / "configs" / f"{name}.yaml")
+    ov = []
+    for ax, key in (("w_over_p", "pulse.w_over_p"), ("A_ratio", "pulse.A_ratio")):
+        v = base.axis(ax).values
+        ov.append(f"{key}={{start: {v[0]!r}, stop: {v[-1]!r}, num: {res}}}")
+    return load_scene(ROOT / "configs" / f"{name}.yaml", ov)
+
+
+def evaluations(arr: dict) -> int:
+    return int(arr["steps"].sum() + arr["event_steps"].sum())
+
+
+def sweep_once(name: str, res: int, jobs: int, adaptive: bool) -> dict:
+    """One sweep of a figure: RK4 evaluations, points computed, wall [s], the arrays."""
+    sc = scene(name, res)
+    t0 = time.perf_counter()
+    arr, rep = sweep_arrays(sc, jobs=jobs, adaptive=ad.Options() if adaptive else None)
+    wall = time.perf_counter() - t0
+    computed = rep.adaptive.computed if adaptive else int(arr["outcome"].size)
+    # the certification's share (reports before it was counted have none: -1)
+    refine = int(getattr(rep, "refine_evaluations", -1))
+    return {"evals": evaluations(arr), "computed": computed, "wall": wall,
+            "cpu": rep.cpu_s, "refine": refine, "arrays": arr}
+
+
+def rules(name: str, res: int, arr: dict, jobs: int) -> dict:
+    """The computed points of an adaptive sweep replayed: bare runs, then the
+    certification with every kernel call tallied by rule and level. Returns name ->
+    RK4 evaluations."""
+    from rocksweep.compute import certify as cf
+
+    sc = scene(name, res)
+    grid = Grid(sc)
+    flat = np.flatnonzero(arr["computed"].ravel() > 0) if "computed" in arr else \
+        np.arange(grid.size)
+    cr = grid.rows_at(flat)
+    lvl = sw.level(sc)
+    tally: dict[str, float] = {}
+
+    def add(key: str, res_rows: np.ndarray) -> None:
+        tally[key] = tally.get(key, 0.0) + float(
+            (res_rows[:, L.OUT_STEPS] + res_rows[:, L.OUT_EVENT_STEPS]).sum())
+
+    def part(sel: np.ndarray) -> None:
+        rows = np.ascontiguousarray(cr.rows[sel])
+        kind = int(cr.kinds[sel][0])
+        from rocksweep.compute.dispatch import run_variant
+
+        bare = run_variant(rows, kind, lvl, sc.ground, 0)
+        add("bare runs", bare)
+        fell = cf._fell(bare)
+        close = cf.close_calls(rows, bare)
+        why = np.where(close & fell, "overturn < 8 m", np.where(close, "safe < m",
+                                                                "near-miss flipped"))
+        last = bare[:, L.OUT_OUTCOME].copy()  # outcome at the level before
+        before = bare[:, L.OUT_OUTCOME].copy()  # ... and the one before it
+
+        def run(sub, idx, keep=True):
+            out = run_variant(np.ascontiguousarray(sub), kind, lvl, sc.ground, 0)
+            if not keep:
+                add("probe of near-misses (1 m .. 4 m)", out)
+                return out
+            level = int(round(np.log2(rows[idx[0], L.PAR_DT] / sub[0, L.PAR_DT])))
+            for j, i in enumerate(idx):
+                if level >= 2:
+                    reason = ("outcome changed" if last[i] != before[i]
+                              else "repeated, still close")
+                else:
+                    reason = why[i]
+                add(f"level {level}: {reason}", out[j:j + 1])
+            before[idx] = last[idx]
+            last[idx] = out[:, L.OUT_OUTCOME]
+            return out
+
+        outs = bare.copy()
+        cf.certify(rows, outs, run, sc.numerics.refine)
+        st = outs[:, L.OUT_STATUS].astype(np.int64)
+        tally["points refined"] = tally.get("points refined", 0) + int(
+            (st & L.STATUS_REFINED != 0).sum())
+        tally["points uncertified"] = tally.get("points uncertified", 0) + int(
+            (st & L.STATUS_UNCERTIFIED != 0).sum())
+
+    halves = np.array_split(np.arange(flat.size), max(1, jobs))
+    masks = []
+    for h in halves:
+        m = np.zeros(flat.size, bool)
+        m[h] = True
+        masks.append(m)
+    with ThreadPoolExecutor(len(masks)) as ex:
+        list(ex.map(part, masks))
+    return tally
+
+
+def measure(args) -> dict:
+    """This checkout's numbers (JSON-able): per figure, a list of rounds."""
+    jobs = sw.effective_jobs(args.jobs)
+    out: dict = {}
+    for name in args.figures:
+        sc = scene(name, args.res)
+        sw.prepare(Grid(sc), sw.level(sc))  # compile/load outside the timings
+        r = sweep_once(name, args.res, jobs, not args.full)
+        item = {k: v for k, v in r.items() if k != "arrays"}
+        if args.rules:
+            item["rules"] = rules(name, args.res, r["arrays"], jobs)
+        if args.classes:
+            np.save(Path(args.classes) / f"{name}.npy", r["arrays"]["outcome"])
+        out[name] = item
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("figures", nargs="*", default=list(FIGS))
+    ap.add_argument("--res", type=int, default=1000, help="points per diagram axis")
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--full", action="store_true", help="full grids, not adaptive")
+    ap.add_argument("--rules", action="store_true", help="evaluations per rule (replay)")
+    ap.add_argument("--classes", help="save each figure's outcome here (DIR/NAME.npy)")
+    ap.add_argument("--json", action="store_true", help="print one JSON line (--against)")
+    ap.add_argument("--against", help="another checkout, run alternately in a subprocess")
+    ap.add_argument("--rounds", type=int, default=1)
+    args = ap.parse_args()
+    if args.json:
+        print(json.dumps(measure(args)))
+        return
+    kind = "full grids" if args.full else "adaptive"
+    print(f"cores: {os.cpu_count()}, jobs: {args.jobs}, {kind} "
+          f"at {args.res} x {args.res} x 3 lam; load average at start: "
+          + ", ".join(f"{x:.2f}" for x in os.getloadavg()), flush=True)
+    sides = {"this": [], "other": []}
+    for rnd in range(args.rounds):
+        order = ["other", "this"] if args.against and rnd % 2 == 0 else ["this", "other"]
+        for side in order:
+            if side == "other" and not args.against:
+                continue
+            env = dict(os.environ)
+            if side == "other":
+                env["PYTHONPATH"] = args.against
+            cmd = [sys.executable, str(Path(__file__)), *args.figures, "--res",
+                   str(args.res), "--jobs", str(args.jobs), "--json"]
+            cmd += ["--full"] if args.full else []
+            cmd += ["--rules"] if args.rules and side == "this" else []
+            load = os.getloadavg()[0]
+            got = json.loads(subprocess.run(cmd, env=env, check=True, capture_output=True,
+                                            text=True).stdout.strip().splitlines()[-1])
+            sides[side].append(got)
+            wall = sum(v["wall"] for v in got.values())
+            print(f"round {rnd + 1} {side}: {wall:.1f} s wall for the figures "
+                  f"(load average {load:.2f} -> {os.getloadavg()[0]:.2f})", flush=True)
+    this = sides["this"]
+    other = sides["other"]
+    print("| figure | RK4 evaluations | of them certification | computed | wall s (best) "
+          "| cpu s |"
+          + (" other's evaluations | ratio | other's wall s | ratio |" if other else ""))
+    tot = {"e": 0, "w": 0.0, "oe": 0, "ow": 0.0}
+    for name in args.figures:
+        e = this[0][name]["evals"]
+        w = min(r[name]["wall"] for r in this)
+        r = this[0][name]["refine"]
+        share = (f"{r / 1e6:.1f}M ({e / (e - r):.3f}x the points' own)" if r >= 0
+                 else "not counted")
+        line = (f"| {name} | {e / 1e6:.1f}M | {share} | {this[0][name]['computed']} | "
+                f"{w:.2f} | {this[0][name]['cpu']:.1f} |")
+        tot["e"] += e
+        tot["w"] += w
+        if other:
+            oe = other[0][name]["evals"]
+            ow = min(r[name]["wall"] for r in other)
+            tot["oe"] += oe
+            tot["ow"] += ow
+            line += f" {oe / 1e6:.1f}M | {e / oe:.3f} | {ow:.2f} | {w / ow:.3f} |"
+        print(line)
+    if other:
+        print(f"| all four | {tot['e'] / 1e6:.1f}M | | | {tot['w']:.2f} | | "
+              f"{tot['oe'] / 1e6:.1f}M | {tot['e'] / tot['oe']:.3f} | {tot['ow']:.2f} | "
+              f"{tot['w'] / tot['ow']:.3f} |")
+    if args.rules:
+        for name in args.figures:
+            t = this[0][name]["rules"]
+            print(f"{name}: where the RK4 evaluations of the computed points go (replayed)")
+            total = sum(v for k, v in t.items() if not k.startswith("points"))
+            for k, v in sorted(t.items()):
+                if k.startswith("points"):
+                    print(f"    {k}: {int(v)}")
+                else:
+                    print(f"    {k:<40} {v / 1e6:8.2f}M ({100 * v / total:5.1f}%)")
+
+
+if __name__ == "__main__":
+    main()
