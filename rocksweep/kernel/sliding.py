@@ -72,14 +72,9 @@ from rocksweep.kernel.layout import (
     PAR_MA,
     PAR_MTOT,
     PAR_RESTRATE,
+    Y_X_DOT,
 )
 from rocksweep.vocab import phases as _phases
-
-# The sliding model's three slots after the loop's six (``layout.Y_*``): phase 2 moves
-# them to ``layout``. y = (theta, theta', u, u', W_in, D_damp, x, x', D_fric).
-Y_X = 6  # x, the sliding displacement [m]
-Y_X_DOT = 7  # x' [m/s]
-Y_D_FRIC = 8  # energy dissipated by friction so far [J] (energy variants)
 
 PHASE_REST = _phases.PHASE_CODE[_phases.REST]
 PHASE_SLIDE = _phases.PHASE_CODE[_phases.SLIDE]

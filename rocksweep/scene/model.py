@@ -11,6 +11,7 @@ import numpy as np
 
 from rocksweep import fields
 from rocksweep.errors import SceneError, set_key
+from rocksweep.kernel.layout import CONTACT_NOSLIP, CONTACT_SLIDE
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody, Body, FlexibleBody, G
 from rocksweep.physics.ground_motion import (
@@ -59,7 +60,7 @@ class Scene:
     single_numerics: Numerics  # single runs (simulate): the sweeps' numerics (one default)
     energy: bool
     text: str = field(repr=False)
-    contact: bool = False  # outputs.contact (on when body.mu is given)
+    contact: bool = False  # outputs.contact (the no-slip model's; not with body.mu)
     check: bool = False  # outputs.check: per-point error estimates (a half-step rerun)
     # the `refine` section (adaptive sweep settings, rocksweep.compute.adaptive.Options keywords),
     # None without one
@@ -137,7 +138,8 @@ class Scene:
     def variables(self) -> dict[str, tuple[str, float, str]]:
         """The per-point variables a sweep of this scene stores, name -> (dtype, fill value
         of a point not computed, meaning): ``fields.variables`` of its outputs."""
-        return fields.variables(self.energy, self.contact, self.check, self.floor)
+        return fields.variables(self.energy, self.contact, self.check, self.floor,
+                                self.slides)
 
     @property
     def freq_axis(self) -> str:
@@ -158,6 +160,18 @@ class Scene:
         shapes = ((RECORD,) if self.recorded or self.path is not None
                   else self.axis("shape").values)
         return shared_ground(ground_code(sh, self.has_vertical) for sh in shapes)
+
+    @property
+    def slides(self) -> bool:
+        """Whether the scene gives body.mu: its base may slide (docs/sliding.md), and its
+        results carry slide_max, slide_final and regime."""
+        return any(a.key == "body.mu" for a in self.axes)
+
+    @property
+    def contact_model(self) -> int:
+        """The kernel's contact model a sweep of the scene runs (``layout.CONTACT_*``): the
+        sliding base where the scene gives body.mu (docs/sliding.md), else the paper's."""
+        return CONTACT_SLIDE if self.slides else CONTACT_NOSLIP
 
     @property
     def has_vertical(self) -> bool:
@@ -294,7 +308,8 @@ class Scene:
                 None if su is not None else np.array([float(values["A_ratio"])]), rec,
                 stripe, np.array([body.alpha_ref]), np.array([rate]), (ex,),
                 np.zeros(1, np.int64))[0])
-        kw = {"mu": float(values.get("mu", math.nan)), **self._law(values),
+        kw = {"mu": float(values.get("mu", math.nan)),
+              "mu_static": float(values.get("mu_static", math.nan)), **self._law(values),
               "initial": self.initial_state(values)}
         if ex.record is None:
             return Point(body, float(values["lam"]), ex, rate, a_ratio, **kw)

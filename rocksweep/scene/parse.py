@@ -436,8 +436,9 @@ def _motion(raw: dict, kind: str, base: Path | None, given_record: GroundRecord 
 
 
 def _outputs(raw: dict, kind: str, mu_spec: Any) -> tuple[bool, bool, bool]:
-    """The ``outputs`` section: (energy, contact, check). ``body.mu`` (mu_spec, None: not
-    given) turns the contact outputs on."""
+    """The ``outputs`` section: (energy, contact, check). The contact outputs are the
+    no-slip model's friction demand: a scene that gives ``body.mu`` (mu_spec, None: not
+    given) slides instead (docs/sliding.md) and has none."""
     outputs = section(raw, "outputs", kind, required=False)
     energy = outputs.get("energy", KEYS["outputs.energy"].default)
     if not isinstance(energy, bool):
@@ -445,11 +446,12 @@ def _outputs(raw: dict, kind: str, mu_spec: Any) -> tuple[bool, bool, bool]:
     contact = outputs.get("contact")
     if contact is not None and not isinstance(contact, bool):
         raise SceneError(f"outputs.contact = {fmt(contact)}: {KEYS['outputs.contact'].allowed}")
-    if mu_spec is not None and contact is False:
-        raise SceneError(f"body.mu = {fmt(mu_spec)}: the slides/lifts_off flags need the "
-                         "contact outputs; remove outputs.contact: false (body.mu turns "
-                         "them on)")
-    contact = bool(contact) or mu_spec is not None
+    if mu_spec is not None and contact:
+        raise SceneError(f"outputs.contact = true: the friction demand is the no-slip "
+                         f"model's, and body.mu = {fmt(mu_spec)} makes the base slide "
+                         "(slide_max, slide_final, regime); remove body.mu for the demand "
+                         "of a base that cannot slide")
+    contact = bool(contact)
     check = outputs.get("check", KEYS["outputs.check"].default)
     if not isinstance(check, bool):
         raise SceneError(f"outputs.check = {fmt(check)}: {KEYS['outputs.check'].allowed}")

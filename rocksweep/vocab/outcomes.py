@@ -23,6 +23,7 @@ MODE_WORDS: tuple[str, ...] = ("none", MODE1, MODE2)
 
 SLIDES, LIFTS_OFF = "slides", "lifts_off"  # the contact status words (outputs.contact)
 AIRBORNE = "airborne"  # the ground falls faster than gravity: the body leaves it
+SLID = "slid"  # the base slipped along the ground (a scene with body.mu: docs/sliding.md)
 #: the bits of a run's ``status``: word -> bit (what each means: docs/diagrams.md, "Status
 #: words")
 STATUS_BIT: dict[str, int] = {
@@ -45,6 +46,8 @@ STATUS_BIT: dict[str, int] = {
     # g + a_v <= 0 (a vertical ground acceleration): the body leaves the ground; the run
     # stops there (kernel)
     AIRBORNE: 32768,
+    # the base slipped (the sliding base, a scene that gives body.mu; kernel)
+    SLID: 65536,
 }
 STATUS_WORDS: dict[int, str] = {b: w for w, b in STATUS_BIT.items()}
 #: the bits that make a run's class unreliable ("flagged")
