@@ -470,8 +470,9 @@ def _first_event(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm, FLEX, D
                  ENERGY, GROUND):
     """The first event of the step (t, y) -> (t + h, y1): (slot, tau, y(tau), trials);
     slot -1, h, y1 if none. ev0, ev1: the event values at both ends. Every slot that
-    changed sign is located, the earliest kept; an impact that dips through theta = 0
-    and back inside the step (a grazing one) is screened with theta's cubic Hermite
+    changed sign is located, the earliest kept; an impact right after theta = 0 (the
+    motion turning straight back), and one that dips through theta = 0 and back inside
+    the step (a grazing one), is screened with theta's cubic Hermite
     interpolant and checked on a fresh step to its minimum."""
     literally(FLEX)
     literally(DAMPED)
@@ -479,7 +480,10 @@ def _first_event(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm, FLEX, D
     best, tau_best, y_best, n = -1, h, y1, 0
     for slot in range(N_SLOTS):
         g0, g1 = _pick(ev0, slot), _pick(ev1, slot)
-        if not g0 > 0.0:
+        # theta = 0 after an impact or an uplift: a motion that turns straight back is an
+        # impact just after t (as ``events._crossing``); the other functions fire only
+        # from > 0 (a phase held on the wrong side of its cone waits to come back)
+        if not (g0 > 0.0 or (s != 0 and slot == SLOT_FIRST and g0 == 0.0 and g1 <= 0.0)):
             continue
         hi, g_hi, y_hi = h, g1, y1
         if g1 > 0.0:
