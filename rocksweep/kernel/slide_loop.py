@@ -27,8 +27,11 @@ Results beside the loop's: OUT_SLIDE_MAX, OUT_SLIDE_FINAL (|x| [m]), OUT_REGIME 
 1 << phase code of every phase entered), OUT_D_FRIC (friction's loss, energy variants:
 W_in = E_end + D_damp + E_impact + D_fric; an impact's loss split by
 ``friction_impact``'s W_f), STATUS_SLID where the base slipped. The no-slip model's
-friction demand (REACTIONS, outputs.contact) has no meaning here: NaN. No rigid early
-exit (``rigid_bounded`` bounds a fixed pivot's energy): a run goes on to rest.
+friction demand (REACTIONS, outputs.contact) has no meaning here: NaN. A rigid body
+rocking on a stuck corner once the ground is still is decided safe where its energy is
+below the barrier (``rigid_bounded``: friction and impacts only take energy away;
+STATUS_BOUNDED, its margin), as in the no-slip loop, but the run goes on to rest: the
+slips still to come count.
 """
 
 import math
@@ -38,7 +41,7 @@ from numba import literally, njit
 
 from rocksweep.kernel._cache import INLINE, INTERNAL
 from rocksweep.kernel.equations import rest_margin, tip_moment, uplift_moment
-from rocksweep.kernel.events import hermite_min
+from rocksweep.kernel.events import HERMITE_PAST, NEWTON_XTOL, hermite_min, hermite_root
 from rocksweep.kernel.ground import ground_acc, ground_flags, ground_gravity
 from rocksweep.kernel.layout import (
     HIST_CONTACT,
@@ -105,6 +108,7 @@ from rocksweep.kernel.layout import (
     PAR_U0,
     PAR_U_DOT0,
     STATUS_AIRBORNE,
+    STATUS_BOUNDED,
     STATUS_E_ABOVE_1,
     STATUS_EVENT_CAP,
     STATUS_HIST_FULL,
@@ -130,6 +134,8 @@ from rocksweep.kernel.loop import (
     _near_saddle,
     _overturned,
     _reset,
+    _rigid_bounded,
+    _rigid_margin,
     _rotation_step,
     _saddle,
     _saddle_bounds,
@@ -137,7 +143,6 @@ from rocksweep.kernel.loop import (
     _theta_max,
 )
 from rocksweep.kernel.sliding import (
-    JAM,
     LIFT_OFF,
     TIP_ROUNDOFF,
     choose_phase,
@@ -197,6 +202,7 @@ def simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     t_close = np.nan
     near = _saddle_bounds(prm)
     ev0 = _event_values(t, y, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED, GROUND)
+    free_check = True  # a rigid body's bound, as the no-slip loop's (once per free flight)
 
     while True:
         on = t < t_pulse
@@ -205,11 +211,27 @@ def simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
                 _flag(out, STATUS_REST)
             break
         if t >= t_end:
-            _flag(out, STATUS_HORIZON)
+            if not int(out[OUT_STATUS]) & STATUS_BOUNDED:  # else: decided, went on to show
+                _flag(out, STATUS_HORIZON)
             break
         if vertical and t >= t_air:
             _flag(out, STATUS_AIRBORNE)
             break
+        if not FLEX and s != 0 and sigma == 0 and not on and free_check:
+            # rocking on a stuck corner, the ground still: its energy can only fall
+            # (impacts with e <= 1 and friction dissipate; a slip's kinetic energy is
+            # part of it), so below the barrier it cannot overturn (``rigid_bounded``):
+            # its class is decided (STATUS_BOUNDED), but the run goes on to rest, for
+            # the slips still to come (slide_max, slide_final)
+            free_check = False
+            margin = _rigid_margin(FLEX, y, s, prm, margin)
+            if margin < prm[PAR_CLOSE]:
+                t_close = t
+            peak = _rigid_bounded(FLEX, y, s, prm, FLEX)
+            if peak >= 0.0:
+                if peak > theta_max:
+                    theta_max = peak
+                _flag(out, STATUS_BOUNDED)
         if steps + event_steps >= max_steps:
             _flag(out, STATUS_STEP_CAP)
             break
@@ -279,6 +301,7 @@ def simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
         if s != 0 and slot == SLOT_FIRST:
             y, s, sigma = _impact(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, ENERGY,
                                   GROUND)
+            free_check = True
         else:
             switches += 1
             y, s, sigma = _switch(slot, t, y, s, sigma, on, mu, mu_s, prm, out, FLEX, DAMPED,
@@ -434,9 +457,13 @@ def _pick(ev, slot):
 @njit(cache=True, **INTERNAL)
 def _locate(slot, t0, y0, k1, g_lo, hi, g_hi, y_hi, s, sigma, on, mu, mu_s, prm, FLEX,
             DAMPED, ENERGY, GROUND):
-    """Shrink the bracket [0, hi] (g(0) = g_lo > 0 >= g(hi) = g_hi) of the event in
-    ``slot`` to PAR_TOL by Illinois regula falsi, each trial a fresh RK4 step from
-    (t0, y0) (as ``events._locate``). Returns (tau, y(tau), trials), tau on the far side."""
+    """Shrink the bracket [0, hi] (g(0) = g_lo >= 0 >= g(hi) = g_hi) of the event in
+    ``slot`` to PAR_TOL, each trial a fresh RK4 step from (t0, y0) (as ``events._locate``):
+    an impact (g = s theta, its rate s theta' in the state) by the roots of g's cubic
+    Hermite interpolant (``events.hermite_root``, each trial after the first HERMITE_PAST
+    tolerances past it, a bisection after two that did not halve the bracket: the no-slip
+    loop's rule), the others by Illinois regula falsi. Returns (tau, y(tau), trials), tau
+    on the far side."""
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)
@@ -444,24 +471,42 @@ def _locate(slot, t0, y0, k1, g_lo, hi, g_hi, y_hi, s, sigma, on, mu, mu_s, prm,
     tol = prm[PAR_TOL]
     n = 0
     side = 0
+    hermite = s != 0 and slot == SLOT_FIRST
+    d_lo, d_hi = s * y0[Y_THETA_DOT], s * y_hi[Y_THETA_DOT]
+    slow = 0
     while hi - lo > tol:
-        mid = hi - g_hi * (hi - lo) / (g_hi - g_lo)
-        if mid <= lo + 0.5 * tol or mid >= hi - 0.5 * tol or not (mid == mid):
+        width = hi - lo
+        if hermite and slow < 2:
+            mid = lo + hermite_root(g_lo, d_lo, g_hi, d_hi, width, NEWTON_XTOL * tol / width)
+            if not (mid == mid):
+                mid = 0.5 * (lo + hi)
+            mid += HERMITE_PAST * tol * side  # (side: +1 after lo moved, -1 after hi)
+            mid = min(max(mid, lo + 0.5 * tol), hi - 0.5 * tol)
+        elif hermite:
             mid = 0.5 * (lo + hi)
+        else:
+            mid = hi - g_hi * (hi - lo) / (g_hi - g_lo)
+            if mid <= lo + 0.5 * tol or mid >= hi - 0.5 * tol or not (mid == mid):
+                mid = 0.5 * (lo + hi)
         y_mid = _rk4(t0, y0, mid, k1, s, sigma, on, mu, prm, FLEX, DAMPED, ENERGY, GROUND)
         g_mid = _pick(_event_values(t0 + mid, y_mid, s, sigma, on, mu, mu_s, prm, FLEX,
                                     DAMPED, GROUND), slot)
+        d_mid = s * y_mid[Y_THETA_DOT]
         n += 1
         if g_mid <= 0.0:
-            hi, g_hi, y_hi = mid, g_mid, y_mid
-            if side == -1:
+            hi, g_hi, d_hi, y_hi = mid, g_mid, d_mid, y_mid
+            if side == -1 and not hermite:
                 g_lo *= 0.5
             side = -1
         else:
-            lo, g_lo = mid, g_mid
-            if side == 1:
+            lo, g_lo, d_lo = mid, g_mid, d_mid
+            if side == 1 and not hermite:
                 g_hi *= 0.5
             side = 1
+        if slow >= 2:
+            slow = 0
+        else:
+            slow = slow + 1 if hi - lo > 0.5 * width else 0
     return hi, y_hi, n
 
 
@@ -625,7 +670,7 @@ def _impact(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, ENERGY, GROUND):
     if out[OUT_IMPACTS] == 1.0:
         out[OUT_T_FIRST_IMPACT] = t
     e_before = _energy(y, s, prm, FLEX) if ENERGY else 0.0
-    s_new, w, ud, xd, e, _, _, w_f, flag = friction_impact(
+    s_new, w, ud, xd, e, _, _, w_f, _ = friction_impact(
         y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], y[Y_X_DOT], s, mu, mu_s, prm, FLEX)
     if e > out[OUT_E_MAX]:
         out[OUT_E_MAX] = e
@@ -639,8 +684,6 @@ def _impact(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, ENERGY, GROUND):
     if ENERGY:
         e_d = e_before - _energy(y, s_new, prm, FLEX) + w_f
         out[OUT_E_IMPACT] += e_d
-    if flag & JAM:
-        pass  # (the impulse's own Painleve: stuck through it, W_f counted)
     if xd == 0.0:
         s2, sigma = _choose(t, y, s_new, on, mu, mu_s, prm, out, FLEX, DAMPED, GROUND)
         if s_new == 0 and s2 != 0:
