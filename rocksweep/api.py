@@ -387,7 +387,8 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     from rocksweep.scene.inputs import load, override_strings
 
     sc, _ = load(scene, [*override_strings(overrides), *override_strings(keys)])
-    out = [Simulation({**r.summary(), **sc.physical_summary(), **sc.floor_summary(r.point)},
+    out = [Simulation({**r.summary(), **sc.physical_summary(), **sc.floor_summary(r.point),
+                       **sc.slide_metres(r.summary())},
                       hist, r, title)
            for r, hist, title in titled_runs(sc, API_MAX_RUNS)]
     return out[0] if sc.size == 1 else out

@@ -159,13 +159,14 @@ KEYS: dict[str, Key] = {
                                   "0: no limit)", 0.0, 10.0, required=False),
     "outputs.energy": Key("bool", "must be true or false (store energy metrics)",
                           required=False, default=False),
-    # where the model holds (rocksweep.kernel.contact); body.mu turns it on
+    # the sliding base (docs/sliding.md): given, the base slides (kernel.slide_loop)
     "body.mu": Key("axis", "must be in (0, 10] (kinetic friction coefficient of the base "
                    "on the ground)", 0.0, 10.0, lo_in=False, required=False),
     # the sliding base (docs/sliding.md): static friction, at least mu (default mu)
     "body.mu_static": Key("axis", "must be in (0, 10] and at least body.mu (static friction "
                           "coefficient of the base on the ground; default body.mu)", 0.0,
                           10.0, lo_in=False, required=False),
+    # where the no-slip model holds (rocksweep.kernel.contact); not with body.mu
     "outputs.contact": Key("bool", "must be true or false (store the friction demand, the "
                            "smallest normal force and the impulse ratio)", required=False,
                            default=False),

@@ -63,6 +63,7 @@ from rocksweep.kernel.layout import (
     HIST_XG,
     OUT_CONTACTS,
     OUT_D_DAMP,
+    OUT_D_FRIC,
     OUT_E_END,
     OUT_E_GAINED,
     OUT_E_IMPACT,
@@ -74,6 +75,9 @@ from rocksweep.kernel.layout import (
     OUT_N_GAINING,
     OUT_OUTCOME,
     OUT_REFINE_EVALS,
+    OUT_REGIME,
+    OUT_SLIDE_FINAL,
+    OUT_SLIDE_MAX,
     OUT_STATUS,
     OUT_STEPS,
     OUT_T_CLOSE,
@@ -369,6 +373,11 @@ def _reset(out):
     out[OUT_E_MAX] = 0.0
     out[OUT_HIST_ROWS] = 0.0
     out[OUT_REFINE_EVALS] = 0.0  # the certification's reruns add theirs (compute.certify)
+    # the sliding base's (``slide_loop`` sets its own; the no-slip model has none)
+    out[OUT_SLIDE_MAX] = np.nan
+    out[OUT_SLIDE_FINAL] = np.nan
+    out[OUT_REGIME] = np.nan
+    out[OUT_D_FRIC] = np.nan
 
 
 @njit(cache=True, **INLINE)

@@ -123,6 +123,15 @@ class Scene:
         {} for a body of Pi groups."""
         return {} if self.physical is None else {"p": float(self.physical["p"])}
 
+    def slide_metres(self, summary: dict) -> dict[str, float]:
+        """A physical body's sliding displacements in metres, ``slide_max_m`` and
+        ``slide_final_m`` (the summary's slide_max, slide_final times its half-width
+        b = h_cg tan(alpha_cg)); {} for a body of Pi groups or a run without mu."""
+        if self.physical is None or summary.get("slide_max") is None:
+            return {}
+        b = float(self.physical["h_cg"]) * math.tan(float(self.physical["alpha_cg"]))
+        return {f"{k}_m": summary[k] * b for k in ("slide_max", "slide_final")}
+
     def floor_summary(self, point: Point) -> dict[str, float]:
         """A run's peak floor acceleration {"floor_pfa": [g]} (a scene with a floor:
         ``floor_pfa`` of the motion that drove it, as a sweep stores it); {} without a
