@@ -266,8 +266,7 @@ def simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
         event_steps += n
         if s != 0:
             theta_max = _theta_max(y, y_ev, tau, s, theta_max)
-            if sigma != 0 and not _normal_positive(t + tau, y_ev, s, sigma, on, mu, prm, FLEX,
-                                                   DAMPED, GROUND):
+            if slot < 0 and not ev1[4] > 0.0:  # slide-rock's N at the step's end
                 _flag(out, STATUS_LIFTS_OFF)  # the ground pulls: outside the model
         if abs(y_ev[Y_X]) > slide_max:
             slide_max = abs(y_ev[Y_X])
@@ -310,6 +309,13 @@ def simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
         _record(hist, t, y, s, sigma, on, prm, out, FLEX, GROUND)
     out[OUT_MARGIN] = margin
     out[OUT_T_CLOSE] = t_close
+    _finish(t, y, s, steps, event_steps, theta_max, slide_max, prm, out, FLEX, ENERGY)
+
+
+@njit(cache=True, **INLINE)
+def _finish(t, y, s, steps, event_steps, theta_max, slide_max, prm, out, FLEX, ENERGY):
+    """The result row's last entries: end time, step counts, theta_max, the slide, the
+    energy accounting (NaN without) and the no-slip demand's slots (NaN)."""
     out[OUT_T_END] = t
     out[OUT_STEPS] = steps
     out[OUT_EVENT_STEPS] = event_steps
@@ -397,14 +403,6 @@ def _rest_for_good(y, mu_s, prm, FLEX):
     return rest_margin(u, ud, prm) < 0.0 and f_max <= mu_s * prm[PAR_MTOT] * prm[PAR_G]
 
 
-@njit(cache=True, **INLINE)
-def _normal_positive(t, y, s, sigma, on, mu, prm, FLEX, DAMPED, GROUND):
-    g = ground_gravity(GROUND, t, on, prm)
-    _, n, _ = slip_state(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s, sigma,
-                         ground_acc(GROUND, t, on, prm), g, mu, prm, FLEX, DAMPED)
-    return n > 0.0
-
-
 # ----------------------------------------------------------------------------------------
 # Events
 # ----------------------------------------------------------------------------------------
@@ -413,17 +411,19 @@ def _normal_positive(t, y, s, sigma, on, mu, prm, FLEX, DAMPED, GROUND):
 @njit(cache=True, **INLINE)
 def _event_values(t, y, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED, GROUND):
     """The four event functions of phase (s, sigma) at (t, y) (module docstring; inf: none
-    in this phase); each fires when it goes from > 0 to <= 0."""
+    in this phase), each fires when it goes from > 0 to <= 0; and N [N] while the base
+    slide-rocks (1 in the other phases: no lift-off to flag)."""
     theta, theta_dot, u, u_dot = y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT]
     xg = ground_acc(GROUND, t, on, prm)
     g = ground_gravity(GROUND, t, on, prm)
     e3 = np.inf
+    n = 1.0
     if s != 0:
         e0 = s * theta
         e1 = prm[PAR_THETA_OVER] - s * theta
         if sigma != 0:
-            e3 = slip_state(theta, theta_dot, u, u_dot, s, sigma, xg, g, mu, prm, FLEX,
-                            DAMPED)[2]
+            _, n, e3 = slip_state(theta, theta_dot, u, u_dot, s, sigma, xg, g, mu, prm, FLEX,
+                                  DAMPED)
     else:
         mgb = tip_moment(g, prm)
         if sigma == 0:
@@ -440,7 +440,7 @@ def _event_values(t, y, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED, GROUND):
             e2 = EDGE
     else:
         e2 = sigma * y[Y_X_DOT]
-    return e0, e1, e2, e3
+    return e0, e1, e2, e3, n
 
 
 @njit(cache=True, **INLINE)
@@ -510,9 +510,27 @@ def _locate(slot, t0, y0, k1, g_lo, hi, g_hi, y_hi, s, sigma, on, mu, mu_s, prm,
     return hi, y_hi, n
 
 
-@njit(cache=True, **INTERNAL)
+@njit(cache=True, **INLINE)
 def _first_event(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED,
                  ENERGY, GROUND):
+    """The first event of the step (t, y) -> (t + h, y1), as ``_search``: a screen on the
+    path of every step (inlined), the search a call where a slot may have fired."""
+    maybe = False
+    for slot in range(N_SLOTS):
+        g0, g1 = _pick(ev0, slot), _pick(ev1, slot)
+        if g1 <= 0.0 and (g0 > 0.0 or (s != 0 and slot == SLOT_FIRST and g0 == 0.0)):
+            maybe = True
+    if s != 0 and ev0[0] > 0.0 and s * y[Y_THETA_DOT] < 0.0 < s * y1[Y_THETA_DOT]:
+        maybe = True  # theta turned back toward 0 inside the step: a dip to screen
+    if not maybe:
+        return -1, h, y1, 0
+    return _search(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED,
+                   ENERGY, GROUND)
+
+
+@njit(cache=True, **INTERNAL)
+def _search(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED, ENERGY,
+            GROUND):
     """The first event of the step (t, y) -> (t + h, y1): (slot, tau, y(tau), trials);
     slot -1, h, y1 if none. ev0, ev1: the event values at both ends. Every slot that
     changed sign is located, the earliest kept; an impact right after theta = 0 (the

@@ -65,6 +65,7 @@ from rocksweep.kernel.layout import (
     PAR_H,
     PAR_HA,
     PAR_HCG,
+    PAR_IA0,
     PAR_IAH,
     PAR_IO,
     PAR_LAW,
@@ -106,13 +107,53 @@ def phase_code(s, sigma):
 
 
 @njit(cache=True, **INLINE)
+def acceleration_rates(theta, u, s, prm, FLEX):
+    """(d theta''/da [rad/m], d u''/da [1]): how the accelerations of phase s != 0 move
+    with the base's absolute acceleration a (``equations.rocking_rhs``, ``rigid_rhs``:
+    a enters F_theta as -a lever, F_u as -m a cos(theta); no velocity or gravity term)."""
+    sb = s * prm[PAR_B]
+    cth, sth = math.cos(theta), math.sin(theta)
+    if not FLEX:
+        return -prm[PAR_MTOT] * (prm[PAR_HCG] * cth + sb * sth) / prm[PAR_IO], 0.0
+    m, h = prm[PAR_M], prm[PAR_H]
+    arm = u - sb
+    lever = m * (h * cth - arm * sth) + prm[PAR_MA] * (prm[PAR_HA] * cth + sb * sth)
+    d_th = (h * m * cth - lever) / (prm[PAR_IA0] + m * arm * arm)
+    return d_th, -cth - h * d_th
+
+
+@njit(cache=True, **INLINE)
+def reaction_rates(theta, u, s, prm, FLEX):
+    """(H_a [kg], N_a [kg]): the rates dH/da, dN/da of ``contact.ground_reactions`` in the
+    base's absolute acceleration a (the a-terms of its formulas, with
+    ``acceleration_rates``): the mass the base drags along and how it loads the ground.
+    Flat: H_a = m_A (flexible: the top mass rides on its spring) or M, N_a = 0."""
+    M = prm[PAR_MTOT]
+    if s == 0:
+        return (M - prm[PAR_M] if FLEX else M), 0.0
+    d_th, d_u = acceleration_rates(theta, u, s, prm, FLEX)
+    sb = s * prm[PAR_B]
+    cth, sth = math.cos(theta), math.sin(theta)
+    if not FLEX:
+        hcg = prm[PAR_HCG]
+        return M * (1.0 + d_th * (hcg * cth + sb * sth)), M * d_th * (sb * cth - hcg * sth)
+    m, m_A, h, h_A = prm[PAR_M], prm[PAR_MA], prm[PAR_H], prm[PAR_HA]
+    arm = u - sb
+    d_xp = 1.0 + d_u * cth + d_th * (h * cth - arm * sth)
+    d_yp = -d_u * sth - d_th * (arm * cth + h * sth)
+    d_xa = 1.0 + d_th * (sb * sth + h_A * cth)
+    d_ya = d_th * (sb * cth - h_A * sth)
+    return m * d_xp + m_A * d_xa, m * d_yp + m_A * d_ya
+
+
+@njit(cache=True, **INLINE)
 def reactions_affine(theta, theta_dot, u, u_dot, s, g, prm, FLEX, DAMPED):
     """(H_0, N_0, H_a, N_a) [N, N, kg, kg]: the ground's reactions in phase s as affine
     functions of the base's absolute horizontal acceleration a [m/s^2]: H = H_0 + a H_a,
-    N = N_0 + a N_a (``contact.ground_reactions`` at a = 0 and 1; exact: both are affine)."""
+    N = N_0 + a N_a (``contact.ground_reactions`` at a = 0, ``reaction_rates``)."""
     h0, n0 = ground_reactions(theta, theta_dot, u, u_dot, s, 0.0, g, prm, FLEX, DAMPED)
-    h1, n1 = ground_reactions(theta, theta_dot, u, u_dot, s, 1.0, g, prm, FLEX, DAMPED)
-    return h0, n0, h1 - h0, n1 - n0
+    h_a, n_a = reaction_rates(theta, u, s, prm, FLEX)
+    return h0, n0, h_a, n_a
 
 
 @njit(cache=True, **INLINE)
