@@ -2,8 +2,8 @@
 none in a scene without mu), their units and meanings, the status word ``slid``, and a
 block that cannot rock (mu < tan alpha) rocking or overturning nowhere on the grid.
 
-Cost: the rigid block's outcome-level chunk variant of the slide loop (~25 s of CPU to
-compile cold), 50 points."""
+Cost: the rigid block's outcome-level chunk variant of the slide loop (18 s of CPU to
+compile cold, docs/sliding.md "Cost"), 100 points."""
 
 
 import rocksweep
