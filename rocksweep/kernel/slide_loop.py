@@ -340,6 +340,22 @@ def _finish(t, y, s, steps, event_steps, theta_max, slide_max, prm, out, FLEX, E
         out[OUT_E_END] = np.nan
 
 
+def chunk_entry(FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
+    """The chunk entry point's body of a row (``variants.ContactModel``): the loop a
+    global name of this module, as ``variants``' no-slip entries."""
+    def chunk(prms, outs):
+        for i in range(prms.shape[0]):
+            simulate_sliding(prms[i], outs[i], None, FLEX, DAMPED, ENERGY, REACTIONS, GROUND)
+    return chunk
+
+
+def point_entry(FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
+    """The point entry point's body of a row (``chunk_entry``'s)."""
+    def point(prm, out, hist):
+        simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND)
+    return point
+
+
 # ----------------------------------------------------------------------------------------
 # Steps
 # ----------------------------------------------------------------------------------------
