@@ -12,6 +12,7 @@ so times are p*t.
 from rocksweep.vocab import ground as _ground
 from rocksweep.vocab import laws as _laws
 from rocksweep.vocab import outcomes as _out
+from rocksweep.vocab import phases as _phases
 from rocksweep.vocab import settings as _settings
 
 # --- parameter row ---------------------------------------------------------------------
@@ -162,6 +163,12 @@ HIST_X = 11  # the sliding displacement x [m]
 HIST_CONTACT = 12  # the contact phase's code (``vocab.phases``: rest, slide, rock, slide-rock)
 HIST_D_FRIC = 13  # energy dissipated by friction so far [J]
 N_HIST = 14
+
+# --- contact phases (``vocab.phases``; the sliding base, docs/sliding.md) -----------------
+PHASE_REST = _phases.PHASE_CODE[_phases.REST]
+PHASE_SLIDE = _phases.PHASE_CODE[_phases.SLIDE]
+PHASE_ROCK = _phases.PHASE_CODE[_phases.ROCK]
+PHASE_SLIDE_ROCK = _phases.PHASE_CODE[_phases.SLIDE_ROCK]
 
 # --- outcome and status codes ----------------------------------------------------------
 # (codes and words: ``rocksweep.vocab.outcomes``)

@@ -50,7 +50,9 @@ from rocksweep.kernel.events import (
 )
 from rocksweep.kernel.ground import ground_acc, ground_flags
 from rocksweep.kernel.layout import (
+    HIST_CONTACT,
     HIST_D_DAMP,
+    HIST_D_FRIC,
     HIST_E,
     HIST_E_IMPACT,
     HIST_PHASE,
@@ -60,6 +62,7 @@ from rocksweep.kernel.layout import (
     HIST_U,
     HIST_U_DOT,
     HIST_W_IN,
+    HIST_X,
     HIST_XG,
     OUT_CONTACTS,
     OUT_D_DAMP,
@@ -111,6 +114,8 @@ from rocksweep.kernel.layout import (
     PAR_TPULSE,
     PAR_U0,
     PAR_U_DOT0,
+    PHASE_REST,
+    PHASE_ROCK,
     STATUS_AIRBORNE,
     STATUS_BOUNDED,
     STATUS_E_ABOVE_1,
@@ -587,6 +592,11 @@ def _write_row(hist, row, t, y, s, on, prm, e_imp, FLEX, GROUND):
     hist[row, HIST_D_DAMP] = y[Y_D_DAMP]
     hist[row, HIST_E_IMPACT] = e_imp
     hist[row, HIST_XG] = ground_acc(GROUND, t, on, prm)
+    # the sliding base's columns, as a base that cannot slide has them: x = 0, rest or
+    # rock (``vocab.phases``' codes), no friction loss
+    hist[row, HIST_X] = 0.0
+    hist[row, HIST_CONTACT] = PHASE_ROCK if s != 0 else PHASE_REST
+    hist[row, HIST_D_FRIC] = 0.0
     return True
 
 

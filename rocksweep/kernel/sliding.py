@@ -73,14 +73,10 @@ from rocksweep.kernel.layout import (
     PAR_MA,
     PAR_MTOT,
     PAR_RESTRATE,
+    PHASE_REST,
+    PHASE_ROCK,
     Y_X_DOT,
 )
-from rocksweep.vocab import phases as _phases
-
-PHASE_REST = _phases.PHASE_CODE[_phases.REST]
-PHASE_SLIDE = _phases.PHASE_CODE[_phases.SLIDE]
-PHASE_ROCK = _phases.PHASE_CODE[_phases.ROCK]
-PHASE_SLIDE_ROCK = _phases.PHASE_CODE[_phases.SLIDE_ROCK]
 
 # ``friction_impact``'s and ``choose_phase``'s flags (bits): no consistent slip (Painleve),
 # the contact stuck by a tangential impulse; the impact needed no push from the ground;
