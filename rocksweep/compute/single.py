@@ -132,14 +132,15 @@ class Run:
     def impact_losses(self) -> np.ndarray:
         """The energy [J] each impact dissipated (eq. 6 under the run's impact law; < 0:
         that impact gained energy), in order: float64[impacts]. From the history, where an
-        impact is the pair of rows at one time whose first rocks (phase != 0): the jump of
-        the impacts' cumulative loss across it."""
+        impact is the pair of rows at one time whose first rocks (phase != 0) and whose
+        second does not rock on the same corner (the sliding base's stick breaks, slip
+        stops and jams keep it): the jump of the impacts' cumulative loss across it."""
         if self.history is None:
             raise ValueError(NO_HISTORY)
         t = np.asarray(self.history["t"])
         phase = np.asarray(self.history["phase"])
         lost = np.asarray(self.history["E_impact"])
-        at = np.flatnonzero((t[1:] == t[:-1]) & (phase[:-1] != 0))
+        at = np.flatnonzero((t[1:] == t[:-1]) & (phase[:-1] != 0) & (phase[1:] != phase[:-1]))
         return lost[at + 1] - lost[at]
 
     def history_columns(self) -> dict[str, np.ndarray]:

@@ -35,6 +35,8 @@ def test_simulate_with_mu_reports_the_slide(tmp_path):
     write_history_csv([sim.run], [], csv)
     assert {"x_over_b", "contact_phase"} <= set(csv.read_text().splitlines()[0].split(","))
     assert len(sim.figure().axes) == 5  # theta's panel has the x/b axis on its right
+    # the stick breaks and slip stops (rows at one time, the corner kept) are no impacts
+    assert len(s["impact_losses_over_Eref"]) == s["impacts"]
 
 
 def test_simulate_without_mu_has_none():
