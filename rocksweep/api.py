@@ -276,7 +276,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     ds: what ``run`` or ``open`` returns (or a result file's path). state: "overturn"
     (either mode), "mode1", "mode2", "uplift", "theta:X" (max|theta|/alpha_cg >= X, or
     overturned, 0 < X <= 1), "slide:D" (the base's sliding displacement slide_max >= D, or
-    overturned, D > 0 in slide_max's units: b, metres for a physical body; a scene with
+    overturned, D > 0 in base half-widths b, slide_max's units; a scene with
     body.mu), or a list of them (a ``state`` dimension; each state fitted
     alone, its numbers the same whatever else is asked for; nested curves that cross in
     the data say "crossing"). joint: damage states share one beta (an ordinal fit, its
@@ -383,7 +383,8 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     from rocksweep.scene.inputs import load, override_strings
 
     sc, _ = load(scene, [*override_strings(overrides), *override_strings(keys)])
-    out = [Simulation({**r.summary(), **sc.physical_summary(), **sc.floor_summary(r.point)},
+    out = [Simulation({**r.summary(), **sc.physical_summary(), **sc.floor_summary(r.point),
+                       **sc.slide_metres(r.summary())},
                       hist, r, title)
            for r, hist, title in titled_runs(sc, API_MAX_RUNS)]
     return out[0] if sc.size == 1 else out

@@ -29,6 +29,10 @@ from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.bodies import G, u_cr
 from rocksweep.vocab.axes import AXES, alpha_symbol
 from rocksweep.vocab.ground import AVGSA_POINTS, RECORD_IMS, SA, SA_DAMPING, SCALE_IMS
+from rocksweep.vocab.phases import PHASE_CODE
+
+#: the regime variable's bits, in words (``vocab.phases``: bit 1 << code of each phase)
+REGIME_BITS = ", ".join(f"{1 << c} {w}" for w, c in PHASE_CODE.items())
 
 
 @dataclass(frozen=True)
@@ -38,7 +42,8 @@ class Field:
     name: the user-facing name; dtype: numpy dtype in files; fill: value of a point not
     computed; unit: see the module docstring; meaning: one line; slot: index into the
     kernel's result row (``layout.OUT_*``); scale: per-point divisor, "" (none),
-    "alpha_ref" or "E_ref"; stored: kept in sweep files; energy: needs the
+    "alpha_ref", "E_ref" or "b" (the base's half-width); stored: kept in sweep files;
+    slide: the sliding base's (a scene that gives body.mu, docs/sliding.md); energy: needs the
     energy-accounting kernel (sweeps with ``outputs: {energy: true}``, single runs);
     contact: needs the ground-reaction kernel (``outputs: {contact: true}``, stored and
     reported only when asked); check: an error estimate from the point's rerun at half the
@@ -56,6 +61,7 @@ class Field:
     stored: bool = True
     energy: bool = False
     contact: bool = False
+    slide: bool = False
     check: str = ""
     label: str = ""
     symbol: str = ""
@@ -147,6 +153,23 @@ FIELDS: tuple[Field, ...] = (
           "largest |horizontal|/vertical ground impulse of an impact (0: no impact)",
           L.OUT_IMPULSE_MAX, contact=True,
           label="largest impulse ratio", symbol="max|P_H|/P_V"),
+    # the sliding base (a scene that gives body.mu; docs/sliding.md)
+    Field("slide_max", "float64", math.nan, "b",
+          "largest sliding displacement max |x| / b over the run (x: how far the base "
+          "slipped along the ground; b the base's half-width)", L.OUT_SLIDE_MAX, "b",
+          slide=True, label="largest sliding displacement", symbol="max|x|/b"),
+    Field("slide_final", "float64", math.nan, "b",
+          "sliding displacement |x| / b at the end of the run (where the base came to rest)",
+          L.OUT_SLIDE_FINAL, "b", slide=True,
+          label="final sliding displacement", symbol="|x_end|/b"),
+    Field("regime", "int8", -1, "1",
+          "contact phases the run visited, a bit mask: bit (1 << code) of each phase "
+          f"entered ({REGIME_BITS}; -1 not computed)", L.OUT_REGIME, slide=True,
+          label="contact phases visited"),
+    Field("friction_loss_over_Eref", "float64", math.nan, "E_ref",
+          "energy dissipated by friction (sliding and friction impulses) / E_ref",
+          L.OUT_D_FRIC, "E_ref", slide=True, energy=True,
+          label="energy dissipated by friction", symbol="E_fric/E_ref"),
     # per-point error estimates (outputs.check): the same point rerun at half the step
     Field("check_outcome", "int8", L.OUTCOME_NOT_RUN, "1",
           "outcome of the point rerun at half the step (differs from outcome: not resolved "
@@ -167,20 +190,29 @@ UNITS: dict[str, str] = {f.name: f.unit for f in FIELDS}
 """name -> unit of every result field (the ``units`` attribute of a file's variable)."""
 
 SWEEP_FIELDS: tuple[Field, ...] = tuple(
-    f for f in FIELDS if f.stored and not f.energy and not f.contact and not f.check)
-ENERGY_FIELDS: tuple[Field, ...] = tuple(f for f in FIELDS if f.stored and f.energy)
+    f for f in FIELDS if f.stored and not f.energy and not f.contact and not f.check
+    and not f.slide)
+ENERGY_FIELDS: tuple[Field, ...] = tuple(
+    f for f in FIELDS if f.stored and f.energy and not f.slide)
+SLIDE_FIELDS: tuple[Field, ...] = tuple(
+    f for f in FIELDS if f.stored and f.slide and not f.energy)
+SLIDE_ENERGY_FIELDS: tuple[Field, ...] = tuple(
+    f for f in FIELDS if f.stored and f.slide and f.energy)
 CONTACT_FIELDS: tuple[Field, ...] = tuple(f for f in FIELDS if f.stored and f.contact)
 CHECK_FIELDS: tuple[Field, ...] = tuple(f for f in FIELDS if f.check)
 RUN_FIELDS: tuple[Field, ...] = tuple(f for f in FIELDS if not f.check)
 """The fields of one run's own result row (single runs, the accuracy report)."""
 
 
-def sweep_fields(energy: bool, contact: bool = False, check: bool = False
-                 ) -> tuple[Field, ...]:
+def sweep_fields(energy: bool, contact: bool = False, check: bool = False,
+                 slide: bool = False) -> tuple[Field, ...]:
     """The fields a sweep file stores (``energy``, ``contact``, ``check``: the scene's
-    ``outputs.energy``, ``outputs.contact`` and ``outputs.check``)."""
+    ``outputs.energy``, ``outputs.contact`` and ``outputs.check``; ``slide``: the scene
+    gives body.mu, its base slides)."""
     return (SWEEP_FIELDS + (ENERGY_FIELDS if energy else ())
-            + (CONTACT_FIELDS if contact else ()) + (CHECK_FIELDS if check else ()))
+            + (CONTACT_FIELDS if contact else ()) + (CHECK_FIELDS if check else ())
+            + (SLIDE_FIELDS if slide else ())
+            + (SLIDE_ENERGY_FIELDS if slide and energy else ()))
 
 
 #: the per-point variable of a scene with a ``floor:`` (not a kernel output: the peak of
@@ -193,12 +225,12 @@ FLOOR_PFA_VARIABLE = ("float64", math.nan,
 
 
 def variables(energy: bool = False, contact: bool = False, check: bool = False,
-              floor: bool = False) -> dict[str, tuple[str, float, str]]:
+              floor: bool = False, slide: bool = False) -> dict[str, tuple[str, float, str]]:
     """The per-point variables a sweep stores: name -> (dtype, fill value of a point not
     computed, meaning), from ``sweep_fields`` (the one table, ``FIELDS``), and
     ``floor_pfa`` [g] with ``floor`` (a scene with a building)."""
     out = {f.name: (f.dtype, f.fill, f.meaning)
-           for f in sweep_fields(energy, contact, check)}
+           for f in sweep_fields(energy, contact, check, slide)}
     if floor:
         out[FLOOR_PFA] = FLOOR_PFA_VARIABLE
     return out
@@ -230,13 +262,15 @@ def check_rows(rows: np.ndarray) -> np.ndarray:
 
 
 def convert(outs: np.ndarray, alpha_ref: np.ndarray | float, E_ref: np.ndarray | float,
-            fields: tuple[Field, ...] | list[Field]) -> dict[str, np.ndarray]:
+            fields: tuple[Field, ...] | list[Field], b: np.ndarray | float = math.nan
+            ) -> dict[str, np.ndarray]:
     """Kernel result rows -> named arrays in the fields' units and dtypes.
 
-    outs: float64[n, N_OUT]; alpha_ref [rad], E_ref [J]: float64[n] or scalars (the
-    per-point scales). Returns name -> array[n] (fresh arrays, not views of ``outs``).
+    outs: float64[n, N_OUT]; alpha_ref [rad], E_ref [J], b [m]: float64[n] or scalars (the
+    per-point scales; b the base's half-width, for the sliding base's fields). Returns
+    name -> array[n] (fresh arrays, not views of ``outs``).
     """
-    scales = {"": None, "alpha_ref": alpha_ref, "E_ref": E_ref}
+    scales = {"": None, "alpha_ref": alpha_ref, "E_ref": E_ref, "b": b}
     arrays = {}
     for f in fields:
         if f.check:
@@ -273,13 +307,14 @@ def plain(v: Any, *, nan_to_none: bool = False) -> Any:
     return v
 
 
-def value(out: np.ndarray, f: Field, alpha_ref: float, E_ref: float) -> int | float | None:
+def value(out: np.ndarray, f: Field, alpha_ref: float, E_ref: float, b: float = math.nan
+          ) -> int | float | None:
     """One field of one result row as a plain Python number (NaN -> None for optional
-    times and energies)."""
+    times and energies); b [m]: the base's half-width (the sliding base's fields)."""
     v = float(out[f.slot])
     if math.isnan(v):
         return None
-    v /= {"": 1.0, "alpha_ref": alpha_ref, "E_ref": E_ref}[f.scale]
+    v /= {"": 1.0, "alpha_ref": alpha_ref, "E_ref": E_ref, "b": b}[f.scale]
     return int(v) if np.dtype(f.dtype).kind == "i" else v
 
 
@@ -420,6 +455,16 @@ HISTORY: tuple[Column, ...] = (
     Column("xg_over_g", "xg", L.HIST_XG, "g", "g", "ground acceleration x_g''/g (eq. 2)"),
 )
 
+#: the sliding base's columns (a point that gives body.mu: its runs write them)
+SLIDE_HISTORY: tuple[Column, ...] = (
+    Column("x_over_b", "x", L.HIST_X, "b", "b",
+           "sliding displacement x/b: how far the base slipped along the ground"),
+    Column("contact_phase", "contact_phase", L.HIST_CONTACT, "", "1",
+           "contact phase code: " + ", ".join(f"{c} {w}" for w, c in PHASE_CODE.items())),
+    Column("D_fric_over_Eref", "D_fric", L.HIST_D_FRIC, "E_ref", "E_ref",
+           "energy dissipated by friction so far / E_ref"),
+)
+
 HISTORY_RAW: tuple[str, ...] = tuple(c.raw for c in sorted(HISTORY, key=lambda c: c.slot))
 """Keys of ``Run.history`` in kernel column order."""
 
@@ -429,5 +474,6 @@ def history_columns(raw: dict[str, np.ndarray], body) -> dict[str, np.ndarray]:
     ``HISTORY`` order. body: the run's body (alpha_ref, u_cr, E_ref)."""
     # a rigid body (welded, a block) has no u_cr: its u column (0) is NaN
     scales = {"": 1.0, "alpha_ref": body.alpha_ref, "u_cr": u_cr(body) or math.nan,
-              "E_ref": body.E_ref, "g": G}
-    return {c.name: np.asarray(raw[c.raw], float) / scales[c.scale] for c in HISTORY}
+              "E_ref": body.E_ref, "g": G, "b": body.b}
+    cols = HISTORY + (SLIDE_HISTORY if SLIDE_HISTORY[0].raw in raw else ())
+    return {c.name: np.asarray(raw[c.raw], float) / scales[c.scale] for c in cols}

@@ -159,9 +159,14 @@ KEYS: dict[str, Key] = {
                                   "0: no limit)", 0.0, 10.0, required=False),
     "outputs.energy": Key("bool", "must be true or false (store energy metrics)",
                           required=False, default=False),
-    # where the model holds (rocksweep.kernel.contact); body.mu turns it on
-    "body.mu": Key("axis", "must be in (0, 10] (friction coefficient of the base on the "
-                   "ground)", 0.0, 10.0, lo_in=False, required=False),
+    # the sliding base (docs/sliding.md): given, the base slides (kernel.slide_loop)
+    "body.mu": Key("axis", "must be in (0, 10] (kinetic friction coefficient of the base "
+                   "on the ground)", 0.0, 10.0, lo_in=False, required=False),
+    # the sliding base (docs/sliding.md): static friction, at least mu (default mu)
+    "body.mu_static": Key("axis", "must be in (0, 10] and at least body.mu (static friction "
+                          "coefficient of the base on the ground; default body.mu)", 0.0,
+                          10.0, lo_in=False, required=False),
+    # where the no-slip model holds (rocksweep.kernel.contact); not with body.mu
     "outputs.contact": Key("bool", "must be true or false (store the friction demand, the "
                            "smallest normal force and the impulse ratio)", required=False,
                            default=False),
@@ -301,6 +306,9 @@ BODY_KEYS: dict[str, tuple[str, ...]] = {
     "block": ("alpha", "inertia"),
     "physical": ("b", "h", "h_A", "m", "m_A", "I_A", "k", "c"),
 }
+#: the ground's keys in the body section (friction of the base on the ground; not the
+#: body's own: a body is made of the other keys)
+FRICTION_KEYS: tuple[str, ...] = ("mu", "mu_static")
 SECTIONS = ("body", "impact", "pulse", "numerics", "outputs", "ground", "refine", "initial",
             "floor")
 
@@ -308,7 +316,7 @@ SECTIONS = ("body", "impact", "pulse", "numerics", "outputs", "ground", "refine"
 def section_keys(section: str, kind: str = "flexible") -> tuple[str, ...]:
     """The keys (without the section) a section may hold; body keys depend on its kind."""
     if section == "body":
-        return ("kind", *BODY_KEYS[kind], "mu")
+        return ("kind", *BODY_KEYS[kind], *FRICTION_KEYS)
     pre = section + "."
     return tuple(k[len(pre):] for k in KEYS if k.startswith(pre) and "." not in k[len(pre):])
 

@@ -27,6 +27,7 @@ times are less sensitive to load than wall times.
     python scripts/bench_compile.py            # ~3-4 min on 2 cores
     python scripts/bench_compile.py --quick    # ~30 s: Figure 3(a)'s variant and scene only
     python scripts/bench_compile.py --vertical # item 1 alone: vertical and ground variants
+    python scripts/bench_compile.py --slide    # item 1 alone: sliding and no-slip variants
 
 Run it against another copy of the package (e.g. the code before a change) with
 ``PYTHONPATH=/path/to/that/copy``: every subprocess inherits the environment.
@@ -88,6 +89,11 @@ QUICK_VARIANTS = [(L.KIND_FLEXIBLE, L.LEVEL_OUTCOME, L.GROUND_PULSE)]
 # extend (docs/vertical.md), each level a scene can ask for
 VERTICAL_VARIANTS = [(k, lv, g) for k in KINDS for lv in (L.LEVEL_OUTCOME, None)
                      for g in (L.GROUND_ANY, L.GROUND_VERTICAL)]
+# --slide: the sliding base's variants (a scene that gives body.mu, docs/sliding.md)
+# beside the no-slip ones they replace: (kind, level, ground, contact)
+SLIDE_VARIANTS = [(k, lv, L.GROUND_PULSE, c) for k in (L.KIND_FLEXIBLE, L.KIND_RIGID)
+                  for lv in (L.LEVEL_OUTCOME, None)
+                  for c in (L.CONTACT_NOSLIP, L.CONTACT_SLIDE)]
 
 _COMPILE_SNIPPET = """
 import json, sys, time
@@ -95,8 +101,8 @@ c0, w0 = time.process_time(), time.perf_counter()
 import rocksweep
 from rocksweep.kernel import warm_up
 c1, w1 = time.process_time(), time.perf_counter()
-kind, level, ground = json.loads(sys.argv[1])
-warm_up(kind, level, ground)
+kind, level, ground, *contact = json.loads(sys.argv[1])
+warm_up(kind, level, ground, *contact)
 c2, w2 = time.process_time(), time.perf_counter()
 print(json.dumps({"import_cpu": c1 - c0, "import_wall": w1 - w0,
                   "cpu": c2 - c1, "wall": w2 - w1, "package": rocksweep.__file__}))
@@ -116,11 +122,11 @@ def child_env(tree: Path | None = None, **extra: str) -> dict[str, str]:
 GROUNDS = {L.GROUND_PULSE: "", L.GROUND_ANY: "_ground", L.GROUND_VERTICAL: "_vertical"}
 
 
-def variant_name(kind: int, level: int | None, ground: int) -> str:
-    return f"{LEVELS[level]}_{KINDS[kind]}{GROUNDS[ground]}"
+def variant_name(kind: int, level: int | None, ground: int, contact: int = 0) -> str:
+    return f"{LEVELS[level]}_{KINDS[kind]}{GROUNDS[ground]}{'_slide' if contact else ''}"
 
 
-def cold_compile(variant: tuple[int, int | None, int], tree: Path | None = None) -> dict:
+def cold_compile(variant: tuple, tree: Path | None = None) -> dict:
     """Compile one variant in a fresh process with an empty NUMBA_CACHE_DIR."""
     with tempfile.TemporaryDirectory() as cache:
         res = subprocess.run([sys.executable, "-c", _COMPILE_SNIPPET, json.dumps(variant)],
@@ -274,6 +280,8 @@ def main() -> None:
                     help="Figure 3(a) only: its variant, its scene, 20 reference points")
     ap.add_argument("--vertical", action="store_true",
                     help="item 1 only, for the vertical variants beside the ground ones")
+    ap.add_argument("--slide", action="store_true",
+                    help="item 1 only, for the sliding base's variants beside the no-slip ones")
     ap.add_argument("--repeat", type=int, default=3, help="best of this many (items 2-4)")
     ap.add_argument("--ref-points", type=int, default=100,
                     help="reference sample per figure (default 100)")
@@ -291,8 +299,8 @@ def main() -> None:
         against(args.against.resolve(), args.rounds, args.repeat)
         print(f"load average at end {bk.load_avg()}")
         return
-    variants = (VERTICAL_VARIANTS if args.vertical else QUICK_VARIANTS if args.quick
-                else ALL_VARIANTS)
+    variants = (VERTICAL_VARIANTS if args.vertical else SLIDE_VARIANTS if args.slide
+                else QUICK_VARIANTS if args.quick else ALL_VARIANTS)
     figures = ["fig3a"] if args.quick else list(bk.FOUR)
     ref_points = 20 if args.quick else args.ref_points
 
@@ -310,7 +318,7 @@ def main() -> None:
                 raise SystemExit(f"the subprocess imported {r['package']}")
             print(f"    {variant_name(*v):<36}{r['cpu']:>8.2f}{r['wall']:>8.2f}"
                   f"{r['import_cpu']:>14.2f}", flush=True)
-    if args.vertical:
+    if args.vertical or args.slide:
         print(f"load average at end {bk.load_avg()}")
         return
 

@@ -21,8 +21,11 @@ Runs the shipped commands, exactly as the README shows them:
   ``rocksweep sweep configs/record-demo.yaml`` and ``rocksweep spectrum``
   (docs/record_spectra.png), and the pulse shapes (``figures.pulses.shapes_figure``,
   docs/pulse_shapes.png): docs/excitations.md;
-- ``rocksweep sweep configs/fig4a.yaml --set body.mu=0.6 --set outputs.contact=true`` and
-  ``rocksweep plot`` (docs/fig4a_mu06.png, docs/contact.md);
+- ``rocksweep sweep configs/fig4a.yaml --set outputs.contact=true`` and ``rocksweep plot
+  --mu`` (docs/fig4a_mu_required.png, docs/contact.md: the no-slip friction demand);
+- ``rocksweep sweep configs/fig3a.yaml --set impact.lam=0.2 --set body.mu=[0.3,0.5,0.7,10]``,
+  ``rocksweep plot`` and ``rocksweep plot --regime`` (docs/fig3a_sliding.png,
+  docs/fig3a_regimes.png: docs/sliding.md);
 - docs/calibration.md's example: ``rocksweep simulate configs/free-rocking.yaml`` at lam =
   0.3 and `fine` to CSV, 1% noise added (seed 1), ``rocksweep calibrate ... --fit
   impact.lam --plot`` (docs/calibration.png);
@@ -47,11 +50,12 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 DIAGRAMS = ("fig3a", "fig3b", "fig4a", "fig4b", "block")
 OTHERS = ("fig3a_check", "fig5", "fig2", "fragility", "impact_laws", "fig2_locked", "risk",
-          "floor_spectrum", "ricker", "fig4a_mu06", "record_spectra", "pulse_shapes",
+          "floor_spectrum", "ricker", "fig4a_mu_required",
+          "fig3a_sliding", "record_spectra", "pulse_shapes",
           "calibration")
 #: every PNG it writes into docs/ ("risk" writes efficiency.png too; "accuracy_fig3a" with
 #: --accuracy): tests/test_docs_figures.py holds docs/ to these
-PNGS = (*DIAGRAMS, *OTHERS, "efficiency", "accuracy_fig3a")
+PNGS = (*DIAGRAMS, *OTHERS, "efficiency", "accuracy_fig3a", "fig3a_regimes")
 
 
 def rocksweep(*args: str) -> None:
@@ -158,12 +162,21 @@ def main(argv: list[str] | None = None) -> None:
             h5 = sweep("ricker", "ricker")
             rocksweep("plot", str(h5), "-o", str(tmp / "ricker.png"), "--dpi", str(args.dpi))
             publish("ricker")
-        if "fig4a_mu06" in wanted:  # docs/contact.md: sliding at mu = 0.6 hatched
-            h5 = sweep("fig4a", "fig4a_mu06", "--set", "body.mu=0.6", "--set",
-                       "outputs.contact=true")
-            rocksweep("plot", str(h5), "-o", str(tmp / "fig4a_mu06.png"), "--dpi",
+        if "fig4a_mu_required" in wanted:  # docs/contact.md: the no-slip friction demand
+            h5 = sweep("fig4a", "fig4a_mu_required", "--set", "outputs.contact=true")
+            rocksweep("plot", str(h5), "--mu", "-o", str(tmp / "fig4a_mu_required.png"),
+                      "--dpi", str(args.dpi))
+            publish("fig4a_mu_required")
+        if "fig3a_sliding" in wanted:  # docs/sliding.md: Figure 3(a) on a base that slides
+            # mu = 10: a base that cannot slip (the no-slip model's classes, a test says)
+            h5 = sweep("fig3a", "fig3a_sliding", "--set", "impact.lam=0.2", "--set",
+                       "body.mu=[0.3,0.5,0.7,10]")
+            rocksweep("plot", str(h5), "-o", str(tmp / "fig3a_sliding.png"), "--dpi",
                       str(args.dpi))
-            publish("fig4a_mu06")
+            publish("fig3a_sliding")
+            rocksweep("plot", str(h5), "--regime", "-o", str(tmp / "fig3a_regimes.png"),
+                      "--dpi", str(args.dpi))
+            publish("fig3a_regimes")
         if "record_spectra" in wanted:  # docs/excitations.md
             h5 = sweep("record-demo", "record_demo")
             rocksweep("spectrum", str(h5), "-o", str(tmp / "record_spectra.png"), "--dpi",

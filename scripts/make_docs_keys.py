@@ -12,10 +12,11 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from rocksweep.schema import KEYS
-
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # the tree this script is in, not an installed copy
+
+from rocksweep.schema import KEYS  # noqa: E402 (after the path: this tree's schema)
+
 PAGE = ROOT / "docs" / "scenes.md"
 BEGIN = "<!-- keys: written by scripts/make_docs_keys.py from rocksweep/schema.py -->"
 END = "<!-- end of keys -->"

@@ -37,11 +37,11 @@ FAMILIES: dict[str, tuple[str, ...]] = {
     "accuracy ladders": settings.LADDER_NAMES,
     "alpha_ref keys": axes.ALPHA_KEYS,
     "alpha_ref LaTeX": tuple(tex for _, tex in axes.ALPHA_REF.values()),
+    "contact phases": phases.PHASES,
     "dataset kinds": kinds.KIND_NAMES,
     "IM components": ground.COMPONENTS,
     "missing components": ground.MISSING,
     "orientation answers": ground.ORIENTATIONS,
-    "contact phases": phases.PHASES,
 }
 # Single words with one home: typed as a string anywhere else (not in a docstring) they fail.
 WORDS: dict[str, str] = {
@@ -156,6 +156,11 @@ def test_kernel_codes_are_the_vocabulary_codes():
     assert [L.ROOT_BISECT, L.ROOT_ILLINOIS, L.ROOT_HERMITE] == [settings.ROOT_CODE[w]
                                                                 for w in settings.ROOTS]
     assert len(set(settings.ROOT_CODE.values())) == len(settings.ROOT_CODE)
+    from rocksweep.kernel import sliding
+
+    # a phase's code is 2 (rocking) + 1 (slipping) of its corner s and slip sigma
+    assert [sliding.phase_code(s, sg) for s, sg in ((0, 0), (0, 1), (1, 0), (-1, -1))] == [
+        phases.PHASE_CODE[w] for w in phases.PHASES]
     # codes distinct, status bits one bit each
     assert len(set(ground.SHAPE_CODE.values())) == len(ground.SHAPE_CODE)
     assert all(b & (b - 1) == 0 for b in outcomes.STATUS_BIT.values())

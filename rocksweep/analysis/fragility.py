@@ -677,7 +677,8 @@ def _dataset(ds: xr.Dataset, state: Any, states: list[str], axis: IMAxis, c: Cou
              "reference": "Baker (2015), Efficient analytical fragility function fitting "
                           "using dynamic structural analysis, Earthquake Spectra 31(1)"}
     if any(parse_state(s)[0] == SLIDE for s in states):  # D's units: slide_max's
-        attrs["slide_max_units"] = str(ds["slide_max"].attrs.get("units", ""))
+        u = ds["slide_max"].attrs  # the scale (b) where the CF units say "1"
+        attrs["slide_max_units"] = str(u.get("rocksweep_units", u.get("units", "")))
     if axis.im_name == "Sa":
         attrs["period"] = axis.period
     if axis.im_name == AVGSA and "record_avgsa" in ds.variables:

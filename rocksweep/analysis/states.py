@@ -4,7 +4,7 @@ fitted together, and which points of a result Dataset reach each one and are cou
 States (``rocksweep.vocab.outcomes``): "overturn" (outcome 1 or 2), "mode1", "mode2",
 "uplift" (uplifts > 0 or overturned), "theta:X" (max|theta|/alpha_cg >= X or overturned,
 0 < X <= 1), "slide:D" (slide_max >= D or overturned, D > 0 in the units of the
-Dataset's ``slide_max``: the base half-width b, metres for a physical body; a sweep of a
+Dataset's ``slide_max``: the base half-width b, for every body; a sweep of a
 scene with ``body.mu``).
 
 Two chains of nested states (a point that reaches one reaches the milder ones of its
@@ -77,7 +77,7 @@ def parse_state(state: str) -> tuple[str, float]:
                                  "(max|theta|/alpha_cg)")
         raise FragilityError(f"state {state!r}: slide:D needs a number D > 0 (slide_max >= D: "
                              "the base's largest sliding displacement, in units of its "
-                             "half-width b, metres for a physical body)")
+                             "half-width b)")
     raise FragilityError(f"state {state!r}: expected one of {', '.join(STATE_WORDS)}")
 
 

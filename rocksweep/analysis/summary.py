@@ -31,6 +31,7 @@ from rocksweep.vocab.outcomes import (
     OUTCOME_NOT_RUN,
     OUTCOME_SAFE,
     SAFE,
+    SLID,
     SLIDES,
     STATUS_BIT,
 )
@@ -42,6 +43,10 @@ CLASSES = (MODE1, MODE2, SAFE, "flagged", "not_computed")
 # Counted too in results with contact outputs (outputs.contact / body.mu): computed points
 # whose status says the base would slide (mu_required > body.mu) or lift off (N < 0).
 CONTACT_COUNTS = (SLIDES, LIFTS_OFF)
+# ... and in results of a scene that gives body.mu (the sliding base, docs/sliding.md):
+# computed points whose base slipped, or met a normal force below zero while rocking
+SLIDE_COUNTS = (SLID, LIFTS_OFF)
+EXTRA_COUNTS = (SLIDES, SLID, LIFTS_OFF)
 # A swept key with more values than this is printed as this many ranges of values.
 MAX_ROWS = 10
 # Variables ``info_dict`` needs from the file (and ``computed`` when the file has it:
@@ -60,7 +65,8 @@ def class_counts(result: SweepResult, by: Sequence[str]) -> list[dict]:
 
     Returns one dict per combination: the key values, then mode1, mode2, safe, flagged
     (computed points with a flagged status) and not_computed; with contact outputs also
-    slides and lifts_off (``CONTACT_COUNTS``).
+    slides and lifts_off (``CONTACT_COUNTS``), where the base slides slid and lifts_off
+    (``SLIDE_COUNTS``).
     """
     out = np.asarray(result.arrays["outcome"])
     status = np.asarray(result.arrays["status"])
@@ -71,9 +77,11 @@ def class_counts(result: SweepResult, by: Sequence[str]) -> list[dict]:
     o = np.transpose(out, [*pos, *rest]).reshape(*shape, -1)
     fl = np.transpose((status & FLAGGED) != 0, [*pos, *rest]).reshape(o.shape)
     fl &= o != OUTCOME_NOT_RUN
-    contact = bool(getattr(result, "scene", {}).get("contact"))
+    scene = getattr(result, "scene", {})
+    counts = (CONTACT_COUNTS if scene.get("contact") else
+              SLIDE_COUNTS if "body.mu" in (scene.get("axes") or {}) else ())
     extra = {c: np.transpose((status & STATUS_BIT[c]) != 0, [*pos, *rest]).reshape(o.shape)
-             & (o != OUTCOME_NOT_RUN) for c in (CONTACT_COUNTS if contact else ())}
+             & (o != OUTCOME_NOT_RUN) for c in counts}
     rows = []
     for idx in np.ndindex(*shape):
         label = {d: (plain(result.coords[d][idx[swept.index(d)]]) if d in swept
@@ -102,8 +110,8 @@ def in_ranges(rows: list[dict], key: str, max_rows: int = MAX_ROWS) -> list[dict
     """Consecutive rows that share every label but ``key`` merged into at most
     ``max_rows`` ranges of ``key``'s values, counts summed; a merged row's ``key`` is
     (first, last) and ``n_values`` says how many values it holds."""
-    labels = [k for k in rows[0] if k not in (*CLASSES, *CONTACT_COUNTS)] if rows else []
-    counted = [c for c in (*CLASSES, *CONTACT_COUNTS) if rows and c in rows[0]]
+    labels = [k for k in rows[0] if k not in (*CLASSES, *EXTRA_COUNTS)] if rows else []
+    counted = [c for c in (*CLASSES, *EXTRA_COUNTS) if rows and c in rows[0]]
     others = [k for k in labels if k != key]
     out: list[dict] = []
     start = 0
@@ -139,9 +147,9 @@ def format_counts(rows: list[dict], indent: str = "") -> list[str]:
     the not_computed column only when some point is missing."""
     if not rows:
         return []
-    labels = [k for k in rows[0] if k not in (*CLASSES, *CONTACT_COUNTS) and k != "n_values"]
+    labels = [k for k in rows[0] if k not in (*CLASSES, *EXTRA_COUNTS) and k != "n_values"]
     classes = [c for c in CLASSES if c != "not_computed" or any(r[c] for r in rows)]
-    classes += [c for c in CONTACT_COUNTS if c in rows[0]]
+    classes += [c for c in EXTRA_COUNTS if c in rows[0]]
     cells = [[_label(r[k]) for k in labels] for r in rows]
     widths = [max(len(k), *(len(c[i]) for c in cells)) for i, k in enumerate(labels)]
     head = "".join(f"{k:<{w + 2}}" for k, w in zip(labels, widths, strict=True))

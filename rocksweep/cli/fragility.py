@@ -69,8 +69,8 @@ def _g(v) -> str:
 @click.option("--state", default="overturn", show_default=True,
               help="What the curve gives the probability of: " + ", ".join(STATES)
               + f", {THETA_STATE} (max|theta|/alpha_cg >= X, 0 < X <= 1) or {SLIDE_STATE} "
-              "(the base's sliding displacement slide_max >= D, D > 0 in units of b, metres "
-              "for a physical body; a scene with body.mu); several separated by commas, each "
+              "(the base's sliding displacement slide_max >= D, D > 0 in base half-widths "
+              "b; a scene with body.mu); several separated by commas, each "
               "fitted alone (the same curve whatever else is asked for).")
 @click.option("--joint", is_flag=True,
               help=f"Fit damage states of one chain ({UPLIFT}, {THETA_STATE}, {OVERTURN}; or "

@@ -66,4 +66,4 @@ def prepare_point_kernel(scene: Any) -> None:
         kind = kernel_kind(point.body)
     except (RocksweepError, ValueError):
         return
-    prepare_point(kind, point.ground, lambda m: click.echo(m, err=True))
+    prepare_point(kind, point.ground, lambda m: click.echo(m, err=True), scene.contact_model)

@@ -110,6 +110,11 @@ def _print_run(r, swept: list[str]) -> None:
                    f"{s['impact_loss_over_Eref']:.4f} (gained {s['impact_gain_over_Eref']:.4f}"
                    f" in {s['energy_gaining_impacts']} impacts), lost in damper "
                    f"{s['damper_loss_over_Eref']:.4f}, left {s['energy_end_over_Eref']:.4f}")
+    if "friction_loss_over_Eref" in s:
+        click.echo(f"  friction: lost {s['friction_loss_over_Eref']:.4f} E_ref")
+    if "slide_max" in s:
+        click.echo(f"  sliding: max |x|/b {s['slide_max']:.4f}, final |x|/b "
+                   f"{s['slide_final']:.4f}, phases {' > '.join(s['phases'])}")
     if "mu_required" in s:
         mu = "inf" if s["mu_required"] is None else f"{s['mu_required']:.4f}"
         click.echo(f"  contact: mu_required {mu}, min N/(M g) {s['normal_min_over_Mg']:.4f},"

@@ -131,11 +131,13 @@ def prepare(dispatchers: Sequence[Any], warm: Callable[[], None],
     return took
 
 
-def prepare_point(kind: int, ground: Any, say: Callable[[str], None]) -> float:
-    """The single-run (history) variant of ``kind`` and ``ground`` compiled or loaded now,
-    said when it compiles (``prepare``): what ``rocksweep simulate`` and ``rocksweep
-    calibrate`` run."""
+def prepare_point(kind: int, ground: Any, say: Callable[[str], None], contact: int = 0
+                  ) -> float:
+    """The single-run (history) variant of ``kind``, ``ground`` and ``contact``
+    (``layout.CONTACT_*``) compiled or loaded now, said when it compiles (``prepare``):
+    what ``rocksweep simulate`` and ``rocksweep calibrate`` run."""
     from rocksweep import kernel
 
-    return prepare([kernel.point_kernel(kind, ground)],
-                   lambda: kernel.warm_up(kind, None, ground), say, compiles_only=True)
+    return prepare([kernel.point_kernel(kind, ground, contact)],
+                   lambda: kernel.warm_up(kind, None, ground, contact), say,
+                   compiles_only=True)

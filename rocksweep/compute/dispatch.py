@@ -19,6 +19,7 @@ from rocksweep import kernel  # its variants looked up at each call (kernel.chun
 from rocksweep.compute.certify import certify
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.physics.ground_motion import Excitation
+from rocksweep.physics.points import kernel_contact
 
 
 def history_capacity(row: np.ndarray) -> int:
@@ -37,9 +38,11 @@ def run_variant(rows: np.ndarray, kind: int, level: int, ground: int, refine: in
                 out: np.ndarray | None = None) -> np.ndarray:
     """Result rows float64[n, N_OUT] of parameter rows float64[n, N_PAR (+ samples)] run
     through the kernel variant of body ``kind`` (``physics.points.kernel_kind``),
-    bookkeeping ``level`` (``kernel.layout.LEVEL_*``) and ``ground``
+    bookkeeping ``level`` (``kernel.layout.LEVEL_*``), ``ground``
     (``kernel.layout.GROUND_*``: the variants of Ricker, MP and samples, and of a moving
-    gravity g + a_v; ``ground_motion.shared_ground``).
+    gravity g + a_v; ``ground_motion.shared_ground``) and the contact model the rows'
+    friction calls for (``physics.points.kernel_contact``: the sliding base where a row
+    gives PAR_MU; rows with and without it run apart, in their places).
 
     refine: close calls re-run finer, up to this many refinements (``compute.certify``,
     ``Numerics.refine``; 0: none). excitation: the excitation all rows share, whose
@@ -51,10 +54,22 @@ def run_variant(rows: np.ndarray, kind: int, level: int, ground: int, refine: in
     Returns the result rows."""
     n = rows.shape[0]
     outs = np.empty((n, L.N_OUT)) if out is None else out
+    given = np.isfinite(rows[:, L.PAR_MU])
+    if given.any() and not given.all():  # each contact model on its own rows
+        for part in (given, ~given):
+            idx = np.flatnonzero(part)
+            sub_h = None if histories is None else [None] * idx.size
+            outs[idx] = run_variant(np.ascontiguousarray(rows[idx]), kind, level, ground,
+                                    refine, excitation, sub_h)
+            if histories is not None:
+                for j, i in enumerate(idx.tolist()):
+                    histories[i] = sub_h[j]
+        return outs
+    contact = kernel_contact(rows[:, L.PAR_MU]) if n else L.CONTACT_NOSLIP
     if excitation is not None and excitation.record is None:
         excitation = None  # a pulse: nothing rides on its rows
     if histories is not None:
-        fn = kernel.point_kernel(kind, ground)
+        fn = kernel.point_kernel(kind, ground, contact)
 
         def call(sub: np.ndarray, res: np.ndarray, idx: Sequence[int],
                  keep: bool = True) -> None:
@@ -65,7 +80,7 @@ def run_variant(rows: np.ndarray, kind: int, level: int, ground: int, refine: in
                 if keep:  # a probe's (``certify``) is not the point's history
                     histories[int(i)] = hist
     else:
-        fn = kernel.chunk_kernel(kind, level, ground)
+        fn = kernel.chunk_kernel(kind, level, ground, contact)
 
         def call(sub: np.ndarray, res: np.ndarray, idx: Sequence[int],
                  keep: bool = True) -> None:

@@ -29,7 +29,7 @@ def history_dataset(run: Run, title: str = "") -> xr.Dataset:
     import xarray as xr  # ~0.4 s that ``rocksweep simulate`` (no Dataset) does not pay
 
     cols = run.history_columns()
-    spec = {c.name: c for c in fields.HISTORY}
+    spec = {c.name: c for c in fields.HISTORY + fields.SLIDE_HISTORY}
     t = cols.pop("p_t")
     ds = xr.Dataset(
         {k: ("p_t", v, {"units": spec[k].unit, "long_name": spec[k].meaning})
@@ -61,12 +61,14 @@ def write_history_csv(runs: Sequence[Run], swept: Sequence[str], path: str | Pat
                       overwrite: bool = False) -> None:
     """The runs' time histories to one CSV file, atomically: columns run, the swept
     keys, then ``rocksweep.fields.HISTORY`` (p_t, theta_over_alpha, u_over_ucr,
-    E_over_Eref, ...); plain numbers (``repr`` of Python floats: nan, inf as such).
+    E_over_Eref, ...) and, where the base may slide, ``fields.SLIDE_HISTORY`` (x_over_b,
+    contact_phase, D_fric_over_Eref); plain numbers (``repr`` of Python floats: nan, inf as such).
     Check the path first with ``rocksweep.outputs.check_output``; an existing file is
     replaced only with ``overwrite`` (``outputs.publish``)."""
     with atomic_path(path, overwrite=overwrite) as tmp, tmp.open("w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["run", *swept, *(c.name for c in fields.HISTORY)])
+        names = list(runs[0].history_columns()) if runs else [c.name for c in fields.HISTORY]
+        w.writerow(["run", *swept, *names])
         for i, r in enumerate(runs):
             fixed = swept_values(r, swept)
             cols = list(r.history_columns().values())

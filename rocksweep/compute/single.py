@@ -13,9 +13,10 @@ from rocksweep.compute.dispatch import run_variant
 from rocksweep.kernel import layout as L
 from rocksweep.kernel import warm_up
 from rocksweep.numerics import Numerics
-from rocksweep.physics.points import Point, kernel_kind, point_row
+from rocksweep.physics.points import Point, kernel_contact, kernel_kind, point_row
 from rocksweep.vocab.ground import FREE
 from rocksweep.vocab.outcomes import outcome_word, status_words
+from rocksweep.vocab.phases import PHASE_WORDS
 
 # What a Run made without its history says when one is asked of it: only Python makes such
 # a Run (``run_point(..., history=False)``, as sweeps and the IDA run points); every command
@@ -49,7 +50,25 @@ class Run:
         """One result field by name (``rocksweep.fields.FIELDS``) in its unit; None for
         a time or energy that does not exist (no overturning, no energy accounting)."""
         body = self.point.body
-        return fields.value(self.out, fields.BY_NAME[name], body.alpha_ref, body.E_ref)
+        return fields.value(self.out, fields.BY_NAME[name], body.alpha_ref, body.E_ref,
+                            body.b)
+
+    @property
+    def slides(self) -> bool:
+        """Whether the point gives body.mu: its base may slide (the sliding base's
+        fields, history columns and ``phases`` are reported)."""
+        return not math.isnan(self.point.mu)
+
+    def phases(self) -> list[str]:
+        """The contact phases the run entered, in order, as words (``vocab.phases``):
+        from the history where there is one, else the visited ones (``regime``) in code
+        order."""
+        if self.history is not None and "contact_phase" in self.history:
+            codes = np.asarray(self.history["contact_phase"]).astype(np.int64)
+            keep = np.concatenate(([True], codes[1:] != codes[:-1])) if codes.size else codes
+            return [PHASE_WORDS[int(c)] for c in codes[keep.astype(bool)]]
+        bits = int(self.out[L.OUT_REGIME])
+        return [w for c, w in PHASE_WORDS.items() if bits & (1 << c)]
 
     @property
     def outcome(self) -> str:
@@ -95,10 +114,14 @@ class Run:
         "event_steps" the re-integrations spent locating events.
         """
         energy = not math.isnan(self.out[L.OUT_W_IN])
+        slides = self.slides
         d = {f.name: self.get(f.name) for f in fields.RUN_FIELDS
-             if (energy or not f.energy) and (self.contact or not f.contact)}
+             if (energy or not f.energy) and (self.contact or not f.contact)
+             and (slides or not f.slide)}
         d["outcome"] = self.outcome
         d["status"] = self.status
+        if slides:
+            d["phases"] = self.phases()
         if energy and self.history is not None:
             E_ref = self.point.body.E_ref
             d["impact_losses_over_Eref"] = [float(v) / E_ref for v in self.impact_losses()]
@@ -109,14 +132,15 @@ class Run:
     def impact_losses(self) -> np.ndarray:
         """The energy [J] each impact dissipated (eq. 6 under the run's impact law; < 0:
         that impact gained energy), in order: float64[impacts]. From the history, where an
-        impact is the pair of rows at one time whose first rocks (phase != 0): the jump of
-        the impacts' cumulative loss across it."""
+        impact is the pair of rows at one time whose first rocks (phase != 0) and whose
+        second does not rock on the same corner (the sliding base's stick breaks, slip
+        stops and jams keep it): the jump of the impacts' cumulative loss across it."""
         if self.history is None:
             raise ValueError(NO_HISTORY)
         t = np.asarray(self.history["t"])
         phase = np.asarray(self.history["phase"])
         lost = np.asarray(self.history["E_impact"])
-        at = np.flatnonzero((t[1:] == t[:-1]) & (phase[:-1] != 0))
+        at = np.flatnonzero((t[1:] == t[:-1]) & (phase[:-1] != 0) & (phase[1:] != phase[:-1]))
         return lost[at + 1] - lost[at]
 
     def history_columns(self) -> dict[str, np.ndarray]:
@@ -139,7 +163,8 @@ def run_point(point: Point, numerics: Numerics, history: bool = True,
     kind = kernel_kind(point.body)
     ground = point.ground
     lvl = L.LEVEL_CONTACT if contact else L.LEVEL_OUTCOME
-    warm_up(kind, None if history else lvl, ground)  # wall_time excludes compilation
+    # wall_time excludes compilation
+    warm_up(kind, None if history else lvl, ground, kernel_contact(point.mu))
     t0 = time.perf_counter()
     # the close calls certified, as in sweeps (``compute.certify``): the finest run's
     # result and history are kept
@@ -151,5 +176,6 @@ def run_point(point: Point, numerics: Numerics, history: bool = True,
             out[L.OUT_STATUS] = int(out[L.OUT_STATUS]) & ~(L.STATUS_SLIDES | L.STATUS_LIFTS_OFF)
             out[[L.OUT_MU_REQ, L.OUT_N_MIN, L.OUT_IMPULSE_MAX]] = np.nan
         n = int(out[L.OUT_HIST_ROWS])
-        hist_d = {c.raw: hists[0][:n, c.slot].copy() for c in fields.HISTORY}
+        columns = fields.HISTORY + (fields.SLIDE_HISTORY if not math.isnan(point.mu) else ())
+        hist_d = {c.raw: hists[0][:n, c.slot].copy() for c in columns}
     return Run(point, numerics, out, hist_d, time.perf_counter() - t0, contact)

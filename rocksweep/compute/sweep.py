@@ -75,8 +75,8 @@ def run_chunk(grid: Grid, start: int, stop: int, level: int) -> ChunkResult:
     outs = run_rows(cr, cr.rows, level, scene)
     contact = level == L.LEVEL_CONTACT  # the contact variants account energy either way
     stored = fields.sweep_fields(scene.energy if contact else level == L.LEVEL_ENERGY,
-                                 contact, scene.check)
-    arrays = fields.convert(outs, cr.alpha_ref, cr.E_ref, stored)
+                                 contact, scene.check, scene.slides)
+    arrays = fields.convert(outs, cr.alpha_ref, cr.E_ref, stored, cr.rows[:, L.PAR_B])
     if scene.floor:  # the peak the body was driven by [g]
         arrays[fields.FLOOR_PFA] = scene.floor_pfa(cr.rows[:, L.PAR_AMP])
     if scene.check:
@@ -153,12 +153,13 @@ def prepare(grid: Grid, level: int) -> None:
     any worker starts: worker threads share the compiled code, and dask workers load
     numba's cache instead of compiling concurrently."""
     for kind in grid.kinds():
-        kernel.warm_up(kind, level, grid.scene.ground)
+        kernel.warm_up(kind, level, grid.scene.ground, grid.scene.contact_model)
 
 
 def chunk_variants(grid: Grid, level: int) -> list:
     """The kernel variants (``kernel.chunk_kernel``) ``prepare`` compiles or loads."""
-    return [kernel.chunk_kernel(kind, level, grid.scene.ground) for kind in grid.kinds()]
+    return [kernel.chunk_kernel(kind, level, grid.scene.ground, grid.scene.contact_model)
+            for kind in grid.kinds()]
 
 
 def kernel_cache_state(grid: Grid, level: int) -> tuple[int, int]:

@@ -40,7 +40,8 @@ def time_history(runs: Sequence[Run], swept: Sequence[str] = (), title: str = ""
 
     runs: Runs with a history (``rocksweep.compute.single.run_point``, history=True); swept:
     the scene's swept axis names, which label the runs; axes: 4 axes to draw into (else a new
-    figure). Returns the figure.
+    figure). Returns the figure. Runs whose base may slide (body.mu, docs/sliding.md) add
+    their sliding displacement x/b to (b) (dashed, right axis) and friction's loss to (d).
     """
     if axes is None:
         fig, grid = new_axes(4, 1, (7.5, 10.0), sharex=True,
@@ -64,6 +65,7 @@ def time_history(runs: Sequence[Run], swept: Sequence[str] = (), title: str = ""
     ps = {r.point.p for r in runs}
     seconds = records and len(ps) == 1
     t_scale = 1.0 / next(iter(ps)) if seconds else 1.0
+    ax_x = ax_th.twinx() if any("x" in r.history for r in runs) else None
     for run in runs:
         h = run.history
         body = run.point.body
@@ -72,7 +74,10 @@ def time_history(runs: Sequence[Run], swept: Sequence[str] = (), title: str = ""
                            label=_label(run, swept))
         c = line.get_color()
         ax_e.plot(t, h["E"] / body.E_ref, lw=1.2, color=c)
-        ax_d.plot(t, (h["D_damp"] + h["E_impact"]) / body.E_ref, lw=1.2, color=c)
+        ax_d.plot(t, (h["D_damp"] + h["E_impact"] + h.get("D_fric", 0.0)) / body.E_ref, lw=1.2,
+                  color=c)
+        if ax_x is not None and "x" in h:
+            ax_x.plot(t, h["x"] / body.b, lw=1.0, ls="--", color=c)
         if run.t_overturn is not None:
             for ax in (ax_th, ax_e, ax_d):
                 ax.axvline(run.t_overturn * t_scale, color=c, ls=":", lw=0.9)
@@ -102,6 +107,9 @@ def time_history(runs: Sequence[Run], swept: Sequence[str] = (), title: str = ""
     ax_th.set_ylim(-3, 3)
     ax_e.set_ylabel(r"$E/E_{ref}$")
     ax_d.set_ylabel("dissipated\n" + r"$(E_d + E_{damper})/E_{ref}$")
+    if ax_x is not None:
+        ax_x.set_ylabel(r"sliding $x/b$ (dashed)")
+        ax_d.set_ylabel("dissipated\n" + r"$(E_d + E_{damper} + E_{fric})/E_{ref}$")
     ax_d.set_xlabel(f"$t$ [s] ($p$ = {next(iter(ps)):g} rad/s)" if seconds else r"$pt$")
     for ax in (ax_in, ax_th, ax_e, ax_d):
         ax.grid(alpha=0.3)

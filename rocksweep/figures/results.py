@@ -167,7 +167,7 @@ def ida_figure(ida: xr.Dataset, *, ax: Any = None, width: str | None = "single")
             else:  # the sliding displacement, its threshold D dashed
                 a.set_ylim(0.0, None)
                 a.axhline(end, color="0.4", lw=0.6, ls="--")
-                du = ida[demand].attrs.get("units", "")
+                du = ida[demand].attrs.get("rocksweep_units", ida[demand].attrs.get("units", ""))
                 a.set_ylabel("max sliding |x|" + (f" [{du}]" if du and du != "1" else ""))
             a.set_title(wrap_title(label or "IDA", fig.get_figwidth() / cols, 8.0),
                         fontsize="small")

@@ -3,7 +3,8 @@
 Numba reads module-level ints as compile-time constants, so these cost nothing in the loop.
 The kernel takes one parameter row per point (``PAR_*``) and fills one result row
 (``OUT_*``; the loop keeps its event counters there as it runs); single runs also fill a history
-buffer (``HIST_*`` columns). Inside the loop the state is a 6-tuple (``Y_*`` slots). All
+buffer (``HIST_*`` columns). Inside the loop the state is a 6-tuple (``Y_*`` slots; 9 slots for the
+sliding base). All
 quantities are SI with m = 1 kg, g = 9.81 m/s^2 and p = 1 rad/s (see ``rocksweep.physics.bodies``),
 so times are p*t.
 """
@@ -11,6 +12,7 @@ so times are p*t.
 from rocksweep.vocab import ground as _ground
 from rocksweep.vocab import laws as _laws
 from rocksweep.vocab import outcomes as _out
+from rocksweep.vocab import phases as _phases
 from rocksweep.vocab import settings as _settings
 
 # --- parameter row ---------------------------------------------------------------------
@@ -72,7 +74,10 @@ PAR_V_OMEGA = 45  # the harmonic's angular frequency [rad/s] (p = 1)
 PAR_V_PHASE = 46  # the harmonic's phase [rad]: a_v = PAR_V_AMP sin(PAR_V_OMEGA t + phase)
 PAR_V_REC = 47  # index in the row of the vertical record's first sample (0: the harmonic)
 PAR_T_AIR = 48  # first time g + a_v <= 0 [s] (inf: never): the run stops there, airborne
-N_PAR = 49
+# The sliding base (CONTACT_SLIDE, docs/sliding.md): PAR_MU is then its kinetic friction
+# coefficient, this its static one (>= PAR_MU; NaN without mu)
+PAR_MU_STATIC = 49
+N_PAR = 50
 # A record's row is longer: its samples xg''/PGA (float64[npts], in [-1, 1]) follow the
 # N_PAR parameters, PAR_REC = N_PAR the first (``points.with_record``). With a vertical
 # record: then one copy of the last horizontal sample (the horizontal's reader clamps at
@@ -122,7 +127,12 @@ OUT_T_CLOSE = 23  # last time [s] the free rocking came within PAR_CLOSE of the 
 OUT_REFINE_EVALS = 24  # RK4 evaluations (regular + event) of the certification's runs of
 #                        this point, counted in OUT_STEPS/OUT_EVENT_STEPS too (0 from the
 #                        kernel; set by ``rocksweep.compute.certify``)
-N_OUT = 25
+# The sliding base (CONTACT_SLIDE only; NaN from the no-slip model)
+OUT_SLIDE_MAX = 25  # max |x| over the run [m]: how far the base slipped along the ground
+OUT_SLIDE_FINAL = 26  # |x| at the end [m]
+OUT_REGIME = 27  # the phases visited: bit (1 << PHASE_CODE) of each (``vocab.phases``)
+OUT_D_FRIC = 28  # energy dissipated by friction [J] (energy variants, else NaN)
+N_OUT = 29
 
 # --- state tuple y (the loop's 6 slots, a UniTuple(float64, 6)) ----------------------------
 Y_THETA = 0  # theta [rad] (0 in full contact)
@@ -131,6 +141,10 @@ Y_U = 2  # u, the top mass's lateral displacement [m] (0 for a rigid body)
 Y_U_DOT = 3  # u' [m/s]
 Y_W_IN = 4  # work of the ground motion so far [J] (energy variants; else stays 0)
 Y_D_DAMP = 5  # energy dissipated by the damper so far [J] (energy variants; else stays 0)
+# the sliding base's three more (``slide_loop``: a UniTuple(float64, 9))
+Y_X = 6  # x, the sliding displacement [m]
+Y_X_DOT = 7  # x' [m/s]
+Y_D_FRIC = 8  # energy dissipated by friction so far [J] (energy variants)
 
 # --- history columns ---------------------------------------------------------------------
 HIST_T = 0
@@ -144,7 +158,17 @@ HIST_W_IN = 7
 HIST_D_DAMP = 8
 HIST_E_IMPACT = 9
 HIST_XG = 10  # ground acceleration [m/s^2]
-N_HIST = 11
+# the sliding base's (CONTACT_SLIDE; the no-slip model leaves them unwritten)
+HIST_X = 11  # the sliding displacement x [m]
+HIST_CONTACT = 12  # the contact phase's code (``vocab.phases``: rest, slide, rock, slide-rock)
+HIST_D_FRIC = 13  # energy dissipated by friction so far [J]
+N_HIST = 14
+
+# --- contact phases (``vocab.phases``; the sliding base, docs/sliding.md) -----------------
+PHASE_REST = _phases.PHASE_CODE[_phases.REST]
+PHASE_SLIDE = _phases.PHASE_CODE[_phases.SLIDE]
+PHASE_ROCK = _phases.PHASE_CODE[_phases.ROCK]
+PHASE_SLIDE_ROCK = _phases.PHASE_CODE[_phases.SLIDE_ROCK]
 
 # --- outcome and status codes ----------------------------------------------------------
 # (codes and words: ``rocksweep.vocab.outcomes``)
@@ -172,6 +196,7 @@ STATUS_SLIDES = _out.STATUS_BIT["slides"]
 STATUS_LIFTS_OFF = _out.STATUS_BIT["lifts_off"]
 # g + a_v <= 0: the ground falls faster than gravity, the body leaves it (outside the model)
 STATUS_AIRBORNE = _out.STATUS_BIT["airborne"]
+STATUS_SLID = _out.STATUS_BIT[_out.SLID]  # the base slipped (CONTACT_SLIDE)
 # Set after the kernel, by the certification of close calls (``rocksweep.compute.certify``)
 STATUS_REFINED = _out.STATUS_BIT["refined"]  # a close call, re-run finer until stable
 STATUS_UNCERTIFIED = _out.STATUS_BIT["uncertified"]  # still changed at the last refinement
@@ -192,5 +217,7 @@ GROUND_PULSE = 0
 GROUND_ANY = 1
 GROUND_VERTICAL = 2
 # contact models (``variants.CONTACTS``): how the body touches the ground; the paper's:
-# rocking on a corner or in full contact, never sliding
+# rocking on a corner or in full contact, never sliding; the base that may slide, on a
+# ground with Coulomb friction (a scene's body.mu: docs/sliding.md)
 CONTACT_NOSLIP = 0
+CONTACT_SLIDE = 1

@@ -50,7 +50,9 @@ from rocksweep.kernel.events import (
 )
 from rocksweep.kernel.ground import ground_acc, ground_flags
 from rocksweep.kernel.layout import (
+    HIST_CONTACT,
     HIST_D_DAMP,
+    HIST_D_FRIC,
     HIST_E,
     HIST_E_IMPACT,
     HIST_PHASE,
@@ -60,9 +62,11 @@ from rocksweep.kernel.layout import (
     HIST_U,
     HIST_U_DOT,
     HIST_W_IN,
+    HIST_X,
     HIST_XG,
     OUT_CONTACTS,
     OUT_D_DAMP,
+    OUT_D_FRIC,
     OUT_E_END,
     OUT_E_GAINED,
     OUT_E_IMPACT,
@@ -74,6 +78,9 @@ from rocksweep.kernel.layout import (
     OUT_N_GAINING,
     OUT_OUTCOME,
     OUT_REFINE_EVALS,
+    OUT_REGIME,
+    OUT_SLIDE_FINAL,
+    OUT_SLIDE_MAX,
     OUT_STATUS,
     OUT_STEPS,
     OUT_T_CLOSE,
@@ -107,6 +114,8 @@ from rocksweep.kernel.layout import (
     PAR_TPULSE,
     PAR_U0,
     PAR_U_DOT0,
+    PHASE_REST,
+    PHASE_ROCK,
     STATUS_AIRBORNE,
     STATUS_BOUNDED,
     STATUS_E_ABOVE_1,
@@ -369,6 +378,11 @@ def _reset(out):
     out[OUT_E_MAX] = 0.0
     out[OUT_HIST_ROWS] = 0.0
     out[OUT_REFINE_EVALS] = 0.0  # the certification's reruns add theirs (compute.certify)
+    # the sliding base's (``slide_loop`` sets its own; the no-slip model has none)
+    out[OUT_SLIDE_MAX] = np.nan
+    out[OUT_SLIDE_FINAL] = np.nan
+    out[OUT_REGIME] = np.nan
+    out[OUT_D_FRIC] = np.nan
 
 
 @njit(cache=True, **INLINE)
@@ -578,6 +592,11 @@ def _write_row(hist, row, t, y, s, on, prm, e_imp, FLEX, GROUND):
     hist[row, HIST_D_DAMP] = y[Y_D_DAMP]
     hist[row, HIST_E_IMPACT] = e_imp
     hist[row, HIST_XG] = ground_acc(GROUND, t, on, prm)
+    # the sliding base's columns, as a base that cannot slide has them: x = 0, rest or
+    # rock (``vocab.phases``' codes), no friction loss
+    hist[row, HIST_X] = 0.0
+    hist[row, HIST_CONTACT] = PHASE_ROCK if s != 0 else PHASE_REST
+    hist[row, HIST_D_FRIC] = 0.0
     return True
 
 

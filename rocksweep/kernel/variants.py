@@ -10,8 +10,9 @@ A variant is one row of four columns, each a small table here or in ``ground``:
 - ground (``ground.GROUNDS``, ``layout.GROUND_*``): the ground kind: the paper's pulses,
   every shape and records, those with a vertical component;
 - contact (``CONTACTS``, ``layout.CONTACT_*``): the contact model, the loop that runs a
-  point with its state, phases and transitions: today the no-slip rocking of the paper
-  (``loop.simulate_point``).
+  point with its state, phases and transitions: the no-slip rocking of the paper
+  (``loop.simulate_point``), or the base that may slide (``slide_loop.simulate_sliding``,
+  where a scene gives body.mu).
 
 REACTIONS (a level's bookkeeping of what the ground does) and the contact model (what the
 ground lets the body do) are separate columns: any level runs under any model.
@@ -51,6 +52,7 @@ from rocksweep.kernel._cache import ENTRY, loads_fast
 from rocksweep.kernel.ground import GROUNDS
 from rocksweep.kernel.layout import (
     CONTACT_NOSLIP,
+    CONTACT_SLIDE,
     GROUND_PULSE,
     KIND_FLEXIBLE,
     KIND_FLEXIBLE_UNDAMPED,
@@ -127,9 +129,25 @@ def _noslip_point(FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     return point
 
 
+def _slide_chunk(FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
+    # imported here: a scene without body.mu imports none of the sliding base (20-35 ms
+    # of the kernel's ~350 ms import, measured with python -X importtime)
+    from rocksweep.kernel import slide_loop
+
+    return slide_loop.chunk_entry(FLEX, DAMPED, ENERGY, REACTIONS, GROUND)
+
+
+def _slide_point(FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
+    from rocksweep.kernel import slide_loop  # (as _slide_chunk's)
+
+    return slide_loop.point_entry(FLEX, DAMPED, ENERGY, REACTIONS, GROUND)
+
+
 CONTACTS: dict[int, ContactModel] = {
     # the paper's: rocking on a corner or in full contact, never sliding
     CONTACT_NOSLIP: ContactModel("", _noslip_chunk, _noslip_point),
+    # the base that may slide on Coulomb friction (a scene's body.mu; docs/sliding.md)
+    CONTACT_SLIDE: ContactModel("_slide", _slide_chunk, _slide_point),
 }
 
 

@@ -44,9 +44,10 @@ class Point:
     for that pulse with its default options. A pulse is timed by w_over_p = omega/p
     (p: NaN); samples by the body's frequency parameter p [rad/s], which fixes the body's
     size against the record's seconds (kernel time p t; w_over_p: NaN). A_ratio: the
-    peak |xg''| of what the body feels over g tan(alpha_ref) (``A``). mu: the friction
-    coefficient of the base on the ground (NaN: none given; only the contact status bits
-    read it). law, e, e_factor: the impact law (one of LAWS), the coefficient of
+    peak |xg''| of what the body feels over g tan(alpha_ref) (``A``). mu: the kinetic
+    friction coefficient of the base on the ground (NaN: none given, the base cannot
+    slide; given, it may: the sliding base, ``kernel_contact``); mu_static: the static one
+    (NaN: mu's). law, e, e_factor: the impact law (one of LAWS), the coefficient of
     restitution of law ``constant`` (NaN for the others) and the factor on the law's e
     (``rocksweep.physics.impact``).
     """
@@ -63,6 +64,7 @@ class Point:
     e_factor: float = 1.0
     # the state at t = 0 (``INITIAL``, normalised; all 0: at rest in full contact)
     initial: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
+    mu_static: float = math.nan
 
     def __post_init__(self) -> None:
         if isinstance(self.excitation, str):
@@ -114,6 +116,18 @@ def kernel_kind(body: Body) -> int:
     if body.rigid:
         return L.KIND_RIGID
     return L.KIND_FLEXIBLE if body.zeta > 0 else L.KIND_FLEXIBLE_UNDAMPED
+
+
+def kernel_contact(mu: np.ndarray | float) -> int:
+    """The contact model (``layout.CONTACT_*``) of points with friction coefficients mu
+    (NaN: none given): the sliding base where every point gives mu, the paper's no-slip
+    model where none does (ValueError for a mix: the dispatch splits them)."""
+    given = np.isfinite(np.asarray(mu, float))
+    if given.all():
+        return L.CONTACT_SLIDE
+    if not given.any():
+        return L.CONTACT_NOSLIP
+    raise ValueError("points with and without body.mu in one kernel call")
 
 
 def body_row(body: Body) -> np.ndarray:
@@ -276,9 +290,9 @@ class Bodies:
 class Columns:
     """A point's own numbers, for n points: float64[n] arrays or scalars (one value for
     all). lam; rate: a pulse's w_over_p, or the body's p [rad/s] against samples; A_ratio:
-    the kernel's (``Point.A_ratio``); mu (NaN: none); law (a LAW_* code), e (law
-    constant's, else NaN) and e_factor: the impact law; initial: the state at t = 0 as
-    four arrays or scalars in ``INITIAL``'s order (theta/alpha_ref, theta'/(p
+    the kernel's (``Point.A_ratio``); mu, mu_static (NaN: none; mu_static NaN: mu's); law
+    (a LAW_* code), e (law constant's, else NaN) and e_factor: the impact law; initial:
+    the state at t = 0 as four arrays or scalars in ``INITIAL``'s order (theta/alpha_ref, theta'/(p
     alpha_ref), u/u_cr, u'/(p u_cr)), None: at rest."""
 
     lam: np.ndarray | float
@@ -289,6 +303,7 @@ class Columns:
     e: np.ndarray | float = math.nan
     e_factor: np.ndarray | float = 1.0
     initial: tuple | None = None
+    mu_static: np.ndarray | float = math.nan
 
     def take(self, sel: np.ndarray) -> Columns:
         """The columns at ``sel`` (bool[n] or int64[m]); scalars stay."""
@@ -296,7 +311,7 @@ class Columns:
             return v[sel] if np.ndim(v) else v
 
         return replace(self, **{k: part(getattr(self, k)) for k in (
-            "lam", "rate", "A_ratio", "mu", "law", "e", "e_factor")},
+            "lam", "rate", "A_ratio", "mu", "law", "e", "e_factor", "mu_static")},
             initial=None if self.initial is None else tuple(part(v) for v in self.initial))
 
 
@@ -351,6 +366,8 @@ def fill_rows(rows: np.ndarray, bodies: Bodies, excitation: Excitation, columns:
     rows[:, L.PAR_RESTRATE] = numerics.rest_rate * alpha_ref  # p = 1
     rows[:, L.PAR_ROOT] = ROOT_CODE[numerics.root]
     rows[:, L.PAR_MU] = columns.mu
+    mu_s = np.asarray(columns.mu_static, float)
+    rows[:, L.PAR_MU_STATIC] = np.where(np.isnan(mu_s), columns.mu, mu_s)
     rows[:, L.PAR_ROT_STEP] = numerics.rotation_step * alpha_ref
     rows[:, L.PAR_ALPHA_REF] = alpha_ref
     rows[:, L.PAR_CLOSE] = close_band(numerics.steps_per_period)
@@ -404,7 +421,7 @@ def points_rows(points: Sequence[Point], numerics: Numerics
                                                       strict=True)))
     columns = Columns(column("lam"), rate, column("A_ratio"), column("mu"),
                       np.array([law_code(p.law) for p in points]), column("e"),
-                      column("e_factor"), initial)
+                      column("e_factor"), initial, column("mu_static"))
     rows = build_rows(Bodies.of([p.body for p in points]), excitations, which, columns,
                       numerics)
     return rows, excitations, which

@@ -32,6 +32,7 @@ from rocksweep.physics.points import (
     law_code,
 )
 from rocksweep.scene.model import Scene
+from rocksweep.schema import FRICTION_KEYS
 from rocksweep.vocab.axes import INITIAL
 from rocksweep.vocab.laws import DEFAULT_LAW
 
@@ -108,8 +109,9 @@ class Grid:
         self.size = scene.size
         names = [a.name for a in scene.axes]
         self._body_pos = [i for i, a in enumerate(scene.axes)
-                          if a.key.startswith("body.") and a.key != "body.mu"]
+                          if a.key.startswith("body.") and a.key[5:] not in FRICTION_KEYS]
         self._i_mu = names.index("mu") if "mu" in names else None
+        self._i_mu_s = names.index("mu_static") if "mu_static" in names else None
         self._body_shape = tuple(self.full_shape[i] for i in self._body_pos)
         self._i_shape = names.index("shape")
         self._i_lam = names.index("lam")
@@ -228,7 +230,7 @@ class Grid:
         initial = (None if all(i is None for i in self._i_init) else
                    tuple(at(i, 0.0) for i in self._i_init))
         return Columns(at(self._i_lam), rate, a_ratio, at(self._i_mu), law, e,
-                       at(self._i_ef, 1.0), initial)
+                       at(self._i_ef, 1.0), initial, at(self._i_mu_s))
 
     def kinds(self) -> list[int]:
         """The kernel kinds the grid's bodies need (each distinct body visited once)."""

@@ -11,6 +11,7 @@ import numpy as np
 
 from rocksweep import fields
 from rocksweep.errors import SceneError, set_key
+from rocksweep.kernel.layout import CONTACT_NOSLIP, CONTACT_SLIDE
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody, Body, FlexibleBody, G
 from rocksweep.physics.ground_motion import (
@@ -26,7 +27,7 @@ from rocksweep.physics.path import GroundPath
 from rocksweep.physics.points import Point
 from rocksweep.physics.records import GroundRecord
 from rocksweep.physics.suite import Suite
-from rocksweep.schema import KEYS, VERTICAL_KEYS
+from rocksweep.schema import FRICTION_KEYS, KEYS, VERTICAL_KEYS
 from rocksweep.vocab.axes import INITIAL
 from rocksweep.vocab.ground import FREE, RECORD, pulse_duration
 from rocksweep.vocab.laws import CONSTANT, DEFAULT_LAW
@@ -59,7 +60,7 @@ class Scene:
     single_numerics: Numerics  # single runs (simulate): the sweeps' numerics (one default)
     energy: bool
     text: str = field(repr=False)
-    contact: bool = False  # outputs.contact (on when body.mu is given)
+    contact: bool = False  # outputs.contact (the no-slip model's; not with body.mu)
     check: bool = False  # outputs.check: per-point error estimates (a half-step rerun)
     # the `refine` section (adaptive sweep settings, rocksweep.compute.adaptive.Options keywords),
     # None without one
@@ -122,6 +123,15 @@ class Scene:
         {} for a body of Pi groups."""
         return {} if self.physical is None else {"p": float(self.physical["p"])}
 
+    def slide_metres(self, summary: dict) -> dict[str, float]:
+        """A physical body's sliding displacements in metres, ``slide_max_m`` and
+        ``slide_final_m`` (the summary's slide_max, slide_final times its half-width
+        b = h_cg tan(alpha_cg)); {} for a body of Pi groups or a run without mu."""
+        if self.physical is None or summary.get("slide_max") is None:
+            return {}
+        b = float(self.physical["h_cg"]) * math.tan(float(self.physical["alpha_cg"]))
+        return {f"{k}_m": summary[k] * b for k in ("slide_max", "slide_final")}
+
     def floor_summary(self, point: Point) -> dict[str, float]:
         """A run's peak floor acceleration {"floor_pfa": [g]} (a scene with a floor:
         ``floor_pfa`` of the motion that drove it, as a sweep stores it); {} without a
@@ -137,7 +147,8 @@ class Scene:
     def variables(self) -> dict[str, tuple[str, float, str]]:
         """The per-point variables a sweep of this scene stores, name -> (dtype, fill value
         of a point not computed, meaning): ``fields.variables`` of its outputs."""
-        return fields.variables(self.energy, self.contact, self.check, self.floor)
+        return fields.variables(self.energy, self.contact, self.check, self.floor,
+                                self.slides)
 
     @property
     def freq_axis(self) -> str:
@@ -158,6 +169,18 @@ class Scene:
         shapes = ((RECORD,) if self.recorded or self.path is not None
                   else self.axis("shape").values)
         return shared_ground(ground_code(sh, self.has_vertical) for sh in shapes)
+
+    @property
+    def slides(self) -> bool:
+        """Whether the scene gives body.mu: its base may slide (docs/sliding.md), and its
+        results carry slide_max, slide_final and regime."""
+        return any(a.key == "body.mu" for a in self.axes)
+
+    @property
+    def contact_model(self) -> int:
+        """The kernel's contact model a sweep of the scene runs (``layout.CONTACT_*``): the
+        sliding base where the scene gives body.mu (docs/sliding.md), else the paper's."""
+        return CONTACT_SLIDE if self.slides else CONTACT_NOSLIP
 
     @property
     def has_vertical(self) -> bool:
@@ -210,11 +233,15 @@ class Scene:
         return math.prod(self.shape)
 
     def body_axes(self) -> tuple[Axis, ...]:
-        """The axes that make the body (body.mu is the ground's, not the body's)."""
-        return tuple(a for a in self.axes if a.key.startswith("body.") and a.key != "body.mu")
+        """The axes that make the body (body.mu, body.mu_static are the ground's, not the
+        body's: ``schema.FRICTION_KEYS``)."""
+        return tuple(a for a in self.axes if a.key.startswith("body.")
+                     and a.key[5:] not in FRICTION_KEYS)
 
     def make_body(self, **values: float) -> Body:
-        """A body from values of the body keys (as in ``body_axes``)."""
+        """A body from values of the body keys (as in ``body_axes``; friction keys among
+        them are the ground's and left out)."""
+        values = {k: v for k, v in values.items() if k not in FRICTION_KEYS}
         if self.kind == "block":
             return BlockBody(**values)
         return FlexibleBody(**values)
@@ -290,7 +317,8 @@ class Scene:
                 None if su is not None else np.array([float(values["A_ratio"])]), rec,
                 stripe, np.array([body.alpha_ref]), np.array([rate]), (ex,),
                 np.zeros(1, np.int64))[0])
-        kw = {"mu": float(values.get("mu", math.nan)), **self._law(values),
+        kw = {"mu": float(values.get("mu", math.nan)),
+              "mu_static": float(values.get("mu_static", math.nan)), **self._law(values),
               "initial": self.initial_state(values)}
         if ex.record is None:
             return Point(body, float(values["lam"]), ex, rate, a_ratio, **kw)

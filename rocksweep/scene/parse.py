@@ -34,6 +34,7 @@ from rocksweep.physics.suite import (
 )
 from rocksweep.scene.admission import candidate_bodies, check_cost
 from rocksweep.scene.floors import excitation_path
+from rocksweep.scene.friction import check_friction, friction_specs
 from rocksweep.scene.ground import ground_record, ground_suite
 from rocksweep.scene.loader import CONTROL_CHARS, YamlError, load_yaml
 from rocksweep.scene.model import Axis, Scene
@@ -41,6 +42,7 @@ from rocksweep.scene.sections import axis_spec, axis_values, section, shape_word
 from rocksweep.scene.vertical import check_vertical_start, pulse_vertical
 from rocksweep.schema import (
     BODY_KEYS,
+    FRICTION_KEYS,
     KEYS,
     SECTIONS,
     VERTICAL_KEYS,
@@ -327,6 +329,7 @@ def _parse(text: str, overrides: list[str], base: Path | None = None,
     specs = _axis_specs(kind, body, impact, initial, motion, forms, law_specs, path_specs)
     _check_size(motion, forms, specs, 1 if law_axis is None else len(law_axis.values))
     axes = _axes(motion, forms, specs, law_axis)
+    check_friction(axes)
 
     numerics, single = _numerics(numerics_sec, contact)
     scene = Scene(name=name or "rocksweep scene", kind=kind, axes=tuple(axes),
@@ -381,7 +384,7 @@ def _body(raw: dict) -> tuple[dict, str, dict | None]:
     except BodyError as err:
         raise SceneError(str(err)) from None
     body = {**{k: physical[k] for k in BODY_KEYS["flexible"]},
-            **({"mu": body["mu"]} if body.get("mu") is not None else {})}
+            **{k: body[k] for k in FRICTION_KEYS if body.get(k) is not None}}
     return body, "flexible", physical
 
 
@@ -433,8 +436,9 @@ def _motion(raw: dict, kind: str, base: Path | None, given_record: GroundRecord 
 
 
 def _outputs(raw: dict, kind: str, mu_spec: Any) -> tuple[bool, bool, bool]:
-    """The ``outputs`` section: (energy, contact, check). ``body.mu`` (mu_spec, None: not
-    given) turns the contact outputs on."""
+    """The ``outputs`` section: (energy, contact, check). The contact outputs are the
+    no-slip model's friction demand: a scene that gives ``body.mu`` (mu_spec, None: not
+    given) slides instead (docs/sliding.md) and has none."""
     outputs = section(raw, "outputs", kind, required=False)
     energy = outputs.get("energy", KEYS["outputs.energy"].default)
     if not isinstance(energy, bool):
@@ -442,11 +446,12 @@ def _outputs(raw: dict, kind: str, mu_spec: Any) -> tuple[bool, bool, bool]:
     contact = outputs.get("contact")
     if contact is not None and not isinstance(contact, bool):
         raise SceneError(f"outputs.contact = {fmt(contact)}: {KEYS['outputs.contact'].allowed}")
-    if mu_spec is not None and contact is False:
-        raise SceneError(f"body.mu = {fmt(mu_spec)}: the slides/lifts_off flags need the "
-                         "contact outputs; remove outputs.contact: false (body.mu turns "
-                         "them on)")
-    contact = bool(contact) or mu_spec is not None
+    if mu_spec is not None and contact:
+        raise SceneError(f"outputs.contact = true: the friction demand is the no-slip "
+                         f"model's, and body.mu = {fmt(mu_spec)} makes the base slide "
+                         "(slide_max, slide_final, regime); remove body.mu for the demand "
+                         "of a base that cannot slide")
+    contact = bool(contact)
     check = outputs.get("check", KEYS["outputs.check"].default)
     if not isinstance(check, bool):
         raise SceneError(f"outputs.check = {fmt(check)}: {KEYS['outputs.check'].allowed}")
@@ -472,7 +477,7 @@ def _axis_specs(kind: str, body: dict, impact: dict, initial: dict, motion: _Mot
     """(name, key, form, spec) of every axis after the shape, in the grid's order, their
     forms checked but no value built: the body, lam (then the impact law's keys), the
     initial state, a suite's records and stripes, the excitation path's (angle, floor),
-    the pulse axes, body.mu last."""
+    the pulse axes, body.mu and body.mu_static last."""
     specs: list[tuple[str, str, str, Any]] = []
     for k in BODY_KEYS[kind]:
         spec = body.get(k, KEYS[f"body.{k}"].default)
@@ -499,9 +504,7 @@ def _axis_specs(kind: str, body: dict, impact: dict, initial: dict, motion: _Mot
             specs.append((k, key, "given", motion.pulse[k]))
             continue
         specs.append((k, key, *axis_spec(key, motion.pulse[k])[:2]))
-    mu_spec = body.get("mu")
-    if mu_spec is not None:  # the last axis: the same grid of runs, flagged per mu
-        specs.append(("mu", "body.mu", *axis_spec("body.mu", mu_spec)[:2]))
+    specs.extend(friction_specs(body))  # the last axes: mu, mu_static
     return specs
 
 

@@ -55,6 +55,7 @@ from rocksweep.store._common import fixed_ascii, utc_now
 from rocksweep.store.identity import files_resolved, resolved_scene
 from rocksweep.vocab.axes import alpha_symbol
 from rocksweep.vocab.outcomes import COMPUTED_FLAGS, COMPUTED_MEANING, OUTCOME_WORDS, STATUS_WORDS
+from rocksweep.vocab.phases import PHASE_CODE
 
 if TYPE_CHECKING:
     import h5py
@@ -104,7 +105,7 @@ COMPUTED_VARIABLE = ("int8", 0, "adaptive sweep: " + ", ".join(
     "point at their fill values")
 
 # Variables whose values are codes (CF flag_values / flag_masks): no units.
-FLAG_VARIABLES = ("outcome", "status", "computed")
+FLAG_VARIABLES = ("outcome", "status", "computed", "regime")
 
 
 def versions() -> dict[str, str]:
@@ -129,7 +130,8 @@ def variables_for(stored: dict) -> dict:
 
     return {**fields.variables(bool(stored.get("energy")), bool(stored.get("contact")),
                                bool(stored.get("check")),
-                               bool((stored.get("path") or {}).get("floor"))),
+                               bool((stored.get("path") or {}).get("floor")),
+                               "body.mu" in (stored.get("axes") or {})),
             **({"computed": COMPUTED_VARIABLE} if stored.get("adaptive") else {})}
 
 
@@ -298,6 +300,9 @@ def variable_attrs(name: str, text: str, kind: str, scalars: tuple[str, ...]
     elif name == "computed":
         out["flag_values"] = np.array(list(COMPUTED_FLAGS), np.int8)
         out["flag_meanings"] = " ".join(COMPUTED_FLAGS.values())
+    elif name == "regime":  # the contact phases visited, a bit each (vocab.phases)
+        out["flag_masks"] = np.array([1 << c for c in PHASE_CODE.values()], np.int8)
+        out["flag_meanings"] = " ".join(PHASE_CODE)
     elif name == "status":
         out["flag_masks"] = np.array(list(STATUS_WORDS), np.int32)
         out["flag_meanings"] = " ".join(STATUS_WORDS.values())

@@ -24,6 +24,7 @@ MODE_WORDS: tuple[str, ...] = ("none", MODE1, MODE2)
 
 SLIDES, LIFTS_OFF = "slides", "lifts_off"  # the contact status words (outputs.contact)
 AIRBORNE = "airborne"  # the ground falls faster than gravity: the body leaves it
+SLID = "slid"  # the base slipped along the ground (a scene with body.mu: docs/sliding.md)
 #: the bits of a run's ``status``: word -> bit (what each means: docs/diagrams.md, "Status
 #: words")
 STATUS_BIT: dict[str, int] = {
@@ -46,6 +47,8 @@ STATUS_BIT: dict[str, int] = {
     # g + a_v <= 0 (a vertical ground acceleration): the body leaves the ground; the run
     # stops there (kernel)
     AIRBORNE: 32768,
+    # the base slipped (the sliding base, a scene that gives body.mu; kernel)
+    SLID: 65536,
 }
 STATUS_WORDS: dict[int, str] = {b: w for w, b in STATUS_BIT.items()}
 #: the bits that make a run's class unreliable ("flagged")
@@ -60,7 +63,7 @@ OVERTURN, UPLIFT = "overturn", "uplift"
 STATES: tuple[str, ...] = (OVERTURN, MODE1, MODE2, UPLIFT)
 THETA_STATE = "theta:X"  # max|theta|/alpha_cg >= X, or overturned
 #: slide_max >= D (the base's largest sliding displacement, in the units of the Dataset's
-#: slide_max: the base half-width b, metres for a physical body), or overturned
+#: slide_max: the base half-width b), or overturned
 SLIDE_STATE = "slide:D"
 
 #: ``computed`` flags of an adaptive sweep (int8 per point): word -> code

@@ -362,10 +362,12 @@ def test_one_field_table():
     assert len(set(slots)) == len(slots)  # no kernel slot read twice in a run's row
     # the error estimates (outputs.check) read run slots of the half-step rerun
     assert {f.slot for f in fields.CHECK_FIELDS} <= set(slots)
-    assert len({c.slot for c in fields.HISTORY}) == L.N_HIST == len(fields.HISTORY)
+    every = fields.HISTORY + fields.SLIDE_HISTORY  # (the sliding base's where it slides)
+    assert len({c.slot for c in every}) == L.N_HIST == len(every)
     run = rocksweep.simulate(FIG5, impact__lam=0.0).run
     contact = {f.name for f in fields.CONTACT_FIELDS}  # only when the scene asks for them
-    assert set(run.summary()) == ({f.name for f in fields.RUN_FIELDS} - contact) | {
+    slide = {f.name for f in fields.FIELDS if f.slide}  # only where the scene gives mu
+    assert set(run.summary()) == ({f.name for f in fields.RUN_FIELDS} - contact - slide) | {
         "accuracy", "wall_time_s", "impact_losses_over_Eref"}  # per impact: single runs
     # "steps" is the regular RK4 steps in a sweep and in a single run alike
     sc = load_scene(FIG5, ["impact.lam=0.2"])

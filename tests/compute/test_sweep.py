@@ -135,7 +135,7 @@ def test_each_point_goes_to_its_kernel_variant(monkeypatch):
     """A body axis crossing zeta = 0 and wn/p = inf: each point to the right variant."""
     seen = []
 
-    def fake_kernel(kind, level, ground=False):
+    def fake_kernel(kind, level, ground=False, contact=L.CONTACT_NOSLIP):
         def run(rows, outs):
             seen.append((kind, level, rows.copy()))
             outs[:] = 0.0

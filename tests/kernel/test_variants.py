@@ -44,18 +44,20 @@ def test_every_row_of_the_table_makes_its_entry_point_named_after_it():
         for level in (*variants.LEVELS, None):
             lvl = variants.HISTORY if level is None else variants.LEVELS[level]
             for ground, g in GROUNDS.items():
-                for contact in variants.CONTACTS:
+                for contact, c in variants.CONTACTS.items():
                     entry = (point_kernel(kind, ground, contact) if level is None
                              else chunk_kernel(kind, level, ground, contact))
                     name = entry.__name__
                     assert name.startswith("point_" if level is None else "chunk_")
-                    assert k.name in name and name.endswith(lvl.name + g.name)
+                    assert k.name in name and name.endswith(lvl.name + g.name + c.name)
                     assert _cells(entry) == {
                         "FLEX": k.flex, "DAMPED": k.damped, "ENERGY": lvl.energy,
                         "REACTIONS": lvl.reactions, "GROUND": ground}
                     seen.add(name)
-                    again = (point_kernel(np.int64(kind), ground) if level is None
-                             else chunk_kernel(np.int64(kind), np.int64(level), ground))
+                    again = (point_kernel(np.int64(kind), ground, np.int64(contact))
+                             if level is None else
+                             chunk_kernel(np.int64(kind), np.int64(level), ground,
+                                          np.int64(contact)))
                     assert again is entry
     # one name per row: numba's cache keys an entry point by its name
     n_rows = len(variants.KINDS) * (len(variants.LEVELS) + 1) * len(GROUNDS) * len(
@@ -66,6 +68,9 @@ def test_every_row_of_the_table_makes_its_entry_point_named_after_it():
     assert chunk_kernel(L.KIND_RIGID, L.LEVEL_ENERGY, True).__name__ == "chunk_rigid_energy_ground"
     assert point_kernel(L.KIND_FLEXIBLE_UNDAMPED, L.GROUND_VERTICAL).__name__ == (
         "point_flexible_undamped_history_vertical")
+    # the sliding base's: the same names, "_slide" after them
+    assert chunk_kernel(L.KIND_RIGID, L.LEVEL_OUTCOME, L.GROUND_PULSE,
+                        L.CONTACT_SLIDE).__name__ == "chunk_rigid_slide"
     with pytest.raises(ValueError, match="no kernel variant"):
         chunk_kernel(L.KIND_RIGID, 2)
     with pytest.raises(ValueError, match="no kernel variant"):

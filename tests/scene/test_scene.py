@@ -124,7 +124,7 @@ STRUCTURE_CASES = [
      "body.kind = ['block']: must be one of flexible, block, physical"),
     (sub("zeta: 0.05", "zeta: 0.05, zta: 1"),
      "body.zta: unknown key for a flexible body (allowed: kind, wn_over_p, zeta, alpha_cg, "
-     "alpha_A, mA_over_m, IA_ratio, mu)"),
+     "alpha_A, mA_over_m, IA_ratio, mu, mu_static)"),
     (GOOD + "numerics: {tol: 1}\n",
      "numerics.tol: unknown key (allowed: accuracy, steps_per_period, pulse_steps, refine, "
      "event_tol, horizon, rest_rate, max_events, root, rotation_step)"),

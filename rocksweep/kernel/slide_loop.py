@@ -1,0 +1,765 @@
+"""The loop of the base that may slide: one point on a ground with Coulomb friction (jitted).
+
+The contact model ``layout.CONTACT_SLIDE`` (``variants.CONTACTS``), run where a scene
+gives ``body.mu`` (docs/sliding.md). ``simulate_sliding`` takes ``loop.simulate_point``'s
+arguments and owns the phase (s, sigma): s the corner (0 flat), sigma the slip direction
+(0 stuck), and the 9-slot state y = (theta, theta', u, u', W_in, D_damp, x, x', D_fric)
+(``layout.Y_*``). Fixed RK4 steps of ``sliding.sliding_derivatives`` (the loop's own step
+lengths, ``loop._step_length``, and rotation limit), and every change of phase a located
+event of a continuous function, on its far side, handled at the event's state:
+
+| phase      | events (slot: 0, 1, 2, 3)                                                |
+|------------|--------------------------------------------------------------------------|
+| rest       | uplift on +b, on -b (s Q = M g b), stick break (mu_s N - abs(H) < 0)     |
+| slide      | uplift while sliding on +b, on -b (``slide_uplift_moment``), slip stop   |
+| rock       | impact (theta = 0), overturning, stick break (N <= 0 included)           |
+| slide-rock | impact, overturning, slip stop (x' = 0), Painleve (den = 0: the jam)     |
+
+A stick break, an uplift and a slip stop go to ``sliding.choose_phase`` (x' = 0 exactly
+at a stop); an impact to ``sliding.friction_impact`` (the scene's law where the corner
+sticks); Painleve to ``sliding.jam_impulse``. An event function fires only when it goes
+from > 0 to <= 0 inside a step (a stick break: < 0, the static cone holds on its edge), so
+a phase entered on its own surface, or held where no phase is consistent (``choose_phase``'s
+JAM and LIFT_OFF: the corner held as in the no-slip model, flagged ``lifts_off``), does not
+switch again at the same instant; every switch counts against the run's event cap.
+
+Results beside the loop's: OUT_SLIDE_MAX, OUT_SLIDE_FINAL (|x| [m]), OUT_REGIME (bit
+1 << phase code of every phase entered), OUT_D_FRIC (friction's loss, energy variants:
+W_in = E_end + D_damp + E_impact + D_fric; an impact's loss split by
+``friction_impact``'s W_f), STATUS_SLID where the base slipped. The no-slip model's
+friction demand (REACTIONS, outputs.contact) has no meaning here: NaN. A rigid body
+rocking on a stuck corner once the ground is still is decided safe where its energy is
+below the barrier (``rigid_bounded``: friction and impacts only take energy away;
+STATUS_BOUNDED, its margin), as in the no-slip loop, but the run goes on to rest: the
+slips still to come count.
+"""
+
+import math
+
+import numpy as np
+from numba import literally, njit
+
+from rocksweep.kernel._cache import INLINE, INTERNAL
+from rocksweep.kernel.equations import rest_margin, tip_moment, uplift_moment
+from rocksweep.kernel.events import HERMITE_PAST, NEWTON_XTOL, hermite_min, hermite_root
+from rocksweep.kernel.ground import ground_acc, ground_flags, ground_gravity
+from rocksweep.kernel.layout import (
+    HIST_CONTACT,
+    HIST_D_DAMP,
+    HIST_D_FRIC,
+    HIST_E,
+    HIST_E_IMPACT,
+    HIST_PHASE,
+    HIST_T,
+    HIST_THETA,
+    HIST_THETA_DOT,
+    HIST_U,
+    HIST_U_DOT,
+    HIST_W_IN,
+    HIST_X,
+    HIST_XG,
+    OUT_CONTACTS,
+    OUT_D_DAMP,
+    OUT_D_FRIC,
+    OUT_E_END,
+    OUT_E_GAINED,
+    OUT_E_IMPACT,
+    OUT_E_MAX,
+    OUT_EVENT_STEPS,
+    OUT_HIST_ROWS,
+    OUT_IMPACTS,
+    OUT_IMPULSE_MAX,
+    OUT_MARGIN,
+    OUT_MU_REQ,
+    OUT_N_GAINING,
+    OUT_N_MIN,
+    OUT_REGIME,
+    OUT_SLIDE_FINAL,
+    OUT_SLIDE_MAX,
+    OUT_STATUS,
+    OUT_STEPS,
+    OUT_T_CLOSE,
+    OUT_T_END,
+    OUT_T_FIRST_IMPACT,
+    OUT_THETA_MAX,
+    OUT_UPLIFTS,
+    OUT_W_IN,
+    PAR_C,
+    PAR_CLOSE,
+    PAR_DT,
+    PAR_DT_ON,
+    PAR_G,
+    PAR_K,
+    PAR_M,
+    PAR_MAXEVENTS,
+    PAR_MAXSTEPS,
+    PAR_MTOT,
+    PAR_MU,
+    PAR_MU_STATIC,
+    PAR_REC_H,
+    PAR_ROT_STEP,
+    PAR_T_AIR,
+    PAR_TEND,
+    PAR_THETA0,
+    PAR_THETA_DOT0,
+    PAR_THETA_OVER,
+    PAR_TOL,
+    PAR_TPULSE,
+    PAR_U0,
+    PAR_U_DOT0,
+    STATUS_AIRBORNE,
+    STATUS_BOUNDED,
+    STATUS_E_ABOVE_1,
+    STATUS_EVENT_CAP,
+    STATUS_HIST_FULL,
+    STATUS_HORIZON,
+    STATUS_LIFTS_OFF,
+    STATUS_NONFINITE,
+    STATUS_REST,
+    STATUS_SETTLED,
+    STATUS_SLID,
+    STATUS_STEP_CAP,
+    Y_D_DAMP,
+    Y_D_FRIC,
+    Y_THETA,
+    Y_THETA_DOT,
+    Y_U,
+    Y_U_DOT,
+    Y_W_IN,
+    Y_X,
+    Y_X_DOT,
+)
+from rocksweep.kernel.loop import (
+    _flag,
+    _near_saddle,
+    _overturned,
+    _reset,
+    _rigid_bounded,
+    _rigid_margin,
+    _rotation_step,
+    _saddle,
+    _saddle_bounds,
+    _step_length,
+    _theta_max,
+)
+from rocksweep.kernel.sliding import (
+    LIFT_OFF,
+    TIP_ROUNDOFF,
+    choose_phase,
+    friction_impact,
+    jam_impulse,
+    phase_code,
+    slide_uplift_moment,
+    sliding_derivatives,
+    sliding_energy,
+    slip_state,
+    stick_margin,
+)
+
+# The event slots of a phase (``_event_values``): 0 and 1 the impact and overturning
+# (rocking) or the uplifts on +b and -b (flat), 2 the stick break (stuck) or the slip stop
+# (slipping), 3 Painleve (slide-rock; else never)
+SLOT_FIRST = 0
+SLOT_SECOND = 1
+SLOT_CONTACT = 2
+SLOT_JAM = 3
+N_SLOTS = 4
+# the least positive float64: a stuck contact exactly on its cone's edge still holds
+# (``choose_phase``), so its margin 0 counts as not crossed
+EDGE = 5e-324
+
+
+@njit(cache=True, **INTERNAL)
+def simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
+    """Run one point of the sliding base from rest (or the row's initial state) to a
+    decided outcome, a cap, rest or the horizon (module docstring). Arguments as
+    ``loop.simulate_point``'s; REACTIONS is not read (the friction demand is NaN)."""
+    literally(FLEX)
+    literally(DAMPED)
+    literally(ENERGY)
+    t, dt, t_pulse, t_end = 0.0, prm[PAR_DT], prm[PAR_TPULSE], prm[PAR_TEND]
+    dt_on = prm[PAR_DT_ON]
+    max_steps, max_events = prm[PAR_MAXSTEPS], prm[PAR_MAXEVENTS]
+    records, vertical = ground_flags(GROUND)
+    h_rec = prm[PAR_REC_H] if records else 0.0
+    t_air = prm[PAR_T_AIR] if vertical else math.inf
+    mu, mu_s = prm[PAR_MU], prm[PAR_MU_STATIC]
+    on = 0.0 < t_pulse
+    _reset(out)
+    y = (prm[PAR_THETA0], prm[PAR_THETA_DOT0], prm[PAR_U0], prm[PAR_U_DOT0], 0.0, 0.0, 0.0,
+         0.0, 0.0)
+    s = 0
+    if y[Y_THETA] != 0.0 or y[Y_THETA_DOT] != 0.0:
+        s = 1 if y[Y_THETA] > 0.0 or (y[Y_THETA] == 0.0 and y[Y_THETA_DOT] > 0.0) else -1
+    s, sigma = _enter(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, GROUND)
+    _record(hist, t, y, s, sigma, on, prm, out, FLEX, GROUND)
+    steps, event_steps, switches = 0, 0, 0
+    theta_max = abs(y[Y_THETA])
+    slide_max = 0.0
+    rot = prm[PAR_ROT_STEP]
+    acc = 0.0
+    margin = np.inf
+    t_close = np.nan
+    near = _saddle_bounds(prm)
+    ev0 = _event_values(t, y, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED, GROUND)
+    free_check = True  # a rigid body's bound, as the no-slip loop's (once per free flight)
+
+    while True:
+        on = t < t_pulse
+        if s == 0 and sigma == 0 and not on and _rest_for_good(y, mu_s, prm, FLEX):
+            if not int(out[OUT_STATUS]) & STATUS_SETTLED:
+                _flag(out, STATUS_REST)
+            break
+        if t >= t_end:
+            if not int(out[OUT_STATUS]) & STATUS_BOUNDED:  # else: decided, went on to show
+                _flag(out, STATUS_HORIZON)
+            break
+        if vertical and t >= t_air:
+            _flag(out, STATUS_AIRBORNE)
+            break
+        if not FLEX and s != 0 and sigma == 0 and not on and free_check:
+            # rocking on a stuck corner, the ground still: its energy can only fall
+            # (impacts with e <= 1 and friction dissipate; a slip's kinetic energy is
+            # part of it), so below the barrier it cannot overturn (``rigid_bounded``):
+            # its class is decided (STATUS_BOUNDED), but the run goes on to rest, for
+            # the slips still to come (slide_max, slide_final)
+            free_check = False
+            margin = _rigid_margin(FLEX, y, s, prm, margin)
+            if margin < prm[PAR_CLOSE]:
+                t_close = t
+            peak = _rigid_bounded(FLEX, y, s, prm, FLEX)
+            if peak >= 0.0:
+                if peak > theta_max:
+                    theta_max = peak
+                _flag(out, STATUS_BOUNDED)
+        if steps + event_steps >= max_steps:
+            _flag(out, STATUS_STEP_CAP)
+            break
+        if out[OUT_IMPACTS] + out[OUT_UPLIFTS] + switches >= max_events:
+            _flag(out, STATUS_EVENT_CAP)
+            break
+        h, lands = _step_length(t, on, dt, dt_on, t_pulse, t_end, h_rec)
+        air = vertical and t + h >= t_air
+        if air:
+            h, lands = t_air - t, False
+        if s != 0 and rot > 0.0:
+            h_rot = _rotation_step(y[Y_THETA_DOT], acc, rot)
+            if h_rot < h:
+                h, lands, air = h_rot, False, False
+        k1 = _rates(t, y, s, sigma, on, mu, prm, FLEX, DAMPED, ENERGY, GROUND)
+        y1 = _rk4(t, y, h, k1, s, sigma, on, mu, prm, FLEX, DAMPED, ENERGY, GROUND)
+        steps += 1
+        if s != 0 and rot > 0.0:
+            turn = abs(y1[Y_THETA] - y[Y_THETA])
+            while turn > 2.0 * rot:
+                h, lands, air = h * max(0.25, 0.9 * math.sqrt(rot / turn)), False, False
+                y1 = _rk4(t, y, h, k1, s, sigma, on, mu, prm, FLEX, DAMPED, ENERGY, GROUND)
+                steps += 1
+                turn = abs(y1[Y_THETA] - y[Y_THETA])
+            acc = abs(y1[Y_THETA_DOT] - y[Y_THETA_DOT]) / h
+        if not _finite(y1):
+            _flag(out, STATUS_NONFINITE)
+            break
+        ev1 = _event_values(t + h, y1, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED, GROUND)
+        slot, tau, y_ev, n = _first_event(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s,
+                                          prm, FLEX, DAMPED, ENERGY, GROUND)
+        event_steps += n
+        if s != 0:
+            theta_max = _theta_max(y, y_ev, tau, s, theta_max)
+            if slot < 0 and not ev1[4] > 0.0:  # slide-rock's N at the step's end
+                _flag(out, STATUS_LIFTS_OFF)  # the ground pulls: outside the model
+        if abs(y_ev[Y_X]) > slide_max:
+            slide_max = abs(y_ev[Y_X])
+
+        if slot < 0:
+            t, y, ev0 = (t_pulse if lands else (t_air if air else t + h)), y1, ev1
+            if s != 0 and sigma == 0 and not on and _near_saddle(y, s, near):
+                q = _saddle(y, s, prm)
+                if q < prm[PAR_CLOSE]:
+                    t_close = t
+                margin = min(margin, q)
+            _record(hist, t, y, s, sigma, t < t_pulse, prm, out, FLEX, GROUND)
+            if lands and sigma == 0:
+                # the pulse's end: xg'' jumps (a cosine's peak), the stuck force with it
+                off = t < t
+                s_new, sigma = _choose(t, y, s, off, mu, mu_s, prm, out, FLEX, DAMPED,
+                                       GROUND)
+                if s_new != s:
+                    out[OUT_UPLIFTS] += 1.0
+                s = s_new
+                ev0 = _event_values(t, y, s, sigma, off, mu, mu_s, prm, FLEX, DAMPED, GROUND)
+                _record(hist, t, y, s, sigma, off, prm, out, FLEX, GROUND)
+            continue
+
+        t, y = t + tau, y_ev
+        _record(hist, t, y, s, sigma, on, prm, out, FLEX, GROUND)
+        if s != 0 and slot == SLOT_SECOND:
+            _overturned(t, out)
+            theta_max = max(theta_max, prm[PAR_THETA_OVER])
+            break
+        if s != 0 and slot == SLOT_FIRST:
+            y, s, sigma = _impact(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, ENERGY,
+                                  GROUND)
+            free_check = True
+        else:
+            switches += 1
+            y, s, sigma = _switch(slot, t, y, s, sigma, on, mu, mu_s, prm, out, FLEX, DAMPED,
+                                  ENERGY, GROUND)
+        ev0 = _event_values(t, y, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED, GROUND)
+        _record(hist, t, y, s, sigma, on, prm, out, FLEX, GROUND)
+    out[OUT_MARGIN] = margin
+    out[OUT_T_CLOSE] = t_close
+    _finish(t, y, s, steps, event_steps, theta_max, slide_max, prm, out, FLEX, ENERGY)
+
+
+@njit(cache=True, **INLINE)
+def _finish(t, y, s, steps, event_steps, theta_max, slide_max, prm, out, FLEX, ENERGY):
+    """The result row's last entries: end time, step counts, theta_max, the slide, the
+    energy accounting (NaN without) and the no-slip demand's slots (NaN)."""
+    out[OUT_T_END] = t
+    out[OUT_STEPS] = steps
+    out[OUT_EVENT_STEPS] = event_steps
+    out[OUT_THETA_MAX] = theta_max
+    out[OUT_SLIDE_MAX] = slide_max
+    out[OUT_SLIDE_FINAL] = abs(y[Y_X])
+    out[OUT_MU_REQ] = np.nan
+    out[OUT_N_MIN] = np.nan
+    out[OUT_IMPULSE_MAX] = np.nan
+    if ENERGY:
+        out[OUT_W_IN] = y[Y_W_IN]
+        out[OUT_D_DAMP] = y[Y_D_DAMP]
+        out[OUT_D_FRIC] = y[Y_D_FRIC]
+        out[OUT_E_END] = _energy(y, s, prm, FLEX)
+    else:
+        out[OUT_W_IN] = np.nan
+        out[OUT_D_DAMP] = np.nan
+        out[OUT_D_FRIC] = np.nan
+        out[OUT_E_IMPACT] = np.nan
+        out[OUT_E_GAINED] = np.nan
+        out[OUT_N_GAINING] = np.nan
+        out[OUT_E_END] = np.nan
+
+
+def chunk_entry(FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
+    """The chunk entry point's body of a row (``variants.ContactModel``): the loop a
+    global name of this module, as ``variants``' no-slip entries."""
+    def chunk(prms, outs):
+        for i in range(prms.shape[0]):
+            simulate_sliding(prms[i], outs[i], None, FLEX, DAMPED, ENERGY, REACTIONS, GROUND)
+    return chunk
+
+
+def point_entry(FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
+    """The point entry point's body of a row (``chunk_entry``'s)."""
+    def point(prm, out, hist):
+        simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND)
+    return point
+
+
+# ----------------------------------------------------------------------------------------
+# Steps
+# ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True, **INLINE)
+def _rates(t, y, s, sigma, on, mu, prm, FLEX, DAMPED, ENERGY, GROUND):
+    return sliding_derivatives(t, y, s, sigma, on, mu, prm, FLEX, DAMPED, ENERGY, GROUND)
+
+
+@njit(cache=True, **INLINE)
+def _axpy(y, a, k):
+    """y + a k, slot by slot (9 slots)."""
+    return (y[0] + a * k[0], y[1] + a * k[1], y[2] + a * k[2], y[3] + a * k[3],
+            y[4] + a * k[4], y[5] + a * k[5], y[6] + a * k[6], y[7] + a * k[7],
+            y[8] + a * k[8])
+
+
+@njit(cache=True, **INLINE)
+def _rk4(t, y, h, k1, s, sigma, on, mu, prm, FLEX, DAMPED, ENERGY, GROUND):
+    """One classical RK4 step of size h from (t, y) in phase (s, sigma) whose first stage
+    k1 is known (as ``stepping.rk4_from``: one call site of the right-hand side)."""
+    k = k1
+    k23 = k1
+    for stage in range(1, 4):
+        c = h if stage == 3 else 0.5 * h
+        k = _rates(t + c, _axpy(y, c, k), s, sigma, on, mu, prm, FLEX, DAMPED, ENERGY,
+                   GROUND)
+        if stage == 1:
+            k23 = k
+        elif stage == 2:
+            k23 = _axpy(k23, 1.0, k)
+    w = h / 6.0
+    return _axpy(_axpy(y, w, k1), w, _axpy(_axpy(k23, 1.0, k23), 1.0, k))
+
+
+@njit(cache=True, **INLINE)
+def _finite(y):
+    return (math.isfinite(y[Y_THETA]) and math.isfinite(y[Y_THETA_DOT])
+            and math.isfinite(y[Y_U]) and math.isfinite(y[Y_U_DOT])
+            and math.isfinite(y[Y_X]) and math.isfinite(y[Y_X_DOT]))
+
+
+@njit(cache=True, **INLINE)
+def _energy(y, s, prm, FLEX):
+    return sliding_energy(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], y[Y_X_DOT], s, prm,
+                          FLEX)
+
+
+@njit(cache=True, **INLINE)
+def _rest_for_good(y, mu_s, prm, FLEX):
+    """Flat, stuck, the ground still: the body never uplifts (``equations.rest_margin``)
+    nor slips again (the spring's largest force on its energy ellipse within mu_s M g);
+    a rigid body at once."""
+    if not FLEX:
+        return True
+    u, ud = y[Y_U], y[Y_U_DOT]
+    m, k, c = prm[PAR_M], prm[PAR_K], prm[PAR_C]
+    e2 = m * ud * ud + k * u * u
+    f_max = math.sqrt(e2 * (k + c * c / m))
+    return rest_margin(u, ud, prm) < 0.0 and f_max <= mu_s * prm[PAR_MTOT] * prm[PAR_G]
+
+
+# ----------------------------------------------------------------------------------------
+# Events
+# ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True, **INLINE)
+def _event_values(t, y, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED, GROUND):
+    """The four event functions of phase (s, sigma) at (t, y) (module docstring; inf: none
+    in this phase), each fires when it goes from > 0 to <= 0; and N [N] while the base
+    slide-rocks (1 in the other phases: no lift-off to flag)."""
+    theta, theta_dot, u, u_dot = y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT]
+    xg = ground_acc(GROUND, t, on, prm)
+    g = ground_gravity(GROUND, t, on, prm)
+    e3 = np.inf
+    n = 1.0
+    if s != 0:
+        e0 = s * theta
+        e1 = prm[PAR_THETA_OVER] - s * theta
+        if sigma != 0:
+            _, n, e3 = slip_state(theta, theta_dot, u, u_dot, s, sigma, xg, g, mu, prm, FLEX,
+                                  DAMPED)
+    else:
+        mgb = tip_moment(g, prm)
+        if sigma == 0:
+            q = uplift_moment(u, u_dot, xg, g, prm, FLEX, DAMPED)
+        else:
+            # a rigid body sliding at mu = tan(alpha_cg) has Q = M g b for good: it slides
+            q = slide_uplift_moment(u, u_dot, sigma, xg, g, mu, prm, FLEX, DAMPED)
+            mgb *= 1.0 + TIP_ROUNDOFF
+        e0 = mgb - q
+        e1 = mgb + q
+    if sigma == 0:
+        e2 = stick_margin(theta, theta_dot, u, u_dot, s, xg, g, mu_s, prm, FLEX, DAMPED)
+        if e2 == 0.0:
+            e2 = EDGE
+    else:
+        e2 = sigma * y[Y_X_DOT]
+    return e0, e1, e2, e3, n
+
+
+@njit(cache=True, **INLINE)
+def _pick(ev, slot):
+    if slot == SLOT_FIRST:
+        return ev[0]
+    if slot == SLOT_SECOND:
+        return ev[1]
+    if slot == SLOT_CONTACT:
+        return ev[2]
+    return ev[3]
+
+
+@njit(cache=True, **INTERNAL)
+def _locate(slot, t0, y0, k1, g_lo, hi, g_hi, y_hi, s, sigma, on, mu, mu_s, prm, FLEX,
+            DAMPED, ENERGY, GROUND):
+    """Shrink the bracket [0, hi] (g(0) = g_lo >= 0 >= g(hi) = g_hi) of the event in
+    ``slot`` to PAR_TOL, each trial a fresh RK4 step from (t0, y0) (as ``events._locate``):
+    an impact (g = s theta, its rate s theta' in the state) by the roots of g's cubic
+    Hermite interpolant (``events.hermite_root``, each trial after the first HERMITE_PAST
+    tolerances past it, a bisection after two that did not halve the bracket: the no-slip
+    loop's rule), the others by Illinois regula falsi. Returns (tau, y(tau), trials), tau
+    on the far side."""
+    literally(FLEX)
+    literally(DAMPED)
+    literally(ENERGY)
+    lo = 0.0
+    tol = prm[PAR_TOL]
+    n = 0
+    side = 0
+    hermite = s != 0 and slot == SLOT_FIRST
+    d_lo, d_hi = s * y0[Y_THETA_DOT], s * y_hi[Y_THETA_DOT]
+    slow = 0
+    while hi - lo > tol:
+        width = hi - lo
+        if hermite and slow < 2:
+            mid = lo + hermite_root(g_lo, d_lo, g_hi, d_hi, width, NEWTON_XTOL * tol / width)
+            if not (mid == mid):
+                mid = 0.5 * (lo + hi)
+            mid += HERMITE_PAST * tol * side  # (side: +1 after lo moved, -1 after hi)
+            mid = min(max(mid, lo + 0.5 * tol), hi - 0.5 * tol)
+        elif hermite:
+            mid = 0.5 * (lo + hi)
+        else:
+            mid = hi - g_hi * (hi - lo) / (g_hi - g_lo)
+            if mid <= lo + 0.5 * tol or mid >= hi - 0.5 * tol or not (mid == mid):
+                mid = 0.5 * (lo + hi)
+        y_mid = _rk4(t0, y0, mid, k1, s, sigma, on, mu, prm, FLEX, DAMPED, ENERGY, GROUND)
+        g_mid = _pick(_event_values(t0 + mid, y_mid, s, sigma, on, mu, mu_s, prm, FLEX,
+                                    DAMPED, GROUND), slot)
+        d_mid = s * y_mid[Y_THETA_DOT]
+        n += 1
+        if g_mid <= 0.0:
+            hi, g_hi, d_hi, y_hi = mid, g_mid, d_mid, y_mid
+            if side == -1 and not hermite:
+                g_lo *= 0.5
+            side = -1
+        else:
+            lo, g_lo, d_lo = mid, g_mid, d_mid
+            if side == 1 and not hermite:
+                g_hi *= 0.5
+            side = 1
+        if slow >= 2:
+            slow = 0
+        else:
+            slow = slow + 1 if hi - lo > 0.5 * width else 0
+    return hi, y_hi, n
+
+
+@njit(cache=True, **INLINE)
+def _first_event(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED,
+                 ENERGY, GROUND):
+    """The first event of the step (t, y) -> (t + h, y1), as ``_search``: a screen on the
+    path of every step (inlined), the search a call where a slot may have fired."""
+    maybe = False
+    for slot in range(N_SLOTS):
+        g0, g1 = _pick(ev0, slot), _pick(ev1, slot)
+        if g1 <= 0.0 and (g0 > 0.0 or (s != 0 and slot == SLOT_FIRST and g0 == 0.0)):
+            maybe = True
+    if s != 0 and ev0[0] > 0.0 and s * y[Y_THETA_DOT] < 0.0 < s * y1[Y_THETA_DOT]:
+        maybe = True  # theta turned back toward 0 inside the step: a dip to screen
+    if not maybe:
+        return -1, h, y1, 0
+    return _search(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED,
+                   ENERGY, GROUND)
+
+
+@njit(cache=True, **INTERNAL)
+def _search(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED, ENERGY,
+            GROUND):
+    """The first event of the step (t, y) -> (t + h, y1): (slot, tau, y(tau), trials);
+    slot -1, h, y1 if none. ev0, ev1: the event values at both ends. Every slot that
+    changed sign is located, the earliest kept; an impact right after theta = 0 (the
+    motion turning straight back), and one that dips through theta = 0 and back inside
+    the step (a grazing one), is screened with theta's cubic Hermite
+    interpolant and checked on a fresh step to its minimum."""
+    literally(FLEX)
+    literally(DAMPED)
+    literally(ENERGY)
+    best, tau_best, y_best, n = -1, h, y1, 0
+    for slot in range(N_SLOTS):
+        g0, g1 = _pick(ev0, slot), _pick(ev1, slot)
+        # theta = 0 after an impact or an uplift: a motion that turns straight back is an
+        # impact just after t (as ``events._crossing``); the other functions fire only
+        # from > 0 (a phase held on the wrong side of its cone waits to come back)
+        if not (g0 > 0.0 or (s != 0 and slot == SLOT_FIRST and g0 == 0.0 and g1 <= 0.0)):
+            continue
+        hi, g_hi, y_hi = h, g1, y1
+        if g1 > 0.0:
+            if not (s != 0 and slot == SLOT_FIRST):
+                continue
+            d0, d1 = s * y[Y_THETA_DOT], s * y1[Y_THETA_DOT]
+            if not (d0 < 0.0 < d1):
+                continue
+            tm, g_min = hermite_min(g0, d0, g1, d1, h)
+            if g_min > min(g0, g1) - g_min or not 0.0 < tm < h:
+                continue
+            y_m = _rk4(t, y, tm, k1, s, sigma, on, mu, prm, FLEX, DAMPED, ENERGY, GROUND)
+            n += 1
+            if s * y_m[Y_THETA] > 0.0:
+                continue
+            hi, g_hi, y_hi = tm, s * y_m[Y_THETA], y_m
+        if hi > tau_best:
+            continue
+        tau, y_ev, k = _locate(slot, t, y, k1, g0, hi, g_hi, y_hi, s, sigma, on, mu, mu_s,
+                               prm, FLEX, DAMPED, ENERGY, GROUND)
+        n += k
+        if best < 0 or tau < tau_best:
+            best, tau_best, y_best = slot, tau, y_ev
+    return best, tau_best, y_best, n
+
+
+# ----------------------------------------------------------------------------------------
+# Actions
+# ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True, **INLINE)
+def _regime(out, s, sigma):
+    """Mark phase (s, sigma) as visited (OUT_REGIME's bit, STATUS_SLID)."""
+    bit = 1 << phase_code(s, sigma)
+    out[OUT_REGIME] = int(out[OUT_REGIME]) | bit
+    if sigma != 0:
+        _flag(out, STATUS_SLID)
+
+
+@njit(cache=True, **INTERNAL)
+def _choose(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, GROUND):
+    """``choose_phase`` at (t, y) of a base that does not slip (x' = 0): the new (s,
+    sigma), entered; JAM and LIFT_OFF hold the corner (LIFT_OFF flagged ``lifts_off``)."""
+    g = ground_gravity(GROUND, t, on, prm)
+    s_new, sigma, flag = choose_phase(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s,
+                                      ground_acc(GROUND, t, on, prm), g, mu, mu_s, prm, FLEX,
+                                      DAMPED)
+    if flag & LIFT_OFF:
+        _flag(out, STATUS_LIFTS_OFF)
+    _regime(out, s_new, sigma)
+    return s_new, sigma
+
+
+@njit(cache=True, **INTERNAL)
+def _enter(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, GROUND):
+    """The phase at the run's start (``_choose``; a tip from rest counts as an uplift)."""
+    out[OUT_REGIME] = 0.0
+    s_new, sigma = _choose(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, GROUND)
+    if s_new != s:
+        out[OUT_UPLIFTS] += 1.0
+    return s_new, sigma
+
+
+@njit(cache=True, **INTERNAL)
+def _switch(slot, t, y, s, sigma, on, mu, mu_s, prm, out, FLEX, DAMPED, ENERGY, GROUND):
+    """A stick break, a slip stop, an uplift or Painleve's jam at (t, y). Returns (y, s,
+    sigma)."""
+    if slot == SLOT_JAM:
+        return _jam(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, ENERGY, GROUND)
+    if slot == SLOT_CONTACT and sigma != 0:  # the slip stops: x' = 0 exactly
+        e_before = _energy(y, s, prm, FLEX) if ENERGY else 0.0
+        y = (y[0], y[1], y[2], y[3], y[4], y[5], y[6], 0.0, y[8])
+        if ENERGY:  # the stop's round-off of x' (within the event tolerance): friction's
+            y = (y[0], y[1], y[2], y[3], y[4], y[5], y[6], 0.0,
+                 y[8] + e_before - _energy(y, s, prm, FLEX))
+        s_new, sigma = _choose(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, GROUND)
+        if s_new != s:
+            out[OUT_UPLIFTS] += 1.0
+        return y, s_new, sigma
+    if s == 0 and slot != SLOT_CONTACT:  # uplift (flat)
+        if sigma != 0:  # tips while sliding: slide-rock on that corner, or the jam
+            s_new = 1 if slot == SLOT_FIRST else -1
+            out[OUT_UPLIFTS] += 1.0
+            return _slipping(t, y, s_new, sigma, on, mu, mu_s, prm, out, FLEX, DAMPED,
+                             ENERGY, GROUND)
+    s_new, sigma = _choose(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, GROUND)
+    if s_new != s:
+        out[OUT_UPLIFTS] += 1.0
+    if s_new == 0:
+        y = (0.0, 0.0, y[2], y[3], y[4], y[5], y[6], y[7], y[8])
+    return y, s_new, sigma
+
+
+@njit(cache=True, **INTERNAL)
+def _jam(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, ENERGY, GROUND):
+    """Painleve: the tangential impulse that sticks the slipping corner
+    (``sliding.jam_impulse``; its work friction's, the rest of the energy change the
+    impacts'), then the phase chosen at x' = 0."""
+    g = ground_gravity(GROUND, t, on, prm)
+    e_before = _energy(y, s, prm, FLEX) if ENERGY else 0.0
+    w, ud, _, _, w_j = jam_impulse(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT],
+                                   y[Y_X_DOT], s, g, prm, FLEX, DAMPED)
+    y = (y[0], w, y[2], ud if FLEX else y[3], y[4], y[5], y[6], 0.0, y[8] - w_j)
+    if ENERGY:
+        out[OUT_E_IMPACT] += e_before - _energy(y, s, prm, FLEX) + w_j
+    s_new, sigma = _choose(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, GROUND)
+    return y, s_new, sigma
+
+
+@njit(cache=True, **INTERNAL)
+def _slipping(t, y, s, sigma, on, mu, mu_s, prm, out, FLEX, DAMPED, ENERGY, GROUND):
+    """The phase a slip (x' != 0, direction sigma) goes on in on corner s (0 flat): flat,
+    it tips at once onto a corner where it would uplift while sliding; rocking, it
+    slide-rocks where a slip is consistent (den > 0), else the jam sticks it."""
+    g = ground_gravity(GROUND, t, on, prm)
+    xg = ground_acc(GROUND, t, on, prm)
+    if s == 0:
+        q = slide_uplift_moment(y[Y_U], y[Y_U_DOT], sigma, xg, g, mu, prm, FLEX, DAMPED)
+        mgb = tip_moment(g, prm) * (1.0 + TIP_ROUNDOFF)
+        if q >= mgb or q <= -mgb:
+            s = 1 if q > 0.0 else -1
+            out[OUT_UPLIFTS] += 1.0
+    if s != 0:
+        den = slip_state(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s, sigma, xg, g, mu,
+                         prm, FLEX, DAMPED)[2]
+        if not den > 0.0:
+            return _jam(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, ENERGY, GROUND)
+    _regime(out, s, sigma)
+    return y, s, sigma
+
+
+@njit(cache=True, **INTERNAL)
+def _impact(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, ENERGY, GROUND):
+    """The impact at (t, y) ending rocking on corner s, with friction
+    (``sliding.friction_impact``: the scene's law where the corner sticks): counters, the
+    energy split between impacts and friction (W_f), then the phase after it."""
+    out[OUT_IMPACTS] += 1.0
+    if out[OUT_IMPACTS] == 1.0:
+        out[OUT_T_FIRST_IMPACT] = t
+    e_before = _energy(y, s, prm, FLEX) if ENERGY else 0.0
+    s_new, w, ud, xd, e, _, _, w_f, _ = friction_impact(
+        y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], y[Y_X_DOT], s, mu, mu_s, prm, FLEX)
+    if e > out[OUT_E_MAX]:
+        out[OUT_E_MAX] = e
+    if e > 1.0:
+        _flag(out, STATUS_E_ABOVE_1)
+    if s_new == 0:
+        out[OUT_CONTACTS] += 1.0
+        if e > 0.0:
+            _flag(out, STATUS_SETTLED)
+    y = (0.0, w, y[2], ud if FLEX else y[3], y[4], y[5], y[6], xd, y[8] - w_f)
+    if ENERGY:
+        e_d = e_before - _energy(y, s_new, prm, FLEX) + w_f
+        out[OUT_E_IMPACT] += e_d
+    if xd == 0.0:
+        s2, sigma = _choose(t, y, s_new, on, mu, mu_s, prm, out, FLEX, DAMPED, GROUND)
+        if s_new == 0 and s2 != 0:
+            out[OUT_UPLIFTS] += 1.0
+        return y, s2, sigma
+    return _slipping(t, y, s_new, 1 if xd > 0.0 else -1, on, mu, mu_s, prm, out, FLEX,
+                     DAMPED, ENERGY, GROUND)
+
+
+# ----------------------------------------------------------------------------------------
+# History
+# ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True, inline="always")
+def _record(hist, t, y, s, sigma, on, prm, out, FLEX, GROUND):
+    """Append a history row (nothing, not even compiled, without a history)."""
+    if hist is not None:
+        if _write_row(hist, int(out[OUT_HIST_ROWS]), t, y, s, sigma, on, prm,
+                      out[OUT_E_IMPACT], FLEX, GROUND):
+            out[OUT_HIST_ROWS] += 1.0
+        else:
+            _flag(out, STATUS_HIST_FULL)
+
+
+@njit(cache=True, **INTERNAL)
+def _write_row(hist, row, t, y, s, sigma, on, prm, e_imp, FLEX, GROUND):
+    literally(FLEX)
+    if row >= hist.shape[0]:
+        return False
+    hist[row, HIST_T] = t
+    hist[row, HIST_THETA] = y[Y_THETA]
+    hist[row, HIST_THETA_DOT] = y[Y_THETA_DOT]
+    hist[row, HIST_U] = y[Y_U]
+    hist[row, HIST_U_DOT] = y[Y_U_DOT]
+    hist[row, HIST_PHASE] = s
+    hist[row, HIST_E] = _energy(y, s, prm, FLEX)
+    hist[row, HIST_W_IN] = y[Y_W_IN]
+    hist[row, HIST_D_DAMP] = y[Y_D_DAMP]
+    hist[row, HIST_E_IMPACT] = e_imp
+    hist[row, HIST_XG] = ground_acc(GROUND, t, on, prm)
+    hist[row, HIST_X] = y[Y_X]
+    hist[row, HIST_CONTACT] = phase_code(s, sigma)
+    hist[row, HIST_D_FRIC] = y[Y_D_FRIC]
+    return True

@@ -1,0 +1,128 @@
+"""The sliding base's loop (``kernel.slide_loop``, the contact model CONTACT_SLIDE) against
+independent answers: the no-slip model where friction is ample, the closed-form
+rigid-plastic block (``physics.friction.sliding_block``), the closed-form onset criteria
+(``physics.friction.onset``), the reference integrator (``physics.sliding_reference``:
+scipy's DOP853 phase by phase, its own equations, events and impacts) and the energy
+balance. (Its hard cases: tests/hard_cases/test_13_sliding.py.)
+
+Cost: the history variants of the rigid and the flexible kind on the paper's pulses (two
+variants of the slide loop, compiled cold once per kernel source: measured in
+docs/sliding.md, "Cost"), and the reference's runs (~1 s each); every case is a few
+points.
+"""
+
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from rocksweep.compute.single import run_point
+from rocksweep.numerics import Numerics
+from rocksweep.physics import friction
+from rocksweep.physics.bodies import BlockBody
+from rocksweep.physics.points import Point
+from rocksweep.physics.sliding_reference import sliding_reference
+from rocksweep.scene.parse import load_scene
+from rocksweep.vocab.outcomes import OUTCOME_CODE, SLID
+from rocksweep.vocab.phases import PHASE_CODE, ROCK, SLIDE, SLIDE_ROCK
+
+CONFIGS = Path(__file__).resolve().parents[2] / "configs"
+
+FINE = Numerics.preset("fine")
+DEFAULT = Numerics.preset("default")
+
+
+def _closure(s: dict) -> float:
+    """W_in - D_damp - E_impact - D_fric - E_end, over E_ref (the summary's energies)."""
+    return (s["work_in_over_Eref"] - s["damper_loss_over_Eref"] - s["impact_loss_over_Eref"]
+            - s["friction_loss_over_Eref"] - s["energy_end_over_Eref"])
+
+
+def _fig5(*sets: str) -> Point:
+    sc = load_scene(CONFIGS / "fig5.yaml", ["impact.lam=0.4", *sets])
+    return sc.single_point()
+
+
+@pytest.mark.parametrize("body", ["flexible", "block"])
+def test_ample_friction_is_the_no_slip_model(body):
+    """mu = 10 on a point whose base never needs it: the no-slip model's outcome, impacts
+    and max|theta| (to 1e-4), and the base never slips (regime: rest and rock)."""
+    if body == "flexible":
+        pt = _fig5("pulse.A_ratio=3.0")
+    else:  # free rocking from a tilt: the no-slip run goes on to rest too (PAR_TO_REST)
+        pt = load_scene(CONFIGS / "free-rocking.yaml").single_point()
+    a, b = run_point(pt, FINE), run_point(replace(pt, mu=10.0), FINE)
+    assert b.outcome == a.outcome
+    assert b.impacts == a.impacts > 0
+    assert b.theta_max_over_alpha == pytest.approx(a.theta_max_over_alpha, rel=1e-4)
+    s = b.summary()
+    assert SLID not in s["status"] and s["slide_max"] == 0.0
+    assert s["regime"] & ((1 << PHASE_CODE[SLIDE]) | (1 << PHASE_CODE[SLIDE_ROCK])) == 0
+    assert s["regime"] & (1 << PHASE_CODE[ROCK])
+
+
+@pytest.mark.parametrize("shape,A_ratio,mu_s", [("sine", 1.5, 0.2), ("cosine", 3.0, 0.2),
+                                                 ("sine", 2.5, 0.27)])
+def test_pure_sliding_is_the_rigid_plastic_block(shape, A_ratio, mu_s):
+    """mu = 0.2 < tan(alpha) = 0.309: slide_max and slide_final equal the closed-form
+    rigid-plastic block's to 0.1%, and the block never rocks (regime: rest and slide, no
+    uplift)."""
+    blk = BlockBody(alpha=0.3)
+    pt = Point(blk, 0.0, shape, 2.0, A_ratio, mu=0.2, mu_static=mu_s)
+    r = run_point(pt, DEFAULT)
+    s = r.summary()
+    cf = friction.sliding_block(pt.A, pt.omega, 0.2, mu_s, shape)
+    assert s["slide_max"] * blk.b == pytest.approx(cf["slide_max"], rel=1e-3)
+    assert s["slide_final"] * blk.b == pytest.approx(cf["slide_final"], rel=1e-3,
+                                                     abs=1e-3 * cf["slide_max"])
+    assert s["uplifts"] == 0 and s["theta_max_over_alpha"] == 0.0
+    assert s["regime"] & ((1 << PHASE_CODE[ROCK]) | (1 << PHASE_CODE[SLIDE_ROCK])) == 0
+    assert SLID in s["status"] and "rest" in s["status"]
+
+
+@pytest.mark.parametrize("mu,A_over_g", [(0.2, 0.1), (0.2, 0.5), (0.8, 0.45), (0.8, 1.5),
+                                         (0.5, 1.2), (0.9, 0.9)])
+def test_onset_phase_equals_the_closed_form(mu, A_over_g):
+    """A cosine pulse is a step of A at t = 0: the first phase the run enters is the
+    closed form's (Shenton's criteria for the rigid block, mu_s = mu), all four met."""
+    blk = BlockBody(alpha=0.35)
+    A_ratio = A_over_g / math.tan(0.35)
+    pt = Point(blk, 0.0, "cosine", 1.0, A_ratio, mu=mu)
+    word = friction.onset(blk, pt.A, mu)[0]
+    assert run_point(pt, DEFAULT).phases()[0] == word
+
+
+# Rigid blocks across the regimes: (mu, alpha, shape, w_over_p, A_ratio) slide, slide-rock
+# then overturn, rock from a cosine's step, slide-rock without impact, a long chattering
+# slide-rock, a slender block overturning after an impact
+BLOCKS = [(0.1, 0.3, "sine", 2.0, 1.5), (0.5, 0.2, "sine", 3.0, 3.0),
+          (0.9, 0.2, "cosine", 3.0, 2.0), (0.3, 0.25, "sine", 2.0, 4.0),
+          (0.6, 0.35, "cosine", 4.0, 5.0), (0.4, 0.1, "sine", 6.0, 8.0)]
+
+
+@pytest.mark.parametrize("mu,alpha,shape,w,A", BLOCKS)
+def test_rigid_blocks_equal_the_reference(mu, alpha, shape, w, A):
+    """At the default preset: the reference's outcome and impacts, its phases (in order),
+    slide_max and slide_final within 2%."""
+    pt = Point(BlockBody(alpha=alpha), 0.0, shape, w, A, mu=mu)
+    r = run_point(pt, DEFAULT)
+    ref = sliding_reference(pt, numerics=DEFAULT)
+    s, b = r.summary(), pt.body.b
+    assert OUTCOME_CODE[s["outcome"]] == ref["outcome"]
+    assert s["impacts"] == ref["impacts"]
+    assert s["phases"][:6] == ref["phases"][:6]
+    assert s["slide_max"] * b == pytest.approx(ref["slide_max"], rel=0.02)
+    assert s["slide_final"] * b == pytest.approx(ref["slide_final"], rel=0.02,
+                                                 abs=0.02 * ref["slide_max"])
+
+
+@pytest.mark.parametrize("mu", [0.5, 0.2])
+def test_energy_closes_with_friction(mu):
+    """Figure 5's point at `fine`: work in = final energy + damper + impacts + friction to
+    1e-4 E_ref, with friction and slide-rock impacts (at mu 0.2 the base slides, tips,
+    slips through impacts)."""
+    s = run_point(_fig5(f"body.mu={mu}"), FINE).summary()
+    assert s["friction_loss_over_Eref"] > 0.0
+    assert abs(_closure(s)) < 1e-4
+    assert {SLIDE_ROCK} <= set(s["phases"])
