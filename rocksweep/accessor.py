@@ -79,7 +79,7 @@ def accessor_class() -> type:
     from rocksweep.api import ANALYSES
 
     methods = {fn.__name__: _method(fn) for fn in ANALYSES}
-    return type("RocksweepAccessor", (_Accessor,), {**methods, "__module__": "rocksweep.api"})
+    return type("RocksweepAccessor", (_Accessor,), {**methods, "__module__": __name__})
 
 
 def register() -> None:

@@ -19,7 +19,6 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rocksweep.accessor import accessor_class
 from rocksweep.analysis.resampling import DEFAULT_CI, DEFAULT_SEED
 from rocksweep.analysis.tolerance import DEFAULT_RTOL, DEFAULT_RTOL_MANY
 from rocksweep.compute.arguments import check_flag
@@ -42,13 +41,6 @@ def analysis(fn: Callable[..., Any]) -> Callable[..., Any]:
     """Mark a function of a Dataset: ``ds.rocksweep.<name>(...)`` is ``<name>(ds, ...)``."""
     ANALYSES.append(fn)
     return fn
-
-
-def __getattr__(name: str) -> Any:
-    """``RocksweepAccessor``: ``ds.rocksweep``'s class, made on first use."""
-    if name == "RocksweepAccessor":
-        return accessor_class()
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 # --- rocksweep.run and rocksweep.open ----------------------------------------------------

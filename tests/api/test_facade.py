@@ -189,7 +189,10 @@ def test_every_analysis_is_on_the_accessor():
     ``ds.rocksweep`` (made from ``api.ANALYSES``; calibrated_overrides is as_overrides)."""
     import inspect
 
-    from rocksweep.api import ANALYSES, RocksweepAccessor
+    from rocksweep.accessor import accessor_class
+    from rocksweep.api import ANALYSES
+
+    RocksweepAccessor = accessor_class()  # noqa: N806 (ds.rocksweep's class)
 
     renamed = {"calibrated_overrides": "as_overrides"}
     of_a_dataset = []
@@ -225,8 +228,8 @@ def test_an_accessor_method_hands_the_dataset_and_arguments_over():
 def test_the_accessor_methods_take_keywords_only():
     import inspect
 
-    from rocksweep.api import RocksweepAccessor
+    from rocksweep.accessor import accessor_class
 
     for name in ("plot", "boundaries", "spectra", "fragility", "ida", "im_efficiency"):
-        params = list(inspect.signature(getattr(RocksweepAccessor, name)).parameters.values())
+        params = list(inspect.signature(getattr(accessor_class(), name)).parameters.values())
         assert [p.kind for p in params[1:]] == [inspect.Parameter.VAR_KEYWORD], name
