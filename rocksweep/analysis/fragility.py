@@ -837,8 +837,7 @@ def probability(frag: xr.Dataset, x: Sequence[float] | np.ndarray) -> xr.DataArr
     bet = frag["beta"].transpose(*(["state"] if lead else []), *dims).values
     med, bet = (np.asarray(a, dtype=np.float64) if lead else np.asarray(a)[None]
                 for a in (med, bet))
-    # a state's model, whatever other dims ``fit`` gained (an orientation's answers,
-    # ``floors.by_orientation``, stack one fit per answer: the same model for a state)
+    # a state's model, whatever other dims ``fit`` gained (one fit per orientation answer)
     fit = frag["fit"] if "fit" in frag else None
     if fit is not None and any(d != "state" for d in fit.dims):
         fit = fit.isel({d: 0 for d in fit.dims if d != "state"})

@@ -87,11 +87,16 @@ def test_an_overturned_point_exceeds_every_slide_state():
         assert fr["n_failed"].sel(state=s).values.tolist() == [0, 1, 2, 2]
 
 
-def test_physical_units_are_the_datasets_and_said():
-    # metres (body.kind: physical): D is compared with slide_max as stored
+def test_the_units_are_the_datasets_and_said():
+    # D is compared with slide_max as stored, in the units it carries: a sweep's scale
+    # (rocksweep_units: b; its CF units "1"), else its units
     fr = F.fragility(slide_suite("m"), state="slide:0.25", bootstrap=0, warn=False)
     assert fr["n_failed"].values.tolist() == [1, 3, 3, 3]
     assert fr.attrs["slide_max_units"] == "m"
+    stored = slide_suite("1")
+    stored["slide_max"].attrs["rocksweep_units"] = "b"
+    fr_b = F.fragility(stored, state="slide:0.25", bootstrap=0, warn=False)
+    assert fr_b.attrs["slide_max_units"] == "b"
     assert "slide_max_units" not in F.fragility(slide_suite(), state="overturn",
                                                 bootstrap=0, warn=False).attrs
     fig = rocksweep.plot(fr)
@@ -434,8 +439,12 @@ def test_regime_map_errors_are_one_line(tmp_path):
 def test_cli_plot_regime(tmp_path, cli):
     out, ds = regime_sweep(tmp_path)
     fig = tmp_path / "r.png"
-    # the file has no regime (the kernel writes it): one line, nothing written
-    res = cli.invoke(main, ["plot", str(out), "--regime", "-o", str(fig)])
+    # a scene without body.mu has no regime (the sliding kernel writes it): one line,
+    # nothing written
+    no_mu = tmp_path / "no_mu.h5"
+    zero_sweep("name: rigid\nbody: {kind: block, alpha: 0.2}\n"
+               "pulse: {shape: sine, w_over_p: 3, A_ratio: [0.5, 1.0]}\n", no_mu)
+    res = cli.invoke(main, ["plot", str(no_mu), "--regime", "-o", str(fig)])
     line = one_line_error(res)
     assert res.exit_code != 0 and "no regime" in line and "body.mu" in line
     assert not fig.exists()
