@@ -104,6 +104,7 @@ from rocksweep.analysis.states import (
     severity,
     state_groups,
 )
+from rocksweep.analysis.table import units_of
 from rocksweep.errors import Arg, FragilityError, FragilityWarning, flag
 from rocksweep.fields import plain
 from rocksweep.vocab.ground import AVGSA
@@ -677,8 +678,7 @@ def _dataset(ds: xr.Dataset, state: Any, states: list[str], axis: IMAxis, c: Cou
              "reference": "Baker (2015), Efficient analytical fragility function fitting "
                           "using dynamic structural analysis, Earthquake Spectra 31(1)"}
     if any(parse_state(s)[0] == SLIDE for s in states):  # D's units: slide_max's
-        u = ds["slide_max"].attrs  # the scale (b) where the CF units say "1"
-        attrs["slide_max_units"] = str(u.get("rocksweep_units", u.get("units", "")))
+        attrs["slide_max_units"] = units_of(ds["slide_max"])
     if axis.im_name == "Sa":
         attrs["period"] = axis.period
     if axis.im_name == AVGSA and "record_avgsa" in ds.variables:

@@ -45,7 +45,7 @@ from rocksweep.vocab.kinds import (
 )
 from rocksweep.vocab.outcomes import OUTCOME_WORDS, status_words
 
-__all__ = ["ROW_VARIABLE", "table"]
+__all__ = ["ROW_VARIABLE", "table", "units_of"]
 
 #: the variable whose dims are a kind's rows
 ROW_VARIABLE = {SWEEP: "outcome", FRAGILITY: ("im_median", "median"), IDA: "ida_im",
@@ -57,7 +57,9 @@ SKIP = ("record_sha256",)  # identity, not data: in the file, not in every row
 
 
 
-def _units(da: xr.DataArray) -> str:
+def units_of(da: xr.DataArray) -> str:
+    """A variable's unit as a reader says it: its scale (``rocksweep_units``, e.g. "b"
+    where the CF ``units`` say "1"), else its ``units``, else ""."""
     return str(da.attrs.get("rocksweep_units") or da.attrs.get("units") or "")
 
 
@@ -84,11 +86,11 @@ def table(ds: xr.Dataset) -> Any:
     for d, g in zip(dims, grids, strict=True):
         vals = ds[d].values if d in ds.coords else np.arange(ds.sizes[d])
         cols[d] = np.asarray(vals)[g.ravel()]
-        units[d] = _units(ds[d]) if d in ds.coords else ""
+        units[d] = units_of(ds[d]) if d in ds.coords else ""
     for name, c in ds.coords.items():
         if c.ndim == 0 and name not in cols:
             cols[str(name)] = np.repeat(c.values, n)
-            units[str(name)] = _units(c)
+            units[str(name)] = units_of(c)
     frame = xr.Dataset(coords={d: np.arange(ds.sizes[d]) for d in dims})
 
     def flat(da: xr.DataArray) -> np.ndarray:
@@ -103,14 +105,14 @@ def table(ds: xr.Dataset) -> Any:
         extra = [d for d in da.dims if d not in dims]
         if not extra:
             cols[name] = flat(da)
-            units[name] = _units(da)
+            units[name] = units_of(da)
         elif (kind == SWEEP and len(extra) == 1 and ds.sizes[extra[0]] <= MAX_SPREAD):
             e = extra[0]
             for i, v in enumerate(ds[e].values if e in ds.coords else range(ds.sizes[e])):
                 label = f"{name}({v:g})" if isinstance(v, float | np.floating) else \
                     f"{name}({v})"
                 cols[label] = flat(da.isel({e: i}))
-                units[label] = _units(da)
+                units[label] = units_of(da)
     if kind == SWEEP and "scale_factor" in ds.data_vars and "record" in dims:
         f = flat(ds["scale_factor"])
         for im, (var, unit, k) in RECORD_IMS.items():

@@ -15,6 +15,7 @@ import numpy as np
 import xarray as xr
 
 from rocksweep.analysis.ida import curve_end, curve_variable
+from rocksweep.analysis.table import units_of
 from rocksweep.figures import WIDTHS
 from rocksweep.figures.style import Figure, curve_colours, grow_to_fit, log_ticks, wrap_title
 from rocksweep.vocab.axes import label as axis_label
@@ -167,7 +168,7 @@ def ida_figure(ida: xr.Dataset, *, ax: Any = None, width: str | None = "single")
             else:  # the sliding displacement, its threshold D dashed
                 a.set_ylim(0.0, None)
                 a.axhline(end, color="0.4", lw=0.6, ls="--")
-                du = ida[demand].attrs.get("rocksweep_units", ida[demand].attrs.get("units", ""))
+                du = units_of(ida[demand])
                 a.set_ylabel("max sliding |x|" + (f" [{du}]" if du and du != "1" else ""))
             a.set_title(wrap_title(label or "IDA", fig.get_figwidth() / cols, 8.0),
                         fontsize="small")
