@@ -536,12 +536,25 @@ def _first_event(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm, FLEX, D
         g0, g1 = _pick(ev0, slot), _pick(ev1, slot)
         if g1 <= 0.0 and (g0 > 0.0 or (s != 0 and slot == SLOT_FIRST and g0 == 0.0)):
             maybe = True
+        if _slip_turned(slot, sigma, g0, g1):
+            maybe = True
     if s != 0 and ev0[0] > 0.0 and s * y[Y_THETA_DOT] < 0.0 < s * y1[Y_THETA_DOT]:
         maybe = True  # theta turned back toward 0 inside the step: a dip to screen
     if not maybe:
         return -1, h, y1, 0
     return _search(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED,
                    ENERGY, GROUND)
+
+
+@njit(cache=True, **INLINE)
+def _slip_turned(slot, sigma, g0, g1):
+    """A slip that starts at x' = 0 (g0 = sigma x' = 0: a phase entered by ``_choose``)
+    and ends its first step moving against sigma: it stopped and turned inside the step.
+    Without this the slot, which fires only from > 0, never fires, and friction pushes
+    the base along its slip (energy from nowhere: a block at alpha 0.15, mu 0.5, sine
+    w/p 12, A_ratio 12 slid 11 b and overturned at `default`, safe at `fine` and in the
+    reference)."""
+    return slot == SLOT_CONTACT and sigma != 0 and g0 == 0.0 and g1 < 0.0
 
 
 @njit(cache=True, **INTERNAL)
@@ -562,7 +575,8 @@ def _search(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED
         # theta = 0 after an impact or an uplift: a motion that turns straight back is an
         # impact just after t (as ``events._crossing``); the other functions fire only
         # from > 0 (a phase held on the wrong side of its cone waits to come back)
-        if not (g0 > 0.0 or (s != 0 and slot == SLOT_FIRST and g0 == 0.0 and g1 <= 0.0)):
+        if not (g0 > 0.0 or (s != 0 and slot == SLOT_FIRST and g0 == 0.0 and g1 <= 0.0)
+                or _slip_turned(slot, sigma, g0, g1)):
             continue
         hi, g_hi, y_hi = h, g1, y1
         if g1 > 0.0:

@@ -117,6 +117,17 @@ def test_rigid_blocks_equal_the_reference(mu, alpha, shape, w, A):
                                                  abs=0.02 * ref["slide_max"])
 
 
+def test_a_slip_that_turns_in_its_first_step_stops():
+    """Far outside the paper's region (w/p 12, A_ratio 12): the base starts to slip in
+    slide-rock from x' = 0 and turns back inside the first step. The slip stop must fire
+    there; it did not, and friction pushed the base on (11 b, mode 2 at `default`, where
+    the reference and `fine` rock it to rest with 5e-5 m of slip)."""
+    pt = Point(BlockBody(alpha=0.15), 0.0, "sine", 12.0, 12.0, mu=0.5)
+    s, ref = run_point(pt, DEFAULT).summary(), sliding_reference(pt, numerics=DEFAULT)
+    assert OUTCOME_CODE[s["outcome"]] == ref["outcome"] == 0
+    assert s["slide_max"] * pt.body.b == pytest.approx(ref["slide_max"], rel=0.02)
+
+
 @pytest.mark.parametrize("mu", [0.5, 0.2])
 def test_energy_closes_with_friction(mu):
     """Figure 5's point at `fine`: work in = final energy + damper + impacts + friction to
