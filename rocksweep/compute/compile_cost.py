@@ -8,7 +8,8 @@ which, and how long: the seconds this machine took for that variant when it last
 it (measured at every compile, kept in ``compile_seconds.json`` beside numba's cache, per
 variant name), else for any variant here (the median of those measured), else
 ``BENCH_SECONDS``, a quiet 2-core machine's figure (docs/performance.md: 4.3-6.5 s CPU a
-variant; a busy machine takes 2-5x, a vertical variant ~1.15x). After it, the time taken.
+variant; a busy machine takes 2-5x, a vertical variant ~1.15x); a sliding variant never
+measured here is forecast at ``RELATIVE`` times that. After it, the time taken.
 """
 
 from __future__ import annotations
@@ -25,6 +26,10 @@ from rocksweep.outputs import write_atomic
 
 #: [s] a variant's cold compile on a quiet 2-core machine (scripts/bench_compile.py)
 BENCH_SECONDS = 6.0
+#: a variant's compile relative to its no-slip row's, by the table's name of its contact
+#: model (``kernel.variants.CONTACTS``): the sliding loop, 1.2-1.8x (docs/sliding.md,
+#: ``scripts/bench_compile.py --slide``)
+RELATIVE = {"_slide": 1.5}
 #: [s] a "compile" quicker than this was a load (the variant was in memory): not kept
 MIN_COMPILE = 0.5
 _FILE = "compile_seconds.json"
@@ -79,10 +84,15 @@ def forecast(names: Sequence[str]) -> tuple[float, str]:
         return sum(known[n] for n in names), "as measured here"
     if known:
         each = statistics.median(known.values())
-        return (sum(known.get(n, each) for n in names),
+        return (sum(known.get(n, each * _relative(n)) for n in names),
                 f"~{each:.0f} s a variant as measured here")
-    return BENCH_SECONDS * len(names), (f"~{BENCH_SECONDS:.0f} s a variant on a quiet "
-                                        "2-core machine, more on a busy one")
+    return (BENCH_SECONDS * sum(_relative(n) for n in names),
+            f"~{BENCH_SECONDS:.0f} s a variant on a quiet 2-core machine, more on a busy one")
+
+
+def _relative(name: str) -> float:
+    """A variant's compile relative to a no-slip one's (``RELATIVE``), by its name."""
+    return next((f for tag, f in RELATIVE.items() if name.endswith(tag)), 1.0)
 
 
 def variant_name(dispatcher: Any) -> str:

@@ -235,6 +235,8 @@ def test_driver_says_compiling_before_an_uncached_kernel(tmp_path, monkeypatch):
     compile_cost.record(["other_a", "other_b"], 20.0)
     assert compile_cost.forecast([name]) == (23.0, "as measured here")
     assert compile_cost.forecast([name, "never"])[0] == pytest.approx(23.0 + 10.0)
+    # a sliding variant never compiled here: RELATIVE times the median (1.5 x 10 s)
+    assert compile_cost.forecast(["chunk_rigid_slide"])[0] == pytest.approx(15.0)
     lines.clear()
     sweep_file(sc, tmp_path / "e.h5", log=lines.append)
     assert any(ln.endswith(f"({name}), once per machine: ~23 s (as measured here)...")
