@@ -128,6 +128,24 @@ def test_a_slip_that_turns_in_its_first_step_stops():
     assert s["slide_max"] * pt.body.b == pytest.approx(ref["slide_max"], rel=0.02)
 
 
+def test_a_stick_break_located_tightly_slips():
+    """Housner's block (alpha 0.2618, mu 0.4) rocking on a stuck corner under a sine: its
+    friction demand |H|/N crosses mu at p t = 0.168 and goes on to 0.42. Located to
+    1e-12, the far side of the stick break holds |H| - mu N ~ 1e-16 N, where the slip's
+    x'' is round-off: the kernel and the reference tested its sign, found no direction
+    consistent and stuck the corner (the reference called it a Painleve jam, impossible
+    for a uniform block below mu = 4/3) with |H| > mu N to the end (no slip, max|theta|
+    1.2% off). Both now slide-rock, alike, with no jam. (Found by `rocksweep accuracy`.)"""
+    pt = Point(BlockBody(alpha=0.2618), 0.0, "sine", 6.0, 3.8, mu=0.4)
+    tight = replace(FINE, event_tol=1e-12)
+    s, ref = run_point(pt, tight).summary(), sliding_reference(pt, numerics=tight)
+    assert "jam" not in ref["status"]
+    assert s["phases"] == ref["phases"] == ["rest", "rock", "slide-rock", "rock", "rest"]
+    assert s["slide_max"] * pt.body.b == pytest.approx(ref["slide_max"], rel=1e-4)
+    assert s["theta_max_over_alpha"] * pt.body.alpha_ref == pytest.approx(ref["theta_max"],
+                                                                          rel=1e-6)
+
+
 @pytest.mark.parametrize("mu", [0.5, 0.2])
 def test_energy_closes_with_friction(mu):
     """Figure 5's point at `fine`: work in = final energy + damper + impacts + friction to
