@@ -74,6 +74,7 @@ MEASURE_LABELS = {
     "t_first_impact": "|d t_first_impact| (p*t)",
     "t_overturn": "|d t_overturn| (p*t)",
     "impacts": "mean |d impacts|",
+    "slide_max": "|d slide_max|/slide_max",  # a scene with body.mu (``measures``)
 }
 # theta_rel is taken where the reference's theta_max is at least this x alpha_cg
 THETA_REL_FLOOR = fields.THETA_REL_FLOOR
