@@ -41,6 +41,7 @@ from rocksweep.kernel.equations import rest_margin, restitution
 from rocksweep.kernel.ground import any_ground_acc
 from rocksweep.numerics import Numerics
 from rocksweep.physics.points import Point, point_row
+from rocksweep.physics.reference import result_row as no_slip_row
 from rocksweep.vocab.outcomes import STATUS_BIT
 from rocksweep.vocab.phases import PHASE_CODE, PHASES
 
@@ -678,28 +679,14 @@ def sliding_reference(point: Point, mu_static: float | None = None,
 
 
 def result_row(r: dict) -> np.ndarray:
-    """A ``sliding_reference`` dict as a kernel result row float64[N_OUT] (the slots the
-    outcome-level kernel fills; the no-slip contact outputs NaN; steps DOP853's): its status
-    words as ``STATUS_*`` bits (``jam``, which no kernel bit names, left out), plus
-    OVERTURNED and SLID where they hold."""
-    out = np.full(L.N_OUT, np.nan)
+    """A ``sliding_reference`` dict as a kernel result row float64[N_OUT]: the no-slip
+    reference's row (``reference.result_row``: the no-slip contact outputs NaN, steps
+    DOP853's) of its status words as ``STATUS_*`` bits (``jam``, which no kernel bit
+    names, left out; OVERTURNED and SLID where they hold), and the slide's slots."""
     status = sum(STATUS_BIT[w] for w in r["status"] if w in STATUS_BIT)
     status |= L.STATUS_OVERTURNED if r["overturned"] else 0
     status |= L.STATUS_SLID if r["slide_max"] > 0.0 else 0
-    out[L.OUT_OUTCOME] = r["outcome"]
-    out[L.OUT_STATUS] = status
-    out[L.OUT_IMPACTS] = r["impacts"]
-    out[L.OUT_UPLIFTS] = r["uplifts"]
-    out[L.OUT_THETA_MAX] = r["theta_max"]
-    out[L.OUT_T_OVERTURN] = r["t_overturn"]
-    out[L.OUT_T_FIRST_IMPACT] = r["t_first_impact"]
-    out[L.OUT_T_END] = r["t_end"]
-    out[L.OUT_STEPS] = r["steps"]
-    out[L.OUT_EVENT_STEPS] = 0.0
-    out[L.OUT_E_MAX] = r["e_max"]
-    out[L.OUT_CONTACTS] = r["contacts"]
-    out[L.OUT_HIST_ROWS] = 0.0
-    out[L.OUT_REFINE_EVALS] = 0.0
+    out = no_slip_row({**r, "status": status})
     out[L.OUT_SLIDE_MAX] = r["slide_max"]
     out[L.OUT_SLIDE_FINAL] = r["slide_final"]
     out[L.OUT_REGIME] = sum(1 << PHASE_CODE[w] for w in set(r["phases"]))
