@@ -12,8 +12,10 @@
    weight N_h / n_h of its stratum, so weighted means estimate the whole scene (outcome
    flips gather at boundaries; sampling them more sharpens the estimate, the weights undo
    the bias).
-3. Run the sample with the reference (``rocksweep.physics.reference``, DOP853 at rtol 1e-10) and
-   with the kernel at each setting of the ladder. Kernel times exclude compilation
+3. Run the sample with the reference (``rocksweep.physics.reference``, DOP853 at rtol 1e-10;
+   a scene that gives body.mu: the sliding base's, ``rocksweep.physics.sliding_reference``,
+   DOP853 phase by phase at the same tolerances) and with the kernel at each setting of the
+   ladder (a scene with body.mu: the sliding variants). Kernel times exclude compilation
    (``kernel.warm_up``). Per-point times come from timing each point as its own 1-row
    chunk (one call into the jitted chunk kernel per point; the call overhead is ~1 us);
    the total is one call on the whole sample (best of ``repeat``).
@@ -21,11 +23,14 @@
    the scene's estimate), RK4 evaluations per point, and errors against the reference:
    |d theta_max|/alpha_cg (points both call safe), |d t_first_impact| (both impact),
    |d t_overturn| (both overturn), |d impacts| (same outcome), and the outcome flips
-   (weighted share, and a matrix of counts: reference outcome -> kernel outcome).
+   (weighted share, and a matrix of counts: reference outcome -> kernel outcome); a scene
+   with body.mu also |d slide_max| / slide_max (same outcome, the reference slid at least
+   SLIDE_REL_FLOOR b).
 5. The observed order of convergence of the step ladder (settings with a common event
    tolerance, steps_per_period doubling): log2 of the ratio of median errors per halving
    of the step, on the first impact time (the smooth stretch uplift -> first impact) and
-   on theta_max of points that never impact (a smooth stretch from uplift to rest).
+   on theta_max of points that never impact (a smooth stretch from uplift to rest), and on
+   slide_max where the scene slides.
 
 Times are p*t (p = 1 rad/s); theta_max errors are in units of alpha_cg (alpha_ref).
 """
@@ -48,7 +53,9 @@ from rocksweep.errors import SceneError
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel import warm_up
 from rocksweep.numerics import PRESETS, Numerics
-from rocksweep.physics.reference import reference_run, result_row
+from rocksweep.physics import sliding_reference as slide_ref
+from rocksweep.physics.points import Point
+from rocksweep.physics.reference import ATOL, RTOL, reference_run, result_row
 from rocksweep.scene.grid import Grid
 from rocksweep.scene.model import Scene
 from rocksweep.vocab.axes import DIAGRAM_AXES, RECORD_X
@@ -58,15 +65,22 @@ from rocksweep.vocab.settings import DEFAULT_PRESET, DEFAULT_SAMPLE_SEED, ROOTS
 OUTCOMES = CLASSES  # codes 0, 1, 2
 # Per-point fields of the report: all the outcome-level kernel fills (no energies).
 REPORT_FIELDS = tuple(f for f in fields.RUN_FIELDS if not f.energy)
-MEASURES = ("theta_max", "t_first_impact", "t_overturn", "impacts", "theta_rel", "energy")
+MEASURES = ("theta_max", "t_first_impact", "t_overturn", "impacts", "theta_rel", "energy",
+            "slide_max")
+# the measures of a scene that gives body.mu only (the sliding base's)
+SLIDE_MEASURES = ("slide_max",)
 MEASURE_LABELS = {
     "theta_max": "|d theta_max|/alpha_cg",
     "t_first_impact": "|d t_first_impact| (p*t)",
     "t_overturn": "|d t_overturn| (p*t)",
     "impacts": "mean |d impacts|",
+    "slide_max": "|d slide_max|/slide_max",  # a scene with body.mu (``measures``)
 }
 # theta_rel is taken where the reference's theta_max is at least this x alpha_cg
 THETA_REL_FLOOR = fields.THETA_REL_FLOOR
+# slide_max's relative error is taken where the reference's slide_max is at least this x b
+# (the base's half-width): below, the base barely slipped and a relative error says nothing
+SLIDE_REL_FLOOR = 1e-3
 # Error bounds against which ``--check`` scores the per-point error estimates (the
 # `accurate` preset's targets for the 95th percentiles, docs/accuracy.md): overturning
 # time [p*t] and relative max|theta|.
@@ -278,8 +292,28 @@ def sample_scene(scene: Scene, n: int | None, seed: int = DEFAULT_SAMPLE_SEED) -
 # ----------------------------------------------------------------------------------------
 
 
+def measures(scene: Scene) -> tuple[str, ...]:
+    """The measures of a scene's study: ``MEASURES`` less the sliding base's where the
+    scene gives no body.mu."""
+    return tuple(m for m in MEASURES if scene.slides or m not in SLIDE_MEASURES)
+
+
+def reference_words(scene: Scene) -> str:
+    """What the scene's reference is, in a few words (the table, the report's attrs)."""
+    if scene.slides:
+        return (f"sliding reference (physics/sliding_reference.py: scipy DOP853 phase by "
+                f"phase, rtol {slide_ref.RTOL:g}, atol {slide_ref.ATOL:g})")
+    return f"reference (scipy DOP853, rtol {RTOL:g}, atol {ATOL:g})"
+
+
 def _no_suite(scene: Scene) -> None:
-    """The accuracy study runs one recorded motion a scene (its rows carry its samples)."""
+    """The accuracy study runs one recorded motion a scene (its rows carry its samples),
+    and a scene with body.mu no vertical (the sliding reference has none)."""
+    if scene.slides and scene.has_vertical:
+        key = "ground.vertical" if scene.recorded else "pulse.vertical"
+        raise SceneError(f"{key}: the accuracy study of a scene with body.mu takes a "
+                         "horizontal ground motion only (the sliding reference has no "
+                         "vertical); remove it or body.mu")
     if scene.suite is not None:
         raise SceneError(f"ground.records: the accuracy study takes one record "
                          f"(ground.record: one of {scene.suite.names[0]}, ...), not a suite")
@@ -312,7 +346,7 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
     outs = np.empty((n, L.N_OUT))
     kinds = np.unique(cr.kinds)
     for kind in kinds:
-        warm_up(int(kind), L.LEVEL_OUTCOME, ground)
+        warm_up(int(kind), L.LEVEL_OUTCOME, ground, scene.contact_model)
     per_point = np.full(n, np.inf)
     batch = math.inf
     part = np.empty_like(outs)
@@ -342,7 +376,9 @@ def run_kernel(scene: Scene, flat: np.ndarray, numerics: Numerics, repeat: int =
 def run_reference(scene: Scene, flat: np.ndarray,
                   progress: Callable[[int, int], None] | None = None
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The reference path on the given points.
+    """The reference path on the given points: ``reference_run``, or where the scene gives
+    body.mu the sliding base's ``sliding_reference`` (its anomalies 0: it has no such
+    self-check).
 
     Returns (outs float64[n, N_OUT], seconds float64[n]: each point's wall time, anomalies
     int64[n]: the reference's self-check, see ``reference_run``). The first point is run
@@ -351,17 +387,23 @@ def run_reference(scene: Scene, flat: np.ndarray,
     grid = Grid(scene)
     values = grid.index_values(flat)
     n = len(flat)
-    if n:
-        reference_run(scene.point({k: v[0] for k, v in values.items()}), scene.numerics)
+
+    def run(point: Point) -> tuple[np.ndarray, dict]:
+        if scene.slides:
+            r = slide_ref.sliding_reference(point, numerics=scene.numerics)
+            return slide_ref.result_row(r), r
+        r = reference_run(point, scene.numerics)
+        return result_row(r), r
+
+    if n and not scene.slides:  # the sliding reference shares no jitted equations
+        run(scene.point({k: v[0] for k, v in values.items()}))
     outs = np.empty((n, L.N_OUT))
     secs = np.empty(n)
     anomalies = np.zeros(n, np.int64)
     for i in range(n):
-        point = scene.point({k: v[i] for k, v in values.items()})
-        r = reference_run(point, scene.numerics)
-        outs[i] = result_row(r)
+        outs[i], r = run(scene.point({k: v[i] for k, v in values.items()}))
         secs[i] = r["wall_time"]
-        anomalies[i] = r["anomalies"]
+        anomalies[i] = r.get("anomalies", 0)
         if progress is not None:
             progress(i + 1, n)
     return outs, secs, anomalies
@@ -373,16 +415,20 @@ def run_reference(scene: Scene, flat: np.ndarray,
 
 
 def point_errors(k: np.ndarray, r: np.ndarray, alpha_ref: np.ndarray,
-                 k_energy: np.ndarray | None = None, e_ref: np.ndarray | None = None
-                 ) -> dict[str, np.ndarray]:
+                 k_energy: np.ndarray | None = None, e_ref: np.ndarray | None = None,
+                 b: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Per-point absolute errors of kernel rows k against reference rows r (NaN where a
     measure does not apply: theta_max where both are safe, t_first_impact where both
     impact, t_overturn where both overturn, impacts where the outcomes agree).
 
     theta_rel: |d theta_max| / theta_max of the reference, where both are safe and the
     reference's theta_max >= THETA_REL_FLOOR alpha_cg. energy: the kernel's own energy
-    balance |W_in - D_damp - E_impact - E_end| / E_ref from k_energy (rows of the
-    energy-accounting kernel at the same setting; NaN without them), e_ref [J] per point.
+    balance |W_in - D_damp - D_fric - E_impact - E_end| / E_ref from k_energy (rows of the
+    energy-accounting kernel at the same setting; NaN without them; D_fric, friction's
+    loss, where the base may slide), e_ref [J] per point. slide_max: |d slide_max| /
+    slide_max of the reference, where the outcomes agree, both are finite and the
+    reference slid at least SLIDE_REL_FLOOR b (b [m] per point: the base's half-width;
+    NaN everywhere without b or where the rows carry no slide, the no-slip model's).
     """
     ko, ro = k[:, L.OUT_OUTCOME], r[:, L.OUT_OUTCOME]
     nan = np.full(len(k), np.nan)
@@ -397,10 +443,17 @@ def point_errors(k: np.ndarray, r: np.ndarray, alpha_ref: np.ndarray,
                      / np.where(up, r[:, L.OUT_THETA_MAX], 1.0), nan)
     d_e = nan
     if k_energy is not None and e_ref is not None:
-        d_e = np.abs(k_energy[:, L.OUT_W_IN] - k_energy[:, L.OUT_D_DAMP]
+        d_fric = np.nan_to_num(k_energy[:, L.OUT_D_FRIC])  # NaN: the no-slip model's
+        d_e = np.abs(k_energy[:, L.OUT_W_IN] - k_energy[:, L.OUT_D_DAMP] - d_fric
                      - k_energy[:, L.OUT_E_IMPACT] - k_energy[:, L.OUT_E_END]) / e_ref
+    d_slide = nan
+    if b is not None:
+        ks, rs = k[:, L.OUT_SLIDE_MAX], r[:, L.OUT_SLIDE_MAX]
+        with np.errstate(invalid="ignore"):  # NaN slides: the comparison is False
+            slid = (ko == ro) & np.isfinite(ks) & (rs >= SLIDE_REL_FLOOR * b)
+        d_slide = np.where(slid, np.abs(ks - rs) / np.where(slid, rs, 1.0), nan)
     return {"theta_max": d_theta, "t_first_impact": d_imp, "t_overturn": d_over,
-            "impacts": d_n, "theta_rel": d_rel, "energy": d_e}
+            "impacts": d_n, "theta_rel": d_rel, "energy": d_e, "slide_max": d_slide}
 
 
 def run_energy(scene: Scene, flat: np.ndarray, numerics: Numerics) -> np.ndarray:
@@ -588,6 +641,7 @@ class Study:
     orders: dict[str, list[tuple[int, int, float]]] = field(default_factory=dict)
     wall_seconds: float = 0.0
     reference_anomalies: np.ndarray | None = None  # int64[n], see ``run_reference``
+    b: np.ndarray | None = None  # float64[n]: each point's base half-width [m]
 
     def row(self, r: SettingResult) -> dict:
         """One line of the table (plain numbers)."""
@@ -603,7 +657,7 @@ class Study:
             "agreement": r.agreement, "agreement_se": r.agreement_se,
             "flips": int(r.flips.sum() - np.trace(r.flips)), "flagged": r.flagged,
         }
-        for m in MEASURES:
+        for m in measures(self.scene):
             d[f"err_{m}"] = r.median_error(m)
             d[f"p95_err_{m}"] = r.p95_error(m)
             d[f"max_err_{m}"] = r.max_error(m)
@@ -658,7 +712,7 @@ def accuracy_study(scene: Scene, n_points: int | None = 200,
         agree = outs[:, L.OUT_OUTCOME] == ref[:, L.OUT_OUTCOME]
         share, se = _agreement(agree, sample)
         flagged = int(np.sum((outs[:, L.OUT_STATUS].astype(np.int64) & FLAGGED) != 0))
-        errors = point_errors(outs, ref, cr.alpha_ref, outs_e, e_ref)
+        errors = point_errors(outs, ref, cr.alpha_ref, outs_e, e_ref, cr.rows[:, L.PAR_B])
         half = run_half(scene, sample.flat, numerics) if check else None
         results.append(SettingResult(
             s, outs, secs, batch, errors, share, se,
@@ -667,8 +721,10 @@ def accuracy_study(scene: Scene, n_points: int | None = 200,
         if progress:
             progress("kernel", j + 1, len(settings))
     study = Study(scene, sample, cr.alpha_ref, values, ref, ref_secs, results,
-                  reference_anomalies=anomalies)
-    study.orders = {m: observed_order(results, m) for m in ("t_first_impact", "theta_max")}
+                  reference_anomalies=anomalies, b=cr.rows[:, L.PAR_B].copy())
+    study.orders = {m: observed_order(results, m)
+                    for m in ("t_first_impact", "theta_max", *SLIDE_MEASURES)
+                    if m in measures(scene)}
     study.wall_seconds = time.perf_counter() - t_wall
     return study
 
@@ -696,33 +752,40 @@ def format_table(study: Study) -> str:
     counts = ", ".join(f"{nm} {int((s.stratum == h).sum())}/{int(s.stratum_size[h])}"
                        for h, nm in enumerate(s.strata))
     lines.append(f"  strata (sampled/in scene): {counts}")
-    lines.append(f"  reference (DOP853, rtol 1e-10, atol 1e-12): {ref_ms:.1f} ms/point median, "
+    lines.append(f"  {reference_words(study.scene)}: {ref_ms:.1f} ms/point median, "
                  f"{mean_w:.1f} ms/point scene mean, {study.reference_seconds.sum():.1f} s total")
     lines.append("  kernel time per point: median of 1-row chunk calls; mean = weighted scene "
                  "estimate; total = one call on the sample")
+    slides = study.scene.slides
     lines.append("  errors against the reference: median |d| (max in brackets); "
-                 "d impacts: mean |d| where outcomes agree")
+                 "d impacts: mean |d| where outcomes agree"
+                 + (f"; slide_max: |d slide_max|/slide_max where outcomes agree and the "
+                    f"reference slid >= {SLIDE_REL_FLOOR:g} b" if slides else ""))
     w = max(11, *(len(r.setting.name) for r in study.results))
+    main_m = ("theta_max", "t_first_impact", "t_overturn") + (SLIDE_MEASURES if slides else ())
+    heads = {"theta_max": "theta_max", "t_first_impact": "t_1st_impact",
+             "t_overturn": "t_overturn", "slide_max": "slide_max (rel)"}
     head = (f"{'setting':>{w}} {'spp':>4} {'tol':>6} {'med us':>8} {'mean us':>8} "
             f"{'total s':>7} {'evals':>7} {'agree %':>13} {'flips':>5} "
-            f"{'theta_max':>17} {'t_1st_impact':>17} {'t_overturn':>17} {'d impacts':>9}")
+            + " ".join(f"{heads[m]:>17}" for m in main_m) + f" {'d impacts':>9}")
     lines.append(head)
     lines.append("-" * len(head))
     for d in study.table():
         agree = f"{100 * d['agreement']:.2f}+-{100 * d['agreement_se']:.2f}"
-        cells = [f"{_e(d['err_' + m])} ({_e(d['max_err_' + m])})"
-                 for m in ("theta_max", "t_first_impact", "t_overturn")]
+        cells = [f"{_e(d['err_' + m])} ({_e(d['max_err_' + m])})" for m in main_m]
         imp = "-" if not math.isfinite(d["err_impacts"]) else f"{d['err_impacts']:.2f}"
         lines.append(
             f"{d['setting']:>{w}} {d['steps_per_period']:>4} {d['event_tol']:>6.0e} "
             f"{d['median_us']:>8.1f} {d['mean_us']:>8.1f} {d['total_s']:>7.3g} "
             f"{d['evals_per_point']:>7.0f} {agree:>13} {d['flips']:>5} "
-            f"{cells[0]:>17} {cells[1]:>17} {cells[2]:>17} {imp:>9}")
+            + " ".join(f"{c:>17}" for c in cells) + f" {imp:>9}")
     lines.append("  tails of the errors against the reference, median / 95th percentile / max "
                  "over the sampled points where each applies (impacts: mean / p95 / max; "
                  "theta_rel: |d theta_max| / theta_max, safe and uplifted; energy: the "
-                 "kernel's own balance / E_ref)")
-    tail_m = ("t_overturn", "theta_max", "theta_rel", "t_first_impact", "impacts", "energy")
+                 "kernel's own balance / E_ref"
+                 + (", friction included; slide_max: relative" if slides else "") + ")")
+    tail_m = ("t_overturn", "theta_max", "theta_rel", "t_first_impact", "impacts",
+              "energy") + (SLIDE_MEASURES if slides else ())
     head = f"{'setting':>{w}} " + " ".join(f"{m:>26}" for m in tail_m)
     lines.append(head)
     lines.append("-" * len(head))

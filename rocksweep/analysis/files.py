@@ -228,8 +228,7 @@ def _write_study(study: Study, path: Path, command: str) -> None:
     # h5py (0.1 s), the accuracy study (numba, 0.6 s): its report's writer only
     import h5py
 
-    from rocksweep.analysis.accuracy import OUTCOMES
-    from rocksweep.physics.reference import ATOL, RTOL
+    from rocksweep.analysis.accuracy import OUTCOMES, reference_words
 
     with h5py.File(path, "w") as f:
         f.attrs[KIND_ATTR] = ACCURACY
@@ -238,7 +237,7 @@ def _write_study(study: Study, path: Path, command: str) -> None:
         f.attrs["scene_yaml"] = study.scene.text
         f.attrs["numerics"] = study.scene.numerics.describe()
         f.attrs["command"] = command
-        f.attrs["reference"] = f"scipy solve_ivp DOP853, rtol {RTOL:g}, atol {ATOL:g}"
+        f.attrs["reference"] = reference_words(study.scene)
         f.attrs["points_in_scene"] = study.sample.size
         f.attrs["points_sampled"] = len(study.sample.flat)
         f.attrs["classify_seconds"] = study.sample.classify_seconds
@@ -272,25 +271,27 @@ def _write_study(study: Study, path: Path, command: str) -> None:
             s.create_dataset(k, data=v.astype(h5py.string_dtype()) if v.dtype.kind in "US"
                              else v)
         g = f.create_group("reference")
-        _write_runs(g, study.reference, study.reference_seconds, study.alpha_ref)
+        _write_runs(g, study, study.reference, study.reference_seconds)
         if study.reference_anomalies is not None:
             g.create_dataset("anomalies", data=study.reference_anomalies)
         k = f.create_group("kernel")
         for r in study.results:
             g = k.create_group(r.setting.name)
-            _write_runs(g, r.outs, r.seconds, study.alpha_ref)
+            _write_runs(g, study, r.outs, r.seconds)
             if r.half is not None:  # the per-point estimates, as a sweep stores them
                 for name, arr in fields.convert_check(r.outs, r.half,
                                                       study.alpha_ref).items():
                     g.create_dataset(name, data=arr).attrs["units"] = fields.UNITS[name]
 
 
-def _write_runs(g: Any, outs: np.ndarray, seconds: np.ndarray, alpha_ref: np.ndarray
-                ) -> None:
-    # every field the outcome-level kernel reports (rocksweep.fields), in its unit
+def _write_runs(g: Any, study: Study, outs: np.ndarray, seconds: np.ndarray) -> None:
+    # every field the outcome-level kernel reports (rocksweep.fields), in its unit; the
+    # sliding base's (in units of b) where the scene gives body.mu
     from rocksweep.analysis.accuracy import REPORT_FIELDS
 
-    for name, arr in fields.convert(outs, alpha_ref, np.nan, REPORT_FIELDS).items():
+    b = np.nan if study.b is None else study.b
+    report = tuple(f for f in REPORT_FIELDS if study.scene.slides or not f.slide)
+    for name, arr in fields.convert(outs, study.alpha_ref, np.nan, report, b).items():
         ds = g.create_dataset(name, data=arr)
         ds.attrs["units"] = fields.UNITS[name]
     g.create_dataset("seconds", data=seconds)

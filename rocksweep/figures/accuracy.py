@@ -5,7 +5,8 @@ measure: the step ladder as a solid line (steps per period labelled), the tolera
 as a dashed line (event_tol labelled), the presets as stars. What is plotted is what
 ``rocksweep.analysis.accuracy`` measures: the median over the sampled points of |d theta_max|/alpha
 (points both call safe), |d t_first_impact| (both impact), |d t_overturn| (both overturn),
-and the *mean* |d impacts| (same outcome); time is the weighted mean of one-point kernel
+the *mean* |d impacts| (same outcome), and where the scene gives body.mu the relative
+|d slide_max| (against the sliding reference); time is the weighted mean of one-point kernel
 calls (the scene estimate), at the event root finder each setting ran with. (b) outcome
 agreement with the reference versus time per point, with its standard error, the 99.5% line
 that picks the default preset, and the reference's own time per point.
@@ -25,7 +26,8 @@ from rocksweep.figures.style import Figure, given_axes, new_axes
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-_COLORS = {"theta_max": "C0", "t_first_impact": "C1", "t_overturn": "C2", "impacts": "C3"}
+_COLORS = {"theta_max": "C0", "t_first_impact": "C1", "t_overturn": "C2", "impacts": "C3",
+           "slide_max": "C4"}
 AGREEMENT_TARGET = 99.5  # % (the rule that picks the default preset)
 
 
@@ -55,7 +57,8 @@ def work_precision(study: Study, axes: Sequence[Axes] | None = None) -> Figure:
 
     curves = sorted({g for g in groups if g != "preset"})
     styles = dict(zip(curves, ["-o", "--s", ":^", "-.v", "-D", "--x"] * 4, strict=False))
-    for m, label in MEASURE_LABELS.items():
+    labels = {m: lab for m, lab in MEASURE_LABELS.items() if f"err_{m}" in table[0]}
+    for m, label in labels.items():
         y = np.array([_positive(d[f"err_{m}"]) for d in table])
         color = _COLORS[m]
         for k, group in enumerate(curves):
@@ -70,7 +73,7 @@ def work_precision(study: Study, axes: Sequence[Axes] | None = None) -> Figure:
         ax_a.plot([], [], styles[group], color="0.4", ms=4, label=group)
     # label the rungs once, on the lowest curve that has a value there
     for i, d in enumerate(table):
-        ys = [_positive(d[f"err_{m}"]) for m in MEASURE_LABELS]
+        ys = [_positive(d[f"err_{m}"]) for m in labels]
         ys = [v for v in ys if math.isfinite(v)]
         if not ys:
             continue
@@ -84,7 +87,8 @@ def work_precision(study: Study, axes: Sequence[Axes] | None = None) -> Figure:
         ax.set_xscale("log")
         ax.set_xlabel("kernel time per point [us] (one core; weighted mean: scene estimate)")
         ax.grid(alpha=0.3, which="both")
-    ax_a.text(ref_us, 0.98, f" reference\n (DOP853)\n {ref_us / 1e3:.0f} ms",
+    ref_name = "sliding\n reference" if study.scene.slides else "reference"
+    ax_a.text(ref_us, 0.98, f" {ref_name}\n (DOP853)\n {ref_us / 1e3:.0f} ms",
               transform=ax_a.get_xaxis_transform(), va="top", fontsize=8, color="0.3")
     ax_a.set_yscale("log")
     ax_a.set_ylabel("error against the reference\n(median over points; impacts: mean)")

@@ -593,8 +593,17 @@ def _search(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED
             if s * y_m[Y_THETA] > 0.0:
                 continue
             hi, g_hi, y_hi = tm, s * y_m[Y_THETA], y_m
-        if hi > tau_best:
-            continue
+        if best >= 0 and hi > tau_best:
+            # a bracket past the earliest event so far: its root may still come first.
+            # Shrink it to that event's time (its state a fresh step, as _locate's
+            # trials); skip it only where it has not fired by then. (Skipped whole, a
+            # block's stick break from rest lost to its later uplift in the same step:
+            # the slip started at the uplift, slide_max 1.5% short at `draft`.)
+            g_b = _pick(_event_values(t + tau_best, y_best, s, sigma, on, mu, mu_s, prm,
+                                      FLEX, DAMPED, GROUND), slot)
+            if g_b > 0.0:
+                continue
+            hi, g_hi, y_hi = tau_best, g_b, y_best
         tau, y_ev, k = _locate(slot, t, y, k1, g0, hi, g_hi, y_hi, s, sigma, on, mu, mu_s,
                                prm, FLEX, DAMPED, ENERGY, GROUND)
         n += k

@@ -287,8 +287,8 @@ def choose_phase(theta, theta_dot, u, u_dot, s, xg, g, mu, mu_s, prm, FLEX, DAMP
                   at equality it slides with theta'' = 0, TIP_ROUNDOFF);
       slide-rock  (s', sg): sg x'' > 0, s' Q >= M g b under the slip's acceleration,
                   N > 0, den > 0 (``slip_state``).
-    s != 0 (rocking on s): rock if |H| <= mu_s N, else slide-rock in the direction whose
-    x'' agrees (sg = -sign(H)) with N > 0.
+    s != 0 (rocking on s): rock if |H| <= mu_s N, else slide-rock in the direction
+    sg = -sign(H) where den > 0 and N > 0 (its x'' then has the sign sg).
     flag: 0, or JAM where no phase is consistent (Painleve: the contact is stuck by a
     tangential impulse: rock on the corner the body tips to, or stays on), or LIFT_OFF
     where N <= 0 while rocking (the ground would have to pull: outside the model; the
@@ -302,11 +302,16 @@ def choose_phase(theta, theta_dot, u, u_dot, s, xg, g, mu, mu_s, prm, FLEX, DAMP
             return s, 0, 0
         if not n > 0.0:  # the ground would have to pull: outside the model, held
             return s, 0, LIFT_OFF
-        for sg in (1, -1):
-            x_dd, n2, den = slip_state(theta, theta_dot, u, u_dot, s, sg, xg, g, mu, prm,
-                                       FLEX, DAMPED)
-            if den > 0.0 and n2 > 0.0 and sg * x_dd > 0.0:
-                return s, sg, 0
+        # friction cannot hold H: the slip goes against it. With den > 0 its x'' =
+        # -(H + mu sg N)/den has the sign sg exactly (|H| > mu_s N >= mu N), so only den
+        # and N are tested: on the far side of a stick break (|H| - mu_s N ~ 1e-16 N at a
+        # tight event_tol) x'' is round-off, and testing its sign jammed the corner stuck
+        # with |H| > mu_s N for the rest of the run
+        sg = -1 if h > 0.0 else 1
+        x_dd, n2, den = slip_state(theta, theta_dot, u, u_dot, s, sg, xg, g, mu, prm,
+                                   FLEX, DAMPED)
+        if den > 0.0 and n2 > 0.0:
+            return s, sg, 0
         return s, 0, JAM
     mgb = tip_moment(g, prm)
     q = uplift_moment(u, u_dot, xg, g, prm, FLEX, DAMPED)

@@ -3,7 +3,9 @@
 
 ``sliding_reference(point, mu_static=None)`` runs one point (a rigid body or the paper's
 flexible body, a pulse or a record) on a ground with Coulomb friction ``point.mu``
-(kinetic) and ``mu_static`` (default mu). It is written apart from the kernel's module:
+(kinetic) and ``mu_static`` (default the point's ``mu_static``, else mu); ``result_row``
+gives its result as a kernel result row (``rocksweep accuracy``). It is written apart from
+the kernel's module:
 
 - equations: Newton-Euler for the masses in the generalised coordinates q = (theta, u, x)
   (x the sliding displacement, the pivot at x + s b): M(q) q'' = f(q, q', t) + e_x F
@@ -29,6 +31,7 @@ and the settling rule (``equations.restitution``), the no-slip rest proof
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -38,7 +41,9 @@ from rocksweep.kernel.equations import rest_margin, restitution
 from rocksweep.kernel.ground import any_ground_acc
 from rocksweep.numerics import Numerics
 from rocksweep.physics.points import Point, point_row
-from rocksweep.vocab.phases import PHASES
+from rocksweep.physics.reference import result_row as no_slip_row
+from rocksweep.vocab.outcomes import STATUS_BIT
+from rocksweep.vocab.phases import PHASE_CODE, PHASES
 
 RTOL = 1e-10
 ATOL = 1e-12
@@ -181,10 +186,13 @@ def choose(body: _Body, t, y, s: int, xg: float, g: float, mu: float, mu_s: floa
         _, force, big_n, _, _ = _Phase(body, s, 0, mu).solve(t, y, xg, g)
         if abs(force) <= mu_s * big_n or big_n <= 0:  # (N <= 0: held, as no-slip)
             return s, 0, False
-        for sg in (1, -1):
-            qdd, _, big_n, den, _ = _Phase(body, s, sg, mu).solve(t, y, xg, g)
-            if den > 0 and big_n > 0 and sg * qdd[_X] > 0:
-                return s, sg, False
+        # the slip against the force friction cannot hold: with den > 0 its x'' has the
+        # sign sg exactly (the phase's F = -mu sg N against |force| > mu N), so its sign
+        # is not tested (round-off on the far side of a stick break)
+        sg = -1 if force > 0 else 1
+        _, _, big_n, den, _ = _Phase(body, s, sg, mu).solve(t, y, xg, g)
+        if den > 0 and big_n > 0:
+            return s, sg, False
         return s, 0, True
     rest = _Phase(body, 0, 0, mu)
     _, force, big_n, _, m_p = rest.solve(t, y, xg, g, corner=1)
@@ -436,6 +444,8 @@ class _Run:
         self.theta_max = self.slide_max = 0.0
         self.e_impact = self.w_fric_impulsive = 0.0
         self.jams = self.lift_offs = 0
+        self.steps = self.contacts = 0  # DOP853 steps, impacts that land flat
+        self.e_max = 0.0  # the largest impact's e
         self.phases: list[str] = []
 
     def xg(self, t: float, on: bool) -> float:
@@ -530,21 +540,30 @@ def sliding_reference(point: Point, mu_static: float | None = None,
                       numerics: Numerics | None = None, rtol: float = RTOL,
                       atol: float = ATOL) -> dict:
     """Run one point from rest on a ground with Coulomb friction point.mu (kinetic) and
-    mu_static (static, default mu) with the reference integrator (module docstring).
+    mu_static (static; default point.mu_static, NaN: mu) with the reference integrator
+    (module docstring).
 
     numerics: horizon, rest_rate and max_events (the kernel's step settings are not
-    used). No vertical ground acceleration. Returns outcome (``layout.OUTCOME_*``),
+    used). No vertical ground acceleration (ValueError). Returns outcome (``layout.OUTCOME_*``),
     overturned, impacts, uplifts, phases (the words ``vocab.phases.PHASES`` in the order
     entered), theta_max [rad], slide_max and slide_final [m] (max |x| and |x| at the end),
-    t_end, status words (horizon, event_cap, jam: a Painleve jam stuck the contact,
+    t_end, t_first_impact and t_overturn [p*t] (NaN: none), wall_time [s], steps (DOP853's),
+    contacts (impacts that land flat), e_max (the largest impact's e), status words
+    (horizon, event_cap, jam: a Painleve jam stuck the contact,
     lifts_off: N < 0 met while rocking), and the energy terms [J]: W_in (the ground's
     work), D_damp, D_fric (friction: sliding and impulses), E_impact (impacts, friction
     excluded), E_end (T + V - V_rest at the end), E_ref (``body.E_ref``) and closure =
     W_in - D_damp - D_fric - E_impact - E_end.
     """
+    if point.excitation.harmonic is not None or point.excitation.vertical is not None:
+        raise ValueError("sliding_reference: a vertical ground acceleration is not "
+                         "modelled (horizontal ground motion only)")
     numerics = numerics or Numerics()
-    run = _Run(point, point.mu if mu_static is None else float(mu_static), numerics, rtol,
-               atol)
+    t0_wall = time.perf_counter()
+    if mu_static is None:
+        mu_static = point.mu if math.isnan(point.mu_static) else point.mu_static
+    run = _Run(point, float(mu_static), numerics, rtol, atol)
+    t_first_impact = t_overturn = math.nan
     bd, g, prm = run.body, run.body.g, run.prm
     y = np.zeros(_N_Y)
     t = 0.0
@@ -569,6 +588,7 @@ def sliding_reference(point: Point, mu_static: float | None = None,
         sol = solve_ivp(ph.rhs(lambda tt, on=on: run.xg(tt, on), g), (t, t_stop), y,
                         method="DOP853", rtol=run.rtol, atol=run.atol, max_step=run.max_step,
                         events=fns, dense_output=True)
+        run.steps += sol.t.size - 1
         for k, te in zip(kinds, sol.t_events, strict=True):
             if k == "peak":
                 run.theta_max = max([run.theta_max] + [abs(sol.sol(v)[0]) for v in te])
@@ -600,6 +620,7 @@ def sliding_reference(point: Point, mu_static: float | None = None,
         if kind == "over":
             outcome = L.OUTCOME_MODE1 if run.impacts else L.OUTCOME_MODE2
             run.theta_max = float(prm[L.PAR_THETA_OVER])
+            t_overturn = t
             break
         if kind == "stop":
             y[5] = 0.0
@@ -622,9 +643,13 @@ def sliding_reference(point: Point, mu_static: float | None = None,
             s, sigma = run.enter(*run.choose(t, y, s, on))
         else:  # impact
             run.impacts += 1
+            if run.impacts == 1:
+                t_first_impact = t
             y[0] = 0.0
             e_before = energy(bd, y, s)
-            y, s_new, sigma_new, _, w_f, jam = impact(bd, prm, y, s, run.mu, run.mu_s)
+            y, s_new, sigma_new, e, w_f, jam = impact(bd, prm, y, s, run.mu, run.mu_s)
+            run.e_max = max(run.e_max, e)
+            run.contacts += int(s_new == 0)
             run.jams += int(jam)
             run.w_fric_impulsive += w_f
             run.e_impact += e_before - energy(bd, y, s_new) + w_f
@@ -644,7 +669,25 @@ def sliding_reference(point: Point, mu_static: float | None = None,
     return {"outcome": outcome, "overturned": outcome != L.OUTCOME_SAFE,
             "impacts": run.impacts, "uplifts": run.uplifts, "phases": run.phases,
             "theta_max": run.theta_max, "slide_max": run.slide_max,
-            "slide_final": abs(y[4]), "t_end": t, "status": sorted(status),
+            "slide_final": abs(y[4]), "t_end": t, "t_first_impact": t_first_impact,
+            "t_overturn": t_overturn, "wall_time": time.perf_counter() - t0_wall,
+            "steps": run.steps, "contacts": run.contacts, "e_max": run.e_max,
+            "status": sorted(status),
             "W_in": y[6], "D_damp": y[7], "D_fric": d_fric, "E_impact": run.e_impact,
             "E_end": e_end, "E_ref": point.body.E_ref,
             "closure": y[6] - y[7] - d_fric - run.e_impact - e_end}
+
+
+def result_row(r: dict) -> np.ndarray:
+    """A ``sliding_reference`` dict as a kernel result row float64[N_OUT]: the no-slip
+    reference's row (``reference.result_row``: the no-slip contact outputs NaN, steps
+    DOP853's) of its status words as ``STATUS_*`` bits (``jam``, which no kernel bit
+    names, left out; OVERTURNED and SLID where they hold), and the slide's slots."""
+    status = sum(STATUS_BIT[w] for w in r["status"] if w in STATUS_BIT)
+    status |= L.STATUS_OVERTURNED if r["overturned"] else 0
+    status |= L.STATUS_SLID if r["slide_max"] > 0.0 else 0
+    out = no_slip_row({**r, "status": status})
+    out[L.OUT_SLIDE_MAX] = r["slide_max"]
+    out[L.OUT_SLIDE_FINAL] = r["slide_final"]
+    out[L.OUT_REGIME] = sum(1 << PHASE_CODE[w] for w in set(r["phases"]))
+    return out

@@ -198,3 +198,45 @@ def _values(sc):
 
     vals = Grid(sc).index_values(np.arange(sc.size))
     return [{k: v[i] for k, v in vals.items()} for i in range(sc.size)]
+
+
+SLIDING = """\
+name: a block that can only slide
+body: {kind: block, alpha: 0.3, mu: 0.2}
+impact: {lam: 0.0}
+pulse: {shape: sine, w_over_p: 2.0, A_ratio: [1.5, 2.5]}
+"""
+
+
+def test_a_sliding_scene_is_measured_against_the_sliding_reference(tmp_path, monkeypatch):
+    """body.mu = 0.2 < tan(alpha): the block only slides (a base held to the ground would
+    uplift: A_ratio > 1). The reference is the sliding one (its slide_max the closed-form
+    rigid-plastic block's, no uplift), and the table reports slide_max's error beside
+    theta_max's. The energy runs are left out: no other test compiles the sliding
+    energy chunk (~18 s), and the energy balance is not what this checks."""
+    from rocksweep.analysis import accuracy as acc
+    from rocksweep.errors import SceneError
+    from rocksweep.physics import friction
+    from rocksweep.scene.parse import load_scene
+
+    path = tmp_path / "slide.yaml"
+    path.write_text(SLIDING)
+    sc = load_scene(path)
+    monkeypatch.setattr(acc, "run_energy", lambda scene, flat, numerics:
+                        np.full((len(flat), L.N_OUT), np.nan))
+    study = acc.accuracy_study(sc, None, ladder("presets")[:1], repeat=1)
+    ref = study.reference
+    assert np.all(ref[:, L.OUT_UPLIFTS] == 0) and np.all(ref[:, L.OUT_THETA_MAX] == 0)
+    for i, a_ratio in enumerate(study.values["A_ratio"]):
+        pt = sc.point({k: v[i] for k, v in study.values.items()})
+        closed = friction.sliding_block(pt.A, pt.omega, 0.2, shape="sine")["slide_max"]
+        assert ref[i, L.OUT_SLIDE_MAX] == pytest.approx(closed, rel=1e-6), a_ratio
+    row = study.table()[0]
+    assert 0 < row["max_err_slide_max"] < 1e-3  # rel. error; the target: 2% at default
+    text = acc.format_table(study)
+    assert "sliding reference" in text and "slide_max (rel)" in text
+    assert f"{row['err_slide_max']:.1e}" in text
+    # the sliding reference has no vertical ground motion: refused in one line
+    with pytest.raises(SceneError, match=r"^pulse\.vertical: .*body\.mu"):
+        acc.accuracy_study(load_scene(path, ["pulse.vertical={amplitude: 0.2, "
+                                             "w_over_p: 2.0}"]), 2)

@@ -31,6 +31,7 @@ CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
 FINE = Numerics.preset("fine")
 DEFAULT = Numerics.preset("default")
+DRAFT = Numerics.preset("draft")
 
 
 def _closure(s: dict) -> float:
@@ -67,15 +68,18 @@ def test_ample_friction_is_the_no_slip_model(body):
 def test_pure_sliding_is_the_rigid_plastic_block(shape, A_ratio, mu_s):
     """mu = 0.2 < tan(alpha) = 0.309: slide_max and slide_final equal the closed-form
     rigid-plastic block's to 0.1%, and the block never rocks (regime: rest and slide, no
-    uplift)."""
+    uplift). At `draft` too: where the sine's first step holds both the stick break
+    (|xg''| = mu g) and the later uplift threshold (g tan alpha), the slip starts at the
+    stick break (it started at the uplift's time, 1.5% short, the stick break's bracket
+    skipped because it reached past the uplift's)."""
     blk = BlockBody(alpha=0.3)
     pt = Point(blk, 0.0, shape, 2.0, A_ratio, mu=0.2, mu_static=mu_s)
-    r = run_point(pt, DEFAULT)
-    s = r.summary()
     cf = friction.sliding_block(pt.A, pt.omega, 0.2, mu_s, shape)
-    assert s["slide_max"] * blk.b == pytest.approx(cf["slide_max"], rel=1e-3)
-    assert s["slide_final"] * blk.b == pytest.approx(cf["slide_final"], rel=1e-3,
-                                                     abs=1e-3 * cf["slide_max"])
+    for numerics in (DRAFT, DEFAULT):
+        s = run_point(pt, numerics).summary()
+        assert s["slide_max"] * blk.b == pytest.approx(cf["slide_max"], rel=1e-3)
+        assert s["slide_final"] * blk.b == pytest.approx(cf["slide_final"], rel=1e-3,
+                                                         abs=1e-3 * cf["slide_max"])
     assert s["uplifts"] == 0 and s["theta_max_over_alpha"] == 0.0
     assert s["regime"] & ((1 << PHASE_CODE[ROCK]) | (1 << PHASE_CODE[SLIDE_ROCK])) == 0
     assert SLID in s["status"] and "rest" in s["status"]
@@ -126,6 +130,24 @@ def test_a_slip_that_turns_in_its_first_step_stops():
     s, ref = run_point(pt, DEFAULT).summary(), sliding_reference(pt, numerics=DEFAULT)
     assert OUTCOME_CODE[s["outcome"]] == ref["outcome"] == 0
     assert s["slide_max"] * pt.body.b == pytest.approx(ref["slide_max"], rel=0.02)
+
+
+def test_a_stick_break_located_tightly_slips():
+    """Housner's block (alpha 0.2618, mu 0.4) rocking on a stuck corner under a sine: its
+    friction demand |H|/N crosses mu at p t = 0.168 and goes on to 0.42. Located to
+    1e-12, the far side of the stick break holds |H| - mu N ~ 1e-16 N, where the slip's
+    x'' is round-off: the kernel and the reference tested its sign, found no direction
+    consistent and stuck the corner (the reference called it a Painleve jam, impossible
+    for a uniform block below mu = 4/3) with |H| > mu N to the end (no slip, max|theta|
+    1.2% off). Both now slide-rock, alike, with no jam. (Found by `rocksweep accuracy`.)"""
+    pt = Point(BlockBody(alpha=0.2618), 0.0, "sine", 6.0, 3.8, mu=0.4)
+    tight = replace(FINE, event_tol=1e-12)
+    s, ref = run_point(pt, tight).summary(), sliding_reference(pt, numerics=tight)
+    assert "jam" not in ref["status"]
+    assert s["phases"] == ref["phases"] == ["rest", "rock", "slide-rock", "rock", "rest"]
+    assert s["slide_max"] * pt.body.b == pytest.approx(ref["slide_max"], rel=1e-4)
+    assert s["theta_max_over_alpha"] * pt.body.alpha_ref == pytest.approx(ref["theta_max"],
+                                                                          rel=1e-6)
 
 
 @pytest.mark.parametrize("mu", [0.5, 0.2])
