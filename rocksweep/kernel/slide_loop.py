@@ -609,6 +609,17 @@ def _search(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED
         n += k
         if best < 0 or tau < tau_best:
             best, tau_best, y_best = slot, tau, y_ev
+    if best > SLOT_FIRST and s != 0 and s * y_best[Y_THETA] < 0.0 <= ev0[SLOT_FIRST]:
+        # theta rose from 0, fell through it and rose again inside the step (so the impact
+        # slot did not fire at its end), and another event came after the fall: the
+        # impact came first. Kept, the state rocked on corner s on the wrong side of it,
+        # through the ground (a flexible body at mu 0.73 after a chatter of impacts: a
+        # slip stop at theta = -5e-6 alpha, then 3.5 b of slip and |theta| to 18 alpha)
+        tau, y_ev, k = _locate(SLOT_FIRST, t, y, k1, _pick(ev0, SLOT_FIRST), tau_best,
+                               s * y_best[Y_THETA], y_best, s, sigma, on, mu, mu_s, prm,
+                               FLEX, DAMPED, ENERGY, GROUND)
+        n += k
+        best, tau_best, y_best = SLOT_FIRST, tau, y_ev
     return best, tau_best, y_best, n
 
 
