@@ -1,9 +1,10 @@
 """The sliding base far outside the paper's region: the kernel at a preset against the
 independent sliding reference, point by point.
 
-Draws random points (fixed seed): rigid blocks (7 in 10; alpha in [0.1, 0.35], I = 4/3 M R^2)
-and flexible bodies (wn/p in [1.5, 8], zeta in [0, 0.15], alpha_cg in [0.08, 0.35],
-alpha_A in [0.15, 0.6], mA/m in [0.2, 3], IA_ratio in [0.3, 1]), mu in [0.1, 0.9], lam in
+Draws random points (fixed seed): rigid blocks (7 in 10; alpha in [0.1, 0.35], I = 4/3 M
+R^2) and flexible bodies (``threshold_sample.flexible_body``: wn/p in [1.5, 8], zeta in
+[0, 0.15], alpha_cg in [0.08, 0.35], alpha_A in [0.15, 0.6], mA/m in [0.2, 3], IA_ratio in
+[0.3, 1]), mu in [0.1, 0.9], lam in
 [0, 0.5], sine or cosine, w/p in [0.5, 12], A_ratio in [0.5, 30]. Runs each with the kernel
 (``compute.single.run_point``, certified) and with ``physics.sliding_reference`` (DOP853 at
 rtol 1e-10, ~0.5 s a point), and prints every point whose outcome differs where the
@@ -23,12 +24,12 @@ import time
 
 import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
 import numpy as np
+from threshold_sample import flexible_body
 
 from rocksweep.compute.single import run_point
-from rocksweep.errors import BodyError
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics
-from rocksweep.physics.bodies import BlockBody, FlexibleBody
+from rocksweep.physics.bodies import BlockBody
 from rocksweep.physics.points import Point
 from rocksweep.physics.sliding_reference import sliding_reference
 
@@ -37,15 +38,7 @@ def draw(rng: np.random.Generator) -> Point:
     if rng.random() < 0.7:
         body = BlockBody(alpha=rng.uniform(0.1, 0.35), inertia=4.0 / 3.0)
     else:
-        while True:
-            try:
-                body = FlexibleBody(
-                    wn_over_p=rng.uniform(1.5, 8.0), zeta=rng.uniform(0.0, 0.15),
-                    alpha_cg=rng.uniform(0.08, 0.35), alpha_A=rng.uniform(0.15, 0.6),
-                    mA_over_m=rng.uniform(0.2, 3.0), IA_ratio=rng.uniform(0.3, 1.0))
-                break
-            except BodyError:  # the top mass below the base: draw again
-                continue
+        body = flexible_body(rng)
     mu = rng.uniform(0.1, 0.9)
     return Point(body, rng.uniform(0.0, 0.5), str(rng.choice(["sine", "cosine"])),
                  rng.uniform(0.5, 12.0), rng.uniform(0.5, 30.0), mu=mu)

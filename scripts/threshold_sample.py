@@ -39,20 +39,25 @@ from rocksweep.physics.reference import reference_run
 FELL = (L.OUTCOME_MODE1, L.OUTCOME_MODE2)
 
 
+def flexible_body(rng: np.random.Generator) -> FlexibleBody:
+    """A random flexible body around the paper's (wn/p 1.5-8, zeta 0-0.15, alpha_cg
+    0.08-0.35, alpha_A 0.15-0.6, mA/m 0.2-3, IA_ratio 0.3-1)."""
+    while True:
+        try:
+            return FlexibleBody(
+                wn_over_p=rng.uniform(1.5, 8.0), zeta=rng.uniform(0.0, 0.15),
+                alpha_cg=rng.uniform(0.08, 0.35), alpha_A=rng.uniform(0.15, 0.6),
+                mA_over_m=rng.uniform(0.2, 3.0), IA_ratio=rng.uniform(0.3, 1.0))
+        except BodyError:  # the top mass below the base: draw again
+            continue
+
+
 def draw(rng: np.random.Generator) -> tuple:
     """(body, lam, shape, w_over_p): a flexible body (a block one time in six)."""
     if rng.random() < 1 / 6:
         body = BlockBody(alpha=rng.uniform(0.1, 0.35), inertia=4.0 / 3.0)
     else:
-        while True:
-            try:
-                body = FlexibleBody(
-                    wn_over_p=rng.uniform(1.5, 8.0), zeta=rng.uniform(0.0, 0.15),
-                    alpha_cg=rng.uniform(0.08, 0.35), alpha_A=rng.uniform(0.15, 0.6),
-                    mA_over_m=rng.uniform(0.2, 3.0), IA_ratio=rng.uniform(0.3, 1.0))
-                break
-            except BodyError:  # the top mass below the base: draw again
-                continue
+        body = flexible_body(rng)
     return (body, rng.uniform(0.0, 0.5), str(rng.choice(["sine", "cosine"])),
             rng.uniform(1.2, 9.0))
 
