@@ -50,6 +50,17 @@ ATOL = 1e-12
 _TH, _U, _X = 0, 1, 2  # coordinates
 # state y: theta, theta', u, u', x, x', W_in, D_damp, D_fric
 _N_Y = 9
+# Most right-hand-side evaluations of one run (~130 us each: ~20 s): past them the run
+# stops with status step_cap, its outcome undecided. A body whose normal force falls
+# through zero on a slipping corner (lifts_off) can drive DOP853's step to nothing near
+# the Painleve point (a flexible body at mu 0.64 under a sine at w/p 11.8 ran for more than
+# an hour; the kernel decides it, mode 2, in milliseconds). The slowest of 550 random
+# points that finished (``scripts/slide_check.py``) took ~6 s, ~45 000 evaluations.
+MAX_EVALUATIONS = 150_000
+
+
+class _OverBudgetError(Exception):
+    """A run past MAX_EVALUATIONS."""
 
 
 class _Body:
@@ -445,6 +456,7 @@ class _Run:
         self.e_impact = self.w_fric_impulsive = 0.0
         self.jams = self.lift_offs = 0
         self.steps = self.contacts = 0  # DOP853 steps, impacts that land flat
+        self.evaluations = 0  # right-hand-side calls, against MAX_EVALUATIONS
         self.e_max = 0.0  # the largest impact's e
         self.phases: list[str] = []
 
@@ -483,6 +495,15 @@ class _Run:
             self.jams += 1
             return y, *self.choose(t, y, s, on)
         return y, s, sigma
+
+    def counted(self, fun):
+        """``fun`` counting its calls in ``evaluations``; _OverBudgetError past MAX_EVALUATIONS."""
+        def counted_fun(t, y):
+            self.evaluations += 1
+            if self.evaluations > MAX_EVALUATIONS:
+                raise _OverBudgetError
+            return fun(t, y)
+        return counted_fun
 
     def events_of(self, s, sigma, on, t0):
         """(event functions, their kinds) of phase (s, sigma)."""
@@ -549,7 +570,7 @@ def sliding_reference(point: Point, mu_static: float | None = None,
     entered), theta_max [rad], slide_max and slide_final [m] (max |x| and |x| at the end),
     t_end, t_first_impact and t_overturn [p*t] (NaN: none), wall_time [s], steps (DOP853's),
     contacts (impacts that land flat), e_max (the largest impact's e), status words
-    (horizon, event_cap, jam: a Painleve jam stuck the contact,
+    (horizon, event_cap, step_cap: past MAX_EVALUATIONS, jam: a Painleve jam stuck the contact,
     lifts_off: N < 0 met while rocking), and the energy terms [J]: W_in (the ground's
     work), D_damp, D_fric (friction: sliding and impulses), E_impact (impacts, friction
     excluded), E_end (T + V - V_rest at the end), E_ref (``body.E_ref``) and closure =
@@ -585,9 +606,13 @@ def sliding_reference(point: Point, mu_static: float | None = None,
             t_stop = min(t_stop, (math.floor(t / run.rec_dt + 1e-9) + 1.0) * run.rec_dt)
         ph = _Phase(bd, s, sigma, run.mu)
         fns, kinds = run.events_of(s, sigma, on, t)
-        sol = solve_ivp(ph.rhs(lambda tt, on=on: run.xg(tt, on), g), (t, t_stop), y,
-                        method="DOP853", rtol=run.rtol, atol=run.atol, max_step=run.max_step,
-                        events=fns, dense_output=True)
+        try:
+            sol = solve_ivp(run.counted(ph.rhs(lambda tt, on=on: run.xg(tt, on), g)),
+                            (t, t_stop), y, method="DOP853", rtol=run.rtol, atol=run.atol,
+                            max_step=run.max_step, events=fns, dense_output=True)
+        except _OverBudgetError:
+            status.add("step_cap")
+            break
         run.steps += sol.t.size - 1
         for k, te in zip(kinds, sol.t_events, strict=True):
             if k == "peak":

@@ -77,3 +77,19 @@ def test_energy_closes_with_friction(body, lam, shape, w, A, mu):
     assert abs(r["closure"]) < 1e-4 * r["E_ref"]
     terms = (r["W_in"], r["D_damp"], r["D_fric"], r["E_impact"], r["E_end"])
     assert all(math.isfinite(v) for v in terms)
+
+
+def test_a_run_past_its_evaluation_budget_stops_flagged(monkeypatch):
+    """Every reference run ends: past MAX_EVALUATIONS right-hand-side calls it stops with
+    status step_cap (a flagged status of the kernel's result row), its outcome undecided
+    (safe), instead of crawling on (a body lifting off a slipping corner near the Painleve
+    point ran for more than an hour). Here the budget is cut to 200 on an ordinary run
+    that needs more."""
+    from rocksweep.physics import sliding_reference as sr
+
+    pt = Point(BlockBody(alpha=0.3), 0.0, "sine", 2.0, 1.5, mu=0.2)
+    assert "step_cap" not in sliding_reference(pt)["status"]
+    monkeypatch.setattr(sr, "MAX_EVALUATIONS", 200)
+    r = sliding_reference(pt)
+    assert "step_cap" in r["status"] and r["outcome"] == L.OUTCOME_SAFE
+    assert int(sr.result_row(r)[L.OUT_STATUS]) & L.STATUS_FLAGGED
