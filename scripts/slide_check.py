@@ -15,12 +15,20 @@ percentile, max).
 
     python scripts/slide_check.py --n 250 --seed 2
     python scripts/slide_check.py --n 300 --seed 3 --preset draft
+    python scripts/slide_check.py --n 120 --seed 5 --preset fine --mu10
+
+``--mu10`` compares instead the kernel at mu = 10 (a base that cannot slip, but for a
+normal force near 0) with the no-slip kernel at the same points: outcome, impacts and
+max|theta| (prints each point that differs, and the largest max|theta| difference of the
+safe points whose base did not slip).
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import time
+from dataclasses import replace
 
 import _here  # noqa: F401 (this checkout's rocksweep, not an installed one)
 import numpy as np
@@ -44,14 +52,38 @@ def draw(rng: np.random.Generator) -> Point:
                  rng.uniform(0.5, 12.0), rng.uniform(0.5, 30.0), mu=mu)
 
 
+def mu10(points: list[Point], numerics: Numerics) -> None:
+    """The ``--mu10`` comparison (module docstring)."""
+    worst = 0.0
+    for i, p in enumerate(points):
+        a = run_point(replace(p, mu=math.nan), numerics, history=False).out
+        b = run_point(replace(p, mu=10.0), numerics, history=False).out
+        d = abs(a[L.OUT_THETA_MAX] - b[L.OUT_THETA_MAX]) / p.body.alpha_ref
+        slipped = b[L.OUT_SLIDE_MAX] > 0.0
+        if a[L.OUT_OUTCOME] == L.OUTCOME_SAFE and not slipped:
+            worst = max(worst, d)
+        if a[L.OUT_OUTCOME] != b[L.OUT_OUTCOME] or (d > 1e-4 and slipped):
+            print(f"{i}: outcome {int(a[L.OUT_OUTCOME])} / {int(b[L.OUT_OUTCOME])}, "
+                  f"max|theta| {d:.2e} alpha apart, slide_max "
+                  f"{b[L.OUT_SLIDE_MAX] / p.body.b:.3g} b: "
+                  f"{p}", flush=True)
+    print(f"points {len(points)}: safe points whose base did not slip, max|theta| apart "
+          f"at most {worst:.2e} alpha")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=100)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--preset", default="default")
+    ap.add_argument("--mu10", action="store_true",
+                    help="mu = 10 against the no-slip kernel instead of the reference")
     a = ap.parse_args()
     rng = np.random.default_rng(a.seed)
     numerics = Numerics.preset(a.preset)
+    if a.mu10:
+        mu10([draw(rng) for _ in range(a.n)], numerics)
+        return
     wrong = flagged = 0
     errs: list[float] = []
     t0 = time.perf_counter()
