@@ -213,6 +213,12 @@ class CalibrationError(RocksweepError, ValueError):
     """A calibration that cannot run as asked (analysis.calibrate)."""
 
 
+class BudgetExceededError(RocksweepError):
+    """A reference run past its budget of right-hand-side evaluations
+    (``physics.sliding_reference.MAX_EVALUATIONS``): raised from inside scipy's solver and
+    caught where the run stops (status step_cap); never reaches a user."""
+
+
 # ---------------------------------------------------------------------------------------
 # Argument checks shared by every layer, written once with one wording
 # ---------------------------------------------------------------------------------------

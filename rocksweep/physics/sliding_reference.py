@@ -36,6 +36,7 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from rocksweep.errors import BudgetExceededError
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel.equations import rest_margin, restitution
 from rocksweep.kernel.ground import any_ground_acc
@@ -57,10 +58,6 @@ _N_Y = 9
 # an hour; the kernel decides it, mode 2, in milliseconds). The slowest of 550 random
 # points that finished (``scripts/slide_check.py``) took ~6 s, ~45 000 evaluations.
 MAX_EVALUATIONS = 150_000
-
-
-class _OverBudgetError(Exception):
-    """A run past MAX_EVALUATIONS."""
 
 
 class _Body:
@@ -497,11 +494,12 @@ class _Run:
         return y, s, sigma
 
     def counted(self, fun):
-        """``fun`` counting its calls in ``evaluations``; _OverBudgetError past MAX_EVALUATIONS."""
+        """``fun`` counting its calls in ``evaluations``; BudgetExceededError past
+        MAX_EVALUATIONS."""
         def counted_fun(t, y):
             self.evaluations += 1
             if self.evaluations > MAX_EVALUATIONS:
-                raise _OverBudgetError
+                raise BudgetExceededError
             return fun(t, y)
         return counted_fun
 
@@ -610,7 +608,7 @@ def sliding_reference(point: Point, mu_static: float | None = None,
             sol = solve_ivp(run.counted(ph.rhs(lambda tt, on=on: run.xg(tt, on), g)),
                             (t, t_stop), y, method="DOP853", rtol=run.rtol, atol=run.atol,
                             max_step=run.max_step, events=fns, dense_output=True)
-        except _OverBudgetError:
+        except BudgetExceededError:
             status.add("step_cap")
             break
         run.steps += sol.t.size - 1
