@@ -43,7 +43,7 @@ def kill_sweep_when(args: list[str], cwd, ready, timeout: float = 300.0) -> None
            "PYTHONPATH": os.pathsep.join(p for p in (root, os.environ.get("PYTHONPATH"))
                                          if p)}
     proc = subprocess.Popen(
-        [sys.executable, "-c", "from rocksweep.cli import main; main()", "sweep", *args],
+        [sys.executable, "-m", "rocksweep", "sweep", *args],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=cwd, env=env)
     try:
         deadline = time.monotonic() + timeout

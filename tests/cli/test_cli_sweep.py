@@ -349,7 +349,7 @@ def test_ctrl_c_writes_every_finished_chunk_before_it_exits(tmp_path):
     sc = load_scene(scene)
     prepare(Grid(sc), level(sc))
     proc = subprocess.Popen(
-        [sys.executable, "-c", "from rocksweep.cli import main; main()", "sweep", str(scene),
+        [sys.executable, "-m", "rocksweep", "sweep", str(scene),
          "-o", str(out), "--jobs", "1", "--chunk-size", "50", "--write-every", "1000"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
     try:
