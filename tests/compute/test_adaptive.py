@@ -330,3 +330,75 @@ def test_interrupted_audit_resumes_to_the_same_flags():
             raise AssertionError("no convergence")
         np.testing.assert_array_equal(computed, ref_comp)
         np.testing.assert_array_equal(ad.fill(plan, outcome, computed), ref_out)
+
+
+def _edge_points_every_cell(plan, mixed, known):
+    """The last level's rules (``adaptive._edge_points``) evaluated on every cell of the
+    panels, as they were written before the planner evaluated them on the cells they can
+    fire at only."""
+    c = ad._corner_classes(known)
+    a, b = c[:, :-1, :-1], c[:, :-1, 1:]  # corners (y, x), (y, x + 1)
+    d, e = c[:, 1:, :-1], c[:, 1:, 1:]  # (y + 1, x), (y + 1, x + 1)
+    ok = mixed & (a >= 0) & (b >= 0) & (d >= 0) & (e >= 0)
+    same = (a == b) & (a == d) & (a == e)
+    split, whole = ok & ~same, ok & same
+    P, cy, cx = mixed.shape
+    _, ny, nx = plan.panel_shape
+    # the centres' classes (-1: not computed, or a last cell one index long: no centre)
+    m = np.full((P, cy, cx), -1, np.int8)
+    cen = known[:, 1::2, 1::2][:, :cy, :cx]
+    m[:, :cen.shape[1], :cen.shape[2]] = cen
+    if (ny - 1) % 2:
+        m[:, -1] = -1
+    if (nx - 1) % 2:
+        m[:, :, -1] = -1
+    lat = np.zeros((P, 2 * cy + 1, 2 * cx + 1), bool)  # stride-1 lattice, as _points_of_cells
+    lat[:, 1::2, 1::2] |= split  # centres
+
+    def crossed(p: np.ndarray, q: np.ndarray, r: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """Edge (p, q) of a split cell crossed; (r, t): the opposite edge's ends."""
+        return (p != q) | ((m >= 0) & (p != m) & ~((r == m) & (t == m)))
+
+    lat[:, 0:-1:2, 1::2] |= split & crossed(a, b, d, e)  # lower edges
+    lat[:, 2::2, 1::2] |= split & crossed(d, e, a, b)  # upper edges
+    lat[:, 1::2, 0:-1:2] |= split & crossed(a, d, b, e)  # left edges
+    lat[:, 1::2, 2::2] |= split & crossed(b, e, a, d)  # right edges
+
+    def band(p: np.ndarray, q: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Edge (p, q) with agreeing ends between centres u, v of another class."""
+        return (p >= 0) & (p == q) & (u >= 0) & (v >= 0) & (u != p) & (v != p)
+
+    no = np.full((P, 1, cx), -1, np.int8)  # beyond the panel: no centre
+    lat[:, 0::2, 1::2] |= band(c[:, :, :-1], c[:, :, 1:], np.concatenate([no, m], 1),
+                               np.concatenate([m, no], 1))  # edges along x
+    no = np.full((P, cy, 1), -1, np.int8)
+    lat[:, 1::2, 0::2] |= band(c[:, :-1, :], c[:, 1:, :], np.concatenate([no, m], 2),
+                               np.concatenate([m, no], 2))  # edges along y
+    for dy in range(3):
+        for dx in range(3):
+            lat[:, dy:dy + 2 * cy:2, dx:dx + 2 * cx:2] |= whole
+    p, jj, ii = np.nonzero(lat)
+    return np.unique(plan.flat_index()[p, np.minimum(jj, ny - 1), np.minimum(ii, nx - 1)])
+
+
+def test_the_last_levels_rules_on_their_cells_equal_them_on_every_cell():
+    """``_edge_points`` looks only at mixed cells and cells with a computed centre; on
+    random states (classes, computed sets, mixed cells; panels of 1-3, odd and even axis
+    lengths, the diagram axes in either order) it picks exactly the points the rules
+    evaluated on every cell pick."""
+    rng = np.random.default_rng(1)
+    picked = 0
+    for _ in range(600):
+        n_p, ny, nx = (int(v) for v in rng.integers((1, 2, 2), (4, 14, 14)))
+        plan = (ad.Plan((n_p, ny, nx), 2, 1) if rng.random() < 0.5
+                else ad.Plan((ny, n_p, nx), 2, 0))
+        shape = plan.panel_shape
+        known = rng.integers(-1, int(rng.integers(1, 4)), size=shape).astype(np.int8)
+        if rng.random() < 0.5:
+            known[rng.random(shape) < 0.6] = -1
+        cells = (shape[0], ad._ncells(shape[1], 2), ad._ncells(shape[2], 2))
+        mixed = rng.random(cells) < rng.uniform(0, 1)
+        got = ad._edge_points(plan, mixed, known)
+        np.testing.assert_array_equal(got, _edge_points_every_cell(plan, mixed, known))
+        picked += got.size
+    assert picked > 1000  # the rules fired
