@@ -412,6 +412,21 @@ def _corner_classes(known: np.ndarray) -> np.ndarray:
     return known[:, _axis_lattice(ny, 2)][:, :, _axis_lattice(nx, 2)]
 
 
+def _centre_classes(known: np.ndarray) -> np.ndarray:
+    """int8[P, cy, cx]: the classes at the centres of the stride-2 cells (-1: not
+    computed, or a last cell one index long: no centre)."""
+    P, ny, nx = known.shape
+    cy, cx = _ncells(ny, 2), _ncells(nx, 2)
+    m = np.full((P, cy, cx), -1, np.int8)
+    cen = known[:, 1::2, 1::2][:, :cy, :cx]
+    m[:, :cen.shape[1], :cen.shape[2]] = cen
+    if (ny - 1) % 2:
+        m[:, -1] = -1
+    if (nx - 1) % 2:
+        m[:, :, -1] = -1
+    return m
+
+
 def _edge_points(plan: Plan, mixed: np.ndarray, known: np.ndarray) -> np.ndarray:
     """Flat indices of the points the last level (stride 2 -> 1) computes in the mixed
     stride-2 cells ``mixed`` (bool[P, cy, cx]) whose four corners are computed.
@@ -435,17 +450,9 @@ def _edge_points(plan: Plan, mixed: np.ndarray, known: np.ndarray) -> np.ndarray
     computed centre), not on every cell: they were 2/3 of a planning pass's time, ~80 ms
     a pass at 1000 x 1000 x 3, on the sweep's critical path.
     """
-    c = _corner_classes(known)
-    P, cy, cx = mixed.shape
+    c, m = _corner_classes(known), _centre_classes(known)
+    _, cy, cx = mixed.shape
     _, ny, nx = plan.panel_shape
-    # the centres' classes (-1: not computed, or a last cell one index long: no centre)
-    m = np.full((P, cy, cx), -1, np.int8)
-    cen = known[:, 1::2, 1::2][:, :cy, :cx]
-    m[:, :cen.shape[1], :cen.shape[2]] = cen
-    if (ny - 1) % 2:
-        m[:, -1] = -1
-    if (nx - 1) % 2:
-        m[:, :, -1] = -1
     pts: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []  # (p, jj, ii) lattice points
 
     p, j, i = np.nonzero(mixed)

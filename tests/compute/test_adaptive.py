@@ -344,14 +344,7 @@ def _edge_points_every_cell(plan, mixed, known):
     split, whole = ok & ~same, ok & same
     P, cy, cx = mixed.shape
     _, ny, nx = plan.panel_shape
-    # the centres' classes (-1: not computed, or a last cell one index long: no centre)
-    m = np.full((P, cy, cx), -1, np.int8)
-    cen = known[:, 1::2, 1::2][:, :cy, :cx]
-    m[:, :cen.shape[1], :cen.shape[2]] = cen
-    if (ny - 1) % 2:
-        m[:, -1] = -1
-    if (nx - 1) % 2:
-        m[:, :, -1] = -1
+    m = ad._centre_classes(known)
     lat = np.zeros((P, 2 * cy + 1, 2 * cx + 1), bool)  # stride-1 lattice, as _points_of_cells
     lat[:, 1::2, 1::2] |= split  # centres
 
