@@ -395,3 +395,23 @@ def test_the_last_levels_rules_on_their_cells_equal_them_on_every_cell():
         np.testing.assert_array_equal(got, _edge_points_every_cell(plan, mixed, known))
         picked += got.size
     assert picked > 1000  # the rules fired
+
+
+def test_the_points_of_marked_cells_are_those_of_their_closed_lattice():
+    """``_points_of_cells`` (the stride-s/2 points inside the marked stride-s cells, edges
+    and corners included) against marking each cell's 3 x 3 points on the whole lattice."""
+    rng = np.random.default_rng(2)
+    for _ in range(300):
+        n_p, ny, nx = (int(v) for v in rng.integers((1, 2, 2), (4, 40, 40)))
+        plan = ad.Plan((n_p, ny, nx), 2, 1)
+        s = int(2 ** rng.integers(1, 5))
+        cy, cx = ad._ncells(ny, s), ad._ncells(nx, s)
+        cells = rng.random((n_p, cy, cx)) < rng.uniform(0, 0.5)
+        lat = np.zeros((n_p, 2 * cy + 1, 2 * cx + 1), bool)
+        for dy in range(3):
+            for dx in range(3):
+                lat[:, dy:dy + 2 * cy:2, dx:dx + 2 * cx:2] |= cells
+        p, jj, ii = np.nonzero(lat)
+        want = np.unique(plan.flat_index()[p, np.minimum(jj * (s // 2), ny - 1),
+                                           np.minimum(ii * (s // 2), nx - 1)])
+        np.testing.assert_array_equal(ad._points_of_cells(plan, cells, s), want)
