@@ -609,17 +609,25 @@ def _search(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED
         n += k
         if best < 0 or tau < tau_best:
             best, tau_best, y_best = slot, tau, y_ev
-    if best > SLOT_FIRST and s != 0 and s * y_best[Y_THETA] < 0.0 <= ev0[SLOT_FIRST]:
-        # theta rose from 0, fell through it and rose again inside the step (so the impact
-        # slot did not fire at its end), and another event came after the fall: the
-        # impact came first. Kept, the state rocked on corner s on the wrong side of it,
-        # through the ground (a flexible body at mu 0.73 after a chatter of impacts: a
-        # slip stop at theta = -5e-6 alpha, then 3.5 b of slip and |theta| to 18 alpha)
-        tau, y_ev, k = _locate(SLOT_FIRST, t, y, k1, _pick(ev0, SLOT_FIRST), tau_best,
-                               s * y_best[Y_THETA], y_best, s, sigma, on, mu, mu_s, prm,
-                               FLEX, DAMPED, ENERGY, GROUND)
-        n += k
-        best, tau_best, y_best = SLOT_FIRST, tau, y_ev
+    if best >= 0:
+        # A slot that fired and came back inside the step (above zero again at its end, so
+        # not bracketed above) may have fired before the event taken: where it is below
+        # zero there, it came first, and is located before it. (Kept, a slip stop after
+        # such an impact left a flexible body at mu 0.73 rocking on the wrong side of its
+        # corner, through the ground: 3.5 b of slip, |theta| to 18 alpha.)
+        ev_b = _event_values(t + tau_best, y_best, s, sigma, on, mu, mu_s, prm, FLEX,
+                             DAMPED, GROUND)
+        for slot in range(N_SLOTS):
+            g0, g_b = _pick(ev0, slot), _pick(ev_b, slot)
+            if slot == best or not g_b < 0.0 or not (
+                    g0 > 0.0 or (s != 0 and slot == SLOT_FIRST and g0 == 0.0)
+                    or _slip_turned(slot, sigma, g0, g_b)):
+                continue
+            tau, y_ev, k = _locate(slot, t, y, k1, g0, tau_best, g_b, y_best, s, sigma, on,
+                                   mu, mu_s, prm, FLEX, DAMPED, ENERGY, GROUND)
+            n += k
+            if tau < tau_best:
+                best, tau_best, y_best = slot, tau, y_ev
     return best, tau_best, y_best, n
 
 
