@@ -38,6 +38,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING
 
+from rocksweep._version import __version__
 from rocksweep.accessor import watch
 from rocksweep.errors import RocksweepError
 
@@ -73,30 +74,10 @@ _API = frozenset(__all__) - {"RocksweepError", "__version__"}
 watch()  # ds.rocksweep once xarray is imported (it is never imported here)
 
 
-def _version() -> str:
-    """The installed distribution's version; from pyproject.toml in a source tree."""
-    # importlib.metadata: ~20 ms, for --version alone
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("rocksweep")
-    except PackageNotFoundError:
-        import re
-        from pathlib import Path
-
-        pyproject = Path(__file__).resolve().parent.parent / "pyproject.toml"
-        try:
-            m = re.search(r'^version\s*=\s*"([^"]+)"', pyproject.read_text(), re.M)
-        except OSError:
-            m = None
-        return f"{m.group(1)}+source" if m else "0+unknown"
-
-
 def __getattr__(name: str) -> object:
     """The API's functions and ``Simulation`` on first use (``rocksweep.api``: ~25 kB of
     source the command line's start-up need not compile), the modules ``import rocksweep``
-    used to load (``rocksweep.api``, ...), and ``__version__``
-    (importlib.metadata costs ~20 ms of every command)."""
+    used to load (``rocksweep.api``, ...)."""
     if name == "Simulation":
         from rocksweep import simulation
 
@@ -107,8 +88,6 @@ def __getattr__(name: str) -> object:
         from rocksweep import api
 
         value = getattr(api, name)
-    elif name == "__version__":
-        value = _version()
     else:
         raise AttributeError(f"module 'rocksweep' has no attribute {name!r}")
     globals()[name] = value

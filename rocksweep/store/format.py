@@ -49,6 +49,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from rocksweep import fields
+from rocksweep._version import __version__
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import fixed_ascii, utc_now
@@ -110,16 +111,10 @@ FLAG_VARIABLES = ("outcome", "status", "computed", "regime")
 
 def versions() -> dict[str, str]:
     """Versions of rocksweep and the libraries that shape its results."""
-    from importlib.metadata import PackageNotFoundError, version
-
     import h5py
     import numba
 
-    try:
-        rs = version("rocksweep")
-    except PackageNotFoundError:  # pragma: no cover - running from a source tree
-        rs = "unknown"
-    return {"rocksweep": rs, "numba": numba.__version__, "numpy": np.__version__,
+    return {"rocksweep": __version__, "numba": numba.__version__, "numpy": np.__version__,
             "h5py": h5py.__version__, "hdf5": h5py.version.hdf5_version,
             "python": platform.python_version()}
 

@@ -179,6 +179,28 @@ def test_kernel_import_pulls_no_io_libraries():
     assert proc.returncode == 0 and proc.stdout.strip() == ""
 
 
+def test_a_quiet_one_point_sweep_pays_for_no_pool_bar_or_metadata(tmp_path):
+    """Demand 3 at start-up: a quiet sweep of one chunk runs it in this thread (no joblib
+    pool: ~60 ms) and shows no bar (no tqdm: ~15 ms); the file records the version
+    (``rocksweep._version``, not a search of the installed distributions)."""
+    out = tmp_path / "one.h5"
+    code = ("import sys\nfrom rocksweep.cli import main\ntry:\n"
+            f"    main(['sweep', {str(CONFIGS / 'fig3a.yaml')!r}, '--set', 'pulse.w_over_p=2',"
+            " '--set', 'pulse.A_ratio=3', '--set', 'impact.lam=0.2', '-q', '-j', '2', "
+            f"'-o', {str(out)!r}])\n"
+            "except SystemExit as e:\n    assert not e.code, e.code\n"
+            "print('LOADED:' + ','.join(m for m in ('joblib', 'tqdm') if m in sys.modules))")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split("LOADED:")[-1].strip() == ""
+    import h5py
+
+    import rocksweep
+
+    with h5py.File(out) as f:
+        assert f.attrs["rocksweep_version"] == rocksweep.__version__
+
+
 @pytest.mark.parametrize("args, needle", [
     (["sweep"], "Missing argument 'SCENE.yaml'"),
     (["sweep", "x.yaml", "--adaptive", "--margin", "1e12"], "Invalid value for '--margin'"),
