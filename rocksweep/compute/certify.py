@@ -30,10 +30,11 @@ when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the th
   step, the point is a close call as above (its full runs from the first refinement on);
   if not, the run's own result is kept.
 
-Only the runs near a threshold pay: on the paper's figures' full grids 10-28% more RK4
+Only the runs near a threshold pay: on the paper's figures' full grids 17-46% more RK4
 evaluations than the points' own, on their adaptive sweeps (almost only points near a
-boundary) 1.5-1.9x (``scripts/bench_certify.py``); within 0.5% of a threshold, where every
-run pays, the certified runs take 2.3-2.8x the bare ones' (``scripts/threshold_sample.py``).
+boundary) 1.7-2.2x (``scripts/bench_certify.py``); within 0.5% of a threshold, where every
+run pays, the certified runs take 2.6-3.2x the bare ones' (``scripts/threshold_sample.py``;
+docs/accuracy.md, "Round 4").
 
 Every refined or checked point has STATUS_REFINED in its status; one whose outcome still
 changed at the last refinement, or which was still a close call there, also
