@@ -130,7 +130,8 @@ def main() -> None:
                           f"{int(f[L.OUT_OUTCOME])}, reference {truth}", flush=True)
     print(f"points {n}  refined {refined}  flagged {flagged}  wrong and unflagged {wrong}  "
           f"fine wrong (where the reference ran) {fine_wrong}  "
-          f"RK4 evaluations certified/bare {cost / bare_cost:.3f}  "
+          f"RK4 evaluations certified/bare {cost / bare_cost:.3f} "
+          f"({cost / 1e6:.2f}M / {bare_cost / 1e6:.2f}M)  "
           f"({time.perf_counter() - t0:.0f} s)")
 
 

@@ -86,6 +86,12 @@ HARD = {
 }
 
 
+# Below this [p t] an overturning time's error is noise: the energy-gaining case's
+# t_overturn at `default` moves by up to 3.2e-3 p t, run and half-step rerun alike, when
+# its step changes by 0.5-3% (a scan of the step at 0.97-1.03 x the rule's)
+NOISE = 2e-3
+
+
 @pytest.mark.parametrize("case", sorted(HARD))
 @pytest.mark.parametrize("preset", ["default", "accurate"])
 def test_estimate_tracks_the_error_against_the_reference(case, preset):
@@ -102,10 +108,10 @@ def test_estimate_tracks_the_error_against_the_reference(case, preset):
     assert out[0, L.OUT_OUTCOME] == half[0, L.OUT_OUTCOME] == ref["outcome"]
     err = abs(out[0, L.OUT_T_OVERTURN] - ref["t_overturn"])
     est = abs(half[0, L.OUT_T_OVERTURN] - out[0, L.OUT_T_OVERTURN])
-    if err > 1e-3:  # above the reference's own and the event tolerance's noise
+    if err > NOISE:
         assert 0.25 * err <= est <= 2 * err, (err, est)
     else:
-        assert est <= 2e-3
+        assert est <= 2 * NOISE
 
 
 def test_scene_without_check_stores_and_runs_nothing_more():
