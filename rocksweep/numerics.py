@@ -194,8 +194,8 @@ SPRING_DECAY_REL = 1.0 / 38.0
 #
 #     n >= 2 pi (min(SPRING_MEMORY, 1/(zeta' omega_rock)) / (120 SPRING_SHIFT))^(1/4).
 #
-# It binds where the spring rings for more than ~5 p*t (zeta' omega_rock below ~0.2 p; 21.6
-# steps a period for an undamped spring): on none of the shipped scenes.
+# It binds on springs that ring long (21.6 steps a period for an undamped spring, 14.4 where
+# 1/(zeta' omega_rock) = 10 p*t), on none of the shipped scenes.
 SPRING_SHIFT = 0.003
 SPRING_MEMORY = 50.0
 

@@ -13,10 +13,10 @@ from pathlib import Path
 
 PKG = Path(__file__).resolve().parents[1] / "rocksweep"
 
-# lowest first: errors and the vocabulary (rocksweep.vocab), kernel, the model, scenes,
-# files, computing, analyses, figures, the facade, the command line
+# lowest first: errors, the vocabulary (rocksweep.vocab) and the version, kernel, the
+# model, scenes, files, computing, analyses, figures, the facade, the command line
 FLOORS: list[tuple[str, ...]] = [
-    ("errors", "vocab"),
+    ("errors", "vocab", "_version"),
     ("outputs", "inputs", "interrupts", "kernel"),
     ("numerics",),
     ("schema",),

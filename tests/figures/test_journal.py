@@ -155,14 +155,19 @@ def test_lam_is_written_as_lambda(laws):
 
 def test_no_progress_bar_class_from_a_notebook_without_progress(monkeypatch):
     """tqdm.auto in a notebook without ipywidgets warns (TqdmWarning) even for a bar that
-    is never shown: with progress=False the terminal's class is used."""
-    import tqdm as tqdm_module
-
-    from rocksweep.compute.driver import progress_class
+    is never shown: with progress=False no tqdm class is used at all (``NoBar``), and it
+    takes the calls the sweep loops make of a bar."""
+    from rocksweep.compute.driver import NoBar, progress_class
 
     monkeypatch.setitem(sys.modules, "ipykernel", sys.modules.get("ipykernel") or
                         type(sys)("ipykernel"))
-    assert progress_class(False) is tqdm_module.tqdm
+    assert progress_class(False) is NoBar
+    with progress_class(False)(total=3, unit="pt", disable=True) as bar:
+        bar.total += 2
+        bar.set_description("refine 4")
+        bar.refresh()
+        bar.update(5)
+    assert bar.total == 5
     import tqdm.auto
 
     assert progress_class(True) is tqdm.auto.tqdm

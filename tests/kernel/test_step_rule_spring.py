@@ -92,9 +92,9 @@ def test_figure4_spring_at_five_steps_was_damped_as_physics() -> None:
     assert spring_steps(27.46, 5, 0.14) >= 5 * 1.4
 
 
-@pytest.mark.parametrize("spp", [5, 10, 20])
-@pytest.mark.parametrize("zeta_rock", [0.0, 0.002, 0.01, 0.05, 0.14])
-@pytest.mark.parametrize("omega_rock", [2.0, 3.5, 10.0, 27.46])
+@pytest.mark.parametrize("spp", [5, 20])
+@pytest.mark.parametrize("zeta_rock", [0.0, 0.002, 0.01, 0.05])
+@pytest.mark.parametrize("omega_rock", [2.0, 10.0, 27.46])
 def test_spring_phase_lag_bounded(omega_rock: float, zeta_rock: float, spp: int) -> None:
     """At the rule's step RK4's oscillating spring falls behind the exact one by at most
     0.003 (5/spp)^4 p t over its memory, min(50, 1/(zeta' omega_rock)) p t (the leading
