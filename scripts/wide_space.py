@@ -75,7 +75,7 @@ def draw(n: int, seed: int) -> list[Point]:
             mA_over_m=_logu(rng, 0.05, 10.0), IA_ratio=float(rng.uniform(0.2, 1.0)))
         sign = 1.0 if rng.uniform() < 0.5 else -1.0
         pts.append(Point(body, lam=float(rng.uniform(0.0, 1.5)),
-                         shape="sine" if rng.uniform() < 0.5 else "cosine",
+                         excitation="sine" if rng.uniform() < 0.5 else "cosine",
                          w_over_p=float(rng.uniform(0.2, 12.0)),
                          A_ratio=sign * float(rng.uniform(0.3, 20.0))))
     return pts
