@@ -195,7 +195,7 @@ def sweep_arrays(scene: Scene, jobs: int = 1, chunk_size: int | None = None,
 
 class NoBar:
     """What ``progress_class`` gives when no bar is shown: tqdm's calls, doing nothing
-    (tqdm's import is ~15 ms of a quiet command; no notebook warning about ipywidgets)."""
+    (tqdm's import is ~10 ms of a quiet command; no notebook warning about ipywidgets)."""
 
     def __init__(self, *_args: object, total: int = 0, **_kwargs: object) -> None:
         self.total = total
@@ -222,7 +222,7 @@ def progress_class(progress: bool = True) -> type:
     No bar shown (``progress`` false): ``NoBar``."""
     if not progress:
         return NoBar
-    # tqdm here, not at the top: ~15 ms that a quiet command does not pay
+    # tqdm here, not at the top: ~10 ms that a quiet command does not pay
     if "ipykernel" in sys.modules:
         from tqdm.auto import tqdm
     else:
