@@ -356,6 +356,8 @@ CLOSE_AFTER = 4.0 * math.pi
 # accuracy.md, "What the certification costs").
 ENERGY_ORDER = 4
 RICHARDSON_SAFETY = 2.0
+# Any repeated overturn, converged or not, is trusted only where both runs fell within
+# SAME_FALL of each other (``compute.certify.certify``).
 SAME_FALL = 1.0
 
 

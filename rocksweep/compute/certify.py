@@ -11,7 +11,8 @@ when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the th
 - a safe run below ``numerics.close_margin``, or an overturn below OVERTURN_BAND times
   it, is run again at half the steps (``refine_rows``: every step and the rotation limit
   halved, the step cap doubled), and again, until two consecutive runs give the same
-  outcome and the finer one is no close call at its own step (its margins scale with the
+  outcome (an overturn on the same approach, within ``numerics.SAME_FALL``) and the finer
+  one is no close call at its own step (its margins scale with the
   step, ``numerics.close_margin``: a knife edge repeats itself at every step it is a
   close call at) with a margin that did not move between them by more than itself
   (``settled``) or ``Numerics.refine`` refinements were made; the finest run is kept.
@@ -189,7 +190,13 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
         if level < levels:
             trusted &= settled(before, new)
             trusted |= converged(refine_rows(rows[idx], level - 1), before, finer, new)
-        stable = (new[:, L.OUT_OUTCOME] == before[:, L.OUT_OUTCOME]) & trusted
+        # a repeated overturn counts only if both runs fell on the same approach (within
+        # SAME_FALL): two falls far apart are two trajectories that parted, whatever their
+        # margins (wide-space.yaml's undamped bodies at lam 1 fell at 79, 195 and 102 p t
+        # at levels 0-2 and the reference rocks to rest)
+        apart = _fell(new) & ~(np.abs(new[:, L.OUT_T_OVERTURN] - before[:, L.OUT_T_OVERTURN])
+                               <= SAME_FALL)
+        stable = (new[:, L.OUT_OUTCOME] == before[:, L.OUT_OUTCOME]) & trusted & ~apart
         status = new[:, L.OUT_STATUS].astype(np.int64) | L.STATUS_REFINED
         new[:, L.OUT_STATUS] = status
         new[:, L.OUT_REFINE_EVALS] = spent_now[:, 2] + _evaluations(new)

@@ -302,6 +302,42 @@ def test_a_repeated_overturn_whose_margin_converged_stops_there():
     assert st[5] & L.STATUS_UNCERTIFIED
 
 
+def test_a_repeated_overturn_on_another_approach_is_not_trusted():
+    """certify's rule on a stand-in kernel: two runs that both overturn clear of the band
+    but SAME_FALL or more apart in time fell on different approaches (trajectories that
+    parted): the point goes on to the next level, and one still apart at the last level is
+    flagged; falls within SAME_FALL stop at level 1 as before."""
+    rows = np.zeros((3, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = 0.01 * CLOSE_BAND
+    rows[:, L.PAR_DT] = 1.0
+    fell = L.OUTCOME_MODE1
+    # per point and level 0..2: (outcome, margin, overturning time); level 0 inside the
+    # overturn band (a close call), every finer margin far outside it and settled
+    ladder = {
+        0: [(fell, 0.02, 10.0), (fell, 0.3, 10.5)],
+        1: [(fell, 0.02, 79.0), (fell, 0.3, 195.0), (fell, 0.3, 195.2)],
+        2: [(fell, 0.02, 79.0), (fell, 0.3, 195.0), (fell, 0.3, 102.0)],
+    }
+    outs = np.zeros((3, L.N_OUT))
+    for i, steps in ladder.items():
+        outs[i, [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN]] = steps[0]
+    levels_run = {i: [] for i in ladder}
+
+    def run(sub, idx, keep=True):
+        res = np.zeros((len(idx), L.N_OUT))
+        level = round(-np.log2(sub[0, L.PAR_DT]))
+        for j, i in enumerate(idx):
+            levels_run[int(i)].append(level)
+            res[j, [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN]] = ladder[int(i)][level]
+        return res
+
+    certify(rows, outs, run, 2)
+    assert levels_run == {0: [1], 1: [1, 2], 2: [1, 2]}
+    st = outs[:, L.OUT_STATUS].astype(int)
+    assert not st[0] & L.STATUS_UNCERTIFIED and not st[1] & L.STATUS_UNCERTIFIED
+    assert st[2] & L.STATUS_UNCERTIFIED
+
+
 SCENE = """
 name: one point
 body: {kind: block, alpha: 0.25}
