@@ -254,6 +254,26 @@ def test_a_knife_edge_is_refined_until_clear_or_flagged():
     assert (outs[:, L.OUT_OUTCOME] == L.OUTCOME_SAFE).all()
 
 
+def _run_ladder(rows: np.ndarray, ladder: dict, levels: int) -> tuple[np.ndarray, dict]:
+    """certify on a stand-in kernel: ladder[i][level] is point i's (outcome, margin,
+    overturning time) at that refinement level (level 0: its own run). Returns the
+    certified result rows and the levels each point was run at."""
+    outs = np.zeros((len(ladder), L.N_OUT))
+    for i, steps in ladder.items():
+        outs[i, [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN]] = steps[0]
+    levels_run = {i: [] for i in ladder}
+
+    def run(sub, idx, keep=True):
+        res = np.zeros((len(idx), L.N_OUT))
+        level = round(-np.log2(sub[0, L.PAR_DT]))
+        for j, i in enumerate(idx):
+            levels_run[int(i)].append(level)
+            res[j, [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN]] = ladder[int(i)][level]
+        return res
+
+    return certify(rows, outs, run, levels), levels_run
+
+
 def test_a_repeated_overturn_whose_margin_converged_stops_there():
     """certify's rule on a stand-in kernel: a repeated overturn still inside the overturn
     band at its own step is certified where its margins converged between the two runs
@@ -282,20 +302,7 @@ def test_a_repeated_overturn_whose_margin_converged_stops_there():
         # it would spare no run, and the verdict stays as before: uncertified
         5: [(fell, 0.05, 10.0), (fell, 0.005, 10.0), (fell, 3e-4, 10.0), (fell, 3e-4, 10.0)],
     }
-    outs = np.zeros((6, L.N_OUT))
-    for i, steps in ladder.items():
-        outs[i, [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN]] = steps[0]
-    levels_run = {i: [] for i in ladder}
-
-    def run(sub, idx, keep=True):
-        res = np.zeros((len(idx), L.N_OUT))
-        level = round(-np.log2(sub[0, L.PAR_DT]))
-        for j, i in enumerate(idx):
-            levels_run[int(i)].append(level)
-            res[j, [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN]] = ladder[int(i)][level]
-        return res
-
-    certify(rows, outs, run, 3)
+    outs, levels_run = _run_ladder(rows, ladder, 3)
     assert levels_run == {0: [1], 1: [1, 2], 2: [1, 2], 3: [1, 2], 4: [1, 2], 5: [1, 2, 3]}
     st = outs[:, L.OUT_STATUS].astype(int)
     assert (st & L.STATUS_REFINED).all() and not (st[:5] & L.STATUS_UNCERTIFIED).any()
@@ -318,20 +325,7 @@ def test_a_repeated_overturn_on_another_approach_is_not_trusted():
         1: [(fell, 0.02, 79.0), (fell, 0.3, 195.0), (fell, 0.3, 195.2)],
         2: [(fell, 0.02, 79.0), (fell, 0.3, 195.0), (fell, 0.3, 102.0)],
     }
-    outs = np.zeros((3, L.N_OUT))
-    for i, steps in ladder.items():
-        outs[i, [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN]] = steps[0]
-    levels_run = {i: [] for i in ladder}
-
-    def run(sub, idx, keep=True):
-        res = np.zeros((len(idx), L.N_OUT))
-        level = round(-np.log2(sub[0, L.PAR_DT]))
-        for j, i in enumerate(idx):
-            levels_run[int(i)].append(level)
-            res[j, [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN]] = ladder[int(i)][level]
-        return res
-
-    certify(rows, outs, run, 2)
+    outs, levels_run = _run_ladder(rows, ladder, 2)
     assert levels_run == {0: [1], 1: [1, 2], 2: [1, 2]}
     st = outs[:, L.OUT_STATUS].astype(int)
     assert not st[0] & L.STATUS_UNCERTIFIED and not st[1] & L.STATUS_UNCERTIFIED
