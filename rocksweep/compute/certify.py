@@ -85,6 +85,13 @@ def close_calls(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     return outs[:, L.OUT_MARGIN] < bound
 
 
+def same_fall(coarse: np.ndarray, fine: np.ndarray) -> np.ndarray:
+    """bool[n]: two runs of the same points (result rows float64[n, N_OUT]) that fell
+    within ``numerics.SAME_FALL`` [p t] of each other, on the same approach (False where
+    either did not fall: NaN)."""
+    return np.abs(fine[:, L.OUT_T_OVERTURN] - coarse[:, L.OUT_T_OVERTURN]) <= SAME_FALL
+
+
 def converged(coarse_rows: np.ndarray, coarse: np.ndarray, fine_rows: np.ndarray,
               fine: np.ndarray) -> np.ndarray:
     """bool[n]: overturns whose margin has converged between two runs of the same points
@@ -96,10 +103,8 @@ def converged(coarse_rows: np.ndarray, coarse: np.ndarray, fine_rows: np.ndarray
     (2^ENERGY_ORDER - 1): the class does not hang on the step."""
     m_c, m_f = coarse[:, L.OUT_MARGIN], fine[:, L.OUT_MARGIN]
     err = np.abs(m_f * m_f - m_c * m_c) / (2.0 ** ENERGY_ORDER - 1.0)
-    same_fall = (np.abs(fine[:, L.OUT_T_OVERTURN] - coarse[:, L.OUT_T_OVERTURN])
-                 <= SAME_FALL)
     with np.errstate(invalid="ignore"):  # inf - inf: a margin never taken
-        return (_fell(coarse) & _fell(fine) & same_fall
+        return (_fell(coarse) & _fell(fine) & same_fall(coarse, fine)
                 & (m_f >= fine_rows[:, L.PAR_CLOSE] / CLOSE_BAND)
                 & (m_f * m_f >= RICHARDSON_SAFETY * err))
 
@@ -194,8 +199,7 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
         # SAME_FALL): two falls far apart are two trajectories that parted, whatever their
         # margins (wide-space.yaml's undamped bodies at lam 1 fell at 79, 195 and 102 p t
         # at levels 0-2 and the reference rocks to rest)
-        apart = _fell(new) & ~(np.abs(new[:, L.OUT_T_OVERTURN] - before[:, L.OUT_T_OVERTURN])
-                               <= SAME_FALL)
+        apart = _fell(new) & ~same_fall(before, new)
         stable = (new[:, L.OUT_OUTCOME] == before[:, L.OUT_OUTCOME]) & trusted & ~apart
         status = new[:, L.OUT_STATUS].astype(np.int64) | L.STATUS_REFINED
         new[:, L.OUT_STATUS] = status

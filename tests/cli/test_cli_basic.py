@@ -179,9 +179,9 @@ def test_kernel_import_pulls_no_io_libraries():
     assert proc.returncode == 0 and proc.stdout.strip() == ""
 
 
-def test_a_quiet_one_point_sweep_pays_for_no_pool_bar_or_metadata(tmp_path):
+def test_a_quiet_one_point_sweep_pays_for_no_pool_or_bar(tmp_path):
     """Demand 3 at start-up: a quiet sweep of one chunk runs it in this thread (no joblib
-    pool: ~60 ms) and shows no bar (no tqdm: ~15 ms); the file records the version
+    pool: ~60 ms) and shows no bar (no tqdm: ~10 ms); the file records the version
     (``rocksweep._version``, not a search of the installed distributions)."""
     out = tmp_path / "one.h5"
     code = ("import sys\nfrom rocksweep.cli import main\ntry:\n"
