@@ -399,19 +399,23 @@ def test_the_last_levels_rules_on_their_cells_equal_them_on_every_cell():
 
 def test_the_points_of_marked_cells_are_those_of_their_closed_lattice():
     """``_points_of_cells`` (the stride-s/2 points inside the marked stride-s cells, edges
-    and corners included) against marking each cell's 3 x 3 points on the whole lattice."""
+    and corners included; with ``known``, those not computed) against each marked cell's
+    3 x 3 points listed one by one, a shorter last cell's clipped to the axis's end."""
     rng = np.random.default_rng(2)
     for _ in range(300):
         n_p, ny, nx = (int(v) for v in rng.integers((1, 2, 2), (4, 40, 40)))
-        plan = ad.Plan((n_p, ny, nx), 2, 1)
+        plan = (ad.Plan((n_p, ny, nx), 2, 1) if rng.random() < 0.5
+                else ad.Plan((ny, n_p, nx), 2, 0))
         s = int(2 ** rng.integers(1, 5))
+        h = s // 2
         cy, cx = ad._ncells(ny, s), ad._ncells(nx, s)
         cells = rng.random((n_p, cy, cx)) < rng.uniform(0, 0.5)
-        lat = np.zeros((n_p, 2 * cy + 1, 2 * cx + 1), bool)
-        for dy in range(3):
-            for dx in range(3):
-                lat[:, dy:dy + 2 * cy:2, dx:dx + 2 * cx:2] |= cells
-        p, jj, ii = np.nonzero(lat)
-        want = np.unique(plan.flat_index()[p, np.minimum(jj * (s // 2), ny - 1),
-                                           np.minimum(ii * (s // 2), nx - 1)])
+        known = rng.integers(-1, 2, size=(n_p, ny, nx)).astype(np.int8)
+        idx = plan.flat_index()
+        pts = {(p, min((2 * j + dy) * h, ny - 1), min((2 * i + dx) * h, nx - 1))
+               for p, j, i in zip(*np.nonzero(cells), strict=True)
+               for dy in range(3) for dx in range(3)}
+        want = sorted(int(idx[q]) for q in pts)
         np.testing.assert_array_equal(ad._points_of_cells(plan, cells, s), want)
+        todo = sorted(int(idx[q]) for q in pts if known[q] < 0)
+        np.testing.assert_array_equal(ad._points_of_cells(plan, cells, s, known), todo)
