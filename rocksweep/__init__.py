@@ -79,13 +79,13 @@ def __getattr__(name: str) -> object:
     source the command line's start-up need not compile), the modules ``import rocksweep``
     used to load (``rocksweep.api``, ...)."""
     if name == "Simulation":
-        from rocksweep import simulation
+        from rocksweep import simulation  # lazy: on first use (the docstring)
 
         value = simulation.Simulation
     elif name in ("api", "simulation", "analysis"):  # bound by import rocksweep before
         value = importlib.import_module(f"rocksweep.{name}")
     elif name in _API:
-        from rocksweep import api
+        from rocksweep import api  # lazy: on first use (the docstring)
 
         value = getattr(api, name)
     else:

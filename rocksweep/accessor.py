@@ -25,6 +25,8 @@ import sys
 from collections.abc import Callable
 from typing import Any
 
+from rocksweep.vocab.outcomes import OUTCOME_WORDS
+
 
 def _method(fn: Callable[..., Any]) -> Callable[..., Any]:
     """``fn`` as a method of the accessor: ``fn(ds, *required, **keywords)``."""
@@ -64,8 +66,6 @@ class _Accessor:
         """``outcome`` as words (not_run, safe, mode1, mode2), an object DataArray."""
         # numpy: import rocksweep loads none
         import numpy as np
-
-        from rocksweep.vocab.outcomes import OUTCOME_WORDS
 
         o = self._ds["outcome"]
         return o.copy(data=np.vectorize(OUTCOME_WORDS.get, otypes=[object])(o.values))

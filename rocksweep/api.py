@@ -111,7 +111,7 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
     while a sweep is still writing the file (no lock is taken). A file that is not a
     rocksweep file is a one-line ``RocksweepError``.
     """
-    from rocksweep.analysis.files import open_any
+    from rocksweep.analysis.files import open_any  # lazy: h5py, yaml (+0.2 s)
 
     check_type("path", path, isinstance(path, str | os.PathLike),
                "a path (str or pathlib.Path)")
@@ -120,14 +120,14 @@ def open(path: str | Path) -> xr.Dataset:  # noqa: A001 (rocksweep.open, like xa
 
 def _dataset_arg(ds: Any, what: str) -> xr.Dataset:
     """A Dataset, or a path to one opened (``analysis.files.as_dataset``)."""
-    from rocksweep.analysis.files import as_dataset
+    from rocksweep.analysis.files import as_dataset  # lazy: h5py, yaml (+0.2 s)
 
     _check_dataset(what, ds)
     return as_dataset(ds, what)
 
 
 def _check_dataset(name: str, ds: Any) -> None:
-    import xarray as xr
+    import xarray as xr  # lazy: xarray, pandas (+0.4 s)
 
     check_type(name, ds, isinstance(ds, xr.Dataset | str | Path),
                "an xarray Dataset (rocksweep.run, rocksweep.open or an analysis) or a path "
@@ -163,7 +163,7 @@ def plot(ds: xr.Dataset, x: str | None = None, y: str | None = None, *, ax: Any 
     of the classes, e.g. x = "body.mu", y = "A_ratio" (Shenton's diagram;
     ``rocksweep.figures.regimes``).
     """
-    from rocksweep.figures.by_kind import plot_any
+    from rocksweep.figures.by_kind import plot_any  # lazy: numba, matplotlib (+0.9 s)
 
     _check_dataset("ds", ds)
     return plot_any(ds, x, y, ax=ax, curves=curves, show_computed=show_computed, mu=mu,
@@ -188,7 +188,7 @@ def boundaries(ds: xr.Dataset, rtol: float = DEFAULT_RTOL, mode: int | None = No
     ``runs``, over every other swept key (e.g. shape, lam) and x. The class boundary
     polylines: ``boundary_lines(ds)``.
     """
-    from rocksweep.analysis.boundaries import boundaries_dataset
+    from rocksweep.analysis.boundaries import boundaries_dataset  # lazy: numba, scipy (+0.3 s)
 
     _check_dataset("ds", ds)
     return boundaries_dataset(ds, rtol, mode, search)
@@ -199,7 +199,7 @@ def boundary_lines(ds: xr.Dataset) -> Any:
     """The lines between classes of a complete result's diagrams as a tidy
     ``pandas.DataFrame``: one row per vertex with the panel's other swept keys, ``line``,
     ``classes`` (e.g. "safe|mode1"), ``closed``, ``vertex``, ``x``, ``y`` (axis values)."""
-    from rocksweep.analysis.boundaries import boundary_lines_frame
+    from rocksweep.analysis.boundaries import boundary_lines_frame  # lazy: numba, scipy (+0.3 s)
 
     _check_dataset("ds", ds)
     return boundary_lines_frame(ds)
@@ -211,6 +211,7 @@ def spectra(ds: xr.Dataset, rtol: float = DEFAULT_RTOL, search: bool = True) -> 
     A_ratio and optionally lam: ``theta_max_over_alpha`` and ``outcome`` over (lam,
     A_ratio, p), ``A_min`` and ``mode`` over (lam, p), A_min to ``rtol`` whatever the grid
     (search=False: the grid's bracket bisected only, as for ``boundaries``)."""
+    # lazy: numba, scipy (+0.7 s)
     from rocksweep.analysis.spectrum import spectra as compute_spectra
 
     _check_dataset("ds", ds)
@@ -227,7 +228,7 @@ def floor_spectrum(ds: xr.Dataset, rtol: float = DEFAULT_RTOL_MANY, search: bool
     only, as for ``spectra``) (``rocksweep.analysis.floors``). ds: what ``run`` or ``open``
     returns, or a result file's path. Its figure: ``rocksweep.plot``; its table:
     ``rocksweep.table``."""
-    from rocksweep.analysis.floors import floor_spectrum as compute
+    from rocksweep.analysis.floors import floor_spectrum as compute  # lazy: xarray, pandas (+0.4 s)
 
     _check_dataset("ds", ds)
     return compute(ds, rtol, search)
@@ -246,6 +247,7 @@ def ida(ds: xr.Dataset, rtol: float = DEFAULT_RTOL_MANY, *, state: str = "overtu
     over the other swept keys and ``record`` (``rocksweep.analysis.ida.ida``) with the
     IDA curves ``rocksweep.plot`` draws. A sweep over ``angle``: every (record, angle) a
     sample, and ``ida_im_worst`` / ``worst_angle`` each record's worst orientation."""
+    # lazy: numba, scipy (+0.7 s)
     from rocksweep.analysis.floors import worst_ida
     from rocksweep.analysis.ida import ida_dataset
 
@@ -285,6 +287,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     over ``angle`` gives an ``orientation`` dimension: "each" (every (record, angle) a
     sample, records resampled with all their angles) and "worst" (the worst angle per record).
     """
+    # lazy: scipy, xarray (+0.5 s)
     from rocksweep.analysis.floors import by_orientation
     from rocksweep.analysis.fragility import fragility as fit
 
@@ -308,6 +311,7 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = N
     ``probability`` per state and lam, their ``_lo``/``_hi`` from the fragility's
     bootstrap resamples, ``annual_rate_max`` (the tail above the hazard at its largest),
     ``reason``; beyond the hazard's range the rate is bounded, never extrapolated."""
+    # lazy: xarray, pandas (+0.4 s)
     from rocksweep.analysis.risk import check_fragility
     from rocksweep.analysis.risk import risk as compute
 
@@ -327,6 +331,7 @@ def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
     dispersion ``beta`` of the fragility in that IM and ``beta_scale`` (comparable across
     IMs; lower is better), per value of the other swept keys
     (``rocksweep.analysis.efficiency``)."""
+    # lazy: scipy, xarray (+0.8 s)
     from rocksweep.analysis.efficiency import im_efficiency as compute
 
     return compute(_dataset_arg(ds, "ds"), state=state)
@@ -340,7 +345,7 @@ def table(ds: xr.Dataset) -> Any:
     scale_factor^n: ``pga``, ``pgv``, ``arias``, ...); one row per curve of an analysis.
     No row is repeated (``ds.to_dataframe()`` repeats a suite's runs per Sa period).
     ``.attrs["units"]`` gives each column's units (``rocksweep.analysis.table``)."""
-    from rocksweep.analysis.table import table as make
+    from rocksweep.analysis.table import table as make  # lazy: xarray, pandas (+0.4 s)
 
     return make(_dataset_arg(ds, "ds"))
 
@@ -350,6 +355,7 @@ def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> A
     it: points, RK4 steps and evaluations expected, seconds with ``jobs`` workers, any
     kernel variant to compile first (measured on 256 points, ~10 ms; uncompiled: the step
     bound). Returns ``rocksweep.compute.sweep.Estimate`` (``str()``: one line)."""
+    # lazy: yaml (+0.1 s)
     from rocksweep.compute.sweep import estimate as sweep_estimate
     from rocksweep.scene.inputs import load
 
@@ -371,6 +377,7 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     one ``Simulation`` per combination, in grid order (at most
     ``rocksweep.compute.history.API_MAX_RUNS``, 100; sweeps are for ``run``).
     """
+    # lazy: numba, scipy (+0.3 s)
     from rocksweep.compute.history import API_MAX_RUNS, titled_runs
     from rocksweep.scene.inputs import load, override_strings
 
@@ -390,6 +397,7 @@ def felt_motion(scene: SceneLike, overrides: Overrides = (), /, **keys: Any) -> 
     ``t`` [s] (``rocksweep.compute.motion``). scene and overrides as for ``simulate`` (one
     point). The kernel runs exactly these samples, linear between them
     (``rocksweep.physics.records.write_at2`` keeps one as a record)."""
+    # lazy: yaml (+94 ms)
     from rocksweep.compute.motion import felt_motion as felt
     from rocksweep.scene.inputs import load, override_strings
 
@@ -418,7 +426,7 @@ def calibrate(scene: SceneLike, measured: Any, fit: str | Sequence[str] = ("impa
     progress: say on stderr when the fit's kernel variant must be compiled first (once per
     machine) and what that costs.
     """
-    from rocksweep.analysis.calibrate import calibrate_scene
+    from rocksweep.analysis.calibrate import calibrate_scene  # lazy: pandas, pyarrow (+0.3 s)
 
     check_flag("progress", progress)
     say = (lambda m: print(m, file=sys.stderr, flush=True)) if progress else None
@@ -430,8 +438,9 @@ def calibrated_overrides(fit: xr.Dataset, which: str = "all") -> dict[str, Any]:
     at the estimate and at both ends of the interval: ``which="all"`` gives [lo, estimate,
     hi] per key (a swept dimension), "estimate", "lo" or "hi" one value.
     ``rocksweep.run(scene, overrides=rocksweep.calibrated_overrides(fit))``."""
-    import xarray as xr
+    import xarray as xr  # lazy: xarray, pandas (+0.4 s)
 
+    # lazy: pandas, pyarrow (+0.3 s)
     from rocksweep.analysis.calibrate import calibrated_overrides as overrides_of
 
     check_type("fit", fit, isinstance(fit, xr.Dataset),

@@ -115,3 +115,61 @@ def test_the_store_scenes_and_computing_take_no_private_name_from_another_module
                               for a in node.names
                               if a.name.startswith("_") and not a.name.startswith("__")]
     assert not taken, "private names imported from another module:\n" + "\n".join(taken)
+
+
+def unexplained_lazy_imports(source: str) -> list[int]:
+    """Lines of the imports inside functions (outside ``if TYPE_CHECKING:``) that say
+    nothing of why they are there: no comment on the statement, nor on another of the run
+    of imports it belongs to (statements on consecutive lines), nor on the line above
+    that run."""
+    lines = source.splitlines()
+    out: list[int] = []
+
+    def commented(first: int, last: int) -> bool:  # 1-based, inclusive
+        return any("#" in lines[i] for i in range(first - 1, last))
+
+    def check(body: list[ast.stmt]) -> None:
+        run: list[ast.stmt] = []
+        for stmt in [*body, None]:
+            if (isinstance(stmt, ast.Import | ast.ImportFrom) and run
+                    and stmt.lineno == (run[-1].end_lineno or run[-1].lineno) + 1):
+                run.append(stmt)
+                continue
+            if run:
+                top = run[0].lineno
+                said = (commented(top, run[-1].end_lineno or run[-1].lineno)
+                        or (top >= 2 and lines[top - 2].strip().startswith("#")))
+                if not said:
+                    out.extend(s.lineno for s in run)
+            run = [stmt] if isinstance(stmt, ast.Import | ast.ImportFrom) else []
+
+    def visit(node: ast.AST, inside: bool) -> None:
+        for field in ("body", "orelse", "finalbody", "handlers"):
+            block = getattr(node, field, None)
+            if isinstance(block, list) and inside and field != "handlers":
+                check(block)
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.If) and "TYPE_CHECKING" in ast.unparse(child.test):
+                continue
+            visit(child, inside or isinstance(child, ast.FunctionDef | ast.AsyncFunctionDef))
+
+    visit(ast.parse(source), False)
+    return sorted(out)
+
+
+def test_every_import_inside_a_function_says_why():
+    """An import inside a function is there for a measured start-up cost (what it loads
+    that its module's importers need not: ``python scripts/lazy_imports.py``), a cycle,
+    or a guard, and its comment says which; every other import is at the top."""
+    found = [f"{path.relative_to(PKG.parent)}:{line}"
+             for path in sorted(PKG.rglob("*.py"))
+             for line in unexplained_lazy_imports(path.read_text())]
+    assert not found, "imports inside functions without a reason: " + ", ".join(found)
+
+
+def test_the_reason_checker_sees_a_silent_import():
+    src = ("import os\n\n\ndef f():\n    import json\n\n    return json\n\n\n"
+           "def g():\n    import xarray as xr  # lazy: xarray (+0.3 s)\n    return xr\n\n\n"
+           "def h():\n    # lazy: h5py (+0.1 s)\n    import h5py\n    from numpy import (\n"
+           "        array,\n    )\n    import yaml\n\n    import scipy\n    return h5py\n")
+    assert unexplained_lazy_imports(src) == [5, 23]

@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from rocksweep import fields
 from rocksweep.analysis.bisection import bisect_thresholds
 from rocksweep.analysis.tolerance import DEFAULT_RTOL
 from rocksweep.compute.adaptive import make_plan
@@ -36,6 +37,7 @@ from rocksweep.compute.dispatch import run_variant
 from rocksweep.errors import (
     MAX_RTOL,
     AdaptiveError,
+    ApiError,
     BoundaryError,
     check_rtol,
 )
@@ -596,7 +598,7 @@ def check_result(result: SweepResult, axes: Sequence[str] | None = None) -> Scen
     """The scene of a complete result with the diagram axes ``axes`` (x, y; None: the
     scene's, ``default_axes``); one-line BoundaryErrors for a result that has no such
     diagram or is not finished."""
-    from rocksweep.store.reader import result_scene
+    from rocksweep.store.reader import result_scene  # lazy: h5py (+26 ms)
 
     sc = result_scene(result)
     axes = default_axes(sc) if axes is None else axes
@@ -657,9 +659,7 @@ def curves_dataset(curves: Sequence[AMinCurve], attrs: dict[str, Any] | None = N
     ``lo``/``hi`` (the final bracket), ``runs`` (kernel runs of the search and the
     bisection), each over every other swept axis (e.g. shape, lam) and the diagram's x
     axis (w_over_p or p); values in the axes' units (A_min in A_ratio)."""
-    import xarray as xr
-
-    from rocksweep import fields
+    import xarray as xr  # lazy: xarray, pandas (+0.3 s)
 
     if not curves:
         return xr.Dataset(attrs=dict(attrs or {}))
@@ -697,7 +697,7 @@ def lines_frame(bounds: Sequence[PanelBoundaries]):
     """The boundary polylines as a tidy ``pandas.DataFrame``: one row per vertex, columns:
     every other swept axis of the panel, ``line`` (its number in the panel), ``classes``
     (e.g. "safe|mode1"), ``vertex``, and the diagram axes' values (``x``, ``y``)."""
-    import pandas as pd
+    import pandas as pd  # lazy: pandas, pyarrow (+0.2 s)
 
     rows = [{**b.where, "line": i, "classes": line.label, "closed": line.closed
              if hasattr(line, "closed") else bool(np.allclose(line.xy[0], line.xy[-1])),
@@ -710,7 +710,7 @@ def lines_frame(bounds: Sequence[PanelBoundaries]):
 def boundary_lines_frame(ds: Any):
     """``rocksweep.boundary_lines``: the class boundary polylines of a complete result's
     diagrams (``diagram_boundaries``) as ``lines_frame``'s DataFrame."""
-    from rocksweep.store.reader import as_result
+    from rocksweep.store.reader import as_result  # lazy: h5py (+26 ms)
 
     result = as_result(ds, ["outcome"])
     return lines_frame(diagram_boundaries(check_result(result), result.arrays["outcome"]))
@@ -719,8 +719,6 @@ def boundary_lines_frame(ds: Any):
 def check_search(search: Any) -> bool:
     """The ``search`` argument of ``a_min``'s callers: True or False (numpy's too), else an
     ApiError."""
-    from rocksweep.errors import ApiError
-
     if not isinstance(search, bool | np.bool_):
         raise ApiError(f"search = {search!r}: must be True or False")
     return bool(search)
@@ -732,8 +730,7 @@ def boundaries_dataset(ds: Any, rtol: float = DEFAULT_RTOL, mode: int | None = N
     complete result (``result_curves``) as a Dataset (``curves_dataset``). rtol, mode
     (None, 1 or 2) and search (a bool) are checked before the result is read: one-line
     ApiErrors."""
-    from rocksweep.errors import ApiError
-    from rocksweep.store.reader import as_result
+    from rocksweep.store.reader import as_result  # lazy: h5py (+26 ms)
 
     rtol = check_rtol(rtol)
     if mode not in (None, 1, 2):

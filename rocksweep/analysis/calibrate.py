@@ -34,7 +34,9 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from collections.abc import Callable, Mapping, Sequence
+from statistics import NormalDist
 from typing import Any
 
 import numpy as np
@@ -79,9 +81,7 @@ def calibrate_problem(problem: Problem, ci: float = 0.95,
     """Fit a ``Problem``: the Dataset of ``rocksweep.calibrate`` (see ``calibrate``).
     say: told when the runs' kernel variant compiles first, and what it costs
     (``compile_cost.prepare_point``)."""
-    from statistics import NormalDist
-
-    import xarray as xr
+    import xarray as xr  # lazy: xarray (+90 ms)
 
     t0 = time.perf_counter()
     k = len(problem.keys)
@@ -157,8 +157,6 @@ def calibrate_problem(problem: Problem, ci: float = 0.95,
         "noise_given": int(problem.noise_given),
     }
     if reason != "ok":
-        import warnings
-
         warnings.warn(CalibrationWarning(
             f"calibration of {', '.join(problem.keys)}: " + "; ".join(
                 f"{w} ({why[w]})" for w in reason.split(","))), stacklevel=2)
@@ -228,7 +226,7 @@ def calibrate_scene(scene: Any, measured: Any, fit: str | Sequence[str],
     ``overrides``), the measured history read (``physics.measured.read_measured``, in the
     scene's body's alpha_ref and u_cr; p [rad/s] given, else the scene's ``_body_p``) and
     the keys fitted (``calibrate_problem``)."""
-    from rocksweep.scene.inputs import load
+    from rocksweep.scene.inputs import load  # lazy: yaml (+25 ms)
 
     check_type("fit", fit, isinstance(fit, str) or (
         isinstance(fit, Sequence) and all(isinstance(k, str) for k in fit)),

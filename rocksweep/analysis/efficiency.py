@@ -40,16 +40,17 @@ Verdicts (``reason`` per IM and curve: "ok", or the words joined by ","; also an
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Any
 
 import numpy as np
 import xarray as xr
-from scipy.optimize import minimize
+from scipy.optimize import linprog, minimize
 from scipy.special import log_ndtr
 
 from rocksweep.analysis.fragility import fit_cloud
 from rocksweep.analysis.states import counted_points, state_reached, trust
-from rocksweep.errors import EfficiencyError
+from rocksweep.errors import AnalysisWarning, EfficiencyError
 from rocksweep.physics.bodies import G
 from rocksweep.vocab.axes import ALPHA_KEYS
 from rocksweep.vocab.ground import PGA_RATIO, PGV_OVER_PGA, PGV_RATIO, RECORD_IMS, SA, SCALE_IMS
@@ -135,8 +136,6 @@ def _separated(lo: np.ndarray, hi: np.ndarray, z: np.ndarray | None) -> bool:
     interval likelihood then grows as the dispersion -> 0 (no finite MLE). A linear
     programme: the largest margin t <= 1 with lo + t <= a + b z <= hi - t; separated iff
     t > 0."""
-    from scipy.optimize import linprog
-
     if np.any(lo >= hi):
         return False
     X = np.ones((lo.size, 1)) if z is None else np.column_stack([np.ones(lo.size), z])
@@ -257,10 +256,6 @@ def _reasons(why: np.ndarray, n_rec: np.ndarray, counted: np.ndarray) -> np.ndar
 
 def _warn(state: str, names: list[str], reason: np.ndarray) -> None:
     """One ``AnalysisWarning`` naming the IMs each verdict word holds for."""
-    import warnings
-
-    from rocksweep.errors import AnalysisWarning
-
     by: dict[str, list[str]] = {}
     for i, name in enumerate(names):
         for w in dict.fromkeys(x for r in reason[i] for x in str(r).split(",")):

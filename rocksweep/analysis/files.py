@@ -32,6 +32,7 @@ from pathlib import Path
 from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any
 
+import h5py
 import numpy as np
 
 from rocksweep import fields
@@ -148,9 +149,7 @@ def write_curves_h5(path: str | Path, curves: Sequence[AMinCurve],
     The rows of ``a_min_rows`` / ``boundary_rows`` (what the CSV files hold) are these
     arrays' entries: A_min rows where A_min is not NaN, line rows one per vertex.
     """
-    # h5py (0.1 s) and analysis.boundaries (numba, 0.6 s): this file's writer only
-    import h5py
-
+    # analysis.boundaries (numba, 0.6 s): this file's writer only
     from rocksweep.analysis.boundaries import A_MIN_METHODS
 
     xname = curves[0].xname if curves else DIAGRAM_AXES[0]
@@ -225,9 +224,7 @@ def write_report(study: Study, path: str | Path, command: str = "", *,
 
 
 def _write_study(study: Study, path: Path, command: str) -> None:
-    # h5py (0.1 s), the accuracy study (numba, 0.6 s): its report's writer only
-    import h5py
-
+    # the accuracy study (numba, 0.6 s): its report's writer only
     from rocksweep.analysis.accuracy import OUTCOMES, reference_words
 
     with h5py.File(path, "w") as f:
@@ -309,9 +306,6 @@ def file_kind(path: str | Path) -> str | None:
     if input_problem(path) is not None:
         return None
     try:
-        # h5py (0.1 s): a file read only
-        import h5py
-
         with h5py.File(path, "r") as f:
             attrs = {KIND_ATTR: f.attrs[KIND_ATTR]} if KIND_ATTR in f.attrs else {}
             if isinstance(attrs.get(KIND_ATTR), bytes):
@@ -369,9 +363,7 @@ def _plain_attr(v: Any) -> Any:
 def _open_boundaries(path: Path) -> xr.Dataset:
     """The A_min curves of a ``write_curves_h5`` file as ``boundaries.curves_dataset``
     gives them (the boundary lines stay in the file's ``lines`` groups)."""
-    # h5py (0.1 s) and analysis.boundaries (numba, 0.6 s): this file's reader only
-    import h5py
-
+    # analysis.boundaries (numba, 0.6 s): this file's reader only
     from rocksweep.analysis.boundaries import AMinCurve, curves_dataset
 
     with h5py.File(path, "r") as f:
@@ -392,8 +384,7 @@ def _open_boundaries(path: Path) -> xr.Dataset:
 def _open_accuracy(path: Path) -> xr.Dataset:
     """An accuracy report's table (one entry per setting) and its attributes (the sample,
     the reference and the kernel's runs stay in the file's groups)."""
-    # h5py and xarray: this file's reader only
-    import h5py
+    # xarray: this file's reader only
     import xarray as xr
 
     with h5py.File(path, "r") as f:

@@ -67,7 +67,7 @@ def minimise(problem: Problem, free: list[int], fixed: dict[int, float],
     simplex = np.vstack([z0, *(z0 + np.diag(0.1 * span)[k] * (1 if z0[k] + 0.1 * span[k]
                                                                 <= b[k, 1] else -1)
                                for k in range(len(free)))])
-    from scipy.optimize import minimize
+    from scipy.optimize import minimize  # lazy: scipy (+0.3 s)
 
     r = minimize(lambda z: problem.misfit(full(z)), z0, method="Nelder-Mead",
                  options={"initial_simplex": simplex, "xatol": 1e-5 * span.min(),
@@ -111,7 +111,7 @@ def fit(problem: Problem) -> tuple[np.ndarray, float]:
         else:
             simplex = np.vstack([x, *(np.clip(x + np.diag(step)[i], b[:, 0], b[:, 1])
                                       for i in range(k))])
-            from scipy.optimize import minimize
+            from scipy.optimize import minimize  # lazy: scipy (+0.3 s)
 
             r = minimize(problem.misfit, x, method="Nelder-Mead",
                          options={"initial_simplex": simplex, "xatol": 1e-5 * span.min(),
@@ -248,7 +248,7 @@ def minimise_local(problem: Problem, free: list[int], fixed: dict[int, float],
         y = x.copy()
         y[free] = z
         return problem.misfit(y)
-    from scipy.optimize import minimize
+    from scipy.optimize import minimize  # lazy: scipy (+0.3 s)
 
     r = minimize(g, x[free], method="Nelder-Mead",
                  options={"xatol": 1e-4 * span.min(), "fatol": 1e-12, "maxfev": 200})

@@ -491,7 +491,7 @@ def _parallel(f: _Fits, o: int, idxs: list[int], lnx: np.ndarray, m: np.ndarray,
     """The likelihood-ratio test of an ordinal fit's common beta (``likelihood.
     parallel_lr``) for curve o, on the states it fitted (finite im_median and beta), and
     the "parallel_rejected" verdict."""
-    from scipy.stats import chi2
+    from scipy.stats import chi2  # lazy: scipy (+0.7 s)
 
     if f.parallel is None:
         f.parallel = (np.full(f.n_undef.shape[1], np.nan),
@@ -685,7 +685,7 @@ def _dataset(ds: xr.Dataset, state: Any, states: list[str], axis: IMAxis, c: Cou
         attrs["avgsa_periods"] = np.asarray(ds["record_avgsa"].attrs.get(
             "avgsa_periods", [math.nan, math.nan]), np.float64)
     if f.parallel is not None:
-        from scipy.stats import chi2
+        from scipy.stats import chi2  # lazy: scipy (+0.7 s)
 
         stat, dof = f.parallel
         with np.errstate(invalid="ignore"):

@@ -56,6 +56,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from rocksweep.analysis.kinds import dataset_kind
 from rocksweep.errors import Arg, RiskError
 from rocksweep.inputs import check_columns, csv_table, number, number_column, read_text
 from rocksweep.outputs import shown
@@ -316,8 +317,6 @@ def check_fragility(ds: Any, src: str, suites: bool = False) -> None:
     """Refuse (one line naming ``src``, the file or argument) a Dataset that is no
     fragility: another analysis's, or a sweep (with ``suites``, a record-suite sweep is
     let through: the command line fits it first)."""
-    from rocksweep.analysis.kinds import dataset_kind
-
     kind = dataset_kind(ds)
     if kind == "fragility":
         return
@@ -363,7 +362,7 @@ def _density(hz: Hazard, x: np.ndarray) -> np.ndarray:
 
 def _fragility_p(x: np.ndarray, median: np.ndarray, beta: np.ndarray) -> np.ndarray:
     """Phi(ln(x / median) / beta) over (curves..., x); beta = 0: the step at the median."""
-    from scipy.special import ndtr
+    from scipy.special import ndtr  # lazy: scipy (+0.1 s)
 
     med = median[..., None]
     b = beta[..., None]
@@ -408,7 +407,7 @@ def _curve_p(fr: xr.Dataset, med: xr.DataArray, beta: xr.DataArray, dims: list[s
     extra = [d for d in med.dims if d not in dims]
     order = [*dims, *extra]
     if "fit" in fr.data_vars and "state" in fr.coords:
-        from rocksweep.analysis.fragility import probability
+        from rocksweep.analysis.fragility import probability  # lazy: scipy, yaml (+0.2 s)
 
         like = xr.Dataset({"im_median": med, "beta": beta, "fit": fr["fit"]},
                           coords={"state": fr["state"]})
@@ -473,7 +472,7 @@ def _narrow(hz: Hazard, med: np.ndarray, beta: np.ndarray
     the curves whose transition median exp(+-Z_TAIL beta) lies inside the hazard's range
     and holds at most ``MAX_INNER`` hazard levels: the steep curves, the shared
     quadrature's worst case. Returns (use, rate) or None when no curve qualifies."""
-    from scipy.special import ndtr
+    from scipy.special import ndtr  # lazy: scipy (+0.1 s)
 
     med = np.asarray(med, np.float64)
     beta = np.asarray(beta, np.float64)

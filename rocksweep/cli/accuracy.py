@@ -74,6 +74,7 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
     if plot_path is not None:
         check_output(plot_path, overwrite=overwrite, inputs=scene.inputs, suffixes=FORMATS)
 
+    # lazy, not on --help: numba, scipy (+0.6 s)
     from rocksweep.analysis.accuracy import accuracy_study, format_table, ladder
     from rocksweep.analysis.files import write_report
 
@@ -100,6 +101,7 @@ def accuracy(scene_path: Path, overrides: tuple[str, ...], report_path: Path | N
         write_report(study, report_path, command, overwrite=overwrite)
         click.echo(f"wrote {report_path}")
     if plot_path is not None:
+        # lazy, not on --help: numba, matplotlib (+0.9 s)
         from rocksweep.figures.accuracy import work_precision
         from rocksweep.figures.style import save_figure
 

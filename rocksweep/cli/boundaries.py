@@ -92,6 +92,7 @@ def boundaries(result_path: Path, csv_path: Path | None, lines_path: Path | None
         n = sum(len(b.lines) for b in bounds)
         click.echo(f"wrote {lines_path} ({n} boundary lines, {len(lrows)} vertices)")
     if fig_path is not None:
+        # lazy, not on --help: matplotlib, h5py (+0.5 s)
         from rocksweep.figures.a_min import a_min_figure
 
         fig = a_min_figure(curves, bounds, title=result.name, kind=result.kind)

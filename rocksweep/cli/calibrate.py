@@ -99,6 +99,7 @@ def calibrate(scene_path: Path, measured_path: Path, fit: tuple[str, ...],
         write_table(out_path, None, ds, CALIBRATION, overwrite)
         click.echo(f"wrote {out_path}")
     if plot_path is not None:
+        # lazy, not on --help: matplotlib (+0.4 s)
         from rocksweep.figures.calibration import calibration_figure
         from rocksweep.figures.style import save_figure
 

@@ -46,6 +46,7 @@ def efficiency(result_path: Path, state: str, out_path: Path | None, fig_path: P
     # run time, not --help: numpy, h5py, numba, matplotlib (0.1-2 s each), outputs (+7%)
     import numpy as np
 
+    # lazy, not on --help: matplotlib, h5py (+0.4 s)
     from rocksweep.figures.style import save_figure
     from rocksweep.store.reader import result_inputs
 

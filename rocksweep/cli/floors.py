@@ -7,7 +7,9 @@ from pathlib import Path
 
 import click
 
+import rocksweep
 from rocksweep.analysis.tolerance import DEFAULT_RTOL_MANY
+from rocksweep.cli.helpers import check_table_outputs, write_table
 from rocksweep.cli.main import main, user_errors
 from rocksweep.cli.options import (
     dpi_option,
@@ -17,6 +19,7 @@ from rocksweep.cli.options import (
     search_option,
 )
 from rocksweep.figures import FORMATS
+from rocksweep.vocab.kinds import FLOOR_SPECTRUM
 
 #: what ``-o`` writes the numbers as (the figure: ``figures.FORMATS``)
 TABLES = (".csv", ".h5", ".hdf5", ".nc")
@@ -39,11 +42,9 @@ def floor_spectrum(result_path: Path, outputs: tuple[Path, ...], rtol: float, se
     """Floor spectrum of a complete sweep over floor.period: P(overturn) per stripe of a
     record suite (each and worst orientation with an angle axis), or A_min of one record
     or a pulse, against the building's period."""
-    import rocksweep
-    from rocksweep.cli.helpers import check_table_outputs, write_table
+    # lazy, not on --help: matplotlib, h5py (+0.4 s)
     from rocksweep.figures.style import save_figure
     from rocksweep.store.reader import result_inputs
-    from rocksweep.vocab.kinds import FLOOR_SPECTRUM
 
     figs = [p for p in outputs if p.suffix.lower() in FORMATS]
     tables = [p for p in outputs if p.suffix.lower() not in FORMATS]

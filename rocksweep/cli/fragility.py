@@ -117,7 +117,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
     states = [s.strip() for s in state.split(",") if s.strip()]
     if not states:
         raise click.ClickException(f"--state {state!r}: give at least one state")
-    from rocksweep.store.reader import result_inputs
+    from rocksweep.store.reader import result_inputs  # lazy, not on --help: h5py, yaml (+0.1 s)
 
     inputs = result_inputs(result_path)  # the result and its records: never written over
     check_table_outputs(out_path, fig_path, CURVE_SUFFIXES, inputs, overwrite)
@@ -145,6 +145,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
                 refined[name]
     rows = curve_rows(frag)
     if as_json:
+        # lazy, not on --help: scipy, xarray (+0.6 s)
         from rocksweep.analysis.fragility import curves_json
 
         click.echo(json.dumps(curves_json(frag), allow_nan=False))
@@ -157,6 +158,7 @@ def fragility(result_path: Path, out_path: Path | None, fig_path: Path | None, s
         write_table(out_path, rows, frag, FRAGILITY, overwrite)
         say(f"wrote {out_path} ({len(rows)} curve{'s' * (len(rows) != 1)})")
     if fig_path is not None:
+        # lazy, not on --help: matplotlib, scipy (+0.8 s)
         from rocksweep.figures.fragility import fragility_figure
 
         fig = fragility_figure(frag, width=width)

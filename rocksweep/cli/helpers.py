@@ -10,6 +10,7 @@ from typing import Any
 
 import click
 
+from rocksweep.errors import RocksweepError
 from rocksweep.figures import FORMATS
 
 
@@ -57,8 +58,8 @@ def prepare_point_kernel(scene: Any) -> None:
     said on stderr when it compiles: how long it will take (``compile_cost``); ``simulate``
     and ``calibrate`` run it. A point the scene cannot make is left to the command's own
     refusal."""
+    # lazy, not on --help: numpy (+0.1 s)
     from rocksweep.compute.compile_cost import prepare_point
-    from rocksweep.errors import RocksweepError
     from rocksweep.physics.points import kernel_kind
 
     try:

@@ -75,6 +75,7 @@ def plot(result_path: Path, fig_path: Path | None, x_key: str | None, y_key: str
         raise click.ClickException(f"{chosen[0]} and {chosen[1]} draw different figures; "
                                    "give one")
     ds = rocksweep.open(result_path)  # a sweep, or an analysis's -o .h5 (its own figure)
+    # lazy, not on --help: analysis.kinds (+0.1 ms)
     from rocksweep.analysis.kinds import dataset_kind
 
     if dataset_kind(ds) != SWEEP:

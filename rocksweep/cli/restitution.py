@@ -82,6 +82,7 @@ def restitution_cmd(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
                  else _lam_text(float(lim.min())))
         click.echo(f"  over u/u_cr in [-2, 2]: {worst}")
     if plot_path is not None:
+        # lazy, not on --help: matplotlib (+0.4 s)
         from rocksweep.figures.restitution import restitution_map
         from rocksweep.figures.style import save_figure
 

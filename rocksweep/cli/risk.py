@@ -89,6 +89,7 @@ def risk(frag_path: Path, hazard_path: Path, years: float, site: int | None,
     # the fragility or sweep file (and a sweep's records), the hazard curve: never written
     inputs = [*result_inputs(frag_path), hazard_path]
     check_table_outputs(out_path, fig_path, RISK_SUFFIXES, inputs, overwrite)
+    # lazy, not on --help: xarray, pandas (+0.4 s)
     from rocksweep.analysis.risk import check_fragility
     from rocksweep.outputs import shown
 

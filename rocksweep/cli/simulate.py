@@ -9,6 +9,7 @@ from pathlib import Path
 
 import click
 
+from rocksweep.cli.helpers import prepare_point_kernel
 from rocksweep.cli.main import load, main, said, user_errors
 from rocksweep.cli.options import json_option, overwrite_option, scene_argument, set_option
 from rocksweep.errors import SceneError
@@ -43,7 +44,6 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
     lost in impacts and in the damper, and the accuracy setting with its cost.
     """
     # run time, not --help: numpy, h5py, numba, matplotlib (0.1-2 s each), outputs (+7%)
-    from rocksweep.cli.helpers import prepare_point_kernel
     from rocksweep.compute.history import run_points, write_history_csv
     from rocksweep.outputs import check_distinct, check_output
 
@@ -79,6 +79,7 @@ def simulate(scene_path: Path, overrides: tuple[str, ...], as_json: bool,
         if not as_json:
             click.echo(f"wrote {csv_path}")
     if plot_path is not None:
+        # lazy, not on --help: numba, matplotlib (+0.6 s)
         from rocksweep.figures.history import time_history
         from rocksweep.figures.style import save_figure
 

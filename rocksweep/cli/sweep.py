@@ -118,7 +118,7 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
                                    "adaptive sweeps; add --adaptive")
     options = adaptive_options(adaptive, base=scene.refine, **settings)
     if dry_run:
-        from rocksweep.compute.sweep import estimate
+        from rocksweep.compute.sweep import estimate  # lazy, not on --help: yaml (+0.1 s)
 
         est = estimate(scene, jobs=jobs if backend == "threads" else 1)
         click.echo(str(est) + (" (every point; an adaptive sweep computes a few % of them)"
@@ -142,6 +142,7 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
         sys.exit(130)
     if quiet:
         return
+    # lazy, not on --help: h5py, yaml (+0.1 s)
     from rocksweep.analysis.summary import (
         certification_share,
         check_info,
@@ -155,7 +156,7 @@ def sweep(scene_path: Path, overrides: tuple[str, ...], out_path: Path | None, j
     result = read_info(out) if scene.check else read_result(out, ["outcome", "status"])
     for line in counts_lines(result):
         click.echo(line)
-    from rocksweep.analysis.restitution import energy_note
+    from rocksweep.analysis.restitution import energy_note  # lazy, not on --help: numpy (+52 ms)
 
     note = energy_note(scene)
     if note:

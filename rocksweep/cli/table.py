@@ -45,7 +45,7 @@ def table_command(result_path: Path, out_path: Path, overwrite: bool) -> None:
     release_warnings()  # a partial file's words before what is written
     units = frame.attrs.get("units", {})
     if suffix == ".csv":
-        from rocksweep.analysis.files import csv_text
+        from rocksweep.analysis.files import csv_text  # lazy, not on --help: h5py, yaml (+0.1 s)
 
         # the units in the header: "name [unit]" (a dimensionless column, "1", or one
         # without units keeps its name)
@@ -53,6 +53,7 @@ def table_command(result_path: Path, out_path: Path, overwrite: bool) -> None:
                                               if units.get(c) not in (None, "", "1")}))
         write_atomic(out_path, lambda tmp: tmp.write_text(text), overwrite=overwrite)
     else:
+        # lazy, not on --help: pyarrow (+92 ms)
         import pyarrow as pa
         import pyarrow.parquet as pq
 

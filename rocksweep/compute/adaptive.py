@@ -16,7 +16,7 @@ swept axes with at least 2 values), for every value of the other axes (a *panel*
    at s = 4 the margin cells get only their centre computed (a probe: if it differs, the
    cell is mixed and refined whole); at s = 2 a mixed cell whose corners differ gets its
    centre and the midpoints of the edges a boundary crosses (ends differ, or a one-point
-   sliver through the centre runs on across the edge; see ``_edge_points``), and the
+   sliver through the centre runs on across the edge; see ``lattice.edge_points``), and the
    other edge midpoints are filled from their two agreeing ends. Measured on Figure 3(a)
    at 1000 x 1000 x 3 lam (``scripts/bench_adaptive.py --fine``): 3.77% of the points
    computed instead of 4.46%, 99.9990% of the outcomes equal to the full grid instead of
@@ -50,7 +50,6 @@ variable (``rocksweep.compute.sweep.VARIABLES``).
 from __future__ import annotations
 
 import functools
-import math
 import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
@@ -58,6 +57,16 @@ from typing import Any
 
 import numpy as np
 
+from rocksweep.compute import sweep as sw
+from rocksweep.compute.lattice import (
+    cell_stats,
+    centres,
+    dilate,
+    edge_fill,
+    edge_points,
+    lattice_points,
+    points_of_cells,
+)
 from rocksweep.errors import AdaptiveError, ApiError, Arg, flag
 from rocksweep.scene.grid import ChunkRows, Grid
 from rocksweep.scene.model import Scene
@@ -85,7 +94,6 @@ COMPUTED_MEANING = _out.COMPUTED_MEANING
 
 # The settings' defaults (MIN_COARSE_CELLS, DEFAULT_MARGIN, ...): rocksweep.vocab.settings
 
-_NO_CLASS = np.int8(127)  # above every class, for minima over computed points
 
 
 
@@ -283,262 +291,14 @@ def default_coarse(ny: int, nx: int) -> int:
     return k
 
 
-# --- lattices and cells ------------------------------------------------------------------
+# --- the coarse lattice, the known classes, the audit sample ----------------------------
 
 def plan_coarse(shape: Sequence[int], axes: tuple[int, int], level: int) -> np.ndarray:
     """Flat indices (int64, increasing) of the coarse lattice: every 2**level-th index of
     the axes at positions ``axes`` (x, y) of ``shape`` plus their last index, for every
     value of the other axes."""
     plan = Plan(tuple(shape), axes[0], axes[1], coarse=level, audit=0.0)
-    return np.sort(_lattice_points(plan, 2**level))
-
-
-def _axis_lattice(n: int, s: int) -> np.ndarray:
-    """Indices of the stride-s lattice of an axis of length n: 0, s, 2s, ... and n - 1."""
-    return np.unique(np.append(np.arange(0, n, s), n - 1))
-
-
-def _lattice_points(plan: Plan, s: int) -> np.ndarray:
-    _, ny, nx = plan.panel_shape
-    idx = plan.flat_index()
-    return idx[:, _axis_lattice(ny, s)][:, :, _axis_lattice(nx, s)].ravel()
-
-
-def _ncells(n: int, s: int) -> int:
-    return max(1, math.ceil((n - 1) / s))
-
-
-def _pad(a: np.ndarray, s: int) -> np.ndarray:
-    """Pad panels (P, ny, nx) by repeating the last row/column to (P, cy s + 1, cx s + 1):
-    the last, shorter cell then spans exactly up to index n - 1."""
-    _, ny, nx = a.shape
-    py, px = _ncells(ny, s) * s + 1 - ny, _ncells(nx, s) * s + 1 - nx
-    return np.pad(a, ((0, 0), (0, py), (0, px)), mode="edge") if py or px else a
-
-
-@dataclass
-class _Cells:
-    """Per stride-s cell of every panel (P, cy, cx): lo/hi class among its computed points
-    (127/-1 when none), and whether its four corners are computed."""
-
-    lo: np.ndarray
-    hi: np.ndarray
-    corners: np.ndarray
-
-    @property
-    def mixed(self) -> np.ndarray:
-        return (self.hi >= 0) & (self.lo < self.hi)
-
-    @property
-    def uniform_class(self) -> np.ndarray:
-        """Class of uniform cells with computed corners, -1 elsewhere."""
-        ok = self.corners & (self.lo == self.hi)
-        return np.where(ok, self.hi, -1).astype(np.int8)
-
-
-def _cells(known: np.ndarray, strides: Sequence[int]) -> dict[int, _Cells]:
-    """Cell statistics at every stride (powers of 2 >= 2). known: int8 panels, the class
-    where computed, -1 elsewhere.
-
-    Stride 2 is reduced from the points (closed windows of 3); each coarser stride from
-    the one below, since a closed 2s-cell is the union of its four closed s-subcells
-    (a missing last subcell beyond the padded edge repeats the last one, which holds the
-    same points of the edge).
-    """
-    out: dict[int, _Cells] = {}
-    if not strides:
-        return out
-    kp = _pad(known, 2)
-    lo_src = np.where(kp < 0, _NO_CLASS, kp)
-
-    def closed3(a: np.ndarray, op: Callable) -> np.ndarray:
-        a = op(op(a[:, :, 0:-1:2], a[:, :, 1::2]), a[:, :, 2::2])
-        return op(op(a[:, 0:-1:2], a[:, 1::2]), a[:, 2::2])
-
-    hi, lo = closed3(kp, np.maximum), closed3(lo_src, np.minimum)
-    _, ny, nx = known.shape
-    s = 2
-    while True:
-        if s in strides:
-            c = known[:, _axis_lattice(ny, s)][:, :, _axis_lattice(nx, s)] >= 0
-            corners = c[:, :-1, :-1] & c[:, 1:, :-1] & c[:, :-1, 1:] & c[:, 1:, 1:]
-            out[s] = _Cells(lo, hi, corners)
-        if s >= max(strides):
-            return out
-        s *= 2
-        cy, cx = _ncells(ny, s), _ncells(nx, s)
-
-        def up(a: np.ndarray, op: Callable, cy: int = cy, cx: int = cx) -> np.ndarray:
-            a = np.pad(a, ((0, 0), (0, 2 * cy - a.shape[1]), (0, 2 * cx - a.shape[2])),
-                       mode="edge")
-            a = op(a[:, 0::2], a[:, 1::2])
-            return op(a[:, :, 0::2], a[:, :, 1::2])
-
-        hi, lo = up(hi, np.maximum), up(lo, np.minimum)
-
-
-def _dilate(mask: np.ndarray, m: int) -> np.ndarray:
-    """Cells within m steps across cell edges (4-neighbourhood, per panel) of a marked
-    cell: a boundary enters a cell through an edge, so its edge neighbours are the cells it
-    can bend into between samples (the 8-neighbourhood cost 13-18% more points at 400 x 400
-    for the same outcomes on the study scenes)."""
-    out = mask.copy()
-    for _ in range(m):
-        cur = out.copy()
-        out[:, 1:, :] |= cur[:, :-1, :]
-        out[:, :-1, :] |= cur[:, 1:, :]
-        out[:, :, 1:] |= cur[:, :, :-1]
-        out[:, :, :-1] |= cur[:, :, 1:]
-    return out
-
-
-def _points_of_cells(plan: Plan, cells: np.ndarray, s: int,
-                     known: np.ndarray | None = None) -> np.ndarray:
-    """Flat indices (increasing) of the stride-s/2 lattice points inside the marked
-    stride-s cells (bool[P, cy, cx]; closed), each once; with ``known`` (int8 panels, -1:
-    not computed) only those not computed yet.
-
-    The cells' 3 x 3 points are marked on the lattice itself (no index per cell and
-    point, and no sort of them to remove the points that neighbouring cells share: that
-    was a sixth of a planning pass's time)."""
-    P, cy, cx = cells.shape
-    _, ny, nx = plan.panel_shape
-    h = s // 2
-    ys, xs = _axis_lattice(ny, h), _axis_lattice(nx, h)
-    lat = np.zeros((P, 2 * cy + 1, 2 * cx + 1), bool)
-    for dy in range(3):
-        for dx in range(3):
-            lat[:, dy:dy + 2 * cy:2, dx:dx + 2 * cx:2] |= cells
-    # 2 cy + 1 is len(ys) or one more: that last row lies past the axis's end (clipped, it
-    # is the lattice's last point), and only the last cell marks it, which marks the row
-    # before it too: the lattice's last one
-    lat = lat[:, :ys.size, :xs.size]
-    if known is not None:
-        lat &= known[:, ys][:, :, xs] < 0
-    p, jj, ii = np.nonzero(lat)
-    return np.sort(plan.flat_index()[p, ys[jj], xs[ii]])
-
-
-def _centres(plan: Plan, cells: np.ndarray, s: int) -> np.ndarray:
-    """Flat indices of the centres of the marked stride-s cells (bool[P, cy, cx]), a
-    shorter last cell's clipped to the axis's last index (then a corner)."""
-    _, ny, nx = plan.panel_shape
-    p, j, i = np.nonzero(cells)
-    return plan.flat_at(p, np.minimum(j * s + s // 2, ny - 1),
-                        np.minimum(i * s + s // 2, nx - 1))
-
-
-def _corner_classes(known: np.ndarray) -> np.ndarray:
-    """int8[P, cy + 1, cx + 1]: the classes (-1: not computed) at the stride-2 lattice
-    points, i.e. the corners of the stride-2 cells."""
-    _, ny, nx = known.shape
-    return known[:, _axis_lattice(ny, 2)][:, :, _axis_lattice(nx, 2)]
-
-
-def _centre_classes(known: np.ndarray) -> np.ndarray:
-    """int8[P, cy, cx]: the classes at the centres of the stride-2 cells (-1: not
-    computed, or a last cell one index long: no centre)."""
-    P, ny, nx = known.shape
-    cy, cx = _ncells(ny, 2), _ncells(nx, 2)
-    m = np.full((P, cy, cx), -1, np.int8)
-    cen = known[:, 1::2, 1::2][:, :cy, :cx]
-    m[:, :cen.shape[1], :cen.shape[2]] = cen
-    if (ny - 1) % 2:
-        m[:, -1] = -1
-    if (nx - 1) % 2:
-        m[:, :, -1] = -1
-    return m
-
-
-def _edge_points(plan: Plan, mixed: np.ndarray, known: np.ndarray) -> np.ndarray:
-    """Flat indices of the points the last level (stride 2 -> 1) computes in the mixed
-    stride-2 cells ``mixed`` (bool[P, cy, cx]) whose four corners are computed.
-
-    Where the corners differ: the centre, and the midpoint of each edge that a boundary
-    crosses: its two ends differ; or they agree, the computed centre differs from them and
-    the opposite edge's ends do not both side with the centre (a one-point sliver through
-    the centre that runs on across the edge, not a boundary between the centre and the
-    edge). Any edge whose ends agree and whose two computed neighbouring centres are both
-    of another class (a one-point band lying along the edge, in which a speck can hide).
-    Where the corners agree (an audit point inside made the cell mixed): all its points.
-    The other edge midpoints are filled from their two agreeing ends (``_edge_fill``).
-
-    Each rule fires only once the points it reads are computed and then holds for good
-    (classes do not change), so the wanted set only grows with the computed set: the
-    least fixed point, and so the result, does not depend on the batch order. Measured on
-    Figure 3(a) at 1000 x 1000 x 3 lam: whole mixed cells at this level are 0.91% of the
-    grid, these points 0.46%.
-
-    The rules are evaluated on the few cells they can fire at (mixed cells; cells with a
-    computed centre), not on every cell: they were 2/3 of a planning pass's time, ~80 ms
-    a pass at 1000 x 1000 x 3, on the sweep's critical path.
-    """
-    c, m = _corner_classes(known), _centre_classes(known)
-    _, cy, cx = mixed.shape
-    _, ny, nx = plan.panel_shape
-    pts: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []  # (p, jj, ii) lattice points
-
-    p, j, i = np.nonzero(mixed)
-    a, b, d, e = c[p, j, i], c[p, j, i + 1], c[p, j + 1, i], c[p, j + 1, i + 1]
-    ok = (a >= 0) & (b >= 0) & (d >= 0) & (e >= 0)
-    same = (a == b) & (a == d) & (a == e)
-    split, whole = ok & ~same, ok & same
-    mc = m[p, j, i]
-
-    def crossed(p_: np.ndarray, q: np.ndarray, r: np.ndarray, t: np.ndarray) -> np.ndarray:
-        """Edge (p_, q) of a split cell crossed; (r, t): the opposite edge's ends."""
-        return (p_ != q) | ((mc >= 0) & (p_ != mc) & ~((r == mc) & (t == mc)))
-
-    jj, ii = 2 * j + 1, 2 * i + 1
-    for sel, dy, dx in ((split, 0, 0),  # centres
-                        (split & crossed(a, b, d, e), -1, 0),  # lower edges
-                        (split & crossed(d, e, a, b), 1, 0),  # upper edges
-                        (split & crossed(a, d, b, e), 0, -1),  # left edges
-                        (split & crossed(b, e, a, d), 0, 1)):  # right edges
-        pts.append((p[sel], jj[sel] + dy, ii[sel] + dx))
-    for dy in (-1, 0, 1):
-        for dx in (-1, 0, 1):
-            pts.append((p[whole], jj[whole] + dy, ii[whole] + dx))
-
-    # one-point bands along an edge: both neighbouring centres computed, of another class
-    # than the edge's agreeing ends
-    pc, jc, ic = np.nonzero(m >= 0)
-    up = jc + 1 < cy  # the edge between cell (jc, ic) and the one above it, along x
-    pu, ju, iu = pc[up], jc[up], ic[up]
-    u, v, e0, e1 = m[pu, ju, iu], m[pu, ju + 1, iu], c[pu, ju + 1, iu], c[pu, ju + 1, iu + 1]
-    band = (v >= 0) & (e0 >= 0) & (e0 == e1) & (u != e0) & (v != e0)
-    pts.append((pu[band], 2 * ju[band] + 2, 2 * iu[band] + 1))
-    right = ic + 1 < cx  # the edge between cell (jc, ic) and the one right of it, along y
-    pr, jr, ir = pc[right], jc[right], ic[right]
-    u, v, e0, e1 = m[pr, jr, ir], m[pr, jr, ir + 1], c[pr, jr, ir + 1], c[pr, jr + 1, ir + 1]
-    band = (v >= 0) & (e0 >= 0) & (e0 == e1) & (u != e0) & (v != e0)
-    pts.append((pr[band], 2 * jr[band] + 1, 2 * ir[band] + 2))
-
-    pp = np.concatenate([q[0] for q in pts])
-    yy = np.minimum(np.concatenate([q[1] for q in pts]), ny - 1)
-    xx = np.minimum(np.concatenate([q[2] for q in pts]), nx - 1)
-    return np.unique(plan.flat_at(pp, yy, xx))
-
-
-def _edge_fill(known: np.ndarray) -> np.ndarray:
-    """int8 panels: at the midpoints of stride-2 edges whose two ends are computed and
-    agree, their class; -1 elsewhere (what the last level leaves uncomputed, see
-    ``_edge_points``)."""
-    _, ny, nx = known.shape
-    c = _corner_classes(known)
-    lat = np.full((c.shape[0], 2 * c.shape[1] - 1, 2 * c.shape[2] - 1), -1, np.int8)
-    h = np.where(c[:, :, :-1] == c[:, :, 1:], c[:, :, :-1], -1)  # edges along x
-    v = np.where(c[:, :-1, :] == c[:, 1:, :], c[:, :-1, :], -1)  # edges along y
-    lat[:, 0::2, 1::2] = h
-    lat[:, 1::2, 0::2] = v
-    out = np.full(known.shape, -1, np.int8)
-    ys = np.minimum(np.arange(lat.shape[1]), ny - 1)
-    xs = np.minimum(np.arange(lat.shape[2]), nx - 1)
-    # the clipped last row/column maps onto the lattice's last points: keep the real ones
-    keep_y = np.r_[True, ys[1:] != ys[:-1]]
-    keep_x = np.r_[True, xs[1:] != xs[:-1]]
-    out[:, ys[keep_y][:, None], xs[keep_x][None, :]] = lat[:, keep_y][:, :, keep_x]
-    return out
+    return np.sort(lattice_points(plan, 2**level))
 
 
 def _known(plan: Plan, outcome: np.ndarray, computed: np.ndarray,
@@ -590,28 +350,28 @@ def next_batch(plan: Plan, outcome: np.ndarray, computed: np.ndarray) -> Batch:
     """
     done = np.asarray(computed).ravel() > FILLED
     s0 = 2**plan.coarse
-    coarse = _lattice_points(plan, s0)
+    coarse = lattice_points(plan, s0)
     missing = coarse[~done[coarse]]
     if missing.size:
         return Batch(np.sort(missing), "coarse", s0)
     known = _known(plan, outcome, computed, done)
     parts, stride = [], 0
-    cells = _cells(known, plan.strides)
+    cells = cell_stats(known, plan.strides)
     light = plan.final_margin == 0  # the last two levels' lighter rules (module docstring)
     for s in plan.strides:
         mixed = cells[s].mixed
-        refine = _dilate(mixed, plan.margin if s > 2 else plan.final_margin)
+        refine = dilate(mixed, plan.margin if s > 2 else plan.final_margin)
         if not refine.any():
             continue
         if s == 2 and light:
-            want = _edge_points(plan, mixed, known)
+            want = edge_points(plan, mixed, known)
             missing = want[~done[want]]
         elif s == 4 and light:
-            centres = _centres(plan, refine, s)
-            missing = np.concatenate([_points_of_cells(plan, mixed, s, known),
-                                      centres[~done[centres]]])
+            probes = centres(plan, refine, s)
+            missing = np.concatenate([points_of_cells(plan, mixed, s, known),
+                                      probes[~done[probes]]])
         else:
-            missing = _points_of_cells(plan, refine, s, known)
+            missing = points_of_cells(plan, refine, s, known)
         if missing.size:
             parts.append(missing)
             stride = stride or s // 2
@@ -630,7 +390,7 @@ def fill(plan: Plan, outcome: np.ndarray, computed: np.ndarray) -> np.ndarray:
     known = _known(plan, outcome, computed)
     out = known.copy()
     _, ny, nx = plan.panel_shape
-    cells = _cells(known, plan.strides)
+    cells = cell_stats(known, plan.strides)
     for s in plan.strides:
         cls = cells[s].uniform_class
         cy = np.minimum(np.arange(ny) // s, cls.shape[1] - 1)
@@ -638,7 +398,7 @@ def fill(plan: Plan, outcome: np.ndarray, computed: np.ndarray) -> np.ndarray:
         cand = cls[:, cy][:, :, cx]
         out = np.where(out < 0, cand, out)
     if plan.strides and plan.final_margin == 0:
-        out = np.where(out < 0, _edge_fill(known), out)
+        out = np.where(out < 0, edge_fill(known), out)
     flat = np.empty(plan.size, np.int8)
     idx = plan.flat_index()
     flat[idx.ravel()] = out.ravel()
@@ -848,8 +608,6 @@ def run_batch(grid: Grid, flat: np.ndarray, jobs: int = 1, chunk_size: int | Non
     each chunk's results as it finishes (any order). Results depend only on the point.
     runner: a sweep's ``compute.overlap.Runner`` (its worker threads, kept busy between
     batches), which then runs them instead."""
-    from rocksweep.compute import sweep as sw
-
     flat = np.asarray(flat, np.int64)
     if flat.size == 0:
         return

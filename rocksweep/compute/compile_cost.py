@@ -24,6 +24,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from rocksweep import kernel
 from rocksweep.outputs import write_atomic
 
 #: [s] a variant's cold compile on a quiet 2-core machine (scripts/bench_compile.py)
@@ -103,7 +104,7 @@ def variant_name(dispatcher: Any) -> str:
 
 def in_cache(dispatcher: Any) -> bool | None:
     """``kernel._cache.in_cache`` (numba's private cache names stay there)."""
-    from rocksweep.kernel._cache import in_cache as cached
+    from rocksweep.kernel._cache import in_cache as cached  # lazy: numba, scipy (+0.2 s)
 
     return cached(dispatcher)
 
@@ -148,8 +149,6 @@ def prepare_point(kind: int, ground: Any, say: Callable[[str], None], contact: i
     """The single-run (history) variant of ``kind``, ``ground`` and ``contact``
     (``layout.CONTACT_*``) compiled or loaded now, said when it compiles (``prepare``):
     what ``rocksweep simulate`` and ``rocksweep calibrate`` run."""
-    from rocksweep import kernel
-
     return prepare([kernel.point_kernel(kind, ground, contact)],
                    lambda: kernel.warm_up(kind, None, ground, contact), say,
                    compiles_only=True)

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from rocksweep.compute import compile_cost
 from rocksweep.interrupts import pending as interrupt_pending
 from rocksweep.interrupts import raise_pending
 
@@ -123,7 +124,7 @@ class ArraySink:
     call."""
 
     def __init__(self, grid: Any) -> None:
-        import numpy as np
+        import numpy as np  # lazy: numpy (+51 ms)
 
         self.grid = grid
         self.flat = {k: np.full(grid.size, fill, dtype)
@@ -183,7 +184,7 @@ def sweep_arrays(scene: Scene, jobs: int = 1, chunk_size: int | None = None,
     Identical, bit for bit, whatever ``jobs``, ``chunk_size`` and backend, and to the
     result file of ``rocksweep sweep``. For the library's own studies and tests;
     ``rocksweep.run`` returns the same as a Dataset."""
-    from rocksweep.scene.grid import Grid
+    from rocksweep.scene.grid import Grid  # lazy: yaml (+0.1 s)
 
     sink = ArraySink(Grid(scene))
     report = SweepReport(Path("memory"), sink.grid.size, 0, 0, 0.0, 0.0, 0.0)
@@ -224,9 +225,9 @@ def progress_class(progress: bool = True) -> type:
         return NoBar
     # tqdm here, not at the top: ~10 ms that a quiet command does not pay
     if "ipykernel" in sys.modules:
-        from tqdm.auto import tqdm
+        from tqdm.auto import tqdm  # lazy: tqdm (+39 ms)
     else:
-        from tqdm import tqdm
+        from tqdm import tqdm  # lazy: tqdm (+35 ms)
     return tqdm
 
 
@@ -236,7 +237,7 @@ def every_point_loop(sf, report: SweepReport, _options: None, *, jobs: int, back
                       pending: list) -> None:
     """Compute every missing point of an open file, writing finished chunks every
     ``write_every`` seconds (and the pending ones whatever ends the loop)."""
-    from rocksweep.compute import sweep as sw
+    from rocksweep.compute import sweep as sw  # lazy: yaml (+0.1 s)
 
     tqdm = progress_class(progress)
 
@@ -282,8 +283,7 @@ def prepare_kernel(sf, lvl: int, report: SweepReport, say: Callable[[str], None]
     """Compile or load the kernel variants the grid needs, saying what happens: the
     variants to compile, named, and what they took here before
     (``compile_cost.prepare``)."""
-    from rocksweep.compute import compile_cost
-    from rocksweep.compute import sweep as sw
+    from rocksweep.compute import sweep as sw  # lazy: yaml (+0.1 s)
 
     report.compile_s = compile_cost.prepare(sw.chunk_variants(sf.grid, lvl),
                                             lambda: sw.prepare(sf.grid, lvl), say)
@@ -305,8 +305,9 @@ def adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backe
     of a finished file stops at once. A file killed at any moment resumes to the same
     result (see ``adaptive.next_step``).
     """
-    import numpy as np
+    import numpy as np  # lazy: numpy (+51 ms)
 
+    # lazy: yaml (+0.2 s)
     from rocksweep.compute import adaptive as ad
     from rocksweep.compute import sweep as sw
     from rocksweep.compute.overlap import Runner

@@ -27,6 +27,8 @@ from rocksweep.compute.sweep import check_scheduler
 from rocksweep.errors import ApiError, Arg, SweepError, flag
 from rocksweep.outputs import check_output, check_path_text, exists_error
 from rocksweep.scene.grid import Grid
+from rocksweep.scene.inputs import load, override_strings
+from rocksweep.store.dataset import open_result, result_dataset
 from rocksweep.store.writer import SweepFile
 
 if TYPE_CHECKING:
@@ -176,10 +178,6 @@ def run_session(scene: SceneLike | Scene, output: str | Path | None, *,
     progress bar; client: see ``client_backend``. Returns the result as the loaded Dataset
     (``store.dataset``: ``open_result`` of the file, or ``result_dataset`` of the
     in-memory file's image)."""
-    # rocksweep.run's alone: rocksweep sweep compiles neither at start-up (8 kB of source)
-    from rocksweep.scene.inputs import load, override_strings
-    from rocksweep.store.dataset import open_result, result_dataset
-
     # types and ranges first: nothing below may touch ``output`` before all are checked
     check_flag("progress", progress)
     check_flag("adaptive", adaptive)

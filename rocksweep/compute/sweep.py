@@ -174,7 +174,7 @@ def check_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
     ``timeout`` seconds (``arguments.probe_scheduler`` first: dask's own timeout does not
     bound a port that accepts and never answers)."""
     try:
-        from distributed import Client
+        from distributed import Client  # lazy: distributed, dask (+0.2 s)
     except ImportError:
         raise SweepError("the dask backend needs dask and distributed: "
                          "pip install 'rocksweep[dask]'") from None
@@ -211,7 +211,7 @@ def run_chunks(grid: Grid, chunks: Iterable[tuple[int, int]], level: int, jobs: 
         for a, b in chunks:
             yield run_chunk(grid, a, b, level)
     else:
-        from joblib import Parallel, delayed, parallel_config
+        from joblib import Parallel, delayed, parallel_config  # lazy: joblib (+50 ms)
 
         tasks = (delayed(run_chunk)(grid, a, b, level) for a, b in chunks)
         with parallel_config(backend="threading", n_jobs=n_jobs):
@@ -227,6 +227,7 @@ def _run_on_cluster(grid: Grid, chunks: list[tuple[int, int]], level: int,
     worker for ``NO_WORKERS_TIMEOUT`` seconds (none joined, or all left) is a
     ``SweepError``; the caller saves what finished.
     """
+    # lazy: distributed, dask (+0.2 s)
     from distributed import Client, KilledWorker, wait
     from distributed.client import FIRST_COMPLETED
 

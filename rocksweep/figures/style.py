@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 
 import matplotlib
 import numpy as np
+from matplotlib import ticker
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure as _MplFigure
 
@@ -220,8 +221,6 @@ def log_ticks(axis, values: Sequence[float] | np.ndarray | None = None) -> None:
     journal width); here the major ticks are the data's own values when they are few
     (``values``: at most 6), else 1, 2, 5 a decade over ranges of up to two decades and
     the decades beyond, each labelled as %g; minor ticks unlabelled."""
-    from matplotlib import ticker
-
     vals = np.unique(np.asarray(values if values is not None else [], float))
     vals = vals[np.isfinite(vals) & (vals > 0)]
     if 1 < vals.size <= 6:

@@ -38,7 +38,7 @@ __all__ = ["chunk_kernel", "point_kernel", "warm_up"]
 
 def __getattr__(name: str) -> Any:
     if name in __all__:
-        from rocksweep.kernel import variants
+        from rocksweep.kernel import variants  # lazy: numba, scipy (+0.3 s)
 
         return getattr(variants, name)
     raise AttributeError(f"module 'rocksweep.kernel' has no attribute {name!r}")

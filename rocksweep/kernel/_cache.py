@@ -36,7 +36,7 @@ def _supported(options: dict) -> dict:
     dropped (the kernel then compiles with numba's default for it: slower, same results)
     instead of failing every ``@njit`` at import."""
     try:
-        from numba.core.cpu import CPUTargetOptions
+        from numba.core.cpu import CPUTargetOptions  # numba's internals: guarded
     except ImportError:  # pragma: no cover (a numba without the class: keep them all)
         return dict(options)
     return {k: v for k, v in options.items() if hasattr(CPUTargetOptions, k)}
@@ -172,7 +172,7 @@ class EntryCache(caching.FunctionCache):
     def load_overload(self, sig, target_context):
         try:
             guard, load = self._guard_against_spurious_io_errors, self._load_overload
-            from numba.core.runtime import rtsys
+            from numba.core.runtime import rtsys  # numba's internals: guarded
         except (AttributeError, ImportError):  # a numba whose cache is built otherwise
             return super().load_overload(sig, target_context)
         rtsys.initialize(target_context)

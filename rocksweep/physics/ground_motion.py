@@ -47,13 +47,13 @@ import threading
 from collections import OrderedDict
 from collections.abc import Callable, Hashable, Iterable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import Numerics, vertical_step
 from rocksweep.physics.bodies import G
+from rocksweep.physics.excitation import PulseShape, mp_peak
 from rocksweep.physics.records import GroundRecord
 from rocksweep.vocab.ground import (
     CYCLES,
@@ -66,9 +66,6 @@ from rocksweep.vocab.ground import (
     SHAPE_CODE,
     SINE,
 )
-
-if TYPE_CHECKING:
-    from rocksweep.physics.excitation import PulseShape
 
 # FREE runs as a sine of amplitude 0 that ends at t = 0 (its own code would be a new
 # branch of the kernel for nothing)
@@ -149,8 +146,6 @@ class Excitation:
     @property
     def pulse(self) -> PulseShape | None:
         """The pulse's reference definition (None for samples and free rocking)."""
-        from rocksweep.physics.excitation import PulseShape  # scipy: loaded when needed
-
         if self.shape in (RECORD, FREE):
             return None
         return PulseShape(self.shape, int(self.cycles), float(self.gamma), float(self.nu))
@@ -160,8 +155,6 @@ class Excitation:
         """1/r_max of an MP pulse (PAR_AMP_NORM: A is its peak), NaN for other shapes."""
         if self.shape != MP:
             return math.nan
-        from rocksweep.physics.excitation import mp_peak
-
         return 1.0 / mp_peak(float(self.gamma), float(self.nu))
 
     @property

@@ -14,6 +14,7 @@ from rocksweep.errors import SceneError, set_key
 from rocksweep.kernel.layout import CONTACT_NOSLIP, CONTACT_SLIDE
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody, Body, FlexibleBody, G
+from rocksweep.physics.excitation import PulseShape
 from rocksweep.physics.ground_motion import (
     Excitation,
     Excitations,
@@ -344,8 +345,6 @@ class Scene:
             return pa.motion(ground, r, angle, floor), ground.pga, r
         if self.record is not None:
             return pa.motion(self.record, 0, angle, floor), self.record.pga, 0
-        from rocksweep.physics.excitation import PulseShape
-
         shape = PulseShape(str(values["shape"]), int(self.option("cycles")),
                            float(self.option("gamma")), float(self.option("nu")))
         return pa.motion(None, 0, 0.0, floor, (shape, float(values["w_over_p"]))), 1.0, 0

@@ -21,11 +21,15 @@ one-line SceneError (or left out with a warning under ``ground.missing: skip``),
 from __future__ import annotations
 
 import re
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
-from rocksweep.errors import SceneError
-from rocksweep.outputs import shown
+from rocksweep.errors import RecordError, SceneError
+from rocksweep.outputs import input_problem, shown
+from rocksweep.physics.path import check_pair
+from rocksweep.physics.records import read_record
+from rocksweep.physics.suite import RecordWarning
 
 _RSN = re.compile(r"^(RSN\d+)_", re.IGNORECASE)
 _VERTICAL = re.compile(r"(?:[-_]?(?:UP|DWN)|[-_]V)$", re.IGNORECASE)
@@ -101,11 +105,6 @@ def folder_files(folder: Path, skip: bool) -> list[Path]:
     that is not (a FIFO, a device, a dangling or looping link, a directory) is named in a
     one-line SceneError, or left out with a RecordWarning (``skip``): never dropped
     without a word."""
-    import warnings
-
-    from rocksweep.outputs import input_problem
-    from rocksweep.physics.suite import RecordWarning
-
     key = "ground.records"
     try:
         entries = sorted(folder.iterdir(), key=lambda p: p.name)
@@ -135,13 +134,6 @@ def peer_suite(folder: Path, skip: bool) -> tuple:
     entry that is not a regular file (``folder_files``) is a one-line SceneError naming
     the files, or left out with a RecordWarning (``skip``); the ``.AT2`` files not named
     as PEER names a component are left out with a RecordWarning naming them."""
-    import warnings
-
-    from rocksweep.errors import RecordError
-    from rocksweep.physics.path import check_pair
-    from rocksweep.physics.records import read_record
-    from rocksweep.physics.suite import RecordWarning
-
     key = "ground.records"
     comps, odd = peer_components(folder_files(folder, skip))
     if not comps:

@@ -44,23 +44,21 @@ import json
 import math
 import platform
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
+import h5py
 import numpy as np
 
 from rocksweep import fields
 from rocksweep._version import __version__
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.physics import floor
 from rocksweep.scene.model import Scene
 from rocksweep.store._common import fixed_ascii, utc_now
 from rocksweep.store.identity import files_resolved, resolved_scene
 from rocksweep.vocab.axes import alpha_symbol
 from rocksweep.vocab.outcomes import COMPUTED_FLAGS, COMPUTED_MEANING, OUTCOME_WORDS, STATUS_WORDS
 from rocksweep.vocab.phases import PHASE_CODE
-
-if TYPE_CHECKING:
-    import h5py
-
 
 FORMAT = "rocksweep-sweep"
 # 1: first release; 2: CF attributes (units, Conventions, int8 flags), fixed-size session
@@ -111,8 +109,7 @@ FLAG_VARIABLES = ("outcome", "status", "computed", "regime")
 
 def versions() -> dict[str, str]:
     """Versions of rocksweep and the libraries that shape its results."""
-    import h5py
-    import numba
+    import numba  # lazy: numba, scipy (+0.2 s)
 
     return {"rocksweep": __version__, "numba": numba.__version__, "numpy": np.__version__,
             "h5py": h5py.__version__, "hdf5": h5py.version.hdf5_version,
@@ -195,8 +192,6 @@ def metadata(scene: Scene, overrides: tuple[str, ...] = (),
              adaptive: dict | None = None) -> Metadata:
     """The ``Metadata`` of a new result file of ``scene`` (made with ``overrides``; adaptive:
     the resolved settings of an adaptive sweep, ``adaptive.Options.resolved``)."""
-    import h5py
-
     vers = versions()
     a: dict[str, Any] = {}
     a["Conventions"] = CONVENTIONS
@@ -311,8 +306,6 @@ def initialise(f: h5py.File, meta: Metadata) -> None:
     """Write ``meta`` into the new, empty file ``f``: the attributes, the record or suite
     files kept, the coordinates, every variable allocated in full at its fill value (no
     metadata changes later), and a suite's per-record variables."""
-    import h5py
-
     for k, v in meta.attrs.items():
         f.attrs[k] = v
     scene = meta.scene
@@ -344,8 +337,6 @@ def path_attrs(scene: Scene) -> dict[str, str]:
     """The attributes stating a scene's excitation path: ``floor`` (the building, one
     line, and the stopping rule of its ring-down) and ``ground_h2`` (the second horizontal
     component: name, SHA-256, path read)."""
-    from rocksweep.physics import floor
-
     out = {}
     if scene.floor:
         out["floor"] = (f"{scene.floor_words()}; cascade (the body does not load the "
@@ -413,8 +404,6 @@ def suite_variables(scene: Scene) -> dict[str, tuple[tuple[str, ...], np.ndarray
 def _write_suite(f: h5py.File, scene: Scene, scales: dict) -> None:
     """The suite's per-record variables (``suite_variables``) with their dimension scales
     (``period`` made here) and CF attributes (``fields.RECORD_VARIABLES``)."""
-    import h5py
-
     su = scene.suite
     per = f.create_dataset("period", data=np.asarray(su.periods, float))
     per.make_scale("period")

@@ -11,8 +11,9 @@ import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, NoReturn
+from typing import NoReturn
 
+import h5py
 import numpy as np
 
 from rocksweep import fields
@@ -37,9 +38,6 @@ from rocksweep.vocab.axes import axis_name
 from rocksweep.vocab.kinds import KIND_ATTR, KINDS, SWEEP
 from rocksweep.vocab.outcomes import CLASSES, COMPUTED_FLAGS, OUTCOME_CODE, OUTCOME_WORDS
 from rocksweep.vocab.settings import ADAPTIVE_RESOLVED
-
-if TYPE_CHECKING:
-    import h5py
 
 
 @dataclass
@@ -146,9 +144,6 @@ def _analysis_kind(f: h5py.File) -> str | None:
 
 def read_layout(f: h5py.File, path: Path) -> FileLayout:
     """Validate the format, the resolved scene, the coordinates and the variables."""
-    # h5py (0.1 s): a result in memory reads no file
-    import h5py
-
     try:  # h5py's attrs.get hides damage as "missing"
         fmt = f.attrs["rocksweep_format"] if "rocksweep_format" in f.attrs else None
     except H5_ERRORS as err:
@@ -222,8 +217,6 @@ def read_layout(f: h5py.File, path: Path) -> FileLayout:
 
 
 def _is_hdf5(path: Path) -> bool:
-    # h5py (0.1 s): a result in memory reads no file
-    import h5py
     try:
         return bool(h5py.is_hdf5(path))
     except H5_ERRORS:
@@ -233,8 +226,6 @@ def _is_hdf5(path: Path) -> bool:
 def open_h5(path: Path, mode: str) -> h5py.File:
     """Open an existing file; foreign, damaged, locked or unreadable files give a one-line
     StoreError. Writers (mode "r+") take HDF5's exclusive lock; readers take none."""
-    # h5py (0.1 s): a result in memory reads no file
-    import h5py
     try:
         st = os.stat(path)
     except FileNotFoundError:

@@ -96,7 +96,7 @@ def test_fig3_adaptive_equals_full_and_the_library(fig3_files):
     flags = a.arrays["computed"]
     # equal but for one point: the tip of a wedge of mode 1 poking one point across an
     # edge of the last level whose ends agree (a one-point feature the last level fills
-    # from its neighbours: rocksweep.compute.adaptive._edge_points); only filled points differ
+    # from its neighbours: rocksweep.compute.lattice.edge_points); only filled points differ
     differ = a.arrays["outcome"] != f.arrays["outcome"]
     assert np.argwhere(differ).tolist() == [[0, 22, 29]]
     assert (flags[differ] == ad.FILLED).all()

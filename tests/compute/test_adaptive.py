@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import rocksweep.compute.adaptive as ad
+from rocksweep.compute import lattice
 from rocksweep.compute.driver import sweep_arrays
 from rocksweep.errors import RocksweepError
 from rocksweep.scene.parse import load_scene, parse_scene
@@ -333,10 +334,10 @@ def test_interrupted_audit_resumes_to_the_same_flags():
 
 
 def _edge_points_every_cell(plan, mixed, known):
-    """The last level's rules (``adaptive._edge_points``) evaluated on every cell of the
+    """The last level's rules (``lattice.edge_points``) evaluated on every cell of the
     panels, as they were written before the planner evaluated them on the cells they can
     fire at only."""
-    c = ad._corner_classes(known)
+    c = lattice.corner_classes(known)
     a, b = c[:, :-1, :-1], c[:, :-1, 1:]  # corners (y, x), (y, x + 1)
     d, e = c[:, 1:, :-1], c[:, 1:, 1:]  # (y + 1, x), (y + 1, x + 1)
     ok = mixed & (a >= 0) & (b >= 0) & (d >= 0) & (e >= 0)
@@ -344,8 +345,8 @@ def _edge_points_every_cell(plan, mixed, known):
     split, whole = ok & ~same, ok & same
     P, cy, cx = mixed.shape
     _, ny, nx = plan.panel_shape
-    m = ad._centre_classes(known)
-    lat = np.zeros((P, 2 * cy + 1, 2 * cx + 1), bool)  # stride-1 lattice, as _points_of_cells
+    m = lattice.centre_classes(known)
+    lat = np.zeros((P, 2 * cy + 1, 2 * cx + 1), bool)  # stride-1 lattice, as points_of_cells
     lat[:, 1::2, 1::2] |= split  # centres
 
     def crossed(p: np.ndarray, q: np.ndarray, r: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -375,7 +376,7 @@ def _edge_points_every_cell(plan, mixed, known):
 
 
 def test_the_last_levels_rules_on_their_cells_equal_them_on_every_cell():
-    """``_edge_points`` looks only at mixed cells and cells with a computed centre; on
+    """``edge_points`` looks only at mixed cells and cells with a computed centre; on
     random states (classes, computed sets, mixed cells; panels of 1-3, odd and even axis
     lengths, the diagram axes in either order) it picks exactly the points the rules
     evaluated on every cell pick."""
@@ -389,16 +390,16 @@ def test_the_last_levels_rules_on_their_cells_equal_them_on_every_cell():
         known = rng.integers(-1, int(rng.integers(1, 4)), size=shape).astype(np.int8)
         if rng.random() < 0.5:
             known[rng.random(shape) < 0.6] = -1
-        cells = (shape[0], ad._ncells(shape[1], 2), ad._ncells(shape[2], 2))
+        cells = (shape[0], lattice.ncells(shape[1], 2), lattice.ncells(shape[2], 2))
         mixed = rng.random(cells) < rng.uniform(0, 1)
-        got = ad._edge_points(plan, mixed, known)
+        got = lattice.edge_points(plan, mixed, known)
         np.testing.assert_array_equal(got, _edge_points_every_cell(plan, mixed, known))
         picked += got.size
     assert picked > 1000  # the rules fired
 
 
 def test_the_points_of_marked_cells_are_those_of_their_closed_lattice():
-    """``_points_of_cells`` (the stride-s/2 points inside the marked stride-s cells, edges
+    """``points_of_cells`` (the stride-s/2 points inside the marked stride-s cells, edges
     and corners included; with ``known``, those not computed) against each marked cell's
     3 x 3 points listed one by one, a shorter last cell's clipped to the axis's end."""
     rng = np.random.default_rng(2)
@@ -408,7 +409,7 @@ def test_the_points_of_marked_cells_are_those_of_their_closed_lattice():
                 else ad.Plan((ny, n_p, nx), 2, 0))
         s = int(2 ** rng.integers(1, 5))
         h = s // 2
-        cy, cx = ad._ncells(ny, s), ad._ncells(nx, s)
+        cy, cx = lattice.ncells(ny, s), lattice.ncells(nx, s)
         cells = rng.random((n_p, cy, cx)) < rng.uniform(0, 0.5)
         known = rng.integers(-1, 2, size=(n_p, ny, nx)).astype(np.int8)
         idx = plan.flat_index()
@@ -416,6 +417,6 @@ def test_the_points_of_marked_cells_are_those_of_their_closed_lattice():
                for p, j, i in zip(*np.nonzero(cells), strict=True)
                for dy in range(3) for dx in range(3)}
         want = sorted(int(idx[q]) for q in pts)
-        np.testing.assert_array_equal(ad._points_of_cells(plan, cells, s), want)
+        np.testing.assert_array_equal(lattice.points_of_cells(plan, cells, s), want)
         todo = sorted(int(idx[q]) for q in pts if known[q] < 0)
-        np.testing.assert_array_equal(ad._points_of_cells(plan, cells, s, known), todo)
+        np.testing.assert_array_equal(lattice.points_of_cells(plan, cells, s, known), todo)
