@@ -41,6 +41,7 @@ from rocksweep.compute import adaptive as ad
 from rocksweep.compute import sweep as sw
 from rocksweep.compute.driver import sweep_arrays
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.numerics import CLOSE_BAND, OVERTURN_BAND
 from rocksweep.scene.parse import load_scene
 
 try:
@@ -106,15 +107,15 @@ def rules(name: str, res: int, arr: dict, jobs: int) -> dict:
         add("bare runs", bare)
         fell = cf._fell(bare)
         close = cf.close_calls(rows, bare)
-        why = np.where(close & fell, "overturn < 8 m", np.where(close, "safe < m",
-                                                                "near-miss flipped"))
+        why = np.where(close & fell, f"overturn < {OVERTURN_BAND:g} m",
+                       np.where(close, "safe < m", "near-miss flipped"))
         last = bare[:, L.OUT_OUTCOME].copy()  # outcome at the level before
         before = bare[:, L.OUT_OUTCOME].copy()  # ... and the one before it
 
         def run(sub, idx, keep=True):
             out = run_variant(np.ascontiguousarray(sub), kind, lvl, sc.ground, 0)
             if not keep:
-                add("probe of near-misses (1 m .. 4 m)", out)
+                add(f"probe of near-misses (1 m .. {CLOSE_BAND:g} m)", out)
                 return out
             level = int(round(np.log2(rows[idx[0], L.PAR_DT] / sub[0, L.PAR_DT])))
             for j, i in enumerate(idx):
