@@ -47,22 +47,31 @@ def _supported(options: dict) -> dict:
 # atomic increment and decrement (with them, a call inside the step loop cost ~40% of the
 # run time even once inlined: numba's refcount pruning cannot pair them across branches).
 #
+# Every kernel function divides as IEEE does (``error_model="numpy"``): numba's default
+# ("python") tests every float divisor for zero to raise ZeroDivisionError, a compare and
+# a branch at each of the right-hand side's divisions. Where no divisor is zero the
+# results are the same to the bit (``scripts/fingerprint.py check``: 709 arrays); a zero
+# divisor gives inf or NaN, which the loop's finiteness check ends the run on
+# (STATUS_NONFINITE), where it raised in a worker before. Figure 3(a) per point: 0.905x
+# (``scripts/bench_compile.py --against``), the four adaptive figures' CPU 0.89x.
+_IEEE = {"error_model": "numpy"}
+#
 # Options of the functions only ever called from jitted code: no Python or C entry point
 # to build (tests reach them through small @njit wrappers). They are calls (the work of
 # events, once per event): ``forceinline`` set False, else numba would pass on the flag of
 # the function whose compilation compiles them (an event search inlined into every copy
 # of the screening doubles the code and the compile time, for nothing measurable).
-INTERNAL = _supported({"no_cpython_wrapper": True, "no_cfunc_wrapper": True, "_nrt": False,
-                       "forceinline": False})
+INTERNAL = _supported({**_IEEE, "no_cpython_wrapper": True, "no_cfunc_wrapper": True,
+                       "_nrt": False, "forceinline": False})
 # Options of the small functions on the path of every step: compiled once per signature
 # and inlined by LLVM (``forceinline``: LLVM's alwaysinline), not by numba (``inline=
 # "always"`` copies and retypes the callee's IR at every call site: 2/3 of the compile
 # time). Still callable from Python (the reference path and the tests use some).
-INLINE = _supported({"forceinline": True, "_nrt": False})
+INLINE = _supported({**_IEEE, "forceinline": True, "_nrt": False})
 # Options of the other functions called from jitted code and from Python.
-PUBLIC = _supported({"_nrt": False})
+PUBLIC = _supported({**_IEEE, "_nrt": False})
 # Options of the entry points (``variants``): called from Python.
-ENTRY = _supported({"_nrt": False})
+ENTRY = _supported({**_IEEE, "_nrt": False})
 
 
 def _kernel_hash() -> str:

@@ -254,3 +254,25 @@ def test_rocking_spring_omega_matches_the_model_at_lever_arm_b_and_is_largest_at
     fast = body.omega_n * math.sqrt(gamma) * (zr + math.sqrt(zr * zr - 1))
     assert rocking_spring_omega(body.omega_n, z, body.m, body.h, i_a0, 0.0) == pytest.approx(
         fast, rel=1e-13)
+
+
+def test_a_zero_divisor_ends_the_run_flagged_not_with_an_exception():
+    """The kernel divides as IEEE does (``_cache``: ``error_model="numpy"``): a row whose
+    top mass is 0 (the contact phase's u'' = -(k u + c u')/m - xg'' is 0/0 at rest) ends
+    with STATUS_NONFINITE, where numba's default raised ZeroDivisionError from the
+    worker; the same row with its mass runs to a finite end."""
+    from rocksweep.kernel import chunk_kernel, warm_up
+    from rocksweep.numerics import Numerics
+    from rocksweep.physics.points import Point, kernel_kind, point_row
+
+    point = Point(BODY3, 0.0, "sine", 2.0, 3.0)
+    row = point_row(point, Numerics.preset("draft"))
+    kind = kernel_kind(point.body)
+    warm_up(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)
+    rows = np.stack([row, row])
+    rows[1, L.PAR_M] = 0.0
+    out = np.empty((2, L.N_OUT))
+    chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)(rows, out)
+    status = out[:, L.OUT_STATUS].astype(np.int64)
+    assert not status[0] & L.STATUS_NONFINITE and np.isfinite(out[0, L.OUT_THETA_MAX])
+    assert status[1] & L.STATUS_NONFINITE
