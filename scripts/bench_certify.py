@@ -41,9 +41,12 @@ from rocksweep.compute import adaptive as ad
 from rocksweep.compute import sweep as sw
 from rocksweep.compute.driver import sweep_arrays
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.numerics import CLOSE_BAND, OVERTURN_BAND
 from rocksweep.scene.parse import load_scene
 
+try:  # the rules' labels (--rules) only
+    from rocksweep.numerics import CLOSE_BAND, OVERTURN_BAND
+except ImportError:  # an older checkout (--against), before the bands had names
+    CLOSE_BAND, OVERTURN_BAND = 4.0, 8.0
 try:
     from rocksweep.scene.grid import Grid
 except ImportError:  # an older checkout (--against): the grid lived in compute/
