@@ -52,8 +52,8 @@ def _supported(options: dict) -> dict:
 # a branch at each of the right-hand side's divisions. Where no divisor is zero the
 # results are the same to the bit (``scripts/fingerprint.py check``: 709 arrays); a zero
 # divisor gives inf or NaN, which the loop's finiteness check ends the run on
-# (STATUS_NONFINITE), where it raised in a worker before. Figure 3(a) per point: 0.905x
-# (``scripts/bench_compile.py --against``), the four adaptive figures' CPU 0.89x.
+# (STATUS_NONFINITE), where it raised in a worker before. Under callgrind a sweep takes
+# 0.80x the time; on the wall clock 0-10% less (docs/performance.md).
 _IEEE = {"error_model": "numpy"}
 #
 # Options of the functions only ever called from jitted code: no Python or C entry point
