@@ -211,8 +211,7 @@ def spectra(ds: xr.Dataset, rtol: float = DEFAULT_RTOL, search: bool = True) -> 
     A_ratio and optionally lam: ``theta_max_over_alpha`` and ``outcome`` over (lam,
     A_ratio, p), ``A_min`` and ``mode`` over (lam, p), A_min to ``rtol`` whatever the grid
     (search=False: the grid's bracket bisected only, as for ``boundaries``)."""
-    # lazy: numba, scipy (+0.7 s)
-    from rocksweep.analysis.spectrum import spectra as compute_spectra
+    from rocksweep.analysis.spectrum import spectra as compute_spectra  # lazy: numba (+0.7 s)
 
     _check_dataset("ds", ds)
     return compute_spectra(ds, rtol, search).to_dataset()
@@ -247,8 +246,7 @@ def ida(ds: xr.Dataset, rtol: float = DEFAULT_RTOL_MANY, *, state: str = "overtu
     over the other swept keys and ``record`` (``rocksweep.analysis.ida.ida``) with the
     IDA curves ``rocksweep.plot`` draws. A sweep over ``angle``: every (record, angle) a
     sample, and ``ida_im_worst`` / ``worst_angle`` each record's worst orientation."""
-    # lazy: numba, scipy (+0.7 s)
-    from rocksweep.analysis.floors import worst_ida
+    from rocksweep.analysis.floors import worst_ida  # lazy: numba (+0.7 s)
     from rocksweep.analysis.ida import ida_dataset
 
     _check_dataset("ds", ds)
@@ -287,8 +285,7 @@ def fragility(ds: xr.Dataset, *, state: str | Sequence[str] = "overturn",
     over ``angle`` gives an ``orientation`` dimension: "each" (every (record, angle) a
     sample, records resampled with all their angles) and "worst" (the worst angle per record).
     """
-    # lazy: scipy, xarray (+0.5 s)
-    from rocksweep.analysis.floors import by_orientation
+    from rocksweep.analysis.floors import by_orientation  # lazy: scipy (+0.5 s)
     from rocksweep.analysis.fragility import fragility as fit
 
     ds = _dataset_arg(ds, "ds")
@@ -311,8 +308,7 @@ def risk(fr: xr.Dataset, hazard: Any, years: float = 50, *, site: int | None = N
     ``probability`` per state and lam, their ``_lo``/``_hi`` from the fragility's
     bootstrap resamples, ``annual_rate_max`` (the tail above the hazard at its largest),
     ``reason``; beyond the hazard's range the rate is bounded, never extrapolated."""
-    # lazy: xarray, pandas (+0.4 s)
-    from rocksweep.analysis.risk import check_fragility
+    from rocksweep.analysis.risk import check_fragility  # lazy: xarray (+0.4 s)
     from rocksweep.analysis.risk import risk as compute
 
     _check_dataset("fr", fr)
@@ -331,8 +327,7 @@ def im_efficiency(ds: xr.Dataset, *, state: str = "overturn") -> xr.Dataset:
     dispersion ``beta`` of the fragility in that IM and ``beta_scale`` (comparable across
     IMs; lower is better), per value of the other swept keys
     (``rocksweep.analysis.efficiency``)."""
-    # lazy: scipy, xarray (+0.8 s)
-    from rocksweep.analysis.efficiency import im_efficiency as compute
+    from rocksweep.analysis.efficiency import im_efficiency as compute  # lazy: scipy (+0.8 s)
 
     return compute(_dataset_arg(ds, "ds"), state=state)
 
@@ -355,8 +350,7 @@ def estimate(scene: SceneLike, *, jobs: int = 1, overrides: Overrides = ()) -> A
     it: points, RK4 steps and evaluations expected, seconds with ``jobs`` workers, any
     kernel variant to compile first (measured on 256 points, ~10 ms; uncompiled: the step
     bound). Returns ``rocksweep.compute.sweep.Estimate`` (``str()``: one line)."""
-    # lazy: yaml (+0.1 s)
-    from rocksweep.compute.sweep import estimate as sweep_estimate
+    from rocksweep.compute.sweep import estimate as sweep_estimate  # lazy: yaml (+0.1 s)
     from rocksweep.scene.inputs import load
 
     sc, _ = load(scene, overrides)
@@ -377,8 +371,7 @@ def simulate(scene: SceneLike, overrides: Overrides = (), /,
     one ``Simulation`` per combination, in grid order (at most
     ``rocksweep.compute.history.API_MAX_RUNS``, 100; sweeps are for ``run``).
     """
-    # lazy: numba, scipy (+0.3 s)
-    from rocksweep.compute.history import API_MAX_RUNS, titled_runs
+    from rocksweep.compute.history import API_MAX_RUNS, titled_runs  # lazy: numba (+0.3 s)
     from rocksweep.scene.inputs import load, override_strings
 
     sc, _ = load(scene, [*override_strings(overrides), *override_strings(keys)])
@@ -397,8 +390,7 @@ def felt_motion(scene: SceneLike, overrides: Overrides = (), /, **keys: Any) -> 
     ``t`` [s] (``rocksweep.compute.motion``). scene and overrides as for ``simulate`` (one
     point). The kernel runs exactly these samples, linear between them
     (``rocksweep.physics.records.write_at2`` keeps one as a record)."""
-    # lazy: yaml (+94 ms)
-    from rocksweep.compute.motion import felt_motion as felt
+    from rocksweep.compute.motion import felt_motion as felt  # lazy: yaml (+94 ms)
     from rocksweep.scene.inputs import load, override_strings
 
     sc, _ = load(scene, [*override_strings(overrides), *override_strings(keys)])

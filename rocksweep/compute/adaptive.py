@@ -159,16 +159,6 @@ class Plan:
         per plan, kept, ``_flat_index``)."""
         return _flat_index(self)
 
-    def flat_at(self, p: np.ndarray, y: np.ndarray, x: np.ndarray) -> np.ndarray:
-        """int64[n]: ``flat_index()[p, y, x]`` for panel coordinates (int arrays[n]),
-        without the whole grid's index (a planning pass asks for a few thousand points of
-        millions: building it was a sixth of the planning's time)."""
-        others = [n for i, n in enumerate(self.full_shape) if i not in (self.x, self.y)]
-        rest = iter(np.unravel_index(np.asarray(p, np.int64), others) if others else ())
-        coords = [np.asarray(y, np.int64) if i == self.y else np.asarray(x, np.int64)
-                  if i == self.x else next(rest) for i in range(len(self.full_shape))]
-        return np.ravel_multi_index(coords, self.full_shape).astype(np.int64, copy=False)
-
 
 # A planning pass asked for the whole grid's index several times: ~4 ms each at 1000 x 1000
 # x 3, 8% of a tail pass (a plan is a frozen, hashable value: one index per plan, the last
@@ -298,7 +288,7 @@ def plan_coarse(shape: Sequence[int], axes: tuple[int, int], level: int) -> np.n
     the axes at positions ``axes`` (x, y) of ``shape`` plus their last index, for every
     value of the other axes."""
     plan = Plan(tuple(shape), axes[0], axes[1], coarse=level, audit=0.0)
-    return np.sort(lattice_points(plan, 2**level))
+    return np.sort(lattice_points(plan.flat_index(), 2**level))
 
 
 def _known(plan: Plan, outcome: np.ndarray, computed: np.ndarray,
@@ -350,7 +340,7 @@ def next_batch(plan: Plan, outcome: np.ndarray, computed: np.ndarray) -> Batch:
     """
     done = np.asarray(computed).ravel() > FILLED
     s0 = 2**plan.coarse
-    coarse = lattice_points(plan, s0)
+    coarse = lattice_points(plan.flat_index(), s0)
     missing = coarse[~done[coarse]]
     if missing.size:
         return Batch(np.sort(missing), "coarse", s0)
@@ -364,14 +354,14 @@ def next_batch(plan: Plan, outcome: np.ndarray, computed: np.ndarray) -> Batch:
         if not refine.any():
             continue
         if s == 2 and light:
-            want = edge_points(plan, mixed, known)
+            want = edge_points(plan.flat_index(), mixed, known)
             missing = want[~done[want]]
         elif s == 4 and light:
-            probes = centres(plan, refine, s)
-            missing = np.concatenate([points_of_cells(plan, mixed, s, known),
+            probes = centres(plan.flat_index(), refine, s)
+            missing = np.concatenate([points_of_cells(plan.flat_index(), mixed, s, known),
                                       probes[~done[probes]]])
         else:
-            missing = points_of_cells(plan, refine, s, known)
+            missing = points_of_cells(plan.flat_index(), refine, s, known)
         if missing.size:
             parts.append(missing)
             stride = stride or s // 2

@@ -6,7 +6,8 @@ Arrays are per panel (panels, ny, nx), the diagram axes last (``Plan.panels``); 
 lattice is every s-th index of both axes plus each axis's last index (``axis_lattice``),
 and its cells are the closed squares between neighbouring lattice points (a shorter last
 cell spans up to the axis's end). ``known`` is an int8 panel array: the class where
-computed, -1 elsewhere. Flat indices are into the grid (``Plan.flat_index``).
+computed, -1 elsewhere. ``index`` is the grid's flat index of every panel cell,
+int64[panels, ny, nx] (``adaptive.Plan.flat_index``): what the functions return is in it.
 """
 
 from __future__ import annotations
@@ -14,12 +15,8 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
-
-if TYPE_CHECKING:
-    from rocksweep.compute.adaptive import Plan
 
 NO_CLASS = np.int8(127)  # above every class, for minima over computed points
 
@@ -29,9 +26,9 @@ def axis_lattice(n: int, s: int) -> np.ndarray:
     return np.unique(np.append(np.arange(0, n, s), n - 1))
 
 
-def lattice_points(plan: Plan, s: int) -> np.ndarray:
-    _, ny, nx = plan.panel_shape
-    idx = plan.flat_index()
+def lattice_points(index: np.ndarray, s: int) -> np.ndarray:
+    _, ny, nx = index.shape
+    idx = index
     return idx[:, axis_lattice(ny, s)][:, :, axis_lattice(nx, s)].ravel()
 
 
@@ -123,7 +120,7 @@ def dilate(mask: np.ndarray, m: int) -> np.ndarray:
     return out
 
 
-def points_of_cells(plan: Plan, cells: np.ndarray, s: int,
+def points_of_cells(index: np.ndarray, cells: np.ndarray, s: int,
                      known: np.ndarray | None = None) -> np.ndarray:
     """Flat indices (increasing) of the stride-s/2 lattice points inside the marked
     stride-s cells (bool[P, cy, cx]; closed), each once; with ``known`` (int8 panels, -1:
@@ -133,7 +130,7 @@ def points_of_cells(plan: Plan, cells: np.ndarray, s: int,
     point, and no sort of them to remove the points that neighbouring cells share: that
     was a sixth of a planning pass's time)."""
     P, cy, cx = cells.shape
-    _, ny, nx = plan.panel_shape
+    _, ny, nx = index.shape
     h = s // 2
     ys, xs = axis_lattice(ny, h), axis_lattice(nx, h)
     lat = np.zeros((P, 2 * cy + 1, 2 * cx + 1), bool)
@@ -147,16 +144,15 @@ def points_of_cells(plan: Plan, cells: np.ndarray, s: int,
     if known is not None:
         lat &= known[:, ys][:, :, xs] < 0
     p, jj, ii = np.nonzero(lat)
-    return np.sort(plan.flat_index()[p, ys[jj], xs[ii]])
+    return np.sort(index[p, ys[jj], xs[ii]])
 
 
-def centres(plan: Plan, cells: np.ndarray, s: int) -> np.ndarray:
+def centres(index: np.ndarray, cells: np.ndarray, s: int) -> np.ndarray:
     """Flat indices of the centres of the marked stride-s cells (bool[P, cy, cx]), a
     shorter last cell's clipped to the axis's last index (then a corner)."""
-    _, ny, nx = plan.panel_shape
+    _, ny, nx = index.shape
     p, j, i = np.nonzero(cells)
-    return plan.flat_at(p, np.minimum(j * s + s // 2, ny - 1),
-                        np.minimum(i * s + s // 2, nx - 1))
+    return index[p, np.minimum(j * s + s // 2, ny - 1), np.minimum(i * s + s // 2, nx - 1)]
 
 
 def corner_classes(known: np.ndarray) -> np.ndarray:
@@ -181,7 +177,7 @@ def centre_classes(known: np.ndarray) -> np.ndarray:
     return m
 
 
-def edge_points(plan: Plan, mixed: np.ndarray, known: np.ndarray) -> np.ndarray:
+def edge_points(index: np.ndarray, mixed: np.ndarray, known: np.ndarray) -> np.ndarray:
     """Flat indices of the points the last level (stride 2 -> 1) computes in the mixed
     stride-2 cells ``mixed`` (bool[P, cy, cx]) whose four corners are computed.
 
@@ -206,7 +202,7 @@ def edge_points(plan: Plan, mixed: np.ndarray, known: np.ndarray) -> np.ndarray:
     """
     c, m = corner_classes(known), centre_classes(known)
     _, cy, cx = mixed.shape
-    _, ny, nx = plan.panel_shape
+    _, ny, nx = index.shape
     pts: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []  # (p, jj, ii) lattice points
 
     p, j, i = np.nonzero(mixed)
@@ -248,7 +244,7 @@ def edge_points(plan: Plan, mixed: np.ndarray, known: np.ndarray) -> np.ndarray:
     pp = np.concatenate([q[0] for q in pts])
     yy = np.minimum(np.concatenate([q[1] for q in pts]), ny - 1)
     xx = np.minimum(np.concatenate([q[2] for q in pts]), nx - 1)
-    return np.unique(plan.flat_at(pp, yy, xx))
+    return np.unique(index[pp, yy, xx])
 
 
 def edge_fill(known: np.ndarray) -> np.ndarray:

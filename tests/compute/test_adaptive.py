@@ -392,7 +392,7 @@ def test_the_last_levels_rules_on_their_cells_equal_them_on_every_cell():
             known[rng.random(shape) < 0.6] = -1
         cells = (shape[0], lattice.ncells(shape[1], 2), lattice.ncells(shape[2], 2))
         mixed = rng.random(cells) < rng.uniform(0, 1)
-        got = lattice.edge_points(plan, mixed, known)
+        got = lattice.edge_points(plan.flat_index(), mixed, known)
         np.testing.assert_array_equal(got, _edge_points_every_cell(plan, mixed, known))
         picked += got.size
     assert picked > 1000  # the rules fired
@@ -417,6 +417,6 @@ def test_the_points_of_marked_cells_are_those_of_their_closed_lattice():
                for p, j, i in zip(*np.nonzero(cells), strict=True)
                for dy in range(3) for dx in range(3)}
         want = sorted(int(idx[q]) for q in pts)
-        np.testing.assert_array_equal(lattice.points_of_cells(plan, cells, s), want)
+        np.testing.assert_array_equal(lattice.points_of_cells(idx, cells, s), want)
         todo = sorted(int(idx[q]) for q in pts if known[q] < 0)
-        np.testing.assert_array_equal(lattice.points_of_cells(plan, cells, s, known), todo)
+        np.testing.assert_array_equal(lattice.points_of_cells(idx, cells, s, known), todo)
