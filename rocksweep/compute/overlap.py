@@ -8,9 +8,8 @@ time with the audit candidates, which are known before the sweep starts.
 
 from __future__ import annotations
 
-import threading
 from collections.abc import Iterator
-from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 
 import numpy as np
 
@@ -43,18 +42,14 @@ class Runner:
     The audit sample is fixed before the sweep starts, and every candidate is computed by
     the time the sweep ends (by a refinement, or by the audit batch), so computing them
     early costs nothing: it fills the time a worker would otherwise wait at the end of a
-    batch while the others finish its last chunks, and while the next batch is planned
-    (the passes are serial: each batch is planned from the results of the one before).
-    Their results wait in memory until a batch asks for their points (``run``), which
-    then gets them as if they had just been computed: what the state machine sees, and so
-    the result, is unchanged (a point's result depends only on the point). A batch's own
-    chunks go first: a spare chunk is started only while fewer chunks than workers are in
-    flight, and it is short (``SPARE_SECONDS`` at the points' pace so far), so that the
-    next batch, on the sweep's critical path, waits for no long one. A chunk that ends
-    starts the next spare one itself (``_done``), so the workers stay busy while the
-    calling thread plans; before, they waited for it from the end of their last spare
-    chunk to the next batch (on Figure 3(b) at 1000 x 1000 x 3 lam, ~30 passes of
-    ~50 ms).
+    batch while the others finish its last chunks and the next batch is planned (the
+    passes are serial: each batch is planned from the results of the one before). Their
+    results wait in memory until a batch asks for their points (``run``), which then gets
+    them as if they had just been computed: what the state machine sees, and so the
+    result, is unchanged (a point's result depends only on the point). A batch's own
+    chunks go first: a spare chunk is started only while fewer chunks than workers run,
+    and it is short (``SPARE_SECONDS`` at the points' pace so far), so that the next
+    batch, on the sweep's critical path, waits for no long one.
     """
 
     def __init__(self, grid: Grid, plan: Plan, computed: np.ndarray, jobs: int = 2,
@@ -67,44 +62,23 @@ class Runner:
                                     & (np.asarray(computed).ravel() == FILLED))
         self.pace = [0.0, 0]  # seconds, points of the chunks so far
         self.ready: list[BatchResult] = []  # spare chunks done, points not asked for yet
-        self.running: dict = {}  # future -> (flat, spare?), until the caller collects it
-        self.flying = 0  # chunks submitted and not ended (running or queued)
-        # chunks kept in flight: every worker while a batch runs, one fewer while the
-        # calling thread plans the next (on the critical path: on 2 cores, with both
-        # workers busy meanwhile, the tail's passes took 35% longer)
-        self.limit = self.workers - 1
-        # spare, running and flying change from the workers' callbacks too
-        self.lock = threading.RLock()  # a future done at once calls back in _submit
+        self.running: dict = {}  # future -> (flat, spare?)
         self.pool = ThreadPoolExecutor(self.workers)
 
     def _submit(self, flat: np.ndarray, spare: bool) -> None:
-        """(under the lock)"""
-        self.flying += 1
-        f = self.pool.submit(self._chunk, flat)
-        self.running[f] = (flat, spare)
-        f.add_done_callback(self._done)
+        self.running[self.pool.submit(self._chunk, flat)] = (flat, spare)
 
     def _chunk(self, flat: np.ndarray) -> BatchResult:
         r = sw.run_chunk(Subset(self.grid, flat), 0, flat.size, self.level)
-        with self.lock:
-            self.pace[0] += r.seconds
-            self.pace[1] += flat.size
         return BatchResult(flat, r.arrays, r.seconds, r.cpu_seconds, r.refine_evaluations)
 
-    def _done(self, _f: Future) -> None:
-        """A chunk ended (in its worker, or at once if cancelled): top the pool up."""
-        with self.lock:
-            self.flying -= 1
-            self._top_up()
-
     def _top_up(self) -> None:
-        """(under the lock)"""
-        while self.spare.size and self.flying < self.limit:
+        while self.spare.size and len(self.running) < self.workers:
             per_point = self.pace[0] / self.pace[1] if self.pace[1] else 1e-3
             n = max(SPARE_MIN, int(SPARE_SECONDS / max(per_point, 1e-9)))
             n = min(n, self.chunk_size or n)
-            chunk, self.spare = self.spare[:n], self.spare[n:]
-            self._submit(chunk, True)
+            self._submit(self.spare[:n], True)
+            self.spare = self.spare[n:]
 
     def _take(self, want: np.ndarray, res: BatchResult
               ) -> tuple[BatchResult | None, BatchResult | None]:
@@ -135,27 +109,24 @@ class Runner:
                 todo[np.searchsorted(want, got.flat)] = False
                 yield got
         self.ready = kept
-        with self.lock:  # no spare chunk starts while the batch's points are sorted out
-            self.limit = self.workers
-            for part, spare in self.running.values():  # spare chunks on their way
-                if spare:
-                    todo[np.searchsorted(want, part[_member(part, want)])] = False
-            need = want[todo]
-            size = self.chunk_size or sw.auto_chunk_size(need.size, self.workers)
-            for i in range(0, need.size, size):
-                self._submit(need[i:i + size], False)
-            self.spare = self.spare[~_member(self.spare, want)]
-            left = int(todo.sum()) + sum(int(_member(p, want).sum())
-                                          for p, sp in self.running.values() if sp)
-            self._top_up()
+        for part, spare in list(self.running.values()):  # spare chunks on their way
+            if spare:
+                todo[np.searchsorted(want, part[_member(part, want)])] = False
+        need = want[todo]
+        size = self.chunk_size or sw.auto_chunk_size(need.size, self.workers)
+        for i in range(0, need.size, size):
+            self._submit(need[i:i + size], False)
+        self.spare = self.spare[~_member(self.spare, want)]
+        left = int(todo.sum()) + sum(int(_member(p, want).sum())
+                                      for p, sp in self.running.values() if sp)
+        self._top_up()
         while left > 0:
-            with self.lock:
-                futures = list(self.running)
-            done, _ = wait(futures, return_when=FIRST_COMPLETED)
+            done, _ = wait(list(self.running), return_when=FIRST_COMPLETED)
             for f in done:
-                with self.lock:
-                    part, spare = self.running.pop(f)
+                part, spare = self.running.pop(f)
                 res = f.result()
+                self.pace[0] += res.seconds
+                self.pace[1] += res.flat.size
                 if spare:
                     got, rest = self._take(want, res)
                     if rest is not None:
@@ -165,14 +136,11 @@ class Runner:
                 if got is not None:
                     left -= got.flat.size
                     yield got
-        with self.lock:  # the caller plans the next batch now
-            self.limit = self.workers - 1
+            self._top_up()
 
     def close(self) -> None:
         """Stop: spare chunks not started are dropped, running ones finish."""
-        with self.lock:
-            self.spare = self.spare[:0]
-            futures = list(self.running)
-        for f in futures:
+        self.spare = self.spare[:0]
+        for f in list(self.running):
             f.cancel()
         self.pool.shutdown(wait=True)
