@@ -95,8 +95,6 @@ COMPUTED_MEANING = _out.COMPUTED_MEANING
 # The settings' defaults (MIN_COARSE_CELLS, DEFAULT_MARGIN, ...): rocksweep.vocab.settings
 
 
-
-
 @dataclass(frozen=True)
 class Plan:
     """Where and how a grid is refined.
