@@ -26,10 +26,15 @@ def axis_lattice(n: int, s: int) -> np.ndarray:
     return np.unique(np.append(np.arange(0, n, s), n - 1))
 
 
+def on_lattice(a: np.ndarray, s: int) -> np.ndarray:
+    """The values of panels a (P, ny, nx) at the stride-s lattice's points."""
+    _, ny, nx = a.shape
+    return a[:, axis_lattice(ny, s)][:, :, axis_lattice(nx, s)]
+
+
 def lattice_points(index: np.ndarray, s: int) -> np.ndarray:
-    _, ny, nx = index.shape
-    idx = index
-    return idx[:, axis_lattice(ny, s)][:, :, axis_lattice(nx, s)].ravel()
+    """Flat indices of the stride-s lattice's points, panel by panel."""
+    return on_lattice(index, s).ravel()
 
 
 def ncells(n: int, s: int) -> int:
@@ -88,7 +93,7 @@ def cell_stats(known: np.ndarray, strides: Sequence[int]) -> dict[int, CellStats
     s = 2
     while True:
         if s in strides:
-            c = known[:, axis_lattice(ny, s)][:, :, axis_lattice(nx, s)] >= 0
+            c = on_lattice(known, s) >= 0
             corners = c[:, :-1, :-1] & c[:, 1:, :-1] & c[:, :-1, 1:] & c[:, 1:, 1:]
             out[s] = CellStats(lo, hi, corners)
         if s >= max(strides):
@@ -142,7 +147,7 @@ def points_of_cells(index: np.ndarray, cells: np.ndarray, s: int,
     # before it too: the lattice's last one
     lat = lat[:, :ys.size, :xs.size]
     if known is not None:
-        lat &= known[:, ys][:, :, xs] < 0
+        lat &= on_lattice(known, h) < 0
     p, jj, ii = np.nonzero(lat)
     return np.sort(index[p, ys[jj], xs[ii]])
 
@@ -158,8 +163,7 @@ def centres(index: np.ndarray, cells: np.ndarray, s: int) -> np.ndarray:
 def corner_classes(known: np.ndarray) -> np.ndarray:
     """int8[P, cy + 1, cx + 1]: the classes (-1: not computed) at the stride-2 lattice
     points, i.e. the corners of the stride-2 cells."""
-    _, ny, nx = known.shape
-    return known[:, axis_lattice(ny, 2)][:, :, axis_lattice(nx, 2)]
+    return on_lattice(known, 2)
 
 
 def centre_classes(known: np.ndarray) -> np.ndarray:
