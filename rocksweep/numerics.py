@@ -201,6 +201,19 @@ SPRING_SHIFT = 0.003
 SPRING_MEMORY = 50.0
 
 
+def spring_memory(omega_rock: np.ndarray | float, zeta_rock: np.ndarray | float
+                  ) -> np.ndarray:
+    """How long [p t] the top mass's spring remembers its past while the base rocks:
+    1/(zeta' omega_rock) for an oscillating spring (zeta_rock = zeta' < 1; inf undamped),
+    0 for an overdamped one or none (omega_rock = 0: a rigid body). omega_rock [rad/s],
+    p = 1 (``points.body_omega_rock``, ``points.rocking_spring_zeta``). float64 like the
+    input."""
+    w = np.asarray(omega_rock, float)
+    zr = np.asarray(zeta_rock, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where((w > 0.0) & (zr < 1.0), 1.0 / (zr * w), 0.0)
+
+
 def spring_decay(zeta_rock: np.ndarray | float, omega_rock: np.ndarray | float
                  ) -> np.ndarray:
     """The largest numerical decay rate [p] RK4 may add to an oscillating spring at 5 steps
@@ -229,7 +242,7 @@ def spring_steps(omega_rock: np.ndarray | float, steps_per_period: int,
     with np.errstate(divide="ignore", invalid="ignore"):
         f = np.maximum(1.0, (OMEGA_SPRING / w) ** 0.4)
         damp = np.where(zr < 1.0, (w / omega_d) ** 0.2, 0.0)
-        memory = np.minimum(SPRING_MEMORY, 1.0 / (zr * w))
+        memory = np.minimum(SPRING_MEMORY, spring_memory(w, zr))
         lag = np.where(zr < 1.0, (2 * math.pi / 5.0)
                        * (memory / (120.0 * SPRING_SHIFT)) ** 0.25, 0.0)
     return steps_per_period * np.maximum(np.maximum(f, damp), lag)
@@ -345,6 +358,17 @@ OVERTURN_BAND = 8.0
 # past the saddle: < 6 for alpha_ref > 0.01), short of the rocking to rest that holds most
 # of such a run's steps.
 CLOSE_AFTER = 4.0 * math.pi
+# A spring that remembers its past longer than RINGING_MEMORY [p t] (``spring_memory``,
+# the kernel's PAR_MEMORY) carries the step's error across many impacts: such a body's
+# coarse run parts from the finer ones far from the saddle, and the finer run falls on an
+# approach the coarse one passed wide, after the probe's stop. Its near-misses are probed
+# up to RINGING_BAND x the band (a run never within the band: to its end), and a probe
+# whose margin moved by more than itself (``compute.certify.settled``) makes the point a
+# close call. The four figures' springs remember 0.26-1.05 p t; the threshold samples'
+# wrong, unflagged classes were bodies of 12-90 p t (docs/accuracy.md, "Springs that ring
+# long").
+RINGING_MEMORY = 5.0
+RINGING_BAND = 2.0
 # A repeated overturn still inside the overturn band at its own step, below the last
 # level, is certified if its margins have converged (``compute.certify.converged``): both
 # runs fell within SAME_FALL [p t] of each other (on the same approach), and the finer

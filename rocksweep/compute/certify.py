@@ -29,7 +29,12 @@ when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the th
   (``probe_rows``): past its last approach, not through the rocking to rest that holds
   most of its steps. If the finer run overturns, or is itself a close call at its own
   step, the point is a close call as above (its full runs from the first refinement on);
-  if not, the run's own result is kept.
+  if not, the run's own result is kept. A body whose spring rings long (``ringing``:
+  PAR_MEMORY above ``numerics.RINGING_MEMORY``) has its safe runs probed up to
+  RINGING_BAND x PAR_CLOSE (to the run's end if it never came within PAR_CLOSE), and a
+  probe whose margin moved by more than itself (``settled``) makes it a close call too:
+  its runs part from finer ones over many impacts, and the finer run falls on a later
+  approach the coarse one passed wide (docs/accuracy.md, "Springs that ring long").
 
 Only the runs near a threshold pay: on the paper's figures' full grids 17-46% more RK4
 evaluations than the points' own, on their adaptive sweeps (almost only points near a
@@ -62,6 +67,8 @@ from rocksweep.numerics import (
     ENERGY_ORDER,
     OVERTURN_BAND,
     RICHARDSON_SAFETY,
+    RINGING_BAND,
+    RINGING_MEMORY,
     SAME_FALL,
 )
 
@@ -102,8 +109,8 @@ def converged(coarse_rows: np.ndarray, coarse: np.ndarray, fine_rows: np.ndarray
     least RICHARDSON_SAFETY times Richardson's estimate of its error, |m_f^2 - m_c^2| /
     (2^ENERGY_ORDER - 1): the class does not hang on the step."""
     m_c, m_f = coarse[:, L.OUT_MARGIN], fine[:, L.OUT_MARGIN]
-    err = np.abs(m_f * m_f - m_c * m_c) / (2.0 ** ENERGY_ORDER - 1.0)
     with np.errstate(invalid="ignore"):  # inf - inf: a margin never taken
+        err = np.abs(m_f * m_f - m_c * m_c) / (2.0 ** ENERGY_ORDER - 1.0)
         return (_fell(coarse) & _fell(fine) & same_fall(coarse, fine)
                 & (m_f >= fine_rows[:, L.PAR_CLOSE] / CLOSE_BAND)
                 & (m_f * m_f >= RICHARDSON_SAFETY * err))
@@ -122,11 +129,20 @@ def settled(coarse: np.ndarray, fine: np.ndarray) -> np.ndarray:
         return ~(np.abs(m_f * m_f - m_c * m_c) > m_f * m_f)
 
 
+def ringing(rows: np.ndarray) -> np.ndarray:
+    """bool[n]: the rows (float64[n, >= N_PAR]) of bodies whose spring remembers its past
+    longer than ``numerics.RINGING_MEMORY`` (PAR_MEMORY): their runs part from finer ones
+    over many impacts, far from the saddle."""
+    return rows[:, L.PAR_MEMORY] > RINGING_MEMORY
+
+
 def near_misses(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
-    """bool[n]: the safe runs whose margin lies in [1/CLOSE_BAND, 1) x PAR_CLOSE: checked
-    by a finer run up to their last approach (``probe_rows``) before they are trusted."""
+    """bool[n]: the safe runs whose margin lies in [1/CLOSE_BAND, 1) x PAR_CLOSE
+    (``ringing`` rows: up to RINGING_BAND x PAR_CLOSE): checked by a finer run up to their
+    last approach (``probe_rows``) before they are trusted."""
     m, band = outs[:, L.OUT_MARGIN], rows[:, L.PAR_CLOSE]
-    return ~_fell(outs) & (m >= band / CLOSE_BAND) & (m < band)
+    top = np.where(ringing(rows), RINGING_BAND * band, band)
+    return ~_fell(outs) & (m >= band / CLOSE_BAND) & (m < top)
 
 
 def refine_rows(rows: np.ndarray, level: int) -> np.ndarray:
@@ -142,10 +158,13 @@ def refine_rows(rows: np.ndarray, level: int) -> np.ndarray:
 
 def probe_rows(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     """The first refinement of ``rows`` (float64[k, >= N_PAR]), stopping CLOSE_AFTER [p t]
-    after each run's last approach to the saddle (``outs[:, OUT_T_CLOSE]``; float64[k,
-    N_OUT] the runs' results)."""
+    after each run's last approach to the saddle within the band (``outs[:, OUT_T_CLOSE]``;
+    float64[k, N_OUT] the runs' results), or at the row's own end where the run never came
+    within it (NaN: a ``ringing`` row's near-miss beyond PAR_CLOSE)."""
     out = refine_rows(rows, 1)
-    out[:, L.PAR_TEND] = np.minimum(out[:, L.PAR_TEND], outs[:, L.OUT_T_CLOSE] + CLOSE_AFTER)
+    stop = outs[:, L.OUT_T_CLOSE] + CLOSE_AFTER
+    out[:, L.PAR_TEND] = np.where(np.isnan(stop), out[:, L.PAR_TEND],
+                                  np.minimum(out[:, L.PAR_TEND], stop))
     return out
 
 
@@ -175,7 +194,10 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
         # was not kept for it; such flips are rare: none on the four figures)
         # or which is itself a close call at its own step (its approach came nearer the
         # saddle than the coarse run's: the coarse margin was not the run's to trust)
-        idx = np.union1d(idx, near[_fell(probe) | close_calls(checks, probe)])
+        # or, for a spring that rings long, whose margin moved by more than itself (its
+        # runs part over many impacts: the finer run's next approach may be its fall)
+        moved = ringing(rows[near]) & ~settled(outs[near], probe)
+        idx = np.union1d(idx, near[_fell(probe) | close_calls(checks, probe) | moved])
     for level in range(1, levels + 1):
         if idx.size == 0:
             break

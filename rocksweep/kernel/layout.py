@@ -77,7 +77,12 @@ PAR_T_AIR = 48  # first time g + a_v <= 0 [s] (inf: never): the run stops there,
 # The sliding base (CONTACT_SLIDE, docs/sliding.md): PAR_MU is then its kinetic friction
 # coefficient, this its static one (>= PAR_MU; NaN without mu)
 PAR_MU_STATIC = 49
-N_PAR = 50
+# How long the top mass's spring remembers its past while the base rocks [s], p = 1
+# (``numerics.spring_memory``; 0 for a rigid body). Not read by the kernel: the
+# certification probes the near-misses of a spring that rings long further
+# (``compute.certify``)
+PAR_MEMORY = 50
+N_PAR = 51
 # A record's row is longer: its samples xg''/PGA (float64[npts], in [-1, 1]) follow the
 # N_PAR parameters, PAR_REC = N_PAR the first (``points.with_record``). With a vertical
 # record: then one copy of the last horizontal sample (the horizontal's reader clamps at

@@ -21,6 +21,7 @@ from rocksweep.numerics import (
     Numerics,
     amplitude_frequency,
     close_band,
+    spring_memory,
     step_budget,
     step_sizes,
 )
@@ -151,6 +152,7 @@ def body_row(body: Body) -> np.ndarray:
         row[L.PAR_HA] = body.h_A
         row[L.PAR_K] = body.k if not body.rigid else 0.0
         row[L.PAR_C] = body.c
+        row[L.PAR_MEMORY] = spring_memory(body_omega_rock(body), body_zeta_rock(body))
     return row
 
 

@@ -27,7 +27,14 @@ from rocksweep.compute.driver import sweep_arrays
 from rocksweep.compute.single import run_point
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.numerics import CLOSE_AFTER, CLOSE_BAND, OVERTURN_BAND, Numerics
+from rocksweep.numerics import (
+    CLOSE_AFTER,
+    CLOSE_BAND,
+    OVERTURN_BAND,
+    RINGING_BAND,
+    RINGING_MEMORY,
+    Numerics,
+)
 from rocksweep.physics.bodies import BlockBody, FlexibleBody
 from rocksweep.physics.points import Point, kernel_kind, point_row
 from rocksweep.physics.reference import reference_run
@@ -86,6 +93,22 @@ CASES = [
                         mA_over_m=0.5870911136601574, IA_ratio=0.5304677117738952),
            0.04798491908524943, "sine", 1.5599727774432728, 1.0689059504580425),
      L.OUTCOME_MODE1),
+    # springs that ring long (seeds 1 and 10; 1/(zeta' omega_rock) = 11.9 and 24.2 p t):
+    # `default` rocks to rest after ~145 impacts with margins of 0.099 and 0.101 alpha_ref,
+    # 7.9 and 8.1 x the close-call margin; 20 steps a period and the reference overturn in
+    # mode 1 after 6 and 3 impacts, at 19.5 and 18.3 p t. The first one's probe at 10 steps
+    # stopped at 14.3 p t, before the fall, its margin 0.008 (moved by more than itself);
+    # the second one lies beyond the band: not probed before RINGING_BAND
+    (Point(FlexibleBody(wn_over_p=4.5995206050253845, zeta=0.01216059849378684,
+                        alpha_cg=0.23548630894464534, alpha_A=0.1846912670297746,
+                        mA_over_m=0.4497075382856386, IA_ratio=0.9795358578478384),
+           0.40432158738642565, "cosine", 7.341356655748948, 10.140268114250159),
+     L.OUTCOME_MODE1),
+    (Point(FlexibleBody(wn_over_p=1.8056627155637202, zeta=0.017385192977056818,
+                        alpha_cg=0.2384100271815635, alpha_A=0.25787897660818015,
+                        mA_over_m=2.8278779999915957, IA_ratio=0.8249220518496778),
+           0.360617709279215, "sine", 2.1547173634520327, 1.273314669996943),
+     L.OUTCOME_MODE1),
 ]
 
 
@@ -94,7 +117,8 @@ CASES = [
                               "flexible-overturn-side", "flexible-safe-side",
                               "flexible-overturn-unconverged",
                               "flexible-probe-close", "flexible-margin-unsettled",
-                              "flexible-near-miss-wide"])
+                              "flexible-near-miss-wide", "ringing-probe-moved",
+                              "ringing-beyond-band"])
 def test_default_classifies_the_reproduced_cases_like_the_reference(point, expected):
     """The reference's outcome is the one written here; `default` (sweep kernel and simulate) gives
     the same. Before the step rule, `default` gave safe / mode 1 here."""
@@ -189,6 +213,49 @@ def test_a_near_miss_is_probed_to_its_last_approach():
     assert outs[1, L.OUT_OUTCOME] == L.OUTCOME_MODE1 and outs[1, L.OUT_STEPS] == 130
     assert st[1] & L.STATUS_REFINED and not st[1] & L.STATUS_UNCERTIFIED
     assert st[2] == 0 and outs[2, L.OUT_STEPS] == 100
+
+
+def test_a_ringing_spring_near_miss_is_probed_wider_and_must_settle():
+    """certify's rule on a stand-in kernel, for a spring that rings long (PAR_MEMORY above
+    RINGING_MEMORY): a safe run up to RINGING_BAND x PAR_CLOSE is probed (one that never
+    came within PAR_CLOSE, OUT_T_CLOSE NaN, to its row's end), and a probe whose margin
+    moved by more than itself makes the point a close call; a body that does not ring
+    keeps both rules as they were."""
+    rows = np.zeros((4, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = 0.04  # close-call margin 0.005
+    rows[:, L.PAR_DT] = 1.0
+    rows[:, L.PAR_TEND] = 100.0
+    rows[:, L.PAR_MEMORY] = [2.0 * RINGING_MEMORY, 0.5 * RINGING_MEMORY] * 2
+    outs = np.zeros((4, L.N_OUT))
+    # rows 0-1: beyond PAR_CLOSE, within RINGING_BAND x it; rows 2-3: near-misses
+    outs[:, L.OUT_MARGIN] = [0.06, 0.06, 0.02, 0.02]
+    outs[:, L.OUT_T_CLOSE] = [np.nan, np.nan, 5.0, 5.0]
+    outs[:, L.OUT_STEPS] = 100
+    calls = []
+
+    def run(sub, idx, keep=True):
+        calls.append((idx.tolist(), sub[:, L.PAR_TEND].tolist(), keep))
+        res = np.zeros((len(idx), L.N_OUT))
+        res[:, L.OUT_STEPS] = 10
+        # the probes pass within 0.008 (clear of the close-call margin, but a ringing
+        # row's 0.02 moved by more than that); the full reruns stay clear and settled
+        res[:, L.OUT_MARGIN] = 0.008 if not keep else 0.5
+        return res
+
+    assert RINGING_BAND * 0.04 > 0.06
+    certify(rows, outs, run, 3)
+    assert calls[0] == ([0, 2, 3], [100.0, 5.0 + CLOSE_AFTER, 5.0 + CLOSE_AFTER], False)
+    # the ringing rows' margins moved (0.06 and 0.02 to 0.008): re-run in full, from
+    # level 1 (margin 0.5 there: clear and settled, certified); row 3's moved as much, but
+    # its spring does not ring: its probe is clear of the close-call margin, it is kept
+    assert calls[1:] == [([0, 2], [100.0, 100.0], True)]
+    st = outs[:, L.OUT_STATUS].astype(int)
+    assert st[0] & L.STATUS_REFINED and st[2] & L.STATUS_REFINED and st[3] & L.STATUS_REFINED
+    assert not (st[0] | st[2] | st[3]) & L.STATUS_FLAGGED
+    assert st[1] == 0  # not ringing: beyond its band, not probed
+    assert outs[3, L.OUT_STEPS] == 110  # probed, its own run kept
+    assert outs[0, L.OUT_STEPS] == outs[2, L.OUT_STEPS] == 120  # probe and level 1 counted
+    assert outs[0, L.OUT_MARGIN] == outs[2, L.OUT_MARGIN] == 0.5  # level 1's run kept
 
 
 def test_an_outcome_that_keeps_changing_is_uncertified():
