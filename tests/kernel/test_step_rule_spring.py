@@ -15,9 +15,9 @@ from bodies import FIG4
 from rocksweep.compute.driver import sweep_arrays
 from rocksweep.compute.single import run_point
 from rocksweep.kernel import layout as L  # noqa: N812
-from rocksweep.numerics import PRESETS, Numerics, spring_steps, step_sizes
+from rocksweep.numerics import PRESETS, Numerics, spring_memory, spring_steps, step_sizes
 from rocksweep.physics.bodies import FlexibleBody
-from rocksweep.physics.points import Point, body_omega_rock, body_zeta_rock
+from rocksweep.physics.points import Point, body_omega_rock, body_zeta_rock, point_row
 from rocksweep.physics.reference import reference_run
 from rocksweep.scene.parse import load_scene
 
@@ -150,6 +150,24 @@ def test_soft_springs_and_rigid_bodies_keep_their_steps(omega_rock: float,
         want = spp * max(1.0, (27.5 / omega_rock) ** 0.4) if omega_rock else math.inf
         got = float(spring_steps(omega_rock, spp, zeta_rock))
         assert got == pytest.approx(want, rel=1e-12)
+
+
+def test_the_spring_memory_is_its_free_decay_time() -> None:
+    """numerics.spring_memory, written into the rows (PAR_MEMORY): the e-folding time of
+    the rocking spring's free vibration, 1/(zeta' omega_rock) = 2 m / (c Gamma) with
+    Gamma = 1 + m h^2 / (I_A + m_A R_A^2) (u'' = -Gamma (k u + c u')/m, the top mass above
+    the corner), from the body's own m, c, h, I_A: inf undamped, 0 rigid or overdamped."""
+    for zeta in (0.0, 0.01, 0.05):
+        body = FlexibleBody(wn_over_p=2.43, zeta=zeta, alpha_cg=0.15, alpha_A=0.28,
+                            mA_over_m=0.47, IA_ratio=0.56)
+        gamma = 1.0 + body.m * body.h**2 / (body.I_A + body.m_A * body.R_A**2)
+        want = math.inf if zeta == 0.0 else 2.0 * body.m / (body.c * gamma)
+        got = float(spring_memory(body_omega_rock(body), body_zeta_rock(body)))
+        assert got == pytest.approx(want, rel=1e-12)
+        row = point_row(Point(body, 0.0, "sine", 2.0, 3.0), Numerics.preset("default"))
+        assert row[L.PAR_MEMORY] == got
+    assert float(spring_memory(0.0, 0.0)) == 0.0  # a rigid body: no spring
+    assert float(spring_memory(5.0, 1.5)) == 0.0  # overdamped: it does not ring
 
 
 def test_threshold_point_of_figure4b_is_safe_at_default() -> None:
