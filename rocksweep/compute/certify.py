@@ -36,6 +36,11 @@ when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the th
   its runs part from finer ones over many impacts, and the finer run falls on a later
   approach the coarse one passed wide (docs/accuracy.md, "Springs that ring long").
 
+Below the last level, a repeated outcome is not trusted either where the finer run grazed
+an impact it did not make (OUT_GRAZE below ``numerics.GRAZE_MARGIN``) by an amount that
+moved by more than itself between the two runs (``grazed``): a coming impact, which a
+finer run makes.
+
 Only the runs near a threshold pay: on the paper's figures' full grids 17-46% more RK4
 evaluations than the points' own, on their adaptive sweeps (almost only points near a
 boundary) 1.7-2.2x (``scripts/bench_certify.py``); within 0.5% of a threshold, where every
@@ -65,6 +70,7 @@ from rocksweep.numerics import (
     CLOSE_AFTER,
     CLOSE_BAND,
     ENERGY_ORDER,
+    GRAZE_MARGIN,
     OVERTURN_BAND,
     RICHARDSON_SAFETY,
     RINGING_BAND,
@@ -127,6 +133,17 @@ def settled(coarse: np.ndarray, fine: np.ndarray) -> np.ndarray:
     m_c, m_f = coarse[:, L.OUT_MARGIN], fine[:, L.OUT_MARGIN]
     with np.errstate(invalid="ignore"):  # inf - inf: a margin never taken
         return ~(np.abs(m_f * m_f - m_c * m_c) > m_f * m_f)
+
+
+def grazed(coarse: np.ndarray, fine: np.ndarray) -> np.ndarray:
+    """bool[n]: the finer of two runs of the same points (result rows float64[n, N_OUT])
+    grazed an impact it did not make by less than ``numerics.GRAZE_MARGIN`` (OUT_GRAZE,
+    alpha_ref), with a graze that moved by more than itself between them: an impact a finer
+    run may make (a graze that converges keeps its size; one that is a coming impact
+    shrinks toward 0 as the step halves)."""
+    g_c, g_f = coarse[:, L.OUT_GRAZE], fine[:, L.OUT_GRAZE]
+    with np.errstate(invalid="ignore"):  # inf - inf: no graze in either
+        return (g_f < GRAZE_MARGIN) & (np.abs(g_f - g_c) > g_f)
 
 
 def ringing(rows: np.ndarray) -> np.ndarray:
@@ -217,6 +234,8 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
         if level < levels:
             trusted &= settled(before, new)
             trusted |= converged(refine_rows(rows[idx], level - 1), before, finer, new)
+            # and, either way, no graze that moved (an impact the next run may make)
+            trusted &= ~grazed(before, new)
         # a repeated overturn counts only if both runs fell on the same approach (within
         # SAME_FALL): two falls far apart are two trajectories that parted, whatever their
         # margins (wide-space.yaml's undamped bodies at lam 1 fell at 79, 195 and 102 p t

@@ -72,6 +72,7 @@ from rocksweep.kernel.layout import (
     OUT_E_IMPACT,
     OUT_E_MAX,
     OUT_EVENT_STEPS,
+    OUT_GRAZE,
     OUT_HIST_ROWS,
     OUT_IMPACTS,
     OUT_MARGIN,
@@ -193,6 +194,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     rot = prm[PAR_ROT_STEP]
     acc = 0.0
     margin = np.inf  # OUT_MARGIN, in a register
+    graze = np.inf  # OUT_GRAZE
     t_close = np.nan  # OUT_T_CLOSE
     # ``_near_saddle``'s bounds, once per run (saddle0 = NaN: no gate, every free rocking
     # step takes ``_saddle``'s test; a row without a body, as warm_up's)
@@ -265,6 +267,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
             theta_max = _theta_max(y, y_ev, tau, s, theta_max)  # (y_ev, tau) = (y1, h) if none
 
         if ev == EV_NONE:
+            if s != 0:
+                graze = _graze(y, y1, h, s, prm, graze)
             t, y = (t_pulse if lands else (t_air if air else t + h)), y1
             if s != 0 and not on and _near_saddle(y, s, near):
                 q = _saddle(y, s, prm)
@@ -296,6 +300,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
                                  DAMPED, ENERGY, GROUND)
     out[OUT_MARGIN] = margin
     out[OUT_T_CLOSE] = t_close
+    out[OUT_GRAZE] = graze
     _finish(t, y, s, steps, event_steps, theta_max, prm, out, FLEX, ENERGY)
     reactions_end(REACTIONS, prm, out)
 
@@ -423,6 +428,20 @@ def _rotation_step(theta_dot, acc, rot):
 def _finite(y):
     return (math.isfinite(y[Y_THETA]) and math.isfinite(y[Y_THETA_DOT])
             and math.isfinite(y[Y_U]) and math.isfinite(y[Y_U_DOT]))
+
+
+@njit(cache=True, **INLINE)
+def _graze(y, y_end, h, s, prm, graze):
+    """OUT_GRAZE updated over a rocking step (t, y) -> (t + h, y_end) on corner s with no
+    event in it: where s theta fell and rose again inside the step (an arc that turned
+    back just short of an impact), the minimum of the step's cubic Hermite interpolant of
+    s theta, in alpha_ref, if below ``graze``."""
+    g0, g1 = s * y[Y_THETA], s * y_end[Y_THETA]
+    d0, d1 = s * y[Y_THETA_DOT], s * y_end[Y_THETA_DOT]
+    if g0 > 0.0 and g1 > 0.0 and d0 < 0.0 < d1:
+        _, g_min = hermite_min(g0, d0, g1, d1, h)
+        return min(graze, g_min / prm[PAR_ALPHA_REF])
+    return graze
 
 
 @njit(cache=True, **INLINE)

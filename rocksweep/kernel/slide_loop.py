@@ -66,6 +66,7 @@ from rocksweep.kernel.layout import (
     OUT_E_IMPACT,
     OUT_E_MAX,
     OUT_EVENT_STEPS,
+    OUT_GRAZE,
     OUT_HIST_ROWS,
     OUT_IMPACTS,
     OUT_IMPULSE_MAX,
@@ -131,6 +132,7 @@ from rocksweep.kernel.layout import (
 )
 from rocksweep.kernel.loop import (
     _flag,
+    _graze,
     _near_saddle,
     _overturned,
     _reset,
@@ -199,6 +201,7 @@ def simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     rot = prm[PAR_ROT_STEP]
     acc = 0.0
     margin = np.inf
+    graze = np.inf  # OUT_GRAZE (``loop._graze``)
     t_close = np.nan
     near = _saddle_bounds(prm)
     ev0 = _event_values(t, y, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED, GROUND)
@@ -272,6 +275,8 @@ def simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
             slide_max = abs(y_ev[Y_X])
 
         if slot < 0:
+            if s != 0:
+                graze = _graze(y, y1, h, s, prm, graze)
             t, y, ev0 = (t_pulse if lands else (t_air if air else t + h)), y1, ev1
             if s != 0 and sigma == 0 and not on and _near_saddle(y, s, near):
                 q = _saddle(y, s, prm)
@@ -309,6 +314,7 @@ def simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
         _record(hist, t, y, s, sigma, on, prm, out, FLEX, GROUND)
     out[OUT_MARGIN] = margin
     out[OUT_T_CLOSE] = t_close
+    out[OUT_GRAZE] = graze
     _finish(t, y, s, steps, event_steps, theta_max, slide_max, prm, out, FLEX, ENERGY)
 
 

@@ -30,6 +30,7 @@ from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import (
     CLOSE_AFTER,
     CLOSE_BAND,
+    GRAZE_MARGIN,
     OVERTURN_BAND,
     RINGING_BAND,
     RINGING_MEMORY,
@@ -109,6 +110,15 @@ CASES = [
                         mA_over_m=2.8278779999915957, IA_ratio=0.8249220518496778),
            0.360617709279215, "sine", 2.1547173634520327, 1.273314669996943),
      L.OUTCOME_MODE1),
+    # a graze (seed 19): just above the pulse's uplift threshold, `default` at 5 and 10
+    # steps a period rocks to rest through ~190 impacts (margins 0.012 and 0.009), its arcs
+    # grazing theta = 0 at 7.3e-4 then 1.3e-4 alpha_ref without an impact; 20 steps and the
+    # reference make that impact (at 1.80 p t) and overturn in mode 1 after 7
+    (Point(FlexibleBody(wn_over_p=3.685875454041754, zeta=0.0970436258544244,
+                        alpha_cg=0.08472585297979551, alpha_A=0.24588356376249662,
+                        mA_over_m=2.906150601512549, IA_ratio=0.36398053129159574),
+           0.1508474214840334, "sine", 2.589274983284195, 1.1223682677246714),
+     L.OUTCOME_MODE1),
 ]
 
 
@@ -118,7 +128,7 @@ CASES = [
                               "flexible-overturn-unconverged",
                               "flexible-probe-close", "flexible-margin-unsettled",
                               "flexible-near-miss-wide", "ringing-probe-moved",
-                              "ringing-beyond-band"])
+                              "ringing-beyond-band", "graze"])
 def test_default_classifies_the_reproduced_cases_like_the_reference(point, expected):
     """The reference's outcome is the one written here; `default` (sweep kernel and simulate) gives
     the same. Before the step rule, `default` gave safe / mode 1 here."""
@@ -318,6 +328,36 @@ def test_a_knife_edge_is_refined_until_clear_or_flagged():
     assert st[0] & L.STATUS_UNCERTIFIED and st[0] & L.STATUS_FLAGGED
     assert st[1] & L.STATUS_REFINED and not st[1] & L.STATUS_UNCERTIFIED
     assert (outs[:, L.OUT_OUTCOME] == L.OUTCOME_SAFE).all()
+
+
+def test_a_graze_that_moved_is_refined_further():
+    """certify's rule on a stand-in kernel: a repeated outcome clear of the saddle whose
+    finer run grazed an impact it did not make by less than GRAZE_MARGIN (OUT_GRAZE), with
+    a graze that shrank by more than itself (a coming impact), goes on to the next level;
+    one whose graze settled, stayed above GRAZE_MARGIN or never was, stops at level 1."""
+    rows = np.zeros((4, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = 0.04
+    rows[:, L.PAR_DT] = 1.0
+    g = GRAZE_MARGIN
+    grazes = {0: [0.8 * g, 0.2 * g, 0.19 * g], 1: [0.8 * g, 0.7 * g],
+              2: [80 * g, 10 * g], 3: [np.inf, np.inf]}
+    outs = np.zeros((4, L.N_OUT))
+    outs[:, L.OUT_MARGIN] = 0.001  # close calls
+    outs[:, L.OUT_GRAZE] = [grazes[i][0] for i in range(4)]
+    levels_run = {i: [] for i in range(4)}
+
+    def run(sub, idx, keep=True):
+        res = np.zeros((len(idx), L.N_OUT))
+        level = round(-np.log2(sub[0, L.PAR_DT]))
+        res[:, L.OUT_MARGIN] = 0.5  # clear and settled
+        for j, i in enumerate(idx):
+            levels_run[int(i)].append(level)
+            res[j, L.OUT_GRAZE] = grazes[int(i)][level]
+        return res
+
+    certify(rows, outs, run, 3)
+    assert levels_run == {0: [1, 2], 1: [1], 2: [1], 3: [1]}
+    assert not (outs[:, L.OUT_STATUS].astype(int) & L.STATUS_FLAGGED).any()
 
 
 def _run_ladder(rows: np.ndarray, ladder: dict, levels: int) -> tuple[np.ndarray, dict]:

@@ -31,6 +31,7 @@ from rocksweep.kernel.events import (
     hermite_newton,
     hermite_root,
 )
+from rocksweep.kernel.loop import _graze
 from rocksweep.kernel.stepping import first_stage, rk4_step
 from rocksweep.physics.points import body_omega_rock
 from rocksweep.vocab.settings import ROOT_CODE
@@ -276,3 +277,28 @@ def test_a_zero_divisor_ends_the_run_flagged_not_with_an_exception():
     status = out[:, L.OUT_STATUS].astype(np.int64)
     assert not status[0] & L.STATUS_NONFINITE and np.isfinite(out[0, L.OUT_THETA_MAX])
     assert status[1] & L.STATUS_NONFINITE
+
+
+def test_the_graze_is_the_step_cubics_minimum():
+    """loop._graze (OUT_GRAZE): over a rocking step in which s theta fell and rose again
+    without reaching 0, the minimum of the cubic through theta and theta' at both ends (its
+    four coefficients solved for here, its minimum from the roots of its derivative), in
+    alpha_ref, kept if below the graze so far; a step without such a dip leaves it."""
+    prm = np.zeros(L.N_PAR)
+    prm[L.PAR_ALPHA_REF] = 0.2
+    h = 0.1
+    th0, thd0, th1, thd1 = 0.004, -0.05, 0.003, 0.04  # on corner s: s theta, s theta'
+    # c0 + c1 t + c2 t^2 + c3 t^3 through (0, th0, thd0) and (h, th1, thd1)
+    a = np.array([[1, 0, 0, 0], [0, 1, 0, 0], [1, h, h**2, h**3], [0, 1, 2 * h, 3 * h**2]])
+    c = np.linalg.solve(a, [th0, thd0, th1, thd1])
+    crit = [r.real for r in np.roots([3 * c[3], 2 * c[2], c[1]])
+            if abs(r.imag) < 1e-12 and 0 < r.real < h]
+    want = min(np.polyval(c[::-1], t) for t in crit)
+    assert 0 < want < min(th0, th1)
+    for s in (1, -1):
+        y0 = (s * th0, s * thd0, 0.0, 0.0, 0.0, 0.0)
+        y1 = (s * th1, s * thd1, 0.0, 0.0, 0.0, 0.0)
+        assert _graze(y0, y1, h, s, prm, math.inf) == pytest.approx(want / 0.2, rel=1e-9)
+        assert _graze(y0, y1, h, s, prm, 1e-6) == 1e-6  # a closer graze before it stays
+        rising = (s * th0, s * 0.01, 0.0, 0.0, 0.0, 0.0)
+        assert _graze(rising, y1, h, s, prm, math.inf) == math.inf  # no dip
