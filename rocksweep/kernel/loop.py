@@ -267,7 +267,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
             theta_max = _theta_max(y, y_ev, tau, s, theta_max)  # (y_ev, tau) = (y1, h) if none
 
         if ev == EV_NONE:
-            if s != 0:
+            if s != 0 and on:
                 graze = _graze(y, y1, h, s, prm, graze)
             t, y = (t_pulse if lands else (t_air if air else t + h)), y1
             if s != 0 and not on and _near_saddle(y, s, near):

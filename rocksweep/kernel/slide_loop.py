@@ -275,7 +275,7 @@ def simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
             slide_max = abs(y_ev[Y_X])
 
         if slot < 0:
-            if s != 0:
+            if s != 0 and on:
                 graze = _graze(y, y1, h, s, prm, graze)
             t, y, ev0 = (t_pulse if lands else (t_air if air else t + h)), y1, ev1
             if s != 0 and sigma == 0 and not on and _near_saddle(y, s, near):
