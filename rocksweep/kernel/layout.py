@@ -137,11 +137,11 @@ OUT_SLIDE_MAX = 25  # max |x| over the run [m]: how far the base slipped along t
 OUT_SLIDE_FINAL = 26  # |x| at the end [m]
 OUT_REGIME = 27  # the phases visited: bit (1 << PHASE_CODE) of each (``vocab.phases``)
 OUT_D_FRIC = 28  # energy dissipated by friction [J] (energy variants, else NaN)
-OUT_GRAZE = 29  # closest a rocking arc came to an impact it did not make: the least
-#                 minimum of s theta inside a step where theta fell and rose again without
-#                 reaching 0 (the step's cubic Hermite interpolant) [alpha_ref] (inf: no
-#                 such dip). A small one that moves between runs is a graze the class may
-#                 hang on (``rocksweep.compute.certify``)
+OUT_GRAZE = 29  # closest a rocking arc came to an impact it did not make while the ground
+#                 moved: the least minimum of s theta inside a step where theta fell and
+#                 rose again without reaching 0 (the step's cubic Hermite interpolant)
+#                 [alpha_ref] (inf: no such dip). A small one that moves between runs is a
+#                 graze the class may hang on (``rocksweep.compute.certify``)
 N_OUT = 30
 
 # --- state tuple y (the loop's 6 slots, a UniTuple(float64, 6)) ----------------------------
