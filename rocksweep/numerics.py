@@ -374,10 +374,10 @@ RINGING_BAND = 2.0
 # impact happens, and a coarse run can miss one a finer run makes: flexible bodies just
 # above the pulse's uplift threshold rocked to rest at 5 and 10 steps a period where 20
 # steps and the reference overturn, after an arc that grazed theta = 0 at 7-8e-4
-# alpha_ref, then 1.3-2.6e-4, and finer runs impacted (docs/accuracy.md, "Grazes"). Below
-# the last level, a repeated outcome whose finer run grazed below GRAZE_MARGIN with a
-# graze that moved by more than itself between the two runs is not trusted
-# (``compute.certify.grazed``).
+# alpha_ref, then 1.3-2.6e-4, and finer runs impacted (docs/accuracy.md, "Grazes while
+# the ground moves"). Below the last level, a repeated outcome whose finer run grazed
+# below GRAZE_MARGIN with a graze that moved by more than itself between the two runs is
+# not trusted (``compute.certify.grazed``).
 GRAZE_MARGIN = 1e-3
 # A repeated overturn still inside the overturn band at its own step, below the last
 # level, is certified if its margins have converged (``compute.certify.converged``): both

@@ -438,7 +438,7 @@ def _graze(y, y_end, h, s, prm, graze):
     s theta, in alpha_ref, if below ``graze``. The loops call it while the ground moves:
     a graze there decides the forced response (after it, the free rocking's grazes moved
     between runs at many points of the figures and decided no class; docs/accuracy.md,
-    "Grazes")."""
+    "Grazes while the ground moves")."""
     g0, g1 = s * y[Y_THETA], s * y_end[Y_THETA]
     d0, d1 = s * y[Y_THETA_DOT], s * y_end[Y_THETA_DOT]
     if g0 > 0.0 and g1 > 0.0 and d0 < 0.0 < d1:
