@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.numerics import EVENT_TOL_REFINE, MIN_EVENT_TOL
 from rocksweep.physics.bodies import G, u_cr
 from rocksweep.vocab.axes import AXES, alpha_symbol
 from rocksweep.vocab.ground import AVGSA_POINTS, RECORD_IMS, SA, SA_DAMPING, SCALE_IMS
@@ -245,20 +246,30 @@ THETA_REL_FLOOR = 1e-2
 # Row slots a half-step rerun (outputs.check) changes, and by what factor: the RK4 steps
 # after and while the ground moves (PAR_DT, PAR_DT_ON; PAR_REC_H, the step while a record
 # acts, stays a whole fraction of its sample interval), the rotation limit of one rocking
-# step, the evaluation budget, which the halved step doubles, and the close-call margin
-# (``numerics.close_margin``). Powers of 2 are exact in float64, so the rerun is the run at
-# twice the steps_per_period and pulse_steps and half the rotation_step, bit for bit.
+# step, the evaluation budget, which the halved step doubles, the close-call margin
+# (``numerics.close_margin``) and the event tolerance (``numerics.EVENT_TOL_REFINE``,
+# down to MIN_EVENT_TOL). Powers of 2 are exact in float64, so the rerun is the run at
+# twice the steps_per_period and pulse_steps, half the rotation_step and a 16th of the
+# event_tol, bit for bit.
 CHECK_SCALE: dict[int, float] = {L.PAR_DT: 0.5, L.PAR_DT_ON: 0.5, L.PAR_REC_H: 0.5,
                                  L.PAR_ROT_STEP: 0.5, L.PAR_MAXSTEPS: 2.0,
-                                 L.PAR_CLOSE: 0.5 ** 2.5}
+                                 L.PAR_CLOSE: 0.5 ** 2.5, L.PAR_TOL: EVENT_TOL_REFINE}
+
+
+def refined_rows(rows: np.ndarray, level: int) -> np.ndarray:
+    """Parameter rows (float64[n, >= N_PAR]) of the same points at 2**level times the
+    steps (``CHECK_SCALE``; ``Numerics.refined``): a close call's rerun at that refinement
+    (``compute.certify``); level 1 is the half-step rerun of outputs.check."""
+    out = rows.copy()
+    for slot, factor in CHECK_SCALE.items():
+        out[:, slot] *= factor ** level
+    np.maximum(out[:, L.PAR_TOL], MIN_EVENT_TOL, out=out[:, L.PAR_TOL])
+    return out
 
 
 def check_rows(rows: np.ndarray) -> np.ndarray:
     """Parameter rows (float64[n, >= N_PAR]) of the half-step rerun of the same points."""
-    half = rows.copy()
-    for slot, factor in CHECK_SCALE.items():
-        half[:, slot] *= factor
-    return half
+    return refined_rows(rows, 1)
 
 
 def convert(outs: np.ndarray, alpha_ref: np.ndarray | float, E_ref: np.ndarray | float,

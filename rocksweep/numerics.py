@@ -58,6 +58,15 @@ _DEFAULT = PRESETS[DEFAULT_PRESET]
 # have. (The root finders bracket tau inside one step, <= pi/2 long, spacing 2.2e-16, so
 # they end for any tolerance above ~1e-15; 1e-12 leaves a margin of ~4000 spacings.)
 MIN_EVENT_TOL = 1e-12
+# A refinement's event tolerance: event_tol x EVENT_TOL_REFINE per halving of the step,
+# down to MIN_EVENT_TOL (``Numerics.refined``, ``fields.refined_rows``). An event's time
+# error carries into the state as a step's error does, and RK4's global error falls as
+# the step^4: a refinement that halved the steps alone left each event's error where it
+# was. On a threshold sample (seed 36) a lightly damped spring's runs at 20-80 steps a
+# period agreed on an overturn after 5 impacts at event_tol 1e-6; at 1e-7 and below every
+# one of them rocks to rest, as `fine` (1e-8) and the reference do (docs/accuracy.md,
+# "Clear by twice the margin, events located finer").
+EVENT_TOL_REFINE = 0.5 ** 4
 
 # RK4 evaluations the kernel may spend locating one event before a run is capped
 # (``step_budget``): bisection takes log2(step/event_tol) ~ 20-40, Hermite 2-5.
@@ -138,12 +147,15 @@ class Numerics:
                 f"refine={self.refine}, horizon={self.horizon:g}, root={self.root})")
 
     def refined(self, level: int) -> Numerics:
-        """These numerics at 2**level times the steps: a close call's rerun at that
-        refinement (``compute.certify.refine_rows`` scales the rows the same way)."""
+        """These numerics at 2**level times the steps (and EVENT_TOL_REFINE**level times
+        the event tolerance): a close call's rerun at that refinement
+        (``fields.refined_rows`` scales the rows the same way)."""
         f = 2 ** level
         return replace(self, steps_per_period=self.steps_per_period * f,
                        pulse_steps=self.pulse_steps * f,
-                       rotation_step=self.rotation_step / f, refine=0)
+                       rotation_step=self.rotation_step / f,
+                       event_tol=max(self.event_tol * EVENT_TOL_REFINE ** level,
+                                     MIN_EVENT_TOL), refine=0)
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -393,6 +405,17 @@ RICHARDSON_SAFETY = 2.0
 # Any repeated overturn, converged or not, is trusted only where both runs fell within
 # SAME_FALL of each other (``compute.certify.certify``).
 SAME_FALL = 1.0
+# Below the last level, a repeated outcome is trusted only where the finer run cleared
+# CLEARANCE times its own step's close-call margin (``compute.certify.clear``): the
+# coarse step's margin scaled as the step^(3/2), not the step^(5/2) of ``close_margin``
+# (2^(5/2 - 3/2) = 2). Where impacts lead the motion to its approach, the error can fall
+# as the step^3 between the first two levels: at a threshold sample's point (seed 10) the
+# speed after a pair of impacts erred by 4.9e-3, 6e-4, 1e-4 alpha_ref p at 5, 10, 20
+# steps a period, and the overturn its 5 and 10 steps agreed on (margins 0.0036 and 0.0042
+# alpha_ref: 1.9 x the finer step's close-call margin) rocks to rest at 20 and in the
+# reference; another's (seed 18) safe runs, 1.9 x too, overturn there (docs/accuracy.md,
+# "Clear by twice the margin").
+CLEARANCE = 2.0
 
 
 def close_margin(steps_per_period: int) -> float:

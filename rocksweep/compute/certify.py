@@ -9,19 +9,22 @@ the vertex of the hyperbola it rocks on, in alpha_ref, ~ sqrt(|E - E_barrier|/E_
 when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the threshold:
 
 - a safe run below ``numerics.close_margin``, or an overturn below OVERTURN_BAND times
-  it, is run again at half the steps (``refine_rows``: every step and the rotation limit
-  halved, the step cap doubled), and again, until two consecutive runs give the same
-  outcome (an overturn on the same approach, within ``numerics.SAME_FALL``) and the finer
-  one is no close call at its own step (its margins scale with the
-  step, ``numerics.close_margin``: a knife edge repeats itself at every step it is a
-  close call at) with a margin that did not move between them by more than itself
-  (``settled``) or ``Numerics.refine`` refinements were made; the finest run is kept.
+  it, is run again at half the steps (``fields.refined_rows``: every step and the
+  rotation limit halved, the step cap doubled, the event tolerance a 16th), and again,
+  until two consecutive runs give the same outcome (an overturn on the same approach,
+  within ``numerics.SAME_FALL``) and the finer one is no close call at its own step (its
+  margins scale with the step, ``numerics.close_margin``: a knife edge repeats itself at
+  every step it is a close call at) and, below the last level, clears that margin
+  ``numerics.CLEARANCE`` times (``clear``: where impacts lead to the approach, the
+  margin's error can fall slower than ``close_margin`` assumes) with a margin that did
+  not move between them by more than itself (``settled``), or ``Numerics.refine``
+  refinements were made; the finest run is kept.
   A repeated overturn still inside the band at its own step is certified too where its
-  margin converged between the two runs (``converged``: the same fall, and the finer
-  squared margin, ~ the energy past the barrier, clear of Richardson's estimate of its
-  error) and a finer run would follow (at the last level the verdict is as before): most
-  of the knife-edge rule's reruns were overturns whose margin had already settled at
-  level 1, the coarse step's band being far wider than its error there;
+  margin converged between the two runs (``converged``: the same fall, the finer margin
+  ``clear``, and its square, ~ the energy past the barrier, clear of Richardson's estimate
+  of its error) and a finer run would follow (at the last level the verdict is as
+  before): most of the knife-edge rule's reruns were overturns whose margin had already
+  settled at level 1, the coarse step's band being far wider than its error there;
 - a safe run between the close-call margin and the row's PAR_CLOSE (``numerics.
   close_band``, CLOSE_BAND times it: a near-miss, which turned back with a margin a
   coarse step's error can still reverse) is checked by a run at half the steps that stops
@@ -64,9 +67,10 @@ from collections.abc import Callable
 
 import numpy as np
 
-from rocksweep.fields import CHECK_SCALE
+from rocksweep.fields import refined_rows
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import (
+    CLEARANCE,
     CLOSE_AFTER,
     CLOSE_BAND,
     ENERGY_ORDER,
@@ -98,6 +102,14 @@ def close_calls(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     return outs[:, L.OUT_MARGIN] < bound
 
 
+def clear(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
+    """bool[n]: runs (parameter rows float64[n, >= N_PAR], result rows float64[n, N_OUT])
+    whose margin is at least ``numerics.CLEARANCE`` times their step's close-call margin
+    (PAR_CLOSE / CLOSE_BAND): clear of the saddle even where the margin's error falls only
+    as the step^3 (impacts), not the step^5 ``close_margin`` assumes."""
+    return outs[:, L.OUT_MARGIN] >= CLEARANCE * rows[:, L.PAR_CLOSE] / CLOSE_BAND
+
+
 def same_fall(coarse: np.ndarray, fine: np.ndarray) -> np.ndarray:
     """bool[n]: two runs of the same points (result rows float64[n, N_OUT]) that fell
     within ``numerics.SAME_FALL`` [p t] of each other, on the same approach (False where
@@ -110,15 +122,15 @@ def converged(coarse_rows: np.ndarray, coarse: np.ndarray, fine_rows: np.ndarray
     """bool[n]: overturns whose margin has converged between two runs of the same points
     (parameter rows float64[n, >= N_PAR] and result rows float64[n, N_OUT] of a run and of
     its refinement at half the steps): both fell, within ``numerics.SAME_FALL`` [p t] of
-    each other (on the same approach), the finer one clear of its own step's close-call
-    margin (PAR_CLOSE / CLOSE_BAND), and its squared margin (~ |E - E_barrier|/E_ref) at
+    each other (on the same approach), the finer one ``clear`` of its own step's close-call
+    margin, and its squared margin (~ |E - E_barrier|/E_ref) at
     least RICHARDSON_SAFETY times Richardson's estimate of its error, |m_f^2 - m_c^2| /
     (2^ENERGY_ORDER - 1): the class does not hang on the step."""
     m_c, m_f = coarse[:, L.OUT_MARGIN], fine[:, L.OUT_MARGIN]
     with np.errstate(invalid="ignore"):  # inf - inf: a margin never taken
         err = np.abs(m_f * m_f - m_c * m_c) / (2.0 ** ENERGY_ORDER - 1.0)
         return (_fell(coarse) & _fell(fine) & same_fall(coarse, fine)
-                & (m_f >= fine_rows[:, L.PAR_CLOSE] / CLOSE_BAND)
+                & clear(fine_rows, fine)
                 & (m_f * m_f >= RICHARDSON_SAFETY * err))
 
 
@@ -162,23 +174,12 @@ def near_misses(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     return ~_fell(outs) & (m >= band / CLOSE_BAND) & (m < top)
 
 
-def refine_rows(rows: np.ndarray, level: int) -> np.ndarray:
-    """Parameter rows (float64[n, >= N_PAR]) of the same points at 2**level times the
-    steps (the slots of ``fields.CHECK_SCALE``: the steps after and while the ground moves,
-    a record's sample step, the rotation limit; the step cap grows as the steps do).
-    Powers of two are exact in float64: level 1 is the half-step rerun of ``check_rows``."""
-    out = rows.copy()
-    for slot, factor in CHECK_SCALE.items():
-        out[:, slot] *= factor ** level
-    return out
-
-
 def probe_rows(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     """The first refinement of ``rows`` (float64[k, >= N_PAR]), stopping CLOSE_AFTER [p t]
     after each run's last approach to the saddle within the band (``outs[:, OUT_T_CLOSE]``;
     float64[k, N_OUT] the runs' results), or at the row's own end where the run never came
     within it (NaN: a ``ringing`` row's near-miss beyond PAR_CLOSE)."""
-    out = refine_rows(rows, 1)
+    out = refined_rows(rows, 1)
     stop = outs[:, L.OUT_T_CLOSE] + CLOSE_AFTER
     out[:, L.PAR_TEND] = np.where(np.isnan(stop), out[:, L.PAR_TEND],
                                   np.minimum(out[:, L.PAR_TEND], stop))
@@ -220,20 +221,21 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
             break
         before = outs[idx]
         spent_now = before[:, [L.OUT_STEPS, L.OUT_EVENT_STEPS, L.OUT_REFINE_EVALS]]
-        finer = refine_rows(rows[idx], level)
+        finer = refined_rows(rows[idx], level)
         new = run(finer, idx)
         # the same outcome twice, and the finer run clear of the saddle by its own step's
         # margin (a knife edge agrees with itself at every step it is a close call at)
-        # and, below the last level, with a margin that did not move by more than itself
-        # (``settled``), or, where it spares a finer run, an overturn whose margin
-        # converged between the two. At the last level neither would spare a run: the
+        # and, below the last level, by CLEARANCE times it (``clear``) with a margin that
+        # did not move by more than itself (``settled``), or, where it spares a finer run,
+        # an overturn whose margin converged between the two. At the last level neither
+        # would spare a run: the
         # verdict there stays as before (knife edges whose margins jitter at ~1e-4
         # alpha_ref would be flagged by ``settled``: 17 more of 1935 on threshold sample 3,
         # none of them wrong)
         trusted = ~close_calls(finer, new)
         if level < levels:
-            trusted &= settled(before, new)
-            trusted |= converged(refine_rows(rows[idx], level - 1), before, finer, new)
+            trusted &= settled(before, new) & clear(finer, new)
+            trusted |= converged(refined_rows(rows[idx], level - 1), before, finer, new)
             # and, either way, no graze that moved (an impact the next run may make)
             trusted &= ~grazed(before, new)
         # a repeated overturn counts only if both runs fell on the same approach (within

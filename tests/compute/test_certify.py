@@ -25,12 +25,15 @@ from bodies import BODY3
 from rocksweep.compute.certify import certify
 from rocksweep.compute.driver import sweep_arrays
 from rocksweep.compute.single import run_point
+from rocksweep.fields import check_rows, refined_rows
 from rocksweep.kernel import chunk_kernel, warm_up
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.numerics import (
+    CLEARANCE,
     CLOSE_AFTER,
     CLOSE_BAND,
     GRAZE_MARGIN,
+    MIN_EVENT_TOL,
     OVERTURN_BAND,
     RINGING_BAND,
     RINGING_MEMORY,
@@ -119,6 +122,29 @@ CASES = [
                         mA_over_m=2.906150601512549, IA_ratio=0.36398053129159574),
            0.1508474214840334, "sine", 2.589274983284195, 1.1223682677246714),
      L.OUTCOME_MODE1),
+    # clear by twice the margin (seeds 10 and 18): `default` at 5 and 10 steps a period
+    # overturns after 3 impacts (margins 0.0036 and 0.0042 alpha_ref, converged, the second
+    # 1.9 x its step's close-call margin); 20 steps and the reference rock to rest. And
+    # one that rocks to rest at 5 and 10 steps (margins 0.0034 and 0.0041, 1.9 x) where 20
+    # steps and the reference overturn after 15 impacts
+    (Point(FlexibleBody(wn_over_p=3.839128118005102, zeta=0.04836142719624848,
+                        alpha_cg=0.08226364888458781, alpha_A=0.28483523130561605,
+                        mA_over_m=2.466746728263963, IA_ratio=0.8438206825733008),
+           0.008303049307849586, "sine", 8.550640729956466, 12.044341170783627),
+     L.OUTCOME_SAFE),
+    (Point(FlexibleBody(wn_over_p=3.244384436080784, zeta=0.1241331001565131,
+                        alpha_cg=0.10430558839545015, alpha_A=0.3825673588512779,
+                        mA_over_m=2.7502004413457013, IA_ratio=0.8790279046190526),
+           0.38111342415709554, "sine", 2.60235692855235, 1.1135754061905543),
+     L.OUTCOME_MODE1),
+    # events located finer (seed 36): a lightly damped spring whose runs at 20-80 steps a
+    # period all overturn after 5 impacts at event_tol 1e-6; at 1e-7 and below each rocks
+    # to rest, as the reference does after ~100 impacts
+    (Point(FlexibleBody(wn_over_p=4.647534481033071, zeta=0.005360295426164207,
+                        alpha_cg=0.2608468305885651, alpha_A=0.2401621490149733,
+                        mA_over_m=2.1164155659054247, IA_ratio=0.6289562775924202),
+           0.045452296669503345, "cosine", 4.494057754758692, 8.396486280261689),
+     L.OUTCOME_SAFE),
 ]
 
 
@@ -128,7 +154,8 @@ CASES = [
                               "flexible-overturn-unconverged",
                               "flexible-probe-close", "flexible-margin-unsettled",
                               "flexible-near-miss-wide", "ringing-probe-moved",
-                              "ringing-beyond-band", "graze"])
+                              "ringing-beyond-band", "graze", "clear-overturn",
+                              "clear-safe", "event-tol"])
 def test_default_classifies_the_reproduced_cases_like_the_reference(point, expected):
     """The reference's outcome is the one written here; `default` (sweep kernel and simulate) gives
     the same. Before the step rule, `default` gave safe / mode 1 here."""
@@ -413,6 +440,53 @@ def test_a_repeated_overturn_whose_margin_converged_stops_there():
     st = outs[:, L.OUT_STATUS].astype(int)
     assert (st & L.STATUS_REFINED).all() and not (st[:5] & L.STATUS_UNCERTIFIED).any()
     assert st[5] & L.STATUS_UNCERTIFIED
+
+
+def test_below_the_last_level_a_repeated_outcome_clears_twice_its_margin():
+    """certify's rule on a stand-in kernel: below the last level, a repeated outcome, safe
+    or a converged overturn, is trusted only where the finer margin is at least CLEARANCE
+    times its own step's close-call margin (the coarse step's scaled as the step^(3/2));
+    at the last level once is enough, as before."""
+    # close-call margin b_L = 0.01 x 2^(-2.5 L): b_1 = 0.00177, CLEARANCE x b_1 = 0.00354
+    rows = np.zeros((4, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = 0.01 * CLOSE_BAND
+    rows[:, L.PAR_DT] = 1.0
+    fell, safe = L.OUTCOME_MODE1, L.OUTCOME_SAFE
+    ladder = {
+        # settled, 1.7 x b_1: one more level
+        0: [(safe, 0.004, np.nan), (safe, 0.003, np.nan), (safe, 0.003, np.nan)],
+        # settled, 2.04 x b_1: stops at level 1
+        1: [(safe, 0.004, np.nan), (safe, 0.0036, np.nan)],
+        # converged overturns (the same fall, Richardson's estimate far below m_f^2) at
+        # 1.7 x and 2.04 x b_1
+        2: [(fell, 0.0032, 10.0), (fell, 0.003, 10.0), (fell, 0.003, 10.0)],
+        3: [(fell, 0.0038, 10.0), (fell, 0.0036, 10.0)],
+    }
+    assert CLEARANCE == 2.0
+    outs, levels_run = _run_ladder(rows, ladder, 3)
+    assert levels_run == {0: [1, 2], 1: [1], 2: [1, 2], 3: [1]}
+    assert not (outs[:, L.OUT_STATUS].astype(int) & L.STATUS_UNCERTIFIED).any()
+    # at the last level (refine 1) the 1.7 x run is certified there
+    outs, levels_run = _run_ladder(rows[:1], {0: ladder[0]}, 1)
+    assert levels_run == {0: [1]}
+    assert not int(outs[0, L.OUT_STATUS]) & L.STATUS_UNCERTIFIED
+
+
+def test_a_refinement_locates_events_finer():
+    """refined_rows (and Numerics.refined, which the admission's cost check runs) take the
+    event tolerance to a 16th per halving of the step, no lower than MIN_EVENT_TOL;
+    outputs.check's rerun is level 1."""
+    point = Point(BLOCK, 0.0, "sine", 8.0, 10.9)
+    n = Numerics.preset("default")
+    row = point_row(point, n)[None, :]
+    for level in (1, 2, 3):
+        tol = refined_rows(row, level)[0, L.PAR_TOL]
+        assert tol == n.event_tol / 16 ** level
+        assert point_row(point, n.refined(level))[L.PAR_TOL] == tol
+    assert check_rows(row)[0, L.PAR_TOL] == n.event_tol / 16
+    tight = Numerics.preset("default", event_tol=4 * MIN_EVENT_TOL)
+    assert tight.refined(3).event_tol == MIN_EVENT_TOL
+    assert refined_rows(point_row(point, tight)[None, :], 3)[0, L.PAR_TOL] == MIN_EVENT_TOL
 
 
 def test_a_repeated_overturn_on_another_approach_is_not_trusted():

@@ -46,10 +46,10 @@ def _same(a: np.ndarray, b: np.ndarray) -> bool:
 
 
 def test_rerun_is_the_sweep_at_half_the_step():
-    """check_* equal the differences to an independent sweep at 2 x steps_per_period and
-    rotation_step / 2 (the row scaling is exact in float64), over flexible and rigid
-    bodies, both shapes, e < 1 and e > 1; the run's own fields equal a sweep without
-    check."""
+    """check_* equal the differences to an independent sweep at 2 x steps_per_period,
+    rotation_step / 2 and event_tol / 16 (the row scaling is exact in float64), over
+    flexible and rigid bodies, both shapes, e < 1 and e > 1; the run's own fields equal a
+    sweep without check."""
     plain = sweep_arrays(parse_scene(SCENE))[0]
     checked = sweep_arrays(parse_scene(SCENE, overrides=["outputs.check=true"]))[0]
     default = PRESETS["default"]
@@ -57,7 +57,8 @@ def test_rerun_is_the_sweep_at_half_the_step():
     half = sweep_arrays(parse_scene(SCENE, overrides=[
         f"numerics.steps_per_period={2 * spp}",
         f"numerics.pulse_steps={2 * default.pulse_steps}",
-        f"numerics.rotation_step={default.rotation_step / 2}"]))[0]
+        f"numerics.rotation_step={default.rotation_step / 2}",
+        f"numerics.event_tol={default.event_tol / 16}"]))[0]
     assert set(checked) == set(plain) | set(CHECK_NAMES)
     for k, v in plain.items():
         assert _same(checked[k], v), k
