@@ -46,9 +46,9 @@ finer run makes.
 
 Only the runs near a threshold pay: on the paper's figures' full grids 17-46% more RK4
 evaluations than the points' own, on their adaptive sweeps (almost only points near a
-boundary) 1.7-2.2x (``scripts/bench_certify.py``); within 0.5% of a threshold, where every
-run pays, the certified runs take 2.6-3.2x the bare ones' (``scripts/threshold_sample.py``;
-docs/accuracy.md, "Round 4").
+boundary) 1.8-2.4x (``scripts/bench_certify.py``); within 0.5% of a threshold, where every
+run pays, the certified runs take 3.1-3.8x the bare ones' (``scripts/threshold_sample.py``;
+docs/accuracy.md, "Round 4" and "Clear by twice the margin, events located finer").
 
 Every refined or checked point has STATUS_REFINED in its status; one whose outcome still
 changed at the last refinement, or which was still a close call there, also
