@@ -414,7 +414,7 @@ SAME_FALL = 1.0
 # steps a period, and the overturn its 5 and 10 steps agreed on (margins 0.0036 and 0.0042
 # alpha_ref: 1.9 x the finer step's close-call margin) rocks to rest at 20 and in the
 # reference; another's (seed 18) safe runs, 1.9 x too, overturn there (docs/accuracy.md,
-# "Clear by twice the margin").
+# "Clear by twice the margin, events located finer").
 CLEARANCE = 2.0
 
 

@@ -227,11 +227,10 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
         # margin (a knife edge agrees with itself at every step it is a close call at)
         # and, below the last level, by CLEARANCE times it (``clear``) with a margin that
         # did not move by more than itself (``settled``), or, where it spares a finer run,
-        # an overturn whose margin converged between the two. At the last level neither
-        # would spare a run: the
-        # verdict there stays as before (knife edges whose margins jitter at ~1e-4
-        # alpha_ref would be flagged by ``settled``: 17 more of 1935 on threshold sample 3,
-        # none of them wrong)
+        # an overturn whose margin converged between the two. At the last level none of
+        # them would spare a run: the verdict there stays as before (knife edges whose
+        # margins jitter at ~1e-4 alpha_ref would be flagged by ``settled``: 17 more of
+        # 1935 on threshold sample 3, none of them wrong)
         trusted = ~close_calls(finer, new)
         if level < levels:
             trusted &= settled(before, new) & clear(finer, new)
