@@ -30,8 +30,9 @@ when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the th
   coarse step's error can still reverse) is checked by a run at half the steps that stops
   ``numerics.CLOSE_AFTER`` after OUT_T_CLOSE, its last time within the band
   (``probe_rows``): past its last approach, not through the rocking to rest that holds
-  most of its steps. If the finer run overturns, or is itself a close call at its own
-  step, the point is a close call as above (its full runs from the first refinement on);
+  most of its steps. If the finer run overturns, or does not ``clear`` its own step's
+  close-call margin CLEARANCE times, the point is a close call as above (its full runs
+  from the first refinement on);
   if not, the run's own result is kept. A body whose spring rings long (``ringing``:
   PAR_MEMORY above ``numerics.RINGING_MEMORY``) has its safe runs probed up to
   RINGING_BAND x PAR_CLOSE (to the run's end if it never came within PAR_CLOSE), and a
@@ -210,12 +211,13 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
         # a near-miss the finer run overturns is a close call: its full runs from level 1
         # (the probe's run is not reused as level 1: a history, where one is recorded,
         # was not kept for it; such flips are rare: none on the four figures)
-        # or which is itself a close call at its own step (its approach came nearer the
-        # saddle than the coarse run's: the coarse margin was not the run's to trust)
+        # or which does not ``clear`` its own step's close-call margin CLEARANCE times, as
+        # a finer run below the last level must (its approach came nearer the saddle than
+        # the coarse run's: the coarse margin was not the run's to trust)
         # or, for a spring that rings long, whose margin moved by more than itself (its
         # runs part over many impacts: the finer run's next approach may be its fall)
         moved = ringing(rows[near]) & ~settled(outs[near], probe)
-        idx = np.union1d(idx, near[_fell(probe) | close_calls(checks, probe) | moved])
+        idx = np.union1d(idx, near[_fell(probe) | ~clear(checks, probe) | moved])
     for level in range(1, levels + 1):
         if idx.size == 0:
             break

@@ -37,6 +37,7 @@ from rocksweep.numerics import (
     OVERTURN_BAND,
     RINGING_BAND,
     RINGING_MEMORY,
+    SAME_FALL,
     Numerics,
 )
 from rocksweep.physics.bodies import BlockBody, FlexibleBody
@@ -145,6 +146,29 @@ CASES = [
                         mA_over_m=2.1164155659054247, IA_ratio=0.6289562775924202),
            0.045452296669503345, "cosine", 4.494057754758692, 8.396486280261689),
      L.OUTCOME_SAFE),
+    # falls that moved (seed 37): `default` at 5 and 10 steps overturns after a chatter of 7
+    # impacts and a 10 p t creep to the saddle, falling 0.86 p t apart (margins 0.016,
+    # 0.018); 20 steps and the reference rock to rest
+    (Point(FlexibleBody(wn_over_p=2.7130457923670743, zeta=0.05408015458343131,
+                        alpha_cg=0.09410451933184985, alpha_A=0.41232774836102537,
+                        mA_over_m=1.3031095121007714, IA_ratio=0.8118827777636031),
+           0.4653911688089458, "sine", 4.788063776208234, 3.1461616999062776),
+     L.OUTCOME_SAFE),
+    # probes that must clear twice their margin (seeds 39 and 44, drawn after the rules
+    # above; before the finer event tolerance, their probes were close calls):
+    # near-misses (margins 1.04 and 1.3 x the close-call margin) whose probes at 10 steps
+    # stay safe 1.1-1.2 x their own step's margin away; 20 steps and the reference
+    # overturn after 1 impact
+    (Point(FlexibleBody(wn_over_p=3.0800381649449644, zeta=0.09052809882064987,
+                        alpha_cg=0.22264291317829377, alpha_A=0.23133862564106367,
+                        mA_over_m=0.3943392577779223, IA_ratio=0.972440396327676),
+           0.2869093448570578, "cosine", 3.7543599616085386, 2.663931193052373),
+     L.OUTCOME_MODE1),
+    (Point(FlexibleBody(wn_over_p=3.772668007617098, zeta=0.04535670898537445,
+                        alpha_cg=0.26259796074669167, alpha_A=0.3297679672564091,
+                        mA_over_m=1.1163266672244812, IA_ratio=0.7017887641230507),
+           0.27312513876994055, "sine", 5.289383516384128, 5.187507434762409),
+     L.OUTCOME_MODE1),
 ]
 
 
@@ -155,7 +179,8 @@ CASES = [
                               "flexible-probe-close", "flexible-margin-unsettled",
                               "flexible-near-miss-wide", "ringing-probe-moved",
                               "ringing-beyond-band", "graze", "clear-overturn",
-                              "clear-safe", "event-tol"])
+                              "clear-safe", "event-tol", "fall-moved", "probe-clear-1",
+                              "probe-clear-2"])
 def test_default_classifies_the_reproduced_cases_like_the_reference(point, expected):
     """The reference's outcome is the one written here; `default` (sweep kernel and simulate) gives
     the same. Before the step rule, `default` gave safe / mode 1 here."""
@@ -250,6 +275,34 @@ def test_a_near_miss_is_probed_to_its_last_approach():
     assert outs[1, L.OUT_OUTCOME] == L.OUTCOME_MODE1 and outs[1, L.OUT_STEPS] == 130
     assert st[1] & L.STATUS_REFINED and not st[1] & L.STATUS_UNCERTIFIED
     assert st[2] == 0 and outs[2, L.OUT_STEPS] == 100
+
+
+def test_a_near_miss_whose_probe_does_not_clear_twice_its_margin_is_a_close_call():
+    """certify's rule on a stand-in kernel: a near-miss whose probe stays safe but within
+    CLEARANCE x its own step's close-call margin is re-run in full from level 1; one whose
+    probe clears it keeps its own result."""
+    rows = np.zeros((2, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = 0.01 * CLOSE_BAND  # level 1's close-call margin: 0.00177
+    rows[:, L.PAR_DT] = 1.0
+    rows[:, L.PAR_TEND] = 100.0
+    outs = np.zeros((2, L.N_OUT))
+    outs[:, L.OUT_MARGIN] = 0.013  # near-misses (1.3 x the close-call margin)
+    outs[:, L.OUT_T_CLOSE] = 5.0
+    levels_run = {0: [], 1: []}
+
+    def run(sub, idx, keep=True):
+        res = np.zeros((len(idx), L.N_OUT))
+        level = round(-np.log2(sub[0, L.PAR_DT]))
+        for j, i in enumerate(idx):
+            levels_run[int(i)].append((level, keep))
+            # the probes: point 0 at 1.2 x, point 1 at 2.2 x level 1's margin
+            res[j, L.OUT_MARGIN] = [0.0021, 0.0039][int(i)] if not keep else 0.5
+        return res
+
+    certify(rows, outs, run, 3)
+    assert levels_run == {0: [(1, False), (1, True)], 1: [(1, False)]}
+    assert not (outs[:, L.OUT_STATUS].astype(int) & L.STATUS_UNCERTIFIED).any()
+    assert outs[1, L.OUT_MARGIN] == 0.013  # its own result kept
 
 
 def test_a_ringing_spring_near_miss_is_probed_wider_and_must_settle():
@@ -501,15 +554,18 @@ def test_a_repeated_overturn_on_another_approach_is_not_trusted():
     # per point and level 0..2: (outcome, margin, overturning time); level 0 inside the
     # overturn band (a close call), every finer margin far outside it and settled
     ladder = {
-        0: [(fell, 0.02, 10.0), (fell, 0.3, 10.5)],
+        0: [(fell, 0.02, 10.0), (fell, 0.3, 10.0 + SAME_FALL)],
         1: [(fell, 0.02, 79.0), (fell, 0.3, 195.0), (fell, 0.3, 195.2)],
         2: [(fell, 0.02, 79.0), (fell, 0.3, 195.0), (fell, 0.3, 102.0)],
+        # a fall that moved by 0.86 p t (seed 37's, a creep to the saddle)
+        3: [(fell, 0.02, 12.59), (fell, 0.3, 13.45), (fell, 0.3, 13.46)],
     }
-    outs, levels_run = _run_ladder(rows, ladder, 2)
-    assert levels_run == {0: [1], 1: [1, 2], 2: [1, 2]}
+    assert SAME_FALL == 0.5
+    outs, levels_run = _run_ladder(np.vstack([rows, rows[:1]]), ladder, 2)
+    assert levels_run == {0: [1], 1: [1, 2], 2: [1, 2], 3: [1, 2]}
     st = outs[:, L.OUT_STATUS].astype(int)
     assert not st[0] & L.STATUS_UNCERTIFIED and not st[1] & L.STATUS_UNCERTIFIED
-    assert st[2] & L.STATUS_UNCERTIFIED
+    assert st[2] & L.STATUS_UNCERTIFIED and not st[3] & L.STATUS_UNCERTIFIED
 
 
 SCENE = """
