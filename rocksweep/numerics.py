@@ -406,8 +406,8 @@ RICHARDSON_SAFETY = 2.0
 # SAME_FALL of each other (``compute.certify.certify``). Half a p t: a fall that moved by
 # more crept toward the saddle, where the class hangs on the speed it came with (seeds 10
 # and 37 of the threshold samples fell 0.67 and 0.86 p t apart at 5 and 10 steps a period
-# and rock to rest at 20 and in the reference); on the four adaptive figures 99% of the
-# repeated falls at refined points are within 0.63 p t, the median 0.003.
+# and rock to rest at 20 and in the reference); on the four adaptive figures (400 x 400 x
+# 3 lam) 99% of the repeated falls at refined points are within 0.63 p t, the median 0.003.
 SAME_FALL = 0.5
 # Below the last level, a repeated outcome is trusted only where the finer run cleared
 # CLEARANCE times its own step's close-call margin (``compute.certify.clear``): the
