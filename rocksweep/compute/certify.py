@@ -94,12 +94,18 @@ def _evaluations(outs: np.ndarray) -> np.ndarray:
     return outs[:, L.OUT_STEPS] + outs[:, L.OUT_EVENT_STEPS]
 
 
+def _close_margin(rows: np.ndarray) -> np.ndarray:
+    """float64[n]: the rows' close-call margin [alpha_ref] (``numerics.close_margin``):
+    PAR_CLOSE / CLOSE_BAND."""
+    return rows[:, L.PAR_CLOSE] / CLOSE_BAND
+
+
 def close_calls(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     """bool[n]: the runs (parameter rows float64[n, >= N_PAR], result rows float64[n,
     N_OUT]) re-run in full: they stayed safe with a margin below the close-call margin
     (``numerics.close_margin``: the row's PAR_CLOSE / CLOSE_BAND, in alpha_ref) or
     overturned with one below OVERTURN_BAND times it."""
-    bound = np.where(_fell(outs), OVERTURN_BAND, 1.0) * (rows[:, L.PAR_CLOSE] / CLOSE_BAND)
+    bound = np.where(_fell(outs), OVERTURN_BAND, 1.0) * _close_margin(rows)
     return outs[:, L.OUT_MARGIN] < bound
 
 
@@ -108,7 +114,7 @@ def clear(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     whose margin is at least ``numerics.CLEARANCE`` times their step's close-call margin
     (PAR_CLOSE / CLOSE_BAND): clear of the saddle even where the margin's error falls only
     as the step^3 (impacts), not the step^5 ``close_margin`` assumes."""
-    return outs[:, L.OUT_MARGIN] >= CLEARANCE * rows[:, L.PAR_CLOSE] / CLOSE_BAND
+    return outs[:, L.OUT_MARGIN] >= CLEARANCE * _close_margin(rows)
 
 
 def same_fall(coarse: np.ndarray, fine: np.ndarray) -> np.ndarray:
@@ -118,15 +124,14 @@ def same_fall(coarse: np.ndarray, fine: np.ndarray) -> np.ndarray:
     return np.abs(fine[:, L.OUT_T_OVERTURN] - coarse[:, L.OUT_T_OVERTURN]) <= SAME_FALL
 
 
-def converged(coarse_rows: np.ndarray, coarse: np.ndarray, fine_rows: np.ndarray,
-              fine: np.ndarray) -> np.ndarray:
+def converged(coarse: np.ndarray, fine_rows: np.ndarray, fine: np.ndarray) -> np.ndarray:
     """bool[n]: overturns whose margin has converged between two runs of the same points
-    (parameter rows float64[n, >= N_PAR] and result rows float64[n, N_OUT] of a run and of
-    its refinement at half the steps): both fell, within ``numerics.SAME_FALL`` [p t] of
-    each other (on the same approach), the finer one ``clear`` of its own step's close-call
-    margin, and its squared margin (~ |E - E_barrier|/E_ref) at
-    least RICHARDSON_SAFETY times Richardson's estimate of its error, |m_f^2 - m_c^2| /
-    (2^ENERGY_ORDER - 1): the class does not hang on the step."""
+    (result rows float64[n, N_OUT] of a run and of its refinement at half the steps, whose
+    parameter rows float64[n, >= N_PAR] are ``fine_rows``): both fell, within
+    ``numerics.SAME_FALL`` [p t] of each other (on the same approach), the finer one
+    ``clear`` of its own step's close-call margin, and its squared margin (~ |E -
+    E_barrier|/E_ref) at least RICHARDSON_SAFETY times Richardson's estimate of its error,
+    |m_f^2 - m_c^2| / (2^ENERGY_ORDER - 1): the class does not hang on the step."""
     m_c, m_f = coarse[:, L.OUT_MARGIN], fine[:, L.OUT_MARGIN]
     with np.errstate(invalid="ignore"):  # inf - inf: a margin never taken
         err = np.abs(m_f * m_f - m_c * m_c) / (2.0 ** ENERGY_ORDER - 1.0)
@@ -172,7 +177,7 @@ def near_misses(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     last approach (``probe_rows``) before they are trusted."""
     m, band = outs[:, L.OUT_MARGIN], rows[:, L.PAR_CLOSE]
     top = np.where(ringing(rows), RINGING_BAND * band, band)
-    return ~_fell(outs) & (m >= band / CLOSE_BAND) & (m < top)
+    return ~_fell(outs) & (m >= _close_margin(rows)) & (m < top)
 
 
 def probe_rows(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
@@ -236,7 +241,7 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
         trusted = ~close_calls(finer, new)
         if level < levels:
             trusted &= settled(before, new) & clear(finer, new)
-            trusted |= converged(refined_rows(rows[idx], level - 1), before, finer, new)
+            trusted |= converged(before, finer, new)
             # and, either way, no graze that moved (an impact the next run may make)
             trusted &= ~grazed(before, new)
         # a repeated overturn counts only if both runs fell on the same approach (within
