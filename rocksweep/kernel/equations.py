@@ -34,7 +34,7 @@ import math
 
 from numba import njit
 
-from rocksweep.kernel import eq1, spring
+from rocksweep.kernel import eq1, ridge, spring
 from rocksweep.kernel._cache import INLINE, PUBLIC
 from rocksweep.kernel.ground import gravity_rate, per_ground
 from rocksweep.kernel.layout import (
@@ -64,6 +64,8 @@ from rocksweep.kernel.layout import (
 # (not compiled on their own)
 _e_eq1 = njit(inline="always")(eq1.restitution)
 _e_rigid = njit(inline="always")(eq1.restitution_rigid)
+# the ridge of the potential energy (``ridge``), inlined into ``ridge_energy``
+_ridge = njit(inline="always")(ridge.ridge_energy)
 
 # ----------------------------------------------------------------------------------------
 # The vertical ground acceleration's power (the ground motions themselves: ``ground``)
@@ -330,13 +332,29 @@ def impact_loss(s, s_new, u, u_dot, w_minus, w_plus, prm, FLEX):
 
 
 # ----------------------------------------------------------------------------------------
+# After the pulse: a flexible body whose energy is below its ridge
+# ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True, **INLINE)
+def ridge_energy(theta, prm):
+    """W(theta) [J]: the least potential energy V - V_rest of the flexible body tilted by
+    |theta| [rad], over the top mass's u (``ridge.ridge_energy``, the one definition: V
+    above is 1/2 k u^2 - m g u sin|theta| plus terms free of u, least at u = m g sin|theta|
+    / k). Its peak, at PAR_RIDGE, is the overturning saddle's energy."""
+    return _ridge(theta, prm[PAR_M], prm[PAR_MA], prm[PAR_H], prm[PAR_HA], prm[PAR_B],
+                  prm[PAR_K], prm[PAR_G])
+
+
+# ----------------------------------------------------------------------------------------
 # After the pulse: a rigid body that can no longer overturn
 # ----------------------------------------------------------------------------------------
 
 
-# Relative margin on the rigid body's energy below its barrier: covers the integrator's
-# energy error (RK4 at the presets drifts far less), so round-off cannot prove a body safe.
-RIGID_ENERGY_MARGIN = 1e-6
+# Relative margin on a body's energy below its barrier (``rigid_peak``) or its ridge
+# (``transitions.flexible_bounded``): covers the integrator's energy error (RK4 at the
+# presets drifts far less), so round-off cannot prove a body safe.
+BOUND_ENERGY_MARGIN = 1e-6
 
 
 @njit(cache=True, **INLINE)
@@ -348,7 +366,7 @@ def rigid_peak(theta, theta_dot, s, prm):
     e^2 <= 1 at every impact when |e| <= 1 (lam <= 1; e is the same at every impact).
     The potential V = M g (R cos(a - s theta) - h_cg), a = atan(b/h_cg), peaks at
     s theta = a; a body inside the barrier (s theta < a) with E below that peak (less
-    RIGID_ENERGY_MARGIN) never overturns. The next peak has V = E if moving away from
+    BOUND_ENERGY_MARGIN) never overturns. The next peak has V = E if moving away from
     theta = 0, else V = e^2 E (after the next impact).
     """
     e = restitution(s, 0.0, prm, False)
@@ -358,7 +376,7 @@ def rigid_peak(theta, theta_dot, s, prm):
     r = math.hypot(b, hcg)
     a = math.atan2(b, hcg)
     e_now = mechanical_energy(theta, theta_dot, 0.0, 0.0, s, prm, False)
-    if not (s * theta < a and e_now < (1.0 - RIGID_ENERGY_MARGIN) * mg * (r - hcg)):
+    if not (s * theta < a and e_now < (1.0 - BOUND_ENERGY_MARGIN) * mg * (r - hcg)):
         return -1.0
     if s * theta_dot < 0.0:
         e_now *= e * e

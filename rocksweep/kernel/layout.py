@@ -62,9 +62,10 @@ PAR_CLOSE = 40  # OUT_MARGIN below which the run is near its threshold (``numeri
 #                 [alpha_ref]
 PAR_U0 = 41  # initial u [m] (flexible bodies; with PAR_THETA0, PAR_THETA_DOT0 the state at t = 0)
 PAR_U_DOT0 = 42  # initial u' [m/s]
-# 1: a rigid body's run goes on past its analytic bound (rigid_bounded) to rest, for a
-# history to show (free rocking, a calibration); the bound still decides the class
-# (STATUS_BOUNDED, never flagged at the horizon). 0: the run ends at the bound.
+# 1: a run goes on past its bound (a rigid body's ``rigid_bounded``, a flexible one's
+# ``flexible_bounded``) to rest, for a history to show (free rocking, a calibration, a
+# flexible body's history); the bound still decides the class (STATUS_BOUNDED, never
+# flagged at the horizon). 0: the run ends at the bound.
 PAR_TO_REST = 43
 # The vertical ground acceleration a_v (positive up; the vertical variants only, else 0):
 # while the ground moves, gravity is g + a_v(t) (docs/vertical.md)
@@ -82,7 +83,15 @@ PAR_MU_STATIC = 49
 # certification probes the near-misses of a spring that rings long further
 # (``compute.certify``)
 PAR_MEMORY = 50
-N_PAR = 51
+# The tilt theta_r [rad] at which the ridge of a flexible body's potential energy peaks
+# (``equations.ridge_energy``: the least V over u at a tilt; the overturning saddle's
+# energy is W(theta_r)). Once the ground is still, a run whose energy T + V falls below
+# W(min(theta_max, theta_r)) can neither overturn nor tilt past its theta_max again: it
+# is decided (STATUS_BOUNDED, ``transitions.flexible_bounded``). NaN: no such bound (a
+# rigid body, which has ``rigid_bounded``; an impact law that may gain energy;
+# ``points.ridge_theta``)
+PAR_RIDGE = 51
+N_PAR = 52
 # A record's row is longer: its samples xg''/PGA (float64[npts], in [-1, 1]) follow the
 # N_PAR parameters, PAR_REC = N_PAR the first (``points.with_record``). With a vertical
 # record: then one copy of the last horizontal sample (the horizontal's reader clamps at

@@ -137,13 +137,21 @@ from rocksweep.kernel.layout import (
     Y_W_IN,
 )
 from rocksweep.kernel.stepping import first_stage, rk4_from
-from rocksweep.kernel.transitions import impact_map, rest_proven, rigid_bounded, uplift_side
+from rocksweep.kernel.transitions import (
+    flexible_bounded,
+    impact_map,
+    rest_proven,
+    rigid_bounded,
+    uplift_side,
+)
 
 # the outcome-only variants do not compile the energy (``_static``)
 _energy = skipped_when(False, mechanical_energy, 0.0)
 # nor does a flexible variant compile the rigid body's bound (its caller's branch is dead
 # there; the value given instead is never used)
 _rigid_bounded = skipped_when(True, rigid_bounded, -1.0)
+# and a rigid one not the flexible body's (``flexible_bounded``)
+_flexible_bounded = skipped_when(False, flexible_bounded, False)
 
 # _step_length: a time within this fraction of a record step of a grid time is on it (t
 # sums steps of ~1e-2..1; its round-off is ~1e-16 relative, far below).
@@ -181,8 +189,9 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     t_air = prm[PAR_T_AIR] if vertical else math.inf
     on = 0.0 < t_pulse
     y, s = _start(prm, out, hist, on, FLEX, DAMPED, GROUND)
-    # rigid: test rigid_bounded at the next loop top after the pulse (PAR_TO_REST: then go
-    # on to rest; a history of free rocking from a tilt would end at once otherwise)
+    # test rigid_bounded (flexible_bounded) at the next loop top after the pulse and after
+    # each impact (PAR_TO_REST: then go on to rest; a history of free rocking from a tilt
+    # would end at once otherwise)
     free_check = True
     # the counters of every step stay in registers (in out: ~3% slower); the rest is in out
     steps, event_steps, theta_max = 0, 0, abs(y[Y_THETA])
@@ -226,6 +235,12 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
             if peak >= 0.0:
                 if peak > theta_max:
                     theta_max = peak
+                _flag(out, STATUS_BOUNDED)
+                if prm[PAR_TO_REST] == 0.0:
+                    break
+        if FLEX and not on and free_check:
+            free_check = False  # T + V only falls after the pulse: test after each impact
+            if _flexible_bounded(FLEX, y, s, theta_max, prm):
                 _flag(out, STATUS_BOUNDED)
                 if prm[PAR_TO_REST] == 0.0:
                     break

@@ -4,7 +4,9 @@
 - ``impact_map``: rocking -> rocking on the other corner or full contact, at theta = 0
   (eq. 1 or the row's impact law, and the settling rule);
 - ``rest_proven``: after the pulse, full contact for good (flexible body);
-- ``rigid_bounded``: after the pulse, a rigid body that can no longer overturn.
+- ``rigid_bounded``: after the pulse, a rigid body that can no longer overturn;
+- ``flexible_bounded``: after the pulse, a flexible body that can neither overturn nor
+  tilt past its theta_max again.
 
 The formulas come from ``equations``; the reference path (``rocksweep.physics.reference``) calls
 the same ones (``tip_moment``, ``rest_margin``, ``rigid_peak``).
@@ -15,10 +17,12 @@ from numba import literally, njit
 from rocksweep.kernel._cache import INTERNAL
 from rocksweep.kernel._static import skipped_when
 from rocksweep.kernel.equations import (
+    BOUND_ENERGY_MARGIN,
     impact_loss,
     mechanical_energy,
     rest_margin,
     restitution,
+    ridge_energy,
     rigid_peak,
     tip_moment,
     top_mass_rate,
@@ -27,6 +31,7 @@ from rocksweep.kernel.equations import (
 from rocksweep.kernel.ground import ground_acc, ground_gravity
 from rocksweep.kernel.layout import (
     PAR_RESTRATE,
+    PAR_RIDGE,
     Y_D_DAMP,
     Y_THETA,
     Y_THETA_DOT,
@@ -76,6 +81,29 @@ def rigid_bounded(y, s, prm, FLEX):
     always -1 for a flexible body, FLEX)."""
     literally(FLEX)
     return _rigid_peak(FLEX, y[Y_THETA], y[Y_THETA_DOT], s, prm)
+
+
+@njit(cache=True, **INTERNAL)
+def flexible_bounded(y, s, theta_max, prm):
+    """After the pulse, a flexible body in phase s at y whose |theta| has not exceeded
+    theta_max [rad]: True if it can neither overturn nor tilt past theta_max again.
+
+    With the ground still, T + V only falls: the damper takes c u'^2, and every impact
+    loses energy where the row's law cannot gain any (PAR_RIDGE is NaN otherwise,
+    ``points.ridge_theta``; the rest-rate rule and full contact only lose). V >= W(theta)
+    (``ridge_energy``) and W rises to its peak at theta_r = PAR_RIDGE, the overturning
+    saddle's energy: a body now inside the ridge (|theta| < theta_r) with an energy below
+    W(min(theta_max, theta_r)) (less BOUND_ENERGY_MARGIN) can reach neither theta_r nor
+    theta_max again (a flexible body may have tilted past theta_r and come back: its u
+    was off the ridge's). Its outcome (safe) and its theta_max are both decided: what is
+    left of the run is the rocking to rest, which the class does not need
+    (docs/accuracy.md, "Decided by its energy").
+    """
+    theta_r = prm[PAR_RIDGE]
+    if not abs(y[Y_THETA]) < theta_r:  # past the ridge's peak now (falling?), or NaN
+        return False
+    e_now = mechanical_energy(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s, prm, True)
+    return e_now < (1.0 - BOUND_ENERGY_MARGIN) * ridge_energy(min(theta_max, theta_r), prm)
 
 
 @njit(cache=True, **INTERNAL)

@@ -15,6 +15,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from rocksweep.kernel import layout as L
+from rocksweep.kernel.eq1 import restitution
+from rocksweep.kernel.ridge import ridge_energy, ridge_theta
 from rocksweep.kernel.spring import rocking_spring_omega
 from rocksweep.numerics import (
     EVENT_STEP_ALLOWANCE,
@@ -156,6 +158,61 @@ def body_row(body: Body) -> np.ndarray:
     return row
 
 
+def ridge_column(rows: np.ndarray) -> np.ndarray:
+    """PAR_RIDGE of body rows float64[n, N_PAR] (``body_row``): theta_r [rad], where a
+    flexible body's ridge of potential energy peaks (``kernel.ridge.ridge_theta``), NaN for
+    a rigid body (k = 0), float64[n]. Vectorised: one call per set of distinct bodies."""
+    k = rows[:, L.PAR_K]
+    flex = k > 0.0
+    out = np.full(rows.shape[0], math.nan)
+    if flex.any():
+        r = rows[flex]
+        out[flex] = ridge_theta(r[:, L.PAR_M], r[:, L.PAR_MA], r[:, L.PAR_H], r[:, L.PAR_HA],
+                                r[:, L.PAR_B], r[:, L.PAR_K], r[:, L.PAR_G])
+    return out
+
+
+# The top mass's positions, as fractions of the largest |u| an impact can have below the
+# ridge, on which ``impacts_lose`` checks eq. (1)'s energy balance (a smooth rational
+# function of u; the slack below covers it between the grid's points)
+_IMPACT_U = np.linspace(-1.0, 1.0, 201)
+_IMPACT_SLACK = 1e-6
+
+
+def impacts_lose(rows: np.ndarray) -> np.ndarray:
+    """bool[n]: rows (float64[n, N_PAR], filled) of flexible bodies whose every impact loses
+    energy once the run's energy is below the ridge W(theta_r) (``ridge_column``): what
+    ``kernel.transitions.flexible_bounded`` needs to end a run.
+
+    An impact is at theta = 0, where V - V_rest = 1/2 k u^2, so |u| <= sqrt(2 W(theta_r) /
+    k). Under eq. (1) and a constant e the top mass keeps its velocity, and the impact loses
+    1/2 (I_0 + m (u - s b)^2) w^2 - 1/2 (I_0 + m (u + s b)^2) (e w)^2 (``equations.
+    impact_loss``, I_0 = PAR_IA0): >= 0 where e <= 0 (full contact) or e^2 (I_0 + m (u +
+    s b)^2) <= I_0 + m (u - s b)^2, checked on ``_IMPACT_U``'s grid of |u| for both corners
+    with e of the row's law and factor (less ``_IMPACT_SLACK``). A locked top mass's impact
+    moves it (its loss depends on u'): never. Computed once per distinct (body, lam, law,
+    e, e_factor)."""
+    cols = [L.PAR_M, L.PAR_MA, L.PAR_IA0, L.PAR_IAH, L.PAR_B, L.PAR_K, L.PAR_RIDGE,
+            L.PAR_LAM, L.PAR_LAW, L.PAR_E, L.PAR_E_FACTOR, L.PAR_G, L.PAR_H, L.PAR_HA]
+    part = rows[:, cols]
+    # NaN (a law's unused e, a rigid body's ridge) is unequal to itself: keyed as -inf
+    _, first, back = np.unique(np.where(np.isnan(part), -np.inf, part), axis=0,
+                               return_index=True, return_inverse=True)
+    m, m_a, i_a0, i_ah, b, k, theta_r, lam, law, e_c, factor, g, h, h_a = (
+        part[first, j:j + 1] for j in range(len(cols)))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        w_r = ridge_energy(theta_r, m, m_a, h, h_a, b, k, g)
+        u = np.sqrt(2.0 * w_r / k) * _IMPACT_U
+        lose = (k[:, 0] > 0.0) & (w_r[:, 0] > 0.0) & (law[:, 0] != L.LAW_LOCKED)
+        for s in (1.0, -1.0):
+            e = np.where(law == L.LAW_CONSTANT, e_c,
+                         restitution(s, u, lam, m, m_a, b, i_ah, 0.0)) * factor
+            after = e * e * (i_a0 + m * (u + s * b) ** 2)
+            lose &= ((e <= 0.0) | (after <= (1.0 - _IMPACT_SLACK) * (i_a0 + m * (u - s * b) ** 2))
+                     ).all(axis=1)
+    return lose[back.ravel()]
+
+
 def body_omega_rock(body: Body) -> float:
     """Fastest rate of the top mass's motion [rad/s], which the step must follow (0 for a
     rigid body: no spring).
@@ -275,6 +332,7 @@ class Bodies:
         rows = np.empty((len(distinct), L.N_PAR))
         for j, b in enumerate(distinct):
             rows[j] = body_row(b)
+        rows[:, L.PAR_RIDGE] = ridge_column(rows)
         return cls(rows, np.array([body_omega_rock(b) for b in distinct], float),
                    np.array([b.alpha_ref for b in distinct], float),
                    np.array([b.E_ref for b in distinct], float),
@@ -376,6 +434,8 @@ def fill_rows(rows: np.ndarray, bodies: Bodies, excitation: Excitation, columns:
     rows[:, L.PAR_LAW] = columns.law
     rows[:, L.PAR_E] = columns.e
     rows[:, L.PAR_E_FACTOR] = columns.e_factor
+    # the energy bound only where impacts lose energy (``impacts_lose``)
+    rows[:, L.PAR_RIDGE] = np.where(impacts_lose(rows), rows[:, L.PAR_RIDGE], math.nan)
     if columns.initial is not None:
         th, thd, u, ud = columns.initial
         rows[:, L.PAR_THETA0] = np.asarray(th, float) * alpha_ref

@@ -6,7 +6,7 @@ result row. It shares the equations with the RK4 kernel, one copy of each, from
 ``rocksweep.kernel.equations`` (called from Python): the ground motion (eq. 2) and its
 rate, the right-hand sides, the uplift moment Q, its rate and the tipping moment M g b,
 the restitution of eq. (1), the energy, the rest bound (``rest_margin``), the rigid bound
-(``rigid_peak``) and the spring's rate while rocking (its step limit). Their independent
+(``rigid_peak``), the ridge of the potential energy (``ridge_energy``) and the spring's rate while rocking (its step limit). Their independent
 check is the sympy derivation (tests/test_derivations.py). The integrator, the loop, the
 event location, the impact map, the settling rule and the horizon are written again here,
 from the rules documented in ``rocksweep.kernel.loop`` and ``rocksweep.kernel.transitions``
@@ -23,7 +23,9 @@ and the paper:
 - after the pulse, in full contact, rest is proven when the largest Q on the oscillator's
   energy ellipse is below M g b (the energy never grows: c >= 0);
 - a rigid body after the pulse whose energy cannot carry it over the barrier stops early
-  (safe, STATUS_BOUNDED), as in the kernel;
+  (safe, STATUS_BOUNDED), as in the kernel; so does a flexible body inside its ridge's
+  peak whose energy, after an impact, is below the ridge at its theta_max
+  (``ridge_energy``, where the row's PAR_RIDGE says its impacts lose energy);
 - the run stops at the horizon t_pulse + horizon (flagged), or after max_events events.
 
 Each phase is one ``solve_ivp`` call from the transition to the next one or to the next
@@ -57,10 +59,12 @@ from scipy.optimize import brentq, minimize_scalar
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel.contact import ground_reactions, impact_impulses, impulse_ratio
 from rocksweep.kernel.equations import (
+    BOUND_ENERGY_MARGIN,
     contact_rhs,
     mechanical_energy,
     rest_margin,
     restitution,
+    ridge_energy,
     rigid_peak,
     rigid_rhs,
     rocking_rhs,
@@ -550,8 +554,9 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
     are the kernel's and are ignored). The run starts at rest, or rocking from
     (theta0 [rad], theta_dot0 [rad/s]) if either is given and nonzero (default: the
     parameter row's PAR_THETA0, PAR_THETA_DOT0), like the kernel. ``early_exit`` False
-    turns off the rigid body's bounded-energy exit (to follow every impact, e.g. to check
-    free rocking against closed forms). Returns a dict with the kernel's summary quantities:
+    turns off the bounded-energy exits, a rigid body's and a flexible body's (to follow
+    every impact, e.g. to check free rocking against closed forms, or to compare with a
+    kernel run that goes on to rest, PAR_TO_REST). Returns a dict with the kernel's summary quantities:
     outcome (OUTCOME_* code), status (STATUS_* bits), impacts, uplifts, contacts,
     theta_max [rad], t_overturn, t_first_impact, t_end [p*t] (NaN when not applicable),
     e_max, plus steps (DOP853 steps), nfev (right-hand-side calls), anomalies (impacts
@@ -597,6 +602,14 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
             peak = rigid_peak(y[0], y[1], s, prm)  # the kernel's STATUS_BOUNDED rule
             if peak >= 0.0:
                 tally.theta_max = max(tally.theta_max, peak)
+                tally.status |= L.STATUS_BOUNDED
+                break
+        if early_exit and flex and not on and free_check:
+            free_check = False  # the kernel's flexible STATUS_BOUNDED rule, after impacts
+            # inside the ridge's peak now (PAR_RIDGE NaN: impacts may gain energy)
+            theta_r = float(prm[L.PAR_RIDGE])
+            if (abs(y[0]) < theta_r and tally.energy(y, s) < (1.0 - BOUND_ENERGY_MARGIN)
+                    * ridge_energy(min(tally.theta_max, theta_r), prm)):
                 tally.status |= L.STATUS_BOUNDED
                 break
         if tally.impacts + tally.uplifts >= max_events:

@@ -27,6 +27,7 @@ from rocksweep.physics.points import (
     Columns,
     body_omega_rock,
     body_row,
+    ridge_column,
     build_rows,
     kernel_kind,
     law_code,
@@ -166,6 +167,7 @@ class Grid:
             E_ref[j] = body.E_ref
             kinds[j] = kernel_kind(body)
             u_cr[j] = body_u_cr(body)
+        rows[:, L.PAR_RIDGE] = ridge_column(rows)
         return Bodies(rows, omega_rock, alpha_ref, E_ref, u_cr, kinds)
 
     def rows(self, start: int, stop: int) -> ChunkRows:

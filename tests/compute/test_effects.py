@@ -18,10 +18,13 @@ from bodies import FIG3, SHARED
 from rocksweep.compute.dispatch import history_capacity
 from rocksweep.compute.single import run_point
 from rocksweep.kernel import chunk_kernel, point_kernel
+from rocksweep.kernel import equations as eq
 from rocksweep.kernel import layout as L  # noqa: N812
+from rocksweep.kernel.ridge import ridge_energy, ridge_theta
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import BlockBody, FlexibleBody, G, restitution, restitution_rigid
 from rocksweep.physics.points import Point, kernel_kind, point_row
+from rocksweep.vocab.laws import CONSTANT, EQ1, LOCKED
 
 TABLE3 = dict(SHARED)  # Table 3 without omega_n/p
 # A short horizon keeps undamped runs (which may never come to rest) cheap.
@@ -296,6 +299,80 @@ def test_rigid_run_below_the_overturning_energy_stops_after_the_pulse(lam, a_rat
              for x in (1.0, e * e)]
     assert out[L.OUT_THETA_MAX] >= min(peaks) * (1 - 1e-12)
     assert out[L.OUT_THETA_MAX] < body.alpha
+
+
+def test_flexible_run_below_its_ridge_stops_after_an_impact(bodies):
+    """Figure 3's body, safe after a pulse that rocks it: once the ground is still and its
+    energy T + V is below the ridge at its theta_max (W, the least V at that tilt over u,
+    ``kernel.ridge``), it can neither overturn nor tilt that far again. The run stops
+    (status 'bounded') at an impact. Run on to rest (PAR_TO_REST) it keeps its class and
+    its theta_max to the bit, makes more impacts, and its energy stays below that W."""
+    body = bodies["flexible"]
+    row = point_row(Point(body, 0.0, "sine", 3.3, 3.5), NUM)
+    out = run_chunk(kernel_kind(body), L.LEVEL_OUTCOME, row[None])[0]
+    # it tilted past the ridge's peak and came back (u off the ridge's): the bound holds
+    # at W(theta_r), from the first impact after the pulse
+    assert out[L.OUT_THETA_MAX] > row[L.PAR_RIDGE]
+    assert out[L.OUT_OUTCOME] == L.OUTCOME_SAFE and out[L.OUT_IMPACTS] >= 1
+    assert int(out[L.OUT_STATUS]) & L.STATUS_BOUNDED
+    assert not int(out[L.OUT_STATUS]) & L.STATUS_FLAGGED
+    on = row.copy()
+    on[L.PAR_TO_REST] = 1.0
+    full, (hist,) = run_points(kernel_kind(body), on[None])
+    full = full[0]
+    assert full[L.OUT_OUTCOME] == L.OUTCOME_SAFE
+    assert full[L.OUT_THETA_MAX] == out[L.OUT_THETA_MAX]
+    assert full[L.OUT_IMPACTS] > out[L.OUT_IMPACTS] + 10  # the rocking to rest it spared
+    assert full[L.OUT_T_END] > out[L.OUT_T_END] + 5.0
+    after = hist[:, L.HIST_T] > out[L.OUT_T_END]  # (the impact's rows share its time)
+    w = ridge_energy(min(out[L.OUT_THETA_MAX], row[L.PAR_RIDGE]), body.m, body.m_A, body.h,
+                     body.h_A, body.b, body.k, G)
+    assert hist[after, L.HIST_E].max() < w
+    assert np.abs(hist[after, L.HIST_THETA]).max() < row[L.PAR_RIDGE]
+
+
+def test_flexible_body_past_its_ridge_still_falls(bodies):
+    """A fall without impact after the pulse (mode 2): its energy is below the ridge's
+    peak as it falls past it, which proves nothing (the bound needs the body inside the
+    ridge's peak, |theta| < theta_r). Figure 3(a)'s point lam 0.2, A 5.7, w/p 2.85."""
+    body = bodies["flexible"]
+    row = point_row(Point(body, 0.2, "sine", 2.85, 5.7), NUM)
+    out = run_chunk(kernel_kind(body), L.LEVEL_OUTCOME, row[None])[0]
+    assert out[L.OUT_OUTCOME] == L.OUTCOME_MODE2
+    assert not int(out[L.OUT_STATUS]) & L.STATUS_BOUNDED
+    assert out[L.OUT_T_OVERTURN] > row[L.PAR_TPULSE]
+
+
+def test_energy_bound_only_where_impacts_lose_energy(bodies):
+    """PAR_RIDGE is kept only where every impact below the ridge loses energy
+    (``points.impacts_lose``): checked against the kernel's own impact loss (eq. 6,
+    ``equations.impact_loss``) at random top-mass positions |u| <= sqrt(2 W(theta_r)/k)."""
+    body = bodies["flexible"]
+    rng = np.random.default_rng(3)
+    seen = set()
+    cases = [(EQ1, 0.0, math.nan, 1.0), (EQ1, 1.0, math.nan, 1.0), (EQ1, 0.5, math.nan, 1.3),
+             (CONSTANT, 0.0, 0.9, 1.0), (CONSTANT, 0.0, 1.02, 1.0), (LOCKED, 0.0, math.nan, 1.0)]
+    for law, lam, e, factor in cases:
+        point = Point(body, lam, "sine", 3.0, 2.0, law=law, e=e, e_factor=factor)
+        row = point_row(point, NUM)
+        kept = bool(row[L.PAR_RIDGE] > 0)
+        seen.add(kept)
+        if law == LOCKED:
+            assert not kept
+            continue
+        w_r = ridge_energy(ridge_theta(body.m, body.m_A, body.h, body.h_A, body.b, body.k, G),
+                           body.m, body.m_A, body.h, body.h_A, body.b, body.k, G)
+        u_lim = math.sqrt(2 * w_r / body.k)
+        losses = []
+        for u in rng.uniform(-u_lim, u_lim, 400):
+            for s in (1, -1):
+                e_u = float(eq.restitution(s, u, row, True))
+                w = -s * 1.0
+                w_plus = e_u * w if e_u > 0 else 0.0
+                losses.append(eq.impact_loss(s, -s if e_u > 0 else 0, u, 0.0, w, w_plus,
+                                             row, True))
+        assert kept == (min(losses) >= 0.0), (law, lam, e, factor, min(losses))
+    assert seen == {True, False}
 
 
 def test_rigid_energy_exit_needs_e_at_most_1():

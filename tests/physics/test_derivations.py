@@ -262,3 +262,38 @@ def test_eq6_function_matches_energy_jump(body_fig2):
                 - eq.mechanical_energy(0.0, w_p, u_, v_p, -s_old, row, True))
         assert float(impact_energy_loss(bd, e, u_, w, upper=(s_old == 1))) == pytest.approx(
             jump, rel=1e-10)
+
+
+@pytest.mark.parametrize("pi", [dict(wn_over_p=2.43), dict(wn_over_p=9.82),
+                                dict(wn_over_p=1.2, alpha_cg=0.4, mA_over_m=2.0)])
+def test_ridge_is_the_least_potential_over_u_and_peaks_at_the_saddle(pi):
+    """The kernel's energy bound (``kernel.ridge``): W(theta) = min over u of V(theta, u)
+    - V_rest, with V written here from the masses' heights, and its peak theta_r, where
+    (theta_r, u(theta_r)) is a stationary point of V: the overturning saddle."""
+    from rocksweep.kernel.ridge import ridge_energy, ridge_theta
+    from rocksweep.physics.bodies import G, FlexibleBody
+
+    body = FlexibleBody(**{"zeta": 0.05, "alpha_cg": 0.15, "alpha_A": 0.28, "mA_over_m": 0.47,
+                           "IA_ratio": 0.56, **pi})
+    th, uu = sp.symbols("th uu", real=True)
+    P, A = _positions(th, uu, 0, b)  # corner s = +1
+    vals = {m: body.m, mA: body.m_A, h: body.h, hA: body.h_A, b: body.b, g: G, k: body.k}
+    V = (m * g * P[1] + mA * g * A[1] + k * uu**2 / 2).subs(vals)
+    V = V - V.subs({th: 0, uu: 0})
+    u_min = sp.solve(sp.diff(V, uu), uu)[0]  # V is quadratic in u, k > 0: its minimum
+    W = sp.simplify(V.subs(uu, u_min))
+    args = (body.m, body.m_A, body.h, body.h_A, body.b, body.k, G)
+    for x in np.linspace(0.0, 1.5, 13):
+        assert ridge_energy(x, *args) == pytest.approx(float(W.subs(th, x)), rel=1e-12,
+                                                       abs=1e-12)
+        assert ridge_energy(-x, *args) == ridge_energy(x, *args)  # the other corner
+    theta_r = float(ridge_theta(*args))
+    # the peak: dW/dtheta = 0 there (sympy's root), and V's gradient vanishes at the saddle
+    root = float(sp.nsolve(sp.diff(W, th), th, theta_r))
+    # (golden sections compare values: W is flat at its peak, so theta_r is found to ~1e-8
+    # rad, where W is within round-off of its peak)
+    assert theta_r == pytest.approx(root, abs=1e-7)
+    u_r = float(u_min.subs(th, root))
+    grad = [float(sp.diff(V, q).subs({th: root, uu: u_r})) for q in (th, uu)]
+    assert np.allclose(grad, 0.0, atol=1e-9 * float(V.subs({th: root, uu: u_r})))
+    assert 0.0 < root < np.pi / 2 and float(W.subs(th, root)) > 0.0
