@@ -158,10 +158,8 @@ def run_point(point: Point, numerics: Numerics, history: bool = True,
     kind runs (what sweeps run), or the contact kernel with ``contact``. ``contact``: the
     summary reports the contact fields."""
     row = point_row(point, numerics)
-    if history and (point.shape == FREE or not point.body.rigid):
-        # free rocking's history goes on past a rigid bound to rest, and a flexible body's
-        # past its energy's bound (``flexible_bounded``: Figure 5 shows the rocking to rest)
-        row[L.PAR_TO_REST] = 1.0
+    if history and point.shape == FREE:
+        row[L.PAR_TO_REST] = 1.0  # free rocking's history goes on past a rigid bound to rest
     kind = kernel_kind(point.body)
     ground = point.ground
     lvl = L.LEVEL_CONTACT if contact else L.LEVEL_OUTCOME

@@ -63,9 +63,10 @@ PAR_CLOSE = 40  # OUT_MARGIN below which the run is near its threshold (``numeri
 PAR_U0 = 41  # initial u [m] (flexible bodies; with PAR_THETA0, PAR_THETA_DOT0 the state at t = 0)
 PAR_U_DOT0 = 42  # initial u' [m/s]
 # 1: a run goes on past its bound (a rigid body's ``rigid_bounded``, a flexible one's
-# ``flexible_bounded``) to rest, for a history to show (free rocking, a calibration, a
-# flexible body's history); the bound still decides the class (STATUS_BOUNDED, never
-# flagged at the horizon). 0: the run ends at the bound.
+# ``flexible_bounded``) to rest, for a history to show (free rocking, a calibration) or a
+# test to follow the rocking to rest; the bound still decides the class (STATUS_BOUNDED,
+# never flagged at the horizon). 0: the run ends at the bound. (A flexible body's bound
+# is tested by the outcome-only variants alone: the others go on to rest anyway.)
 PAR_TO_REST = 43
 # The vertical ground acceleration a_v (positive up; the vertical variants only, else 0):
 # while the ground moves, gravity is g + a_v(t) (docs/vertical.md)

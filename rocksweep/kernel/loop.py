@@ -189,7 +189,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     t_air = prm[PAR_T_AIR] if vertical else math.inf
     on = 0.0 < t_pulse
     y, s = _start(prm, out, hist, on, FLEX, DAMPED, GROUND)
-    # test rigid_bounded (flexible_bounded) at the next loop top after the pulse and after
+    # is the outcome decided (``_decided``)? At the first loop top after the pulse and after
     # each impact (PAR_TO_REST: then go on to rest; a history of free rocking from a tilt
     # would end at once otherwise)
     free_check = True
@@ -226,21 +226,11 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
         if vertical and t >= t_air:
             _flag(out, STATUS_AIRBORNE)
             break
-        if not FLEX and s != 0 and not on and free_check:
-            free_check = False  # E is constant between impacts after the pulse: test once
-            margin = _rigid_margin(FLEX, y, s, prm, margin)
-            if margin < prm[PAR_CLOSE]:
-                t_close = t
-            peak = _rigid_bounded(FLEX, y, s, prm, FLEX)
-            if peak >= 0.0:
-                if peak > theta_max:
-                    theta_max = peak
-                _flag(out, STATUS_BOUNDED)
-                if prm[PAR_TO_REST] == 0.0:
-                    break
-        if FLEX and not on and free_check:
-            free_check = False  # T + V only falls after the pulse: test after each impact
-            if _flexible_bounded(FLEX, y, s, theta_max, prm):
+        if not on and free_check and (FLEX or s != 0):
+            free_check = False
+            bound, theta_max, margin, t_close = _decided(t, y, s, theta_max, margin, t_close,
+                                                         prm, FLEX, ENERGY, REACTIONS)
+            if bound:
                 _flag(out, STATUS_BOUNDED)
                 if prm[PAR_TO_REST] == 0.0:
                     break
@@ -512,6 +502,27 @@ def _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, GROUND):
     if s_new == 0:
         s_new = _uplift(t, y, on, prm, out, FLEX, DAMPED, GROUND)
     return y, s_new
+
+
+@njit(cache=True, **INTERNAL)
+def _decided(t, y, s, theta_max, margin, t_close, prm, FLEX, ENERGY, REACTIONS):
+    """After the pulse, at the first loop top after it and after each impact: is the
+    outcome decided (safe)? Returns (decided, theta_max, margin, t_close).
+
+    A rigid body's E is constant to its next impact: its OUT_MARGIN is taken here, and
+    ``rigid_bounded`` gives the peak still to come. A flexible body's T + V only falls
+    (``flexible_bounded``), tested where only the outcome is asked for: a run that
+    accounts energy or the ground's reactions goes on, its story to rest was asked for.
+    """
+    literally(FLEX)
+    if FLEX:
+        return (not (ENERGY or REACTIONS) and _flexible_bounded(FLEX, y, s, theta_max, prm),
+                theta_max, margin, t_close)
+    margin = _rigid_margin(FLEX, y, s, prm, margin)
+    if margin < prm[PAR_CLOSE]:
+        t_close = t
+    peak = _rigid_bounded(FLEX, y, s, prm, FLEX)
+    return peak >= 0.0, max(theta_max, peak), margin, t_close
 
 
 @njit(cache=True, **INTERNAL)

@@ -6,8 +6,9 @@ result row. It shares the equations with the RK4 kernel, one copy of each, from
 ``rocksweep.kernel.equations`` (called from Python): the ground motion (eq. 2) and its
 rate, the right-hand sides, the uplift moment Q, its rate and the tipping moment M g b,
 the restitution of eq. (1), the energy, the rest bound (``rest_margin``), the rigid bound
-(``rigid_peak``), the ridge of the potential energy (``ridge_energy``) and the spring's rate while rocking (its step limit). Their independent
-check is the sympy derivation (tests/test_derivations.py). The integrator, the loop, the
+(``rigid_peak``), the ridge of the potential energy (``ridge_energy``) and the spring's
+rate while rocking (its step limit). Their independent check is the sympy derivation
+(tests/test_derivations.py). The integrator, the loop, the
 event location, the impact map, the settling rule and the horizon are written again here,
 from the rules documented in ``rocksweep.kernel.loop`` and ``rocksweep.kernel.transitions``
 and the paper:
@@ -25,7 +26,8 @@ and the paper:
 - a rigid body after the pulse whose energy cannot carry it over the barrier stops early
   (safe, STATUS_BOUNDED), as in the kernel; so does a flexible body inside its ridge's
   peak whose energy, after an impact, is below the ridge at its theta_max
-  (``ridge_energy``, where the row's PAR_RIDGE says its impacts lose energy);
+  (``ridge_energy``, where the row's PAR_RIDGE says its impacts lose energy), in a run
+  without events or contact logged (the kernel's outcome-only variants);
 - the run stops at the horizon t_pulse + horizon (flagged), or after max_events events.
 
 Each phase is one ``solve_ivp`` call from the transition to the next one or to the next
@@ -554,9 +556,10 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
     are the kernel's and are ignored). The run starts at rest, or rocking from
     (theta0 [rad], theta_dot0 [rad/s]) if either is given and nonzero (default: the
     parameter row's PAR_THETA0, PAR_THETA_DOT0), like the kernel. ``early_exit`` False
-    turns off the bounded-energy exits, a rigid body's and a flexible body's (to follow
-    every impact, e.g. to check free rocking against closed forms, or to compare with a
-    kernel run that goes on to rest, PAR_TO_REST). Returns a dict with the kernel's summary quantities:
+    turns off the bounded-energy exits (to follow every impact, e.g. to check free rocking
+    against closed forms): a rigid body's, and a flexible body's, which, as in the kernel,
+    only a run without ``events`` or ``contact`` takes (the kernel's outcome-only
+    variants; the others go on to rest). Returns a dict with the kernel's summary quantities:
     outcome (OUTCOME_* code), status (STATUS_* bits), impacts, uplifts, contacts,
     theta_max [rad], t_overturn, t_first_impact, t_end [p*t] (NaN when not applicable),
     e_max, plus steps (DOP853 steps), nfev (right-hand-side calls), anomalies (impacts
@@ -579,7 +582,10 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
     t = 0.0
     y = (th0, thd0, float(prm[L.PAR_U0]), float(prm[L.PAR_U_DOT0]))  # theta, theta', u, u'
     tally = _Tally(pb, th0, events)
-    free_check = True  # rigid: test the bounded-energy exit once per excursion
+    free_check = True  # test the bounded-energy exit once per excursion (after impacts)
+    # a flexible body's bound, as the kernel's outcome-only variants: a run that logs its
+    # events or its reactions goes on to rest, as the kernel's that account them do
+    outcome_only = not (events or contact)
     ct = _Contact(pb) if contact else None
     if th0 != 0.0 or thd0 != 0.0:  # rocking from the given state, on the corner it points to
         s = 1 if th0 > 0.0 or (th0 == 0.0 and thd0 > 0.0) else -1
@@ -604,7 +610,7 @@ def reference_run(point: Point, numerics: Numerics | None = None, rtol: float = 
                 tally.theta_max = max(tally.theta_max, peak)
                 tally.status |= L.STATUS_BOUNDED
                 break
-        if early_exit and flex and not on and free_check:
+        if early_exit and flex and outcome_only and not on and free_check:
             free_check = False  # the kernel's flexible STATUS_BOUNDED rule, after impacts
             # inside the ridge's peak now (PAR_RIDGE NaN: impacts may gain energy)
             theta_r = float(prm[L.PAR_RIDGE])

@@ -27,10 +27,10 @@ from rocksweep.physics.points import (
     Columns,
     body_omega_rock,
     body_row,
-    ridge_column,
     build_rows,
     kernel_kind,
     law_code,
+    ridge_column,
 )
 from rocksweep.scene.model import Scene
 from rocksweep.schema import FRICTION_KEYS

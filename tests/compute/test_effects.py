@@ -67,10 +67,12 @@ def run_points(kind: int, rows: np.ndarray) -> tuple[np.ndarray, list[np.ndarray
 CONTACT_BITS = L.STATUS_SLIDES | L.STATUS_LIFTS_OFF
 
 
-def assert_same_outcomes(a: np.ndarray, b: np.ndarray, cols=OUTCOME_COLS) -> None:
+def assert_same_outcomes(a: np.ndarray, b: np.ndarray, cols=OUTCOME_COLS, ignore: int = 0
+                         ) -> None:
     np.testing.assert_array_equal(a[:, L.OUT_OUTCOME], b[:, L.OUT_OUTCOME])
-    np.testing.assert_array_equal(a[:, L.OUT_STATUS].astype(int) & ~CONTACT_BITS,
-                                  b[:, L.OUT_STATUS].astype(int) & ~CONTACT_BITS)
+    mask = ~(CONTACT_BITS | ignore)
+    np.testing.assert_array_equal(a[:, L.OUT_STATUS].astype(int) & mask,
+                                  b[:, L.OUT_STATUS].astype(int) & mask)
     np.testing.assert_allclose(a[:, cols], b[:, cols], rtol=1e-12, atol=1e-14)
 
 
@@ -138,13 +140,28 @@ def test_damping_is_not_ignored(bodies):
 def test_bookkeeping_levels_give_identical_outcomes(bodies, name):
     body = bodies[name]
     kind = kernel_kind(body)
-    rows = rows_for(body)
+    bounded_rows = rows_for(body)
+    # every level to rest: the outcome-only kernel ends a flexible run at its energy's
+    # bound (``flexible_bounded``), which the others do not test
+    rows = bounded_rows.copy()
+    rows[:, L.PAR_TO_REST] = 1.0
     outcome_only = run_chunk(kind, L.LEVEL_OUTCOME, rows)
     energy = run_chunk(kind, L.LEVEL_ENERGY, rows)
     history, hists = run_points(kind, rows)
     assert_covers_all_outcomes(outcome_only)
-    assert_same_outcomes(outcome_only, energy)
-    assert_same_outcomes(outcome_only, history)
+    # ending there keeps every outcome, and a flexible body's theta_max, to the bit (a rigid
+    # body's bound gives the peak to come in closed form, ``rigid_peak``)
+    bounded = run_chunk(kind, L.LEVEL_OUTCOME, bounded_rows)
+    cols = [L.OUT_OUTCOME, L.OUT_T_OVERTURN] + ([L.OUT_THETA_MAX] if name != "rigid" else [])
+    for col in cols:
+        np.testing.assert_array_equal(bounded[:, col], outcome_only[:, col])
+    ends = (bounded[:, L.OUT_STATUS].astype(int) & L.STATUS_BOUNDED) > 0
+    assert ends.any()
+    assert np.all(bounded[ends, L.OUT_T_END] < outcome_only[ends, L.OUT_T_END])
+    # (the outcome-only kernel flags a flexible run's bound, then 'bounded', not 'horizon')
+    flex_bits = 0 if name == "rigid" else L.STATUS_BOUNDED | L.STATUS_HORIZON
+    assert_same_outcomes(outcome_only, energy, ignore=flex_bits)
+    assert_same_outcomes(outcome_only, history, ignore=flex_bits)
     np.testing.assert_allclose(energy[:, ENERGY_COLS], history[:, ENERGY_COLS], rtol=1e-12,
                                atol=1e-14)
     # the outcome-only kernel keeps no energy account and no history ...

@@ -113,11 +113,13 @@ def test_chattering_cut_short_by_the_rest_rate_is_not_rest():
     the same rule, is still chattering at the horizon on its own trajectory (hundreds more
     impacts), and so is every preset: `default` (and `draft`) ended "settled" at p*t ~ 56
     (43) while RK4 damped this undamped spring (omega_rock/p = 117) at ~2 p, before the
-    spring's steps bounded that damping (``numerics.spring_decay``)."""
+    spring's steps bounded that damping (``numerics.spring_decay``). The runs account
+    energy (a history's kernel), which goes on past the energy's bound (the outcome-only
+    kernel ends these runs there, 'bounded': ``flexible_bounded``)."""
     body = FlexibleBody(22.5, 0.0, 0.195, 0.644, 0.359, 0.582)
     p = Point(body, 0.334, "cosine", 4.78, 15.9)
     for name in ("draft", "default", "accurate", "fine"):
-        r = run_point(p, Numerics.preset(name), history=False)
+        r = run_point(p, Numerics.preset(name))
         assert r.status == ["horizon", "settled"] and r.outcome == "safe", (name, r.status)
         assert r.impacts > 1000, name  # chattering on to the horizon, as the reference does
 

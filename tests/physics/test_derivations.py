@@ -271,7 +271,7 @@ def test_ridge_is_the_least_potential_over_u_and_peaks_at_the_saddle(pi):
     - V_rest, with V written here from the masses' heights, and its peak theta_r, where
     (theta_r, u(theta_r)) is a stationary point of V: the overturning saddle."""
     from rocksweep.kernel.ridge import ridge_energy, ridge_theta
-    from rocksweep.physics.bodies import G, FlexibleBody
+    from rocksweep.physics.bodies import FlexibleBody, G
 
     body = FlexibleBody(**{"zeta": 0.05, "alpha_cg": 0.15, "alpha_A": 0.28, "mA_over_m": 0.47,
                            "IA_ratio": 0.56, **pi})
