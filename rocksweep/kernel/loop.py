@@ -151,7 +151,7 @@ _energy = skipped_when(False, mechanical_energy, 0.0)
 # there; the value given instead is never used)
 _rigid_bounded = skipped_when(True, rigid_bounded, -1.0)
 # and a rigid one not the flexible body's (``flexible_bounded``)
-_flexible_bounded = skipped_when(False, flexible_bounded, False)
+_flexible_bounded = skipped_when(False, flexible_bounded, -1.0)
 
 # _step_length: a time within this fraction of a record step of a grid time is on it (t
 # sums steps of ~1e-2..1; its round-off is ~1e-16 relative, far below).
@@ -511,13 +511,18 @@ def _decided(t, y, s, theta_max, margin, t_close, prm, FLEX, ENERGY, REACTIONS):
 
     A rigid body's E is constant to its next impact: its OUT_MARGIN is taken here, and
     ``rigid_bounded`` gives the peak still to come. A flexible body's T + V only falls
-    (``flexible_bounded``), tested where only the outcome is asked for: a run that
-    accounts energy or the ground's reactions goes on, its story to rest was asked for.
+    (``flexible_bounded``, whose energy margin a decided run's OUT_MARGIN takes, as a
+    rigid body's), tested where only the outcome is asked for: a run that accounts energy
+    or the ground's reactions goes on, its story to rest was asked for.
     """
     literally(FLEX)
     if FLEX:
-        return (not (ENERGY or REACTIONS) and _flexible_bounded(FLEX, y, s, theta_max, prm),
-                theta_max, margin, t_close)
+        q = -1.0 if ENERGY or REACTIONS else _flexible_bounded(FLEX, y, s, theta_max, prm)
+        if q >= 0.0:  # decided: its energy margin is the closest it comes from here on
+            margin = min(margin, q)
+            if q < prm[PAR_CLOSE]:
+                t_close = t
+        return q >= 0.0, theta_max, margin, t_close
     margin = _rigid_margin(FLEX, y, s, prm, margin)
     if margin < prm[PAR_CLOSE]:
         t_close = t

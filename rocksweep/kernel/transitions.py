@@ -12,6 +12,8 @@ The formulas come from ``equations``; the reference path (``rocksweep.physics.re
 the same ones (``tip_moment``, ``rest_margin``, ``rigid_peak``).
 """
 
+import math
+
 from numba import literally, njit
 
 from rocksweep.kernel._cache import INTERNAL
@@ -86,24 +88,30 @@ def rigid_bounded(y, s, prm, FLEX):
 @njit(cache=True, **INTERNAL)
 def flexible_bounded(y, s, theta_max, prm):
     """After the pulse, a flexible body in phase s at y whose |theta| has not exceeded
-    theta_max [rad]: True if it can neither overturn nor tilt past theta_max again.
+    theta_max [rad]: its energy margin sqrt((W_r - E) / W_r) if it can neither overturn nor
+    tilt past theta_max again, else -1 (not proven).
 
     With the ground still, T + V only falls: the damper takes c u'^2, and every impact
     loses energy where the row's law cannot gain any (PAR_RIDGE is NaN otherwise,
     ``points.ridge_theta``; the rest-rate rule and full contact only lose). V >= W(theta)
-    (``ridge_energy``) and W rises to its peak at theta_r = PAR_RIDGE, the overturning
+    (``ridge_energy``) and W rises to its peak W_r at theta_r = PAR_RIDGE, the overturning
     saddle's energy: a body now inside the ridge (|theta| < theta_r) with an energy below
     W(min(theta_max, theta_r)) (less BOUND_ENERGY_MARGIN) can reach neither theta_r nor
     theta_max again (a flexible body may have tilted past theta_r and come back: its u
     was off the ridge's). Its outcome (safe) and its theta_max are both decided: what is
     left of the run is the rocking to rest, which the class does not need
-    (docs/accuracy.md, "Decided by its energy").
+    (docs/accuracy.md, "Decided by its energy"). The margin, in the units of a rigid
+    body's (``rigid_peak``, ``loop._energy_margin``), says how far the decision was from
+    the step's error in E (``compute.certify``).
     """
     theta_r = prm[PAR_RIDGE]
     if not abs(y[Y_THETA]) < theta_r:  # past the ridge's peak now (falling?), or NaN
-        return False
+        return -1.0
     e_now = mechanical_energy(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s, prm, True)
-    return e_now < (1.0 - BOUND_ENERGY_MARGIN) * ridge_energy(min(theta_max, theta_r), prm)
+    if not e_now < (1.0 - BOUND_ENERGY_MARGIN) * ridge_energy(min(theta_max, theta_r), prm):
+        return -1.0
+    w_r = ridge_energy(theta_r, prm)
+    return math.sqrt((w_r - e_now) / w_r)
 
 
 @njit(cache=True, **INTERNAL)

@@ -9,8 +9,9 @@ This is the only place where the model's dimensional quantities are packed for t
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
@@ -158,18 +159,40 @@ def body_row(body: Body) -> np.ndarray:
     return row
 
 
+# Results by distinct row (``per_distinct``): a sweep's chunks share their bodies and lam
+_RIDGE: dict[bytes, float] = {}
+_LOSE: dict[bytes, bool] = {}
+_CACHE_MAX = 100_000
+
+
+def per_distinct(part: np.ndarray, compute: Callable[[np.ndarray], np.ndarray],
+                 cache: dict[bytes, Any]) -> np.ndarray:
+    """compute(rows float64[k, c]) -> values[k] on the distinct rows of ``part`` (float64[n,
+    c], compared bit for bit), each computed once per process and kept in ``cache``
+    (cleared past _CACHE_MAX entries). Returns values[n]."""
+    c = np.ascontiguousarray(part, float)
+    keys, first, back = np.unique(c.view(np.dtype((np.void, c.itemsize * c.shape[1]))).ravel(),
+                                  return_index=True, return_inverse=True)
+    keys = [k.tobytes() for k in keys]
+    new = [j for j, k in enumerate(keys) if k not in cache]
+    if new:
+        if len(cache) > _CACHE_MAX:
+            cache.clear()
+        cache.update(zip([keys[j] for j in new], compute(c[first[new]]), strict=True))
+    return np.array([cache[k] for k in keys])[back.ravel()]
+
+
 def ridge_column(rows: np.ndarray) -> np.ndarray:
     """PAR_RIDGE of body rows float64[n, N_PAR] (``body_row``): theta_r [rad], where a
     flexible body's ridge of potential energy peaks (``kernel.ridge.ridge_theta``), NaN for
-    a rigid body (k = 0), float64[n]. Vectorised: one call per set of distinct bodies."""
-    k = rows[:, L.PAR_K]
-    flex = k > 0.0
-    out = np.full(rows.shape[0], math.nan)
-    if flex.any():
-        r = rows[flex]
-        out[flex] = ridge_theta(r[:, L.PAR_M], r[:, L.PAR_MA], r[:, L.PAR_H], r[:, L.PAR_HA],
-                                r[:, L.PAR_B], r[:, L.PAR_K], r[:, L.PAR_G])
-    return out
+    a rigid body (k = 0), float64[n]."""
+    cols = [L.PAR_M, L.PAR_MA, L.PAR_H, L.PAR_HA, L.PAR_B, L.PAR_K, L.PAR_G]
+
+    def theta_r(r: np.ndarray) -> np.ndarray:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(r[:, 5] > 0.0, ridge_theta(*r.T), math.nan)
+
+    return per_distinct(rows[:, cols], theta_r, _RIDGE).astype(float)
 
 
 # The top mass's positions, as fractions of the largest |u| an impact can have below the
@@ -194,23 +217,24 @@ def impacts_lose(rows: np.ndarray) -> np.ndarray:
     e, e_factor)."""
     cols = [L.PAR_M, L.PAR_MA, L.PAR_IA0, L.PAR_IAH, L.PAR_B, L.PAR_K, L.PAR_RIDGE,
             L.PAR_LAM, L.PAR_LAW, L.PAR_E, L.PAR_E_FACTOR, L.PAR_G, L.PAR_H, L.PAR_HA]
-    part = rows[:, cols]
-    # NaN (a law's unused e, a rigid body's ridge) is unequal to itself: keyed as -inf
-    _, first, back = np.unique(np.where(np.isnan(part), -np.inf, part), axis=0,
-                               return_index=True, return_inverse=True)
-    m, m_a, i_a0, i_ah, b, k, theta_r, lam, law, e_c, factor, g, h, h_a = (
-        part[first, j:j + 1] for j in range(len(cols)))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        w_r = ridge_energy(theta_r, m, m_a, h, h_a, b, k, g)
-        u = np.sqrt(2.0 * w_r / k) * _IMPACT_U
-        lose = (k[:, 0] > 0.0) & (w_r[:, 0] > 0.0) & (law[:, 0] != L.LAW_LOCKED)
-        for s in (1.0, -1.0):
-            e = np.where(law == L.LAW_CONSTANT, e_c,
-                         restitution(s, u, lam, m, m_a, b, i_ah, 0.0)) * factor
-            after = e * e * (i_a0 + m * (u + s * b) ** 2)
-            lose &= ((e <= 0.0) | (after <= (1.0 - _IMPACT_SLACK) * (i_a0 + m * (u - s * b) ** 2))
-                     ).all(axis=1)
-    return lose[back.ravel()]
+
+    def lose(part: np.ndarray) -> np.ndarray:
+        m, m_a, i_a0, i_ah, b, k, theta_r, lam, law, e_c, factor, g, h, h_a = (
+            part[:, j:j + 1] for j in range(len(cols)))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            w_r = ridge_energy(theta_r, m, m_a, h, h_a, b, k, g)
+            u = np.sqrt(2.0 * w_r / k) * _IMPACT_U
+            ok = (k[:, 0] > 0.0) & (w_r[:, 0] > 0.0) & (law[:, 0] != L.LAW_LOCKED)
+            for s in (1.0, -1.0):
+                e = np.where(law == L.LAW_CONSTANT, e_c,
+                             restitution(s, u, lam, m, m_a, b, i_ah, 0.0)) * factor
+                after = e * e * (i_a0 + m * (u + s * b) ** 2)
+                ok &= ((e <= 0.0)
+                       | (after <= (1.0 - _IMPACT_SLACK) * (i_a0 + m * (u - s * b) ** 2))
+                       ).all(axis=1)
+        return ok
+
+    return per_distinct(rows[:, cols], lose, _LOSE).astype(bool)
 
 
 def body_omega_rock(body: Body) -> float:

@@ -116,8 +116,7 @@ def test_rigid_block_bounded_exit_matches_the_kernel():
 def undamped_run():
     body = FlexibleBody(**table3(zeta=0.0))
     p = Point(body, 0.0, "sine", 3.0, 3.0)
-    # every impact to the horizon: past the energy's bound (``flexible_bounded``)
-    return body, p, reference_run(p, Numerics(horizon=30.0), events=True, early_exit=False)
+    return body, p, reference_run(p, Numerics(horizon=30.0), events=True)
 
 
 def test_undamped_energy_is_conserved_between_events_after_the_pulse(undamped_run):
@@ -175,8 +174,7 @@ def _kernel_impacts(run) -> list[float]:
 
 @pytest.fixture(scope="module")
 def references():
-    # to rest, as a single run with a history goes on past the energy's bound
-    return {k: reference_run(p, events=True, early_exit=False) for k, p in CASES.items()}
+    return {k: reference_run(p, events=True) for k, p in CASES.items()}
 
 
 @pytest.mark.parametrize("name", list(CASES))
