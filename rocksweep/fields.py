@@ -81,10 +81,11 @@ FIELDS: tuple[Field, ...] = (
           "-1 not computed, 0 safe, 1 mode 1 (overturned after impacts), "
           "2 mode 2 (overturned without impact)", L.OUT_OUTCOME,
           label="outcome class"),
-    Field("impacts", "int32", -1, "1", "number of impacts", L.OUT_IMPACTS,
-          label="impacts"),
-    Field("uplifts", "int32", -1, "1", "number of uplifts (rocking starts from full contact)",
-          L.OUT_UPLIFTS,
+    Field("impacts", "int32", -1, "1",
+          "number of impacts (of a 'bounded' run: up to its end, where its class was decided)",
+          L.OUT_IMPACTS, label="impacts"),
+    Field("uplifts", "int32", -1, "1", "number of uplifts (rocking starts from full contact; "
+          "of a 'bounded' run: up to its end)", L.OUT_UPLIFTS,
           label="uplifts"),
     Field("theta_max_over_alpha", "float64", math.nan, "alpha_ref", "max |theta| / alpha_ref",
           L.OUT_THETA_MAX, "alpha_ref",

@@ -209,8 +209,9 @@ STATUS_ENERGY_GAIN = _out.STATUS_BIT["energy_gain"]
 STATUS_SETTLED = _out.STATUS_BIT["settled"]
 STATUS_OVERTURNED = _out.STATUS_BIT["overturned"]
 STATUS_E_ABOVE_1 = _out.STATUS_BIT["e_above_1"]  # at least one impact had e > 1
-# rigid body after the pulse below its overturning energy, |e| <= 1: safe proven (early
-# exit; impacts counted up to there)
+# safe proven after the pulse (early exit; impacts counted up to there): a rigid body below
+# its overturning energy, |e| <= 1 (``rigid_bounded``), or a flexible body below its ridge
+# (``flexible_bounded``, outcome-only runs)
 STATUS_BOUNDED = _out.STATUS_BIT["bounded"]
 STATUS_SLIDES = _out.STATUS_BIT["slides"]
 STATUS_LIFTS_OFF = _out.STATUS_BIT["lifts_off"]
