@@ -10,11 +10,15 @@ pick the compiled variant of an effect set, a row of one table (``variants``);
   physics evaluates it on arrays), compiled by ``equations``;
 - ``spring``: the top mass's spring rate while rocking (the step-size rule's input); plain
   Python, importable without numba;
+- ``ridge``: the least potential energy over the top mass's u at a tilt, whose peak a
+  decided flexible run's energy is below (``transitions.flexible_bounded``); plain
+  Python, compiled by ``equations``;
 - ``equations``: the physics, pure formulas (also called by ``rocksweep.physics.reference``);
 - ``ground``: the ground's motion as the body feels it, one row per ground kind;
 - ``stepping``: the right-hand side on the state and one RK4 step;
 - ``events``: event functions, detection inside a step and location of the root;
-- ``transitions``: uplift, the impact map, the rest and rigid-bound early exits;
+- ``transitions``: uplift, the impact map, the rest, rigid-bound and flexible-bound early
+  exits;
 - ``contact``: the ground's reactions, friction demand and impact impulses (where the
   model holds), and their bookkeeping as the loop calls it (outputs.contact);
 - ``loop``: ``simulate_point``, one point from start to outcome (the no-slip contact

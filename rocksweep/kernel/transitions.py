@@ -9,7 +9,7 @@
   tilt past its theta_max again.
 
 The formulas come from ``equations``; the reference path (``rocksweep.physics.reference``) calls
-the same ones (``tip_moment``, ``rest_margin``, ``rigid_peak``).
+the same ones (``tip_moment``, ``rest_margin``, ``rigid_peak``, ``ridge_energy``).
 """
 
 import math
@@ -93,7 +93,7 @@ def flexible_bounded(y, s, theta_max, prm):
 
     With the ground still, T + V only falls: the damper takes c u'^2, and every impact
     loses energy where the row's law cannot gain any (PAR_RIDGE is NaN otherwise,
-    ``points.ridge_theta``; the rest-rate rule and full contact only lose). V >= W(theta)
+    ``physics.points.impacts_lose``; the rest-rate rule and full contact only lose). V >= W(theta)
     (``ridge_energy``) and W rises to its peak W_r at theta_r = PAR_RIDGE, the overturning
     saddle's energy: a body now inside the ridge (|theta| < theta_r) with an energy below
     W(min(theta_max, theta_r)) (less BOUND_ENERGY_MARGIN) can reach neither theta_r nor

@@ -190,7 +190,7 @@ def ridge_column(rows: np.ndarray) -> np.ndarray:
 
     def theta_r(r: np.ndarray) -> np.ndarray:
         with np.errstate(invalid="ignore", divide="ignore"):
-            return np.where(r[:, 5] > 0.0, ridge_theta(*r.T), math.nan)
+            return np.where(r[:, cols.index(L.PAR_K)] > 0.0, ridge_theta(*r.T), math.nan)
 
     return per_distinct(rows[:, cols], theta_r, _RIDGE).astype(float)
 
