@@ -86,11 +86,12 @@ PAR_MU_STATIC = 49
 PAR_MEMORY = 50
 # The tilt theta_r [rad] at which the ridge of a flexible body's potential energy peaks
 # (``equations.ridge_energy``: the least V over u at a tilt; the overturning saddle's
-# energy is W(theta_r)). Once the ground is still, a run whose energy T + V falls below
-# W(min(theta_max, theta_r)) can neither overturn nor tilt past its theta_max again: it
-# is decided (STATUS_BOUNDED, ``transitions.flexible_bounded``). NaN: no such bound (a
-# rigid body, which has ``rigid_bounded``; an impact law that may gain energy;
-# ``points.ridge_theta``)
+# energy is W(theta_r)). Once the ground is still, a run inside the peak (|theta| <
+# theta_r) whose energy T + V is below W(min(theta_max, theta_r)) can neither overturn
+# nor tilt past its theta_max again: it is decided (STATUS_BOUNDED,
+# ``transitions.flexible_bounded``). NaN: no such bound (a rigid body, which has
+# ``rigid_bounded``; an impact law that may gain energy). Filled by ``physics.points``
+# (``ridge_column``, ``impacts_lose``)
 PAR_RIDGE = 51
 N_PAR = 52
 # A record's row is longer: its samples xg''/PGA (float64[npts], in [-1, 1]) follow the
