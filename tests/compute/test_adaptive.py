@@ -211,6 +211,42 @@ def test_audit_catches_planted_island():
     assert st_clean.audit_misses == 0 and not st_clean.suspicious
 
 
+@pytest.mark.parametrize("coarse, margin, final_margin", [(4, 1, 0), (3, 2, 1), (2, 0, 3)])
+def test_windowed_planning_equals_the_whole_grid(monkeypatch, coarse, margin, final_margin):
+    """After a refine or audit batch, ``next_batch`` looks only at windows around its
+    points (``adaptive._windows``, their size from ``reach``): at every step of a run over
+    planted diagrams with specks, islands and winding boundaries, the windowed batch (the
+    windows forced whatever their size) equals the one planned over the whole grid."""
+    real = ad.next_batch
+    seen = []
+
+    def both(plan, outcome, computed, near=None):
+        b = real(plan, outcome, computed, near)
+        if near is not None:
+            assert ad._windows(plan, near) is not None
+            w = real(plan, outcome, computed)
+            assert (b.kind, b.stride) == (w.kind, w.stride)
+            np.testing.assert_array_equal(b.flat, w.flat)
+            seen.append(b.kind)
+        return b
+
+    monkeypatch.setattr(ad, "next_batch", both)
+    monkeypatch.setattr(ad, "WINDOWS_SHARE", np.inf)
+    rng = np.random.default_rng(11)
+    shape = (2, 161, 137)
+    y, x = np.mgrid[0:shape[1], 0:shape[2]]
+    wave = np.where(y > 60 + 25 * np.sin(x / 9.0) + 0.1 * x, 1, 0)  # a winding boundary
+    for truth in (disc_map(shape, 70.3, 41.7, 9.0), np.broadcast_to(wave, shape).copy()):
+        truth = truth.astype(np.int8)
+        specks = rng.integers(0, [shape[0], shape[1], shape[2]], size=(25, 3))
+        truth[specks[:, 0], specks[:, 1], specks[:, 2]] = 2  # one-point specks anywhere
+        plan = ad.Plan(shape, 2, 1, coarse=coarse, margin=margin,
+                       final_margin=final_margin, audit=0.05, seed=4)
+        t = truth.ravel()
+        ad.run_on_function(plan, lambda flat, batch, t=t: t[flat])
+    assert seen.count("refine") >= 3 and "audit" in seen and "done" in seen
+
+
 def test_interrupted_run_resumes_to_the_same_result():
     """The next batch is a function of the state: computing any part of a batch, then
     asking again, ends with the same outcomes and computed set as an uninterrupted run."""
