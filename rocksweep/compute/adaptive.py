@@ -147,6 +147,13 @@ class Plan:
         """Cell sizes of the refinement levels, coarse to fine: 2**coarse, ..., 2."""
         return [2**k for k in range(self.coarse, 0, -1)]
 
+    @property
+    def in_order(self) -> bool:
+        """The diagram axes are the grid's last two, y before x: the panels are the flat
+        grid reshaped (``panels`` is a view, ``flat_index`` counts up)."""
+        n = len(self.full_shape)
+        return (self.y, self.x) == (n - 2, n - 1)
+
     def panels(self, a: np.ndarray) -> np.ndarray:
         """A flat per-point array (size,) as panels (panels, ny, nx), diagram axes last."""
         full = np.asarray(a).reshape(self.full_shape)
@@ -449,8 +456,11 @@ def _windows(plan: Plan, near: np.ndarray) -> list[tuple[int, slice, slice]] | N
 def _panel_position(plan: Plan) -> np.ndarray:
     """int64[size]: each flat index's position in the panels (p ny nx + y nx + x); the
     inverse of ``Plan.flat_index``, one per plan, read-only."""
-    pos = np.empty(plan.size, np.int64)
-    pos[plan.flat_index().ravel()] = np.arange(plan.size, dtype=np.int64)
+    if plan.in_order:
+        pos = np.arange(plan.size, dtype=np.int64)
+    else:
+        pos = np.empty(plan.size, np.int64)
+        pos[plan.flat_index().ravel()] = np.arange(plan.size, dtype=np.int64)
     pos.flags.writeable = False
     return pos
 
@@ -471,9 +481,10 @@ def fill(plan: Plan, outcome: np.ndarray, computed: np.ndarray) -> np.ndarray:
         out = np.where(out < 0, cand, out)
     if plan.strides and plan.final_margin == 0:
         out = np.where(out < 0, edge_fill(known), out)
+    if plan.in_order:
+        return out.reshape(-1)
     flat = np.empty(plan.size, np.int8)
-    idx = plan.flat_index()
-    flat[idx.ravel()] = out.ravel()
+    flat[plan.flat_index().ravel()] = out.ravel()
     return flat
 
 

@@ -262,11 +262,6 @@ def edge_fill(known: np.ndarray) -> np.ndarray:
     v = np.where(c[:, :-1, :] == c[:, 1:, :], c[:, :-1, :], -1)  # edges along y
     lat[:, 0::2, 1::2] = h
     lat[:, 1::2, 0::2] = v
-    out = np.full(known.shape, -1, np.int8)
-    ys = np.minimum(np.arange(lat.shape[1]), ny - 1)
-    xs = np.minimum(np.arange(lat.shape[2]), nx - 1)
-    # the clipped last row/column maps onto the lattice's last points: keep the real ones
-    keep_y = np.r_[True, ys[1:] != ys[:-1]]
-    keep_x = np.r_[True, xs[1:] != xs[:-1]]
-    out[:, ys[keep_y][:, None], xs[keep_x][None, :]] = lat[:, keep_y][:, :, keep_x]
-    return out
+    # lattice index k is grid index k up to the axis's end; past it (a last cell one index
+    # long) it is clipped onto the end, whose own value is the lattice's earlier point
+    return np.ascontiguousarray(lat[:, :ny, :nx])

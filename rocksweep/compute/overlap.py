@@ -70,6 +70,7 @@ class Runner:
         self.ready: list[BatchResult] = []  # spare chunks done, points not asked for yet
         self.running: dict = {}  # future -> (flat, spare?), until the main thread takes it
         self.closed = False
+        self.topping = False  # inside _top_up (a callback re-entering it returns)
         # running, spare and pace are shared with the workers' done-callbacks (``_refill``)
         self.lock = threading.RLock()
         self.pool = ThreadPoolExecutor(self.workers)
@@ -92,12 +93,20 @@ class Runner:
         return BatchResult(flat, r.arrays, r.seconds, r.cpu_seconds, r.refine_evaluations)
 
     def _top_up(self) -> None:
-        while self.spare.size and sum(not f.done() for f in self.running) < self.workers:
-            per_point = self.pace[0] / self.pace[1] if self.pace[1] else 1e-3
-            n = max(SPARE_MIN, int(SPARE_SECONDS / max(per_point, 1e-9)))
-            n = min(n, self.chunk_size or n)
-            self._submit(self.spare[:n], True)
-            self.spare = self.spare[n:]
+        """Spare chunks while fewer chunks than workers run (call with the lock held)."""
+        if self.topping:  # a chunk done at once calls back into here: the loop goes on
+            return
+        self.topping = True
+        try:
+            while self.spare.size and sum(not f.done() for f in self.running) < self.workers:
+                per_point = self.pace[0] / self.pace[1] if self.pace[1] else 1e-3
+                n = max(SPARE_MIN, int(SPARE_SECONDS / max(per_point, 1e-9)))
+                n = min(n, self.chunk_size or n)
+                # taken from the spare list before the chunk can run (and call back)
+                chunk, self.spare = self.spare[:n], self.spare[n:]
+                self._submit(chunk, True)
+        finally:
+            self.topping = False
 
     def _take(self, want: np.ndarray, res: BatchResult
               ) -> tuple[BatchResult | None, BatchResult | None]:
