@@ -8,7 +8,6 @@ time with the audit candidates, which are known before the sweep starts.
 
 from __future__ import annotations
 
-import threading
 from collections.abc import Iterator
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 
@@ -50,12 +49,7 @@ class Runner:
     result, is unchanged (a point's result depends only on the point). A batch's own
     chunks go first: a spare chunk is started only while fewer chunks than workers run,
     and it is short (``SPARE_SECONDS`` at the points' pace so far), so that the next
-    batch, on the sweep's critical path, waits for no long one. A worker that finishes a
-    chunk while fewer chunks than workers are left takes the next spare chunk itself
-    (``_refill``, a done-callback), so the pool stays busy while the main thread plans the
-    next batch and writes the last one, not only while it waits on a batch: on the four
-    figures at 1000 x 1000 x 3 lam the workers were otherwise both idle for 0.7-1.4 s of
-    each sweep's 5-9 s (``scripts/bench_certify.py``).
+    batch, on the sweep's critical path, waits for no long one.
     """
 
     def __init__(self, grid: Grid, plan: Plan, computed: np.ndarray, jobs: int = 2,
@@ -68,45 +62,23 @@ class Runner:
                                     & (np.asarray(computed).ravel() == FILLED))
         self.pace = [0.0, 0]  # seconds, points of the chunks so far
         self.ready: list[BatchResult] = []  # spare chunks done, points not asked for yet
-        self.running: dict = {}  # future -> (flat, spare?), until the main thread takes it
-        self.closed = False
-        self.topping = False  # inside _top_up (a callback re-entering it returns)
-        # running, spare and pace are shared with the workers' done-callbacks (``_refill``)
-        self.lock = threading.RLock()
+        self.running: dict = {}  # future -> (flat, spare?)
         self.pool = ThreadPoolExecutor(self.workers)
 
     def _submit(self, flat: np.ndarray, spare: bool) -> None:
-        with self.lock:
-            f = self.pool.submit(self._chunk, flat)
-            self.running[f] = (flat, spare)
-        f.add_done_callback(self._refill)
-
-    def _refill(self, _future) -> None:
-        """A chunk is done (in its worker, or at once if it already was): top the pool up
-        with spare chunks, whatever the main thread is doing."""
-        with self.lock:
-            if not self.closed:
-                self._top_up()
+        self.running[self.pool.submit(self._chunk, flat)] = (flat, spare)
 
     def _chunk(self, flat: np.ndarray) -> BatchResult:
         r = sw.run_chunk(Subset(self.grid, flat), 0, flat.size, self.level)
         return BatchResult(flat, r.arrays, r.seconds, r.cpu_seconds, r.refine_evaluations)
 
     def _top_up(self) -> None:
-        """Spare chunks while fewer chunks than workers run (call with the lock held)."""
-        if self.topping:  # a chunk done at once calls back into here: the loop goes on
-            return
-        self.topping = True
-        try:
-            while self.spare.size and sum(not f.done() for f in self.running) < self.workers:
-                per_point = self.pace[0] / self.pace[1] if self.pace[1] else 1e-3
-                n = max(SPARE_MIN, int(SPARE_SECONDS / max(per_point, 1e-9)))
-                n = min(n, self.chunk_size or n)
-                # taken from the spare list before the chunk can run (and call back)
-                chunk, self.spare = self.spare[:n], self.spare[n:]
-                self._submit(chunk, True)
-        finally:
-            self.topping = False
+        while self.spare.size and len(self.running) < self.workers:
+            per_point = self.pace[0] / self.pace[1] if self.pace[1] else 1e-3
+            n = max(SPARE_MIN, int(SPARE_SECONDS / max(per_point, 1e-9)))
+            n = min(n, self.chunk_size or n)
+            self._submit(self.spare[:n], True)
+            self.spare = self.spare[n:]
 
     def _take(self, want: np.ndarray, res: BatchResult
               ) -> tuple[BatchResult | None, BatchResult | None]:
@@ -137,28 +109,24 @@ class Runner:
                 todo[np.searchsorted(want, got.flat)] = False
                 yield got
         self.ready = kept
-        with self.lock:  # no spare chunk may take a wanted point from here on
-            self.spare = self.spare[~_member(self.spare, want)]
-            for part, spare in self.running.values():  # spare chunks on their way
-                if spare:
-                    todo[np.searchsorted(want, part[_member(part, want)])] = False
-            left = int(todo.sum()) + sum(int(_member(p, want).sum())
-                                          for p, sp in self.running.values() if sp)
+        for part, spare in list(self.running.values()):  # spare chunks on their way
+            if spare:
+                todo[np.searchsorted(want, part[_member(part, want)])] = False
         need = want[todo]
         size = self.chunk_size or sw.auto_chunk_size(need.size, self.workers)
         for i in range(0, need.size, size):
             self._submit(need[i:i + size], False)
+        self.spare = self.spare[~_member(self.spare, want)]
+        left = int(todo.sum()) + sum(int(_member(p, want).sum())
+                                      for p, sp in self.running.values() if sp)
+        self._top_up()
         while left > 0:
-            with self.lock:
-                self._top_up()
-                running = list(self.running)
-            done, _ = wait(running, return_when=FIRST_COMPLETED)
+            done, _ = wait(list(self.running), return_when=FIRST_COMPLETED)
             for f in done:
-                with self.lock:
-                    part, spare = self.running.pop(f)
-                    res = f.result()
-                    self.pace[0] += res.seconds
-                    self.pace[1] += res.flat.size
+                part, spare = self.running.pop(f)
+                res = f.result()
+                self.pace[0] += res.seconds
+                self.pace[1] += res.flat.size
                 if spare:
                     got, rest = self._take(want, res)
                     if rest is not None:
@@ -168,13 +136,11 @@ class Runner:
                 if got is not None:
                     left -= got.flat.size
                     yield got
+            self._top_up()
 
     def close(self) -> None:
         """Stop: spare chunks not started are dropped, running ones finish."""
-        with self.lock:
-            self.closed = True
-            self.spare = self.spare[:0]
-            running = list(self.running)
-        for f in running:
+        self.spare = self.spare[:0]
+        for f in list(self.running):
             f.cancel()
         self.pool.shutdown(wait=True)
