@@ -130,9 +130,9 @@ def effective_jobs(jobs: int) -> int:
     return check_jobs(jobs)
 
 
-def auto_chunk_size(n_todo: int, n_workers: int) -> int:
-    """About 32 chunks per worker, between 8 and MAX_CHUNK points each."""
-    return int(min(MAX_CHUNK, max(8, math.ceil(n_todo / (32 * max(1, n_workers))))))
+def auto_chunk_size(n_todo: int, n_workers: int, per_worker: int = 32) -> int:
+    """About ``per_worker`` chunks per worker, between 8 and MAX_CHUNK points each."""
+    return int(min(MAX_CHUNK, max(8, math.ceil(n_todo / (per_worker * max(1, n_workers))))))
 
 
 def plan_chunks(todo: np.ndarray, chunk_size: int) -> list[tuple[int, int]]:
