@@ -39,7 +39,9 @@ matter. ``next_batch`` is therefore a pure function of
 (outcome, computed): ``run_plan`` (the loop, written once, that the sweep driver
 ``rocksweep.compute.driver`` runs) calls it, computes the batch it returns (any workers, any
 chunking; a point's result depends only on the point), stores the results and calls it
-again, until it returns an empty batch. An interrupted sweep resumes from the file.
+again, until it returns an empty batch; after a refine or audit batch it tells it which
+points that batch held, so that it looks only at windows around them, with the same
+result (``next_batch``'s ``near``). An interrupted sweep resumes from the file.
 
 Per point, the state is two arrays over the grid's flat indices (``rocksweep.scene.grid``):
 ``outcome`` (int8, the kernel's class; read only where computed > 0) and ``computed``
@@ -297,9 +299,16 @@ def plan_coarse(shape: Sequence[int], axes: tuple[int, int], level: int) -> np.n
 
 
 def _known(plan: Plan, outcome: np.ndarray, computed: np.ndarray,
-           done: np.ndarray | None = None) -> np.ndarray:
+           done: np.ndarray | None = None,
+           window: tuple[int, slice, slice] | None = None) -> np.ndarray:
     """int8 panels: the class where computed, -1 elsewhere. done: computed > FILLED
-    (bool[size]) where the caller has it."""
+    (bool[size]) where the caller has it; window: (panel, rows, columns), that part of
+    the panels alone (int8[1, rows, columns])."""
+    if window is not None:
+        p, ys, xs = window
+        c = plan.panels(computed)[p:p + 1, ys, xs] > FILLED
+        return np.where(c, plan.panels(np.asarray(outcome, np.int8))[p:p + 1, ys, xs],
+                        np.int8(-1))
     c = np.asarray(computed).ravel() > FILLED if done is None else done
     return plan.panels(np.where(c, np.asarray(outcome, np.int8).ravel(), np.int8(-1)))
 
@@ -361,12 +370,11 @@ def next_batch(plan: Plan, outcome: np.ndarray, computed: np.ndarray,
     if windows is None:
         wanted = _wanted(plan, plan.flat_index(), _known(plan, outcome, computed, done), done)
     else:
-        oc, cc, idx = plan.panels(outcome), plan.panels(computed), plan.flat_index()
         wanted = {}
         for p, ys, xs in windows:
-            known = np.where(cc[p:p + 1, ys, xs] > FILLED, oc[p:p + 1, ys, xs],
-                             np.int8(-1)).astype(np.int8)
-            for s, pts in _wanted(plan, idx[p:p + 1, ys, xs], known, done).items():
+            known = _known(plan, outcome, computed, window=(p, ys, xs))
+            index = plan.flat_index()[p:p + 1, ys, xs]
+            for s, pts in _wanted(plan, index, known, done).items():
                 wanted.setdefault(s, []).append(pts)
         wanted = {s: np.concatenate(v) for s, v in wanted.items()}
     parts = [wanted[s] for s in plan.strides if s in wanted]
