@@ -420,6 +420,16 @@ SAME_FALL = 0.5
 # reference; another's (seed 18) safe runs, 1.9 x too, overturn there (docs/accuracy.md,
 # "Clear by twice the margin, events located finer").
 CLEARANCE = 2.0
+# An overturn's mode (1: after impacts, 2: without) hangs on whether the rocking touched
+# theta = 0 before the fall. Where it came near (OUT_MODE_GRAZE: a mode 2's least dip
+# toward theta = 0, a mode 1's deepest impact, in alpha_ref) below MODE_BAND x PAR_CLOSE
+# (0.02 alpha_ref at 5 steps a period, scaled with the step as the band), the overturn is
+# a close call (``compute.certify.mode_close``): on threshold samples, default runs that
+# turned back 1e-3 and 8e-3 alpha_ref short of theta = 0 after the pulse fell in mode 2
+# where finer runs and the reference impact and fall in mode 1, and one whose only
+# impacts (a pair) were as shallow fell in mode 1 where they fall in mode 2 (none was a
+# close call by its saddle margin, 0.15-0.2 or inf).
+MODE_BAND = 0.2
 
 
 def close_margin(steps_per_period: int) -> float:

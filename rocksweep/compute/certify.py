@@ -40,6 +40,13 @@ when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the th
   its runs part from finer ones over many impacts, and the finer run falls on a later
   approach the coarse one passed wide (docs/accuracy.md, "Springs that ring long").
 
+An overturn is a close call too where its mode hung on a graze (``mode_close``): a mode
+2 whose rocking came within ``numerics.MODE_BAND`` x PAR_CLOSE of theta = 0 (a turn back
+just short of an impact, after the pulse as while it acts), or a mode 1 whose deepest
+impact was that shallow (OUT_MODE_GRAZE): a finer run may make the impact, or miss them
+all, and fall in the other mode. Such a close call is trusted once two runs agree and the
+finer one's graze clears its own step's band, converged margin or not.
+
 Below the last level, a repeated outcome is not trusted either where the finer run grazed
 an impact it did not make (OUT_GRAZE below ``numerics.GRAZE_MARGIN``) by an amount that
 moved by more than itself between the two runs (``grazed``): a coming impact, which a
@@ -78,6 +85,7 @@ from rocksweep.numerics import (
     CLOSE_BAND,
     ENERGY_ORDER,
     GRAZE_MARGIN,
+    MODE_BAND,
     OVERTURN_BAND,
     RICHARDSON_SAFETY,
     RINGING_BAND,
@@ -108,7 +116,16 @@ def close_calls(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     (``numerics.close_margin``: the row's PAR_CLOSE / CLOSE_BAND, in alpha_ref) or
     overturned with one below OVERTURN_BAND times it."""
     bound = np.where(_fell(outs), OVERTURN_BAND, 1.0) * _close_margin(rows)
-    return outs[:, L.OUT_MARGIN] < bound
+    return (outs[:, L.OUT_MARGIN] < bound) | mode_close(rows, outs)
+
+
+def mode_close(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
+    """bool[n]: overturns (result rows float64[n, N_OUT] of parameter rows float64[n, >=
+    N_PAR]) whose mode hung on a graze: OUT_MODE_GRAZE below ``numerics.MODE_BAND`` x
+    PAR_CLOSE (a mode 2 whose rocking came that near theta = 0, a mode 1 whose deepest
+    impact was that shallow): a finer run may make an impact this one missed, or miss
+    those it made, and fall in the other mode."""
+    return _fell(outs) & (outs[:, L.OUT_MODE_GRAZE] < MODE_BAND * rows[:, L.PAR_CLOSE])
 
 
 def clear(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
@@ -244,8 +261,9 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
         if level < levels:
             trusted &= settled(before, new) & clear(finer, new)
             trusted |= converged(before, finer, new)
-            # and, either way, no graze that moved (an impact the next run may make)
-            trusted &= ~grazed(before, new)
+            # and, either way, no graze that moved (an impact the next run may make), nor
+            # a mode that hangs on a graze (a converged margin says nothing of the mode)
+            trusted &= ~grazed(before, new) & ~mode_close(finer, new)
         # a repeated overturn counts only if both runs fell on the same approach (within
         # SAME_FALL): two falls far apart are two trajectories that parted, whatever their
         # margins (wide-space.yaml's undamped bodies at lam 1 fell at 79, 195 and 102 p t

@@ -153,7 +153,12 @@ OUT_GRAZE = 29  # closest a rocking arc came to an impact it did not make while 
 #                 rose again without reaching 0 (the step's cubic Hermite interpolant)
 #                 [alpha_ref] (inf: no such dip). A small one that moves between runs is a
 #                 graze the class may hang on (``rocksweep.compute.certify``)
-N_OUT = 30
+OUT_MODE_GRAZE = 30  # how near the run came to the other mode [alpha_ref]: without an
+#                 impact, the least dip of s theta toward 0 (as OUT_GRAZE, at any time);
+#                 with impacts, the deepest one's depth, (theta'/alpha_ref)^2 / 2 at it
+#                 (a finer run that missed them all would fall in mode 2). inf: no dip;
+#                 a base that slides takes none
+N_OUT = 31
 
 # --- state tuple y (the loop's 6 slots, a UniTuple(float64, 6)) ----------------------------
 Y_THETA = 0  # theta [rad] (0 in full contact)

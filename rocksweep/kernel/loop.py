@@ -76,6 +76,7 @@ from rocksweep.kernel.layout import (
     OUT_HIST_ROWS,
     OUT_IMPACTS,
     OUT_MARGIN,
+    OUT_MODE_GRAZE,
     OUT_N_GAINING,
     OUT_OUTCOME,
     OUT_REFINE_EVALS,
@@ -204,6 +205,9 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     acc = 0.0
     margin = np.inf  # OUT_MARGIN, in a register
     graze = np.inf  # OUT_GRAZE
+    # OUT_MODE_GRAZE: the least dip toward theta = 0 before the first impact (what a
+    # mode 2 hangs on) and the deepest impact (what a mode 1 hangs on: all of them missed)
+    dip, deepest = np.inf, 0.0
     t_close = np.nan  # OUT_T_CLOSE
     # ``_near_saddle``'s bounds, once per run (saddle0 = NaN: no gate, every free rocking
     # step takes ``_saddle``'s test; a row without a body, as warm_up's)
@@ -274,6 +278,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
         if ev == EV_NONE:
             if s != 0 and on:
                 graze = _graze(y, y1, h, s, prm, graze)
+            if s != 0 and out[OUT_IMPACTS] == 0.0:  # no impact yet: a fall now is mode 2
+                dip = _graze(y, y1, h, s, prm, dip)
             t, y = (t_pulse if lands else (t_air if air else t + h)), y1
             if s != 0 and not on and _near_saddle(y, s, near):
                 q = _saddle(y, s, prm)
@@ -297,6 +303,11 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
         if ev == EV_OVERTURN:
             _overturned(t, out)
             break
+        if ev == EV_IMPACT:
+            # how deep the arc would have gone below theta = 0 (~ theta'^2 / 2 theta'',
+            # theta'' ~ p^2 alpha_ref near theta = 0)
+            v = y[Y_THETA_DOT] / prm[PAR_ALPHA_REF]
+            deepest = max(deepest, 0.5 * v * v)
         y, s = _act(ev, t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, REACTIONS, GROUND)
         free_check = free_check or ev == EV_IMPACT
         _record(hist, t, y, s, on, prm, out, FLEX, GROUND)
@@ -306,6 +317,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     out[OUT_MARGIN] = margin
     out[OUT_T_CLOSE] = t_close
     out[OUT_GRAZE] = graze
+    out[OUT_MODE_GRAZE] = dip if out[OUT_IMPACTS] == 0.0 else deepest
     _finish(t, y, s, steps, event_steps, theta_max, prm, out, FLEX, ENERGY)
     reactions_end(REACTIONS, prm, out)
 

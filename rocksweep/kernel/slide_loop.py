@@ -71,6 +71,7 @@ from rocksweep.kernel.layout import (
     OUT_IMPACTS,
     OUT_IMPULSE_MAX,
     OUT_MARGIN,
+    OUT_MODE_GRAZE,
     OUT_MU_REQ,
     OUT_N_GAINING,
     OUT_N_MIN,
@@ -315,6 +316,7 @@ def simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     out[OUT_MARGIN] = margin
     out[OUT_T_CLOSE] = t_close
     out[OUT_GRAZE] = graze
+    out[OUT_MODE_GRAZE] = np.inf  # not taken: the sliding base's phases differ
     _finish(t, y, s, steps, event_steps, theta_max, slide_max, prm, out, FLEX, ENERGY)
 
 

@@ -34,6 +34,7 @@ from rocksweep.numerics import (
     CLOSE_BAND,
     GRAZE_MARGIN,
     MIN_EVENT_TOL,
+    MODE_BAND,
     OVERTURN_BAND,
     RINGING_BAND,
     RINGING_MEMORY,
@@ -46,6 +47,14 @@ from rocksweep.physics.reference import reference_run
 from rocksweep.scene.parse import parse_scene
 
 BLOCK = BlockBody(alpha=0.25, inertia=4.0 / 3.0)
+
+
+def _stand_in(n: int) -> np.ndarray:
+    """Result rows float64[n, N_OUT] of a stand-in kernel: zeros, and no mode graze (inf,
+    as a run whose rocking never neared theta = 0 before its first impact)."""
+    out = np.zeros((n, L.N_OUT))
+    out[:, L.OUT_MODE_GRAZE] = np.inf
+    return out
 CASES = [
     # (point, what the issue found the reference does)
     (Point(BLOCK, 0.0, "sine", 8.0, 10.9), L.OUTCOME_MODE1),
@@ -248,7 +257,7 @@ def test_a_near_miss_is_probed_to_its_last_approach():
     rows[:, L.PAR_CLOSE] = 0.04
     rows[:, L.PAR_DT] = 1.0
     rows[:, L.PAR_TEND] = 100.0
-    outs = np.zeros((3, L.N_OUT))
+    outs = _stand_in(3)
     outs[:, L.OUT_MARGIN] = [0.02, 0.03, 0.5]  # two near-misses, one clear
     outs[:, L.OUT_T_CLOSE] = [5.0, 7.0, np.nan]
     outs[:, L.OUT_T_END] = 40.0
@@ -258,7 +267,7 @@ def test_a_near_miss_is_probed_to_its_last_approach():
     def run(sub, idx, keep=True):
         calls.append((idx.tolist(), sub[:, L.PAR_DT].tolist(), sub[:, L.PAR_TEND].tolist(),
                       keep))
-        res = np.zeros((len(idx), L.N_OUT))
+        res = _stand_in(len(idx))
         res[:, L.OUT_OUTCOME] = np.where(idx == 1, L.OUTCOME_MODE1, L.OUTCOME_SAFE)
         res[:, L.OUT_STEPS] = 10
         res[:, L.OUT_MARGIN] = 1.0
@@ -285,13 +294,13 @@ def test_a_near_miss_whose_probe_does_not_clear_twice_its_margin_is_a_close_call
     rows[:, L.PAR_CLOSE] = 0.01 * CLOSE_BAND  # level 1's close-call margin: 0.00177
     rows[:, L.PAR_DT] = 1.0
     rows[:, L.PAR_TEND] = 100.0
-    outs = np.zeros((2, L.N_OUT))
+    outs = _stand_in(2)
     outs[:, L.OUT_MARGIN] = 0.013  # near-misses (1.3 x the close-call margin)
     outs[:, L.OUT_T_CLOSE] = 5.0
     levels_run = {0: [], 1: []}
 
     def run(sub, idx, keep=True):
-        res = np.zeros((len(idx), L.N_OUT))
+        res = _stand_in(len(idx))
         level = round(-np.log2(sub[0, L.PAR_DT]))
         for j, i in enumerate(idx):
             levels_run[int(i)].append((level, keep))
@@ -316,7 +325,7 @@ def test_a_ringing_spring_near_miss_is_probed_wider_and_must_settle():
     rows[:, L.PAR_DT] = 1.0
     rows[:, L.PAR_TEND] = 100.0
     rows[:, L.PAR_MEMORY] = [2.0 * RINGING_MEMORY, 0.5 * RINGING_MEMORY] * 2
-    outs = np.zeros((4, L.N_OUT))
+    outs = _stand_in(4)
     # rows 0-1: beyond PAR_CLOSE, within RINGING_BAND x it; rows 2-3: near-misses
     outs[:, L.OUT_MARGIN] = [0.06, 0.06, 0.02, 0.02]
     outs[:, L.OUT_T_CLOSE] = [np.nan, np.nan, 5.0, 5.0]
@@ -325,7 +334,7 @@ def test_a_ringing_spring_near_miss_is_probed_wider_and_must_settle():
 
     def run(sub, idx, keep=True):
         calls.append((idx.tolist(), sub[:, L.PAR_TEND].tolist(), keep))
-        res = np.zeros((len(idx), L.N_OUT))
+        res = _stand_in(len(idx))
         res[:, L.OUT_STEPS] = 10
         # the probes pass within 0.008 (clear of the close-call margin, but a ringing
         # row's 0.02 moved by more than that); the full reruns stay clear and settled
@@ -355,14 +364,14 @@ def test_an_outcome_that_keeps_changing_is_uncertified():
     rows = np.zeros((3, L.N_PAR))
     rows[:, L.PAR_CLOSE] = 0.01
     rows[:, L.PAR_DT] = 1.0
-    outs = np.zeros((3, L.N_OUT))
+    outs = _stand_in(3)
     outs[:, L.OUT_MARGIN] = [0.001, 0.001, 0.5]
     outs[:, L.OUT_OUTCOME] = [0, 0, 0]
     calls = []
 
     def run(sub, idx, keep=True):
         calls.append((idx.tolist(), sub[:, L.PAR_DT].tolist()))
-        res = np.zeros((len(idx), L.N_OUT))
+        res = _stand_in(len(idx))
         level = round(-np.log2(sub[0, L.PAR_DT]))
         res[:, L.OUT_OUTCOME] = np.where(idx == 0, level % 2, 0)  # point 0 flips
         res[:, L.OUT_STEPS] = 10
@@ -388,12 +397,12 @@ def test_a_knife_edge_is_refined_until_clear_or_flagged():
     rows = np.zeros((2, L.N_PAR))
     rows[:, L.PAR_CLOSE] = 0.04  # close-call margin 0.01 at level 0
     rows[:, L.PAR_DT] = 1.0
-    outs = np.zeros((2, L.N_OUT))
+    outs = _stand_in(2)
     outs[:, L.OUT_MARGIN] = 0.001
     levels_run = {0: [], 1: []}
 
     def run(sub, idx, keep=True):
-        res = np.zeros((len(idx), L.N_OUT))
+        res = _stand_in(len(idx))
         level = round(-np.log2(sub[0, L.PAR_DT]))
         for i in idx:
             levels_run[int(i)].append(level)
@@ -421,13 +430,13 @@ def test_a_graze_that_moved_is_refined_further():
     g = GRAZE_MARGIN
     grazes = {0: [0.8 * g, 0.2 * g, 0.19 * g], 1: [0.8 * g, 0.7 * g],
               2: [80 * g, 10 * g], 3: [np.inf, np.inf]}
-    outs = np.zeros((4, L.N_OUT))
+    outs = _stand_in(4)
     outs[:, L.OUT_MARGIN] = 0.001  # close calls
     outs[:, L.OUT_GRAZE] = [grazes[i][0] for i in range(4)]
     levels_run = {i: [] for i in range(4)}
 
     def run(sub, idx, keep=True):
-        res = np.zeros((len(idx), L.N_OUT))
+        res = _stand_in(len(idx))
         level = round(-np.log2(sub[0, L.PAR_DT]))
         res[:, L.OUT_MARGIN] = 0.5  # clear and settled
         for j, i in enumerate(idx):
@@ -444,13 +453,13 @@ def _run_ladder(rows: np.ndarray, ladder: dict, levels: int) -> tuple[np.ndarray
     """certify on a stand-in kernel: ladder[i][level] is point i's (outcome, margin,
     overturning time) at that refinement level (level 0: its own run). Returns the
     certified result rows and the levels each point was run at."""
-    outs = np.zeros((len(ladder), L.N_OUT))
+    outs = _stand_in(len(ladder))
     for i, steps in ladder.items():
         outs[i, [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN]] = steps[0]
     levels_run = {i: [] for i in ladder}
 
     def run(sub, idx, keep=True):
-        res = np.zeros((len(idx), L.N_OUT))
+        res = _stand_in(len(idx))
         level = round(-np.log2(sub[0, L.PAR_DT]))
         for j, i in enumerate(idx):
             levels_run[int(i)].append(level)
@@ -675,3 +684,72 @@ def test_a_file_states_what_its_certification_cost(tmp_path):
     again = sweep_file(two, old, resume=True)
     assert again.computed == 1 and again.attrs["refine_evaluations"] == -1
     assert info_dict(read_info(old))["certification"]["refine_evaluations"] is None
+
+
+def test_an_overturn_whose_mode_hangs_on_a_graze_is_a_close_call():
+    """certify's rule on a stand-in kernel: an overturn clear of the saddle whose rocking
+    came within MODE_BAND x PAR_CLOSE of theta = 0 before its first impact (OUT_MODE_GRAZE)
+    is re-run finer, and trusted once two runs agree and the finer one's graze is clear of
+    its own step's band (which shrinks with the step); one still that close at the last
+    level is flagged; a safe run's mode graze, or a wide one, buys no rerun."""
+    rows = np.zeros((4, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = 0.1  # 5 steps a period: band 0.2 x 0.1 = 0.02
+    rows[:, L.PAR_DT] = 1.0
+    band = MODE_BAND * 0.1
+    # level -> (outcome, mode graze); the band at level k is band x 2^(-2.5 k)
+    mode2, mode1, safe = L.OUTCOME_MODE2, L.OUTCOME_MODE1, L.OUTCOME_SAFE
+    ladder = {0: [(mode2, 0.05 * band), (mode1, 0.3 * band), (mode1, 0.3 * band)],
+              1: [(mode1, 0.01 * band)] + [(mode1, 1e-6 * band)] * 3,
+              2: [(safe, 0.01 * band)],
+              3: [(mode2, 2.0 * band)]}
+    outs = _stand_in(4)
+    outs[:, L.OUT_MARGIN] = 0.5  # clear of the saddle at every level
+    outs[:, L.OUT_T_OVERTURN] = 5.0
+    for i, steps in ladder.items():
+        outs[i, [L.OUT_OUTCOME, L.OUT_MODE_GRAZE]] = steps[0]
+    levels_run = {i: [] for i in ladder}
+
+    def run(sub, idx, keep=True):
+        res = _stand_in(len(idx))
+        level = round(-np.log2(sub[0, L.PAR_DT]))
+        res[:, L.OUT_MARGIN] = 0.5
+        res[:, L.OUT_T_OVERTURN] = 5.0
+        for j, i in enumerate(idx):
+            levels_run[int(i)].append(level)
+            res[j, [L.OUT_OUTCOME, L.OUT_MODE_GRAZE]] = ladder[int(i)][level]
+        return res
+
+    certify(rows, outs, run, 3)
+    # 0: mode 2 at its own step, mode 1 at 1 and 2 with a graze clear of level 2's band
+    # (0.3 band > band x 2^-5): certified mode 1 there
+    assert levels_run == {0: [1, 2], 1: [1, 2, 3], 2: [], 3: []}
+    st = outs[:, L.OUT_STATUS].astype(int)
+    assert outs[0, L.OUT_OUTCOME] == mode1 and not st[0] & L.STATUS_FLAGGED
+    assert st[1] & L.STATUS_UNCERTIFIED  # a knife edge of the mode at every level
+    assert not st[2] & L.STATUS_REFINED and not st[3] & L.STATUS_REFINED
+
+
+def test_the_first_impacts_depth_is_its_speed_squared():
+    """The kernel's OUT_MODE_GRAZE of a rigid block released at rest from theta0 with no
+    ground motion: its first impact comes at the speed energy conservation gives,
+    theta'^2 / 2 = cos(alpha - theta0) - cos(alpha) (p t units), so the mode graze, (theta' /
+    alpha)^2 / 2, is (cos(alpha - theta0) - cos(alpha)) / alpha^2 (before it the rocking
+    only falls toward theta = 0: no dip). At 80 steps a period (four refinements) the run
+    gives it to 1e-6; at 5, within 3%."""
+    alpha = 0.2
+    body = BlockBody(alpha=alpha, inertia=4.0 / 3.0)
+    row = point_row(Point(body, 0.0, "sine", 1.0, 1.0), Numerics.preset("default"))[None, :]
+    row = row.copy()
+    row[0, L.PAR_TPULSE] = 0.0  # no ground motion
+    row[0, L.PAR_TO_REST] = 1.0  # on to the impact (a still block is decided at once)
+    kind = kernel_kind(body)
+    warm_up(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)
+    for theta0 in (0.02, 0.1, 0.15):
+        row[0, L.PAR_THETA0] = theta0
+        want = (np.cos(alpha - theta0) - np.cos(alpha)) / alpha**2
+        for level, rel in ((0, 0.03), (4, 1e-6)):
+            out = np.empty((1, L.N_OUT))
+            r = np.ascontiguousarray(refined_rows(row, level) if level else row)
+            chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)(r, out)
+            assert out[0, L.OUT_IMPACTS] >= 1
+            assert out[0, L.OUT_MODE_GRAZE] == pytest.approx(want, rel=rel)
