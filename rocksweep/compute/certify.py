@@ -114,7 +114,8 @@ def close_calls(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     """bool[n]: the runs (parameter rows float64[n, >= N_PAR], result rows float64[n,
     N_OUT]) re-run in full: they stayed safe with a margin below the close-call margin
     (``numerics.close_margin``: the row's PAR_CLOSE / CLOSE_BAND, in alpha_ref) or
-    overturned with one below OVERTURN_BAND times it."""
+    overturned with one below OVERTURN_BAND times it, or overturned in a mode that hung on
+    a graze (``mode_close``)."""
     bound = np.where(_fell(outs), OVERTURN_BAND, 1.0) * _close_margin(rows)
     return (outs[:, L.OUT_MARGIN] < bound) | mode_close(rows, outs)
 
