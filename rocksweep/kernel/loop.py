@@ -205,9 +205,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     acc = 0.0
     margin = np.inf  # OUT_MARGIN, in a register
     graze = np.inf  # OUT_GRAZE
-    # OUT_MODE_GRAZE: the least dip toward theta = 0 before the first impact (what a
-    # mode 2 hangs on) and the deepest impact (what a mode 1 hangs on: all of them missed)
-    dip, deepest = np.inf, 0.0
+    dip = np.inf  # OUT_MODE_GRAZE of a run without impacts (with: ``_apply_impact``)
     t_close = np.nan  # OUT_T_CLOSE
     # ``_near_saddle``'s bounds, once per run (saddle0 = NaN: no gate, every free rocking
     # step takes ``_saddle``'s test; a row without a body, as warm_up's)
@@ -303,11 +301,6 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
         if ev == EV_OVERTURN:
             _overturned(t, out)
             break
-        if ev == EV_IMPACT:
-            # how deep the arc would have gone below theta = 0 (~ theta'^2 / 2 theta'',
-            # theta'' ~ p^2 alpha_ref near theta = 0)
-            v = y[Y_THETA_DOT] / prm[PAR_ALPHA_REF]
-            deepest = max(deepest, 0.5 * v * v)
         y, s = _act(ev, t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, REACTIONS, GROUND)
         free_check = free_check or ev == EV_IMPACT
         _record(hist, t, y, s, on, prm, out, FLEX, GROUND)
@@ -317,7 +310,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     out[OUT_MARGIN] = margin
     out[OUT_T_CLOSE] = t_close
     out[OUT_GRAZE] = graze
-    out[OUT_MODE_GRAZE] = dip if out[OUT_IMPACTS] == 0.0 else deepest
+    out[OUT_MODE_GRAZE] = dip if out[OUT_IMPACTS] == 0.0 else out[OUT_MODE_GRAZE]
     _finish(t, y, s, steps, event_steps, theta_max, prm, out, FLEX, ENERGY)
     reactions_end(REACTIONS, prm, out)
 
@@ -400,6 +393,7 @@ def _reset(out):
     out[OUT_E_MAX] = 0.0
     out[OUT_HIST_ROWS] = 0.0
     out[OUT_REFINE_EVALS] = 0.0  # the certification's reruns add theirs (compute.certify)
+    out[OUT_MODE_GRAZE] = 0.0  # the deepest impact so far (``_apply_impact``)
     # the sliding base's (``slide_loop`` sets its own; the no-slip model has none)
     out[OUT_SLIDE_MAX] = np.nan
     out[OUT_SLIDE_FINAL] = np.nan
@@ -496,6 +490,11 @@ def _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, GROUND):
     out[OUT_IMPACTS] += 1.0
     if out[OUT_IMPACTS] == 1.0:
         out[OUT_T_FIRST_IMPACT] = t
+    # OUT_MODE_GRAZE with impacts: the deepest, how far below theta = 0 its arc would have
+    # gone (theta'^2 / 2 theta'', theta'' ~ p^2 alpha_ref there): a finer run that missed
+    # them all would fall in mode 2
+    v = y[Y_THETA_DOT] / prm[PAR_ALPHA_REF]
+    out[OUT_MODE_GRAZE] = max(out[OUT_MODE_GRAZE], 0.5 * v * v)
     y, s_new, e, e_d, loss = impact_map(y, s, prm, FLEX, ENERGY)
     if e > out[OUT_E_MAX]:
         out[OUT_E_MAX] = e
