@@ -274,10 +274,10 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
             theta_max = _theta_max(y, y_ev, tau, s, theta_max)  # (y_ev, tau) = (y1, h) if none
 
         if ev == EV_NONE:
-            if s != 0 and on:
-                graze = _graze(y, y1, h, s, prm, graze)
-            if s != 0 and out[OUT_IMPACTS] == 0.0:  # no impact yet: a fall now is mode 2
-                dip = _graze(y, y1, h, s, prm, dip)
+            if s != 0 and (on or out[OUT_IMPACTS] == 0.0):  # (no impact yet: mode 2)
+                g = _graze(y, y1, h, s, prm, np.inf)  # one call site: one inlined copy
+                graze = min(graze, g) if on else graze
+                dip = min(dip, g) if out[OUT_IMPACTS] == 0.0 else dip
             t, y = (t_pulse if lands else (t_air if air else t + h)), y1
             if s != 0 and not on and _near_saddle(y, s, near):
                 q = _saddle(y, s, prm)
