@@ -108,9 +108,11 @@ def flexible_bounded(y, s, theta_max, prm):
     if not abs(y[Y_THETA]) < theta_r:  # past the ridge's peak now (falling?), or NaN
         return -1.0
     e_now = mechanical_energy(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s, prm, True)
-    if not e_now < (1.0 - BOUND_ENERGY_MARGIN) * ridge_energy(min(theta_max, theta_r), prm):
-        return -1.0
     w_r = ridge_energy(theta_r, prm)
+    # W at min(theta_max, theta_r): the peak itself once theta_max has reached it
+    w_cap = w_r if theta_max >= theta_r else ridge_energy(theta_max, prm)
+    if not e_now < (1.0 - BOUND_ENERGY_MARGIN) * w_cap:
+        return -1.0
     return math.sqrt((w_r - e_now) / w_r)
 
 
