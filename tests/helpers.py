@@ -83,3 +83,16 @@ def load_script(name: str) -> ModuleType:
     finally:
         sys.path.remove(str(ROOT / "scripts"))
     return mod
+
+
+def python_entry(fn):
+    """A Python entry to a kernel function compiled without one (``_cache.INLINE`` or
+    ``INTERNAL``: a direct call from Python would crash the interpreter): an @njit wrapper
+    taking the same arguments."""
+    from numba import njit  # not at the top: most tests compile nothing
+
+    @njit(cache=False)
+    def call(*args):
+        return fn(*args)
+
+    return call

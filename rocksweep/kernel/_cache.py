@@ -73,8 +73,17 @@ INTERNAL = _supported({**_BASE, "no_cpython_wrapper": True, "_nrt": False,
 # Options of the small functions on the path of every step: compiled once per signature
 # and inlined by LLVM (``forceinline``: LLVM's alwaysinline), not by numba (``inline=
 # "always"`` copies and retypes the callee's IR at every call site: 2/3 of the compile
-# time). Still callable from Python (the reference path and the tests use some).
-INLINE = _supported({**_BASE, "forceinline": True, "_nrt": False})
+# time). Called from jitted code only, as INTERNAL: no Python entry point (the CPython
+# wrapper boxes and unboxes every argument and result, and was lowered, optimised and
+# compiled to machine code for each of them: 9% of the instructions of Figure 3(a)'s
+# cold compile, 40.8G -> 37.1G). A Python call of one crashes the interpreter, so none is made
+# (``tests/kernel/test_python_entry.py``); tests reach them through @njit wrappers
+# (``tests/helpers.py``: ``python_entry``).
+INLINE = _supported({**_BASE, "forceinline": True, "_nrt": False, "no_cpython_wrapper": True})
+# INLINE, with a Python entry point: the equations that the reference path (``physics.
+# reference``, ``physics.sliding_reference``) and the tests' derivations also call from
+# Python.
+INLINE_PUBLIC = _supported({**_BASE, "forceinline": True, "_nrt": False})
 # Options of the other functions called from jitted code and from Python.
 PUBLIC = _supported({**_BASE, "_nrt": False})
 # Options of the entry points (``variants``): called from Python.

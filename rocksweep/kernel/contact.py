@@ -42,7 +42,7 @@ from collections import namedtuple
 import numpy as np
 from numba import literally, njit
 
-from rocksweep.kernel._cache import INLINE, INTERNAL
+from rocksweep.kernel._cache import INLINE, INLINE_PUBLIC, INTERNAL
 from rocksweep.kernel._static import chosen
 from rocksweep.kernel.equations import contact_rhs, rigid_rhs, rocking_rhs
 from rocksweep.kernel.ground import ground_acc, ground_gravity
@@ -94,7 +94,7 @@ Track = namedtuple("Track", ["samples", "t_a", "y_a", "ratio_a", "normal_a",
                              "t_b", "y_b", "ratio_b", "normal_b"])
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def ground_reactions(theta, theta_dot, u, u_dot, s, xg, g, prm, FLEX, DAMPED):
     """(H [N], N [N]): the ground's horizontal and vertical reaction on the body in phase
     s (0 full contact) at the state (theta, theta', u, u'), ground acceleration xg and
@@ -126,7 +126,7 @@ def ground_reactions(theta, theta_dot, u, u_dot, s, xg, g, prm, FLEX, DAMPED):
     return m * xp + m_A * xa, m * (yp + g) + m_A * (ya + g)
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def impact_impulses(s, u, u_dot_minus, w_minus, s_new, u_dot_plus, w_plus, prm, FLEX):
     """(J_x, J_y) [N s]: the ground's impulse on the body at an impact at theta = 0 that
     ends rocking on corner s (rate w_minus, top mass rate u_dot_minus) and leaves it in
@@ -144,7 +144,7 @@ def impact_impulses(s, u, u_dot_minus, w_minus, s_new, u_dot_plus, w_plus, prm, 
     return j_x, j_y
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def impulse_ratio(j_x, j_y):
     """|J_x| / J_y (+inf when the ground would have to pull: J_y <= 0)."""
     if j_y <= 0.0:

@@ -35,7 +35,7 @@ import math
 from numba import njit
 
 from rocksweep.kernel import eq1, ridge, spring
-from rocksweep.kernel._cache import INLINE, PUBLIC
+from rocksweep.kernel._cache import INLINE, INLINE_PUBLIC, PUBLIC
 from rocksweep.kernel.ground import gravity_rate, per_ground
 from rocksweep.kernel.layout import (
     LAW_CONSTANT,
@@ -72,7 +72,7 @@ _ridge = njit(inline="always")(ridge.ridge_energy)
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def vertical_power(p_in, theta, theta_dot, u, u_dot, s, g, prm, FLEX):
     """p_in plus the power [W] of the vertical d'Alembert loads -m_i a_v on the masses'
     heights Y_i (a_v = g - PAR_G): -a_v sum m_i Y_i' (full contact: 0). The work of a_v
@@ -111,7 +111,7 @@ with_vertical_power = per_ground(lambda k: _power_vertical if k.vertical else _p
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def rocking_rhs(theta, theta_dot, u, u_dot, s, xg, g, prm, DAMPED):
     """Accelerations while rocking on corner s (+1 / -1), and the input and damper powers,
     under ground acceleration xg [m/s^2] and gravity g [m/s^2] (``ground_gravity``).
@@ -133,7 +133,7 @@ def rocking_rhs(theta, theta_dot, u, u_dot, s, xg, g, prm, DAMPED):
     return theta_dd, u_dd, power_in, f_damp * u_dot
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def rigid_rhs(theta, theta_dot, s, xg, g, prm):
     """Rigid body (top mass welded, or a block): I_O theta'' = moment about corner s.
 
@@ -153,7 +153,7 @@ def rigid_rhs(theta, theta_dot, s, xg, g, prm):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def contact_rhs(u, u_dot, xg, prm, DAMPED):
     """Full contact: m u'' + c u' + k u = -m xg''. Returns (u'', ground power, damper power)."""
     f_damp = prm[PAR_C] * u_dot if DAMPED else 0.0
@@ -161,7 +161,7 @@ def contact_rhs(u, u_dot, xg, prm, DAMPED):
     return u_dd, -prm[PAR_M] * xg * u_dot, f_damp * u_dot
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def uplift_moment(u, u_dot, xg, g, prm, FLEX, DAMPED):
     """Q [N m]: the moment that tips the body in full contact (g: ``ground_gravity``).
 
@@ -181,7 +181,7 @@ def uplift_moment(u, u_dot, xg, g, prm, FLEX, DAMPED):
     return prm[PAR_H] * f + prm[PAR_M] * g * u - prm[PAR_MA] * prm[PAR_HA] * xg
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def uplift_moment_rate(u, u_dot, xg, jerk, g, prm, FLEX, DAMPED):
     """dQ/dt [N m/s] in full contact, at constant g (a vertical's rate: ``uplift_rates``)."""
     if not FLEX:
@@ -191,7 +191,7 @@ def uplift_moment_rate(u, u_dot, xg, jerk, g, prm, FLEX, DAMPED):
     return prm[PAR_H] * df + prm[PAR_M] * g * u_dot - prm[PAR_MA] * prm[PAR_HA] * jerk
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def tip_moment(g, prm):
     """M g b [N m]: the moment about a corner that the body's weight resists uplift with
     (g: ``ground_gravity``, or the row's PAR_G)."""
@@ -216,7 +216,7 @@ uplift_rates = per_ground(lambda k: _rates_vertical if k.vertical else _rates_pl
                           "uplift_rates")
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def rest_margin(u, u_dot, prm):
     """Q_max^2 - (M g b)^2 [N^2 m^2] after the pulse, in full contact (< 0: rest for good).
 
@@ -336,7 +336,7 @@ def impact_loss(s, s_new, u, u_dot, w_minus, w_plus, prm, FLEX):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def ridge_energy(theta, prm):
     """W(theta) [J]: the least potential energy V - V_rest of the flexible body tilted by
     |theta| [rad], over the top mass's u (``ridge.ridge_energy``, the one definition: V
@@ -357,7 +357,7 @@ def ridge_energy(theta, prm):
 BOUND_ENERGY_MARGIN = 1e-6
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def rigid_peak(theta, theta_dot, s, prm):
     """After the pulse, a rigid body rocking on corner s: the largest |theta| [rad] still to
     come if it can never overturn, else -1 (not proven).

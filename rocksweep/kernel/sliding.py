@@ -44,7 +44,7 @@ import math
 
 from numba import njit
 
-from rocksweep.kernel._cache import INLINE, PUBLIC
+from rocksweep.kernel._cache import INLINE, INLINE_PUBLIC, PUBLIC
 from rocksweep.kernel.contact import ground_reactions
 from rocksweep.kernel.equations import (
     contact_rhs,
@@ -91,7 +91,7 @@ LIFT_OFF = 8  # N <= 0 while rocking: the corner held as in the no-slip model (f
 TIP_ROUNDOFF = 1e-12
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def phase_code(s, sigma):
     """The phase's code (``vocab.phases``) of corner s (0 flat) and slip direction sigma."""
     return (PHASE_ROCK if s != 0 else PHASE_REST) + (1 if sigma != 0 else 0)
@@ -152,7 +152,7 @@ def reactions_affine(theta, theta_dot, u, u_dot, s, g, prm, FLEX, DAMPED):
     return h0, n0, h_a, n_a
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def slip_state(theta, theta_dot, u, u_dot, s, sigma, xg, g, mu, prm, FLEX, DAMPED):
     """While the base slips in direction sigma (+1 / -1) in phase s (0 flat), under ground
     acceleration xg and gravity g: (x'' [m/s^2], N [N], den [kg]). F = -mu sigma N;
@@ -176,7 +176,7 @@ def _phase_accelerations(theta, theta_dot, u, u_dot, s, a, g, prm, FLEX, DAMPED)
     return th_dd, u_dd
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def accelerations(theta, theta_dot, u, u_dot, s, sigma, xg, g, mu, prm, FLEX, DAMPED):
     """(theta'' [rad/s^2], u'' [m/s^2], x'' [m/s^2], F [N]) in phase (s, sigma): stuck
     (sigma = 0: x'' = 0; F = 0 is returned, the stuck force is ``ground_reactions``' H) or
@@ -208,7 +208,7 @@ def relative_momentum(theta, theta_dot, u, u_dot, s, prm, FLEX):
     return lever * theta_dot + m * cth * u_dot
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def sliding_energy(theta, theta_dot, u, u_dot, x_dot, s, prm, FLEX):
     """T + V - V_rest [J] in the ground's frame with the base slipping at x' [m/s]:
     ``equations.mechanical_energy`` plus x' sum m_i X_i' + 1/2 M x'^2."""
@@ -255,7 +255,7 @@ def any_sliding_derivatives(t, y, s, sigma, on, mu, prm, FLEX, DAMPED, ENERGY):
 # ----------------------------------------------------------------------------------------
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def stick_margin(theta, theta_dot, u, u_dot, s, xg, g, mu_s, prm, FLEX, DAMPED):
     """mu_s N - |H| [N] of a stuck contact in phase s (rest or rock): the stick-break
     event's function (the contact slips once it is < 0)."""
@@ -263,7 +263,7 @@ def stick_margin(theta, theta_dot, u, u_dot, s, xg, g, mu_s, prm, FLEX, DAMPED):
     return mu_s * n - abs(h)
 
 
-@njit(cache=True, **INLINE)
+@njit(cache=True, **INLINE_PUBLIC)
 def slide_uplift_moment(u, u_dot, sigma, xg, g, mu, prm, FLEX, DAMPED):
     """Q [N m] of the sliding body (flat, slipping in direction sigma): the uplift
     moment ``equations.uplift_moment`` under the base's acceleration a = xg'' + x''

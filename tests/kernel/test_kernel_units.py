@@ -1,7 +1,8 @@
 """The kernel's root finders and Hermite helpers on their own, against closed forms.
 
-The Hermite helpers are pure arithmetic with a Python entry point. ``_locate`` is compiled
-without one, so it is reached through a small @njit wrapper (one rigid specialisation, a
+The Hermite helpers are pure arithmetic, compiled (as ``_locate``) without a Python entry
+point: they are reached through @njit wrappers (``helpers.python_entry``); ``_locate``
+through a small one of its own (one rigid specialisation, a
 few seconds to compile) on two event functions whose exact root is known in closed form
 and that the RK4 step follows exactly (so the only error left is the root finder's):
 
@@ -17,24 +18,21 @@ import math
 import numpy as np
 import pytest
 from bodies import BODY3
+from helpers import python_entry
 from numba import njit
 
+from rocksweep.kernel import events, loop
 from rocksweep.kernel import layout as L  # noqa: N812
 from rocksweep.kernel.equations import rocking_spring_omega
-from rocksweep.kernel.events import (
-    EV_IMPACT,
-    EV_UPLIFT_POS,
-    _locate,
-    event_value,
-    hermite_cubic,
-    hermite_min,
-    hermite_newton,
-    hermite_root,
-)
-from rocksweep.kernel.loop import _graze
+from rocksweep.kernel.events import EV_IMPACT, EV_UPLIFT_POS, _locate, event_value
 from rocksweep.kernel.stepping import first_stage, rk4_step
 from rocksweep.physics.points import body_omega_rock
 from rocksweep.vocab.settings import ROOT_CODE
+
+# jitted-only functions (no Python entry point): called through @njit wrappers
+hermite_cubic, hermite_min, hermite_newton, hermite_root, _graze = (
+    python_entry(f) for f in (events.hermite_cubic, events.hermite_min, events.hermite_newton,
+                              events.hermite_root, loop._graze))
 
 # Newton's stopping step in units of the step, as _locate asks for (0.05 tol / width).
 XTOL = 1e-8
