@@ -36,12 +36,20 @@ Run it against another copy of the package (e.g. the code before a change) with
    archive main | tar -x -C DIR``): rounds alternating between this copy and DIR, each
    measurement in a fresh process: item 1's cold compile of Figure 3(a)'s variant (CPU s),
    the warm whole-process wall time of a 1-point ``rocksweep sweep`` (the start-up
-   target: under 0.5 s), and item 3's core-us per point of Figure 3(a) (this copy's
+   target: under 0.5 s), of ``import rocksweep.cli.main`` and of ``rocksweep --help``
+   (best of ``--repeat`` each), and item 3's core-us per point of Figure 3(a) (this copy's
    ``bench_kernel.best_pass`` on DIR's package), the order swapped every round; the
    median of each and the ratio this / DIR. Alone (``--against DIR --ab-only``) it takes
    ~25 s per round on 2 cores.
 
     python scripts/bench_compile.py --against /tmp/main --ab-only --rounds 3
+
+6. instructions (``--instructions``, with ``--against DIR``): the instructions (valgrind's
+   callgrind, Ir) of item 1's cold compile of Figure 3(a)'s variant, less those of the
+   import alone, this copy and DIR side by side (one per core): deterministic, where the
+   CPU seconds of item 5 vary by +-20% between single runs on a shared machine. ~12 min.
+
+    python scripts/bench_compile.py --against /tmp/main --instructions
 """
 
 from __future__ import annotations
@@ -50,6 +58,7 @@ import argparse
 import json
 import os
 import resource
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -213,6 +222,11 @@ def ab_round(tree: Path | None, repeat: int, tmp: str) -> dict[str, float]:
     sweep = [sys.executable, "-m", "rocksweep", "sweep", str(CONFIGS / "fig3a.yaml"),
              *ONE_POINT, "-o", h5, "--overwrite", "-q"]
     subprocess.run(sweep, check=True, capture_output=True, env=child_env(tree), cwd=tmp)
+    # warm start-up without a kernel: the command line's import, and --help
+    imp = [sys.executable, "-c", "import rocksweep.cli.main"]
+    helps = [sys.executable, "-m", "rocksweep", "--help"]
+    first = {"import": imp, "help": helps}
+    starts = {k: min(_wall(cmd, tree, tmp) for _ in range(repeat)) for k, cmd in first.items()}
     walls = []
     for _ in range(repeat):  # numba's cache now filled: warm start-up
         t0 = time.perf_counter()
@@ -228,7 +242,13 @@ def ab_round(tree: Path | None, repeat: int, tmp: str) -> dict[str, float]:
     pp = json.loads(res.stdout.splitlines()[-1])
     if not pp["package"].startswith(package):
         raise SystemExit(f"the per-point subprocess imported {pp['package']}, not {package}")
-    return {"compile": comp["cpu"], "start": min(walls), "us": pp["us"]}
+    return {"compile": comp["cpu"], "start": min(walls), "us": pp["us"], **starts}
+
+
+def _wall(cmd: list[str], tree: Path | None, cwd: str) -> float:
+    t0 = time.perf_counter()
+    subprocess.run(cmd, check=True, capture_output=True, env=child_env(tree), cwd=cwd)
+    return time.perf_counter() - t0
 
 
 def against(other: Path, rounds: int, repeat: int) -> None:
@@ -245,14 +265,62 @@ def against(other: Path, rounds: int, repeat: int) -> None:
                 r = ab_round(tree, repeat, tmp)
                 got[who].append(r)
                 print(f"    round {i + 1} {who:<6} compile {r['compile']:5.2f} s CPU, 1-point "
-                      f"sweep {r['start']:5.3f} s wall, fig3a {r['us']:6.2f} core-us/pt  "
+                      f"sweep {r['start']:5.3f} s wall, fig3a {r['us']:6.2f} core-us/pt, "
+                      f"import {r['import']:5.3f} s, --help {r['help']:5.3f} s  "
                       f"(load {bk.load_avg()})", flush=True)
     print(f"    {'median':<28}{'this':>10}{'other':>10}{'this/other':>12}")
     for key, what in (("compile", "cold compile, CPU s"), ("start", "1-point sweep, wall s"),
-                      ("us", "fig3a, core-us/pt")):
+                      ("us", "fig3a, core-us/pt"), ("import", "import cli.main, wall s"),
+                      ("help", "rocksweep --help, wall s")):
         a = float(np.median([r[key] for r in got["this"]]))
         b = float(np.median([r[key] for r in got["other"]]))
         print(f"    {what:<28}{a:>10.3f}{b:>10.3f}{a / b:>12.3f}")
+
+
+_VALGRIND_SNIPPET = """
+import rocksweep
+from rocksweep.kernel import warm_up
+if {compile}:
+    warm_up(0, 0, 0)
+"""
+
+
+def _callgrind(tree: Path | None, compile_too: bool, tmp: str) -> subprocess.Popen:
+    """A callgrind run (Ir only, no cache simulation) of the import, and the cold compile of
+    Figure 3(a)'s variant if ``compile_too``, in a fresh process with an empty cache."""
+    cache = tempfile.mkdtemp(dir=tmp)
+    code = _VALGRIND_SNIPPET.format(compile=compile_too)
+    return subprocess.Popen(
+        ["valgrind", "--tool=callgrind", f"--callgrind-out-file={cache}/cg.out",
+         sys.executable, "-c", code],
+        env=child_env(tree, NUMBA_CACHE_DIR=cache, PYTHONMALLOC="malloc"), cwd=cache,
+        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+
+
+def _collected(proc: subprocess.Popen) -> int:
+    err = proc.communicate()[1]
+    if proc.returncode:
+        raise SystemExit(f"callgrind failed:\n{err[-2000:]}")
+    return int(err.split("Collected :")[1].split()[0])
+
+
+def instructions(other: Path) -> None:
+    """Item 6: the cold compile's instructions, this copy and ``other`` side by side."""
+    if shutil.which("valgrind") is None:
+        raise SystemExit("--instructions needs valgrind on PATH")
+    print(f"\n[6] instructions of Figure 3(a)'s cold compile (callgrind Ir, less the "
+          f"import's), this copy and {other} side by side", flush=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        got = {}
+        for compile_too in (True, False):
+            procs = {who: _callgrind(tree, compile_too, tmp)
+                     for who, tree in (("this", None), ("other", other))}
+            got[compile_too] = {who: _collected(p) for who, p in procs.items()}
+    comp = {who: got[True][who] - got[False][who] for who in ("this", "other")}
+    print(f"    {'':<28}{'this':>10}{'other':>10}{'this/other':>12}")
+    for what, d in (("import, G instructions", got[False]), ("cold compile, G instr.", comp)):
+        print(f"    {what:<28}{d['this'] / 1e9:>10.2f}{d['other'] / 1e9:>10.2f}"
+              f"{d['this'] / d['other']:>12.3f}")
 
 
 def reference(name: str, pp: dict, points: int, seed: int = 0) -> dict:
@@ -290,7 +358,14 @@ def main() -> None:
                     help="item 5: A/B against the rocksweep package in DIR")
     ap.add_argument("--rounds", type=int, default=3, help="item 5's alternating rounds")
     ap.add_argument("--ab-only", action="store_true", help="item 5 only (with --against)")
+    ap.add_argument("--instructions", action="store_true",
+                    help="item 6 only (with --against): the cold compile's instructions")
     args = ap.parse_args()
+    if args.instructions:
+        if args.against is None:
+            raise SystemExit("--instructions needs --against DIR")
+        instructions(args.against.resolve())
+        return
     if args.ab_only:
         if args.against is None:
             raise SystemExit("--ab-only needs --against DIR")
