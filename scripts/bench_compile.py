@@ -225,8 +225,8 @@ def ab_round(tree: Path | None, repeat: int, tmp: str) -> dict[str, float]:
     # warm start-up without a kernel: the command line's import, and --help
     imp = [sys.executable, "-c", "import rocksweep.cli.main"]
     helps = [sys.executable, "-m", "rocksweep", "--help"]
-    first = {"import": imp, "help": helps}
-    starts = {k: min(_wall(cmd, tree, tmp) for _ in range(repeat)) for k, cmd in first.items()}
+    bare = {"import": imp, "help": helps}
+    starts = {k: min(_wall(cmd, tree, tmp) for _ in range(repeat)) for k, cmd in bare.items()}
     walls = []
     for _ in range(repeat):  # numba's cache now filled: warm start-up
         t0 = time.perf_counter()

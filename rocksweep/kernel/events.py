@@ -102,7 +102,8 @@ def event_rate(ev, t, y, s, on, prm, FLEX, DAMPED, GROUND):
 
 
 # ----------------------------------------------------------------------------------------
-# The cubic Hermite interpolant of g over a step (pure arithmetic; callable from Python)
+# The cubic Hermite interpolant of g over a step (pure arithmetic; jitted callers only: the
+# tests reach these through @njit wrappers)
 # ----------------------------------------------------------------------------------------
 
 

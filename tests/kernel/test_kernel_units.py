@@ -1,9 +1,9 @@
 """The kernel's root finders and Hermite helpers on their own, against closed forms.
 
 The Hermite helpers are pure arithmetic, compiled (as ``_locate``) without a Python entry
-point: they are reached through @njit wrappers (``helpers.python_entry``); ``_locate``
-through a small one of its own (one rigid specialisation, a
-few seconds to compile) on two event functions whose exact root is known in closed form
+point: they are reached through @njit wrappers (``helpers.python_entry``). ``_locate`` is
+reached through a small one of its own (one rigid specialisation, a few seconds to
+compile) on two event functions whose exact root is known in closed form
 and that the RK4 step follows exactly (so the only error left is the root finder's):
 
 - a rigid body at rest in full contact under a sine pulse: the uplift function
