@@ -144,15 +144,16 @@ def cold_compile(variant: tuple, tree: Path | None = None) -> dict:
     return json.loads(res.stdout.splitlines()[-1])
 
 
-def timed(cmd: list[str], repeat: int) -> tuple[float, float]:
-    """(wall, CPU) seconds of a command in a fresh process, the best of ``repeat``; CPU is
-    the child's user + sys time."""
+def timed(cmd: list[str], repeat: int, tree: Path | None = None) -> tuple[float, float]:
+    """(wall, CPU) seconds of a command in a fresh process (importing the rocksweep of
+    ``tree``, default this one), the best of ``repeat``; CPU is the child's user + sys
+    time."""
     best_wall = best_cpu = float("inf")
     for _ in range(repeat):
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         t0 = time.perf_counter()
         subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                       env=child_env(), cwd=tempfile.gettempdir())
+                       env=child_env(tree), cwd=tempfile.gettempdir())
         wall = time.perf_counter() - t0
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
         cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -213,7 +214,8 @@ ONE_POINT = ["--set", "pulse.w_over_p=2.0", "--set", "pulse.A_ratio=3.0",
 
 def ab_round(tree: Path | None, repeat: int, tmp: str) -> dict[str, float]:
     """Item 5's measurements of one copy (``tree``; None: this one), each in a fresh
-    process: cold compile CPU s, warm 1-point sweep wall s, fig3a core-us per point."""
+    process: cold compile CPU s, warm 1-point sweep, ``import rocksweep.cli.main`` and
+    ``rocksweep --help`` wall s (best of ``repeat``), fig3a core-us per point."""
     package = str((tree or Path(rocksweep.__file__).resolve().parents[1]) / "rocksweep")
     comp = cold_compile(QUICK_VARIANTS[0], tree)
     if not comp["package"].startswith(package):
@@ -222,16 +224,11 @@ def ab_round(tree: Path | None, repeat: int, tmp: str) -> dict[str, float]:
     sweep = [sys.executable, "-m", "rocksweep", "sweep", str(CONFIGS / "fig3a.yaml"),
              *ONE_POINT, "-o", h5, "--overwrite", "-q"]
     subprocess.run(sweep, check=True, capture_output=True, env=child_env(tree), cwd=tmp)
-    # warm start-up without a kernel: the command line's import, and --help
-    imp = [sys.executable, "-c", "import rocksweep.cli.main"]
-    helps = [sys.executable, "-m", "rocksweep", "--help"]
-    bare = {"import": imp, "help": helps}
-    starts = {k: min(_wall(cmd, tree, tmp) for _ in range(repeat)) for k, cmd in bare.items()}
-    walls = []
-    for _ in range(repeat):  # numba's cache now filled: warm start-up
-        t0 = time.perf_counter()
-        subprocess.run(sweep, check=True, capture_output=True, env=child_env(tree), cwd=tmp)
-        walls.append(time.perf_counter() - t0)
+    # warm start-up (numba's cache now filled), and without a kernel: the command line's
+    # import, and --help
+    starts = {k: timed(cmd, repeat, tree)[0] for k, cmd in (
+        ("start", sweep), ("import", [sys.executable, "-c", "import rocksweep.cli.main"]),
+        ("help", [sys.executable, "-m", "rocksweep", "--help"]))}
     # the copy's own bench_kernel where it has one: this copy's imports names an old
     # package lacks; both time the same thing (``best_pass`` of ``kernel_pass``)
     own = None if tree is None else tree / "scripts"
@@ -242,13 +239,7 @@ def ab_round(tree: Path | None, repeat: int, tmp: str) -> dict[str, float]:
     pp = json.loads(res.stdout.splitlines()[-1])
     if not pp["package"].startswith(package):
         raise SystemExit(f"the per-point subprocess imported {pp['package']}, not {package}")
-    return {"compile": comp["cpu"], "start": min(walls), "us": pp["us"], **starts}
-
-
-def _wall(cmd: list[str], tree: Path | None, cwd: str) -> float:
-    t0 = time.perf_counter()
-    subprocess.run(cmd, check=True, capture_output=True, env=child_env(tree), cwd=cwd)
-    return time.perf_counter() - t0
+    return {"compile": comp["cpu"], "us": pp["us"], **starts}
 
 
 def against(other: Path, rounds: int, repeat: int) -> None:
