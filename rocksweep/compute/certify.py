@@ -44,8 +44,11 @@ An overturn is a close call too where its mode hung on a graze (``mode_close``):
 2 whose rocking came within ``numerics.MODE_BAND`` x PAR_CLOSE of theta = 0 (a turn back
 just short of an impact, after the pulse as while it acts), or a mode 1 whose deepest
 impact was that shallow (OUT_MODE_GRAZE): a finer run may make the impact, or miss them
-all, and fall in the other mode. Such a close call is trusted once two runs agree and the
-finer one's graze clears its own step's band, converged margin or not.
+all, and fall in the other mode. So is a mode 2 whose body, in full contact before it
+uplifted, came within ``numerics.LIFT_BAND`` x PAR_CLOSE of uplifting (OUT_LIFT_GRAZE, a
+fraction of M g b): a finer run may uplift there by a hair, impact, and fall in mode 1.
+Such a close call is trusted once two runs agree and the finer one's graze clears its own
+step's band, converged margin or not.
 
 Below the last level, a repeated outcome is not trusted either where the finer run grazed
 an impact it did not make (OUT_GRAZE below ``numerics.GRAZE_MARGIN``) by an amount that
@@ -85,6 +88,7 @@ from rocksweep.numerics import (
     CLOSE_BAND,
     ENERGY_ORDER,
     GRAZE_MARGIN,
+    LIFT_BAND,
     MODE_BAND,
     OVERTURN_BAND,
     RICHARDSON_SAFETY,
@@ -124,9 +128,14 @@ def mode_close(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     """bool[n]: overturns (result rows float64[n, N_OUT] of parameter rows float64[n, >=
     N_PAR]) whose mode hung on a graze: OUT_MODE_GRAZE below ``numerics.MODE_BAND`` x
     PAR_CLOSE (a mode 2 whose rocking came that near theta = 0, a mode 1 whose deepest
-    impact was that shallow): a finer run may make an impact this one missed, or miss
+    impact was that shallow), or a mode 2 whose body came within ``numerics.LIFT_BAND`` x
+    PAR_CLOSE of uplifting before its first uplift (OUT_LIFT_GRAZE, over M g b): a finer
+    run may make an impact this one missed (or uplift by a hair and impact), or miss
     those it made, and fall in the other mode."""
-    return _fell(outs) & (outs[:, L.OUT_MODE_GRAZE] < MODE_BAND * rows[:, L.PAR_CLOSE])
+    band = rows[:, L.PAR_CLOSE]
+    lifted = ((outs[:, L.OUT_OUTCOME] == L.OUTCOME_MODE2)
+              & (outs[:, L.OUT_LIFT_GRAZE] < LIFT_BAND * band))
+    return _fell(outs) & ((outs[:, L.OUT_MODE_GRAZE] < MODE_BAND * band) | lifted)
 
 
 def clear(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:

@@ -289,11 +289,13 @@ def _locate(ev, t0, y0, k1, g_lo, hi, g_hi, y_hi, s, on, prm, FLEX, DAMPED, ENER
 def _crossing(ev, t0, y0, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY, GROUND):
     """Did event ``ev`` fire in the step (t0, y0) -> (t0 + h, y1)?
 
-    Returns (tau, y_event, re-integrations); tau < 0 if it did not. A sign change at the
-    ends is bracketed at once. Same sign at both ends but falling then rising (a dip
+    Returns (tau, y_event, re-integrations, g_dip); tau < 0 if it did not. A sign change
+    at the ends is bracketed at once. Same sign at both ends but falling then rising (a dip
     through zero and back, e.g. a grazing impact inside a coarse step) is checked with the
     step's cubic Hermite interpolant; when its minimum is nearer zero than the dip is deep,
-    ``_dip`` searches the integrator's own solution. This screening runs for every event
+    ``_dip`` searches the integrator's own solution. g_dip: the cubic's minimum (>= 0) of
+    a dip that turned back without an event (inf if none): how near the event came, which
+    the loop keeps for the uplift (OUT_LIFT_GRAZE). This screening runs for every event
     function at every step and is inlined into the loop (with ``_first_event``); the
     searches are calls.
     """
@@ -302,21 +304,26 @@ def _crossing(ev, t0, y0, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY, GROUND):
     if g1 <= 0.0:
         # g0 = 0 happens right after an action put the state on g = 0 (uplift leaves
         # theta = 0): if the motion turns straight back, that is an event just after t0.
-        return _locate(ev, t0, y0, k1, g0, h, g1, y1, s, on, prm, FLEX, DAMPED, ENERGY,
-                       GROUND)
+        tau, y_e, n = _locate(ev, t0, y0, k1, g0, h, g1, y1, s, on, prm, FLEX, DAMPED,
+                              ENERGY, GROUND)
+        return tau, y_e, n, math.inf
     if g0 <= 0.0:
-        return -1.0, y1, 0  # leaving g = 0 after an action: not an event
+        return -1.0, y1, 0, math.inf  # leaving g = 0 after an action: not an event
     d0 = event_rate(ev, t0, y0, s, on, prm, FLEX, DAMPED, GROUND)
     if d0 >= 0.0:
-        return -1.0, y1, 0
+        return -1.0, y1, 0, math.inf
     d1 = event_rate(ev, t0 + h, y1, s, on, prm, FLEX, DAMPED, GROUND)
     if d1 <= 0.0:
-        return -1.0, y1, 0
+        return -1.0, y1, 0, math.inf
     tau, g_min = hermite_min(g0, d0, g1, d1, h)
     if g_min > min(g0, g1) - g_min:
-        return -1.0, y1, 0  # far from zero compared with the dip: the cubic is good enough
-    return _dip(ev, t0, y0, k1, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERGY,
-                GROUND)
+        # far from zero compared with the dip: the cubic is good enough
+        return -1.0, y1, 0, g_min
+    tau, y_e, n = _dip(ev, t0, y0, k1, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED,
+                       ENERGY, GROUND)
+    # a dip the search proved to stay above zero: the cubic's minimum (clipped at 0, where
+    # the cubic dipped below and the solution did not) says how near it came
+    return tau, y_e, n, (max(g_min, 0.0) if tau < 0.0 else math.inf)
 
 
 @njit(cache=True, **INTERNAL)
@@ -368,7 +375,8 @@ def _dip(ev, t0, y0, k1, y1, h, g0, d0, d1, tau, s, on, prm, FLEX, DAMPED, ENERG
 def _first_event(t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY, GROUND):
     """The first event in the step (t, y) -> (t + h, y1) of phase s.
 
-    Returns (event code, tau, state at the event, re-integrations); EV_NONE and y1 if none.
+    Returns (event code, tau, state at the event, re-integrations, g_dip); EV_NONE and y1
+    if none; g_dip: the least of the two event functions' ``_crossing`` dips (inf if none).
     """
     literally(FLEX)
     literally(DAMPED)
@@ -380,13 +388,15 @@ def _first_event(t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY, GROUND):
         ev_a, ev_b = EV_IMPACT, EV_OVERTURN
     else:
         ev_a, ev_b = EV_UPLIFT_POS, EV_UPLIFT_NEG
-    tau, y_ev, n = _crossing(ev_a, t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY, GROUND)
+    tau, y_ev, n, dip = _crossing(ev_a, t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY,
+                                  GROUND)
     if s != 0 and tau >= 0.0:
-        return ev_a, tau, y_ev, n  # the impact ends the phase before any overturning
-    tau2, y_ev2, n2 = _crossing(ev_b, t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY,
-                                GROUND)
+        return ev_a, tau, y_ev, n, dip  # the impact ends the phase before any overturning
+    tau2, y_ev2, n2, dip2 = _crossing(ev_b, t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY,
+                                      GROUND)
+    dip = min(dip, dip2)
     if tau2 >= 0.0 and (tau < 0.0 or tau2 < tau):
-        return ev_b, tau2, y_ev2, n + n2
+        return ev_b, tau2, y_ev2, n + n2, dip
     if tau >= 0.0:
-        return ev_a, tau, y_ev, n + n2
-    return EV_NONE, h, y1, n + n2
+        return ev_a, tau, y_ev, n + n2, dip
+    return EV_NONE, h, y1, n + n2, dip

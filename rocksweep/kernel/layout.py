@@ -158,7 +158,14 @@ OUT_MODE_GRAZE = 30  # how near the run came to the other mode [alpha_ref]: with
 #                 with impacts, the deepest one's depth, (theta'/alpha_ref)^2 / 2 at it
 #                 (a finer run that missed them all would fall in mode 2). inf: no dip;
 #                 a base that slides takes none
-N_OUT = 31
+OUT_LIFT_GRAZE = 31  # how near the body came to uplifting before its first uplift, in full
+#                 contact: the least minimum of the uplift function M g b - s Q inside a
+#                 step where it fell and rose again without reaching 0 (the step's cubic
+#                 Hermite interpolant, as OUT_GRAZE), over M g b at PAR_G. inf: no such
+#                 dip; a base that slides takes none. A mode 2 that came this near an
+#                 earlier uplift hangs on it: a finer run may uplift by a hair there and
+#                 impact, and fall in mode 1 (``rocksweep.compute.certify.mode_close``)
+N_OUT = 32
 
 # --- state tuple y (the loop's 6 slots, a UniTuple(float64, 6)) ----------------------------
 Y_THETA = 0  # theta [rad] (0 in full contact)

@@ -39,7 +39,7 @@ from rocksweep.kernel.contact import (
     reactions_impact,
     reactions_sample,
 )
-from rocksweep.kernel.equations import mechanical_energy
+from rocksweep.kernel.equations import mechanical_energy, tip_moment
 from rocksweep.kernel.events import (
     EV_IMPACT,
     EV_NONE,
@@ -75,6 +75,7 @@ from rocksweep.kernel.layout import (
     OUT_GRAZE,
     OUT_HIST_ROWS,
     OUT_IMPACTS,
+    OUT_LIFT_GRAZE,
     OUT_MARGIN,
     OUT_MODE_GRAZE,
     OUT_N_GAINING,
@@ -206,6 +207,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     margin = np.inf  # OUT_MARGIN, in a register
     graze = np.inf  # OUT_GRAZE
     dip = np.inf  # OUT_MODE_GRAZE of a run without impacts (with: ``_apply_impact``)
+    lift = np.inf  # OUT_LIFT_GRAZE [N m] until the end
     t_close = np.nan  # OUT_T_CLOSE
     # ``_near_saddle``'s bounds, once per run (saddle0 = NaN: no gate, every free rocking
     # step takes ``_saddle``'s test; a row without a body, as warm_up's)
@@ -268,7 +270,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
         if not _finite(y1):
             _flag(out, STATUS_NONFINITE)
             break
-        ev, tau, y_ev, n = _first_event(t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY, GROUND)
+        ev, tau, y_ev, n, low = _first_event(t, y, k1, y1, h, s, on, prm, FLEX, DAMPED, ENERGY,
+                                             GROUND)
         event_steps += n
         if s != 0:
             theta_max = _theta_max(y, y_ev, tau, s, theta_max)  # (y_ev, tau) = (y1, h) if none
@@ -278,6 +281,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
                 g = _graze(y, y1, h, s, prm, np.inf)  # one call site: one inlined copy
                 graze = min(graze, g) if on else graze
                 dip = min(dip, g) if out[OUT_IMPACTS] == 0.0 else dip
+            elif s == 0 and out[OUT_IMPACTS] == 0.0:  # (before the first uplift)
+                lift = min(lift, low)
             t, y = (t_pulse if lands else (t_air if air else t + h)), y1
             if s != 0 and not on and _near_saddle(y, s, near):
                 q = _saddle(y, s, prm)
@@ -311,6 +316,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     out[OUT_T_CLOSE] = t_close
     out[OUT_GRAZE] = graze
     out[OUT_MODE_GRAZE] = dip if out[OUT_IMPACTS] == 0.0 else out[OUT_MODE_GRAZE]
+    out[OUT_LIFT_GRAZE] = lift / tip_moment(prm[PAR_G], prm)
     _finish(t, y, s, steps, event_steps, theta_max, prm, out, FLEX, ENERGY)
     reactions_end(REACTIONS, prm, out)
 

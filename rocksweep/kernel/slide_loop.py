@@ -70,6 +70,7 @@ from rocksweep.kernel.layout import (
     OUT_HIST_ROWS,
     OUT_IMPACTS,
     OUT_IMPULSE_MAX,
+    OUT_LIFT_GRAZE,
     OUT_MARGIN,
     OUT_MODE_GRAZE,
     OUT_MU_REQ,
@@ -317,6 +318,7 @@ def simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     out[OUT_T_CLOSE] = t_close
     out[OUT_GRAZE] = graze
     out[OUT_MODE_GRAZE] = np.inf  # not taken: the sliding base's phases differ
+    out[OUT_LIFT_GRAZE] = np.inf
     _finish(t, y, s, steps, event_steps, theta_max, slide_max, prm, out, FLEX, ENERGY)
 
 

@@ -33,6 +33,7 @@ from rocksweep.numerics import (
     CLOSE_AFTER,
     CLOSE_BAND,
     GRAZE_MARGIN,
+    LIFT_BAND,
     MIN_EVENT_TOL,
     MODE_BAND,
     OVERTURN_BAND,
@@ -51,9 +52,10 @@ BLOCK = BlockBody(alpha=0.25, inertia=4.0 / 3.0)
 
 def _stand_in(n: int) -> np.ndarray:
     """Result rows float64[n, N_OUT] of a stand-in kernel: zeros, and no mode graze (inf,
-    as a run whose rocking never neared theta = 0 before its first impact)."""
+    as a run whose rocking never neared theta = 0 before its first impact) nor lift graze
+    (inf: never near an uplift it did not make)."""
     out = np.zeros((n, L.N_OUT))
-    out[:, L.OUT_MODE_GRAZE] = np.inf
+    out[:, [L.OUT_MODE_GRAZE, L.OUT_LIFT_GRAZE]] = np.inf
     return out
 CASES = [
     # (point, what the issue found the reference does)
@@ -753,3 +755,63 @@ def test_the_first_impacts_depth_is_its_speed_squared():
             chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)(r, out)
             assert out[0, L.OUT_IMPACTS] >= 1
             assert out[0, L.OUT_MODE_GRAZE] == pytest.approx(want, rel=rel)
+
+
+def test_a_mode_2_that_nearly_uplifted_before_is_a_close_call():
+    """certify's rule on a stand-in kernel: a mode 2 whose body came within LIFT_BAND x
+    PAR_CLOSE of an uplift it did not make (OUT_LIFT_GRAZE, before its first uplift) is
+    re-run finer; once its finer run (mode 1 after an uplift by a hair, whose impact is
+    as shallow: OUT_MODE_GRAZE ~ 0) agrees with none, the point is flagged; a mode 2
+    whose dip clears the band, and a safe run or a mode 1 with the same dip, buy no
+    rerun."""
+    rows = np.zeros((4, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = 0.1
+    rows[:, L.PAR_DT] = 1.0
+    band = LIFT_BAND * 0.1
+    mode2, mode1, safe = L.OUTCOME_MODE2, L.OUTCOME_MODE1, L.OUTCOME_SAFE
+    outs = _stand_in(4)
+    outs[:, L.OUT_MARGIN] = 0.5
+    outs[:, L.OUT_T_OVERTURN] = 5.0
+    outs[:, L.OUT_OUTCOME] = (mode2, mode2, safe, mode1)
+    outs[:, L.OUT_LIFT_GRAZE] = (0.02 * band, 2.0 * band, 0.02 * band, 0.02 * band)
+    outs[3, L.OUT_MODE_GRAZE] = 1.0  # a mode 1 with deep impacts
+    seen = []
+
+    def run(sub, idx, keep=True):
+        seen.extend(int(i) for i in idx)
+        res = _stand_in(len(idx))
+        res[:, L.OUT_MARGIN] = 0.5
+        res[:, L.OUT_T_OVERTURN] = 5.0
+        res[:, L.OUT_OUTCOME] = mode1
+        res[:, L.OUT_MODE_GRAZE] = 1e-9  # the hair's impact
+        return res
+
+    certify(rows, outs, run, 3)
+    assert set(seen) == {0}
+    st = outs[:, L.OUT_STATUS].astype(int)
+    assert st[0] & L.STATUS_UNCERTIFIED
+    assert not (st[1:] & L.STATUS_REFINED).any()
+
+
+def test_a_blocks_least_uplift_gap_is_one_less_its_amplitude_ratio():
+    """The kernel's OUT_LIFT_GRAZE of a rigid block on the ground under a sine pulse too
+    weak to uplift it (A_ratio < 1): in full contact the uplift function is M g b - s M
+    a_g h_cg, so its least value over the pulse, over M g b, is 1 - A_ratio (A = A_ratio
+    g tan alpha, tan alpha = b / h_cg), reached at the pulse's peaks, inside steps. At 5
+    steps a period the step's cubic gives it to 1e-3 of M g b, at 80 to 1e-8. With
+    A_ratio > 1 the block uplifts and no dip is kept (inf)."""
+    body = BlockBody(alpha=0.2, inertia=4.0 / 3.0)
+    kind = kernel_kind(body)
+    warm_up(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)
+    for a_ratio in (0.3, 0.9, 0.999):
+        row = point_row(Point(body, 0.0, "sine", 3.0, a_ratio), Numerics.preset("default"))
+        for level, tol in ((0, 1e-3), (4, 1e-8)):
+            out = np.empty((1, L.N_OUT))
+            r = np.ascontiguousarray(refined_rows(row[None, :], level))
+            chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)(r, out)
+            assert out[0, L.OUT_UPLIFTS] == 0
+            assert abs(out[0, L.OUT_LIFT_GRAZE] - (1.0 - a_ratio)) < tol
+    row = point_row(Point(body, 0.0, "sine", 3.0, 1.5), Numerics.preset("default"))
+    out = np.empty((1, L.N_OUT))
+    chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)(row[None, :].copy(), out)
+    assert out[0, L.OUT_UPLIFTS] >= 1 and out[0, L.OUT_LIFT_GRAZE] == np.inf
