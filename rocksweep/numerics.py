@@ -373,14 +373,20 @@ CLOSE_AFTER = 4.0 * math.pi
 # A spring that remembers its past longer than RINGING_MEMORY [p t] (``spring_memory``,
 # the kernel's PAR_MEMORY) carries the step's error across many impacts: such a body's
 # coarse run parts from the finer ones far from the saddle, and the finer run falls on an
-# approach the coarse one passed wide, after the probe's stop. Its near-misses are probed
-# up to RINGING_BAND x the band (a run never within the band: to its end), and a probe
-# whose margin moved by more than itself (``compute.certify.settled``) makes the point a
-# close call. The four figures' springs remember 0.26-1.05 p t; the threshold samples'
-# wrong, unflagged classes were bodies of 12-90 p t (docs/accuracy.md, "Springs that ring
-# long").
+# approach the coarse one passed wide, after a probe's stop. Its safe runs are close calls
+# (full runs) up to RINGING_BAND x the band, its overturns up to RINGING_BAND x
+# OVERTURN_BAND x the close-call margin, and a repeated safe outcome below the last level
+# is trusted only where both runs made the same number of impacts, within IMPACT_AGREE
+# of the larger (``compute.certify.same_path``). The four figures' springs remember
+# 0.26-1.05 p t; the threshold samples' wrong, unflagged classes were bodies of 12-90 p t
+# (docs/accuracy.md, "Springs that ring long", "Two paths, one class").
 RINGING_MEMORY = 5.0
 RINGING_BAND = 2.0
+# Seeds 54 and 64's default runs at 5 and 10 steps a period rocked to rest after 24 and
+# 29, 82 and 36 impacts where finer runs fall in mode 1 (after 22 and 12); of the ~1800
+# safe runs of ringing bodies on seeds 51-70, 1 in 9 differed by more than this between
+# the two levels and all but 7 of those agreed at the next.
+IMPACT_AGREE = 0.1
 # A rocking arc that turns back just short of an impact (a graze: OUT_GRAZE, the least
 # minimum of s theta in a step while the ground moves, in alpha_ref) decides whether that
 # impact happens, and a coarse run can miss one a finer run makes: flexible bodies just
@@ -420,6 +426,11 @@ SAME_FALL = 0.5
 # reference; another's (seed 18) safe runs, 1.9 x too, overturn there (docs/accuracy.md,
 # "Clear by twice the margin, events located finer").
 CLEARANCE = 2.0
+# The slowest the margin's error is taken to fall (as the step^MARGIN_ORDER, impacts
+# leading to the approach, as CLEARANCE's): a near-miss's probe whose margin fell below
+# Richardson's estimate of its own error at this order (below 1/2^3 of the coarse one) is
+# a close call (``compute.certify.kept``).
+MARGIN_ORDER = 3
 # An overturn's mode (1: after impacts, 2: without) hangs on whether the rocking touched
 # theta = 0 before the fall. Where it came near (OUT_MODE_GRAZE: a mode 2's least dip
 # toward theta = 0, a mode 1's deepest impact, in alpha_ref) below MODE_BAND x PAR_CLOSE

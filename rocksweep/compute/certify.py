@@ -33,12 +33,15 @@ when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the th
   most of its steps. If the finer run overturns, or does not ``clear`` its own step's
   close-call margin CLEARANCE times, the point is a close call as above (its full runs
   from the first refinement on);
-  if not, the run's own result is kept. A body whose spring rings long (``ringing``:
-  PAR_MEMORY above ``numerics.RINGING_MEMORY``) has its safe runs probed up to
-  RINGING_BAND x PAR_CLOSE (to the run's end if it never came within PAR_CLOSE), and a
-  probe whose margin moved by more than itself (``settled``) makes it a close call too:
-  its runs part from finer ones over many impacts, and the finer run falls on a later
-  approach the coarse one passed wide (docs/accuracy.md, "Springs that ring long").
+  if not, the run's own result is kept;
+- a body whose spring rings long (``ringing``: PAR_MEMORY above
+  ``numerics.RINGING_MEMORY``) is not probed: its runs part from finer ones over many
+  impacts, and the finer run falls on a later approach the coarse one passed wide. Its
+  safe runs up to RINGING_BAND x PAR_CLOSE and its overturns up to RINGING_BAND x
+  OVERTURN_BAND x the close-call margin are close calls, and a repeated safe outcome
+  below the last level is trusted only where both runs made as many impacts
+  (``same_path``, within ``numerics.IMPACT_AGREE``) (docs/accuracy.md, "Springs that
+  ring long", "Two paths, one class").
 
 An overturn is a close call too where its mode hung on a graze (``mode_close``): a mode
 2 whose rocking came within ``numerics.MODE_BAND`` x PAR_CLOSE of theta = 0 (a turn back
@@ -88,7 +91,9 @@ from rocksweep.numerics import (
     CLOSE_BAND,
     ENERGY_ORDER,
     GRAZE_MARGIN,
+    IMPACT_AGREE,
     LIFT_BAND,
+    MARGIN_ORDER,
     MODE_BAND,
     OVERTURN_BAND,
     RICHARDSON_SAFETY,
@@ -119,8 +124,14 @@ def close_calls(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     N_OUT]) re-run in full: they stayed safe with a margin below the close-call margin
     (``numerics.close_margin``: the row's PAR_CLOSE / CLOSE_BAND, in alpha_ref) or
     overturned with one below OVERTURN_BAND times it, or overturned in a mode that hung on
-    a graze (``mode_close``)."""
-    bound = np.where(_fell(outs), OVERTURN_BAND, 1.0) * _close_margin(rows)
+    a graze (``mode_close``). A spring that rings long (``ringing``) widens both: its
+    overturns up to RINGING_BAND x OVERTURN_BAND, its safe runs up to RINGING_BAND x
+    PAR_CLOSE (its near-misses: a probe up to the last approach says nothing of the
+    approaches after it, on the path a finer run takes)."""
+    ring = ringing(rows)
+    fell_band = OVERTURN_BAND * np.where(ring, RINGING_BAND, 1.0)
+    safe_band = np.where(ring, RINGING_BAND * CLOSE_BAND, 1.0)
+    bound = np.where(_fell(outs), fell_band, safe_band) * _close_margin(rows)
     return (outs[:, L.OUT_MARGIN] < bound) | mode_close(rows, outs)
 
 
@@ -182,6 +193,20 @@ def settled(coarse: np.ndarray, fine: np.ndarray) -> np.ndarray:
         return ~(np.abs(m_f * m_f - m_c * m_c) > m_f * m_f)
 
 
+def kept(coarse: np.ndarray, fine: np.ndarray) -> np.ndarray:
+    """bool[n]: the finer of two runs of the same points (result rows float64[n, N_OUT], the
+    second at half the first's steps) kept a margin at least Richardson's estimate of its
+    error were the margin's error to fall only as the step^3 (impacts leading to the
+    approach, ``numerics.CLEARANCE``): m_f >= (m_c - m_f) / (2^3 - 1), a margin that did
+    not fall to below an eighth of the coarse one. One that did (a near-miss at 0.091
+    alpha_ref whose probe passed at 0.0068, threshold seed 73: 20 steps a period and the
+    reference overturn) measured another approach, or one the coarse step had wrong by
+    more than the finer run's margin."""
+    m_c, m_f = coarse[:, L.OUT_MARGIN], fine[:, L.OUT_MARGIN]
+    with np.errstate(invalid="ignore"):  # inf - inf: a margin never taken
+        return ~(m_c - m_f > (2.0 ** MARGIN_ORDER - 1.0) * m_f)
+
+
 def grazed(coarse: np.ndarray, fine: np.ndarray) -> np.ndarray:
     """bool[n]: the finer of two runs of the same points (result rows float64[n, N_OUT])
     grazed an impact it did not make by less than ``numerics.GRAZE_MARGIN`` (OUT_GRAZE,
@@ -200,20 +225,29 @@ def ringing(rows: np.ndarray) -> np.ndarray:
     return rows[:, L.PAR_MEMORY] > RINGING_MEMORY
 
 
+def same_path(coarse: np.ndarray, fine: np.ndarray) -> np.ndarray:
+    """bool[n]: two runs of the same points (result rows float64[n, N_OUT]) that made the
+    same number of impacts, within ``numerics.IMPACT_AGREE`` of the larger: one path, not
+    two that parted over the impacts (what a spring that rings long carries the step's
+    error across) and agree on the class by chance."""
+    i_c, i_f = coarse[:, L.OUT_IMPACTS], fine[:, L.OUT_IMPACTS]
+    return np.abs(i_f - i_c) <= IMPACT_AGREE * np.maximum(i_c, i_f)
+
+
 def near_misses(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
-    """bool[n]: the safe runs whose margin lies in [1/CLOSE_BAND, 1) x PAR_CLOSE
-    (``ringing`` rows: up to RINGING_BAND x PAR_CLOSE): checked by a finer run up to their
-    last approach (``probe_rows``) before they are trusted."""
-    m, band = outs[:, L.OUT_MARGIN], rows[:, L.PAR_CLOSE]
-    top = np.where(ringing(rows), RINGING_BAND * band, band)
-    return ~_fell(outs) & (m >= _close_margin(rows)) & (m < top)
+    """bool[n]: the safe runs whose margin lies in [1/CLOSE_BAND, 1) x PAR_CLOSE, of
+    bodies that do not ring long (``ringing`` ones are close calls there): checked by a
+    finer run up to their last approach (``probe_rows``) before they are trusted."""
+    m = outs[:, L.OUT_MARGIN]
+    return (~_fell(outs) & ~ringing(rows) & (m >= _close_margin(rows))
+            & (m < rows[:, L.PAR_CLOSE]))
 
 
 def probe_rows(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     """The first refinement of ``rows`` (float64[k, >= N_PAR]), stopping CLOSE_AFTER [p t]
     after each run's last approach to the saddle within the band (``outs[:, OUT_T_CLOSE]``;
     float64[k, N_OUT] the runs' results), or at the row's own end where the run never came
-    within it (NaN: a ``ringing`` row's near-miss beyond PAR_CLOSE)."""
+    within it (NaN)."""
     out = refined_rows(rows, 1)
     stop = outs[:, L.OUT_T_CLOSE] + CLOSE_AFTER
     out[:, L.PAR_TEND] = np.where(np.isnan(stop), out[:, L.PAR_TEND],
@@ -248,10 +282,9 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
         # or which does not ``clear`` its own step's close-call margin CLEARANCE times, as
         # a finer run below the last level must (its approach came nearer the saddle than
         # the coarse run's: the coarse margin was not the run's to trust)
-        # or, for a spring that rings long, whose margin moved by more than itself (its
-        # runs part over many impacts: the finer run's next approach may be its fall)
-        moved = ringing(rows[near]) & ~settled(outs[near], probe)
-        idx = np.union1d(idx, near[_fell(probe) | ~clear(checks, probe) | moved])
+        # or whose margin fell below Richardson's estimate of its own error (``kept``)
+        idx = np.union1d(idx, near[_fell(probe) | ~clear(checks, probe)
+                                   | ~kept(outs[near], probe)])
     for level in range(1, levels + 1):
         if idx.size == 0:
             break
@@ -274,6 +307,9 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
             # and, either way, no graze that moved (an impact the next run may make), nor
             # a mode that hangs on a graze (a converged margin says nothing of the mode)
             trusted &= ~grazed(before, new) & ~mode_close(finer, new)
+            # and a spring that rings long stays safe on one path (``same_path``): its two
+            # runs' margins may agree where the finer ones part from both over the impacts
+            trusted &= ~(ringing(rows[idx]) & ~_fell(new) & ~same_path(before, new))
         # a repeated overturn counts only if both runs fell on the same approach (within
         # SAME_FALL): two falls far apart are two trajectories that parted, whatever their
         # margins (wide-space.yaml's undamped bodies at lam 1 fell at 79, 195 and 102 p t

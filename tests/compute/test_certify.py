@@ -33,7 +33,9 @@ from rocksweep.numerics import (
     CLOSE_AFTER,
     CLOSE_BAND,
     GRAZE_MARGIN,
+    IMPACT_AGREE,
     LIFT_BAND,
+    MARGIN_ORDER,
     MIN_EVENT_TOL,
     MODE_BAND,
     OVERTURN_BAND,
@@ -180,6 +182,37 @@ CASES = [
                         mA_over_m=1.1163266672244812, IA_ratio=0.7017887641230507),
            0.27312513876994055, "sine", 5.289383516384128, 5.187507434762409),
      L.OUTCOME_MODE1),
+    # nearly uplifted (seed 63): at 5 steps a period the uplift moment turns back 3.5e-5
+    # M g b short of uplifting and the body falls later without an impact (mode 2); finer
+    # runs and the reference uplift there by a hair, impact once and fall in mode 1
+    (Point(FlexibleBody(wn_over_p=1.7957502692358451, zeta=0.08062461560373882,
+                        alpha_cg=0.18801316374715496, alpha_A=0.22816281603351407,
+                        mA_over_m=2.6435877119708886, IA_ratio=0.3667814134254739),
+           0.2524961519237265, "cosine", 1.3323570528284048, 1.4121684954916087),
+     L.OUTCOME_MODE1),
+    # two paths, one class (seeds 64 and 66, springs that ring long): `default` at 5 and
+    # 10 steps a period rocks to rest after 82 and 36 impacts, margins 0.032 and 0.033;
+    # 20 steps and finer fall in mode 1 after 12, as the reference does. And an overturn
+    # after 5 impacts at 1.06 x the overturn band where finer runs and the reference rock
+    # to rest after 8
+    (Point(FlexibleBody(wn_over_p=7.037649694070546, zeta=0.0023540019192680116,
+                        alpha_cg=0.2294307100554438, alpha_A=0.1948138215409945,
+                        mA_over_m=2.1745212409788, IA_ratio=0.977377538803013),
+           0.33332330202872895, "cosine", 6.421472704841054, 11.571988404376356),
+     L.OUTCOME_MODE1),
+    (Point(FlexibleBody(wn_over_p=3.075709081322864, zeta=0.030134590120287907,
+                        alpha_cg=0.2694365211138179, alpha_A=0.19254937652001652,
+                        mA_over_m=1.0962236801345875, IA_ratio=0.8953117873169059),
+           0.25831097900721167, "cosine", 4.713245726626207, 10.697457631199324),
+     L.OUTCOME_SAFE),
+    # a probe whose margin fell past its error (seed 73): a near-miss at 0.091 alpha_ref
+    # whose probe at 10 steps passes at 0.0068 (clear of twice its margin); 20 steps and
+    # the reference overturn in mode 1 after 3 impacts
+    (Point(FlexibleBody(wn_over_p=2.4690161419528724, zeta=0.0686134070587241,
+                        alpha_cg=0.11032806691211333, alpha_A=0.18697876631211824,
+                        mA_over_m=2.4517520795207446, IA_ratio=0.5664574421239543),
+           0.35996189697155917, "cosine", 3.8059568165695747, 13.449372852900005),
+     L.OUTCOME_MODE1),
 ]
 
 
@@ -191,7 +224,8 @@ CASES = [
                               "flexible-near-miss-wide", "ringing-probe-moved",
                               "ringing-beyond-band", "graze", "clear-overturn",
                               "clear-safe", "event-tol", "fall-moved", "probe-clear-1",
-                              "probe-clear-2"])
+                              "probe-clear-2", "nearly-uplifted", "two-paths-safe",
+                              "two-paths-overturn", "probe-kept"])
 def test_default_classifies_the_reproduced_cases_like_the_reference(point, expected):
     """The reference's outcome is the one written here; `default` (sweep kernel and simulate) gives
     the same. Before the step rule, `default` gave safe / mode 1 here."""
@@ -316,47 +350,83 @@ def test_a_near_miss_whose_probe_does_not_clear_twice_its_margin_is_a_close_call
     assert outs[1, L.OUT_MARGIN] == 0.013  # its own result kept
 
 
-def test_a_ringing_spring_near_miss_is_probed_wider_and_must_settle():
+def test_a_near_miss_whose_probe_margin_fell_past_its_error_is_a_close_call():
+    """certify's rule on a stand-in kernel: a near-miss whose probe stays safe and clear of
+    CLEARANCE x its own step's close-call margin, but with a margin below Richardson's
+    estimate of its own error at MARGIN_ORDER ((m_c - m_f) / (2^3 - 1): below an eighth
+    of the coarse margin), is re-run in full from level 1; one whose probe margin fell
+    less keeps its own result."""
+    rows = np.zeros((2, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = 0.1  # close-call margin 0.0125; level 1's 0.00221
+    rows[:, L.PAR_DT] = 1.0
+    rows[:, L.PAR_TEND] = 100.0
+    outs = _stand_in(2)
+    outs[:, L.OUT_MARGIN] = 0.09  # near-misses
+    outs[:, L.OUT_T_CLOSE] = 5.0
+    # the probes: 0.0068 (threshold seed 73's) and 0.012, both clear of 2 x 0.00221
+    probe = (0.0068, 0.012)
+    assert min(probe) > CLEARANCE * 0.1 / CLOSE_BAND * 2.0 ** -2.5
+    assert 0.09 - probe[0] > (2 ** MARGIN_ORDER - 1) * probe[0]
+    assert 0.09 - probe[1] <= (2 ** MARGIN_ORDER - 1) * probe[1]
+    levels_run = {0: [], 1: []}
+
+    def run(sub, idx, keep=True):
+        res = _stand_in(len(idx))
+        level = round(-np.log2(sub[0, L.PAR_DT]))
+        for j, i in enumerate(idx):
+            levels_run[int(i)].append((level, keep))
+            res[j, L.OUT_MARGIN] = probe[int(i)] if not keep else 0.5
+        return res
+
+    certify(rows, outs, run, 3)
+    assert levels_run == {0: [(1, False), (1, True)], 1: [(1, False)]}
+    assert outs[1, L.OUT_MARGIN] == 0.09  # its own result kept
+
+
+def test_a_ringing_spring_is_a_close_call_wider_and_must_keep_its_path():
     """certify's rule on a stand-in kernel, for a spring that rings long (PAR_MEMORY above
-    RINGING_MEMORY): a safe run up to RINGING_BAND x PAR_CLOSE is probed (one that never
-    came within PAR_CLOSE, OUT_T_CLOSE NaN, to its row's end), and a probe whose margin
-    moved by more than itself makes the point a close call; a body that does not ring
-    keeps both rules as they were."""
+    RINGING_MEMORY): its safe runs up to RINGING_BAND x PAR_CLOSE and its overturns up to
+    RINGING_BAND x OVERTURN_BAND x the close-call margin are re-run in full (not probed),
+    and a repeated safe outcome below the last level counts only where both runs made as
+    many impacts, within IMPACT_AGREE (a repeated overturn needs the same fall, not the
+    same impacts); a body that does not ring is not re-run at those margins."""
     rows = np.zeros((4, L.N_PAR))
     rows[:, L.PAR_CLOSE] = 0.04  # close-call margin 0.005
     rows[:, L.PAR_DT] = 1.0
     rows[:, L.PAR_TEND] = 100.0
     rows[:, L.PAR_MEMORY] = [2.0 * RINGING_MEMORY, 0.5 * RINGING_MEMORY] * 2
+    # rows 0-1 safe, 2-3 overturned, all at 0.06: beyond the band and beyond OVERTURN_BAND
+    # x the close-call margin (0.04), within RINGING_BAND x both (0.08)
+    assert OVERTURN_BAND * 0.005 < 0.06 < RINGING_BAND * min(0.04, OVERTURN_BAND * 0.005)
     outs = _stand_in(4)
-    # rows 0-1: beyond PAR_CLOSE, within RINGING_BAND x it; rows 2-3: near-misses
-    outs[:, L.OUT_MARGIN] = [0.06, 0.06, 0.02, 0.02]
-    outs[:, L.OUT_T_CLOSE] = [np.nan, np.nan, 5.0, 5.0]
-    outs[:, L.OUT_STEPS] = 100
+    outs[:, L.OUT_OUTCOME] = [L.OUTCOME_SAFE] * 2 + [L.OUTCOME_MODE1] * 2
+    outs[:, L.OUT_MARGIN] = 0.06
+    outs[:, L.OUT_T_OVERTURN] = [np.nan, np.nan, 5.0, 5.0]
+    outs[:, L.OUT_IMPACTS] = 20
+    # level -> impacts: row 0's second run parts from its first (30 against 20, beyond
+    # IMPACT_AGREE), its third keeps to the second's path (31); row 2's falls on the same
+    # approach after other impacts
+    impacts = {1: {0: 30, 2: 40}, 2: {0: 31, 2: 40}}
+    assert abs(31 - 30) <= IMPACT_AGREE * 31 < abs(30 - 20)
     calls = []
 
     def run(sub, idx, keep=True):
-        calls.append((idx.tolist(), sub[:, L.PAR_TEND].tolist(), keep))
+        level = round(-np.log2(sub[0, L.PAR_DT]))
+        calls.append((idx.tolist(), level, keep))
         res = _stand_in(len(idx))
-        res[:, L.OUT_STEPS] = 10
-        # the probes pass within 0.008 (clear of the close-call margin, but a ringing
-        # row's 0.02 moved by more than that); the full reruns stay clear and settled
-        res[:, L.OUT_MARGIN] = 0.008 if not keep else 0.5
+        res[:, L.OUT_OUTCOME] = outs[idx, L.OUT_OUTCOME]
+        res[:, L.OUT_T_OVERTURN] = outs[idx, L.OUT_T_OVERTURN]
+        res[:, L.OUT_MARGIN] = 0.5  # clear and settled
+        res[:, L.OUT_IMPACTS] = [impacts[level][int(i)] for i in idx]
         return res
 
-    assert RINGING_BAND * 0.04 > 0.06
     certify(rows, outs, run, 3)
-    assert calls[0] == ([0, 2, 3], [100.0, 5.0 + CLOSE_AFTER, 5.0 + CLOSE_AFTER], False)
-    # the ringing rows' margins moved (0.06 and 0.02 to 0.008): re-run in full, from
-    # level 1 (margin 0.5 there: clear and settled, certified); row 3's moved as much, but
-    # its spring does not ring: its probe is clear of the close-call margin, it is kept
-    assert calls[1:] == [([0, 2], [100.0, 100.0], True)]
+    assert calls == [([0, 2], 1, True), ([0], 2, True)]
     st = outs[:, L.OUT_STATUS].astype(int)
-    assert st[0] & L.STATUS_REFINED and st[2] & L.STATUS_REFINED and st[3] & L.STATUS_REFINED
-    assert not (st[0] | st[2] | st[3]) & L.STATUS_FLAGGED
-    assert st[1] == 0  # not ringing: beyond its band, not probed
-    assert outs[3, L.OUT_STEPS] == 110  # probed, its own run kept
-    assert outs[0, L.OUT_STEPS] == outs[2, L.OUT_STEPS] == 120  # probe and level 1 counted
-    assert outs[0, L.OUT_MARGIN] == outs[2, L.OUT_MARGIN] == 0.5  # level 1's run kept
+    assert st[0] & L.STATUS_REFINED and st[2] & L.STATUS_REFINED
+    assert not (st[0] | st[2]) & L.STATUS_FLAGGED
+    assert st[1] == 0 and st[3] == 0  # not ringing: not re-run
+    assert outs[0, L.OUT_IMPACTS] == 31 and outs[2, L.OUT_IMPACTS] == 40  # finest kept
 
 
 def test_an_outcome_that_keeps_changing_is_uncertified():
