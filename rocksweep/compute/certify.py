@@ -38,7 +38,8 @@ when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the th
   ``numerics.RINGING_MEMORY``) is not probed: its runs part from finer ones over many
   impacts, and the finer run falls on a later approach the coarse one passed wide. Its
   safe runs up to RINGING_BAND x PAR_CLOSE and its overturns up to RINGING_BAND x
-  OVERTURN_BAND x the close-call margin are close calls, and a repeated safe outcome
+  OVERTURN_BAND x the close-call margin are close calls (``ringing_calls``; their finer
+  runs answer to the bands above), and a repeated safe outcome
   below the last level is trusted only where both runs made as many impacts
   (``same_path``, within ``numerics.IMPACT_AGREE``) (docs/accuracy.md, "Springs that
   ring long", "Two paths, one class").
@@ -124,15 +125,21 @@ def close_calls(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     N_OUT]) re-run in full: they stayed safe with a margin below the close-call margin
     (``numerics.close_margin``: the row's PAR_CLOSE / CLOSE_BAND, in alpha_ref) or
     overturned with one below OVERTURN_BAND times it, or overturned in a mode that hung on
-    a graze (``mode_close``). A spring that rings long (``ringing``) widens both: its
-    overturns up to RINGING_BAND x OVERTURN_BAND, its safe runs up to RINGING_BAND x
-    PAR_CLOSE (its near-misses: a probe up to the last approach says nothing of the
-    approaches after it, on the path a finer run takes)."""
-    ring = ringing(rows)
-    fell_band = OVERTURN_BAND * np.where(ring, RINGING_BAND, 1.0)
-    safe_band = np.where(ring, RINGING_BAND * CLOSE_BAND, 1.0)
-    bound = np.where(_fell(outs), fell_band, safe_band) * _close_margin(rows)
+    a graze (``mode_close``)."""
+    bound = np.where(_fell(outs), OVERTURN_BAND, 1.0) * _close_margin(rows)
     return (outs[:, L.OUT_MARGIN] < bound) | mode_close(rows, outs)
+
+
+def ringing_calls(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
+    """bool[n]: the first runs (parameter rows float64[n, >= N_PAR], result rows float64[n,
+    N_OUT]) of bodies whose spring rings long (``ringing``) re-run in full from wider
+    bands than ``close_calls``': safe up to RINGING_BAND x PAR_CLOSE (their near-misses:
+    a probe up to the last approach says nothing of the approaches after it, on the path
+    a finer run takes), overturned up to RINGING_BAND x OVERTURN_BAND x the close-call
+    margin. Their finer runs answer to ``close_calls`` as any close call's: a band this
+    wide at the last level would flag margins the finer steps resolve."""
+    bound = np.where(_fell(outs), OVERTURN_BAND, CLOSE_BAND) * RINGING_BAND * _close_margin(rows)
+    return ringing(rows) & (outs[:, L.OUT_MARGIN] < bound)
 
 
 def mode_close(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
@@ -267,7 +274,7 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
     """
     if levels <= 0 or outs.shape[0] == 0:
         return outs
-    idx = np.flatnonzero(close_calls(rows, outs))
+    idx = np.flatnonzero(close_calls(rows, outs) | ringing_calls(rows, outs))
     near = np.flatnonzero(near_misses(rows, outs))
     if near.size:
         checks = probe_rows(rows[near], outs[near])

@@ -389,7 +389,8 @@ def test_a_ringing_spring_is_a_close_call_wider_and_must_keep_its_path():
     RINGING_BAND x OVERTURN_BAND x the close-call margin are re-run in full (not probed),
     and a repeated safe outcome below the last level counts only where both runs made as
     many impacts, within IMPACT_AGREE (a repeated overturn needs the same fall, not the
-    same impacts); a body that does not ring is not re-run at those margins."""
+    same impacts); the finer runs answer to the plain bands; a body that does not ring is
+    not re-run at those margins."""
     rows = np.zeros((4, L.N_PAR))
     rows[:, L.PAR_CLOSE] = 0.04  # close-call margin 0.005
     rows[:, L.PAR_DT] = 1.0
@@ -408,6 +409,10 @@ def test_a_ringing_spring_is_a_close_call_wider_and_must_keep_its_path():
     # approach after other impacts
     impacts = {1: {0: 30, 2: 40}, 2: {0: 31, 2: 40}}
     assert abs(31 - 30) <= IMPACT_AGREE * 31 < abs(30 - 20)
+    # row 0's margins at levels 1 and 2: settled, clear, and at level 2 inside RINGING_BAND
+    # x its band (0.04 x 2^-5 = 0.00125): the finer runs answer to the plain bands
+    margins = {1: {0: 0.003, 2: 0.5}, 2: {0: 0.0024, 2: 0.5}}
+    assert 0.0024 < RINGING_BAND * 0.04 * 2.0 ** -5
     calls = []
 
     def run(sub, idx, keep=True):
@@ -416,7 +421,7 @@ def test_a_ringing_spring_is_a_close_call_wider_and_must_keep_its_path():
         res = _stand_in(len(idx))
         res[:, L.OUT_OUTCOME] = outs[idx, L.OUT_OUTCOME]
         res[:, L.OUT_T_OVERTURN] = outs[idx, L.OUT_T_OVERTURN]
-        res[:, L.OUT_MARGIN] = 0.5  # clear and settled
+        res[:, L.OUT_MARGIN] = [margins[level][int(i)] for i in idx]
         res[:, L.OUT_IMPACTS] = [impacts[level][int(i)] for i in idx]
         return res
 
