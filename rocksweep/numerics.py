@@ -375,11 +375,12 @@ CLOSE_AFTER = 4.0 * math.pi
 # coarse run parts from the finer ones far from the saddle, and the finer run falls on an
 # approach the coarse one passed wide, after a probe's stop. Its safe runs are close calls
 # (full runs) up to RINGING_BAND x the band, its overturns up to RINGING_BAND x
-# OVERTURN_BAND x the close-call margin, and a repeated safe outcome below the last level
-# is trusted only where both runs made the same number of impacts, within IMPACT_AGREE
-# of the larger (``compute.certify.same_path``). The four figures' springs remember
-# 0.26-1.05 p t; the threshold samples' wrong, unflagged classes were bodies of 12-90 p t
-# (docs/accuracy.md, "Springs that ring long", "Two paths, one class").
+# OVERTURN_BAND x the close-call margin, its class is trusted only from two refined runs,
+# and a repeated safe outcome below the last level only where both runs made the same
+# number of impacts, within IMPACT_AGREE of the larger (``compute.certify.same_path``).
+# The four figures' springs remember 0.26-1.05 p t; the threshold samples' wrong,
+# unflagged classes were bodies of 12-90 p t (docs/accuracy.md, "Springs that ring long",
+# "Two paths, one class").
 RINGING_MEMORY = 5.0
 RINGING_BAND = 2.0
 # Seeds 54 and 64's default runs at 5 and 10 steps a period rocked to rest after 24 and
