@@ -65,7 +65,7 @@ evaluations than the points' own, on their adaptive sweeps (almost only points n
 boundary) 2.0-3.0x in all (``scripts/bench_certify.py``; the points' own runs are short: a safe
 flexible run ends once its energy decides it, ``kernel.transitions.flexible_bounded``:
 the certification is now mostly overturns); within 0.5% of a threshold, where every run
-pays, the certified runs take 3.8-4.7x the bare ones' (``scripts/threshold_sample.py``;
+pays, the certified runs take 4.0-5.2x the bare ones' (``scripts/threshold_sample.py``;
 docs/accuracy.md, "Decided by its energy").
 
 Every refined or checked point has STATUS_REFINED in its status; one whose outcome still
