@@ -31,8 +31,9 @@ when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the th
   ``numerics.CLOSE_AFTER`` after OUT_T_CLOSE, its last time within the band
   (``probe_rows``): past its last approach, not through the rocking to rest that holds
   most of its steps. If the finer run overturns, or does not ``clear`` its own step's
-  close-call margin CLEARANCE times, the point is a close call as above (its full runs
-  from the first refinement on);
+  close-call margin CLEARANCE times, or its margin fell below Richardson's estimate of its
+  own error at ``numerics.MARGIN_ORDER`` (``kept``), the point is a close call as above
+  (its full runs from the first refinement on);
   if not, the run's own result is kept;
 - a body whose spring rings long (``ringing``: PAR_MEMORY above
   ``numerics.RINGING_MEMORY``) is not probed: its runs part from finer ones over many
