@@ -168,15 +168,12 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     """Run one point from rest (or the given initial state) to a decided outcome, a cap or
     the horizon: the no-slip rocking model (``variants.CONTACTS``).
 
-    prm: float64[N_PAR] parameter row; out: float64[N_OUT] result row (filled);
-    hist: float64[n, N_HIST] history buffer, or None: no history (the recording code is
-    then not compiled at all). REACTIONS: True to track the ground reactions
-    (``contact``: the friction demand, the lowest normal force and the impacts' impulse
-    ratio), False not to (the bookkeeping's calls are then no-ops, not compiled); every
-    sample is a state the loop reaches anyway (step ends, event states before and after the
-    action). GROUND (``layout.GROUND_*``, a row of ``ground.GROUNDS``): the ground kind; one
-    with a vertical also steps to land on PAR_T_AIR, where g + a_v reaches 0, and stops
-    there (STATUS_AIRBORNE).
+    prm: float64[N_PAR] parameter row; out: float64[N_OUT] result row (filled); hist:
+    float64[n, N_HIST] history buffer, or None (no history: its code is not compiled).
+    REACTIONS: track the ground reactions (``contact``: friction demand, lowest normal
+    force, impulse ratio) at states the loop reaches anyway, or not (no-ops, not compiled).
+    GROUND (``layout.GROUND_*``, a row of ``ground.GROUNDS``): the ground kind; one with a
+    vertical also lands on PAR_T_AIR, where g + a_v reaches 0, and stops (STATUS_AIRBORNE).
     """
     literally(FLEX)
     literally(DAMPED)
@@ -191,9 +188,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     t_air = prm[PAR_T_AIR] if vertical else math.inf
     on = 0.0 < t_pulse
     y, s = _start(prm, out, hist, on, FLEX, DAMPED, GROUND)
-    # is the outcome decided (``_decided``)? At the first loop top after the pulse and after
-    # each impact (PAR_TO_REST: then go on to rest; a history of free rocking from a tilt
-    # would end at once otherwise)
+    # decide the outcome (``_decided``) at the first loop top after the pulse and after each
+    # impact (PAR_TO_REST: go on to rest; a history from a tilt would end at once otherwise)
     free_check = True
     # the counters of every step stay in registers (in out: ~3% slower); the rest is in out
     steps, event_steps, theta_max = 0, 0, abs(y[Y_THETA])
@@ -206,8 +202,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     acc = 0.0
     margin = np.inf  # OUT_MARGIN, in a register
     graze = np.inf  # OUT_GRAZE
-    dip = np.inf  # OUT_MODE_GRAZE of a run without impacts (with: ``_apply_impact``)
-    lift = np.inf  # OUT_LIFT_GRAZE [N m] until the end
+    dip, lift = np.inf, np.inf  # OUT_MODE_GRAZE before an impact, OUT_LIFT_GRAZE [N m]
     t_close = np.nan  # OUT_T_CLOSE
     # ``_near_saddle``'s bounds, once per run (saddle0 = NaN: no gate, every free rocking
     # step takes ``_saddle``'s test; a row without a body, as warm_up's)
