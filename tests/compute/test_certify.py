@@ -322,52 +322,17 @@ def test_a_near_miss_is_probed_to_its_last_approach():
     assert st[2] == 0 and outs[2, L.OUT_STEPS] == 100
 
 
-def test_a_near_miss_whose_probe_does_not_clear_twice_its_margin_is_a_close_call():
-    """certify's rule on a stand-in kernel: a near-miss whose probe stays safe but within
-    CLEARANCE x its own step's close-call margin is re-run in full from level 1; one whose
-    probe clears it keeps its own result."""
+def _probed_near_misses(band: float, margin: float, probe: tuple[float, float]):
+    """Two near-misses (safe, ``margin``, last close at 5 p t; rows with PAR_CLOSE ``band``)
+    certified on a stand-in kernel whose probes (keep=False) pass at ``probe[i]`` and whose
+    full runs clear everything (0.5). Returns ({point: [(level, keep), ...]}, outs)."""
     rows = np.zeros((2, L.N_PAR))
-    rows[:, L.PAR_CLOSE] = 0.01 * CLOSE_BAND  # level 1's close-call margin: 0.00177
+    rows[:, L.PAR_CLOSE] = band
     rows[:, L.PAR_DT] = 1.0
     rows[:, L.PAR_TEND] = 100.0
     outs = _stand_in(2)
-    outs[:, L.OUT_MARGIN] = 0.013  # near-misses (1.3 x the close-call margin)
+    outs[:, L.OUT_MARGIN] = margin
     outs[:, L.OUT_T_CLOSE] = 5.0
-    levels_run = {0: [], 1: []}
-
-    def run(sub, idx, keep=True):
-        res = _stand_in(len(idx))
-        level = round(-np.log2(sub[0, L.PAR_DT]))
-        for j, i in enumerate(idx):
-            levels_run[int(i)].append((level, keep))
-            # the probes: point 0 at 1.2 x, point 1 at 2.2 x level 1's margin
-            res[j, L.OUT_MARGIN] = [0.0021, 0.0039][int(i)] if not keep else 0.5
-        return res
-
-    certify(rows, outs, run, 3)
-    assert levels_run == {0: [(1, False), (1, True)], 1: [(1, False)]}
-    assert not (outs[:, L.OUT_STATUS].astype(int) & L.STATUS_UNCERTIFIED).any()
-    assert outs[1, L.OUT_MARGIN] == 0.013  # its own result kept
-
-
-def test_a_near_miss_whose_probe_margin_fell_past_its_error_is_a_close_call():
-    """certify's rule on a stand-in kernel: a near-miss whose probe stays safe and clear of
-    CLEARANCE x its own step's close-call margin, but with a margin below Richardson's
-    estimate of its own error at MARGIN_ORDER ((m_c - m_f) / (2^3 - 1): below an eighth
-    of the coarse margin), is re-run in full from level 1; one whose probe margin fell
-    less keeps its own result."""
-    rows = np.zeros((2, L.N_PAR))
-    rows[:, L.PAR_CLOSE] = 0.1  # close-call margin 0.0125; level 1's 0.00221
-    rows[:, L.PAR_DT] = 1.0
-    rows[:, L.PAR_TEND] = 100.0
-    outs = _stand_in(2)
-    outs[:, L.OUT_MARGIN] = 0.09  # near-misses
-    outs[:, L.OUT_T_CLOSE] = 5.0
-    # the probes: 0.0068 (threshold seed 73's) and 0.012, both clear of 2 x 0.00221
-    probe = (0.0068, 0.012)
-    assert min(probe) > CLEARANCE * 0.1 / CLOSE_BAND * 2.0 ** -2.5
-    assert 0.09 - probe[0] > (2 ** MARGIN_ORDER - 1) * probe[0]
-    assert 0.09 - probe[1] <= (2 ** MARGIN_ORDER - 1) * probe[1]
     levels_run = {0: [], 1: []}
 
     def run(sub, idx, keep=True):
@@ -379,6 +344,34 @@ def test_a_near_miss_whose_probe_margin_fell_past_its_error_is_a_close_call():
         return res
 
     certify(rows, outs, run, 3)
+    return levels_run, outs
+
+
+def test_a_near_miss_whose_probe_does_not_clear_twice_its_margin_is_a_close_call():
+    """certify's rule on a stand-in kernel: a near-miss whose probe stays safe but within
+    CLEARANCE x its own step's close-call margin is re-run in full from level 1; one whose
+    probe clears it keeps its own result."""
+    # near-misses at 1.3 x the close-call margin (0.01; level 1's: 0.00177), probed at 1.2
+    # and 2.2 x level 1's margin
+    levels_run, outs = _probed_near_misses(0.01 * CLOSE_BAND, 0.013, (0.0021, 0.0039))
+    assert levels_run == {0: [(1, False), (1, True)], 1: [(1, False)]}
+    assert not (outs[:, L.OUT_STATUS].astype(int) & L.STATUS_UNCERTIFIED).any()
+    assert outs[1, L.OUT_MARGIN] == 0.013  # its own result kept
+
+
+def test_a_near_miss_whose_probe_margin_fell_past_its_error_is_a_close_call():
+    """certify's rule on a stand-in kernel: a near-miss whose probe stays safe and clear of
+    CLEARANCE x its own step's close-call margin, but with a margin below Richardson's
+    estimate of its own error at MARGIN_ORDER ((m_c - m_f) / (2^3 - 1): below an eighth
+    of the coarse margin), is re-run in full from level 1; one whose probe margin fell
+    less keeps its own result."""
+    # near-misses at 0.09 (close-call margin 0.0125; level 1's 0.00221), probed at 0.0068
+    # (threshold seed 73's) and 0.012, both clear of 2 x 0.00221
+    probe = (0.0068, 0.012)
+    assert min(probe) > CLEARANCE * 0.1 / CLOSE_BAND * 2.0 ** -2.5
+    assert 0.09 - probe[0] > (2 ** MARGIN_ORDER - 1) * probe[0]
+    assert 0.09 - probe[1] <= (2 ** MARGIN_ORDER - 1) * probe[1]
+    levels_run, outs = _probed_near_misses(0.1, 0.09, probe)
     assert levels_run == {0: [(1, False), (1, True)], 1: [(1, False)]}
     assert outs[1, L.OUT_MARGIN] == 0.09  # its own result kept
 
