@@ -61,6 +61,7 @@ import numpy as np
 
 from rocksweep.compute import sweep as sw
 from rocksweep.compute.lattice import (
+    cell_blocks,
     cell_stats,
     centres,
     dilate,
@@ -482,13 +483,9 @@ def fill(plan: Plan, outcome: np.ndarray, computed: np.ndarray) -> np.ndarray:
     _, ny, nx = plan.panel_shape
     cells = cell_stats(known, plan.strides)
     for s in plan.strides:
-        cls = cells[s].uniform_class
-        cy = np.minimum(np.arange(ny) // s, cls.shape[1] - 1)
-        cx = np.minimum(np.arange(nx) // s, cls.shape[2] - 1)
-        cand = cls[:, cy][:, :, cx]
-        out = np.where(out < 0, cand, out)
+        np.copyto(out, cell_blocks(cells[s].uniform_class, s, ny, nx), where=out < 0)
     if plan.strides and plan.final_margin == 0:
-        out = np.where(out < 0, edge_fill(known), out)
+        np.copyto(out, edge_fill(known), where=out < 0)
     if plan.in_order:
         return out.reshape(-1)
     flat = np.empty(plan.size, np.int8)

@@ -456,3 +456,25 @@ def test_the_points_of_marked_cells_are_those_of_their_closed_lattice():
         np.testing.assert_array_equal(lattice.points_of_cells(idx, cells, s), want)
         todo = sorted(int(idx[q]) for q in pts if known[q] < 0)
         np.testing.assert_array_equal(lattice.points_of_cells(idx, cells, s, known), todo)
+
+
+def test_lattice_blocks_pads_and_axes_against_their_definitions():
+    """The block copies ``fill`` is built of: ``cell_blocks`` gives point (y, x) its cell's
+    value (min(y // s, cy - 1), min(x // s, cx - 1)), ``pad_edge`` equals numpy's edge
+    pad, ``axis_lattice`` is 0, s, 2s, ... and n - 1; on random shapes, odd and even
+    axis lengths, strides up to beyond the axis."""
+    rng = np.random.default_rng(3)
+    for _ in range(300):
+        n_p, ny, nx = (int(v) for v in rng.integers((1, 2, 2), (4, 40, 40)))
+        s = int(2 ** rng.integers(1, 6))
+        cy, cx = lattice.ncells(ny, s), lattice.ncells(nx, s)
+        cells = rng.integers(-1, 3, size=(n_p, cy, cx)).astype(np.int8)
+        y, x = np.meshgrid(np.arange(ny), np.arange(nx), indexing="ij")
+        want = cells[:, np.minimum(y // s, cy - 1), np.minimum(x // s, cx - 1)]
+        np.testing.assert_array_equal(lattice.cell_blocks(cells, s, ny, nx), want)
+        a = rng.integers(0, 9, size=(n_p, ny, nx))
+        py, px = (int(v) for v in rng.integers(0, 4, 2))
+        np.testing.assert_array_equal(lattice.pad_edge(a, ny + py, nx + px),
+                                      np.pad(a, ((0, 0), (0, py), (0, px)), mode="edge"))
+        want_axis = sorted(set(range(0, ny, s)) | {ny - 1})
+        np.testing.assert_array_equal(lattice.axis_lattice(ny, s), want_axis)
