@@ -15,6 +15,7 @@ rule that made them close calls and by refinement level), replayed on the comput
     PYTHONPATH=/path/to/other/checkout python scripts/bench_certify.py   # another checkout
     python scripts/bench_certify.py --against /path/to/other/checkout --rounds 2
     python scripts/bench_certify.py --against /path/before --against /path/older   # both
+    python scripts/bench_certify.py --cli --against /path/before --rounds 2   # the command
 
 ``--against`` (repeatable) runs the same sweeps of other checkouts in subprocesses,
 alternating with this one's (round by round, the order reversed each round, each process
@@ -30,6 +31,7 @@ import json
 import os
 import subprocess
 import sys
+import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -81,6 +83,37 @@ def sweep_once(name: str, res: int, jobs: int, adaptive: bool) -> dict:
     refine = int(getattr(rep, "refine_evaluations", -1))
     return {"evals": evaluations(arr), "computed": computed, "wall": wall,
             "cpu": rep.cpu_s, "refine": refine, "arrays": arr}
+
+
+def cli_once(name: str, res: int, jobs: int, out: Path) -> dict:
+    """The figure's adaptive sweep as a user runs it: ``rocksweep sweep --adaptive`` in a
+    process of its own (the rocksweep of this process's PYTHONPATH), the result an HDF5
+    file. wall: the command's [s]; startup: a warm one-point sweep's of the same scene
+    (interpreter, imports, numba's cache, a tiny file) [s], which ``wall - startup``
+    leaves out."""
+    sc = scene(name, res)
+    sets = []
+    for ax, key in (("w_over_p", "pulse.w_over_p"), ("A_ratio", "pulse.A_ratio")):
+        v = sc.axis(ax).values
+        sets += ["--set", f"{key}={{start: {v[0]!r}, stop: {v[-1]!r}, num: {res}}}"]
+    base = [sys.executable, "-m", "rocksweep", "sweep", str(ROOT / "configs" / f"{name}.yaml"),
+            "-o", str(out), "--overwrite", "-q", "-j", str(jobs)]
+
+    def timed(cmd: list[str]) -> float:
+        t0 = time.perf_counter()
+        # run from out's folder: ``python -m`` puts the working directory first on
+        # sys.path, so from a checkout it would run that checkout, not PYTHONPATH's copy
+        subprocess.run(cmd, check=True, capture_output=True, cwd=out.parent)
+        return time.perf_counter() - t0
+
+    one = ["--set", "pulse.w_over_p=1.0", "--set", "pulse.A_ratio=2.0", "--set", "impact.lam=0.0"]
+    timed(base + one)  # the kernel compiled (or its cache loaded) before the timings
+    startup = timed(base + one)
+    wall = timed(base + ["--adaptive", *sets])
+    package = subprocess.run([sys.executable, "-c", "import rocksweep; print(rocksweep.__file__)"],
+                             check=True, capture_output=True, text=True,
+                             cwd=out.parent).stdout.strip()
+    return {"wall": wall, "startup": startup, "package": str(Path(package).parent)}
 
 
 def rules(name: str, res: int, arr: dict, jobs: int) -> dict:
@@ -155,6 +188,10 @@ def measure(args) -> dict:
     """This checkout's numbers (JSON-able): per figure, a list of rounds."""
     jobs = sw.effective_jobs(args.jobs)
     out: dict = {}
+    if args.cli:
+        with tempfile.TemporaryDirectory() as tmp:
+            return {name: cli_once(name, args.res, jobs, Path(tmp) / "fig.h5")
+                    for name in args.figures}
     for name in args.figures:
         sc = scene(name, args.res)
         sw.prepare(Grid(sc), sw.level(sc))  # compile/load outside the timings
@@ -178,6 +215,9 @@ def main() -> None:
     ap.add_argument("--rules", action="store_true", help="evaluations per rule (replay)")
     ap.add_argument("--classes", help="save each figure's outcome here (DIR/NAME.npy; "
                     "DIR/this/NAME.npy and one folder per --against tree)")
+    ap.add_argument("--cli", action="store_true",
+                    help="time the rocksweep sweep --adaptive command instead (wall, and "
+                    "without a warm one-point sweep's start-up)")
     ap.add_argument("--json", action="store_true", help="print one JSON line (--against)")
     ap.add_argument("--against", action="append",
                     help="another checkout, run alternately in a subprocess (repeatable)")
@@ -202,6 +242,7 @@ def main() -> None:
             cmd = [sys.executable, str(Path(__file__)), *args.figures, "--res",
                    str(args.res), "--jobs", str(args.jobs), "--json"]
             cmd += ["--full"] if args.full else []
+            cmd += ["--cli"] if args.cli else []
             cmd += ["--rules"] if args.rules and side == "this" else []
             if args.classes:  # each tree's in a folder of its own
                 sub = Path(args.classes) / ("this" if side == "this"
@@ -216,6 +257,9 @@ def main() -> None:
             print(f"round {rnd + 1} {side}: {wall:.1f} s wall for the figures "
                   f"(load average {load:.2f} -> {os.getloadavg()[0]:.2f})", flush=True)
     this = sides["this"]
+    if args.cli:
+        cli_table(args.figures, sides)
+        return
     print("| figure | RK4 evaluations | of them certification | computed | wall s (best) "
           "| cpu s (best) |" + "".join(f" {o}: evaluations | ratio | wall s | ratio | cpu s "
                                       "| ratio |" for o in others))
@@ -257,6 +301,35 @@ def main() -> None:
                     print(f"    {k}: {int(v)}")
                 else:
                     print(f"    {k:<40} {v / 1e6:8.2f}M ({100 * v / total:5.1f}%)")
+
+
+def cli_table(figures: list[str], sides: dict[str, list]) -> None:
+    """The ``--cli`` rounds: per figure and tree, the best command wall and the best
+    wall less its round's start-up; this tree's ratios to each other tree."""
+    names = list(sides)
+    print("| figure |" + "".join(f" {n}: wall s | less start-up |" for n in names)
+          + "".join(f" this / {n}: wall | less start-up |" for n in names[1:]))
+    tot = {n: [0.0, 0.0] for n in names}
+    for name in [*figures, "all"]:
+        line = f"| {name} |"
+        best = {}
+        for n in names:
+            if name == "all":
+                w, c = tot[n]
+            else:
+                w = min(r[name]["wall"] for r in sides[n])
+                c = min(r[name]["wall"] - r[name]["startup"] for r in sides[n])
+                tot[n][0] += w
+                tot[n][1] += c
+            best[n] = (w, c)
+            line += f" {w:.2f} | {c:.2f} |"
+        for n in names[1:]:
+            line += f" {best['this'][0] / best[n][0]:.3f} | {best['this'][1] / best[n][1]:.3f} |"
+        print(line)
+    print("the commands ran: " + ", ".join(
+        f"{n} {sorted({r[f]['package'] for r in sides[n] for f in figures})}" for n in names))
+    print("start-up (warm one-point sweep, best): " + ", ".join(
+        f"{n} {min(r[f]['startup'] for r in sides[n] for f in figures):.2f} s" for n in names))
 
 
 if __name__ == "__main__":
