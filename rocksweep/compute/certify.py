@@ -205,12 +205,13 @@ def settled(coarse: np.ndarray, fine: np.ndarray) -> np.ndarray:
 def kept(coarse: np.ndarray, fine: np.ndarray) -> np.ndarray:
     """bool[n]: the finer of two runs of the same points (result rows float64[n, N_OUT], the
     second at half the first's steps) kept a margin at least Richardson's estimate of its
-    error were the margin's error to fall only as the step^3 (impacts leading to the
-    approach, ``numerics.CLEARANCE``): m_f >= (m_c - m_f) / (2^3 - 1), a margin that did
-    not fall to below an eighth of the coarse one. One that did (a near-miss at 0.091
-    alpha_ref whose probe passed at 0.0068, threshold seed 73: 20 steps a period and the
-    reference overturn) measured another approach, or one the coarse step had wrong by
-    more than the finer run's margin."""
+    error were the margin's error to fall only as the step^MARGIN_ORDER (2, below the
+    step^3 that impacts leading to the approach give, ``numerics.CLEARANCE``): m_f >= (m_c
+    - m_f) / (2^MARGIN_ORDER - 1), a margin that did not fall to below a quarter of the
+    coarse one. One that did (near-misses at 0.091 and 0.0369 alpha_ref whose probes
+    passed at 0.0068, threshold seeds 73 and 91: 20 steps a period and the reference
+    overturn) measured another approach, or one the coarse step had wrong by more than the
+    finer run's margin."""
     m_c, m_f = coarse[:, L.OUT_MARGIN], fine[:, L.OUT_MARGIN]
     with np.errstate(invalid="ignore"):  # inf - inf: a margin never taken
         return ~(m_c - m_f > (2.0 ** MARGIN_ORDER - 1.0) * m_f)

@@ -213,6 +213,15 @@ CASES = [
                         mA_over_m=2.4517520795207446, IA_ratio=0.5664574421239543),
            0.35996189697155917, "cosine", 3.8059568165695747, 13.449372852900005),
      L.OUTCOME_MODE1),
+    # ... and one whose margin's error fell as the step^1.8 (seed 91): a near-miss at
+    # 0.0369 alpha_ref, its probe at 10 steps safe at 0.0068 on the same approach (after 2
+    # impacts both): above an eighth of the coarse margin, below a quarter; 20 steps and
+    # the reference overturn in mode 1 after 2 impacts
+    (Point(FlexibleBody(wn_over_p=3.921693151038834, zeta=0.04685791416296161,
+                        alpha_cg=0.24501445506105962, alpha_A=0.1921075786309662,
+                        mA_over_m=0.6957075438595095, IA_ratio=0.6439474412600221),
+           0.3921048784532814, "cosine", 5.623570097921776, 12.107635581056998),
+     L.OUTCOME_MODE1),
 ]
 
 
@@ -225,7 +234,7 @@ CASES = [
                               "ringing-beyond-band", "graze", "clear-overturn",
                               "clear-safe", "event-tol", "fall-moved", "probe-clear-1",
                               "probe-clear-2", "nearly-uplifted", "two-paths-safe",
-                              "two-paths-overturn", "probe-kept"])
+                              "two-paths-overturn", "probe-kept", "probe-kept-order-2"])
 def test_default_classifies_the_reproduced_cases_like_the_reference(point, expected):
     """The reference's outcome is the one written here; `default` (sweep kernel and simulate) gives
     the same. Before the step rule, `default` gave safe / mode 1 here."""
@@ -362,12 +371,12 @@ def test_a_near_miss_whose_probe_does_not_clear_twice_its_margin_is_a_close_call
 def test_a_near_miss_whose_probe_margin_fell_past_its_error_is_a_close_call():
     """certify's rule on a stand-in kernel: a near-miss whose probe stays safe and clear of
     CLEARANCE x its own step's close-call margin, but with a margin below Richardson's
-    estimate of its own error at MARGIN_ORDER ((m_c - m_f) / (2^3 - 1): below an eighth
+    estimate of its own error at MARGIN_ORDER ((m_c - m_f) / (2^2 - 1): below a quarter
     of the coarse margin), is re-run in full from level 1; one whose probe margin fell
     less keeps its own result."""
     # near-misses at 0.09 (close-call margin 0.0125; level 1's 0.00221), probed at 0.0068
-    # (threshold seed 73's) and 0.012, both clear of 2 x 0.00221
-    probe = (0.0068, 0.012)
+    # (threshold seed 73's) and 0.03, both clear of 2 x 0.00221
+    probe = (0.0068, 0.03)
     assert min(probe) > CLEARANCE * 0.1 / CLOSE_BAND * 2.0 ** -2.5
     assert 0.09 - probe[0] > (2 ** MARGIN_ORDER - 1) * probe[0]
     assert 0.09 - probe[1] <= (2 ** MARGIN_ORDER - 1) * probe[1]
