@@ -427,18 +427,6 @@ SAME_FALL = 0.5
 # reference; another's (seed 18) safe runs, 1.9 x too, overturn there (docs/accuracy.md,
 # "Clear by twice the margin, events located finer").
 CLEARANCE = 2.0
-# The slowest the margin's error is taken to fall (as the step^MARGIN_ORDER): a
-# near-miss's probe whose margin fell below Richardson's estimate of its own error at this
-# order (below 1/2^MARGIN_ORDER of the coarse one: a quarter) is a close call
-# (``compute.certify.kept``). 3 at first, CLEARANCE's order; then a threshold sample's
-# near-miss (seed 91) rocked to rest at 5 and 10 steps a period with margins 0.0369 and
-# 0.0068 alpha_ref on the same approach (after 2 impacts both), an error that fell as the
-# step^1.8 (the 20-step run and the reference overturn after 2 impacts): at order 3 its
-# probe was kept (0.0068 above 0.0301 / 7), at order 2 it is not (below 0.0301 / 3). On
-# 70 threshold samples and the four adaptive figures, order 2 flagged no point more and
-# took 0.9% and 1.3% more RK4 evaluations (docs/accuracy.md, "A probe's margin that fell
-# past its error").
-MARGIN_ORDER = 2
 # An overturn's mode (1: after impacts, 2: without) hangs on whether the rocking touched
 # theta = 0 before the fall. Where it came near (OUT_MODE_GRAZE: a mode 2's least dip
 # toward theta = 0, a mode 1's deepest impact, in alpha_ref) below MODE_BAND x PAR_CLOSE

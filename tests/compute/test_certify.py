@@ -32,13 +32,14 @@ from rocksweep.numerics import (
     CLEARANCE,
     CLOSE_AFTER,
     CLOSE_BAND,
+    ENERGY_ORDER,
     GRAZE_MARGIN,
     IMPACT_AGREE,
     LIFT_BAND,
-    MARGIN_ORDER,
     MIN_EVENT_TOL,
     MODE_BAND,
     OVERTURN_BAND,
+    RICHARDSON_SAFETY,
     RINGING_BAND,
     RINGING_MEMORY,
     SAME_FALL,
@@ -215,13 +216,27 @@ CASES = [
      L.OUTCOME_MODE1),
     # ... and one whose margin's error fell as the step^1.8 (seed 91): a near-miss at
     # 0.0369 alpha_ref, its probe at 10 steps safe at 0.0068 on the same approach (after 2
-    # impacts both): above an eighth of the coarse margin, below a quarter; 20 steps and
-    # the reference overturn in mode 1 after 2 impacts
+    # impacts both): above an eighth of the coarse margin (kept at order 3), its square
+    # below Richardson's estimate of its error; 20 steps and the reference overturn in
+    # mode 1 after 2 impacts
     (Point(FlexibleBody(wn_over_p=3.921693151038834, zeta=0.04685791416296161,
                         alpha_cg=0.24501445506105962, alpha_A=0.1921075786309662,
                         mA_over_m=0.6957075438595095, IA_ratio=0.6439474412600221),
            0.3921048784532814, "cosine", 5.623570097921776, 12.107635581056998),
      L.OUTCOME_MODE1),
+    # ... and one whose probe kept a quarter of the coarse margin (seed 108): 0.0214 ->
+    # 0.0059 alpha_ref (kept by a margin falling as the step^2), its square below twice
+    # Richardson's estimate of its error; 20 steps and the reference overturn in mode 1
+    # after 3 impacts
+    (Point(FlexibleBody(wn_over_p=2.3525895708138695, zeta=0.05318234470632472,
+                        alpha_cg=0.1271048357583636, alpha_A=0.1748262277044242,
+                        mA_over_m=0.4525297464932731, IA_ratio=0.4499597382431248),
+           0.11343676581875684, "sine", 3.3780099563350623, 2.1434725405584727),
+     L.OUTCOME_MODE1),
+    # ... and a point of Figure 3(a) at 1000 x 1000 x 3 lam (lam 0.4): a near-miss at
+    # 0.0393 alpha_ref whose probe passed at 0.0103 (above a quarter); 20 steps, `fine`
+    # and the reference overturn in mode 1 after 5 impacts
+    (Point(BODY3, 0.4, "sine", 2.4533033033033034, 0.9777777777777779), L.OUTCOME_MODE1),
 ]
 
 
@@ -234,7 +249,8 @@ CASES = [
                               "ringing-beyond-band", "graze", "clear-overturn",
                               "clear-safe", "event-tol", "fall-moved", "probe-clear-1",
                               "probe-clear-2", "nearly-uplifted", "two-paths-safe",
-                              "two-paths-overturn", "probe-kept", "probe-kept-order-2"])
+                              "two-paths-overturn", "probe-kept", "probe-kept-91", "probe-kept-108",
+                              "fig3a-probe-kept"])
 def test_default_classifies_the_reproduced_cases_like_the_reference(point, expected):
     """The reference's outcome is the one written here; `default` (sweep kernel and simulate) gives
     the same. Before the step rule, `default` gave safe / mode 1 here."""
@@ -361,8 +377,9 @@ def test_a_near_miss_whose_probe_does_not_clear_twice_its_margin_is_a_close_call
     CLEARANCE x its own step's close-call margin is re-run in full from level 1; one whose
     probe clears it keeps its own result."""
     # near-misses at 1.3 x the close-call margin (0.01; level 1's: 0.00177), probed at 1.2
-    # and 2.2 x level 1's margin
-    levels_run, outs = _probed_near_misses(0.01 * CLOSE_BAND, 0.013, (0.0021, 0.0039))
+    # and 2.8 x level 1's margin (the second's square clear of twice Richardson's estimate
+    # of its error too: ``kept``)
+    levels_run, outs = _probed_near_misses(0.01 * CLOSE_BAND, 0.013, (0.0021, 0.005))
     assert levels_run == {0: [(1, False), (1, True)], 1: [(1, False)]}
     assert not (outs[:, L.OUT_STATUS].astype(int) & L.STATUS_UNCERTIFIED).any()
     assert outs[1, L.OUT_MARGIN] == 0.013  # its own result kept
@@ -370,16 +387,19 @@ def test_a_near_miss_whose_probe_does_not_clear_twice_its_margin_is_a_close_call
 
 def test_a_near_miss_whose_probe_margin_fell_past_its_error_is_a_close_call():
     """certify's rule on a stand-in kernel: a near-miss whose probe stays safe and clear of
-    CLEARANCE x its own step's close-call margin, but with a margin below Richardson's
-    estimate of its own error at MARGIN_ORDER ((m_c - m_f) / (2^2 - 1): below a quarter
-    of the coarse margin), is re-run in full from level 1; one whose probe margin fell
-    less keeps its own result."""
+    CLEARANCE x its own step's close-call margin, but with a squared margin below
+    RICHARDSON_SAFETY x Richardson's estimate of its error at ENERGY_ORDER
+    ((m_c^2 - m_f^2) / (2^4 - 1)), is re-run in full from level 1; one whose probe margin
+    fell less keeps its own result."""
     # near-misses at 0.09 (close-call margin 0.0125; level 1's 0.00221), probed at 0.0068
-    # (threshold seed 73's) and 0.03, both clear of 2 x 0.00221
-    probe = (0.0068, 0.03)
+    # (threshold seed 73's) and 0.04, both clear of 2 x 0.00221
+    probe = (0.0068, 0.04)
     assert min(probe) > CLEARANCE * 0.1 / CLOSE_BAND * 2.0 ** -2.5
-    assert 0.09 - probe[0] > (2 ** MARGIN_ORDER - 1) * probe[0]
-    assert 0.09 - probe[1] <= (2 ** MARGIN_ORDER - 1) * probe[1]
+
+    def err(m_f: float) -> float:
+        return RICHARDSON_SAFETY * (0.09 ** 2 - m_f ** 2) / (2 ** ENERGY_ORDER - 1)
+
+    assert probe[0] ** 2 < err(probe[0]) and probe[1] ** 2 >= err(probe[1])
     levels_run, outs = _probed_near_misses(0.1, 0.09, probe)
     assert levels_run == {0: [(1, False), (1, True)], 1: [(1, False)]}
     assert outs[1, L.OUT_MARGIN] == 0.09  # its own result kept
