@@ -32,7 +32,7 @@ when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the th
   (``probe_rows``): past its last approach, not through the rocking to rest that holds
   most of its steps. If the finer run overturns, or does not ``clear`` its own step's
   close-call margin CLEARANCE times, or its squared margin fell below twice Richardson's
-  estimate of its own error (``kept``, ``energy_clear``), the point is a close call as above
+  estimate of its own error (``energy_clear``), the point is a close call as above
   (its full runs from the first refinement on);
   if not, the run's own result is kept;
 - a body whose spring rings long (``ringing``: PAR_MEMORY above
@@ -208,21 +208,6 @@ def settled(coarse: np.ndarray, fine: np.ndarray) -> np.ndarray:
         return ~(np.abs(m_f * m_f - m_c * m_c) > m_f * m_f)
 
 
-def kept(coarse: np.ndarray, fine: np.ndarray) -> np.ndarray:
-    """bool[n]: the finer of two runs of the same points (result rows float64[n, N_OUT], the
-    second at half the first's steps) kept a squared margin (~ |E - E_barrier|/E_ref) at
-    least RICHARDSON_SAFETY times Richardson's estimate of its error at ENERGY_ORDER
-    (``energy_clear``, the test ``converged`` puts to an overturn): a near-miss's probe
-    whose margin fell past it measured another approach, or one the coarse step had wrong
-    by more than the finer run's margin. Near-misses at 0.091, 0.0369 and 0.0214 alpha_ref
-    whose probes passed at 0.0068, 0.0068 and 0.0059 (threshold seeds 73, 91 and 108: 20
-    steps a period and the reference overturn) fail it; a margin taken to fall as a power
-    of the step instead (m_f >= (m_c - m_f) / (2^p - 1)) let the last two pass at p = 3
-    and seed 108's at p = 2: near the saddle the margin, a square root of the energy's
-    distance, falls as the step^(ENERGY_ORDER / 2) at best."""
-    return energy_clear(coarse, fine)  # a near-miss's coarse margin is finite
-
-
 def grazed(coarse: np.ndarray, fine: np.ndarray) -> np.ndarray:
     """bool[n]: the finer of two runs of the same points (result rows float64[n, N_OUT])
     grazed an impact it did not make by less than ``numerics.GRAZE_MARGIN`` (OUT_GRAZE,
@@ -298,9 +283,13 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
         # or which does not ``clear`` its own step's close-call margin CLEARANCE times, as
         # a finer run below the last level must (its approach came nearer the saddle than
         # the coarse run's: the coarse margin was not the run's to trust)
-        # or whose margin fell below Richardson's estimate of its own error (``kept``)
+        # or whose squared margin fell below twice Richardson's estimate of its error
+        # (``energy_clear``, as an overturn's in ``converged``: near the saddle the margin
+        # is a square root of the energy's distance, its error falling as the step^2 at
+        # best; a margin taken to fall as the step^3, then ^2, let threshold seeds 91 and
+        # 108 and a Figure 3(a) point pass, where the reference overturns)
         idx = np.union1d(idx, near[_fell(probe) | ~clear(checks, probe)
-                                   | ~kept(outs[near], probe)])
+                                   | ~energy_clear(outs[near], probe)])
     for level in range(1, levels + 1):
         if idx.size == 0:
             break

@@ -378,7 +378,7 @@ def test_a_near_miss_whose_probe_does_not_clear_twice_its_margin_is_a_close_call
     probe clears it keeps its own result."""
     # near-misses at 1.3 x the close-call margin (0.01; level 1's: 0.00177), probed at 1.2
     # and 2.8 x level 1's margin (the second's square clear of twice Richardson's estimate
-    # of its error too: ``kept``)
+    # of its error too: ``energy_clear``)
     levels_run, outs = _probed_near_misses(0.01 * CLOSE_BAND, 0.013, (0.0021, 0.005))
     assert levels_run == {0: [(1, False), (1, True)], 1: [(1, False)]}
     assert not (outs[:, L.OUT_STATUS].astype(int) & L.STATUS_UNCERTIFIED).any()
