@@ -398,6 +398,15 @@ IMPACT_AGREE = 0.1
 # below GRAZE_MARGIN with a graze that moved by more than itself between the two runs is
 # not trusted (``compute.certify.grazed``).
 GRAZE_MARGIN = 1e-3
+# ... and a run that grazed below GRAZE_BAND x PAR_CLOSE (GRAZE_MARGIN at 5 steps a period,
+# scaled with the step as the band) is a close call whatever its margin, safe or overturned
+# (``compute.certify.graze_close``): threshold seed 123's safe run at 5 steps a period, 0.2
+# alpha_ref from the saddle, turned back 2e-4 alpha_ref short of an impact during the
+# pulse, which 10 steps a period and finer make, and fall in mode 1 as the reference. On
+# Figure 4(b)'s adaptive points (1000 x 1000 x 3 lam) the graze of such a run moved by 17%
+# of itself (median; 80% at the 90th percentile) between 5 and 40 steps a period; the
+# band twice as wide (MODE_BAND's) cost that figure 18% more RK4 evaluations.
+GRAZE_BAND = 0.01
 # A repeated overturn still inside the overturn band at its own step, below the last
 # level, is certified if its margins have converged (``compute.certify.converged``): both
 # runs fell within SAME_FALL [p t] of each other (on the same approach), and the finer

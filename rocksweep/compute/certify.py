@@ -54,7 +54,10 @@ all, and fall in the other mode. So is a mode 2 whose body, in full contact befo
 uplifted, came within ``numerics.LIFT_BAND`` x PAR_CLOSE of uplifting (OUT_LIFT_GRAZE, a
 fraction of M g b): a finer run may uplift there by a hair, impact, and fall in mode 1.
 Such a close call is trusted once two runs agree and the finer one's graze clears its own
-step's band, converged margin or not.
+step's band, converged margin or not. Any run, safe or overturned, whose rocking turned
+back within ``numerics.GRAZE_BAND`` x PAR_CLOSE of an impact while the ground moved
+(OUT_GRAZE; ``graze_close``) is re-run as well, however far from the saddle: a finer run
+may make that impact and take another path (its finer runs answer to ``grazed`` below).
 
 Below the last level, a repeated outcome is not trusted either where the finer run grazed
 an impact it did not make (OUT_GRAZE below ``numerics.GRAZE_MARGIN``) by an amount that
@@ -93,6 +96,7 @@ from rocksweep.numerics import (
     CLOSE_AFTER,
     CLOSE_BAND,
     ENERGY_ORDER,
+    GRAZE_BAND,
     GRAZE_MARGIN,
     IMPACT_AGREE,
     LIFT_BAND,
@@ -155,6 +159,16 @@ def mode_close(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     lifted = ((outs[:, L.OUT_OUTCOME] == L.OUTCOME_MODE2)
               & (outs[:, L.OUT_LIFT_GRAZE] < LIFT_BAND * band))
     return _fell(outs) & ((outs[:, L.OUT_MODE_GRAZE] < MODE_BAND * band) | lifted)
+
+
+def graze_close(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
+    """bool[n]: runs (result rows float64[n, N_OUT] of parameter rows float64[n, >= N_PAR])
+    whose rocking came within ``numerics.GRAZE_BAND`` x PAR_CLOSE of an impact it did not
+    make while the ground moved (OUT_GRAZE): a finer run may make that impact and take
+    another path, to the other class (threshold seed 123: a safe run at 5 steps a period
+    that turned back 2e-4 alpha_ref short of theta = 0 during the pulse, far from the
+    saddle, where finer runs and the reference impact there and fall in mode 1)."""
+    return outs[:, L.OUT_GRAZE] < GRAZE_BAND * rows[:, L.PAR_CLOSE]
 
 
 def clear(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
@@ -268,8 +282,9 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
     """
     if levels <= 0 or outs.shape[0] == 0:
         return outs
-    idx = np.flatnonzero(close_calls(rows, outs) | ringing_calls(rows, outs))
-    near = np.flatnonzero(near_misses(rows, outs))
+    idx = np.flatnonzero(close_calls(rows, outs) | ringing_calls(rows, outs)
+                         | graze_close(rows, outs))
+    near = np.setdiff1d(np.flatnonzero(near_misses(rows, outs)), idx, assume_unique=True)
     if near.size:
         checks = probe_rows(rows[near], outs[near])
         probe = run(checks, near, keep=False)
@@ -311,6 +326,9 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
             trusted |= converged(before, finer, new)
             # and, either way, no graze that moved (an impact the next run may make), nor
             # a mode that hangs on a graze (a converged margin says nothing of the mode)
+            # (a first run's graze, ``graze_close``, answers to ``grazed`` too: one that
+            # converged is a graze of the true path, whose touch-down at theta' ~ 0, or none,
+            # leaves the body in nearly one state)
             trusted &= ~grazed(before, new) & ~mode_close(finer, new)
             # and a spring that rings long stays safe on one path (``same_path``): its two
             # runs' margins may agree where the finer ones part from both over the impacts

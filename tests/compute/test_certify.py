@@ -33,6 +33,7 @@ from rocksweep.numerics import (
     CLOSE_AFTER,
     CLOSE_BAND,
     ENERGY_ORDER,
+    GRAZE_BAND,
     GRAZE_MARGIN,
     IMPACT_AGREE,
     LIFT_BAND,
@@ -54,11 +55,12 @@ BLOCK = BlockBody(alpha=0.25, inertia=4.0 / 3.0)
 
 
 def _stand_in(n: int) -> np.ndarray:
-    """Result rows float64[n, N_OUT] of a stand-in kernel: zeros, and no mode graze (inf,
-    as a run whose rocking never neared theta = 0 before its first impact) nor lift graze
-    (inf: never near an uplift it did not make)."""
+    """Result rows float64[n, N_OUT] of a stand-in kernel: zeros, and no graze (inf, as a
+    run whose rocking never neared an impact it did not make while the ground moved), mode
+    graze (inf: never neared theta = 0 before its first impact) nor lift graze (inf: never
+    near an uplift it did not make)."""
     out = np.zeros((n, L.N_OUT))
-    out[:, [L.OUT_MODE_GRAZE, L.OUT_LIFT_GRAZE]] = np.inf
+    out[:, [L.OUT_GRAZE, L.OUT_MODE_GRAZE, L.OUT_LIFT_GRAZE]] = np.inf
     return out
 CASES = [
     # (point, what the issue found the reference does)
@@ -237,6 +239,14 @@ CASES = [
     # 0.0393 alpha_ref whose probe passed at 0.0103 (above a quarter); 20 steps, `fine`
     # and the reference overturn in mode 1 after 5 impacts
     (Point(BODY3, 0.4, "sine", 2.4533033033033034, 0.9777777777777779), L.OUTCOME_MODE1),
+    # a safe run far from the saddle (margin 0.20 alpha_ref) that turned back 2e-4 alpha_ref
+    # short of an impact during the pulse (seed 123): 10 steps a period and finer, `fine`
+    # and the reference make the impact and fall in mode 1 after 6 impacts
+    (Point(FlexibleBody(wn_over_p=6.218136792383917, zeta=0.14781416683518317,
+                        alpha_cg=0.09124220466571292, alpha_A=0.1737986144034394,
+                        mA_over_m=0.30571760553678246, IA_ratio=0.8152897221194817),
+           0.47940659424735316, "cosine", 1.30534476443025, 1.0446585255087506),
+     L.OUTCOME_MODE1),
 ]
 
 
@@ -250,7 +260,7 @@ CASES = [
                               "clear-safe", "event-tol", "fall-moved", "probe-clear-1",
                               "probe-clear-2", "nearly-uplifted", "two-paths-safe",
                               "two-paths-overturn", "probe-kept", "probe-kept-91", "probe-kept-108",
-                              "fig3a-probe-kept"])
+                              "fig3a-probe-kept", "graze-safe-123"])
 def test_default_classifies_the_reproduced_cases_like_the_reference(point, expected):
     """The reference's outcome is the one written here; `default` (sweep kernel and simulate) gives
     the same. Before the step rule, `default` gave safe / mode 1 here."""
@@ -829,6 +839,60 @@ def test_an_overturn_whose_mode_hangs_on_a_graze_is_a_close_call():
     assert outs[0, L.OUT_OUTCOME] == mode1 and not st[0] & L.STATUS_FLAGGED
     assert st[1] & L.STATUS_UNCERTIFIED  # a knife edge of the mode at every level
     assert not st[2] & L.STATUS_REFINED and not st[3] & L.STATUS_REFINED
+
+
+def test_a_run_that_grazed_an_impact_while_the_ground_moved_is_a_close_call():
+    """certify's rule on a stand-in kernel: a run clear of the saddle, safe or overturned,
+    that came within GRAZE_BAND x PAR_CLOSE of an impact it did not make while the ground
+    moved (OUT_GRAZE) is re-run finer, and trusted once two runs agree and the finer one's
+    graze clears its own step's band (band x 2^-2.5 a level) or converged (``grazed``: it
+    moved by less than itself between the two runs: the true path's graze, whose touch-down
+    at theta' ~ 0, or none, leaves nearly one state); a graze wider than the band buys
+    nothing."""
+    rows = np.zeros((5, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = 0.1  # 5 steps a period: band 0.01 x 0.1 = GRAZE_MARGIN
+    rows[:, L.PAR_DT] = 1.0
+    band = GRAZE_BAND * 0.1
+    assert band == pytest.approx(GRAZE_MARGIN)
+    safe, mode1 = L.OUTCOME_SAFE, L.OUTCOME_MODE1
+    # level -> (outcome, graze); level k's band is band x 2^(-2.5 k)
+    ladder = {0: [(safe, 0.01 * band), (mode1, 0.5 * band), (mode1, 0.5 * band)],
+              1: [(mode1, 0.9 * band), (mode1, 0.9 * band), (mode1, np.inf)],
+              2: [(safe, 0.01 * band)] + [(safe, 1e-4 * band)] * 3,
+              3: [(safe, 1.01 * band)],
+              4: [(mode1, 2.0 * band)]}
+    outs = _stand_in(5)
+    outs[:, L.OUT_MARGIN] = 0.5  # clear of the saddle at every level
+    outs[:, L.OUT_T_OVERTURN] = np.where([False, True, False, False, True], 5.0, np.nan)
+    for i, steps in ladder.items():
+        outs[i, [L.OUT_OUTCOME, L.OUT_GRAZE]] = steps[0]
+    levels_run = {i: [] for i in ladder}
+
+    def run(sub, idx, keep=True):
+        res = _stand_in(len(idx))
+        level = round(-np.log2(sub[0, L.PAR_DT]))
+        res[:, L.OUT_MARGIN] = 0.5
+        for j, i in enumerate(idx):
+            levels_run[int(i)].append(level)
+            res[j, [L.OUT_OUTCOME, L.OUT_GRAZE]] = ladder[int(i)][level]
+            res[j, L.OUT_T_OVERTURN] = 5.0 if res[j, L.OUT_OUTCOME] == mode1 else np.nan
+        return res
+
+    certify(rows, outs, run, 3)
+    # 0: safe grazing at its own step, mode 1 at levels 1 and 2 (graze 0.5 band, clear of
+    # level 2's band, 2^-5 band): certified mode 1 at level 2
+    # 1: mode 1 grazing at its own step, mode 1 at level 1 with a graze (0.9 band) clear of
+    # level 1's band (2^-2.5 band): certified there
+    # 2: safe at every level, grazing within each level's band: 1e-4 band at level 1 (it
+    # moved by more than itself from 0.01 band), again at level 2 (converged): certified
+    # 3, 4: grazes at or past the band: no rerun
+    assert levels_run == {0: [1, 2], 1: [1], 2: [1, 2], 3: [], 4: []}
+    st = outs[:, L.OUT_STATUS].astype(int)
+    assert outs[0, L.OUT_OUTCOME] == mode1 and not st[0] & L.STATUS_FLAGGED
+    assert outs[1, L.OUT_OUTCOME] == mode1 and not st[1] & L.STATUS_FLAGGED
+    assert outs[2, L.OUT_OUTCOME] == safe and st[2] & L.STATUS_REFINED
+    assert not st[2] & L.STATUS_FLAGGED
+    assert not st[3] & L.STATUS_REFINED and not st[4] & L.STATUS_REFINED
 
 
 def test_the_first_impacts_depth_is_its_speed_squared():
