@@ -402,13 +402,14 @@ IMPACT_AGREE = 0.1
 # not trusted (``compute.certify.grazed``).
 GRAZE_MARGIN = 1e-3
 # ... and a run that grazed below GRAZE_BAND x PAR_CLOSE (GRAZE_MARGIN at 5 steps a period,
-# scaled with the step as the band) is a close call whatever its margin, safe or overturned
+# scaled with the step as the band) is re-run finer whatever its margin, safe or overturned
 # (``compute.certify.graze_close``): threshold seed 123's safe run at 5 steps a period, 0.2
 # alpha_ref from the saddle, turned back 2e-4 alpha_ref short of an impact during the
 # pulse, which 10 steps a period and finer make, and fall in mode 1 as the reference. On
 # Figure 4(b)'s adaptive points (1000 x 1000 x 3 lam) the graze of such a run moved by 17%
-# of itself (median; 80% at the 90th percentile) between 5 and 40 steps a period; the
-# band twice as wide (MODE_BAND's) cost that figure 18% more RK4 evaluations.
+# of itself (median; 80% at the 90th percentile) between 5 and 40 steps a period;
+# MODE_BAND's band, 20 times as wide, cost that figure 18% more RK4 evaluations, this one
+# 2.7% (docs/accuracy.md, "A graze far from the saddle").
 GRAZE_BAND = 0.01
 # A repeated overturn still inside the overturn band at its own step, below the last
 # level, is certified if its margins have converged (``compute.certify.converged``): both

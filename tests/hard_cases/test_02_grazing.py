@@ -30,7 +30,7 @@ BRACKET = (1.06, 1.09)  # amplitudes with / without the touch-down
 
 
 # the bisection's step: FINE's, without the certification's finer reruns (a run this near a
-# graze is a close call, ``certify.graze_close``: its finest rerun's graze is its own)
+# graze is re-run finer, ``certify.graze_close``: its finest rerun's graze is its own)
 GRAZE_NUM = numerics(steps_per_period=160, event_tol=1e-12)
 
 
