@@ -806,40 +806,54 @@ def test_a_file_states_what_its_certification_cost(tmp_path):
     assert info_dict(read_info(old))["certification"]["refine_evaluations"] is None
 
 
+def _certify_ladder(ladder: dict, slot: int, levels: int = 3
+                    ) -> tuple[np.ndarray, dict[int, list[int]]]:
+    """certify on a stand-in kernel whose row i gives ``ladder[i][level]`` = (outcome, the
+    result's ``slot``) at each level (5 steps a period at level 0, PAR_CLOSE 0.1), every run
+    clear of the saddle (margin 0.5 alpha_ref), an overturn at 5 p t. Returns the certified
+    result rows and the levels each row was re-run at."""
+    n = len(ladder)
+    rows = np.zeros((n, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = 0.1
+    rows[:, L.PAR_DT] = 1.0
+
+    def fill(res: np.ndarray, j: int, step: tuple) -> None:
+        res[j, [L.OUT_OUTCOME, slot]] = step
+        res[j, L.OUT_T_OVERTURN] = 5.0 if step[0] != L.OUTCOME_SAFE else np.nan
+
+    outs = _stand_in(n)
+    outs[:, L.OUT_MARGIN] = 0.5
+    for i, steps in ladder.items():
+        fill(outs, i, steps[0])
+    levels_run = {i: [] for i in ladder}
+
+    def run(sub, idx, keep=True):
+        res = _stand_in(len(idx))
+        res[:, L.OUT_MARGIN] = 0.5
+        level = round(-np.log2(sub[0, L.PAR_DT]))
+        for j, i in enumerate(idx):
+            levels_run[int(i)].append(level)
+            fill(res, j, ladder[int(i)][level])
+        return res
+
+    certify(rows, outs, run, levels)
+    return outs, levels_run
+
+
 def test_an_overturn_whose_mode_hangs_on_a_graze_is_a_close_call():
     """certify's rule on a stand-in kernel: an overturn clear of the saddle whose rocking
     came within MODE_BAND x PAR_CLOSE of theta = 0 before its first impact (OUT_MODE_GRAZE)
     is re-run finer, and trusted once two runs agree and the finer one's graze is clear of
     its own step's band (which shrinks with the step); one still that close at the last
     level is flagged; a safe run's mode graze, or a wide one, buys no rerun."""
-    rows = np.zeros((4, L.N_PAR))
-    rows[:, L.PAR_CLOSE] = 0.1  # 5 steps a period: band 0.2 x 0.1 = 0.02
-    rows[:, L.PAR_DT] = 1.0
-    band = MODE_BAND * 0.1
-    # level -> (outcome, mode graze); the band at level k is band x 2^(-2.5 k)
+    band = MODE_BAND * 0.1  # 5 steps a period: band 0.2 x 0.1 = 0.02
+    # row -> (outcome, mode graze) at each level; the band at level k is band x 2^(-2.5 k)
     mode2, mode1, safe = L.OUTCOME_MODE2, L.OUTCOME_MODE1, L.OUTCOME_SAFE
     ladder = {0: [(mode2, 0.05 * band), (mode1, 0.3 * band), (mode1, 0.3 * band)],
               1: [(mode1, 0.01 * band)] + [(mode1, 1e-6 * band)] * 3,
               2: [(safe, 0.01 * band)],
               3: [(mode2, 2.0 * band)]}
-    outs = _stand_in(4)
-    outs[:, L.OUT_MARGIN] = 0.5  # clear of the saddle at every level
-    outs[:, L.OUT_T_OVERTURN] = 5.0
-    for i, steps in ladder.items():
-        outs[i, [L.OUT_OUTCOME, L.OUT_MODE_GRAZE]] = steps[0]
-    levels_run = {i: [] for i in ladder}
-
-    def run(sub, idx, keep=True):
-        res = _stand_in(len(idx))
-        level = round(-np.log2(sub[0, L.PAR_DT]))
-        res[:, L.OUT_MARGIN] = 0.5
-        res[:, L.OUT_T_OVERTURN] = 5.0
-        for j, i in enumerate(idx):
-            levels_run[int(i)].append(level)
-            res[j, [L.OUT_OUTCOME, L.OUT_MODE_GRAZE]] = ladder[int(i)][level]
-        return res
-
-    certify(rows, outs, run, 3)
+    outs, levels_run = _certify_ladder(ladder, L.OUT_MODE_GRAZE)
     # 0: mode 2 at its own step, mode 1 at 1 and 2 with a graze clear of level 2's band
     # (0.3 band > band x 2^-5): certified mode 1 there
     assert levels_run == {0: [1, 2], 1: [1, 2, 3], 2: [], 3: []}
@@ -857,36 +871,16 @@ def test_a_run_that_grazed_an_impact_while_the_ground_moved_is_a_close_call():
     moved by less than itself between the two runs: the true path's graze, whose touch-down
     at theta' ~ 0, or none, leaves nearly one state); a graze wider than the band buys
     nothing."""
-    rows = np.zeros((5, L.N_PAR))
-    rows[:, L.PAR_CLOSE] = 0.1  # 5 steps a period: band 0.01 x 0.1 = GRAZE_MARGIN
-    rows[:, L.PAR_DT] = 1.0
-    band = GRAZE_BAND * 0.1
+    band = GRAZE_BAND * 0.1  # 5 steps a period: band 0.01 x 0.1 = GRAZE_MARGIN
     assert band == pytest.approx(GRAZE_MARGIN)
     safe, mode1 = L.OUTCOME_SAFE, L.OUTCOME_MODE1
-    # level -> (outcome, graze); level k's band is band x 2^(-2.5 k)
+    # row -> (outcome, graze) at each level; level k's band is band x 2^(-2.5 k)
     ladder = {0: [(safe, 0.01 * band), (mode1, 0.5 * band), (mode1, 0.5 * band)],
               1: [(mode1, 0.9 * band), (mode1, 0.9 * band), (mode1, np.inf)],
               2: [(safe, 0.01 * band)] + [(safe, 1e-4 * band)] * 3,
               3: [(safe, 1.01 * band)],
               4: [(mode1, 2.0 * band)]}
-    outs = _stand_in(5)
-    outs[:, L.OUT_MARGIN] = 0.5  # clear of the saddle at every level
-    outs[:, L.OUT_T_OVERTURN] = np.where([False, True, False, False, True], 5.0, np.nan)
-    for i, steps in ladder.items():
-        outs[i, [L.OUT_OUTCOME, L.OUT_GRAZE]] = steps[0]
-    levels_run = {i: [] for i in ladder}
-
-    def run(sub, idx, keep=True):
-        res = _stand_in(len(idx))
-        level = round(-np.log2(sub[0, L.PAR_DT]))
-        res[:, L.OUT_MARGIN] = 0.5
-        for j, i in enumerate(idx):
-            levels_run[int(i)].append(level)
-            res[j, [L.OUT_OUTCOME, L.OUT_GRAZE]] = ladder[int(i)][level]
-            res[j, L.OUT_T_OVERTURN] = 5.0 if res[j, L.OUT_OUTCOME] == mode1 else np.nan
-        return res
-
-    certify(rows, outs, run, 3)
+    outs, levels_run = _certify_ladder(ladder, L.OUT_GRAZE)
     # 0: safe grazing at its own step, mode 1 at levels 1 and 2 (graze 0.5 band, clear of
     # level 2's band, 2^-5 band): certified mode 1 at level 2
     # 1: mode 1 grazing at its own step, mode 1 at level 1 with a graze (0.9 band) clear of
