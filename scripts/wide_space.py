@@ -3,7 +3,8 @@
 Draws a sample of random points over a wide Pi space (fixed seed): flexible bodies with
 wn/p in [1, 60] (log-uniform), zeta in [0, 0.3] (a sixth exactly 0), alpha_cg in
 [0.05, 0.45], alpha_A in [alpha_cg, 1.2], mA/m in [0.05, 10] (log), IA_ratio in [0.2, 1],
-lam in [0, 1.5], w/p in [0.2, 12], |A_ratio| in [0.3, 20] (random sign), sine or cosine
+lam in [0, 1.5], w/p in [0.2, 12], |A_ratio| in [0.3, 20] (random sign; ``--a-max`` widens
+it: ``--a-max 30`` reaches the guide's A up to 30, a sample of its own), sine or cosine
 (uniform unless marked log: most pulses are far above the uplift threshold); plus a share
 of rigid bodies (wn/p = inf, same ranges otherwise). Runs the reference
 (``rocksweep.physics.reference``, DOP853 at rtol 1e-10) once per sample (cached with ``--cache``)
@@ -61,8 +62,9 @@ def _logu(rng: np.random.Generator, lo: float, hi: float) -> float:
     return float(math.exp(rng.uniform(math.log(lo), math.log(hi))))
 
 
-def draw(n: int, seed: int) -> list[Point]:
-    """n random points of the wide Pi space (see the module docstring), reproducible."""
+def draw(n: int, seed: int, a_max: float = 20.0) -> list[Point]:
+    """n random points of the wide Pi space (see the module docstring), reproducible;
+    |A_ratio| up to ``a_max`` (at 20, the samples drawn before the option existed)."""
     rng = np.random.default_rng(seed)
     pts = []
     for _ in range(n):
@@ -77,7 +79,7 @@ def draw(n: int, seed: int) -> list[Point]:
         pts.append(Point(body, lam=float(rng.uniform(0.0, 1.5)),
                          excitation="sine" if rng.uniform() < 0.5 else "cosine",
                          w_over_p=float(rng.uniform(0.2, 12.0)),
-                         A_ratio=sign * float(rng.uniform(0.3, 20.0))))
+                         A_ratio=sign * float(rng.uniform(0.3, a_max))))
     return pts
 
 
@@ -190,6 +192,8 @@ def main() -> None:
     ap.add_argument("--n", type=int, default=400)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--presets", default=",".join(PRESETS))
+    ap.add_argument("--a-max", type=float, default=20.0,
+                    help="largest |A_ratio| drawn (default 20; the reference cache is per value)")
     ap.add_argument("--setting", action="append", default=[])
     ap.add_argument("--cache", type=Path, default=None,
                     help="directory for the reference results (reused on the next run)")
@@ -203,11 +207,13 @@ def main() -> None:
                     help="t_overturn [p*t] and theta_rel targets for --check")
     args = ap.parse_args()
 
-    points = draw(args.n, args.seed)
+    points = draw(args.n, args.seed, args.a_max)
     t0 = time.perf_counter()
-    ref, secs = reference(points, Numerics(), args.cache, f"n{args.n}_s{args.seed}")
+    tag = f"n{args.n}_s{args.seed}" + ("" if args.a_max == 20.0 else f"_a{args.a_max:g}")
+    ref, secs = reference(points, Numerics(), args.cache, tag)
     n_rigid = sum(p.body.rigid for p in points)
-    print(f"wide-space sample: {args.n} points, seed {args.seed} ({n_rigid} rigid); reference "
+    print(f"wide-space sample: {args.n} points, seed {args.seed}, |A_ratio| <= {args.a_max:g} "
+          f"({n_rigid} rigid); reference "
           f"{np.mean(secs) * 1e3:.0f} ms/point mean ({time.perf_counter() - t0:.0f} s here)")
     ref_flag = int(np.sum((ref[:, L.OUT_STATUS].astype(np.int64) & L.STATUS_FLAGGED) != 0))
     print("reference outcomes: " + ", ".join(
