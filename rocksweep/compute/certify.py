@@ -22,8 +22,9 @@ when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the th
   A repeated overturn still inside the band at its own step is certified too where its
   margin converged between the two runs (``converged``: the same fall, the finer margin
   ``clear``, and its square, ~ the energy past the barrier, clear of Richardson's estimate
-  of its error) and a finer run would follow (at the last level the verdict is as
-  before): most of the knife-edge rule's reruns were overturns whose margin had already
+  of its error), the finer run had no phase no step split (``unsplit``: the coarser run
+  took the same single step over it; threshold seed 116's chatter during the pulse) and
+  a finer run would follow (at the last level the verdict is as before): most of the knife-edge rule's reruns were overturns whose margin had already
   settled at level 1, the coarse step's band being far wider than its error there;
 - a safe run between the close-call margin and the row's PAR_CLOSE (``numerics.
   close_band``, CLOSE_BAND times it: a near-miss, which turned back with a margin a
@@ -106,6 +107,7 @@ from rocksweep.numerics import (
     RINGING_BAND,
     RINGING_MEMORY,
     SAME_FALL,
+    UNSPLIT_SHARE,
 )
 
 
@@ -207,6 +209,15 @@ def converged(coarse: np.ndarray, fine_rows: np.ndarray, fine: np.ndarray) -> np
     hang on the step."""
     return (_fell(coarse) & _fell(fine) & same_fall(coarse, fine)
             & clear(fine_rows, fine) & energy_clear(coarse, fine))
+
+
+def unsplit(fine: np.ndarray) -> np.ndarray:
+    """bool[n]: runs (result rows float64[n, N_OUT]) with a phase, while the ground moved,
+    that ended inside the first step after its start and was longer than
+    ``numerics.UNSPLIT_SHARE`` of that step (OUT_UNSPLIT): a coarser run at twice the step
+    took the same single step over it, so the two runs' agreement (``converged``) says
+    nothing of its error."""
+    return fine[:, L.OUT_UNSPLIT] > UNSPLIT_SHARE
 
 
 def settled(coarse: np.ndarray, fine: np.ndarray) -> np.ndarray:
@@ -324,7 +335,9 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
         trusted = ~close_calls(finer, new)
         if level < levels:
             trusted &= settled(before, new) & clear(finer, new)
-            trusted |= converged(before, finer, new)
+            # (not where the finer run had a phase no step split: the two runs integrated
+            # it alike, whatever its error, ``unsplit``)
+            trusted |= converged(before, finer, new) & ~unsplit(new)
             # and, either way, no graze that moved (an impact the next run may make), nor
             # a mode that hangs on a graze (a converged margin says nothing of the mode)
             # (a first run's graze, ``graze_close``, answers to ``grazed`` too: one that

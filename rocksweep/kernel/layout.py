@@ -165,7 +165,13 @@ OUT_LIFT_GRAZE = 31  # how near the body came to uplifting before its first upli
 #                 dip; a base that slides takes none. A mode 2 that came this near an
 #                 earlier uplift hangs on it: a finer run may uplift by a hair there and
 #                 impact, and fall in mode 1 (``rocksweep.compute.certify.mode_close``)
-N_OUT = 32
+OUT_UNSPLIT = 32  # the longest phase (event to event) while the ground moved that ended
+#                   inside the first step after its start, over that step (dt_on): a
+#                   phase no step split, integrated alike at every step longer than it
+#                   (0: none; a base that slides takes none). A finer run's above
+#                   ``numerics.UNSPLIT_SHARE`` voids its agreement with the coarser one
+#                   (``rocksweep.compute.certify.unsplit``)
+N_OUT = 33
 
 # --- state tuple y (the loop's 6 slots, a UniTuple(float64, 6)) ----------------------------
 Y_THETA = 0  # theta [rad] (0 in full contact)

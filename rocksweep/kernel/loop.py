@@ -91,6 +91,7 @@ from rocksweep.kernel.layout import (
     OUT_T_FIRST_IMPACT,
     OUT_T_OVERTURN,
     OUT_THETA_MAX,
+    OUT_UNSPLIT,
     OUT_UPLIFTS,
     OUT_W_IN,
     OUTCOME_MODE1,
@@ -204,6 +205,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     graze = np.inf  # OUT_GRAZE
     dip, lift = np.inf, np.inf  # OUT_MODE_GRAZE before an impact, OUT_LIFT_GRAZE [N m]
     t_close = np.nan  # OUT_T_CLOSE
+    t_ev, first, unsplit = 0.0, True, 0.0  # the phase's start, no step ended yet; OUT_UNSPLIT
     # ``_near_saddle``'s bounds, once per run (saddle0 = NaN: no gate, every free rocking
     # step takes ``_saddle``'s test; a row without a body, as warm_up's)
     near = _saddle_bounds(prm)
@@ -247,8 +249,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
             h_rot = _rotation_step(y[Y_THETA_DOT], acc, rot)
             if h_rot < h:
                 h, lands, air = h_rot, False, False
-        # k1: shared by every step from y
-        k1 = first_stage(t, y, s, on, prm, FLEX, DAMPED, ENERGY, GROUND)
+        k1 = first_stage(t, y, s, on, prm, FLEX, DAMPED, ENERGY, GROUND)  # of any step from y
         y1 = rk4_from(t, y, h, k1, s, on, prm, FLEX, DAMPED, ENERGY, GROUND)
         steps += 1
         if s != 0 and rot > 0.0:
@@ -278,7 +279,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
                 dip = min(dip, g) if out[OUT_IMPACTS] == 0.0 else dip
             elif s == 0 and out[OUT_IMPACTS] == 0.0:  # (before the first uplift)
                 lift = min(lift, low)
-            t, y = (t_pulse if lands else (t_air if air else t + h)), y1
+            t, y, first = (t_pulse if lands else (t_air if air else t + h)), y1, False
             if s != 0 and not on and _near_saddle(y, s, near):
                 q = _saddle(y, s, prm)
                 if q < prm[PAR_CLOSE]:
@@ -294,8 +295,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
             continue
 
         t, y = t + tau, y_ev
-        _record(hist, t, y, s, on, prm, out, FLEX, GROUND)
-        # the event state, last sample of its phase
+        unsplit, t_ev, first = _unsplit(t - t_ev, first and on, dt_on, unsplit), t, True
+        _record(hist, t, y, s, on, prm, out, FLEX, GROUND)  # the event state, last of its phase
         track = reactions_sample(REACTIONS, track, t, y, s, on, SAMPLE_EVENT, prm, out, FLEX,
                                  DAMPED, ENERGY, GROUND)
         if ev == EV_OVERTURN:
@@ -308,7 +309,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
         track = reactions_sample(REACTIONS, track, t, y, s, on, SAMPLE_START, prm, out, FLEX,
                                  DAMPED, ENERGY, GROUND)
     out[OUT_MARGIN] = margin
-    out[OUT_T_CLOSE] = t_close
+    out[OUT_T_CLOSE], out[OUT_UNSPLIT] = t_close, unsplit
     out[OUT_GRAZE] = graze
     out[OUT_MODE_GRAZE] = dip if out[OUT_IMPACTS] == 0.0 else out[OUT_MODE_GRAZE]
     out[OUT_LIFT_GRAZE] = lift / tip_moment(prm[PAR_G], prm)
@@ -394,6 +395,7 @@ def _reset(out):
     out[OUT_E_MAX] = 0.0
     out[OUT_HIST_ROWS] = 0.0
     out[OUT_REFINE_EVALS] = 0.0  # the certification's reruns add theirs (compute.certify)
+    out[OUT_UNSPLIT] = 0.0  # (the no-slip loop sets its own at the end; a sliding base none)
     out[OUT_MODE_GRAZE] = 0.0  # the deepest impact so far (``_apply_impact``)
     # the sliding base's (``slide_loop`` sets its own; the no-slip model has none)
     out[OUT_SLIDE_MAX] = np.nan
@@ -457,6 +459,15 @@ def _graze(y, y_end, h, s, prm, graze):
         _, g_min = hermite_min(g0, d0, g1, d1, h)
         return min(graze, g_min / prm[PAR_ALPHA_REF])
     return graze
+
+
+@njit(cache=True, inline="always")
+def _unsplit(tau, one_step, dt_on, unsplit):
+    """OUT_UNSPLIT updated at an event that ended a phase of length tau [s]: where the
+    phase ended inside the first step after its start while the ground moved (one_step),
+    tau / dt_on if above ``unsplit``. Such a phase is one RK4 step of length tau at every
+    step longer than it, so two runs at such steps agree on it whatever its error."""
+    return max(unsplit, tau / dt_on) if one_step else unsplit
 
 
 @njit(cache=True, **INLINE)

@@ -44,6 +44,7 @@ from rocksweep.numerics import (
     RINGING_BAND,
     RINGING_MEMORY,
     SAME_FALL,
+    UNSPLIT_SHARE,
     Numerics,
 )
 from rocksweep.physics.bodies import BlockBody, FlexibleBody
@@ -62,6 +63,11 @@ def _stand_in(n: int) -> np.ndarray:
     out = np.zeros((n, L.N_OUT))
     out[:, [L.OUT_GRAZE, L.OUT_MODE_GRAZE, L.OUT_LIFT_GRAZE]] = np.inf
     return out
+# threshold seed 116's body and pulse (``test_a_phase_no_step_split_...``, CASES)
+CHATTER_116 = Point(FlexibleBody(wn_over_p=2.2884208799658987, zeta=0.07749233964307982,
+                                 alpha_cg=0.10536760629882237, alpha_A=0.4257780382044154,
+                                 mA_over_m=2.6949288737431365, IA_ratio=0.8313050697778259),
+                    0.4112574981187938, "cosine", 3.603490843936676, 3.967538642746966)
 CASES = [
     # (point, what the issue found the reference does)
     (Point(BLOCK, 0.0, "sine", 8.0, 10.9), L.OUTCOME_MODE1),
@@ -255,6 +261,10 @@ CASES = [
                         mA_over_m=1.862923374039951, IA_ratio=0.9316619683201901),
            0.16010470152810913, "cosine", 5.160447353459797, 15.997318617223787),
      L.OUTCOME_MODE1),
+    # a chatter through the pulse (seed 116): a phase of 0.0363 p t is one step at 5 and at
+    # 10 steps a period, both runs fall after 7 impacts with margins that converged; 20
+    # steps a period and finer, and the reference, rock to rest (``unsplit``)
+    (CHATTER_116, L.OUTCOME_SAFE),
 ]
 
 
@@ -268,7 +278,8 @@ CASES = [
                               "clear-safe", "event-tol", "fall-moved", "probe-clear-1",
                               "probe-clear-2", "nearly-uplifted", "two-paths-safe",
                               "two-paths-overturn", "probe-kept", "probe-kept-91", "probe-kept-108",
-                              "fig3a-probe-kept", "graze-safe-123", "ringing-4-143"])
+                              "fig3a-probe-kept", "graze-safe-123", "ringing-4-143",
+                              "chatter-116"])
 def test_default_classifies_the_reproduced_cases_like_the_reference(point, expected):
     """The reference's outcome is the one written here; `default` (sweep kernel and simulate) gives
     the same. Before the step rule, `default` gave safe / mode 1 here."""
@@ -981,3 +992,69 @@ def test_a_blocks_least_uplift_gap_is_one_less_its_amplitude_ratio():
     out = np.empty((1, L.N_OUT))
     chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)(row[None, :].copy(), out)
     assert out[0, L.OUT_UPLIFTS] >= 1 and out[0, L.OUT_LIFT_GRAZE] == np.inf
+
+
+def test_a_phase_no_step_split_is_the_longest_single_step_phase_of_the_history():
+    """OUT_UNSPLIT against the run's own history: the longest phase (event to event, the
+    history's phase changes) while the pulse acts that is shorter than the step while the
+    ground moves (so the first step after its start ended it), over that step. Seed 116's
+    chatter: the phase of 0.0363 p t is one step at 5 and at 10 steps a period, two at 20,
+    where a shorter one is the longest left; none at 80 (every phase split)."""
+    from rocksweep.compute.dispatch import run_variant
+
+    row = point_row(CHATTER_116, Numerics.preset("default"))[None, :]
+    found = []
+    for level in (0, 1, 2, 4):
+        rows = np.ascontiguousarray(refined_rows(row, level) if level else row)
+        hist = [None]
+        out = run_variant(rows, kernel_kind(CHATTER_116.body), L.LEVEL_OUTCOME,
+                          L.GROUND_PULSE, 0, histories=hist)[0]
+        h = hist[0][:int(out[L.OUT_HIST_ROWS])]
+        t, s = h[:, L.HIST_T], h[:, L.HIST_PHASE]
+        change = t[np.flatnonzero(np.diff(s) != 0) + 1]
+        # each phase from one change to the next (the first from t = 0), while the pulse acts
+        starts = np.concatenate(([0.0], change[:-1]))
+        tau = change - starts
+        dt_on = rows[0, L.PAR_DT_ON]
+        short = tau[(change <= rows[0, L.PAR_TPULSE]) & (tau < dt_on)]
+        expected = short.max() / dt_on if short.size else 0.0
+        assert out[L.OUT_UNSPLIT] == pytest.approx(expected, rel=1e-12)
+        found.append(out[L.OUT_UNSPLIT])
+    assert found[0] > UNSPLIT_SHARE and found[1] > 0.99 and found[3] == 0.0
+    assert 0.0 < found[2] < found[1]
+
+
+def test_converged_margins_do_not_certify_a_run_with_a_phase_no_step_split():
+    """certify on a stand-in kernel: two overturns whose margins converged between levels 0
+    and 1 inside the finer run's band (0.0150 -> 0.0152 alpha_ref at PAR_CLOSE 0.1, as
+    seed 116's): one whose level-1 run took a phase of 0.99 of its step in one step goes on
+    to level 2, one whose longest such phase was 0.3 of its step is certified at level 1."""
+    rows = np.zeros((2, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = 0.1
+    rows[:, L.PAR_DT] = 1.0
+    # (margin, OUT_UNSPLIT) of each row at levels 0, 1, 2
+    ladder = {0: [(0.0150, 0.6), (0.0152, 0.99), (0.0152, 0.9)],
+              1: [(0.0150, 0.6), (0.0152, 0.3), (0.0152, 0.3)]}
+
+    def fill(res, j, i, level):
+        res[j, L.OUT_OUTCOME] = L.OUTCOME_MODE1
+        res[j, L.OUT_T_OVERTURN] = 5.0
+        res[j, [L.OUT_MARGIN, L.OUT_UNSPLIT]] = ladder[i][level]
+
+    outs = _stand_in(2)
+    for i in ladder:
+        fill(outs, i, i, 0)
+    levels_run = {i: [] for i in ladder}
+
+    def run(sub, idx, keep=True):
+        res = _stand_in(len(idx))
+        level = round(-np.log2(sub[0, L.PAR_DT]))
+        for j, i in enumerate(idx):
+            levels_run[int(i)].append(level)
+            fill(res, j, int(i), level)
+        return res
+
+    certify(rows, outs, run, 3)
+    assert levels_run == {0: [1, 2], 1: [1]}
+    status = outs[:, L.OUT_STATUS].astype(np.int64)
+    assert not (status & L.STATUS_UNCERTIFIED).any()
