@@ -24,8 +24,9 @@ when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the th
   ``clear``, and its square, ~ the energy past the barrier, clear of Richardson's estimate
   of its error), the finer run had no phase no step split (``unsplit``: the coarser run
   took the same single step over it; threshold seed 116's chatter during the pulse) and
-  a finer run would follow (at the last level the verdict is as before): most of the knife-edge rule's reruns were overturns whose margin had already
-  settled at level 1, the coarse step's band being far wider than its error there;
+  a finer run would follow (at the last level the verdict is as before): most of the
+  knife-edge rule's reruns were overturns whose margin had already settled at level 1,
+  the coarse step's band being far wider than its error there;
 - a safe run between the close-call margin and the row's PAR_CLOSE (``numerics.
   close_band``, CLOSE_BAND times it: a near-miss, which turned back with a margin a
   coarse step's error can still reverse) is checked by a run at half the steps that stops
