@@ -22,11 +22,9 @@ when it was last near it (``OUT_T_CLOSE``). Close calls, on both sides of the th
   A repeated overturn still inside the band at its own step is certified too where its
   margin converged between the two runs (``converged``: the same fall, the finer margin
   ``clear``, and its square, ~ the energy past the barrier, clear of Richardson's estimate
-  of its error), the finer run had no phase no step split (``unsplit``: the coarser run
-  took the same single step over it; threshold seed 116's chatter during the pulse) and
-  a finer run would follow (at the last level the verdict is as before): most of the
-  knife-edge rule's reruns were overturns whose margin had already settled at level 1,
-  the coarse step's band being far wider than its error there;
+  of its error) and a finer run would follow (at the last level the verdict is as
+  before): most of the knife-edge rule's reruns were overturns whose margin had already
+  settled at level 1, the coarse step's band being far wider than its error there;
 - a safe run between the close-call margin and the row's PAR_CLOSE (``numerics.
   close_band``, CLOSE_BAND times it: a near-miss, which turned back with a margin a
   coarse step's error can still reverse) is checked by a run at half the steps that stops
@@ -61,10 +59,15 @@ back within ``numerics.GRAZE_BAND`` x PAR_CLOSE of an impact while the ground mo
 (OUT_GRAZE; ``graze_close``) is re-run as well, however far from the saddle: a finer run
 may make that impact and take another path (its finer runs answer to ``grazed`` below).
 
-Below the last level, a repeated outcome is not trusted either where the finer run grazed
-an impact it did not make (OUT_GRAZE below ``numerics.GRAZE_MARGIN``) by an amount that
-moved by more than itself between the two runs (``grazed``): a coming impact, which a
-finer run makes.
+Below the last level, a repeated outcome is not trusted either where the finer run came
+within its own band of the saddle (its row's PAR_CLOSE) after a phase (event to event)
+longer than ``numerics.UNSPLIT_SHARE`` of its step that one step took, before its last
+approach or its fall (``unsplit``, OUT_UNSPLIT): the coarser run took the same single step
+over it, so the two agree on it whatever its error
+(threshold seeds 37, 116 and 168: chatters before the approach, docs/accuracy.md, "A
+phase no step split"). Nor where the finer run grazed an impact it did not make
+(OUT_GRAZE below ``numerics.GRAZE_MARGIN``) by an amount that moved by more than itself
+between the two runs (``grazed``): a coming impact, which a finer run makes.
 
 Only the runs near a threshold pay: on the paper's figures' full grids 26-65% more RK4
 evaluations than the points' own, on their adaptive sweeps (almost only points near a
@@ -213,11 +216,11 @@ def converged(coarse: np.ndarray, fine_rows: np.ndarray, fine: np.ndarray) -> np
 
 
 def unsplit(fine: np.ndarray) -> np.ndarray:
-    """bool[n]: runs (result rows float64[n, N_OUT]) with a phase, while the ground moved,
-    that ended inside the first step after its start and was longer than
-    ``numerics.UNSPLIT_SHARE`` of that step (OUT_UNSPLIT): a coarser run at twice the step
-    took the same single step over it, so the two runs' agreement (``converged``) says
-    nothing of its error."""
+    """bool[n]: runs (result rows float64[n, N_OUT]) with a phase, before their last
+    approach to the saddle or their fall, that ended inside the first step after its start
+    and was longer than ``numerics.UNSPLIT_SHARE`` of that step (OUT_UNSPLIT): a coarser run
+    at twice the step took the same single step over it, so the two runs' agreement
+    (``settled``, ``converged``) says nothing of its error."""
     return fine[:, L.OUT_UNSPLIT] > UNSPLIT_SHARE
 
 
@@ -336,15 +339,17 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
         trusted = ~close_calls(finer, new)
         if level < levels:
             trusted &= settled(before, new) & clear(finer, new)
-            # (not where the finer run had a phase no step split: the two runs integrated
-            # it alike, whatever its error, ``unsplit``)
-            trusted |= converged(before, finer, new) & ~unsplit(new)
+            trusted |= converged(before, finer, new)
             # and, either way, no graze that moved (an impact the next run may make), nor
             # a mode that hangs on a graze (a converged margin says nothing of the mode)
             # (a first run's graze, ``graze_close``, answers to ``grazed`` too: one that
             # converged is a graze of the true path, whose touch-down at theta' ~ 0, or none,
             # leaves the body in nearly one state)
             trusted &= ~grazed(before, new) & ~mode_close(finer, new)
+            # nor where the finer run came within its band of the saddle (PAR_CLOSE) after a
+            # phase no step split (the two runs integrated it alike, whatever its error:
+            # ``unsplit``)
+            trusted &= ~(unsplit(new) & (new[:, L.OUT_MARGIN] < finer[:, L.PAR_CLOSE]))
             # and a spring that rings long stays safe on one path (``same_path``): its two
             # runs' margins may agree where the finer ones part from both over the impacts
             trusted &= ~(ringing(rows[idx]) & ~_fell(new) & ~same_path(before, new))

@@ -165,10 +165,12 @@ OUT_LIFT_GRAZE = 31  # how near the body came to uplifting before its first upli
 #                 dip; a base that slides takes none. A mode 2 that came this near an
 #                 earlier uplift hangs on it: a finer run may uplift by a hair there and
 #                 impact, and fall in mode 1 (``rocksweep.compute.certify.mode_close``)
-OUT_UNSPLIT = 32  # the longest phase (event to event) while the ground moved that ended
-#                   inside the first step after its start, over that step (dt_on): a
-#                   phase no step split, integrated alike at every step longer than it
-#                   (0: none; a base that slides takes none). A finer run's above
+OUT_UNSPLIT = 32  # the longest phase (event to event) that ended inside the first step
+#                   after its start, over the step then in effect (dt_on while the ground
+#                   moves, dt after), among those before the run's last approach within
+#                   PAR_CLOSE of the saddle (OUT_T_CLOSE), or before its fall: a phase no
+#                   step split, integrated alike at every step longer than it (0: none; a
+#                   base that slides takes none). A finer run's above
 #                   ``numerics.UNSPLIT_SHARE`` voids its agreement with the coarser one
 #                   (``rocksweep.compute.certify.unsplit``)
 N_OUT = 33

@@ -202,10 +202,9 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     rot = prm[PAR_ROT_STEP]
     acc = 0.0
     margin = np.inf  # OUT_MARGIN, in a register
-    graze = np.inf  # OUT_GRAZE
-    dip, lift = np.inf, np.inf  # OUT_MODE_GRAZE before an impact, OUT_LIFT_GRAZE [N m]
+    graze = dip = lift = np.inf  # OUT_GRAZE, OUT_MODE_GRAZE before an impact, OUT_LIFT_GRAZE
     t_close = np.nan  # OUT_T_CLOSE
-    t_ev, first, unsplit = 0.0, True, 0.0  # the phase's start, no step ended yet; OUT_UNSPLIT
+    t_ev, first, unsplit, u_close = 0.0, True, 0.0, 0.0  # OUT_UNSPLIT's (``_unsplit``)
     # ``_near_saddle``'s bounds, once per run (saddle0 = NaN: no gate, every free rocking
     # step takes ``_saddle``'s test; a row without a body, as warm_up's)
     near = _saddle_bounds(prm)
@@ -231,6 +230,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
             free_check = False
             bound, theta_max, margin, t_close = _decided(t, y, s, theta_max, margin, t_close,
                                                          prm, FLEX, ENERGY, REACTIONS)
+            u_close = unsplit if t_close == t else u_close
             if bound:
                 _flag(out, STATUS_BOUNDED)
                 if prm[PAR_TO_REST] == 0.0:
@@ -282,8 +282,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
             t, y, first = (t_pulse if lands else (t_air if air else t + h)), y1, False
             if s != 0 and not on and _near_saddle(y, s, near):
                 q = _saddle(y, s, prm)
-                if q < prm[PAR_CLOSE]:
-                    t_close = t
+                t_close, u_close = (t, unsplit) if q < prm[PAR_CLOSE] else (t_close, u_close)
                 margin = min(margin, q)
             _record(hist, t, y, s, t < t_pulse, prm, out, FLEX, GROUND)
             # the step's end, with the step's own ground motion
@@ -295,7 +294,7 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
             continue
 
         t, y = t + tau, y_ev
-        unsplit, t_ev, first = _unsplit(t - t_ev, first and on, dt_on, unsplit), t, True
+        unsplit, t_ev, first = _unsplit(t - t_ev, first, dt_on if on else dt, unsplit), t, True
         _record(hist, t, y, s, on, prm, out, FLEX, GROUND)  # the event state, last of its phase
         track = reactions_sample(REACTIONS, track, t, y, s, on, SAMPLE_EVENT, prm, out, FLEX,
                                  DAMPED, ENERGY, GROUND)
@@ -309,7 +308,8 @@ def simulate_point(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
         track = reactions_sample(REACTIONS, track, t, y, s, on, SAMPLE_START, prm, out, FLEX,
                                  DAMPED, ENERGY, GROUND)
     out[OUT_MARGIN] = margin
-    out[OUT_T_CLOSE], out[OUT_UNSPLIT] = t_close, unsplit
+    out[OUT_T_CLOSE] = t_close
+    out[OUT_UNSPLIT] = u_close if out[OUT_OUTCOME] == OUTCOME_SAFE else unsplit
     out[OUT_GRAZE] = graze
     out[OUT_MODE_GRAZE] = dip if out[OUT_IMPACTS] == 0.0 else out[OUT_MODE_GRAZE]
     out[OUT_LIFT_GRAZE] = lift / tip_moment(prm[PAR_G], prm)
@@ -462,12 +462,15 @@ def _graze(y, y_end, h, s, prm, graze):
 
 
 @njit(cache=True, inline="always")
-def _unsplit(tau, one_step, dt_on, unsplit):
-    """OUT_UNSPLIT updated at an event that ended a phase of length tau [s]: where the
-    phase ended inside the first step after its start while the ground moved (one_step),
-    tau / dt_on if above ``unsplit``. Such a phase is one RK4 step of length tau at every
-    step longer than it, so two runs at such steps agree on it whatever its error."""
-    return max(unsplit, tau / dt_on) if one_step else unsplit
+def _unsplit(tau, one_step, h, unsplit):
+    """OUT_UNSPLIT so far, updated at an event that ended a phase of length tau [s]: where
+    the phase ended inside the first step after its start (one_step), tau / h (h [s]: the
+    step then in effect, dt_on while the ground moves, dt after) if above ``unsplit``. Such
+    a phase is one RK4 step of length tau at every step longer than it, so two runs at such
+    steps agree on it whatever its error. The loop keeps the value at t_close too: a safe
+    run reports the phases up to its last approach to the saddle, an overturn all those
+    before its fall."""
+    return max(unsplit, tau / h) if one_step else unsplit
 
 
 @njit(cache=True, **INLINE)
