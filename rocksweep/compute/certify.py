@@ -63,11 +63,11 @@ Below the last level, a repeated outcome is not trusted either where the finer r
 within its own band of the saddle (its row's PAR_CLOSE) after a phase (event to event)
 longer than ``numerics.UNSPLIT_SHARE`` of its step that one step took, before its last
 approach or its fall (``unsplit``, OUT_UNSPLIT): the coarser run took the same single step
-over it, so the two agree on it whatever its error
-(threshold seeds 37, 116 and 168: chatters before the approach, docs/accuracy.md, "A
-phase no step split"). Nor where the finer run grazed an impact it did not make
-(OUT_GRAZE below ``numerics.GRAZE_MARGIN``) by an amount that moved by more than itself
-between the two runs (``grazed``): a coming impact, which a finer run makes.
+over it, so the two agree on it whatever its error (threshold seeds 37, 116 and 168:
+chatters before the approach, docs/accuracy.md, "A phase no step split"). Nor where the
+finer run grazed an impact it did not make (OUT_GRAZE below ``numerics.GRAZE_MARGIN``) by
+an amount that moved by more than itself between the two runs (``grazed``): a coming
+impact, which a finer run makes.
 
 Only the runs near a threshold pay: on the paper's figures' full grids 26-65% more RK4
 evaluations than the points' own, on their adaptive sweeps (almost only points near a
