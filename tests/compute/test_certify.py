@@ -63,11 +63,14 @@ def _stand_in(n: int) -> np.ndarray:
     out = np.zeros((n, L.N_OUT))
     out[:, [L.OUT_GRAZE, L.OUT_MODE_GRAZE, L.OUT_LIFT_GRAZE]] = np.inf
     return out
-# threshold seed 116's body and pulse (``test_a_phase_no_step_split_...``, CASES)
+
+
+# threshold seed 116's body and pulse (CASES, ``test_a_phase_no_step_split_...``)
 CHATTER_116 = Point(FlexibleBody(wn_over_p=2.2884208799658987, zeta=0.07749233964307982,
                                  alpha_cg=0.10536760629882237, alpha_A=0.4257780382044154,
                                  mA_over_m=2.6949288737431365, IA_ratio=0.8313050697778259),
                     0.4112574981187938, "cosine", 3.603490843936676, 3.967538642746966)
+
 CASES = [
     # (point, what the issue found the reference does)
     (Point(BLOCK, 0.0, "sine", 8.0, 10.9), L.OUTCOME_MODE1),
