@@ -595,13 +595,18 @@ def test_a_graze_that_moved_is_refined_further():
     assert not (outs[:, L.OUT_STATUS].astype(int) & L.STATUS_FLAGGED).any()
 
 
-def _run_ladder(rows: np.ndarray, ladder: dict, levels: int) -> tuple[np.ndarray, dict]:
+LADDER_SLOTS = [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN]
+
+
+def _run_ladder(rows: np.ndarray, ladder: dict, levels: int, slots: list[int] = LADDER_SLOTS
+                ) -> tuple[np.ndarray, dict]:
     """certify on a stand-in kernel: ladder[i][level] is point i's (outcome, margin,
-    overturning time) at that refinement level (level 0: its own run). Returns the
-    certified result rows and the levels each point was run at."""
+    overturning time) at that refinement level (level 0: its own run), or the values of
+    ``slots`` in their order. Returns the certified result rows and the levels each point
+    was run at."""
     outs = _stand_in(len(ladder))
     for i, steps in ladder.items():
-        outs[i, [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN]] = steps[0]
+        outs[i, slots] = steps[0]
     levels_run = {i: [] for i in ladder}
 
     def run(sub, idx, keep=True):
@@ -609,7 +614,7 @@ def _run_ladder(rows: np.ndarray, ladder: dict, levels: int) -> tuple[np.ndarray
         level = round(-np.log2(sub[0, L.PAR_DT]))
         for j, i in enumerate(idx):
             levels_run[int(i)].append(level)
-            res[j, [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN]] = ladder[int(i)][level]
+            res[j, slots] = ladder[int(i)][level]
         return res
 
     return certify(rows, outs, run, levels), levels_run
@@ -1038,6 +1043,9 @@ def test_a_phase_no_step_split_is_the_longest_single_step_phase_of_the_history()
     assert found[0] > UNSPLIT_SHARE and found[1] > 0.99
 
 
+UNSPLIT_SLOTS = [L.OUT_OUTCOME, L.OUT_T_OVERTURN, L.OUT_MARGIN, L.OUT_UNSPLIT]
+
+
 def test_a_safe_run_s_agreement_over_a_phase_no_step_split_certifies_nothing():
     """certify on a stand-in kernel: safe runs clear of the saddle at levels 0 and 1
     (margins 0.0055 and 0.0047 alpha_ref at PAR_CLOSE 0.1, settled and clear, as seed 37's):
@@ -1045,27 +1053,15 @@ def test_a_safe_run_s_agreement_over_a_phase_no_step_split_certifies_nothing():
     goes on to level 2 (where its steps split it), one whose longest such phase was 0.4 of
     its step is kept at level 1, and so is one that took such a phase but passed the
     saddle beyond its band (0.05 alpha_ref, PAR_CLOSE 0.0177 at level 1)."""
-    ladder = {0: [(0.0055, 0.7), (0.0047, 0.9), (0.0047, 0.3)],
-              1: [(0.0055, 0.7), (0.0047, 0.4), (0.0047, 0.4)],
-              2: [(0.0100, 0.7), (0.0500, 0.9), (0.0500, 0.9)]}
+    safe = L.OUTCOME_SAFE, np.nan
+    # (outcome, overturning time, margin, OUT_UNSPLIT) of each row at levels 0, 1, 2
+    ladder = {0: [(*safe, 0.0055, 0.7), (*safe, 0.0047, 0.9), (*safe, 0.0047, 0.3)],
+              1: [(*safe, 0.0055, 0.7), (*safe, 0.0047, 0.4), (*safe, 0.0047, 0.4)],
+              2: [(*safe, 0.0100, 0.7), (*safe, 0.0500, 0.9), (*safe, 0.0500, 0.9)]}
     rows = np.zeros((3, L.N_PAR))
     rows[:, L.PAR_CLOSE] = 0.1
     rows[:, L.PAR_DT] = 1.0
-    outs = _stand_in(3)
-    for i in ladder:
-        outs[i, [L.OUT_MARGIN, L.OUT_UNSPLIT]] = ladder[i][0]
-    levels_run = {i: [] for i in ladder}
-
-    def run(sub, idx, keep=True):
-        res = _stand_in(len(idx))
-        level = round(-np.log2(sub[0, L.PAR_DT]))
-        for j, i in enumerate(idx):
-            levels_run[int(i)].append(level)
-            res[j, [L.OUT_MARGIN, L.OUT_UNSPLIT]] = ladder[int(i)][level]
-        res[:, L.OUT_T_OVERTURN] = np.nan
-        return res
-
-    certify(rows, outs, run, 3)
+    outs, levels_run = _run_ladder(rows, ladder, 3, UNSPLIT_SLOTS)
     assert levels_run == {0: [1, 2], 1: [1], 2: [1]}
     assert (outs[:, L.OUT_OUTCOME] == L.OUTCOME_SAFE).all()
 
@@ -1079,29 +1075,11 @@ def test_converged_margins_do_not_certify_a_run_with_a_phase_no_step_split():
     rows = np.zeros((2, L.N_PAR))
     rows[:, L.PAR_CLOSE] = 0.1
     rows[:, L.PAR_DT] = 1.0
-    # (margin, OUT_UNSPLIT) of each row at levels 0, 1, 2
-    ladder = {0: [(0.0150, 0.6), (0.0152, 0.99), (0.0152, 0.3)],
-              1: [(0.0150, 0.6), (0.0152, 0.3), (0.0152, 0.3)]}
-
-    def fill(res, j, i, level):
-        res[j, L.OUT_OUTCOME] = L.OUTCOME_MODE1
-        res[j, L.OUT_T_OVERTURN] = 5.0
-        res[j, [L.OUT_MARGIN, L.OUT_UNSPLIT]] = ladder[i][level]
-
-    outs = _stand_in(2)
-    for i in ladder:
-        fill(outs, i, i, 0)
-    levels_run = {i: [] for i in ladder}
-
-    def run(sub, idx, keep=True):
-        res = _stand_in(len(idx))
-        level = round(-np.log2(sub[0, L.PAR_DT]))
-        for j, i in enumerate(idx):
-            levels_run[int(i)].append(level)
-            fill(res, j, int(i), level)
-        return res
-
-    certify(rows, outs, run, 3)
+    fell = L.OUTCOME_MODE1, 5.0
+    # (outcome, overturning time, margin, OUT_UNSPLIT) of each row at levels 0, 1, 2
+    ladder = {0: [(*fell, 0.0150, 0.6), (*fell, 0.0152, 0.99), (*fell, 0.0152, 0.3)],
+              1: [(*fell, 0.0150, 0.6), (*fell, 0.0152, 0.3), (*fell, 0.0152, 0.3)]}
+    outs, levels_run = _run_ladder(rows, ladder, 3, UNSPLIT_SLOTS)
     assert levels_run == {0: [1, 2], 1: [1]}
     status = outs[:, L.OUT_STATUS].astype(np.int64)
     assert not (status & L.STATUS_UNCERTIFIED).any()
