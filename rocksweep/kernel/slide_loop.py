@@ -171,6 +171,15 @@ N_SLOTS = 4
 # the least positive float64: a stuck contact exactly on its cone's edge still holds
 # (``choose_phase``), so its margin 0 counts as not crossed
 EDGE = 5e-324
+# A slide-rock step whose normal force N moved by more than N_JUMP x max(M g, |N| at its
+# start) is taken again a quarter as long, up to N_RETRIES times (``_painleve_step``,
+# ``_shorter``): near a Painleve point (den -> 0) the slip's accelerations grow as 1/den,
+# and one fixed step through it (threshold seed 5 at mu 0.62, 5 steps a period: den
+# 0.0135 -> 0.0050, N 0.85 -> -710 M g, theta' -0.48 -> 3.7 rad/s) flung the body over in
+# mode 2 where finer steps rock to rest or fall in mode 1 (docs/sliding.md, "Near
+# thresholds"). A smooth step moves N by ~0.1 M g at 5 steps a period.
+N_JUMP = 0.5
+N_RETRIES = 8
 
 
 @njit(cache=True, **INTERNAL)
@@ -188,6 +197,7 @@ def simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     h_rec = prm[PAR_REC_H] if records else 0.0
     t_air = prm[PAR_T_AIR] if vertical else math.inf
     mu, mu_s = prm[PAR_MU], prm[PAR_MU_STATIC]
+    jump = N_JUMP * prm[PAR_MTOT] * prm[PAR_G]  # ``_painleve_step``'s least [N]
     on = 0.0 < t_pulse
     _reset(out)
     y = (prm[PAR_THETA0], prm[PAR_THETA_DOT0], prm[PAR_U0], prm[PAR_U_DOT0], 0.0, 0.0, 0.0,
@@ -200,8 +210,7 @@ def simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
     steps, event_steps, switches = 0, 0, 0
     theta_max = abs(y[Y_THETA])
     slide_max = 0.0
-    rot = prm[PAR_ROT_STEP]
-    acc = 0.0
+    rot, acc = prm[PAR_ROT_STEP], 0.0
     margin = np.inf
     graze = np.inf  # OUT_GRAZE (``loop._graze``)
     t_close = np.nan
@@ -262,10 +271,14 @@ def simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
                 steps += 1
                 turn = abs(y1[Y_THETA] - y[Y_THETA])
             acc = abs(y1[Y_THETA_DOT] - y[Y_THETA_DOT]) / h
+        ev1 = _event_values(t + h, y1, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED, GROUND)
+        if s != 0 and sigma != 0 and _painleve_step(ev0, ev1, jump):
+            h, y1, ev1, more = _shorter(t, y, h, k1, ev0, jump, s, sigma, on, mu, mu_s, prm,
+                                        FLEX, DAMPED, ENERGY, GROUND)
+            steps, lands, air = steps + more, False, False
         if not _finite(y1):
             _flag(out, STATUS_NONFINITE)
             break
-        ev1 = _event_values(t + h, y1, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED, GROUND)
         slot, tau, y_ev, n = _first_event(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s,
                                           prm, FLEX, DAMPED, ENERGY, GROUND)
         event_steps += n
@@ -369,6 +382,30 @@ def point_entry(FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
 # ----------------------------------------------------------------------------------------
 # Steps
 # ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True, **INLINE)
+def _painleve_step(ev0, ev1, jump):
+    """A slide-rock step whose normal force N (slot 4) moved by more than ``jump`` [N] or
+    N_JUMP of its own size at the step's start, whichever is larger."""
+    return abs(ev1[4] - ev0[4]) > max(jump, N_JUMP * abs(ev0[4]))
+
+
+@njit(cache=True, **INTERNAL)
+def _shorter(t, y, h, k1, ev0, jump, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED, ENERGY,
+             GROUND):
+    """A slide-rock step of h [s] from (t, y) (first stage k1, event values ev0 at its
+    start) that ``_painleve_step`` refused, taken again a quarter as long until it
+    passes, at most N_RETRIES times (or the state is not finite).
+    Returns (h, y1, its event values, the RK4 evaluations taken)."""
+    more = 0
+    while True:
+        h *= 0.25
+        y1 = _rk4(t, y, h, k1, s, sigma, on, mu, prm, FLEX, DAMPED, ENERGY, GROUND)
+        ev1 = _event_values(t + h, y1, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED, GROUND)
+        more += 1
+        if not _painleve_step(ev0, ev1, jump) or more >= N_RETRIES or not _finite(y1):
+            return h, y1, ev1, more
 
 
 @njit(cache=True, **INLINE)

@@ -199,3 +199,24 @@ def test_an_impact_before_a_slip_stop_in_the_same_step_is_taken_first():
     assert s["theta_max_over_alpha"] * body.alpha_cg == pytest.approx(ref["theta_max"],
                                                                     rel=1e-3)
     assert s["slide_max"] * body.b < 1e-4  # the reference's slip: 1.9e-5 m
+
+
+def test_a_slide_rock_step_past_a_painleve_point_is_taken_again_shorter():
+    """Threshold seed 5 at mu 0.62 (``scripts/threshold_sample.py --mu 0.15 1.5``): during
+    the pulse the body slide-rocks near a Painleve point (den -> 0, the slip's
+    accelerations ~ 1/den). One `default` step took den from 0.0135 to 0.0050 and N from
+    0.85 to -710 M g: the corner was held (`lifts_off`) and the body fell in mode 2 at 1.5
+    p t, at 5 and 10 steps a period alike. Retaken shorter where N jumps (``slide_loop.
+    _shorter``), the uncertified run at `default` rocks on as the reference does and falls
+    in mode 1 after one impact at 11.4 p t."""
+    body = FlexibleBody(wn_over_p=7.2810467651018245, zeta=0.0755017452978083,
+                        alpha_cg=0.2934390141263994, alpha_A=0.1591144161454679,
+                        mA_over_m=0.5188305568649272, IA_ratio=0.304432527370192)
+    pt = Point(body, 0.2913956357360759, "sine", 3.1138079302773445, 3.73904849352834,
+               mu=0.6183334894742714)
+    ref = sliding_reference(pt)
+    assert not ref["status"]  # decided: no cap, no lift-off
+    s = run_point(pt, replace(DEFAULT, refine=0)).summary()
+    assert OUTCOME_CODE[s["outcome"]] == ref["outcome"] == OUTCOME_CODE["mode1"]
+    assert s["impacts"] == ref["impacts"] and "lifts_off" not in s["status"]
+    assert s["t_overturn"] == pytest.approx(ref["t_overturn"], abs=0.05)
