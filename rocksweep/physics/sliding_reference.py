@@ -142,10 +142,14 @@ class _Phase:
             ix = free.index(_X)
             a[ix] += self.mu * sigma * n[free]
             rhs[ix] -= self.mu * sigma * n0
-            den = float(np.linalg.det(a) / np.linalg.det(mass[np.ix_(free, free)]))
+            with np.errstate(invalid="ignore"):  # a rejected stage's NaN state
+                den = float(np.linalg.det(a) / np.linalg.det(mass[np.ix_(free, free)]))
         qdd = np.zeros(3)
         if free:
-            qdd[free] = np.linalg.solve(a, rhs)
+            try:
+                qdd[free] = np.linalg.solve(a, rhs)
+            except np.linalg.LinAlgError:  # den = 0 exactly (a Painleve point): no finite
+                qdd[free] = np.nan  # accelerations; DOP853 rejects the step and shortens it
         big_n = float(n @ qdd + n0)
         force = float(hx @ qdd + h0)
         moment = float(mass[_TH] @ qdd - f[_TH]) if s == 0 else 0.0

@@ -5,6 +5,7 @@ balance. Few points: the reference is slow (0.2-3 s a run)."""
 
 import math
 
+import numpy as np
 import pytest
 from bodies import BODY3
 
@@ -93,3 +94,28 @@ def test_a_run_past_its_evaluation_budget_stops_flagged(monkeypatch):
     r = sliding_reference(pt)
     assert "step_cap" in r["status"] and r["outcome"] == L.OUTCOME_SAFE
     assert int(sr.result_row(r)[L.OUT_STATUS]) & L.STATUS_FLAGGED
+
+
+def test_a_stage_exactly_at_a_painleve_point_is_rejected_not_raised(monkeypatch):
+    """A DOP853 stage that lands exactly on a Painleve point (den = 0: the slip's system
+    singular) gives NaN accelerations, which DOP853 rejects and retries shorter, instead of
+    numpy's LinAlgError ending the reference with a traceback (threshold seed 13 at mu
+    1.19, ``scripts/threshold_sample.py --mu``). Here one solve of a pure sliding run is
+    made singular: the run ends as without it."""
+    from rocksweep.physics import sliding_reference as sr
+
+    pt = Point(BlockBody(alpha=0.3), 0.0, "sine", 2.0, 1.5, mu=0.2)
+    plain = sliding_reference(pt)
+    solve, calls = np.linalg.solve, [0]
+
+    def singular_once(a, b):
+        calls[0] += 1
+        if calls[0] == 60:
+            raise np.linalg.LinAlgError("Singular matrix")
+        return solve(a, b)
+
+    monkeypatch.setattr(sr.np.linalg, "solve", singular_once)
+    r = sliding_reference(pt)
+    assert calls[0] > 60
+    assert r["outcome"] == plain["outcome"] and r["status"] == plain["status"]
+    assert r["slide_max"] == pytest.approx(plain["slide_max"], rel=1e-6)
