@@ -20,7 +20,7 @@ percent, ``scripts/fingerprint.py diff``).
 ``--mu LO HI`` gives every body a base that may slide (docs/sliding.md), with mu drawn
 log-uniformly in [LO, HI] per body after its other draws (without it the draws are the
 no-slip samples' own): the kernel's sliding variants, and the sliding reference
-(``physics.sliding_reference``, ~0.5-1.2 s a point) where `default` and `fine` differ.
+(``physics.sliding_reference``, 0.5-40 s a point) where `default` and `fine` differ.
 
 The third form measures another checkout's package (an older certification) on the same
 points (``scripts/_here.py``).
