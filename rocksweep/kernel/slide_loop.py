@@ -257,8 +257,7 @@ def simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
             _flag(out, STATUS_EVENT_CAP)
             break
         h, lands = _step_length(t, on, dt, dt_on, t_pulse, t_end, h_rec)
-        if sigma != 0 and h > SLIP_STEP * (dt_on if on else dt):  # the base slips
-            h, lands = SLIP_STEP * (dt_on if on else dt), False
+        h, lands = _slip_step(h, lands, sigma, on, dt, dt_on)
         air = vertical and t + h >= t_air
         if air:
             h, lands = t_air - t, False
@@ -388,6 +387,17 @@ def point_entry(FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
 # ----------------------------------------------------------------------------------------
 # Steps
 # ----------------------------------------------------------------------------------------
+
+
+@njit(cache=True, **INLINE)
+def _slip_step(h, lands, sigma, on, dt, dt_on):
+    """(h [s], lands): the step, at most SLIP_STEP of the step then in effect (dt_on while
+    the ground moves, dt after) while the base slips (sigma != 0); a shortened step no
+    longer lands on the pulse's end (the next one does)."""
+    cap = SLIP_STEP * (dt_on if on else dt)
+    if sigma != 0 and h > cap:
+        return cap, False
+    return h, lands
 
 
 @njit(cache=True, **INLINE)
