@@ -18,6 +18,8 @@ scipy's DOP853 at rtol 1e-10 with located events).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from bodies import BODY3
@@ -48,7 +50,7 @@ from rocksweep.numerics import (
     Numerics,
 )
 from rocksweep.physics.bodies import BlockBody, FlexibleBody
-from rocksweep.physics.points import Point, kernel_kind, point_row
+from rocksweep.physics.points import Point, kernel_contact, kernel_kind, point_row
 from rocksweep.physics.reference import reference_run
 from rocksweep.scene.parse import parse_scene
 
@@ -928,28 +930,31 @@ def test_a_run_that_grazed_an_impact_while_the_ground_moved_is_a_close_call():
     assert not st[3] & L.STATUS_REFINED and not st[4] & L.STATUS_REFINED
 
 
-def test_the_first_impacts_depth_is_its_speed_squared():
+@pytest.mark.parametrize("mu", [math.nan, 5.0])
+def test_the_first_impacts_depth_is_its_speed_squared(mu):
     """The kernel's OUT_MODE_GRAZE of a rigid block released at rest from theta0 with no
     ground motion: its first impact comes at the speed energy conservation gives,
     theta'^2 / 2 = cos(alpha - theta0) - cos(alpha) (p t units), so the mode graze, (theta' /
     alpha)^2 / 2, is (cos(alpha - theta0) - cos(alpha)) / alpha^2 (before it the rocking
     only falls toward theta = 0: no dip). At 80 steps a period (four refinements) the run
-    gives it to 1e-6; at 5, within 3%."""
+    gives it to 1e-6; at 5, within 3%. The same on a base that may slide, where friction
+    (mu 5) holds the corner: the sliding base's loop keeps the mode graze too."""
     alpha = 0.2
     body = BlockBody(alpha=alpha, inertia=4.0 / 3.0)
-    row = point_row(Point(body, 0.0, "sine", 1.0, 1.0), Numerics.preset("default"))[None, :]
+    pt = Point(body, 0.0, "sine", 1.0, 1.0, mu=mu)
+    row = point_row(pt, Numerics.preset("default"))[None, :]
     row = row.copy()
     row[0, L.PAR_TPULSE] = 0.0  # no ground motion
     row[0, L.PAR_TO_REST] = 1.0  # on to the impact (a still block is decided at once)
-    kind = kernel_kind(body)
-    warm_up(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)
+    kind, contact = kernel_kind(body), kernel_contact(mu)
+    warm_up(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE, contact)
     for theta0 in (0.02, 0.1, 0.15):
         row[0, L.PAR_THETA0] = theta0
         want = (np.cos(alpha - theta0) - np.cos(alpha)) / alpha**2
         for level, rel in ((0, 0.03), (4, 1e-6)):
             out = np.empty((1, L.N_OUT))
             r = np.ascontiguousarray(refined_rows(row, level) if level else row)
-            chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)(r, out)
+            chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE, contact)(r, out)
             assert out[0, L.OUT_IMPACTS] >= 1
             assert out[0, L.OUT_MODE_GRAZE] == pytest.approx(want, rel=rel)
 
@@ -990,27 +995,31 @@ def test_a_mode_2_that_nearly_uplifted_before_is_a_close_call():
     assert not (st[1:] & L.STATUS_REFINED).any()
 
 
-def test_a_blocks_least_uplift_gap_is_one_less_its_amplitude_ratio():
+@pytest.mark.parametrize("mu", [math.nan, 5.0])
+def test_a_blocks_least_uplift_gap_is_one_less_its_amplitude_ratio(mu):
     """The kernel's OUT_LIFT_GRAZE of a rigid block on the ground under a sine pulse too
     weak to uplift it (A_ratio < 1): in full contact the uplift function is M g b - s M
     a_g h_cg, so its least value over the pulse, over M g b, is 1 - A_ratio (A = A_ratio
     g tan alpha, tan alpha = b / h_cg), reached at the pulse's peaks, inside steps. At 5
     steps a period the step's cubic gives it to 1e-3 of M g b, at 80 to 1e-8. With
-    A_ratio > 1 the block uplifts and no dip is kept (inf)."""
+    A_ratio > 1 the block uplifts and no dip is kept (inf). The same on a base that may
+    slide where friction (mu 5) holds it: its loop screens the rest phase's uplift
+    functions inside a step as the no-slip loop does (``slide_events._lift_dip``)."""
     body = BlockBody(alpha=0.2, inertia=4.0 / 3.0)
-    kind = kernel_kind(body)
-    warm_up(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)
+    kind, contact = kernel_kind(body), kernel_contact(mu)
+    warm_up(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE, contact)
     for a_ratio in (0.3, 0.9, 0.999):
-        row = point_row(Point(body, 0.0, "sine", 3.0, a_ratio), Numerics.preset("default"))
+        row = point_row(Point(body, 0.0, "sine", 3.0, a_ratio, mu=mu),
+                        Numerics.preset("default"))
         for level, tol in ((0, 1e-3), (4, 1e-8)):
             out = np.empty((1, L.N_OUT))
             r = np.ascontiguousarray(refined_rows(row[None, :], level))
-            chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)(r, out)
+            chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE, contact)(r, out)
             assert out[0, L.OUT_UPLIFTS] == 0
             assert abs(out[0, L.OUT_LIFT_GRAZE] - (1.0 - a_ratio)) < tol
-    row = point_row(Point(body, 0.0, "sine", 3.0, 1.5), Numerics.preset("default"))
+    row = point_row(Point(body, 0.0, "sine", 3.0, 1.5, mu=mu), Numerics.preset("default"))
     out = np.empty((1, L.N_OUT))
-    chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)(row[None, :].copy(), out)
+    chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE, contact)(row[None, :].copy(), out)
     assert out[0, L.OUT_UPLIFTS] >= 1 and out[0, L.OUT_LIFT_GRAZE] == np.inf
 
 

@@ -241,3 +241,25 @@ def test_a_block_slipping_near_its_tipping_point_takes_half_steps(A_ratio, expec
     s = run_point(pt, replace(DEFAULT, refine=0)).summary()
     assert s["outcome"] == expected
     assert abs(s["impacts"] - ref["impacts"]) <= 2
+
+
+def test_an_uplift_inside_a_step_at_rest_is_found():
+    """Threshold seed 28 at mu 0.30 (``scripts/threshold_sample.py --mu 0.15 1.5``): at rest
+    during a cosine, the body's uplift moment crosses M g b inside one `default` step and
+    turns back before its end. Finer runs and the reference uplift there by a hair, make 6
+    impacts, settle, uplift again and fall in mode 1 at 6.04 p t; the run that saw only
+    the step's ends fell in mode 2 at the same time. The rest phase's uplift functions are
+    now screened inside the step with their cubic Hermite interpolant (``slide_events.
+    _lift_dip``, the no-slip model's ``events._crossing``): the uncertified run at
+    `default` takes the reference's class and impacts."""
+    body = FlexibleBody(wn_over_p=1.6913321929354148, zeta=0.1443916261018191,
+                        alpha_cg=0.22951701006243408, alpha_A=0.4377970517320052,
+                        mA_over_m=1.5123255436071759, IA_ratio=0.5981090617798844)
+    pt = Point(body, 0.3176354063133086, "cosine", 1.7000503872414043, 1.4560670531549458,
+               mu=0.3011832404399563)
+    ref = sliding_reference(pt)
+    assert not ref["status"] and ref["outcome"] == OUTCOME_CODE["mode1"]
+    s = run_point(pt, replace(DEFAULT, refine=0)).summary()
+    assert s["outcome"] == "mode1" and s["impacts"] == ref["impacts"] == 6
+    assert s["t_overturn"] == pytest.approx(ref["t_overturn"], abs=0.01)
+
