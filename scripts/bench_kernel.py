@@ -430,7 +430,8 @@ def main() -> None:
     args = ap.parse_args()
     if args.tiny:
         args.n, args.ref_points, args.mix_points = 6, 4, 8
-        args.roof_steps, args.repeat, args.four_n, args.eff_n = 20_000, 1, 4, 8
+        # one grid size in [4] (eff_n = n) and one warm start in [6]: a smoke run
+        args.roof_steps, args.repeat, args.four_n, args.eff_n = 20_000, 1, 4, 6
     four_n = 200 if args.paper else args.four_n
     seed = 0
 
@@ -594,9 +595,9 @@ def main() -> None:
     # --- 6 -------------------------------------------------------------------------------
     cmd = [*_rocksweep(), "simulate", str(CONFIGS / "fig2.yaml")]
     run_timed(cmd)  # fills numba's cache for the single-run variant if needed
-    warm = min(run_timed(cmd)[0] for _ in range(3))
+    warm = min(run_timed(cmd)[0] for _ in range(max(1, args.repeat)))
     print(f"\n[6] warm start: `rocksweep simulate configs/fig2.yaml` {warm:.2f} s "
-          "(best of 3, numba cache filled)")
+          f"(best of {max(1, args.repeat)}, numba cache filled)")
 
     if args.million:
         overrides = ["pulse.w_over_p.num=708", "pulse.A_ratio.num=707"]

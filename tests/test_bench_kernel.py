@@ -54,8 +54,8 @@ def test_tiny_run_prints_every_section():
     rows2b = [ln for ln in lines[start["[2b]"]:start["[3]"]] if re.match(r"fig\w+\s+[a-z]", ln)]
     rows3 = [ln for ln in lines[start["[3]"]:start["[4]"]] if re.match(r"fig\w+\s+\d", ln)]
     rows4 = [ln for ln in lines[start["[4]"]:start["[5]"]] if re.match(r"fig\w+\s+\d", ln)]
-    # [4]: two grid sizes (the scene's and --eff-n) x jobs 1, 2 per scene
-    assert len(rows2) == 2 and len(rows3) == 2 and len(rows4) == 8
+    # [4]: the grid sizes (the scene's and --eff-n: one size in --tiny) x jobs 1, 2 per scene
+    assert len(rows2) == 2 and len(rows3) == 2 and len(rows4) == 4
     # [2b]: three root finders per scene, bisection's speed-up over itself is 1
     assert [ln.split()[1] for ln in rows2b] == ["bisection", "illinois", "hermite"] * 2
     assert all(_numbers(ln)[-2] == 1.0 for ln in rows2b if " bisection " in ln)
