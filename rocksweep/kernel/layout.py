@@ -156,15 +156,14 @@ OUT_GRAZE = 29  # closest a rocking arc came to an impact it did not make while 
 OUT_MODE_GRAZE = 30  # how near the run came to the other mode [alpha_ref]: without an
 #                 impact, the least dip of s theta toward 0 (as OUT_GRAZE, at any time);
 #                 with impacts, the deepest one's depth, (theta'/alpha_ref)^2 / 2 at it
-#                 (a finer run that missed them all would fall in mode 2). inf: no dip;
-#                 a base that slides takes none
+#                 (a finer run that missed them all would fall in mode 2). inf: no dip
 OUT_LIFT_GRAZE = 31  # how near the body came to uplifting before its first uplift, in full
 #                 contact: the least minimum of the uplift function M g b - s Q inside a
 #                 step where it fell and rose again without reaching 0 (the step's cubic
-#                 Hermite interpolant, as OUT_GRAZE), over M g b at PAR_G. inf: no such
-#                 dip; a base that slides takes none. A mode 2 that came this near an
-#                 earlier uplift hangs on it: a finer run may uplift by a hair there and
-#                 impact, and fall in mode 1 (``rocksweep.compute.certify.mode_close``)
+#                 Hermite interpolant, as OUT_GRAZE), over M g b at PAR_G (a base that
+#                 slides: at rest only, stuck and flat). inf: no such dip. A mode 2 that
+#                 came this near an earlier uplift hangs on it: a finer run may uplift by a
+#                 hair there and impact, and fall in mode 1 (``certify.mode_close``)
 OUT_UNSPLIT = 32  # the longest phase (event to event) that ended inside the first step
 #                   after its start, over the step then in effect (dt_on while the ground
 #                   moves, dt after), among those before the run's last approach within
