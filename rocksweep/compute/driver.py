@@ -249,6 +249,9 @@ def every_point_loop(sf, report: SweepReport, _options: None, *, jobs: int, back
     def write_pending() -> None:
         for merged in sw.merge_contiguous(pending):
             sf.write(merged)
+            # counted once written: the interrupt's message says what the file holds (a
+            # Ctrl-C between a chunk's arrival and its count had it written, not counted)
+            report.computed += merged.stop - merged.start
         pending.clear()
 
     try:
@@ -272,7 +275,6 @@ def every_point_loop(sf, report: SweepReport, _options: None, *, jobs: int, back
                 report.cpu_s += res.cpu_seconds
                 if res.refine_evaluations is not None:
                     report.refine_evaluations += int(res.refine_evaluations.sum())
-                report.computed += res.stop - res.start
                 bar.update(res.stop - res.start)
                 raise_pending()  # this chunk is kept: written on the way out
                 if time.perf_counter() - t_write >= write_every:
@@ -337,6 +339,7 @@ def adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backe
                   for k in pending[0].arrays}
         flags = np.concatenate(pending_flags)[order]
         sf.write_points(flat[order], arrays, flags)
+        report.computed += len(flat)  # once written (``every_point_loop``'s)
         pending.clear()
         pending_flags.clear()
 
@@ -371,7 +374,6 @@ def adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backe
                 pending_flags.append(flags)
                 report.cpu_s += res.cpu_seconds
                 report.refine_evaluations += res.refine_total
-                report.computed += len(res.flat)
                 bar.update(len(res.flat))
                 raise_pending()  # this chunk is kept: written on the way out
                 if time.perf_counter() - t_write >= write_every:
