@@ -256,9 +256,10 @@ def _search(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED
     """The first event of the step (t, y) -> (t + h, y1): (slot, tau, y(tau), trials);
     slot -1, h, y1 if none. ev0, ev1: the event values at both ends. Every slot that
     changed sign is located, the earliest kept; an impact right after theta = 0 (the
-    motion turning straight back), and one that dips through theta = 0 and back inside
-    the step (a grazing one), is screened with theta's cubic Hermite
-    interpolant and checked on a fresh step to its minimum."""
+    motion turning straight back) too. One that dips through theta = 0 and back inside
+    the step (a grazing one), and at rest an uplift moment that peaks past M g b inside
+    it (``_lift_dip``), are screened with the function's cubic Hermite interpolant and
+    checked on a fresh step to its minimum."""
     literally(FLEX)
     literally(DAMPED)
     literally(ENERGY)

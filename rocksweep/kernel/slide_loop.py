@@ -333,19 +333,22 @@ def simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
                                   ENERGY, GROUND)
         ev0 = _event_values(t, y, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED, GROUND)
         _record(hist, t, y, s, sigma, on, prm, out, FLEX, GROUND)
-    _finish(t, y, s, steps, event_steps, theta_max, slide_max, (margin, t_close, graze, dip,
-                                                               lift), prm, out, FLEX, ENERGY)
+    _finish(t, y, s, steps, event_steps, theta_max, slide_max,
+            (margin, t_close, graze, dip, lift), prm, out, FLEX, ENERGY)
 
 
 @njit(cache=True, **INLINE)
-def _finish(t, y, s, steps, event_steps, theta_max, slide_max, near, prm, out, FLEX, ENERGY):
+def _finish(t, y, s, steps, event_steps, theta_max, slide_max, nearness, prm, out, FLEX,
+            ENERGY):
     """The result row's last entries: end time, step counts, theta_max, the slide, how
-    near the run came to the other class (near: OUT_MARGIN, OUT_T_CLOSE, OUT_GRAZE, the dip
-    before an impact and the uplift moment's before the first uplift, as the no-slip
-    loop's), the energy accounting (NaN without) and the no-slip demand's slots (NaN)."""
-    out[OUT_MARGIN], out[OUT_T_CLOSE], out[OUT_GRAZE] = near[0], near[1], near[2]
-    out[OUT_MODE_GRAZE] = near[3] if out[OUT_IMPACTS] == 0.0 else out[OUT_MODE_GRAZE]
-    out[OUT_LIFT_GRAZE] = near[4] / tip_moment(prm[PAR_G], prm)
+    near the run came to the other class (nearness: OUT_MARGIN, OUT_T_CLOSE, OUT_GRAZE, the
+    dip before an impact and the uplift function's least value before the first uplift
+    [N m], as the no-slip loop's), the energy accounting (NaN without) and the no-slip
+    demand's slots (NaN)."""
+    margin, t_close, graze, dip, lift = nearness
+    out[OUT_MARGIN], out[OUT_T_CLOSE], out[OUT_GRAZE] = margin, t_close, graze
+    out[OUT_MODE_GRAZE] = dip if out[OUT_IMPACTS] == 0.0 else out[OUT_MODE_GRAZE]
+    out[OUT_LIFT_GRAZE] = lift / tip_moment(prm[PAR_G], prm)
     out[OUT_T_END] = t
     out[OUT_STEPS] = steps
     out[OUT_EVENT_STEPS] = event_steps
