@@ -196,16 +196,17 @@ def _first_event(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm, FLEX, D
             maybe = True
     if s != 0 and ev0[0] > 0.0 and s * y[Y_THETA_DOT] < 0.0 < s * y1[Y_THETA_DOT]:
         maybe = True  # theta turned back toward 0 inside the step: a dip to screen
-    low = np.inf
+    dip = (-1, h, np.inf)  # (slot, tau, g_min): ``_lift_dip``'s, at rest
     if s == 0 and sigma == 0:
-        lift, _, low = _lift_dip(t, y, y1, h, ev0, ev1, on, prm, FLEX, DAMPED, GROUND)
+        dip = _lift_dip(t, y, y1, h, ev0, ev1, on, prm, FLEX, DAMPED, GROUND)
+        lift, low = dip[0], dip[2]
         if lift >= 0 and not low > min(ev0[lift], ev1[lift]) - low:
             maybe = True  # an uplift moment that peaked inside the step near M g b
     if not maybe:
-        return -1, h, y1, 0, low
-    slot, tau, y_ev, n = _search(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm,
-                                 FLEX, DAMPED, ENERGY, GROUND)
-    return slot, tau, y_ev, n, max(low, 0.0)
+        return -1, h, y1, 0, dip[2]
+    slot, tau, y_ev, n = _search(t, y, k1, y1, h, ev0, ev1, dip, s, sigma, on, mu, mu_s,
+                                 prm, FLEX, DAMPED, ENERGY, GROUND)
+    return slot, tau, y_ev, n, max(dip[2], 0.0)
 
 
 @njit(cache=True, **INLINE)
@@ -251,10 +252,11 @@ def _slip_turned(slot, sigma, g0, g1):
 
 
 @njit(cache=True, **INTERNAL)
-def _search(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED, ENERGY,
-            GROUND):
+def _search(t, y, k1, y1, h, ev0, ev1, dip, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED,
+            ENERGY, GROUND):
     """The first event of the step (t, y) -> (t + h, y1): (slot, tau, y(tau), trials);
-    slot -1, h, y1 if none. ev0, ev1: the event values at both ends. Every slot that
+    slot -1, h, y1 if none. ev0, ev1: the event values at both ends; dip: ``_lift_dip``'s
+    (slot, tau, g_min) at rest (slot -1 elsewhere). Every slot that
     changed sign is located, the earliest kept; an impact right after theta = 0 (the
     motion turning straight back) too. One that dips through theta = 0 and back inside
     the step (a grazing one), and at rest an uplift moment that peaks past M g b inside
@@ -281,11 +283,8 @@ def _search(t, y, k1, y1, h, ev0, ev1, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED
                 if not (d0 < 0.0 < d1):
                     continue
                 tm, g_min = hermite_min(g0, d0, g1, d1, h)
-            elif s == 0 and sigma == 0:
-                lift, tm, g_min = _lift_dip(t, y, y1, h, ev0, ev1, on, prm, FLEX, DAMPED,
-                                            GROUND)
-                if lift != slot:
-                    continue
+            elif dip[0] == slot:
+                tm, g_min = dip[1], dip[2]
             else:
                 continue
             if g_min > min(g0, g1) - g_min or not 0.0 < tm < h:

@@ -46,6 +46,14 @@ def _fig5(*sets: str) -> Point:
     return sc.single_point()
 
 
+def _uncertified_and_reference(pt: Point) -> tuple[dict, dict]:
+    """(the uncertified `default` run's summary, the sliding reference's result) of a
+    threshold sample's point, the reference decided (no cap, no lift-off)."""
+    ref = sliding_reference(pt)
+    assert not ref["status"]
+    return run_point(pt, replace(DEFAULT, refine=0)).summary(), ref
+
+
 @pytest.mark.parametrize("body", ["flexible", "block"])
 def test_ample_friction_is_the_no_slip_model(body):
     """mu = 10 on a point whose base never needs it: the no-slip model's outcome, impacts
@@ -214,9 +222,7 @@ def test_a_slide_rock_step_past_a_painleve_point_is_taken_again_shorter():
                         mA_over_m=0.5188305568649272, IA_ratio=0.304432527370192)
     pt = Point(body, 0.2913956357360759, "sine", 3.1138079302773445, 3.73904849352834,
                mu=0.6183334894742714)
-    ref = sliding_reference(pt)
-    assert not ref["status"]  # decided: no cap, no lift-off
-    s = run_point(pt, replace(DEFAULT, refine=0)).summary()
+    s, ref = _uncertified_and_reference(pt)
     assert OUTCOME_CODE[s["outcome"]] == ref["outcome"] == OUTCOME_CODE["mode1"]
     assert s["impacts"] == ref["impacts"] and "lifts_off" not in s["status"]
     # on the same approach (the fall near the saddle: the coarse step's least accurate
@@ -236,10 +242,8 @@ def test_a_block_slipping_near_its_tipping_point_takes_half_steps(A_ratio, expec
     `default` takes the reference's class, with its impacts."""
     pt = Point(BlockBody(alpha=0.24848521746135252, inertia=4.0 / 3.0), 0.48693205265718686,
                "cosine", 1.3883556364126837, A_ratio, mu=0.26438999715309713)
-    ref = sliding_reference(pt)
-    assert not ref["status"] and ref["outcome"] == OUTCOME_CODE[expected]
-    s = run_point(pt, replace(DEFAULT, refine=0)).summary()
-    assert s["outcome"] == expected
+    s, ref = _uncertified_and_reference(pt)
+    assert ref["outcome"] == OUTCOME_CODE[expected] and s["outcome"] == expected
     assert abs(s["impacts"] - ref["impacts"]) <= 2
 
 
@@ -257,9 +261,8 @@ def test_an_uplift_inside_a_step_at_rest_is_found():
                         mA_over_m=1.5123255436071759, IA_ratio=0.5981090617798844)
     pt = Point(body, 0.3176354063133086, "cosine", 1.7000503872414043, 1.4560670531549458,
                mu=0.3011832404399563)
-    ref = sliding_reference(pt)
-    assert not ref["status"] and ref["outcome"] == OUTCOME_CODE["mode1"]
-    s = run_point(pt, replace(DEFAULT, refine=0)).summary()
-    assert s["outcome"] == "mode1" and s["impacts"] == ref["impacts"] == 6
+    s, ref = _uncertified_and_reference(pt)
+    assert ref["outcome"] == OUTCOME_CODE["mode1"] and s["outcome"] == "mode1"
+    assert s["impacts"] == ref["impacts"] == 6
     assert s["t_overturn"] == pytest.approx(ref["t_overturn"], abs=0.01)
 
