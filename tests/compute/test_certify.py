@@ -48,6 +48,7 @@ from rocksweep.numerics import (
     SAME_FALL,
     UNSPLIT_SHARE,
     Numerics,
+    close_band,
 )
 from rocksweep.physics.bodies import BlockBody, FlexibleBody
 from rocksweep.physics.points import Point, kernel_contact, kernel_kind, point_row
@@ -282,6 +283,14 @@ CASES = [
                         mA_over_m=1.9815800204068397, IA_ratio=0.5792516804898262),
            0.47784499636566097, "sine", 8.472913494896671, 13.255574397855478),
      L.OUTCOME_MODE1),
+    # just outside the near-miss band of 8 x the close-call margin (fresh seed 208): safe
+    # at 5 steps a period with margin 0.1032 alpha_ref (8.26 x), at 10 with 0.011; 20 steps
+    # and finer, and the reference, fall in mode 1 (a knife-edge overturn)
+    (Point(FlexibleBody(wn_over_p=2.8371270000994024, zeta=0.047357018196036556,
+                        alpha_cg=0.19996446254270336, alpha_A=0.3090525518678418,
+                        mA_over_m=2.81824933627754, IA_ratio=0.4035747943050826),
+           0.0002890750586505564, "cosine", 3.3879898935437556, 9.170677551207886),
+     L.OUTCOME_MODE1),
 ]
 
 
@@ -296,7 +305,8 @@ CASES = [
                               "probe-clear-2", "nearly-uplifted", "two-paths-safe",
                               "two-paths-overturn", "probe-kept", "probe-kept-91", "probe-kept-108",
                               "fig3a-probe-kept", "graze-safe-123", "ringing-4-143",
-                              "chatter-116", "chatter-37", "chatter-168"])
+                              "chatter-116", "chatter-37", "chatter-168",
+                              "band-edge-208"])
 def test_default_classifies_the_reproduced_cases_like_the_reference(point, expected):
     """The reference's outcome is the one written here; `default` (sweep kernel and simulate) gives
     the same. Before the step rule, `default` gave safe / mode 1 here."""
@@ -513,7 +523,8 @@ def test_an_outcome_that_keeps_changing_is_uncertified():
     rows[:, L.PAR_CLOSE] = 0.01
     rows[:, L.PAR_DT] = 1.0
     outs = _stand_in(3)
-    outs[:, L.OUT_MARGIN] = [0.001, 0.001, 0.5]
+    inside = 0.5 * 0.01 / CLOSE_BAND  # half the close-call margin
+    outs[:, L.OUT_MARGIN] = [inside, inside, 0.5]
     outs[:, L.OUT_OUTCOME] = [0, 0, 0]
     calls = []
 
@@ -842,12 +853,12 @@ def test_a_file_states_what_its_certification_cost(tmp_path):
 def _certify_ladder(ladder: dict, slot: int, levels: int = 3
                     ) -> tuple[np.ndarray, dict[int, list[int]]]:
     """certify on a stand-in kernel whose row i gives ``ladder[i][level]`` = (outcome, the
-    result's ``slot``) at each level (5 steps a period at level 0, PAR_CLOSE 0.1), every run
-    clear of the saddle (margin 0.5 alpha_ref), an overturn at 5 p t. Returns the certified
-    result rows and the levels each row was re-run at."""
+    result's ``slot``) at each level (5 steps a period at level 0: PAR_CLOSE close_band(5)),
+    every run clear of the saddle (margin 0.5 alpha_ref), an overturn at 5 p t. Returns the
+    certified result rows and the levels each row was re-run at."""
     n = len(ladder)
     rows = np.zeros((n, L.N_PAR))
-    rows[:, L.PAR_CLOSE] = 0.1
+    rows[:, L.PAR_CLOSE] = close_band(5)
     rows[:, L.PAR_DT] = 1.0
 
     def fill(res: np.ndarray, j: int, step: tuple) -> None:
@@ -879,7 +890,8 @@ def test_an_overturn_whose_mode_hangs_on_a_graze_is_a_close_call():
     is re-run finer, and trusted once two runs agree and the finer one's graze is clear of
     its own step's band (which shrinks with the step); one still that close at the last
     level is flagged; a safe run's mode graze, or a wide one, buys no rerun."""
-    band = MODE_BAND * 0.1  # 5 steps a period: band 0.2 x 0.1 = 0.02
+    band = MODE_BAND * close_band(5)  # 5 steps a period: 0.02 alpha_ref
+    assert band == pytest.approx(0.02)
     # row -> (outcome, mode graze) at each level; the band at level k is band x 2^(-2.5 k)
     mode2, mode1, safe = L.OUTCOME_MODE2, L.OUTCOME_MODE1, L.OUTCOME_SAFE
     ladder = {0: [(mode2, 0.05 * band), (mode1, 0.3 * band), (mode1, 0.3 * band)],
@@ -904,7 +916,7 @@ def test_a_run_that_grazed_an_impact_while_the_ground_moved_is_a_close_call():
     moved by less than itself between the two runs: the true path's graze, whose touch-down
     at theta' ~ 0, or none, leaves nearly one state); a graze wider than the band buys
     nothing."""
-    band = GRAZE_BAND * 0.1  # 5 steps a period: band 0.01 x 0.1 = GRAZE_MARGIN
+    band = GRAZE_BAND * close_band(5)  # 5 steps a period: GRAZE_MARGIN
     assert band == pytest.approx(GRAZE_MARGIN)
     safe, mode1 = L.OUTCOME_SAFE, L.OUTCOME_MODE1
     # row -> (outcome, graze) at each level; level k's band is band x 2^(-2.5 k)
@@ -967,9 +979,10 @@ def test_a_mode_2_that_nearly_uplifted_before_is_a_close_call():
     whose dip clears the band, and a safe run or a mode 1 with the same dip, buy no
     rerun."""
     rows = np.zeros((4, L.N_PAR))
-    rows[:, L.PAR_CLOSE] = 0.1
+    rows[:, L.PAR_CLOSE] = close_band(5)
     rows[:, L.PAR_DT] = 1.0
-    band = LIFT_BAND * 0.1
+    band = LIFT_BAND * close_band(5)  # 5 steps a period: 2e-3 of M g b
+    assert band == pytest.approx(2e-3)
     mode2, mode1, safe = L.OUTCOME_MODE2, L.OUTCOME_MODE1, L.OUTCOME_SAFE
     outs = _stand_in(4)
     outs[:, L.OUT_MARGIN] = 0.5
