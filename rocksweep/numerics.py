@@ -416,6 +416,17 @@ GRAZE_MARGIN = 1e-3
 # MODE_BAND's band, 20 times as wide, cost that figure 18% more RK4 evaluations, this one
 # 2.7% (docs/accuracy.md, "A graze far from the saddle").
 GRAZE_BAND = 0.008
+# ... and an impact made that shallow while the ground moved (OUT_SHALLOW, the mirror: an
+# impact a finer run may miss) sends a run finer where it came within SHALLOW_REACH
+# [alpha_ref] of the saddle, safe or overturned (``compute.certify.shallow_close``): a path
+# that parts at such an impact can end with its energy a barrier's worth away. Threshold
+# seed 36's body, safe at 5 steps a period with margin 0.21 after an impact pair 3.6e-4
+# deep during the pulse, and two Figure 4(b) points, safe with margins 0.37 and 0.56 after
+# impacts 2e-4 and 6e-9 deep, where finer runs, `fine` and the reference fall in mode 1.
+# Without the reach, every run with such an impact (most under a record, whose margins are
+# far or never taken) was re-run: +88% RK4 evaluations on the record scenes
+# (docs/accuracy.md, "An impact too shallow to trust").
+SHALLOW_REACH = 1.0
 # A repeated overturn still inside the overturn band at its own step, below the last
 # level, is certified if its margins have converged (``compute.certify.converged``): both
 # runs fell within SAME_FALL [p t] of each other (on the same approach), and the finer

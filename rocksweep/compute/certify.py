@@ -58,6 +58,9 @@ step's band, converged margin or not. Any run, safe or overturned, whose rocking
 back within ``numerics.GRAZE_BAND`` x PAR_CLOSE of an impact while the ground moved
 (OUT_GRAZE; ``graze_close``) is re-run as well, however far from the saddle: a finer run
 may make that impact and take another path (its finer runs answer to ``grazed`` below).
+So is one that made an impact that shallow then (OUT_SHALLOW; ``shallow_close``), which a
+finer run may miss, where it came within ``numerics.SHALLOW_REACH`` alpha_ref of the
+saddle (under a record most runs make such impacts far from it).
 
 Below the last level, a repeated outcome is not trusted either where the finer run came
 within its own band of the saddle (its row's PAR_CLOSE) after a phase (event to event)
@@ -111,6 +114,7 @@ from rocksweep.numerics import (
     RINGING_BAND,
     RINGING_MEMORY,
     SAME_FALL,
+    SHALLOW_REACH,
     UNSPLIT_SHARE,
 )
 
@@ -175,6 +179,18 @@ def graze_close(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     that turned back 2e-4 alpha_ref short of theta = 0 during the pulse, far from the
     saddle, where finer runs and the reference impact there and fall in mode 1)."""
     return outs[:, L.OUT_GRAZE] < GRAZE_BAND * rows[:, L.PAR_CLOSE]
+
+
+def shallow_close(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
+    """bool[n]: runs (result rows float64[n, N_OUT] of parameter rows float64[n, >= N_PAR])
+    that made an impact shallower than ``numerics.GRAZE_BAND`` x PAR_CLOSE while the
+    ground moved (OUT_SHALLOW) and came within ``numerics.SHALLOW_REACH`` [alpha_ref] of
+    the saddle, safe or overturned (OUT_MARGIN): a finer run may miss that impact and take
+    another path, to the other class (threshold seed 36: safe with margin 0.21 alpha_ref
+    after an impact pair 3.6e-4 deep during the pulse, where finer runs and the reference
+    fall in mode 1). The mirror of ``graze_close``'s impact missed by a hair."""
+    return ((outs[:, L.OUT_SHALLOW] < GRAZE_BAND * rows[:, L.PAR_CLOSE])
+            & (outs[:, L.OUT_MARGIN] < SHALLOW_REACH))
 
 
 def clear(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
@@ -298,7 +314,7 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
     if levels <= 0 or outs.shape[0] == 0:
         return outs
     idx = np.flatnonzero(close_calls(rows, outs) | ringing_calls(rows, outs)
-                         | graze_close(rows, outs))
+                         | graze_close(rows, outs) | shallow_close(rows, outs))
     # a near-miss re-run in full already (a graze) needs no probe
     near = np.setdiff1d(np.flatnonzero(near_misses(rows, outs)), idx, assume_unique=True)
     if near.size:

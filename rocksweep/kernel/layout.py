@@ -172,7 +172,11 @@ OUT_UNSPLIT = 32  # the longest phase (event to event) that ended inside the fir
 #                   base that slides takes none). A finer run's above
 #                   ``numerics.UNSPLIT_SHARE`` voids its agreement with the coarser one
 #                   (``rocksweep.compute.certify.unsplit``)
-N_OUT = 33
+OUT_SHALLOW = 33  # the shallowest impact made while the ground moved: the least depth,
+#                   (theta'/alpha_ref)^2 / 2 at it (``loop.impact_depths``) [alpha_ref]
+#                   (inf: none). A finer run may miss an impact this shallow, the mirror
+#                   of OUT_GRAZE's, and take another path (``certify.shallow_close``)
+N_OUT = 34
 
 # --- state tuple y (the loop's 6 slots, a UniTuple(float64, 6)) ----------------------------
 Y_THETA = 0  # theta [rad] (0 in full contact)

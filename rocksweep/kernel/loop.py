@@ -82,6 +82,7 @@ from rocksweep.kernel.layout import (
     OUT_OUTCOME,
     OUT_REFINE_EVALS,
     OUT_REGIME,
+    OUT_SHALLOW,
     OUT_SLIDE_FINAL,
     OUT_SLIDE_MAX,
     OUT_STATUS,
@@ -396,7 +397,8 @@ def _reset(out):
     out[OUT_HIST_ROWS] = 0.0
     out[OUT_REFINE_EVALS] = 0.0  # the certification's reruns add theirs (compute.certify)
     out[OUT_UNSPLIT] = 0.0  # (the no-slip loop sets its own at the end; a sliding base none)
-    out[OUT_MODE_GRAZE] = 0.0  # the deepest impact so far (``_apply_impact``)
+    out[OUT_MODE_GRAZE] = 0.0  # the deepest impact so far (``impact_depths``)
+    out[OUT_SHALLOW] = np.inf  # the shallowest while the ground moves
     # the sliding base's (``slide_loop`` sets its own; the no-slip model has none)
     out[OUT_SLIDE_MAX] = np.nan
     out[OUT_SLIDE_FINAL] = np.nan
@@ -442,6 +444,20 @@ def _rotation_step(theta_dot, acc, rot):
 def _finite(y):
     return (math.isfinite(y[Y_THETA]) and math.isfinite(y[Y_THETA_DOT])
             and math.isfinite(y[Y_U]) and math.isfinite(y[Y_U_DOT]))
+
+
+@njit(cache=True, **INLINE)
+def impact_depths(y, on, prm, out):
+    """An impact's depth at state y, how far below theta = 0 its arc would have gone, in
+    alpha_ref: (theta'/alpha_ref)^2 / 2 (theta'^2 / 2 theta'', theta'' ~ p^2 alpha_ref near
+    theta = 0). The deepest is OUT_MODE_GRAZE (a finer run that missed them all would
+    fall in mode 2), the shallowest while the ground moves (``on``) OUT_SHALLOW (a finer
+    run may miss it and take another path). Both loops' impacts call it."""
+    v = y[Y_THETA_DOT] / prm[PAR_ALPHA_REF]
+    depth = 0.5 * v * v
+    out[OUT_MODE_GRAZE] = max(out[OUT_MODE_GRAZE], depth)
+    if on:
+        out[OUT_SHALLOW] = min(out[OUT_SHALLOW], depth)
 
 
 @njit(cache=True, **INLINE)
@@ -505,11 +521,7 @@ def _apply_impact(t, y, s, on, prm, out, FLEX, DAMPED, ENERGY, GROUND):
     out[OUT_IMPACTS] += 1.0
     if out[OUT_IMPACTS] == 1.0:
         out[OUT_T_FIRST_IMPACT] = t
-    # OUT_MODE_GRAZE with impacts: the deepest, how far below theta = 0 its arc would have
-    # gone (theta'^2 / 2 theta'', theta'' ~ p^2 alpha_ref there): a finer run that missed
-    # them all would fall in mode 2
-    v = y[Y_THETA_DOT] / prm[PAR_ALPHA_REF]
-    out[OUT_MODE_GRAZE] = max(out[OUT_MODE_GRAZE], 0.5 * v * v)
+    impact_depths(y, on, prm, out)
     y, s_new, e, e_d, loss = impact_map(y, s, prm, FLEX, ENERGY)
     if e > out[OUT_E_MAX]:
         out[OUT_E_MAX] = e

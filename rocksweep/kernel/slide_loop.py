@@ -87,7 +87,6 @@ from rocksweep.kernel.layout import (
     OUT_THETA_MAX,
     OUT_UPLIFTS,
     OUT_W_IN,
-    PAR_ALPHA_REF,
     PAR_C,
     PAR_CLOSE,
     PAR_DT,
@@ -145,6 +144,7 @@ from rocksweep.kernel.loop import (
     _saddle_bounds,
     _step_length,
     _theta_max,
+    impact_depths,
 )
 from rocksweep.kernel.slide_events import (
     SLOT_CONTACT,
@@ -571,8 +571,7 @@ def _impact(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, ENERGY, GROUND):
     out[OUT_IMPACTS] += 1.0
     if out[OUT_IMPACTS] == 1.0:
         out[OUT_T_FIRST_IMPACT] = t
-    v = y[Y_THETA_DOT] / prm[PAR_ALPHA_REF]  # the deepest impact (``loop._apply_impact``)
-    out[OUT_MODE_GRAZE] = max(out[OUT_MODE_GRAZE], 0.5 * v * v)
+    impact_depths(y, on, prm, out)  # the deepest, the shallowest while the ground moves
     e_before = _energy(y, s, prm, FLEX) if ENERGY else 0.0
     s_new, w, ud, xd, e, _, _, w_f, _ = friction_impact(
         y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], y[Y_X_DOT], s, mu, mu_s, prm, FLEX)

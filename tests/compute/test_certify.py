@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 import pytest
-from bodies import BODY3
+from bodies import BODY3, BODY4
 
 from rocksweep.compute.certify import certify
 from rocksweep.compute.driver import sweep_arrays
@@ -46,6 +46,7 @@ from rocksweep.numerics import (
     RINGING_BAND,
     RINGING_MEMORY,
     SAME_FALL,
+    SHALLOW_REACH,
     UNSPLIT_SHARE,
     Numerics,
     close_band,
@@ -61,10 +62,10 @@ BLOCK = BlockBody(alpha=0.25, inertia=4.0 / 3.0)
 def _stand_in(n: int) -> np.ndarray:
     """Result rows float64[n, N_OUT] of a stand-in kernel: zeros, and no graze (inf, as a
     run whose rocking never neared an impact it did not make while the ground moved), mode
-    graze (inf: never neared theta = 0 before its first impact) nor lift graze (inf: never
-    near an uplift it did not make)."""
+    graze (inf: never neared theta = 0 before its first impact), lift graze (inf: never
+    near an uplift it did not make) nor shallow impact (inf: none while the ground moved)."""
     out = np.zeros((n, L.N_OUT))
-    out[:, [L.OUT_GRAZE, L.OUT_MODE_GRAZE, L.OUT_LIFT_GRAZE]] = np.inf
+    out[:, [L.OUT_GRAZE, L.OUT_MODE_GRAZE, L.OUT_LIFT_GRAZE, L.OUT_SHALLOW]] = np.inf
     return out
 
 
@@ -291,6 +292,18 @@ CASES = [
                         mA_over_m=2.81824933627754, IA_ratio=0.4035747943050826),
            0.0002890750586505564, "cosine", 3.3879898935437556, 9.170677551207886),
      L.OUTCOME_MODE1),
+    # an impact made by a hair while the ground moves, which finer runs make later and
+    # deeper: seed 36's body (on a base without sliding), safe at 5 steps a period with
+    # margin 0.21 alpha_ref after 7 impacts (the shallowest 3.6e-4 alpha_ref deep, 0.019 p t
+    # late); and a Figure 4(b) point at 1000 x 1000 (lam 0.2), safe with margin 0.37 after
+    # 15 (2.2e-4 deep). 10 steps a period and finer, `fine` and the reference fall in mode 1
+    # after 6 and 14
+    (Point(FlexibleBody(wn_over_p=6.39578552800787, zeta=0.13122225893448825,
+                        alpha_cg=0.2857983365637249, alpha_A=0.16199849037018302,
+                        mA_over_m=0.4325411830436524, IA_ratio=0.3324034469049034),
+           0.21839509262713191, "cosine", 1.2607246731818131, 1.1187845670129442),
+     L.OUTCOME_MODE1),
+    (Point(BODY4, 0.2, "cosine", 0.7926426426426425, 1.0344094094094094), L.OUTCOME_MODE1),
 ]
 
 
@@ -306,7 +319,7 @@ CASES = [
                               "two-paths-overturn", "probe-kept", "probe-kept-91", "probe-kept-108",
                               "fig3a-probe-kept", "graze-safe-123", "ringing-4-143",
                               "chatter-116", "chatter-37", "chatter-168",
-                              "band-edge-208"])
+                              "band-edge-208", "shallow-36", "shallow-fig4b"])
 def test_default_classifies_the_reproduced_cases_like_the_reference(point, expected):
     """The reference's outcome is the one written here; `default` (sweep kernel and simulate) gives
     the same. Before the step rule, `default` gave safe / mode 1 here."""
@@ -969,6 +982,73 @@ def test_the_first_impacts_depth_is_its_speed_squared(mu):
             chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE, contact)(r, out)
             assert out[0, L.OUT_IMPACTS] >= 1
             assert out[0, L.OUT_MODE_GRAZE] == pytest.approx(want, rel=rel)
+
+
+@pytest.mark.parametrize("mu", [math.nan, 5.0])
+def test_the_shallowest_impact_while_the_ground_moves_is_kept(mu):
+    """The kernel's OUT_SHALLOW of a rigid block (alpha 0.2) released at rest from theta0 =
+    alpha/2 while a ground of zero amplitude 'moves' up to t_pulse. Linearized (theta(t) =
+    alpha - (alpha - theta0) cosh t, p t units) the first impact comes at arccosh(2) = 1.32
+    p t, the second at ~3.6 and the third at ~5.6 (restitution ~0.94). A ground still from
+    1 p t on: no impact while it moves (inf). Moving to 2.5 p t: the first impact's depth,
+    (cos(alpha - theta0) - cos alpha) / alpha^2 by energy conservation (the mode graze's).
+    To 5 p t: the second's, shallower than the first (the shallowest, not the deepest).
+    The same on a base that may slide, friction (mu 5) holding the corner."""
+    alpha, theta0 = 0.2, 0.1
+    body = BlockBody(alpha=alpha, inertia=4.0 / 3.0)
+    row = point_row(Point(body, 0.0, "sine", 1.0, 1.0, mu=mu), Numerics.preset("default"))
+    row = refined_rows(row[None, :], 4)  # 80 steps a period
+    row[0, L.PAR_AMP] = 0.0
+    row[0, L.PAR_TO_REST] = 1.0  # on to the impact (a still block is decided at once)
+    row[0, L.PAR_THETA0] = theta0
+    kind, contact = kernel_kind(body), kernel_contact(mu)
+    warm_up(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE, contact)
+    depth = {}
+    for t_pulse in (1.0, 2.5, 5.0):
+        row[0, L.PAR_TPULSE] = t_pulse
+        out = np.empty((1, L.N_OUT))
+        chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE, contact)(row, out)
+        assert out[0, L.OUT_IMPACTS] >= 3
+        depth[t_pulse] = out[0, L.OUT_SHALLOW]
+        first = out[0, L.OUT_MODE_GRAZE]
+    want = (np.cos(alpha - theta0) - np.cos(alpha)) / alpha**2
+    assert first == pytest.approx(want, rel=1e-6)
+    assert depth[1.0] == np.inf
+    assert depth[2.5] == pytest.approx(want, rel=1e-6)
+    assert 0.5 * want < depth[5.0] < 0.95 * want
+
+
+def test_a_shallow_impact_near_the_saddle_is_a_close_call():
+    """certify's rule on a stand-in kernel: a run that made an impact shallower than
+    GRAZE_BAND x PAR_CLOSE while the ground moved (OUT_SHALLOW) is re-run finer where it
+    came within SHALLOW_REACH of the saddle, safe or overturned; farther from it, or with
+    every impact deeper than the band, it is not."""
+    band = GRAZE_BAND * close_band(5)
+    safe, mode1 = L.OUTCOME_SAFE, L.OUTCOME_MODE1
+    # (outcome, margin, shallowest impact) of each first run; its finer runs all mode 1
+    first = [(safe, 0.5 * SHALLOW_REACH, 0.5 * band), (mode1, 0.5 * SHALLOW_REACH, 0.5 * band),
+             (safe, 1.5 * SHALLOW_REACH, 0.5 * band), (safe, 0.5 * SHALLOW_REACH, 2.0 * band)]
+    rows = np.zeros((4, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = close_band(5)
+    rows[:, L.PAR_DT] = 1.0
+    outs = _stand_in(4)
+    outs[:, L.OUT_OUTCOME], outs[:, L.OUT_MARGIN], outs[:, L.OUT_SHALLOW] = np.array(first).T
+    outs[:, L.OUT_T_OVERTURN] = np.where(outs[:, L.OUT_OUTCOME] == mode1, 5.0, np.nan)
+    seen = []
+
+    def run(sub, idx, keep=True):
+        seen.append(idx.tolist())
+        res = _stand_in(len(idx))
+        res[:, L.OUT_OUTCOME] = mode1
+        res[:, L.OUT_MARGIN] = 0.5
+        res[:, L.OUT_T_OVERTURN] = 5.0
+        return res
+
+    certify(rows, outs, run, 3)
+    assert seen[0] == [0, 1]
+    assert outs[0, L.OUT_OUTCOME] == mode1  # the finer runs' class
+    assert outs[2, L.OUT_OUTCOME] == safe and outs[3, L.OUT_OUTCOME] == safe
+    assert not int(outs[2, L.OUT_STATUS]) & L.STATUS_REFINED
 
 
 def test_a_mode_2_that_nearly_uplifted_before_is_a_close_call():
