@@ -417,16 +417,19 @@ GRAZE_MARGIN = 1e-3
 # 2.7% (docs/accuracy.md, "A graze far from the saddle").
 GRAZE_BAND = 0.008
 # ... and an impact made that shallow while the ground moved (OUT_SHALLOW, the mirror: an
-# impact a finer run may miss) sends a run finer where it came within SHALLOW_REACH
-# [alpha_ref] of the saddle, safe or overturned (``compute.certify.shallow_close``): a path
-# that parts at such an impact can end with its energy a barrier's worth away. Threshold
-# seed 36's body, safe at 5 steps a period with margin 0.21 after an impact pair 3.6e-4
-# deep during the pulse, and two Figure 4(b) points, safe with margins 0.37 and 0.56 after
-# impacts 2e-4 and 6e-9 deep, where finer runs, `fine` and the reference fall in mode 1.
-# Without the reach, every run with such an impact (most under a record, whose margins are
-# far or never taken) was re-run: +88% RK4 evaluations on the record scenes
-# (docs/accuracy.md, "An impact too shallow to trust").
-SHALLOW_REACH = 1.0
+# impact a finer run may miss) sends a run finer where it came within PATH_REACH
+# [alpha_ref] of the saddle, safe or overturned (``compute.certify.shallow_close``), as
+# does a base that rocked on a slipping corner (``compute.certify.slide_rock_close``):
+# where a path may part from the finer runs' there, it can end with its energy a
+# barrier's worth away. Threshold seed 36's body, safe at 5 steps a period with margin
+# 0.21 after an impact pair 3.6e-4 deep during the pulse, and two Figure 4(b) points,
+# safe with margins 0.37 and 0.56 after impacts 2e-4 and 6e-9 deep, where finer runs,
+# `fine` and the reference fall in mode 1; on a base that slides, threshold points under
+# cosines of A 5-16 whose slide-rock at 5 steps a period took another path than at 10
+# (docs/sliding.md, "Near thresholds"). Without the reach, every run with a shallow impact
+# (most under a record, whose margins are far or never taken) was re-run: +88% RK4
+# evaluations on the record scenes (docs/accuracy.md, "An impact too shallow to trust").
+PATH_REACH = 1.0
 # A repeated overturn still inside the overturn band at its own step, below the last
 # level, is certified if its margins have converged (``compute.certify.converged``): both
 # runs fell within SAME_FALL [p t] of each other (on the same approach), and the finer

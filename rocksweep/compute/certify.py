@@ -59,8 +59,10 @@ back within ``numerics.GRAZE_BAND`` x PAR_CLOSE of an impact while the ground mo
 (OUT_GRAZE; ``graze_close``) is re-run as well, however far from the saddle: a finer run
 may make that impact and take another path (its finer runs answer to ``grazed`` below).
 So is one that made an impact that shallow then (OUT_SHALLOW; ``shallow_close``), which a
-finer run may miss, where it came within ``numerics.SHALLOW_REACH`` alpha_ref of the
-saddle (under a record most runs make such impacts far from it).
+finer run may miss, where it came within ``numerics.PATH_REACH`` alpha_ref of the
+saddle (under a record most runs make such impacts far from it); and a run of a base
+that may slide which rocked on a slipping corner (``slide_rock_close``), whose path a
+finer run may not share, within that reach.
 
 Below the last level, a repeated outcome is not trusted either where the finer run came
 within its own band of the saddle (its row's PAR_CLOSE) after a phase (event to event)
@@ -110,13 +112,14 @@ from rocksweep.numerics import (
     LIFT_BAND,
     MODE_BAND,
     OVERTURN_BAND,
+    PATH_REACH,
     RICHARDSON_SAFETY,
     RINGING_BAND,
     RINGING_MEMORY,
     SAME_FALL,
-    SHALLOW_REACH,
     UNSPLIT_SHARE,
 )
+from rocksweep.vocab.phases import PHASE_CODE, SLIDE_ROCK
 
 
 def _fell(outs: np.ndarray) -> np.ndarray:
@@ -184,13 +187,26 @@ def graze_close(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
 def shallow_close(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     """bool[n]: runs (result rows float64[n, N_OUT] of parameter rows float64[n, >= N_PAR])
     that made an impact shallower than ``numerics.GRAZE_BAND`` x PAR_CLOSE while the
-    ground moved (OUT_SHALLOW) and came within ``numerics.SHALLOW_REACH`` [alpha_ref] of
+    ground moved (OUT_SHALLOW) and came within ``numerics.PATH_REACH`` [alpha_ref] of
     the saddle, safe or overturned (OUT_MARGIN): a finer run may miss that impact and take
     another path, to the other class (threshold seed 36: safe with margin 0.21 alpha_ref
     after an impact pair 3.6e-4 deep during the pulse, where finer runs and the reference
     fall in mode 1). The mirror of ``graze_close``'s impact missed by a hair."""
     return ((outs[:, L.OUT_SHALLOW] < GRAZE_BAND * rows[:, L.PAR_CLOSE])
-            & (outs[:, L.OUT_MARGIN] < SHALLOW_REACH))
+            & (outs[:, L.OUT_MARGIN] < PATH_REACH))
+
+
+def slide_rock_close(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
+    """bool[n]: runs of a base that may slide (result rows float64[n, N_OUT] of parameter
+    rows float64[n, >= N_PAR]) that rocked on a slipping corner (slide-rock: OUT_REGIME's
+    bit of ``vocab.phases``' code) and came within ``numerics.PATH_REACH`` [alpha_ref] of
+    the saddle, safe or overturned: at 5 steps a period slide-rock can take another path
+    than finer runs (threshold points under cosines of A 5-16: a slide of 4.26 m that
+    erred by 14%, 0.9% at 10 steps a period), to the other class far outside the bands.
+    A base without sliding (OUT_REGIME NaN) never is."""
+    regime = np.nan_to_num(outs[:, L.OUT_REGIME], nan=0.0).astype(np.int64)
+    rocked_slipping = (regime >> PHASE_CODE[SLIDE_ROCK]) & 1 == 1
+    return rocked_slipping & (outs[:, L.OUT_MARGIN] < PATH_REACH)
 
 
 def clear(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
@@ -314,7 +330,8 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
     if levels <= 0 or outs.shape[0] == 0:
         return outs
     idx = np.flatnonzero(close_calls(rows, outs) | ringing_calls(rows, outs)
-                         | graze_close(rows, outs) | shallow_close(rows, outs))
+                         | graze_close(rows, outs) | shallow_close(rows, outs)
+                         | slide_rock_close(rows, outs))
     # a near-miss re-run in full already (a graze) needs no probe
     near = np.setdiff1d(np.flatnonzero(near_misses(rows, outs)), idx, assume_unique=True)
     if near.size:

@@ -19,6 +19,7 @@ scipy's DOP853 at rtol 1e-10 with located events).
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -42,11 +43,11 @@ from rocksweep.numerics import (
     MIN_EVENT_TOL,
     MODE_BAND,
     OVERTURN_BAND,
+    PATH_REACH,
     RICHARDSON_SAFETY,
     RINGING_BAND,
     RINGING_MEMORY,
     SAME_FALL,
-    SHALLOW_REACH,
     UNSPLIT_SHARE,
     Numerics,
     close_band,
@@ -54,7 +55,9 @@ from rocksweep.numerics import (
 from rocksweep.physics.bodies import BlockBody, FlexibleBody
 from rocksweep.physics.points import Point, kernel_contact, kernel_kind, point_row
 from rocksweep.physics.reference import reference_run
+from rocksweep.physics.sliding_reference import sliding_reference
 from rocksweep.scene.parse import parse_scene
+from rocksweep.vocab.phases import PHASE_CODE, REST, ROCK, SLIDE, SLIDE_ROCK
 
 BLOCK = BlockBody(alpha=0.25, inertia=4.0 / 3.0)
 
@@ -1021,13 +1024,13 @@ def test_the_shallowest_impact_while_the_ground_moves_is_kept(mu):
 def test_a_shallow_impact_near_the_saddle_is_a_close_call():
     """certify's rule on a stand-in kernel: a run that made an impact shallower than
     GRAZE_BAND x PAR_CLOSE while the ground moved (OUT_SHALLOW) is re-run finer where it
-    came within SHALLOW_REACH of the saddle, safe or overturned; farther from it, or with
+    came within PATH_REACH of the saddle, safe or overturned; farther from it, or with
     every impact deeper than the band, it is not."""
     band = GRAZE_BAND * close_band(5)
     safe, mode1 = L.OUTCOME_SAFE, L.OUTCOME_MODE1
     # (outcome, margin, shallowest impact) of each first run; its finer runs all mode 1
-    first = [(safe, 0.5 * SHALLOW_REACH, 0.5 * band), (mode1, 0.5 * SHALLOW_REACH, 0.5 * band),
-             (safe, 1.5 * SHALLOW_REACH, 0.5 * band), (safe, 0.5 * SHALLOW_REACH, 2.0 * band)]
+    first = [(safe, 0.5 * PATH_REACH, 0.5 * band), (mode1, 0.5 * PATH_REACH, 0.5 * band),
+             (safe, 1.5 * PATH_REACH, 0.5 * band), (safe, 0.5 * PATH_REACH, 2.0 * band)]
     rows = np.zeros((4, L.N_PAR))
     rows[:, L.PAR_CLOSE] = close_band(5)
     rows[:, L.PAR_DT] = 1.0
@@ -1049,6 +1052,53 @@ def test_a_shallow_impact_near_the_saddle_is_a_close_call():
     assert outs[0, L.OUT_OUTCOME] == mode1  # the finer runs' class
     assert outs[2, L.OUT_OUTCOME] == safe and outs[3, L.OUT_OUTCOME] == safe
     assert not int(outs[2, L.OUT_STATUS]) & L.STATUS_REFINED
+
+
+def test_a_slide_rock_run_near_the_saddle_is_a_close_call():
+    """certify's rule on a stand-in kernel: a run of a base that may slide which rocked on
+    a slipping corner (OUT_REGIME's slide-rock bit) is re-run finer where it came within
+    PATH_REACH of the saddle; one that only rested, slid flat and rocked on a stuck corner,
+    one farther from the saddle, and a base without sliding (OUT_REGIME NaN) are not."""
+    bit = {w: 1 << c for w, c in PHASE_CODE.items()}
+    slide_rock = bit[REST] | bit[ROCK] | bit[SLIDE_ROCK]
+    first = [(slide_rock, 0.5 * PATH_REACH), (bit[REST] | bit[SLIDE] | bit[ROCK], 0.5 * PATH_REACH),
+             (slide_rock, 1.5 * PATH_REACH), (np.nan, 0.5 * PATH_REACH)]
+    rows = np.zeros((4, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = close_band(5)
+    rows[:, L.PAR_DT] = 1.0
+    outs = _stand_in(4)
+    outs[:, L.OUT_REGIME], outs[:, L.OUT_MARGIN] = np.array(first).T
+    seen = []
+
+    def run(sub, idx, keep=True):
+        seen.append(idx.tolist())
+        res = _stand_in(len(idx))
+        res[:, L.OUT_MARGIN] = 0.5
+        return res
+
+    certify(rows, outs, run, 3)
+    assert seen[0] == [0]
+    assert int(outs[0, L.OUT_STATUS]) & L.STATUS_REFINED
+    assert not any(int(outs[i, L.OUT_STATUS]) & L.STATUS_REFINED for i in (1, 2, 3))
+
+
+def test_a_slide_rock_path_the_coarse_step_misses_is_certified():
+    """Threshold seed 39 at mu 0.38 (``scripts/threshold_sample.py --mu 0.15 1.5``): under a
+    cosine of A 14.9 the base slide-rocks; at 5 steps a period the body falls in mode 1
+    after 1 impact with margin 0.114 alpha_ref (outside the overturn band), where 10 steps
+    a period and finer, and the sliding reference, rock to rest after 34-36 impacts. As a
+    slide-rock run near the saddle (``certify.slide_rock_close``) it is re-run, and the
+    certified run takes the reference's class."""
+    body = FlexibleBody(wn_over_p=7.313953952175054, zeta=0.0578493875902795,
+                        alpha_cg=0.24101584287064365, alpha_A=0.575281851740087,
+                        mA_over_m=0.9388866932687785, IA_ratio=0.4920433916277761)
+    pt = Point(body, 0.41744305178839125, "cosine", 5.156788109035284, 14.92266972835969,
+               mu=0.37755136239301296)
+    default = Numerics.preset("default")
+    ref = sliding_reference(pt)
+    assert not ref["status"] and ref["outcome"] == L.OUTCOME_SAFE
+    assert run_point(pt, replace(default, refine=0)).out[L.OUT_OUTCOME] == L.OUTCOME_MODE1
+    assert run_point(pt, default).out[L.OUT_OUTCOME] == ref["outcome"]
 
 
 def test_a_mode_2_that_nearly_uplifted_before_is_a_close_call():
