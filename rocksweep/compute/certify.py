@@ -74,13 +74,14 @@ finer run grazed an impact it did not make (OUT_GRAZE below ``numerics.GRAZE_MAR
 an amount that moved by more than itself between the two runs (``grazed``): a coming
 impact, which a finer run makes.
 
-Only the runs near a threshold pay: on the paper's figures' full grids 26-65% more RK4
+Only the runs near a threshold pay: on the paper's figures' full grids 39-80% more RK4
 evaluations than the points' own, on their adaptive sweeps (almost only points near a
-boundary) 2.1-3.1x in all (``scripts/bench_certify.py``; the points' own runs are short: a safe
-flexible run ends once its energy decides it, ``kernel.transitions.flexible_bounded``:
-the certification is now mostly overturns); within 0.5% of a threshold, where every run
-pays, the certified runs take 4.0-5.2x the bare ones' (``scripts/threshold_sample.py``;
-docs/accuracy.md, "Decided by its energy").
+boundary) 2.3-3.1x in all (``scripts/bench_certify.py``, 2026-11-30; the points' own runs
+are short: a safe flexible run ends once its energy decides it,
+``kernel.transitions.flexible_bounded``: the certification is now mostly overturns);
+within 0.5% of a threshold, where every run pays, the certified runs take 4.0-5.8x the
+bare ones' (``scripts/threshold_sample.py``; docs/accuracy.md, "Decided by its
+energy").
 
 Every refined or checked point has STATUS_REFINED in its status; one whose outcome still
 changed at the last refinement, or which was still a close call there, also
