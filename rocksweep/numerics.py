@@ -358,7 +358,7 @@ CLOSE_MARGIN = 0.0125
 # lag bounded (``spring_steps``) 4 still left 15 on twelve samples against 9 at 8
 # (docs/accuracy.md, "Round 4", "Lightly damped springs"). 10, not 8: fresh threshold
 # samples found safe runs just past 8 x (seed 208 at 8.26 x, a base that may slide, seed
-# 20, at 8.5 x) where 20 steps a period and the reference fall in mode 1; probing to 10 x
+# 20, at 8.5 x) where 20 steps a period and the reference overturn; probing to 10 x
 # cost the four adaptive figures 1.4% more RK4 evaluations, the record scenes nothing
 # (docs/accuracy.md, "Just outside the band"). The bands of grazes below (GRAZE_BAND,
 # MODE_BAND, LIFT_BAND x PAR_CLOSE) kept their size in alpha_ref.
