@@ -193,8 +193,7 @@ def shallow_close(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     another path, to the other class (threshold seed 36: safe with margin 0.21 alpha_ref
     after an impact pair 3.6e-4 deep during the pulse, where finer runs and the reference
     fall in mode 1). The mirror of ``graze_close``'s impact missed by a hair."""
-    return ((outs[:, L.OUT_SHALLOW] < GRAZE_BAND * rows[:, L.PAR_CLOSE])
-            & (outs[:, L.OUT_MARGIN] < PATH_REACH))
+    return (outs[:, L.OUT_SHALLOW] < GRAZE_BAND * rows[:, L.PAR_CLOSE]) & _within_reach(outs)
 
 
 def slide_rock_close(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
@@ -207,7 +206,14 @@ def slide_rock_close(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     A base without sliding (OUT_REGIME NaN) never is."""
     regime = np.nan_to_num(outs[:, L.OUT_REGIME], nan=0.0).astype(np.int64)
     rocked_slipping = (regime >> PHASE_CODE[SLIDE_ROCK]) & 1 == 1
-    return rocked_slipping & (outs[:, L.OUT_MARGIN] < PATH_REACH)
+    return rocked_slipping & _within_reach(outs)
+
+
+def _within_reach(outs: np.ndarray) -> np.ndarray:
+    """bool[n]: runs (result rows float64[n, N_OUT]) that came within
+    ``numerics.PATH_REACH`` [alpha_ref] of the saddle, safe or overturned (OUT_MARGIN):
+    where a path that parts from the finer runs' can end on the other side."""
+    return outs[:, L.OUT_MARGIN] < PATH_REACH
 
 
 def clear(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
