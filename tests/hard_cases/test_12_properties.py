@@ -1,7 +1,6 @@
 """Hard case 12: properties over the admissible Pi space (hypothesis), named cases pinned."""
 
 import math
-from datetime import timedelta
 
 import numpy as np
 import pytest
@@ -14,7 +13,7 @@ from hypothesis import strategies as st
 from rocksweep.errors import BodyError
 from rocksweep.numerics import Numerics
 from rocksweep.physics.bodies import FlexibleBody
-from rocksweep.physics.points import Point
+from rocksweep.physics.points import Point, body_omega_rock
 
 pytestmark = pytest.mark.hard
 
@@ -36,6 +35,11 @@ def points(draw) -> Point:
     except BodyError:
         assume(False)
     assume(b.h_over_b > 0.05)
+    # The step follows the spring while the base rocks (``body_omega_rock``): a tall top
+    # mass on a base with little inertia about its corner makes it ~80 x omega_n and a run
+    # 10^7 steps long (one draw: 1883 rad/s, 27 s a run, 8 runs a check). Springs up to 300
+    # (44 x Table 3's body) are drawn here; stiffer ones are case 6's subject (to 560).
+    assume(body_omega_rock(b) <= 300.0)
     lam = draw(st.floats(0.0, 0.6))  # up to 1 is admissible, but e -> 1 rocks for ever
     shape = draw(st.sampled_from(["sine", "cosine"]))
     # the pulses that make bodies rock (the extremes are pinned examples and case 9)
@@ -112,7 +116,9 @@ def _pinned(f):
     return f
 
 
-@settings(max_examples=150, deadline=timedelta(seconds=20), derandomize=True,
+# No deadline: a run's time is bounded by the draw (omega_rock above) and measured in
+# scripts/, not asserted; a deadline failed on a loaded machine (an example 4x slower).
+@settings(max_examples=150, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 @given(p=points())
 @_pinned
@@ -121,7 +127,7 @@ def test_properties_at_the_suites_accuracy(p):
     _check(p, BASE, BALANCE_TOL)
 
 
-@settings(max_examples=100, deadline=timedelta(seconds=20), derandomize=True,
+@settings(max_examples=100, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 @given(p=points())
 @_pinned
