@@ -62,7 +62,9 @@ So is one that made an impact that shallow then (OUT_SHALLOW; ``shallow_close``)
 finer run may miss, where it came within ``numerics.PATH_REACH`` alpha_ref of the
 saddle (under a record most runs make such impacts far from it); and a run of a base
 that may slide which rocked on a slipping corner (``slide_rock_close``), whose path a
-finer run may not share, within that reach.
+finer run may not share, within that reach. So is every run of a base that may slide
+whose rocking corner's normal force fell to zero (``lifted_off``: where the corner is
+held hangs on the step); within that reach its class comes from two refined runs.
 
 Below the last level, a repeated outcome is not trusted either where the finer run came
 within its own band of the saddle (its row's PAR_CLOSE) after a phase (event to event)
@@ -81,7 +83,9 @@ are short: a safe flexible run ends once its energy decides it,
 ``kernel.transitions.flexible_bounded``: the certification is now mostly overturns);
 within 0.5% of a threshold, where every run pays, the certified runs take 4.0-5.8x the
 bare ones' (``scripts/threshold_sample.py``; docs/accuracy.md, "Decided by its
-energy").
+energy"). A base that may slide pays for its lift-offs too, wherever they are: Figure
+3(a)'s sliding grid +29% at mu 0.3 (28% of its runs lift off, all overturns deep in the
+region), +2.2% and +1.2% at mu 0.5 and 0.7 (docs/sliding.md, "Near thresholds").
 
 Every refined or checked point has STATUS_REFINED in its status; one whose outcome still
 changed at the last refinement, or which was still a close call there, also
@@ -207,6 +211,21 @@ def slide_rock_close(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
     regime = np.nan_to_num(outs[:, L.OUT_REGIME], nan=0.0).astype(np.int64)
     rocked_slipping = (regime >> PHASE_CODE[SLIDE_ROCK]) & 1 == 1
     return rocked_slipping & _within_reach(outs)
+
+
+def lifted_off(outs: np.ndarray) -> np.ndarray:
+    """bool[n]: runs of a base that may slide (result rows float64[n, N_OUT]) whose
+    rocking corner's normal force fell to zero (STATUS_LIFTS_OFF: the corner held, outside
+    the model's contact): where and when it does hangs on the step, and a coarse run can
+    take another path from there, far from any band (sliding threshold seed 58: safe with
+    no approach at 5 steps a period, mode 1 at 10 and finer; mode 2 at 5 and 10 with
+    margins 0.29-0.31, safe or mode 1 from 20 on, as the reference). Re-run finer; where
+    they also came within ``numerics.PATH_REACH`` of the saddle, their class comes from two
+    refined runs, as a ringing body's (the two coarse runs can share the path). A base
+    without sliding (OUT_REGIME NaN) never is: its lift-off (the no-slip model's contact
+    outputs) changes nothing of its path."""
+    sliding = ~np.isnan(outs[:, L.OUT_REGIME])
+    return sliding & (outs[:, L.OUT_STATUS].astype(np.int64) & L.STATUS_LIFTS_OFF != 0)
 
 
 def _within_reach(outs: np.ndarray) -> np.ndarray:
@@ -336,9 +355,11 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
     """
     if levels <= 0 or outs.shape[0] == 0:
         return outs
+    lifted = lifted_off(outs)
+    lifted_near = lifted & _within_reach(outs)  # (their class from levels 1 and 2)
     idx = np.flatnonzero(close_calls(rows, outs) | ringing_calls(rows, outs)
                          | graze_close(rows, outs) | shallow_close(rows, outs)
-                         | slide_rock_close(rows, outs))
+                         | slide_rock_close(rows, outs) | lifted)
     # a near-miss re-run in full already (a graze) needs no probe
     near = np.setdiff1d(np.flatnonzero(near_misses(rows, outs)), idx, assume_unique=True)
     if near.size:
@@ -398,7 +419,7 @@ def certify(rows: np.ndarray, outs: np.ndarray, run: Callable[..., np.ndarray],
             # leave: threshold seeds 69 and 78 rocked to rest at 5 and 10 steps a period,
             # 212 and 223, 5 and 5 impacts, and fell at 20 and finer)
             if level == 1:
-                trusted &= ~ringing(rows[idx])
+                trusted &= ~ringing(rows[idx]) & ~lifted_near[idx]
         # a repeated overturn counts only if both runs fell on the same approach (within
         # SAME_FALL): two falls far apart are two trajectories that parted, whatever their
         # margins (wide-space.yaml's undamped bodies at lam 1 fell at 79, 195 and 102 p t

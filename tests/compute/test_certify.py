@@ -25,7 +25,7 @@ import numpy as np
 import pytest
 from bodies import BODY3, BODY4
 
-from rocksweep.compute.certify import certify
+from rocksweep.compute.certify import certify, lifted_off
 from rocksweep.compute.driver import sweep_arrays
 from rocksweep.compute.single import run_point
 from rocksweep.fields import check_rows, refined_rows
@@ -1099,6 +1099,64 @@ def test_a_slide_rock_path_the_coarse_step_misses_is_certified():
     assert not ref["status"] and ref["outcome"] == L.OUTCOME_SAFE
     assert run_point(pt, replace(default, refine=0)).out[L.OUT_OUTCOME] == L.OUTCOME_MODE1
     assert run_point(pt, default).out[L.OUT_OUTCOME] == ref["outcome"]
+
+
+def test_a_run_that_lifted_off_takes_its_class_from_two_refined_runs():
+    """certify's rule on a stand-in kernel: a run whose rocking corner's normal force fell
+    to zero (STATUS_LIFTS_OFF), far from every band (margin inf or 0.3 alpha_ref), is re-run
+    finer; within PATH_REACH of the saddle its class comes from two refined runs (levels
+    1 and 2), not from level 1's agreement with it; the same ladder without the lift-off
+    is not re-run."""
+    rows = np.zeros((4, L.N_PAR))
+    rows[:, L.PAR_CLOSE] = close_band(5)
+    rows[:, L.PAR_DT] = 1.0
+    m1, m2, safe, off = L.OUTCOME_MODE1, L.OUTCOME_MODE2, L.OUTCOME_SAFE, L.STATUS_LIFTS_OFF
+    ladder = {  # per point and level 0..3: (outcome, margin, overturning time, status)
+        # as sliding threshold seed 58's body under a cosine of A 15.3: mode 2 at 5 and 10
+        # steps a period, mode 1 after 2 impacts from 20 on
+        0: [(m2, 0.31, 5.68, off), (m2, 0.28, 5.69, off), (m1, 0.017, 9.07, off),
+            (m1, 0.015, 9.07, off)],
+        # safe with no approach at 5 steps a period, mode 1 from 10 on
+        1: [(safe, np.inf, np.nan, off), (m1, 0.5, 7.62, off), (m1, 0.5, 7.62, off)],
+        2: [(m2, 0.31, 5.68, 0), (m2, 0.28, 5.69, 0), (m1, 0.017, 9.07, 0)],
+        # beyond PATH_REACH (no approach): level 1's agreement is enough
+        3: [(m2, np.inf, 1.87, off), (m2, np.inf, 1.87, off), (m1, np.inf, 1.2, off)],
+    }
+    outs, levels_run = _run_ladder(rows, ladder, 3,
+                                   [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN,
+                                    L.OUT_STATUS])
+    assert levels_run == {0: [1, 2, 3], 1: [1, 2], 2: [], 3: [1]}
+    assert outs[:, L.OUT_OUTCOME].tolist() == [m1, m1, m2, m2]
+    st = outs[:, L.OUT_STATUS].astype(int)
+    assert (st[[0, 1, 3]] & L.STATUS_REFINED).all() and not st[2] & L.STATUS_REFINED
+    assert not (st & L.STATUS_UNCERTIFIED).any()
+    # the no-slip model's lift-off (its contact outputs; OUT_REGIME NaN) is not the rule's
+    no_slip = _stand_in(2)
+    no_slip[:, L.OUT_STATUS] = off
+    no_slip[1, L.OUT_REGIME] = np.nan
+    assert lifted_off(no_slip).tolist() == [True, False]
+
+
+def test_a_coarse_lift_off_path_is_certified():
+    """Sliding threshold seed 58 (``scripts/threshold_sample.py --mu 0.15 1.5``): under a
+    sine of A 13.3 on a base at mu 1.41, at 5 steps a period the corner's normal force
+    falls to zero and the body falls in mode 1 after 1 impact at 1.18 p t (no margin,
+    outside every band), where 10 steps a period and finer, and the sliding reference,
+    are flung over in mode 2 at 1.868 p t. As a run that lifted off (``certify.
+    lifted_off``) it is re-run, and the certified run takes the reference's class."""
+    body = FlexibleBody(wn_over_p=3.3722378857946786, zeta=0.1224068555290883,
+                        alpha_cg=0.2109865729030082, alpha_A=0.5335889012185802,
+                        mA_over_m=2.2114254931342257, IA_ratio=0.3985674791314566)
+    pt = Point(body, 0.38981991628991713, "sine", 4.1184429356192265, 13.302344358319083,
+               mu=1.4103002721120335)
+    default = Numerics.preset("default")
+    ref = sliding_reference(pt)
+    assert ref["outcome"] == L.OUTCOME_MODE2
+    bare = run_point(pt, replace(default, refine=0)).out
+    assert bare[L.OUT_OUTCOME] == L.OUTCOME_MODE1 and np.isinf(bare[L.OUT_MARGIN])
+    out = run_point(pt, default).out
+    assert out[L.OUT_OUTCOME] == ref["outcome"]
+    assert out[L.OUT_T_OVERTURN] == pytest.approx(ref["t_overturn"], abs=1e-2)
 
 
 def test_a_mode_2_that_nearly_uplifted_before_is_a_close_call():
