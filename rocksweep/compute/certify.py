@@ -219,7 +219,7 @@ def lifted_off(outs: np.ndarray) -> np.ndarray:
     the model's contact): where and when it does hangs on the step, and a coarse run can
     take another path from there, far from any band (sliding threshold seed 58: safe with
     no approach at 5 steps a period, mode 1 at 10 and finer; mode 2 at 5 and 10 with
-    margins 0.29-0.31, safe or mode 1 from 20 on, as the reference). Re-run finer; where
+    margins 0.26-0.31, safe or mode 1 from 20 on, as the reference). Re-run finer; where
     they also came within ``numerics.PATH_REACH`` of the saddle, their class comes from two
     refined runs, as a ringing body's (the two coarse runs can share the path). A base
     without sliding (OUT_REGIME NaN) never is: its lift-off (the no-slip model's contact
