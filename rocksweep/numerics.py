@@ -430,6 +430,15 @@ GRAZE_BAND = 0.008
 # (most under a record, whose margins are far or never taken) was re-run: +88% RK4
 # evaluations on the record scenes (docs/accuracy.md, "An impact too shallow to trust").
 PATH_REACH = 1.0
+
+# A base that may slide whose rocking corner's normal force fell to zero (lifts_off) after
+# the ground stopped, with |theta| beyond LIFT_PAST alpha_ref (OUT_LIFT_ANGLE): far past
+# the saddle, the body is falling, and where its corner is held changes no class. Such
+# lift-offs are not re-run (``compute.certify.lifted_off``). On Figure 3(a)'s sliding
+# grid at mu 0.3, 28% of the runs lift off, all at 6.96-10.5 alpha_ref, 0-0.44 p t
+# before they lie on their side (re-running them cost +29% RK4 evaluations and changed
+# no class); the misses the rule is for lift off during the pulse, near theta = 0.
+LIFT_PAST = 2.0
 # A repeated overturn still inside the overturn band at its own step, below the last
 # level, is certified if its margins have converged (``compute.certify.converged``): both
 # runs fell within SAME_FALL [p t] of each other (on the same approach), and the finer

@@ -115,6 +115,7 @@ from rocksweep.numerics import (
     GRAZE_MARGIN,
     IMPACT_AGREE,
     LIFT_BAND,
+    LIFT_PAST,
     MODE_BAND,
     OVERTURN_BAND,
     PATH_REACH,
@@ -221,11 +222,13 @@ def lifted_off(outs: np.ndarray) -> np.ndarray:
     no approach at 5 steps a period, mode 1 at 10 and finer; mode 2 at 5 and 10 with
     margins 0.26-0.31, safe or mode 1 from 20 on, as the reference). Re-run finer; where
     they also came within ``numerics.PATH_REACH`` of the saddle, their class comes from two
-    refined runs, as a ringing body's (the two coarse runs can share the path). A base
-    without sliding (OUT_REGIME NaN) never is: its lift-off (the no-slip model's contact
-    outputs) changes nothing of its path."""
+    refined runs, as a ringing body's (the two coarse runs can share the path). Not a
+    lift-off only after the ground stopped and beyond ``numerics.LIFT_PAST`` alpha_ref
+    (OUT_LIFT_ANGLE): a falling body's. Nor a base without sliding (OUT_REGIME NaN): its
+    lift-off (the no-slip model's contact outputs) changes nothing of its path."""
     sliding = ~np.isnan(outs[:, L.OUT_REGIME])
-    return sliding & (outs[:, L.OUT_STATUS].astype(np.int64) & L.STATUS_LIFTS_OFF != 0)
+    lifted = outs[:, L.OUT_STATUS].astype(np.int64) & L.STATUS_LIFTS_OFF != 0
+    return sliding & lifted & (outs[:, L.OUT_LIFT_ANGLE] < LIFT_PAST)
 
 
 def _within_reach(outs: np.ndarray) -> np.ndarray:

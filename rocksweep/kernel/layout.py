@@ -176,7 +176,12 @@ OUT_SHALLOW = 33  # the shallowest impact made while the ground moved: the least
 #                   (theta'/alpha_ref)^2 / 2 at it (``loop.impact_depths``) [alpha_ref]
 #                   (inf: none). A finer run may miss an impact this shallow, the mirror
 #                   of OUT_GRAZE's, and take another path (``certify.shallow_close``)
-N_OUT = 34
+OUT_LIFT_ANGLE = 34  # a base that may slide: where its rocking corner's normal force fell
+#                   to zero (STATUS_LIFTS_OFF), the least |theta| / alpha_ref at such a
+#                   lift-off after the ground stopped, 0 for one while it moved (inf: none).
+#                   One far past the saddle is a falling body's: it changes no class
+#                   (``certify.lifted_off``)
+N_OUT = 35
 
 # --- state tuple y (the loop's 6 slots, a UniTuple(float64, 6)) ----------------------------
 Y_THETA = 0  # theta [rad] (0 in full contact)

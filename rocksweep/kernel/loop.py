@@ -75,6 +75,7 @@ from rocksweep.kernel.layout import (
     OUT_GRAZE,
     OUT_HIST_ROWS,
     OUT_IMPACTS,
+    OUT_LIFT_ANGLE,
     OUT_LIFT_GRAZE,
     OUT_MARGIN,
     OUT_MODE_GRAZE,
@@ -399,6 +400,7 @@ def _reset(out):
     out[OUT_UNSPLIT] = 0.0  # (the no-slip loop sets its own at the end; a sliding base none)
     out[OUT_MODE_GRAZE] = 0.0  # the deepest impact so far (``impact_depths``)
     out[OUT_SHALLOW] = np.inf  # the shallowest while the ground moves
+    out[OUT_LIFT_ANGLE] = np.inf  # (a base that may slide: ``slide_loop._lifted``)
     # the sliding base's (``slide_loop`` sets its own; the no-slip model has none)
     out[OUT_SLIDE_MAX] = np.nan
     out[OUT_SLIDE_FINAL] = np.nan

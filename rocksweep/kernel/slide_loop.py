@@ -70,6 +70,7 @@ from rocksweep.kernel.layout import (
     OUT_HIST_ROWS,
     OUT_IMPACTS,
     OUT_IMPULSE_MAX,
+    OUT_LIFT_ANGLE,
     OUT_LIFT_GRAZE,
     OUT_MARGIN,
     OUT_MODE_GRAZE,
@@ -87,6 +88,7 @@ from rocksweep.kernel.layout import (
     OUT_THETA_MAX,
     OUT_UPLIFTS,
     OUT_W_IN,
+    PAR_ALPHA_REF,
     PAR_C,
     PAR_CLOSE,
     PAR_DT,
@@ -287,7 +289,7 @@ def simulate_sliding(prm, out, hist, FLEX, DAMPED, ENERGY, REACTIONS, GROUND):
         if s != 0:
             theta_max = _theta_max(y, y_ev, tau, s, theta_max)
             if slot < 0 and not ev1[4] > 0.0:  # slide-rock's N at the step's end
-                _flag(out, STATUS_LIFTS_OFF)  # the ground pulls: outside the model
+                _lifted(out, y1, on, prm)  # the ground pulls: outside the model
         if abs(y_ev[Y_X]) > slide_max:
             slide_max = abs(y_ev[Y_X])
 
@@ -471,6 +473,16 @@ def _regime(out, s, sigma):
         _flag(out, STATUS_SLID)
 
 
+@njit(cache=True, **INLINE)
+def _lifted(out, y, on, prm):
+    """Flag a lift-off (STATUS_LIFTS_OFF: the rocking corner's N <= 0, held) at state y and
+    keep OUT_LIFT_ANGLE: the least |theta| / alpha_ref of one after the ground stopped, 0
+    for one while it moves (``on``)."""
+    _flag(out, STATUS_LIFTS_OFF)
+    angle = 0.0 if on else abs(y[Y_THETA]) / prm[PAR_ALPHA_REF]
+    out[OUT_LIFT_ANGLE] = min(out[OUT_LIFT_ANGLE], angle)
+
+
 @njit(cache=True, **INTERNAL)
 def _choose(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, GROUND):
     """``choose_phase`` at (t, y) of a base that does not slip (x' = 0): the new (s,
@@ -480,7 +492,7 @@ def _choose(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, GROUND):
                                       ground_acc(GROUND, t, on, prm), g, mu, mu_s, prm, FLEX,
                                       DAMPED)
     if flag & LIFT_OFF:
-        _flag(out, STATUS_LIFTS_OFF)
+        _lifted(out, y, on, prm)
     _regime(out, s_new, sigma)
     return s_new, sigma
 

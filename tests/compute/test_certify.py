@@ -40,6 +40,7 @@ from rocksweep.numerics import (
     GRAZE_MARGIN,
     IMPACT_AGREE,
     LIFT_BAND,
+    LIFT_PAST,
     MIN_EVENT_TOL,
     MODE_BAND,
     OVERTURN_BAND,
@@ -1130,11 +1131,45 @@ def test_a_run_that_lifted_off_takes_its_class_from_two_refined_runs():
     st = outs[:, L.OUT_STATUS].astype(int)
     assert (st[[0, 1, 3]] & L.STATUS_REFINED).all() and not st[2] & L.STATUS_REFINED
     assert not (st & L.STATUS_UNCERTIFIED).any()
-    # the no-slip model's lift-off (its contact outputs; OUT_REGIME NaN) is not the rule's
-    no_slip = _stand_in(2)
-    no_slip[:, L.OUT_STATUS] = off
-    no_slip[1, L.OUT_REGIME] = np.nan
-    assert lifted_off(no_slip).tolist() == [True, False]
+    # the no-slip model's lift-off (its contact outputs; OUT_REGIME NaN) is not the rule's,
+    # nor a falling body's: after the ground stopped, LIFT_PAST alpha_ref or more past
+    # theta = 0 (OUT_LIFT_ANGLE; 0: one while the ground moved)
+    lifts = _stand_in(4)
+    lifts[:, L.OUT_STATUS] = off
+    lifts[1, L.OUT_REGIME] = np.nan
+    lifts[:, L.OUT_LIFT_ANGLE] = [0.0, 0.0, 0.999 * LIFT_PAST, LIFT_PAST]
+    assert lifted_off(lifts).tolist() == [True, False, True, False]
+
+
+FIG3A_BODY = FlexibleBody(wn_over_p=2.43, zeta=0.05, alpha_cg=0.15, alpha_A=0.28,
+                          mA_over_m=0.47, IA_ratio=0.56)
+
+
+@pytest.mark.parametrize(("a_ratio", "during"), [(0.8181818181818182, False),
+                                                 (1.5363636363636366, True)])
+def test_a_lift_off_s_angle_is_kept(a_ratio, during):
+    """The kernel's OUT_LIFT_ANGLE: Figure 3(a)'s body on a base at mu 0.3, lam 0, a sine
+    at w/p 1.152 (its pulse lasts 5.45 p t). At A 0.82 it falls in mode 1 after the pulse
+    (7.54 p t) and its corner lifts off on the way over, after the ground stopped: the
+    angle is |theta| / alpha_cg there, past LIFT_PAST and at most pi / 2 / alpha_cg (the
+    run ends on its side), and the certification leaves the run alone. At A 1.54 it falls
+    in mode 2 during the pulse (4.50 p t): a lift-off while the ground moves, 0, which the
+    certification re-runs."""
+    pt = Point(FIG3A_BODY, 0.0, "sine", 1.1522727272727271, a_ratio, mu=0.3)
+    row = point_row(pt, Numerics.preset("default"))[None]
+    out = np.empty((1, L.N_OUT))
+    chunk_kernel(kernel_kind(FIG3A_BODY), L.LEVEL_OUTCOME, L.GROUND_PULSE,
+                 kernel_contact(pt.mu))(row, out)
+    bare = out[0]
+    assert int(bare[L.OUT_STATUS]) & L.STATUS_LIFTS_OFF
+    fell_after = bare[L.OUT_T_OVERTURN] > 2 * math.pi / 1.1522727272727271
+    assert fell_after != during
+    angle = bare[L.OUT_LIFT_ANGLE]
+    if during:
+        assert angle == 0.0
+    else:
+        assert LIFT_PAST < angle <= (math.pi / 2) / 0.15 + 1e-9
+    assert lifted_off(bare[None]).tolist() == [during]
 
 
 def test_a_coarse_lift_off_path_is_certified():
