@@ -439,6 +439,7 @@ PATH_REACH = 1.0
 # before they lie on their side (re-running them cost +29% RK4 evaluations and changed
 # no class); the misses the rule is for lift off during the pulse, near theta = 0.
 LIFT_PAST = 2.0
+
 # A repeated overturn still inside the overturn band at its own step, below the last
 # level, is certified if its margins have converged (``compute.certify.converged``): both
 # runs fell within SAME_FALL [p t] of each other (on the same approach), and the finer

@@ -62,9 +62,11 @@ So is one that made an impact that shallow then (OUT_SHALLOW; ``shallow_close``)
 finer run may miss, where it came within ``numerics.PATH_REACH`` alpha_ref of the
 saddle (under a record most runs make such impacts far from it); and a run of a base
 that may slide which rocked on a slipping corner (``slide_rock_close``), whose path a
-finer run may not share, within that reach. So is every run of a base that may slide
-whose rocking corner's normal force fell to zero (``lifted_off``: where the corner is
-held hangs on the step); within that reach its class comes from two refined runs.
+finer run may not share, within that reach. So is a run of a base that may slide whose
+rocking corner's normal force fell to zero (``lifted_off``: where the corner is held
+hangs on the step) while the ground moved or within ``numerics.LIFT_PAST`` alpha_ref of
+theta = 0 (not a falling body's); within that reach its class comes from two refined
+runs.
 
 Below the last level, a repeated outcome is not trusted either where the finer run came
 within its own band of the saddle (its row's PAR_CLOSE) after a phase (event to event)
@@ -223,10 +225,11 @@ def lifted_off(outs: np.ndarray) -> np.ndarray:
     no approach at 5 steps a period, mode 1 at 10 and finer; mode 2 at 5 and 10 with
     margins 0.26-0.31, safe or mode 1 from 20 on, as the reference). Re-run finer; where
     they also came within ``numerics.PATH_REACH`` of the saddle, their class comes from two
-    refined runs, as a ringing body's (the two coarse runs can share the path). Not a
-    lift-off only after the ground stopped and beyond ``numerics.LIFT_PAST`` alpha_ref
-    (OUT_LIFT_ANGLE): a falling body's. Nor a base without sliding (OUT_REGIME NaN): its
-    lift-off (the no-slip model's contact outputs) changes nothing of its path."""
+    refined runs, as a ringing body's (the two coarse runs can share the path). Not a run
+    whose every lift-off came after the ground stopped, beyond ``numerics.LIFT_PAST``
+    alpha_ref (OUT_LIFT_ANGLE, the least such angle, 0 for one while the ground moved): a
+    falling body's. Nor a base without sliding (OUT_REGIME NaN): its lift-off (the no-slip
+    model's contact outputs) changes nothing of its path."""
     sliding = ~np.isnan(outs[:, L.OUT_REGIME])
     lifted = outs[:, L.OUT_STATUS].astype(np.int64) & L.STATUS_LIFTS_OFF != 0
     return sliding & lifted & (outs[:, L.OUT_LIFT_ANGLE] < LIFT_PAST)
