@@ -117,7 +117,7 @@ def _pinned(f):
 
 
 # No deadline: a run's time is bounded by the draw (omega_rock above) and measured in
-# scripts/, not asserted; a deadline failed on a loaded machine (an example 4x slower).
+# scripts/, not asserted; a 20 s deadline failed on a loaded machine (one draw: 27 s a run).
 @settings(max_examples=150, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 @given(p=points())
