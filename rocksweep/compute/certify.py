@@ -220,7 +220,8 @@ def slide_rock_close(rows: np.ndarray, outs: np.ndarray) -> np.ndarray:
 def lifted_off(outs: np.ndarray) -> np.ndarray:
     """bool[n]: runs of a base that may slide (result rows float64[n, N_OUT]) whose
     rocking corner's normal force fell to zero (STATUS_LIFTS_OFF: the corner held, outside
-    the model's contact): where and when it does hangs on the step, and a coarse run can
+    the model's contact), or within ``kernel.slide_loop.LIFT_NEAR`` M g of it in slide-rock
+    (OUT_LIFT_ANGLE finite): where and when it does hangs on the step, and a coarse run can
     take another path from there, far from any band (sliding threshold seed 58: safe with
     no approach at 5 steps a period, mode 1 at 10 and finer; mode 2 at 5 and 10 with
     margins 0.26-0.31, safe or mode 1 from 20 on, as the reference). Re-run finer; where
@@ -231,8 +232,7 @@ def lifted_off(outs: np.ndarray) -> np.ndarray:
     falling body's. Nor a base without sliding (OUT_REGIME NaN): its lift-off (the no-slip
     model's contact outputs) changes nothing of its path."""
     sliding = ~np.isnan(outs[:, L.OUT_REGIME])
-    lifted = outs[:, L.OUT_STATUS].astype(np.int64) & L.STATUS_LIFTS_OFF != 0
-    return sliding & lifted & (outs[:, L.OUT_LIFT_ANGLE] < LIFT_PAST)
+    return sliding & (outs[:, L.OUT_LIFT_ANGLE] < LIFT_PAST)
 
 
 def _within_reach(outs: np.ndarray) -> np.ndarray:

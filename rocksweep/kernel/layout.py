@@ -177,10 +177,10 @@ OUT_SHALLOW = 33  # the shallowest impact made while the ground moved: the least
 #                   (inf: none). A finer run may miss an impact this shallow, the mirror
 #                   of OUT_GRAZE's, and take another path (``certify.shallow_close``)
 OUT_LIFT_ANGLE = 34  # a base that may slide: where its rocking corner's normal force fell
-#                   to zero (STATUS_LIFTS_OFF), the least |theta| / alpha_ref at such a
-#                   lift-off after the ground stopped, 0 for one while it moved (inf: none).
-#                   One far past the saddle is a falling body's: it changes no class
-#                   (``certify.lifted_off``)
+#                   to zero (STATUS_LIFTS_OFF) or within ``slide_loop.LIFT_NEAR`` M g of
+#                   it in slide-rock, the least |theta| / alpha_ref there after the ground
+#                   stopped, 0 while it moved (inf: never). One far past the saddle is a
+#                   falling body's: it changes no class (``certify.lifted_off``)
 N_OUT = 35
 
 # --- state tuple y (the loop's 6 slots, a UniTuple(float64, 6)) ----------------------------

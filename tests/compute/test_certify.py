@@ -67,9 +67,11 @@ def _stand_in(n: int) -> np.ndarray:
     """Result rows float64[n, N_OUT] of a stand-in kernel: zeros, and no graze (inf, as a
     run whose rocking never neared an impact it did not make while the ground moved), mode
     graze (inf: never neared theta = 0 before its first impact), lift graze (inf: never
-    near an uplift it did not make) nor shallow impact (inf: none while the ground moved)."""
+    near an uplift it did not make), shallow impact (inf: none while the ground moved) nor
+    lift-off (inf: its corner's N never neared zero)."""
     out = np.zeros((n, L.N_OUT))
-    out[:, [L.OUT_GRAZE, L.OUT_MODE_GRAZE, L.OUT_LIFT_GRAZE, L.OUT_SHALLOW]] = np.inf
+    out[:, [L.OUT_GRAZE, L.OUT_MODE_GRAZE, L.OUT_LIFT_GRAZE, L.OUT_SHALLOW,
+            L.OUT_LIFT_ANGLE]] = np.inf
     return out
 
 
@@ -1111,21 +1113,23 @@ def test_a_run_that_lifted_off_takes_its_class_from_two_refined_runs():
     rows = np.zeros((4, L.N_PAR))
     rows[:, L.PAR_CLOSE] = close_band(5)
     rows[:, L.PAR_DT] = 1.0
-    m1, m2, safe, off = L.OUTCOME_MODE1, L.OUTCOME_MODE2, L.OUTCOME_SAFE, L.STATUS_LIFTS_OFF
-    ladder = {  # per point and level 0..3: (outcome, margin, overturning time, status)
+    m1, m2, safe = L.OUTCOME_MODE1, L.OUTCOME_MODE2, L.OUTCOME_SAFE
+    off, none = (L.STATUS_LIFTS_OFF, 0.0), (0, np.inf)  # (status, OUT_LIFT_ANGLE)
+    ladder = {  # per point and level 0..3: (outcome, margin, overturning time, status,
+        # angle), a lift-off while the ground moves (angle 0) or none
         # as sliding threshold seed 58's body under a cosine of A 15.3: mode 2 at 5 and 10
         # steps a period, mode 1 after 2 impacts from 20 on
-        0: [(m2, 0.31, 5.68, off), (m2, 0.28, 5.69, off), (m1, 0.017, 9.07, off),
-            (m1, 0.015, 9.07, off)],
+        0: [(m2, 0.31, 5.68, *off), (m2, 0.28, 5.69, *off), (m1, 0.017, 9.07, *off),
+            (m1, 0.015, 9.07, *off)],
         # safe with no approach at 5 steps a period, mode 1 from 10 on
-        1: [(safe, np.inf, np.nan, off), (m1, 0.5, 7.62, off), (m1, 0.5, 7.62, off)],
-        2: [(m2, 0.31, 5.68, 0), (m2, 0.28, 5.69, 0), (m1, 0.017, 9.07, 0)],
+        1: [(safe, np.inf, np.nan, *off), (m1, 0.5, 7.62, *off), (m1, 0.5, 7.62, *off)],
+        2: [(m2, 0.31, 5.68, *none), (m2, 0.28, 5.69, *none), (m1, 0.017, 9.07, *none)],
         # beyond PATH_REACH (no approach): level 1's agreement is enough
-        3: [(m2, np.inf, 1.87, off), (m2, np.inf, 1.87, off), (m1, np.inf, 1.2, off)],
+        3: [(m2, np.inf, 1.87, *off), (m2, np.inf, 1.87, *off), (m1, np.inf, 1.2, *off)],
     }
     outs, levels_run = _run_ladder(rows, ladder, 3,
                                    [L.OUT_OUTCOME, L.OUT_MARGIN, L.OUT_T_OVERTURN,
-                                    L.OUT_STATUS])
+                                    L.OUT_STATUS, L.OUT_LIFT_ANGLE])
     assert levels_run == {0: [1, 2, 3], 1: [1, 2], 2: [], 3: [1]}
     assert outs[:, L.OUT_OUTCOME].tolist() == [m1, m1, m2, m2]
     st = outs[:, L.OUT_STATUS].astype(int)
@@ -1135,7 +1139,7 @@ def test_a_run_that_lifted_off_takes_its_class_from_two_refined_runs():
     # nor a falling body's: after the ground stopped, LIFT_PAST alpha_ref or more past
     # theta = 0 (OUT_LIFT_ANGLE; 0: one while the ground moved)
     lifts = _stand_in(4)
-    lifts[:, L.OUT_STATUS] = off
+    lifts[:, L.OUT_STATUS] = L.STATUS_LIFTS_OFF
     lifts[1, L.OUT_REGIME] = np.nan
     lifts[:, L.OUT_LIFT_ANGLE] = [0.0, 0.0, 0.999 * LIFT_PAST, LIFT_PAST]
     assert lifted_off(lifts).tolist() == [True, False, True, False]
@@ -1170,6 +1174,31 @@ def test_a_lift_off_s_angle_is_kept(a_ratio, during):
     else:
         assert LIFT_PAST < angle <= (math.pi / 2) / 0.15 + 1e-9
     assert lifted_off(bare[None]).tolist() == [during]
+
+
+def test_a_lift_off_missed_by_a_hair_is_certified():
+    """Sliding threshold seed 55 (``scripts/threshold_sample.py --mu 0.15 1.5``): under a
+    cosine of A 15.4 on a base at mu 0.66, at 5 steps a period the slipping corner's normal
+    force comes within 0.0087 M g of zero (below ``slide_loop.LIFT_NEAR``) and the body
+    falls in mode 1 after 2 impacts, where 10 steps a period and finer, and the sliding
+    reference, lift off and are flung over in mode 2. The near lift-off is kept (OUT_LIFT_
+    ANGLE 0: while the ground moves, not flagged ``lifts_off``), and the certified run
+    takes the reference's class."""
+    body = FlexibleBody(wn_over_p=5.739779894600782, zeta=0.009244754900421282,
+                        alpha_cg=0.2444371655176647, alpha_A=0.19856112740667958,
+                        mA_over_m=0.47599883287641626, IA_ratio=0.8240761237198564)
+    pt = Point(body, 0.4550727763510952, "cosine", 2.9105671717123416, 15.418119666858884,
+               mu=0.663152819894955)
+    row = point_row(pt, Numerics.preset("default"))[None]
+    out = np.empty((1, L.N_OUT))
+    chunk_kernel(kernel_kind(body), L.LEVEL_OUTCOME, L.GROUND_PULSE,
+                 kernel_contact(pt.mu))(row, out)
+    assert out[0, L.OUT_OUTCOME] == L.OUTCOME_MODE1
+    assert not int(out[0, L.OUT_STATUS]) & L.STATUS_LIFTS_OFF
+    assert out[0, L.OUT_LIFT_ANGLE] == 0.0
+    ref = sliding_reference(pt)
+    assert ref["outcome"] == L.OUTCOME_MODE2
+    assert run_point(pt, Numerics.preset("default")).out[L.OUT_OUTCOME] == ref["outcome"]
 
 
 def test_a_coarse_lift_off_path_is_certified():
