@@ -63,10 +63,10 @@ finer run may miss, where it came within ``numerics.PATH_REACH`` alpha_ref of th
 saddle (under a record most runs make such impacts far from it); and a run of a base
 that may slide which rocked on a slipping corner (``slide_rock_close``), whose path a
 finer run may not share, within that reach. So is a run of a base that may slide whose
-rocking corner's normal force fell to zero (``lifted_off``: where the corner is held
-hangs on the step) while the ground moved or within ``numerics.LIFT_PAST`` alpha_ref of
-theta = 0 (not a falling body's); within that reach its class comes from two refined
-runs.
+rocking corner's normal force fell to zero, or nearly (``lifted_off``: where the corner
+is held hangs on the step), while the ground moved or within ``numerics.LIFT_PAST``
+alpha_ref of theta = 0 (not a falling body's); within that reach its class comes from
+two refined runs.
 
 Below the last level, a repeated outcome is not trusted either where the finer run came
 within its own band of the saddle (its row's PAR_CLOSE) after a phase (event to event)
