@@ -140,8 +140,9 @@ def test_each_point_goes_to_its_kernel_variant(monkeypatch):
             seen.append((kind, level, rows.copy()))
             outs[:] = 0.0
             outs[:, L.OUT_MARGIN] = np.inf  # never near the saddle: no close call to refine
-            # nor near the other mode, nor an impact it did not make
-            outs[:, [L.OUT_GRAZE, L.OUT_MODE_GRAZE, L.OUT_LIFT_GRAZE]] = np.inf
+            # nor near the other mode, nor an impact it did not make, nor a lift-off
+            outs[:, [L.OUT_GRAZE, L.OUT_MODE_GRAZE, L.OUT_LIFT_GRAZE,
+                     L.OUT_LIFT_ANGLE]] = np.inf
             outs[:, L.OUT_OUTCOME] = kind  # mark which variant computed the point
         return run
 
