@@ -338,13 +338,22 @@ def test_default_classifies_the_reproduced_cases_like_the_reference(point, expec
 
 
 def _bare(point: Point, numerics: Numerics) -> np.ndarray:
-    """One kernel run without certification: the result row."""
+    """One kernel run without certification: the result row (the kernel's own status, as
+    the certification sees it)."""
     row = point_row(point, numerics)
-    kind = kernel_kind(point.body)
-    warm_up(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)
+    kind, contact = kernel_kind(point.body), kernel_contact(point.mu)
+    warm_up(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE, contact)
     out = np.empty((1, L.N_OUT))
-    chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE)(row[None, :], out)
+    chunk_kernel(kind, L.LEVEL_OUTCOME, L.GROUND_PULSE, contact)(row[None, :], out)
     return out[0]
+
+
+def _sliding_runs(point: Point) -> tuple[dict, np.ndarray, np.ndarray]:
+    """(the sliding reference's run, the `default` run without certification, the
+    certified one) of a point on a base that may slide: result rows float64[N_OUT]."""
+    default = Numerics.preset("default")
+    return (sliding_reference(point), run_point(point, replace(default, refine=0)).out,
+            run_point(point, default).out)
 
 
 def test_close_calls_are_refined_and_clear_ones_are_not():
@@ -1097,11 +1106,10 @@ def test_a_slide_rock_path_the_coarse_step_misses_is_certified():
                         mA_over_m=0.9388866932687785, IA_ratio=0.4920433916277761)
     pt = Point(body, 0.41744305178839125, "cosine", 5.156788109035284, 14.92266972835969,
                mu=0.37755136239301296)
-    default = Numerics.preset("default")
-    ref = sliding_reference(pt)
+    ref, bare, certified = _sliding_runs(pt)
     assert not ref["status"] and ref["outcome"] == L.OUTCOME_SAFE
-    assert run_point(pt, replace(default, refine=0)).out[L.OUT_OUTCOME] == L.OUTCOME_MODE1
-    assert run_point(pt, default).out[L.OUT_OUTCOME] == ref["outcome"]
+    assert bare[L.OUT_OUTCOME] == L.OUTCOME_MODE1
+    assert certified[L.OUT_OUTCOME] == ref["outcome"]
 
 
 def test_a_run_that_lifted_off_takes_its_class_from_two_refined_runs():
@@ -1160,11 +1168,7 @@ def test_a_lift_off_s_angle_is_kept(a_ratio, during):
     in mode 2 during the pulse (4.50 p t): a lift-off while the ground moves, 0, which the
     certification re-runs."""
     pt = Point(FIG3A_BODY, 0.0, "sine", 1.1522727272727271, a_ratio, mu=0.3)
-    row = point_row(pt, Numerics.preset("default"))[None]
-    out = np.empty((1, L.N_OUT))
-    chunk_kernel(kernel_kind(FIG3A_BODY), L.LEVEL_OUTCOME, L.GROUND_PULSE,
-                 kernel_contact(pt.mu))(row, out)
-    bare = out[0]
+    bare = _bare(pt, Numerics.preset("default"))
     assert int(bare[L.OUT_STATUS]) & L.STATUS_LIFTS_OFF
     fell_after = bare[L.OUT_T_OVERTURN] > 2 * math.pi / 1.1522727272727271
     assert fell_after != during
@@ -1189,16 +1193,13 @@ def test_a_lift_off_missed_by_a_hair_is_certified():
                         mA_over_m=0.47599883287641626, IA_ratio=0.8240761237198564)
     pt = Point(body, 0.4550727763510952, "cosine", 2.9105671717123416, 15.418119666858884,
                mu=0.663152819894955)
-    row = point_row(pt, Numerics.preset("default"))[None]
-    out = np.empty((1, L.N_OUT))
-    chunk_kernel(kernel_kind(body), L.LEVEL_OUTCOME, L.GROUND_PULSE,
-                 kernel_contact(pt.mu))(row, out)
-    assert out[0, L.OUT_OUTCOME] == L.OUTCOME_MODE1
-    assert not int(out[0, L.OUT_STATUS]) & L.STATUS_LIFTS_OFF
-    assert out[0, L.OUT_LIFT_ANGLE] == 0.0
-    ref = sliding_reference(pt)
+    bare = _bare(pt, Numerics.preset("default"))
+    assert bare[L.OUT_OUTCOME] == L.OUTCOME_MODE1
+    assert not int(bare[L.OUT_STATUS]) & L.STATUS_LIFTS_OFF
+    assert bare[L.OUT_LIFT_ANGLE] == 0.0
+    ref, _, certified = _sliding_runs(pt)
     assert ref["outcome"] == L.OUTCOME_MODE2
-    assert run_point(pt, Numerics.preset("default")).out[L.OUT_OUTCOME] == ref["outcome"]
+    assert certified[L.OUT_OUTCOME] == ref["outcome"]
 
 
 def test_a_coarse_lift_off_path_is_certified():
@@ -1213,14 +1214,11 @@ def test_a_coarse_lift_off_path_is_certified():
                         mA_over_m=2.2114254931342257, IA_ratio=0.3985674791314566)
     pt = Point(body, 0.38981991628991713, "sine", 4.1184429356192265, 13.302344358319083,
                mu=1.4103002721120335)
-    default = Numerics.preset("default")
-    ref = sliding_reference(pt)
+    ref, bare, certified = _sliding_runs(pt)
     assert ref["outcome"] == L.OUTCOME_MODE2
-    bare = run_point(pt, replace(default, refine=0)).out
     assert bare[L.OUT_OUTCOME] == L.OUTCOME_MODE1 and np.isinf(bare[L.OUT_MARGIN])
-    out = run_point(pt, default).out
-    assert out[L.OUT_OUTCOME] == ref["outcome"]
-    assert out[L.OUT_T_OVERTURN] == pytest.approx(ref["t_overturn"], abs=1e-2)
+    assert certified[L.OUT_OUTCOME] == ref["outcome"]
+    assert certified[L.OUT_T_OVERTURN] == pytest.approx(ref["t_overturn"], abs=1e-2)
 
 
 def test_a_mode_2_that_nearly_uplifted_before_is_a_close_call():
