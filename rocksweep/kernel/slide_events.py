@@ -14,6 +14,7 @@ from rocksweep.kernel.equations import tip_moment, uplift_moment, uplift_moment_
 from rocksweep.kernel.events import HERMITE_PAST, NEWTON_XTOL, hermite_min, hermite_root
 from rocksweep.kernel.ground import ground_acc, ground_gravity, ground_jerk
 from rocksweep.kernel.layout import (
+    PAR_MTOT,
     PAR_THETA_OVER,
     PAR_TOL,
     Y_THETA,
@@ -23,6 +24,7 @@ from rocksweep.kernel.layout import (
     Y_X_DOT,
 )
 from rocksweep.kernel.sliding import (
+    JAM_DEN,
     TIP_ROUNDOFF,
     slide_uplift_moment,
     sliding_derivatives,
@@ -32,7 +34,7 @@ from rocksweep.kernel.sliding import (
 
 # The event slots of a phase (``_event_values``): 0 and 1 the impact and overturning
 # (rocking) or the uplifts on +b and -b (flat), 2 the stick break (stuck) or the slip stop
-# (slipping), 3 Painleve (slide-rock; else never)
+# (slipping), 3 Painleve (slide-rock, den - JAM_DEN M: ``sliding.JAM_DEN``; else never)
 SLOT_FIRST = 0
 SLOT_SECOND = 1
 SLOT_CONTACT = 2
@@ -94,8 +96,9 @@ def _event_values(t, y, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED, GROUND):
         e0 = s * theta
         e1 = prm[PAR_THETA_OVER] - s * theta
         if sigma != 0:
-            _, n, e3 = slip_state(theta, theta_dot, u, u_dot, s, sigma, xg, g, mu, prm, FLEX,
-                                  DAMPED)
+            _, n, den = slip_state(theta, theta_dot, u, u_dot, s, sigma, xg, g, mu, prm,
+                                   FLEX, DAMPED)
+            e3 = den - JAM_DEN * prm[PAR_MTOT]
     else:
         mgb = tip_moment(g, prm)
         if sigma == 0:

@@ -159,6 +159,7 @@ from rocksweep.kernel.slide_events import (
     _rk4,
 )
 from rocksweep.kernel.sliding import (
+    JAM_DEN,
     LIFT_OFF,
     TIP_ROUNDOFF,
     choose_phase,
@@ -567,7 +568,8 @@ def _jam(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, ENERGY, GROUND):
 def _slipping(t, y, s, sigma, on, mu, mu_s, prm, out, FLEX, DAMPED, ENERGY, GROUND):
     """The phase a slip (x' != 0, direction sigma) goes on in on corner s (0 flat): flat,
     it tips at once onto a corner where it would uplift while sliding; rocking, it
-    slide-rocks where a slip is consistent (den > 0), else the jam sticks it."""
+    slide-rocks where a slip is consistent (den > ``sliding.JAM_DEN`` M), else the jam
+    sticks it."""
     g = ground_gravity(GROUND, t, on, prm)
     xg = ground_acc(GROUND, t, on, prm)
     if s == 0:
@@ -579,7 +581,7 @@ def _slipping(t, y, s, sigma, on, mu, mu_s, prm, out, FLEX, DAMPED, ENERGY, GROU
     if s != 0:
         den = slip_state(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s, sigma, xg, g, mu,
                          prm, FLEX, DAMPED)[2]
-        if not den > 0.0:
+        if not den > JAM_DEN * prm[PAR_MTOT]:
             return _jam(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, ENERGY, GROUND)
     _regime(out, s, sigma)
     return y, s, sigma

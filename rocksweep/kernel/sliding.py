@@ -89,6 +89,21 @@ LIFT_OFF = 8  # N <= 0 while rocking: the corner held as in the no-slip model (f
 # body sliding at mu = tan(alpha_cg) exactly has Q = M g b for good (it slides, the normal
 # force at its leading corner, theta'' = 0), which float64 may miss by an ulp or two
 TIP_ROUNDOFF = 1e-12
+# Slide-rock needs den = H_a + mu sigma N_a above JAM_DEN x M [kg], not only above 0:
+# below it the contact jams (``choose_phase``, ``slide_loop._slipping``; ``slide_events``'
+# Painleve slot fires there). Toward den = 0 the slip's acceleration and the reactions
+# grow as 1/den, and the slip stops in a time that vanishes with den: the jam impulse
+# (``jam_impulse``) is that stop's limit (its theta' jump is theta'' per unit a times the
+# x' it removes). Stepped through to den = 0, fixed RK4 steps met the 1/den with no limit
+# as the step shrank: the slip stop was located at den ~ 1e-6..1e-9 on a state with
+# theta' of 1e2-1e5 alpha_ref (sliding threshold seed 60, mu 1.29: its deepest impact
+# (theta'/alpha_ref)^2/2 5.7, 3e4, 5e3, 1e7, 8e5, 1e10 at 5 to 320 steps a period, its class
+# flipping; seed 58, mu 1.41: lifted off and fell in mode 1 at 5 steps a period). With the
+# jam at 1e-2 / 3e-3 / 1e-3 / 3e-4 M both converge at every step to the reference's class
+# (seed 60's depth 5.96 / 5.83 / 5.77 / 5.75); at 1e-2 a slide-rock whose den dips to
+# ~0.005 M and recovers (threshold seed 5, mu 0.62) jammed and fell 0.94 p t early. The
+# impulse this early leaves |J_x|/J_y at mu (1 + ~1e-3 M/H_a): on the friction cone.
+JAM_DEN = 1e-3
 
 
 @njit(cache=True, **INLINE_PUBLIC)
@@ -286,9 +301,9 @@ def choose_phase(theta, theta_dot, u, u_dot, s, xg, g, mu, mu_s, prm, FLEX, DAMP
                   (|Q| <= M g b under the slip's acceleration, ``slide_uplift_moment``:
                   at equality it slides with theta'' = 0, TIP_ROUNDOFF);
       slide-rock  (s', sg): sg x'' > 0, s' Q >= M g b under the slip's acceleration,
-                  N > 0, den > 0 (``slip_state``).
+                  N > 0, den > JAM_DEN M (``slip_state``).
     s != 0 (rocking on s): rock if |H| <= mu_s N, else slide-rock in the direction
-    sg = -sign(H) where den > 0 and N > 0 (its x'' then has the sign sg).
+    sg = -sign(H) where den > JAM_DEN M and N > 0 (its x'' then has the sign sg).
     flag: 0, or JAM where no phase is consistent (Painleve: the contact is stuck by a
     tangential impulse: rock on the corner the body tips to, or stays on), or LIFT_OFF
     where N <= 0 while rocking (the ground would have to pull: outside the model; the
@@ -310,7 +325,7 @@ def choose_phase(theta, theta_dot, u, u_dot, s, xg, g, mu, mu_s, prm, FLEX, DAMP
         sg = -1 if h > 0.0 else 1
         x_dd, n2, den = slip_state(theta, theta_dot, u, u_dot, s, sg, xg, g, mu, prm,
                                    FLEX, DAMPED)
-        if den > 0.0 and n2 > 0.0:
+        if den > JAM_DEN * prm[PAR_MTOT] and n2 > 0.0:
             return s, sg, 0
         return s, 0, JAM
     mgb = tip_moment(g, prm)
@@ -332,7 +347,7 @@ def choose_phase(theta, theta_dot, u, u_dot, s, xg, g, mu, mu_s, prm, FLEX, DAMP
         for sg in (1, -1):
             x_dd, n, den = slip_state(0.0, 0.0, u, u_dot, sc, sg, xg, g, mu, prm, FLEX,
                                       DAMPED)
-            if (den > 0.0 and n > 0.0 and sg * x_dd > 0.0
+            if (den > JAM_DEN * prm[PAR_MTOT] and n > 0.0 and sg * x_dd > 0.0
                     and sc * uplift_moment(u, u_dot, xg + x_dd, g, prm, FLEX, DAMPED) >= mgb):
                 return sc, sg, 0
     return tip, 0, JAM

@@ -1202,25 +1202,6 @@ def test_a_lift_off_missed_by_a_hair_is_certified():
     assert certified[L.OUT_OUTCOME] == ref["outcome"]
 
 
-def test_a_coarse_lift_off_path_is_certified():
-    """Sliding threshold seed 58 (``scripts/threshold_sample.py --mu 0.15 1.5``): under a
-    sine of A 13.3 on a base at mu 1.41, at 5 steps a period the corner's normal force
-    falls to zero and the body falls in mode 1 after 1 impact at 1.18 p t (no margin,
-    outside every band), where 10 steps a period and finer, and the sliding reference,
-    are flung over in mode 2 at 1.868 p t. As a run that lifted off (``certify.
-    lifted_off``) it is re-run, and the certified run takes the reference's class."""
-    body = FlexibleBody(wn_over_p=3.3722378857946786, zeta=0.1224068555290883,
-                        alpha_cg=0.2109865729030082, alpha_A=0.5335889012185802,
-                        mA_over_m=2.2114254931342257, IA_ratio=0.3985674791314566)
-    pt = Point(body, 0.38981991628991713, "sine", 4.1184429356192265, 13.302344358319083,
-               mu=1.4103002721120335)
-    ref, bare, certified = _sliding_runs(pt)
-    assert ref["outcome"] == L.OUTCOME_MODE2
-    assert bare[L.OUT_OUTCOME] == L.OUTCOME_MODE1 and np.isinf(bare[L.OUT_MARGIN])
-    assert certified[L.OUT_OUTCOME] == ref["outcome"]
-    assert certified[L.OUT_T_OVERTURN] == pytest.approx(ref["t_overturn"], abs=1e-2)
-
-
 def test_a_mode_2_that_nearly_uplifted_before_is_a_close_call():
     """certify's rule on a stand-in kernel: a mode 2 whose body came within LIFT_BAND x
     PAR_CLOSE of an uplift it did not make (OUT_LIFT_GRAZE, before its first uplift) is

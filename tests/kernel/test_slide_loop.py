@@ -18,6 +18,7 @@ from pathlib import Path
 import pytest
 
 from rocksweep.compute.single import run_point
+from rocksweep.kernel import layout as L
 from rocksweep.numerics import Numerics
 from rocksweep.physics import friction
 from rocksweep.physics.bodies import BlockBody, FlexibleBody
@@ -266,3 +267,47 @@ def test_an_uplift_inside_a_step_at_rest_is_found():
     assert s["impacts"] == ref["impacts"] == 6
     assert s["t_overturn"] == pytest.approx(ref["t_overturn"], abs=0.01)
 
+
+
+# Sliding threshold seeds 58 and 60 (``scripts/threshold_sample.py --mu 0.15 1.5``): a
+# slide-rock whose den = H_a + mu sigma N_a falls through zero inside one step
+PAINLEVE_POINTS = {
+    58: Point(FlexibleBody(wn_over_p=3.3722378857946786, zeta=0.1224068555290883,
+                           alpha_cg=0.2109865729030082, alpha_A=0.5335889012185802,
+                           mA_over_m=2.2114254931342257, IA_ratio=0.3985674791314566),
+              0.38981991628991713, "sine", 4.1184429356192265, 13.302344358319083,
+              mu=1.4103002721120335),
+    60: Point(FlexibleBody(wn_over_p=7.817045861122146, zeta=0.13475997850773416,
+                           alpha_cg=0.2652356462792552, alpha_A=0.18595209432962762,
+                           mA_over_m=0.3762826832083047, IA_ratio=0.706262482032598),
+              0.15306589315024344, "cosine", 5.339530649562527, 12.867805017509495,
+              mu=1.2856029950234569),
+}
+
+
+@pytest.mark.parametrize("seed", sorted(PAINLEVE_POINTS))
+def test_a_slip_toward_a_painleve_point_jams_at_every_step(seed):
+    """Toward den = 0 the slip's accelerations grow as 1/den and the slip stops in a
+    vanishing time, whose limit is the jam impulse; the loop jams at den = JAM_DEN M
+    (``sliding.JAM_DEN``). Stepped through to den = 0 instead, the slip stop was located
+    on a state with theta' of 1e2-1e5 alpha_ref, different at every step: seed 58 lifted
+    off and fell in mode 1 after an impact at 5 steps a period, seed 60 (deepest impact
+    (theta'/alpha_ref)^2/2 5.7, 3e4, 5e3 at 5, 10, 20 steps a period) flipped between safe
+    and mode 1. Now, uncertified, at 5 and 10 steps a period: the reference's class (which
+    jams too), seed 58's fall at its time, seed 60's impacts as deep at both steps (a
+    path that converges) and as many as the reference's."""
+    pt = PAINLEVE_POINTS[seed]
+    ref = sliding_reference(pt)
+    assert "jam" in ref["status"]
+    runs = [run_point(pt, DEFAULT.refined(level)) for level in (0, 1)]
+    for r in runs:
+        assert OUTCOME_CODE[r.outcome] == ref["outcome"]
+        if seed == 58:
+            assert ref["outcome"] == OUTCOME_CODE["mode2"]
+            assert r.summary()["t_overturn"] == pytest.approx(ref["t_overturn"], abs=1e-2)
+        else:
+            assert ref["outcome"] == OUTCOME_CODE["safe"]
+            assert abs(r.summary()["impacts"] - ref["impacts"]) <= 1
+    if seed == 60:
+        depth = [r.out[L.OUT_MODE_GRAZE] for r in runs]
+        assert depth[1] == pytest.approx(depth[0], rel=0.02) and depth[0] < 10.0
