@@ -173,7 +173,9 @@ def run_point(point: Point, numerics: Numerics, history: bool = True,
     hist_d = None
     if history:
         if not contact:  # tracked by the history variants anyway; reported when asked
-            out[L.OUT_STATUS] = int(out[L.OUT_STATUS]) & ~(L.STATUS_SLIDES | L.STATUS_LIFTS_OFF)
+            # (on a base that may slide, lifts_off is the model's own word, as in sweeps)
+            words = L.STATUS_SLIDES | (L.STATUS_LIFTS_OFF if math.isnan(point.mu) else 0)
+            out[L.OUT_STATUS] = int(out[L.OUT_STATUS]) & ~words
             out[[L.OUT_MU_REQ, L.OUT_N_MIN, L.OUT_IMPULSE_MAX]] = np.nan
         n = int(out[L.OUT_HIST_ROWS])
         columns = fields.HISTORY + (fields.SLIDE_HISTORY if not math.isnan(point.mu) else ())

@@ -10,9 +10,11 @@ import numpy as np
 
 import rocksweep
 from rocksweep.compute.history import write_history_csv
+from rocksweep.vocab.outcomes import STATUS_BIT
 from rocksweep.vocab.phases import PHASE_WORDS, PHASES
 
 FIG5 = Path(__file__).resolve().parents[2] / "configs" / "fig5.yaml"
+FIG3A = FIG5.with_name("fig3a.yaml")
 SLIDE_KEYS = {"slide_max", "slide_final", "friction_loss_over_Eref", "phases", "regime"}
 
 
@@ -43,3 +45,19 @@ def test_simulate_without_mu_has_none():
     s = rocksweep.simulate(FIG5, impact__lam=0.4).summary
     assert not SLIDE_KEYS & set(s)
     assert "x_over_b" not in rocksweep.simulate(FIG5, impact__lam=0.4).history
+
+
+def test_a_lift_off_is_in_a_history_run_s_status_as_in_a_sweep_s():
+    """On a base that may slide, `lifts_off` is the model's own word (the rocking corner's
+    normal force fell to zero and the loop held the corner), which a sweep reports without
+    contact outputs: a single run with its history reports it too. Figure 3(a)'s body at
+    mu 0.3 under a sine at w/p 1.152, A 0.82, lifts off on its way over. Without mu the
+    word is a contact output, reported only when asked (``outputs.contact``)."""
+    sets = {"impact__lam": 0.0, "pulse__w_over_p": 1.1522727272727271,
+            "pulse__A_ratio": 0.82}
+    sim = rocksweep.simulate(FIG3A, body__mu=0.3, **sets)
+    swept = rocksweep.run(FIG3A, overrides={"body.mu": 0.3, **{
+        k.replace("__", "."): v for k, v in sets.items()}})
+    assert "lifts_off" in sim.summary["status"]
+    assert int(swept["status"].values.ravel()[0]) & STATUS_BIT["lifts_off"]
+    assert "lifts_off" not in rocksweep.simulate(FIG3A, **sets).summary["status"]
