@@ -14,7 +14,7 @@ its far side, handled at the event's state:
 | rest       | uplift on +b, on -b (s Q = M g b), stick break (mu_s N - abs(H) < 0)     |
 | slide      | uplift while sliding on +b, on -b (``slide_uplift_moment``), slip stop   |
 | rock       | impact (theta = 0), overturning, stick break (N <= 0 included)           |
-| slide-rock | impact, overturning, slip stop (x' = 0), Painleve (den = 0: the jam)     |
+| slide-rock | impact, overturning, slip stop (x' = 0), Painleve (den = JAM_DEN M: jam) |
 
 A stick break, an uplift and a slip stop go to ``sliding.choose_phase`` (x' = 0 exactly
 at a stop); an impact to ``sliding.friction_impact`` (the scene's law where the corner

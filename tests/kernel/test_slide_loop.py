@@ -268,7 +268,6 @@ def test_an_uplift_inside_a_step_at_rest_is_found():
     assert s["t_overturn"] == pytest.approx(ref["t_overturn"], abs=0.01)
 
 
-
 # Sliding threshold seeds 58 and 60 (``scripts/threshold_sample.py --mu 0.15 1.5``): a
 # slide-rock whose den = H_a + mu sigma N_a falls through zero inside one step
 PAINLEVE_POINTS = {
