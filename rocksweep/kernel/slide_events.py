@@ -14,7 +14,6 @@ from rocksweep.kernel.equations import tip_moment, uplift_moment, uplift_moment_
 from rocksweep.kernel.events import HERMITE_PAST, NEWTON_XTOL, hermite_min, hermite_root
 from rocksweep.kernel.ground import ground_acc, ground_gravity, ground_jerk
 from rocksweep.kernel.layout import (
-    PAR_MTOT,
     PAR_THETA_OVER,
     PAR_TOL,
     Y_THETA,
@@ -24,8 +23,8 @@ from rocksweep.kernel.layout import (
     Y_X_DOT,
 )
 from rocksweep.kernel.sliding import (
-    JAM_DEN,
     TIP_ROUNDOFF,
+    jam_clearance,
     slide_uplift_moment,
     sliding_derivatives,
     slip_state,
@@ -34,7 +33,7 @@ from rocksweep.kernel.sliding import (
 
 # The event slots of a phase (``_event_values``): 0 and 1 the impact and overturning
 # (rocking) or the uplifts on +b and -b (flat), 2 the stick break (stuck) or the slip stop
-# (slipping), 3 Painleve (slide-rock, den - JAM_DEN M: ``sliding.JAM_DEN``; else never)
+# (slipping), 3 Painleve (slide-rock, ``sliding.jam_clearance``; else never)
 SLOT_FIRST = 0
 SLOT_SECOND = 1
 SLOT_CONTACT = 2
@@ -98,7 +97,7 @@ def _event_values(t, y, s, sigma, on, mu, mu_s, prm, FLEX, DAMPED, GROUND):
         if sigma != 0:
             _, n, den = slip_state(theta, theta_dot, u, u_dot, s, sigma, xg, g, mu, prm,
                                    FLEX, DAMPED)
-            e3 = den - JAM_DEN * prm[PAR_MTOT]
+            e3 = jam_clearance(den, prm)
     else:
         mgb = tip_moment(g, prm)
         if sigma == 0:

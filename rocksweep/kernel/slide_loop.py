@@ -159,11 +159,11 @@ from rocksweep.kernel.slide_events import (
     _rk4,
 )
 from rocksweep.kernel.sliding import (
-    JAM_DEN,
     LIFT_OFF,
     TIP_ROUNDOFF,
     choose_phase,
     friction_impact,
+    jam_clearance,
     jam_impulse,
     phase_code,
     slide_uplift_moment,
@@ -581,7 +581,7 @@ def _slipping(t, y, s, sigma, on, mu, mu_s, prm, out, FLEX, DAMPED, ENERGY, GROU
     if s != 0:
         den = slip_state(y[Y_THETA], y[Y_THETA_DOT], y[Y_U], y[Y_U_DOT], s, sigma, xg, g, mu,
                          prm, FLEX, DAMPED)[2]
-        if not den > JAM_DEN * prm[PAR_MTOT]:
+        if not jam_clearance(den, prm) > 0.0:
             return _jam(t, y, s, on, mu, mu_s, prm, out, FLEX, DAMPED, ENERGY, GROUND)
     _regime(out, s, sigma)
     return y, s, sigma

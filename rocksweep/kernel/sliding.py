@@ -106,6 +106,14 @@ TIP_ROUNDOFF = 1e-12
 JAM_DEN = 1e-3
 
 
+@njit(cache=True, **INLINE)
+def jam_clearance(den, prm):
+    """How far den [kg] (``slip_state``) lies above the jam band, JAM_DEN x M: > 0 where a
+    slip on a corner is consistent (``choose_phase``, ``slide_loop._slipping``); the
+    Painleve slot's event function (``slide_events``)."""
+    return den - JAM_DEN * prm[PAR_MTOT]
+
+
 @njit(cache=True, **INLINE_PUBLIC)
 def phase_code(s, sigma):
     """The phase's code (``vocab.phases``) of corner s (0 flat) and slip direction sigma."""
@@ -325,7 +333,7 @@ def choose_phase(theta, theta_dot, u, u_dot, s, xg, g, mu, mu_s, prm, FLEX, DAMP
         sg = -1 if h > 0.0 else 1
         x_dd, n2, den = slip_state(theta, theta_dot, u, u_dot, s, sg, xg, g, mu, prm,
                                    FLEX, DAMPED)
-        if den > JAM_DEN * prm[PAR_MTOT] and n2 > 0.0:
+        if jam_clearance(den, prm) > 0.0 and n2 > 0.0:
             return s, sg, 0
         return s, 0, JAM
     mgb = tip_moment(g, prm)
@@ -347,7 +355,7 @@ def choose_phase(theta, theta_dot, u, u_dot, s, xg, g, mu, mu_s, prm, FLEX, DAMP
         for sg in (1, -1):
             x_dd, n, den = slip_state(0.0, 0.0, u, u_dot, sc, sg, xg, g, mu, prm, FLEX,
                                       DAMPED)
-            if (den > JAM_DEN * prm[PAR_MTOT] and n > 0.0 and sg * x_dd > 0.0
+            if (jam_clearance(den, prm) > 0.0 and n > 0.0 and sg * x_dd > 0.0
                     and sc * uplift_moment(u, u_dot, xg + x_dd, g, prm, FLEX, DAMPED) >= mgb):
                 return sc, sg, 0
     return tip, 0, JAM
