@@ -320,10 +320,16 @@ def audit_mask(plan: Plan) -> np.ndarray:
     (``seed``); those still filled once refinement has converged are computed. Read-only,
     one per plan (drawing it took ~20 ms at 1000 x 1000 x 3, asked for by every pass of
     the audit)."""
-    if plan.audit <= 0:
-        mask = np.zeros(plan.size, bool)
-    else:
-        mask = np.random.default_rng(plan.seed).random(plan.size) < plan.audit
+    mask = np.zeros(plan.size, bool)
+    if plan.audit > 0:
+        # drawn a block at a time: the same stream as one draw of them all (a double per
+        # draw, in order), without its float64 temporary of 8 bytes a point, whose fresh
+        # pages were most of the ~60 ms this took before an adaptive figure's first chunk
+        rng, block = np.random.default_rng(plan.seed), np.empty(min(plan.size, 1 << 16))
+        for i in range(0, plan.size, block.size):
+            u = block[:min(block.size, plan.size - i)]
+            rng.random(out=u)
+            np.less(u, plan.audit, out=mask[i:i + u.size])
     mask.flags.writeable = False
     return mask
 
@@ -445,7 +451,10 @@ def _windows(plan: Plan, near: np.ndarray) -> list[tuple[int, slice, slice]] | N
     if not plan.strides or near.size == 0:
         return None
     P, ny, nx = plan.panel_shape
-    pos = _panel_position(plan)[np.asarray(near, np.int64)]
+    near = np.asarray(near, np.int64)
+    # (diagram axes last: a flat index is its own position; building the identity map of
+    # 3M points took ~65 ms of the main thread, on the sweep's critical path)
+    pos = near if plan.in_order else _panel_position(plan)[near]
     p, r = np.divmod(pos, ny * nx)
     y, x = np.divmod(r, nx)
     s0, w = 2**plan.coarse, 2 * reach(plan)
@@ -464,12 +473,10 @@ def _windows(plan: Plan, near: np.ndarray) -> list[tuple[int, slice, slice]] | N
 @functools.lru_cache(maxsize=4)
 def _panel_position(plan: Plan) -> np.ndarray:
     """int64[size]: each flat index's position in the panels (p ny nx + y nx + x); the
-    inverse of ``Plan.flat_index``, one per plan, read-only."""
-    if plan.in_order:
-        pos = np.arange(plan.size, dtype=np.int64)
-    else:
-        pos = np.empty(plan.size, np.int64)
-        pos[plan.flat_index().ravel()] = np.arange(plan.size, dtype=np.int64)
+    inverse of ``Plan.flat_index``, one per plan, read-only; for a plan not ``in_order``
+    (in order, each index is its own position)."""
+    pos = np.empty(plan.size, np.int64)
+    pos[plan.flat_index().ravel()] = np.arange(plan.size, dtype=np.int64)
     pos.flags.writeable = False
     return pos
 

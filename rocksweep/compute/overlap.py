@@ -8,8 +8,11 @@ time with the audit candidates, which are known before the sweep starts.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
+import itertools
+import queue
+import threading
+from collections.abc import Callable, Iterator
+from concurrent.futures import FIRST_COMPLETED, Future, wait
 
 import numpy as np
 
@@ -30,6 +33,51 @@ SPARE_MIN = 16
 # figures at 1000 x 1000 x 3 lam, at 8 about half that; the longer last chunk of a batch
 # is what the spare chunks fill.
 BATCH_CHUNKS = 8
+# Spare chunks queued behind the running ones, per worker: a worker that finishes takes
+# one at once, while the main thread plans the next batch (next_step: ~40-110 ms of the
+# four figures at 1000 x 1000 x 3 lam, longer than a spare chunk) or writes. With one
+# spare started only when a worker was free, both workers sat idle 0.6-0.9 s of CPU a
+# figure, between batches. A batch's chunks go ahead of them (``Pool``).
+SPARE_QUEUED = 2
+
+
+class Pool:
+    """Worker threads taking tasks by priority (lower first; in order of submission within
+    one): a batch's chunks go ahead of queued spare chunks, which no worker waits for
+    while a batch's chunk is queued. ``concurrent.futures``' executor has one queue,
+    first in, first out."""
+
+    def __init__(self, workers: int) -> None:
+        self.tasks: queue.PriorityQueue = queue.PriorityQueue()
+        self.order = itertools.count()
+        self.threads = [threading.Thread(target=self._work, daemon=True)
+                        for _ in range(workers)]
+        for t in self.threads:
+            t.start()
+
+    def submit(self, priority: int, fn: Callable, *args: object) -> Future:
+        f: Future = Future()
+        self.tasks.put((priority, next(self.order), f, fn, args))
+        return f
+
+    def _work(self) -> None:
+        while True:
+            _p, _n, f, fn, args = self.tasks.get()
+            if f is None:  # shutdown
+                return
+            if not f.set_running_or_notify_cancel():  # cancelled while queued
+                continue
+            try:
+                f.set_result(fn(*args))
+            except BaseException as err:  # the caller's wait gets it
+                f.set_exception(err)
+
+    def shutdown(self) -> None:
+        """Stop once the running tasks finish (queued ones must be cancelled first)."""
+        for _ in self.threads:  # after every queued task: the largest priority
+            self.tasks.put((2, next(self.order), None, None, ()))
+        for t in self.threads:
+            t.join()
 
 
 def _member(x: np.ndarray, sorted_want: np.ndarray) -> np.ndarray:
@@ -53,9 +101,10 @@ class Runner:
     results wait in memory until a batch asks for their points (``run``), which then gets
     them as if they had just been computed: what the state machine sees, and so the
     result, is unchanged (a point's result depends only on the point). A batch's own
-    chunks go first: a spare chunk is started only while fewer chunks than workers run,
-    and it is short (``SPARE_SECONDS`` at the points' pace so far), so that the next
-    batch, on the sweep's critical path, waits for no long one.
+    chunks go first (``Pool``: a spare chunk waits in the queue behind them, and
+    SPARE_QUEUED of them a worker wait there for a worker to come free), and a spare is
+    short (``SPARE_SECONDS`` at the points' pace so far), so that the next batch, on the
+    sweep's critical path, waits for no long one.
     """
 
     def __init__(self, grid: Grid, plan: Plan, computed: np.ndarray, jobs: int = 2,
@@ -69,17 +118,19 @@ class Runner:
         self.pace = [0.0, 0]  # seconds, points of the chunks so far
         self.ready: list[BatchResult] = []  # spare chunks done, points not asked for yet
         self.running: dict = {}  # future -> (flat, spare?)
-        self.pool = ThreadPoolExecutor(self.workers)
+        self.pool = Pool(self.workers)
 
     def _submit(self, flat: np.ndarray, spare: bool) -> None:
-        self.running[self.pool.submit(self._chunk, flat)] = (flat, spare)
+        self.running[self.pool.submit(int(spare), self._chunk, flat)] = (flat, spare)
 
     def _chunk(self, flat: np.ndarray) -> BatchResult:
         r = sw.run_chunk(Subset(self.grid, flat), 0, flat.size, self.level)
         return BatchResult(flat, r.arrays, r.seconds, r.cpu_seconds, r.refine_evaluations)
 
     def _top_up(self) -> None:
-        while self.spare.size and len(self.running) < self.workers:
+        """Keep SPARE_QUEUED spare chunks a worker queued, beyond the workers themselves
+        (running or waiting chunks of a batch count as busy workers)."""
+        while self.spare.size and len(self.running) < self.workers * (1 + SPARE_QUEUED):
             per_point = self.pace[0] / self.pace[1] if self.pace[1] else 1e-3
             n = max(SPARE_MIN, int(SPARE_SECONDS / max(per_point, 1e-9)))
             n = min(n, self.chunk_size or n)
@@ -149,4 +200,4 @@ class Runner:
         self.spare = self.spare[:0]
         for f in list(self.running):
             f.cancel()
-        self.pool.shutdown(wait=True)
+        self.pool.shutdown()

@@ -120,6 +120,38 @@ def test_spare_workers_compute_the_audit_early_without_changing_anything(block_l
     assert ra.adaptive.batches == rb.adaptive.batches
     assert ra.refine_evaluations == rb.refine_evaluations
 
+def test_a_batch_s_chunks_go_ahead_of_queued_spare_chunks():
+    """``overlap.Pool``: a worker that comes free takes a batch's chunk (priority 0) before
+    the spare chunks (priority 1) queued ahead of it, in submission order within one
+    priority (a first-in, first-out executor would run the spares first, and the next
+    batch, on the sweep's critical path, would wait for them)."""
+    import threading
+
+    from rocksweep.compute.overlap import Pool
+
+    pool, gate, order = Pool(1), threading.Event(), []
+    busy = pool.submit(0, gate.wait)  # holds the only worker while the rest queue
+    spares = [pool.submit(1, order.append, f"spare {i}") for i in range(2)]
+    batch = [pool.submit(0, order.append, f"batch {i}") for i in range(2)]
+    dropped = pool.submit(1, order.append, "cancelled")
+    assert dropped.cancel()
+    gate.set()
+    for f in [busy, *spares, *batch]:
+        f.result(timeout=10)
+    pool.shutdown()
+    assert order == ["batch 0", "batch 1", "spare 0", "spare 1"]
+
+
+def test_the_audit_sample_is_one_draw_of_the_seed_s_stream():
+    """``audit_mask``, drawn a block at a time, is the Bernoulli(audit) sample of one draw
+    of ``size`` doubles from the plan's seed, across block edges (65 536 doubles)."""
+    for shape, audit, seed in (((3, 210, 211), 0.02, 0), ((1, 2, 65537), 0.3, 5),
+                               ((1, 2, 3), 0.5, 1)):
+        plan = ad.Plan(shape, 2, 1, audit=audit, seed=seed)
+        u = np.random.default_rng(seed).random(int(np.prod(shape)))
+        np.testing.assert_array_equal(ad.audit_mask(plan), u < audit)
+
+
 # --- planted maps (synthetic classifier) --------------------------------------------------
 
 def disc_map(shape, cx, cy, r):
