@@ -21,18 +21,20 @@ from rocksweep.compute.adaptive import FILLED, BatchResult, Plan, Subset, audit_
 from rocksweep.scene.grid import Grid
 
 # A spare chunk's length [s] at the pace of the chunks so far: a batch planned meanwhile
-# may wait this long for a worker; at ~50 us a point (the four figures) about 1000 points
-# (shorter chunks cost more of their own Python: ~1 s of CPU more on Figure 3(b) at 1000 x
-# 1000 x 3 lam at 0.02 s)
-SPARE_SECONDS = 0.05
-# ... at least this many points (a chunk's own Python costs ~1 ms)
+# may wait this long for a worker; at ~50 us a point (the four figures) about 2000 points.
+# A chunk's own Python (its rows, the certification's bookkeeping: ~4 ms, most of it the
+# same whatever the chunk's length) and kernel calls are paid per chunk: shorter chunks
+# cost more CPU (~1 s more on Figure 3(b) at 1000 x 1000 x 3 lam at 0.02 s)
+SPARE_SECONDS = 0.1
+# ... at least this many points
 SPARE_MIN = 16
-# A batch's chunks per worker (``sweep.auto_chunk_size``): 8, not a full sweep's 32. A
-# chunk's own Python (its rows, the certification's bookkeeping) costs ~1.5 ms of a
-# worker's CPU, with the GIL held: at 32 a worker, 10-17% of the workers' CPU on the four
-# figures at 1000 x 1000 x 3 lam, at 8 about half that; the longer last chunk of a batch
-# is what the spare chunks fill.
-BATCH_CHUNKS = 8
+# A batch's chunks per worker (``sweep.auto_chunk_size``): 4, not a full sweep's 32. At 32
+# a worker the chunks' own Python was 10-17% of the workers' CPU on the four figures at
+# 1000 x 1000 x 3 lam; at 8 about half that. The longer last chunk of a batch is what the
+# queued spare chunks fill (``Pool``), so 4 a worker and spare chunks of 0.1 s, not 8 and
+# 0.05 s, lost nothing to waiting: the four figures in 20.46 s against 23.87 s (median of
+# 4 alternating rounds in one process, ``Pool`` both ways), their CPU 38.7 s against 45.4 s.
+BATCH_CHUNKS = 4
 # Spare chunks queued behind the running ones, per worker: a worker that finishes takes
 # one at once, while the main thread plans the next batch (next_step: ~40-110 ms of the
 # four figures at 1000 x 1000 x 3 lam, longer than a spare chunk) or writes. With one
