@@ -231,6 +231,10 @@ def main() -> None:
           f"at {args.res} x {args.res} x 3 lam; load average at start: "
           + ", ".join(f"{x:.2f}" for x in os.getloadavg()), flush=True)
     others = list(args.against or [])
+    if args.cli:  # every command imports the package: .pyc files as an install has them
+        from bench_compile import byte_compiled
+
+        byte_compiled(ROOT / "rocksweep", *(Path(o) / "rocksweep" for o in others))
     sides: dict[str, list] = {"this": [], **{o: [] for o in others}}
     for rnd in range(args.rounds):
         # alternate which tree goes first, round by round

@@ -242,6 +242,17 @@ def ab_round(tree: Path | None, repeat: int, tmp: str) -> dict[str, float]:
     return {"compile": comp["cpu"], "us": pp["us"], **starts}
 
 
+def byte_compiled(*packages: Path) -> None:
+    """Write the packages' .pyc files, as ``pip install`` does: with
+    PYTHONDONTWRITEBYTECODE set (this sandbox sets it), a copy made by ``git archive``, or
+    a module changed since its .pyc, is compiled from source by every process that
+    imports it (~0.1-0.3 s of a command), and the side that has fewer .pyc files loses."""
+    import compileall
+
+    for pkg in packages:
+        compileall.compile_dir(str(pkg), quiet=1)
+
+
 def against(other: Path, rounds: int, repeat: int) -> None:
     """Item 5: this copy and ``other`` alternately, ``rounds`` times; medians and ratios."""
     if not (other / "rocksweep" / "__init__.py").is_file():
@@ -249,6 +260,7 @@ def against(other: Path, rounds: int, repeat: int) -> None:
     print(f"\n[5] A/B against {other}: {rounds} rounds alternating, each measurement a "
           "fresh process (load average beside each round)")
     got: dict[str, list[dict[str, float]]] = {"this": [], "other": []}
+    byte_compiled(ROOT / "rocksweep", other / "rocksweep")
     with tempfile.TemporaryDirectory() as tmp:
         for i in range(rounds):
             pair = (("other", other), ("this", None))
