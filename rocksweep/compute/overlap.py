@@ -32,8 +32,11 @@ SPARE_MIN = 16
 # a worker the chunks' own Python was 10-17% of the workers' CPU on the four figures at
 # 1000 x 1000 x 3 lam; at 8 about half that. The longer last chunk of a batch is what the
 # queued spare chunks fill (``Pool``), so 4 a worker and spare chunks of 0.1 s, not 8 and
-# 0.05 s, lost nothing to waiting: the four figures in 20.46 s against 23.87 s (median of
-# 4 alternating rounds in one process, ``Pool`` both ways), their CPU 38.7 s against 45.4 s.
+# 0.05 s: 596 chunks instead of 1003 for the four figures, at the price of longer idle
+# workers in the tail passes once the spares are done; the four figures, settings
+# alternated round by round in one process, in 20.46 s against 23.87 s in memory (median
+# of 4 rounds, ``Pool`` both ways) and 23.72 s against 24.77 s into a file (median of 8,
+# against the executor before ``Pool``): a few per cent, about one run's noise here.
 BATCH_CHUNKS = 4
 # Spare chunks queued behind the running ones, per worker: a worker that finishes takes
 # one at once, while the main thread plans the next batch (next_step: ~40-110 ms of the
