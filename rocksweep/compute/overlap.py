@@ -46,6 +46,10 @@ BATCH_CHUNKS = 4
 SPARE_QUEUED = 2
 
 
+# ``Pool``'s priorities (lower first): a batch's chunks, spare chunks, the workers' stop
+BATCH, SPARE, STOP = 0, 1, 2
+
+
 class Pool:
     """Worker threads taking tasks by priority (lower first; in order of submission within
     one): a batch's chunks go ahead of queued spare chunks, which no worker waits for
@@ -79,8 +83,8 @@ class Pool:
 
     def shutdown(self) -> None:
         """Stop once the running tasks finish (queued ones must be cancelled first)."""
-        for _ in self.threads:  # after every queued task: the largest priority
-            self.tasks.put((2, next(self.order), None, None, ()))
+        for _ in self.threads:  # after every queued task
+            self.tasks.put((STOP, next(self.order), None, None, ()))
         for t in self.threads:
             t.join()
 
@@ -126,7 +130,7 @@ class Runner:
         self.pool = Pool(self.workers)
 
     def _submit(self, flat: np.ndarray, spare: bool) -> None:
-        self.running[self.pool.submit(int(spare), self._chunk, flat)] = (flat, spare)
+        self.running[self.pool.submit(SPARE if spare else BATCH, self._chunk, flat)] = (flat, spare)
 
     def _chunk(self, flat: np.ndarray) -> BatchResult:
         r = sw.run_chunk(Subset(self.grid, flat), 0, flat.size, self.level)

@@ -121,19 +121,19 @@ def test_spare_workers_compute_the_audit_early_without_changing_anything(block_l
     assert ra.refine_evaluations == rb.refine_evaluations
 
 def test_a_batch_s_chunks_go_ahead_of_queued_spare_chunks():
-    """``overlap.Pool``: a worker that comes free takes a batch's chunk (priority 0) before
-    the spare chunks (priority 1) queued ahead of it, in submission order within one
+    """``overlap.Pool``: a worker that comes free takes a batch's chunk (``BATCH``) before
+    the spare chunks (``SPARE``) queued ahead of it, in submission order within one
     priority (a first-in, first-out executor would run the spares first, and the next
     batch, on the sweep's critical path, would wait for them)."""
     import threading
 
-    from rocksweep.compute.overlap import Pool
+    from rocksweep.compute.overlap import BATCH, SPARE, Pool
 
     pool, gate, order = Pool(1), threading.Event(), []
-    busy = pool.submit(0, gate.wait)  # holds the only worker while the rest queue
-    spares = [pool.submit(1, order.append, f"spare {i}") for i in range(2)]
-    batch = [pool.submit(0, order.append, f"batch {i}") for i in range(2)]
-    dropped = pool.submit(1, order.append, "cancelled")
+    busy = pool.submit(BATCH, gate.wait)  # holds the only worker while the rest queue
+    spares = [pool.submit(SPARE, order.append, f"spare {i}") for i in range(2)]
+    batch = [pool.submit(BATCH, order.append, f"batch {i}") for i in range(2)]
+    dropped = pool.submit(SPARE, order.append, "cancelled")
     assert dropped.cancel()
     gate.set()
     for f in [busy, *spares, *batch]:
