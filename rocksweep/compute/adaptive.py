@@ -54,7 +54,7 @@ from __future__ import annotations
 import functools
 import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -339,18 +339,23 @@ def audit_mask(plan: Plan) -> np.ndarray:
 @dataclass(frozen=True)
 class Batch:
     """Points to compute next: flat: int64[n], increasing; kind: "coarse" | "refine" |
-    "audit" | "done" (flat empty); stride: the lattice the points complete (1 for audit)."""
+    "audit" | "done" (flat empty); stride: the lattice the points complete (1 for audit).
+    ahead: while the batch runs, the points (flat, int64[k], increasing) the next batch
+    will want that the results so far already show (``Ahead``, set by ``run_plan``), for a
+    runner to compute early (``compute.overlap.Runner``); None: not known."""
 
     flat: np.ndarray
     kind: str
     stride: int
+    ahead: Callable[[], np.ndarray] | None = field(default=None, compare=False, repr=False)
 
     def __len__(self) -> int:
         return int(self.flat.size)
 
 
 def next_batch(plan: Plan, outcome: np.ndarray, computed: np.ndarray,
-               near: np.ndarray | None = None) -> Batch:
+               near: np.ndarray | None = None,
+               prior: dict[int, np.ndarray] | None = None) -> Batch:
     """The next batch of points to compute, from the state alone (see module docstring).
 
     outcome, computed: int8[size] (or the grid's shape); outcome is read only where
@@ -366,6 +371,9 @@ def next_batch(plan: Plan, outcome: np.ndarray, computed: np.ndarray,
     without a pass over the whole grid for each of the few points a boundary's last
     cells add (Figure 3(b) at 1000 x 1000 x 3 lam: 31 passes, 20 of them of 1-100
     points, at ~60 ms a pass on the sweep's critical path). None: the whole grid.
+    prior: stride -> the points the refinement wanted at an earlier state (``Ahead``)
+    where near holds every point computed since; those not computed yet are still wanted
+    at the same level (the wants only grow), and every other want comes from near.
     """
     done = np.asarray(computed).ravel() > FILLED
     s0 = 2**plan.coarse
@@ -373,17 +381,9 @@ def next_batch(plan: Plan, outcome: np.ndarray, computed: np.ndarray,
     missing = coarse[~done[coarse]]
     if missing.size:
         return Batch(np.sort(missing), "coarse", s0)
-    windows = None if near is None else _windows(plan, near)
-    if windows is None:
-        wanted = _wanted(plan, plan.flat_index(), _known(plan, outcome, computed, done), done)
-    else:
-        wanted = {}
-        for p, ys, xs in windows:
-            known = _known(plan, outcome, computed, window=(p, ys, xs))
-            index = plan.flat_index()[p:p + 1, ys, xs]
-            for s, pts in _wanted(plan, index, known, done).items():
-                wanted.setdefault(s, []).append(pts)
-        wanted = {s: np.concatenate(v) for s, v in wanted.items()}
+    wanted = _wanted_near(plan, outcome, computed, done, near)
+    if prior is not None:
+        wanted = _merged(wanted, prior, done)
     parts = [wanted[s] for s in plan.strides if s in wanted]
     if parts:
         stride = next(s for s in plan.strides if s in wanted) // 2
@@ -392,6 +392,75 @@ def next_batch(plan: Plan, outcome: np.ndarray, computed: np.ndarray,
     if missing.size:
         return Batch(missing.astype(np.int64), "audit", 1)
     return Batch(np.empty(0, np.int64), "done", 0)
+
+
+def _wanted_near(plan: Plan, outcome: np.ndarray, computed: np.ndarray, done: np.ndarray,
+                 near: np.ndarray | None) -> dict[int, np.ndarray]:
+    """``_wanted`` of the whole grid, or of the windows around the points ``near`` (flat,
+    int64[k]; ``_windows``) where they are a small part of it (``next_batch``)."""
+    windows = None if near is None else _windows(plan, near)
+    if windows is None:
+        return _wanted(plan, plan.flat_index(), _known(plan, outcome, computed, done), done)
+    wanted: dict[int, list[np.ndarray]] = {}
+    for p, ys, xs in windows:
+        known = _known(plan, outcome, computed, window=(p, ys, xs))
+        index = plan.flat_index()[p:p + 1, ys, xs]
+        for s, pts in _wanted(plan, index, known, done).items():
+            wanted.setdefault(s, []).append(pts)
+    return {s: np.concatenate(v) for s, v in wanted.items()}
+
+
+def _merged(wanted: dict[int, np.ndarray], prior: dict[int, np.ndarray], done: np.ndarray
+            ) -> dict[int, np.ndarray]:
+    """Stride -> wanted points: ``wanted``'s with ``prior``'s not computed yet (``done``,
+    bool[size]) added, level by level (duplicates are left to the caller's unique)."""
+    out = dict(wanted)
+    for s, pts in prior.items():
+        keep = pts[~done[pts]]
+        if keep.size:
+            out[s] = np.concatenate([out[s], keep]) if s in out else keep
+    return out
+
+
+class Ahead:
+    """While a batch runs: the points (flat, int64[k], increasing) the refinement wants
+    from the state as it stands, some of the batch's results in (``__call__``). All of them
+    belong to the next batch, or to this one (the wants only grow with the computed set,
+    module docstring), so a runner may compute them early (``compute.overlap.Runner``);
+    and the next batch is planned from them (``next_batch``'s ``prior``) and the windows
+    around the points computed since (``late``), not from the whole batch again.
+
+    The first call looks in windows around the whole batch (a point wanted now and not
+    when the batch was planned is wanted because of one of its points); each later one
+    around the points computed since the one before, its wants added.
+    """
+
+    def __init__(self, plan: Plan, outcome: np.ndarray, computed: np.ndarray,
+                 flat: np.ndarray) -> None:
+        self.plan, self.outcome, self.computed = plan, outcome, computed
+        self.late: list[np.ndarray] = [flat]  # computed since the last call (at first: all)
+        self.wanted: dict[int, np.ndarray] | None = None  # at the last call
+
+    def arrived(self, flat: np.ndarray) -> None:
+        """The points ``flat`` (int64[n]) are in the state now."""
+        if self.wanted is not None:
+            self.late.append(flat)
+
+    def __call__(self) -> np.ndarray:
+        done = np.asarray(self.computed).ravel() > FILLED
+        w = _wanted_near(self.plan, self.outcome, self.computed, done,
+                         np.concatenate(self.late))
+        if self.wanted is not None:
+            w = _merged(w, self.wanted, done)
+        self.wanted, self.late = w, []
+        return np.unique(np.concatenate(list(w.values()))) if w else np.empty(0, np.int64)
+
+    def next_hint(self, flat: np.ndarray) -> tuple[np.ndarray, dict[int, np.ndarray] | None]:
+        """(near, prior) for ``next_batch`` once the batch ``flat`` is computed: the points
+        computed since the last call and its wants, or the batch alone if never called."""
+        if self.wanted is None:
+            return flat, None
+        return np.concatenate(self.late) if self.late else np.empty(0, np.int64), self.wanted
 
 
 def _wanted(plan: Plan, index: np.ndarray, known: np.ndarray, done: np.ndarray
@@ -530,19 +599,21 @@ class Step:
 
 
 def next_step(plan: Plan, outcome: np.ndarray, computed: np.ndarray,
-              near: np.ndarray | None = None) -> Step:
+              near: np.ndarray | None = None,
+              prior: dict[int, np.ndarray] | None = None) -> Step:
     """``next_batch``, except that an audit batch, once begun (some point flagged AUDIT or
     AUDIT_MISS while audit candidates are still filled), is finished before refinement
     resumes: the audit is one batch whatever interrupted it, so a resumed sweep computes
     the same points with the same flags as an uninterrupted one. Pure function of the
-    state, like ``next_batch`` (near: see there)."""
+    state, like ``next_batch`` (near, prior: see there; an audit begun is finished in the
+    batch after it began, or at a resume, with no prior)."""
     c = np.asarray(computed).ravel()
     if plan.audit > 0 and np.any(c >= AUDIT):
         missing = np.flatnonzero(audit_mask(plan) & (c == FILLED))
         if missing.size:
             return Step(Batch(missing.astype(np.int64), "audit", 1),
                         audit_before(plan, outcome, c))
-    b = next_batch(plan, outcome, c, near)
+    b = next_batch(plan, outcome, c, near, prior)
     return Step(b, audit_before(plan, outcome, c) if b.kind == "audit" else None)
 
 
@@ -598,9 +669,11 @@ def stats_of(outcome_computed: np.ndarray, threshold: float = DEFAULT_AUDIT_THRE
              ) -> AdaptiveStats:
     """Counts from a ``computed`` flag array alone (what ``rocksweep info`` can print)."""
     c = np.asarray(outcome_computed).ravel()
-    n = np.bincount(c.astype(np.int64), minlength=4)
-    return AdaptiveStats(points=int(c.size), computed=int(n[1:].sum()),
-                         audited=int(n[AUDIT] + n[AUDIT_MISS]), audit_misses=int(n[AUDIT_MISS]),
+    # a count per flag, not a bincount of an int64 copy (~10-50 ms at 3M points, at the
+    # end of an adaptive sweep, its workers idle)
+    n = {f: int(np.count_nonzero(c == f)) for f in (FILLED, AUDIT, AUDIT_MISS)}
+    return AdaptiveStats(points=int(c.size), computed=int(c.size) - n[FILLED],
+                         audited=n[AUDIT] + n[AUDIT_MISS], audit_misses=n[AUDIT_MISS],
                          threshold=threshold)
 
 
@@ -616,21 +689,27 @@ def run_plan(plan: Plan, outcome: np.ndarray, computed: np.ndarray,
     once it is in the state: the sweep driver (``compute.driver.adaptive_loop``) writes
     them to its sink; ``run_on_function`` only counts them.
     """
-    near = None  # the last batch, once every point wanted before it is computed
+    # after a refine or audit batch: the batch (every point wanted before it is computed
+    # now), or what ``Ahead`` saw while it ran (``next_batch``'s near and prior)
+    near, prior = None, None
     while True:
-        step = next_step(plan, outcome, computed, near=near)
+        step = next_step(plan, outcome, computed, near=near, prior=prior)
         b = step.batch
         if b.kind == "done":
             return
-        for res in run(b):
+        # (a coarse batch is planned before refinement has looked)
+        ahead = None if b.kind == "coarse" else Ahead(plan, outcome, computed, b.flat)
+        for res in run(b if ahead is None else replace(b, ahead=ahead)):
             cls = res.arrays["outcome"]
             flags = step.flags(res.flat, cls)
             outcome[res.flat] = cls
             computed[res.flat] = flags
+            if ahead is not None:
+                ahead.arrived(res.flat)
             yield b, res, flags
         # a refine batch is everything refinement wanted; an audit comes once it wants
-        # nothing (a coarse batch is planned before refinement has looked)
-        near = b.flat if b.kind in ("refine", "audit") else None
+        # nothing
+        near, prior = (None, None) if ahead is None else ahead.next_hint(b.flat)
 
 
 def run_on_function(plan: Plan, evaluate: Callable[[np.ndarray, Batch], np.ndarray],
@@ -703,16 +782,18 @@ class Subset:
 
 def run_batch(grid: Grid, flat: np.ndarray, jobs: int = 1, chunk_size: int | None = None,
               backend: str = "threads", scheduler: str | None = None,
-              runner: Any = None) -> Iterator[BatchResult]:
+              runner: Any = None, ahead: Callable[[], np.ndarray] | None = None
+              ) -> Iterator[BatchResult]:
     """Compute the points ``flat`` (int64[n]) through ``rocksweep.compute.sweep.run_chunks``; yield
     each chunk's results as it finishes (any order). Results depend only on the point.
     runner: a sweep's ``compute.overlap.Runner`` (its worker threads, kept busy between
-    batches), which then runs them instead."""
+    batches), which then runs them instead, and computes the points ``ahead`` gives
+    (``Batch.ahead``) early."""
     flat = np.asarray(flat, np.int64)
     if flat.size == 0:
         return
     if runner is not None:
-        yield from runner.run(flat)
+        yield from runner.run(flat, ahead)
         return
     n_workers = sw.effective_jobs(jobs) if backend == "threads" else 1
     size = chunk_size or sw.auto_chunk_size(flat.size, n_workers)

@@ -368,7 +368,7 @@ def adaptive_loop(sf, report: SweepReport, options: Options, *, jobs: int, backe
             # thread, between two batches (Figure 3(b) at 1000 x 1000 x 3 lam: 34
             # batches, 0.7 s); the next batch is planned from the state in memory
             yield from ad.run_batch(sf.grid, b.flat, jobs, chunk_size, backend, scheduler,
-                                    runner)
+                                    runner, b.ahead)
 
         t_write = time.perf_counter()
         try:

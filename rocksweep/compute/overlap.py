@@ -3,7 +3,8 @@
 Each batch of an adaptive sweep (``compute.adaptive``) is planned from the results of the
 one before, so between batches the workers wait: for the last chunks of a batch, then
 while the next one is planned and the finished chunks are written. ``Runner`` fills that
-time with the audit candidates, which are known before the sweep starts.
+time with the points the next batch will want that the results so far already show
+(``Batch.ahead``), and with the audit candidates, which are known before the sweep starts.
 """
 
 from __future__ import annotations
@@ -46,8 +47,14 @@ BATCH_CHUNKS = 4
 SPARE_QUEUED = 2
 
 
-# ``Pool``'s priorities (lower first): a batch's chunks, spare chunks, the workers' stop
-BATCH, SPARE, STOP = 0, 1, 2
+# The next batch's points are asked for (``Runner.run``'s ``ahead``: a planning pass, ~2-40
+# ms of the main thread at 1000 x 1000 x 3) only while this much of the batch's work [s,
+# at the points' pace] is still to come: at its end, the next batch is planned anyway
+AHEAD_SECONDS = 0.02
+
+# ``Pool``'s priorities (lower first): a batch's chunks, the next batch's points computed
+# ahead (``Runner._ahead``), spare chunks (the audit's), the workers' stop
+BATCH, AHEAD, SPARE, STOP = 0, 1, 2, 3
 
 
 class Pool:
@@ -100,20 +107,26 @@ def _member(x: np.ndarray, sorted_want: np.ndarray) -> np.ndarray:
 
 class Runner:
     """The batches of one adaptive sweep on a pool of worker threads, the pool kept busy
-    meanwhile with the audit candidates (``audit_mask``) not computed yet.
+    meanwhile with points computed before a batch asks for them: the next batch's, that the
+    results so far already want (``_ahead``), and the audit candidates (``audit_mask``) not
+    computed yet.
 
-    The audit sample is fixed before the sweep starts, and every candidate is computed by
-    the time the sweep ends (by a refinement, or by the audit batch), so computing them
-    early costs nothing: it fills the time a worker would otherwise wait at the end of a
-    batch while the others finish its last chunks and the next batch is planned (the
-    passes are serial: each batch is planned from the results of the one before). Their
-    results wait in memory until a batch asks for their points (``run``), which then gets
-    them as if they had just been computed: what the state machine sees, and so the
-    result, is unchanged (a point's result depends only on the point). A batch's own
-    chunks go first (``Pool``: a spare chunk waits in the queue behind them, and
-    SPARE_QUEUED of them a worker wait there for a worker to come free), and a spare is
-    short (``SPARE_SECONDS`` at the points' pace so far), so that the next batch, on the
-    sweep's critical path, waits for no long one.
+    Both are computed by the time the sweep ends whatever else is computed: the refinement
+    only ever adds wanted points (``compute.adaptive``'s least fixed point: a point the
+    rules want once some of a batch's results are in is wanted once all are, if not one of
+    that batch), and every audit candidate is computed (by a refinement, or by the audit
+    batch). So computing them early costs nothing: it fills the time a worker would
+    otherwise wait at the end of a batch while the others finish its last chunks and the
+    next batch is planned (the passes are serial: each batch is planned from the results
+    of the one before). Their results wait in memory until a batch asks for their points
+    (``run``), which then gets them as if they had just been computed: what the state
+    machine sees, and so the result, is unchanged (a point's result depends only on the
+    point), and a point computed early and never asked for would only have cost its run.
+    A batch's own chunks go first (``Pool``: the others wait in the queue behind them,
+    the next batch's points before the audit's, and SPARE_QUEUED audit chunks a worker
+    wait there for a worker to come free), and an audit chunk is short (``SPARE_SECONDS``
+    at the points' pace so far), so that the next batch, on the sweep's critical path,
+    waits for no long one.
     """
 
     def __init__(self, grid: Grid, plan: Plan, computed: np.ndarray, jobs: int = 2,
@@ -124,13 +137,16 @@ class Runner:
         # the audit candidates not computed yet, in order (int64[k])
         self.spare = np.flatnonzero(audit_mask(plan)
                                     & (np.asarray(computed).ravel() == FILLED))
+        self.claimed = np.zeros(plan.size, bool)  # points in a chunk of this sweep
         self.pace = [0.0, 0]  # seconds, points of the chunks so far
-        self.ready: list[BatchResult] = []  # spare chunks done, points not asked for yet
-        self.running: dict = {}  # future -> (flat, spare?)
+        self.ready: list[BatchResult] = []  # early chunks done, points not asked for yet
+        self.running: dict = {}  # future -> (flat, priority)
         self.pool = Pool(self.workers)
+        self.ahead_points = 0  # points computed ahead of their batch (``_ahead``)
 
-    def _submit(self, flat: np.ndarray, spare: bool) -> None:
-        self.running[self.pool.submit(SPARE if spare else BATCH, self._chunk, flat)] = (flat, spare)
+    def _submit(self, flat: np.ndarray, priority: int) -> None:
+        self.claimed[flat] = True
+        self.running[self.pool.submit(priority, self._chunk, flat)] = (flat, priority)
 
     def _chunk(self, flat: np.ndarray) -> BatchResult:
         r = sw.run_chunk(Subset(self.grid, flat), 0, flat.size, self.level)
@@ -140,11 +156,31 @@ class Runner:
         """Keep SPARE_QUEUED spare chunks a worker queued, beyond the workers themselves
         (running or waiting chunks of a batch count as busy workers)."""
         while self.spare.size and len(self.running) < self.workers * (1 + SPARE_QUEUED):
-            per_point = self.pace[0] / self.pace[1] if self.pace[1] else 1e-3
-            n = max(SPARE_MIN, int(SPARE_SECONDS / max(per_point, 1e-9)))
+            n = max(SPARE_MIN, int(SPARE_SECONDS / max(self._per_point(), 1e-9)))
             n = min(n, self.chunk_size or n)
-            self._submit(self.spare[:n], True)
+            self._submit(self.spare[:n], SPARE)
             self.spare = self.spare[n:]
+
+    def _per_point(self) -> float:
+        """A point's seconds at the pace of the chunks so far (1 ms before the first)."""
+        return self.pace[0] / self.pace[1] if self.pace[1] else 1e-3
+
+    def _queued(self, below: int) -> bool:
+        """Whether a chunk of priority below ``below`` waits for a worker."""
+        return any(pr < below and not f.running() and not f.done()
+                   for f, (_flat, pr) in self.running.items())
+
+    def _ahead(self, points: np.ndarray) -> None:
+        """Queue the points (flat, int64[k], increasing) the next batch will want, those no
+        chunk holds yet, behind the running batch's chunks (``AHEAD``), cut as a batch's."""
+        pts = points[~self.claimed[points]]
+        if pts.size == 0:
+            return
+        size = self.chunk_size or sw.auto_chunk_size(pts.size, self.workers, BATCH_CHUNKS)
+        for i in range(0, pts.size, size):
+            self._submit(pts[i:i + size], AHEAD)
+        self.spare = self.spare[~self.claimed[self.spare]]  # audit candidates among them
+        self.ahead_points += int(pts.size)
 
     def _take(self, want: np.ndarray, res: BatchResult
               ) -> tuple[BatchResult | None, BatchResult | None]:
@@ -161,9 +197,13 @@ class Runner:
 
         return part(hit, res.seconds, res.cpu_seconds), part(~hit, 0.0, 0.0)
 
-    def run(self, flat: np.ndarray) -> Iterator[BatchResult]:
+    def run(self, flat: np.ndarray, ahead: Callable[[], np.ndarray] | None = None
+            ) -> Iterator[BatchResult]:
         """The results of the points ``flat`` (int64[n], increasing), in chunks, as they
-        are ready (spare results first)."""
+        are ready (those computed early first). ahead: the points (flat, int64[k],
+        increasing) the next batch will want, from the results so far (``Batch.ahead``):
+        asked whenever results came in since it was last asked and no chunk of this batch
+        or of the next waits for a worker."""
         want = np.asarray(flat, np.int64)
         todo = np.ones(want.size, bool)
         kept = []
@@ -175,37 +215,42 @@ class Runner:
                 todo[np.searchsorted(want, got.flat)] = False
                 yield got
         self.ready = kept
-        for part, spare in list(self.running.values()):  # spare chunks on their way
-            if spare:
+        for part, pr in list(self.running.values()):  # early chunks on their way
+            if pr != BATCH:
                 todo[np.searchsorted(want, part[_member(part, want)])] = False
         need = want[todo]
         size = self.chunk_size or sw.auto_chunk_size(need.size, self.workers, BATCH_CHUNKS)
         for i in range(0, need.size, size):
-            self._submit(need[i:i + size], False)
+            self._submit(need[i:i + size], BATCH)
         self.spare = self.spare[~_member(self.spare, want)]
         left = int(todo.sum()) + sum(int(_member(p, want).sum())
-                                      for p, sp in self.running.values() if sp)
+                                      for p, pr in self.running.values() if pr != BATCH)
         self._top_up()
+        fresh = False  # results in since ``ahead`` was last asked
         while left > 0:
             done, _ = wait(list(self.running), return_when=FIRST_COMPLETED)
             for f in done:
-                part, spare = self.running.pop(f)
+                part, pr = self.running.pop(f)
                 res = f.result()
                 self.pace[0] += res.seconds
                 self.pace[1] += res.flat.size
-                if spare:
+                got = res
+                if pr != BATCH:
                     got, rest = self._take(want, res)
                     if rest is not None:
                         self.ready.append(rest)
-                else:
-                    got = res
                 if got is not None:
                     left -= got.flat.size
+                    fresh = True
                     yield got
+            if (ahead is not None and fresh and not self._queued(SPARE)
+                    and left * self._per_point() >= AHEAD_SECONDS):
+                self._ahead(ahead())  # (the state holds the results yielded so far)
+                fresh = False
             self._top_up()
 
     def close(self) -> None:
-        """Stop: spare chunks not started are dropped, running ones finish."""
+        """Stop: early chunks not started are dropped, running ones finish."""
         self.spare = self.spare[:0]
         for f in list(self.running):
             f.cancel()

@@ -95,7 +95,8 @@ def test_same_results_whatever_jobs_and_chunks(block_long):
 
 def test_spare_workers_compute_the_audit_early_without_changing_anything(block_long,
                                                                          monkeypatch):
-    """The worker threads take the audit candidates while batches leave them idle
+    """The worker threads take the audit candidates and the next batch's points that the
+    results so far show (``adaptive.Ahead``) while batches leave them idle
     (``compute.overlap.Runner``): the sweep equals the one that runs each batch alone
     (``run_batch`` without a runner, the dask backend's way), and a point computed early
     is not computed again when its batch asks for it."""
@@ -103,17 +104,24 @@ def test_spare_workers_compute_the_audit_early_without_changing_anything(block_l
     from rocksweep.compute import sweep as sw
 
     sc, _ = block_long
-    runs = []
-    real = sw.run_chunk
+    runs, runners = [], []
+    real, real_runner = sw.run_chunk, ov.Runner
 
     def counted(grid, start, stop, level):
         runs.extend(grid.flat[start:stop].tolist())
         return real(grid, start, stop, level)
 
+    def kept(*args, **kw):
+        runners.append(real_runner(*args, **kw))
+        return runners[-1]
+
     monkeypatch.setattr(sw, "run_chunk", counted)
+    monkeypatch.setattr(ov, "Runner", kept)
+    monkeypatch.setattr(ov, "AHEAD_SECONDS", 0.0)  # look ahead whatever is left
     a, ra = sweep_arrays(sc, jobs=2, chunk_size=5, adaptive=ad.Options())
     assert sorted(runs) == sorted(set(runs))  # every point once
     assert len(runs) == ra.adaptive.computed
+    assert runners[0].ahead_points > 0  # some computed before their batch was planned
     monkeypatch.setattr(ov, "Runner", lambda *args, **kw: None)  # each batch alone
     b, rb = sweep_arrays(sc, jobs=2, chunk_size=5, adaptive=ad.Options())
     assert_same(a, b)
@@ -252,8 +260,8 @@ def test_windowed_planning_equals_the_whole_grid(monkeypatch, coarse, margin, fi
     real = ad.next_batch
     seen = []
 
-    def both(plan, outcome, computed, near=None):
-        b = real(plan, outcome, computed, near)
+    def both(plan, outcome, computed, near=None, prior=None):
+        b = real(plan, outcome, computed, near, prior)
         if near is not None:
             assert ad._windows(plan, near) is not None
             w = real(plan, outcome, computed)
@@ -277,6 +285,64 @@ def test_windowed_planning_equals_the_whole_grid(monkeypatch, coarse, margin, fi
         t = truth.ravel()
         ad.run_on_function(plan, lambda flat, batch, t=t: t[flat])
     assert seen.count("refine") >= 3 and "audit" in seen and "done" in seen
+
+
+@pytest.mark.parametrize("coarse, margin, final_margin", [(4, 1, 0), (3, 2, 1)])
+def test_a_look_ahead_wants_only_next_batch_points_and_plans_it_as_the_whole_grid(
+        monkeypatch, coarse, margin, final_margin):
+    """While a batch runs, ``Ahead`` (asked after some of its results, at random) wants
+    only points of this batch or the next (a runner computes them early, none in vain),
+    and the next batch planned from what it saw (``next_batch``'s near and prior: the
+    windows around the points computed since) equals the one planned over the whole grid,
+    on planted diagrams with specks and a winding boundary."""
+    real = ad.next_batch
+    from_prior = []
+
+    def both(plan, outcome, computed, near=None, prior=None):
+        b = real(plan, outcome, computed, near, prior)
+        w = real(plan, outcome, computed)
+        assert (b.kind, b.stride) == (w.kind, w.stride)
+        np.testing.assert_array_equal(b.flat, w.flat)
+        if prior is not None:
+            from_prior.append(b.kind)
+        return b
+
+    monkeypatch.setattr(ad, "next_batch", both)
+    monkeypatch.setattr(ad, "WINDOWS_SHARE", np.inf)
+    rng = np.random.default_rng(7)
+    shape = (2, 161, 137)
+    y, x = np.mgrid[0:shape[1], 0:shape[2]]
+    wave = np.where(y > 60 + 25 * np.sin(x / 9.0) + 0.1 * x, 1, 0)
+    for truth in (disc_map(shape, 70.3, 41.7, 9.0), np.broadcast_to(wave, shape).copy()):
+        truth = truth.astype(np.int8)
+        specks = rng.integers(0, [shape[0], shape[1], shape[2]], size=(25, 3))
+        truth[specks[:, 0], specks[:, 1], specks[:, 2]] = 2
+        t = truth.ravel()
+        plan = ad.Plan(shape, 2, 1, coarse=coarse, margin=margin,
+                       final_margin=final_margin, audit=0.05, seed=4)
+        looked, flats = [], []  # (batch number, points wanted ahead); each batch's points
+
+        def run(b, t=t, looked=looked, flats=flats):
+            flats.append(b.flat)
+            # in chunks of neighbouring points, as a runner's, in any order
+            parts = np.array_split(b.flat, min(len(b), int(rng.integers(2, 9))))
+            for i in rng.permutation(len(parts)):
+                part = parts[i]
+                yield ad.BatchResult(part, {"outcome": t[part]}, 0.0, 0.0)
+                if b.ahead is not None and rng.random() < 0.7:
+                    looked.append((len(flats) - 1, b.ahead()))
+
+        outcome = np.full(plan.size, -1, np.int8)
+        computed = np.zeros(plan.size, np.int8)
+        for _ in ad.run_plan(plan, outcome, computed, run):
+            pass
+        ref_out, ref_comp, _ = ad.run_on_function(plan, lambda flat, batch, t=t: t[flat])
+        np.testing.assert_array_equal(computed, ref_comp)
+        assert sum(p.size for _, p in looked) > 0
+        for k, pts in looked:  # this batch's or the next one's, never in vain
+            later = np.concatenate(flats[k:k + 2])
+            assert np.isin(pts, later).all()
+    assert from_prior.count("refine") >= 3 and "done" in from_prior
 
 
 def test_interrupted_run_resumes_to_the_same_result():
