@@ -155,8 +155,8 @@ def test_interrupted_in_any_batch_resumes_to_the_same_file(fig3_files, tmp_path,
 
     real_next_step = ad.next_step
 
-    def spy_next_step(plan, outcome, computed, near=None):
-        step = real_next_step(plan, outcome, computed, near)
+    def spy_next_step(plan, outcome, computed, near=None, prior=None):
+        step = real_next_step(plan, outcome, computed, near, prior)
         seen["kind"] = step.batch.kind
         return step
 
