@@ -222,7 +222,7 @@ class Runner:
         size = self.chunk_size or sw.auto_chunk_size(need.size, self.workers, BATCH_CHUNKS)
         for i in range(0, need.size, size):
             self._submit(need[i:i + size], BATCH)
-        self.spare = self.spare[~_member(self.spare, want)]
+        self.spare = self.spare[~self.claimed[self.spare]]  # every point of want is in a chunk
         left = int(todo.sum()) + sum(int(_member(p, want).sum())
                                       for p, pr in self.running.values() if pr != BATCH)
         self._top_up()

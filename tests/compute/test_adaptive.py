@@ -251,35 +251,53 @@ def test_audit_catches_planted_island():
     assert st_clean.audit_misses == 0 and not st_clean.suspicious
 
 
+def planted_with_specks(rng, shape):
+    """Two planted diagrams (int8 panels): a disc and a winding boundary, each with 25
+    one-point specks of class 2 anywhere."""
+    y, x = np.mgrid[0:shape[1], 0:shape[2]]
+    wave = np.where(y > 60 + 25 * np.sin(x / 9.0) + 0.1 * x, 1, 0)  # a winding boundary
+    for truth in (disc_map(shape, 70.3, 41.7, 9.0), np.broadcast_to(wave, shape).copy()):
+        truth = truth.astype(np.int8)
+        specks = rng.integers(0, [shape[0], shape[1], shape[2]], size=(25, 3))
+        truth[specks[:, 0], specks[:, 1], specks[:, 2]] = 2
+        yield truth
+
+
+def check_against_whole_grid(monkeypatch, seen):
+    """Make every ``next_batch`` given a hint (near or prior) also plan over the whole grid
+    and assert both batches equal; seen(batch, near, prior) is told of each. Windows are
+    forced whatever their size."""
+    real = ad.next_batch
+
+    def both(plan, outcome, computed, near=None, prior=None):
+        b = real(plan, outcome, computed, near, prior)
+        if near is not None or prior is not None:
+            w = real(plan, outcome, computed)
+            assert (b.kind, b.stride) == (w.kind, w.stride)
+            np.testing.assert_array_equal(b.flat, w.flat)
+            seen(b, plan, near, prior)
+        return b
+
+    monkeypatch.setattr(ad, "next_batch", both)
+    monkeypatch.setattr(ad, "WINDOWS_SHARE", np.inf)
+
+
 @pytest.mark.parametrize("coarse, margin, final_margin", [(4, 1, 0), (3, 2, 1), (2, 0, 3)])
 def test_windowed_planning_equals_the_whole_grid(monkeypatch, coarse, margin, final_margin):
     """After a refine or audit batch, ``next_batch`` looks only at windows around its
     points (``adaptive._windows``, their size from ``reach``): at every step of a run over
     planted diagrams with specks, islands and winding boundaries, the windowed batch (the
     windows forced whatever their size) equals the one planned over the whole grid."""
-    real = ad.next_batch
     seen = []
 
-    def both(plan, outcome, computed, near=None, prior=None):
-        b = real(plan, outcome, computed, near, prior)
-        if near is not None:
-            assert ad._windows(plan, near) is not None
-            w = real(plan, outcome, computed)
-            assert (b.kind, b.stride) == (w.kind, w.stride)
-            np.testing.assert_array_equal(b.flat, w.flat)
-            seen.append(b.kind)
-        return b
+    def windowed(b, plan, near, prior):
+        assert ad._windows(plan, near) is not None
+        seen.append(b.kind)
 
-    monkeypatch.setattr(ad, "next_batch", both)
-    monkeypatch.setattr(ad, "WINDOWS_SHARE", np.inf)
+    check_against_whole_grid(monkeypatch, windowed)
     rng = np.random.default_rng(11)
     shape = (2, 161, 137)
-    y, x = np.mgrid[0:shape[1], 0:shape[2]]
-    wave = np.where(y > 60 + 25 * np.sin(x / 9.0) + 0.1 * x, 1, 0)  # a winding boundary
-    for truth in (disc_map(shape, 70.3, 41.7, 9.0), np.broadcast_to(wave, shape).copy()):
-        truth = truth.astype(np.int8)
-        specks = rng.integers(0, [shape[0], shape[1], shape[2]], size=(25, 3))
-        truth[specks[:, 0], specks[:, 1], specks[:, 2]] = 2  # one-point specks anywhere
+    for truth in planted_with_specks(rng, shape):
         plan = ad.Plan(shape, 2, 1, coarse=coarse, margin=margin,
                        final_margin=final_margin, audit=0.05, seed=4)
         t = truth.ravel()
@@ -295,28 +313,16 @@ def test_a_look_ahead_wants_only_next_batch_points_and_plans_it_as_the_whole_gri
     and the next batch planned from what it saw (``next_batch``'s near and prior: the
     windows around the points computed since) equals the one planned over the whole grid,
     on planted diagrams with specks and a winding boundary."""
-    real = ad.next_batch
     from_prior = []
 
-    def both(plan, outcome, computed, near=None, prior=None):
-        b = real(plan, outcome, computed, near, prior)
-        w = real(plan, outcome, computed)
-        assert (b.kind, b.stride) == (w.kind, w.stride)
-        np.testing.assert_array_equal(b.flat, w.flat)
+    def planned_from_prior(b, plan, near, prior):
         if prior is not None:
             from_prior.append(b.kind)
-        return b
 
-    monkeypatch.setattr(ad, "next_batch", both)
-    monkeypatch.setattr(ad, "WINDOWS_SHARE", np.inf)
+    check_against_whole_grid(monkeypatch, planned_from_prior)
     rng = np.random.default_rng(7)
     shape = (2, 161, 137)
-    y, x = np.mgrid[0:shape[1], 0:shape[2]]
-    wave = np.where(y > 60 + 25 * np.sin(x / 9.0) + 0.1 * x, 1, 0)
-    for truth in (disc_map(shape, 70.3, 41.7, 9.0), np.broadcast_to(wave, shape).copy()):
-        truth = truth.astype(np.int8)
-        specks = rng.integers(0, [shape[0], shape[1], shape[2]], size=(25, 3))
-        truth[specks[:, 0], specks[:, 1], specks[:, 2]] = 2
+    for truth in planted_with_specks(rng, shape):
         t = truth.ravel()
         plan = ad.Plan(shape, 2, 1, coarse=coarse, margin=margin,
                        final_margin=final_margin, audit=0.05, seed=4)
